@@ -1,0 +1,165 @@
+"""The frozen, versioned, JSON-serializable result of a fit, which applies itself.
+
+A model file is JSON with ``"format": "gyrocomp-calibration"`` and an integer ``schema_version``.
+Loading checks both, upgrades files written with an older schema, and refuses newer ones.
+Nothing is ever unpickled: loading a model file cannot run code.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+from .io.atomic import write_text_atomic
+from .models.temperature import PolynomialBias
+from .recording import Recording
+
+FORMAT_NAME = "gyrocomp-calibration"
+SCHEMA_VERSION = 1
+#: upgrade functions from schema version v to v + 1, applied in turn by ``load``
+UPGRADES: dict[int, Callable[[dict], dict]] = {}
+UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
+
+
+@dataclass(frozen=True)
+class AxisCalibration:
+    """Everything known about one gyro axis.
+
+    Attributes
+    ----------
+    temperature : PolynomialBias or None
+        The bias shape against temperature, or None for no temperature model.
+    turn_on_biases_dps : tuple of float
+        Fitted turn-on constant of each calibration run [deg/s].
+    temperature_column : str
+        The temperature channel the model reads (``temperature`` or ``temperature_x`` ...).
+    """
+
+    temperature: PolynomialBias | None
+    turn_on_biases_dps: tuple[float, ...]
+    temperature_column: str = "temperature"
+
+    @property
+    def mean_turn_on_bias_dps(self) -> float:
+        """The constant subtracted when no turn-on window is given [deg/s]."""
+        return float(np.mean(self.turn_on_biases_dps))
+
+    def shape_dps(self, temperature_degc: np.ndarray | None) -> np.ndarray | float:
+        if self.temperature is None:
+            return 0.0
+        return self.temperature.shape_dps(temperature_degc)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "temperature": None if self.temperature is None else self.temperature.to_dict(),
+            "turn_on_biases_dps": list(self.turn_on_biases_dps),
+            "temperature_column": self.temperature_column,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "AxisCalibration":
+        temp = d.get("temperature")
+        if temp is not None and temp.get("type") != "polynomial":
+            raise InputError(f"unknown temperature model type {temp.get('type')!r}")
+        return cls(
+            temperature=None if temp is None else PolynomialBias.from_dict(temp),
+            turn_on_biases_dps=tuple(float(c) for c in d["turn_on_biases_dps"]),
+            temperature_column=str(d.get("temperature_column", "temperature")),
+        )
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A fitted compensation: per-axis models, units, valid ranges and provenance.
+
+    Create one with :func:`gyrocomp.fit_calibration`; apply it with :func:`gyrocomp.apply`
+    or a :class:`gyrocomp.Compensator`; store it with :meth:`save` / :meth:`load`.
+    """
+
+    axes: dict[str, AxisCalibration]
+    model: str
+    provenance: dict[str, Any] = field(default_factory=dict)
+    fit_report: dict[str, Any] = field(default_factory=dict)
+    schema_version: int = SCHEMA_VERSION
+
+    @property
+    def needs_temperature(self) -> bool:
+        return any(ax.temperature is not None for ax in self.axes.values())
+
+    def predict_error(self, recording: Recording) -> np.ndarray:
+        """Predicted deterministic error (n, k) [deg/s] for the recording's axes (0 where not modelled),
+        using the mean turn-on constant of the calibration runs."""
+        from .compensate import apply
+
+        return recording.gyro_dps - apply(self, recording).gyro_dps
+
+    # -- serialization -------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "format": FORMAT_NAME,
+            "schema_version": self.schema_version,
+            "model": self.model,
+            "units": dict(UNITS),
+            "axes": {name: ax.to_dict() for name, ax in self.axes.items()},
+            "fit_report": self.fit_report,
+            "provenance": self.provenance,
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n"
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write the model file atomically."""
+        write_text_atomic(path, self.to_json())
+
+    @classmethod
+    def from_dict(cls, d: Any, source: str = "<dict>") -> "Calibration":
+        if not isinstance(d, dict) or d.get("format") != FORMAT_NAME:
+            raise InputError(f"{source}: not a gyrocomp model file (no \"format\": \"{FORMAT_NAME}\")")
+        version = d.get("schema_version")
+        if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+            raise InputError(f"{source}: schema_version {version!r} is not a positive whole number")
+        if version > SCHEMA_VERSION:
+            raise InputError(
+                f"{source}: written with model schema {version}, this gyrocomp reads schema {SCHEMA_VERSION} "
+                "and older; upgrade gyrocomp to read it"
+            )
+        while version < SCHEMA_VERSION:
+            d = UPGRADES[version](d)
+            version += 1
+        try:
+            axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
+            if not axes:
+                raise InputError("no axes")
+            return cls(axes=axes, model=str(d["model"]), provenance=dict(d.get("provenance", {})),
+                       fit_report=dict(d.get("fit_report", {})), schema_version=SCHEMA_VERSION)
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise InputError(f"{source}: malformed model file ({type(exc).__name__}: {exc})") from None
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> "Calibration":
+        """Read and validate a model file written by :meth:`save`."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise InputError(f"{path}: no such model file") from None
+        except (UnicodeDecodeError, IsADirectoryError):
+            raise InputError(f"{path}: not a gyrocomp model file (not UTF-8 JSON text)") from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(
+                f"{path}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg}); "
+                "the file may be truncated, write it again with gyrocomp fit"
+            ) from None
+        return cls.from_dict(data, source=str(path))

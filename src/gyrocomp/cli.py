@@ -1,0 +1,298 @@
+"""The ``gyrocomp`` command line: parses options, calls the library, prints tables, maps errors to exit codes.
+
+Exit status: 0 success, 2 bad input or usage, 1 other failures. Errors are one line on stderr;
+``--debug`` adds the traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import traceback
+import warnings
+from pathlib import Path
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+from . import __version__
+from .calibration import Calibration
+from .compensate import apply as apply_calibration
+from .errors import GyrocompError, InputError
+from .io import (
+    TableLayout,
+    detect_format,
+    parse_column_mapping,
+    read_table,
+    refuse_to_overwrite_inputs,
+    write_gyro_back,
+    write_recording,
+    write_text_atomic,
+)
+from .metrics import Evaluation, evaluate_run
+from .models.pipelines import fit_calibration
+from .models.temperature import parse_temperature_option
+
+EXIT_INPUT = 2
+EXIT_FAILURE = 1
+
+
+def _console() -> Console:
+    return Console(width=None if sys.stdout.isatty() else 160, highlight=False, markup=False)
+
+
+def read_options(func):
+    """Options every command that reads data files shares."""
+    options = [
+        click.option("--columns", "columns", metavar="CH=COL,...",
+                     help="Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T."),
+        click.option("--gyro-unit", default="deg/s", show_default=True, help="deg/s, rad/s or mdps."),
+        click.option("--accel-unit", default="g", show_default=True, help="g, mg or m/s2."),
+        click.option("--time-unit", default="s", show_default=True, help="s, ms, us or ns."),
+        click.option("--format", "fmt", default=None, help="Input format (default: from the suffix): csv, parquet."),
+        click.option("--drop-nan", is_flag=True, help="Drop rows with empty/NaN values (says how many) instead of refusing the file."),
+    ]
+    for option in reversed(options):
+        func = option(func)
+    return func
+
+
+def _layout(columns, gyro_unit, accel_unit, time_unit) -> TableLayout:
+    return TableLayout(parse_column_mapping(columns), gyro_unit, accel_unit, time_unit)
+
+
+def _read(path, opts: dict):
+    layout = _layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"])
+    return read_table(path, layout, fmt=detect_format(path, opts["fmt"]), drop_nonfinite=opts["drop_nan"])
+
+
+def _pop_read_options(kwargs: dict) -> dict:
+    return {k: kwargs.pop(k) for k in ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan")}
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="gyrocomp")
+@click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
+@click.option("--quiet", "-q", is_flag=True, help="Print only errors.")
+@click.pass_context
+def cli(ctx, debug, quiet):
+    """Remove temperature-driven drift from MEMS gyro logs, and measure what is left.
+
+    Units: angular rate deg/s, acceleration g, temperature degC, time s.
+    """
+    ctx.obj = {"debug": debug, "quiet": quiet}
+
+
+# -- simulate ---------------------------------------------------------------------------------------
+@cli.command()
+@click.option("--profile", default="chamber", show_default=True, help="chamber, cycle or static.")
+@click.option("--duration", "duration_s", type=float, default=3600.0, show_default=True, help="Run length [s].")
+@click.option("--rate", "rate_hz", type=float, default=100.0, show_default=True, help="Sample rate [Hz].")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--axes", default="x,y,z", show_default=True, help="Gyro axes to simulate, e.g. z or x,y,z.")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output CSV or Parquet.")
+@click.option("--truth", type=click.Path(dir_okay=False), help="Write the parameters used as JSON here.")
+@click.pass_context
+def simulate(ctx, profile, duration_s, rate_hz, seed, axes, output, truth):
+    """Simulate a calibration run of a gyro at rest, with its truth."""
+    from .simulate import GyroErrorModel
+    from .simulate import simulate as run_simulation
+
+    wanted = [a.strip() for a in axes.split(",") if a.strip()]
+    default = GyroErrorModel()
+    names = [f"gyro_{a}" for a in wanted]
+    if not names or any(n not in default.axes for n in names) or len(set(names)) != len(names):
+        raise InputError(f"--axes: {axes!r}; use a comma-separated subset of x, y, z")
+    coefs = tuple(default.temperature_coefficients[default.axes.index(n)] for n in names)
+    model = GyroErrorModel(axes=tuple(names), temperature_coefficients=coefs)
+    detect_format(output)
+    sim = run_simulation(model, profile=profile, duration_s=duration_s, rate_hz=rate_hz, seed=seed,
+                         source=str(output))
+    write_recording(sim.recording, output)
+    if truth:
+        write_text_atomic(truth, json.dumps(sim.truth.to_dict(), indent=2) + "\n")
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}: {sim.recording.n_samples} rows, {sim.recording.duration_s:g} s at {rate_hz:g} Hz")
+
+
+# -- fit --------------------------------------------------------------------------------------------
+@cli.command()
+@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write (JSON).")
+@click.option("--temperature", default="poly", show_default=True,
+              help="poly (order by cross-validation), poly:N (N = 0..5) or none.")
+@click.option("--bin-width", "bin_width_degc", type=float, default=None, help="Temperature bin width [degC] (default: span/100).")
+@read_options
+@click.pass_context
+def fit(ctx, runs, output, temperature, bin_width_degc, **kwargs):
+    """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
+    opts = _pop_read_options(kwargs)
+    order = parse_temperature_option(temperature)
+    refuse_to_overwrite_inputs(output, runs)
+    recordings = [_read(path, opts).recording for path in runs]
+    calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc)
+    calibration.save(output)
+    if not ctx.obj["quiet"]:
+        _print_fit(calibration, output)
+
+
+def _print_fit(calibration: Calibration, output) -> None:
+    console = _console()
+    report = calibration.fit_report
+    table = Table(title=f"gyrocomp fit: {calibration.model}  ->  {output}")
+    for col in ("axis", "model", "range [degC]", "fit RMS [deg/s]", "turn-on biases [deg/s]"):
+        table.add_column(col)
+    for axis, ax in calibration.axes.items():
+        info = report.get("axes", {}).get(axis, {})
+        model = "constant" if ax.temperature is None else f"poly order {ax.temperature.order}"
+        rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
+        rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
+        table.add_row(axis, model, rng, rms, ", ".join(f"{c:+.4g}" for c in ax.turn_on_biases_dps))
+    console.print(table)
+    scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
+    if scores:
+        how = report.get("order_selection")
+        unit = "CV RMS [deg/s]" if how == "leave-one-run-out" else "BIC"
+        st = Table(title=f"order selection by {how} ({unit}; lower is better)")
+        st.add_column("axis")
+        orders = sorted({int(p) for s in scores.values() for p in s})
+        for p in orders:
+            st.add_column(f"order {p}", justify="right")
+        for axis, s in scores.items():
+            chosen = calibration.axes[axis].temperature.order
+            st.add_row(axis, *[(f"{s[str(p)]:.4g}*" if p == chosen else f"{s[str(p)]:.4g}")
+                               if str(p) in s else "-" for p in orders])
+        console.print(st)
+
+
+# -- apply ------------------------------------------------------------------------------------------
+@cli.command()
+@click.argument("model", type=click.Path())
+@click.argument("input_path", metavar="IN", type=click.Path())
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Compensated output file.")
+@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+              help="Estimate the turn-on bias from the first S seconds of IN [s] (default: the model's mean).")
+@read_options
+@click.pass_context
+def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
+    """Compensate IN with MODEL: same columns and rows out, gyro columns compensated."""
+    opts = _pop_read_options(kwargs)
+    refuse_to_overwrite_inputs(output, [input_path, model])
+    calibration = Calibration.load(model)
+    out_fmt = detect_format(output, None) if Path(output).suffix else "csv"
+    data = _read(input_path, opts)
+    compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s)
+    write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}: {data.table.num_rows} rows, {', '.join(data.recording.gyro_axes)} compensated")
+
+
+# -- evaluate ---------------------------------------------------------------------------------------
+@cli.command()
+@click.argument("model", type=click.Path())
+@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.option("--window", "window_s", type=float, default=None,
+              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
+@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+              help="Estimate each run's turn-on bias from its first S seconds [s].")
+@click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
+@read_options
+@click.pass_context
+def evaluate(ctx, model, runs, window_s, turn_on_window_s, as_json, **kwargs):
+    """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL."""
+    opts = _pop_read_options(kwargs)
+    calibration = Calibration.load(model)
+    results = []
+    for path in runs:
+        rec = _read(path, opts).recording
+        comp = apply_calibration(calibration, rec, turn_on_window_s=turn_on_window_s)
+        results.append(evaluate_run(rec, comp, window_s=window_s))
+    evaluation = Evaluation(results)
+    if as_json:
+        click.echo(json.dumps(evaluation.to_dict(), indent=2))
+    else:
+        print_evaluation(evaluation)
+
+
+def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
+    console = _console()
+    table = Table(title=title)
+    for col in ("run", "axis", "window [s]", "offset raw [deg/s]", "offset comp [deg/s]", "improvement",
+                "BI raw [deg/h]", "BI comp [deg/h]", "int. time raw [s]", "int. time comp [s]", "residual RMS [deg/s]"):
+        table.add_column(col, justify="left" if col in ("run", "axis") else "right")
+    for run in evaluation.runs:
+        for axis, m in run.axes.items():
+            table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.bias_offset_raw_dps:.4g}",
+                          f"{m.bias_offset_comp_dps:.4g}", f"{m.offset_improvement:.3g}x",
+                          f"{m.bias_instability_raw_dph:.4g}", f"{m.bias_instability_comp_dph:.4g}",
+                          f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
+                          f"{m.residual_rms_dps:.3g}")
+    console.print(table)
+
+
+# -- demo -------------------------------------------------------------------------------------------
+@cli.command()
+@click.option("-o", "--output", "out_dir", default="gyrocomp-demo", show_default=True,
+              type=click.Path(file_okay=False), help="Folder for the demo's files.")
+@click.pass_context
+def demo(ctx, out_dir):
+    """The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score it."""
+    from .demo import run_demo
+
+    result = run_demo(Path(out_dir))
+    if not ctx.obj["quiet"]:
+        console = _console()
+        console.print(result.summary)
+        print_evaluation(result.evaluation, title="held-out run, raw vs compensated")
+        console.print(f"files in {out_dir}/: " + ", ".join(sorted(p.name for p in Path(out_dir).iterdir())))
+
+
+# -- entry point ------------------------------------------------------------------------------------
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    click.echo(f"gyrocomp: warning: {message}", err=True)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Console entry point: runs the command and returns (and, as a script, exits with) its status."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    debug = "--debug" in args
+    previous = warnings.showwarning
+    warnings.showwarning = _show_warning
+    try:
+        result = cli.main(args=args, prog_name="gyrocomp", standalone_mode=False)
+        status = result if isinstance(result, int) else 0
+    except click.exceptions.Exit as exc:
+        status = exc.exit_code
+    except click.exceptions.Abort:
+        click.echo("gyrocomp: aborted", err=True)
+        status = EXIT_FAILURE
+    except click.ClickException as exc:  # usage errors: bad option, missing argument
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {exc.format_message()}", err=True)
+        status = EXIT_INPUT if isinstance(exc, click.UsageError) else exc.exit_code
+    except InputError as exc:
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {exc}", err=True)
+        status = EXIT_INPUT
+    except GyrocompError as exc:
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {exc}", err=True)
+        status = EXIT_FAILURE
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {exc} (run with --debug for the traceback)",
+                   err=True)
+        status = EXIT_FAILURE
+    finally:
+        warnings.showwarning = previous
+    if argv is None:
+        sys.exit(status)
+    return status
+
+
+__all__ = ["cli", "main"]

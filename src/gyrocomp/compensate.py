@@ -1,0 +1,126 @@
+"""Applying a calibration: one streaming implementation, used for whole recordings too."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from .calibration import Calibration
+from .errors import InputError, TemperatureRangeWarning
+from .models.base import estimate_turn_on_bias
+from .recording import Recording
+
+
+class Compensator:
+    """Streaming compensation: feed chunks with :meth:`update`, then call :meth:`finish`.
+
+    Concatenating every returned block gives exactly what :func:`apply` gives for the
+    whole recording, whatever the chunk sizes.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    gyro_axes : tuple of str
+        Names of the gyro columns in the chunks; axes the model does not know pass through unchanged.
+    turn_on_window_s : float, optional
+        Estimate each axis's turn-on constant as the mean residual over the first
+        ``turn_on_window_s`` seconds [s] (output is held back until that window is complete).
+        Default: subtract the mean turn-on constant of the calibration runs.
+    """
+
+    def __init__(self, calibration: Calibration, gyro_axes: tuple[str, ...], *,
+                 turn_on_window_s: float | None = None, source: str = "<stream>"):
+        if turn_on_window_s is not None and not turn_on_window_s > 0:
+            raise InputError(f"--turn-on-window: must be a positive number of seconds, got {turn_on_window_s}")
+        self.calibration = calibration
+        self.gyro_axes = tuple(gyro_axes)
+        self.turn_on_window_s = turn_on_window_s
+        self.source = source
+        self._modelled = [(j, calibration.axes[a]) for j, a in enumerate(self.gyro_axes) if a in calibration.axes]
+        if not self._modelled:
+            raise InputError(
+                f"{source}: the model covers {', '.join(calibration.axes)}, the data has "
+                f"{', '.join(self.gyro_axes)}; no axis in common"
+            )
+        self._warned = False
+        self._t0: float | None = None
+        self._constants: np.ndarray | None = None
+        if turn_on_window_s is None:
+            self._constants = np.array([ax.mean_turn_on_bias_dps for _, ax in self._modelled])
+        self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
+        self._pending_time: list[np.ndarray] = []
+
+    def _residual(self, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
+        out = np.array(gyro_dps, dtype=float, copy=True)
+        for k, (j, ax) in enumerate(self._modelled):
+            if ax.temperature is None:
+                continue
+            if temperature_degc is None:
+                raise InputError(f"{self.source}: the model needs temperature, the data has none")
+            t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc[:, j]
+            if not self._warned and ax.temperature.outside_range(t):
+                warnings.warn(
+                    f"{self.source}: temperature outside the model's range "
+                    f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
+                    "the model is held at its edge there",
+                    TemperatureRangeWarning, stacklevel=3,
+                )
+                self._warned = True
+            out[:, j] -= ax.temperature.shape_dps(t)
+        return out
+
+    def _subtract_constants(self, residual: np.ndarray) -> np.ndarray:
+        for k, (j, _) in enumerate(self._modelled):
+            residual[:, j] -= self._constants[k]
+        return residual
+
+    def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None = None) -> np.ndarray:
+        """Compensate one chunk: time [s] (m,), gyro [deg/s] (m, k), temperature [degC] (m,) or (m, k).
+
+        Returns the compensated gyro rows [deg/s] that are ready: all of them, except while the
+        turn-on window is still filling (those come out of a later call or :meth:`finish`).
+        """
+        time_s = np.asarray(time_s, dtype=float)
+        gyro_dps = np.asarray(gyro_dps, dtype=float).reshape(time_s.size, len(self.gyro_axes))
+        if temperature_degc is not None:
+            temperature_degc = np.asarray(temperature_degc, dtype=float)
+        residual = self._residual(gyro_dps, temperature_degc)
+        if self._constants is not None:
+            return self._subtract_constants(residual)
+        if self._t0 is None and time_s.size:
+            self._t0 = float(time_s[0])
+        self._pending.append(residual)
+        self._pending_time.append(time_s)
+        if time_s.size and time_s[-1] - self._t0 >= self.turn_on_window_s:
+            return self._release()
+        return np.empty((0, len(self.gyro_axes)))
+
+    def _release(self) -> np.ndarray:
+        residual = np.concatenate(self._pending)
+        time_s = np.concatenate(self._pending_time)
+        self._pending, self._pending_time = [], []
+        self._constants = np.array([
+            estimate_turn_on_bias(residual[:, j], time_s, self.turn_on_window_s) for j, _ in self._modelled
+        ])
+        return self._subtract_constants(residual)
+
+    def finish(self) -> np.ndarray:
+        """Release rows still held back (a stream shorter than the turn-on window)."""
+        if self._constants is not None or not self._pending:
+            return np.empty((0, len(self.gyro_axes)))
+        held_s = float(np.concatenate(self._pending_time)[-1] - self._t0)
+        warnings.warn(
+            f"{self.source}: the data lasts {held_s:.3g} s, shorter than the turn-on window of "
+            f"{self.turn_on_window_s:g} s; the constant was estimated from all of it",
+            UserWarning, stacklevel=2,
+        )
+        return self._release()
+
+
+def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None) -> Recording:
+    """Compensate a whole recording; the result has the same rows, axes and other channels."""
+    comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s, source=recording.source)
+    out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc)
+    rest = comp.finish()
+    return recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)

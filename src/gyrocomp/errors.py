@@ -1,0 +1,29 @@
+"""Typed errors raised by gyrocomp.
+
+Library code raises these with messages that name the file, row, column or option at fault
+and say what to do; only :mod:`gyrocomp.cli` turns them into one line on stderr and an exit status.
+"""
+
+
+class GyrocompError(Exception):
+    """Base class of every error gyrocomp raises on purpose."""
+
+
+class InputError(GyrocompError, ValueError):
+    """Bad data, a bad file or a bad option value (CLI exit status 2)."""
+
+
+class ModelError(GyrocompError):
+    """A model could not be fitted, loaded or applied (CLI exit status 1)."""
+
+
+class NotFittedError(ModelError, AttributeError):
+    """An estimator was used before ``fit`` was called."""
+
+
+class TemperatureRangeWarning(UserWarning):
+    """Data lies outside the temperature range a model was fitted on; the model was clamped to its edge."""
+
+
+class DataQualityWarning(UserWarning):
+    """Data was accepted but something about it deserves attention (rows dropped, gaps found)."""

@@ -1,0 +1,300 @@
+"""CSV and Parquet tables: the default layout, column mappings, unit conversion, write-back."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from ..errors import DataQualityWarning, InputError
+from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
+from ..units import unit_factor
+from .atomic import atomic_path
+
+TIME_COLUMN = "time"
+PER_AXIS_TEMPERATURES = tuple(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES)
+CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *PER_AXIS_TEMPERATURES)
+
+
+@dataclass(frozen=True)
+class TableLayout:
+    """How a table's columns map to gyrocomp's channels, and the units they are in.
+
+    Parameters
+    ----------
+    columns : dict
+        Canonical channel name (``time``, ``gyro_z``, ``temperature`` ...) to the file's column name.
+        Channels not named here are looked up under their canonical name.
+    gyro_unit, accel_unit, time_unit : str
+        Units of the file's columns, e.g. ``"rad/s"``, ``"m/s2"``, ``"ms"``.
+    """
+
+    columns: dict[str, str] = field(default_factory=dict)
+    gyro_unit: str = "deg/s"
+    accel_unit: str = "g"
+    time_unit: str = "s"
+
+    def __post_init__(self) -> None:
+        for canonical in self.columns:
+            if canonical not in CANONICAL_COLUMNS:
+                raise InputError(
+                    f"--columns: unknown channel {canonical!r}; use any of {', '.join(CANONICAL_COLUMNS)}"
+                )
+        unit_factor("gyro", self.gyro_unit, "--gyro-unit")
+        unit_factor("accel", self.accel_unit, "--accel-unit")
+        unit_factor("time", self.time_unit, "--time-unit")
+
+    def resolve(self, header: list[str], source: str) -> dict[str, str]:
+        """Canonical name to file column for every channel present in ``header``."""
+        resolved = {name: name for name in CANONICAL_COLUMNS if name in header}
+        for canonical, column in self.columns.items():
+            if column not in header:
+                raise InputError(
+                    f"{source}: --columns {canonical}={column}: no column {column!r}; "
+                    f"the file has {', '.join(header)}"
+                )
+            resolved[canonical] = column
+        return resolved
+
+
+def parse_column_mapping(text: str | None) -> dict[str, str]:
+    """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``."""
+    if not text:
+        return {}
+    mapping = {}
+    for item in text.split(","):
+        if not item.strip():
+            continue
+        if "=" not in item:
+            raise InputError(f"--columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
+        key, value = (part.strip() for part in item.split("=", 1))
+        if not key or not value:
+            raise InputError(f"--columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
+        mapping[key] = value
+    return mapping
+
+
+@dataclass(frozen=True, eq=False)
+class TableData:
+    """A table as read, with the recording built from it and what is needed to write results back."""
+
+    recording: Recording
+    table: pa.Table
+    layout: TableLayout
+    resolved_columns: dict[str, str]
+    kept_rows: np.ndarray  # 0-based indices of table rows that are in the recording
+    path: Path
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes, hex."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _read_arrow(path: Path, fmt: str) -> pa.Table:
+    if not path.exists():
+        raise InputError(f"{path}: no such file")
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder, not a file")
+    if fmt == "csv":
+        if path.stat().st_size == 0 or not path.read_bytes()[:4096].strip():
+            raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
+        try:
+            return pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(strings_can_be_null=True))
+        except pa.ArrowInvalid as exc:
+            raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
+    try:
+        return pq.read_table(path)
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise InputError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
+
+
+def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
+    array = table.column(column)
+    if pa.types.is_floating(array.type) or pa.types.is_integer(array.type):
+        return array.to_numpy(zero_copy_only=False).astype(float, copy=False)
+    if pa.types.is_null(array.type):
+        return np.full(len(array), np.nan)
+    if pa.types.is_boolean(array.type) or pa.types.is_timestamp(array.type):
+        raise InputError(f"{source}: column {column!r} has type {array.type}; expected numbers")
+    values = array.to_pylist()
+    out = np.empty(len(values))
+    for i, value in enumerate(values):
+        if value is None:
+            out[i] = np.nan
+            continue
+        try:
+            out[i] = float(value)
+        except (TypeError, ValueError):
+            raise InputError(
+                f"{source}: row {i + 1} (line {i + 2}), column {column!r}: {value!r} is not a number"
+            ) from None
+    return out
+
+
+def detect_table_format(path: Path) -> str | None:
+    suffix = path.suffix.lower()
+    if suffix in (".csv", ".txt"):
+        return "csv"
+    if suffix in (".parquet", ".pq"):
+        return "parquet"
+    return None
+
+
+def read_table(
+    path: str | os.PathLike,
+    layout: TableLayout | None = None,
+    *,
+    fmt: str | None = None,
+    drop_nonfinite: bool = False,
+) -> TableData:
+    """Read a CSV or Parquet table into a :class:`Recording`, keeping the table for write-back.
+
+    Parameters
+    ----------
+    path : path
+        The file. Default layout: ``time,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z,temperature``
+        in [s], [deg/s], [g], [degC]; any subset of gyro axes, accelerometer optional,
+        ``temperature_x/_y/_z`` for one temperature per axis.
+    layout : TableLayout, optional
+        Column mapping and units for other layouts.
+    fmt : {"csv", "parquet"}, optional
+        Format; detected from the suffix when not given.
+    drop_nonfinite : bool
+        Drop rows where a used channel is empty, NaN or infinite (a :class:`DataQualityWarning`
+        says how many) instead of refusing the file.
+    """
+    layout = layout or TableLayout()
+    path = Path(path)
+    fmt = fmt or detect_table_format(path) or "csv"
+    table = _read_arrow(path, fmt)
+    if table.num_rows == 0:
+        raise InputError(f"{path}: a header but no data rows")
+    header = table.column_names
+    cols = layout.resolve(header, str(path))
+    if TIME_COLUMN not in cols:
+        raise InputError(
+            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with --columns time=NAME"
+        )
+    gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
+    if not gyro_axes:
+        raise InputError(
+            f"{path}: no gyro column (expected gyro_x, gyro_y or gyro_z; the file has {', '.join(header)}); "
+            "map one with --columns gyro_z=NAME"
+        )
+    accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
+    per_axis_temps = [f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in gyro_axes]
+    if all(t in cols for t in per_axis_temps) and TEMPERATURE_COLUMN not in cols:
+        temp_names = per_axis_temps
+    elif TEMPERATURE_COLUMN in cols:
+        temp_names = [TEMPERATURE_COLUMN]
+    else:
+        temp_names = []
+
+    gyro_factor = unit_factor("gyro", layout.gyro_unit, "--gyro-unit")
+    accel_factor = unit_factor("accel", layout.accel_unit, "--accel-unit")
+    time_factor = unit_factor("time", layout.time_unit, "--time-unit")
+    num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
+    time_s = num(TIME_COLUMN) * time_factor
+    gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor
+    temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
+    accel = np.column_stack([num(a) for a in accel_axes]) * accel_factor if accel_axes else None
+
+    n = table.num_rows
+    kept = np.arange(n)
+    if drop_nonfinite:
+        ok = np.isfinite(time_s) & np.isfinite(gyro).all(axis=1)
+        if temp is not None:
+            ok &= np.isfinite(temp).all(axis=1)
+        if accel is not None:
+            ok &= np.isfinite(accel).all(axis=1)
+        if not ok.all():
+            kept = np.flatnonzero(ok)
+            warnings.warn(
+                f"{path}: dropped {n - kept.size} of {n} rows with empty, NaN or infinite values",
+                DataQualityWarning,
+                stacklevel=2,
+            )
+            time_s, gyro = time_s[kept], gyro[kept]
+            temp = None if temp is None else temp[kept]
+            accel = None if accel is None else accel[kept]
+    recording = Recording(
+        time_s=time_s,
+        gyro_dps=gyro,
+        gyro_axes=gyro_axes,
+        temperature_degc=temp,
+        accel_g=accel,
+        accel_axes=accel_axes,
+        source=str(path),
+        row_numbers=kept + 1,
+        metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)},
+    )
+    return TableData(recording, table, layout, cols, kept, path)
+
+
+def _write_arrow(table: pa.Table, path: Path, fmt: str) -> None:
+    with atomic_path(path) as tmp:
+        if fmt == "parquet":
+            pq.write_table(table, tmp)
+        else:
+            pacsv.write_csv(table, tmp)
+
+
+def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLike, *, fmt: str | None = None) -> None:
+    """Write the table as read with its gyro columns replaced by ``gyro_dps`` [deg/s].
+
+    Values are converted back to the file's gyro unit; rows dropped on reading get NaN;
+    every other column, the column order and the row count are unchanged. Written atomically.
+    """
+    path = Path(path)
+    fmt = fmt or detect_table_format(path) or "csv"
+    factor = unit_factor("gyro", data.layout.gyro_unit)
+    table = data.table
+    n = table.num_rows
+    for j, axis in enumerate(data.recording.gyro_axes):
+        column = data.resolved_columns[axis]
+        values = np.full(n, np.nan)
+        values[data.kept_rows] = gyro_dps[:, j] / factor
+        table = table.set_column(table.column_names.index(column), column, pa.array(values, type=pa.float64()))
+    _write_arrow(table, path, fmt)
+
+
+def write_recording(recording: Recording, path: str | os.PathLike, *, fmt: str | None = None,
+                    extra_columns: dict[str, np.ndarray] | None = None) -> None:
+    """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically."""
+    path = Path(path)
+    fmt = fmt or detect_table_format(path) or "csv"
+    columns: dict[str, np.ndarray] = {TIME_COLUMN: recording.time_s}
+    for j, axis in enumerate(recording.gyro_axes):
+        columns[axis] = recording.gyro_dps[:, j]
+    for j, axis in enumerate(recording.accel_axes):
+        columns[axis] = recording.accel_g[:, j]
+    if recording.temperature_degc is not None:
+        temps = recording.temperature_degc.reshape(recording.n_samples, -1)
+        for j, name in enumerate(recording.temperature_columns):
+            columns[name] = temps[:, j]
+    for name, values in (extra_columns or {}).items():
+        columns[name] = np.asarray(values, dtype=float)
+    _write_arrow(pa.table(columns), path, fmt)
+
+
+__all__ = [
+    "TableLayout",
+    "TableData",
+    "parse_column_mapping",
+    "read_table",
+    "write_gyro_back",
+    "write_recording",
+    "file_sha256",
+]

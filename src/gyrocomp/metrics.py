@@ -1,0 +1,159 @@
+"""The reference thesis's figures of merit for a compensation.
+
+- *bias offset*: peak-to-peak of the moving average of the gyro output over a run [deg/s];
+- *bias instability*: minimum of the overlapping Allan deviation divided by 0.664 [deg/h]
+  (IEEE Std 952-1997, C.1: sigma_min = sqrt(2 ln 2 / pi) B), and the tau at that minimum,
+  the *integration time* [s];
+- *residual RMS*: RMS of the moving-averaged compensated output about its mean [deg/s].
+
+M. Ali, *Correction of temperature and acceleration effects on MEMS gyro output signals*,
+MS thesis, METU, 2014, sections 2.5.1 and 4.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .allan import allan_deviation
+from .errors import DataQualityWarning, InputError
+from .recording import Recording
+from .units import DEG_PER_S_TO_DEG_PER_H
+
+BIAS_INSTABILITY_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)  # 0.6643
+MIN_WINDOW_S = 1.0
+
+
+def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
+    """Moving average over ``window_samples`` samples, only where the window is full (n - w + 1 values)."""
+    x = np.asarray(x, dtype=float)
+    w = int(window_samples)
+    if w < 1:
+        raise InputError(f"window: must be at least one sample, got {w}")
+    if w > x.size:
+        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
+    c = np.concatenate([[0.0], np.cumsum(x - x[0])])
+    return (c[w:] - c[:-w]) / w + x[0]
+
+
+def bias_offset(x: np.ndarray, window_samples: int) -> float:
+    """Peak-to-peak of the moving average [unit of x]."""
+    return float(np.ptp(moving_average(x, window_samples)))
+
+
+@dataclass(frozen=True)
+class BiasInstability:
+    """Bias instability [deg/h] and the averaging time at the Allan minimum [s]."""
+
+    bias_instability_deg_per_h: float
+    integration_time_s: float
+
+
+def bias_instability(rate_dps: np.ndarray, rate_hz: float) -> BiasInstability:
+    """Bias instability from the minimum of the octave overlapping Allan deviation of rate data [deg/s]."""
+    tau, dev = allan_deviation(rate_dps, rate_hz, taus="octave").minimum()
+    return BiasInstability(dev / BIAS_INSTABILITY_FACTOR * DEG_PER_S_TO_DEG_PER_H, tau)
+
+
+def default_window_s(recording: Recording) -> float:
+    """The moving-average window the thesis uses: tau at the raw data's Allan minimum, at least 1 s.
+
+    With several axes, the longest of their Allan-minimum taus.
+    """
+    taus = [bias_instability(recording.gyro_dps[:, j], recording.rate_hz).integration_time_s
+            for j in range(len(recording.gyro_axes))]
+    return max(MIN_WINDOW_S, max(taus))
+
+
+@dataclass(frozen=True)
+class AxisMetrics:
+    """Raw and compensated figures of one gyro axis over one run."""
+
+    bias_offset_raw_dps: float
+    bias_offset_comp_dps: float
+    offset_improvement: float
+    bias_instability_raw_dph: float
+    bias_instability_comp_dph: float
+    integration_time_raw_s: float
+    integration_time_comp_s: float
+    residual_rms_dps: float
+
+
+@dataclass(frozen=True)
+class RunEvaluation:
+    """Figures of one run, per gyro axis, computed with one moving-average window."""
+
+    file: str
+    window_s: float
+    axes: dict[str, AxisMetrics]
+
+    def to_dict(self) -> dict:
+        return {"file": self.file, "window_s": self.window_s,
+                "axes": {name: asdict(m) for name, m in self.axes.items()}}
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Figures of several runs; ``to_dict`` gives the JSON shape ``gyrocomp evaluate --json`` prints."""
+
+    runs: list[RunEvaluation]
+
+    def to_dict(self) -> dict:
+        return {"runs": [run.to_dict() for run in self.runs]}
+
+
+def window_samples(window_s: float, rate_hz: float, n_samples: int) -> int:
+    """Number of samples in a window of ``window_s`` seconds, checked against the data length."""
+    if not window_s > 0:
+        raise InputError(f"--window: must be positive, got {window_s}")
+    w = max(1, int(round(window_s * rate_hz)))
+    if w > n_samples:
+        raise InputError(
+            f"--window: {window_s} s is longer than the run ({n_samples / rate_hz:.6g} s); choose a shorter window"
+        )
+    return w
+
+
+def smoothed_residual_rms(x: np.ndarray, window_samples: int) -> float:
+    """RMS about its mean of the moving-averaged series [unit of x]."""
+    smooth = moving_average(x, window_samples)
+    return float(np.sqrt(np.mean((smooth - smooth.mean()) ** 2)))
+
+
+def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None) -> RunEvaluation:
+    """Compare one run before and after compensation, axis by axis.
+
+    Parameters
+    ----------
+    raw, compensated : Recording
+        The same run before and after compensation (same rows and axes).
+    window_s : float, optional
+        Moving-average window [s]; default :func:`default_window_s` of the raw run.
+    """
+    if raw.gaps:
+        warnings.warn(
+            f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation treats the samples as contiguous",
+            DataQualityWarning, stacklevel=2,
+        )
+    if window_s is None:
+        window_s = default_window_s(raw)
+    w = window_samples(window_s, raw.rate_hz, raw.n_samples)
+    axes = {}
+    for j, axis in enumerate(raw.gyro_axes):
+        r, c = raw.gyro_dps[:, j], compensated.gyro_dps[:, j]
+        off_raw, off_comp = bias_offset(r, w), bias_offset(c, w)
+        bi_raw, bi_comp = bias_instability(r, raw.rate_hz), bias_instability(c, raw.rate_hz)
+        axes[axis] = AxisMetrics(
+            bias_offset_raw_dps=off_raw,
+            bias_offset_comp_dps=off_comp,
+            offset_improvement=off_raw / off_comp if off_comp > 0 else math.inf,
+            bias_instability_raw_dph=bi_raw.bias_instability_deg_per_h,
+            bias_instability_comp_dph=bi_comp.bias_instability_deg_per_h,
+            integration_time_raw_s=bi_raw.integration_time_s,
+            integration_time_comp_s=bi_comp.integration_time_s,
+            residual_rms_dps=smoothed_residual_rms(c, w),
+        )
+    return RunEvaluation(file=raw.source, window_s=float(window_s), axes=axes)

@@ -1,0 +1,254 @@
+"""Temperature models of the gyro bias.
+
+The polynomial model (thesis section 2.5.2) writes the bias of one axis in run r as
+
+    b_r(T) = c_r + sum_{k=1}^{p} a_k u^k,    u = (clip(T, T_min, T_max) - T_ref) / T_scale
+
+with one turn-on constant c_r per run (each power-on has its own) and the shape a_1..a_p
+shared by all runs. T is centred and scaled for conditioning. Samples are averaged in
+temperature bins before the least-squares fit so that every temperature interval counts
+equally, whatever the heating rate.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError, ModelError, NotFittedError
+from ..recording import Recording
+from .base import TemperatureBins, bin_by_temperature, bin_width_for
+
+MAX_ORDER = 5
+#: with automatic order, the lowest order whose CV score is within this factor of the best wins
+PARSIMONY_TOLERANCE = 1.01
+
+
+@dataclass(frozen=True)
+class PolynomialBias:
+    """Fitted temperature shape of one axis's bias, without its turn-on constant.
+
+    bias(T) = sum_k coefficients_dps[k-1] * u^k,  u = (clip(T, t_min_degc, t_max_degc) - t_ref_degc) / t_scale_degc
+    """
+
+    coefficients_dps: tuple[float, ...]
+    t_ref_degc: float
+    t_scale_degc: float
+    t_min_degc: float
+    t_max_degc: float
+
+    @property
+    def order(self) -> int:
+        return len(self.coefficients_dps)
+
+    def outside_range(self, temperature_degc: np.ndarray) -> bool:
+        t = np.asarray(temperature_degc)
+        return bool(np.any(t < self.t_min_degc) or np.any(t > self.t_max_degc))
+
+    def shape_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
+        """Bias shape [deg/s] at ``temperature_degc`` [degC], clamped to the valid range."""
+        u = (np.clip(temperature_degc, self.t_min_degc, self.t_max_degc) - self.t_ref_degc) / self.t_scale_degc
+        out = np.zeros_like(u, dtype=float)
+        for a in reversed(self.coefficients_dps):  # Horner, no constant term
+            out = (out + a) * u
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "type": "polynomial",
+            "coefficients_dps": list(self.coefficients_dps),
+            "t_ref_degc": self.t_ref_degc,
+            "t_scale_degc": self.t_scale_degc,
+            "t_min_degc": self.t_min_degc,
+            "t_max_degc": self.t_max_degc,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "PolynomialBias":
+        return cls(tuple(float(c) for c in d["coefficients_dps"]), float(d["t_ref_degc"]),
+                   float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]))
+
+
+def parse_temperature_option(text: str) -> int | str | None:
+    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"none"`` -> None; anything else is an InputError."""
+    text = text.strip().lower()
+    if text in ("poly", "auto"):
+        return "auto"
+    if text == "none":
+        return None
+    if text.startswith("poly:"):
+        try:
+            order = int(text[5:])
+        except ValueError:
+            order = -1
+        if 0 <= order <= MAX_ORDER:
+            return order
+        raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
+    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}) or none")
+
+
+@dataclass(frozen=True)
+class _Design:
+    bins: TemperatureBins
+    n_runs: int
+    t_ref: float
+    t_scale: float
+    t_min: float
+    t_max: float
+
+    def powers(self, temperature: np.ndarray, order: int, t_min=None, t_max=None) -> np.ndarray:
+        lo = self.t_min if t_min is None else t_min
+        hi = self.t_max if t_max is None else t_max
+        u = (np.clip(temperature, lo, hi) - self.t_ref) / self.t_scale
+        return u[:, None] ** np.arange(1, order + 1)
+
+
+def _solve(design: _Design, order: int, runs: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """Weighted least squares of the bins of ``runs``: (shape coefficients, run constants, weighted RSS)."""
+    b = design.bins
+    sel = np.isin(b.run, runs)
+    t, y, w, r = b.temperature_degc[sel], b.value[sel], b.weight[sel], b.run[sel]
+    run_index = np.searchsorted(runs, r)
+    onehot = np.zeros((t.size, runs.size))
+    onehot[np.arange(t.size), run_index] = 1.0
+    x = np.hstack([onehot, design.powers(t, order, t.min(), t.max())])
+    sw = np.sqrt(w)
+    coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
+    resid = y - x @ coef
+    return coef[runs.size:], coef[:runs.size], float(np.sum(w * resid**2))
+
+
+def _leave_one_run_out(design: _Design, order: int) -> float:
+    """RMS error [deg/s] of bins of each run predicted by a fit on the other runs (constant refitted)."""
+    b = design.bins
+    sse = wsum = 0.0
+    all_runs = np.arange(design.n_runs)
+    for held in all_runs:
+        train = all_runs[all_runs != held]
+        tr = np.isin(b.run, train)
+        shape, _, _ = _solve(design, order, train)
+        sel = b.run == held
+        t, y, w = b.temperature_degc[sel], b.value[sel], b.weight[sel]
+        lo, hi = b.temperature_degc[tr].min(), b.temperature_degc[tr].max()
+        pred = design.powers(t, order, lo, hi) @ shape if order else np.zeros_like(y)
+        e = y - pred
+        e -= np.sum(w * e) / np.sum(w)
+        sse += float(np.sum(w * e**2))
+        wsum += float(np.sum(w))
+    return math.sqrt(sse / wsum)
+
+
+def _bic(design: _Design, order: int) -> float:
+    _, _, rss = _solve(design, order, np.arange(design.n_runs))
+    n = float(np.sum(design.bins.weight))
+    k = order + design.n_runs
+    return n * math.log(max(rss, 1e-300) / n) + k * math.log(n)
+
+
+@dataclass
+class PolynomialTemperatureModel:
+    """Polynomial temperature model, fitted per gyro axis on one or many runs jointly.
+
+    Parameters
+    ----------
+    order : int or "auto"
+        Polynomial order (0..5), or ``"auto"``: chosen by leave-one-run-out cross-validation
+        with two runs or more, by the Bayesian information criterion with one.
+    max_order : int
+        Highest order tried by ``"auto"``.
+    bin_width_degc : float, optional
+        Temperature bin width [degC]; default: the temperature span / 100.
+
+    Attributes (after ``fit``)
+    --------------------------
+    curves_ : dict[str, PolynomialBias]
+        The fitted shape of each axis.
+    turn_on_biases_dps_ : dict[str, np.ndarray]
+        The fitted constant of each run [deg/s], per axis.
+    scores_ : dict[str, dict[int, float]]
+        Per axis, the selection score of each order tried (CV RMS [deg/s], or BIC).
+    selection_ : str
+        ``"fixed"``, ``"leave-one-run-out"`` or ``"bic"``.
+    fit_rms_dps_ : dict[str, float]
+        Weighted RMS of the bin residuals of the final fit [deg/s].
+    """
+
+    order: int | str = "auto"
+    max_order: int = MAX_ORDER
+    bin_width_degc: float | None = None
+    _fitted: bool = field(default=False, init=False, repr=False)
+
+    def fit(self, recordings: list[Recording]) -> "PolynomialTemperatureModel":
+        """Fit on ``recordings`` (each one power-on) and return self."""
+        if isinstance(recordings, Recording):
+            recordings = [recordings]
+        if not recordings:
+            raise InputError("fit: no recordings given")
+        if self.order != "auto" and not (isinstance(self.order, int) and 0 <= self.order <= MAX_ORDER):
+            raise InputError(f"order: {self.order!r}; use 'auto' or a whole number from 0 to {MAX_ORDER}")
+        axes = recordings[0].gyro_axes
+        for rec in recordings[1:]:
+            if rec.gyro_axes != axes:
+                raise InputError(
+                    f"{rec.source}: gyro axes {', '.join(rec.gyro_axes)} differ from "
+                    f"{recordings[0].source}'s ({', '.join(axes)}); fit runs of the same sensor together"
+                )
+        self.curves_, self.turn_on_biases_dps_, self.scores_, self.fit_rms_dps_ = {}, {}, {}, {}
+        for axis in axes:
+            temps = [rec.temperature_for(axis) for rec in recordings]
+            values = [rec.gyro(axis) for rec in recordings]
+            width = bin_width_for(temps, self.bin_width_degc)
+            bins = bin_by_temperature(temps, values, width)
+            t_min = min(float(t.min()) for t in temps)
+            t_max = max(float(t.max()) for t in temps)
+            span = t_max - t_min
+            design = _Design(bins, len(recordings), (t_min + t_max) / 2, span / 2 if span > 0 else 1.0, t_min, t_max)
+            distinct = np.unique(bins.temperature_degc).size
+            order = self._choose_order(axis, design, distinct)
+            shape, consts, rss = _solve(design, order, np.arange(len(recordings)))
+            self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), design.t_ref, design.t_scale,
+                                                t_min, t_max)
+            self.turn_on_biases_dps_[axis] = consts
+            self.fit_rms_dps_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))
+        self._fitted = True
+        return self
+
+    def _choose_order(self, axis: str, design: _Design, distinct: int) -> int:
+        usable = distinct - 1  # a polynomial of order p needs p+1 distinct temperatures
+        if self.order != "auto":
+            if self.order > usable:
+                raise ModelError(
+                    f"{axis}: order {self.order} needs {self.order + 1} distinct temperature bins, "
+                    f"the data has {distinct}; use a lower order or data over a wider temperature range"
+                )
+            self.selection_ = "fixed"
+            self.scores_[axis] = {}
+            return int(self.order)
+        candidates = list(range(0, min(self.max_order, usable) + 1))
+        if design.n_runs >= 2:
+            self.selection_ = "leave-one-run-out"
+            scores = {p: _leave_one_run_out(design, p) for p in candidates}
+            best = min(scores.values())
+            chosen = min(p for p in candidates if scores[p] <= best * PARSIMONY_TOLERANCE)
+        else:
+            self.selection_ = "bic"
+            scores = {p: _bic(design, p) for p in candidates}
+            chosen = min(scores, key=scores.get)
+        self.scores_[axis] = scores
+        return chosen
+
+    def _check_fitted(self) -> None:
+        if not self._fitted:
+            raise NotFittedError("PolynomialTemperatureModel is not fitted yet; call fit(recordings) first")
+
+    def predict_error(self, recording: Recording) -> np.ndarray:
+        """Predicted error (n, k) [deg/s]: the shape plus the mean turn-on constant of the fit runs."""
+        self._check_fitted()
+        cols = []
+        for axis in recording.gyro_axes:
+            curve = self.curves_[axis]
+            cols.append(curve.shape_dps(recording.temperature_for(axis)) + self.turn_on_biases_dps_[axis].mean())
+        return np.column_stack(cols)

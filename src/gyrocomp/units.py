@@ -1,0 +1,58 @@
+"""Unit conversions at the edge of the library.
+
+Inside gyrocomp, angular rate is in [deg/s], acceleration in [g], temperature in [degC] and time in [s].
+Readers and CLI options convert to these with the factors below; writers convert back.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .errors import InputError
+
+STANDARD_GRAVITY_M_PER_S2 = 9.80665  # [m/s^2], CGPM 1901
+
+#: multiply a value in the named unit by the factor to get [deg/s]
+GYRO_UNITS_TO_DPS = {
+    "deg/s": 1.0,
+    "dps": 1.0,
+    "rad/s": 180.0 / math.pi,
+    "mdps": 1e-3,
+    "deg/h": 1.0 / 3600.0,
+}
+#: multiply a value in the named unit by the factor to get [g]
+ACCEL_UNITS_TO_G = {
+    "g": 1.0,
+    "mg": 1e-3,
+    "m/s2": 1.0 / STANDARD_GRAVITY_M_PER_S2,
+    "m/s^2": 1.0 / STANDARD_GRAVITY_M_PER_S2,
+}
+#: multiply a value in the named unit by the factor to get [s]
+TIME_UNITS_TO_S = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+# Conversions of noise parameters between the units people quote them in.
+DEG_PER_S_PER_SQRT_HZ_TO_DEG_PER_SQRT_H = 60.0  # sqrt(3600)
+DEG_PER_S_TO_DEG_PER_H = 3600.0
+DEG_PER_S_PER_SQRT_S_TO_DEG_PER_H_PER_SQRT_H = 3600.0 * 60.0
+
+
+def unit_factor(kind: str, unit: str, option: str | None = None) -> float:
+    """Factor that converts a value in ``unit`` to gyrocomp's internal unit for ``kind``.
+
+    Parameters
+    ----------
+    kind : {"gyro", "accel", "time"}
+    unit : str
+        Unit name as a user writes it, e.g. ``"rad/s"``.
+    option : str, optional
+        The CLI option or argument the unit came from, named in the error message.
+    """
+    tables = {"gyro": GYRO_UNITS_TO_DPS, "accel": ACCEL_UNITS_TO_G, "time": TIME_UNITS_TO_S}
+    table = tables[kind]
+    try:
+        return table[unit.strip()]
+    except KeyError:
+        where = option or f"{kind} unit"
+        raise InputError(
+            f"{where}: unknown unit {unit!r}; use one of {', '.join(sorted(table))}"
+        ) from None
