@@ -218,9 +218,12 @@ def evaluate(ctx, model, runs, window_s, turn_on_window_s, as_json, **kwargs):
 def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
     console = _console()
     table = Table(title=title)
-    for col in ("run", "axis", "window [s]", "offset raw [deg/s]", "offset comp [deg/s]", "improvement",
-                "BI raw [deg/h]", "BI comp [deg/h]", "int. time raw [s]", "int. time comp [s]", "residual RMS [deg/s]"):
-        table.add_column(col, justify="left" if col in ("run", "axis") else "right")
+    table.add_column("run", no_wrap=True)
+    table.add_column("axis", no_wrap=True)
+    for col in ("window\n[s]", "offset raw\n[deg/s]", "offset comp\n[deg/s]", "improvement\n(raw/comp)",
+                "BI raw\n[deg/h]", "BI comp\n[deg/h]", "int. time raw\n[s]", "int. time comp\n[s]",
+                "residual RMS\n[deg/s]"):
+        table.add_column(col, justify="right")
     for run in evaluation.runs:
         for axis, m in run.axes.items():
             table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.bias_offset_raw_dps:.4g}",

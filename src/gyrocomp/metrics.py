@@ -112,7 +112,7 @@ def window_samples(window_s: float, rate_hz: float, n_samples: int) -> int:
     w = max(1, int(round(window_s * rate_hz)))
     if w > n_samples:
         raise InputError(
-            f"--window: {window_s} s is longer than the run ({n_samples / rate_hz:.6g} s); choose a shorter window"
+            f"--window: {window_s:g} s is longer than the run ({n_samples / rate_hz:.6g} s); choose a shorter window"
         )
     return w
 

@@ -1,0 +1,31 @@
+"""Shared fixtures: simulated runs with known truth, and the shared datasets (skipped when absent)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gyrocomp.simulate import GyroErrorModel, simulate
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED = REPO.parent / "shared"
+DATASETS = SHARED / "datasets"
+
+
+def shared_dataset(name: str) -> Path:
+    """Path of a folder in ../shared/datasets, or skip the test with a message saying what is missing."""
+    path = DATASETS / name
+    if not path.is_dir():
+        pytest.skip(f"shared dataset {name!r} not found at {path}; these tests need ../shared beside the repository")
+    return path
+
+
+#: the test sensor: MTi-10-class temperature drift, moderate bias instability
+TEST_MODEL = GyroErrorModel(bias_instability_deg_per_h=5.0)
+
+
+@pytest.fixture(scope="session")
+def chamber_runs():
+    """Seven 1-hour chamber runs at 20 Hz of TEST_MODEL (seeds 0..6), each with its own turn-on bias."""
+    return [simulate(TEST_MODEL, profile="chamber", duration_s=3600, rate_hz=20, seed=s) for s in range(7)]

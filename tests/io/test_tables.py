@@ -1,0 +1,181 @@
+import math
+import os
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.io import (
+    TableLayout,
+    atomic_path,
+    parse_column_mapping,
+    read,
+    read_table,
+    refuse_to_overwrite_inputs,
+    write_gyro_back,
+    write_recording,
+)
+from gyrocomp.simulate import GyroErrorModel, simulate
+
+
+def write_csv(path, text):
+    path.write_text(text)
+    return path
+
+
+def test_default_layout_round_trip_csv_and_parquet(tmp_path):
+    sim = simulate(duration_s=10, rate_hz=10, seed=1)
+    for name in ("run.csv", "run.parquet"):
+        write_recording(sim.recording, tmp_path / name)
+        back = read(tmp_path / name)
+        assert back.gyro_axes == ("gyro_x", "gyro_y", "gyro_z")
+        assert back.accel_axes == ("accel_x", "accel_y", "accel_z")
+        np.testing.assert_array_equal(back.gyro_dps, sim.recording.gyro_dps)  # exact: shortest round-trip floats
+        np.testing.assert_array_equal(back.temperature_degc, sim.recording.temperature_degc)
+        np.testing.assert_array_equal(back.time_s, sim.recording.time_s)
+
+
+def test_single_axis_without_accel(tmp_path):
+    p = write_csv(tmp_path / "z.csv", "time,gyro_z,temperature\n0,0.1,20\n0.5,0.2,20.5\n1.0,0.3,21\n")
+    rec = read(p)
+    assert rec.gyro_axes == ("gyro_z",)
+    assert rec.accel_g is None
+    assert rec.rate_hz == 2.0
+
+
+def test_per_axis_temperatures(tmp_path):
+    p = write_csv(tmp_path / "t.csv", "time,gyro_x,gyro_z,temperature_x,temperature_z\n0,1,2,20,30\n1,1,2,21,31\n")
+    rec = read(p)
+    np.testing.assert_array_equal(rec.temperature_for("gyro_z"), [30, 31])
+
+
+def test_mapping_and_unit_conversions(tmp_path):
+    p = write_csv(tmp_path / "vendor.csv", "Stamp,GyrZ,AccX,AccY,AccZ,T\n"
+                  "0,3.141592653589793,0,0,9.80665,25\n1000,0,0,9.80665,0,26\n2000,0,0,0,0,27\n")
+    layout = TableLayout(parse_column_mapping(
+        "time=Stamp,gyro_z=GyrZ,accel_x=AccX,accel_y=AccY,accel_z=AccZ,temperature=T"),
+        gyro_unit="rad/s", accel_unit="m/s2", time_unit="ms")
+    rec = read(p, layout)
+    np.testing.assert_allclose(rec.time_s, [0, 1, 2])
+    assert rec.gyro_dps[0, 0] == pytest.approx(180.0)
+    np.testing.assert_allclose(rec.accel_g[0], [0, 0, 1])
+    np.testing.assert_allclose(rec.accel_g[1], [0, 1, 0])
+    np.testing.assert_array_equal(rec.temperature_degc, [25, 26, 27])
+
+
+@pytest.mark.parametrize("unit,factor", [("mdps", 1e-3), ("deg/s", 1.0), ("rad/s", 180 / math.pi)])
+def test_gyro_units(tmp_path, unit, factor):
+    p = write_csv(tmp_path / "u.csv", "time,gyro_z\n0,2\n1,4\n")
+    rec = read(p, TableLayout(gyro_unit=unit))
+    np.testing.assert_allclose(rec.gyro_dps[:, 0], np.array([2, 4]) * factor)
+
+
+@pytest.mark.parametrize("unit,factor", [("us", 1e-6), ("ns", 1e-9), ("s", 1.0)])
+def test_time_units(tmp_path, unit, factor):
+    p = write_csv(tmp_path / "t.csv", "time,gyro_z\n0,2\n5000,4\n")
+    assert read(p, TableLayout(time_unit=unit)).time_s[1] == pytest.approx(5000 * factor)
+
+
+@pytest.mark.parametrize(
+    "text,message",
+    [
+        ("", r"e.csv: the file is empty; expected a header"),
+        ("\n\n", r"e.csv: the file is empty"),
+        ("time,gyro_z,temperature\n", r"e.csv: a header but no data rows"),
+        ("time,gyro_z,temperature\n0,1,20\n1,abc,21\n2,1,22\n", r"e.csv: row 2 \(line 3\), column 'gyro_z': 'abc' is not a number"),
+        ("time,gyro_z,temperature\n0,1,20\n1,,21\n2,1,22\n", r"e.csv: row 2: gyro is not a finite number"),
+        ("time,gyro_z,temperature\n0,1,20\n1,nan,21\n2,1,22\n", r"e.csv: row 2: gyro is not a finite number"),
+        ("time,gyro_z,temperature\n0,1,20\n2,1,21\n1,1,22\n", r"e.csv: row 3: time goes backwards"),
+        ("t,gyro_z\n0,1\n1,2\n", r"e.csv: no 'time' column \(the file has t, gyro_z\); map one with --columns time=NAME"),
+        ("time,temperature\n0,1\n1,2\n", r"e.csv: no gyro column .*--columns gyro_z=NAME"),
+    ],
+)
+def test_bad_csv_messages(tmp_path, text, message):
+    p = write_csv(tmp_path / "e.csv", text)
+    with pytest.raises(InputError, match=message):
+        read(p)
+
+
+def test_mapping_errors(tmp_path):
+    p = write_csv(tmp_path / "m.csv", "time,gyro_z\n0,1\n1,2\n")
+    with pytest.raises(InputError, match=r"--columns gyro_x=Nope: no column 'Nope'; the file has time, gyro_z"):
+        read(p, TableLayout({"gyro_x": "Nope"}))
+    with pytest.raises(InputError, match=r"--columns: unknown channel 'gyro_w'"):
+        TableLayout({"gyro_w": "x"})
+    with pytest.raises(InputError, match=r"--columns: 'gyro_z' is not CHANNEL=COLUMN"):
+        parse_column_mapping("gyro_z")
+    with pytest.raises(InputError, match=r"--accel-unit: unknown unit 'furlong/s2'"):
+        TableLayout(accel_unit="furlong/s2")
+
+
+def test_missing_file_and_unknown_suffix(tmp_path):
+    with pytest.raises(InputError, match=r"nothere.csv: no such file"):
+        read(tmp_path / "nothere.csv")
+    (tmp_path / "x.dat").write_text("time,gyro_z\n0,1\n1,2\n")
+    with pytest.raises(InputError, match=r"x.dat: cannot tell the format from the suffix '.dat'; name it with --format"):
+        read(tmp_path / "x.dat")
+    assert read(tmp_path / "x.dat", fmt="csv").n_samples == 2
+
+
+def test_not_a_parquet_file(tmp_path):
+    p = write_csv(tmp_path / "fake.parquet", "time,gyro_z\n0,1\n")
+    with pytest.raises(InputError, match=r"fake.parquet: not a readable Parquet file"):
+        read(p)
+
+
+def test_drop_nan_reports_count_and_write_back_keeps_rows(tmp_path):
+    p = write_csv(tmp_path / "n.csv", "time,gyro_z,temperature,note\n0,1,20,a\n1,,21,b\n2,3,22,c\n3,4,inf,d\n4,5,23,e\n")
+    with pytest.warns(DataQualityWarning, match=r"n.csv: dropped 2 of 5 rows"):
+        data = read_table(p, drop_nonfinite=True)
+    assert list(data.recording.row_numbers) == [1, 3, 5]
+    write_gyro_back(data, data.recording.gyro_dps * 2, tmp_path / "out.csv")
+    out = pd.read_csv(tmp_path / "out.csv")
+    assert list(out.columns) == ["time", "gyro_z", "temperature", "note"]
+    assert len(out) == 5
+    np.testing.assert_array_equal(out["gyro_z"].to_numpy(), [2, np.nan, 6, np.nan, 10])
+    assert list(out["note"]) == list("abcde")
+
+
+def test_write_back_converts_to_file_unit(tmp_path):
+    p = write_csv(tmp_path / "r.csv", "time,GyrZ\n0,1\n1,2\n")
+    data = read_table(p, TableLayout({"gyro_z": "GyrZ"}, gyro_unit="rad/s"))
+    write_gyro_back(data, data.recording.gyro_dps, tmp_path / "o.csv")
+    out = pd.read_csv(tmp_path / "o.csv")
+    np.testing.assert_allclose(out["GyrZ"], [1, 2], rtol=1e-15)
+
+
+def test_atomic_path_leaves_target_untouched_on_failure(tmp_path):
+    target = tmp_path / "out.csv"
+    target.write_text("precious")
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("boom")
+    assert target.read_text() == "precious"
+    assert os.listdir(tmp_path) == ["out.csv"]
+
+
+def test_atomic_path_needs_existing_folder(tmp_path):
+    with pytest.raises(InputError, match=r"folder .*nodir does not exist"):
+        with atomic_path(tmp_path / "nodir" / "x.csv"):
+            pass
+
+
+def test_refuse_to_overwrite_inputs(tmp_path):
+    src = write_csv(tmp_path / "in.csv", "x")
+    with pytest.raises(InputError, match=r"-o .*in.csv: this is an input file"):
+        refuse_to_overwrite_inputs(src, [src])
+    os.link(src, tmp_path / "hard.csv")
+    with pytest.raises(InputError, match="this is an input file"):
+        refuse_to_overwrite_inputs(tmp_path / "hard.csv", [src])
+    refuse_to_overwrite_inputs(tmp_path / "other.csv", [src])
+
+
+def test_single_axis_simulation_writes_default_layout(tmp_path):
+    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((1e-3,),), accel_g=None)
+    write_recording(simulate(model, duration_s=5, rate_hz=10).recording, tmp_path / "s.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert pd.read_csv(tmp_path / "s.csv").columns.tolist() == ["time", "gyro_z", "temperature"]

@@ -1,0 +1,205 @@
+"""The command line, run through its real entry point in a subprocess."""
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+SCRIPT = Path(sys.executable).parent / "gyrocomp"
+
+
+def run(*args, cwd=None):
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+    env = {**os.environ, "COLUMNS": "200"}
+    return subprocess.run([*cmd, *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    """Three simulated chamber runs and a model fitted on two of them, made with the CLI itself."""
+    d = tmp_path_factory.mktemp("cli")
+    for seed in (1, 2, 3):
+        r = run("simulate", "--profile", "chamber", "--duration", 1200, "--rate", 10, "--seed", seed,
+                "-o", d / f"run{seed}.csv", "--truth", d / f"truth{seed}.json")
+        assert r.returncode == 0, r.stderr
+    r = run("fit", d / "run1.csv", d / "run2.csv", "-o", d / "model.json", "--temperature", "poly:3")
+    assert r.returncode == 0, r.stderr
+    return d
+
+
+def test_simulate_writes_data_and_truth(workdir):
+    df = pd.read_csv(workdir / "run1.csv")
+    assert list(df.columns) == ["time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z", "temperature"]
+    assert len(df) == 12001
+    truth = json.loads((workdir / "truth1.json").read_text())
+    assert truth["seed"] == 1 and truth["rate_hz"] == 10
+    assert set(truth["turn_on_bias_dps"]) == {"gyro_x", "gyro_y", "gyro_z"}
+
+
+def test_fit_prints_table_and_writes_model(workdir):
+    r = run("fit", workdir / "run1.csv", workdir / "run2.csv", "-o", workdir / "auto.json")
+    assert r.returncode == 0, r.stderr
+    assert "order selection by leave-one-run-out" in r.stdout
+    assert "gyro_z" in r.stdout
+    model = json.loads((workdir / "auto.json").read_text())
+    assert model["fit_report"]["order_selection"] == "leave-one-run-out"
+
+
+def test_apply_keeps_columns_rows_and_other_channels(workdir):
+    out = workdir / "comp.csv"
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", out)
+    assert r.returncode == 0, r.stderr
+    raw, comp = pd.read_csv(workdir / "run3.csv"), pd.read_csv(out)
+    assert list(comp.columns) == list(raw.columns) and len(comp) == len(raw)
+    for col in ("time", "accel_x", "accel_y", "accel_z", "temperature"):
+        np.testing.assert_array_equal(comp[col], raw[col])
+    assert comp["gyro_z"].rolling(600).mean().dropna().pipe(np.ptp) < raw["gyro_z"].rolling(600).mean().dropna().pipe(np.ptp)
+
+
+def test_apply_parquet_and_turn_on_window(workdir):
+    out = workdir / "comp.parquet"
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", out, "--turn-on-window", 30)
+    assert r.returncode == 0, r.stderr
+    comp = pd.read_parquet(out)
+    assert abs(comp["gyro_z"][comp["time"] < 30].mean()) < 1e-12
+
+
+def test_evaluate_json_shape(workdir):
+    r = run("evaluate", workdir / "model.json", workdir / "run3.csv", "--json")
+    assert r.returncode == 0, r.stderr
+    data = json.loads(r.stdout)
+    assert set(data) == {"runs"}
+    run0 = data["runs"][0]
+    assert set(run0) == {"file", "window_s", "axes"}
+    assert run0["window_s"] >= 1.0
+    keys = {"bias_offset_raw_dps", "bias_offset_comp_dps", "offset_improvement", "bias_instability_raw_dph",
+            "bias_instability_comp_dph", "integration_time_raw_s", "integration_time_comp_s", "residual_rms_dps"}
+    for axis in ("gyro_x", "gyro_y", "gyro_z"):
+        assert set(run0["axes"][axis]) == keys
+        assert run0["axes"][axis]["offset_improvement"] > 1
+
+
+def test_evaluate_table_and_window(workdir):
+    r = run("evaluate", workdir / "model.json", workdir / "run3.csv", "--window", 20)
+    assert r.returncode == 0, r.stderr
+    assert "offset raw" in r.stdout and "[deg/s]" in r.stdout and "run3.csv" in r.stdout
+    assert re.search(r"run3\.csv\s*\S\s*gyro_x\s*\S\s*20\s", r.stdout)  # the window column shows --window
+
+
+def test_demo(tmp_path):
+    r = run("demo", "-o", tmp_path / "demo")
+    assert r.returncode == 0, r.stderr
+    names = {p.name for p in (tmp_path / "demo").iterdir()}
+    assert {"model.json", "heldout_compensated.csv", "metrics.json", "heldout_run.csv"} <= names
+    metrics = json.loads((tmp_path / "demo" / "metrics.json").read_text())
+    assert all(a["offset_improvement"] > 1.5 for a in metrics["runs"][0]["axes"].values())
+    assert "held-out run, raw vs compensated" in r.stdout
+
+
+def test_mapping_and_units_through_cli(workdir, tmp_path):
+    df = pd.read_csv(workdir / "run3.csv")
+    vendor = pd.DataFrame({"Stamp": df["time"] * 1000, "GyrZ": np.deg2rad(df["gyro_z"]), "T": df["temperature"]})
+    vendor.to_csv(tmp_path / "vendor.csv", index=False)
+    r = run("apply", workdir / "model.json", tmp_path / "vendor.csv", "-o", tmp_path / "v_out.csv",
+            "--columns", "time=Stamp,gyro_z=GyrZ,temperature=T", "--gyro-unit", "rad/s", "--time-unit", "ms")
+    assert r.returncode == 0, r.stderr
+    ours = pd.read_csv(tmp_path / "v_out.csv")
+    theirs = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "d_out.csv")
+    assert theirs.returncode == 0
+    np.testing.assert_allclose(np.rad2deg(ours["GyrZ"]), pd.read_csv(tmp_path / "d_out.csv")["gyro_z"], atol=1e-12)
+
+
+ERROR_CASES = {
+    "empty": ("", r"empty.csv: the file is empty"),
+    "header_only": ("time,gyro_z,temperature\n", r"header_only.csv: a header but no data rows"),
+    "no_temperature": ("time,gyro_z\n0,1\n1,2\n2,3\n", r"no_temperature.csv: no temperature column"),
+    "text_in_number": ("time,gyro_z,temperature\n0,1,20\n1,x1,21\n2,1,22\n",
+                       r"text_in_number.csv: row 2 \(line 3\), column 'gyro_z': 'x1' is not a number"),
+    "nan_rows": ("time,gyro_z,temperature\n0,1,20\n1,NaN,21\n2,1,22\n",
+                 r"nan_rows.csv: row 2: gyro is not a finite number; fix the file or drop such rows explicitly \(--drop-nan\)"),
+    "time_backwards": ("time,gyro_z,temperature\n0,1,20\n1,1,21\n0.5,1,22\n",
+                       r"time_backwards.csv: row 3: time goes backwards \(0.5 s after 1 s\)"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(ERROR_CASES))
+def test_bad_inputs_give_one_line_and_status_2(tmp_path, name):
+    text, message = ERROR_CASES[name]
+    (tmp_path / f"{name}.csv").write_text(text)
+    r = run("fit", tmp_path / f"{name}.csv", "-o", tmp_path / "m.json")
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    assert lines[0].startswith("gyrocomp: error: ")
+    assert re.search(message, lines[0]), lines[0]
+    assert "Traceback" not in r.stderr
+    assert not (tmp_path / "m.json").exists()
+
+
+def test_debug_shows_traceback(tmp_path):
+    (tmp_path / "e.csv").write_text("")
+    r = run("--debug", "fit", tmp_path / "e.csv", "-o", tmp_path / "m.json")
+    assert r.returncode == 2 and "Traceback" in r.stderr
+
+
+def test_drop_nan_reports_and_proceeds(tmp_path):
+    (tmp_path / "n.csv").write_text("time,gyro_z,temperature\n0,1,20\n1,NaN,21\n2,1,22\n3,2,23\n")
+    r = run("fit", tmp_path / "n.csv", "-o", tmp_path / "m.json", "--drop-nan", "--temperature", "poly:1")
+    assert r.returncode == 0, r.stderr
+    assert "gyrocomp: warning: " in r.stderr and "dropped 1 of 4 rows" in r.stderr
+
+
+@pytest.mark.parametrize("edit,message", [
+    (lambda t: t.replace('"schema_version": 1', '"schema_version": 99'), r"written with model schema 99, .*upgrade gyrocomp"),
+    (lambda t: t[: len(t) // 2], r"not valid JSON \(line \d+, column \d+: .*\); the file may be truncated"),
+])
+def test_bad_model_files(workdir, tmp_path, edit, message):
+    (tmp_path / "bad.json").write_text(edit((workdir / "model.json").read_text()))
+    r = run("apply", tmp_path / "bad.json", workdir / "run3.csv", "-o", tmp_path / "o.csv")
+    assert r.returncode == 2
+    assert re.search(message, r.stderr.strip()) and len(r.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_refuses_to_overwrite_input(workdir, tmp_path):
+    src = tmp_path / "in.csv"
+    shutil.copy(workdir / "run3.csv", src)
+    before = src.read_bytes()
+    r = run("apply", workdir / "model.json", src, "-o", src)
+    assert r.returncode == 2
+    assert "this is an input file; choose another output path" in r.stderr
+    assert src.read_bytes() == before
+
+
+@pytest.mark.parametrize("args,message", [
+    (["simulate", "--duration", "abc", "-o", "x.csv"], r"Invalid value for '--duration': 'abc' is not a valid float"),
+    (["fit", "x.csv"], r"Missing option '-o'"),
+    (["fit", "{run}", "-o", "m.json", "--temperature", "poly:7"], r"--temperature: 'poly:7': the order must be"),
+    (["fit", "{run}", "-o", "m.json", "--columns", "gyro_z=Nope"], r"--columns gyro_z=Nope: no column 'Nope'"),
+    (["apply", "{model}", "{run}", "-o", "o.csv", "--gyro-unit", "rpm"], r"--gyro-unit: unknown unit 'rpm'"),
+    (["apply", "{model}", "{run}", "-o", "o.csv", "--turn-on-window", "-3"], r"--turn-on-window: must be a positive"),
+    (["evaluate", "{model}", "{run}", "--window", "1e9"], r"--window: 1e\+09 s is longer than the run"),
+    (["simulate", "--profile", "oven", "-o", "x.csv"], r"--profile: unknown profile 'oven'"),
+    (["simulate", "--axes", "q", "-o", "x.csv"], r"--axes: 'q'; use a comma-separated subset of x, y, z"),
+    (["nosuchcommand"], r"No such command 'nosuchcommand'"),
+])
+def test_usage_errors(workdir, tmp_path, args, message):
+    args = [a.format(run=workdir / "run3.csv", model=workdir / "model.json") for a in args]
+    r = run(*args, cwd=tmp_path)
+    assert r.returncode == 2, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert re.search(message, r.stderr), r.stderr
+
+
+def test_version_and_help():
+    r = run("--version")
+    assert r.returncode == 0 and "gyrocomp" in r.stdout
+    r = run("--help")
+    assert r.returncode == 0 and "demo" in r.stdout and "evaluate" in r.stdout

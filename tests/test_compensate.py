@@ -1,0 +1,87 @@
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gyrocomp import Compensator, apply, fit_calibration
+from gyrocomp.errors import InputError, TemperatureRangeWarning
+from gyrocomp.recording import Recording
+from gyrocomp.simulate import simulate
+
+SIM = simulate(duration_s=120, rate_hz=10, seed=5)
+CAL = fit_calibration([simulate(duration_s=600, rate_hz=10, seed=s).recording for s in (1, 2)], temperature=3)
+
+
+def stream(rec, cuts, **kw):
+    comp = Compensator(CAL, rec.gyro_axes, **kw)
+    edges = [0, *sorted(cuts), rec.n_samples]
+    blocks = [comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b])
+              for a, b in zip(edges[:-1], edges[1:])]
+    blocks.append(comp.finish())
+    return np.concatenate(blocks)
+
+
+@settings(max_examples=60, deadline=None)
+@given(cuts=st.lists(st.integers(0, SIM.recording.n_samples), max_size=12),
+       window=st.one_of(st.none(), st.floats(0.05, 200.0)))
+def test_any_chunking_equals_batch(cuts, window):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        batch = apply(CAL, SIM.recording, turn_on_window_s=window).gyro_dps
+        streamed = stream(SIM.recording, cuts, turn_on_window_s=window)
+    assert streamed.shape == batch.shape
+    np.testing.assert_allclose(streamed, batch, rtol=0, atol=1e-12)
+
+
+def test_turn_on_window_uses_the_first_seconds():
+    out = apply(CAL, SIM.recording, turn_on_window_s=10.0)
+    head = SIM.recording.time_s < 10.0
+    np.testing.assert_allclose(out.gyro_dps[head].mean(axis=0), 0.0, atol=1e-12)
+
+
+def test_turn_on_window_removes_this_runs_constant():
+    """With the window, a run whose turn-on bias is far from the calibration runs' is still centred."""
+    shifted = SIM.recording.with_gyro(SIM.recording.gyro_dps + 0.5)
+    default = apply(CAL, shifted).gyro_dps.mean(axis=0)
+    windowed = apply(CAL, shifted, turn_on_window_s=60.0).gyro_dps.mean(axis=0)
+    assert np.all(np.abs(default) > 0.4)
+    assert np.all(np.abs(windowed) < 0.05)
+
+
+def test_window_longer_than_data_warns():
+    with pytest.warns(UserWarning, match=r"shorter than the turn-on window of 1000 s"):
+        apply(CAL, SIM.recording, turn_on_window_s=1000.0)
+
+
+def test_warns_once_across_chunks():
+    rec = SIM.recording
+    hot = rec.temperature_degc + 200
+    comp = Compensator(CAL, rec.gyro_axes)
+    with pytest.warns(TemperatureRangeWarning) as record:
+        for a in range(0, rec.n_samples, 100):
+            comp.update(rec.time_s[a:a + 100], rec.gyro_dps[a:a + 100], hot[a:a + 100])
+    assert len(record) == 1
+
+
+def test_axes_not_in_model_pass_through():
+    t = np.arange(600) / 10.0
+    temp = np.linspace(10, 40, t.size)
+    z_only = Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
+    cal_z = fit_calibration([z_only], temperature=1)
+    both = Recording(time_s=t, gyro_dps=np.column_stack([np.ones(t.size), 1e-3 * temp]),
+                     gyro_axes=("gyro_x", "gyro_z"), temperature_degc=temp)
+    out = apply(cal_z, both)
+    np.testing.assert_array_equal(out.gyro_dps[:, 0], 1.0)
+    np.testing.assert_allclose(out.gyro_dps[:, 1], 0.0, atol=1e-12)
+
+
+def test_errors():
+    with pytest.raises(InputError, match=r"--turn-on-window: must be a positive number of seconds, got -1"):
+        Compensator(CAL, ("gyro_z",), turn_on_window_s=-1)
+    with pytest.raises(InputError, match=r"the model covers gyro_x, gyro_y, gyro_z, the data has gyro_w; no axis in common"):
+        Compensator(CAL, ("gyro_w",))
+    comp = Compensator(CAL, ("gyro_x", "gyro_y", "gyro_z"))
+    with pytest.raises(InputError, match="the model needs temperature, the data has none"):
+        comp.update(np.arange(3.0), np.zeros((3, 3)))

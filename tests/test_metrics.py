@@ -1,0 +1,66 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gyrocomp.errors import InputError
+from gyrocomp.metrics import (
+    BIAS_INSTABILITY_FACTOR,
+    bias_instability,
+    bias_offset,
+    evaluate_run,
+    moving_average,
+    window_samples,
+)
+from gyrocomp.recording import Recording
+
+
+@settings(max_examples=50, deadline=None)
+@given(x=st.lists(st.floats(-1e3, 1e3), min_size=1, max_size=60), w=st.integers(1, 60))
+def test_moving_average_equals_convolution(x, w):
+    x = np.array(x)
+    if w > x.size:
+        return
+    np.testing.assert_allclose(moving_average(x, w), np.convolve(x, np.ones(w) / w, mode="valid"), atol=1e-9)
+
+
+def test_bias_offset_of_a_ramp():
+    x = np.linspace(0, 1, 1001)  # moving average of a ramp is the ramp, shortened by w - 1 samples
+    assert bias_offset(x, 101) == pytest.approx(0.9)
+
+
+def test_bias_instability_factor():
+    assert BIAS_INSTABILITY_FACTOR == pytest.approx(0.6643, abs=1e-4)
+
+
+def test_bias_instability_of_white_noise_is_at_the_longest_tau():
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal(100_000) * 0.1
+    bi = bias_instability(y, 100.0)
+    assert bi.integration_time_s == pytest.approx(163.84)
+
+
+def test_evaluate_run_on_known_drift():
+    t = np.arange(0, 1000, 0.1)
+    drift = 0.01 * np.sin(2 * np.pi * t / 1000)
+    rng = np.random.default_rng(0)
+    noise = rng.standard_normal(t.size) * 1e-3
+    raw = Recording(time_s=t, gyro_dps=drift + noise, gyro_axes=("gyro_z",))
+    comp = raw.with_gyro(noise)
+    run = evaluate_run(raw, comp, window_s=10.0)
+    m = run.axes["gyro_z"]
+    assert run.window_s == 10.0
+    assert m.bias_offset_raw_dps == pytest.approx(0.02, rel=0.05)
+    assert m.bias_offset_comp_dps < 0.002
+    assert m.offset_improvement == pytest.approx(m.bias_offset_raw_dps / m.bias_offset_comp_dps)
+    assert m.residual_rms_dps == pytest.approx(1e-3 / np.sqrt(100), rel=0.2)
+    assert m.bias_instability_comp_dph < m.bias_instability_raw_dph
+
+
+def test_window_errors():
+    with pytest.raises(InputError, match=r"--window: must be positive, got -1"):
+        window_samples(-1, 10.0, 100)
+    with pytest.raises(InputError, match=r"--window: 100 s is longer than the run \(10 s\)"):
+        window_samples(100, 10.0, 100)
+    with pytest.raises(InputError, match=r"window: 20 samples is longer than the data"):
+        moving_average(np.zeros(10), 20)
