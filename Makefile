@@ -19,7 +19,6 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
-	$(BIN)/python -m pip install --quiet '.[bench]'
 	$(BIN)/python benchmarks/bench_apply.py
 
 clean:
