@@ -123,7 +123,7 @@ ERROR_CASES = {
     "text_in_number": ("time,gyro_z,temperature\n0,1,20\n1,x1,21\n2,1,22\n",
                        r"text_in_number.csv: row 2 \(line 3\), column 'gyro_z': 'x1' is not a number"),
     "nan_rows": ("time,gyro_z,temperature\n0,1,20\n1,NaN,21\n2,1,22\n",
-                 r"nan_rows.csv: row 2: gyro is not a finite number; fix the file or drop such rows explicitly \(--drop-nan\)"),
+                 r"nan_rows.csv: row 2, column 'gyro_z': nan is not a finite number; fix the file or drop such rows explicitly \(--drop-nan\)"),
     "time_backwards": ("time,gyro_z,temperature\n0,1,20\n1,1,21\n0.5,1,22\n",
                        r"time_backwards.csv: row 3: time goes backwards \(0.5 s after 1 s\)"),
 }
@@ -203,3 +203,9 @@ def test_version_and_help():
     assert r.returncode == 0 and "gyrocomp" in r.stdout
     r = run("--help")
     assert r.returncode == 0 and "demo" in r.stdout and "evaluate" in r.stdout
+
+
+def test_apply_unknown_output_suffix_keeps_input_format(workdir, tmp_path):
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "out.dat")
+    assert r.returncode == 0, r.stderr
+    assert len(pd.read_csv(tmp_path / "out.dat")) == 12001

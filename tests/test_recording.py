@@ -29,7 +29,7 @@ def test_time_repeat_names_row_number_from_source():
 
 
 def test_nan_names_row_and_channel():
-    with pytest.raises(InputError, match=r"row 2: temperature is not a finite number.*--drop-nan"):
+    with pytest.raises(InputError, match=r"row 2, column 'temperature': nan is not a finite number.*--drop-nan"):
         make([0.0, 1.0, 2.0], temp=np.array([20.0, np.nan, 21.0]))
 
 

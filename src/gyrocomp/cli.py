@@ -21,6 +21,7 @@ from .calibration import Calibration
 from .compensate import apply as apply_calibration
 from .errors import GyrocompError, InputError
 from .io import (
+    detect_table_format,
     TableLayout,
     detect_format,
     parse_column_mapping,
@@ -180,8 +181,8 @@ def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
     opts = _pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path, model])
     calibration = Calibration.load(model)
-    out_fmt = detect_format(output, None) if Path(output).suffix else "csv"
     data = _read(input_path, opts)
+    out_fmt = detect_table_format(Path(output)) or data.recording.metadata["format"]
     compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s)
     write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt)
     if not ctx.obj["quiet"]:

@@ -53,7 +53,7 @@ class Compensator:
 
     def _residual(self, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
-        for k, (j, ax) in enumerate(self._modelled):
+        for j, ax in self._modelled:
             if ax.temperature is None:
                 continue
             if temperature_degc is None:

@@ -112,15 +112,18 @@ class Recording:
                 raise InputError(
                     f"{src}: accelerometer data has shape {accel.shape}, expected ({n}, {len(self.accel_axes)})"
                 )
-        for name, arr in (("time", time_s), ("gyro", gyro), ("temperature", temp), ("accel", accel)):
+        temp_names = (TEMPERATURE_COLUMN,) if temp is None or temp.ndim == 1 else tuple(
+            f"{TEMPERATURE_COLUMN}_{a.split('_')[-1]}" for a in axes)
+        for names, arr in ((("time",), time_s), (axes, gyro), (temp_names, temp), (tuple(self.accel_axes), accel)):
             if arr is None:
                 continue
-            bad = ~np.isfinite(arr)
+            bad = ~np.isfinite(arr.reshape(n, -1))
             if bad.any():
-                first = int(np.flatnonzero(bad.reshape(n, -1).any(axis=1))[0])
+                first = int(np.flatnonzero(bad.any(axis=1))[0])
+                column = names[int(np.flatnonzero(bad[first])[0])]
                 raise InputError(
-                    f"{src}: row {rows[first]}: {name} is not a finite number; "
-                    "fix the file or drop such rows explicitly (--drop-nan)"
+                    f"{src}: row {rows[first]}, column {column!r}: {arr.reshape(n, -1)[first][bad[first]][0]} "
+                    "is not a finite number; fix the file or drop such rows explicitly (--drop-nan)"
                 )
         dt = np.diff(time_s)
         bad_steps = np.flatnonzero(dt <= 0)

@@ -85,8 +85,8 @@ def test_time_units(tmp_path, unit, factor):
         ("\n\n", r"e.csv: the file is empty"),
         ("time,gyro_z,temperature\n", r"e.csv: a header but no data rows"),
         ("time,gyro_z,temperature\n0,1,20\n1,abc,21\n2,1,22\n", r"e.csv: row 2 \(line 3\), column 'gyro_z': 'abc' is not a number"),
-        ("time,gyro_z,temperature\n0,1,20\n1,,21\n2,1,22\n", r"e.csv: row 2: gyro is not a finite number"),
-        ("time,gyro_z,temperature\n0,1,20\n1,nan,21\n2,1,22\n", r"e.csv: row 2: gyro is not a finite number"),
+        ("time,gyro_z,temperature\n0,1,20\n1,,21\n2,1,22\n", r"e.csv: row 2, column 'gyro_z': nan is not a finite number"),
+        ("time,gyro_z,temperature\n0,1,20\n1,nan,21\n2,1,22\n", r"e.csv: row 2, column 'gyro_z': nan is not a finite number"),
         ("time,gyro_z,temperature\n0,1,20\n2,1,21\n1,1,22\n", r"e.csv: row 3: time goes backwards"),
         ("t,gyro_z\n0,1\n1,2\n", r"e.csv: no 'time' column \(the file has t, gyro_z\); map one with --columns time=NAME"),
         ("time,temperature\n0,1\n1,2\n", r"e.csv: no gyro column .*--columns gyro_z=NAME"),
@@ -179,3 +179,19 @@ def test_single_axis_simulation_writes_default_layout(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert pd.read_csv(tmp_path / "s.csv").columns.tolist() == ["time", "gyro_z", "temperature"]
+
+
+def test_gaps_are_reported_and_kept(tmp_path):
+    rows = [f"{t:.2f},0.1,20" for t in [0, 0.01, 0.02, 0.03, 3.0, 3.01, 3.02, 9.0, 9.01]]
+    p = write_csv(tmp_path / "g.csv", "time,gyro_z,temperature\n" + "\n".join(rows) + "\n")
+    with pytest.warns(DataQualityWarning, match=r"g.csv: 2 time gap\(s\) longer than 2 sample periods "
+                                                 r"\(longest 5.98 s after row 7\); kept as they are, nothing interpolated"):
+        rec = read(p)
+    assert rec.n_samples == 9
+    assert [g.after_row for g in rec.gaps] == [4, 7]
+
+
+def test_accel_nan_names_its_column(tmp_path):
+    p = write_csv(tmp_path / "a.csv", "time,gyro_z,accel_x,accel_y,accel_z\n0,1,0,0,1\n1,1,0,inf,1\n")
+    with pytest.raises(InputError, match=r"a.csv: row 2, column 'accel_y': inf is not a finite number"):
+        read(p)

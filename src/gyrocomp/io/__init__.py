@@ -54,6 +54,7 @@ __all__ = [
     "TableLayout",
     "atomic_path",
     "detect_format",
+    "detect_table_format",
     "file_sha256",
     "parse_column_mapping",
     "read",

@@ -240,6 +240,13 @@ def read_table(
         row_numbers=kept + 1,
         metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)},
     )
+    if recording.gaps:
+        longest = max(recording.gaps, key=lambda g: g.duration_s)
+        warnings.warn(
+            f"{path}: {len(recording.gaps)} time gap(s) longer than 2 sample periods (longest {longest.duration_s:.6g} s "
+            f"after row {longest.after_row}); kept as they are, nothing interpolated",
+            DataQualityWarning, stacklevel=2,
+        )
     return TableData(recording, table, layout, cols, kept, path)
 
 
