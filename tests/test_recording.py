@@ -70,3 +70,12 @@ def test_shape_mismatch_and_too_short():
 def test_missing_temperature_message():
     with pytest.raises(InputError, match="no temperature column.*--columns temperature=NAME"):
         make([0.0, 1.0]).temperature_for("gyro_z")
+
+
+def test_temperature_column_for_axis():
+    t = np.arange(5.0)
+    one = Recording(time_s=t, gyro_dps=np.zeros((5, 2)), gyro_axes=("gyro_x", "gyro_z"), temperature_degc=t)
+    assert one.temperature_column_for("gyro_z") == "temperature"
+    per_axis = Recording(time_s=t, gyro_dps=np.zeros((5, 2)), gyro_axes=("gyro_x", "gyro_z"),
+                         temperature_degc=np.column_stack([t, t]))
+    assert per_axis.temperature_column_for("gyro_z") == "temperature_z"

@@ -166,6 +166,11 @@ class Recording:
             return (TEMPERATURE_COLUMN,)
         return tuple(f"{TEMPERATURE_COLUMN}_{axis.split('_')[-1]}" for axis in self.gyro_axes)
 
+    def temperature_column_for(self, axis: str) -> str:
+        """Name of the temperature channel that goes with a gyro axis."""
+        columns = self.temperature_columns
+        return columns[0] if len(columns) == 1 else columns[self._axis_index(axis)]
+
     def gyro(self, axis: str) -> np.ndarray:
         """Angular rate of one axis [deg/s]."""
         return self.gyro_dps[:, self._axis_index(axis)]

@@ -195,3 +195,8 @@ def test_accel_nan_names_its_column(tmp_path):
     p = write_csv(tmp_path / "a.csv", "time,gyro_z,accel_x,accel_y,accel_z\n0,1,0,0,1\n1,1,0,inf,1\n")
     with pytest.raises(InputError, match=r"a.csv: row 2, column 'accel_y': inf is not a finite number"):
         read(p)
+
+
+def test_quoted_numbers_are_read(tmp_path):
+    p = write_csv(tmp_path / "q.csv", 'time,gyro_z,temperature\n0,"1.5",20\n1,"2.5",21\n')
+    np.testing.assert_array_equal(read(p).gyro_dps[:, 0], [1.5, 2.5])

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
@@ -108,7 +109,9 @@ def _read_arrow(path: Path, fmt: str) -> pa.Table:
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a file")
     if fmt == "csv":
-        if path.stat().st_size == 0 or not path.read_bytes()[:4096].strip():
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+        if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
         try:
             return pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(strings_can_be_null=True))
@@ -128,6 +131,10 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
         return np.full(len(array), np.nan)
     if pa.types.is_boolean(array.type) or pa.types.is_timestamp(array.type):
         raise InputError(f"{source}: column {column!r} has type {array.type}; expected numbers")
+    try:  # numbers stored as text (quoted, say): one vectorized cast; only on failure find the bad row
+        return pc.cast(array, pa.float64()).to_numpy(zero_copy_only=False)
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+        pass
     values = array.to_pylist()
     out = np.empty(len(values))
     for i, value in enumerate(values):

@@ -67,9 +67,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     axes = {}
     report = {"temperature": "polynomial", "order_selection": model.selection_, "axes": {}}
     for axis, curve in model.curves_.items():
-        temp_col = recordings[0].temperature_columns[0 if recordings[0].temperature_degc.ndim == 1
-                                                       else recordings[0].gyro_axes.index(axis)]
-        axes[axis] = AxisCalibration(curve, tuple(float(c) for c in model.turn_on_biases_dps_[axis]), temp_col)
+        axes[axis] = AxisCalibration(curve, tuple(float(c) for c in model.turn_on_biases_dps_[axis]),
+                                     recordings[0].temperature_column_for(axis))
         report["axes"][axis] = {
             "order": curve.order,
             "scores": {str(p): float(s) for p, s in model.scores_[axis].items()},
