@@ -21,9 +21,9 @@ from .calibration import Calibration
 from .compensate import apply as apply_calibration
 from .errors import GyrocompError, InputError
 from .io import (
-    detect_table_format,
     TableLayout,
     detect_format,
+    detect_table_format,
     parse_column_mapping,
     read_table,
     refuse_to_overwrite_inputs,

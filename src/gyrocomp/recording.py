@@ -17,6 +17,13 @@ TEMPERATURE_COLUMN = "temperature"
 GAP_FACTOR = 2.0
 
 
+def _temperature_names(gyro_axes: tuple[str, ...], per_axis: bool) -> tuple[str, ...]:
+    """Temperature channel names: one shared column, or ``temperature_x`` ... one per gyro axis."""
+    if not per_axis:
+        return (TEMPERATURE_COLUMN,)
+    return tuple(f"{TEMPERATURE_COLUMN}_{axis.split('_')[-1]}" for axis in gyro_axes)
+
+
 def _nominal_rate(period_s: float) -> float:
     """1/period [Hz], snapped to 6 decimals when it is that close (time stamps like k / 100.0)."""
     rate = 1.0 / period_s
@@ -112,17 +119,17 @@ class Recording:
                 raise InputError(
                     f"{src}: accelerometer data has shape {accel.shape}, expected ({n}, {len(self.accel_axes)})"
                 )
-        temp_names = (TEMPERATURE_COLUMN,) if temp is None or temp.ndim == 1 else tuple(
-            f"{TEMPERATURE_COLUMN}_{a.split('_')[-1]}" for a in axes)
+        temp_names = _temperature_names(axes, temp is not None and temp.ndim == 2)
         for names, arr in ((("time",), time_s), (axes, gyro), (temp_names, temp), (tuple(self.accel_axes), accel)):
             if arr is None:
                 continue
-            bad = ~np.isfinite(arr.reshape(n, -1))
+            table = arr.reshape(n, -1)
+            bad = ~np.isfinite(table)
             if bad.any():
                 first = int(np.flatnonzero(bad.any(axis=1))[0])
                 column = names[int(np.flatnonzero(bad[first])[0])]
                 raise InputError(
-                    f"{src}: row {rows[first]}, column {column!r}: {arr.reshape(n, -1)[first][bad[first]][0]} "
+                    f"{src}: row {rows[first]}, column {column!r}: {table[first][bad[first]][0]} "
                     "is not a finite number; fix the file or drop such rows explicitly (--drop-nan)"
                 )
         dt = np.diff(time_s)
@@ -162,9 +169,7 @@ class Recording:
     def temperature_columns(self) -> tuple[str, ...]:
         if self.temperature_degc is None:
             return ()
-        if self.temperature_degc.ndim == 1:
-            return (TEMPERATURE_COLUMN,)
-        return tuple(f"{TEMPERATURE_COLUMN}_{axis.split('_')[-1]}" for axis in self.gyro_axes)
+        return _temperature_names(self.gyro_axes, self.temperature_degc.ndim == 2)
 
     def temperature_column_for(self, axis: str) -> str:
         """Name of the temperature channel that goes with a gyro axis."""
