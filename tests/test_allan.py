@@ -3,7 +3,18 @@
 import numpy as np
 import pytest
 
-from gyrocomp.allan import allan_deviation, averaging_factors, to_phase
+from gyrocomp.allan import (
+    ONE_SIGMA,
+    allan_deviation,
+    allan_deviation_segments,
+    averaging_factors,
+    confidence_interval,
+    edf_greenhall,
+    edf_totdev,
+    identify_noise,
+    phase_from_chunks,
+    to_phase,
+)
 from gyrocomp.errors import InputError
 
 from .conftest import shared_dataset
@@ -44,13 +55,20 @@ def brute_force(kind, y, rate_hz, m):
         step = m if kind == "hdev" else 1
         terms = [(avg(i + 2 * m) - 2 * avg(i + m) + avg(i)) ** 2 / 6 for i in range(0, y.size - 3 * m + 1, step)]
         return np.sqrt(np.mean(terms)), len(terms)
+    if kind == "totdev":
+        # NIST SP 1065 eq. 25: the phase reflected about both ends, terms i = 1..N-2
+        x = np.concatenate([[0.0], np.cumsum(y - y.mean()) / rate_hz])
+        n = x.size
+        star = lambda j: 2 * x[0] - x[-j] if j < 0 else (x[j] if j < n else 2 * x[-1] - x[2 * (n - 1) - j])  # noqa: E731
+        terms = [(star(i - m) - 2 * x[i] + star(i + m)) ** 2 for i in range(1, n - 1)]
+        return np.sqrt(np.sum(terms) / (2 * tau ** 2 * (n - 2))), len(terms)
     # modified Allan: the Allan term of averages, itself averaged over m consecutive starts
     terms = [np.mean([avg(i + m) - avg(i) for i in range(j, j + m)]) ** 2 / 2 for j in range(y.size - 3 * m + 2)]
     mdev = np.sqrt(np.mean(terms))
     return (mdev if kind == "mdev" else tau * mdev / np.sqrt(3)), len(terms)
 
 
-@pytest.mark.parametrize("kind", ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev"])
+@pytest.mark.parametrize("kind", ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"])
 def test_every_kind_matches_its_definition(kind):
     rng = np.random.default_rng(2)
     y = rng.standard_normal(300).cumsum() * 0.02 + rng.standard_normal(300)
@@ -106,27 +124,109 @@ STABLE32_FILES = [
     # Stable32 ran this one with tau0 = 42 s
     *[("pink_frequency/pink_frequency.txt", "rate", 1.0 / 42, f"pink_frequency/{k}.txt", k, 1e-4)
       for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
+    ("pink_frequency/pink_frequency.txt", "rate", 1.0 / 42, "pink_frequency/totdev_alpha0.txt", "totdev", 1e-4),
+    ("pink_frequency/pink_frequency.txt", "rate", 1.0, "pink_frequency/s32_oadev_octave.txt", "oadev", 1e-4),
+    # total deviation
+    ("phasedat/PHASE.DAT", "phase", 1.0, "phasedat/phase_dat_totdev_octave.txt", "totdev", 1e-4),
+    ("phasedat/PHASE.DAT", "phase", 1.0, "phasedat/phase_dat_totdev.txt", "totdev", 1e-4),
+    ("gps/gps_1pps_phase_data.txt.gz", "phase", 1.0, "gps/stable32_TOTDEV_octave.txt", "totdev", 1e-4),
+    ("Cs5071A/5071A_phase.txt.gz", "phase", 1.0, "Cs5071A/totdev_decade.txt", "totdev", 1e-4),
+    ("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", 1.0, "Keysight53230A_ti_noise_floor/tic_totdev.txt",
+     "totdev", 1e-4),
+    # ocxo/totdev_octave.txt came from the differently normalised input (.001); TOTDEV's end reflections
+    # make it 1.2e-2 off, so TOTDEV is checked on the all-tau run of the (f - 1e7)/1e7 data instead
+    ("ocxo/ocxo_frequency.txt", "ocxo", 1.0, "ocxo/stable32_totdev_alltau.txt", "totdev", 1e-4),
 ]
 _SERIES_CACHE = {}
 
 
-@pytest.mark.parametrize("data_file,data_type,rate_hz,result_file,kind,rtol", STABLE32_FILES,
-                         ids=[f[3] for f in STABLE32_FILES])
-def test_matches_stable32_row_by_row(data_file, data_type, rate_hz, result_file, kind, rtol):
+def stable32_case(data_file, data_type, result_file):
+    """(data, data type, reference rows) of one Stable32 comparison."""
     folder = shared_dataset("allantools-stable32")
     if data_file not in _SERIES_CACHE:
         _SERIES_CACHE[data_file] = load_series(folder / data_file)
     data = _SERIES_CACHE[data_file]
     if data_type == "ocxo":
         data, data_type = (data - 1e7) / 1e7, "rate"
-    ref = read_columns(folder / result_file)
-    res = allan_deviation(data, rate_hz, kind=kind, taus=ref[:, 0] / rate_hz, data_type=data_type)
+    return data, data_type, read_columns(folder / result_file)
+
+
+@pytest.mark.parametrize("data_file,data_type,rate_hz,result_file,kind,rtol", STABLE32_FILES,
+                         ids=[f[3] for f in STABLE32_FILES])
+def test_matches_stable32_row_by_row(data_file, data_type, rate_hz, result_file, kind, rtol):
+    data, data_type, ref = stable32_case(data_file, data_type, result_file)
+    res = allan_deviation(data, rate_hz, kind=kind, taus=ref[:, 0] / rate_hz, data_type=data_type, confidence=None)
     np.testing.assert_array_equal(res.n, ref[:, 2].astype(int))
     np.testing.assert_allclose(res.tau, ref[:, 0] / rate_hz, rtol=1e-12)
     np.testing.assert_allclose(res.deviation, ref[:, 5], rtol=rtol)
 
 
-@pytest.mark.parametrize("kind", ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev"])
+# every reference file that carries Stable32's confidence intervals and noise types (octave/decade runs)
+CI_FILES = [
+    *[("phasedat/PHASE.DAT", "phase", f"phasedat/phase_dat_{k}_octave.txt", k)
+      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    ("gps/gps_1pps_phase_data.txt.gz", "phase", "gps/stable32_ADEV_decade.txt", "adev"),
+    *[("gps/gps_1pps_phase_data.txt.gz", "phase", f"gps/stable32_{k.upper()}_octave.txt", k)
+      for k in ("oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    *[("Cs5071A/5071A_phase.txt.gz", "phase", f"Cs5071A/{k}_decade.txt", k)
+      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    *[("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", f"Keysight53230A_ti_noise_floor/tic_{k}.txt", k)
+      for k in ("oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    *[("ocxo/ocxo_frequency.txt", "ocxo", f"ocxo/{k}_octave.txt", k)
+      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    ("pink_frequency/pink_frequency.txt", "rate", "pink_frequency/s32_oadev_octave.txt", "oadev"),
+]
+_EDF_ARGS = {"adev": (2, False, False), "oadev": (2, True, False), "mdev": (2, True, True), "tdev": (2, True, True),
+             "hdev": (3, False, False), "ohdev": (3, True, False)}
+
+
+def stable32_edf(kind, alpha, m, n_phase):
+    if kind == "totdev":
+        return edf_totdev(alpha, m, n_phase)
+    d, overlapping, modified = _EDF_ARGS[kind]
+    return edf_greenhall(alpha, d, m, n_phase, overlapping=overlapping, modified=modified)
+
+
+@pytest.mark.parametrize("data_file,data_type,result_file,kind", CI_FILES, ids=[f[2] for f in CI_FILES])
+def test_confidence_intervals_match_stable32(data_file, data_type, result_file, kind):
+    """Our degrees of freedom with Stable32's noise type and deviation give Stable32's bounds within 2e-3."""
+    data, data_type, ref = stable32_case(data_file, data_type, result_file)
+    n_phase = data.size + (1 if data_type == "rate" else 0)
+    for m, _, _, alpha, low_ref, dev_ref, high_ref in ref:
+        low, high = confidence_interval(dev_ref, stable32_edf(kind, int(alpha), int(m), n_phase))
+        # one row, TOTDEV flicker PM at m = 65536 (3.7 averages): Stable32's degrees of freedom there are
+        # 43.6, SP 1065's formula gives 41.6; every other row of every file is within 2e-3
+        tol = 4e-3 if (result_file == "gps/stable32_TOTDEV_octave.txt" and m == 65536) else 2e-3
+        assert low == pytest.approx(low_ref, rel=tol), m
+        assert high == pytest.approx(high_ref, rel=tol), m
+
+
+@pytest.mark.parametrize("data_file,data_type,result_file,kind", CI_FILES, ids=[f[2] for f in CI_FILES])
+def test_noise_identification_and_end_to_end_intervals(data_file, data_type, result_file, kind):
+    """The lag-1 noise types match Stable32's wherever 30 points remain, and then so do the bounds."""
+    data, data_type, ref = stable32_case(data_file, data_type, result_file)
+    res = allan_deviation(data, 1.0, kind=kind, taus=ref[:, 0], data_type=data_type)
+    n_phase = data.size + (1 if data_type == "rate" else 0)
+    identified = (n_phase - 1) // ref[:, 0] + 1 >= 30
+    mismatches = {int(m) for m, ours, theirs, ok in zip(ref[:, 0], res.alpha, ref[:, 3], identified)
+                  if ok and ours != theirs}
+    if result_file == "Cs5071A/totdev_decade.txt":
+        # Stable32 lists alpha 0 on every row, while its own OADEV run of the same data finds 2 (white PM)
+        # at m = 1: this TOTDEV run used a fixed noise type, so only the intervals are compared above
+        return
+    # Cs5071A m = 10000 (56 points): Stable32 says white FM, the lag-1 statistic says white PM (allantools
+    # finds the same); the other 400+ identifiable rows of all files agree
+    assert mismatches <= ({10000} if result_file.startswith("Cs5071A/") else set())
+    agree = identified & (res.alpha == ref[:, 3])
+    assert agree.any()
+    if kind == "totdev" and data_type == "rate":
+        return  # the ocxo TOTDEV rows come from other input data (see STABLE32_FILES); alphas checked above
+    tol = 2e-3 + (2e-3 if data_file.startswith("ocxo/") else 1e-4)  # plus the deviation's own tolerance
+    np.testing.assert_allclose(res.ci_low[agree], ref[agree, 4], rtol=tol)
+    np.testing.assert_allclose(res.ci_high[agree], ref[agree, 6], rtol=tol)
+
+
+@pytest.mark.parametrize("kind", ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"])
 @pytest.mark.parametrize("dataset,data_file,data_type", [
     ("nbs14_10", "nbs14_10point_phase.txt", "phase"),
     ("nbs14_10", "nbs14_10point_freq.txt", "rate"),
@@ -189,3 +289,90 @@ def test_errors():
         allan_deviation(np.zeros(10), 1.0, taus=np.array([100.0]))
     with pytest.raises(InputError, match=r"data_type: 'angle'"):
         allan_deviation(np.zeros(10), 1.0, data_type="angle")
+
+
+def test_octave_pass_is_exact_on_drift_dominated_data():
+    """The block-wise octave pass (dot-product identity on centred windows) against window means, on a
+    series where a drift dwarfs the noise and spans several blocks."""
+    rng = np.random.default_rng(11)
+    n = 700_000
+    y = 0.5 + 2.0 * np.linspace(0.0, 1.0, n) + 1e-3 * rng.standard_normal(n)
+    res = allan_deviation(y, 1.0, taus=np.array([1, 2, 4, 8, 16]), confidence=None)
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    for m, dev in zip((1, 2, 4, 8, 16), res.deviation):
+        means = sliding_window_view(y, m).mean(axis=1)
+        ref = np.sqrt(0.5 * np.mean((means[m:] - means[:-m]) ** 2))
+        assert dev == pytest.approx(ref, rel=1e-7), m
+
+
+def test_identify_noise_on_power_law_noises():
+    rng = np.random.default_rng(5)
+    white = rng.standard_normal(20_000)
+    assert identify_noise(white, 1).alpha == 2  # white PM: the phase itself is white
+    assert identify_noise(np.cumsum(white), 1).alpha == 0  # white FM
+    assert identify_noise(np.cumsum(np.cumsum(white)), 4).alpha == -2  # random walk FM
+    assert identify_noise(white[:29], 1) is None
+    assert identify_noise(np.zeros(100), 1) is None
+
+
+def test_without_confidence_the_intervals_are_nan():
+    res = allan_deviation(np.random.default_rng(0).standard_normal(1000), 1.0, confidence=None)
+    assert np.isnan(res.ci_low).all() and np.isnan(res.alpha).all()
+    full = allan_deviation(np.random.default_rng(0).standard_normal(1000), 1.0)
+    np.testing.assert_array_equal(res.deviation, full.deviation)
+    assert (full.ci_low < full.deviation).all() and (full.deviation < full.ci_high).all()
+
+
+def test_memory_mapped_input_and_phase(tmp_path):
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal(300_001) + 0.2
+    path = tmp_path / "rate.npy"
+    np.save(path, y)
+    phase = np.lib.format.open_memmap(tmp_path / "phase.npy", mode="w+", dtype=np.float64, shape=(y.size + 1,))
+    mapped = allan_deviation(np.load(path, mmap_mode="r"), 10.0, phase_out=phase)
+    plain = allan_deviation(y, 10.0)
+    np.testing.assert_allclose(mapped.deviation, plain.deviation, rtol=1e-12)
+    np.testing.assert_array_equal(mapped.alpha, plain.alpha)
+    np.testing.assert_allclose(np.asarray(phase), to_phase(y, 10.0), rtol=0, atol=1e-9)
+    chunks = lambda: (y[i:i + 70_000] for i in range(0, y.size, 70_000))  # noqa: E731
+    np.testing.assert_allclose(phase_from_chunks(chunks, 10.0, y.size), to_phase(y, 10.0), atol=1e-9)
+    with pytest.raises(InputError, match=r"chunks: delivered 300001 samples, expected 5"):
+        phase_from_chunks(chunks, 10.0, 5)
+    with pytest.raises(InputError, match=r"out: needs 300002 elements for 300001 rate samples, has 3"):
+        to_phase(y, 10.0, out=np.empty(3))
+
+
+@pytest.mark.parametrize("kind", ["oadev", "adev", "mdev", "hdev", "ohdev"])
+def test_pooled_stretches_sum_the_terms_of_each(kind):
+    rng = np.random.default_rng(9)
+    pieces = [rng.standard_normal(n).cumsum() * 0.01 + rng.standard_normal(n) for n in (400, 250, 90)]
+    res = allan_deviation_segments(pieces, 2.0, kind=kind, taus="all")
+    for tau, dev, n in zip(res.tau, res.deviation, res.n):
+        m = int(round(tau * 2.0))
+        total, count = 0.0, 0
+        for piece in pieces:
+            if piece.size >= (3 * m if kind in ("mdev", "hdev", "ohdev") else 2 * m):
+                ref, k = brute_force(kind, piece, 2.0, m)
+                total, count = total + ref ** 2 * k, count + k
+        assert n == count
+        assert dev == pytest.approx(np.sqrt(total / count), rel=1e-9)
+    single = allan_deviation_segments([pieces[0]], 2.0, kind=kind)
+    np.testing.assert_allclose(single.deviation, allan_deviation(pieces[0], 2.0, kind=kind).deviation, rtol=1e-12)
+    np.testing.assert_allclose(single.ci_high, allan_deviation(pieces[0], 2.0, kind=kind).ci_high, rtol=1e-12)
+    with pytest.raises(InputError, match=r"kind: totdev cannot pool stretches"):
+        allan_deviation_segments(pieces, 2.0, kind="totdev")
+
+
+def test_interval_identities():
+    # chi-squared bounds: more degrees of freedom, tighter interval, always around the estimate
+    low, high = confidence_interval(np.array([1.0, 1.0]), np.array([10.0, 1000.0]))
+    assert low[0] < low[1] < 1.0 < high[1] < high[0]
+    assert ONE_SIGMA == pytest.approx(0.682689492, abs=1e-9)
+    # white FM, overlapping Allan, large N: Greenhall's edf tends to (table 2) r / (a0 - a1/r) ~ 1.5 N/m
+    assert edf_greenhall(0, 2, 100, 1_000_001, overlapping=True, modified=False) == pytest.approx(
+        1.5 * 1_000_000 / 100, rel=0.01)
+    with pytest.raises(InputError, match=r"alpha: -3 is outside the range the difference order 2 can estimate"):
+        edf_greenhall(-3, 2, 1, 100, overlapping=True, modified=False)
+    with pytest.raises(InputError, match=r"alpha: -3 has no total-deviation degrees of freedom"):
+        edf_totdev(-3, 1, 100)

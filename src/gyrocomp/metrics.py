@@ -18,12 +18,11 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .allan import allan_deviation
+from .allan import BIAS_INSTABILITY_FACTOR, allan_deviation
 from .errors import DataQualityWarning, InputError
 from .recording import Recording
 from .units import DEG_PER_S_TO_DEG_PER_H
 
-BIAS_INSTABILITY_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)  # 0.6643
 MIN_WINDOW_S = 1.0
 
 
@@ -54,8 +53,8 @@ class BiasInstability:
 
 def bias_instability(rate_dps: np.ndarray, rate_hz: float) -> BiasInstability:
     """Bias instability from the minimum of the octave overlapping Allan deviation of rate data [deg/s]."""
-    tau, dev = allan_deviation(rate_dps, rate_hz, taus="octave").minimum()
-    return BiasInstability(dev / BIAS_INSTABILITY_FACTOR * DEG_PER_S_TO_DEG_PER_H, tau)
+    low = allan_deviation(rate_dps, rate_hz, taus="octave", confidence=None).minimum()
+    return BiasInstability(low.deviation / BIAS_INSTABILITY_FACTOR * DEG_PER_S_TO_DEG_PER_H, low.tau_s)
 
 
 def default_window_s(recording: Recording) -> float:
