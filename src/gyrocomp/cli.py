@@ -13,13 +13,15 @@ import warnings
 from pathlib import Path
 
 import click
+import numpy as np
 from rich.console import Console
 from rich.table import Table
 
 from . import __version__
+from .allan import KINDS
 from .calibration import Calibration
 from .compensate import apply as apply_calibration
-from .errors import GyrocompError, InputError
+from .errors import DataQualityWarning, GyrocompError, InputError
 from .io import (
     TableLayout,
     detect_format,
@@ -31,9 +33,12 @@ from .io import (
     write_recording,
     write_text_atomic,
 )
+from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .metrics import Evaluation, evaluate_run
 from .models.pipelines import fit_calibration
 from .models.temperature import parse_temperature_option
+from .noise import NoiseAnalysis, analyse_noise
+from .report.figures import allan_figure, check_figure_path
 
 EXIT_INPUT = 2
 EXIT_FAILURE = 1
@@ -232,6 +237,124 @@ def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -
                           f"{m.bias_instability_raw_dph:.4g}", f"{m.bias_instability_comp_dph:.4g}",
                           f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
                           f"{m.residual_rms_dps:.3g}")
+    console.print(table)
+
+
+# -- allan -------------------------------------------------------------------------------------------
+def _parse_taus(text: str):
+    if text in ("octave", "decade", "all"):
+        return text
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or min(values) <= 0:
+        raise click.BadParameter("use octave, decade, all or a comma-separated list of taus [s], e.g. 1,10,100",
+                                 param_hint="--taus")
+    return values
+
+
+def _parse_fit_taus(text: str | None):
+    if text is None:
+        return None
+    try:
+        low, high = (float(v) for v in text.split(","))
+    except ValueError:
+        low = high = -1.0
+    if not 0 < low < high:
+        raise click.BadParameter("use MIN,MAX in seconds with 0 < MIN < MAX, e.g. 3,1000", param_hint="--fit-taus")
+    return low, high
+
+
+#: RMS misfit (in ln deviation) of the noise model beyond which ``gyrocomp allan`` warns
+POOR_FIT_LOG_RESIDUAL = 0.25
+
+
+@cli.command()
+@click.argument("input_path", metavar="FILE", type=click.Path())
+@click.option("--axes", "axes", default=None, help="Columns to analyse, e.g. gyro_x,gyro_z,accel_z (default: every gyro axis).")
+@click.option("--kind", type=click.Choice(KINDS), default="oadev", show_default=True, help="Estimator of the printed curve.")
+@click.option("--taus", default="octave", show_default=True, help="octave, decade, all, or taus [s] such as 1,10,100.")
+@click.option("--json", "as_json", is_flag=True, help="Print curves and noise terms as JSON on stdout.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write the Allan plot here (.png, .svg, .pdf).")
+@click.option("--kalibr", "kalibr_path", type=click.Path(dir_okay=False), help="Write Kalibr's imu.yaml here.")
+@click.option("--rostopic", default="/imu0", show_default=True, help="rostopic written into the Kalibr file.")
+@click.option("--split-gaps", is_flag=True, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
+@click.option("--fit-taus", "fit_taus", default=None, metavar="MIN,MAX",
+              help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.")
+@read_options
+@click.pass_context
+def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, rostopic, split_gaps, fit_taus,
+          **kwargs):
+    """Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of FILE."""
+    opts = _pop_read_options(kwargs)
+    tau_spec = _parse_taus(taus)
+    fit_range = _parse_fit_taus(fit_taus)
+    for option, path in (("--plot", plot_path), ("--kalibr", kalibr_path)):
+        if path:
+            refuse_to_overwrite_inputs(path, [input_path], option=option)
+    if plot_path:
+        check_figure_path(plot_path)
+    recording = _read(input_path, opts).recording
+    names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
+    if kalibr_path:
+        names += [a for a in recording.accel_axes if a not in names]
+    analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                             fit_taus_s=fit_range)
+    if analysis.how and not ctx.obj["quiet"]:
+        click.echo(f"gyrocomp: note: {analysis.how}", err=True)
+    for name, a in analysis.axes.items():
+        if a.terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
+            warnings.warn(f"{name}: the five-term noise model misses the curve by {a.terms.fit_rms_log_residual:.0%} "
+                          "RMS; compare the read-offs, or restrict the fit with --fit-taus", DataQualityWarning)
+    if kalibr_path:
+        write_text_atomic(kalibr_path, kalibr_imu_yaml(kalibr_imu(analysis, rostopic)))
+    if plot_path:
+        allan_figure(analysis, plot_path)
+    if as_json:
+        click.echo(json.dumps(analysis.to_dict(), indent=2))
+    elif not ctx.obj["quiet"]:
+        print_noise(analysis)
+
+
+def print_noise(analysis: NoiseAnalysis) -> None:
+    console = _console()
+    for name, a in analysis.axes.items():
+        c = a.curve
+        table = Table(title=f"{Path(analysis.source).name}: {name} {c.kind.upper()} [{a.unit}]")
+        for col in ("tau [s]", "deviation", "ci low", "ci high", "n", "alpha"):
+            table.add_column(col, justify="right")
+        for row in zip(c.tau, c.deviation, c.ci_low, c.ci_high, c.n, c.alpha):
+            table.add_row(f"{row[0]:.6g}", f"{row[1]:.5g}", f"{row[2]:.5g}", f"{row[3]:.5g}", f"{row[4]:d}",
+                          "-" if np.isnan(row[5]) else f"{row[5]:+.0f}")
+        console.print(table)
+    table = Table(title="noise terms (IEEE Std 952 fit; B = Allan minimum / 0.664)")
+    table.add_column("axis", no_wrap=True)
+    table.add_column("term")
+    table.add_column("value", justify="right")
+    table.add_column("read-off", justify="right")
+    for name, a in analysis.axes.items():
+        n = a.noise
+        if a.sensor == "gyro":
+            rows = [("N [deg/s/sqrt(Hz)]", n.noise_density_dps_per_sqrt_hz, n.noise_density_readoff_dps_per_sqrt_hz),
+                    ("ARW [deg/sqrt(h)]", n.arw_deg_per_sqrt_h, None),
+                    ("B [deg/h]", n.bias_instability_deg_per_h, None),
+                    ("integration time [s]", n.integration_time_s, None),
+                    ("K [deg/h/sqrt(h)]", n.rrw_deg_per_h_per_sqrt_h, n.rrw_readoff_deg_per_h_per_sqrt_h),
+                    ("Q [deg]", n.quantization_deg, None),
+                    ("R [deg/h^2]", n.rate_ramp_deg_per_h2, None)]
+        else:
+            rows = [("N [g/sqrt(Hz)]", n.noise_density_g_per_sqrt_hz, n.noise_density_readoff_g_per_sqrt_hz),
+                    ("VRW [m/s/sqrt(h)]", n.vrw_m_per_s_per_sqrt_h, None),
+                    ("B [micro-g]", n.bias_instability_micro_g, None),
+                    ("integration time [s]", n.integration_time_s, None),
+                    ("K [m/s^3/sqrt(Hz)]", n.random_walk_m_per_s3_per_sqrt_hz, n.random_walk_readoff_m_per_s3_per_sqrt_hz),
+                    ("Q [m/s]", n.quantization_m_per_s, None),
+                    ("R [m/s^3]", n.ramp_m_per_s3, None)]
+        for i, (term, value, readoff) in enumerate(rows):
+            table.add_row(name if i == 0 else "", term, f"{value:.4g}", "" if readoff is None else f"{readoff:.4g}")
+        if not n.floor_reached:
+            table.add_row("", "(no floor: B is an upper bound)", "", "")
     console.print(table)
 
 

@@ -1,0 +1,160 @@
+"""Noise analysis of a recording: an Allan curve and the IEEE Std 952 noise terms for each axis.
+
+Gyro axes are analysed in [deg/s], accelerometer axes in [g]. A recording with time gaps is refused
+unless ``split_gaps`` is set; then the contiguous stretches are pooled so that no difference spans a
+gap (TOTDEV, which has no pooled form, uses the longest stretch).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .allan import (
+    AccelNoise,
+    AllanResult,
+    GyroNoise,
+    NoiseTerms,
+    allan_deviation,
+    allan_deviation_segments,
+    noise_terms,
+)
+from .errors import InputError
+from .recording import Recording
+
+
+@dataclass(frozen=True)
+class AxisNoise:
+    """One axis: the requested curve, the overlapping Allan curve the noise terms come from, the terms in
+    the data's unit and in the units they are quoted in."""
+
+    axis: str
+    sensor: str
+    unit: str
+    curve: AllanResult
+    allan: AllanResult
+    terms: NoiseTerms
+    noise: GyroNoise | AccelNoise
+
+
+@dataclass(frozen=True)
+class NoiseAnalysis:
+    """Noise of every analysed axis of one recording.
+
+    ``stretches`` is the number of contiguous stretches used and ``how`` says how gaps were handled
+    (None for a recording without gaps).
+    """
+
+    source: str
+    rate_hz: float
+    axes: dict[str, AxisNoise]
+    stretches: int = 1
+    how: str | None = None
+
+    def to_dict(self) -> dict:
+        """The ``gyrocomp allan --json`` document (NaN written as null)."""
+        return {
+            "rate_hz": self.rate_hz,
+            "axes": {
+                name: {
+                    "tau_s": _floats(a.curve.tau),
+                    "adev": _floats(a.curve.deviation),
+                    "n": [int(v) for v in a.curve.n],
+                    "ci_low": _floats(a.curve.ci_low),
+                    "ci_high": _floats(a.curve.ci_high),
+                    "noise": {k: _float(v) for k, v in a.noise.summary().items()},
+                }
+                for name, a in self.axes.items()
+            },
+        }
+
+
+def _float(value):
+    if value is None:
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def _floats(values) -> list:
+    return [_float(v) for v in np.asarray(values, dtype=float)]
+
+
+def contiguous_stretches(recording: Recording) -> list[slice]:
+    """Sample ranges between the recording's time gaps, in order."""
+    starts = [0]
+    for gap in recording.gaps:
+        starts.append(int(np.searchsorted(recording.time_s, gap.start_s)) + 1)
+    bounds = starts + [recording.n_samples]
+    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def _channel(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
+    if axis in recording.gyro_axes:
+        return recording.gyro(axis), "gyro", "deg/s"
+    if axis in recording.accel_axes:
+        return recording.accel_g[:, recording.accel_axes.index(axis)], "accel", "g"
+    have = ", ".join((*recording.gyro_axes, *recording.accel_axes))
+    raise InputError(f"--axes: {axis!r} is not in {recording.source}; it has {have}")
+
+
+def _describe_gap(recording: Recording) -> str:
+    gap = recording.gaps[0]
+    more = f" (and {len(recording.gaps) - 1} more)" if len(recording.gaps) > 1 else ""
+    return (f"{recording.source}: time gap of {gap.duration_s:.6g} s after row {gap.after_row} "
+            f"(t = {gap.start_s:.6g} s){more}; Allan deviations need evenly spaced samples: "
+            f"use --split-gaps to pool the contiguous stretches")
+
+
+def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: str = "oadev",
+                  taus="octave", split_gaps: bool = False,
+                  fit_taus_s: tuple[float, float] | None = None) -> NoiseAnalysis:
+    """Allan curve (``kind``) and noise terms (from the overlapping Allan deviation) for each axis.
+
+    Parameters
+    ----------
+    recording : Recording
+    axes : list of str, optional
+        Gyro and/or accelerometer columns, e.g. ``["gyro_x", "accel_z"]``; default every gyro axis.
+    kind, taus : see :func:`gyrocomp.allan.allan_deviation`.
+    split_gaps : bool
+        Pool the contiguous stretches of a recording with gaps instead of refusing it.
+    fit_taus_s : (float, float), optional
+        Fit the noise model only on taus in this range [s] (see :func:`gyrocomp.allan.noise_terms`).
+    """
+    names = list(axes) if axes else list(recording.gyro_axes)
+    if recording.gaps and not split_gaps:
+        raise InputError(_describe_gap(recording))
+    stretches = contiguous_stretches(recording)
+    how = None
+    if len(stretches) > 1:
+        longest = max(stretches, key=lambda s: s.stop - s.start)
+        length_s = (longest.stop - longest.start) / recording.rate_hz
+        how = (f"{recording.source}: pooled {len(stretches)} contiguous stretches split at "
+               f"{len(recording.gaps)} gap(s); no difference spans a gap (longest stretch {length_s:.6g} s)")
+        if kind == "totdev":
+            how = (f"{recording.source}: TOTDEV on the longest of {len(stretches)} contiguous stretches "
+                   f"({length_s:.6g} s, rows {recording.row_numbers[longest.start]}-"
+                   f"{recording.row_numbers[longest.stop - 1]}); the noise terms pool all stretches")
+    results = {}
+    for name in names:
+        values, sensor, unit = _channel(recording, name)
+        pieces = [values[s] for s in stretches]
+        if len(pieces) == 1:
+            curve = allan_deviation(values, recording.rate_hz, kind=kind, taus=taus)
+            allan = curve if kind == "oadev" else allan_deviation(values, recording.rate_hz, taus="octave")
+        else:
+            allan = allan_deviation_segments(pieces, recording.rate_hz, taus="octave")
+            if kind == "totdev":
+                curve = allan_deviation(max(pieces, key=len), recording.rate_hz, kind=kind, taus=taus)
+            elif kind == "oadev" and isinstance(taus, str) and taus == "octave":
+                curve = allan
+            else:
+                curve = allan_deviation_segments(pieces, recording.rate_hz, kind=kind, taus=taus)
+        terms = noise_terms(allan, fit_taus_s)
+        quoted = GyroNoise.from_terms(terms) if sensor == "gyro" else AccelNoise.from_terms(terms)
+        results[name] = AxisNoise(name, sensor, unit, curve, allan, terms, quoted)
+    return NoiseAnalysis(source=recording.source, rate_hz=recording.rate_hz, axes=results,
+                         stretches=len(stretches), how=how)

@@ -1,0 +1,1 @@
+"""Figures and reports for test reports. Needs matplotlib: ``pip install 'gyrocomp[plot]'``."""

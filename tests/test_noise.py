@@ -1,0 +1,77 @@
+"""Noise analysis of recordings: axes, accelerometers, time gaps."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gyrocomp.allan import allan_deviation, allan_deviation_segments
+from gyrocomp.errors import InputError
+from gyrocomp.noise import analyse_noise, contiguous_stretches
+from gyrocomp.recording import Recording
+
+
+def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0):
+    rng = np.random.default_rng(seed)
+    time_s = np.arange(n) / rate_hz
+    if gap_after is not None:
+        time_s[gap_after:] += 10.0  # a 10 s hole
+    gyro = rng.standard_normal((n, 2)) * 0.01 * math.sqrt(rate_hz)  # N = 0.01 deg/s/sqrt(Hz)
+    accel = np.column_stack([rng.standard_normal(n) * 1e-3, rng.standard_normal(n) * 1e-3,
+                             1.0 + rng.standard_normal(n) * 1e-3])
+    return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=("gyro_x", "gyro_z"), accel_g=accel,
+                     accel_axes=("accel_x", "accel_y", "accel_z"), source="static.csv")
+
+
+def test_every_gyro_axis_by_default_and_accelerometers_on_request():
+    rec = static_recording()
+    analysis = analyse_noise(rec)
+    assert list(analysis.axes) == ["gyro_x", "gyro_z"]
+    gyro = analysis.axes["gyro_z"]
+    assert gyro.sensor == "gyro" and gyro.unit == "deg/s"
+    assert gyro.noise.noise_density_dps_per_sqrt_hz == pytest.approx(0.01, rel=0.03)
+    accel = analyse_noise(rec, ["accel_z"]).axes["accel_z"]
+    assert accel.sensor == "accel" and accel.unit == "g"
+    # white accelerometer noise of 1e-3 g per sample at 50 Hz: N = 1e-3 / sqrt(50) [g/sqrt(Hz)]
+    assert accel.noise.noise_density_g_per_sqrt_hz == pytest.approx(1e-3 / math.sqrt(50), rel=0.03)
+    with pytest.raises(InputError, match=r"--axes: 'gyro_y' is not in static.csv; it has gyro_x, gyro_z, accel_x"):
+        analyse_noise(rec, ["gyro_y"])
+
+
+def test_other_kinds_keep_noise_terms_from_the_overlapping_curve():
+    rec = static_recording()
+    analysis = analyse_noise(rec, ["gyro_x"], kind="mdev", taus="decade")
+    axis = analysis.axes["gyro_x"]
+    assert axis.curve.kind == "mdev" and axis.allan.kind == "oadev"
+    np.testing.assert_allclose(axis.allan.deviation, allan_deviation(rec.gyro("gyro_x"), rec.rate_hz).deviation)
+
+
+def test_gaps_are_refused_unless_split():
+    rec = static_recording(gap_after=40_000)
+    with pytest.raises(InputError, match=r"static.csv: time gap of 10.02 s after row 40000 \(t = 799.98 s\); "
+                                         r"Allan deviations need evenly spaced samples: use --split-gaps"):
+        analyse_noise(rec)
+    assert [(s.start, s.stop) for s in contiguous_stretches(rec)] == [(0, 40_000), (40_000, 60_000)]
+    analysis = analyse_noise(rec, split_gaps=True)
+    assert analysis.stretches == 2
+    assert "pooled 2 contiguous stretches split at 1 gap(s)" in analysis.how
+    pooled = allan_deviation_segments([rec.gyro("gyro_x")[:40_000], rec.gyro("gyro_x")[40_000:]], rec.rate_hz)
+    np.testing.assert_allclose(analysis.axes["gyro_x"].curve.deviation, pooled.deviation, rtol=1e-12)
+    # no term spans the gap: the count is what the two stretches have on their own
+    assert analysis.axes["gyro_x"].curve.n[0] == (40_000 - 1) + (20_000 - 1)
+    total = analyse_noise(rec, ["gyro_x"], kind="totdev", split_gaps=True)
+    assert "TOTDEV on the longest of 2 contiguous stretches (800 s, rows 1-40000)" in total.how
+
+
+def test_json_document_has_the_documented_shape_and_no_nan():
+    rec = static_recording(n=2000)
+    doc = analyse_noise(rec, ["gyro_z", "accel_x"]).to_dict()
+    assert set(doc) == {"rate_hz", "axes"}
+    z = doc["axes"]["gyro_z"]
+    assert set(z) == {"tau_s", "adev", "n", "ci_low", "ci_high", "noise"}
+    assert set(z["noise"]) == {"noise_density_dps_per_sqrt_hz", "arw_deg_per_sqrt_h", "bias_instability_deg_per_h",
+                               "integration_time_s", "rrw_deg_per_h_per_sqrt_h", "quantization_deg",
+                               "rate_ramp_deg_per_h2"}
+    assert "noise_density_g_per_sqrt_hz" in doc["axes"]["accel_x"]["noise"]
+    flat = [v for axis in doc["axes"].values() for key in ("adev", "ci_low", "ci_high") for v in axis[key]]
+    assert all(v is None or math.isfinite(v) for v in flat)
