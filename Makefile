@@ -19,7 +19,9 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
+	$(BIN)/pip install -q -e '.[bench]'
 	$(BIN)/python benchmarks/bench_apply.py
+	$(BIN)/python benchmarks/bench_allan.py
 
 clean:
 	rm -rf $(VENV) demo-output build src/*.egg-info
