@@ -3,8 +3,8 @@
 Kalibr (ethz-asl/kalibr, wiki "IMU Noise Model") takes the continuous-time white-noise densities and
 bias random walks: gyroscope_noise_density [rad/s/sqrt(Hz)] = N, gyroscope_random_walk
 [rad/s^2/sqrt(Hz)] = K, accelerometer_noise_density [m/s^2/sqrt(Hz)], accelerometer_random_walk
-[m/s^3/sqrt(Hz)], plus update_rate [Hz] and rostopic. They are the N and K of the Allan analysis
-(not the discrete-time standard deviations, which are these times sqrt(update_rate) and
+[m/s^3/sqrt(Hz)], plus update_rate [Hz] and rostopic. They are the N and K of the Allan analysis;
+Kalibr derives the discrete-time values itself (noise density times sqrt(update_rate), random walk
 divided by it). With several axes, the largest value is written, which is the conservative choice.
 """
 
