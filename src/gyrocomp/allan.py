@@ -136,6 +136,23 @@ def _mean(data) -> float:
     return float(np.mean(data, dtype=np.float64))
 
 
+def _running_sum(chunks, mean: float, out: np.ndarray, divisor: float = 1.0) -> np.ndarray:
+    """out[0] = 0, out[k] = sum_{i<k} (data[i] - mean) / divisor, chunk by chunk, with a carried total."""
+    out[0] = 0.0
+    carry, position = 0.0, 0
+    for chunk in chunks:
+        block = np.cumsum(np.asarray(chunk, dtype=np.float64) - mean)
+        if not block.size:
+            continue
+        block += carry
+        carry = float(block[-1])
+        if divisor != 1.0:
+            block /= divisor
+        out[position + 1:position + 1 + block.size] = block
+        position += block.size
+    return out
+
+
 def to_phase(rate, rate_hz: float, out: np.ndarray | None = None) -> np.ndarray:
     """Integrate rate samples into N+1 phase points [unit*s], mean removed first (as Stable32 does).
 
@@ -146,16 +163,7 @@ def to_phase(rate, rate_hz: float, out: np.ndarray | None = None) -> np.ndarray:
     phase = np.empty(n + 1) if out is None else out
     if len(phase) != n + 1:
         raise InputError(f"out: needs {n + 1} elements for {n} rate samples, has {len(phase)}")
-    mean = _mean(rate)
-    phase[0] = 0.0
-    carry = 0.0
-    for start, stop in _blocks(n):
-        block = np.cumsum(np.asarray(rate[start:stop], dtype=np.float64) - mean)
-        block += carry
-        carry = float(block[-1])
-        block /= rate_hz
-        phase[start + 1:stop + 1] = block
-    return phase
+    return _running_sum((rate[a:b] for a, b in _blocks(n)), _mean(rate), phase, rate_hz)
 
 
 def phase_from_chunks(chunks, rate_hz: float, n_samples: int, out: np.ndarray | None = None) -> np.ndarray:
@@ -170,17 +178,8 @@ def phase_from_chunks(chunks, rate_hz: float, n_samples: int, out: np.ndarray | 
         count += len(chunk)
     if count != n_samples:
         raise InputError(f"chunks: delivered {count} samples, expected {n_samples}")
-    mean = total / count
     phase = np.empty(n_samples + 1) if out is None else out
-    phase[0] = 0.0
-    carry, position = 0.0, 0
-    for chunk in chunks():
-        block = np.cumsum(np.asarray(chunk, dtype=np.float64) - mean)
-        block += carry
-        carry = float(block[-1]) if block.size else carry
-        phase[position + 1:position + 1 + block.size] = block / rate_hz
-        position += block.size
-    return phase
+    return _running_sum(chunks(), total / count, phase, rate_hz)
 
 
 def averaging_factors(n_phase: int, taus: str | np.ndarray, rate_hz: float, kind: str = "oadev") -> np.ndarray:
@@ -338,16 +337,7 @@ def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
 
 def _cumulated(phase) -> np.ndarray:
     """X[k] = sum_{i<k} (x[i] - mean(x)), the running sum the modified variance differences."""
-    out = np.empty(len(phase) + 1)
-    out[0] = 0.0
-    mean = _mean(phase)
-    carry = 0.0
-    for start, stop in _blocks(len(phase)):
-        block = np.cumsum(np.asarray(phase[start:stop], dtype=np.float64) - mean)
-        block += carry
-        carry = float(block[-1])
-        out[start + 1:stop + 1] = block
-    return out
+    return _running_sum((phase[a:b] for a, b in _blocks(len(phase))), _mean(phase), np.empty(len(phase) + 1))
 
 
 def _one_sum(kind: str, phase, cumulated, m: int, count: int) -> float:
