@@ -309,7 +309,7 @@ def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
     levels = top.bit_length()
     sums = np.zeros(levels)
     window = block + 2 * top
-    first, second = np.empty(window), np.empty(window)
+    first, second = np.empty(min(window, n)), np.empty(min(window, n))  # short series: no 3 MiB buffers
     for start in range(0, n - 2, block):
         current, spare = first, second
         w = np.asarray(x[start:min(start + window, n)], dtype=np.float64)
