@@ -125,20 +125,24 @@ def test_random_walk_gives_plus_half_slope_and_recovers_k():
 
 def test_bias_instability_floor_where_simulated():
     rate_hz, density, b_deg_per_h = 20.0, 0.005, 10.0  # [Hz], [deg/s/sqrt(Hz)], [deg/h]
-    rng = np.random.default_rng(4)
-    n = 20 * 3600 * 3
-    y = rng.standard_normal(n) * density * math.sqrt(rate_hz) + flicker_bank(n, rate_hz, b_deg_per_h, rng)
-    res = allan_deviation(y, rate_hz)
     floor = BIAS_INSTABILITY_FACTOR * b_deg_per_h / 3600.0  # [deg/s]
-    expected = np.sqrt(density ** 2 / res.tau + floor ** 2)
-    plateau = (res.tau > 20) & (res.tau < 500)
-    assert plateau.sum() >= 4
-    # inside each point's 68 % interval, widened by 5 % for the ripple of the Gauss-Markov bank
-    assert (expected[plateau] >= 0.95 * res.ci_low[plateau]).all()
-    assert (expected[plateau] <= 1.05 * res.ci_high[plateau]).all()
-    gyro = noise_parameters(res)
-    assert gyro.noise_density_dps_per_sqrt_hz == pytest.approx(density, rel=0.05)
-    # the bank has no time constant beyond the run, so the curve rolls off at the longest taus and their
-    # few terms scatter low; the minimum / 0.664 is therefore only bounded, not pinned
-    assert 0.4 * b_deg_per_h < gyro.bias_instability_deg_per_h < 1.2 * b_deg_per_h
-    assert gyro.integration_time_s > 20.0
+    n = 20 * 3600 * 3
+    estimates, inside, total = [], 0, 0
+    for seed in range(4, 12):
+        rng = np.random.default_rng(seed)
+        y = rng.standard_normal(n) * density * math.sqrt(rate_hz) + flicker_bank(n, rate_hz, b_deg_per_h, rng)
+        res = allan_deviation(y, rate_hz, confidence=0.95)
+        expected = np.sqrt(density ** 2 / res.tau + floor ** 2)
+        plateau = (res.tau > 20) & (res.tau < 500)
+        assert plateau.sum() >= 4
+        inside += int(np.sum((expected[plateau] >= res.ci_low[plateau]) & (expected[plateau] <= res.ci_high[plateau])))
+        total += int(plateau.sum())
+        gyro = noise_parameters(res)
+        assert gyro.noise_density_dps_per_sqrt_hz == pytest.approx(density, rel=0.05)
+        assert gyro.integration_time_s > 20.0
+        estimates.append(gyro.bias_instability_deg_per_h)
+    # 95 % intervals over 8 seeds x 5 taus: a couple may miss, not more
+    assert inside >= 0.9 * total
+    # the minimum of a noisy 3-hour curve is picked among low scatter at long taus, so min / 0.664
+    # runs low by selection; over seeds it sits within a few tens of percent of B
+    assert 0.7 * b_deg_per_h < np.median(estimates) < 1.05 * b_deg_per_h

@@ -39,8 +39,12 @@ def test_simulate_writes_data_and_truth(workdir):
     assert list(df.columns) == ["time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z", "temperature"]
     assert len(df) == 12001
     truth = json.loads((workdir / "truth1.json").read_text())
-    assert truth["seed"] == 1 and truth["rate_hz"] == 10
-    assert set(truth["turn_on_bias_dps"]) == {"gyro_x", "gyro_y", "gyro_z"}
+    assert truth["preset"] == "mti10" and truth["rate_hz"] == 10 and truth["duration_s"] == 1200
+    assert truth["profile"]["set_points_degc"] == [-25, 90]  # the preset's chamber range
+    (only,) = truth["runs"]
+    assert only["seed"] == 1 and only["file"] == "run1.csv" and only["samples"] == 12001
+    assert set(only["turn_on_bias_dps"]) == {"gyro_x", "gyro_y", "gyro_z"}
+    assert truth["error_model"]["noise_density_dps_per_sqrt_hz"] == 0.03
 
 
 def test_fit_prints_table_and_writes_model(workdir):
@@ -187,7 +191,15 @@ def test_refuses_to_overwrite_input(workdir, tmp_path):
     (["apply", "{model}", "{run}", "-o", "o.csv", "--turn-on-window", "-3"], r"--turn-on-window: must be a positive"),
     (["evaluate", "{model}", "{run}", "--window", "1e9"], r"--window: 1e\+09 s is longer than the run"),
     (["simulate", "--profile", "oven", "-o", "x.csv"], r"--profile: unknown profile 'oven'"),
-    (["simulate", "--axes", "q", "-o", "x.csv"], r"--axes: 'q'; use a comma-separated subset of x, y, z"),
+    (["simulate", "--axes", "q", "-o", "x.csv"], r"--axes: gyro_q; this part has gyro_x, gyro_y, gyro_z"),
+    (["simulate", "--preset", "adxrs450", "--axes", "x", "-o", "x.csv"], r"--axes: gyro_x; this part has gyro_z"),
+    (["simulate", "--preset", "mems", "-o", "x.csv"], r"--preset: unknown preset 'mems'; use one of adxrs450, mti10"),
+    (["simulate", "--runs", "0", "-o", "x.csv"], r"Invalid value for --runs: must be at least 1"),
+    (["simulate", "--set-points", "cold", "-o", "x.csv"], r"Invalid value for --set-points: give comma-separated"),
+    (["simulate", "--ramp-rate", "0", "-o", "x.csv"], r"--ramp-rate: must be positive, got 0"),
+    (["simulate", "--cycles", "0", "-o", "x.csv"], r"--cycles: must be at least 1, got 0"),
+    (["simulate", "--unit", "-1", "-o", "x.csv"], r"--unit: must be a whole number >= 0, got -1"),
+    (["simulate", "-o", "x.csv", "--truth", "x.csv"], r"--truth x.csv: the same file as a data output"),
     (["nosuchcommand"], r"No such command 'nosuchcommand'"),
 ])
 def test_usage_errors(workdir, tmp_path, args, message):

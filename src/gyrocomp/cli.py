@@ -6,6 +6,7 @@ Exit status: 0 success, 2 bad input or usage, 1 other failures. Errors are one l
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 import traceback
@@ -91,35 +92,80 @@ def cli(ctx, debug, quiet):
 
 
 # -- simulate ---------------------------------------------------------------------------------------
+def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
+    if text is None:
+        return None
+    try:
+        values = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        values = ()
+    if not values:
+        raise click.BadParameter("give comma-separated numbers, e.g. -20,70", param_hint=option)
+    return values
+
+
 @cli.command()
-@click.option("--profile", default="chamber", show_default=True, help="chamber, cycle or static.")
-@click.option("--duration", "duration_s", type=float, default=3600.0, show_default=True, help="Run length [s].")
+@click.option("--preset", default="mti10", show_default=True,
+              help="Sensor: adxrs450, mti10, adis16488 or consumer (values from datasheets; see the docs).")
+@click.option("--profile", default="chamber", show_default=True,
+              help="static, warmup, chamber, cycle, tumble, combined or ratetable.")
+@click.option("--duration", "duration_s", type=float, default=None,
+              help="Run length [s] (default: the profile's own; a set duration stretches the profile).")
 @click.option("--rate", "rate_hz", type=float, default=100.0, show_default=True, help="Sample rate [Hz].")
-@click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--axes", default="x,y,z", show_default=True, help="Gyro axes to simulate, e.g. z or x,y,z.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of run 0; run i uses seed + i.")
+@click.option("--runs", type=int, default=1, show_default=True,
+              help="Write K power-ons (own turn-on bias and noise) as OUT_0.csv ... OUT_{K-1}.csv.")
+@click.option("--unit", type=int, default=None, help="Simulate unit N of the preset's production spread (default: nominal).")
+@click.option("--axes", default=None, help="Gyro axes to simulate, e.g. z or x,y,z (default: all of the preset's).")
+@click.option("--set-points", "set_points", default=None, metavar="T1,T2,...",
+              help="Chamber set points [degC] (default: the preset's range).")
+@click.option("--ramp-rate", "ramp_rate", type=float, default=None, help="Ramp rate between set points [degC/min].")
+@click.option("--dwell", "dwell_s", type=float, default=None, help="Time held at each set point [s].")
+@click.option("--cycles", type=int, default=None, help="Cold-hot-cold repetitions of the cycle profile.")
+@click.option("--position-time", "position_s", type=float, default=None, help="Time at each tumble position [s].")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output CSV or Parquet.")
-@click.option("--truth", type=click.Path(dir_okay=False), help="Write the parameters used as JSON here.")
+@click.option("--truth", type=click.Path(dir_okay=False), help="Write every parameter used as JSON here.")
+@click.option("--truth-columns", is_flag=True,
+              help="Add true_error_gyro_*, true_noise_gyro_*, true_rate_gyro_* and true_structure_temperature columns.")
 @click.pass_context
-def simulate(ctx, profile, duration_s, rate_hz, seed, axes, output, truth):
-    """Simulate a calibration run of a gyro at rest, with its truth."""
-    from .simulate import GyroErrorModel
+def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, set_points, ramp_rate, dwell_s,
+             cycles, position_s, output, truth, truth_columns):
+    """Simulate calibration runs of a sensor preset through a test profile, with the exact truth."""
+    from .simulate import Simulation, preset_model, resolve_profile
     from .simulate import simulate as run_simulation
 
-    wanted = [a.strip() for a in axes.split(",") if a.strip()]
-    default = GyroErrorModel()
-    names = [f"gyro_{a}" for a in wanted]
-    if not names or any(n not in default.axes for n in names) or len(set(names)) != len(names):
-        raise InputError(f"--axes: {axes!r}; use a comma-separated subset of x, y, z")
-    coefs = tuple(default.temperature_coefficients[default.axes.index(n)] for n in names)
-    model = GyroErrorModel(axes=tuple(names), temperature_coefficients=coefs)
+    model = preset_model(preset, unit)
+    if axes:
+        model = model.subset(tuple(f"gyro_{a.strip()}" for a in axes.split(",") if a.strip()))
+    if runs < 1:
+        raise click.BadParameter("must be at least 1", param_hint="--runs")
+    prof = resolve_profile(profile, preset, set_points_degc=_float_list(set_points, "--set-points"),
+                           ramp_rate_degc_per_min=ramp_rate, dwell_s=dwell_s, cycles=cycles, position_s=position_s)
     detect_format(output)
-    sim = run_simulation(model, profile=profile, duration_s=duration_s, rate_hz=rate_hz, seed=seed,
-                         source=str(output))
-    write_recording(sim.recording, output)
+    out = Path(output)
+    paths = [out] if runs == 1 else [out.with_name(f"{out.stem}_{i}{out.suffix}") for i in range(runs)]
+    if truth and any(Path(truth).resolve() == p.resolve() for p in paths):
+        raise InputError(f"--truth {truth}: the same file as a data output; choose another path")
+    records = []
+    for i, path in enumerate(paths):
+        sim = run_simulation(model, profile=prof, duration_s=duration_s, rate_hz=rate_hz, seed=seed + i,
+                             source=str(path))
+        sim = Simulation(sim.recording, dataclasses.replace(sim.truth, preset=preset, unit=unit))
+        write_recording(sim.recording, path, extra_columns=sim.truth.truth_columns() if truth_columns else None)
+        records.append((path, sim))
+        if not ctx.obj["quiet"]:
+            rec = sim.recording
+            gaps = f", {len(rec.gaps)} gaps" if rec.gaps else ""
+            click.echo(f"wrote {path}: {rec.n_samples} rows, {rec.duration_s:g} s at {rate_hz:g} Hz{gaps}")
     if truth:
-        write_text_atomic(truth, json.dumps(sim.truth.to_dict(), indent=2) + "\n")
-    if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}: {sim.recording.n_samples} rows, {sim.recording.duration_s:g} s at {rate_hz:g} Hz")
+        first = records[0][1].truth.to_dict()
+        doc = {k: v for k, v in first.items() if k not in ("seed", "turn_on_bias_dps", "samples",
+                                                            "deterministic_error_range_dps")}
+        doc["runs"] = [{"file": path.name, "seed": sim.truth.seed, "samples": sim.recording.n_samples,
+                        "turn_on_bias_dps": sim.truth.to_dict()["turn_on_bias_dps"],
+                        "deterministic_error_range_dps": sim.truth.to_dict()["deterministic_error_range_dps"]}
+                       for path, sim in records]
+        write_text_atomic(truth, json.dumps(doc, indent=2) + "\n")
 
 
 # -- fit --------------------------------------------------------------------------------------------

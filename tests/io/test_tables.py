@@ -174,7 +174,7 @@ def test_refuse_to_overwrite_inputs(tmp_path):
 
 
 def test_single_axis_simulation_writes_default_layout(tmp_path):
-    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((1e-3,),), accel_g=None)
+    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((1e-3,),), accelerometer=None)
     write_recording(simulate(model, duration_s=5, rate_hz=10).recording, tmp_path / "s.csv")
     with warnings.catch_warnings():
         warnings.simplefilter("error")

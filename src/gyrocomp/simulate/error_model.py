@@ -1,4 +1,17 @@
-"""Deterministic and random gyro errors, with their truth.
+"""The error model of a simulated gyro (and its accelerometer), and the random errors.
+
+Output of gyro axis i, sample k (every term switchable; units in brackets):
+
+    w_out = Q_lsb( w_i + (s_i + c_i (T_s - T_ref)) 1e-6 w_i + sum_{j != i} M_ij w_j      scale factor, misalignment
+                   + b0_i + p_i(T_s - T_ref)                                            turn-on bias, temperature
+                   + h_i(|T_s - T_turn|)   (after a reversal, chosen branches/band)     hysteresis
+                   + sum_j G_ij a_j + sum_m Q_im (a a)_m                               g and g x g sensitivity
+                   + n_white + n_flicker + n_rrw )                                      noise
+
+with w the true body rate [deg/s], a the specific force [g], T_s the temperature of the MEMS
+structure, which lags the reported temperature T through a first-order time constant [s], and
+Q_lsb rounding to the output LSB. The reported temperature itself gets the sensor's noise and
+quantization (some parts report whole degrees).
 
 Noise terms follow IEEE Std 952-1997 Annex C. For rate samples taken every dt = 1/rate_hz:
 
@@ -6,37 +19,117 @@ Noise terms follow IEEE Std 952-1997 Annex C. For rate samples taken every dt = 
   Allan variance N^2 / tau;
 - bias instability B [deg/h]: flicker noise with one-sided PSD B^2 / (pi f), built as a bank of
   first-order Gauss-Markov processes with log-spaced correlation times T_i = T_0 r^i, each of
-  variance (B^2 / pi) ln r, whose PSDs add up to 1/f between the bank's corner frequencies;
-  Allan floor (2 ln 2 / pi)^(1/2) B = 0.664 B;
+  variance (B^2 / pi) ln r, whose PSDs add up to 1/f between the bank's corner frequencies
+  (dt/2 up to ten times the run, so the floor stays flat from 2 samples to the longest tau); the slow
+  processes are drawn on coarser grids (50 steps per correlation time) and interpolated, which
+  keeps a 24-hour 100 Hz run to seconds; Allan floor (2 ln 2 / pi)^(1/2) B = 0.664 B;
 - rate random walk K [deg/s/sqrt(s)]: integrated white noise, Allan variance K^2 tau / 3.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy.signal import lfilter
 
+from ..effects import HYSTERESIS_DIRECTIONS, find_turns, g_sensitivity_offset, hysteresis_offset, thermal_lag
 from ..errors import InputError
+from ..recording import GYRO_AXES
 from ..units import DEG_PER_S_TO_DEG_PER_H
 
 GM_RATIO = 3.0  # spacing of the Gauss-Markov correlation times
+GM_STEPS_PER_TIME_CONSTANT = 50  # grid of the slow Gauss-Markov processes
+GM_LONGEST_PER_RUN = 10.0  # longest correlation time, in run lengths
+#: turning points of the (noise-free) structure temperature are confirmed past this [degC],
+#: which only keeps round-off in the lag filter from making reversals
+TURN_THRESHOLD_DEGC = 1e-6
+
+
+@dataclass(frozen=True)
+class Hysteresis:
+    """Offset on the temperature branch after a reversal (thesis section 2.6).
+
+    Parameters
+    ----------
+    coefficients_dps : tuple of tuples
+        Per gyro axis, h_1..h_p of offset = sum_j h_j |T_s - T_turn|^j [deg/s/degC^j].
+    direction : {"descending", "ascending", "both"}
+        Branches that carry the offset.
+    band_degc : (lo, hi), optional
+        Structure-temperature band [degC] outside which there is none.
+    """
+
+    coefficients_dps: tuple[tuple[float, ...], ...]
+    direction: str = "descending"
+    band_degc: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.direction not in HYSTERESIS_DIRECTIONS:
+            raise InputError(f"hysteresis direction: {self.direction!r}; use one of {', '.join(HYSTERESIS_DIRECTIONS)}")
+        if self.band_degc is not None and not self.band_degc[0] < self.band_degc[1]:
+            raise InputError(f"hysteresis band_degc: {self.band_degc}; give (low, high) with low < high")
+
+
+@dataclass(frozen=True)
+class AccelErrorModel:
+    """Errors of the accelerometer triad (x, y, z).
+
+    Parameters
+    ----------
+    bias_g : 3 floats
+        Constant bias [g].
+    bias_tempco_g_per_degc : 3 floats
+        Bias change per degree of structure temperature from the gyro's T_ref [g/degC].
+    noise_density_g_per_sqrt_hz : float
+        White noise (velocity random walk) [g/sqrt(Hz)].
+    quantization_g : float
+        Output LSB [g]; 0 for none.
+    """
+
+    bias_g: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    bias_tempco_g_per_degc: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    noise_density_g_per_sqrt_hz: float = 0.0
+    quantization_g: float = 0.0
+
+
+def _per_axis(name: str, value, k: int, width: int | None = None) -> np.ndarray | None:
+    if value is None:
+        return None
+    arr = np.asarray(value, dtype=float)
+    shape = (k,) if width is None else (k, width)
+    if arr.shape != shape:
+        raise InputError(f"{name}: shape {arr.shape}, expected {shape} (one entry per gyro axis)")
+    return arr
 
 
 @dataclass(frozen=True)
 class GyroErrorModel:
-    """Error parameters of a gyro, per axis.
+    """Error parameters of a gyro, per axis (see the module doc for the equation).
 
     Parameters
     ----------
     axes : tuple of str
         Gyro axes simulated, e.g. ``("gyro_z",)``.
     temperature_coefficients : tuple of tuples
-        Per axis, coefficients of (T - t_ref_degc)^k for k = 1, 2, ... [deg/s/degC^k].
+        Per axis, coefficients of (T_s - t_ref_degc)^k for k = 1, 2, ... [deg/s/degC^k].
     t_ref_degc : float
-        Reference temperature of the polynomial [degC].
+        Reference temperature [degC].
+    thermal_time_constant_s : float
+        Lag of the structure temperature behind the reported one [s]; 0 for none.
+    hysteresis : Hysteresis, optional
+    g_sensitivity_dps_per_g : tuple of 3-tuples, optional
+        Per axis, the row of the g-sensitivity matrix G [deg/s/g].
+    g_squared_dps_per_g2 : tuple of 6-tuples, optional
+        Per axis, g x g sensitivities to xx, yy, zz, xy, xz, yz [deg/s/g^2].
+    scale_factor_error_ppm : tuple of float, optional
+        Per axis, scale factor error at t_ref [ppm].
+    scale_factor_tempco_ppm_per_degc : tuple of float, optional
+        Per axis, its temperature coefficient [ppm/degC].
+    misalignment_rad : tuple of 3-tuples, optional
+        Per axis, sensitivity to the body rates about x, y, z [rad]; the entry of the axis itself is ignored.
     turn_on_bias_sigma_dps : float
         Standard deviation of the random constant bias of each power-on [deg/s].
     noise_density_dps_per_sqrt_hz : float
@@ -45,31 +138,64 @@ class GyroErrorModel:
         Bias instability B [deg/h].
     rate_random_walk_dps_per_sqrt_s : float
         Rate random walk K [deg/s/sqrt(s)].
-    accel_g : tuple of 3 floats, optional
-        Constant specific force written as accelerometer columns [g], or None for no accelerometer.
+    quantization_dps : float
+        Output LSB [deg/s]; 0 for none.
+    temperature_noise_degc : float
+        Standard deviation of the temperature sensor's white noise [degC].
+    temperature_quantization_degc : float
+        Temperature output LSB [degC] (1.0: whole degrees); 0 for none.
+    accelerometer : AccelErrorModel, optional
+        None for a part without accelerometer (no accel columns are written).
     """
 
-    axes: tuple[str, ...] = ("gyro_x", "gyro_y", "gyro_z")
+    axes: tuple[str, ...] = GYRO_AXES
     temperature_coefficients: tuple[tuple[float, ...], ...] = ((4e-4, 6e-6, -8e-8), (-3e-4, 4e-6, 5e-8), (5e-4, -5e-6, 6e-8))
     t_ref_degc: float = 25.0
+    thermal_time_constant_s: float = 0.0
+    hysteresis: Hysteresis | None = None
+    g_sensitivity_dps_per_g: tuple[tuple[float, float, float], ...] | None = None
+    g_squared_dps_per_g2: tuple[tuple[float, ...], ...] | None = None
+    scale_factor_error_ppm: tuple[float, ...] | None = None
+    scale_factor_tempco_ppm_per_degc: tuple[float, ...] | None = None
+    misalignment_rad: tuple[tuple[float, float, float], ...] | None = None
     turn_on_bias_sigma_dps: float = 0.02
     noise_density_dps_per_sqrt_hz: float = 0.01
     bias_instability_deg_per_h: float = 10.0
     rate_random_walk_dps_per_sqrt_s: float = 0.0
-    accel_g: tuple[float, float, float] | None = (0.0, 0.0, 1.0)
+    quantization_dps: float = 0.0
+    temperature_noise_degc: float = 0.0
+    temperature_quantization_degc: float = 0.0
+    accelerometer: AccelErrorModel | None = field(default_factory=AccelErrorModel)
 
     def __post_init__(self) -> None:
-        if len(self.temperature_coefficients) != len(self.axes):
+        k = len(self.axes)
+        if not k or any(a not in GYRO_AXES for a in self.axes) or len(set(self.axes)) != k:
+            raise InputError(f"axes: {self.axes}; use distinct names from {', '.join(GYRO_AXES)}")
+        if len(self.temperature_coefficients) != k:
             raise InputError(
-                f"temperature_coefficients: {len(self.temperature_coefficients)} sets for {len(self.axes)} axes"
+                f"temperature_coefficients: {len(self.temperature_coefficients)} sets for {k} axes"
             )
         for name in ("turn_on_bias_sigma_dps", "noise_density_dps_per_sqrt_hz", "bias_instability_deg_per_h",
-                     "rate_random_walk_dps_per_sqrt_s"):
+                     "rate_random_walk_dps_per_sqrt_s", "quantization_dps", "temperature_noise_degc",
+                     "temperature_quantization_degc", "thermal_time_constant_s"):
             if getattr(self, name) < 0:
                 raise InputError(f"{name}: must not be negative")
+        _per_axis("g_sensitivity_dps_per_g", self.g_sensitivity_dps_per_g, k, 3)
+        _per_axis("g_squared_dps_per_g2", self.g_squared_dps_per_g2, k, 6)
+        _per_axis("scale_factor_error_ppm", self.scale_factor_error_ppm, k)
+        _per_axis("scale_factor_tempco_ppm_per_degc", self.scale_factor_tempco_ppm_per_degc, k)
+        _per_axis("misalignment_rad", self.misalignment_rad, k, 3)
+        if self.hysteresis is not None and len(self.hysteresis.coefficients_dps) != k:
+            raise InputError(f"hysteresis coefficients_dps: {len(self.hysteresis.coefficients_dps)} sets for {k} axes")
 
+    @property
+    def body_index(self) -> list[int]:
+        """Index (0, 1, 2 for x, y, z) of each simulated axis in the body frame."""
+        return [GYRO_AXES.index(a) for a in self.axes]
+
+    # -- deterministic effects (pure functions of the trajectory) ---------------------------------
     def temperature_error_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
-        """Deterministic bias (n, k) [deg/s] at ``temperature_degc`` (without the turn-on constant)."""
+        """Temperature bias (n, k) [deg/s] at the structure temperature (without the turn-on constant)."""
         d = np.asarray(temperature_degc, dtype=float) - self.t_ref_degc
         cols = []
         for coefs in self.temperature_coefficients:
@@ -79,49 +205,147 @@ class GyroErrorModel:
             cols.append(out)
         return np.column_stack(cols)
 
+    def hysteresis_error_dps(self, structure_degc: np.ndarray) -> np.ndarray:
+        """Hysteresis offset (n, k) [deg/s] of the structure-temperature history."""
+        n, k = structure_degc.size, len(self.axes)
+        if self.hysteresis is None:
+            return np.zeros((n, k))
+        turns = find_turns(structure_degc, TURN_THRESHOLD_DEGC)
+        h = self.hysteresis
+        return np.column_stack([hysteresis_offset(structure_degc, turns, c, direction=h.direction,
+                                                  band_degc=h.band_degc) for c in h.coefficients_dps])
+
+    def acceleration_error_dps(self, specific_force_g: np.ndarray) -> np.ndarray:
+        """g and g x g sensitive bias (n, k) [deg/s]."""
+        k = len(self.axes)
+        if self.g_sensitivity_dps_per_g is None and self.g_squared_dps_per_g2 is None:
+            return np.zeros((specific_force_g.shape[0], k))
+        g = np.zeros((k, 3)) if self.g_sensitivity_dps_per_g is None else np.asarray(self.g_sensitivity_dps_per_g)
+        q = None if self.g_squared_dps_per_g2 is None else np.asarray(self.g_squared_dps_per_g2)
+        return g_sensitivity_offset(specific_force_g, g, q)
+
+    def scale_error_dps(self, angular_rate_dps: np.ndarray, structure_degc: np.ndarray) -> np.ndarray:
+        """Scale factor and misalignment error on the true rate (n, k) [deg/s]."""
+        n, k = angular_rate_dps.shape[0], len(self.axes)
+        out = np.zeros((n, k))
+        if not np.any(angular_rate_dps):
+            return out
+        own = angular_rate_dps[:, self.body_index]
+        if self.scale_factor_error_ppm is not None:
+            out += own * np.asarray(self.scale_factor_error_ppm) * 1e-6
+        if self.scale_factor_tempco_ppm_per_degc is not None:
+            out += own * np.outer(structure_degc - self.t_ref_degc,
+                                  np.asarray(self.scale_factor_tempco_ppm_per_degc)) * 1e-6
+        if self.misalignment_rad is not None:
+            m = np.array(self.misalignment_rad, dtype=float)
+            m[np.arange(k), self.body_index] = 0.0
+            out += angular_rate_dps @ m.T
+        return out
+
+    def subset(self, axes: tuple[str, ...]) -> "GyroErrorModel":
+        """The same part with only ``axes`` simulated (every per-axis parameter picked accordingly)."""
+        missing = [a for a in axes if a not in self.axes]
+        if missing or not axes:
+            raise InputError(f"--axes: {', '.join(missing) or 'none given'}; this part has {', '.join(self.axes)}")
+        idx = [self.axes.index(a) for a in axes]
+        pick = lambda rows: None if rows is None else tuple(rows[i] for i in idx)  # noqa: E731
+        hyst = self.hysteresis
+        if hyst is not None:
+            hyst = dataclasses.replace(hyst, coefficients_dps=pick(hyst.coefficients_dps))
+        return dataclasses.replace(
+            self, axes=tuple(axes), temperature_coefficients=pick(self.temperature_coefficients), hysteresis=hyst,
+            g_sensitivity_dps_per_g=pick(self.g_sensitivity_dps_per_g), g_squared_dps_per_g2=pick(self.g_squared_dps_per_g2),
+            scale_factor_error_ppm=pick(self.scale_factor_error_ppm),
+            scale_factor_tempco_ppm_per_degc=pick(self.scale_factor_tempco_ppm_per_degc),
+            misalignment_rad=pick(self.misalignment_rad))
+
     def to_dict(self) -> dict:
         return asdict(self)
 
 
 @dataclass(frozen=True)
 class NoiseTruth:
-    """The noise that was added, per axis (n, k) [deg/s], and its parts' parameters."""
+    """The random errors that were added, per axis (n, k) [deg/s]; quantization is the rounding of the output."""
 
     white_dps: np.ndarray = field(repr=False)
     flicker_dps: np.ndarray = field(repr=False)
     random_walk_dps: np.ndarray = field(repr=False)
+    quantization_dps: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def total_dps(self) -> np.ndarray:
-        return self.white_dps + self.flicker_dps + self.random_walk_dps
+        total = self.white_dps + self.flicker_dps + self.random_walk_dps
+        return total if self.quantization_dps is None else total + self.quantization_dps
+
+    def take(self, index) -> "NoiseTruth":
+        q = None if self.quantization_dps is None else self.quantization_dps[index]
+        return NoiseTruth(self.white_dps[index], self.flicker_dps[index], self.random_walk_dps[index], q)
+
+
+def _gauss_markov(m: int, step_s: float, time_constant_s: float, variance: float,
+                  rng: np.random.Generator) -> np.ndarray:
+    """A stationary first-order Gauss-Markov process of ``m`` samples ``step_s`` apart."""
+    phi = math.exp(-step_s / time_constant_s)
+    drive = rng.standard_normal(m) * math.sqrt(variance * -math.expm1(-2.0 * step_s / time_constant_s))
+    drive[0] = rng.standard_normal() * math.sqrt(variance)  # start in the stationary distribution
+    return lfilter([1.0], [1.0, -phi], drive)
 
 
 def flicker_bank(n: int, rate_hz: float, bias_instability_deg_per_h: float, rng: np.random.Generator,
                  shortest_s: float | None = None, longest_s: float | None = None) -> np.ndarray:
-    """Flicker (bias instability) noise [deg/s] from a bank of Gauss-Markov processes (see module doc)."""
+    """Flicker (bias instability) noise [deg/s] from a bank of Gauss-Markov processes (see module doc).
+
+    Processes whose correlation time spans more than ``GM_STEPS_PER_TIME_CONSTANT`` samples are
+    drawn on a grid of 4^j samples (the coarsest that keeps that many steps per correlation time)
+    and the slow part is built coarse to fine, interpolating linearly once per level.
+    """
     if bias_instability_deg_per_h == 0 or n == 0:
         return np.zeros(n)
     dt = 1.0 / rate_hz
     b_dps = bias_instability_deg_per_h / DEG_PER_S_TO_DEG_PER_H
-    shortest = shortest_s or 2.0 * dt
-    longest = longest_s or max(n * dt, shortest * GM_RATIO)
+    shortest = shortest_s or 0.5 * dt
+    longest = longest_s or max(GM_LONGEST_PER_RUN * n * dt, shortest * GM_RATIO)
     count = int(math.ceil(math.log(longest / shortest) / math.log(GM_RATIO))) + 1
     variance = b_dps**2 / math.pi * math.log(GM_RATIO)
-    out = np.zeros(n)
+    levels: dict[int, list[float]] = {}
     for i in range(count):
         tc = shortest * GM_RATIO**i
-        phi = math.exp(-dt / tc)
-        drive = rng.standard_normal(n) * math.sqrt(variance * -math.expm1(-2.0 * dt / tc))
-        drive[0] = rng.standard_normal() * math.sqrt(variance)  # start in the stationary distribution
-        out += lfilter([1.0], [1.0, -phi], drive)
-    return out
+        steps = tc / (GM_STEPS_PER_TIME_CONSTANT * dt)
+        level = 0 if steps < 4 else int(math.log(steps, 4))
+        while 4**level > max(1, (n - 1) // 2):  # keep at least three nodes on the grid
+            level -= 1
+        levels.setdefault(max(level, 0), []).append(tc)
+    acc: np.ndarray | None = None
+    acc_step = 0
+    for level in sorted(levels, reverse=True):
+        step = 4**level
+        m = (n - 1 + step - 1) // step + 1  # nodes 0, step, ..., covering n - 1
+        here = np.zeros(m)
+        for tc in levels[level]:
+            here += _gauss_markov(m, step * dt, tc, variance, rng)
+        if acc is not None:
+            here += np.interp(np.arange(m) * step, np.arange(acc.size) * acc_step, acc)
+        acc, acc_step = here, step
+    if acc_step != 1:
+        acc = np.interp(np.arange(n), np.arange(acc.size) * acc_step, acc)
+    return acc[:n]
 
 
 def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random.Generator) -> NoiseTruth:
-    """Draw the random errors of every axis."""
+    """Draw the random errors of every axis (without quantization, which depends on the output)."""
     k = len(model.axes)
     white = rng.standard_normal((n, k)) * model.noise_density_dps_per_sqrt_hz * math.sqrt(rate_hz)
     flicker = np.column_stack([flicker_bank(n, rate_hz, model.bias_instability_deg_per_h, rng) for _ in range(k)])
-    steps = rng.standard_normal((n, k)) * model.rate_random_walk_dps_per_sqrt_s * math.sqrt(1.0 / rate_hz)
-    walk = np.cumsum(steps, axis=0)
+    if model.rate_random_walk_dps_per_sqrt_s > 0:
+        steps = rng.standard_normal((n, k)) * model.rate_random_walk_dps_per_sqrt_s * math.sqrt(1.0 / rate_hz)
+        walk = np.cumsum(steps, axis=0)
+    else:
+        walk = np.zeros((n, k))
     return NoiseTruth(white, flicker, walk)
+
+
+def structure_temperature(model: GyroErrorModel, time_s: np.ndarray, temperature_degc: np.ndarray,
+                          rate_hz: float) -> np.ndarray:
+    """Temperature of the MEMS structure [degC]: the reported temperature through the thermal lag."""
+    lagged, _ = thermal_lag(time_s, temperature_degc, model.thermal_time_constant_s, period_s=1.0 / rate_hz)
+    return lagged

@@ -1,0 +1,330 @@
+"""The deterministic gyro effects as pure, vectorized functions.
+
+The simulator adds these effects and the models fit and remove them, with the same code, so a
+simulated truth and a fitted model mean the same thing by construction. Each function works on
+whole arrays; the ones with memory (thermal lag, turning points) take and return a state so
+that a stream cut into chunks gives exactly the result of one call.
+
+References
+----------
+M. Ali, *Correction of temperature and acceleration effects on MEMS gyro output signals*,
+MS thesis, METU, 2014: section 2.6 (hysteresis as a polynomial in |T - T_turn| after the
+temperature slope reverses), section 2.7.1 (the 3x3 g-sensitivity matrix).
+IEEE Std 1431-2004 (Coriolis vibratory gyros), Annex B: g-sensitive and g x g-sensitive bias.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import lfilter
+
+from .errors import InputError
+
+HYSTERESIS_DIRECTIONS = ("descending", "ascending", "both")
+#: order of the g x g terms: products of specific-force components [g^2]
+G_SQUARED_TERMS = ("xx", "yy", "zz", "xy", "xz", "yz")
+
+
+# -- thermal lag ------------------------------------------------------------------------------------
+def lag_coefficients(step_s: float, time_constant_s: float) -> tuple[float, float, float]:
+    """Coefficients (a, b0, b1) of the exact first-order lag for an input linear between samples.
+
+    The structure temperature T_s follows dT_s/dt = (T - T_s) / tau. If the reported
+    temperature T is linear over a step of length h (first-order hold), the exact update is
+
+        T_s[k] = a T_s[k-1] + b0 T[k] + b1 T[k-1],
+        a = exp(-h/tau),  b0 = 1 - (1 - a) tau/h,  b1 = (1 - a) tau/h - a,
+
+    so a steady ramp of r [degC/s] is followed with a lag of exactly r tau [degC].
+
+    Parameters
+    ----------
+    step_s : float
+        Time step h [s].
+    time_constant_s : float
+        Thermal time constant tau [s]; 0 means no lag (a = 0, b0 = 1, b1 = 0).
+    """
+    if time_constant_s <= 0:
+        return 0.0, 1.0, 0.0
+    h = step_s / time_constant_s
+    a = math.exp(-h)
+    g = -math.expm1(-h) / h  # (1 - a) / h, accurate for small h
+    return a, 1.0 - g, g - a
+
+
+@dataclass(frozen=True)
+class LagState:
+    """Where a thermal-lag filter stands after a chunk: the last input [degC] and output [degC], and its time [s]."""
+
+    last_input_degc: float
+    last_output_degc: float
+    last_time_s: float
+
+
+def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_s: float, *,
+                period_s: float | None = None, state: LagState | None = None) -> tuple[np.ndarray, LagState]:
+    """Temperature of the sensing structure, lagging the reported temperature (first-order) [degC].
+
+    Parameters
+    ----------
+    time_s : array (n,)
+        Sample times [s], increasing.
+    temperature_degc : array (n,)
+        Reported temperature [degC].
+    time_constant_s : float
+        Thermal time constant tau [s] (>= 0).
+    period_s : float, optional
+        Nominal sample period [s]. Steps within 1.5 periods are taken as exactly one period (real
+        logs jitter); longer steps (gaps) are bridged exactly, assuming the temperature linear
+        across the gap. Default: the median step.
+    state : LagState, optional
+        Where the previous chunk ended; without it the structure starts in equilibrium
+        (T_s = T at the first sample).
+
+    Returns
+    -------
+    structure_degc : array (n,)
+    state : LagState
+        Pass it with the next chunk to continue the stream exactly.
+    """
+    t = np.asarray(time_s, dtype=float)
+    u = np.asarray(temperature_degc, dtype=float)
+    if time_constant_s < 0:
+        raise InputError(f"thermal time constant: must not be negative, got {time_constant_s}")
+    if u.size == 0:
+        return u.copy(), state
+    if time_constant_s == 0:
+        return u.copy(), LagState(float(u[-1]), float(u[-1]), float(t[-1]))
+    if period_s is None:
+        period_s = float(np.median(np.diff(t))) if t.size > 1 else (
+            t[0] - state.last_time_s if state else 1.0)
+    if state is None:
+        prev_u, prev_y, prev_t = float(u[0]), float(u[0]), float(t[0])
+        start = 1
+        out = np.empty_like(u)
+        out[0] = u[0]
+    else:
+        prev_u, prev_y, prev_t = state.last_input_degc, state.last_output_degc, state.last_time_s
+        start = 0
+        out = np.empty_like(u)
+    steps = np.diff(np.concatenate([[prev_t], t]))
+    long_steps = np.flatnonzero(steps[start:] > 1.5 * period_s) + start
+    a, b0, b1 = lag_coefficients(period_s, time_constant_s)
+    bounds = list(long_steps) + [u.size]
+    i = start
+    for stop in bounds:
+        if i < stop:
+            # uniform stretch [i, stop): y[k] = a y[k-1] + b0 u[k] + b1 u[k-1]
+            seg = u[i:stop]
+            zi = np.array([a * prev_y + b1 * prev_u])
+            out[i:stop], _ = lfilter([b0, b1], [1.0, -a], seg, zi=zi)
+            prev_u, prev_y = float(seg[-1]), float(out[stop - 1])
+        if stop < u.size:  # bridge the gap before sample `stop` exactly
+            ga, gb0, gb1 = lag_coefficients(float(steps[stop]), time_constant_s)
+            out[stop] = ga * prev_y + gb0 * u[stop] + gb1 * prev_u
+            prev_u, prev_y = float(u[stop]), float(out[stop])
+            i = stop + 1
+    return out, LagState(float(u[-1]), float(out[-1]), float(t[-1]))
+
+
+# -- turning points and hysteresis ------------------------------------------------------------------
+@dataclass(frozen=True)
+class TurnState:
+    """Where a turning-point detector stands: the direction of travel (+1 rising, -1 falling,
+    0 not yet known), the running extreme of the current branch [degC], the last turn [degC]
+    (NaN before the first), and, while the direction is not known, the lowest and highest
+    temperature seen [degC]."""
+
+    direction: int
+    extreme_degc: float
+    turn_degc: float
+    low_degc: float
+    high_degc: float
+
+
+@dataclass(frozen=True)
+class Turns:
+    """Per-sample hysteresis state of a temperature series.
+
+    Attributes
+    ----------
+    direction : array (n,) of int
+        +1 on a rising branch, -1 on a falling branch, 0 before the direction is known.
+    turn_degc : array (n,)
+        Temperature of the last confirmed turning point [degC], NaN before the first.
+    turn_index : array (m,) of int
+        Sample index at which each reversal was confirmed.
+    state : TurnState
+        Pass it with the next chunk to continue the stream exactly.
+    """
+
+    direction: np.ndarray
+    turn_degc: np.ndarray
+    turn_index: np.ndarray
+    state: TurnState
+
+
+def _first_true(mask: np.ndarray) -> int:
+    hit = np.flatnonzero(mask)
+    return int(hit[0]) if hit.size else -1
+
+
+def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
+               state: TurnState | None = None) -> Turns:
+    """Turning points of a temperature series, robust to noise and to whole-degree steps.
+
+    A reversal is confirmed when the temperature has come back from the running extreme of the
+    current branch by more than ``threshold_degc``; its turning temperature T_turn is that extreme.
+    Noise and quantization steps smaller than the threshold never make a reversal. The detector is
+    causal, so a stream processed in chunks (passing ``state``) gives exactly the batch result.
+    The work is vectorized per branch, not per sample.
+
+    Parameters
+    ----------
+    temperature_degc : array (n,)
+        Temperature [degC].
+    threshold_degc : float
+        Hysteresis of the detector [degC]: 0 for clean data, a few times the noise or the
+        quantization step of the temperature sensor for measured data.
+    state : TurnState, optional
+        Where the previous chunk ended.
+    """
+    x = np.asarray(temperature_degc, dtype=float)
+    n = x.size
+    if threshold_degc < 0:
+        raise InputError(f"turning-point threshold: must not be negative, got {threshold_degc}")
+    direction = np.zeros(n, dtype=np.int8)
+    turn = np.full(n, np.nan)
+    turns: list[int] = []
+    if state is None:
+        if n == 0:
+            return Turns(direction, turn, np.array([], dtype=np.int64),
+                         TurnState(0, math.nan, math.nan, math.inf, -math.inf))
+        state = TurnState(0, math.nan, math.nan, math.inf, -math.inf)
+    d, extreme, last_turn = state.direction, state.extreme_degc, state.turn_degc
+    low, high = state.low_degc, state.high_degc
+    i = 0
+    while i < n:
+        seg = x[i:]
+        if d == 0:
+            # direction unknown: it becomes known when the series leaves the band extreme +- threshold
+            lo = np.minimum.accumulate(np.minimum(seg, low))
+            hi = np.maximum.accumulate(np.maximum(seg, high))
+            up = _first_true(seg - lo > threshold_degc)
+            down = _first_true(hi - seg > threshold_degc)
+            if up < 0 and down < 0:
+                low, high = float(lo[-1]), float(hi[-1])
+                break
+            k, d = (up, 1) if down < 0 or (0 <= up < down) else (down, -1)
+            extreme = float(hi[k]) if d == 1 else float(lo[k])
+            direction[i + k:] = d
+            i += k + 1
+            continue
+        running = np.maximum.accumulate(np.maximum(seg, extreme)) if d == 1 else \
+            np.minimum.accumulate(np.minimum(seg, extreme))
+        back = (running - seg) if d == 1 else (seg - running)
+        k = _first_true(back > threshold_degc)
+        if k < 0:
+            extreme = float(running[-1])
+            break
+        last_turn = float(running[k])
+        d = -d
+        direction[i + k:] = d
+        turn[i + k:] = last_turn
+        turns.append(i + k)
+        extreme = float(seg[k])
+        i += k + 1
+    if state.direction != 0:
+        direction[: (turns[0] if turns else n)] = state.direction
+    if not math.isnan(state.turn_degc):
+        turn[: (turns[0] if turns else n)] = state.turn_degc
+    return Turns(direction, turn, np.asarray(turns, dtype=np.int64),
+                 TurnState(int(d), extreme, last_turn, low, high))
+
+
+def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_dps: tuple[float, ...] | np.ndarray,
+                      *, direction: str = "descending", band_degc: tuple[float, float] | None = None) -> np.ndarray:
+    """Bias offset on the branch after a temperature reversal [deg/s] (thesis section 2.6).
+
+        offset = sum_j h_j d^j,   d = |T - T_turn|,   j = 1..p
+
+    on branches of the given direction after the first confirmed reversal, zero elsewhere
+    (the first branch is the reference path), and, with ``band_degc``, only where
+    lo <= T <= hi (the ADXRS450 shows it only between 55 and 80 degC on cooling).
+
+    Parameters
+    ----------
+    temperature_degc : array (n,)
+        Temperature the effect depends on [degC].
+    turns : Turns
+        From :func:`find_turns` on the same series.
+    coefficients_dps : sequence of float
+        h_1..h_p [deg/s/degC^j].
+    direction : {"descending", "ascending", "both"}
+        Branches that carry the offset.
+    band_degc : (lo, hi), optional
+        Temperature band [degC] outside which the offset is zero.
+    """
+    if direction not in HYSTERESIS_DIRECTIONS:
+        raise InputError(f"hysteresis direction: {direction!r}; use one of {', '.join(HYSTERESIS_DIRECTIONS)}")
+    t = np.asarray(temperature_degc, dtype=float)
+    active = ~np.isnan(turns.turn_degc)
+    if direction == "descending":
+        active &= turns.direction == -1
+    elif direction == "ascending":
+        active &= turns.direction == 1
+    if band_degc is not None:
+        lo, hi = band_degc
+        active &= (t >= lo) & (t <= hi)
+    d = np.where(active, np.abs(t - np.where(active, turns.turn_degc, 0.0)), 0.0)
+    out = np.zeros_like(t)
+    for h in reversed(tuple(coefficients_dps)):
+        out = (out + h) * d
+    return np.where(active, out, 0.0)
+
+
+# -- acceleration -----------------------------------------------------------------------------------
+def g_squared_products(accel_g: np.ndarray) -> np.ndarray:
+    """Products of specific-force components in the order of ``G_SQUARED_TERMS`` (n, 6) [g^2]."""
+    a = np.asarray(accel_g, dtype=float)
+    x, y, z = a[:, 0], a[:, 1], a[:, 2]
+    return np.column_stack([x * x, y * y, z * z, x * y, x * z, y * z])
+
+
+def g_sensitivity_offset(accel_g: np.ndarray, matrix_dps_per_g: np.ndarray,
+                         squared_dps_per_g2: np.ndarray | None = None) -> np.ndarray:
+    """Gyro bias caused by specific force (n, k) [deg/s]: G a (+ the g x g terms).
+
+        offset_i = sum_j G_ij a_j + sum_m Q_im p_m(a)
+
+    Parameters
+    ----------
+    accel_g : array (n, 3)
+        Specific force along the body x, y, z axes [g].
+    matrix_dps_per_g : array (k, 3)
+        g-sensitivity G: row i is gyro axis i's sensitivity to each accelerometer axis [deg/s/g].
+    squared_dps_per_g2 : array (k, 6), optional
+        g x g sensitivity to the products in ``G_SQUARED_TERMS`` [deg/s/g^2].
+    """
+    a = np.asarray(accel_g, dtype=float)
+    out = a @ np.asarray(matrix_dps_per_g, dtype=float).T
+    if squared_dps_per_g2 is not None:
+        out = out + g_squared_products(a) @ np.asarray(squared_dps_per_g2, dtype=float).T
+    return out
+
+
+def quantize(x: np.ndarray, lsb: float) -> np.ndarray:
+    """Round to whole multiples of ``lsb`` (unit of x); ``lsb = 0`` leaves x as it is."""
+    if lsb <= 0:
+        return np.asarray(x, dtype=float)
+    return np.round(np.asarray(x, dtype=float) / lsb) * lsb
+
+
+__all__ = [
+    "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "find_turns",
+    "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "quantize",
+    "thermal_lag",
+]
