@@ -22,6 +22,7 @@ bench: $(STAMP)
 	$(BIN)/pip install -q -e '.[bench]'
 	$(BIN)/python benchmarks/bench_apply.py
 	$(BIN)/python benchmarks/bench_allan.py
+	$(BIN)/python benchmarks/bench_simulate.py
 
 clean:
 	rm -rf $(VENV) demo-output build src/*.egg-info

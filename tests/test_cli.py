@@ -47,6 +47,39 @@ def test_simulate_writes_data_and_truth(workdir):
     assert truth["error_model"]["noise_density_dps_per_sqrt_hz"] == 0.03
 
 
+def test_simulate_runs_with_truth_columns_that_add_up(tmp_path):
+    r = run("simulate", "--preset", "adxrs450", "--profile", "cycle", "--duration", 3600, "--rate", 2, "--runs", 3,
+            "--seed", 10, "-o", tmp_path / "cyc.csv", "--truth", tmp_path / "truth.json", "--truth-columns")
+    assert r.returncode == 0, r.stderr
+    assert [p.name for p in sorted(tmp_path.glob("cyc_*.csv"))] == ["cyc_0.csv", "cyc_1.csv", "cyc_2.csv"]
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert [run_["seed"] for run_ in truth["runs"]] == [10, 11, 12]
+    biases = [run_["turn_on_bias_dps"]["gyro_z"] for run_ in truth["runs"]]
+    assert len(set(biases)) == 3
+    assert truth["error_model"]["hysteresis"]["band_degc"] == [55.0, 80.0]
+    for i in range(3):
+        df = pd.read_csv(tmp_path / f"cyc_{i}.csv")
+        assert list(df.columns) == ["time", "gyro_z", "temperature", "true_error_gyro_z", "true_noise_gyro_z",
+                                    "true_rate_gyro_z", "true_structure_temperature"]
+        rebuilt = df["true_rate_gyro_z"] + df["true_error_gyro_z"] + df["true_noise_gyro_z"]
+        np.testing.assert_allclose(df["gyro_z"], rebuilt, rtol=0, atol=1e-12)
+        # the quantized output: whole multiples of the ADXRS450's 1/80 deg/s LSB
+        np.testing.assert_allclose(df["gyro_z"] * 80, np.round(df["gyro_z"] * 80), atol=1e-6)
+    # the data with truth columns is still an ordinary input: the extra columns are ignored
+    r = run("allan", tmp_path / "cyc_0.csv", "--json")
+    assert r.returncode == 0, r.stderr
+    assert list(json.loads(r.stdout)["axes"]) == ["gyro_z"]
+
+
+def test_simulate_combined_run_has_gaps_and_accelerometer(tmp_path):
+    r = run("simulate", "--profile", "combined", "--rate", 1, "--duration", 7200, "-o", tmp_path / "c.parquet")
+    assert r.returncode == 0, r.stderr
+    assert re.search(r"wrote .*c.parquet: \d+ rows, \d+ s at 1 Hz, \d+ gaps", r.stdout)
+    df = pd.read_parquet(tmp_path / "c.parquet")
+    assert {"accel_x", "accel_y", "accel_z"} <= set(df.columns)
+    assert np.diff(df["time"]).max() > 10
+
+
 def test_fit_prints_table_and_writes_model(workdir):
     r = run("fit", workdir / "run1.csv", workdir / "run2.csv", "-o", workdir / "auto.json")
     assert r.returncode == 0, r.stderr
@@ -101,10 +134,22 @@ def test_demo(tmp_path):
     r = run("demo", "-o", tmp_path / "demo")
     assert r.returncode == 0, r.stderr
     names = {p.name for p in (tmp_path / "demo").iterdir()}
-    assert {"model.json", "heldout_compensated.csv", "metrics.json", "heldout_run.csv"} <= names
+    assert {"model.json", "heldout_compensated.csv", "metrics.json", "heldout_run.csv", "effects.json",
+            "heldout_truth.json"} <= names
     metrics = json.loads((tmp_path / "demo" / "metrics.json").read_text())
-    assert all(a["offset_improvement"] > 1.5 for a in metrics["runs"][0]["axes"].values())
+    assert all(a["offset_improvement"] > 1.0 for a in metrics["runs"][0]["axes"].values())
     assert "held-out run, raw vs compensated" in r.stdout
+    # the preset's three effects are shown; what the compensation leaves is less than the temperature drift
+    effects = json.loads((tmp_path / "demo" / "effects.json").read_text())
+    sizes = effects["effects_peak_to_peak_dps"]
+    assert set(sizes) == {"temperature (with thermal lag)", "hysteresis", "g-sensitivity"}
+    for axis, left in effects["residual_peak_to_peak_dps"].items():
+        assert left < sizes["temperature (with thermal lag)"][axis]
+        assert sizes["hysteresis"][axis] > 0.002 and sizes["g-sensitivity"][axis] > 0.005
+    assert "hysteresis" in r.stdout and "g-sensitivity" in r.stdout and "not compensated in this release" in r.stdout
+    truth = json.loads((tmp_path / "demo" / "heldout_truth.json").read_text())
+    assert truth["preset"] == "mti10" and truth["profile"]["name"] == "combined"
+    assert "warning" not in r.stderr
 
 
 def test_mapping_and_units_through_cli(workdir, tmp_path):

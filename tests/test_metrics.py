@@ -64,3 +64,21 @@ def test_window_errors():
         window_samples(100, 10.0, 100)
     with pytest.raises(InputError, match=r"window: 20 samples is longer than the data"):
         moving_average(np.zeros(10), 20)
+
+
+def test_runs_with_gaps_pool_the_allan_sums_over_their_stretches():
+    from gyrocomp.allan import allan_deviation_segments
+    from gyrocomp.errors import DataQualityWarning
+    from gyrocomp.simulate import simulate
+
+    sim = simulate("mti10", profile="combined", duration_s=6 * 3600, rate_hz=2, seed=1)
+    rec = sim.recording
+    assert len(rec.gaps) > 10
+    with pytest.warns(DataQualityWarning, match=r"time gap\(s\); the Allan deviation pools the \d+ stretches"):
+        ev = evaluate_run(rec, rec, window_s=10.0)
+    stretches = rec.contiguous_stretches()
+    pooled = allan_deviation_segments([rec.gyro_dps[s, 0] for s in stretches], rec.rate_hz).minimum()
+    assert ev.axes["gyro_x"].bias_instability_raw_dph == pytest.approx(
+        pooled.deviation / BIAS_INSTABILITY_FACTOR * 3600, rel=1e-12)
+    # no tau longer than a stretch: the curve stops where the positions do
+    assert ev.axes["gyro_x"].integration_time_raw_s <= max(s.stop - s.start for s in stretches) / rec.rate_hz

@@ -7,7 +7,7 @@ import pytest
 
 from gyrocomp.allan import allan_deviation, allan_deviation_segments
 from gyrocomp.errors import InputError
-from gyrocomp.noise import analyse_noise, contiguous_stretches
+from gyrocomp.noise import analyse_noise
 from gyrocomp.recording import Recording
 
 
@@ -51,7 +51,7 @@ def test_gaps_are_refused_unless_split():
     with pytest.raises(InputError, match=r"static.csv: time gap of 10.02 s after row 40000 \(t = 799.98 s\); "
                                          r"Allan deviations need evenly spaced samples: use --split-gaps"):
         analyse_noise(rec)
-    assert [(s.start, s.stop) for s in contiguous_stretches(rec)] == [(0, 40_000), (40_000, 60_000)]
+    assert [(s.start, s.stop) for s in rec.contiguous_stretches()] == [(0, 40_000), (40_000, 60_000)]
     analysis = analyse_noise(rec, split_gaps=True)
     assert analysis.stretches == 2
     assert "pooled 2 contiguous stretches split at 1 gap(s)" in analysis.how

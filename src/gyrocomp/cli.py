@@ -117,6 +117,9 @@ def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
               help="Write K power-ons (own turn-on bias and noise) as OUT_0.csv ... OUT_{K-1}.csv.")
 @click.option("--unit", type=int, default=None, help="Simulate unit N of the preset's production spread (default: nominal).")
 @click.option("--axes", default=None, help="Gyro axes to simulate, e.g. z or x,y,z (default: all of the preset's).")
+@click.option("--disable", default=None, metavar="TERM,...",
+              help="Switch error terms off: temperature, lag, hysteresis, g-sensitivity, scale-factor, "
+                   "misalignment, turn-on, noise, quantization, temperature-noise.")
 @click.option("--set-points", "set_points", default=None, metavar="T1,T2,...",
               help="Chamber set points [degC] (default: the preset's range).")
 @click.option("--ramp-rate", "ramp_rate", type=float, default=None, help="Ramp rate between set points [degC/min].")
@@ -128,7 +131,7 @@ def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
 @click.option("--truth-columns", is_flag=True,
               help="Add true_error_gyro_*, true_noise_gyro_*, true_rate_gyro_* and true_structure_temperature columns.")
 @click.pass_context
-def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, set_points, ramp_rate, dwell_s,
+def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, disable, set_points, ramp_rate, dwell_s,
              cycles, position_s, output, truth, truth_columns):
     """Simulate calibration runs of a sensor preset through a test profile, with the exact truth."""
     from .simulate import Simulation, preset_model, resolve_profile
@@ -137,6 +140,8 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
     model = preset_model(preset, unit)
     if axes:
         model = model.subset(tuple(f"gyro_{a.strip()}" for a in axes.split(",") if a.strip()))
+    if disable:
+        model = model.without(*(t.strip() for t in disable.split(",") if t.strip()))
     if runs < 1:
         raise click.BadParameter("must be at least 1", param_hint="--runs")
     prof = resolve_profile(profile, preset, set_points_degc=_float_list(set_points, "--set-points"),

@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .allan import BIAS_INSTABILITY_FACTOR, allan_deviation
+from .allan import BIAS_INSTABILITY_FACTOR, allan_deviation, allan_deviation_segments
 from .errors import DataQualityWarning, InputError
 from .recording import Recording
 from .units import DEG_PER_S_TO_DEG_PER_H
@@ -51,9 +51,16 @@ class BiasInstability:
     integration_time_s: float
 
 
-def bias_instability(rate_dps: np.ndarray, rate_hz: float) -> BiasInstability:
-    """Bias instability from the minimum of the octave overlapping Allan deviation of rate data [deg/s]."""
-    low = allan_deviation(rate_dps, rate_hz, taus="octave", confidence=None).minimum()
+def bias_instability(rate_dps: np.ndarray, rate_hz: float, stretches: list[slice] | None = None) -> BiasInstability:
+    """Bias instability from the minimum of the octave overlapping Allan deviation of rate data [deg/s].
+
+    With ``stretches`` (the pieces of a recording between time gaps), the Allan sums are pooled over
+    them so that no difference spans a gap.
+    """
+    if stretches is not None and len(stretches) > 1:
+        low = allan_deviation_segments([rate_dps[s] for s in stretches], rate_hz, taus="octave").minimum()
+    else:
+        low = allan_deviation(rate_dps, rate_hz, taus="octave", confidence=None).minimum()
     return BiasInstability(low.deviation / BIAS_INSTABILITY_FACTOR * DEG_PER_S_TO_DEG_PER_H, low.tau_s)
 
 
@@ -62,7 +69,8 @@ def default_window_s(recording: Recording) -> float:
 
     With several axes, the longest of their Allan-minimum taus.
     """
-    taus = [bias_instability(recording.gyro_dps[:, j], recording.rate_hz).integration_time_s
+    stretches = recording.contiguous_stretches()
+    taus = [bias_instability(recording.gyro_dps[:, j], recording.rate_hz, stretches).integration_time_s
             for j in range(len(recording.gyro_axes))]
     return max(MIN_WINDOW_S, max(taus))
 
@@ -132,9 +140,11 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
     window_s : float, optional
         Moving-average window [s]; default :func:`default_window_s` of the raw run.
     """
+    stretches = raw.contiguous_stretches()
     if raw.gaps:
         warnings.warn(
-            f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation treats the samples as contiguous",
+            f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation pools the {len(stretches)} stretches "
+            "between them, the moving average runs across them",
             DataQualityWarning, stacklevel=2,
         )
     if window_s is None:
@@ -144,7 +154,7 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
     for j, axis in enumerate(raw.gyro_axes):
         r, c = raw.gyro_dps[:, j], compensated.gyro_dps[:, j]
         off_raw, off_comp = bias_offset(r, w), bias_offset(c, w)
-        bi_raw, bi_comp = bias_instability(r, raw.rate_hz), bias_instability(c, raw.rate_hz)
+        bi_raw, bi_comp = bias_instability(r, raw.rate_hz, stretches), bias_instability(c, raw.rate_hz, stretches)
         axes[axis] = AxisMetrics(
             bias_offset_raw_dps=off_raw,
             bias_offset_comp_dps=off_comp,

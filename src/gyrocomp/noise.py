@@ -82,15 +82,6 @@ def _floats(values) -> list:
     return [_float(v) for v in np.asarray(values, dtype=float)]
 
 
-def contiguous_stretches(recording: Recording) -> list[slice]:
-    """Sample ranges between the recording's time gaps, in order."""
-    starts = [0]
-    for gap in recording.gaps:
-        starts.append(int(np.searchsorted(recording.time_s, gap.start_s)) + 1)
-    bounds = starts + [recording.n_samples]
-    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-
-
 def _channel(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
     if axis in recording.gyro_axes:
         return recording.gyro(axis), "gyro", "deg/s"
@@ -127,7 +118,7 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
     names = list(axes) if axes else list(recording.gyro_axes)
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
-    stretches = contiguous_stretches(recording)
+    stretches = recording.contiguous_stretches()
     how = None
     if len(stretches) > 1:
         longest = max(stretches, key=lambda s: s.stop - s.start)

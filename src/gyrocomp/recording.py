@@ -199,6 +199,12 @@ class Recording:
                 f"{self.source}: no gyro axis {axis!r}; this recording has {', '.join(self.gyro_axes)}"
             ) from None
 
+    def contiguous_stretches(self) -> list[slice]:
+        """Sample ranges between the recording's time gaps, in order (one slice when there is no gap)."""
+        starts = [0] + [int(np.searchsorted(self.row_numbers, gap.after_row)) + 1 for gap in self.gaps]
+        bounds = starts + [self.n_samples]
+        return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
     def with_gyro(self, gyro_dps: np.ndarray) -> "Recording":
         """A copy with the gyro data replaced (same axes, same shape)."""
         return dataclasses.replace(self, gyro_dps=gyro_dps)

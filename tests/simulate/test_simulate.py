@@ -247,3 +247,19 @@ def test_parameter_errors():
         simulate(rate_hz=0)
     with pytest.raises(InputError, match="--preset: unknown preset 'bmi'"):
         simulate("bmi")
+
+
+def test_terms_switch_off_one_by_one():
+    base = preset_model("mti10")
+    quiet = base.without("noise", "quantization", "temperature-noise", "turn-on")
+    sim = simulate(quiet.without("hysteresis", "g-sensitivity"), profile="cycle", duration_s=4000, rate_hz=1)
+    t = sim.truth
+    assert not np.any(t.components_dps["hysteresis"]) and not np.any(t.components_dps["acceleration"])
+    np.testing.assert_allclose(sim.recording.gyro_dps, t.components_dps["temperature"], atol=1e-15)
+    no_lag = simulate(quiet.without("lag"), profile="cycle", duration_s=4000, rate_hz=1)
+    np.testing.assert_array_equal(no_lag.truth.structure_temperature_degc, no_lag.truth.reported_temperature_degc)
+    flat = simulate(quiet.without("temperature", "hysteresis", "g-sensitivity"), profile="cycle", duration_s=4000,
+                    rate_hz=1)
+    assert not np.any(flat.recording.gyro_dps)
+    with pytest.raises(InputError, match="--disable: unknown term 'wind'; use any of temperature, lag"):
+        base.without("wind")

@@ -242,6 +242,16 @@ class GyroErrorModel:
             out += angular_rate_dps @ m.T
         return out
 
+    def without(self, *terms: str) -> "GyroErrorModel":
+        """The same part with the named terms switched off (see ``SWITCHABLE_TERMS``)."""
+        unknown = [t for t in terms if t not in SWITCHABLE_TERMS]
+        if unknown:
+            raise InputError(f"--disable: unknown term {unknown[0]!r}; use any of {', '.join(SWITCHABLE_TERMS)}")
+        changes: dict = {}
+        for term in terms:
+            changes.update(SWITCHABLE_TERMS[term](self))
+        return dataclasses.replace(self, **changes)
+
     def subset(self, axes: tuple[str, ...]) -> "GyroErrorModel":
         """The same part with only ``axes`` simulated (every per-axis parameter picked accordingly)."""
         missing = [a for a in axes if a not in self.axes]
@@ -261,6 +271,22 @@ class GyroErrorModel:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+#: what ``GyroErrorModel.without`` (and ``gyrocomp simulate --disable``) can switch off
+SWITCHABLE_TERMS = {
+    "temperature": lambda m: {"temperature_coefficients": tuple((0.0,) for _ in m.axes)},
+    "lag": lambda m: {"thermal_time_constant_s": 0.0},
+    "hysteresis": lambda m: {"hysteresis": None},
+    "g-sensitivity": lambda m: {"g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None},
+    "scale-factor": lambda m: {"scale_factor_error_ppm": None, "scale_factor_tempco_ppm_per_degc": None},
+    "misalignment": lambda m: {"misalignment_rad": None},
+    "turn-on": lambda m: {"turn_on_bias_sigma_dps": 0.0},
+    "noise": lambda m: {"noise_density_dps_per_sqrt_hz": 0.0, "bias_instability_deg_per_h": 0.0,
+                        "rate_random_walk_dps_per_sqrt_s": 0.0},
+    "quantization": lambda m: {"quantization_dps": 0.0, "temperature_quantization_degc": 0.0},
+    "temperature-noise": lambda m: {"temperature_noise_degc": 0.0},
+}
 
 
 @dataclass(frozen=True)
