@@ -102,3 +102,16 @@ def test_predict_error_is_raw_minus_compensated(calibration):
     sim = simulate(duration_s=300, rate_hz=10, seed=4)
     err = calibration.predict_error(sim.recording)
     np.testing.assert_allclose(sim.recording.gyro_dps - err, apply(calibration, sim.recording).gyro_dps, atol=1e-15)
+
+
+def test_schema_1_files_load_without_lag_or_hysteresis(calibration, tmp_path):
+    d = json.loads(calibration.to_json())
+    d["schema_version"] = 1
+    for ax in d["axes"].values():
+        del ax["lag_time_constant_s"], ax["hysteresis"]
+    path = tmp_path / "v1.json"
+    path.write_text(json.dumps(d))
+    loaded = Calibration.load(path)
+    assert loaded.schema_version == SCHEMA_VERSION == 2
+    assert all(ax.lag_time_constant_s == 0 and ax.hysteresis is None for ax in loaded.axes.values())
+    assert loaded.axes["gyro_z"].temperature == calibration.axes["gyro_z"].temperature

@@ -12,6 +12,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from gyrocomp.calibration import SCHEMA_VERSION
+
 SCRIPT = Path(sys.executable).parent / "gyrocomp"
 
 
@@ -206,7 +208,7 @@ def test_drop_nan_reports_and_proceeds(tmp_path):
 
 
 @pytest.mark.parametrize("edit,message", [
-    (lambda t: t.replace('"schema_version": 1', '"schema_version": 99'), r"written with model schema 99, .*upgrade gyrocomp"),
+    (lambda t: t.replace(f'"schema_version": {SCHEMA_VERSION}', '"schema_version": 99'), r"written with model schema 99, .*upgrade gyrocomp"),
     (lambda t: t[: len(t) // 2], r"not valid JSON \(line \d+, column \d+: .*\); the file may be truncated"),
 ])
 def test_bad_model_files(workdir, tmp_path, edit, message):

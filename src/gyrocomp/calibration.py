@@ -19,12 +19,25 @@ import numpy as np
 from .errors import InputError
 from .io.atomic import write_text_atomic
 from .models.temperature import PolynomialBias
+from .models.thermal import HysteresisCurve
 from .recording import Recording
 
 FORMAT_NAME = "gyrocomp-calibration"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+
+
+def _upgrade_1_to_2(d: dict) -> dict:
+    """Schema 2 adds thermal lag and hysteresis per axis; a schema-1 file has neither."""
+    d = dict(d)
+    if isinstance(d.get("axes"), dict):
+        d["axes"] = {name: {**ax, "lag_time_constant_s": 0.0, "hysteresis": None} if isinstance(ax, dict) else ax
+                     for name, ax in d["axes"].items()}
+    d["schema_version"] = 2
+    return d
+
+
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
-UPGRADES: dict[int, Callable[[dict], dict]] = {}
+UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2}
 UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
 
 
@@ -40,11 +53,23 @@ class AxisCalibration:
         Fitted turn-on constant of each calibration run [deg/s].
     temperature_column : str
         The temperature channel the model reads (``temperature`` or ``temperature_x`` ...).
+    lag_time_constant_s : float
+        Thermal lag [s]: the polynomial and the hysteresis read the reported temperature through a
+        first-order lag of this time constant; 0 for none.
+    hysteresis : HysteresisCurve or None
+        Turning-point hysteresis on top of the polynomial.
     """
 
     temperature: PolynomialBias | None
     turn_on_biases_dps: tuple[float, ...]
     temperature_column: str = "temperature"
+    lag_time_constant_s: float = 0.0
+    hysteresis: HysteresisCurve | None = None
+
+    @property
+    def has_memory(self) -> bool:
+        """Whether the correction depends on the temperature history (lag or hysteresis), not only its value."""
+        return self.lag_time_constant_s > 0 or self.hysteresis is not None
 
     @property
     def mean_turn_on_bias_dps(self) -> float:
@@ -61,6 +86,8 @@ class AxisCalibration:
             "temperature": None if self.temperature is None else self.temperature.to_dict(),
             "turn_on_biases_dps": list(self.turn_on_biases_dps),
             "temperature_column": self.temperature_column,
+            "lag_time_constant_s": self.lag_time_constant_s,
+            "hysteresis": None if self.hysteresis is None else self.hysteresis.to_dict(),
         }
 
     @classmethod
@@ -72,6 +99,8 @@ class AxisCalibration:
             temperature=None if temp is None else PolynomialBias.from_dict(temp),
             turn_on_biases_dps=tuple(float(c) for c in d["turn_on_biases_dps"]),
             temperature_column=str(d.get("temperature_column", "temperature")),
+            lag_time_constant_s=float(d["lag_time_constant_s"]),
+            hysteresis=None if d["hysteresis"] is None else HysteresisCurve.from_dict(d["hysteresis"]),
         )
 
 

@@ -7,6 +7,7 @@ import warnings
 import numpy as np
 
 from .calibration import Calibration
+from .effects import find_turns, thermal_lag
 from .errors import InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .recording import Recording
@@ -27,10 +28,16 @@ class Compensator:
         Estimate each axis's turn-on constant as the mean residual over the first
         ``turn_on_window_s`` seconds [s] (output is held back until that window is complete).
         Default: subtract the mean turn-on constant of the calibration runs.
+    rate_hz : float, optional
+        Nominal sample rate of the stream [Hz]; needed when the model has thermal lag (its filter
+        steps one nominal period per sample and bridges longer gaps exactly).
+
+    Models with thermal lag or hysteresis carry their state (lag filter, turning-point detector)
+    from one chunk to the next, so the chunking never changes the result.
     """
 
     def __init__(self, calibration: Calibration, gyro_axes: tuple[str, ...], *,
-                 turn_on_window_s: float | None = None, source: str = "<stream>"):
+                 turn_on_window_s: float | None = None, rate_hz: float | None = None, source: str = "<stream>"):
         if turn_on_window_s is not None and not turn_on_window_s > 0:
             raise InputError(f"--turn-on-window: must be a positive number of seconds, got {turn_on_window_s}")
         self.calibration = calibration
@@ -43,6 +50,13 @@ class Compensator:
                 f"{source}: the model covers {', '.join(calibration.axes)}, the data has "
                 f"{', '.join(self.gyro_axes)}; no axis in common"
             )
+        if rate_hz is not None and not rate_hz > 0:
+            raise InputError(f"rate_hz: must be positive, got {rate_hz}")
+        if rate_hz is None and any(ax.lag_time_constant_s > 0 for _, ax in self._modelled):
+            raise InputError(f"{source}: the model has thermal lag; give the stream's sample rate (rate_hz)")
+        self.rate_hz = rate_hz
+        self._lag_states = [None] * len(self._modelled)
+        self._turn_states = [None] * len(self._modelled)
         self._warned = False
         self._t0: float | None = None
         self._constants: np.ndarray | None = None
@@ -51,23 +65,39 @@ class Compensator:
         self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
         self._pending_time: list[np.ndarray] = []
 
-    def _residual(self, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
+    def _model_temperature(self, k: int, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
+        """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""
+        if ax.lag_time_constant_s <= 0:
+            return temperature_degc
+        lagged, self._lag_states[k] = thermal_lag(time_s, temperature_degc, ax.lag_time_constant_s,
+                                                  period_s=1.0 / self.rate_hz, state=self._lag_states[k])
+        return lagged
+
+    def _residual(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
-        for j, ax in self._modelled:
+        for k, (j, ax) in enumerate(self._modelled):
             if ax.temperature is None:
                 continue
             if temperature_degc is None:
                 raise InputError(f"{self.source}: the model needs temperature, the data has none")
             t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc[:, j]
-            if not self._warned and ax.temperature.outside_range(t):
+            if time_s.size == 0:
+                continue
+            t_model = self._model_temperature(k, ax, time_s, t)
+            if not self._warned and ax.temperature.outside_range(t_model):
+                lagged = f" (through its {ax.lag_time_constant_s:.3g} s thermal lag)" if ax.lag_time_constant_s else ""
                 warnings.warn(
-                    f"{self.source}: temperature outside the model's range "
+                    f"{self.source}: temperature{lagged} outside the model's range "
                     f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
                     "the model is held at its edge there",
                     TemperatureRangeWarning, stacklevel=3,
                 )
                 self._warned = True
-            out[:, j] -= ax.temperature.shape_dps(t)
+            out[:, j] -= ax.temperature.shape_dps(t_model)
+            if ax.hysteresis is not None:
+                turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states[k])
+                self._turn_states[k] = turns.state
+                out[:, j] -= ax.hysteresis.offset_dps(t_model, turns)
         return out
 
     def _subtract_constants(self, residual: np.ndarray) -> np.ndarray:
@@ -85,7 +115,7 @@ class Compensator:
         gyro_dps = np.asarray(gyro_dps, dtype=float).reshape(time_s.size, len(self.gyro_axes))
         if temperature_degc is not None:
             temperature_degc = np.asarray(temperature_degc, dtype=float)
-        residual = self._residual(gyro_dps, temperature_degc)
+        residual = self._residual(time_s, gyro_dps, temperature_degc)
         if self._constants is not None:
             return self._subtract_constants(residual)
         if self._t0 is None and time_s.size:
@@ -120,7 +150,8 @@ class Compensator:
 
 def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None) -> Recording:
     """Compensate a whole recording; the result has the same rows, axes and other channels."""
-    comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s, source=recording.source)
+    comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
+                       rate_hz=recording.rate_hz, source=recording.source)
     out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc)
     rest = comp.finish()
     return recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)

@@ -142,7 +142,7 @@ def test_heating_rate_does_not_weight_the_fit():
     rec = Recording(time_s=t, gyro_dps=gyro, gyro_axes=("gyro_z",), temperature_degc=temp)
     bins = bin_by_temperature([temp], [gyro], 1.0)
     assert bins.weight.max() == 1.0
-    cal = fit_calibration([rec], temperature=2)
+    cal = fit_calibration([rec], temperature=2, hysteresis="none")
     shape = cal.axes["gyro_z"].temperature.shape_dps(GRID)
     truth = 1e-3 * (GRID - 25) + 1e-5 * (GRID - 25) ** 2
     np.testing.assert_allclose(shape - shape.mean(), truth - truth.mean(), atol=1e-6)
@@ -160,6 +160,20 @@ def test_clamps_outside_range_and_warns_once():
     curve = cal.axes["gyro_z"].temperature
     assert np.all(out.gyro_dps[-300:, 0] == out.gyro_dps[-1, 0])  # held at the edge
     assert curve.shape_dps(np.array([80.0])) == curve.shape_dps(np.array([40.0]))
+
+
+def test_noise_level_overshoot_of_the_range_is_not_outside_it():
+    t = np.arange(0, 600.0)
+    temp = np.linspace(10, 40, t.size)
+    cal = fit_calibration([Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)],
+                          temperature=1)
+    curve = cal.axes["gyro_z"].temperature
+    assert curve.range_tolerance_degc == 0.5  # 1 % of a 30 degC span is less
+    assert not curve.outside_range(np.array([9.6, 40.4]))
+    assert curve.outside_range(np.array([40.6]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        apply(cal, Recording(time_s=t, gyro_dps=np.zeros(t.size), gyro_axes=("gyro_z",), temperature_degc=temp + 0.3))
 
 
 def test_errors():

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from pathlib import Path
 
 
@@ -10,6 +11,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
 from ..recording import Recording
 from .temperature import PolynomialTemperatureModel
+from .thermal import HYSTERESIS_CHOICES, ThermalHysteresisModel, heats_and_cools
 
 
 def _provenance(recordings: list[Recording]) -> dict:
@@ -32,7 +34,9 @@ def _provenance(recordings: list[Recording]) -> dict:
 
 
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
-                    bin_width_degc: float | None = None) -> Calibration:
+                    bin_width_degc: float | None = None, hysteresis: str = "auto",
+                    hysteresis_order: int | str = "auto",
+                    hysteresis_band_degc: tuple[float, float] | None = None) -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -44,6 +48,14 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         for no temperature model (each run's constant only).
     bin_width_degc : float, optional
         Temperature bin width for the fit [degC].
+    hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
+        Thermal lag and/or turning-point hysteresis on top of the polynomial
+        (:mod:`gyrocomp.models.thermal`). ``"auto"``: when the runs both heat and cool, every candidate is
+        compared by leave-one-run-out error and the best kept; otherwise none.
+    hysteresis_order : int or "auto"
+        Order of the turning-point polynomial (1..3) or chosen by validation.
+    hysteresis_band_degc : (lo, hi), optional
+        Limit the hysteresis to this band [degC].
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
@@ -63,12 +75,36 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                 f"{rec.source}: no temperature column; a temperature model needs one "
                 "(map it with --columns temperature=NAME, or fit with --temperature none)"
             )
+    if hysteresis not in HYSTERESIS_CHOICES:
+        raise InputError(f"--hysteresis: {hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
     model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc).fit(recordings)
+    mode = hysteresis
+    if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
+        mode = "none"
+    thermal = None
+    if mode != "none":
+        orders = {axis: curve.order for axis, curve in model.curves_.items()}
+        thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
+                                         band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc).fit(recordings)
     axes = {}
     report = {"temperature": "polynomial", "order_selection": model.selection_, "axes": {}}
+    if thermal is not None:
+        report["hysteresis"] = {"mode": hysteresis, "selection": thermal.selection_, "axes": {
+            axis: {"chosen": thermal.chosen_[axis], "lag_time_constant_s": thermal.lag_time_constants_s_[axis],
+                   "scores_dps" if thermal.selection_ != "bic" else "scores_bic":
+                       {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()}}
+            for axis in thermal.chosen_}}
+    else:
+        report["hysteresis"] = {"mode": hysteresis, "selection": "none: the runs do not both heat and cool"
+                                if hysteresis == "auto" else "none"}
     for axis, curve in model.curves_.items():
-        axes[axis] = AxisCalibration(curve, tuple(float(c) for c in model.turn_on_biases_dps_[axis]),
-                                     recordings[0].temperature_column_for(axis))
+        consts = model.turn_on_biases_dps_[axis]
+        lag, hyst = 0.0, None
+        if thermal is not None:
+            curve, consts = thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]
+            lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
+        axes[axis] = AxisCalibration(curve, tuple(float(c) for c in consts),
+                                     recordings[0].temperature_column_for(axis), lag, hyst)
         report["axes"][axis] = {
             "order": curve.order,
             "scores": {str(p): float(s) for p, s in model.scores_[axis].items()},
@@ -80,6 +116,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
     if temperature == "auto":
         name += " (auto)"
+    if thermal is not None:
+        extras = sorted({c.split(" (")[0] for c in thermal.chosen_.values()} - {"none"})
+        if extras:
+            name += " + " + "/".join(extras)
     return Calibration(axes=axes, model=name, provenance=_provenance(recordings), fit_report=report)
 
 

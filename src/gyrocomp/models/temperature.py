@@ -23,6 +23,9 @@ from ..recording import Recording
 from .base import TemperatureBins, bin_by_temperature, bin_width_for
 
 MAX_ORDER = 5
+#: data beyond the fitted temperature range by less than max(these) is not reported as outside it
+RANGE_TOLERANCE_DEGC = 0.5
+RANGE_TOLERANCE_FRACTION = 0.01
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins
 PARSIMONY_TOLERANCE = 1.01
 
@@ -44,9 +47,17 @@ class PolynomialBias:
     def order(self) -> int:
         return len(self.coefficients_dps)
 
+    @property
+    def range_tolerance_degc(self) -> float:
+        """How far past its range data may go before it counts as outside [degC]: sensor noise and
+        rounding make a new run at the same set points overshoot the fit's extremes slightly."""
+        return max(RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION * (self.t_max_degc - self.t_min_degc))
+
     def outside_range(self, temperature_degc: np.ndarray) -> bool:
+        """Whether any temperature lies beyond the fitted range by more than ``range_tolerance_degc``."""
         t = np.asarray(temperature_degc)
-        return bool(np.any(t < self.t_min_degc) or np.any(t > self.t_max_degc))
+        tol = self.range_tolerance_degc
+        return bool(np.any(t < self.t_min_degc - tol) or np.any(t > self.t_max_degc + tol))
 
     def shape_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
         """Bias shape [deg/s] at ``temperature_degc`` [degC], clamped to the valid range."""

@@ -1,0 +1,377 @@
+"""Hysteresis and thermal lag on top of the temperature polynomial, and the data's choice between them.
+
+Per gyro axis and run r, the bias is modelled as
+
+    b_r(t) = c_r + p(T_s(t)) + H(T_s, history)
+
+- T_s is the reported temperature T, or, with thermal lag, T through a first-order lag of time
+  constant tau (the MEMS structure is not at the reported temperature while it changes), tau fitted;
+- p is the polynomial of :mod:`gyrocomp.models.temperature` (no constant; the run constants c_r
+  take that);
+- H is the thesis's hysteresis (section 2.6): after a confirmed reversal of T_s, sum_j h_j d^j with
+  d = |T_s - T_turn|, one set of h for cooling branches and one for heating branches, optionally only
+  inside a temperature band.
+
+The fit works on block means of each run (``block_s`` seconds), in time order, weighted so that
+every temperature bin of every run counts equally (as the polynomial's binning does). For a fixed
+tau everything is linear; tau is found by a log-spaced search refined by a bounded scalar
+minimization (variable projection). The candidates none, turning-point, lag and turning-point+lag
+are compared by leave-one-run-out error (the held-out run's constant refitted), or by BIC with
+one run; the hysteresis order (1-3) is chosen the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ..effects import find_turns, hysteresis_offset, thermal_lag
+from ..errors import InputError, ModelError, NotFittedError
+from ..recording import Recording
+from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
+
+HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
+CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag")
+MAX_HYSTERESIS_ORDER = 3
+#: bounds of the thermal time constant search [s]
+LAG_MIN_BLOCKS = 2.0
+LAG_MAX_S = 4 * 3600.0
+DEFAULT_BLOCK_S = 2.0
+#: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
+#: score measures drift (what compensation is for) rather than white noise, which no model removes
+SCORE_WINDOW_S = 60.0
+
+
+def turn_threshold_degc(temperature_degc: np.ndarray) -> float:
+    """Turning-point threshold for a measured temperature series [degC].
+
+    Ten times the sample noise (robust, from the median absolute second difference, which a ramp
+    does not inflate: the running extreme of a long dwell wanders several sigma), 1.5 times the
+    quantization step when the values sit on a grid, and at least 0.1 degC.
+    """
+    t = np.asarray(temperature_degc, dtype=float)
+    second = np.diff(t, 2)
+    noise = 1.4826 * float(np.median(np.abs(second))) / math.sqrt(6.0) if second.size else 0.0
+    steps = np.abs(np.diff(t))
+    steps = steps[steps > 0]
+    lsb = 0.0
+    if steps.size:
+        smallest = float(steps.min())
+        if np.allclose(steps / smallest, np.round(steps / smallest), atol=1e-6):
+            lsb = smallest
+    return max(10.0 * noise, 1.5 * lsb, 0.1)
+
+
+def heats_and_cools(recordings: list[Recording], axis: str) -> bool:
+    """Whether the runs together contain both a rising and a falling temperature branch."""
+    up = down = False
+    for rec in recordings:
+        t = rec.temperature_for(axis)
+        d = find_turns(t, turn_threshold_degc(t)).direction
+        up |= bool(np.any(d == 1))
+        down |= bool(np.any(d == -1))
+    return up and down
+
+
+@dataclass(frozen=True)
+class HysteresisCurve:
+    """Fitted hysteresis of one axis: offset after a reversal of the model temperature.
+
+    offset = sum_j h_j |T - T_turn|^j, h from ``descending_dps`` on cooling branches and
+    ``ascending_dps`` on heating branches [deg/s/degC^j], zero outside ``band_degc`` if given.
+    Reversals are confirmed ``threshold_degc`` past the extreme (see :func:`gyrocomp.effects.find_turns`).
+    """
+
+    descending_dps: tuple[float, ...]
+    ascending_dps: tuple[float, ...]
+    threshold_degc: float
+    band_degc: tuple[float, float] | None = None
+
+    @property
+    def order(self) -> int:
+        return len(self.descending_dps)
+
+    def offset_dps(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
+        down = hysteresis_offset(temperature_degc, turns, self.descending_dps, direction="descending",
+                                 band_degc=self.band_degc)
+        up = hysteresis_offset(temperature_degc, turns, self.ascending_dps, direction="ascending",
+                               band_degc=self.band_degc)
+        return down + up
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"type": "turning-point", "descending_dps": list(self.descending_dps),
+                "ascending_dps": list(self.ascending_dps), "threshold_degc": self.threshold_degc,
+                "band_degc": None if self.band_degc is None else list(self.band_degc)}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "HysteresisCurve":
+        if d.get("type") != "turning-point":
+            raise InputError(f"unknown hysteresis model type {d.get('type')!r}")
+        band = d.get("band_degc")
+        return cls(tuple(float(v) for v in d["descending_dps"]), tuple(float(v) for v in d["ascending_dps"]),
+                   float(d["threshold_degc"]), None if band is None else (float(band[0]), float(band[1])))
+
+
+@dataclass(frozen=True)
+class _RunBlocks:
+    time_s: np.ndarray
+    temperature_degc: np.ndarray
+    value_dps: np.ndarray
+    weight: np.ndarray
+
+
+def _block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float) -> _RunBlocks:
+    """Means over consecutive blocks of ``block_s`` (never across a time gap), with bin-balancing weights."""
+    t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
+    per_block = max(1, int(round(block_s * rec.rate_hz)))
+    starts = []
+    for piece in rec.contiguous_stretches():
+        starts.extend(range(piece.start, piece.stop, per_block))
+    starts = np.asarray(starts)
+    counts = np.diff(np.append(starts, t.size))
+    mean = lambda x: np.add.reduceat(x, starts) / counts  # noqa: E731
+    bt, btemp, by = mean(t), mean(temp), mean(y)
+    idx = np.floor(btemp / bin_width_degc).astype(np.int64)
+    _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
+    weight = (counts / counts.max()) / per_bin[inverse]
+    return _RunBlocks(bt, btemp, by, weight)
+
+
+@dataclass(frozen=True)
+class _Spec:
+    """One candidate: polynomial order, thermal lag on/off, hysteresis order (0 = none)."""
+
+    order: int
+    lag: bool
+    hysteresis_order: int
+
+    @property
+    def name(self) -> str:
+        if self.lag and self.hysteresis_order:
+            return "turning-point+lag"
+        return "lag" if self.lag else ("turning-point" if self.hysteresis_order else "none")
+
+
+@dataclass
+class _Problem:
+    runs: list[_RunBlocks]
+    t_ref: float
+    t_scale: float
+    threshold: float
+    band: tuple[float, float] | None
+    block_s: float
+
+    def features(self, run: _RunBlocks, spec: _Spec, tau: float, t_lo: float, t_hi: float):
+        """(T_s, columns of the shape and hysteresis) of one run at thermal time constant tau."""
+        temp = run.temperature_degc
+        if spec.lag and tau > 0:
+            temp, _ = thermal_lag(run.time_s, temp, tau, period_s=self.block_s)
+        u = (np.clip(temp, t_lo, t_hi) - self.t_ref) / self.t_scale
+        cols = [u ** k for k in range(1, spec.order + 1)]
+        if spec.hysteresis_order:
+            turns = find_turns(temp, self.threshold)
+            active = ~np.isnan(turns.turn_degc)
+            if self.band is not None:
+                active &= (temp >= self.band[0]) & (temp <= self.band[1])
+            d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0)
+            for sign in (-1, 1):
+                on = active & (turns.direction == sign)
+                cols += [np.where(on, d ** j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
+        return temp, (np.column_stack(cols) if cols else np.zeros((temp.size, 0)))
+
+    def solve(self, spec: _Spec, tau: float, which: list[int]):
+        """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range)."""
+        temps, feats, ys, ws, onehots = [], [], [], [], []
+        lagged = [self.features(self.runs[r], spec, tau, -np.inf, np.inf)[0] for r in which]
+        t_lo = min(float(t.min()) for t in lagged)
+        t_hi = max(float(t.max()) for t in lagged)
+        for k, r in enumerate(which):
+            run = self.runs[r]
+            temp, x = self.features(run, spec, tau, t_lo, t_hi)
+            oh = np.zeros((temp.size, len(which)))
+            oh[:, k] = 1.0
+            feats.append(x)
+            onehots.append(oh)
+            ys.append(run.value_dps)
+            ws.append(run.weight)
+            temps.append(temp)
+        x = np.hstack([np.vstack(onehots), np.vstack(feats)])
+        y, w = np.concatenate(ys), np.concatenate(ws)
+        sw = np.sqrt(w)
+        coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
+        rss = float(np.sum(w * (y - x @ coef) ** 2))
+        return coef[len(which):], coef[: len(which)], rss, (t_lo, t_hi)
+
+    def fit(self, spec: _Spec, which: list[int]):
+        """Best tau for the spec (0 without lag) and the solution there."""
+        if not spec.lag:
+            return 0.0, self.solve(spec, 0.0, which)
+        lo, hi = LAG_MIN_BLOCKS * self.block_s, LAG_MAX_S
+        grid = np.geomspace(lo, hi, 25)
+        rss = [self.solve(spec, tau, which)[2] for tau in grid]
+        best = int(np.argmin(rss))
+        a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
+        res = minimize_scalar(lambda lt: self.solve(spec, math.exp(lt), which)[2], bounds=(a, b), method="bounded",
+                              options={"xatol": 1e-3})
+        tau = math.exp(res.x) if res.fun <= rss[best] else float(grid[best])
+        return tau, self.solve(spec, tau, which)
+
+    def held_out_error(self, spec: _Spec) -> float:
+        """RMS [deg/s] of each run predicted by a fit on the others, its constant refitted."""
+        sse = wsum = 0.0
+        n = len(self.runs)
+        for held in range(n):
+            train = [r for r in range(n) if r != held]
+            tau, (coef, _, _, (t_lo, t_hi)) = self.fit(spec, train)
+            run = self.runs[held]
+            _, x = self.features(run, spec, tau, t_lo, t_hi)
+            e = run.value_dps - x @ coef
+            e -= np.sum(run.weight * e) / np.sum(run.weight)
+            w = max(1, min(e.size, int(round(SCORE_WINDOW_S / self.block_s))))
+            kernel = np.ones(w) / w
+            smooth_e = np.convolve(e, kernel, mode="valid")
+            smooth_w = np.convolve(run.weight, kernel, mode="valid")
+            sse += float(np.sum(smooth_w * smooth_e ** 2))
+            wsum += float(np.sum(smooth_w))
+        return math.sqrt(sse / wsum)
+
+    def bic(self, spec: _Spec) -> float:
+        _, (coef, consts, rss, _) = self.fit(spec, list(range(len(self.runs))))
+        n = sum(r.value_dps.size for r in self.runs)
+        w = sum(float(np.sum(r.weight)) for r in self.runs)
+        k = coef.size + consts.size + (1 if spec.lag else 0)
+        return n * math.log(max(rss / w, 1e-300)) + k * math.log(n)
+
+
+@dataclass
+class ThermalHysteresisModel:
+    """Polynomial temperature model with thermal lag and/or turning-point hysteresis, chosen by the data.
+
+    Parameters
+    ----------
+    order : int or dict
+        Polynomial order of the temperature shape, or one per axis (from :class:`PolynomialTemperatureModel`'s
+        choice).
+    hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
+        The model, or ``"auto"``: every candidate compared by leave-one-run-out error.
+    hysteresis_order : int or "auto"
+        Order of the turning-point polynomial (1..3), or chosen by the same validation.
+    band_degc : (lo, hi), optional
+        Limit the hysteresis to this temperature band [degC] (the ADXRS450 shows it only from 55 to 80).
+    block_s : float
+        Length of the block means the fit works on [s].
+    bin_width_degc : float, optional
+        Temperature bin of the weights [degC]; default span / 100.
+
+    Attributes (after ``fit``)
+    --------------------------
+    curves_ : dict[str, PolynomialBias]
+    lag_time_constants_s_ : dict[str, float]
+        Fitted thermal time constant per axis [s], 0 without lag.
+    hysteresis_ : dict[str, HysteresisCurve or None]
+    turn_on_biases_dps_ : dict[str, np.ndarray]
+    chosen_ : dict[str, str]
+        The candidate kept per axis.
+    scores_ : dict[str, dict[str, float]]
+        Per axis, the validation score of every candidate tried (RMS [deg/s], or BIC with one run).
+    selection_ : str
+        ``"leave-one-run-out"``, ``"bic"`` or ``"fixed"``.
+    """
+
+    order: int | dict[str, int]
+    hysteresis: str = "auto"
+    hysteresis_order: int | str = "auto"
+    band_degc: tuple[float, float] | None = None
+    block_s: float = DEFAULT_BLOCK_S
+    bin_width_degc: float | None = None
+    _fitted: bool = field(default=False, init=False, repr=False)
+
+    def _candidates(self) -> list[str]:
+        return list(CANDIDATES) if self.hysteresis == "auto" else [self.hysteresis]
+
+    def _specs(self, name: str, order: int) -> list[_Spec]:
+        lag = name in ("lag", "turning-point+lag")
+        if "turning-point" not in name:
+            return [_Spec(order, lag, 0)]
+        orders = range(1, MAX_HYSTERESIS_ORDER + 1) if self.hysteresis_order == "auto" else [int(self.hysteresis_order)]
+        return [_Spec(order, lag, p) for p in orders]
+
+    def fit(self, recordings: list[Recording]) -> "ThermalHysteresisModel":
+        """Fit on ``recordings`` (each one power-on at rest) and return self."""
+        if isinstance(recordings, Recording):
+            recordings = [recordings]
+        if self.hysteresis not in HYSTERESIS_CHOICES:
+            raise InputError(f"--hysteresis: {self.hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
+        if self.hysteresis_order != "auto" and not (
+                isinstance(self.hysteresis_order, int) and 1 <= self.hysteresis_order <= MAX_HYSTERESIS_ORDER):
+            raise InputError(f"--hysteresis-order: {self.hysteresis_order!r}; use auto or 1..{MAX_HYSTERESIS_ORDER}")
+        if self.band_degc is not None and not self.band_degc[0] < self.band_degc[1]:
+            raise InputError(f"--hysteresis-band: {self.band_degc}; give LOW,HIGH with LOW < HIGH [degC]")
+        if not self.block_s > 0:
+            raise InputError(f"block_s: must be positive, got {self.block_s}")
+        self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
+        self.turn_on_biases_dps_, self.chosen_, self.scores_ = {}, {}, {}
+        axes = recordings[0].gyro_axes
+        n_runs = len(recordings)
+        self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
+            "leave-one-run-out" if n_runs >= 2 else "bic")
+        for axis in axes:
+            temps = [rec.temperature_for(axis) for rec in recordings]
+            lo = min(float(t.min()) for t in temps)
+            hi = max(float(t.max()) for t in temps)
+            width = self.bin_width_degc or max((hi - lo) / 100.0, 1e-3)
+            block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
+            runs = [_block_means(rec, axis, block_s, width) for rec in recordings]
+            threshold = max(turn_threshold_degc(t) for t in temps)
+            problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, self.band_degc,
+                               block_s)
+            scores: dict[str, float] = {}
+            best_spec: dict[str, _Spec] = {}
+            order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
+            for name in self._candidates():
+                specs = self._specs(name, order)
+                if len(specs) == 1 and self.selection_ == "fixed":
+                    best_spec[name], scores[name] = specs[0], math.nan
+                    continue
+                score = problem.held_out_error if n_runs >= 2 else problem.bic
+                tried = {s: score(s) for s in specs}
+                best_spec[name] = min(tried, key=tried.get)
+                scores[name] = tried[best_spec[name]]
+            if len(scores) == 1:
+                chosen = next(iter(scores))
+            else:
+                finite = {k: v for k, v in scores.items() if math.isfinite(v)}
+                if not finite:
+                    raise ModelError(f"{axis}: no hysteresis candidate could be scored")
+                if self.selection_ == "bic":
+                    chosen = min(finite, key=finite.get)
+                else:  # the simplest candidate within the parsimony tolerance of the best
+                    best = min(finite.values())
+                    chosen = next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
+            spec = best_spec[chosen]
+            tau, (coef, consts, _, (t_lo, t_hi)) = problem.fit(spec, list(range(n_runs)))
+            shape = coef[: spec.order]
+            self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,
+                                                t_lo, t_hi)
+            self.lag_time_constants_s_[axis] = float(tau)
+            p = spec.hysteresis_order
+            self.hysteresis_[axis] = None if not p else HysteresisCurve(
+                tuple(float(v) for v in coef[spec.order: spec.order + p]),
+                tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), threshold, self.band_degc)
+            self.turn_on_biases_dps_[axis] = consts
+            self.chosen_[axis] = chosen if not p else f"{chosen} (order {p})"
+            self.scores_[axis] = scores
+        self._fitted = True
+        return self
+
+    def _check_fitted(self) -> None:
+        if not self._fitted:
+            raise NotFittedError("ThermalHysteresisModel is not fitted yet; call fit(recordings) first")
+
+
+__all__ = ["CANDIDATES", "HYSTERESIS_CHOICES", "HysteresisCurve", "ThermalHysteresisModel", "heats_and_cools",
+           "turn_threshold_degc"]
