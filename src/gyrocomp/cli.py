@@ -38,6 +38,7 @@ from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .metrics import Evaluation, evaluate_run
 from .models.pipelines import fit_calibration
 from .models.temperature import parse_temperature_option
+from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
 from .noise import NoiseAnalysis, analyse_noise
 from .report.figures import allan_figure, check_figure_path
 
@@ -180,15 +181,30 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 @click.option("--temperature", default="poly", show_default=True,
               help="poly (order by cross-validation), poly:N (N = 0..5) or none.")
 @click.option("--bin-width", "bin_width_degc", type=float, default=None, help="Temperature bin width [degC] (default: span/100).")
+@click.option("--hysteresis", type=click.Choice(HYSTERESIS_CHOICES), default="auto", show_default=True,
+              help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
+                   "when the runs both heat and cool.")
+@click.option("--hysteresis-order", default="auto", show_default=True,
+              help="Order of the turning-point polynomial in |T - T_turn|: auto (validated) or 1..3.")
+@click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
+              help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.")
 @read_options
 @click.pass_context
-def fit(ctx, runs, output, temperature, bin_width_degc, **kwargs):
+def fit(ctx, runs, output, temperature, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
+    if hysteresis_order != "auto":
+        if hysteresis_order not in ("1", "2", "3"):
+            raise click.BadParameter("use auto, 1, 2 or 3", param_hint="--hysteresis-order")
+        hysteresis_order = int(hysteresis_order)
+    band = _float_list(hysteresis_band, "--hysteresis-band")
+    if band is not None and (len(band) != 2 or not band[0] < band[1]):
+        raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     refuse_to_overwrite_inputs(output, runs)
     recordings = [_read(path, opts).recording for path in runs]
-    calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc)
+    calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
+                                  hysteresis_order=hysteresis_order, hysteresis_band_degc=band)
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)
@@ -203,6 +219,12 @@ def _print_fit(calibration: Calibration, output) -> None:
     for axis, ax in calibration.axes.items():
         info = report.get("axes", {}).get(axis, {})
         model = "constant" if ax.temperature is None else f"poly order {ax.temperature.order}"
+        if ax.lag_time_constant_s > 0:
+            model += f", lag {ax.lag_time_constant_s:.3g} s"
+        if ax.hysteresis is not None:
+            model += f", hysteresis order {ax.hysteresis.order}"
+            if ax.hysteresis.band_degc is not None:
+                model += f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
         rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
         table.add_row(axis, model, rng, rms, ", ".join(f"{c:+.4g}" for c in ax.turn_on_biases_dps))
@@ -221,6 +243,22 @@ def _print_fit(calibration: Calibration, output) -> None:
             st.add_row(axis, *[(f"{s[str(p)]:.4g}*" if p == chosen else f"{s[str(p)]:.4g}")
                                if str(p) in s else "-" for p in orders])
         console.print(st)
+    hyst = report.get("hysteresis", {})
+    if hyst.get("axes") and any(len(a.get("scores_dps", a.get("scores_bic", {}))) > 1 for a in hyst["axes"].values()):
+        bic = hyst["selection"] == "bic"
+        ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if bic else
+                   "leave-one-run-out residual drift RMS [deg/s] (60 s moving average; lower is better)"))
+        ht.add_column("axis")
+        for name in CANDIDATES:
+            ht.add_column(name, justify="right")
+        ht.add_column("chosen")
+        for axis, info in hyst["axes"].items():
+            scores = info.get("scores_bic" if bic else "scores_dps", {})
+            chosen = info["chosen"].split(" (")[0]
+            cells = [("-" if scores.get(c) is None else f"{scores[c]:.4g}" + ("*" if c == chosen else ""))
+                     if c in scores else "-" for c in CANDIDATES]
+            ht.add_row(axis, *cells, info["chosen"])
+        console.print(ht)
 
 
 # -- apply ------------------------------------------------------------------------------------------

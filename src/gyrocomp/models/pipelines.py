@@ -85,12 +85,15 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     if mode != "none":
         orders = {axis: curve.order for axis, curve in model.curves_.items()}
         thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
-                                         band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc).fit(recordings)
+                                         band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
+                                         reselect_order=temperature == "auto").fit(recordings)
     axes = {}
     report = {"temperature": "polynomial", "order_selection": model.selection_, "axes": {}}
     if thermal is not None:
         report["hysteresis"] = {"mode": hysteresis, "selection": thermal.selection_, "axes": {
             axis: {"chosen": thermal.chosen_[axis], "lag_time_constant_s": thermal.lag_time_constants_s_[axis],
+                   "order": thermal.curves_[axis].order,
+                   "order_scores": {str(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()},
                    "scores_dps" if thermal.selection_ != "bic" else "scores_bic":
                        {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()}}
             for axis in thermal.chosen_}}
@@ -112,7 +115,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
             "t_min_degc": curve.t_min_degc,
             "t_max_degc": curve.t_max_degc,
         }
-    orders = sorted({c.order for c in model.curves_.values()})
+    orders = sorted({ax.temperature.order for ax in axes.values()})
     name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
     if temperature == "auto":
         name += " (auto)"

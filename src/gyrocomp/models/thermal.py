@@ -165,11 +165,13 @@ class _Problem:
     band: tuple[float, float] | None
     block_s: float
 
-    def features(self, run: _RunBlocks, spec: _Spec, tau: float, t_lo: float, t_hi: float):
-        """(T_s, columns of the shape and hysteresis) of one run at thermal time constant tau."""
-        temp = run.temperature_degc
+    def model_temperature(self, run: _RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
         if spec.lag and tau > 0:
-            temp, _ = thermal_lag(run.time_s, temp, tau, period_s=self.block_s)
+            return thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
+        return run.temperature_degc
+
+    def features(self, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
+        """Columns of the shape and the hysteresis at model temperature ``temp``."""
         u = (np.clip(temp, t_lo, t_hi) - self.t_ref) / self.t_scale
         cols = [u ** k for k in range(1, spec.order + 1)]
         if spec.hysteresis_order:
@@ -181,26 +183,22 @@ class _Problem:
             for sign in (-1, 1):
                 on = active & (turns.direction == sign)
                 cols += [np.where(on, d ** j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
-        return temp, (np.column_stack(cols) if cols else np.zeros((temp.size, 0)))
+        return np.column_stack(cols) if cols else np.zeros((temp.size, 0))
 
     def solve(self, spec: _Spec, tau: float, which: list[int]):
         """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range)."""
-        temps, feats, ys, ws, onehots = [], [], [], [], []
-        lagged = [self.features(self.runs[r], spec, tau, -np.inf, np.inf)[0] for r in which]
-        t_lo = min(float(t.min()) for t in lagged)
-        t_hi = max(float(t.max()) for t in lagged)
-        for k, r in enumerate(which):
-            run = self.runs[r]
-            temp, x = self.features(run, spec, tau, t_lo, t_hi)
+        temps = [self.model_temperature(self.runs[r], spec, tau) for r in which]
+        t_lo = min(float(t.min()) for t in temps)
+        t_hi = max(float(t.max()) for t in temps)
+        feats, onehots = [], []
+        for k, temp in enumerate(temps):
             oh = np.zeros((temp.size, len(which)))
             oh[:, k] = 1.0
-            feats.append(x)
+            feats.append(self.features(temp, spec, t_lo, t_hi))
             onehots.append(oh)
-            ys.append(run.value_dps)
-            ws.append(run.weight)
-            temps.append(temp)
         x = np.hstack([np.vstack(onehots), np.vstack(feats)])
-        y, w = np.concatenate(ys), np.concatenate(ws)
+        y = np.concatenate([self.runs[r].value_dps for r in which])
+        w = np.concatenate([self.runs[r].weight for r in which])
         sw = np.sqrt(w)
         coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
         rss = float(np.sum(w * (y - x @ coef) ** 2))
@@ -211,7 +209,7 @@ class _Problem:
         if not spec.lag:
             return 0.0, self.solve(spec, 0.0, which)
         lo, hi = LAG_MIN_BLOCKS * self.block_s, LAG_MAX_S
-        grid = np.geomspace(lo, hi, 25)
+        grid = np.geomspace(lo, hi, 16)
         rss = [self.solve(spec, tau, which)[2] for tau in grid]
         best = int(np.argmin(rss))
         a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
@@ -228,7 +226,7 @@ class _Problem:
             train = [r for r in range(n) if r != held]
             tau, (coef, _, _, (t_lo, t_hi)) = self.fit(spec, train)
             run = self.runs[held]
-            _, x = self.features(run, spec, tau, t_lo, t_hi)
+            x = self.features(self.model_temperature(run, spec, tau), spec, t_lo, t_hi)
             e = run.value_dps - x @ coef
             e -= np.sum(run.weight * e) / np.sum(run.weight)
             w = max(1, min(e.size, int(round(SCORE_WINDOW_S / self.block_s))))
@@ -266,6 +264,9 @@ class ThermalHysteresisModel:
         Length of the block means the fit works on [s].
     bin_width_degc : float, optional
         Temperature bin of the weights [degC]; default span / 100.
+    reselect_order : bool
+        Choose the polynomial order again (1..max_order) inside the winning candidate.
+    max_order : int
 
     Attributes (after ``fit``)
     --------------------------
@@ -288,6 +289,8 @@ class ThermalHysteresisModel:
     band_degc: tuple[float, float] | None = None
     block_s: float = DEFAULT_BLOCK_S
     bin_width_degc: float | None = None
+    reselect_order: bool = False
+    max_order: int = 5
     _fitted: bool = field(default=False, init=False, repr=False)
 
     def _candidates(self) -> list[str]:
@@ -314,7 +317,7 @@ class ThermalHysteresisModel:
         if not self.block_s > 0:
             raise InputError(f"block_s: must be positive, got {self.block_s}")
         self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
-        self.turn_on_biases_dps_, self.chosen_, self.scores_ = {}, {}, {}
+        self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
         axes = recordings[0].gyro_axes
         n_runs = len(recordings)
         self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
@@ -353,6 +356,15 @@ class ThermalHysteresisModel:
                     best = min(finite.values())
                     chosen = next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
             spec = best_spec[chosen]
+            if self.reselect_order and self.selection_ != "fixed" and chosen != "none":
+                # the binned polynomial's order was chosen with lag and hysteresis unmodelled, which a
+                # higher order partly imitates; choose it again inside the winning candidate
+                score = problem.held_out_error if n_runs >= 2 else problem.bic
+                tried = {o: score(_Spec(o, spec.lag, spec.hysteresis_order)) for o in range(1, self.max_order + 1)}
+                best = min(tried.values())
+                pick = min(o for o, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
+                spec = _Spec(pick, spec.lag, spec.hysteresis_order)
+                self.order_scores_[axis] = tried
             tau, (coef, consts, _, (t_lo, t_hi)) = problem.fit(spec, list(range(n_runs)))
             shape = coef[: spec.order]
             self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,
