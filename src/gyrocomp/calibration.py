@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import InputError
 from .io.atomic import write_text_atomic
+from .models.mlp import MLPBias
 from .models.temperature import PolynomialBias
 from .models.thermal import HysteresisCurve
 from .recording import Recording
@@ -47,7 +48,7 @@ class AxisCalibration:
 
     Attributes
     ----------
-    temperature : PolynomialBias or None
+    temperature : PolynomialBias, MLPBias or None
         The bias shape against temperature, or None for no temperature model.
     turn_on_biases_dps : tuple of float
         Fitted turn-on constant of each calibration run [deg/s].
@@ -60,7 +61,7 @@ class AxisCalibration:
         Turning-point hysteresis on top of the polynomial.
     """
 
-    temperature: PolynomialBias | None
+    temperature: PolynomialBias | MLPBias | None
     turn_on_biases_dps: tuple[float, ...]
     temperature_column: str = "temperature"
     lag_time_constant_s: float = 0.0
@@ -93,10 +94,11 @@ class AxisCalibration:
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "AxisCalibration":
         temp = d.get("temperature")
-        if temp is not None and temp.get("type") != "polynomial":
+        kinds = {"polynomial": PolynomialBias, "mlp": MLPBias}
+        if temp is not None and temp.get("type") not in kinds:
             raise InputError(f"unknown temperature model type {temp.get('type')!r}")
         return cls(
-            temperature=None if temp is None else PolynomialBias.from_dict(temp),
+            temperature=None if temp is None else kinds[temp["type"]].from_dict(temp),
             turn_on_biases_dps=tuple(float(c) for c in d["turn_on_biases_dps"]),
             temperature_column=str(d.get("temperature_column", "temperature")),
             lag_time_constant_s=float(d["lag_time_constant_s"]),

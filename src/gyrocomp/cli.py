@@ -179,7 +179,10 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write (JSON).")
 @click.option("--temperature", default="poly", show_default=True,
-              help="poly (order by cross-validation), poly:N (N = 0..5) or none.")
+              help="poly (order by cross-validation), poly:N (N = 0..5), mlp (the thesis's 1-3-1 network, "
+                   "Levenberg-Marquardt), mlp:H (H hidden neurons) or none.")
+@click.option("--seed", "mlp_seed", type=int, default=0, show_default=True,
+              help="Seed of the network's initializations (mlp); the same seed gives the same model.")
 @click.option("--bin-width", "bin_width_degc", type=float, default=None, help="Temperature bin width [degC] (default: span/100).")
 @click.option("--hysteresis", type=click.Choice(HYSTERESIS_CHOICES), default="auto", show_default=True,
               help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
@@ -190,7 +193,8 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
               help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.")
 @read_options
 @click.pass_context
-def fit(ctx, runs, output, temperature, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band, **kwargs):
+def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
+        **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -204,7 +208,7 @@ def fit(ctx, runs, output, temperature, bin_width_degc, hysteresis, hysteresis_o
     refuse_to_overwrite_inputs(output, runs)
     recordings = [_read(path, opts).recording for path in runs]
     calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
-                                  hysteresis_order=hysteresis_order, hysteresis_band_degc=band)
+                                  hysteresis_order=hysteresis_order, hysteresis_band_degc=band, mlp_seed=mlp_seed)
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)
@@ -218,7 +222,8 @@ def _print_fit(calibration: Calibration, output) -> None:
         table.add_column(col)
     for axis, ax in calibration.axes.items():
         info = report.get("axes", {}).get(axis, {})
-        model = "constant" if ax.temperature is None else f"poly order {ax.temperature.order}"
+        order = None if ax.temperature is None else ax.temperature.order
+        model = "constant" if order is None else (f"poly order {order}" if isinstance(order, int) else order)
         if ax.lag_time_constant_s > 0:
             model += f", lag {ax.lag_time_constant_s:.3g} s"
         if ax.hysteresis is not None:
@@ -229,7 +234,15 @@ def _print_fit(calibration: Calibration, output) -> None:
         rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
         table.add_row(axis, model, rng, rms, ", ".join(f"{c:+.4g}" for c in ax.turn_on_biases_dps))
     console.print(table)
+    net = report.get("network")
+    if net:
+        console.print(f"network: 1-{'-'.join(map(str, net['hidden']))}-1 tanh/linear, {net['restarts']} restarts "
+                      f"(seed {net['seed']}), {net['training']}; validation RMS of the restarts [deg/s]: " + "; ".join(
+                          f"{a} " + ", ".join(f"{v:.4g}" for v in info["validation_rmse_dps"])
+                          for a, info in net["axes"].items()))
     scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
+    if net:
+        scores = {}
     if scores:
         how = report.get("order_selection")
         unit = "CV RMS [deg/s]" if how == "leave-one-run-out" else "BIC"
@@ -285,18 +298,43 @@ def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
 
 # -- evaluate ---------------------------------------------------------------------------------------
 @cli.command()
-@click.argument("model", type=click.Path())
-@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.argument("paths", nargs=-1, required=True, type=click.Path(), metavar="MODEL RUNS... | --compare RUNS...")
 @click.option("--window", "window_s", type=float, default=None,
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
 @click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
               help="Estimate each run's turn-on bias from its first S seconds [s].")
+@click.option("--compare", is_flag=True,
+              help="The thesis's comparison on RUNS: raw, polynomial, network, each with and without hysteresis "
+                   "(leave one run out with two runs or more).")
+@click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
+              help="With --compare: limit the hysteresis to this band [degC].")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
 @read_options
 @click.pass_context
-def evaluate(ctx, model, runs, window_s, turn_on_window_s, as_json, **kwargs):
-    """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL."""
+def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, as_json, **kwargs):
+    """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.
+
+    With --compare, no model is given: the methods of the reference thesis are fitted on the runs and compared.
+    """
     opts = _pop_read_options(kwargs)
+    if window_s is not None and not window_s > 0:
+        raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
+    if compare:
+        from .comparison import compare_methods
+
+        band = _float_list(hysteresis_band, "--hysteresis-band")
+        if band is not None and (len(band) != 2 or not band[0] < band[1]):
+            raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
+        recordings = [_read(path, opts).recording for path in paths]
+        result = compare_methods(recordings, window_s=window_s, hysteresis_band_degc=band)
+        if as_json:
+            click.echo(json.dumps(result.to_dict(), indent=2))
+        elif not ctx.obj["quiet"]:
+            print_comparison(result)
+        return
+    if len(paths) < 2:
+        raise click.UsageError("give MODEL and at least one run, or --compare RUNS...")
+    model, runs = paths[0], paths[1:]
     calibration = Calibration.load(model)
     results = []
     for path in runs:
@@ -308,6 +346,20 @@ def evaluate(ctx, model, runs, window_s, turn_on_window_s, as_json, **kwargs):
         click.echo(json.dumps(evaluation.to_dict(), indent=2))
     else:
         print_evaluation(evaluation)
+
+
+def print_comparison(result) -> None:
+    console = _console()
+    table = Table(title=f"methods compared ({result.how})")
+    for col in ("axis", "method"):
+        table.add_column(col, no_wrap=True)
+    for col in ("bias offset\n[deg/s]", "improvement\n(raw/method)", "bias instability\n[deg/h]",
+                "integration time\n[s]"):
+        table.add_column(col, justify="right")
+    for row in result.rows:
+        table.add_row(row.axis, row.method, f"{row.bias_offset_dps:.4g}", f"{row.improvement:.3g}x",
+                      f"{row.bias_instability_deg_per_h:.4g}", f"{row.integration_time_s:.4g}")
+    console.print(table)
 
 
 def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:

@@ -10,8 +10,10 @@ from pathlib import Path
 from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
 from ..recording import Recording
-from .temperature import PolynomialTemperatureModel
-from .thermal import HYSTERESIS_CHOICES, ThermalHysteresisModel, heats_and_cools
+from ..effects import find_turns, thermal_lag
+from .mlp import DEFAULT_HIDDEN, MLPTemperatureModel
+from .temperature import PolynomialBias, PolynomialTemperatureModel
+from .thermal import DEFAULT_BLOCK_S, HYSTERESIS_CHOICES, ThermalHysteresisModel, block_means, heats_and_cools
 
 
 def _provenance(recordings: list[Recording]) -> dict:
@@ -33,19 +35,44 @@ def _provenance(recordings: list[Recording]) -> dict:
     }
 
 
+def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
+                 hysteresis, poly: PolynomialBias, bin_width_degc: float | None):
+    """Train the network on the block means of the runs, through the lag and without the hysteresis
+    that the polynomial stage found (a cascade: the network replaces the polynomial shape)."""
+    temps = [rec.temperature_for(axis) for rec in recordings]
+    lo, hi = min(float(t.min()) for t in temps), max(float(t.max()) for t in temps)
+    width = bin_width_degc or max((hi - lo) / 100.0, 1e-3)
+    block_s = max(DEFAULT_BLOCK_S, 1.0 / recordings[0].rate_hz)
+    t_in, y_in, w_in = [], [], []
+    for rec in recordings:
+        blocks = block_means(rec, axis, block_s, width)
+        temp = blocks.temperature_degc
+        if lag_s > 0:
+            temp, _ = thermal_lag(blocks.time_s, temp, lag_s, period_s=block_s)
+        value = blocks.value_dps
+        if hysteresis is not None:
+            value = value - hysteresis.offset_dps(temp, find_turns(temp, hysteresis.threshold_degc))
+        t_in.append(temp)
+        y_in.append(value)
+        w_in.append(blocks.weight)
+    network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc)
+    return network.curves_[axis], network.turn_on_biases_dps_[axis]
+
+
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
-                    hysteresis_band_degc: tuple[float, float] | None = None) -> Calibration:
+                    hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0) -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
     ----------
     recordings : list of Recording
         Calibration runs; each gets its own turn-on constant, the temperature shape is shared.
-    temperature : "auto", int or None
-        Polynomial order of the temperature model: ``"auto"`` (cross-validated), 0..5, or None
-        for no temperature model (each run's constant only).
+    temperature : "auto", int, "mlp", ("mlp", hidden) or None
+        Polynomial order of the temperature model: ``"auto"`` (cross-validated), 0..5; ``"mlp"`` for
+        the thesis's 1-3-1 network, ``("mlp", (H,))`` for H hidden neurons; or None for no
+        temperature model (each run's constant only).
     bin_width_degc : float, optional
         Temperature bin width for the fit [degC].
     hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
@@ -56,6 +83,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         Order of the turning-point polynomial (1..3) or chosen by validation.
     hysteresis_band_degc : (lo, hi), optional
         Limit the hysteresis to this band [degC].
+    mlp_seed : int
+        Seed of the network's initializations (the same seed gives the same model).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
@@ -77,6 +106,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
             )
     if hysteresis not in HYSTERESIS_CHOICES:
         raise InputError(f"--hysteresis: {hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
+    hidden = None
+    if temperature == "mlp" or (isinstance(temperature, tuple) and temperature[0] == "mlp"):
+        hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
+        temperature = "auto"  # the polynomial still finds lag and hysteresis for the network
     model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc).fit(recordings)
     mode = hysteresis
     if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
@@ -100,25 +133,36 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     else:
         report["hysteresis"] = {"mode": hysteresis, "selection": "none: the runs do not both heat and cool"
                                 if hysteresis == "auto" else "none"}
+    network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
     for axis, curve in model.curves_.items():
         consts = model.turn_on_biases_dps_[axis]
         lag, hyst = 0.0, None
         if thermal is not None:
             curve, consts = thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]
             lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
+        if network is not None:
+            curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc)
         axes[axis] = AxisCalibration(curve, tuple(float(c) for c in consts),
                                      recordings[0].temperature_column_for(axis), lag, hyst)
         report["axes"][axis] = {
             "order": curve.order,
             "scores": {str(p): float(s) for p, s in model.scores_[axis].items()},
-            "fit_rms_dps": model.fit_rms_dps_[axis],
+            "fit_rms_dps": model.fit_rms_dps_[axis] if network is None else network.train_rmse_dps_[axis],
             "t_min_degc": curve.t_min_degc,
             "t_max_degc": curve.t_max_degc,
         }
-    orders = sorted({ax.temperature.order for ax in axes.values()})
-    name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
-    if temperature == "auto":
-        name += " (auto)"
+    if network is not None:
+        report["temperature"] = "mlp"
+        report["network"] = {"hidden": list(hidden), "restarts": network.restarts, "seed": network.seed,
+                             "training": "Levenberg-Marquardt, early stopping on 20 % held-out segments",
+                             "axes": {a: {"validation_rmse_dps": network.validation_rmse_dps_[a],
+                                          "epochs": network.epochs_[a]} for a in network.curves_}}
+        name = "mlp:1-" + "-".join(map(str, hidden)) + "-1"
+    else:
+        orders = sorted({ax.temperature.order for ax in axes.values()})
+        name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
+        if temperature == "auto":
+            name += " (auto)"
     if thermal is not None:
         extras = sorted({c.split(" (")[0] for c in thermal.chosen_.values()} - {"none"})
         if extras:

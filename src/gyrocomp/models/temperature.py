@@ -83,9 +83,13 @@ class PolynomialBias:
                    float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]))
 
 
-def parse_temperature_option(text: str) -> int | str | None:
-    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"none"`` -> None; anything else is an InputError."""
+def parse_temperature_option(text: str) -> int | str | tuple | None:
+    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"mlp"``/``"mlp:5"`` -> ("mlp", hidden), ``"none"`` -> None."""
     text = text.strip().lower()
+    if text == "mlp" or text.startswith("mlp:"):
+        from .mlp import parse_hidden
+
+        return ("mlp", parse_hidden(text))
     if text in ("poly", "auto"):
         return "auto"
     if text == "none":
@@ -98,7 +102,8 @@ def parse_temperature_option(text: str) -> int | str | None:
         if 0 <= order <= MAX_ORDER:
             return order
         raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
-    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}) or none")
+    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}), "
+                     "mlp (the thesis's 1-3-1 network), mlp:H or none")
 
 
 @dataclass(frozen=True)

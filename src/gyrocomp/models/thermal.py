@@ -117,14 +117,14 @@ class HysteresisCurve:
 
 
 @dataclass(frozen=True)
-class _RunBlocks:
+class RunBlocks:
     time_s: np.ndarray
     temperature_degc: np.ndarray
     value_dps: np.ndarray
     weight: np.ndarray
 
 
-def _block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float) -> _RunBlocks:
+def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float) -> RunBlocks:
     """Means over consecutive blocks of ``block_s`` (never across a time gap), with bin-balancing weights."""
     t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
     per_block = max(1, int(round(block_s * rec.rate_hz)))
@@ -138,7 +138,7 @@ def _block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: floa
     idx = np.floor(btemp / bin_width_degc).astype(np.int64)
     _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
     weight = (counts / counts.max()) / per_bin[inverse]
-    return _RunBlocks(bt, btemp, by, weight)
+    return RunBlocks(bt, btemp, by, weight)
 
 
 @dataclass(frozen=True)
@@ -158,14 +158,14 @@ class _Spec:
 
 @dataclass
 class _Problem:
-    runs: list[_RunBlocks]
+    runs: list[RunBlocks]
     t_ref: float
     t_scale: float
     threshold: float
     band: tuple[float, float] | None
     block_s: float
 
-    def model_temperature(self, run: _RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
+    def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
         if spec.lag and tau > 0:
             return thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
         return run.temperature_degc
@@ -328,7 +328,7 @@ class ThermalHysteresisModel:
             hi = max(float(t.max()) for t in temps)
             width = self.bin_width_degc or max((hi - lo) / 100.0, 1e-3)
             block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
-            runs = [_block_means(rec, axis, block_s, width) for rec in recordings]
+            runs = [block_means(rec, axis, block_s, width) for rec in recordings]
             threshold = max(turn_threshold_degc(t) for t in temps)
             problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, self.band_degc,
                                block_s)
