@@ -7,6 +7,7 @@ Nothing is ever unpickled: loading a model file cannot run code.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from collections.abc import Callable
@@ -24,7 +25,7 @@ from .models.thermal import HysteresisCurve
 from .recording import Recording
 
 FORMAT_NAME = "gyrocomp-calibration"
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 
 def _upgrade_1_to_2(d: dict) -> dict:
@@ -37,9 +38,27 @@ def _upgrade_1_to_2(d: dict) -> dict:
     return d
 
 
+def _upgrade_2_to_3(d: dict) -> dict:
+    """Schema 3 adds the g-sensitivity per axis; a schema-2 file has none."""
+    d = dict(d)
+    if isinstance(d.get("axes"), dict):
+        d["axes"] = {name: {**ax, "g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None}
+                     if isinstance(ax, dict) else ax for name, ax in d["axes"].items()}
+    d["schema_version"] = 3
+    return d
+
+
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
-UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2}
+UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3}
 UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
+
+
+def _floats(values, count: int, name: str):
+    if values is None:
+        return None
+    if len(values) != count:
+        raise InputError(f"{name}: {len(values)} values, expected {count}")
+    return tuple(float(v) for v in values)
 
 
 @dataclass(frozen=True)
@@ -59,6 +78,10 @@ class AxisCalibration:
         first-order lag of this time constant; 0 for none.
     hysteresis : HysteresisCurve or None
         Turning-point hysteresis on top of the polynomial.
+    g_sensitivity_dps_per_g : 3 floats or None
+        This axis's row of the g-sensitivity matrix G, on accel_x, accel_y, accel_z [deg/s/g].
+    g_squared_dps_per_g2 : 6 floats or None
+        g x g sensitivity to the products xx, yy, zz, xy, xz, yz [deg/s/g^2].
     """
 
     temperature: PolynomialBias | MLPBias | None
@@ -66,6 +89,12 @@ class AxisCalibration:
     temperature_column: str = "temperature"
     lag_time_constant_s: float = 0.0
     hysteresis: HysteresisCurve | None = None
+    g_sensitivity_dps_per_g: tuple[float, float, float] | None = None
+    g_squared_dps_per_g2: tuple[float, ...] | None = None
+
+    @property
+    def needs_accel(self) -> bool:
+        return self.g_sensitivity_dps_per_g is not None or self.g_squared_dps_per_g2 is not None
 
     @property
     def has_memory(self) -> bool:
@@ -89,6 +118,8 @@ class AxisCalibration:
             "temperature_column": self.temperature_column,
             "lag_time_constant_s": self.lag_time_constant_s,
             "hysteresis": None if self.hysteresis is None else self.hysteresis.to_dict(),
+            "g_sensitivity_dps_per_g": None if self.g_sensitivity_dps_per_g is None else list(self.g_sensitivity_dps_per_g),
+            "g_squared_dps_per_g2": None if self.g_squared_dps_per_g2 is None else list(self.g_squared_dps_per_g2),
         }
 
     @classmethod
@@ -103,6 +134,8 @@ class AxisCalibration:
             temperature_column=str(d.get("temperature_column", "temperature")),
             lag_time_constant_s=float(d["lag_time_constant_s"]),
             hysteresis=None if d["hysteresis"] is None else HysteresisCurve.from_dict(d["hysteresis"]),
+            g_sensitivity_dps_per_g=_floats(d["g_sensitivity_dps_per_g"], 3, "g_sensitivity_dps_per_g"),
+            g_squared_dps_per_g2=_floats(d["g_squared_dps_per_g2"], 6, "g_squared_dps_per_g2"),
         )
 
 
@@ -119,6 +152,32 @@ class Calibration:
     provenance: dict[str, Any] = field(default_factory=dict)
     fit_report: dict[str, Any] = field(default_factory=dict)
     schema_version: int = SCHEMA_VERSION
+
+    def without(self, *parts: str) -> "Calibration":
+        """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
+        (turning-point), ``"lag"``. What is left is applied as fitted (the parts were fitted jointly), so
+        this shows each part's contribution, as the stages of the thesis's Table 4.4."""
+        known = ("acceleration", "hysteresis", "lag")
+        for part in parts:
+            if part not in known:
+                raise InputError(f"unknown part {part!r}; use any of {', '.join(known)}")
+        changes = {}
+        if "acceleration" in parts:
+            changes.update(g_sensitivity_dps_per_g=None, g_squared_dps_per_g2=None)
+        if "hysteresis" in parts:
+            changes["hysteresis"] = None
+        if "lag" in parts:
+            changes["lag_time_constant_s"] = 0.0
+        axes = {name: dataclasses.replace(ax, **changes) for name, ax in self.axes.items()}
+        return dataclasses.replace(self, axes=axes, model=f"{self.model} without {', '.join(parts)}" if parts else self.model)
+
+    @property
+    def has_acceleration(self) -> bool:
+        return any(ax.needs_accel for ax in self.axes.values())
+
+    @property
+    def has_hysteresis(self) -> bool:
+        return any(ax.hysteresis is not None for ax in self.axes.values())
 
     @property
     def needs_temperature(self) -> bool:

@@ -38,7 +38,7 @@ from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .metrics import Evaluation, evaluate_run
 from .models.pipelines import fit_calibration
 from .models.temperature import parse_temperature_option
-from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
+from .models.thermal import ACCELERATION_CHOICES, CANDIDATES, HYSTERESIS_CHOICES
 from .noise import NoiseAnalysis, analyse_noise
 from .report.figures import allan_figure, check_figure_path
 
@@ -191,10 +191,13 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
               help="Order of the turning-point polynomial in |T - T_turn|: auto (validated) or 1..3.")
 @click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
               help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.")
+@click.option("--acceleration", type=click.Choice(["auto", *ACCELERATION_CHOICES]), default="auto", show_default=True,
+              help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
+                   "none; auto: matrix when the runs turn the unit between positions.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        **kwargs):
+        acceleration, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -208,7 +211,8 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     refuse_to_overwrite_inputs(output, runs)
     recordings = [_read(path, opts).recording for path in runs]
     calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
-                                  hysteresis_order=hysteresis_order, hysteresis_band_degc=band, mlp_seed=mlp_seed)
+                                  hysteresis_order=hysteresis_order, hysteresis_band_degc=band, mlp_seed=mlp_seed,
+                                  acceleration=acceleration)
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)
@@ -272,6 +276,18 @@ def _print_fit(calibration: Calibration, output) -> None:
                      if c in scores else "-" for c in CANDIDATES]
             ht.add_row(axis, *cells, info["chosen"])
         console.print(ht)
+    acc = report.get("acceleration", {})
+    if acc.get("axes"):
+        gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc['static_segments'])} "
+                         f"static segments; excited: {', '.join(acc['excited_axes']) or 'none'})")
+        gt.add_column("gyro axis")
+        for name in ("accel_x", "accel_y", "accel_z"):
+            gt.add_column(name, justify="right")
+        for axis, info in acc["axes"].items():
+            cells = [f"{g:+.4g} +- {e:.2g}" if e is not None else "not fitted"
+                     for g, e in zip(info["g_sensitivity_dps_per_g"], info["standard_error_dps_per_g"])]
+            gt.add_row(axis, *cells)
+        console.print(gt)
 
 
 # -- apply ------------------------------------------------------------------------------------------
@@ -308,10 +324,13 @@ def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
                    "(leave one run out with two runs or more).")
 @click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
               help="With --compare: limit the hysteresis to this band [degC].")
+@click.option("--stages", is_flag=True,
+              help="Report each stage of MODEL (the thesis's Table 4.4): raw, temperature only, + acceleration, "
+                   "+ hysteresis.")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
 @read_options
 @click.pass_context
-def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, as_json, **kwargs):
+def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, as_json, **kwargs):
     """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.
 
     With --compare, no model is given: the methods of the reference thesis are fitted on the runs and compared.
@@ -336,6 +355,16 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, a
         raise click.UsageError("give MODEL and at least one run, or --compare RUNS...")
     model, runs = paths[0], paths[1:]
     calibration = Calibration.load(model)
+    if stages:
+        from .metrics import evaluate_stages
+
+        staged = [evaluate_stages(calibration, _read(path, opts).recording, window_s=window_s,
+                                  turn_on_window_s=turn_on_window_s) for path in runs]
+        if as_json:
+            click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
+        elif not ctx.obj["quiet"]:
+            print_stages(staged)
+        return
     results = []
     for path in runs:
         rec = _read(path, opts).recording
@@ -346,6 +375,27 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, a
         click.echo(json.dumps(evaluation.to_dict(), indent=2))
     else:
         print_evaluation(evaluation)
+
+
+def print_stages(staged) -> None:
+    console = _console()
+    for run in staged:
+        table = Table(title=f"{Path(run.file).name}: stages of the compensation (window {run.window_s:.4g} s)")
+        for col in ("axis", "stage"):
+            table.add_column(col, no_wrap=True)
+        for col in ("bias offset\n[deg/s]", "improvement\n(raw/stage)", "bias instability\n[deg/h]",
+                    "integration time\n[s]"):
+            table.add_column(col, justify="right")
+        first = next(iter(run.stages.values()))
+        for axis in first:
+            m0 = first[axis]
+            table.add_row(axis, "raw", f"{m0.bias_offset_raw_dps:.4g}", "1x", f"{m0.bias_instability_raw_dph:.4g}",
+                          f"{m0.integration_time_raw_s:.4g}")
+            for name, axes in run.stages.items():
+                m = axes[axis]
+                table.add_row("", name, f"{m.bias_offset_comp_dps:.4g}", f"{m.offset_improvement:.3g}x",
+                              f"{m.bias_instability_comp_dph:.4g}", f"{m.integration_time_comp_s:.4g}")
+        console.print(table)
 
 
 def print_comparison(result) -> None:

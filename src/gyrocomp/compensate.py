@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 
 from .calibration import Calibration
-from .effects import find_turns, thermal_lag
+from .effects import find_turns, g_sensitivity_offset, thermal_lag
 from .errors import InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .recording import Recording
@@ -73,9 +73,17 @@ class Compensator:
                                                   period_s=1.0 / self.rate_hz, state=self._lag_states[k])
         return lagged
 
-    def _residual(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
+    def _residual(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None,
+                  accel_g: np.ndarray | None = None) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
         for k, (j, ax) in enumerate(self._modelled):
+            if ax.needs_accel and time_s.size:
+                if accel_g is None:
+                    raise InputError(f"{self.source}: the model has g-sensitivity; the data needs accel_x, accel_y "
+                                     "and accel_z columns [g] (map them with --columns)")
+                g = np.zeros(3) if ax.g_sensitivity_dps_per_g is None else np.asarray(ax.g_sensitivity_dps_per_g)
+                q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
+                out[:, j] -= g_sensitivity_offset(accel_g, g[None, :], q)[:, 0]
             if ax.temperature is None:
                 continue
             if temperature_degc is None:
@@ -105,8 +113,10 @@ class Compensator:
             residual[:, j] -= self._constants[k]
         return residual
 
-    def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None = None) -> np.ndarray:
-        """Compensate one chunk: time [s] (m,), gyro [deg/s] (m, k), temperature [degC] (m,) or (m, k).
+    def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None = None,
+               accel_g: np.ndarray | None = None) -> np.ndarray:
+        """Compensate one chunk: time [s] (m,), gyro [deg/s] (m, k), temperature [degC] (m,) or (m, k),
+        specific force [g] (m, 3) on accel_x, accel_y, accel_z (needed by a model with g-sensitivity).
 
         Returns the compensated gyro rows [deg/s] that are ready: all of them, except while the
         turn-on window is still filling (those come out of a later call or :meth:`finish`).
@@ -115,7 +125,9 @@ class Compensator:
         gyro_dps = np.asarray(gyro_dps, dtype=float).reshape(time_s.size, len(self.gyro_axes))
         if temperature_degc is not None:
             temperature_degc = np.asarray(temperature_degc, dtype=float)
-        residual = self._residual(time_s, gyro_dps, temperature_degc)
+        if accel_g is not None:
+            accel_g = np.asarray(accel_g, dtype=float).reshape(time_s.size, 3)
+        residual = self._residual(time_s, gyro_dps, temperature_degc, accel_g)
         if self._constants is not None:
             return self._subtract_constants(residual)
         if self._t0 is None and time_s.size:
@@ -152,6 +164,9 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     """Compensate a whole recording; the result has the same rows, axes and other channels."""
     comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
                        rate_hz=recording.rate_hz, source=recording.source)
-    out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc)
+    accel = None
+    if recording.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(recording.accel_axes):
+        accel = recording.accel_g[:, [recording.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]]
+    out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel)
     rest = comp.finish()
     return recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)

@@ -10,10 +10,19 @@ from pathlib import Path
 from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
 from ..recording import Recording
-from ..effects import find_turns, thermal_lag
+import numpy as np
+
+from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from .mlp import DEFAULT_HIDDEN, MLPTemperatureModel
 from .temperature import PolynomialBias, PolynomialTemperatureModel
-from .thermal import DEFAULT_BLOCK_S, HYSTERESIS_CHOICES, ThermalHysteresisModel, block_means, heats_and_cools
+from .thermal import (
+    ACCELERATION_CHOICES,
+    DEFAULT_BLOCK_S,
+    HYSTERESIS_CHOICES,
+    ThermalHysteresisModel,
+    block_means,
+    heats_and_cools,
+)
 
 
 def _provenance(recordings: list[Recording]) -> dict:
@@ -36,7 +45,8 @@ def _provenance(recordings: list[Recording]) -> dict:
 
 
 def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
-                 hysteresis, poly: PolynomialBias, bin_width_degc: float | None):
+                 hysteresis, poly: PolynomialBias, bin_width_degc: float | None, g_row=None, g_squared=None,
+                 segments=None):
     """Train the network on the block means of the runs, through the lag and without the hysteresis
     that the polynomial stage found (a cascade: the network replaces the polynomial shape)."""
     temps = [rec.temperature_for(axis) for rec in recordings]
@@ -44,14 +54,18 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     width = bin_width_degc or max((hi - lo) / 100.0, 1e-3)
     block_s = max(DEFAULT_BLOCK_S, 1.0 / recordings[0].rate_hz)
     t_in, y_in, w_in = [], [], []
-    for rec in recordings:
-        blocks = block_means(rec, axis, block_s, width)
+    for r, rec in enumerate(recordings):
+        pieces = [slice(g.start, g.stop) for g in segments[r]] if segments and segments[r] else None
+        blocks = block_means(rec, axis, block_s, width, pieces)
         temp = blocks.temperature_degc
         if lag_s > 0:
             temp, _ = thermal_lag(blocks.time_s, temp, lag_s, period_s=block_s)
         value = blocks.value_dps
         if hysteresis is not None:
             value = value - hysteresis.offset_dps(temp, find_turns(temp, hysteresis.threshold_degc))
+        if g_row is not None:
+            q = None if g_squared is None else np.asarray(g_squared)[None, :]
+            value = value - g_sensitivity_offset(blocks.accel_g, np.asarray(g_row)[None, :], q)[:, 0]
         t_in.append(temp)
         y_in.append(value)
         w_in.append(blocks.weight)
@@ -59,10 +73,27 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     return network.curves_[axis], network.turn_on_biases_dps_[axis]
 
 
+def _listed(values: np.ndarray) -> list:
+    return [None if not np.isfinite(v) else float(v) for v in values]
+
+
+def _turned_between_positions(recordings: list[Recording]) -> bool:
+    """Whether some run has an accelerometer triad and more than one orientation among its static segments."""
+    from ..static import orientations, static_segments
+
+    for rec in recordings:
+        if rec.accel_g is None or not set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
+            continue
+        if len(orientations(static_segments(rec))) > 1:
+            return True
+    return False
+
+
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
-                    hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0) -> Calibration:
+                    hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
+                    acceleration: str = "auto") -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -85,6 +116,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         Limit the hysteresis to this band [degC].
     mlp_seed : int
         Seed of the network's initializations (the same seed gives the same model).
+    acceleration : {"auto", "none", "matrix", "matrix2"}
+        g-sensitivity fitted jointly with the temperature model and the run constants, on the static
+        segments: the 3x3 matrix (``matrix``), plus g x g terms (``matrix2``). ``"auto"``: ``matrix``
+        when the runs have accelerometer axes and the unit is turned between positions within a run.
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
@@ -111,15 +146,20 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
         temperature = "auto"  # the polynomial still finds lag and hysteresis for the network
     model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc).fit(recordings)
+    if acceleration not in ("auto", *ACCELERATION_CHOICES):
+        raise InputError(f"--acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
+    accel_mode = acceleration
+    if accel_mode == "auto":
+        accel_mode = "matrix" if _turned_between_positions(recordings) else "none"
     mode = hysteresis
     if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
         mode = "none"
     thermal = None
-    if mode != "none":
+    if mode != "none" or accel_mode != "none":
         orders = {axis: curve.order for axis, curve in model.curves_.items()}
         thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
                                          band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
-                                         reselect_order=temperature == "auto").fit(recordings)
+                                         reselect_order=temperature == "auto", acceleration=accel_mode).fit(recordings)
     axes = {}
     report = {"temperature": "polynomial", "order_selection": model.selection_, "axes": {}}
     if thermal is not None:
@@ -133,17 +173,35 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     else:
         report["hysteresis"] = {"mode": hysteresis, "selection": "none: the runs do not both heat and cool"
                                 if hysteresis == "auto" else "none"}
+    if accel_mode != "none":
+        report["acceleration"] = {
+            "mode": accel_mode, "excited_axes": list(thermal.excited_axes_),
+            "static_segments": [len(segs) for segs in thermal.segments_],
+            "axes": {a: {"g_sensitivity_dps_per_g": _listed(thermal.g_sensitivity_dps_per_g_[a]),
+                         "standard_error_dps_per_g": _listed(thermal.g_sensitivity_se_dps_per_g_[a]),
+                         **({"g_squared_dps_per_g2": _listed(thermal.g_squared_dps_per_g2_[a]),
+                             "g_squared_standard_error_dps_per_g2": _listed(thermal.g_squared_se_dps_per_g2_[a])}
+                            if accel_mode == "matrix2" else {})}
+                     for a in thermal.g_sensitivity_dps_per_g_}}
+    else:
+        report["acceleration"] = {"mode": "none", "why": "the runs do not turn the unit between positions"
+                                  if acceleration == "auto" else "not asked for"}
     network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
     for axis, curve in model.curves_.items():
         consts = model.turn_on_biases_dps_[axis]
-        lag, hyst = 0.0, None
+        lag, hyst, g_row, g_sq = 0.0, None, None, None
         if thermal is not None:
             curve, consts = thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]
             lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
+            if accel_mode != "none" and thermal.excited_axes_:
+                g_row = tuple(float(v) for v in thermal.g_sensitivity_dps_per_g_[axis])
+                if accel_mode == "matrix2":
+                    g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
         if network is not None:
-            curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc)
+            curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc, g_row, g_sq,
+                                         thermal.segments_ if thermal is not None else None)
         axes[axis] = AxisCalibration(curve, tuple(float(c) for c in consts),
-                                     recordings[0].temperature_column_for(axis), lag, hyst)
+                                     recordings[0].temperature_column_for(axis), lag, hyst, g_row, g_sq)
         report["axes"][axis] = {
             "order": curve.order,
             "scores": {str(p): float(s) for p, s in model.scores_[axis].items()},
@@ -167,6 +225,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         extras = sorted({c.split(" (")[0] for c in thermal.chosen_.values()} - {"none"})
         if extras:
             name += " + " + "/".join(extras)
+        if accel_mode != "none" and thermal.excited_axes_:
+            name += " + g-sensitivity" + (" (g x g)" if accel_mode == "matrix2" else "")
     return Calibration(axes=axes, model=name, provenance=_provenance(recordings), fit_report=report)
 
 

@@ -23,14 +23,15 @@ one run; the hysteresis order (1-3) is chosen the same way.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..effects import find_turns, hysteresis_offset, thermal_lag
-from ..errors import InputError, ModelError, NotFittedError
+from ..effects import G_SQUARED_TERMS, find_turns, g_squared_products, hysteresis_offset, thermal_lag
+from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..recording import Recording
 from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
 
@@ -41,6 +42,9 @@ MAX_HYSTERESIS_ORDER = 3
 LAG_MIN_BLOCKS = 2.0
 LAG_MAX_S = 4 * 3600.0
 DEFAULT_BLOCK_S = 2.0
+ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
+#: an accelerometer axis is excited when its within-run spread over the positions exceeds this [g]
+EXCITATION_G = 0.1
 #: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
 #: score measures drift (what compensation is for) rather than white noise, which no model removes
 SCORE_WINDOW_S = 60.0
@@ -122,23 +126,40 @@ class RunBlocks:
     temperature_degc: np.ndarray
     value_dps: np.ndarray
     weight: np.ndarray
+    accel_g: np.ndarray | None = None
+    cluster: np.ndarray | None = None
 
 
-def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float) -> RunBlocks:
-    """Means over consecutive blocks of ``block_s`` (never across a time gap), with bin-balancing weights."""
+def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float,
+                pieces: list[slice] | None = None) -> RunBlocks:
+    """Means over consecutive blocks of ``block_s`` inside each of ``pieces`` (default: the stretches
+    between time gaps; for multi-position runs, the static segments), with bin-balancing weights.
+    ``cluster`` numbers the piece each block comes from."""
     t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
     per_block = max(1, int(round(block_s * rec.rate_hz)))
-    starts = []
-    for piece in rec.contiguous_stretches():
-        starts.extend(range(piece.start, piece.stop, per_block))
-    starts = np.asarray(starts)
-    counts = np.diff(np.append(starts, t.size))
-    mean = lambda x: np.add.reduceat(x, starts) / counts  # noqa: E731
-    bt, btemp, by = mean(t), mean(temp), mean(y)
+    pieces = rec.contiguous_stretches() if pieces is None else pieces
+    starts, ends, cluster = [], [], []
+    for k, piece in enumerate(pieces):
+        s = np.arange(piece.start, piece.stop, per_block)
+        starts.append(s)
+        ends.append(np.minimum(s + per_block, piece.stop))
+        cluster.append(np.full(s.size, k))
+    starts, ends, cluster = np.concatenate(starts), np.concatenate(ends), np.concatenate(cluster)
+    counts = ends - starts
+
+    def mean(x):
+        c = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)])
+        return (c[ends] - c[starts]) / (counts if x.ndim == 1 else counts[:, None])
+
+    bt, btemp, by = mean(t - t[0]) + t[0], mean(temp), mean(y)
+    accel = None
+    if rec.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
+        order = [rec.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]
+        accel = mean(rec.accel_g[:, order])
     idx = np.floor(btemp / bin_width_degc).astype(np.int64)
     _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
     weight = (counts / counts.max()) / per_bin[inverse]
-    return RunBlocks(bt, btemp, by, weight)
+    return RunBlocks(bt, btemp, by, weight, accel, cluster)
 
 
 @dataclass(frozen=True)
@@ -164,14 +185,17 @@ class _Problem:
     threshold: float
     band: tuple[float, float] | None
     block_s: float
+    accel_cols: tuple[int, ...] = ()
+    square_cols: tuple[int, ...] = ()
 
     def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
         if spec.lag and tau > 0:
             return thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
         return run.temperature_degc
 
-    def features(self, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
-        """Columns of the shape and the hysteresis at model temperature ``temp``."""
+    def features(self, run: RunBlocks, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
+        """Columns of the shape and the hysteresis at model temperature ``temp``, then of the g and g x g
+        sensitivity (the excited accelerometer axes only)."""
         u = (np.clip(temp, t_lo, t_hi) - self.t_ref) / self.t_scale
         cols = [u ** k for k in range(1, spec.order + 1)]
         if spec.hysteresis_order:
@@ -183,6 +207,11 @@ class _Problem:
             for sign in (-1, 1):
                 on = active & (turns.direction == sign)
                 cols += [np.where(on, d ** j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
+        if self.accel_cols:
+            cols += [run.accel_g[:, j] for j in self.accel_cols]
+        if self.square_cols:
+            products = g_squared_products(run.accel_g)
+            cols += [products[:, m] for m in self.square_cols]
         return np.column_stack(cols) if cols else np.zeros((temp.size, 0))
 
     def solve(self, spec: _Spec, tau: float, which: list[int]):
@@ -194,7 +223,7 @@ class _Problem:
         for k, temp in enumerate(temps):
             oh = np.zeros((temp.size, len(which)))
             oh[:, k] = 1.0
-            feats.append(self.features(temp, spec, t_lo, t_hi))
+            feats.append(self.features(self.runs[which[k]], temp, spec, t_lo, t_hi))
             onehots.append(oh)
         x = np.hstack([np.vstack(onehots), np.vstack(feats)])
         y = np.concatenate([self.runs[r].value_dps for r in which])
@@ -209,12 +238,12 @@ class _Problem:
         if not spec.lag:
             return 0.0, self.solve(spec, 0.0, which)
         lo, hi = LAG_MIN_BLOCKS * self.block_s, LAG_MAX_S
-        grid = np.geomspace(lo, hi, 16)
+        grid = np.geomspace(lo, hi, 12)
         rss = [self.solve(spec, tau, which)[2] for tau in grid]
         best = int(np.argmin(rss))
         a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
         res = minimize_scalar(lambda lt: self.solve(spec, math.exp(lt), which)[2], bounds=(a, b), method="bounded",
-                              options={"xatol": 1e-3})
+                              options={"xatol": 1e-2})
         tau = math.exp(res.x) if res.fun <= rss[best] else float(grid[best])
         return tau, self.solve(spec, tau, which)
 
@@ -226,7 +255,7 @@ class _Problem:
             train = [r for r in range(n) if r != held]
             tau, (coef, _, _, (t_lo, t_hi)) = self.fit(spec, train)
             run = self.runs[held]
-            x = self.features(self.model_temperature(run, spec, tau), spec, t_lo, t_hi)
+            x = self.features(run, self.model_temperature(run, spec, tau), spec, t_lo, t_hi)
             e = run.value_dps - x @ coef
             e -= np.sum(run.weight * e) / np.sum(run.weight)
             w = max(1, min(e.size, int(round(SCORE_WINDOW_S / self.block_s))))
@@ -236,6 +265,34 @@ class _Problem:
             sse += float(np.sum(smooth_w * smooth_e ** 2))
             wsum += float(np.sum(smooth_w))
         return math.sqrt(sse / wsum)
+
+    def covariance(self, spec: _Spec, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients (run constants first) and their cluster-robust covariance: the sandwich estimator
+        with the static segments (or stretches) of each run as clusters, since the noise within a
+        segment is correlated (flicker) while different positions are close to independent."""
+        which = list(range(len(self.runs)))
+        temps = [self.model_temperature(self.runs[r], spec, tau) for r in which]
+        t_lo, t_hi = min(float(t.min()) for t in temps), max(float(t.max()) for t in temps)
+        xs, ys, ws, cl = [], [], [], []
+        for k, temp in enumerate(temps):
+            run = self.runs[k]
+            oh = np.zeros((temp.size, len(which)))
+            oh[:, k] = 1.0
+            xs.append(np.hstack([oh, self.features(run, temp, spec, t_lo, t_hi)]))
+            ys.append(run.value_dps)
+            ws.append(run.weight)
+            cl.append(run.cluster * len(which) + k if run.cluster is not None else np.full(temp.size, k))
+        x, y, w, clusters = np.vstack(xs), np.concatenate(ys), np.concatenate(ws), np.concatenate(cl)
+        xtw = x.T * w
+        bread = np.linalg.pinv(xtw @ x)
+        coef = bread @ (xtw @ y)
+        score = x * (w * (y - x @ coef))[:, None]
+        _, inverse = np.unique(clusters, return_inverse=True)
+        per_cluster = np.zeros((inverse.max() + 1, x.shape[1]))
+        np.add.at(per_cluster, inverse, score)
+        g = per_cluster.shape[0]
+        meat = per_cluster.T @ per_cluster * (g / max(g - 1, 1))
+        return coef, bread @ meat @ bread
 
     def bic(self, spec: _Spec) -> float:
         _, (coef, consts, rss, _) = self.fit(spec, list(range(len(self.runs))))
@@ -267,6 +324,9 @@ class ThermalHysteresisModel:
     reselect_order : bool
         Choose the polynomial order again (1..max_order) inside the winning candidate.
     max_order : int
+    acceleration : {"none", "matrix", "matrix2"}
+        Fit the g-sensitivity row G (thesis 2.7.1) jointly with the temperature model and the run
+        constants (``matrix2`` adds the g x g terms), on the static segments of the runs only.
 
     Attributes (after ``fit``)
     --------------------------
@@ -281,6 +341,14 @@ class ThermalHysteresisModel:
         Per axis, the validation score of every candidate tried (RMS [deg/s], or BIC with one run).
     selection_ : str
         ``"leave-one-run-out"``, ``"bic"`` or ``"fixed"``.
+    g_sensitivity_dps_per_g_, g_sensitivity_se_dps_per_g_ : dict[str, np.ndarray (3,)]
+        Fitted G row and its cluster-robust standard error [deg/s/g] (0 and NaN for axes not excited).
+    g_squared_dps_per_g2_, g_squared_se_dps_per_g2_ : dict[str, np.ndarray (6,)]
+        The g x g terms in the order of ``gyrocomp.effects.G_SQUARED_TERMS`` (``matrix2`` only).
+    excited_axes_ : tuple of str
+        Accelerometer axes the positions excite (within-run spread above ``EXCITATION_G``).
+    segments_ : list of list of StaticSegment
+        The static segments used, per run.
     """
 
     order: int | dict[str, int]
@@ -291,17 +359,17 @@ class ThermalHysteresisModel:
     bin_width_degc: float | None = None
     reselect_order: bool = False
     max_order: int = 5
+    acceleration: str = "none"
     _fitted: bool = field(default=False, init=False, repr=False)
 
     def _candidates(self) -> list[str]:
         return list(CANDIDATES) if self.hysteresis == "auto" else [self.hysteresis]
 
-    def _specs(self, name: str, order: int) -> list[_Spec]:
+    def _spec(self, name: str, order: int, hysteresis_order: int = 2) -> _Spec:
         lag = name in ("lag", "turning-point+lag")
         if "turning-point" not in name:
-            return [_Spec(order, lag, 0)]
-        orders = range(1, MAX_HYSTERESIS_ORDER + 1) if self.hysteresis_order == "auto" else [int(self.hysteresis_order)]
-        return [_Spec(order, lag, p) for p in orders]
+            return _Spec(order, lag, 0)
+        return _Spec(order, lag, hysteresis_order if self.hysteresis_order == "auto" else int(self.hysteresis_order))
 
     def fit(self, recordings: list[Recording]) -> "ThermalHysteresisModel":
         """Fit on ``recordings`` (each one power-on at rest) and return self."""
@@ -316,10 +384,15 @@ class ThermalHysteresisModel:
             raise InputError(f"--hysteresis-band: {self.band_degc}; give LOW,HIGH with LOW < HIGH [degC]")
         if not self.block_s > 0:
             raise InputError(f"block_s: must be positive, got {self.block_s}")
+        if self.acceleration not in ACCELERATION_CHOICES:
+            raise InputError(f"--acceleration: {self.acceleration!r}; use one of {', '.join(ACCELERATION_CHOICES)}")
         self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
         self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
+        self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
+        self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
         axes = recordings[0].gyro_axes
         n_runs = len(recordings)
+        pieces = self._pieces(recordings)
         self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
             "leave-one-run-out" if n_runs >= 2 else "bic")
         for axis in axes:
@@ -328,22 +401,19 @@ class ThermalHysteresisModel:
             hi = max(float(t.max()) for t in temps)
             width = self.bin_width_degc or max((hi - lo) / 100.0, 1e-3)
             block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
-            runs = [block_means(rec, axis, block_s, width) for rec in recordings]
+            runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
             threshold = max(turn_threshold_degc(t) for t in temps)
+            accel_cols, square_cols = self._accel_columns(runs, axis == axes[0])
             problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, self.band_degc,
-                               block_s)
+                               block_s, accel_cols, square_cols)
             scores: dict[str, float] = {}
             best_spec: dict[str, _Spec] = {}
             order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
+            score = problem.held_out_error if n_runs >= 2 else problem.bic
             for name in self._candidates():
-                specs = self._specs(name, order)
-                if len(specs) == 1 and self.selection_ == "fixed":
-                    best_spec[name], scores[name] = specs[0], math.nan
-                    continue
-                score = problem.held_out_error if n_runs >= 2 else problem.bic
-                tried = {s: score(s) for s in specs}
-                best_spec[name] = min(tried, key=tried.get)
-                scores[name] = tried[best_spec[name]]
+                # candidates compared at hysteresis order 2 (the thesis's); the winner's order is validated after
+                best_spec[name] = self._spec(name, order)
+                scores[name] = math.nan if self.selection_ == "fixed" else score(best_spec[name])
             if len(scores) == 1:
                 chosen = next(iter(scores))
             else:
@@ -355,11 +425,17 @@ class ThermalHysteresisModel:
                 else:  # the simplest candidate within the parsimony tolerance of the best
                     best = min(finite.values())
                     chosen = next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
+            if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
+                tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p)))
+                         for p in range(1, MAX_HYSTERESIS_ORDER + 1)}
+                best = min(tried.values())
+                pick = min(p for p, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
+                best_spec[chosen] = self._spec(chosen, order, pick)
+                scores[chosen] = tried[pick]
             spec = best_spec[chosen]
-            if self.reselect_order and self.selection_ != "fixed" and chosen != "none":
-                # the binned polynomial's order was chosen with lag and hysteresis unmodelled, which a
-                # higher order partly imitates; choose it again inside the winning candidate
-                score = problem.held_out_error if n_runs >= 2 else problem.bic
+            if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
+                # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
+                # which a higher order partly imitates; choose it again inside the winning candidate
                 tried = {o: score(_Spec(o, spec.lag, spec.hysteresis_order)) for o in range(1, self.max_order + 1)}
                 best = min(tried.values())
                 pick = min(o for o, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
@@ -377,8 +453,69 @@ class ThermalHysteresisModel:
             self.turn_on_biases_dps_[axis] = consts
             self.chosen_[axis] = chosen if not p else f"{chosen} (order {p})"
             self.scores_[axis] = scores
+            if self.acceleration != "none":
+                self._store_acceleration(axis, problem, spec, tau, coef, n_runs)
         self._fitted = True
         return self
+
+    def _pieces(self, recordings: list[Recording]) -> list[list[slice] | None]:
+        """Per run, the stretches the fit uses: the static segments where the unit moves between
+        positions (runs with an accelerometer), else every stretch between time gaps."""
+        from ..static import static_segments
+
+        self.segments_ = []
+        out = []
+        for rec in recordings:
+            segs = static_segments(rec) if rec.accel_g is not None else []
+            self.segments_.append(segs)
+            if rec.accel_g is not None and not segs:
+                warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
+                              DataQualityWarning, stacklevel=3)
+            out.append([slice(g.start, g.stop) for g in segs] if segs else None)
+        return out
+
+    def _accel_columns(self, runs: list[RunBlocks], warn: bool) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        if self.acceleration == "none":
+            return (), ()
+        if any(r.accel_g is None for r in runs):
+            raise InputError("--acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
+                             "fit; map them with --columns or fit with --acceleration none")
+        spread = np.sqrt(sum(np.sum(r.weight[:, None] * (r.accel_g - np.average(r.accel_g, axis=0, weights=r.weight))
+                                    ** 2, axis=0) for r in runs) / sum(float(np.sum(r.weight)) for r in runs))
+        excited = tuple(j for j in range(3) if spread[j] > EXCITATION_G)
+        names = ("accel_x", "accel_y", "accel_z")
+        self.excited_axes_ = tuple(names[j] for j in excited)
+        missing = [f"{names[j]} ({spread[j]:.2g} g)" for j in range(3) if j not in excited]
+        if missing and warn:
+            warnings.warn(
+                f"the positions do not excite {', '.join(missing)}: within-run spread below {EXCITATION_G} g; "
+                "those columns of the g-sensitivity matrix are not fitted (reported as 0 with no standard error). "
+                "Record positions that tilt every axis (a tumble: +1, 0 and -1 g on each)",
+                DataQualityWarning, stacklevel=3)
+        squares: tuple[int, ...] = ()
+        if self.acceleration == "matrix2":
+            pairs = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
+            squares = tuple(m for m, term in enumerate(G_SQUARED_TERMS)
+                            if set(pairs[term]) <= set(excited) and not (len(excited) == 3 and term == "zz"))
+        return excited, squares
+
+    def _store_acceleration(self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray,
+                            n_runs: int) -> None:
+        start = spec.order + 2 * spec.hysteresis_order
+        full, cov = problem.covariance(spec, tau)
+        se_all = np.sqrt(np.maximum(np.diag(cov), 0.0))[n_runs:]
+        g, g_se = np.zeros(3), np.full(3, np.nan)
+        for k, j in enumerate(problem.accel_cols):
+            g[j], g_se[j] = coef[start + k], se_all[start + k]
+        self.g_sensitivity_dps_per_g_[axis] = g
+        self.g_sensitivity_se_dps_per_g_[axis] = g_se
+        if self.acceleration == "matrix2":
+            q, q_se = np.zeros(6), np.full(6, np.nan)
+            base = start + len(problem.accel_cols)
+            for k, m in enumerate(problem.square_cols):
+                q[m], q_se[m] = coef[base + k], se_all[base + k]
+            self.g_squared_dps_per_g2_[axis] = q
+            self.g_squared_se_dps_per_g2_[axis] = q_se
 
     def _check_fitted(self) -> None:
         if not self._fitted:
