@@ -108,6 +108,31 @@ def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     assert model["axes"]["gyro_z"]["hysteresis"]["band_degc"] == [55.0, 80.0]
 
 
+def test_fit_g_sensitivity_table_and_stages(tmp_path):
+    r = run("simulate", "--preset", "consumer", "--profile", "combined", "--rate", 1, "--duration", 14000,
+            "--runs", 2, "-o", tmp_path / "c.csv")
+    assert r.returncode == 0, r.stderr
+    r = run("simulate", "--preset", "consumer", "--profile", "combined", "--rate", 1, "--duration", 14000,
+            "--seed", 9, "-o", tmp_path / "held.csv")
+    assert r.returncode == 0, r.stderr
+    r = run("fit", tmp_path / "c_0.csv", tmp_path / "c_1.csv", "-o", tmp_path / "m.json")
+    assert r.returncode == 0, r.stderr
+    assert "g-sensitivity G [deg/s/g] +- standard error" in r.stdout
+    assert re.search(r"gyro_x\s*\S\s*\+0\.0\d+ \+- 0\.00\d+", r.stdout)  # the preset's 0.1 deg/s/g on the diagonal
+    model = json.loads((tmp_path / "m.json").read_text())
+    assert model["axes"]["gyro_y"]["g_sensitivity_dps_per_g"][1] == pytest.approx(0.1, abs=0.01)
+    r = run("evaluate", tmp_path / "m.json", tmp_path / "held.csv", "--stages", "--window", 100)
+    assert r.returncode == 0, r.stderr
+    for stage in ("raw", "temperature only", "temperature + acceleration"):
+        assert stage in r.stdout
+    r = run("evaluate", tmp_path / "m.json", tmp_path / "held.csv", "--stages", "--json", "--window", 100)
+    stages = json.loads(r.stdout)["runs"][0]["stages"]
+    assert stages["temperature + acceleration"]["gyro_z"]["bias_offset_comp_dps"] < \
+        stages["temperature only"]["gyro_z"]["bias_offset_comp_dps"]
+    r = run("fit", tmp_path / "c_0.csv", "-o", tmp_path / "x.json", "--acceleration", "cubic")
+    assert r.returncode == 2 and "Invalid value for '--acceleration'" in r.stderr
+
+
 def test_apply_keeps_columns_rows_and_other_channels(workdir):
     out = workdir / "comp.csv"
     r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", out)
@@ -164,9 +189,9 @@ def test_demo(tmp_path):
     assert set(sizes) == {"temperature (with thermal lag)", "hysteresis", "g-sensitivity"}
     for axis, left in effects["residual_peak_to_peak_dps"].items():
         assert left < sizes["temperature (with thermal lag)"][axis]
-        assert sizes["hysteresis"][axis] > 0.002 and sizes["g-sensitivity"][axis] > 0.005
+        assert sizes["hysteresis"][axis] > 0.001 and sizes["g-sensitivity"][axis] > 0.004
     assert "hysteresis" in r.stdout and "g-sensitivity" in r.stdout
-    assert re.search(r"g-sensitivity .*\(not compensated in this release\)", r.stdout)
+    assert re.search(r"g-sensitivity .*\(compensated: 3x3 G fitted jointly\)", r.stdout)
     truth = json.loads((tmp_path / "demo" / "heldout_truth.json").read_text())
     assert truth["preset"] == "mti10" and truth["profile"]["name"] == "combined"
     assert "warning" not in r.stderr
