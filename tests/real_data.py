@@ -13,6 +13,15 @@ from gyrocomp.allan import allan_deviation, noise_parameters
 from .conftest import DATASETS
 
 ADIS = DATASETS / "smac-imudata-adis16405"
+CATS = DATASETS / "skdivemove-cats-tempcal"
+#: the three static periods of the CATS experiment [s since the file's start] (its README, from the package)
+CATS_PERIODS_S = ((480, 92460), (92880, 183780), (184920, 268020))
+#: the fit choices compared on the CATS runs: name -> fit_calibration options
+CATS_CHOICES = {"cubic": dict(temperature=3, hysteresis="none", acceleration="none"),
+                "default (auto)": {}, "polynomial, order by CV, no hysteresis": dict(hysteresis="none"),
+                "network 1-3-1": dict(temperature="mlp")}
+#: moving-average window of the held-out drift on the CATS runs [s]
+CATS_WINDOW_S = 600
 GALAXY = DATASETS / "skdivemove-galaxy-s5-static"
 AXES = ("x", "y", "z")
 
@@ -26,6 +35,45 @@ def adis_sessions() -> dict[str, np.ndarray]:
         data = rdata.read_rda(ADIS / f"adis_16405_imu{k}.rda")
         sessions[f"imu{k}"] = np.asarray(next(iter(data.values())), dtype=np.float64)[:, :3]
     return sessions
+
+
+def cats_runs() -> list:
+    """The three static periods of the CATS tag (gravity on -z, -x, -y), 1 Hz, as Recordings [deg/s, g, degC]."""
+    from gyrocomp.recording import Recording
+
+    d = np.load(CATS / "cats_temperature_calib_1hz.npz")
+    t = d["t_s"].astype(np.float64)
+    runs = []
+    for k, (lo, hi) in enumerate(CATS_PERIODS_S):
+        m = (t >= lo) & (t < hi)
+        runs.append(Recording(time_s=t[m], gyro_dps=np.degrees(d["gyro_mrad_s"][m].astype(np.float64) / 1000.0),
+                              gyro_axes=("gyro_x", "gyro_y", "gyro_z"),
+                              temperature_degc=d["temperature_c"][m].astype(np.float64),
+                              accel_g=d["acc_m_s2"][m].astype(np.float64) / 9.80665,
+                              accel_axes=("accel_x", "accel_y", "accel_z"), source=f"CATS period {k + 1}"))
+    return runs
+
+
+def cats_held_out_drift(choices: dict | None = None) -> dict[str, np.ndarray]:
+    """Choice -> (3 held-out runs, 3 axes) residual drift [deg/s]: each run compensated by a fit on the other two,
+    drift = RMS of the CATS_WINDOW_S moving average about its mean."""
+    import warnings
+
+    from gyrocomp import apply, fit_calibration
+    from gyrocomp.metrics import smoothed_residual_rms
+
+    runs = cats_runs()
+    out = {}
+    for name, options in (choices or CATS_CHOICES).items():
+        drift = np.zeros((3, 3))
+        for held in range(3):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                cal = fit_calibration([r for i, r in enumerate(runs) if i != held], **options)
+                comp = apply(cal, runs[held]).gyro_dps
+            drift[held] = [smoothed_residual_rms(comp[:, j], CATS_WINDOW_S) for j in range(3)]
+        out[name] = drift
+    return out
 
 
 def galaxy_gyro_dps() -> np.ndarray:
@@ -59,5 +107,24 @@ def main() -> None:
                   f"{n.integration_time_s:.0f} | {n.rrw_deg_per_h_per_sqrt_h:.0f} | {n.fit_rms_log_residual:.0%} |")
 
 
+def main_temperature() -> None:
+    raw = np.array([[0.0] * 3] * 3)
+    from gyrocomp.metrics import smoothed_residual_rms
+
+    for k, run in enumerate(cats_runs()):
+        raw[k] = [smoothed_residual_rms(run.gyro_dps[:, j], CATS_WINDOW_S) for j in range(3)]
+    drift = cats_held_out_drift()
+    cubic = drift["cubic"].mean()
+    print("| fit (on two runs, scored on the third) | drift x | drift y | drift z | mean [deg/s] | vs cubic |")
+    print("|---|---:|---:|---:|---:|---:|")
+    print(f"| raw (no compensation) | " + " | ".join(f"{v:.4f}" for v in raw.mean(axis=0)) +
+          f" | {raw.mean():.4f} | {raw.mean() / cubic - 1:+.0%} |")
+    for name, d in drift.items():
+        print(f"| {name} | " + " | ".join(f"{v:.4f}" for v in d.mean(axis=0)) + f" | {d.mean():.4f} | "
+              f"{d.mean() / cubic - 1:+.0%} |")
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+
+    main_temperature() if "temperature" in sys.argv[1:] else main()

@@ -17,7 +17,6 @@ from .mlp import DEFAULT_HIDDEN, MLPTemperatureModel
 from .temperature import PolynomialBias, PolynomialTemperatureModel
 from .thermal import (
     ACCELERATION_CHOICES,
-    DEFAULT_BLOCK_S,
     HYSTERESIS_CHOICES,
     ThermalHysteresisModel,
     block_means,
@@ -52,7 +51,7 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo, hi = min(float(t.min()) for t in temps), max(float(t.max()) for t in temps)
     width = bin_width_degc or max((hi - lo) / 100.0, 1e-3)
-    block_s = max(DEFAULT_BLOCK_S, 1.0 / recordings[0].rate_hz)
+    block_s = max(NETWORK_BLOCK_S, 1.0 / recordings[0].rate_hz)
     t_in, y_in, w_in = [], [], []
     for r, rec in enumerate(recordings):
         pieces = [slice(g.start, g.stop) for g in segments[r]] if segments and segments[r] else None
@@ -71,6 +70,11 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
         w_in.append(blocks.weight)
     network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc)
     return network.curves_[axis], network.turn_on_biases_dps_[axis]
+
+
+#: block means the network trains on [s]: temperature moves slowly, so 10-s means lose nothing and keep a
+#: day of data to under 10,000 points per run
+NETWORK_BLOCK_S = 10.0
 
 
 def _listed(values: np.ndarray) -> list:
