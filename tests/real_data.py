@@ -76,6 +76,80 @@ def cats_held_out_drift(choices: dict | None = None) -> dict[str, np.ndarray]:
     return out
 
 
+XSENS = DATASETS / "imu_tk-xsens"
+FERRARIS = DATASETS / "imucal-ferraris"
+MPU = DATASETS / "tomisuarez2-mpu6050"
+#: poses held by hand last a few seconds: shorter static segments than the default 10 s [s]
+POSE_MIN_S = {"Xsens (imu_tk)": 3.0, "imucal Ferraris session": 3.0, "MPU-6050 (tomisuarez2)": 1.5}
+
+
+def _unit_sphere(accel: np.ndarray, rec_for_segments) -> np.ndarray:
+    """Accelerometer counts to [g] by the ellipsoid through the static means: sum_j p_j (a_j - c_j)^2 = 1."""
+    from gyrocomp.static import static_segments
+
+    means = np.array([s.gravity_g for s in static_segments(rec_for_segments, min_duration_s=3.0)])
+    mid, spread = means.mean(axis=0), np.abs(means - means.mean(axis=0)).max()
+    x = (means - mid) / spread  # conditioning
+    design = np.column_stack([x ** 2, x, np.ones(len(x))])
+    coef, *_ = np.linalg.lstsq(design, np.ones(len(x)), rcond=None)
+    p, q, r = coef[:3], coef[3:6], coef[6]
+    centre = -q / (2 * p)
+    k = 1 - r + np.sum(p * centre ** 2)
+    return np.sqrt(p / k) * ((accel - mid) / spread - centre)
+
+
+def multi_position_recordings() -> dict:
+    """The three hand-placed multi-position sessions as Recordings [deg/s, g] (no temperature)."""
+    from gyrocomp.recording import Recording
+
+    gyro_axes, accel_axes = ("gyro_x", "gyro_y", "gyro_z"), ("accel_x", "accel_y", "accel_z")
+    out = {}
+    g = np.loadtxt(XSENS / "xsens_gyro.mat")
+    a = np.loadtxt(XSENS / "xsens_acc.mat")
+    gyro = np.degrees(g[:, 1:] / 6258.0)  # imu_tk's scale: 1/6258 (rad/s)/count; the offset is a bias
+    raw = Recording(time_s=g[:, 0], gyro_dps=gyro, gyro_axes=gyro_axes, accel_g=a[:, 1:], accel_axes=accel_axes)
+    out["Xsens (imu_tk)"] = Recording(time_s=g[:, 0], gyro_dps=gyro, gyro_axes=gyro_axes,
+                                      accel_g=_unit_sphere(a[:, 1:], raw), accel_axes=accel_axes,
+                                      source="imu_tk-xsens")
+    f = np.genfromtxt(FERRARIS / "example_ferraris_session.csv", delimiter=",", names=True)
+    out["imucal Ferraris session"] = Recording(
+        time_s=f["n_samples"] / 102.4, gyro_dps=np.column_stack([f["gyr_x"], f["gyr_y"], f["gyr_z"]]),
+        gyro_axes=gyro_axes, accel_g=np.column_stack([f["acc_x"], f["acc_y"], f["acc_z"]]) / 9.80665,
+        accel_axes=accel_axes, source="imucal-ferraris")
+    m = np.loadtxt(MPU / "example_data_calibration.csv", delimiter=",", skiprows=5)
+    out["MPU-6050 (tomisuarez2)"] = Recording(
+        time_s=np.arange(len(m)) / 100.0, gyro_dps=m[:, 3:] / 131.0, gyro_axes=gyro_axes, accel_g=m[:, :3] / 16384.0,
+        accel_axes=accel_axes, source="tomisuarez2-mpu6050")
+    return out
+
+
+def g_sensitivity_fits() -> dict:
+    """Dataset -> Calibration with G only (one power-on each, no temperature)."""
+    import warnings
+
+    from gyrocomp import fit_calibration
+
+    fits = {}
+    for name, rec in multi_position_recordings().items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fits[name] = fit_calibration([rec], temperature=None, acceleration="matrix",
+                                         static_min_duration_s=POSE_MIN_S[name])
+    return fits
+
+
+def main_g_sensitivity() -> None:
+    print("| session | static poses | gyro | G accel_x | G accel_y | G accel_z | [deg/s/g], +- standard error |")
+    print("|---|---:|---|---:|---:|---:|---|")
+    for name, cal in g_sensitivity_fits().items():
+        acc = cal.fit_report["acceleration"]
+        for k, (axis, info) in enumerate(acc["axes"].items()):
+            cells = [f"{g:+.4f} +- {e:.4f}" if e is not None else "not excited"
+                     for g, e in zip(info["g_sensitivity_dps_per_g"], info["standard_error_dps_per_g"])]
+            print(f"| {name if k == 0 else ''} | {acc['static_segments'][0] if k == 0 else ''} | {axis} | "
+                  + " | ".join(cells) + " | |")
+
+
 def galaxy_gyro_dps() -> np.ndarray:
     """(214800, 3) 'measured' (uncalibrated) gyro rates [deg/s] at 10 Hz."""
     import h5py
@@ -127,4 +201,9 @@ def main_temperature() -> None:
 if __name__ == "__main__":
     import sys
 
-    main_temperature() if "temperature" in sys.argv[1:] else main()
+    if "temperature" in sys.argv[1:]:
+        main_temperature()
+    elif "g-sensitivity" in sys.argv[1:]:
+        main_g_sensitivity()
+    else:
+        main()

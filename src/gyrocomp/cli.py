@@ -194,10 +194,12 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 @click.option("--acceleration", type=click.Choice(["auto", *ACCELERATION_CHOICES]), default="auto", show_default=True,
               help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
                    "none; auto: matrix when the runs turn the unit between positions.")
+@click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
+              help="Shortest still stretch used as a static position [s].")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, **kwargs):
+        acceleration, static_min_duration_s, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -212,7 +214,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     recordings = [_read(path, opts).recording for path in runs]
     calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
                                   hysteresis_order=hysteresis_order, hysteresis_band_degc=band, mlp_seed=mlp_seed,
-                                  acceleration=acceleration)
+                                  acceleration=acceleration, static_min_duration_s=static_min_duration_s)
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as _dt
 import math
 from pathlib import Path
@@ -81,23 +82,51 @@ def _listed(values: np.ndarray) -> list:
     return [None if not np.isfinite(v) else float(v) for v in values]
 
 
-def _turned_between_positions(recordings: list[Recording]) -> bool:
+def _turned_between_positions(recordings: list[Recording], min_duration_s: float) -> bool:
     """Whether some run has an accelerometer triad and more than one orientation among its static segments."""
     from ..static import orientations, static_segments
 
     for rec in recordings:
         if rec.accel_g is None or not set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
             continue
-        if len(orientations(static_segments(rec))) > 1:
+        if len(orientations(static_segments(rec, min_duration_s=min_duration_s))) > 1:
             return True
     return False
+
+
+def _acceleration_report(thermal: ThermalHysteresisModel, mode: str) -> dict:
+    return {
+        "mode": mode, "excited_axes": list(thermal.excited_axes_),
+        "static_segments": [len(segs) for segs in thermal.segments_],
+        "axes": {a: {"g_sensitivity_dps_per_g": _listed(thermal.g_sensitivity_dps_per_g_[a]),
+                     "standard_error_dps_per_g": _listed(thermal.g_sensitivity_se_dps_per_g_[a]),
+                     **({"g_squared_dps_per_g2": _listed(thermal.g_squared_dps_per_g2_[a]),
+                         "g_squared_standard_error_dps_per_g2": _listed(thermal.g_squared_se_dps_per_g2_[a])}
+                        if mode == "matrix2" else {})}
+                 for a in thermal.g_sensitivity_dps_per_g_}}
+
+
+def _fit_g_only(recordings: list[Recording], mode: str, static_min_duration_s: float) -> Calibration:
+    """g-sensitivity and run constants without a temperature model (no temperature, or --temperature none)."""
+    flat = [dataclasses.replace(rec, temperature_degc=np.zeros(rec.n_samples)) for rec in recordings]
+    thermal = ThermalHysteresisModel(order=0, hysteresis="none", acceleration=mode,
+                                     static_min_duration_s=static_min_duration_s).fit(flat)
+    axes = {}
+    for axis in recordings[0].gyro_axes:
+        g_row = tuple(map(float, thermal.g_sensitivity_dps_per_g_[axis])) if thermal.excited_axes_ else None
+        g_sq = tuple(map(float, thermal.g_squared_dps_per_g2_[axis])) if mode == "matrix2" and g_row else None
+        axes[axis] = AxisCalibration(None, tuple(float(c) for c in thermal.turn_on_biases_dps_[axis]),
+                                     g_sensitivity_dps_per_g=g_row, g_squared_dps_per_g2=g_sq)
+    name = "g-sensitivity" + (" (g x g)" if mode == "matrix2" else "") if thermal.excited_axes_ else "none"
+    return Calibration(axes=axes, model=name, provenance=_provenance(recordings),
+                       fit_report={"temperature": None, "acceleration": _acceleration_report(thermal, mode)})
 
 
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
-                    acceleration: str = "auto") -> Calibration:
+                    acceleration: str = "auto", static_min_duration_s: float = 10.0) -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -124,12 +153,22 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         g-sensitivity fitted jointly with the temperature model and the run constants, on the static
         segments: the 3x3 matrix (``matrix``), plus g x g terms (``matrix2``). ``"auto"``: ``matrix``
         when the runs have accelerometer axes and the unit is turned between positions within a run.
+        With ``temperature=None`` only G and the run constants are fitted.
+    static_min_duration_s : float
+        Shortest still stretch used as a static segment [s] (hand-placed poses may last only a few seconds).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
     recordings = list(recordings)
     if not recordings:
         raise InputError("fit: give at least one calibration run")
+    if acceleration not in ("auto", *ACCELERATION_CHOICES):
+        raise InputError(f"--acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
+    if not static_min_duration_s > 0:
+        raise InputError(f"--min-static: must be a positive number of seconds, got {static_min_duration_s}")
+    if temperature is None and acceleration != "none" and (
+            acceleration != "auto" or _turned_between_positions(recordings, static_min_duration_s)):
+        return _fit_g_only(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
     if temperature is None:
         axes = {}
         for axis in recordings[0].gyro_axes:
@@ -150,11 +189,9 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
         temperature = "auto"  # the polynomial still finds lag and hysteresis for the network
     model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc).fit(recordings)
-    if acceleration not in ("auto", *ACCELERATION_CHOICES):
-        raise InputError(f"--acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
     accel_mode = acceleration
     if accel_mode == "auto":
-        accel_mode = "matrix" if _turned_between_positions(recordings) else "none"
+        accel_mode = "matrix" if _turned_between_positions(recordings, static_min_duration_s) else "none"
     mode = hysteresis
     if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
         mode = "none"
@@ -163,7 +200,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         orders = {axis: curve.order for axis, curve in model.curves_.items()}
         thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
                                          band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
-                                         reselect_order=temperature == "auto", acceleration=accel_mode).fit(recordings)
+                                         reselect_order=temperature == "auto", acceleration=accel_mode,
+                                         static_min_duration_s=static_min_duration_s).fit(recordings)
     axes = {}
     report = {"temperature": "polynomial", "order_selection": model.selection_, "axes": {}}
     if thermal is not None:
@@ -178,15 +216,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         report["hysteresis"] = {"mode": hysteresis, "selection": "none: the runs do not both heat and cool"
                                 if hysteresis == "auto" else "none"}
     if accel_mode != "none":
-        report["acceleration"] = {
-            "mode": accel_mode, "excited_axes": list(thermal.excited_axes_),
-            "static_segments": [len(segs) for segs in thermal.segments_],
-            "axes": {a: {"g_sensitivity_dps_per_g": _listed(thermal.g_sensitivity_dps_per_g_[a]),
-                         "standard_error_dps_per_g": _listed(thermal.g_sensitivity_se_dps_per_g_[a]),
-                         **({"g_squared_dps_per_g2": _listed(thermal.g_squared_dps_per_g2_[a]),
-                             "g_squared_standard_error_dps_per_g2": _listed(thermal.g_squared_se_dps_per_g2_[a])}
-                            if accel_mode == "matrix2" else {})}
-                     for a in thermal.g_sensitivity_dps_per_g_}}
+        report["acceleration"] = _acceleration_report(thermal, accel_mode)
     else:
         report["acceleration"] = {"mode": "none", "why": "the runs do not turn the unit between positions"
                                   if acceleration == "auto" else "not asked for"}

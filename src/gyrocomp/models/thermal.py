@@ -291,7 +291,9 @@ class _Problem:
         per_cluster = np.zeros((inverse.max() + 1, x.shape[1]))
         np.add.at(per_cluster, inverse, score)
         g = per_cluster.shape[0]
-        meat = per_cluster.T @ per_cluster * (g / max(g - 1, 1))
+        if g <= x.shape[1]:  # fewer clusters than coefficients: the spread of the clusters says nothing
+            return coef, np.full((x.shape[1], x.shape[1]), np.nan)
+        meat = per_cluster.T @ per_cluster * (g / (g - 1))
         return coef, bread @ meat @ bread
 
     def bic(self, spec: _Spec) -> float:
@@ -360,6 +362,7 @@ class ThermalHysteresisModel:
     reselect_order: bool = False
     max_order: int = 5
     acceleration: str = "none"
+    static_min_duration_s: float = 10.0
     _fitted: bool = field(default=False, init=False, repr=False)
 
     def _candidates(self) -> list[str]:
@@ -466,7 +469,7 @@ class ThermalHysteresisModel:
         self.segments_ = []
         out = []
         for rec in recordings:
-            segs = static_segments(rec) if rec.accel_g is not None else []
+            segs = static_segments(rec, min_duration_s=self.static_min_duration_s) if rec.accel_g is not None else []
             self.segments_.append(segs)
             if rec.accel_g is not None and not segs:
                 warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
