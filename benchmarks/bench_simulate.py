@@ -58,8 +58,8 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
           f"numpy {np.__version__}")
     print(f"run: {args.hours:g} h at {args.rate:g} Hz, 3 axes = {n:,} samples per axis")
-    print(f"| step | time [s] | ratio |")
-    print(f"|---|---:|---:|")
+    print("| step | time [s] | ratio |")
+    print("|---|---:|---:|")
     print(f"| gyrocomp simulate, every effect | {t_sim:.2f} | {t_sim / t_white:.1f}x numpy white noise |")
     print(f"| numpy white noise only (baseline) | {t_white:.2f} | 1 |")
     print(f"| flicker bank, coarse grids (3 axes) | {t_bank:.2f} | {t_bank_full / t_bank:.1f}x faster than full rate |")

@@ -191,7 +191,7 @@ def main_temperature() -> None:
     cubic = drift["cubic"].mean()
     print("| fit (on two runs, scored on the third) | drift x | drift y | drift z | mean [deg/s] | vs cubic |")
     print("|---|---:|---:|---:|---:|---:|")
-    print(f"| raw (no compensation) | " + " | ".join(f"{v:.4f}" for v in raw.mean(axis=0)) +
+    print("| raw (no compensation) | " + " | ".join(f"{v:.4f}" for v in raw.mean(axis=0)) +
           f" | {raw.mean():.4f} | {raw.mean() / cubic - 1:+.0%} |")
     for name, d in drift.items():
         print(f"| {name} | " + " | ".join(f"{v:.4f}" for v in d.mean(axis=0)) + f" | {d.mean():.4f} | "

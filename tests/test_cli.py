@@ -386,3 +386,15 @@ def test_allan_never_overwrites_its_input(static_log):
     r = run("allan", static_log / "s.csv", "--kalibr", static_log / "s.csv")
     assert r.returncode == 2 and "--kalibr" in r.stderr and "this is an input file" in r.stderr
     assert (static_log / "s.csv").read_bytes() == before
+
+
+def test_fit_pipeline_option(tmp_path):
+    r = run("simulate", "--preset", "consumer", "--profile", "tumble", "--rate", 1, "--runs", 2, "-o", tmp_path / "t.csv")
+    assert r.returncode == 0, r.stderr
+    r = run("fit", tmp_path / "t_0.csv", tmp_path / "t_1.csv", "-o", tmp_path / "m.json", "--pipeline", "matrix>poly")
+    assert r.returncode == 0, r.stderr
+    model = json.loads((tmp_path / "m.json").read_text())
+    assert model["model"].startswith("matrix>poly: g-sensitivity > ")
+    assert model["fit_report"]["pipeline"] == "matrix>poly" and len(model["fit_report"]["stages"]) == 2
+    r = run("fit", tmp_path / "t_0.csv", "-o", tmp_path / "m.json", "--pipeline", "poly+matrix")
+    assert r.returncode == 2 and "--pipeline: 'poly+matrix'; use one of joint, poly>matrix" in r.stderr

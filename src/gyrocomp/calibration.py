@@ -94,7 +94,9 @@ class AxisCalibration:
 
     @property
     def needs_accel(self) -> bool:
-        return self.g_sensitivity_dps_per_g is not None or self.g_squared_dps_per_g2 is not None
+        """Whether the correction reads the accelerometer (a G row, g x g terms, or a network with accel inputs)."""
+        return (self.g_sensitivity_dps_per_g is not None or self.g_squared_dps_per_g2 is not None
+                or bool(getattr(self.temperature, "needs_accel", False)))
 
     @property
     def has_memory(self) -> bool:
@@ -173,7 +175,9 @@ class Calibration:
 
     @property
     def has_acceleration(self) -> bool:
-        return any(ax.needs_accel for ax in self.axes.values())
+        """Whether some axis has a g-sensitivity stage (G or g x g) that ``without("acceleration")`` removes."""
+        return any(ax.g_sensitivity_dps_per_g is not None or ax.g_squared_dps_per_g2 is not None
+                   for ax in self.axes.values())
 
     @property
     def has_hysteresis(self) -> bool:

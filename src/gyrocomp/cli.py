@@ -36,7 +36,7 @@ from .io import (
 )
 from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .metrics import Evaluation, evaluate_run
-from .models.pipelines import fit_calibration
+from .models.pipelines import fit_pipeline
 from .models.temperature import parse_temperature_option
 from .models.thermal import ACCELERATION_CHOICES, CANDIDATES, HYSTERESIS_CHOICES
 from .noise import NoiseAnalysis, analyse_noise
@@ -194,12 +194,16 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 @click.option("--acceleration", type=click.Choice(["auto", *ACCELERATION_CHOICES]), default="auto", show_default=True,
               help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
                    "none; auto: matrix when the runs turn the unit between positions.")
+@click.option("--pipeline", default="joint", show_default=True,
+              help="joint (temperature, lag/hysteresis, G and run constants in one fit), or a cascade fitted stage by "
+                   "stage: 'poly>matrix', 'matrix>poly', 'mlp>matrix', or 'joint-mlp' (one network reading the "
+                   "temperature and the three accelerations). Quote the > in a shell.")
 @click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
               help="Shortest still stretch used as a static position [s].")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, static_min_duration_s, **kwargs):
+        acceleration, pipeline, static_min_duration_s, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -212,9 +216,9 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     refuse_to_overwrite_inputs(output, runs)
     recordings = [_read(path, opts).recording for path in runs]
-    calibration = fit_calibration(recordings, temperature=order, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
-                                  hysteresis_order=hysteresis_order, hysteresis_band_degc=band, mlp_seed=mlp_seed,
-                                  acceleration=acceleration, static_min_duration_s=static_min_duration_s)
+    calibration = fit_pipeline(recordings, pipeline, temperature=order, bin_width_degc=bin_width_degc,
+                               hysteresis=hysteresis, hysteresis_order=hysteresis_order, hysteresis_band_degc=band,
+                               mlp_seed=mlp_seed, acceleration=acceleration, static_min_duration_s=static_min_duration_s)
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)

@@ -81,9 +81,10 @@ class Compensator:
                 if accel_g is None:
                     raise InputError(f"{self.source}: the model has g-sensitivity; the data needs accel_x, accel_y "
                                      "and accel_z columns [g] (map them with --columns)")
-                g = np.zeros(3) if ax.g_sensitivity_dps_per_g is None else np.asarray(ax.g_sensitivity_dps_per_g)
-                q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
-                out[:, j] -= g_sensitivity_offset(accel_g, g[None, :], q)[:, 0]
+                if ax.g_sensitivity_dps_per_g is not None or ax.g_squared_dps_per_g2 is not None:
+                    g = np.zeros(3) if ax.g_sensitivity_dps_per_g is None else np.asarray(ax.g_sensitivity_dps_per_g)
+                    q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
+                    out[:, j] -= g_sensitivity_offset(accel_g, g[None, :], q)[:, 0]
             if ax.temperature is None:
                 continue
             if temperature_degc is None:
@@ -101,7 +102,10 @@ class Compensator:
                     TemperatureRangeWarning, stacklevel=3,
                 )
                 self._warned = True
-            out[:, j] -= ax.temperature.shape_dps(t_model)
+            if getattr(ax.temperature, "needs_accel", False):
+                out[:, j] -= ax.temperature.shape_dps(t_model, accel_g)
+            else:
+                out[:, j] -= ax.temperature.shape_dps(t_model)
             if ax.hysteresis is not None:
                 turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states[k])
                 self._turn_states[k] = turns.state

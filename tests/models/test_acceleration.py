@@ -150,3 +150,68 @@ def test_acceleration_needs_accelerometer_columns():
     assert cal.fit_report["acceleration"]["mode"] == "none"
     with pytest.raises(InputError, match="--acceleration: 'cube'; use one of auto, none, matrix, matrix2"):
         fit_calibration(runs, acceleration="cube")
+
+
+@pytest.fixture(scope="module")
+def pipelines(consumer):
+    from gyrocomp.models.pipelines import PIPELINES, fit_pipeline
+
+    _, runs, held, joint = consumer
+    out = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name in PIPELINES:
+            cal = joint if name == "joint" else fit_pipeline([r.recording for r in runs], name)
+            comp = apply(cal, held.recording).gyro_dps
+            ratio = [smoothed_residual_rms(comp[:, j] - held.truth.true_rate_dps[:, j], 60)
+                     / smoothed_residual_rms(held.truth.noise.total_dps[:, j], 60) for j in range(3)]
+            out[name] = (cal, float(np.mean(ratio)))
+    return out
+
+
+def test_joint_fit_beats_every_cascade(pipelines):
+    # the thesis's point (2.8): fitting temperature and acceleration together keeps the drift during the
+    # tumble out of G and the orientation offsets out of the temperature curve
+    joint = pipelines["joint"][1]
+    assert joint < 1.15
+    for name in ("poly>matrix", "matrix>poly", "mlp>matrix", "joint-mlp"):
+        assert joint <= pipelines[name][1], name
+        assert "stages" in pipelines[name][0].fit_report or name == "joint-mlp"
+
+
+def test_a_cascade_applies_as_its_stages_in_turn(consumer, pipelines):
+    from gyrocomp.models.pipelines import fit_calibration
+
+    _, runs, held, _ = consumer
+    chained = pipelines["matrix>poly"][0]
+    recs = [r.recording for r in runs]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        first = fit_calibration(recs, temperature=None, acceleration="matrix")
+        second = fit_calibration([apply(first, r) for r in recs], acceleration="none")
+        step = apply(second, apply(first, held.recording)).gyro_dps
+        np.testing.assert_allclose(apply(chained, held.recording).gyro_dps, step, rtol=0, atol=1e-12)
+
+
+def test_joint_network_reads_the_accelerations(consumer, pipelines, tmp_path):
+    _, _, held, _ = consumer
+    cal = pipelines["joint-mlp"][0]
+    ax = cal.axes["gyro_x"]
+    assert ax.temperature.inputs == ("temperature", "accel_x", "accel_y", "accel_z")
+    assert ax.g_sensitivity_dps_per_g is None and ax.needs_accel
+    assert cal.model.startswith("joint-mlp: mlp:4-3-1")
+    cal.save(tmp_path / "j.json")
+    loaded = Calibration.load(tmp_path / "j.json")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        np.testing.assert_array_equal(apply(loaded, held.recording).gyro_dps, apply(cal, held.recording).gyro_dps)
+    with pytest.raises(InputError, match="the data needs accel_x, accel_y and accel_z"):
+        Compensator(cal, ("gyro_x", "gyro_y", "gyro_z"), rate_hz=1.0).update(
+            held.recording.time_s[:5], held.recording.gyro_dps[:5], held.recording.temperature_degc[:5])
+
+
+def test_unknown_pipeline():
+    from gyrocomp.models.pipelines import fit_pipeline
+
+    with pytest.raises(InputError, match=r"--pipeline: 'poly>net'; use one of joint, poly>matrix, matrix>poly"):
+        fit_pipeline([simulate("mti10", profile="static", duration_s=100, rate_hz=1).recording], "poly>net")

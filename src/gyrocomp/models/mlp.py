@@ -201,12 +201,19 @@ def validation_mask(run: np.ndarray, n_runs: int, share: float = VALIDATION_SHAR
 
 
 # -- the frozen result -------------------------------------------------------------------------------
+#: inputs a network may read: the model temperature [degC] and the specific force [g]
+NETWORK_INPUTS = ("temperature", "accel_x", "accel_y", "accel_z")
+ACCEL_INPUTS = ("accel_x", "accel_y", "accel_z")
+
+
 @dataclass(frozen=True)
 class MLPBias:
-    """Fitted network temperature shape of one axis, without its turn-on constant.
+    """Fitted network shape of one axis's bias, without its turn-on constant.
 
-    bias(T) = net(x(T)) - net(x(t_ref_degc)),  x = 2 (clip(T) - t_min) / (t_max - t_min) - 1,
-    net output in deg/s = standardized output * output_scale_dps + output_mean_dps.
+    bias(inputs) = net(x(inputs)) - net(x(reference)),  x_i = 2 (clip(v_i) - min_i) / (max_i - min_i) - 1,
+    net output in deg/s = standardized output * output_scale_dps + output_mean_dps. The thesis's network
+    reads the temperature only; with ``inputs`` = temperature, accel_x, accel_y, accel_z it is the joint
+    network of thesis 2.7.2 / 2.8 (``reference`` then includes a 1 g z-up orientation).
     """
 
     hidden: tuple[int, ...]
@@ -216,10 +223,24 @@ class MLPBias:
     t_ref_degc: float
     t_min_degc: float
     t_max_degc: float
+    inputs: tuple[str, ...] = ("temperature",)
+    input_min: tuple[float, ...] = ()
+    input_max: tuple[float, ...] = ()
+    reference: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.input_min:  # temperature only: its range and reference
+            object.__setattr__(self, "input_min", (self.t_min_degc,))
+            object.__setattr__(self, "input_max", (self.t_max_degc,))
+            object.__setattr__(self, "reference", (self.t_ref_degc,))
 
     @property
     def order(self) -> str:
-        return "mlp 1-" + "-".join(map(str, self.hidden)) + "-1"
+        return f"mlp {len(self.inputs)}-" + "-".join(map(str, self.hidden)) + "-1"
+
+    @property
+    def needs_accel(self) -> bool:
+        return any(name in ACCEL_INPUTS for name in self.inputs)
 
     @property
     def range_tolerance_degc(self) -> float:
@@ -235,19 +256,39 @@ class MLPBias:
     def _theta(self) -> np.ndarray:
         return np.concatenate([np.asarray(layer, dtype=float) for layer in self.weights])
 
-    def net_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
-        t = np.clip(np.asarray(temperature_degc, dtype=float), self.t_min_degc, self.t_max_degc)
-        span = self.t_max_degc - self.t_min_degc
-        x = (2.0 * (t - self.t_min_degc) / span - 1.0 if span > 0 else np.zeros_like(t)).reshape(-1, 1)
-        out, _ = forward(self._theta(), layer_shapes(1, self.hidden), x)
-        return (out * self.output_scale_dps + self.output_mean_dps).reshape(np.shape(temperature_degc))
+    def net_dps(self, values: np.ndarray) -> np.ndarray:
+        """Network output [deg/s] for input values (n, len(inputs)) in their units, clipped to the fitted ranges."""
+        v = np.asarray(values, dtype=float).reshape(-1, len(self.inputs))
+        lo, hi = np.asarray(self.input_min), np.asarray(self.input_max)
+        span = np.where(hi > lo, hi - lo, 1.0)
+        x = np.where(hi > lo, 2.0 * (np.clip(v, lo, hi) - lo) / span - 1.0, 0.0)
+        out, _ = forward(self._theta(), layer_shapes(len(self.inputs), self.hidden), x)
+        return out * self.output_scale_dps + self.output_mean_dps
 
-    def shape_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
-        """Bias shape [deg/s] at ``temperature_degc`` [degC], zero at t_ref, held at the range's edges."""
-        return self.net_dps(temperature_degc) - float(self.net_dps(np.array([self.t_ref_degc]))[0])
+    def input_values(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
+        """The (n, len(inputs)) matrix the network reads, from temperature [degC] and specific force (n, 3) [g]."""
+        t = np.asarray(temperature_degc, dtype=float).reshape(-1)
+        cols = []
+        for name in self.inputs:
+            if name == "temperature":
+                cols.append(t)
+            else:
+                if accel_g is None:
+                    raise InputError("the network reads the accelerations; the data needs accel_x, accel_y and "
+                                     "accel_z columns [g]")
+                cols.append(np.asarray(accel_g, dtype=float)[:, ACCEL_INPUTS.index(name)])
+        return np.column_stack(cols)
+
+    def shape_dps(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
+        """Bias shape [deg/s], zero at the reference inputs, held at the edges of the fitted ranges."""
+        shape = self.net_dps(self.input_values(temperature_degc, accel_g)) - float(
+            self.net_dps(np.asarray(self.reference)[None, :])[0])
+        return shape.reshape(np.shape(temperature_degc))
 
     def to_dict(self) -> dict[str, Any]:
         return {"type": "mlp", "hidden": list(self.hidden), "activation": "tanh", "output": "linear",
+                "inputs": list(self.inputs), "input_min": list(self.input_min), "input_max": list(self.input_max),
+                "reference": list(self.reference),
                 "weights": [list(layer) for layer in self.weights], "output_mean_dps": self.output_mean_dps,
                 "output_scale_dps": self.output_scale_dps, "t_ref_degc": self.t_ref_degc,
                 "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
@@ -255,12 +296,17 @@ class MLPBias:
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "MLPBias":
         hidden = tuple(int(h) for h in d["hidden"])
+        inputs = tuple(str(i) for i in d.get("inputs", ["temperature"]))
+        if not inputs or any(i not in NETWORK_INPUTS for i in inputs):
+            raise InputError(f"mlp inputs {list(inputs)}: use names from {', '.join(NETWORK_INPUTS)}")
         weights = tuple(tuple(float(v) for v in layer) for layer in d["weights"])
-        shapes = layer_shapes(1, hidden)
+        shapes = layer_shapes(len(inputs), hidden)
         if [len(layer) for layer in weights] != [r * c + r for r, c in shapes]:
-            raise InputError(f"mlp weights do not fit a 1-{'-'.join(map(str, hidden))}-1 network")
+            raise InputError(f"mlp weights do not fit a {len(inputs)}-{'-'.join(map(str, hidden))}-1 network")
+        floats = lambda key: tuple(float(v) for v in d.get(key, ()))  # noqa: E731
         return cls(hidden, weights, float(d["output_mean_dps"]), float(d["output_scale_dps"]), float(d["t_ref_degc"]),
-                   float(d["t_min_degc"]), float(d["t_max_degc"]))
+                   float(d["t_min_degc"]), float(d["t_max_degc"]), inputs, floats("input_min"), floats("input_max"),
+                   floats("reference"))
 
 
 def parse_hidden(text: str) -> tuple[int, ...]:
@@ -309,8 +355,10 @@ class MLPTemperatureModel:
     _fitted: bool = field(default=False, init=False, repr=False)
 
     def fit_blocks(self, axis: str, temperature_degc: list[np.ndarray], value_dps: list[np.ndarray],
-                   weight: list[np.ndarray], t_ref_degc: float) -> "MLPTemperatureModel":
-        """Fit one axis on per-run arrays of temperature [degC], value [deg/s] and weight."""
+                   weight: list[np.ndarray], t_ref_degc: float, accel_g: list[np.ndarray] | None = None,
+                   inputs: tuple[str, ...] = ("temperature",)) -> "MLPTemperatureModel":
+        """Fit one axis on per-run arrays of temperature [degC], value [deg/s], weight and, for a network that
+        reads them, specific force (n, 3) [g]."""
         if self.restarts < 1:
             raise InputError(f"restarts: must be at least 1, got {self.restarts}")
         if not hasattr(self, "curves_"):
@@ -321,19 +369,25 @@ class MLPTemperatureModel:
         w = np.concatenate(weight)
         run = np.concatenate([np.full(a.size, r) for r, a in enumerate(temperature_degc)])
         n_runs = len(temperature_degc)
+        accel = None if accel_g is None else np.vstack(accel_g)
+        probe = MLPBias(self.hidden, (), 0.0, 1.0, t_ref_degc, 0.0, 0.0, inputs, (0.0,) * len(inputs),
+                        (0.0,) * len(inputs), (0.0,) * len(inputs))
+        values = probe.input_values(t, accel)
+        lo, hi = values.min(axis=0), values.max(axis=0)
         t_min, t_max = float(t.min()), float(t.max())
-        if t_max - t_min <= 0:
+        if "temperature" in inputs and t_max - t_min <= 0:
             raise ModelError(f"{axis}: the temperature does not vary; a network needs a temperature range")
-        n_params = n_parameters(layer_shapes(1, self.hidden)) + n_runs - 1
+        n_params = n_parameters(layer_shapes(len(inputs), self.hidden)) + n_runs - 1
         if y.size < 2 * n_params:
             raise ModelError(f"{axis}: {y.size} training points for {n_params} parameters; record longer runs "
                              "or choose fewer hidden neurons")
-        x = (2.0 * (t - t_min) / (t_max - t_min) - 1.0)[:, None]
+        span = np.where(hi > lo, hi - lo, 1.0)
+        x = np.where(hi > lo, 2.0 * (values - lo) / span - 1.0, 0.0)
         mean, scale = float(np.average(y, weights=w)), float(np.sqrt(np.average((y - np.average(y, weights=w)) ** 2,
                                                                                   weights=w))) or 1.0
         target = (y - mean) / scale
         train = validation_mask(run, n_runs)
-        shapes = layer_shapes(1, self.hidden)
+        shapes = layer_shapes(len(inputs), self.hidden)
         results = []
         for k in range(self.restarts):
             rng = np.random.default_rng([self.seed, k])
@@ -348,8 +402,11 @@ class MLPTemperatureModel:
                            best.epochs + final.epochs)
         layers = unpack(best.theta, shapes)
         weights = tuple(tuple(float(v) for v in np.concatenate([wt.ravel(), b])) for wt, b in layers)
-        curve = MLPBias(self.hidden, weights, mean, scale, t_ref_degc, t_min, t_max)
-        at_ref = float(curve.net_dps(np.array([t_ref_degc]))[0])
+        reference = tuple(t_ref_degc if name == "temperature" else (1.0 if name == "accel_z" else 0.0)
+                          for name in inputs)
+        curve = MLPBias(self.hidden, weights, mean, scale, t_ref_degc, t_min, t_max, tuple(inputs),
+                        tuple(map(float, lo)), tuple(map(float, hi)), reference)
+        at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
         self.curves_[axis] = curve
         self.turn_on_biases_dps_[axis] = best.run_constants * scale + at_ref
         self.validation_rmse_dps_[axis] = [r.validation_rmse * scale for r in results]
@@ -363,5 +420,5 @@ class MLPTemperatureModel:
             raise NotFittedError("MLPTemperatureModel is not fitted yet; call fit first")
 
 
-__all__ = ["MLPBias", "MLPTemperatureModel", "TrainResult", "forward", "jacobian", "layer_shapes", "parse_hidden",
+__all__ = ["ACCEL_INPUTS", "NETWORK_INPUTS", "MLPBias", "MLPTemperatureModel", "TrainResult", "forward", "jacobian", "layer_shapes", "parse_hidden",
            "train_lm", "validation_mask"]

@@ -5,16 +5,17 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import math
+import warnings
 from pathlib import Path
 
 
 from ..calibration import AxisCalibration, Calibration
-from ..errors import InputError
+from ..errors import InputError, TemperatureRangeWarning
 from ..recording import Recording
 import numpy as np
 
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from .mlp import DEFAULT_HIDDEN, MLPTemperatureModel
+from .mlp import DEFAULT_HIDDEN, NETWORK_INPUTS, MLPTemperatureModel
 from .temperature import PolynomialBias, PolynomialTemperatureModel
 from .thermal import (
     ACCELERATION_CHOICES,
@@ -46,14 +47,14 @@ def _provenance(recordings: list[Recording]) -> dict:
 
 def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
                  hysteresis, poly: PolynomialBias, bin_width_degc: float | None, g_row=None, g_squared=None,
-                 segments=None):
+                 segments=None, inputs: tuple[str, ...] = ("temperature",)):
     """Train the network on the block means of the runs, through the lag and without the hysteresis
     that the polynomial stage found (a cascade: the network replaces the polynomial shape)."""
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo, hi = min(float(t.min()) for t in temps), max(float(t.max()) for t in temps)
     width = bin_width_degc or max((hi - lo) / 100.0, 1e-3)
     block_s = max(NETWORK_BLOCK_S, 1.0 / recordings[0].rate_hz)
-    t_in, y_in, w_in = [], [], []
+    t_in, y_in, w_in, a_in = [], [], [], []
     for r, rec in enumerate(recordings):
         pieces = [slice(g.start, g.stop) for g in segments[r]] if segments and segments[r] else None
         blocks = block_means(rec, axis, block_s, width, pieces)
@@ -69,7 +70,12 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
         t_in.append(temp)
         y_in.append(value)
         w_in.append(blocks.weight)
-    network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc)
+        a_in.append(blocks.accel_g)
+    needs_accel = any(name != "temperature" for name in inputs)
+    if needs_accel and any(a is None for a in a_in):
+        raise InputError("--pipeline joint-mlp: the runs need accel_x, accel_y and accel_z columns")
+    network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc, accel_g=a_in if needs_accel else None,
+                       inputs=inputs)
     return network.curves_[axis], network.turn_on_biases_dps_[axis]
 
 
@@ -126,7 +132,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
-                    acceleration: str = "auto", static_min_duration_s: float = 10.0) -> Calibration:
+                    acceleration: str = "auto", static_min_duration_s: float = 10.0,
+                    network_inputs: tuple[str, ...] = ("temperature",)) -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -156,6 +163,9 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         With ``temperature=None`` only G and the run constants are fitted.
     static_min_duration_s : float
         Shortest still stretch used as a static segment [s] (hand-placed poses may last only a few seconds).
+    network_inputs : tuple of str
+        What a network (``temperature="mlp"``) reads: the temperature, or also ``accel_x``, ``accel_y``,
+        ``accel_z`` (the joint network of the ``joint-mlp`` pipeline, which then fits no separate G).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
@@ -232,8 +242,12 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                 if accel_mode == "matrix2":
                     g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
         if network is not None:
-            curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc, g_row, g_sq,
-                                         thermal.segments_ if thermal is not None else None)
+            joint = network_inputs != ("temperature",)
+            curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc,
+                                         None if joint else g_row, None if joint else g_sq,
+                                         thermal.segments_ if thermal is not None else None, network_inputs)
+            if joint:  # the network reads the accelerations itself: the least-squares G was only a scaffold
+                g_row = g_sq = None
         axes[axis] = AxisCalibration(curve, tuple(float(c) for c in consts),
                                      recordings[0].temperature_column_for(axis), lag, hyst, g_row, g_sq)
         report["axes"][axis] = {
@@ -249,7 +263,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                              "training": "Levenberg-Marquardt, early stopping on 20 % held-out segments",
                              "axes": {a: {"validation_rmse_dps": network.validation_rmse_dps_[a],
                                           "epochs": network.epochs_[a]} for a in network.curves_}}
-        name = "mlp:1-" + "-".join(map(str, hidden)) + "-1"
+        name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, hidden)) + "-1"
     else:
         orders = sorted({ax.temperature.order for ax in axes.values()})
         name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
@@ -259,9 +273,78 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         extras = sorted({c.split(" (")[0] for c in thermal.chosen_.values()} - {"none"})
         if extras:
             name += " + " + "/".join(extras)
-        if accel_mode != "none" and thermal.excited_axes_:
+        if any(ax.g_sensitivity_dps_per_g is not None for ax in axes.values()):
             name += " + g-sensitivity" + (" (g x g)" if accel_mode == "matrix2" else "")
     return Calibration(axes=axes, model=name, provenance=_provenance(recordings), fit_report=report)
 
 
-__all__ = ["fit_calibration"]
+#: the named pipelines of ``gyrocomp fit --pipeline`` (thesis 2.8): stages left to right, each fitted on the
+#: output of the one before; ``joint`` is the default joint least-squares fit, ``joint-mlp`` one network
+#: reading the temperature and the three accelerations
+PIPELINES = ("joint", "poly>matrix", "matrix>poly", "mlp>matrix", "joint-mlp")
+
+
+def _residual_runs(calibration: Calibration, recordings: list[Recording]) -> list[Recording]:
+    from ..compensate import apply
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)
+        return [apply(calibration, rec) for rec in recordings]
+
+
+def _chain(first: Calibration, second: Calibration, recordings: list[Recording], name: str) -> Calibration:
+    """One calibration applying ``first`` then ``second``: the temperature part from whichever has it, G from
+    whichever has it, and per-run constants that add up (the second stage saw the first's mean removed)."""
+    axes = {}
+    for axis, a in first.axes.items():
+        b = second.axes[axis]
+        temp_stage = a if a.temperature is not None or a.has_memory else b
+        g_stage = a if a.needs_accel else b
+        consts = tuple(a.mean_turn_on_bias_dps + cb for cb in b.turn_on_biases_dps)
+        axes[axis] = AxisCalibration(temp_stage.temperature, consts, temp_stage.temperature_column,
+                                     temp_stage.lag_time_constant_s, temp_stage.hysteresis,
+                                     g_stage.g_sensitivity_dps_per_g, g_stage.g_squared_dps_per_g2)
+    report = {"pipeline": name, "stages": [first.fit_report, second.fit_report],
+              "acceleration": (first.fit_report if first.has_acceleration else second.fit_report).get("acceleration", {})}
+    return Calibration(axes=axes, model=f"{name}: {first.model} > {second.model}", provenance=_provenance(recordings),
+                       fit_report=report)
+
+
+def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint", **options) -> Calibration:
+    """Fit a named pipeline (``PIPELINES``); ``options`` go to :func:`fit_calibration` for the temperature stage.
+
+    - ``joint``: temperature model, lag/hysteresis, G and run constants in one least-squares fit (the default);
+    - ``poly>matrix``, ``mlp>matrix``: the temperature model (polynomial or network, with lag/hysteresis as
+      chosen) first, then G on its output;
+    - ``matrix>poly``: G first (no temperature model), then the temperature model on its output;
+    - ``joint-mlp``: one network with the (lagged) temperature and the three accelerations as inputs.
+    """
+    if isinstance(recordings, Recording):
+        recordings = [recordings]
+    recordings = list(recordings)
+    if pipeline not in PIPELINES:
+        raise InputError(f"--pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
+    options = dict(options)
+    if pipeline == "joint":
+        return fit_calibration(recordings, **options)
+    acceleration = options.pop("acceleration", "auto")
+    accel_mode = "matrix" if acceleration in ("auto", "none") else acceleration
+    min_static = options.get("static_min_duration_s", 10.0)
+    if pipeline == "joint-mlp":
+        options["temperature"] = options.get("temperature") if isinstance(options.get("temperature"), tuple) else "mlp"
+        cal = fit_calibration(recordings, acceleration=accel_mode, network_inputs=NETWORK_INPUTS, **options)
+        return dataclasses.replace(cal, model=f"joint-mlp: {cal.model}", fit_report={**cal.fit_report,
+                                                                                      "pipeline": pipeline})
+    if pipeline in ("poly>matrix", "mlp>matrix"):
+        if pipeline == "mlp>matrix" and not isinstance(options.get("temperature"), tuple):
+            options["temperature"] = "mlp"
+        first = fit_calibration(recordings, acceleration="none", **options)
+        second = fit_calibration(_residual_runs(first, recordings), temperature=None, acceleration=accel_mode,
+                                 static_min_duration_s=min_static)
+        return _chain(first, second, recordings, pipeline)
+    first = fit_calibration(recordings, temperature=None, acceleration=accel_mode, static_min_duration_s=min_static)
+    second = fit_calibration(_residual_runs(first, recordings), acceleration="none", **options)
+    return _chain(first, second, recordings, pipeline)
+
+
+__all__ = ["PIPELINES", "fit_calibration", "fit_pipeline"]
