@@ -146,3 +146,13 @@ def test_a_lag_model_needs_the_stream_rate(both_effects):
     cal = both_effects[0]
     with pytest.raises(InputError, match=r"<stream>: the model has thermal lag; give the stream's sample rate"):
         Compensator(cal, ("gyro_z",))
+
+
+def test_the_band_is_found_in_the_data_when_not_given():
+    cal, _, vs_perfect, cubic_over_chosen = _experiment(preset_model("adxrs450"))
+    ax = cal.axes["gyro_z"]
+    lo, hi = ax.hysteresis.band_degc
+    # the preset's hysteresis lives between 55 and 80 degC on cooling (zero at both ends)
+    assert 50 < lo < 60 and 72 < hi <= 80.5
+    assert ax.lag_time_constant_s == pytest.approx(60.0, rel=0.25)
+    assert vs_perfect < 1.35 and cubic_over_chosen > 2.0

@@ -266,6 +266,61 @@ class _Problem:
             wsum += float(np.sum(smooth_w))
         return math.sqrt(sse / wsum)
 
+    def observed_band(self, order: int) -> tuple[float, float] | None:
+        """The temperature band where the branches after a reversal part from the others, from the residual
+        of the polynomial alone; None when no band stands out or it spans most of the range.
+
+        Per temperature bin (span / 40, at least 1 degC), the mean residual on branches after a confirmed
+        reversal minus the mean on the opposite-direction branches; bins where that difference exceeds
+        three standard errors and 30 % of its largest value, contiguous around the largest, are the band.
+        """
+        spec = _Spec(order, False, 0)
+        which = list(range(len(self.runs)))
+        coef, consts, _, (t_lo, t_hi) = self.solve(spec, 0.0, which)
+        temps, resid, after, rising = [], [], [], []
+        for k, run in enumerate(self.runs):
+            t = run.temperature_degc
+            e = run.value_dps - self.features(run, t, spec, t_lo, t_hi) @ coef - consts[k]
+            turns = find_turns(t, self.threshold)
+            temps.append(t)
+            resid.append(e)
+            after.append(~np.isnan(turns.turn_degc))
+            rising.append(turns.direction)
+        t, e, after, d = map(np.concatenate, (temps, resid, after, rising))
+        width = max(1.0, (t.max() - t.min()) / 40.0)
+        edges = np.arange(t.min(), t.max() + width, width)
+        best = None
+        for direction in (-1, 1):
+            hit = after & (d == direction)
+            ref = d == -direction
+            diff, se = np.full(edges.size - 1, np.nan), np.full(edges.size - 1, np.inf)
+            for b in range(edges.size - 1):
+                inside = (t >= edges[b]) & (t < edges[b + 1])
+                h, r = e[inside & hit], e[inside & ref]
+                if h.size >= 3 and r.size >= 3:
+                    diff[b] = h.mean() - r.mean()
+                    se[b] = math.sqrt(h.var() / h.size + r.var() / r.size)
+            if np.all(np.isnan(diff)):
+                continue
+            peak = int(np.nanargmax(np.abs(diff)))
+            if best is None or abs(diff[peak]) > best[0]:
+                best = (abs(diff[peak]), diff, se, peak)
+        if best is None:
+            return None
+        top, diff, se, peak = best
+        strong = (np.abs(np.nan_to_num(diff)) > 3 * se) & (np.abs(np.nan_to_num(diff)) > 0.3 * top)
+        if not strong[peak]:
+            return None
+        a = b = peak
+        while a > 0 and strong[a - 1]:
+            a -= 1
+        while b < strong.size - 1 and strong[b + 1]:
+            b += 1
+        covered = np.count_nonzero(~np.isnan(diff))
+        if b - a + 1 >= 0.8 * covered:
+            return None
+        return float(edges[a]), float(edges[b + 1])
+
     def covariance(self, spec: _Spec, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """Coefficients (run constants first) and their cluster-robust covariance: the sandwich estimator
         with the static segments (or stretches) of each run as clusters, since the noise within a
@@ -319,6 +374,8 @@ class ThermalHysteresisModel:
         Order of the turning-point polynomial (1..3), or chosen by the same validation.
     band_degc : (lo, hi), optional
         Limit the hysteresis to this temperature band [degC] (the ADXRS450 shows it only from 55 to 80).
+        Without it, the band where the branches visibly part (:meth:`_Problem.observed_band`) is tried
+        against no band, and the validation keeps the better.
     block_s : float
         Length of the block means the fit works on [s].
     bin_width_degc : float, optional
@@ -347,6 +404,8 @@ class ThermalHysteresisModel:
         Fitted G row and its cluster-robust standard error [deg/s/g] (0 and NaN for axes not excited).
     g_squared_dps_per_g2_, g_squared_se_dps_per_g2_ : dict[str, np.ndarray (6,)]
         The g x g terms in the order of ``gyrocomp.effects.G_SQUARED_TERMS`` (``matrix2`` only).
+    bands_ : dict[str, tuple or None]
+        The hysteresis band used per axis [degC] (given, found in the data, or None).
     excited_axes_ : tuple of str
         Accelerometer axes the positions excite (within-run spread above ``EXCITATION_G``).
     segments_ : list of list of StaticSegment
@@ -391,6 +450,7 @@ class ThermalHysteresisModel:
             raise InputError(f"--acceleration: {self.acceleration!r}; use one of {', '.join(ACCELERATION_CHOICES)}")
         self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
         self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
+        self.bands_ = {}
         self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
         self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
         axes = recordings[0].gyro_axes
@@ -413,10 +473,23 @@ class ThermalHysteresisModel:
             best_spec: dict[str, _Spec] = {}
             order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
             score = problem.held_out_error if n_runs >= 2 else problem.bic
+            band = self.band_degc
+            found = None
+            if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates()):
+                found = problem.observed_band(order)
+            bands: dict[str, tuple[float, float] | None] = {}
             for name in self._candidates():
                 # candidates compared at hysteresis order 2 (the thesis's); the winner's order is validated after
                 best_spec[name] = self._spec(name, order)
                 scores[name] = math.nan if self.selection_ == "fixed" else score(best_spec[name])
+                bands[name] = band
+                if found is not None and "turning-point" in name:
+                    # the band the data shows, tried against none: the data chooses
+                    problem.band = found
+                    with_band = score(best_spec[name])
+                    problem.band = band
+                    if with_band < scores[name]:
+                        scores[name], bands[name] = with_band, found
             if len(scores) == 1:
                 chosen = next(iter(scores))
             else:
@@ -435,6 +508,8 @@ class ThermalHysteresisModel:
                 pick = min(p for p, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
                 best_spec[chosen] = self._spec(chosen, order, pick)
                 scores[chosen] = tried[pick]
+            problem.band = bands.get(chosen, band)
+            self.bands_[axis] = problem.band
             spec = best_spec[chosen]
             if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
                 # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
@@ -452,7 +527,7 @@ class ThermalHysteresisModel:
             p = spec.hysteresis_order
             self.hysteresis_[axis] = None if not p else HysteresisCurve(
                 tuple(float(v) for v in coef[spec.order: spec.order + p]),
-                tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), threshold, self.band_degc)
+                tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), threshold, problem.band)
             self.turn_on_biases_dps_[axis] = consts
             self.chosen_[axis] = chosen if not p else f"{chosen} (order {p})"
             self.scores_[axis] = scores
