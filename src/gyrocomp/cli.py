@@ -555,6 +555,38 @@ def print_noise(analysis: NoiseAnalysis) -> None:
     console.print(table)
 
 
+# -- export -----------------------------------------------------------------------------------------
+EXPORT_FORMATS = ("px4", "ardupilot")
+
+
+@cli.command()
+@click.argument("model", type=click.Path())
+@click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), required=True,
+              help="px4 (TC_G* parameters, QGroundControl .params) or ardupilot (INS_TCAL* parameters).")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Parameter file to write.")
+@click.option("--instance", type=int, default=None, help="Sensor instance: PX4 gyro 0..3 (default 0), ArduPilot IMU 1..3 "
+                                                       "(default 1).")
+@click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id (TC_G*_ID).")
+@click.pass_context
+def export(ctx, model, fmt, output, instance, device_id):
+    """Write MODEL as the thermal-calibration parameters of an autopilot (the temperature cubic only)."""
+    from .export.autopilot import ardupilot_params_file, px4_params_file
+
+    refuse_to_overwrite_inputs(output, [model])
+    calibration = Calibration.load(model)
+    if fmt == "px4":
+        text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)
+    else:
+        text = ardupilot_params_file(calibration, instance=1 if instance is None else instance)
+    write_text_atomic(output, text)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}")
+        for line in text.splitlines()[1:]:
+            if not line.startswith("#"):
+                break
+            click.echo(line.lstrip("# "))
+
+
 # -- demo -------------------------------------------------------------------------------------------
 @cli.command()
 @click.option("-o", "--output", "out_dir", default="gyrocomp-demo", show_default=True,

@@ -1,5 +1,7 @@
 """Calibrations and noise figures out, in the formats other tools read."""
 
+from .autopilot import ardupilot_parameters, ardupilot_params_file, px4_parameters, px4_params_file
 from .kalibr import KalibrImu, kalibr_imu, kalibr_imu_yaml
 
-__all__ = ["KalibrImu", "kalibr_imu", "kalibr_imu_yaml"]
+__all__ = ["KalibrImu", "ardupilot_parameters", "ardupilot_params_file", "kalibr_imu", "kalibr_imu_yaml",
+           "px4_parameters", "px4_params_file"]

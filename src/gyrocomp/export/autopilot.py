@@ -1,0 +1,168 @@
+"""PX4 and ArduPilot thermal-calibration parameters from a gyrocomp model.
+
+Both autopilots correct the gyro bias with a cubic in temperature, in rad/s, and nothing else:
+
+- PX4 (``src/lib/temperature_compensation``, parameters ``TC_G{i}_*``): offset = X0 + X1 d + X2 d^2 + X3 d^3
+  with d = clip(T, TMIN, TMAX) - TREF, and corrected = (raw - offset) * SCL.
+- ArduPilot (``AP_InertialSensor_tempcal.cpp``, parameters ``INS_TCAL{n}_*``): P(d) = (c1 + (c2 + c3 d) d) d
+  * 1e-6 with d = clip(T, TMIN, TMAX) - 35 degC, and corrected = raw - P(T) + P(T_cal), T_cal being the
+  temperature at which the ordinary gyro offsets were taken (the bias at T_cal is theirs to remove).
+
+gyrocomp's temperature curve (a polynomial of any order, or a network) is converted to that cubic by
+least squares on a dense grid over the model's range; the largest difference is reported, and is zero
+(to rounding) for polynomials of order 3 or less. Thermal lag, hysteresis and g-sensitivity have no
+place in either autopilot: they are left out with a warning that says how much correction is lost.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..calibration import AxisCalibration, Calibration
+from ..errors import DataQualityWarning, InputError
+
+DEG_TO_RAD = math.pi / 180.0
+ARDUPILOT_TEMP_REFERENCE_DEGC = 35.0
+ARDUPILOT_SCALE = 1.0e6
+AXIS_INDEX = {"gyro_x": 0, "gyro_y": 1, "gyro_z": 2}
+GRID_POINTS = 401
+
+
+@dataclass(frozen=True)
+class CubicFit:
+    """One axis's temperature curve as a cubic in d = T - reference [rad/s per degC^k], and how far it is
+    from gyrocomp's curve over [t_min, t_max] [deg/s]."""
+
+    coefficients_rad_per_s: tuple[float, float, float, float]  # X0..X3
+    reference_degc: float
+    t_min_degc: float
+    t_max_degc: float
+    max_error_dps: float
+
+
+def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool) -> CubicFit:
+    """Least-squares cubic of an axis's bias (shape plus mean turn-on constant) in d = T - reference."""
+    curve = axis.temperature
+    if curve is None:
+        raise InputError("export: the model has no temperature curve on this axis; fit one (--temperature poly)")
+    t = np.linspace(curve.t_min_degc, curve.t_max_degc, GRID_POINTS)
+    bias_dps = np.asarray(curve.shape_dps(t), dtype=float) + (axis.mean_turn_on_bias_dps if with_constant else 0.0)
+    d = t - reference_degc
+    powers = np.column_stack([d ** k for k in (range(4) if with_constant else range(1, 4))])
+    target = bias_dps if with_constant else bias_dps - np.asarray(curve.shape_dps(np.array([reference_degc]))[0])
+    coef, *_ = np.linalg.lstsq(powers, target, rcond=None)
+    error = float(np.max(np.abs(powers @ coef - target)))
+    full = tuple(float(c) for c in coef) if with_constant else (0.0, *map(float, coef))
+    return CubicFit(tuple(c * DEG_TO_RAD for c in full), reference_degc, curve.t_min_degc, curve.t_max_degc, error)
+
+
+def _warn_left_out(calibration: Calibration, target: str) -> None:
+    parts = []
+    if any(ax.lag_time_constant_s > 0 for ax in calibration.axes.values()):
+        parts.append("thermal lag")
+    if calibration.has_hysteresis:
+        parts.append("hysteresis")
+    if any(ax.needs_accel for ax in calibration.axes.values()):
+        parts.append("g-sensitivity")
+    if parts:
+        warnings.warn(f"{target} has no {' or '.join(parts)} term: left out of the export, only the temperature cubic "
+                      "is written (compare with `gyrocomp evaluate --stages` to see what that costs)",
+                      DataQualityWarning, stacklevel=3)
+
+
+def _gyro_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
+    axes = {name: ax for name, ax in calibration.axes.items() if name in AXIS_INDEX and ax.temperature is not None}
+    if not axes:
+        raise InputError("export: the model has no gyro axis with a temperature curve; nothing to export")
+    return axes
+
+
+@dataclass(frozen=True)
+class AutopilotParameters:
+    """Parameter names and values, and the cubic fit of each axis."""
+
+    values: dict[str, float]
+    fits: dict[str, CubicFit]
+
+
+def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: int = 0) -> AutopilotParameters:
+    """``TC_G{instance}_*`` for PX4: TREF is the middle of the model's range, SCL 1, axes not in the model 0."""
+    if not 0 <= instance <= 3:
+        raise InputError(f"--instance: PX4 has thermal compensation for gyros 0..3, got {instance}")
+    _warn_left_out(calibration, "PX4")
+    axes = _gyro_axes(calibration)
+    t_min = min(ax.temperature.t_min_degc for ax in axes.values())
+    t_max = max(ax.temperature.t_max_degc for ax in axes.values())
+    t_ref = 0.5 * (t_min + t_max)
+    p = f"TC_G{instance}_"
+    values: dict[str, float] = {"TC_G_ENABLE": 1, f"{p}ID": int(device_id), f"{p}TMIN": t_min, f"{p}TMAX": t_max,
+                                f"{p}TREF": t_ref}
+    fits = {}
+    for name, j in AXIS_INDEX.items():
+        fit = cubic_of(axes[name], t_ref, with_constant=True) if name in axes else None
+        coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
+        for k in range(4):
+            values[f"{p}X{k}_{j}"] = coef[k]
+        values[f"{p}SCL_{j}"] = 1.0
+        if fit:
+            fits[name] = fit
+    return AutopilotParameters(values, fits)
+
+
+def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> AutopilotParameters:
+    """``INS_TCAL{instance}_*`` for ArduPilot: cubic without constant about 35 degC, coefficients x 1e6."""
+    if not 1 <= instance <= 3:
+        raise InputError(f"--instance: ArduPilot numbers its IMUs 1..3, got {instance}")
+    _warn_left_out(calibration, "ArduPilot")
+    axes = _gyro_axes(calibration)
+    t_min = min(ax.temperature.t_min_degc for ax in axes.values())
+    t_max = max(ax.temperature.t_max_degc for ax in axes.values())
+    p = f"INS_TCAL{instance}_"
+    values: dict[str, float] = {f"{p}ENABLE": 1, f"{p}TMIN": t_min, f"{p}TMAX": t_max}
+    fits = {}
+    for name, j in AXIS_INDEX.items():
+        fit = cubic_of(axes[name], ARDUPILOT_TEMP_REFERENCE_DEGC, with_constant=False) if name in axes else None
+        coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
+        for k in (1, 2, 3):
+            values[f"{p}GYR{k}_{'XYZ'[j]}"] = coef[k] * ARDUPILOT_SCALE
+        if fit:
+            fits[name] = fit
+    return AutopilotParameters(values, fits)
+
+
+def _header(calibration: Calibration, params: AutopilotParameters, target: str, comment: str) -> list[str]:
+    lines = [f"{comment} {target} thermal calibration written by gyrocomp from model {calibration.model!r}",
+             f"{comment} gyro bias as a cubic in temperature [rad/s]; largest difference from the gyrocomp model over "
+             "its range:"]
+    for name, fit in params.fits.items():
+        lines.append(f"{comment}   {name}: {fit.max_error_dps:.3g} deg/s over {fit.t_min_degc:.2f}..{fit.t_max_degc:.2f} degC")
+    return lines
+
+
+def px4_params_file(calibration: Calibration, **options) -> str:
+    """A QGroundControl parameter file (vehicle 1, component 1; type 6 = int32, 9 = float32)."""
+    params = px4_parameters(calibration, **options)
+    lines = _header(calibration, params, "PX4", "#")
+    lines.append("# Vehicle-Id Component-Id Name Value Type")
+    for name, value in params.values.items():
+        integer = name == "TC_G_ENABLE" or name.endswith("_ID")
+        lines.append(f"1\t1\t{name}\t{int(value) if integer else format(np.float32(value), '.9g')}\t{6 if integer else 9}")
+    return "\n".join(lines) + "\n"
+
+
+def ardupilot_params_file(calibration: Calibration, **options) -> str:
+    """An ArduPilot parameter file (``NAME VALUE`` per line, as MAVProxy and Mission Planner load)."""
+    params = ardupilot_parameters(calibration, **options)
+    lines = _header(calibration, params, "ArduPilot", "#")
+    lines.append("# the correction is relative to INS_GYR_CALTEMP: the gyro offsets taken at boot remove the bias there")
+    for name, value in params.values.items():
+        lines.append(f"{name} {int(value)}" if name.endswith("ENABLE") else f"{name} {float(value):.9g}")
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["AutopilotParameters", "CubicFit", "ardupilot_parameters", "ardupilot_params_file", "cubic_of",
+           "px4_parameters", "px4_params_file"]

@@ -1,0 +1,120 @@
+"""PX4 and ArduPilot parameters: each autopilot's own correction formula, written out here from its
+source (PX4 temperature_compensation, ArduPilot AP_InertialSensor_tempcal.cpp), must reproduce gyrocomp's."""
+
+import math
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import fit_calibration
+from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
+from gyrocomp.simulate import GyroErrorModel, simulate
+from tests.test_cli import run
+
+RAD_TO_DEG = 180.0 / math.pi
+
+
+def _model(order):
+    truth = GyroErrorModel(bias_instability_deg_per_h=2.0)
+    runs = [simulate(truth, profile="chamber", duration_s=3600, rate_hz=5, seed=s).recording for s in range(3)]
+    return fit_calibration(runs, temperature=order, hysteresis="none")
+
+
+def _read_px4(text):
+    values = {}
+    for line in text.splitlines():
+        if line.startswith("#"):
+            continue
+        _, _, name, value, kind = line.split("\t")
+        values[name] = int(value) if kind == "6" else float(value)
+    return values
+
+
+def px4_offset_rad_s(p, instance, axis, temperature):
+    """PX4: offset = X0 + X1 d + X2 d^2 + X3 d^3, d = clip(T, TMIN, TMAX) - TREF."""
+    g = f"TC_G{instance}_"
+    d = np.clip(temperature, p[g + "TMIN"], p[g + "TMAX"]) - p[g + "TREF"]
+    return sum(p[f"{g}X{k}_{axis}"] * d ** k for k in range(4))
+
+
+def _read_ardupilot(text):
+    return {name: float(value) for name, value in (line.split() for line in text.splitlines() if not line.startswith("#"))}
+
+
+def ardupilot_correction_rad_s(p, instance, axis, temperature, cal_temp):
+    """ArduPilot: v -= P(T - 35) - P(T_cal - 35), P(d) = (c1 + (c2 + c3 d) d) d * 1e-6, T clamped to TMIN..TMAX."""
+    g = f"INS_TCAL{instance}_"
+    c = [p[f"{g}GYR{k}_{'XYZ'[axis]}"] for k in (1, 2, 3)]
+
+    def poly(t):
+        d = np.clip(t, p[g + "TMIN"], p[g + "TMAX"]) - 35.0
+        return (c[0] + (c[1] + c[2] * d) * d) * d * 1e-6
+
+    return poly(temperature) - poly(cal_temp)
+
+
+@pytest.mark.parametrize("order, tolerance_dps", [(3, 1e-6), (5, None)])
+def test_px4_formula_reproduces_the_model(order, tolerance_dps):
+    cal = _model(order)
+    text = px4_params_file(cal, instance=1, device_id=1311244)
+    p = _read_px4(text)
+    assert p["TC_G_ENABLE"] == 1 and p["TC_G1_ID"] == 1311244 and p["TC_G1_SCL_2"] == 1.0
+    t = np.linspace(-30, 80, 500)  # beyond the range on both sides: both clamp
+    for name, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
+        ax = cal.axes[name]
+        ours = ax.temperature.shape_dps(t) + ax.mean_turn_on_bias_dps
+        theirs = px4_offset_rad_s(p, 1, j, t) * RAD_TO_DEG
+        stated = float(re.search(rf"{name}: ([\d.e+-]+) deg/s", text).group(1))
+        # float32 parameters: about 1e-7 relative on coefficients of up to ~0.05 deg/s over the range
+        assert np.max(np.abs(theirs - ours)) <= (tolerance_dps or stated) + 1e-6
+        if order == 5:
+            assert stated < 0.2 * np.ptp(ours)  # a cubic is close, and the file says how close
+
+
+def test_ardupilot_formula_reproduces_the_model_relative_to_the_calibration_temperature():
+    cal = _model(3)
+    text = ardupilot_params_file(cal, instance=2)
+    p = _read_ardupilot(text)
+    assert p["INS_TCAL2_ENABLE"] == 1 and "INS_TCAL2_GYR3_Z" in p
+    t = np.linspace(-30, 80, 500)
+    cal_temp = 22.0
+    for name, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
+        curve = cal.axes[name].temperature
+        ours = curve.shape_dps(t) - curve.shape_dps(np.array([cal_temp]))[0]
+        theirs = ardupilot_correction_rad_s(p, 2, j, t, cal_temp) * RAD_TO_DEG
+        np.testing.assert_allclose(theirs, ours, atol=1e-7)
+
+
+def test_terms_the_autopilots_lack_are_named():
+    runs = [simulate("adxrs450", profile="cycle", rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="lag")
+    with pytest.warns(DataQualityWarning, match="PX4 has no thermal lag term: left out of the export"):
+        text = px4_params_file(cal)
+    p = _read_px4(text)
+    assert p["TC_G0_X1_0"] == 0.0 and p["TC_G0_X1_2"] != 0.0  # the ADXRS450 preset is z only
+    with pytest.raises(InputError, match=r"--instance: ArduPilot numbers its IMUs 1..3, got 0"):
+        ardupilot_params_file(cal, instance=0)
+    with pytest.raises(InputError, match=r"--instance: PX4 has thermal compensation for gyros 0..3, got 7"):
+        px4_params_file(cal, instance=7)
+    flat = fit_calibration(runs, temperature=None)
+    with pytest.raises(InputError, match="export: the model has no gyro axis with a temperature curve"):
+        px4_params_file(flat)
+
+
+def test_cli_export(tmp_path):
+    _model(3).save(tmp_path / "m.json")
+    r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params", "--device-id", "7")
+    assert r.returncode == 0, r.stderr
+    assert "gyro_z:" in r.stdout and (tmp_path / "tc.params").read_text().count("TC_G0_X") == 12
+    r = run("export", tmp_path / "m.json", "--format", "ardupilot", "-o", tmp_path / "tc.parm")
+    assert r.returncode == 0, r.stderr
+    assert "INS_TCAL1_GYR1_X" in (tmp_path / "tc.parm").read_text()
+    r = run("export", tmp_path / "m.json", "--format", "c", "-o", tmp_path / "x.c")
+    assert r.returncode == 2 and "Invalid value for '--format'" in r.stderr
+    r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
+    assert r.returncode == 2 and "this is an input file" in r.stderr
