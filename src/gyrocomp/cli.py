@@ -556,24 +556,40 @@ def print_noise(analysis: NoiseAnalysis) -> None:
 
 
 # -- export -----------------------------------------------------------------------------------------
-EXPORT_FORMATS = ("px4", "ardupilot")
+EXPORT_FORMATS = ("px4", "ardupilot", "c")
 
 
 @cli.command()
 @click.argument("model", type=click.Path())
 @click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), required=True,
-              help="px4 (TC_G* parameters, QGroundControl .params) or ardupilot (INS_TCAL* parameters).")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Parameter file to write.")
+              help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters), "
+                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o).")
+@click.option("-o", "--output", required=True, type=click.Path(), help="Parameter file to write (c: a folder).")
+@click.option("--rate", "rate_hz", type=float, default=None,
+              help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")
 @click.option("--instance", type=int, default=None, help="Sensor instance: PX4 gyro 0..3 (default 0), ArduPilot IMU 1..3 "
                                                        "(default 1).")
 @click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id (TC_G*_ID).")
 @click.pass_context
-def export(ctx, model, fmt, output, instance, device_id):
-    """Write MODEL as the thermal-calibration parameters of an autopilot (the temperature cubic only)."""
+def export(ctx, model, fmt, output, rate_hz, instance, device_id):
+    """Write MODEL as autopilot thermal-calibration parameters (the temperature cubic only), or as C code."""
     from .export.autopilot import ardupilot_params_file, px4_params_file
 
     refuse_to_overwrite_inputs(output, [model])
     calibration = Calibration.load(model)
+    if fmt == "c":
+        from .export.c_code import c_sources
+
+        folder = Path(output)
+        if folder.exists() and not folder.is_dir():
+            raise InputError(f"-o {output}: --format c writes a folder (gyrocomp.h, gyrocomp.c); this is a file")
+        sources = c_sources(calibration, rate_hz=rate_hz)
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, text in sources.items():
+            write_text_atomic(folder / name, text)
+        if not ctx.obj["quiet"]:
+            click.echo(f"wrote {folder / 'gyrocomp.h'} and {folder / 'gyrocomp.c'}")
+        return
     if fmt == "px4":
         text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)
     else:

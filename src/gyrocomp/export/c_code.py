@@ -1,0 +1,236 @@
+"""The whole model as dependency-free C99 for firmware: ``gyrocomp.h`` and ``gyrocomp.c``.
+
+Interface (``gyrocomp_state`` is defined in the header, so callers allocate it; no dynamic memory)::
+
+    void gyrocomp_init(gyrocomp_state *s);
+    void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],
+                       double temperature, double out[3]);
+
+Units: t [s], gyro and out [deg/s] on x, y, z, accel [g] on x, y, z, temperature [degC]. Axes the model
+does not cover pass through unchanged. The code does what :class:`gyrocomp.Compensator` does, sample by
+sample and in the same order of operations: g-sensitivity, the temperature curve (polynomial or network)
+on the lagged temperature (the first-order-hold lag steps one nominal period per sample and bridges longer
+gaps exactly), the turning-point hysteresis, and the mean turn-on constant of the calibration runs.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..calibration import AxisCalibration, Calibration
+from ..errors import InputError
+from ..models.mlp import MLPBias, layer_shapes
+from ..models.temperature import PolynomialBias
+
+AXES = ("gyro_x", "gyro_y", "gyro_z")
+
+
+def _num(x: float) -> str:
+    if not math.isfinite(x):
+        raise InputError("export: the model holds a non-finite number; fit it again")
+    return repr(float(x))
+
+
+def _array(values) -> str:
+    return "{" + ", ".join(_num(v) for v in values) + "}"
+
+
+def _temperature_code(j: int, curve) -> list[str]:
+    """C statements setting `shape` for axis j from `tm` (model temperature) and `accel`."""
+    if curve is None:
+        return ["    shape = 0.0;"]
+    if isinstance(curve, PolynomialBias):
+        lines = [f"    {{ const double c[] = {_array(curve.coefficients_dps)};" if curve.coefficients_dps else "    {",
+                 f"      double u = (clip(tm, {_num(curve.t_min_degc)}, {_num(curve.t_max_degc)}) - "
+                 f"{_num(curve.t_ref_degc)}) / {_num(curve.t_scale_degc)};",
+                 "      shape = 0.0;"]
+        if curve.coefficients_dps:
+            lines.append(f"      for (int k = {len(curve.coefficients_dps) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
+        lines.append("    }")
+        return lines
+    if isinstance(curve, MLPBias):
+        return [f"    shape = net{j}(tm, accel) - net{j}_ref;"]
+    raise InputError(f"export: no C code for a {type(curve).__name__} temperature model")
+
+
+def _network_function(j: int, curve: MLPBias) -> list[str]:
+    shapes = layer_shapes(len(curve.inputs), curve.hidden)
+    lines = [f"static double net{j}(double tm, const double accel[3])", "{"]
+    values = []
+    for name in curve.inputs:
+        values.append("tm" if name == "temperature" else f"accel[{('accel_x', 'accel_y', 'accel_z').index(name)}]")
+    lines.append(f"    double a0[{len(curve.inputs)}];")
+    for i, (v, lo, hi) in enumerate(zip(values, curve.input_min, curve.input_max)):
+        if hi > lo:
+            lines.append(f"    a0[{i}] = 2.0 * (clip({v}, {_num(lo)}, {_num(hi)}) - {_num(lo)}) / {_num(hi - lo)} - 1.0;")
+        else:
+            lines.append(f"    a0[{i}] = 0.0;")
+    prev = "a0"
+    for k, ((rows, cols), flat) in enumerate(zip(shapes, curve.weights)):
+        last = k == len(shapes) - 1
+        lines.append(f"    static const double w{k}[{rows * cols}] = {_array(flat[: rows * cols])};")
+        lines.append(f"    static const double b{k}[{rows}] = {_array(flat[rows * cols:])};")
+        lines.append(f"    double a{k + 1}[{rows}];")
+        lines.append(f"    for (int r = 0; r < {rows}; ++r) {{")
+        lines.append("        double z = 0.0;")
+        lines.append(f"        for (int c = 0; c < {cols}; ++c) z += {prev}[c] * w{k}[r * {cols} + c];")
+        lines.append(f"        a{k + 1}[r] = {'z + b%d[r]' % k if last else 'tanh(z + b%d[r])' % k};")
+        lines.append("    }")
+        prev = f"a{k + 1}"
+    lines.append(f"    return {prev}[0] * {_num(curve.output_scale_dps)} + {_num(curve.output_mean_dps)};")
+    lines.append("}")
+    return lines
+
+
+def _hysteresis_code(j: int, ax: AxisCalibration) -> list[str]:
+    h = ax.hysteresis
+    if h is None:
+        return []
+    lines = [f"    turn_update(&s->turn[{j}], tm, {_num(h.threshold_degc)});",
+             f"    if (s->turn[{j}].has_turn) {{"]
+    band = "" if h.band_degc is None else f" && tm >= {_num(h.band_degc[0])} && tm <= {_num(h.band_degc[1])}"
+    for sign, coefs in ((-1, h.descending_dps), (1, h.ascending_dps)):
+        lines.append(f"        if (s->turn[{j}].direction == {sign}{band}) {{")
+        lines.append(f"            const double h[] = {_array(coefs)};")
+        lines.append(f"            double d = fabs(tm - s->turn[{j}].turn), off = 0.0;")
+        lines.append(f"            for (int k = {len(coefs) - 1}; k >= 0; --k) off = (off + h[k]) * d;")
+        lines.append("            shape += off;")
+        lines.append("        }")
+    lines.append("    }")
+    return lines
+
+
+def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict[str, str]:
+    """``{"gyrocomp.h": ..., "gyrocomp.c": ...}`` for the model; ``rate_hz`` [Hz] is needed with thermal lag."""
+    axes = {name: ax for name, ax in calibration.axes.items() if name in AXES}
+    if not axes:
+        raise InputError("export: the model has none of gyro_x, gyro_y, gyro_z")
+    if any(ax.temperature_column != "temperature" for ax in axes.values()):
+        raise InputError("export --format c: the model reads one temperature per axis; the C interface takes one")
+    if any(ax.lag_time_constant_s > 0 for ax in axes.values()) and not (rate_hz and rate_hz > 0):
+        raise InputError("export --format c: the model has thermal lag; give the data's sample rate with --rate HZ")
+    period = 1.0 / rate_hz if rate_hz else 0.0
+    header = f"""/* gyrocomp model {calibration.model!r}, generated by gyrocomp. C99, no dynamic memory.
+ * Units: t [s], gyro and out [deg/s], accel [g], temperature [degC]. Axes x, y, z. */
+#ifndef GYROCOMP_H
+#define GYROCOMP_H
+
+typedef struct {{
+    int started;         /* the lag filter starts in equilibrium on the first sample */
+    double last_input;   /* temperature of the previous sample [degC] */
+    double last_output;  /* lagged temperature of the previous sample [degC] */
+}} gyrocomp_lag;
+
+typedef struct {{
+    int direction;       /* +1 rising, -1 falling, 0 not yet known */
+    int has_turn;        /* a reversal has been confirmed */
+    double extreme;      /* running extreme of the current branch [degC] */
+    double turn;         /* temperature of the last reversal [degC] */
+    double low, high;    /* range seen while the direction is not known [degC] */
+}} gyrocomp_turn;
+
+typedef struct gyrocomp_state {{
+    int started;
+    double last_t;
+    gyrocomp_lag lag[3];
+    gyrocomp_turn turn[3];
+}} gyrocomp_state;
+
+void gyrocomp_init(gyrocomp_state *s);
+void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],
+                   double temperature, double out[3]);
+
+#endif
+"""
+    body = [f"/* gyrocomp model {calibration.model!r}, generated by gyrocomp. */",
+            "#include <math.h>", "#include \"gyrocomp.h\"", "",
+            "static inline double clip(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }", "",
+            f"static const double PERIOD_S = {_num(period)};", "",
+            "static inline void lag_coefficients(double step, double tau, double *a, double *b0, double *b1)",
+            "{",
+            "    double h = step / tau;",
+            "    *a = exp(-h);",
+            "    double g = -expm1(-h) / h;",
+            "    *b0 = 1.0 - g;",
+            "    *b1 = g - *a;",
+            "}", "",
+            "static inline double lag_update(gyrocomp_lag *l, double step, double u, double tau)",
+            "{",
+            "    if (!l->started) { l->started = 1; l->last_input = u; l->last_output = u; return u; }",
+            "    double a, b0, b1;",
+            "    lag_coefficients(step > 1.5 * PERIOD_S ? step : PERIOD_S, tau, &a, &b0, &b1);",
+            "    double y = step > 1.5 * PERIOD_S ? a * l->last_output + b0 * u + b1 * l->last_input",
+            "                                     : b0 * u + (a * l->last_output + b1 * l->last_input);",
+            "    l->last_input = u;",
+            "    l->last_output = y;",
+            "    return y;",
+            "}", "",
+            "static inline void turn_update(gyrocomp_turn *s, double x, double thr)",
+            "{",
+            "    if (s->direction == 0) {",
+            "        if (x < s->low) s->low = x;",
+            "        if (x > s->high) s->high = x;",
+            "        int up = x - s->low > thr, down = s->high - x > thr;",
+            "        if (down) { s->direction = -1; s->extreme = s->low; }",
+            "        else if (up) { s->direction = 1; s->extreme = s->high; }",
+            "        return;",
+            "    }",
+            "    double running = s->direction == 1 ? (x > s->extreme ? x : s->extreme) : (x < s->extreme ? x : s->extreme);",
+            "    double back = s->direction == 1 ? running - x : x - running;",
+            "    if (back > thr) { s->turn = running; s->has_turn = 1; s->direction = -s->direction; s->extreme = x; }",
+            "    else s->extreme = running;",
+            "}", ""]
+    for j, name in enumerate(AXES):
+        ax = axes.get(name)
+        if ax is not None and isinstance(ax.temperature, MLPBias):
+            body += _network_function(j, ax.temperature) + [f"static double net{j}_ref;", ""]
+    body += ["void gyrocomp_init(gyrocomp_state *s)", "{",
+             "    s->started = 0;", "    s->last_t = 0.0;",
+             "    for (int j = 0; j < 3; ++j) {",
+             "        s->lag[j].started = 0; s->lag[j].last_input = 0.0; s->lag[j].last_output = 0.0;",
+             "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
+             "        s->turn[j].turn = 0.0; s->turn[j].low = INFINITY; s->turn[j].high = -INFINITY;",
+             "    }"]
+    for j, name in enumerate(AXES):
+        ax = axes.get(name)
+        if ax is not None and isinstance(ax.temperature, MLPBias):
+            ref = list(ax.temperature.reference)
+            t_ref = ref[ax.temperature.inputs.index("temperature")] if "temperature" in ax.temperature.inputs else 0.0
+            acc = [ref[ax.temperature.inputs.index(a)] if a in ax.temperature.inputs else 0.0
+                   for a in ("accel_x", "accel_y", "accel_z")]
+            body.append(f"    {{ const double ref_accel[3] = {_array(acc)}; net{j}_ref = net{j}({_num(t_ref)}, ref_accel); }}")
+    body += ["}", "",
+             "void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],",
+             "                   double temperature, double out[3])", "{",
+             "    double step = s->started ? t - s->last_t : 0.0;",
+             "    s->started = 1;", "    s->last_t = t;",
+             "    for (int j = 0; j < 3; ++j) out[j] = gyro[j];",
+             "    double tm, shape;", "    (void)accel; (void)step; (void)tm; (void)shape;"]
+    for j, name in enumerate(AXES):
+        ax = axes.get(name)
+        if ax is None:
+            continue
+        body.append(f"    /* {name} */")
+        g, q = ax.g_sensitivity_dps_per_g, ax.g_squared_dps_per_g2
+        if g is not None or q is not None:
+            g = g or (0.0, 0.0, 0.0)
+            expr = f"accel[0] * {_num(g[0])} + accel[1] * {_num(g[1])} + accel[2] * {_num(g[2])}"
+            if q is not None:
+                products = ("accel[0] * accel[0]", "accel[1] * accel[1]", "accel[2] * accel[2]",
+                            "accel[0] * accel[1]", "accel[0] * accel[2]", "accel[1] * accel[2]")
+                expr = f"({expr}) + (" + " + ".join(f"{p} * {_num(c)}" for p, c in zip(products, q)) + ")"
+            body.append(f"    out[{j}] -= {expr};")
+        if ax.temperature is not None:
+            if ax.lag_time_constant_s > 0:
+                body.append(f"    tm = lag_update(&s->lag[{j}], step, temperature, {_num(ax.lag_time_constant_s)});")
+            else:
+                body.append("    tm = temperature;")
+            body += _temperature_code(j, ax.temperature)
+            body += _hysteresis_code(j, ax)
+            body.append(f"    out[{j}] -= shape;")
+        body.append(f"    out[{j}] -= {_num(ax.mean_turn_on_bias_dps)};")
+    body += ["}", ""]
+    return {"gyrocomp.h": header, "gyrocomp.c": "\n".join(body)}
+
+
+__all__ = ["c_sources"]

@@ -1,0 +1,121 @@
+"""The model as C: compiled with the system compiler, fed simulated runs sample by sample, and compared
+with gyrocomp apply to 1e-9."""
+
+import shutil
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import apply, fit_calibration
+from gyrocomp.errors import InputError
+from gyrocomp.export.c_code import c_sources
+from gyrocomp.models.pipelines import fit_pipeline
+from gyrocomp.simulate import get_profile, simulate
+from tests.test_cli import run
+
+DRIVER = r"""
+#include <stdio.h>
+#include "gyrocomp.h"
+int main(void) {
+    gyrocomp_state s;
+    gyrocomp_init(&s);
+    double t, g[3], a[3], temp, out[3];
+    while (scanf("%lf %lf %lf %lf %lf %lf %lf %lf", &t, &g[0], &g[1], &g[2], &a[0], &a[1], &a[2], &temp) == 8) {
+        gyrocomp_step(&s, t, g, a, temp, out);
+        printf("%.17g %.17g %.17g\n", out[0], out[1], out[2]);
+    }
+    return 0;
+}
+"""
+CC = shutil.which("cc") or shutil.which("gcc")
+pytestmark = pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+
+
+def _run_c(calibration, recording, tmp_path):
+    for name, text in c_sources(calibration, rate_hz=recording.rate_hz).items():
+        (tmp_path / name).write_text(text)
+    (tmp_path / "driver.c").write_text(DRIVER)
+    exe = tmp_path / "driver"
+    subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-o", str(exe), str(tmp_path / "driver.c"),
+                    str(tmp_path / "gyrocomp.c"), "-lm"], check=True, capture_output=True, text=True)
+    gyro = np.zeros((recording.n_samples, 3))
+    cols = {"gyro_x": 0, "gyro_y": 1, "gyro_z": 2}
+    for j, axis in enumerate(recording.gyro_axes):
+        gyro[:, cols[axis]] = recording.gyro_dps[:, j]
+    accel = recording.accel_g if recording.accel_g is not None else np.zeros((recording.n_samples, 3))
+    table = np.column_stack([recording.time_s, gyro, accel, recording.temperature_degc])
+    text = "\n".join(" ".join(repr(float(v)) for v in row) for row in table) + "\n"
+    done = subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True)
+    out = np.loadtxt(done.stdout.splitlines())
+    return out[:, [cols[a] for a in recording.gyro_axes]]
+
+
+def _compare(calibration, recording, tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ours = apply(calibration, recording).gyro_dps
+    theirs = _run_c(calibration, recording, tmp_path)
+    scale = np.maximum(np.abs(ours), 1.0)
+    assert np.max(np.abs(theirs - ours) / scale) < 1e-9
+
+
+def test_polynomial_lag_and_hysteresis(tmp_path):
+    prof = get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1)
+    runs = [simulate("adxrs450", profile=prof, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="turning-point+lag", hysteresis_band_degc=(55.0, 80.0))
+    assert cal.axes["gyro_z"].lag_time_constant_s > 0 and cal.axes["gyro_z"].hysteresis is not None
+    held = simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
+                                                     ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
+    _compare(cal, held, tmp_path)
+
+
+def test_g_sensitivity_with_time_gaps(tmp_path):
+    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, acceleration="matrix2")
+    held = simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=5).recording
+    assert held.gaps and cal.has_acceleration
+    _compare(cal, held, tmp_path)
+
+
+def test_joint_network_reading_temperature_and_accelerations(tmp_path):
+    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_pipeline(runs, "joint-mlp")
+    held = simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=5).recording
+    _compare(cal, held, tmp_path)
+
+
+def test_single_axis_model_passes_other_axes_through(tmp_path):
+    runs = [simulate("mti10", profile="chamber", duration_s=2000, rate_hz=2, seed=s).recording for s in range(2)]
+    cal = fit_calibration([r.take(slice(None)) for r in runs], temperature=2)
+    cal = type(cal)(axes={"gyro_y": cal.axes["gyro_y"]}, model=cal.model)
+    held = simulate("mti10", profile="chamber", duration_s=2000, rate_hz=2, seed=3).recording
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ours = apply(cal, held).gyro_dps
+    theirs = _run_c(cal, held, tmp_path)
+    np.testing.assert_array_equal(theirs[:, 0], held.gyro_dps[:, 0])
+    np.testing.assert_allclose(theirs, ours, rtol=1e-9, atol=1e-12)
+
+
+def test_lag_needs_the_rate_and_the_cli_writes_a_folder(tmp_path):
+    prof = get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1)
+    runs = [simulate("adxrs450", profile=prof, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="lag")
+    with pytest.raises(InputError, match="the model has thermal lag; give the data's sample rate with --rate HZ"):
+        c_sources(cal)
+    cal.save(tmp_path / "m.json")
+    r = run("export", tmp_path / "m.json", "--format", "c", "--rate", 1, "-o", tmp_path / "fw")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "fw" / "gyrocomp.h").read_text().count("typedef struct gyrocomp_state") == 1
+    r = run("export", tmp_path / "m.json", "--format", "c", "-o", tmp_path / "fw2")
+    assert r.returncode == 2 and "--rate HZ" in r.stderr
