@@ -114,7 +114,7 @@ def test_cli_export(tmp_path):
     r = run("export", tmp_path / "m.json", "--format", "ardupilot", "-o", tmp_path / "tc.parm")
     assert r.returncode == 0, r.stderr
     assert "INS_TCAL1_GYR1_X" in (tmp_path / "tc.parm").read_text()
-    r = run("export", tmp_path / "m.json", "--format", "c", "-o", tmp_path / "x.c")
+    r = run("export", tmp_path / "m.json", "--format", "simulink", "-o", tmp_path / "x.slx")
     assert r.returncode == 2 and "Invalid value for '--format'" in r.stderr
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and "this is an input file" in r.stderr
