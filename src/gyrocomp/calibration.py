@@ -25,7 +25,7 @@ from .models.thermal import HysteresisCurve
 from .recording import Recording
 
 FORMAT_NAME = "gyrocomp-calibration"
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 
 
 def _upgrade_1_to_2(d: dict) -> dict:
@@ -48,8 +48,18 @@ def _upgrade_2_to_3(d: dict) -> dict:
     return d
 
 
+def _upgrade_3_to_4(d: dict) -> dict:
+    """Schema 4 adds a network on the accelerations per axis (pipeline mlp>mlp-accel); schema 3 has none."""
+    d = dict(d)
+    if isinstance(d.get("axes"), dict):
+        d["axes"] = {name: {**ax, "acceleration_network": None} if isinstance(ax, dict) else ax
+                     for name, ax in d["axes"].items()}
+    d["schema_version"] = 4
+    return d
+
+
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
-UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3}
+UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4}
 UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
 
 
@@ -82,6 +92,8 @@ class AxisCalibration:
         This axis's row of the g-sensitivity matrix G, on accel_x, accel_y, accel_z [deg/s/g].
     g_squared_dps_per_g2 : 6 floats or None
         g x g sensitivity to the products xx, yy, zz, xy, xz, yz [deg/s/g^2].
+    acceleration_network : MLPBias or None
+        A network of the three accelerations (the second stage of the ``mlp>mlp-accel`` pipeline).
     """
 
     temperature: PolynomialBias | MLPBias | None
@@ -91,12 +103,18 @@ class AxisCalibration:
     hysteresis: HysteresisCurve | None = None
     g_sensitivity_dps_per_g: tuple[float, float, float] | None = None
     g_squared_dps_per_g2: tuple[float, ...] | None = None
+    acceleration_network: MLPBias | None = None
+
+    @property
+    def has_acceleration_stage(self) -> bool:
+        """Whether the axis has a g-sensitivity stage: G, g x g terms or an acceleration network."""
+        return (self.g_sensitivity_dps_per_g is not None or self.g_squared_dps_per_g2 is not None
+                or self.acceleration_network is not None)
 
     @property
     def needs_accel(self) -> bool:
-        """Whether the correction reads the accelerometer (a G row, g x g terms, or a network with accel inputs)."""
-        return (self.g_sensitivity_dps_per_g is not None or self.g_squared_dps_per_g2 is not None
-                or bool(getattr(self.temperature, "needs_accel", False)))
+        """Whether the correction reads the accelerometer (an acceleration stage, or a network with accel inputs)."""
+        return self.has_acceleration_stage or bool(getattr(self.temperature, "needs_accel", False))
 
     @property
     def has_memory(self) -> bool:
@@ -122,6 +140,7 @@ class AxisCalibration:
             "hysteresis": None if self.hysteresis is None else self.hysteresis.to_dict(),
             "g_sensitivity_dps_per_g": None if self.g_sensitivity_dps_per_g is None else list(self.g_sensitivity_dps_per_g),
             "g_squared_dps_per_g2": None if self.g_squared_dps_per_g2 is None else list(self.g_squared_dps_per_g2),
+            "acceleration_network": None if self.acceleration_network is None else self.acceleration_network.to_dict(),
         }
 
     @classmethod
@@ -138,6 +157,7 @@ class AxisCalibration:
             hysteresis=None if d["hysteresis"] is None else HysteresisCurve.from_dict(d["hysteresis"]),
             g_sensitivity_dps_per_g=_floats(d["g_sensitivity_dps_per_g"], 3, "g_sensitivity_dps_per_g"),
             g_squared_dps_per_g2=_floats(d["g_squared_dps_per_g2"], 6, "g_squared_dps_per_g2"),
+            acceleration_network=None if d["acceleration_network"] is None else MLPBias.from_dict(d["acceleration_network"]),
         )
 
 
@@ -165,7 +185,7 @@ class Calibration:
                 raise InputError(f"unknown part {part!r}; use any of {', '.join(known)}")
         changes = {}
         if "acceleration" in parts:
-            changes.update(g_sensitivity_dps_per_g=None, g_squared_dps_per_g2=None)
+            changes.update(g_sensitivity_dps_per_g=None, g_squared_dps_per_g2=None, acceleration_network=None)
         if "hysteresis" in parts:
             changes["hysteresis"] = None
         if "lag" in parts:
@@ -176,8 +196,7 @@ class Calibration:
     @property
     def has_acceleration(self) -> bool:
         """Whether some axis has a g-sensitivity stage (G or g x g) that ``without("acceleration")`` removes."""
-        return any(ax.g_sensitivity_dps_per_g is not None or ax.g_squared_dps_per_g2 is not None
-                   for ax in self.axes.values())
+        return any(ax.has_acceleration_stage for ax in self.axes.values())
 
     @property
     def has_hysteresis(self) -> bool:

@@ -85,6 +85,8 @@ class Compensator:
                     g = np.zeros(3) if ax.g_sensitivity_dps_per_g is None else np.asarray(ax.g_sensitivity_dps_per_g)
                     q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
                     out[:, j] -= g_sensitivity_offset(accel_g, g[None, :], q)[:, 0]
+                if ax.acceleration_network is not None:
+                    out[:, j] -= ax.acceleration_network.shape_dps(np.zeros(time_s.size), accel_g)
             if ax.temperature is None:
                 continue
             if temperature_degc is None:

@@ -119,3 +119,13 @@ def test_lag_needs_the_rate_and_the_cli_writes_a_folder(tmp_path):
     assert (tmp_path / "fw" / "gyrocomp.h").read_text().count("typedef struct gyrocomp_state") == 1
     r = run("export", tmp_path / "m.json", "--format", "c", "-o", tmp_path / "fw2")
     assert r.returncode == 2 and "--rate HZ" in r.stderr
+
+
+def test_temperature_network_then_acceleration_network(tmp_path):
+    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_pipeline(runs, "mlp>mlp-accel")
+    assert cal.axes["gyro_x"].acceleration_network is not None
+    held = simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=5).recording
+    _compare(cal, held, tmp_path)

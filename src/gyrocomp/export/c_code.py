@@ -53,9 +53,9 @@ def _temperature_code(j: int, curve) -> list[str]:
     raise InputError(f"export: no C code for a {type(curve).__name__} temperature model")
 
 
-def _network_function(j: int, curve: MLPBias) -> list[str]:
+def _network_function(name: str, curve: MLPBias) -> list[str]:
     shapes = layer_shapes(len(curve.inputs), curve.hidden)
-    lines = [f"static double net{j}(double tm, const double accel[3])", "{"]
+    lines = [f"static double {name}(double tm, const double accel[3])", "{", "    (void)tm; (void)accel;"]
     values = []
     for name in curve.inputs:
         values.append("tm" if name == "temperature" else f"accel[{('accel_x', 'accel_y', 'accel_z').index(name)}]")
@@ -180,10 +180,15 @@ void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const doub
             "    if (back > thr) { s->turn = running; s->has_turn = 1; s->direction = -s->direction; s->extreme = x; }",
             "    else s->extreme = running;",
             "}", ""]
+    networks = {}  # C function name -> network
     for j, name in enumerate(AXES):
         ax = axes.get(name)
         if ax is not None and isinstance(ax.temperature, MLPBias):
-            body += _network_function(j, ax.temperature) + [f"static double net{j}_ref;", ""]
+            networks[f"net{j}"] = ax.temperature
+        if ax is not None and ax.acceleration_network is not None:
+            networks[f"anet{j}"] = ax.acceleration_network
+    for fname, curve in networks.items():
+        body += _network_function(fname, curve) + [f"static double {fname}_ref;", ""]
     body += ["void gyrocomp_init(gyrocomp_state *s)", "{",
              "    s->started = 0;", "    s->last_t = 0.0;",
              "    for (int j = 0; j < 3; ++j) {",
@@ -191,14 +196,11 @@ void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const doub
              "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
              "        s->turn[j].turn = 0.0; s->turn[j].low = INFINITY; s->turn[j].high = -INFINITY;",
              "    }"]
-    for j, name in enumerate(AXES):
-        ax = axes.get(name)
-        if ax is not None and isinstance(ax.temperature, MLPBias):
-            ref = list(ax.temperature.reference)
-            t_ref = ref[ax.temperature.inputs.index("temperature")] if "temperature" in ax.temperature.inputs else 0.0
-            acc = [ref[ax.temperature.inputs.index(a)] if a in ax.temperature.inputs else 0.0
-                   for a in ("accel_x", "accel_y", "accel_z")]
-            body.append(f"    {{ const double ref_accel[3] = {_array(acc)}; net{j}_ref = net{j}({_num(t_ref)}, ref_accel); }}")
+    for fname, curve in networks.items():
+        ref = list(curve.reference)
+        t_ref = ref[curve.inputs.index("temperature")] if "temperature" in curve.inputs else 0.0
+        acc = [ref[curve.inputs.index(a)] if a in curve.inputs else 0.0 for a in ("accel_x", "accel_y", "accel_z")]
+        body.append(f"    {{ const double ref_accel[3] = {_array(acc)}; {fname}_ref = {fname}({_num(t_ref)}, ref_accel); }}")
     body += ["}", "",
              "void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],",
              "                   double temperature, double out[3])", "{",
@@ -220,6 +222,8 @@ void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const doub
                             "accel[0] * accel[1]", "accel[0] * accel[2]", "accel[1] * accel[2]")
                 expr = f"({expr}) + (" + " + ".join(f"{p} * {_num(c)}" for p, c in zip(products, q)) + ")"
             body.append(f"    out[{j}] -= {expr};")
+        if ax.acceleration_network is not None:
+            body.append(f"    out[{j}] -= anet{j}(0.0, accel) - anet{j}_ref;")
         if ax.temperature is not None:
             if ax.lag_time_constant_s > 0:
                 body.append(f"    tm = lag_update(&s->lag[{j}], step, temperature, {_num(ax.lag_time_constant_s)});")

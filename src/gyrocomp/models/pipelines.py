@@ -15,7 +15,7 @@ from ..recording import Recording
 import numpy as np
 
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from .mlp import DEFAULT_HIDDEN, NETWORK_INPUTS, MLPTemperatureModel
+from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_INPUTS, MLPTemperatureModel
 from .temperature import PolynomialBias, PolynomialTemperatureModel
 from .thermal import (
     ACCELERATION_CHOICES,
@@ -281,7 +281,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
 #: the named pipelines of ``gyrocomp fit --pipeline`` (thesis 2.8): stages left to right, each fitted on the
 #: output of the one before; ``joint`` is the default joint least-squares fit, ``joint-mlp`` one network
 #: reading the temperature and the three accelerations
-PIPELINES = ("joint", "poly>matrix", "matrix>poly", "mlp>matrix", "joint-mlp")
+PIPELINES = ("joint", "poly>matrix", "matrix>poly", "mlp>matrix", "mlp>mlp-accel", "joint-mlp")
 
 
 def _residual_runs(calibration: Calibration, recordings: list[Recording]) -> list[Recording]:
@@ -303,11 +303,41 @@ def _chain(first: Calibration, second: Calibration, recordings: list[Recording],
         consts = tuple(a.mean_turn_on_bias_dps + cb for cb in b.turn_on_biases_dps)
         axes[axis] = AxisCalibration(temp_stage.temperature, consts, temp_stage.temperature_column,
                                      temp_stage.lag_time_constant_s, temp_stage.hysteresis,
-                                     g_stage.g_sensitivity_dps_per_g, g_stage.g_squared_dps_per_g2)
+                                     g_stage.g_sensitivity_dps_per_g, g_stage.g_squared_dps_per_g2,
+                                     g_stage.acceleration_network)
     report = {"pipeline": name, "stages": [first.fit_report, second.fit_report],
               "acceleration": (first.fit_report if first.has_acceleration else second.fit_report).get("acceleration", {})}
     return Calibration(axes=axes, model=f"{name}: {first.model} > {second.model}", provenance=_provenance(recordings),
                        fit_report=report)
+
+
+def _fit_acceleration_network(recordings: list[Recording], options: dict, min_static: float) -> Calibration:
+    """A network of accel_x, accel_y, accel_z (and one constant per run) on the static segments of the runs."""
+    from ..static import static_segments
+
+    hidden = options["temperature"][1] if isinstance(options.get("temperature"), tuple) else DEFAULT_HIDDEN
+    network = MLPTemperatureModel(hidden=hidden, seed=options.get("mlp_seed", 0))
+    segments = [static_segments(rec, min_duration_s=min_static) for rec in recordings]
+    for rec in recordings:
+        if rec.accel_g is None:
+            raise InputError(f"{rec.source}: --pipeline mlp>mlp-accel needs accel_x, accel_y and accel_z columns")
+    axes = {}
+    for axis in recordings[0].gyro_axes:
+        t_in, y_in, w_in, a_in = [], [], [], []
+        for rec, segs in zip(recordings, segments):
+            pieces = [slice(g.start, g.stop) for g in segs] or None
+            blocks = block_means(rec, axis, NETWORK_BLOCK_S, 1e9, pieces)  # one temperature bin: equal weights
+            t_in.append(blocks.temperature_degc)
+            y_in.append(blocks.value_dps)
+            w_in.append(blocks.weight)
+            a_in.append(blocks.accel_g)
+        network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=0.0, accel_g=a_in, inputs=ACCEL_INPUTS)
+        axes[axis] = AxisCalibration(None, tuple(float(c) for c in network.turn_on_biases_dps_[axis]),
+                                     acceleration_network=network.curves_[axis])
+    report = {"acceleration": {"mode": "network", "hidden": list(hidden),
+                               "static_segments": [len(s) for s in segments]}}
+    return Calibration(axes=axes, model="mlp-accel:3-" + "-".join(map(str, hidden)) + "-1",
+                       provenance=_provenance(recordings), fit_report=report)
 
 
 def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint", **options) -> Calibration:
@@ -317,6 +347,8 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
     - ``poly>matrix``, ``mlp>matrix``: the temperature model (polynomial or network, with lag/hysteresis as
       chosen) first, then G on its output;
     - ``matrix>poly``: G first (no temperature model), then the temperature model on its output;
+    - ``mlp>mlp-accel``: the temperature network first, then a network of the three accelerations on its
+      output (thesis 2.7.2);
     - ``joint-mlp``: one network with the (lagged) temperature and the three accelerations as inputs.
     """
     if isinstance(recordings, Recording):
@@ -335,6 +367,12 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
         cal = fit_calibration(recordings, acceleration=accel_mode, network_inputs=NETWORK_INPUTS, **options)
         return dataclasses.replace(cal, model=f"joint-mlp: {cal.model}", fit_report={**cal.fit_report,
                                                                                       "pipeline": pipeline})
+    if pipeline == "mlp>mlp-accel":
+        if not isinstance(options.get("temperature"), tuple):
+            options["temperature"] = "mlp"
+        first = fit_calibration(recordings, acceleration="none", **options)
+        second = _fit_acceleration_network(_residual_runs(first, recordings), options, min_static)
+        return _chain(first, second, recordings, pipeline)
     if pipeline in ("poly>matrix", "mlp>matrix"):
         if pipeline == "mlp>matrix" and not isinstance(options.get("temperature"), tuple):
             options["temperature"] = "mlp"
