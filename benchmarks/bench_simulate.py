@@ -16,20 +16,11 @@ from __future__ import annotations
 import argparse
 import platform
 import resource
-import time
 
 import numpy as np
+from bench_apply import best_of  # run as a script from the repository root: benchmarks/ is on the path
 
 from gyrocomp.simulate import error_model, get_profile, simulate
-
-
-def best_of(repeat, func):
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        func()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:
