@@ -326,7 +326,7 @@ def _fit_acceleration_network(recordings: list[Recording], options: dict, min_st
         t_in, y_in, w_in, a_in = [], [], [], []
         for rec, segs in zip(recordings, segments):
             pieces = [slice(g.start, g.stop) for g in segs] or None
-            blocks = block_means(rec, axis, NETWORK_BLOCK_S, 1e9, pieces)  # one temperature bin: equal weights
+            blocks = block_means(rec, axis, NETWORK_BLOCK_S, math.inf, pieces)  # one temperature bin: equal weights
             t_in.append(blocks.temperature_degc)
             y_in.append(blocks.value_dps)
             w_in.append(blocks.weight)
