@@ -74,11 +74,13 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
                       DataQualityWarning, stacklevel=3)
 
 
-def _gyro_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
+def _gyro_axes(calibration: Calibration) -> tuple[dict[str, AxisCalibration], float, float]:
+    """The gyro axes with a temperature curve, and the temperature range they cover together [degC]."""
     axes = {name: ax for name, ax in calibration.axes.items() if name in AXIS_INDEX and ax.temperature is not None}
     if not axes:
         raise InputError("export: the model has no gyro axis with a temperature curve; nothing to export")
-    return axes
+    return (axes, min(ax.temperature.t_min_degc for ax in axes.values()),
+            max(ax.temperature.t_max_degc for ax in axes.values()))
 
 
 @dataclass(frozen=True)
@@ -94,9 +96,7 @@ def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: in
     if not 0 <= instance <= 3:
         raise InputError(f"--instance: PX4 has thermal compensation for gyros 0..3, got {instance}")
     _warn_left_out(calibration, "PX4")
-    axes = _gyro_axes(calibration)
-    t_min = min(ax.temperature.t_min_degc for ax in axes.values())
-    t_max = max(ax.temperature.t_max_degc for ax in axes.values())
+    axes, t_min, t_max = _gyro_axes(calibration)
     t_ref = 0.5 * (t_min + t_max)
     p = f"TC_G{instance}_"
     values: dict[str, float] = {"TC_G_ENABLE": 1, f"{p}ID": int(device_id), f"{p}TMIN": t_min, f"{p}TMAX": t_max,
@@ -118,9 +118,7 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
     if not 1 <= instance <= 3:
         raise InputError(f"--instance: ArduPilot numbers its IMUs 1..3, got {instance}")
     _warn_left_out(calibration, "ArduPilot")
-    axes = _gyro_axes(calibration)
-    t_min = min(ax.temperature.t_min_degc for ax in axes.values())
-    t_max = max(ax.temperature.t_max_degc for ax in axes.values())
+    axes, t_min, t_max = _gyro_axes(calibration)
     p = f"INS_TCAL{instance}_"
     values: dict[str, float] = {f"{p}ENABLE": 1, f"{p}TMIN": t_min, f"{p}TMAX": t_max}
     fits = {}

@@ -15,6 +15,7 @@ from ..recording import Recording
 import numpy as np
 
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
+from .base import bin_width_for
 from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_INPUTS, MLPTemperatureModel
 from .temperature import PolynomialBias, PolynomialTemperatureModel
 from .thermal import (
@@ -50,9 +51,7 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
                  segments=None, inputs: tuple[str, ...] = ("temperature",)):
     """Train the network on the block means of the runs, through the lag and without the hysteresis
     that the polynomial stage found (a cascade: the network replaces the polynomial shape)."""
-    temps = [rec.temperature_for(axis) for rec in recordings]
-    lo, hi = min(float(t.min()) for t in temps), max(float(t.max()) for t in temps)
-    width = bin_width_degc or max((hi - lo) / 100.0, 1e-3)
+    width = bin_width_for([rec.temperature_for(axis) for rec in recordings], bin_width_degc)
     block_s = max(NETWORK_BLOCK_S, 1.0 / recordings[0].rate_hz)
     t_in, y_in, w_in, a_in = [], [], [], []
     for r, rec in enumerate(recordings):

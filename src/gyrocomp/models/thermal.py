@@ -33,6 +33,7 @@ from scipy.optimize import minimize_scalar
 from ..effects import G_SQUARED_TERMS, find_turns, g_squared_products, hysteresis_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..recording import Recording
+from .base import bin_width_for
 from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
@@ -214,8 +215,9 @@ class _Problem:
             cols += [products[:, m] for m in self.square_cols]
         return np.column_stack(cols) if cols else np.zeros((temp.size, 0))
 
-    def solve(self, spec: _Spec, tau: float, which: list[int]):
-        """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range)."""
+    def design(self, spec: _Spec, tau: float, which: list[int]):
+        """The weighted least-squares problem on the runs ``which``: design matrix (one constant column per
+        run, then the features), values, weights, and the model-temperature range of those runs."""
         temps = [self.model_temperature(self.runs[r], spec, tau) for r in which]
         t_lo = min(float(t.min()) for t in temps)
         t_hi = max(float(t.max()) for t in temps)
@@ -228,10 +230,15 @@ class _Problem:
         x = np.hstack([np.vstack(onehots), np.vstack(feats)])
         y = np.concatenate([self.runs[r].value_dps for r in which])
         w = np.concatenate([self.runs[r].weight for r in which])
+        return x, y, w, (t_lo, t_hi)
+
+    def solve(self, spec: _Spec, tau: float, which: list[int]):
+        """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range)."""
+        x, y, w, t_range = self.design(spec, tau, which)
         sw = np.sqrt(w)
         coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
         rss = float(np.sum(w * (y - x @ coef) ** 2))
-        return coef[len(which):], coef[: len(which)], rss, (t_lo, t_hi)
+        return coef[len(which):], coef[: len(which)], rss, t_range
 
     def fit(self, spec: _Spec, which: list[int]):
         """Best tau for the spec (0 without lag) and the solution there."""
@@ -325,19 +332,10 @@ class _Problem:
         """Coefficients (run constants first) and their cluster-robust covariance: the sandwich estimator
         with the static segments (or stretches) of each run as clusters, since the noise within a
         segment is correlated (flicker) while different positions are close to independent."""
-        which = list(range(len(self.runs)))
-        temps = [self.model_temperature(self.runs[r], spec, tau) for r in which]
-        t_lo, t_hi = min(float(t.min()) for t in temps), max(float(t.max()) for t in temps)
-        xs, ys, ws, cl = [], [], [], []
-        for k, temp in enumerate(temps):
-            run = self.runs[k]
-            oh = np.zeros((temp.size, len(which)))
-            oh[:, k] = 1.0
-            xs.append(np.hstack([oh, self.features(run, temp, spec, t_lo, t_hi)]))
-            ys.append(run.value_dps)
-            ws.append(run.weight)
-            cl.append(run.cluster * len(which) + k if run.cluster is not None else np.full(temp.size, k))
-        x, y, w, clusters = np.vstack(xs), np.concatenate(ys), np.concatenate(ws), np.concatenate(cl)
+        n = len(self.runs)
+        x, y, w, _ = self.design(spec, tau, list(range(n)))
+        clusters = np.concatenate([run.cluster * n + k if run.cluster is not None else np.full(run.value_dps.size, k)
+                                   for k, run in enumerate(self.runs)])
         xtw = x.T * w
         bread = np.linalg.pinv(xtw @ x)
         coef = bread @ (xtw @ y)
@@ -462,7 +460,7 @@ class ThermalHysteresisModel:
             temps = [rec.temperature_for(axis) for rec in recordings]
             lo = min(float(t.min()) for t in temps)
             hi = max(float(t.max()) for t in temps)
-            width = self.bin_width_degc or max((hi - lo) / 100.0, 1e-3)
+            width = bin_width_for(temps, self.bin_width_degc)
             block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
             runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
             threshold = max(turn_threshold_degc(t) for t in temps)
