@@ -6,6 +6,7 @@ Exit status: 0 success, 2 bad input or usage, 1 other failures. Errors are one l
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import sys
@@ -16,6 +17,7 @@ from pathlib import Path
 import click
 import numpy as np
 from rich.console import Console
+from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from . import __version__
@@ -24,11 +26,13 @@ from .calibration import Calibration
 from .compensate import apply as apply_calibration
 from .errors import DataQualityWarning, GyrocompError, InputError
 from .io import (
+    FORMATS,
+    ReadOptions,
     TableLayout,
     detect_format,
-    detect_table_format,
     parse_column_mapping,
-    read_table,
+    output_format,
+    read_input,
     refuse_to_overwrite_inputs,
     write_gyro_back,
     write_recording,
@@ -58,8 +62,16 @@ def read_options(func):
         click.option("--gyro-unit", default="deg/s", show_default=True, help="deg/s, rad/s or mdps."),
         click.option("--accel-unit", default="g", show_default=True, help="g, mg or m/s2."),
         click.option("--time-unit", default="s", show_default=True, help="s, ms, us or ns."),
-        click.option("--format", "fmt", default=None, help="Input format (default: from the suffix): csv, parquet."),
+        click.option("--format", "fmt", default=None,
+                     help=f"Input format (default: told from the file): {', '.join(FORMATS)}."),
         click.option("--drop-nan", is_flag=True, help="Drop rows with empty/NaN values (says how many) instead of refusing the file."),
+        click.option("--instance", type=int, default=None,
+                     help="Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0)."),
+        click.option("--device-id", "device_id", type=int, default=None, help="PX4 device id of the gyro to read."),
+        click.option("--imu-topic", default=None, help="ROS bag: the sensor_msgs/Imu topic (default: the only one)."),
+        click.option("--temperature-topic", default=None,
+                     help="ROS bag: the sensor_msgs/Temperature topic (default: the only one)."),
+        click.option("--record", default=None, help="ArduPilot log: IMU (default) or TCLR (onboard learning records)."),
     ]
     for option in reversed(options):
         func = option(func)
@@ -70,13 +82,35 @@ def _layout(columns, gyro_unit, accel_unit, time_unit) -> TableLayout:
     return TableLayout(parse_column_mapping(columns), gyro_unit, accel_unit, time_unit)
 
 
+_READ_OPTIONS = ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan", "instance", "device_id",
+                 "imu_topic", "temperature_topic", "record")
+
+
+@contextlib.contextmanager
+def progress_bar(description: str):
+    """A progress callback drawing a bar on stderr when it is a terminal and --quiet is off; else None."""
+    ctx = click.get_current_context(silent=True)
+    quiet = bool(ctx and ctx.find_root().obj and ctx.find_root().obj.get("quiet"))
+    if quiet or not sys.stderr.isatty():
+        yield None
+        return
+    with Progress(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(), TimeElapsedColumn(),
+                  console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(description, total=1.0)
+        yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
+
+
 def _read(path, opts: dict):
     layout = _layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"])
-    return read_table(path, layout, fmt=detect_format(path, opts["fmt"]), drop_nonfinite=opts["drop_nan"])
+    options = ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=opts["instance"],
+                          device_id=opts["device_id"], imu_topic=opts["imu_topic"],
+                          temperature_topic=opts["temperature_topic"], record=opts["record"])
+    with progress_bar(f"reading {Path(path).name}") as progress:
+        return read_input(path, options, fmt=opts["fmt"], progress=progress)
 
 
 def _pop_read_options(kwargs: dict) -> dict:
-    return {k: kwargs.pop(k) for k in ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan")}
+    return {k: kwargs.pop(k) for k in _READ_OPTIONS}
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -147,7 +181,7 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
         raise click.BadParameter("must be at least 1", param_hint="--runs")
     prof = resolve_profile(profile, preset, set_points_degc=_float_list(set_points, "--set-points"),
                            ramp_rate_degc_per_min=ramp_rate, dwell_s=dwell_s, cycles=cycles, position_s=position_s)
-    detect_format(output)
+    output_format(output)
     out = Path(output)
     paths = [out] if runs == 1 else [out.with_name(f"{out.stem}_{i}{out.suffix}") for i in range(runs)]
     if truth and any(Path(truth).resolve() == p.resolve() for p in paths):
@@ -310,12 +344,36 @@ def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
     opts = _pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path, model])
     calibration = Calibration.load(model)
+    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
+    out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     data = _read(input_path, opts)
-    out_fmt = detect_table_format(Path(output)) or data.recording.metadata["format"]
     compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s)
     write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt)
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output}: {data.table.num_rows} rows, {', '.join(data.recording.gyro_axes)} compensated")
+
+
+# -- convert ----------------------------------------------------------------------------------------
+@cli.command()
+@click.argument("input_path", metavar="IN", type=click.Path())
+@click.argument("output", metavar="OUT", type=click.Path(dir_okay=False))
+@read_options
+@click.pass_context
+def convert(ctx, input_path, output, **kwargs):
+    """Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.
+
+    Columns: time [s], gyro_x/y/z [deg/s], accel_x/y/z [g], temperature [degC].
+    """
+    opts = _pop_read_options(kwargs)
+    refuse_to_overwrite_inputs(output, [input_path], option="OUT")
+    out_fmt = output_format(output, option="OUT")
+    recording = _read(input_path, opts).recording
+    write_recording(recording, output, fmt=out_fmt)
+    if not ctx.obj["quiet"]:
+        channels = [*recording.gyro_axes, *recording.accel_axes, *recording.temperature_columns]
+        gaps = f", {len(recording.gaps)} time gap(s)" if recording.gaps else ""
+        click.echo(f"wrote {output}: {recording.n_samples} rows, {recording.duration_s:.6g} s at "
+                   f"{recording.rate_hz:.6g} Hz{gaps}; {', '.join(channels)}")
 
 
 # -- evaluate ---------------------------------------------------------------------------------------

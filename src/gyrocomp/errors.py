@@ -27,3 +27,7 @@ class TemperatureRangeWarning(UserWarning):
 
 class DataQualityWarning(UserWarning):
     """Data was accepted but something about it deserves attention (rows dropped, gaps found)."""
+
+
+class MissingDependencyError(GyrocompError, ImportError):
+    """An optional package is needed for this (the message names the extra to install; CLI exit status 1)."""

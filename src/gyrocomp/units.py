@@ -17,6 +17,7 @@ GYRO_UNITS_TO_DPS = {
     "deg/s": 1.0,
     "dps": 1.0,
     "rad/s": 180.0 / math.pi,
+    "mrad/s": 0.18 / math.pi,
     "mdps": 1e-3,
     "deg/h": 1.0 / 3600.0,
 }

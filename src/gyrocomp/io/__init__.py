@@ -1,4 +1,9 @@
-"""Readers and writers. Every reader returns a :class:`gyrocomp.recording.Recording` in internal units."""
+"""Readers and writers. Every reader returns a :class:`gyrocomp.recording.Recording` in internal units.
+
+Formats: CSV and Parquet tables; PX4 ULog (extra ``[ulog]``); ArduPilot DataFlash (``[dataflash]``);
+ROS 1 / ROS 2 bags (``[ros]``); HDF5 / NetCDF-4 (``[hdf5]``). The format is told from the file's
+first bytes, then its suffix, and can be named instead.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +13,7 @@ from pathlib import Path
 from ..errors import InputError
 from ..recording import Recording
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
+from .common import ProgressCallback, ReadOptions
 from .tables import (
     TableData,
     TableLayout,
@@ -15,26 +21,102 @@ from .tables import (
     file_sha256,
     parse_column_mapping,
     read_table,
+    recording_table,
+    table_data,
     write_gyro_back,
     write_recording,
 )
 
-FORMATS = ("csv", "parquet")
+TABLE_FORMATS = ("csv", "parquet")
+LOG_FORMATS = ("ulog", "dataflash", "rosbag", "hdf5")
+FORMATS = TABLE_FORMATS + LOG_FORMATS
+#: aliases accepted by ``--format``
+FORMAT_ALIASES = {"ulg": "ulog", "px4": "ulog", "bin": "dataflash", "ardupilot": "dataflash", "bag": "rosbag",
+                  "ros": "rosbag", "netcdf": "hdf5", "nc": "hdf5", "h5": "hdf5", "pq": "parquet"}
+_SUFFIXES = {".ulg": "ulog", ".bin": "dataflash", ".bag": "rosbag", ".db3": "rosbag", ".mcap": "rosbag",
+             ".h5": "hdf5", ".hdf5": "hdf5", ".nc": "hdf5", ".nc4": "hdf5"}
+_MAGIC = ((b"ULog\x01\x12\x35", "ulog"), (b"\x89HDF\r\n\x1a\n", "hdf5"), (b"#ROSBAG", "rosbag"),
+          (b"\x89MCAP", "rosbag"), (b"PAR1", "parquet"), (b"\xa3\x95", "dataflash"))
+
+
+def sniff_format(head: bytes) -> str | None:
+    """The format a file's first bytes announce, or None (CSV has no signature)."""
+    for magic, fmt in _MAGIC:
+        if head.startswith(magic):
+            return fmt
+    return None
 
 
 def detect_format(path: str | os.PathLike, fmt: str | None = None) -> str:
-    """The format name of ``path``: ``fmt`` if given (checked), else from the file suffix."""
+    """The format name of ``path``: ``fmt`` if given (checked), else from its first bytes or suffix."""
     if fmt is not None:
-        if fmt not in FORMATS:
+        name = FORMAT_ALIASES.get(fmt.lower(), fmt.lower())
+        if name not in FORMATS:
             raise InputError(f"--format: unknown format {fmt!r}; use one of {', '.join(FORMATS)}")
-        return fmt
-    found = detect_table_format(Path(path))
+        return name
+    path = Path(path)
+    if path.is_dir():
+        if (path / "metadata.yaml").exists():
+            return "rosbag"
+        raise InputError(f"{path}: is a folder (not a ROS 2 bag: no metadata.yaml in it); name a file")
+    if path.is_file():
+        with open(path, "rb") as fh:
+            found = sniff_format(fh.read(16))
+        if found is not None:
+            return found
+    found = detect_table_format(path) or _SUFFIXES.get(path.suffix.lower())
     if found is None:
         raise InputError(
-            f"{path}: cannot tell the format from the suffix {Path(path).suffix!r}; "
+            f"{path}: cannot tell the format from the file or its suffix {path.suffix!r}; "
             f"name it with --format ({', '.join(FORMATS)})"
         )
     return found
+
+
+def output_format(path: str | os.PathLike, option: str = "-o", default: str | None = None) -> str:
+    """The table format an output path asks for by its suffix (``default`` when it names none)."""
+    found = detect_table_format(Path(path)) or default
+    if found not in TABLE_FORMATS:
+        raise InputError(f"{option} {path}: gyrocomp writes CSV or Parquet; name the file .csv or .parquet")
+    return found
+
+
+def _log_reader(fmt: str):
+    if fmt == "ulog":
+        from .ulog import read_ulog as reader
+    elif fmt == "dataflash":
+        from .dataflash import read_dataflash as reader
+    elif fmt == "rosbag":
+        from .rosbag import read_rosbag as reader
+    else:
+        from .hdf5 import read_hdf5 as reader
+    return reader
+
+
+def read_input(
+    path: str | os.PathLike,
+    options: ReadOptions | None = None,
+    *,
+    fmt: str | None = None,
+    progress: ProgressCallback | None = None,
+) -> TableData:
+    """Read any supported file, keeping what is needed to write results back.
+
+    Tables keep their own columns and units; logs become a table in the default layout
+    ([s], [deg/s], [g], [degC]).
+    """
+    options = options or ReadOptions()
+    fmt = detect_format(path, fmt)
+    if fmt in TABLE_FORMATS:
+        if not Path(path).exists():
+            raise InputError(f"{path}: no such file")
+        data = read_table(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite)
+        if progress:
+            progress(1.0)
+        return data
+    if not Path(path).exists():
+        raise InputError(f"{path}: no such file")
+    return table_data(_log_reader(fmt)(path, options, progress))
 
 
 def read(
@@ -43,23 +125,47 @@ def read(
     *,
     fmt: str | None = None,
     drop_nonfinite: bool = False,
+    progress: ProgressCallback | None = None,
+    **options,
 ) -> Recording:
-    """Read any supported file into a :class:`Recording` (see :func:`read_table` for options)."""
-    return read_table(path, layout, fmt=detect_format(path, fmt), drop_nonfinite=drop_nonfinite).recording
+    """Read any supported file into a :class:`Recording` [s, deg/s, g, degC].
+
+    Parameters
+    ----------
+    path : path
+        A CSV or Parquet table, PX4 ULog, ArduPilot DataFlash log, ROS bag, or HDF5/NetCDF-4 file.
+    layout : TableLayout, optional
+        Column mapping and units (tables, HDF5).
+    fmt : str, optional
+        The format (default: told from the file).
+    drop_nonfinite : bool
+        Drop rows with NaN or infinite values instead of refusing the file.
+    progress : callable, optional
+        Called with the fraction done.
+    **options
+        ``instance``, ``device_id``, ``imu_topic``, ``temperature_topic``, ``record``: see :class:`ReadOptions`.
+    """
+    read_options = ReadOptions(layout=layout or TableLayout(), drop_nonfinite=drop_nonfinite, **options)
+    return read_input(path, read_options, fmt=fmt, progress=progress).recording
 
 
 __all__ = [
     "FORMATS",
+    "ReadOptions",
     "TableData",
     "TableLayout",
     "atomic_path",
     "detect_format",
     "detect_table_format",
     "file_sha256",
+    "output_format",
     "parse_column_mapping",
     "read",
+    "read_input",
     "read_table",
+    "recording_table",
     "refuse_to_overwrite_inputs",
+    "sniff_format",
     "write_gyro_back",
     "write_recording",
     "write_text_atomic",

@@ -22,6 +22,8 @@ from .atomic import atomic_path
 TIME_COLUMN = "time"
 PER_AXIS_TEMPERATURES = tuple(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES)
 CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *PER_AXIS_TEMPERATURES)
+#: channels a mapping may name as one (n, 3) array, in formats that hold arrays (HDF5/NetCDF)
+ARRAY_CHANNELS = ("gyro", "accel")
 
 
 @dataclass(frozen=True)
@@ -44,9 +46,10 @@ class TableLayout:
 
     def __post_init__(self) -> None:
         for canonical in self.columns:
-            if canonical not in CANONICAL_COLUMNS:
+            if canonical not in CANONICAL_COLUMNS + ARRAY_CHANNELS:
                 raise InputError(
-                    f"--columns: unknown channel {canonical!r}; use any of {', '.join(CANONICAL_COLUMNS)}"
+                    f"--columns: unknown channel {canonical!r}; use any of {', '.join(CANONICAL_COLUMNS)} "
+                    f"(or {' and '.join(ARRAY_CHANNELS)} for an (n, 3) array in HDF5/NetCDF)"
                 )
         unit_factor("gyro", self.gyro_unit, "--gyro-unit")
         unit_factor("accel", self.accel_unit, "--accel-unit")
@@ -56,6 +59,11 @@ class TableLayout:
         """Canonical name to file column for every channel present in ``header``."""
         resolved = {name: name for name in CANONICAL_COLUMNS if name in header}
         for canonical, column in self.columns.items():
+            if canonical in ARRAY_CHANNELS:
+                raise InputError(
+                    f"{source}: --columns {canonical}={column}: a table has one column per axis; "
+                    f"map {canonical}_x=..., {canonical}_y=..., {canonical}_z=... instead"
+                )
             if column not in header:
                 raise InputError(
                     f"{source}: --columns {canonical}={column}: no column {column!r}; "
@@ -284,11 +292,8 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
     _write_arrow(table, path, fmt)
 
 
-def write_recording(recording: Recording, path: str | os.PathLike, *, fmt: str | None = None,
-                    extra_columns: dict[str, np.ndarray] | None = None) -> None:
-    """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically."""
-    path = Path(path)
-    fmt = fmt or detect_table_format(path) or "csv"
+def recording_table(recording: Recording, extra_columns: dict[str, np.ndarray] | None = None) -> pa.Table:
+    """A recording as a table in the default layout ([s], [deg/s], [g], [degC])."""
     columns: dict[str, np.ndarray] = {TIME_COLUMN: recording.time_s}
     for j, axis in enumerate(recording.gyro_axes):
         columns[axis] = recording.gyro_dps[:, j]
@@ -300,7 +305,21 @@ def write_recording(recording: Recording, path: str | os.PathLike, *, fmt: str |
             columns[name] = temps[:, j]
     for name, values in (extra_columns or {}).items():
         columns[name] = np.asarray(values, dtype=float)
-    _write_arrow(pa.table(columns), path, fmt)
+    return pa.table(columns)
+
+
+def table_data(recording: Recording) -> TableData:
+    """A recording read from a log, as table data in the default layout, so results can be written back."""
+    table = recording_table(recording)
+    return TableData(recording, table, TableLayout(), {name: name for name in table.column_names},
+                     np.arange(recording.n_samples), Path(recording.source))
+
+
+def write_recording(recording: Recording, path: str | os.PathLike, *, fmt: str | None = None,
+                    extra_columns: dict[str, np.ndarray] | None = None) -> None:
+    """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically."""
+    path = Path(path)
+    _write_arrow(recording_table(recording, extra_columns), path, fmt or detect_table_format(path) or "csv")
 
 
 __all__ = [
@@ -310,5 +329,7 @@ __all__ = [
     "read_table",
     "write_gyro_back",
     "write_recording",
+    "recording_table",
+    "table_data",
     "file_sha256",
 ]

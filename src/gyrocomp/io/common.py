@@ -1,0 +1,160 @@
+"""Helpers every log reader shares: optional imports, time matching, ordering, progress."""
+
+from __future__ import annotations
+
+import importlib
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from types import ModuleType
+
+import numpy as np
+
+from ..errors import DataQualityWarning, InputError, MissingDependencyError
+from .tables import TableLayout
+
+#: ``progress(fraction_done)``, fraction in [0, 1]; readers call it now and then on long files
+ProgressCallback = Callable[[float], None]
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """What to read from a file, beyond its format.
+
+    Parameters
+    ----------
+    layout : TableLayout
+        Column (or dataset) mapping and units, for tables and HDF5/NetCDF files.
+    drop_nonfinite : bool
+        Drop rows with NaN or infinite values instead of refusing the file.
+    instance : int, optional
+        Sensor instance in autopilot logs (PX4 ``multi_id``, ArduPilot ``I`` / IMU2 / IMU3); default 0.
+    device_id : int, optional
+        PX4 device id of the gyro to read (instead of ``instance``).
+    imu_topic, temperature_topic : str, optional
+        ROS topics of the ``sensor_msgs/Imu`` and ``sensor_msgs/Temperature`` messages
+        (default: the only topic of that type in the bag).
+    record : str, optional
+        ArduPilot DataFlash record to read: ``"IMU"`` (default) or ``"TCLR"`` (the onboard
+        temperature-learning records).
+    """
+
+    layout: TableLayout = field(default_factory=TableLayout)
+    drop_nonfinite: bool = False
+    instance: int | None = None
+    device_id: int | None = None
+    imu_topic: str | None = None
+    temperature_topic: str | None = None
+    record: str | None = None
+
+
+def require(module: str, extra: str, what: str) -> ModuleType:
+    """Import an optional dependency, or raise one line that names the extra to install."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise MissingDependencyError(
+            f"{what} needs the optional package {module.split('.')[0]}; "
+            f"install it with: pip install 'gyrocomp[{extra}]'"
+        ) from None
+
+
+def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -> tuple:
+    """Sort samples by time and drop repeated time stamps (the first is kept), saying how many.
+
+    Logs written by autopilots and ROS nodes repeat or reorder a few stamps now and then;
+    the recording needs strictly increasing time.
+    """
+    time_s = np.asarray(time_s, dtype=float)
+    order = np.argsort(time_s, kind="stable")
+    sorted_t = time_s[order]
+    keep = np.ones(sorted_t.size, dtype=bool)
+    keep[1:] = np.diff(sorted_t) > 0
+    index = order[keep]
+    moved = int(np.count_nonzero(order != np.arange(order.size)))
+    dropped = int(sorted_t.size - index.size)
+    if moved or dropped:
+        warnings.warn(
+            f"{source}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) dropped",
+            DataQualityWarning, stacklevel=3,
+        )
+    return (time_s[index], *(None if a is None else np.asarray(a)[index] for a in arrays))
+
+
+def match_by_time(
+    source: str,
+    what: str,
+    target_time_s: np.ndarray,
+    time_s: np.ndarray,
+    values: np.ndarray,
+    max_gap_s: float | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Values of another stream at the target times, by linear interpolation.
+
+    Parameters
+    ----------
+    source, what : str
+        File and stream name, for messages.
+    target_time_s : array (n,)
+        Times to interpolate at [s] (the gyro's).
+    time_s : array (m,)
+        Times of the other stream [s], increasing.
+    values : array (m,) or (m, k)
+        The other stream.
+    max_gap_s : float, optional
+        Target samples farther than this from any sample of the other stream are not matched
+        (default: 5 of the other stream's median periods).
+
+    Returns
+    -------
+    matched : array (n,) or (n, k)
+        Interpolated values (NaN where not matched).
+    ok : array (n,) of bool
+        Where the match is valid.
+    """
+    time_s = np.asarray(time_s, dtype=float)
+    values = np.asarray(values, dtype=float)
+    if time_s.size < 2:
+        raise InputError(f"{source}: {what} has {time_s.size} sample(s); at least 2 are needed to match it by time")
+    if max_gap_s is None:
+        max_gap_s = 5.0 * float(np.median(np.diff(time_s)))
+    columns = values.reshape(time_s.size, -1)
+    matched = np.column_stack([np.interp(target_time_s, time_s, c) for c in columns.T])
+    nearest = np.clip(np.searchsorted(time_s, target_time_s), 1, time_s.size - 1)
+    distance = np.minimum(np.abs(target_time_s - time_s[nearest - 1]), np.abs(time_s[nearest] - target_time_s))
+    ok = (target_time_s >= time_s[0] - max_gap_s) & (target_time_s <= time_s[-1] + max_gap_s) & (distance <= max_gap_s)
+    matched[~ok] = np.nan
+    return (matched[:, 0] if values.ndim == 1 else matched), ok
+
+
+def keep_matched(source: str, what: str, ok: np.ndarray) -> np.ndarray:
+    """Index of the samples that could be matched; warns how many were left out, refuses if none."""
+    if not ok.any():
+        raise InputError(f"{source}: no gyro sample lies within the time span of {what}; they cannot be matched")
+    if not ok.all():
+        warnings.warn(
+            f"{source}: {int(np.count_nonzero(~ok))} of {ok.size} gyro samples lie outside the time span of {what} "
+            "and were left out",
+            DataQualityWarning, stacklevel=3,
+        )
+    return np.flatnonzero(ok)
+
+
+def check_magic(path, expected: bytes, what: str, hint: str) -> None:
+    """Refuse a file whose first bytes are not ``expected``, in one line that says what it is instead."""
+    with open(path, "rb") as fh:
+        head = fh.read(max(len(expected), 16))
+    if not head.startswith(expected):
+        found = _describe_head(head)
+        raise InputError(f"{path}: not a {what} file ({found}); {hint}")
+
+
+def _describe_head(head: bytes) -> str:
+    from . import sniff_format
+
+    fmt = sniff_format(head)
+    if fmt is not None:
+        return f"it looks like {fmt}"
+    if not head:
+        return "it is empty"
+    return f"it starts with {head[:8]!r}"

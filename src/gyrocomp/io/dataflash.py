@@ -1,0 +1,205 @@
+"""ArduPilot DataFlash ``.bin`` reader (optional extra ``[dataflash]``, pymavlink).
+
+pymavlink indexes the log (message formats and the offset of every message); the fields of the
+records read are then unpacked in bulk with numpy from the memory-mapped file, so a long log is
+not turned into millions of Python objects.
+
+Records: ``IMU`` (rad/s, m/s^2, ``T`` degC; the instance in the ``I`` field on current firmware,
+or ``IMU2``/``IMU3`` records on older firmware), or ``TCLR``, the onboard temperature learner's
+records (``SType`` 0 accelerometer, 1 gyro; ``Temp``; ``X,Y,Z``), as ArduPilot's
+``Tools/scripts/tempcal_IMU.py --tclr`` reads them. A log cut off mid-message (a truncated
+download) is read up to its last whole message, with a warning.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataQualityWarning, InputError
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..units import unit_factor
+from .common import ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
+
+DATAFLASH_MAGIC = b"\xa3\x95"
+RECORDS = ("IMU", "TCLR")
+_US = unit_factor("time", "us")
+_RAD = unit_factor("gyro", "rad/s")
+_MS2 = unit_factor("accel", "m/s2")
+_STRUCT_TO_NUMPY = {"b": "i1", "B": "u1", "h": "<i2", "H": "<u2", "i": "<i4", "I": "<u4",
+                    "q": "<i8", "Q": "<u8", "f": "<f4", "d": "<f8"}
+_TCLR_ACCEL, _TCLR_GYRO = 0, 1
+
+
+def _dtype(fmt) -> np.dtype:
+    """A numpy record type for a message body, from pymavlink's struct string (``<QffffffIIfBBHH``)."""
+    names, formats = [], []
+    for count, code in re.findall(r"(\d*)([a-zA-Z])", fmt.msg_struct.lstrip("<")):
+        n = int(count) if count else 1
+        if code == "s":
+            formats.append(f"S{n}")
+        elif code in _STRUCT_TO_NUMPY:
+            formats.append(_STRUCT_TO_NUMPY[code] if n == 1 else (_STRUCT_TO_NUMPY[code], (n,)))
+        else:
+            raise InputError(f"DataFlash message {fmt.name}: field type {code!r} cannot be read")
+        names.append(fmt.columns[len(names)] if len(names) < len(fmt.columns) else f"_{len(names)}")
+    return np.dtype({"names": names, "formats": formats})
+
+
+class _Log:
+    """The indexed log: message types by name and a reader of all records of one type."""
+
+    def __init__(self, path: Path, progress: ProgressCallback | None):
+        DFReader = require("pymavlink.DFReader", "dataflash", "reading ArduPilot DataFlash logs")
+        self.path = path
+        try:
+            self.reader = DFReader.DFReader_binary(
+                str(path), zero_time_base=False,
+                progress_callback=(lambda pct: progress(0.8 * pct / 100.0)) if progress else None,
+            )
+        except Exception as exc:  # pymavlink raises assorted errors on corrupt files
+            raise InputError(f"{path}: not a readable DataFlash log ({type(exc).__name__}: {exc})") from None
+        self.bytes = np.frombuffer(self.reader.data_map, dtype=np.uint8)
+        self.types = {fmt.name: type_id for type_id, fmt in self.reader.formats.items()}
+        self.cut_bytes = self._truncation()
+
+    def _truncation(self) -> int:
+        """Bytes after the last whole message (0 for a complete log)."""
+        end = 0
+        for type_id, offsets in enumerate(self.reader.offsets):
+            if offsets and type_id in self.reader.formats:
+                length = self.reader.formats[type_id].len
+                whole = [o for o in offsets[-2:] if o + length <= self.bytes.size]
+                if whole:
+                    end = max(end, whole[-1] + length)
+        return int(self.bytes.size - end)
+
+    def close(self) -> None:
+        del self.bytes  # the mmap cannot close while a numpy view of it exists
+        self.reader.close()
+
+    def has(self, name: str) -> bool:
+        type_id = self.types.get(name)
+        return type_id is not None and bool(self.reader.offsets[type_id])
+
+    def records(self, name: str) -> np.ndarray:
+        """Every whole ``name`` message as a numpy record array (multipliers applied by the caller)."""
+        type_id = self.types[name]
+        fmt = self.reader.formats[type_id]
+        offsets = np.asarray(self.reader.offsets[type_id], dtype=np.int64)
+        offsets = offsets[offsets + fmt.len <= self.bytes.size]
+        body = self.bytes[offsets[:, None] + 3 + np.arange(fmt.len - 3)]
+        return np.ascontiguousarray(body).view(_dtype(fmt)).reshape(-1)
+
+    def parameters(self) -> dict[str, float]:
+        if not self.has("PARM"):
+            return {}
+        parm = self.records("PARM")
+        return {name.split(b"\0")[0].decode("ascii", "replace"): float(value)
+                for name, value in zip(parm["Name"], parm["Value"])}
+
+
+def _instance_records(log: _Log, instance: int) -> np.ndarray:
+    if log.has("IMU") and "I" in log.records("IMU").dtype.names:
+        imu = log.records("IMU")
+        found = sorted(set(int(i) for i in np.unique(imu["I"])))
+        if instance not in found:
+            raise InputError(f"{log.path}: --instance {instance}: no IMU instance {instance}; "
+                             f"the log has {', '.join(map(str, found))}")
+        return imu[imu["I"] == instance], found
+    names = ["IMU", "IMU2", "IMU3"]
+    found = [i for i, name in enumerate(names) if log.has(name)]
+    if instance not in found:
+        raise InputError(f"{log.path}: --instance {instance}: no {names[instance] if instance < 3 else 'IMU'} "
+                         f"records; the log has instance(s) {', '.join(map(str, found))}")
+    return log.records(names[instance]), found
+
+
+def _from_imu(log: _Log, instance: int, explicit: bool):
+    if not (log.has("IMU") or log.has("IMU2")):
+        present = sorted(name for name in log.types if log.has(name))
+        raise InputError(f"{log.path}: no IMU records in this log; it has {', '.join(present) or 'none'}")
+    imu, found = _instance_records(log, instance)
+    if not explicit and len(found) > 1:
+        warnings.warn(f"{log.path}: {len(found)} IMU instances ({', '.join(map(str, found))}); read instance "
+                      f"{instance}, choose another with --instance N", DataQualityWarning, stacklevel=4)
+    time_s = imu["TimeUS"].astype(float) * _US
+    gyro = np.column_stack([imu[f"Gyr{a}"] for a in "XYZ"]).astype(float) * _RAD
+    accel = np.column_stack([imu[f"Acc{a}"] for a in "XYZ"]).astype(float) * _MS2
+    temperature = imu["T"].astype(float) if "T" in imu.dtype.names else None
+    return order_by_time(str(log.path), time_s, gyro, accel, temperature)
+
+
+def _from_tclr(log: _Log, instance: int):
+    if not log.has("TCLR"):
+        raise InputError(f"{log.path}: --record TCLR: no TCLR records in this log "
+                         "(the onboard learner writes them while INS_TCALn_ENABLE = 2)")
+    tclr = log.records("TCLR")
+    tclr = tclr[tclr["I"] == instance]
+    gyro_rows, accel_rows = tclr[tclr["SType"] == _TCLR_GYRO], tclr[tclr["SType"] == _TCLR_ACCEL]
+    if gyro_rows.size < 2:
+        raise InputError(f"{log.path}: --record TCLR: {gyro_rows.size} gyro record(s) for instance {instance}; "
+                         "at least 2 are needed")
+    time_s, gyro, temperature = order_by_time(
+        str(log.path), gyro_rows["TimeUS"].astype(float) * _US,
+        np.column_stack([gyro_rows[a] for a in "XYZ"]).astype(float) * _RAD, gyro_rows["Temp"].astype(float))
+    accel = None
+    if accel_rows.size >= 2:
+        a_time, a_values = order_by_time(str(log.path), accel_rows["TimeUS"].astype(float) * _US,
+                                         np.column_stack([accel_rows[a] for a in "XYZ"]).astype(float) * _MS2)
+        accel, ok = match_by_time(str(log.path), "the TCLR accelerometer records", time_s, a_time, a_values)
+        keep = keep_matched(str(log.path), "the TCLR accelerometer records", ok)
+        time_s, gyro, accel, temperature = time_s[keep], gyro[keep], accel[keep], temperature[keep]
+    return time_s, gyro, accel, temperature
+
+
+def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
+    """Read an ArduPilot DataFlash log into a :class:`Recording` [s, deg/s, g, degC].
+
+    Parameters
+    ----------
+    path : path
+        The ``.bin`` log.
+    options : ReadOptions, optional
+        ``instance`` (IMU number from 0, default 0) and ``record`` (``"IMU"`` or ``"TCLR"``).
+    progress : callable, optional
+        Called with the fraction done.
+    """
+    options = options or ReadOptions()
+    path = Path(path)
+    check_magic(path, DATAFLASH_MAGIC, "ArduPilot DataFlash", "name its real format with --format, or leave --format out to have it told from the file")
+    record = (options.record or "IMU").upper()
+    if record not in RECORDS:
+        raise InputError(f"--record: unknown DataFlash record {options.record!r}; use IMU or TCLR")
+    log = _Log(path, progress)
+    try:
+        if log.cut_bytes >= 3:
+            warnings.warn(f"{path}: the log ends mid-message ({log.cut_bytes} bytes after the last whole message, "
+                          "a truncated download?); read up to there", DataQualityWarning, stacklevel=2)
+        instance = 0 if options.instance is None else options.instance
+        if record == "TCLR":
+            time_s, gyro, accel, temperature = _from_tclr(log, instance)
+        else:
+            time_s, gyro, accel, temperature = _from_imu(log, instance, options.instance is not None)
+        params = log.parameters()
+    finally:
+        log.close()
+    orientation = params.get("AHRS_ORIENTATION", 0.0)
+    if orientation:
+        warnings.warn(f"{path}: AHRS_ORIENTATION = {orientation:g}: the logged IMU axes are the board's, rotated "
+                      "from the sensor's; INS_TCAL parameters apply in the sensor frame", DataQualityWarning,
+                      stacklevel=2)
+    if params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU":
+        warnings.warn(f"{path}: INS_TCAL{instance + 1}_ENABLE = 1: the logged IMU data are already corrected by "
+                      "the onboard temperature calibration", DataQualityWarning, stacklevel=2)
+    if progress:
+        progress(1.0)
+    return Recording(
+        time_s=time_s, gyro_dps=gyro, gyro_axes=GYRO_AXES, temperature_degc=temperature,
+        accel_g=accel, accel_axes=ACCEL_AXES if accel is not None else (), source=str(path),
+        metadata={"path": str(path), "format": "dataflash", "record": record, "instance": instance,
+                  "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0},
+    )

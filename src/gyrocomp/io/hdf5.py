@@ -1,0 +1,175 @@
+"""HDF5 and NetCDF-4 reader (optional extra ``[hdf5]``, h5py).
+
+A channel is a one-dimensional dataset (``time``, ``gyro_z``, ``temperature`` ...) or, for
+``gyro`` and ``accel``, a two-dimensional dataset of shape (n, 3) (x, y, z columns).
+Without a mapping, datasets are looked up under gyrocomp's names and common ones
+(``angular_velocity``, ``acceleration``, ``timestamp`` ...). Units come from each dataset's
+``units`` attribute when it names a unit gyrocomp knows (CF conventions: ``"mrad/s"``,
+``"m/s2"``, ``"seconds since 2021-09-20 08:52:00"``, ``"C"``), else from the options.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
+from ..units import unit_factor
+from .common import ProgressCallback, ReadOptions, check_magic, require
+from .tables import TIME_COLUMN
+
+HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
+NETCDF3_MAGIC = b"CDF"
+#: names tried, in order, for each channel when the mapping does not name it
+COMMON_NAMES = {
+    TIME_COLUMN: ("time", "time_s", "timestamp", "timestamp_utc", "t"),
+    "gyro": ("gyro", "angular_velocity", "gyroscope", "angular_rate"),
+    "accel": ("accel", "acceleration", "accelerometer", "linear_acceleration"),
+    TEMPERATURE_COLUMN: ("temperature", "temp", "temperature_degc"),
+}
+_CELSIUS = {"c", "degc", "deg_c", "celsius", "degree_celsius", "degrees_celsius", "°c"}
+
+
+def _units(dataset) -> str | None:
+    value = dataset.attrs.get("units")
+    if value is None:
+        return None
+    if isinstance(value, np.ndarray):
+        value = value.reshape(-1)[0]
+    return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> float:
+    """Factor to gyrocomp's units: from the dataset's ``units`` attribute when known, else the option's unit."""
+    units = _units(dataset)
+    if units is not None:
+        unit = units.split(" since ")[0].strip() if kind == "time" else units.strip()
+        unit = {"seconds": "s", "second": "s", "milliseconds": "ms", "microseconds": "us"}.get(unit, unit)
+        try:
+            return unit_factor(kind, unit)
+        except InputError:
+            pass
+    return unit_factor(kind, fallback, option)
+
+
+def _temperature(dataset, source: str) -> np.ndarray:
+    values = np.asarray(dataset[()], dtype=float)
+    units = (_units(dataset) or "degC").strip().lower()
+    if units in _CELSIUS:
+        return values
+    if units in ("k", "kelvin"):
+        return values - 273.15
+    raise InputError(f"{source}: dataset {dataset.name!r} has units {units!r}; expected degC or K")
+
+
+def _find(handle, source: str, channel: str, mapping: dict[str, str]):
+    if channel in mapping:
+        name = mapping[channel]
+        if name not in handle:
+            raise InputError(f"{source}: --columns {channel}={name}: no dataset {name!r}; "
+                             f"the file has {', '.join(_datasets(handle))}")
+        return handle[name]
+    for name in COMMON_NAMES.get(channel, (channel,)):
+        if name in handle and hasattr(handle[name], "shape"):
+            return handle[name]
+    return None
+
+
+def _datasets(handle) -> list[str]:
+    names: list[str] = []
+    handle.visititems(lambda name, obj: names.append(name) if hasattr(obj, "shape") else None)
+    return names
+
+
+def _vector(handle, source: str, kind: str, axes: tuple[str, ...], mapping: dict[str, str]):
+    """The (n, k) channels of ``kind`` (gyro or accel) and their axis names, from one 2-D or several 1-D datasets."""
+    whole = _find(handle, source, kind, mapping)
+    if whole is not None:
+        values = np.asarray(whole[()], dtype=float)
+        if values.ndim == 1:
+            values = values[:, None]
+        if values.ndim != 2 or values.shape[1] not in (1, 3):
+            raise InputError(f"{source}: dataset {whole.name!r} has shape {whole.shape}; expected (n,) or (n, 3)")
+        names = axes if values.shape[1] == 3 else (axes[2],)
+        return values, names, whole
+    columns, names, first = [], [], None
+    for axis in axes:
+        dataset = _find(handle, source, axis, mapping) if axis in mapping or axis in handle else None
+        if dataset is not None:
+            columns.append(np.asarray(dataset[()], dtype=float).reshape(-1))
+            names.append(axis)
+            first = first or dataset
+    if not columns:
+        return None, (), None
+    return np.column_stack(columns), tuple(names), first
+
+
+def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
+    """Read an HDF5 or NetCDF-4 file into a :class:`Recording` [s, deg/s, g, degC].
+
+    Parameters
+    ----------
+    path : path
+        The ``.h5`` / ``.hdf5`` / ``.nc`` file.
+    options : ReadOptions, optional
+        ``layout.columns`` maps channels to dataset paths (``time=timestamp_utc,gyro=angular_velocity``);
+        ``layout``'s units apply where a dataset has no ``units`` attribute.
+    progress : callable, optional
+        Called with the fraction done.
+    """
+    options = options or ReadOptions()
+    path = Path(path)
+    source = str(path)
+    if not path.exists():
+        raise InputError(f"{path}: no such file")
+    with open(path, "rb") as fh:
+        head = fh.read(8)
+    if head.startswith(NETCDF3_MAGIC):
+        raise InputError(f"{path}: a NetCDF-3 (classic) file; gyrocomp reads NetCDF-4, convert it with "
+                         "'nccopy -k nc4 IN OUT'")
+    if not head.startswith(HDF5_MAGIC):
+        check_magic(path, HDF5_MAGIC, "HDF5/NetCDF-4", "name its real format with --format, or leave --format out to have it told from the file")
+    h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
+    layout = options.layout
+    mapping = dict(layout.columns)
+    with h5py.File(path, "r") as handle:
+        time_ds = _find(handle, source, TIME_COLUMN, mapping)
+        if time_ds is None:
+            raise InputError(f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
+                             "map one with --columns time=NAME")
+        time_s = np.asarray(time_ds[()], dtype=float).reshape(-1)
+        time_s = time_s * _factor("time", time_ds, layout.time_unit, "--time-unit", source)
+        gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
+        if gyro is None:
+            raise InputError(f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
+                             "map one with --columns gyro=NAME (an (n, 3) array) or gyro_z=NAME")
+        gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "--gyro-unit", source)
+        if progress:
+            progress(0.5)
+        accel, accel_axes, accel_ds = _vector(handle, source, "accel", ACCEL_AXES, mapping)
+        if accel is not None:
+            accel = accel * _factor("accel", accel_ds, layout.accel_unit, "--accel-unit", source)
+        temp_ds = _find(handle, source, TEMPERATURE_COLUMN, mapping)
+        temperature = _temperature(temp_ds, source) if temp_ds is not None else None
+    n = time_s.size
+    for name, values in (("gyro", gyro), ("accel", accel), ("temperature", temperature)):
+        if values is not None and values.shape[0] != n:
+            raise InputError(f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
+                             "map datasets of the same length with --columns")
+    keep = np.ones(n, dtype=bool)
+    if options.drop_nonfinite:
+        for values in (time_s, gyro, accel, temperature):
+            if values is not None:
+                keep &= np.isfinite(values.reshape(n, -1)).all(axis=1)
+    index = np.flatnonzero(keep)
+    pick = lambda a: None if a is None else a[index]  # noqa: E731
+    if progress:
+        progress(1.0)
+    return Recording(
+        time_s=time_s[index], gyro_dps=gyro[index], gyro_axes=gyro_axes, temperature_degc=pick(temperature),
+        accel_g=pick(accel), accel_axes=accel_axes if accel is not None else (), source=source,
+        row_numbers=index + 1,
+        metadata={"path": source, "format": "hdf5", "rows_dropped": int(n - index.size)},
+    )

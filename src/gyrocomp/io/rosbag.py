@@ -1,0 +1,128 @@
+"""ROS 1 and ROS 2 bag reader (optional extra ``[ros]``, rosbags).
+
+Reads a ``sensor_msgs/Imu`` topic (rad/s, m/s^2, time from each message's header stamp) and a
+``sensor_msgs/Temperature`` topic (degC) matched to it by time. Messages are read one topic at a
+time, straight into arrays; a ROS 2 bag is its folder (with ``metadata.yaml``) or a file in it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataQualityWarning, InputError
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..units import unit_factor
+from .common import ProgressCallback, ReadOptions, keep_matched, match_by_time, order_by_time, require
+
+IMU_TYPE = "sensor_msgs/msg/Imu"
+TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
+_RAD = unit_factor("gyro", "rad/s")
+_MS2 = unit_factor("accel", "m/s2")
+
+
+def bag_path(path: Path) -> Path:
+    """The path rosbags opens: a ROS 1 ``.bag`` file, or a ROS 2 bag folder (given a file inside it too)."""
+    if path.is_file() and path.suffix.lower() in (".db3", ".mcap") and (path.parent / "metadata.yaml").exists():
+        return path.parent
+    return path
+
+
+def _topic(path: Path, connections: list, msgtype: str, asked: str | None, option: str):
+    """The connections of the topic asked for, or of the only topic of that type."""
+    of_type = sorted({c.topic for c in connections if c.msgtype == msgtype and c.msgcount > 0})
+    if asked is not None:
+        chosen = [c for c in connections if c.topic == asked]
+        if not chosen:
+            raise InputError(f"{path}: {option} {asked}: no such topic in the bag; "
+                             f"its {msgtype} topics are {', '.join(of_type) or 'none'}")
+        if chosen[0].msgtype != msgtype:
+            raise InputError(f"{path}: {option} {asked}: the topic has type {chosen[0].msgtype}, not {msgtype}")
+        if not sum(c.msgcount for c in chosen):
+            raise InputError(f"{path}: {option} {asked}: the topic has no messages")
+        return chosen
+    if not of_type:
+        return []
+    if len(of_type) > 1:
+        raise InputError(f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with {option}")
+    return [c for c in connections if c.topic == of_type[0]]
+
+
+def _stamp_s(header) -> float:
+    stamp = header.stamp
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
+    """Read a ROS 1 or ROS 2 bag into a :class:`Recording` [s, deg/s, g, degC].
+
+    Parameters
+    ----------
+    path : path
+        A ROS 1 ``.bag`` file or a ROS 2 bag folder.
+    options : ReadOptions, optional
+        ``imu_topic`` and ``temperature_topic`` (default: the only topic of each type).
+    progress : callable, optional
+        Called with the fraction done.
+    """
+    options = options or ReadOptions()
+    path = Path(path)
+    highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
+    if not path.exists():
+        raise InputError(f"{path}: no such file or folder")
+    try:
+        reader = highlevel.AnyReader([bag_path(path)])
+        reader.open()
+    except Exception as exc:  # rosbags raises its own error types for files that are not bags
+        raise InputError(f"{path}: not a readable ROS bag ({type(exc).__name__}: {exc})") from None
+    try:
+        connections = list(reader.connections)
+        imu = _topic(path, connections, IMU_TYPE, options.imu_topic, "--imu-topic")
+        if not imu:
+            topics = ", ".join(sorted(f"{c.topic} ({c.msgtype})" for c in connections)) or "none"
+            raise InputError(f"{path}: no {IMU_TYPE} topic in the bag; its topics are {topics}")
+        thermo = _topic(path, connections, TEMPERATURE_TYPE, options.temperature_topic, "--temperature-topic")
+        total = max(1, sum(c.msgcount for c in imu + thermo))
+        done = 0
+        n = sum(c.msgcount for c in imu)
+        time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
+        i = 0
+        for connection, _, raw in reader.messages(connections=imu):
+            msg = reader.deserialize(raw, connection.msgtype)
+            time_s[i] = _stamp_s(msg.header)
+            w, a = msg.angular_velocity, msg.linear_acceleration
+            gyro[i] = (w.x, w.y, w.z)
+            accel[i] = (a.x, a.y, a.z)
+            i += 1
+            done += 1
+            if progress and done % 20000 == 0:
+                progress(done / total)
+        time_s, gyro, accel = time_s[:i], gyro[:i] * _RAD, accel[:i] * _MS2
+        time_s, gyro, accel = order_by_time(str(path), time_s, gyro, accel)
+        temperature = None
+        if thermo:
+            t_time, t_value = [], []
+            for connection, _, raw in reader.messages(connections=thermo):
+                msg = reader.deserialize(raw, connection.msgtype)
+                t_time.append(_stamp_s(msg.header))
+                t_value.append(msg.temperature)
+            t_time, t_value = order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
+            what = f"temperature topic {thermo[0].topic}"
+            temperature, ok = match_by_time(str(path), what, time_s, t_time, t_value)
+            keep = keep_matched(str(path), what, ok)
+            time_s, gyro, accel, temperature = time_s[keep], gyro[keep], accel[keep], temperature[keep]
+    finally:
+        reader.close()
+    if temperature is None:
+        warnings.warn(f"{path}: no {TEMPERATURE_TYPE} topic; the recording has no temperature "
+                      "(only noise analysis works without it)", DataQualityWarning, stacklevel=2)
+    if progress:
+        progress(1.0)
+    return Recording(
+        time_s=time_s, gyro_dps=gyro, gyro_axes=GYRO_AXES, temperature_degc=temperature,
+        accel_g=accel, accel_axes=ACCEL_AXES, source=str(path),
+        metadata={"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
+                  "temperature_topic": thermo[0].topic if thermo else None},
+    )

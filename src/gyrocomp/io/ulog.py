@@ -1,0 +1,153 @@
+"""PX4 ULog reader (optional extra ``[ulog]``, pyulog).
+
+Reads ``sensor_gyro`` (rad/s) with its ``temperature`` (degC), and ``sensor_accel`` (m/s^2) of the
+same instance matched by time. When a log has no ``sensor_gyro``, falls back to ``vehicle_imu``
+(delta angles over their interval) or ``sensor_combined``, which carry no temperature.
+Only the topics named are parsed (pyulog's message filter), not the whole log.
+
+Reference: PX4 ULog file format, https://docs.px4.io/main/en/dev_log/ulog_file_format.html;
+uORB messages sensor_gyro, sensor_accel, vehicle_imu, sensor_combined.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataQualityWarning, InputError
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..units import unit_factor
+from .common import ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
+
+ULOG_MAGIC = b"ULog\x01\x12\x35"
+GYRO_TOPICS = ("sensor_gyro", "vehicle_imu", "sensor_combined")
+_US = unit_factor("time", "us")
+_RAD = unit_factor("gyro", "rad/s")
+_MS2 = unit_factor("accel", "m/s2")
+
+
+def _time_s(data: dict) -> np.ndarray:
+    stamps = data["timestamp_sample"] if "timestamp_sample" in data else data["timestamp"]
+    return np.asarray(stamps, dtype=float) * _US
+
+
+def _choose(path: Path, topic: str, datasets: list, options: ReadOptions, id_field: str = "device_id"):
+    """The instance of ``topic`` asked for (by ``--instance`` or ``--device-id``), or instance 0."""
+    found = {d.multi_id: d for d in datasets if d.name == topic}
+    if options.device_id is not None:
+        for dataset in found.values():
+            ids = np.unique(dataset.data.get(id_field, []))
+            if options.device_id in ids:
+                return dataset
+        available = sorted({int(i) for d in found.values() for i in np.unique(d.data.get(id_field, []))})
+        raise InputError(
+            f"{path}: --device-id {options.device_id}: no {topic} with that device id; "
+            f"the log has {', '.join(map(str, available)) or 'none'}"
+        )
+    instance = 0 if options.instance is None else options.instance
+    if instance not in found:
+        raise InputError(
+            f"{path}: --instance {instance}: no {topic} instance {instance}; "
+            f"the log has instance(s) {', '.join(map(str, sorted(found)))}"
+        )
+    if options.instance is None and len(found) > 1:
+        warnings.warn(
+            f"{path}: {len(found)} {topic} instances ({', '.join(map(str, sorted(found)))}); read instance 0, "
+            "choose another with --instance N or --device-id ID",
+            DataQualityWarning, stacklevel=4,
+        )
+    return found[instance]
+
+
+def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
+    """Read a PX4 ULog into a :class:`Recording` [s, deg/s, g, degC].
+
+    Parameters
+    ----------
+    path : path
+        The ``.ulg`` file.
+    options : ReadOptions, optional
+        ``instance`` (uORB multi-instance, default 0) or ``device_id`` choose the sensor.
+    progress : callable, optional
+        Called with the fraction done.
+    """
+    options = options or ReadOptions()
+    path = Path(path)
+    check_magic(path, ULOG_MAGIC, "PX4 ULog", "name its real format with --format, or leave --format out to have it told from the file")
+    pyulog = require("pyulog", "ulog", "reading PX4 ULog files")
+    if progress:
+        progress(0.0)
+    try:
+        ulog = pyulog.ULog(str(path), list(GYRO_TOPICS) + ["sensor_accel"], parse_header_only=False)
+    except Exception as exc:  # pyulog raises bare Exceptions on corrupt files
+        raise InputError(f"{path}: not a readable ULog ({type(exc).__name__}: {exc})") from None
+    if progress:
+        progress(0.8)
+    datasets = ulog.data_list
+    names = {d.name for d in datasets}
+    metadata = {"path": str(path), "format": "ulog"}
+    if "sensor_gyro" in names:
+        gyro_set = _choose(path, "sensor_gyro", datasets, options)
+        data = gyro_set.data
+        time_s = _time_s(data)
+        gyro = np.column_stack([data[a] for a in "xyz"]).astype(float) * _RAD
+        temperature = np.asarray(data["temperature"], dtype=float) if "temperature" in data else None
+        if temperature is not None and not np.isfinite(temperature).any():
+            temperature = None
+        metadata.update(topic="sensor_gyro", instance=int(gyro_set.multi_id),
+                        device_id=int(data["device_id"][0]) if "device_id" in data else None)
+        accel = None
+        time_s, gyro, temperature = order_by_time(str(path), time_s, gyro, temperature)
+        accel_sets = [d for d in datasets if d.name == "sensor_accel" and d.multi_id == gyro_set.multi_id]
+        if accel_sets:
+            adata = accel_sets[0].data
+            a_time, a_values = order_by_time(str(path), _time_s(adata),
+                                             np.column_stack([adata[a] for a in "xyz"]).astype(float) * _MS2)
+            accel, ok = match_by_time(str(path), f"sensor_accel instance {gyro_set.multi_id}", time_s, a_time, a_values)
+            keep = keep_matched(str(path), f"sensor_accel instance {gyro_set.multi_id}", ok)
+            time_s, gyro, accel = time_s[keep], gyro[keep], accel[keep]
+            temperature = None if temperature is None else temperature[keep]
+    elif "vehicle_imu" in names:
+        imu = _choose(path, "vehicle_imu", datasets, options, id_field="gyro_device_id").data
+        dt_s = np.asarray(imu["delta_angle_dt"], dtype=float) * _US
+        good = dt_s > 0
+        time_s = _time_s(imu)[good]
+        gyro = np.column_stack([imu[f"delta_angle[{i}]"] for i in range(3)])[good] / dt_s[good, None] * _RAD
+        dv_dt = np.asarray(imu["delta_velocity_dt"], dtype=float)[good] * _US
+        accel = np.column_stack([imu[f"delta_velocity[{i}]"] for i in range(3)])[good] / dv_dt[:, None] * _MS2
+        temperature = None
+        time_s, gyro, accel = order_by_time(str(path), time_s, gyro, accel)
+        metadata.update(topic="vehicle_imu")
+    elif "sensor_combined" in names:
+        combined = [d for d in datasets if d.name == "sensor_combined"][0].data
+        time_s = _time_s(combined)
+        gyro = np.column_stack([combined[f"gyro_rad[{i}]"] for i in range(3)]).astype(float) * _RAD
+        accel = np.column_stack([combined[f"accelerometer_m_s2[{i}]"] for i in range(3)]).astype(float) * _MS2
+        temperature = None
+        time_s, gyro, accel = order_by_time(str(path), time_s, gyro, accel)
+        metadata.update(topic="sensor_combined")
+    else:
+        topics = sorted({d.name for d in pyulog.ULog(str(path), parse_header_only=False).data_list})
+        raise InputError(
+            f"{path}: no gyro topic ({', '.join(GYRO_TOPICS)}) in this ULog; it has {', '.join(topics) or 'no data'}"
+        )
+    if temperature is None:
+        warnings.warn(
+            f"{path}: {metadata['topic']} carries no temperature; log sensor_gyro for temperature calibration "
+            "(only noise analysis works without it)",
+            DataQualityWarning, stacklevel=3,
+        )
+    if progress:
+        progress(1.0)
+    return Recording(
+        time_s=time_s,
+        gyro_dps=gyro,
+        gyro_axes=GYRO_AXES,
+        temperature_degc=temperature,
+        accel_g=accel,
+        accel_axes=ACCEL_AXES if accel is not None else (),
+        source=str(path),
+        metadata=metadata,
+    )

@@ -1,0 +1,401 @@
+"""Log readers: real PX4, ArduPilot and NetCDF samples, files written here, unit conversions, bad input."""
+
+from __future__ import annotations
+
+import math
+import re
+import warnings
+
+import h5py
+import numpy as np
+import pytest
+
+from gyrocomp.errors import DataQualityWarning, InputError, MissingDependencyError
+from gyrocomp.io import TableLayout, detect_format, read, sniff_format
+from gyrocomp.io.common import match_by_time, order_by_time
+from tests.conftest import shared_dataset
+from tests.io.log_writers import write_dataflash, write_ulog
+
+RAD_TO_DEG = 180.0 / math.pi
+G = 9.80665
+
+pyulog = pytest.importorskip("pyulog", reason="the [ulog] extra (pyulog) is not installed")
+pytest.importorskip("pymavlink", reason="the [dataflash] extra (pymavlink) is not installed")
+pytest.importorskip("rosbags", reason="the [ros] extra (rosbags) is not installed")
+
+
+# -- PX4 ULog -----------------------------------------------------------------------------------------
+def test_ulog_real_sample_instances_units_and_times():
+    path = shared_dataset("px4-pyulog-samples") / "sample_log_small.ulg"
+    raw = {d.multi_id: d.data for d in pyulog.ULog(str(path), ["sensor_gyro", "sensor_accel"]).data_list
+           if d.name == "sensor_gyro"}
+    with pytest.warns(DataQualityWarning, match=r"3 sensor_gyro instances \(0, 1, 2\); read instance 0"):
+        first = read(path)
+    for instance, (low, high) in {0: (40.0, 40.4), 1: (28.2, 28.4), 2: (29.4, 29.7)}.items():
+        rec = read(path, instance=instance) if instance else first
+        assert rec.n_samples == 6
+        assert low - 0.05 <= rec.temperature_degc.min() and rec.temperature_degc.max() <= high + 0.05
+        np.testing.assert_allclose(rec.gyro_dps[:, 2], raw[instance]["z"] * RAD_TO_DEG, rtol=1e-6)
+        np.testing.assert_allclose(rec.time_s, raw[instance]["timestamp_sample"] * 1e-6)
+        # a board lying still: gravity, in g, along -z
+        assert np.allclose(np.linalg.norm(rec.accel_g, axis=1), 1.0, atol=0.03)
+    assert first.metadata["device_id"] == 2424842
+    by_id = read(path, device_id=int(raw[2]["device_id"][0]))
+    assert by_id.metadata["instance"] == 2
+
+
+def test_ulog_without_sensor_gyro_falls_back_to_sensor_combined_and_says_temperature_is_missing():
+    path = shared_dataset("px4-pyulog-samples") / "sample.ulg"
+    with pytest.warns(DataQualityWarning, match="sensor_combined carries no temperature"):
+        rec = read(path)
+    assert rec.metadata["topic"] == "sensor_combined" and rec.temperature_degc is None
+    assert rec.n_samples > 17000 and abs(rec.rate_hz - 250) < 10
+    assert np.median(np.linalg.norm(rec.accel_g, axis=1)) == pytest.approx(1.0, abs=0.1)
+
+
+def _gyro_topic(n=200, rate_hz=50.0, multi_id=0, device_id=7):
+    t_us = (1_000_000 + np.arange(n) * 1e6 / rate_hz).astype(np.uint64)
+    return ("sensor_gyro", multi_id), {
+        "timestamp": ("uint64_t", t_us),
+        "device_id": ("uint32_t", np.full(n, device_id, dtype=np.uint32)),
+        "x": ("float", np.full(n, 0.01, dtype=np.float32)),
+        "y": ("float", np.zeros(n, dtype=np.float32)),
+        "z": ("float", np.linspace(-0.02, 0.02, n).astype(np.float32)),
+        "temperature": ("float", np.linspace(20, 40, n).astype(np.float32)),
+    }
+
+
+def test_ulog_written_here_converts_units_and_matches_accel_by_time(tmp_path):
+    key, gyro = _gyro_topic()
+    n = 100  # accelerometer at half the rate, offset by 3 ms
+    t_acc = (1_003_000 + np.arange(n) * 40_000).astype(np.uint64)
+    accel = {"timestamp": ("uint64_t", t_acc), "device_id": ("uint32_t", np.full(n, 9, dtype=np.uint32)),
+             "x": ("float", np.zeros(n, np.float32)), "y": ("float", np.linspace(0, 1, n).astype(np.float32)),
+             "z": ("float", np.full(n, -G, np.float32))}
+    path = tmp_path / "log.ulg"
+    write_ulog(path, {key: gyro, ("sensor_accel", 0): accel})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)  # the last gyro samples lie past the last accel
+        rec = read(path)
+    assert rec.rate_hz == pytest.approx(50.0)
+    np.testing.assert_allclose(rec.gyro_dps[:, 0], 0.01 * RAD_TO_DEG, rtol=1e-6)
+    np.testing.assert_allclose(rec.accel_g[:, 2], -1.0, rtol=1e-6)
+    expected_y = np.interp(rec.time_s, t_acc * 1e-6, np.linspace(0, 1, n).astype(np.float32)) / G
+    np.testing.assert_allclose(rec.accel_g[:, 1], expected_y, rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(rec.temperature_degc[[0, -1]], [20, np.linspace(20, 40, 200)[rec.n_samples - 1]],
+                               rtol=1e-6)
+
+
+def test_ulog_without_gyro_topics_names_what_it_has(tmp_path):
+    path = tmp_path / "baro.ulg"
+    t = (np.arange(10) * 1000).astype(np.uint64)
+    write_ulog(path, {("sensor_baro", 0): {"timestamp": ("uint64_t", t), "temperature": ("float", np.ones(10))}})
+    with pytest.raises(InputError, match=r"baro.ulg: no gyro topic \(sensor_gyro, vehicle_imu, sensor_combined\) "
+                                         r"in this ULog; it has sensor_baro"):
+        read(path)
+
+
+def test_ulog_instance_and_device_id_that_are_not_there(tmp_path):
+    path = tmp_path / "one.ulg"
+    write_ulog(path, dict([_gyro_topic()]))
+    with pytest.raises(InputError, match=r"--instance 3: no sensor_gyro instance 3; the log has instance\(s\) 0"):
+        read(path, instance=3)
+    with pytest.raises(InputError, match=r"--device-id 5: no sensor_gyro with that device id; the log has 7"):
+        read(path, device_id=5)
+
+
+# -- ArduPilot DataFlash ------------------------------------------------------------------------------
+_IMU_COLUMNS = [("TimeUS", "Q"), ("I", "B"), ("GyrX", "f"), ("GyrY", "f"), ("GyrZ", "f"),
+                ("AccX", "f"), ("AccY", "f"), ("AccZ", "f"), ("T", "f")]
+_TCLR_COLUMNS = [("TimeUS", "Q"), ("I", "B"), ("SType", "B"), ("Temp", "f"), ("X", "f"), ("Y", "f"), ("Z", "f"),
+                 ("NDone", "I")]
+
+
+def test_dataflash_real_sample_is_read_up_to_its_cut_end():
+    path = shared_dataset("ardupilot-pymavlink-sample") / "test.BIN"
+    with pytest.warns(DataQualityWarning) as caught:
+        imu1 = read(path, instance=0)
+    said = " | ".join(str(w.message) for w in caught)
+    assert re.search(r"the log ends mid-message \(\d+ bytes after the last whole message", said)
+    assert "AHRS_ORIENTATION = 8: the logged IMU axes are the board's" in said
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)
+        imu2 = read(path, instance=1)
+    assert imu1.n_samples == 45 and imu2.n_samples == 45
+    assert 44.4 <= imu1.temperature_degc.min() and imu1.temperature_degc.max() <= 44.5
+    assert abs(np.mean(imu2.temperature_degc) - 39.9) < 0.1
+    # first IMU record, as pymavlink's own message parser reads it
+    from pymavlink import DFReader
+
+    log = DFReader.DFReader_binary(str(path))
+    try:
+        msg = log.recv_match(type="IMU")
+    finally:
+        log.close()
+    assert imu1.time_s[0] == pytest.approx(msg.TimeUS * 1e-6)
+    np.testing.assert_allclose(imu1.gyro_dps[0], np.array([msg.GyrX, msg.GyrY, msg.GyrZ]) * RAD_TO_DEG, rtol=1e-6)
+    np.testing.assert_allclose(imu1.accel_g[0], np.array([msg.AccX, msg.AccY, msg.AccZ]) / G, rtol=1e-6)
+
+
+def test_dataflash_instance_field_and_tclr_records(tmp_path):
+    n = 60
+    imu = [(1_000_000 + i * 10_000 + k, k, 0.001 * i, 0.0, -0.002, 0.0, 0.1, -G, 25.0 + 10 * k + 0.01 * i)
+           for i in range(n) for k in (0, 1)]
+    tclr = [(2_000_000 + i * 100_000 + s, 0, s, 20.0 + i, 0.01 * i, 0.0, 0.0, i) for i in range(n) for s in (0, 1)]
+    path = tmp_path / "tcal.bin"
+    write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, imu), "TCLR": (131, _TCLR_COLUMNS, tclr)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a whole log, one instance asked for: nothing to say
+        second = read(path, instance=1)
+    np.testing.assert_allclose(second.temperature_degc, 35.0 + 0.01 * np.arange(n), rtol=1e-6)
+    np.testing.assert_allclose(second.gyro_dps[:, 2], -0.002 * RAD_TO_DEG, rtol=1e-6)
+    learned = read(path, record="TCLR")
+    # SType 1 is the gyro (rad/s), SType 0 the accelerometer (m/s^2), as ArduPilot's tempcal_IMU.py reads them
+    np.testing.assert_allclose(learned.temperature_degc, 20.0 + np.arange(n))
+    np.testing.assert_allclose(learned.gyro_dps[:, 0], 0.01 * np.arange(n) * RAD_TO_DEG, rtol=1e-6)
+    np.testing.assert_allclose(learned.accel_g[:, 0], np.interp(learned.time_s, 2.0 + 0.1 * np.arange(n),
+                                                                0.01 * np.arange(n)) / G, rtol=1e-5, atol=1e-9)
+    with pytest.raises(InputError, match=r"--instance 2: no IMU instance 2; the log has 0, 1"):
+        read(path, instance=2)
+    with pytest.raises(InputError, match=r"--record: unknown DataFlash record 'GPS'; use IMU or TCLR"):
+        read(path, record="GPS")
+
+
+def test_dataflash_truncated_mid_message_reads_the_whole_ones(tmp_path):
+    rows = [(1_000_000 + i * 10_000, 0, 0.0, 0.0, 0.0, 0.0, 0.0, -G, 30.0) for i in range(20)]
+    path = tmp_path / "cut.bin"
+    write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, rows)}, cut=7)
+    with pytest.warns(DataQualityWarning, match=r"cut.bin: the log ends mid-message \(33 bytes after"):
+        rec = read(path)
+    assert rec.n_samples == 19
+
+
+def test_dataflash_tclr_asked_for_but_absent(tmp_path):
+    path = tmp_path / "imu.bin"
+    write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, [(1000 * i, 0, 0, 0, 0, 0, 0, -G, 30.0) for i in range(5)])})
+    with pytest.raises(InputError, match=r"--record TCLR: no TCLR records in this log"):
+        read(path, record="TCLR")
+
+
+# -- ROS bags -------------------------------------------------------------------------------------------
+def _write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",)):
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
+    Imu, Temperature = store.types["sensor_msgs/msg/Imu"], store.types["sensor_msgs/msg/Temperature"]
+    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
+    Vector3, Quaternion = store.types["geometry_msgs/msg/Vector3"], store.types["geometry_msgs/msg/Quaternion"]
+    serialize = store.serialize_cdr if ros2 else store.serialize_ros1
+    if ros2:
+        from rosbags.rosbag2 import Writer
+        writer = Writer(path, version=9)
+    else:
+        from rosbags.rosbag1 import Writer
+        writer = Writer(path)
+
+    def header(t):
+        sec = int(t)
+        stamp = Time(sec=sec, nanosec=int(round((t - sec) * 1e9)))
+        return Header(stamp=stamp, frame_id="imu") if ros2 else Header(seq=0, stamp=stamp, frame_id="imu")
+
+    cov = np.zeros(9)
+    with writer:
+        imus = [writer.add_connection(topic, Imu.__msgtype__, typestore=store) for topic in imu_topics]
+        thermo = writer.add_connection("/imu/temperature", Temperature.__msgtype__, typestore=store)
+        for i in range(n):
+            t = 100.0 + i / rate_hz
+            msg = Imu(header=header(t), orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
+                      angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01), angular_velocity_covariance=cov,
+                      linear_acceleration=Vector3(x=0.0, y=0.0, z=G), linear_acceleration_covariance=cov)
+            for conn in imus:
+                writer.write(conn, int(t * 1e9), serialize(msg, Imu.__msgtype__))
+            if temperature and i % 10 == 0:  # 10 Hz temperature
+                msg = Temperature(header=header(t), temperature=20.0 + i / 10.0, variance=0.0)
+                writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))
+
+
+@pytest.mark.parametrize("ros2", [False, True], ids=["ros1", "ros2"])
+def test_rosbag_imu_and_temperature_matched_by_time(tmp_path, ros2):
+    path = tmp_path / ("bag" if ros2 else "imu.bag")
+    _write_bag(path, ros2)
+    rec = read(path)
+    assert rec.metadata["imu_topic"] == "/imu/data" and rec.metadata["temperature_topic"] == "/imu/temperature"
+    assert rec.rate_hz == pytest.approx(100.0)
+    np.testing.assert_allclose(rec.time_s, 100.0 + np.arange(rec.n_samples) / 100.0, atol=1e-9)
+    np.testing.assert_allclose(rec.gyro_dps[:, 0], 0.001 * np.arange(rec.n_samples) * RAD_TO_DEG, rtol=1e-12)
+    np.testing.assert_allclose(rec.accel_g[:, 2], 1.0, rtol=1e-12)
+    # temperature rises 1 degC per 10 samples: linear interpolation is exact; the last 9 IMU samples,
+    # within 5 temperature periods of the last temperature, hold its value
+    np.testing.assert_allclose(rec.temperature_degc, 20.0 + np.minimum(np.arange(rec.n_samples), 90) / 10.0,
+                               atol=1e-9)
+    assert rec.n_samples == 100
+    assert detect_format(path) == "rosbag"
+
+
+def test_rosbag_topic_choices_and_missing_topics(tmp_path):
+    path = tmp_path / "two.bag"
+    _write_bag(path, ros2=False, temperature=False, imu_topics=("/imu0", "/imu1"))
+    with pytest.raises(InputError, match=r"2 sensor_msgs/msg/Imu topics \(/imu0, /imu1\); choose one with --imu-topic"):
+        read(path)
+    with pytest.raises(InputError, match=r"--imu-topic /imu9: no such topic in the bag; its sensor_msgs/msg/Imu "
+                                         r"topics are /imu0, /imu1"):
+        read(path, imu_topic="/imu9")
+    with pytest.raises(InputError, match=r"--temperature-topic /imu1: the topic has type sensor_msgs/msg/Imu"):
+        read(path, imu_topic="/imu0", temperature_topic="/imu1")
+    with pytest.warns(DataQualityWarning, match="no sensor_msgs/msg/Temperature topic"):
+        rec = read(path, imu_topic="/imu1")
+    assert rec.temperature_degc is None and rec.n_samples == 100
+
+
+# -- HDF5 / NetCDF-4 --------------------------------------------------------------------------------------
+def test_netcdf_cats_file_reads_without_options_and_matches_the_npz_copy():
+    folder = shared_dataset("skdivemove-cats-tempcal")
+    rec = read(folder / "cats_temperature_calib.nc")
+    npz = np.load(folder / "cats_temperature_calib_1hz.npz")
+    assert rec.n_samples == 268081 and rec.rate_hz == 1.0
+    # the npz is a float32 copy: gyro within 5e-4 mrad/s, temperature within 1e-6 degC (its README)
+    np.testing.assert_allclose(rec.gyro_dps, npz["gyro_mrad_s"] * 0.18 / math.pi, atol=5e-4 * 0.18 / math.pi)
+    np.testing.assert_allclose(rec.accel_g, npz["acc_m_s2"] / G, atol=1e-5)
+    np.testing.assert_allclose(rec.temperature_degc, npz["temperature_c"], atol=2e-6)
+    np.testing.assert_allclose(rec.time_s - rec.time_s[0], npz["t_s"] - npz["t_s"][0])
+
+
+def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
+    path = tmp_path / "log.h5"
+    n = 50
+    with h5py.File(path, "w") as f:
+        f["imu/t_ms"] = np.arange(n) * 10.0
+        f["imu/wz"] = np.full(n, 2.0)
+        f["imu/wz"].attrs["units"] = "rad/s"
+        f["imu/acc"] = np.tile([0.0, 0.0, -G], (n, 1))
+        f["imu/acc"].attrs["units"] = "m/s^2"
+        f["imu/temp_k"] = np.full(n, 300.0)
+        f["imu/temp_k"].attrs["units"] = "K"
+    layout = TableLayout(columns={"time": "imu/t_ms", "gyro_z": "imu/wz", "accel": "imu/acc",
+                                  "temperature": "imu/temp_k"}, time_unit="ms")
+    rec = read(path, layout)
+    assert rec.gyro_axes == ("gyro_z",) and rec.rate_hz == pytest.approx(100.0)
+    np.testing.assert_allclose(rec.gyro_dps[:, 0], 2.0 * RAD_TO_DEG)
+    np.testing.assert_allclose(rec.accel_g[:, 2], -1.0)
+    np.testing.assert_allclose(rec.temperature_degc, 26.85)
+    with pytest.raises(InputError, match=r"--columns gyro_z=wz: no dataset 'wz'; the file has imu/acc"):
+        read(path, TableLayout(columns={"time": "imu/t_ms", "gyro_z": "wz"}))
+    with pytest.raises(InputError, match=r"no time dataset \(the file has imu/acc, .*\); map one with --columns"):
+        read(path)
+
+
+# -- format detection and helpers ------------------------------------------------------------------------
+def test_formats_are_told_from_the_first_bytes_not_only_the_suffix(tmp_path):
+    assert sniff_format(b"ULog\x01\x12\x35\x01") == "ulog"
+    assert sniff_format(b"\x89HDF\r\n\x1a\n") == "hdf5"
+    assert sniff_format(b"#ROSBAG V2.0\n") == "rosbag"
+    assert sniff_format(b"PAR1") == "parquet"
+    assert sniff_format(b"time,gyro_z\n") is None
+    disguised = tmp_path / "flight.dat"
+    write_ulog(disguised, dict([_gyro_topic()]))
+    assert detect_format(disguised) == "ulog"
+    assert detect_format(tmp_path / "later.BIN") == "dataflash"  # not there yet: the suffix decides
+    with pytest.raises(InputError, match=r"--format: unknown format 'xls'; use one of csv, parquet, ulog"):
+        detect_format(disguised, "xls")
+    assert detect_format(disguised, "px4") == "ulog"
+
+
+def test_a_file_that_is_not_the_named_format_says_what_it_looks_like(tmp_path):
+    csv = tmp_path / "run.csv"
+    csv.write_text("time,gyro_z\n0,1\n1,2\n")
+    with pytest.raises(InputError, match=r"run.csv: not a PX4 ULog file \(it starts with b'time,gyr'\)"):
+        read(csv, fmt="ulog")
+    ulog = tmp_path / "x.ulg"
+    write_ulog(ulog, dict([_gyro_topic()]))
+    with pytest.raises(InputError, match=r"x.ulg: not a ArduPilot DataFlash file \(it looks like ulog\)"):
+        read(ulog, fmt="dataflash")
+    with pytest.raises(InputError, match=r"x.ulg: not a HDF5/NetCDF-4 file \(it looks like ulog\)"):
+        read(ulog, fmt="hdf5")
+    with pytest.raises(InputError, match=r"x.ulg: not a readable ROS bag"):
+        read(ulog, fmt="rosbag")
+
+
+def test_missing_extra_is_named_in_one_line(monkeypatch, tmp_path):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "pyulog", None)  # makes "import pyulog" fail as if it were not installed
+    path = tmp_path / "x.ulg"
+    write_ulog(path, dict([_gyro_topic()]))
+    with pytest.raises(MissingDependencyError, match=r"^reading PX4 ULog files needs the optional package pyulog; "
+                                                     r"install it with: pip install 'gyrocomp\[ulog\]'$"):
+        read(path)
+
+
+def test_order_by_time_sorts_and_drops_repeats():
+    with pytest.warns(DataQualityWarning, match=r"1 sample\(s\) out of time order were sorted|2 sample"):
+        t, v = order_by_time("f", np.array([0.0, 2.0, 1.0, 2.0, 3.0]), np.arange(5.0))
+    np.testing.assert_array_equal(t, [0, 1, 2, 3])
+    np.testing.assert_array_equal(v, [0, 2, 1, 4])
+
+
+def test_match_by_time_interpolates_and_marks_what_is_too_far():
+    target = np.array([0.5, 1.5, 2.5, 50.0])
+    values, ok = match_by_time("f", "temperature", target, np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 10, 20, 30]))
+    np.testing.assert_allclose(values[:3], [5, 15, 25])
+    assert ok.tolist() == [True, True, True, False] and np.isnan(values[3])
+    with pytest.raises(InputError, match=r"f: temperature has 1 sample\(s\); at least 2 are needed"):
+        match_by_time("f", "temperature", target, np.array([0.0]), np.array([1.0]))
+
+
+# -- through the command line ------------------------------------------------------------------------------
+def test_cli_fits_applies_and_converts_a_ulog_directly(tmp_path):
+    from tests.test_cli import run
+
+    n, rate_hz = 3000, 10.0
+    temperature = np.linspace(10, 50, n)
+    bias_rad_s = 1e-3 * (temperature - 30) + 2e-5 * (temperature - 30) ** 2
+    rng = np.random.default_rng(0)
+    t_us = (1_000_000 + np.arange(n) * 1e6 / rate_hz).astype(np.uint64)
+    fields = {"timestamp": ("uint64_t", t_us), "device_id": ("uint32_t", np.full(n, 7, np.uint32))}
+    for axis in "xyz":
+        fields[axis] = ("float", (bias_rad_s + 1e-5 * rng.standard_normal(n)).astype(np.float32))
+    fields["temperature"] = ("float", temperature.astype(np.float32))
+    log = tmp_path / "cal.ulg"
+    write_ulog(log, {("sensor_gyro", 0): fields})
+    r = run("fit", log, "-o", tmp_path / "model.json", "--temperature", "poly:2", "--hysteresis", "none")
+    assert r.returncode == 0, r.stderr
+    r = run("apply", tmp_path / "model.json", log, "-o", tmp_path / "out.csv")
+    assert r.returncode == 0, r.stderr
+    import pandas as pd
+
+    out = pd.read_csv(tmp_path / "out.csv")
+    assert list(out.columns) == ["time", "gyro_x", "gyro_y", "gyro_z", "temperature"]
+    raw_dps = bias_rad_s * RAD_TO_DEG
+    assert np.std(out["gyro_z"]) < 0.02 * np.std(raw_dps)  # the quadratic drift is gone
+    r = run("convert", log, tmp_path / "log.parquet")
+    assert r.returncode == 0 and "wrote" in r.stdout and "3000 rows" in r.stdout, r.stderr
+    back = pd.read_parquet(tmp_path / "log.parquet")
+    np.testing.assert_allclose(back["gyro_x"], fields["x"][1] * RAD_TO_DEG, rtol=1e-6)
+
+
+@pytest.mark.parametrize("case", ["not-the-format", "no-gyro-topic", "no-such-bag-topic", "output-format"])
+def test_cli_bad_logs_give_one_line_and_status_2(tmp_path, case):
+    from tests.test_cli import run
+
+    if case == "not-the-format":
+        path = tmp_path / "run.csv"
+        path.write_text("time,gyro_z\n0,1\n1,2\n")
+        args, expected = ["convert", path, tmp_path / "o.csv", "--format", "ulog"], "run.csv: not a PX4 ULog file"
+    elif case == "no-gyro-topic":
+        path = tmp_path / "baro.ulg"
+        t = (np.arange(10) * 1000).astype(np.uint64)
+        write_ulog(path, {("sensor_baro", 0): {"timestamp": ("uint64_t", t), "temperature": ("float", np.ones(10))}})
+        args, expected = ["allan", path], "baro.ulg: no gyro topic"
+    elif case == "no-such-bag-topic":
+        path = tmp_path / "imu.bag"
+        _write_bag(path, ros2=False)
+        args, expected = ["convert", path, tmp_path / "o.csv", "--imu-topic", "/gyro"], "--imu-topic /gyro: no such topic"
+    else:
+        path = tmp_path / "x.ulg"
+        write_ulog(path, dict([_gyro_topic()]))
+        args, expected = ["convert", path, tmp_path / "o.ulg"], "OUT " + str(tmp_path / "o.ulg") + ": gyrocomp writes CSV"
+    r = run(*args)
+    assert r.returncode == 2
+    errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
+    assert len(errors) == 1 and expected in errors[0], r.stderr
+    assert "Traceback" not in r.stderr
