@@ -110,9 +110,11 @@ def test_schema_1_files_load_without_lag_or_hysteresis(calibration, tmp_path):
     for ax in d["axes"].values():
         del ax["lag_time_constant_s"], ax["hysteresis"], ax["g_sensitivity_dps_per_g"], ax["g_squared_dps_per_g2"]
         del ax["acceleration_network"]
+    del d["accel_axes"], d["accel_reference_degc"]
     path = tmp_path / "v1.json"
     path.write_text(json.dumps(d))
     loaded = Calibration.load(path)
-    assert loaded.schema_version == SCHEMA_VERSION == 4
+    assert loaded.schema_version == SCHEMA_VERSION == 5
+    assert loaded.accel_axes == {} and loaded.accel_reference_degc is None
     assert all(ax.lag_time_constant_s == 0 and ax.hysteresis is None for ax in loaded.axes.values())
     assert loaded.axes["gyro_z"].temperature == calibration.axes["gyro_z"].temperature

@@ -25,7 +25,7 @@ from .models.thermal import HysteresisCurve
 from .recording import Recording
 
 FORMAT_NAME = "gyrocomp-calibration"
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 
 
 def _upgrade_1_to_2(d: dict) -> dict:
@@ -58,8 +58,18 @@ def _upgrade_3_to_4(d: dict) -> dict:
     return d
 
 
+def _upgrade_4_to_5(d: dict) -> dict:
+    """Schema 5 adds accelerometer temperature models; older files have none."""
+    d = dict(d)
+    d.setdefault("accel_axes", {})
+    d.setdefault("accel_reference_degc", None)
+    d["schema_version"] = 5
+    return d
+
+
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
-UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4}
+UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4,
+                                               4: _upgrade_4_to_5}
 UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
 
 
@@ -71,9 +81,24 @@ def _floats(values, count: int, name: str):
     return tuple(float(v) for v in values)
 
 
+def _in_g(d: Any, to_g: bool) -> Any:
+    """An accelerometer axis's dictionary with its ``..._dps`` keys named ``..._g`` (and back): the same
+    models serve both sensors, and the file says the unit of what it holds."""
+    if not isinstance(d, dict):
+        return d
+
+    def renamed(key: str) -> str:
+        if to_g:
+            return key[:-4] + "_g" if key.endswith("_dps") else key
+        return key[:-2] + "_dps" if key.endswith("_g") and not key.endswith("_per_g") else key
+
+    return {renamed(k): _in_g(v, to_g) for k, v in d.items()}
+
+
 @dataclass(frozen=True)
 class AxisCalibration:
-    """Everything known about one gyro axis.
+    """Everything known about one gyro axis (or, in ``Calibration.accel_axes``, one accelerometer axis,
+    whose ``..._dps`` values are then in [g]).
 
     Attributes
     ----------
@@ -174,6 +199,10 @@ class Calibration:
     provenance: dict[str, Any] = field(default_factory=dict)
     fit_report: dict[str, Any] = field(default_factory=dict)
     schema_version: int = SCHEMA_VERSION
+    #: accelerometer temperature models (accel_x ...): values in [g]; the correction is relative to
+    #: ``accel_reference_degc``, since a static accelerometer's constant cannot be told from gravity
+    accel_axes: dict[str, AxisCalibration] = field(default_factory=dict)
+    accel_reference_degc: float | None = None
 
     def without(self, *parts: str) -> "Calibration":
         """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
@@ -221,6 +250,8 @@ class Calibration:
             "model": self.model,
             "units": dict(UNITS),
             "axes": {name: ax.to_dict() for name, ax in self.axes.items()},
+            "accel_axes": {name: _in_g(ax.to_dict(), True) for name, ax in self.accel_axes.items()},
+            "accel_reference_degc": self.accel_reference_degc,
             "fit_report": self.fit_report,
             "provenance": self.provenance,
         }
@@ -249,10 +280,16 @@ class Calibration:
             version += 1
         try:
             axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
-            if not axes:
+            accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False))
+                          for name, ax in d["accel_axes"].items()}
+            if not axes and not accel_axes:
                 raise InputError("no axes")
+            reference = d["accel_reference_degc"]
+            if accel_axes and reference is None:
+                raise InputError("accel_axes need accel_reference_degc")
             return cls(axes=axes, model=str(d["model"]), provenance=dict(d.get("provenance", {})),
-                       fit_report=dict(d.get("fit_report", {})), schema_version=SCHEMA_VERSION)
+                       fit_report=dict(d.get("fit_report", {})), schema_version=SCHEMA_VERSION,
+                       accel_axes=accel_axes, accel_reference_degc=None if reference is None else float(reference))
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
         except (KeyError, TypeError, ValueError, AttributeError) as exc:

@@ -24,7 +24,7 @@ from . import __version__
 from .allan import KINDS
 from .calibration import Calibration
 from .compensate import apply as apply_calibration
-from .errors import DataQualityWarning, GyrocompError, InputError
+from .errors import DataQualityWarning, GyrocompError, InputError, TemperatureRangeWarning
 from .io import (
     FORMATS,
     ReadOptions,
@@ -40,7 +40,7 @@ from .io import (
 )
 from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .metrics import Evaluation, evaluate_run
-from .models.pipelines import fit_pipeline
+from .models.pipelines import fit_channels, parse_channels
 from .models.temperature import parse_temperature_option
 from .models.thermal import ACCELERATION_CHOICES, CANDIDATES, HYSTERESIS_CHOICES
 from .noise import NoiseAnalysis, analyse_noise
@@ -87,8 +87,9 @@ _READ_OPTIONS = ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop
 
 
 @contextlib.contextmanager
-def progress_bar(description: str):
-    """A progress callback drawing a bar on stderr when it is a terminal and --quiet is off; else None."""
+def progress_bar(description: str, indeterminate: bool = False):
+    """A progress callback drawing a bar on stderr when it is a terminal and --quiet is off; else None.
+    ``indeterminate``: a pulsing bar for work that does not report its fraction done."""
     ctx = click.get_current_context(silent=True)
     quiet = bool(ctx and ctx.find_root().obj and ctx.find_root().obj.get("quiet"))
     if quiet or not sys.stderr.isatty():
@@ -96,7 +97,7 @@ def progress_bar(description: str):
         return
     with Progress(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(), TimeElapsedColumn(),
                   console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task(description, total=1.0)
+        task = bar.add_task(description, total=None if indeterminate else 1.0)
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
 
@@ -234,10 +235,13 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
                    "temperature and the three accelerations). Quote the > in a shell.")
 @click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
               help="Shortest still stretch used as a static position [s].")
+@click.option("--channels", default="gyro", show_default=True,
+              help="What to model: gyro, accel (the accelerometer's bias against temperature, in g) or gyro,accel "
+                   "(then G reads the temperature-compensated accelerations).")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, pipeline, static_min_duration_s, **kwargs):
+        acceleration, pipeline, static_min_duration_s, channels, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -248,11 +252,14 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     band = _float_list(hysteresis_band, "--hysteresis-band")
     if band is not None and (len(band) != 2 or not band[0] < band[1]):
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
+    channels = parse_channels(channels)
     refuse_to_overwrite_inputs(output, runs)
     recordings = [_read(path, opts).recording for path in runs]
-    calibration = fit_pipeline(recordings, pipeline, temperature=order, bin_width_degc=bin_width_degc,
-                               hysteresis=hysteresis, hysteresis_order=hysteresis_order, hysteresis_band_degc=band,
-                               mlp_seed=mlp_seed, acceleration=acceleration, static_min_duration_s=static_min_duration_s)
+    with progress_bar("fitting", indeterminate=True):
+        calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
+                                   hysteresis=hysteresis, hysteresis_order=hysteresis_order,
+                                   hysteresis_band_degc=band, mlp_seed=mlp_seed, acceleration=acceleration,
+                                   static_min_duration_s=static_min_duration_s)
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)
@@ -260,11 +267,21 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
 
 def _print_fit(calibration: Calibration, output) -> None:
     console = _console()
-    report = calibration.fit_report
-    table = Table(title=f"gyrocomp fit: {calibration.model}  ->  {output}")
-    for col in ("axis", "model", "range [degC]", "fit RMS [deg/s]", "turn-on biases [deg/s]"):
+    if calibration.axes:
+        _print_axis_fits(console, calibration.axes, calibration.fit_report, f"gyrocomp fit: {calibration.model}  ->  "
+                         f"{output}", "deg/s")
+    if calibration.accel_axes:
+        _print_axis_fits(console, calibration.accel_axes, calibration.fit_report.get("accel", {}),
+                         f"accelerometer (correction relative to {calibration.accel_reference_degc:.2f} degC; "
+                         "constants per run or per static position)" + ("" if calibration.axes else f"  ->  {output}"),
+                         "g")
+
+
+def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -> None:
+    table = Table(title=title)
+    for col in ("axis", "model", "range [degC]", f"fit RMS [{unit}]", f"constants [{unit}]"):
         table.add_column(col)
-    for axis, ax in calibration.axes.items():
+    for axis, ax in axes.items():
         info = report.get("axes", {}).get(axis, {})
         order = None if ax.temperature is None else ax.temperature.order
         model = "constant" if order is None else (f"poly order {order}" if isinstance(order, int) else order)
@@ -276,12 +293,14 @@ def _print_fit(calibration: Calibration, output) -> None:
                 model += f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
         rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
-        table.add_row(axis, model, rng, rms, ", ".join(f"{c:+.4g}" for c in ax.turn_on_biases_dps))
+        constants = ax.turn_on_biases_dps
+        shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (f" ... ({len(constants)})" if len(constants) > 6 else "")
+        table.add_row(axis, model, rng, rms, shown)
     console.print(table)
     net = report.get("network")
     if net:
         console.print(f"network: 1-{'-'.join(map(str, net['hidden']))}-1 tanh/linear, {net['restarts']} restarts "
-                      f"(seed {net['seed']}), {net['training']}; validation RMS of the restarts [deg/s]: " + "; ".join(
+                      f"(seed {net['seed']}), {net['training']}; validation RMS of the restarts [{unit}]: " + "; ".join(
                           f"{a} " + ", ".join(f"{v:.4g}" for v in info["validation_rmse_dps"])
                           for a, info in net["axes"].items()))
     scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
@@ -289,14 +308,14 @@ def _print_fit(calibration: Calibration, output) -> None:
         scores = {}
     if scores:
         how = report.get("order_selection")
-        unit = "CV RMS [deg/s]" if how == "leave-one-run-out" else "BIC"
-        st = Table(title=f"order selection by {how} ({unit}; lower is better)")
+        unit_label = f"CV RMS [{unit}]" if how == "leave-one-run-out" else "BIC"
+        st = Table(title=f"order selection by {how} ({unit_label}; lower is better)")
         st.add_column("axis")
         orders = sorted({int(p) for s in scores.values() for p in s})
         for p in orders:
             st.add_column(f"order {p}", justify="right")
         for axis, s in scores.items():
-            chosen = calibration.axes[axis].temperature.order
+            chosen = axes[axis].temperature.order
             st.add_row(axis, *[(f"{s[str(p)]:.4g}*" if p == chosen else f"{s[str(p)]:.4g}")
                                if str(p) in s else "-" for p in orders])
         console.print(st)
@@ -304,7 +323,7 @@ def _print_fit(calibration: Calibration, output) -> None:
     if hyst.get("axes") and any(len(a.get("scores_dps", a.get("scores_bic", {}))) > 1 for a in hyst["axes"].values()):
         bic = hyst["selection"] == "bic"
         ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if bic else
-                   "leave-one-run-out residual drift RMS [deg/s] (60 s moving average; lower is better)"))
+                   f"leave-one-run-out residual drift RMS [{unit}] (60 s moving average; lower is better)"))
         ht.add_column("axis")
         for name in CANDIDATES:
             ht.add_column(name, justify="right")
@@ -348,9 +367,12 @@ def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     data = _read(input_path, opts)
     compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s)
-    write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt)
+    accel = compensated.accel_g if calibration.accel_axes else None
+    write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt, accel_g=accel)
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}: {data.table.num_rows} rows, {', '.join(data.recording.gyro_axes)} compensated")
+        done = [a for a in data.recording.gyro_axes if a in calibration.axes]
+        done += list(data.recording.accel_axes) if accel is not None else []
+        click.echo(f"wrote {output}: {data.table.num_rows} rows, {', '.join(done)} compensated")
 
 
 # -- convert ----------------------------------------------------------------------------------------
@@ -433,7 +455,7 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     for path in runs:
         rec = _read(path, opts).recording
         comp = apply_calibration(calibration, rec, turn_on_window_s=turn_on_window_s)
-        results.append(evaluate_run(rec, comp, window_s=window_s))
+        results.append(evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes)))
     evaluation = Evaluation(results)
     if as_json:
         click.echo(json.dumps(evaluation.to_dict(), indent=2))
@@ -493,6 +515,22 @@ def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -
                           f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
                           f"{m.residual_rms_dps:.3g}")
     console.print(table)
+    if any(run.accel_axes for run in evaluation.runs):
+        table = Table(title=f"{title}: accelerometer")
+        table.add_column("run", no_wrap=True)
+        table.add_column("axis", no_wrap=True)
+        for col in ("window\n[s]", "offset raw\n[g]", "offset comp\n[g]", "improvement\n(raw/comp)",
+                    "BI raw\n[ug]", "BI comp\n[ug]", "int. time raw\n[s]", "int. time comp\n[s]",
+                    "residual RMS\n[g]"):
+            table.add_column(col, justify="right")
+        for run in evaluation.runs:
+            for axis, m in run.accel_axes.items():
+                table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.bias_offset_raw_g:.4g}",
+                              f"{m.bias_offset_comp_g:.4g}", f"{m.offset_improvement:.3g}x",
+                              f"{m.bias_instability_raw_ug:.4g}", f"{m.bias_instability_comp_ug:.4g}",
+                              f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
+                              f"{m.residual_rms_g:.3g}")
+        console.print(table)
 
 
 # -- allan -------------------------------------------------------------------------------------------
@@ -554,8 +592,9 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
     names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
     if kalibr_path:
         names += [a for a in recording.accel_axes if a not in names]
-    analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
-                             fit_taus_s=fit_range)
+    with progress_bar("Allan deviation", indeterminate=True):
+        analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                                 fit_taus_s=fit_range)
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
     for name, a in analysis.axes.items():
@@ -659,6 +698,152 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id):
             if not line.startswith("#"):
                 break
             click.echo(line.lstrip("# "))
+
+
+# -- report and plot --------------------------------------------------------------------------------
+@cli.command()
+@click.argument("model", type=click.Path())
+@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="The HTML file to write.")
+@click.option("--window", "window_s", type=float, default=None,
+              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
+@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+              help="Estimate each run's turn-on bias from its first S seconds [s].")
+@click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
+              help="Shortest still stretch drawn as a static position [s].")
+@read_options
+@click.pass_context
+def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_duration_s, **kwargs):
+    """One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias against
+    temperature, raw and compensated series, Allan deviations, g-sensitivity."""
+    from .report.html import build_report
+
+    from .report.figures import require_matplotlib
+
+    opts = _pop_read_options(kwargs)
+    refuse_to_overwrite_inputs(output, [model, *runs])
+    if not str(output).lower().endswith((".html", ".htm")):
+        raise click.BadParameter(f"{output}: name the report .html", param_hint="-o")
+    if window_s is not None and not window_s > 0:
+        raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
+    require_matplotlib()
+    calibration = Calibration.load(model)
+    recordings = [_read(path, opts).recording for path in runs]
+    with progress_bar("report") as progress:
+        result = build_report(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s,
+                              min_static_s=static_min_duration_s, progress=progress)
+    write_text_atomic(output, result.html)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}: {len(result.html) / 1e6:.2f} MB, sections {', '.join(result.sections)}")
+
+
+@cli.group()
+def plot():
+    """Single figures as PNG, SVG or PDF (from the suffix of -o)."""
+
+
+def _figure_output(output, inputs) -> None:
+    from .report.figures import require_matplotlib
+
+    check_figure_path(output)
+    refuse_to_overwrite_inputs(output, inputs)
+    require_matplotlib()
+
+
+def _compensated(model, runs, opts, turn_on_window_s):
+    calibration = Calibration.load(model)
+    recordings = [_read(path, opts).recording for path in runs]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)
+        comps = [apply_calibration(calibration, rec, turn_on_window_s=turn_on_window_s) for rec in recordings]
+    return calibration, recordings, comps
+
+
+def _axis_option(axis, calibration, recording) -> str:
+    known = [a for a in recording.gyro_axes if a in calibration.axes]
+    known += [a for a in calibration.accel_axes if a in recording.accel_axes]
+    if axis is None:
+        if not known:
+            raise InputError(f"{recording.source}: no axis of the model in the data")
+        return known[0]
+    if axis not in known:
+        raise click.BadParameter(f"{axis!r}: the model and the data share {', '.join(known) or 'no axis'}",
+                                 param_hint="--axis")
+    return axis
+
+
+@plot.command("allan")
+@click.argument("input_path", metavar="FILE", type=click.Path())
+@click.option("--model", type=click.Path(), default=None, help="Also draw FILE compensated with this model.")
+@click.option("--axes", default=None, help="Axes to draw, e.g. gyro_x,gyro_z (default: every gyro axis).")
+@click.option("--split-gaps", is_flag=True, help="Pool the stretches between time gaps.")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
+@read_options
+@click.pass_context
+def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
+    """Allan deviation of FILE (and of FILE compensated with --model) with intervals and slope lines."""
+    from .report.figures import allan_plot, save_figure
+
+    opts = _pop_read_options(kwargs)
+    _figure_output(output, [input_path] + ([model] if model else []))
+    recording = _read(input_path, opts).recording
+    names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
+    analyses = {"raw": analyse_noise(recording, names, split_gaps=split_gaps)}
+    if model:
+        _, _, (comp,) = _compensated(model, [input_path], opts, None)
+        analyses["compensated"] = analyse_noise(comp, names, split_gaps=split_gaps)
+    save_figure(allan_plot(analyses, title=f"Allan deviation: {Path(input_path).name}"), output)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}")
+
+
+@plot.command("temperature")
+@click.argument("model", type=click.Path())
+@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.option("--axis", default=None, help="The axis to draw (default: the model's first).")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
+@read_options
+@click.pass_context
+def plot_temperature(ctx, model, runs, axis, output, **kwargs):
+    """Bias against temperature of RUNS (heating and cooling branches), MODEL's correction, the residual."""
+    from .report.figures import save_figure, temperature_plot
+
+    opts = _pop_read_options(kwargs)
+    _figure_output(output, [model, *runs])
+    calibration, recordings, comps = _compensated(model, runs, opts, None)
+    if any(rec.temperature_degc is None for rec in recordings):
+        raise InputError("plot temperature: every run needs a temperature column")
+    axis = _axis_option(axis, calibration, recordings[0])
+    save_figure(temperature_plot(recordings, comps, axis, "g" if axis.startswith("accel") else "deg/s"), output)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}")
+
+
+@plot.command("timeseries")
+@click.argument("model", type=click.Path())
+@click.argument("run", type=click.Path())
+@click.option("--axis", default=None, help="The axis to draw (default: the model's first).")
+@click.option("--window", "window_s", type=float, default=None,
+              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
+@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+              help="Estimate the run's turn-on bias from its first S seconds [s].")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
+@read_options
+@click.pass_context
+def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, **kwargs):
+    """Raw and compensated output of RUN against time, with moving averages and the temperature."""
+    from .metrics import default_window_s
+    from .report.figures import save_figure, timeseries_plot
+
+    opts = _pop_read_options(kwargs)
+    _figure_output(output, [model, run])
+    calibration, (recording,), (comp,) = _compensated(model, [run], opts, turn_on_window_s)
+    axis = _axis_option(axis, calibration, recording)
+    window = window_s or default_window_s(recording)
+    save_figure(timeseries_plot(recording, comp, axis, window, "g" if axis.startswith("accel") else "deg/s",
+                                title=f"{axis}: {Path(run).name}"), output)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}")
 
 
 # -- demo -------------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -10,7 +11,7 @@ from .calibration import Calibration
 from .effects import find_turns, g_sensitivity_offset, thermal_lag
 from .errors import InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
-from .recording import Recording
+from .recording import ACCEL_AXES, Recording
 
 
 class Compensator:
@@ -45,18 +46,22 @@ class Compensator:
         self.turn_on_window_s = turn_on_window_s
         self.source = source
         self._modelled = [(j, calibration.axes[a]) for j, a in enumerate(self.gyro_axes) if a in calibration.axes]
-        if not self._modelled:
+        self._accel_modelled = [(j, a, calibration.accel_axes[a]) for j, a in enumerate(ACCEL_AXES)
+                                if a in calibration.accel_axes]
+        if not self._modelled and not self._accel_modelled:
             raise InputError(
                 f"{source}: the model covers {', '.join(calibration.axes)}, the data has "
                 f"{', '.join(self.gyro_axes)}; no axis in common"
             )
         if rate_hz is not None and not rate_hz > 0:
             raise InputError(f"rate_hz: must be positive, got {rate_hz}")
-        if rate_hz is None and any(ax.lag_time_constant_s > 0 for _, ax in self._modelled):
+        every = [ax for _, ax in self._modelled] + [ax for _, _, ax in self._accel_modelled]
+        if rate_hz is None and any(ax.lag_time_constant_s > 0 for ax in every):
             raise InputError(f"{source}: the model has thermal lag; give the stream's sample rate (rate_hz)")
         self.rate_hz = rate_hz
-        self._lag_states = [None] * len(self._modelled)
-        self._turn_states = [None] * len(self._modelled)
+        self._lag_states: dict[str, object] = {}
+        self._turn_states: dict[str, object] = {}
+        self._accel_out: list[np.ndarray] = []
         self._warned = False
         self._t0: float | None = None
         self._constants: np.ndarray | None = None
@@ -65,18 +70,72 @@ class Compensator:
         self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
         self._pending_time: list[np.ndarray] = []
 
-    def _model_temperature(self, k: int, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
+    def _model_temperature(self, key: str, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
         """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""
         if ax.lag_time_constant_s <= 0:
             return temperature_degc
-        lagged, self._lag_states[k] = thermal_lag(time_s, temperature_degc, ax.lag_time_constant_s,
-                                                  period_s=1.0 / self.rate_hz, state=self._lag_states[k])
+        lagged, self._lag_states[key] = thermal_lag(time_s, temperature_degc, ax.lag_time_constant_s,
+                                                    period_s=1.0 / self.rate_hz, state=self._lag_states.get(key))
         return lagged
+
+    def _temperature_error(self, key: str, ax, time_s: np.ndarray, t: np.ndarray,
+                           accel_g: np.ndarray | None) -> np.ndarray:
+        """The axis's temperature-driven error (shape and hysteresis) [deg/s, or g for an accelerometer]."""
+        t_model = self._model_temperature(key, ax, time_s, t)
+        if not self._warned and ax.temperature.outside_range(t_model):
+            lagged = f" (through its {ax.lag_time_constant_s:.3g} s thermal lag)" if ax.lag_time_constant_s else ""
+            warnings.warn(
+                f"{self.source}: temperature{lagged} outside the model's range "
+                f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
+                "the model is held at its edge there",
+                TemperatureRangeWarning, stacklevel=4,
+            )
+            self._warned = True
+        if getattr(ax.temperature, "needs_accel", False):
+            error = np.asarray(ax.temperature.shape_dps(t_model, accel_g), dtype=float)
+        else:
+            error = np.asarray(ax.temperature.shape_dps(t_model), dtype=float)
+        if ax.hysteresis is not None:
+            turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states.get(key))
+            self._turn_states[key] = turns.state
+            error = error + ax.hysteresis.offset_dps(t_model, turns)
+        return error
+
+    def _compensate_accel(self, time_s: np.ndarray, temperature_degc: np.ndarray | None,
+                          accel_g: np.ndarray | None) -> np.ndarray | None:
+        """Accelerometer axes with their temperature error removed, relative to the model's reference [g]."""
+        if not self._accel_modelled or accel_g is None or time_s.size == 0:
+            return accel_g
+        if temperature_degc is None:
+            raise InputError(f"{self.source}: the model compensates the accelerometer for temperature; "
+                             "the data has no temperature")
+        t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc.mean(axis=1)
+        reference = np.array([self.calibration.accel_reference_degc])
+        out = np.array(accel_g, dtype=float, copy=True)
+        for j, name, ax in self._accel_modelled:
+            at_reference = float(np.asarray(ax.temperature.shape_dps(reference), dtype=float)[0])
+            out[:, j] -= self._temperature_error(name, ax, time_s, t, None) - at_reference
+        return out
+
+    @property
+    def compensates_accel(self) -> bool:
+        """Whether the model has accelerometer axes (then :meth:`take_accel` gives them compensated)."""
+        return bool(self._accel_modelled)
+
+    def take_accel(self) -> np.ndarray:
+        """The compensated accelerometer rows [g] (n, 3) of the chunks given since the last call
+        (the raw rows when the model has no accelerometer axes); never held back."""
+        rows = np.concatenate(self._accel_out) if self._accel_out else np.empty((0, 3))
+        self._accel_out = []
+        return rows
 
     def _residual(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None,
                   accel_g: np.ndarray | None = None) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
-        for k, (j, ax) in enumerate(self._modelled):
+        accel_g = self._compensate_accel(time_s, temperature_degc, accel_g)
+        if accel_g is not None:
+            self._accel_out.append(accel_g)
+        for j, ax in self._modelled:
             if ax.needs_accel and time_s.size:
                 if accel_g is None:
                     raise InputError(f"{self.source}: the model has g-sensitivity; the data needs accel_x, accel_y "
@@ -94,24 +153,7 @@ class Compensator:
             t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc[:, j]
             if time_s.size == 0:
                 continue
-            t_model = self._model_temperature(k, ax, time_s, t)
-            if not self._warned and ax.temperature.outside_range(t_model):
-                lagged = f" (through its {ax.lag_time_constant_s:.3g} s thermal lag)" if ax.lag_time_constant_s else ""
-                warnings.warn(
-                    f"{self.source}: temperature{lagged} outside the model's range "
-                    f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
-                    "the model is held at its edge there",
-                    TemperatureRangeWarning, stacklevel=3,
-                )
-                self._warned = True
-            if getattr(ax.temperature, "needs_accel", False):
-                out[:, j] -= ax.temperature.shape_dps(t_model, accel_g)
-            else:
-                out[:, j] -= ax.temperature.shape_dps(t_model)
-            if ax.hysteresis is not None:
-                turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states[k])
-                self._turn_states[k] = turns.state
-                out[:, j] -= ax.hysteresis.offset_dps(t_model, turns)
+            out[:, j] -= self._temperature_error(self.gyro_axes[j], ax, time_s, t, accel_g)
         return out
 
     def _subtract_constants(self, residual: np.ndarray) -> np.ndarray:
@@ -167,12 +209,23 @@ class Compensator:
 
 
 def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None) -> Recording:
-    """Compensate a whole recording; the result has the same rows, axes and other channels."""
+    """Compensate a whole recording; the result has the same rows, axes and other channels.
+
+    The gyro axes the model covers are compensated [deg/s]; so are the accelerometer axes [g] when the
+    model has accelerometer temperature models (then also a g-sensitivity term reads the compensated ones).
+    """
     comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
                        rate_hz=recording.rate_hz, source=recording.source)
     accel = None
-    if recording.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(recording.accel_axes):
-        accel = recording.accel_g[:, [recording.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]]
+    if recording.accel_g is not None and set(ACCEL_AXES) <= set(recording.accel_axes):
+        accel = recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
+    elif comp.compensates_accel:
+        raise InputError(f"{recording.source}: the model compensates the accelerometer; the data needs accel_x, "
+                         "accel_y and accel_z columns [g]")
     out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel)
     rest = comp.finish()
-    return recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)
+    result = recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)
+    if calibration.accel_axes:
+        order = [ACCEL_AXES.index(a) for a in recording.accel_axes]
+        result = dataclasses.replace(result, accel_g=comp.take_accel()[:, order])
+    return result

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -57,11 +57,15 @@ def bias_instability(rate_dps: np.ndarray, rate_hz: float, stretches: list[slice
     With ``stretches`` (the pieces of a recording between time gaps), the Allan sums are pooled over
     them so that no difference spans a gap.
     """
-    if stretches is not None and len(stretches) > 1:
-        low = allan_deviation_segments([rate_dps[s] for s in stretches], rate_hz, taus="octave").minimum()
-    else:
-        low = allan_deviation(rate_dps, rate_hz, taus="octave", confidence=None).minimum()
+    low = _allan_minimum(rate_dps, rate_hz, stretches)
     return BiasInstability(low.deviation / BIAS_INSTABILITY_FACTOR * DEG_PER_S_TO_DEG_PER_H, low.tau_s)
+
+
+def _allan_minimum(x: np.ndarray, rate_hz: float, stretches: list[slice] | None):
+    """The minimum of the octave overlapping Allan deviation [unit of x], pooled over ``stretches``."""
+    if stretches is not None and len(stretches) > 1:
+        return allan_deviation_segments([x[s] for s in stretches], rate_hz, taus="octave").minimum()
+    return allan_deviation(x, rate_hz, taus="octave", confidence=None).minimum()
 
 
 def default_window_s(recording: Recording) -> float:
@@ -90,16 +94,36 @@ class AxisMetrics:
 
 
 @dataclass(frozen=True)
+class AccelAxisMetrics:
+    """Raw and compensated figures of one accelerometer axis over one run (a static run: the moving average
+    of a unit being turned follows gravity, not the bias)."""
+
+    bias_offset_raw_g: float
+    bias_offset_comp_g: float
+    offset_improvement: float
+    bias_instability_raw_ug: float
+    bias_instability_comp_ug: float
+    integration_time_raw_s: float
+    integration_time_comp_s: float
+    residual_rms_g: float
+
+
+@dataclass(frozen=True)
 class RunEvaluation:
-    """Figures of one run, per gyro axis, computed with one moving-average window."""
+    """Figures of one run, per gyro axis (and accelerometer axis, when compensated), with one moving-average
+    window."""
 
     file: str
     window_s: float
     axes: dict[str, AxisMetrics]
+    accel_axes: dict[str, AccelAxisMetrics] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        return {"file": self.file, "window_s": self.window_s,
-                "axes": {name: asdict(m) for name, m in self.axes.items()}}
+        out = {"file": self.file, "window_s": self.window_s,
+               "axes": {name: asdict(m) for name, m in self.axes.items()}}
+        if self.accel_axes:
+            out["accel_axes"] = {name: asdict(m) for name, m in self.accel_axes.items()}
+        return out
 
 
 @dataclass(frozen=True)
@@ -130,7 +154,24 @@ def smoothed_residual_rms(x: np.ndarray, window_samples: int) -> float:
     return float(np.sqrt(np.mean((smooth - smooth.mean()) ** 2)))
 
 
-def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None) -> RunEvaluation:
+def _accel_metrics(raw: Recording, compensated: Recording, w: int, stretches: list[slice]) -> dict:
+    out = {}
+    for j, axis in enumerate(raw.accel_axes):
+        r, c = raw.accel_g[:, j], compensated.accel_g[:, j]
+        off_raw, off_comp = bias_offset(r, w), bias_offset(c, w)
+        low_raw, low_comp = _allan_minimum(r, raw.rate_hz, stretches), _allan_minimum(c, raw.rate_hz, stretches)
+        out[axis] = AccelAxisMetrics(
+            bias_offset_raw_g=off_raw, bias_offset_comp_g=off_comp,
+            offset_improvement=off_raw / off_comp if off_comp > 0 else math.inf,
+            bias_instability_raw_ug=low_raw.deviation / BIAS_INSTABILITY_FACTOR * 1e6,
+            bias_instability_comp_ug=low_comp.deviation / BIAS_INSTABILITY_FACTOR * 1e6,
+            integration_time_raw_s=low_raw.tau_s, integration_time_comp_s=low_comp.tau_s,
+            residual_rms_g=smoothed_residual_rms(c, w))
+    return out
+
+
+def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None,
+                 accel: bool = False) -> RunEvaluation:
     """Compare one run before and after compensation, axis by axis.
 
     Parameters
@@ -139,6 +180,8 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
         The same run before and after compensation (same rows and axes).
     window_s : float, optional
         Moving-average window [s]; default :func:`default_window_s` of the raw run.
+    accel : bool
+        Also compare the accelerometer axes [g] (when the compensation covers them).
     """
     stretches = raw.contiguous_stretches()
     if raw.gaps:
@@ -165,7 +208,10 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
             integration_time_comp_s=bi_comp.integration_time_s,
             residual_rms_dps=smoothed_residual_rms(c, w),
         )
-    return RunEvaluation(file=raw.source, window_s=float(window_s), axes=axes)
+    accel_axes = {}
+    if accel and raw.accel_g is not None and compensated.accel_g is not None:
+        accel_axes = _accel_metrics(raw, compensated, w, stretches)
+    return RunEvaluation(file=raw.source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
 
 
 @dataclass(frozen=True)

@@ -33,9 +33,9 @@ def _read_px4(text):
     return values
 
 
-def px4_offset_rad_s(p, instance, axis, temperature):
-    """PX4: offset = X0 + X1 d + X2 d^2 + X3 d^3, d = clip(T, TMIN, TMAX) - TREF."""
-    g = f"TC_G{instance}_"
+def px4_offset_rad_s(p, instance, axis, temperature, sensor="G"):
+    """PX4: offset = X0 + X1 d + X2 d^2 + X3 d^3, d = clip(T, TMIN, TMAX) - TREF (sensor G gyro, A accel)."""
+    g = f"TC_{sensor}{instance}_"
     d = np.clip(temperature, p[g + "TMIN"], p[g + "TMAX"]) - p[g + "TREF"]
     return sum(p[f"{g}X{k}_{axis}"] * d ** k for k in range(4))
 
@@ -44,10 +44,10 @@ def _read_ardupilot(text):
     return {name: float(value) for name, value in (line.split() for line in text.splitlines() if not line.startswith("#"))}
 
 
-def ardupilot_correction_rad_s(p, instance, axis, temperature, cal_temp):
+def ardupilot_correction_rad_s(p, instance, axis, temperature, cal_temp, sensor="GYR"):
     """ArduPilot: v -= P(T - 35) - P(T_cal - 35), P(d) = (c1 + (c2 + c3 d) d) d * 1e-6, T clamped to TMIN..TMAX."""
     g = f"INS_TCAL{instance}_"
-    c = [p[f"{g}GYR{k}_{'XYZ'[axis]}"] for k in (1, 2, 3)]
+    c = [p[f"{g}{sensor}{k}_{'XYZ'[axis]}"] for k in (1, 2, 3)]
 
     def poly(t):
         d = np.clip(t, p[g + "TMIN"], p[g + "TMAX"]) - 35.0
@@ -102,7 +102,7 @@ def test_terms_the_autopilots_lack_are_named():
     with pytest.raises(InputError, match=r"--instance: PX4 has thermal compensation for gyros 0..3, got 7"):
         px4_params_file(cal, instance=7)
     flat = fit_calibration(runs, temperature=None)
-    with pytest.raises(InputError, match="export: the model has no gyro axis with a temperature curve"):
+    with pytest.raises(InputError, match="export: the model has no gyro or accelerometer axis with a temperature curve"):
         px4_params_file(flat)
 
 
@@ -118,3 +118,26 @@ def test_cli_export(tmp_path):
     assert r.returncode == 2 and "Invalid value for '--format'" in r.stderr
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and "this is an input file" in r.stderr
+
+
+def test_accelerometer_parameters_reproduce_the_accelerometer_model():
+    from gyrocomp.models.pipelines import fit_channels
+
+    runs = [simulate("consumer", profile="cycle", rate_hz=0.5, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_channels(runs, ("gyro", "accel"), temperature=3, hysteresis="none")
+        px4, ardu = _read_px4(px4_params_file(cal)), _read_ardupilot(ardupilot_params_file(cal))
+    assert px4["TC_A_ENABLE"] == 1 and px4["TC_G_ENABLE"] == 1
+    reference = cal.accel_reference_degc
+    assert px4["TC_A0_TREF"] == pytest.approx(reference, abs=1e-4)
+    temps = np.linspace(px4["TC_A0_TMIN"], px4["TC_A0_TMAX"], 57)
+    g0 = 9.80665
+    for j, name in enumerate(("accel_x", "accel_y", "accel_z")):
+        curve = cal.accel_axes[name].temperature
+        ours_g = curve.shape_dps(temps) - curve.shape_dps(np.array([reference]))[0]
+        theirs_px4 = px4_offset_rad_s(px4, 0, j, temps, sensor="A") / g0
+        theirs_ardu = ardupilot_correction_rad_s(ardu, 1, j, temps, reference, sensor="ACC") / g0
+        # a cubic model: exact to the float32 / 9-digit rounding of the parameter files
+        np.testing.assert_allclose(theirs_px4, ours_g, atol=2e-6)
+        np.testing.assert_allclose(theirs_ardu, ours_g, atol=2e-6)

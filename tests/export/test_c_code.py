@@ -1,6 +1,7 @@
 """The model as C: compiled with the system compiler, fed simulated runs sample by sample, and compared
 with gyrocomp apply to 1e-9."""
 
+import dataclasses
 import shutil
 import subprocess
 import warnings
@@ -129,3 +130,35 @@ def test_temperature_network_then_acceleration_network(tmp_path):
     assert cal.axes["gyro_x"].acceleration_network is not None
     held = simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=5).recording
     _compare(cal, held, tmp_path)
+
+
+DRIVER_ACCEL = DRIVER.replace('printf("%.17g %.17g %.17g\\n", out[0], out[1], out[2]);',
+                              'printf("%.17g %.17g %.17g %.17g %.17g %.17g\\n", out[0], out[1], out[2], '
+                              's.accel_out[0], s.accel_out[1], s.accel_out[2]);')
+
+
+def test_accelerometer_temperature_models_and_g_sensitivity_on_compensated_accelerations(tmp_path):
+    from gyrocomp.models.pipelines import fit_channels
+
+    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(2)]
+    chamber = [simulate("consumer", profile="cycle", rate_hz=0.5, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_channels(runs, ("gyro", "accel"))
+        lagged = fit_channels(chamber, ("accel",), hysteresis="lag").accel_axes
+        ours = apply(cal := dataclasses.replace(cal, accel_axes=lagged), runs[1])
+    assert cal.has_acceleration
+    assert any(ax.lag_time_constant_s > 0 for ax in cal.accel_axes.values())
+    for name, text in c_sources(cal, rate_hz=runs[1].rate_hz).items():
+        (tmp_path / name).write_text(text)
+    (tmp_path / "driver.c").write_text(DRIVER_ACCEL)
+    exe = tmp_path / "driver"
+    subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-o", str(exe), str(tmp_path / "driver.c"),
+                    str(tmp_path / "gyrocomp.c"), "-lm"], check=True, capture_output=True, text=True)
+    rec = runs[1]
+    table = np.column_stack([rec.time_s, rec.gyro_dps, rec.accel_g, rec.temperature_degc])
+    text = "\n".join(" ".join(repr(float(v)) for v in row) for row in table) + "\n"
+    out = np.loadtxt(subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True).stdout.splitlines())
+    for theirs, mine in ((out[:, :3], ours.gyro_dps), (out[:, 3:], ours.accel_g)):
+        assert np.max(np.abs(theirs - mine) / np.maximum(np.abs(mine), 1.0)) < 1e-9
+    assert np.max(np.abs(ours.accel_g - rec.accel_g)) > 1e-3  # the accelerometer really was compensated

@@ -114,7 +114,7 @@ def test_missing_file_and_unknown_suffix(tmp_path):
     with pytest.raises(InputError, match=r"nothere.csv: no such file"):
         read(tmp_path / "nothere.csv")
     (tmp_path / "x.dat").write_text("time,gyro_z\n0,1\n1,2\n")
-    with pytest.raises(InputError, match=r"x.dat: cannot tell the format from the suffix '.dat'; name it with --format"):
+    with pytest.raises(InputError, match=r"x.dat: cannot tell the format from the file or its suffix '.dat'; name it with --format"):
         read(tmp_path / "x.dat")
     assert read(tmp_path / "x.dat", fmt="csv").n_samples == 2
 

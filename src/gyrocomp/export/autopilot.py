@@ -8,6 +8,10 @@ Both autopilots correct the gyro bias with a cubic in temperature, in rad/s, and
   * 1e-6 with d = clip(T, TMIN, TMAX) - 35 degC, and corrected = raw - P(T) + P(T_cal), T_cal being the
   temperature at which the ordinary gyro offsets were taken (the bias at T_cal is theirs to remove).
 
+When the model compensates the accelerometer too (``fit --channels gyro,accel``), its axes are written the
+same way in m/s^2: PX4 ``TC_A{i}_*`` (relative to TREF: the accelerometer's constant stays with its ordinary
+calibration), ArduPilot ``INS_TCAL{n}_ACC{1,2,3}_{X,Y,Z}``.
+
 gyrocomp's temperature curve (a polynomial of any order, or a network) is converted to that cubic by
 least squares on a dense grid over the model's range; the largest difference is reported, and is zero
 (to rounding) for polynomials of order 3 or less. Thermal lag, hysteresis and g-sensitivity have no
@@ -24,28 +28,33 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..errors import DataQualityWarning, InputError
+from ..units import STANDARD_GRAVITY_M_PER_S2
 
 DEG_TO_RAD = math.pi / 180.0
 ARDUPILOT_TEMP_REFERENCE_DEGC = 35.0
 ARDUPILOT_SCALE = 1.0e6
 AXIS_INDEX = {"gyro_x": 0, "gyro_y": 1, "gyro_z": 2}
+ACCEL_INDEX = {"accel_x": 0, "accel_y": 1, "accel_z": 2}
+G_TO_M_PER_S2 = STANDARD_GRAVITY_M_PER_S2
 GRID_POINTS = 401
 
 
 @dataclass(frozen=True)
 class CubicFit:
-    """One axis's temperature curve as a cubic in d = T - reference [rad/s per degC^k], and how far it is
-    from gyrocomp's curve over [t_min, t_max] [deg/s]."""
+    """One axis's temperature curve as a cubic in d = T - reference [rad/s per degC^k, or m/s^2 per degC^k
+    for an accelerometer], and how far it is from gyrocomp's curve over [t_min, t_max] [deg/s, or g]."""
 
-    coefficients_rad_per_s: tuple[float, float, float, float]  # X0..X3
+    coefficients_rad_per_s: tuple[float, float, float, float]  # X0..X3 (m/s^2 for an accelerometer axis)
     reference_degc: float
     t_min_degc: float
     t_max_degc: float
-    max_error_dps: float
+    max_error_dps: float  # [g] for an accelerometer axis
 
 
-def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool) -> CubicFit:
-    """Least-squares cubic of an axis's bias (shape plus mean turn-on constant) in d = T - reference."""
+def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool,
+             to_si: float = DEG_TO_RAD) -> CubicFit:
+    """Least-squares cubic of an axis's bias (shape plus mean turn-on constant) in d = T - reference;
+    ``to_si`` converts the model's unit to the autopilot's (deg/s -> rad/s, or g -> m/s^2)."""
     curve = axis.temperature
     if curve is None:
         raise InputError("export: the model has no temperature curve on this axis; fit one (--temperature poly)")
@@ -57,14 +66,15 @@ def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool) 
     coef, *_ = np.linalg.lstsq(powers, target, rcond=None)
     error = float(np.max(np.abs(powers @ coef - target)))
     full = tuple(float(c) for c in coef) if with_constant else (0.0, *map(float, coef))
-    return CubicFit(tuple(c * DEG_TO_RAD for c in full), reference_degc, curve.t_min_degc, curve.t_max_degc, error)
+    return CubicFit(tuple(c * to_si for c in full), reference_degc, curve.t_min_degc, curve.t_max_degc, error)
 
 
 def _warn_left_out(calibration: Calibration, target: str) -> None:
     parts = []
-    if any(ax.lag_time_constant_s > 0 for ax in calibration.axes.values()):
+    every = list(calibration.axes.values()) + list(calibration.accel_axes.values())
+    if any(ax.lag_time_constant_s > 0 for ax in every):
         parts.append("thermal lag")
-    if calibration.has_hysteresis:
+    if any(ax.hysteresis is not None for ax in every):
         parts.append("hysteresis")
     if any(ax.needs_accel for ax in calibration.axes.values()):
         parts.append("g-sensitivity")
@@ -74,13 +84,13 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
                       DataQualityWarning, stacklevel=3)
 
 
-def _gyro_axes(calibration: Calibration) -> tuple[dict[str, AxisCalibration], float, float]:
-    """The gyro axes with a temperature curve, and the temperature range they cover together [degC]."""
+def _gyro_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
+    """The gyro axes with a temperature curve (refused when neither they nor accelerometer axes exist)."""
     axes = {name: ax for name, ax in calibration.axes.items() if name in AXIS_INDEX and ax.temperature is not None}
-    if not axes:
-        raise InputError("export: the model has no gyro axis with a temperature curve; nothing to export")
-    return (axes, min(ax.temperature.t_min_degc for ax in axes.values()),
-            max(ax.temperature.t_max_degc for ax in axes.values()))
+    if not axes and not _accel_axes(calibration):
+        raise InputError("export: the model has no gyro or accelerometer axis with a temperature curve; "
+                         "nothing to export")
+    return axes
 
 
 @dataclass(frozen=True)
@@ -91,53 +101,73 @@ class AutopilotParameters:
     fits: dict[str, CubicFit]
 
 
+def _accel_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
+    return {name: ax for name, ax in calibration.accel_axes.items() if name in ACCEL_INDEX and ax.temperature is not None}
+
+
+def _range(axes: dict[str, AxisCalibration]) -> tuple[float, float]:
+    return (min(ax.temperature.t_min_degc for ax in axes.values()), max(ax.temperature.t_max_degc for ax in axes.values()))
+
+
 def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: int = 0) -> AutopilotParameters:
-    """``TC_G{instance}_*`` for PX4: TREF is the middle of the model's range, SCL 1, axes not in the model 0."""
+    """``TC_G{instance}_*`` (and ``TC_A{instance}_*``) for PX4: TREF is the middle of the model's range,
+    SCL 1, axes not in the model 0."""
     if not 0 <= instance <= 3:
         raise InputError(f"--instance: PX4 has thermal compensation for gyros 0..3, got {instance}")
     _warn_left_out(calibration, "PX4")
-    axes, t_min, t_max = _gyro_axes(calibration)
-    t_ref = 0.5 * (t_min + t_max)
-    p = f"TC_G{instance}_"
-    values: dict[str, float] = {"TC_G_ENABLE": 1, f"{p}ID": int(device_id), f"{p}TMIN": t_min, f"{p}TMAX": t_max,
-                                f"{p}TREF": t_ref}
+    values: dict[str, float] = {}
     fits = {}
-    for name, j in AXIS_INDEX.items():
-        fit = cubic_of(axes[name], t_ref, with_constant=True) if name in axes else None
-        coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
-        for k in range(4):
-            values[f"{p}X{k}_{j}"] = coef[k]
-        values[f"{p}SCL_{j}"] = 1.0
-        if fit:
-            fits[name] = fit
+    for sensor, axes, index, to_si, with_constant in (
+            ("G", _gyro_axes(calibration), AXIS_INDEX, DEG_TO_RAD, True),
+            ("A", _accel_axes(calibration), ACCEL_INDEX, G_TO_M_PER_S2, False)):
+        if not axes:
+            continue
+        t_min, t_max = _range(axes)
+        t_ref = 0.5 * (t_min + t_max)
+        p = f"TC_{sensor}{instance}_"
+        values.update({f"TC_{sensor}_ENABLE": 1, f"{p}ID": int(device_id), f"{p}TMIN": t_min, f"{p}TMAX": t_max,
+                       f"{p}TREF": t_ref})
+        for name, j in index.items():
+            fit = cubic_of(axes[name], t_ref, with_constant=with_constant, to_si=to_si) if name in axes else None
+            coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
+            for k in range(4):
+                values[f"{p}X{k}_{j}"] = coef[k]
+            values[f"{p}SCL_{j}"] = 1.0
+            if fit:
+                fits[name] = fit
     return AutopilotParameters(values, fits)
 
 
 def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> AutopilotParameters:
-    """``INS_TCAL{instance}_*`` for ArduPilot: cubic without constant about 35 degC, coefficients x 1e6."""
+    """``INS_TCAL{instance}_*`` for ArduPilot: cubic without constant about 35 degC, coefficients x 1e6
+    (gyro in rad/s, accelerometer in m/s^2)."""
     if not 1 <= instance <= 3:
         raise InputError(f"--instance: ArduPilot numbers its IMUs 1..3, got {instance}")
     _warn_left_out(calibration, "ArduPilot")
-    axes, t_min, t_max = _gyro_axes(calibration)
+    gyro, accel = _gyro_axes(calibration), _accel_axes(calibration)
+    t_min, t_max = _range({**gyro, **accel})
     p = f"INS_TCAL{instance}_"
     values: dict[str, float] = {f"{p}ENABLE": 1, f"{p}TMIN": t_min, f"{p}TMAX": t_max}
     fits = {}
-    for name, j in AXIS_INDEX.items():
-        fit = cubic_of(axes[name], ARDUPILOT_TEMP_REFERENCE_DEGC, with_constant=False) if name in axes else None
-        coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
-        for k in (1, 2, 3):
-            values[f"{p}GYR{k}_{'XYZ'[j]}"] = coef[k] * ARDUPILOT_SCALE
-        if fit:
-            fits[name] = fit
+    for sensor, axes, index, to_si in (("ACC", accel, ACCEL_INDEX, G_TO_M_PER_S2), ("GYR", gyro, AXIS_INDEX, DEG_TO_RAD)):
+        for name, j in index.items():
+            fit = cubic_of(axes[name], ARDUPILOT_TEMP_REFERENCE_DEGC, with_constant=False, to_si=to_si) \
+                if name in axes else None
+            coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
+            for k in (1, 2, 3):
+                values[f"{p}{sensor}{k}_{'XYZ'[j]}"] = coef[k] * ARDUPILOT_SCALE
+            if fit:
+                fits[name] = fit
     return AutopilotParameters(values, fits)
 
 
 def _header(calibration: Calibration, params: AutopilotParameters, target: str, comment: str) -> list[str]:
     lines = [f"{comment} {target} thermal calibration written by gyrocomp from model {calibration.model!r}",
-             f"{comment} gyro bias as a cubic in temperature [rad/s]; largest difference from the gyrocomp model over "
-             "its range:"]
+             f"{comment} bias as a cubic in temperature [rad/s, accelerometer m/s^2]; largest difference from the "
+             "gyrocomp model over its range:"]
     for name, fit in params.fits.items():
-        lines.append(f"{comment}   {name}: {fit.max_error_dps:.3g} deg/s over {fit.t_min_degc:.2f}..{fit.t_max_degc:.2f} degC")
+        unit = "g" if name in ACCEL_INDEX else "deg/s"
+        lines.append(f"{comment}   {name}: {fit.max_error_dps:.3g} {unit} over {fit.t_min_degc:.2f}..{fit.t_max_degc:.2f} degC")
     return lines
 
 
@@ -147,7 +177,7 @@ def px4_params_file(calibration: Calibration, **options) -> str:
     lines = _header(calibration, params, "PX4", "#")
     lines.append("# Vehicle-Id Component-Id Name Value Type")
     for name, value in params.values.items():
-        integer = name == "TC_G_ENABLE" or name.endswith("_ID")
+        integer = name in ("TC_G_ENABLE", "TC_A_ENABLE") or name.endswith("_ID")
         lines.append(f"1\t1\t{name}\t{int(value) if integer else format(np.float32(value), '.9g')}\t{6 if integer else 9}")
     return "\n".join(lines) + "\n"
 

@@ -273,22 +273,27 @@ def _write_arrow(table: pa.Table, path: Path, fmt: str) -> None:
             pacsv.write_csv(table, tmp)
 
 
-def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLike, *, fmt: str | None = None) -> None:
-    """Write the table as read with its gyro columns replaced by ``gyro_dps`` [deg/s].
+def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLike, *, fmt: str | None = None,
+                    accel_g: np.ndarray | None = None) -> None:
+    """Write the table as read with its gyro columns replaced by ``gyro_dps`` [deg/s] (and its accelerometer
+    columns by ``accel_g`` [g], when given).
 
-    Values are converted back to the file's gyro unit; rows dropped on reading get NaN;
+    Values are converted back to the file's units; rows dropped on reading get NaN;
     every other column, the column order and the row count are unchanged. Written atomically.
     """
     path = Path(path)
     fmt = fmt or detect_table_format(path) or "csv"
-    factor = unit_factor("gyro", data.layout.gyro_unit)
     table = data.table
     n = table.num_rows
-    for j, axis in enumerate(data.recording.gyro_axes):
-        column = data.resolved_columns[axis]
-        values = np.full(n, np.nan)
-        values[data.kept_rows] = gyro_dps[:, j] / factor
-        table = table.set_column(table.column_names.index(column), column, pa.array(values, type=pa.float64()))
+    replaced = [(data.recording.gyro_axes, gyro_dps, unit_factor("gyro", data.layout.gyro_unit))]
+    if accel_g is not None:
+        replaced.append((data.recording.accel_axes, accel_g, unit_factor("accel", data.layout.accel_unit)))
+    for axes, values_internal, factor in replaced:
+        for j, axis in enumerate(axes):
+            column = data.resolved_columns[axis]
+            values = np.full(n, np.nan)
+            values[data.kept_rows] = values_internal[:, j] / factor
+            table = table.set_column(table.column_names.index(column), column, pa.array(values, type=pa.float64()))
     _write_arrow(table, path, fmt)
 
 

@@ -8,12 +8,11 @@ import math
 import warnings
 from pathlib import Path
 
+import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError, TemperatureRangeWarning
-from ..recording import Recording
-import numpy as np
-
+from ..recording import ACCEL_AXES, Recording
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from .base import bin_width_for
 from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_INPUTS, MLPTemperatureModel
@@ -132,7 +131,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                     hysteresis_order: int | str = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
                     acceleration: str = "auto", static_min_duration_s: float = 10.0,
-                    network_inputs: tuple[str, ...] = ("temperature",)) -> Calibration:
+                    network_inputs: tuple[str, ...] = ("temperature",),
+                    run_folds: tuple[int, ...] | None = None) -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -165,6 +165,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     network_inputs : tuple of str
         What a network (``temperature="mlp"``) reads: the temperature, or also ``accel_x``, ``accel_y``,
         ``accel_z`` (the joint network of the ``joint-mlp`` pipeline, which then fits no separate G).
+    run_folds : tuple of int, optional
+        The validation fold of each recording for the polynomial order (pieces of one run left out together).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
@@ -197,7 +199,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     if temperature == "mlp" or (isinstance(temperature, tuple) and temperature[0] == "mlp"):
         hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
         temperature = "auto"  # the polynomial still finds lag and hysteresis for the network
-    model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc).fit(recordings)
+    model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
+                                       folds=run_folds).fit(recordings)
     accel_mode = acceleration
     if accel_mode == "auto":
         accel_mode = "matrix" if _turned_between_positions(recordings, static_min_duration_s) else "none"
@@ -384,4 +387,98 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
     return _chain(first, second, recordings, pipeline)
 
 
-__all__ = ["PIPELINES", "fit_calibration", "fit_pipeline"]
+#: what ``gyrocomp fit --channels`` can model
+CHANNELS = ("gyro", "accel")
+#: options of :func:`fit_calibration` that the accelerometer's temperature model takes too
+_ACCEL_OPTIONS = ("temperature", "bin_width_degc", "hysteresis", "hysteresis_order", "hysteresis_band_degc",
+                  "mlp_seed", "static_min_duration_s")
+
+
+def parse_channels(text: str | tuple | list) -> tuple[str, ...]:
+    """``"gyro,accel"`` -> ``("gyro", "accel")``, checked."""
+    items = tuple(c.strip() for c in (text.split(",") if isinstance(text, str) else text) if c.strip())
+    unknown = [c for c in items if c not in CHANNELS]
+    if unknown or not items:
+        raise InputError(f"--channels: {','.join(unknown) or repr(text)}: use gyro, accel or gyro,accel")
+    return tuple(c for c in CHANNELS if c in items)
+
+
+def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> tuple[list[Recording], tuple, bool]:
+    """Each run's accelerometer as a signal to fit against temperature: the whole run when it stays in one
+    orientation, else each static segment on its own (its own constant absorbs its gravity projection).
+    Also gives the run each piece comes from (its validation fold), and whether some run was split."""
+    from ..static import orientations, static_segments
+
+    pieces, folds, split = [], [], False
+    for run, rec in enumerate(recordings):
+        if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
+            raise InputError(f"{rec.source}: --channels accel needs accel_x, accel_y and accel_z columns [g]")
+        if rec.temperature_degc is None:
+            raise InputError(f"{rec.source}: no temperature column; an accelerometer temperature model needs one")
+        accel = rec.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
+        temperature = rec.temperature_degc if rec.temperature_degc.ndim == 1 else rec.temperature_degc.mean(axis=1)
+        signal = Recording(time_s=rec.time_s, gyro_dps=accel, gyro_axes=ACCEL_AXES, temperature_degc=temperature,
+                           source=rec.source, row_numbers=rec.row_numbers)
+        segments = static_segments(rec, min_duration_s=min_static_s)
+        if len(orientations(segments)) > 1:
+            pieces += [signal.take(slice(seg.start, seg.stop)) for seg in segments]
+            folds += [run] * len(segments)
+            split = True
+        else:
+            pieces.append(signal)
+            folds.append(run)
+    return pieces, tuple(folds), split
+
+
+def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
+    """Temperature models of the accelerometer axes (polynomial or network, lag and hysteresis as for the
+    gyro), with a constant per run, or per static segment when a run turns the unit.
+
+    Returns a calibration with only ``accel_axes``; its correction is relative to the middle of the
+    calibrated temperature range (``accel_reference_degc``), since at rest the accelerometer's constant
+    cannot be told from gravity. ``options``: those of :func:`fit_calibration` for the temperature model.
+    When a run turns the unit, its static segments are fitted as separate pieces, and lag and hysteresis
+    (which need each piece's whole temperature history, and a validation over dozens of short pieces)
+    are left out unless asked for by name.
+    """
+    unknown = sorted(set(options) - set(_ACCEL_OPTIONS))
+    if unknown:
+        raise InputError(f"fit_accelerometer: options {', '.join(unknown)} are for the gyro only")
+    pieces, folds, split = _accelerometer_pieces(recordings, options.get("static_min_duration_s", 10.0))
+    if split and options.get("hysteresis", "auto") == "auto":
+        options = {**options, "hysteresis": "none"}
+    fitted = fit_calibration(pieces, acceleration="none", run_folds=folds, **options)
+    t_min = min(ax.temperature.t_min_degc for ax in fitted.axes.values())
+    t_max = max(ax.temperature.t_max_degc for ax in fitted.axes.values())
+    return Calibration(axes={}, model=f"accel {fitted.model}", provenance=_provenance(recordings),
+                       fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}},
+                       accel_axes=fitted.axes, accel_reference_degc=0.5 * (t_min + t_max))
+
+
+def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, ...] | str = ("gyro",),
+                 pipeline: str = "joint", **options) -> Calibration:
+    """Fit the gyro (``fit_pipeline``), the accelerometer (``fit_accelerometer``), or both.
+
+    With both, the accelerometer is modelled first and the gyro's g-sensitivity stage is fitted on the
+    temperature-compensated accelerations (the same ones the compensation will feed it).
+    """
+    if isinstance(recordings, Recording):
+        recordings = [recordings]
+    recordings = list(recordings)
+    channels = parse_channels(channels)
+    if "accel" not in channels:
+        return fit_pipeline(recordings, pipeline, **options)
+    accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
+    if "gyro" not in channels:
+        return accel_cal
+    from ..compensate import apply
+
+    compensated = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
+    gyro_cal = fit_pipeline(compensated, pipeline, **options)
+    return dataclasses.replace(gyro_cal, model=f"{gyro_cal.model}; {accel_cal.model}",
+                               fit_report={**gyro_cal.fit_report, **accel_cal.fit_report},
+                               accel_axes=accel_cal.accel_axes, accel_reference_degc=accel_cal.accel_reference_degc)
+
+
+__all__ = ["CHANNELS", "PIPELINES", "fit_accelerometer", "fit_calibration", "fit_channels", "fit_pipeline",
+           "parse_channels"]

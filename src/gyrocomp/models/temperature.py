@@ -114,6 +114,7 @@ class _Design:
     t_scale: float
     t_min: float
     t_max: float
+    folds: np.ndarray  # the validation fold of each run (runs of one fold are left out together)
 
     def powers(self, temperature: np.ndarray, order: int, t_min=None, t_max=None) -> np.ndarray:
         lo = self.t_min if t_min is None else t_min
@@ -138,22 +139,26 @@ def _solve(design: _Design, order: int, runs: np.ndarray) -> tuple[np.ndarray, n
 
 
 def _leave_one_run_out(design: _Design, order: int) -> float:
-    """RMS error [deg/s] of bins of each run predicted by a fit on the other runs (constant refitted)."""
+    """RMS error [deg/s] of bins of each run predicted by a fit on the runs of the other folds (each run's
+    constant refitted); with one fold per run, leave one run out."""
     b = design.bins
     sse = wsum = 0.0
     all_runs = np.arange(design.n_runs)
-    for held in all_runs:
-        train = all_runs[all_runs != held]
+    for fold in np.unique(design.folds):
+        train = all_runs[design.folds != fold]
         tr = np.isin(b.run, train)
         shape, _, _ = _solve(design, order, train)
-        sel = b.run == held
-        t, y, w = b.temperature_degc[sel], b.value[sel], b.weight[sel]
         lo, hi = b.temperature_degc[tr].min(), b.temperature_degc[tr].max()
-        pred = design.powers(t, order, lo, hi) @ shape if order else np.zeros_like(y)
-        e = y - pred
-        e -= np.sum(w * e) / np.sum(w)
-        sse += float(np.sum(w * e**2))
-        wsum += float(np.sum(w))
+        for held in all_runs[design.folds == fold]:
+            sel = b.run == held
+            t, y, w = b.temperature_degc[sel], b.value[sel], b.weight[sel]
+            if not y.size:
+                continue
+            pred = design.powers(t, order, lo, hi) @ shape if order else np.zeros_like(y)
+            e = y - pred
+            e -= np.sum(w * e) / np.sum(w)
+            sse += float(np.sum(w * e**2))
+            wsum += float(np.sum(w))
     return math.sqrt(sse / wsum)
 
 
@@ -177,6 +182,9 @@ class PolynomialTemperatureModel:
         Highest order tried by ``"auto"``.
     bin_width_degc : float, optional
         Temperature bin width [degC]; default: the temperature span / 100.
+    folds : tuple of int, optional
+        The validation fold of each recording: pieces of one run (its static positions, each with its own
+        constant) are left out together. Default: one fold per recording.
 
     Attributes (after ``fit``)
     --------------------------
@@ -195,6 +203,7 @@ class PolynomialTemperatureModel:
     order: int | str = "auto"
     max_order: int = MAX_ORDER
     bin_width_degc: float | None = None
+    folds: tuple[int, ...] | None = None
     _fitted: bool = field(default=False, init=False, repr=False)
 
     def fit(self, recordings: list[Recording]) -> "PolynomialTemperatureModel":
@@ -221,7 +230,11 @@ class PolynomialTemperatureModel:
             t_min = min(float(t.min()) for t in temps)
             t_max = max(float(t.max()) for t in temps)
             span = t_max - t_min
-            design = _Design(bins, len(recordings), (t_min + t_max) / 2, span / 2 if span > 0 else 1.0, t_min, t_max)
+            folds = np.arange(len(recordings)) if self.folds is None else np.asarray(self.folds)
+            if folds.shape != (len(recordings),):
+                raise InputError(f"folds: {folds.size} given for {len(recordings)} recordings; give one per recording")
+            design = _Design(bins, len(recordings), (t_min + t_max) / 2, span / 2 if span > 0 else 1.0, t_min, t_max,
+                             folds)
             distinct = np.unique(bins.temperature_degc).size
             order = self._choose_order(axis, design, distinct)
             shape, consts, rss = _solve(design, order, np.arange(len(recordings)))
@@ -244,7 +257,7 @@ class PolynomialTemperatureModel:
             self.scores_[axis] = {}
             return int(self.order)
         candidates = list(range(0, min(self.max_order, usable) + 1))
-        if design.n_runs >= 2:
+        if np.unique(design.folds).size >= 2:
             self.selection_ = "leave-one-run-out"
             scores = {p: _leave_one_run_out(design, p) for p in candidates}
             best = min(scores.values())

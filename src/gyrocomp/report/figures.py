@@ -1,4 +1,17 @@
-"""Single figures, written atomically as PNG, SVG or PDF (from the suffix)."""
+"""The figures of a test report, as matplotlib figures (extra ``[plot]``, Agg backend), and written
+atomically as PNG, SVG or PDF (from the suffix).
+
+Every figure is computed on the full data and drawn from a decimated copy: a 24 h run at 100 Hz
+(8.6 million samples) is drawn as a min/max envelope of ``DRAW_POINTS`` columns, and scatter plots
+are binned or thinned, so the figures stay readable and fast.
+
+- :func:`allan_plot`: Allan deviation of raw and compensated data, 68 % intervals, the -1/2, 0 and +1/2
+  slope lines of the identified noise terms, the bias-instability points;
+- :func:`temperature_plot`: bias against temperature, heating and cooling branches in their own colours,
+  the fitted curve, the turning points, and the residual against temperature;
+- :func:`timeseries_plot`: raw and compensated output against time with their moving averages;
+- :func:`g_sensitivity_plot`: the offset of each static position against each accelerometer axis, with G.
+"""
 
 from __future__ import annotations
 
@@ -7,11 +20,16 @@ import os
 import numpy as np
 
 from ..allan import BIAS_INSTABILITY_FACTOR
-from ..errors import InputError
+from ..errors import InputError, MissingDependencyError
 from ..io.atomic import atomic_path
 from ..noise import NoiseAnalysis
 
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+DRAW_POINTS = 2000
+RAW_COLOUR, COMP_COLOUR = "tab:gray", "tab:blue"
+HEATING_COLOUR, COOLING_COLOUR = "tab:red", "tab:blue"
 
 
 def _pyplot():
@@ -20,9 +38,50 @@ def _pyplot():
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise InputError("plots need matplotlib: pip install 'gyrocomp[plot]'") from exc
+    except ImportError:
+        raise MissingDependencyError("plots need the optional package matplotlib; install it with: "
+                                     "pip install 'gyrocomp[plot]'") from None
     return plt
+
+
+def require_matplotlib() -> None:
+    """Raise the one-line :class:`MissingDependencyError` now, before long work, when matplotlib is missing."""
+    _pyplot()
+
+
+def save_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
+    """Write a figure atomically, in the format its suffix names, and close it."""
+    suffix = check_figure_path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=suffix[1:], dpi=dpi)
+    _pyplot().close(fig)
+
+
+def envelope(time_s: np.ndarray, values: np.ndarray, columns: int = DRAW_POINTS) -> tuple[np.ndarray, np.ndarray]:
+    """A series cut to at most ``2 * columns`` points that keep its look: each column's minimum and maximum,
+    in time order (for drawing only)."""
+    n = values.size
+    if n <= 2 * columns:
+        return time_s, values
+    edges = np.linspace(0, n, columns + 1).astype(int)
+    starts = edges[:-1]
+    lo = np.minimum.reduceat(values, starts)
+    hi = np.maximum.reduceat(values, starts)
+    mid_t = time_s[np.minimum((edges[:-1] + edges[1:]) // 2, n - 1)]
+    t = np.repeat(mid_t, 2)
+    v = np.column_stack([lo, hi]).reshape(-1)
+    return t, v
+
+
+def _slope_lines(panel, terms, tau: np.ndarray, colour) -> None:
+    """The identified terms' asymptotes: N/sqrt(tau), the bias-instability floor 0.664 B, K sqrt(tau/3)."""
+    tau = np.asarray(tau, dtype=float)
+    if terms.white_noise_density > 0:
+        panel.plot(tau, terms.white_noise_density / np.sqrt(tau), ":", color=colour, lw=0.9)
+    if terms.bias_instability > 0:
+        panel.plot(tau, np.full(tau.size, terms.bias_instability * BIAS_INSTABILITY_FACTOR), ":", color=colour, lw=0.9)
+    if terms.random_walk > 0:
+        panel.plot(tau, terms.random_walk * np.sqrt(tau / 3.0), ":", color=colour, lw=0.9)
 
 
 def check_figure_path(path) -> str:
@@ -68,3 +127,176 @@ def allan_figure(analysis: NoiseAnalysis, path: str | os.PathLike) -> None:
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=suffix[1:], dpi=120)
     plt.close(fig)
+
+
+def allan_plot(analyses: dict, title: str = "Allan deviation"):
+    """Allan deviation of each labelled analysis (``{"raw": NoiseAnalysis, "compensated": ...}``), one panel
+    per axis, with 68 % intervals, the slope lines (dotted) of the identified white noise (-1/2), bias
+    instability (0) and rate random walk (+1/2), and the bias-instability points (triangles)."""
+    plt = _pyplot()
+    first = next(iter(analyses.values()))
+    axes = [a for a in first.axes if np.any(first.axes[a].curve.deviation > 0)]
+    if not axes:
+        raise InputError(f"{first.source}: every analysed channel is constant; nothing to plot")
+    fig, panels = plt.subplots(1, len(axes), figsize=(5.5 * len(axes), 4.4), squeeze=False)
+    colours = {"raw": RAW_COLOUR, "compensated": COMP_COLOUR}
+    for panel, axis in zip(panels[0], axes):
+        unit = first.axes[axis].unit
+        for i, (label, analysis) in enumerate(analyses.items()):
+            a = analysis.axes[axis]
+            c, colour = a.curve, colours.get(label, f"C{i + 2}")
+            errors = np.vstack([c.deviation - c.ci_low, c.ci_high - c.deviation])
+            b = a.terms.bias_instability
+            b_text = f"{b * 3600.0:.3g} deg/h" if unit == "deg/s" else f"{b * 1e6:.3g} ug" if unit == "g" else \
+                f"{b:.3g} {unit}"
+            panel.errorbar(c.tau, c.deviation, yerr=np.nan_to_num(errors), fmt="o-", ms=3, capsize=2, color=colour,
+                           label=f"{label}: B = {b_text} at {a.terms.integration_time_s:.3g} s")
+            _slope_lines(panel, a.terms, c.tau, colour)
+            panel.plot([a.terms.integration_time_s], [a.terms.bias_instability * BIAS_INSTABILITY_FACTOR], "v",
+                       color=colour, ms=9, mec="black")
+        panel.set_xscale("log")
+        panel.set_yscale("log")
+        panel.set_title(axis)
+        panel.set_xlabel("averaging time tau [s]")
+        panel.set_ylabel(f"Allan deviation [{unit}]")
+        panel.grid(True, which="both", alpha=0.3)
+        panel.legend(fontsize="small", loc="best")
+    fig.suptitle(f"{title} (dotted: -1/2, 0, +1/2 slope lines of the identified terms; triangle: bias "
+                 "instability)", fontsize="medium")
+    fig.tight_layout()
+    return fig
+
+
+def _branches(temperature: np.ndarray) -> np.ndarray:
+    """+1 where the temperature rises, -1 where it falls (robust turning points), 0 before the first move."""
+    from ..effects import find_turns
+    from ..models.thermal import turn_threshold_degc
+
+    return find_turns(temperature, turn_threshold_degc(temperature)).direction
+
+
+def _binned(t: np.ndarray, y: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray]:
+    if t.size == 0:
+        return t, y
+    index = np.floor((t - t.min()) / width).astype(int)
+    counts = np.bincount(index)
+    keep = counts > 0
+    return (np.bincount(index, t)[keep] / counts[keep], np.bincount(index, y)[keep] / counts[keep])
+
+
+def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: str | None = None):
+    """Bias against temperature of one axis of one or more runs: the raw output (binned by 0.25 % of the
+    range on each branch, heating red, cooling blue), the model's correction (black), the turning points
+    (diamonds); and, below, the residual after compensation against temperature.
+
+    ``raw`` and ``compensated`` are lists of recordings (the same runs before and after); each run is
+    shifted by the mean of its compensated output so runs with different turn-on biases line up."""
+    plt = _pyplot()
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8.0, 7.0), sharex=True, height_ratios=(3, 2))
+    accel = axis.startswith("accel")
+    labelled = set()
+    for rec, comp in zip(raw, compensated):
+        j = (rec.accel_axes if accel else rec.gyro_axes).index(axis)
+        y_raw = (rec.accel_g if accel else rec.gyro_dps)[:, j]
+        y_comp = (comp.accel_g if accel else comp.gyro_dps)[:, j]
+        t = rec.temperature_degc if rec.temperature_degc.ndim == 1 else (
+            rec.temperature_degc.mean(axis=1) if accel else rec.temperature_for(axis))
+        offset = float(np.mean(y_comp))
+        correction = y_raw - y_comp
+        width = max(float(np.ptp(t)) / 400.0, 1e-3)
+        direction = _branches(t)
+        for sign, colour, name in ((1, HEATING_COLOUR, "heating"), (-1, COOLING_COLOUR, "cooling"),
+                                   (0, "tab:gray", "before the first move")):
+            sel = direction == sign
+            if not sel.any():
+                continue
+            tb, yb = _binned(t[sel], y_raw[sel] - offset, width)
+            top.plot(tb, yb, ".", ms=3, color=colour, alpha=0.7, label=None if name in labelled else f"raw, {name}")
+            labelled.add(name)
+            tc, yc = _binned(t[sel], correction[sel], width)
+            top.plot(tc, yc, "-", color="black", lw=1.2,
+                     label=None if "model" in labelled else "model correction")
+            labelled.add("model")
+            tr, yr = _binned(t[sel], y_comp[sel] - offset, width)
+            bottom.plot(tr, yr, ".", ms=3, color=colour, alpha=0.7)
+        turns = np.flatnonzero(np.diff(direction) != 0) + 1
+        turns = turns[direction[turns - 1] != 0]
+        if turns.size:
+            top.plot(t[turns], (y_raw - offset)[turns], "D", color="black", ms=6, mfc="gold",
+                     label=None if "turn" in labelled else "turning points")
+            labelled.add("turn")
+    top.set_ylabel(f"bias [{unit}]")
+    top.set_title(title or f"{axis}: bias against temperature")
+    top.grid(True, alpha=0.3)
+    top.legend(fontsize="small", loc="best")
+    bottom.axhline(0.0, color="black", lw=0.8)
+    bottom.set_xlabel("temperature [degC]")
+    bottom.set_ylabel(f"residual [{unit}]")
+    bottom.set_title("after compensation", fontsize="medium")
+    bottom.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "deg/s", title: str | None = None):
+    """Raw and compensated output of one axis against time (min/max envelope), with their moving averages
+    over ``window_s`` [s] (computed on every sample, drawn decimated), and the temperature."""
+    from ..metrics import moving_average, window_samples
+
+    plt = _pyplot()
+    accel = axis.startswith("accel")
+    j = (raw.accel_axes if accel else raw.gyro_axes).index(axis)
+    series = {"raw": (raw.accel_g if accel else raw.gyro_dps)[:, j],
+              "compensated": (compensated.accel_g if accel else compensated.gyro_dps)[:, j]}
+    hours = raw.duration_s > 3 * 3600
+    scale, t_unit = (1 / 3600.0, "h") if hours else (1.0, "s")
+    t = (raw.time_s - raw.time_s[0]) * scale
+    w = window_samples(window_s, raw.rate_hz, raw.n_samples)
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9.0, 6.5), sharex=True, height_ratios=(3, 1))
+    for (label, y), colour in zip(series.items(), (RAW_COLOUR, COMP_COLOUR)):
+        te, ye = envelope(t, y)
+        top.plot(te, ye, "-", color=colour, lw=0.5, alpha=0.35)
+        smooth = moving_average(y, w)
+        ts = t[w // 2: w // 2 + smooth.size]
+        ts, smooth = envelope(ts, smooth)
+        top.plot(ts, smooth, "-", color=colour, lw=1.6, label=f"{label}, {window_s:.3g} s moving average")
+    top.set_ylabel(f"{axis} [{unit}]")
+    top.set_title(title or f"{axis}: raw and compensated output")
+    top.grid(True, alpha=0.3)
+    top.legend(fontsize="small", loc="best")
+    if raw.temperature_degc is not None:
+        temp = raw.temperature_degc if raw.temperature_degc.ndim == 1 else raw.temperature_degc.mean(axis=1)
+        bottom.plot(*envelope(t, temp), "-", color="tab:red", lw=1.0)
+    bottom.set_ylabel("temperature [degC]")
+    bottom.set_xlabel(f"time [{t_unit}]")
+    bottom.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def g_sensitivity_plot(positions: dict, g_matrix: dict, title: str = "g-sensitivity"):
+    """The offset of each static position against each accelerometer axis, with the fitted G.
+
+    ``positions``: gyro axis -> (gravity [g] (m, 3), offset [deg/s] (m,)), the offsets with the temperature
+    model and the run constants removed; ``g_matrix``: gyro axis -> (G row [deg/s/g], standard errors)."""
+    plt = _pyplot()
+    names = list(positions)
+    fig, panels = plt.subplots(len(names), 3, figsize=(11.0, 3.0 * len(names)), squeeze=False)
+    for r, axis in enumerate(names):
+        gravity, offset = positions[axis]
+        row, errors = g_matrix[axis]
+        for k, accel_axis in enumerate(("accel_x", "accel_y", "accel_z")):
+            panel = panels[r][k]
+            x = gravity[:, k]
+            others = offset - sum(row[i] * gravity[:, i] for i in range(3) if i != k)
+            panel.plot(x, others, "o", ms=4, color="tab:blue", label="static positions")
+            grid = np.linspace(min(-1.0, float(x.min())), max(1.0, float(x.max())), 3)
+            se = "" if errors[k] is None else f" +- {errors[k]:.2g}"
+            panel.plot(grid, row[k] * grid, "-", color="black", label=f"G = {row[k]:.3g}{se} deg/s/g")
+            panel.set_xlabel(f"{accel_axis} [g]")
+            panel.set_ylabel(f"{axis} offset [deg/s]")
+            panel.grid(True, alpha=0.3)
+            panel.legend(fontsize="x-small", loc="best")
+    fig.suptitle(f"{title} (other axes' terms removed from each panel's points)", fontsize="medium")
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,300 @@
+"""One self-contained HTML test report: a model and the runs it was judged on.
+
+Images are PNGs embedded as data URIs and the style sheet is inline, so the file opens anywhere with
+no network access. Sections (each an ``<section id=...>``): ``summary`` (the model: type, order, inputs,
+valid ranges, validation scores, the candidates compared), ``evaluation`` (the thesis's figures of merit,
+by stage when the model has stages), one ``axis-<name>`` per axis (bias against temperature with the
+heating and cooling branches, fitted curve, turning points and residual; raw and compensated output
+against time), ``allan`` (raw and compensated Allan deviation per run), and ``g-sensitivity`` when the
+model has a g-sensitivity matrix.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import io
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import __version__
+from ..calibration import Calibration
+from ..compensate import apply
+from ..errors import DataQualityWarning, TemperatureRangeWarning
+from ..metrics import default_window_s, evaluate_run, evaluate_stages, stage_calibrations
+from ..noise import analyse_noise
+from ..recording import ACCEL_AXES, Recording
+from . import figures
+
+SECTIONS = ("summary", "evaluation", "allan")
+_CSS = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
+h1 { font-size: 1.6em; } h2 { border-bottom: 2px solid #ccc; padding-bottom: 0.2em; margin-top: 2em; }
+table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
+th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }
+th { background: #eef; } td:first-child, th:first-child { text-align: left; }
+img { max-width: 100%; display: block; margin: 0.6em 0; border: 1px solid #ddd; }
+.note { color: #555; font-size: 0.9em; } nav a { margin-right: 1em; }
+"""
+
+
+@dataclass(frozen=True)
+class Report:
+    """The report's HTML text and the ids of its sections, in order."""
+
+    html: str
+    sections: tuple[str, ...]
+
+
+def _png(fig) -> str:
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=90)
+    figures._pyplot().close(fig)
+    return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def _img(fig, alt: str) -> str:
+    return f'<img src="{_png(fig)}" alt="{html.escape(alt)}">'
+
+
+def _table(header: list[str], rows: list[list], caption: str | None = None) -> str:
+    out = ["<table>"]
+    if caption:
+        out.append(f"<caption>{html.escape(caption)}</caption>")
+    out.append("<tr>" + "".join(f"<th>{html.escape(str(h))}</th>" for h in header) + "</tr>")
+    for row in rows:
+        out.append("<tr>" + "".join(f"<td>{html.escape(_fmt(v))}</td>" for v in row) + "</tr>")
+    out.append("</table>")
+    return "\n".join(out)
+
+
+def _fmt(value) -> str:
+    if isinstance(value, float):
+        return "-" if not np.isfinite(value) else f"{value:.4g}"
+    return "-" if value is None else str(value)
+
+
+def _describe(ax) -> str:
+    if ax.temperature is None:
+        return "constant"
+    order = ax.temperature.order
+    text = f"polynomial order {order}" if isinstance(order, int) else f"network {order}"
+    if ax.lag_time_constant_s > 0:
+        text += f", thermal lag {ax.lag_time_constant_s:.3g} s"
+    if ax.hysteresis is not None:
+        band = "" if ax.hysteresis.band_degc is None else \
+            f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
+        text += f", turning-point hysteresis order {ax.hysteresis.order}{band}"
+    if ax.has_acceleration_stage:
+        text += ", g-sensitivity"
+    return text
+
+
+def _summary(calibration: Calibration) -> str:
+    report = calibration.fit_report
+    parts = [f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
+             f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>"]
+    rows = []
+    for group, axes, unit in (("gyro", calibration.axes, "deg/s"), ("accelerometer", calibration.accel_axes, "g")):
+        for name, ax in axes.items():
+            inputs = ", ".join(getattr(ax.temperature, "inputs", ("temperature",))) if ax.temperature else "-"
+            rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
+            info = (report.get("accel", {}) if group == "accelerometer" else report).get("axes", {}).get(name, {})
+            rms = info.get("fit_rms_dps")
+            rows.append([name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}",
+                         len(ax.turn_on_biases_dps)])
+    parts.append(_table(["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"], rows))
+    if calibration.accel_axes:
+        parts.append(f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
+                     "degC (its constant cannot be told from gravity at rest).</p>")
+    scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
+    if scores:
+        orders = sorted({int(p) for s in scores.values() for p in s})
+        how = report.get("order_selection", "")
+        parts.append(_table(["axis"] + [f"order {p}" for p in orders],
+                            [[a] + [s.get(str(p)) for p in orders] for a, s in scores.items()],
+                            f"polynomial order by {how} (lower is better)"))
+    hyst = report.get("hysteresis", {})
+    cand = {a: i for a, i in hyst.get("axes", {}).items() if i.get("scores_dps") or i.get("scores_bic")}
+    if cand:
+        names = sorted({c for i in cand.values() for c in (i.get("scores_dps") or i.get("scores_bic"))})
+        parts.append(_table(["axis"] + names + ["chosen"],
+                            [[a] + [(i.get("scores_dps") or i.get("scores_bic")).get(c) for c in names] + [i["chosen"]]
+                             for a, i in cand.items()],
+                            f"hysteresis / thermal lag candidates by {hyst.get('selection')} (lower is better)"))
+    prov = calibration.provenance
+    if prov:
+        files = ", ".join(str(f.get("file", f)) if isinstance(f, dict) else str(f) for f in prov.get("inputs", []))
+        parts.append(f"<p class=note>Fitted {html.escape(str(prov.get('created_utc', '')))} by gyrocomp "
+                     f"{html.escape(str(prov.get('gyrocomp_version', '')))} on {html.escape(files)}.</p>")
+    return "\n".join(parts)
+
+
+def _evaluation(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
+                window_s: float | None, turn_on_window_s: float | None) -> str:
+    staged = len(stage_calibrations(calibration)) > 1
+    parts = []
+    rows, accel_rows = [], []
+    for rec, comp in zip(runs, compensated):
+        name = html.escape(rec.source.rsplit("/", 1)[-1])
+        if staged:
+            st = evaluate_stages(calibration, rec, window_s=window_s, turn_on_window_s=turn_on_window_s)
+            first = next(iter(st.stages.values()))
+            for axis in first:
+                m0 = first[axis]
+                rows.append([name, axis, "raw", m0.bias_offset_raw_dps, "1x", m0.bias_instability_raw_dph,
+                             m0.integration_time_raw_s])
+                for stage, axes in st.stages.items():
+                    m = axes[axis]
+                    rows.append(["", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x",
+                                 m.bias_instability_comp_dph, m.integration_time_comp_s])
+        ev = evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
+        if not staged:
+            for axis, m in ev.axes.items():
+                rows.append([name, axis, "compensated", m.bias_offset_raw_dps, m.bias_offset_comp_dps,
+                             f"{m.offset_improvement:.3g}x", m.bias_instability_raw_dph, m.bias_instability_comp_dph,
+                             m.integration_time_raw_s, m.integration_time_comp_s])
+        for axis, m in ev.accel_axes.items():
+            accel_rows.append([name, axis, m.bias_offset_raw_g, m.bias_offset_comp_g, f"{m.offset_improvement:.3g}x",
+                               m.bias_instability_raw_ug, m.bias_instability_comp_ug])
+    if staged:
+        parts.append(_table(["run", "axis", "stage", "bias offset [deg/s]", "improvement (raw/stage)",
+                             "bias instability [deg/h]", "integration time [s]"], rows,
+                            "stages of the compensation (the thesis's Table 4.4)"))
+    else:
+        parts.append(_table(["run", "axis", "", "offset raw [deg/s]", "offset comp [deg/s]", "improvement",
+                             "BI raw [deg/h]", "BI comp [deg/h]", "int. time raw [s]", "int. time comp [s]"], rows))
+    if accel_rows:
+        parts.append(_table(["run", "axis", "offset raw [g]", "offset comp [g]", "improvement", "BI raw [ug]",
+                             "BI comp [ug]"], accel_rows, "accelerometer"))
+    parts.append("<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
+                 "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>")
+    return "\n".join(parts)
+
+
+def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: float):
+    """Per gyro axis: gravity of every static position and its offset with temperature and run constants out."""
+    from ..static import static_segments
+
+    no_g = calibration.without("acceleration")
+    gravity, offsets = [], []
+    for rec in runs:
+        if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
+            continue
+        segments = static_segments(rec, min_duration_s=min_static_s)
+        if len(segments) < 2:
+            continue
+        out = apply(no_g, rec)
+        accel = out.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
+        g = np.array([accel[s.start:s.stop].mean(axis=0) for s in segments])
+        y = np.array([out.gyro_dps[s.start:s.stop].mean(axis=0) for s in segments])
+        gravity.append(g)
+        offsets.append(y)
+    result = {}
+    for j, axis in enumerate(runs[0].gyro_axes):
+        row = calibration.axes.get(axis)
+        if row is None or row.g_sensitivity_dps_per_g is None or not gravity:
+            continue
+        G = np.asarray(row.g_sensitivity_dps_per_g)
+        ys = [y[:, j] - np.mean(y[:, j] - g @ G) for g, y in zip(gravity, offsets)]  # each run's constant out
+        result[axis] = (np.vstack(gravity), np.concatenate(ys))
+    return result
+
+
+def build_report(calibration: Calibration, runs: list[Recording], *, window_s: float | None = None,
+                 turn_on_window_s: float | None = None, min_static_s: float = 10.0,
+                 progress: Callable[[float], None] | None = None) -> Report:
+    """The report of ``calibration`` judged on ``runs`` (see the module doc for what it holds).
+
+    Parameters
+    ----------
+    window_s : float, optional
+        Moving-average window [s]; default: tau at each raw run's Allan minimum, at least 1 s.
+    turn_on_window_s : float, optional
+        Estimate each run's turn-on constant from its first seconds [s].
+    min_static_s : float
+        Shortest static position drawn in the g-sensitivity figure [s].
+    progress : callable, optional
+        Called with the fraction done.
+    """
+    figures._pyplot()  # fail early, in one line, without matplotlib
+    steps = 3 + 2 * len(runs)
+    done = [0]
+
+    def tick() -> None:
+        done[0] += 1
+        if progress:
+            progress(min(done[0] / steps, 1.0))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)
+        warnings.simplefilter("ignore", DataQualityWarning)
+        compensated = [apply(calibration, rec, turn_on_window_s=turn_on_window_s) for rec in runs]
+        tick()
+        sections: dict[str, str] = {}
+        sections["summary"] = ("Model", _summary(calibration))
+        sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, compensated, window_s, turn_on_window_s))
+        tick()
+        windows = [window_s or default_window_s(rec) for rec in runs]
+        modelled = [a for a in runs[0].gyro_axes if a in calibration.axes]
+        modelled += [a for a in calibration.accel_axes if runs[0].accel_g is not None]
+        for axis in modelled:
+            unit = "g" if axis.startswith("accel") else "deg/s"
+            body = []
+            if runs[0].temperature_degc is not None:
+                body.append(_img(figures.temperature_plot(runs, compensated, axis, unit),
+                                 f"{axis}: bias against temperature"))
+            for rec, comp, w in zip(runs, compensated, windows):
+                body.append(_img(figures.timeseries_plot(rec, comp, axis, w, unit,
+                                                         title=f"{axis}: {rec.source.rsplit('/', 1)[-1]}"),
+                                 f"{axis}: raw and compensated output"))
+            sections[f"axis-{axis}"] = (f"Axis {axis}", "\n".join(body))
+        tick()
+        allan = []
+        for rec, comp in zip(runs, compensated):
+            names = list(rec.gyro_axes)
+            split = bool(rec.gaps)
+            analyses = {"raw": analyse_noise(rec, names, split_gaps=split),
+                        "compensated": analyse_noise(comp, names, split_gaps=split)}
+            allan.append(_img(figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
+                              "Allan deviation, raw and compensated"))
+            tick()
+        sections["allan"] = ("Allan deviation", "\n".join(allan))
+        if calibration.has_acceleration:
+            positions = _g_positions(calibration, runs, min_static_s)
+            acc = calibration.fit_report.get("acceleration", {}).get("axes", {})
+            rows, g_matrix = [], {}
+            for axis, ax in calibration.axes.items():
+                if ax.g_sensitivity_dps_per_g is None:
+                    continue
+                errors = acc.get(axis, {}).get("standard_error_dps_per_g", [None, None, None])
+                g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
+                rows.append([axis] + [f"{g:+.4g}" + ("" if e is None else f" +- {e:.2g}")
+                                      for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
+            body = [_table(["gyro axis", "accel_x", "accel_y", "accel_z"], rows,
+                           "g-sensitivity matrix G [deg/s/g] +- standard error")]
+            if positions:
+                body.append(_img(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
+            else:
+                body.append("<p class=note>These runs have no static positions to draw.</p>")
+            sections["g-sensitivity"] = ("g-sensitivity", "\n".join(body))
+        tick()
+    created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    nav = " ".join(f'<a href="#{sid}">{html.escape(title)}</a>' for sid, (title, _) in sections.items())
+    files = ", ".join(html.escape(rec.source.rsplit("/", 1)[-1]) for rec in runs)
+    page = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
+            f"<title>gyrocomp report: {html.escape(calibration.model)}</title>",
+            f"<style>{_CSS}</style></head><body>",
+            f"<h1>gyrocomp report</h1><p class=note>{created}, gyrocomp {__version__}; runs: {files}</p>",
+            f"<nav>{nav}</nav>"]
+    for sid, (title, body) in sections.items():
+        page.append(f'<section id="{sid}"><h2>{html.escape(title)}</h2>\n{body}\n</section>')
+    page.append("</body></html>")
+    return Report("\n".join(page) + "\n", tuple(sections))
+
+
+__all__ = ["Report", "SECTIONS", "build_report"]

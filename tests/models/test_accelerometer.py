@@ -1,0 +1,112 @@
+"""Accelerometer temperature compensation (``--channels accel``): simulate, fit, recover the truth."""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import apply
+from gyrocomp.calibration import Calibration
+from gyrocomp.compensate import Compensator
+from gyrocomp.errors import InputError
+from gyrocomp.metrics import evaluate_run, moving_average
+from gyrocomp.models.pipelines import fit_accelerometer, fit_channels, parse_channels
+from gyrocomp.simulate import get_profile, simulate
+
+
+def _quiet(func, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return func(*args, **kwargs)
+
+
+@pytest.fixture(scope="module")
+def cycles():
+    """Consumer-grade part (tempco up to 7.5e-4 g/degC, 30 s thermal lag) through cold-hot-cold cycles."""
+    prof = get_profile("cycle", cycles=1)
+    return [simulate("consumer", profile=prof, rate_hz=0.5, seed=s) for s in range(4)]
+
+
+def test_recovers_the_tempco_and_removes_the_drift_on_a_held_out_run(cycles):
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:3]], ("accel",))
+    assert not cal.axes and set(cal.accel_axes) == {"accel_x", "accel_y", "accel_z"}
+    held = cycles[3]
+    out = _quiet(apply, cal, held.recording)
+    truth = held.truth
+    tempco = np.asarray(truth.model.accelerometer.bias_tempco_g_per_degc)
+    # what perfect compensation leaves: the specific force, the constant bias, the tempco at the reference
+    structure = truth.structure_temperature_degc
+    perfect = held.recording.accel_g - np.outer(structure - cal.accel_reference_degc, tempco)
+    w = int(60 * held.recording.rate_hz)  # 60-s moving average: noise 400 ug/sqrt(Hz) -> ~50 ug, LSB 61 ug
+    for j in range(3):
+        raw_drift = np.ptp(moving_average(held.recording.accel_g[:, j] - perfect[:, j], w))
+        left = np.max(np.abs(moving_average(out.accel_g[:, j] - perfect[:, j], w)))
+        assert raw_drift > 0.03  # 0.035 .. 0.075 g over -20..70 degC
+        assert left < 0.03 * raw_drift, (j, left, raw_drift)
+    # the gyro is not touched by an accelerometer-only model
+    np.testing.assert_array_equal(out.gyro_dps, held.recording.gyro_dps)
+
+
+def test_gyro_and_accel_together_fit_g_on_compensated_accelerations():
+    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s) for s in range(3)]
+    both = _quiet(fit_channels, [s.recording for s in runs[:2]], "gyro,accel")
+    assert both.accel_axes and both.has_acceleration
+    assert "accel" in both.fit_report and "acceleration" in both.fit_report
+    # G matches the truth within a few standard errors
+    truth_g = np.asarray(runs[0].truth.model.g_sensitivity_dps_per_g)
+    acc = both.fit_report["acceleration"]["axes"]
+    for i, axis in enumerate(("gyro_x", "gyro_y", "gyro_z")):
+        g = np.asarray(acc[axis]["g_sensitivity_dps_per_g"])
+        se = np.asarray(acc[axis]["standard_error_dps_per_g"])
+        assert np.all(np.abs(g - truth_g[i]) < 4 * se + 2e-3), (axis, g, truth_g[i], se)
+    held = runs[2].recording
+    out = _quiet(apply, both, held)
+    assert np.max(np.abs(out.accel_g - held.accel_g)) > 1e-3
+    evaluation = _quiet(evaluate_run, held, out, accel=True)
+    assert set(evaluation.accel_axes) == {"accel_x", "accel_y", "accel_z"}
+    assert "accel_axes" in evaluation.to_dict()
+
+
+def test_round_trip_names_accelerometer_values_in_g(cycles, tmp_path):
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("gyro", "accel"), temperature=2,
+                 hysteresis="none")
+    path = tmp_path / "model.json"
+    cal.save(path)
+    text = path.read_text()
+    assert '"turn_on_biases_g"' in text and '"coefficients_g"' in text
+    loaded = Calibration.load(path)
+    assert loaded.accel_axes == cal.accel_axes and loaded.accel_reference_degc == cal.accel_reference_degc
+    a = _quiet(apply, cal, cycles[3].recording)
+    b = _quiet(apply, loaded, cycles[3].recording)
+    np.testing.assert_array_equal(a.accel_g, b.accel_g)
+    np.testing.assert_array_equal(a.gyro_dps, b.gyro_dps)
+
+
+def test_streaming_equals_batch_with_lag(cycles):
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), hysteresis="lag")
+    assert any(ax.lag_time_constant_s > 0 for ax in cal.accel_axes.values())
+    rec = cycles[3].recording
+    batch = _quiet(apply, cal, rec).accel_g
+    comp = Compensator(cal, rec.gyro_axes, rate_hz=rec.rate_hz)
+    edges = [0, 7, 500, 501, 3000, rec.n_samples]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for a, b in zip(edges[:-1], edges[1:]):
+            comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b], rec.accel_g[a:b])
+    np.testing.assert_allclose(comp.take_accel(), batch, rtol=0, atol=1e-12)
+
+
+def test_bad_channels_and_missing_accelerometer(cycles):
+    with pytest.raises(InputError, match=r"--channels: mag: use gyro, accel or gyro,accel"):
+        parse_channels("gyro,mag")
+    bare = dataclasses.replace(cycles[0].recording, accel_g=None, accel_axes=())
+    with pytest.raises(InputError, match=r"--channels accel needs accel_x, accel_y and accel_z columns"):
+        fit_accelerometer([bare])
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), temperature=1, hysteresis="none")
+    with pytest.raises(InputError, match=r"the model compensates the accelerometer; the data needs accel_x"):
+        apply(cal, bare)
+    with pytest.raises(InputError, match=r"fit_accelerometer: options acceleration are for the gyro only"):
+        fit_accelerometer([cycles[0].recording], acceleration="matrix")

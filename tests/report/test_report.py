@@ -1,0 +1,191 @@
+"""The HTML report and the single figures: structure, decodable images, no network, the real entry point."""
+
+from __future__ import annotations
+
+import base64
+import io
+import os
+import pty
+import re
+import subprocess
+import sys
+import warnings
+from html.parser import HTMLParser
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gyrocomp import fit_calibration
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.report.figures import envelope
+from gyrocomp.report.html import SECTIONS, build_report
+from gyrocomp.simulate import get_profile, simulate
+from tests.test_cli import SCRIPT, run
+
+matplotlib_image = pytest.importorskip("matplotlib.image", reason="the report tests draw with matplotlib")
+
+
+class _Page(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.sections, self.images, self.links, self.heads = [], [], [], 0
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "section":
+            self.sections.append(attrs["id"])
+        if tag == "img":
+            self.images.append(attrs["src"])
+        for key in ("href", "src"):
+            if key in attrs and tag != "img":
+                self.links.append(attrs[key])
+
+
+def _check_page(text: str, expected_sections: list[str]) -> _Page:
+    page = _Page()
+    page.feed(text)
+    assert page.sections == expected_sections
+    assert page.images, "no figure in the report"
+    for src in page.images:
+        assert src.startswith("data:image/png;base64,")
+        image = matplotlib_image.imread(io.BytesIO(base64.b64decode(src.split(",", 1)[1])), format="png")
+        assert image.ndim == 3 and image.shape[0] > 100 and image.shape[1] > 100
+        assert np.ptp(image[..., :3]) > 0.5  # drawn, not blank
+    assert all(link.startswith("#") for link in page.links)  # only links within the page
+    assert not re.search(r"(https?:)?//[a-z0-9]", re.sub(r"data:image/png;base64,[A-Za-z0-9+/=]+", "", text))
+    return page
+
+
+def _quiet(func, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return func(*args, **kwargs)
+
+
+def test_single_axis_report_with_hysteresis_has_every_section():
+    prof = get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1)
+    runs = [simulate("adxrs450", profile=prof, rate_hz=0.5, seed=s).recording for s in range(3)]
+    cal = _quiet(fit_calibration, runs[:2], hysteresis="turning-point")
+    report = build_report(cal, [runs[2]])
+    assert report.sections == ("summary", "evaluation", "axis-gyro_z", "allan")
+    page = _check_page(report.html, list(report.sections))
+    assert len(page.images) == 3  # bias against temperature, time series, Allan
+    assert "stages of the compensation" in report.html  # the thesis's Table 4.4 shape with hysteresis
+    assert "temperature + hysteresis" in report.html and "polynomial order" in report.html
+
+
+def test_three_axis_report_with_acceleration_and_accelerometer():
+    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(3)]
+    cal = _quiet(fit_channels, runs[:2], ("gyro", "accel"), hysteresis="none")
+    progress = []
+    report = build_report(cal, [runs[2]], progress=progress.append)
+    axes = [f"axis-{a}" for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")]
+    assert report.sections == ("summary", "evaluation", *axes, "allan", "g-sensitivity")
+    _check_page(report.html, list(report.sections))
+    assert "g-sensitivity matrix G [deg/s/g] +- standard error" in report.html
+    assert "temperature + acceleration" in report.html and "accelerometer" in report.html
+    assert progress == sorted(progress) and progress[-1] == 1.0
+    assert set(SECTIONS) <= set(report.sections)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-1e6, 1e6, allow_nan=False), min_size=1, max_size=3000), st.integers(1, 400))
+def test_envelope_keeps_every_extreme_and_bounds_the_points(values, columns):
+    v = np.asarray(values)
+    t, e = envelope(np.arange(v.size, dtype=float), v, columns)
+    assert e.size <= max(v.size, 2 * columns)
+    assert e.min() == v.min() and e.max() == v.max()
+    assert np.all(np.diff(t) >= 0)
+
+
+@pytest.fixture(scope="module")
+def cli_files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("report")
+    for seed in (1, 2):
+        r = run("simulate", "--preset", "mti10", "--profile", "combined", "--duration", 7200, "--rate", 1,
+                "--seed", seed, "-o", d / f"run{seed}.csv")
+        assert r.returncode == 0, r.stderr
+    r = run("fit", d / "run1.csv", "-o", d / "model.json", "--hysteresis", "none")
+    assert r.returncode == 0, r.stderr
+    return d
+
+
+def test_cli_report_and_plots(cli_files):
+    d = cli_files
+    r = run("report", d / "model.json", d / "run2.csv", "-o", d / "report.html")
+    assert r.returncode == 0, r.stderr
+    assert "sections summary, evaluation, axis-gyro_x" in r.stdout and "g-sensitivity" in r.stdout
+    _check_page((d / "report.html").read_text(), list(_sections((d / "report.html").read_text())))
+    for kind, args, out, magic in (
+            ("allan", [d / "run2.csv", "--model", d / "model.json", "--split-gaps"], "allan.png", b"\x89PNG"),
+            ("temperature", [d / "model.json", d / "run1.csv", d / "run2.csv", "--axis", "gyro_y"], "t.svg", b"<?xml"),
+            ("timeseries", [d / "model.json", d / "run2.csv", "--axis", "gyro_z"], "ts.pdf", b"%PDF")):
+        r = run("plot", kind, *args, "-o", d / out)
+        assert r.returncode == 0, r.stderr
+        assert (d / out).read_bytes().startswith(magic)
+
+
+def _sections(text):
+    page = _Page()
+    page.feed(text)
+    return page.sections
+
+
+@pytest.mark.parametrize("args, message", [
+    (["report", "{d}/model.json", "{d}/run2.csv", "-o", "{d}/r.txt"], "-o: {d}/r.txt: name the report .html"),
+    (["plot", "timeseries", "{d}/model.json", "{d}/run2.csv", "-o", "{d}/x.gif"], "x.gif: figure suffix '.gif'"),
+    (["plot", "timeseries", "{d}/model.json", "{d}/run2.csv", "--axis", "gyro_q", "-o", "{d}/x.png"],
+     "--axis: 'gyro_q': the model and the data share gyro_x, gyro_y, gyro_z"),
+    (["report", "{d}/model.json", "{d}/run2.csv", "-o", "{d}/run2.csv"], "this is an input file"),
+])
+def test_cli_report_and_plot_refuse_bad_options_in_one_line(cli_files, args, message):
+    d = cli_files
+    r = run(*[a.format(d=d) for a in args])
+    assert r.returncode == 2
+    errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
+    assert len(errors) == 1 and message.format(d=d) in errors[0], r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_progress_bar_on_a_terminal_only(cli_files):
+    d = cli_files
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+
+    def stderr_of(*extra):
+        master, slave = pty.openpty()
+        done = subprocess.run([*cmd, *extra, "report", str(d / "model.json"), str(d / "run2.csv"), "-o",
+                               str(d / "tty.html")], stdout=subprocess.PIPE, stderr=slave, timeout=300)
+        os.close(slave)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(master, 65536)
+            except OSError:
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        os.close(master)
+        assert done.returncode == 0
+        return b"".join(chunks)
+
+    bar = b"\xe2\x94\x81"  # the bar's glyph
+    shown = stderr_of()
+    assert b"report" in shown and bar in shown
+    assert bar not in stderr_of("--quiet")
+    piped = run("report", d / "model.json", d / "run2.csv", "-o", d / "piped.html")
+    assert bar.decode() not in piped.stderr  # not a terminal: no bar
+
+
+def test_package_imports_and_cli_answers_without_matplotlib(cli_files, tmp_path):
+    code = ("import sys; sys.modules['matplotlib'] = None; import gyrocomp, gyrocomp.cli; "
+            "from gyrocomp.cli import main; sys.exit(main(sys.argv[1:]))")
+    d = cli_files
+    done = subprocess.run([sys.executable, "-c", code, "report", str(d / "model.json"), str(d / "run2.csv"),
+                           "-o", str(tmp_path / "r.html")], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1
+    assert done.stderr.strip() == ("gyrocomp: error: plots need the optional package matplotlib; install it with: "
+                                   "pip install 'gyrocomp[plot]'")
+    assert not (tmp_path / "r.html").exists()
