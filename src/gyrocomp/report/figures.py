@@ -222,7 +222,7 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
         turns = np.flatnonzero(np.diff(direction) != 0) + 1
         turns = turns[direction[turns - 1] != 0]
         if turns.size:
-            top.plot(t[turns], (y_raw - offset)[turns], "D", color="black", ms=6, mfc="gold",
+            top.plot(t[turns], correction[turns], "D", color="black", ms=6, mfc="gold",
                      label=None if "turn" in labelled else "turning points")
             labelled.add("turn")
     top.set_ylabel(f"bias [{unit}]")

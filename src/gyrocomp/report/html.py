@@ -36,7 +36,7 @@ body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1200px; 
 h1 { font-size: 1.6em; } h2 { border-bottom: 2px solid #ccc; padding-bottom: 0.2em; margin-top: 2em; }
 table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
 th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }
-th { background: #eef; } td:first-child, th:first-child { text-align: left; }
+th { background: #eef; } td:first-child, th:first-child, td.text { text-align: left; }
 img { max-width: 100%; display: block; margin: 0.6em 0; border: 1px solid #ddd; }
 .note { color: #555; font-size: 0.9em; } nav a { margin-right: 1em; }
 """
@@ -67,9 +67,16 @@ def _table(header: list[str], rows: list[list], caption: str | None = None) -> s
         out.append(f"<caption>{html.escape(caption)}</caption>")
     out.append("<tr>" + "".join(f"<th>{html.escape(str(h))}</th>" for h in header) + "</tr>")
     for row in rows:
-        out.append("<tr>" + "".join(f"<td>{html.escape(_fmt(v))}</td>" for v in row) + "</tr>")
+        out.append("<tr>" + "".join(f"<td{_cell_class(v)}>{html.escape(_fmt(v))}</td>" for v in row) + "</tr>")
     out.append("</table>")
     return "\n".join(out)
+
+
+def _cell_class(value) -> str:
+    """Words are left-aligned, numbers (and numbers with units) right-aligned."""
+    if isinstance(value, str) and value and not value.lstrip("+-")[:1].isdigit():
+        return ' class="text"'
+    return ""
 
 
 def _fmt(value) -> str:
