@@ -20,6 +20,7 @@ Every sum is evaluated in blocks, so the working memory beyond the phase array s
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Iterable
@@ -628,7 +629,9 @@ def confidence_interval(deviation, edf, confidence: float = ONE_SIGMA) -> tuple[
     return low, high
 
 
+@functools.lru_cache(maxsize=4096)
 def _edf(kind: str, alpha: int, m: int, n_phase: int) -> float:
+    """Equivalent degrees of freedom (cached: stretches of one length between gaps repeat the same terms)."""
     if kind == "totdev":
         return edf_totdev(alpha, m, n_phase)
     spec = _ESTIMATORS[kind]
@@ -718,12 +721,13 @@ def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave",
 
 
 def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: str = "oadev", taus="octave",
-                             data_type: str = "rate", confidence: float = ONE_SIGMA) -> AllanResult:
+                             data_type: str = "rate", confidence: float | None = ONE_SIGMA) -> AllanResult:
     """One deviation curve from several contiguous stretches of data separated by gaps.
 
     The sums of squared differences and their term counts are pooled over the stretches, so no term
     spans a gap; the degrees of freedom add. The noise type comes from the longest stretch. The named
-    tau grids follow the longest stretch. TOTDEV's reflected series has no pooled form.
+    tau grids follow the longest stretch. TOTDEV's reflected series has no pooled form. ``confidence``
+    None skips the noise identification and the intervals, as in :func:`allan_deviation`.
     """
     _check(kind, rate_hz, data_type)
     if kind == "totdev":
@@ -735,18 +739,19 @@ def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: str = 
     ms = averaging_factors(longest.size, taus, rate_hz, kind)
     tau = ms / rate_hz
     sums, counts, edf = np.zeros(len(ms)), np.zeros(len(ms), dtype=np.int64), np.zeros(len(ms))
-    alphas = _noise_types(kind, longest, ms)
+    alphas = _noise_types(kind, longest, ms) if confidence is not None else np.full(len(ms), np.nan)
     for phase in phases:
         own = np.maximum(term_count(kind, phase.size, ms), 0)
         sums += _variance_sums(kind, phase, ms, own)
         counts += own
-        own_edf = _degrees_of_freedom(kind, alphas, ms, phase.size)
-        edf += np.where((own > 0) & np.isfinite(own_edf), own_edf, 0.0)
+        if confidence is not None:
+            own_edf = _degrees_of_freedom(kind, alphas, ms, phase.size)
+            edf += np.where((own > 0) & np.isfinite(own_edf), own_edf, 0.0)
     edf = np.where(np.isnan(alphas), np.nan, edf)
     deviation = _normalize(kind, sums, ms, tau, counts)
-    low, high = confidence_interval(deviation, edf, confidence)
+    low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
-                       edf=edf, kind=kind, confidence=confidence)
+                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence)
 
 
 # --- IEEE Std 952 noise terms ----------------------------------------------------------------------------

@@ -64,7 +64,7 @@ def bias_instability(rate_dps: np.ndarray, rate_hz: float, stretches: list[slice
 def _allan_minimum(x: np.ndarray, rate_hz: float, stretches: list[slice] | None):
     """The minimum of the octave overlapping Allan deviation [unit of x], pooled over ``stretches``."""
     if stretches is not None and len(stretches) > 1:
-        return allan_deviation_segments([x[s] for s in stretches], rate_hz, taus="octave").minimum()
+        return allan_deviation_segments([x[s] for s in stretches], rate_hz, taus="octave", confidence=None).minimum()
     return allan_deviation(x, rate_hz, taus="octave", confidence=None).minimum()
 
 

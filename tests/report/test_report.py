@@ -77,7 +77,7 @@ def test_single_axis_report_with_hysteresis_has_every_section():
 
 
 def test_three_axis_report_with_acceleration_and_accelerometer():
-    runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(3)]
+    runs = [simulate("consumer", profile="combined", duration_s=5400, rate_hz=1, seed=s).recording for s in range(3)]
     cal = _quiet(fit_channels, runs[:2], ("gyro", "accel"), hysteresis="none")
     progress = []
     report = build_report(cal, [runs[2]], progress=progress.append)
@@ -104,7 +104,7 @@ def test_envelope_keeps_every_extreme_and_bounds_the_points(values, columns):
 def cli_files(tmp_path_factory):
     d = tmp_path_factory.mktemp("report")
     for seed in (1, 2):
-        r = run("simulate", "--preset", "mti10", "--profile", "combined", "--duration", 7200, "--rate", 1,
+        r = run("simulate", "--preset", "mti10", "--profile", "combined", "--duration", 3600, "--rate", 1,
                 "--seed", seed, "-o", d / f"run{seed}.csv")
         assert r.returncode == 0, r.stderr
     r = run("fit", d / "run1.csv", "-o", d / "model.json", "--hysteresis", "none")
@@ -155,8 +155,8 @@ def test_progress_bar_on_a_terminal_only(cli_files):
 
     def stderr_of(*extra):
         master, slave = pty.openpty()
-        done = subprocess.run([*cmd, *extra, "report", str(d / "model.json"), str(d / "run2.csv"), "-o",
-                               str(d / "tty.html")], stdout=subprocess.PIPE, stderr=slave, timeout=300)
+        done = subprocess.run([*cmd, *extra, "convert", str(d / "run2.csv"), str(d / "tty.parquet")],
+                               stdout=subprocess.PIPE, stderr=slave, timeout=300)
         os.close(slave)
         chunks = []
         while True:
@@ -173,9 +173,9 @@ def test_progress_bar_on_a_terminal_only(cli_files):
 
     bar = b"\xe2\x94\x81"  # the bar's glyph
     shown = stderr_of()
-    assert b"report" in shown and bar in shown
+    assert b"reading run2.csv" in shown and bar in shown
     assert bar not in stderr_of("--quiet")
-    piped = run("report", d / "model.json", d / "run2.csv", "-o", d / "piped.html")
+    piped = run("convert", d / "run2.csv", d / "piped.parquet")
     assert bar.decode() not in piped.stderr  # not a terminal: no bar
 
 

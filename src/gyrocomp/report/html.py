@@ -142,11 +142,11 @@ def _summary(calibration: Calibration) -> str:
 
 
 def _evaluation(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
-                window_s: float | None, turn_on_window_s: float | None) -> str:
+                windows: list[float], turn_on_window_s: float | None) -> str:
     staged = len(stage_calibrations(calibration)) > 1
     parts = []
     rows, accel_rows = [], []
-    for rec, comp in zip(runs, compensated):
+    for rec, comp, window_s in zip(runs, compensated, windows):
         name = html.escape(rec.source.rsplit("/", 1)[-1])
         if staged:
             st = evaluate_stages(calibration, rec, window_s=window_s, turn_on_window_s=turn_on_window_s)
@@ -159,6 +159,8 @@ def _evaluation(calibration: Calibration, runs: list[Recording], compensated: li
                     m = axes[axis]
                     rows.append(["", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x",
                                  m.bias_instability_comp_dph, m.integration_time_comp_s])
+        if staged and not calibration.accel_axes:
+            continue
         ev = evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
         if not staged:
             for axis, m in ev.axes.items():
@@ -244,9 +246,9 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         tick()
         sections: dict[str, str] = {}
         sections["summary"] = ("Model", _summary(calibration))
-        sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, compensated, window_s, turn_on_window_s))
-        tick()
         windows = [window_s or default_window_s(rec) for rec in runs]
+        sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, compensated, windows, turn_on_window_s))
+        tick()
         modelled = [a for a in runs[0].gyro_axes if a in calibration.axes]
         modelled += [a for a in calibration.accel_axes if runs[0].accel_g is not None]
         for axis in modelled:
