@@ -138,19 +138,23 @@ def _mean(data) -> float:
 
 
 def _running_sum(chunks, mean: float, out: np.ndarray, divisor: float = 1.0) -> np.ndarray:
-    """out[0] = 0, out[k] = sum_{i<k} (data[i] - mean) / divisor, chunk by chunk, with a carried total."""
+    """out[0] = 0, out[k] = sum_{i<k} (data[i] - mean) / divisor, chunk by chunk, with a carried total,
+    computed in place in ``out`` (no temporary arrays)."""
     out[0] = 0.0
     carry, position = 0.0, 0
     for chunk in chunks:
-        block = np.cumsum(np.asarray(chunk, dtype=np.float64) - mean)
-        if not block.size:
+        size = len(chunk)
+        if not size:
             continue
-        block += carry
-        carry = float(block[-1])
+        target = out[position + 1:position + 1 + size]
+        np.subtract(chunk, mean, out=target, dtype=np.float64)
+        np.cumsum(target, out=target)
+        if carry:
+            target += carry
+        carry = float(target[-1])
         if divisor != 1.0:
-            block /= divisor
-        out[position + 1:position + 1 + block.size] = block
-        position += block.size
+            target /= divisor
+        position += size
     return out
 
 
@@ -300,11 +304,14 @@ _OCTAVE_BLOCK = 1 << 18
 def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
     """Overlapping Allan sums for m = 1, 2, 4, ..., top (a power of two) in one pass over x.
 
-    With u_m(i) = x[i+m] - x[i] the second difference is
-    D_m(i) = u_m(i+m) - u_m(i), and the windows double by u_2m(i) = u_m(i) + u_m(i+m), so each block of
-    x is read once for every level. Within a block, u_1 is centred on its mean (D does not change), and
-    sum D^2 = sum u(i+m)^2 + sum u(i)^2 - 2 sum u(i) u(i+m) is taken from BLAS dot products; the
-    centring keeps the cancellation in that identity at (block / m)^2 rounding units at most.
+    With u_m(i) = x[i+m] - x[i] the second difference is D_m(i) = u_m(i+m) - u_m(i), and the windows
+    double by u_2m(i) = u_m(i) + u_m(i+m), so each block of x is read once for every level. Within a
+    block, u_1 is centred on its mean (D does not change). The parallelogram law
+    sum D_m(i)^2 + sum u_2m(i)^2 = 2 sum u_m(i)^2 + 2 sum u_m(i+m)^2 (i < count) gives each level's sum
+    from one BLAS dot product of the next level's window, sum u_2m^2, which is also the next level's
+    sum of squares (extended by the few terms past the block); the top level uses
+    sum D^2 = sum u(i+m)^2 + sum u(i)^2 - 2 sum u(i) u(i+m). The centring keeps the cancellation in these
+    identities at (block / m)^2 rounding units at most.
     """
     n = len(x)
     levels = top.bit_length()
@@ -318,21 +325,29 @@ def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
         u = current[:length]
         np.subtract(w[1:], w[:-1], out=u)
         u -= u[:min(block, length)].mean()
+        known_sum, known_len = 0.0, 0  # sum of u[:known_len]^2, carried from the level before
         m = 1
         for level in range(levels):
             count = min(block, n - 2 * m - start)
             if count <= 0:
                 break
-            squares = np.dot(u[:count + m], u[:count + m])
-            head, tail = u[:m], u[count:count + m]
-            total = 2.0 * squares - np.dot(head, head) - np.dot(tail, tail) - 2.0 * np.dot(u[:count], u[m:m + count])
-            sums[level] += total
-            if level + 1 < levels:
-                length -= m
-                np.add(u[:length], u[m:m + length], out=spare[:length])
-                current, spare = spare, current
-                u = current[:length]
-                m *= 2
+            need = count + m
+            extra = u[known_len:need]
+            squares = known_sum + float(np.dot(extra, extra))
+            head, tail = u[:m], u[count:need]
+            edges = float(np.dot(head, head)) + float(np.dot(tail, tail))
+            last = level + 1 == levels or min(block, n - 4 * m - start) <= 0
+            if last:
+                sums[level] += 2.0 * squares - edges - 2.0 * float(np.dot(u[:count], u[m:need]))
+                break
+            length -= m
+            np.add(u[:length], u[m:m + length], out=spare[:length])
+            current, spare = spare, current
+            u = current[:length]
+            doubled = float(np.dot(u[:count], u[:count]))
+            sums[level] += 2.0 * (2.0 * squares - edges) - doubled
+            known_sum, known_len = doubled, count
+            m *= 2
     return sums
 
 
