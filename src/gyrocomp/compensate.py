@@ -34,7 +34,9 @@ class Compensator:
         steps one nominal period per sample and bridges longer gaps exactly).
 
     Models with thermal lag or hysteresis carry their state (lag filter, turning-point detector)
-    from one chunk to the next, so the chunking never changes the result.
+    from one chunk to the next, so the chunking never changes the result. A model with accelerometer
+    axes also compensates the accelerations (read them with :meth:`take_accel`), and its g-sensitivity
+    reads the compensated ones.
     """
 
     def __init__(self, calibration: Calibration, gyro_axes: tuple[str, ...], *,
@@ -123,8 +125,9 @@ class Compensator:
         return bool(self._accel_modelled)
 
     def take_accel(self) -> np.ndarray:
-        """The compensated accelerometer rows [g] (n, 3) of the chunks given since the last call
-        (the raw rows when the model has no accelerometer axes); never held back."""
+        """The compensated accelerometer rows [g] (n, 3) of the chunks given since the last call (empty when
+        the model has no accelerometer axes); never held back. A stream calls it after each :meth:`update`,
+        so the rows do not pile up."""
         rows = np.concatenate(self._accel_out) if self._accel_out else np.empty((0, 3))
         self._accel_out = []
         return rows
@@ -133,7 +136,7 @@ class Compensator:
                   accel_g: np.ndarray | None = None) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
         accel_g = self._compensate_accel(time_s, temperature_degc, accel_g)
-        if accel_g is not None:
+        if accel_g is not None and self._accel_modelled:
             self._accel_out.append(accel_g)
         for j, ax in self._modelled:
             if ax.needs_accel and time_s.size:
