@@ -444,6 +444,9 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     if stages:
         from .metrics import evaluate_stages
 
+        if not calibration.axes:
+            raise InputError(f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
+                             "evaluate it without --stages")
         staged = [evaluate_stages(calibration, _read(path, opts).recording, window_s=window_s,
                                   turn_on_window_s=turn_on_window_s) for path in runs]
         if as_json:

@@ -254,5 +254,5 @@ def evaluate_stages(calibration, recording: Recording, *, window_s: float | None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DataQualityWarning)
             result = evaluate_run(recording, apply(cal, recording, turn_on_window_s=turn_on_window_s), window_s=window_s)
-        stages[name] = result.axes
+        stages[name] = {axis: m for axis, m in result.axes.items() if axis in calibration.axes}
     return StageEvaluation(recording.source, float(window_s), stages)

@@ -110,3 +110,28 @@ def test_bad_channels_and_missing_accelerometer(cycles):
         apply(cal, bare)
     with pytest.raises(InputError, match=r"fit_accelerometer: options acceleration are for the gyro only"):
         fit_accelerometer([cycles[0].recording], acceleration="matrix")
+
+
+def test_cli_accelerometer_channel_end_to_end(tmp_path):
+    from tests.test_cli import run
+
+    for seed in (1, 2, 3):
+        r = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 0.5, "--seed", seed,
+                "-o", tmp_path / f"run{seed}.csv")
+        assert r.returncode == 0, r.stderr
+    r = run("fit", tmp_path / "run1.csv", tmp_path / "run2.csv", "--channels", "accel", "--hysteresis", "none",
+            "-o", tmp_path / "acc.json")
+    assert r.returncode == 0, r.stderr
+    assert "accelerometer (correction relative to" in r.stdout and "fit RMS [g]" in r.stdout
+    r = run("evaluate", tmp_path / "acc.json", tmp_path / "run3.csv", "--json")
+    assert r.returncode == 0, r.stderr
+    import json
+
+    accel = json.loads(r.stdout)["runs"][0]["accel_axes"]
+    assert all(m["offset_improvement"] > 10 for m in accel.values())
+    r = run("evaluate", "--stages", tmp_path / "acc.json", tmp_path / "run3.csv")
+    assert r.returncode == 2 and "--stages: " in r.stderr and "has no gyro axes" in r.stderr
+    r = run("apply", tmp_path / "acc.json", tmp_path / "run3.csv", "-o", tmp_path / "out.csv")
+    assert r.returncode == 0 and "accel_x, accel_y, accel_z compensated" in r.stdout, r.stderr
+    r = run("fit", tmp_path / "run1.csv", "--channels", "gyro,mag", "-o", tmp_path / "x.json")
+    assert r.returncode == 2 and "--channels: mag: use gyro, accel or gyro,accel" in r.stderr

@@ -186,7 +186,8 @@ def ardupilot_params_file(calibration: Calibration, **options) -> str:
     """An ArduPilot parameter file (``NAME VALUE`` per line, as MAVProxy and Mission Planner load)."""
     params = ardupilot_parameters(calibration, **options)
     lines = _header(calibration, params, "ArduPilot", "#")
-    lines.append("# the correction is relative to INS_GYR_CALTEMP: the gyro offsets taken at boot remove the bias there")
+    lines.append("# the correction is relative to INS_GYRn_CALTEMP (INS_ACCn_CALTEMP for the accelerometer): the offsets "
+                 "taken there remove the bias at that temperature")
     for name, value in params.values.items():
         lines.append(f"{name} {int(value)}" if name.endswith("ENABLE") else f"{name} {float(value):.9g}")
     return "\n".join(lines) + "\n"
