@@ -501,39 +501,34 @@ def print_comparison(result) -> None:
     console.print(table)
 
 
-def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
-    console = _console()
+def _metrics_table(title: str, evaluation: Evaluation, rows_of, unit: str, bi_unit: str, suffix: str) -> Table:
+    """One table of raw and compensated figures; ``rows_of(run)`` gives (axis, metrics) pairs whose field
+    names end in ``suffix`` (``dps``/``dph`` for the gyro, ``g``/``ug`` for the accelerometer)."""
     table = Table(title=title)
     table.add_column("run", no_wrap=True)
     table.add_column("axis", no_wrap=True)
-    for col in ("window\n[s]", "offset raw\n[deg/s]", "offset comp\n[deg/s]", "improvement\n(raw/comp)",
-                "BI raw\n[deg/h]", "BI comp\n[deg/h]", "int. time raw\n[s]", "int. time comp\n[s]",
-                "residual RMS\n[deg/s]"):
+    for col in ("window\n[s]", f"offset raw\n[{unit}]", f"offset comp\n[{unit}]", "improvement\n(raw/comp)",
+                f"BI raw\n[{bi_unit}]", f"BI comp\n[{bi_unit}]", "int. time raw\n[s]", "int. time comp\n[s]",
+                f"residual RMS\n[{unit}]"):
         table.add_column(col, justify="right")
+    value, bi = suffix.split("/")
     for run in evaluation.runs:
-        for axis, m in run.axes.items():
-            table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.bias_offset_raw_dps:.4g}",
-                          f"{m.bias_offset_comp_dps:.4g}", f"{m.offset_improvement:.3g}x",
-                          f"{m.bias_instability_raw_dph:.4g}", f"{m.bias_instability_comp_dph:.4g}",
+        for axis, m in rows_of(run):
+            get = lambda name: getattr(m, name)  # noqa: E731
+            table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{get('bias_offset_raw_' + value):.4g}",
+                          f"{get('bias_offset_comp_' + value):.4g}", f"{m.offset_improvement:.3g}x",
+                          f"{get('bias_instability_raw_' + bi):.4g}", f"{get('bias_instability_comp_' + bi):.4g}",
                           f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
-                          f"{m.residual_rms_dps:.3g}")
-    console.print(table)
+                          f"{get('residual_rms_' + value):.3g}")
+    return table
+
+
+def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
+    console = _console()
+    console.print(_metrics_table(title, evaluation, lambda run: run.axes.items(), "deg/s", "deg/h", "dps/dph"))
     if any(run.accel_axes for run in evaluation.runs):
-        table = Table(title=f"{title}: accelerometer")
-        table.add_column("run", no_wrap=True)
-        table.add_column("axis", no_wrap=True)
-        for col in ("window\n[s]", "offset raw\n[g]", "offset comp\n[g]", "improvement\n(raw/comp)",
-                    "BI raw\n[ug]", "BI comp\n[ug]", "int. time raw\n[s]", "int. time comp\n[s]",
-                    "residual RMS\n[g]"):
-            table.add_column(col, justify="right")
-        for run in evaluation.runs:
-            for axis, m in run.accel_axes.items():
-                table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.bias_offset_raw_g:.4g}",
-                              f"{m.bias_offset_comp_g:.4g}", f"{m.offset_improvement:.3g}x",
-                              f"{m.bias_instability_raw_ug:.4g}", f"{m.bias_instability_comp_ug:.4g}",
-                              f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
-                              f"{m.residual_rms_g:.3g}")
-        console.print(table)
+        console.print(_metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items(),
+                                     "g", "ug", "g/ug"))
 
 
 # -- allan -------------------------------------------------------------------------------------------

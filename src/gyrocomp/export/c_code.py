@@ -105,6 +105,15 @@ def _hysteresis_code(j: int, ax: AxisCalibration) -> list[str]:
     return lines
 
 
+def _shape_code(k: int, ax: AxisCalibration) -> list[str]:
+    """C statements setting `shape` for state slot k: the (lagged) temperature, its curve and hysteresis."""
+    if ax.lag_time_constant_s > 0:
+        lines = [f"    tm = lag_update(&s->lag[{k}], step, temperature, {_num(ax.lag_time_constant_s)});"]
+    else:
+        lines = ["    tm = temperature;"]
+    return lines + _temperature_code(k, ax.temperature) + _hysteresis_code(k, ax)
+
+
 def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict[str, str]:
     """``{"gyrocomp.h": ..., "gyrocomp.c": ...}`` for the model; ``rate_hz`` [Hz] is needed with thermal lag."""
     axes = {name: ax for name, ax in calibration.axes.items() if name in AXES}
@@ -223,14 +232,8 @@ void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const doub
         ax = accel_axes.get(name)
         if ax is None or ax.temperature is None:
             continue
-        k = 3 + i
         body.append(f"    /* {name}: temperature error relative to {reference:g} degC */")
-        if ax.lag_time_constant_s > 0:
-            body.append(f"    tm = lag_update(&s->lag[{k}], step, temperature, {_num(ax.lag_time_constant_s)});")
-        else:
-            body.append("    tm = temperature;")
-        body += _temperature_code(k, ax.temperature)
-        body += _hysteresis_code(k, ax)
+        body += _shape_code(3 + i, ax)
         at_reference = float(ax.temperature.shape_dps(np.array([reference]))[0])
         body.append(f"    acc[{i}] -= shape - {_num(at_reference)};")
     body.append("    for (int j = 0; j < 3; ++j) s->accel_out[j] = acc[j];")
@@ -251,12 +254,7 @@ void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const doub
         if ax.acceleration_network is not None:
             body.append(f"    out[{j}] -= anet{j}(0.0, acc) - anet{j}_ref;")
         if ax.temperature is not None:
-            if ax.lag_time_constant_s > 0:
-                body.append(f"    tm = lag_update(&s->lag[{j}], step, temperature, {_num(ax.lag_time_constant_s)});")
-            else:
-                body.append("    tm = temperature;")
-            body += _temperature_code(j, ax.temperature)
-            body += _hysteresis_code(j, ax)
+            body += _shape_code(j, ax)
             body.append(f"    out[{j}] -= shape;")
         body.append(f"    out[{j}] -= {_num(ax.mean_turn_on_bias_dps)};")
     body += ["}", ""]
