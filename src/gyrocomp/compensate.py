@@ -48,8 +48,10 @@ class Compensator:
         self.turn_on_window_s = turn_on_window_s
         self.source = source
         self._modelled = [(j, calibration.axes[a]) for j, a in enumerate(self.gyro_axes) if a in calibration.axes]
-        self._accel_modelled = [(j, a, calibration.accel_axes[a]) for j, a in enumerate(ACCEL_AXES)
-                                if a in calibration.accel_axes]
+        # each accelerometer axis with its error at the reference temperature, which the correction keeps
+        reference = np.array([calibration.accel_reference_degc])
+        self._accel_modelled = [(j, a, ax, float(np.asarray(ax.temperature.shape_dps(reference), dtype=float)[0]))
+                                for j, a in enumerate(ACCEL_AXES) if (ax := calibration.accel_axes.get(a)) is not None]
         if not self._modelled and not self._accel_modelled:
             raise InputError(
                 f"{source}: the model covers {', '.join(calibration.axes)}, the data has "
@@ -57,7 +59,7 @@ class Compensator:
             )
         if rate_hz is not None and not rate_hz > 0:
             raise InputError(f"rate_hz: must be positive, got {rate_hz}")
-        every = [ax for _, ax in self._modelled] + [ax for _, _, ax in self._accel_modelled]
+        every = [ax for _, ax in self._modelled] + [ax for _, _, ax, _ in self._accel_modelled]
         if rate_hz is None and any(ax.lag_time_constant_s > 0 for ax in every):
             raise InputError(f"{source}: the model has thermal lag; give the stream's sample rate (rate_hz)")
         self.rate_hz = rate_hz
@@ -112,10 +114,8 @@ class Compensator:
             raise InputError(f"{self.source}: the model compensates the accelerometer for temperature; "
                              "the data has no temperature")
         t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc.mean(axis=1)
-        reference = np.array([self.calibration.accel_reference_degc])
         out = np.array(accel_g, dtype=float, copy=True)
-        for j, name, ax in self._accel_modelled:
-            at_reference = float(np.asarray(ax.temperature.shape_dps(reference), dtype=float)[0])
+        for j, name, ax, at_reference in self._accel_modelled:
             out[:, j] -= self._temperature_error(name, ax, time_s, t, None) - at_reference
         return out
 

@@ -108,6 +108,9 @@ def test_bad_channels_and_missing_accelerometer(cycles):
     cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), temperature=1, hysteresis="none")
     with pytest.raises(InputError, match=r"the model compensates the accelerometer; the data needs accel_x"):
         apply(cal, bare)
+    with pytest.raises(InputError, match=r"--channels accel: the accelerometer model is a temperature model; "
+                                         r"--temperature none leaves nothing to fit"):
+        fit_accelerometer([cycles[0].recording], temperature=None)
     with pytest.raises(InputError, match=r"fit_accelerometer: options acceleration are for the gyro only"):
         fit_accelerometer([cycles[0].recording], acceleration="matrix")
 

@@ -107,15 +107,13 @@ def read_input(
     """
     options = options or ReadOptions()
     fmt = detect_format(path, fmt)
+    if not Path(path).exists():
+        raise InputError(f"{path}: no such file")
     if fmt in TABLE_FORMATS:
-        if not Path(path).exists():
-            raise InputError(f"{path}: no such file")
         data = read_table(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite)
         if progress:
             progress(1.0)
         return data
-    if not Path(path).exists():
-        raise InputError(f"{path}: no such file")
     return table_data(_log_reader(fmt)(path, options, progress))
 
 

@@ -85,6 +85,10 @@ class _Log:
         type_id = self.types.get(name)
         return type_id is not None and bool(self.reader.offsets[type_id])
 
+    def fields(self, name: str) -> tuple[str, ...]:
+        """The field names of a message type, from its format (no record is read)."""
+        return _dtype(self.reader.formats[self.types[name]]).names
+
     def records(self, name: str) -> np.ndarray:
         """Every whole ``name`` message as a numpy record array (multipliers applied by the caller)."""
         type_id = self.types[name]
@@ -103,7 +107,7 @@ class _Log:
 
 
 def _instance_records(log: _Log, instance: int) -> np.ndarray:
-    if log.has("IMU") and "I" in log.records("IMU").dtype.names:
+    if log.has("IMU") and "I" in log.fields("IMU"):
         imu = log.records("IMU")
         found = sorted(set(int(i) for i in np.unique(imu["I"])))
         if instance not in found:

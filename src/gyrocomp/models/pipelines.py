@@ -444,6 +444,9 @@ def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
     unknown = sorted(set(options) - set(_ACCEL_OPTIONS))
     if unknown:
         raise InputError(f"fit_accelerometer: options {', '.join(unknown)} are for the gyro only")
+    if "temperature" in options and options["temperature"] is None:
+        raise InputError("--channels accel: the accelerometer model is a temperature model; "
+                         "--temperature none leaves nothing to fit (use poly, poly:N or mlp)")
     pieces, folds, split = _accelerometer_pieces(recordings, options.get("static_min_duration_s", 10.0))
     if split and options.get("hysteresis", "auto") == "auto":
         options = {**options, "hysteresis": "none"}
