@@ -20,10 +20,9 @@ from gyrocomp.errors import InputError
 from .conftest import shared_dataset
 
 
-def brute_force_oadev(rate, rate_hz, m):
+def brute_force_oadev(rate, m):
     """The textbook overlapping estimator, term by term, from averages of m rate samples."""
-    y = np.asarray(rate, float)
-    tau = m / rate_hz
+    y = np.asarray(rate, float)  # averages of rate samples: the deviation does not depend on rate_hz
     terms = []
     for i in range(y.size - 2 * m + 1):
         a = y[i:i + m].mean()
@@ -37,7 +36,7 @@ def test_matches_brute_force_definition():
     y = rng.standard_normal(500).cumsum() * 0.01 + rng.standard_normal(500)
     res = allan_deviation(y, 4.0, taus="all")
     for m, tau, dev, n in zip(range(1, 200), res.tau, res.deviation, res.n):
-        ref, count = brute_force_oadev(y, 4.0, m)
+        ref, count = brute_force_oadev(y, m)
         assert tau == pytest.approx(m / 4.0)
         assert n == count
         assert dev == pytest.approx(ref, rel=1e-10)
@@ -306,6 +305,27 @@ def test_octave_pass_is_exact_on_drift_dominated_data():
         assert dev == pytest.approx(ref, rel=1e-7), m
 
 
+@pytest.mark.parametrize("shape", ["ramp", "random_walk", "step", "cubic"])
+def test_long_taus_from_lag_products_match_second_differences(shape):
+    """Factors with N/m <= 128 come from lag products of the phase; on drift-dominated phases (where the
+    cancellation in that identity is worst, ~ (N/m)^4 / 12 rounding units) they match the direct sum of
+    squared second differences, for octave and for arbitrary factors."""
+    rng = np.random.default_rng(8)
+    n = 399_999  # 400 000 phase points: 3125 is the shortest factor with N/m <= 128
+    t = np.linspace(0.0, 1.0, n)
+    y = {"ramp": 0.5 + 2.0 * t + 1e-3 * rng.standard_normal(n),
+         "random_walk": np.cumsum(rng.standard_normal(n)),
+         "step": np.where(t > 0.37, 1.0, 0.0) + 1e-6 * rng.standard_normal(n),
+         "cubic": 1e3 * (t - 0.3) ** 3 + 1e-6 * rng.standard_normal(n)}[shape]
+    ms = np.array([3125, 4096, 5000, 8192, 16384, 30001, 65536, 100_000])
+    assert (ms * 128 >= n + 1).all() and (ms <= (n + 1) // 4).all()
+    res = allan_deviation(y, 1.0, taus=ms.astype(float), confidence=None)
+    phase = np.concatenate([[0.0], np.cumsum(y - y.mean())])
+    for m, dev in zip(ms, res.deviation):
+        d = phase[2 * m:] - 2.0 * phase[m:-m] + phase[:-2 * m]
+        assert dev == pytest.approx(np.sqrt(np.dot(d, d) / (2.0 * m ** 2 * d.size)), rel=1e-7), m
+
+
 def test_identify_noise_on_power_law_noises():
     rng = np.random.default_rng(5)
     white = rng.standard_normal(20_000)
@@ -334,7 +354,7 @@ def test_memory_mapped_input_and_phase(tmp_path):
     plain = allan_deviation(y, 10.0)
     np.testing.assert_allclose(mapped.deviation, plain.deviation, rtol=1e-12)
     np.testing.assert_array_equal(mapped.alpha, plain.alpha)
-    np.testing.assert_allclose(np.asarray(phase), to_phase(y, 10.0), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(np.asarray(phase) / 10.0, to_phase(y, 10.0), rtol=0, atol=1e-9)  # [unit*samples]
     chunks = lambda: (y[i:i + 70_000] for i in range(0, y.size, 70_000))  # noqa: E731
     np.testing.assert_allclose(phase_from_chunks(chunks, 10.0, y.size), to_phase(y, 10.0), atol=1e-9)
     with pytest.raises(InputError, match=r"chunks: delivered 300001 samples, expected 5"):

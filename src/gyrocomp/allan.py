@@ -14,8 +14,10 @@ chi-squared bounds (SP 1065 eq. 45). The power-law noise type at each tau comes 
 autocorrelation (W. Riley and C. Greenhall, "Power law noise identification using the lag 1
 autocorrelation", EFTF 2004).
 
-Every sum is evaluated in blocks, so the working memory beyond the phase array stays a few MiB;
-``phase_out`` lets the phase itself live in a memory-mapped file for data larger than memory.
+Every sum is evaluated in blocks or as dot products of views, so the working memory beyond the phase
+array stays about 10 MiB; ``phase_out`` lets the phase itself live in a memory-mapped file for data larger
+than memory. The overlapping Allan sums have two fast paths: octave factors 1, 2, 4, ... in one
+cache-resident pass per block, and factors long against the series (N/m <= 128) from lag products.
 """
 
 from __future__ import annotations
@@ -298,7 +300,7 @@ def _total_sum(x, m: int, buffer: np.ndarray, spare: np.ndarray) -> float:
 
 #: octave levels up to this m are computed together, block by block, from windowed sums kept in cache
 _OCTAVE_IN_CACHE_MAX_M = 1 << 16
-_OCTAVE_BLOCK = 1 << 18
+_OCTAVE_BLOCK = 1 << 19
 
 
 def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
@@ -351,6 +353,48 @@ def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
     return sums
 
 
+#: averaging factors with n_phase / m at most this use lag products of the phase (see _lagged_oadev_sums)
+_LAGGED_MAX_SPANS = 128
+
+
+def _prefix_dots(x, lag: int, cuts: list[int]) -> dict[int, float]:
+    """P(c) = sum_{j<c} x[j] x[j+lag] at each cut c (sorted, within 0..len(x)-lag), one dot per segment."""
+    prefix, total, previous = {}, 0.0, 0
+    for cut in cuts:
+        if cut > previous:
+            total += float(np.dot(x[previous:cut], x[previous + lag:cut + lag]))
+            previous = cut
+        prefix[cut] = total
+    return prefix
+
+
+def _lagged_oadev_sums(x, ms: np.ndarray) -> np.ndarray:
+    """Overlapping Allan sums for long averaging factors from lag products of the phase alone.
+
+    With N = len(x), c = N - 2m, Q(a, b) = sum_{a<=j<b} x_j^2 and L_k(a, b) = sum_{a<=j<b} x_j x_{j+k},
+    sum_{i<c} (x_{i+2m} - 2 x_{i+m} + x_i)^2 = Q(2m, N) + 4 Q(m, N-m) + Q(0, c)
+                                             - 4 L_m(m, N-m) - 4 L_m(0, c) + 2 L_2m(0, c),
+    so each distinct lag (m and 2m; octave factors share them) costs one BLAS dot product over the series,
+    with no temporary array. The terms are of the order of N x^2 while the result is of the order of
+    N D_m^2; on a phase dominated by a drift that ratio grows like (N/m)^4 / 12, which is why only
+    factors with N/m <= _LAGGED_MAX_SPANS come here (relative rounding below ~1e-8).
+    """
+    n = len(x)
+    ms = [int(m) for m in ms]
+    squares = _prefix_dots(x, 0, sorted({0, n} | {c for m in ms for c in (m, 2 * m, n - 2 * m, n - m)}))
+    cuts: dict[int, set[int]] = {}
+    for m in ms:
+        cuts.setdefault(m, set()).update((0, m, n - 2 * m, n - m))
+        cuts.setdefault(2 * m, set()).update((0, n - 2 * m))
+    lagged = {k: _prefix_dots(x, k, sorted(c)) for k, c in cuts.items()}
+    sums = np.empty(len(ms))
+    for j, m in enumerate(ms):
+        c, q, lm, l2m = n - 2 * m, squares, lagged[m], lagged[2 * m]
+        sums[j] = ((q[n] - q[2 * m]) + 4.0 * (q[n - m] - q[m]) + q[c]
+                   - 4.0 * (lm[n - m] - lm[m]) - 4.0 * lm[c] + 2.0 * l2m[c])
+    return sums
+
+
 def _cumulated(phase) -> np.ndarray:
     """X[k] = sum_{i<k} (x[i] - mean(x)), the running sum the modified variance differences."""
     return _running_sum((phase[a:b] for a, b in _blocks(len(phase))), _mean(phase), np.empty(len(phase) + 1))
@@ -369,39 +413,51 @@ def _one_sum(kind: str, phase, cumulated, m: int, count: int) -> float:
     return _third_difference_sum(cumulated, m, 1, count, buffer, spare)
 
 
-def _octave_chain(ms: np.ndarray) -> int:
-    """How many of ms (sorted) are 1, 2, 4, ... in a row, up to the in-cache limit."""
+def _octave_chain(ms: np.ndarray, n_phase: int) -> int:
+    """How many of ms (sorted) are 1, 2, 4, ... in a row, up to the in-cache limit and short of the
+    factors the lag products take."""
     length = 0
-    while length < len(ms) and ms[length] == 1 << length and ms[length] <= _OCTAVE_IN_CACHE_MAX_M:
+    while (length < len(ms) and ms[length] == 1 << length and ms[length] <= _OCTAVE_IN_CACHE_MAX_M
+           and ms[length] * _LAGGED_MAX_SPANS < n_phase):
         length += 1
     return length
 
 
 def _variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """The sum of squared differences behind each estimator, before its normalization."""
+    """The sum of squared differences behind each estimator, before its normalization.
+
+    OADEV: octave factors 1, 2, 4, ... in one block-wise pass (_octave_oadev_sums), factors long against
+    the series from lag products (_lagged_oadev_sums); everything else term by term in blocks.
+    """
     cumulated = _cumulated(phase) if kind in ("mdev", "tdev") else None
     sums = np.zeros(len(ms))
-    chain = _octave_chain(ms) if kind == "oadev" else 0
-    if chain >= 2:
-        sums[:chain] = _octave_oadev_sums(phase, int(ms[chain - 1]))
-    else:
-        chain = 0
-    for j in range(chain, len(ms)):
-        if counts[j] >= 1:
-            sums[j] = _one_sum(kind, phase, cumulated, int(ms[j]), int(counts[j]))
+    rest = np.flatnonzero(counts >= 1)
+    if kind == "oadev":
+        chain = _octave_chain(ms, len(phase))
+        if chain >= 2:
+            sums[:chain] = _octave_oadev_sums(phase, int(ms[chain - 1]))
+            rest = rest[rest >= chain]
+        lagged = rest[ms[rest] * _LAGGED_MAX_SPANS >= len(phase)]
+        if lagged.size:
+            sums[lagged] = np.maximum(_lagged_oadev_sums(phase, ms[lagged]), 0.0)  # rounding below 0 is 0
+        rest = np.setdiff1d(rest, lagged)
+    for j in rest:
+        sums[j] = _one_sum(kind, phase, cumulated, int(ms[j]), int(counts[j]))
     return sums
 
 
-
-
-def _normalize(kind: str, sums: np.ndarray, ms: np.ndarray, tau: np.ndarray, counts: np.ndarray) -> np.ndarray:
+def _normalize(kind: str, sums: np.ndarray, ms: np.ndarray, tau: np.ndarray, counts: np.ndarray,
+               phase_scale: float) -> np.ndarray:
+    """Deviations from the sums; ``phase_scale`` is what the phase was multiplied by (rate_hz for rate
+    data integrated in samples, see _as_phase)."""
+    scaled_tau = tau * phase_scale
     with np.errstate(invalid="ignore", divide="ignore"):
         if kind in ("oadev", "adev", "totdev"):
-            var = sums / (2.0 * tau ** 2 * counts)
+            var = sums / (2.0 * scaled_tau ** 2 * counts)
         elif kind in ("hdev", "ohdev"):
-            var = sums / (6.0 * tau ** 2 * counts)
+            var = sums / (6.0 * scaled_tau ** 2 * counts)
         else:
-            var = sums / (2.0 * ms.astype(float) ** 2 * tau ** 2 * counts)
+            var = sums / (2.0 * ms.astype(float) ** 2 * scaled_tau ** 2 * counts)
         dev = np.sqrt(np.where(counts > 0, var, np.nan))
     if kind == "tdev":
         dev = tau * dev / np.sqrt(3.0)  # time deviation [unit*s]: tau / sqrt(3) * MDEV
@@ -682,16 +738,18 @@ def _check(kind: str, rate_hz: float, data_type: str) -> None:
         raise InputError(f"data_type: {data_type!r}; use 'rate' or 'phase'")
 
 
-def _as_phase(data, rate_hz: float, data_type: str, phase_out) -> np.ndarray:
+def _as_phase(data, rate_hz: float, data_type: str, phase_out) -> tuple[np.ndarray, float]:
+    """The phase and the factor it carries: rate data is summed without the division by rate_hz (one
+    pass fewer over the data; the deviations do not depend on it), so its phase is in [unit*samples]."""
     if data_type == "rate":
         if np.ndim(data) != 1:
             raise InputError("data: need a one-dimensional series")
-        phase = to_phase(data, rate_hz, out=phase_out)
+        phase, scale = to_phase(data, 1.0, out=phase_out), rate_hz
     else:
-        phase = data if isinstance(data, np.ndarray) else np.asarray(data, dtype=float)
+        phase, scale = (data if isinstance(data, np.ndarray) else np.asarray(data, dtype=float)), 1.0
     if phase.ndim != 1 or phase.size < 3:
         raise InputError("data: need a one-dimensional series of at least 3 phase points")
-    return phase
+    return phase, scale
 
 
 def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave", data_type: str = "rate",
@@ -715,15 +773,16 @@ def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave",
         Two-sided confidence of ``ci_low``/``ci_high`` (default one sigma, 0.683). None skips the noise
         identification and the intervals (``ci_low``, ``ci_high``, ``alpha``, ``edf`` are NaN).
     phase_out : array (n+1,), optional
-        Where to put the integrated phase of rate data, e.g. a memory-mapped file for data larger than
-        memory; by default a new array.
+        Where to put the integrated rate data, e.g. a memory-mapped file for data larger than memory; by
+        default a new array. It receives the running sum of the rate minus its mean [unit*samples], i.e.
+        the phase times ``rate_hz``.
     """
     _check(kind, rate_hz, data_type)
-    phase = _as_phase(data, rate_hz, data_type, phase_out)
+    phase, scale = _as_phase(data, rate_hz, data_type, phase_out)
     ms = averaging_factors(phase.size, taus, rate_hz, kind)
     tau = ms / rate_hz
     counts = term_count(kind, phase.size, ms)
-    deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts)
+    deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
     if confidence is None:
         alphas = np.full(len(ms), np.nan)
         edf = alphas.copy()
@@ -747,9 +806,11 @@ def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: str = 
     _check(kind, rate_hz, data_type)
     if kind == "totdev":
         raise InputError("kind: totdev cannot pool stretches separated by gaps; use oadev, or one stretch")
-    phases = [_as_phase(s, rate_hz, data_type, None) for s in segments if len(s) >= (3 if data_type == "phase" else 2)]
-    if not phases:
+    shortest = 3 if data_type == "phase" else 2
+    integrated = [_as_phase(s, rate_hz, data_type, None) for s in segments if len(s) >= shortest]
+    if not integrated:
         raise InputError("data: no stretch has enough samples")
+    phases, scale = [phase for phase, _ in integrated], integrated[0][1]
     longest = max(phases, key=len)
     ms = averaging_factors(longest.size, taus, rate_hz, kind)
     tau = ms / rate_hz
@@ -763,7 +824,7 @@ def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: str = 
             own_edf = _degrees_of_freedom(kind, alphas, ms, phase.size)
             edf += np.where((own > 0) & np.isfinite(own_edf), own_edf, 0.0)
     edf = np.where(np.isnan(alphas), np.nan, edf)
-    deviation = _normalize(kind, sums, ms, tau, counts)
+    deviation = _normalize(kind, sums, ms, tau, counts, scale)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
                        edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence)
