@@ -195,6 +195,17 @@ def test_demo(tmp_path):
     truth = json.loads((tmp_path / "demo" / "heldout_truth.json").read_text())
     assert truth["preset"] == "mti10" and truth["profile"]["name"] == "combined"
     assert "warning" not in r.stderr
+    report = (tmp_path / "demo" / "report.html").read_text()
+    assert report.startswith("<!DOCTYPE html>") and "heldout_run.csv" in report and "data:image/png;base64," in report
+    assert "report.html (open it in a browser)" in r.stdout
+
+
+def test_demo_without_matplotlib_says_why_there_is_no_report(tmp_path, monkeypatch):
+    from gyrocomp import demo
+
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # import matplotlib now fails, as when not installed
+    why = demo._write_report(None, None, tmp_path / "report.html")
+    assert why is not None and "[plot]" in why and not (tmp_path / "report.html").exists()
 
 
 def test_mapping_and_units_through_cli(workdir, tmp_path):

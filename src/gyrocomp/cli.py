@@ -854,6 +854,8 @@ def demo(ctx, out_dir):
     from .demo import run_demo
 
     result = run_demo(Path(out_dir))
+    if result.report_skipped:
+        click.echo(f"gyrocomp: note: no report.html: {result.report_skipped}", err=True)
     if not ctx.obj["quiet"]:
         console = _console()
         console.print(result.summary)

@@ -19,7 +19,7 @@ import numpy as np
 
 from .calibration import Calibration
 from .compensate import apply
-from .errors import DataQualityWarning
+from .errors import DataQualityWarning, MissingDependencyError
 from .io import read_table, write_gyro_back, write_recording, write_text_atomic
 from .metrics import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
 from .models.pipelines import fit_calibration
@@ -54,13 +54,16 @@ class DemoResult:
     residual_dps: dict[str, float]
     summary: str
     files: list[Path]
+    #: why report.html was not written (matplotlib missing), or None when it was
+    report_skipped: str | None = None
 
 
-def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ) -> DemoResult:
+def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) -> DemoResult:
     """Simulate calibration cycles, fit on them, compensate a held-out tumbling cycle, and score it.
 
     Writes to ``out_dir``: the calibration runs and the held-out run (CSV), ``model.json``,
-    ``heldout_compensated.csv``, ``metrics.json``, ``effects.json`` and ``heldout_truth.json``.
+    ``heldout_compensated.csv``, ``metrics.json``, ``effects.json``, ``heldout_truth.json`` and, with
+    ``report`` and matplotlib installed, ``report.html`` (the model judged on the held-out run).
     """
     out_dir.mkdir(parents=True, exist_ok=True)
     cal_profile = get_profile("combined", set_points_degc=(-25.0, 90.0), ramp_rate_degc_per_min=1.0, dwell_s=900.0)
@@ -141,8 +144,23 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ) -> DemoResult:
         lines.append(f"  {axis}: {m.residual_rms_dps:.3g} deg/s compensated, {perfect[axis]:.3g} deg/s noise alone "
                      f"(ratio {m.residual_rms_dps / perfect[axis]:.2f}); raw bias offset {m.bias_offset_raw_dps:.3g} "
                      f"-> {m.bias_offset_comp_dps:.3g} deg/s")
+    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html") if report else "not asked for"
+    if skipped is None:
+        lines.append(f"Report of the model on the held-out run: {out_dir / 'report.html'} (open it in a browser).")
     files = sorted(out_dir.iterdir())
-    return DemoResult(calibration, evaluation, perfect, effects, residual, "\n".join(lines), files)
+    return DemoResult(calibration, evaluation, perfect, effects, residual, "\n".join(lines), files, skipped)
+
+
+def _write_report(calibration: Calibration, run, path: Path) -> str | None:
+    """Write the HTML report; return why not (the missing [plot] extra), or None."""
+    try:
+        from .report.html import build_report
+
+        html = build_report(calibration, [run]).html
+    except MissingDependencyError as exc:
+        return str(exc)
+    write_text_atomic(path, html)
+    return None
 
 
 __all__ = ["DemoResult", "EffectSize", "run_demo"]

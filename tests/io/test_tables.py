@@ -157,6 +157,24 @@ def test_atomic_path_leaves_target_untouched_on_failure(tmp_path):
     assert os.listdir(tmp_path) == ["out.csv"]
 
 
+def test_atomic_outputs_get_ordinary_permissions(tmp_path):
+    """Not the temporary file's private 0o600: a new file gets 0o666 less the umask, an existing one keeps
+    its mode."""
+    previous = os.umask(0o027)
+    try:
+        with atomic_path(tmp_path / "new.csv") as tmp:
+            tmp.write_text("x")
+        assert (tmp_path / "new.csv").stat().st_mode & 0o777 == 0o640
+        kept = tmp_path / "kept.csv"
+        kept.write_text("old")
+        kept.chmod(0o604)
+        with atomic_path(kept) as tmp:
+            tmp.write_text("new")
+        assert kept.stat().st_mode & 0o777 == 0o604 and kept.read_text() == "new"
+    finally:
+        os.umask(previous)
+
+
 def test_atomic_path_needs_existing_folder(tmp_path):
     with pytest.raises(InputError, match=r"folder .*nodir does not exist"):
         with atomic_path(tmp_path / "nodir" / "x.csv"):
