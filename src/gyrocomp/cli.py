@@ -586,7 +586,10 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
             refuse_to_overwrite_inputs(path, [input_path], option=option)
     if plot_path:
         check_figure_path(plot_path)
-    recording = _read(input_path, opts).recording
+    with warnings.catch_warnings():
+        # gaps are refused below, or split with a note, in one line of their own
+        warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
+        recording = _read(input_path, opts).recording
     names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
     if kalibr_path:
         names += [a for a in recording.accel_axes if a not in names]
@@ -784,7 +787,10 @@ def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
 
     opts = _pop_read_options(kwargs)
     _figure_output(output, [input_path] + ([model] if model else []))
-    recording = _read(input_path, opts).recording
+    with warnings.catch_warnings():
+        # gaps are refused below, or split with a note, in one line of their own
+        warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
+        recording = _read(input_path, opts).recording
     names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
     analyses = {"raw": analyse_noise(recording, names, split_gaps=split_gaps)}
     if model:
