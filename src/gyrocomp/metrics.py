@@ -154,20 +154,26 @@ def smoothed_residual_rms(x: np.ndarray, window_samples: int) -> float:
     return float(np.sqrt(np.mean((smooth - smooth.mean()) ** 2)))
 
 
-def _accel_metrics(raw: Recording, compensated: Recording, w: int, stretches: list[slice]) -> dict:
-    out = {}
-    for j, axis in enumerate(raw.accel_axes):
-        r, c = raw.accel_g[:, j], compensated.accel_g[:, j]
-        off_raw, off_comp = bias_offset(r, w), bias_offset(c, w)
-        low_raw, low_comp = _allan_minimum(r, raw.rate_hz, stretches), _allan_minimum(c, raw.rate_hz, stretches)
-        out[axis] = AccelAxisMetrics(
-            bias_offset_raw_g=off_raw, bias_offset_comp_g=off_comp,
-            offset_improvement=off_raw / off_comp if off_comp > 0 else math.inf,
-            bias_instability_raw_ug=low_raw.deviation / BIAS_INSTABILITY_FACTOR * 1e6,
-            bias_instability_comp_ug=low_comp.deviation / BIAS_INSTABILITY_FACTOR * 1e6,
-            integration_time_raw_s=low_raw.tau_s, integration_time_comp_s=low_comp.tau_s,
-            residual_rms_g=smoothed_residual_rms(c, w))
-    return out
+@dataclass(frozen=True)
+class _Figures:
+    """One axis's figures in its own unit (deviations at the Allan minimum, not yet divided by 0.664)."""
+
+    offset_raw: float
+    offset_comp: float
+    improvement: float
+    allan_min_raw: float
+    allan_min_comp: float
+    integration_time_raw_s: float
+    integration_time_comp_s: float
+    residual_rms: float
+
+
+def _figures(raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretches: list[slice]) -> _Figures:
+    off_raw, off_comp = bias_offset(raw, w), bias_offset(comp, w)
+    low_raw, low_comp = _allan_minimum(raw, rate_hz, stretches), _allan_minimum(comp, rate_hz, stretches)
+    return _Figures(off_raw, off_comp, off_raw / off_comp if off_comp > 0 else math.inf,
+                    low_raw.deviation, low_comp.deviation, low_raw.tau_s, low_comp.tau_s,
+                    smoothed_residual_rms(comp, w))
 
 
 def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None,
@@ -193,24 +199,25 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
     if window_s is None:
         window_s = default_window_s(raw)
     w = window_samples(window_s, raw.rate_hz, raw.n_samples)
+    to_dph = DEG_PER_S_TO_DEG_PER_H / BIAS_INSTABILITY_FACTOR
     axes = {}
     for j, axis in enumerate(raw.gyro_axes):
-        r, c = raw.gyro_dps[:, j], compensated.gyro_dps[:, j]
-        off_raw, off_comp = bias_offset(r, w), bias_offset(c, w)
-        bi_raw, bi_comp = bias_instability(r, raw.rate_hz, stretches), bias_instability(c, raw.rate_hz, stretches)
+        f = _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches)
         axes[axis] = AxisMetrics(
-            bias_offset_raw_dps=off_raw,
-            bias_offset_comp_dps=off_comp,
-            offset_improvement=off_raw / off_comp if off_comp > 0 else math.inf,
-            bias_instability_raw_dph=bi_raw.bias_instability_deg_per_h,
-            bias_instability_comp_dph=bi_comp.bias_instability_deg_per_h,
-            integration_time_raw_s=bi_raw.integration_time_s,
-            integration_time_comp_s=bi_comp.integration_time_s,
-            residual_rms_dps=smoothed_residual_rms(c, w),
-        )
+            bias_offset_raw_dps=f.offset_raw, bias_offset_comp_dps=f.offset_comp, offset_improvement=f.improvement,
+            bias_instability_raw_dph=f.allan_min_raw * to_dph, bias_instability_comp_dph=f.allan_min_comp * to_dph,
+            integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
+            residual_rms_dps=f.residual_rms)
     accel_axes = {}
     if accel and raw.accel_g is not None and compensated.accel_g is not None:
-        accel_axes = _accel_metrics(raw, compensated, w, stretches)
+        to_ug = 1e6 / BIAS_INSTABILITY_FACTOR
+        for j, axis in enumerate(raw.accel_axes):
+            f = _figures(raw.accel_g[:, j], compensated.accel_g[:, j], raw.rate_hz, w, stretches)
+            accel_axes[axis] = AccelAxisMetrics(
+                bias_offset_raw_g=f.offset_raw, bias_offset_comp_g=f.offset_comp, offset_improvement=f.improvement,
+                bias_instability_raw_ug=f.allan_min_raw * to_ug, bias_instability_comp_ug=f.allan_min_comp * to_ug,
+                integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
+                residual_rms_g=f.residual_rms)
     return RunEvaluation(file=raw.source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
 
 
