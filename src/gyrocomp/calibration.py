@@ -21,7 +21,7 @@ from .errors import InputError
 from .io.atomic import write_text_atomic
 from .models.mlp import MLPBias
 from .models.temperature import PolynomialBias
-from .models.thermal import HysteresisCurve
+from .models.hysteresis import HysteresisCurve
 from .recording import Recording
 
 FORMAT_NAME = "gyrocomp-calibration"

@@ -40,9 +40,10 @@ from .io import (
 )
 from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .metrics import Evaluation, evaluate_run
+from .models.acceleration import ACCELERATION_CHOICES
 from .models.pipelines import fit_channels, parse_channels
 from .models.temperature import parse_temperature_option
-from .models.thermal import ACCELERATION_CHOICES, CANDIDATES, HYSTERESIS_CHOICES
+from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
 from .noise import NoiseAnalysis, analyse_noise
 from .report.figures import allan_figure, check_figure_path
 
@@ -120,7 +121,11 @@ def _pop_read_options(kwargs: dict) -> dict:
 @click.option("--quiet", "-q", is_flag=True, help="Print only errors.")
 @click.pass_context
 def cli(ctx, debug, quiet):
-    """Remove temperature-driven drift from MEMS gyro logs, and measure what is left.
+    """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
+    g-sensitivity) from logs, and measure what is left.
+
+    Typical flow: fit on calibration runs, apply to new data, evaluate or report, export to firmware
+    or an autopilot; allan for noise; demo for all of it on simulated data.
 
     Units: angular rate deg/s, acceleration g, temperature degC, time s.
     """
@@ -856,7 +861,8 @@ def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, *
               type=click.Path(file_okay=False), help="Folder for the demo's files.")
 @click.pass_context
 def demo(ctx, out_dir):
-    """The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score it."""
+    """The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score it,
+    and write the HTML report."""
     from .demo import run_demo
 
     result = run_demo(Path(out_dir))

@@ -11,7 +11,8 @@ import pytest
 from gyrocomp import Calibration, Compensator, apply, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.metrics import evaluate_stages, smoothed_residual_rms
-from gyrocomp.effects import g_squared_products
+from gyrocomp.models.acceleration import excited_columns
+from gyrocomp.effects import G_SQUARED_TERMS, g_squared_products
 from gyrocomp.simulate import get_profile, preset_model, simulate, tumble_positions
 
 RATE_HZ = 1.0
@@ -218,3 +219,22 @@ def test_unknown_pipeline():
 
     with pytest.raises(InputError, match=r"--pipeline: 'poly>net'; use one of joint, poly>matrix, matrix>poly"):
         fit_pipeline([simulate("mti10", profile="static", duration_s=100, rate_hz=1).recording], "poly>net")
+
+
+def test_excited_columns_from_the_spread_of_the_positions():
+    """Positions that tilt x and y but leave z near 1 g excite two columns; with all three excited the zz
+    term is left out of the g x g set (xx + yy + zz = 1 g^2 at rest makes it the run constant)."""
+    rng = np.random.default_rng(4)
+    tilted = np.column_stack([rng.choice([-0.5, 0.0, 0.5], 200), rng.choice([-0.5, 0.5], 200),
+                              0.95 + 0.01 * rng.standard_normal(200)])
+    weights = [np.ones(200), np.ones(200)]
+    with pytest.warns(DataQualityWarning, match=r"the positions do not excite accel_z \(0\.01 g\): within-run spread "
+                                                r"below 0\.1 g"):
+        excited, squares, names = excited_columns([tilted, tilted[::-1]], weights, squares=True)
+    assert excited == (0, 1) and names == ("accel_x", "accel_y")
+    assert [G_SQUARED_TERMS[m] for m in squares] == ["xx", "yy", "xy"]
+    tumble = np.vstack([np.eye(3), -np.eye(3)]).repeat(20, axis=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # every axis excited: no warning
+        excited, squares, _ = excited_columns([tumble], [np.ones(len(tumble))], squares=True)
+    assert excited == (0, 1, 2) and "zz" not in [G_SQUARED_TERMS[m] for m in squares] and len(squares) == 5

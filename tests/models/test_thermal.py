@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from gyrocomp import Calibration, Compensator, apply, fit_calibration
 from gyrocomp.errors import InputError, NotFittedError
 from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.thermal import HysteresisCurve, ThermalHysteresisModel, turn_threshold_degc
+from gyrocomp.models.thermal import ThermalHysteresisModel
 from gyrocomp.simulate import Hysteresis, get_profile, preset_model, simulate
 
 RANGE = (-30.0, 80.0)
@@ -118,19 +118,7 @@ def test_heating_only_runs_get_no_hysteresis_candidates():
     assert all(not ax.has_memory for ax in cal.axes.values())
 
 
-def test_turn_threshold_sees_noise_and_whole_degrees():
-    rng = np.random.default_rng(0)
-    ramp = np.linspace(20, 60, 20000)
-    assert turn_threshold_degc(ramp + rng.normal(0, 0.05, ramp.size)) == pytest.approx(0.5, rel=0.1)
-    assert turn_threshold_degc(np.round(ramp)) == 1.5
-    assert turn_threshold_degc(ramp) == 0.1
-
-
-def test_hysteresis_curve_dict_round_trip_and_errors():
-    curve = HysteresisCurve((0.1, -0.01), (0.0, 0.0), 0.5, (55.0, 80.0))
-    assert HysteresisCurve.from_dict(json.loads(json.dumps(curve.to_dict()))) == curve
-    with pytest.raises(InputError, match="unknown hysteresis model type 'spline'"):
-        HysteresisCurve.from_dict({"type": "spline"})
+def test_bad_hysteresis_options_and_not_fitted():
     runs = [simulate("adxrs450", profile="cycle", duration_s=2000, rate_hz=1, seed=1).recording]
     with pytest.raises(InputError, match=r"--hysteresis: 'magic'; use one of auto, none, turning-point, lag"):
         fit_calibration(runs, hysteresis="magic")

@@ -1,12 +1,15 @@
-"""Helpers every model shares: temperature binning and the per-run turn-on constants."""
+"""Helpers every model shares: temperature binning, block means, the per-run turn-on constants, provenance."""
 
 from __future__ import annotations
 
+import datetime as _dt
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
+from ..recording import Recording
 
 #: default number of temperature bins across the span of the calibration data
 DEFAULT_BINS_PER_SPAN = 100
@@ -44,6 +47,51 @@ class TemperatureBins:
         return np.minimum(1.0, self.count / np.median(self.count))
 
 
+@dataclass(frozen=True)
+class RunBlocks:
+    """Block means of one run and axis: time [s], temperature [degC], gyro [deg/s], bin-balancing weight,
+    the accelerations [g] when the run has the triad, and the piece (segment) each block comes from."""
+
+    time_s: np.ndarray
+    temperature_degc: np.ndarray
+    value_dps: np.ndarray
+    weight: np.ndarray
+    accel_g: np.ndarray | None = None
+    cluster: np.ndarray | None = None
+
+
+def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float,
+                pieces: list[slice] | None = None) -> RunBlocks:
+    """Means over consecutive blocks of ``block_s`` inside each of ``pieces`` (default: the stretches
+    between time gaps; for multi-position runs, the static segments), with bin-balancing weights.
+    ``cluster`` numbers the piece each block comes from."""
+    t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
+    per_block = max(1, int(round(block_s * rec.rate_hz)))
+    pieces = rec.contiguous_stretches() if pieces is None else pieces
+    starts, ends, cluster = [], [], []
+    for k, piece in enumerate(pieces):
+        s = np.arange(piece.start, piece.stop, per_block)
+        starts.append(s)
+        ends.append(np.minimum(s + per_block, piece.stop))
+        cluster.append(np.full(s.size, k))
+    starts, ends, cluster = np.concatenate(starts), np.concatenate(ends), np.concatenate(cluster)
+    counts = ends - starts
+
+    def mean(x):
+        c = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)])
+        return (c[ends] - c[starts]) / (counts if x.ndim == 1 else counts[:, None])
+
+    bt, btemp, by = mean(t - t[0]) + t[0], mean(temp), mean(y)
+    accel = None
+    if rec.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
+        order = [rec.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]
+        accel = mean(rec.accel_g[:, order])
+    idx = np.floor(btemp / bin_width_degc).astype(np.int64)
+    _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
+    weight = (counts / counts.max()) / per_bin[inverse]
+    return RunBlocks(bt, btemp, by, weight, accel, cluster)
+
+
 def bin_width_for(temperatures: list[np.ndarray], bin_width_degc: float | None) -> float:
     """The bin width [degC]: as given, or the span of all runs divided by ``DEFAULT_BINS_PER_SPAN``."""
     if bin_width_degc is not None:
@@ -74,3 +122,24 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
     """Mean of ``residual_dps`` over the first ``window_s`` seconds of a run [deg/s]."""
     head = time_s - time_s[0] < window_s
     return float(residual_dps[head].mean())
+
+
+def provenance(recordings) -> dict:
+    """Where a calibration came from: gyrocomp's version, the time, and each input (name, rows, duration,
+    rate, SHA-256 of the file when it is on disk)."""
+    from .. import __version__
+    from ..io import file_sha256
+
+    inputs = []
+    for rec in recordings:
+        entry = {"file": Path(rec.source).name, "rows": rec.n_samples, "duration_s": rec.duration_s,
+                 "rate_hz": rec.rate_hz}
+        path = rec.metadata.get("path")
+        if path and Path(path).is_file():
+            entry["sha256"] = file_sha256(path)
+        inputs.append(entry)
+    return {
+        "gyrocomp_version": __version__,
+        "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "inputs": inputs,
+    }

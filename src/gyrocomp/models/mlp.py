@@ -27,6 +27,9 @@ MAX_FAIL = 6
 MU_START, MU_DEC, MU_INC, MU_MAX = 1e-3, 0.1, 10.0, 1e10
 MAX_EPOCHS = 300
 DEFAULT_HIDDEN = (3,)
+#: block means the network trains on [s]: temperature moves slowly, so 10-s means lose nothing and keep a
+#: day of data to under 10,000 points per run
+NETWORK_BLOCK_S = 10.0
 DEFAULT_RESTARTS = 5
 #: share of each run held out (as contiguous segments) to validate restarts and stop early
 VALIDATION_SHARE = 0.2

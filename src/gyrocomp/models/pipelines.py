@@ -3,46 +3,27 @@
 from __future__ import annotations
 
 import dataclasses
-import datetime as _dt
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
+from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import InputError, TemperatureRangeWarning
 from ..recording import ACCEL_AXES, Recording
-from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from .base import bin_width_for
-from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_INPUTS, MLPTemperatureModel
-from .temperature import PolynomialBias, PolynomialTemperatureModel
-from .thermal import (
+from .acceleration import (
     ACCELERATION_CHOICES,
-    HYSTERESIS_CHOICES,
-    ThermalHysteresisModel,
-    block_means,
-    heats_and_cools,
+    acceleration_report,
+    fit_acceleration_network,
+    fit_g_sensitivity,
+    turned_between_positions,
 )
-
-
-def _provenance(recordings: list[Recording]) -> dict:
-    from .. import __version__
-    from ..io import file_sha256
-
-    inputs = []
-    for rec in recordings:
-        entry = {"file": Path(rec.source).name, "rows": rec.n_samples, "duration_s": rec.duration_s,
-                 "rate_hz": rec.rate_hz}
-        path = rec.metadata.get("path")
-        if path and Path(path).is_file():
-            entry["sha256"] = file_sha256(path)
-        inputs.append(entry)
-    return {
-        "gyrocomp_version": __version__,
-        "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "inputs": inputs,
-    }
+from .base import bin_width_for, block_means, provenance
+from .hysteresis import heats_and_cools
+from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
+from .temperature import PolynomialBias, PolynomialTemperatureModel
+from .thermal import HYSTERESIS_CHOICES, ThermalHysteresisModel
 
 
 def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
@@ -75,55 +56,6 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc, accel_g=a_in if needs_accel else None,
                        inputs=inputs)
     return network.curves_[axis], network.turn_on_biases_dps_[axis]
-
-
-#: block means the network trains on [s]: temperature moves slowly, so 10-s means lose nothing and keep a
-#: day of data to under 10,000 points per run
-NETWORK_BLOCK_S = 10.0
-
-
-def _listed(values: np.ndarray) -> list:
-    return [None if not np.isfinite(v) else float(v) for v in values]
-
-
-def _turned_between_positions(recordings: list[Recording], min_duration_s: float) -> bool:
-    """Whether some run has an accelerometer triad and more than one orientation among its static segments."""
-    from ..static import orientations, static_segments
-
-    for rec in recordings:
-        if rec.accel_g is None or not set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
-            continue
-        if len(orientations(static_segments(rec, min_duration_s=min_duration_s))) > 1:
-            return True
-    return False
-
-
-def _acceleration_report(thermal: ThermalHysteresisModel, mode: str) -> dict:
-    return {
-        "mode": mode, "excited_axes": list(thermal.excited_axes_),
-        "static_segments": [len(segs) for segs in thermal.segments_],
-        "axes": {a: {"g_sensitivity_dps_per_g": _listed(thermal.g_sensitivity_dps_per_g_[a]),
-                     "standard_error_dps_per_g": _listed(thermal.g_sensitivity_se_dps_per_g_[a]),
-                     **({"g_squared_dps_per_g2": _listed(thermal.g_squared_dps_per_g2_[a]),
-                         "g_squared_standard_error_dps_per_g2": _listed(thermal.g_squared_se_dps_per_g2_[a])}
-                        if mode == "matrix2" else {})}
-                 for a in thermal.g_sensitivity_dps_per_g_}}
-
-
-def _fit_g_only(recordings: list[Recording], mode: str, static_min_duration_s: float) -> Calibration:
-    """g-sensitivity and run constants without a temperature model (no temperature, or --temperature none)."""
-    flat = [dataclasses.replace(rec, temperature_degc=np.zeros(rec.n_samples)) for rec in recordings]
-    thermal = ThermalHysteresisModel(order=0, hysteresis="none", acceleration=mode,
-                                     static_min_duration_s=static_min_duration_s).fit(flat)
-    axes = {}
-    for axis in recordings[0].gyro_axes:
-        g_row = tuple(map(float, thermal.g_sensitivity_dps_per_g_[axis])) if thermal.excited_axes_ else None
-        g_sq = tuple(map(float, thermal.g_squared_dps_per_g2_[axis])) if mode == "matrix2" and g_row else None
-        axes[axis] = AxisCalibration(None, tuple(float(c) for c in thermal.turn_on_biases_dps_[axis]),
-                                     g_sensitivity_dps_per_g=g_row, g_squared_dps_per_g2=g_sq)
-    name = "g-sensitivity" + (" (g x g)" if mode == "matrix2" else "") if thermal.excited_axes_ else "none"
-    return Calibration(axes=axes, model=name, provenance=_provenance(recordings),
-                       fit_report={"temperature": None, "acceleration": _acceleration_report(thermal, mode)})
 
 
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
@@ -178,14 +110,14 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     if not static_min_duration_s > 0:
         raise InputError(f"--min-static: must be a positive number of seconds, got {static_min_duration_s}")
     if temperature is None and acceleration != "none" and (
-            acceleration != "auto" or _turned_between_positions(recordings, static_min_duration_s)):
-        return _fit_g_only(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
+            acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
+        return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
     if temperature is None:
         axes = {}
         for axis in recordings[0].gyro_axes:
             consts = tuple(float(rec.gyro(axis).mean()) for rec in recordings)
             axes[axis] = AxisCalibration(None, consts)
-        return Calibration(axes=axes, model="none", provenance=_provenance(recordings),
+        return Calibration(axes=axes, model="none", provenance=provenance(recordings),
                            fit_report={"temperature": None})
     for rec in recordings:
         if rec.temperature_degc is None:
@@ -203,7 +135,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                                        folds=run_folds).fit(recordings)
     accel_mode = acceleration
     if accel_mode == "auto":
-        accel_mode = "matrix" if _turned_between_positions(recordings, static_min_duration_s) else "none"
+        accel_mode = "matrix" if turned_between_positions(recordings, static_min_duration_s) else "none"
     mode = hysteresis
     if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
         mode = "none"
@@ -228,7 +160,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         report["hysteresis"] = {"mode": hysteresis, "selection": "none: the runs do not both heat and cool"
                                 if hysteresis == "auto" else "none"}
     if accel_mode != "none":
-        report["acceleration"] = _acceleration_report(thermal, accel_mode)
+        report["acceleration"] = acceleration_report(thermal, accel_mode)
     else:
         report["acceleration"] = {"mode": "none", "why": "the runs do not turn the unit between positions"
                                   if acceleration == "auto" else "not asked for"}
@@ -277,7 +209,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
             name += " + " + "/".join(extras)
         if any(ax.g_sensitivity_dps_per_g is not None for ax in axes.values()):
             name += " + g-sensitivity" + (" (g x g)" if accel_mode == "matrix2" else "")
-    return Calibration(axes=axes, model=name, provenance=_provenance(recordings), fit_report=report)
+    return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
 
 
 #: the named pipelines of ``gyrocomp fit --pipeline`` (thesis 2.8): stages left to right, each fitted on the
@@ -309,37 +241,8 @@ def _chain(first: Calibration, second: Calibration, recordings: list[Recording],
                                      g_stage.acceleration_network)
     report = {"pipeline": name, "stages": [first.fit_report, second.fit_report],
               "acceleration": (first.fit_report if first.has_acceleration else second.fit_report).get("acceleration", {})}
-    return Calibration(axes=axes, model=f"{name}: {first.model} > {second.model}", provenance=_provenance(recordings),
+    return Calibration(axes=axes, model=f"{name}: {first.model} > {second.model}", provenance=provenance(recordings),
                        fit_report=report)
-
-
-def _fit_acceleration_network(recordings: list[Recording], options: dict, min_static: float) -> Calibration:
-    """A network of accel_x, accel_y, accel_z (and one constant per run) on the static segments of the runs."""
-    from ..static import static_segments
-
-    hidden = options["temperature"][1] if isinstance(options.get("temperature"), tuple) else DEFAULT_HIDDEN
-    network = MLPTemperatureModel(hidden=hidden, seed=options.get("mlp_seed", 0))
-    segments = [static_segments(rec, min_duration_s=min_static) for rec in recordings]
-    for rec in recordings:
-        if rec.accel_g is None:
-            raise InputError(f"{rec.source}: --pipeline mlp>mlp-accel needs accel_x, accel_y and accel_z columns")
-    axes = {}
-    for axis in recordings[0].gyro_axes:
-        t_in, y_in, w_in, a_in = [], [], [], []
-        for rec, segs in zip(recordings, segments):
-            pieces = [slice(g.start, g.stop) for g in segs] or None
-            blocks = block_means(rec, axis, NETWORK_BLOCK_S, math.inf, pieces)  # one temperature bin: equal weights
-            t_in.append(blocks.temperature_degc)
-            y_in.append(blocks.value_dps)
-            w_in.append(blocks.weight)
-            a_in.append(blocks.accel_g)
-        network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=0.0, accel_g=a_in, inputs=ACCEL_INPUTS)
-        axes[axis] = AxisCalibration(None, tuple(float(c) for c in network.turn_on_biases_dps_[axis]),
-                                     acceleration_network=network.curves_[axis])
-    report = {"acceleration": {"mode": "network", "hidden": list(hidden),
-                               "static_segments": [len(s) for s in segments]}}
-    return Calibration(axes=axes, model="mlp-accel:3-" + "-".join(map(str, hidden)) + "-1",
-                       provenance=_provenance(recordings), fit_report=report)
 
 
 def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint", **options) -> Calibration:
@@ -373,7 +276,7 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
         if not isinstance(options.get("temperature"), tuple):
             options["temperature"] = "mlp"
         first = fit_calibration(recordings, acceleration="none", **options)
-        second = _fit_acceleration_network(_residual_runs(first, recordings), options, min_static)
+        second = fit_acceleration_network(_residual_runs(first, recordings), options, min_static)
         return _chain(first, second, recordings, pipeline)
     if pipeline in ("poly>matrix", "mlp>matrix"):
         if pipeline == "mlp>matrix" and not isinstance(options.get("temperature"), tuple):
@@ -453,7 +356,7 @@ def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
     fitted = fit_calibration(pieces, acceleration="none", run_folds=folds, **options)
     t_min = min(ax.temperature.t_min_degc for ax in fitted.axes.values())
     t_max = max(ax.temperature.t_max_degc for ax in fitted.axes.values())
-    return Calibration(axes={}, model=f"accel {fitted.model}", provenance=_provenance(recordings),
+    return Calibration(axes={}, model=f"accel {fitted.model}", provenance=provenance(recordings),
                        fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}},
                        accel_axes=fitted.axes, accel_reference_degc=0.5 * (t_min + t_max))
 

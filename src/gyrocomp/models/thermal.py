@@ -25,15 +25,16 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..effects import G_SQUARED_TERMS, find_turns, g_squared_products, hysteresis_offset, thermal_lag
+from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..recording import Recording
-from .base import bin_width_for
+from .acceleration import ACCELERATION_CHOICES, excited_columns
+from .base import RunBlocks, bin_width_for, block_means
+from .hysteresis import HysteresisCurve, turn_threshold_degc
 from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
@@ -43,124 +44,9 @@ MAX_HYSTERESIS_ORDER = 3
 LAG_MIN_BLOCKS = 2.0
 LAG_MAX_S = 4 * 3600.0
 DEFAULT_BLOCK_S = 2.0
-ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
-#: an accelerometer axis is excited when its within-run spread over the positions exceeds this [g]
-EXCITATION_G = 0.1
 #: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
 #: score measures drift (what compensation is for) rather than white noise, which no model removes
 SCORE_WINDOW_S = 60.0
-
-
-def turn_threshold_degc(temperature_degc: np.ndarray) -> float:
-    """Turning-point threshold for a measured temperature series [degC].
-
-    Ten times the sample noise (robust, from the median absolute second difference, which a ramp
-    does not inflate: the running extreme of a long dwell wanders several sigma), 1.5 times the
-    quantization step when the values sit on a grid, and at least 0.1 degC.
-    """
-    t = np.asarray(temperature_degc, dtype=float)
-    second = np.diff(t, 2)
-    noise = 1.4826 * float(np.median(np.abs(second))) / math.sqrt(6.0) if second.size else 0.0
-    steps = np.abs(np.diff(t))
-    steps = steps[steps > 0]
-    lsb = 0.0
-    if steps.size:
-        smallest = float(steps.min())
-        if np.allclose(steps / smallest, np.round(steps / smallest), atol=1e-6):
-            lsb = smallest
-    return max(10.0 * noise, 1.5 * lsb, 0.1)
-
-
-def heats_and_cools(recordings: list[Recording], axis: str) -> bool:
-    """Whether the runs together contain both a rising and a falling temperature branch."""
-    up = down = False
-    for rec in recordings:
-        t = rec.temperature_for(axis)
-        d = find_turns(t, turn_threshold_degc(t)).direction
-        up |= bool(np.any(d == 1))
-        down |= bool(np.any(d == -1))
-    return up and down
-
-
-@dataclass(frozen=True)
-class HysteresisCurve:
-    """Fitted hysteresis of one axis: offset after a reversal of the model temperature.
-
-    offset = sum_j h_j |T - T_turn|^j, h from ``descending_dps`` on cooling branches and
-    ``ascending_dps`` on heating branches [deg/s/degC^j], zero outside ``band_degc`` if given.
-    Reversals are confirmed ``threshold_degc`` past the extreme (see :func:`gyrocomp.effects.find_turns`).
-    """
-
-    descending_dps: tuple[float, ...]
-    ascending_dps: tuple[float, ...]
-    threshold_degc: float
-    band_degc: tuple[float, float] | None = None
-
-    @property
-    def order(self) -> int:
-        return len(self.descending_dps)
-
-    def offset_dps(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
-        down = hysteresis_offset(temperature_degc, turns, self.descending_dps, direction="descending",
-                                 band_degc=self.band_degc)
-        up = hysteresis_offset(temperature_degc, turns, self.ascending_dps, direction="ascending",
-                               band_degc=self.band_degc)
-        return down + up
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"type": "turning-point", "descending_dps": list(self.descending_dps),
-                "ascending_dps": list(self.ascending_dps), "threshold_degc": self.threshold_degc,
-                "band_degc": None if self.band_degc is None else list(self.band_degc)}
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "HysteresisCurve":
-        if d.get("type") != "turning-point":
-            raise InputError(f"unknown hysteresis model type {d.get('type')!r}")
-        band = d.get("band_degc")
-        return cls(tuple(float(v) for v in d["descending_dps"]), tuple(float(v) for v in d["ascending_dps"]),
-                   float(d["threshold_degc"]), None if band is None else (float(band[0]), float(band[1])))
-
-
-@dataclass(frozen=True)
-class RunBlocks:
-    time_s: np.ndarray
-    temperature_degc: np.ndarray
-    value_dps: np.ndarray
-    weight: np.ndarray
-    accel_g: np.ndarray | None = None
-    cluster: np.ndarray | None = None
-
-
-def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float,
-                pieces: list[slice] | None = None) -> RunBlocks:
-    """Means over consecutive blocks of ``block_s`` inside each of ``pieces`` (default: the stretches
-    between time gaps; for multi-position runs, the static segments), with bin-balancing weights.
-    ``cluster`` numbers the piece each block comes from."""
-    t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
-    per_block = max(1, int(round(block_s * rec.rate_hz)))
-    pieces = rec.contiguous_stretches() if pieces is None else pieces
-    starts, ends, cluster = [], [], []
-    for k, piece in enumerate(pieces):
-        s = np.arange(piece.start, piece.stop, per_block)
-        starts.append(s)
-        ends.append(np.minimum(s + per_block, piece.stop))
-        cluster.append(np.full(s.size, k))
-    starts, ends, cluster = np.concatenate(starts), np.concatenate(ends), np.concatenate(cluster)
-    counts = ends - starts
-
-    def mean(x):
-        c = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)])
-        return (c[ends] - c[starts]) / (counts if x.ndim == 1 else counts[:, None])
-
-    bt, btemp, by = mean(t - t[0]) + t[0], mean(temp), mean(y)
-    accel = None
-    if rec.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
-        order = [rec.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]
-        accel = mean(rec.accel_g[:, order])
-    idx = np.floor(btemp / bin_width_degc).astype(np.int64)
-    _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
-    weight = (counts / counts.max()) / per_bin[inverse]
-    return RunBlocks(bt, btemp, by, weight, accel, cluster)
 
 
 @dataclass(frozen=True)
@@ -556,23 +442,8 @@ class ThermalHysteresisModel:
         if any(r.accel_g is None for r in runs):
             raise InputError("--acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
                              "fit; map them with --columns or fit with --acceleration none")
-        spread = np.sqrt(sum(np.sum(r.weight[:, None] * (r.accel_g - np.average(r.accel_g, axis=0, weights=r.weight))
-                                    ** 2, axis=0) for r in runs) / sum(float(np.sum(r.weight)) for r in runs))
-        excited = tuple(j for j in range(3) if spread[j] > EXCITATION_G)
-        names = ("accel_x", "accel_y", "accel_z")
-        self.excited_axes_ = tuple(names[j] for j in excited)
-        missing = [f"{names[j]} ({spread[j]:.2g} g)" for j in range(3) if j not in excited]
-        if missing and warn:
-            warnings.warn(
-                f"the positions do not excite {', '.join(missing)}: within-run spread below {EXCITATION_G} g; "
-                "those columns of the g-sensitivity matrix are not fitted (reported as 0 with no standard error). "
-                "Record positions that tilt every axis (a tumble: +1, 0 and -1 g on each)",
-                DataQualityWarning, stacklevel=3)
-        squares: tuple[int, ...] = ()
-        if self.acceleration == "matrix2":
-            pairs = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
-            squares = tuple(m for m, term in enumerate(G_SQUARED_TERMS)
-                            if set(pairs[term]) <= set(excited) and not (len(excited) == 3 and term == "zz"))
+        excited, squares, self.excited_axes_ = excited_columns([r.accel_g for r in runs], [r.weight for r in runs],
+                                                               squares=self.acceleration == "matrix2", warn=warn)
         return excited, squares
 
     def _store_acceleration(self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray,
@@ -598,5 +469,4 @@ class ThermalHysteresisModel:
             raise NotFittedError("ThermalHysteresisModel is not fitted yet; call fit(recordings) first")
 
 
-__all__ = ["CANDIDATES", "HYSTERESIS_CHOICES", "HysteresisCurve", "ThermalHysteresisModel", "heats_and_cools",
-           "turn_threshold_degc"]
+__all__ = ["CANDIDATES", "HYSTERESIS_CHOICES", "ThermalHysteresisModel"]

@@ -170,7 +170,7 @@ def allan_plot(analyses: dict, title: str = "Allan deviation"):
 def _branches(temperature: np.ndarray) -> np.ndarray:
     """+1 where the temperature rises, -1 where it falls (robust turning points), 0 before the first move."""
     from ..effects import find_turns
-    from ..models.thermal import turn_threshold_degc
+    from ..models.hysteresis import turn_threshold_degc
 
     return find_turns(temperature, turn_threshold_degc(temperature)).direction
 
