@@ -19,14 +19,13 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..effects import G_SQUARED_TERMS
 from ..errors import DataQualityWarning, InputError
-from ..recording import Recording
+from ..recording import ACCEL_AXES, Recording
 from .base import block_means, provenance
 from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S, MLPTemperatureModel
 
 ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
 #: an accelerometer axis is excited when its within-run spread over the positions exceeds this [g]
 EXCITATION_G = 0.1
-ACCEL_NAMES = ("accel_x", "accel_y", "accel_z")
 
 
 def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squares: bool = False,
@@ -48,7 +47,7 @@ def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squ
     spread = np.sqrt(sum(np.sum(w[:, None] * (a - np.average(a, axis=0, weights=w)) ** 2, axis=0)
                          for a, w in zip(accel_g, weights)) / sum(float(np.sum(w)) for w in weights))
     excited = tuple(j for j in range(3) if spread[j] > EXCITATION_G)
-    missing = [f"{ACCEL_NAMES[j]} ({spread[j]:.2g} g)" for j in range(3) if j not in excited]
+    missing = [f"{ACCEL_AXES[j]} ({spread[j]:.2g} g)" for j in range(3) if j not in excited]
     if missing and warn:
         warnings.warn(
             f"the positions do not excite {', '.join(missing)}: within-run spread below {EXCITATION_G} g; "
@@ -60,7 +59,7 @@ def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squ
         pairs = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
         chosen = tuple(m for m, term in enumerate(G_SQUARED_TERMS)
                        if set(pairs[term]) <= set(excited) and not (len(excited) == 3 and term == "zz"))
-    return excited, chosen, tuple(ACCEL_NAMES[j] for j in excited)
+    return excited, chosen, tuple(ACCEL_AXES[j] for j in excited)
 
 
 def _listed(values: np.ndarray) -> list:
@@ -72,7 +71,7 @@ def turned_between_positions(recordings: list[Recording], min_duration_s: float)
     from ..static import orientations, static_segments
 
     for rec in recordings:
-        if rec.accel_g is None or not set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
+        if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
             continue
         if len(orientations(static_segments(rec, min_duration_s=min_duration_s))) > 1:
             return True
