@@ -2,7 +2,10 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from gyrocomp import allan as allan_module
 from gyrocomp.allan import (
     ONE_SIGMA,
     allan_deviation,
@@ -324,6 +327,44 @@ def test_long_taus_from_lag_products_match_second_differences(shape):
     for m, dev in zip(ms, res.deviation):
         d = phase[2 * m:] - 2.0 * phase[m:-m] + phase[:-2 * m]
         assert dev == pytest.approx(np.sqrt(np.dot(d, d) / (2.0 * m ** 2 * d.size)), rel=1e-7), m
+
+
+def _second_difference_sums(phase, ms):
+    return np.array([np.sum((phase[2 * m:] - 2.0 * phase[m:-m] + phase[:-2 * m]) ** 2) for m in ms])
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(8, 3000), block_log2=st.integers(2, 12), offset=st.floats(-1e3, 1e3),
+       slope=st.floats(-10.0, 10.0), seed=st.integers(0, 2 ** 16))
+def test_octave_pass_equals_direct_sums_for_any_length_block_and_drift(n, block_log2, offset, slope, seed):
+    """The block-wise octave pass gives the direct sums of squared second differences whatever the block
+    length (blocks shorter than the top factor's window included), the length and the drift."""
+    rng = np.random.default_rng(seed)
+    y = offset + slope * np.linspace(0.0, 1.0, n) + rng.standard_normal(n)
+    phase = np.concatenate([[0.0], np.cumsum(y - y.mean())])
+    top = 1 << int(np.floor(np.log2((n + 1) // 4)))
+    ms = 2 ** np.arange(top.bit_length())
+    got = allan_module._octave_oadev_sums(phase, top, block=1 << block_log2)
+    np.testing.assert_allclose(got, _second_difference_sums(phase, ms), rtol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(8, 3000), seed=st.integers(0, 2 ** 16), data=st.data())
+def test_lag_products_equal_direct_sums_for_any_factors(n, seed, data):
+    """Lag products of the phase for any set of factors (shared lags, crossing cut points, m up to N/2)."""
+    phase = np.concatenate([[0.0], np.cumsum(np.random.default_rng(seed).standard_normal(n))])
+    ms = np.unique(data.draw(st.lists(st.integers(1, n // 2), min_size=1, max_size=6)))
+    np.testing.assert_allclose(allan_module._lagged_oadev_sums(phase, ms), _second_difference_sums(phase, ms),
+                               rtol=1e-7, atol=1e-9 * n)
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(2, 5000), cuts=st.lists(st.integers(1, 4999), max_size=8), seed=st.integers(0, 2 ** 16))
+def test_phase_from_any_chunking_equals_the_batch_phase(n, cuts, seed):
+    y = np.random.default_rng(seed).standard_normal(n) + 3.0
+    edges = [0, *sorted({c for c in cuts if c < n}), n]
+    chunks = lambda: (y[a:b] for a, b in zip(edges[:-1], edges[1:]))  # noqa: E731
+    np.testing.assert_allclose(phase_from_chunks(chunks, 50.0, n), to_phase(y, 50.0), rtol=0, atol=1e-12 * n)
 
 
 def test_identify_noise_on_power_law_noises():
