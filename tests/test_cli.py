@@ -191,6 +191,14 @@ def test_demo(tmp_path):
         assert left < sizes["temperature (with thermal lag)"][axis]
         assert sizes["hysteresis"][axis] > 0.001 and sizes["g-sensitivity"][axis] > 0.004
     assert "hysteresis" in r.stdout and "g-sensitivity" in r.stdout
+    # against the autopilots' own fits on the same runs: less deterministic error left, on average over the axes
+    left = effects["deterministic_error_left_rms_dps_by_method"]
+    assert list(left)[0] == "raw (no compensation)" and list(left)[1].startswith("gyrocomp: ")
+    mean = {name: np.mean(list(axes.values())) for name, axes in left.items()}
+    ours = mean[list(left)[1]]
+    assert ours < mean["PX4 cubic (process_sensor_caldata.py)"] and ours < mean["ArduPilot cubic (tempcal_IMU.py)"]
+    assert all(axes[a] < left["raw (no compensation)"][a] for axes in list(left.values())[1:] for a in axes)
+    assert "ArduPilot cubic (tempcal_IMU.py)" in r.stdout
     assert re.search(r"g-sensitivity .*\(compensated: 3x3 G fitted jointly\)", r.stdout)
     truth = json.loads((tmp_path / "demo" / "heldout_truth.json").read_text())
     assert truth["preset"] == "mti10" and truth["profile"]["name"] == "combined"

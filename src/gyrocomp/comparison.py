@@ -1,5 +1,6 @@
 """The reference thesis's comparison of methods on one data set: raw, polynomial, network, each with
-and without hysteresis compensation (M. Ali, METU, 2014, Tables 3.x and 4.4).
+and without hysteresis compensation (M. Ali, METU, 2014, Tables 3.x and 4.4), and what the autopilots'
+own tools fit (PX4's ``Tools/process_sensor_caldata.py``, ArduPilot's ``Tools/scripts/tempcal_IMU.py``).
 
 With two runs or more every run is compensated by models fitted on the other runs (leave one run
 out), so no method is scored on the data it was fitted on; with one run the models are fitted and
@@ -9,15 +10,92 @@ scored on that run, as the thesis did, and the result says so.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from scipy.signal import medfilt
 
+from .calibration import AxisCalibration, Calibration
 from .compensate import apply
 from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .metrics import default_window_s, evaluate_run
+from .models.base import provenance
 from .models.pipelines import fit_calibration
+from .models.temperature import PolynomialBias
 from .recording import Recording
+
+#: the polynomial order both autopilots use for the gyro bias against temperature
+AUTOPILOT_ORDER = 3
+#: PX4 process_sensor_caldata.py: median filter length [samples] and number of equal-width temperature bins
+PX4_MEDIAN_SAMPLES = 31
+PX4_BINS = 2000
+#: ArduPilot tempcal_IMU.py: moving-average width [s] and the fixed reference temperature [degC]
+ARDUPILOT_AVERAGE_S = 2
+ARDUPILOT_TEMP_REF_DEGC = 35.0
+
+
+def _cubic_calibration(recordings: list[Recording], name: str, fit_axis) -> Calibration:
+    """A calibration holding, per gyro axis, the cubic ``fit_axis(recording list, axis)`` returns as
+    (coefficients of np.polyfit in T - t_ref, highest first, t_ref, t_min, t_max)."""
+    axes = {}
+    for axis in recordings[0].gyro_axes:
+        coef, t_ref, t_min, t_max = fit_axis(recordings, axis)
+        shape = tuple(float(c) for c in coef[::-1][1:])  # np.polyfit: highest power first; X0 is the constant
+        axes[axis] = AxisCalibration(PolynomialBias(shape, float(t_ref), 1.0, float(t_min), float(t_max)),
+                                     tuple(float(coef[-1]) for _ in recordings))
+    return Calibration(axes=axes, model=name, provenance=provenance(recordings),
+                       fit_report={"temperature": name})
+
+
+def fit_px4_style(recordings: list[Recording]) -> Calibration:
+    """The cubic PX4's ``Tools/process_sensor_caldata.py`` fits (its default, resampling on): the gyro
+    through a 31-sample median filter (``scipy.signal.medfilt``), the samples in 2000 equal-width bins of
+    temperature between its extremes, and ``np.polyfit`` of order 3 on the bin means, unweighted, in
+    T - TREF with TREF the middle of the range; applied clamped to [TMIN, TMAX]. Several runs are pooled
+    as one log.
+    """
+    def fit_axis(recs, axis):
+        temperature = np.concatenate([r.temperature_for(axis) for r in recs])
+        gyro = np.concatenate([medfilt(r.gyro(axis), PX4_MEDIAN_SAMPLES) for r in recs])
+        t_min, t_max = float(temperature.min()), float(temperature.max())
+        t_ref = 0.5 * (t_min + t_max)
+        span = t_max - t_min
+        index = np.clip(((temperature - t_min) / (span / PX4_BINS)).astype(np.int64) if span > 0 else
+                        np.zeros(temperature.size, dtype=np.int64), 0, PX4_BINS - 1)
+        count = np.bincount(index, minlength=PX4_BINS)
+        full = count > 0
+        t_mean = np.bincount(index, weights=temperature - t_ref, minlength=PX4_BINS)[full] / count[full]
+        g_mean = np.bincount(index, weights=gyro, minlength=PX4_BINS)[full] / count[full]
+        return np.polyfit(t_mean, g_mean, AUTOPILOT_ORDER), t_ref, t_min, t_max
+
+    return _cubic_calibration(recordings, "PX4 cubic (process_sensor_caldata.py)", fit_axis)
+
+
+def _moving_average(x: np.ndarray, w: int) -> np.ndarray:
+    c = np.cumsum(x)
+    c[w:] = c[w:] - c[:-w]
+    return c[w - 1:] / w
+
+
+def fit_ardupilot_style(recordings: list[Recording]) -> Calibration:
+    """The cubic ArduPilot's ``Tools/scripts/tempcal_IMU.py`` fits from IMU records: gyro and temperature
+    through a 2 s moving average (``int(samples / seconds) * 2`` samples), then ``np.polyfit`` of order 3
+    over every sample, unweighted, in T - 35 degC; applied clamped to [TMIN, TMAX] of the log. Several runs
+    are pooled as one log.
+    """
+    def fit_axis(recs, axis):
+        temps, gyros = [], []
+        for r in recs:
+            w = int(r.n_samples / (r.time_s[-1] - r.time_s[0])) * ARDUPILOT_AVERAGE_S
+            t, g = r.temperature_for(axis), r.gyro(axis)
+            temps.append(_moving_average(t, w) if w > 1 else t)
+            gyros.append(_moving_average(g, w) if w > 1 else g)
+        temperature, gyro = np.concatenate(temps), np.concatenate(gyros)
+        coef = np.polyfit(temperature - ARDUPILOT_TEMP_REF_DEGC, gyro, AUTOPILOT_ORDER)
+        return coef, ARDUPILOT_TEMP_REF_DEGC, float(temperature.min()), float(temperature.max())
+
+    return _cubic_calibration(recordings, "ArduPilot cubic (tempcal_IMU.py)", fit_axis)
 
 #: the thesis's methods: name -> options of :func:`fit_calibration`
 THESIS_METHODS: dict[str, dict] = {
@@ -26,9 +104,14 @@ THESIS_METHODS: dict[str, dict] = {
     "network": {"temperature": "mlp", "hysteresis": "none"},
     "network + hysteresis": {"temperature": "mlp", "hysteresis": "turning-point"},
 }
-#: the thesis's methods and gyrocomp's default (lag and/or hysteresis chosen by the data)
-DEFAULT_METHODS: dict[str, dict] = {**THESIS_METHODS,
-                                    "gyrocomp default (auto)": {"temperature": "auto", "hysteresis": "auto"}}
+#: what the autopilots' own calibration tools fit
+AUTOPILOT_METHODS: dict[str, Callable[[list[Recording]], Calibration]] = {
+    "PX4 cubic (process_sensor_caldata.py)": fit_px4_style,
+    "ArduPilot cubic (tempcal_IMU.py)": fit_ardupilot_style,
+}
+#: the autopilots' fits, the thesis's methods and gyrocomp's default (lag and/or hysteresis chosen by the data)
+DEFAULT_METHODS: dict[str, dict | Callable] = {**AUTOPILOT_METHODS, **THESIS_METHODS,
+                                               "gyrocomp default (auto)": {"temperature": "auto", "hysteresis": "auto"}}
 
 
 @dataclass(frozen=True)
@@ -73,7 +156,8 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
     recordings : list of Recording
         Runs of one sensor at rest through temperature changes.
     methods : dict, optional
-        Name -> :func:`fit_calibration` options; default ``DEFAULT_METHODS``.
+        Name -> :func:`fit_calibration` options, or a function of the training runs returning a
+        Calibration (``AUTOPILOT_METHODS``); default ``DEFAULT_METHODS``.
     window_s : float, optional
         Moving-average window [s]; default each run's raw Allan-minimum tau (the thesis's choice).
     hysteresis_band_degc : (lo, hi), optional
@@ -91,13 +175,16 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
         w = window_s if window_s is not None else default_window_s(rec)
         windows[rec.source] = w
         for name, options in methods.items():
-            opts = dict(options)
-            if opts.get("hysteresis") not in (None, "none"):
-                opts["hysteresis_band_degc"] = hysteresis_band_degc
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", TemperatureRangeWarning)
                 warnings.simplefilter("ignore", DataQualityWarning)
-                cal = fit_calibration(train, mlp_seed=seed, **opts)
+                if callable(options):
+                    cal = options(train)
+                else:
+                    opts = dict(options)
+                    if opts.get("hysteresis") not in (None, "none"):
+                        opts["hysteresis_band_degc"] = hysteresis_band_degc
+                    cal = fit_calibration(train, mlp_seed=seed, **opts)
                 result = evaluate_run(rec, apply(cal, rec), window_s=w)
             scored[name].append(result)
             if name == next(iter(methods)):
@@ -123,4 +210,5 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
     return MethodComparison(rows, how, windows)
 
 
-__all__ = ["DEFAULT_METHODS", "MethodComparison", "MethodRow", "THESIS_METHODS", "compare_methods"]
+__all__ = ["AUTOPILOT_METHODS", "DEFAULT_METHODS", "MethodComparison", "MethodRow", "THESIS_METHODS", "compare_methods",
+           "fit_ardupilot_style", "fit_px4_style"]

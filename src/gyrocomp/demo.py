@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .calibration import Calibration
+from .comparison import AUTOPILOT_METHODS
 from .compensate import apply
 from .errors import DataQualityWarning, MissingDependencyError
 from .io import read_table, write_gyro_back, write_recording, write_text_atomic
@@ -52,6 +53,9 @@ class DemoResult:
     perfect_residual_rms_dps: dict[str, float]
     effects: list[EffectSize]
     residual_dps: dict[str, float]
+    #: deterministic error left in the held-out run (RMS of the moving average) [deg/s] per method and axis:
+    #: raw, gyrocomp's model, and the cubics PX4's and ArduPilot's tools fit on the same calibration runs
+    deterministic_left_rms_dps: dict[str, dict[str, float]]
     summary: str
     files: list[Path]
     #: why report.html was not written (matplotlib missing), or None when it was
@@ -83,13 +87,17 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)  # the pauses while turning the unit are the profile's
-        calibration = fit_calibration([read_table(p).recording for p in cal_paths])
+        cal_runs = [read_table(p).recording for p in cal_paths]
+        calibration = fit_calibration(cal_runs)
+        autopilots = {name: fit(cal_runs) for name, fit in AUTOPILOT_METHODS.items()}
     calibration.save(out_dir / "model.json")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)  # the pauses are the profile's; said in the summary
         held_data = read_table(held_path)
         compensated = apply(calibration, held_data.recording)
         run_eval = evaluate_run(held_data.recording, compensated)
+        by_method = {f"gyrocomp: {calibration.model}": compensated}
+        by_method.update({name: apply(cal, held_data.recording) for name, cal in autopilots.items()})
     write_gyro_back(held_data, compensated.gyro_dps, out_dir / "heldout_compensated.csv")
     evaluation = Evaluation([run_eval])
     write_text_atomic(out_dir / "metrics.json", json.dumps(evaluation.to_dict(), indent=2) + "\n")
@@ -116,12 +124,21 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     # what the compensation left: output minus what it should be (true rate + noise), minus its mean
     left = compensated.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
     residual = {a: float(np.ptp(moving_average(left[:, j] - left[:, j].mean(), w_eff))) for j, a in enumerate(axes)}
-    write_text_atomic(out_dir / "effects.json", json.dumps(
-        {"window_s": EFFECT_WINDOW_S, "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
-         "residual_peak_to_peak_dps": residual}, indent=2) + "\n")
 
     w = window_samples(run_eval.window_s, rate_hz, held.recording.n_samples)
     perfect = {axis: smoothed_residual_rms(truth.noise.total_dps[:, j], w) for j, axis in enumerate(axes)}
+    def deterministic_left(comp) -> dict[str, float]:
+        """Output minus what it should be (true rate + noise): the deterministic error a model left, RMS of
+        its moving average about the mean [deg/s]."""
+        left = comp.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
+        return {axis: smoothed_residual_rms(left[:, j], w_eff) for j, axis in enumerate(axes)}
+
+    methods_rms = {"raw (no compensation)": deterministic_left(held.recording)}
+    methods_rms.update({name: deterministic_left(comp) for name, comp in by_method.items()})
+    write_text_atomic(out_dir / "effects.json", json.dumps(
+        {"window_s": EFFECT_WINDOW_S, "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
+         "residual_peak_to_peak_dps": residual,
+         "deterministic_error_left_rms_dps_by_method": methods_rms}, indent=2) + "\n")
     hours = held.recording.duration_s / 3600
     lines = [
         f"Simulated {len(cal_paths)} cold-hot-cold calibration cycles (-25 -> 90 -> -25 degC at 1 degC/min, "
@@ -144,11 +161,17 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
         lines.append(f"  {axis}: {m.residual_rms_dps:.3g} deg/s compensated, {perfect[axis]:.3g} deg/s noise alone "
                      f"(ratio {m.residual_rms_dps / perfect[axis]:.2f}); raw bias offset {m.bias_offset_raw_dps:.3g} "
                      f"-> {m.bias_offset_comp_dps:.3g} deg/s")
+    lines.append("Against the cubics the autopilots' own tools fit on the same three runs: the deterministic error each "
+                 f"leaves in the held-out run (output - true rate - noise; RMS of a {EFFECT_WINDOW_S:g} s moving "
+                 "average) [deg/s]:")
+    for name, rms in methods_rms.items():
+        lines.append(f"  {name:60.60s} " + "  ".join(f"{a} {v:.2g}" for a, v in rms.items()))
     skipped = _write_report(calibration, held_data.recording, out_dir / "report.html") if report else "not asked for"
     if skipped is None:
         lines.append(f"Report of the model on the held-out run: {out_dir / 'report.html'} (open it in a browser).")
     files = sorted(out_dir.iterdir())
-    return DemoResult(calibration, evaluation, perfect, effects, residual, "\n".join(lines), files, skipped)
+    return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, "\n".join(lines), files,
+                      skipped)
 
 
 def _write_report(calibration: Calibration, run, path: Path) -> str | None:
