@@ -471,15 +471,22 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
         print_evaluation(evaluation)
 
 
+def _figures_table(title: str, what: str) -> Table:
+    """A table of the thesis's figures per axis and ``what`` (stage, method)."""
+    table = Table(title=title)
+    for col in ("axis", what):
+        table.add_column(col, no_wrap=True)
+    for col in ("bias offset\n[deg/s]", f"improvement\n(raw/{what})", "bias instability\n[deg/h]",
+                "integration time\n[s]"):
+        table.add_column(col, justify="right")
+    return table
+
+
 def print_stages(staged) -> None:
     console = _console()
     for run in staged:
-        table = Table(title=f"{Path(run.file).name}: stages of the compensation (window {run.window_s:.4g} s)")
-        for col in ("axis", "stage"):
-            table.add_column(col, no_wrap=True)
-        for col in ("bias offset\n[deg/s]", "improvement\n(raw/stage)", "bias instability\n[deg/h]",
-                    "integration time\n[s]"):
-            table.add_column(col, justify="right")
+        table = _figures_table(f"{Path(run.file).name}: stages of the compensation (window {run.window_s:.4g} s)",
+                               "stage")
         first = next(iter(run.stages.values()))
         for axis in first:
             m0 = first[axis]
@@ -494,12 +501,7 @@ def print_stages(staged) -> None:
 
 def print_comparison(result) -> None:
     console = _console()
-    table = Table(title=f"methods compared ({result.how})")
-    for col in ("axis", "method"):
-        table.add_column(col, no_wrap=True)
-    for col in ("bias offset\n[deg/s]", "improvement\n(raw/method)", "bias instability\n[deg/h]",
-                "integration time\n[s]"):
-        table.add_column(col, justify="right")
+    table = _figures_table(f"methods compared ({result.how})", "method")
     for row in result.rows:
         table.add_row(row.axis, row.method, f"{row.bias_offset_dps:.4g}", f"{row.improvement:.3g}x",
                       f"{row.bias_instability_deg_per_h:.4g}", f"{row.integration_time_s:.4g}")

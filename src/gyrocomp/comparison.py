@@ -19,7 +19,7 @@ from scipy.signal import medfilt
 from .calibration import AxisCalibration, Calibration
 from .compensate import apply
 from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
-from .metrics import default_window_s, evaluate_run
+from .metrics import default_window_s, evaluate_run, moving_average
 from .models.base import provenance
 from .models.pipelines import fit_calibration
 from .models.temperature import PolynomialBias
@@ -72,12 +72,6 @@ def fit_px4_style(recordings: list[Recording]) -> Calibration:
     return _cubic_calibration(recordings, "PX4 cubic (process_sensor_caldata.py)", fit_axis)
 
 
-def _moving_average(x: np.ndarray, w: int) -> np.ndarray:
-    c = np.cumsum(x)
-    c[w:] = c[w:] - c[:-w]
-    return c[w - 1:] / w
-
-
 def fit_ardupilot_style(recordings: list[Recording]) -> Calibration:
     """The cubic ArduPilot's ``Tools/scripts/tempcal_IMU.py`` fits from IMU records: gyro and temperature
     through a 2 s moving average (``int(samples / seconds) * 2`` samples), then ``np.polyfit`` of order 3
@@ -89,8 +83,8 @@ def fit_ardupilot_style(recordings: list[Recording]) -> Calibration:
         for r in recs:
             w = int(r.n_samples / (r.time_s[-1] - r.time_s[0])) * ARDUPILOT_AVERAGE_S
             t, g = r.temperature_for(axis), r.gyro(axis)
-            temps.append(_moving_average(t, w) if w > 1 else t)
-            gyros.append(_moving_average(g, w) if w > 1 else g)
+            temps.append(moving_average(t, w) if w > 1 else t)  # its valid part, as tempcal_IMU.py keeps
+            gyros.append(moving_average(g, w) if w > 1 else g)
         temperature, gyro = np.concatenate(temps), np.concatenate(gyros)
         coef = np.polyfit(temperature - ARDUPILOT_TEMP_REF_DEGC, gyro, AUTOPILOT_ORDER)
         return coef, ARDUPILOT_TEMP_REF_DEGC, float(temperature.min()), float(temperature.max())

@@ -121,20 +121,16 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
         for name, key in (("temperature (with thermal lag)", "temperature"), ("hysteresis", "hysteresis"),
                           ("g-sensitivity", "acceleration"))
     ]
-    # what the compensation left: output minus what it should be (true rate + noise), minus its mean
-    left = compensated.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
+    # what each compensation left: output minus what it should be (true rate + noise) [deg/s]
+    lefts = {name: rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
+             for name, rec in {"raw (no compensation)": held.recording, **by_method}.items()}
+    left = lefts[f"gyrocomp: {calibration.model}"]
     residual = {a: float(np.ptp(moving_average(left[:, j] - left[:, j].mean(), w_eff))) for j, a in enumerate(axes)}
 
     w = window_samples(run_eval.window_s, rate_hz, held.recording.n_samples)
     perfect = {axis: smoothed_residual_rms(truth.noise.total_dps[:, j], w) for j, axis in enumerate(axes)}
-    def deterministic_left(comp) -> dict[str, float]:
-        """Output minus what it should be (true rate + noise): the deterministic error a model left, RMS of
-        its moving average about the mean [deg/s]."""
-        left = comp.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
-        return {axis: smoothed_residual_rms(left[:, j], w_eff) for j, axis in enumerate(axes)}
-
-    methods_rms = {"raw (no compensation)": deterministic_left(held.recording)}
-    methods_rms.update({name: deterministic_left(comp) for name, comp in by_method.items()})
+    methods_rms = {name: {axis: smoothed_residual_rms(d[:, j], w_eff) for j, axis in enumerate(axes)}
+                   for name, d in lefts.items()}
     write_text_atomic(out_dir / "effects.json", json.dumps(
         {"window_s": EFFECT_WINDOW_S, "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
          "residual_peak_to_peak_dps": residual,
