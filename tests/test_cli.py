@@ -417,3 +417,20 @@ def test_fit_pipeline_option(tmp_path):
     assert model["fit_report"]["pipeline"] == "matrix>poly" and len(model["fit_report"]["stages"]) == 2
     r = run("fit", tmp_path / "t_0.csv", "-o", tmp_path / "m.json", "--pipeline", "poly+matrix")
     assert r.returncode == 2 and "--pipeline: 'poly+matrix'; use one of joint, poly>matrix" in r.stderr
+
+
+def test_validate_prints_every_method_and_json_holds_the_folds(workdir):
+    runs = sorted(str(p) for p in Path(workdir).glob("run*.csv"))[:3]
+    out = run("validate", *runs, "--json")
+    assert out.returncode == 0, out.stderr
+    result = json.loads(out.stdout)
+    assert result["fold_kind"] == "runs" and len(result["folds"]) == 3
+    assert result["methods"] == ["raw", "PX4 cubic", "ArduPilot cubic", "cubic + run constants", "gyrocomp default"]
+    means = result["mean_over_axes_dps"]
+    # chamber runs with a strong tempco: every model beats the raw output
+    assert all(means[m] < means["raw"] for m in result["methods"] if m != "raw")
+    table = run("validate", *runs, "--candidate", "poly:1")
+    assert table.returncode == 0, table.stderr
+    assert "gyrocomp poly:1" in table.stdout and "vs cubic" in table.stdout
+    bad = run("validate", *runs, "--folds", "sideways")
+    assert bad.returncode == 2 and "--folds" in bad.stderr

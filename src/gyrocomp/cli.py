@@ -43,7 +43,9 @@ from .metrics import Evaluation, evaluate_run
 from .models.acceleration import ACCELERATION_CHOICES
 from .models.pipelines import fit_channels, parse_channels
 from .models.temperature import parse_temperature_option
+from .models.selection import FOLD_KINDS
 from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
+from .validation import ValidationResult, validate as validate_runs
 from .noise import NoiseAnalysis, analyse_noise
 from .report.figures import allan_figure, check_figure_path
 
@@ -243,10 +245,13 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 @click.option("--channels", default="gyro", show_default=True,
               help="What to model: gyro, accel (the accelerometer's bias against temperature, in g) or gyro,accel "
                    "(then G reads the temperature-compensated accelerations).")
+@click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
+              help="What the model choice holds out: each run, each heating or cooling leg, or time blocks; "
+                   "auto: runs with three runs or more, else legs.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, pipeline, static_min_duration_s, channels, **kwargs):
+        acceleration, pipeline, static_min_duration_s, channels, folds, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -264,7 +269,8 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
                                    hysteresis=hysteresis, hysteresis_order=hysteresis_order,
                                    hysteresis_band_degc=band, mlp_seed=mlp_seed, acceleration=acceleration,
-                                   static_min_duration_s=static_min_duration_s)
+                                   static_min_duration_s=static_min_duration_s,
+                                   **({} if folds == "auto" else {"folds": folds}))
     calibration.save(output)
     if not ctx.obj["quiet"]:
         _print_fit(calibration, output)
@@ -324,6 +330,9 @@ def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -
             st.add_row(axis, *[(f"{s[str(p)]:.4g}*" if p == chosen else f"{s[str(p)]:.4g}")
                                if str(p) in s else "-" for p in orders])
         console.print(st)
+    if report.get("selection"):
+        _print_selection(console, report["selection"], unit)
+        return _print_g_sensitivity(console, report)
     hyst = report.get("hysteresis", {})
     if hyst.get("axes") and any(len(a.get("scores_dps", a.get("scores_bic", {}))) > 1 for a in hyst["axes"].values()):
         bic = hyst["selection"] == "bic"
@@ -340,6 +349,37 @@ def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -
                      if c in scores else "-" for c in CANDIDATES]
             ht.add_row(axis, *cells, info["chosen"])
         console.print(ht)
+    _print_g_sensitivity(console, report)
+
+
+def _print_selection(console, selection: dict, unit: str) -> None:
+    """The model choice: per axis the chosen and best candidates against the run constant alone, then the fold
+    scores of those three (every candidate's are in the model file)."""
+    first = next(iter(selection.values()))
+    table = Table(title=f"model choice by held-out drift ({first['fold_kind']}: {len(first['folds'])} folds, "
+                        f"{first['window_s']:g} s moving average, simplest within one standard error) [{unit}]")
+    for col in ("axis", "chosen", "held-out drift", "best", "best drift", "constant only"):
+        table.add_column(col, justify="left" if col in ("axis", "chosen", "best") else "right")
+    for axis, sel in selection.items():
+        scores = {c["label"]: c for c in sel["candidates"]}
+        chosen, best = scores[sel["chosen"]["label"]], scores[sel["best"]["label"]]
+        table.add_row(axis, chosen["label"], f"{chosen['mean_drift_dps']:.4g} +- {chosen['standard_error_dps']:.2g}",
+                      best["label"], f"{best['mean_drift_dps']:.4g}", f"{sel['raw_drift_dps']:.4g}")
+    console.print(table)
+    folds = Table(title=f"held-out drift per fold [{unit}]")
+    folds.add_column("axis")
+    folds.add_column("model")
+    for name in first["folds"]:
+        folds.add_column(name, justify="right")
+    for axis, sel in selection.items():
+        scores = {c["label"]: c for c in sel["candidates"]}
+        shown = dict.fromkeys([sel["chosen"]["label"], sel["best"]["label"], "constant (time)"])
+        for label in shown:
+            folds.add_row(axis, label, *[f"{v:.4g}" for v in scores[label]["fold_drift_dps"]])
+    console.print(folds)
+
+
+def _print_g_sensitivity(console, report: dict) -> None:
     acc = report.get("acceleration", {})
     if acc.get("axes"):
         gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc['static_segments'])} "
@@ -401,6 +441,63 @@ def convert(ctx, input_path, output, **kwargs):
         gaps = f", {len(recording.gaps)} time gap(s)" if recording.gaps else ""
         click.echo(f"wrote {output}: {recording.n_samples} rows, {recording.duration_s:.6g} s at "
                    f"{recording.rate_hz:.6g} Hz{gaps}; {', '.join(channels)}")
+
+
+# -- validate ---------------------------------------------------------------------------------------
+@cli.command()
+@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
+              help="Hold out each run, each heating or cooling leg, or time blocks; auto: runs with three runs "
+                   "or more, else legs.")
+@click.option("--window", "window_s", type=float, default=None,
+              help="Moving-average window of the drift [s] (default: a tenth of the median fold, 60..600 s).")
+@click.option("--candidate", "candidates", multiple=True, metavar="SPEC",
+              help="Also validate gyrocomp fitted with --temperature SPEC (poly:N, poly, mlp); repeatable.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
+@read_options
+@click.pass_context
+def validate(ctx, runs, folds, window_s, candidates, as_json, **kwargs):
+    """Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's default.
+
+    Each method is fitted without the fold it is scored on (leave one run out, or one heating or cooling leg
+    with fewer than three runs); the score is the RMS of the moving-averaged compensated output about its mean.
+    """
+    opts = _pop_read_options(kwargs)
+    if window_s is not None and not window_s > 0:
+        raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
+    named = {}
+    for spec in candidates:
+        order = parse_temperature_option(spec)
+        if order is None:
+            raise click.BadParameter("a candidate needs a temperature model (poly, poly:N or mlp)",
+                                     param_hint="--candidate")
+        named[f"gyrocomp {spec}"] = {"temperature": order}
+    recordings = [_read(path, opts).recording for path in runs]
+    with progress_bar("validating", indeterminate=True):
+        result = validate_runs(recordings, folds=folds, window_s=window_s, candidates=named)
+    if as_json:
+        click.echo(json.dumps(result.to_dict(), indent=2))
+    elif not ctx.obj["quiet"]:
+        print_validation(result)
+
+
+def print_validation(result: ValidationResult) -> None:
+    console = _console()
+    table = Table(title=f"held-out drift [deg/s], {result.window_s:g} s moving average, mean +- standard error "
+                        f"over {len(result.folds)} folds ({result.fold_kind})")
+    table.add_column("method")
+    for axis in result.axes:
+        table.add_column(axis, justify="right")
+    table.add_column("mean", justify="right")
+    table.add_column("vs cubic", justify="right")
+    cubic = result.mean_over_axes("cubic + run constants")
+    for method in result.methods:
+        cells = [f"{result.score(method, a).mean_drift_dps:.4g} +- {result.score(method, a).standard_error_dps:.2g}"
+                 for a in result.axes]
+        mean = result.mean_over_axes(method)
+        table.add_row(method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-")
+    console.print(table)
+    console.print("folds: " + ", ".join(result.folds))
 
 
 # -- evaluate ---------------------------------------------------------------------------------------

@@ -91,7 +91,8 @@ class Compensator:
             warnings.warn(
                 f"{self.source}: temperature{lagged} outside the model's range "
                 f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
-                "the model is held at its edge there",
+                + ("the model is continued along its tangent there"
+                   if getattr(ax.temperature, "extrapolation", "hold") == "linear" else "the model is held at its edge there"),
                 TemperatureRangeWarning, stacklevel=4,
             )
             self._warned = True

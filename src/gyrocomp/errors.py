@@ -31,3 +31,8 @@ class DataQualityWarning(UserWarning):
 
 class MissingDependencyError(GyrocompError, ImportError):
     """An optional package is needed for this (the message names the extra to install; CLI exit status 1)."""
+
+
+class ModelChoiceWarning(UserWarning):
+    """Validation found that a temperature model does not help an axis (none generalizes to held-out data, or
+    the chosen one leaves more drift there than the raw output)."""

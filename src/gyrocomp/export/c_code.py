@@ -51,6 +51,11 @@ def _temperature_code(j: int, curve) -> list[str]:
                  "      shape = 0.0;"]
         if curve.coefficients_dps:
             lines.append(f"      for (int k = {len(curve.coefficients_dps) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
+            if curve.extrapolation == "linear":  # continued along the tangent past the range
+                lines += ["      double slope = 0.0;",
+                          f"      for (int k = {len(curve.coefficients_dps) - 1}; k >= 0; --k) "
+                          "slope = slope * u + (k + 1) * c[k];",
+                          f"      shape += slope * ((tm - {_num(curve.t_ref_degc)}) / {_num(curve.t_scale_degc)} - u);"]
         lines.append("    }")
         return lines
     if isinstance(curve, MLPBias):

@@ -50,7 +50,8 @@ class TemperatureBins:
 @dataclass(frozen=True)
 class RunBlocks:
     """Block means of one run and axis: time [s], temperature [degC], gyro [deg/s], bin-balancing weight,
-    the accelerations [g] when the run has the triad, and the piece (segment) each block comes from."""
+    the accelerations [g] when the run has the triad, the piece (segment) each block comes from, and the
+    number of samples in each block (its duration, for time weights)."""
 
     time_s: np.ndarray
     temperature_degc: np.ndarray
@@ -58,6 +59,7 @@ class RunBlocks:
     weight: np.ndarray
     accel_g: np.ndarray | None = None
     cluster: np.ndarray | None = None
+    samples: np.ndarray | None = None
 
 
 def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float,
@@ -89,7 +91,7 @@ def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float
     idx = np.floor(btemp / bin_width_degc).astype(np.int64)
     _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
     weight = (counts / counts.max()) / per_bin[inverse]
-    return RunBlocks(bt, btemp, by, weight, accel, cluster)
+    return RunBlocks(bt, btemp, by, weight, accel, cluster, counts)
 
 
 def bin_width_for(temperatures: list[np.ndarray], bin_width_degc: float | None) -> float:

@@ -10,20 +10,25 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from ..errors import InputError, TemperatureRangeWarning
+from ..errors import InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..recording import ACCEL_AXES, Recording
 from .acceleration import (
     ACCELERATION_CHOICES,
     acceleration_report,
     fit_acceleration_network,
+    excited_columns,
     fit_g_sensitivity,
     turned_between_positions,
 )
 from .base import bin_width_for, block_means, provenance
 from .hysteresis import heats_and_cools
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
-from .temperature import PolynomialBias, PolynomialTemperatureModel
-from .thermal import HYSTERESIS_CHOICES, ThermalHysteresisModel
+from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis
+from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
+from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+
+#: how the fit report names each kind of fold
+FOLD_SELECTION = {"runs": "leave-one-run-out", "legs": "leave-one-leg-out", "blocks": "leave-one-block-out"}
 
 
 def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
@@ -58,13 +63,106 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     return network.curves_[axis], network.turn_on_biases_dps_[axis]
 
 
+def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memories: tuple[str, ...],
+                  hysteresis_orders: tuple[int, ...] = (1, 2, 3), acceleration: str = "none",
+                  static_min_duration_s: float = 10.0, bin_width_degc: float | None = None,
+                  run_folds: tuple[int, ...] | None = None, folds: str = "auto") -> dict[str, AxisSelection]:
+    """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.models.selection`).
+
+    Parameters
+    ----------
+    orders : tuple of int
+        Polynomial orders to try (0: the run constant alone).
+    memories : tuple of str
+        Among ``none``, ``lag``, ``turning-point``, ``turning-point+lag``.
+    hysteresis_orders : tuple of int
+        Turning-point orders to try.
+    acceleration : {"none", "matrix", "matrix2"}
+        g-sensitivity columns fitted with every candidate.
+    run_folds : tuple of int, optional
+        The run of each recording (pieces of one run are held out together).
+    folds : {"auto", "runs", "legs", "blocks"}
+    """
+    if folds not in FOLD_KINDS:
+        raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
+    _, pieces = static_pieces(recordings, static_min_duration_s)
+    out: dict[str, AxisSelection] = {}
+    accel_cols: tuple[int, ...] = ()
+    square_cols: tuple[int, ...] = ()
+    for k, axis in enumerate(recordings[0].gyro_axes):
+        problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
+                               fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders)
+        if acceleration != "none":
+            if any(r.accel_g is None for r in problem.runs):
+                raise InputError("--acceleration: the runs need accel_x, accel_y and accel_z columns for a "
+                                 "g-sensitivity fit; map them with --columns or fit with --acceleration none")
+            if k == 0:
+                accel_cols, square_cols, _ = excited_columns([r.accel_g for r in problem.runs],
+                                                             [r.weight for r in problem.runs],
+                                                             squares=acceleration == "matrix2", warn=False)
+            problem.accel_cols, problem.square_cols = accel_cols, square_cols
+        out[axis] = select_axis(axis, problem, orders, memories)
+    return out
+
+
+def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
+    for axis, sel in selections.items():
+        across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[sel.fold_kind]
+        if not sel.generalizes:
+            warnings.warn(f"{axis}: no temperature model generalizes across {across}; left uncompensated "
+                          "(run constant only)", ModelChoiceWarning, stacklevel=3)
+        elif sel.chosen_drift_dps > sel.raw_drift_dps:
+            warnings.warn(f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift_dps:.3g} deg/s of "
+                          f"held-out drift, more than the raw output's {sel.raw_drift_dps:.3g} deg/s",
+                          ModelChoiceWarning, stacklevel=3)
+
+
+def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHysteresisModel, mode: str) -> dict:
+    """The hysteresis part of the fit report from the selection: per axis the memory chosen, its lag, and the best
+    held-out drift of each memory at the chosen order and weighting [deg/s]."""
+    kind = FOLD_SELECTION[next(iter(selections.values())).fold_kind]
+    axes = {}
+    for axis, sel in selections.items():
+        c = sel.chosen
+        by_memory = {}
+        for s in sel.scores:
+            same = s.candidate.order == c.order and s.candidate.weighting == c.weighting
+            if same or (s.candidate.order == 0 and c.order == 0):
+                m = s.candidate.memory
+                by_memory[m] = min(by_memory.get(m, float("inf")), s.mean_drift_dps)
+        axes[axis] = {"chosen": c.memory + (f" (order {c.hysteresis_order})" if c.hysteresis_order else ""),
+                      "lag_time_constant_s": thermal.lag_time_constants_s_[axis], "order": c.order,
+                      "weighting": c.weighting, "scores_dps": by_memory}
+    return {"mode": mode, "selection": kind, "axes": axes}
+
+
+def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, hysteresis_order,
+                  accel_mode: str, bin_width_degc, static_min_duration_s: float, run_folds, folds: str):
+    """Select by held-out drift, then fit each axis's chosen model on all runs."""
+    orders = tuple(range(MAX_ORDER + 1)) if temperature == "auto" else (int(temperature),)
+    memories = tuple(CANDIDATES) if hysteresis == "auto" else (hysteresis,)
+    h_orders = tuple(range(1, MAX_HYSTERESIS_ORDER + 1)) if hysteresis_order == "auto" else (int(hysteresis_order),)
+    selections = select_models(recordings, orders=orders, memories=memories, hysteresis_orders=h_orders,
+                               acceleration=accel_mode, static_min_duration_s=static_min_duration_s,
+                               bin_width_degc=bin_width_degc, run_folds=run_folds, folds=folds)
+    _warn_about_choice(selections)
+    chosen = {axis: sel.chosen for axis, sel in selections.items()}
+    thermal = ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
+                                     hysteresis={a: c.memory for a, c in chosen.items()},
+                                     hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
+                                     weighting={a: c.weighting for a, c in chosen.items()},
+                                     bin_width_degc=bin_width_degc, acceleration=accel_mode,
+                                     static_min_duration_s=static_min_duration_s).fit(recordings)
+    return selections, thermal
+
+
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
                     acceleration: str = "auto", static_min_duration_s: float = 10.0,
                     network_inputs: tuple[str, ...] = ("temperature",),
-                    run_folds: tuple[int, ...] | None = None) -> Calibration:
+                    run_folds: tuple[int, ...] | None = None, folds: str = "auto") -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -99,6 +197,15 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         ``accel_z`` (the joint network of the ``joint-mlp`` pipeline, which then fits no separate G).
     run_folds : tuple of int, optional
         The validation fold of each recording for the polynomial order (pieces of one run left out together).
+    folds : {"auto", "runs", "legs", "blocks"}
+        What the model choice holds out (:func:`gyrocomp.models.selection.make_folds`): each run (the
+        default with three runs or more), each heating or cooling leg (the default with fewer), or contiguous
+        time blocks.
+
+    Whenever something is left to choose (``temperature="auto"`` or ``hysteresis="auto"``, no band given),
+    every candidate is scored by held-out drift and the simplest within one standard error of the best is
+    fitted (:mod:`gyrocomp.models.selection`); an axis where no temperature model beats the run constant
+    gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
@@ -131,24 +238,36 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     if temperature == "mlp" or (isinstance(temperature, tuple) and temperature[0] == "mlp"):
         hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
         temperature = "auto"  # the polynomial still finds lag and hysteresis for the network
-    model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
-                                       folds=run_folds).fit(recordings)
     accel_mode = acceleration
     if accel_mode == "auto":
         accel_mode = "matrix" if turned_between_positions(recordings, static_min_duration_s) else "none"
-    mode = hysteresis
-    if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
-        mode = "none"
-    thermal = None
-    if mode != "none" or accel_mode != "none":
-        orders = {axis: curve.order for axis, curve in model.curves_.items()}
-        thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
-                                         band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
-                                         reselect_order=temperature == "auto", acceleration=accel_mode,
-                                         static_min_duration_s=static_min_duration_s).fit(recordings)
+    selections, model, thermal = None, None, None
+    if hysteresis_band_degc is None and (temperature == "auto" or hysteresis == "auto"):
+        selections, thermal = _fit_selected(recordings, temperature=temperature, hysteresis=hysteresis,
+                                            hysteresis_order=hysteresis_order, accel_mode=accel_mode,
+                                            bin_width_degc=bin_width_degc,
+                                            static_min_duration_s=static_min_duration_s, run_folds=run_folds,
+                                            folds=folds)
+    else:
+        model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
+                                           folds=run_folds).fit(recordings)
+        mode = hysteresis
+        if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
+            mode = "none"
+        if mode != "none" or accel_mode != "none":
+            orders = {axis: curve.order for axis, curve in model.curves_.items()}
+            thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
+                                             band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
+                                             reselect_order=temperature == "auto", acceleration=accel_mode,
+                                             static_min_duration_s=static_min_duration_s).fit(recordings)
     axes = {}
-    report = {"temperature": "polynomial", "order_selection": model.selection_, "axes": {}}
-    if thermal is not None:
+    report = {"temperature": "polynomial", "axes": {},
+              "order_selection": FOLD_SELECTION[next(iter(selections.values())).fold_kind] if selections
+              else model.selection_}
+    if selections is not None:
+        report["selection"] = {axis: sel.to_dict() for axis, sel in selections.items()}
+        report["hysteresis"] = _selection_report(selections, thermal, hysteresis)
+    elif thermal is not None:
         report["hysteresis"] = {"mode": hysteresis, "selection": thermal.selection_, "axes": {
             axis: {"chosen": thermal.chosen_[axis], "lag_time_constant_s": thermal.lag_time_constants_s_[axis],
                    "order": thermal.curves_[axis].order,
@@ -165,11 +284,11 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         report["acceleration"] = {"mode": "none", "why": "the runs do not turn the unit between positions"
                                   if acceleration == "auto" else "not asked for"}
     network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
-    for axis, curve in model.curves_.items():
-        consts = model.turn_on_biases_dps_[axis]
+    for axis in recordings[0].gyro_axes:
+        curve, consts = (thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]) if thermal is not None else (
+            model.curves_[axis], model.turn_on_biases_dps_[axis])
         lag, hyst, g_row, g_sq = 0.0, None, None, None
         if thermal is not None:
-            curve, consts = thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]
             lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
             if accel_mode != "none" and thermal.excited_axes_:
                 g_row = tuple(float(v) for v in thermal.g_sensitivity_dps_per_g_[axis])
@@ -182,15 +301,18 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                                          thermal.segments_ if thermal is not None else None, network_inputs)
             if joint:  # the network reads the accelerations itself: the least-squares G was only a scaffold
                 g_row = g_sq = None
-        axes[axis] = AxisCalibration(curve, tuple(float(c) for c in consts),
+        if selections is not None and isinstance(curve, PolynomialBias):  # validated with the tangent extension
+            curve = dataclasses.replace(curve, extrapolation="linear")
+        keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
+        axes[axis] = AxisCalibration(keep_curve, tuple(float(c) for c in consts),
                                      recordings[0].temperature_column_for(axis), lag, hyst, g_row, g_sq)
-        report["axes"][axis] = {
-            "order": curve.order,
-            "scores": {str(p): float(s) for p, s in model.scores_[axis].items()},
-            "fit_rms_dps": model.fit_rms_dps_[axis] if network is None else network.train_rmse_dps_[axis],
-            "t_min_degc": curve.t_min_degc,
-            "t_max_degc": curve.t_max_degc,
-        }
+        report["axes"][axis] = {"order": curve.order, "t_min_degc": curve.t_min_degc, "t_max_degc": curve.t_max_degc}
+        if model is not None:
+            report["axes"][axis]["scores"] = {str(p): float(v) for p, v in model.scores_[axis].items()}
+        if network is not None:
+            report["axes"][axis]["fit_rms_dps"] = network.train_rmse_dps_[axis]
+        elif model is not None and thermal is None:
+            report["axes"][axis]["fit_rms_dps"] = model.fit_rms_dps_[axis]
     if network is not None:
         report["temperature"] = "mlp"
         report["network"] = {"hidden": list(hidden), "restarts": network.restarts, "seed": network.seed,
@@ -199,7 +321,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                                           "epochs": network.epochs_[a]} for a in network.curves_}}
         name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, hidden)) + "-1"
     else:
-        orders = sorted({ax.temperature.order for ax in axes.values()})
+        orders = sorted({ax.temperature.order if ax.temperature is not None else 0 for ax in axes.values()})
         name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
         if temperature == "auto":
             name += " (auto)"

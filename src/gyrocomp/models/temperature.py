@@ -28,6 +28,8 @@ RANGE_TOLERANCE_DEGC = 0.5
 RANGE_TOLERANCE_FRACTION = 0.01
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins
 PARSIMONY_TOLERANCE = 1.01
+#: what a polynomial does past its fitted range: held at the edge, or continued along its tangent
+EXTRAPOLATIONS = ("hold", "linear")
 
 
 @dataclass(frozen=True)
@@ -35,6 +37,11 @@ class PolynomialBias:
     """Fitted temperature shape of one axis's bias, without its turn-on constant.
 
     bias(T) = sum_k coefficients_dps[k-1] * u^k,  u = (clip(T, t_min_degc, t_max_degc) - t_ref_degc) / t_scale_degc
+
+    Past the fitted range the curve is held at its edge (``extrapolation="hold"``, what PX4 and ArduPilot do),
+    or continued along its tangent there (``"linear"``): bias(T) = bias(T_e) + bias'(T_e) (T - T_e), T_e the
+    nearer edge. A temperature coefficient rarely vanishes just past the calibrated range, while a polynomial
+    of higher order extrapolated as such diverges; the tangent is the first-order Taylor extension.
     """
 
     coefficients_dps: tuple[float, ...]
@@ -42,6 +49,11 @@ class PolynomialBias:
     t_scale_degc: float
     t_min_degc: float
     t_max_degc: float
+    extrapolation: str = "hold"
+
+    def __post_init__(self) -> None:
+        if self.extrapolation not in EXTRAPOLATIONS:
+            raise InputError(f"extrapolation: {self.extrapolation!r}; use one of {', '.join(EXTRAPOLATIONS)}")
 
     @property
     def order(self) -> int:
@@ -60,15 +72,19 @@ class PolynomialBias:
         return bool(np.any(t < self.t_min_degc - tol) or np.any(t > self.t_max_degc + tol))
 
     def shape_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
-        """Bias shape [deg/s] at ``temperature_degc`` [degC], clamped to the valid range."""
-        u = (np.clip(temperature_degc, self.t_min_degc, self.t_max_degc) - self.t_ref_degc) / self.t_scale_degc
-        out = np.zeros_like(u, dtype=float)
-        for a in reversed(self.coefficients_dps):  # Horner, no constant term
-            out = (out + a) * u
-        return out
+        """Bias shape [deg/s] at ``temperature_degc`` [degC]; past the range held or extended (``extrapolation``)."""
+        t = np.asarray(temperature_degc, dtype=float)
+        u = (np.clip(t, self.t_min_degc, self.t_max_degc) - self.t_ref_degc) / self.t_scale_degc
+        return polynomial_columns(u, self.order, self.extrapolation_u(t, u)) @ np.asarray(self.coefficients_dps)
+
+    def extrapolation_u(self, temperature_degc: np.ndarray, clipped_u: np.ndarray) -> np.ndarray | None:
+        """How far past the range each temperature lies, in u units (None when the curve is held)."""
+        if self.extrapolation == "hold":
+            return None
+        return (np.asarray(temperature_degc, dtype=float) - self.t_ref_degc) / self.t_scale_degc - clipped_u
 
     def to_dict(self) -> dict[str, Any]:
-        return {
+        d = {
             "type": "polynomial",
             "coefficients_dps": list(self.coefficients_dps),
             "t_ref_degc": self.t_ref_degc,
@@ -76,11 +92,25 @@ class PolynomialBias:
             "t_min_degc": self.t_min_degc,
             "t_max_degc": self.t_max_degc,
         }
+        if self.extrapolation != "hold":  # files without the key hold the edge, as every earlier file did
+            d["extrapolation"] = self.extrapolation
+        return d
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "PolynomialBias":
         return cls(tuple(float(c) for c in d["coefficients_dps"]), float(d["t_ref_degc"]),
-                   float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]))
+                   float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]),
+                   str(d.get("extrapolation", "hold")))
+
+
+def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray | None = None) -> np.ndarray:
+    """Columns u^1..u^order at the clipped u, each continued along its tangent by ``beyond_u`` (u - clipped u)
+    when given: u_c^k + k u_c^(k-1) (u - u_c). The curve is linear in its coefficients either way."""
+    k = np.arange(1, order + 1)
+    cols = clipped_u[:, None] ** k
+    if beyond_u is not None and order:
+        cols = cols + k * clipped_u[:, None] ** (k - 1) * beyond_u[:, None]
+    return cols
 
 
 def parse_temperature_option(text: str) -> int | str | tuple | None:

@@ -22,6 +22,7 @@ one run; the hysteresis order (1-3) is chosen the same way.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -32,6 +33,7 @@ from scipy.optimize import minimize_scalar
 from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..recording import Recording
+from ..static import static_segments
 from .acceleration import ACCELERATION_CHOICES, excited_columns
 from .base import RunBlocks, bin_width_for, block_means
 from .hysteresis import HysteresisCurve, turn_threshold_degc
@@ -251,11 +253,12 @@ class ThermalHysteresisModel:
     ----------
     order : int or dict
         Polynomial order of the temperature shape, or one per axis (from :class:`PolynomialTemperatureModel`'s
-        choice).
-    hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
-        The model, or ``"auto"``: every candidate compared by leave-one-run-out error.
-    hysteresis_order : int or "auto"
-        Order of the turning-point polynomial (1..3), or chosen by the same validation.
+        choice, or :mod:`gyrocomp.models.selection`'s).
+    hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"} or dict
+        The model, or ``"auto"``: every candidate compared by leave-one-run-out error; or a fixed model per axis.
+    hysteresis_order : int or "auto" or dict
+        Order of the turning-point polynomial (1..3), or chosen by the same validation; or one per axis
+        (0 for an axis without turning-point hysteresis).
     band_degc : (lo, hi), optional
         Limit the hysteresis to this temperature band [degC] (the ADXRS450 shows it only from 55 to 80).
         Without it, the band where the branches visibly part (:meth:`_Problem.observed_band`) is tried
@@ -306,26 +309,38 @@ class ThermalHysteresisModel:
     max_order: int = 5
     acceleration: str = "none"
     static_min_duration_s: float = 10.0
+    weighting: str | dict[str, str] = "temperature-balanced"
     _fitted: bool = field(default=False, init=False, repr=False)
 
-    def _candidates(self) -> list[str]:
-        return list(CANDIDATES) if self.hysteresis == "auto" else [self.hysteresis]
+    @staticmethod
+    def _of(value, axis: str):
+        return value[axis] if isinstance(value, dict) else value
 
-    def _spec(self, name: str, order: int, hysteresis_order: int = 2) -> _Spec:
+    def _candidates(self, axis: str) -> list[str]:
+        mode = self._of(self.hysteresis, axis)
+        return list(CANDIDATES) if mode == "auto" else [mode]
+
+    def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "") -> _Spec:
         lag = name in ("lag", "turning-point+lag")
         if "turning-point" not in name:
             return _Spec(order, lag, 0)
-        return _Spec(order, lag, hysteresis_order if self.hysteresis_order == "auto" else int(self.hysteresis_order))
+        fixed = self._of(self.hysteresis_order, axis)
+        return _Spec(order, lag, hysteresis_order if fixed == "auto" else int(fixed))
 
     def fit(self, recordings: list[Recording]) -> "ThermalHysteresisModel":
         """Fit on ``recordings`` (each one power-on at rest) and return self."""
         if isinstance(recordings, Recording):
             recordings = [recordings]
-        if self.hysteresis not in HYSTERESIS_CHOICES:
-            raise InputError(f"--hysteresis: {self.hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
-        if self.hysteresis_order != "auto" and not (
-                isinstance(self.hysteresis_order, int) and 1 <= self.hysteresis_order <= MAX_HYSTERESIS_ORDER):
-            raise InputError(f"--hysteresis-order: {self.hysteresis_order!r}; use auto or 1..{MAX_HYSTERESIS_ORDER}")
+        for mode in (self.hysteresis.values() if isinstance(self.hysteresis, dict) else [self.hysteresis]):
+            if mode not in HYSTERESIS_CHOICES:
+                raise InputError(f"hysteresis: {mode!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
+        for h in (self.hysteresis_order.values() if isinstance(self.hysteresis_order, dict)
+                  else [self.hysteresis_order]):
+            if h != "auto" and not (isinstance(h, int) and 0 <= h <= MAX_HYSTERESIS_ORDER):
+                raise InputError(f"hysteresis_order: {h!r}; use 'auto' or 1..{MAX_HYSTERESIS_ORDER}")
+        for w in (self.weighting.values() if isinstance(self.weighting, dict) else [self.weighting]):
+            if w not in ("time", "temperature-balanced"):
+                raise InputError(f"weighting: {w!r}; use 'time' or 'temperature-balanced'")
         if self.band_degc is not None and not self.band_degc[0] < self.band_degc[1]:
             raise InputError(f"--hysteresis-band: {self.band_degc}; give LOW,HIGH with LOW < HIGH [degC]")
         if not self.block_s > 0:
@@ -349,6 +364,8 @@ class ThermalHysteresisModel:
             width = bin_width_for(temps, self.bin_width_degc)
             block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
             runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
+            if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
+                runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
             threshold = max(turn_threshold_degc(t) for t in temps)
             accel_cols, square_cols = self._accel_columns(runs, axis == axes[0])
             problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, self.band_degc,
@@ -359,12 +376,12 @@ class ThermalHysteresisModel:
             score = problem.held_out_error if n_runs >= 2 else problem.bic
             band = self.band_degc
             found = None
-            if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates()):
+            if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates(axis)):
                 found = problem.observed_band(order)
             bands: dict[str, tuple[float, float] | None] = {}
-            for name in self._candidates():
+            for name in self._candidates(axis):
                 # candidates compared at hysteresis order 2 (the thesis's); the winner's order is validated after
-                best_spec[name] = self._spec(name, order)
+                best_spec[name] = self._spec(name, order, axis=axis)
                 scores[name] = math.nan if self.selection_ == "fixed" else score(best_spec[name])
                 bands[name] = band
                 if found is not None and "turning-point" in name:
@@ -386,11 +403,11 @@ class ThermalHysteresisModel:
                     best = min(finite.values())
                     chosen = next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
             if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
-                tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p)))
+                tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
                          for p in range(1, MAX_HYSTERESIS_ORDER + 1)}
                 best = min(tried.values())
                 pick = min(p for p, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
-                best_spec[chosen] = self._spec(chosen, order, pick)
+                best_spec[chosen] = self._spec(chosen, order, pick, axis)
                 scores[chosen] = tried[pick]
             problem.band = bands.get(chosen, band)
             self.bands_[axis] = problem.band
@@ -421,20 +438,8 @@ class ThermalHysteresisModel:
         return self
 
     def _pieces(self, recordings: list[Recording]) -> list[list[slice] | None]:
-        """Per run, the stretches the fit uses: the static segments where the unit moves between
-        positions (runs with an accelerometer), else every stretch between time gaps."""
-        from ..static import static_segments
-
-        self.segments_ = []
-        out = []
-        for rec in recordings:
-            segs = static_segments(rec, min_duration_s=self.static_min_duration_s) if rec.accel_g is not None else []
-            self.segments_.append(segs)
-            if rec.accel_g is not None and not segs:
-                warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
-                              DataQualityWarning, stacklevel=3)
-            out.append([slice(g.start, g.stop) for g in segs] if segs else None)
-        return out
+        self.segments_, pieces = static_pieces(recordings, self.static_min_duration_s)
+        return pieces
 
     def _accel_columns(self, runs: list[RunBlocks], warn: bool) -> tuple[tuple[int, ...], tuple[int, ...]]:
         if self.acceleration == "none":
@@ -469,4 +474,18 @@ class ThermalHysteresisModel:
             raise NotFittedError("ThermalHysteresisModel is not fitted yet; call fit(recordings) first")
 
 
-__all__ = ["CANDIDATES", "HYSTERESIS_CHOICES", "ThermalHysteresisModel"]
+def static_pieces(recordings: list[Recording], min_duration_s: float) -> tuple[list, list[list[slice] | None]]:
+    """Per run, its static segments and the stretches a fit uses: the static segments where the unit moves
+    between positions (runs with an accelerometer), else None (every stretch between time gaps)."""
+    segments, out = [], []
+    for rec in recordings:
+        segs = static_segments(rec, min_duration_s=min_duration_s) if rec.accel_g is not None else []
+        segments.append(segs)
+        if rec.accel_g is not None and not segs:
+            warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
+                          DataQualityWarning, stacklevel=3)
+        out.append([slice(g.start, g.stop) for g in segs] if segs else None)
+    return segments, out
+
+
+__all__ = ["CANDIDATES", "HYSTERESIS_CHOICES", "ThermalHysteresisModel", "static_pieces"]

@@ -88,7 +88,8 @@ class Profile:
         ``tumble``: time to turn from one position to the next [s] (recorded, at constant rate);
         ``combined``: pause of the recording while the unit is repositioned [s].
     positions_g : tuple of 3-tuples
-        Orientations as specific-force vectors [g].
+        Orientations as specific-force vectors [g]. ``warmup``, ``chamber`` and ``cycle`` with more than one
+        visit them in turn, ``position_s`` each, paused ``move_s`` between (as ``combined``).
     rates_dps : tuple of float
         ``ratetable``: rates applied about each axis in turn [deg/s], ``position_s`` each.
     duration_s : float, optional
@@ -151,12 +152,12 @@ class Profile:
         """(length [s], force at start, force at end, recorded) for each stretch of the motion."""
         if self.name == "ratetable":
             return [(self.position_s, UP, UP, True)] * (1 + 3 * len(self.rates_dps))
-        if self.name not in ("tumble", "combined"):
+        if self.name not in ("tumble", "combined") and len(self.positions_g) == 1:
             return [(self._natural_duration(), self.positions_g[0], self.positions_g[0], True)]
         segs = []
         positions = self.positions_g
-        if self.name == "combined":
-            total = self._temperature_knots()[0][-1]
+        if self.name != "tumble":  # a temperature profile visiting the positions in turn, as ``combined``
+            total = self._natural_duration()
             count = max(1, int(total // (self.position_s + self.move_s)))
             positions = tuple(positions[k % len(positions)] for k in range(count))
         for k, pos in enumerate(positions):
@@ -208,7 +209,7 @@ class Profile:
         force = np.empty((n, 3))
         rate = np.zeros((n, 3))
         recorded = np.ones(n, dtype=bool)
-        if self.name in ("static", "warmup", "chamber", "cycle"):
+        if self.name in ("static", "warmup", "chamber", "cycle") and len(self.positions_g) == 1:
             force[:] = self.positions_g[0]
         else:
             self._fill_motion(time_s * stretch, stretch, force, rate, recorded)

@@ -1,0 +1,621 @@
+"""Model choice by held-out drift: folds, candidate scores and the one-standard-error rule.
+
+What a user judges a compensation by is the drift left in data the model has not seen: the RMS, about its
+mean, of the moving-averaged compensated output. This module scores every candidate model of one axis by
+exactly that, on folds of the calibration data, and keeps the simplest candidate whose score is within one
+standard error of the best.
+
+Folds (:func:`make_folds`)
+    With three runs or more, each run is held out in turn (leave one run out). With one or two runs there
+    is only one such fold per held-out run, too few to judge a choice, so the runs are split at their
+    confirmed temperature reversals into heating and cooling legs, and each leg is held out in turn (the
+    other legs, of the same run too, train). Runs without enough reversals are split into contiguous time
+    blocks (temperature blocks, on a ramp). The held-out piece's constant is always refitted (its mean is
+    removed): the score is drift, not the turn-on bias.
+
+Candidates (:class:`Candidate`)
+    Polynomial order 0..5 (0: the run constant alone, no temperature curve), thermal lag, turning-point
+    hysteresis of order 1..3 (only where the runs reverse), and the weighting of the fit: ``time`` (every
+    second of data counts equally, as in the score) or ``temperature-balanced`` (every temperature bin of
+    every run counts equally, so a slow ramp cannot dominate). The lag of a fold's fit is chosen on that
+    fold's training data (a log-spaced grid), so the held-out score judges the whole procedure.
+
+Score and rule
+    Per fold, the time-weighted RMS of the moving average (``window_s``) of the held-out residual about its
+    mean [deg/s]; a candidate's score is the mean over folds. The least complex candidate whose score is within
+    one standard error (of the best candidate's mean over folds) of the best is chosen: Breiman's
+    one-standard-error rule. (Its paired form, on per-fold differences, was tried and rejected: with three
+    folds its standard error is so uncertain that a candidate far worse on one fold passes.) Complexity is
+    the number of shape terms: the order, plus 1 for the lag, plus 2 per hysteresis order. On a temperature
+    register with coarse steps (:func:`temperature_step_degc`) the lag
+    costs nothing: it is what turns the steps back into the smooth temperature of the structure.
+
+Every fold's training solve comes from normal equations per (run, fold) piece, computed once per lag value
+and weighting and shared by all candidates and folds.
+
+References: L. Breiman et al., *Classification and Regression Trees*, 1984, section 3.4.3 (the one-SE rule);
+T. Hastie, R. Tibshirani, J. Friedman, *The Elements of Statistical Learning*, 2nd ed., 2009, section 7.10.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from ..effects import find_turns, g_squared_products, thermal_lag
+from .base import RunBlocks
+from .temperature import polynomial_columns
+
+Weighting = Literal["time", "temperature-balanced"]
+FoldKind = Literal["runs", "legs", "blocks"]
+WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
+FOLD_KINDS = ("auto", "runs", "legs", "blocks")
+#: the fewest folds a choice is made on; runs are split into legs (or blocks) below this
+MIN_FOLDS = 3
+#: with blocks, each run is cut into this many contiguous pieces (at least MIN_FOLDS in all)
+BLOCKS_PER_RUN = 4
+#: the moving-average window of the score: a tenth of the median fold, within these bounds [s]
+WINDOW_MIN_S = 60.0
+WINDOW_MAX_S = 600.0
+#: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run)
+LAG_GRID_POINTS = 16
+LAG_MAX_S = 4 * 3600.0
+#: a temperature register whose steps are at least this coarse is treated as quantized [degC]
+COARSE_STEP_DEGC = 0.25
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One model of an axis's bias: polynomial order, thermal lag, hysteresis order, fit weighting."""
+
+    order: int
+    lag: bool = False
+    hysteresis_order: int = 0
+    weighting: Weighting = "time"
+
+    @property
+    def memory(self) -> str:
+        """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
+        if self.lag and self.hysteresis_order:
+            return "turning-point+lag"
+        return "lag" if self.lag else ("turning-point" if self.hysteresis_order else "none")
+
+    @property
+    def complexity(self) -> int:
+        """Number of shape terms: the order, the lag's time constant, two per hysteresis order."""
+        return self.order + int(self.lag) + 2 * self.hysteresis_order
+
+    @property
+    def has_temperature_model(self) -> bool:
+        return self.order > 0 or self.lag or self.hysteresis_order > 0
+
+    @property
+    def label(self) -> str:
+        """Short name, e.g. ``poly:3 + lag + turning-point:2 (time)``; ``constant`` for order 0."""
+        parts = ["constant" if self.order == 0 else f"poly:{self.order}"]
+        if self.lag:
+            parts.append("lag")
+        if self.hysteresis_order:
+            parts.append(f"turning-point:{self.hysteresis_order}")
+        return " + ".join(parts) + f" ({self.weighting})"
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
+                "weighting": self.weighting, "label": self.label}
+
+
+@dataclass(frozen=True)
+class CandidateScore:
+    """Held-out drift of one candidate on every fold [deg/s], and what each fold's fit chose for the lag [s]."""
+
+    candidate: Candidate
+    fold_drift_dps: tuple[float, ...]
+    fold_lag_s: tuple[float, ...]
+
+    @property
+    def mean_drift_dps(self) -> float:
+        return float(np.mean(self.fold_drift_dps))
+
+    @property
+    def standard_error_dps(self) -> float:
+        """Standard error of the mean over folds [deg/s]."""
+        f = len(self.fold_drift_dps)
+        return float(np.std(self.fold_drift_dps, ddof=1) / math.sqrt(f)) if f > 1 else math.nan
+
+    def to_dict(self) -> dict:
+        return {**self.candidate.to_dict(), "mean_drift_dps": self.mean_drift_dps,
+                "standard_error_dps": self.standard_error_dps, "fold_drift_dps": list(self.fold_drift_dps),
+                "fold_lag_s": list(self.fold_lag_s)}
+
+
+@dataclass(frozen=True)
+class Folds:
+    """How the calibration data is held out: the fold of every block of every run, and each fold's name."""
+
+    kind: FoldKind
+    of_block: tuple[np.ndarray, ...]
+    names: tuple[str, ...]
+
+    @property
+    def count(self) -> int:
+        return len(self.names)
+
+
+@dataclass(frozen=True)
+class AxisSelection:
+    """The choice for one axis, with every candidate's fold scores.
+
+    Attributes
+    ----------
+    axis : str
+    fold_kind : {"runs", "legs", "blocks"}
+    folds : tuple of str
+        Name of each fold (``run 2``, ``run 1 leg 3 (cooling)``, ``run 1 block 2``).
+    window_s : float
+        Moving-average window of the drift score [s].
+    temperature_step_degc : float
+        Step of a coarsely quantized temperature register [degC], 0 when the temperature is fine-grained.
+    scores : tuple of CandidateScore
+    best : Candidate
+        The lowest mean held-out drift.
+    chosen : Candidate
+        The simplest candidate within one standard error of the best.
+    """
+
+    axis: str
+    fold_kind: FoldKind
+    folds: tuple[str, ...]
+    window_s: float
+    temperature_step_degc: float
+    scores: tuple[CandidateScore, ...]
+    best: Candidate
+    chosen: Candidate
+
+    def score_of(self, candidate: Candidate) -> CandidateScore:
+        return next(s for s in self.scores if s.candidate == candidate)
+
+    @property
+    def raw_drift_dps(self) -> float:
+        """Mean held-out drift with the run constant alone (time-weighted) [deg/s]."""
+        return self.score_of(Candidate(0)).mean_drift_dps
+
+    @property
+    def chosen_drift_dps(self) -> float:
+        return self.score_of(self.chosen).mean_drift_dps
+
+    @property
+    def generalizes(self) -> bool:
+        """Whether some temperature model beat the run constant alone on held-out data."""
+        return self.chosen.has_temperature_model
+
+    def to_dict(self) -> dict:
+        return {"axis": self.axis, "fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
+                "temperature_step_degc": self.temperature_step_degc, "best": self.best.to_dict(),
+                "chosen": self.chosen.to_dict(), "raw_drift_dps": self.raw_drift_dps,
+                "chosen_drift_dps": self.chosen_drift_dps, "generalizes": self.generalizes,
+                "candidates": [s.to_dict() for s in self.scores]}
+
+
+def temperature_step_degc(temperature_degc: np.ndarray) -> float:
+    """The step of a quantized temperature register [degC], or 0 when the values are not on a coarse grid.
+
+    The step is the most common non-zero difference between consecutive samples; the series counts as
+    quantized when that step is at least ``COARSE_STEP_DEGC`` and almost every value (99 %) lies on its grid.
+    """
+    t = np.asarray(temperature_degc, dtype=float)
+    steps = np.abs(np.diff(t))
+    steps = steps[steps > 1e-9]
+    if not steps.size:
+        return 0.0
+    values, counts = np.unique(np.round(steps, 6), return_counts=True)
+    step = float(values[np.argmax(counts)])
+    if step < COARSE_STEP_DEGC:
+        return 0.0
+    offset = t - np.round(t / step) * step
+    phase = float(np.median(offset))
+    on_grid = np.abs(offset - phase) < 0.01 * step
+    return step if np.mean(on_grid) >= 0.99 else 0.0
+
+
+def _split_long(leg_of_block: np.ndarray, pieces: int) -> np.ndarray:
+    """Cut a run's blocks into ``pieces`` contiguous parts of equal length."""
+    n = leg_of_block.size
+    return np.minimum((np.arange(n) * pieces) // max(n, 1), pieces - 1)
+
+
+def leg_labels(temperature_degc: np.ndarray, threshold_degc: float, min_length: int) -> tuple[np.ndarray, list[int]]:
+    """The heating or cooling leg of each sample: legs split where a reversal is confirmed
+    (:func:`gyrocomp.effects.find_turns`), a leg shorter than ``min_length`` samples joined to the one before.
+    Returns the leg number of each sample and each leg's direction (+1 heating, -1 cooling, 0 unknown)."""
+    turns = find_turns(temperature_degc, threshold_degc)
+    n = turns.direction.size
+    kept: list[int] = []
+    for c in (int(i) for i in turns.turn_index):
+        if c - (kept[-1] if kept else 0) >= min_length and n - c >= min_length:
+            kept.append(c)
+    labels = np.searchsorted(np.asarray(kept, dtype=np.int64), np.arange(n), side="right")
+    starts = [0] + kept
+    # a leg's direction: the one most of its samples carry (the first samples of a run have none yet)
+    directions = []
+    for j, start in enumerate(starts):
+        stop = kept[j] if j < len(kept) else n
+        d = turns.direction[start:stop]
+        directions.append(int(np.sign(np.sum(d))) if d.size else 0)
+    return labels, directions
+
+
+def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: list[float], kind: str = "auto",
+               min_leg_blocks: int = 10) -> Folds:
+    """The folds of a selection.
+
+    Parameters
+    ----------
+    runs : list of RunBlocks
+        Block means of each recording (one axis).
+    groups : tuple of int
+        The run each recording belongs to (pieces of one run are held out together).
+    thresholds_degc : list of float
+        Turning-point threshold of each recording [degC].
+    kind : {"auto", "runs", "legs", "blocks"}
+        ``auto``: runs with at least ``MIN_FOLDS`` runs, else legs when they give ``MIN_FOLDS`` folds, else
+        blocks.
+    min_leg_blocks : int
+        A leg shorter than this many blocks joins the leg before it.
+    """
+    n_groups = len(set(groups))
+    if kind == "auto":
+        kind = "runs" if n_groups >= MIN_FOLDS else "legs"
+    if kind == "runs":
+        ids = sorted(set(groups))
+        return Folds("runs", tuple(np.full(r.value_dps.size, ids.index(g)) for r, g in zip(runs, groups)),
+                     tuple(f"run {g + 1}" for g in ids))
+    legs, names = [], []
+    for k, (run, threshold) in enumerate(zip(runs, thresholds_degc)):
+        leg, directions = leg_labels(run.temperature_degc, threshold, min_leg_blocks)
+        legs.append(leg)
+        names += [f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, "")
+                  for j, d in enumerate(directions)]
+    if kind == "legs" and len(names) >= MIN_FOLDS:
+        offsets = np.cumsum([0] + [int(leg.max()) + 1 for leg in legs[:-1]])
+        return Folds("legs", tuple(leg + o for leg, o in zip(legs, offsets)), tuple(names))
+    per_run = max(BLOCKS_PER_RUN, math.ceil(MIN_FOLDS / len(runs)))
+    of_block, names = [], []
+    for k, run in enumerate(runs):
+        of_block.append(_split_long(np.zeros(run.value_dps.size), per_run) + k * per_run)
+        names += [f"run {k + 1} block {j + 1}" for j in range(per_run)]
+    return Folds("blocks", tuple(of_block), tuple(names))
+
+
+def moving_average_valid(x: np.ndarray, window: int) -> np.ndarray:
+    """Moving average over ``window`` consecutive values, only where the window is full (cumulative sums)."""
+    window = max(1, min(window, x.size))
+    c = np.concatenate([[0.0], np.cumsum(x)])
+    return (c[window:] - c[:-window]) / window
+
+
+def drift_rms(residual: np.ndarray, weight: np.ndarray, window: int) -> tuple[float, float]:
+    """(weighted sum of squares, sum of weights) of the moving average of ``residual`` about its weighted mean."""
+    e = residual - np.sum(weight * residual) / np.sum(weight)
+    smooth = moving_average_valid(e, window)
+    w = moving_average_valid(weight, window)
+    smooth = smooth - np.sum(w * smooth) / np.sum(w)
+    return float(np.sum(w * smooth ** 2)), float(np.sum(w))
+
+
+@dataclass
+class SelectionProblem:
+    """One axis's calibration data, prepared once for every candidate and fold.
+
+    Parameters
+    ----------
+    runs : list of RunBlocks
+        Block means of each recording [s, degC, deg/s]; ``samples`` gives the time weights.
+    groups : tuple of int
+        The run of each recording.
+    folds : Folds
+    t_ref_degc, t_scale_degc : float
+        Centre and half-span of the temperature [degC] (conditioning of the polynomial columns).
+    threshold_degc : float
+        Turning-point threshold [degC].
+    block_s : float
+        Block length [s].
+    window_s : float
+        Moving-average window of the score [s].
+    max_order : int
+    hysteresis_orders : tuple of int
+        Hysteresis orders to try (empty: no turning-point candidates).
+    accel_cols, square_cols : tuple of int
+        Accelerometer columns (and g x g products) fitted in every candidate (g-sensitivity).
+    temperature_step_degc : float
+        Step of a quantized temperature register [degC], 0 if none.
+    """
+
+    runs: list[RunBlocks]
+    groups: tuple[int, ...]
+    folds: Folds
+    t_ref_degc: float
+    t_scale_degc: float
+    threshold_degc: float
+    block_s: float
+    window_s: float
+    max_order: int = 5
+    hysteresis_orders: tuple[int, ...] = (1, 2, 3)
+    accel_cols: tuple[int, ...] = ()
+    square_cols: tuple[int, ...] = ()
+    temperature_step_degc: float = 0.0
+    _cache: dict = field(default_factory=dict, init=False, repr=False)
+
+    @property
+    def max_hysteresis(self) -> int:
+        return max(self.hysteresis_orders, default=0)
+
+    def lag_grid_s(self) -> np.ndarray:
+        longest = max(float(r.time_s[-1] - r.time_s[0]) for r in self.runs)
+        lo = 2.0 * self.block_s
+        hi = max(lo * 2.0, min(LAG_MAX_S, longest))
+        return np.geomspace(lo, hi, LAG_GRID_POINTS)
+
+    # -- columns ---------------------------------------------------------------------------------------
+    def model_temperature(self, k: int, tau_s: float) -> np.ndarray:
+        run = self.runs[k]
+        if tau_s > 0:
+            return thermal_lag(run.time_s, run.temperature_degc, tau_s, period_s=self.block_s)[0]
+        return run.temperature_degc
+
+    def columns(self, k: int, temp: np.ndarray, lo: float | None = None, hi: float | None = None) -> np.ndarray:
+        """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order (u clipped to
+        [lo, hi]), the cooling then heating hysteresis terms (d / t_scale)^j, then the accelerometer columns."""
+        clipped = temp if lo is None else np.clip(temp, lo, hi)
+        u = (clipped - self.t_ref_degc) / self.t_scale_degc
+        cols = [u[:, None] ** np.arange(1, self.max_order + 1)]
+        h = self.max_hysteresis
+        if h:
+            turns = find_turns(temp, self.threshold_degc)
+            active = ~np.isnan(turns.turn_degc)
+            d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0) / self.t_scale_degc
+            powers = d[:, None] ** np.arange(1, h + 1)
+            for sign in (-1, 1):
+                cols.append(np.where((active & (turns.direction == sign))[:, None], powers, 0.0))
+        run = self.runs[k]
+        if self.accel_cols:
+            cols.append(run.accel_g[:, list(self.accel_cols)])
+        if self.square_cols:
+            cols.append(g_squared_products(run.accel_g)[:, list(self.square_cols)])
+        return np.hstack(cols)
+
+    def column_index(self, c: Candidate) -> np.ndarray:
+        o, h = self.max_order, self.max_hysteresis
+        idx = list(range(c.order))
+        idx += [o + j for j in range(c.hysteresis_order)] + [o + h + j for j in range(c.hysteresis_order)]
+        n_accel = len(self.accel_cols) + len(self.square_cols)
+        idx += [o + 2 * h + j for j in range(n_accel)]
+        return np.asarray(idx, dtype=np.int64)
+
+    def weights(self, k: int, weighting: Weighting) -> np.ndarray:
+        run = self.runs[k]
+        if weighting == "time":
+            return run.samples / run.samples.max()
+        return run.weight
+
+    # -- normal equations, per fold --------------------------------------------------------------------
+    def _prepared(self, tau_s: float):
+        """Per run at lag ``tau_s``: model temperature, columns, and per fold its min and max temperature."""
+        key = ("prep", tau_s)
+        if key not in self._cache:
+            out = []
+            for k in range(len(self.runs)):
+                temp = self.model_temperature(k, tau_s)
+                out.append((temp, self.columns(k, temp)))
+            self._cache[key] = out
+        return self._cache[key]
+
+    def training_matrices(self, tau_s: float, weighting: Weighting) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(F, P+1, P+1) centred normal matrices of [columns, y] over each fold's training data (each run's
+        constant profiled out), and the (F,) lowest and highest training model temperature."""
+        key = ("train", tau_s, weighting)
+        if key in self._cache:
+            return self._cache[key]
+        n_folds = self.folds.count
+        prepared = self._prepared(tau_s)
+        p = prepared[0][1].shape[1]
+        # per group (run) and fold: raw sums
+        group_ids = sorted(set(self.groups))
+        gram = np.zeros((len(group_ids), n_folds, p + 1, p + 1))
+        first = np.zeros((len(group_ids), n_folds, p + 1))
+        total = np.zeros((len(group_ids), n_folds))
+        lo = np.full(n_folds, np.inf)
+        hi = np.full(n_folds, -np.inf)
+        t_lo = np.full((len(self.runs), n_folds), np.inf)
+        t_hi = np.full((len(self.runs), n_folds), -np.inf)
+        for k, (temp, cols) in enumerate(prepared):
+            g = group_ids.index(self.groups[k])
+            z = np.hstack([cols, self.runs[k].value_dps[:, None]])
+            w = self.weights(k, weighting)
+            fold = self.folds.of_block[k]
+            for f in np.unique(fold):
+                sel = fold == f
+                zw = z[sel] * w[sel, None]
+                gram[g, f] += zw.T @ z[sel]
+                first[g, f] += zw.sum(axis=0)
+                total[g, f] += w[sel].sum()
+                t_lo[k, f], t_hi[k, f] = temp[sel].min(), temp[sel].max()
+        matrices = np.zeros((n_folds, p + 1, p + 1))
+        g_all, m_all, s_all = gram.sum(axis=1), first.sum(axis=1), total.sum(axis=1)
+        for f in range(n_folds):
+            for g in range(len(group_ids)):
+                s = s_all[g] - total[g, f]
+                if s <= 0:
+                    continue
+                m = m_all[g] - first[g, f]
+                matrices[f] += g_all[g] - gram[g, f] - np.outer(m, m) / s
+            keep = np.ones(n_folds, dtype=bool)
+            keep[f] = False
+            lo[f], hi[f] = t_lo[:, keep].min(), t_hi[:, keep].max()
+        self._cache[key] = (matrices, lo, hi)
+        return self._cache[key]
+
+    @staticmethod
+    def solve(matrix: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, float]:
+        """Coefficients of the columns ``idx`` and the training residual sum of squares, from a centred normal
+        matrix (minimum-norm where columns are not identified, e.g. a branch absent from the training data)."""
+        if idx.size == 0:
+            return np.zeros(0), float(matrix[-1, -1])
+        a = matrix[np.ix_(idx, idx)]
+        b = matrix[idx, -1]
+        scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
+        coef, *_ = np.linalg.lstsq(a / np.outer(scale, scale), b / scale, rcond=1e-10)
+        coef = coef / scale
+        return coef, float(matrix[-1, -1] - b @ coef)
+
+    def _held_out(self, f: int, c: Candidate, tau_s: float, coef: np.ndarray, lo: float, hi: float) -> float:
+        sse = wsum = 0.0
+        window = max(1, int(round(self.window_s / self.block_s)))
+        idx = self.column_index(c)
+        for k, (temp, cols) in enumerate(self._prepared(tau_s)):
+            sel = self.folds.of_block[k] == f
+            if not np.any(sel):
+                continue
+            x = cols[sel][:, idx]
+            if c.order:  # past the training range the curve continues along its tangent, as applied
+                t = temp[sel]
+                u = (np.clip(t, lo, hi) - self.t_ref_degc) / self.t_scale_degc
+                x = x.copy()
+                x[:, : c.order] = polynomial_columns(u, c.order, (t - self.t_ref_degc) / self.t_scale_degc - u)
+            e = self.runs[k].value_dps[sel] - (x @ coef if idx.size else 0.0)
+            w = self.runs[k].samples[sel].astype(float)
+            s, n = drift_rms(e, w, window)
+            sse += s
+            wsum += n
+        return math.sqrt(sse / wsum) if wsum > 0 else math.nan
+
+    def score(self, c: Candidate) -> CandidateScore:
+        """Held-out drift of ``c`` on every fold."""
+        idx = self.column_index(c)
+        taus = self.lag_grid_s() if c.lag else np.array([0.0])
+        drifts, lags = [], []
+        for f in range(self.folds.count):
+            best = None
+            for tau in taus:  # the lag of this fold's fit: least training residual
+                matrices, lo, hi = self.training_matrices(float(tau), c.weighting)
+                coef, rss = self.solve(matrices[f], idx)
+                if best is None or rss < best[0]:
+                    best = (rss, float(tau), coef, lo[f], hi[f])
+            _, tau, coef, lo_f, hi_f = best
+            drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f))
+            lags.append(tau)
+        return CandidateScore(c, tuple(drifts), tuple(lags))
+
+    def candidates(self, orders: tuple[int, ...], memories: tuple[str, ...],
+                   weightings: tuple[Weighting, ...] = WEIGHTINGS) -> list[Candidate]:
+        out = []
+        for w in weightings:
+            for p in orders:
+                for mem in memories:
+                    lag = "lag" in mem
+                    if mem in ("none", "lag"):
+                        hs = (0,)
+                    else:
+                        hs = self.hysteresis_orders
+                    for h in hs:
+                        if (lag or h) and p == 0:
+                            continue
+                        c = Candidate(p, lag, h, w)
+                        if c not in out:
+                            out.append(c)
+        return out
+
+    def complexity(self, c: Candidate) -> int:
+        """Complexity for the rule: on a coarsely quantized register the lag is free (it de-quantizes)."""
+        return c.complexity - (1 if c.lag and self.temperature_step_degc > 0 else 0)
+
+
+def choose(scores: list[CandidateScore], complexity) -> tuple[Candidate, Candidate]:
+    """(best, chosen): the lowest mean score, and the least complex candidate whose mean is within one standard
+    error of the best's (the standard error of the best candidate's mean over folds); ties in complexity go to
+    the lower score."""
+    finite = [s for s in scores if np.all(np.isfinite(s.fold_drift_dps))]
+    best = min(finite, key=lambda s: s.mean_drift_dps)
+    se = best.standard_error_dps if len(best.fold_drift_dps) > 1 else 0.0
+    accepted = [s for s in finite if s.mean_drift_dps <= best.mean_drift_dps + se]
+    chosen = min(accepted, key=lambda s: (complexity(s.candidate), s.mean_drift_dps))
+    return best.candidate, chosen.candidate
+
+
+def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],
+                weightings: tuple[Weighting, ...] = WEIGHTINGS) -> AxisSelection:
+    """Score every candidate of one axis and choose (see the module doc)."""
+    cands = problem.candidates(orders, memories, weightings)
+    if Candidate(0) not in cands:
+        cands.insert(0, Candidate(0))
+    scores = [problem.score(c) for c in cands]
+    best, chosen = choose(scores, problem.complexity)
+    return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
+                         problem.temperature_step_degc, tuple(scores), best, chosen)
+
+
+def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
+    """The score's moving-average window [s]: a tenth of the median fold length, within
+    [WINDOW_MIN_S, WINDOW_MAX_S]."""
+    lengths = []
+    for f in range(folds.count):
+        n = sum(int(np.count_nonzero(fold == f)) for fold in folds.of_block)
+        lengths.append(n * block_s)
+    return float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
+
+
+__all__ = ["AxisSelection", "Candidate", "CandidateScore", "Folds", "SelectionProblem", "Weighting", "choose",
+           "make_folds", "select_axis", "temperature_step_degc", "window_for"]
+
+
+def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,
+                 block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
+                 max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
+                 square_cols: tuple[int, ...] = ()) -> SelectionProblem:
+    """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
+
+    Parameters
+    ----------
+    recordings : list of Recording
+    axis : str
+    pieces : list of (list of slice or None), optional
+        Per recording, the stretches to use (static segments of a multi-position run); default every stretch.
+    groups : tuple of int, optional
+        The run of each recording (default: each its own run).
+    block_s : float
+        Block length [s] (at least one sample).
+    bin_width_degc : float, optional
+        Temperature bin of the temperature-balanced weights [degC].
+    fold_kind : {"auto", "runs", "legs", "blocks"}
+    max_order : int
+    hysteresis_orders : tuple of int
+        Tried only where the runs hold branches after reversals in both directions.
+    accel_cols, square_cols : tuple of int
+        g-sensitivity columns fitted with every candidate.
+    """
+    from .base import bin_width_for, block_means
+    from .hysteresis import turn_threshold_degc
+
+    temps = [rec.temperature_for(axis) for rec in recordings]
+    lo = min(float(t.min()) for t in temps)
+    hi = max(float(t.max()) for t in temps)
+    width = bin_width_for(temps, bin_width_degc)
+    block_s = max(block_s, 1.0 / recordings[0].rate_hz)
+    pieces = pieces or [None] * len(recordings)
+    runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
+    thresholds = [turn_threshold_degc(t) for t in temps]
+    groups = tuple(range(len(recordings))) if groups is None else tuple(int(g) for g in groups)
+    folds = make_folds(runs, groups, thresholds, fold_kind)
+    step = max(temperature_step_degc(t) for t in temps)
+    # turning-point hysteresis needs a branch after a reversal in each direction: fitted on one side only it
+    # imitates curvature of the shape and fails on the other branch
+    branches = set()
+    for r, th in zip(runs, thresholds):
+        turns = find_turns(r.temperature_degc, th)
+        branches |= set(np.unique(turns.direction[~np.isnan(turns.turn_degc)]).tolist())
+    reverses = {-1, 1} <= branches
+    return SelectionProblem(runs, groups, folds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, max(thresholds),
+                            block_s, window_for(folds, runs, block_s), max_order,
+                            hysteresis_orders if reverses else (), accel_cols, square_cols, step)

@@ -1,0 +1,120 @@
+"""Model choice by held-out drift (gyrocomp.models.selection): the rule, the folds, the quantization detector,
+the tangent extension past the fitted range, and simulate-then-recover on single chamber cycles."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import apply, fit_calibration
+from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.models.selection import Candidate, CandidateScore, choose, leg_labels, temperature_step_degc
+from gyrocomp.models.temperature import PolynomialBias
+from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.validation import fit_plain_cubic, make_sample_folds
+
+
+def _score(c, folds):
+    return CandidateScore(c, tuple(folds), tuple(0.0 for _ in folds))
+
+
+def test_simplest_within_one_standard_error_of_the_best_is_chosen():
+    best = _score(Candidate(3), [1.0, 1.2, 1.4])  # mean 1.2, SE 0.1155
+    close = _score(Candidate(1), [1.1, 1.3, 1.5])  # mean 1.3: within one SE
+    far = _score(Candidate(0), [1.3, 1.5, 1.7])  # mean 1.5: not
+    b, c = choose([best, close, far], lambda k: k.complexity)
+    assert b == Candidate(3) and c == Candidate(1)
+    # a candidate that must earn its terms: the simpler one is 2 SE worse, so the complex one stays
+    b, c = choose([best, _score(Candidate(1), [1.3, 1.5, 1.6])], lambda k: k.complexity)
+    assert c == Candidate(3)
+
+
+def test_a_candidate_far_worse_on_one_fold_does_not_pass():
+    best = _score(Candidate(4, lag=True), [0.0035, 0.0043, 0.0065])
+    erratic = _score(Candidate(1), [0.0030, 0.0040, 0.0400])  # better on two folds, 6x worse on one
+    _, c = choose([best, erratic], lambda k: k.complexity)
+    assert c == Candidate(4, lag=True)
+
+
+def test_candidate_complexity_and_labels():
+    c = Candidate(3, lag=True, hysteresis_order=2, weighting="temperature-balanced")
+    assert c.complexity == 3 + 1 + 4 and c.memory == "turning-point+lag"
+    assert c.label == "poly:3 + lag + turning-point:2 (temperature-balanced)"
+    assert not Candidate(0).has_temperature_model and Candidate(0).label == "constant (time)"
+
+
+@pytest.mark.parametrize("step", [1.0, 0.5])
+def test_quantized_temperature_is_detected(step):
+    rng = np.random.default_rng(1)
+    t = 20 + 10 * np.sin(np.linspace(0, 3, 5000)) + 0.2 * rng.standard_normal(5000)
+    assert temperature_step_degc(np.round(t / step) * step) == step
+    assert temperature_step_degc(np.round(t, 2)) == 0.0  # a fine register is not coarse
+    assert temperature_step_degc(np.full(10, 25.0)) == 0.0
+
+
+def test_legs_split_at_confirmed_reversals():
+    t = np.concatenate([np.linspace(25, -20, 400), np.linspace(-20, 70, 800), np.linspace(70, -20, 800)])
+    labels, directions = leg_labels(t, 0.5, 10)
+    assert directions == [-1, 1, -1]
+    # the splits lie just past the extremes (a reversal is confirmed 0.5 degC after it)
+    assert np.all(np.diff(labels) >= 0) and abs(np.flatnonzero(np.diff(labels))[0] - 400) < 10
+
+
+def test_folds_runs_legs_and_blocks():
+    cycle = simulate("adxrs450", profile="cycle", duration_s=4000, rate_hz=1, seed=1).recording
+    kind, folds = make_sample_folds([cycle])
+    assert kind == "legs" and len(folds) >= 3
+    directions = [f.name.split("(")[-1].rstrip(")") for f in folds]
+    assert all(a != b for a, b in zip(directions, directions[1:]))  # heating and cooling alternate
+    assert sum(f.rows.size for f in folds) == cycle.n_samples
+    ramp = simulate("adxrs450", profile="chamber", duration_s=3000, rate_hz=1, seed=2).recording
+    kind, folds = make_sample_folds([ramp])  # no reversal: contiguous blocks
+    assert kind == "blocks" and len(folds) == 4
+    kind, folds = make_sample_folds([ramp, ramp, ramp])
+    assert kind == "runs" and [f.name for f in folds] == ["run 1", "run 2", "run 3"]
+
+
+def test_tangent_extension_past_the_range():
+    curve = PolynomialBias((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0, extrapolation="linear")
+    t = np.array([40.0, 5.0])
+    # analytic: at the edge u=1 the value is 0.07 and the slope d/du is 0.1 - 0.1 + 0.06 = 0.06 per u
+    expected_hi = 0.07 + 0.06 * (40 - 30) / 10
+    lo_u = -1.0
+    value_lo = 0.1 * lo_u - 0.05 * lo_u ** 2 + 0.02 * lo_u ** 3
+    slope_lo = 0.1 - 0.1 * lo_u + 0.06 * lo_u ** 2
+    np.testing.assert_allclose(curve.shape_dps(t), [expected_hi, value_lo + slope_lo * (5 - 10) / 10], rtol=1e-12)
+    held = PolynomialBias((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0)
+    np.testing.assert_allclose(held.shape_dps(t), [0.07, value_lo], rtol=1e-12)
+    assert "extrapolation" not in held.to_dict() and PolynomialBias.from_dict(curve.to_dict()) == curve
+    with pytest.raises(ValueError, match="extrapolation: 'cubic'; use one of hold, linear"):
+        PolynomialBias((0.1,), 20.0, 10.0, 10.0, 30.0, extrapolation="cubic")
+
+
+def _single_cycle(seed):
+    """One chamber run cooled, heated, cooled again (the way PX4 and most vendors calibrate), 2 Hz."""
+    prof = get_profile("chamber", set_points_degc=(25.0, -20.0, 70.0, -20.0), ramp_rate_degc_per_min=1.0,
+                       dwell_s=600.0)
+    return simulate("adxrs450", profile=prof, rate_hz=2.0, seed=seed)
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_single_chamber_cycle_fit_to_the_hottest_point_holds_on_the_last_cooling_leg(seed):
+    sim = _single_cycle(seed)
+    rec = sim.recording
+    hottest = int(np.argmax(rec.temperature_degc))
+    # the last cooling leg starts where the temperature leaves the hot dwell
+    leaves = hottest + int(np.argmax(rec.temperature_degc[hottest:] < rec.temperature_degc[hottest] - 1.0))
+    train = rec.take(slice(0, hottest + 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        default = fit_calibration([train])
+        cubic = fit_plain_cubic([train])
+        comp = {name: apply(cal, rec).gyro_dps[leaves:] for name, cal in (("default", default), ("cubic", cubic))}
+    # two legs (cooling, heating) are fewer than three folds: contiguous time blocks are held out
+    assert default.fit_report["selection"]["gyro_z"]["fold_kind"] == "blocks"
+    w = 600 * 2
+    truth = sim.truth.true_rate_dps[leaves:]
+    drift = {k: smoothed_residual_rms(v[:, 0] - truth[:, 0], w) for k, v in comp.items()}
+    raw = smoothed_residual_rms(rec.gyro_dps[leaves:, 0] - truth[:, 0], w)
+    assert drift["default"] <= drift["cubic"]
+    assert drift["default"] < raw
