@@ -49,7 +49,7 @@ def test_least_squares_is_linear_in_the_data(chamber_runs):
         "truth": [s.recording.with_gyro(s.truth.deterministic_error_dps) for s in runs],
         "noise": [s.recording.with_gyro(s.truth.noise.total_dps) for s in runs],
     }
-    cal = {k: fit_calibration(v, temperature=3) for k, v in parts.items()}
+    cal = {k: fit_calibration(v, temperature=3, hysteresis="none") for k, v in parts.items()}
     truth = TEST_MODEL.temperature_error_dps(GRID)
     for j, axis in enumerate(TEST_MODEL.axes):
         shape = {k: c.axes[axis].temperature.shape_dps(GRID) for k, c in cal.items()}
@@ -152,7 +152,7 @@ def test_clamps_outside_range_and_warns_once():
     t = np.arange(0, 600.0)
     temp = np.linspace(10, 40, t.size)
     rec = Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
-    cal = fit_calibration([rec], temperature=1)
+    cal = fit_calibration([rec], temperature=1, hysteresis="none")  # a fixed fit holds its edge
     hot = Recording(time_s=t, gyro_dps=np.zeros(t.size), gyro_axes=("gyro_z",), temperature_degc=temp + 30)
     with pytest.warns(TemperatureRangeWarning, match=r"outside the model's range 10.00..40.00 degC") as record:
         out = apply(cal, hot)
