@@ -30,7 +30,7 @@ from .metrics import smoothed_residual_rms
 from .models.base import provenance
 from .models.hysteresis import turn_threshold_degc
 from .models.pipelines import fit_calibration
-from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
+from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, FoldDrift, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
 from .models.temperature import PolynomialBias
 from .recording import Recording
 from .comparison import fit_ardupilot_style, fit_px4_style
@@ -80,21 +80,12 @@ class Fold:
 
 
 @dataclass(frozen=True)
-class MethodScore:
+class MethodScore(FoldDrift):
     """Held-out drift of one method on one axis, per fold and on average [deg/s]."""
 
     method: str
     axis: str
     fold_drift_dps: tuple[float, ...]
-
-    @property
-    def mean_drift_dps(self) -> float:
-        return float(np.mean(self.fold_drift_dps))
-
-    @property
-    def standard_error_dps(self) -> float:
-        f = len(self.fold_drift_dps)
-        return float(np.std(self.fold_drift_dps, ddof=1) / math.sqrt(f)) if f > 1 else math.nan
 
     def to_dict(self) -> dict:
         return {"method": self.method, "axis": self.axis, "mean_drift_dps": self.mean_drift_dps,

@@ -46,7 +46,8 @@ from typing import Literal
 import numpy as np
 
 from ..effects import find_turns, g_squared_products, thermal_lag
-from .base import RunBlocks
+from .base import RunBlocks, bin_width_for, block_means
+from .hysteresis import turn_threshold_degc
 from .temperature import polynomial_columns
 
 Weighting = Literal["time", "temperature-balanced"]
@@ -107,13 +108,10 @@ class Candidate:
                 "weighting": self.weighting, "label": self.label}
 
 
-@dataclass(frozen=True)
-class CandidateScore:
-    """Held-out drift of one candidate on every fold [deg/s], and what each fold's fit chose for the lag [s]."""
+class FoldDrift:
+    """Mean and standard error of a ``fold_drift_dps`` tuple (held-out drift per fold [deg/s])."""
 
-    candidate: Candidate
     fold_drift_dps: tuple[float, ...]
-    fold_lag_s: tuple[float, ...]
 
     @property
     def mean_drift_dps(self) -> float:
@@ -121,9 +119,18 @@ class CandidateScore:
 
     @property
     def standard_error_dps(self) -> float:
-        """Standard error of the mean over folds [deg/s]."""
+        """Standard error of the mean over folds [deg/s] (NaN with one fold)."""
         f = len(self.fold_drift_dps)
         return float(np.std(self.fold_drift_dps, ddof=1) / math.sqrt(f)) if f > 1 else math.nan
+
+
+@dataclass(frozen=True)
+class CandidateScore(FoldDrift):
+    """Held-out drift of one candidate on every fold [deg/s], and what each fold's fit chose for the lag [s]."""
+
+    candidate: Candidate
+    fold_drift_dps: tuple[float, ...]
+    fold_lag_s: tuple[float, ...]
 
     def to_dict(self) -> dict:
         return {**self.candidate.to_dict(), "mean_drift_dps": self.mean_drift_dps,
@@ -595,9 +602,6 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     accel_cols, square_cols : tuple of int
         g-sensitivity columns fitted with every candidate.
     """
-    from .base import bin_width_for, block_means
-    from .hysteresis import turn_threshold_degc
-
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
     hi = max(float(t.max()) for t in temps)
