@@ -352,6 +352,11 @@ def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -
     _print_g_sensitivity(console, report)
 
 
+def _score(value: float | None, spec: str = ".4g") -> str:
+    """A held-out score for a table cell; '-' where the folds held too little data to compute it."""
+    return "-" if value is None else format(value, spec)
+
+
 def _print_selection(console, selection: dict, unit: str) -> None:
     """The model choice: per axis the chosen and best candidates against the run constant alone, then the fold
     scores of those three (every candidate's are in the model file)."""
@@ -363,8 +368,9 @@ def _print_selection(console, selection: dict, unit: str) -> None:
     for axis, sel in selection.items():
         scores = {c["label"]: c for c in sel["candidates"]}
         chosen, best = scores[sel["chosen"]["label"]], scores[sel["best"]["label"]]
-        table.add_row(axis, chosen["label"], f"{chosen['mean_drift_dps']:.4g} +- {chosen['standard_error_dps']:.2g}",
-                      best["label"], f"{best['mean_drift_dps']:.4g}", f"{sel['raw_drift_dps']:.4g}")
+        table.add_row(axis, chosen["label"],
+                      f"{_score(chosen['mean_drift_dps'])} +- {_score(chosen['standard_error_dps'], '.2g')}",
+                      best["label"], _score(best["mean_drift_dps"]), _score(sel["raw_drift_dps"]))
     console.print(table)
     folds = Table(title=f"held-out drift per fold [{unit}]")
     folds.add_column("axis")
@@ -375,7 +381,7 @@ def _print_selection(console, selection: dict, unit: str) -> None:
         scores = {c["label"]: c for c in sel["candidates"]}
         shown = dict.fromkeys([sel["chosen"]["label"], sel["best"]["label"], "constant (time)"])
         for label in shown:
-            folds.add_row(axis, label, *[f"{v:.4g}" for v in scores[label]["fold_drift_dps"]])
+            folds.add_row(axis, label, *[_score(v) for v in scores[label]["fold_drift_dps"]])
     console.print(folds)
 
 

@@ -1,15 +1,18 @@
 """Model choice by held-out drift (gyrocomp.models.selection): the rule, the folds, the quantization detector,
 the tangent extension past the fitted range, and simulate-then-recover on single chamber cycles."""
 
+import json
 import warnings
 
 import numpy as np
 import pytest
 
 from gyrocomp import apply, fit_calibration
+from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.selection import Candidate, CandidateScore, choose, leg_labels, temperature_step_degc
 from gyrocomp.models.temperature import PolynomialBias
+from gyrocomp.recording import Recording
 from gyrocomp.simulate import get_profile, simulate
 from gyrocomp.validation import fit_plain_cubic, make_sample_folds
 
@@ -72,6 +75,32 @@ def test_folds_runs_legs_and_blocks():
     assert kind == "blocks" and len(folds) == 4
     kind, folds = make_sample_folds([ramp, ramp, ramp])
     assert kind == "runs" and [f.name for f in folds] == ["run 1", "run 2", "run 3"]
+
+
+def _ramp(n, rate_hz=10.0):
+    t = np.arange(n) / rate_hz
+    temp = np.linspace(10, 40, n)
+    return Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
+
+
+def test_an_order_asked_for_is_fitted_even_where_the_constant_scores_as_well():
+    # a 60-s ramp: every held-out block is shorter than the smallest window, and the noise-free line scores 0
+    cal = fit_calibration([_ramp(600)], temperature=1)
+    assert cal.axes["gyro_z"].temperature.order == 1
+    assert cal.fit_report["selection"]["gyro_z"]["chosen"]["order"] == 1
+
+
+def test_too_little_data_to_hold_out_warns_and_writes_no_nan():
+    with pytest.warns(ModelChoiceWarning, match="gyro_z: too little data to hold out time blocks; poly:1 "):
+        cal = fit_calibration([_ramp(3)], temperature=1)
+    sel = cal.fit_report["selection"]["gyro_z"]
+    assert sel["validated"] is False and sel["raw_drift_dps"] is None
+    json.dumps(cal.fit_report, allow_nan=False)  # a model file a strict reader accepts
+
+
+def test_turning_point_asked_for_on_a_monotone_run_is_refused():
+    with pytest.raises(InputError, match="hysteresis='turning-point': the temperature of gyro_z never reverses"):
+        fit_calibration([_ramp(6000)], hysteresis="turning-point")
 
 
 def test_tangent_extension_past_the_range():

@@ -91,7 +91,8 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     square_cols: tuple[int, ...] = ()
     for k, axis in enumerate(recordings[0].gyro_axes):
         problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
-                               fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders)
+                               fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders,
+                               both_directions="none" in memories)
         if acceleration != "none":
             if any(r.accel_g is None for r in problem.runs):
                 raise InputError("--acceleration: the runs need accel_x, accel_y and accel_z columns for a "
@@ -108,7 +109,10 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
 def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
     for axis, sel in selections.items():
         across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[sel.fold_kind]
-        if not sel.generalizes:
+        if not sel.validated:
+            warnings.warn(f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without "
+                          "validation", ModelChoiceWarning, stacklevel=3)
+        elif not sel.generalizes:
             warnings.warn(f"{axis}: no temperature model generalizes across {across}; left uncompensated "
                           "(run constant only)", ModelChoiceWarning, stacklevel=3)
         elif sel.chosen_drift_dps > sel.raw_drift_dps:
@@ -129,7 +133,8 @@ def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHyst
             same = s.candidate.order == c.order and s.candidate.weighting == c.weighting
             if same or (s.candidate.order == 0 and c.order == 0):
                 m = s.candidate.memory
-                by_memory[m] = min(by_memory.get(m, float("inf")), s.mean_drift_dps)
+                if math.isfinite(s.mean_drift_dps):
+                    by_memory[m] = min(by_memory.get(m, s.mean_drift_dps), s.mean_drift_dps)
         axes[axis] = {"chosen": c.memory + (f" (order {c.hysteresis_order})" if c.hysteresis_order else ""),
                       "lag_time_constant_s": thermal.lag_time_constants_s_[axis], "order": c.order,
                       "weighting": c.weighting, "scores_dps": by_memory}

@@ -45,6 +45,7 @@ from typing import Literal
 
 import numpy as np
 
+from ..errors import InputError
 from ..effects import find_turns, g_squared_products, thermal_lag
 from .base import RunBlocks, bin_width_for, block_means
 from .hysteresis import turn_threshold_degc
@@ -108,6 +109,11 @@ class Candidate:
                 "weighting": self.weighting, "label": self.label}
 
 
+def _json_number(value: float) -> float | None:
+    """A score for a JSON file: None where it could not be computed (too little held-out data)."""
+    return float(value) if math.isfinite(value) else None
+
+
 class FoldDrift:
     """Mean and standard error of a ``fold_drift_dps`` tuple (held-out drift per fold [deg/s])."""
 
@@ -133,9 +139,9 @@ class CandidateScore(FoldDrift):
     fold_lag_s: tuple[float, ...]
 
     def to_dict(self) -> dict:
-        return {**self.candidate.to_dict(), "mean_drift_dps": self.mean_drift_dps,
-                "standard_error_dps": self.standard_error_dps, "fold_drift_dps": list(self.fold_drift_dps),
-                "fold_lag_s": list(self.fold_lag_s)}
+        return {**self.candidate.to_dict(), "mean_drift_dps": _json_number(self.mean_drift_dps),
+                "standard_error_dps": _json_number(self.standard_error_dps),
+                "fold_drift_dps": [_json_number(v) for v in self.fold_drift_dps], "fold_lag_s": list(self.fold_lag_s)}
 
 
 @dataclass(frozen=True)
@@ -194,6 +200,11 @@ class AxisSelection:
         return self.score_of(self.chosen).mean_drift_dps
 
     @property
+    def validated(self) -> bool:
+        """Whether the folds held enough data to score the run constant alone."""
+        return bool(np.isfinite(self.raw_drift_dps))
+
+    @property
     def generalizes(self) -> bool:
         """Whether some temperature model beat the run constant alone on held-out data."""
         return self.chosen.has_temperature_model
@@ -201,8 +212,9 @@ class AxisSelection:
     def to_dict(self) -> dict:
         return {"axis": self.axis, "fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
                 "temperature_step_degc": self.temperature_step_degc, "best": self.best.to_dict(),
-                "chosen": self.chosen.to_dict(), "raw_drift_dps": self.raw_drift_dps,
-                "chosen_drift_dps": self.chosen_drift_dps, "generalizes": self.generalizes,
+                "chosen": self.chosen.to_dict(), "raw_drift_dps": _json_number(self.raw_drift_dps),
+                "chosen_drift_dps": _json_number(self.chosen_drift_dps), "validated": self.validated,
+                "generalizes": self.generalizes,
                 "candidates": [s.to_dict() for s in self.scores]}
 
 
@@ -478,6 +490,8 @@ class SelectionProblem:
         return coef, float(matrix[-1, -1] - b @ coef)
 
     def _held_out(self, f: int, c: Candidate, tau_s: float, coef: np.ndarray, lo: float, hi: float) -> float:
+        if not (math.isfinite(lo) and math.isfinite(hi) and np.all(np.isfinite(coef))):
+            return math.nan  # nothing left to train on without this fold
         sse = wsum = 0.0
         window = max(1, int(round(self.window_s / self.block_s)))
         idx = self.column_index(c)
@@ -544,6 +558,9 @@ def choose(scores: list[CandidateScore], complexity) -> tuple[Candidate, Candida
     error of the best's (the standard error of the best candidate's mean over folds); ties in complexity go to
     the lower score."""
     finite = [s for s in scores if np.all(np.isfinite(s.fold_drift_dps))]
+    if not finite:  # too little data to hold anything out: the simplest candidate, unvalidated
+        simplest = min(scores, key=lambda s: complexity(s.candidate)).candidate
+        return simplest, simplest
     best = min(finite, key=lambda s: s.mean_drift_dps)
     se = best.standard_error_dps if len(best.fold_drift_dps) > 1 else 0.0
     accepted = [s for s in finite if s.mean_drift_dps <= best.mean_drift_dps + se]
@@ -555,10 +572,14 @@ def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], m
                 weightings: tuple[Weighting, ...] = WEIGHTINGS) -> AxisSelection:
     """Score every candidate of one axis and choose (see the module doc)."""
     cands = problem.candidates(orders, memories, weightings)
-    if Candidate(0) not in cands:
+    if not cands:
+        raise InputError(f"hysteresis={'/'.join(memories)!r}: the temperature of {axis} never reverses in these "
+                         "runs, so there is no branch to fit; use hysteresis='none' or 'lag'")
+    eligible = set(cands)
+    if Candidate(0) not in cands:  # the reference every score is read against; chosen only when asked for
         cands.insert(0, Candidate(0))
     scores = [problem.score(c) for c in cands]
-    best, chosen = choose(scores, problem.complexity)
+    best, chosen = choose([s for s in scores if s.candidate in eligible], problem.complexity)
     return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
                          problem.temperature_step_degc, tuple(scores), best, chosen)
 
@@ -570,7 +591,8 @@ def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
     for f in range(folds.count):
         n = sum(int(np.count_nonzero(fold == f)) for fold in folds.of_block)
         lengths.append(n * block_s)
-    return float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
+    window = float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
+    return max(block_s, min(window, min(lengths) / 4.0))  # short folds: a window that still moves
 
 
 __all__ = ["AxisSelection", "Candidate", "CandidateScore", "Folds", "SelectionProblem", "Weighting", "choose",
@@ -580,7 +602,7 @@ __all__ = ["AxisSelection", "Candidate", "CandidateScore", "Folds", "SelectionPr
 def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,
                  block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
                  max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
-                 square_cols: tuple[int, ...] = ()) -> SelectionProblem:
+                 square_cols: tuple[int, ...] = (), both_directions: bool = True) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
     Parameters
@@ -598,9 +620,12 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     fold_kind : {"auto", "runs", "legs", "blocks"}
     max_order : int
     hysteresis_orders : tuple of int
-        Tried only where the runs hold branches after reversals in both directions.
+        Turning-point orders to try.
     accel_cols, square_cols : tuple of int
         g-sensitivity columns fitted with every candidate.
+    both_directions : bool
+        Offer turning-point candidates only where the runs hold branches after reversals in both directions
+        (when hysteresis is being chosen rather than asked for).
     """
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
@@ -619,7 +644,7 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     for r, th in zip(runs, thresholds):
         turns = find_turns(r.temperature_degc, th)
         branches |= set(np.unique(turns.direction[~np.isnan(turns.turn_degc)]).tolist())
-    reverses = {-1, 1} <= branches
+    reverses = {-1, 1} <= branches if both_directions else bool(branches)
     return SelectionProblem(runs, groups, folds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, max(thresholds),
                             block_s, window_for(folds, runs, block_s), max_order,
                             hysteresis_orders if reverses else (), accel_cols, square_cols, step)
