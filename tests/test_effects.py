@@ -143,6 +143,20 @@ def test_hysteresis_offset_on_the_chosen_branches_and_band():
         hysteresis_offset(temp, turns, h, direction="up")
 
 
+def test_hysteresis_offset_is_held_past_the_largest_distance_fitted():
+    temp = _cycle(1)
+    turns = find_turns(temp)
+    h = (0.01, 2e-4)
+    free = hysteresis_offset(temp, turns, h, direction="descending")
+    held = hysteresis_offset(temp, turns, h, direction="descending", max_distance_degc=30.0)
+    falling = turns.direction == -1
+    d = np.abs(temp - np.nan_to_num(turns.turn_degc))
+    near, far = falling & (d <= 30.0), falling & (d > 30.0)
+    assert near.any() and far.any()
+    np.testing.assert_array_equal(held[near], free[near])
+    np.testing.assert_allclose(held[far], 0.01 * 30 + 2e-4 * 30 ** 2, rtol=1e-12)  # the value at d = 30 degC
+
+
 def test_g_sensitivity_is_the_matrix_times_the_force():
     rng = np.random.default_rng(1)
     a = rng.normal(size=(50, 3))

@@ -246,7 +246,8 @@ def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
 
 
 def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_dps: tuple[float, ...] | np.ndarray,
-                      *, direction: str = "descending", band_degc: tuple[float, float] | None = None) -> np.ndarray:
+                      *, direction: str = "descending", band_degc: tuple[float, float] | None = None,
+                      max_distance_degc: float | None = None) -> np.ndarray:
     """Bias offset on the branch after a temperature reversal [deg/s] (thesis section 2.6).
 
         offset = sum_j h_j d^j,   d = |T - T_turn|,   j = 1..p
@@ -267,6 +268,9 @@ def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_d
         Branches that carry the offset.
     band_degc : (lo, hi), optional
         Temperature band [degC] outside which the offset is zero.
+    max_distance_degc : float, optional
+        Largest d the offset follows [degC]; beyond it the offset is held at its value there (a fitted
+        polynomial in d is not extrapolated past the distances it was fitted on).
     """
     if direction not in HYSTERESIS_DIRECTIONS:
         raise InputError(f"hysteresis direction: {direction!r}; use one of {', '.join(HYSTERESIS_DIRECTIONS)}")
@@ -280,6 +284,8 @@ def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_d
         lo, hi = band_degc
         active &= (t >= lo) & (t <= hi)
     d = np.where(active, np.abs(t - np.where(active, turns.turn_degc, 0.0)), 0.0)
+    if max_distance_degc is not None:
+        d = np.minimum(d, max_distance_degc)
     out = np.zeros_like(t)
     for h in reversed(tuple(coefficients_dps)):
         out = (out + h) * d

@@ -34,8 +34,6 @@ def consumer():
     return model, runs, held, cal
 
 
-@pytest.mark.xfail(reason="issue 15, open: the held-out-drift default leaves 1.34x perfect on one axis of this "
-                          "consumer part (was < 1.15x)")
 def test_default_is_within_15_percent_of_perfect_on_every_axis(consumer):
     model, runs, held, cal = consumer
     assert "g-sensitivity" in cal.model

@@ -43,6 +43,9 @@ def test_curve_dict_round_trip_and_errors():
     curve = HysteresisCurve((0.1, -0.01), (0.0, 0.0), 0.5, (55.0, 80.0))
     assert HysteresisCurve.from_dict(json.loads(json.dumps(curve.to_dict()))) == curve
     assert HysteresisCurve.from_dict(HysteresisCurve((0.1,), (0.2,), 0.3).to_dict()).band_degc is None
+    reach = HysteresisCurve((0.1,), (0.2,), 0.3, None, (25.0, 12.5))
+    assert HysteresisCurve.from_dict(json.loads(json.dumps(reach.to_dict()))) == reach
+    assert "max_distance_degc" not in HysteresisCurve((0.1,), (0.2,), 0.3).to_dict()  # earlier files unchanged
     with pytest.raises(InputError, match="unknown hysteresis model type 'spline'"):
         HysteresisCurve.from_dict({"type": "spline"})
 

@@ -99,10 +99,13 @@ def _hysteresis_code(j: int, ax: AxisCalibration) -> list[str]:
     lines = [f"    turn_update(&s->turn[{j}], tm, {_num(h.threshold_degc)});",
              f"    if (s->turn[{j}].has_turn) {{"]
     band = "" if h.band_degc is None else f" && tm >= {_num(h.band_degc[0])} && tm <= {_num(h.band_degc[1])}"
-    for sign, coefs in ((-1, h.descending_dps), (1, h.ascending_dps)):
+    reach = h.max_distance_degc or (None, None)
+    for sign, coefs, d_max in ((-1, h.descending_dps, reach[0]), (1, h.ascending_dps, reach[1])):
         lines.append(f"        if (s->turn[{j}].direction == {sign}{band}) {{")
         lines.append(f"            const double h[] = {_array(coefs)};")
         lines.append(f"            double d = fabs(tm - s->turn[{j}].turn), off = 0.0;")
+        if d_max is not None:
+            lines.append(f"            if (d > {_num(d_max)}) d = {_num(d_max)};")
         lines.append(f"            for (int k = {len(coefs) - 1}; k >= 0; --k) off = (off + h[k]) * d;")
         lines.append("            shape += off;")
         lines.append("        }")

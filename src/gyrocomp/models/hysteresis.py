@@ -55,7 +55,9 @@ class HysteresisCurve:
     """Fitted hysteresis of one axis: offset after a reversal of the model temperature.
 
     offset = sum_j h_j |T - T_turn|^j, h from ``descending_dps`` on cooling branches and
-    ``ascending_dps`` on heating branches [deg/s/degC^j], zero outside ``band_degc`` if given.
+    ``ascending_dps`` on heating branches [deg/s/degC^j], zero outside ``band_degc`` if given. With
+    ``max_distance_degc`` (cooling, heating) the offset is held at its value at the largest distance d the
+    fit saw on each branch (files without it follow the polynomial in d everywhere, as earlier ones did).
     Reversals are confirmed ``threshold_degc`` past the extreme (see :func:`gyrocomp.effects.find_turns`).
     """
 
@@ -63,30 +65,95 @@ class HysteresisCurve:
     ascending_dps: tuple[float, ...]
     threshold_degc: float
     band_degc: tuple[float, float] | None = None
+    max_distance_degc: tuple[float, float] | None = None
 
     @property
     def order(self) -> int:
         return len(self.descending_dps)
 
     def offset_dps(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
+        reach = self.max_distance_degc or (None, None)
         down = hysteresis_offset(temperature_degc, turns, self.descending_dps, direction="descending",
-                                 band_degc=self.band_degc)
+                                 band_degc=self.band_degc, max_distance_degc=reach[0])
         up = hysteresis_offset(temperature_degc, turns, self.ascending_dps, direction="ascending",
-                               band_degc=self.band_degc)
+                               band_degc=self.band_degc, max_distance_degc=reach[1])
         return down + up
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": "turning-point", "descending_dps": list(self.descending_dps),
-                "ascending_dps": list(self.ascending_dps), "threshold_degc": self.threshold_degc,
-                "band_degc": None if self.band_degc is None else list(self.band_degc)}
+        d = {"type": "turning-point", "descending_dps": list(self.descending_dps),
+             "ascending_dps": list(self.ascending_dps), "threshold_degc": self.threshold_degc,
+             "band_degc": None if self.band_degc is None else list(self.band_degc)}
+        if self.max_distance_degc is not None:  # written only when set: earlier readers see an earlier file
+            d["max_distance_degc"] = list(self.max_distance_degc)
+        return d
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "HysteresisCurve":
         if d.get("type") != "turning-point":
             raise InputError(f"unknown hysteresis model type {d.get('type')!r}")
         band = d.get("band_degc")
+        reach = d.get("max_distance_degc")
         return cls(tuple(float(v) for v in d["descending_dps"]), tuple(float(v) for v in d["ascending_dps"]),
-                   float(d["threshold_degc"]), None if band is None else (float(band[0]), float(band[1])))
+                   float(d["threshold_degc"]), None if band is None else (float(band[0]), float(band[1])),
+                   None if reach is None else (float(reach[0]), float(reach[1])))
 
 
-__all__ = ["HysteresisCurve", "heats_and_cools", "turn_threshold_degc"]
+__all__ = ["HysteresisCurve", "heats_and_cools", "parting_band_degc", "turn_threshold_degc"]
+
+
+def parting_band_degc(temperature_degc: np.ndarray, residual_dps: np.ndarray, after_turn: np.ndarray,
+                      direction: np.ndarray) -> tuple[float, float] | None:
+    """The temperature band where the branches after a reversal part from the opposite branches [degC], or None
+    when no band stands out or it spans most of the range.
+
+    Per temperature bin (span / 40, at least 1 degC), the mean residual on branches after a confirmed reversal
+    minus the mean on the opposite-direction branches; bins where that difference exceeds three standard errors
+    and 30 % of its largest value, contiguous around the largest, are the band.
+
+    Parameters
+    ----------
+    temperature_degc : (N,) array
+        Temperature of each sample or block [degC].
+    residual_dps : (N,) array
+        Residual of the temperature model without hysteresis [deg/s].
+    after_turn : (N,) bool array
+        Whether the sample lies on a branch after a confirmed reversal.
+    direction : (N,) int array
+        Direction of travel (-1 cooling, +1 heating, 0 unknown), as :func:`gyrocomp.effects.find_turns` gives.
+    """
+    t, e, after, d = temperature_degc, residual_dps, after_turn, direction
+    if t.size == 0 or not t.max() > t.min():
+        return None
+    width = max(1.0, (t.max() - t.min()) / 40.0)
+    edges = np.arange(t.min(), t.max() + width, width)
+    best = None
+    for sign in (-1, 1):
+        hit = after & (d == sign)
+        ref = d == -sign
+        diff, se = np.full(edges.size - 1, np.nan), np.full(edges.size - 1, np.inf)
+        for b in range(edges.size - 1):
+            inside = (t >= edges[b]) & (t < edges[b + 1])
+            h, r = e[inside & hit], e[inside & ref]
+            if h.size >= 3 and r.size >= 3:
+                diff[b] = h.mean() - r.mean()
+                se[b] = math.sqrt(h.var() / h.size + r.var() / r.size)
+        if np.all(np.isnan(diff)):
+            continue
+        peak = int(np.nanargmax(np.abs(diff)))
+        if best is None or abs(diff[peak]) > best[0]:
+            best = (abs(diff[peak]), diff, se, peak)
+    if best is None:
+        return None
+    top, diff, se, peak = best
+    strong = (np.abs(np.nan_to_num(diff)) > 3 * se) & (np.abs(np.nan_to_num(diff)) > 0.3 * top)
+    if not strong[peak]:
+        return None
+    a = b = peak
+    while a > 0 and strong[a - 1]:
+        a -= 1
+    while b < strong.size - 1 and strong[b + 1]:
+        b += 1
+    covered = np.count_nonzero(~np.isnan(diff))
+    if b - a + 1 >= 0.8 * covered:
+        return None
+    return float(edges[a]), float(edges[b + 1])

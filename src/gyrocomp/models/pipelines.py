@@ -156,6 +156,8 @@ def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, 
                                      hysteresis={a: c.memory for a, c in chosen.items()},
                                      hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
                                      weighting={a: c.weighting for a, c in chosen.items()},
+                                     band_degc={a: selections[a].band_degc if c.band else None
+                                                for a, c in chosen.items()},
                                      bin_width_degc=bin_width_degc, acceleration=accel_mode,
                                      static_min_duration_s=static_min_duration_s).fit(recordings)
     return selections, thermal

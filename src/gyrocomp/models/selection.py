@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import InputError
 from ..effects import find_turns, g_squared_products, thermal_lag
 from .base import RunBlocks, bin_width_for, block_means
-from .hysteresis import turn_threshold_degc
+from .hysteresis import parting_band_degc, turn_threshold_degc
 from .temperature import polynomial_columns
 
 Weighting = Literal["time", "temperature-balanced"]
@@ -64,6 +64,8 @@ WINDOW_MIN_S = 60.0
 WINDOW_MAX_S = 600.0
 #: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run)
 LAG_GRID_POINTS = 16
+#: polynomial order of the residual in which the band where the branches part is looked for (the field's cubic)
+BAND_ORDER = 3
 LAG_MAX_S = 4 * 3600.0
 #: a temperature register whose steps are at least this coarse is treated as quantized [degC]
 COARSE_STEP_DEGC = 0.25
@@ -77,6 +79,7 @@ class Candidate:
     lag: bool = False
     hysteresis_order: int = 0
     weighting: Weighting = "time"
+    band: bool = False  # the turning-point terms act only inside the band found in the data
 
     @property
     def memory(self) -> str:
@@ -87,8 +90,8 @@ class Candidate:
 
     @property
     def complexity(self) -> int:
-        """Number of shape terms: the order, the lag's time constant, two per hysteresis order."""
-        return self.order + int(self.lag) + 2 * self.hysteresis_order
+        """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band."""
+        return self.order + int(self.lag) + 2 * self.hysteresis_order + int(self.band)
 
     @property
     def has_temperature_model(self) -> bool:
@@ -101,12 +104,12 @@ class Candidate:
         if self.lag:
             parts.append("lag")
         if self.hysteresis_order:
-            parts.append(f"turning-point:{self.hysteresis_order}")
+            parts.append(f"turning-point:{self.hysteresis_order}" + (" in band" if self.band else ""))
         return " + ".join(parts) + f" ({self.weighting})"
 
     def to_dict(self) -> dict:
         return {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
-                "weighting": self.weighting, "label": self.label}
+                "weighting": self.weighting, "band": self.band, "label": self.label}
 
 
 def _json_number(value: float) -> float | None:
@@ -176,6 +179,8 @@ class AxisSelection:
         The lowest mean held-out drift.
     chosen : Candidate
         The simplest candidate within one standard error of the best.
+    band_degc : (lo, hi) or None
+        The band where the branches part in the data [degC], tried with the turning-point candidates.
     """
 
     axis: str
@@ -186,6 +191,7 @@ class AxisSelection:
     scores: tuple[CandidateScore, ...]
     best: Candidate
     chosen: Candidate
+    band_degc: tuple[float, float] | None = None
 
     def score_of(self, candidate: Candidate) -> CandidateScore:
         return next(s for s in self.scores if s.candidate == candidate)
@@ -211,7 +217,8 @@ class AxisSelection:
 
     def to_dict(self) -> dict:
         return {"axis": self.axis, "fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
-                "temperature_step_degc": self.temperature_step_degc, "best": self.best.to_dict(),
+                "temperature_step_degc": self.temperature_step_degc,
+                "band_degc": list(self.band_degc) if self.band_degc is not None else None, "best": self.best.to_dict(),
                 "chosen": self.chosen.to_dict(), "raw_drift_dps": _json_number(self.raw_drift_dps),
                 "chosen_drift_dps": _json_number(self.chosen_drift_dps), "validated": self.validated,
                 "generalizes": self.generalizes,
@@ -350,6 +357,9 @@ class SelectionProblem:
         Accelerometer columns (and g x g products) fitted in every candidate (g-sensitivity).
     temperature_step_degc : float
         Step of a quantized temperature register [degC], 0 if none.
+    band_degc : (lo, hi), optional
+        Temperature band where the branches part in the data [degC]: turning-point candidates are also tried
+        with their terms limited to it.
     """
 
     runs: list[RunBlocks]
@@ -365,6 +375,7 @@ class SelectionProblem:
     accel_cols: tuple[int, ...] = ()
     square_cols: tuple[int, ...] = ()
     temperature_step_degc: float = 0.0
+    band_degc: tuple[float, float] | None = None
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -398,6 +409,10 @@ class SelectionProblem:
             powers = d[:, None] ** np.arange(1, h + 1)
             for sign in (-1, 1):
                 cols.append(np.where((active & (turns.direction == sign))[:, None], powers, 0.0))
+            if self.band_degc is not None:  # the same terms, zero outside the band
+                inside = (temp >= self.band_degc[0]) & (temp <= self.band_degc[1])
+                for sign in (-1, 1):
+                    cols.append(np.where((active & inside & (turns.direction == sign))[:, None], powers, 0.0))
         run = self.runs[k]
         if self.accel_cols:
             cols.append(run.accel_g[:, list(self.accel_cols)])
@@ -407,10 +422,12 @@ class SelectionProblem:
 
     def column_index(self, c: Candidate) -> np.ndarray:
         o, h = self.max_order, self.max_hysteresis
+        n_h = 2 * h * (2 if h and self.band_degc is not None else 1)
+        start = o + (2 * h if c.band else 0)
         idx = list(range(c.order))
-        idx += [o + j for j in range(c.hysteresis_order)] + [o + h + j for j in range(c.hysteresis_order)]
+        idx += [start + j for j in range(c.hysteresis_order)] + [start + h + j for j in range(c.hysteresis_order)]
         n_accel = len(self.accel_cols) + len(self.square_cols)
-        idx += [o + 2 * h + j for j in range(n_accel)]
+        idx += [o + n_h + j for j in range(n_accel)]
         return np.asarray(idx, dtype=np.int64)
 
     def weights(self, k: int, weighting: Weighting) -> np.ndarray:
@@ -543,9 +560,10 @@ class SelectionProblem:
                     for h in hs:
                         if (lag or h) and p == 0:
                             continue
-                        c = Candidate(p, lag, h, w)
-                        if c not in out:
-                            out.append(c)
+                        for band in ((False, True) if h and self.band_degc is not None else (False,)):
+                            c = Candidate(p, lag, h, w, band)
+                            if c not in out:
+                                out.append(c)
         return out
 
     def complexity(self, c: Candidate) -> int:
@@ -581,7 +599,7 @@ def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], m
     scores = [problem.score(c) for c in cands]
     best, chosen = choose([s for s in scores if s.candidate in eligible], problem.complexity)
     return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
-                         problem.temperature_step_degc, tuple(scores), best, chosen)
+                         problem.temperature_step_degc, tuple(scores), best, chosen, problem.band_degc)
 
 
 def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
@@ -624,8 +642,9 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     accel_cols, square_cols : tuple of int
         g-sensitivity columns fitted with every candidate.
     both_directions : bool
-        Offer turning-point candidates only where the runs hold branches after reversals in both directions
-        (when hysteresis is being chosen rather than asked for).
+        Offer turning-point candidates only where the branches after reversals can be told apart from the
+        polynomial (:func:`branches_identified`; when hysteresis is being chosen rather than asked for), else
+        wherever a branch exists.
     """
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
@@ -638,13 +657,81 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     groups = tuple(range(len(recordings))) if groups is None else tuple(int(g) for g in groups)
     folds = make_folds(runs, groups, thresholds, fold_kind)
     step = max(temperature_step_degc(t) for t in temps)
-    # turning-point hysteresis needs a branch after a reversal in each direction: fitted on one side only it
-    # imitates curvature of the shape and fails on the other branch
-    branches = set()
-    for r, th in zip(runs, thresholds):
-        turns = find_turns(r.temperature_degc, th)
-        branches |= set(np.unique(turns.direction[~np.isnan(turns.turn_degc)]).tolist())
-    reverses = {-1, 1} <= branches if both_directions else bool(branches)
+    reverses = (branches_identified(runs, thresholds, one_sided=folds.kind == "runs") if both_directions
+                else branches_present(runs, thresholds))
+    # the band is found once on all the runs, so its candidates' scores are optimistic; they are offered only
+    # where whole runs are held out (with leg or block folds, a lower "best" moved the one-SE rule's choice to
+    # more terms on the CATS recording)
+    band = observed_band(runs, groups, thresholds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0,
+                         min(BAND_ORDER, max_order)) if reverses and hysteresis_orders and folds.kind == "runs" else None
     return SelectionProblem(runs, groups, folds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, max(thresholds),
                             block_s, window_for(folds, runs, block_s), max_order,
-                            hysteresis_orders if reverses else (), accel_cols, square_cols, step)
+                            hysteresis_orders if reverses else (), accel_cols, square_cols, step, band)
+
+
+#: the least share of a branch after a reversal (time-weighted) that must lie at temperatures the opposite
+#: direction of travel also visited, for its turning-point terms to be told apart from the polynomial
+BRANCH_OVERLAP = 0.75
+
+
+def branches_present(runs: list[RunBlocks], thresholds: list[float]) -> bool:
+    """Whether any run holds a branch after a confirmed reversal."""
+    return any(np.any(~np.isnan(find_turns(r.temperature_degc, th).turn_degc)) for r, th in zip(runs, thresholds))
+
+
+def branches_identified(runs: list[RunBlocks], thresholds: list[float], one_sided: bool = True) -> bool:
+    """Whether turning-point terms can be told apart from the polynomial: some branch after a reversal exists,
+    and for each direction that does, at least :data:`BRANCH_OVERLAP` of it (time-weighted) lies inside the
+    temperature range the opposite direction of travel covers. A branch that goes where the other direction
+    never went (a run cooled, then heated past its start) would fit curvature of the shape as hysteresis and
+    fail on the next leg.
+
+    ``one_sided=False`` also asks for branches after reversals in both directions. Use it when whole runs
+    cannot be held out: branches of one direction only (every run cooled then warmed) differ from the rest by
+    a change of slope that legs of the same runs confirm but other runs need not share (measured on the CATS
+    recording: fitted on two runs, a one-sided term passed the leg folds and doubled the third run's drift)."""
+    temps, after, direction, samples = [], [], [], []
+    for r, th in zip(runs, thresholds):
+        turns = find_turns(r.temperature_degc, th)
+        temps.append(r.temperature_degc)
+        after.append(~np.isnan(turns.turn_degc))
+        direction.append(turns.direction)
+        samples.append(r.samples.astype(float))
+    t, a, d, n = map(np.concatenate, (temps, after, direction, samples))
+    present = [sign for sign in (-1, 1) if np.any(a & (d == sign))]
+    if not one_sided and len(present) < 2:
+        return False
+    for sign in present:
+        ref = t[d == -sign]
+        if ref.size == 0:
+            return False
+        branch = a & (d == sign)
+        inside = branch & (t >= ref.min()) & (t <= ref.max())
+        if n[inside].sum() < BRANCH_OVERLAP * n[branch].sum():
+            return False
+    return bool(present)
+
+
+def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], t_ref_degc: float,
+                  t_scale_degc: float, order: int) -> tuple[float, float] | None:
+    """The band where the branches after a reversal part [degC] (:func:`parting_band_degc`), in the residual of
+    a polynomial of ``order`` with one constant per run, fitted by time-weighted least squares on the blocks."""
+    group_ids = sorted(set(groups))
+    rows, ys, ws = [], [], []
+    for r, g in zip(runs, groups):
+        u = (r.temperature_degc - t_ref_degc) / t_scale_degc
+        onehot = np.zeros((u.size, len(group_ids)))
+        onehot[:, group_ids.index(g)] = 1.0
+        rows.append(np.hstack([onehot, u[:, None] ** np.arange(1, order + 1)]))
+        ys.append(r.value_dps)
+        ws.append(np.sqrt(r.samples.astype(float)))
+    x, y, w = np.vstack(rows), np.concatenate(ys), np.concatenate(ws)
+    coef, *_ = np.linalg.lstsq(x * w[:, None], y * w, rcond=None)
+    resid = y - x @ coef
+    after, direction = [], []
+    for r, th in zip(runs, thresholds):
+        turns = find_turns(r.temperature_degc, th)
+        after.append(~np.isnan(turns.turn_degc))
+        direction.append(turns.direction)
+    temps = np.concatenate([r.temperature_degc for r in runs])
+    return parting_band_degc(temps, resid, np.concatenate(after), np.concatenate(direction))

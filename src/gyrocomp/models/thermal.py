@@ -36,7 +36,7 @@ from ..recording import Recording
 from ..static import static_segments
 from .acceleration import ACCELERATION_CHOICES, excited_columns
 from .base import RunBlocks, bin_width_for, block_means
-from .hysteresis import HysteresisCurve, turn_threshold_degc
+from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
@@ -103,6 +103,23 @@ class _Problem:
             cols += [products[:, m] for m in self.square_cols]
         return np.column_stack(cols) if cols else np.zeros((temp.size, 0))
 
+    def branch_reach(self, spec: _Spec, tau: float) -> tuple[float, float]:
+        """The largest |T - T_turn| on the cooling and on the heating branches after a reversal (inside the
+        band, if any) over every run [degC]: how far each branch's polynomial in d was fitted."""
+        reach = [0.0, 0.0]
+        for run in self.runs:
+            temp = self.model_temperature(run, spec, tau)
+            turns = find_turns(temp, self.threshold)
+            active = ~np.isnan(turns.turn_degc)
+            if self.band is not None:
+                active &= (temp >= self.band[0]) & (temp <= self.band[1])
+            d = np.abs(temp - np.where(active, turns.turn_degc, temp))
+            for i, sign in enumerate((-1, 1)):
+                on = active & (turns.direction == sign)
+                if np.any(on):
+                    reach[i] = max(reach[i], float(d[on].max()))
+        return reach[0], reach[1]
+
     def design(self, spec: _Spec, tau: float, which: list[int]):
         """The weighted least-squares problem on the runs ``which``: design matrix (one constant column per
         run, then the features), values, weights, and the model-temperature range of those runs."""
@@ -165,9 +182,7 @@ class _Problem:
         """The temperature band where the branches after a reversal part from the others, from the residual
         of the polynomial alone; None when no band stands out or it spans most of the range.
 
-        Per temperature bin (span / 40, at least 1 degC), the mean residual on branches after a confirmed
-        reversal minus the mean on the opposite-direction branches; bins where that difference exceeds
-        three standard errors and 30 % of its largest value, contiguous around the largest, are the band.
+        See :func:`gyrocomp.models.hysteresis.parting_band_degc`.
         """
         spec = _Spec(order, False, 0)
         which = list(range(len(self.runs)))
@@ -181,40 +196,7 @@ class _Problem:
             resid.append(e)
             after.append(~np.isnan(turns.turn_degc))
             rising.append(turns.direction)
-        t, e, after, d = map(np.concatenate, (temps, resid, after, rising))
-        width = max(1.0, (t.max() - t.min()) / 40.0)
-        edges = np.arange(t.min(), t.max() + width, width)
-        best = None
-        for direction in (-1, 1):
-            hit = after & (d == direction)
-            ref = d == -direction
-            diff, se = np.full(edges.size - 1, np.nan), np.full(edges.size - 1, np.inf)
-            for b in range(edges.size - 1):
-                inside = (t >= edges[b]) & (t < edges[b + 1])
-                h, r = e[inside & hit], e[inside & ref]
-                if h.size >= 3 and r.size >= 3:
-                    diff[b] = h.mean() - r.mean()
-                    se[b] = math.sqrt(h.var() / h.size + r.var() / r.size)
-            if np.all(np.isnan(diff)):
-                continue
-            peak = int(np.nanargmax(np.abs(diff)))
-            if best is None or abs(diff[peak]) > best[0]:
-                best = (abs(diff[peak]), diff, se, peak)
-        if best is None:
-            return None
-        top, diff, se, peak = best
-        strong = (np.abs(np.nan_to_num(diff)) > 3 * se) & (np.abs(np.nan_to_num(diff)) > 0.3 * top)
-        if not strong[peak]:
-            return None
-        a = b = peak
-        while a > 0 and strong[a - 1]:
-            a -= 1
-        while b < strong.size - 1 and strong[b + 1]:
-            b += 1
-        covered = np.count_nonzero(~np.isnan(diff))
-        if b - a + 1 >= 0.8 * covered:
-            return None
-        return float(edges[a]), float(edges[b + 1])
+        return parting_band_degc(*map(np.concatenate, (temps, resid, after, rising)))
 
     def covariance(self, spec: _Spec, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """Coefficients (run constants first) and their cluster-robust covariance: the sandwich estimator
@@ -302,7 +284,7 @@ class ThermalHysteresisModel:
     order: int | dict[str, int]
     hysteresis: str = "auto"
     hysteresis_order: int | str = "auto"
-    band_degc: tuple[float, float] | None = None
+    band_degc: tuple[float, float] | None | dict[str, tuple[float, float] | None] = None
     block_s: float = DEFAULT_BLOCK_S
     bin_width_degc: float | None = None
     reselect_order: bool = False
@@ -341,8 +323,9 @@ class ThermalHysteresisModel:
         for w in (self.weighting.values() if isinstance(self.weighting, dict) else [self.weighting]):
             if w not in ("time", "temperature-balanced"):
                 raise InputError(f"weighting: {w!r}; use 'time' or 'temperature-balanced'")
-        if self.band_degc is not None and not self.band_degc[0] < self.band_degc[1]:
-            raise InputError(f"--hysteresis-band: {self.band_degc}; give LOW,HIGH with LOW < HIGH [degC]")
+        for band in (self.band_degc.values() if isinstance(self.band_degc, dict) else [self.band_degc]):
+            if band is not None and not band[0] < band[1]:
+                raise InputError(f"band_degc: {band}; give (low, high) with low < high [degC]")
         if not self.block_s > 0:
             raise InputError(f"block_s: must be positive, got {self.block_s}")
         if self.acceleration not in ACCELERATION_CHOICES:
@@ -368,13 +351,13 @@ class ThermalHysteresisModel:
                 runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
             threshold = max(turn_threshold_degc(t) for t in temps)
             accel_cols, square_cols = self._accel_columns(runs, axis == axes[0])
-            problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, self.band_degc,
+            band = self._of(self.band_degc, axis)
+            problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, band,
                                block_s, accel_cols, square_cols)
             scores: dict[str, float] = {}
             best_spec: dict[str, _Spec] = {}
             order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
             score = problem.held_out_error if n_runs >= 2 else problem.bic
-            band = self.band_degc
             found = None
             if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates(axis)):
                 found = problem.observed_band(order)
@@ -428,7 +411,8 @@ class ThermalHysteresisModel:
             p = spec.hysteresis_order
             self.hysteresis_[axis] = None if not p else HysteresisCurve(
                 tuple(float(v) for v in coef[spec.order: spec.order + p]),
-                tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), threshold, problem.band)
+                tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), threshold, problem.band,
+                problem.branch_reach(spec, tau))
             self.turn_on_biases_dps_[axis] = consts
             self.chosen_[axis] = chosen if not p else f"{chosen} (order {p})"
             self.scores_[axis] = scores
