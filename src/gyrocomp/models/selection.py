@@ -45,8 +45,9 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import InputError
 from ..effects import find_turns, g_squared_products, thermal_lag
+from ..errors import InputError
+from ..metrics import moving_average
 from .base import RunBlocks, bin_width_for, block_means
 from .hysteresis import parting_band_degc, turn_threshold_degc
 from .temperature import polynomial_columns
@@ -315,18 +316,12 @@ def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: 
     return Folds("blocks", tuple(of_block), tuple(names))
 
 
-def moving_average_valid(x: np.ndarray, window: int) -> np.ndarray:
-    """Moving average over ``window`` consecutive values, only where the window is full (cumulative sums)."""
-    window = max(1, min(window, x.size))
-    c = np.concatenate([[0.0], np.cumsum(x)])
-    return (c[window:] - c[:-window]) / window
-
-
 def drift_rms(residual: np.ndarray, weight: np.ndarray, window: int) -> tuple[float, float]:
     """(weighted sum of squares, sum of weights) of the moving average of ``residual`` about its weighted mean."""
     e = residual - np.sum(weight * residual) / np.sum(weight)
-    smooth = moving_average_valid(e, window)
-    w = moving_average_valid(weight, window)
+    window = max(1, min(window, e.size))  # a fold shorter than the window: one mean over all of it
+    smooth = moving_average(e, window)
+    w = moving_average(weight, window)
     smooth = smooth - np.sum(w * smooth) / np.sum(w)
     return float(np.sum(w * smooth ** 2)), float(np.sum(w))
 
