@@ -407,7 +407,7 @@ def test_memory_mapped_input_and_phase(tmp_path):
 @pytest.mark.parametrize("kind", ["oadev", "adev", "mdev", "hdev", "ohdev"])
 def test_pooled_stretches_sum_the_terms_of_each(kind):
     rng = np.random.default_rng(9)
-    pieces = [rng.standard_normal(n).cumsum() * 0.01 + rng.standard_normal(n) for n in (400, 250, 90)]
+    pieces = [rng.standard_normal(n).cumsum() * 0.01 + rng.standard_normal(n) for n in (260, 160, 60)]
     res = allan_deviation_segments(pieces, 2.0, kind=kind, taus="all")
     for tau, dev, n in zip(res.tau, res.deviation, res.n):
         m = int(round(tau * 2.0))

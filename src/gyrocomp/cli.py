@@ -822,17 +822,20 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id):
               help="Estimate each run's turn-on bias from its first S seconds [s].")
 @click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
               help="Shortest still stretch drawn as a static position [s].")
+@click.option("--validate-on", "validate_on", multiple=True, type=click.Path(),
+              help="A calibration run to validate on (repeat it for each run): adds the table of gyrocomp validate.")
 @read_options
 @click.pass_context
-def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_duration_s, **kwargs):
+def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_duration_s, validate_on, **kwargs):
     """One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias against
-    temperature, raw and compensated series, Allan deviations, g-sensitivity."""
+    temperature, raw and compensated series, Allan deviations, g-sensitivity; with --validate-on, the held-out
+    drift of each method on those calibration runs."""
     from .report.html import build_report
 
     from .report.figures import require_matplotlib
 
     opts = _pop_read_options(kwargs)
-    refuse_to_overwrite_inputs(output, [model, *runs])
+    refuse_to_overwrite_inputs(output, [model, *runs, *validate_on])
     if not str(output).lower().endswith((".html", ".htm")):
         raise click.BadParameter(f"{output}: name the report .html", param_hint="-o")
     if window_s is not None and not window_s > 0:
@@ -840,9 +843,13 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
     require_matplotlib()
     calibration = Calibration.load(model)
     recordings = [_read(path, opts).recording for path in runs]
+    validation = None
+    if validate_on:
+        with progress_bar("validating", indeterminate=True):
+            validation = validate_runs([_read(path, opts).recording for path in validate_on])
     with progress_bar("report") as progress:
         result = build_report(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s,
-                              min_static_s=static_min_duration_s, progress=progress)
+                              min_static_s=static_min_duration_s, progress=progress, validation=validation)
     write_text_atomic(output, result.html)
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output}: {len(result.html) / 1e6:.2f} MB, sections {', '.join(result.sections)}")
@@ -976,6 +983,7 @@ def demo(ctx, out_dir):
     if not ctx.obj["quiet"]:
         console = _console()
         console.print(result.summary)
+        print_validation(result.validation)
         print_evaluation(result.evaluation, title="held-out run, raw vs compensated")
         console.print(f"files in {out_dir}/: " + ", ".join(sorted(p.name for p in Path(out_dir).iterdir())))
 

@@ -1,11 +1,14 @@
 """``gyrocomp demo``: the main job on built-in simulated data, through the same files and functions a user's data takes.
 
 A simulated Xsens MTi-10 (the ``mti10`` preset: temperature drift, thermal lag, hysteresis on
-cooling, g-sensitivity) is cycled cold-hot-cold three times while it is turned through six
-orientations (recording paused while it is turned); a compensation is fitted on those runs
+cooling, g-sensitivity) is cycled cold-hot-cold in three runs while it is turned through six
+orientations (recording paused while it is turned); the candidates are validated on those runs
+(leave one run out, against the autopilots' cubics) and a compensation is fitted on all three
 (polynomial, thermal lag and hysteresis where the data supports them, and the 3x3 g-sensitivity
-matrix, jointly); a fourth run, at other temperatures and twelve other orientations, is compensated
-and scored against its exact truth, effect by effect.
+matrix, jointly). A fourth run, recorded without a pause through three faster cycles with the unit
+tilted to an orientation none of the calibration runs had, is compensated and scored against its
+exact truth: effect by effect, and by the Allan deviation, which temperature drift makes rise at long
+averaging times and which compensation should bring back to the sensor's own noise.
 """
 
 from __future__ import annotations
@@ -22,9 +25,12 @@ from .comparison import AUTOPILOT_METHODS
 from .compensate import apply
 from .errors import DataQualityWarning, MissingDependencyError
 from .io import read_table, write_gyro_back, write_recording, write_text_atomic
+from .allan import allan_deviation_segments
 from .metrics import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
 from .models.pipelines import fit_calibration
-from .simulate import get_profile, simulate, tumble_positions
+from .simulate import get_profile, simulate
+from .units import DEG_PER_S_TO_DEG_PER_H
+from .validation import ValidationResult, validate
 
 PRESET = "mti10"
 CALIBRATION_SEEDS = (1, 2, 3)
@@ -32,6 +38,13 @@ HELDOUT_SEED = 99
 RATE_HZ = 2.0
 #: moving-average window of the effect table [s]
 EFFECT_WINDOW_S = 100.0
+#: the held-out run: three cycles over most of the range, twice as fast as the calibration ramps, the unit
+#: tilted so that gravity reaches every axis (specific force [g])
+HELDOUT_RANGE_DEGC = (-20.0, 85.0)
+HELDOUT_RAMP_DEGC_PER_MIN = 2.0
+HELDOUT_TILT_G = (0.5, -0.5, 0.7071)
+#: averaging times of the printed Allan table [s]
+ALLAN_TABLE_TAUS_S = (1.0, 16.0, 128.0, 512.0, 2048.0)
 
 
 @dataclass(frozen=True)
@@ -42,6 +55,22 @@ class EffectSize:
     effect: str
     size_dps: dict[str, float]
     compensated: str
+
+
+@dataclass(frozen=True)
+class AllanComparison:
+    """Overlapping Allan deviation of one axis of the held-out run [deg/h] at averaging times ``tau_s`` [s]:
+    raw, compensated, and the sensor's own noise alone (what perfect compensation would leave)."""
+
+    tau_s: tuple[float, ...]
+    raw_deg_per_h: tuple[float, ...]
+    compensated_deg_per_h: tuple[float, ...]
+    noise_alone_deg_per_h: tuple[float, ...]
+
+    def to_dict(self) -> dict:
+        return {"tau_s": list(self.tau_s), "raw_deg_per_h": list(self.raw_deg_per_h),
+                "compensated_deg_per_h": list(self.compensated_deg_per_h),
+                "noise_alone_deg_per_h": list(self.noise_alone_deg_per_h)}
 
 
 @dataclass(frozen=True)
@@ -56,6 +85,10 @@ class DemoResult:
     #: deterministic error left in the held-out run (RMS of the moving average) [deg/s] per method and axis:
     #: raw, gyrocomp's model, and the cubics PX4's and ArduPilot's tools fit on the same calibration runs
     deterministic_left_rms_dps: dict[str, dict[str, float]]
+    #: held-out drift of raw, the autopilots' cubics, a plain cubic and the default on the calibration runs
+    validation: ValidationResult
+    #: Allan deviations of the held-out run per axis
+    allan: dict[str, AllanComparison]
     summary: str
     files: list[Path]
     #: why report.html was not written (matplotlib missing), or None when it was
@@ -66,7 +99,8 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     """Simulate calibration cycles, fit on them, compensate a held-out tumbling cycle, and score it.
 
     Writes to ``out_dir``: the calibration runs and the held-out run (CSV), ``model.json``,
-    ``heldout_compensated.csv``, ``metrics.json``, ``effects.json``, ``heldout_truth.json`` and, with
+    ``heldout_compensated.csv``, ``metrics.json``, ``effects.json``, ``validation.json``, ``allan.json``,
+    ``heldout_truth.json`` and, with
     ``report`` and matplotlib installed, ``report.html`` (the model judged on the held-out run).
     """
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -77,10 +111,9 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
         path = out_dir / f"calibration_run_{seed}.csv"
         write_recording(sim.recording, path)
         cal_paths.append(path)
-    # other temperatures, other orientations (+-0.5 g on each axis), 20 minutes at each
-    held = simulate(PRESET, profile=get_profile("combined", set_points_degc=(-10.0, 70.0), position_s=1200.0,
-                                                positions_g=tumble_positions((0.5, -0.5))),
-                    rate_hz=rate_hz, seed=HELDOUT_SEED)
+    held_profile = get_profile("cycle", set_points_degc=HELDOUT_RANGE_DEGC, cycles=3, dwell_s=600.0,
+                               ramp_rate_degc_per_min=HELDOUT_RAMP_DEGC_PER_MIN, positions_g=(HELDOUT_TILT_G,))
+    held = simulate(PRESET, profile=held_profile, rate_hz=rate_hz, seed=HELDOUT_SEED)
     held_path = out_dir / "heldout_run.csv"
     write_recording(held.recording, held_path)
     write_text_atomic(out_dir / "heldout_truth.json", json.dumps(held.truth.to_dict(), indent=2) + "\n")
@@ -89,6 +122,7 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
         warnings.simplefilter("ignore", DataQualityWarning)  # the pauses while turning the unit are the profile's
         cal_runs = [read_table(p).recording for p in cal_paths]
         calibration = fit_calibration(cal_runs)
+        validation = validate(cal_runs)
         autopilots = {name: fit(cal_runs) for name, fit in AUTOPILOT_METHODS.items()}
     calibration.save(out_dir / "model.json")
     with warnings.catch_warnings():
@@ -101,6 +135,9 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     write_gyro_back(held_data, compensated.gyro_dps, out_dir / "heldout_compensated.csv")
     evaluation = Evaluation([run_eval])
     write_text_atomic(out_dir / "metrics.json", json.dumps(evaluation.to_dict(), indent=2) + "\n")
+    write_text_atomic(out_dir / "validation.json", json.dumps(validation.to_dict(), indent=2) + "\n")
+    allan = _allan_table(held, compensated)
+    write_text_atomic(out_dir / "allan.json", json.dumps({a: c.to_dict() for a, c in allan.items()}, indent=2) + "\n")
 
     axes = held.recording.gyro_axes
     w_eff = window_samples(EFFECT_WINDOW_S, rate_hz, held.recording.n_samples)
@@ -115,11 +152,13 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
         "acceleration": "compensated: 3x3 G fitted jointly" if calibration.has_acceleration
         else "not modelled",
     }
+    # the tilt is held all run, so its g-sensitivity is a constant: its size is the mean, not a swing
     effects = [
-        EffectSize(name, {a: float(np.ptp(moving_average(truth.components_dps[key][:, j], w_eff)))
+        EffectSize(name, {a: float(np.ptp(moving_average(truth.components_dps[key][:, j], w_eff)) if swing
+                                   else abs(np.mean(truth.components_dps[key][:, j])))
                           for j, a in enumerate(axes)}, compensated=status[key])
-        for name, key in (("temperature (with thermal lag)", "temperature"), ("hysteresis", "hysteresis"),
-                          ("g-sensitivity", "acceleration"))
+        for name, key, swing in (("temperature (with thermal lag)", "temperature", True),
+                                 ("hysteresis", "hysteresis", True), ("g-sensitivity", "acceleration", False))
     ]
     # what each compensation left: output minus what it should be (true rate + noise) [deg/s]
     lefts = {name: rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
@@ -136,21 +175,31 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
          "residual_peak_to_peak_dps": residual,
          "deterministic_error_left_rms_dps_by_method": methods_rms}, indent=2) + "\n")
     hours = held.recording.duration_s / 3600
+    lo, hi = HELDOUT_RANGE_DEGC
     lines = [
         f"Simulated {len(cal_paths)} cold-hot-cold calibration cycles (-25 -> 90 -> -25 degC at 1 degC/min, "
         f"{rate_hz:g} Hz) of the '{PRESET}' preset (Xsens MTi-10 raw output: temperature drift, 120 s thermal lag, "
         "hysteresis on cooling, g-sensitivity), the unit turned to +-1 g on each axis every 5 minutes, each run "
-        "with its own turn-on bias;",
-        f"fitted {calibration.model} (polynomial order, thermal lag and hysteresis chosen by leave-one-run-out "
-        "error; G jointly on the static segments).",
-        f"Held out: a {hours:.1f} h cycle over -10..70 degC with the unit at 12 other orientations "
-        f"(20 min each, {len(held.recording.gaps)} one-minute pauses while turning; Allan sums pooled over the stretches).",
-        f"Deterministic effects in the held-out run (peak-to-peak of a {EFFECT_WINDOW_S:g} s moving average) [deg/s]:",
+        "with its own turn-on bias.",
+        f"Validated on them (each method fitted without the run it is scored on; the table below), then fitted on "
+        f"all three: {calibration.model}.",
+        f"Held out: {hours:.1f} h without a pause, three cycles over {lo:g}..{hi:g} degC at "
+        f"{HELDOUT_RAMP_DEGC_PER_MIN:g} degC/min (twice the calibration rate), the unit tilted to "
+        f"({', '.join(f'{g:g}' for g in HELDOUT_TILT_G)}) g, an orientation none of the calibration runs had.",
+        f"Deterministic effects in the held-out run (peak-to-peak of a {EFFECT_WINDOW_S:g} s moving average; the "
+        "g-sensitivity at the fixed tilt is a constant: its mean) [deg/s]:",
     ]
     for e in effects:
         lines.append(f"  {e.effect:32s} " + "  ".join(f"{a} {v:.2g}" for a, v in e.size_dps.items())
                      + f"   ({e.compensated})")
     lines.append(f"  {'left after compensation':32s} " + "  ".join(f"{a} {v:.2g}" for a, v in residual.items()))
+    lines.append("Allan deviation of the held-out run [deg/h]: raw / compensated / the sensor's noise alone (what "
+                 "perfect compensation leaves). Temperature drift makes the raw curve rise at long averaging times:")
+    lines.append("  " + " " * 8 + "".join(f"{f'tau {t:g} s':>22s}" for t in allan[axes[0]].tau_s))
+    for axis, c in allan.items():
+        cells = [f"{r:.3g} / {k:.3g} / {n:.3g}" for r, k, n in
+                 zip(c.raw_deg_per_h, c.compensated_deg_per_h, c.noise_alone_deg_per_h)]
+        lines.append(f"  {axis:8s}" + "".join(f"{cell:>22s}" for cell in cells))
     lines.append("Residual drift of the held-out run (RMS of the moving average) against what perfect "
                  "compensation leaves:")
     for axis, m in run_eval.axes.items():
@@ -162,24 +211,38 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
                  "average) [deg/s]:")
     for name, rms in methods_rms.items():
         lines.append(f"  {name:60.60s} " + "  ".join(f"{a} {v:.2g}" for a, v in rms.items()))
-    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html") if report else "not asked for"
+    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html", validation) if report else "not asked for"
     if skipped is None:
         lines.append(f"Report of the model on the held-out run: {out_dir / 'report.html'} (open it in a browser).")
     files = sorted(out_dir.iterdir())
-    return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, "\n".join(lines), files,
-                      skipped)
+    return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, validation, allan,
+                      "\n".join(lines), files, skipped)
 
 
-def _write_report(calibration: Calibration, run, path: Path) -> str | None:
+def _allan_table(held, compensated) -> dict[str, AllanComparison]:
+    """Allan deviations of the held-out run at :data:`ALLAN_TABLE_TAUS_S` (those the run is long enough for)."""
+    rate_hz = held.recording.rate_hz
+    stretches = held.recording.contiguous_stretches()
+    out = {}
+    for j, axis in enumerate(held.recording.gyro_axes):
+        curves = [allan_deviation_segments([x[s] for s in stretches], rate_hz, taus=np.array(ALLAN_TABLE_TAUS_S))
+                  for x in (held.recording.gyro_dps[:, j], compensated.gyro_dps[:, j],
+                            held.truth.noise.total_dps[:, j])]
+        to_dph = [tuple(float(v) * DEG_PER_S_TO_DEG_PER_H for v in c.deviation) for c in curves]
+        out[axis] = AllanComparison(tuple(float(t) for t in curves[0].tau), *to_dph)
+    return out
+
+
+def _write_report(calibration: Calibration, run, path: Path, validation: ValidationResult | None = None) -> str | None:
     """Write the HTML report; return why not (the missing [plot] extra), or None."""
     try:
         from .report.html import build_report
 
-        html = build_report(calibration, [run]).html
+        html = build_report(calibration, [run], validation=validation).html
     except MissingDependencyError as exc:
         return str(exc)
     write_text_atomic(path, html)
     return None
 
 
-__all__ = ["DemoResult", "EffectSize", "run_demo"]
+__all__ = ["AllanComparison", "DemoResult", "EffectSize", "run_demo"]

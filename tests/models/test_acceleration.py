@@ -145,7 +145,7 @@ def test_rank_deficient_positions_warn_and_leave_the_columns_unfitted():
 
 def test_acceleration_needs_accelerometer_columns():
     runs = [simulate(preset_model("adxrs450"), profile="tumble", duration_s=2000, rate_hz=1, seed=0).recording]
-    with pytest.raises(InputError, match="--acceleration: the runs need accel_x, accel_y and accel_z columns"):
+    with pytest.raises(InputError, match="acceleration: the runs need accel_x, accel_y and accel_z columns"):
         fit_calibration(runs, acceleration="matrix")
     cal = fit_calibration(runs)  # auto: no accelerometer, no g-sensitivity
     assert cal.fit_report["acceleration"]["mode"] == "none"

@@ -1,6 +1,7 @@
 """Model choice by held-out drift (gyrocomp.models.selection): the rule, the folds, the quantization detector,
 the tangent extension past the fitted range, and simulate-then-recover on single chamber cycles."""
 
+import dataclasses
 import json
 import warnings
 
@@ -13,7 +14,8 @@ from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.selection import Candidate, CandidateScore, choose, leg_labels, temperature_step_degc
 from gyrocomp.models.temperature import PolynomialBias
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulate import get_profile, preset_model, simulate
+from gyrocomp.simulate.profiles import Profile
 from gyrocomp.validation import fit_plain_cubic, make_sample_folds
 
 
@@ -147,3 +149,38 @@ def test_single_chamber_cycle_fit_to_the_hottest_point_holds_on_the_last_cooling
     raw = smoothed_residual_rms(rec.gyro_dps[leaves:, 0] - truth[:, 0], w)
     assert drift["default"] <= drift["cubic"]
     assert drift["default"] < raw
+
+
+SIX_POSITIONS_G = ((1.0, 0, 0), (-1.0, 0, 0), (0, 1.0, 0), (0, -1.0, 0), (0, 0, 1.0), (0, 0, -1.0))
+
+
+def _consumer_runs(seed):
+    """The issue's consumer-class part (whole-degree register, 20 s lag, ~0.1 deg/s/g): a warm-up, a
+    ramp-and-hold and a heat-cool cycle of 40-60 min, six orientations each, and a held-out cycle with a
+    different range and rate."""
+    model = dataclasses.replace(preset_model("consumer"), thermal_time_constant_s=20.0)
+    kw = dict(positions_g=SIX_POSITIONS_G, position_s=300.0, move_s=10.0)
+    profiles = [Profile("warmup", set_points_degc=(20.0,), warmup_rise_degc=25.0, warmup_time_constant_s=600.0,
+                        duration_s=2400.0, **kw),
+                Profile("chamber", set_points_degc=(10.0, 50.0), ramp_rate_degc_per_min=2.0, dwell_s=600.0, **kw),
+                Profile("cycle", set_points_degc=(10.0, 50.0), ramp_rate_degc_per_min=2.0, dwell_s=300.0, **kw)]
+    held = Profile("cycle", set_points_degc=(15.0, 45.0), ramp_rate_degc_per_min=1.5, dwell_s=200.0, **kw)
+    runs = [simulate(model, profile=p, rate_hz=10.0, seed=10 * seed + k).recording for k, p in enumerate(profiles)]
+    return runs, simulate(model, profile=held, rate_hz=10.0, seed=10 * seed + 9)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_consumer_part_held_out_within_1_3x_of_perfect_compensation(seed):
+    runs, held = _consumer_runs(seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs)
+        comp = apply(cal, held.recording).gyro_dps
+    w = 60 * 10
+    for j, axis in enumerate(held.recording.gyro_axes):
+        # perfect compensation leaves the sensor's own noise; its drift is the yardstick
+        perfect = smoothed_residual_rms(held.truth.noise.total_dps[:, j], w)
+        left = smoothed_residual_rms(comp[:, j] - held.truth.true_rate_dps[:, j], w)
+        assert left <= 1.3 * perfect, axis
+        # one die behind one temperature register: one lag for every axis, near the truth
+        assert cal.axes[axis].lag_time_constant_s == pytest.approx(20.0, rel=0.25)

@@ -148,3 +148,19 @@ def test_the_band_is_found_in_the_data_when_not_given():
     assert 50 < lo < 60 and 72 < hi <= 80.5
     assert ax.lag_time_constant_s == pytest.approx(60.0, rel=0.25)
     assert vs_perfect < 1.35 and cubic_over_chosen > 2.0
+
+
+def test_one_temperature_column_gives_every_lagged_axis_one_time_constant():
+    runs = [simulate("consumer", profile="cycle", duration_s=4000, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        shared = ThermalHysteresisModel(order=2, hysteresis="lag", hysteresis_order=0).fit(runs)
+        own = ThermalHysteresisModel(order=2, hysteresis="lag", hysteresis_order=0, shared_lag=False).fit(runs)
+        # one temperature column per axis: each axis may sit on its own die, so each keeps its own lag
+        per_axis = [dataclasses.replace(r, temperature_degc=np.repeat(r.temperature_degc[:, None], 3, axis=1))
+                    for r in runs]
+        separate = ThermalHysteresisModel(order=2, hysteresis="lag", hysteresis_order=0).fit(per_axis)
+    taus = list(shared.lag_time_constants_s_.values())
+    assert len(set(taus)) == 1 and taus[0] == pytest.approx(30.0, rel=0.25)  # the preset's 30 s
+    assert len(set(own.lag_time_constants_s_.values())) == 3
+    assert separate.lag_time_constants_s_ == own.lag_time_constants_s_

@@ -114,10 +114,15 @@ def cli_files(tmp_path_factory):
 
 def test_cli_report_and_plots(cli_files):
     d = cli_files
-    r = run("report", d / "model.json", d / "run2.csv", "-o", d / "report.html")
+    r = run("report", d / "model.json", d / "run2.csv", "-o", d / "report.html",
+            "--validate-on", d / "run1.csv", "--validate-on", d / "run2.csv")
     assert r.returncode == 0, r.stderr
-    assert "sections summary, evaluation, axis-gyro_x" in r.stdout and "g-sensitivity" in r.stdout
-    _check_page((d / "report.html").read_text(), list(_sections((d / "report.html").read_text())))
+    assert "sections summary, validation, evaluation, axis-gyro_x" in r.stdout and "g-sensitivity" in r.stdout
+    text = (d / "report.html").read_text()
+    _check_page(text, list(_sections(text)))
+    # the table gyrocomp validate prints: every method, the folds it held out (legs of two runs)
+    assert "held-out drift [deg/s]" in text and "PX4 cubic" in text and "gyrocomp default" in text
+    assert "folds: run 1" in text and "(legs)" in text
     for kind, args, out, magic in (
             ("allan", [d / "run2.csv", "--model", d / "model.json", "--split-gaps"], "allan.png", b"\x89PNG"),
             ("temperature", [d / "model.json", d / "run1.csv", d / "run2.csv", "--axis", "gyro_y"], "t.svg", b"<?xml"),

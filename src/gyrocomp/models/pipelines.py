@@ -23,7 +23,7 @@ from .acceleration import (
 from .base import bin_width_for, block_means, provenance
 from .hysteresis import heats_and_cools
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
-from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis
+from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
 from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 
@@ -66,7 +66,8 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
 def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memories: tuple[str, ...],
                   hysteresis_orders: tuple[int, ...] = (1, 2, 3), acceleration: str = "none",
                   static_min_duration_s: float = 10.0, bin_width_degc: float | None = None,
-                  run_folds: tuple[int, ...] | None = None, folds: str = "auto") -> dict[str, AxisSelection]:
+                  run_folds: tuple[int, ...] | None = None, folds: str = "auto",
+                  shared_lag: bool = True) -> dict[str, AxisSelection]:
     """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.models.selection`).
 
     Parameters
@@ -82,28 +83,34 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     run_folds : tuple of int, optional
         The run of each recording (pieces of one run are held out together).
     folds : {"auto", "runs", "legs", "blocks"}
+    shared_lag : bool
+        With one temperature column, score every lag candidate at one lag per fold shared by the axes
+        (:func:`gyrocomp.models.selection.share_fold_lags`).
     """
     if folds not in FOLD_KINDS:
         raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
     _, pieces = static_pieces(recordings, static_min_duration_s)
-    out: dict[str, AxisSelection] = {}
     accel_cols: tuple[int, ...] = ()
     square_cols: tuple[int, ...] = ()
+    problems = {}
     for k, axis in enumerate(recordings[0].gyro_axes):
         problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
                                fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders,
                                both_directions="none" in memories)
         if acceleration != "none":
             if any(r.accel_g is None for r in problem.runs):
-                raise InputError("--acceleration: the runs need accel_x, accel_y and accel_z columns for a "
-                                 "g-sensitivity fit; map them with --columns or fit with --acceleration none")
+                raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a "
+                                 "g-sensitivity fit; map them with columns= or fit with acceleration='none'")
             if k == 0:
                 accel_cols, square_cols, _ = excited_columns([r.accel_g for r in problem.runs],
                                                              [r.weight for r in problem.runs],
                                                              squares=acceleration == "matrix2", warn=False)
             problem.accel_cols, problem.square_cols = accel_cols, square_cols
-        out[axis] = select_axis(axis, problem, orders, memories)
-    return out
+        problems[axis] = problem
+    one_sensor = all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1 for rec in recordings)
+    if shared_lag and one_sensor and any("lag" in m for m in memories):
+        share_fold_lags(list(problems.values()), orders)
+    return {axis: select_axis(axis, problem, orders, memories) for axis, problem in problems.items()}
 
 
 def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:

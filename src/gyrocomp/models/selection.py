@@ -355,6 +355,9 @@ class SelectionProblem:
     band_degc : (lo, hi), optional
         Temperature band where the branches part in the data [degC]: turning-point candidates are also tried
         with their terms limited to it.
+    fold_lags_s : dict
+        Per (order, weighting), each fold's lag [s] shared with the other axes (:func:`share_fold_lags`); a lag
+        candidate not in it picks its own per fold.
     """
 
     runs: list[RunBlocks]
@@ -371,6 +374,7 @@ class SelectionProblem:
     square_cols: tuple[int, ...] = ()
     temperature_step_degc: float = 0.0
     band_degc: tuple[float, float] | None = None
+    fold_lags_s: dict[tuple[int, str], np.ndarray] = field(default_factory=dict)
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -529,9 +533,10 @@ class SelectionProblem:
         idx = self.column_index(c)
         taus = self.lag_grid_s() if c.lag else np.array([0.0])
         drifts, lags = [], []
+        shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag else None
         for f in range(self.folds.count):
             best = None
-            for tau in taus:  # the lag of this fold's fit: least training residual
+            for tau in (taus if shared is None else shared[f:f + 1]):  # the fold's lag: least training residual
                 matrices, lo, hi = self.training_matrices(float(tau), c.weighting)
                 coef, rss = self.solve(matrices[f], idx)
                 if best is None or rss < best[0]:
@@ -540,6 +545,16 @@ class SelectionProblem:
             drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f))
             lags.append(tau)
         return CandidateScore(c, tuple(drifts), tuple(lags))
+
+    def lag_rss(self, order: int, weighting: Weighting, grid_s: np.ndarray) -> np.ndarray:
+        """(folds, lags) training residual sum of squares of ``poly:order + lag`` at each lag of ``grid_s`` [s],
+        each fold's row divided by its minimum (so that axes of different noise weigh the same)."""
+        idx = self.column_index(Candidate(order, True, 0, weighting))
+        out = np.empty((self.folds.count, grid_s.size))
+        for g, tau in enumerate(grid_s):
+            matrices = self.training_matrices(float(tau), weighting)[0]
+            out[:, g] = [self.solve(matrices[f], idx)[1] for f in range(self.folds.count)]
+        return out / np.maximum(out.min(axis=1, keepdims=True), 1e-300)
 
     def candidates(self, orders: tuple[int, ...], memories: tuple[str, ...],
                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> list[Candidate]:
@@ -579,6 +594,24 @@ def choose(scores: list[CandidateScore], complexity) -> tuple[Candidate, Candida
     accepted = [s for s in finite if s.mean_drift_dps <= best.mean_drift_dps + se]
     chosen = min(accepted, key=lambda s: (complexity(s.candidate), s.mean_drift_dps))
     return best.candidate, chosen.candidate
+
+
+def share_fold_lags(problems: list[SelectionProblem], orders: tuple[int, ...],
+                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> None:
+    """Give the axes one lag per fold and per (order, weighting): the lag is the die's, behind one temperature
+    sensor, and the axes together pin it down better than any one of them (as the final fit does, see
+    :class:`gyrocomp.models.thermal.ThermalHysteresisModel`'s ``shared_lag``). Each fold's lag minimizes the
+    sum over axes of their relative training residuals (:meth:`SelectionProblem.lag_rss`). The problems must
+    share their runs' times and folds; nothing is shared otherwise."""
+    if len(problems) < 2 or len({(p.folds.count, p.block_s) for p in problems}) > 1:
+        return
+    grid = problems[0].lag_grid_s()
+    for order in (o for o in orders if o > 0):
+        for weighting in weightings:
+            total = sum(p.lag_rss(order, weighting, grid) for p in problems)
+            taus = grid[np.argmin(total, axis=1)]
+            for p in problems:
+                p.fold_lags_s[(order, weighting)] = taus
 
 
 def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],

@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,6 +50,17 @@ DEFAULT_BLOCK_S = 2.0
 #: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
 #: score measures drift (what compensation is for) rather than white noise, which no model removes
 SCORE_WINDOW_S = 60.0
+
+
+def best_lag_s(rss: Callable[[float], float], lo_s: float, hi_s: float = LAG_MAX_S) -> float:
+    """The time constant [s] that minimizes ``rss(tau)``: a 12-point log-spaced search between ``lo_s`` and
+    ``hi_s`` [s], refined by a bounded scalar minimization in log(tau) around the best grid point."""
+    grid = np.geomspace(lo_s, hi_s, 12)
+    values = [rss(float(tau)) for tau in grid]
+    best = int(np.argmin(values))
+    a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
+    res = minimize_scalar(lambda lt: rss(math.exp(lt)), bounds=(a, b), method="bounded", options={"xatol": 1e-2})
+    return math.exp(res.x) if res.fun <= values[best] else float(grid[best])
 
 
 @dataclass(frozen=True)
@@ -145,19 +157,20 @@ class _Problem:
         rss = float(np.sum(w * (y - x @ coef) ** 2))
         return coef[len(which):], coef[: len(which)], rss, t_range
 
-    def fit(self, spec: _Spec, which: list[int]):
-        """Best tau for the spec (0 without lag) and the solution there."""
+    def fit(self, spec: _Spec, which: list[int], tau_s: float | None = None):
+        """Best tau for the spec (0 without lag; ``tau_s`` when given) and the solution there."""
         if not spec.lag:
             return 0.0, self.solve(spec, 0.0, which)
-        lo, hi = LAG_MIN_BLOCKS * self.block_s, LAG_MAX_S
-        grid = np.geomspace(lo, hi, 12)
-        rss = [self.solve(spec, tau, which)[2] for tau in grid]
-        best = int(np.argmin(rss))
-        a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
-        res = minimize_scalar(lambda lt: self.solve(spec, math.exp(lt), which)[2], bounds=(a, b), method="bounded",
-                              options={"xatol": 1e-2})
-        tau = math.exp(res.x) if res.fun <= rss[best] else float(grid[best])
-        return tau, self.solve(spec, tau, which)
+        if tau_s is None:
+            tau_s = best_lag_s(lambda tau: self.solve(spec, tau, which)[2], LAG_MIN_BLOCKS * self.block_s)
+        return tau_s, self.solve(spec, tau_s, which)
+
+    def lag_profile(self, spec: _Spec) -> Callable[[float], float]:
+        """The all-run residual sum of squares as a function of tau [s], divided by its minimum (1 at the
+        axis's own best tau), so that axes with different noise weigh the same in a shared lag."""
+        which = list(range(len(self.runs)))
+        own = self.fit(spec, which)[1][2]
+        return lambda tau: self.solve(spec, tau, which)[2] / max(own, 1e-300)
 
     def held_out_error(self, spec: _Spec) -> float:
         """RMS [deg/s] of each run predicted by a fit on the others, its constant refitted."""
@@ -227,6 +240,22 @@ class _Problem:
         return n * math.log(max(rss / w, 1e-300)) + k * math.log(n)
 
 
+@dataclass(frozen=True)
+class _AxisChoice:
+    """What one axis's choice settled: its problem (band set), the candidate and every candidate's score."""
+
+    problem: _Problem
+    spec: _Spec
+    name: str
+    scores: dict[str, float]
+
+
+def _simplest(tried: dict[int, float], n_runs: int) -> int:
+    """The smallest key whose score is within the parsimony tolerance of the best (the best with BIC)."""
+    best = min(tried.values())
+    return min(k for k, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
+
+
 @dataclass
 class ThermalHysteresisModel:
     """Polynomial temperature model with thermal lag and/or turning-point hysteresis, chosen by the data.
@@ -255,6 +284,11 @@ class ThermalHysteresisModel:
     acceleration : {"none", "matrix", "matrix2"}
         Fit the g-sensitivity row G (thesis 2.7.1) jointly with the temperature model and the run
         constants (``matrix2`` adds the g x g terms), on the static segments of the runs only.
+    weighting : {"time", "temperature-balanced"} or dict
+        Weights of the block means: every second equal, or every temperature bin of every run equal.
+    shared_lag : bool
+        Axes that read one temperature column and all have lag get one time constant, fitted on all of them
+        together (the lag is the die's, behind one sensor); False fits one per axis.
 
     Attributes (after ``fit``)
     --------------------------
@@ -292,6 +326,7 @@ class ThermalHysteresisModel:
     acceleration: str = "none"
     static_min_duration_s: float = 10.0
     weighting: str | dict[str, str] = "temperature-balanced"
+    shared_lag: bool = True
     _fitted: bool = field(default=False, init=False, repr=False)
 
     @staticmethod
@@ -313,6 +348,25 @@ class ThermalHysteresisModel:
         """Fit on ``recordings`` (each one power-on at rest) and return self."""
         if isinstance(recordings, Recording):
             recordings = [recordings]
+        self._check_settings()
+        self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
+        self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
+        self.bands_ = {}
+        self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
+        self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
+        axes = recordings[0].gyro_axes
+        pieces = self._pieces(recordings)
+        self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
+            "leave-one-run-out" if len(recordings) >= 2 else "bic")
+        choices = {axis: self._choose(axis, recordings, pieces, first=axis == axes[0]) for axis in axes}
+        one_sensor = all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1 for rec in recordings)
+        taus = self._shared_lag(choices) if self.shared_lag and one_sensor else {}
+        for axis, choice in choices.items():
+            self._store(axis, choice, taus.get(axis))
+        self._fitted = True
+        return self
+
+    def _check_settings(self) -> None:
         for mode in (self.hysteresis.values() if isinstance(self.hysteresis, dict) else [self.hysteresis]):
             if mode not in HYSTERESIS_CHOICES:
                 raise InputError(f"hysteresis: {mode!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
@@ -329,97 +383,111 @@ class ThermalHysteresisModel:
         if not self.block_s > 0:
             raise InputError(f"block_s: must be positive, got {self.block_s}")
         if self.acceleration not in ACCELERATION_CHOICES:
-            raise InputError(f"--acceleration: {self.acceleration!r}; use one of {', '.join(ACCELERATION_CHOICES)}")
-        self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
-        self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
-        self.bands_ = {}
-        self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
-        self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
-        axes = recordings[0].gyro_axes
+            raise InputError(f"acceleration: {self.acceleration!r}; use one of {', '.join(ACCELERATION_CHOICES)}")
+
+    def _problem(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _Problem:
+        """The least-squares problem of one axis: block means of every run, weights, hysteresis threshold and
+        the accelerometer columns."""
+        temps = [rec.temperature_for(axis) for rec in recordings]
+        lo = min(float(t.min()) for t in temps)
+        hi = max(float(t.max()) for t in temps)
+        width = bin_width_for(temps, self.bin_width_degc)
+        block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
+        runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
+        if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
+            runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
+        threshold = max(turn_threshold_degc(t) for t in temps)
+        accel_cols, square_cols = self._accel_columns(runs, first)
+        return _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold,
+                        self._of(self.band_degc, axis), block_s, accel_cols, square_cols)
+
+    def _choose(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _AxisChoice:
+        """The candidate of one axis: given, or the best by leave-one-run-out error (BIC with one run)."""
+        problem = self._problem(axis, recordings, pieces, first)
+        band = problem.band
         n_runs = len(recordings)
-        pieces = self._pieces(recordings)
-        self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
-            "leave-one-run-out" if n_runs >= 2 else "bic")
-        for axis in axes:
-            temps = [rec.temperature_for(axis) for rec in recordings]
-            lo = min(float(t.min()) for t in temps)
-            hi = max(float(t.max()) for t in temps)
-            width = bin_width_for(temps, self.bin_width_degc)
-            block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
-            runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
-            if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
-                runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
-            threshold = max(turn_threshold_degc(t) for t in temps)
-            accel_cols, square_cols = self._accel_columns(runs, axis == axes[0])
-            band = self._of(self.band_degc, axis)
-            problem = _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold, band,
-                               block_s, accel_cols, square_cols)
-            scores: dict[str, float] = {}
-            best_spec: dict[str, _Spec] = {}
-            order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
-            score = problem.held_out_error if n_runs >= 2 else problem.bic
-            found = None
-            if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates(axis)):
-                found = problem.observed_band(order)
-            bands: dict[str, tuple[float, float] | None] = {}
-            for name in self._candidates(axis):
-                # candidates compared at hysteresis order 2 (the thesis's); the winner's order is validated after
-                best_spec[name] = self._spec(name, order, axis=axis)
-                scores[name] = math.nan if self.selection_ == "fixed" else score(best_spec[name])
-                bands[name] = band
-                if found is not None and "turning-point" in name:
-                    # the band the data shows, tried against none: the data chooses
-                    problem.band = found
-                    with_band = score(best_spec[name])
-                    problem.band = band
-                    if with_band < scores[name]:
-                        scores[name], bands[name] = with_band, found
-            if len(scores) == 1:
-                chosen = next(iter(scores))
-            else:
-                finite = {k: v for k, v in scores.items() if math.isfinite(v)}
-                if not finite:
-                    raise ModelError(f"{axis}: no hysteresis candidate could be scored")
-                if self.selection_ == "bic":
-                    chosen = min(finite, key=finite.get)
-                else:  # the simplest candidate within the parsimony tolerance of the best
-                    best = min(finite.values())
-                    chosen = next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
-            if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
-                tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
-                         for p in range(1, MAX_HYSTERESIS_ORDER + 1)}
-                best = min(tried.values())
-                pick = min(p for p, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
-                best_spec[chosen] = self._spec(chosen, order, pick, axis)
-                scores[chosen] = tried[pick]
-            problem.band = bands.get(chosen, band)
-            self.bands_[axis] = problem.band
-            spec = best_spec[chosen]
-            if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
-                # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
-                # which a higher order partly imitates; choose it again inside the winning candidate
-                tried = {o: score(_Spec(o, spec.lag, spec.hysteresis_order)) for o in range(1, self.max_order + 1)}
-                best = min(tried.values())
-                pick = min(o for o, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
-                spec = _Spec(pick, spec.lag, spec.hysteresis_order)
-                self.order_scores_[axis] = tried
-            tau, (coef, consts, _, (t_lo, t_hi)) = problem.fit(spec, list(range(n_runs)))
-            shape = coef[: spec.order]
-            self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,
-                                                t_lo, t_hi)
-            self.lag_time_constants_s_[axis] = float(tau)
-            p = spec.hysteresis_order
-            self.hysteresis_[axis] = None if not p else HysteresisCurve(
-                tuple(float(v) for v in coef[spec.order: spec.order + p]),
-                tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), threshold, problem.band,
-                problem.branch_reach(spec, tau))
-            self.turn_on_biases_dps_[axis] = consts
-            self.chosen_[axis] = chosen if not p else f"{chosen} (order {p})"
-            self.scores_[axis] = scores
-            if self.acceleration != "none":
-                self._store_acceleration(axis, problem, spec, tau, coef, n_runs)
-        self._fitted = True
-        return self
+        scores: dict[str, float] = {}
+        best_spec: dict[str, _Spec] = {}
+        order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
+        score = problem.held_out_error if n_runs >= 2 else problem.bic
+        found = None
+        if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates(axis)):
+            found = problem.observed_band(order)
+        bands: dict[str, tuple[float, float] | None] = {}
+        for name in self._candidates(axis):
+            # candidates compared at hysteresis order 2 (the thesis's); the winner's order is validated after
+            best_spec[name] = self._spec(name, order, axis=axis)
+            scores[name] = math.nan if self.selection_ == "fixed" else score(best_spec[name])
+            bands[name] = band
+            if found is not None and "turning-point" in name:
+                # the band the data shows, tried against none: the data chooses
+                problem.band = found
+                with_band = score(best_spec[name])
+                problem.band = band
+                if with_band < scores[name]:
+                    scores[name], bands[name] = with_band, found
+        chosen = self._pick(axis, scores, n_runs)
+        if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
+            tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
+                     for p in range(1, MAX_HYSTERESIS_ORDER + 1)}
+            pick = _simplest(tried, n_runs)
+            best_spec[chosen] = self._spec(chosen, order, pick, axis)
+            scores[chosen] = tried[pick]
+        problem.band = bands.get(chosen, band)
+        spec = best_spec[chosen]
+        if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
+            # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
+            # which a higher order partly imitates; choose it again inside the winning candidate
+            tried = {o: score(_Spec(o, spec.lag, spec.hysteresis_order)) for o in range(1, self.max_order + 1)}
+            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order)
+            self.order_scores_[axis] = tried
+        return _AxisChoice(problem, spec, chosen, scores)
+
+    def _pick(self, axis: str, scores: dict[str, float], n_runs: int) -> str:
+        if len(scores) == 1:
+            return next(iter(scores))
+        finite = {k: v for k, v in scores.items() if math.isfinite(v)}
+        if not finite:
+            raise ModelError(f"{axis}: no hysteresis candidate could be scored")
+        if self.selection_ == "bic":
+            return min(finite, key=finite.get)
+        best = min(finite.values())  # the simplest candidate within the parsimony tolerance of the best
+        return next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
+
+    @staticmethod
+    def _shared_lag(choices: dict[str, _AxisChoice]) -> dict[str, float]:
+        """One time constant [s] for every axis with lag: the lag is that of the die behind one temperature
+        sensor, not of an axis, and the axes together pin it down better than any one of them. It minimizes
+        the sum over those axes of each one's residual sum of squares relative to its own minimum."""
+        lagged = {axis: c for axis, c in choices.items() if c.spec.lag}
+        if len(lagged) < 2:
+            return {}
+        profiles = [c.problem.lag_profile(c.spec) for c in lagged.values()]
+        lo_s = LAG_MIN_BLOCKS * max(c.problem.block_s for c in lagged.values())
+        tau_s = best_lag_s(lambda tau: sum(f(tau) for f in profiles), lo_s)
+        return {axis: tau_s for axis in lagged}
+
+    def _store(self, axis: str, choice: _AxisChoice, tau_s: float | None) -> None:
+        """Fit the chosen model of one axis on every run (at the shared lag ``tau_s`` [s] when given) and
+        keep what it learned."""
+        problem, spec = choice.problem, choice.spec
+        n_runs = len(problem.runs)
+        tau, (coef, consts, _, (t_lo, t_hi)) = problem.fit(spec, list(range(n_runs)), tau_s)
+        shape = coef[: spec.order]
+        self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,
+                                            t_lo, t_hi)
+        self.lag_time_constants_s_[axis] = float(tau)
+        p = spec.hysteresis_order
+        self.hysteresis_[axis] = None if not p else HysteresisCurve(
+            tuple(float(v) for v in coef[spec.order: spec.order + p]),
+            tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), problem.threshold, problem.band,
+            problem.branch_reach(spec, tau))
+        self.bands_[axis] = problem.band
+        self.turn_on_biases_dps_[axis] = consts
+        self.chosen_[axis] = choice.name if not p else f"{choice.name} (order {p})"
+        self.scores_[axis] = choice.scores
+        if self.acceleration != "none":
+            self._store_acceleration(axis, problem, spec, tau, coef, n_runs)
 
     def _pieces(self, recordings: list[Recording]) -> list[list[slice] | None]:
         self.segments_, pieces = static_pieces(recordings, self.static_min_duration_s)
@@ -429,8 +497,8 @@ class ThermalHysteresisModel:
         if self.acceleration == "none":
             return (), ()
         if any(r.accel_g is None for r in runs):
-            raise InputError("--acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
-                             "fit; map them with --columns or fit with --acceleration none")
+            raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
+                             "fit; map them with columns= or fit with acceleration='none'")
         excited, squares, self.excited_axes_ = excited_columns([r.accel_g for r in runs], [r.weight for r in runs],
                                                                squares=self.acceleration == "matrix2", warn=warn)
         return excited, squares

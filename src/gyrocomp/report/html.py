@@ -2,7 +2,9 @@
 
 Images are PNGs embedded as data URIs and the style sheet is inline, so the file opens anywhere with
 no network access. Sections (each an ``<section id=...>``): ``summary`` (the model: type, order, inputs,
-valid ranges, validation scores, the candidates compared), ``evaluation`` (the thesis's figures of merit,
+valid ranges, validation scores, the candidates compared), ``validation`` when a
+:class:`~gyrocomp.validation.ValidationResult` is given (held-out drift of raw, the autopilots' cubics, a
+plain cubic and gyrocomp's default, as ``gyrocomp validate`` prints it), ``evaluation`` (the thesis's figures of merit,
 by stage when the model has stages), one ``axis-<name>`` per axis (bias against temperature with the
 heating and cooling branches, fitted curve, turning points and residual; raw and compensated output
 against time), ``allan`` (raw and compensated Allan deviation per run), and ``g-sensitivity`` when the
@@ -28,6 +30,7 @@ from ..errors import DataQualityWarning, TemperatureRangeWarning
 from ..metrics import default_window_s, evaluate_run, evaluate_stages, stage_calibrations
 from ..noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
+from ..validation import ValidationResult
 from . import figures
 
 SECTIONS = ("summary", "evaluation", "allan")
@@ -141,6 +144,21 @@ def _summary(calibration: Calibration) -> str:
     return "\n".join(parts)
 
 
+def _validation(result: ValidationResult) -> str:
+    """The held-out drift table: mean +- standard error per method and axis [deg/s], and against the cubic."""
+    cubic = result.mean_over_axes("cubic + run constants") if "cubic + run constants" in result.methods else 0.0
+    rows = []
+    for method in result.methods:
+        cells = [f"{result.score(method, a).mean_drift_dps:.4g} +- {result.score(method, a).standard_error_dps:.2g}"
+                 for a in result.axes]
+        mean = result.mean_over_axes(method)
+        rows.append([method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-"])
+    caption = (f"held-out drift [deg/s], {result.window_s:g} s moving average, mean +- standard error over "
+               f"{len(result.folds)} folds ({result.fold_kind}): each method fitted without the fold it is scored on")
+    folds = f"<p class=note>folds: {html.escape(', '.join(result.folds))}</p>"
+    return _table(["method", *result.axes, "mean", "vs cubic"], rows, caption) + folds
+
+
 def _evaluation(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
                 windows: list[float], turn_on_window_s: float | None) -> str:
     staged = len(stage_calibrations(calibration)) > 1
@@ -216,7 +234,8 @@ def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: 
 
 def build_report(calibration: Calibration, runs: list[Recording], *, window_s: float | None = None,
                  turn_on_window_s: float | None = None, min_static_s: float = 10.0,
-                 progress: Callable[[float], None] | None = None) -> Report:
+                 progress: Callable[[float], None] | None = None,
+                 validation: ValidationResult | None = None) -> Report:
     """The report of ``calibration`` judged on ``runs`` (see the module doc for what it holds).
 
     Parameters
@@ -229,6 +248,8 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         Shortest static position drawn in the g-sensitivity figure [s].
     progress : callable, optional
         Called with the fraction done.
+    validation : ValidationResult, optional
+        Held-out drift of the methods on the calibration runs (:func:`gyrocomp.validation.validate`).
     """
     figures._pyplot()  # fail early, in one line, without matplotlib
     steps = 3 + 2 * len(runs)
@@ -246,6 +267,8 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         tick()
         sections: dict[str, str] = {}
         sections["summary"] = ("Model", _summary(calibration))
+        if validation is not None:
+            sections["validation"] = ("Validation", _validation(validation))
         windows = [window_s or default_window_s(rec) for rec in runs]
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, compensated, windows, turn_on_window_s))
         tick()
