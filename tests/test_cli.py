@@ -13,6 +13,7 @@ import pandas as pd
 import pytest
 
 from gyrocomp.calibration import SCHEMA_VERSION
+from gyrocomp.cli import in_cli_words
 
 SCRIPT = Path(sys.executable).parent / "gyrocomp"
 
@@ -458,3 +459,44 @@ def test_validate_prints_every_method_and_json_holds_the_folds(workdir):
     assert "gyrocomp poly:1" in table.stdout and "vs cubic" in table.stdout
     bad = run("validate", *runs, "--folds", "sideways")
     assert bad.returncode == 2 and "--folds" in bad.stderr
+
+
+def test_a_model_with_nan_coefficients_is_refused_before_anything_is_written(workdir, tmp_path):
+    d = json.loads((workdir / "model.json").read_text())
+    d["axes"]["gyro_x"]["temperature"]["coefficients_dps"][1] = float("nan")
+    (tmp_path / "nan.json").write_text(json.dumps(d))  # Python writes the NaN token JSON readers accept
+    r = run("export", tmp_path / "nan.json", "--format", "px4", "-o", tmp_path / "tc.params")
+    assert r.returncode == 2 and not (tmp_path / "tc.params").exists()
+    assert r.stderr.strip() == (f"gyrocomp: error: {tmp_path / 'nan.json'}: "
+                                "axes.gyro_x.temperature.coefficients_dps[1]: nan is not a finite number")
+
+
+def test_apply_refuses_an_axis_the_model_lacks_unless_axes_are_named(workdir, tmp_path):
+    d = json.loads((workdir / "model.json").read_text())
+    d["axes"] = {"gyro_z": d["axes"]["gyro_z"]}
+    (tmp_path / "z.json").write_text(json.dumps(d))
+    r = run("apply", tmp_path / "z.json", workdir / "run3.csv", "-o", tmp_path / "out.csv")
+    assert r.returncode == 2 and not (tmp_path / "out.csv").exists()
+    assert r.stderr.strip() == (f"gyrocomp: error: {workdir / 'run3.csv'}: the model has no curve for gyro_x, gyro_y "
+                                "(it covers gyro_z); give --axes with the axes to compensate, the others are then "
+                                "left raw")
+    r = run("apply", tmp_path / "z.json", workdir / "run3.csv", "-o", tmp_path / "out.csv", "--axes", "gyro_z")
+    assert r.returncode == 0, r.stderr
+    assert "gyro_x, gyro_y left raw (not among the axes to compensate)" in r.stderr
+    assert "gyro_z compensated" in r.stdout
+    raw, out = pd.read_csv(workdir / "run3.csv"), pd.read_csv(tmp_path / "out.csv")
+    assert (out["gyro_x"] == raw["gyro_x"]).all() and not (out["gyro_z"] == raw["gyro_z"]).all()
+
+
+@pytest.mark.parametrize("message, shown", [
+    ("window_s: must be positive, got -1", "--window: must be positive, got -1"),
+    ("a.csv: the model has no curve for gyro_x; give axes= with the axes", "a.csv: the model has no curve for gyro_x; give --axes with the axes"),
+    ("no temperature column (map it with columns={'temperature': 'NAME'}, or fit with temperature=none)",
+     "no temperature column (map it with --columns temperature=NAME, or fit with --temperature none)"),
+    ("row 2: nan (drop such rows explicitly (drop_nonfinite=True))", "row 2: nan (drop such rows explicitly (--drop-nan))"),
+    ("a.ulg: instance=3: no sensor_gyro instance 3", "a.ulg: --instance 3: no sensor_gyro instance 3"),
+    # what is not a parameter stays: axis names, words in file paths, parameters the command line lacks
+    ("/data/axes: gyro_z: the temperature does not vary; fit_report: x", "/data/axes: gyro_z: the temperature does not vary; fit_report: x"),
+])
+def test_library_messages_are_shown_with_the_flags_that_set_their_parameters(message, shown):
+    assert in_cli_words(message) == shown

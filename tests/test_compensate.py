@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyrocomp import Compensator, apply, fit_calibration
-from gyrocomp.errors import InputError, TemperatureRangeWarning
+from gyrocomp.errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 
@@ -65,20 +65,28 @@ def test_warns_once_across_chunks():
     assert len(record) == 1
 
 
-def test_axes_not_in_model_pass_through():
+def test_an_axis_the_model_lacks_is_refused_unless_the_axes_are_named():
     t = np.arange(600) / 10.0
     temp = np.linspace(10, 40, t.size)
     z_only = Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
     cal_z = fit_calibration([z_only], temperature=1)
     both = Recording(time_s=t, gyro_dps=np.column_stack([np.ones(t.size), 1e-3 * temp]),
-                     gyro_axes=("gyro_x", "gyro_z"), temperature_degc=temp)
-    out = apply(cal_z, both)
+                     gyro_axes=("gyro_x", "gyro_z"), temperature_degc=temp, source="both.csv")
+    with pytest.raises(InputError, match=r"both.csv: the model has no curve for gyro_x \(it covers gyro_z\); "
+                                         r"give axes= with the axes to compensate"):
+        apply(cal_z, both)
+    with pytest.warns(DataQualityWarning, match=r"both.csv: gyro_x left raw \(not among the axes to compensate\)"):
+        out = apply(cal_z, both, axes=("gyro_z",))
     np.testing.assert_array_equal(out.gyro_dps[:, 0], 1.0)
     np.testing.assert_allclose(out.gyro_dps[:, 1], 0.0, atol=1e-12)
+    with pytest.raises(InputError, match=r"axes: 'gyro_y' is not in the model or both.csv"):
+        apply(cal_z, both, axes=("gyro_y",))
+    # the model may cover more axes than the data has: those it has are compensated
+    np.testing.assert_allclose(apply(cal_z, z_only).gyro_dps[:, 0], 0.0, atol=1e-12)
 
 
 def test_errors():
-    with pytest.raises(InputError, match=r"--turn-on-window: must be a positive number of seconds, got -1"):
+    with pytest.raises(InputError, match=r"turn_on_window_s: must be a positive number of seconds, got -1"):
         Compensator(CAL, ("gyro_z",), turn_on_window_s=-1)
     with pytest.raises(InputError, match=r"the model covers gyro_x, gyro_y, gyro_z, the data has gyro_w; no axis in common"):
         Compensator(CAL, ("gyro_w",))

@@ -58,9 +58,9 @@ def test_evaluate_run_on_known_drift():
 
 
 def test_window_errors():
-    with pytest.raises(InputError, match=r"--window: must be positive, got -1"):
+    with pytest.raises(InputError, match=r"window_s: must be positive, got -1"):
         window_samples(-1, 10.0, 100)
-    with pytest.raises(InputError, match=r"--window: 100 s is longer than the run \(10 s\)"):
+    with pytest.raises(InputError, match=r"window_s: 100 s is longer than the run \(10 s\)"):
         window_samples(100, 10.0, 100)
     with pytest.raises(InputError, match=r"window: 20 samples is longer than the data"):
         moving_average(np.zeros(10), 20)

@@ -34,7 +34,7 @@ def test_every_gyro_axis_by_default_and_accelerometers_on_request():
     assert accel.sensor == "accel" and accel.unit == "g"
     # white accelerometer noise of 1e-3 g per sample at 50 Hz: N = 1e-3 / sqrt(50) [g/sqrt(Hz)]
     assert accel.noise.noise_density_g_per_sqrt_hz == pytest.approx(1e-3 / math.sqrt(50), rel=0.03)
-    with pytest.raises(InputError, match=r"--axes: 'gyro_y' is not in static.csv; it has gyro_x, gyro_z, accel_x"):
+    with pytest.raises(InputError, match=r"axes: 'gyro_y' is not in static.csv; it has gyro_x, gyro_z, accel_x"):
         analyse_noise(rec, ["gyro_y"])
 
 
@@ -49,7 +49,7 @@ def test_other_kinds_keep_noise_terms_from_the_overlapping_curve():
 def test_gaps_are_refused_unless_split():
     rec = static_recording(gap_after=40_000)
     with pytest.raises(InputError, match=r"static.csv: time gap of 10.02 s after row 40000 \(t = 799.98 s\); "
-                                         r"Allan deviations need evenly spaced samples: use --split-gaps"):
+                                         r"Allan deviations need evenly spaced samples: use split_gaps=True"):
         analyse_noise(rec)
     assert [(s.start, s.stop) for s in rec.contiguous_stretches()] == [(0, 40_000), (40_000, 60_000)]
     analysis = analyse_noise(rec, split_gaps=True)

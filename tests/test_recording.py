@@ -29,7 +29,7 @@ def test_time_repeat_names_row_number_from_source():
 
 
 def test_nan_names_row_and_channel():
-    with pytest.raises(InputError, match=r"row 2, column 'temperature': nan is not a finite number.*--drop-nan"):
+    with pytest.raises(InputError, match=r"row 2, column 'temperature': nan is not a finite number.*drop_nonfinite=True"):
         make([0.0, 1.0, 2.0], temp=np.array([20.0, np.nan, 21.0]))
 
 
@@ -68,7 +68,7 @@ def test_shape_mismatch_and_too_short():
 
 
 def test_missing_temperature_message():
-    with pytest.raises(InputError, match="no temperature column.*--columns temperature=NAME"):
+    with pytest.raises(InputError, match="no temperature column.*columns={'temperature': 'NAME'}"):
         make([0.0, 1.0]).temperature_for("gyro_z")
 
 

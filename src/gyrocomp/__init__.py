@@ -3,21 +3,39 @@
 Internal units: angular rate [deg/s], acceleration [g], temperature [degC], time [s].
 """
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 from .allan import AllanResult, allan_deviation, noise_parameters
 from .calibration import Calibration
-from .compensate import Compensator, apply
-from .errors import GyrocompError, InputError, ModelError, NotFittedError, TemperatureRangeWarning
+from .compensate import Compensator, apply, predict_error
+from .errors import (
+    DataQualityWarning,
+    GyrocompError,
+    InputError,
+    MissingDependencyError,
+    ModelChoiceWarning,
+    ModelError,
+    NotFittedError,
+    TemperatureRangeWarning,
+)
+from .evaluation import evaluate, evaluate_stages
 from .io import read
+from .io import write_recording as write
 from .metrics import Evaluation, evaluate_run
 from .models import PolynomialTemperatureModel
-from .models.pipelines import fit_calibration
+from .models.pipelines import fit_calibration, fit_channels
 from .noise import analyse_noise
 from .recording import Recording
+from .simulate import simulate
+from .validation import validate
+
+#: ``gyrocomp.fit`` is :func:`fit_calibration`: recordings in, a frozen Calibration out
+fit = fit_calibration
 
 __all__ = [
-    "AllanResult", "Calibration", "Compensator", "Evaluation", "GyrocompError", "InputError", "ModelError",
-    "NotFittedError", "PolynomialTemperatureModel", "Recording", "TemperatureRangeWarning", "allan_deviation",
-    "analyse_noise", "apply", "evaluate_run", "fit_calibration", "noise_parameters", "read", "__version__",
+    "AllanResult", "Calibration", "Compensator", "DataQualityWarning", "Evaluation", "GyrocompError", "InputError",
+    "MissingDependencyError", "ModelChoiceWarning", "ModelError", "NotFittedError", "PolynomialTemperatureModel",
+    "Recording", "TemperatureRangeWarning", "allan_deviation", "analyse_noise", "apply", "evaluate",
+    "evaluate_run", "evaluate_stages", "fit", "fit_calibration", "fit_channels", "noise_parameters",
+    "predict_error", "read", "simulate", "validate", "write", "__version__",
 ]

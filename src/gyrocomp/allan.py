@@ -1021,7 +1021,7 @@ def noise_terms(result: AllanResult, fit_taus_s: tuple[float, float] | None = No
     if fit_taus_s is not None:
         fitted &= (result.tau >= fit_taus_s[0]) & (result.tau <= fit_taus_s[1])
         if fitted.sum() < 2:
-            raise InputError(f"--fit-taus: fewer than two taus between {fit_taus_s[0]:g} and {fit_taus_s[1]:g} s")
+            raise InputError(f"fit_taus_s: fewer than two taus between {fit_taus_s[0]:g} and {fit_taus_s[1]:g} s")
     tau, dev = result.tau[fitted], result.deviation[fitted]
     variance = dev ** 2
     half_width = (result.ci_high[fitted] ** 2 - result.ci_low[fitted] ** 2) / 2.0

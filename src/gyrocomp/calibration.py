@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -22,7 +23,7 @@ from .io.atomic import write_text_atomic
 from .models.mlp import MLPBias
 from .models.temperature import PolynomialBias
 from .models.hysteresis import HysteresisCurve
-from .recording import Recording
+from .recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
 
 FORMAT_NAME = "gyrocomp-calibration"
 SCHEMA_VERSION = 5
@@ -71,6 +72,78 @@ def _upgrade_4_to_5(d: dict) -> dict:
 UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4,
                                                4: _upgrade_4_to_5}
 UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
+
+
+#: the temperature channels a model may read: one shared, or one per gyro axis
+TEMPERATURE_CHANNELS = (TEMPERATURE_COLUMN, *(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES))
+#: no number in a model file is larger than this in magnitude (deg/s, g, degC, s, network weights)
+MAX_MAGNITUDE = 1e9
+#: the longest list a model file holds (network weights of the largest network the fitter builds)
+MAX_LIST = 10000
+#: the most polynomial or hysteresis coefficients a curve may have
+MAX_COEFFICIENTS = 10
+
+
+def _check_numbers(value: Any, where: str) -> None:
+    """Every number under ``value`` finite and of a size a sensor model can have, and every list of a sane
+    length; the error names the field (``axes.gyro_z.temperature.coefficients_dps[0]``)."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            _check_numbers(item, f"{where}.{key}")
+    elif isinstance(value, list):
+        if len(value) > MAX_LIST:
+            raise InputError(f"{where}: {len(value)} values; at most {MAX_LIST}")
+        for k, item in enumerate(value):
+            _check_numbers(item, f"{where}[{k}]")
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        if not math.isfinite(value):
+            raise InputError(f"{where}: {value} is not a finite number")
+        if abs(value) > MAX_MAGNITUDE:
+            raise InputError(f"{where}: {value:g} is beyond any MEMS sensor's range")
+
+
+def _check_axis(section: str, name: str, d: Any, allowed: tuple[str, ...]) -> None:
+    """What the numbers alone do not say: a known axis, a known temperature channel, the entries present, at
+    least one run constant, a lag that is a time constant, curves of sane size with ordered ranges."""
+    if name not in allowed:
+        raise InputError(f"{section}: {name!r} is not a {allowed[0].split('_')[0]} axis; use {', '.join(allowed)}")
+    where = f"{section}.{name}"
+    if not isinstance(d, dict):
+        raise InputError(f"{where}: not an object")
+    if "temperature" not in d:
+        raise InputError(f"{where}: no 'temperature' entry (null for none)")
+    column = d.get("temperature_column", TEMPERATURE_COLUMN)
+    if column not in TEMPERATURE_CHANNELS:
+        raise InputError(f"{where}.temperature_column: {column!r} is not a temperature channel; "
+                         f"use {', '.join(TEMPERATURE_CHANNELS)}")
+    if section == "axes" and not d.get("turn_on_biases_dps"):  # accelerometer models have a reference instead
+        raise InputError(f"{where}.turn_on_biases_dps: no values")
+    lag = d.get("lag_time_constant_s", 0.0)
+    if isinstance(lag, (int, float)) and lag < 0:
+        raise InputError(f"{where}.lag_time_constant_s: {lag:g} s; a time constant is 0 (none) or positive")
+    curves = [("temperature", d["temperature"], ("coefficients_dps",)),
+              ("hysteresis", d.get("hysteresis"), ("descending_dps", "ascending_dps"))]
+    for key, curve, lists in curves:
+        if not isinstance(curve, dict):
+            continue
+        for field_name in lists:
+            if len(curve.get(field_name) or ()) > MAX_COEFFICIENTS:
+                raise InputError(f"{where}.{key}.{field_name}: {len(curve[field_name])} values; "
+                                 f"at most {MAX_COEFFICIENTS}")
+        lo, hi = curve.get("t_min_degc"), curve.get("t_max_degc")
+        if isinstance(lo, (int, float)) and isinstance(hi, (int, float)) and lo > hi:
+            raise InputError(f"{where}.{key}: t_min_degc {lo:g} is above t_max_degc {hi:g}")
+
+
+def _check_model(d: dict) -> None:
+    for section, allowed in (("axes", GYRO_AXES), ("accel_axes", ACCEL_AXES)):
+        axes = d.get(section) or {}
+        if not isinstance(axes, dict):
+            raise InputError(f"{section}: not an object")
+        for name, ax in axes.items():
+            _check_axis(section, name, ax, allowed)
+        _check_numbers(axes, section)
+    _check_numbers(d.get("accel_reference_degc"), "accel_reference_degc")
 
 
 def _floats(values, count: int, name: str):
@@ -175,7 +248,7 @@ class AxisCalibration:
         if temp is not None and temp.get("type") not in kinds:
             raise InputError(f"unknown temperature model type {temp.get('type')!r}")
         return cls(
-            temperature=None if temp is None else kinds[temp["type"]].from_dict(temp),
+            temperature=None if d["temperature"] is None else kinds[temp["type"]].from_dict(temp),
             turn_on_biases_dps=tuple(float(c) for c in d["turn_on_biases_dps"]),
             temperature_column=str(d.get("temperature_column", "temperature")),
             lag_time_constant_s=float(d["lag_time_constant_s"]),
@@ -235,13 +308,6 @@ class Calibration:
     def needs_temperature(self) -> bool:
         return any(ax.temperature is not None for ax in self.axes.values())
 
-    def predict_error(self, recording: Recording) -> np.ndarray:
-        """Predicted deterministic error (n, k) [deg/s] for the recording's axes (0 where not modelled),
-        using the mean turn-on constant of the calibration runs."""
-        from .compensate import apply
-
-        return recording.gyro_dps - apply(self, recording).gyro_dps
-
     # -- serialization -------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -279,6 +345,7 @@ class Calibration:
             d = UPGRADES[version](d)
             version += 1
         try:
+            _check_model(d)
             axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
             accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False))
                           for name, ax in d["accel_axes"].items()}
@@ -312,4 +379,8 @@ class Calibration:
                 f"{path}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg}); "
                 "the file may be truncated, write it again with gyrocomp fit"
             ) from None
+        except RecursionError:
+            raise InputError(f"{path}: not a gyrocomp model file (nested too deeply)") from None
+        except ValueError as exc:  # e.g. an integer with more digits than Python converts
+            raise InputError(f"{path}: not valid JSON ({exc})") from None
         return cls.from_dict(data, source=str(path))

@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import json
+import re
 import sys
 import traceback
 import warnings
@@ -20,7 +21,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from . import __version__
+from ._version import __version__
 from .allan import KINDS
 from .calibration import Calibration
 from .compensate import apply as apply_calibration
@@ -39,11 +40,22 @@ from .io import (
     write_text_atomic,
 )
 from .export.kalibr import kalibr_imu, kalibr_imu_yaml
-from .metrics import Evaluation, evaluate_run
+from .comparison import compare_methods
+from .demo import run_demo
+from .evaluation import evaluate as evaluate_calibration
+from .export.autopilot import ardupilot_params_file, px4_params_file
+from .export.c_code import c_sources
+from .evaluation import evaluate_stages
+from .metrics import Evaluation, default_window_s
+from .report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
+from .report.html import build_report
+from .simulate import Simulation, preset_model, resolve_profile
+from .simulate import simulate as run_simulation
 from .models.acceleration import ACCELERATION_CHOICES
+from .models.mlp import DEFAULT_HIDDEN
 from .models.pipelines import fit_channels, parse_channels
-from .models.temperature import parse_temperature_option
 from .models.selection import FOLD_KINDS
+from .models.temperature import MAX_ORDER
 from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
 from .validation import ValidationResult, validate as validate_runs
 from .noise import NoiseAnalysis, analyse_noise
@@ -134,6 +146,41 @@ def cli(ctx, debug, quiet):
     ctx.obj = {"debug": debug, "quiet": quiet}
 
 
+def parse_hidden(text: str) -> tuple[int, ...]:
+    """``"mlp"`` -> (3,), ``"mlp:5"`` -> (5,), ``"mlp:5x4"`` -> (5, 4)."""
+    text = text.strip().lower()
+    if text == "mlp":
+        return DEFAULT_HIDDEN
+    try:
+        hidden = tuple(int(h) for h in text.split(":", 1)[1].split("x"))
+    except (IndexError, ValueError):
+        hidden = ()
+    if not hidden or any(h < 1 or h > 50 for h in hidden) or len(hidden) > 3:
+        raise InputError(f"--temperature: {text!r}; use mlp, mlp:H (H hidden tanh neurons, 1..50) or mlp:HxH")
+    return hidden
+
+
+def parse_temperature_option(text: str) -> int | str | tuple | None:
+    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"mlp"``/``"mlp:5"`` -> ("mlp", hidden), ``"none"`` -> None."""
+    text = text.strip().lower()
+    if text == "mlp" or text.startswith("mlp:"):
+        return ("mlp", parse_hidden(text))
+    if text in ("poly", "auto"):
+        return "auto"
+    if text == "none":
+        return None
+    if text.startswith("poly:"):
+        try:
+            order = int(text[5:])
+        except ValueError:
+            order = -1
+        if 0 <= order <= MAX_ORDER:
+            return order
+        raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
+    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}), "
+                     "mlp (the thesis's 1-3-1 network), mlp:H or none")
+
+
 # -- simulate ---------------------------------------------------------------------------------------
 def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     if text is None:
@@ -177,8 +224,6 @@ def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
 def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, disable, set_points, ramp_rate, dwell_s,
              cycles, position_s, output, truth, truth_columns):
     """Simulate calibration runs of a sensor preset through a test profile, with the exact truth."""
-    from .simulate import Simulation, preset_model, resolve_profile
-    from .simulate import simulate as run_simulation
 
     model = preset_model(preset, unit)
     if axes:
@@ -407,9 +452,12 @@ def _print_g_sensitivity(console, report: dict) -> None:
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Compensated output file.")
 @click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
               help="Estimate the turn-on bias from the first S seconds of IN [s] (default: the model's mean).")
+@click.option("--axes", "axes", default=None, metavar="AXES",
+              help="Gyro axes to compensate, e.g. gyro_z (default: all; data with an axis the model lacks is "
+                   "refused unless the axes are named, and the others are then left raw).")
 @read_options
 @click.pass_context
-def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
+def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
     """Compensate IN with MODEL: same columns and rows out, gyro columns compensated."""
     opts = _pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path, model])
@@ -417,11 +465,12 @@ def apply(ctx, model, input_path, output, turn_on_window_s, **kwargs):
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     data = _read(input_path, opts)
-    compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s)
+    named = None if axes is None else tuple(a.strip() for a in axes.split(",") if a.strip())
+    compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=named)
     accel = compensated.accel_g if calibration.accel_axes else None
     write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt, accel_g=accel)
     if not ctx.obj["quiet"]:
-        done = [a for a in data.recording.gyro_axes if a in calibration.axes]
+        done = [a for a in data.recording.gyro_axes if a in calibration.axes and (named is None or a in named)]
         done += list(data.recording.accel_axes) if accel is not None else []
         click.echo(f"wrote {output}: {data.table.num_rows} rows, {', '.join(done)} compensated")
 
@@ -533,7 +582,6 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     if window_s is not None and not window_s > 0:
         raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
     if compare:
-        from .comparison import compare_methods
 
         band = _float_list(hysteresis_band, "--hysteresis-band")
         if band is not None and (len(band) != 2 or not band[0] < band[1]):
@@ -550,8 +598,6 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     model, runs = paths[0], paths[1:]
     calibration = Calibration.load(model)
     if stages:
-        from .metrics import evaluate_stages
-
         if not calibration.axes:
             raise InputError(f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
                              "evaluate it without --stages")
@@ -562,12 +608,8 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
         elif not ctx.obj["quiet"]:
             print_stages(staged)
         return
-    results = []
-    for path in runs:
-        rec = _read(path, opts).recording
-        comp = apply_calibration(calibration, rec, turn_on_window_s=turn_on_window_s)
-        results.append(evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes)))
-    evaluation = Evaluation(results)
+    evaluation = evaluate_calibration(calibration, [_read(path, opts).recording for path in runs],
+                                      window_s=window_s, turn_on_window_s=turn_on_window_s)
     if as_json:
         click.echo(json.dumps(evaluation.to_dict(), indent=2))
     else:
@@ -781,12 +823,10 @@ EXPORT_FORMATS = ("px4", "ardupilot", "c")
 @click.pass_context
 def export(ctx, model, fmt, output, rate_hz, instance, device_id):
     """Write MODEL as autopilot thermal-calibration parameters (the temperature cubic only), or as C code."""
-    from .export.autopilot import ardupilot_params_file, px4_params_file
 
     refuse_to_overwrite_inputs(output, [model])
     calibration = Calibration.load(model)
     if fmt == "c":
-        from .export.c_code import c_sources
 
         folder = Path(output)
         if folder.exists() and not folder.is_dir():
@@ -830,9 +870,7 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
     """One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias against
     temperature, raw and compensated series, Allan deviations, g-sensitivity; with --validate-on, the held-out
     drift of each method on those calibration runs."""
-    from .report.html import build_report
 
-    from .report.figures import require_matplotlib
 
     opts = _pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [model, *runs, *validate_on])
@@ -861,7 +899,6 @@ def plot():
 
 
 def _figure_output(output, inputs) -> None:
-    from .report.figures import require_matplotlib
 
     check_figure_path(output)
     refuse_to_overwrite_inputs(output, inputs)
@@ -900,7 +937,6 @@ def _axis_option(axis, calibration, recording) -> str:
 @click.pass_context
 def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
     """Allan deviation of FILE (and of FILE compensated with --model) with intervals and slope lines."""
-    from .report.figures import allan_plot, save_figure
 
     opts = _pop_read_options(kwargs)
     _figure_output(output, [input_path] + ([model] if model else []))
@@ -927,7 +963,6 @@ def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
 @click.pass_context
 def plot_temperature(ctx, model, runs, axis, output, **kwargs):
     """Bias against temperature of RUNS (heating and cooling branches), MODEL's correction, the residual."""
-    from .report.figures import save_figure, temperature_plot
 
     opts = _pop_read_options(kwargs)
     _figure_output(output, [model, *runs])
@@ -953,8 +988,6 @@ def plot_temperature(ctx, model, runs, axis, output, **kwargs):
 @click.pass_context
 def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, **kwargs):
     """Raw and compensated output of RUN against time, with moving averages and the temperature."""
-    from .metrics import default_window_s
-    from .report.figures import save_figure, timeseries_plot
 
     opts = _pop_read_options(kwargs)
     _figure_output(output, [model, run])
@@ -975,7 +1008,6 @@ def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, *
 def demo(ctx, out_dir):
     """The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score it,
     and write the HTML report."""
-    from .demo import run_demo
 
     result = run_demo(Path(out_dir))
     if result.report_skipped:
@@ -989,8 +1021,41 @@ def demo(ctx, out_dir):
 
 
 # -- entry point ------------------------------------------------------------------------------------
+#: the library names its Python parameters in messages (``window_s: must be positive``, ``give axes= ...``);
+#: on the command line the user typed a flag, so the message names that instead
+PARAMETER_FLAGS = {
+    "window_s": "--window", "turn_on_window_s": "--turn-on-window", "rate_hz": "--rate", "axes": "--axes",
+    "static_min_duration_s": "--min-static", "acceleration": "--acceleration", "hysteresis": "--hysteresis",
+    "hysteresis_order": "--hysteresis-order", "hysteresis_band_degc": "--hysteresis-band",
+    "pipeline": "--pipeline", "channels": "--channels", "columns": "--columns", "fmt": "--format",
+    "instance": "--instance", "device_id": "--device-id", "record": "--record", "imu_topic": "--imu-topic",
+    "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
+    "time_unit": "--time-unit", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
+    "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
+    "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
+    "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
+    "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps",
+}
+_MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
+_SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone
+_PARAMETER = re.compile(r"(?<![\w.\-/])(" + "|".join(sorted(PARAMETER_FLAGS, key=len, reverse=True)) + r")([:=])")
+
+
+def in_cli_words(message: str) -> str:
+    """``message`` with the Python parameters it names (``name:`` or ``name=value``) as the flags that set them
+    (``--flag:``, ``--flag value``)."""
+    def flag(m: re.Match) -> str:
+        name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
+        if sep == ":":
+            return PARAMETER_FLAGS[name] + ":"
+        return PARAMETER_FLAGS[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
+
+    message = _PARAMETER.sub(flag, _SWITCH.sub(r"\1=", message))
+    return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    click.echo(f"gyrocomp: warning: {message}", err=True)
+    click.echo(f"gyrocomp: warning: {in_cli_words(str(message))}", err=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -1015,7 +1080,7 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {exc}", err=True)
+        click.echo(f"gyrocomp: error: {in_cli_words(str(exc))}", err=True)
         status = EXIT_INPUT
     except GyrocompError as exc:
         if debug:

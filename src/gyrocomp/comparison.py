@@ -14,7 +14,6 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy.signal import medfilt
 
 from .calibration import AxisCalibration, Calibration
 from .compensate import apply
@@ -55,6 +54,8 @@ def fit_px4_style(recordings: list[Recording]) -> Calibration:
     T - TREF with TREF the middle of the range; applied clamped to [TMIN, TMAX]. Several runs are pooled
     as one log.
     """
+    from scipy.signal import medfilt  # scipy.signal is slow to import; only this baseline filters
+
     def fit_axis(recs, axis):
         temperature = np.concatenate([r.temperature_for(axis) for r in recs])
         gyro = np.concatenate([medfilt(r.gyro(axis), PX4_MEDIAN_SAMPLES) for r in recs])

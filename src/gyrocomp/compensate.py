@@ -9,7 +9,7 @@ import numpy as np
 
 from .calibration import Calibration
 from .effects import find_turns, g_sensitivity_offset, thermal_lag
-from .errors import InputError, TemperatureRangeWarning
+from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .recording import ACCEL_AXES, Recording
 
@@ -42,7 +42,7 @@ class Compensator:
     def __init__(self, calibration: Calibration, gyro_axes: tuple[str, ...], *,
                  turn_on_window_s: float | None = None, rate_hz: float | None = None, source: str = "<stream>"):
         if turn_on_window_s is not None and not turn_on_window_s > 0:
-            raise InputError(f"--turn-on-window: must be a positive number of seconds, got {turn_on_window_s}")
+            raise InputError(f"turn_on_window_s: must be a positive number of seconds, got {turn_on_window_s}")
         self.calibration = calibration
         self.gyro_axes = tuple(gyro_axes)
         self.turn_on_window_s = turn_on_window_s
@@ -143,7 +143,7 @@ class Compensator:
             if ax.needs_accel and time_s.size:
                 if accel_g is None:
                     raise InputError(f"{self.source}: the model has g-sensitivity; the data needs accel_x, accel_y "
-                                     "and accel_z columns [g] (map them with --columns)")
+                                     "and accel_z columns [g] (map them with columns=)")
                 if ax.g_sensitivity_dps_per_g is not None or ax.g_squared_dps_per_g2 is not None:
                     g = np.zeros(3) if ax.g_sensitivity_dps_per_g is None else np.asarray(ax.g_sensitivity_dps_per_g)
                     q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
@@ -212,12 +212,24 @@ class Compensator:
         return self._release()
 
 
-def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None) -> Recording:
+def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None,
+          axes: tuple[str, ...] | None = None) -> Recording:
     """Compensate a whole recording; the result has the same rows, axes and other channels.
 
     The gyro axes the model covers are compensated [deg/s]; so are the accelerometer axes [g] when the
     model has accelerometer temperature models (then also a g-sensitivity term reads the compensated ones).
+
+    Parameters
+    ----------
+    turn_on_window_s : float, optional
+        Estimate the run's turn-on constant from its first seconds [s] (default: the calibration runs' mean).
+    axes : tuple of str, optional
+        The gyro axes to compensate. By default every gyro axis of the recording, and a recording with a gyro
+        axis the model has no curve for is refused (a model of another part, or a column mapped to the wrong
+        axis, would otherwise leave it raw unnoticed); name the axes to compensate the others and leave the
+        rest raw, with a warning saying which.
     """
+    calibration = _restricted(calibration, recording, axes)
     comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
                        rate_hz=recording.rate_hz, source=recording.source)
     accel = None
@@ -233,3 +245,34 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
         order = [ACCEL_AXES.index(a) for a in recording.accel_axes]
         result = dataclasses.replace(result, accel_g=comp.take_accel()[:, order])
     return result
+
+
+def _restricted(calibration: Calibration, recording: Recording, axes: tuple[str, ...] | None) -> Calibration:
+    """The calibration limited to ``axes``, after checking the recording's gyro axes against the model's."""
+    if not calibration.axes:  # an accelerometer-only model: the gyro passes through by design
+        return calibration
+    if axes is None:
+        missing = [a for a in recording.gyro_axes if a not in calibration.axes]
+        if missing:
+            raise InputError(f"{recording.source}: the model has no curve for {', '.join(missing)} (it covers "
+                             f"{', '.join(calibration.axes)}); give axes= with the axes to compensate, the "
+                             "others are then left raw")
+        return calibration
+    axes = tuple(axes)
+    for axis in axes:
+        where = [] if axis in calibration.axes else ["the model"]
+        where += [] if axis in recording.gyro_axes else [recording.source]
+        if where:
+            raise InputError(f"axes: {axis!r} is not in {' or '.join(where)} (the model covers "
+                             f"{', '.join(calibration.axes)}; the data has {', '.join(recording.gyro_axes)})")
+    raw = [a for a in recording.gyro_axes if a not in axes]
+    if raw:
+        warnings.warn(f"{recording.source}: {', '.join(raw)} left raw (not among the axes to compensate)",
+                      DataQualityWarning, stacklevel=3)
+    return dataclasses.replace(calibration, axes={a: calibration.axes[a] for a in axes})
+
+
+def predict_error(calibration: Calibration, recording: Recording) -> np.ndarray:
+    """Predicted deterministic error (n, k) [deg/s] for the recording's gyro axes (0 where not modelled): the
+    raw output less what :func:`apply` leaves, with the mean turn-on constant of the calibration runs."""
+    return recording.gyro_dps - apply(calibration, recording).gyro_dps

@@ -28,6 +28,7 @@ from .io import read_table, write_gyro_back, write_recording, write_text_atomic
 from .allan import allan_deviation_segments
 from .metrics import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
 from .models.pipelines import fit_calibration
+from .report.html import build_report
 from .simulate import get_profile, simulate
 from .units import DEG_PER_S_TO_DEG_PER_H
 from .validation import ValidationResult, validate
@@ -236,8 +237,6 @@ def _allan_table(held, compensated) -> dict[str, AllanComparison]:
 def _write_report(calibration: Calibration, run, path: Path, validation: ValidationResult | None = None) -> str | None:
     """Write the HTML report; return why not (the missing [plot] extra), or None."""
     try:
-        from .report.html import build_report
-
         html = build_report(calibration, [run], validation=validation).html
     except MissingDependencyError as exc:
         return str(exc)

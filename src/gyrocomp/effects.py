@@ -19,7 +19,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from .errors import InputError
 
@@ -29,6 +28,14 @@ G_SQUARED_TERMS = ("xx", "yy", "zz", "xy", "xz", "yz")
 
 
 # -- thermal lag ------------------------------------------------------------------------------------
+
+def _lfilter(b, a, x, zi=None):
+    """``scipy.signal.lfilter``, imported on first use: scipy.signal costs most of a second at start-up and
+    most commands never filter."""
+    from scipy.signal import lfilter
+
+    return lfilter(b, a, x) if zi is None else lfilter(b, a, x, zi=zi)
+
 def lag_coefficients(step_s: float, time_constant_s: float) -> tuple[float, float, float]:
     """Coefficients (a, b0, b1) of the exact first-order lag for an input linear between samples.
 
@@ -120,7 +127,7 @@ def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_
             # uniform stretch [i, stop): y[k] = a y[k-1] + b0 u[k] + b1 u[k-1]
             seg = u[i:stop]
             zi = np.array([a * prev_y + b1 * prev_u])
-            out[i:stop], _ = lfilter([b0, b1], [1.0, -a], seg, zi=zi)
+            out[i:stop], _ = _lfilter([b0, b1], [1.0, -a], seg, zi=zi)
             prev_u, prev_y = float(seg[-1]), float(out[stop - 1])
         if stop < u.size:  # bridge the gap before sample `stop` exactly
             ga, gb0, gb1 = lag_coefficients(float(steps[stop]), time_constant_s)

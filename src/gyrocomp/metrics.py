@@ -139,11 +139,11 @@ class Evaluation:
 def window_samples(window_s: float, rate_hz: float, n_samples: int) -> int:
     """Number of samples in a window of ``window_s`` seconds, checked against the data length."""
     if not window_s > 0:
-        raise InputError(f"--window: must be positive, got {window_s}")
+        raise InputError(f"window_s: must be positive, got {window_s}")
     w = max(1, int(round(window_s * rate_hz)))
     if w > n_samples:
         raise InputError(
-            f"--window: {window_s:g} s is longer than the run ({n_samples / rate_hz:.6g} s); choose a shorter window"
+            f"window_s: {window_s:g} s is longer than the run ({n_samples / rate_hz:.6g} s); choose a shorter window"
         )
     return w
 
@@ -219,47 +219,3 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
                 integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
                 residual_rms_g=f.residual_rms)
     return RunEvaluation(file=raw.source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
-
-
-@dataclass(frozen=True)
-class StageEvaluation:
-    """One run through the stages of a calibration (the thesis's Table 4.4): ``stages`` maps a stage
-    name (raw, temperature only, + acceleration, + hysteresis) to each axis's figures."""
-
-    file: str
-    window_s: float
-    stages: dict[str, dict[str, AxisMetrics]]
-
-    def to_dict(self) -> dict:
-        return {"file": self.file, "window_s": self.window_s,
-                "stages": {name: {a: asdict(m) for a, m in axes.items()} for name, axes in self.stages.items()}}
-
-
-def stage_calibrations(calibration) -> dict:
-    """The stages a calibration has, in the thesis's order, each as a calibration with the later parts off."""
-    stages = {}
-    later = [p for p, on in (("acceleration", calibration.has_acceleration), ("hysteresis", calibration.has_hysteresis))
-             if on]
-    stages["temperature only"] = calibration.without(*later)
-    if calibration.has_acceleration:
-        stages["temperature + acceleration"] = calibration.without(*[p for p in later if p != "acceleration"])
-    if calibration.has_hysteresis:
-        name = "temperature + acceleration + hysteresis" if calibration.has_acceleration else "temperature + hysteresis"
-        stages[name] = calibration
-    return stages
-
-
-def evaluate_stages(calibration, recording: Recording, *, window_s: float | None = None,
-                    turn_on_window_s: float | None = None) -> StageEvaluation:
-    """Bias offset, improvement, bias instability and integration time of a run at each stage of the calibration."""
-    from .compensate import apply
-
-    if window_s is None:
-        window_s = default_window_s(recording)
-    stages: dict[str, dict[str, AxisMetrics]] = {}
-    for name, cal in stage_calibrations(calibration).items():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DataQualityWarning)
-            result = evaluate_run(recording, apply(cal, recording, turn_on_window_s=turn_on_window_s), window_s=window_s)
-        stages[name] = {axis: m for axis, m in result.axes.items() if axis in calibration.axes}
-    return StageEvaluation(recording.source, float(window_s), stages)

@@ -88,7 +88,7 @@ def _channel(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
     if axis in recording.accel_axes:
         return recording.accel_g[:, recording.accel_axes.index(axis)], "accel", "g"
     have = ", ".join((*recording.gyro_axes, *recording.accel_axes))
-    raise InputError(f"--axes: {axis!r} is not in {recording.source}; it has {have}")
+    raise InputError(f"axes: {axis!r} is not in {recording.source}; it has {have}")
 
 
 def _describe_gap(recording: Recording) -> str:
@@ -96,7 +96,7 @@ def _describe_gap(recording: Recording) -> str:
     more = f" (and {len(recording.gaps) - 1} more)" if len(recording.gaps) > 1 else ""
     return (f"{recording.source}: time gap of {gap.duration_s:.6g} s after row {gap.after_row} "
             f"(t = {gap.start_s:.6g} s){more}; Allan deviations need evenly spaced samples: "
-            f"use --split-gaps to pool the contiguous stretches")
+            f"use split_gaps=True to pool the contiguous stretches")
 
 
 def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: str = "oadev",

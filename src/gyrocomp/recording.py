@@ -130,7 +130,7 @@ class Recording:
                 column = names[int(np.flatnonzero(bad[first])[0])]
                 raise InputError(
                     f"{src}: row {rows[first]}, column {column!r}: {table[first][bad[first]][0]} "
-                    "is not a finite number; fix the file or drop such rows explicitly (--drop-nan)"
+                    "is not a finite number; fix the file or drop such rows explicitly (drop_nonfinite=True)"
                 )
         dt = np.diff(time_s)
         bad_steps = np.flatnonzero(dt <= 0)
@@ -185,7 +185,7 @@ class Recording:
         if self.temperature_degc is None:
             raise InputError(
                 f"{self.source}: no temperature column; a temperature model needs one "
-                "(map it with --columns temperature=NAME)"
+                "(map it with columns={'temperature': 'NAME'})"
             )
         if self.temperature_degc.ndim == 1:
             return self.temperature_degc

@@ -46,14 +46,14 @@ def unit_factor(kind: str, unit: str, option: str | None = None) -> float:
     unit : str
         Unit name as a user writes it, e.g. ``"rad/s"``.
     option : str, optional
-        The CLI option or argument the unit came from, named in the error message.
+        The parameter the unit came from (``gyro_unit`` ...), named in the error message.
     """
     tables = {"gyro": GYRO_UNITS_TO_DPS, "accel": ACCEL_UNITS_TO_G, "time": TIME_UNITS_TO_S}
     table = tables[kind]
     try:
         return table[unit.strip()]
     except KeyError:
-        where = option or f"{kind} unit"
+        where = option or f"{kind}_unit"
         raise InputError(
             f"{where}: unknown unit {unit!r}; use one of {', '.join(sorted(table))}"
         ) from None

@@ -97,9 +97,9 @@ def test_terms_the_autopilots_lack_are_named():
         text = px4_params_file(cal)
     p = _read_px4(text)
     assert p["TC_G0_X1_0"] == 0.0 and p["TC_G0_X1_2"] != 0.0  # the ADXRS450 preset is z only
-    with pytest.raises(InputError, match=r"--instance: ArduPilot numbers its IMUs 1..3, got 0"):
+    with pytest.raises(InputError, match=r"instance: ArduPilot numbers its IMUs 1..3, got 0"):
         ardupilot_params_file(cal, instance=0)
-    with pytest.raises(InputError, match=r"--instance: PX4 has thermal compensation for gyros 0..3, got 7"):
+    with pytest.raises(InputError, match=r"instance: PX4 has thermal compensation for gyros 0..3, got 7"):
         px4_params_file(cal, instance=7)
     flat = fit_calibration(runs, temperature=None)
     with pytest.raises(InputError, match="export: the model has no gyro or accelerometer axis with a temperature curve"):

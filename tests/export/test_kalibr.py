@@ -60,5 +60,5 @@ def test_gyro_only_logs_say_what_is_missing():
     assert "no accelerometer axes, so imu.yaml has gyroscope values only" in said
     assert "no gyroscope random walk is visible" in said
     assert "accelerometer_noise_density:" not in text and "no accelerometer columns in the log" in text
-    with pytest.raises(InputError, match=r"--kalibr: needs at least one gyro axis"):
+    with pytest.raises(InputError, match=r"kalibr: needs at least one gyro axis"):
         kalibr_imu(analyse_noise(static_recording(), ["accel_z"]))

@@ -88,8 +88,8 @@ def test_time_units(tmp_path, unit, factor):
         ("time,gyro_z,temperature\n0,1,20\n1,,21\n2,1,22\n", r"e.csv: row 2, column 'gyro_z': nan is not a finite number"),
         ("time,gyro_z,temperature\n0,1,20\n1,nan,21\n2,1,22\n", r"e.csv: row 2, column 'gyro_z': nan is not a finite number"),
         ("time,gyro_z,temperature\n0,1,20\n2,1,21\n1,1,22\n", r"e.csv: row 3: time goes backwards"),
-        ("t,gyro_z\n0,1\n1,2\n", r"e.csv: no 'time' column \(the file has t, gyro_z\); map one with --columns time=NAME"),
-        ("time,temperature\n0,1\n1,2\n", r"e.csv: no gyro column .*--columns gyro_z=NAME"),
+        ("t,gyro_z\n0,1\n1,2\n", r"e.csv: no 'time' column \(the file has t, gyro_z\); map one with columns=\{'time': 'NAME'\}"),
+        ("time,temperature\n0,1\n1,2\n", r"e.csv: no gyro column .*columns=\{'gyro_z': 'NAME'\}"),
     ],
 )
 def test_bad_csv_messages(tmp_path, text, message):
@@ -100,13 +100,13 @@ def test_bad_csv_messages(tmp_path, text, message):
 
 def test_mapping_errors(tmp_path):
     p = write_csv(tmp_path / "m.csv", "time,gyro_z\n0,1\n1,2\n")
-    with pytest.raises(InputError, match=r"--columns gyro_x=Nope: no column 'Nope'; the file has time, gyro_z"):
+    with pytest.raises(InputError, match=r"columns={'gyro_x': 'Nope'}: no column 'Nope'; the file has time, gyro_z"):
         read(p, TableLayout({"gyro_x": "Nope"}))
-    with pytest.raises(InputError, match=r"--columns: unknown channel 'gyro_w'"):
+    with pytest.raises(InputError, match=r"columns: unknown channel 'gyro_w'"):
         TableLayout({"gyro_w": "x"})
-    with pytest.raises(InputError, match=r"--columns: 'gyro_z' is not CHANNEL=COLUMN"):
+    with pytest.raises(InputError, match=r"columns: 'gyro_z' is not CHANNEL=COLUMN"):
         parse_column_mapping("gyro_z")
-    with pytest.raises(InputError, match=r"--accel-unit: unknown unit 'furlong/s2'"):
+    with pytest.raises(InputError, match=r"accel_unit: unknown unit 'furlong/s2'"):
         TableLayout(accel_unit="furlong/s2")
 
 
@@ -114,7 +114,7 @@ def test_missing_file_and_unknown_suffix(tmp_path):
     with pytest.raises(InputError, match=r"nothere.csv: no such file"):
         read(tmp_path / "nothere.csv")
     (tmp_path / "x.dat").write_text("time,gyro_z\n0,1\n1,2\n")
-    with pytest.raises(InputError, match=r"x.dat: cannot tell the format from the file or its suffix '.dat'; name it with --format"):
+    with pytest.raises(InputError, match=r"x.dat: cannot tell the format from the file or its suffix '.dat'; name it with fmt="):
         read(tmp_path / "x.dat")
     assert read(tmp_path / "x.dat", fmt="csv").n_samples == 2
 

@@ -10,7 +10,8 @@ import pytest
 
 from gyrocomp import Calibration, Compensator, apply, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.metrics import evaluate_stages, smoothed_residual_rms
+from gyrocomp.evaluation import evaluate_stages
+from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.acceleration import excited_columns
 from gyrocomp.effects import G_SQUARED_TERMS, g_squared_products
 from gyrocomp.simulate import get_profile, preset_model, simulate, tumble_positions
@@ -149,7 +150,7 @@ def test_acceleration_needs_accelerometer_columns():
         fit_calibration(runs, acceleration="matrix")
     cal = fit_calibration(runs)  # auto: no accelerometer, no g-sensitivity
     assert cal.fit_report["acceleration"]["mode"] == "none"
-    with pytest.raises(InputError, match="--acceleration: 'cube'; use one of auto, none, matrix, matrix2"):
+    with pytest.raises(InputError, match="acceleration: 'cube'; use one of auto, none, matrix, matrix2"):
         fit_calibration(runs, acceleration="cube")
 
 
@@ -217,7 +218,7 @@ def test_joint_network_reads_the_accelerations(consumer, pipelines, tmp_path):
 def test_unknown_pipeline():
     from gyrocomp.models.pipelines import fit_pipeline
 
-    with pytest.raises(InputError, match=r"--pipeline: 'poly>net'; use one of joint, poly>matrix, matrix>poly"):
+    with pytest.raises(InputError, match=r"pipeline: 'poly>net'; use one of joint, poly>matrix, matrix>poly"):
         fit_pipeline([simulate("mti10", profile="static", duration_s=100, rate_hz=1).recording], "poly>net")
 
 

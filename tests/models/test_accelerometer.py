@@ -100,16 +100,16 @@ def test_streaming_equals_batch_with_lag(cycles):
 
 
 def test_bad_channels_and_missing_accelerometer(cycles):
-    with pytest.raises(InputError, match=r"--channels: mag: use gyro, accel or gyro,accel"):
+    with pytest.raises(InputError, match=r"channels: mag: use gyro, accel or gyro,accel"):
         parse_channels("gyro,mag")
     bare = dataclasses.replace(cycles[0].recording, accel_g=None, accel_axes=())
-    with pytest.raises(InputError, match=r"--channels accel needs accel_x, accel_y and accel_z columns"):
+    with pytest.raises(InputError, match=r"channels=accel needs accel_x, accel_y and accel_z columns"):
         fit_accelerometer([bare])
     cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), temperature=1, hysteresis="none")
     with pytest.raises(InputError, match=r"the model compensates the accelerometer; the data needs accel_x"):
         apply(cal, bare)
-    with pytest.raises(InputError, match=r"--channels accel: the accelerometer model is a temperature model; "
-                                         r"--temperature none leaves nothing to fit"):
+    with pytest.raises(InputError, match=r"channels=accel: the accelerometer model is a temperature model; "
+                                         r"temperature=none leaves nothing to fit"):
         fit_accelerometer([cycles[0].recording], temperature=None)
     with pytest.raises(InputError, match=r"fit_accelerometer: options acceleration are for the gyro only"):
         fit_accelerometer([cycles[0].recording], acceleration="matrix")

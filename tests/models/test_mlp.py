@@ -16,11 +16,10 @@ from gyrocomp.models.mlp import (
     jacobian,
     layer_shapes,
     nguyen_widrow,
-    parse_hidden,
     train_lm,
     validation_mask,
 )
-from gyrocomp.models.temperature import parse_temperature_option
+from gyrocomp.cli import parse_hidden, parse_temperature_option
 from gyrocomp.simulate import GyroErrorModel, get_profile, preset_model, simulate
 
 

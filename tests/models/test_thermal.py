@@ -124,7 +124,7 @@ def test_heating_only_runs_get_no_hysteresis_candidates():
 
 def test_bad_hysteresis_options_and_not_fitted():
     runs = [simulate("adxrs450", profile="cycle", duration_s=2000, rate_hz=1, seed=1).recording]
-    with pytest.raises(InputError, match=r"--hysteresis: 'magic'; use one of auto, none, turning-point, lag"):
+    with pytest.raises(InputError, match=r"hysteresis: 'magic'; use one of auto, none, turning-point, lag"):
         fit_calibration(runs, hysteresis="magic")
     with pytest.raises(InputError, match=r"band_degc: \(80.0, 55.0\); give \(low, high\) with low < high"):
         ThermalHysteresisModel(order=2, band_degc=(80.0, 55.0)).fit(runs)

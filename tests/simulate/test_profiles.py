@@ -103,13 +103,13 @@ def test_preset_supplies_the_chamber_range():
 
 
 def test_profile_errors():
-    with pytest.raises(InputError, match=r"--profile: unknown profile 'oven'; use one of static, warmup"):
+    with pytest.raises(InputError, match=r"profile: unknown profile 'oven'; use one of static, warmup"):
         get_profile("oven")
-    with pytest.raises(InputError, match="--ramp-rate: must be positive, got -1"):
+    with pytest.raises(InputError, match="ramp_rate_degc_per_min: must be positive, got -1"):
         get_profile("chamber", ramp_rate_degc_per_min=-1.0)
-    with pytest.raises(InputError, match="--cycles: must be at least 1, got 0"):
+    with pytest.raises(InputError, match="cycles: must be at least 1, got 0"):
         get_profile("cycle", cycles=0)
-    with pytest.raises(InputError, match="--duration: 0.1 s is too short for two samples at 1 Hz"):
+    with pytest.raises(InputError, match="duration_s: 0.1 s is too short for two samples at 1 Hz"):
         get_profile("static").with_duration(0.1).trajectory(1.0)
-    with pytest.raises(InputError, match="--duration: must be positive, got -5"):
+    with pytest.raises(InputError, match="duration_s: must be positive, got -5"):
         get_profile("static").with_duration(-5)

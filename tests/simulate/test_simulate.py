@@ -243,9 +243,9 @@ def test_parameter_errors():
         GyroErrorModel(g_sensitivity_dps_per_g=((0, 0, 0), (0, 0, 0)))
     with pytest.raises(InputError, match=r"hysteresis band_degc: \(80, 55\); give \(low, high\) with low < high"):
         Hysteresis(((1.0,),), band_degc=(80, 55))
-    with pytest.raises(InputError, match="--rate: must be positive, got 0"):
+    with pytest.raises(InputError, match="rate_hz: must be positive, got 0"):
         simulate(rate_hz=0)
-    with pytest.raises(InputError, match="--preset: unknown preset 'bmi'"):
+    with pytest.raises(InputError, match="preset: unknown preset 'bmi'"):
         simulate("bmi")
 
 
@@ -261,5 +261,5 @@ def test_terms_switch_off_one_by_one():
     flat = simulate(quiet.without("temperature", "hysteresis", "g-sensitivity"), profile="cycle", duration_s=4000,
                     rate_hz=1)
     assert not np.any(flat.recording.gyro_dps)
-    with pytest.raises(InputError, match="--disable: unknown term 'wind'; use any of temperature, lag"):
+    with pytest.raises(InputError, match="disable: unknown term 'wind'; use any of temperature, lag"):
         base.without("wind")

@@ -57,7 +57,7 @@ def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool,
     ``to_si`` converts the model's unit to the autopilot's (deg/s -> rad/s, or g -> m/s^2)."""
     curve = axis.temperature
     if curve is None:
-        raise InputError("export: the model has no temperature curve on this axis; fit one (--temperature poly)")
+        raise InputError("export: the model has no temperature curve on this axis; fit one (temperature= a polynomial)")
     t = np.linspace(curve.t_min_degc, curve.t_max_degc, GRID_POINTS)
     bias_dps = np.asarray(curve.shape_dps(t), dtype=float) + (axis.mean_turn_on_bias_dps if with_constant else 0.0)
     d = t - reference_degc
@@ -80,7 +80,7 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
         parts.append("g-sensitivity")
     if parts:
         warnings.warn(f"{target} has no {' or '.join(parts)} term: left out of the export, only the temperature cubic "
-                      "is written (compare with `gyrocomp evaluate --stages` to see what that costs)",
+                      "is written (compare the stages of the evaluation to see what that costs)",
                       DataQualityWarning, stacklevel=3)
 
 
@@ -113,7 +113,7 @@ def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: in
     """``TC_G{instance}_*`` (and ``TC_A{instance}_*``) for PX4: TREF is the middle of the model's range,
     SCL 1, axes not in the model 0."""
     if not 0 <= instance <= 3:
-        raise InputError(f"--instance: PX4 has thermal compensation for gyros 0..3, got {instance}")
+        raise InputError(f"instance: PX4 has thermal compensation for gyros 0..3, got {instance}")
     _warn_left_out(calibration, "PX4")
     values: dict[str, float] = {}
     fits = {}
@@ -142,7 +142,7 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
     """``INS_TCAL{instance}_*`` for ArduPilot: cubic without constant about 35 degC, coefficients x 1e6
     (gyro in rad/s, accelerometer in m/s^2)."""
     if not 1 <= instance <= 3:
-        raise InputError(f"--instance: ArduPilot numbers its IMUs 1..3, got {instance}")
+        raise InputError(f"instance: ArduPilot numbers its IMUs 1..3, got {instance}")
     _warn_left_out(calibration, "ArduPilot")
     gyro, accel = _gyro_axes(calibration), _accel_axes(calibration)
     t_min, t_max = _range({**gyro, **accel})

@@ -38,12 +38,12 @@ def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
     gyros = [a.noise for a in analysis.axes.values() if a.sensor == "gyro"]
     accels = [a.noise for a in analysis.axes.values() if a.sensor == "accel"]
     if not gyros:
-        raise InputError("--kalibr: needs at least one gyro axis; add one to --axes")
+        raise InputError("kalibr: needs at least one gyro axis; add one to axes=")
     gyro_walk = max(g.rrw_dps_sqrt_hz for g in gyros) * DEG_TO_RAD
     accel_walk = max(a.random_walk_m_per_s3_per_sqrt_hz for a in accels) if accels else None
     if not accels:
         warnings.warn(f"{analysis.source}: no accelerometer axes, so imu.yaml has gyroscope values only; "
-                      "Kalibr needs both (name the accelerometer columns with --columns)", DataQualityWarning,
+                      "Kalibr needs both (name the accelerometer columns with columns=)", DataQualityWarning,
                       stacklevel=2)
     for label, walk in (("gyroscope", gyro_walk), ("accelerometer", accel_walk)):
         if walk is not None and walk == 0.0:

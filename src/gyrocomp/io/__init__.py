@@ -13,7 +13,10 @@ from pathlib import Path
 from ..errors import InputError
 from ..recording import Recording
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
-from .common import ProgressCallback, ReadOptions
+from .common import ProgressCallback, ReadOptions, sniff_format
+from .dataflash import read_dataflash
+from .hdf5 import read_hdf5
+from .rosbag import read_rosbag
 from .tables import (
     TableData,
     TableLayout,
@@ -26,6 +29,7 @@ from .tables import (
     write_gyro_back,
     write_recording,
 )
+from .ulog import read_ulog
 
 TABLE_FORMATS = ("csv", "parquet")
 LOG_FORMATS = ("ulog", "dataflash", "rosbag", "hdf5")
@@ -35,24 +39,12 @@ FORMAT_ALIASES = {"ulg": "ulog", "px4": "ulog", "bin": "dataflash", "ardupilot":
                   "ros": "rosbag", "netcdf": "hdf5", "nc": "hdf5", "h5": "hdf5", "pq": "parquet"}
 _SUFFIXES = {".ulg": "ulog", ".bin": "dataflash", ".bag": "rosbag", ".db3": "rosbag", ".mcap": "rosbag",
              ".h5": "hdf5", ".hdf5": "hdf5", ".nc": "hdf5", ".nc4": "hdf5"}
-_MAGIC = ((b"ULog\x01\x12\x35", "ulog"), (b"\x89HDF\r\n\x1a\n", "hdf5"), (b"#ROSBAG", "rosbag"),
-          (b"\x89MCAP", "rosbag"), (b"PAR1", "parquet"), (b"\xa3\x95", "dataflash"))
-
-
-def sniff_format(head: bytes) -> str | None:
-    """The format a file's first bytes announce, or None (CSV has no signature)."""
-    for magic, fmt in _MAGIC:
-        if head.startswith(magic):
-            return fmt
-    return None
-
-
 def detect_format(path: str | os.PathLike, fmt: str | None = None) -> str:
     """The format name of ``path``: ``fmt`` if given (checked), else from its first bytes or suffix."""
     if fmt is not None:
         name = FORMAT_ALIASES.get(fmt.lower(), fmt.lower())
         if name not in FORMATS:
-            raise InputError(f"--format: unknown format {fmt!r}; use one of {', '.join(FORMATS)}")
+            raise InputError(f"fmt: unknown format {fmt!r}; use one of {', '.join(FORMATS)}")
         return name
     path = Path(path)
     if path.is_dir():
@@ -68,7 +60,7 @@ def detect_format(path: str | os.PathLike, fmt: str | None = None) -> str:
     if found is None:
         raise InputError(
             f"{path}: cannot tell the format from the file or its suffix {path.suffix!r}; "
-            f"name it with --format ({', '.join(FORMATS)})"
+            f"name it with fmt= ({', '.join(FORMATS)})"
         )
     return found
 
@@ -82,15 +74,7 @@ def output_format(path: str | os.PathLike, option: str = "-o", default: str | No
 
 
 def _log_reader(fmt: str):
-    if fmt == "ulog":
-        from .ulog import read_ulog as reader
-    elif fmt == "dataflash":
-        from .dataflash import read_dataflash as reader
-    elif fmt == "rosbag":
-        from .rosbag import read_rosbag as reader
-    else:
-        from .hdf5 import read_hdf5 as reader
-    return reader
+    return {"ulog": read_ulog, "dataflash": read_dataflash, "rosbag": read_rosbag}.get(fmt, read_hdf5)
 
 
 def read_input(

@@ -149,9 +149,19 @@ def check_magic(path, expected: bytes, what: str, hint: str) -> None:
         raise InputError(f"{path}: not a {what} file ({found}); {hint}")
 
 
-def _describe_head(head: bytes) -> str:
-    from . import sniff_format
+_MAGIC = ((b"ULog\x01\x12\x35", "ulog"), (b"\x89HDF\r\n\x1a\n", "hdf5"), (b"#ROSBAG", "rosbag"),
+          (b"\x89MCAP", "rosbag"), (b"PAR1", "parquet"), (b"\xa3\x95", "dataflash"))
 
+
+def sniff_format(head: bytes) -> str | None:
+    """The format a file's first bytes announce, or None (CSV has no signature)."""
+    for magic, fmt in _MAGIC:
+        if head.startswith(magic):
+            return fmt
+    return None
+
+
+def _describe_head(head: bytes) -> str:
     fmt = sniff_format(head)
     if fmt is not None:
         return f"it looks like {fmt}"

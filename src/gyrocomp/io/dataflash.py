@@ -111,13 +111,13 @@ def _instance_records(log: _Log, instance: int) -> np.ndarray:
         imu = log.records("IMU")
         found = sorted(set(int(i) for i in np.unique(imu["I"])))
         if instance not in found:
-            raise InputError(f"{log.path}: --instance {instance}: no IMU instance {instance}; "
+            raise InputError(f"{log.path}: instance={instance}: no IMU instance {instance}; "
                              f"the log has {', '.join(map(str, found))}")
         return imu[imu["I"] == instance], found
     names = ["IMU", "IMU2", "IMU3"]
     found = [i for i, name in enumerate(names) if log.has(name)]
     if instance not in found:
-        raise InputError(f"{log.path}: --instance {instance}: no {names[instance] if instance < 3 else 'IMU'} "
+        raise InputError(f"{log.path}: instance={instance}: no {names[instance] if instance < 3 else 'IMU'} "
                          f"records; the log has instance(s) {', '.join(map(str, found))}")
     return log.records(names[instance]), found
 
@@ -129,7 +129,7 @@ def _from_imu(log: _Log, instance: int, explicit: bool):
     imu, found = _instance_records(log, instance)
     if not explicit and len(found) > 1:
         warnings.warn(f"{log.path}: {len(found)} IMU instances ({', '.join(map(str, found))}); read instance "
-                      f"{instance}, choose another with --instance N", DataQualityWarning, stacklevel=4)
+                      f"{instance}, choose another with instance=", DataQualityWarning, stacklevel=4)
     time_s = imu["TimeUS"].astype(float) * _US
     gyro = np.column_stack([imu[f"Gyr{a}"] for a in "XYZ"]).astype(float) * _RAD
     accel = np.column_stack([imu[f"Acc{a}"] for a in "XYZ"]).astype(float) * _MS2
@@ -139,13 +139,13 @@ def _from_imu(log: _Log, instance: int, explicit: bool):
 
 def _from_tclr(log: _Log, instance: int):
     if not log.has("TCLR"):
-        raise InputError(f"{log.path}: --record TCLR: no TCLR records in this log "
+        raise InputError(f"{log.path}: record=TCLR: no TCLR records in this log "
                          "(the onboard learner writes them while INS_TCALn_ENABLE = 2)")
     tclr = log.records("TCLR")
     tclr = tclr[tclr["I"] == instance]
     gyro_rows, accel_rows = tclr[tclr["SType"] == _TCLR_GYRO], tclr[tclr["SType"] == _TCLR_ACCEL]
     if gyro_rows.size < 2:
-        raise InputError(f"{log.path}: --record TCLR: {gyro_rows.size} gyro record(s) for instance {instance}; "
+        raise InputError(f"{log.path}: record=TCLR: {gyro_rows.size} gyro record(s) for instance {instance}; "
                          "at least 2 are needed")
     time_s, gyro, temperature = order_by_time(
         str(log.path), gyro_rows["TimeUS"].astype(float) * _US,
@@ -174,10 +174,10 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
     """
     options = options or ReadOptions()
     path = Path(path)
-    check_magic(path, DATAFLASH_MAGIC, "ArduPilot DataFlash", "name its real format with --format, or leave --format out to have it told from the file")
+    check_magic(path, DATAFLASH_MAGIC, "ArduPilot DataFlash", "name its real format with fmt=, or leave fmt= out to have it told from the file")
     record = (options.record or "IMU").upper()
     if record not in RECORDS:
-        raise InputError(f"--record: unknown DataFlash record {options.record!r}; use IMU or TCLR")
+        raise InputError(f"record: unknown DataFlash record {options.record!r}; use IMU or TCLR")
     log = _Log(path, progress)
     try:
         if log.cut_bytes >= 3:

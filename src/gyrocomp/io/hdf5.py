@@ -68,7 +68,7 @@ def _find(handle, source: str, channel: str, mapping: dict[str, str]):
     if channel in mapping:
         name = mapping[channel]
         if name not in handle:
-            raise InputError(f"{source}: --columns {channel}={name}: no dataset {name!r}; "
+            raise InputError(f"{source}: columns={{{channel!r}: {name!r}}}: no dataset {name!r}; "
                              f"the file has {', '.join(_datasets(handle))}")
         return handle[name]
     for name in COMMON_NAMES.get(channel, (channel,)):
@@ -130,7 +130,7 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
         raise InputError(f"{path}: a NetCDF-3 (classic) file; gyrocomp reads NetCDF-4, convert it with "
                          "'nccopy -k nc4 IN OUT'")
     if not head.startswith(HDF5_MAGIC):
-        check_magic(path, HDF5_MAGIC, "HDF5/NetCDF-4", "name its real format with --format, or leave --format out to have it told from the file")
+        check_magic(path, HDF5_MAGIC, "HDF5/NetCDF-4", "name its real format with fmt=, or leave fmt= out to have it told from the file")
     h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
     layout = options.layout
     mapping = dict(layout.columns)
@@ -138,26 +138,26 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
         time_ds = _find(handle, source, TIME_COLUMN, mapping)
         if time_ds is None:
             raise InputError(f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
-                             "map one with --columns time=NAME")
+                             "map one with columns={'time': 'NAME'}")
         time_s = np.asarray(time_ds[()], dtype=float).reshape(-1)
-        time_s = time_s * _factor("time", time_ds, layout.time_unit, "--time-unit", source)
+        time_s = time_s * _factor("time", time_ds, layout.time_unit, "time_unit", source)
         gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
         if gyro is None:
             raise InputError(f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
-                             "map one with --columns gyro=NAME (an (n, 3) array) or gyro_z=NAME")
-        gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "--gyro-unit", source)
+                             "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}")
+        gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "gyro_unit", source)
         if progress:
             progress(0.5)
         accel, accel_axes, accel_ds = _vector(handle, source, "accel", ACCEL_AXES, mapping)
         if accel is not None:
-            accel = accel * _factor("accel", accel_ds, layout.accel_unit, "--accel-unit", source)
+            accel = accel * _factor("accel", accel_ds, layout.accel_unit, "accel_unit", source)
         temp_ds = _find(handle, source, TEMPERATURE_COLUMN, mapping)
         temperature = _temperature(temp_ds, source) if temp_ds is not None else None
     n = time_s.size
     for name, values in (("gyro", gyro), ("accel", accel), ("temperature", temperature)):
         if values is not None and values.shape[0] != n:
             raise InputError(f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
-                             "map datasets of the same length with --columns")
+                             "map datasets of the same length with columns=")
     keep = np.ones(n, dtype=bool)
     if options.drop_nonfinite:
         for values in (time_s, gyro, accel, temperature):

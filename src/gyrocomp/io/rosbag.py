@@ -36,17 +36,17 @@ def _topic(path: Path, connections: list, msgtype: str, asked: str | None, optio
     if asked is not None:
         chosen = [c for c in connections if c.topic == asked]
         if not chosen:
-            raise InputError(f"{path}: {option} {asked}: no such topic in the bag; "
+            raise InputError(f"{path}: {option}={asked}: no such topic in the bag; "
                              f"its {msgtype} topics are {', '.join(of_type) or 'none'}")
         if chosen[0].msgtype != msgtype:
-            raise InputError(f"{path}: {option} {asked}: the topic has type {chosen[0].msgtype}, not {msgtype}")
+            raise InputError(f"{path}: {option}={asked}: the topic has type {chosen[0].msgtype}, not {msgtype}")
         if not sum(c.msgcount for c in chosen):
-            raise InputError(f"{path}: {option} {asked}: the topic has no messages")
+            raise InputError(f"{path}: {option}={asked}: the topic has no messages")
         return chosen
     if not of_type:
         return []
     if len(of_type) > 1:
-        raise InputError(f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with {option}")
+        raise InputError(f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with {option}=")
     return [c for c in connections if c.topic == of_type[0]]
 
 
@@ -79,11 +79,11 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
         raise InputError(f"{path}: not a readable ROS bag ({type(exc).__name__}: {exc})") from None
     try:
         connections = list(reader.connections)
-        imu = _topic(path, connections, IMU_TYPE, options.imu_topic, "--imu-topic")
+        imu = _topic(path, connections, IMU_TYPE, options.imu_topic, "imu_topic")
         if not imu:
             topics = ", ".join(sorted(f"{c.topic} ({c.msgtype})" for c in connections)) or "none"
             raise InputError(f"{path}: no {IMU_TYPE} topic in the bag; its topics are {topics}")
-        thermo = _topic(path, connections, TEMPERATURE_TYPE, options.temperature_topic, "--temperature-topic")
+        thermo = _topic(path, connections, TEMPERATURE_TYPE, options.temperature_topic, "temperature_topic")
         total = max(1, sum(c.msgcount for c in imu + thermo))
         done = 0
         n = sum(c.msgcount for c in imu)

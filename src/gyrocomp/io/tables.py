@@ -48,12 +48,12 @@ class TableLayout:
         for canonical in self.columns:
             if canonical not in CANONICAL_COLUMNS + ARRAY_CHANNELS:
                 raise InputError(
-                    f"--columns: unknown channel {canonical!r}; use any of {', '.join(CANONICAL_COLUMNS)} "
+                    f"columns: unknown channel {canonical!r}; use any of {', '.join(CANONICAL_COLUMNS)} "
                     f"(or {' and '.join(ARRAY_CHANNELS)} for an (n, 3) array in HDF5/NetCDF)"
                 )
-        unit_factor("gyro", self.gyro_unit, "--gyro-unit")
-        unit_factor("accel", self.accel_unit, "--accel-unit")
-        unit_factor("time", self.time_unit, "--time-unit")
+        unit_factor("gyro", self.gyro_unit, "gyro_unit")
+        unit_factor("accel", self.accel_unit, "accel_unit")
+        unit_factor("time", self.time_unit, "time_unit")
 
     def resolve(self, header: list[str], source: str) -> dict[str, str]:
         """Canonical name to file column for every channel present in ``header``."""
@@ -61,12 +61,12 @@ class TableLayout:
         for canonical, column in self.columns.items():
             if canonical in ARRAY_CHANNELS:
                 raise InputError(
-                    f"{source}: --columns {canonical}={column}: a table has one column per axis; "
+                    f"{source}: columns={{{canonical!r}: {column!r}}}: a table has one column per axis; "
                     f"map {canonical}_x=..., {canonical}_y=..., {canonical}_z=... instead"
                 )
             if column not in header:
                 raise InputError(
-                    f"{source}: --columns {canonical}={column}: no column {column!r}; "
+                    f"{source}: columns={{{canonical!r}: {column!r}}}: no column {column!r}; "
                     f"the file has {', '.join(header)}"
                 )
             resolved[canonical] = column
@@ -82,10 +82,10 @@ def parse_column_mapping(text: str | None) -> dict[str, str]:
         if not item.strip():
             continue
         if "=" not in item:
-            raise InputError(f"--columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
+            raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
         key, value = (part.strip() for part in item.split("=", 1))
         if not key or not value:
-            raise InputError(f"--columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
+            raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
         mapping[key] = value
     return mapping
 
@@ -200,13 +200,13 @@ def read_table(
     cols = layout.resolve(header, str(path))
     if TIME_COLUMN not in cols:
         raise InputError(
-            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with --columns time=NAME"
+            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with columns={{'time': 'NAME'}}"
         )
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
     if not gyro_axes:
         raise InputError(
             f"{path}: no gyro column (expected gyro_x, gyro_y or gyro_z; the file has {', '.join(header)}); "
-            "map one with --columns gyro_z=NAME"
+            "map one with columns={'gyro_z': 'NAME'}"
         )
     accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
     per_axis_temps = [f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in gyro_axes]
@@ -217,9 +217,9 @@ def read_table(
     else:
         temp_names = []
 
-    gyro_factor = unit_factor("gyro", layout.gyro_unit, "--gyro-unit")
-    accel_factor = unit_factor("accel", layout.accel_unit, "--accel-unit")
-    time_factor = unit_factor("time", layout.time_unit, "--time-unit")
+    gyro_factor = unit_factor("gyro", layout.gyro_unit, "gyro_unit")
+    accel_factor = unit_factor("accel", layout.accel_unit, "accel_unit")
+    time_factor = unit_factor("time", layout.time_unit, "time_unit")
     num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
     time_s = num(TIME_COLUMN) * time_factor
     gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor

@@ -43,19 +43,19 @@ def _choose(path: Path, topic: str, datasets: list, options: ReadOptions, id_fie
                 return dataset
         available = sorted({int(i) for d in found.values() for i in np.unique(d.data.get(id_field, []))})
         raise InputError(
-            f"{path}: --device-id {options.device_id}: no {topic} with that device id; "
+            f"{path}: device_id={options.device_id}: no {topic} with that device id; "
             f"the log has {', '.join(map(str, available)) or 'none'}"
         )
     instance = 0 if options.instance is None else options.instance
     if instance not in found:
         raise InputError(
-            f"{path}: --instance {instance}: no {topic} instance {instance}; "
+            f"{path}: instance={instance}: no {topic} instance {instance}; "
             f"the log has instance(s) {', '.join(map(str, sorted(found)))}"
         )
     if options.instance is None and len(found) > 1:
         warnings.warn(
             f"{path}: {len(found)} {topic} instances ({', '.join(map(str, sorted(found)))}); read instance 0, "
-            "choose another with --instance N or --device-id ID",
+            "choose another with instance= or device_id=",
             DataQualityWarning, stacklevel=4,
         )
     return found[instance]
@@ -75,7 +75,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
     """
     options = options or ReadOptions()
     path = Path(path)
-    check_magic(path, ULOG_MAGIC, "PX4 ULog", "name its real format with --format, or leave --format out to have it told from the file")
+    check_magic(path, ULOG_MAGIC, "PX4 ULog", "name its real format with fmt=, or leave fmt= out to have it told from the file")
     pyulog = require("pyulog", "ulog", "reading PX4 ULog files")
     if progress:
         progress(0.0)

@@ -9,6 +9,6 @@
   :class:`gyrocomp.calibration.Calibration` out.
 """
 
-from .temperature import PolynomialBias, PolynomialTemperatureModel, parse_temperature_option
+from .temperature import PolynomialBias, PolynomialTemperatureModel
 
-__all__ = ["PolynomialBias", "PolynomialTemperatureModel", "parse_temperature_option"]
+__all__ = ["PolynomialBias", "PolynomialTemperatureModel"]

@@ -1,6 +1,6 @@
 """g-sensitivity: the gyro bias that linear acceleration causes (thesis section 2.7).
 
-- which accelerometer axes the calibration positions excite, and so which columns of G a fit can see;
+- which accelerometer axes the calibration positions excite (:mod:`gyrocomp.models.gsensitivity`);
 - G alone by least squares over the static positions (:func:`fit_g_sensitivity`; with a temperature
   model G is fitted jointly by :class:`gyrocomp.models.thermal.ThermalHysteresisModel`);
 - the network with the three accelerations as inputs (:func:`fit_acceleration_network`).
@@ -12,70 +12,20 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..effects import G_SQUARED_TERMS
-from ..errors import DataQualityWarning, InputError
-from ..recording import ACCEL_AXES, Recording
+from ..errors import InputError
+from ..recording import Recording
+from ..static import static_segments
 from .base import block_means, provenance
+from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, turned_between_positions
 from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S, MLPTemperatureModel
-
-ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
-#: an accelerometer axis is excited when its within-run spread over the positions exceeds this [g]
-EXCITATION_G = 0.1
-
-
-def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squares: bool = False,
-                    warn: bool = True) -> tuple[tuple[int, ...], tuple[int, ...], tuple[str, ...]]:
-    """The accelerometer axes the positions excite, the g x g terms a fit can tell apart, and the names.
-
-    Parameters
-    ----------
-    accel_g : list of array (n_r, 3)
-        Per run, the (block-mean) accelerations of the fit's points [g].
-    weights : list of array (n_r,)
-        The points' weights.
-    squares : bool
-        Also choose the g x g terms (``gyrocomp.effects.G_SQUARED_TERMS`` indices) among the excited axes;
-        with all three excited, zz is left out (xx + yy + zz = 1 g^2 at rest makes it the constant).
-    warn : bool
-        Warn (``DataQualityWarning``) about axes below ``EXCITATION_G`` of within-run spread.
-    """
-    spread = np.sqrt(sum(np.sum(w[:, None] * (a - np.average(a, axis=0, weights=w)) ** 2, axis=0)
-                         for a, w in zip(accel_g, weights)) / sum(float(np.sum(w)) for w in weights))
-    excited = tuple(j for j in range(3) if spread[j] > EXCITATION_G)
-    missing = [f"{ACCEL_AXES[j]} ({spread[j]:.2g} g)" for j in range(3) if j not in excited]
-    if missing and warn:
-        warnings.warn(
-            f"the positions do not excite {', '.join(missing)}: within-run spread below {EXCITATION_G} g; "
-            "those columns of the g-sensitivity matrix are not fitted (reported as 0 with no standard error). "
-            "Record positions that tilt every axis (a tumble: +1, 0 and -1 g on each)",
-            DataQualityWarning, stacklevel=4)
-    chosen: tuple[int, ...] = ()
-    if squares:
-        pairs = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
-        chosen = tuple(m for m, term in enumerate(G_SQUARED_TERMS)
-                       if set(pairs[term]) <= set(excited) and not (len(excited) == 3 and term == "zz"))
-    return excited, chosen, tuple(ACCEL_AXES[j] for j in excited)
-
+from .thermal import ThermalHysteresisModel
 
 def _listed(values: np.ndarray) -> list:
     return [None if not np.isfinite(v) else float(v) for v in values]
-
-
-def turned_between_positions(recordings: list[Recording], min_duration_s: float) -> bool:
-    """Whether some run has an accelerometer triad and more than one orientation among its static segments."""
-    from ..static import orientations, static_segments
-
-    for rec in recordings:
-        if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
-            continue
-        if len(orientations(static_segments(rec, min_duration_s=min_duration_s))) > 1:
-            return True
-    return False
 
 
 def acceleration_report(thermal, mode: str) -> dict:
@@ -93,11 +43,9 @@ def acceleration_report(thermal, mode: str) -> dict:
 
 def fit_g_sensitivity(recordings: list[Recording], mode: str, static_min_duration_s: float) -> Calibration:
     """The thesis's 3x3 g-sensitivity matrix G (section 2.7.1) and one constant per run, by least squares over
-    the static segments, without a temperature model (no temperature, or --temperature none); ``mode``
+    the static segments, without a temperature model (no temperature, or temperature=None); ``mode``
     ``matrix2`` adds the g x g terms. With a temperature model, G is fitted jointly instead
     (:class:`gyrocomp.models.thermal.ThermalHysteresisModel`)."""
-    from .thermal import ThermalHysteresisModel
-
     flat = [dataclasses.replace(rec, temperature_degc=np.zeros(rec.n_samples)) for rec in recordings]
     thermal = ThermalHysteresisModel(order=0, hysteresis="none", acceleration=mode,
                                      static_min_duration_s=static_min_duration_s).fit(flat)
@@ -115,14 +63,12 @@ def fit_g_sensitivity(recordings: list[Recording], mode: str, static_min_duratio
 def fit_acceleration_network(recordings: list[Recording], options: dict, min_static: float) -> Calibration:
     """The thesis's acceleration network (section 2.7.2): accel_x, accel_y, accel_z in, the gyro bias out (and
     one constant per run), trained on the static segments of the runs."""
-    from ..static import static_segments
-
     hidden = options["temperature"][1] if isinstance(options.get("temperature"), tuple) else DEFAULT_HIDDEN
     network = MLPTemperatureModel(hidden=hidden, seed=options.get("mlp_seed", 0))
     segments = [static_segments(rec, min_duration_s=min_static) for rec in recordings]
     for rec in recordings:
         if rec.accel_g is None:
-            raise InputError(f"{rec.source}: --pipeline mlp>mlp-accel needs accel_x, accel_y and accel_z columns")
+            raise InputError(f"{rec.source}: pipeline=mlp>mlp-accel needs accel_x, accel_y and accel_z columns")
     axes = {}
     for axis in recordings[0].gyro_axes:
         t_in, y_in, w_in, a_in = [], [], [], []

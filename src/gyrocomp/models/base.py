@@ -8,11 +8,19 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
 from ..errors import InputError
+from ..io import file_sha256
 from ..recording import Recording
 
 #: default number of temperature bins across the span of the calibration data
 DEFAULT_BINS_PER_SPAN = 100
+
+
+#: how far outside its calibration range a temperature model is still used without a warning: the larger of
+#: this many degC and this fraction of the range
+RANGE_TOLERANCE_DEGC = 0.5
+RANGE_TOLERANCE_FRACTION = 0.01
 
 
 @dataclass(frozen=True)
@@ -129,9 +137,6 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
 def provenance(recordings) -> dict:
     """Where a calibration came from: gyrocomp's version, the time, and each input (name, rows, duration,
     rate, SHA-256 of the file when it is on disk)."""
-    from .. import __version__
-    from ..io import file_sha256
-
     inputs = []
     for rec in recordings:
         entry = {"file": Path(rec.source).name, "rows": rec.n_samples, "duration_s": rec.duration_s,

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, ModelError, NotFittedError
+from .base import RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION
 
 MAX_FAIL = 6
 MU_START, MU_DEC, MU_INC, MU_MAX = 1e-3, 0.1, 10.0, 1e10
@@ -247,8 +248,6 @@ class MLPBias:
 
     @property
     def range_tolerance_degc(self) -> float:
-        from .temperature import RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION
-
         return max(RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION * (self.t_max_degc - self.t_min_degc))
 
     def outside_range(self, temperature_degc: np.ndarray) -> bool:
@@ -310,20 +309,6 @@ class MLPBias:
         return cls(hidden, weights, float(d["output_mean_dps"]), float(d["output_scale_dps"]), float(d["t_ref_degc"]),
                    float(d["t_min_degc"]), float(d["t_max_degc"]), inputs, floats("input_min"), floats("input_max"),
                    floats("reference"))
-
-
-def parse_hidden(text: str) -> tuple[int, ...]:
-    """``"mlp"`` -> (3,), ``"mlp:5"`` -> (5,), ``"mlp:5x4"`` -> (5, 4)."""
-    text = text.strip().lower()
-    if text == "mlp":
-        return DEFAULT_HIDDEN
-    try:
-        hidden = tuple(int(h) for h in text.split(":", 1)[1].split("x"))
-    except (IndexError, ValueError):
-        hidden = ()
-    if not hidden or any(h < 1 or h > 50 for h in hidden) or len(hidden) > 3:
-        raise InputError(f"--temperature: {text!r}; use mlp, mlp:H (H hidden tanh neurons, 1..50) or mlp:HxH")
-    return hidden
 
 
 @dataclass
@@ -423,5 +408,5 @@ class MLPTemperatureModel:
             raise NotFittedError("MLPTemperatureModel is not fitted yet; call fit first")
 
 
-__all__ = ["ACCEL_INPUTS", "NETWORK_INPUTS", "MLPBias", "MLPTemperatureModel", "TrainResult", "forward", "jacobian", "layer_shapes", "parse_hidden",
+__all__ = ["ACCEL_INPUTS", "NETWORK_INPUTS", "MLPBias", "MLPTemperatureModel", "TrainResult", "forward", "jacobian", "layer_shapes", 
            "train_lm", "validation_mask"]

@@ -9,9 +9,11 @@ import warnings
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
+from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..recording import ACCEL_AXES, Recording
+from ..static import orientations, static_segments
 from .acceleration import (
     ACCELERATION_CHOICES,
     acceleration_report,
@@ -57,7 +59,7 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
         a_in.append(blocks.accel_g)
     needs_accel = any(name != "temperature" for name in inputs)
     if needs_accel and any(a is None for a in a_in):
-        raise InputError("--pipeline joint-mlp: the runs need accel_x, accel_y and accel_z columns")
+        raise InputError("pipeline=joint-mlp: the runs need accel_x, accel_y and accel_z columns")
     network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc, accel_g=a_in if needs_accel else None,
                        inputs=inputs)
     return network.curves_[axis], network.turn_on_biases_dps_[axis]
@@ -227,9 +229,9 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     if not recordings:
         raise InputError("fit: give at least one calibration run")
     if acceleration not in ("auto", *ACCELERATION_CHOICES):
-        raise InputError(f"--acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
+        raise InputError(f"acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
     if not static_min_duration_s > 0:
-        raise InputError(f"--min-static: must be a positive number of seconds, got {static_min_duration_s}")
+        raise InputError(f"static_min_duration_s: must be a positive number of seconds, got {static_min_duration_s}")
     if temperature is None and acceleration != "none" and (
             acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
         return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
@@ -244,10 +246,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         if rec.temperature_degc is None:
             raise InputError(
                 f"{rec.source}: no temperature column; a temperature model needs one "
-                "(map it with --columns temperature=NAME, or fit with --temperature none)"
+                "(map it with columns={'temperature': 'NAME'}, or fit with temperature=none)"
             )
     if hysteresis not in HYSTERESIS_CHOICES:
-        raise InputError(f"--hysteresis: {hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
+        raise InputError(f"hysteresis: {hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
     hidden = None
     if temperature == "mlp" or (isinstance(temperature, tuple) and temperature[0] == "mlp"):
         hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
@@ -355,8 +357,6 @@ PIPELINES = ("joint", "poly>matrix", "matrix>poly", "mlp>matrix", "mlp>mlp-accel
 
 
 def _residual_runs(calibration: Calibration, recordings: list[Recording]) -> list[Recording]:
-    from ..compensate import apply
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TemperatureRangeWarning)
         return [apply(calibration, rec) for rec in recordings]
@@ -396,7 +396,7 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
         recordings = [recordings]
     recordings = list(recordings)
     if pipeline not in PIPELINES:
-        raise InputError(f"--pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
+        raise InputError(f"pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
     options = dict(options)
     if pipeline == "joint":
         return fit_calibration(recordings, **options)
@@ -438,7 +438,7 @@ def parse_channels(text: str | tuple | list) -> tuple[str, ...]:
     items = tuple(c.strip() for c in (text.split(",") if isinstance(text, str) else text) if c.strip())
     unknown = [c for c in items if c not in CHANNELS]
     if unknown or not items:
-        raise InputError(f"--channels: {','.join(unknown) or repr(text)}: use gyro, accel or gyro,accel")
+        raise InputError(f"channels: {','.join(unknown) or repr(text)}: use gyro, accel or gyro,accel")
     return tuple(c for c in CHANNELS if c in items)
 
 
@@ -446,12 +446,10 @@ def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> t
     """Each run's accelerometer as a signal to fit against temperature: the whole run when it stays in one
     orientation, else each static segment on its own (its own constant absorbs its gravity projection).
     Also gives the run each piece comes from (its validation fold), and whether some run was split."""
-    from ..static import orientations, static_segments
-
     pieces, folds, split = [], [], False
     for run, rec in enumerate(recordings):
         if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
-            raise InputError(f"{rec.source}: --channels accel needs accel_x, accel_y and accel_z columns [g]")
+            raise InputError(f"{rec.source}: channels=accel needs accel_x, accel_y and accel_z columns [g]")
         if rec.temperature_degc is None:
             raise InputError(f"{rec.source}: no temperature column; an accelerometer temperature model needs one")
         accel = rec.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
@@ -484,8 +482,8 @@ def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
     if unknown:
         raise InputError(f"fit_accelerometer: options {', '.join(unknown)} are for the gyro only")
     if "temperature" in options and options["temperature"] is None:
-        raise InputError("--channels accel: the accelerometer model is a temperature model; "
-                         "--temperature none leaves nothing to fit (use poly, poly:N or mlp)")
+        raise InputError("channels=accel: the accelerometer model is a temperature model; "
+                         "temperature=none leaves nothing to fit (use a polynomial or a network)")
     pieces, folds, split = _accelerometer_pieces(recordings, options.get("static_min_duration_s", 10.0))
     if split and options.get("hysteresis", "auto") == "auto":
         options = {**options, "hysteresis": "none"}
@@ -513,8 +511,6 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
     accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
     if "gyro" not in channels:
         return accel_cal
-    from ..compensate import apply
-
     compensated = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
     gyro_cal = fit_pipeline(compensated, pipeline, **options)
     return dataclasses.replace(gyro_cal, model=f"{gyro_cal.model}; {accel_cal.model}",

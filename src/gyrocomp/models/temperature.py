@@ -20,12 +20,10 @@ import numpy as np
 
 from ..errors import InputError, ModelError, NotFittedError
 from ..recording import Recording
-from .base import TemperatureBins, bin_by_temperature, bin_width_for
+from .base import RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, TemperatureBins, bin_by_temperature, bin_width_for
 
 MAX_ORDER = 5
 #: data beyond the fitted temperature range by less than max(these) is not reported as outside it
-RANGE_TOLERANCE_DEGC = 0.5
-RANGE_TOLERANCE_FRACTION = 0.01
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins
 PARSIMONY_TOLERANCE = 1.01
 #: what a polynomial does past its fitted range: held at the edge, or continued along its tangent
@@ -111,29 +109,6 @@ def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray |
     if beyond_u is not None and order:
         cols = cols + k * clipped_u[:, None] ** (k - 1) * beyond_u[:, None]
     return cols
-
-
-def parse_temperature_option(text: str) -> int | str | tuple | None:
-    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"mlp"``/``"mlp:5"`` -> ("mlp", hidden), ``"none"`` -> None."""
-    text = text.strip().lower()
-    if text == "mlp" or text.startswith("mlp:"):
-        from .mlp import parse_hidden
-
-        return ("mlp", parse_hidden(text))
-    if text in ("poly", "auto"):
-        return "auto"
-    if text == "none":
-        return None
-    if text.startswith("poly:"):
-        try:
-            order = int(text[5:])
-        except ValueError:
-            order = -1
-        if 0 <= order <= MAX_ORDER:
-            return order
-        raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
-    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}), "
-                     "mlp (the thesis's 1-3-1 network), mlp:H or none")
 
 
 @dataclass(frozen=True)

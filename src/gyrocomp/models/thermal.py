@@ -35,7 +35,7 @@ from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..recording import Recording
 from ..static import static_segments
-from .acceleration import ACCELERATION_CHOICES, excited_columns
+from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from .base import RunBlocks, bin_width_for, block_means
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .temperature import PARSIMONY_TOLERANCE, PolynomialBias

@@ -20,8 +20,11 @@ import os
 import numpy as np
 
 from ..allan import BIAS_INSTABILITY_FACTOR
+from ..effects import find_turns
 from ..errors import InputError, MissingDependencyError
 from ..io.atomic import atomic_path
+from ..metrics import moving_average, window_samples
+from ..models.hysteresis import turn_threshold_degc
 from ..noise import NoiseAnalysis
 
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
@@ -169,9 +172,6 @@ def allan_plot(analyses: dict, title: str = "Allan deviation"):
 
 def _branches(temperature: np.ndarray) -> np.ndarray:
     """+1 where the temperature rises, -1 where it falls (robust turning points), 0 before the first move."""
-    from ..effects import find_turns
-    from ..models.hysteresis import turn_threshold_degc
-
     return find_turns(temperature, turn_threshold_degc(temperature)).direction
 
 
@@ -241,8 +241,6 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
 def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "deg/s", title: str | None = None):
     """Raw and compensated output of one axis against time (min/max envelope), with their moving averages
     over ``window_s`` [s] (computed on every sample, drawn decimated), and the temperature."""
-    from ..metrics import moving_average, window_samples
-
     plt = _pyplot()
     accel = axis.startswith("accel")
     j = (raw.accel_axes if accel else raw.gyro_axes).index(axis)

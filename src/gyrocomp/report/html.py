@@ -23,13 +23,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..calibration import Calibration
 from ..compensate import apply
 from ..errors import DataQualityWarning, TemperatureRangeWarning
-from ..metrics import default_window_s, evaluate_run, evaluate_stages, stage_calibrations
+from ..evaluation import evaluate_stages, stage_calibrations
+from ..metrics import default_window_s, evaluate_run
 from ..noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
+from ..static import static_segments
 from ..validation import ValidationResult
 from . import figures
 
@@ -205,8 +207,6 @@ def _evaluation(calibration: Calibration, runs: list[Recording], compensated: li
 
 def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: float):
     """Per gyro axis: gravity of every static position and its offset with temperature and run constants out."""
-    from ..static import static_segments
-
     no_g = calibration.without("acceleration")
     gravity, offsets = [], []
     for rec in runs:

@@ -186,7 +186,7 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
     model = model or GyroErrorModel()
     prof = resolve_profile(profile, preset_name).with_duration(duration_s)
     if not rate_hz > 0:
-        raise InputError(f"--rate: must be positive, got {rate_hz}")
+        raise InputError(f"rate_hz: must be positive, got {rate_hz}")
     traj = prof.trajectory(rate_hz)
     n = traj.time_s.size
     rng = np.random.default_rng(seed)

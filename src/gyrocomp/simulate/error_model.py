@@ -33,7 +33,6 @@ import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.signal import lfilter
 
 from ..effects import HYSTERESIS_DIRECTIONS, find_turns, g_sensitivity_offset, hysteresis_offset, thermal_lag
 from ..errors import InputError
@@ -246,7 +245,7 @@ class GyroErrorModel:
         """The same part with the named terms switched off (see ``SWITCHABLE_TERMS``)."""
         unknown = [t for t in terms if t not in SWITCHABLE_TERMS]
         if unknown:
-            raise InputError(f"--disable: unknown term {unknown[0]!r}; use any of {', '.join(SWITCHABLE_TERMS)}")
+            raise InputError(f"disable: unknown term {unknown[0]!r}; use any of {', '.join(SWITCHABLE_TERMS)}")
         changes: dict = {}
         for term in terms:
             changes.update(SWITCHABLE_TERMS[term](self))
@@ -256,7 +255,7 @@ class GyroErrorModel:
         """The same part with only ``axes`` simulated (every per-axis parameter picked accordingly)."""
         missing = [a for a in axes if a not in self.axes]
         if missing or not axes:
-            raise InputError(f"--axes: {', '.join(missing) or 'none given'}; this part has {', '.join(self.axes)}")
+            raise InputError(f"axes: {', '.join(missing) or 'none given'}; this part has {', '.join(self.axes)}")
         idx = [self.axes.index(a) for a in axes]
         pick = lambda rows: None if rows is None else tuple(rows[i] for i in idx)  # noqa: E731
         hyst = self.hysteresis
@@ -314,6 +313,8 @@ def _gauss_markov(m: int, step_s: float, time_constant_s: float, variance: float
     phi = math.exp(-step_s / time_constant_s)
     drive = rng.standard_normal(m) * math.sqrt(variance * -math.expm1(-2.0 * step_s / time_constant_s))
     drive[0] = rng.standard_normal() * math.sqrt(variance)  # start in the stationary distribution
+    from scipy.signal import lfilter  # scipy.signal is slow to import; only simulation needs it here
+
     return lfilter([1.0], [1.0, -phi], drive)
 
 

@@ -166,7 +166,7 @@ def get_preset(name: str) -> Preset:
     try:
         return PRESETS[name]
     except KeyError:
-        raise InputError(f"--preset: unknown preset {name!r}; use one of {', '.join(PRESETS)}") from None
+        raise InputError(f"preset: unknown preset {name!r}; use one of {', '.join(PRESETS)}") from None
 
 
 def _vary(rows, rng: np.random.Generator):
@@ -186,7 +186,7 @@ def preset_model(name: str, unit: int | None = None) -> GyroErrorModel:
     if unit is None:
         return model
     if unit < 0:
-        raise InputError(f"--unit: must be a whole number >= 0, got {unit}")
+        raise InputError(f"unit: must be a whole number >= 0, got {unit}")
     rng = np.random.default_rng([unit, sum(map(ord, name))])
     hyst = model.hysteresis
     if hyst is not None:

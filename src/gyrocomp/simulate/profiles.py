@@ -111,16 +111,16 @@ class Profile:
 
     def __post_init__(self) -> None:
         if not self.set_points_degc:
-            raise InputError("--set-points: give at least one temperature")
-        for option, value in (("--ramp-rate", self.ramp_rate_degc_per_min), ("--position-time", self.position_s)):
+            raise InputError("set_points_degc: give at least one temperature")
+        for option, value in (("ramp_rate_degc_per_min", self.ramp_rate_degc_per_min), ("position_s", self.position_s)):
             if not value > 0:
                 raise InputError(f"{option}: must be positive, got {value}")
         if self.dwell_s < 0 or self.move_s < 0:
-            raise InputError("--dwell and move times must not be negative")
+            raise InputError("dwell_s: the dwell and move times must not be negative")
         if self.cycles < 1:
-            raise InputError(f"--cycles: must be at least 1, got {self.cycles}")
+            raise InputError(f"cycles: must be at least 1, got {self.cycles}")
         if self.duration_s is not None and not self.duration_s > 0:
-            raise InputError(f"--duration: must be positive, got {self.duration_s}")
+            raise InputError(f"duration_s: must be positive, got {self.duration_s}")
 
     # -- temperature ----------------------------------------------------------------------------
     def _temperature_knots(self) -> tuple[np.ndarray, np.ndarray]:
@@ -190,11 +190,11 @@ class Profile:
     def trajectory(self, rate_hz: float) -> Trajectory:
         """Sample the profile every 1/rate_hz seconds over its total duration."""
         if not rate_hz > 0:
-            raise InputError(f"--rate: must be positive, got {rate_hz}")
+            raise InputError(f"rate_hz: must be positive, got {rate_hz}")
         duration = self.total_duration_s
         n = int(math.floor(duration * rate_hz + 1e-9)) + 1
         if n < 2:
-            raise InputError(f"--duration: {duration:g} s is too short for two samples at {rate_hz:g} Hz")
+            raise InputError(f"duration_s: {duration:g} s is too short for two samples at {rate_hz:g} Hz")
         time_s = np.arange(n) / rate_hz
         natural = self._natural_duration()
         stretch = natural / duration  # profile time per run time
@@ -285,6 +285,6 @@ def get_profile(name: str, **overrides) -> Profile:
     try:
         base = PROFILES[name]
     except KeyError:
-        raise InputError(f"--profile: unknown profile {name!r}; use one of {', '.join(PROFILES)}") from None
+        raise InputError(f"profile: unknown profile {name!r}; use one of {', '.join(PROFILES)}") from None
     overrides = {k: v for k, v in overrides.items() if v is not None}
     return dataclasses.replace(base, **overrides) if overrides else base
