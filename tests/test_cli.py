@@ -500,3 +500,47 @@ def test_apply_refuses_an_axis_the_model_lacks_unless_axes_are_named(workdir, tm
 ])
 def test_library_messages_are_shown_with_the_flags_that_set_their_parameters(message, shown):
     assert in_cli_words(message) == shown
+
+
+def test_apply_drop_nan_leaves_the_dropped_rows_out_and_keeps_the_others(workdir, tmp_path):
+    raw = pd.read_csv(workdir / "run3.csv").iloc[:200].copy()
+    raw.loc[5, "temperature"] = np.nan  # the gyro values of row 7 (1-based, after the header) are valid
+    raw.to_csv(tmp_path / "holes.csv", index=False)
+    r = run("apply", workdir / "model.json", tmp_path / "holes.csv", "-o", tmp_path / "out.csv", "--drop-nan")
+    assert r.returncode == 0, r.stderr
+    assert "dropped 1 of 200 rows" in r.stderr and "wrote" in r.stdout and ": 199 rows," in r.stdout
+    out = pd.read_csv(tmp_path / "out.csv")
+    assert len(out) == 199 and not out.isna().any().any()
+    np.testing.assert_array_equal(out["time"], raw["time"].drop(index=5))
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
+def test_special_outputs_are_refused_and_links_written_through(workdir, tmp_path):
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", fifo)
+    assert r.returncode == 2 and r.stderr.strip() == f"gyrocomp: error: {fifo}: is a FIFO; outputs are written to " \
+                                                     "regular files (name a new path)"
+    assert fifo.is_fifo()
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", "-")
+    assert r.returncode == 2 and "-: gyrocomp writes its outputs to files, not to standard output" in r.stderr
+    assert not Path("-").exists()
+    # a symbolic link is written through: the link stays, its target gets the output
+    (tmp_path / "real.csv").write_text("old\n")
+    (tmp_path / "link.csv").symlink_to(tmp_path / "real.csv")
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "link.csv")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "link.csv").is_symlink() and (tmp_path / "real.csv").read_text().startswith("time,gyro_x,")
+
+
+def test_sigterm_leaves_no_temporary_file(tmp_path):
+    # the console script's signal handling around an atomic write interrupted half-way
+    code = ("import os, signal, sys; from gyrocomp import cli; from gyrocomp.io.atomic import atomic_path\n"
+            "cli._exit_on_termination()\n"
+            "with atomic_path(sys.argv[1]) as tmp:\n"
+            "    tmp.write_text('half')\n"
+            "    os.kill(os.getpid(), signal.SIGTERM)\n")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "out.csv")], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 128 + 15, done.stderr
+    assert list(tmp_path.iterdir()) == []

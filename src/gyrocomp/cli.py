@@ -10,6 +10,7 @@ import contextlib
 import dataclasses
 import json
 import re
+import signal
 import sys
 import traceback
 import warnings
@@ -472,7 +473,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
     if not ctx.obj["quiet"]:
         done = [a for a in data.recording.gyro_axes if a in calibration.axes and (named is None or a in named)]
         done += list(data.recording.accel_axes) if accel is not None else []
-        click.echo(f"wrote {output}: {data.table.num_rows} rows, {', '.join(done)} compensated")
+        click.echo(f"wrote {output}: {data.recording.n_samples} rows, {', '.join(done)} compensated")
 
 
 # -- convert ----------------------------------------------------------------------------------------
@@ -1058,8 +1059,21 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
     click.echo(f"gyrocomp: warning: {in_cli_words(str(message))}", err=True)
 
 
+def _exit_on_termination() -> None:
+    """SIGTERM and SIGHUP end the command as an exception would: every temporary output is removed on the
+    way out (the atomic writers clean up on any exception) and nothing half-written is left at a target."""
+    def stop(signum, frame):
+        raise SystemExit(128 + signum)
+
+    for name in ("SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), stop)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Console entry point: runs the command and returns (and, as a script, exits with) its status."""
+    if argv is None:
+        _exit_on_termination()
     args = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in args
     previous = warnings.showwarning

@@ -125,7 +125,7 @@ def test_not_a_parquet_file(tmp_path):
         read(p)
 
 
-def test_drop_nan_reports_count_and_write_back_keeps_rows(tmp_path):
+def test_drop_nan_reports_count_and_write_back_leaves_the_dropped_rows_out(tmp_path):
     p = write_csv(tmp_path / "n.csv", "time,gyro_z,temperature,note\n0,1,20,a\n1,,21,b\n2,3,22,c\n3,4,inf,d\n4,5,23,e\n")
     with pytest.warns(DataQualityWarning, match=r"n.csv: dropped 2 of 5 rows"):
         data = read_table(p, drop_nonfinite=True)
@@ -133,9 +133,10 @@ def test_drop_nan_reports_count_and_write_back_keeps_rows(tmp_path):
     write_gyro_back(data, data.recording.gyro_dps * 2, tmp_path / "out.csv")
     out = pd.read_csv(tmp_path / "out.csv")
     assert list(out.columns) == ["time", "gyro_z", "temperature", "note"]
-    assert len(out) == 5
-    np.testing.assert_array_equal(out["gyro_z"].to_numpy(), [2, np.nan, 6, np.nan, 10])
-    assert list(out["note"]) == list("abcde")
+    # the rows read are the rows written: row 4's valid gyro value is not overwritten with NaN
+    assert len(out) == 3
+    np.testing.assert_array_equal(out["gyro_z"].to_numpy(), [2, 6, 10])
+    assert list(out["note"]) == list("ace") and list(out["time"]) == [0, 2, 4]
 
 
 def test_write_back_converts_to_file_unit(tmp_path):
@@ -218,3 +219,14 @@ def test_accel_nan_names_its_column(tmp_path):
 def test_quoted_numbers_are_read(tmp_path):
     p = write_csv(tmp_path / "q.csv", 'time,gyro_z,temperature\n0,"1.5",20\n1,"2.5",21\n')
     np.testing.assert_array_equal(read(p).gyro_dps[:, 0], [1.5, 2.5])
+
+
+def test_written_csv_headers_are_unquoted_unless_a_name_needs_quotes(tmp_path):
+    p = write_csv(tmp_path / "h.csv", 'time,gyro_z,"temp, C"\n0,1,20\n1,2,21\n')
+    data = read_table(p, TableLayout({"temperature": "temp, C"}))
+    write_gyro_back(data, data.recording.gyro_dps, tmp_path / "o.csv")
+    assert (tmp_path / "o.csv").read_text().splitlines()[0] == '"time","gyro_z","temp, C"'
+    plain = read_table(write_csv(tmp_path / "p.csv", "time,gyro_z\n0,1\n1,2\n"))
+    write_gyro_back(plain, plain.recording.gyro_dps, tmp_path / "q.csv")
+    assert (tmp_path / "q.csv").read_text().splitlines()[0] == "time,gyro_z"
+    assert list(pd.read_csv(tmp_path / "o.csv").columns) == ["time", "gyro_z", "temp, C"]

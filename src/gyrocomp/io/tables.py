@@ -270,7 +270,16 @@ def _write_arrow(table: pa.Table, path: Path, fmt: str) -> None:
         if fmt == "parquet":
             pq.write_table(table, tmp)
         else:
-            pacsv.write_csv(table, tmp)
+            pacsv.write_csv(table, tmp, _csv_options(table.column_names))
+
+
+def _csv_options(names: list[str]) -> pacsv.WriteOptions:
+    """A header as other tools write and expect it: names unquoted unless one needs quotes."""
+    plain = not any(ch in name for name in names for ch in ',"\n\r')
+    try:
+        return pacsv.WriteOptions(quoting_header="none" if plain else "needed")
+    except TypeError:  # pyarrow without the option (before 17): its default, quoted names
+        return pacsv.WriteOptions()
 
 
 def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLike, *, fmt: str | None = None,
@@ -278,12 +287,15 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
     """Write the table as read with its gyro columns replaced by ``gyro_dps`` [deg/s] (and its accelerometer
     columns by ``accel_g`` [g], when given).
 
-    Values are converted back to the file's units; rows dropped on reading get NaN;
-    every other column, the column order and the row count are unchanged. Written atomically.
+    Values are converted back to the file's units; every other column and the column order are unchanged.
+    Rows dropped on reading (``drop_nonfinite``) are left out of the output as well, as ``convert`` does: a
+    row that could not be compensated is not written with its valid values replaced. Written atomically.
     """
     path = Path(path)
     fmt = fmt or detect_table_format(path) or "csv"
     table = data.table
+    if data.kept_rows.size < table.num_rows:
+        table = table.take(pa.array(data.kept_rows))
     n = table.num_rows
     replaced = [(data.recording.gyro_axes, gyro_dps, unit_factor("gyro", data.layout.gyro_unit))]
     if accel_g is not None:
@@ -291,8 +303,7 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
     for axes, values_internal, factor in replaced:
         for j, axis in enumerate(axes):
             column = data.resolved_columns[axis]
-            values = np.full(n, np.nan)
-            values[data.kept_rows] = values_internal[:, j] / factor
+            values = values_internal[:, j] / factor
             table = table.set_column(table.column_names.index(column), column, pa.array(values, type=pa.float64()))
     _write_arrow(table, path, fmt)
 
