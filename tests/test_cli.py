@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from gyrocomp.calibration import SCHEMA_VERSION
-from gyrocomp.cli import in_cli_words
+from gyrocomp.cli import _environment_message, in_cli_words
 
 SCRIPT = Path(sys.executable).parent / "gyrocomp"
 
@@ -544,3 +544,40 @@ def test_sigterm_leaves_no_temporary_file(tmp_path):
                           timeout=120)
     assert done.returncode == 128 + 15, done.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads files whatever their permissions")
+def test_permission_denied_is_a_bad_input_in_one_line(workdir, tmp_path):
+    locked = tmp_path / "locked.csv"
+    shutil.copy(workdir / "run3.csv", locked)
+    locked.chmod(0)
+    r = run("apply", workdir / "model.json", locked, "-o", tmp_path / "o.csv")
+    assert r.returncode == 2 and r.stderr.strip() == f"gyrocomp: error: {locked}: permission denied; check its permissions"
+
+
+def test_a_model_that_is_a_symbolic_link_loop(workdir, tmp_path):
+    loop = tmp_path / "loop.json"
+    loop.symlink_to(loop)
+    r = run("apply", loop, workdir / "run3.csv", "-o", tmp_path / "o.csv")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert r.stderr.strip() == f"gyrocomp: error: {loop}: cannot read the model file (too many levels of symbolic links)"
+
+
+def test_a_write_the_file_system_refuses_is_a_bad_input_and_leaves_nothing(workdir, tmp_path):
+    resource = pytest.importorskip("resource")
+    limit = lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (64 * 1024, 64 * 1024))  # noqa: E731 - ulimit -f 64
+    done = subprocess.run([shutil.which("gyrocomp") or str(Path(sys.executable).with_name("gyrocomp")), "apply",
+                           str(workdir / "model.json"), str(workdir / "run3.csv"), "-o", str(tmp_path / "o.csv")],
+                          capture_output=True, text=True, preexec_fn=limit, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith("gyrocomp: error: ") and "file too large" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("exc, line", [
+    (PermissionError(13, "Permission denied", "x.csv"), "x.csv: permission denied; check its permissions"),
+    (OSError(28, "No space left on device", "o.csv"), "o.csv: no space left on device; the disk is full; free space and run again"),
+    (MemoryError(), "not enough memory for this size of data; process it in pieces or on a larger machine"),
+])
+def test_environment_errors_read_as_one_line(exc, line):
+    assert _environment_message(exc) == line

@@ -16,6 +16,7 @@ from .errors import (
     ModelChoiceWarning,
     ModelError,
     NotFittedError,
+    PlausibilityWarning,
     TemperatureRangeWarning,
 )
 from .evaluation import evaluate, evaluate_stages
@@ -34,7 +35,7 @@ fit = fit_calibration
 
 __all__ = [
     "AllanResult", "Calibration", "Compensator", "DataQualityWarning", "Evaluation", "GyrocompError", "InputError",
-    "MissingDependencyError", "ModelChoiceWarning", "ModelError", "NotFittedError", "PolynomialTemperatureModel",
+    "MissingDependencyError", "ModelChoiceWarning", "ModelError", "NotFittedError", "PlausibilityWarning", "PolynomialTemperatureModel",
     "Recording", "TemperatureRangeWarning", "allan_deviation", "analyse_noise", "apply", "evaluate",
     "evaluate_run", "evaluate_stages", "fit", "fit_calibration", "fit_channels", "noise_parameters",
     "predict_error", "read", "simulate", "validate", "write", "__version__",

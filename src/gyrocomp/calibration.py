@@ -372,6 +372,8 @@ class Calibration:
             raise InputError(f"{path}: no such model file") from None
         except (UnicodeDecodeError, IsADirectoryError):
             raise InputError(f"{path}: not a gyrocomp model file (not UTF-8 JSON text)") from None
+        except OSError as exc:  # permissions, a symbolic link loop, a device that fails
+            raise InputError(f"{path}: cannot read the model file ({(exc.strerror or type(exc).__name__).lower()})") from None
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import errno
 import json
 import re
 import signal
@@ -1059,6 +1060,18 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
     click.echo(f"gyrocomp: warning: {in_cli_words(str(message))}", err=True)
 
 
+def _environment_message(exc: BaseException) -> str:
+    """One line for an error of the machine rather than of gyrocomp: the file and what to do."""
+    if isinstance(exc, MemoryError):
+        return "not enough memory for this size of data; process it in pieces or on a larger machine"
+    where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+    hint = {errno.EACCES: "check its permissions", errno.EPERM: "check its permissions",
+            errno.ENOSPC: "the disk is full; free space and run again", errno.EFBIG: "the file is too large here",
+            errno.ELOOP: "a symbolic link loops", errno.EROFS: "the file system is read-only"}
+    reason = exc.strerror or type(exc).__name__
+    return f"{where}{reason.lower()}" + (f"; {hint[exc.errno]}" if getattr(exc, "errno", None) in hint else "")
+
+
 def _exit_on_termination() -> None:
     """SIGTERM and SIGHUP end the command as an exception would: every temporary output is removed on the
     way out (the atomic writers clean up on any exception) and nothing half-written is left at a target."""
@@ -1101,6 +1114,11 @@ def main(argv: list[str] | None = None) -> int:
             traceback.print_exc()
         click.echo(f"gyrocomp: error: {exc}", err=True)
         status = EXIT_FAILURE
+    except (OSError, MemoryError) as exc:  # the environment, not a bug: permissions, a full disk, a link loop
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {_environment_message(exc)}", err=True)
+        status = EXIT_INPUT
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
         if debug:
             traceback.print_exc()

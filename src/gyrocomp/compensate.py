@@ -9,8 +9,9 @@ import numpy as np
 
 from .calibration import Calibration
 from .effects import find_turns, g_sensitivity_offset, thermal_lag
-from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
+from .errors import DataQualityWarning, InputError, PlausibilityWarning, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
+from .plausibility import recording_concerns
 from .recording import ACCEL_AXES, Recording
 
 
@@ -230,6 +231,8 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
         rest raw, with a warning saying which.
     """
     calibration = _restricted(calibration, recording, axes)
+    for concern in recording_concerns(recording):
+        warnings.warn(concern.message, PlausibilityWarning, stacklevel=2)
     comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
                        rate_hz=recording.rate_hz, source=recording.source)
     accel = None

@@ -29,6 +29,11 @@ class DataQualityWarning(UserWarning):
     """Data was accepted but something about it deserves attention (rows dropped, gaps found)."""
 
 
+class PlausibilityWarning(DataQualityWarning):
+    """The data is probably not what it claims: a unit mistake (kelvin, ms), values beyond any MEMS sensor, a
+    calibration run that turns or whose temperature barely varies (:mod:`gyrocomp.plausibility`)."""
+
+
 class MissingDependencyError(GyrocompError, ImportError):
     """An optional package is needed for this (the message names the extra to install; CLI exit status 1)."""
 

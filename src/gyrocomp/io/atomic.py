@@ -78,7 +78,7 @@ def refuse_to_overwrite_inputs(output: str | os.PathLike, inputs: Iterable[str |
     out = Path(output)
     for item in inputs:
         src = Path(item)
-        same = out.resolve() == src.resolve()
+        same = os.path.realpath(out) == os.path.realpath(src)  # realpath, unlike resolve, survives link loops
         if not same and out.exists() and src.exists():
             same = os.path.samefile(out, src)
         if same:

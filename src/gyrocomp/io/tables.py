@@ -296,7 +296,6 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
     table = data.table
     if data.kept_rows.size < table.num_rows:
         table = table.take(pa.array(data.kept_rows))
-    n = table.num_rows
     replaced = [(data.recording.gyro_axes, gyro_dps, unit_factor("gyro", data.layout.gyro_unit))]
     if accel_g is not None:
         replaced.append((data.recording.accel_axes, accel_g, unit_factor("accel", data.layout.accel_unit)))

@@ -1,0 +1,101 @@
+"""Plausibility of a recording: what is probably a unit mistake or the wrong kind of data, said before a fit or a
+compensation quietly produces a wrong result.
+
+Each check is a pure function of the recording that returns the concerns it finds (empty when none); the
+pipelines and ``apply`` turn them into :class:`gyrocomp.errors.PlausibilityWarning` (a
+:class:`DataQualityWarning`), which ``warnings.filterwarnings`` silences like any other warning.
+
+The limits are physical, not tuned: MEMS gyros measure at most a few thousand deg/s; a zero-rate offset is at
+most tens of deg/s (the MPU-6050's tolerance is +-20 deg/s); a bias does not move by tens of deg/s within a run
+at rest; temperatures of electronics in degC lie far below 150 (in kelvin they are above 200); sample rates of
+logged IMUs lie between 1 mHz and 100 kHz.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .metrics import moving_average
+from .recording import Recording
+
+#: beyond any MEMS gyro's measurement range [deg/s]
+MAX_RATE_DPS = 5000.0
+#: beyond any zero-rate offset at rest [deg/s]
+MAX_OFFSET_DPS = 50.0
+#: a bias moves less than this within a run at rest; more is rotation [deg/s], judged on 10 s means
+MAX_SWING_DPS = 25.0
+SWING_WINDOW_S = 10.0
+#: electronics read in degC stay below this; a median above it is probably kelvin [degC]
+KELVIN_LOOKING_DEGC = 150.0
+#: a calibration run that varies less than this in temperature cannot identify a temperature curve [degC]
+MIN_TEMPERATURE_SPAN_DEGC = 1.0
+#: plausible sample rates of a logged IMU [Hz] (the fastest MEMS output data rates are 32 kHz)
+RATE_RANGE_HZ = (1e-3, 4e4)
+#: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
+LONG_SLOW_S = 7 * 86400.0
+
+
+@dataclass(frozen=True)
+class Concern:
+    """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
+    ``temperature-span``) and the one-line message, which starts with the recording's source."""
+
+    check: str
+    message: str
+
+
+def recording_concerns(recording: Recording) -> list[Concern]:
+    """Unit mistakes any use of ``recording`` suffers from: values beyond any MEMS range, kelvin-looking
+    temperatures, an implausible sample rate (a time column in ms read as s, or the reverse)."""
+    out = []
+    src = recording.source
+    peak = float(np.max(np.abs(recording.gyro_dps))) if recording.gyro_dps.size else 0.0
+    if peak > MAX_RATE_DPS:
+        out.append(Concern("rate", f"{src}: gyro values up to {peak:.3g} deg/s, beyond any MEMS gyro's range "
+                                   f"({MAX_RATE_DPS:g} deg/s): a unit mistake or a corrupt file?"))
+    if recording.temperature_degc is not None:
+        median = float(np.median(recording.temperature_degc))
+        if median > KELVIN_LOOKING_DEGC:
+            out.append(Concern("kelvin", f"{src}: median temperature {median:.4g} degC looks like kelvin; "
+                                         "gyrocomp reads degC (subtract 273.15)"))
+    lo, hi = RATE_RANGE_HZ
+    if not lo <= recording.rate_hz <= hi:
+        out.append(Concern("time-unit", f"{src}: {recording.rate_hz:.3g} Hz is no IMU's sample rate: is the time "
+                                        "column in another unit than the one given?"))
+    elif recording.duration_s > LONG_SLOW_S and recording.rate_hz <= 1.0:
+        out.append(Concern("time-unit", f"{src}: {recording.duration_s / 86400:.3g} days at {recording.rate_hz:.3g} "
+                                        "Hz: is the time column in ms read as s?"))
+    return out
+
+
+def calibration_concerns(recording: Recording) -> list[Concern]:
+    """What makes ``recording`` a poor calibration run besides :func:`recording_concerns`: a zero-rate offset
+    no MEMS part has, or a swing of the 10 s means that only rotation makes (a 10 s mean is the angle turned
+    over 10 s: turning a unit between positions, 90 or 180 degrees, stays below the limit, a rate table does
+    not), and a temperature that barely varies (with its own constant, such a run adds nothing to the curve)."""
+    out = recording_concerns(recording)
+    src = recording.source
+    w = max(1, int(round(SWING_WINDOW_S * recording.rate_hz)))
+    for j, axis in enumerate(recording.gyro_axes):
+        x = recording.gyro_dps[:, j]
+        median = float(np.median(x))
+        if abs(median) > MAX_OFFSET_DPS:
+            out.append(Concern("offset", f"{src}: {axis} reads {median:.3g} deg/s at the median, more than any "
+                                         "zero-rate offset: does the unit turn, or is the unit of the data wrong?"))
+        if x.size >= w:
+            swing = float(np.ptp(moving_average(x, w)))
+            if swing > MAX_SWING_DPS:
+                out.append(Concern("rotation", f"{src}: {axis} swings by {swing:.3g} deg/s over {SWING_WINDOW_S:g} s "
+                                               "means: the unit turns, and a calibration run must be at rest "
+                                               "(record still positions, or cut the run to them)"))
+    if recording.temperature_degc is not None:
+        span = float(np.ptp(recording.temperature_degc))
+        if span < MIN_TEMPERATURE_SPAN_DEGC:
+            out.append(Concern("temperature-span", f"{src}: the temperature spans only {span:.3g} degC; a "
+                                                   "temperature curve needs runs over a temperature range"))
+    return out
+
+
+__all__ = ["Concern", "calibration_concerns", "recording_concerns"]

@@ -1,0 +1,84 @@
+"""Plausibility checks: unit mistakes and the wrong kind of data are said, never silently fitted."""
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import apply, fit_calibration
+from gyrocomp.errors import DataQualityWarning, PlausibilityWarning
+from gyrocomp.plausibility import calibration_concerns, recording_concerns
+from gyrocomp.recording import Recording
+from gyrocomp.simulate import simulate
+
+RUN = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=1).recording
+
+
+def _checks(concerns):
+    return [c.check for c in concerns]
+
+
+def test_a_clean_calibration_run_raises_no_concern():
+    assert calibration_concerns(RUN) == []
+    # turning between positions (moves recorded) is not rotation: a 10 s mean is the angle turned / 10 s
+    tumble = simulate("consumer", profile="tumble", rate_hz=10, seed=2).recording
+    assert "rotation" not in _checks(calibration_concerns(tumble))
+
+
+def test_kelvin_looking_temperatures():
+    kelvin = dataclasses.replace(RUN, temperature_degc=RUN.temperature_degc + 273.15)
+    (concern,) = recording_concerns(kelvin)
+    assert concern.check == "kelvin" and "looks like kelvin; gyrocomp reads degC" in concern.message
+
+
+def _still(rate_hz, n, time_factor=1.0):
+    t = np.arange(n) / rate_hz
+    return Recording(time_s=t * time_factor, gyro_dps=np.zeros((n, 1)), gyro_axes=("gyro_z",),
+                     temperature_degc=np.linspace(20.0, 30.0, n), source="t.csv")
+
+
+def test_time_in_another_unit():
+    # 10 Hz with the time in ms read as s: 0.01 Hz for 116 days
+    (concern,) = recording_concerns(_still(10.0, 100_000, time_factor=1000.0))
+    assert concern.check == "time-unit" and concern.message == "t.csv: 116 days at 0.01 Hz: is the time column in ms read as s?"
+    # 100 Hz with the time in s read as ms: 100 kHz
+    (concern,) = recording_concerns(_still(100.0, 1000, time_factor=1e-3))
+    assert concern.message.startswith("t.csv: 1e+05 Hz is no IMU's sample rate")
+    assert recording_concerns(_still(100.0, 1000)) == []
+
+
+def test_values_beyond_any_mems_range():
+    gyro = RUN.gyro_dps.copy()
+    gyro[10, 0] = 6e31
+    (concern,) = recording_concerns(dataclasses.replace(RUN, gyro_dps=gyro))
+    assert concern.check == "rate" and "6e+31 deg/s, beyond any MEMS gyro's range" in concern.message
+
+
+def test_a_rate_table_run_is_rotation_and_a_large_offset_is_said():
+    gyro = RUN.gyro_dps.copy()
+    gyro[100:400, 2] += 100.0  # 150 s at 100 deg/s about z, still before and after
+    checks = _checks(calibration_concerns(dataclasses.replace(RUN, gyro_dps=gyro)))
+    assert checks == ["rotation"]
+    spinning = dataclasses.replace(RUN, gyro_dps=RUN.gyro_dps + 80.0)
+    assert _checks(calibration_concerns(spinning)) == ["offset"] * 3
+
+
+def test_constant_temperature_run():
+    flat = dataclasses.replace(RUN, temperature_degc=np.full(RUN.n_samples, 25.0))
+    (concern,) = calibration_concerns(flat)
+    assert concern.check == "temperature-span" and "spans only 0 degC" in concern.message
+
+
+def test_fit_and_apply_warn_and_the_warning_can_be_silenced():
+    kelvin = dataclasses.replace(RUN, temperature_degc=RUN.temperature_degc + 273.15)
+    with pytest.warns(PlausibilityWarning, match=r"looks like kelvin"):
+        cal = fit_calibration([kelvin], temperature=2)
+    with pytest.warns(PlausibilityWarning, match=r"looks like kelvin"):
+        apply(cal, kelvin)
+    assert issubclass(PlausibilityWarning, DataQualityWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", category=PlausibilityWarning)
+        warnings.filterwarnings("ignore", category=DataQualityWarning)
+        apply(cal, kelvin)
