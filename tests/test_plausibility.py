@@ -8,7 +8,7 @@ import pytest
 
 from gyrocomp import apply, fit_calibration
 from gyrocomp.errors import DataQualityWarning, PlausibilityWarning
-from gyrocomp.plausibility import calibration_concerns, recording_concerns
+from gyrocomp.plausibility import calibration_concerns, recording_concerns, temperature_span_concern
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 
@@ -64,10 +64,13 @@ def test_a_rate_table_run_is_rotation_and_a_large_offset_is_said():
     assert _checks(calibration_concerns(spinning)) == ["offset"] * 3
 
 
-def test_constant_temperature_run():
+def test_a_curve_asked_for_on_runs_at_one_temperature():
     flat = dataclasses.replace(RUN, temperature_degc=np.full(RUN.n_samples, 25.0))
-    (concern,) = calibration_concerns(flat)
-    assert concern.check == "temperature-span" and "spans only 0 degC" in concern.message
+    assert calibration_concerns(flat) == [] and temperature_span_concern([RUN, flat]) is None
+    concern = temperature_span_concern([flat, flat])
+    assert concern.check == "temperature-span" and "every run spans at most 0 degC" in concern.message
+    with pytest.warns(PlausibilityWarning, match=r"every run spans at most 0 degC"):
+        fit_calibration([flat, flat], temperature=2)
 
 
 def test_fit_and_apply_warn_and_the_warning_can_be_silenced():

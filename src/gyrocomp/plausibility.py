@@ -74,7 +74,7 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
     """What makes ``recording`` a poor calibration run besides :func:`recording_concerns`: a zero-rate offset
     no MEMS part has, or a swing of the 10 s means that only rotation makes (a 10 s mean is the angle turned
     over 10 s: turning a unit between positions, 90 or 180 degrees, stays below the limit, a rate table does
-    not), and a temperature that barely varies (with its own constant, such a run adds nothing to the curve)."""
+    not)."""
     out = recording_concerns(recording)
     src = recording.source
     w = max(1, int(round(SWING_WINDOW_S * recording.rate_hz)))
@@ -90,12 +90,18 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
                 out.append(Concern("rotation", f"{src}: {axis} swings by {swing:.3g} deg/s over {SWING_WINDOW_S:g} s "
                                                "means: the unit turns, and a calibration run must be at rest "
                                                "(record still positions, or cut the run to them)"))
-    if recording.temperature_degc is not None:
-        span = float(np.ptp(recording.temperature_degc))
-        if span < MIN_TEMPERATURE_SPAN_DEGC:
-            out.append(Concern("temperature-span", f"{src}: the temperature spans only {span:.3g} degC; a "
-                                                   "temperature curve needs runs over a temperature range"))
     return out
 
 
-__all__ = ["Concern", "calibration_concerns", "recording_concerns"]
+def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
+    """A temperature curve asked for on runs that each stay at one temperature: with one constant per run, such
+    runs say nothing about the curve (a multi-position run at room temperature is fine for G alone)."""
+    spans = [float(np.ptp(r.temperature_degc)) for r in recordings if r.temperature_degc is not None]
+    if not spans or max(spans) >= MIN_TEMPERATURE_SPAN_DEGC:
+        return None
+    return Concern("temperature-span", f"{recordings[0].source}: the temperature of every run spans at most "
+                                       f"{max(spans):.3g} degC; a temperature curve needs runs over a temperature "
+                                       "range (or fit with temperature=none)")
+
+
+__all__ = ["Concern", "calibration_concerns", "recording_concerns", "temperature_span_concern"]

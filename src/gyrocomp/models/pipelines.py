@@ -12,7 +12,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import InputError, ModelChoiceWarning, PlausibilityWarning, TemperatureRangeWarning
-from ..plausibility import calibration_concerns
+from ..plausibility import calibration_concerns, temperature_span_concern
 from ..recording import ACCEL_AXES, Recording
 from ..static import orientations, static_segments
 from .acceleration import (
@@ -233,9 +233,11 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         raise InputError(f"acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
     if not static_min_duration_s > 0:
         raise InputError(f"static_min_duration_s: must be a positive number of seconds, got {static_min_duration_s}")
-    for rec in recordings:
-        for concern in calibration_concerns(rec):
-            warnings.warn(concern.message, PlausibilityWarning, stacklevel=2)
+    concerns = [c for rec in recordings for c in calibration_concerns(rec)]
+    if temperature not in (None, "auto", 0):  # a curve asked for
+        concerns.append(temperature_span_concern(recordings))
+    for concern in filter(None, concerns):
+        warnings.warn(concern.message, PlausibilityWarning, stacklevel=2)
     if temperature is None and acceleration != "none" and (
             acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
         return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
