@@ -105,20 +105,7 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     ``report`` and matplotlib installed, ``report.html`` (the model judged on the held-out run).
     """
     out_dir.mkdir(parents=True, exist_ok=True)
-    cal_profile = get_profile("combined", set_points_degc=(-25.0, 90.0), ramp_rate_degc_per_min=1.0, dwell_s=900.0)
-    cal_paths = []
-    for seed in CALIBRATION_SEEDS:
-        sim = simulate(PRESET, profile=cal_profile, rate_hz=rate_hz, seed=seed)
-        path = out_dir / f"calibration_run_{seed}.csv"
-        write_recording(sim.recording, path)
-        cal_paths.append(path)
-    held_profile = get_profile("cycle", set_points_degc=HELDOUT_RANGE_DEGC, cycles=3, dwell_s=600.0,
-                               ramp_rate_degc_per_min=HELDOUT_RAMP_DEGC_PER_MIN, positions_g=(HELDOUT_TILT_G,))
-    held = simulate(PRESET, profile=held_profile, rate_hz=rate_hz, seed=HELDOUT_SEED)
-    held_path = out_dir / "heldout_run.csv"
-    write_recording(held.recording, held_path)
-    write_text_atomic(out_dir / "heldout_truth.json", json.dumps(held.truth.to_dict(), indent=2) + "\n")
-
+    cal_paths, held, held_path = _simulate_inputs(out_dir, rate_hz)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)  # the pauses while turning the unit are the profile's
         cal_runs = [read_table(p).recording for p in cal_paths]
@@ -139,20 +126,62 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     write_text_atomic(out_dir / "validation.json", json.dumps(validation.to_dict(), indent=2) + "\n")
     allan = _allan_table(held, compensated)
     write_text_atomic(out_dir / "allan.json", json.dumps({a: c.to_dict() for a, c in allan.items()}, indent=2) + "\n")
+    effects, residual, methods_rms = _effects(held, calibration, by_method, rate_hz)
+    write_text_atomic(out_dir / "effects.json", json.dumps(
+        {"window_s": EFFECT_WINDOW_S, "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
+         "residual_peak_to_peak_dps": residual,
+         "deterministic_error_left_rms_dps_by_method": methods_rms}, indent=2) + "\n")
+    w = window_samples(run_eval.window_s, rate_hz, held.recording.n_samples)
+    perfect = {axis: smoothed_residual_rms(held.truth.noise.total_dps[:, j], w)
+               for j, axis in enumerate(held.recording.gyro_axes)}
+    lines = _summary(len(cal_paths), rate_hz, calibration, held, effects, residual, allan, run_eval, perfect,
+                     methods_rms)
+    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html", validation) if report else "not asked for"
+    if skipped is None:
+        lines.append(f"Report of the model on the held-out run: {out_dir / 'report.html'} (open it in a browser).")
+    files = sorted(out_dir.iterdir())
+    return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, validation, allan,
+                      "\n".join(lines), files, skipped)
 
-    axes = held.recording.gyro_axes
-    w_eff = window_samples(EFFECT_WINDOW_S, rate_hz, held.recording.n_samples)
-    truth = held.truth
-    modelled = calibration.axes.values()
-    status = {
-        "temperature": "compensated" + (" (with fitted thermal lag on " + ", ".join(
-            a for a, ax in calibration.axes.items() if ax.lag_time_constant_s > 0) + ")"
-            if any(ax.lag_time_constant_s > 0 for ax in modelled) else ""),
-        "hysteresis": "compensated on " + ", ".join(a for a, ax in calibration.axes.items() if ax.hysteresis)
-        if any(ax.hysteresis for ax in modelled) else "not modelled: the data chose no hysteresis",
-        "acceleration": "compensated: 3x3 G fitted jointly" if calibration.has_acceleration
-        else "not modelled",
+
+def _simulate_inputs(out_dir: Path, rate_hz: float):
+    """The three calibration runs and the held-out run as CSV files (and the held-out truth as JSON)."""
+    cal_profile = get_profile("combined", set_points_degc=(-25.0, 90.0), ramp_rate_degc_per_min=1.0, dwell_s=900.0)
+    cal_paths = []
+    for seed in CALIBRATION_SEEDS:
+        sim = simulate(PRESET, profile=cal_profile, rate_hz=rate_hz, seed=seed)
+        path = out_dir / f"calibration_run_{seed}.csv"
+        write_recording(sim.recording, path)
+        cal_paths.append(path)
+    held_profile = get_profile("cycle", set_points_degc=HELDOUT_RANGE_DEGC, cycles=3, dwell_s=600.0,
+                               ramp_rate_degc_per_min=HELDOUT_RAMP_DEGC_PER_MIN, positions_g=(HELDOUT_TILT_G,))
+    held = simulate(PRESET, profile=held_profile, rate_hz=rate_hz, seed=HELDOUT_SEED)
+    held_path = out_dir / "heldout_run.csv"
+    write_recording(held.recording, held_path)
+    write_text_atomic(out_dir / "heldout_truth.json", json.dumps(held.truth.to_dict(), indent=2) + "\n")
+    return cal_paths, held, held_path
+
+
+def _status(calibration: Calibration) -> dict[str, str]:
+    """What the fitted model does about each effect, in words."""
+    axes = calibration.axes
+    lagged = [a for a, ax in axes.items() if ax.lag_time_constant_s > 0]
+    with_hysteresis = [a for a, ax in axes.items() if ax.hysteresis]
+    return {
+        "temperature": "compensated" + (f" (with fitted thermal lag on {', '.join(lagged)})" if lagged else ""),
+        "hysteresis": f"compensated on {', '.join(with_hysteresis)}" if with_hysteresis
+        else "not modelled: the data chose no hysteresis",
+        "acceleration": "compensated: 3x3 G fitted jointly" if calibration.has_acceleration else "not modelled",
     }
+
+
+def _effects(held, calibration: Calibration, by_method: dict, rate_hz: float):
+    """Each effect's size in the held-out run, what gyrocomp's model leaves of them (peak-to-peak [deg/s]), and
+    the deterministic error every method leaves (RMS of the moving average [deg/s])."""
+    axes = held.recording.gyro_axes
+    truth = held.truth
+    w_eff = window_samples(EFFECT_WINDOW_S, rate_hz, held.recording.n_samples)
+    status = _status(calibration)
     # the tilt is held all run, so its g-sensitivity is a constant: its size is the mean, not a swing
     effects = [
         EffectSize(name, {a: float(np.ptp(moving_average(truth.components_dps[key][:, j], w_eff)) if swing
@@ -166,26 +195,24 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
              for name, rec in {"raw (no compensation)": held.recording, **by_method}.items()}
     left = lefts[f"gyrocomp: {calibration.model}"]
     residual = {a: float(np.ptp(moving_average(left[:, j] - left[:, j].mean(), w_eff))) for j, a in enumerate(axes)}
-
-    w = window_samples(run_eval.window_s, rate_hz, held.recording.n_samples)
-    perfect = {axis: smoothed_residual_rms(truth.noise.total_dps[:, j], w) for j, axis in enumerate(axes)}
     methods_rms = {name: {axis: smoothed_residual_rms(d[:, j], w_eff) for j, axis in enumerate(axes)}
                    for name, d in lefts.items()}
-    write_text_atomic(out_dir / "effects.json", json.dumps(
-        {"window_s": EFFECT_WINDOW_S, "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
-         "residual_peak_to_peak_dps": residual,
-         "deterministic_error_left_rms_dps_by_method": methods_rms}, indent=2) + "\n")
-    hours = held.recording.duration_s / 3600
+    return effects, residual, methods_rms
+
+
+def _summary(n_runs: int, rate_hz: float, calibration: Calibration, held, effects, residual, allan, run_eval, perfect,
+             methods_rms) -> list[str]:
+    """The lines the demo prints."""
     lo, hi = HELDOUT_RANGE_DEGC
     lines = [
-        f"Simulated {len(cal_paths)} cold-hot-cold calibration cycles (-25 -> 90 -> -25 degC at 1 degC/min, "
+        f"Simulated {n_runs} cold-hot-cold calibration cycles (-25 -> 90 -> -25 degC at 1 degC/min, "
         f"{rate_hz:g} Hz) of the '{PRESET}' preset (Xsens MTi-10 raw output: temperature drift, 120 s thermal lag, "
         "hysteresis on cooling, g-sensitivity), the unit turned to +-1 g on each axis every 5 minutes, each run "
         "with its own turn-on bias.",
         f"Validated on them (each method fitted without the run it is scored on; the table below), then fitted on "
         f"all three: {calibration.model}.",
-        f"Held out: {hours:.1f} h without a pause, three cycles over {lo:g}..{hi:g} degC at "
-        f"{HELDOUT_RAMP_DEGC_PER_MIN:g} degC/min (twice the calibration rate), the unit tilted to "
+        f"Held out: {held.recording.duration_s / 3600:.1f} h without a pause, three cycles over {lo:g}..{hi:g} degC "
+        f"at {HELDOUT_RAMP_DEGC_PER_MIN:g} degC/min (twice the calibration rate), the unit tilted to "
         f"({', '.join(f'{g:g}' for g in HELDOUT_TILT_G)}) g, an orientation none of the calibration runs had.",
         f"Deterministic effects in the held-out run (peak-to-peak of a {EFFECT_WINDOW_S:g} s moving average; the "
         "g-sensitivity at the fixed tilt is a constant: its mean) [deg/s]:",
@@ -196,7 +223,7 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     lines.append(f"  {'left after compensation':32s} " + "  ".join(f"{a} {v:.2g}" for a, v in residual.items()))
     lines.append("Allan deviation of the held-out run [deg/h]: raw / compensated / the sensor's noise alone (what "
                  "perfect compensation leaves). Temperature drift makes the raw curve rise at long averaging times:")
-    lines.append("  " + " " * 8 + "".join(f"{f'tau {t:g} s':>22s}" for t in allan[axes[0]].tau_s))
+    lines.append("  " + " " * 8 + "".join(f"{f'tau {t:g} s':>22s}" for t in next(iter(allan.values())).tau_s))
     for axis, c in allan.items():
         cells = [f"{r:.3g} / {k:.3g} / {n:.3g}" for r, k, n in
                  zip(c.raw_deg_per_h, c.compensated_deg_per_h, c.noise_alone_deg_per_h)]
@@ -212,12 +239,7 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
                  "average) [deg/s]:")
     for name, rms in methods_rms.items():
         lines.append(f"  {name:60.60s} " + "  ".join(f"{a} {v:.2g}" for a, v in rms.items()))
-    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html", validation) if report else "not asked for"
-    if skipped is None:
-        lines.append(f"Report of the model on the held-out run: {out_dir / 'report.html'} (open it in a browser).")
-    files = sorted(out_dir.iterdir())
-    return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, validation, allan,
-                      "\n".join(lines), files, skipped)
+    return lines
 
 
 def _allan_table(held, compensated) -> dict[str, AllanComparison]:

@@ -224,36 +224,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     fitted (:mod:`gyrocomp.models.selection`); an axis where no temperature model beats the run constant
     gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
-    if isinstance(recordings, Recording):
-        recordings = [recordings]
-    recordings = list(recordings)
-    if not recordings:
-        raise InputError("fit: give at least one calibration run")
-    if acceleration not in ("auto", *ACCELERATION_CHOICES):
-        raise InputError(f"acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
-    if not static_min_duration_s > 0:
-        raise InputError(f"static_min_duration_s: must be a positive number of seconds, got {static_min_duration_s}")
-    concerns = [c for rec in recordings for c in calibration_concerns(rec)]
-    if temperature not in (None, "auto", 0):  # a curve asked for
-        concerns.append(temperature_span_concern(recordings))
-    for concern in filter(None, concerns):
-        warnings.warn(concern.message, PlausibilityWarning, stacklevel=2)
-    if temperature is None and acceleration != "none" and (
-            acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
-        return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
+    recordings = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    _check_fit_inputs(recordings, temperature, acceleration, static_min_duration_s)
     if temperature is None:
-        axes = {}
-        for axis in recordings[0].gyro_axes:
-            consts = tuple(float(rec.gyro(axis).mean()) for rec in recordings)
-            axes[axis] = AxisCalibration(None, consts)
-        return Calibration(axes=axes, model="none", provenance=provenance(recordings),
-                           fit_report={"temperature": None})
-    for rec in recordings:
-        if rec.temperature_degc is None:
-            raise InputError(
-                f"{rec.source}: no temperature column; a temperature model needs one "
-                "(map it with columns={'temperature': 'NAME'}, or fit with temperature=none)"
-            )
+        return _fit_without_temperature(recordings, acceleration, static_min_duration_s)
     if hysteresis not in HYSTERESIS_CHOICES:
         raise InputError(f"hysteresis: {hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
     hidden = None
@@ -271,18 +245,80 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
                                             static_min_duration_s=static_min_duration_s, run_folds=run_folds,
                                             folds=folds)
     else:
-        model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
-                                           folds=run_folds).fit(recordings)
-        mode = hysteresis
-        if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
-            mode = "none"
-        if mode != "none" or accel_mode != "none":
-            orders = {axis: curve.order for axis, curve in model.curves_.items()}
-            thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
-                                             band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
-                                             reselect_order=temperature == "auto", acceleration=accel_mode,
-                                             static_min_duration_s=static_min_duration_s).fit(recordings)
+        model, thermal = _fit_binned(recordings, temperature=temperature, hysteresis=hysteresis,
+                                     hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,
+                                     bin_width_degc=bin_width_degc, accel_mode=accel_mode,
+                                     static_min_duration_s=static_min_duration_s, run_folds=run_folds)
+    report = _report_of_choice(selections, model, thermal, hysteresis, acceleration, accel_mode)
+    network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
     axes = {}
+    for axis in recordings[0].gyro_axes:
+        axes[axis], report["axes"][axis] = _axis_calibration(
+            axis, recordings, selections, model, thermal, network, accel_mode, bin_width_degc, network_inputs)
+    if network is not None:
+        report["temperature"] = "mlp"
+        report["network"] = {"hidden": list(hidden), "restarts": network.restarts, "seed": network.seed,
+                             "training": "Levenberg-Marquardt, early stopping on 20 % held-out segments",
+                             "axes": {a: {"validation_rmse_dps": network.validation_rmse_dps_[a],
+                                          "epochs": network.epochs_[a]} for a in network.curves_}}
+    name = _model_name(axes, network, network_inputs, temperature, thermal, accel_mode)
+    return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
+
+
+def _check_fit_inputs(recordings: list[Recording], temperature, acceleration: str,
+                      static_min_duration_s: float) -> None:
+    """Refuse what cannot be fitted; warn about what is probably not calibration data."""
+    if not recordings:
+        raise InputError("fit: give at least one calibration run")
+    if acceleration not in ("auto", *ACCELERATION_CHOICES):
+        raise InputError(f"acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
+    if not static_min_duration_s > 0:
+        raise InputError(f"static_min_duration_s: must be a positive number of seconds, got {static_min_duration_s}")
+    concerns = [c for rec in recordings for c in calibration_concerns(rec)]
+    if temperature not in (None, "auto", 0):  # a curve asked for
+        concerns.append(temperature_span_concern(recordings))
+    for concern in filter(None, concerns):
+        warnings.warn(concern.message, PlausibilityWarning, stacklevel=3)
+    if temperature is not None:
+        for rec in recordings:
+            if rec.temperature_degc is None:
+                raise InputError(
+                    f"{rec.source}: no temperature column; a temperature model needs one "
+                    "(map it with columns={'temperature': 'NAME'}, or fit with temperature=none)"
+                )
+
+
+def _fit_without_temperature(recordings: list[Recording], acceleration: str, static_min_duration_s: float):
+    """G alone (when the runs turn between positions or it is asked for), else the run constants alone."""
+    if acceleration != "none" and (
+            acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
+        return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
+    axes = {axis: AxisCalibration(None, tuple(float(rec.gyro(axis).mean()) for rec in recordings))
+            for axis in recordings[0].gyro_axes}
+    return Calibration(axes=axes, model="none", provenance=provenance(recordings), fit_report={"temperature": None})
+
+
+def _fit_binned(recordings: list[Recording], *, temperature, hysteresis: str, hysteresis_order,
+                hysteresis_band_degc, bin_width_degc, accel_mode: str, static_min_duration_s: float, run_folds):
+    """The earlier path (a fixed band, or a fixed order and memory): the binned polynomial, then lag,
+    hysteresis and G on top where asked for or where the runs heat and cool."""
+    model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
+                                       folds=run_folds).fit(recordings)
+    mode = hysteresis
+    if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
+        mode = "none"
+    thermal = None
+    if mode != "none" or accel_mode != "none":
+        orders = {axis: curve.order for axis, curve in model.curves_.items()}
+        thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
+                                         band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
+                                         reselect_order=temperature == "auto", acceleration=accel_mode,
+                                         static_min_duration_s=static_min_duration_s).fit(recordings)
+    return model, thermal
+
+
+def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration: str, accel_mode: str) -> dict:
+    """The fit report's account of what was chosen and how (the axes are filled in after)."""
     report = {"temperature": "polynomial", "axes": {},
               "order_selection": FOLD_SELECTION[next(iter(selections.values())).fold_kind] if selections
               else model.selection_}
@@ -305,43 +341,49 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     else:
         report["acceleration"] = {"mode": "none", "why": "the runs do not turn the unit between positions"
                                   if acceleration == "auto" else "not asked for"}
-    network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
-    for axis in recordings[0].gyro_axes:
-        curve, consts = (thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]) if thermal is not None else (
-            model.curves_[axis], model.turn_on_biases_dps_[axis])
-        lag, hyst, g_row, g_sq = 0.0, None, None, None
-        if thermal is not None:
-            lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
-            if accel_mode != "none" and thermal.excited_axes_:
-                g_row = tuple(float(v) for v in thermal.g_sensitivity_dps_per_g_[axis])
-                if accel_mode == "matrix2":
-                    g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
-        if network is not None:
-            joint = network_inputs != ("temperature",)
-            curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc,
-                                         None if joint else g_row, None if joint else g_sq,
-                                         thermal.segments_ if thermal is not None else None, network_inputs)
-            if joint:  # the network reads the accelerations itself: the least-squares G was only a scaffold
-                g_row = g_sq = None
-        if selections is not None and isinstance(curve, PolynomialBias):  # validated with the tangent extension
-            curve = dataclasses.replace(curve, extrapolation="linear")
-        keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
-        axes[axis] = AxisCalibration(keep_curve, tuple(float(c) for c in consts),
-                                     recordings[0].temperature_column_for(axis), lag, hyst, g_row, g_sq)
-        report["axes"][axis] = {"order": curve.order, "t_min_degc": curve.t_min_degc, "t_max_degc": curve.t_max_degc}
-        if model is not None:
-            report["axes"][axis]["scores"] = {str(p): float(v) for p, v in model.scores_[axis].items()}
-        if network is not None:
-            report["axes"][axis]["fit_rms_dps"] = network.train_rmse_dps_[axis]
-        elif model is not None and thermal is None:
-            report["axes"][axis]["fit_rms_dps"] = model.fit_rms_dps_[axis]
+    return report
+
+
+def _axis_calibration(axis: str, recordings: list[Recording], selections, model, thermal, network, accel_mode: str,
+                      bin_width_degc, network_inputs: tuple[str, ...]) -> tuple[AxisCalibration, dict]:
+    """One axis's frozen result from the fitted models (the network trained on top when asked for), and its
+    entry in the fit report."""
+    curve, consts = (thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]) if thermal is not None else (
+        model.curves_[axis], model.turn_on_biases_dps_[axis])
+    lag, hyst, g_row, g_sq = 0.0, None, None, None
+    if thermal is not None:
+        lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
+        if accel_mode != "none" and thermal.excited_axes_:
+            g_row = tuple(float(v) for v in thermal.g_sensitivity_dps_per_g_[axis])
+            if accel_mode == "matrix2":
+                g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
     if network is not None:
-        report["temperature"] = "mlp"
-        report["network"] = {"hidden": list(hidden), "restarts": network.restarts, "seed": network.seed,
-                             "training": "Levenberg-Marquardt, early stopping on 20 % held-out segments",
-                             "axes": {a: {"validation_rmse_dps": network.validation_rmse_dps_[a],
-                                          "epochs": network.epochs_[a]} for a in network.curves_}}
-        name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, hidden)) + "-1"
+        joint = network_inputs != ("temperature",)
+        curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc,
+                                     None if joint else g_row, None if joint else g_sq,
+                                     thermal.segments_ if thermal is not None else None, network_inputs)
+        if joint:  # the network reads the accelerations itself: the least-squares G was only a scaffold
+            g_row = g_sq = None
+    if selections is not None and isinstance(curve, PolynomialBias):  # validated with the tangent extension
+        curve = dataclasses.replace(curve, extrapolation="linear")
+    keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
+    result = AxisCalibration(keep_curve, tuple(float(c) for c in consts), recordings[0].temperature_column_for(axis),
+                             lag, hyst, g_row, g_sq)
+    entry = {"order": curve.order, "t_min_degc": curve.t_min_degc, "t_max_degc": curve.t_max_degc}
+    if model is not None:
+        entry["scores"] = {str(p): float(v) for p, v in model.scores_[axis].items()}
+    if network is not None:
+        entry["fit_rms_dps"] = network.train_rmse_dps_[axis]
+    elif model is not None and thermal is None:
+        entry["fit_rms_dps"] = model.fit_rms_dps_[axis]
+    return result, entry
+
+
+def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, temperature, thermal,
+                accel_mode: str) -> str:
+    """The short name of the fitted model, e.g. ``poly:2/3 (auto) + lag + g-sensitivity``."""
+    if network is not None:
+        name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, network.hidden)) + "-1"
     else:
         orders = sorted({ax.temperature.order if ax.temperature is not None else 0 for ax in axes.values()})
         name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
@@ -353,7 +395,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
             name += " + " + "/".join(extras)
         if any(ax.g_sensitivity_dps_per_g is not None for ax in axes.values()):
             name += " + g-sensitivity" + (" (g x g)" if accel_mode == "matrix2" else "")
-    return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
+    return name
 
 
 #: the named pipelines of ``gyrocomp fit --pipeline`` (thesis 2.8): stages left to right, each fitted on the
