@@ -6,8 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply, fit_calibration
-from gyrocomp.errors import DataQualityWarning, PlausibilityWarning
+from gyrocomp import apply, comparison, fit_calibration, validation
+from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning
 from gyrocomp.plausibility import calibration_concerns, recording_concerns, temperature_span_concern
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
@@ -85,3 +85,13 @@ def test_fit_and_apply_warn_and_the_warning_can_be_silenced():
         warnings.filterwarnings("ignore", category=PlausibilityWarning)
         warnings.filterwarnings("ignore", category=DataQualityWarning)
         apply(cal, kelvin)
+
+
+@pytest.mark.parametrize("what, call", [("compare", "compare_methods"), ("validate", "validate")])
+def test_comparing_temperature_models_on_flat_runs_is_refused_in_one_line(what, call):
+    flat = [dataclasses.replace(RUN, temperature_degc=np.full(RUN.n_samples, 25.0), source=f"flat{k}.csv")
+            for k in range(3)]
+    function = getattr(comparison if call == "compare_methods" else validation, call)
+    with pytest.raises(InputError, match=rf"flat0.csv: the temperature of every run spans at most 0 degC; {what} "
+                                         "compares temperature models"):
+        function(flat)

@@ -22,6 +22,7 @@ from .metrics import default_window_s, evaluate_run, moving_average
 from .models.base import provenance
 from .models.pipelines import fit_calibration
 from .models.temperature import PolynomialBias
+from .plausibility import require_temperature_span
 from .recording import Recording
 
 #: the polynomial order both autopilots use for the gyro bias against temperature
@@ -161,6 +162,7 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
     methods = DEFAULT_METHODS if methods is None else methods
     if not recordings:
         raise InputError("compare: give at least one run")
+    require_temperature_span(recordings, "compare")
     n = len(recordings)
     scored: dict[str, list] = {name: [] for name in ("raw", *methods)}
     windows = {}

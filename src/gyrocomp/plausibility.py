@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import InputError
 from .metrics import moving_average
 from .recording import Recording
 
@@ -93,6 +94,15 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
     return out
 
 
+def require_temperature_span(recordings: list[Recording], what: str) -> None:
+    """Refuse to compare temperature models on runs whose temperature does not vary at all: every such model
+    is then undetermined (``what`` names the operation in the message)."""
+    spans = [float(np.ptp(r.temperature_degc)) for r in recordings if r.temperature_degc is not None]
+    if spans and max(spans) < MIN_TEMPERATURE_SPAN_DEGC:
+        raise InputError(f"{recordings[0].source}: the temperature of every run spans at most {max(spans):.3g} degC; "
+                         f"{what} compares temperature models, which need runs over a temperature range")
+
+
 def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
     """A temperature curve asked for on runs that each stay at one temperature: with one constant per run, such
     runs say nothing about the curve (a multi-position run at room temperature is fine for G alone)."""
@@ -104,4 +114,5 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
                                        "range (or fit with temperature=none)")
 
 
-__all__ = ["Concern", "calibration_concerns", "recording_concerns", "temperature_span_concern"]
+__all__ = ["Concern", "calibration_concerns", "recording_concerns", "require_temperature_span",
+           "temperature_span_concern"]

@@ -32,6 +32,7 @@ from .models.hysteresis import turn_threshold_degc
 from .models.pipelines import fit_calibration
 from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, FoldDrift, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
 from .models.temperature import PolynomialBias
+from .plausibility import require_temperature_span
 from .recording import Recording
 from .comparison import fit_ardupilot_style, fit_px4_style
 
@@ -187,6 +188,7 @@ def validate(recordings: list[Recording], *, folds: str = "auto", window_s: floa
     for rec in recordings:
         if rec.temperature_degc is None:
             raise InputError(f"{rec.source}: no temperature column; validation compares temperature models")
+    require_temperature_span(recordings, "validate")
     kind, fold_list = make_sample_folds(recordings, folds)
     if window_s is None:
         lengths = [fold.rows.size / recordings[fold.run].rate_hz for fold in fold_list]

@@ -230,3 +230,9 @@ def test_written_csv_headers_are_unquoted_unless_a_name_needs_quotes(tmp_path):
     write_gyro_back(plain, plain.recording.gyro_dps, tmp_path / "q.csv")
     assert (tmp_path / "q.csv").read_text().splitlines()[0] == "time,gyro_z"
     assert list(pd.read_csv(tmp_path / "o.csv").columns) == ["time", "gyro_z", "temp, C"]
+
+
+def test_a_repeated_column_name_is_refused_in_one_line(tmp_path):
+    p = write_csv(tmp_path / "dup.csv", "time,gyro_z,gyro_z,temperature\n0,1,2,20\n1,1,2,21\n")
+    with pytest.raises(InputError, match=r"dup.csv: column 'gyro_z' appears 2 times in the header; give each column"):
+        read_table(p)

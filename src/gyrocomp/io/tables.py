@@ -197,6 +197,10 @@ def read_table(
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     header = table.column_names
+    repeated = sorted({name for name in header if header.count(name) > 1})
+    if repeated:
+        raise InputError(f"{path}: column {repeated[0]!r} appears {header.count(repeated[0])} times in the header; "
+                         "give each column its own name")
     cols = layout.resolve(header, str(path))
     if TIME_COLUMN not in cols:
         raise InputError(
