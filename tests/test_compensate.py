@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import Compensator, apply, fit_calibration
+from gyrocomp import Calibration, Compensator, apply, fit_calibration, read
 from gyrocomp.errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
@@ -93,3 +93,36 @@ def test_errors():
     comp = Compensator(CAL, ("gyro_x", "gyro_y", "gyro_z"))
     with pytest.raises(InputError, match="the model needs temperature, the data has none"):
         comp.update(np.arange(3.0), np.zeros((3, 3)))
+
+
+def test_wrong_calls_raise_input_errors_that_name_the_argument():
+    rec = SIM.recording
+    with pytest.raises(InputError, match=r"calibration: expected a Calibration .* got NoneType"):
+        apply(None, rec)
+    with pytest.raises(InputError, match=r"recording: expected a Recording .* got str"):
+        apply(CAL, "flight.csv")
+    with pytest.raises(InputError, match=r"path: expected a file name or path, got NoneType"):
+        read(None)
+    with pytest.raises(InputError, match=r"path: expected a model file name or path, got int"):
+        Calibration.load(3)
+    with pytest.raises(InputError, match=r"recordings\[1\]: expected a Recording .* got NoneType"):
+        fit_calibration([rec, None])
+    with pytest.raises(InputError, match=r"fit: give at least one calibration run"):
+        fit_calibration(None)
+
+
+def test_stream_chunks_are_checked():
+    rec = SIM.recording
+    comp = Compensator(CAL, rec.gyro_axes)
+    t, g, temp = rec.time_s, rec.gyro_dps, rec.temperature_degc
+    with pytest.raises(InputError, match=r"gyro_dps: shape \(10, 2\); give \(10, 3\) for 10 time stamps"):
+        comp.update(t[:10], g[:10, :2], temp[:10])
+    comp.update(t[:10], g[:10], temp[:10])
+    with pytest.raises(InputError, match=r"time_s goes back from .* between chunks; give the chunks in time order"):
+        comp.update(t[5:15], g[5:15], temp[5:15])
+    bad = temp[10:20].copy()
+    bad[3] = np.nan
+    with pytest.raises(InputError, match=r"temperature_degc is not finite at row 3 of this chunk"):
+        comp.update(t[10:20], g[10:20], bad)
+    with pytest.raises(InputError, match=r"calibration: expected a Calibration"):
+        Compensator({"axes": {}}, rec.gyro_axes)

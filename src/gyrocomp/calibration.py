@@ -365,6 +365,8 @@ class Calibration:
     @classmethod
     def load(cls, path: str | os.PathLike) -> "Calibration":
         """Read and validate a model file written by :meth:`save`."""
+        if not isinstance(path, (str, os.PathLike)):
+            raise InputError(f"path: expected a model file name or path, got {type(path).__name__}")
         path = Path(path)
         try:
             text = path.read_text(encoding="utf-8")

@@ -42,6 +42,9 @@ class Compensator:
 
     def __init__(self, calibration: Calibration, gyro_axes: tuple[str, ...], *,
                  turn_on_window_s: float | None = None, rate_hz: float | None = None, source: str = "<stream>"):
+        if not isinstance(calibration, Calibration):
+            raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+                             f"got {type(calibration).__name__}")
         if turn_on_window_s is not None and not turn_on_window_s > 0:
             raise InputError(f"turn_on_window_s: must be a positive number of seconds, got {turn_on_window_s}")
         self.calibration = calibration
@@ -72,6 +75,7 @@ class Compensator:
         self._constants: np.ndarray | None = None
         if turn_on_window_s is None:
             self._constants = np.array([ax.mean_turn_on_bias_dps for _, ax in self._modelled])
+        self._last_time_s: float | None = None
         self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
         self._pending_time: list[np.ndarray] = []
 
@@ -174,12 +178,7 @@ class Compensator:
         Returns the compensated gyro rows [deg/s] that are ready: all of them, except while the
         turn-on window is still filling (those come out of a later call or :meth:`finish`).
         """
-        time_s = np.asarray(time_s, dtype=float)
-        gyro_dps = np.asarray(gyro_dps, dtype=float).reshape(time_s.size, len(self.gyro_axes))
-        if temperature_degc is not None:
-            temperature_degc = np.asarray(temperature_degc, dtype=float)
-        if accel_g is not None:
-            accel_g = np.asarray(accel_g, dtype=float).reshape(time_s.size, 3)
+        time_s, gyro_dps, temperature_degc, accel_g = self._checked(time_s, gyro_dps, temperature_degc, accel_g)
         residual = self._residual(time_s, gyro_dps, temperature_degc, accel_g)
         if self._constants is not None:
             return self._subtract_constants(residual)
@@ -190,6 +189,43 @@ class Compensator:
         if time_s.size and time_s[-1] - self._t0 >= self.turn_on_window_s:
             return self._release()
         return np.empty((0, len(self.gyro_axes)))
+
+    def _checked(self, time_s, gyro_dps, temperature_degc, accel_g):
+        """The chunk as float arrays of the documented shapes, its time increasing from the previous chunk's and
+        its temperature finite; anything else is refused naming the argument."""
+        try:
+            time_s = np.asarray(time_s, dtype=float).reshape(-1)
+            n, k = time_s.size, len(self.gyro_axes)
+            shapes = {"gyro_dps": (n, k), "temperature_degc": None, "accel_g": (n, 3)}
+            arrays = {"gyro_dps": gyro_dps, "temperature_degc": temperature_degc, "accel_g": accel_g}
+            for name, value in arrays.items():
+                if value is None:
+                    continue
+                value = np.asarray(value, dtype=float)
+                want = shapes[name]
+                if name == "temperature_degc":
+                    if value.shape not in ((n,), (n, k)) and not (value.ndim == 2 and value.shape[0] == n):
+                        raise InputError(f"temperature_degc: shape {value.shape}; give ({n},) or ({n}, {k}) for "
+                                         f"{n} time stamps")
+                elif value.size != n * want[1]:
+                    raise InputError(f"{name}: shape {value.shape}; give {want} for {n} time stamps")
+                arrays[name] = value.reshape(want) if want else value
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{self.source}: a chunk that is not numbers ({exc})") from None
+        if n and self._last_time_s is not None and time_s[0] <= self._last_time_s:
+            raise InputError(f"{self.source}: time_s goes back from {self._last_time_s:.9g} s to {time_s[0]:.9g} s "
+                             "between chunks; give the chunks in time order")
+        if n > 1 and np.any(np.diff(time_s) <= 0):
+            raise InputError(f"{self.source}: time_s does not increase within the chunk "
+                             f"(row {int(np.argmax(np.diff(time_s) <= 0)) + 1})")
+        temp = arrays["temperature_degc"]
+        if temp is not None and temp.size and not np.all(np.isfinite(temp)):
+            row = int(np.argmax(~np.isfinite(temp.reshape(n, -1)).any(axis=1)))
+            raise InputError(f"{self.source}: temperature_degc is not finite at row {row} of this chunk; the "
+                             "compensation would be NaN (drop such rows or fill them before compensating)")
+        if n:
+            self._last_time_s = float(time_s[-1])
+        return time_s, arrays["gyro_dps"], temp, arrays["accel_g"]
 
     def _release(self) -> np.ndarray:
         residual = np.concatenate(self._pending)
@@ -230,6 +266,11 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
         axis, would otherwise leave it raw unnoticed); name the axes to compensate the others and leave the
         rest raw, with a warning saying which.
     """
+    if not isinstance(recording, Recording):
+        raise InputError(f"recording: expected a Recording (from gyrocomp.read or simulate), got {type(recording).__name__}")
+    if not isinstance(calibration, Calibration):
+        raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+                         f"got {type(calibration).__name__}")
     calibration = _restricted(calibration, recording, axes)
     for concern in recording_concerns(recording):
         warnings.warn(concern.message, PlausibilityWarning, stacklevel=2)

@@ -89,6 +89,8 @@ def read_input(
     Tables keep their own columns and units; logs become a table in the default layout
     ([s], [deg/s], [g], [degC]).
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"path: expected a file name or path, got {type(path).__name__}")
     options = options or ReadOptions()
     fmt = detect_format(path, fmt)
     if not Path(path).exists():

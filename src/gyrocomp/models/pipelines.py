@@ -224,7 +224,11 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     fitted (:mod:`gyrocomp.models.selection`); an axis where no temperature model beats the run constant
     gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
-    recordings = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    recordings = [recordings] if isinstance(recordings, Recording) else list(recordings or ())
+    for k, rec in enumerate(recordings):
+        if not isinstance(rec, Recording):
+            raise InputError(f"recordings[{k}]: expected a Recording (from gyrocomp.read or simulate), "
+                             f"got {type(rec).__name__}")
     _check_fit_inputs(recordings, temperature, acceleration, static_min_duration_s)
     if temperature is None:
         return _fit_without_temperature(recordings, acceleration, static_min_duration_s)
