@@ -581,3 +581,14 @@ def test_a_write_the_file_system_refuses_is_a_bad_input_and_leaves_nothing(workd
 ])
 def test_environment_errors_read_as_one_line(exc, line):
     assert _environment_message(exc) == line
+
+
+def test_a_tab_separated_export_with_decimal_commas_reads_with_or_without_options(tmp_path):
+    (tmp_path / "v.txt").write_text("Time\tGyro_Z\tTemperature\n0\t1,5\t20,5\n1\t2,5\t21\n2\t3\t22\n")
+    for extra in ([], ["--delimiter", "tab", "--decimal", ","]):
+        r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", *extra)
+        assert r.returncode == 0, r.stderr
+        out = pd.read_csv(tmp_path / "o.csv")
+        assert list(out["gyro_z"]) == [1.5, 2.5, 3.0] and list(out["temperature"]) == [20.5, 21.0, 22.0]
+    r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", "--decimal", ":")
+    assert r.returncode == 2 and r.stderr.strip() == "gyrocomp: error: --decimal: ':'; use '.' or ','"

@@ -81,6 +81,9 @@ def read_options(func):
         click.option("--time-unit", default="s", show_default=True, help="s, ms, us or ns."),
         click.option("--format", "fmt", default=None,
                      help=f"Input format (default: told from the file): {', '.join(FORMATS)}."),
+        click.option("--delimiter", default=None,
+                     help="CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a tab)."),
+        click.option("--decimal", default=None, help="CSV decimal point, . or , (default: told from the first row)."),
         click.option("--drop-nan", is_flag=True, help="Drop rows with empty/NaN values (says how many) instead of refusing the file."),
         click.option("--instance", type=int, default=None,
                      help="Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0)."),
@@ -95,12 +98,13 @@ def read_options(func):
     return func
 
 
-def _layout(columns, gyro_unit, accel_unit, time_unit) -> TableLayout:
-    return TableLayout(parse_column_mapping(columns), gyro_unit, accel_unit, time_unit)
+def _layout(columns, gyro_unit, accel_unit, time_unit, delimiter=None, decimal=None) -> TableLayout:
+    return TableLayout(parse_column_mapping(columns), gyro_unit, accel_unit, time_unit,
+                       "\t" if delimiter == "tab" else delimiter, decimal)
 
 
 _READ_OPTIONS = ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan", "instance", "device_id",
-                 "imu_topic", "temperature_topic", "record")
+                 "imu_topic", "temperature_topic", "record", "delimiter", "decimal")
 
 
 @contextlib.contextmanager
@@ -119,7 +123,8 @@ def progress_bar(description: str, indeterminate: bool = False):
 
 
 def _read(path, opts: dict):
-    layout = _layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"])
+    layout = _layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"], opts["delimiter"],
+                     opts["decimal"])
     options = ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=opts["instance"],
                           device_id=opts["device_id"], imu_topic=opts["imu_topic"],
                           temperature_topic=opts["temperature_topic"], record=opts["record"])
@@ -1036,7 +1041,8 @@ PARAMETER_FLAGS = {
     "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
     "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
-    "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps",
+    "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
+    "decimal": "--decimal",
 }
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
 _SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone

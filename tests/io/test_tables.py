@@ -1,9 +1,11 @@
+import lzma
 import math
 import os
 import warnings
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 import pytest
 
 from gyrocomp.errors import DataQualityWarning, InputError
@@ -236,3 +238,41 @@ def test_a_repeated_column_name_is_refused_in_one_line(tmp_path):
     p = write_csv(tmp_path / "dup.csv", "time,gyro_z,gyro_z,temperature\n0,1,2,20\n1,1,2,21\n")
     with pytest.raises(InputError, match=r"dup.csv: column 'gyro_z' appears 2 times in the header; give each column"):
         read_table(p)
+
+
+SEMICOLON = "time;gyro_z;temperature\n0;1,5;20,25\n1;2,5;21,5\n2;-0,5;22\n"
+
+
+@pytest.mark.parametrize("text, layout", [
+    (SEMICOLON, TableLayout()),                                     # a spreadsheet in a decimal-comma locale
+    (SEMICOLON.replace(";", "\t"), TableLayout()),                  # tab-separated
+    (SEMICOLON, TableLayout(delimiter=";", decimal=",")),           # said explicitly
+    (" Time , GYRO_Z , Temperature\n0,1.5,20.25\n1,2.5,21.5\n2,-0.5,22\n", TableLayout()),  # spaced, capitalized
+])
+def test_delimiters_decimal_commas_and_loose_standard_names(tmp_path, text, layout):
+    data = read_table(write_csv(tmp_path / "v.csv", text), layout)
+    np.testing.assert_array_equal(data.recording.gyro_dps[:, 0], [1.5, 2.5, -0.5])
+    np.testing.assert_array_equal(data.recording.temperature_degc, [20.25, 21.5, 22.0])
+
+
+@pytest.mark.parametrize("codec, suffix", [("gzip", ".gz"), ("bz2", ".bz2"), ("zstd", ".zst"), ("xz", ".xz")])
+def test_compressed_csv_by_magic_bytes_and_suffix(tmp_path, codec, suffix):
+    raw = b"time,gyro_z,temperature\n0,1,20\n1,2,21\n"
+    path = tmp_path / f"r.csv{suffix}"
+    if codec == "xz":
+        path.write_bytes(lzma.compress(raw))
+    else:
+        with pa.output_stream(str(path), compression=codec) as out:
+            out.write(raw)
+    rec = read(path)
+    np.testing.assert_array_equal(rec.gyro_dps[:, 0], [1.0, 2.0])
+    (tmp_path / f"bad.csv{suffix}").write_bytes(path.read_bytes()[:12])  # cut short
+    with pytest.raises(InputError, match=rf"bad.csv{suffix}: "):
+        read(tmp_path / f"bad.csv{suffix}")
+
+
+def test_bad_delimiter_and_decimal_options():
+    with pytest.raises(InputError, match=r"delimiter: ';;'; give one character"):
+        TableLayout(delimiter=";;")
+    with pytest.raises(InputError, match=r"decimal: ':'; use '.' or ','"):
+        TableLayout(decimal=":")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import lzma
 import os
 import warnings
 from dataclasses import dataclass, field
@@ -37,12 +38,18 @@ class TableLayout:
         Channels not named here are looked up under their canonical name.
     gyro_unit, accel_unit, time_unit : str
         Units of the file's columns, e.g. ``"rad/s"``, ``"m/s2"``, ``"ms"``.
+    delimiter : str, optional
+        CSV field separator; default: told from the header (comma, semicolon or tab).
+    decimal : {".", ","}, optional
+        CSV decimal point; default: a comma when the separator is not one and the first row's numbers have one.
     """
 
     columns: dict[str, str] = field(default_factory=dict)
     gyro_unit: str = "deg/s"
     accel_unit: str = "g"
     time_unit: str = "s"
+    delimiter: str | None = None
+    decimal: str | None = None
 
     def __post_init__(self) -> None:
         for canonical in self.columns:
@@ -54,10 +61,19 @@ class TableLayout:
         unit_factor("gyro", self.gyro_unit, "gyro_unit")
         unit_factor("accel", self.accel_unit, "accel_unit")
         unit_factor("time", self.time_unit, "time_unit")
+        if self.delimiter is not None and (len(self.delimiter) != 1 or self.delimiter in '"\r\n'):
+            raise InputError(f"delimiter: {self.delimiter!r}; give one character, e.g. ';' (or a tab)")
+        if self.decimal not in (None, ".", ","):
+            raise InputError(f"decimal: {self.decimal!r}; use '.' or ','")
 
     def resolve(self, header: list[str], source: str) -> dict[str, str]:
         """Canonical name to file column for every channel present in ``header``."""
         resolved = {name: name for name in CANONICAL_COLUMNS if name in header}
+        # the standard names also match whatever their case and surrounding spaces (" Gyro_Z" is gyro_z)
+        loose = {column.strip().lower(): column for column in header}
+        for name in CANONICAL_COLUMNS:
+            if name not in resolved and name in loose and loose[name] not in resolved.values():
+                resolved[name] = loose[name]
         for canonical, column in self.columns.items():
             if canonical in ARRAY_CHANNELS:
                 raise InputError(
@@ -111,18 +127,63 @@ def file_sha256(path: str | os.PathLike) -> str:
     return digest.hexdigest()
 
 
-def _read_arrow(path: Path, fmt: str) -> pa.Table:
+#: compressed CSV, told by its first bytes: the codec's name for pyarrow (xz through Python's lzma)
+_COMPRESSED = ((b"\x1f\x8b", "gzip"), (b"BZh", "bz2"), (b"\x28\xb5\x2f\xfd", "zstd"),
+               (b"\xfd7zXZ\x00", "xz"))
+#: field separators a CSV may use (vendor exports, spreadsheets in locales with a decimal comma)
+DELIMITERS = (",", ";", "\t")
+
+
+def _csv_bytes(path: Path) -> tuple[pa.NativeFile | Path, bytes]:
+    """The CSV's source for pyarrow (decompressing gzip, bz2, zstd or xz by their magic bytes) and its first
+    4 kB of text."""
+    with open(path, "rb") as fh:
+        magic = fh.read(6)
+    codec = next((name for sig, name in _COMPRESSED if magic.startswith(sig)), None)
+    if codec is None:
+        with open(path, "rb") as fh:
+            return path, fh.read(4096)
+    try:
+        if codec == "xz":
+            with lzma.open(path) as fh:
+                data = pa.py_buffer(fh.read())
+        else:
+            with pa.input_stream(str(path), compression=codec) as fh:
+                data = pa.py_buffer(fh.read())
+    except (OSError, EOFError, lzma.LZMAError, pa.ArrowInvalid) as exc:
+        raise InputError(f"{path}: a {codec} file that does not decompress ({str(exc).splitlines()[0]})") from None
+    return pa.BufferReader(data), data.to_pybytes()[:4096]
+
+
+def sniff_csv(head: bytes) -> tuple[str, str]:
+    """(delimiter, decimal point) of a CSV from its first bytes: the separator that splits the header into the
+    most fields (comma on a tie), and a decimal comma when the separator is not a comma and a number in the first
+    data row has one."""
+    lines = head.decode("utf-8", errors="replace").splitlines()
+    header = lines[0] if lines else ""
+    delimiter = max(DELIMITERS, key=lambda d: (header.count(d), d == ","))
+    decimal = "."
+    if delimiter != "," and len(lines) > 1:
+        cells = [c.strip() for c in lines[1].split(delimiter)]
+        if any(c.replace("-", "", 1).replace(",", "", 1).isdigit() and "," in c for c in cells):
+            decimal = ","
+    return delimiter, decimal
+
+
+def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str | None = None) -> pa.Table:
     if not path.exists():
         raise InputError(f"{path}: no such file")
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a file")
     if fmt == "csv":
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
+        source, head = _csv_bytes(path)
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
+        found_delimiter, found_decimal = sniff_csv(head)
+        parse = pacsv.ParseOptions(delimiter=delimiter or found_delimiter)
+        convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal or found_decimal)
         try:
-            return pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(strings_can_be_null=True))
+            return pacsv.read_csv(source, parse_options=parse, convert_options=convert)
         except pa.ArrowInvalid as exc:
             raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
     try:
@@ -160,6 +221,8 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
 
 def detect_table_format(path: Path) -> str | None:
     suffix = path.suffix.lower()
+    if suffix in (".gz", ".bz2", ".xz", ".zst") and Path(path.stem).suffix.lower() in (".csv", ".txt"):
+        return "csv"  # compressed CSV, e.g. run.csv.gz
     if suffix in (".csv", ".txt"):
         return "csv"
     if suffix in (".parquet", ".pq"):
@@ -193,7 +256,7 @@ def read_table(
     layout = layout or TableLayout()
     path = Path(path)
     fmt = fmt or detect_table_format(path) or "csv"
-    table = _read_arrow(path, fmt)
+    table = _read_arrow(path, fmt, layout.delimiter, layout.decimal)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     header = table.column_names
