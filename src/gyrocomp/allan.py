@@ -28,14 +28,12 @@ from dataclasses import dataclass
 from typing import Iterable
 
 import numpy as np
-from scipy import special
-from scipy.optimize import nnls
 
 from .errors import InputError
 from .units import STANDARD_GRAVITY_M_PER_S2
 
 #: two-sided confidence of one standard deviation, erf(1/sqrt(2)) = 0.6827
-ONE_SIGMA = float(special.erf(1.0 / math.sqrt(2.0)))
+ONE_SIGMA = math.erf(1.0 / math.sqrt(2.0))
 KINDS = ("oadev", "adev", "mdev", "tdev", "hdev", "ohdev", "totdev")
 #: Stable32 stops its tau grids at N / stop ratio (N phase points)
 STOP_RATIO = {"adev": 5, "hdev": 5, "totdev": 2}
@@ -472,7 +470,7 @@ def _trend_gram(length: int) -> np.ndarray:
     power_sums = [n, n * (n - 1) // 2, (n - 1) * n * (2 * n - 1) // 6, (n * (n - 1) // 2) ** 2,
                   (n - 1) * n * (2 * n - 1) * (3 * (n - 1) ** 2 + 3 * (n - 1) - 1) // 30]
     scale = 2.0 / (n - 1)
-    u_sums = [sum(special.comb(p, j, exact=True) * scale ** j * (-1.0) ** (p - j) * power_sums[j]
+    u_sums = [sum(math.comb(p, j) * scale ** j * (-1.0) ** (p - j) * power_sums[j]
                   for j in range(p + 1)) for p in range(5)]
     return np.array([[u_sums[p + q] for q in range(3)] for p in range(3)])
 
@@ -571,7 +569,7 @@ def _sz(t: np.ndarray, filter_factor: float, alpha: int, d: int) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     total = np.zeros_like(t)
     for k in range(-d, d + 1):
-        total += (-1) ** abs(k) * special.comb(2 * d, d + k, exact=True) * _sx(t + k, filter_factor, alpha)
+        total += (-1) ** abs(k) * math.comb(2 * d, d + k) * _sx(t + k, filter_factor, alpha)
     return total
 
 
@@ -662,7 +660,7 @@ def edf_greenhall(alpha: int, d: int, m: int, n_phase: int, *, overlapping: bool
     # alpha == 2, unmodified
     if math.ceil(r) <= d:
         return exact(float(_sz(np.array(0.0), m, 2, d)) ** 2, j_terms, m_terms, stride, m)
-    a0 = special.comb(4 * d, 2 * d) / special.comb(2 * d, d) ** 2
+    a0 = math.comb(4 * d, 2 * d) / math.comb(2 * d, d) ** 2
     return m_terms / (a0 - (d / 2.0) / r)
 
 
@@ -693,10 +691,12 @@ def confidence_interval(deviation, edf, confidence: float = ONE_SIGMA) -> tuple[
     deviation = np.asarray(deviation, dtype=float)
     edf = np.asarray(edf, dtype=float)
     tail = (1.0 - confidence) / 2.0
+    from scipy.special import gammaincinv  # scipy.special is slow to import; only the intervals need it
+
     with np.errstate(invalid="ignore", divide="ignore"):
         # chi-squared quantile: chi2.ppf(q, edf) = 2 * gammaincinv(edf / 2, q)
-        low = deviation * np.sqrt(edf / (2.0 * special.gammaincinv(edf / 2.0, 1.0 - tail)))
-        high = deviation * np.sqrt(edf / (2.0 * special.gammaincinv(edf / 2.0, tail)))
+        low = deviation * np.sqrt(edf / (2.0 * gammaincinv(edf / 2.0, 1.0 - tail)))
+        high = deviation * np.sqrt(edf / (2.0 * gammaincinv(edf / 2.0, tail)))
     return low, high
 
 
@@ -1033,6 +1033,8 @@ def noise_terms(result: AllanResult, fit_taus_s: tuple[float, float] | None = No
     half_width = np.maximum(half_width, MODEL_UNCERTAINTY * variance)
     basis = _model_basis(tau) / half_width[:, None]
     scale = np.linalg.norm(basis, axis=0)
+    from scipy.optimize import nnls  # scipy.optimize is slow to import; only the noise terms need it
+
     solution, _ = nnls(basis / scale, variance / half_width)
     q2, n2, b2, k2, r2 = coefficients = solution / scale
     with np.errstate(divide="ignore"):

@@ -29,7 +29,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
@@ -55,6 +54,8 @@ SCORE_WINDOW_S = 60.0
 def best_lag_s(rss: Callable[[float], float], lo_s: float, hi_s: float = LAG_MAX_S) -> float:
     """The time constant [s] that minimizes ``rss(tau)``: a 12-point log-spaced search between ``lo_s`` and
     ``hi_s`` [s], refined by a bounded scalar minimization in log(tau) around the best grid point."""
+    from scipy.optimize import minimize_scalar  # slow to import; only lag fits need it
+
     grid = np.geomspace(lo_s, hi_s, 12)
     values = [rss(float(tau)) for tau in grid]
     best = int(np.argmin(values))
