@@ -282,6 +282,12 @@ def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
         read(path, TableLayout(columns={"time": "imu/t_ms", "gyro_z": "wz"}))
     with pytest.raises(InputError, match=r"no time dataset \(the file has imu/acc, .*\); map one with columns="):
         read(path)
+    # a units attribute gyrocomp does not know is said, not read silently as deg/s
+    with h5py.File(path, "a") as f:
+        f["imu/wz"].attrs["units"] = "furlongs/fortnight"
+    with pytest.warns(DataQualityWarning, match=r"dataset /imu/wz has units 'furlongs/fortnight', which gyrocomp "
+                                                r"does not know; read as deg/s \(set gyro_unit= if that is wrong\)"):
+        read(path, TableLayout(columns={"time": "imu/t_ms", "gyro_z": "imu/wz"}, time_unit="ms"))
 
 
 # -- format detection and helpers ------------------------------------------------------------------------

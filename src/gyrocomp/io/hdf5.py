@@ -10,11 +10,12 @@ Without a mapping, datasets are looked up under gyrocomp's names and common ones
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, check_magic, require
@@ -50,7 +51,8 @@ def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> floa
         try:
             return unit_factor(kind, unit)
         except InputError:
-            pass
+            warnings.warn(f"{source}: dataset {dataset.name} has units {units!r}, which gyrocomp does not know; "
+                          f"read as {fallback} (set {option}= if that is wrong)", DataQualityWarning, stacklevel=4)
     return unit_factor(kind, fallback, option)
 
 
