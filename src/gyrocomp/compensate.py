@@ -263,8 +263,8 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     axes : tuple of str, optional
         The gyro axes to compensate. By default every gyro axis of the recording, and a recording with a gyro
         axis the model has no curve for is refused (a model of another part, or a column mapped to the wrong
-        axis, would otherwise leave it raw unnoticed); name the axes to compensate the others and leave the
-        rest raw, with a warning saying which.
+        axis, would otherwise leave it raw unnoticed); name axes to compensate only those, the others left raw
+        with a warning saying which.
     """
     if not isinstance(recording, Recording):
         raise InputError(f"recording: expected a Recording (from gyrocomp.read or simulate), got {type(recording).__name__}")

@@ -18,7 +18,8 @@ Candidates (:class:`Candidate`)
     hysteresis of order 1..3 (only where the runs reverse), and the weighting of the fit: ``time`` (every
     second of data counts equally, as in the score) or ``temperature-balanced`` (every temperature bin of
     every run counts equally, so a slow ramp cannot dominate). The lag of a fold's fit is chosen on that
-    fold's training data (a log-spaced grid), so the held-out score judges the whole procedure.
+    fold's training data (a log-spaced grid), so the held-out score judges the whole procedure; with one
+    temperature column it is one lag for all axes (:func:`share_fold_lags`), as in the final fit.
 
 Score and rule
     Per fold, the time-weighted RMS of the moving average (``window_s``) of the held-out residual about its
