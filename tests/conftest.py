@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -29,3 +32,14 @@ TEST_MODEL = GyroErrorModel(bias_instability_deg_per_h=5.0)
 def chamber_runs():
     """Seven 1-hour chamber runs at 20 Hz of TEST_MODEL (seeds 0..6), each with its own turn-on bias."""
     return [simulate(TEST_MODEL, profile="chamber", duration_s=3600, rate_hz=20, seed=s) for s in range(7)]
+
+
+#: the console script of this environment, run as a user would
+SCRIPT = Path(sys.executable).parent / "gyrocomp"
+
+
+def run(*args, cwd=None) -> subprocess.CompletedProcess:
+    """Run the ``gyrocomp`` command through its real entry point in a subprocess (wide terminal, 300 s limit)."""
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+    env = {**os.environ, "COLUMNS": "200"}
+    return subprocess.run([*cmd, *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)

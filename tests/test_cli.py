@@ -15,14 +15,7 @@ import pytest
 from gyrocomp.calibration import SCHEMA_VERSION
 from gyrocomp.cli import _environment_message, in_cli_words
 
-SCRIPT = Path(sys.executable).parent / "gyrocomp"
-
-
-def run(*args, cwd=None):
-    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
-    env = {**os.environ, "COLUMNS": "200"}
-    return subprocess.run([*cmd, *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
-
+from .conftest import run
 
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory):

@@ -17,7 +17,7 @@ from gyrocomp.comparison import (
 from gyrocomp.errors import InputError, TemperatureRangeWarning
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import get_profile, simulate
-from tests.test_cli import run
+from .conftest import run
 
 
 @pytest.fixture(scope="module")

@@ -46,7 +46,7 @@ from .comparison import compare_methods
 from .demo import run_demo
 from .evaluation import evaluate as evaluate_calibration
 from .export.autopilot import ardupilot_params_file, px4_params_file
-from .export.c_code import c_sources
+from .export.c_code import write_c_sources
 from .evaluation import evaluate_stages
 from .metrics import Evaluation, default_window_s
 from .report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
@@ -835,15 +835,9 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id):
     calibration = Calibration.load(model)
     if fmt == "c":
 
-        folder = Path(output)
-        if folder.exists() and not folder.is_dir():
-            raise InputError(f"-o {output}: --format c writes a folder (gyrocomp.h, gyrocomp.c); this is a file")
-        sources = c_sources(calibration, rate_hz=rate_hz)
-        folder.mkdir(parents=True, exist_ok=True)
-        for name, text in sources.items():
-            write_text_atomic(folder / name, text)
+        written = write_c_sources(calibration, output, rate_hz=rate_hz)
         if not ctx.obj["quiet"]:
-            click.echo(f"wrote {folder / 'gyrocomp.h'} and {folder / 'gyrocomp.c'}")
+            click.echo("wrote " + " and ".join(str(p) for p in written))
         return
     if fmt == "px4":
         text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)

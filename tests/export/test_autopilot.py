@@ -12,7 +12,7 @@ from gyrocomp import fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.simulate import GyroErrorModel, simulate
-from tests.test_cli import run
+from ..conftest import run
 
 RAD_TO_DEG = 180.0 / math.pi
 

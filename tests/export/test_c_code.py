@@ -11,10 +11,10 @@ import pytest
 
 from gyrocomp import apply, fit_calibration
 from gyrocomp.errors import InputError
-from gyrocomp.export.c_code import c_sources
+from gyrocomp.export.c_code import c_sources, write_c_sources
 from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulate import get_profile, simulate
-from tests.test_cli import run
+from ..conftest import run
 
 DRIVER = r"""
 #include <stdio.h>
@@ -162,3 +162,18 @@ def test_accelerometer_temperature_models_and_g_sensitivity_on_compensated_accel
     for theirs, mine in ((out[:, :3], ours.gyro_dps), (out[:, 3:], ours.accel_g)):
         assert np.max(np.abs(theirs - mine) / np.maximum(np.abs(mine), 1.0)) < 1e-9
     assert np.max(np.abs(ours.accel_g - rec.accel_g)) > 1e-3  # the accelerometer really was compensated
+
+
+def test_the_two_files_are_written_both_or_neither(tmp_path):
+    runs = [simulate("mti10", profile="chamber", duration_s=1200, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, temperature=2, hysteresis="none", acceleration="none")
+    (tmp_path / "gyrocomp.h").write_text("old header\n")
+    (tmp_path / "gyrocomp.c").mkdir()  # the second file cannot be written
+    with pytest.raises(InputError, match=r"gyrocomp.c: is a folder"):
+        write_c_sources(cal, tmp_path)
+    assert (tmp_path / "gyrocomp.h").read_text() == "old header\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gyrocomp.c", "gyrocomp.h"]  # no temporary left
+    written = write_c_sources(cal, tmp_path / "new")
+    assert [p.name for p in written] == ["gyrocomp.h", "gyrocomp.c"] and "#ifndef" in written[0].read_text()

@@ -13,7 +13,8 @@ import pytest
 from gyrocomp.errors import DataQualityWarning, InputError, MissingDependencyError
 from gyrocomp.io import TableLayout, detect_format, read, sniff_format
 from gyrocomp.io.common import match_by_time, order_by_time
-from tests.conftest import shared_dataset
+
+from ..conftest import run, shared_dataset
 from tests.io.log_writers import write_dataflash, write_ulog
 
 RAD_TO_DEG = 180.0 / math.pi
@@ -350,8 +351,6 @@ def test_match_by_time_interpolates_and_marks_what_is_too_far():
 
 # -- through the command line ------------------------------------------------------------------------------
 def test_cli_fits_applies_and_converts_a_ulog_directly(tmp_path):
-    from tests.test_cli import run
-
     n, rate_hz = 3000, 10.0
     temperature = np.linspace(10, 50, n)
     bias_rad_s = 1e-3 * (temperature - 30) + 2e-5 * (temperature - 30) ** 2
@@ -381,8 +380,6 @@ def test_cli_fits_applies_and_converts_a_ulog_directly(tmp_path):
 
 @pytest.mark.parametrize("case", ["not-the-format", "no-gyro-topic", "no-such-bag-topic", "output-format"])
 def test_cli_bad_logs_give_one_line_and_status_2(tmp_path, case):
-    from tests.test_cli import run
-
     if case == "not-the-format":
         path = tmp_path / "run.csv"
         path.write_text("time,gyro_z\n0,1\n1,2\n")

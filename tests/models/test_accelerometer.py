@@ -16,6 +16,8 @@ from gyrocomp.metrics import evaluate_run, moving_average
 from gyrocomp.models.pipelines import fit_accelerometer, fit_channels, parse_channels
 from gyrocomp.simulate import get_profile, simulate
 
+from ..conftest import run
+
 
 def _quiet(func, *args, **kwargs):
     with warnings.catch_warnings():
@@ -116,8 +118,6 @@ def test_bad_channels_and_missing_accelerometer(cycles):
 
 
 def test_cli_accelerometer_channel_end_to_end(tmp_path):
-    from tests.test_cli import run
-
     for seed in (1, 2, 3):
         r = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 0.5, "--seed", seed,
                 "-o", tmp_path / f"run{seed}.csv")

@@ -22,7 +22,7 @@ from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.report.figures import envelope
 from gyrocomp.report.html import SECTIONS, build_report
 from gyrocomp.simulate import get_profile, simulate
-from tests.test_cli import SCRIPT, run
+from ..conftest import SCRIPT, run
 
 matplotlib_image = pytest.importorskip("matplotlib.image", reason="the report tests draw with matplotlib")
 

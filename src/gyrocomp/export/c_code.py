@@ -18,11 +18,14 @@ gaps exactly), the turning-point hysteresis, and the mean turn-on constant of th
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
+from ..io.atomic import write_texts_atomic
 from ..models.mlp import MLPBias, layer_shapes
 from ..models.temperature import PolynomialBias
 
@@ -269,4 +272,15 @@ void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const doub
     return {"gyrocomp.h": header, "gyrocomp.c": "\n".join(body)}
 
 
-__all__ = ["c_sources"]
+def write_c_sources(calibration: Calibration, folder: str | os.PathLike, *, rate_hz: float | None = None) -> list[Path]:
+    """Write gyrocomp.h and gyrocomp.c (:func:`c_sources`) into ``folder`` (created if needed), both or
+    neither: a write that fails leaves the files there as they were. Returns the paths written."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder}: the C export writes a folder (gyrocomp.h, gyrocomp.c); this is a file")
+    sources = c_sources(calibration, rate_hz=rate_hz)
+    folder.mkdir(parents=True, exist_ok=True)
+    return write_texts_atomic(folder, sources)
+
+
+__all__ = ["c_sources", "write_c_sources"]

@@ -67,6 +67,20 @@ def _mode_for(target: Path) -> int:
         return 0o666 & ~umask
 
 
+def write_texts_atomic(folder: str | os.PathLike, texts: dict[str, str]) -> list[Path]:
+    """Write several files into ``folder`` all or none: every one goes to a temporary file first, and only when
+    all are written are they renamed into place (a full disk while writing leaves the old files as they were).
+    Returns the paths written."""
+    folder = Path(folder)
+    with contextlib.ExitStack() as stack:
+        temps = []
+        for name, text in texts.items():
+            tmp = stack.enter_context(atomic_path(folder / name))  # each renames on exit, after all are written
+            tmp.write_text(text, encoding="utf-8")
+            temps.append(folder / name)
+    return temps
+
+
 def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     with atomic_path(path) as tmp:
