@@ -545,19 +545,13 @@ def validate(ctx, runs, folds, window_s, candidates, as_json, **kwargs):
 
 def print_validation(result: ValidationResult) -> None:
     console = _console()
-    table = Table(title=f"held-out drift [deg/s], {result.window_s:g} s moving average, mean +- standard error "
-                        f"over {len(result.folds)} folds ({result.fold_kind})")
-    table.add_column("method")
-    for axis in result.axes:
-        table.add_column(axis, justify="right")
-    table.add_column("mean", justify="right")
-    table.add_column("vs cubic", justify="right")
-    cubic = result.mean_over_axes("cubic + run constants")
-    for method in result.methods:
-        cells = [f"{result.score(method, a).mean_drift_dps:.4g} +- {result.score(method, a).standard_error_dps:.2g}"
-                 for a in result.axes]
-        mean = result.mean_over_axes(method)
-        table.add_row(method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-")
+    table = Table(title=result.title)
+    header, rows = result.table_rows()
+    table.add_column(header[0])
+    for column in header[1:]:
+        table.add_column(column, justify="right")
+    for row in rows:
+        table.add_row(*row)
     console.print(table)
     console.print("folds: " + ", ".join(result.folds))
 

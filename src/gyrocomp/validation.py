@@ -111,6 +111,24 @@ class ValidationResult:
         """A method's held-out drift averaged over the axes [deg/s]."""
         return float(np.mean([self.score(method, a).mean_drift_dps for a in self.axes]))
 
+    @property
+    def title(self) -> str:
+        """What the table shows: the quantity, window, statistic and folds."""
+        return (f"held-out drift [deg/s], {self.window_s:g} s moving average, mean +- standard error over "
+                f"{len(self.folds)} folds ({self.fold_kind})")
+
+    def table_rows(self) -> tuple[list[str], list[list[str]]]:
+        """(header, rows) of the table ``gyrocomp validate`` prints and the report shows: per method, each axis's
+        mean +- standard error [deg/s], the mean over the axes and its ratio to the plain cubic's."""
+        cubic = self.mean_over_axes("cubic + run constants") if "cubic + run constants" in self.methods else 0.0
+        rows = []
+        for method in self.methods:
+            cells = [f"{self.score(method, a).mean_drift_dps:.4g} +- {self.score(method, a).standard_error_dps:.2g}"
+                     for a in self.axes]
+            mean = self.mean_over_axes(method)
+            rows.append([method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-"])
+        return ["method", *self.axes, "mean", "vs cubic"], rows
+
     def to_dict(self) -> dict:
         return {"fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
                 "methods": list(self.methods), "axes": list(self.axes),

@@ -148,17 +148,10 @@ def _summary(calibration: Calibration) -> str:
 
 def _validation(result: ValidationResult) -> str:
     """The held-out drift table: mean +- standard error per method and axis [deg/s], and against the cubic."""
-    cubic = result.mean_over_axes("cubic + run constants") if "cubic + run constants" in result.methods else 0.0
-    rows = []
-    for method in result.methods:
-        cells = [f"{result.score(method, a).mean_drift_dps:.4g} +- {result.score(method, a).standard_error_dps:.2g}"
-                 for a in result.axes]
-        mean = result.mean_over_axes(method)
-        rows.append([method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-"])
-    caption = (f"held-out drift [deg/s], {result.window_s:g} s moving average, mean +- standard error over "
-               f"{len(result.folds)} folds ({result.fold_kind}): each method fitted without the fold it is scored on")
+    header, rows = result.table_rows()
+    caption = f"{result.title}: each method fitted without the fold it is scored on"
     folds = f"<p class=note>folds: {html.escape(', '.join(result.folds))}</p>"
-    return _table(["method", *result.axes, "mean", "vs cubic"], rows, caption) + folds
+    return _table(header, rows, caption) + folds
 
 
 def _evaluation(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
