@@ -94,23 +94,29 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
     return out
 
 
+def _largest_span_degc(recordings: list[Recording]) -> float | None:
+    """The largest temperature span of any run [degC], or None when no run has a temperature."""
+    spans = [float(np.ptp(r.temperature_degc)) for r in recordings if r.temperature_degc is not None]
+    return max(spans) if spans else None
+
+
 def require_temperature_span(recordings: list[Recording], what: str) -> None:
     """Refuse to compare temperature models on runs whose temperature does not vary at all: every such model
     is then undetermined (``what`` names the operation in the message)."""
-    spans = [float(np.ptp(r.temperature_degc)) for r in recordings if r.temperature_degc is not None]
-    if spans and max(spans) < MIN_TEMPERATURE_SPAN_DEGC:
-        raise InputError(f"{recordings[0].source}: the temperature of every run spans at most {max(spans):.3g} degC; "
+    span = _largest_span_degc(recordings)
+    if span is not None and span < MIN_TEMPERATURE_SPAN_DEGC:
+        raise InputError(f"{recordings[0].source}: the temperature of every run spans at most {span:.3g} degC; "
                          f"{what} compares temperature models, which need runs over a temperature range")
 
 
 def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
     """A temperature curve asked for on runs that each stay at one temperature: with one constant per run, such
     runs say nothing about the curve (a multi-position run at room temperature is fine for G alone)."""
-    spans = [float(np.ptp(r.temperature_degc)) for r in recordings if r.temperature_degc is not None]
-    if not spans or max(spans) >= MIN_TEMPERATURE_SPAN_DEGC:
+    span = _largest_span_degc(recordings)
+    if span is None or span >= MIN_TEMPERATURE_SPAN_DEGC:
         return None
     return Concern("temperature-span", f"{recordings[0].source}: the temperature of every run spans at most "
-                                       f"{max(spans):.3g} degC; a temperature curve needs runs over a temperature "
+                                       f"{span:.3g} degC; a temperature curve needs runs over a temperature "
                                        "range (or fit with temperature=none)")
 
 

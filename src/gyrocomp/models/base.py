@@ -134,6 +134,11 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
     return float(residual_dps[head].mean())
 
 
+def one_temperature_column(recordings: list[Recording]) -> bool:
+    """Whether every recording reads one temperature for all its axes (one sensor, so one die and one lag)."""
+    return all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1 for rec in recordings)
+
+
 def provenance(recordings) -> dict:
     """Where a calibration came from: gyrocomp's version, the time, and each input (name, rows, duration,
     rate, SHA-256 of the file when it is on disk)."""

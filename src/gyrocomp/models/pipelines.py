@@ -23,7 +23,7 @@ from .acceleration import (
     fit_g_sensitivity,
     turned_between_positions,
 )
-from .base import bin_width_for, block_means, provenance
+from .base import bin_width_for, block_means, one_temperature_column, provenance
 from .hysteresis import heats_and_cools
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
@@ -110,8 +110,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
                                                              squares=acceleration == "matrix2", warn=False)
             problem.accel_cols, problem.square_cols = accel_cols, square_cols
         problems[axis] = problem
-    one_sensor = all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1 for rec in recordings)
-    if shared_lag and one_sensor and any("lag" in m for m in memories):
+    if shared_lag and one_temperature_column(recordings) and any("lag" in m for m in memories):
         share_fold_lags(list(problems.values()), orders)
     return {axis: select_axis(axis, problem, orders, memories) for axis, problem in problems.items()}
 

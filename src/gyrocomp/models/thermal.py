@@ -35,7 +35,7 @@ from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..recording import Recording
 from ..static import static_segments
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
-from .base import RunBlocks, bin_width_for, block_means
+from .base import RunBlocks, bin_width_for, block_means, one_temperature_column
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
 
@@ -360,8 +360,7 @@ class ThermalHysteresisModel:
         self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
             "leave-one-run-out" if len(recordings) >= 2 else "bic")
         choices = {axis: self._choose(axis, recordings, pieces, first=axis == axes[0]) for axis in axes}
-        one_sensor = all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1 for rec in recordings)
-        taus = self._shared_lag(choices) if self.shared_lag and one_sensor else {}
+        taus = self._shared_lag(choices) if self.shared_lag and one_temperature_column(recordings) else {}
         for axis, choice in choices.items():
             self._store(axis, choice, taus.get(axis))
         self._fitted = True
