@@ -1,0 +1,216 @@
+"""Power-law noise type of phase data at each averaging factor, as Stable32 identifies it.
+
+With at least 30 decimated points: the lag-1 autocorrelation (W. Riley and C. Greenhall, "Power law noise
+identification using the lag 1 autocorrelation", EFTF 2004). With fewer: the B1 ratio of the standard to
+the Allan variance (D. Howe, R. Beard, C. Greenhall, W. Riley, "A total estimator of the Hadamard function
+used for GPS operations", PTTI 2000, Tables 3-4; NIST SP 1065 section 5.6), which cannot tell white from
+flicker PM, so that pair is split by R(n) = MVAR/AVAR (NIST TN 1337 A-6).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from .estimators import _BLOCK, _ESTIMATORS, _blocks, _normalize, _variance_sums, term_count
+
+#: fewest decimated points for which the lag-1 autocorrelation identifies a noise type (Riley 2004)
+NOISE_ID_MIN_POINTS = 30
+#: and the most it uses (a contiguous stretch from the start)
+NOISE_ID_MAX_POINTS = 1 << 20
+
+
+@dataclass(frozen=True)
+class NoiseIdentification:
+    """Power-law noise type at one averaging factor.
+
+    ``alpha`` is the integer exponent of S_y(f) ~ f^alpha. ``method`` says how it was found: "lag1" (the
+    lag-1 autocorrelation; ``alpha_estimate`` is then the unrounded value, ``differences`` how often the
+    decimated phase was differenced, ``rho`` the ratio r1/(1+r1)), "b1" (the B1 ratio, in ``ratio``) or
+    "rn" (B1 found white or flicker PM and R(n), in ``ratio``, chose between them); the lag-1 fields are
+    NaN (``differences`` -1) for those.
+    """
+
+    alpha: int
+    alpha_estimate: float
+    differences: int
+    rho: float
+    method: Literal["lag1", "b1", "rn"] = "lag1"
+    ratio: float = math.nan
+
+
+def _trend_gram(length: int) -> np.ndarray:
+    """sum_k u^(p+q), p, q = 0..2, for u = 2k/(L-1) - 1, k = 0..L-1 (exact power sums of k, then rescaled)."""
+    n = length
+    power_sums = [n, n * (n - 1) // 2, (n - 1) * n * (2 * n - 1) // 6, (n * (n - 1) // 2) ** 2,
+                  (n - 1) * n * (2 * n - 1) * (3 * (n - 1) ** 2 + 3 * (n - 1) - 1) // 30]
+    scale = 2.0 / (n - 1)
+    u_sums = [sum(math.comb(p, j) * scale ** j * (-1.0) ** (p - j) * power_sums[j]
+                  for j in range(p + 1)) for p in range(5)]
+    return np.array([[u_sums[p + q] for q in range(3)] for p in range(3)])
+
+
+def _quadratic_trend(x) -> np.ndarray:
+    """Least-squares coefficients of c0 + c1 u + c2 u^2, u = 2k/(L-1) - 1, fitted to x[k], in blocks."""
+    length = len(x)
+    moments = np.zeros(3)
+    scale = 2.0 / (length - 1)
+    steps = np.arange(_BLOCK) * scale
+    for start, stop in _blocks(length):
+        block = np.asarray(x[start:stop], dtype=np.float64)
+        u = steps[:stop - start] + (start * scale - 1.0)
+        ux = u * block
+        moments += (block.sum(), ux.sum(), np.dot(u, ux))
+    return np.linalg.solve(_trend_gram(length), moments)
+
+
+def _lag1_autocorrelations(x, trend: np.ndarray, max_differences: int) -> list[float]:
+    """Lag-1 autocorrelation of the residual of x about its quadratic trend, differenced 0..max times."""
+    length = len(x)
+    scale = 2.0 / (length - 1)
+    steps = np.arange(_BLOCK + max_differences + 1) * scale
+    sums = np.zeros((max_differences + 1, 5))  # per d: sum, sum of squares, lag-1 products, first, last
+    for start, stop in _blocks(length):
+        hi = min(stop + max_differences + 1, length)  # overlap, to pair and difference across blocks
+        u = steps[:hi - start] + (start * scale - 1.0)
+        z = np.asarray(x[start:hi], dtype=np.float64) - (trend[0] + u * (trend[1] + u * trend[2]))
+        for d in range(max_differences + 1):
+            size = length - d
+            own = z[:min(stop, size) - start]
+            if own.size:
+                paired = z[:min(stop + 1, size) - start]
+                row = sums[d]
+                row[0] += own.sum()
+                row[1] += np.dot(own, own)
+                row[2] += np.dot(paired[:-1], paired[1:])
+                if start == 0:
+                    row[3] = own[0]
+                row[4] = own[-1]
+            z = z[1:] - z[:-1]
+    result = []
+    for d, (s1, s2, pairs, first, last) in enumerate(sums):
+        size = length - d
+        mean = s1 / size
+        numerator = pairs - mean * (2.0 * s1 - first - last) + (size - 1) * mean * mean
+        denominator = s2 - size * mean * mean
+        result.append(numerator / denominator if denominator > 0 else math.nan)
+    return result
+
+
+def identify_noise(phase, m: int, *, max_differences: int = 2) -> NoiseIdentification | None:
+    """Power-law noise type of phase data at averaging factor m, by the lag-1 autocorrelation.
+
+    The phase is decimated by m, its quadratic trend removed, and it is differenced until the
+    autocorrelation ratio rho = r1 / (1 + r1) falls below 0.25 (or ``max_differences`` is reached);
+    then alpha = 2 - 2 (rho + d), rounded (Riley and Greenhall 2004). Returns None with fewer than
+    30 decimated points. At most the first 2^20 decimated points are used: the lag-1 estimate's
+    standard error there (1e-3) is far inside the rounding margin, and no reference series is longer.
+    """
+    x = phase[:NOISE_ID_MAX_POINTS * m:m]
+    if len(x) < NOISE_ID_MIN_POINTS:
+        return None
+    correlations = _lag1_autocorrelations(x, _quadratic_trend(x), max_differences)
+    for d, r1 in enumerate(correlations):
+        if math.isnan(r1):
+            return None  # a constant (or exactly polynomial) series has no noise type
+        rho = r1 / (1.0 + r1)
+        if rho < 0.25 or d == max_differences:
+            break
+    estimate = 2.0 - 2.0 * (rho + d)
+    return NoiseIdentification(alpha=int(2 - np.round(2.0 * rho) - 2 * d), alpha_estimate=estimate,
+                               differences=d, rho=rho)
+
+
+
+# --- fewer than 30 points: the B1 ratio and R(n) ------------------------------------------------------------
+
+def b1_expected(n_points: int, mu: int) -> float:
+    """Expected B1 ratio (standard over Allan variance) of ``n_points`` frequency averages of a noise whose
+    Allan variance goes as tau^mu: N(1 - N^mu) / (2(N-1)(1 - 2^mu)), with its limits at mu = 0 and -1
+    (Howe et al. 2000, Table 3)."""
+    n = float(n_points)
+    if mu == 0:
+        return n * math.log(n) / (2.0 * (n - 1.0) * math.log(2.0))
+    if mu == -1:
+        return 1.0
+    return n * (1.0 - n ** mu) / (2.0 * (n - 1.0) * (1.0 - 2.0 ** mu))
+
+
+def rn_expected(m: int, alpha: Literal[1, 2]) -> float:
+    """Expected R(n) = MVAR/AVAR at averaging factor m: 1/m for white PM; 3.37 / (1.04 + 3 ln(pi m)) for
+    flicker PM with the measurement bandwidth at the Nyquist frequency (NIST TN 1337, A-6, Table 2)."""
+    return 1.0 / m if alpha == 2 else 3.37 / (1.04 + 3.0 * math.log(math.pi * m))
+
+
+def _variance_at(kind: str, phase, m: int) -> float:
+    """The variance of estimator ``kind`` at averaging factor m (NaN where no term fits)."""
+    ms = np.array([m])
+    counts = term_count(kind, len(phase), ms)
+    if counts[0] < 1:
+        return math.nan
+    return float(_normalize(kind, _variance_sums(kind, phase, ms, counts), ms, ms.astype(float), counts, 1.0)[0] ** 2)
+
+
+def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
+    """Noise type at averaging factor m from the B1 ratio, for series too short for the lag-1 method.
+
+    The N = (len(phase) - 1) // m frequency averages at m have their linear drift removed (as the lag-1
+    method removes the quadratic phase trend); B1 is their standard variance over their Allan variance. The
+    Allan variance's exponent mu is the one whose expected B1 lies nearest on a log scale (boundaries at
+    the geometric means, Howe et al. 2000, Table 4), alpha = -mu - 1. mu = -2 (white or flicker PM) is
+    split by R(n) = MVAR/AVAR of the whole series against the geometric mean of the two expected values.
+    Returns None with fewer than 3 averages or a series without variation.
+    """
+    n_points = (len(phase) - 1) // m
+    if n_points < 3:
+        return None
+    x = np.asarray(phase[:n_points * m + 1:m], dtype=np.float64)
+    averages = np.diff(x) / m
+    k = np.arange(n_points, dtype=np.float64)
+    residual = averages - np.polyval(np.polyfit(k, averages, 1), k)
+    allan = 0.5 * float(np.mean(np.diff(averages) ** 2))
+    if not allan > 0:
+        return None
+    ratio = float(np.var(residual, ddof=1)) / allan
+    mu = -2
+    for candidate in (2, 1, 0, -1):
+        if ratio > math.sqrt(b1_expected(n_points, candidate) * b1_expected(n_points, candidate - 1)):
+            mu = candidate
+            break
+    if mu > -2:
+        return NoiseIdentification(alpha=-mu - 1, alpha_estimate=math.nan, differences=-1, rho=math.nan,
+                                   method="b1", ratio=ratio)
+    rn = _variance_at("mdev", phase, m) / _variance_at("adev", phase, m)
+    if not math.isfinite(rn):
+        return None
+    alpha = 1 if rn > math.sqrt(rn_expected(m, 1) * rn_expected(m, 2)) else 2
+    return NoiseIdentification(alpha=alpha, alpha_estimate=math.nan, differences=-1, rho=math.nan,
+                               method="rn", ratio=rn)
+
+
+def noise_types(kind: str, phase, ms: np.ndarray) -> np.ndarray:
+    """alpha at each averaging factor in ``ms`` (ascending), as Stable32 identifies it.
+
+    The lag-1 autocorrelation where 30 decimated points remain, the B1 ratio with R(n) below that. A B1
+    type is capped by the type found at the next shorter tau: in a sum of independent power-law noises the
+    dominant exponent can only fall as tau grows, and the lag-1 type from many points is the better
+    determined. Where neither method applies the type found at the next shorter tau is carried forward.
+    Types are kept within the estimator's range (alpha + 2d > 1).
+    """
+    spec = _ESTIMATORS[kind]
+    lowest = 2 - 2 * spec.difference_order
+    alphas = np.full(len(ms), np.nan)
+    current = math.nan
+    for j, m in enumerate(ms):
+        m = int(m)
+        found = identify_noise(phase, m, max_differences=spec.difference_order)
+        if found is not None:
+            current = float(min(2, max(lowest, found.alpha)))
+        elif (few := identify_noise_b1(phase, m)) is not None:
+            capped = few.alpha if math.isnan(current) else min(few.alpha, current)
+            current = float(min(2, max(lowest, capped)))
+        alphas[j] = current
+    return alphas
