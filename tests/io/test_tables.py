@@ -21,6 +21,8 @@ from gyrocomp.io import (
 )
 from gyrocomp.simulate import GyroErrorModel, simulate
 
+from ..conftest import run
+
 
 def write_csv(path, text):
     path.write_text(text)
@@ -238,6 +240,34 @@ def test_a_repeated_column_name_is_refused_in_one_line(tmp_path):
     p = write_csv(tmp_path / "dup.csv", "time,gyro_z,gyro_z,temperature\n0,1,2,20\n1,1,2,21\n")
     with pytest.raises(InputError, match=r"dup.csv: column 'gyro_z' appears 2 times in the header; give each column"):
         read_table(p)
+
+
+THREE_AXES = "time,gyro_x,gyro_y,gyro_z,temperature\n0,1,2,3,20\n1,1,2,3,21\n"
+
+
+def test_a_column_read_as_two_channels_is_refused_and_a_swap_is_read(tmp_path):
+    p = write_csv(tmp_path / "three.csv", THREE_AXES)
+    with pytest.raises(InputError, match=r"three.csv: column 'gyro_x' would be read as gyro_x and gyro_z "
+                                         r"\(columns=\{'gyro_z': 'gyro_x'\}\); one column feeds one channel"):
+        read_table(p, TableLayout(columns={"gyro_z": "gyro_x"}))
+    swapped = read_table(p, TableLayout(columns={"gyro_x": "gyro_z", "gyro_z": "gyro_x"})).recording
+    np.testing.assert_array_equal(swapped.gyro_dps[0], [3.0, 2.0, 1.0])
+
+
+def test_a_channels_own_column_left_unread_by_a_mapping_is_said(tmp_path):
+    p = write_csv(tmp_path / "alt.csv", "time,gyro_z,gyro_z_filtered,temperature\n0,1,5,20\n1,1,6,21\n")
+    with pytest.warns(DataQualityWarning, match=r"alt.csv: column 'gyro_z' is not read: "
+                                                r"columns=\{'gyro_z': 'gyro_z_filtered'\} reads gyro_z from"):
+        data = read_table(p, TableLayout(columns={"gyro_z": "gyro_z_filtered"}))
+    np.testing.assert_array_equal(data.recording.gyro_dps[:, 0], [5.0, 6.0])
+
+
+def test_cli_refuses_a_mapping_that_reads_one_column_twice(tmp_path):
+    p = write_csv(tmp_path / "three.csv", THREE_AXES)
+    result = run("convert", p, tmp_path / "out.csv", "--columns", "gyro_z=gyro_x")
+    assert result.returncode == 2 and not (tmp_path / "out.csv").exists()
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "would be read as gyro_x and gyro_z (--columns gyro_z=gyro_x)" in lines[0], lines
 
 
 SEMICOLON = "time;gyro_z;temperature\n0;1,5;20,25\n1;2,5;21,5\n2;-0,5;22\n"

@@ -86,7 +86,30 @@ class TableLayout:
                     f"the file has {', '.join(header)}"
                 )
             resolved[canonical] = column
+        self._check_claims(resolved, header, source)
         return resolved
+
+    def _check_claims(self, resolved: dict[str, str], header: list[str], source: str) -> None:
+        """One column feeds one channel; a channel's own column left unread by a mapping is said."""
+        readers: dict[str, list[str]] = {}
+        for canonical, column in resolved.items():
+            readers.setdefault(column, []).append(canonical)
+        for column, channels in readers.items():
+            if len(channels) > 1 and not all(c.startswith(TEMPERATURE_COLUMN) for c in channels):
+                mapped = {c: self.columns[c] for c in channels if c in self.columns}
+                raise InputError(
+                    f"{source}: column {column!r} would be read as {' and '.join(channels)} "
+                    f"(columns={mapped}); one column feeds one channel. To swap axes map both, "
+                    "e.g. columns={'gyro_x': 'gyro_z', 'gyro_z': 'gyro_x'}"
+                )
+        unread = [c for c in self.columns if c in header and c not in readers and self.columns[c] != c]
+        for canonical in unread:
+            warnings.warn(
+                f"{source}: column {canonical!r} is not read: columns={{{canonical!r}: {self.columns[canonical]!r}}} "
+                f"reads {canonical} from {self.columns[canonical]!r}; where the output keeps the table, "
+                f"{canonical!r} stays as it was",
+                DataQualityWarning, stacklevel=4,
+            )
 
 
 def parse_column_mapping(text: str | None) -> dict[str, str]:
