@@ -6,11 +6,19 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply, comparison, fit_calibration, validation
+from gyrocomp import apply, comparison, fit_calibration, validation, write
 from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning
-from gyrocomp.plausibility import calibration_concerns, recording_concerns, temperature_span_concern
+from gyrocomp.plausibility import (
+    CHECKS,
+    calibration_concerns,
+    recording_concerns,
+    silence_pattern,
+    temperature_span_concern,
+)
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
+
+from .conftest import run
 
 RUN = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=1).recording
 
@@ -95,3 +103,30 @@ def test_comparing_temperature_models_on_flat_runs_is_refused_in_one_line(what, 
     with pytest.raises(InputError, match=rf"flat0.csv: the temperature of every run spans at most 0 degC; {what} "
                                          "compares temperature models"):
         function(flat)
+
+
+def test_one_check_is_silenced_by_its_name_and_the_others_still_speak():
+    kelvin = dataclasses.replace(RUN, temperature_degc=RUN.temperature_degc + 273.15)
+    spinning = dataclasses.replace(kelvin, gyro_dps=kelvin.gyro_dps + 80.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        warnings.filterwarnings("ignore", message=silence_pattern("kelvin"), category=PlausibilityWarning)
+        fit_calibration([spinning], temperature=2)
+    found = [w.message for w in caught if isinstance(w.message, PlausibilityWarning)]
+    assert {w.check for w in found} == {"offset"} and len(found) == 3
+    assert all(str(w).endswith("(check 'offset')") for w in found)
+    with pytest.raises(InputError, match=r"check: unknown plausibility check 'kelvins'; use one of rate, kelvin"):
+        silence_pattern("kelvins")
+    assert set(CHECKS) >= {"rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span"}
+
+
+def test_cli_allow_silences_one_check(tmp_path):
+    kelvin = dataclasses.replace(RUN, temperature_degc=RUN.temperature_degc + 273.15)
+    path = tmp_path / "k.csv"
+    write(kelvin, path)
+    said = run("fit", path, "-o", tmp_path / "m.json", "--temperature", "poly:2")
+    assert said.returncode == 0 and "looks like kelvin" in said.stderr and "(check 'kelvin')" in said.stderr
+    quiet = run("--allow", "kelvin", "fit", path, "-o", tmp_path / "m2.json", "--temperature", "poly:2")
+    assert quiet.returncode == 0 and "kelvin" not in quiet.stderr, quiet.stderr
+    bad = run("--allow", "kelvins", "fit", path, "-o", tmp_path / "m3.json")
+    assert bad.returncode == 2 and "'kelvins' is not one of" in bad.stderr

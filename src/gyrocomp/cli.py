@@ -27,7 +27,8 @@ from ._version import __version__
 from .allan import KINDS
 from .calibration import Calibration
 from .compensate import apply as apply_calibration
-from .errors import DataQualityWarning, GyrocompError, InputError, TemperatureRangeWarning
+from .errors import DataQualityWarning, GyrocompError, InputError, PlausibilityWarning, TemperatureRangeWarning
+from .plausibility import CHECKS, silence_pattern
 from .io import (
     FORMATS,
     ReadOptions,
@@ -140,8 +141,10 @@ def _pop_read_options(kwargs: dict) -> dict:
 @click.version_option(__version__, prog_name="gyrocomp")
 @click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
 @click.option("--quiet", "-q", is_flag=True, help="Print only errors.")
+@click.option("--allow", "allowed", multiple=True, type=click.Choice(CHECKS), metavar="CHECK",
+              help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.")
 @click.pass_context
-def cli(ctx, debug, quiet):
+def cli(ctx, debug, quiet, allowed):
     """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
     g-sensitivity) from logs, and measure what is left.
 
@@ -151,6 +154,10 @@ def cli(ctx, debug, quiet):
     Units: angular rate deg/s, acceleration g, temperature degC, time s.
     """
     ctx.obj = {"debug": debug, "quiet": quiet}
+    if allowed:
+        ctx.with_resource(warnings.catch_warnings())
+        for check in allowed:
+            warnings.filterwarnings("ignore", message=silence_pattern(check), category=PlausibilityWarning)
 
 
 def parse_hidden(text: str) -> tuple[int, ...]:

@@ -9,7 +9,7 @@ import numpy as np
 
 from .calibration import Calibration
 from .effects import find_turns, g_sensitivity_offset, thermal_lag
-from .errors import DataQualityWarning, InputError, PlausibilityWarning, TemperatureRangeWarning
+from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .plausibility import recording_concerns
 from .recording import ACCEL_AXES, Recording
@@ -273,7 +273,7 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
                          f"got {type(calibration).__name__}")
     calibration = _restricted(calibration, recording, axes)
     for concern in recording_concerns(recording):
-        warnings.warn(concern.message, PlausibilityWarning, stacklevel=2)
+        warnings.warn(concern.warning(), stacklevel=2)
     comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
                        rate_hz=recording.rate_hz, source=recording.source)
     accel = None

@@ -31,7 +31,12 @@ class DataQualityWarning(UserWarning):
 
 class PlausibilityWarning(DataQualityWarning):
     """The data is probably not what it claims: a unit mistake (kelvin, ms), values beyond any MEMS sensor, a
-    calibration run that turns or whose temperature barely varies (:mod:`gyrocomp.plausibility`)."""
+    calibration run that turns or whose temperature barely varies (:mod:`gyrocomp.plausibility`). ``check``
+    names the check that found it."""
+
+    def __init__(self, message: str = "", check: str | None = None):
+        super().__init__(message)
+        self.check = check
 
 
 class MissingDependencyError(GyrocompError, ImportError):

@@ -3,7 +3,9 @@ compensation quietly produces a wrong result.
 
 Each check is a pure function of the recording that returns the concerns it finds (empty when none); the
 pipelines and ``apply`` turn them into :class:`gyrocomp.errors.PlausibilityWarning` (a
-:class:`DataQualityWarning`), which ``warnings.filterwarnings`` silences like any other warning.
+:class:`DataQualityWarning`) whose ``check`` names the check and whose message ends ``(check 'NAME')``. One
+check is silenced with ``warnings.filterwarnings("ignore", message=silence_pattern("rotation"))``, all of them
+with ``category=PlausibilityWarning``.
 
 The limits are physical, not tuned: MEMS gyros measure at most a few thousand deg/s; a zero-rate offset is at
 most tens of deg/s (the MPU-6050's tolerance is +-20 deg/s); a bias does not move by tens of deg/s within a run
@@ -13,11 +15,12 @@ logged IMUs lie between 1 mHz and 100 kHz.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, PlausibilityWarning
 from .metrics import moving_average
 from .recording import Recording
 
@@ -36,6 +39,8 @@ MIN_TEMPERATURE_SPAN_DEGC = 1.0
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
 LONG_SLOW_S = 7 * 86400.0
+#: every check's name
+CHECKS = ("rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span")
 
 
 @dataclass(frozen=True)
@@ -45,6 +50,17 @@ class Concern:
 
     check: str
     message: str
+
+    def warning(self) -> PlausibilityWarning:
+        """The warning to raise: the message ending with ``(check 'NAME')``, ``check`` set."""
+        return PlausibilityWarning(f"{self.message} (check '{self.check}')", check=self.check)
+
+
+def silence_pattern(check: str) -> str:
+    """The ``message`` regular expression for ``warnings.filterwarnings`` that silences one check."""
+    if check not in CHECKS:
+        raise InputError(f"check: unknown plausibility check {check!r}; use one of {', '.join(CHECKS)}")
+    return rf"(?s).*\(check {re.escape(repr(check))}\)$"
 
 
 def recording_concerns(recording: Recording) -> list[Concern]:
@@ -120,5 +136,5 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
                                        "range (or fit with temperature=none)")
 
 
-__all__ = ["Concern", "calibration_concerns", "recording_concerns", "require_temperature_span",
+__all__ = ["CHECKS", "Concern", "calibration_concerns", "silence_pattern", "recording_concerns", "require_temperature_span",
            "temperature_span_concern"]

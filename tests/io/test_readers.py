@@ -87,6 +87,21 @@ def test_ulog_written_here_converts_units_and_matches_accel_by_time(tmp_path):
                                rtol=1e-6)
 
 
+def test_ulog_cut_inside_a_message_is_said_and_a_whole_one_is_not(tmp_path):
+    key, gyro = _gyro_topic()
+    whole = tmp_path / "whole.ulg"
+    write_ulog(whole, {key: gyro})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        full = read(whole)
+    cut = tmp_path / "cut.ulg"
+    cut.write_bytes(whole.read_bytes()[:-5])
+    with pytest.warns(DataQualityWarning, match=r"cut.ulg: the file ends \d+ byte\(s\) short inside its last "
+                                                r"message \(at byte \d+\): a truncated or damaged log"):
+        short = read(cut)
+    assert short.n_samples == full.n_samples - 1
+
+
 def test_ulog_without_gyro_topics_names_what_it_has(tmp_path):
     path = tmp_path / "baro.ulg"
     t = (np.arange(10) * 1000).astype(np.uint64)
@@ -169,6 +184,22 @@ def test_dataflash_truncated_mid_message_reads_the_whole_ones(tmp_path):
     with pytest.warns(DataQualityWarning, match=r"cut.bin: the log ends mid-message \(33 bytes after"):
         rec = read(path)
     assert rec.n_samples == 19
+
+
+def test_dataflash_garbage_chatter_of_pymavlink_is_one_warning(tmp_path, capfd):
+    """pymavlink (and its C indexer) print a line per bad byte; gyrocomp says it once and reads what is whole."""
+    rows = [(1_000_000 + i * 10_000, 0, 0.0, 0.0, 0.0, 0.0, 0.0, -G, 30.0) for i in range(50)]
+    path = tmp_path / "noisy.bin"
+    write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, rows)})
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2:len(data) // 2] = bytes(range(40))  # 40 bytes of garbage between two messages
+    path.write_bytes(bytes(data))
+    capfd.readouterr()
+    with pytest.warns(DataQualityWarning, match=r"noisy.bin: pymavlink reported \d+ line\(s\) while reading, the "
+                                                r"first: .*; the log is probably damaged in places") as record:
+        rec = read(path)
+    assert rec.n_samples == 50 and len(record) == 1
+    assert capfd.readouterr() == ("", "")  # nothing printed past gyrocomp
 
 
 def test_dataflash_tclr_asked_for_but_absent(tmp_path):

@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import importlib
+import io
+import os
+import sys
+import tempfile
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from types import ModuleType
 
@@ -57,6 +62,45 @@ def require(module: str, extra: str, what: str) -> ModuleType:
             f"{what} needs the optional package {module.split('.')[0]}; "
             f"install it with: pip install 'gyrocomp[{extra}]'"
         ) from None
+
+
+@contextlib.contextmanager
+def _descriptor_into(fd: int, sink) -> Iterator[None]:
+    """Point file descriptor ``fd`` at ``sink`` for the block (what C extensions write goes there too); a
+    descriptor that is not open is left alone."""
+    try:
+        saved = os.dup(fd)
+    except OSError:
+        yield
+        return
+    try:
+        os.dup2(sink.fileno(), fd)
+        yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
+@contextlib.contextmanager
+def foreign_output(source: str, library: str) -> Iterator[None]:
+    """Capture what a foreign reader (pyulog, pymavlink and its C indexer) prints to stdout or stderr while it
+    reads, and say it in one :class:`DataQualityWarning`: how many lines, the first with control characters
+    escaped. The descriptors are process-wide, so this is meant around a reader's own call only."""
+    captured = io.StringIO()
+    with tempfile.TemporaryFile() as sink:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        with _descriptor_into(1, sink), _descriptor_into(2, sink), \
+                contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
+            yield
+        sink.seek(0)
+        text = captured.getvalue() + sink.read().decode("utf-8", "replace")
+    lines = [line for line in text.splitlines() if line.strip()]
+    if lines:
+        first = "".join(c if c.isprintable() else f"\\x{ord(c):02x}" for c in lines[0].strip())[:120]
+        warnings.warn(f"{source}: {library} reported {len(lines)} line(s) while reading, the first: {first!r}; "
+                      "the log is probably damaged in places", DataQualityWarning, stacklevel=3)
 
 
 def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -> tuple:

@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
+from .common import foreign_output, ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
 
 DATAFLASH_MAGIC = b"\xa3\x95"
 RECORDS = ("IMU", "TCLR")
@@ -56,10 +56,11 @@ class _Log:
         DFReader = require("pymavlink.DFReader", "dataflash", "reading ArduPilot DataFlash logs")
         self.path = path
         try:
-            self.reader = DFReader.DFReader_binary(
-                str(path), zero_time_base=False,
-                progress_callback=(lambda pct: progress(0.8 * pct / 100.0)) if progress else None,
-            )
+            with foreign_output(str(path), "pymavlink"):
+                self.reader = DFReader.DFReader_binary(
+                    str(path), zero_time_base=False,
+                    progress_callback=(lambda pct: progress(0.8 * pct / 100.0)) if progress else None,
+                )
         except Exception as exc:  # pymavlink raises assorted errors on corrupt files
             raise InputError(f"{path}: not a readable DataFlash log ({type(exc).__name__}: {exc})") from None
         self.bytes = np.frombuffer(self.reader.data_map, dtype=np.uint8)

@@ -11,6 +11,8 @@ uORB messages sensor_gyro, sensor_accel, vehicle_imu, sensor_combined.
 
 from __future__ import annotations
 
+import mmap
+import struct
 import warnings
 from pathlib import Path
 
@@ -19,13 +21,42 @@ import numpy as np
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
+from .common import foreign_output, ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"
 GYRO_TOPICS = ("sensor_gyro", "vehicle_imu", "sensor_combined")
 _US = unit_factor("time", "us")
 _RAD = unit_factor("gyro", "rad/s")
 _MS2 = unit_factor("accel", "m/s2")
+
+
+_MESSAGE_HEADER = struct.Struct("<HB")  # msg_size (payload bytes), msg_type
+_FILE_HEADER_BYTES = 16  # magic (7), version (1), timestamp (8)
+
+
+def cut_message(path: Path) -> tuple[int, int] | None:
+    """(offset, bytes missing) of a last message the file ends inside of, or None when the ULog's message
+    framing ends exactly at the end of the file. pyulog reads a cut log as a shorter one without a word; a
+    cut (a log copied while written, a partial download) almost always lands inside a message."""
+    with open(path, "rb") as fh:
+        size = fh.seek(0, 2)
+        if size <= _FILE_HEADER_BYTES:
+            return None
+        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            pos, unpack = _FILE_HEADER_BYTES, _MESSAGE_HEADER.unpack_from
+            while pos + 3 <= size:
+                end = pos + 3 + unpack(data, pos)[0]
+                if end > size:
+                    return pos, end - size
+                pos = end
+            return (pos, 3 - (size - pos)) if pos < size else None
+
+
+def _warn_if_cut(path: Path) -> None:
+    cut = cut_message(path)
+    if cut is not None:
+        warnings.warn(f"{path}: the file ends {cut[1]} byte(s) short inside its last message (at byte {cut[0]}): "
+                      "a truncated or damaged log; read up to there", DataQualityWarning, stacklevel=3)
 
 
 def _time_s(data: dict) -> np.ndarray:
@@ -80,9 +111,11 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
     if progress:
         progress(0.0)
     try:
-        ulog = pyulog.ULog(str(path), list(GYRO_TOPICS) + ["sensor_accel"], parse_header_only=False)
+        with foreign_output(str(path), "pyulog"):
+            ulog = pyulog.ULog(str(path), list(GYRO_TOPICS) + ["sensor_accel"], parse_header_only=False)
     except Exception as exc:  # pyulog raises bare Exceptions on corrupt files
         raise InputError(f"{path}: not a readable ULog ({type(exc).__name__}: {exc})") from None
+    _warn_if_cut(path)
     if progress:
         progress(0.8)
     datasets = ulog.data_list

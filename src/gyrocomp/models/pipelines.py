@@ -11,7 +11,7 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from ..errors import InputError, ModelChoiceWarning, PlausibilityWarning, TemperatureRangeWarning
+from ..errors import InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..plausibility import calibration_concerns, temperature_span_concern
 from ..recording import ACCEL_AXES, Recording
 from ..static import orientations, static_segments
@@ -281,7 +281,7 @@ def _check_fit_inputs(recordings: list[Recording], temperature, acceleration: st
     if temperature not in (None, "auto", 0):  # a curve asked for
         concerns.append(temperature_span_concern(recordings))
     for concern in filter(None, concerns):
-        warnings.warn(concern.message, PlausibilityWarning, stacklevel=3)
+        warnings.warn(concern.warning(), stacklevel=3)
     if temperature is not None:
         for rec in recordings:
             if rec.temperature_degc is None:
