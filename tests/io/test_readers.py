@@ -292,6 +292,24 @@ def test_netcdf_cats_file_reads_without_options_and_matches_the_npz_copy():
     np.testing.assert_allclose(rec.time_s - rec.time_s[0], npz["t_s"] - npz["t_s"][0])
 
 
+def test_hdf5_of_strings_and_damaged_hdf5_are_refused_in_one_line(tmp_path):
+    strings = tmp_path / "strings.h5"
+    with h5py.File(strings, "w") as f:
+        f["time"] = np.array([b"a", b"b", b"c"])
+        f["gyro_z"] = np.array([b"1", b"2", b"3"])
+    with pytest.raises(InputError, match=r"strings.h5: dataset '/time' holds \|S1 values, not numbers"):
+        read(strings)
+    whole = tmp_path / "whole.h5"
+    with h5py.File(whole, "w") as f:
+        f["time"], f["gyro_z"] = np.arange(100.0), np.zeros(100)
+    cut = tmp_path / "cut.h5"
+    cut.write_bytes(whole.read_bytes()[:whole.stat().st_size // 2])
+    with pytest.raises(InputError, match=r"cut.h5: not a readable HDF5 file \(.*truncated file.*\); is it damaged"):
+        read(cut)
+    result = run("allan", cut)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1 and "not a readable HDF5 file" in result.stderr
+
+
 def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
     path = tmp_path / "log.h5"
     n = 50

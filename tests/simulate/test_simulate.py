@@ -263,3 +263,11 @@ def test_terms_switch_off_one_by_one():
     assert not np.any(flat.recording.gyro_dps)
     with pytest.raises(InputError, match="disable: unknown term 'wind'; use any of temperature, lag"):
         base.without("wind")
+
+
+def test_a_simulation_larger_than_memory_is_refused_up_front():
+    """1e9 s at 100 Hz (1e11 samples) would end in a MemoryError after minutes; it is refused at once, naming
+    the two settings (the command line's exit 2)."""
+    with pytest.raises(InputError, match=r"duration_s: 1e\+09 s at rate_hz=100 is 1e\+11 samples, about .* GB to "
+                                         r"simulate, more than this machine's .* GB; shorten duration_s= or lower"):
+        simulate("mti10", duration_s=1e9, rate_hz=100.0)

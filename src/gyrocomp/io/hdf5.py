@@ -10,6 +10,7 @@ Without a mapping, datasets are looked up under gyrocomp's names and common ones
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from pathlib import Path
 
@@ -56,8 +57,29 @@ def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> floa
     return unit_factor(kind, fallback, option)
 
 
+@contextlib.contextmanager
+def _opened(h5py, path: Path):
+    """The open file; what HDF5 reports about a damaged one (a truncated file, a bad signature or B-tree, a
+    failed read) becomes an InputError naming the file. Permission and missing-file errors stay as they are."""
+    try:
+        with h5py.File(path, "r") as handle:
+            yield handle
+    except (PermissionError, FileNotFoundError, IsADirectoryError):
+        raise
+    except OSError as exc:
+        raise InputError(f"{path}: not a readable HDF5 file ({exc}); is it damaged or cut short?") from None
+
+
+def _numbers(dataset, source: str) -> np.ndarray:
+    """The dataset's values as floats; a dataset of strings, compounds or references is refused by name."""
+    if dataset.dtype.kind not in "biuf":
+        raise InputError(f"{source}: dataset {dataset.name!r} holds {dataset.dtype} values, not numbers; "
+                         "store numbers, or map another dataset with columns=")
+    return np.asarray(dataset[()], dtype=float)
+
+
 def _temperature(dataset, source: str) -> np.ndarray:
-    values = np.asarray(dataset[()], dtype=float)
+    values = _numbers(dataset, source)
     units = (_units(dataset) or "degC").strip().lower()
     if units in _CELSIUS:
         return values
@@ -89,7 +111,7 @@ def _vector(handle, source: str, kind: str, axes: tuple[str, ...], mapping: dict
     """The (n, k) channels of ``kind`` (gyro or accel) and their axis names, from one 2-D or several 1-D datasets."""
     whole = _find(handle, source, kind, mapping)
     if whole is not None:
-        values = np.asarray(whole[()], dtype=float)
+        values = _numbers(whole, source)
         if values.ndim == 1:
             values = values[:, None]
         if values.ndim != 2 or values.shape[1] not in (1, 3):
@@ -100,7 +122,7 @@ def _vector(handle, source: str, kind: str, axes: tuple[str, ...], mapping: dict
     for axis in axes:
         dataset = _find(handle, source, axis, mapping) if axis in mapping or axis in handle else None
         if dataset is not None:
-            columns.append(np.asarray(dataset[()], dtype=float).reshape(-1))
+            columns.append(_numbers(dataset, source).reshape(-1))
             names.append(axis)
             first = first or dataset
     if not columns:
@@ -136,12 +158,12 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
     h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
     layout = options.layout
     mapping = dict(layout.columns)
-    with h5py.File(path, "r") as handle:
+    with _opened(h5py, path) as handle:
         time_ds = _find(handle, source, TIME_COLUMN, mapping)
         if time_ds is None:
             raise InputError(f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
                              "map one with columns={'time': 'NAME'}")
-        time_s = np.asarray(time_ds[()], dtype=float).reshape(-1)
+        time_s = _numbers(time_ds, source).reshape(-1)
         time_s = time_s * _factor("time", time_ds, layout.time_unit, "time_unit", source)
         gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
         if gyro is None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,6 +63,28 @@ class Trajectory:
     specific_force_g: np.ndarray
     angular_rate_dps: np.ndarray
     recorded: np.ndarray
+
+
+#: what simulating one sample holds at its peak (truth, components, trajectory; measured: about 400) [bytes]
+SIMULATION_BYTES_PER_SAMPLE = 500
+
+
+def _memory_bytes() -> int | None:
+    """This machine's physical memory [bytes], or None where the platform does not say."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def _check_memory(n_samples: int, duration_s: float, rate_hz: float) -> None:
+    """Refuse up front a simulation that cannot fit in this machine's memory, naming the two settings."""
+    need = n_samples * SIMULATION_BYTES_PER_SAMPLE
+    have = _memory_bytes()
+    if have is not None and need > have:
+        raise InputError(f"duration_s: {duration_s:g} s at rate_hz={rate_hz:g} is {n_samples:.3g} samples, about "
+                         f"{need / 1e9:.3g} GB to simulate, more than this machine's {have / 1e9:.3g} GB; "
+                         "shorten duration_s= or lower rate_hz=")
 
 
 @dataclass(frozen=True)
@@ -195,6 +218,7 @@ class Profile:
         n = int(math.floor(duration * rate_hz + 1e-9)) + 1
         if n < 2:
             raise InputError(f"duration_s: {duration:g} s is too short for two samples at {rate_hz:g} Hz")
+        _check_memory(n, duration, rate_hz)
         time_s = np.arange(n) / rate_hz
         natural = self._natural_duration()
         stretch = natural / duration  # profile time per run time
