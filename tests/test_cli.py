@@ -585,3 +585,12 @@ def test_a_tab_separated_export_with_decimal_commas_reads_with_or_without_option
         assert list(out["gyro_z"]) == [1.5, 2.5, 3.0] and list(out["temperature"]) == [20.5, 21.0, 22.0]
     r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", "--decimal", ":")
     assert r.returncode == 2 and r.stderr.strip() == "gyrocomp: error: --decimal: ':'; use '.' or ','"
+
+
+def test_control_characters_in_a_message_are_escaped_to_keep_one_line(tmp_path):
+    """A file name (or a foreign library's message) with a newline or a raw byte stays one escaped line."""
+    odd = tmp_path / "two\nlines\x1b.csv"
+    odd.write_text("time,gyro_z\n0,1\n")
+    result = run("allan", odd)
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1 and "two\\nlines\\x1b.csv" in result.stderr, result.stderr
