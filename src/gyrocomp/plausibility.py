@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -39,8 +40,10 @@ MIN_TEMPERATURE_SPAN_DEGC = 1.0
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
 LONG_SLOW_S = 7 * 86400.0
+#: the name of a check
+CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span"]
 #: every check's name
-CHECKS = ("rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span")
+CHECKS: tuple[CheckName, ...] = get_args(CheckName)
 
 
 @dataclass(frozen=True)
@@ -48,7 +51,7 @@ class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
     ``temperature-span``) and the one-line message, which starts with the recording's source."""
 
-    check: str
+    check: CheckName
     message: str
 
     def warning(self) -> PlausibilityWarning:
@@ -136,5 +139,5 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
                                        "range (or fit with temperature=none)")
 
 
-__all__ = ["CHECKS", "Concern", "calibration_concerns", "silence_pattern", "recording_concerns", "require_temperature_span",
-           "temperature_span_concern"]
+__all__ = ["CHECKS", "CheckName", "Concern", "calibration_concerns", "recording_concerns", "require_temperature_span",
+           "silence_pattern", "temperature_span_concern"]
