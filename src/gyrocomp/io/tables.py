@@ -253,6 +253,49 @@ def detect_table_format(path: Path) -> str | None:
     return None
 
 
+def _resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dict[str, str]:
+    """Canonical name to column, refusing a repeated column name, a missing time column or no gyro column."""
+    repeated = sorted({name for name in header if header.count(name) > 1})
+    if repeated:
+        raise InputError(f"{path}: column {repeated[0]!r} appears {header.count(repeated[0])} times in the header; "
+                         "give each column its own name")
+    cols = layout.resolve(header, str(path))
+    if TIME_COLUMN not in cols:
+        raise InputError(
+            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with columns={{'time': 'NAME'}}"
+        )
+    if not any(a in cols for a in GYRO_AXES):
+        raise InputError(
+            f"{path}: no gyro column (expected gyro_x, gyro_y or gyro_z; the file has {', '.join(header)}); "
+            "map one with columns={'gyro_z': 'NAME'}"
+        )
+    return cols
+
+
+def _temperature_columns(cols: dict[str, str], gyro_axes: tuple[str, ...]) -> list[str]:
+    """One temperature per gyro axis (temperature_x, ...) when all are there and no plain one; else the plain one."""
+    per_axis = [f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in gyro_axes]
+    if all(t in cols for t in per_axis) and TEMPERATURE_COLUMN not in cols:
+        return per_axis
+    return [TEMPERATURE_COLUMN] if TEMPERATURE_COLUMN in cols else []
+
+
+def _finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | None) -> tuple[np.ndarray, list]:
+    """The indices of rows where every channel is finite and the channels cut to them (a warning says how many
+    rows went)."""
+    n = time_s.size
+    ok = np.isfinite(time_s)
+    for values in channels:
+        if values is not None:
+            ok &= np.isfinite(values).all(axis=1)
+    if ok.all():
+        return np.arange(n), [time_s, *channels]
+    kept = np.flatnonzero(ok)
+    warnings.warn(f"{path}: dropped {n - kept.size} of {n} rows with empty, NaN or infinite values",
+                  DataQualityWarning, stacklevel=3)
+    return kept, [time_s[kept], *(None if v is None else v[kept] for v in channels)]
+
+
 def read_table(
     path: str | os.PathLike,
     layout: TableLayout | None = None,
@@ -282,69 +325,23 @@ def read_table(
     table = _read_arrow(path, fmt, layout.delimiter, layout.decimal)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
-    header = table.column_names
-    repeated = sorted({name for name in header if header.count(name) > 1})
-    if repeated:
-        raise InputError(f"{path}: column {repeated[0]!r} appears {header.count(repeated[0])} times in the header; "
-                         "give each column its own name")
-    cols = layout.resolve(header, str(path))
-    if TIME_COLUMN not in cols:
-        raise InputError(
-            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with columns={{'time': 'NAME'}}"
-        )
+    cols = _resolved_columns(table.column_names, layout, path)
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
-    if not gyro_axes:
-        raise InputError(
-            f"{path}: no gyro column (expected gyro_x, gyro_y or gyro_z; the file has {', '.join(header)}); "
-            "map one with columns={'gyro_z': 'NAME'}"
-        )
     accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
-    per_axis_temps = [f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in gyro_axes]
-    if all(t in cols for t in per_axis_temps) and TEMPERATURE_COLUMN not in cols:
-        temp_names = per_axis_temps
-    elif TEMPERATURE_COLUMN in cols:
-        temp_names = [TEMPERATURE_COLUMN]
-    else:
-        temp_names = []
-
-    gyro_factor = unit_factor("gyro", layout.gyro_unit, "gyro_unit")
-    accel_factor = unit_factor("accel", layout.accel_unit, "accel_unit")
-    time_factor = unit_factor("time", layout.time_unit, "time_unit")
+    temp_names = _temperature_columns(cols, gyro_axes)
     num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
-    time_s = num(TIME_COLUMN) * time_factor
-    gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor
+    time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
+    gyro = np.column_stack([num(a) for a in gyro_axes]) * unit_factor("gyro", layout.gyro_unit, "gyro_unit")
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
-    accel = np.column_stack([num(a) for a in accel_axes]) * accel_factor if accel_axes else None
-
+    accel = (np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
+             if accel_axes else None)
     n = table.num_rows
     kept = np.arange(n)
     if drop_nonfinite:
-        ok = np.isfinite(time_s) & np.isfinite(gyro).all(axis=1)
-        if temp is not None:
-            ok &= np.isfinite(temp).all(axis=1)
-        if accel is not None:
-            ok &= np.isfinite(accel).all(axis=1)
-        if not ok.all():
-            kept = np.flatnonzero(ok)
-            warnings.warn(
-                f"{path}: dropped {n - kept.size} of {n} rows with empty, NaN or infinite values",
-                DataQualityWarning,
-                stacklevel=2,
-            )
-            time_s, gyro = time_s[kept], gyro[kept]
-            temp = None if temp is None else temp[kept]
-            accel = None if accel is None else accel[kept]
-    recording = Recording(
-        time_s=time_s,
-        gyro_dps=gyro,
-        gyro_axes=gyro_axes,
-        temperature_degc=temp,
-        accel_g=accel,
-        accel_axes=accel_axes,
-        source=str(path),
-        row_numbers=kept + 1,
-        metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)},
-    )
+        kept, (time_s, gyro, temp, accel) = _finite_rows(path, time_s, gyro, temp, accel)
+    recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temp, accel_g=accel,
+                          accel_axes=accel_axes, source=str(path), row_numbers=kept + 1,
+                          metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)})
     if recording.gaps:
         longest = max(recording.gaps, key=lambda g: g.duration_s)
         warnings.warn(

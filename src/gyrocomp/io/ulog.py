@@ -92,6 +92,60 @@ def _choose(path: Path, topic: str, datasets: list, options: ReadOptions, id_fie
     return found[instance]
 
 
+def _from_sensor_gyro(path: Path, datasets: list, options: ReadOptions, metadata: dict):
+    """(time, gyro, accel, temperature) from ``sensor_gyro`` and the ``sensor_accel`` of its instance."""
+    gyro_set = _choose(path, "sensor_gyro", datasets, options)
+    data = gyro_set.data
+    time_s = _time_s(data)
+    gyro = np.column_stack([data[a] for a in "xyz"]).astype(float) * _RAD
+    temperature = np.asarray(data["temperature"], dtype=float) if "temperature" in data else None
+    if temperature is not None and not np.isfinite(temperature).any():
+        temperature = None
+    metadata.update(topic="sensor_gyro", instance=int(gyro_set.multi_id),
+                    device_id=int(data["device_id"][0]) if "device_id" in data else None)
+    accel = None
+    time_s, gyro, temperature = order_by_time(str(path), time_s, gyro, temperature)
+    accel_sets = [d for d in datasets if d.name == "sensor_accel" and d.multi_id == gyro_set.multi_id]
+    if accel_sets:
+        adata = accel_sets[0].data
+        what = f"sensor_accel instance {gyro_set.multi_id}"
+        a_time, a_values = order_by_time(str(path), _time_s(adata),
+                                         np.column_stack([adata[a] for a in "xyz"]).astype(float) * _MS2)
+        accel, ok = match_by_time(str(path), what, time_s, a_time, a_values)
+        keep = keep_matched(str(path), what, ok)
+        time_s, gyro, accel = time_s[keep], gyro[keep], accel[keep]
+        temperature = None if temperature is None else temperature[keep]
+    return time_s, gyro, accel, temperature
+
+
+def _from_vehicle_imu(path: Path, datasets: list, options: ReadOptions, metadata: dict):
+    """(time, gyro, accel, None) from ``vehicle_imu``'s delta angles and velocities over their intervals."""
+    imu = _choose(path, "vehicle_imu", datasets, options, id_field="gyro_device_id").data
+    dt_s = np.asarray(imu["delta_angle_dt"], dtype=float) * _US
+    good = dt_s > 0
+    time_s = _time_s(imu)[good]
+    gyro = np.column_stack([imu[f"delta_angle[{i}]"] for i in range(3)])[good] / dt_s[good, None] * _RAD
+    dv_dt = np.asarray(imu["delta_velocity_dt"], dtype=float)[good] * _US
+    accel = np.column_stack([imu[f"delta_velocity[{i}]"] for i in range(3)])[good] / dv_dt[:, None] * _MS2
+    metadata.update(topic="vehicle_imu")
+    return (*order_by_time(str(path), time_s, gyro, accel), None)
+
+
+def _from_sensor_combined(path: Path, datasets: list, options: ReadOptions, metadata: dict):
+    """(time, gyro, accel, None) from ``sensor_combined``."""
+    combined = [d for d in datasets if d.name == "sensor_combined"][0].data
+    time_s = _time_s(combined)
+    gyro = np.column_stack([combined[f"gyro_rad[{i}]"] for i in range(3)]).astype(float) * _RAD
+    accel = np.column_stack([combined[f"accelerometer_m_s2[{i}]"] for i in range(3)]).astype(float) * _MS2
+    metadata.update(topic="sensor_combined")
+    return (*order_by_time(str(path), time_s, gyro, accel), None)
+
+
+#: the gyro topics in order of preference, each with the function that reads it
+_TOPIC_READERS = {"sensor_gyro": _from_sensor_gyro, "vehicle_imu": _from_vehicle_imu,
+                  "sensor_combined": _from_sensor_combined}
+
+
 def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read a PX4 ULog into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -118,54 +172,16 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
     _warn_if_cut(path)
     if progress:
         progress(0.8)
-    datasets = ulog.data_list
-    names = {d.name for d in datasets}
-    metadata = {"path": str(path), "format": "ulog"}
-    if "sensor_gyro" in names:
-        gyro_set = _choose(path, "sensor_gyro", datasets, options)
-        data = gyro_set.data
-        time_s = _time_s(data)
-        gyro = np.column_stack([data[a] for a in "xyz"]).astype(float) * _RAD
-        temperature = np.asarray(data["temperature"], dtype=float) if "temperature" in data else None
-        if temperature is not None and not np.isfinite(temperature).any():
-            temperature = None
-        metadata.update(topic="sensor_gyro", instance=int(gyro_set.multi_id),
-                        device_id=int(data["device_id"][0]) if "device_id" in data else None)
-        accel = None
-        time_s, gyro, temperature = order_by_time(str(path), time_s, gyro, temperature)
-        accel_sets = [d for d in datasets if d.name == "sensor_accel" and d.multi_id == gyro_set.multi_id]
-        if accel_sets:
-            adata = accel_sets[0].data
-            a_time, a_values = order_by_time(str(path), _time_s(adata),
-                                             np.column_stack([adata[a] for a in "xyz"]).astype(float) * _MS2)
-            accel, ok = match_by_time(str(path), f"sensor_accel instance {gyro_set.multi_id}", time_s, a_time, a_values)
-            keep = keep_matched(str(path), f"sensor_accel instance {gyro_set.multi_id}", ok)
-            time_s, gyro, accel = time_s[keep], gyro[keep], accel[keep]
-            temperature = None if temperature is None else temperature[keep]
-    elif "vehicle_imu" in names:
-        imu = _choose(path, "vehicle_imu", datasets, options, id_field="gyro_device_id").data
-        dt_s = np.asarray(imu["delta_angle_dt"], dtype=float) * _US
-        good = dt_s > 0
-        time_s = _time_s(imu)[good]
-        gyro = np.column_stack([imu[f"delta_angle[{i}]"] for i in range(3)])[good] / dt_s[good, None] * _RAD
-        dv_dt = np.asarray(imu["delta_velocity_dt"], dtype=float)[good] * _US
-        accel = np.column_stack([imu[f"delta_velocity[{i}]"] for i in range(3)])[good] / dv_dt[:, None] * _MS2
-        temperature = None
-        time_s, gyro, accel = order_by_time(str(path), time_s, gyro, accel)
-        metadata.update(topic="vehicle_imu")
-    elif "sensor_combined" in names:
-        combined = [d for d in datasets if d.name == "sensor_combined"][0].data
-        time_s = _time_s(combined)
-        gyro = np.column_stack([combined[f"gyro_rad[{i}]"] for i in range(3)]).astype(float) * _RAD
-        accel = np.column_stack([combined[f"accelerometer_m_s2[{i}]"] for i in range(3)]).astype(float) * _MS2
-        temperature = None
-        time_s, gyro, accel = order_by_time(str(path), time_s, gyro, accel)
-        metadata.update(topic="sensor_combined")
-    else:
-        topics = sorted({d.name for d in pyulog.ULog(str(path), parse_header_only=False).data_list})
+    names = {d.name for d in ulog.data_list}
+    topic = next((t for t in GYRO_TOPICS if t in names), None)
+    if topic is None:
+        with foreign_output(str(path), "pyulog"):
+            topics = sorted({d.name for d in pyulog.ULog(str(path), parse_header_only=False).data_list})
         raise InputError(
             f"{path}: no gyro topic ({', '.join(GYRO_TOPICS)}) in this ULog; it has {', '.join(topics) or 'no data'}"
         )
+    metadata = {"path": str(path), "format": "ulog"}
+    time_s, gyro, accel, temperature = _TOPIC_READERS[topic](path, ulog.data_list, options, metadata)
     if temperature is None:
         warnings.warn(
             f"{path}: {metadata['topic']} carries no temperature; log sensor_gyro for temperature calibration "
@@ -174,13 +190,5 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
         )
     if progress:
         progress(1.0)
-    return Recording(
-        time_s=time_s,
-        gyro_dps=gyro,
-        gyro_axes=GYRO_AXES,
-        temperature_degc=temperature,
-        accel_g=accel,
-        accel_axes=ACCEL_AXES if accel is not None else (),
-        source=str(path),
-        metadata=metadata,
-    )
+    return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=GYRO_AXES, temperature_degc=temperature, accel_g=accel,
+                     accel_axes=ACCEL_AXES if accel is not None else (), source=str(path), metadata=metadata)
