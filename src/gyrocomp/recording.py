@@ -40,6 +40,35 @@ class Gap:
     duration_s: float
 
 
+def _require_finite(src: str, rows: np.ndarray, channels) -> None:
+    """Refuse the first non-finite value of any channel, naming its row and column; ``channels`` holds
+    (column names, (n,) or (n, k) array or None) pairs."""
+    for names, arr in channels:
+        if arr is None:
+            continue
+        table = arr.reshape(arr.shape[0], -1)
+        bad = ~np.isfinite(table)
+        if bad.any():
+            first = int(np.flatnonzero(bad.any(axis=1))[0])
+            column = names[int(np.flatnonzero(bad[first])[0])]
+            raise InputError(
+                f"{src}: row {rows[first]}, column {column!r}: {table[first][bad[first]][0]} "
+                "is not a finite number; fix the file or drop such rows explicitly (drop_nonfinite=True)"
+            )
+
+
+def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray, dt: np.ndarray) -> None:
+    """Refuse the first row whose time repeats or goes backwards."""
+    bad_steps = np.flatnonzero(dt <= 0)
+    if bad_steps.size:
+        i = int(bad_steps[0]) + 1
+        what = "repeats" if dt[i - 1] == 0 else "goes backwards"
+        raise InputError(
+            f"{src}: row {rows[i]}: time {what} ({time_s[i]:.9g} s after {time_s[i - 1]:.9g} s); "
+            "time must strictly increase"
+        )
+
+
 @dataclass(frozen=True, eq=False)
 class Recording:
     """Time series of one power-on of a gyro, in gyrocomp's internal units.
@@ -120,27 +149,10 @@ class Recording:
                     f"{src}: accelerometer data has shape {accel.shape}, expected ({n}, {len(self.accel_axes)})"
                 )
         temp_names = _temperature_names(axes, temp is not None and temp.ndim == 2)
-        for names, arr in ((("time",), time_s), (axes, gyro), (temp_names, temp), (tuple(self.accel_axes), accel)):
-            if arr is None:
-                continue
-            table = arr.reshape(n, -1)
-            bad = ~np.isfinite(table)
-            if bad.any():
-                first = int(np.flatnonzero(bad.any(axis=1))[0])
-                column = names[int(np.flatnonzero(bad[first])[0])]
-                raise InputError(
-                    f"{src}: row {rows[first]}, column {column!r}: {table[first][bad[first]][0]} "
-                    "is not a finite number; fix the file or drop such rows explicitly (drop_nonfinite=True)"
-                )
+        _require_finite(src, rows, ((("time",), time_s), (axes, gyro), (temp_names, temp),
+                                    (tuple(self.accel_axes), accel)))
         dt = np.diff(time_s)
-        bad_steps = np.flatnonzero(dt <= 0)
-        if bad_steps.size:
-            i = int(bad_steps[0]) + 1
-            what = "repeats" if dt[i - 1] == 0 else "goes backwards"
-            raise InputError(
-                f"{src}: row {rows[i]}: time {what} ({time_s[i]:.9g} s after {time_s[i - 1]:.9g} s); "
-                "time must strictly increase"
-            )
+        _require_increasing(src, rows, time_s, dt)
         period = float(np.median(dt))
         gap_steps = np.flatnonzero(dt > GAP_FACTOR * period)
         gaps = tuple(Gap(int(rows[i]), float(time_s[i]), float(dt[i])) for i in gap_steps)
