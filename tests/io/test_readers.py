@@ -310,6 +310,19 @@ def test_hdf5_of_strings_and_damaged_hdf5_are_refused_in_one_line(tmp_path):
     assert result.returncode == 2 and result.stderr.count("\n") == 1 and "not a readable HDF5 file" in result.stderr
 
 
+def test_hdf5_rows_dropped_for_non_finite_values_are_said(tmp_path):
+    path = tmp_path / "holes.h5"
+    gyro = np.zeros(50)
+    gyro[7] = np.nan
+    with h5py.File(path, "w") as f:
+        f["time"], f["gyro_z"], f["temperature"] = np.arange(50.0), gyro, np.linspace(20, 30, 50)
+    with pytest.raises(InputError, match=r"holes.h5: row 8, column 'gyro_z': nan is not a finite number"):
+        read(path)
+    with pytest.warns(DataQualityWarning, match=r"holes.h5: dropped 1 of 50 rows with empty, NaN or infinite values"):
+        rec = read(path, drop_nonfinite=True)
+    assert rec.n_samples == 49 and rec.row_numbers[7] == 9 and rec.temperature_degc.shape == (49,)
+
+
 def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
     path = tmp_path / "log.h5"
     n = 50

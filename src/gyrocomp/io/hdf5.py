@@ -20,7 +20,7 @@ from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, check_magic, require
-from .tables import TIME_COLUMN
+from .tables import TIME_COLUMN, keep_finite_rows
 
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
 NETCDF3_MAGIC = b"CDF"
@@ -130,6 +130,29 @@ def _vector(handle, source: str, kind: str, axes: tuple[str, ...], mapping: dict
     return np.column_stack(columns), tuple(names), first
 
 
+def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
+    """(time [s], gyro [deg/s], gyro axes, accel [g] or None, accel axes, temperature [degC] or None)."""
+    source, mapping = str(path), dict(layout.columns)
+    time_ds = _find(handle, source, TIME_COLUMN, mapping)
+    if time_ds is None:
+        raise InputError(f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
+                         "map one with columns={'time': 'NAME'}")
+    time_s = _numbers(time_ds, source).reshape(-1) * _factor("time", time_ds, layout.time_unit, "time_unit", source)
+    gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
+    if gyro is None:
+        raise InputError(f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
+                         "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}")
+    gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "gyro_unit", source)
+    if progress:
+        progress(0.5)
+    accel, accel_axes, accel_ds = _vector(handle, source, "accel", ACCEL_AXES, mapping)
+    if accel is not None:
+        accel = accel * _factor("accel", accel_ds, layout.accel_unit, "accel_unit", source)
+    temp_ds = _find(handle, source, TEMPERATURE_COLUMN, mapping)
+    temperature = _temperature(temp_ds, source) if temp_ds is not None else None
+    return time_s, gyro, gyro_axes, accel, accel_axes, temperature
+
+
 def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read an HDF5 or NetCDF-4 file into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -156,44 +179,21 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
     if not head.startswith(HDF5_MAGIC):
         check_magic(path, HDF5_MAGIC, "HDF5/NetCDF-4", "name its real format with fmt=, or leave fmt= out to have it told from the file")
     h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
-    layout = options.layout
-    mapping = dict(layout.columns)
     with _opened(h5py, path) as handle:
-        time_ds = _find(handle, source, TIME_COLUMN, mapping)
-        if time_ds is None:
-            raise InputError(f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
-                             "map one with columns={'time': 'NAME'}")
-        time_s = _numbers(time_ds, source).reshape(-1)
-        time_s = time_s * _factor("time", time_ds, layout.time_unit, "time_unit", source)
-        gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
-        if gyro is None:
-            raise InputError(f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
-                             "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}")
-        gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "gyro_unit", source)
-        if progress:
-            progress(0.5)
-        accel, accel_axes, accel_ds = _vector(handle, source, "accel", ACCEL_AXES, mapping)
-        if accel is not None:
-            accel = accel * _factor("accel", accel_ds, layout.accel_unit, "accel_unit", source)
-        temp_ds = _find(handle, source, TEMPERATURE_COLUMN, mapping)
-        temperature = _temperature(temp_ds, source) if temp_ds is not None else None
+        time_s, gyro, gyro_axes, accel, accel_axes, temperature = _channels(handle, options.layout, path, progress)
     n = time_s.size
     for name, values in (("gyro", gyro), ("accel", accel), ("temperature", temperature)):
         if values is not None and values.shape[0] != n:
             raise InputError(f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
                              "map datasets of the same length with columns=")
-    keep = np.ones(n, dtype=bool)
+    index = np.arange(n)
     if options.drop_nonfinite:
-        for values in (time_s, gyro, accel, temperature):
-            if values is not None:
-                keep &= np.isfinite(values.reshape(n, -1)).all(axis=1)
-    index = np.flatnonzero(keep)
-    pick = lambda a: None if a is None else a[index]  # noqa: E731
+        index, (time_s, gyro, accel, temperature) = keep_finite_rows(path, time_s, gyro, accel, temperature)
     if progress:
         progress(1.0)
     return Recording(
-        time_s=time_s[index], gyro_dps=gyro[index], gyro_axes=gyro_axes, temperature_degc=pick(temperature),
-        accel_g=pick(accel), accel_axes=accel_axes if accel is not None else (), source=source,
+        time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temperature,
+        accel_g=accel, accel_axes=accel_axes if accel is not None else (), source=source,
         row_numbers=index + 1,
         metadata={"path": source, "format": "hdf5", "rows_dropped": int(n - index.size)},
     )

@@ -280,14 +280,14 @@ def _temperature_columns(cols: dict[str, str], gyro_axes: tuple[str, ...]) -> li
     return [TEMPERATURE_COLUMN] if TEMPERATURE_COLUMN in cols else []
 
 
-def _finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | None) -> tuple[np.ndarray, list]:
+def keep_finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | None) -> tuple[np.ndarray, list]:
     """The indices of rows where every channel is finite and the channels cut to them (a warning says how many
     rows went)."""
     n = time_s.size
     ok = np.isfinite(time_s)
     for values in channels:
         if values is not None:
-            ok &= np.isfinite(values).all(axis=1)
+            ok &= np.isfinite(values.reshape(n, -1)).all(axis=1)
     if ok.all():
         return np.arange(n), [time_s, *channels]
     kept = np.flatnonzero(ok)
@@ -338,7 +338,7 @@ def read_table(
     n = table.num_rows
     kept = np.arange(n)
     if drop_nonfinite:
-        kept, (time_s, gyro, temp, accel) = _finite_rows(path, time_s, gyro, temp, accel)
+        kept, (time_s, gyro, temp, accel) = keep_finite_rows(path, time_s, gyro, temp, accel)
     recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temp, accel_g=accel,
                           accel_axes=accel_axes, source=str(path), row_numbers=kept + 1,
                           metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)})
