@@ -7,7 +7,6 @@ never another exception, and never a non-finite value passed on as data.
 from __future__ import annotations
 
 import copy
-import dataclasses
 import functools
 import json
 import math

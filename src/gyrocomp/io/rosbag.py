@@ -55,6 +55,33 @@ def _stamp_s(header) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
+def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | None, total: int):
+    """(time [s], gyro [deg/s], accel [g]) of every message on the IMU topic, in time order."""
+    n = sum(c.msgcount for c in imu)
+    time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
+    i = 0
+    for connection, _, raw in reader.messages(connections=imu):
+        msg = reader.deserialize(raw, connection.msgtype)
+        time_s[i] = _stamp_s(msg.header)
+        w, a = msg.angular_velocity, msg.linear_acceleration
+        gyro[i] = (w.x, w.y, w.z)
+        accel[i] = (a.x, a.y, a.z)
+        i += 1
+        if progress and i % 20000 == 0:
+            progress(i / total)
+    return order_by_time(str(path), time_s[:i], gyro[:i] * _RAD, accel[:i] * _MS2)
+
+
+def _temperature_samples(path: Path, reader, thermo: list):
+    """(time [s], temperature [degC]) of every message on the temperature topic, in time order."""
+    t_time, t_value = [], []
+    for connection, _, raw in reader.messages(connections=thermo):
+        msg = reader.deserialize(raw, connection.msgtype)
+        t_time.append(_stamp_s(msg.header))
+        t_value.append(msg.temperature)
+    return order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
+
+
 def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read a ROS 1 or ROS 2 bag into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -85,30 +112,10 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
             raise InputError(f"{path}: no {IMU_TYPE} topic in the bag; its topics are {topics}")
         thermo = _topic(path, connections, TEMPERATURE_TYPE, options.temperature_topic, "temperature_topic")
         total = max(1, sum(c.msgcount for c in imu + thermo))
-        done = 0
-        n = sum(c.msgcount for c in imu)
-        time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
-        i = 0
-        for connection, _, raw in reader.messages(connections=imu):
-            msg = reader.deserialize(raw, connection.msgtype)
-            time_s[i] = _stamp_s(msg.header)
-            w, a = msg.angular_velocity, msg.linear_acceleration
-            gyro[i] = (w.x, w.y, w.z)
-            accel[i] = (a.x, a.y, a.z)
-            i += 1
-            done += 1
-            if progress and done % 20000 == 0:
-                progress(done / total)
-        time_s, gyro, accel = time_s[:i], gyro[:i] * _RAD, accel[:i] * _MS2
-        time_s, gyro, accel = order_by_time(str(path), time_s, gyro, accel)
+        time_s, gyro, accel = _imu_samples(path, reader, imu, progress, total)
         temperature = None
         if thermo:
-            t_time, t_value = [], []
-            for connection, _, raw in reader.messages(connections=thermo):
-                msg = reader.deserialize(raw, connection.msgtype)
-                t_time.append(_stamp_s(msg.header))
-                t_value.append(msg.temperature)
-            t_time, t_value = order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
+            t_time, t_value = _temperature_samples(path, reader, thermo)
             what = f"temperature topic {thermo[0].topic}"
             temperature, ok = match_by_time(str(path), what, time_s, t_time, t_value)
             keep = keep_matched(str(path), what, ok)
