@@ -27,7 +27,14 @@ from ._version import __version__
 from .allan import KINDS
 from .calibration import Calibration
 from .compensate import apply as apply_calibration
-from .errors import DataQualityWarning, GyrocompError, InputError, PlausibilityWarning, TemperatureRangeWarning
+from .errors import (
+    DataQualityWarning,
+    GyrocompError,
+    InputError,
+    PlausibilityWarning,
+    TemperatureRangeWarning,
+    printable,
+)
 from .plausibility import CHECKS, silence_pattern
 from .io import (
     FORMATS,
@@ -1057,14 +1064,8 @@ def in_cli_words(message: str) -> str:
     return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
 
 
-def one_line(text: str) -> str:
-    """``text`` with control characters escaped (a newline or a raw byte in a foreign library's message would
-    otherwise break the one-line contract or the terminal)."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    click.echo(f"gyrocomp: warning: {one_line(in_cli_words(str(message)))}", err=True)
+    click.echo(f"gyrocomp: warning: {printable(in_cli_words(str(message)))}", err=True)
 
 
 def _environment_message(exc: BaseException) -> str:
@@ -1109,28 +1110,28 @@ def main(argv: list[str] | None = None) -> int:
     except click.ClickException as exc:  # usage errors: bad option, missing argument
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {one_line(exc.format_message())}", err=True)
+        click.echo(f"gyrocomp: error: {printable(exc.format_message())}", err=True)
         status = EXIT_INPUT if isinstance(exc, click.UsageError) else exc.exit_code
     except InputError as exc:
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {one_line(in_cli_words(str(exc)))}", err=True)
+        click.echo(f"gyrocomp: error: {printable(in_cli_words(str(exc)))}", err=True)
         status = EXIT_INPUT
     except GyrocompError as exc:
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {one_line(str(exc))}", err=True)
+        click.echo(f"gyrocomp: error: {printable(str(exc))}", err=True)
         status = EXIT_FAILURE
     except (OSError, MemoryError) as exc:  # the environment, not a bug: permissions, a full disk, a link loop
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {one_line(_environment_message(exc))}", err=True)
+        click.echo(f"gyrocomp: error: {printable(_environment_message(exc))}", err=True)
         status = EXIT_INPUT
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {one_line(str(exc))} (run with --debug for the traceback)",
-                   err=True)
+        click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
+                   "(run with --debug for the traceback)", err=True)
         status = EXIT_FAILURE
     finally:
         warnings.showwarning = previous

@@ -46,3 +46,10 @@ class MissingDependencyError(GyrocompError, ImportError):
 class ModelChoiceWarning(UserWarning):
     """Validation found that a temperature model does not help an axis (none generalizes to held-out data, or
     the chosen one leaves more drift there than the raw output)."""
+
+
+def printable(text: str) -> str:
+    """``text`` with control characters escaped (``\\n``, ``\\x1b``): a newline or a raw byte in a message (a file
+    name's, a foreign library's) would otherwise break a one-line message or the terminal."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+

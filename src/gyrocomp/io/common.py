@@ -15,7 +15,7 @@ from types import ModuleType
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError, MissingDependencyError
+from ..errors import DataQualityWarning, InputError, MissingDependencyError, printable
 from .tables import TableLayout
 
 #: ``progress(fraction_done)``, fraction in [0, 1]; readers call it now and then on long files
@@ -98,7 +98,7 @@ def foreign_output(source: str, library: str) -> Iterator[None]:
         text = captured.getvalue() + sink.read().decode("utf-8", "replace")
     lines = [line for line in text.splitlines() if line.strip()]
     if lines:
-        first = "".join(c if c.isprintable() else f"\\x{ord(c):02x}" for c in lines[0].strip())[:120]
+        first = printable(lines[0].strip())[:120]
         warnings.warn(f"{source}: {library} reported {len(lines)} line(s) while reading, the first: {first!r}; "
                       "the log is probably damaged in places", DataQualityWarning, stacklevel=3)
 
