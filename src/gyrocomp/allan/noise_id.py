@@ -161,7 +161,7 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
     method removes the quadratic phase trend); B1 is their standard variance over their Allan variance. The
     Allan variance's exponent mu is the one whose expected B1 lies nearest on a log scale (boundaries at
     the geometric means, Howe et al. 2000, Table 4), alpha = -mu - 1. mu = -2 (white or flicker PM) is
-    split by R(n) = MVAR/AVAR of the whole series against the geometric mean of the two expected values.
+    split by R(n) = MVAR/AVAR (MVAR of the whole series) against the geometric mean of the two expected values.
     Returns None with fewer than 3 averages or a series without variation.
     """
     n_points = (len(phase) - 1) // m
@@ -183,7 +183,7 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
     if mu > -2:
         return NoiseIdentification(alpha=-mu - 1, alpha_estimate=math.nan, differences=-1, rho=math.nan,
                                    method="b1", ratio=ratio)
-    rn = _variance_at("mdev", phase, m) / _variance_at("adev", phase, m)
+    rn = _variance_at("mdev", phase, m) / allan  # the ADEV at m is the Allan variance of these averages
     if not math.isfinite(rn):
         return None
     alpha = 1 if rn > math.sqrt(rn_expected(m, 1) * rn_expected(m, 2)) else 2
