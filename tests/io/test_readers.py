@@ -102,6 +102,21 @@ def test_ulog_cut_inside_a_message_is_said_and_a_whole_one_is_not(tmp_path):
     assert short.n_samples == full.n_samples - 1
 
 
+def test_ulog_drop_nonfinite_drops_the_row_the_refusal_names(tmp_path):
+    """The refusal of a NaN sample advises drop_nonfinite; for logs it works as for tables (it was ignored)."""
+    key, gyro = _gyro_topic()
+    values = gyro["x"][1].copy()
+    values[5] = np.nan
+    path = tmp_path / "hole.ulg"
+    write_ulog(path, {key: {**gyro, "x": ("float", values)}})
+    with pytest.raises(InputError, match=r"hole.ulg: row 6, column 'gyro_x': nan is not a finite number; .* "
+                                         r"\(drop_nonfinite=True\)"):
+        read(path)
+    with pytest.warns(DataQualityWarning, match=r"hole.ulg: dropped 1 of 200 rows with empty, NaN or infinite"):
+        rec = read(path, drop_nonfinite=True)
+    assert rec.n_samples == 199 and rec.row_numbers[5] == 7 and rec.metadata["rows_dropped"] == 1
+
+
 def test_ulog_without_gyro_topics_names_what_it_has(tmp_path):
     path = tmp_path / "baro.ulg"
     t = (np.arange(10) * 1000).astype(np.uint64)

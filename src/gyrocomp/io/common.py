@@ -16,7 +16,8 @@ from types import ModuleType
 import numpy as np
 
 from ..errors import DataQualityWarning, InputError, MissingDependencyError, printable
-from .tables import TableLayout
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from .tables import TableLayout, keep_finite_rows
 
 #: ``progress(fraction_done)``, fraction in [0, 1]; readers call it now and then on long files
 ProgressCallback = Callable[[float], None]
@@ -101,6 +102,21 @@ def foreign_output(source: str, library: str) -> Iterator[None]:
         first = printable(lines[0].strip())[:120]
         warnings.warn(f"{source}: {library} reported {len(lines)} line(s) while reading, the first: {first!r}; "
                       "the log is probably damaged in places", DataQualityWarning, stacklevel=3)
+
+
+def log_recording(path, options: ReadOptions, time_s: np.ndarray, gyro_dps: np.ndarray, accel_g: np.ndarray | None,
+                  temperature_degc: np.ndarray | None, metadata: dict,
+                  gyro_axes: tuple[str, ...] = GYRO_AXES) -> Recording:
+    """The :class:`Recording` a log reader returns [s, deg/s, g, degC]; with ``options.drop_nonfinite`` the rows
+    holding an empty, NaN or infinite value are dropped first (a warning says how many), as for tables."""
+    n = time_s.size
+    index = np.arange(n)
+    if options.drop_nonfinite:
+        index, (time_s, gyro_dps, accel_g, temperature_degc) = keep_finite_rows(
+            path, time_s, gyro_dps, accel_g, temperature_degc)
+    return Recording(time_s=time_s, gyro_dps=gyro_dps, gyro_axes=gyro_axes, temperature_degc=temperature_degc,
+                     accel_g=accel_g, accel_axes=ACCEL_AXES if accel_g is not None else (), source=str(path),
+                     row_numbers=index + 1, metadata={**metadata, "rows_dropped": int(n - index.size)})
 
 
 def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -> tuple:

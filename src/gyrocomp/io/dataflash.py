@@ -20,9 +20,19 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataQualityWarning, InputError
-from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..recording import Recording
 from ..units import unit_factor
-from .common import foreign_output, ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
+from .common import (
+    ProgressCallback,
+    ReadOptions,
+    check_magic,
+    foreign_output,
+    keep_matched,
+    log_recording,
+    match_by_time,
+    order_by_time,
+    require,
+)
 
 DATAFLASH_MAGIC = b"\xa3\x95"
 RECORDS = ("IMU", "TCLR")
@@ -202,9 +212,6 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
                       "the onboard temperature calibration", DataQualityWarning, stacklevel=2)
     if progress:
         progress(1.0)
-    return Recording(
-        time_s=time_s, gyro_dps=gyro, gyro_axes=GYRO_AXES, temperature_degc=temperature,
-        accel_g=accel, accel_axes=ACCEL_AXES if accel is not None else (), source=str(path),
-        metadata={"path": str(path), "format": "dataflash", "record": record, "instance": instance,
-                  "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0},
-    )
+    return log_recording(path, options, time_s, gyro, accel, temperature,
+                         {"path": str(path), "format": "dataflash", "record": record, "instance": instance,
+                          "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0})

@@ -19,8 +19,8 @@ import numpy as np
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, check_magic, require
-from .tables import TIME_COLUMN, keep_finite_rows
+from .common import ProgressCallback, ReadOptions, check_magic, log_recording, require
+from .tables import TIME_COLUMN
 
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
 NETCDF3_MAGIC = b"CDF"
@@ -186,14 +186,7 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
         if values is not None and values.shape[0] != n:
             raise InputError(f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
                              "map datasets of the same length with columns=")
-    index = np.arange(n)
-    if options.drop_nonfinite:
-        index, (time_s, gyro, accel, temperature) = keep_finite_rows(path, time_s, gyro, accel, temperature)
     if progress:
         progress(1.0)
-    return Recording(
-        time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temperature,
-        accel_g=accel, accel_axes=accel_axes if accel is not None else (), source=source,
-        row_numbers=index + 1,
-        metadata={"path": source, "format": "hdf5", "rows_dropped": int(n - index.size)},
-    )
+    return log_recording(path, options, time_s, gyro, accel, temperature, {"path": source, "format": "hdf5"},
+                         gyro_axes=gyro_axes)

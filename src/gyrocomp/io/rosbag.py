@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataQualityWarning, InputError
-from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..recording import Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, keep_matched, match_by_time, order_by_time, require
+from .common import ProgressCallback, ReadOptions, keep_matched, log_recording, match_by_time, order_by_time, require
 
 IMU_TYPE = "sensor_msgs/msg/Imu"
 TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
@@ -127,9 +127,6 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
                       "(only noise analysis works without it)", DataQualityWarning, stacklevel=2)
     if progress:
         progress(1.0)
-    return Recording(
-        time_s=time_s, gyro_dps=gyro, gyro_axes=GYRO_AXES, temperature_degc=temperature,
-        accel_g=accel, accel_axes=ACCEL_AXES, source=str(path),
-        metadata={"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
-                  "temperature_topic": thermo[0].topic if thermo else None},
-    )
+    return log_recording(path, options, time_s, gyro, accel, temperature,
+                         {"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
+                          "temperature_topic": thermo[0].topic if thermo else None})

@@ -19,9 +19,19 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataQualityWarning, InputError
-from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..recording import Recording
 from ..units import unit_factor
-from .common import foreign_output, ProgressCallback, ReadOptions, check_magic, keep_matched, match_by_time, order_by_time, require
+from .common import (
+    ProgressCallback,
+    ReadOptions,
+    check_magic,
+    foreign_output,
+    keep_matched,
+    log_recording,
+    match_by_time,
+    order_by_time,
+    require,
+)
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"
 GYRO_TOPICS = ("sensor_gyro", "vehicle_imu", "sensor_combined")
@@ -190,5 +200,4 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
         )
     if progress:
         progress(1.0)
-    return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=GYRO_AXES, temperature_degc=temperature, accel_g=accel,
-                     accel_axes=ACCEL_AXES if accel is not None else (), source=str(path), metadata=metadata)
+    return log_recording(path, options, time_s, gyro, accel, temperature, metadata)
