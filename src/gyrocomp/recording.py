@@ -12,6 +12,8 @@ from .errors import InputError
 
 GYRO_AXES = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL_AXES = ("accel_x", "accel_y", "accel_z")
+#: a rate table's commanded angular rate in the sensor frame [deg/s] (optional columns)
+REFERENCE_RATE_AXES = ("ref_rate_x", "ref_rate_y", "ref_rate_z")
 TEMPERATURE_COLUMN = "temperature"
 #: a gap is a time step longer than this many median sample periods
 GAP_FACTOR = 2.0
@@ -94,6 +96,9 @@ class Recording:
         Defaults to 1..n.
     metadata : dict
         Free-form provenance (file hash, reader options).
+    reference_rate_dps : array (n, 3), optional
+        The angular rate a rate table applied, in the sensor frame (``ref_rate_x/_y/_z``) [deg/s]:
+        the reference for scale-factor and misalignment calibration.
 
     Validation happens once, here: shapes agree, values are finite (readers drop
     non-finite rows only when asked to), time strictly increases. Gaps longer than
@@ -110,6 +115,7 @@ class Recording:
     source: str = "<memory>"
     row_numbers: np.ndarray | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
+    reference_rate_dps: np.ndarray | None = None
     rate_hz: float = field(init=False)
     gaps: tuple[Gap, ...] = field(init=False)
 
@@ -148,9 +154,15 @@ class Recording:
                 raise InputError(
                     f"{src}: accelerometer data has shape {accel.shape}, expected ({n}, {len(self.accel_axes)})"
                 )
+        reference = None
+        if self.reference_rate_dps is not None:
+            reference = np.asarray(self.reference_rate_dps, dtype=float)
+            if reference.shape != (n, 3):
+                raise InputError(f"{src}: reference rates have shape {reference.shape}, expected ({n}, 3) "
+                                 f"for {', '.join(REFERENCE_RATE_AXES)}")
         temp_names = _temperature_names(axes, temp is not None and temp.ndim == 2)
         _require_finite(src, rows, ((("time",), time_s), (axes, gyro), (temp_names, temp),
-                                    (tuple(self.accel_axes), accel)))
+                                    (tuple(self.accel_axes), accel), (REFERENCE_RATE_AXES, reference)))
         dt = np.diff(time_s)
         _require_increasing(src, rows, time_s, dt)
         period = float(np.median(dt))
@@ -163,6 +175,7 @@ class Recording:
         set_(self, "temperature_degc", temp)
         set_(self, "accel_g", accel)
         set_(self, "accel_axes", tuple(self.accel_axes))
+        set_(self, "reference_rate_dps", reference)
         set_(self, "row_numbers", rows)
         set_(self, "rate_hz", _nominal_rate(period))
         set_(self, "gaps", gaps)
@@ -230,5 +243,6 @@ class Recording:
             gyro_dps=self.gyro_dps[index],
             temperature_degc=pick(self.temperature_degc),
             accel_g=pick(self.accel_g),
+            reference_rate_dps=pick(self.reference_rate_dps),
             row_numbers=self.row_numbers[index],
         )

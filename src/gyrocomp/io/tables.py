@@ -16,13 +16,14 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import DataQualityWarning, InputError
-from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
+from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .atomic import atomic_path
 
 TIME_COLUMN = "time"
 PER_AXIS_TEMPERATURES = tuple(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES)
-CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *PER_AXIS_TEMPERATURES)
+CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *PER_AXIS_TEMPERATURES,
+                     *REFERENCE_RATE_AXES)
 #: channels a mapping may name as one (n, 3) array, in formats that hold arrays (HDF5/NetCDF)
 ARRAY_CHANNELS = ("gyro", "accel")
 
@@ -296,6 +297,18 @@ def keep_finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | Non
     return kept, [time_s[kept], *(None if v is None else v[kept] for v in channels)]
 
 
+def _reference_rates(cols: dict[str, str], num, path: Path, factor: float) -> np.ndarray | None:
+    """The rate table's reference rates (n, 3) [deg/s, in the gyro's unit in the file], or None; all three or none."""
+    present = [a for a in REFERENCE_RATE_AXES if a in cols]
+    if not present:
+        return None
+    if len(present) < 3:
+        missing = [a for a in REFERENCE_RATE_AXES if a not in cols]
+        raise InputError(f"{path}: reference rate column(s) {', '.join(missing)} missing; give all three "
+                         f"({', '.join(REFERENCE_RATE_AXES)}, 0 about the axes the table does not turn)")
+    return np.column_stack([num(a) for a in REFERENCE_RATE_AXES]) * factor
+
+
 def read_table(
     path: str | os.PathLike,
     layout: TableLayout | None = None,
@@ -335,12 +348,13 @@ def read_table(
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
     accel = (np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
              if accel_axes else None)
+    reference = _reference_rates(cols, num, path, unit_factor("gyro", layout.gyro_unit, "gyro_unit"))
     n = table.num_rows
     kept = np.arange(n)
     if drop_nonfinite:
-        kept, (time_s, gyro, temp, accel) = keep_finite_rows(path, time_s, gyro, temp, accel)
+        kept, (time_s, gyro, temp, accel, reference) = keep_finite_rows(path, time_s, gyro, temp, accel, reference)
     recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temp, accel_g=accel,
-                          accel_axes=accel_axes, source=str(path), row_numbers=kept + 1,
+                          accel_axes=accel_axes, reference_rate_dps=reference, source=str(path), row_numbers=kept + 1,
                           metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)})
     if recording.gaps:
         longest = max(recording.gaps, key=lambda g: g.duration_s)
@@ -405,6 +419,9 @@ def recording_table(recording: Recording, extra_columns: dict[str, np.ndarray] |
         temps = recording.temperature_degc.reshape(recording.n_samples, -1)
         for j, name in enumerate(recording.temperature_columns):
             columns[name] = temps[:, j]
+    if recording.reference_rate_dps is not None:
+        for j, name in enumerate(REFERENCE_RATE_AXES):
+            columns[name] = recording.reference_rate_dps[:, j]
     for name, values in (extra_columns or {}).items():
         columns[name] = np.asarray(values, dtype=float)
     return pa.table(columns)

@@ -149,7 +149,7 @@ def resolve_profile(profile: str | Profile, preset: str | None = None, **overrid
 
 def _accelerometer(acc: AccelErrorModel, force: np.ndarray, structure: np.ndarray, t_ref: float, rate_hz: float,
                    rng: np.random.Generator) -> np.ndarray:
-    out = force + np.asarray(acc.bias_g) + np.outer(structure - t_ref, np.asarray(acc.bias_tempco_g_per_degc))
+    out = force @ acc.sensitivity.T + np.asarray(acc.bias_g) + np.outer(structure - t_ref, np.asarray(acc.bias_tempco_g_per_degc))
     if acc.noise_density_g_per_sqrt_hz > 0:
         out = out + rng.standard_normal(force.shape) * acc.noise_density_g_per_sqrt_hz * math.sqrt(rate_hz)
     return quantize(out, acc.quantization_g)
@@ -217,6 +217,7 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
     rec = Recording(time_s=traj.time_s[keep], gyro_dps=gyro[keep], gyro_axes=model.axes,
                     temperature_degc=temperature[keep], accel_g=None if accel is None else accel[keep],
                     accel_axes=ACCEL_AXES if accel is not None else (), source=src,
+                    reference_rate_dps=traj.angular_rate_dps[keep] if prof.name == "ratetable" else None,
                     metadata={"simulated": True, "preset": preset_name, "seed": seed, "unit": unit})
     truth = Truth(model, prof, seed, float(rate_hz), prof.total_duration_s, turn_on,
                   {name: c[keep] for name, c in components.items()}, noise.take(keep), true_rate[keep],

@@ -86,12 +86,26 @@ class AccelErrorModel:
         White noise (velocity random walk) [g/sqrt(Hz)].
     quantization_g : float
         Output LSB [g]; 0 for none.
+    scale_misalignment : 3 rows of 3 floats, optional
+        E of the output a_out = (I + E) f + bias + noise: scale-factor errors on the diagonal,
+        axis misalignments (cross-coupling) off it [dimensionless]; None for a perfect triad.
     """
 
     bias_g: tuple[float, float, float] = (0.0, 0.0, 0.0)
     bias_tempco_g_per_degc: tuple[float, float, float] = (0.0, 0.0, 0.0)
     noise_density_g_per_sqrt_hz: float = 0.0
     quantization_g: float = 0.0
+    scale_misalignment: tuple[tuple[float, float, float], ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.scale_misalignment is not None and np.shape(self.scale_misalignment) != (3, 3):
+            raise InputError(f"scale_misalignment: shape {np.shape(self.scale_misalignment)}; give 3 rows of 3 values")
+
+    @property
+    def sensitivity(self) -> np.ndarray:
+        """K = I + E, the matrix the triad applies to the specific force (3, 3) [dimensionless]."""
+        e = np.zeros((3, 3)) if self.scale_misalignment is None else np.asarray(self.scale_misalignment, dtype=float)
+        return np.eye(3) + e
 
 
 def _per_axis(name: str, value, k: int, width: int | None = None) -> np.ndarray | None:
