@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -6,8 +7,9 @@ import pytest
 from gyrocomp import Calibration, apply, fit_calibration
 from gyrocomp.calibration import SCHEMA_VERSION
 from gyrocomp.compensate import predict_error
-from gyrocomp.errors import InputError
+from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io import write_recording
+from gyrocomp.io.tables import read_table
 from gyrocomp.simulate import simulate
 
 
@@ -116,12 +118,13 @@ def test_schema_1_files_load_without_lag_or_hysteresis(calibration, tmp_path):
     for ax in d["axes"].values():
         del ax["lag_time_constant_s"], ax["hysteresis"], ax["g_sensitivity_dps_per_g"], ax["g_squared_dps_per_g2"]
         del ax["acceleration_network"]
-    del d["accel_axes"], d["accel_reference_degc"]
+    del d["accel_axes"], d["accel_reference_degc"], d["gyro_triad"], d["accel_triad"]
     path = tmp_path / "v1.json"
     path.write_text(json.dumps(d))
     loaded = Calibration.load(path)
-    assert loaded.schema_version == SCHEMA_VERSION == 5
+    assert loaded.schema_version == SCHEMA_VERSION == 6
     assert loaded.accel_axes == {} and loaded.accel_reference_degc is None
+    assert loaded.gyro_triad is None and loaded.accel_triad is None
     assert all(ax.lag_time_constant_s == 0 and ax.hysteresis is None for ax in loaded.axes.values())
     assert loaded.axes["gyro_z"].temperature == calibration.axes["gyro_z"].temperature
 
@@ -178,3 +181,19 @@ def test_a_valid_file_still_loads_and_applies_identically(calibration, tmp_path)
     sim = simulate(duration_s=120, rate_hz=10, seed=8)
     np.testing.assert_array_equal(apply(Calibration.load(tmp_path / "ok.json"), sim.recording).gyro_dps,
                                   apply(calibration, sim.recording).gyro_dps)
+
+
+def test_schema_5_file_written_by_the_previous_release_loads_and_applies_identically():
+    """tests/data/schema5: a model file written by gyrocomp at commit dcded69 (schema 5; its fit_report emptied
+    to keep the file small, apply does not read it) and a held-out run with the output that version's apply
+    gave (``expected_gyro_*``, turn-on window 60 s)."""
+    folder = Path(__file__).parent / "data" / "schema5"
+    assert json.loads((folder / "model.json").read_text())["schema_version"] == 5
+    loaded = Calibration.load(folder / "model.json")
+    assert loaded.schema_version == SCHEMA_VERSION and loaded.gyro_triad is None and loaded.accel_triad is None
+    with pytest.warns(DataQualityWarning, match="time gap"):  # the run pauses between positions
+        data = read_table(folder / "heldout.csv")
+    out = apply(loaded, data.recording, turn_on_window_s=60)
+    for j, axis in enumerate(out.gyro_axes):
+        expected = data.table.column(f"expected_{axis}").to_numpy()
+        np.testing.assert_allclose(out.gyro_dps[:, j], expected, rtol=0, atol=1e-12)

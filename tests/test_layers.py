@@ -17,9 +17,10 @@ LAYERS = (
     # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve) live beside the
     # estimators of the same curve; neither imports anything above this layer
     ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),
-    ("calibration", ("calibration",)),
+    ("calibration", ("calibration", "triad")),
     ("compensate", ("compensate",)),
-    ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration")),
+    ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration",
+                 "models.triad_fit")),
     ("pipelines", ("models.pipelines", "models")),
     ("evaluation", ("evaluation", "comparison", "validation")),
     ("output", ("report", "export", "demo")),

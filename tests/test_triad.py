@@ -6,21 +6,26 @@ norm of gravity on real multi-position sessions (held-out recordings where the d
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from gyrocomp.errors import InputError
+from gyrocomp import Calibration, Compensator, apply
+from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.export.autopilot import px4_params_file
+from gyrocomp.export.c_code import c_sources
 from gyrocomp.io.tables import read_table, write_recording
+from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.models.triad_fit import (Pose, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                                        rate_segments, rq_upper)
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulate import AccelErrorModel, GyroErrorModel, get_profile, preset_model, simulate, tumble_positions
 from gyrocomp.triad import TriadCalibration
 
-from .conftest import shared_dataset
+from .conftest import run, shared_dataset
 
 #: a triad with 0.2-0.4 % scale errors and 1-2 mrad misalignments, 20-30 mg bias, 100 ug/sqrt(Hz) noise
 ACCEL = AccelErrorModel(bias_g=(0.02, -0.015, 0.03), noise_density_g_per_sqrt_hz=100e-6,
@@ -246,3 +251,79 @@ def test_reference_rate_columns_round_trip_and_all_three_are_required(tmp_path):
     path.write_text(text)
     with pytest.raises(InputError, match=r"table.csv: reference rate column\(s\) ref_rate_z missing"):
         read_table(path)
+
+
+# -- in the model file, the compensation and the CLI ------------------------------------------------------
+def test_fit_with_rate_table_runs_stores_k_and_apply_corrects_the_held_out_rates(tmp_path, rate_fit):
+    chamber = [simulate(RATE_PART, profile="chamber", duration_s=3600, rate_hz=2, seed=20 + s).recording
+               for s in range(3)]
+    rate_runs = [_rate_run(t, s) for s, t in enumerate((-10.0, 25.0, 60.0))]
+    cal = fit_channels(rate_runs + chamber, hysteresis="none")
+    assert cal.gyro_triad is not None and cal.gyro_triad == rate_fit.calibration
+    path = tmp_path / "model.json"
+    cal.save(path)
+    loaded = Calibration.load(path)
+    assert loaded.gyro_triad == cal.gyro_triad and loaded.to_json() == cal.to_json()
+    held = _rate_run(40.0, 9)
+    out = apply(loaded, held, turn_on_window_s=50)
+    plain = apply(loaded.without("scale-factor"), held, turn_on_window_s=50)
+
+    def rate_error_dps(rec):  # RMS over the 100-300 deg/s stretches of their mean error
+        segs = [s for s in rate_segments([rec]) if np.linalg.norm(s.reference_dps) >= 100]
+        return np.sqrt(np.mean([(s.gyro_dps - s.reference_dps) ** 2 for s in segs]))
+
+    assert rate_error_dps(out) < rate_error_dps(plain) / 5
+    # streaming: any chunking gives the batch result
+    comp = Compensator(loaded, held.gyro_axes, turn_on_window_s=50, rate_hz=held.rate_hz)
+    edges = np.r_[0, np.sort(np.random.default_rng(3).choice(held.n_samples, 7, replace=False)), held.n_samples]
+    chunks = [comp.update(held.time_s[a:b], held.gyro_dps[a:b], held.temperature_degc[a:b], held.accel_g[a:b])
+              for a, b in zip(edges[:-1], edges[1:])]
+    np.testing.assert_allclose(np.concatenate([*chunks, comp.finish()]), out.gyro_dps, rtol=0, atol=1e-12)
+    with pytest.raises(InputError, match="couples gyro_x, gyro_y and gyro_z"):
+        apply(loaded, held, axes=("gyro_z",))
+
+
+def test_accel_channel_on_a_multi_position_session_without_temperature(tmp_path):
+    rec = _xsens(shared_dataset("imu_tk-xsens"))
+    cal = fit_channels(rec, ("accel",))
+    assert cal.accel_triad is not None and not cal.accel_axes and cal.accel_triad.method == "norm"
+    path = tmp_path / "accel.json"
+    cal.save(path)
+    out = apply(Calibration.load(path), rec)
+    norms = [np.linalg.norm(out.accel_g[p.start_s <= rec.time_s][: p.samples].mean(axis=0))
+             for p in find_poses(rec)]
+    assert np.sqrt(np.mean((np.array(norms) - 1.0) ** 2)) < 2e-4
+    with pytest.raises(InputError, match="no temperature .* and do not turn every accelerometer axis"):
+        fit_channels(rec.take(slice(0, 5000)), ("accel",))
+
+
+def test_cli_fits_the_scale_factor_from_rate_table_files(tmp_path):
+    for temperature, seed in ((-10, 1), (25, 2), (60, 3)):
+        result = run("-q", "simulate", "--preset", "mti10", "--profile", "ratetable", "--set-points", temperature,
+                     "--rates", "100,-100,300,-300", "--position-time", "30", "--rate", "20", "--disable",
+                     "g-sensitivity", "--seed", seed, "-o", tmp_path / f"rt{seed}.csv")
+        assert result.returncode == 0, result.stderr
+    result = run("-q", "simulate", "--preset", "mti10", "--profile", "chamber", "--duration", "3600", "--rate", "2",
+                 "--runs", "3", "--disable", "g-sensitivity", "-o", tmp_path / "ch.csv")
+    assert result.returncode == 0, result.stderr
+    files = [tmp_path / f"rt{s}.csv" for s in (1, 2, 3)] + [tmp_path / f"ch_{i}.csv" for i in range(3)]
+    result = run("fit", *files, "-o", tmp_path / "model.json", "--hysteresis", "none")
+    assert result.returncode == 0, result.stderr
+    assert "gyro scale factor and misalignment (rate-table" in result.stdout
+    assert Calibration.load(tmp_path / "model.json").gyro_triad is not None
+    result = run("fit", tmp_path / "ch_0.csv", "-o", tmp_path / "m.json", "--scale-factor", "matrix")
+    assert result.returncode == 2 and not (tmp_path / "m.json").exists()
+    assert result.stderr.strip() == ("gyrocomp: error: --scale-factor 'matrix': no run carries reference rates "
+                                     "(ref_rate_x, ref_rate_y, ref_rate_z [deg/s]); a scale-factor calibration "
+                                     "needs rate-table runs")
+
+
+def test_exports_say_what_they_leave_out_of_a_triad(rate_fit):
+    chamber = [simulate(RATE_PART, profile="chamber", duration_s=1800, rate_hz=1, seed=40 + s).recording for s in range(2)]
+    cal = dataclasses.replace(fit_channels(chamber, temperature=2, hysteresis="none", acceleration="none"),
+                              gyro_triad=rate_fit.calibration)
+    with pytest.warns(DataQualityWarning, match="scale-factor and misalignment"):
+        px4_params_file(cal)
+    with pytest.raises(InputError, match="C export: the model has a scale-factor and misalignment triad"):
+        c_sources(cal)
+    assert "gyrocomp.c" in c_sources(cal.without("scale-factor"))

@@ -25,9 +25,11 @@ from .io import write_recording as write
 from .metrics import Evaluation, evaluate_run
 from .models import PolynomialTemperatureModel
 from .models.pipelines import fit_calibration, fit_channels
+from .models.triad_fit import find_poses, fit_accel_multiposition, fit_gyro_rate_table
 from .noise import analyse_noise
 from .recording import Recording
 from .simulate import simulate
+from .triad import TriadCalibration
 from .validation import validate
 
 #: ``gyrocomp.fit`` is :func:`fit_calibration`: recordings in, a frozen Calibration out
@@ -36,7 +38,8 @@ fit = fit_calibration
 __all__ = [
     "AllanResult", "Calibration", "Compensator", "DataQualityWarning", "Evaluation", "GyrocompError", "InputError",
     "MissingDependencyError", "ModelChoiceWarning", "ModelError", "NotFittedError", "PlausibilityWarning", "PolynomialTemperatureModel",
-    "Recording", "TemperatureRangeWarning", "allan_deviation", "analyse_noise", "apply", "evaluate",
-    "evaluate_run", "evaluate_stages", "fit", "fit_calibration", "fit_channels", "noise_parameters",
+    "Recording", "TemperatureRangeWarning", "TriadCalibration", "allan_deviation", "analyse_noise", "apply", "evaluate",
+    "evaluate_run", "evaluate_stages", "find_poses", "fit", "fit_accel_multiposition", "fit_calibration",
+    "fit_channels", "fit_gyro_rate_table", "noise_parameters",
     "predict_error", "read", "simulate", "validate", "write", "__version__",
 ]

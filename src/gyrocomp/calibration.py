@@ -24,9 +24,10 @@ from .models.mlp import MLPBias
 from .models.temperature import PolynomialBias
 from .models.hysteresis import HysteresisCurve
 from .recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
+from .triad import TriadCalibration
 
 FORMAT_NAME = "gyrocomp-calibration"
-SCHEMA_VERSION = 5
+SCHEMA_VERSION = 6
 
 
 def _upgrade_1_to_2(d: dict) -> dict:
@@ -68,9 +69,18 @@ def _upgrade_4_to_5(d: dict) -> dict:
     return d
 
 
+def _upgrade_5_to_6(d: dict) -> dict:
+    """Schema 6 adds scale factor and misalignment of the gyro and accelerometer triads; older files have none."""
+    d = dict(d)
+    d.setdefault("gyro_triad", None)
+    d.setdefault("accel_triad", None)
+    d["schema_version"] = 6
+    return d
+
+
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
 UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4,
-                                               4: _upgrade_4_to_5}
+                                               4: _upgrade_4_to_5, 5: _upgrade_5_to_6}
 UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
 
 
@@ -144,6 +154,14 @@ def _check_model(d: dict) -> None:
             _check_axis(section, name, ax, allowed)
         _check_numbers(axes, section)
     _check_numbers(d.get("accel_reference_degc"), "accel_reference_degc")
+
+
+def _check_triads(triads: dict[str, TriadCalibration | None], axes: dict) -> None:
+    gyro, accel = triads["gyro_triad"], triads["accel_triad"]
+    if gyro is not None and (gyro.unit != "deg/s" or set(axes) != set(GYRO_AXES)):
+        raise InputError("gyro_triad: a gyro triad in deg/s needs models of all three gyro axes")
+    if accel is not None and accel.unit != "g":
+        raise InputError(f"accel_triad.unit: {accel.unit!r}; the accelerometer's is 'g'")
 
 
 def _floats(values, count: int, name: str):
@@ -276,12 +294,18 @@ class Calibration:
     #: ``accel_reference_degc``, since a static accelerometer's constant cannot be told from gravity
     accel_axes: dict[str, AxisCalibration] = field(default_factory=dict)
     accel_reference_degc: float | None = None
+    #: the gyro's scale factor and misalignment K(T): corrected = K(T)^-1 (gyro - bias models)
+    gyro_triad: TriadCalibration | None = None
+    #: the accelerometer's bias, scale factor and misalignment: corrected = C (accel - b), after the
+    #: accelerometer's temperature models
+    accel_triad: TriadCalibration | None = None
 
     def without(self, *parts: str) -> "Calibration":
         """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
-        (turning-point), ``"lag"``. What is left is applied as fitted (the parts were fitted jointly), so
-        this shows each part's contribution, as the stages of the thesis's Table 4.4."""
-        known = ("acceleration", "hysteresis", "lag")
+        (turning-point), ``"lag"``, ``"scale-factor"`` (the gyro triad's K(T)). What is left is applied as fitted
+        (the parts were fitted jointly), so this shows each part's contribution, as the stages of the thesis's
+        Table 4.4."""
+        known = ("acceleration", "hysteresis", "lag", "scale-factor")
         for part in parts:
             if part not in known:
                 raise InputError(f"unknown part {part!r}; use any of {', '.join(known)}")
@@ -293,7 +317,13 @@ class Calibration:
         if "lag" in parts:
             changes["lag_time_constant_s"] = 0.0
         axes = {name: dataclasses.replace(ax, **changes) for name, ax in self.axes.items()}
-        return dataclasses.replace(self, axes=axes, model=f"{self.model} without {', '.join(parts)}" if parts else self.model)
+        triad = None if "scale-factor" in parts else self.gyro_triad
+        return dataclasses.replace(self, axes=axes, gyro_triad=triad, model=f"{self.model} without {', '.join(parts)}" if parts else self.model)
+
+    def without_accel_triad(self) -> "Calibration":
+        """The same calibration without the accelerometer's bias, scale and misalignment (its temperature models
+        kept): the accelerations the gyro's g-sensitivity reads."""
+        return dataclasses.replace(self, accel_triad=None)
 
     @property
     def has_acceleration(self) -> bool:
@@ -318,6 +348,8 @@ class Calibration:
             "axes": {name: ax.to_dict() for name, ax in self.axes.items()},
             "accel_axes": {name: _in_g(ax.to_dict(), True) for name, ax in self.accel_axes.items()},
             "accel_reference_degc": self.accel_reference_degc,
+            "gyro_triad": None if self.gyro_triad is None else self.gyro_triad.to_dict(),
+            "accel_triad": None if self.accel_triad is None else self.accel_triad.to_dict(),
             "fit_report": self.fit_report,
             "provenance": self.provenance,
         }
@@ -349,14 +381,18 @@ class Calibration:
             axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
             accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False))
                           for name, ax in d["accel_axes"].items()}
-            if not axes and not accel_axes:
+            triads = {key: None if d[key] is None else TriadCalibration.from_dict(d[key], key)
+                      for key in ("gyro_triad", "accel_triad")}
+            _check_triads(triads, axes)
+            if not axes and not accel_axes and triads["accel_triad"] is None:
                 raise InputError("no axes")
             reference = d["accel_reference_degc"]
             if accel_axes and reference is None:
                 raise InputError("accel_axes need accel_reference_degc")
             return cls(axes=axes, model=str(d["model"]), provenance=dict(d.get("provenance", {})),
                        fit_report=dict(d.get("fit_report", {})), schema_version=SCHEMA_VERSION,
-                       accel_axes=accel_axes, accel_reference_degc=None if reference is None else float(reference))
+                       accel_axes=accel_axes, accel_reference_degc=None if reference is None else float(reference),
+                       **triads)
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
         except (KeyError, TypeError, ValueError, AttributeError) as exc:

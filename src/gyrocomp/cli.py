@@ -63,7 +63,7 @@ from .simulate import Simulation, preset_model, resolve_profile
 from .simulate import simulate as run_simulation
 from .models.acceleration import ACCELERATION_CHOICES
 from .models.mlp import DEFAULT_HIDDEN
-from .models.pipelines import fit_channels, parse_channels
+from .models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
 from .models.selection import FOLD_KINDS
 from .models.temperature import MAX_ORDER
 from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
@@ -236,14 +236,18 @@ def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
 @click.option("--ramp-rate", "ramp_rate", type=float, default=None, help="Ramp rate between set points [degC/min].")
 @click.option("--dwell", "dwell_s", type=float, default=None, help="Time held at each set point [s].")
 @click.option("--cycles", type=int, default=None, help="Cold-hot-cold repetitions of the cycle profile.")
-@click.option("--position-time", "position_s", type=float, default=None, help="Time at each tumble position [s].")
+@click.option("--position-time", "position_s", type=float, default=None,
+              help="Time at each tumble position or rate-table rate [s].")
+@click.option("--rates", "rates", default=None, metavar="R1,R2,...",
+              help="ratetable: rates applied about each axis in turn [deg/s], e.g. 100,-100,300,-300 (the file gets "
+                   "ref_rate_x/y/z columns; the first --set-points value is the table's temperature).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output CSV or Parquet.")
 @click.option("--truth", type=click.Path(dir_okay=False), help="Write every parameter used as JSON here.")
 @click.option("--truth-columns", is_flag=True,
               help="Add true_error_gyro_*, true_noise_gyro_*, true_rate_gyro_* and true_structure_temperature columns.")
 @click.pass_context
 def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, disable, set_points, ramp_rate, dwell_s,
-             cycles, position_s, output, truth, truth_columns):
+             cycles, position_s, rates, output, truth, truth_columns):
     """Simulate calibration runs of a sensor preset through a test profile, with the exact truth."""
 
     model = preset_model(preset, unit)
@@ -254,7 +258,8 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
     if runs < 1:
         raise click.BadParameter("must be at least 1", param_hint="--runs")
     prof = resolve_profile(profile, preset, set_points_degc=_float_list(set_points, "--set-points"),
-                           ramp_rate_degc_per_min=ramp_rate, dwell_s=dwell_s, cycles=cycles, position_s=position_s)
+                           ramp_rate_degc_per_min=ramp_rate, dwell_s=dwell_s, cycles=cycles, position_s=position_s,
+                           rates_dps=_float_list(rates, "--rates"))
     output_format(output)
     out = Path(output)
     paths = [out] if runs == 1 else [out.with_name(f"{out.stem}_{i}{out.suffix}") for i in range(runs)]
@@ -314,10 +319,15 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 @click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
               help="What the model choice holds out: each run, each heating or cooling leg, or time blocks; "
                    "auto: runs with three runs or more, else legs.")
+@click.option("--scale-factor", "scale_factor", type=click.Choice(SCALE_FACTOR_CHOICES), default="auto",
+              show_default=True,
+              help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table): matrix "
+                   "(constant), matrix-temperature (linear in temperature), none; auto: order by leave-one-run-out "
+                   "when such runs are given.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, pipeline, static_min_duration_s, channels, folds, **kwargs):
+        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -335,7 +345,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
                                    hysteresis=hysteresis, hysteresis_order=hysteresis_order,
                                    hysteresis_band_degc=band, mlp_seed=mlp_seed, acceleration=acceleration,
-                                   static_min_duration_s=static_min_duration_s,
+                                   static_min_duration_s=static_min_duration_s, scale_factor=scale_factor,
                                    **({} if folds == "auto" else {"folds": folds}))
     calibration.save(output)
     if not ctx.obj["quiet"]:
@@ -344,6 +354,8 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
 
 def _print_fit(calibration: Calibration, output) -> None:
     console = _console()
+    if not calibration.axes and not calibration.accel_axes:
+        console.print(f"gyrocomp fit: {calibration.model}  ->  {output}")
     if calibration.axes:
         _print_axis_fits(console, calibration.axes, calibration.fit_report, f"gyrocomp fit: {calibration.model}  ->  "
                          f"{output}", "deg/s")
@@ -352,6 +364,22 @@ def _print_fit(calibration: Calibration, output) -> None:
                          f"accelerometer (correction relative to {calibration.accel_reference_degc:.2f} degC; "
                          "constants per run or per static position)" + ("" if calibration.axes else f"  ->  {output}"),
                          "g")
+    for name, triad in (("gyro", calibration.gyro_triad), ("accelerometer", calibration.accel_triad)):
+        if triad is not None:
+            _print_triad(console, name, triad)
+
+
+def _print_triad(console, name: str, triad) -> None:
+    """K (and its standard errors) of a triad, with its scale-factor errors in ppm."""
+    table = Table(title=f"{name} scale factor and misalignment ({triad.method}"
+                  + (f", K linear in temperature about {triad.reference_degc:.1f} degC" if triad.temperature_order else "")
+                  + ")")
+    for col in ("axis", "K row (+- standard error)", "scale error [ppm]", f"bias [{triad.unit}]"):
+        table.add_column(col)
+    for i, axis in enumerate("xyz"):
+        row = "  ".join(f"{k:+.6f}+-{e:.1g}" for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i]))
+        table.add_row(axis, row, f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g}")
+    console.print(table)
 
 
 def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -> None:
@@ -1036,7 +1064,7 @@ PARAMETER_FLAGS = {
     "window_s": "--window", "turn_on_window_s": "--turn-on-window", "rate_hz": "--rate", "axes": "--axes",
     "static_min_duration_s": "--min-static", "acceleration": "--acceleration", "hysteresis": "--hysteresis",
     "hysteresis_order": "--hysteresis-order", "hysteresis_band_degc": "--hysteresis-band",
-    "pipeline": "--pipeline", "channels": "--channels", "columns": "--columns", "fmt": "--format",
+    "pipeline": "--pipeline", "channels": "--channels", "scale_factor": "--scale-factor", "columns": "--columns", "fmt": "--format",
     "instance": "--instance", "device_id": "--device-id", "record": "--record", "imu_topic": "--imu-topic",
     "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
     "time_unit": "--time-unit", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",

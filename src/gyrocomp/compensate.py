@@ -12,7 +12,7 @@ from .effects import find_turns, g_sensitivity_offset, thermal_lag
 from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .plausibility import recording_concerns
-from .recording import ACCEL_AXES, Recording
+from .recording import ACCEL_AXES, GYRO_AXES, Recording
 
 
 class Compensator:
@@ -56,7 +56,14 @@ class Compensator:
         reference = np.array([calibration.accel_reference_degc])
         self._accel_modelled = [(j, a, ax, float(np.asarray(ax.temperature.shape_dps(reference), dtype=float)[0]))
                                 for j, a in enumerate(ACCEL_AXES) if (ax := calibration.accel_axes.get(a)) is not None]
-        if not self._modelled and not self._accel_modelled:
+        self._triad_columns = None
+        if calibration.gyro_triad is not None:
+            missing = [a for a in GYRO_AXES if a not in self.gyro_axes]
+            if missing:
+                raise InputError(f"{source}: the model corrects scale factor and misalignment across gyro_x, gyro_y "
+                                 f"and gyro_z; the data has no {', '.join(missing)}")
+            self._triad_columns = [self.gyro_axes.index(a) for a in GYRO_AXES]
+        if not self._modelled and not self._accel_modelled and calibration.accel_triad is None:
             raise InputError(
                 f"{source}: the model covers {', '.join(calibration.axes)}, the data has "
                 f"{', '.join(self.gyro_axes)}; no axis in common"
@@ -78,6 +85,7 @@ class Compensator:
         self._last_time_s: float | None = None
         self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
         self._pending_time: list[np.ndarray] = []
+        self._pending_temp: list[np.ndarray | None] = []
 
     def _model_temperature(self, key: str, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
         """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""
@@ -125,10 +133,21 @@ class Compensator:
             out[:, j] -= self._temperature_error(name, ax, time_s, t, None) - at_reference
         return out
 
+    def _accel_output(self, time_s: np.ndarray, temperature_degc: np.ndarray | None,
+                      accel_g: np.ndarray | None) -> np.ndarray | None:
+        """The accelerations the gyro's g-sensitivity reads (temperature-compensated, as it was fitted), and the
+        accelerometer output queued for :meth:`take_accel` (also bias, scale and misalignment corrected)."""
+        accel_g = self._compensate_accel(time_s, temperature_degc, accel_g)
+        if accel_g is not None and self.compensates_accel:
+            triad = self.calibration.accel_triad
+            self._accel_out.append(accel_g if triad is None else triad.correct(accel_g))
+        return accel_g
+
     @property
     def compensates_accel(self) -> bool:
-        """Whether the model has accelerometer axes (then :meth:`take_accel` gives them compensated)."""
-        return bool(self._accel_modelled)
+        """Whether the model corrects the accelerometer (temperature models or a triad calibration; then
+        :meth:`take_accel` gives the corrected accelerations)."""
+        return bool(self._accel_modelled) or self.calibration.accel_triad is not None
 
     def take_accel(self) -> np.ndarray:
         """The compensated accelerometer rows [g] (n, 3) of the chunks given since the last call (empty when
@@ -141,9 +160,7 @@ class Compensator:
     def _residual(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None,
                   accel_g: np.ndarray | None = None) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
-        accel_g = self._compensate_accel(time_s, temperature_degc, accel_g)
-        if accel_g is not None and self._accel_modelled:
-            self._accel_out.append(accel_g)
+        accel_g = self._accel_output(time_s, temperature_degc, accel_g)
         for j, ax in self._modelled:
             if ax.needs_accel and time_s.size:
                 if accel_g is None:
@@ -165,9 +182,19 @@ class Compensator:
             out[:, j] -= self._temperature_error(self.gyro_axes[j], ax, time_s, t, accel_g)
         return out
 
-    def _subtract_constants(self, residual: np.ndarray) -> np.ndarray:
+    def _subtract_constants(self, residual: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
+        """The bias-free residual, then (with a gyro triad) K(T)^-1 applied to the three axes [deg/s]."""
         for k, (j, _) in enumerate(self._modelled):
             residual[:, j] -= self._constants[k]
+        triad = self.calibration.gyro_triad
+        if triad is not None and residual.shape[0]:
+            t = None
+            if triad.temperature_order:
+                if temperature_degc is None:
+                    raise InputError(f"{self.source}: the model's scale factor depends on temperature; the data has none")
+                t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc.mean(axis=1)
+            cols = self._triad_columns
+            residual[:, cols] = triad.correct(residual[:, cols], t)
         return residual
 
     def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None = None,
@@ -181,11 +208,12 @@ class Compensator:
         time_s, gyro_dps, temperature_degc, accel_g = self._checked(time_s, gyro_dps, temperature_degc, accel_g)
         residual = self._residual(time_s, gyro_dps, temperature_degc, accel_g)
         if self._constants is not None:
-            return self._subtract_constants(residual)
+            return self._subtract_constants(residual, temperature_degc)
         if self._t0 is None and time_s.size:
             self._t0 = float(time_s[0])
         self._pending.append(residual)
         self._pending_time.append(time_s)
+        self._pending_temp.append(temperature_degc)
         if time_s.size and time_s[-1] - self._t0 >= self.turn_on_window_s:
             return self._release()
         return np.empty((0, len(self.gyro_axes)))
@@ -230,11 +258,12 @@ class Compensator:
     def _release(self) -> np.ndarray:
         residual = np.concatenate(self._pending)
         time_s = np.concatenate(self._pending_time)
-        self._pending, self._pending_time = [], []
+        temps = None if any(t is None for t in self._pending_temp) else np.concatenate(self._pending_temp)
+        self._pending, self._pending_time, self._pending_temp = [], [], []
         self._constants = np.array([
             estimate_turn_on_bias(residual[:, j], time_s, self.turn_on_window_s) for j, _ in self._modelled
         ])
-        return self._subtract_constants(residual)
+        return self._subtract_constants(residual, temps)
 
     def finish(self) -> np.ndarray:
         """Release rows still held back (a stream shorter than the turn-on window)."""
@@ -253,8 +282,9 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
           axes: tuple[str, ...] | None = None) -> Recording:
     """Compensate a whole recording; the result has the same rows, axes and other channels.
 
-    The gyro axes the model covers are compensated [deg/s]; so are the accelerometer axes [g] when the
-    model has accelerometer temperature models (then also a g-sensitivity term reads the compensated ones).
+    The gyro axes the model covers are compensated [deg/s] (with a gyro triad, scale factor and misalignment
+    corrected last); so are the accelerometer axes [g] when the model has accelerometer temperature models
+    (then also a g-sensitivity term reads the compensated ones) or an accelerometer triad.
 
     Parameters
     ----------
@@ -285,7 +315,7 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel)
     rest = comp.finish()
     result = recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)
-    if calibration.accel_axes:
+    if comp.compensates_accel:
         order = [ACCEL_AXES.index(a) for a in recording.accel_axes]
         result = dataclasses.replace(result, accel_g=comp.take_accel()[:, order])
     return result
@@ -303,6 +333,9 @@ def _restricted(calibration: Calibration, recording: Recording, axes: tuple[str,
                              "others are then left raw")
         return calibration
     axes = tuple(axes)
+    if calibration.gyro_triad is not None and set(axes) != set(GYRO_AXES):
+        raise InputError(f"axes: {', '.join(axes)}; the model's scale-factor and misalignment correction couples "
+                         "gyro_x, gyro_y and gyro_z, compensate all three (or use calibration.without('scale-factor'))")
     for axis in axes:
         where = [] if axis in calibration.axes else ["the model"]
         where += [] if axis in recording.gyro_axes else [recording.source]

@@ -78,6 +78,8 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
         parts.append("hysteresis")
     if any(ax.needs_accel for ax in calibration.axes.values()):
         parts.append("g-sensitivity")
+    if calibration.gyro_triad is not None or calibration.accel_triad is not None:
+        parts.append("scale-factor and misalignment")
     if parts:
         warnings.warn(f"{target} has no {' or '.join(parts)} term: left out of the export, only the temperature cubic "
                       "is written (compare the stages of the evaluation to see what that costs)",

@@ -133,6 +133,9 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
         raise InputError("export: the model has none of gyro_x, gyro_y, gyro_z, accel_x, accel_y, accel_z")
     if any(ax.temperature_column != "temperature" for ax in axes.values()):
         raise InputError("C export: the model reads one temperature per axis; the C interface takes one")
+    if calibration.gyro_triad is not None or calibration.accel_triad is not None:
+        raise InputError("C export: the model has a scale-factor and misalignment triad, which the C code does not "
+                         "carry yet; export the model without it (calibration.without('scale-factor') for the gyro)")
     every = list(axes.values()) + list(accel_axes.values())
     if any(ax.lag_time_constant_s > 0 for ax in every) and not (rate_hz and rate_hz > 0):
         raise InputError("C export: the model has thermal lag; give the data's sample rate with rate_hz=")

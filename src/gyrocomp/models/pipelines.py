@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
+from typing import Literal
 
 import numpy as np
 
@@ -14,6 +15,7 @@ from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..plausibility import calibration_concerns, temperature_span_concern
 from ..recording import ACCEL_AXES, Recording
+from ..triad import TriadCalibration
 from ..static import orientations, static_segments
 from .acceleration import (
     ACCELERATION_CHOICES,
@@ -28,6 +30,7 @@ from .hysteresis import heats_and_cools
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
+from .triad_fit import Pose, find_poses, fit_accel_multiposition, fit_gyro_rate_table, spans_axes
 from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 
 #: how the fit report names each kind of fold
@@ -546,28 +549,97 @@ def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
                        accel_axes=fitted.axes, accel_reference_degc=0.5 * (t_min + t_max))
 
 
-def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, ...] | str = ("gyro",),
-                 pipeline: str = "joint", **options) -> Calibration:
-    """Fit the gyro (``fit_pipeline``), the accelerometer (``fit_accelerometer``), or both.
+#: how ``fit_channels`` treats the gyro's scale factor and misalignment
+ScaleFactor = Literal["auto", "none", "matrix", "matrix-temperature"]
+SCALE_FACTOR_CHOICES: tuple[str, ...] = ("auto", "none", "matrix", "matrix-temperature")
 
-    With both, the accelerometer is modelled first and the gyro's g-sensitivity stage is fitted on the
-    temperature-compensated accelerations (the same ones the compensation will feed it).
+
+def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCalibration | None, list[Recording]]:
+    """The gyro's K(T) from the runs that carry reference rates, and the runs left for the bias model."""
+    if scale_factor not in SCALE_FACTOR_CHOICES:
+        raise InputError(f"scale_factor: {scale_factor!r}; use one of {', '.join(SCALE_FACTOR_CHOICES)}")
+    rate_runs = [r for r in recordings if r.reference_rate_dps is not None]
+    if scale_factor in ("matrix", "matrix-temperature") and not rate_runs:
+        raise InputError(f"scale_factor={scale_factor!r}: no run carries reference rates (ref_rate_x, ref_rate_y, "
+                         "ref_rate_z [deg/s]); a scale-factor calibration needs rate-table runs")
+    if not rate_runs or scale_factor == "none":
+        return None, recordings
+    rest = [r for r in recordings if r.reference_rate_dps is None]
+    if not rest:
+        raise InputError("scale_factor: every run is a rate-table run; the temperature bias model also needs runs "
+                         "at rest (chamber runs): give both, or fit the rate table alone with fit_gyro_rate_table")
+    order = {"auto": "auto", "matrix": 0, "matrix-temperature": 1}[scale_factor]
+    return fit_gyro_rate_table(rate_runs, temperature_order=order).calibration, rest
+
+
+def _spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
+    """The still poses of runs that turn the accelerometer's every axis up and down (a multi-position test), or
+    None when they do not."""
+    poses = [p for rec in recordings if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes)
+             for p in find_poses(rec)]
+    return poses if len(poses) >= 6 and spans_axes(poses) else None
+
+
+def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibration:
+    """The accelerometer: temperature models where the runs have a temperature, then bias, scale and
+    misalignment from the still poses (of the temperature-compensated accelerations) where the runs turn every
+    axis up and down."""
+    with_temperature = all(r.temperature_degc is not None for r in recordings)
+    accel_cal = None
+    if with_temperature:
+        accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
+        recordings = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
+    poses = _spanning_poses(recordings)
+    if poses is None:
+        if accel_cal is None:
+            raise InputError("channels=accel: the runs have no temperature (for a temperature model) and do not turn "
+                             "every accelerometer axis up and down (for a multi-position calibration)")
+        return accel_cal
+    fit = fit_accel_multiposition(poses)
+    report = {"accel_triad": {"method": fit.calibration.method, "poses": len(poses),
+                              "norm_rms_before_g": fit.norm_rms_error_before_g, "norm_rms_after_g": fit.norm_rms_error_g,
+                              "degrees_of_freedom": fit.degrees_of_freedom}}
+    if accel_cal is None:
+        return Calibration(axes={}, model=f"accel {fit.calibration.method}", provenance=provenance(recordings),
+                           fit_report=report, accel_triad=fit.calibration)
+    return dataclasses.replace(accel_cal, model=f"{accel_cal.model} + {fit.calibration.method}",
+                               fit_report={**accel_cal.fit_report, **report}, accel_triad=fit.calibration)
+
+
+def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, ...] | str = ("gyro",),
+                 pipeline: str = "joint", *, scale_factor: ScaleFactor = "auto", **options) -> Calibration:
+    """Fit the gyro (``fit_pipeline``), the accelerometer, or both.
+
+    The accelerometer gets temperature models (``fit_accelerometer``) when the runs have a temperature, and
+    bias, scale factor and misalignment (``fit_accel_multiposition``) when they turn its every axis up and
+    down. With both channels the accelerometer is modelled first and the gyro's g-sensitivity stage is fitted
+    on the temperature-compensated accelerations (the same ones the compensation will feed it).
+
+    ``scale_factor``: runs that carry a rate table's reference rates (``reference_rate_dps``) give the gyro's
+    scale factor and misalignment K(T) (:func:`fit_gyro_rate_table`) and the other runs the bias model;
+    ``"auto"`` when such runs are given, ``"matrix"`` K constant, ``"matrix-temperature"`` K linear in
+    temperature, ``"none"`` no K (every run is then a bias run).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]
     recordings = list(recordings)
     channels = parse_channels(channels)
+    gyro_triad, recordings = _gyro_triad(recordings, scale_factor) if "gyro" in channels else (None, recordings)
     if "accel" not in channels:
-        return fit_pipeline(recordings, pipeline, **options)
-    accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
+        return dataclasses.replace(fit_pipeline(recordings, pipeline, **options), gyro_triad=gyro_triad)
+    accel_cal = _fit_accel_channel(recordings, options)
     if "gyro" not in channels:
         return accel_cal
-    compensated = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
+    compensated = recordings
+    if accel_cal.accel_axes:
+        compensated = [dataclasses.replace(rec, accel_g=apply(accel_cal.without_accel_triad(), rec).accel_g)
+                       for rec in recordings]
     gyro_cal = fit_pipeline(compensated, pipeline, **options)
     return dataclasses.replace(gyro_cal, model=f"{gyro_cal.model}; {accel_cal.model}",
                                fit_report={**gyro_cal.fit_report, **accel_cal.fit_report},
-                               accel_axes=accel_cal.accel_axes, accel_reference_degc=accel_cal.accel_reference_degc)
+                               accel_axes=accel_cal.accel_axes, accel_reference_degc=accel_cal.accel_reference_degc,
+                               gyro_triad=gyro_triad, accel_triad=accel_cal.accel_triad)
 
 
-__all__ = ["CHANNELS", "PIPELINES", "fit_accelerometer", "fit_calibration", "fit_channels", "fit_pipeline",
-           "parse_channels"]
+__all__ = ["CHANNELS", "PIPELINES", "SCALE_FACTOR_CHOICES", "ScaleFactor", "fit_accelerometer", "fit_calibration",
+           "fit_channels", "fit_pipeline", "parse_channels"]

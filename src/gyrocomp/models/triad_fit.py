@@ -176,6 +176,16 @@ def _directions(means: np.ndarray) -> np.ndarray:
     return means / norms[:, None]
 
 
+def spans_axes(poses: list[Pose]) -> bool:
+    """Whether the poses turn every accelerometer axis both up and down (gravity within 60 deg of +-x, +-y, +-z)."""
+    means = np.array([p.accel_g for p in poses], dtype=float)
+    norms = np.linalg.norm(means, axis=1)
+    if means.size == 0 or np.any(norms < 0.1):
+        return False
+    units = means / norms[:, None]
+    return all(np.any(sign * units[:, axis] > SPAN_FRACTION) for axis in range(3) for sign in (1, -1))
+
+
 def _require_span(units: np.ndarray) -> None:
     for axis, name in enumerate("xyz"):
         for sign, word in ((1, "up"), (-1, "down")):
@@ -547,5 +557,5 @@ def rq_upper(sensitivity: np.ndarray) -> np.ndarray:
 
 
 __all__ = ["AUTO_NORM_POSES", "MIN_POSES_NORM", "Pose", "PoseFit", "PoseMethod", "RateSegment", "RateTableFit",
-           "distinct_orientations", "find_poses", "fit_accel_multiposition", "fit_gyro_rate_table", "rate_segments",
+           "distinct_orientations", "find_poses", "spans_axes", "fit_accel_multiposition", "fit_gyro_rate_table", "rate_segments",
            "rq_upper"]
