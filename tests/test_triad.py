@@ -324,6 +324,6 @@ def test_exports_say_what_they_leave_out_of_a_triad(rate_fit):
                               gyro_triad=rate_fit.calibration)
     with pytest.warns(DataQualityWarning, match="scale-factor and misalignment"):
         px4_params_file(cal)
-    with pytest.raises(InputError, match="C export: the model has a scale-factor and misalignment triad"):
+    with pytest.raises(InputError, match="C export: the model has the gyro's scale factor and misalignment"):
         c_sources(cal)
     assert "gyrocomp.c" in c_sources(cal.without("scale-factor"))

@@ -17,14 +17,16 @@ gaps exactly), the turning-point hysteresis, and the mean turn-on constant of th
 
 from __future__ import annotations
 
+
 import math
+import warnings
 import os
 from pathlib import Path
 
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..errors import InputError
+from ..errors import DataQualityWarning, InputError
 from ..io.atomic import write_texts_atomic
 from ..models.mlp import MLPBias, layer_shapes
 from ..models.temperature import PolynomialBias
@@ -133,9 +135,12 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
         raise InputError("export: the model has none of gyro_x, gyro_y, gyro_z, accel_x, accel_y, accel_z")
     if any(ax.temperature_column != "temperature" for ax in axes.values()):
         raise InputError("C export: the model reads one temperature per axis; the C interface takes one")
-    if calibration.gyro_triad is not None or calibration.accel_triad is not None:
-        raise InputError("C export: the model has a scale-factor and misalignment triad, which the C code does not "
-                         "carry yet; export the model without it (calibration.without('scale-factor') for the gyro)")
+    if calibration.gyro_triad is not None:
+        raise InputError("C export: the model has the gyro's scale factor and misalignment, which the C code does "
+                         "not carry yet; export calibration.without('scale-factor')")
+    if calibration.accel_triad is not None:
+        warnings.warn("C export: the accelerometer's bias, scale and misalignment (accel_triad) are not in the C code "
+                      "yet; its accelerations come out temperature-compensated only", DataQualityWarning, stacklevel=2)
     every = list(axes.values()) + list(accel_axes.values())
     if any(ax.lag_time_constant_s > 0 for ax in every) and not (rate_hz and rate_hz > 0):
         raise InputError("C export: the model has thermal lag; give the data's sample rate with rate_hz=")
