@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -551,7 +551,7 @@ def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
 
 #: how ``fit_channels`` treats the gyro's scale factor and misalignment
 ScaleFactor = Literal["auto", "none", "matrix", "matrix-temperature"]
-SCALE_FACTOR_CHOICES: tuple[str, ...] = ("auto", "none", "matrix", "matrix-temperature")
+SCALE_FACTOR_CHOICES: tuple[str, ...] = get_args(ScaleFactor)
 
 
 def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCalibration | None, list[Recording]]:

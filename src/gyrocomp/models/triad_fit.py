@@ -141,6 +141,8 @@ class PoseFit:
         Equations minus unknowns.
     poses_left_out : int
         Poses the six-position method could not assign to an axis direction.
+    gravity_g : float
+        The norm the poses were fitted to [g].
     """
 
     calibration: TriadCalibration
@@ -150,20 +152,17 @@ class PoseFit:
     reduced_chi_square: float
     degrees_of_freedom: int
     poses_left_out: int = 0
+    gravity_g: float = 1.0
 
     @property
     def norm_rms_error_g(self) -> float:
         """RMS of |a| - g over the poses after the correction [g]."""
-        return float(np.sqrt(np.mean((self.norm_after_g - self._gravity) ** 2)))
+        return float(np.sqrt(np.mean((self.norm_after_g - self.gravity_g) ** 2)))
 
     @property
     def norm_rms_error_before_g(self) -> float:
         """RMS of |a| - g over the poses before the correction [g]."""
-        return float(np.sqrt(np.mean((self.norm_before_g - self._gravity) ** 2)))
-
-    @property
-    def _gravity(self) -> float:
-        return float(np.median(self.norm_after_g)) if self.norm_after_g.size else 1.0
+        return float(np.sqrt(np.mean((self.norm_before_g - self.gravity_g) ** 2)))
 
 
 def _directions(means: np.ndarray) -> np.ndarray:
@@ -176,23 +175,32 @@ def _directions(means: np.ndarray) -> np.ndarray:
     return means / norms[:, None]
 
 
+def _unturned(units: np.ndarray) -> tuple[int, int] | None:
+    """The first (axis, sign) that no pose turns within 60 deg of gravity, or None when every axis points both
+    up and down in some pose."""
+    for axis in range(3):
+        for sign in (1, -1):
+            if not np.any(sign * units[:, axis] > SPAN_FRACTION):
+                return axis, sign
+    return None
+
+
 def spans_axes(poses: list[Pose]) -> bool:
     """Whether the poses turn every accelerometer axis both up and down (gravity within 60 deg of +-x, +-y, +-z)."""
-    means = np.array([p.accel_g for p in poses], dtype=float)
+    means = np.array([p.accel_g for p in poses], dtype=float).reshape(-1, 3)
     norms = np.linalg.norm(means, axis=1)
     if means.size == 0 or np.any(norms < 0.1):
         return False
-    units = means / norms[:, None]
-    return all(np.any(sign * units[:, axis] > SPAN_FRACTION) for axis in range(3) for sign in (1, -1))
+    return _unturned(means / norms[:, None]) is None
 
 
 def _require_span(units: np.ndarray) -> None:
-    for axis, name in enumerate("xyz"):
-        for sign, word in ((1, "up"), (-1, "down")):
-            if not np.any(sign * units[:, axis] > SPAN_FRACTION):
-                raise InputError(
-                    f"poses: no pose has the {name} axis pointing {word} (gravity within 60 deg of "
-                    f"{'+' if sign > 0 else '-'}{name}); the poses must turn every axis both up and down")
+    missing = _unturned(units)
+    if missing is not None:
+        axis, sign = missing
+        name, word = "xyz"[axis], "up" if sign > 0 else "down"
+        raise InputError(f"poses: no pose has the {name} axis pointing {word} (gravity within 60 deg of "
+                         f"{'+' if sign > 0 else '-'}{name}); the poses must turn every axis both up and down")
 
 
 def distinct_orientations(units: np.ndarray) -> int:
@@ -225,12 +233,12 @@ def _upper(theta: np.ndarray) -> np.ndarray:
     return c
 
 
-def _norm_residuals(theta: np.ndarray, means: np.ndarray, gravity_g: float, sigma: np.ndarray) -> np.ndarray:
+def _norm_residuals(theta: np.ndarray, means: np.ndarray, gravity_g: float) -> np.ndarray:
     w = (means - theta[:3]) @ _upper(theta).T
-    return (np.linalg.norm(w, axis=1) - gravity_g) / sigma
+    return np.linalg.norm(w, axis=1) - gravity_g
 
 
-def _norm_jacobian(theta: np.ndarray, means: np.ndarray, gravity_g: float, sigma: np.ndarray) -> np.ndarray:
+def _norm_jacobian(theta: np.ndarray, means: np.ndarray, gravity_g: float) -> np.ndarray:
     c = _upper(theta)
     v = means - theta[:3]
     w = v @ c.T
@@ -238,7 +246,7 @@ def _norm_jacobian(theta: np.ndarray, means: np.ndarray, gravity_g: float, sigma
     d_bias = -u @ c
     rows, cols = np.triu_indices(3)
     d_c = u[:, rows] * v[:, cols]
-    return np.hstack([d_bias, d_c]) / sigma[:, None]
+    return np.hstack([d_bias, d_c])
 
 
 def _sphere_start(means: np.ndarray, gravity_g: float) -> np.ndarray:
@@ -280,9 +288,8 @@ def _fit_norm(poses: list[Pose], means: np.ndarray, units: np.ndarray, gravity_g
     if distinct < MIN_POSES_NORM:
         raise InputError(f"poses: {distinct} distinct orientations (of {len(poses)} still poses); the norm method "
                          f"needs at least {MIN_POSES_NORM} (nine unknowns: bias, scale and misalignment)")
-    ones = np.ones(len(poses))
     sol = optimize.least_squares(_norm_residuals, _sphere_start(means, gravity_g), jac=_norm_jacobian,
-                                 args=(means, gravity_g, ones), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+                                 args=(means, gravity_g), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
     theta = sol.x
     sens = np.linalg.inv(_upper(theta)) if abs(np.linalg.det(_upper(theta))) > 1e-9 else np.full((3, 3), np.inf)
     if np.any(np.diag(_upper(theta)) <= 0) or np.max(np.abs(sens - np.eye(3))) > MAX_SENSITIVITY_ERROR:
@@ -361,7 +368,8 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
                            sensitivity_stderr=tuple(map(tuple, sens_se)), bias_stderr=tuple(float(b) for b in bias_se),
                            unit="g")
     after = cal.correct(means)
-    return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1), np.linalg.norm(after, axis=1), red, dof, left)
+    return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1), np.linalg.norm(after, axis=1), red, dof, left,
+                   float(gravity_g))
 
 
 # -- gyro: rate table -------------------------------------------------------------------------------------
@@ -440,15 +448,14 @@ def _held_out_rms(segments: list[RateSegment], runs: int, order: int, t_ref: flo
     y = np.array([s.gyro_dps for s in segments])
     x = _rate_design(segments, runs, order, t_ref)
     run_of = np.array([s.run for s in segments])
+    moving = np.linalg.norm(np.array([s.reference_dps for s in segments]), axis=1) >= MIN_REFERENCE_RATE_DPS
     errors = []
     for r in range(runs):
         train = run_of != r
         coef = np.linalg.lstsq(x[train], y[train], rcond=None)[0]
-        pred = x[~train][:, runs:] @ coef[runs:]
-        resid = y[~train] - pred
+        resid = y[~train] - x[~train][:, runs:] @ coef[runs:]
         resid -= resid.mean(axis=0)
-        moving = np.linalg.norm(np.array([s.reference_dps for s in segments])[~train], axis=1) >= MIN_REFERENCE_RATE_DPS
-        errors.append(resid[moving])
+        errors.append(resid[moving[~train]])
     return float(np.sqrt(np.mean(np.concatenate(errors) ** 2)))
 
 
