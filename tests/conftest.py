@@ -7,8 +7,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulate import GyroErrorModel, simulate
 
 REPO = Path(__file__).resolve().parents[1]
@@ -22,6 +24,17 @@ def shared_dataset(name: str) -> Path:
     if not path.is_dir():
         pytest.skip(f"shared dataset {name!r} not found at {path}; these tests need ../shared beside the repository")
     return path
+
+
+def xsens_session():
+    """imu_tk's Xsens multi-position session (../shared/datasets/imu_tk-xsens) as a Recording: raw 16-bit counts
+    around 32768, scaled by nominal factors only (about 3700 counts per g, imu_tk's 1/6258 (rad/s)/count); the
+    calibrations find the real ones. Skips when the dataset is absent."""
+    folder = shared_dataset("imu_tk-xsens")
+    acc = np.loadtxt(folder / "xsens_acc.mat")
+    gyro = np.loadtxt(folder / "xsens_gyro.mat")
+    return Recording(acc[:, 0], np.degrees((gyro[:, 1:] - 32768) / 6258), GYRO_AXES,
+                     accel_g=(acc[:, 1:] - 32768) / 3700.0, accel_axes=ACCEL_AXES, source="xsens")
 
 
 #: the test sensor: MTi-10-class temperature drift, moderate bias instability

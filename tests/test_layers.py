@@ -20,7 +20,7 @@ LAYERS = (
     ("calibration", ("calibration", "triad")),
     ("compensate", ("compensate",)),
     ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration",
-                 "models.triad_fit")),
+                 "models.triad_fit", "models.pose_rotation")),
     ("pipelines", ("models.pipelines", "models")),
     ("evaluation", ("evaluation", "comparison", "validation")),
     ("output", ("report", "export", "demo")),

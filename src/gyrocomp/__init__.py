@@ -25,6 +25,7 @@ from .io import write_recording as write
 from .metrics import Evaluation, evaluate_run
 from .models import PolynomialTemperatureModel
 from .models.pipelines import fit_calibration, fit_channels
+from .models.pose_rotation import fit_gyro_between_poses, rotation_errors
 from .models.triad_fit import find_poses, fit_accel_multiposition, fit_gyro_rate_table
 from .noise import analyse_noise
 from .recording import Recording
@@ -40,6 +41,6 @@ __all__ = [
     "MissingDependencyError", "ModelChoiceWarning", "ModelError", "NotFittedError", "PlausibilityWarning", "PolynomialTemperatureModel",
     "Recording", "TemperatureRangeWarning", "TriadCalibration", "allan_deviation", "analyse_noise", "apply", "evaluate",
     "evaluate_run", "evaluate_stages", "find_poses", "fit", "fit_accel_multiposition", "fit_calibration",
-    "fit_channels", "fit_gyro_rate_table", "noise_parameters",
-    "predict_error", "read", "simulate", "validate", "write", "__version__",
+    "fit_channels", "fit_gyro_between_poses", "fit_gyro_rate_table", "noise_parameters",
+    "predict_error", "read", "rotation_errors", "simulate", "validate", "write", "__version__",
 ]

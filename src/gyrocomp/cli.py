@@ -321,9 +321,10 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
                    "auto: runs with three runs or more, else legs.")
 @click.option("--scale-factor", "scale_factor", type=click.Choice(SCALE_FACTOR_CHOICES), default="auto",
               show_default=True,
-              help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table): matrix "
-                   "(constant), matrix-temperature (linear in temperature), none; auto: order by leave-one-run-out "
-                   "when such runs are given.")
+              help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table) or, "
+                   "without them, from the turns between the still poses of multi-position runs: matrix (constant), "
+                   "matrix-temperature (linear in temperature; rate table), none; auto: when such runs are given, "
+                   "the order by leave-one-run-out.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,

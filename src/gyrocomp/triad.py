@@ -14,21 +14,23 @@ Ferraris test, poses along +-x, +-y, +-z of a reference frame) K is full and rel
 
 For the gyro, K(T) may depend on temperature: each element is a polynomial in (T - T_ref)
 (coefficients in ``sensitivity_per_degc``), as rate-table calibrations at several temperatures give.
+Without a rate table, rotations between still poses (``method="rotation"``) give the gyro's K relative
+to the accelerometer's corrected frame: gravity, measured before and after each turn, is the reference.
 These classes are data only; the fitters live in :mod:`gyrocomp.models.triad_fit`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 import numpy as np
 
 from .errors import InputError
 
 #: how a triad was calibrated
-TriadMethod = Literal["norm", "six-position", "rate-table"]
-TRIAD_METHODS: tuple[str, ...] = ("norm", "six-position", "rate-table")
+TriadMethod = Literal["norm", "six-position", "rate-table", "rotation"]
+TRIAD_METHODS: tuple[str, ...] = get_args(TriadMethod)
 
 
 def _matrix(value: Any, where: str) -> np.ndarray:
@@ -59,7 +61,7 @@ class TriadCalibration:
         K at ``reference_degc``: raw = K v + bias [dimensionless].
     bias : 3 floats
         Constant bias [g for the accelerometer, deg/s for the gyro].
-    method : {"norm", "six-position", "rate-table"}
+    method : {"norm", "six-position", "rate-table", "rotation"}
         How it was found (see the module doc for the frame each method fixes).
     sensitivity_stderr, bias_stderr : 3 x 3, 3 floats
         Standard errors of the above (same units).

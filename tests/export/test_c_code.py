@@ -14,6 +14,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources, write_c_sources
 from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.triad import TriadCalibration
 from ..conftest import run
 
 DRIVER = r"""
@@ -137,17 +138,36 @@ DRIVER_ACCEL = DRIVER.replace('printf("%.17g %.17g %.17g\\n", out[0], out[1], ou
                               's.accel_out[0], s.accel_out[1], s.accel_out[2]);')
 
 
-def test_accelerometer_temperature_models_and_g_sensitivity_on_compensated_accelerations(tmp_path):
+def _triad(k0, unit, bias=(0.0, 0.0, 0.0), k1=None):
+    zeros = ((0.0,) * 3,) * 3
+    k0 = tuple(map(tuple, np.eye(3) + np.asarray(k0)))
+    per_degc = () if k1 is None else (tuple(map(tuple, k1)),)
+    return TriadCalibration(k0, bias, "rate-table" if unit == "deg/s" else "norm", zeros, (0.0, 0.0, 0.0), unit,
+                            reference_degc=None if k1 is None else 25.0, sensitivity_per_degc=per_degc,
+                            sensitivity_per_degc_stderr=() if k1 is None else (zeros,))
+
+
+#: a gyro K(T) linear in temperature (0.5 % scale, 1 mrad misalignment, 50 ppm/degC) and an accelerometer triad
+GYRO_TRIAD = _triad([[5e-3, 1e-3, -1e-3], [-1e-3, -4e-3, 2e-3], [1e-3, -2e-3, 3e-3]], "deg/s",
+                    k1=np.diag([5e-5, -3e-5, 4e-5]) + 1e-6)
+ACCEL_TRIAD = _triad([[2e-3, 1e-3, -2e-3], [0.0, -3e-3, 1.5e-3], [0.0, 0.0, 4e-3]], "g", bias=(0.02, -0.015, 0.03))
+
+
+def test_accelerometer_temperature_models_g_sensitivity_and_both_triads(tmp_path):
     from gyrocomp.models.pipelines import fit_channels
 
     runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(2)]
     chamber = [simulate("consumer", profile="cycle", rate_hz=0.5, seed=s).recording for s in range(2)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        cal = fit_channels(runs, ("gyro", "accel"))  # the C code carries no accelerometer triad yet: left out below
+        cal = fit_channels(runs, ("gyro", "accel"))
         lagged = fit_channels(chamber, ("accel",), hysteresis="lag").accel_axes
-        ours = apply(cal := dataclasses.replace(cal, accel_axes=lagged, accel_triad=None), runs[1])
+        cal = dataclasses.replace(cal, accel_axes=lagged, gyro_triad=GYRO_TRIAD, accel_triad=ACCEL_TRIAD)
+        ours = apply(cal, runs[1])
+        plain = apply(cal.without("scale-factor").without_accel_triad(), runs[1])
     assert cal.has_acceleration
+    assert np.max(np.abs(ours.gyro_dps - plain.gyro_dps)) > 1e-4  # the triads really act (on residuals near 0)
+    assert np.max(np.abs(ours.accel_g - plain.accel_g)) > 1e-3
     assert any(ax.lag_time_constant_s > 0 for ax in cal.accel_axes.values())
     for name, text in c_sources(cal, rate_hz=runs[1].rate_hz).items():
         (tmp_path / name).write_text(text)

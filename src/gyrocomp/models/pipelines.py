@@ -12,9 +12,9 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from ..errors import InputError, ModelChoiceWarning, TemperatureRangeWarning
+from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..plausibility import calibration_concerns, temperature_span_concern
-from ..recording import ACCEL_AXES, Recording
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..triad import TriadCalibration
 from ..static import orientations, static_segments
 from .acceleration import (
@@ -27,6 +27,7 @@ from .acceleration import (
 )
 from .base import bin_width_for, block_means, one_temperature_column, provenance
 from .hysteresis import heats_and_cools
+from .pose_rotation import fit_gyro_between_poses
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
@@ -554,16 +555,44 @@ ScaleFactor = Literal["auto", "none", "matrix", "matrix-temperature"]
 SCALE_FACTOR_CHOICES: tuple[str, ...] = get_args(ScaleFactor)
 
 
+def _turning_sessions(recordings: list[Recording]) -> list[Recording]:
+    """The runs that are multi-position sessions with the turns between their poses recorded (three gyro and
+    three accelerometer axes, still poses turning every accelerometer axis up and down)."""
+    out = []
+    for rec in recordings:
+        if rec.reference_rate_dps is None and rec.gyro_axes == GYRO_AXES and rec.accel_g is not None \
+                and set(ACCEL_AXES) <= set(rec.accel_axes) and _spanning_poses([rec]) is not None:
+            out.append(rec)
+    return out
+
+
 def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCalibration | None, list[Recording]]:
-    """The gyro's K(T) from the runs that carry reference rates, and the runs left for the bias model."""
+    """The gyro's K(T) from the runs that carry reference rates (those runs then leave the bias model) or, without
+    them, K from the turns between the still poses of multi-position sessions; and the runs for the bias model."""
     if scale_factor not in SCALE_FACTOR_CHOICES:
         raise InputError(f"scale_factor: {scale_factor!r}; use one of {', '.join(SCALE_FACTOR_CHOICES)}")
-    rate_runs = [r for r in recordings if r.reference_rate_dps is not None]
-    if scale_factor in ("matrix", "matrix-temperature") and not rate_runs:
-        raise InputError(f"scale_factor={scale_factor!r}: no run carries reference rates (ref_rate_x, ref_rate_y, "
-                         "ref_rate_z [deg/s]); a scale-factor calibration needs rate-table runs")
-    if not rate_runs or scale_factor == "none":
+    if scale_factor == "none":
         return None, recordings
+    rate_runs = [r for r in recordings if r.reference_rate_dps is not None]
+    if not rate_runs:
+        sessions = _turning_sessions(recordings)
+        if scale_factor == "matrix-temperature":
+            raise InputError("scale_factor='matrix-temperature': no run carries reference rates (ref_rate_x, "
+                             "ref_rate_y, ref_rate_z [deg/s]); K's temperature dependence needs rate-table runs at "
+                             "several temperatures")
+        if scale_factor == "matrix" and not sessions:
+            raise InputError("scale_factor='matrix': no run carries reference rates (ref_rate_x, ref_rate_y, "
+                             "ref_rate_z [deg/s]) or turns between still poses; a scale-factor calibration needs "
+                             "rate-table runs or a multi-position session with the turns recorded")
+        if not sessions:
+            return None, recordings
+        try:
+            return fit_gyro_between_poses(sessions).calibration, recordings
+        except InputError as exc:
+            if scale_factor == "matrix":
+                raise
+            warnings.warn(f"scale factor not fitted from the multi-position runs: {exc}", DataQualityWarning, stacklevel=3)
+            return None, recordings
     rest = [r for r in recordings if r.reference_rate_dps is None]
     if not rest:
         raise InputError("scale_factor: every run is a rate-table run; the temperature bias model also needs runs "
@@ -617,8 +646,10 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
 
     ``scale_factor``: runs that carry a rate table's reference rates (``reference_rate_dps``) give the gyro's
     scale factor and misalignment K(T) (:func:`fit_gyro_rate_table`) and the other runs the bias model;
-    ``"auto"`` when such runs are given, ``"matrix"`` K constant, ``"matrix-temperature"`` K linear in
-    temperature, ``"none"`` no K (every run is then a bias run).
+    without them, multi-position sessions whose turns between still poses are recorded give a constant K
+    (:func:`fit_gyro_between_poses`; they stay bias runs too). ``"auto"`` when such runs are given (a warning
+    when their turns do not determine K), ``"matrix"`` K constant, ``"matrix-temperature"`` K linear in
+    temperature (rate-table runs only), ``"none"`` no K (every run is then a bias run).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]

@@ -9,8 +9,9 @@ Accelerometer, multi-position (no turntable, no known orientations needed):
 * ``method="six-position"`` (Ferraris et al. 1995; imucal): the poses lie along +-x, +-y, +-z of a
   reference frame (a cube on a level table), so ``a_i = K d_i + b`` with d_i the known direction:
   linear least squares for the full K and b; every one of the six directions at least once.
-* ``method="auto"``: the norm method with 12 or more poses, else six-position when the six directions
-  are present, else the norm method when it has its 10 poses.
+* ``method="auto"``: the norm method with 12 or more poses whose directions determine its nine unknowns
+  (:func:`undetermined_norm_term`), else six-position when the six directions are present, else the norm
+  method when it has its 10 poses.
 
 Both fits are unweighted (placement errors of hand-held poses, not the sensor noise, set the scatter
 of real poses). Standard errors come from the fit's covariance scaled by the residual variance, never
@@ -19,13 +20,14 @@ below what the poses' own noise (standard error of each mean) allows.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from scipy import linalg, optimize
 
-from ..errors import InputError
+from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
 from ..static import static_segments
 from ..triad import TriadCalibration, rows_of
@@ -70,6 +72,8 @@ class Pose:
         Mean angular rate [deg/s].
     temperature_degc : float or None
         Mean temperature [degC].
+    start_index, stop_index : int
+        Its samples in the recording, [start_index, stop_index) (0, 0 when it was not taken from one).
     """
 
     source: str
@@ -80,6 +84,8 @@ class Pose:
     accel_sem_g: np.ndarray
     gyro_dps: np.ndarray | None
     temperature_degc: float | None
+    start_index: int = 0
+    stop_index: int = 0
 
 
 def _pose(recording: Recording, start: int, stop: int) -> Pose:
@@ -89,7 +95,7 @@ def _pose(recording: Recording, start: int, stop: int) -> Pose:
     return Pose(recording.source, float(recording.time_s[start]), float(recording.time_s[stop - 1] - recording.time_s[start]),
                 int(n), acc.mean(axis=0), acc.std(axis=0, ddof=1) / np.sqrt(n),
                 recording.gyro_dps[start:stop].mean(axis=0),
-                None if temp is None else float(np.mean(temp[start:stop])))
+                None if temp is None else float(np.mean(temp[start:stop])), start, stop)
 
 
 def find_poses(recording: Recording, *, ranges: list[tuple[int, int]] | None = None,
@@ -212,6 +218,52 @@ def distinct_orientations(units: np.ndarray) -> int:
     return len(kept)
 
 
+#: the norm method's nine unknowns are determined when the poses' directions leave no combination of the terms
+#: below nearly unseen: smallest singular value of their design, per pose (1/sqrt(3) for the six faces alone)
+MIN_NORM_SINGULAR = 0.02
+_NORM_TERMS = ("x*x", "y*y", "z*z", "x*y", "x*z", "y*z", "x", "y", "z")
+
+
+def undetermined_norm_term(units: np.ndarray, fixed: tuple[str, ...] = ()) -> str | None:
+    """The term (``"x*y"``, ...) of the norm method's linearized model that the pose directions (n, 3) leave
+    undetermined, or None when they determine all nine unknowns (all but the ``fixed`` terms).
+
+    Near the solution, |C (a - b)|^2 = g^2 changes with the unknowns through the terms u_i u_j (the six of
+    C^T C) and u_i (the bias) of each pose direction u; poses that never tilt between two axes (u_x u_y = 0
+    for all of them, as in a tumble about two axes only) leave that coupling undetermined.
+    """
+    x, y, z = np.asarray(units, dtype=float).T
+    keep = [k for k, name in enumerate(_NORM_TERMS) if name not in fixed]
+    design = np.column_stack([x * x, y * y, z * z, x * y, x * z, y * z, x, y, z])[:, keep]
+    if design.shape[0] < design.shape[1]:
+        return _NORM_TERMS[keep[int(np.argmin(np.abs(design).sum(axis=0)))]]
+    _, sing, vt = np.linalg.svd(design, full_matrices=False)
+    if sing[-1] / np.sqrt(design.shape[0]) >= MIN_NORM_SINGULAR:
+        return None
+    return _NORM_TERMS[keep[int(np.argmax(np.abs(vt[-1])))]]
+
+
+#: the element of theta (bias 3, then C's upper triangle row by row) each coupling term sets
+_COUPLING_INDEX = {"x*y": 4, "x*z": 5, "y*z": 7}
+
+
+def _fixed_couplings(poses: list[Pose], units: np.ndarray) -> tuple[str, ...]:
+    """The axis couplings the poses leave undetermined (fixed at zero, with a warning); refuses when a scale or
+    bias term is undetermined."""
+    fixed: tuple[str, ...] = ()
+    while (term := undetermined_norm_term(units, fixed)) is not None:
+        if term not in _COUPLING_INDEX:
+            raise InputError(f"poses: the {len(poses)} orientations leave the norm method's {term} term undetermined "
+                             f"(the poses do not vary the {term[0]} axis's share of gravity enough); add poses tilted "
+                             "between the axes, or use method='six-position'")
+        fixed += (term,)
+    if fixed:
+        pairs = ", ".join(f"{t[0]} and {t[2]}" for t in fixed)
+        warnings.warn(f"poses: no pose has gravity between the {pairs} axes; that misalignment is not determined and "
+                      "is taken as zero (add poses tilted between the axes to fit it)", DataQualityWarning, stacklevel=4)
+    return fixed
+
+
 def _axis_assignment(units: np.ndarray) -> np.ndarray:
     """Index 0..5 (+x, -x, +y, -y, +z, -z) of each pose's direction, -1 where no axis dominates."""
     axis = np.argmax(np.abs(units), axis=1)
@@ -258,8 +310,9 @@ def _sphere_start(means: np.ndarray, gravity_g: float) -> np.ndarray:
     return np.concatenate([centre, (gravity_g / radius) * np.eye(3)[np.triu_indices(3)]])
 
 
-def _propagate(fun, theta: np.ndarray, cov: np.ndarray) -> np.ndarray:
-    """Standard errors of fun(theta) by linear propagation (central differences)."""
+def propagate_stderr(fun, theta: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """Standard errors of fun(theta) given the covariance ``cov`` of theta, by linear propagation (central
+    differences)."""
     base = np.asarray(fun(theta), dtype=float).ravel()
     jac = np.empty((base.size, theta.size))
     for j in range(theta.size):
@@ -288,20 +341,30 @@ def _fit_norm(poses: list[Pose], means: np.ndarray, units: np.ndarray, gravity_g
     if distinct < MIN_POSES_NORM:
         raise InputError(f"poses: {distinct} distinct orientations (of {len(poses)} still poses); the norm method "
                          f"needs at least {MIN_POSES_NORM} (nine unknowns: bias, scale and misalignment)")
-    sol = optimize.least_squares(_norm_residuals, _sphere_start(means, gravity_g), jac=_norm_jacobian,
-                                 args=(means, gravity_g), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    theta = sol.x
+    fixed = _fixed_couplings(poses, units)
+    free = np.array([k for k in range(9) if k not in [_COUPLING_INDEX[t] for t in fixed]])
+    start = _sphere_start(means, gravity_g)
+
+    def full(t: np.ndarray) -> np.ndarray:
+        theta = start.copy()
+        theta[free] = t
+        return theta
+
+    sol = optimize.least_squares(lambda t: _norm_residuals(full(t), means, gravity_g), start[free],
+                                 jac=lambda t: _norm_jacobian(full(t), means, gravity_g)[:, free],
+                                 method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    theta = full(sol.x)
     sens = np.linalg.inv(_upper(theta)) if abs(np.linalg.det(_upper(theta))) > 1e-9 else np.full((3, 3), np.inf)
     if np.any(np.diag(_upper(theta)) <= 0) or np.max(np.abs(sens - np.eye(3))) > MAX_SENSITIVITY_ERROR:
         raise InputError(f"poses: the norm fit over {len(poses)} poses found no plausible triad (scale or "
                          f"misalignment beyond {MAX_SENSITIVITY_ERROR:.0%}); the orientations do not determine it")
-    dof = len(poses) - theta.size
+    dof = len(poses) - free.size
     red, variance = _residual_variance(float(np.sum(sol.fun ** 2)), dof,
                                        float(np.mean(_sigma_of_norm(poses, units) ** 2)))
-    jac = sol.jac
-    cov = np.linalg.pinv(jac.T @ jac) * variance
+    cov = np.zeros((9, 9))
+    cov[np.ix_(free, free)] = np.linalg.pinv(sol.jac.T @ sol.jac) * variance
     sens = lambda t: np.linalg.inv(_upper(t))  # noqa: E731
-    return theta[:3], sens(theta), np.sqrt(np.diag(cov))[:3], _propagate(sens, theta, cov).reshape(3, 3), red, dof, 0
+    return theta[:3], sens(theta), np.sqrt(np.diag(cov))[:3], propagate_stderr(sens, theta, cov).reshape(3, 3), red, dof, 0
 
 
 def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray):
@@ -358,7 +421,9 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
     if method == "auto":
         six = bool(np.all(np.isin(np.arange(6), _axis_assignment(units))))
         distinct = distinct_orientations(units)
-        method = "norm" if distinct >= AUTO_NORM_POSES or (not six and distinct >= MIN_POSES_NORM) else "six-position"
+        norm_possible = undetermined_norm_term(units) is None or not six
+        method = "norm" if norm_possible and (distinct >= AUTO_NORM_POSES or (not six and distinct >= MIN_POSES_NORM)) \
+            else "six-position"
     if method == "norm":
         bias, sens, bias_se, sens_se, red, dof, left = _fit_norm(poses, means, units, gravity_g)
     else:
@@ -564,5 +629,5 @@ def rq_upper(sensitivity: np.ndarray) -> np.ndarray:
 
 
 __all__ = ["AUTO_NORM_POSES", "MIN_POSES_NORM", "Pose", "PoseFit", "PoseMethod", "RateSegment", "RateTableFit",
-           "distinct_orientations", "find_poses", "spans_axes", "fit_accel_multiposition", "fit_gyro_rate_table", "rate_segments",
-           "rq_upper"]
+           "distinct_orientations", "find_poses", "spans_axes", "fit_accel_multiposition", "fit_gyro_rate_table", "propagate_stderr", "rate_segments",
+           "rq_upper", "undetermined_norm_term"]
