@@ -8,11 +8,14 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import fit_calibration
+from gyrocomp import Calibration, find_poses, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.simulate import GyroErrorModel, simulate
-from ..conftest import run
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.units import STANDARD_GRAVITY_M_PER_S2 as G0
+
+from ..conftest import run, xsens_session
 
 RAD_TO_DEG = 180.0 / math.pi
 
@@ -121,8 +124,6 @@ def test_cli_export(tmp_path):
 
 
 def test_accelerometer_parameters_reproduce_the_accelerometer_model():
-    from gyrocomp.models.pipelines import fit_channels
-
     runs = [simulate("consumer", profile="cycle", rate_hz=0.5, seed=s).recording for s in range(2)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -141,3 +142,30 @@ def test_accelerometer_parameters_reproduce_the_accelerometer_model():
         # a cubic model: exact to the float32 / 9-digit rounding of the parameter files
         np.testing.assert_allclose(theirs_px4, ours_g, atol=2e-6)
         np.testing.assert_allclose(theirs_ardu, ours_g, atol=2e-6)
+
+
+def test_accelerometer_offsets_and_scales_from_a_multi_position_calibration(tmp_path):
+    """imu_tk's Xsens session: the autopilots' (raw - offset) * scale [m/s^2] reproduces the triad's correction on
+    its poses to its misalignment (a few mrad of 1 g), and the CLI writes them from the model file."""
+    rec = xsens_session()
+    cal = fit_channels(rec, ("accel",))
+    triad = cal.accel_triad
+    off_diagonal = np.max(np.abs(np.asarray(triad.sensitivity) - np.diag(np.diag(triad.sensitivity))))
+    with pytest.warns(DataQualityWarning, match=r"accelerometer misalignment \(up to .* mrad; its offsets and scales"):
+        px4 = _read_px4(px4_params_file(cal, device_id=5))
+    with pytest.warns(DataQualityWarning, match="accelerometer misalignment"):
+        ardu = _read_ardupilot(ardupilot_params_file(cal, instance=2))
+    raw = np.array([p.accel_g for p in find_poses(rec)])
+    ours = triad.correct(raw) * G0
+    for offsets, scales in ((np.array([px4[f"CAL_ACC0_{a}OFF"] for a in "XYZ"]),
+                             np.array([px4[f"CAL_ACC0_{a}SCALE"] for a in "XYZ"])),
+                            (np.array([ardu[f"INS_ACC2OFFS_{a}"] for a in "XYZ"]),
+                             np.array([ardu[f"INS_ACC2SCAL_{a}"] for a in "XYZ"]))):
+        theirs = (raw * G0 - offsets) * scales
+        assert np.max(np.abs(theirs - ours)) < 2 * off_diagonal * G0 + 1e-5  # float32 in the PX4 file
+    assert px4["CAL_ACC0_ID"] == 5 and not any(k.startswith("INS_TCAL") for k in ardu)
+    cal.save(tmp_path / "accel.json")
+    r = run("export", tmp_path / "accel.json", "--format", "ardupilot", "-o", tmp_path / "acc.parm")
+    assert r.returncode == 0, r.stderr
+    assert _read_ardupilot((tmp_path / "acc.parm").read_text())["INS_ACCOFFS_X"] == pytest.approx(ardu["INS_ACC2OFFS_X"])
+    assert Calibration.load(tmp_path / "accel.json").accel_triad == triad

@@ -10,7 +10,12 @@ Both autopilots correct the gyro bias with a cubic in temperature, in rad/s, and
 
 When the model compensates the accelerometer too (``fit --channels gyro,accel``), its axes are written the
 same way in m/s^2: PX4 ``TC_A{i}_*`` (relative to TREF: the accelerometer's constant stays with its ordinary
-calibration), ArduPilot ``INS_TCAL{n}_ACC{1,2,3}_{X,Y,Z}``.
+calibration), ArduPilot ``INS_TCAL{n}_ACC{1,2,3}_{X,Y,Z}``. An accelerometer triad (multi-position
+calibration) is that ordinary calibration: both autopilots correct (raw - offset) * scale per axis, PX4 with
+``CAL_ACC{i}_{X,Y,Z}OFF`` [m/s^2] and ``CAL_ACC{i}_{X,Y,Z}SCALE`` (``sensors/.../Calibration::Correct``),
+ArduPilot with ``INS_ACC{,2,3}OFFS_{X,Y,Z}`` [m/s^2] and ``INS_ACC{,2,3}SCAL_{X,Y,Z}``; the offsets are the
+triad's bias and the scales 1 / K_ii, and the misalignment (off-diagonal K) is left out with a warning, as is
+the gyro's scale factor and misalignment, which neither autopilot holds.
 
 gyrocomp's temperature curve (a polynomial of any order, or a network) is converted to that cubic by
 least squares on a dense grid over the model's range; the largest difference is reported, and is zero
@@ -78,20 +83,37 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
         parts.append("hysteresis")
     if any(ax.needs_accel for ax in calibration.axes.values()):
         parts.append("g-sensitivity")
-    if calibration.gyro_triad is not None or calibration.accel_triad is not None:
-        parts.append("scale-factor and misalignment")
+    if calibration.gyro_triad is not None:
+        parts.append("gyro scale-factor and misalignment")
+    triad = calibration.accel_triad
+    if triad is not None:
+        k = np.asarray(triad.sensitivity, dtype=float)
+        off = float(np.max(np.abs(k - np.diag(np.diag(k)))))
+        if off > 0:
+            parts.append(f"accelerometer misalignment (up to {off * 1e3:.2g} mrad; its offsets and scales are written)")
+        if triad.sensitivity_per_degc:
+            parts.append("accelerometer scale-factor temperature dependence")
     if parts:
         warnings.warn(f"{target} has no {' or '.join(parts)} term: left out of the export, only the temperature cubic "
-                      "is written (compare the stages of the evaluation to see what that costs)",
-                      DataQualityWarning, stacklevel=3)
+                      "and the accelerometer's offsets and scales are written (compare the stages of the evaluation "
+                      "to see what that costs)", DataQualityWarning, stacklevel=3)
+
+
+def accel_offsets_and_scales(calibration: Calibration) -> tuple[np.ndarray, np.ndarray] | None:
+    """The accelerometer triad as the autopilots hold it, corrected = (raw - offset) * scale per axis: offsets
+    [m/s^2] (the triad's bias) and scales (1 / K_ii: misalignment has no place there), or None without a triad."""
+    triad = calibration.accel_triad
+    if triad is None:
+        return None
+    return np.asarray(triad.bias, dtype=float) * G_TO_M_PER_S2, 1.0 / np.diag(np.asarray(triad.sensitivity, dtype=float))
 
 
 def _gyro_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
     """The gyro axes with a temperature curve (refused when neither they nor accelerometer axes exist)."""
     axes = {name: ax for name, ax in calibration.axes.items() if name in AXIS_INDEX and ax.temperature is not None}
-    if not axes and not _accel_axes(calibration):
-        raise InputError("export: the model has no gyro or accelerometer axis with a temperature curve; "
-                         "nothing to export")
+    if not axes and not _accel_axes(calibration) and calibration.accel_triad is None:
+        raise InputError("export: the model has no gyro or accelerometer axis with a temperature curve and no "
+                         "accelerometer calibration; nothing to export")
     return axes
 
 
@@ -137,6 +159,14 @@ def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: in
             values[f"{p}SCL_{j}"] = 1.0
             if fit:
                 fits[name] = fit
+    triad = accel_offsets_and_scales(calibration)
+    if triad is not None:
+        p = f"CAL_ACC{instance}_"
+        values[f"{p}ID"] = int(device_id)
+        for j, axis in enumerate("XYZ"):
+            values[f"{p}{axis}OFF"] = float(triad[0][j])
+        for j, axis in enumerate("XYZ"):
+            values[f"{p}{axis}SCALE"] = float(triad[1][j])
     return AutopilotParameters(values, fits)
 
 
@@ -147,10 +177,18 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
         raise InputError(f"instance: ArduPilot numbers its IMUs 1..3, got {instance}")
     _warn_left_out(calibration, "ArduPilot")
     gyro, accel = _gyro_axes(calibration), _accel_axes(calibration)
+    values: dict[str, float] = {}
+    fits = {}
+    triad = accel_offsets_and_scales(calibration)
+    if triad is not None:  # INS_ACCOFFS_X for the first IMU, INS_ACC2OFFS_X for the second, ...
+        n = "" if instance == 1 else str(instance)
+        values.update({f"INS_ACC{n}OFFS_{a}": float(triad[0][j]) for j, a in enumerate("XYZ")})
+        values.update({f"INS_ACC{n}SCAL_{a}": float(triad[1][j]) for j, a in enumerate("XYZ")})
+    if not gyro and not accel:
+        return AutopilotParameters(values, fits)
     t_min, t_max = _range({**gyro, **accel})
     p = f"INS_TCAL{instance}_"
-    values: dict[str, float] = {f"{p}ENABLE": 1, f"{p}TMIN": t_min, f"{p}TMAX": t_max}
-    fits = {}
+    values.update({f"{p}ENABLE": 1, f"{p}TMIN": t_min, f"{p}TMAX": t_max})
     for sensor, axes, index, to_si in (("ACC", accel, ACCEL_INDEX, G_TO_M_PER_S2), ("GYR", gyro, AXIS_INDEX, DEG_TO_RAD)):
         for name, j in index.items():
             fit = cubic_of(axes[name], ARDUPILOT_TEMP_REFERENCE_DEGC, with_constant=False, to_si=to_si) \
@@ -195,5 +233,5 @@ def ardupilot_params_file(calibration: Calibration, **options) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["AutopilotParameters", "CubicFit", "ardupilot_parameters", "ardupilot_params_file", "cubic_of",
+__all__ = ["AutopilotParameters", "CubicFit", "accel_offsets_and_scales", "ardupilot_parameters", "ardupilot_params_file", "cubic_of",
            "px4_parameters", "px4_params_file"]
