@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from gyrocomp import Calibration, apply
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io.tables import write_recording
 from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.report.html import _pose_residuals, build_report
 from gyrocomp.models.pose_rotation import (fit_gyro_between_poses, ordered_product, quaternion_from_rotvec,
                                            rotation_errors, rotation_matrix)
 from gyrocomp.simulate import AccelErrorModel, get_profile, preset_model, simulate
@@ -128,3 +130,18 @@ def test_cli_fits_the_scale_factor_from_a_turned_session(tmp_path):
     assert result.returncode == 0, result.stderr
     assert "gyro scale factor and misalignment (rotation" in result.stdout
     assert Calibration.load(tmp_path / "model.json").gyro_triad.method == "rotation"
+
+
+def test_report_draws_the_scale_factor_and_the_residual_of_each_pose_and_turn():
+    part = dataclasses.replace(PART, scale_factor_error_ppm=(10000.0, -8000.0, 6000.0))
+    rec = _session(7, part=part)
+    cal = fit_channels([rec], ("gyro", "accel"), hysteresis="none")  # one temperature: the triads alone
+    assert cal.gyro_triad.method == "rotation" and cal.accel_triad.method == "six-position" and not cal.accel_axes
+    residuals = _pose_residuals(cal, [rec], [apply(cal, rec)])
+    before, after = residuals["accelerometer |a| - 1 g [mg]"]
+    assert len(before) == 34 and np.max(np.abs(before)) > 5 and np.max(np.abs(after)) < 0.5  # 3-5 mg bias, 0.4 % scale
+    before, after = residuals["gyro: gravity direction after each turn [deg]"]
+    assert len(before) == 33 and np.sqrt(np.mean(after ** 2)) < 0.1 < np.sqrt(np.mean(before ** 2))
+    report = build_report(cal, [rec])
+    assert "scale-factor" in report.sections and "+10000" not in report.html  # the fitted error, not the truth
+    assert re.search(r"gyro x</td><td[^>]*>rotation</td><td[^>]*>\+1\.0(09|10|11)", report.html)

@@ -543,8 +543,12 @@ def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
     if split and options.get("hysteresis", "auto") == "auto":
         options = {**options, "hysteresis": "none"}
     fitted = fit_calibration(pieces, acceleration="none", run_folds=folds, **options)
-    t_min = min(ax.temperature.t_min_degc for ax in fitted.axes.values())
-    t_max = max(ax.temperature.t_max_degc for ax in fitted.axes.values())
+    curves = [ax.temperature for ax in fitted.axes.values() if ax.temperature is not None]
+    if not curves:
+        raise InputError("channels=accel: no temperature model of the accelerometer generalizes across these runs "
+                         "(every axis is left a constant); their temperatures do not span enough to fit one")
+    t_min = min(c.t_min_degc for c in curves)
+    t_max = max(c.t_max_degc for c in curves)
     return Calibration(axes={}, model=f"accel {fitted.model}", provenance=provenance(recordings),
                        fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}},
                        accel_axes=fitted.axes, accel_reference_degc=0.5 * (t_min + t_max))
@@ -616,8 +620,13 @@ def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibratio
     with_temperature = all(r.temperature_degc is not None for r in recordings)
     accel_cal = None
     if with_temperature:
-        accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
-        recordings = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
+        try:
+            accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
+        except InputError:
+            if _spanning_poses(recordings) is None:  # a multi-position session at one temperature: the triad alone
+                raise
+        if accel_cal is not None:
+            recordings = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
     poses = _spanning_poses(recordings)
     if poses is None:
         if accel_cal is None:

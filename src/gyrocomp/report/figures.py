@@ -298,3 +298,44 @@ def g_sensitivity_plot(positions: dict, g_matrix: dict, title: str = "g-sensitiv
     fig.suptitle(f"{title} (other axes' terms removed from each panel's points)", fontsize="medium")
     fig.tight_layout()
     return fig
+
+
+def triad_plot(triads: dict, temperature_range_degc: tuple[float, float] | None, poses: dict,
+               title: str = "Scale factor and misalignment"):
+    """Left: each triad's scale-factor error (diagonal of K(T) - I) [ppm] against temperature over
+    ``temperature_range_degc`` [degC] (a constant K: flat lines), with its standard error band at the reference.
+    Right: the residual of each still pose or turn before and after the calibration: ``poses`` maps a label
+    (e.g. "accelerometer |a| - 1 g [mg]") to (before (m,), after (m,)).
+
+    ``triads``: name ("gyro", "accelerometer") -> TriadCalibration."""
+    plt = _pyplot()
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11.0, 3.6))
+    lo, hi = temperature_range_degc or (20.0, 30.0)
+    grid = np.linspace(lo, hi, 50)
+    styles = {"gyro": "-", "accelerometer": "--"}
+    for name, triad in triads.items():
+        k = triad.sensitivity_at(grid) if triad.sensitivity_per_degc else np.broadcast_to(
+            np.asarray(triad.sensitivity, dtype=float), (grid.size, 3, 3))
+        se = np.diag(np.asarray(triad.sensitivity_stderr, dtype=float))
+        for j, colour in enumerate(("tab:red", "tab:green", "tab:blue")):
+            error_ppm = (k[:, j, j] - 1.0) * 1e6
+            left.plot(grid, error_ppm, styles.get(name, "-"), color=colour, label=f"{name} {'xyz'[j]}")
+            left.fill_between(grid, error_ppm - se[j] * 1e6, error_ppm + se[j] * 1e6, color=colour, alpha=0.15)
+    left.set_xlabel("temperature [degC]")
+    left.set_ylabel("scale-factor error [ppm]")
+    left.grid(True, alpha=0.3)
+    left.legend(fontsize="x-small", loc="best")
+    for (label, (before, after)), marker, colour in zip(poses.items(), ("o", "s"), (COMP_COLOUR, "tab:orange")):
+        index = np.arange(len(before))
+        right.plot(index, before, marker, ms=4, color=RAW_COLOUR, mfc="none", label=f"{label}, raw")
+        right.plot(index, after, marker, ms=4, color=colour, label=f"{label}, calibrated")
+    right.set_xlabel("pose or turn (in recording order)")
+    right.set_ylabel("residual (unit in the legend)")
+    right.grid(True, alpha=0.3)
+    if poses:
+        right.legend(fontsize="x-small", loc="best")
+    else:
+        right.text(0.5, 0.5, "no still poses in these runs", ha="center", va="center", transform=right.transAxes)
+    fig.suptitle(title, fontsize="medium")
+    fig.tight_layout()
+    return fig

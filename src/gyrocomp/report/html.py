@@ -7,13 +7,16 @@ valid ranges, validation scores, the candidates compared), ``validation`` when a
 plain cubic and gyrocomp's default, as ``gyrocomp validate`` prints it), ``evaluation`` (the thesis's figures of merit,
 by stage when the model has stages), one ``axis-<name>`` per axis (bias against temperature with the
 heating and cooling branches, fitted curve, turning points and residual; raw and compensated output
-against time), ``allan`` (raw and compensated Allan deviation per run), and ``g-sensitivity`` when the
-model has a g-sensitivity matrix.
+against time), ``allan`` (raw and compensated Allan deviation per run), ``g-sensitivity`` when the
+model has a g-sensitivity matrix, and ``scale-factor`` when it has a gyro or accelerometer triad (K with standard
+errors, scale-factor error against temperature, and the residual of each still pose (|a| - 1 g) and each turn
+between poses (the gravity direction the gyro predicts) before and after).
 """
 
 from __future__ import annotations
 
 import base64
+import dataclasses
 import datetime as _dt
 import html
 import io
@@ -26,12 +29,15 @@ import numpy as np
 from .._version import __version__
 from ..calibration import Calibration
 from ..compensate import apply
-from ..errors import DataQualityWarning, TemperatureRangeWarning
+from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..evaluation import evaluate_stages, stage_calibrations
 from ..metrics import default_window_s, evaluate_run
 from ..noise import analyse_noise
-from ..recording import ACCEL_AXES, Recording
+from ..models.pose_rotation import rotation_errors
+from ..models.triad_fit import find_poses, spans_axes
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..static import static_segments
+from ..triad import TriadCalibration
 from ..validation import ValidationResult
 from . import figures
 
@@ -225,6 +231,63 @@ def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: 
     return result
 
 
+#: the identity triad: rotation_errors through it measures the turns of data as given
+_IDENTITY_TRIAD = TriadCalibration(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0), "rotation",
+                                   ((0.0, 0.0, 0.0),) * 3, (0.0, 0.0, 0.0), "deg/s")
+
+
+def _pose_residuals(calibration: Calibration, runs: list[Recording], compensated: list[Recording]) -> dict:
+    """Label -> (before, after) per still pose (accelerometer: |a| - 1 g [mg]) and per turn between poses (gyro
+    triad: error of the gravity direction the gyro predicts [deg]) of the runs that are multi-position sessions."""
+    out = {}
+    norms: tuple[list, list] = ([], [])
+    turns: tuple[list, list] = ([], [])
+    for rec, comp in zip(runs, compensated):
+        if rec.accel_g is None or rec.accel_g.shape[1] != 3:
+            continue
+        poses = find_poses(rec)
+        if len(poses) < 6 or not spans_axes(poses):
+            continue
+        if calibration.accel_triad is not None and comp.accel_g is not None:
+            for p in poses:
+                norms[0].append((np.linalg.norm(p.accel_g) - 1.0) * 1e3)
+                norms[1].append((np.linalg.norm(comp.accel_g[p.start_index:p.stop_index].mean(axis=0)) - 1.0) * 1e3)
+        if calibration.gyro_triad is not None and rec.gyro_axes == GYRO_AXES:
+            try:
+                raw, fixed = (rotation_errors(r, _IDENTITY_TRIAD, accel_calibration=calibration.accel_triad)
+                              for r in (rec, dataclasses.replace(rec, gyro_dps=comp.gyro_dps)))
+            except InputError:
+                continue
+            turns[0].extend(m.error_after_deg for m in raw)
+            turns[1].extend(m.error_after_deg for m in fixed)
+    if norms[0]:
+        out["accelerometer |a| - 1 g [mg]"] = (np.array(norms[0]), np.array(norms[1]))
+    if turns[0]:
+        out["gyro: gravity direction after each turn [deg]"] = (np.array(turns[0]), np.array(turns[1]))
+    return out
+
+
+def _triads(calibration: Calibration, runs: list[Recording], compensated: list[Recording]) -> str:
+    """The scale-factor section: each triad's K with standard errors, its scale-factor error against
+    temperature and the residual per pose or turn."""
+    triads = {name: t for name, t in (("gyro", calibration.gyro_triad), ("accelerometer", calibration.accel_triad))
+              if t is not None}
+    rows = []
+    for name, triad in triads.items():
+        for i, axis in enumerate("xyz"):
+            rows.append([f"{name} {axis}", triad.method]
+                        + [f"{k:+.6f} +- {e:.1g}" for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i])]
+                        + [f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g} {triad.unit}"])
+    temps = [rec.temperature_degc for rec in runs if rec.temperature_degc is not None]
+    span = (float(min(np.min(t) for t in temps)), float(max(np.max(t) for t in temps))) if temps else None
+    body = [_table(["triad", "method", "K column x", "K column y", "K column z", "scale error [ppm]", "bias"], rows,
+                   "raw = K(T) v + bias, corrected v = K(T)^-1 (raw - bias); K at the reference temperature "
+                   "+- standard error"),
+            _img(figures.triad_plot(triads, span, _pose_residuals(calibration, runs, compensated)),
+                 "scale-factor error against temperature, residual per pose")]
+    return "\n".join(body)
+
+
 def build_report(calibration: Calibration, runs: list[Recording], *, window_s: float | None = None,
                  turn_on_window_s: float | None = None, min_static_s: float = 10.0,
                  progress: Callable[[float], None] | None = None,
@@ -307,6 +370,8 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
             else:
                 body.append("<p class=note>These runs have no static positions to draw.</p>")
             sections["g-sensitivity"] = ("g-sensitivity", "\n".join(body))
+        if calibration.gyro_triad is not None or calibration.accel_triad is not None:
+            sections["scale-factor"] = ("Scale factor and misalignment", _triads(calibration, runs, compensated))
         tick()
     created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     nav = " ".join(f'<a href="#{sid}">{html.escape(title)}</a>' for sid, (title, _) in sections.items())
