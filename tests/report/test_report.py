@@ -82,7 +82,9 @@ def test_three_axis_report_with_acceleration_and_accelerometer():
     progress = []
     report = build_report(cal, [runs[2]], progress=progress.append)
     axes = [f"axis-{a}" for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")]
-    assert report.sections == ("summary", "evaluation", *axes, "allan", "g-sensitivity")
+    # the combined profile visits the six faces: the accelerometer triad gets its section too
+    assert cal.accel_triad is not None
+    assert report.sections == ("summary", "evaluation", *axes, "allan", "g-sensitivity", "scale-factor")
     _check_page(report.html, list(report.sections))
     assert "g-sensitivity matrix G [deg/s/g] +- standard error" in report.html
     assert "temperature + acceleration" in report.html and "accelerometer" in report.html

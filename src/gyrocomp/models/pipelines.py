@@ -27,7 +27,7 @@ from .acceleration import (
 )
 from .base import bin_width_for, block_means, one_temperature_column, provenance
 from .hysteresis import heats_and_cools
-from .pose_rotation import fit_gyro_between_poses
+from .pose_rotation import TooFewTurns, fit_gyro_between_poses
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
@@ -595,6 +595,8 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCa
         except InputError as exc:
             if scale_factor == "matrix":
                 raise
+            if isinstance(exc, TooFewTurns):  # the turns were not recorded: nothing to say
+                return None, recordings
             warnings.warn(f"scale factor not fitted from the multi-position runs: {exc}", DataQualityWarning, stacklevel=3)
             return None, recordings
     rest = [r for r in recordings if r.reference_rate_dps is None]

@@ -45,6 +45,11 @@ GAP_FACTOR = 5.0
 MAX_SENSITIVITY_ERROR = 0.5
 
 
+class TooFewTurns(InputError):
+    """The recordings hold fewer recorded turns between still poses than the fit needs (a session recorded
+    only while still, or not a multi-position session)."""
+
+
 @dataclass(frozen=True)
 class PoseMove:
     """One turn between two consecutive still poses.
@@ -294,7 +299,7 @@ def _prepare(recordings: list[Recording] | Recording, accel_calibration: TriadCa
         coefs.append(coef)
         moves += _session_moves(rec, poses, coef, t_mean, _directions(poses, accel))
     if len(moves) < 5:
-        raise InputError(f"moves between poses: {len(moves)} found; the gyro's scale factor and misalignment (nine "
+        raise TooFewTurns(f"moves between poses: {len(moves)} found; the gyro's scale factor and misalignment (nine "
                          "unknowns, two equations per move) need at least 5 turns between still poses")
     return _Session(all_poses, accel, coefs, _pad(moves))
 
@@ -361,5 +366,5 @@ def rotation_errors(recordings: list[Recording] | Recording, gyro_calibration: T
     return _move_table(session.moves, correction)
 
 
-__all__ = ["PoseMove", "RotationFit", "fit_gyro_between_poses", "ordered_product", "quaternion_from_rotvec",
+__all__ = ["PoseMove", "RotationFit", "TooFewTurns", "fit_gyro_between_poses", "ordered_product", "quaternion_from_rotvec",
            "quaternion_multiply", "rotation_errors", "rotation_matrix"]
