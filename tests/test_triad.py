@@ -124,6 +124,37 @@ def test_too_few_or_one_sided_poses_are_refused_naming_what_is_missing():
         find_poses(rec)
 
 
+#: a consumer part whose accelerometer's scale and misalignment change with temperature: 15-30 ppm/degC
+ACCEL_TEMPCO = ((2e-5, 2e-6, 0.0), (0.0, -1.5e-5, -3e-6), (1e-6, 0.0, 3e-5))
+DRIFTING = dataclasses.replace(preset_model("consumer"), accelerometer=dataclasses.replace(
+    preset_model("consumer").accelerometer, scale_misalignment=ACCEL.scale_misalignment,
+    scale_misalignment_per_degc=ACCEL_TEMPCO))
+
+
+def test_accelerometer_triad_over_temperature_recovers_dk_dt_and_holds_on_another_run():
+    """The combined profile (six faces visited through -20..70 degC): K(T) and its temperature coefficients within
+    3 standard errors; on another run the norm of gravity per pose is 1 g within 1.3e-4 g RMS (measured), 7.6e-4 g
+    with K held constant, 0.03 g raw."""
+    cal = fit_channels(simulate(DRIFTING, profile="combined", rate_hz=1, seed=0).recording, ("accel",))
+    triad = cal.accel_triad
+    assert triad.method == "six-position" and triad.temperature_order == 1 and cal.accel_axes
+    _within(triad.sensitivity_per_degc[0], triad.sensitivity_per_degc_stderr[0], ACCEL_TEMPCO)
+    at_reference = ACCEL.sensitivity + np.asarray(ACCEL_TEMPCO) * (triad.reference_degc - DRIFTING.t_ref_degc)
+    _within(triad.sensitivity, triad.sensitivity_stderr, at_reference)
+    constant = dataclasses.replace(cal, accel_triad=dataclasses.replace(
+        triad, sensitivity_per_degc=(), sensitivity_per_degc_stderr=(), reference_degc=None))
+    other = simulate(DRIFTING, profile="combined", rate_hz=1, seed=5).recording
+
+    def norm_rms_g(calibration):
+        out = apply(calibration, other).accel_g
+        return np.sqrt(np.mean([(np.linalg.norm(out[p.start_index:p.stop_index].mean(axis=0)) - 1.0) ** 2
+                                for p in find_poses(other)]))
+
+    assert norm_rms_g(cal) < 2.5e-4 and norm_rms_g(cal) < norm_rms_g(constant) / 3
+    with pytest.raises(InputError, match="temperature_order: the norm method fits K constant"):
+        fit_accel_multiposition(find_poses(other), method="norm", temperature_order=1)
+
+
 # -- accelerometer, real sessions -------------------------------------------------------------------------
 def test_six_position_equals_imucal_ferraris_on_its_annotated_session():
     """imucal's regression snapshot (tests/snapshots/example_cal.json, mad-lab-fau/imucal, MIT) for this session:

@@ -140,8 +140,19 @@ class Compensator:
         accel_g = self._compensate_accel(time_s, temperature_degc, accel_g)
         if accel_g is not None and self.compensates_accel:
             triad = self.calibration.accel_triad
-            self._accel_out.append(accel_g if triad is None else triad.correct(accel_g))
+            if triad is None:
+                self._accel_out.append(accel_g)
+            else:
+                self._accel_out.append(triad.correct(accel_g, self._triad_temperature(triad, temperature_degc)))
         return accel_g
+
+    def _triad_temperature(self, triad, temperature_degc: np.ndarray | None) -> np.ndarray | None:
+        """The temperature a triad's K(T) reads [degC] (the mean of several columns), None when K is constant."""
+        if not triad.temperature_order:
+            return None
+        if temperature_degc is None:
+            raise InputError(f"{self.source}: the model's scale factor depends on temperature; the data has none")
+        return temperature_degc if temperature_degc.ndim == 1 else temperature_degc.mean(axis=1)
 
     @property
     def compensates_accel(self) -> bool:
@@ -188,13 +199,8 @@ class Compensator:
             residual[:, j] -= self._constants[k]
         triad = self.calibration.gyro_triad
         if triad is not None and residual.shape[0]:
-            t = None
-            if triad.temperature_order:
-                if temperature_degc is None:
-                    raise InputError(f"{self.source}: the model's scale factor depends on temperature; the data has none")
-                t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc.mean(axis=1)
             cols = self._triad_columns
-            residual[:, cols] = triad.correct(residual[:, cols], t)
+            residual[:, cols] = triad.correct(residual[:, cols], self._triad_temperature(triad, temperature_degc))
         return residual
 
     def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None = None,

@@ -31,7 +31,8 @@ from .pose_rotation import TooFewTurns, fit_gyro_between_poses
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
-from .triad_fit import Pose, find_poses, fit_accel_multiposition, fit_gyro_rate_table, spans_axes
+from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
+                        spans_axes)
 from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 
 #: how the fit report names each kind of fold
@@ -615,6 +616,38 @@ def _spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
     return poses if len(poses) >= 6 and spans_axes(poses) else None
 
 
+def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[PoseFit, Calibration | None]:
+    """The accelerometer triad from the (temperature-compensated) poses, and the temperature models it completes.
+
+    Where the poses span temperatures (a six-face session through a temperature profile), the six-position fit
+    takes a linear bias drift alongside K(T): what the per-axis temperature models left of the bias's slope
+    (they take the bias to be the same in every pose, so a scale factor changing with temperature, which moves
+    each axis by dK/dT f (T - T_ref), leaves them a slope error of its mean over the poses).
+    That slope is added to the polynomial temperature models (exact: the correction is a difference from the
+    reference temperature) and the triad's bias is moved to their reference, so the compensation is whole."""
+    temps = [p.temperature_degc for p in poses]
+    if accel_cal is None or any(t is None for t in temps) or np.ptp(temps) < MIN_TRIAD_SPAN_DEGC:
+        return fit_accel_multiposition(poses), accel_cal
+    try:
+        fit = fit_accel_multiposition(poses, method="six-position", bias_temperature_order=1)
+    except InputError:
+        return fit_accel_multiposition(poses), accel_cal
+    triad = fit.calibration
+    t_six = float(np.round(0.5 * (min(temps) + max(temps)), 1))
+    slope = fit.bias_drift_g[0]
+    axes = dict(accel_cal.accel_axes)
+    for j, name in enumerate(ACCEL_AXES):
+        curve = None if name not in axes else axes[name].temperature
+        if not isinstance(curve, PolynomialBias):
+            return fit_accel_multiposition(poses), accel_cal  # a network cannot take the slope: K constant
+        coefficients = list(curve.coefficients_dps) or [0.0]
+        coefficients[0] += slope[j] * curve.t_scale_degc
+        axes[name] = dataclasses.replace(axes[name], temperature=dataclasses.replace(curve, coefficients_dps=tuple(coefficients)))
+    bias = np.asarray(triad.bias) + slope * (accel_cal.accel_reference_degc - t_six)
+    fit = dataclasses.replace(fit, calibration=dataclasses.replace(triad, bias=tuple(float(b) for b in bias)))
+    return fit, dataclasses.replace(accel_cal, accel_axes=axes)
+
+
 def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibration:
     """The accelerometer: temperature models where the runs have a temperature, then bias, scale and
     misalignment from the still poses (of the temperature-compensated accelerations) where the runs turn every
@@ -635,10 +668,11 @@ def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibratio
             raise InputError("channels=accel: the runs have no temperature (for a temperature model) and do not turn "
                              "every accelerometer axis up and down (for a multi-position calibration)")
         return accel_cal
-    fit = fit_accel_multiposition(poses)
+    fit, accel_cal = _accel_triad(poses, accel_cal)
     report = {"accel_triad": {"method": fit.calibration.method, "poses": len(poses),
                               "norm_rms_before_g": fit.norm_rms_error_before_g, "norm_rms_after_g": fit.norm_rms_error_g,
-                              "degrees_of_freedom": fit.degrees_of_freedom}}
+                              "degrees_of_freedom": fit.degrees_of_freedom,
+                              "temperature_order": fit.calibration.temperature_order}}
     if accel_cal is None:
         return Calibration(axes={}, model=f"accel {fit.calibration.method}", provenance=provenance(recordings),
                            fit_report=report, accel_triad=fit.calibration)

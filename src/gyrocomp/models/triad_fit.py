@@ -21,7 +21,7 @@ below what the poses' own noise (standard error of each mean) allows.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -43,6 +43,10 @@ AXIS_ALIGNED_FRACTION = 0.985
 SPAN_FRACTION = 0.5
 #: poses whose gravity directions are closer than this are one orientation (cosine of 10 deg)
 SAME_DIRECTION_COS = 0.985
+#: the lowest order whose held-out error is within this factor of the best is chosen (parsimony)
+ORDER_TOLERANCE = 1.05
+#: poses spanning at least this many degC may give K(T) (six-position method)
+MIN_TRIAD_SPAN_DEGC = 5.0
 #: a fitted K further than this from I (any element) is no sensor's: the poses did not determine it
 MAX_SENSITIVITY_ERROR = 0.5
 DEFAULT_POSE_MIN_S = 1.0
@@ -149,6 +153,9 @@ class PoseFit:
         Poses the six-position method could not assign to an axis direction.
     gravity_g : float
         The norm the poses were fitted to [g].
+    bias_drift_g : array (order, 3)
+        With ``bias_temperature_order``: coefficients of (T - reference_degc)^p, p = 1..order, of the bias
+        drift fitted alongside [g/degC^p] (empty otherwise).
     """
 
     calibration: TriadCalibration
@@ -159,6 +166,7 @@ class PoseFit:
     degrees_of_freedom: int
     poses_left_out: int = 0
     gravity_g: float = 1.0
+    bias_drift_g: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def norm_rms_error_g(self) -> float:
@@ -367,7 +375,44 @@ def _fit_norm(poses: list[Pose], means: np.ndarray, units: np.ndarray, gravity_g
     return theta[:3], sens(theta), np.sqrt(np.diag(cov))[:3], propagate_stderr(sens, theta, cov).reshape(3, 3), red, dof, 0
 
 
-def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray):
+def _six_position_design(d: np.ndarray, temperatures: np.ndarray | None, order: int, t_ref: float,
+                         bias_order: int = 0) -> np.ndarray:
+    """Columns: the direction (3), then (T - t_ref)^p times it for p = 1..order, then 1 (the bias), then
+    (T - t_ref)^p for p = 1..bias_order (a bias still drifting with temperature)."""
+    blocks = [d] + [d * ((temperatures - t_ref) ** p)[:, None] for p in range(1, order + 1)]
+    drift = [(temperatures - t_ref) ** p for p in range(1, bias_order + 1)]
+    return np.column_stack(blocks + [np.ones(d.shape[0])] + drift)
+
+
+def _press(x: np.ndarray, y: np.ndarray) -> float:
+    """Leave-one-pose-out prediction error sum of squares of a linear least-squares fit (hat-matrix form)."""
+    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+    hat = np.einsum("ij,jk,ik->i", x, np.linalg.pinv(x.T @ x), x)
+    if np.any(hat > 1 - 1e-9):
+        return float("inf")
+    return float(np.sum(((y - x @ coef) / (1.0 - hat)[:, None]) ** 2))
+
+
+def _six_position_order(d: np.ndarray, y: np.ndarray, temperatures: np.ndarray | None, t_ref: float,
+                        temperature_order: int | Literal["auto"], bias_order: int) -> int:
+    """0 (K constant) or 1 (K linear in temperature): as asked, or by leave-one-pose-out error when the poses
+    span MIN_TRIAD_SPAN_DEGC (the lowest order within 5 % of the best)."""
+    span = 0.0 if temperatures is None else float(np.ptp(temperatures))
+    if temperature_order == "auto":
+        if span < MIN_TRIAD_SPAN_DEGC or d.shape[0] < 14 + bias_order:
+            return 0
+        scores = [_press(_six_position_design(d, temperatures, q, t_ref, bias_order), y) for q in (0, 1)]
+        return 1 if scores[1] < scores[0] / ORDER_TOLERANCE else 0
+    if temperature_order not in (0, 1):
+        raise InputError(f"temperature_order: {temperature_order!r}; use 'auto', 0 or 1")
+    if temperature_order == 1 and span < MIN_TRIAD_SPAN_DEGC:
+        raise InputError(f"temperature_order: 1 needs poses over at least {MIN_TRIAD_SPAN_DEGC:g} degC; these span "
+                         f"{span:.1f} degC")
+    return temperature_order
+
+
+def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray,
+                      temperature_order: int | Literal["auto"] = 0, bias_order: int = 0):
     which = _axis_assignment(units)
     missing = [_DIRECTION_NAMES[k] for k in range(6) if not np.any(which == k)]
     if missing:
@@ -376,21 +421,49 @@ def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray):
     keep = which >= 0
     d = np.zeros((int(keep.sum()), 3))
     d[np.arange(d.shape[0]), which[keep] // 2] = np.where(which[keep] % 2, -1.0, 1.0)
-    x = np.column_stack([d, np.ones(d.shape[0])])
     y = means[keep]
+    temps = [p.temperature_degc for p, k in zip(poses, keep) if k]
+    temperatures = None if any(t is None for t in temps) else np.asarray(temps, dtype=float)
+    t_ref = 0.0 if temperatures is None else float(np.round(0.5 * (temperatures.min() + temperatures.max()), 1))
+    if bias_order and (temperatures is None or np.ptp(temperatures) < MIN_TRIAD_SPAN_DEGC):
+        raise InputError(f"bias_temperature_order: {bias_order} needs poses with temperatures over at least "
+                         f"{MIN_TRIAD_SPAN_DEGC:g} degC")
+    order = _six_position_order(d, y, temperatures, t_ref, temperature_order, bias_order)
+    x = _six_position_design(d, temperatures, order, t_ref, bias_order)
     sem = np.array([p.accel_sem_g for p in poses])[keep]
-    # ordinary least squares: with one pose per face this is Ferraris's closed form (b the mean of the
-    # six, column k of K half the difference of +k and -k)
+    # ordinary least squares: with one pose per face and K constant this is Ferraris's closed form (b the mean
+    # of the six, column k of K half the difference of +k and -k)
     coef = np.linalg.lstsq(x, y, rcond=None)[0]
     ssr = float(np.sum((y - x @ coef) ** 2))
-    dof = 3 * (d.shape[0] - 4)
+    dof = 3 * (d.shape[0] - x.shape[1])
     red, variance = _residual_variance(ssr, dof, float(np.mean(sem ** 2)))
     unscaled = np.diag(np.linalg.pinv(x.T @ x))
     se = np.sqrt(np.outer(np.ones(3), unscaled) * variance)
-    return coef[3], coef[:3].T, se[:, 3], se[:, :3], red, dof, int((~keep).sum())
+    blocks = [coef[3 * p: 3 * p + 3].T for p in range(order + 1)]
+    block_se = [se[:, 3 * p: 3 * p + 3] for p in range(order + 1)]
+    constant = 3 * (order + 1)
+    return SixPosition(coef[constant], blocks, se[:, constant], block_se, red, dof, int((~keep).sum()),
+                       t_ref if order or bias_order else None, coef[constant + 1:])
 
 
-def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", gravity_g: float = 1.0) -> PoseFit:
+@dataclass(frozen=True)
+class SixPosition:
+    """What the six-position least squares finds: bias [g], K and its temperature coefficients (blocks[0] = K at
+    ``reference_degc``, blocks[p] the coefficient of (T - reference)^p) with standard errors."""
+
+    bias: np.ndarray
+    blocks: list
+    bias_se: np.ndarray
+    blocks_se: list
+    reduced_chi_square: float
+    dof: int
+    left_out: int
+    reference_degc: float | None
+    bias_drift: np.ndarray  # (bias_order, 3): coefficients of (T - reference)^p, p = 1.. [g/degC^p]
+
+
+def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", gravity_g: float = 1.0,
+                            temperature_order: int | Literal["auto"] = "auto", bias_temperature_order: int = 0) -> PoseFit:
     """Bias, scale factor and misalignment of an accelerometer from still poses (see the module doc).
 
     Parameters
@@ -402,6 +475,14 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
     gravity_g : float
         The norm of the specific force at rest [g]: 1.0 unless the accelerations were scaled with a
         different local gravity.
+    temperature_order : int or "auto"
+        Six-position method: K constant (0) or linear in temperature (1; the poses must span at least
+        5 degC, each face visited across it); ``auto`` chooses by leave-one-pose-out error when the poses
+        span 5 degC (the lowest order within 5 % of the best), else 0. The norm method fits K constant.
+    bias_temperature_order : int
+        Six-position method on poses whose bias still drifts with temperature (no temperature model removed
+        it): a polynomial of this order in (T - reference) fitted alongside, in ``PoseFit.bias_drift_g``;
+        the calibration keeps the constant only.
 
     Returns
     -------
@@ -424,24 +505,39 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
         norm_possible = undetermined_norm_term(units) is None or not six
         method = "norm" if norm_possible and (distinct >= AUTO_NORM_POSES or (not six and distinct >= MIN_POSES_NORM)) \
             else "six-position"
+    temperatures, drift = None, np.zeros((0, 3))
     if method == "norm":
+        if temperature_order not in ("auto", 0) or bias_temperature_order:
+            raise InputError("temperature_order: the norm method fits K constant; K(T) needs the six-position method "
+                             "(the unit on its six faces across the temperatures)")
         bias, sens, bias_se, sens_se, red, dof, left = _fit_norm(poses, means, units, gravity_g)
+        extra = {}
     else:
-        bias, sens, bias_se, sens_se, red, dof, left = _fit_six_position(poses, means / gravity_g, units)
-        bias, bias_se = bias * gravity_g, bias_se * gravity_g
-    cal = TriadCalibration(sensitivity=tuple(map(tuple, sens)), bias=tuple(float(b) for b in bias), method=method,
-                           sensitivity_stderr=tuple(map(tuple, sens_se)), bias_stderr=tuple(float(b) for b in bias_se),
-                           unit="g")
-    after = cal.correct(means)
+        fit = _fit_six_position(poses, means / gravity_g, units, temperature_order, bias_temperature_order)
+        drift = fit.bias_drift * gravity_g
+        bias, bias_se, sens, sens_se = fit.bias * gravity_g, fit.bias_se * gravity_g, fit.blocks[0], fit.blocks_se[0]
+        red, dof, left = fit.reduced_chi_square, fit.dof, fit.left_out
+        extra = {"reference_degc": fit.reference_degc,
+                 "sensitivity_per_degc": tuple(rows_of(b) for b in fit.blocks[1:]),
+                 "sensitivity_per_degc_stderr": tuple(rows_of(b) for b in fit.blocks_se[1:])}
+        if not extra["sensitivity_per_degc"]:
+            extra["reference_degc"] = None
+        if fit.reference_degc is not None:
+            temperatures = np.array([p.temperature_degc for p in poses], dtype=float)
+            if drift.size:  # the pose means less the fitted drift: what the calibration sees
+                d = temperatures - fit.reference_degc
+                means = means - sum(np.outer(d ** (p + 1), drift[p]) for p in range(drift.shape[0]))
+    cal = TriadCalibration(sensitivity=rows_of(sens), bias=tuple(float(b) for b in bias), method=method,
+                           sensitivity_stderr=rows_of(sens_se), bias_stderr=tuple(float(b) for b in bias_se),
+                           unit="g", **extra)
+    after = cal.correct(means, temperatures if cal.temperature_order else None)
     return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1), np.linalg.norm(after, axis=1), red, dof, left,
-                   float(gravity_g))
+                   float(gravity_g), drift)
 
 
 # -- gyro: rate table -------------------------------------------------------------------------------------
 #: the highest order of K(T) in temperature the rate-table fit considers
 MAX_TRIAD_TEMPERATURE_ORDER = 2
-#: the lowest order whose held-out error is within this factor of the best is chosen (parsimony)
-ORDER_TOLERANCE = 1.05
 #: a reference rate at least this fast [deg/s] makes a segment informative about K
 MIN_REFERENCE_RATE_DPS = 1.0
 

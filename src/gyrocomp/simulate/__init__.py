@@ -150,6 +150,8 @@ def resolve_profile(profile: str | Profile, preset: str | None = None, **overrid
 def _accelerometer(acc: AccelErrorModel, force: np.ndarray, structure: np.ndarray, t_ref: float, rate_hz: float,
                    rng: np.random.Generator) -> np.ndarray:
     out = force @ acc.sensitivity.T + np.asarray(acc.bias_g) + np.outer(structure - t_ref, np.asarray(acc.bias_tempco_g_per_degc))
+    if acc.scale_misalignment_per_degc is not None:
+        out = out + (structure - t_ref)[:, None] * (force @ acc.sensitivity_per_degc.T)
     if acc.noise_density_g_per_sqrt_hz > 0:
         out = out + rng.standard_normal(force.shape) * acc.noise_density_g_per_sqrt_hz * math.sqrt(rate_hz)
     return quantize(out, acc.quantization_g)

@@ -89,6 +89,9 @@ class AccelErrorModel:
     scale_misalignment : 3 rows of 3 floats, optional
         E of the output a_out = (I + E) f + bias + noise: scale-factor errors on the diagonal,
         axis misalignments (cross-coupling) off it [dimensionless]; None for a perfect triad.
+    scale_misalignment_per_degc : 3 rows of 3 floats, optional
+        E1 of E(T) = E + E1 (T_s - T_ref), structure temperature from the gyro's T_ref [1/degC]; None for
+        none.
     """
 
     bias_g: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -96,16 +99,25 @@ class AccelErrorModel:
     noise_density_g_per_sqrt_hz: float = 0.0
     quantization_g: float = 0.0
     scale_misalignment: tuple[tuple[float, float, float], ...] | None = None
+    scale_misalignment_per_degc: tuple[tuple[float, float, float], ...] | None = None
 
     def __post_init__(self) -> None:
-        if self.scale_misalignment is not None and np.shape(self.scale_misalignment) != (3, 3):
-            raise InputError(f"scale_misalignment: shape {np.shape(self.scale_misalignment)}; give 3 rows of 3 values")
+        for name in ("scale_misalignment", "scale_misalignment_per_degc"):
+            value = getattr(self, name)
+            if value is not None and np.shape(value) != (3, 3):
+                raise InputError(f"{name}: shape {np.shape(value)}; give 3 rows of 3 values")
 
     @property
     def sensitivity(self) -> np.ndarray:
         """K = I + E, the matrix the triad applies to the specific force (3, 3) [dimensionless]."""
         e = np.zeros((3, 3)) if self.scale_misalignment is None else np.asarray(self.scale_misalignment, dtype=float)
         return np.eye(3) + e
+
+    @property
+    def sensitivity_per_degc(self) -> np.ndarray:
+        """E1, the change of K per degree of structure temperature (3, 3) [1/degC]."""
+        e1 = self.scale_misalignment_per_degc
+        return np.zeros((3, 3)) if e1 is None else np.asarray(e1, dtype=float)
 
 
 def _per_axis(name: str, value, k: int, width: int | None = None) -> np.ndarray | None:
