@@ -323,8 +323,8 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
               show_default=True,
               help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table) or, "
                    "without them, from the turns between the still poses of multi-position runs: matrix (constant), "
-                   "matrix-temperature (linear in temperature; rate table), none; auto: when such runs are given, "
-                   "the order by leave-one-run-out.")
+                   "matrix-temperature (linear in temperature), none; auto: when such runs are given, the order by "
+                   "leave-one-run-out.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
@@ -725,6 +725,22 @@ def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -
     if any(run.accel_axes for run in evaluation.runs):
         console.print(_metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items(),
                                      "g", "ug", "g/ug"))
+    if evaluation.triads:
+        table = Table(title=f"{title}: scale factor and misalignment (RMS over the run's poses, turns or stretches)")
+        for col in ("run", "figure", "count", "raw", "compensated", "improvement"):
+            table.add_column(col, justify="left" if col in ("run", "figure") else "right")
+        for t in evaluation.triads:
+            label, scale, unit = _TRIAD_FIGURES[t.figure]
+            table.add_row(Path(t.file).name, label, str(t.raw.size), f"{t.rms_raw * scale:.3g} {unit}",
+                          f"{t.rms_compensated * scale:.3g} {unit}",
+                          f"{t.rms_raw / t.rms_compensated:.3g}x" if t.rms_compensated > 0 else "-")
+        console.print(table)
+
+
+#: how ``evaluate`` prints each scale-factor figure: label, factor to the printed unit, unit
+_TRIAD_FIGURES = {"pose_norm_g": ("|a| - 1 g at each still pose", 1e3, "mg"),
+                  "turn_direction_deg": ("gravity direction after each turn", 1.0, "deg"),
+                  "rate_error_dps": ("rate error on each rate-table stretch", 1.0, "deg/s")}
 
 
 # -- allan -------------------------------------------------------------------------------------------

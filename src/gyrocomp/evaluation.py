@@ -6,14 +6,20 @@ recordings in), this module runs the calibration to get the compensated one.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import asdict, dataclass
 
+import numpy as np
+
 from .calibration import Calibration
 from .compensate import apply
-from .errors import DataQualityWarning
-from .metrics import AxisMetrics, Evaluation, default_window_s, evaluate_run
-from .recording import Recording
+from .errors import DataQualityWarning, InputError
+from .metrics import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_run
+from .models.pose_rotation import rotation_errors
+from .models.triad_fit import find_poses, rate_segments, spans_axes
+from .recording import GYRO_AXES, Recording
+from .triad import TriadCalibration
 
 
 def evaluate(calibration: Calibration, recordings: list[Recording] | Recording, *, window_s: float | None = None,
@@ -31,8 +37,54 @@ def evaluate(calibration: Calibration, recordings: list[Recording] | Recording, 
         Estimate each run's turn-on constant from its first seconds [s].
     """
     recordings = [recordings] if isinstance(recordings, Recording) else list(recordings)
-    return Evaluation([evaluate_run(rec, apply(calibration, rec, turn_on_window_s=turn_on_window_s),
-                                    window_s=window_s, accel=bool(calibration.accel_axes)) for rec in recordings])
+    compensated = [apply(calibration, rec, turn_on_window_s=turn_on_window_s) for rec in recordings]
+    runs = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
+            for rec, comp in zip(recordings, compensated)]
+    return Evaluation(runs, [r for rec, comp in zip(recordings, compensated)
+                             for r in triad_residuals(calibration, rec, comp)])
+
+
+#: the identity triad: rotation_errors through it measures the turns of data as given
+_IDENTITY = TriadCalibration(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0), "rotation",
+                             ((0.0, 0.0, 0.0),) * 3, (0.0, 0.0, 0.0), "deg/s")
+
+
+def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recording) -> list[TriadResiduals]:
+    """The residuals a model's triads decide on one run, raw and compensated (the run ``compensated`` by
+    ``calibration``): with an accelerometer triad, |a| - 1 g of each still pose of a multi-position run [g]; with a
+    gyro triad, the gravity direction's error after each turn between poses [deg] and, on a rate-table run, the
+    rate error of each constant stretch [deg/s] (the raw output less its mean where the table stood still)."""
+    out = []
+    name = raw.source
+    if calibration.gyro_triad is not None and raw.reference_rate_dps is not None:
+        before, after = rate_segments([raw]), rate_segments([compensated])
+        ref = np.array([s.reference_dps for s in before])
+        still = np.all(ref == 0, axis=1)
+        moving = np.linalg.norm(ref, axis=1) >= 1.0
+        if np.any(still) and np.any(moving):
+            bias = np.mean([s.gyro_dps for s, k in zip(before, still) if k], axis=0)
+            err = lambda segs, b: np.array([np.linalg.norm(s.gyro_dps - b - s.reference_dps)  # noqa: E731
+                                            for s, k in zip(segs, moving) if k])
+            out.append(TriadResiduals(name, "rate_error_dps", err(before, bias), err(after, 0.0)))
+    if raw.accel_g is None or raw.accel_g.shape[1] != 3 or raw.reference_rate_dps is not None:
+        return out
+    poses = find_poses(raw)
+    if len(poses) < 6 or not spans_axes(poses):
+        return out
+    if calibration.accel_triad is not None and compensated.accel_g is not None:
+        norm = lambda a: np.linalg.norm(a) - 1.0  # noqa: E731
+        out.append(TriadResiduals(name, "pose_norm_g", np.array([norm(p.accel_g) for p in poses]),
+                                  np.array([norm(compensated.accel_g[p.start_index:p.stop_index].mean(axis=0))
+                                            for p in poses])))
+    if calibration.gyro_triad is not None and raw.gyro_axes == GYRO_AXES:
+        try:
+            before, after = (rotation_errors(r, _IDENTITY, accel_calibration=calibration.accel_triad)
+                             for r in (raw, dataclasses.replace(raw, gyro_dps=compensated.gyro_dps)))
+        except InputError:
+            return out
+        out.append(TriadResiduals(name, "turn_direction_deg", np.array([m.error_after_deg for m in before]),
+                                  np.array([m.error_after_deg for m in after])))
+    return out
 
 
 @dataclass(frozen=True)

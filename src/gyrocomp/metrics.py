@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import asdict, dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -126,14 +127,47 @@ class RunEvaluation:
         return out
 
 
+#: what a scale-factor figure measures: the norm of each still pose's specific force less 1 g [g], the error of
+#: the gravity direction the gyro predicts after each turn between poses [deg], the rate error on each constant
+#: stretch of a rate table (the raw output less its bias at rest) [deg/s]
+TriadFigure = Literal["pose_norm_g", "turn_direction_deg", "rate_error_dps"]
+
+
+@dataclass(frozen=True)
+class TriadResiduals:
+    """One run's residuals that the scale factor and misalignment decide, raw and compensated, one per still
+    pose, turn or rate-table stretch (unit in ``figure``)."""
+
+    file: str
+    figure: TriadFigure
+    raw: np.ndarray
+    compensated: np.ndarray
+
+    @property
+    def rms_raw(self) -> float:
+        return float(np.sqrt(np.mean(self.raw ** 2)))
+
+    @property
+    def rms_compensated(self) -> float:
+        return float(np.sqrt(np.mean(self.compensated ** 2)))
+
+    def to_dict(self) -> dict:
+        return {"file": self.file, "figure": self.figure, "count": int(self.raw.size), "rms_raw": self.rms_raw,
+                "rms_compensated": self.rms_compensated}
+
+
 @dataclass(frozen=True)
 class Evaluation:
     """Figures of several runs; ``to_dict`` gives the JSON shape ``gyrocomp evaluate --json`` prints."""
 
     runs: list[RunEvaluation]
+    triads: list[TriadResiduals] = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        return {"runs": [run.to_dict() for run in self.runs]}
+        out = {"runs": [run.to_dict() for run in self.runs]}
+        if self.triads:
+            out["scale_factor"] = [t.to_dict() for t in self.triads]
+        return out
 
 
 def window_samples(window_s: float, rate_hz: float, n_samples: int) -> int:

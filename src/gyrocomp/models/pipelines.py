@@ -581,20 +581,17 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCa
     rate_runs = [r for r in recordings if r.reference_rate_dps is not None]
     if not rate_runs:
         sessions = _turning_sessions(recordings)
-        if scale_factor == "matrix-temperature":
-            raise InputError("scale_factor='matrix-temperature': no run carries reference rates (ref_rate_x, "
-                             "ref_rate_y, ref_rate_z [deg/s]); K's temperature dependence needs rate-table runs at "
-                             "several temperatures")
-        if scale_factor == "matrix" and not sessions:
-            raise InputError("scale_factor='matrix': no run carries reference rates (ref_rate_x, ref_rate_y, "
+        if scale_factor != "auto" and not sessions:
+            raise InputError(f"scale_factor={scale_factor!r}: no run carries reference rates (ref_rate_x, ref_rate_y, "
                              "ref_rate_z [deg/s]) or turns between still poses; a scale-factor calibration needs "
                              "rate-table runs or a multi-position session with the turns recorded")
         if not sessions:
             return None, recordings
+        order = {"auto": "auto", "matrix": 0, "matrix-temperature": 1}[scale_factor]
         try:
-            return fit_gyro_between_poses(sessions).calibration, recordings
+            return fit_gyro_between_poses(sessions, temperature_order=order).calibration, recordings
         except InputError as exc:
-            if scale_factor == "matrix":
+            if scale_factor != "auto":
                 raise
             if isinstance(exc, TooFewTurns):  # the turns were not recorded: nothing to say
                 return None, recordings
@@ -691,10 +688,10 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
 
     ``scale_factor``: runs that carry a rate table's reference rates (``reference_rate_dps``) give the gyro's
     scale factor and misalignment K(T) (:func:`fit_gyro_rate_table`) and the other runs the bias model;
-    without them, multi-position sessions whose turns between still poses are recorded give a constant K
+    without them, multi-position sessions whose turns between still poses are recorded give K(T)
     (:func:`fit_gyro_between_poses`; they stay bias runs too). ``"auto"`` when such runs are given (a warning
-    when their turns do not determine K), ``"matrix"`` K constant, ``"matrix-temperature"`` K linear in
-    temperature (rate-table runs only), ``"none"`` no K (every run is then a bias run).
+    when their turns do not determine K), the order by leave-one-run-out; ``"matrix"`` K constant,
+    ``"matrix-temperature"`` K linear in temperature, ``"none"`` no K (every run is then a bias run).
     """
     if isinstance(recordings, Recording):
         recordings = [recordings]

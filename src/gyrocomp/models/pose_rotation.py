@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from scipy import optimize
@@ -30,12 +31,12 @@ from scipy import optimize
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
 from ..triad import TriadCalibration, rows_of
-from .triad_fit import Pose, find_poses, fit_accel_multiposition, propagate_stderr
+from .triad_fit import MIN_TRIAD_SPAN_DEGC, ORDER_TOLERANCE, Pose, find_poses, fit_accel_multiposition
 
 #: every axis must be turned at least this far [deg] in some move, about an axis other than gravity
 MIN_TURN_DEG = 20.0
 #: the turns determine K when no combination of its elements moves the gravity directions by less than this
-#: per move [rad per unit of K^-1] (a well-turned session: about 0.5; turns about one axis only once: 0.001)
+#: per move [rad per unit of K] (a well-turned session: about 0.5; turns about one axis only once: 0.001)
 MIN_TURN_SINGULAR = 0.02
 #: a session whose poses' temperatures span more than this [degC] gets a temperature term in its bias at rest
 TEMPERATURE_SPAN_DEGC = 1.0
@@ -92,8 +93,9 @@ class RotationFit:
         b of each recording's bias at rest (see the module doc) [deg/s].
     g_sensitivity_dps_per_g : array (sessions, 3, 3)
         G of each recording's bias at rest [deg/s/g].
-    accel_calibration : TriadCalibration or None
-        The accelerometer calibration the gravity directions were taken through (None: raw directions).
+    accel_calibrations : tuple of TriadCalibration or None
+        Per recording, the accelerometer calibration its gravity directions were taken through (None: raw
+        directions).
     """
 
     calibration: TriadCalibration
@@ -101,7 +103,7 @@ class RotationFit:
     moves: tuple[PoseMove, ...]
     bias_at_rest_dps: np.ndarray
     g_sensitivity_dps_per_g: np.ndarray
-    accel_calibration: TriadCalibration | None
+    accel_calibrations: tuple[TriadCalibration | None, ...]
 
     @property
     def error_rms_before_deg(self) -> float:
@@ -156,18 +158,33 @@ def rotation_matrix(q: np.ndarray) -> np.ndarray:
 # -- the fit ----------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class _Moves:
-    """The moves of a session, padded to one length: rates (m, L, 3) [deg/s] freed of the bias at rest,
-    sample intervals (m, L) [s] (0 in the padding), gravity directions before and after (m, 3)."""
+    """The moves of the sessions, padded to one length: rates (m, L, 3) [deg/s] freed of the bias at rest,
+    sample intervals (m, L) [s] (0 in the padding), temperatures (m, L) [degC] (NaN without), gravity
+    directions before and after (m, 3), the session (recording) of each move (m,)."""
 
     rates_dps: np.ndarray
     dt_s: np.ndarray
+    temperature_degc: np.ndarray
     before: np.ndarray
     after: np.ndarray
+    session: np.ndarray
     meta: list[tuple[str, float, float]]
 
-    def predicted(self, correction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(predicted gravity direction after each move (m, 3), rotation angle of each move (m,) [deg])."""
-        phi = np.radians(self.rates_dps @ correction.T) * self.dt_s[..., None]
+    def take(self, which: np.ndarray) -> "_Moves":
+        """The moves selected by the boolean mask ``which``."""
+        return _Moves(self.rates_dps[which], self.dt_s[which], self.temperature_degc[which], self.before[which],
+                      self.after[which], self.session[which], [m for m, w in zip(self.meta, which) if w])
+
+    def predicted(self, triad: tuple[np.ndarray, ...], reference_degc: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """(predicted gravity direction after each move (m, 3), rotation angle of each move (m,) [deg]) for
+        K(T) = triad[0] + sum_p triad[p] (T - reference_degc)^p."""
+        if len(triad) == 1:
+            rates = self.rates_dps @ np.linalg.inv(triad[0]).T
+        else:
+            d = np.nan_to_num(self.temperature_degc - reference_degc)
+            k = triad[0] + sum(np.multiply.outer(d ** p, triad[p]) for p in range(1, len(triad)))
+            rates = np.linalg.solve(k, self.rates_dps[..., None])[..., 0]
+        phi = np.radians(rates) * self.dt_s[..., None]
         q = ordered_product(quaternion_from_rotvec(phi))
         angle = np.degrees(2.0 * np.arccos(np.clip(np.abs(q[:, 0]), 0.0, 1.0)))
         return np.einsum("mji,mj->mi", rotation_matrix(q), self.before), angle
@@ -209,19 +226,23 @@ def _session_moves(recording: Recording, poses: list[Pose], coef: np.ndarray, t_
         dt = time[a + 1:b + 1] - time[a:b]
         if np.any(dt > gap):  # the recording paused during the turn: it cannot be integrated
             continue
-        out.append((recording.gyro_dps[a:b] - bias, dt, directions[k], directions[k + 1],
+        t = np.full(b - a, np.nan) if temp is None else temp[a:b]
+        out.append((recording.gyro_dps[a:b] - bias, dt, t, directions[k], directions[k + 1],
                     (recording.source, float(time[a]), float(time[b] - time[a]))))
     return out
 
 
-def _pad(moves: list[tuple]) -> _Moves:
+def _pad(moves: list[tuple], sessions: list[int]) -> _Moves:
     length = max(len(m[1]) for m in moves)
     rates = np.zeros((len(moves), length, 3))
     dt = np.zeros((len(moves), length))
+    temp = np.full((len(moves), length), np.nan)
     for i, m in enumerate(moves):
         rates[i, :len(m[1])] = m[0]
         dt[i, :len(m[1])] = m[1]
-    return _Moves(rates, dt, np.array([m[2] for m in moves]), np.array([m[3] for m in moves]), [m[4] for m in moves])
+        temp[i, :len(m[1])] = m[2]
+    return _Moves(rates, dt, temp, np.array([m[3] for m in moves]), np.array([m[4] for m in moves]),
+                  np.asarray(sessions), [m[5] for m in moves])
 
 
 def _require_turns(moves: _Moves) -> None:
@@ -236,15 +257,17 @@ def _require_turns(moves: _Moves) -> None:
 
 
 def _require_determined(jacobian: np.ndarray, moves: int) -> None:
-    """Refuse when some combination of C's elements barely moves the predicted gravity directions: smallest
-    singular value of the Jacobian (radians of direction per unit of C) per sqrt(move) below MIN_TURN_SINGULAR."""
+    """Refuse when some combination of K's elements barely moves the predicted gravity directions: smallest
+    singular value of the Jacobian (radians of direction per unit of K) per sqrt(move) below MIN_TURN_SINGULAR."""
     _, sing, vt = np.linalg.svd(jacobian, full_matrices=False)
     if sing[-1] / np.sqrt(moves) >= MIN_TURN_SINGULAR:
         return
-    row, col = divmod(int(np.argmax(np.abs(vt[-1]))), 3)
+    block, element = divmod(int(np.argmax(np.abs(vt[-1]))), 9)
+    row, col = divmod(element, 3)
+    what = "" if block == 0 else ", its change with temperature"
     raise InputError(f"moves between poses: the turns leave the gyro's K undetermined (the {'xyz'[row]} output's "
-                     f"response to turns about {'xyz'[col]}); turn the unit about its {'xyz'[col]} axis more, from poses "
-                     f"with gravity off that axis")
+                     f"response to turns about {'xyz'[col]}{what}); turn the unit about its {'xyz'[col]} axis more, from "
+                     f"poses with gravity off that axis")
 
 
 def _angle_deg(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -261,22 +284,36 @@ def _directions(poses: list[Pose], accel_calibration: TriadCalibration | None) -
     return means / np.linalg.norm(means, axis=1)[:, None]
 
 
-def _accel_from_poses(poses: list[Pose]) -> TriadCalibration | None:
-    try:
-        return fit_accel_multiposition(poses).calibration
-    except InputError as exc:
-        warnings.warn(f"accelerometer not calibrated from the poses ({exc}); the gravity directions carry its bias "
-                      "and scale errors, and so does the gyro's K", DataQualityWarning, stacklevel=3)
-        return None
+def _session_accels(sessions: list[tuple[Recording, list[Pose]]]) -> list[TriadCalibration | None]:
+    """The accelerometer calibration of each session from its own poses (its bias changes with temperature and
+    power-on), or from all the sessions' poses where one alone cannot give it; None (raw directions, with a
+    warning) where neither can."""
+    joint: list = []
+    out = []
+    for _, poses in sessions:
+        try:
+            out.append(fit_accel_multiposition(poses).calibration)
+            continue
+        except InputError:
+            pass
+        if not joint:
+            try:
+                joint.append(fit_accel_multiposition([p for _, ps in sessions for p in ps]).calibration)
+            except InputError as exc:
+                warnings.warn(f"accelerometer not calibrated from the poses ({exc}); the gravity directions carry its "
+                              "bias and scale errors, and so does the gyro's K", DataQualityWarning, stacklevel=4)
+                joint.append(None)
+        out.append(joint[0])
+    return out
 
 
 @dataclass(frozen=True)
 class _Session:
-    """The poses of the recordings, the accelerometer calibration their directions come through, the bias at
-    rest of each recording (coefficients, see ``_bias_at_rest``) and the moves."""
+    """The poses of the recordings, the accelerometer calibration each recording's directions come through, the
+    bias at rest of each recording (coefficients, see ``_bias_at_rest``) and the moves."""
 
     poses: list[Pose]
-    accel: TriadCalibration | None
+    accels: tuple[TriadCalibration | None, ...]
     coefficients: list[np.ndarray]
     moves: _Moves
 
@@ -290,29 +327,79 @@ def _prepare(recordings: list[Recording] | Recording, accel_calibration: TriadCa
             raise InputError(f"{rec.source}: a scale-factor and misalignment calibration needs all three gyro axes")
         sessions.append((rec, find_poses(rec)))
     all_poses = [p for _, poses in sessions for p in poses]
-    accel = accel_calibration if accel_calibration is not None else _accel_from_poses(all_poses)
-    moves, coefs = [], []
-    for rec, poses in sessions:
+    accels = [accel_calibration] * len(sessions) if accel_calibration is not None else _session_accels(sessions)
+    moves, coefs, index = [], [], []
+    for k, (rec, poses) in enumerate(sessions):
         if len(poses) < 2:
             continue
         coef, t_mean = _bias_at_rest(poses)
         coefs.append(coef)
-        moves += _session_moves(rec, poses, coef, t_mean, _directions(poses, accel))
+        found = _session_moves(rec, poses, coef, t_mean, _directions(poses, accels[k]))
+        moves += found
+        index += [k] * len(found)
     if len(moves) < 5:
         raise TooFewTurns(f"moves between poses: {len(moves)} found; the gyro's scale factor and misalignment (nine "
                          "unknowns, two equations per move) need at least 5 turns between still poses")
-    return _Session(all_poses, accel, coefs, _pad(moves))
+    return _Session(all_poses, tuple(accels), coefs, _pad(moves, index))
 
 
-def _move_table(moves: _Moves, correction: np.ndarray) -> tuple[PoseMove, ...]:
-    before, _ = moves.predicted(np.eye(3))
-    after, turn = moves.predicted(correction)
+def _move_table(moves: _Moves, triad: tuple[np.ndarray, ...], reference_degc: float = 0.0) -> tuple[PoseMove, ...]:
+    before, _ = moves.predicted((np.eye(3),))
+    after, turn = moves.predicted(triad, reference_degc)
     return tuple(PoseMove(src, start, length, float(t), float(e0), float(e1)) for (src, start, length), t, e0, e1
                  in zip(moves.meta, turn, _angle_deg(before, moves.after), _angle_deg(after, moves.after)))
 
 
+def _solve(moves: _Moves, order: int, reference_degc: float):
+    """Least squares for K(T) of the given order: (the fit's solution, the triad's blocks)."""
+
+    def residuals(theta: np.ndarray) -> np.ndarray:
+        return (moves.predicted(tuple(theta.reshape(-1, 3, 3)), reference_degc)[0] - moves.after).ravel()
+
+    start = np.concatenate([np.eye(3).ravel(), np.zeros(9 * order)])
+    sol = optimize.least_squares(residuals, start, method="lm", jac="3-point", xtol=1e-12, ftol=1e-12)
+    return sol, tuple(sol.x.reshape(-1, 3, 3))
+
+
+def _session_temperatures(moves: _Moves) -> np.ndarray:
+    """Mean temperature of each session's turns [degC] (NaN without temperature)."""
+    with np.errstate(invalid="ignore"):
+        return np.array([np.nanmean(moves.temperature_degc[moves.session == k]) if np.any(moves.session == k)
+                         and np.any(np.isfinite(moves.temperature_degc[moves.session == k])) else np.nan
+                         for k in np.unique(moves.session)])
+
+
+def _held_out_error(moves: _Moves, order: int, reference_degc: float) -> float:
+    """RMS gravity-direction error [rad] of each session's turns predicted by K(T) fitted on the other sessions."""
+    errors = []
+    for k in np.unique(moves.session):
+        held = moves.session == k
+        _, triad = _solve(moves.take(~held), order, reference_degc)
+        predicted, _ = moves.take(held).predicted(triad, reference_degc)
+        errors.append(predicted - moves.after[held])
+    return float(np.sqrt(np.mean(np.concatenate(errors) ** 2)))
+
+
+def _rotation_order(moves: _Moves, reference_degc: float, temperature_order: int | Literal["auto"]) -> int:
+    temps = _session_temperatures(moves)
+    distinct = len(np.unique(np.round(temps[np.isfinite(temps)])))
+    span = float(np.ptp(temps)) if distinct else 0.0
+    if temperature_order == "auto":
+        if distinct < 3 or span < MIN_TRIAD_SPAN_DEGC:
+            return 0
+        scores = [_held_out_error(moves, q, reference_degc) for q in (0, 1)]
+        return 1 if scores[1] < scores[0] / ORDER_TOLERANCE else 0
+    if temperature_order not in (0, 1):
+        raise InputError(f"temperature_order: {temperature_order!r}; use 'auto', 0 or 1")
+    if temperature_order == 1 and (distinct < 2 or span < MIN_TRIAD_SPAN_DEGC):
+        raise InputError(f"temperature_order: 1 needs turning sessions at temperatures at least {MIN_TRIAD_SPAN_DEGC:g} "
+                         f"degC apart; these span {span:.1f} degC")
+    return temperature_order
+
+
 def fit_gyro_between_poses(recordings: list[Recording] | Recording, *,
-                           accel_calibration: TriadCalibration | None = None) -> RotationFit:
+                           accel_calibration: TriadCalibration | None = None,
+                           temperature_order: int | Literal["auto"] = "auto") -> RotationFit:
     """Scale factor and misalignment of a gyro triad from the rotations between still poses (no rate table).
 
     Parameters
@@ -322,48 +409,53 @@ def fit_gyro_between_poses(recordings: list[Recording] | Recording, *,
         (or otherwise) between still poses, the turns recorded; each recording is one power-on (its own bias
         at rest). The poses are found as in :func:`find_poses`.
     accel_calibration : TriadCalibration, optional
-        The accelerometer calibration the gravity directions are taken through; default: fitted from the
-        same poses (:func:`fit_accel_multiposition`), raw directions with a warning where the poses do
-        not allow it.
+        The accelerometer calibration the gravity directions are taken through; default: fitted from each
+        recording's poses (:func:`fit_accel_multiposition`; its bias moves with temperature and power-on), from
+        all of them where one recording's cannot, raw directions with a warning where neither can.
+    temperature_order : int or "auto"
+        K constant (0) or linear in temperature (1: sessions at temperatures at least 5 degC apart, the
+        sample's temperature read during each turn); ``auto``: by leave-one-session-out error with sessions
+        at three or more temperatures (the lowest order within 5 % of the best), else 0.
 
     Returns
     -------
     RotationFit
-        K and its standard errors, the moves with the gravity direction's error before and after.
+        K(T) and its standard errors, the moves with the gravity direction's error before and after.
     """
     session = _prepare(recordings, accel_calibration)
     moves = session.moves
     _require_turns(moves)
-
-    def residuals(theta: np.ndarray) -> np.ndarray:
-        return (moves.predicted(theta.reshape(3, 3))[0] - moves.after).ravel()
-
-    sol = optimize.least_squares(residuals, np.eye(3).ravel(), method="lm", jac="3-point", xtol=1e-12, ftol=1e-12)
-    correction = sol.x.reshape(3, 3)
+    temps = _session_temperatures(moves)
+    reference = float(np.round(0.5 * (np.nanmin(temps) + np.nanmax(temps)), 1)) if np.any(np.isfinite(temps)) else 0.0
+    order = _rotation_order(moves, reference, temperature_order)
+    sol, triad = _solve(moves, order, reference)
     _require_determined(sol.jac, len(moves.meta))
-    sens = np.linalg.inv(correction)
-    if np.max(np.abs(sens - np.eye(3))) > MAX_SENSITIVITY_ERROR:
+    if np.max(np.abs(triad[0] - np.eye(3))) > MAX_SENSITIVITY_ERROR:
         raise InputError(f"moves between poses: the fit found no plausible gyro triad (scale or misalignment beyond "
                          f"{MAX_SENSITIVITY_ERROR:.0%}); the turns do not determine it")
-    dof = 2 * len(moves.meta) - 9
+    dof = 2 * len(moves.meta) - sol.x.size
     variance = float(np.sum(sol.fun ** 2) / max(dof, 1))
-    cov = np.linalg.pinv(sol.jac.T @ sol.jac) * variance
-    sens_se = propagate_stderr(lambda t: np.linalg.inv(t.reshape(3, 3)), sol.x, cov).reshape(3, 3)
-    cal = TriadCalibration(sensitivity=rows_of(sens), bias=(0.0, 0.0, 0.0), method="rotation",
-                           sensitivity_stderr=rows_of(sens_se), bias_stderr=(0.0, 0.0, 0.0), unit="deg/s")
+    se = np.sqrt(np.diag(np.linalg.pinv(sol.jac.T @ sol.jac)) * variance).reshape(-1, 3, 3)
+    cal = TriadCalibration(sensitivity=rows_of(triad[0]), bias=(0.0, 0.0, 0.0), method="rotation",
+                           sensitivity_stderr=rows_of(se[0]), bias_stderr=(0.0, 0.0, 0.0), unit="deg/s",
+                           reference_degc=reference if order else None,
+                           sensitivity_per_degc=tuple(rows_of(k) for k in triad[1:]),
+                           sensitivity_per_degc_stderr=tuple(rows_of(k) for k in se[1:]))
     coefs = session.coefficients
-    return RotationFit(cal, tuple(session.poses), _move_table(moves, correction), np.array([c[0] for c in coefs]),
-                       np.array([c[1:4].T for c in coefs]), session.accel)
+    return RotationFit(cal, tuple(session.poses), _move_table(moves, triad, reference), np.array([c[0] for c in coefs]),
+                       np.array([c[1:4].T for c in coefs]), session.accels)
 
 
 def rotation_errors(recordings: list[Recording] | Recording, gyro_calibration: TriadCalibration, *,
                     accel_calibration: TriadCalibration | None = None) -> tuple[PoseMove, ...]:
-    """The turns between the still poses of ``recordings`` and how well ``gyro_calibration`` (its K; a K(T) at
-    its reference temperature) predicts each one's gravity direction: a held-out check of a calibration on
-    another session. ``accel_calibration`` as in :func:`fit_gyro_between_poses`."""
+    """The turns between the still poses of ``recordings`` and how well ``gyro_calibration`` (its K(T) at each
+    sample's temperature) predicts each one's gravity direction: a held-out check of a calibration on another
+    session. ``accel_calibration`` as in :func:`fit_gyro_between_poses`."""
     session = _prepare(recordings, accel_calibration)
-    correction = np.linalg.inv(np.asarray(gyro_calibration.sensitivity, dtype=float))
-    return _move_table(session.moves, correction)
+    triad = tuple(np.asarray(k, dtype=float) for k in (gyro_calibration.sensitivity, *gyro_calibration.sensitivity_per_degc))
+    if len(triad) > 1 and not np.all(np.isfinite(session.moves.temperature_degc[session.moves.dt_s > 0])):
+        raise InputError("recordings: the calibration's K depends on temperature; the sessions have no temperature")
+    return _move_table(session.moves, triad, gyro_calibration.reference_degc or 0.0)
 
 
 __all__ = ["PoseMove", "RotationFit", "TooFewTurns", "fit_gyro_between_poses", "ordered_product", "quaternion_from_rotvec",

@@ -16,7 +16,6 @@ between poses (the gravity direction the gyro predicts) before and after).
 from __future__ import annotations
 
 import base64
-import dataclasses
 import datetime as _dt
 import html
 import io
@@ -29,15 +28,12 @@ import numpy as np
 from .._version import __version__
 from ..calibration import Calibration
 from ..compensate import apply
-from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
-from ..evaluation import evaluate_stages, stage_calibrations
+from ..errors import DataQualityWarning, TemperatureRangeWarning
+from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
 from ..metrics import default_window_s, evaluate_run
 from ..noise import analyse_noise
-from ..models.pose_rotation import rotation_errors
-from ..models.triad_fit import find_poses, spans_axes
-from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..recording import ACCEL_AXES, Recording
 from ..static import static_segments
-from ..triad import TriadCalibration
 from ..validation import ValidationResult
 from . import figures
 
@@ -231,40 +227,23 @@ def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: 
     return result
 
 
-#: the identity triad: rotation_errors through it measures the turns of data as given
-_IDENTITY_TRIAD = TriadCalibration(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0), "rotation",
-                                   ((0.0, 0.0, 0.0),) * 3, (0.0, 0.0, 0.0), "deg/s")
+#: how the report labels each scale-factor residual, and the factor to its unit
+_RESIDUAL_LABELS = {"pose_norm_g": ("accelerometer |a| - 1 g [mg]", 1e3),
+                    "turn_direction_deg": ("gyro: gravity direction after each turn [deg]", 1.0),
+                    "rate_error_dps": ("gyro: rate error on each rate-table stretch [deg/s]", 1.0)}
 
 
 def _pose_residuals(calibration: Calibration, runs: list[Recording], compensated: list[Recording]) -> dict:
-    """Label -> (before, after) per still pose (accelerometer: |a| - 1 g [mg]) and per turn between poses (gyro
-    triad: error of the gravity direction the gyro predicts [deg]) of the runs that are multi-position sessions."""
-    out = {}
-    norms: tuple[list, list] = ([], [])
-    turns: tuple[list, list] = ([], [])
+    """Label -> (raw, compensated) of every still pose, turn and rate-table stretch of the runs
+    (:func:`gyrocomp.evaluation.triad_residuals`), the runs one after the other."""
+    merged: dict[str, tuple[list, list]] = {}
     for rec, comp in zip(runs, compensated):
-        if rec.accel_g is None or rec.accel_g.shape[1] != 3:
-            continue
-        poses = find_poses(rec)
-        if len(poses) < 6 or not spans_axes(poses):
-            continue
-        if calibration.accel_triad is not None and comp.accel_g is not None:
-            for p in poses:
-                norms[0].append((np.linalg.norm(p.accel_g) - 1.0) * 1e3)
-                norms[1].append((np.linalg.norm(comp.accel_g[p.start_index:p.stop_index].mean(axis=0)) - 1.0) * 1e3)
-        if calibration.gyro_triad is not None and rec.gyro_axes == GYRO_AXES:
-            try:
-                raw, fixed = (rotation_errors(r, _IDENTITY_TRIAD, accel_calibration=calibration.accel_triad)
-                              for r in (rec, dataclasses.replace(rec, gyro_dps=comp.gyro_dps)))
-            except InputError:
-                continue
-            turns[0].extend(m.error_after_deg for m in raw)
-            turns[1].extend(m.error_after_deg for m in fixed)
-    if norms[0]:
-        out["accelerometer |a| - 1 g [mg]"] = (np.array(norms[0]), np.array(norms[1]))
-    if turns[0]:
-        out["gyro: gravity direction after each turn [deg]"] = (np.array(turns[0]), np.array(turns[1]))
-    return out
+        for r in triad_residuals(calibration, rec, comp):
+            label, factor = _RESIDUAL_LABELS[r.figure]
+            merged.setdefault(label, ([], []))
+            merged[label][0].extend(r.raw * factor)
+            merged[label][1].extend(r.compensated * factor)
+    return {label: (np.array(a), np.array(b)) for label, (a, b) in merged.items()}
 
 
 def _triads(calibration: Calibration, runs: list[Recording], compensated: list[Recording]) -> str:
