@@ -17,6 +17,7 @@ from gyrocomp import Calibration, Compensator, apply, evaluate
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.autopilot import px4_params_file
 from gyrocomp.export.c_code import c_sources
+from gyrocomp.io.schedule import apply_schedule, read_rate_schedule
 from gyrocomp.io.tables import read_table, write_recording
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.models.triad_fit import (Pose, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
@@ -347,6 +348,21 @@ def test_cli_fits_the_scale_factor_from_rate_table_files(tmp_path):
     assert result.returncode == 0, result.stderr
     assert "gyro scale factor and misalignment (rate-table" in result.stdout
     assert Calibration.load(tmp_path / "model.json").gyro_triad is not None
+    # the same rates as a schedule file beside runs without the columns: the same K
+    lines = ["file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z"]
+    for seed in (1, 2, 3):
+        table = pd.read_csv(tmp_path / f"rt{seed}.csv")
+        ref, t = table[["ref_rate_x", "ref_rate_y", "ref_rate_z"]].to_numpy(), table["time"].to_numpy()
+        edges = np.r_[0, np.flatnonzero(np.any(np.diff(ref, axis=0) != 0, axis=1)) + 1, len(t)]
+        lines += [",".join([f"bare{seed}.csv"] + [repr(float(v)) for v in (t[a] - t[0], t[b - 1] - t[0] + 0.025, *ref[a])])
+                  for a, b in zip(edges[:-1], edges[1:]) if np.any(ref[a] != 0)]
+        table.drop(columns=["ref_rate_x", "ref_rate_y", "ref_rate_z"]).to_csv(tmp_path / f"bare{seed}.csv", index=False)
+    (tmp_path / "schedule.csv").write_text("\n".join(lines) + "\n")
+    bare = [tmp_path / f"bare{s}.csv" for s in (1, 2, 3)] + files[3:]
+    result = run("fit", *bare, "-o", tmp_path / "scheduled.json", "--hysteresis", "none", "--rate-schedule",
+                 tmp_path / "schedule.csv")
+    assert result.returncode == 0, result.stderr
+    assert Calibration.load(tmp_path / "scheduled.json").gyro_triad == Calibration.load(tmp_path / "model.json").gyro_triad
     result = run("fit", tmp_path / "ch_0.csv", "-o", tmp_path / "m.json", "--scale-factor", "matrix")
     assert result.returncode == 2 and not (tmp_path / "m.json").exists()
     assert result.stderr.strip() == ("gyrocomp: error: --scale-factor 'matrix': no run carries reference rates "
@@ -363,3 +379,36 @@ def test_exports_say_what_they_leave_out_of_a_triad(rate_fit):
         px4_params_file(cal)
     assert "solve3(k, out);" in c_sources(cal)["gyrocomp.c"]  # the C code carries K(T) (parity: tests/export)
     assert "solve3(k, out);" not in c_sources(cal.without("scale-factor"))["gyrocomp.c"]
+
+
+def test_a_rate_schedule_file_gives_the_reference_rates_instead_of_columns(tmp_path):
+    """The rates as a separate schedule (rate-table software logs them apart): the same K as the columns give,
+    and every malformed schedule refused naming the row."""
+    run_ = _rate_run(25.0, 0)
+    plain = dataclasses.replace(run_, reference_rate_dps=None)
+    write_recording(plain, tmp_path / "rt.csv")
+    ref = run_.reference_rate_dps
+    change = np.r_[0, np.flatnonzero(np.any(np.diff(ref, axis=0) != 0, axis=1)) + 1, run_.n_samples]
+    t = run_.time_s - run_.time_s[0]
+    rows = [f"rt.csv,{float(t[a])!r},{float(t[b - 1] + 1 / run_.rate_hz)!r},{ref[a][0]},{ref[a][1]},{ref[a][2]}"
+            for a, b in zip(change[:-1], change[1:]) if np.any(ref[a] != 0)]
+    (tmp_path / "schedule.csv").write_text("file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z\n" + "\n".join(rows) + "\n")
+    schedule = read_rate_schedule(tmp_path / "schedule.csv")
+    back, = apply_schedule(schedule, [read_table(tmp_path / "rt.csv").recording], [tmp_path / "rt.csv"])
+    np.testing.assert_array_equal(back.reference_rate_dps, ref)
+    with pytest.raises(InputError, match=r"has ref_rate_x/_y/_z columns and the schedule .* names it too"):
+        schedule.apply(run_, "rt.csv")
+    bad = {"file,start_s,end_s,ref_rate_x,ref_rate_y\nrt.csv,0,1,1,1\n": r"schedule column\(s\) ref_rate_z missing",
+           "file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z\nrt.csv,0,x,1,1,1\n": r"row 2: end_s 'x' is not a finite",
+           "file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z\nrt.csv,5,2,1,1,1\n": "row 2: start_s 5, end_s 2",
+           "file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z\nrt.csv,0,10,1,0,0\nrt.csv,5,20,2,0,0\n":
+               "rows 2 and 3: the stretches of rt.csv overlap"}
+    for text, message in bad.items():
+        (tmp_path / "bad.csv").write_text(text)
+        with pytest.raises(InputError, match=message):
+            read_rate_schedule(tmp_path / "bad.csv")
+    (tmp_path / "other.csv").write_text("file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z\nelse.csv,0,10,1,0,0\n")
+    with pytest.raises(InputError, match=r"other.csv, row 2: file 'else.csv' is not among the runs given"):
+        apply_schedule(read_rate_schedule(tmp_path / "other.csv"), [plain], [tmp_path / "rt.csv"])
+    result = run("evaluate", tmp_path / "rt.csv", tmp_path / "rt.csv", "--rate-schedule", tmp_path / "nothere.csv")
+    assert result.returncode == 2 and "nothere.csv: no such file" in result.stderr

@@ -49,6 +49,7 @@ from .io import (
     write_recording,
     write_text_atomic,
 )
+from .io.schedule import apply_schedule, read_rate_schedule
 from .export.kalibr import kalibr_imu, kalibr_imu_yaml
 from .comparison import compare_methods
 from .demo import run_demo
@@ -325,10 +326,13 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
                    "without them, from the turns between the still poses of multi-position runs: matrix (constant), "
                    "matrix-temperature (linear in temperature), none; auto: when such runs are given, the order by "
                    "leave-one-run-out.")
+@click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
+              help="A rate table's schedule (CSV: file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z [deg/s]) "
+                   "giving the reference rates of the runs it names, instead of ref_rate_x/y/z columns.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, **kwargs):
+        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, rate_schedule, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
     opts = _pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
@@ -342,6 +346,8 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     channels = parse_channels(channels)
     refuse_to_overwrite_inputs(output, runs)
     recordings = [_read(path, opts).recording for path in runs]
+    if rate_schedule is not None:
+        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
     with progress_bar("fitting", indeterminate=True):
         calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
                                    hysteresis=hysteresis, hysteresis_order=hysteresis_order,
@@ -615,9 +621,11 @@ def print_validation(result: ValidationResult) -> None:
               help="Report each stage of MODEL (the thesis's Table 4.4): raw, temperature only, + acceleration, "
                    "+ hysteresis.")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
+@click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
+              help="A rate table's schedule for the RUNS it names (as for fit): adds their rate error.")
 @read_options
 @click.pass_context
-def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, as_json, **kwargs):
+def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, as_json, rate_schedule, **kwargs):
     """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.
 
     With --compare, no model is given: the methods of the reference thesis are fitted on the runs and compared.
@@ -652,8 +660,10 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
         elif not ctx.obj["quiet"]:
             print_stages(staged)
         return
-    evaluation = evaluate_calibration(calibration, [_read(path, opts).recording for path in runs],
-                                      window_s=window_s, turn_on_window_s=turn_on_window_s)
+    recordings = [_read(path, opts).recording for path in runs]
+    if rate_schedule is not None:
+        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+    evaluation = evaluate_calibration(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s)
     if as_json:
         click.echo(json.dumps(evaluation.to_dict(), indent=2))
     else:
