@@ -181,3 +181,38 @@ def test_effect_option_errors():
         thermal_lag(np.arange(3.0), np.arange(3.0), -1.0)
     with pytest.raises(InputError, match="turning-point threshold: must not be negative, got -0.1"):
         find_turns(np.arange(3.0), -0.1)
+
+
+def _turns_sample_by_sample(x, threshold):
+    """The detector's definition, one sample at a time (as the C export's turn_update does)."""
+    d, extreme, turn, low, high = 0, np.nan, np.nan, np.inf, -np.inf
+    direction, turns, index = [], [], []
+    for i, v in enumerate(x):
+        if d == 0:
+            low, high = min(low, v), max(high, v)
+            if high - v > threshold:
+                d, extreme = -1, low
+            elif v - low > threshold:
+                d, extreme = 1, high
+        else:
+            running = max(extreme, v) if d == 1 else min(extreme, v)
+            if (running - v if d == 1 else v - running) > threshold:
+                turn, d, extreme = running, -d, v
+                index.append(i)
+            else:
+                extreme = running
+        direction.append(d)
+        turns.append(turn)
+    return np.array(direction), np.array(turns), np.array(index, dtype=int)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.sampled_from([0.0, 0.3, 2.0]), st.integers(1, 5000))
+def test_find_turns_equals_its_sample_by_sample_definition(seed, threshold, n):
+    rng = np.random.default_rng(seed)
+    x = np.round(np.cumsum(rng.normal(0, 1, n)) + 10 * np.sin(np.arange(n) / rng.uniform(5, 500)), 1)
+    direction, turn, index = _turns_sample_by_sample(x, threshold)
+    got = find_turns(x, threshold)
+    np.testing.assert_array_equal(got.direction, direction)
+    np.testing.assert_array_equal(got.turn_degc, turn)
+    np.testing.assert_array_equal(got.turn_index, index)

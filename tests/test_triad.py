@@ -410,5 +410,6 @@ def test_a_rate_schedule_file_gives_the_reference_rates_instead_of_columns(tmp_p
     (tmp_path / "other.csv").write_text("file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z\nelse.csv,0,10,1,0,0\n")
     with pytest.raises(InputError, match=r"other.csv, row 2: file 'else.csv' is not among the runs given"):
         apply_schedule(read_rate_schedule(tmp_path / "other.csv"), [plain], [tmp_path / "rt.csv"])
-    result = run("evaluate", tmp_path / "rt.csv", tmp_path / "rt.csv", "--rate-schedule", tmp_path / "nothere.csv")
+    result = run("fit", tmp_path / "rt.csv", "-o", tmp_path / "m.json", "--rate-schedule", tmp_path / "nothere.csv")
     assert result.returncode == 2 and "nothere.csv: no such file" in result.stderr
+    assert not (tmp_path / "m.json").exists()

@@ -179,6 +179,50 @@ def _first_true(mask: np.ndarray) -> int:
     return int(hit[0]) if hit.size else -1
 
 
+#: first block a branch is searched in [samples]; each further block doubles
+_TURN_BLOCK = 256
+
+
+def _leave_band(x: np.ndarray, start: int, low: float, high: float,
+                threshold: float) -> tuple[int, int, float, float, float]:
+    """Where the series x [degC] leaves the band of its running extremes (from ``low``, ``high`` [degC]) by more
+    than ``threshold`` [degC] while the direction is unknown: (index or -1, direction, extreme there, low,
+    high), scanning blocks from ``start``."""
+    block, pos = _TURN_BLOCK, start
+    while pos < x.size:
+        seg = x[pos:pos + block]
+        lo = np.minimum.accumulate(np.minimum(seg, low))
+        hi = np.maximum.accumulate(np.maximum(seg, high))
+        up = _first_true(seg - lo > threshold)
+        down = _first_true(hi - seg > threshold)
+        if up >= 0 or down >= 0:
+            k, d = (up, 1) if down < 0 or (0 <= up < down) else (down, -1)
+            return pos + k, d, float(hi[k]) if d == 1 else float(lo[k]), low, high
+        low, high = float(lo[-1]), float(hi[-1])
+        pos += seg.size
+        block *= 2
+    return -1, 0, math.nan, low, high
+
+
+def _reversal(x: np.ndarray, start: int, d: int, extreme: float, threshold: float) -> tuple[int, float]:
+    """Where the branch of direction d (+1 rising, -1 falling) of x [degC] reverses (its running extreme, from
+    ``extreme``, left by more than ``threshold`` [degC]), scanning blocks from ``start``: (index or -1, the
+    running extreme there or at the end [degC])."""
+    block, pos = _TURN_BLOCK, start
+    while pos < x.size:
+        seg = x[pos:pos + block]
+        running = np.maximum.accumulate(np.maximum(seg, extreme)) if d == 1 else \
+            np.minimum.accumulate(np.minimum(seg, extreme))
+        back = (running - seg) if d == 1 else (seg - running)
+        k = _first_true(back > threshold)
+        if k >= 0:
+            return pos + k, float(running[k])
+        extreme = float(running[-1])
+        pos += seg.size
+        block *= 2
+    return -1, extreme
+
+
 def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
                state: TurnState | None = None) -> Turns:
     """Turning points of a temperature series, robust to noise and to whole-degree steps.
@@ -187,7 +231,8 @@ def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
     current branch by more than ``threshold_degc``; its turning temperature T_turn is that extreme.
     Noise and quantization steps smaller than the threshold never make a reversal. The detector is
     causal, so a stream processed in chunks (passing ``state``) gives exactly the batch result.
-    The work is vectorized per branch, not per sample.
+    Each branch is searched in blocks that double from 256 samples, so the work is linear in the length
+    of the series (it was quadratic in the number of branches), vectorized per block, not per sample.
 
     Parameters
     ----------
@@ -203,53 +248,44 @@ def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
     n = x.size
     if threshold_degc < 0:
         raise InputError(f"turning-point threshold: must not be negative, got {threshold_degc}")
-    direction = np.zeros(n, dtype=np.int8)
-    turn = np.full(n, np.nan)
-    turns: list[int] = []
     if state is None:
-        if n == 0:
-            return Turns(direction, turn, np.array([], dtype=np.int64),
-                         TurnState(0, math.nan, math.nan, math.inf, -math.inf))
         state = TurnState(0, math.nan, math.nan, math.inf, -math.inf)
     d, extreme, last_turn = state.direction, state.extreme_degc, state.turn_degc
     low, high = state.low_degc, state.high_degc
+    changes = []  # (index, direction, turn temperature or None when only the direction became known)
+    turns = []
     i = 0
     while i < n:
-        seg = x[i:]
         if d == 0:
-            # direction unknown: it becomes known when the series leaves the band extreme +- threshold
-            lo = np.minimum.accumulate(np.minimum(seg, low))
-            hi = np.maximum.accumulate(np.maximum(seg, high))
-            up = _first_true(seg - lo > threshold_degc)
-            down = _first_true(hi - seg > threshold_degc)
-            if up < 0 and down < 0:
-                low, high = float(lo[-1]), float(hi[-1])
+            k, d, extreme, low, high = _leave_band(x, i, low, high, threshold_degc)
+            if k < 0:
                 break
-            k, d = (up, 1) if down < 0 or (0 <= up < down) else (down, -1)
-            extreme = float(hi[k]) if d == 1 else float(lo[k])
-            direction[i + k:] = d
-            i += k + 1
+            changes.append((k, d, None))
+            i = k + 1
             continue
-        running = np.maximum.accumulate(np.maximum(seg, extreme)) if d == 1 else \
-            np.minimum.accumulate(np.minimum(seg, extreme))
-        back = (running - seg) if d == 1 else (seg - running)
-        k = _first_true(back > threshold_degc)
+        k, running = _reversal(x, i, d, extreme, threshold_degc)
         if k < 0:
-            extreme = float(running[-1])
+            extreme = running
             break
-        last_turn = float(running[k])
+        last_turn = running
         d = -d
-        direction[i + k:] = d
-        turn[i + k:] = last_turn
-        turns.append(i + k)
-        extreme = float(seg[k])
-        i += k + 1
+        changes.append((k, d, last_turn))
+        turns.append(k)
+        extreme = float(x[k])
+        i = k + 1
+    direction = np.zeros(n, dtype=np.int8)
+    turn = np.full(n, np.nan)
+    for (k, dk, _), stop in zip(changes, [c[0] for c in changes[1:]] + [n]):
+        direction[k:stop] = dk
+    values = [tk for _, _, tk in changes if tk is not None]
+    for k, tk, stop in zip(turns, values, turns[1:] + [n]):
+        turn[k:stop] = tk
+    first = turns[0] if turns else n
     if state.direction != 0:
-        direction[: (turns[0] if turns else n)] = state.direction
+        direction[:first] = state.direction
     if not math.isnan(state.turn_degc):
-        turn[: (turns[0] if turns else n)] = state.turn_degc
-    return Turns(direction, turn, np.asarray(turns, dtype=np.int64),
-                 TurnState(int(d), extreme, last_turn, low, high))
+        turn[:first] = state.turn_degc
+    return Turns(direction, turn, np.asarray(turns, dtype=np.int64), TurnState(int(d), extreme, last_turn, low, high))
 
 
 def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_dps: tuple[float, ...] | np.ndarray,

@@ -73,7 +73,13 @@ class PolynomialBias:
         """Bias shape [deg/s] at ``temperature_degc`` [degC]; past the range held or extended (``extrapolation``)."""
         t = np.asarray(temperature_degc, dtype=float)
         u = (np.clip(t, self.t_min_degc, self.t_max_degc) - self.t_ref_degc) / self.t_scale_degc
-        return polynomial_columns(u, self.order, self.extrapolation_u(t, u)) @ np.asarray(self.coefficients_dps)
+        # Horner's rule (as polynomial_columns @ coefficients, without building the columns)
+        coefficients = [0.0, *map(float, self.coefficients_dps)]
+        value = horner(u, coefficients)
+        beyond = self.extrapolation_u(t, u)
+        if beyond is not None and self.order:
+            value = value + horner(u, [k * c for k, c in enumerate(coefficients)][1:]) * beyond
+        return value
 
     def extrapolation_u(self, temperature_degc: np.ndarray, clipped_u: np.ndarray) -> np.ndarray | None:
         """How far past the range each temperature lies, in u units (None when the curve is held)."""
@@ -99,6 +105,15 @@ class PolynomialBias:
         return cls(tuple(float(c) for c in d["coefficients_dps"]), float(d["t_ref_degc"]),
                    float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]),
                    str(d.get("extrapolation", "hold")))
+
+
+def horner(u: np.ndarray, coefficients: list[float]) -> np.ndarray:
+    """sum_k coefficients[k] u^k by Horner's rule, one pass over u per coefficient."""
+    value = np.full(np.shape(u), coefficients[-1]) if len(coefficients) == 1 else coefficients[-1] * u + coefficients[-2]
+    for c in reversed(coefficients[:-2]):
+        value *= u
+        value += c
+    return value
 
 
 def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray | None = None) -> np.ndarray:

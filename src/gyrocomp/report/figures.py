@@ -16,6 +16,7 @@ are binned or thinned, so the figures stay readable and fast.
 from __future__ import annotations
 
 import os
+import weakref
 
 import numpy as np
 
@@ -170,9 +171,21 @@ def allan_plot(analyses: dict, title: str = "Allan deviation"):
     return fig
 
 
+#: the branches of the temperature arrays drawn lately, by identity: the axes of one run share its temperature,
+#: so its turning points are found once per run, not once per axis
+_BRANCHES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
+
+
 def _branches(temperature: np.ndarray) -> np.ndarray:
     """+1 where the temperature rises, -1 where it falls (robust turning points), 0 before the first move."""
-    return find_turns(temperature, turn_threshold_degc(temperature)).direction
+    hit = _BRANCHES.get(id(temperature))
+    if hit is not None and hit[0]() is temperature:
+        return hit[1]
+    direction = find_turns(temperature, turn_threshold_degc(temperature)).direction
+    for key in [k for k, (ref, _) in _BRANCHES.items() if ref() is None]:
+        del _BRANCHES[key]
+    _BRANCHES[id(temperature)] = (weakref.ref(temperature), direction)
+    return direction
 
 
 def _binned(t: np.ndarray, y: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray]:
