@@ -202,9 +202,11 @@ class _Figures:
     residual_rms: float
 
 
-def _figures(raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretches: list[slice]) -> _Figures:
+def _figures(raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretches: list[slice],
+             lows: tuple | None = None) -> _Figures:
+    """``lows``: the raw and compensated Allan minima when already computed."""
     off_raw, off_comp = bias_offset(raw, w), bias_offset(comp, w)
-    low_raw, low_comp = _allan_minimum(raw, rate_hz, stretches), _allan_minimum(comp, rate_hz, stretches)
+    low_raw, low_comp = lows or (_allan_minimum(raw, rate_hz, stretches), _allan_minimum(comp, rate_hz, stretches))
     return _Figures(off_raw, off_comp, off_raw / off_comp if off_comp > 0 else math.inf,
                     low_raw.deviation, low_comp.deviation, low_raw.tau_s, low_comp.tau_s,
                     smoothed_residual_rms(comp, w))
@@ -230,13 +232,16 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
             "between them, the moving average runs across them",
             DataQualityWarning, stacklevel=2,
         )
+    # the Allan minima do not depend on the window; the default window is the raw minima's longest tau
+    lows = [(_allan_minimum(raw.gyro_dps[:, j], raw.rate_hz, stretches),
+             _allan_minimum(compensated.gyro_dps[:, j], raw.rate_hz, stretches)) for j in range(len(raw.gyro_axes))]
     if window_s is None:
-        window_s = default_window_s(raw)
+        window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows))  # as default_window_s(raw)
     w = window_samples(window_s, raw.rate_hz, raw.n_samples)
     to_dph = DEG_PER_S_TO_DEG_PER_H / BIAS_INSTABILITY_FACTOR
     axes = {}
     for j, axis in enumerate(raw.gyro_axes):
-        f = _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches)
+        f = _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches, lows[j])
         axes[axis] = AxisMetrics(
             bias_offset_raw_dps=f.offset_raw, bias_offset_comp_dps=f.offset_comp, offset_improvement=f.improvement,
             bias_instability_raw_dph=f.allan_min_raw * to_dph, bias_instability_comp_dph=f.allan_min_comp * to_dph,

@@ -188,13 +188,15 @@ def _branches(temperature: np.ndarray) -> np.ndarray:
     return direction
 
 
-def _binned(t: np.ndarray, y: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray]:
+def _binned(t: np.ndarray, width: float, *series: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Mean temperature and mean of each series in temperature bins of ``width`` [degC] (the bins found once
+    for all the series)."""
     if t.size == 0:
-        return t, y
-    index = np.floor((t - t.min()) / width).astype(int)
+        return (t, *series)
+    index = np.floor((t - t.min()) / width).astype(np.intp)
     counts = np.bincount(index)
     keep = counts > 0
-    return (np.bincount(index, t)[keep] / counts[keep], np.bincount(index, y)[keep] / counts[keep])
+    return tuple(np.bincount(index, y)[keep] / counts[keep] for y in (t, *series))
 
 
 def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: str | None = None):
@@ -223,15 +225,13 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
             sel = direction == sign
             if not sel.any():
                 continue
-            tb, yb = _binned(t[sel], y_raw[sel] - offset, width)
+            tb, yb, yc, yr = _binned(t[sel], width, y_raw[sel] - offset, correction[sel], y_comp[sel] - offset)
             top.plot(tb, yb, ".", ms=3, color=colour, alpha=0.7, label=None if name in labelled else f"raw, {name}")
             labelled.add(name)
-            tc, yc = _binned(t[sel], correction[sel], width)
-            top.plot(tc, yc, "-", color="black", lw=1.2,
+            top.plot(tb, yc, "-", color="black", lw=1.2,
                      label=None if "model" in labelled else "model correction")
             labelled.add("model")
-            tr, yr = _binned(t[sel], y_comp[sel] - offset, width)
-            bottom.plot(tr, yr, ".", ms=3, color=colour, alpha=0.7)
+            bottom.plot(tb, yr, ".", ms=3, color=colour, alpha=0.7)
         turns = np.flatnonzero(np.diff(direction) != 0) + 1
         turns = turns[direction[turns - 1] != 0]
         if turns.size:

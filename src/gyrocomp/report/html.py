@@ -30,7 +30,7 @@ from ..calibration import Calibration
 from ..compensate import apply
 from ..errors import DataQualityWarning, TemperatureRangeWarning
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
-from ..metrics import default_window_s, evaluate_run
+from ..metrics import evaluate_run
 from ..noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
 from ..static import static_segments
@@ -156,12 +156,15 @@ def _validation(result: ValidationResult) -> str:
     return _table(header, rows, caption) + folds
 
 
-def _evaluation(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
-                windows: list[float], turn_on_window_s: float | None) -> str:
+def _evaluation(calibration: Calibration, runs: list[Recording], evaluations: list,
+                turn_on_window_s: float | None) -> str:
+    """The evaluation table: ``evaluations`` (:func:`evaluate_run` of each run), or the stages of a staged model
+    over the same windows."""
     staged = len(stage_calibrations(calibration)) > 1
     parts = []
     rows, accel_rows = [], []
-    for rec, comp, window_s in zip(runs, compensated, windows):
+    for rec, ev in zip(runs, evaluations):
+        window_s = ev.window_s
         name = html.escape(rec.source.rsplit("/", 1)[-1])
         if staged:
             st = evaluate_stages(calibration, rec, window_s=window_s, turn_on_window_s=turn_on_window_s)
@@ -174,9 +177,6 @@ def _evaluation(calibration: Calibration, runs: list[Recording], compensated: li
                     m = axes[axis]
                     rows.append(["", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x",
                                  m.bias_instability_comp_dph, m.integration_time_comp_s])
-        if staged and not calibration.accel_axes:
-            continue
-        ev = evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
         if not staged:
             for axis, m in ev.axes.items():
                 rows.append([name, axis, "compensated", m.bias_offset_raw_dps, m.bias_offset_comp_dps,
@@ -304,8 +304,10 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         sections["summary"] = ("Model", _summary(calibration))
         if validation is not None:
             sections["validation"] = ("Validation", _validation(validation))
-        windows = [window_s or default_window_s(rec) for rec in runs]
-        sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, compensated, windows, turn_on_window_s))
+        evaluations = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
+                       for rec, comp in zip(runs, compensated)]
+        windows = [ev.window_s for ev in evaluations]
+        sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
         modelled = [a for a in runs[0].gyro_axes if a in calibration.axes]
         modelled += [a for a in calibration.accel_axes if runs[0].accel_g is not None]
