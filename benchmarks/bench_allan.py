@@ -10,6 +10,8 @@ tracemalloc (numpy reports its buffers there), as a multiple of the input array'
 memory-mapped ``.npy`` file and the phase goes to a second memory-mapped file (``phase_out``); it
 prints the throughput and the process's peak resident memory.
 
+The largest size is timed again with a busy neighbour process on one core (``benchmarks/busy.py``).
+
 Usage: python benchmarks/bench_allan.py [--sizes 1e6,1e7] [--repeat 3] [--huge 1e9 --workdir DIR]
 Needs the bench extra: pip install -e '.[bench]'
 """
@@ -26,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from busy import busy_neighbour
 from gyrocomp.allan import allan_deviation, averaging_factors
 
 
@@ -109,6 +112,12 @@ def main() -> None:
               f"{r['speedup']:.1f}x | {r['gyrocomp_ci_s']:.3f} | {r['speedup_ci']:.1f}x | "
               f"{r['allantools_extra_memory_x']:.2f}x / {r['gyrocomp_extra_memory_x']:.2f}x / "
               f"{r['gyrocomp_ci_extra_memory_x']:.2f}x input | {r['max_relative_difference']:.1e} |")
+    largest = max(int(float(size)) for size in args.sizes.split(","))
+    with busy_neighbour():
+        r = compare(largest, args.repeat)
+    print(f"\nwith a busy neighbour process on one core, {largest:.0e} samples: allantools {r['allantools_s']:.3f} s, "
+          f"gyrocomp {r['gyrocomp_s']:.3f} s = {r['speedup']:.1f}x; with noise ID + CIs {r['gyrocomp_ci_s']:.3f} s "
+          f"= {r['speedup_ci']:.1f}x")
     if args.huge:
         with tempfile.TemporaryDirectory(dir=args.workdir) as tmp:
             r = huge(int(args.huge), Path(tmp))

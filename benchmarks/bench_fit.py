@@ -12,6 +12,9 @@ a heat-cool cycle, a ramp-and-hold and a warm-up, one power-on each. Timed in th
 - ``validate``: the whole comparison table (raw, PX4's and ArduPilot's cubics, the plain cubic, the default),
   each method refitted on every fold.
 
+The plain cubic and the default fit are timed again with a busy neighbour process on one core
+(``benchmarks/busy.py``): the library keeps BLAS on one thread, so it should barely notice.
+
 Usage: python benchmarks/bench_fit.py [--minutes M] [--rate HZ]
 """
 
@@ -25,6 +28,7 @@ import warnings
 
 import numpy as np
 
+from busy import busy_neighbour
 from gyrocomp import fit_calibration
 from gyrocomp.simulate import get_profile, simulate
 from gyrocomp.validation import fit_plain_cubic, validate
@@ -58,6 +62,9 @@ def main() -> None:
     t_cubic, _ = timed(lambda: fit_plain_cubic(recordings))
     t_fit, cal = timed(lambda: fit_calibration(recordings))
     t_validate, result = timed(lambda: validate(recordings))
+    with busy_neighbour():
+        t_cubic_busy, _ = timed(lambda: fit_plain_cubic(recordings))
+        t_fit_busy, _ = timed(lambda: fit_calibration(recordings))
     scored = sum(len(s["candidates"]) for s in cal.fit_report["selection"].values())
 
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
@@ -70,6 +77,8 @@ def main() -> None:
     print(f"| `fit_calibration`, defaults (every candidate scored on held-out folds) | {t_fit:.1f} | "
           f"{t_fit / t_cubic:.1f}x |")
     print(f"| `validate` (5 methods, each refitted on every fold) | {t_validate:.1f} | {t_validate / t_cubic:.1f}x |")
+    print(f"| with a busy neighbour on one core: plain cubic | {t_cubic_busy:.1f} | {t_cubic_busy / t_cubic:.2f}x idle |")
+    print(f"| with a busy neighbour on one core: `fit_calibration` | {t_fit_busy:.1f} | {t_fit_busy / t_fit:.2f}x idle |")
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 
 #: bottom to top; a module belongs to the first layer one of whose prefixes it matches
 LAYERS = (
-    ("foundation", ("_version", "errors", "units")),
+    ("foundation", ("_version", "errors", "units", "threads")),
     ("signals", ("recording", "effects", "allan", "noise", "static", "metrics", "plausibility", "simulate")),
     ("io", ("io",)),
     # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve) live beside the

@@ -23,6 +23,7 @@ from .models.base import provenance
 from .models.pipelines import fit_calibration
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
+from .threads import single_threaded_blas
 from .recording import Recording
 
 #: the polynomial order both autopilots use for the gyro bias against temperature
@@ -142,6 +143,7 @@ class MethodComparison:
         return {"how": self.how, "window_s": self.window_s, "rows": [asdict(r) for r in self.rows]}
 
 
+@single_threaded_blas
 def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | None = None,
                     window_s: float | None = None, hysteresis_band_degc: tuple[float, float] | None = None,
                     seed: int = 0) -> MethodComparison:

@@ -33,6 +33,7 @@ from .models.pipelines import fit_calibration
 from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, FoldDrift, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
+from .threads import single_threaded_blas
 from .recording import Recording
 from .comparison import fit_ardupilot_style, fit_px4_style
 
@@ -186,6 +187,7 @@ def _fit(method, train: list[Recording]) -> Calibration | None:
     return fit_calibration(train, **method)
 
 
+@single_threaded_blas
 def validate(recordings: list[Recording], *, folds: str = "auto", window_s: float | None = None,
              candidates: dict[str, dict] | None = None) -> ValidationResult:
     """Held-out drift of the baselines, gyrocomp's default and ``candidates`` on folds of ``recordings``.

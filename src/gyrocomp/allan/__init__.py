@@ -16,6 +16,7 @@ from typing import Iterable
 
 import numpy as np
 
+from ..threads import single_threaded_blas
 from ..errors import InputError
 from .estimators import (
     DEFAULT_STOP_RATIO,
@@ -87,6 +88,7 @@ def _as_phase(data, rate_hz: float, data_type: str, phase_out) -> tuple[np.ndarr
     return phase, scale
 
 
+@single_threaded_blas
 def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave", data_type: str = "rate",
                     confidence: float | None = ONE_SIGMA, phase_out: np.ndarray | None = None) -> AllanResult:
     """Allan deviation of ``data`` sampled at ``rate_hz``, with confidence intervals.
@@ -129,6 +131,7 @@ def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave",
                        edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence)
 
 
+@single_threaded_blas
 def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: str = "oadev", taus="octave",
                              data_type: str = "rate", confidence: float | None = ONE_SIGMA) -> AllanResult:
     """One deviation curve from several contiguous stretches of data separated by gaps.

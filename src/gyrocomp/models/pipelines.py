@@ -34,6 +34,7 @@ from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
 from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+from ..threads import single_threaded_blas
 
 #: how the fit report names each kind of fold
 FOLD_SELECTION = {"runs": "leave-one-run-out", "legs": "leave-one-leg-out", "blocks": "leave-one-block-out"}
@@ -177,6 +178,7 @@ def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, 
     return selections, thermal
 
 
+@single_threaded_blas
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
@@ -677,6 +679,7 @@ def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibratio
                                fit_report={**accel_cal.fit_report, **report}, accel_triad=fit.calibration)
 
 
+@single_threaded_blas
 def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, ...] | str = ("gyro",),
                  pipeline: str = "joint", *, scale_factor: ScaleFactor = "auto", **options) -> Calibration:
     """Fit the gyro (``fit_pipeline``), the accelerometer, or both.

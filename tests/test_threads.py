@@ -1,0 +1,35 @@
+"""The library's hot paths hold BLAS to one thread while they run and give the caller its setting back (#21)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from threadpoolctl import threadpool_limits
+
+from gyrocomp.allan import allan_deviation
+from gyrocomp.errors import InputError
+from gyrocomp.threads import blas_threads, single_threaded_blas
+
+pytestmark = pytest.mark.skipif(blas_threads() is None, reason="numpy loaded no BLAS library threadpoolctl can see")
+
+
+def test_blas_runs_on_one_thread_inside_and_the_callers_setting_returns():
+    seen = []
+
+    @single_threaded_blas
+    def work():
+        seen.append(blas_threads())
+        return np.linalg.lstsq(np.eye(3), np.ones(3), rcond=None)[0]
+
+    with threadpool_limits(2, user_api="blas"):
+        before = blas_threads()
+        np.testing.assert_allclose(work(), np.ones(3))
+        assert seen == [1] and blas_threads() == before
+
+
+def test_the_setting_returns_when_the_call_raises():
+    with threadpool_limits(2, user_api="blas"):
+        before = blas_threads()
+        with pytest.raises(InputError, match="rate_hz: must be positive"):
+            allan_deviation(np.ones(100), 0.0)
+        assert blas_threads() == before
