@@ -1,46 +1,79 @@
 """gyrocomp: remove the deterministic errors of MEMS gyroscopes from logged data, and prove it.
 
 Internal units: angular rate [deg/s], acceleration [g], temperature [degC], time [s].
+
+The names below are imported from their modules the first time they are used (PEP 562), so ``import gyrocomp``
+and the command line's ``--help`` start without loading numpy, scipy and pandas; ``from gyrocomp import X``
+works as usual.
 """
+
+from __future__ import annotations
+
+import importlib
+import sys
+import types
 
 from ._version import __version__
 
-from .allan import AllanResult, allan_deviation, noise_parameters
-from .calibration import Calibration
-from .compensate import Compensator, apply, predict_error
-from .errors import (
-    DataQualityWarning,
-    GyrocompError,
-    InputError,
-    MissingDependencyError,
-    ModelChoiceWarning,
-    ModelError,
-    NotFittedError,
-    PlausibilityWarning,
-    TemperatureRangeWarning,
-)
-from .evaluation import evaluate, evaluate_stages
-from .io import read
-from .io import write_recording as write
-from .metrics import Evaluation, evaluate_run
-from .models import PolynomialTemperatureModel
-from .models.pipelines import fit_calibration, fit_channels
-from .models.pose_rotation import fit_gyro_between_poses, rotation_errors
-from .models.triad_fit import find_poses, fit_accel_multiposition, fit_gyro_rate_table
-from .noise import analyse_noise
-from .recording import Recording
-from .simulate import simulate
-from .triad import TriadCalibration
-from .validation import validate
+#: public name -> (module, name in it)
+_EXPORTS = {
+    "AllanResult": ("allan", "AllanResult"), "allan_deviation": ("allan", "allan_deviation"),
+    "noise_parameters": ("allan", "noise_parameters"), "Calibration": ("calibration", "Calibration"),
+    "Compensator": ("compensate", "Compensator"), "apply": ("compensate", "apply"),
+    "predict_error": ("compensate", "predict_error"),
+    **{name: ("errors", name) for name in (
+        "DataQualityWarning", "GyrocompError", "InputError", "MissingDependencyError", "ModelChoiceWarning",
+        "ModelError", "NotFittedError", "PlausibilityWarning", "TemperatureRangeWarning")},
+    "evaluate": ("evaluation", "evaluate"), "evaluate_stages": ("evaluation", "evaluate_stages"),
+    "read": ("io", "read"), "write": ("io", "write_recording"),
+    "Evaluation": ("metrics", "Evaluation"), "evaluate_run": ("metrics", "evaluate_run"),
+    "PolynomialTemperatureModel": ("models", "PolynomialTemperatureModel"),
+    "fit_calibration": ("models.pipelines", "fit_calibration"), "fit_channels": ("models.pipelines", "fit_channels"),
+    # ``gyrocomp.fit`` is fit_calibration: recordings in, a frozen Calibration out
+    "fit": ("models.pipelines", "fit_calibration"),
+    "fit_gyro_between_poses": ("models.pose_rotation", "fit_gyro_between_poses"),
+    "rotation_errors": ("models.pose_rotation", "rotation_errors"),
+    "find_poses": ("models.triad_fit", "find_poses"),
+    "fit_accel_multiposition": ("models.triad_fit", "fit_accel_multiposition"),
+    "fit_gyro_rate_table": ("models.triad_fit", "fit_gyro_rate_table"),
+    "analyse_noise": ("noise", "analyse_noise"), "Recording": ("recording", "Recording"),
+    "simulate": ("simulate", "simulate"), "TriadCalibration": ("triad", "TriadCalibration"),
+    "validate": ("validation", "validate"),
+}
 
-#: ``gyrocomp.fit`` is :func:`fit_calibration`: recordings in, a frozen Calibration out
-fit = fit_calibration
 
-__all__ = [
-    "AllanResult", "Calibration", "Compensator", "DataQualityWarning", "Evaluation", "GyrocompError", "InputError",
-    "MissingDependencyError", "ModelChoiceWarning", "ModelError", "NotFittedError", "PlausibilityWarning", "PolynomialTemperatureModel",
-    "Recording", "TemperatureRangeWarning", "TriadCalibration", "allan_deviation", "analyse_noise", "apply", "evaluate",
-    "evaluate_run", "evaluate_stages", "find_poses", "fit", "fit_accel_multiposition", "fit_calibration",
-    "fit_channels", "fit_gyro_between_poses", "fit_gyro_rate_table", "noise_parameters",
-    "predict_error", "read", "rotation_errors", "simulate", "validate", "write", "__version__",
-]
+def _load(name: str):
+    module, attribute = _EXPORTS[name]
+    return getattr(importlib.import_module(f"gyrocomp.{module}"), attribute)
+
+
+class _Package(types.ModuleType):
+    """The package's module type: ``gyrocomp.simulate`` is the function :func:`gyrocomp.simulate.simulate`, even
+    after the subpackage of that name was imported (which sets the attribute to the subpackage; the function
+    always won that race when the package imported everything at once)."""
+
+    @property
+    def simulate(self):
+        return _load("simulate")
+
+    @simulate.setter
+    def simulate(self, value) -> None:  # the import system binding the subpackage: the function stays
+        pass
+
+
+sys.modules[__name__].__class__ = _Package
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'gyrocomp' has no attribute {name!r}")
+    value = _load(name)
+    globals()[name] = value  # found once
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
+
+
+__all__ = sorted(_EXPORTS) + ["__version__"]

@@ -4,6 +4,11 @@ Library code raises these with messages that name the file, row, column or optio
 and say what to do; only :mod:`gyrocomp.cli` turns them into one line on stderr and an exit status.
 """
 
+from __future__ import annotations
+
+import re
+from typing import Literal, get_args
+
 
 class GyrocompError(Exception):
     """Base class of every error gyrocomp raises on purpose."""
@@ -37,6 +42,19 @@ class PlausibilityWarning(DataQualityWarning):
     def __init__(self, message: str = "", check: str | None = None):
         super().__init__(message)
         self.check = check
+
+
+#: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.plausibility`)
+CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span"]
+#: every check's name
+CHECKS: tuple[CheckName, ...] = get_args(CheckName)
+
+
+def silence_pattern(check: str) -> str:
+    """The ``message`` regular expression for ``warnings.filterwarnings`` that silences one check."""
+    if check not in CHECKS:
+        raise InputError(f"check: unknown plausibility check {check!r}; use one of {', '.join(CHECKS)}")
+    return rf"(?s).*\(check {re.escape(repr(check))}\)$"
 
 
 class MissingDependencyError(GyrocompError, ImportError):

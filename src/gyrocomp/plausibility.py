@@ -15,13 +15,11 @@ logged IMUs lie between 1 mHz and 100 kHz.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
-from typing import Literal, get_args
 
 import numpy as np
 
-from .errors import InputError, PlausibilityWarning
+from .errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
 from .metrics import moving_average
 from .recording import Recording
 
@@ -40,10 +38,6 @@ MIN_TEMPERATURE_SPAN_DEGC = 1.0
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
 LONG_SLOW_S = 7 * 86400.0
-#: the name of a check
-CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span"]
-#: every check's name
-CHECKS: tuple[CheckName, ...] = get_args(CheckName)
 
 
 @dataclass(frozen=True)
@@ -57,13 +51,6 @@ class Concern:
     def warning(self) -> PlausibilityWarning:
         """The warning to raise: the message ending with ``(check 'NAME')``, ``check`` set."""
         return PlausibilityWarning(f"{self.message} (check '{self.check}')", check=self.check)
-
-
-def silence_pattern(check: str) -> str:
-    """The ``message`` regular expression for ``warnings.filterwarnings`` that silences one check."""
-    if check not in CHECKS:
-        raise InputError(f"check: unknown plausibility check {check!r}; use one of {', '.join(CHECKS)}")
-    return rf"(?s).*\(check {re.escape(repr(check))}\)$"
 
 
 def recording_concerns(recording: Recording) -> list[Concern]:

@@ -1,19 +1,14 @@
-"""The ``gyrocomp`` command line: parses options, calls the library, prints tables, maps errors to exit codes.
-
-Exit status: 0 success, 2 bad input or usage, 1 other failures. Errors are one line on stderr;
-``--debug`` adds the traceback.
+"""The commands of the ``gyrocomp`` command line: each parses its options, calls the library and prints its
+tables. :mod:`gyrocomp.cli` loads this module only when a command runs (``gyrocomp --help`` does not need the
+library), and maps errors to exit codes.
 """
 
 from __future__ import annotations
 
 import contextlib
 import dataclasses
-import errno
 import json
-import re
-import signal
 import sys
-import traceback
 import warnings
 from pathlib import Path
 
@@ -23,20 +18,11 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from ._version import __version__
-from .allan import KINDS
-from .calibration import Calibration
-from .compensate import apply as apply_calibration
-from .errors import (
-    DataQualityWarning,
-    GyrocompError,
-    InputError,
-    PlausibilityWarning,
-    TemperatureRangeWarning,
-    printable,
-)
-from .plausibility import CHECKS, silence_pattern
-from .io import (
+from ..allan import KINDS
+from ..calibration import Calibration
+from ..compensate import apply as apply_calibration
+from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
+from ..io import (
     FORMATS,
     ReadOptions,
     TableLayout,
@@ -49,31 +35,29 @@ from .io import (
     write_recording,
     write_text_atomic,
 )
-from .io.schedule import apply_schedule, read_rate_schedule
-from .export.kalibr import kalibr_imu, kalibr_imu_yaml
-from .comparison import compare_methods
-from .demo import run_demo
-from .evaluation import evaluate as evaluate_calibration
-from .export.autopilot import ardupilot_params_file, px4_params_file
-from .export.c_code import write_c_sources
-from .evaluation import evaluate_stages
-from .metrics import Evaluation, default_window_s
-from .report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
-from .report.html import build_report
-from .simulate import Simulation, preset_model, resolve_profile
-from .simulate import simulate as run_simulation
-from .models.acceleration import ACCELERATION_CHOICES
-from .models.mlp import DEFAULT_HIDDEN
-from .models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
-from .models.selection import FOLD_KINDS
-from .models.temperature import MAX_ORDER
-from .models.thermal import CANDIDATES, HYSTERESIS_CHOICES
-from .validation import ValidationResult, validate as validate_runs
-from .noise import NoiseAnalysis, analyse_noise
-from .report.figures import allan_figure, check_figure_path
+from ..io.schedule import apply_schedule, read_rate_schedule
+from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
+from ..comparison import compare_methods
+from ..demo import run_demo
+from ..evaluation import evaluate as evaluate_calibration
+from ..export.autopilot import ardupilot_params_file, px4_params_file
+from ..export.c_code import write_c_sources
+from ..evaluation import evaluate_stages
+from ..metrics import Evaluation, default_window_s
+from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
+from ..report.html import build_report
+from ..simulate import Simulation, preset_model, resolve_profile
+from ..simulate import simulate as run_simulation
+from ..models.acceleration import ACCELERATION_CHOICES
+from ..models.mlp import DEFAULT_HIDDEN
+from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
+from ..models.selection import FOLD_KINDS
+from ..models.temperature import MAX_ORDER
+from ..models.thermal import CANDIDATES, HYSTERESIS_CHOICES
+from ..validation import ValidationResult, validate as validate_runs
+from ..noise import NoiseAnalysis, analyse_noise
+from ..report.figures import allan_figure, check_figure_path
 
-EXIT_INPUT = 2
-EXIT_FAILURE = 1
 
 
 def _console() -> Console:
@@ -145,29 +129,6 @@ def _pop_read_options(kwargs: dict) -> dict:
     return {k: kwargs.pop(k) for k in _READ_OPTIONS}
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="gyrocomp")
-@click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
-@click.option("--quiet", "-q", is_flag=True, help="Print only errors.")
-@click.option("--allow", "allowed", multiple=True, type=click.Choice(CHECKS), metavar="CHECK",
-              help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.")
-@click.pass_context
-def cli(ctx, debug, quiet, allowed):
-    """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
-    g-sensitivity) from logs, and measure what is left.
-
-    Typical flow: fit on calibration runs, apply to new data, evaluate or report, export to firmware
-    or an autopilot; allan for noise; demo for all of it on simulated data.
-
-    Units: angular rate deg/s, acceleration g, temperature degC, time s.
-    """
-    ctx.obj = {"debug": debug, "quiet": quiet}
-    if allowed:
-        ctx.with_resource(warnings.catch_warnings())
-        for check in allowed:
-            warnings.filterwarnings("ignore", message=silence_pattern(check), category=PlausibilityWarning)
-
-
 def parse_hidden(text: str) -> tuple[int, ...]:
     """``"mlp"`` -> (3,), ``"mlp:5"`` -> (5,), ``"mlp:5x4"`` -> (5, 4)."""
     text = text.strip().lower()
@@ -216,7 +177,7 @@ def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-@cli.command()
+@click.command()
 @click.option("--preset", default="mti10", show_default=True,
               help="Sensor: adxrs450, mti10, adis16488 or consumer (values from datasheets; see the docs).")
 @click.option("--profile", default="chamber", show_default=True,
@@ -289,7 +250,7 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
 
 
 # -- fit --------------------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write (JSON).")
 @click.option("--temperature", default="poly", show_default=True,
@@ -502,7 +463,7 @@ def _print_g_sensitivity(console, report: dict) -> None:
 
 
 # -- apply ------------------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.argument("model", type=click.Path())
 @click.argument("input_path", metavar="IN", type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Compensated output file.")
@@ -532,7 +493,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
 
 
 # -- convert ----------------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.argument("input_path", metavar="IN", type=click.Path())
 @click.argument("output", metavar="OUT", type=click.Path(dir_okay=False))
 @read_options
@@ -555,7 +516,7 @@ def convert(ctx, input_path, output, **kwargs):
 
 
 # -- validate ---------------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
               help="Hold out each run, each heating or cooling leg, or time blocks; auto: runs with three runs "
@@ -606,7 +567,7 @@ def print_validation(result: ValidationResult) -> None:
 
 
 # -- evaluate ---------------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path(), metavar="MODEL RUNS... | --compare RUNS...")
 @click.option("--window", "window_s", type=float, default=None,
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
@@ -783,7 +744,7 @@ def _parse_fit_taus(text: str | None):
 POOR_FIT_LOG_RESIDUAL = 0.25
 
 
-@cli.command()
+@click.command()
 @click.argument("input_path", metavar="FILE", type=click.Path())
 @click.option("--axes", "axes", default=None, help="Columns to analyse, e.g. gyro_x,gyro_z,accel_z (default: every gyro axis).")
 @click.option("--kind", type=click.Choice(KINDS), default="oadev", show_default=True, help="Estimator of the printed curve.")
@@ -879,7 +840,7 @@ def print_noise(analysis: NoiseAnalysis) -> None:
 EXPORT_FORMATS = ("px4", "ardupilot", "c")
 
 
-@cli.command()
+@click.command()
 @click.argument("model", type=click.Path())
 @click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), required=True,
               help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters), "
@@ -892,7 +853,7 @@ EXPORT_FORMATS = ("px4", "ardupilot", "c")
 @click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id (TC_G*_ID).")
 @click.pass_context
 def export(ctx, model, fmt, output, rate_hz, instance, device_id):
-    """Write MODEL as autopilot thermal-calibration parameters (the temperature cubic only), or as C code."""
+    """Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code."""
 
     refuse_to_overwrite_inputs(output, [model])
     calibration = Calibration.load(model)
@@ -916,7 +877,7 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id):
 
 
 # -- report and plot --------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.argument("model", type=click.Path())
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="The HTML file to write.")
@@ -957,7 +918,7 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
         click.echo(f"wrote {output}: {len(result.html) / 1e6:.2f} MB, sections {', '.join(result.sections)}")
 
 
-@cli.group()
+@click.group()
 def plot():
     """Single figures as PNG, SVG or PDF (from the suffix of -o)."""
 
@@ -1065,7 +1026,7 @@ def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, *
 
 
 # -- demo -------------------------------------------------------------------------------------------
-@cli.command()
+@click.command()
 @click.option("-o", "--output", "out_dir", default="gyrocomp-demo", show_default=True,
               type=click.Path(file_okay=False), help="Folder for the demo's files.")
 @click.pass_context
@@ -1082,117 +1043,3 @@ def demo(ctx, out_dir):
         print_validation(result.validation)
         print_evaluation(result.evaluation, title="held-out run, raw vs compensated")
         console.print(f"files in {out_dir}/: " + ", ".join(sorted(p.name for p in Path(out_dir).iterdir())))
-
-
-# -- entry point ------------------------------------------------------------------------------------
-#: the library names its Python parameters in messages (``window_s: must be positive``, ``give axes= ...``);
-#: on the command line the user typed a flag, so the message names that instead
-PARAMETER_FLAGS = {
-    "window_s": "--window", "turn_on_window_s": "--turn-on-window", "rate_hz": "--rate", "axes": "--axes",
-    "static_min_duration_s": "--min-static", "acceleration": "--acceleration", "hysteresis": "--hysteresis",
-    "hysteresis_order": "--hysteresis-order", "hysteresis_band_degc": "--hysteresis-band",
-    "pipeline": "--pipeline", "channels": "--channels", "scale_factor": "--scale-factor", "columns": "--columns", "fmt": "--format",
-    "instance": "--instance", "device_id": "--device-id", "record": "--record", "imu_topic": "--imu-topic",
-    "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
-    "time_unit": "--time-unit", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
-    "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
-    "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
-    "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
-    "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
-    "decimal": "--decimal",
-}
-_MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
-_SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone
-_PARAMETER = re.compile(r"(?<![\w.\-/])(" + "|".join(sorted(PARAMETER_FLAGS, key=len, reverse=True)) + r")([:=])")
-
-
-def in_cli_words(message: str) -> str:
-    """``message`` with the Python parameters it names (``name:`` or ``name=value``) as the flags that set them
-    (``--flag:``, ``--flag value``)."""
-    def flag(m: re.Match) -> str:
-        name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
-        if sep == ":":
-            return PARAMETER_FLAGS[name] + ":"
-        return PARAMETER_FLAGS[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
-
-    message = _PARAMETER.sub(flag, _SWITCH.sub(r"\1=", message))
-    return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None):
-    click.echo(f"gyrocomp: warning: {printable(in_cli_words(str(message)))}", err=True)
-
-
-def _environment_message(exc: BaseException) -> str:
-    """One line for an error of the machine rather than of gyrocomp: the file and what to do."""
-    if isinstance(exc, MemoryError):
-        return "not enough memory for this size of data; process it in pieces or on a larger machine"
-    where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-    hint = {errno.EACCES: "check its permissions", errno.EPERM: "check its permissions",
-            errno.ENOSPC: "the disk is full; free space and run again", errno.EFBIG: "the file is too large here",
-            errno.ELOOP: "a symbolic link loops", errno.EROFS: "the file system is read-only"}
-    reason = exc.strerror or type(exc).__name__
-    return f"{where}{reason.lower()}" + (f"; {hint[exc.errno]}" if getattr(exc, "errno", None) in hint else "")
-
-
-def _exit_on_termination() -> None:
-    """SIGTERM and SIGHUP end the command as an exception would: every temporary output is removed on the
-    way out (the atomic writers clean up on any exception) and nothing half-written is left at a target."""
-    def stop(signum, frame):
-        raise SystemExit(128 + signum)
-
-    for name in ("SIGTERM", "SIGHUP"):
-        if hasattr(signal, name):
-            signal.signal(getattr(signal, name), stop)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Console entry point: runs the command and returns (and, as a script, exits with) its status."""
-    if argv is None:
-        _exit_on_termination()
-    args = sys.argv[1:] if argv is None else list(argv)
-    debug = "--debug" in args
-    previous = warnings.showwarning
-    warnings.showwarning = _show_warning
-    try:
-        result = cli.main(args=args, prog_name="gyrocomp", standalone_mode=False)
-        status = result if isinstance(result, int) else 0
-    except click.exceptions.Exit as exc:
-        status = exc.exit_code
-    except click.exceptions.Abort:
-        click.echo("gyrocomp: aborted", err=True)
-        status = EXIT_FAILURE
-    except click.ClickException as exc:  # usage errors: bad option, missing argument
-        if debug:
-            traceback.print_exc()
-        click.echo(f"gyrocomp: error: {printable(exc.format_message())}", err=True)
-        status = EXIT_INPUT if isinstance(exc, click.UsageError) else exc.exit_code
-    except InputError as exc:
-        if debug:
-            traceback.print_exc()
-        click.echo(f"gyrocomp: error: {printable(in_cli_words(str(exc)))}", err=True)
-        status = EXIT_INPUT
-    except GyrocompError as exc:
-        if debug:
-            traceback.print_exc()
-        click.echo(f"gyrocomp: error: {printable(str(exc))}", err=True)
-        status = EXIT_FAILURE
-    except (OSError, MemoryError) as exc:  # the environment, not a bug: permissions, a full disk, a link loop
-        if debug:
-            traceback.print_exc()
-        click.echo(f"gyrocomp: error: {printable(_environment_message(exc))}", err=True)
-        status = EXIT_INPUT
-    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
-        if debug:
-            traceback.print_exc()
-        click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
-                   "(run with --debug for the traceback)", err=True)
-        status = EXIT_FAILURE
-    finally:
-        warnings.showwarning = previous
-    if argv is None:
-        sys.exit(status)
-    return status
-
-
-__all__ = ["cli", "main"]

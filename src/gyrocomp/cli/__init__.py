@@ -1,0 +1,206 @@
+"""The ``gyrocomp`` command line: the group, its commands loaded when used, and the mapping of errors to exit codes.
+
+Exit status: 0 success, 2 bad input or usage, 1 other failures. Errors are one line on stderr;
+``--debug`` adds the traceback.
+
+This module needs only click: ``gyrocomp --help`` and ``gyrocomp --version`` start without numpy, scipy or
+pandas. The commands live in :mod:`gyrocomp.cli.commands`, imported the first time one is looked up; their one-line
+descriptions are listed here (a test checks they match the commands' own).
+"""
+
+from __future__ import annotations
+
+import errno
+import importlib
+import re
+import signal
+import sys
+import traceback
+import warnings
+
+import click
+from click.utils import make_default_short_help
+
+from .._version import __version__
+from ..errors import CHECKS, GyrocompError, InputError, PlausibilityWarning, printable, silence_pattern
+
+EXIT_INPUT = 2
+EXIT_FAILURE = 1
+
+#: every command: its name, the function in gyrocomp.cli.commands, and its one-line help (``gyrocomp --help``
+#: shows it shortened to the terminal)
+COMMANDS = {
+    "simulate": ("simulate", 'Simulate calibration runs of a sensor preset through a test profile, with the exact truth.'),
+    "fit": ("fit", 'Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest).'),
+    "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
+    "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
+    "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's "
+                    'default.'),
+    "evaluate": ("evaluate", 'Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.'),
+    "allan": ("allan", 'Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of '
+                 'FILE.'),
+    "export": ("export", 'Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as '
+                  'C code.'),
+    "report": ("report", 'One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias '
+                  'against temperature, raw and compensated series, Allan deviations, g-sensitivity; with '
+                  '--validate-on, the held-out drift of each method on those calibration runs.'),
+    "plot": ("plot", 'Single figures as PNG, SVG or PDF (from the suffix of -o).'),
+    "demo": ("demo", 'The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score '
+                'it, and write the HTML report.'),
+}
+
+
+class LazyGroup(click.Group):
+    """A click group whose commands are imported when one is looked up (running it or its --help), and whose
+    own help lists them from :data:`COMMANDS` without importing anything."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in COMMANDS:
+            return None
+        return getattr(importlib.import_module("gyrocomp.cli.commands"), COMMANDS[name][0])
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        limit = formatter.width - 6 - max(len(name) for name in COMMANDS)
+        with formatter.section("Commands"):
+            formatter.write_dl([(name, make_default_short_help(text, limit))
+                                for name, (_, text) in sorted(COMMANDS.items())])
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="gyrocomp")
+@click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
+@click.option("--quiet", "-q", is_flag=True, help="Print only errors.")
+@click.option("--allow", "allowed", multiple=True, type=click.Choice(CHECKS), metavar="CHECK",
+              help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.")
+@click.pass_context
+def cli(ctx, debug, quiet, allowed):
+    """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
+    g-sensitivity) from logs, and measure what is left.
+
+    Typical flow: fit on calibration runs, apply to new data, evaluate or report, export to firmware
+    or an autopilot; allan for noise; demo for all of it on simulated data.
+
+    Units: angular rate deg/s, acceleration g, temperature degC, time s.
+    """
+    ctx.obj = {"debug": debug, "quiet": quiet}
+    if allowed:
+        ctx.with_resource(warnings.catch_warnings())
+        for check in allowed:
+            warnings.filterwarnings("ignore", message=silence_pattern(check), category=PlausibilityWarning)
+
+
+# -- entry point ------------------------------------------------------------------------------------
+#: the library names its Python parameters in messages (``window_s: must be positive``, ``give axes= ...``);
+#: on the command line the user typed a flag, so the message names that instead
+PARAMETER_FLAGS = {
+    "window_s": "--window", "turn_on_window_s": "--turn-on-window", "rate_hz": "--rate", "axes": "--axes",
+    "static_min_duration_s": "--min-static", "acceleration": "--acceleration", "hysteresis": "--hysteresis",
+    "hysteresis_order": "--hysteresis-order", "hysteresis_band_degc": "--hysteresis-band",
+    "pipeline": "--pipeline", "channels": "--channels", "scale_factor": "--scale-factor", "columns": "--columns", "fmt": "--format",
+    "instance": "--instance", "device_id": "--device-id", "record": "--record", "imu_topic": "--imu-topic",
+    "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
+    "time_unit": "--time-unit", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
+    "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
+    "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
+    "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
+    "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
+    "decimal": "--decimal",
+}
+_MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
+_SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone
+_PARAMETER = re.compile(r"(?<![\w.\-/])(" + "|".join(sorted(PARAMETER_FLAGS, key=len, reverse=True)) + r")([:=])")
+
+
+def in_cli_words(message: str) -> str:
+    """``message`` with the Python parameters it names (``name:`` or ``name=value``) as the flags that set them
+    (``--flag:``, ``--flag value``)."""
+    def flag(m: re.Match) -> str:
+        name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
+        if sep == ":":
+            return PARAMETER_FLAGS[name] + ":"
+        return PARAMETER_FLAGS[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
+
+    message = _PARAMETER.sub(flag, _SWITCH.sub(r"\1=", message))
+    return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    click.echo(f"gyrocomp: warning: {printable(in_cli_words(str(message)))}", err=True)
+
+
+def _environment_message(exc: BaseException) -> str:
+    """One line for an error of the machine rather than of gyrocomp: the file and what to do."""
+    if isinstance(exc, MemoryError):
+        return "not enough memory for this size of data; process it in pieces or on a larger machine"
+    where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+    hint = {errno.EACCES: "check its permissions", errno.EPERM: "check its permissions",
+            errno.ENOSPC: "the disk is full; free space and run again", errno.EFBIG: "the file is too large here",
+            errno.ELOOP: "a symbolic link loops", errno.EROFS: "the file system is read-only"}
+    reason = exc.strerror or type(exc).__name__
+    return f"{where}{reason.lower()}" + (f"; {hint[exc.errno]}" if getattr(exc, "errno", None) in hint else "")
+
+
+def _exit_on_termination() -> None:
+    """SIGTERM and SIGHUP end the command as an exception would: every temporary output is removed on the
+    way out (the atomic writers clean up on any exception) and nothing half-written is left at a target."""
+    def stop(signum, frame):
+        raise SystemExit(128 + signum)
+
+    for name in ("SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), stop)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Console entry point: runs the command and returns (and, as a script, exits with) its status."""
+    if argv is None:
+        _exit_on_termination()
+    args = sys.argv[1:] if argv is None else list(argv)
+    debug = "--debug" in args
+    previous = warnings.showwarning
+    warnings.showwarning = _show_warning
+    try:
+        result = cli.main(args=args, prog_name="gyrocomp", standalone_mode=False)
+        status = result if isinstance(result, int) else 0
+    except click.exceptions.Exit as exc:
+        status = exc.exit_code
+    except click.exceptions.Abort:
+        click.echo("gyrocomp: aborted", err=True)
+        status = EXIT_FAILURE
+    except click.ClickException as exc:  # usage errors: bad option, missing argument
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {printable(exc.format_message())}", err=True)
+        status = EXIT_INPUT if isinstance(exc, click.UsageError) else exc.exit_code
+    except InputError as exc:
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {printable(in_cli_words(str(exc)))}", err=True)
+        status = EXIT_INPUT
+    except GyrocompError as exc:
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {printable(str(exc))}", err=True)
+        status = EXIT_FAILURE
+    except (OSError, MemoryError) as exc:  # the environment, not a bug: permissions, a full disk, a link loop
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: error: {printable(_environment_message(exc))}", err=True)
+        status = EXIT_INPUT
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
+        if debug:
+            traceback.print_exc()
+        click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
+                   "(run with --debug for the traceback)", err=True)
+        status = EXIT_FAILURE
+    finally:
+        warnings.showwarning = previous
+    if argv is None:
+        sys.exit(status)
+    return status
+
+
+__all__ = ["COMMANDS", "LazyGroup", "cli", "in_cli_words", "main"]
