@@ -46,7 +46,7 @@ from ..evaluation import evaluate_stages
 from ..metrics import Evaluation, default_window_s
 from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
 from ..report.html import build_report
-from ..simulate import Simulation, preset_model, resolve_profile
+from ..simulate import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles
 from ..simulate import simulate as run_simulation
 from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.mlp import DEFAULT_HIDDEN
@@ -194,7 +194,8 @@ def _float_list(text: str | None, option: str) -> tuple[float, ...] | None:
               help="Switch error terms off: temperature, lag, hysteresis, g-sensitivity, scale-factor, "
                    "misalignment, turn-on, noise, quantization, temperature-noise.")
 @click.option("--set-points", "set_points", default=None, metavar="T1,T2,...",
-              help="Chamber set points [degC] (default: the preset's range).")
+              help="Chamber set points [degC] (default: the preset's range); static, tumble and ratetable: one run "
+                   "per set point.")
 @click.option("--ramp-rate", "ramp_rate", type=float, default=None, help="Ramp rate between set points [degC/min].")
 @click.option("--dwell", "dwell_s", type=float, default=None, help="Time held at each set point [s].")
 @click.option("--cycles", type=int, default=None, help="Cold-hot-cold repetitions of the cycle profile.")
@@ -222,6 +223,9 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
     prof = resolve_profile(profile, preset, set_points_degc=_float_list(set_points, "--set-points"),
                            ramp_rate_degc_per_min=ramp_rate, dwell_s=dwell_s, cycles=cycles, position_s=position_s,
                            rates_dps=_float_list(rates, "--rates"))
+    if runs == 1 and prof.name in ONE_TEMPERATURE_PROFILES and len(prof.set_points_degc) > 1:
+        runs = len(prof.set_points_degc)  # one run per temperature
+    profiles = run_profiles(prof, runs)
     output_format(output)
     out = Path(output)
     paths = [out] if runs == 1 else [out.with_name(f"{out.stem}_{i}{out.suffix}") for i in range(runs)]
@@ -229,7 +233,7 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
         raise InputError(f"--truth {truth}: the same file as a data output; choose another path")
     records = []
     for i, path in enumerate(paths):
-        sim = run_simulation(model, profile=prof, duration_s=duration_s, rate_hz=rate_hz, seed=seed + i,
+        sim = run_simulation(model, profile=profiles[i], duration_s=duration_s, rate_hz=rate_hz, seed=seed + i,
                              source=str(path))
         sim = Simulation(sim.recording, dataclasses.replace(sim.truth, preset=preset, unit=unit))
         write_recording(sim.recording, path, extra_columns=sim.truth.truth_columns() if truth_columns else None)

@@ -36,6 +36,18 @@ from .profiles import PROFILES, Profile, Trajectory, get_profile, tumble_positio
 
 #: profiles whose temperature visits set points, which a preset's chamber range replaces by default
 SET_POINT_PROFILES = ("chamber", "cycle", "combined")
+#: profiles held at one temperature: with several set points, run i is held at set point i (cycling)
+ONE_TEMPERATURE_PROFILES = ("static", "tumble", "ratetable")
+
+
+def run_profiles(profile: Profile, runs: int) -> list[Profile]:
+    """The profile of each of ``runs`` runs: a one-temperature profile (static, tumble, ratetable) given several
+    set points holds run i at set point i (cycling through them), so a rate table at three temperatures is three
+    runs; every other profile is the same for every run."""
+    if profile.name not in ONE_TEMPERATURE_PROFILES or len(profile.set_points_degc) < 2:
+        return [profile] * runs
+    points = profile.set_points_degc
+    return [dataclasses.replace(profile, set_points_degc=(points[i % len(points)],)) for i in range(runs)]
 #: the parts of the deterministic error, in the order they are listed in the truth
 COMPONENTS = ("temperature", "hysteresis", "acceleration", "scale_misalignment")
 
@@ -228,6 +240,6 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
     return Simulation(rec, truth)
 
 
-__all__ = ["AccelErrorModel", "COMPONENTS", "GyroErrorModel", "Hysteresis", "NoiseTruth", "PRESETS", "PROFILES",
+__all__ = ["AccelErrorModel", "COMPONENTS", "ONE_TEMPERATURE_PROFILES", "GyroErrorModel", "Hysteresis", "NoiseTruth", "PRESETS", "PROFILES",
            "Preset", "Profile", "Simulation", "Trajectory", "Truth", "flicker_bank", "get_preset", "get_profile",
-           "preset_model", "resolve_profile", "simulate", "simulate_noise", "tumble_positions"]
+           "preset_model", "resolve_profile", "run_profiles", "simulate", "simulate_noise", "tumble_positions"]
