@@ -223,6 +223,24 @@ def _reversal(x: np.ndarray, start: int, d: int, extreme: float, threshold: floa
     return -1, extreme
 
 
+def _turn_arrays(n: int, changes: list, turns: list[int], state: TurnState) -> tuple[np.ndarray, np.ndarray]:
+    """Per-sample direction and turning temperature [degC] from the changes (index, direction, turn temperature
+    or None) found in a chunk of n samples, the chunk's start continuing ``state``."""
+    direction = np.zeros(n, dtype=np.int8)
+    turn = np.full(n, np.nan)
+    for (k, dk, _), stop in zip(changes, [c[0] for c in changes[1:]] + [n]):
+        direction[k:stop] = dk
+    values = [tk for _, _, tk in changes if tk is not None]
+    for k, tk, stop in zip(turns, values, turns[1:] + [n]):
+        turn[k:stop] = tk
+    first = turns[0] if turns else n
+    if state.direction != 0:
+        direction[:first] = state.direction
+    if not math.isnan(state.turn_degc):
+        turn[:first] = state.turn_degc
+    return direction, turn
+
+
 def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
                state: TurnState | None = None) -> Turns:
     """Turning points of a temperature series, robust to noise and to whole-degree steps.
@@ -273,18 +291,7 @@ def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
         turns.append(k)
         extreme = float(x[k])
         i = k + 1
-    direction = np.zeros(n, dtype=np.int8)
-    turn = np.full(n, np.nan)
-    for (k, dk, _), stop in zip(changes, [c[0] for c in changes[1:]] + [n]):
-        direction[k:stop] = dk
-    values = [tk for _, _, tk in changes if tk is not None]
-    for k, tk, stop in zip(turns, values, turns[1:] + [n]):
-        turn[k:stop] = tk
-    first = turns[0] if turns else n
-    if state.direction != 0:
-        direction[:first] = state.direction
-    if not math.isnan(state.turn_degc):
-        turn[:first] = state.turn_degc
+    direction, turn = _turn_arrays(n, changes, turns, state)
     return Turns(direction, turn, np.asarray(turns, dtype=np.int64), TurnState(int(d), extreme, last_turn, low, high))
 
 

@@ -489,6 +489,40 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
     PoseFit
         The calibration (``correct`` gives the specific force [g]) and its residual on the poses.
     """
+    means, units = _checked_poses(poses, method, gravity_g)
+    method = _auto_method(units) if method == "auto" else method
+    if method == "norm":
+        if temperature_order not in ("auto", 0) or bias_temperature_order:
+            raise InputError("temperature_order: the norm method fits K constant; K(T) needs the six-position method "
+                             "(the unit on its six faces across the temperatures)")
+        bias, sens, bias_se, sens_se, red, dof, left = _fit_norm(poses, means, units, gravity_g)
+        cal = TriadCalibration(sensitivity=rows_of(sens), bias=tuple(float(b) for b in bias), method=method,
+                               sensitivity_stderr=rows_of(sens_se), bias_stderr=tuple(float(b) for b in bias_se),
+                               unit="g")
+        return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1),
+                       np.linalg.norm(cal.correct(means), axis=1), red, dof, left, float(gravity_g))
+    fit = _fit_six_position(poses, means / gravity_g, units, temperature_order, bias_temperature_order)
+    drift = fit.bias_drift * gravity_g
+    blocks = fit.blocks[1:]
+    cal = TriadCalibration(sensitivity=rows_of(fit.blocks[0]), bias=tuple(float(b) * gravity_g for b in fit.bias),
+                           method=method, sensitivity_stderr=rows_of(fit.blocks_se[0]),
+                           bias_stderr=tuple(float(b) * gravity_g for b in fit.bias_se), unit="g",
+                           reference_degc=fit.reference_degc if blocks else None,
+                           sensitivity_per_degc=tuple(rows_of(b) for b in blocks),
+                           sensitivity_per_degc_stderr=tuple(rows_of(b) for b in fit.blocks_se[1:]))
+    seen, temperatures = means, None
+    if fit.reference_degc is not None:
+        temperatures = np.array([p.temperature_degc for p in poses], dtype=float)
+        d = temperatures - fit.reference_degc  # the pose means less the fitted drift: what the calibration sees
+        seen = means - sum((np.outer(d ** (p + 1), drift[p]) for p in range(drift.shape[0])), np.zeros_like(means))
+    after = cal.correct(seen, temperatures if cal.temperature_order else None)
+    return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1), np.linalg.norm(after, axis=1),
+                   fit.reduced_chi_square, fit.dof, fit.left_out, float(gravity_g), drift)
+
+
+def _checked_poses(poses: list[Pose], method: str, gravity_g: float) -> tuple[np.ndarray, np.ndarray]:
+    """The poses' mean specific forces [g] and their directions, once the arguments are checked and the poses
+    turn every axis up and down."""
     if method not in ("auto", "norm", "six-position"):
         raise InputError(f"method: {method!r}; use 'auto', 'norm' or 'six-position'")
     if not gravity_g > 0:
@@ -499,40 +533,18 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
     means = np.array([p.accel_g for p in poses], dtype=float)
     units = _directions(means)
     _require_span(units)
-    if method == "auto":
-        six = bool(np.all(np.isin(np.arange(6), _axis_assignment(units))))
-        distinct = distinct_orientations(units)
-        norm_possible = undetermined_norm_term(units) is None or not six
-        method = "norm" if norm_possible and (distinct >= AUTO_NORM_POSES or (not six and distinct >= MIN_POSES_NORM)) \
-            else "six-position"
-    temperatures, drift = None, np.zeros((0, 3))
-    if method == "norm":
-        if temperature_order not in ("auto", 0) or bias_temperature_order:
-            raise InputError("temperature_order: the norm method fits K constant; K(T) needs the six-position method "
-                             "(the unit on its six faces across the temperatures)")
-        bias, sens, bias_se, sens_se, red, dof, left = _fit_norm(poses, means, units, gravity_g)
-        extra = {}
-    else:
-        fit = _fit_six_position(poses, means / gravity_g, units, temperature_order, bias_temperature_order)
-        drift = fit.bias_drift * gravity_g
-        bias, bias_se, sens, sens_se = fit.bias * gravity_g, fit.bias_se * gravity_g, fit.blocks[0], fit.blocks_se[0]
-        red, dof, left = fit.reduced_chi_square, fit.dof, fit.left_out
-        extra = {"reference_degc": fit.reference_degc,
-                 "sensitivity_per_degc": tuple(rows_of(b) for b in fit.blocks[1:]),
-                 "sensitivity_per_degc_stderr": tuple(rows_of(b) for b in fit.blocks_se[1:])}
-        if not extra["sensitivity_per_degc"]:
-            extra["reference_degc"] = None
-        if fit.reference_degc is not None:
-            temperatures = np.array([p.temperature_degc for p in poses], dtype=float)
-            if drift.size:  # the pose means less the fitted drift: what the calibration sees
-                d = temperatures - fit.reference_degc
-                means = means - sum(np.outer(d ** (p + 1), drift[p]) for p in range(drift.shape[0]))
-    cal = TriadCalibration(sensitivity=rows_of(sens), bias=tuple(float(b) for b in bias), method=method,
-                           sensitivity_stderr=rows_of(sens_se), bias_stderr=tuple(float(b) for b in bias_se),
-                           unit="g", **extra)
-    after = cal.correct(means, temperatures if cal.temperature_order else None)
-    return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1), np.linalg.norm(after, axis=1), red, dof, left,
-                   float(gravity_g), drift)
+    return means, units
+
+
+def _auto_method(units: np.ndarray) -> str:
+    """``norm`` with 12 or more orientations that determine it (or 10 without the six faces), else
+    ``six-position``."""
+    six = bool(np.all(np.isin(np.arange(6), _axis_assignment(units))))
+    distinct = distinct_orientations(units)
+    norm_possible = undetermined_norm_term(units) is None or not six
+    if norm_possible and (distinct >= AUTO_NORM_POSES or (not six and distinct >= MIN_POSES_NORM)):
+        return "norm"
+    return "six-position"
 
 
 # -- gyro: rate table -------------------------------------------------------------------------------------
