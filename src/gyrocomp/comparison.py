@@ -144,6 +144,17 @@ class MethodComparison:
 
 
 @single_threaded_blas
+def _method_row(name: str, axis: str, metrics: list) -> MethodRow:
+    """One method's figures on one axis, averaged over the held-out runs (``raw``: the runs' raw figures)."""
+    mean = lambda field: float(np.mean([getattr(m, field) for m in metrics]))  # noqa: E731
+    if name == "raw":
+        return MethodRow(name, axis, mean("bias_offset_raw_dps"), 1.0, mean("bias_instability_raw_dph"),
+                         mean("integration_time_raw_s"))
+    offset, raw = mean("bias_offset_comp_dps"), mean("bias_offset_raw_dps")
+    return MethodRow(name, axis, offset, raw / offset if offset > 0 else float("inf"),
+                     mean("bias_instability_comp_dph"), mean("integration_time_comp_s"))
+
+
 def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | None = None,
                     window_s: float | None = None, hysteresis_band_degc: tuple[float, float] | None = None,
                     seed: int = 0) -> MethodComparison:
@@ -188,22 +199,8 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
             scored[name].append(result)
             if name == next(iter(methods)):
                 scored["raw"].append(result)
-    rows = []
-    for axis in recordings[0].gyro_axes:
-        for name, results in scored.items():
-            metrics = [r.axes[axis] for r in results]
-            if name == "raw":
-                offset = float(np.mean([m.bias_offset_raw_dps for m in metrics]))
-                bi = float(np.mean([m.bias_instability_raw_dph for m in metrics]))
-                tau = float(np.mean([m.integration_time_raw_s for m in metrics]))
-                improvement = 1.0
-            else:
-                offset = float(np.mean([m.bias_offset_comp_dps for m in metrics]))
-                bi = float(np.mean([m.bias_instability_comp_dph for m in metrics]))
-                tau = float(np.mean([m.integration_time_comp_s for m in metrics]))
-                raw = float(np.mean([m.bias_offset_raw_dps for m in metrics]))
-                improvement = raw / offset if offset > 0 else float("inf")
-            rows.append(MethodRow(name, axis, offset, improvement, bi, tau))
+    rows = [_method_row(name, axis, [r.axes[axis] for r in results])
+            for axis in recordings[0].gyro_axes for name, results in scored.items()]
     how = ("leave one run out: each run compensated by models fitted on the other runs" if n > 1 else
            "one run: the models are fitted and scored on the same run, as in the thesis (optimistic)")
     return MethodComparison(rows, how, windows)

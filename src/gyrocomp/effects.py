@@ -117,12 +117,20 @@ def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_
         prev_u, prev_y, prev_t = state.last_input_degc, state.last_output_degc, state.last_time_s
         start = 0
         out = np.empty_like(u)
+    _lag_stretches(t, u, out, start, (prev_u, prev_y, prev_t), period_s, time_constant_s)
+    return out, LagState(float(u[-1]), float(out[-1]), float(t[-1]))
+
+
+def _lag_stretches(t: np.ndarray, u: np.ndarray, out: np.ndarray, start: int, previous: tuple[float, float, float],
+                   period_s: float, time_constant_s: float) -> None:
+    """Fill ``out[start:]`` with the lagged temperature [degC]: each uniform stretch by one IIR filter, each gap
+    (a step over 1.5 periods) bridged exactly; ``previous`` is (input, output, time) before ``start``."""
+    prev_u, prev_y, prev_t = previous
     steps = np.diff(np.concatenate([[prev_t], t]))
     long_steps = np.flatnonzero(steps[start:] > 1.5 * period_s) + start
     a, b0, b1 = lag_coefficients(period_s, time_constant_s)
-    bounds = list(long_steps) + [u.size]
     i = start
-    for stop in bounds:
+    for stop in list(long_steps) + [u.size]:
         if i < stop:
             # uniform stretch [i, stop): y[k] = a y[k-1] + b0 u[k] + b1 u[k-1]
             seg = u[i:stop]
@@ -134,7 +142,6 @@ def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_
             out[stop] = ga * prev_y + gb0 * u[stop] + gb1 * prev_u
             prev_u, prev_y = float(u[stop]), float(out[stop])
             i = stop + 1
-    return out, LagState(float(u[-1]), float(out[-1]), float(t[-1]))
 
 
 # -- turning points and hysteresis ------------------------------------------------------------------

@@ -354,20 +354,26 @@ def _print_triad(console, name: str, triad) -> None:
     console.print(table)
 
 
+def _describe_axis(ax) -> str:
+    """An axis's model in words: curve, lag, hysteresis."""
+    order = None if ax.temperature is None else ax.temperature.order
+    model = "constant" if order is None else (f"poly order {order}" if isinstance(order, int) else order)
+    if ax.lag_time_constant_s > 0:
+        model += f", lag {ax.lag_time_constant_s:.3g} s"
+    if ax.hysteresis is not None:
+        model += f", hysteresis order {ax.hysteresis.order}"
+        if ax.hysteresis.band_degc is not None:
+            model += f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
+    return model
+
+
 def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -> None:
     table = Table(title=title)
     for col in ("axis", "model", "range [degC]", f"fit RMS [{unit}]", f"constants [{unit}]"):
         table.add_column(col)
     for axis, ax in axes.items():
         info = report.get("axes", {}).get(axis, {})
-        order = None if ax.temperature is None else ax.temperature.order
-        model = "constant" if order is None else (f"poly order {order}" if isinstance(order, int) else order)
-        if ax.lag_time_constant_s > 0:
-            model += f", lag {ax.lag_time_constant_s:.3g} s"
-        if ax.hysteresis is not None:
-            model += f", hysteresis order {ax.hysteresis.order}"
-            if ax.hysteresis.band_degc is not None:
-                model += f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
+        model = _describe_axis(ax)
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
         rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
         constants = ax.turn_on_biases_dps
