@@ -19,7 +19,7 @@ from gyrocomp.models.mlp import (
     train_lm,
     validation_mask,
 )
-from gyrocomp.cli.commands import parse_hidden, parse_temperature_option
+from gyrocomp.cli.common import parse_hidden, parse_temperature_option
 from gyrocomp.simulate import GyroErrorModel, get_profile, preset_model, simulate
 
 

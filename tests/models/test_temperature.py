@@ -10,7 +10,7 @@ from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureRangeWarning
 from gyrocomp.metrics import default_window_s, smoothed_residual_rms
 from gyrocomp.models.base import bin_by_temperature
-from gyrocomp.cli.commands import parse_temperature_option
+from gyrocomp.cli.common import parse_temperature_option
 from gyrocomp.models.temperature import PolynomialTemperatureModel
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import GyroErrorModel, simulate

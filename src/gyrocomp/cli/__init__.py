@@ -4,8 +4,9 @@ Exit status: 0 success, 2 bad input or usage, 1 other failures. Errors are one l
 ``--debug`` adds the traceback.
 
 This module needs only click: ``gyrocomp --help`` and ``gyrocomp --version`` start without numpy, scipy or
-pandas. The commands live in :mod:`gyrocomp.cli.commands`, imported the first time one is looked up; their one-line
-descriptions are listed here (a test checks they match the commands' own).
+pandas. Each command lives in its own module (``gyrocomp.cli.fit``, ...), imported when the command is looked up,
+so a command loads only what it uses; ``common`` holds what they share (reading files, options) and ``render``
+the tables they print. The one-line descriptions are listed here (a test checks they match the commands' own).
 """
 
 from __future__ import annotations
@@ -27,8 +28,8 @@ from ..errors import CHECKS, GyrocompError, InputError, PlausibilityWarning, pri
 EXIT_INPUT = 2
 EXIT_FAILURE = 1
 
-#: every command: its name, the function in gyrocomp.cli.commands, and its one-line help (``gyrocomp --help``
-#: shows it shortened to the terminal)
+#: every command: its name, its module in gyrocomp.cli (the command is the function of the same name there), and
+#: its one-line help (``gyrocomp --help`` shows it shortened to the terminal)
 COMMANDS = {
     "simulate": ("simulate", 'Simulate calibration runs of a sensor preset through a test profile, with the exact truth.'),
     "fit": ("fit", 'Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest).'),
@@ -60,7 +61,7 @@ class LazyGroup(click.Group):
     def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
         if name not in COMMANDS:
             return None
-        return getattr(importlib.import_module("gyrocomp.cli.commands"), COMMANDS[name][0])
+        return getattr(importlib.import_module(f"gyrocomp.cli.{COMMANDS[name][0]}"), name)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         limit = formatter.width - 6 - max(len(name) for name in COMMANDS)

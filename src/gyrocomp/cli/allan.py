@@ -1,0 +1,100 @@
+"""``gyrocomp allan``: parse its options, call the library, print the result."""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import click
+
+from ..allan import KINDS
+from ..errors import DataQualityWarning
+from ..io import refuse_to_overwrite_inputs, write_text_atomic
+from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
+from ..noise import analyse_noise
+from ..report.figures import allan_figure, check_figure_path
+from .common import pop_read_options, read_run, progress_bar, read_options
+from .render import print_noise
+
+
+def _parse_taus(text: str):
+    if text in ("octave", "decade", "all"):
+        return text
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or min(values) <= 0:
+        raise click.BadParameter("use octave, decade, all or a comma-separated list of taus [s], e.g. 1,10,100",
+                                 param_hint="--taus")
+    return values
+
+
+def _parse_fit_taus(text: str | None):
+    if text is None:
+        return None
+    try:
+        low, high = (float(v) for v in text.split(","))
+    except ValueError:
+        low = high = -1.0
+    if not 0 < low < high:
+        raise click.BadParameter("use MIN,MAX in seconds with 0 < MIN < MAX, e.g. 3,1000", param_hint="--fit-taus")
+    return low, high
+
+
+#: RMS misfit (in ln deviation) of the noise model beyond which ``gyrocomp allan`` warns
+POOR_FIT_LOG_RESIDUAL = 0.25
+
+
+@click.command()
+@click.argument("input_path", metavar="FILE", type=click.Path())
+@click.option("--axes", "axes", default=None, help="Columns to analyse, e.g. gyro_x,gyro_z,accel_z (default: every gyro axis).")
+@click.option("--kind", type=click.Choice(KINDS), default="oadev", show_default=True, help="Estimator of the printed curve.")
+@click.option("--taus", default="octave", show_default=True, help="octave, decade, all, or taus [s] such as 1,10,100.")
+@click.option("--json", "as_json", is_flag=True, help="Print curves and noise terms as JSON on stdout.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write the Allan plot here (.png, .svg, .pdf).")
+@click.option("--kalibr", "kalibr_path", type=click.Path(dir_okay=False), help="Write Kalibr's imu.yaml here.")
+@click.option("--rostopic", default="/imu0", show_default=True, help="rostopic written into the Kalibr file.")
+@click.option("--split-gaps", is_flag=True, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
+@click.option("--fit-taus", "fit_taus", default=None, metavar="MIN,MAX",
+              help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.")
+@read_options
+@click.pass_context
+def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, rostopic, split_gaps, fit_taus,
+          **kwargs):
+    """Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of FILE."""
+    opts = pop_read_options(kwargs)
+    tau_spec = _parse_taus(taus)
+    fit_range = _parse_fit_taus(fit_taus)
+    for option, path in (("--plot", plot_path), ("--kalibr", kalibr_path)):
+        if path:
+            refuse_to_overwrite_inputs(path, [input_path], option=option)
+    if plot_path:
+        check_figure_path(plot_path)
+    with warnings.catch_warnings():
+        # gaps are refused below, or split with a note, in one line of their own
+        warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
+        recording = read_run(input_path, opts).recording
+    names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
+    if kalibr_path:
+        names += [a for a in recording.accel_axes if a not in names]
+    with progress_bar("Allan deviation", indeterminate=True):
+        analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                                 fit_taus_s=fit_range)
+    if analysis.how and not ctx.obj["quiet"]:
+        click.echo(f"gyrocomp: note: {analysis.how}", err=True)
+    for name, a in analysis.axes.items():
+        if a.terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
+            warnings.warn(f"{name}: the five-term noise model misses the curve by {a.terms.fit_rms_log_residual:.0%} "
+                          "RMS; compare the read-offs, or restrict the fit with --fit-taus", DataQualityWarning)
+    if kalibr_path:
+        write_text_atomic(kalibr_path, kalibr_imu_yaml(kalibr_imu(analysis, rostopic)))
+    if plot_path:
+        allan_figure(analysis, plot_path)
+    if as_json:
+        click.echo(json.dumps(analysis.to_dict(), indent=2))
+    elif not ctx.obj["quiet"]:
+        print_noise(analysis)
+
+
+__all__ = ["POOR_FIT_LOG_RESIDUAL", "allan"]

@@ -1,0 +1,135 @@
+"""What the commands share: reading files with the common options, the console, the progress bar, option parsing."""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+from pathlib import Path
+
+import click
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
+
+from ..errors import InputError
+from ..io import FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
+from ..models.mlp import DEFAULT_HIDDEN
+from ..models.temperature import MAX_ORDER
+
+
+def make_console() -> Console:
+    return Console(width=None if sys.stdout.isatty() else 160, highlight=False, markup=False)
+
+
+def read_options(func):
+    """Options every command that reads data files shares."""
+    options = [
+        click.option("--columns", "columns", metavar="CH=COL,...",
+                     help="Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T."),
+        click.option("--gyro-unit", default="deg/s", show_default=True, help="deg/s, rad/s or mdps."),
+        click.option("--accel-unit", default="g", show_default=True, help="g, mg or m/s2."),
+        click.option("--time-unit", default="s", show_default=True, help="s, ms, us or ns."),
+        click.option("--format", "fmt", default=None,
+                     help=f"Input format (default: told from the file): {', '.join(FORMATS)}."),
+        click.option("--delimiter", default=None,
+                     help="CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a tab)."),
+        click.option("--decimal", default=None, help="CSV decimal point, . or , (default: told from the first row)."),
+        click.option("--drop-nan", is_flag=True, help="Drop rows with empty/NaN values (says how many) instead of refusing the file."),
+        click.option("--instance", type=int, default=None,
+                     help="Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0)."),
+        click.option("--device-id", "device_id", type=int, default=None, help="PX4 device id of the gyro to read."),
+        click.option("--imu-topic", default=None, help="ROS bag: the sensor_msgs/Imu topic (default: the only one)."),
+        click.option("--temperature-topic", default=None,
+                     help="ROS bag: the sensor_msgs/Temperature topic (default: the only one)."),
+        click.option("--record", default=None, help="ArduPilot log: IMU (default) or TCLR (onboard learning records)."),
+    ]
+    for option in reversed(options):
+        func = option(func)
+    return func
+
+
+def table_layout(columns, gyro_unit, accel_unit, time_unit, delimiter=None, decimal=None) -> TableLayout:
+    return TableLayout(parse_column_mapping(columns), gyro_unit, accel_unit, time_unit,
+                       "\t" if delimiter == "tab" else delimiter, decimal)
+
+
+READ_OPTIONS = ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan", "instance", "device_id",
+                 "imu_topic", "temperature_topic", "record", "delimiter", "decimal")
+
+
+@contextlib.contextmanager
+def progress_bar(description: str, indeterminate: bool = False):
+    """A progress callback drawing a bar on stderr when it is a terminal and --quiet is off; else None.
+    ``indeterminate``: a pulsing bar for work that does not report its fraction done."""
+    ctx = click.get_current_context(silent=True)
+    quiet = bool(ctx and ctx.find_root().obj and ctx.find_root().obj.get("quiet"))
+    if quiet or not sys.stderr.isatty():
+        yield None
+        return
+    with Progress(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(), TimeElapsedColumn(),
+                  console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(description, total=None if indeterminate else 1.0)
+        yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
+
+
+def read_run(path, opts: dict):
+    layout = table_layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"], opts["delimiter"],
+                     opts["decimal"])
+    options = ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=opts["instance"],
+                          device_id=opts["device_id"], imu_topic=opts["imu_topic"],
+                          temperature_topic=opts["temperature_topic"], record=opts["record"])
+    with progress_bar(f"reading {Path(path).name}") as progress:
+        return read_input(path, options, fmt=opts["fmt"], progress=progress)
+
+
+def pop_read_options(kwargs: dict) -> dict:
+    return {k: kwargs.pop(k) for k in READ_OPTIONS}
+
+
+def parse_hidden(text: str) -> tuple[int, ...]:
+    """``"mlp"`` -> (3,), ``"mlp:5"`` -> (5,), ``"mlp:5x4"`` -> (5, 4)."""
+    text = text.strip().lower()
+    if text == "mlp":
+        return DEFAULT_HIDDEN
+    try:
+        hidden = tuple(int(h) for h in text.split(":", 1)[1].split("x"))
+    except (IndexError, ValueError):
+        hidden = ()
+    if not hidden or any(h < 1 or h > 50 for h in hidden) or len(hidden) > 3:
+        raise InputError(f"--temperature: {text!r}; use mlp, mlp:H (H hidden tanh neurons, 1..50) or mlp:HxH")
+    return hidden
+
+
+def parse_temperature_option(text: str) -> int | str | tuple | None:
+    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"mlp"``/``"mlp:5"`` -> ("mlp", hidden), ``"none"`` -> None."""
+    text = text.strip().lower()
+    if text == "mlp" or text.startswith("mlp:"):
+        return ("mlp", parse_hidden(text))
+    if text in ("poly", "auto"):
+        return "auto"
+    if text == "none":
+        return None
+    if text.startswith("poly:"):
+        try:
+            order = int(text[5:])
+        except ValueError:
+            order = -1
+        if 0 <= order <= MAX_ORDER:
+            return order
+        raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
+    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}), "
+                     "mlp (the thesis's 1-3-1 network), mlp:H or none")
+
+
+def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
+    if text is None:
+        return None
+    try:
+        values = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        values = ()
+    if not values:
+        raise click.BadParameter("give comma-separated numbers, e.g. -20,70", param_hint=option)
+    return values
+
+
+__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_hidden", "parse_temperature_option", "pop_read_options", "progress_bar", "read_options", "read_run", "table_layout"]

@@ -1,0 +1,83 @@
+"""``gyrocomp evaluate``: parse its options, call the library, print the result."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from ..calibration import Calibration
+from ..errors import InputError
+from ..io.schedule import apply_schedule, read_rate_schedule
+from ..comparison import compare_methods
+from ..evaluation import evaluate as evaluate_calibration
+from ..evaluation import evaluate_stages
+from .common import float_list, pop_read_options, read_run, read_options
+from .render import print_comparison, print_evaluation, print_stages
+
+
+@click.command()
+@click.argument("paths", nargs=-1, required=True, type=click.Path(), metavar="MODEL RUNS... | --compare RUNS...")
+@click.option("--window", "window_s", type=float, default=None,
+              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
+@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+              help="Estimate each run's turn-on bias from its first S seconds [s].")
+@click.option("--compare", is_flag=True,
+              help="The thesis's comparison on RUNS: raw, polynomial, network, each with and without hysteresis "
+                   "(leave one run out with two runs or more).")
+@click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
+              help="With --compare: limit the hysteresis to this band [degC].")
+@click.option("--stages", is_flag=True,
+              help="Report each stage of MODEL (the thesis's Table 4.4): raw, temperature only, + acceleration, "
+                   "+ hysteresis.")
+@click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
+@click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
+              help="A rate table's schedule for the RUNS it names (as for fit): adds their rate error.")
+@read_options
+@click.pass_context
+def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, as_json, rate_schedule, **kwargs):
+    """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.
+
+    With --compare, no model is given: the methods of the reference thesis are fitted on the runs and compared.
+    """
+    opts = pop_read_options(kwargs)
+    if window_s is not None and not window_s > 0:
+        raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
+    if compare:
+
+        band = float_list(hysteresis_band, "--hysteresis-band")
+        if band is not None and (len(band) != 2 or not band[0] < band[1]):
+            raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
+        recordings = [read_run(path, opts).recording for path in paths]
+        result = compare_methods(recordings, window_s=window_s, hysteresis_band_degc=band)
+        if as_json:
+            click.echo(json.dumps(result.to_dict(), indent=2))
+        elif not ctx.obj["quiet"]:
+            print_comparison(result)
+        return
+    if len(paths) < 2:
+        raise click.UsageError("give MODEL and at least one run, or --compare RUNS...")
+    model, runs = paths[0], paths[1:]
+    calibration = Calibration.load(model)
+    if stages:
+        if not calibration.axes:
+            raise InputError(f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
+                             "evaluate it without --stages")
+        staged = [evaluate_stages(calibration, read_run(path, opts).recording, window_s=window_s,
+                                  turn_on_window_s=turn_on_window_s) for path in runs]
+        if as_json:
+            click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
+        elif not ctx.obj["quiet"]:
+            print_stages(staged)
+        return
+    recordings = [read_run(path, opts).recording for path in runs]
+    if rate_schedule is not None:
+        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+    evaluation = evaluate_calibration(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s)
+    if as_json:
+        click.echo(json.dumps(evaluation.to_dict(), indent=2))
+    else:
+        print_evaluation(evaluation)
+
+
+__all__ = ["evaluate"]

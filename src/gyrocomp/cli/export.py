@@ -1,0 +1,52 @@
+"""``gyrocomp export``: parse its options, call the library, print the result."""
+
+from __future__ import annotations
+
+import click
+
+from ..calibration import Calibration
+from ..io import refuse_to_overwrite_inputs, write_text_atomic
+from ..export.autopilot import ardupilot_params_file, px4_params_file
+from ..export.c_code import write_c_sources
+
+
+EXPORT_FORMATS = ("px4", "ardupilot", "c")
+
+
+@click.command()
+@click.argument("model", type=click.Path())
+@click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), required=True,
+              help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters), "
+                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o).")
+@click.option("-o", "--output", required=True, type=click.Path(), help="Parameter file to write (c: a folder).")
+@click.option("--rate", "rate_hz", type=float, default=None,
+              help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")
+@click.option("--instance", type=int, default=None, help="Sensor instance: PX4 gyro 0..3 (default 0), ArduPilot IMU 1..3 "
+                                                       "(default 1).")
+@click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id (TC_G*_ID).")
+@click.pass_context
+def export(ctx, model, fmt, output, rate_hz, instance, device_id):
+    """Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code."""
+
+    refuse_to_overwrite_inputs(output, [model])
+    calibration = Calibration.load(model)
+    if fmt == "c":
+
+        written = write_c_sources(calibration, output, rate_hz=rate_hz)
+        if not ctx.obj["quiet"]:
+            click.echo("wrote " + " and ".join(str(p) for p in written))
+        return
+    if fmt == "px4":
+        text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)
+    else:
+        text = ardupilot_params_file(calibration, instance=1 if instance is None else instance)
+    write_text_atomic(output, text)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}")
+        for line in text.splitlines()[1:]:
+            if not line.startswith("#"):
+                break
+            click.echo(line.lstrip("# "))
+
+
+__all__ = ["EXPORT_FORMATS", "export"]

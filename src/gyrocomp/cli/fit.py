@@ -1,0 +1,87 @@
+"""``gyrocomp fit``: parse its options, call the library, print the result."""
+
+from __future__ import annotations
+
+import click
+
+from ..io import refuse_to_overwrite_inputs
+from ..io.schedule import apply_schedule, read_rate_schedule
+from ..models.acceleration import ACCELERATION_CHOICES
+from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
+from ..models.selection import FOLD_KINDS
+from ..models.thermal import HYSTERESIS_CHOICES
+from .common import float_list, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
+from .render import print_fit
+
+
+@click.command()
+@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write (JSON).")
+@click.option("--temperature", default="poly", show_default=True,
+              help="poly (order by cross-validation), poly:N (N = 0..5), mlp (the thesis's 1-3-1 network, "
+                   "Levenberg-Marquardt), mlp:H (H hidden neurons) or none.")
+@click.option("--seed", "mlp_seed", type=int, default=0, show_default=True,
+              help="Seed of the network's initializations (mlp); the same seed gives the same model.")
+@click.option("--bin-width", "bin_width_degc", type=float, default=None, help="Temperature bin width [degC] (default: span/100).")
+@click.option("--hysteresis", type=click.Choice(HYSTERESIS_CHOICES), default="auto", show_default=True,
+              help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
+                   "when the runs both heat and cool.")
+@click.option("--hysteresis-order", default="auto", show_default=True,
+              help="Order of the turning-point polynomial in |T - T_turn|: auto (validated) or 1..3.")
+@click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
+              help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.")
+@click.option("--acceleration", type=click.Choice(["auto", *ACCELERATION_CHOICES]), default="auto", show_default=True,
+              help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
+                   "none; auto: matrix when the runs turn the unit between positions.")
+@click.option("--pipeline", default="joint", show_default=True,
+              help="joint (temperature, lag/hysteresis, G and run constants in one fit), or a cascade fitted stage by "
+                   "stage: 'poly>matrix', 'matrix>poly', 'mlp>matrix', or 'joint-mlp' (one network reading the "
+                   "temperature and the three accelerations). Quote the > in a shell.")
+@click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
+              help="Shortest still stretch used as a static position [s].")
+@click.option("--channels", default="gyro", show_default=True,
+              help="What to model: gyro, accel (the accelerometer's bias against temperature, in g) or gyro,accel "
+                   "(then G reads the temperature-compensated accelerations).")
+@click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
+              help="What the model choice holds out: each run, each heating or cooling leg, or time blocks; "
+                   "auto: runs with three runs or more, else legs.")
+@click.option("--scale-factor", "scale_factor", type=click.Choice(SCALE_FACTOR_CHOICES), default="auto",
+              show_default=True,
+              help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table) or, "
+                   "without them, from the turns between the still poses of multi-position runs: matrix (constant), "
+                   "matrix-temperature (linear in temperature), none; auto: when such runs are given, the order by "
+                   "leave-one-run-out.")
+@click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
+              help="A rate table's schedule (CSV: file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z [deg/s]) "
+                   "giving the reference rates of the runs it names, instead of ref_rate_x/y/z columns.")
+@read_options
+@click.pass_context
+def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
+        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, rate_schedule, **kwargs):
+    """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
+    opts = pop_read_options(kwargs)
+    order = parse_temperature_option(temperature)
+    if hysteresis_order != "auto":
+        if hysteresis_order not in ("1", "2", "3"):
+            raise click.BadParameter("use auto, 1, 2 or 3", param_hint="--hysteresis-order")
+        hysteresis_order = int(hysteresis_order)
+    band = float_list(hysteresis_band, "--hysteresis-band")
+    if band is not None and (len(band) != 2 or not band[0] < band[1]):
+        raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
+    channels = parse_channels(channels)
+    refuse_to_overwrite_inputs(output, runs)
+    recordings = [read_run(path, opts).recording for path in runs]
+    if rate_schedule is not None:
+        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+    with progress_bar("fitting", indeterminate=True):
+        calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
+                                   hysteresis=hysteresis, hysteresis_order=hysteresis_order,
+                                   hysteresis_band_degc=band, mlp_seed=mlp_seed, acceleration=acceleration,
+                                   static_min_duration_s=static_min_duration_s, scale_factor=scale_factor,
+                                   **({} if folds == "auto" else {"folds": folds}))
+    calibration.save(output)
+    if not ctx.obj["quiet"]:
+        print_fit(calibration, output)
+
+
+__all__ = ["fit"]

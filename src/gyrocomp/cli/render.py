@@ -1,0 +1,303 @@
+"""Tables the commands print (rich): fits, triads, evaluations, comparisons, validation, noise."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from rich.table import Table
+
+from ..calibration import Calibration
+from ..metrics import Evaluation
+from ..models.thermal import CANDIDATES
+from ..validation import ValidationResult
+from ..noise import NoiseAnalysis
+from .common import make_console
+
+
+def print_fit(calibration: Calibration, output) -> None:
+    console = make_console()
+    if not calibration.axes and not calibration.accel_axes:
+        console.print(f"gyrocomp fit: {calibration.model}  ->  {output}")
+    if calibration.axes:
+        _print_axis_fits(console, calibration.axes, calibration.fit_report, f"gyrocomp fit: {calibration.model}  ->  "
+                         f"{output}", "deg/s")
+    if calibration.accel_axes:
+        _print_axis_fits(console, calibration.accel_axes, calibration.fit_report.get("accel", {}),
+                         f"accelerometer (correction relative to {calibration.accel_reference_degc:.2f} degC; "
+                         "constants per run or per static position)" + ("" if calibration.axes else f"  ->  {output}"),
+                         "g")
+    for name, triad in (("gyro", calibration.gyro_triad), ("accelerometer", calibration.accel_triad)):
+        if triad is not None:
+            _print_triad(console, name, triad)
+
+
+def _print_triad(console, name: str, triad) -> None:
+    """K (and its standard errors) of a triad, with its scale-factor errors in ppm."""
+    table = Table(title=f"{name} scale factor and misalignment ({triad.method}"
+                  + (f", K linear in temperature about {triad.reference_degc:.1f} degC" if triad.temperature_order else "")
+                  + ")")
+    for col in ("axis", "K row (+- standard error)", "scale error [ppm]", f"bias [{triad.unit}]"):
+        table.add_column(col)
+    for i, axis in enumerate("xyz"):
+        row = "  ".join(f"{k:+.6f}+-{e:.1g}" for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i]))
+        table.add_row(axis, row, f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g}")
+    console.print(table)
+
+
+def _describe_axis(ax) -> str:
+    """An axis's model in words: curve, lag, hysteresis."""
+    order = None if ax.temperature is None else ax.temperature.order
+    model = "constant" if order is None else (f"poly order {order}" if isinstance(order, int) else order)
+    if ax.lag_time_constant_s > 0:
+        model += f", lag {ax.lag_time_constant_s:.3g} s"
+    if ax.hysteresis is not None:
+        model += f", hysteresis order {ax.hysteresis.order}"
+        if ax.hysteresis.band_degc is not None:
+            model += f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
+    return model
+
+
+def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -> None:
+    table = Table(title=title)
+    for col in ("axis", "model", "range [degC]", f"fit RMS [{unit}]", f"constants [{unit}]"):
+        table.add_column(col)
+    for axis, ax in axes.items():
+        info = report.get("axes", {}).get(axis, {})
+        model = _describe_axis(ax)
+        rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
+        rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
+        constants = ax.turn_on_biases_dps
+        shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (f" ... ({len(constants)})" if len(constants) > 6 else "")
+        table.add_row(axis, model, rng, rms, shown)
+    console.print(table)
+    net = report.get("network")
+    if net:
+        console.print(f"network: 1-{'-'.join(map(str, net['hidden']))}-1 tanh/linear, {net['restarts']} restarts "
+                      f"(seed {net['seed']}), {net['training']}; validation RMS of the restarts [{unit}]: " + "; ".join(
+                          f"{a} " + ", ".join(f"{v:.4g}" for v in info["validation_rmse_dps"])
+                          for a, info in net["axes"].items()))
+    scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
+    if net:
+        scores = {}
+    if scores:
+        how = report.get("order_selection")
+        unit_label = f"CV RMS [{unit}]" if how == "leave-one-run-out" else "BIC"
+        st = Table(title=f"order selection by {how} ({unit_label}; lower is better)")
+        st.add_column("axis")
+        orders = sorted({int(p) for s in scores.values() for p in s})
+        for p in orders:
+            st.add_column(f"order {p}", justify="right")
+        for axis, s in scores.items():
+            chosen = axes[axis].temperature.order
+            st.add_row(axis, *[(f"{s[str(p)]:.4g}*" if p == chosen else f"{s[str(p)]:.4g}")
+                               if str(p) in s else "-" for p in orders])
+        console.print(st)
+    if report.get("selection"):
+        _print_selection(console, report["selection"], unit)
+        return _print_g_sensitivity(console, report)
+    hyst = report.get("hysteresis", {})
+    if hyst.get("axes") and any(len(a.get("scores_dps", a.get("scores_bic", {}))) > 1 for a in hyst["axes"].values()):
+        bic = hyst["selection"] == "bic"
+        ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if bic else
+                   f"leave-one-run-out residual drift RMS [{unit}] (60 s moving average; lower is better)"))
+        ht.add_column("axis")
+        for name in CANDIDATES:
+            ht.add_column(name, justify="right")
+        ht.add_column("chosen")
+        for axis, info in hyst["axes"].items():
+            scores = info.get("scores_bic" if bic else "scores_dps", {})
+            chosen = info["chosen"].split(" (")[0]
+            cells = [("-" if scores.get(c) is None else f"{scores[c]:.4g}" + ("*" if c == chosen else ""))
+                     if c in scores else "-" for c in CANDIDATES]
+            ht.add_row(axis, *cells, info["chosen"])
+        console.print(ht)
+    _print_g_sensitivity(console, report)
+
+
+def _score(value: float | None, spec: str = ".4g") -> str:
+    """A held-out score for a table cell; '-' where the folds held too little data to compute it."""
+    return "-" if value is None else format(value, spec)
+
+
+def _print_selection(console, selection: dict, unit: str) -> None:
+    """The model choice: per axis the chosen and best candidates against the run constant alone, then the fold
+    scores of those three (every candidate's are in the model file)."""
+    first = next(iter(selection.values()))
+    table = Table(title=f"model choice by held-out drift ({first['fold_kind']}: {len(first['folds'])} folds, "
+                        f"{first['window_s']:g} s moving average, simplest within one standard error) [{unit}]")
+    for col in ("axis", "chosen", "held-out drift", "best", "best drift", "constant only"):
+        table.add_column(col, justify="left" if col in ("axis", "chosen", "best") else "right")
+    for axis, sel in selection.items():
+        scores = {c["label"]: c for c in sel["candidates"]}
+        chosen, best = scores[sel["chosen"]["label"]], scores[sel["best"]["label"]]
+        table.add_row(axis, chosen["label"],
+                      f"{_score(chosen['mean_drift_dps'])} +- {_score(chosen['standard_error_dps'], '.2g')}",
+                      best["label"], _score(best["mean_drift_dps"]), _score(sel["raw_drift_dps"]))
+    console.print(table)
+    folds = Table(title=f"held-out drift per fold [{unit}]")
+    folds.add_column("axis")
+    folds.add_column("model")
+    for name in first["folds"]:
+        folds.add_column(name, justify="right")
+    for axis, sel in selection.items():
+        scores = {c["label"]: c for c in sel["candidates"]}
+        shown = dict.fromkeys([sel["chosen"]["label"], sel["best"]["label"], "constant (time)"])
+        for label in shown:
+            folds.add_row(axis, label, *[_score(v) for v in scores[label]["fold_drift_dps"]])
+    console.print(folds)
+
+
+def _print_g_sensitivity(console, report: dict) -> None:
+    acc = report.get("acceleration", {})
+    if acc.get("axes"):
+        gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc['static_segments'])} "
+                         f"static segments; excited: {', '.join(acc['excited_axes']) or 'none'})")
+        gt.add_column("gyro axis")
+        for name in ("accel_x", "accel_y", "accel_z"):
+            gt.add_column(name, justify="right")
+        for axis, info in acc["axes"].items():
+            cells = [f"{g:+.4g} +- {e:.2g}" if e is not None else "not fitted"
+                     for g, e in zip(info["g_sensitivity_dps_per_g"], info["standard_error_dps_per_g"])]
+            gt.add_row(axis, *cells)
+        console.print(gt)
+
+
+def print_validation(result: ValidationResult) -> None:
+    console = make_console()
+    table = Table(title=result.title)
+    header, rows = result.table_rows()
+    table.add_column(header[0])
+    for column in header[1:]:
+        table.add_column(column, justify="right")
+    for row in rows:
+        table.add_row(*row)
+    console.print(table)
+    console.print("folds: " + ", ".join(result.folds))
+
+
+def _figures_table(title: str, what: str) -> Table:
+    """A table of the thesis's figures per axis and ``what`` (stage, method)."""
+    table = Table(title=title)
+    for col in ("axis", what):
+        table.add_column(col, no_wrap=True)
+    for col in ("bias offset\n[deg/s]", f"improvement\n(raw/{what})", "bias instability\n[deg/h]",
+                "integration time\n[s]"):
+        table.add_column(col, justify="right")
+    return table
+
+
+def print_stages(staged) -> None:
+    console = make_console()
+    for run in staged:
+        table = _figures_table(f"{Path(run.file).name}: stages of the compensation (window {run.window_s:.4g} s)",
+                               "stage")
+        first = next(iter(run.stages.values()))
+        for axis in first:
+            m0 = first[axis]
+            table.add_row(axis, "raw", f"{m0.bias_offset_raw_dps:.4g}", "1x", f"{m0.bias_instability_raw_dph:.4g}",
+                          f"{m0.integration_time_raw_s:.4g}")
+            for name, axes in run.stages.items():
+                m = axes[axis]
+                table.add_row("", name, f"{m.bias_offset_comp_dps:.4g}", f"{m.offset_improvement:.3g}x",
+                              f"{m.bias_instability_comp_dph:.4g}", f"{m.integration_time_comp_s:.4g}")
+        console.print(table)
+
+
+def print_comparison(result) -> None:
+    console = make_console()
+    table = _figures_table(f"methods compared ({result.how})", "method")
+    for row in result.rows:
+        table.add_row(row.axis, row.method, f"{row.bias_offset_dps:.4g}", f"{row.improvement:.3g}x",
+                      f"{row.bias_instability_deg_per_h:.4g}", f"{row.integration_time_s:.4g}")
+    console.print(table)
+
+
+def _metrics_table(title: str, evaluation: Evaluation, rows_of, unit: str, bi_unit: str, suffix: str) -> Table:
+    """One table of raw and compensated figures; ``rows_of(run)`` gives (axis, metrics) pairs whose field
+    names end in ``suffix`` (``dps``/``dph`` for the gyro, ``g``/``ug`` for the accelerometer)."""
+    table = Table(title=title)
+    table.add_column("run", no_wrap=True)
+    table.add_column("axis", no_wrap=True)
+    for col in ("window\n[s]", f"offset raw\n[{unit}]", f"offset comp\n[{unit}]", "improvement\n(raw/comp)",
+                f"BI raw\n[{bi_unit}]", f"BI comp\n[{bi_unit}]", "int. time raw\n[s]", "int. time comp\n[s]",
+                f"residual RMS\n[{unit}]"):
+        table.add_column(col, justify="right")
+    value, bi = suffix.split("/")
+    for run in evaluation.runs:
+        for axis, m in rows_of(run):
+            get = lambda name: getattr(m, name)  # noqa: E731
+            table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{get('bias_offset_raw_' + value):.4g}",
+                          f"{get('bias_offset_comp_' + value):.4g}", f"{m.offset_improvement:.3g}x",
+                          f"{get('bias_instability_raw_' + bi):.4g}", f"{get('bias_instability_comp_' + bi):.4g}",
+                          f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
+                          f"{get('residual_rms_' + value):.3g}")
+    return table
+
+
+def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
+    console = make_console()
+    console.print(_metrics_table(title, evaluation, lambda run: run.axes.items(), "deg/s", "deg/h", "dps/dph"))
+    if any(run.accel_axes for run in evaluation.runs):
+        console.print(_metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items(),
+                                     "g", "ug", "g/ug"))
+    if evaluation.triads:
+        table = Table(title=f"{title}: scale factor and misalignment (RMS over the run's poses, turns or stretches)")
+        for col in ("run", "figure", "count", "raw", "compensated", "improvement"):
+            table.add_column(col, justify="left" if col in ("run", "figure") else "right")
+        for t in evaluation.triads:
+            label, scale, unit = _TRIAD_FIGURES[t.figure]
+            table.add_row(Path(t.file).name, label, str(t.raw.size), f"{t.rms_raw * scale:.3g} {unit}",
+                          f"{t.rms_compensated * scale:.3g} {unit}",
+                          f"{t.rms_raw / t.rms_compensated:.3g}x" if t.rms_compensated > 0 else "-")
+        console.print(table)
+
+
+#: how ``evaluate`` prints each scale-factor figure: label, factor to the printed unit, unit
+_TRIAD_FIGURES = {"pose_norm_g": ("|a| - 1 g at each still pose", 1e3, "mg"),
+                  "turn_direction_deg": ("gravity direction after each turn", 1.0, "deg"),
+                  "rate_error_dps": ("rate error on each rate-table stretch", 1.0, "deg/s")}
+
+
+def print_noise(analysis: NoiseAnalysis) -> None:
+    console = make_console()
+    for name, a in analysis.axes.items():
+        c = a.curve
+        table = Table(title=f"{Path(analysis.source).name}: {name} {c.kind.upper()} [{a.unit}]")
+        for col in ("tau [s]", "deviation", "ci low", "ci high", "n", "alpha"):
+            table.add_column(col, justify="right")
+        for row in zip(c.tau, c.deviation, c.ci_low, c.ci_high, c.n, c.alpha):
+            table.add_row(f"{row[0]:.6g}", f"{row[1]:.5g}", f"{row[2]:.5g}", f"{row[3]:.5g}", f"{row[4]:d}",
+                          "-" if np.isnan(row[5]) else f"{row[5]:+.0f}")
+        console.print(table)
+    table = Table(title="noise terms (IEEE Std 952 fit; B = Allan minimum / 0.664)")
+    table.add_column("axis", no_wrap=True)
+    table.add_column("term")
+    table.add_column("value", justify="right")
+    table.add_column("read-off", justify="right")
+    for name, a in analysis.axes.items():
+        n = a.noise
+        if a.sensor == "gyro":
+            rows = [("N [deg/s/sqrt(Hz)]", n.noise_density_dps_per_sqrt_hz, n.noise_density_readoff_dps_per_sqrt_hz),
+                    ("ARW [deg/sqrt(h)]", n.arw_deg_per_sqrt_h, None),
+                    ("B [deg/h]", n.bias_instability_deg_per_h, None),
+                    ("integration time [s]", n.integration_time_s, None),
+                    ("K [deg/h/sqrt(h)]", n.rrw_deg_per_h_per_sqrt_h, n.rrw_readoff_deg_per_h_per_sqrt_h),
+                    ("Q [deg]", n.quantization_deg, None),
+                    ("R [deg/h^2]", n.rate_ramp_deg_per_h2, None)]
+        else:
+            rows = [("N [g/sqrt(Hz)]", n.noise_density_g_per_sqrt_hz, n.noise_density_readoff_g_per_sqrt_hz),
+                    ("VRW [m/s/sqrt(h)]", n.vrw_m_per_s_per_sqrt_h, None),
+                    ("B [micro-g]", n.bias_instability_micro_g, None),
+                    ("integration time [s]", n.integration_time_s, None),
+                    ("K [m/s^3/sqrt(Hz)]", n.random_walk_m_per_s3_per_sqrt_hz, n.random_walk_readoff_m_per_s3_per_sqrt_hz),
+                    ("Q [m/s]", n.quantization_m_per_s, None),
+                    ("R [m/s^3]", n.ramp_m_per_s3, None)]
+        for i, (term, value, readoff) in enumerate(rows):
+            table.add_row(name if i == 0 else "", term, f"{value:.4g}", "" if readoff is None else f"{readoff:.4g}")
+        if not n.floor_reached:
+            table.add_row("", "(no floor: B is an upper bound)", "", "")
+    console.print(table)
+
+
+__all__ = ["print_comparison", "print_evaluation", "print_fit", "print_noise", "print_stages", "print_validation"]
