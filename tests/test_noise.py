@@ -1,12 +1,13 @@
 """Noise analysis of recordings: axes, accelerometers, time gaps."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
 from gyrocomp.allan import allan_deviation, allan_deviation_segments
-from gyrocomp.errors import InputError
+from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.noise import analyse_noise
 from gyrocomp.recording import Recording
 
@@ -75,3 +76,18 @@ def test_json_document_has_the_documented_shape_and_no_nan():
     assert "noise_density_g_per_sqrt_hz" in doc["axes"]["accel_x"]["noise"]
     flat = [v for axis in doc["axes"].values() for key in ("adev", "ci_low", "ci_high") for v in axis[key]]
     assert all(v is None or math.isfinite(v) for v in flat)
+
+
+def test_a_noise_model_that_misses_the_curve_is_warned_about_in_the_library():
+    """A periodic disturbance (50 s sine) bends the Allan curve where no power-law term can follow: the library
+    warns, naming the parameter that restricts the fit; white noise alone fits and stays silent."""
+    rng = np.random.default_rng(0)
+    t = np.arange(200_000) / 100.0
+    white = Recording(t, rng.normal(0, 0.01, t.size)[:, None], ("gyro_z",))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DataQualityWarning)
+        analyse_noise(white)
+    periodic = Recording(t, (rng.normal(0, 0.01, t.size) + 0.5 * np.sin(2 * np.pi * t / 50.0))[:, None], ("gyro_z",))
+    with pytest.warns(DataQualityWarning, match=r"gyro_z: the five-term noise model misses the curve by \d+% RMS.*"
+                                                r"fit_taus_s: \(low, high\) \[s\]"):
+        analyse_noise(periodic)

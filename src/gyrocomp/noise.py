@@ -8,6 +8,7 @@ gap (TOTDEV, which has no pooled form, uses the longest stretch).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +22,7 @@ from .allan import (
     allan_deviation_segments,
     noise_terms,
 )
-from .errors import InputError
+from .errors import DataQualityWarning, InputError
 from .recording import Recording
 
 
@@ -99,6 +100,10 @@ def _describe_gap(recording: Recording) -> str:
             f"use split_gaps=True to pool the contiguous stretches")
 
 
+#: RMS misfit (in ln deviation) of the noise model beyond which :func:`analyse_noise` warns
+POOR_FIT_LOG_RESIDUAL = 0.25
+
+
 def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: str = "oadev",
                   taus="octave", split_gaps: bool = False,
                   fit_taus_s: tuple[float, float] | None = None) -> NoiseAnalysis:
@@ -145,6 +150,10 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
             else:
                 curve = allan_deviation_segments(pieces, recording.rate_hz, kind=kind, taus=taus)
         terms = noise_terms(allan, fit_taus_s)
+        if terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
+            warnings.warn(f"{name}: the five-term noise model misses the curve by {terms.fit_rms_log_residual:.0%} "
+                          "RMS; compare the read-offs, or restrict the fit to the taus where a term holds "
+                          "(fit_taus_s: (low, high) [s])", DataQualityWarning, stacklevel=2)
         quoted = GyroNoise.from_terms(terms) if sensor == "gyro" else AccelNoise.from_terms(terms)
         results[name] = AxisNoise(name, sensor, unit, curve, allan, terms, quoted)
     return NoiseAnalysis(source=recording.source, rate_hz=recording.rate_hz, axes=results,

@@ -42,10 +42,6 @@ def _parse_fit_taus(text: str | None):
     return low, high
 
 
-#: RMS misfit (in ln deviation) of the noise model beyond which ``gyrocomp allan`` warns
-POOR_FIT_LOG_RESIDUAL = 0.25
-
-
 @click.command()
 @click.argument("input_path", metavar="FILE", type=click.Path())
 @click.option("--axes", "axes", default=None, help="Columns to analyse, e.g. gyro_x,gyro_z,accel_z (default: every gyro axis).")
@@ -83,10 +79,6 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
                                  fit_taus_s=fit_range)
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
-    for name, a in analysis.axes.items():
-        if a.terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
-            warnings.warn(f"{name}: the five-term noise model misses the curve by {a.terms.fit_rms_log_residual:.0%} "
-                          "RMS; compare the read-offs, or restrict the fit with --fit-taus", DataQualityWarning)
     if kalibr_path:
         write_text_atomic(kalibr_path, kalibr_imu_yaml(kalibr_imu(analysis, rostopic)))
     if plot_path:
@@ -97,4 +89,4 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
         print_noise(analysis)
 
 
-__all__ = ["POOR_FIT_LOG_RESIDUAL", "allan"]
+__all__ = ["allan"]

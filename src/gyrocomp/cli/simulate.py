@@ -10,7 +10,7 @@ import click
 
 from ..errors import InputError
 from ..io import output_format, write_recording, write_text_atomic
-from ..simulate import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles
+from ..simulate import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles, truth_document
 from ..simulate import simulate as run_simulation
 from .common import float_list
 
@@ -81,13 +81,7 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
             gaps = f", {len(rec.gaps)} gaps" if rec.gaps else ""
             click.echo(f"wrote {path}: {rec.n_samples} rows, {rec.duration_s:g} s at {rate_hz:g} Hz{gaps}")
     if truth:
-        first = records[0][1].truth.to_dict()
-        doc = {k: v for k, v in first.items() if k not in ("seed", "turn_on_bias_dps", "samples",
-                                                            "deterministic_error_range_dps")}
-        doc["runs"] = [{"file": path.name, "seed": sim.truth.seed, "samples": sim.recording.n_samples,
-                        "turn_on_bias_dps": sim.truth.to_dict()["turn_on_bias_dps"],
-                        "deterministic_error_range_dps": sim.truth.to_dict()["deterministic_error_range_dps"]}
-                       for path, sim in records]
+        doc = truth_document([(path.name, sim) for path, sim in records])
         write_text_atomic(truth, json.dumps(doc, indent=2) + "\n")
 
 

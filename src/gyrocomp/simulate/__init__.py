@@ -169,6 +169,19 @@ def _accelerometer(acc: AccelErrorModel, force: np.ndarray, structure: np.ndarra
     return quantize(out, acc.quantization_g)
 
 
+def truth_document(runs: list[tuple[str, "Simulation"]]) -> dict:
+    """The truth of several simulated runs of one part as one JSON document: the part's parameters once, then
+    per run (named by its file) its seed, samples, turn-on bias [deg/s] and deterministic error range [deg/s]."""
+    per_run = ("seed", "turn_on_bias_dps", "samples", "deterministic_error_range_dps")
+    first = runs[0][1].truth.to_dict()
+    doc = {k: v for k, v in first.items() if k not in per_run}
+    doc["runs"] = [{"file": name, "seed": sim.truth.seed, "samples": sim.recording.n_samples,
+                    "turn_on_bias_dps": sim.truth.to_dict()["turn_on_bias_dps"],
+                    "deterministic_error_range_dps": sim.truth.to_dict()["deterministic_error_range_dps"]}
+                   for name, sim in runs]
+    return doc
+
+
 def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profile = "chamber",
              duration_s: float | None = None, rate_hz: float = 100.0, seed: int = 0, unit: int | None = None,
              source: str | None = None) -> Simulation:
@@ -242,4 +255,5 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
 
 __all__ = ["AccelErrorModel", "COMPONENTS", "ONE_TEMPERATURE_PROFILES", "GyroErrorModel", "Hysteresis", "NoiseTruth", "PRESETS", "PROFILES",
            "Preset", "Profile", "Simulation", "Trajectory", "Truth", "flicker_bank", "get_preset", "get_profile",
-           "preset_model", "resolve_profile", "run_profiles", "simulate", "simulate_noise", "tumble_positions"]
+           "preset_model", "resolve_profile", "run_profiles", "simulate", "simulate_noise", "truth_document",
+           "tumble_positions"]
