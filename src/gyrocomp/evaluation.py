@@ -56,6 +56,8 @@ def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recor
     rate error of each constant stretch [deg/s] (the raw output less its mean where the table stood still)."""
     out = []
     name = raw.source
+    if calibration.gyro_triad is None and calibration.accel_triad is None:
+        return out
     if calibration.gyro_triad is not None and raw.reference_rate_dps is not None:
         before, after = rate_segments([raw]), rate_segments([compensated])
         ref = np.array([s.reference_dps for s in before])

@@ -40,6 +40,8 @@ MIN_TURN_DEG = 20.0
 MIN_TURN_SINGULAR = 0.02
 #: a session whose poses' temperatures span more than this [degC] gets a temperature term in its bias at rest
 TEMPERATURE_SPAN_DEGC = 1.0
+#: a stretch between two still poses longer than this [s] is not taken as a turn
+MAX_TURN_S = 60.0
 #: a sample interval this many times the median is a pause in the recording
 GAP_FACTOR = 5.0
 #: a fitted K further than this from I (any element) is no gyro's: the moves did not determine it
@@ -210,8 +212,9 @@ def _bias_at_rest(poses: list[Pose]) -> tuple[np.ndarray, float | None]:
 
 def _session_moves(recording: Recording, poses: list[Pose], coef: np.ndarray, t_mean: float | None,
                    directions: np.ndarray) -> list[tuple]:
-    """(rates freed of the bias at rest [deg/s], dt [s], before, after, meta) of each move between consecutive
-    poses of one recording that was recorded without a pause."""
+    """(rates freed of the bias at rest [deg/s], dt [s], temperature [degC], before, after, meta) of each move
+    between consecutive poses of one recording that was recorded without a pause and lasts at most MAX_TURN_S
+    (longer stretches between still poses are motion, not a turn: their bias drift would dominate)."""
     out = []
     time = recording.time_s
     gap = GAP_FACTOR * float(np.median(np.diff(time)))
@@ -224,7 +227,7 @@ def _session_moves(recording: Recording, poses: list[Pose], coef: np.ndarray, t_
         if t_mean is not None:
             bias = bias + np.outer(temp[a:b] - t_mean, coef[4])
         dt = time[a + 1:b + 1] - time[a:b]
-        if np.any(dt > gap):  # the recording paused during the turn: it cannot be integrated
+        if np.any(dt > gap) or time[b] - time[a] > MAX_TURN_S:  # a pause, or not a turn between two poses
             continue
         t = np.full(b - a, np.nan) if temp is None else temp[a:b]
         out.append((recording.gyro_dps[a:b] - bias, dt, t, directions[k], directions[k + 1],
