@@ -40,23 +40,24 @@ def timed(func):
     return time.perf_counter() - start, result
 
 
-def runs(minutes: float, rate_hz: float):
-    """Three power-ons of the consumer preset: a heat-cool cycle, a ramp-and-hold, a warm-up."""
+def runs(minutes: float, rate_hz: float, count: int = 3):
+    """``count`` power-ons of the consumer preset: a heat-cool cycle, a ramp-and-hold, a warm-up, in turn."""
     duration = minutes * 60.0
     profiles = [get_profile("cycle", set_points_degc=(10.0, 50.0), cycles=1),
                 get_profile("chamber", set_points_degc=(10.0, 50.0)),
                 get_profile("warmup")]
-    return [simulate("consumer", profile=p, duration_s=duration, rate_hz=rate_hz, seed=s).recording
-            for s, p in enumerate(profiles)]
+    return [simulate("consumer", profile=profiles[s % 3], duration_s=duration, rate_hz=rate_hz, seed=s).recording
+            for s in range(count)]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=60.0)
     parser.add_argument("--rate", type=float, default=100.0)
+    parser.add_argument("--runs", type=int, default=3, help="number of runs (e.g. 10: how the fit grows with runs)")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
-    recordings = runs(args.minutes, args.rate)
+    recordings = runs(args.minutes, args.rate, args.runs)
     n = sum(r.n_samples for r in recordings)
 
     t_cubic, _ = timed(lambda: fit_plain_cubic(recordings))
@@ -69,7 +70,7 @@ def main() -> None:
 
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"python {platform.python_version()}, numpy {np.__version__}")
-    print(f"runs: 3 x {args.minutes:g} min at {args.rate:g} Hz, 3 axes = {n:,} samples per axis; "
+    print(f"runs: {args.runs} x {args.minutes:g} min at {args.rate:g} Hz, 3 axes = {n:,} samples per axis; "
           f"chosen {cal.model}; {scored} candidates scored over 3 axes, folds: {result.fold_kind}")
     print("| step | time [s] | ratio |")
     print("|---|---:|---:|")
