@@ -14,11 +14,12 @@ from gyrocomp.plausibility import (
     recording_concerns,
     silence_pattern,
     temperature_span_concern,
+    turned_between_poses,
 )
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 
-from .conftest import run
+from .conftest import run, xsens_session
 
 RUN = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=1).recording
 
@@ -130,3 +131,15 @@ def test_cli_allow_silences_one_check(tmp_path):
     assert quiet.returncode == 0 and "kelvin" not in quiet.stderr, quiet.stderr
     bad = run("--allow", "kelvins", "fit", path, "-o", tmp_path / "m3.json")
     assert bad.returncode == 2 and "'kelvins' is not one of" in bad.stderr
+
+
+def test_a_hand_turned_multi_position_session_is_not_taken_for_a_rotating_run():
+    """imu_tk's Xsens session swings by about 40 deg/s over 10 s means (fast hand turns), but its 38 still poses
+    turn every axis up and down: a multi-position session, whose turns are meant; the same data with the
+    accelerometer held on one face is a rotating run again."""
+    session = xsens_session()
+    assert turned_between_poses(session)
+    assert "rotation" not in _checks(calibration_concerns(session))
+    one_face = dataclasses.replace(session, accel_g=np.tile([0.0, 0.0, 1.0], (session.n_samples, 1)))
+    assert not turned_between_poses(one_face)
+    assert "rotation" in _checks(calibration_concerns(one_face))

@@ -22,6 +22,7 @@ import numpy as np
 from .errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
 from .metrics import moving_average
 from .recording import Recording
+from .static import static_segments
 
 #: beyond any MEMS gyro's measurement range [deg/s]
 MAX_RATE_DPS = 5000.0
@@ -34,6 +35,9 @@ SWING_WINDOW_S = 10.0
 KELVIN_LOOKING_DEGC = 150.0
 #: a calibration run that varies less than this in temperature cannot identify a temperature curve [degC]
 MIN_TEMPERATURE_SPAN_DEGC = 1.0
+#: still poses of a hand-turned multi-position session: 1 s still, judged on 0.5 s windows, up to 10 times the
+#: median variance (as gyrocomp.models.triad_fit.find_poses finds them)
+POSE_WINDOW_S, POSE_MIN_S, POSE_FACTOR = 0.5, 1.0, 10.0
 #: plausible sample rates of a logged IMU [Hz] (the fastest MEMS output data rates are 32 kHz)
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
@@ -81,7 +85,7 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
     """What makes ``recording`` a poor calibration run besides :func:`recording_concerns`: a zero-rate offset
     no MEMS part has, or a swing of the 10 s means that only rotation makes (a 10 s mean is the angle turned
     over 10 s: turning a unit between positions, 90 or 180 degrees, stays below the limit, a rate table does
-    not)."""
+    not; a hand-turned multi-position session may exceed it and is recognized, :func:`turned_between_poses`)."""
     out = recording_concerns(recording)
     src = recording.source
     w = max(1, int(round(SWING_WINDOW_S * recording.rate_hz)))
@@ -93,11 +97,26 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
                                          "zero-rate offset: does the unit turn, or is the unit of the data wrong?"))
         if x.size >= w:
             swing = float(np.ptp(moving_average(x, w)))
-            if swing > MAX_SWING_DPS:
+            if swing > MAX_SWING_DPS and not turned_between_poses(recording):
                 out.append(Concern("rotation", f"{src}: {axis} swings by {swing:.3g} deg/s over {SWING_WINDOW_S:g} s "
                                                "means: the unit turns, and a calibration run must be at rest "
                                                "(record still positions, or cut the run to them)"))
     return out
+
+
+def turned_between_poses(recording: Recording) -> bool:
+    """Whether the recording is a multi-position session: still poses (of at least 1 s) whose gravity directions
+    turn every accelerometer axis within 60 deg of up and of down. Its turns are meant (the fits use its still
+    stretches, and the scale-factor fit its turns), so its swing is no sign of a run that should have been at
+    rest."""
+    if recording.accel_g is None or recording.accel_g.shape[1] != 3:
+        return False
+    segments = static_segments(recording, window_s=POSE_WINDOW_S, min_duration_s=POSE_MIN_S, factor=POSE_FACTOR)
+    if len(segments) < 6:
+        return False
+    means = np.array([recording.accel_g[s.start:s.stop].mean(axis=0) for s in segments])
+    units = means / np.maximum(np.linalg.norm(means, axis=1), 1e-12)[:, None]
+    return bool(np.all(np.any(units > 0.5, axis=0)) and np.all(np.any(units < -0.5, axis=0)))
 
 
 def _largest_span_degc(recordings: list[Recording]) -> float | None:
@@ -127,4 +146,4 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
 
 
 __all__ = ["CHECKS", "CheckName", "Concern", "calibration_concerns", "recording_concerns", "require_temperature_span",
-           "silence_pattern", "temperature_span_concern"]
+           "silence_pattern", "temperature_span_concern", "turned_between_poses"]
