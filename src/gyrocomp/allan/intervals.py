@@ -66,6 +66,8 @@ _TABLE3 = {1: (6.0, 4.0), 2: (15.23, 12.0), 3: (47.8, 40.0)}
 _J_MAX = 100
 
 
+# Over 60 lines on purpose: Greenhall and Riley's algorithm, case by case as the paper gives it (its docstring
+# is half of it), so that each step can be read against the paper.
 def edf_greenhall(alpha: int, d: int, m: int, n_phase: int, *, overlapping: bool, modified: bool) -> float:
     """Equivalent degrees of freedom of a difference variance (Greenhall and Riley 2003, "edf").
 

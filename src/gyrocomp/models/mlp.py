@@ -115,6 +115,8 @@ class TrainResult:
     epochs: int
 
 
+# Over 60 lines on purpose: one Levenberg-Marquardt loop (damping, step, acceptance, early stop) whose state
+# is shared by every branch; split, its pieces would pass that state back and forth.
 def train_lm(x: np.ndarray, y: np.ndarray, w: np.ndarray, run: np.ndarray, n_runs: int, train: np.ndarray,
              shapes, rng: np.random.Generator | None, max_epochs: int = MAX_EPOCHS,
              start: np.ndarray | None = None) -> TrainResult:

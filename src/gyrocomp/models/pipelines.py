@@ -178,6 +178,8 @@ def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, 
     return selections, thermal
 
 
+# Over 60 lines, not yet split: the default fit's option checks and its routes (no temperature, cross-validated
+# selection, one binned fit, with or without a network); #18's typed options are to take the checks out.
 @single_threaded_blas
 def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",

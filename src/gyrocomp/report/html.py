@@ -267,6 +267,47 @@ def _triads(calibration: Calibration, runs: list[Recording], compensated: list[R
     return "\n".join(body)
 
 
+def _axis_sections(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
+                   windows: list[float]) -> dict:
+    """One section per modelled axis: bias against temperature, raw and compensated output of each run."""
+    modelled = [a for a in runs[0].gyro_axes if a in calibration.axes]
+    modelled += [a for a in calibration.accel_axes if runs[0].accel_g is not None]
+    sections = {}
+    for axis in modelled:
+        unit = "g" if axis.startswith("accel") else "deg/s"
+        body = []
+        if runs[0].temperature_degc is not None:
+            body.append(_img(figures.temperature_plot(runs, compensated, axis, unit),
+                             f"{axis}: bias against temperature"))
+        for rec, comp, w in zip(runs, compensated, windows):
+            body.append(_img(figures.timeseries_plot(rec, comp, axis, w, unit,
+                                                     title=f"{axis}: {rec.source.rsplit('/', 1)[-1]}"),
+                             f"{axis}: raw and compensated output"))
+        sections[f"axis-{axis}"] = (f"Axis {axis}", "\n".join(body))
+    return sections
+
+
+def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s: float) -> str:
+    """The g-sensitivity section: G with standard errors, and the static positions against it."""
+    positions = _g_positions(calibration, runs, min_static_s)
+    acc = calibration.fit_report.get("acceleration", {}).get("axes", {})
+    rows, g_matrix = [], {}
+    for axis, ax in calibration.axes.items():
+        if ax.g_sensitivity_dps_per_g is None:
+            continue
+        errors = acc.get(axis, {}).get("standard_error_dps_per_g", [None, None, None])
+        g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
+        rows.append([axis] + [f"{g:+.4g}" + ("" if e is None else f" +- {e:.2g}")
+                              for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
+    body = [_table(["gyro axis", "accel_x", "accel_y", "accel_z"], rows,
+                   "g-sensitivity matrix G [deg/s/g] +- standard error")]
+    if positions:
+        body.append(_img(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
+    else:
+        body.append("<p class=note>These runs have no static positions to draw.</p>")
+    return "\n".join(body)
+
+
 def build_report(calibration: Calibration, runs: list[Recording], *, window_s: float | None = None,
                  turn_on_window_s: float | None = None, min_static_s: float = 10.0,
                  progress: Callable[[float], None] | None = None,
@@ -309,19 +350,7 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         windows = [ev.window_s for ev in evaluations]
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
-        modelled = [a for a in runs[0].gyro_axes if a in calibration.axes]
-        modelled += [a for a in calibration.accel_axes if runs[0].accel_g is not None]
-        for axis in modelled:
-            unit = "g" if axis.startswith("accel") else "deg/s"
-            body = []
-            if runs[0].temperature_degc is not None:
-                body.append(_img(figures.temperature_plot(runs, compensated, axis, unit),
-                                 f"{axis}: bias against temperature"))
-            for rec, comp, w in zip(runs, compensated, windows):
-                body.append(_img(figures.timeseries_plot(rec, comp, axis, w, unit,
-                                                         title=f"{axis}: {rec.source.rsplit('/', 1)[-1]}"),
-                                 f"{axis}: raw and compensated output"))
-            sections[f"axis-{axis}"] = (f"Axis {axis}", "\n".join(body))
+        sections.update(_axis_sections(calibration, runs, compensated, windows))
         tick()
         allan = []
         for rec, comp in zip(runs, compensated):
@@ -334,26 +363,15 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
             tick()
         sections["allan"] = ("Allan deviation", "\n".join(allan))
         if calibration.has_acceleration:
-            positions = _g_positions(calibration, runs, min_static_s)
-            acc = calibration.fit_report.get("acceleration", {}).get("axes", {})
-            rows, g_matrix = [], {}
-            for axis, ax in calibration.axes.items():
-                if ax.g_sensitivity_dps_per_g is None:
-                    continue
-                errors = acc.get(axis, {}).get("standard_error_dps_per_g", [None, None, None])
-                g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
-                rows.append([axis] + [f"{g:+.4g}" + ("" if e is None else f" +- {e:.2g}")
-                                      for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
-            body = [_table(["gyro axis", "accel_x", "accel_y", "accel_z"], rows,
-                           "g-sensitivity matrix G [deg/s/g] +- standard error")]
-            if positions:
-                body.append(_img(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
-            else:
-                body.append("<p class=note>These runs have no static positions to draw.</p>")
-            sections["g-sensitivity"] = ("g-sensitivity", "\n".join(body))
+            sections["g-sensitivity"] = ("g-sensitivity", _g_sensitivity(calibration, runs, min_static_s))
         if calibration.gyro_triad is not None or calibration.accel_triad is not None:
             sections["scale-factor"] = ("Scale factor and misalignment", _triads(calibration, runs, compensated))
         tick()
+    return Report(_page(calibration, runs, sections), tuple(sections))
+
+
+def _page(calibration: Calibration, runs: list[Recording], sections: dict) -> str:
+    """The self-contained HTML page: title, navigation, the sections in order."""
     created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     nav = " ".join(f'<a href="#{sid}">{html.escape(title)}</a>' for sid, (title, _) in sections.items())
     files = ", ".join(html.escape(rec.source.rsplit("/", 1)[-1]) for rec in runs)
@@ -365,7 +383,7 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
     for sid, (title, body) in sections.items():
         page.append(f'<section id="{sid}"><h2>{html.escape(title)}</h2>\n{body}\n</section>')
     page.append("</body></html>")
-    return Report("\n".join(page) + "\n", tuple(sections))
+    return "\n".join(page) + "\n"
 
 
 __all__ = ["Report", "SECTIONS", "build_report"]

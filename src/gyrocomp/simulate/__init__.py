@@ -182,6 +182,8 @@ def truth_document(runs: list[tuple[str, "Simulation"]]) -> dict:
     return doc
 
 
+# Over 60 lines on purpose: the simulation in the order the physics happens (trajectory, temperatures, each
+# error term, sensor output, truth), each step a call; the docstring is a third of it.
 def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profile = "chamber",
              duration_s: float | None = None, rate_hz: float = 100.0, seed: int = 0, unit: int | None = None,
              source: str | None = None) -> Simulation:
