@@ -37,8 +37,7 @@ PART = dataclasses.replace(preset_model("mti10"), accelerometer=AccelErrorModel(
     bias_g=(0.005, -0.003, 0.004), noise_density_g_per_sqrt_hz=80e-6,
     scale_misalignment=((2e-3, 1e-3, -2e-3), (0.5e-3, -3e-3, 1.5e-3), (-1e-3, 2e-3, 4e-3))))
 TRUTH = np.eye(3) + np.diag(np.array(PART.scale_factor_error_ppm) * 1e-6) + np.array(PART.misalignment_rad)
-IDENTITY = TriadCalibration(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0), "rotation",
-                            ((0.0,) * 3,) * 3, (0.0, 0.0, 0.0), "deg/s")
+IDENTITY = TriadCalibration.identity()
 
 
 def _session(seed, positions=FACES * 2, part=PART):
@@ -103,7 +102,7 @@ def test_sessions_at_three_temperatures_give_k_and_its_temperature_coefficients(
 def test_bad_sessions_are_refused_naming_what_is_missing():
     still = simulate(PART, profile="static", duration_s=60, rate_hz=20, seed=0).recording
     with pytest.raises(InputError, match="moves between poses: 0 found; .* need at least 5 turns"):
-        fit_gyro_between_poses(still, accel_calibration=IDENTITY)
+        fit_gyro_between_poses(still, accel_calibration=TriadCalibration.identity("g"))
     no_z = ((0, 0, 1), (1, 0, 0), (0, 0, -1), (-1, 0, 0), (0, 0, 1), (0, 1, 0), (0, 0, -1), (0, -1, 0), (0, 0, 1))
     with pytest.raises(InputError, match="none turns about the z axis by 20 deg or more"):
         fit_gyro_between_poses(_session(2, no_z))

@@ -56,6 +56,7 @@ def test_correct_inverts_the_triad_model_with_temperature():
     np.testing.assert_allclose(cal.correct(raw, t), v, atol=1e-9)
     again = TriadCalibration.from_dict(json.loads(json.dumps(cal.to_dict())))
     assert again == cal
+    assert np.array_equal(TriadCalibration.identity("g").correct(v), v) and TriadCalibration.identity().unit == "deg/s"
     with pytest.raises(InputError, match="depends on temperature; give the temperature"):
         cal.correct(raw)
 

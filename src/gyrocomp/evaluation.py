@@ -17,7 +17,7 @@ from .compensate import apply
 from .errors import DataQualityWarning, InputError
 from .metrics import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_run
 from .models.pose_rotation import rotation_errors
-from .models.triad_fit import find_poses, rate_segments, spans_axes
+from .models.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
 from .recording import GYRO_AXES, Recording
 from .triad import TriadCalibration
 
@@ -44,11 +44,6 @@ def evaluate(calibration: Calibration, recordings: list[Recording] | Recording, 
                              for r in triad_residuals(calibration, rec, comp)])
 
 
-#: the identity triad: rotation_errors through it measures the turns of data as given
-_IDENTITY = TriadCalibration(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0), "rotation",
-                             ((0.0, 0.0, 0.0),) * 3, (0.0, 0.0, 0.0), "deg/s")
-
-
 def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recording) -> list[TriadResiduals]:
     """The residuals a model's triads decide on one run, raw and compensated (the run ``compensated`` by
     ``calibration``): with an accelerometer triad, |a| - 1 g of each still pose of a multi-position run [g]; with a
@@ -62,7 +57,7 @@ def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recor
         before, after = rate_segments([raw]), rate_segments([compensated])
         ref = np.array([s.reference_dps for s in before])
         still = np.all(ref == 0, axis=1)
-        moving = np.linalg.norm(ref, axis=1) >= 1.0
+        moving = np.linalg.norm(ref, axis=1) >= MIN_REFERENCE_RATE_DPS
         if np.any(still) and np.any(moving):
             bias = np.mean([s.gyro_dps for s, k in zip(before, still) if k], axis=0)
             err = lambda segs, b: np.array([np.linalg.norm(s.gyro_dps - b - s.reference_dps)  # noqa: E731
@@ -80,7 +75,7 @@ def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recor
                                             for p in poses])))
     if calibration.gyro_triad is not None and raw.gyro_axes == GYRO_AXES:
         try:
-            before, after = (rotation_errors(r, _IDENTITY, accel_calibration=calibration.accel_triad)
+            before, after = (rotation_errors(r, TriadCalibration.identity(), accel_calibration=calibration.accel_triad)
                              for r in (raw, dataclasses.replace(raw, gyro_dps=compensated.gyro_dps)))
         except InputError:
             return out

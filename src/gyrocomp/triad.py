@@ -140,6 +140,14 @@ class TriadCalibration:
         k = np.asarray(self.sensitivity, dtype=float)
         return k - np.diag(np.diag(k))
 
+    @classmethod
+    def identity(cls, unit: Literal["g", "deg/s"] = "deg/s") -> "TriadCalibration":
+        """K = I and no bias (zero standard errors): a triad that passes the data through as given, e.g. to measure
+        raw data with the tools that take a calibration (``rotation_errors``)."""
+        zeros = ((0.0, 0.0, 0.0),) * 3
+        return cls(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0),
+                   "norm" if unit == "g" else "rotation", zeros, (0.0, 0.0, 0.0), unit)
+
     # -- serialization ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         suffix = "_g" if self.unit == "g" else "_dps"

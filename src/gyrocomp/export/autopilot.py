@@ -87,8 +87,7 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
         parts.append("gyro scale-factor and misalignment")
     triad = calibration.accel_triad
     if triad is not None:
-        k = np.asarray(triad.sensitivity, dtype=float)
-        off = float(np.max(np.abs(k - np.diag(np.diag(k)))))
+        off = float(np.max(np.abs(triad.misalignment)))
         if off > 0:
             parts.append(f"accelerometer misalignment (up to {off * 1e3:.2g} mrad; its offsets and scales are written)")
         if triad.sensitivity_per_degc:
@@ -163,10 +162,8 @@ def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: in
     if triad is not None:
         p = f"CAL_ACC{instance}_"
         values[f"{p}ID"] = int(device_id)
-        for j, axis in enumerate("XYZ"):
-            values[f"{p}{axis}OFF"] = float(triad[0][j])
-        for j, axis in enumerate("XYZ"):
-            values[f"{p}{axis}SCALE"] = float(triad[1][j])
+        values.update({f"{p}{a}OFF": float(triad[0][j]) for j, a in enumerate("XYZ")})
+        values.update({f"{p}{a}SCALE": float(triad[1][j]) for j, a in enumerate("XYZ")})
     return AutopilotParameters(values, fits)
 
 

@@ -612,9 +612,18 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCa
 def _spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
     """The still poses of runs that turn the accelerometer's every axis up and down (a multi-position test), or
     None when they do not."""
-    poses = [p for rec in recordings if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes)
-             for p in find_poses(rec)]
+    turned = [rec for rec in recordings if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes)
+              and _reaches_both_ways(rec)]
+    poses = [p for rec in turned for p in find_poses(rec)]
     return poses if len(poses) >= 6 and spans_axes(poses) else None
+
+
+def _reaches_both_ways(recording: Recording) -> bool:
+    """Whether some sample has each accelerometer axis beyond +-0.4 g: without it no pose can turn that axis
+    within 60 deg of up and of down (half of gravity; 0.4 leaves room for a scale error), and the still-pose
+    search (on every run of every fit) is not worth doing."""
+    accel = recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
+    return bool(np.all(accel.max(axis=0) > 0.4) and np.all(accel.min(axis=0) < -0.4))
 
 
 def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[PoseFit, Calibration | None]:
