@@ -23,6 +23,8 @@ LAYERS = (
                  "models.triad_fit", "models.pose_rotation")),
     ("pipelines", ("models.pipelines", "models")),
     ("evaluation", ("evaluation", "comparison", "validation")),
+    # fleets fit, measure and judge many units: above evaluation, below the reports that draw them
+    ("fleet", ("fleet",)),
     ("output", ("report", "export", "demo")),
     ("cli", ("cli", "__main__")),
     ("package", ("",)),

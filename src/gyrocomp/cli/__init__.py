@@ -46,6 +46,8 @@ COMMANDS = {
                   'against temperature, raw and compensated series, Allan deviations, g-sensitivity; with '
                   '--validate-on, the held-out drift of each method on those calibration runs.'),
     "plot": ("plot", 'Single figures as PNG, SVG or PDF (from the suffix of -o).'),
+    "fleet": ("fleet", 'Production calibration of many units: fit them on Dask into a calibration store, judge them '
+                  "against limits, look a unit's calibration up and export it."),
     "demo": ("demo", 'The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score '
                 'it, and write the HTML report.'),
 }

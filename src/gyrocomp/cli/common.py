@@ -71,14 +71,18 @@ def progress_bar(description: str, indeterminate: bool = False):
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
 
-def read_run(path, opts: dict):
+def read_settings(opts: dict) -> ReadOptions:
+    """The :class:`ReadOptions` the common reading options (``pop_read_options``) give."""
     layout = table_layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"], opts["delimiter"],
-                     opts["decimal"])
-    options = ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=opts["instance"],
-                          device_id=opts["device_id"], imu_topic=opts["imu_topic"],
-                          temperature_topic=opts["temperature_topic"], record=opts["record"])
+                          opts["decimal"])
+    return ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=opts["instance"],
+                       device_id=opts["device_id"], imu_topic=opts["imu_topic"],
+                       temperature_topic=opts["temperature_topic"], record=opts["record"])
+
+
+def read_run(path, opts: dict):
     with progress_bar(f"reading {Path(path).name}") as progress:
-        return read_input(path, options, fmt=opts["fmt"], progress=progress)
+        return read_input(path, read_settings(opts), fmt=opts["fmt"], progress=progress)
 
 
 def pop_read_options(kwargs: dict) -> dict:
@@ -132,4 +136,4 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_hidden", "parse_temperature_option", "pop_read_options", "progress_bar", "read_options", "read_run", "table_layout"]
+__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_hidden", "parse_temperature_option", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]

@@ -29,24 +29,33 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id):
     """Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code."""
 
     refuse_to_overwrite_inputs(output, [model])
-    calibration = Calibration.load(model)
-    if fmt == "c":
+    write_export(Calibration.load(model), fmt, output, rate_hz=rate_hz, instance=instance, device_id=device_id,
+                 quiet=ctx.obj["quiet"])
 
+
+def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, instance=None, device_id: int = 0,
+                 quiet: bool = False) -> None:
+    """Write ``calibration`` as ``fmt`` (px4, ardupilot, c, or json: the model file) and say what was written."""
+    if fmt == "json":
+        calibration.save(output)
+        written = [output]
+    elif fmt == "c":
         written = write_c_sources(calibration, output, rate_hz=rate_hz)
-        if not ctx.obj["quiet"]:
-            click.echo("wrote " + " and ".join(str(p) for p in written))
-        return
-    if fmt == "px4":
-        text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)
     else:
-        text = ardupilot_params_file(calibration, instance=1 if instance is None else instance)
-    write_text_atomic(output, text)
-    if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}")
-        for line in text.splitlines()[1:]:
-            if not line.startswith("#"):
-                break
-            click.echo(line.lstrip("# "))
+        if fmt == "px4":
+            text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)
+        else:
+            text = ardupilot_params_file(calibration, instance=1 if instance is None else instance)
+        write_text_atomic(output, text)
+        if not quiet:
+            click.echo(f"wrote {output}")
+            for line in text.splitlines()[1:]:
+                if not line.startswith("#"):
+                    break
+                click.echo(line.lstrip("# "))
+        return
+    if not quiet:
+        click.echo("wrote " + " and ".join(str(p) for p in written))
 
 
-__all__ = ["EXPORT_FORMATS", "export"]
+__all__ = ["EXPORT_FORMATS", "export", "write_export"]

@@ -1,0 +1,205 @@
+"""``gyrocomp fleet``: fit many units into a calibration store, look them up, export them."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import click
+import pandas as pd
+from rich.table import Table
+
+from ..errors import InputError
+from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit_fleet, fleet_yield, parse_time,
+                     units_from_manifest, units_from_pattern)
+from ..io import refuse_to_overwrite_inputs
+from .common import make_console, pop_read_options, progress_bar, read_options, read_settings
+from .export import EXPORT_FORMATS, write_export
+
+#: failures and outliers listed after a fleet fit (the fleet table has them all)
+_LISTED = 10
+
+
+@click.group()
+def fleet():
+    """Production calibration of many units: fit them on Dask into a calibration store, judge them against
+    limits, look a unit's calibration up and export it."""
+
+
+@fleet.command("fit")
+@click.argument("data", nargs=-1, required=True, type=click.Path())
+@click.option("-o", "--output", required=True, type=click.Path(file_okay=False),
+              help="Fleet folder: calibrations.sqlite, models/SERIAL.json, fleet.parquet.")
+@click.option("--unit-from", "unit_pattern", default=None, metavar="PATTERN",
+              help="Which unit each run belongs to, from its path: e.g. '{serial}/run_{n}.csv' (matched against "
+                   "the end of the path; {serial} required).")
+@click.option("--manifest", default=None, type=click.Path(dir_okay=False),
+              help="CSV or Parquet table of the runs: columns path, serial, optional metadata (instead of --unit-from).")
+@click.option("--limits", "limits_file", default=None, type=click.Path(dir_okay=False),
+              help="Pass/fail limits on the figures of merit (TOML).")
+@click.option("--scheduler", default="local", show_default=True,
+              help="local (a Dask cluster on this machine), serial (no Dask), or a Dask scheduler address "
+                   "(tcp://host:8786; the runs must be readable at the same paths on its workers).")
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Local cluster: worker processes (default: one per core).")
+@click.option("--memory-limit", default="auto", show_default=True,
+              help="Local cluster: memory per worker (e.g. 2GiB; auto shares the machine's memory out).")
+@click.option("--store", default=None, help="Store the calibrations here instead (an SQLite file or a SQLAlchemy URL).")
+@click.option("--channels", default="gyro", show_default=True, help="gyro, accel or gyro,accel (as gyrocomp fit).")
+@click.option("--pipeline", default="joint", show_default=True, help="As gyrocomp fit.")
+@read_options
+@click.pass_context
+def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, workers, memory_limit, store, channels,
+        pipeline, **kwargs):
+    """Fit every unit of DATA (folders, globs or files of runs) as gyrocomp fit would, in parallel; rerun to fit
+    only the units whose runs changed."""
+    opts = pop_read_options(kwargs)
+    if (unit_pattern is None) == (manifest is None):
+        raise click.UsageError("say which unit each run belongs to: give --unit-from PATTERN or --manifest FILE "
+                               "(one of them)")
+    if manifest is not None:
+        units = units_from_manifest(manifest)
+    else:
+        units = units_from_pattern(expand_inputs(data), unit_pattern)
+    limits = Limits.load(limits_file) if limits_file else None
+    for unit in units:
+        refuse_to_overwrite_inputs(output, unit.paths)
+    settings = FleetSettings(channels=tuple(c.strip() for c in channels.split(",")), pipeline=pipeline,
+                             read=read_settings(opts), fmt=opts["fmt"])
+    memory = int(memory_limit) if memory_limit.isdigit() else memory_limit
+    with progress_bar(f"fitting {len(units)} units") as bar:
+        summary = fit_fleet(units, output, settings, limits=limits, scheduler=scheduler, workers=workers,
+                            memory_limit=memory, store=store,
+                            progress=None if bar is None else (lambda done, total: bar(done / total)))
+    if len(summary.failed) == len(units):
+        first = next(iter(summary.failed.items()))
+        raise InputError(f"every unit failed (e.g. {first[0]}: {first[1]}); nothing was calibrated")
+    if not ctx.obj["quiet"]:
+        _print_summary(summary, output, limits is not None)
+
+
+def _print_summary(summary, output, judged: bool) -> None:
+    console = make_console()
+    table = pd.read_parquet(summary.table)
+    counts = fleet_yield(table)
+    console.print(f"gyrocomp fleet fit -> {output}: {len(summary.fitted)} unit(s) fitted, {len(summary.unchanged)} "
+                  f"unchanged (skipped), {len(summary.failed)} failed")
+    if judged:
+        console.print(f"yield: {counts.passed}/{counts.units} units pass ({100 * counts.yield_fraction:.1f} %)")
+    if summary.failed:
+        _print_rows(console, "failed units", [(s, e) for s, e in summary.failed.items()], ("serial", "error"))
+    if judged:
+        rejected = table[table["verdict"] == "fail"]
+        _print_rows(console, "units outside the limits", list(zip(rejected["serial"], rejected["failing"])),
+                    ("serial", "failing figures"))
+    outliers = table[table["outlier"]].sort_values("outlier_score", ascending=False)
+    _print_rows(console, "outliers of the population (robust z > 3.5)",
+                [(s, f"{z:.1f}", f) for s, z, f in zip(outliers["serial"], outliers["outlier_score"],
+                                                        outliers["outlier_figures"])],
+                ("serial", "score", "figures"))
+
+
+def _print_rows(console, title: str, rows: list[tuple], columns: tuple[str, ...]) -> None:
+    if not rows:
+        return
+    table = Table(title=f"{title}: {len(rows)}" + (f" (first {_LISTED}; all in fleet.parquet)" if len(rows) > _LISTED else ""))
+    for column in columns:
+        table.add_column(column, overflow="fold")
+    for row in rows[:_LISTED]:
+        table.add_row(*map(str, row))
+    console.print(table)
+
+
+@fleet.command("show")
+@click.argument("serial")
+@click.option("--store", required=True, help="The fleet folder, an SQLite file or a SQLAlchemy URL.")
+@click.option("--at", "at", default=None, metavar="DATE",
+              help="The calibration valid at this date or time (ISO 8601, UTC unless a zone is given; a date means "
+                   "its end); default: the newest.")
+@click.option("--history", is_flag=True, help="List every calibration of the unit instead.")
+@click.option("--json", "as_json", is_flag=True, help="Print the calibration (record and model) as JSON.")
+@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), help="Also write its model file here.")
+@click.pass_context
+def show(ctx, serial, store, at, history, as_json, output):
+    """The calibration of unit SERIAL valid now (or --at a past time): when, from what, verdict, figures."""
+    when = parse_time(at) if at is not None else None
+    with CalibrationStore(store) as db:
+        if history:
+            rows = db.history(serial)
+            if not rows:
+                raise InputError(f"serial: no unit {serial!r} in {store}")
+            _print_history(rows)
+            return
+        record = db.valid_at(serial, when)
+    calibration = record.calibration()
+    if output is not None:
+        calibration.save(output)
+    if as_json:
+        click.echo(json.dumps(_record_document(record), indent=2))
+    elif not ctx.obj["quiet"]:
+        _print_record(record, calibration)
+
+
+def _record_document(record) -> dict:
+    return {"serial": record.serial, "calibrated_utc": record.calibrated_utc.isoformat() + "Z", "id": record.id,
+            "verdict": record.verdict, "failures": [f.figure + " " + f.reason for f in record.failures],
+            "input_hash": record.input_hash, "inputs": [{"path": i.path, "sha256": i.sha256} for i in record.inputs],
+            "metadata": record.metadata, "gyrocomp_version": record.gyrocomp_version,
+            "figures": json.loads(json.dumps(record.figures.to_dict()).replace("NaN", "null")),
+            "warnings": list(record.warnings), "model": json.loads(record.model_json)}
+
+
+def _print_record(record, calibration) -> None:
+    console = make_console()
+    console.print(f"unit {record.serial}: calibration {record.id} of {record.calibrated_utc:%Y-%m-%d %H:%M:%S} UTC "
+                  f"(gyrocomp {record.gyrocomp_version}), {len(record.inputs)} run(s); model {calibration.model}")
+    if record.verdict is not None:
+        console.print(f"verdict: {record.verdict}" + (f" ({'; '.join(f.figure + ' ' + f.reason for f in record.failures)})"
+                                                       if record.failures else ""))
+    figures = record.figures
+    table = Table(title=f"figures of merit (runs {figures.temperature_min_degc:.1f}..{figures.temperature_max_degc:.1f} degC)")
+    table.add_column("figure")
+    names = list(next(iter(figures.axes.values())).__dataclass_fields__) if figures.axes else []
+    for axis in figures.axes:
+        table.add_column(axis, justify="right")
+    for name in names:
+        table.add_row(name, *(_number(getattr(f, name)) for f in figures.axes.values()))
+    console.print(table)
+    for message in record.warnings:
+        console.print(f"warning at fit: {message}")
+
+
+def _number(value: float) -> str:
+    return "-" if math.isnan(value) else f"{value:.4g}"
+
+
+def _print_history(rows) -> None:
+    table = Table(title=f"unit {rows[0].serial}: {len(rows)} calibration(s)")
+    for column in ("id", "calibrated (UTC)", "status", "verdict", "runs", "input hash", "error"):
+        table.add_column(column, overflow="fold")
+    for r in rows:
+        table.add_row(str(r.id), f"{r.calibrated_utc:%Y-%m-%d %H:%M:%S}", r.status, r.verdict or "-",
+                      str(len(r.inputs)), r.input_hash[:12], r.error or "")
+    make_console().print(table)
+
+
+@fleet.command("export")
+@click.argument("serial")
+@click.option("--store", required=True, help="The fleet folder, an SQLite file or a SQLAlchemy URL.")
+@click.option("--format", "fmt", type=click.Choice((*EXPORT_FORMATS, "json")), required=True,
+              help="px4, ardupilot, c (a folder) or json (the model file).")
+@click.option("-o", "--output", required=True, type=click.Path(), help="File (c: folder) to write.")
+@click.option("--at", "at", default=None, metavar="DATE", help="Export the calibration valid at this date or time.")
+@click.option("--rate", "rate_hz", type=float, default=None, help="c: the sample rate the code will run at [Hz].")
+@click.option("--instance", type=int, default=None, help="As gyrocomp export.")
+@click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id.")
+@click.pass_context
+def export(ctx, serial, store, fmt, output, at, rate_hz, instance, device_id):
+    """Write the calibration of unit SERIAL from the store as autopilot parameters, C code or a model file."""
+    when = parse_time(at) if at is not None else None
+    with CalibrationStore(store) as db:
+        calibration = db.valid_at(serial, when).calibration()
+    write_export(calibration, fmt, output, rate_hz=rate_hz, instance=instance, device_id=device_id,
+                 quiet=ctx.obj["quiet"])
+
+
+__all__ = ["fleet"]

@@ -1,0 +1,172 @@
+"""Figures of merit of one unit's calibration: what a production line puts limits on and compares across units.
+
+Per gyro axis (``AxisFigures``):
+
+- ``held_out_drift_dps`` / ``raw_drift_dps``: the RMS drift left on held-out runs (or legs) by the chosen model,
+  and by a constant, as the model choice measured them (leave-one-run-out) [deg/s];
+- ``temperature_sensitivity_dps_per_degc``: d bias / dT at the reference temperature [deg/s/degC], from the
+  fitted curve (central difference over +-0.5 degC); NaN when the reference lies outside the range the unit saw;
+- ``tempco_1_dps_per_degc``, ``tempco_2_dps_per_degc2``, ``tempco_3_dps_per_degc3``: the fitted curve as a cubic
+  in (T - T_ref) by least squares over the unit's range: bias(T) - bias(T_ref) ~ sum_k c_k (T - T_ref)^k. Every
+  unit in the same basis whatever its model, so that coefficients compare across a fleet;
+- ``bias_span_dps``: peak-to-peak of the fitted curve over the unit's range [deg/s];
+- ``turn_on_bias_dps``, ``turn_on_repeatability_dps``: mean and sample standard deviation of the per-run
+  constants [deg/s] (NaN with one run);
+- ``g_sensitivity_dps_per_g``: the norm of the axis's g-sensitivity row [deg/s/g] (NaN when not fitted);
+- ``noise_density_dps_per_sqrt_hz`` and ``bias_instability_deg_per_h``: IEEE Std 952 white noise and bias
+  instability of the compensated longest run (:func:`gyrocomp.noise.analyse_noise`).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from ..calibration import AxisCalibration, Calibration
+from ..compensate import apply
+from ..errors import GyrocompError
+from ..noise import analyse_noise
+from ..recording import Recording
+
+#: the reference temperature of the temperature sensitivity and of the cubic coefficients [degC]
+REFERENCE_TEMPERATURE_DEGC = 25.0
+_DERIVATIVE_STEP_DEGC = 0.5
+_GRID_POINTS = 201
+
+
+@dataclass(frozen=True)
+class AxisFigures:
+    """One gyro axis's figures (see the module for each); NaN where a figure does not apply."""
+
+    held_out_drift_dps: float
+    raw_drift_dps: float
+    temperature_sensitivity_dps_per_degc: float
+    tempco_1_dps_per_degc: float
+    tempco_2_dps_per_degc2: float
+    tempco_3_dps_per_degc3: float
+    bias_span_dps: float
+    turn_on_bias_dps: float
+    turn_on_repeatability_dps: float
+    g_sensitivity_dps_per_g: float
+    noise_density_dps_per_sqrt_hz: float
+    bias_instability_deg_per_h: float
+
+
+#: the figure names a limit may name (for every axis, or prefixed by one axis: ``gyro_z_held_out_drift_dps``)
+FIGURE_NAMES = tuple(f.name for f in fields(AxisFigures))
+
+
+@dataclass(frozen=True)
+class UnitFigures:
+    """Every gyro axis's figures of one unit, and the temperature range its runs covered [degC]."""
+
+    axes: dict[str, AxisFigures]
+    temperature_min_degc: float
+    temperature_max_degc: float
+    runs: int
+
+    def as_row(self) -> dict[str, float]:
+        """Flat ``{axis_figure: value}`` (``gyro_x_noise_density_dps_per_sqrt_hz``, ...) for a table."""
+        row = {"runs": float(self.runs), "temperature_min_degc": self.temperature_min_degc,
+               "temperature_max_degc": self.temperature_max_degc}
+        for axis, figures in self.axes.items():
+            row.update({f"{axis}_{name}": value for name, value in asdict(figures).items()})
+        return row
+
+    def to_dict(self) -> dict:
+        return {"axes": {a: asdict(f) for a, f in self.axes.items()}, "temperature_min_degc": self.temperature_min_degc,
+                "temperature_max_degc": self.temperature_max_degc, "runs": self.runs}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "UnitFigures":
+        return cls({a: AxisFigures(**{k: float(v) if v is not None else math.nan for k, v in f.items()})
+                    for a, f in d["axes"].items()},
+                   float(d["temperature_min_degc"]), float(d["temperature_max_degc"]), int(d["runs"]))
+
+
+def unit_figures(calibration: Calibration, recordings: list[Recording], *,
+                 reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC) -> UnitFigures:
+    """The figures of merit of ``calibration`` fitted on ``recordings`` (see the module).
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The unit's model (from :func:`gyrocomp.fit` on ``recordings``).
+    recordings : list of Recording
+        The runs it was fitted on [s, deg/s, g, degC].
+    reference_temperature_degc : float
+        Where the temperature sensitivity is taken and the cubic coefficients are centred [degC].
+    """
+    temps = [r.temperature_degc for r in recordings if r.temperature_degc is not None]
+    t_lo = float(min(np.nanmin(t) for t in temps)) if temps else math.nan
+    t_hi = float(max(np.nanmax(t) for t in temps)) if temps else math.nan
+    noise = _noise(calibration, max(recordings, key=lambda r: r.n_samples))
+    selection = calibration.fit_report.get("selection", {})
+    axes = {}
+    for name, axis in calibration.axes.items():
+        chosen = selection.get(name, {}) if isinstance(selection, dict) else {}
+        axes[name] = AxisFigures(
+            held_out_drift_dps=_number(chosen.get("chosen_drift_dps")),
+            raw_drift_dps=_number(chosen.get("raw_drift_dps")),
+            **_curve_figures(axis, t_lo, t_hi, reference_temperature_degc),
+            **_constants(axis),
+            g_sensitivity_dps_per_g=(float(np.linalg.norm(axis.g_sensitivity_dps_per_g))
+                                     if axis.g_sensitivity_dps_per_g is not None else math.nan),
+            **noise.get(name, {"noise_density_dps_per_sqrt_hz": math.nan, "bias_instability_deg_per_h": math.nan}),
+        )
+    return UnitFigures(axes, t_lo, t_hi, len(recordings))
+
+
+def _number(value) -> float:
+    return float(value) if isinstance(value, (int, float)) and value is not None else math.nan
+
+
+def _curve_figures(axis: AxisCalibration, t_lo: float, t_hi: float, t_ref: float) -> dict[str, float]:
+    """Temperature sensitivity at ``t_ref``, the cubic in (T - t_ref) and the span over [t_lo, t_hi]."""
+    nan = {"temperature_sensitivity_dps_per_degc": math.nan, "tempco_1_dps_per_degc": math.nan,
+           "tempco_2_dps_per_degc2": math.nan, "tempco_3_dps_per_degc3": math.nan, "bias_span_dps": math.nan}
+    if axis.temperature is None or not t_hi > t_lo:
+        return {**nan, "bias_span_dps": 0.0} if axis.temperature is None else nan
+    grid = np.linspace(t_lo, t_hi, _GRID_POINTS)
+    curve = np.asarray(axis.shape_dps(grid), dtype=float)
+    inside = t_lo <= t_ref <= t_hi
+    slope = math.nan
+    if inside:
+        h = _DERIVATIVE_STEP_DEGC
+        ends = np.asarray(axis.shape_dps(np.array([t_ref - h, t_ref + h])), dtype=float)
+        slope = float(ends[1] - ends[0]) / (2 * h)
+    d = grid - t_ref
+    basis = np.column_stack([np.ones_like(d), d, d ** 2, d ** 3])
+    coefficients = np.linalg.lstsq(basis, curve, rcond=None)[0]
+    return {"temperature_sensitivity_dps_per_degc": slope, "tempco_1_dps_per_degc": float(coefficients[1]),
+            "tempco_2_dps_per_degc2": float(coefficients[2]), "tempco_3_dps_per_degc3": float(coefficients[3]),
+            "bias_span_dps": float(np.ptp(curve))}
+
+
+def _constants(axis: AxisCalibration) -> dict[str, float]:
+    c = np.asarray(axis.turn_on_biases_dps, dtype=float)
+    return {"turn_on_bias_dps": float(c.mean()) if c.size else math.nan,
+            "turn_on_repeatability_dps": float(c.std(ddof=1)) if c.size > 1 else math.nan}
+
+
+def _noise(calibration: Calibration, recording: Recording) -> dict[str, dict[str, float]]:
+    """White noise density and bias instability of each modelled axis of the compensated ``recording``."""
+    axes = [a for a in calibration.axes if a in recording.gyro_axes]
+    if not axes:
+        return {}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a poor noise-model fit still gives the figures; the fit warns itself
+            compensated = apply(calibration, recording)
+            analysis = analyse_noise(compensated, axes, split_gaps=True)
+    except GyrocompError:
+        return {}
+    return {name: {"noise_density_dps_per_sqrt_hz": float(a.noise.noise_density_dps_per_sqrt_hz),
+                   "bias_instability_deg_per_h": float(a.noise.bias_instability_deg_per_h)}
+            for name, a in analysis.axes.items()}
+
+
+__all__ = ["FIGURE_NAMES", "REFERENCE_TEMPERATURE_DEGC", "AxisFigures", "UnitFigures", "unit_figures"]

@@ -1,0 +1,283 @@
+"""Fit a fleet: one model per unit, on a Dask cluster, into a calibration store; resumable and failure-tolerant.
+
+Each unit is one task. The task gets the unit's file paths and the settings (a few hundred bytes), reads and
+hashes its own files, fits them as ``gyrocomp fit`` would with its defaults (:func:`gyrocomp.fit_channels`),
+computes the figures of merit, and returns the model JSON and the figures (a few kB): nothing large passes
+through the client, whatever the size of the runs. The client appends one row per unit to the store as the
+tasks finish, so an interrupted fleet keeps what it finished. A rerun passes each unit the input hash of its
+newest successful calibration; a unit whose files (by content) and settings hash the same returns at once
+without fitting. A unit that fails (an unreadable file, too little data, any error) is recorded with its error
+and the others go on.
+
+Schedulers: ``"local"`` starts a local Dask cluster (one single-threaded worker process per core, memory bounded
+per worker), an address (``tcp://host:8786``) uses a running cluster (the run files must be readable at the same
+paths on the workers: a shared file system), ``"serial"`` fits in this process one unit after another (no Dask;
+the baseline of ``benchmarks/bench_fleet.py``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import warnings
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Literal
+
+from .._version import __version__
+from ..errors import GyrocompError, InputError
+from ..io import ReadOptions, read_input
+from ..io.atomic import atomic_path, write_text_atomic
+from ..io.common import require
+from ..io.tables import file_sha256
+from ..models.pipelines import fit_channels, parse_channels
+from ..threads import single_threaded_blas
+from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
+from .limits import Limits
+from .population import fleet_table
+from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
+from .units import UnitRuns, input_hash
+
+MODELS_FOLDER = "models"
+FLEET_TABLE = "fleet.parquet"
+#: most warnings kept per unit (a run can warn once per axis and check)
+_MAX_WARNINGS = 20
+
+
+@dataclass(frozen=True)
+class FleetSettings:
+    """How each unit is read and fitted (the defaults are ``gyrocomp fit``'s).
+
+    Parameters
+    ----------
+    channels : tuple of str
+        ``("gyro",)``, ``("accel",)`` or both (see :func:`gyrocomp.fit_channels`).
+    pipeline : str
+        The fit's pipeline (``"joint"``).
+    read : ReadOptions
+        Column layout and units of tables, sensor instance of logs.
+    fmt : str, optional
+        The runs' format (default: told from each file).
+    reference_temperature_degc : float
+        Reference of the temperature figures [degC].
+    """
+
+    channels: tuple[str, ...] = ("gyro",)
+    pipeline: str = "joint"
+    read: ReadOptions = field(default_factory=ReadOptions)
+    fmt: str | None = None
+    reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "channels", parse_channels(self.channels))
+
+    def fingerprint(self) -> dict:
+        """What of the settings changes a unit's model (part of its input hash)."""
+        return {"channels": list(self.channels), "pipeline": self.pipeline, "read": repr(self.read),
+                "fmt": self.fmt, "reference_temperature_degc": self.reference_temperature_degc}
+
+
+@dataclass(frozen=True)
+class UnitOutcome:
+    """What one unit's task returns: ``unchanged`` when its inputs hash as its newest calibration's did."""
+
+    serial: str
+    status: Literal["ok", "failed", "unchanged"]
+    input_hash: str
+    inputs: tuple[InputFile, ...] = ()
+    model_json: str | None = None
+    figures: UnitFigures | None = None
+    error: str | None = None
+    warnings: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class FleetSummary:
+    """What a fleet fit did: units fitted now, skipped as unchanged, failed, and the verdicts of those fitted."""
+
+    fitted: tuple[str, ...]
+    unchanged: tuple[str, ...]
+    failed: dict[str, str]
+    passed: tuple[str, ...]
+    rejected: tuple[str, ...]
+    store: str
+    table: Path | None
+
+
+@single_threaded_blas
+def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = None) -> UnitOutcome:
+    """Fit one unit (the task of a fleet fit): hash its files, stop if the hash is ``known_hash``, else read,
+    fit and measure. Never raises for a problem of the unit: the outcome is then ``failed`` with the error."""
+    try:
+        inputs = tuple(InputFile(p, file_sha256(p) if Path(p).is_file() else input_hash([p], {})) for p in unit.paths)
+    except OSError as exc:
+        return UnitOutcome(unit.serial, "failed", "", error=_error_text(exc))
+    digest = input_hash(unit.paths, settings.fingerprint())
+    if digest == known_hash:
+        return UnitOutcome(unit.serial, "unchanged", digest, inputs)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            recordings = [read_input(p, settings.read, fmt=settings.fmt).recording for p in unit.paths]
+            calibration = fit_channels(recordings, settings.channels, settings.pipeline)
+            figures = unit_figures(calibration, recordings,
+                                   reference_temperature_degc=settings.reference_temperature_degc)
+        except Exception as exc:  # noqa: BLE001 - one unit's failure, whatever it is, must not stop the fleet
+            return UnitOutcome(unit.serial, "failed", digest, inputs, error=_error_text(exc))
+    messages = tuple(dict.fromkeys(str(w.message) for w in caught))[:_MAX_WARNINGS]
+    return UnitOutcome(unit.serial, "ok", digest, inputs, calibration.to_json(), figures, warnings=messages)
+
+
+def _error_text(exc: BaseException) -> str:
+    if isinstance(exc, GyrocompError):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
+def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: FleetSettings | None = None, *,
+              limits: Limits | None = None, scheduler: str = "local", workers: int | None = None,
+              memory_limit: str | int = "auto", store: str | os.PathLike | None = None,
+              progress: Callable[[int, int], None] | None = None) -> FleetSummary:
+    """Fit every unit (see the module) and write the fleet's outputs into the folder ``output``.
+
+    Parameters
+    ----------
+    units : iterable of UnitRuns
+        The units and their run files (:func:`units_from_pattern`, :func:`units_from_manifest`).
+    output : path
+        Folder for the store (``calibrations.sqlite``, unless ``store`` names another), the newest model of each
+        unit (``models/SERIAL.json``) and the fleet table (``fleet.parquet``).
+    settings : FleetSettings, optional
+        How each unit is read and fitted.
+    limits : Limits, optional
+        Pass/fail limits; each unit's verdict is stored with its calibration, and the table judges every unit
+        by these limits.
+    scheduler : str
+        ``"local"`` (a local Dask cluster), ``"serial"`` (this process, no Dask), or a Dask scheduler address.
+    workers : int, optional
+        Worker processes of the local cluster (default: one per core).
+    memory_limit : str or int
+        Memory per worker of the local cluster (Dask's ``"auto"``: the machine's memory shared out; or bytes,
+        or ``"2GiB"``); a worker past it is restarted by Dask and its unit recorded as failed.
+    store : str or path, optional
+        Another store location (an SQLite file or a database URL; see :mod:`gyrocomp.fleet.store`).
+    progress : callable, optional
+        Called with (units done, units in all) as each unit finishes.
+    """
+    units = list(units)
+    _check_units(units)
+    settings = settings or FleetSettings()
+    output = Path(output)
+    if output.exists() and not output.is_dir():
+        raise InputError(f"output: {output} is a file; a fleet is written into a folder")
+    output.mkdir(parents=True, exist_ok=True)
+    units = [replace(u, paths=tuple(os.path.abspath(p) for p in u.paths)) for u in units]
+    fitted, unchanged, failed, passed, rejected = [], [], {}, [], []
+    with CalibrationStore(store if store is not None else output, create=True) as db:
+        known = {}
+        for unit in units:
+            latest = next((r for r in reversed(db.history(unit.serial)) if r.status == "ok"), None)
+            known[unit.serial] = latest.input_hash if latest is not None else None
+        by_serial = {u.serial: u for u in units}
+        for done, outcome in enumerate(_outcomes(units, settings, known, scheduler, workers, memory_limit), 1):
+            if outcome.status == "unchanged":
+                unchanged.append(outcome.serial)
+            else:
+                record = _record(outcome, by_serial[outcome.serial], limits)
+                db.add(record)
+                if record.status == "ok":
+                    fitted.append(outcome.serial)
+                    (passed if record.verdict != "fail" else rejected).append(outcome.serial)
+                    _write_model(output, outcome)
+                else:
+                    failed[outcome.serial] = outcome.error or "failed"
+            if progress is not None:
+                progress(done, len(units))
+        table = write_fleet_table(db, output / FLEET_TABLE, limits)
+    return FleetSummary(tuple(fitted), tuple(unchanged), failed, tuple(passed), tuple(rejected),
+                        store=os.fspath(store if store is not None else output), table=table)
+
+
+def _check_units(units: list[UnitRuns]) -> None:
+    if not units:
+        raise InputError("units: no unit to fit")
+    serials = [u.serial for u in units]
+    repeated = sorted({s for s in serials if serials.count(s) > 1})
+    if repeated:
+        raise InputError(f"units: serial {repeated[0]!r} is given twice; give each unit once with all its runs")
+
+
+def _outcomes(units: list[UnitRuns], settings: FleetSettings, known: dict[str, str | None], scheduler: str,
+              workers: int | None, memory_limit: str | int) -> Iterator[UnitOutcome]:
+    """Each unit's outcome as it finishes."""
+    if scheduler == "serial":
+        for unit in units:
+            yield fit_unit(unit, settings, known[unit.serial])
+        return
+    distributed = require("dask.distributed", "fleet", "fitting a fleet on Dask (scheduler local or an address)")
+    with _client(distributed, scheduler, workers, memory_limit) as client:
+        futures = {client.submit(fit_unit, unit, settings, known[unit.serial], pure=False,
+                                 key=f"gyrocomp-fit-{_safe_name(unit.serial)}-{os.getpid()}-{id(unit)}"): unit
+                   for unit in units}
+        for future in distributed.as_completed(futures):
+            unit = futures[future]
+            if future.status == "finished":
+                yield future.result()
+            else:  # the worker died (memory limit, a crash): the unit fails, the fleet goes on
+                yield UnitOutcome(unit.serial, "failed", "", error=_error_text(future.exception()))
+            future.release()
+
+
+@contextlib.contextmanager
+def _client(distributed, scheduler: str, workers: int | None, memory_limit: str | int):
+    if scheduler == "local":
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # Dask's notes on ports and the dashboard are not the user's concern
+            cluster = distributed.LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
+                                               processes=True, memory_limit=memory_limit, dashboard_address=None)
+        with cluster, distributed.Client(cluster) as client:
+            yield client
+        return
+    try:
+        client = distributed.Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError(f"scheduler: cannot reach a Dask scheduler at {scheduler!r} ({exc})") from None
+    with client:
+        yield client
+
+
+def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None) -> CalibrationRecord:
+    verdict = None
+    if outcome.status == "ok" and limits is not None:
+        verdict = limits.check(outcome.figures)
+    return CalibrationRecord(
+        serial=outcome.serial, calibrated_utc=utc_now(), status="ok" if outcome.status == "ok" else "failed",
+        input_hash=outcome.input_hash, gyrocomp_version=__version__, inputs=outcome.inputs,
+        metadata=dict(unit.metadata), verdict=None if verdict is None else verdict.label,
+        failures=() if verdict is None else verdict.failures, model_json=outcome.model_json,
+        figures=outcome.figures, error=outcome.error, warnings=outcome.warnings)
+
+
+def _safe_name(serial: str) -> str:
+    """A file name for a serial: anything but letters, digits, ``.``, ``-`` and ``_`` becomes ``_``."""
+    name = re.sub(r"[^\w.-]", "_", serial)
+    return "_" + name if name.startswith(".") or not name else name
+
+
+def _write_model(output: Path, outcome: UnitOutcome) -> None:
+    folder = output / MODELS_FOLDER
+    folder.mkdir(exist_ok=True)
+    write_text_atomic(folder / f"{_safe_name(outcome.serial)}.json", outcome.model_json)
+
+
+def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None) -> Path:
+    """Write the fleet table (one row per unit, its newest calibration; see :func:`fleet_table`) atomically."""
+    table = fleet_table(store.latest_rows(), limits)
+    with atomic_path(path) as tmp:
+        table.to_parquet(tmp, index=False)
+    return path
+
+
+__all__ = ["FLEET_TABLE", "MODELS_FOLDER", "FleetSettings", "FleetSummary", "UnitOutcome", "fit_fleet", "fit_unit"]

@@ -1,0 +1,259 @@
+"""The calibration store: every calibration of every unit, in SQLite by default or any database SQLAlchemy reaches.
+
+One row per calibration attempt, never overwritten: a unit calibrated again gets a new row, so the calibration
+valid at any past time can be found (:meth:`CalibrationStore.valid_at`). A row holds the serial, the time (UTC),
+the status (``ok`` or ``failed`` with its error), the inputs and their content hash, gyrocomp's version, the model
+JSON (validated when read back, as a model file is), the figures of merit and the verdict against the limits.
+
+``location`` names the store: a folder (the fleet's output; the store is ``calibrations.sqlite`` in it), an
+SQLite file (``.sqlite``, ``.sqlite3``, ``.db``), or a SQLAlchemy URL (``postgresql://user@host/db``; the driver
+is the user's to install).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+from ..calibration import Calibration
+from ..errors import InputError, ModelError
+from ..io.common import require
+from .figures import UnitFigures
+from .limits import Failure
+
+sa = require("sqlalchemy", "fleet", "the calibration store")
+
+STORE_FILE = "calibrations.sqlite"
+STORE_SCHEMA_VERSION = 1
+_SQLITE_SUFFIXES = (".sqlite", ".sqlite3", ".db")
+
+_META = sa.MetaData()
+_INFO = sa.Table("gyrocomp_store", _META, sa.Column("key", sa.String(64), primary_key=True),
+                 sa.Column("value", sa.String(256), nullable=False))
+_ROWS = sa.Table(
+    "calibrations", _META,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("serial", sa.String(200), nullable=False, index=True),
+    sa.Column("calibrated_utc", sa.DateTime, nullable=False, index=True),
+    sa.Column("status", sa.String(16), nullable=False),
+    sa.Column("verdict", sa.String(8)),
+    sa.Column("failures", sa.Text, nullable=False),
+    sa.Column("input_hash", sa.String(64), nullable=False),
+    sa.Column("inputs", sa.Text, nullable=False),
+    sa.Column("unit_metadata", sa.Text, nullable=False),
+    sa.Column("gyrocomp_version", sa.String(32), nullable=False),
+    sa.Column("model", sa.Text),
+    sa.Column("figures", sa.Text),
+    sa.Column("error", sa.Text),
+    sa.Column("warnings", sa.Text, nullable=False),
+)
+
+Status = Literal["ok", "failed"]
+
+
+@dataclass(frozen=True)
+class InputFile:
+    """One run file of a calibration: its path as given and the SHA-256 of its content."""
+
+    path: str
+    sha256: str
+
+
+@dataclass(frozen=True)
+class CalibrationRecord:
+    """One row of the store. ``calibrated_utc`` is naive UTC; ``model_json`` is None for a failed unit."""
+
+    serial: str
+    calibrated_utc: _dt.datetime
+    status: Status
+    input_hash: str
+    gyrocomp_version: str
+    inputs: tuple[InputFile, ...] = ()
+    metadata: dict[str, str] = field(default_factory=dict)
+    verdict: Literal["pass", "fail"] | None = None
+    failures: tuple[Failure, ...] = ()
+    model_json: str | None = None
+    figures: UnitFigures | None = None
+    error: str | None = None
+    warnings: tuple[str, ...] = ()
+    id: int | None = None
+
+    def calibration(self) -> Calibration:
+        """The model, validated (and upgraded) as a model file is on load."""
+        if self.model_json is None:
+            raise ModelError(f"unit {self.serial}: the calibration of {self.calibrated_utc:%Y-%m-%d %H:%M:%S} "
+                             f"failed ({self.error}); it has no model")
+        return Calibration.from_dict(json.loads(self.model_json), source=f"store row {self.id} ({self.serial})")
+
+
+def utc_now() -> _dt.datetime:
+    """Now, naive UTC (what the store keeps), to the microsecond."""
+    return _dt.datetime.now(_dt.timezone.utc).replace(tzinfo=None)
+
+
+def parse_time(text: str, name: str = "at") -> _dt.datetime:
+    """An ISO 8601 date or time (``2026-11-24``, ``2026-11-24T10:30``, with or without a zone) as naive UTC; a date
+    alone means the end of that day (a calibration made that day is valid at it)."""
+    try:
+        value = _dt.datetime.fromisoformat(text.strip())
+    except ValueError:
+        raise InputError(f"{name}: {text!r} is not an ISO 8601 date or time (e.g. 2026-11-24 or "
+                         f"2026-11-24T10:30:00Z)") from None
+    if len(text.strip()) <= 10:
+        value = value + _dt.timedelta(days=1) - _dt.timedelta(microseconds=1)
+    if value.tzinfo is not None:
+        value = value.astimezone(_dt.timezone.utc).replace(tzinfo=None)
+    return value
+
+
+def store_url(location: str | os.PathLike) -> str:
+    """The SQLAlchemy URL of a store location (see the module)."""
+    text = os.fspath(location)
+    if "://" in text:
+        return text
+    path = Path(text)
+    if path.suffix.lower() not in _SQLITE_SUFFIXES:
+        path = path / STORE_FILE
+    return f"sqlite:///{path.resolve()}"
+
+
+class CalibrationStore:
+    """A calibration store (see the module). ``create``: make the database (and its tables) when absent."""
+
+    def __init__(self, location: str | os.PathLike, *, create: bool = False) -> None:
+        self.location = os.fspath(location)
+        url = store_url(location)
+        if url.startswith("sqlite:///"):
+            file = Path(url[len("sqlite:///"):])
+            if not file.exists():
+                if not create:
+                    raise InputError(f"{self.location}: no calibration store there (no {file.name}); give the folder "
+                                     f"a fleet fit wrote, an SQLite file or a database URL")
+                file.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.engine = sa.create_engine(url)
+        except (sa.exc.ArgumentError, sa.exc.NoSuchModuleError, ModuleNotFoundError) as exc:
+            raise InputError(f"{self.location}: not a database URL SQLAlchemy can open ({exc})") from None
+        self._prepare(create)
+
+    def _prepare(self, create: bool) -> None:
+        try:
+            inspector = sa.inspect(self.engine)
+            present = inspector.has_table(_ROWS.name)
+        except sa.exc.DatabaseError as exc:
+            raise InputError(f"{self.location}: not a database ({exc.orig})") from None
+        if not present:
+            if not create:
+                raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
+            _META.create_all(self.engine)
+            with self.engine.begin() as conn:
+                conn.execute(_INFO.insert().values(key="schema_version", value=str(STORE_SCHEMA_VERSION)))
+            return
+        with self.engine.connect() as conn:
+            version = conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
+        if version is None or not version.isdigit() or int(version) > STORE_SCHEMA_VERSION:
+            raise InputError(f"{self.location}: store schema version {version}; this gyrocomp reads up to "
+                             f"{STORE_SCHEMA_VERSION} (upgrade gyrocomp)")
+
+    def close(self) -> None:
+        self.engine.dispose()
+
+    def __enter__(self) -> "CalibrationStore":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- writing -------------------------------------------------------------------------------------------
+    def add(self, record: CalibrationRecord) -> int:
+        """Append ``record`` (a new row, whatever the serial's history); returns its id."""
+        with self.engine.begin() as conn:
+            result = conn.execute(_ROWS.insert().values(**_to_row(record)))
+            return int(result.inserted_primary_key[0])
+
+    # -- reading -------------------------------------------------------------------------------------------
+    def history(self, serial: str) -> list[CalibrationRecord]:
+        """Every row of ``serial``, oldest first."""
+        query = sa.select(_ROWS).where(_ROWS.c.serial == serial).order_by(_ROWS.c.calibrated_utc, _ROWS.c.id)
+        with self.engine.connect() as conn:
+            return [_from_row(r) for r in conn.execute(query).mappings()]
+
+    def latest(self, serial: str) -> CalibrationRecord | None:
+        """The newest row of ``serial`` (ok or failed), or None."""
+        rows = self.history(serial)
+        return rows[-1] if rows else None
+
+    def valid_at(self, serial: str, at: _dt.datetime | None = None) -> CalibrationRecord:
+        """The calibration of ``serial`` valid at ``at`` (naive UTC; default now): its newest successful row made
+        at or before then."""
+        rows = self.history(serial)
+        if not rows:
+            raise InputError(f"serial: no unit {serial!r} in {self.location}")
+        ok = [r for r in rows if r.status == "ok" and (at is None or r.calibrated_utc <= at)]
+        if not ok:
+            first = next((r for r in rows if r.status == "ok"), None)
+            when = f" at {at:%Y-%m-%d %H:%M:%S}" if at is not None else ""
+            hint = (f"; its first calibration is of {first.calibrated_utc:%Y-%m-%d %H:%M:%S} UTC" if first is not None
+                    else f"; every calibration of it failed (last: {rows[-1].error})")
+            raise InputError(f"serial: unit {serial!r} had no valid calibration{when}{hint}")
+        return ok[-1]
+
+    def latest_rows(self) -> list[CalibrationRecord]:
+        """The newest row of every unit, by serial."""
+        newest = (sa.select(_ROWS.c.serial, sa.func.max(_ROWS.c.id).label("id")).group_by(_ROWS.c.serial)
+                  .subquery())
+        query = sa.select(_ROWS).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial)
+        with self.engine.connect() as conn:
+            return [_from_row(r) for r in conn.execute(query).mappings()]
+
+    def serials(self) -> list[str]:
+        with self.engine.connect() as conn:
+            return list(conn.execute(sa.select(_ROWS.c.serial).distinct().order_by(_ROWS.c.serial)).scalars())
+
+
+def _to_row(record: CalibrationRecord) -> dict:
+    return {
+        "serial": record.serial, "calibrated_utc": record.calibrated_utc, "status": record.status,
+        "verdict": record.verdict,
+        "failures": json.dumps([[f.figure, _json_float(f.value), f.reason] for f in record.failures]),
+        "input_hash": record.input_hash,
+        "inputs": json.dumps([[i.path, i.sha256] for i in record.inputs]),
+        "unit_metadata": json.dumps(dict(record.metadata)), "gyrocomp_version": record.gyrocomp_version,
+        "model": record.model_json,
+        "figures": None if record.figures is None else json.dumps(_without_nan(record.figures.to_dict())),
+        "error": record.error, "warnings": json.dumps(list(record.warnings)),
+    }
+
+
+def _json_float(value):
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+def _without_nan(value):
+    """``value`` with every NaN as None (JSON has no NaN; other readers of the database must parse it)."""
+    if isinstance(value, dict):
+        return {k: _without_nan(v) for k, v in value.items()}
+    return _json_float(value)
+
+
+def _from_row(row) -> CalibrationRecord:
+    figures = None
+    if row["figures"] is not None:
+        figures = UnitFigures.from_dict(json.loads(row["figures"]))
+    return CalibrationRecord(
+        serial=row["serial"], calibrated_utc=row["calibrated_utc"], status=row["status"],
+        input_hash=row["input_hash"], gyrocomp_version=row["gyrocomp_version"],
+        inputs=tuple(InputFile(p, h) for p, h in json.loads(row["inputs"])),
+        metadata=json.loads(row["unit_metadata"]), verdict=row["verdict"],
+        failures=tuple(Failure(f, math.nan if v is None else v, r) for f, v, r in json.loads(row["failures"])),
+        model_json=row["model"], figures=figures, error=row["error"], warnings=tuple(json.loads(row["warnings"])),
+        id=row["id"])
+
+
+__all__ = ["STORE_FILE", "STORE_SCHEMA_VERSION", "CalibrationRecord", "CalibrationStore", "InputFile", "parse_time",
+           "store_url", "utc_now"]

@@ -1,0 +1,61 @@
+"""A simulated fleet on disk: units of the consumer preset's production spread, a few made bad on purpose."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+from gyrocomp.io.tables import write_recording
+from gyrocomp.simulate import preset_model, resolve_profile, simulate
+
+PRESET = "consumer"
+#: each unit: three 15-minute chamber runs over the preset's range at 10 Hz
+RUNS_PER_UNIT = 3
+RUN_DURATION_S = 900.0
+RATE_HZ = 10.0
+FLEET_UNITS = 200
+#: units made bad on purpose: three times the white noise, five times the temperature coefficients
+NOISY_UNIT = 17
+HOT_UNIT = 42
+#: a unit one of whose files is not a table
+CORRUPT_UNIT = 99
+
+
+def unit_model(unit: int):
+    """The true error model of ``unit`` (the preset's spread; the bad units changed)."""
+    model = preset_model(PRESET, unit)
+    if unit == NOISY_UNIT:
+        model = dataclasses.replace(model, noise_density_dps_per_sqrt_hz=3 * model.noise_density_dps_per_sqrt_hz)
+    if unit == HOT_UNIT:
+        model = dataclasses.replace(model, temperature_coefficients=tuple(tuple(5 * c for c in row)
+                                                                          for row in model.temperature_coefficients))
+    return model
+
+
+def serial(unit: int) -> str:
+    return f"SN{unit:04d}"
+
+
+def write_unit(folder: Path, unit: int, session: int = 0) -> list[Path]:
+    """Write the runs of ``unit`` in chamber ``session`` as folder/SERIAL/run_K.parquet; returns their paths."""
+    paths = []
+    (folder / serial(unit)).mkdir(parents=True, exist_ok=True)
+    for k in range(RUNS_PER_UNIT):
+        sim = simulate(unit_model(unit), profile=resolve_profile("chamber", PRESET), duration_s=RUN_DURATION_S,
+                       rate_hz=RATE_HZ, seed=1000 * unit + 10 * session + k)
+        path = folder / serial(unit) / f"run_{k}.parquet"
+        write_recording(sim.recording, path)
+        paths.append(path)
+    return paths
+
+
+@pytest.fixture(scope="session")
+def fleet_data(tmp_path_factory) -> Path:
+    """FLEET_UNITS units on disk (about 6 s to simulate); CORRUPT_UNIT's second run is garbage."""
+    folder = tmp_path_factory.mktemp("fleet") / "data"
+    for unit in range(FLEET_UNITS):
+        write_unit(folder, unit)
+    (folder / serial(CORRUPT_UNIT) / "run_1.parquet").write_bytes(b"PAR1 this is not a parquet file")
+    return folder
