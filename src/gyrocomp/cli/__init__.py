@@ -20,7 +20,6 @@ import traceback
 import warnings
 
 import click
-from click.utils import make_default_short_help
 
 from .._version import __version__
 from ..errors import CHECKS, GyrocompError, InputError, PlausibilityWarning, printable, silence_pattern
@@ -53,6 +52,16 @@ COMMANDS = {
 }
 
 
+def short_help(text: str, limit: int) -> str:
+    """The first sentence of ``text``, cut at a word with ``...`` when longer than ``limit`` characters (what
+    click shows for a command's help in its parent's list)."""
+    sentence = text.split(". ", 1)[0].rstrip(".")
+    if len(sentence) <= limit:
+        return sentence
+    cut = sentence[: max(limit - 3, 1)].rsplit(" ", 1)[0]
+    return cut.rstrip(",;:") + "..."
+
+
 class LazyGroup(click.Group):
     """A click group whose commands are imported when one is looked up (running it or its --help), and whose
     own help lists them from :data:`COMMANDS` without importing anything."""
@@ -68,7 +77,7 @@ class LazyGroup(click.Group):
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         limit = formatter.width - 6 - max(len(name) for name in COMMANDS)
         with formatter.section("Commands"):
-            formatter.write_dl([(name, make_default_short_help(text, limit))
+            formatter.write_dl([(name, short_help(text, limit))
                                 for name, (_, text) in sorted(COMMANDS.items())])
 
 
@@ -110,7 +119,7 @@ PARAMETER_FLAGS = {
     "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
     "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
-    "decimal": "--decimal",
+    "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
 }
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
 _SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone

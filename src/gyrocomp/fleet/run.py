@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import socket
 import warnings
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
@@ -169,6 +170,8 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
     units = list(units)
     _check_units(units)
     settings = settings or FleetSettings()
+    if scheduler not in ("local", "serial"):
+        _check_reachable(scheduler)
     output = Path(output)
     if output.exists() and not output.is_dir():
         raise InputError(f"output: {output} is a file; a fleet is written into a folder")
@@ -246,6 +249,20 @@ def _client(distributed, scheduler: str, workers: int | None, memory_limit: str 
         raise InputError(f"scheduler: cannot reach a Dask scheduler at {scheduler!r} ({exc})") from None
     with client:
         yield client
+
+
+def _check_reachable(address: str) -> None:
+    """Refuse at once a TCP scheduler address nothing listens on (Dask would retry until its timeout)."""
+    m = re.fullmatch(r"(?:tcp://)?\[?([^\]\s]+?)\]?:(\d+)", address.strip())
+    if m is None:
+        if "://" not in address:
+            raise InputError(f"scheduler: {address!r}; use local, serial or a Dask scheduler address "
+                             f"(tcp://host:8786)")
+        return  # another protocol (tls://, ucx://, inproc://): Dask connects and reports
+    try:
+        socket.create_connection((m.group(1), int(m.group(2))), timeout=10).close()
+    except OSError as exc:
+        raise InputError(f"scheduler: cannot reach a Dask scheduler at {address!r} ({exc.strerror or exc})") from None
 
 
 def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None) -> CalibrationRecord:

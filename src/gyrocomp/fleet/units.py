@@ -95,8 +95,9 @@ def pattern_regex(pattern: str) -> re.Pattern:
 
 
 def units_from_pattern(paths: Iterable[str | os.PathLike], pattern: str) -> list[UnitRuns]:
-    """Group run files into units by ``pattern`` (see the module). Fields other than ``serial`` that are the same
-    for every run of a unit become its metadata. A file that does not match is left out with a warning."""
+    """Group run files into units by ``pattern`` (see the module). Fields other than ``serial`` become the units'
+    metadata, except those that differ between the runs of some unit (a run number). A file that does not match
+    is left out with a warning."""
     regex = pattern_regex(pattern)
     groups: dict[str, list[tuple[str, dict[str, str]]]] = {}
     unmatched = []
@@ -114,13 +115,11 @@ def units_from_pattern(paths: Iterable[str | os.PathLike], pattern: str) -> list
                              f"(e.g. {unmatched[0]})")
         warnings.warn(f"unit_pattern: {len(unmatched)} file(s) do not match {pattern!r} and are left out "
                       f"(e.g. {unmatched[0]})", DataQualityWarning, stacklevel=2)
-    return [UnitRuns(serial, tuple(sorted(p for p, _ in runs)), _common_fields([f for _, f in runs]))
+    # a field that differs between the runs of any unit names runs (``{n}``); the others describe units
+    per_run = {k for runs in groups.values() for k in runs[0][1] if len({f[k] for _, f in runs}) > 1}
+    return [UnitRuns(serial, tuple(sorted(p for p, _ in runs)),
+                     {k: v for k, v in runs[0][1].items() if k not in per_run})
             for serial, runs in sorted(groups.items())]
-
-
-def _common_fields(fields: list[dict[str, str]]) -> dict[str, str]:
-    first = fields[0]
-    return {k: v for k, v in first.items() if all(f.get(k) == v for f in fields)}
 
 
 def units_from_manifest(path: str | os.PathLike) -> list[UnitRuns]:
