@@ -10,6 +10,8 @@ import pytest
 from gyrocomp.io.tables import write_recording
 from gyrocomp.simulate import preset_model, resolve_profile, simulate
 
+from ..conftest import run
+
 PRESET = "consumer"
 #: each unit: three 15-minute chamber runs over the preset's range at 10 Hz
 RUNS_PER_UNIT = 3
@@ -21,6 +23,7 @@ NOISY_UNIT = 17
 HOT_UNIT = 42
 #: a unit one of whose files is not a table
 CORRUPT_UNIT = 99
+PATTERN = "{serial}/run_{n}.parquet"
 
 
 def unit_model(unit: int):
@@ -59,3 +62,22 @@ def fleet_data(tmp_path_factory) -> Path:
         write_unit(folder, unit)
     (folder / serial(CORRUPT_UNIT) / "run_1.parquet").write_bytes(b"PAR1 this is not a parquet file")
     return folder
+
+
+def _limits_text() -> str:
+    """Limits a production engineer would set from the part's nominal figures: twice its noise density, twice its
+    largest temperature sensitivity."""
+    nominal = preset_model(PRESET)
+    sensitivity = max(abs(row[0]) for row in nominal.temperature_coefficients)
+    return (f"[noise_density_dps_per_sqrt_hz]\nmax = {2 * nominal.noise_density_dps_per_sqrt_hz}\n\n"
+            f"[temperature_sensitivity_dps_per_degc]\nabs_max = {2 * sensitivity}\n")
+
+
+@pytest.fixture(scope="session")
+def fleet_run(fleet_data, tmp_path_factory):
+    """The fleet fitted once through the command line, on a local Dask cluster of two workers."""
+    out = tmp_path_factory.mktemp("fleet-out") / "FLEET"
+    limits = out.parent / "limits.toml"
+    limits.write_text(_limits_text())
+    result = run("fleet", "fit", fleet_data, "--unit-from", PATTERN, "-o", out, "--limits", limits, "--workers", 2)
+    return out, limits, result

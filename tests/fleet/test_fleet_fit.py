@@ -15,33 +15,9 @@ from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, FleetSettings, UnitRuns, fit_unit
 from gyrocomp.io import read
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import preset_model
 
 from ..conftest import run
-from .conftest import (CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PRESET, serial, unit_model,
-                       write_unit)
-
-PATTERN = "{serial}/run_{n}.parquet"
-
-
-def _limits_text() -> str:
-    """Limits a production engineer would set from the part's nominal figures: twice its noise density, twice its
-    largest temperature sensitivity."""
-    nominal = preset_model(PRESET)
-    sensitivity = max(abs(row[0]) for row in nominal.temperature_coefficients)
-    return (f"[noise_density_dps_per_sqrt_hz]\nmax = {2 * nominal.noise_density_dps_per_sqrt_hz}\n\n"
-            f"[temperature_sensitivity_dps_per_degc]\nabs_max = {2 * sensitivity}\n")
-
-
-@pytest.fixture(scope="module")
-def fleet_run(fleet_data, tmp_path_factory):
-    """The fleet fitted once through the command line, on a local Dask cluster of two workers."""
-    out = tmp_path_factory.mktemp("fleet-out") / "FLEET"
-    limits = out.parent / "limits.toml"
-    limits.write_text(_limits_text())
-    result = run("fleet", "fit", fleet_data, "--unit-from", PATTERN, "-o", out, "--limits", limits, "--workers", 2)
-    return out, limits, result
-
+from .conftest import CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PATTERN, serial, unit_model, write_unit
 
 def test_every_unit_is_fitted_or_recorded_as_failed(fleet_run):
     out, _, result = fleet_run

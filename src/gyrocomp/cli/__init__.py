@@ -120,6 +120,7 @@ PARAMETER_FLAGS = {
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
     "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
     "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
+    "prior": "--prior",
 }
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
 _SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone

@@ -6,7 +6,8 @@ and compared with their population.
 - :mod:`~gyrocomp.fleet.limits`: pass/fail limits (TOML) and verdicts;
 - :mod:`~gyrocomp.fleet.store`: the calibration store (SQLite or any SQLAlchemy database), with history;
 - :mod:`~gyrocomp.fleet.run`: the fleet fit itself (Dask local cluster, a running cluster, or serial);
-- :mod:`~gyrocomp.fleet.population`: the fleet table, robust outlier scores, yield.
+- :mod:`~gyrocomp.fleet.population`: the fleet table, robust outlier scores, yield;
+- :mod:`~gyrocomp.fleet.prior`: a new unit from a short run, with the fleet's population as the prior.
 
 Needs the ``fleet`` extra (``pip install 'gyrocomp[fleet]'``: dask[distributed], SQLAlchemy).
 """
@@ -14,11 +15,12 @@ Needs the ``fleet`` extra (``pip install 'gyrocomp[fleet]'``: dask[distributed],
 from .figures import FIGURE_NAMES, REFERENCE_TEMPERATURE_DEGC, AxisFigures, UnitFigures, unit_figures
 from .limits import Failure, Limit, Limits, Verdict
 from .population import FleetYield, fleet_table, fleet_yield, robust_z
+from .prior import AxisPrior, PopulationPrior, block_covariance, fit_with_prior, population_prior
 from .run import FLEET_TABLE, MODELS_FOLDER, FleetSettings, FleetSummary, UnitOutcome, fit_fleet, fit_unit
 from .store import CalibrationRecord, CalibrationStore, InputFile, parse_time, store_url, utc_now
 from .units import UnitRuns, expand_inputs, input_hash, units_from_manifest, units_from_pattern
 
-__all__ = ["AxisFigures", "CalibrationRecord", "CalibrationStore", "FIGURE_NAMES", "FLEET_TABLE", "Failure",
+__all__ = ["AxisPrior", "PopulationPrior", "block_covariance", "fit_with_prior", "population_prior", "AxisFigures", "CalibrationRecord", "CalibrationStore", "FIGURE_NAMES", "FLEET_TABLE", "Failure",
            "FleetSettings", "FleetSummary", "FleetYield", "InputFile", "Limit", "Limits", "MODELS_FOLDER",
            "REFERENCE_TEMPERATURE_DEGC", "UnitFigures", "UnitOutcome", "UnitRuns", "Verdict", "expand_inputs",
            "fit_fleet", "fit_unit", "fleet_table", "fleet_yield", "input_hash", "parse_time", "robust_z", "store_url",

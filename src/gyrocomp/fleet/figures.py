@@ -14,7 +14,10 @@ Per gyro axis (``AxisFigures``):
   constants [deg/s] (NaN with one run);
 - ``g_sensitivity_dps_per_g``: the norm of the axis's g-sensitivity row [deg/s/g] (NaN when not fitted);
 - ``noise_density_dps_per_sqrt_hz`` and ``bias_instability_deg_per_h``: IEEE Std 952 white noise and bias
-  instability of the compensated longest run (:func:`gyrocomp.noise.analyse_noise`).
+  instability of the compensated longest run (:func:`gyrocomp.noise.analyse_noise`);
+- ``curve_sd_dps``: for a unit fitted with its population's prior (:mod:`gyrocomp.fleet.prior`), the largest
+  standard deviation of its fitted curve over the population's range [deg/s] (its stated uncertainty; such a fit
+  has no held-out drift); NaN otherwise.
 """
 
 from __future__ import annotations
@@ -53,6 +56,7 @@ class AxisFigures:
     g_sensitivity_dps_per_g: float
     noise_density_dps_per_sqrt_hz: float
     bias_instability_deg_per_h: float
+    curve_sd_dps: float = math.nan
 
 
 #: the figure names a limit may name (for every axis, or prefixed by one axis: ``gyro_z_held_out_drift_dps``)
@@ -105,6 +109,7 @@ def unit_figures(calibration: Calibration, recordings: list[Recording], *,
     t_hi = float(max(np.nanmax(t) for t in temps)) if temps else math.nan
     noise = _noise(calibration, max(recordings, key=lambda r: r.n_samples))
     selection = calibration.fit_report.get("selection", {})
+    prior_fit = calibration.fit_report.get("prior", {})
     axes = {}
     for name, axis in calibration.axes.items():
         chosen = selection.get(name, {}) if isinstance(selection, dict) else {}
@@ -116,6 +121,7 @@ def unit_figures(calibration: Calibration, recordings: list[Recording], *,
             g_sensitivity_dps_per_g=(float(np.linalg.norm(axis.g_sensitivity_dps_per_g))
                                      if axis.g_sensitivity_dps_per_g is not None else math.nan),
             **noise.get(name, {"noise_density_dps_per_sqrt_hz": math.nan, "bias_instability_deg_per_h": math.nan}),
+            curve_sd_dps=_number(prior_fit.get(name, {}).get("curve_sd_max_dps")),
         )
     return UnitFigures(axes, t_lo, t_hi, len(recordings))
 

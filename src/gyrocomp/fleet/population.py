@@ -92,7 +92,7 @@ def fleet_table(records: Sequence[CalibrationRecord], limits: Limits | None = No
                "calibrated_utc": r.calibrated_utc, "error": r.error or ""}
         row.update(r.figures.as_row() if r.figures is not None else {})
         rows.append(row)
-    table = pd.DataFrame(rows)
+    table = pd.DataFrame(rows, columns=None if rows else list(INFO_COLUMNS[:6]))
     figures = [c for c in table.columns if c not in INFO_COLUMNS]
     ok = (table["status"] == "ok") if len(table) else pd.Series(dtype=bool)
     scored = [c for c in figures if c in _UNIT_SCORED or any(c.endswith("_" + f) for f in SCORED_FIGURES)]

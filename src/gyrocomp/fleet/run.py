@@ -38,6 +38,7 @@ from ..threads import single_threaded_blas
 from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
 from .limits import Limits
 from .population import fleet_table
+from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
 from .units import UnitRuns, input_hash
 
@@ -63,6 +64,9 @@ class FleetSettings:
         The runs' format (default: told from each file).
     reference_temperature_degc : float
         Reference of the temperature figures [degC].
+    prior : PopulationPrior, optional
+        Fit each unit with this population prior (:func:`gyrocomp.fleet.fit_with_prior`: short runs) instead of
+        the default fit; ``channels`` and ``pipeline`` then do not apply.
     """
 
     channels: tuple[str, ...] = ("gyro",)
@@ -70,6 +74,7 @@ class FleetSettings:
     read: ReadOptions = field(default_factory=ReadOptions)
     fmt: str | None = None
     reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC
+    prior: PopulationPrior | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "channels", parse_channels(self.channels))
@@ -77,7 +82,8 @@ class FleetSettings:
     def fingerprint(self) -> dict:
         """What of the settings changes a unit's model (part of its input hash)."""
         return {"channels": list(self.channels), "pipeline": self.pipeline, "read": repr(self.read),
-                "fmt": self.fmt, "reference_temperature_degc": self.reference_temperature_degc}
+                "fmt": self.fmt, "reference_temperature_degc": self.reference_temperature_degc,
+                "prior": None if self.prior is None else self.prior.digest()}
 
 
 @dataclass(frozen=True)
@@ -122,7 +128,10 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
         warnings.simplefilter("always")
         try:
             recordings = [read_input(p, settings.read, fmt=settings.fmt).recording for p in unit.paths]
-            calibration = fit_channels(recordings, settings.channels, settings.pipeline)
+            if settings.prior is not None:
+                calibration = fit_with_prior(recordings, settings.prior)
+            else:
+                calibration = fit_channels(recordings, settings.channels, settings.pipeline)
             figures = unit_figures(calibration, recordings,
                                    reference_temperature_degc=settings.reference_temperature_degc)
         except Exception as exc:  # noqa: BLE001 - one unit's failure, whatever it is, must not stop the fleet
