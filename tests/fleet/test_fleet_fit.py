@@ -15,9 +15,11 @@ from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, FleetSettings, UnitRuns, fit_unit
 from gyrocomp.io import read
 from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.simulate import resolve_profile, simulate
 
 from ..conftest import run
-from .conftest import CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PATTERN, serial, unit_model, write_unit
+from .conftest import (CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PATTERN, PRESET, RATE_HZ, RUN_DURATION_S,
+                       RUNS_PER_UNIT, serial, unit_model, write_unit)
 
 def test_every_unit_is_fitted_or_recorded_as_failed(fleet_run):
     out, _, result = fleet_run
@@ -79,11 +81,21 @@ def test_a_fleet_model_equals_gyrocomp_fit_on_the_command_line(fleet_run, fleet_
 
 def test_figures_recover_the_true_temperature_sensitivity(fleet_run):
     """d bias/dT at 25 degC against the simulated unit's first coefficient, within three times what the curve's
-    held-out drift allows over half the temperature span (the slope error a drift that size could cause)."""
+    held-out drift allows over half the temperature span (the slope error a drift that size could cause); the bias
+    at 25 degC against the mean of the runs' true constant biases (the curve is zero there), within three held-out
+    drifts."""
     out, _, _ = fleet_run
     with CalibrationStore(out) as db:
         for unit in (0, 7, 123, HOT_UNIT):
             figures = db.valid_at(serial(unit)).figures
+            truths = [simulate(unit_model(unit), profile=resolve_profile("chamber", PRESET), duration_s=RUN_DURATION_S,
+                               rate_hz=RATE_HZ, seed=1000 * unit + k).truth for k in range(RUNS_PER_UNIT)]
+            # at rest, upright: the turn-on bias plus the g-sensitivity's 1 g term, which a run at one orientation
+            # cannot tell apart
+            turn_on = np.mean([t.turn_on_bias_dps + t.components_dps["acceleration"].mean(axis=0) for t in truths],
+                              axis=0)
+            for j, f in enumerate(figures.axes.values()):
+                assert f.turn_on_bias_dps == pytest.approx(turn_on[j], abs=3 * f.held_out_drift_dps), (unit, j)
             span = figures.temperature_max_degc - figures.temperature_min_degc
             for axis, row in zip(figures.axes, unit_model(unit).temperature_coefficients):
                 f = figures.axes[axis]
@@ -124,3 +136,18 @@ def test_serial_scheduler_gives_the_dask_models(fleet_run, fleet_data):
             == _model_document(Calibration.load(out / "models" / f"{serial(11)}.json")))
     assert fit_unit(unit, FleetSettings(), known_hash=outcome.input_hash).status == "unchanged"
     assert np.isfinite(outcome.figures.axes["gyro_x"].bias_instability_deg_per_h)
+
+
+def test_the_fleet_report_shows_yield_distributions_outliers_and_failures(fleet_run, tmp_path):
+    out, limits, _ = fleet_run
+    result = run("fleet", "report", out, "-o", tmp_path / "fleet.html", "--limits", limits)
+    assert result.returncode == 0, result.stderr
+    assert "sections: summary, distributions, outliers, worst, rejected, failed" in result.stdout
+    page = (tmp_path / "fleet.html").read_text()
+    sections = dict(re.findall(r'<section id="(\w+)">(.*?)</section>', page, re.S))
+    for bad in (NOISY_UNIT, HOT_UNIT):
+        assert serial(bad) in sections["outliers"] and serial(bad) in sections["rejected"]
+        assert serial(bad) in sections["worst"]
+    assert serial(CORRUPT_UNIT) in sections["failed"] and "run_1.parquet" in sections["failed"]
+    assert "data:image/png;base64," in sections["distributions"]
+    assert "<td>yield</td>" in sections["summary"].replace(' class="text"', "")

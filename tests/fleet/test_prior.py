@@ -34,12 +34,15 @@ DRIFT_WINDOW_S = 60.0
 
 def test_block_covariance_gives_the_allan_floor_of_flicker_and_white_noise():
     """Allan variance of adjacent block means, 0.5 (var_1 + var_2 - 2 cov_12): for flicker it is the plateau
-    (0.664 B)^2, for white noise N^2 / tau (IEEE Std 952, C.1)."""
+    (0.664 B)^2, for a rate random walk K^2 tau / 3, for white noise N^2 / tau (IEEE Std 952, C.1)."""
     b_deg_per_h, length_s = 10.0, 20.0
     cov = block_covariance(np.full(200, length_s), 0.0, b_deg_per_h)
     i = 100
     adev = math.sqrt(0.5 * (cov[i, i] + cov[i + 1, i + 1] - 2 * cov[i, i + 1]))
     assert adev == pytest.approx(math.sqrt(2 * math.log(2) / math.pi) * b_deg_per_h / 3600, rel=0.03)
+    walk = block_covariance(np.full(50, length_s), 0.0, 0.0, 1e-4)  # rate random walk: K^2 tau / 3
+    allan_variance = 0.5 * (walk[i - 60, i - 60] + walk[i - 59, i - 59] - 2 * walk[i - 60, i - 59])
+    assert allan_variance == pytest.approx(1e-8 * length_s / 3, rel=1e-12)
     white = block_covariance(np.array([10.0, 10.0, 5.0]), 0.01, 0.0)
     assert np.allclose(white, np.diag([1e-5, 1e-5, 2e-5]))
     assert np.all(np.linalg.eigvalsh(cov) > 0)  # a covariance: symmetric positive definite
@@ -82,10 +85,11 @@ def test_the_prior_leaves_out_outliers_and_spans_the_fleet(prior, fleet_run):
 
 
 def test_a_short_run_with_the_prior_comes_close_to_the_full_calibration(prior):
-    """Measured: with the prior, the short run (a third of the range, a quarter of the time) leaves 1.4-4.8x the
-    held-out drift of the unit's full calibration (median 2.7x over ten units); alone it leaves 6.7-15x (median
-    11x). The issue's target of 1.5x is not reached on this part, whose coefficients vary independently by 20 %:
-    a third of the range leaves the curvature to the prior."""
+    """benchmarks/bench_prior.py measured, over 40 new units: with the prior, the short run (a third of the range,
+    a quarter of the time) leaves 2.25x the held-out drift of the unit's full calibration (median; worst 3.9x);
+    alone it leaves 11.8x (worst 15.8x). The issue's target of 1.5x is not reached on this part, whose coefficients
+    vary independently by 20 %: what a third of the range does not show (the curvature) is left to the prior's
+    spread. Here, on four units: the prior at least halves the short run's drift ratio, on every unit."""
     with_prior, alone = [], []
     for unit in NEW_UNITS:
         full = [simulate(PRESET, profile="chamber", duration_s=RUN_DURATION_S, rate_hz=RATE_HZ, seed=1000 * unit + k,
@@ -98,9 +102,8 @@ def test_a_short_run_with_the_prior_comes_close_to_the_full_calibration(prior):
             reference = _held_out_drift(fit_channels(full), held_out)
             alone.append(_held_out_drift(fit_channels(short), held_out) / reference)
         with_prior.append(_held_out_drift(fit_with_prior(short, prior), held_out) / reference)
-    assert np.median(with_prior) < 4.0
-    assert np.median(with_prior) < np.median(alone) / 2.5
-    assert all(p < a for p, a in zip(with_prior, alone))
+    assert np.median(with_prior) < 6.0
+    assert all(p < a / 2 for p, a in zip(with_prior, alone)), (with_prior, alone)
 
 
 def test_the_stated_uncertainty_covers_the_true_curve(prior):

@@ -75,6 +75,8 @@ def test_history_is_kept_and_the_valid_calibration_is_the_one_before(store, mode
     assert store.valid_at("U1").calibration().to_dict() == models[1].to_dict()
     assert [r.serial for r in store.latest_rows()] == ["U1", "U2"]
     assert store.latest("U1").calibrated_utc == JUN and store.serials() == ["U1", "U2"]
+    store.add(_record("U3", JUN, None))  # a unit that never succeeded has no hash to skip by
+    assert store.ok_hashes() == {"U1": "ab" * 32, "U2": "ab" * 32}
 
 
 def test_valid_at_refuses_a_time_before_the_first_and_an_unknown_serial(store):

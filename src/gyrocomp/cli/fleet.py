@@ -10,10 +10,11 @@ import pandas as pd
 from rich.table import Table
 
 from ..errors import InputError
-from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit_fleet, fleet_yield, parse_time,
+from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit_fleet, fleet_table, fleet_yield, parse_time,
                     population_prior,
                      units_from_manifest, units_from_pattern)
-from ..io import refuse_to_overwrite_inputs
+from ..io import refuse_to_overwrite_inputs, write_text_atomic
+from ..report.fleet import build_fleet_report
 from .common import make_console, pop_read_options, progress_bar, read_options, read_settings
 from .export import EXPORT_FORMATS, write_export
 
@@ -188,6 +189,24 @@ def _print_history(rows) -> None:
         table.add_row(str(r.id), f"{r.calibrated_utc:%Y-%m-%d %H:%M:%S}", r.status, r.verdict or "-",
                       str(len(r.inputs)), r.input_hash[:12], r.error or "")
     make_console().print(table)
+
+
+@fleet.command("report")
+@click.argument("store")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="HTML file to write.")
+@click.option("--limits", "limits_file", default=None, type=click.Path(dir_okay=False),
+              help="Judge the units by these limits (TOML; default: the verdicts stored with each calibration).")
+@click.pass_context
+def report(ctx, store, output, limits_file):
+    """One HTML page of the fleet in STORE (folder, SQLite file or URL): yield, distributions of every figure,
+    outliers, the worst units, rejected and failed units."""
+    limits = Limits.load(limits_file) if limits_file else None
+    with CalibrationStore(store) as db:
+        table = fleet_table(db.latest_rows(), limits)
+    page = build_fleet_report(table, limits=limits, title=str(store))
+    write_text_atomic(output, page.html)
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output} ({len(table)} units; sections: {', '.join(page.sections)})")
 
 
 @fleet.command("export")

@@ -10,11 +10,15 @@ Per gyro axis (``AxisFigures``):
   in (T - T_ref) by least squares over the unit's range: bias(T) - bias(T_ref) ~ sum_k c_k (T - T_ref)^k. Every
   unit in the same basis whatever its model, so that coefficients compare across a fleet;
 - ``bias_span_dps``: peak-to-peak of the fitted curve over the unit's range [deg/s];
-- ``turn_on_bias_dps``, ``turn_on_repeatability_dps``: mean and sample standard deviation of the per-run
-  constants [deg/s] (NaN with one run);
+- ``turn_on_bias_dps``: the bias at the reference temperature, mean over the runs (each run's constant plus the
+  curve there) [deg/s]; ``turn_on_repeatability_dps``: the sample standard deviation of the per-run constants
+  [deg/s] (NaN with one run);
 - ``g_sensitivity_dps_per_g``: the norm of the axis's g-sensitivity row [deg/s/g] (NaN when not fitted);
-- ``noise_density_dps_per_sqrt_hz`` and ``bias_instability_deg_per_h``: IEEE Std 952 white noise and bias
-  instability of the compensated longest run (:func:`gyrocomp.noise.analyse_noise`);
+- ``noise_density_dps_per_sqrt_hz``, ``bias_instability_deg_per_h`` and ``rate_random_walk_dps_per_sqrt_s``:
+  IEEE Std 952 white noise, bias instability (Allan minimum / 0.664) and rate random walk of the compensated
+  longest run (:func:`gyrocomp.noise.analyse_noise`); ``flicker_deg_per_h``: the flicker level B of the noise
+  model fitted to the whole Allan curve (on a short run the Allan minimum is not reached and reads low: 11.5
+  against 18.9 deg/h on 15 minutes of a 20 deg/h part);
 - ``curve_sd_dps``: for a unit fitted with its population's prior (:mod:`gyrocomp.fleet.prior`), the largest
   standard deviation of its fitted curve over the population's range [deg/s] (its stated uncertainty; such a fit
   has no held-out drift); NaN otherwise.
@@ -56,6 +60,8 @@ class AxisFigures:
     g_sensitivity_dps_per_g: float
     noise_density_dps_per_sqrt_hz: float
     bias_instability_deg_per_h: float
+    rate_random_walk_dps_per_sqrt_s: float = math.nan
+    flicker_deg_per_h: float = math.nan
     curve_sd_dps: float = math.nan
 
 
@@ -117,10 +123,11 @@ def unit_figures(calibration: Calibration, recordings: list[Recording], *,
             held_out_drift_dps=_number(chosen.get("chosen_drift_dps")),
             raw_drift_dps=_number(chosen.get("raw_drift_dps")),
             **_curve_figures(axis, t_lo, t_hi, reference_temperature_degc),
-            **_constants(axis),
+            **_constants(axis, reference_temperature_degc),
             g_sensitivity_dps_per_g=(float(np.linalg.norm(axis.g_sensitivity_dps_per_g))
                                      if axis.g_sensitivity_dps_per_g is not None else math.nan),
-            **noise.get(name, {"noise_density_dps_per_sqrt_hz": math.nan, "bias_instability_deg_per_h": math.nan}),
+            **noise.get(name, {"noise_density_dps_per_sqrt_hz": math.nan, "bias_instability_deg_per_h": math.nan,
+                               "rate_random_walk_dps_per_sqrt_s": math.nan, "flicker_deg_per_h": math.nan}),
             curve_sd_dps=_number(prior_fit.get(name, {}).get("curve_sd_max_dps")),
         )
     return UnitFigures(axes, t_lo, t_hi, len(recordings))
@@ -152,14 +159,16 @@ def _curve_figures(axis: AxisCalibration, t_lo: float, t_hi: float, t_ref: float
             "bias_span_dps": float(np.ptp(curve))}
 
 
-def _constants(axis: AxisCalibration) -> dict[str, float]:
+def _constants(axis: AxisCalibration, t_ref: float) -> dict[str, float]:
     c = np.asarray(axis.turn_on_biases_dps, dtype=float)
-    return {"turn_on_bias_dps": float(c.mean()) if c.size else math.nan,
+    at_reference = float(np.asarray(axis.shape_dps(np.array([t_ref])), dtype=float).reshape(-1)[0])
+    return {"turn_on_bias_dps": float(c.mean()) + at_reference if c.size else math.nan,
             "turn_on_repeatability_dps": float(c.std(ddof=1)) if c.size > 1 else math.nan}
 
 
 def _noise(calibration: Calibration, recording: Recording) -> dict[str, dict[str, float]]:
-    """White noise density and bias instability of each modelled axis of the compensated ``recording``."""
+    """White noise density, bias instability and rate random walk of each modelled axis of the compensated
+    ``recording``."""
     axes = [a for a in calibration.axes if a in recording.gyro_axes]
     if not axes:
         return {}
@@ -171,7 +180,9 @@ def _noise(calibration: Calibration, recording: Recording) -> dict[str, dict[str
     except GyrocompError:
         return {}
     return {name: {"noise_density_dps_per_sqrt_hz": float(a.noise.noise_density_dps_per_sqrt_hz),
-                   "bias_instability_deg_per_h": float(a.noise.bias_instability_deg_per_h)}
+                   "bias_instability_deg_per_h": float(a.noise.bias_instability_deg_per_h),
+                   "rate_random_walk_dps_per_sqrt_s": float(a.noise.rrw_dps_sqrt_hz),
+                   "flicker_deg_per_h": float(a.noise.bias_instability_fit_deg_per_h)}
             for name, a in analysis.axes.items()}
 
 

@@ -10,10 +10,12 @@ prior theta ~ N(mu, S). The thermal time constant of the lag is the population's
 averaged in blocks of ``block_s`` seconds. Its noise is not white: flicker wanders slowly, and over one short run
 whose temperature ramps it looks like curvature; treating the blocks as independent would make the data look far
 more certain than they are. The blocks' noise covariance is therefore that of the population's IEEE Std 952 noise:
-white, N^2 / t_b on the diagonal (N [deg/s/sqrt(Hz)], t_b the block's length), plus flicker of bias instability B,
+white, N^2 / t_b on the diagonal (N [deg/s/sqrt(Hz)], t_b the block's length), plus flicker of bias instability B
+(the population's median flicker level of the fitted noise model, ``flicker_deg_per_h``),
 the 1/f spectrum S(f) = B^2 / (pi f) written as a sum of first-order Gauss-Markov processes of time constants T_k
 spaced by a factor R (from a twentieth of a block to twenty times the run), each of variance B^2 ln(R) / pi (the
-standard construction of 1/f noise, e.g. Keshner 1982). For a process of covariance v exp(-|t| / T), the means
+standard construction of 1/f noise, e.g. Keshner 1982), plus the rate random walk K (covariance K^2 min(s, t)
+from the run's start). For a process of covariance v exp(-|t| / T), the means
 of blocks of lengths L_i and L_j whose centres lie Delta apart have
 
     cov = v (2T / L_i) sinh(L_i / 2T) (2T / L_j) sinh(L_j / 2T) exp(-Delta / T)     (disjoint blocks)
@@ -70,8 +72,8 @@ _JITTER = 1e-9
 @dataclass(frozen=True)
 class AxisPrior:
     """The population of one gyro axis: mean and covariance of (theta_1, theta_2, theta_3) [deg/s, (deg/s)^2],
-    median thermal lag [s], median held-out drift [deg/s], white-noise density [deg/s/sqrt(Hz)] and bias
-    instability [deg/h]."""
+    median thermal lag [s], median held-out drift [deg/s], white-noise density [deg/s/sqrt(Hz)], bias
+    instability [deg/h] and rate random walk [deg/s/sqrt(s)]."""
 
     mean_dps: tuple[float, ...]
     covariance_dps2: tuple[tuple[float, ...], ...]
@@ -79,6 +81,7 @@ class AxisPrior:
     residual_drift_dps: float
     noise_density_dps_per_sqrt_hz: float
     bias_instability_deg_per_h: float
+    rate_random_walk_dps_per_sqrt_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -98,7 +101,8 @@ class PopulationPrior:
                              "lag_time_constant_s": p.lag_time_constant_s,
                              "residual_drift_dps": p.residual_drift_dps,
                              "noise_density_dps_per_sqrt_hz": p.noise_density_dps_per_sqrt_hz,
-                             "bias_instability_deg_per_h": p.bias_instability_deg_per_h}
+                             "bias_instability_deg_per_h": p.bias_instability_deg_per_h,
+                             "rate_random_walk_dps_per_sqrt_s": p.rate_random_walk_dps_per_sqrt_s}
                          for a, p in self.axes.items()},
                 "reference_temperature_degc": self.reference_temperature_degc,
                 "temperature_scale_degc": self.temperature_scale_degc,
@@ -152,10 +156,16 @@ def population_prior(records: Sequence[CalibrationRecord], *, threshold: float =
             lag_time_constant_s=float(np.median(lags)),
             residual_drift_dps=float(np.nanmedian([f.held_out_drift_dps for f in figures])),
             noise_density_dps_per_sqrt_hz=float(np.nanmedian([f.noise_density_dps_per_sqrt_hz for f in figures])),
-            bias_instability_deg_per_h=float(np.nanmedian([f.bias_instability_deg_per_h for f in figures])))
+            bias_instability_deg_per_h=_median_or_zero([f.flicker_deg_per_h for f in figures]),
+            rate_random_walk_dps_per_sqrt_s=_median_or_zero([f.rate_random_walk_dps_per_sqrt_s for f in figures]))
     if not axes:
         raise InputError("prior: no axis has a temperature curve in enough units")
     return PopulationPrior(axes, reference_temperature_degc, scale, t_min, t_max, len(good))
+
+
+def _median_or_zero(values: list[float]) -> float:
+    finite = [v for v in values if math.isfinite(v)]
+    return float(np.median(finite)) if finite else 0.0
 
 
 def _blocks(recording: Recording, axis: str, lag_s: float, block_s: float):
@@ -210,12 +220,19 @@ def fit_with_prior(recordings: Sequence[Recording] | Recording, prior: Populatio
 
 
 def block_covariance(duration_s: np.ndarray, noise_density_dps_per_sqrt_hz: float,
-                     bias_instability_deg_per_h: float) -> np.ndarray:
-    """Covariance [(deg/s)^2] of the means of consecutive blocks of ``duration_s`` [s] under white noise of
-    density N [deg/s/sqrt(Hz)] and flicker of bias instability B [deg/h] (see the module)."""
+                     bias_instability_deg_per_h: float, rate_random_walk_dps_per_sqrt_s: float = 0.0) -> np.ndarray:
+    """Covariance [(deg/s)^2] of the means of consecutive blocks of ``duration_s`` [s] from the start of a run,
+    under white noise of density N [deg/s/sqrt(Hz)], flicker of bias instability B [deg/h] and a rate random walk
+    K [deg/s/sqrt(s)] from the run's start (see the module)."""
     length = np.asarray(duration_s, dtype=float)
     centre = np.cumsum(length) - length / 2
     cov = np.diag(noise_density_dps_per_sqrt_hz ** 2 / length)
+    if rate_random_walk_dps_per_sqrt_s > 0:
+        # W(t) of variance K^2 t: cov(W(s), W(t)) = K^2 min(s, t); averaged over two disjoint blocks, K^2 times the
+        # earlier block's centre; over one block [a, a + L], K^2 (a + L / 3)
+        walk = np.minimum(centre[:, None], centre[None, :])
+        np.fill_diagonal(walk, centre - length / 2 + length / 3)
+        cov = cov + rate_random_walk_dps_per_sqrt_s ** 2 * walk
     b_dps = bias_instability_deg_per_h / DEG_PER_S_TO_DEG_PER_H
     if b_dps <= 0:
         return cov
@@ -263,7 +280,8 @@ def _fit_axis(recordings: list[Recording], axis: str, p: AxisPrior, prior: Popul
         ys.append(rate)
         us.append((temperature - prior.reference_temperature_degc) / prior.temperature_scale_degc)
         columns.append(np.full(rate.size, r))
-        covariances.append(block_covariance(duration_s, p.noise_density_dps_per_sqrt_hz, p.bias_instability_deg_per_h))
+        covariances.append(block_covariance(duration_s, p.noise_density_dps_per_sqrt_hz, p.bias_instability_deg_per_h,
+                                            p.rate_random_walk_dps_per_sqrt_s))
     y, u, run = (np.concatenate(v) for v in (ys, us, columns))
     design = np.column_stack([(run[:, None] == np.arange(runs)).astype(float), *(u ** k for k in range(1, _ORDER + 1))])
     noise = np.zeros((y.size, y.size))

@@ -211,6 +211,14 @@ class CalibrationStore:
         with self.engine.connect() as conn:
             return [_from_row(r) for r in conn.execute(query).mappings()]
 
+    def ok_hashes(self) -> dict[str, str]:
+        """The input hash of every unit's newest successful calibration, by serial (one query)."""
+        newest = (sa.select(sa.func.max(_ROWS.c.id).label("id")).where(_ROWS.c.status == "ok")
+                  .group_by(_ROWS.c.serial).subquery())
+        query = sa.select(_ROWS.c.serial, _ROWS.c.input_hash).join(newest, _ROWS.c.id == newest.c.id)
+        with self.engine.connect() as conn:
+            return {serial: digest for serial, digest in conn.execute(query)}
+
     def serials(self) -> list[str]:
         with self.engine.connect() as conn:
             return list(conn.execute(sa.select(_ROWS.c.serial).distinct().order_by(_ROWS.c.serial)).scalars())

@@ -352,3 +352,50 @@ def triad_plot(triads: dict, temperature_range_degc: tuple[float, float] | None,
     fig.suptitle(title, fontsize="medium")
     fig.tight_layout()
     return fig
+
+
+def fleet_distributions(table, figure_names: tuple[str, ...], axes: tuple[str, ...], limits=None,
+                        title: str = "fleet: distribution of each figure"):
+    """One histogram per figure of a fleet table (every axis overlaid), the limits as dashed lines.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :func:`gyrocomp.fleet.fleet_table` (the fitted units' rows are drawn).
+    figure_names : tuple of str
+        The per-axis figures to draw (``noise_density_dps_per_sqrt_hz``, ...).
+    axes : tuple of str
+        The gyro axes (``gyro_x``, ...).
+    limits : Limits, optional
+        Drawn where they bound a figure (``abs_max`` on both sides).
+    """
+    plt = _pyplot()
+    names = [n for n in figure_names if any(f"{a}_{n}" in table.columns for a in axes)]
+    columns = 4
+    rows = max(1, (len(names) + columns - 1) // columns)
+    fig, panels = plt.subplots(rows, columns, figsize=(4.2 * columns, 2.6 * rows), squeeze=False)
+    ok = table[table["status"] == "ok"]
+    for panel, name in zip(panels.flat, names):
+        series = [(a, ok[f"{a}_{name}"].to_numpy(dtype=float)) for a in axes if f"{a}_{name}" in ok.columns]
+        values = np.concatenate([v[np.isfinite(v)] for _, v in series]) if series else np.array([])
+        if values.size == 0:
+            panel.text(0.5, 0.5, "not measured", ha="center", va="center", transform=panel.transAxes)
+        else:
+            bins = np.histogram_bin_edges(values, bins=min(40, max(5, int(np.sqrt(values.size)))))
+            for axis, v in series:
+                panel.hist(v[np.isfinite(v)], bins=bins, histtype="step", label=axis.replace("gyro_", ""))
+        for limit in (limits.limits if limits is not None else ()):
+            if limit.figure != name:
+                continue
+            for bound in (limit.min, limit.max, limit.abs_max, -limit.abs_max if limit.abs_max is not None else None):
+                if bound is not None:
+                    panel.axvline(bound, color="k", ls="--", lw=0.9)
+        panel.set_title(name, fontsize=8)
+        panel.tick_params(labelsize=7)
+    for panel in list(panels.flat)[len(names):]:
+        panel.set_visible(False)
+    if names:
+        panels.flat[0].legend(fontsize=7)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,98 @@
+"""Benchmark: how much chamber time the population prior saves (issue #17, ``gyrocomp fleet fit --prior``).
+
+A fleet of ``--fleet`` units of the ``consumer`` preset's production spread (three 15-minute chamber runs over
+-20..70 degC at 10 Hz each) is fitted and its prior built. Then, for ``--new`` units not in the fleet, each is
+calibrated three ways and judged on a held-out full-range chamber run (mean over the axes of the RMS of the 60 s
+moving average of the compensated rate):
+
+- ``full``: the default fit on the unit's three full runs (45 minutes of chamber time: the reference);
+- ``prior``: ``fit_with_prior`` on one short run;
+- ``alone``: the default fit on that short run alone;
+
+for short runs covering a third, half, two thirds and all of the range, in a quarter or half of the full chamber
+time. Printed: the median (and worst) ratio of the held-out drift to the full calibration's.
+
+Usage: python benchmarks/bench_prior.py [--fleet N] [--new M]
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from gyrocomp.compensate import apply
+from gyrocomp.fleet import CalibrationStore, UnitRuns, fit_fleet, fit_with_prior, population_prior
+from gyrocomp.io.tables import write_recording
+from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.simulate import preset_model, resolve_profile, simulate
+
+RUN_S, RATE_HZ, RUNS = 900.0, 10.0, 3
+COVERAGES = {"a third (10..40 degC)": (10.0, 40.0), "half (2.5..47.5 degC)": (2.5, 47.5),
+             "two thirds (-5..55 degC)": (-5.0, 55.0), "all (-20..70 degC)": (-20.0, 70.0)}
+TIME_FRACTIONS = (0.25, 0.5)
+
+
+def drift(calibration, recording) -> float:
+    compensated = apply(calibration, recording)
+    window = int(60 * recording.rate_hz)
+    return float(np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], window) for j in range(3)]))
+
+
+def run(unit: int, seed: int, profile="chamber", duration_s: float = RUN_S):
+    if isinstance(profile, str):
+        return simulate("consumer", profile=profile, duration_s=duration_s, rate_hz=RATE_HZ, seed=seed,
+                        unit=unit).recording
+    return simulate(preset_model("consumer", unit), profile=profile, duration_s=duration_s, rate_hz=RATE_HZ,
+                    seed=seed).recording
+
+
+def fleet_prior(units: int, folder: Path):
+    fleet = []
+    for unit in range(units):
+        paths = []
+        for k in range(RUNS):
+            path = folder / f"U{unit}_{k}.parquet"
+            write_recording(run(unit, 1000 * unit + k), path)
+            paths.append(str(path))
+        fleet.append(UnitRuns(f"U{unit}", tuple(paths)))
+    fit_fleet(fleet, folder / "FLEET", scheduler="local")
+    with CalibrationStore(folder / "FLEET") as db:
+        return population_prior(db.latest_rows())
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fleet", type=int, default=200)
+    parser.add_argument("--new", type=int, default=20)
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")
+    with tempfile.TemporaryDirectory() as tmp:
+        prior = fleet_prior(args.fleet, Path(tmp))
+    print(f"prior from {prior.units} of {args.fleet} units; {args.new} new units; full calibration: "
+          f"{RUNS} x {RUN_S / 60:.0f} min over -20..70 degC")
+    print(f"{'short run covers':26s} {'time':>6s}  {'prior: median (worst)':>22s}  {'alone: median (worst)':>22s}")
+    new = range(10_000, 10_000 + args.new)
+    references = {}
+    held_out = {}
+    for unit in new:
+        held_out[unit] = run(unit, 7)
+        references[unit] = drift(fit_channels([run(unit, 1000 * unit + k) for k in range(RUNS)]), held_out[unit])
+    for label, (low, high) in COVERAGES.items():
+        profile = resolve_profile("chamber", "consumer", set_points_degc=(low, high))
+        for fraction in TIME_FRACTIONS:
+            with_prior, alone = [], []
+            for unit in new:
+                short = run(unit, 9, profile, fraction * RUNS * RUN_S)
+                with_prior.append(drift(fit_with_prior(short, prior), held_out[unit]) / references[unit])
+                alone.append(drift(fit_channels(short), held_out[unit]) / references[unit])
+            print(f"{label:26s} {fraction:5.0%}   {np.median(with_prior):8.2f}x ({max(with_prior):5.2f}x)     "
+                  f"{np.median(alone):8.2f}x ({max(alone):5.2f}x)")
+
+
+if __name__ == "__main__":
+    main()

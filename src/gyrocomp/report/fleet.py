@@ -1,0 +1,99 @@
+"""The fleet report: one self-contained HTML page of a calibrated fleet.
+
+Sections: ``summary`` (units, fitted, failed, yield against the limits, outliers), ``distributions`` (a histogram of
+every figure of merit and coefficient over the fitted units, every axis overlaid, the limits dashed), ``outliers``
+(the units far from their population, by robust score, with the figures that put them there), ``worst`` (the ten
+highest-scoring units' figures, worst axis each), ``rejected`` (the units outside the limits and why) and
+``failed`` (the units whose fit failed, with the error).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import html
+
+import numpy as np
+import pandas as pd
+
+from .._version import __version__
+from ..fleet import FIGURE_NAMES, Limits, fleet_yield
+from ..fleet.population import OUTLIER_THRESHOLD
+from . import figures
+from .html import _CSS, Report, _img, _table
+
+#: units listed in the worst-units table
+WORST_UNITS = 10
+
+
+def build_fleet_report(table: pd.DataFrame, *, limits: Limits | None = None, title: str = "fleet") -> Report:
+    """The fleet report of a fleet table (:func:`gyrocomp.fleet.fleet_table`, judged by ``limits`` when given)."""
+    figures.require_matplotlib()
+    axes = tuple(sorted({c[: -len(n) - 1] for c in table.columns for n in FIGURE_NAMES if c.endswith("_" + n)}))
+    counts = fleet_yield(table)
+    sections = {"summary": ("Summary", _summary(table, counts, limits))}
+    if counts.fitted:
+        sections["distributions"] = ("Distributions", _img(
+            figures.fleet_distributions(table, FIGURE_NAMES, axes, limits), "histograms of every figure"))
+    outliers = table[table["outlier"]].sort_values("outlier_score", ascending=False)
+    sections["outliers"] = ("Outliers", _table(
+        ["serial", "score", "figures", "verdict"],
+        [[s, float(z), f, v or "-"] for s, z, f, v in zip(outliers["serial"], outliers["outlier_score"],
+                                                          outliers["outlier_figures"], outliers["verdict"])],
+        f"units whose robust z-score passes {OUTLIER_THRESHOLD} on some figure: {len(outliers)}")
+        if len(outliers) else "<p>No unit stands out of its population.</p>")
+    sections["worst"] = ("Worst units", _worst(table, axes))
+    rejected = table[table["verdict"] == "fail"]
+    if len(rejected):
+        sections["rejected"] = ("Outside the limits", _table(
+            ["serial", "failing figures"], [[s, f] for s, f in zip(rejected["serial"], rejected["failing"])]))
+    failed = table[table["status"] == "failed"]
+    if len(failed):
+        sections["failed"] = ("Failed fits", _table(["serial", "error"],
+                                                    [[s, e] for s, e in zip(failed["serial"], failed["error"])]))
+    return Report(_page(title, sections), tuple(sections))
+
+
+def _summary(table: pd.DataFrame, counts, limits: Limits | None) -> str:
+    rows = [["units", counts.units], ["fitted", counts.fitted], ["failed", counts.units - counts.fitted],
+            ["outliers", int(table["outlier"].sum())]]
+    if limits is not None or (table["verdict"] != "").any():
+        rows.append(["pass", counts.passed])
+        rows.append(["yield", f"{100 * counts.yield_fraction:.1f} %"])
+    text = _table(["", "count"], rows)
+    if limits is not None:
+        text += _table(["figure", "axis", "min", "max", "abs_max"],
+                       [[lim.figure, lim.axis or "every", lim.min, lim.max, lim.abs_max] for lim in limits.limits],
+                       f"limits ({limits.source})")
+    return text
+
+
+def _worst(table: pd.DataFrame, axes: tuple[str, ...]) -> str:
+    """The highest-scoring units, each figure at its worst axis (largest magnitude)."""
+    top = table[table["status"] == "ok"].sort_values("outlier_score", ascending=False).head(WORST_UNITS)
+    if not len(top):
+        return "<p>No fitted unit.</p>"
+    names = [n for n in FIGURE_NAMES if any(f"{a}_{n}" in top.columns for a in axes)]
+    rows = []
+    for _, unit in top.iterrows():
+        row = [unit["serial"], unit["verdict"] or "-", float(unit["outlier_score"])]
+        for name in names:
+            values = np.array([unit.get(f"{a}_{name}", np.nan) for a in axes], dtype=float)
+            row.append(float(values[np.nanargmax(np.abs(values))]) if np.isfinite(values).any() else np.nan)
+        rows.append(row)
+    return _table(["serial", "verdict", "score", *names], rows, "worst axis of each figure")
+
+
+def _page(title: str, sections: dict) -> str:
+    created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    nav = " ".join(f'<a href="#{sid}">{html.escape(name)}</a>' for sid, (name, _) in sections.items())
+    page = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
+            f"<title>gyrocomp fleet report: {html.escape(title)}</title>", f"<style>{_CSS}</style></head><body>",
+            f"<h1>gyrocomp fleet report: {html.escape(title)}</h1><p class=note>{created}, gyrocomp {__version__}</p>",
+            f"<nav>{nav}</nav>"]
+    for sid, (name, body) in sections.items():
+        page.append(f'<section id="{sid}"><h2>{html.escape(name)}</h2>\n{body}\n</section>')
+    page.append("</body></html>")
+    return "\n".join(page) + "\n"
+
+
+__all__ = ["WORST_UNITS", "build_fleet_report"]
