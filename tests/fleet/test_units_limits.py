@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 import warnings
@@ -12,7 +13,7 @@ import pytest
 from scipy.stats import norm
 
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.fleet import (AxisFigures, CalibrationRecord, Limits, UnitFigures, UnitRuns, expand_inputs,
+from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Limits, UnitFigures, UnitRuns, expand_inputs,
                             fleet_table, fleet_yield, input_hash, robust_z, units_from_manifest,
                             units_from_pattern, utc_now)
 from gyrocomp.fleet.population import MIN_UNITS_FOR_OUTLIERS
@@ -204,3 +205,30 @@ def test_units_given_twice_are_refused(tmp_path):
         warnings.simplefilter("error")
         with pytest.raises(InputError, match=r"units: no unit to fit"):
             fit_fleet([], tmp_path / "out", scheduler="serial")
+
+
+def test_a_running_dask_cluster_is_used_by_its_address(tmp_path):
+    """``scheduler=ADDRESS``: the units go to a cluster someone else started, which stays up after the fleet."""
+    from dask.distributed import Client, LocalCluster
+
+    from gyrocomp.fleet import FleetSettings, fit_fleet, fit_unit
+    from gyrocomp.io.tables import write_recording
+    from gyrocomp.simulate import simulate
+
+    units = []
+    for k in range(3):
+        path = tmp_path / f"u{k}.parquet"
+        write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=5, seed=k, unit=k).recording,
+                        path)
+        units.append(UnitRuns(f"U{k}", (str(path),)))
+    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster, Client(cluster) as client:
+        summary = fit_fleet(units, tmp_path / "FLEET", scheduler=cluster.scheduler_address)
+        assert sorted(summary.fitted) == ["U0", "U1", "U2"]
+        assert len(client.scheduler_info()["workers"]) == 1  # still running
+    serial = fit_unit(units[1], FleetSettings())
+    with CalibrationStore(tmp_path / "FLEET") as db:
+        stored = json.loads(db.valid_at("U1").model_json)
+    alone = json.loads(serial.model_json)
+    for document in (stored, alone):
+        document["provenance"].pop("created_utc")
+    assert stored == alone

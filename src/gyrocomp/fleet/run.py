@@ -32,7 +32,6 @@ from ..errors import GyrocompError, InputError
 from ..io import ReadOptions, read_input
 from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
-from ..io.tables import file_sha256
 from ..models.pipelines import fit_channels, parse_channels
 from ..threads import single_threaded_blas
 from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
@@ -40,7 +39,7 @@ from .limits import Limits
 from .population import fleet_table
 from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
-from .units import UnitRuns, input_hash
+from .units import UnitRuns, content_hash, input_hash
 
 MODELS_FOLDER = "models"
 FLEET_TABLE = "fleet.parquet"
@@ -118,10 +117,10 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
     """Fit one unit (the task of a fleet fit): hash its files, stop if the hash is ``known_hash``, else read,
     fit and measure. Never raises for a problem of the unit: the outcome is then ``failed`` with the error."""
     try:
-        inputs = tuple(InputFile(p, file_sha256(p) if Path(p).is_file() else input_hash([p], {})) for p in unit.paths)
+        inputs = tuple(InputFile(p, content_hash(p)) for p in unit.paths)
     except OSError as exc:
         return UnitOutcome(unit.serial, "failed", "", error=_error_text(exc))
-    digest = input_hash(unit.paths, settings.fingerprint())
+    digest = input_hash(unit.paths, settings.fingerprint(), contents=[i.sha256 for i in inputs])
     if digest == known_hash:
         return UnitOutcome(unit.serial, "unchanged", digest, inputs)
     with warnings.catch_warnings(record=True) as caught:

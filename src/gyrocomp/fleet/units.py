@@ -155,11 +155,17 @@ def units_from_manifest(path: str | os.PathLike) -> list[UnitRuns]:
     return [UnitRuns(serial, tuple(sorted(p for p, _ in runs)), dict(runs[0][1])) for serial, runs in sorted(groups.items())]
 
 
-def input_hash(paths: Iterable[str | os.PathLike], settings: Mapping) -> str:
+def content_hash(path: str | os.PathLike) -> str:
+    """SHA-256 of a run's content: its bytes, or for a ROS 2 bag folder its files' names and bytes."""
+    return file_sha256(path) if Path(path).is_file() else _folder_sha256(Path(path))
+
+
+def input_hash(paths: Iterable[str | os.PathLike], settings: Mapping, *, contents: Iterable[str] | None = None) -> str:
     """SHA-256 over the contents of the run files (not their names or times) and the fit's settings: a unit
-    whose hash is unchanged would be fitted to the same model again."""
+    whose hash is unchanged would be fitted to the same model again. ``contents``: the files' content hashes
+    when already known (:func:`content_hash`; the files are then not read again)."""
     digest = hashlib.sha256()
-    for content in sorted(file_sha256(p) if Path(p).is_file() else _folder_sha256(Path(p)) for p in paths):
+    for content in sorted(contents if contents is not None else (content_hash(p) for p in paths)):
         digest.update(content.encode())
     digest.update(json.dumps(settings, sort_keys=True, default=str).encode())
     return digest.hexdigest()
@@ -174,5 +180,5 @@ def _folder_sha256(folder: Path) -> str:
     return digest.hexdigest()
 
 
-__all__ = ["RUN_SUFFIXES", "UnitRuns", "expand_inputs", "input_hash", "pattern_regex", "units_from_manifest",
+__all__ = ["RUN_SUFFIXES", "UnitRuns", "content_hash", "expand_inputs", "input_hash", "pattern_regex", "units_from_manifest",
            "units_from_pattern"]
