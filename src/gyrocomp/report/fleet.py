@@ -9,17 +9,13 @@ highest-scoring units' figures, worst axis each), ``rejected`` (the units outsid
 
 from __future__ import annotations
 
-import datetime as _dt
-import html
-
 import numpy as np
 import pandas as pd
 
-from .._version import __version__
 from ..fleet import FIGURE_NAMES, Limits, fleet_yield
 from ..fleet.population import OUTLIER_THRESHOLD
 from . import figures
-from .html import _CSS, Report, _img, _table
+from .html import Report, _img, _table, html_page
 
 #: units listed in the worst-units table
 WORST_UNITS = 10
@@ -50,7 +46,8 @@ def build_fleet_report(table: pd.DataFrame, *, limits: Limits | None = None, tit
     if len(failed):
         sections["failed"] = ("Failed fits", _table(["serial", "error"],
                                                     [[s, e] for s, e in zip(failed["serial"], failed["error"])]))
-    return Report(_page(title, sections), tuple(sections))
+    return Report(html_page(f"gyrocomp fleet report: {title}", f"gyrocomp fleet report: {title}", "", sections),
+                  tuple(sections))
 
 
 def _summary(table: pd.DataFrame, counts, limits: Limits | None) -> str:
@@ -81,19 +78,6 @@ def _worst(table: pd.DataFrame, axes: tuple[str, ...]) -> str:
             row.append(float(values[np.nanargmax(np.abs(values))]) if np.isfinite(values).any() else np.nan)
         rows.append(row)
     return _table(["serial", "verdict", "score", *names], rows, "worst axis of each figure")
-
-
-def _page(title: str, sections: dict) -> str:
-    created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    nav = " ".join(f'<a href="#{sid}">{html.escape(name)}</a>' for sid, (name, _) in sections.items())
-    page = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
-            f"<title>gyrocomp fleet report: {html.escape(title)}</title>", f"<style>{_CSS}</style></head><body>",
-            f"<h1>gyrocomp fleet report: {html.escape(title)}</h1><p class=note>{created}, gyrocomp {__version__}</p>",
-            f"<nav>{nav}</nav>"]
-    for sid, (name, body) in sections.items():
-        page.append(f'<section id="{sid}"><h2>{html.escape(name)}</h2>\n{body}\n</section>')
-    page.append("</body></html>")
-    return "\n".join(page) + "\n"
 
 
 __all__ = ["WORST_UNITS", "build_fleet_report"]

@@ -372,18 +372,23 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
 
 def _page(calibration: Calibration, runs: list[Recording], sections: dict) -> str:
     """The self-contained HTML page: title, navigation, the sections in order."""
-    created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    nav = " ".join(f'<a href="#{sid}">{html.escape(title)}</a>' for sid, (title, _) in sections.items())
     files = ", ".join(html.escape(rec.source.rsplit("/", 1)[-1]) for rec in runs)
+    return html_page(f"gyrocomp report: {calibration.model}", "gyrocomp report", f"runs: {files}", sections)
+
+
+def html_page(title: str, heading: str, note: str, sections: dict[str, tuple[str, str]]) -> str:
+    """A self-contained page: ``title``, the ``heading``, the time and version with ``note`` (HTML) beside them, a
+    navigation bar, and ``sections`` (id -> (title, HTML body)) in order."""
+    created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    nav = " ".join(f'<a href="#{sid}">{html.escape(name)}</a>' for sid, (name, _) in sections.items())
     page = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
-            f"<title>gyrocomp report: {html.escape(calibration.model)}</title>",
-            f"<style>{_CSS}</style></head><body>",
-            f"<h1>gyrocomp report</h1><p class=note>{created}, gyrocomp {__version__}; runs: {files}</p>",
-            f"<nav>{nav}</nav>"]
-    for sid, (title, body) in sections.items():
-        page.append(f'<section id="{sid}"><h2>{html.escape(title)}</h2>\n{body}\n</section>')
+            f"<title>{html.escape(title)}</title>", f"<style>{_CSS}</style></head><body>",
+            f"<h1>{html.escape(heading)}</h1><p class=note>{created}, gyrocomp {__version__}"
+            + (f"; {note}" if note else "") + "</p>", f"<nav>{nav}</nav>"]
+    for sid, (name, body) in sections.items():
+        page.append(f'<section id="{sid}"><h2>{html.escape(name)}</h2>\n{body}\n</section>')
     page.append("</body></html>")
     return "\n".join(page) + "\n"
 
 
-__all__ = ["Report", "SECTIONS", "build_report"]
+__all__ = ["Report", "SECTIONS", "build_report", "html_page"]
