@@ -12,7 +12,8 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 #: bottom to top; a module belongs to the first layer one of whose prefixes it matches
 LAYERS = (
     ("foundation", ("_version", "errors", "units", "threads")),
-    ("signals", ("recording", "effects", "allan", "noise", "static", "metrics", "plausibility", "simulate")),
+    ("signals", ("recording", "effects", "allan", "noise", "static", "stillness", "metrics", "plausibility",
+                 "simulate")),
     ("io", ("io",)),
     # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve) live beside the
     # estimators of the same curve; neither imports anything above this layer

@@ -39,6 +39,8 @@ _EXPORTS = {
     "analyse_noise": ("noise", "analyse_noise"), "Recording": ("recording", "Recording"),
     "simulate": ("simulate", "simulate"), "TriadCalibration": ("triad", "TriadCalibration"),
     "validate": ("validation", "validate"),
+    "detect_still": ("stillness", "detect_still"), "StillnessState": ("stillness", "StillnessState"),
+    "field_recordings": ("models.field", "field_recordings"),
 }
 
 

@@ -113,3 +113,23 @@ def test_profile_errors():
         get_profile("static").with_duration(0.1).trajectory(1.0)
     with pytest.raises(InputError, match="duration_s: must be positive, got -5"):
         get_profile("static").with_duration(-5)
+
+
+def test_field_profile_warms_up_rests_and_moves():
+    """Room temperature plus a self-heating rise, still position_s then moving move_s in turn; while still the
+    specific force is 1 g at the attitude the last move left, and each move's rate turns it there."""
+    profile = get_profile("field", duration_s=1800.0, motion_seed=3)
+    traj = profile.trajectory(20.0)
+    assert traj.temperature_degc[0] == 20.0
+    assert traj.temperature_degc[-1] == pytest.approx(20.0 + 25.0 * (1 - np.exp(-1800.0 / 900.0)))
+    moving = np.any(traj.angular_rate_dps != 0, axis=1)
+    assert moving.mean() == pytest.approx(240.0 / 360.0, abs=0.01)
+    still = ~moving
+    assert np.allclose(np.linalg.norm(traj.specific_force_g[still], axis=1), 1.0)
+    starts = np.flatnonzero(still[1:] & ~still[:-1]) + 1  # the first still sample after each move
+    attitudes = traj.specific_force_g[starts]
+    assert len({tuple(np.round(a, 6)) for a in attitudes}) == len(starts)  # every move leaves a new attitude
+    again = profile.trajectory(20.0)  # the motion seed fixes the moves
+    assert np.array_equal(traj.specific_force_g, again.specific_force_g)
+    other = get_profile("field", duration_s=1800.0, motion_seed=4).trajectory(20.0)
+    assert not np.array_equal(traj.specific_force_g, other.specific_force_g)

@@ -31,7 +31,8 @@ EXIT_FAILURE = 1
 #: its one-line help (``gyrocomp --help`` shows it shortened to the terminal)
 COMMANDS = {
     "simulate": ("simulate", 'Simulate calibration runs of a sensor preset through a test profile, with the exact truth.'),
-    "fit": ("fit", 'Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest).'),
+    "fit": ("fit", 'Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still '
+                   'moments of field logs.'),
     "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's "
@@ -120,7 +121,7 @@ PARAMETER_FLAGS = {
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
     "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
     "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
-    "prior": "--prior",
+    "prior": "--prior", "still_only": "--still-only",
 }
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
 _SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone

@@ -7,11 +7,12 @@ import click
 from ..io import refuse_to_overwrite_inputs
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
+from ..models.field import field_recordings
 from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
 from ..models.selection import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
 from .common import float_list, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
-from .render import print_fit
+from .render import print_contributions, print_fit
 
 
 @click.command()
@@ -54,11 +55,17 @@ from .render import print_fit
 @click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
               help="A rate table's schedule (CSV: file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z [deg/s]) "
                    "giving the reference rates of the runs it names, instead of ref_rate_x/y/z columns.")
+@click.option("--still-only", "still_only", type=click.Choice(["auto", "yes", "no"]), default="auto",
+              show_default=True,
+              help="Fit on the still segments of field logs (flights, drives: each one power-on) found from their "
+                   "own noise: yes for every run, auto for the runs still less than half the time, no for none.")
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, rate_schedule, **kwargs):
-    """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest)."""
+        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, rate_schedule, still_only,
+        **kwargs):
+    """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still
+    moments of field logs."""
     opts = pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
     if hysteresis_order != "auto":
@@ -73,6 +80,9 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     recordings = [read_run(path, opts).recording for path in runs]
     if rate_schedule is not None:
         recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+    recordings, contributions = field_recordings(recordings, still_only)
+    if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
+        print_contributions(contributions)
     with progress_bar("fitting", indeterminate=True):
         calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
                                    hysteresis=hysteresis, hysteresis_order=hysteresis_order,

@@ -32,6 +32,20 @@ def print_fit(calibration: Calibration, output) -> None:
             _print_triad(console, name, triad)
 
 
+def print_contributions(contributions) -> None:
+    """What each field log gave the fit: still minutes and segments, and the temperature range they cover."""
+    table = Table(title="field logs: still data used")
+    for col in ("log", "length [min]", "still [min]", "still %", "segments", "temperature [degC]", "used"):
+        table.add_column(col)
+    for c in contributions:
+        span = ("-" if c.temperature_min_degc is None else
+                f"{c.temperature_min_degc:.1f} .. {c.temperature_max_degc:.1f}")
+        table.add_row(Path(c.source).name, f"{c.duration_s / 60:.1f}", f"{c.still_s / 60:.1f}",
+                      f"{100 * c.still_fraction:.0f}", str(c.segments), span,
+                      "still segments" if c.still_only else "whole run")
+    make_console().print(table)
+
+
 def _print_triad(console, name: str, triad) -> None:
     """K (and its standard errors) of a triad, with its scale-factor errors in ppm."""
     table = Table(title=f"{name} scale factor and misalignment ({triad.method}"

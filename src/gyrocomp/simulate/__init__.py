@@ -43,7 +43,10 @@ ONE_TEMPERATURE_PROFILES = ("static", "tumble", "ratetable")
 def run_profiles(profile: Profile, runs: int) -> list[Profile]:
     """The profile of each of ``runs`` runs: a one-temperature profile (static, tumble, ratetable) given several
     set points holds run i at set point i (cycling through them), so a rate table at three temperatures is three
-    runs; every other profile is the same for every run."""
+    runs; a field profile moves differently in each run (motion seeds motion_seed, motion_seed + 1, ...); every
+    other profile is the same for every run."""
+    if profile.name == "field":
+        return [dataclasses.replace(profile, motion_seed=profile.motion_seed + i) for i in range(runs)]
     if profile.name not in ONE_TEMPERATURE_PROFILES or len(profile.set_points_degc) < 2:
         return [profile] * runs
     points = profile.set_points_degc
@@ -195,7 +198,7 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
         Error parameters, or a preset name (``adxrs450``, ``mti10``, ``adis16488``, ``consumer``);
         default: a 3-axis MTi-10-class part with temperature drift and noise only.
     profile : str or Profile
-        ``static``, ``warmup``, ``chamber``, ``cycle``, ``tumble``, ``combined``, ``ratetable``, or
+        ``static``, ``warmup``, ``chamber``, ``cycle``, ``tumble``, ``combined``, ``ratetable``, ``field``, or
         a :class:`Profile` with its own parameters.
     duration_s : float, optional
         Length of the run [s]; default the profile's natural length (it is stretched to fit).

@@ -94,7 +94,7 @@ class Profile:
     Parameters
     ----------
     name : str
-        ``static``, ``warmup``, ``chamber``, ``cycle``, ``tumble``, ``combined`` or ``ratetable``.
+        ``static``, ``warmup``, ``chamber``, ``cycle``, ``tumble``, ``combined``, ``ratetable`` or ``field``.
     set_points_degc : tuple of float
         Temperatures visited, in order [degC] (``static``, ``tumble``, ``ratetable``: the first one; with
         several, :func:`gyrocomp.simulate.run_profiles` holds run i at set point i).
@@ -116,6 +116,9 @@ class Profile:
         visit them in turn, ``position_s`` each, paused ``move_s`` between (as ``combined``).
     rates_dps : tuple of float
         ``ratetable``: rates applied about each axis in turn [deg/s], ``position_s`` each.
+    motion_seed : int
+        ``field``: seed of the moves (their axes, angles, accelerations and vibration); the same seed gives the
+        same trajectory.
     duration_s : float, optional
         Total length [s]; default: the natural length from the parameters above.
     """
@@ -132,6 +135,7 @@ class Profile:
     positions_g: tuple[tuple[float, float, float], ...] = (UP,)
     rates_dps: tuple[float, ...] = ()
     duration_s: float | None = None
+    motion_seed: int = 0
 
     def __post_init__(self) -> None:
         if not self.set_points_degc:
@@ -195,7 +199,7 @@ class Profile:
             return float(self._temperature_knots()[0][-1])
         if self.name in ("tumble", "ratetable"):
             return float(sum(s[0] for s in self._segments()))
-        return 3600.0  # static, warmup
+        return 3600.0  # static, warmup, field
 
     @property
     def natural_duration_s(self) -> float:
@@ -225,7 +229,7 @@ class Profile:
         stretch = natural / duration  # profile time per run time
         if self.name == "static" or self.name in ("tumble", "ratetable"):
             temperature = np.full(n, float(self.set_points_degc[0]))
-        elif self.name == "warmup":
+        elif self.name in ("warmup", "field"):
             temperature = self.set_points_degc[0] + self.warmup_rise_degc * -np.expm1(
                 -time_s / self.warmup_time_constant_s)
         else:
@@ -234,7 +238,10 @@ class Profile:
         force = np.empty((n, 3))
         rate = np.zeros((n, 3))
         recorded = np.ones(n, dtype=bool)
-        if self.name in ("static", "warmup", "chamber", "cycle") and len(self.positions_g) == 1:
+        if self.name == "field":
+            field_motion(time_s, self.position_s / stretch, self.move_s / stretch, self.positions_g[0],
+                         np.random.default_rng(self.motion_seed), force, rate)
+        elif self.name in ("static", "warmup", "chamber", "cycle") and len(self.positions_g) == 1:
             force[:] = self.positions_g[0]
         else:
             self._fill_motion(time_s * stretch, stretch, force, rate, recorded)
@@ -268,6 +275,62 @@ class Profile:
             start = stop
 
 
+#: field profile: largest turn of one move [deg], RMS of the vibration while moving [g] and [deg/s], peak of the
+#: manoeuvring acceleration [g]
+FIELD_TURN_DEG = 120.0
+FIELD_VIBRATION_G = 0.15
+FIELD_VIBRATION_DPS = 1.0
+FIELD_ACCELERATION_G = 0.3
+
+
+#: field profile: longest single turn [s]
+FIELD_TURN_S = 20.0
+
+
+def field_motion(time_s: np.ndarray, still_s: float, move_s: float, start_g: tuple[float, float, float],
+                 rng: np.random.Generator, force: np.ndarray, rate: np.ndarray) -> np.ndarray:
+    """Fill ``force`` [g] and ``rate`` [deg/s] with a field log's motion: still for ``still_s``, then moving for
+    ``move_s``, in turn, from ``start_g``. A move is a series of turns of at most FIELD_TURN_S seconds, each about
+    a random axis by up to FIELD_TURN_DEG with a smooth start and stop (angle Phi (tau - sin(2 pi tau) / (2 pi)),
+    tau the turn's fraction), with white vibration (FIELD_VIBRATION_G and FIELD_VIBRATION_DPS RMS) and a
+    manoeuvring acceleration (a half-sine of up to FIELD_ACCELERATION_G along a random direction, body frame); the
+    vehicle then rests at its new attitude. Returns the mask of the still samples."""
+    still = np.ones(time_s.size, dtype=bool)
+    gravity = np.asarray(start_g, dtype=float)
+    period = still_s + move_s
+    turns = max(1, int(np.ceil(move_s / FIELD_TURN_S)))
+    for k in range(int(np.ceil(time_s[-1] / period)) + 1):
+        begin = k * period
+        force[(time_s >= begin) & (time_s < begin + still_s)] = gravity
+        for j in range(turns if move_s > 0 else 0):
+            start = begin + still_s + j * move_s / turns
+            moving = (time_s >= start) & (time_s < start + move_s / turns)
+            if not moving.any():
+                continue
+            still[moving] = False
+            gravity = _turn(time_s[moving], start, move_s / turns, gravity, rng, force, rate, moving)
+    return still
+
+
+def _turn(t: np.ndarray, start: float, length: float, gravity: np.ndarray, rng: np.random.Generator,
+          force: np.ndarray, rate: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """One smooth turn of a field move (see :func:`field_motion`); returns the gravity direction after it."""
+    tau = (t - start) / length
+    axis = rng.standard_normal(3)
+    axis /= np.linalg.norm(axis)
+    turn = np.radians(rng.uniform(-FIELD_TURN_DEG, FIELD_TURN_DEG))
+    angle = turn * (tau - np.sin(2 * np.pi * tau) / (2 * np.pi))
+    push = rng.standard_normal(3)
+    push *= rng.uniform(0, FIELD_ACCELERATION_G) / np.linalg.norm(push)
+    m = t.size
+    force[where] = (_rotate(gravity, axis, angle) + np.outer(np.sin(np.pi * tau), push)
+                    + rng.standard_normal((m, 3)) * FIELD_VIBRATION_G)
+    # df/dt = -omega x f, as in _fill_motion: omega = -(d angle / dt) axis
+    rate[where] = (-np.degrees(turn * (1 - np.cos(2 * np.pi * tau)) / length)[:, None] * axis
+                   + rng.standard_normal((m, 3)) * FIELD_VIBRATION_DPS)
+    return _rotate(gravity, axis, np.array([turn]))[0]
+
+
 def _rotation_between(f0: np.ndarray, f1: np.ndarray) -> tuple[np.ndarray, float]:
     """Unit axis and angle [rad] of the rotation taking unit vector f0 to f1."""
     cross = np.cross(f0, f1)
@@ -298,6 +361,9 @@ def _profiles() -> dict[str, Profile]:
                             dwell_s=1800.0, position_s=240.0, move_s=60.0, positions_g=tumble_positions((1.0, 0.0, -1.0))),
         "ratetable": Profile("ratetable", set_points_degc=(25.0,), position_s=60.0,
                              rates_dps=(10.0, -10.0, 100.0, -100.0)),
+        # a field log: powered on at room temperature, warming by self-heating, still 2 minutes then moving 4
+        "field": Profile("field", set_points_degc=(20.0,), warmup_rise_degc=25.0, warmup_time_constant_s=900.0,
+                         position_s=120.0, move_s=240.0),
     }
 
 
