@@ -80,13 +80,16 @@ def test_field_data_that_cannot_make_a_model_is_refused():
 def test_fit_on_field_logs_through_the_command_line(tmp_path):
     for k, log in enumerate(_field_logs(3, duration_s=1800.0)):
         write_recording(log, tmp_path / f"flight_{k}.parquet")
-    result = run("fit", *sorted(tmp_path.glob("flight_*.parquet")), "-o", tmp_path / "model.json")
+    result = run("fit", tmp_path, "-o", tmp_path / "model.json")  # a folder: every run in it
     assert result.returncode == 0, result.stderr
     assert "field logs: still data used" in result.stdout and "still segments" in result.stdout
     for k in range(3):
         assert f"flight_{k}.parquet" in result.stdout
+    glob = run("fit", str(tmp_path / "flight_[01].parquet"), "-o", tmp_path / "two.json")
+    assert glob.returncode == 0 and "flight_1.parquet" in glob.stdout and "flight_2" not in glob.stdout
     narrow = _field_logs(1, warmup_rise_degc=2.0, duration_s=1200.0)[0]
-    write_recording(narrow, tmp_path / "short.parquet")
-    refused = run("fit", tmp_path / "short.parquet", "-o", tmp_path / "m2.json", "--still-only", "yes")
+    (tmp_path / "narrow").mkdir()
+    write_recording(narrow, tmp_path / "narrow" / "short.parquet")
+    refused = run("fit", tmp_path / "narrow" / "short.parquet", "-o", tmp_path / "m2.json", "--still-only", "yes")
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1
     assert "a temperature model needs at least 5 degC" in refused.stderr and not (tmp_path / "m2.json").exists()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from ..io import refuse_to_overwrite_inputs
+from ..io.files import expand_runs
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
@@ -16,7 +17,7 @@ from .render import print_contributions, print_fit
 
 
 @click.command()
-@click.argument("runs", nargs=-1, required=True, type=click.Path())
+@click.argument("runs", nargs=-1, required=True, type=click.Path())  # files, folders of runs, or quoted globs
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write (JSON).")
 @click.option("--temperature", default="poly", show_default=True,
               help="poly (order by cross-validation), poly:N (N = 0..5), mlp (the thesis's 1-3-1 network, "
@@ -65,7 +66,9 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, rate_schedule, still_only,
         **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still
-    moments of field logs."""
+    moments of field logs.
+
+    RUNS are files, folders (every run file in them) or quoted glob patterns ('logs/**/*.ulg')."""
     opts = pop_read_options(kwargs)
     order = parse_temperature_option(temperature)
     if hysteresis_order != "auto":
@@ -76,6 +79,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     if band is not None and (len(band) != 2 or not band[0] < band[1]):
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     channels = parse_channels(channels)
+    runs = expand_runs(runs)
     refuse_to_overwrite_inputs(output, runs)
     recordings = [read_run(path, opts).recording for path in runs]
     if rate_schedule is not None:

@@ -9,7 +9,6 @@ manifest table with a ``path`` and a ``serial`` column (any other column is kept
 
 from __future__ import annotations
 
-import glob
 import hashlib
 import json
 import os
@@ -22,10 +21,9 @@ from pathlib import Path
 import pandas as pd
 
 from ..errors import DataQualityWarning, InputError
+from ..io.files import RUN_SUFFIXES, expand_inputs
 from ..io.tables import detect_table_format, file_sha256
 
-#: suffixes of the files a folder is searched for (every format gyrocomp reads)
-RUN_SUFFIXES = (".csv", ".txt", ".parquet", ".pq", ".ulg", ".bin", ".bag", ".mcap", ".h5", ".hdf5", ".nc", ".nc4")
 _FIELD = re.compile(r"\{(\w+)\}")
 
 
@@ -36,44 +34,6 @@ class UnitRuns:
     serial: str
     paths: tuple[str, ...]
     metadata: Mapping[str, str] = field(default_factory=dict)
-
-
-def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
-    """The run files that ``data`` names: files as given, folders searched recursively for every readable format
-    (a ROS 2 bag folder, with its ``metadata.yaml``, counts as one run), glob patterns expanded; sorted, each once."""
-    found: set[Path] = set()
-    for item in data:
-        text = os.fspath(item)
-        path = Path(text)
-        if path.is_dir():
-            found.update(_runs_in_folder(path))
-        elif path.exists():
-            found.add(path)
-        elif glob.has_magic(text):
-            matches = [Path(m) for m in glob.glob(text, recursive=True)]
-            if not matches:
-                raise InputError(f"{text}: the pattern matches no file")
-            for match in matches:
-                found.update(_runs_in_folder(match) if match.is_dir() else [match])
-        else:
-            raise InputError(f"{text}: no such file or folder")
-    if not found:
-        raise InputError(f"{', '.join(map(os.fspath, data))}: no run file found (looked for "
-                         f"{', '.join(RUN_SUFFIXES)})")
-    return sorted(found)
-
-
-def _runs_in_folder(folder: Path) -> list[Path]:
-    runs, bags = [], []
-    for root, dirs, files in os.walk(folder):
-        if "metadata.yaml" in files and root != os.fspath(folder):
-            bags.append(Path(root))
-            dirs.clear()
-            continue
-        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-        runs += [Path(root) / f for f in sorted(files)
-                 if not f.startswith(".") and (Path(f).suffix.lower() in RUN_SUFFIXES or detect_table_format(Path(f)))]
-    return runs + bags
 
 
 def pattern_regex(pattern: str) -> re.Pattern:

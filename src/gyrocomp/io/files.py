@@ -1,0 +1,73 @@
+"""Which files a list of inputs names: files as given, folders searched for runs, glob patterns expanded."""
+
+from __future__ import annotations
+
+import glob
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+from ..errors import InputError
+from .tables import detect_table_format
+
+#: suffixes of the files a folder is searched for (every format gyrocomp reads)
+RUN_SUFFIXES = (".csv", ".txt", ".parquet", ".pq", ".ulg", ".bin", ".bag", ".mcap", ".h5", ".hdf5", ".nc", ".nc4")
+
+
+def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
+    """The run files that ``data`` names: files as given, folders searched recursively for every readable format
+    (a ROS 2 bag folder, with its ``metadata.yaml``, counts as one run), glob patterns expanded; sorted, each once."""
+    found: set[Path] = set()
+    for item in data:
+        text = os.fspath(item)
+        path = Path(text)
+        if path.is_dir():
+            found.update(_runs_in_folder(path))
+        elif path.exists():
+            found.add(path)
+        elif glob.has_magic(text):
+            matches = [Path(m) for m in glob.glob(text, recursive=True)]
+            if not matches:
+                raise InputError(f"{text}: the pattern matches no file")
+            for match in matches:
+                found.update(_runs_in_folder(match) if match.is_dir() else [match])
+        else:
+            raise InputError(f"{text}: no such file or folder")
+    if not found:
+        raise InputError(f"{', '.join(map(os.fspath, data))}: no run file found (looked for "
+                         f"{', '.join(RUN_SUFFIXES)})")
+    return sorted(found)
+
+
+def _runs_in_folder(folder: Path) -> list[Path]:
+    runs, bags = [], []
+    for root, dirs, files in os.walk(folder):
+        if "metadata.yaml" in files and root != os.fspath(folder):
+            bags.append(Path(root))
+            dirs.clear()
+            continue
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+        runs += [Path(root) / f for f in sorted(files)
+                 if not f.startswith(".") and (Path(f).suffix.lower() in RUN_SUFFIXES or detect_table_format(Path(f)))]
+    return runs + bags
+
+
+
+
+def expand_runs(items: Iterable[str | os.PathLike]) -> list[str]:
+    """Run names for a command: a folder (not a ROS 2 bag's) becomes the runs in it and a glob pattern no file
+    is named after becomes its matches (both sorted, see :func:`expand_inputs`); any other name stays as given, in
+    order (a missing file is then reported by the reader)."""
+    out: list[str] = []
+    for item in items:
+        text = os.fspath(item)
+        path = Path(text)
+        folder = path.is_dir() and not (path / "metadata.yaml").exists()
+        if folder or (not path.exists() and glob.has_magic(text)):
+            out += [os.fspath(p) for p in expand_inputs([text])]
+        else:
+            out.append(text)
+    return out
+
+
+__all__ = ["RUN_SUFFIXES", "expand_inputs", "expand_runs"]
