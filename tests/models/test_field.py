@@ -93,3 +93,21 @@ def test_fit_on_field_logs_through_the_command_line(tmp_path):
     refused = run("fit", tmp_path / "narrow" / "short.parquet", "-o", tmp_path / "m2.json", "--still-only", "yes")
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1
     assert "a temperature model needs at least 5 degC" in refused.stderr and not (tmp_path / "m2.json").exists()
+
+
+def test_the_report_draws_the_still_segments_of_a_field_log():
+    from gyrocomp.report.html import build_report
+    from gyrocomp.stillness import detect_still
+
+    logs = _field_logs(2, duration_s=1800.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = fit_channels(field_recordings(logs)[0])
+    report = build_report(model, [logs[0]])
+    assert report.sections[-1] == "stillness"
+    body = report.html.split('<section id="stillness">')[1].split("</section>")[0]
+    found = detect_still(logs[0])
+    assert f"{len(found.segments)} still segment(s), {found.still_s / 60:.1f} of 30.0 min" in body
+    assert body.count("<tr>") == len(found.segments) + 1 and "data:image/png;base64," in body
+    chamber = simulate(PRESET, profile="chamber", rate_hz=5, duration_s=1800, seed=1).recording
+    assert "stillness" not in build_report(model, [chamber]).sections

@@ -84,7 +84,7 @@ def field_recordings(recordings: list[Recording], still_only: StillOnly = "auto"
             runs.append(rec)  # auto: a run for the accelerometer, G or a rate table, used as given
             continue
         found = detect_still(rec, min_duration_s=min_still_s)
-        keep = still_only == "yes" or _moves(found)
+        keep = still_only == "yes" or moves_most_of_the_time(found)
         contributions.append(_contribution(rec, found, keep))
         if not keep:
             runs.append(rec)
@@ -95,7 +95,7 @@ def field_recordings(recordings: list[Recording], still_only: StillOnly = "auto"
     return runs, contributions
 
 
-def _moves(found: StillDetection) -> bool:
+def moves_most_of_the_time(found: StillDetection) -> bool:
     """Whether a log moves most of the time: enough whole blocks to judge, and fewer than AUTO_STILL_FRACTION of
     them still."""
     whole = found.blocks.whole
@@ -125,4 +125,5 @@ def _require_still_data(contributions: list[LogContribution]) -> None:
                          "(log cold starts and warm-ups, still now and then)")
 
 
-__all__ = ["AUTO_STILL_FRACTION", "LogContribution", "MIN_FIELD_SPAN_DEGC", "StillOnly", "field_recordings"]
+__all__ = ["AUTO_STILL_FRACTION", "LogContribution", "MIN_FIELD_SPAN_DEGC", "StillOnly", "field_recordings",
+           "moves_most_of_the_time"]

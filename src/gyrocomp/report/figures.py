@@ -399,3 +399,27 @@ def fleet_distributions(table, figure_names: tuple[str, ...], axes: tuple[str, .
     fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def stillness_plot(recording, detection, title: str | None = None):
+    """A log's gyro rate against time [deg/s] (min/max envelope) with its still segments shaded, and its
+    temperature [degC] on the right axis (:func:`gyrocomp.stillness.detect_still`)."""
+    plt = _pyplot()
+    fig, panel = plt.subplots(figsize=(11, 3.6))
+    t = recording.time_s - recording.time_s[0]
+    for j, axis in enumerate(recording.gyro_axes):
+        panel.plot(*envelope(t, recording.gyro_dps[:, j]), lw=0.6, label=axis)
+    for k, segment in enumerate(detection.segments):
+        panel.axvspan(segment.start_s - recording.time_s[0], segment.stop_s - recording.time_s[0], color="tab:green",
+                      alpha=0.18, lw=0, label="still" if k == 0 else None)
+    panel.set_xlabel("time [s]")
+    panel.set_ylabel("rate [deg/s]")
+    if recording.temperature_degc is not None:
+        right = panel.twinx()
+        right.plot(*_binned(t, max(float(t[-1]) / DRAW_POINTS, 1e-9), recording.temperature_degc), color="k", lw=0.9,
+                   ls="--")  # means over short time bins: a whole-degree sensor's steps and noise averaged
+        right.set_ylabel("temperature [degC] (dashed)")
+    panel.legend(loc="upper left", fontsize=8, ncol=4)
+    panel.set_title(title or f"still segments: {recording.source.rsplit('/', 1)[-1]}")
+    fig.tight_layout()
+    return fig

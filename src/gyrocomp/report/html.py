@@ -10,7 +10,8 @@ heating and cooling branches, fitted curve, turning points and residual; raw and
 against time), ``allan`` (raw and compensated Allan deviation per run), ``g-sensitivity`` when the
 model has a g-sensitivity matrix, and ``scale-factor`` when it has a gyro or accelerometer triad (K with standard
 errors, scale-factor error against temperature, and the residual of each still pose (|a| - 1 g) and each turn
-between poses (the gravity direction the gyro predicts) before and after).
+between poses (the gravity direction the gyro predicts) before and after), and ``stillness`` for runs that move
+most of the time (field logs): their still segments drawn over the rate and temperature, and listed.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ from ..metrics import evaluate_run
 from ..noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
 from ..static import static_segments
+from ..stillness import detect_still
+from ..models.field import moves_most_of_the_time
 from ..validation import ValidationResult
 from . import figures
 
@@ -352,22 +355,47 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         tick()
         sections.update(_axis_sections(calibration, runs, compensated, windows))
         tick()
-        allan = []
-        for rec, comp in zip(runs, compensated):
-            names = list(rec.gyro_axes)
-            split = bool(rec.gaps)
-            analyses = {"raw": analyse_noise(rec, names, split_gaps=split),
-                        "compensated": analyse_noise(comp, names, split_gaps=split)}
-            allan.append(_img(figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
-                              "Allan deviation, raw and compensated"))
-            tick()
-        sections["allan"] = ("Allan deviation", "\n".join(allan))
+        sections["allan"] = ("Allan deviation", _allan(runs, compensated, tick))
         if calibration.has_acceleration:
             sections["g-sensitivity"] = ("g-sensitivity", _g_sensitivity(calibration, runs, min_static_s))
         if calibration.gyro_triad is not None or calibration.accel_triad is not None:
             sections["scale-factor"] = ("Scale factor and misalignment", _triads(calibration, runs, compensated))
+        moving = [(rec, found) for rec in runs for found in [detect_still(rec)] if moves_most_of_the_time(found)]
+        if moving:
+            sections["stillness"] = ("Still moments of the field logs", _stillness(moving))
         tick()
     return Report(_page(calibration, runs, sections), tuple(sections))
+
+
+def _allan(runs: list[Recording], compensated: list[Recording], tick: Callable[[], None]) -> str:
+    """Raw and compensated Allan deviations of each run, one figure per run."""
+    parts = []
+    for rec, comp in zip(runs, compensated):
+        names = list(rec.gyro_axes)
+        split = bool(rec.gaps)
+        analyses = {"raw": analyse_noise(rec, names, split_gaps=split),
+                    "compensated": analyse_noise(comp, names, split_gaps=split)}
+        parts.append(_img(figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
+                          "Allan deviation, raw and compensated"))
+        tick()
+    return "\n".join(parts)
+
+
+def _stillness(moving: list) -> str:
+    """For each run that moves most of the time: its still segments drawn over its rate and temperature, and
+    listed (where, how long, temperature, mean rate = the bias there)."""
+    parts = []
+    for rec, found in moving:
+        parts.append(_img(figures.stillness_plot(rec, found), "rate and temperature with the still segments shaded"))
+        rows = [[f"{s.start_s - rec.time_s[0]:.0f}", f"{s.duration_s:.0f}",
+                 "-" if s.temperature_degc is None else f"{s.temperature_degc:.2f}",
+                 *(float(v) for v in s.gyro_mean_dps)] for s in found.segments]
+        total = rec.duration_s
+        parts.append(_table(["start [s]", "length [s]", "temperature [degC]",
+                             *(f"{a} mean [deg/s]" for a in rec.gyro_axes)], rows,
+                            f"{rec.source.rsplit('/', 1)[-1]}: {len(found.segments)} still segment(s), "
+                            f"{found.still_s / 60:.1f} of {total / 60:.1f} min"))
+    return "\n".join(parts)
 
 
 def _page(calibration: Calibration, runs: list[Recording], sections: dict) -> str:
