@@ -10,8 +10,10 @@ import numpy as np
 _ULOG_TYPES = {"uint64_t": "Q", "uint32_t": "I", "float": "f", "uint8_t": "B", "int32_t": "i"}
 
 
-def write_ulog(path, topics: dict[tuple[str, int], dict[str, tuple[str, np.ndarray]]]) -> None:
-    """Write a ULog with one data series per ``(topic, multi_id)``: ``{field: (c_type, values)}``.
+def write_ulog(path, topics: dict[tuple[str, int], dict[str, tuple[str, np.ndarray]]],
+               parameters: dict[str, int | float] | None = None) -> None:
+    """Write a ULog with one data series per ``(topic, multi_id)``: ``{field: (c_type, values)}``, and
+    ``parameters`` (an int is written as int32_t, a float as float) in the definitions section.
 
     Every topic must have a ``timestamp`` field (uint64_t, microseconds) first.
     """
@@ -28,6 +30,9 @@ def write_ulog(path, topics: dict[tuple[str, int], dict[str, tuple[str, np.ndarr
         formats_done.add(name)
         spec = "".join(f"{ctype} {field};" for field, (ctype, _) in fields.items())
         message(b"F", f"{name}:{spec}".encode())
+    for name, value in (parameters or {}).items():
+        key = f"{'int32_t' if isinstance(value, int) else 'float'} {name}".encode()
+        message(b"P", bytes([len(key)]) + key + struct.pack("<i" if isinstance(value, int) else "<f", value))
     for msg_id, ((name, multi_id), fields) in enumerate(topics.items()):
         message(b"A", struct.pack("<BH", multi_id, msg_id) + name.encode())
     rows = []

@@ -479,3 +479,78 @@ def test_cli_bad_logs_give_one_line_and_status_2(tmp_path, case):
     errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
     assert len(errors) == 1 and expected in errors[0], r.stderr
     assert "Traceback" not in r.stderr
+
+
+def _drifting_gyro(multi_id: int, slope_rad_s_per_degc: float, n: int = 3000, rate_hz: float = 10.0):
+    """A sensor_gyro instance whose bias is linear in temperature (10 -> 50 degC) with the given slope."""
+    temperature = np.linspace(10, 50, n)
+    t_us = (1_000_000 + np.arange(n) * 1e6 / rate_hz).astype(np.uint64)
+    rng = np.random.default_rng(multi_id)
+    fields = {"timestamp": ("uint64_t", t_us), "device_id": ("uint32_t", np.full(n, 7 + multi_id, np.uint32)),
+              "temperature": ("float", temperature.astype(np.float32))}
+    for axis in "xyz":
+        rate = slope_rad_s_per_degc * (temperature - 30) + 1e-5 * rng.standard_normal(n)
+        fields[axis] = ("float", rate.astype(np.float32))
+    return ("sensor_gyro", multi_id), fields
+
+
+def _slopes_dps_per_degc(path) -> list[float]:
+    from gyrocomp.calibration import Calibration
+
+    model = Calibration.load(path)
+    return [float(np.diff(axis.shape_dps(np.array([29.5, 30.5])))[0]) for axis in model.axes.values()]
+
+
+def test_fit_every_instance_of_a_px4_and_an_ardupilot_log(tmp_path):
+    """--instance all: one model file per IMU, each with its own IMU's temperature slope."""
+    ulog = tmp_path / "two.ulg"
+    write_ulog(ulog, dict([_drifting_gyro(0, 1e-3), _drifting_gyro(1, -2e-3)]))
+    r = run("fit", ulog, "-o", tmp_path / "px4.json", "--instance", "all", "--hysteresis", "none")
+    assert r.returncode == 0, r.stderr
+    assert _slopes_dps_per_degc(tmp_path / "px4_imu0.json") == pytest.approx([np.degrees(1e-3)] * 3, rel=0.01)
+    assert _slopes_dps_per_degc(tmp_path / "px4_imu1.json") == pytest.approx([np.degrees(-2e-3)] * 3, rel=0.01)
+    assert not (tmp_path / "px4.json").exists()
+    n = 3000
+    temperature = np.linspace(10, 50, n)
+    rows = [(1_000_000 + i * 100_000, k, s * (temperature[i] - 30), s * (temperature[i] - 30), s * (temperature[i] - 30),
+             0.0, 0.0, -G, temperature[i]) for i in range(n) for k, s in ((0, 5e-4), (1, 1.5e-3))]
+    dataflash = tmp_path / "two.bin"
+    write_dataflash(dataflash, {"IMU": (130, _IMU_COLUMNS, rows)})
+    r = run("fit", dataflash, "-o", tmp_path / "ap.json", "--instance", "all", "--hysteresis", "none")
+    assert r.returncode == 0, r.stderr
+    assert _slopes_dps_per_degc(tmp_path / "ap_imu0.json") == pytest.approx([np.degrees(5e-4)] * 3, rel=0.01)
+    assert _slopes_dps_per_degc(tmp_path / "ap_imu1.json") == pytest.approx([np.degrees(1.5e-3)] * 3, rel=0.01)
+    # a run without one of the instances the others have is refused, nothing written
+    single = tmp_path / "one.ulg"
+    write_ulog(single, dict([_drifting_gyro(0, 1e-3)]))
+    r = run("fit", ulog, single, "-o", tmp_path / "mixed.json", "--instance", "all")
+    assert r.returncode == 2 and "one.ulg: no instance 1 (it has 0); --instance all fits each instance" in r.stderr
+    assert not list(tmp_path.glob("mixed*"))
+    r = run("apply", tmp_path / "px4_imu0.json", ulog, "-o", tmp_path / "o.csv", "--instance", "all")
+    assert r.returncode == 2 and "--instance: all is for gyrocomp fit" in r.stderr
+
+
+def test_a_px4_log_already_corrected_onboard_is_recognized(tmp_path):
+    """With TC_G_ENABLE = 1, PX4's sensor_gyro is still raw (the correction is applied after it), but
+    sensor_combined is corrected: reading it warns that a model would correct twice."""
+    key, gyro = _gyro_topic()
+    raw_log = tmp_path / "raw.ulg"
+    write_ulog(raw_log, {key: gyro}, parameters={"TC_G_ENABLE": 1})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        raw = read(raw_log)
+    assert raw.metadata["px4_thermal_compensation"] and not raw.metadata["corrected_onboard"]
+    n = 100
+    combined = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 20_000).astype(np.uint64)),
+                **{f"gyro_rad[{i}]": ("float", np.zeros(n, np.float32)) for i in range(3)},
+                **{f"accelerometer_m_s2[{i}]": ("float", np.full(n, -G if i == 2 else 0.0, np.float32))
+                   for i in range(3)}}
+    corrected_log = tmp_path / "corrected.ulg"
+    write_ulog(corrected_log, {("sensor_combined", 0): combined}, parameters={"TC_G_ENABLE": 1})
+    with pytest.warns(DataQualityWarning, match=r"TC_G_ENABLE = 1: sensor_combined is already corrected by PX4's "
+                                                r"thermal compensation; a model fitted or applied on it would correct "
+                                                r"twice"):
+        corrected = read(corrected_log)
+    assert corrected.metadata["corrected_onboard"]
+    write_ulog(tmp_path / "off.ulg", {("sensor_combined", 0): combined}, parameters={"TC_G_ENABLE": 0})
+    assert not read(tmp_path / "off.ulg").metadata["corrected_onboard"]

@@ -34,8 +34,9 @@ def read_options(func):
                      help="CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a tab)."),
         click.option("--decimal", default=None, help="CSV decimal point, . or , (default: told from the first row)."),
         click.option("--drop-nan", is_flag=True, help="Drop rows with empty/NaN values (says how many) instead of refusing the file."),
-        click.option("--instance", type=int, default=None,
-                     help="Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0)."),
+        click.option("--instance", default=None, metavar="N",
+                     help="Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0); "
+                          "fit: all fits every instance, one model file each."),
         click.option("--device-id", "device_id", type=int, default=None, help="PX4 device id of the gyro to read."),
         click.option("--imu-topic", default=None, help="ROS bag: the sensor_msgs/Imu topic (default: the only one)."),
         click.option("--temperature-topic", default=None,
@@ -75,9 +76,26 @@ def read_settings(opts: dict) -> ReadOptions:
     """The :class:`ReadOptions` the common reading options (``pop_read_options``) give."""
     layout = table_layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"], opts["delimiter"],
                           opts["decimal"])
-    return ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=opts["instance"],
+    return ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=parse_instance(opts["instance"]),
                        device_id=opts["device_id"], imu_topic=opts["imu_topic"],
                        temperature_topic=opts["temperature_topic"], record=opts["record"])
+
+
+def parse_instance(text: str | int | None) -> int | None:
+    """``--instance``: a whole number >= 0 (``all`` is taken by ``gyrocomp fit`` before reading)."""
+    if text is None or isinstance(text, int):
+        return text
+    if text.strip().lower() == "all":
+        raise click.BadParameter("all is for gyrocomp fit (one model per instance); give a number here",
+                                 param_hint="--instance")
+    try:
+        value = int(text)
+    except ValueError:
+        raise click.BadParameter(f"{text!r}: give a whole number >= 0 (or all, in gyrocomp fit)",
+                                 param_hint="--instance") from None
+    if value < 0:
+        raise click.BadParameter(f"{value}: give a whole number >= 0", param_hint="--instance")
+    return value
 
 
 def read_run(path, opts: dict):
@@ -136,4 +154,4 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_hidden", "parse_temperature_option", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]
+__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_hidden", "parse_temperature_option", "pop_read_options", "parse_instance", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]

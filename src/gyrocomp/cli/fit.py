@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
-from ..io import refuse_to_overwrite_inputs
+from ..errors import InputError
+from ..io import instances, refuse_to_overwrite_inputs
+from ..io.atomic import write_texts_atomic
 from ..io.files import expand_runs
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
@@ -81,21 +85,46 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     channels = parse_channels(channels)
     runs = expand_runs(runs)
     refuse_to_overwrite_inputs(output, runs)
-    recordings = [read_run(path, opts).recording for path in runs]
-    if rate_schedule is not None:
-        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
-    recordings, contributions = field_recordings(recordings, still_only)
-    if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
-        print_contributions(contributions)
-    with progress_bar("fitting", indeterminate=True):
-        calibration = fit_channels(recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
-                                   hysteresis=hysteresis, hysteresis_order=hysteresis_order,
-                                   hysteresis_band_degc=band, mlp_seed=mlp_seed, acceleration=acceleration,
-                                   static_min_duration_s=static_min_duration_s, scale_factor=scale_factor,
-                                   **({} if folds == "auto" else {"folds": folds}))
-    calibration.save(output)
+    every = str(opts["instance"]).strip().lower() == "all"
+    chosen = _common_instances(runs, opts["fmt"]) if every else [None]
+    fits = {}
+    for instance in chosen:
+        read_opts = {**opts, "instance": instance if every else opts["instance"]}
+        recordings = [read_run(path, read_opts).recording for path in runs]
+        if rate_schedule is not None:
+            recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+        recordings, contributions = field_recordings(recordings, still_only)
+        if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
+            print_contributions(contributions)
+        with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):
+            fits[instance] = fit_channels(
+                recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
+                hysteresis=hysteresis, hysteresis_order=hysteresis_order, hysteresis_band_degc=band,
+                mlp_seed=mlp_seed, acceleration=acceleration, static_min_duration_s=static_min_duration_s,
+                scale_factor=scale_factor, **({} if folds == "auto" else {"folds": folds}))
+    if every:  # one model file per instance, all written or none
+        out = Path(output)
+        names = {instance: f"{out.stem}_imu{instance}{out.suffix}" for instance in fits}
+        write_texts_atomic(out.parent, {names[i]: c.to_json() for i, c in fits.items()})
+        written = {i: out.parent / names[i] for i in fits}
+    else:
+        fits[None].save(output)
+        written = {None: output}
     if not ctx.obj["quiet"]:
-        print_fit(calibration, output)
+        for instance, calibration in fits.items():
+            print_fit(calibration, written[instance])
+
+
+def _common_instances(runs: list[str], fmt: str | None) -> list[int]:
+    """The sensor instances of every run (``--instance all``); a run missing one another run has is refused."""
+    found = {path: instances(path, fmt) for path in runs}
+    every = sorted(set().union(*found.values()))
+    for path, have in found.items():
+        lacking = [i for i in every if i not in have]
+        if lacking:
+            raise InputError(f"{path}: no instance {lacking[0]} (it has {', '.join(map(str, have))}); --instance all "
+                             "fits each instance on every run, so every run must hold the same instances")
+    return every
 
 
 __all__ = ["fit"]

@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..recording import Recording
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
 from .common import ProgressCallback, ReadOptions, sniff_format
-from .dataflash import read_dataflash
+from .dataflash import dataflash_instances, read_dataflash
 from .hdf5 import read_hdf5
 from .rosbag import read_rosbag
 from .tables import (
@@ -29,7 +29,7 @@ from .tables import (
     write_gyro_back,
     write_recording,
 )
-from .ulog import read_ulog
+from .ulog import read_ulog, ulog_instances
 
 TABLE_FORMATS = ("csv", "parquet")
 LOG_FORMATS = ("ulog", "dataflash", "rosbag", "hdf5")
@@ -103,6 +103,19 @@ def read_input(
     return table_data(_log_reader(fmt)(path, options, progress))
 
 
+def instances(path: str | os.PathLike, fmt: str | None = None) -> tuple[int, ...]:
+    """The sensor instances a log holds (PX4 uORB ``multi_id``, ArduPilot IMU number from 0), sorted; ``(0,)`` for
+    a table, a ROS bag or an HDF5 file (one sensor each)."""
+    fmt = detect_format(path, fmt)
+    if not Path(path).exists():
+        raise InputError(f"{path}: no such file")
+    if fmt == "ulog":
+        return ulog_instances(path)
+    if fmt == "dataflash":
+        return dataflash_instances(path)
+    return (0,)
+
+
 def read(
     path: str | os.PathLike,
     layout: TableLayout | None = None,
@@ -142,6 +155,7 @@ __all__ = [
     "detect_format",
     "detect_table_format",
     "file_sha256",
+    "instances",
     "output_format",
     "parse_column_mapping",
     "read",

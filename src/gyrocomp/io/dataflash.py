@@ -117,16 +117,34 @@ class _Log:
                 for name, value in zip(parm["Name"], parm["Value"])}
 
 
+def _instances(log: _Log) -> list[int]:
+    """The IMU instances of a log: the ``I`` field's values, or which of IMU, IMU2, IMU3 it has (older firmware)."""
+    if log.has("IMU") and "I" in log.fields("IMU"):
+        return sorted(set(int(i) for i in np.unique(log.records("IMU")["I"])))
+    return [i for i, name in enumerate(("IMU", "IMU2", "IMU3")) if log.has(name)]
+
+
+def dataflash_instances(path) -> tuple[int, ...]:
+    """The IMU instances (from 0) of an ArduPilot DataFlash log, sorted."""
+    path = Path(path)
+    check_magic(path, DATAFLASH_MAGIC, "ArduPilot DataFlash", "name its real format with fmt=")
+    log = _Log(path, None)
+    try:
+        return tuple(_instances(log))
+    finally:
+        log.close()
+
+
 def _instance_records(log: _Log, instance: int) -> np.ndarray:
     if log.has("IMU") and "I" in log.fields("IMU"):
         imu = log.records("IMU")
-        found = sorted(set(int(i) for i in np.unique(imu["I"])))
+        found = _instances(log)
         if instance not in found:
             raise InputError(f"{log.path}: instance={instance}: no IMU instance {instance}; "
                              f"the log has {', '.join(map(str, found))}")
         return imu[imu["I"] == instance], found
     names = ["IMU", "IMU2", "IMU3"]
-    found = [i for i, name in enumerate(names) if log.has(name)]
+    found = _instances(log)
     if instance not in found:
         raise InputError(f"{log.path}: instance={instance}: no {names[instance] if instance < 3 else 'IMU'} "
                          f"records; the log has instance(s) {', '.join(map(str, found))}")

@@ -156,6 +156,36 @@ _TOPIC_READERS = {"sensor_gyro": _from_sensor_gyro, "vehicle_imu": _from_vehicle
                   "sensor_combined": _from_sensor_combined}
 
 
+def _warn_if_corrected(path: Path, topic: str, parameters: dict, metadata: dict) -> None:
+    """PX4 applies its thermal compensation (``TC_G_ENABLE = 1``) in the sensors module, after ``sensor_gyro``:
+    that topic is raw, ``vehicle_imu`` and ``sensor_combined`` are corrected. Fitting or applying a model to
+    corrected data would correct twice."""
+    enabled = int(parameters.get("TC_G_ENABLE", 0)) == 1
+    metadata["px4_thermal_compensation"] = enabled
+    metadata["corrected_onboard"] = enabled and topic != "sensor_gyro"
+    if metadata["corrected_onboard"]:
+        warnings.warn(f"{path}: TC_G_ENABLE = 1: {topic} is already corrected by PX4's thermal compensation; a "
+                      "model fitted or applied on it would correct twice (log sensor_gyro, the raw topic, or "
+                      "disable TC_G_ENABLE)", DataQualityWarning, stacklevel=4)
+
+
+def ulog_instances(path) -> tuple[int, ...]:
+    """The uORB instances (``multi_id``) of the gyro topic :func:`read_ulog` reads in a ULog, sorted."""
+    path = Path(path)
+    check_magic(path, ULOG_MAGIC, "PX4 ULog", "name its real format with fmt=")
+    pyulog = require("pyulog", "ulog", "reading PX4 ULog files")
+    try:
+        with foreign_output(str(path), "pyulog"):
+            ulog = pyulog.ULog(str(path), list(GYRO_TOPICS), parse_header_only=False)
+    except Exception as exc:  # pyulog raises bare Exceptions on corrupt files
+        raise InputError(f"{path}: not a readable ULog ({type(exc).__name__}: {exc})") from None
+    names = {d.name for d in ulog.data_list}
+    topic = next((t for t in GYRO_TOPICS if t in names), None)
+    if topic is None:
+        raise InputError(f"{path}: no gyro topic ({', '.join(GYRO_TOPICS)}) in this ULog")
+    return tuple(sorted({int(d.multi_id) for d in ulog.data_list if d.name == topic}))
+
+
 def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read a PX4 ULog into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -192,6 +222,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
         )
     metadata = {"path": str(path), "format": "ulog"}
     time_s, gyro, accel, temperature = _TOPIC_READERS[topic](path, ulog.data_list, options, metadata)
+    _warn_if_corrected(path, topic, ulog.initial_parameters, metadata)
     if temperature is None:
         warnings.warn(
             f"{path}: {metadata['topic']} carries no temperature; log sensor_gyro for temperature calibration "
