@@ -20,6 +20,8 @@ from .models.pose_rotation import rotation_errors
 from .models.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
 from .recording import GYRO_AXES, Recording
 from .triad import TriadCalibration
+from .installed import installed_calibration
+from .models.field import field_recordings
 
 
 def evaluate(calibration: Calibration, recordings: list[Recording] | Recording, *, window_s: float | None = None,
@@ -126,4 +128,68 @@ def evaluate_stages(calibration, recording: Recording, *, window_s: float | None
     return StageEvaluation(recording.source, float(window_s), stages)
 
 
-__all__ = ["StageEvaluation", "evaluate", "evaluate_stages", "stage_calibrations"]
+@dataclass(frozen=True)
+class InstalledComparison:
+    """A log's installed autopilot calibration against a gyrocomp model on the same data (its still segments when
+    it moves most of the time): per gyro axis, the residual RMS [deg/s] (of the moving average about its mean)
+    raw, with the installed calibration and with the model. ``installed`` is None when the log's parameters hold
+    no enabled calibration; ``corrected_onboard`` when the logged data already went through it (raw is then
+    the installed one, and a model on top would correct twice: its figures are then NaN)."""
+
+    file: str
+    autopilot: str
+    installed: str | None
+    corrected_onboard: bool
+    still_only: bool
+    data_s: float
+    window_s: float
+    raw_dps: dict[str, float]
+    installed_dps: dict[str, float]
+    model_dps: dict[str, float]
+
+
+def compare_installed(calibration: Calibration, recording: Recording, *, window_s: float | None = None
+                      ) -> InstalledComparison:
+    """Judge the thermal calibration installed on the vehicle that wrote ``recording`` (a PX4 ULog's ``TC_G*`` or
+    an ArduPilot log's ``INS_TCAL*`` parameters, :func:`gyrocomp.installed.installed_calibration`) against
+    ``calibration`` on the same data: the log's still segments when it moves most of the time
+    (:func:`gyrocomp.models.field.field_recordings`), else all of it.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        gyrocomp's model of the same sensor.
+    recording : Recording
+        A log read by :func:`gyrocomp.read` (its ``metadata`` carries the autopilot's parameters).
+    window_s : float, optional
+        Moving-average window [s] (default as :func:`evaluate`).
+    """
+    fmt = recording.metadata.get("format")
+    if fmt not in ("ulog", "dataflash") or "autopilot_parameters" not in recording.metadata:
+        raise InputError(f"{recording.source}: not a PX4 ULog or ArduPilot DataFlash log; the installed calibration "
+                         "is read from a log's parameters")
+    autopilot = "px4" if fmt == "ulog" else "ardupilot"
+    installed = installed_calibration(recording.metadata["autopilot_parameters"], autopilot,
+                                      int(recording.metadata.get("instance") or 0))
+    onboard = bool(recording.metadata.get("corrected_onboard"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)
+        runs, contributions = field_recordings([recording], "auto")
+    data = runs[0]
+    still_only = bool(contributions and contributions[0].still_only)
+    window = window_s if window_s is not None else default_window_s(data)
+
+    def residual(model: Calibration | None) -> dict[str, float]:
+        if model is None:
+            return {a: float("nan") for a in data.gyro_axes}
+        evaluation = evaluate_run(data, data if model is None else apply(model, data), window_s=window)
+        return {a: m.residual_rms_dps for a, m in evaluation.axes.items()}
+
+    raw = {a: m.residual_rms_dps for a, m in evaluate_run(data, data, window_s=window).axes.items()}
+    return InstalledComparison(recording.source, autopilot, None if installed is None else installed.model, onboard,
+                               still_only, data.duration_s if not still_only else contributions[0].still_s, window,
+                               raw, raw if onboard else residual(installed),
+                               residual(None) if onboard else residual(calibration))
+
+
+__all__ = ["InstalledComparison", "compare_installed", "StageEvaluation", "evaluate", "evaluate_stages", "stage_calibrations"]

@@ -169,3 +169,102 @@ def test_accelerometer_offsets_and_scales_from_a_multi_position_calibration(tmp_
     assert r.returncode == 0, r.stderr
     assert _read_ardupilot((tmp_path / "acc.parm").read_text())["INS_ACCOFFS_X"] == pytest.approx(ardu["INS_ACC2OFFS_X"])
     assert Calibration.load(tmp_path / "accel.json").accel_triad == triad
+
+
+def test_the_installed_calibration_reproduces_each_autopilot_formula():
+    """installed_calibration reads the parameters back: its correction, at temperatures inside and beyond
+    TMIN..TMAX, is the autopilot's own formula (PX4 with its X0; ArduPilot relative to its curve's zero at 35 degC)."""
+    from gyrocomp.export.autopilot import ardupilot_parameters, installed_calibration, px4_parameters
+
+    model = _model(3)
+    temperature = np.linspace(-40.0, 90.0, 27)
+    px4 = px4_parameters(model, instance=1).values
+    installed = installed_calibration(px4, "px4", instance=1)
+    for axis, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
+        got = installed.axes[axis].shape_dps(temperature) + installed.axes[axis].turn_on_biases_dps[0]
+        assert np.allclose(got, px4_offset_rad_s(px4, 1, j, temperature) * RAD_TO_DEG, atol=1e-12)
+    ardupilot = ardupilot_parameters(model, instance=2).values
+    installed = installed_calibration(ardupilot, "ardupilot", instance=1)
+    for axis, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
+        got = installed.axes[axis].shape_dps(temperature)
+        want = ardupilot_correction_rad_s(ardupilot, 2, j, temperature, cal_temp=35.0) * RAD_TO_DEG
+        assert np.allclose(got, want, atol=1e-12)
+    assert installed_calibration({"TC_G_ENABLE": 0}, "px4") is None
+    assert installed_calibration({}, "ardupilot") is None
+    with pytest.raises(InputError, match=r"autopilot: 'betaflight'; use px4 or ardupilot"):
+        installed_calibration({}, "betaflight")
+    with pytest.raises(InputError, match=r"TC_G0_TMIN 50 is not below TC_G0_TMAX 10"):
+        installed_calibration({"TC_G_ENABLE": 1, "TC_G0_TMIN": 50.0, "TC_G0_TMAX": 10.0}, "px4")
+
+
+def test_a_logs_installed_calibration_is_read_from_its_parameters(tmp_path):
+    """A ULog carrying TC_G* parameters: read() keeps them, and the installed calibration removes the drift that
+    PX4's formula put into the (simulated) raw sensor_gyro."""
+    from gyrocomp import apply, read
+    from gyrocomp.export.autopilot import installed_calibration, px4_parameters
+
+    from ..io.log_writers import write_ulog
+
+    model = _model(3)
+    params = px4_parameters(model, instance=0).values
+    n = 2000
+    temperature = np.linspace(model.axes["gyro_x"].temperature.t_min_degc,
+                              model.axes["gyro_x"].temperature.t_max_degc, n)
+    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 100_000).astype(np.uint64)),
+              "device_id": ("uint32_t", np.full(n, 7, np.uint32)),
+              "temperature": ("float", temperature.astype(np.float32))}
+    for j, axis in enumerate("xyz"):
+        fields[axis] = ("float", px4_offset_rad_s(params, 0, j, temperature).astype(np.float32))
+    write_ulog(tmp_path / "tc.ulg", {("sensor_gyro", 0): fields},
+               parameters={k: (int(v) if k.endswith(("ENABLE", "_ID")) else float(v)) for k, v in params.items()
+                           if k.startswith("TC_G")})
+    rec = read(tmp_path / "tc.ulg")
+    installed = installed_calibration(rec.metadata["autopilot_parameters"], "px4")
+    assert np.max(np.abs(apply(installed, rec).gyro_dps)) < 1e-4  # float32 logging, nothing else left
+
+
+def test_evaluate_installed_judges_the_autopilots_calibration_against_the_model(tmp_path):
+    """A ULog whose raw sensor_gyro drifts as a gyrocomp model says, written twice: once with that model's PX4
+    parameters installed, once with a stale calibration (slopes halved). The installed residual is the model's in
+    the first, and in the second stays between the model's and raw."""
+    from gyrocomp.evaluation import compare_installed
+    from gyrocomp import read
+    from gyrocomp.export.autopilot import px4_parameters
+
+    from ..io.log_writers import write_ulog
+
+    model = _model(3)
+    model.save(tmp_path / "model.json")
+    params = px4_parameters(model, instance=0).values
+    n = 6000
+    curve = model.axes["gyro_x"].temperature
+    temperature = np.linspace(curve.t_min_degc, curve.t_max_degc, n)
+    rng = np.random.default_rng(3)
+    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 200_000).astype(np.uint64)),
+              "device_id": ("uint32_t", np.full(n, 7, np.uint32)),
+              "temperature": ("float", temperature.astype(np.float32))}
+    for j, axis in enumerate("xyz"):
+        drift = px4_offset_rad_s(params, 0, j, temperature) + 2e-5 * rng.standard_normal(n)
+        fields[axis] = ("float", drift.astype(np.float32))
+    installed = {k: (int(v) if k.endswith(("ENABLE", "_ID")) else float(v)) for k, v in params.items()
+                 if k.startswith("TC_G")}
+    stale = {k: (0.5 * v if "_X1_" in k or "_X2_" in k or "_X3_" in k else v) for k, v in installed.items()}
+    write_ulog(tmp_path / "good.ulg", {("sensor_gyro", 0): fields}, parameters=installed)
+    write_ulog(tmp_path / "stale.ulg", {("sensor_gyro", 0): fields}, parameters=stale)
+    good = compare_installed(model, read(tmp_path / "good.ulg"))
+    assert good.autopilot == "px4" and good.installed.startswith("installed px4 cubic") and not good.still_only
+    for axis in good.raw_dps:
+        assert good.installed_dps[axis] == pytest.approx(good.model_dps[axis], rel=0.05)
+        assert good.installed_dps[axis] < good.raw_dps[axis] / 20
+    bad = compare_installed(model, read(tmp_path / "stale.ulg"))
+    for axis in bad.raw_dps:
+        assert bad.model_dps[axis] * 5 < bad.installed_dps[axis] < bad.raw_dps[axis]
+    result = run("evaluate", tmp_path / "model.json", tmp_path / "stale.ulg", "--installed")
+    assert result.returncode == 0, result.stderr
+    assert "stale.ulg: installed px4 cubic (TC_G0_*) vs the model, on all" in result.stdout
+    as_json = run("evaluate", tmp_path / "model.json", tmp_path / "stale.ulg", "--installed", "--json")
+    assert '"autopilot": "px4"' in as_json.stdout
+    csv = tmp_path / "table.csv"
+    csv.write_text("time,gyro_x,gyro_y,gyro_z,temperature\n0,0,0,0,20\n1,0,0,0,21\n")
+    refused = run("evaluate", tmp_path / "model.json", csv, "--installed")
+    assert refused.returncode == 2 and "not a PX4 ULog or ArduPilot DataFlash log" in refused.stderr

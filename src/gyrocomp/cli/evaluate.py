@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 
 import click
 
@@ -11,9 +13,13 @@ from ..errors import InputError
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
-from ..evaluation import evaluate_stages
+from ..evaluation import compare_installed, evaluate_stages
 from .common import float_list, pop_read_options, read_run, read_options
-from .render import print_comparison, print_evaluation, print_stages
+from .render import print_comparison, print_evaluation, print_installed, print_stages
+
+
+def _nan_none(value):
+    return None if isinstance(value, float) and math.isnan(value) else value
 
 
 @click.command()
@@ -30,12 +36,17 @@ from .render import print_comparison, print_evaluation, print_stages
 @click.option("--stages", is_flag=True,
               help="Report each stage of MODEL (the thesis's Table 4.4): raw, temperature only, + acceleration, "
                    "+ hysteresis.")
+@click.option("--installed", is_flag=True,
+              help="RUNS are PX4/ArduPilot logs: judge the thermal calibration installed on the vehicle (TC_G*, "
+                   "INS_TCAL* parameters in the log) against MODEL on the same data (the still segments of a log "
+                   "that moves).")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
 @click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
               help="A rate table's schedule for the RUNS it names (as for fit): adds their rate error.")
 @read_options
 @click.pass_context
-def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, as_json, rate_schedule, **kwargs):
+def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, installed, as_json, rate_schedule,
+             **kwargs):
     """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.
 
     With --compare, no model is given: the methods of the reference thesis are fitted on the runs and compared.
@@ -69,6 +80,13 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
             click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
         elif not ctx.obj["quiet"]:
             print_stages(staged)
+        return
+    if installed:
+        results = [compare_installed(calibration, read_run(path, opts).recording, window_s=window_s) for path in runs]
+        if as_json:
+            click.echo(json.dumps({"runs": [dataclasses.asdict(r) for r in results]}, indent=2, default=_nan_none))
+        elif not ctx.obj["quiet"]:
+            print_installed(results)
         return
     recordings = [read_run(path, opts).recording for path in runs]
     if rate_schedule is not None:

@@ -153,7 +153,7 @@ def _record_document(record) -> dict:
             "verdict": record.verdict, "failures": [f.figure + " " + f.reason for f in record.failures],
             "input_hash": record.input_hash, "inputs": [{"path": i.path, "sha256": i.sha256} for i in record.inputs],
             "metadata": record.metadata, "gyrocomp_version": record.gyrocomp_version,
-            "figures": json.loads(json.dumps(record.figures.to_dict()).replace("NaN", "null")),
+            "figures": record.figures.to_dict(),
             "warnings": list(record.warnings), "model": json.loads(record.model_json)}
 
 

@@ -32,6 +32,28 @@ def print_fit(calibration: Calibration, output) -> None:
             _print_triad(console, name, triad)
 
 
+def print_installed(results) -> None:
+    """The installed autopilot calibration against the model, per log and axis (residual RMS)."""
+    console = make_console()
+    for r in results:
+        where = (f"{r.data_s / 60:.1f} min of still segments" if r.still_only else f"all {r.data_s / 60:.1f} min")
+        console.print(f"{Path(r.file).name}: {r.installed or f'no {r.autopilot} thermal calibration installed'} vs "
+                      f"the model, on {where} (residual RMS of the {r.window_s:.3g} s moving average, deg/s)")
+        table = Table()
+        for col in ("axis", "raw" + (" (corrected onboard)" if r.corrected_onboard else ""), "installed", "model"):
+            table.add_column(col, justify="right")
+        for axis in r.raw_dps:
+            table.add_row(axis, *(_number(v[axis]) for v in (r.raw_dps, r.installed_dps, r.model_dps)))
+        console.print(table)
+        if r.corrected_onboard:
+            console.print("the logged data are already corrected onboard: the model would correct them twice "
+                          "(log the raw sensor, or disable the onboard calibration)")
+
+
+def _number(value: float) -> str:
+    return "-" if value != value else f"{value:.5g}"
+
+
 def print_contributions(contributions) -> None:
     """What each field log gave the fit: still minutes and segments, and the temperature range they cover."""
     table = Table(title="field logs: still data used")

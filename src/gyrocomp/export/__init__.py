@@ -1,7 +1,8 @@
 """Calibrations and noise figures out, in the formats other tools read."""
 
-from .autopilot import ardupilot_parameters, ardupilot_params_file, px4_parameters, px4_params_file
+from .autopilot import (ardupilot_parameters, ardupilot_params_file, installed_calibration, px4_parameters,
+                        px4_params_file)
 from .kalibr import KalibrImu, kalibr_imu, kalibr_imu_yaml
 
-__all__ = ["KalibrImu", "ardupilot_parameters", "ardupilot_params_file", "kalibr_imu", "kalibr_imu_yaml",
+__all__ = ["KalibrImu", "ardupilot_parameters", "ardupilot_params_file", "installed_calibration", "kalibr_imu", "kalibr_imu_yaml",
            "px4_parameters", "px4_params_file"]

@@ -25,20 +25,16 @@ place in either autopilot: they are left out with a warning that says how much c
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
+from ..installed import ARDUPILOT_SCALE, ARDUPILOT_TEMP_REFERENCE_DEGC, AXIS_INDEX, DEG_TO_RAD, installed_calibration
 from ..errors import DataQualityWarning, InputError
 from ..units import STANDARD_GRAVITY_M_PER_S2
 
-DEG_TO_RAD = math.pi / 180.0
-ARDUPILOT_TEMP_REFERENCE_DEGC = 35.0
-ARDUPILOT_SCALE = 1.0e6
-AXIS_INDEX = {"gyro_x": 0, "gyro_y": 1, "gyro_z": 2}
 ACCEL_INDEX = {"accel_x": 0, "accel_y": 1, "accel_z": 2}
 G_TO_M_PER_S2 = STANDARD_GRAVITY_M_PER_S2
 GRID_POINTS = 401
@@ -231,4 +227,4 @@ def ardupilot_params_file(calibration: Calibration, **options) -> str:
 
 
 __all__ = ["AutopilotParameters", "CubicFit", "accel_offsets_and_scales", "ardupilot_parameters", "ardupilot_params_file", "cubic_of",
-           "px4_parameters", "px4_params_file"]
+           "installed_calibration", "px4_parameters", "px4_params_file"]

@@ -87,14 +87,19 @@ class UnitFigures:
         return row
 
     def to_dict(self) -> dict:
-        return {"axes": {a: asdict(f) for a, f in self.axes.items()}, "temperature_min_degc": self.temperature_min_degc,
-                "temperature_max_degc": self.temperature_max_degc, "runs": self.runs}
+        """The figures as a JSON document (a figure not measured, NaN, as null)."""
+        def number(v):
+            return None if isinstance(v, float) and math.isnan(v) else v
+        return {"axes": {a: {k: number(v) for k, v in asdict(f).items()} for a, f in self.axes.items()},
+                "temperature_min_degc": number(self.temperature_min_degc),
+                "temperature_max_degc": number(self.temperature_max_degc), "runs": self.runs}
 
     @classmethod
     def from_dict(cls, d: dict) -> "UnitFigures":
-        return cls({a: AxisFigures(**{k: float(v) if v is not None else math.nan for k, v in f.items()})
-                    for a, f in d["axes"].items()},
-                   float(d["temperature_min_degc"]), float(d["temperature_max_degc"]), int(d["runs"]))
+        def number(v):
+            return math.nan if v is None else float(v)
+        return cls({a: AxisFigures(**{k: number(v) for k, v in f.items()}) for a, f in d["axes"].items()},
+                   number(d["temperature_min_degc"]), number(d["temperature_max_degc"]), int(d["runs"]))
 
 
 def unit_figures(calibration: Calibration, recordings: list[Recording], *,

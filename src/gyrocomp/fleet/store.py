@@ -233,20 +233,13 @@ def _to_row(record: CalibrationRecord) -> dict:
         "inputs": json.dumps([[i.path, i.sha256] for i in record.inputs]),
         "unit_metadata": json.dumps(dict(record.metadata)), "gyrocomp_version": record.gyrocomp_version,
         "model": record.model_json,
-        "figures": None if record.figures is None else json.dumps(_without_nan(record.figures.to_dict())),
+        "figures": None if record.figures is None else json.dumps(record.figures.to_dict()),
         "error": record.error, "warnings": json.dumps(list(record.warnings)),
     }
 
 
 def _json_float(value):
     return None if isinstance(value, float) and math.isnan(value) else value
-
-
-def _without_nan(value):
-    """``value`` with every NaN as None (JSON has no NaN; other readers of the database must parse it)."""
-    if isinstance(value, dict):
-        return {k: _without_nan(v) for k, v in value.items()}
-    return _json_float(value)
 
 
 def _from_row(row) -> CalibrationRecord:

@@ -232,4 +232,5 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature,
                          {"path": str(path), "format": "dataflash", "record": record, "instance": instance,
+                          "autopilot_parameters": {k: v for k, v in params.items() if k.startswith("INS_TCAL")},
                           "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0})

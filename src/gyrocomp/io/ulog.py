@@ -162,6 +162,8 @@ def _warn_if_corrected(path: Path, topic: str, parameters: dict, metadata: dict)
     corrected data would correct twice."""
     enabled = int(parameters.get("TC_G_ENABLE", 0)) == 1
     metadata["px4_thermal_compensation"] = enabled
+    # the installed thermal calibration, to judge it (gyrocomp.export.installed_calibration)
+    metadata["autopilot_parameters"] = {k: float(v) for k, v in parameters.items() if k.startswith("TC_G")}
     metadata["corrected_onboard"] = enabled and topic != "sensor_gyro"
     if metadata["corrected_onboard"]:
         warnings.warn(f"{path}: TC_G_ENABLE = 1: {topic} is already corrected by PX4's thermal compensation; a "
