@@ -182,7 +182,7 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
     def residual(model: Calibration | None) -> dict[str, float]:
         if model is None:
             return {a: float("nan") for a in data.gyro_axes}
-        evaluation = evaluate_run(data, data if model is None else apply(model, data), window_s=window)
+        evaluation = evaluate_run(data, apply(model, data), window_s=window)
         return {a: m.residual_rms_dps for a, m in evaluation.axes.items()}
 
     raw = {a: m.residual_rms_dps for a, m in evaluate_run(data, data, window_s=window).axes.items()}
