@@ -169,21 +169,27 @@ class StillnessState:
     def _cut(self, final: bool) -> None:
         if not self._pending:
             return
-        time_s, gyro, accel, temperature, gaps = (
-            np.concatenate(part) if part[0] is not None else None for part in zip(*self._pending))
+        time_s, gyro, accel, temperature, gaps = (  # one chunk pending (a whole log): used as it is, not copied
+            None if part[0] is None else part[0] if len(part) == 1 else np.concatenate(part)
+            for part in zip(*self._pending))
         w = self.block_samples
-        start = 0
         n = time_s.size
-        while start < n:
-            stop = min(start + w, n)
-            gap_at = np.flatnonzero(gaps[start + 1:stop])
-            if gap_at.size:
-                stop = start + 1 + int(gap_at[0])
-            elif stop - start < w and not final:
-                break
-            self._done.append(_block(time_s, gyro, accel, temperature, start, stop, self._seen + start, w,
-                                     bool(gaps[start]) and self._seen + start > 0))
-            start = stop
+        # a block ends every w samples from the last block's start, or early, before a gap
+        ends = np.append(np.flatnonzero(gaps[1:]) + 1, n)
+        start = 0
+        for end in ends:
+            if start >= end:
+                continue
+            whole = (end - start) // w  # full blocks, all at once
+            if whole:
+                self._done.append(_blocks(time_s, gyro, accel, temperature, start, whole, w, self._seen, gaps, w))
+                start += whole * w
+            if start < end:  # a short block: closed by the gap, or the log's end when final
+                if end == n and not final:
+                    break
+                self._done.append(_blocks(time_s, gyro, accel, temperature, start, 1, end - start, self._seen, gaps,
+                                          w))
+                start = end
         self._seen += start
         rest = slice(start, None)
         self._pending = [] if start >= n else [(time_s[rest], gyro[rest], None if accel is None else accel[rest],
@@ -196,41 +202,53 @@ class StillnessState:
 
 
 def _detrended_variance(x: np.ndarray) -> np.ndarray:
-    """Variance of each column of ``x`` (m, k) about its least-squares line in the sample index, m - 2 degrees of
-    freedom (inf for m < 3): a bias drifting with temperature within a block is not noise."""
-    m = x.shape[0]
+    """Variance of each column of each block of ``x`` (blocks, m, k) about its least-squares line in the sample
+    index, m - 2 degrees of freedom (inf for m < 3): a bias drifting with temperature within a block is not
+    noise."""
+    m = x.shape[1]
     if m < 3:
-        return np.full(x.shape[1], np.inf)
+        return np.full((x.shape[0], x.shape[2]), np.inf)
     i = np.arange(m) - (m - 1) / 2
-    e = x - x.mean(axis=0)
-    slope = (i @ e) / (i @ i)
-    return np.maximum(np.einsum("ij,ij->j", e, e) - slope ** 2 * (i @ i), 0.0) / (m - 2)
+    e = x - x.mean(axis=1, keepdims=True)
+    slope = np.einsum("j,bjk->bk", i, e) / (i @ i)
+    return np.maximum(np.einsum("bjk,bjk->bk", e, e) - slope ** 2 * (i @ i), 0.0) / (m - 2)
 
 
-def _block(time_s, gyro, accel, temperature, start: int, stop: int, first: int, w: int, after_gap: bool) -> tuple:
-    sl = slice(start, stop)
-    count = stop - start
-    return (time_s[start], time_s[stop - 1], first, count, count == w, after_gap,
-            gyro[sl].mean(axis=0), _detrended_variance(gyro[sl]),
-            None if accel is None else accel[sl].mean(axis=0),
-            None if accel is None else _detrended_variance(accel[sl]),
-            None if temperature is None else float(temperature[sl].mean()),
-            None if temperature is None else float(temperature[sl].min()),
-            None if temperature is None else float(temperature[sl].max()))
+def _blocks(time_s, gyro, accel, temperature, start: int, count: int, length: int, seen: int, gaps: np.ndarray,
+            w: int) -> dict:
+    """Statistics of ``count`` consecutive blocks of ``length`` samples from ``start`` (``w``: a full block's
+    length; ``seen``: samples before this buffer)."""
+    sl = slice(start, start + count * length)
+
+    def blocked(x):
+        return x[sl].reshape(count, length, -1)
+
+    firsts = np.arange(count) * length + start
+    temps = None if temperature is None else blocked(temperature).reshape(count, -1)
+    return {
+        "start_s": time_s[firsts], "stop_s": time_s[firsts + length - 1], "first": seen + firsts,
+        "count": np.full(count, length), "whole": np.full(count, length == w),
+        "after_gap": gaps[firsts] & (seen + firsts > 0),
+        "gyro_mean": blocked(gyro).mean(axis=1), "gyro_var": _detrended_variance(blocked(gyro)),
+        "accel_mean": None if accel is None else blocked(accel).mean(axis=1),
+        "accel_var": None if accel is None else _detrended_variance(blocked(accel)),
+        "temperature": None if temps is None else np.column_stack([temps.mean(axis=1), temps.min(axis=1),
+                                                                   temps.max(axis=1)]),
+    }
 
 
-def _stack(done: list, w: int) -> BlockStats:
+def _stack(done: list[dict], w: int) -> BlockStats:
     if not done:
         empty = np.zeros(0)
         return BlockStats(empty, empty, empty.astype(int), empty.astype(int), empty.astype(bool), empty.astype(bool),
                           np.zeros((0, 1)), np.zeros((0, 1)), None, None, None, w)
-    cols = list(zip(*done))
-    array = np.asarray
-    return BlockStats(array(cols[0]), array(cols[1]), array(cols[2]), array(cols[3]), array(cols[4]), array(cols[5]),
-                      np.vstack(cols[6]), np.vstack(cols[7]),
-                      None if cols[8][0] is None else np.vstack(cols[8]),
-                      None if cols[9][0] is None else np.vstack(cols[9]),
-                      None if cols[10][0] is None else np.column_stack([cols[10], cols[11], cols[12]]), w)
+
+    def joined(key):
+        return None if done[0][key] is None else np.concatenate([d[key] for d in done])
+
+    return BlockStats(joined("start_s"), joined("stop_s"), joined("first"), joined("count"), joined("whole"),
+                      joined("after_gap"), joined("gyro_mean"), joined("gyro_var"), joined("accel_mean"),
+                      joined("accel_var"), joined("temperature"), w)
 
 
 def _noise_level(variance: np.ndarray, usable: np.ndarray, w: int, quantile: float) -> np.ndarray:
