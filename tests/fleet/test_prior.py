@@ -150,3 +150,10 @@ def test_fit_with_prior_refuses_runs_without_temperature(prior):
         fit_with_prior(replace(rec, temperature_degc=None), prior)
     with pytest.raises(InputError, match=r"block_s: must be positive, got 0"):
         fit_with_prior(rec, prior, block_s=0)
+
+
+def test_a_temperature_column_per_axis_is_read_as_each_axis_own(prior):
+    rec = _short_run(NEW_UNITS[0], 1)
+    from dataclasses import replace
+    per_axis = replace(rec, temperature_degc=np.column_stack([rec.temperature_degc] * 3))
+    assert fit_with_prior(per_axis, prior).axes == fit_with_prior(rec, prior).axes

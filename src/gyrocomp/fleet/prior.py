@@ -171,13 +171,13 @@ def _median_or_zero(values: list[float]) -> float:
 def _blocks(recording: Recording, axis: str, lag_s: float, block_s: float):
     """Block means of the rate and the lagged temperature, and each block's duration [s]."""
     t = recording.time_s
-    temperature = recording.temperature_degc
+    temperature = recording.temperature_for(axis)  # the axis's own column when the log has one per axis
     if lag_s > 0:
         temperature = thermal_lag(t, temperature, lag_s)[0]
     index = np.floor((t - t[0]) / block_s).astype(np.int64)
     counts = np.bincount(index)
     used = counts > 0
-    rate = recording.gyro_dps[:, recording.gyro_axes.index(axis)]
+    rate = recording.gyro(axis)
     mean_rate = np.bincount(index, weights=rate)[used] / counts[used]
     mean_temperature = np.bincount(index, weights=temperature)[used] / counts[used]
     return mean_rate, mean_temperature, counts[used] / recording.rate_hz
