@@ -20,7 +20,7 @@ LAYERS = (
     ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),
     ("calibration", ("calibration", "triad", "installed")),
     ("compensate", ("compensate",)),
-    ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration",
+    ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration", "models.online",
                  "models.triad_fit", "models.pose_rotation")),
     ("pipelines", ("models.pipelines", "models")),
     ("evaluation", ("evaluation", "comparison", "validation")),

@@ -41,6 +41,7 @@ _EXPORTS = {
     "validate": ("validation", "validate"),
     "detect_still": ("stillness", "detect_still"), "StillnessState": ("stillness", "StillnessState"),
     "field_recordings": ("models.field", "field_recordings"),
+    "OnlineCalibrator": ("models.online", "OnlineCalibrator"), "LearnerSettings": ("models.online", "LearnerSettings"),
 }
 
 

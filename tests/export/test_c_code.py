@@ -190,10 +190,13 @@ def test_the_two_files_are_written_both_or_neither(tmp_path):
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, temperature=2, hysteresis="none", acceleration="none")
     (tmp_path / "gyrocomp.h").write_text("old header\n")
-    (tmp_path / "gyrocomp.c").mkdir()  # the second file cannot be written
-    with pytest.raises(InputError, match=r"gyrocomp.c: is a folder"):
+    (tmp_path / "gyrocomp_learn.c").mkdir()  # the last file cannot be written
+    with pytest.raises(InputError, match=r"gyrocomp_learn.c: is a folder"):
         write_c_sources(cal, tmp_path)
     assert (tmp_path / "gyrocomp.h").read_text() == "old header\n"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["gyrocomp.c", "gyrocomp.h"]  # no temporary left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gyrocomp.h", "gyrocomp_learn.c"]  # no temporary left
     written = write_c_sources(cal, tmp_path / "new")
-    assert [p.name for p in written] == ["gyrocomp.h", "gyrocomp.c"] and "#ifndef" in written[0].read_text()
+    assert [p.name for p in written] == ["gyrocomp.h", "gyrocomp.c", "gyrocomp_learn.h", "gyrocomp_learn.c"]
+    assert "#ifndef" in written[0].read_text() and "gyrocomp_learn_step" in written[3].read_text()
+    assert [p.name for p in write_c_sources(cal, tmp_path / "alone", with_learner=False)] == ["gyrocomp.h",
+                                                                                               "gyrocomp.c"]

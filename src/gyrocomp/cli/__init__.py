@@ -33,6 +33,8 @@ COMMANDS = {
     "simulate": ("simulate", 'Simulate calibration runs of a sensor preset through a test profile, with the exact truth.'),
     "fit": ("fit", 'Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still '
                    'moments of field logs.'),
+    "learn": ("learn", 'Learn a temperature model from the still moments of LOGS, as the online learner would on the '
+                       'vehicle: each log one power-on, replayed in the order given.'),
     "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's "

@@ -17,7 +17,7 @@ EXPORT_FORMATS = ("px4", "ardupilot", "c")
 @click.argument("model", type=click.Path())
 @click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), required=True,
               help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters), "
-                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o).")
+                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o, with the online learner beside them: gyrocomp_learn.h, gyrocomp_learn.c).")
 @click.option("-o", "--output", required=True, type=click.Path(), help="Parameter file to write (c: a folder).")
 @click.option("--rate", "rate_hz", type=float, default=None,
               help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")

@@ -68,6 +68,27 @@ def print_contributions(contributions) -> None:
     make_console().print(table)
 
 
+def print_learner(learner, contributions, output) -> None:
+    """What each replayed log gave the online learner, and the model it learned."""
+    table = Table(title="logs replayed (each one power-on)")
+    for col in ("log", "length [min]", "still used [min]", "rejected pieces", "temperature [degC]"):
+        table.add_column(col)
+    for c in contributions:
+        table.add_row(Path(c.source).name, f"{c.duration_s / 60:.1f}", f"{c.still_s / 60:.1f}", str(c.rejected),
+                      f"{c.temperature_min_degc:.1f} .. {c.temperature_max_degc:.1f}")
+    console = make_console()
+    console.print(table)
+    st = learner.status
+    console.print(f"learned: curve of degree {st.degree} in the temperature through a {st.lag_time_constant_s:g} s lag, "
+                  f"{st.t_min_degc:.1f}..{st.t_max_degc:.1f} degC, from {st.still_s / 60:.1f} still minutes of "
+                  f"{st.sessions} power-on(s) ({st.points} points, {st.rejected_outliers} outliers and "
+                  f"{st.rejected_bound} out-of-bound pieces rejected)")
+    console.print("residual RMS [deg/s]: " + ", ".join(f"{a} {v:.4f}" for a, v in zip("xyz", st.rms_dps))
+                  + "; standard error of the model [deg/s]: "
+                  + ", ".join(f"{a} {v:.4f}" for a, v in zip("xyz", st.uncertainty_dps)))
+    console.print(f"wrote {output}")
+
+
 def _print_triad(console, name: str, triad) -> None:
     """K (and its standard errors) of a triad, with its scale-factor errors in ppm."""
     table = Table(title=f"{name} scale factor and misalignment ({triad.method}"

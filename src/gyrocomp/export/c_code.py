@@ -1,4 +1,5 @@
-"""The whole model as dependency-free C99 for firmware: ``gyrocomp.h`` and ``gyrocomp.c``.
+"""The whole model as dependency-free C99 for firmware: ``gyrocomp.h`` and ``gyrocomp.c`` (and, beside them, the
+online learner: :mod:`gyrocomp.export.c_learner`).
 
 Interface (``gyrocomp_state`` is defined in the header, so callers allocate it; no dynamic memory)::
 
@@ -32,7 +33,9 @@ from ..errors import InputError
 from ..io.atomic import write_texts_atomic
 from ..models.mlp import MLPBias, layer_shapes
 from ..models.temperature import PolynomialBias
+from ..models.online import LearnerSettings
 from ..triad import TriadCalibration
+from .c_learner import learner_c_sources
 
 AXES = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL = ("accel_x", "accel_y", "accel_z")
@@ -327,13 +330,18 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
     return {"gyrocomp.h": _HEADER.replace("{model}", repr(calibration.model)), "gyrocomp.c": "\n".join(body)}
 
 
-def write_c_sources(calibration: Calibration, folder: str | os.PathLike, *, rate_hz: float | None = None) -> list[Path]:
-    """Write gyrocomp.h and gyrocomp.c (:func:`c_sources`) into ``folder`` (created if needed), both or
-    neither: a write that fails leaves the files there as they were. Returns the paths written."""
+def write_c_sources(calibration: Calibration, folder: str | os.PathLike, *, rate_hz: float | None = None,
+                    learner: LearnerSettings | None = None, with_learner: bool = True) -> list[Path]:
+    """Write gyrocomp.h and gyrocomp.c (:func:`c_sources`) into ``folder`` (created if needed), with the online
+    learner beside them (gyrocomp_learn.h and gyrocomp_learn.c, :func:`learner_c_sources` with ``learner``'s
+    settings, the defaults when None) unless ``with_learner`` is false; all or none: a write that fails leaves the
+    files there as they were. Returns the paths written."""
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise InputError(f"{folder}: the C export writes a folder (gyrocomp.h, gyrocomp.c); this is a file")
     sources = c_sources(calibration, rate_hz=rate_hz)
+    if with_learner:
+        sources.update(learner_c_sources(learner))
     folder.mkdir(parents=True, exist_ok=True)
     return write_texts_atomic(folder, sources)
 
