@@ -38,7 +38,7 @@ def _drift(calibration, recording) -> float:
     """Mean over the axes of the RMS of the 60 s moving average about its mean (at rest the truth is 0)."""
     compensated = recording if calibration is None else apply(calibration, recording)
     return float(np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz))
-                          for j in range(3)]))
+                          for j in range(compensated.gyro_dps.shape[1])]))
 
 
 def _field_logs(count: int, rate_hz: float, first_seed: int = 100):
@@ -364,3 +364,22 @@ def test_learn_through_the_command_line(tmp_path):
     assert not (tmp_path / "none.json").exists()
     done = run("learn", paths[0], "-o", tmp_path / "x.json", "--save-state", tmp_path / "x.json")
     assert done.returncode == 2 and "--save-state" in done.stderr
+
+
+def test_a_single_axis_gyro_learns_its_axis():
+    """The thesis's ADXRS450 (gyro_z only): the missing axes read nothing and are never tested; the model file
+    holds gyro_z alone and removes most of its drift on a held-out chamber run (measured: 0.143 -> 0.013 deg/s)."""
+    logs = [simulate("adxrs450", profile=get_profile("field", motion_seed=k), rate_hz=5.0, seed=10 + k).recording
+            for k in range(4)]
+    held_out = simulate("adxrs450", profile=resolve_profile("chamber", "adxrs450", set_points_degc=(20.0, 45.0)),
+                        rate_hz=5.0, duration_s=3600, seed=30).recording
+    learner = OnlineCalibrator(5.0)
+    contributions = replay(learner, logs)
+    assert {c.gyro_axes for c in contributions} == {("gyro_z",)}
+    model = learner.to_calibration(axes=["gyro_z"])
+    assert list(model.axes) == ["gyro_z"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert _drift(model, held_out) < _drift(None, held_out) / 5
+    with pytest.raises(InputError, match="axes: some of gyro_x, gyro_y, gyro_z"):
+        learner.to_calibration(axes=["accel_x"])

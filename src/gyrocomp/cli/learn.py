@@ -10,7 +10,7 @@ from ..errors import InputError, NotFittedError
 from ..io import refuse_to_overwrite_inputs
 from ..io.atomic import write_texts_atomic
 from ..io.files import expand_runs
-from ..models.online import LearnerSettings, OnlineCalibrator, replay
+from ..models.online import GYRO_AXES, LearnerSettings, OnlineCalibrator, replay
 from .common import pop_read_options, read_options, read_run
 from .render import print_learner
 
@@ -57,7 +57,7 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, rate_hz
         recordings = itertools.chain([first], recordings)
     contributions = replay(learner, recordings)
     try:
-        model = learner.to_calibration()
+        model = learner.to_calibration(axes=[a for a in GYRO_AXES if any(a in c.gyro_axes for c in contributions)])
     except NotFittedError as exc:  # no still piece in any log: bad input, not a failure
         raise InputError(str(exc)) from None
     texts = {output: model.to_json()}

@@ -819,11 +819,15 @@ class OnlineCalibrator:
         leverage = np.einsum("ij,ij->i", at, np.linalg.solve(normal, at.T).T) * weights.sum() / used.size
         return tuple(float(r * math.sqrt(leverage.max())) for r in self._rms)
 
-    def to_calibration(self, *, model: str = "online", require_curve: bool = True) -> Calibration:
+    def to_calibration(self, *, model: str = "online", require_curve: bool = True,
+                       axes: Iterable[str] = GYRO_AXES) -> Calibration:
         """The learned model as a model file's :class:`Calibration` (the curve continued along its tangent past
         the range seen, its lag, the g-sensitivity, the sessions' constants as turn-on biases); ``gyrocomp apply``
-        takes it. With ``require_curve``, a learner whose still data span less than ``min_span_degc`` (constants
-        only) is refused with :class:`InputError`."""
+        takes it, for ``axes`` (those the logs had). With ``require_curve``, a learner whose still data span less
+        than ``min_span_degc`` (constants only) is refused with :class:`InputError`."""
+        axes = list(axes)
+        if not axes or any(a not in GYRO_AXES for a in axes):
+            raise InputError(f"axes: some of {', '.join(GYRO_AXES)}, got {axes!r}")
         if self._degree < 0:
             raise NotFittedError("the learner has no model yet: it has seen no still piece long enough "
                                  f"({self.settings.min_still_s:g} s) in {self._session} log(s)")
@@ -833,14 +837,16 @@ class OnlineCalibrator:
             raise InputError(f"the still data of {self._session} log(s) cover {low:.1f}..{high:.1f} degC; a temperature "
                              f"model needs at least {self.settings.min_span_degc:g} degC (min_span_degc)")
         low, high = self._t_range
-        axes = {}
+        out = {}
         for j, name in enumerate(GYRO_AXES):
+            if name not in axes:
+                continue
             curve = None
             if self._degree > 0:
                 curve = PolynomialBias(tuple(float(c) for c in self._coef[j, :self._degree]), T_REF_DEGC,
                                        T_SCALE_DEGC, low, high, extrapolation="linear")
             g = tuple(float(v) for v in self._g[j]) if self._tilted.any() else None
-            axes[name] = AxisCalibration(temperature=curve, g_sensitivity_dps_per_g=g,
+            out[name] = AxisCalibration(temperature=curve, g_sensitivity_dps_per_g=g,
                                          lag_time_constant_s=self.lag_time_constant_s,
                                          turn_on_biases_dps=tuple(float(c) for c in self._constants[:, j]))
         status = self.status
@@ -848,7 +854,7 @@ class OnlineCalibrator:
                   "still_s": status.still_s, "degree": self._degree,
                   "rejected": status.rejected_bound + status.rejected_outliers,
                   "settings": self.settings.to_dict()}
-        return Calibration(axes=axes, model=model, provenance=provenance([]), fit_report=report)
+        return Calibration(axes=out, model=model, provenance=provenance([]), fit_report=report)
 
     # ---------------------------------------------------------------- state as JSON
     def to_dict(self) -> dict[str, Any]:
@@ -927,10 +933,11 @@ def _fresh_dequantizer() -> dict:
 
 @dataclass(frozen=True)
 class LogContribution:
-    """What one replayed log gave the learner: its length [s], the still time accepted [s], the pieces rejected
-    (beyond the bound or as outliers) and the temperature range of the log [degC]."""
+    """What one replayed log gave the learner: its gyro axes, its length [s], the still time accepted [s], the
+    pieces rejected (beyond the bound or as outliers) and the temperature range of the log [degC]."""
 
     source: str
+    gyro_axes: tuple[str, ...]
     duration_s: float
     still_s: float
     rejected: int
@@ -951,14 +958,16 @@ def replay(learner: OnlineCalibrator, recordings: Iterable[Recording], *, chunk_
     for rec in recordings:
         if rec.temperature_degc is None:
             raise InputError(f"{rec.source}: no temperature; the learner learns the bias against temperature")
-        missing = [a for a in GYRO_AXES if a not in rec.gyro_axes]
-        if missing:
-            raise InputError(f"{rec.source}: no {', '.join(missing)}; the learner needs the three gyro axes")
+        if not any(a in rec.gyro_axes for a in GYRO_AXES):
+            raise InputError(f"{rec.source}: none of {', '.join(GYRO_AXES)}; the learner learns those axes")
         rate = learner.settings.rate_hz
         if abs(rec.rate_hz - rate) > RATE_TOLERANCE * rate:
             raise InputError(f"{rec.source}: sampled at {rec.rate_hz:.4g} Hz; the learner was set up for {rate:.4g} Hz "
                              "(rate_hz): its blocks and gaps count samples at that rate")
-        gyro = rec.gyro_dps[:, [rec.gyro_axes.index(a) for a in GYRO_AXES]]
+        gyro = np.zeros((rec.n_samples, 3))  # an axis the log lacks reads 0: no noise, never tested, learns 0
+        for j, axis in enumerate(GYRO_AXES):
+            if axis in rec.gyro_axes:
+                gyro[:, j] = rec.gyro_dps[:, rec.gyro_axes.index(axis)]
         temperature = np.asarray(rec.temperature_degc, dtype=float)
         before = learner.status
         learner.start_session()
@@ -969,7 +978,7 @@ def replay(learner: OnlineCalibrator, recordings: Iterable[Recording], *, chunk_
         learner.end_session()
         after = learner.status
         out.append(LogContribution(
-            rec.source, rec.duration_s, after.still_s - before.still_s,
+            rec.source, tuple(a for a in GYRO_AXES if a in rec.gyro_axes), rec.duration_s, after.still_s - before.still_s,
             after.rejected_bound + after.rejected_outliers - before.rejected_bound - before.rejected_outliers,
             float(np.nanmin(temperature)), float(np.nanmax(temperature))))
     return out
@@ -1207,5 +1216,5 @@ def _restore_model(self: OnlineCalibrator, model: dict) -> None:
         "constant": _finite_array(saved["constant"], (3,), "model.saved.constant")}
 
 
-__all__ = ["LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LearnerSettings", "LearnerStatus", "LogContribution",
+__all__ = ["GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LearnerSettings", "LearnerStatus", "LogContribution",
            "OnlineCalibrator", "block_statistics", "chi2_quantile", "replay"]
