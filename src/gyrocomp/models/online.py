@@ -39,7 +39,10 @@ memory, what Android's over-temperature calibration (AOSP ``over_temp_cal``), Ar
    ``max_tempco_dps_per_degc`` for every degree it lies beyond the temperatures the model has seen: a bump, a slow
    turn read as still. After each refit the session's own points are judged the same way and those that fail are
    dropped (a bad first piece, accepted while the session's constant was unknown, goes once the session has
-   points enough), and the model is refitted.
+   points enough), and the model is refitted. The session's last POOL_PIECES rejected pieces are kept: when
+   MIN_SESSION_POINTS of them or more agree among themselves (each within max(``outlier_dps``, ``outlier_sigmas``
+   rms) of their median offset from the curve) and hold more still time than the session's points, the points
+   were the wrong ones (a power-on that began with a slow turn): they are dropped and the pieces kept.
 7. **Points** (at most ``max_points``) keep one estimate per temperature bin and session (bias [deg/s], mean
    specific force [g], the temperature through every candidate lag [degC], still time [s], and the time of the
    last update on the learner's clock, the operating time it has seen). A piece merges into its bin's point of
@@ -110,6 +113,8 @@ POINTS_PER_TILT = 3
 #: session (whose median offset is its constant)
 MIN_OUTLIER_DOF = 5
 MIN_SESSION_POINTS = 3
+#: the last rejected pieces of a session kept, to overrule its points when they agree and outweigh them
+POOL_PIECES = 4
 #: relative ridge on the normal equations' diagonal (guards a nearly singular system)
 _RIDGE = 1e-12
 GYRO_AXES = ("gyro_x", "gyro_y", "gyro_z")
@@ -326,6 +331,7 @@ class OnlineCalibrator:
         self._run_s = 0.0
         self._piece = np.zeros(7 + self._lags)  # sums of gyro (3), accelerometer (3), temperatures (lags); samples
         self._piece_bin = -1
+        self._pool: list[tuple] = []  # the session's last rejected pieces: (bin, bias, accel, temperatures, s)
 
     def _init_points(self, n: int) -> None:
         self._pt_bias = np.zeros((n, 3))
@@ -358,6 +364,7 @@ class OnlineCalibrator:
         """A new power-on: its own turn-on constant; the stream restarts (time may start again from zero)."""
         self.end_session()
         self._session += 1
+        self._pool = []
         self._accel = None
         self._last_t = None
         self._lag_t = None
@@ -617,7 +624,49 @@ class OnlineCalibrator:
             return
         if self._is_outlier(bias, accel, temperature):
             self._counts["rejected_outliers"] += 1
+            self._pool = (self._pool + [(bin_index, bias, accel, temperature, seconds)])[-POOL_PIECES:]
+            if self._pool_outvotes():
+                self._swap_for_pool(now)
             return
+        self._store(bin_index, bias, accel, temperature, seconds, now)
+        self._refit(now)
+        # the session's points judged again by the model they made: a bad first piece, accepted while its
+        # session's constant was unknown, is found once the session has points enough for a robust constant
+        mine = np.flatnonzero(self._pt_session == self._session)
+        bad = [i for i in mine if self._is_outlier(self._pt_bias[i], self._pt_accel[i], self._pt_t[i])]
+        if bad:
+            self._counts["rejected_outliers"] += len(bad)
+            self._counts["still_s"] -= float(self._pt_s[bad].sum())
+            self._pt_session[bad] = 0
+            self._refit(now)
+
+    def _pool_outvotes(self) -> bool:
+        """Whether the session's last rejected pieces agree among themselves (each within the outlier limit of
+        their median offset from the curve) and hold more still time than the session's points: then the
+        points, not the pieces, were wrong (the power-on began with a slow turn)."""
+        if len(self._pool) < MIN_SESSION_POINTS or self._degree < 0:
+            return False
+        offsets = np.array([bias - self._shape(temps[self._lag_index]) - self._g @ accel
+                            for _, bias, accel, temps, _ in self._pool])
+        limit = np.maximum(self.settings.outlier_dps, self.settings.outlier_sigmas * self._rms)
+        if np.any(np.abs(offsets - np.median(offsets, axis=0)) > limit):
+            return False
+        mine = self._pt_session == self._session
+        return sum(piece[4] for piece in self._pool) > float(self._pt_s[mine].sum())
+
+    def _swap_for_pool(self, now: float) -> None:
+        mine = np.flatnonzero(self._pt_session == self._session)
+        self._counts["rejected_outliers"] += mine.size - len(self._pool)
+        self._counts["still_s"] -= float(self._pt_s[mine].sum())
+        self._pt_session[mine] = 0
+        for piece in self._pool:
+            self._store(*piece, now)
+        self._pool = []
+        self._refit(now)
+
+    def _store(self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float,
+               now: float) -> None:
+        """A piece into its bin's point of this session, or a new point."""
         self._counts["still_s"] += seconds
         same = np.flatnonzero((self._pt_session == self._session) & (self._pt_bin == bin_index))
         if same.size:
@@ -639,16 +688,6 @@ class OnlineCalibrator:
             self._pt_s[index] = seconds
             self._pt_session[index] = self._session
         self._pt_clock[index] = now
-        self._refit(now)
-        # the session's points judged again by the model they made: a bad first piece, accepted while its
-        # session's constant was unknown, is found once the session has points enough for a robust constant
-        mine = np.flatnonzero(self._pt_session == self._session)
-        bad = [i for i in mine if self._is_outlier(self._pt_bias[i], self._pt_accel[i], self._pt_t[i])]
-        if bad:
-            self._counts["rejected_outliers"] += len(bad)
-            self._counts["still_s"] -= float(self._pt_s[bad].sum())
-            self._pt_session[bad] = 0
-            self._refit(now)
 
     def _decay(self, age_s: float) -> float:
         return 2.0 ** (-age_s / (self.settings.half_life_h * 3600.0))
@@ -871,7 +910,10 @@ class OnlineCalibrator:
                       "ring_pos": self._ring_pos.tolist(), "step_ring": self._step_ring.tolist(),
                       "step_count": self._step_count.tolist(), "step_pos": self._step_pos.tolist(),
                       "level": [None if math.isnan(v) else float(v) for v in self._level]},
-            "piece": {"run_s": self._run_s, "sums": self._piece.tolist(), "bin": self._piece_bin},
+            "piece": {"run_s": self._run_s, "sums": self._piece.tolist(), "bin": self._piece_bin,
+                      "pool": [{"bin": b, "bias_dps": list(map(float, bias)), "accel_g": list(map(float, accel)),
+                                "temperature_degc": list(map(float, temps)), "still_s": float(sec)}
+                               for b, bias, accel, temps, sec in self._pool]},
             "points": {"bias_dps": self._pt_bias.tolist(), "temperature_degc": self._pt_t.tolist(),
                      "accel_g": self._pt_accel.tolist(),
                      "still_s": self._pt_s.tolist(), "clock_s": self._pt_clock.tolist(),
@@ -1163,6 +1205,10 @@ def _restore_stream(self: OnlineCalibrator, stream: dict, piece: dict) -> None:
     self._run_s = float(piece["run_s"])
     self._piece = _finite_array(piece["sums"], (7 + self._lags,), "piece.sums")
     self._piece_bin = int(piece["bin"])
+    self._pool = [(int(p["bin"]), _finite_array(p["bias_dps"], (3,), "piece.pool.bias_dps"),
+                   _finite_array(p["accel_g"], (3,), "piece.pool.accel_g"),
+                   _finite_array(p["temperature_degc"], (self._lags,), "piece.pool.temperature_degc"),
+                   float(p["still_s"])) for p in piece["pool"][-POOL_PIECES:]]
 
 
 def _restore_noise(self: OnlineCalibrator, noise: dict) -> None:
