@@ -624,9 +624,7 @@ class OnlineCalibrator:
             return
         if self._is_outlier(bias, accel, temperature):
             self._counts["rejected_outliers"] += 1
-            self._pool = (self._pool + [(bin_index, bias, accel, temperature, seconds)])[-POOL_PIECES:]
-            if self._pool_outvotes():
-                self._swap_for_pool(now)
+            self._to_pool(bin_index, bias, accel, temperature, seconds, now)
             return
         self._store(bin_index, bias, accel, temperature, seconds, now)
         self._refit(now)
@@ -635,10 +633,22 @@ class OnlineCalibrator:
         mine = np.flatnonzero(self._pt_session == self._session)
         bad = [i for i in mine if self._is_outlier(self._pt_bias[i], self._pt_accel[i], self._pt_t[i])]
         if bad:
+            dropped = [(int(self._pt_bin[i]), self._pt_bias[i].copy(), self._pt_accel[i].copy(), self._pt_t[i].copy(),
+                        float(self._pt_s[i])) for i in bad]
             self._counts["rejected_outliers"] += len(bad)
             self._counts["still_s"] -= float(self._pt_s[bad].sum())
             self._pt_session[bad] = 0
             self._refit(now)
+            for piece in dropped:
+                self._to_pool(*piece, now)
+
+    def _to_pool(self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float,
+                 now: float) -> None:
+        """A rejected piece (or a dropped point) into the session's pool; the pool replaces the session's points
+        when it outvotes them."""
+        self._pool = (self._pool + [(bin_index, bias, accel, temperature, seconds)])[-POOL_PIECES:]
+        if self._pool_outvotes():
+            self._swap_for_pool(now)
 
     def _pool_outvotes(self) -> bool:
         """Whether the session's last rejected pieces agree among themselves (each within the outlier limit of
