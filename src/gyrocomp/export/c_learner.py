@@ -18,6 +18,7 @@ steps of a session and not others); a sample with a non-finite value breaks the 
 no g-sensitivity) with this session's constant (or the mean of the sessions' before the first piece of this one)
 and returns 0, or -1 while there is no model. ``s->should_save`` says the model changed enough to be stored.
 
+Scratch arrays are static (kept off a small firmware stack), so one learner steps at a time (not reentrant).
 The code does what :class:`gyrocomp.models.online.OnlineCalibrator` does, in the same order of operations (the
 tests feed both the same samples and compare the models to 1e-9).
 """
