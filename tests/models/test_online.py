@@ -359,6 +359,7 @@ def test_learn_through_the_command_line(tmp_path):
     assert done.returncode == 0, done.stderr
     one, two = (Calibration.load(tmp_path / n) for n in ("all.json", "second.json"))
     assert one.axes == two.axes
+    assert [entry["file"] for entry in one.provenance["inputs"]] == ["log0.csv", "log1.csv", "log2.csv"]
     assert run("-q", "apply", tmp_path / "all.json", paths[0], "-o", tmp_path / "out.csv").returncode == 0
     moving = simulate(PRESET, profile="tumble", rate_hz=10.0, duration_s=600, seed=1, unit=UNIT).recording
     write_recording(moving, tmp_path / "moving.csv")

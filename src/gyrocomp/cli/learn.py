@@ -57,7 +57,8 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, rate_hz
         recordings = itertools.chain([first], recordings)
     contributions = replay(learner, recordings)
     try:
-        model = learner.to_calibration(axes=[a for a in GYRO_AXES if any(a in c.gyro_axes for c in contributions)])
+        model = learner.to_calibration(axes=[a for a in GYRO_AXES if any(a in c.gyro_axes for c in contributions)],
+                                       contributions=contributions)
     except NotFittedError as exc:  # no still piece in any log: bad input, not a failure
         raise InputError(str(exc)) from None
     texts = {output: model.to_json()}

@@ -869,10 +869,12 @@ class OnlineCalibrator:
         return tuple(float(r * math.sqrt(leverage.max())) for r in self._rms)
 
     def to_calibration(self, *, model: str = "online", require_curve: bool = True,
-                       axes: Iterable[str] = GYRO_AXES) -> Calibration:
+                       axes: Iterable[str] = GYRO_AXES, contributions: Iterable[LogContribution] = ()
+                       ) -> Calibration:
         """The learned model as a model file's :class:`Calibration` (the curve continued along its tangent past
         the range seen, its lag, the g-sensitivity, the sessions' constants as turn-on biases); ``gyrocomp apply``
-        takes it, for ``axes`` (those the logs had). With ``require_curve``, a learner whose still data span less
+        takes it, for ``axes`` (those the logs had); ``contributions`` (from :func:`replay`) are listed in its
+        provenance. With ``require_curve``, a learner whose still data span less
         than ``min_span_degc`` (constants only) is refused with :class:`InputError`."""
         axes = list(axes)
         if not axes or any(a not in GYRO_AXES for a in axes):
@@ -903,7 +905,10 @@ class OnlineCalibrator:
                   "still_s": status.still_s, "degree": self._degree,
                   "rejected": status.rejected_bound + status.rejected_outliers,
                   "settings": self.settings.to_dict()}
-        return Calibration(axes=out, model=model, provenance=provenance([]), fit_report=report)
+        origin = provenance([])
+        origin["inputs"] = [{"file": Path(c.source).name, "duration_s": c.duration_s, "still_s": c.still_s,
+                             "rejected_pieces": c.rejected} for c in contributions]
+        return Calibration(axes=out, model=model, provenance=origin, fit_report=report)
 
     # ---------------------------------------------------------------- state as JSON
     def to_dict(self) -> dict[str, Any]:
