@@ -232,16 +232,27 @@ def test_noise_identification_and_end_to_end_intervals(data_file, data_type, res
     data, data_type, ref = stable32_case(data_file, data_type, result_file)
     res = allan_deviation(data, 1.0, kind=kind, taus=ref[:, 0], data_type=data_type)
     assert np.isfinite(res.alpha).all() and np.isfinite(res.ci_low).all()
+    tol = 5e-3 + (2e-3 if data_file.startswith("ocxo/") else 1e-4)  # plus the deviation's own tolerance
     if result_file == "Cs5071A/totdev_decade.txt":
+        # this run's noise type was fixed by its user (white FM on every row): so is ours, and the bounds agree
+        assert set(ref[:, 3]) == {0.0}
+        forced = allan_deviation(data, 1.0, kind=kind, taus=ref[:, 0], data_type=data_type, noise_alpha=0)
+        np.testing.assert_allclose(forced.ci_low, ref[:, 4], rtol=5e-3)
+        np.testing.assert_allclose(forced.ci_high, ref[:, 6], rtol=5e-3)
         return
     mismatches = {int(m) for m, ours, theirs in zip(ref[:, 0], res.alpha, ref[:, 3]) if ours != theirs}
     assert mismatches == _FEW_POINTS_DIFFER.get(result_file, set())
     agree = res.alpha == ref[:, 3]
     if kind == "totdev" and data_type == "rate":
         return  # the ocxo TOTDEV rows come from other input data (see STABLE32_FILES); alphas checked above
-    tol = 5e-3 + (2e-3 if data_file.startswith("ocxo/") else 1e-4)  # plus the deviation's own tolerance
     np.testing.assert_allclose(res.ci_low[agree], ref[agree, 4], rtol=tol)
     np.testing.assert_allclose(res.ci_high[agree], ref[agree, 6], rtol=tol)
+    # on every row, the longest taus included: with Stable32's noise type (which its user may also choose, as
+    # noise_alpha does here) the bounds agree; so where the types differ, only the identification differs
+    forced = allan_deviation(data, 1.0, kind=kind, taus=ref[:, 0], data_type=data_type, noise_alpha=ref[:, 3])
+    assert np.array_equal(forced.alpha, ref[:, 3]) and np.array_equal(forced.deviation, res.deviation)
+    np.testing.assert_allclose(forced.ci_low, ref[:, 4], rtol=5e-3)  # measured: within 3.2e-3 on every file
+    np.testing.assert_allclose(forced.ci_high, ref[:, 6], rtol=5e-3)
 
 
 def test_fewer_than_30_points_use_b1_and_rn():
@@ -263,6 +274,10 @@ def test_fewer_than_30_points_use_b1_and_rn():
     assert identify_noise_b1(np.zeros(100), 10) is None  # no variation
     assert identify_noise_b1(rng.standard_normal(4001), 2000) is None  # two averages
     assert b1_expected(20, -1) == 1.0 and b1_expected(20, 1) == pytest.approx(10.0)  # N/2 for random walk FM
+    with pytest.raises(InputError, match=r"noise_alpha: each one of 2, 1, 0, -1, -2"):
+        allan_deviation(rng.standard_normal(100), 1.0, noise_alpha=3)
+    with pytest.raises(InputError, match=r"noise_alpha: one alpha, or one per tau \(5\), got 2"):
+        allan_deviation(rng.standard_normal(100), 1.0, noise_alpha=[0, 1])
     assert b1_expected(20, -2) == pytest.approx((20 ** 2 - 1) / (1.5 * 20 * 19))
     assert rn_expected(8, 2) == 1 / 8
 

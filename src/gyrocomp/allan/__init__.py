@@ -90,7 +90,8 @@ def _as_phase(data, rate_hz: float, data_type: str, phase_out) -> tuple[np.ndarr
 
 @single_threaded_blas
 def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave", data_type: str = "rate",
-                    confidence: float | None = ONE_SIGMA, phase_out: np.ndarray | None = None) -> AllanResult:
+                    confidence: float | None = ONE_SIGMA, phase_out: np.ndarray | None = None,
+                    noise_alpha=None) -> AllanResult:
     """Allan deviation of ``data`` sampled at ``rate_hz``, with confidence intervals.
 
     Parameters
@@ -113,10 +114,15 @@ def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave",
         Where to put the integrated rate data, e.g. a memory-mapped file for data larger than memory; by
         default a new array. It receives the running sum of the rate minus its mean [unit*samples], i.e.
         the phase times ``rate_hz``.
+    noise_alpha : int or sequence of int, optional
+        The power-law noise type of the intervals (alpha of S_y(f) ~ f^alpha: 2 white PM, 1 flicker PM, 0 white
+        FM, -1 flicker FM, -2 random walk FM), one for every tau or one per tau, instead of identifying it from
+        the data (lag-1 autocorrelation, B1 ratio and R(n)); as Stable32 lets its user choose the noise type.
     """
     _check(kind, rate_hz, data_type)
     phase, scale = _as_phase(data, rate_hz, data_type, phase_out)
     ms = averaging_factors(phase.size, taus, rate_hz, kind)
+    forced = _noise_alpha(noise_alpha, len(ms))
     tau = ms / rate_hz
     counts = term_count(kind, phase.size, ms)
     deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
@@ -124,11 +130,27 @@ def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave",
         alphas = np.full(len(ms), np.nan)
         edf = alphas.copy()
     else:
-        alphas = noise_types(kind, phase, ms)
+        alphas = noise_types(kind, phase, ms) if forced is None else forced
         edf = degrees_of_freedom(kind, alphas, ms, phase.size)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
                        edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence)
+
+
+def _noise_alpha(value, count: int) -> np.ndarray | None:
+    """``noise_alpha`` as one alpha per tau (None: identify from the data)."""
+    if value is None:
+        return None
+    try:
+        values = np.atleast_1d(np.asarray(value, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"noise_alpha: whole numbers from -2 to 2, got {value!r}") from None
+    if values.ndim != 1 or values.size not in (1, count):
+        raise InputError(f"noise_alpha: one alpha, or one per tau ({count}), got {values.size}")
+    if not np.all(np.isin(values, (-2, -1, 0, 1, 2))):
+        raise InputError(f"noise_alpha: each one of 2, 1, 0, -1, -2 (white PM .. random walk FM), got "
+                         f"{values.tolist()}")
+    return np.broadcast_to(values, (count,)).astype(float)
 
 
 @single_threaded_blas
