@@ -6,13 +6,17 @@ import dataclasses
 import warnings
 
 import numpy as np
+import pyarrow as pa
 
 from .calibration import Calibration
 from .effects import find_turns, g_sensitivity_offset, thermal_lag
 from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .plausibility import recording_concerns
+from .io.stream import CHUNK_ROWS, NotStreamable, TableStream, TableWriter
+from .io.tables import TableLayout, read_table, write_gyro_back
 from .recording import ACCEL_AXES, GYRO_AXES, Recording
+from .units import unit_factor
 
 
 class Compensator:
@@ -359,3 +363,103 @@ def predict_error(calibration: Calibration, recording: Recording) -> np.ndarray:
     """Predicted deterministic error (n, k) [deg/s] for the recording's gyro axes (0 where not modelled): the
     raw output less what :func:`apply` leaves, with the mean turn-on constant of the calibration runs."""
     return recording.gyro_dps - apply(calibration, recording).gyro_dps
+
+
+@dataclasses.dataclass(frozen=True)
+class FileResult:
+    """What :func:`apply_file` wrote: the rows [count], the gyro and accelerometer axes compensated, and whether
+    it went through the file in chunks (``streamed``) or read it whole."""
+
+    rows: int
+    axes: tuple[str, ...]
+    streamed: bool
+
+
+def apply_file(calibration: Calibration, input_path, output_path, *, layout: TableLayout | None = None,
+               fmt: str | None = None, out_fmt: str | None = None, drop_nonfinite: bool = False,
+               axes: tuple[str, ...] | None = None, turn_on_window_s: float | None = None,
+               chunk_rows: int = CHUNK_ROWS) -> FileResult:
+    """Compensate a CSV or Parquet table into ``output_path`` (CSV or Parquet), chunk by chunk.
+
+    The output is what :func:`apply` and :func:`gyrocomp.io.write_gyro_back` give for the whole file (the same
+    rows and columns, the gyro columns, and the accelerometer's when the model compensates them, replaced in the
+    file's units), to the bit, but memory stays bounded by ``chunk_rows`` [rows] whatever the file's length: the
+    file is read in chunks (:class:`gyrocomp.io.stream.TableStream`), each goes through one
+    :class:`Compensator`, and the output is written as it comes, into a temporary file renamed over
+    ``output_path`` at the end. A file that cannot be read in chunks (a CSV column whose type changes after the
+    first 16 MB), or a model with accelerometer axes applied with ``turn_on_window_s``, is read whole instead.
+    """
+    if not isinstance(calibration, Calibration):
+        raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+                         f"got {type(calibration).__name__}")
+    stream = TableStream(input_path, layout, fmt=fmt, drop_nonfinite=drop_nonfinite, chunk_rows=chunk_rows)
+    try:
+        return _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s)
+    except NotStreamable:
+        data = read_table(input_path, layout, fmt=stream.fmt, drop_nonfinite=drop_nonfinite)
+        compensated = apply(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=axes)
+        accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
+        write_gyro_back(data, compensated.gyro_dps, output_path, fmt=out_fmt, accel_g=accel)
+        return FileResult(data.recording.n_samples, _compensated_axes(calibration, data.recording, axes, accel),
+                          False)
+
+
+def _compensated_axes(calibration: Calibration, recording: Recording, axes, accel) -> tuple[str, ...]:
+    done = [a for a in recording.gyro_axes if a in calibration.axes and (axes is None or a in axes)]
+    return tuple(done + (list(recording.accel_axes) if accel is not None else []))
+
+
+def _apply_stream(calibration: Calibration, stream: TableStream, output_path, out_fmt, axes,
+                  turn_on_window_s) -> FileResult:
+    gyro_factor = unit_factor("gyro", stream.layout.gyro_unit)
+    accel_factor = unit_factor("accel", stream.layout.accel_unit)
+    comp, accel_order, pending, written, first = None, None, [], 0, None
+    with TableWriter(output_path, out_fmt) as writer:
+        def flush(gyro: np.ndarray, accel: np.ndarray | None) -> None:
+            nonlocal pending, written
+            if not len(gyro):
+                return
+            rows = pa.concat_tables(pending) if len(pending) > 1 else pending[0]
+            out, rest = rows.slice(0, len(gyro)), rows.slice(len(gyro))
+            pending = [rest] if rest.num_rows else []
+            replaced = [(stream.gyro_axes, gyro, gyro_factor)]
+            if accel is not None:
+                replaced.append((stream.accel_axes, accel, accel_factor))
+            for names, values, factor in replaced:
+                for j, axis in enumerate(names):
+                    column = stream.columns[axis]
+                    out = out.set_column(out.column_names.index(column), column,
+                                         pa.array(values[:, j] / factor, type=pa.float64()))
+            writer.write(out)
+            written += out.num_rows
+
+        for chunk in stream.chunks():
+            rec = chunk.recording
+            if comp is None:
+                first = rec
+                restricted = _restricted(calibration, rec, axes)
+                for concern in recording_concerns(rec):
+                    warnings.warn(concern.warning(), stacklevel=2)
+                comp = Compensator(restricted, rec.gyro_axes, turn_on_window_s=turn_on_window_s, rate_hz=rec.rate_hz,
+                                   source=rec.source)
+                if comp.compensates_accel:
+                    if turn_on_window_s is not None:
+                        raise NotStreamable("the accelerometer is not held back with the turn-on window")
+                    if not set(ACCEL_AXES) <= set(rec.accel_axes):
+                        raise InputError(f"{rec.source}: the model compensates the accelerometer; the data needs "
+                                         "accel_x, accel_y and accel_z columns [g]")
+            accel = None
+            if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes):
+                accel = rec.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
+            rows = chunk.table if chunk.kept.size == chunk.table.num_rows else chunk.table.take(pa.array(chunk.kept))
+            pending.append(rows)
+            gyro = comp.update(rec.time_s, rec.gyro_dps, rec.temperature_degc, accel)
+            accel_out = None
+            if comp.compensates_accel:
+                accel_order = accel_order or [ACCEL_AXES.index(a) for a in rec.accel_axes]
+                accel_out = comp.take_accel()[:, accel_order]
+            flush(gyro, accel_out)
+        flush(comp.finish(), None)
+    stream.warn_summary()
+    return FileResult(written, _compensated_axes(calibration, first, axes, True if comp.compensates_accel else None),
+                      True)

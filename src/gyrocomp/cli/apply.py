@@ -7,9 +7,9 @@ from pathlib import Path
 import click
 
 from ..calibration import Calibration
-from ..compensate import apply as apply_calibration
-from ..io import detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
-from .common import pop_read_options, read_run, read_options
+from ..compensate import apply as apply_calibration, apply_file
+from ..io import TABLE_FORMATS, detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
+from .common import pop_read_options, read_run, read_options, read_settings
 
 
 @click.command()
@@ -30,15 +30,22 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
     calibration = Calibration.load(model)
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
-    data = read_run(input_path, opts)
     named = None if axes is None else tuple(a.strip() for a in axes.split(",") if a.strip())
-    compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=named)
-    accel = compensated.accel_g if calibration.accel_axes else None
-    write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt, accel_g=accel)
-    if not ctx.obj["quiet"]:
+    if in_fmt in TABLE_FORMATS:  # in chunks: memory bounded whatever the file's length
+        result = apply_file(calibration, input_path, output, layout=read_settings(opts).layout, fmt=in_fmt,
+                            out_fmt=out_fmt, drop_nonfinite=opts["drop_nan"], axes=named,
+                            turn_on_window_s=turn_on_window_s)
+        rows, done = result.rows, result.axes
+    else:
+        data = read_run(input_path, opts)
+        compensated = apply_calibration(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=named)
+        accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
+        write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt, accel_g=accel)
+        rows = data.recording.n_samples
         done = [a for a in data.recording.gyro_axes if a in calibration.axes and (named is None or a in named)]
         done += list(data.recording.accel_axes) if accel is not None else []
-        click.echo(f"wrote {output}: {data.recording.n_samples} rows, {', '.join(done)} compensated")
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}: {rows} rows, {', '.join(done)} compensated")
 
 
 __all__ = ["apply"]

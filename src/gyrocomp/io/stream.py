@@ -1,0 +1,262 @@
+"""CSV and Parquet tables read and written in chunks, so a command's memory is bounded by the chunk, whatever the
+file's length: CSV through pyarrow's streaming reader (``pyarrow.csv.open_csv``, compressed files decompressed as
+they stream), Parquet by record batches (``ParquetFile.iter_batches``), written through ``CSVWriter`` or
+``ParquetWriter`` into a temporary file renamed over the target at the end (atomic, as every output).
+
+Each chunk is validated as a whole file is (:class:`gyrocomp.Recording`: finite values, increasing time, row numbers
+of the file in the messages); time must also increase from one chunk to the next; gaps and dropped rows are counted
+over the whole file and reported once, as :func:`gyrocomp.io.read_table` reports them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import lzma
+import sys
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from ..errors import DataQualityWarning, InputError
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..units import unit_factor
+from .atomic import atomic_path
+from .tables import (_COMPRESSED, TIME_COLUMN, TableLayout, _csv_options, _numeric_column, _reference_rates,
+                     _resolved_columns, _temperature_columns, detect_table_format, keep_finite_rows, sniff_csv)
+
+#: rows per chunk (about 100 MB of numbers for an 8-column table)
+CHUNK_ROWS = 1 << 20
+#: CSV bytes parsed at once by the streaming reader (it infers the column types from the first block)
+CSV_BLOCK_BYTES = 16 << 20
+
+
+class NotStreamable(Exception):
+    """The file cannot be read in chunks as it is (a CSV column whose type changes after the first block): the
+    caller reads it whole instead."""
+
+
+@dataclass(frozen=True, eq=False)
+class TableChunk:
+    """Consecutive rows of a table: the rows as read (``table``, every column), the recording built from those
+    kept (``kept``: 0-based indices in this chunk), and the index of its first row in the file."""
+
+    table: pa.Table
+    recording: Recording
+    kept: np.ndarray
+    first_row: int
+
+
+class TableStream:
+    """A CSV or Parquet table read in chunks of about ``chunk_rows`` rows (see the module)."""
+
+    def __init__(self, path, layout: TableLayout | None = None, *, fmt: str | None = None,
+                 drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS):
+        self.path = Path(path)
+        self.layout = layout or TableLayout()
+        self.fmt = fmt or detect_table_format(self.path) or "csv"
+        if not self.path.exists():
+            raise InputError(f"{self.path}: no such file")
+        if self.path.is_dir():
+            raise InputError(f"{self.path}: is a folder, not a file")
+        if int(chunk_rows) != chunk_rows or chunk_rows < 2:
+            raise InputError(f"chunk_rows: a whole number of at least 2, got {chunk_rows!r}")
+        self.drop_nonfinite = drop_nonfinite
+        self.chunk_rows = int(chunk_rows)
+        self.schema = self._open_schema()
+        self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
+        self.gyro_axes = tuple(a for a in GYRO_AXES if a in self.columns)
+        self.accel_axes = tuple(a for a in ACCEL_AXES if a in self.columns)
+        self.rows = 0
+        self.rows_dropped = 0
+        self.gaps = 0
+        self.longest_gap: tuple[float, int] | None = None  # (duration [s], after row)
+
+    # ------------------------------------------------------------------ reading
+    def _open_schema(self) -> pa.Schema:
+        if self.fmt == "parquet":
+            try:
+                return pq.ParquetFile(self.path).schema_arrow
+            except (pa.ArrowInvalid, OSError) as exc:
+                raise InputError(f"{self.path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
+        with self._csv_reader() as reader:
+            return reader.schema
+
+    @contextlib.contextmanager
+    def _csv_reader(self):
+        with open(self.path, "rb") as fh:
+            magic = fh.read(6)
+        codec = next((name for sig, name in _COMPRESSED if magic.startswith(sig)), None)
+        with contextlib.ExitStack() as stack:
+            try:
+                with self._open(codec) as peek:
+                    head = peek.read(4096)
+                source = stack.enter_context(self._open(codec))
+                if not head.strip():
+                    raise InputError(f"{self.path}: the file is empty; expected a header such as "
+                                     "time,gyro_z,temperature")
+                delimiter, decimal = sniff_csv(head)
+                parse = pacsv.ParseOptions(delimiter=self.layout.delimiter or delimiter)
+                convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.layout.decimal or decimal)
+                reader = pacsv.open_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
+                                        parse_options=parse, convert_options=convert)
+            except (pa.ArrowInvalid, OSError, EOFError, lzma.LZMAError) as exc:
+                what = "CSV table" if codec is None else f"{codec} CSV file"
+                raise InputError(f"{self.path}: not a readable {what} ({str(exc).splitlines()[0]})") from None
+            yield reader
+
+    def _open(self, codec: str | None):
+        """The file's bytes, decompressed as they are read."""
+        if codec is None:
+            return pa.OSFile(str(self.path), "rb")
+        if codec == "xz":
+            return pa.PythonFile(lzma.open(self.path), mode="r")
+        return pa.input_stream(str(self.path), compression=codec)
+
+    def _batches(self) -> Iterator[pa.RecordBatch]:
+        if self.fmt == "parquet":
+            yield from pq.ParquetFile(self.path).iter_batches(batch_size=self.chunk_rows)
+            return
+        with self._csv_reader() as reader:
+            while True:
+                try:
+                    batch = reader.read_next_batch()
+                except StopIteration:
+                    return
+                except pa.ArrowInvalid as exc:  # a later block does not fit the types of the first
+                    raise NotStreamable(str(exc).splitlines()[0]) from None
+                yield batch
+
+    def _tables(self) -> Iterator[pa.Table]:
+        """Batches gathered into tables of about ``chunk_rows`` rows, none of fewer than 2 (a short last one is
+        joined to the one before)."""
+        gathered, rows, held = [], 0, None
+        for batch in self._batches():
+            offset = 0
+            while offset < batch.num_rows:  # a batch longer than a chunk is cut
+                take = min(batch.num_rows - offset, self.chunk_rows - rows)
+                gathered.append(batch.slice(offset, take))
+                rows += take
+                offset += take
+                if rows >= self.chunk_rows:
+                    if held is not None:
+                        yield held
+                    held = pa.Table.from_batches(gathered)
+                    gathered, rows = [], 0
+        rest = pa.Table.from_batches(gathered) if gathered else None
+        if held is not None and rest is not None and rest.num_rows < 2:
+            held, rest = pa.concat_tables([held, rest]), None
+        for table in (held, rest):
+            if table is not None:
+                yield table
+
+    def chunks(self) -> Iterator[TableChunk]:
+        """The file's rows as :class:`TableChunk` s, each validated as a recording."""
+        gyro_factor = unit_factor("gyro", self.layout.gyro_unit, "gyro_unit")
+        accel_factor = unit_factor("accel", self.layout.accel_unit, "accel_unit")
+        time_factor = unit_factor("time", self.layout.time_unit, "time_unit")
+        temp_names = _temperature_columns(self.columns, self.gyro_axes)
+        last: tuple[float, int] | None = None  # time [s] and row number of the previous chunk's last row
+        period = None
+        first = 0
+        for table in self._tables():
+            num = lambda name: _numeric_column(table, self.columns[name], self.path)  # noqa: E731
+            time_s = num(TIME_COLUMN) * time_factor
+            gyro = np.column_stack([num(a) for a in self.gyro_axes]) * gyro_factor
+            temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
+            accel = np.column_stack([num(a) for a in self.accel_axes]) * accel_factor if self.accel_axes else None
+            reference = _reference_rates(self.columns, num, self.path, gyro_factor)
+            kept = np.arange(table.num_rows)
+            if self.drop_nonfinite:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", DataQualityWarning)  # counted over the file, said once
+                    kept, (time_s, gyro, temp, accel, reference) = keep_finite_rows(self.path, time_s, gyro, temp,
+                                                                                     accel, reference)
+                self.rows_dropped += table.num_rows - kept.size
+            if kept.size < 2:
+                raise InputError(f"{self.path}: rows {first + 1}..{first + table.num_rows}: fewer than 2 rows with "
+                                 "values in every used column")
+            recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=self.gyro_axes, temperature_degc=temp,
+                                  accel_g=accel, accel_axes=self.accel_axes, reference_rate_dps=reference,
+                                  source=str(self.path), row_numbers=first + kept + 1,
+                                  metadata={"path": str(self.path), "format": self.fmt})
+            if last is not None:
+                step = float(time_s[0] - last[0])
+                if not step > 0:
+                    raise InputError(f"{self.path}: row {first + kept[0] + 1}: time {time_s[0]!r} s does not "
+                                     f"increase (row {last[1]}: {last[0]!r} s); sort the file by time")
+                if step > 2.0 * period:
+                    self._gap(step, last[1])
+            period = period or 1.0 / recording.rate_hz
+            for gap in recording.gaps:
+                self._gap(gap.duration_s, gap.after_row)
+            last = (float(time_s[-1]), int(first + kept[-1] + 1))
+            self.rows += table.num_rows
+            yield TableChunk(table, recording, kept, first)
+            first += table.num_rows
+        if self.rows == 0:
+            raise InputError(f"{self.path}: a header but no data rows")
+
+    def _gap(self, duration_s: float, after_row: int) -> None:
+        self.gaps += 1
+        if self.longest_gap is None or duration_s > self.longest_gap[0]:
+            self.longest_gap = (duration_s, after_row)
+
+    def warn_summary(self) -> None:
+        """The warnings a whole-file read gives: rows dropped, time gaps (once each, for the whole file)."""
+        if self.rows_dropped:
+            warnings.warn(f"{self.path}: dropped {self.rows_dropped} of {self.rows} rows with empty, NaN or infinite "
+                          "values", DataQualityWarning, stacklevel=2)
+        if self.gaps:
+            duration, row = self.longest_gap
+            warnings.warn(f"{self.path}: {self.gaps} time gap(s) longer than 2 sample periods (longest "
+                          f"{duration:.6g} s after row {row}); kept as they are, nothing interpolated",
+                          DataQualityWarning, stacklevel=2)
+
+
+class TableWriter:
+    """A CSV or Parquet table written chunk by chunk into a temporary file, renamed over ``path`` when the block
+    ends without an error (else removed): use as a context manager, :meth:`write` each chunk."""
+
+    def __init__(self, path, fmt: str | None = None):
+        self.path = Path(path)
+        self.fmt = fmt or detect_table_format(self.path) or "csv"
+        self._writer = None
+        self._schema: pa.Schema | None = None
+        self._stack = contextlib.ExitStack()
+
+    def __enter__(self) -> "TableWriter":
+        self._tmp = self._stack.enter_context(atomic_path(self.path))
+        return self
+
+    def write(self, table: pa.Table) -> None:
+        if self._writer is None:
+            self._schema = table.schema
+            if self.fmt == "parquet":
+                self._writer = pq.ParquetWriter(self._tmp, table.schema)
+            else:
+                self._writer = pacsv.CSVWriter(self._tmp, table.schema,
+                                               write_options=_csv_options(table.column_names))
+        elif table.schema != self._schema:
+            try:
+                table = table.cast(self._schema)
+            except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
+                raise NotStreamable(str(exc).splitlines()[0]) from None
+        self._writer.write_table(table)
+
+    def __exit__(self, kind, value, traceback) -> bool:
+        try:
+            if self._writer is not None:
+                self._writer.close()
+        except BaseException:
+            self._stack.__exit__(*sys.exc_info())
+            raise
+        return self._stack.__exit__(kind, value, traceback)
+
+
+__all__ = ["CHUNK_ROWS", "NotStreamable", "TableChunk", "TableStream", "TableWriter"]

@@ -1,0 +1,169 @@
+"""Tables in chunks: apply_file writes, chunk by chunk, exactly what the whole-file apply writes (CSV and Parquet,
+any chunk size, gaps, dropped rows, a turn-on window that holds output back, a lag model, the accelerometer), says
+the same warnings once, names the file's own rows in its errors, and reads a file whole when it cannot stream."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+import pytest
+from hypothesis import given, settings as hsettings, strategies as st
+
+from gyrocomp.compensate import apply, apply_file
+from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.io import stream as stream_module
+from gyrocomp.io.stream import TableStream
+from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_recording
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.simulate import simulate
+
+_CACHE = {}
+
+
+def _model():
+    """A consumer part's default model (thermal lag included), fitted once."""
+    if "model" not in _CACHE:
+        runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
+                for s in range(2)]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            _CACHE["model"] = fit_channels(runs)
+    return _CACHE["model"]
+
+
+def _whole(calibration, source, target, **kwargs):
+    """The whole-file path: read_table, apply, write_gyro_back."""
+    layout = kwargs.pop("layout", None)
+    data = read_table(source, layout, drop_nonfinite=kwargs.pop("drop_nonfinite", False))
+    write_gyro_back(data, apply(calibration, data.recording, **kwargs).gyro_dps, target)
+
+
+def _read(path):
+    return pq.read_table(path) if str(path).endswith(".parquet") else pacsv.read_csv(path)
+
+
+@pytest.fixture(scope="module")
+def held_out(tmp_path_factory):
+    """A held-out run with a 30 s gap and two rows with an empty cell, as CSV and Parquet."""
+    rec = simulate("consumer", profile="chamber", rate_hz=2, duration_s=1800, seed=9, unit=3).recording
+    keep = np.ones(rec.n_samples, dtype=bool)
+    keep[1000:1060] = False
+    rec = rec.take(keep)
+    folder = tmp_path_factory.mktemp("stream")
+    paths = {}
+    for suffix in ("csv", "parquet"):
+        paths[suffix] = folder / f"run.{suffix}"
+        write_recording(rec, paths[suffix], extra_columns={"flag": np.arange(rec.n_samples) % 3})
+    text = paths["csv"].read_text().splitlines()
+    for row in (500, 2500):
+        cells = text[row].split(",")
+        cells[2] = ""
+        text[row] = ",".join(cells)
+    (folder / "holes.csv").write_text("\n".join(text) + "\n")
+    paths["holes"] = folder / "holes.csv"
+    return paths
+
+
+@hsettings(max_examples=6, deadline=None)
+@given(st.integers(2, 4000), st.sampled_from(["csv", "parquet"]), st.sampled_from([None, 120.0]))
+def test_any_chunk_size_writes_what_the_whole_file_gives(held_out, tmp_path_factory, chunk_rows, suffix, window):
+    out = tmp_path_factory.mktemp("out")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _whole(_model(), held_out[suffix], out / f"whole.{suffix}", turn_on_window_s=window)
+        result = apply_file(_model(), held_out[suffix], out / f"chunks.{suffix}", chunk_rows=chunk_rows,
+                            turn_on_window_s=window)
+    assert result.streamed and result.rows == _read(held_out[suffix]).num_rows
+    assert _read(out / f"chunks.{suffix}").equals(_read(out / f"whole.{suffix}"))
+    if suffix == "csv":  # the same bytes
+        assert (out / f"chunks.{suffix}").read_bytes() == (out / f"whole.{suffix}").read_bytes()
+
+
+def test_dropped_rows_and_gaps_are_said_once_for_the_whole_file(held_out, tmp_path):
+    with pytest.warns(DataQualityWarning) as caught:
+        result = apply_file(_model(), held_out["holes"], tmp_path / "out.csv", drop_nonfinite=True, chunk_rows=700)
+    said = [str(w.message) for w in caught if issubclass(w.category, DataQualityWarning)]
+    assert sum("dropped 2 of 3541 rows" in m for m in said) == 1
+    assert sum("1 time gap(s)" in m and "longest 30.5 s after row 1000" in m for m in said) == 1
+    assert result.rows == 3539
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _whole(_model(), held_out["holes"], tmp_path / "whole.csv", drop_nonfinite=True)
+    assert (tmp_path / "out.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+
+
+def test_errors_name_the_rows_of_the_file(held_out, tmp_path):
+    with pytest.raises(InputError, match=r"holes.csv: row 500, column 'gyro_y': nan is not a finite number"):
+        apply_file(_model(), held_out["holes"], tmp_path / "out.csv", chunk_rows=300)
+    assert not (tmp_path / "out.csv").exists() and not list(tmp_path.iterdir())  # nothing left behind
+    lines = held_out["csv"].read_text().splitlines()
+    lines[400], lines[399] = lines[399], lines[400]  # rows 399 and 400 swapped, across the chunk boundary
+    (tmp_path / "swapped.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"swapped.csv: row 400: time .* does not increase \(row 399"):
+        apply_file(_model(), tmp_path / "swapped.csv", tmp_path / "out.csv", chunk_rows=399)
+    with pytest.raises(InputError, match="chunk_rows: a whole number of at least 2"):
+        TableStream(held_out["csv"], chunk_rows=1)
+
+
+def test_a_csv_whose_column_type_changes_is_read_whole(held_out, tmp_path, monkeypatch):
+    """A column of whole numbers in the first block and decimals later cannot be streamed with the first block's
+    types: the file is read whole, with the same result."""
+    lines = held_out["csv"].read_text().splitlines()
+    head = lines[0].split(",")
+    flag = head.index("flag")
+    cells = lines[3000].split(",")
+    cells[flag] = "0.5"
+    lines[3000] = ",".join(cells)
+    (tmp_path / "mixed.csv").write_text("\n".join(lines) + "\n")
+    monkeypatch.setattr(stream_module, "CSV_BLOCK_BYTES", 4096)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = apply_file(_model(), tmp_path / "mixed.csv", tmp_path / "out.csv", chunk_rows=500)
+        _whole(_model(), tmp_path / "mixed.csv", tmp_path / "whole.csv")
+    assert not result.streamed
+    assert (tmp_path / "out.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+
+
+def test_units_and_mapped_columns_stream_too(held_out, tmp_path):
+    """A file in rad/s and milliseconds with its own column names: the output keeps them, in its units."""
+    table = pacsv.read_csv(held_out["csv"])
+    table = table.rename_columns(["t_ms" if n == "time" else n.upper() if n.startswith("gyro") else n
+                                  for n in table.column_names])
+    table = table.set_column(0, "t_ms", pa.array(table.column("t_ms").to_numpy() * 1000.0))
+    for axis in ("GYRO_X", "GYRO_Y", "GYRO_Z"):
+        i = table.column_names.index(axis)
+        table = table.set_column(i, axis, pa.array(table.column(axis).to_numpy() * np.pi / 180))
+    pq.write_table(table, tmp_path / "own.parquet")
+    layout = TableLayout(columns={"time": "t_ms", "gyro_x": "GYRO_X", "gyro_y": "GYRO_Y", "gyro_z": "GYRO_Z"},
+                         gyro_unit="rad/s", time_unit="ms")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        apply_file(_model(), tmp_path / "own.parquet", tmp_path / "out.parquet", layout=layout, chunk_rows=333)
+        _whole(_model(), tmp_path / "own.parquet", tmp_path / "whole.parquet", layout=layout)
+    out = pq.read_table(tmp_path / "out.parquet")
+    assert out.column_names == table.column_names
+    assert out.equals(pq.read_table(tmp_path / "whole.parquet"))
+
+
+def test_a_model_with_the_accelerometer_streams_its_columns_too(held_out, tmp_path):
+    """Accelerometer temperature models: the accel columns are replaced chunk by chunk as in the whole-file path;
+    with a turn-on window (which holds the gyro back, not the accelerometer) the file is read whole."""
+    runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
+            for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = fit_channels(runs, ("gyro", "accel"))
+        assert model.accel_axes
+        for window in (None, 60.0):
+            result = apply_file(model, held_out["parquet"], tmp_path / "out.parquet", chunk_rows=250,
+                                turn_on_window_s=window)
+            data = read_table(held_out["parquet"])
+            done = apply(model, data.recording, turn_on_window_s=window)
+            write_gyro_back(data, done.gyro_dps, tmp_path / "whole.parquet", accel_g=done.accel_g)
+            assert result.streamed == (window is None)
+            assert "accel_x" in result.axes
+            assert pq.read_table(tmp_path / "out.parquet").equals(pq.read_table(tmp_path / "whole.parquet"))
