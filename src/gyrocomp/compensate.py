@@ -378,7 +378,7 @@ class FileResult:
 def apply_file(calibration: Calibration, input_path, output_path, *, layout: TableLayout | None = None,
                fmt: str | None = None, out_fmt: str | None = None, drop_nonfinite: bool = False,
                axes: tuple[str, ...] | None = None, turn_on_window_s: float | None = None,
-               chunk_rows: int = CHUNK_ROWS) -> FileResult:
+               chunk_rows: int = CHUNK_ROWS, progress=None) -> FileResult:
     """Compensate a CSV or Parquet table into ``output_path`` (CSV or Parquet), chunk by chunk.
 
     The output is what :func:`apply` and :func:`gyrocomp.io.write_gyro_back` give for the whole file (the same
@@ -388,11 +388,13 @@ def apply_file(calibration: Calibration, input_path, output_path, *, layout: Tab
     :class:`Compensator`, and the output is written as it comes, into a temporary file renamed over
     ``output_path`` at the end. A file that cannot be read in chunks (a CSV column whose type changes after the
     first 16 MB), or a model with accelerometer axes applied with ``turn_on_window_s``, is read whole instead.
+    ``progress`` is called with the fraction of the file read.
     """
     if not isinstance(calibration, Calibration):
         raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
                          f"got {type(calibration).__name__}")
-    stream = TableStream(input_path, layout, fmt=fmt, drop_nonfinite=drop_nonfinite, chunk_rows=chunk_rows)
+    stream = TableStream(input_path, layout, fmt=fmt, drop_nonfinite=drop_nonfinite, chunk_rows=chunk_rows,
+                         progress=progress)
     try:
         return _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s)
     except NotStreamable:

@@ -16,7 +16,7 @@ from hypothesis import given, settings as hsettings, strategies as st
 from gyrocomp.compensate import apply, apply_file
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io import stream as stream_module
-from gyrocomp.io.stream import TableStream
+from gyrocomp.io.stream import TableStream, convert_table
 from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_recording
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import simulate
@@ -167,3 +167,15 @@ def test_a_model_with_the_accelerometer_streams_its_columns_too(held_out, tmp_pa
             assert result.streamed == (window is None)
             assert "accel_x" in result.axes
             assert pq.read_table(tmp_path / "out.parquet").equals(pq.read_table(tmp_path / "whole.parquet"))
+
+
+@pytest.mark.parametrize("suffix,out_suffix", [("csv", "parquet"), ("parquet", "csv"), ("holes", "csv")])
+def test_convert_in_chunks_writes_what_the_whole_file_gives(held_out, tmp_path, suffix, out_suffix):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = convert_table(held_out[suffix], tmp_path / f"chunks.{out_suffix}", drop_nonfinite=True,
+                               chunk_rows=777)
+        write_recording(read_table(held_out[suffix], drop_nonfinite=True).recording, tmp_path / f"whole.{out_suffix}")
+    assert _read(tmp_path / f"chunks.{out_suffix}").equals(_read(tmp_path / f"whole.{out_suffix}"))
+    assert result.gaps == 1 and result.rate_hz == 2.0 and result.channels[:3] == ("gyro_x", "gyro_y", "gyro_z")
+    assert result.rows == _read(tmp_path / f"whole.{out_suffix}").num_rows

@@ -9,7 +9,7 @@ import click
 from ..calibration import Calibration
 from ..compensate import apply as apply_calibration, apply_file
 from ..io import TABLE_FORMATS, detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
-from .common import pop_read_options, read_run, read_options, read_settings
+from .common import pop_read_options, progress_bar, read_run, read_options, read_settings
 
 
 @click.command()
@@ -32,9 +32,10 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     named = None if axes is None else tuple(a.strip() for a in axes.split(",") if a.strip())
     if in_fmt in TABLE_FORMATS:  # in chunks: memory bounded whatever the file's length
-        result = apply_file(calibration, input_path, output, layout=read_settings(opts).layout, fmt=in_fmt,
-                            out_fmt=out_fmt, drop_nonfinite=opts["drop_nan"], axes=named,
-                            turn_on_window_s=turn_on_window_s)
+        with progress_bar(f"reading {Path(input_path).name}") as progress:
+            result = apply_file(calibration, input_path, output, layout=read_settings(opts).layout, fmt=in_fmt,
+                                out_fmt=out_fmt, drop_nonfinite=opts["drop_nan"], axes=named,
+                                turn_on_window_s=turn_on_window_s, progress=progress)
         rows, done = result.rows, result.axes
     else:
         data = read_run(input_path, opts)

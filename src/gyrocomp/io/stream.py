@@ -28,7 +28,8 @@ from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
 from .atomic import atomic_path
 from .tables import (_COMPRESSED, TIME_COLUMN, TableLayout, _csv_options, _numeric_column, _reference_rates,
-                     _resolved_columns, _temperature_columns, detect_table_format, keep_finite_rows, sniff_csv)
+                     _resolved_columns, _temperature_columns, detect_table_format, keep_finite_rows, recording_table,
+                     sniff_csv)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 1 << 20
@@ -56,7 +57,7 @@ class TableStream:
     """A CSV or Parquet table read in chunks of about ``chunk_rows`` rows (see the module)."""
 
     def __init__(self, path, layout: TableLayout | None = None, *, fmt: str | None = None,
-                 drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS):
+                 drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS, progress=None):
         self.path = Path(path)
         self.layout = layout or TableLayout()
         self.fmt = fmt or detect_table_format(self.path) or "csv"
@@ -68,6 +69,8 @@ class TableStream:
             raise InputError(f"chunk_rows: a whole number of at least 2, got {chunk_rows!r}")
         self.drop_nonfinite = drop_nonfinite
         self.chunk_rows = int(chunk_rows)
+        self.progress = progress  # called with the fraction of the file read
+        self._source = None  # the open CSV file, whose position tells the progress (None: compressed)
         self.schema = self._open_schema()
         self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
         self.gyro_axes = tuple(a for a in GYRO_AXES if a in self.columns)
@@ -97,6 +100,7 @@ class TableStream:
                 with self._open(codec) as peek:
                     head = peek.read(4096)
                 source = stack.enter_context(self._open(codec))
+                self._source = source if codec is None else None
                 if not head.strip():
                     raise InputError(f"{self.path}: the file is empty; expected a header such as "
                                      "time,gyro_z,temperature")
@@ -197,10 +201,23 @@ class TableStream:
                 self._gap(gap.duration_s, gap.after_row)
             last = (float(time_s[-1]), int(first + kept[-1] + 1))
             self.rows += table.num_rows
+            self._report()
             yield TableChunk(table, recording, kept, first)
             first += table.num_rows
         if self.rows == 0:
             raise InputError(f"{self.path}: a header but no data rows")
+        if self.progress:
+            self.progress(1.0)
+
+    def _report(self) -> None:
+        if not self.progress:
+            return
+        if self.fmt == "parquet":
+            total = pq.ParquetFile(self.path).metadata.num_rows
+            self.progress(self.rows / total if total else 1.0)
+        elif self._source is not None:
+            with contextlib.suppress(OSError, ValueError):
+                self.progress(self._source.tell() / max(self.path.stat().st_size, 1))
 
     def _gap(self, duration_s: float, after_row: int) -> None:
         self.gaps += 1
@@ -259,4 +276,41 @@ class TableWriter:
         return self._stack.__exit__(kind, value, traceback)
 
 
-__all__ = ["CHUNK_ROWS", "NotStreamable", "TableChunk", "TableStream", "TableWriter"]
+@dataclass(frozen=True)
+class ConvertResult:
+    """What :func:`convert_table` wrote: rows [count], the time it spans [s], the nominal rate of its first chunk
+    [Hz], the time gaps found, and the channels written."""
+
+    rows: int
+    duration_s: float
+    rate_hz: float
+    gaps: int
+    channels: tuple[str, ...]
+
+
+def convert_table(input_path, output_path, layout: TableLayout | None = None, *, fmt: str | None = None,
+                  out_fmt: str | None = None, drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS,
+                  progress=None) -> ConvertResult:
+    """A CSV or Parquet table written as the canonical table (time [s], gyro [deg/s], accel [g], temperature
+    [degC]) in CSV or Parquet, chunk by chunk: the same bytes as reading it whole and writing the recording
+    (:func:`gyrocomp.io.write_recording`), with memory bounded by ``chunk_rows`` [rows]. ``progress`` is called
+    with the fraction read."""
+    stream = TableStream(input_path, layout, fmt=fmt, drop_nonfinite=drop_nonfinite, chunk_rows=chunk_rows,
+                         progress=progress)
+    first = last = None
+    written = 0
+    with TableWriter(output_path, out_fmt) as writer:
+        for chunk in stream.chunks():
+            rec = chunk.recording
+            first = first or rec
+            last = rec
+            table = recording_table(rec)
+            writer.write(table)
+            written += table.num_rows
+    stream.warn_summary()
+    channels = (*first.gyro_axes, *first.accel_axes, *first.temperature_columns)
+    return ConvertResult(written, float(last.time_s[-1] - first.time_s[0]), first.rate_hz, stream.gaps, channels)
+
+
+__all__ = ["CHUNK_ROWS", "ConvertResult", "NotStreamable", "TableChunk", "TableStream", "TableWriter",
+           "convert_table"]
