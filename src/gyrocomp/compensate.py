@@ -387,7 +387,7 @@ def apply_file(calibration: Calibration, input_path, output_path, *, layout: Tab
     file is read in chunks (:class:`gyrocomp.io.stream.TableStream`), each goes through one
     :class:`Compensator`, and the output is written as it comes, into a temporary file renamed over
     ``output_path`` at the end. A file that cannot be read in chunks (a CSV column whose type changes after the
-    first 16 MB), or a model with accelerometer axes applied with ``turn_on_window_s``, is read whole instead.
+    first megabyte), or a model with accelerometer axes applied with ``turn_on_window_s``, is read whole instead.
     ``progress`` is called with the fraction of the file read.
     """
     if not isinstance(calibration, Calibration):
@@ -416,7 +416,8 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
     gyro_factor = unit_factor("gyro", stream.layout.gyro_unit)
     accel_factor = unit_factor("accel", stream.layout.accel_unit)
     comp, accel_order, pending, written, first = None, None, [], 0, None
-    with TableWriter(output_path, out_fmt) as writer:
+    computed = tuple(stream.columns[a] for a in stream.gyro_axes + stream.accel_axes)
+    with TableWriter(output_path, out_fmt, computed=computed) as writer:
         def flush(gyro: np.ndarray, accel: np.ndarray | None) -> None:
             nonlocal pending, written
             if not len(gyro):

@@ -418,7 +418,8 @@ static int is_outlier(gyrocomp_learner *s, const double bias[3], const double ac
             if (s->pt_session[i] != s->session) continue;
             double ga = 0.0;
             for (int a = 0; a < 3; ++a) ga += s->g[j][a] * s->pt_accel[i][a];
-            offsets[n++] = s->pt_bias[i][j] - curve(s->coef[j], s->degree, s->t_min, s->t_max, s->pt_t[i][s->lag_index]) - ga;
+            offsets[n++] = s->pt_bias[i][j]
+                           - curve(s->coef[j], s->degree, s->t_min, s->t_max, s->pt_t[i][s->lag_index]) - ga;
         }
         double ga = 0.0;
         for (int a = 0; a < 3; ++a) ga += s->g[j][a] * accel[a];
@@ -521,7 +522,10 @@ static int to_pool(gyrocomp_learner *s, int bin, const double bias[3], const dou
             for (int p = 1; p < POOL_PIECES; ++p) {
                 s->pool_bin[p - 1] = s->pool_bin[p];
                 s->pool_s[p - 1] = s->pool_s[p];
-                for (int j = 0; j < 3; ++j) { s->pool_bias[p - 1][j] = s->pool_bias[p][j]; s->pool_accel[p - 1][j] = s->pool_accel[p][j]; }
+                for (int j = 0; j < 3; ++j) {
+                    s->pool_bias[p - 1][j] = s->pool_bias[p][j];
+                    s->pool_accel[p - 1][j] = s->pool_accel[p][j];
+                }
                 for (int k = 0; k < GL_LAGS; ++k) s->pool_t[p - 1][k] = s->pool_t[p][k];
             }
             s->pool_n -= 1;
@@ -552,7 +556,8 @@ static int commit(gyrocomp_learner *s, int bin, const double bias[3], const doub
     static int bad[GL_POINTS];
     int n_bad = 0;
     for (int i = 0; i < GL_POINTS; ++i)
-        if (s->pt_session[i] == s->session && is_outlier(s, s->pt_bias[i], s->pt_accel[i], s->pt_t[i])) bad[n_bad++] = i;
+        if (s->pt_session[i] == s->session && is_outlier(s, s->pt_bias[i], s->pt_accel[i], s->pt_t[i]))
+            bad[n_bad++] = i;
     if (n_bad) {
         double seconds_bad = 0.0;
         for (int b = 0; b < n_bad; ++b) seconds_bad += s->pt_s[bad[b]];

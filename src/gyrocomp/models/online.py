@@ -128,11 +128,14 @@ def chi2_quantile(z: float, dof: float) -> float:
 
 @dataclass(frozen=True)
 class LearnerSettings:
-    """What the learner is told (see the module): the stream's nominal rate ``rate_hz`` [Hz], blocks [s], the
-    still time a piece needs and its longest span [s], the tests' false-alarm probability, the noise estimate's
-    quantile and history [blocks], the temperature bins [degC], the curve's degree and the spans that allow it
-    [degC], the weighting and forgetting [operating hours], sessions kept, rejection bounds [deg/s], the change
-    that asks for a save [deg/s]."""
+    """What the learner is told (see the module): the stream's nominal rate ``rate_hz`` [Hz], blocks ``block_s``
+    [s], the still time a piece's run needs and a piece's longest span (``min_still_s``, ``piece_s`` [s]), the
+    tests' false-alarm probability ``alpha``, the noise estimate's quantile and history [blocks], the temperature
+    bins (``bin_width_degc`` from ``t_low_degc`` to ``t_high_degc``), the curve's ``degree`` and the spans that allow
+    it [degC], the weighting and forgetting (``half_life_h``, ``stale_h`` [operating hours]), the power-ons and
+    points kept, the rejection bounds (``max_bias_dps``, ``outlier_dps`` [deg/s], ``outlier_sigmas``,
+    ``max_tempco_dps_per_degc`` [deg/s/degC]), the change that asks for a save (``save_change_dps``), and the
+    candidate thermal lags (``lag_candidates_s`` [s], the first 0)."""
 
     rate_hz: float
     block_s: float = 1.0
@@ -610,7 +613,8 @@ class OnlineCalibrator:
     def _close_piece(self, now: float | None = None) -> None:
         if self._piece_bin >= 0 and self._run_s >= self.settings.min_still_s:
             samples = self._piece[-1]
-            self._commit(self._piece_bin, self._piece[:3] / samples, self._piece[3:6] / samples, self._piece[6:-1] / samples,
+            self._commit(self._piece_bin, self._piece[:3] / samples, self._piece[3:6] / samples,
+                         self._piece[6:-1] / samples,
                          samples / self.settings.rate_hz, self._clock if now is None else now)
         self._piece[:] = 0.0
         self._piece_bin = -1
@@ -885,8 +889,8 @@ class OnlineCalibrator:
         if require_curve and self._degree == 0:
             used = self._pt_session > 0
             low, high = float(self._pt_t[used, 0].min()), float(self._pt_t[used, 0].max())
-            raise InputError(f"the still data of {self._session} log(s) cover {low:.1f}..{high:.1f} degC; a temperature "
-                             f"model needs at least {self.settings.min_span_degc:g} degC (min_span_degc)")
+            raise InputError(f"the still data of {self._session} log(s) cover {low:.1f}..{high:.1f} degC; a "
+                             f"temperature model needs at least {self.settings.min_span_degc:g} degC (min_span_degc)")
         low, high = self._t_range
         out = {}
         for j, name in enumerate(GYRO_AXES):
@@ -937,7 +941,8 @@ class OnlineCalibrator:
                       "tilted": self._tilted.tolist(), "sessions": self._sessions.tolist(),
                       "constants_dps": self._constants.tolist(), "rms_dps": self._rms.tolist(),
                       "t_range_degc": list(self._t_range), "should_save": self._should_save,
-                      "lag_index": self._lag_index, "dof": self._dof, "lower": self._lower.tolist(), "scale2": self._scale2.tolist(),
+                      "lag_index": self._lag_index, "dof": self._dof, "lower": self._lower.tolist(),
+                      "scale2": self._scale2.tolist(),
                       "saved": None if self._saved is None else {
                           "degree": self._saved["degree"], "coef": self._saved["coef"].tolist(),
                           "t_range": list(self._saved["t_range"]), "constant": self._saved["constant"].tolist()}},
@@ -1035,7 +1040,8 @@ def replay(learner: OnlineCalibrator, recordings: Iterable[Recording], *, chunk_
         learner.end_session()
         after = learner.status
         out.append(LogContribution(
-            rec.source, tuple(a for a in GYRO_AXES if a in rec.gyro_axes), rec.duration_s, after.still_s - before.still_s,
+            rec.source, tuple(a for a in GYRO_AXES if a in rec.gyro_axes), rec.duration_s,
+            after.still_s - before.still_s,
             after.rejected_bound + after.rejected_outliers - before.rejected_bound - before.rejected_outliers,
             float(np.nanmin(temperature)), float(np.nanmax(temperature))))
     return out
@@ -1277,5 +1283,6 @@ def _restore_model(self: OnlineCalibrator, model: dict) -> None:
         "constant": _finite_array(saved["constant"], (3,), "model.saved.constant")}
 
 
-__all__ = ["GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LearnerSettings", "LearnerStatus", "LogContribution",
+__all__ = ["GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LearnerSettings", "LearnerStatus",
+           "LogContribution",
            "OnlineCalibrator", "block_statistics", "chi2_quantile", "replay"]

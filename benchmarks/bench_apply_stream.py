@@ -1,0 +1,108 @@
+"""Benchmark: ``gyrocomp apply`` on a long Parquet (or CSV) file, peak memory and time (issue #21).
+
+A file of ``--rows`` rows (time, gyro x/y/z, accel x/y/z, temperature; a simulated hour at 100 Hz repeated with
+the time running on, written row group by row group) is compensated, each in a fresh process, by:
+
+- ``pyarrow``: ``pq.read_table`` + ``pq.write_table`` of the same file (the baseline: plain I/O, nothing done);
+- ``gyrocomp apply``: the command through its entry point (chunks of 2^20 rows: read, validate, compensate, write);
+- ``whole file``: ``read_table`` + ``apply`` + ``write_gyro_back`` (what ``apply`` did before it streamed).
+
+Printed: each one's wall time and peak resident memory (``ru_maxrss`` of its process), and the ratios of
+``gyrocomp apply`` to the baseline.
+
+Usage: python benchmarks/bench_apply_stream.py [--rows N] [--format parquet|csv] [--skip-whole]
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from gyrocomp.io.tables import recording_table
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.simulate import simulate
+
+BLOCK_ROWS = 360_000  # one simulated hour at 100 Hz
+
+PROGRAMS = {
+    "pyarrow": ("import pyarrow.parquet as pq, pyarrow.csv as pc, sys\n"
+                "i, o = sys.argv[1], sys.argv[2]\n"
+                "if i.endswith('.parquet'): pq.write_table(pq.read_table(i), o)\n"
+                "else: pc.write_csv(pc.read_csv(i), o)\n"),
+    "gyrocomp apply": ("import sys\nfrom gyrocomp.cli import main\n"
+                       "sys.exit(main(['--quiet', 'apply', sys.argv[3], sys.argv[1], '-o', sys.argv[2]]))\n"),
+    "whole file": ("import sys, warnings\nwarnings.simplefilter('ignore')\n"
+                   "from gyrocomp import Calibration, apply\nfrom gyrocomp.io.tables import read_table, write_gyro_back\n"
+                   "data = read_table(sys.argv[1])\n"
+                   "write_gyro_back(data, apply(Calibration.load(sys.argv[3]), data.recording).gyro_dps, sys.argv[2])\n"),
+}
+WRAPPER = ("import resource, runpy, sys, time\nstart = time.perf_counter()\n"
+           "try:\n    exec(compile(sys.argv.pop(1), 'program', 'exec'))\nexcept SystemExit as e:\n"
+           "    assert not e.code, e.code\n"
+           "print(time.perf_counter() - start, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n")
+
+
+def make_file(path: Path, rows: int, fmt: str) -> None:
+    """``rows`` rows: a simulated hour at 100 Hz repeated, the time running on."""
+    block = recording_table(simulate("consumer", profile="chamber", rate_hz=100.0, duration_s=(BLOCK_ROWS - 1) / 100,
+                                     seed=1, unit=3).recording)
+    writer = pq.ParquetWriter(path, block.schema) if fmt == "parquet" else pacsv.CSVWriter(path, block.schema)
+    done, k = 0, 0
+    while done < rows:
+        n = min(BLOCK_ROWS, rows - done)
+        part = block.slice(0, n)
+        part = part.set_column(0, "time", pa.array(part.column("time").to_numpy() + k * BLOCK_ROWS / 100.0))
+        writer.write_table(part)
+        done += n
+        k += 1
+    writer.close()
+
+
+def measure(name: str, source: Path, target: Path, model: Path) -> tuple[float, float]:
+    done = subprocess.run([sys.executable, "-c", WRAPPER, PROGRAMS[name], str(source), str(target), str(model)],
+                          capture_output=True, text=True, check=True)
+    seconds, kb = done.stderr.strip().splitlines()[-1].split()
+    return float(seconds), float(kb) / 1024.0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--rows", type=float, default=3e7)
+    parser.add_argument("--format", choices=("parquet", "csv"), default="parquet")
+    parser.add_argument("--skip-whole", action="store_true", help="skip the whole-file run (it needs GBs)")
+    args = parser.parse_args()
+    rows = int(args.rows)
+    warnings.simplefilter("ignore")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        source = tmp / f"in.{args.format}"
+        make_file(source, rows, args.format)
+        model = tmp / "model.json"
+        fit_channels([simulate("consumer", profile="chamber", rate_hz=5, duration_s=3600, seed=s, unit=3).recording
+                      for s in (2, 3)]).save(model)
+        size_mb = source.stat().st_size / 2 ** 20
+        print(f"{rows:,} rows, {args.format} {size_mb:,.0f} MB")
+        results = {}
+        for name in PROGRAMS:
+            if name == "whole file" and args.skip_whole:
+                continue
+            results[name] = measure(name, source, tmp / f"out.{args.format}", model)
+            (tmp / f"out.{args.format}").unlink(missing_ok=True)
+            print(f"  {name:15s} {results[name][0]:8.1f} s  {results[name][1]:8.0f} MB peak")
+        base, ours = results["pyarrow"], results["gyrocomp apply"]
+        print(f"  gyrocomp apply: {ours[0] / base[0]:.2f}x pyarrow's time, {ours[1]:.0f} MB peak "
+              f"({ours[1] / base[1]:.2f}x pyarrow's)")
+
+
+if __name__ == "__main__":
+    main()
