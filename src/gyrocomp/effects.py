@@ -29,7 +29,7 @@ G_SQUARED_TERMS = ("xx", "yy", "zz", "xy", "xz", "yz")
 
 # -- thermal lag ------------------------------------------------------------------------------------
 
-def _lfilter(b, a, x, zi=None):
+def lazy_lfilter(b, a, x, zi=None):
     """``scipy.signal.lfilter``, imported on first use: scipy.signal costs most of a second at start-up and
     most commands never filter."""
     from scipy.signal import lfilter
@@ -135,7 +135,7 @@ def _lag_stretches(t: np.ndarray, u: np.ndarray, out: np.ndarray, start: int, pr
             # uniform stretch [i, stop): y[k] = a y[k-1] + b0 u[k] + b1 u[k-1]
             seg = u[i:stop]
             zi = np.array([a * prev_y + b1 * prev_u])
-            out[i:stop], _ = _lfilter([b0, b1], [1.0, -a], seg, zi=zi)
+            out[i:stop], _ = lazy_lfilter([b0, b1], [1.0, -a], seg, zi=zi)
             prev_u, prev_y = float(seg[-1]), float(out[stop - 1])
         if stop < u.size:  # bridge the gap before sample `stop` exactly
             ga, gb0, gb1 = lag_coefficients(float(steps[stop]), time_constant_s)
@@ -388,6 +388,6 @@ def quantize(x: np.ndarray, lsb: float) -> np.ndarray:
 
 __all__ = [
     "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "find_turns",
-    "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "quantize",
+    "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter", "quantize",
     "thermal_lag",
 ]

@@ -82,10 +82,10 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from scipy.signal import lfilter
 from scipy.stats import norm
 
 from ..calibration import AxisCalibration, Calibration
+from ..effects import lazy_lfilter
 from ..errors import InputError, NotFittedError
 from ..io.atomic import write_text_atomic
 from ..recording import Recording
@@ -464,8 +464,8 @@ class OnlineCalibrator:
                 if end > first + 1:
                     a = nominal[k]
                     if tau > 0:
-                        y[first + 1:end, k] = lfilter([a], [1.0, -(1.0 - a)], x[first + 1:end],
-                                                      zi=[(1.0 - a) * state[k]])[0]
+                        y[first + 1:end, k] = lazy_lfilter([a], [1.0, -(1.0 - a)], x[first + 1:end],
+                                                           zi=[(1.0 - a) * state[k]])[0]
                     else:
                         y[first + 1:end, k] = x[first + 1:end]
                     state[k] = y[end - 1, k]
