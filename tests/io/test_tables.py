@@ -1,3 +1,4 @@
+import gzip
 import lzma
 import math
 import os
@@ -306,3 +307,28 @@ def test_bad_delimiter_and_decimal_options():
         TableLayout(delimiter=";;")
     with pytest.raises(InputError, match=r"decimal: ':'; use '.' or ','"):
         TableLayout(decimal=":")
+
+
+@pytest.mark.parametrize("suffix", ["csv", "csv.gz", "parquet"])
+def test_reading_only_some_channels(tmp_path, suffix):
+    """channels=: only time and those channels' columns are read (the table kept holds only them), with the same
+    values as a whole read; a mapped column is found by its channel."""
+    rec = simulate("mti10", profile="static", rate_hz=10, duration_s=60, seed=4).recording
+    path = tmp_path / f"run.{suffix}"
+    if suffix == "csv.gz":
+        write_recording(rec, tmp_path / "run.csv")
+        path.write_bytes(gzip.compress((tmp_path / "run.csv").read_bytes()))
+    else:
+        write_recording(rec, path)
+    whole = read_table(path)
+    some = read_table(path, channels=("gyro_z", "accel_x"))
+    assert some.table.column_names == ["time", "gyro_z", "accel_x"]
+    assert some.recording.gyro_axes == ("gyro_z",) and some.recording.accel_axes == ("accel_x",)
+    assert some.recording.temperature_degc is None
+    np.testing.assert_array_equal(some.recording.gyro_dps[:, 0], whole.recording.gyro_dps[:, 2])
+    layout = TableLayout(columns={"gyro_x": "gyro_z", "gyro_z": "gyro_x"})  # the file's gyro_z read as gyro_x
+    mapped = read_table(path, layout, channels=("gyro_x",))
+    assert mapped.table.column_names == ["time", "gyro_z"]
+    np.testing.assert_array_equal(mapped.recording.gyro_dps[:, 0], whole.recording.gyro_dps[:, 2])
+    with pytest.raises(InputError, match=r"none of the channels read \(accel_x\) is a gyro axis of the file"):
+        read_table(path, channels=("accel_x",))

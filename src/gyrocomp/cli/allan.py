@@ -10,6 +10,7 @@ import click
 from ..allan import KINDS
 from ..errors import DataQualityWarning
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
+from ..recording import ACCEL_AXES, GYRO_AXES
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..noise import analyse_noise
 from ..report.figures import allan_figure, check_figure_path
@@ -70,8 +71,14 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
     with warnings.catch_warnings():
         # gaps are refused below, or split with a note, in one line of their own
         warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
-        recording = read_run(input_path, opts).recording
-    names = [a.strip() for a in axes.split(",") if a.strip()] if axes else list(recording.gyro_axes)
+        named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
+        # a table: only the columns analysed are read (time, the gyro axes, the named axes, the accelerometer for
+        # Kalibr), not its temperature or others
+        wanted = (*GYRO_AXES, *(named or ()), *(ACCEL_AXES if kalibr_path else ()))
+        if any(name not in GYRO_AXES + ACCEL_AXES for name in wanted):
+            wanted = None  # a name that is no axis: read everything, so the refusal can list what the file has
+        recording = read_run(input_path, opts, channels=wanted).recording
+    names = named or list(recording.gyro_axes)
     if kalibr_path:
         names += [a for a in recording.accel_axes if a not in names]
     with progress_bar("Allan deviation", indeterminate=True):

@@ -72,13 +72,14 @@ def progress_bar(description: str, indeterminate: bool = False):
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
 
-def read_settings(opts: dict) -> ReadOptions:
-    """The :class:`ReadOptions` the common reading options (``pop_read_options``) give."""
+def read_settings(opts: dict, channels: tuple[str, ...] | None = None) -> ReadOptions:
+    """The :class:`ReadOptions` the common reading options (``pop_read_options``) give; ``channels``: a table's
+    channels to read (None: all)."""
     layout = table_layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"], opts["delimiter"],
                           opts["decimal"])
     return ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=parse_instance(opts["instance"]),
                        device_id=opts["device_id"], imu_topic=opts["imu_topic"],
-                       temperature_topic=opts["temperature_topic"], record=opts["record"])
+                       temperature_topic=opts["temperature_topic"], record=opts["record"], channels=channels)
 
 
 def parse_instance(text: str | int | None) -> int | None:
@@ -98,9 +99,9 @@ def parse_instance(text: str | int | None) -> int | None:
     return value
 
 
-def read_run(path, opts: dict):
+def read_run(path, opts: dict, channels: tuple[str, ...] | None = None):
     with progress_bar(f"reading {Path(path).name}") as progress:
-        return read_input(path, read_settings(opts), fmt=opts["fmt"], progress=progress)
+        return read_input(path, read_settings(opts, channels), fmt=opts["fmt"], progress=progress)
 
 
 def pop_read_options(kwargs: dict) -> dict:

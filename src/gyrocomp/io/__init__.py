@@ -96,7 +96,8 @@ def read_input(
     if not Path(path).exists():
         raise InputError(f"{path}: no such file")
     if fmt in TABLE_FORMATS:
-        data = read_table(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite)
+        data = read_table(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite,
+                          channels=options.channels)
         if progress:
             progress(1.0)
         return data

@@ -43,6 +43,9 @@ class ReadOptions:
     record : str, optional
         ArduPilot DataFlash record to read: ``"IMU"`` (default) or ``"TCLR"`` (the onboard
         temperature-learning records).
+    channels : tuple of str, optional
+        Tables: read only these channels' columns (``time`` always), e.g. ``("gyro_x", "gyro_z")``; a command
+        that uses three of eight columns then neither converts nor holds the others. Default: every channel.
     """
 
     layout: TableLayout = field(default_factory=TableLayout)
@@ -52,6 +55,7 @@ class ReadOptions:
     imu_topic: str | None = None
     temperature_topic: str | None = None
     record: str | None = None
+    channels: tuple[str, ...] | None = None
 
 
 def require(module: str, extra: str, what: str) -> ModuleType:

@@ -194,7 +194,10 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
     return delimiter, decimal
 
 
-def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str | None = None) -> pa.Table:
+def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str | None = None,
+                select=None) -> pa.Table:
+    """The table; ``select`` (a function of the header's names giving the names to read, or None for all)
+    reads only some columns."""
     if not path.exists():
         raise InputError(f"{path}: no such file")
     if path.is_dir():
@@ -207,11 +210,15 @@ def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str
         parse = pacsv.ParseOptions(delimiter=delimiter or found_delimiter)
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal or found_decimal)
         try:
+            if select is not None:  # the header's names, from its first line
+                header = pacsv.read_csv(pa.py_buffer(head.splitlines()[0] + b"\n"), parse_options=parse)
+                convert.include_columns = select(header.column_names)
             return pacsv.read_csv(source, parse_options=parse, convert_options=convert)
         except pa.ArrowInvalid as exc:
             raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
     try:
-        return pq.read_table(path)
+        columns = None if select is None else select(pq.read_schema(path).names)
+        return pq.read_table(path, columns=columns)
     except (pa.ArrowInvalid, OSError) as exc:
         raise InputError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
 
@@ -309,12 +316,29 @@ def _reference_rates(cols: dict[str, str], num, path: Path, factor: float) -> np
     return np.column_stack([num(a) for a in REFERENCE_RATE_AXES]) * factor
 
 
+def _channel_selector(channels: tuple[str, ...], layout: TableLayout, path: Path, chosen: dict):
+    """The columns to read for ``channels`` (and time), resolved on the whole header (so a mapping may name any
+    column), the channels found put in ``chosen``."""
+    wanted = {TIME_COLUMN, *channels}
+
+    def select(names: list[str]) -> list[str]:
+        found = _resolved_columns(names, layout, path)
+        chosen.update({channel: column for channel, column in found.items() if channel in wanted})
+        if not any(a in chosen for a in GYRO_AXES):
+            raise InputError(f"{path}: none of the channels read ({', '.join(channels)}) is a gyro axis of the "
+                             f"file ({', '.join(a for a in GYRO_AXES if a in found)})")
+        return list(dict.fromkeys(chosen.values()))
+
+    return select
+
+
 def read_table(
     path: str | os.PathLike,
     layout: TableLayout | None = None,
     *,
     fmt: str | None = None,
     drop_nonfinite: bool = False,
+    channels: tuple[str, ...] | None = None,
 ) -> TableData:
     """Read a CSV or Parquet table into a :class:`Recording`, keeping the table for write-back.
 
@@ -331,14 +355,18 @@ def read_table(
     drop_nonfinite : bool
         Drop rows where a used channel is empty, NaN or infinite (a :class:`DataQualityWarning`
         says how many) instead of refusing the file.
+    channels : tuple of str, optional
+        Read only these channels' columns (and time); the table kept holds only those.
     """
     layout = layout or TableLayout()
     path = Path(path)
     fmt = fmt or detect_table_format(path) or "csv"
-    table = _read_arrow(path, fmt, layout.delimiter, layout.decimal)
+    chosen: dict[str, str] = {}
+    select = None if channels is None else _channel_selector(tuple(channels), layout, path, chosen)
+    table = _read_arrow(path, fmt, layout.delimiter, layout.decimal, select)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
-    cols = _resolved_columns(table.column_names, layout, path)
+    cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
     accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
     temp_names = _temperature_columns(cols, gyro_axes)
