@@ -17,7 +17,7 @@ PRESET = "consumer"
 RUNS_PER_UNIT = 3
 RUN_DURATION_S = 900.0
 RATE_HZ = 10.0
-FLEET_UNITS = 200
+FLEET_UNITS = 120
 #: units made bad on purpose: three times the white noise, five times the temperature coefficients
 NOISY_UNIT = 17
 HOT_UNIT = 42
