@@ -107,6 +107,7 @@ def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     assert model["axes"]["gyro_z"]["hysteresis"]["band_degc"] == [55.0, 80.0]
 
 
+@pytest.mark.slow
 def test_fit_g_sensitivity_table_and_stages(tmp_path):
     r = run("simulate", "--preset", "consumer", "--profile", "combined", "--rate", 1, "--duration", 14000,
             "--runs", 2, "-o", tmp_path / "c.csv")
@@ -173,6 +174,7 @@ def test_evaluate_table_and_window(workdir):
     assert re.search(r"run3\.csv\s*\S\s*gyro_x\s*\S\s*20\s", r.stdout)  # the window column shows --window
 
 
+@pytest.mark.slow
 def test_demo(tmp_path):
     r = run("demo", "-o", tmp_path / "demo")
     assert r.returncode == 0, r.stderr

@@ -54,6 +54,7 @@ def test_one_run_is_scored_on_itself_and_says_so(cycles):
         compare_methods([])
 
 
+@pytest.mark.slow
 def test_cli_compare(tmp_path):
     r = run("simulate", "--preset", "adxrs450", "--profile", "cycle", "--cycles", 1, "--rate", 1, "--runs", 2,
             "--duration", 6000, "-o", tmp_path / "c.csv")

@@ -7,6 +7,8 @@ import pytest
 from .conftest import shared_dataset
 from .real_data import CATS_CHOICES, cats_held_out_drift, cats_numpy_cubic_drift, cats_runs
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def drift():

@@ -335,6 +335,7 @@ def test_accel_channel_on_a_multi_position_session_without_temperature(tmp_path)
         fit_channels(rec.take(slice(0, 5000)), ("accel",))
 
 
+@pytest.mark.slow
 def test_cli_fits_the_scale_factor_from_rate_table_files(tmp_path):
     # several set points of a one-temperature profile: one run per set point
     result = run("simulate", "--preset", "mti10", "--profile", "ratetable", "--set-points", "-10,25,60",

@@ -153,6 +153,7 @@ GYRO_TRIAD = _triad([[5e-3, 1e-3, -1e-3], [-1e-3, -4e-3, 2e-3], [1e-3, -2e-3, 3e
 ACCEL_TRIAD = _triad([[2e-3, 1e-3, -2e-3], [0.0, -3e-3, 1.5e-3], [0.0, 0.0, 4e-3]], "g", bias=(0.02, -0.015, 0.03))
 
 
+@pytest.mark.slow
 def test_accelerometer_temperature_models_g_sensitivity_and_both_triads(tmp_path):
     from gyrocomp.models.pipelines import fit_channels
 

@@ -21,6 +21,9 @@ from ..conftest import run
 from .conftest import (CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PATTERN, PRESET, RATE_HZ, RUN_DURATION_S,
                        RUNS_PER_UNIT, serial, unit_model, write_unit)
 
+pytestmark = pytest.mark.slow
+
+
 def test_every_unit_is_fitted_or_recorded_as_failed(fleet_run):
     out, _, result = fleet_run
     assert result.returncode == 0, result.stderr

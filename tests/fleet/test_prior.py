@@ -24,6 +24,9 @@ from gyrocomp.simulate import preset_model, resolve_profile, simulate
 from ..conftest import run
 from .conftest import FLEET_UNITS, PRESET, RATE_HZ, RUN_DURATION_S, RUNS_PER_UNIT
 
+pytestmark = pytest.mark.slow
+
+
 #: new units, not in the fleet
 NEW_UNITS = (300, 301, 302, 303)
 #: the short run: the middle third of the preset's -20..70 degC, a quarter of the full runs' chamber time

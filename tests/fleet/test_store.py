@@ -120,6 +120,7 @@ def test_a_store_of_a_newer_schema_is_refused(store, tmp_path):
         CalibrationStore(tmp_path / "FLEET")
 
 
+@pytest.mark.slow
 def test_fleet_show_and_export_through_the_command_line(store, models, tmp_path):
     folder = tmp_path / "FLEET"
     shown = run("fleet", "show", "U1", "--store", folder, "--at", "2026-05-01", "--json")

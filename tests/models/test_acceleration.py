@@ -171,6 +171,7 @@ def pipelines(consumer):
     return out
 
 
+@pytest.mark.slow
 def test_joint_fit_beats_every_cascade(pipelines):
     # the thesis's point (2.8): fitting temperature and acceleration together keeps the drift during the
     # tumble out of G and the orientation offsets out of the temperature curve

@@ -117,6 +117,7 @@ def test_bad_channels_and_missing_accelerometer(cycles):
         fit_accelerometer([cycles[0].recording], acceleration="matrix")
 
 
+@pytest.mark.slow
 def test_cli_accelerometer_channel_end_to_end(tmp_path):
     for seed in (1, 2, 3):
         r = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 0.5, "--seed", seed,

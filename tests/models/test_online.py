@@ -67,6 +67,7 @@ def learned(study):
     return learner, replay(learner, study[0])
 
 
+@pytest.mark.slow
 def test_ten_field_logs_learn_as_well_as_the_chamber(study, learned):
     """Replayed log by log, the learner's model is within 1.5x of the chamber model on the held-out run and far
     below raw. Measured: 0.0090 deg/s against the chamber's 0.0073 (1.2x), raw 0.32."""
@@ -105,6 +106,7 @@ def _inject(rec, turn_dps: float):
     return dataclasses.replace(rec, gyro_dps=gyro, accel_g=accel)
 
 
+@pytest.mark.slow
 def test_injected_outliers_are_rejected(study, learned):
     """A slow turn (0.1 deg/s for 80 s, about the vertical) and a bump in each of the last five logs: with the
     outlier test the model is as good as on clean logs; without it (outlier_dps huge) it is several times
@@ -343,6 +345,7 @@ def test_a_narrow_range_gives_no_temperature_model():
     assert learner.to_calibration(require_curve=False).axes["gyro_x"].temperature is None
 
 
+@pytest.mark.slow
 def test_learn_through_the_command_line(tmp_path):
     """gyrocomp learn on two logs; in two steps (--save-state, then --resume) the same model; apply takes it;
     a log without still data exits 2 in one line, writing nothing."""

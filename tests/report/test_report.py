@@ -76,6 +76,7 @@ def test_single_axis_report_with_hysteresis_has_every_section():
     assert "temperature + hysteresis" in report.html and "polynomial order" in report.html
 
 
+@pytest.mark.slow
 def test_three_axis_report_with_acceleration_and_accelerometer():
     runs = [simulate("consumer", profile="combined", duration_s=5400, rate_hz=1, seed=s).recording for s in range(3)]
     cal = _quiet(fit_channels, runs[:2], ("gyro", "accel"), hysteresis="none")
@@ -114,6 +115,7 @@ def cli_files(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow
 def test_cli_report_and_plots(cli_files):
     d = cli_files
     r = run("report", d / "model.json", d / "run2.csv", "-o", d / "report.html",
