@@ -49,3 +49,25 @@ def test_the_command_table_matches_the_commands():
     assert cli.get_command(ctx, "nothing") is None
     result = run("nothing")
     assert result.returncode == 2 and "No such command 'nothing'" in result.stderr
+
+
+def test_apply_and_convert_of_a_table_do_not_load_pandas(tmp_path):
+    """pyarrow imports pandas (a third of a second) the first time it converts to or from numpy its own way; the
+    table readers and writers read and build the columns' buffers directly, nulls and whole numbers included."""
+    rec = simulate_function("mti10", profile="chamber", rate_hz=1, duration_s=1800, seed=1).recording
+    gyrocomp.fit_calibration([rec], temperature=1, hysteresis="none").save(tmp_path / "model.json")
+    gyrocomp.write(rec, tmp_path / "run.csv")
+    lines = (tmp_path / "run.csv").read_text().splitlines()
+    lines[0] += ",count"
+    lines[1:] = [line + f",{i}" for i, line in enumerate(lines[1:])]
+    cells = lines[5].split(",")
+    cells[1] = ""  # an empty gyro cell: a null in the column
+    lines[5] = ",".join(cells)
+    (tmp_path / "run.csv").write_text("\n".join(lines) + "\n")
+    code = ("from gyrocomp.cli import main; "
+            f"assert main(['-q', 'apply', r'{tmp_path / 'model.json'}', r'{tmp_path / 'run.csv'}', '--drop-nan', "
+            f"'-o', r'{tmp_path / 'out.parquet'}']) == 0; "
+            f"assert main(['-q', 'convert', r'{tmp_path / 'out.parquet'}', r'{tmp_path / 'back.csv'}']) == 0")
+    assert "pandas" not in _modules_after(code)
+    back = gyrocomp.read(tmp_path / "back.csv")
+    assert back.n_samples == rec.n_samples - 1

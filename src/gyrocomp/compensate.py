@@ -14,7 +14,7 @@ from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
 from .plausibility import recording_concerns
 from .io.stream import CHUNK_ROWS, NotStreamable, TableStream, TableWriter
-from .io.tables import TableLayout, read_table, write_gyro_back
+from .io.tables import TableLayout, arrow_floats, arrow_indices, read_table, write_gyro_back
 from .recording import ACCEL_AXES, GYRO_AXES, Recording
 from .units import unit_factor
 
@@ -432,7 +432,7 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
                 for j, axis in enumerate(names):
                     column = stream.columns[axis]
                     out = out.set_column(out.column_names.index(column), column,
-                                         pa.array(values[:, j] / factor, type=pa.float64()))
+                                         arrow_floats(values[:, j] / factor))
             writer.write(out)
             written += out.num_rows
 
@@ -454,7 +454,7 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
             accel = None
             if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes):
                 accel = rec.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
-            rows = chunk.table if chunk.kept.size == chunk.table.num_rows else chunk.table.take(pa.array(chunk.kept))
+            rows = chunk.table if chunk.kept.size == chunk.table.num_rows else chunk.table.take(arrow_indices(chunk.kept))
             pending.append(rows)
             gyro = comp.update(rec.time_s, rec.gyro_dps, rec.temperature_degc, accel)
             accel_out = None

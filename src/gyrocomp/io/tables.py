@@ -223,16 +223,54 @@ def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str
         raise InputError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
 
 
+def arrow_floats(values: np.ndarray) -> pa.Array:
+    """A float64 Arrow array of ``values`` (zero-copy when they are contiguous float64). Unlike ``pa.array``, it
+    does not make pyarrow import pandas (a third of a second at start-up)."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    return pa.Array.from_buffers(pa.float64(), values.size, [None, pa.py_buffer(values)])
+
+
+def arrow_indices(values: np.ndarray) -> pa.Array:
+    """An int64 Arrow array of ``values`` (row indices for ``take``), without pandas (see :func:`arrow_floats`)."""
+    values = np.ascontiguousarray(values, dtype=np.int64)
+    return pa.Array.from_buffers(pa.int64(), values.size, [None, pa.py_buffer(values)])
+
+
+def _to_numpy(array: pa.ChunkedArray) -> np.ndarray:
+    """The column's numbers as float64 [its unit], nulls as NaN, read from the chunks' buffers: pyarrow's
+    ``to_numpy`` imports pandas (a third of a second at start-up)."""
+    parts = [_chunk_numbers(chunk) for chunk in array.chunks]
+    if not parts:
+        return np.empty(0)
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
+def _chunk_numbers(chunk: pa.Array) -> np.ndarray:
+    kind = chunk.type
+    if not (pa.types.is_integer(kind) or pa.types.is_float32(kind) or pa.types.is_float64(kind)):
+        return chunk.to_numpy(zero_copy_only=False).astype(float, copy=False)
+    validity, data = chunk.buffers()[:2]
+    dtype = np.dtype(np.float32 if pa.types.is_float32(kind) else np.float64 if pa.types.is_float64(kind)
+                     else kind.to_pandas_dtype())
+    values = np.frombuffer(data, dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize)
+    values = values.astype(float, copy=False)
+    if chunk.null_count:
+        bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
+        valid = bits[chunk.offset:chunk.offset + len(chunk)].astype(bool)
+        values = np.where(valid, values, np.nan)
+    return values
+
+
 def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
     array = table.column(column)
     if pa.types.is_floating(array.type) or pa.types.is_integer(array.type):
-        return array.to_numpy(zero_copy_only=False).astype(float, copy=False)
+        return _to_numpy(array).astype(float, copy=False)
     if pa.types.is_null(array.type):
         return np.full(len(array), np.nan)
     if pa.types.is_boolean(array.type) or pa.types.is_timestamp(array.type):
         raise InputError(f"{source}: column {column!r} has type {array.type}; expected numbers")
     try:  # numbers stored as text (quoted, say): one vectorized cast; only on failure find the bad row
-        return pc.cast(array, pa.float64()).to_numpy(zero_copy_only=False)
+        return _to_numpy(pc.cast(array, pa.float64()))
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
         pass
     values = array.to_pylist()
@@ -424,7 +462,7 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
     fmt = fmt or detect_table_format(path) or "csv"
     table = data.table
     if data.kept_rows.size < table.num_rows:
-        table = table.take(pa.array(data.kept_rows))
+        table = table.take(arrow_indices(data.kept_rows))
     replaced = [(data.recording.gyro_axes, gyro_dps, unit_factor("gyro", data.layout.gyro_unit))]
     if accel_g is not None:
         replaced.append((data.recording.accel_axes, accel_g, unit_factor("accel", data.layout.accel_unit)))
@@ -432,7 +470,7 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
         for j, axis in enumerate(axes):
             column = data.resolved_columns[axis]
             values = values_internal[:, j] / factor
-            table = table.set_column(table.column_names.index(column), column, pa.array(values, type=pa.float64()))
+            table = table.set_column(table.column_names.index(column), column, arrow_floats(values))
     _write_arrow(table, path, fmt)
 
 
@@ -452,7 +490,7 @@ def recording_table(recording: Recording, extra_columns: dict[str, np.ndarray] |
             columns[name] = recording.reference_rate_dps[:, j]
     for name, values in (extra_columns or {}).items():
         columns[name] = np.asarray(values, dtype=float)
-    return pa.table(columns)
+    return pa.table({name: arrow_floats(values) for name, values in columns.items()})
 
 
 def table_data(recording: Recording) -> TableData:
