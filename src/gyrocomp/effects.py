@@ -29,12 +29,33 @@ G_SQUARED_TERMS = ("xx", "yy", "zz", "xy", "xz", "yz")
 
 # -- thermal lag ------------------------------------------------------------------------------------
 
+#: a first-order filter of at most this many samples runs in Python (about 0.1 us a sample) rather than import
+#: scipy.signal (0.6 s) for it
+PYTHON_FILTER_SAMPLES = 100_000
+
+
 def lazy_lfilter(b, a, x, zi=None):
     """``scipy.signal.lfilter``, imported on first use: scipy.signal costs most of a second at start-up and
-    most commands never filter."""
+    most commands never filter. A first-order filter (``a = [1, a1]``) of a short input runs in Python with
+    scipy's operations in scipy's order (its direct form II transposed: y = x b0 + z, z = x b1 - y a1), so the
+    result is the same to the bit (tested)."""
+    x = np.asarray(x, dtype=float)
+    if len(a) == 2 and a[0] == 1.0 and len(b) <= 2 and x.ndim == 1 and x.size <= PYTHON_FILTER_SAMPLES:
+        return _first_order(b, a, x, zi)
     from scipy.signal import lfilter
 
     return lfilter(b, a, x) if zi is None else lfilter(b, a, x, zi=zi)
+
+
+def _first_order(b, a, x: np.ndarray, zi):
+    b0, b1, a1 = float(b[0]), float(b[1]) if len(b) > 1 else 0.0, float(a[1])
+    z = 0.0 if zi is None else float(np.asarray(zi, dtype=float).reshape(-1)[0])
+    out = np.empty(x.size)
+    for i, value in enumerate(x.tolist()):
+        y = value * b0 + z
+        z = value * b1 - y * a1
+        out[i] = y
+    return out if zi is None else (out, np.array([z]))
 
 def lag_coefficients(step_s: float, time_constant_s: float) -> tuple[float, float, float]:
     """Coefficients (a, b0, b1) of the exact first-order lag for an input linear between samples.
