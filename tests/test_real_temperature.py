@@ -1,11 +1,17 @@
 """Temperature compensation on a real recording: the CATS tag, three static runs cooled then warmed
 (../shared/datasets/skdivemove-cats-tempcal), each compensated by a fit on the other two."""
 
+import warnings
+
 import numpy as np
 import pytest
 
+from gyrocomp import apply
+from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.models.online import OnlineCalibrator, replay
+
 from .conftest import shared_dataset
-from .real_data import CATS_CHOICES, cats_held_out_drift, cats_numpy_cubic_drift, cats_runs
+from .real_data import CATS_CHOICES, CATS_WINDOW_S, cats_held_out_drift, cats_numpy_cubic_drift, cats_runs
 
 pytestmark = pytest.mark.slow
 
@@ -33,3 +39,23 @@ def test_default_leaves_at_most_0_9_of_a_plain_cubic(drift):
     assert default.mean() <= 0.9 * cubic.mean()
     # and no axis is left worse than the cubic leaves it by more than the spread of its folds
     assert np.all(default.mean(axis=0) <= cubic.mean(axis=0) + cubic.std(axis=0))
+
+
+def test_the_online_learner_does_as_well_as_a_plain_cubic():
+    """The online learner, replayed over two runs (each one power-on), judged on the third by the same protocol:
+    as good as the plain cubic fitted on every sample (measured 0.98x; 0.0257 against 0.0262 deg/s), though it
+    keeps only its still pieces and points. An attitude that changes only between power-ons gives it no
+    g-sensitivity (it cannot be told from the power-ons' constants)."""
+    shared_dataset("skdivemove-cats-tempcal")
+    runs = cats_runs()
+    drift = np.zeros((3, 3))
+    for held in range(3):
+        learner = OnlineCalibrator(runs[0].rate_hz)
+        replay(learner, [r for i, r in enumerate(runs) if i != held])
+        model = learner.to_calibration()
+        assert all(ax.g_sensitivity_dps_per_g is None for ax in model.axes.values())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            compensated = apply(model, runs[held]).gyro_dps
+        drift[held] = [smoothed_residual_rms(compensated[:, j], CATS_WINDOW_S) for j in range(3)]
+    assert drift.mean() <= 1.1 * cats_numpy_cubic_drift().mean()

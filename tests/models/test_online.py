@@ -268,7 +268,7 @@ def test_the_c_learner_matches_python(tmp_path):
     out = subprocess.run([str(exe)], input="\n".join(lines) + "\n", capture_output=True, text=True,
                          check=True).stdout.splitlines()
     status = learner.status
-    assert status.rejected_outliers >= 3
+    assert status.rejected_outliers >= 2  # the slow turn: its pieces went to the pool, which replaced the points
     head = out[0].split()
     assert [int(v) for v in head[:5]] == [status.degree, learner._lag_index, learner._sessions.size,
                                           status.rejected_outliers, status.rejected_bound]

@@ -29,8 +29,8 @@ import math
 
 from ..errors import InputError
 from ..models.online import (GAP_PERIODS, LEVEL_GROWTH, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G,
-                             POINTS_PER_TILT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC, LearnerSettings, _MAD_TO_SIGMA,
-                             _RIDGE)
+                             PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC,
+                             LearnerSettings, _MAD_TO_SIGMA, _RIDGE)
 from ..stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY, MIN_BLOCK_SAMPLES
 
 
@@ -86,7 +86,8 @@ typedef struct gyrocomp_learner {
            pt_clock[GL_POINTS];
     int pt_session[GL_POINTS], pt_bin[GL_POINTS];
     /* the model */
-    int degree, lag_index, n_sessions, tilted[3], n_params, dof;
+    int degree, lag_index, n_sessions, tilted[3], n_params, dof, judged;
+    double piece_var[3], residual[3];   /* accepted pieces' mean square residual; the last judged residual */
     double coef[3][3], g[3][3], constants[GL_SESSIONS][3], rms[3], t_min, t_max;
     int sessions[GL_SESSIONS];
     double lower[GL_PARAMS][GL_PARAMS], scale2[3];
@@ -125,6 +126,7 @@ static const double CUBIC_SPAN = @CUBIC_SPAN@, MIN_SPAN = @MIN_SPAN@, HALF_LIFE_
 static const double STALE_H = @STALE_H@, MAX_BIAS = @MAX_BIAS@, OUTLIER_DPS = @OUTLIER_DPS@;
 static const double OUTLIER_SIGMAS = @OUTLIER_SIGMAS@, MAX_TEMPCO = @MAX_TEMPCO@, SAVE_CHANGE = @SAVE_CHANGE@;
 static const double GAP_PERIODS = @GAP_PERIODS@, LEVEL_GROWTH = @LEVEL_GROWTH@, MAD_TO_SIGMA = @MAD@;
+static const double PIECE_WEIGHT = @PIECE_WEIGHT@;
 static const double MIN_TILT = @MIN_TILT@, RIDGE = @RIDGE@, T_REF = @T_REF@, T_SCALE = @T_SCALE@;
 static const double CEILING2[6] = @CEILING@;
 
@@ -194,6 +196,7 @@ void gyrocomp_learn_init(gyrocomp_learner *s, double rate_hz)
     for (int k = 0; k < GL_LAGS; ++k)
         s->nominal[k] = LAGS_S[k] > 0 ? 1.0 - exp(-s->period_s / LAGS_S[k]) : 1.0;
     for (int c = 0; c < 6; ++c) s->level[c] = NAN;
+    for (int j = 0; j < 3; ++j) s->piece_var[j] = NAN;
     s->has_accel = -1;
     s->broken = 1;
     s->piece_bin = -1;
@@ -352,14 +355,19 @@ static void refit(gyrocomp_learner *s, double now)
     int degree = span >= CUBIC_SPAN ? MAX_DEGREE : (span >= MIN_SPAN ? 1 : 0);
     while (degree > 0 && n < degree + n_sessions + 1) --degree;
     int tilted[3] = {0, 0, 0}, spare = n - degree - n_sessions - 1;
-    for (int a = 0; a < 3; ++a) {
-        double amin = INFINITY, amax = -INFINITY;
-        for (int m = 0; m < n; ++m) {
-            double v = s->pt_accel[used[m]][a];
-            if (v < amin) amin = v;
-            if (v > amax) amax = v;
+    for (int a = 0; a < 3; ++a) {   /* the range within one power-on */
+        double span = 0.0;
+        for (int q = 0; q < n_sessions; ++q) {
+            double amin = INFINITY, amax = -INFINITY;
+            for (int m = 0; m < n; ++m) {
+                if (s->pt_session[used[m]] != sessions[q]) continue;
+                double v = s->pt_accel[used[m]][a];
+                if (v < amin) amin = v;
+                if (v > amax) amax = v;
+            }
+            if (amax - amin > span) span = amax - amin;
         }
-        if (spare >= POINTS_PER_TILT && amax - amin >= MIN_TILT) { tilted[a] = 1; spare -= POINTS_PER_TILT; }
+        if (spare >= POINTS_PER_TILT && span >= MIN_TILT) { tilted[a] = 1; spare -= POINTS_PER_TILT; }
     }
     for (int m = 0; m < n; ++m) weights[m] = s->pt_s[used[m]] * decay(now - s->pt_clock[used[m]]);
     static fit_result best, trial;   /* large: kept off the stack (the learner is not reentrant) */
@@ -402,8 +410,12 @@ static void refit(gyrocomp_learner *s, double now)
     s->should_save = changed(s);
 }
 
-static int is_outlier(gyrocomp_learner *s, const double bias[3], const double accel[3], const double *temps)
+/* a piece (piece = 1: judged with the accepted pieces' own scatter) or a point beyond the outlier limit; a judged
+   piece's residual is left in s->residual (s->judged = 1) */
+static int is_outlier(gyrocomp_learner *s, const double bias[3], const double accel[3], const double *temps,
+                      int piece)
 {
+    s->judged = 0;
     if (s->degree < 0) return 0;
     double tm = temps[s->lag_index];
     int mine = -1, points = 0;
@@ -425,6 +437,7 @@ static int is_outlier(gyrocomp_learner *s, const double bias[3], const double ac
         for (int a = 0; a < 3; ++a) ga += s->g[j][a] * accel[a];
         predicted[j] = curve(s->coef[j], s->degree, s->t_min, s->t_max, tm) + ga + median(offsets, n);
         spread2[j] = s->rms[j] * s->rms[j];
+        if (piece && !isnan(s->piece_var[0]) && s->piece_var[j] > spread2[j]) spread2[j] = s->piece_var[j];
     }
     double x[GL_PARAMS], y[GL_PARAMS], clipped = tm < s->t_min ? s->t_min : (tm > s->t_max ? s->t_max : tm);
     double u = (clipped - T_REF) / T_SCALE;
@@ -437,12 +450,15 @@ static int is_outlier(gyrocomp_learner *s, const double bias[3], const double ac
     for (int i = 0; i < p; ++i) zz += y[i] * y[i];
     double beyond = s->t_min - tm > tm - s->t_max ? s->t_min - tm : tm - s->t_max;
     if (beyond < 0.0) beyond = 0.0;
+    int outlier = 0;
     for (int j = 0; j < 3; ++j) {
         double sd = OUTLIER_SIGMAS * sqrt(spread2[j] + s->scale2[j] * zz);
         double limit = (OUTLIER_DPS > sd ? OUTLIER_DPS : sd) + MAX_TEMPCO * beyond;
-        if (fabs(bias[j] - predicted[j]) > limit) return 1;
+        s->residual[j] = bias[j] - predicted[j];
+        if (fabs(s->residual[j]) > limit) outlier = 1;
     }
-    return 0;
+    s->judged = 1;
+    return outlier;
 }
 
 static void store(gyrocomp_learner *s, int bin, const double bias[3], const double accel[3], const double *temps,
@@ -546,9 +562,16 @@ static int commit(gyrocomp_learner *s, int bin, const double bias[3], const doub
 {
     for (int j = 0; j < 3; ++j)
         if (fabs(bias[j]) > MAX_BIAS) { s->rejected_bound += 1; return 0; }
-    if (is_outlier(s, bias, accel, temps)) {
+    if (is_outlier(s, bias, accel, temps, 1)) {
         s->rejected_outliers += 1;
         return to_pool(s, bin, bias, accel, temps, seconds, now);
+    }
+    if (s->judged) {   /* the scatter of accepted pieces about the model, a running mean square */
+        int fresh = isnan(s->piece_var[0]);
+        for (int j = 0; j < 3; ++j) {
+            double square = s->residual[j] * s->residual[j];
+            s->piece_var[j] = fresh ? square : (1.0 - PIECE_WEIGHT) * s->piece_var[j] + PIECE_WEIGHT * square;
+        }
     }
     store(s, bin, bias, accel, temps, seconds, now);
     refit(s, now);
@@ -556,7 +579,7 @@ static int commit(gyrocomp_learner *s, int bin, const double bias[3], const doub
     static int bad[GL_POINTS];
     int n_bad = 0;
     for (int i = 0; i < GL_POINTS; ++i)
-        if (s->pt_session[i] == s->session && is_outlier(s, s->pt_bias[i], s->pt_accel[i], s->pt_t[i]))
+        if (s->pt_session[i] == s->session && is_outlier(s, s->pt_bias[i], s->pt_accel[i], s->pt_t[i], 0))
             bad[n_bad++] = i;
     if (n_bad) {
         double seconds_bad = 0.0;
@@ -852,7 +875,7 @@ def learner_c_sources(settings: LearnerSettings | None = None) -> dict[str, str]
         "STALE_H": _num(s.stale_h), "MAX_BIAS": _num(s.max_bias_dps), "OUTLIER_DPS": _num(s.outlier_dps),
         "OUTLIER_SIGMAS": _num(s.outlier_sigmas), "MAX_TEMPCO": _num(s.max_tempco_dps_per_degc),
         "SAVE_CHANGE": _num(s.save_change_dps), "GAP_PERIODS": _num(GAP_PERIODS), "LEVEL_GROWTH": _num(LEVEL_GROWTH),
-        "MAD": _num(_MAD_TO_SIGMA), "MIN_TILT": _num(MIN_TILT_G), "RIDGE": _num(_RIDGE), "T_REF": _num(T_REF_DEGC),
+        "MAD": _num(_MAD_TO_SIGMA), "MIN_TILT": _num(MIN_TILT_G), "PIECE_WEIGHT": _num(PIECE_SPREAD_WEIGHT), "RIDGE": _num(_RIDGE), "T_REF": _num(T_REF_DEGC),
         "T_SCALE": _num(T_SCALE_DEGC),
         "CEILING": "{" + ", ".join([_num(MAX_GYRO_NOISE_DENSITY ** 2)] * 3 + [_num(MAX_ACCEL_NOISE_DENSITY ** 2)] * 3)
                    + "}",

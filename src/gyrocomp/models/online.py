@@ -52,7 +52,7 @@ memory, what Android's over-temperature calibration (AOSP ``over_temp_cal``), Ar
 8. **The model**, refitted after every accepted piece by weighted least squares on the points: bias =
    sum_k c_k u^k + G a + b_session, u = (T_lag - 25) / 25 degC, one constant per session (each power-on has its own
    turn-on bias), G the g-sensitivity [deg/s/g] of the accelerometer axes the points excite (a range of
-   MIN_TILT_G, POINTS_PER_TILT spare points each); weights still time x 2^(-age / half_life_h). The degree is
+   MIN_TILT_G within one power-on, POINTS_PER_TILT spare points each); weights still time x 2^(-age / half_life_h). The degree is
    ``degree`` once the points span ``cubic_span_degc``, 1 from ``min_span_degc``, else 0 (constants only), and
    lower while there are too few points; solved by Cholesky on the normal equations for every candidate lag, the
    one leaving the smallest weighted residual kept. Past the temperatures it has seen the curve continues along
@@ -113,6 +113,8 @@ POINTS_PER_TILT = 3
 #: session (whose median offset is its constant)
 MIN_OUTLIER_DOF = 5
 MIN_SESSION_POINTS = 3
+#: weight of each judged piece in the running mean square of the pieces' residuals
+PIECE_SPREAD_WEIGHT = 0.05
 #: the last rejected pieces of a session kept, to overrule its points when they agree and outweigh them
 POOL_PIECES = 4
 #: relative ridge on the normal equations' diagonal (guards a nearly singular system)
@@ -353,6 +355,9 @@ class OnlineCalibrator:
         self._lower = np.zeros((0, 0))  # Cholesky factor of the last fit's normal matrix
         self._scale2 = np.zeros(3)  # rms^2 sum(w) / n of the last fit, per axis
         self._dof = 0  # its residual degrees of freedom
+        self._piece_var = np.full(3, np.nan)  # running mean square of accepted pieces' residuals [(deg/s)^2]
+        self._offset_cache: tuple[int, np.ndarray] | None = None  # (session, its median offset)
+        self._residual: np.ndarray | None = None
         self._sessions = np.zeros(0, dtype=int)
         self._constants = np.zeros((0, 3))
         self._rms = np.zeros(3)
@@ -543,12 +548,12 @@ class OnlineCalibrator:
             self._ring_pos[c] = (self._ring_pos[c] + 1) % self.settings.history_blocks
             self._var_count[c] = min(self._var_count[c] + 1, self.settings.history_blocks)
         quiet = True
+        estimates = self._ring_quantiles(self._var_ring, self._var_count, channels, self.settings.noise_quantile)
         for c in range(channels):
             if self._var_count[c] < self.settings.history_blocks // 2:
                 quiet = False
                 continue
-            estimate = float(_quantile(self._var_ring[:self._var_count[c], c], self.settings.noise_quantile)
-                             ) * self._noise_factor
+            estimate = float(estimates[c]) * self._noise_factor
             held = self._level[c] * LEVEL_GROWTH
             self._level[c] = estimate if not held < estimate else held
             if self._level[c] > self._ceiling[c]:
@@ -576,13 +581,14 @@ class OnlineCalibrator:
         step = np.abs(record["mean"] - previous["mean"])
         both_quiet = previous["quiet"] and record["quiet"]
         agree = True
+        medians = self._ring_quantiles(self._step_ring, self._step_count, channels, 0.5)
         for c in range(channels):
             level = self._level[c]
             if not level > 0:
                 continue
             scale = math.sqrt(2.0 * level / self._w)
             if self._step_count[c] >= MIN_STEPS:
-                robust = float(_quantile(self._step_ring[:self._step_count[c], c], 0.5)) / _MAD_TO_SIGMA
+                robust = float(medians[c]) / _MAD_TO_SIGMA
                 scale = max(scale, robust)
             if step[c] > self._z[f"step{channels}"] * scale:
                 agree = False
@@ -592,6 +598,15 @@ class OnlineCalibrator:
                 self._step_pos[c] = (self._step_pos[c] + 1) % self.settings.history_blocks
                 self._step_count[c] = min(self._step_count[c] + 1, self.settings.history_blocks)
         return agree
+
+    @staticmethod
+    def _ring_quantiles(ring: np.ndarray, counts: np.ndarray, channels: int, q: float) -> np.ndarray:
+        """The ``q`` quantile of each channel's filled part of a ring (NaN where empty); one sort for all
+        channels when they hold as many values (the usual case), the same numbers as one channel at a time."""
+        first = int(counts[0])
+        if first and np.all(counts[:channels] == first):
+            return _quantile(ring[:first, :channels], q)
+        return np.array([_quantile(ring[:int(counts[c]), c], q) if counts[c] else np.nan for c in range(channels)])
 
     def _interior(self, block: dict, interior: bool, now: float) -> None:
         s = self.settings
@@ -626,10 +641,14 @@ class OnlineCalibrator:
         if np.any(np.abs(bias) > s.max_bias_dps):
             self._counts["rejected_bound"] += 1
             return
-        if self._is_outlier(bias, accel, temperature):
+        if self._is_outlier(bias, accel, temperature, piece=True):
             self._counts["rejected_outliers"] += 1
             self._to_pool(bin_index, bias, accel, temperature, seconds, now)
             return
+        if self._residual is not None:  # the scatter of accepted pieces about the model, a running mean square
+            square = self._residual * self._residual
+            self._piece_var = square if np.isnan(self._piece_var[0]) else \
+                (1.0 - PIECE_SPREAD_WEIGHT) * self._piece_var + PIECE_SPREAD_WEIGHT * square
         self._store(bin_index, bias, accel, temperature, seconds, now)
         self._refit(now)
         # the session's points judged again by the model they made: a bad first piece, accepted while its
@@ -706,7 +725,12 @@ class OnlineCalibrator:
     def _decay(self, age_s: float) -> float:
         return 2.0 ** (-age_s / (self.settings.half_life_h * 3600.0))
 
-    def _is_outlier(self, bias: np.ndarray, accel: np.ndarray, temperatures: np.ndarray) -> bool:
+    def _is_outlier(self, bias: np.ndarray, accel: np.ndarray, temperatures: np.ndarray, *,
+                    piece: bool = False) -> bool:
+        """Whether a piece (``piece``: judged with the pieces' own scatter, which a point's averaging hides) or a
+        point lies beyond the outlier limit (see the module, step 6); a judged piece's residual is kept in
+        ``self._residual``."""
+        self._residual = None
         if self._degree < 0:
             return False
         temperature = float(temperatures[self._lag_index])
@@ -716,10 +740,9 @@ class OnlineCalibrator:
         points = np.flatnonzero(self._pt_session == self._session)
         if points.size < MIN_SESSION_POINTS or mine.size == 0 or self._dof < MIN_OUTLIER_DOF:
             return False  # the session's constant is not known robustly yet, or the model is too young to judge
-        # this session's constant, robustly: the median of its points' offsets from the curve
-        offsets = self._pt_bias[points] - self._shape(self._pt_t[points, self._lag_index]) \
-            - self._pt_accel[points] @ self._g.T
-        predicted, spread2 = shape + np.median(offsets, axis=0), self._rms ** 2
+        predicted, spread2 = shape + self._session_offset(points), self._rms ** 2
+        if piece and not np.isnan(self._piece_var[0]):
+            spread2 = np.maximum(spread2, self._piece_var)
         sessions = np.zeros(self._sessions.size)
         sessions[mine[0]] = 1.0
         # the model's own uncertainty there: s^2 x' (X'WX)^-1 x, s^2 = rms^2 sum(w) / n
@@ -732,7 +755,17 @@ class OnlineCalibrator:
         low, high = self._t_range
         beyond = max(low - temperature, temperature - high, 0.0)
         limit = np.maximum(s.outlier_dps, s.outlier_sigmas * np.sqrt(spread2)) + s.max_tempco_dps_per_degc * beyond
-        return bool(np.any(np.abs(bias - predicted) > limit))
+        self._residual = bias - predicted
+        return bool(np.any(np.abs(self._residual) > limit))
+
+    def _session_offset(self, points: np.ndarray) -> np.ndarray:
+        """This session's constant, robustly: the median of its points' offsets from the curve (kept until the
+        model or the points change: every change is followed by a refit, which forgets it)."""
+        if self._offset_cache is None or self._offset_cache[0] != self._session:
+            offsets = self._pt_bias[points] - self._shape(self._pt_t[points, self._lag_index]) \
+                - self._pt_accel[points] @ self._g.T
+            self._offset_cache = (self._session, np.median(offsets, axis=0))
+        return self._offset_cache[1]
 
     def _drop_old_sessions(self) -> None:
         old = (self._pt_session > 0) & (self._pt_session <= self._session - self.settings.max_sessions)
@@ -742,6 +775,7 @@ class OnlineCalibrator:
             self._refit(self._clock)
 
     def _refit(self, now: float) -> None:
+        self._offset_cache = None
         s = self.settings
         stale = (self._pt_session > 0) & (now - self._pt_clock > s.stale_h * 3600.0)
         if np.any(stale):
@@ -757,7 +791,7 @@ class OnlineCalibrator:
         while degree > 0 and used.size < degree + sessions.size + 1:
             degree -= 1
         accel = self._pt_accel[used]
-        tilted = _tilted(accel, used.size - degree - sessions.size - 1)
+        tilted = _tilted(accel, self._pt_session[used], sessions, used.size - degree - sessions.size - 1)
         weights = np.array([self._pt_s[i] * self._decay(now - self._pt_clock[i]) for i in used])
         while True:
             # every candidate lag, the one leaving the smallest weighted residual kept (the first of equals)
@@ -942,6 +976,7 @@ class OnlineCalibrator:
                       "constants_dps": self._constants.tolist(), "rms_dps": self._rms.tolist(),
                       "t_range_degc": list(self._t_range), "should_save": self._should_save,
                       "lag_index": self._lag_index, "dof": self._dof, "lower": self._lower.tolist(),
+                      "piece_var": [None if math.isnan(v) else float(v) for v in self._piece_var],
                       "scale2": self._scale2.tolist(),
                       "saved": None if self._saved is None else {
                           "degree": self._saved["degree"], "coef": self._saved["coef"].tolist(),
@@ -1074,12 +1109,14 @@ def _curve(coef: np.ndarray, degree: int, t_range: tuple[float, float], temperat
     return out + slope * beyond
 
 
-def _tilted(accel: np.ndarray, spare: int) -> np.ndarray:
-    """Which accelerometer axes the points excite enough (a range of MIN_TILT_G) to fit their g-sensitivity,
-    POINTS_PER_TILT of the ``spare`` points (beyond the other unknowns) for each."""
+def _tilted(accel: np.ndarray, point_sessions: np.ndarray, sessions: np.ndarray, spare: int) -> np.ndarray:
+    """Which accelerometer axes the points excite enough to fit their g-sensitivity: a range of MIN_TILT_G within
+    one power-on (an attitude that changes only from one power-on to the next cannot be told from the power-ons'
+    constants), POINTS_PER_TILT of the ``spare`` points (beyond the other unknowns) for each."""
     out = np.zeros(3, dtype=bool)
     for k in range(3):
-        if spare >= POINTS_PER_TILT and accel[:, k].max() - accel[:, k].min() >= MIN_TILT_G:
+        span = max(float(np.ptp(accel[point_sessions == q, k])) for q in sessions)
+        if spare >= POINTS_PER_TILT and span >= MIN_TILT_G:
             out[k] = True
             spare -= POINTS_PER_TILT
     return out
@@ -1100,11 +1137,11 @@ def _weighted_fit(temps, accel, tilted, bin_sessions, sessions, bias, weights, d
     RMS (3,)), or None when the system is not positive definite."""
     x = _design(temps, accel, tilted, bin_sessions, sessions, degree)
     n, p = x.shape
-    a = np.zeros((p, p))
-    b = np.zeros((p, 3))
-    for i in range(n):
-        a += weights[i] * np.outer(x[i], x[i])
-        b += weights[i] * np.outer(x[i], bias[i])
+    # sums over the points in their order, each term w (x_r x_c): a reduction over the first axis of a contiguous
+    # array adds the points one after the other, as the C code does
+    w = np.asarray(weights, dtype=float)[:, None, None]
+    a = np.ascontiguousarray(w * (x[:, :, None] * x[:, None, :])).sum(axis=0)
+    b = np.ascontiguousarray(w * (x[:, :, None] * np.asarray(bias, dtype=float)[:, None, :])).sum(axis=0)
     for i in range(p):
         a[i, i] *= 1.0 + _RIDGE
     lower = _cholesky(a)
@@ -1271,6 +1308,7 @@ def _restore_model(self: OnlineCalibrator, model: dict) -> None:
     self._should_save = bool(model["should_save"])
     self._lag_index = int(model["lag_index"])
     self._dof = int(model["dof"])
+    self._piece_var = np.array([np.nan if v is None else float(v) for v in model["piece_var"]]).reshape(3)
     if not 0 <= self._lag_index < self._lags:
         raise InputError(f"model.lag_index: {self._lag_index} outside 0..{self._lags - 1}")
     p = 0 if self._degree < 0 else self._degree + int(self._tilted.sum()) + self._sessions.size
