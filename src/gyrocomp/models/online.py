@@ -34,8 +34,9 @@ memory, what Android's over-temperature calibration (AOSP ``over_temp_cal``), Ar
 6. **Rejection**: a piece beyond ``max_bias_dps`` (no MEMS bias is that large: motion) is rejected. Once the
    model has MIN_OUTLIER_DOF residual degrees of freedom and the session MIN_SESSION_POINTS points, so is a piece
    farther from the model (curve, g-sensitivity and the session's constant, taken as the median offset of its
-   points, so one bad point cannot poison it) than max(``outlier_dps``, ``outlier_sigmas`` sqrt(rms^2 + se^2)) on
-   any axis (rms the fit's residual RMS, se the model's own standard error there), plus
+   points, so one bad point cannot poison it) than max(``outlier_dps``, ``outlier_sigmas`` sqrt(v + se^2)) on
+   any axis (v the larger of the fit's residual mean square and the accepted pieces' running mean square residual,
+   weight PIECE_SPREAD_WEIGHT, since a point averages many pieces; se the model's own standard error there), plus
    ``max_tempco_dps_per_degc`` for every degree it lies beyond the temperatures the model has seen: a bump, a slow
    turn read as still. After each refit the session's own points are judged the same way and those that fail are
    dropped (a bad first piece, accepted while the session's constant was unknown, goes once the session has
