@@ -15,8 +15,9 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/gyrocomp demo -o demo-output
 
+# two processes (pytest-xdist), each test file in one of them (its module fixtures built once)
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 bench: $(STAMP)
 	$(BIN)/pip install -q -e '.[bench]'
@@ -28,6 +29,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_startup.py
 	$(BIN)/python benchmarks/bench_fleet.py
 	$(BIN)/python benchmarks/bench_prior.py
+	$(BIN)/python benchmarks/bench_learner.py
+	$(BIN)/python benchmarks/bench_apply_stream.py --rows 3e7 --skip-whole
 
 clean:
 	rm -rf $(VENV) demo-output build src/*.egg-info
