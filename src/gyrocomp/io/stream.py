@@ -72,6 +72,7 @@ class TableStream:
         self.chunk_rows = int(chunk_rows)
         self.progress = progress  # called with the fraction of the file read
         self._source = None  # the open CSV file, whose position tells the progress (None: compressed)
+        self._total_rows: int | None = None  # a Parquet file's rows, read once for the progress
         self.schema = self._open_schema()
         self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
         self.gyro_axes = tuple(a for a in GYRO_AXES if a in self.columns)
@@ -216,8 +217,9 @@ class TableStream:
         if not self.progress:
             return
         if self.fmt == "parquet":
-            total = pq.ParquetFile(self.path).metadata.num_rows
-            self.progress(self.rows / total if total else 1.0)
+            if self._total_rows is None:
+                self._total_rows = pq.ParquetFile(self.path).metadata.num_rows
+            self.progress(self.rows / self._total_rows if self._total_rows else 1.0)
         elif self._source is not None:
             with contextlib.suppress(OSError, ValueError):
                 self.progress(self._source.tell() / max(self.path.stat().st_size, 1))
