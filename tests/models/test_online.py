@@ -173,6 +173,9 @@ def test_state_saved_in_the_middle_goes_on_exactly(tmp_path):
     for learner in (straight, resumed):
         learner.end_session()
     assert json.dumps(resumed.to_dict()) == json.dumps(straight.to_dict())
+    fresh = OnlineCalibrator(LearnerSettings(rate_hz=10.0, degree=2))  # a state before any sample loads too
+    fresh.save(tmp_path / "fresh.json")
+    assert OnlineCalibrator.load(tmp_path / "fresh.json").to_dict() == fresh.to_dict()
 
 
 def test_should_save_turns_on_when_the_model_moves():
@@ -364,6 +367,15 @@ def test_learn_through_the_command_line(tmp_path):
     assert one.axes == two.axes
     assert [entry["file"] for entry in one.provenance["inputs"]] == ["log0.csv", "log1.csv"]
     assert run("-q", "apply", tmp_path / "all.json", paths[0], "-o", tmp_path / "out.csv").returncode == 0
+    # the C export bakes a learner state's settings (here 2.5 degC bins) into gyrocomp_learn.c
+    OnlineCalibrator(LearnerSettings(rate_hz=10.0, bin_width_degc=2.5)).save(tmp_path / "coarse.json")
+    done = run("-q", "export", tmp_path / "all.json", "--format", "c", "--rate", 10, "--learner",
+               tmp_path / "coarse.json", "-o", tmp_path / "c")
+    assert done.returncode == 0, done.stderr
+    assert "BIN_WIDTH = 2.5," in (tmp_path / "c" / "gyrocomp_learn.c").read_text()
+    done = run("export", tmp_path / "all.json", "--format", "px4", "--learner", tmp_path / "coarse.json", "-o",
+               tmp_path / "x.params")
+    assert done.returncode == 2 and "--learner" in done.stderr and not (tmp_path / "x.params").exists()
     moving = simulate(PRESET, profile="tumble", rate_hz=10.0, duration_s=600, seed=1, unit=UNIT).recording
     write_recording(moving, tmp_path / "moving.csv")
     done = run("learn", tmp_path / "moving.csv", "-o", tmp_path / "none.json", "--save-state", tmp_path / "s.json")

@@ -8,6 +8,7 @@ from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.autopilot import ardupilot_params_file, px4_params_file
 from ..export.c_code import write_c_sources
+from ..models.online import LearnerSettings, OnlineCalibrator
 
 
 EXPORT_FORMATS = ("px4", "ardupilot", "c")
@@ -24,23 +25,29 @@ EXPORT_FORMATS = ("px4", "ardupilot", "c")
 @click.option("--instance", type=int, default=None, help="Sensor instance: PX4 gyro 0..3 (default 0), ArduPilot IMU 1..3 "
                                                        "(default 1).")
 @click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id (TC_G*_ID).")
+@click.option("--learner", "learner_state", type=click.Path(dir_okay=False), default=None,
+              help="c: bake the online learner's settings from this learner state (gyrocomp learn --save-state) "
+                   "instead of the defaults.")
 @click.pass_context
-def export(ctx, model, fmt, output, rate_hz, instance, device_id):
+def export(ctx, model, fmt, output, rate_hz, instance, device_id, learner_state):
     """Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code."""
 
-    refuse_to_overwrite_inputs(output, [model])
+    refuse_to_overwrite_inputs(output, [model] + ([learner_state] if learner_state else []))
+    if learner_state is not None and fmt != "c":
+        raise click.BadParameter("the learner is exported with --format c only", param_hint="--learner")
+    settings = OnlineCalibrator.load(learner_state).settings if learner_state else None
     write_export(Calibration.load(model), fmt, output, rate_hz=rate_hz, instance=instance, device_id=device_id,
-                 quiet=ctx.obj["quiet"])
+                 quiet=ctx.obj["quiet"], learner=settings)
 
 
 def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, instance=None, device_id: int = 0,
-                 quiet: bool = False) -> None:
+                 quiet: bool = False, learner: LearnerSettings | None = None) -> None:
     """Write ``calibration`` as ``fmt`` (px4, ardupilot, c, or json: the model file) and say what was written."""
     if fmt == "json":
         calibration.save(output)
         written = [output]
     elif fmt == "c":
-        written = write_c_sources(calibration, output, rate_hz=rate_hz)
+        written = write_c_sources(calibration, output, rate_hz=rate_hz, learner=learner)
     else:
         if fmt == "px4":
             text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)

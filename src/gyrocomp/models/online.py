@@ -1303,7 +1303,9 @@ def _restore_model(self: OnlineCalibrator, model: dict) -> None:
     self._g = _finite_array(model["g_dps_per_g"], (3, 3), "model.g_dps_per_g")
     self._tilted = np.array([bool(v) for v in model["tilted"]], dtype=bool).reshape(3)
     self._sessions = np.array(model["sessions"], dtype=int).reshape(-1)
-    self._constants = _finite_array(model["constants_dps"], (self._sessions.size, 3), "model.constants_dps")
+    constants = model["constants_dps"]
+    self._constants = _finite_array(constants if constants else np.zeros((0, 3)), (self._sessions.size, 3),
+                                    "model.constants_dps")
     self._rms = _finite_array(model["rms_dps"], (3,), "model.rms_dps")
     self._t_range = tuple(float(v) for v in model["t_range_degc"])
     self._should_save = bool(model["should_save"])
