@@ -402,13 +402,16 @@ def apply_file(calibration: Calibration, input_path, output_path, *, layout: Tab
         compensated = apply(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=axes)
         accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
         write_gyro_back(data, compensated.gyro_dps, output_path, fmt=out_fmt, accel_g=accel)
-        return FileResult(data.recording.n_samples, _compensated_axes(calibration, data.recording, axes, accel),
-                          False)
+        return FileResult(data.recording.n_samples,
+                          compensated_axes(calibration, data.recording, axes, accel is not None), False)
 
 
-def _compensated_axes(calibration: Calibration, recording: Recording, axes, accel) -> tuple[str, ...]:
+def compensated_axes(calibration: Calibration, recording: Recording, axes: tuple[str, ...] | None,
+                     with_accel: bool) -> tuple[str, ...]:
+    """The axes :func:`apply` compensates in ``recording``: the gyro axes the model covers (those of ``axes``
+    when given), and the accelerometer's when ``with_accel``."""
     done = [a for a in recording.gyro_axes if a in calibration.axes and (axes is None or a in axes)]
-    return tuple(done + (list(recording.accel_axes) if accel is not None else []))
+    return tuple(done + (list(recording.accel_axes) if with_accel else []))
 
 
 def _apply_stream(calibration: Calibration, stream: TableStream, output_path, out_fmt, axes,
@@ -464,5 +467,4 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
             flush(gyro, accel_out)
         flush(comp.finish(), None)
     stream.warn_summary()
-    return FileResult(written, _compensated_axes(calibration, first, axes, True if comp.compensates_accel else None),
-                      True)
+    return FileResult(written, compensated_axes(calibration, first, axes, comp.compensates_accel), True)

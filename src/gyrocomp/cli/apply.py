@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from ..calibration import Calibration
-from ..compensate import apply as apply_calibration, apply_file
+from ..compensate import apply as apply_calibration, apply_file, compensated_axes
 from ..io import TABLE_FORMATS, detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
 from .common import pop_read_options, progress_bar, read_run, read_options, read_settings
 
@@ -43,8 +43,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
         accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
         write_gyro_back(data, compensated.gyro_dps, output, fmt=out_fmt, accel_g=accel)
         rows = data.recording.n_samples
-        done = [a for a in data.recording.gyro_axes if a in calibration.axes and (named is None or a in named)]
-        done += list(data.recording.accel_axes) if accel is not None else []
+        done = compensated_axes(calibration, data.recording, named, accel is not None)
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output}: {rows} rows, {', '.join(done)} compensated")
 

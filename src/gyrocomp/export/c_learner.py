@@ -136,7 +136,7 @@ static double chi2_quantile(double z, double dof)
     return dof * pow(1.0 - h + z * sqrt(h), 3.0);
 }
 
-static double quantile(double *v, int n, double q)   /* sorts v */
+static void sort(double *v, int n)   /* insertion sort: short arrays */
 {
     for (int i = 1; i < n; ++i) {
         double x = v[i];
@@ -144,20 +144,20 @@ static double quantile(double *v, int n, double q)   /* sorts v */
         while (j >= 0 && v[j] > x) { v[j + 1] = v[j]; --j; }
         v[j + 1] = x;
     }
+}
+
+static double quantile(double *v, int n, double q)   /* sorts v */
+{
+    sort(v, n);
     double pos = q * (n - 1);
     int low = (int)floor(pos);
     if (low + 1 >= n) return v[low];
     return v[low] + (pos - low) * (v[low + 1] - v[low]);
 }
 
-static double median(double *v, int n)
+static double median(double *v, int n)   /* sorts v; numpy's median (the mean of the middle two) */
 {
-    for (int i = 1; i < n; ++i) {
-        double x = v[i];
-        int j = i - 1;
-        while (j >= 0 && v[j] > x) { v[j + 1] = v[j]; --j; }
-        v[j + 1] = x;
-    }
+    sort(v, n);
     return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2.0;
 }
 

@@ -25,11 +25,9 @@ import pyarrow.parquet as pq
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
-from ..units import unit_factor
 from .atomic import atomic_path
-from .tables import (_COMPRESSED, TIME_COLUMN, TableLayout, _csv_options, _numeric_column, _reference_rates,
-                     _resolved_columns, _temperature_columns, detect_table_format, keep_finite_rows, recording_table,
-                     sniff_csv)
+from .tables import (_COMPRESSED, TableLayout, _csv_options, _resolved_columns, detect_table_format,
+                     recording_table, sniff_csv, table_recording)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
@@ -165,34 +163,16 @@ class TableStream:
 
     def chunks(self) -> Iterator[TableChunk]:
         """The file's rows as :class:`TableChunk` s, each validated as a recording."""
-        gyro_factor = unit_factor("gyro", self.layout.gyro_unit, "gyro_unit")
-        accel_factor = unit_factor("accel", self.layout.accel_unit, "accel_unit")
-        time_factor = unit_factor("time", self.layout.time_unit, "time_unit")
-        temp_names = _temperature_columns(self.columns, self.gyro_axes)
         last: tuple[float, int] | None = None  # time [s] and row number of the previous chunk's last row
         period = None
         first = 0
         for table in self._tables():
-            num = lambda name: _numeric_column(table, self.columns[name], self.path)  # noqa: E731
-            time_s = num(TIME_COLUMN) * time_factor
-            gyro = np.column_stack([num(a) for a in self.gyro_axes]) * gyro_factor
-            temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
-            accel = np.column_stack([num(a) for a in self.accel_axes]) * accel_factor if self.accel_axes else None
-            reference = _reference_rates(self.columns, num, self.path, gyro_factor)
-            kept = np.arange(table.num_rows)
-            if self.drop_nonfinite:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", DataQualityWarning)  # counted over the file, said once
-                    kept, (time_s, gyro, temp, accel, reference) = keep_finite_rows(self.path, time_s, gyro, temp,
-                                                                                     accel, reference)
-                self.rows_dropped += table.num_rows - kept.size
-            if kept.size < 2:
-                raise InputError(f"{self.path}: rows {first + 1}..{first + table.num_rows}: fewer than 2 rows with "
-                                 "values in every used column")
-            recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=self.gyro_axes, temperature_degc=temp,
-                                  accel_g=accel, accel_axes=self.accel_axes, reference_rate_dps=reference,
-                                  source=str(self.path), row_numbers=first + kept + 1,
-                                  metadata={"path": str(self.path), "format": self.fmt})
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", DataQualityWarning)  # rows dropped: counted over the file, said once
+                recording, kept = table_recording(table, self.columns, self.layout, self.path, self.fmt,
+                                                  drop_nonfinite=self.drop_nonfinite, first_row=first)
+            self.rows_dropped += table.num_rows - kept.size
+            time_s = recording.time_s
             if last is not None:
                 step = float(time_s[0] - last[0])
                 if not step > 0:

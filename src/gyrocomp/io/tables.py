@@ -405,23 +405,7 @@ def read_table(
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
-    gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
-    accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
-    temp_names = _temperature_columns(cols, gyro_axes)
-    num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
-    time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
-    gyro = np.column_stack([num(a) for a in gyro_axes]) * unit_factor("gyro", layout.gyro_unit, "gyro_unit")
-    temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
-    accel = (np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
-             if accel_axes else None)
-    reference = _reference_rates(cols, num, path, unit_factor("gyro", layout.gyro_unit, "gyro_unit"))
-    n = table.num_rows
-    kept = np.arange(n)
-    if drop_nonfinite:
-        kept, (time_s, gyro, temp, accel, reference) = keep_finite_rows(path, time_s, gyro, temp, accel, reference)
-    recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temp, accel_g=accel,
-                          accel_axes=accel_axes, reference_rate_dps=reference, source=str(path), row_numbers=kept + 1,
-                          metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)})
+    recording, kept = table_recording(table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite)
     if recording.gaps:
         longest = max(recording.gaps, key=lambda g: g.duration_s)
         warnings.warn(
@@ -430,6 +414,37 @@ def read_table(
             DataQualityWarning, stacklevel=2,
         )
     return TableData(recording, table, layout, cols, kept, path)
+
+
+def table_recording(table: pa.Table, cols: dict[str, str], layout: TableLayout, path: Path, fmt: str, *,
+                    drop_nonfinite: bool = False, first_row: int = 0) -> tuple[Recording, np.ndarray]:
+    """The recording [s, deg/s, g, degC] of a table's rows (``cols``: channel -> column) and the indices of the
+    rows kept in it (all, or those with every used value finite when ``drop_nonfinite``; a warning says how many
+    went). ``first_row``: the table's first row in its file (0-based), for the row numbers in messages. Used by
+    :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for each chunk."""
+    gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
+    accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
+    temp_names = _temperature_columns(cols, gyro_axes)
+    gyro_factor = unit_factor("gyro", layout.gyro_unit, "gyro_unit")
+    num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
+    time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
+    gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor
+    temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
+    accel = (np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
+             if accel_axes else None)
+    reference = _reference_rates(cols, num, path, gyro_factor)
+    n = table.num_rows
+    kept = np.arange(n)
+    if drop_nonfinite:
+        kept, (time_s, gyro, temp, accel, reference) = keep_finite_rows(path, time_s, gyro, temp, accel, reference)
+        if kept.size < 2:
+            raise InputError(f"{path}: rows {first_row + 1}..{first_row + n}: fewer than 2 rows with values in "
+                             "every used column")
+    recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temp, accel_g=accel,
+                          accel_axes=accel_axes, reference_rate_dps=reference, source=str(path),
+                          row_numbers=first_row + kept + 1,
+                          metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)})
+    return recording, kept
 
 
 def _write_arrow(table: pa.Table, path: Path, fmt: str) -> None:
@@ -517,4 +532,5 @@ __all__ = [
     "recording_table",
     "table_data",
     "file_sha256",
+    "table_recording",
 ]
