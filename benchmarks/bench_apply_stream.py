@@ -1,16 +1,23 @@
-"""Benchmark: ``gyrocomp apply`` on a long Parquet (or CSV) file, peak memory and time (issue #21).
+"""Benchmark: ``gyrocomp apply``, ``allan`` and ``evaluate`` on a long Parquet (or CSV) file, peak memory and
+time (issue #21).
 
 A file of ``--rows`` rows (time, gyro x/y/z, accel x/y/z, temperature; a simulated hour at 100 Hz repeated with
-the time running on, written row group by row group) is compensated, each in a fresh process, by:
+the time running on, written row group by row group) is processed, each in a fresh process, by:
 
 - ``pyarrow``: ``pq.read_table`` + ``pq.write_table`` of the same file (the baseline: plain I/O, nothing done);
-- ``gyrocomp apply``: the command through its entry point (chunks of 2^20 rows: read, validate, compensate, write);
-- ``whole file``: ``read_table`` + ``apply`` + ``write_gyro_back`` (what ``apply`` did before it streamed).
+- ``gyrocomp apply``: the command through its entry point (chunks of 2^18 rows: read, validate, compensate, write);
+- ``whole file``: ``read_table`` + ``apply`` + ``write_gyro_back`` (what ``apply`` did before it streamed);
+- ``gyrocomp allan`` (the three gyro axes, in chunks, phases spilled to temporary files past 8 MiB each) and
+  ``allan whole file`` (``read_table`` of the columns used + ``analyse_noise``, what it did before);
+- ``gyrocomp evaluate`` (the model on the file, in chunks) and ``evaluate whole file`` (``read_table`` +
+  ``evaluate``).
 
-Printed: each one's wall time and peak resident memory (``ru_maxrss`` of its process), and the ratios of
-``gyrocomp apply`` to the baseline.
+Printed: each one's wall time, peak resident memory (``ru_maxrss`` of its process: this includes the pages of the
+memory-mapped temporary files, which are file cache the kernel can drop, not working memory) and peak anonymous
+memory (``RssAnon``, sampled every 20 ms: the working memory), and the ratios to the baseline.
 
 Usage: python benchmarks/bench_apply_stream.py [--rows N] [--format parquet|csv] [--skip-whole]
+       [--commands apply,allan,evaluate]
 """
 
 from __future__ import annotations
@@ -43,11 +50,30 @@ PROGRAMS = {
                    "from gyrocomp import Calibration, apply\nfrom gyrocomp.io.tables import read_table, write_gyro_back\n"
                    "data = read_table(sys.argv[1])\n"
                    "write_gyro_back(data, apply(Calibration.load(sys.argv[3]), data.recording).gyro_dps, sys.argv[2])\n"),
+    "gyrocomp allan": ("import sys\nfrom gyrocomp.cli import main\n"
+                       "sys.exit(main(['--quiet', 'allan', sys.argv[1]]))\n"),
+    "allan whole file": ("import sys, warnings\nwarnings.simplefilter('ignore')\n"
+                         "from gyrocomp.io.tables import read_table\nfrom gyrocomp.noise import analyse_noise\n"
+                         "analyse_noise(read_table(sys.argv[1], channels=('gyro_x', 'gyro_y', 'gyro_z')).recording)\n"),
+    "gyrocomp evaluate": ("import sys\nfrom gyrocomp.cli import main\n"
+                          "sys.exit(main(['--quiet', 'evaluate', sys.argv[3], sys.argv[1]]))\n"),
+    "evaluate whole file": ("import sys, warnings\nwarnings.simplefilter('ignore')\n"
+                            "from gyrocomp import Calibration\nfrom gyrocomp.evaluation import evaluate\n"
+                            "from gyrocomp.io.tables import read_table\n"
+                            "evaluate(Calibration.load(sys.argv[3]), read_table(sys.argv[1]).recording)\n"),
 }
-WRAPPER = ("import resource, runpy, sys, time\nstart = time.perf_counter()\n"
+#: the programs each command runs (the first is its streamed path, the second what it did before)
+COMMANDS = {"apply": ("gyrocomp apply", "whole file"), "allan": ("gyrocomp allan", "allan whole file"),
+            "evaluate": ("gyrocomp evaluate", "evaluate whole file")}
+WRAPPER = ("import resource, sys, threading, time\npeak = [0]\n"
+           "def anon():\n    for line in open('/proc/self/status'):\n"
+           "        if line.startswith('RssAnon:'):\n            return int(line.split()[1])\n    return 0\n"
+           "def watch():\n    while True:\n        peak[0] = max(peak[0], anon())\n        time.sleep(0.02)\n"
+           "threading.Thread(target=watch, daemon=True).start()\nstart = time.perf_counter()\n"
            "try:\n    exec(compile(sys.argv.pop(1), 'program', 'exec'))\nexcept SystemExit as e:\n"
            "    assert not e.code, e.code\n"
-           "print(time.perf_counter() - start, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n")
+           "print(time.perf_counter() - start, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, max(peak[0], anon()),"
+           " file=sys.stderr)\n")
 
 
 def make_file(path: Path, rows: int, fmt: str) -> None:
@@ -66,18 +92,20 @@ def make_file(path: Path, rows: int, fmt: str) -> None:
     writer.close()
 
 
-def measure(name: str, source: Path, target: Path, model: Path) -> tuple[float, float]:
+def measure(name: str, source: Path, target: Path, model: Path) -> tuple[float, float, float]:
+    """(wall time [s], peak RSS [MB], peak anonymous memory [MB]) of one program in a fresh process."""
     done = subprocess.run([sys.executable, "-c", WRAPPER, PROGRAMS[name], str(source), str(target), str(model)],
                           capture_output=True, text=True, check=True)
-    seconds, kb = done.stderr.strip().splitlines()[-1].split()
-    return float(seconds), float(kb) / 1024.0
+    seconds, kb, anon_kb = done.stderr.strip().splitlines()[-1].split()
+    return float(seconds), float(kb) / 1024.0, float(anon_kb) / 1024.0
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rows", type=float, default=3e7)
     parser.add_argument("--format", choices=("parquet", "csv"), default="parquet")
-    parser.add_argument("--skip-whole", action="store_true", help="skip the whole-file run (it needs GBs)")
+    parser.add_argument("--skip-whole", action="store_true", help="skip the whole-file runs (they need GBs)")
+    parser.add_argument("--commands", default="apply,allan,evaluate", help="comma-separated: apply, allan, evaluate")
     args = parser.parse_args()
     rows = int(args.rows)
     warnings.simplefilter("ignore")
@@ -90,17 +118,24 @@ def main() -> None:
                       for s in (2, 3)]).save(model)
         size_mb = source.stat().st_size / 2 ** 20
         print(f"{rows:,} rows, {args.format} {size_mb:,.0f} MB")
-        results = {}
-        for name in PROGRAMS:
-            if name == "whole file" and args.skip_whole:
-                continue
-            results[name] = measure(name, source, tmp / f"out.{args.format}", model)
-            (tmp / f"out.{args.format}").unlink(missing_ok=True)
-            print(f"  {name:15s} {results[name][0]:8.1f} s  {results[name][1]:8.0f} MB peak")
-        base, ours = results["pyarrow"], results["gyrocomp apply"]
-        print(f"  gyrocomp apply: {ours[0] / base[0]:.2f}x pyarrow's time, {ours[1]:.0f} MB peak "
-              f"({ours[1] / base[1]:.2f}x pyarrow's)")
+        results = {"pyarrow": measure("pyarrow", source, tmp / f"out.{args.format}", model)}
+        _print("pyarrow", results["pyarrow"])
+        for command in args.commands.split(","):
+            for name in COMMANDS[command.strip()]:
+                if name.endswith("whole file") and args.skip_whole:
+                    continue
+                results[name] = measure(name, source, tmp / f"out.{args.format}", model)
+                (tmp / f"out.{args.format}").unlink(missing_ok=True)
+                _print(name, results[name])
+        base = results["pyarrow"]
+        for command in args.commands.split(","):
+            ours = results[COMMANDS[command.strip()][0]]
+            print(f"  gyrocomp {command.strip()}: {ours[0] / base[0]:.2f}x pyarrow's time, {ours[1]:.0f} MB peak RSS "
+                  f"({ours[1] / base[1]:.2f}x pyarrow's), {ours[2]:.0f} MB peak anonymous")
 
+
+def _print(name: str, result: tuple[float, float, float]) -> None:
+    print(f"  {name:20s} {result[0]:8.1f} s  {result[1]:8.0f} MB peak RSS  {result[2]:8.0f} MB peak anonymous")
 
 if __name__ == "__main__":
     main()

@@ -13,8 +13,10 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 LAYERS = (
     ("foundation", ("_version", "errors", "units", "threads")),
     ("signals", ("recording", "effects", "allan", "noise", "static", "stillness", "metrics", "plausibility",
-                 "simulate")),
+                 "simulate", "spill")),
     ("io", ("io",)),
+    # files read in chunks and analysed as they come
+    ("files", ("noise_file",)),
     # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve) live beside the
     # estimators of the same curve; neither imports anything above this layer
     ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),

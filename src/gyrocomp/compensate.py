@@ -311,24 +311,38 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     if not isinstance(calibration, Calibration):
         raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
                          f"got {type(calibration).__name__}")
-    calibration = _restricted(calibration, recording, axes)
-    for concern in recording_concerns(recording):
-        warnings.warn(concern.warning(), stacklevel=2)
-    comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
-                       rate_hz=recording.rate_hz, source=recording.source)
-    accel = None
-    if recording.accel_g is not None and set(ACCEL_AXES) <= set(recording.accel_axes):
-        accel = recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
-    elif comp.compensates_accel:
-        raise InputError(f"{recording.source}: the model compensates the accelerometer; the data needs accel_x, "
-                         "accel_y and accel_z columns [g]")
-    out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel)
+    comp = compensator_for(calibration, recording, axes=axes, turn_on_window_s=turn_on_window_s)
+    out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel_xyz(recording))
     rest = comp.finish()
     result = recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)
     if comp.compensates_accel:
         order = [ACCEL_AXES.index(a) for a in recording.accel_axes]
         result = dataclasses.replace(result, accel_g=comp.take_accel()[:, order])
     return result
+
+
+def compensator_for(calibration: Calibration, recording: Recording, *, axes: tuple[str, ...] | None = None,
+                    turn_on_window_s: float | None = None) -> Compensator:
+    """The :class:`Compensator` that :func:`apply` runs on ``recording`` (or on a file whose first chunk it is):
+    the model limited to ``axes`` after checking the recording's axes against it, the recording's plausibility
+    concerns warned about, the accelerometer's three axes required when the model compensates them."""
+    calibration = _restricted(calibration, recording, axes)
+    for concern in recording_concerns(recording):
+        warnings.warn(concern.warning(), stacklevel=3)
+    comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
+                       rate_hz=recording.rate_hz, source=recording.source)
+    if comp.compensates_accel and not set(ACCEL_AXES) <= set(recording.accel_axes):
+        raise InputError(f"{recording.source}: the model compensates the accelerometer; the data needs accel_x, "
+                         "accel_y and accel_z columns [g]")
+    return comp
+
+
+def accel_xyz(recording: Recording) -> np.ndarray | None:
+    """The accelerometer in accel_x, accel_y, accel_z order [g] (what a :class:`Compensator` takes), or None
+    without all three."""
+    if recording.accel_g is not None and set(ACCEL_AXES) <= set(recording.accel_axes):
+        return recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
+    return None
 
 
 def _restricted(calibration: Calibration, recording: Recording, axes: tuple[str, ...] | None) -> Calibration:
@@ -443,20 +457,10 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
             rec = chunk.recording
             if comp is None:
                 first = rec
-                restricted = _restricted(calibration, rec, axes)
-                for concern in recording_concerns(rec):
-                    warnings.warn(concern.warning(), stacklevel=2)
-                comp = Compensator(restricted, rec.gyro_axes, turn_on_window_s=turn_on_window_s, rate_hz=rec.rate_hz,
-                                   source=rec.source)
-                if comp.compensates_accel:
-                    if turn_on_window_s is not None:
-                        raise NotStreamable("the accelerometer is not held back with the turn-on window")
-                    if not set(ACCEL_AXES) <= set(rec.accel_axes):
-                        raise InputError(f"{rec.source}: the model compensates the accelerometer; the data needs "
-                                         "accel_x, accel_y and accel_z columns [g]")
-            accel = None
-            if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes):
-                accel = rec.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
+                comp = compensator_for(calibration, rec, axes=axes, turn_on_window_s=turn_on_window_s)
+                if comp.compensates_accel and turn_on_window_s is not None:
+                    raise NotStreamable("the accelerometer is not held back with the turn-on window")
+            accel = accel_xyz(rec)
             rows = chunk.table if chunk.kept.size == chunk.table.num_rows else chunk.table.take(arrow_indices(chunk.kept))
             pending.append(rows)
             gyro = comp.update(rec.time_s, rec.gyro_dps, rec.temperature_degc, accel)

@@ -13,12 +13,16 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .calibration import Calibration
-from .compensate import apply
+from .compensate import Compensator, accel_xyz, apply, compensator_for
 from .errors import DataQualityWarning, InputError
-from .metrics import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_run
+from .io.stream import NotStreamable, TableStream
+from .io.tables import TableLayout, read_table
+from .metrics import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_phases, evaluate_run
+from .noise_file import ChunkSettings, TimeSteps
+from .allan.streaming import PhaseAccumulator
 from .models.pose_rotation import rotation_errors
 from .models.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
-from .recording import GYRO_AXES, Recording
+from .recording import ACCEL_AXES, GYRO_AXES, Recording
 from .triad import TriadCalibration
 from .installed import installed_calibration
 from .models.field import field_recordings
@@ -193,3 +197,79 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
 
 
 __all__ = ["InstalledComparison", "compare_installed", "StageEvaluation", "evaluate", "evaluate_stages", "stage_calibrations"]
+
+
+def evaluate_file(calibration: Calibration, path, *, layout: TableLayout | None = None, fmt: str | None = None,
+                  drop_nonfinite: bool = False, window_s: float | None = None,
+                  turn_on_window_s: float | None = None, chunks: ChunkSettings = ChunkSettings(),
+                  progress=None) -> Evaluation:
+    """:func:`gyrocomp.evaluation.evaluate` of ``calibration`` on a CSV or Parquet file, read in chunks (see the
+    module): each chunk is compensated by one :class:`gyrocomp.Compensator` and both the raw and the compensated
+    rates are integrated.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    path : path
+        The run, a table.
+    layout, fmt, drop_nonfinite : as :func:`gyrocomp.io.read_table`.
+    window_s, turn_on_window_s : as :func:`gyrocomp.evaluation.evaluate` [s].
+    chunks : ChunkSettings
+    progress : callable, optional
+        Called with the fraction of the file read.
+    """
+    if not isinstance(calibration, Calibration):
+        raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+                         f"got {type(calibration).__name__}")
+    stream = TableStream(path, layout, fmt=fmt, drop_nonfinite=drop_nonfinite, chunk_rows=chunks.chunk_rows,
+                         progress=progress)
+    try:
+        if calibration.gyro_triad is not None or calibration.accel_triad is not None:
+            raise NotStreamable("a triad is judged on whole still poses")
+        return Evaluation([_evaluate_stream(calibration, stream, window_s, turn_on_window_s, chunks)])
+    except NotStreamable:
+        recording = read_table(path, layout, fmt=stream.fmt, drop_nonfinite=drop_nonfinite).recording
+        return evaluate(calibration, recording, window_s=window_s, turn_on_window_s=turn_on_window_s)
+
+
+def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, turn_on_window_s,
+                     chunks: ChunkSettings):
+    comp: Compensator | None = None
+    accel_axes: tuple[str, ...] = ()
+    steps, raw, compensated = TimeSteps(chunks), None, None
+    try:
+        for chunk in stream.chunks():
+            recording = chunk.recording
+            if recording.gaps or stream.gaps:
+                raise NotStreamable("a time gap")
+            if comp is None:
+                comp = compensator_for(calibration, recording, turn_on_window_s=turn_on_window_s)
+                if comp.compensates_accel and turn_on_window_s is not None:
+                    raise NotStreamable("the accelerometer is not held back with the turn-on window")
+                if calibration.accel_axes and comp.compensates_accel:
+                    accel_axes = recording.accel_axes
+                columns = len(recording.gyro_axes) + len(accel_axes)
+                raw, compensated = (PhaseAccumulator(columns, memory_bytes=chunks.memory_bytes,
+                                                     directory=chunks.scratch_dir) for _ in range(2))
+                first = recording
+            steps.add(recording.time_s)
+            raw.update(np.column_stack([recording.gyro_dps] + ([recording.accel_g] if accel_axes else [])))
+            out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel_xyz(recording))
+            compensated.update(_compensated(comp, out, accel_axes))
+        compensated.update(_compensated(comp, comp.finish(), accel_axes))
+        rate_hz = steps.rate_hz()
+        stream.warn_summary()
+        return evaluate_phases(first.source, raw.finish(rate_hz), compensated.finish(rate_hz), rate_hz,
+                               gyro_axes=first.gyro_axes, accel_axes=accel_axes, window_s=window_s)
+    finally:
+        steps.close()
+        for accumulator in (raw, compensated):
+            if accumulator is not None:
+                accumulator.close()
+
+
+def _compensated(comp: Compensator, gyro: np.ndarray, accel_axes: tuple[str, ...]) -> np.ndarray:
+    """The compensated block to integrate: the gyro, then the accelerometer in the file's axis order."""
+    if not accel_axes:
+        return gyro
+    return np.column_stack([gyro, comp.take_accel()[:, [ACCEL_AXES.index(a) for a in accel_axes]]])

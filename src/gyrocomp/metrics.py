@@ -238,23 +238,93 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
     if window_s is None:
         window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows))  # as default_window_s(raw)
     w = window_samples(window_s, raw.rate_hz, raw.n_samples)
-    to_dph = DEG_PER_S_TO_DEG_PER_H / BIAS_INSTABILITY_FACTOR
-    axes = {}
-    for j, axis in enumerate(raw.gyro_axes):
-        f = _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches, lows[j])
-        axes[axis] = AxisMetrics(
-            bias_offset_raw_dps=f.offset_raw, bias_offset_comp_dps=f.offset_comp, offset_improvement=f.improvement,
-            bias_instability_raw_dph=f.allan_min_raw * to_dph, bias_instability_comp_dph=f.allan_min_comp * to_dph,
-            integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
-            residual_rms_dps=f.residual_rms)
-    accel_axes = {}
+    gyro = {axis: _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches, lows[j])
+            for j, axis in enumerate(raw.gyro_axes)}
+    accel_figures = {}
     if accel and raw.accel_g is not None and compensated.accel_g is not None:
-        to_ug = 1e6 / BIAS_INSTABILITY_FACTOR
-        for j, axis in enumerate(raw.accel_axes):
-            f = _figures(raw.accel_g[:, j], compensated.accel_g[:, j], raw.rate_hz, w, stretches)
-            accel_axes[axis] = AccelAxisMetrics(
-                bias_offset_raw_g=f.offset_raw, bias_offset_comp_g=f.offset_comp, offset_improvement=f.improvement,
-                bias_instability_raw_ug=f.allan_min_raw * to_ug, bias_instability_comp_ug=f.allan_min_comp * to_ug,
-                integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
-                residual_rms_g=f.residual_rms)
-    return RunEvaluation(file=raw.source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
+        accel_figures = {axis: _figures(raw.accel_g[:, j], compensated.accel_g[:, j], raw.rate_hz, w, stretches)
+                         for j, axis in enumerate(raw.accel_axes)}
+    return _run_evaluation(raw.source, window_s, gyro, accel_figures)
+
+
+def _run_evaluation(source: str, window_s: float, gyro: dict[str, _Figures],
+                    accel: dict[str, _Figures]) -> RunEvaluation:
+    """The figures of each axis in their quoted units: gyro [deg/s, deg/h], accelerometer [g, ug]."""
+    to_dph = DEG_PER_S_TO_DEG_PER_H / BIAS_INSTABILITY_FACTOR
+    to_ug = 1e6 / BIAS_INSTABILITY_FACTOR
+    axes = {axis: AxisMetrics(
+        bias_offset_raw_dps=f.offset_raw, bias_offset_comp_dps=f.offset_comp, offset_improvement=f.improvement,
+        bias_instability_raw_dph=f.allan_min_raw * to_dph, bias_instability_comp_dph=f.allan_min_comp * to_dph,
+        integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
+        residual_rms_dps=f.residual_rms) for axis, f in gyro.items()}
+    accel_axes = {axis: AccelAxisMetrics(
+        bias_offset_raw_g=f.offset_raw, bias_offset_comp_g=f.offset_comp, offset_improvement=f.improvement,
+        bias_instability_raw_ug=f.allan_min_raw * to_ug, bias_instability_comp_ug=f.allan_min_comp * to_ug,
+        integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
+        residual_rms_g=f.residual_rms) for axis, f in accel.items()}
+    return RunEvaluation(file=source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
+
+
+def evaluate_phases(source: str, raw: list[np.ndarray], compensated: list[np.ndarray], rate_hz: float, *,
+                    gyro_axes: tuple[str, ...], accel_axes: tuple[str, ...] = (),
+                    window_s: float | None = None) -> RunEvaluation:
+    """:func:`evaluate_run` of one contiguous run given as phases, e.g. integrated chunk by chunk from a file
+    (:class:`gyrocomp.allan.PhaseAccumulator`, possibly memory-mapped): the moving average of a series is a
+    difference of its phase, (x[k + w] - x[k]) rate_hz / w, and the Allan deviation reads the phase itself.
+
+    Parameters
+    ----------
+    source : str
+        The run's file, for the result.
+    raw, compensated : list of arrays (N+1,)
+        The phase [unit*s] of each axis before and after compensation: ``gyro_axes`` [deg] then ``accel_axes``
+        [g*s], in that order.
+    rate_hz : float
+        Sample rate [Hz].
+    window_s : float, optional
+        Moving-average window [s]; default the longest tau at the raw gyro axes' Allan minima, at least 1 s.
+    """
+    names = (*gyro_axes, *accel_axes)
+    if not (len(raw) == len(compensated) == len(names)):
+        raise InputError(f"raw, compensated: one phase per axis ({', '.join(names)}); got {len(raw)} and "
+                         f"{len(compensated)}")
+    n_samples = len(raw[0]) - 1
+    lows = [(_phase_allan_minimum(r, rate_hz), _phase_allan_minimum(c, rate_hz)) for r, c in zip(raw, compensated)]
+    if window_s is None:
+        window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows[:len(gyro_axes)]))
+    w = window_samples(window_s, rate_hz, n_samples)
+    figures = {}
+    for name, r, c, (low_raw, low_comp) in zip(names, raw, compensated, lows):
+        off_raw, _ = _smoothed_spread(r, rate_hz, w)
+        off_comp, rms = _smoothed_spread(c, rate_hz, w)
+        figures[name] = _Figures(off_raw, off_comp, off_raw / off_comp if off_comp > 0 else math.inf,
+                                 low_raw.deviation, low_comp.deviation, low_raw.tau_s, low_comp.tau_s, rms)
+    return _run_evaluation(source, window_s, {a: figures[a] for a in gyro_axes},
+                           {a: figures[a] for a in accel_axes})
+
+
+def _phase_allan_minimum(phase: np.ndarray, rate_hz: float):
+    return allan_deviation(phase, rate_hz, taus="octave", confidence=None, data_type="phase").minimum()
+
+
+#: phase points read at once by _smoothed_spread
+_PHASE_BLOCK = 1 << 20
+
+
+def _smoothed_spread(phase: np.ndarray, rate_hz: float, w: int) -> tuple[float, float]:
+    """Peak-to-peak and RMS about its mean of the ``w``-sample moving average of the series whose phase [unit*s]
+    is given, block by block (:func:`bias_offset` and :func:`smoothed_residual_rms` of the series)."""
+    count = len(phase) - w
+    scale = rate_hz / w
+
+    def averages():
+        for start in range(0, count, _PHASE_BLOCK):
+            stop = min(start + _PHASE_BLOCK, count)
+            yield (np.asarray(phase[start + w:stop + w]) - np.asarray(phase[start:stop])) * scale
+
+    low, high, total = math.inf, -math.inf, 0.0
+    for smooth in averages():
+        low, high, total = min(low, float(smooth.min())), max(high, float(smooth.max())), total + float(smooth.sum())
+    mean = total / count
+    squares = sum(float(np.dot(smooth - mean, smooth - mean)) for smooth in averages())
+    return high - low, math.sqrt(squares / count)

@@ -83,7 +83,8 @@ def _floats(values) -> list:
     return [_float(v) for v in np.asarray(values, dtype=float)]
 
 
-def _channel(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
+def axis_values(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
+    """A gyro [deg/s] or accelerometer [g] column of ``recording`` by name, with its sensor and unit."""
     if axis in recording.gyro_axes:
         return recording.gyro(axis), "gyro", "deg/s"
     if axis in recording.accel_axes:
@@ -136,7 +137,7 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
                    f"{recording.row_numbers[longest.stop - 1]}); the noise terms pool all stretches")
     results = {}
     for name in names:
-        values, sensor, unit = _channel(recording, name)
+        values, sensor, unit = axis_values(recording, name)
         pieces = [values[s] for s in stretches]
         if len(pieces) == 1:
             curve = allan_deviation(values, recording.rate_hz, kind=kind, taus=taus)
@@ -149,12 +150,43 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
                 curve = allan
             else:
                 curve = allan_deviation_segments(pieces, recording.rate_hz, kind=kind, taus=taus)
-        terms = noise_terms(allan, fit_taus_s)
-        if terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
-            warnings.warn(f"{name}: the five-term noise model misses the curve by {terms.fit_rms_log_residual:.0%} "
-                          "RMS; compare the read-offs, or restrict the fit to the taus where a term holds "
-                          "(fit_taus_s: (low, high) [s])", DataQualityWarning, stacklevel=2)
-        quoted = GyroNoise.from_terms(terms) if sensor == "gyro" else AccelNoise.from_terms(terms)
-        results[name] = AxisNoise(name, sensor, unit, curve, allan, terms, quoted)
+        results[name] = _axis_noise(name, sensor, unit, curve, allan, fit_taus_s)
     return NoiseAnalysis(source=recording.source, rate_hz=recording.rate_hz, axes=results,
                          stretches=len(stretches), how=how)
+
+
+def analyse_noise_phases(phases: dict[str, np.ndarray], rate_hz: float, *, source: str = "<phases>",
+                         kind: str = "oadev", taus="octave",
+                         fit_taus_s: tuple[float, float] | None = None) -> NoiseAnalysis:
+    """:func:`analyse_noise` of one contiguous stretch given as the phase of each axis, e.g. integrated chunk by
+    chunk from a file (:class:`gyrocomp.allan.PhaseAccumulator`), possibly memory-mapped.
+
+    Parameters
+    ----------
+    phases : dict of str to array (N+1,)
+        The phase of each axis [unit*s]: ``gyro_*`` in [deg], ``accel_*`` in [g*s].
+    rate_hz : float
+        Sample rate [Hz].
+    source : str
+        The file's name, for messages.
+    kind, taus, fit_taus_s : as :func:`analyse_noise`.
+    """
+    results = {}
+    for name, phase in phases.items():
+        sensor, unit = ("accel", "g") if name.startswith("accel") else ("gyro", "deg/s")
+        curve = allan_deviation(phase, rate_hz, kind=kind, taus=taus, data_type="phase")
+        allan = curve if kind == "oadev" else allan_deviation(phase, rate_hz, taus="octave", data_type="phase")
+        results[name] = _axis_noise(name, sensor, unit, curve, allan, fit_taus_s)
+    return NoiseAnalysis(source=source, rate_hz=rate_hz, axes=results)
+
+
+def _axis_noise(name: str, sensor: str, unit: str, curve: AllanResult, allan: AllanResult,
+                fit_taus_s: tuple[float, float] | None) -> AxisNoise:
+    """One axis's noise terms read from its overlapping Allan curve (a warning when the model misses it)."""
+    terms = noise_terms(allan, fit_taus_s)
+    if terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
+        warnings.warn(f"{name}: the five-term noise model misses the curve by {terms.fit_rms_log_residual:.0%} "
+                      "RMS; compare the read-offs, or restrict the fit to the taus where a term holds "
+                      "(fit_taus_s: (low, high) [s])", DataQualityWarning, stacklevel=3)
+    quoted = GyroNoise.from_terms(terms) if sensor == "gyro" else AccelNoise.from_terms(terms)
+    return AxisNoise(name, sensor, unit, curve, allan, terms, quoted)

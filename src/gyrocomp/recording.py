@@ -26,7 +26,7 @@ def _temperature_names(gyro_axes: tuple[str, ...], per_axis: bool) -> tuple[str,
     return tuple(f"{TEMPERATURE_COLUMN}_{axis.split('_')[-1]}" for axis in gyro_axes)
 
 
-def _nominal_rate(period_s: float) -> float:
+def nominal_rate_hz(period_s: float) -> float:
     """1/period [Hz], snapped to 6 decimals when it is that close (time stamps like k / 100.0)."""
     rate = 1.0 / period_s
     snapped = round(rate, 6)
@@ -177,7 +177,7 @@ class Recording:
         set_(self, "accel_axes", tuple(self.accel_axes))
         set_(self, "reference_rate_dps", reference)
         set_(self, "row_numbers", rows)
-        set_(self, "rate_hz", _nominal_rate(period))
+        set_(self, "rate_hz", nominal_rate_hz(period))
         set_(self, "gaps", gaps)
 
     # -- convenience -------------------------------------------------------------

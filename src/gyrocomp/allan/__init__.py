@@ -32,6 +32,7 @@ from .estimators import (
     term_count,
     to_phase,
 )
+from .streaming import PhaseAccumulator
 from .intervals import confidence_interval, degrees_of_freedom, edf_greenhall, edf_totdev
 from .noise_id import (
     NOISE_ID_MAX_POINTS,
@@ -57,7 +58,7 @@ from .terms import (
 __all__ = [
     "AccelNoise", "AllanMinimum", "AllanResult", "BIAS_INSTABILITY_FACTOR", "DEFAULT_STOP_RATIO", "GyroNoise",
     "KINDS", "MODEL_UNCERTAINTY", "NOISE_ID_MAX_POINTS", "NOISE_ID_MIN_POINTS", "NoiseIdentification",
-    "NoiseTerms", "ONE_SIGMA", "READOFF_SLOPE_TOLERANCE", "STOP_RATIO", "allan_deviation",
+    "NoiseTerms", "ONE_SIGMA", "PhaseAccumulator", "READOFF_SLOPE_TOLERANCE", "STOP_RATIO", "allan_deviation",
     "allan_deviation_segments", "averaging_factors", "b1_expected", "confidence_interval",
     "degrees_of_freedom", "edf_greenhall", "edf_totdev", "identify_noise", "identify_noise_b1",
     "noise_parameters", "noise_terms", "noise_types", "phase_from_chunks", "rn_expected", "term_count",

@@ -4,17 +4,18 @@ from __future__ import annotations
 
 import json
 import warnings
+from pathlib import Path
 
 import click
 
 from ..allan import KINDS
 from ..errors import DataQualityWarning
-from ..io import refuse_to_overwrite_inputs, write_text_atomic
-from ..recording import ACCEL_AXES, GYRO_AXES
+from ..noise_file import analyse_noise_file
+from ..io import TABLE_FORMATS, detect_format, refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..noise import analyse_noise
 from ..report.figures import allan_figure, check_figure_path
-from .common import pop_read_options, read_run, progress_bar, read_options
+from .common import pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_noise
 
 
@@ -68,22 +69,25 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
             refuse_to_overwrite_inputs(path, [input_path], option=option)
     if plot_path:
         check_figure_path(plot_path)
-    with warnings.catch_warnings():
-        # gaps are refused below, or split with a note, in one line of their own
-        warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
-        named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
-        # a table: only the columns analysed are read (time, the gyro axes, the named axes, the accelerometer for
-        # Kalibr), not its temperature or others
-        wanted = (*GYRO_AXES, *(named or ()), *(ACCEL_AXES if kalibr_path else ()))
-        if any(name not in GYRO_AXES + ACCEL_AXES for name in wanted):
-            wanted = None  # a name that is no axis: read everything, so the refusal can list what the file has
-        recording = read_run(input_path, opts, channels=wanted).recording
-    names = named or list(recording.gyro_axes)
-    if kalibr_path:
-        names += [a for a in recording.accel_axes if a not in names]
-    with progress_bar("Allan deviation", indeterminate=True):
-        analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
-                                 fit_taus_s=fit_range)
+    named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
+    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
+    if in_fmt in TABLE_FORMATS:  # in chunks: memory bounded whatever the file's length
+        with progress_bar(f"reading {Path(input_path).name}") as progress:
+            analysis = analyse_noise_file(input_path, named, layout=read_settings(opts).layout, fmt=in_fmt,
+                                          drop_nonfinite=opts["drop_nan"], with_accel=bool(kalibr_path), kind=kind,
+                                          taus=tau_spec, split_gaps=split_gaps, fit_taus_s=fit_range,
+                                          progress=progress)
+    else:
+        with warnings.catch_warnings():
+            # gaps are refused below, or split with a note, in one line of their own
+            warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
+            recording = read_run(input_path, opts).recording
+        names = named or list(recording.gyro_axes)
+        if kalibr_path:
+            names += [a for a in recording.accel_axes if a not in names]
+        with progress_bar("Allan deviation", indeterminate=True):
+            analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                                     fit_taus_s=fit_range)
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
     if kalibr_path:

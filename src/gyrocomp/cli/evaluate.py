@@ -5,17 +5,25 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from pathlib import Path
 
 import click
 
 from ..calibration import Calibration
 from ..errors import InputError
+from ..evaluation import evaluate_file
+from ..io import TABLE_FORMATS, detect_format
 from ..io.schedule import apply_schedule, read_rate_schedule
+from ..metrics import Evaluation
 from ..comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
-from .common import float_list, pop_read_options, read_run, read_options
+from .common import float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_comparison, print_evaluation, print_installed, print_stages
+
+
+def _is_table(path, opts: dict) -> bool:
+    return Path(path).exists() and detect_format(path, opts["fmt"]) in TABLE_FORMATS
 
 
 def _nan_none(value):
@@ -88,14 +96,27 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
         elif not ctx.obj["quiet"]:
             print_installed(results)
         return
-    recordings = [read_run(path, opts).recording for path in runs]
-    if rate_schedule is not None:
-        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
-    evaluation = evaluate_calibration(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s)
+    evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
     if as_json:
         click.echo(json.dumps(evaluation.to_dict(), indent=2))
     else:
         print_evaluation(evaluation)
+
+
+def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, rate_schedule) -> Evaluation:
+    """The model on each run: tables in chunks (memory bounded whatever the files' lengths), other files whole."""
+    if rate_schedule is None and all(_is_table(path, opts) for path in runs):
+        parts = []
+        for path in runs:
+            with progress_bar(f"reading {Path(path).name}") as progress:
+                parts.append(evaluate_file(calibration, path, layout=read_settings(opts).layout,
+                                           fmt=detect_format(path, opts["fmt"]), drop_nonfinite=opts["drop_nan"],
+                                           window_s=window_s, turn_on_window_s=turn_on_window_s, progress=progress))
+        return Evaluation([r for p in parts for r in p.runs], [t for p in parts for t in p.triads])
+    recordings = [read_run(path, opts).recording for path in runs]
+    if rate_schedule is not None:
+        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+    return evaluate_calibration(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s)
 
 
 __all__ = ["evaluate"]

@@ -26,8 +26,8 @@ import pyarrow.parquet as pq
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import atomic_path
-from .tables import (_COMPRESSED, TableLayout, _csv_options, _resolved_columns, detect_table_format,
-                     recording_table, sniff_csv, table_recording)
+from .tables import (_COMPRESSED, TableLayout, _channel_selector, _csv_options, _resolved_columns,
+                     detect_table_format, recording_table, sniff_csv, table_recording)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
@@ -53,10 +53,12 @@ class TableChunk:
 
 
 class TableStream:
-    """A CSV or Parquet table read in chunks of about ``chunk_rows`` rows (see the module)."""
+    """A CSV or Parquet table read in chunks of about ``chunk_rows`` rows (see the module); with ``channels``, only
+    those channels' columns (and time) are read, as :func:`gyrocomp.io.read_table` reads them."""
 
     def __init__(self, path, layout: TableLayout | None = None, *, fmt: str | None = None,
-                 drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS, progress=None):
+                 drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS, progress=None,
+                 channels: tuple[str, ...] | None = None):
         self.path = Path(path)
         self.layout = layout or TableLayout()
         self.fmt = fmt or detect_table_format(self.path) or "csv"
@@ -71,8 +73,13 @@ class TableStream:
         self.progress = progress  # called with the fraction of the file read
         self._source = None  # the open CSV file, whose position tells the progress (None: compressed)
         self._total_rows: int | None = None  # a Parquet file's rows, read once for the progress
+        self._read: list[str] | None = None  # the columns read (None: all)
         self.schema = self._open_schema()
-        self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
+        if channels is None:
+            self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
+        else:  # only these channels' columns (and time) are read, as read_table(channels=...)
+            self.columns = {}
+            self._read = _channel_selector(tuple(channels), self.layout, self.path, self.columns)(self.schema.names)
         self.gyro_axes = tuple(a for a in GYRO_AXES if a in self.columns)
         self.accel_axes = tuple(a for a in ACCEL_AXES if a in self.columns)
         self.rows = 0
@@ -106,7 +113,8 @@ class TableStream:
                                      "time,gyro_z,temperature")
                 delimiter, decimal = sniff_csv(head)
                 parse = pacsv.ParseOptions(delimiter=self.layout.delimiter or delimiter)
-                convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.layout.decimal or decimal)
+                convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.layout.decimal or decimal,
+                                               include_columns=self._read or [])
                 reader = pacsv.open_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
                                         parse_options=parse, convert_options=convert)
             except (pa.ArrowInvalid, OSError, EOFError, lzma.LZMAError) as exc:
@@ -126,7 +134,8 @@ class TableStream:
         if self.fmt == "parquet":
             # without pre-buffering: pyarrow would keep every row group's read-ahead until the file is closed
             # (memory growing with the file, about 12 bytes a row)
-            yield from pq.ParquetFile(self.path, pre_buffer=False).iter_batches(batch_size=self.chunk_rows)
+            yield from pq.ParquetFile(self.path, pre_buffer=False).iter_batches(batch_size=self.chunk_rows,
+                                                                                 columns=self._read)
             return
         with self._csv_reader() as reader:
             while True:
