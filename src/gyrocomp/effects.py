@@ -407,8 +407,21 @@ def quantize(x: np.ndarray, lsb: float) -> np.ndarray:
     return np.round(np.asarray(x, dtype=float) / lsb) * lsb
 
 
+def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
+    """Moving average over ``window_samples`` samples, only where the window is full (n - w + 1 values)."""
+    x = np.asarray(x, dtype=float)
+    w = int(window_samples)
+    if w < 1:
+        raise InputError(f"window: must be at least one sample, got {w}")
+    if w > x.size:
+        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
+    c = np.concatenate([[0.0], np.cumsum(x - x[0])])
+    return (c[w:] - c[:-w]) / w + x[0]
+
+
 __all__ = [
     "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "find_turns",
-    "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter", "quantize",
-    "thermal_lag",
+    "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter",
+    "moving_average", "quantize", "thermal_lag",
 ]
+

@@ -20,23 +20,12 @@ from typing import Literal
 import numpy as np
 
 from .allan import BIAS_INSTABILITY_FACTOR, allan_deviation, allan_deviation_segments
+from .effects import moving_average
 from .errors import DataQualityWarning, InputError
 from .recording import Recording
 from .units import DEG_PER_S_TO_DEG_PER_H
 
 MIN_WINDOW_S = 1.0
-
-
-def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
-    """Moving average over ``window_samples`` samples, only where the window is full (n - w + 1 values)."""
-    x = np.asarray(x, dtype=float)
-    w = int(window_samples)
-    if w < 1:
-        raise InputError(f"window: must be at least one sample, got {w}")
-    if w > x.size:
-        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
-    c = np.concatenate([[0.0], np.cumsum(x - x[0])])
-    return (c[w:] - c[:-w]) / w + x[0]
 
 
 def bias_offset(x: np.ndarray, window_samples: int) -> float:

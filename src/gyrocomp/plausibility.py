@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
-from .metrics import moving_average
+from .effects import moving_average
 from .recording import Recording
 from .static import static_segments
 

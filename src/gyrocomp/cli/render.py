@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rich.table import Table
 
-from ..calibration import Calibration
-from ..metrics import Evaluation
-from ..models.thermal import CANDIDATES
-from ..validation import ValidationResult
-from ..noise import NoiseAnalysis
 from .common import make_console
+
+if TYPE_CHECKING:  # types only: `gyrocomp allan` need not import the fitting to print its table
+    from ..calibration import Calibration
+    from ..metrics import Evaluation
+    from ..noise import NoiseAnalysis
+    from ..validation import ValidationResult
 
 
 def print_fit(calibration: Calibration, output) -> None:
@@ -159,14 +161,16 @@ def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -
         ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if bic else
                    f"leave-one-run-out residual drift RMS [{unit}] (60 s moving average; lower is better)"))
         ht.add_column("axis")
-        for name in CANDIDATES:
+        candidates = list(dict.fromkeys(c for info in hyst["axes"].values()
+                                        for c in info.get("scores_bic" if bic else "scores_dps", {})))
+        for name in candidates:
             ht.add_column(name, justify="right")
         ht.add_column("chosen")
         for axis, info in hyst["axes"].items():
             scores = info.get("scores_bic" if bic else "scores_dps", {})
             chosen = info["chosen"].split(" (")[0]
             cells = [("-" if scores.get(c) is None else f"{scores[c]:.4g}" + ("*" if c == chosen else ""))
-                     if c in scores else "-" for c in CANDIDATES]
+                     if c in scores else "-" for c in candidates]
             ht.add_row(axis, *cells, info["chosen"])
         console.print(ht)
     _print_g_sensitivity(console, report)

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
@@ -270,7 +269,7 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
     if pa.types.is_boolean(array.type) or pa.types.is_timestamp(array.type):
         raise InputError(f"{source}: column {column!r} has type {array.type}; expected numbers")
     try:  # numbers stored as text (quoted, say): one vectorized cast; only on failure find the bad row
-        return _to_numpy(pc.cast(array, pa.float64()))
+        return _to_numpy(array.cast(pa.float64()))  # pyarrow.compute, loaded only here (70 ms)
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
         pass
     values = array.to_pylist()
