@@ -20,7 +20,7 @@ LAYERS = (
     # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve) live beside the
     # estimators of the same curve; neither imports anything above this layer
     ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),
-    ("calibration", ("calibration", "triad", "installed")),
+    ("calibration", ("calibration", "fit_report", "triad", "installed")),
     ("compensate", ("compensate",)),
     ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration", "models.online",
                  "models.triad_fit", "models.pose_rotation")),

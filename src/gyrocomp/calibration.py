@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .fit_report import FitReport
 from .io.atomic import write_text_atomic
 from .models.mlp import MLPBias
 from .models.temperature import PolynomialBias
@@ -300,6 +301,11 @@ class Calibration:
     #: accelerometer's temperature models
     accel_triad: TriadCalibration | None = None
 
+
+    @property
+    def report(self) -> FitReport:
+        """How the model was fitted, typed (:class:`gyrocomp.fit_report.FitReport`), read from ``fit_report``."""
+        return FitReport.from_dict(self.fit_report)
     def without(self, *parts: str) -> "Calibration":
         """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
         (turning-point), ``"lag"``, ``"scale-factor"`` (the gyro triad's K(T)). What is left is applied as fitted

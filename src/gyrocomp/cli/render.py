@@ -12,6 +12,7 @@ from .common import make_console
 
 if TYPE_CHECKING:  # types only: `gyrocomp allan` need not import the fitting to print its table
     from ..calibration import Calibration
+    from ..fit_report import FitReport, GSensitivityReport, OrderSelection, SelectionReport
     from ..metrics import Evaluation
     from ..noise import NoiseAnalysis
     from ..validation import ValidationResult
@@ -21,11 +22,12 @@ def print_fit(calibration: Calibration, output) -> None:
     console = make_console()
     if not calibration.axes and not calibration.accel_axes:
         console.print(f"gyrocomp fit: {calibration.model}  ->  {output}")
+    report = calibration.report
     if calibration.axes:
-        _print_axis_fits(console, calibration.axes, calibration.fit_report, f"gyrocomp fit: {calibration.model}  ->  "
+        _print_axis_fits(console, calibration.axes, report, f"gyrocomp fit: {calibration.model}  ->  "
                          f"{output}", "deg/s")
-    if calibration.accel_axes:
-        _print_axis_fits(console, calibration.accel_axes, calibration.fit_report.get("accel", {}),
+    if calibration.accel_axes and report.accel is not None:
+        _print_axis_fits(console, calibration.accel_axes, report.accel,
                          f"accelerometer (correction relative to {calibration.accel_reference_degc:.2f} degC; "
                          "constants per run or per static position)" + ("" if calibration.axes else f"  ->  {output}"),
                          "g")
@@ -117,63 +119,58 @@ def _describe_axis(ax) -> str:
     return model
 
 
-def _print_axis_fits(console, axes: dict, report: dict, title: str, unit: str) -> None:
+def _print_axis_fits(console, axes: dict, report: FitReport, title: str, unit: str) -> None:
     table = Table(title=title)
     for col in ("axis", "model", "range [degC]", f"fit RMS [{unit}]", f"constants [{unit}]"):
         table.add_column(col)
     for axis, ax in axes.items():
-        info = report.get("axes", {}).get(axis, {})
+        fit = report.axes.get(axis)
         model = _describe_axis(ax)
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
-        rms = f"{info['fit_rms_dps']:.3g}" if "fit_rms_dps" in info else "-"
+        rms = "-" if fit is None or fit.fit_rms is None else f"{fit.fit_rms:.3g}"
         constants = ax.turn_on_biases_dps
         shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (f" ... ({len(constants)})" if len(constants) > 6 else "")
         table.add_row(axis, model, rng, rms, shown)
     console.print(table)
-    net = report.get("network")
+    net = report.network
     if net:
-        console.print(f"network: 1-{'-'.join(map(str, net['hidden']))}-1 tanh/linear, {net['restarts']} restarts "
-                      f"(seed {net['seed']}), {net['training']}; validation RMS of the restarts [{unit}]: " + "; ".join(
-                          f"{a} " + ", ".join(f"{v:.4g}" for v in info["validation_rmse_dps"])
-                          for a, info in net["axes"].items()))
-    scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
-    if net:
-        scores = {}
-    if scores:
-        how = report.get("order_selection")
-        unit_label = f"CV RMS [{unit}]" if how == "leave-one-run-out" else "BIC"
-        st = Table(title=f"order selection by {how} ({unit_label}; lower is better)")
-        st.add_column("axis")
-        orders = sorted({int(p) for s in scores.values() for p in s})
-        for p in orders:
-            st.add_column(f"order {p}", justify="right")
-        for axis, s in scores.items():
-            chosen = axes[axis].temperature.order
-            st.add_row(axis, *[(f"{s[str(p)]:.4g}*" if p == chosen else f"{s[str(p)]:.4g}")
-                               if str(p) in s else "-" for p in orders])
-        console.print(st)
-    if report.get("selection"):
-        _print_selection(console, report["selection"], unit)
-        return _print_g_sensitivity(console, report)
-    hyst = report.get("hysteresis", {})
-    if hyst.get("axes") and any(len(a.get("scores_dps", a.get("scores_bic", {}))) > 1 for a in hyst["axes"].values()):
-        bic = hyst["selection"] == "bic"
-        ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if bic else
+        console.print(f"network: 1-{'-'.join(map(str, net.hidden))}-1 tanh/linear, {net.restarts} restarts "
+                      f"(seed {net.seed}), {net.training}; validation RMS of the restarts [{unit}]: " + "; ".join(
+                          f"{a} " + ", ".join(f"{v:.4g}" for v in rmse) for a, rmse in net.validation_rmse_dps.items()))
+    if report.order_selection is not None:
+        _print_order_selection(console, axes, report.order_selection, unit)
+    if report.selection:
+        _print_selection(console, report.selection, unit)
+        return _print_g_sensitivity(console, report.acceleration)
+    hyst = report.hysteresis
+    if hyst is not None and any(len(choice.scores) > 1 for choice in hyst.axes.values()):
+        ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if hyst.by_bic else
                    f"leave-one-run-out residual drift RMS [{unit}] (60 s moving average; lower is better)"))
         ht.add_column("axis")
-        candidates = list(dict.fromkeys(c for info in hyst["axes"].values()
-                                        for c in info.get("scores_bic" if bic else "scores_dps", {})))
+        candidates = hyst.memories_scored
         for name in candidates:
             ht.add_column(name, justify="right")
         ht.add_column("chosen")
-        for axis, info in hyst["axes"].items():
-            scores = info.get("scores_bic" if bic else "scores_dps", {})
-            chosen = info["chosen"].split(" (")[0]
-            cells = [("-" if scores.get(c) is None else f"{scores[c]:.4g}" + ("*" if c == chosen else ""))
-                     if c in scores else "-" for c in candidates]
-            ht.add_row(axis, *cells, info["chosen"])
+        for axis, choice in hyst.axes.items():
+            cells = [("-" if choice.scores.get(c) is None else f"{choice.scores[c]:.4g}"
+                      + ("*" if c == choice.memory else "")) if c in choice.scores else "-" for c in candidates]
+            ht.add_row(axis, *cells, choice.label)
         console.print(ht)
-    _print_g_sensitivity(console, report)
+    _print_g_sensitivity(console, report.acceleration)
+
+
+def _print_order_selection(console, axes: dict, selection: OrderSelection, unit: str) -> None:
+    """Each axis's score of every polynomial order tried, the chosen one starred."""
+    unit_label = f"CV RMS [{unit}]" if selection.method == "leave-one-run-out" else "BIC"
+    st = Table(title=f"order selection by {selection.method} ({unit_label}; lower is better)")
+    st.add_column("axis")
+    orders = selection.orders
+    for p in orders:
+        st.add_column(f"order {p}", justify="right")
+    for axis, s in selection.scores.items():
+        chosen = axes[axis].temperature.order if axes[axis].temperature is not None else 0
+        st.add_row(axis, *[(f"{s[p]:.4g}*" if p == chosen else f"{s[p]:.4g}") if p in s else "-" for p in orders])
+    console.print(st)
 
 
 def _score(value: float | None, spec: str = ".4g") -> str:
@@ -181,45 +178,41 @@ def _score(value: float | None, spec: str = ".4g") -> str:
     return "-" if value is None else format(value, spec)
 
 
-def _print_selection(console, selection: dict, unit: str) -> None:
+def _print_selection(console, selection: dict[str, SelectionReport], unit: str) -> None:
     """The model choice: per axis the chosen and best candidates against the run constant alone, then the fold
     scores of those three (every candidate's are in the model file)."""
     first = next(iter(selection.values()))
-    table = Table(title=f"model choice by held-out drift ({first['fold_kind']}: {len(first['folds'])} folds, "
-                        f"{first['window_s']:g} s moving average, simplest within one standard error) [{unit}]")
+    table = Table(title=f"model choice by held-out drift ({first.fold_kind}: {len(first.folds)} folds, "
+                        f"{first.window_s:g} s moving average, simplest within one standard error) [{unit}]")
     for col in ("axis", "chosen", "held-out drift", "best", "best drift", "constant only"):
         table.add_column(col, justify="left" if col in ("axis", "chosen", "best") else "right")
     for axis, sel in selection.items():
-        scores = {c["label"]: c for c in sel["candidates"]}
-        chosen, best = scores[sel["chosen"]["label"]], scores[sel["best"]["label"]]
-        table.add_row(axis, chosen["label"],
-                      f"{_score(chosen['mean_drift_dps'])} +- {_score(chosen['standard_error_dps'], '.2g')}",
-                      best["label"], _score(best["mean_drift_dps"]), _score(sel["raw_drift_dps"]))
+        chosen, best = sel.result(sel.chosen.label), sel.result(sel.best.label)
+        table.add_row(axis, sel.chosen.label,
+                      f"{_score(chosen.mean_drift_dps)} +- {_score(chosen.standard_error_dps, '.2g')}",
+                      sel.best.label, _score(best.mean_drift_dps), _score(sel.raw_drift_dps))
     console.print(table)
     folds = Table(title=f"held-out drift per fold [{unit}]")
     folds.add_column("axis")
     folds.add_column("model")
-    for name in first["folds"]:
+    for name in first.folds:
         folds.add_column(name, justify="right")
     for axis, sel in selection.items():
-        scores = {c["label"]: c for c in sel["candidates"]}
-        shown = dict.fromkeys([sel["chosen"]["label"], sel["best"]["label"], "constant (time)"])
-        for label in shown:
-            folds.add_row(axis, label, *[_score(v) for v in scores[label]["fold_drift_dps"]])
+        for label in dict.fromkeys([sel.chosen.label, sel.best.label, "constant (time)"]):
+            folds.add_row(axis, label, *[_score(v) for v in sel.result(label).fold_drift_dps])
     console.print(folds)
 
 
-def _print_g_sensitivity(console, report: dict) -> None:
-    acc = report.get("acceleration", {})
-    if acc.get("axes"):
-        gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc['static_segments'])} "
-                         f"static segments; excited: {', '.join(acc['excited_axes']) or 'none'})")
+def _print_g_sensitivity(console, acc: GSensitivityReport | None) -> None:
+    if acc is not None and acc.axes:
+        gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc.static_segments)} "
+                         f"static segments; excited: {', '.join(acc.excited_axes) or 'none'})")
         gt.add_column("gyro axis")
         for name in ("accel_x", "accel_y", "accel_z"):
             gt.add_column(name, justify="right")
-        for axis, info in acc["axes"].items():
+        for axis, row in acc.axes.items():
             cells = [f"{g:+.4g} +- {e:.2g}" if e is not None else "not fitted"
-                     for g, e in zip(info["g_sensitivity_dps_per_g"], info["standard_error_dps_per_g"])]
+                     for g, e in zip(row.g_sensitivity_dps_per_g, row.standard_error_dps_per_g)]
             gt.add_row(axis, *cells)
         console.print(gt)
 

@@ -119,14 +119,14 @@ def unit_figures(calibration: Calibration, recordings: list[Recording], *,
     t_lo = float(min(np.nanmin(t) for t in temps)) if temps else math.nan
     t_hi = float(max(np.nanmax(t) for t in temps)) if temps else math.nan
     noise = _noise(calibration, max(recordings, key=lambda r: r.n_samples))
-    selection = calibration.fit_report.get("selection", {})
-    prior_fit = calibration.fit_report.get("prior", {})
+    report = calibration.report
+    prior_fit = report.sections.get("prior", {})
     axes = {}
     for name, axis in calibration.axes.items():
-        chosen = selection.get(name, {}) if isinstance(selection, dict) else {}
+        chosen = report.selection.get(name)
         axes[name] = AxisFigures(
-            held_out_drift_dps=_number(chosen.get("chosen_drift_dps")),
-            raw_drift_dps=_number(chosen.get("raw_drift_dps")),
+            held_out_drift_dps=_number(None if chosen is None else chosen.chosen_drift_dps),
+            raw_drift_dps=_number(None if chosen is None else chosen.raw_drift_dps),
             **_curve_figures(axis, t_lo, t_hi, reference_temperature_degc),
             **_constants(axis, reference_temperature_degc),
             g_sensitivity_dps_per_g=(float(np.linalg.norm(axis.g_sensitivity_dps_per_g))

@@ -151,6 +151,7 @@ def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHyst
                 if math.isfinite(s.mean_drift_dps):
                     by_memory[m] = min(by_memory.get(m, s.mean_drift_dps), s.mean_drift_dps)
         axes[axis] = {"chosen": c.memory + (f" (order {c.hysteresis_order})" if c.hysteresis_order else ""),
+                      "memory": c.memory, "hysteresis_order": c.hysteresis_order,
                       "lag_time_constant_s": thermal.lag_time_constants_s_[axis], "order": c.order,
                       "weighting": c.weighting, "scores_dps": by_memory}
     return {"mode": mode, "selection": kind, "axes": axes}
@@ -339,7 +340,9 @@ def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration:
         report["hysteresis"] = _selection_report(selections, thermal, hysteresis)
     elif thermal is not None:
         report["hysteresis"] = {"mode": hysteresis, "selection": thermal.selection_, "axes": {
-            axis: {"chosen": thermal.chosen_[axis], "lag_time_constant_s": thermal.lag_time_constants_s_[axis],
+            axis: {"chosen": thermal.chosen_[axis], "memory": thermal.memories_[axis][0],
+                   "hysteresis_order": thermal.memories_[axis][1],
+                   "lag_time_constant_s": thermal.lag_time_constants_s_[axis],
                    "order": thermal.curves_[axis].order,
                    "order_scores": {str(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()},
                    "scores_dps" if thermal.selection_ != "bic" else "scores_bic":
@@ -402,7 +405,7 @@ def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, tempe
         if temperature == "auto":
             name += " (auto)"
     if thermal is not None:
-        extras = sorted({c.split(" (")[0] for c in thermal.chosen_.values()} - {"none"})
+        extras = sorted({memory for memory, _ in thermal.memories_.values()} - {"none"})
         if extras:
             name += " + " + "/".join(extras)
         if any(ax.g_sensitivity_dps_per_g is not None for ax in axes.values()):

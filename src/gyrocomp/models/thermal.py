@@ -299,7 +299,9 @@ class ThermalHysteresisModel:
     hysteresis_ : dict[str, HysteresisCurve or None]
     turn_on_biases_dps_ : dict[str, np.ndarray]
     chosen_ : dict[str, str]
-        The candidate kept per axis.
+        The candidate kept per axis, in words (``turning-point (order 2)``).
+    memories_ : dict[str, (str, int)]
+        The same as its memory (``none``, ``lag``, ``turning-point``, ``turning-point+lag``) and turning-point order.
     scores_ : dict[str, dict[str, float]]
         Per axis, the validation score of every candidate tried (RMS [deg/s], or BIC with one run).
     selection_ : str
@@ -352,6 +354,7 @@ class ThermalHysteresisModel:
         self._check_settings()
         self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
         self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
+        self.memories_ = {}
         self.bands_ = {}
         self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
         self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
@@ -485,6 +488,7 @@ class ThermalHysteresisModel:
         self.bands_[axis] = problem.band
         self.turn_on_biases_dps_[axis] = consts
         self.chosen_[axis] = choice.name if not p else f"{choice.name} (order {p})"
+        self.memories_[axis] = (choice.name, p)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
             self._store_acceleration(axis, problem, spec, tau, coef, n_runs)

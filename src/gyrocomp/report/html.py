@@ -112,37 +112,35 @@ def _describe(ax) -> str:
 
 
 def _summary(calibration: Calibration) -> str:
-    report = calibration.fit_report
+    report = calibration.report
     parts = [f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
              f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>"]
     rows = []
     for group, axes, unit in (("gyro", calibration.axes, "deg/s"), ("accelerometer", calibration.accel_axes, "g")):
+        fits = (report.accel.axes if report.accel is not None else {}) if group == "accelerometer" else report.axes
         for name, ax in axes.items():
             inputs = ", ".join(getattr(ax.temperature, "inputs", ("temperature",))) if ax.temperature else "-"
             rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
-            info = (report.get("accel", {}) if group == "accelerometer" else report).get("axes", {}).get(name, {})
-            rms = info.get("fit_rms_dps")
+            rms = fits[name].fit_rms if name in fits else None
             rows.append([name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}",
                          len(ax.turn_on_biases_dps)])
     parts.append(_table(["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"], rows))
     if calibration.accel_axes:
         parts.append(f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
                      "degC (its constant cannot be told from gravity at rest).</p>")
-    scores = {a: i.get("scores") for a, i in report.get("axes", {}).items() if i.get("scores")}
-    if scores:
-        orders = sorted({int(p) for s in scores.values() for p in s})
-        how = report.get("order_selection", "")
+    selection = report.order_selection
+    if selection is not None:
+        orders = selection.orders
         parts.append(_table(["axis"] + [f"order {p}" for p in orders],
-                            [[a] + [s.get(str(p)) for p in orders] for a, s in scores.items()],
-                            f"polynomial order by {how} (lower is better)"))
-    hyst = report.get("hysteresis", {})
-    cand = {a: i for a, i in hyst.get("axes", {}).items() if i.get("scores_dps") or i.get("scores_bic")}
-    if cand:
-        names = sorted({c for i in cand.values() for c in (i.get("scores_dps") or i.get("scores_bic"))})
-        parts.append(_table(["axis"] + names + ["chosen"],
-                            [[a] + [(i.get("scores_dps") or i.get("scores_bic")).get(c) for c in names] + [i["chosen"]]
-                             for a, i in cand.items()],
-                            f"hysteresis / thermal lag candidates by {hyst.get('selection')} (lower is better)"))
+                            [[a] + [s.get(p) for p in orders] for a, s in selection.scores.items()],
+                            f"polynomial order by {selection.method} (lower is better)"))
+    hyst = report.hysteresis
+    scored = {a: c for a, c in hyst.axes.items() if c.scores} if hyst is not None else {}
+    if scored:
+        names = hyst.memories_scored
+        parts.append(_table(["axis"] + list(names) + ["chosen"],
+                            [[a] + [c.scores.get(m) for m in names] + [c.label] for a, c in scored.items()],
+                            f"hysteresis / thermal lag candidates by {hyst.selection} (lower is better)"))
     prov = calibration.provenance
     if prov:
         files = ", ".join(str(f.get("file", f)) if isinstance(f, dict) else str(f) for f in prov.get("inputs", []))
@@ -293,12 +291,13 @@ def _axis_sections(calibration: Calibration, runs: list[Recording], compensated:
 def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s: float) -> str:
     """The g-sensitivity section: G with standard errors, and the static positions against it."""
     positions = _g_positions(calibration, runs, min_static_s)
-    acc = calibration.fit_report.get("acceleration", {}).get("axes", {})
+    fitted = calibration.report.acceleration
+    acc = fitted.axes if fitted is not None else {}
     rows, g_matrix = [], {}
     for axis, ax in calibration.axes.items():
         if ax.g_sensitivity_dps_per_g is None:
             continue
-        errors = acc.get(axis, {}).get("standard_error_dps_per_g", [None, None, None])
+        errors = acc[axis].standard_error_dps_per_g if axis in acc else (None, None, None)
         g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
         rows.append([axis] + [f"{g:+.4g}" + ("" if e is None else f" +- {e:.2g}")
                               for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])

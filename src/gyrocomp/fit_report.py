@@ -1,0 +1,288 @@
+"""How a calibration was fitted, as typed records: ``Calibration.report`` (a :class:`FitReport`).
+
+The model file keeps the account as the JSON object ``fit_report`` (the shape every schema version has written);
+:meth:`FitReport.from_dict` reads it into these dataclasses, so the command line, the HTML report and the fleet
+figures read attributes instead of parsing strings. Older files that wrote the chosen thermal memory only as text
+(``"turning-point (order 2)"``) are read into the same fields. Sections the fit did not produce are None (or empty);
+what has no typed record here (the online learner's, the population prior's, a triad's account) stays in
+``FitReport.sections``.
+
+Units are in the names: [deg/s] (``_dps``), [s], [degC], [deg/s/g].
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+#: the thermal memories a gyro axis's model may carry
+MEMORIES = ("none", "lag", "turning-point", "turning-point+lag")
+_TYPED = ("temperature", "axes", "order_selection", "selection", "hysteresis", "network", "acceleration", "stages",
+          "accel", "pipeline")
+
+
+def _number(value) -> float | None:
+    """A score as stored: None where it could not be computed."""
+    if value is None:
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+@dataclass(frozen=True)
+class CandidateSpec:
+    """One candidate model of an axis's bias: polynomial order, thermal lag, turning-point order, fit weighting,
+    whether the turning-point terms act only in a band, and its short name (``poly:3 + lag (time)``)."""
+
+    order: int
+    lag: bool
+    hysteresis_order: int
+    weighting: str
+    band: bool
+    label: str
+
+    @property
+    def memory(self) -> str:
+        """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
+        if self.lag and self.hysteresis_order:
+            return "turning-point+lag"
+        return "lag" if self.lag else ("turning-point" if self.hysteresis_order else "none")
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "CandidateSpec":
+        return cls(int(d["order"]), bool(d.get("lag", False)), int(d.get("hysteresis_order", 0)),
+                   str(d.get("weighting", "time")), bool(d.get("band", False)), str(d["label"]))
+
+
+@dataclass(frozen=True)
+class CandidateResult:
+    """A candidate's held-out drift: mean and standard error over the folds, each fold's, and the lag each fold's
+    fit chose [deg/s, s]; None where a fold held too little data."""
+
+    candidate: CandidateSpec
+    mean_drift_dps: float | None
+    standard_error_dps: float | None
+    fold_drift_dps: tuple[float | None, ...]
+    fold_lag_s: tuple[float, ...]
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "CandidateResult":
+        return cls(CandidateSpec.from_dict(d), _number(d.get("mean_drift_dps")), _number(d.get("standard_error_dps")),
+                   tuple(_number(v) for v in d.get("fold_drift_dps", ())),
+                   tuple(float(v) for v in d.get("fold_lag_s", ())))
+
+
+@dataclass(frozen=True)
+class SelectionReport:
+    """The choice for one axis by held-out drift (:class:`gyrocomp.models.selection.AxisSelection` as stored):
+    how the data was held out, the moving-average window of the score [s], every candidate's result, the best
+    and the chosen one (the simplest within one standard error of the best)."""
+
+    axis: str
+    fold_kind: str
+    folds: tuple[str, ...]
+    window_s: float
+    temperature_step_degc: float
+    band_degc: tuple[float, float] | None
+    best: CandidateSpec
+    chosen: CandidateSpec
+    raw_drift_dps: float | None
+    chosen_drift_dps: float | None
+    validated: bool
+    generalizes: bool
+    candidates: tuple[CandidateResult, ...]
+
+    def result(self, label: str) -> CandidateResult:
+        """The result of the candidate named ``label``."""
+        for result in self.candidates:
+            if result.candidate.label == label:
+                return result
+        raise KeyError(f"label: no candidate {label!r} for {self.axis}")
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "SelectionReport":
+        band = d.get("band_degc")
+        return cls(str(d["axis"]), str(d["fold_kind"]), tuple(d.get("folds", ())), float(d["window_s"]),
+                   float(d.get("temperature_step_degc", 0.0)), None if band is None else (float(band[0]), float(band[1])),
+                   CandidateSpec.from_dict(d["best"]), CandidateSpec.from_dict(d["chosen"]),
+                   _number(d.get("raw_drift_dps")), _number(d.get("chosen_drift_dps")), bool(d.get("validated", True)),
+                   bool(d.get("generalizes", True)), tuple(CandidateResult.from_dict(c) for c in d.get("candidates", ())))
+
+
+_CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
+
+
+@dataclass(frozen=True)
+class MemoryChoice:
+    """The thermal memory chosen for one axis (``memory`` one of :data:`MEMORIES`, with the turning-point order,
+    0 without), its lag's time constant [s], the polynomial order and weighting it came with, and the score of
+    each memory (held-out drift [deg/s], or BIC when ``HysteresisReport.by_bic``; None where not computed)."""
+
+    memory: str
+    hysteresis_order: int
+    lag_time_constant_s: float
+    order: int | None
+    weighting: str | None
+    scores: dict[str, float | None] = field(default_factory=dict)
+
+    @property
+    def label(self) -> str:
+        """``turning-point (order 2)``, ``lag``, ``none``."""
+        return self.memory + (f" (order {self.hysteresis_order})" if self.hysteresis_order else "")
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "MemoryChoice":
+        if "memory" in d:
+            memory, order = str(d["memory"]), int(d.get("hysteresis_order", 0))
+        else:  # files before the fields: the chosen memory as text
+            match = _CHOSEN.match(str(d.get("chosen", "none")))
+            memory, order = (match["memory"], int(match["order"] or 0)) if match else (str(d.get("chosen")), 0)
+        scores = d.get("scores_dps", d.get("scores_bic", {})) or {}
+        return cls(memory, order, float(d.get("lag_time_constant_s", 0.0)),
+                   None if d.get("order") is None else int(d["order"]), d.get("weighting"),
+                   {str(k): _number(v) for k, v in scores.items()})
+
+
+@dataclass(frozen=True)
+class HysteresisReport:
+    """Thermal lag and turning-point hysteresis: the mode asked for, how the memory was chosen
+    (``leave-one-run-out``, ``bic``, or why none was), and the choice per axis."""
+
+    mode: str
+    selection: str
+    axes: dict[str, MemoryChoice]
+
+    @property
+    def by_bic(self) -> bool:
+        return self.selection == "bic"
+
+    @property
+    def memories_scored(self) -> tuple[str, ...]:
+        """The memories some axis has a score for, in :data:`MEMORIES` order."""
+        seen = {m for choice in self.axes.values() for m in choice.scores}
+        return tuple(m for m in MEMORIES if m in seen) + tuple(sorted(seen - set(MEMORIES)))
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "HysteresisReport":
+        return cls(str(d.get("mode", "auto")), str(d.get("selection", "none")),
+                   {str(a): MemoryChoice.from_dict(v) for a, v in (d.get("axes") or {}).items()})
+
+
+@dataclass(frozen=True)
+class OrderSelection:
+    """The polynomial order by ``method`` (``leave-one-run-out`` residual [deg/s] or ``bic``): each axis's score of
+    each order tried."""
+
+    method: str
+    scores: dict[str, dict[int, float]]
+
+    @property
+    def orders(self) -> tuple[int, ...]:
+        return tuple(sorted({p for s in self.scores.values() for p in s}))
+
+
+@dataclass(frozen=True)
+class NetworkReport:
+    """The temperature network: hidden layer sizes, restarts, seed, how it was trained, and per axis the
+    validation RMS of each restart [deg/s] and the epochs of the one kept."""
+
+    hidden: tuple[int, ...]
+    restarts: int
+    seed: int
+    training: str
+    validation_rmse_dps: dict[str, tuple[float, ...]]
+    epochs: dict[str, Any]
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "NetworkReport":
+        axes = d.get("axes", {})
+        return cls(tuple(int(h) for h in d["hidden"]), int(d.get("restarts", 1)), int(d.get("seed", 0)),
+                   str(d.get("training", "")),
+                   {a: tuple(float(v) for v in i.get("validation_rmse_dps", ())) for a, i in axes.items()},
+                   {a: i.get("epochs") for a, i in axes.items()})
+
+
+@dataclass(frozen=True)
+class GSensitivityRow:
+    """One gyro axis's row of G [deg/s/g] and its standard errors (None: not fitted, the axis was not excited)."""
+
+    g_sensitivity_dps_per_g: tuple[float, ...]
+    standard_error_dps_per_g: tuple[float | None, ...]
+
+
+@dataclass(frozen=True)
+class GSensitivityReport:
+    """The g-sensitivity fit: its mode (``matrix``, ``matrix2``, ``network`` or ``none``, with why), the static
+    segments of each run, the accelerometer axes the positions excite, and the rows of G."""
+
+    mode: str
+    why: str | None
+    static_segments: tuple[int, ...]
+    excited_axes: tuple[str, ...]
+    axes: dict[str, GSensitivityRow]
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "GSensitivityReport":
+        return cls(str(d.get("mode", "none")), d.get("why"), tuple(int(s) for s in d.get("static_segments", ())),
+                   tuple(d.get("excited_axes", ())),
+                   {a: GSensitivityRow(tuple(float(v) for v in i["g_sensitivity_dps_per_g"]),
+                                       tuple(_number(v) for v in i.get("standard_error_dps_per_g", (None,) * 3)))
+                    for a, i in (d.get("axes") or {}).items() if "g_sensitivity_dps_per_g" in i})
+
+
+@dataclass(frozen=True)
+class AxisFit:
+    """One axis's fitted curve: its order (an int for a polynomial, the network's name for a network), the
+    temperature range it was fitted on [degC], and its fit RMS [deg/s or g] where the fit reported one."""
+
+    order: int | str | None
+    t_min_degc: float | None
+    t_max_degc: float | None
+    fit_rms: float | None
+
+
+@dataclass(frozen=True)
+class FitReport:
+    """How a calibration was fitted (see the module). ``method`` is the temperature model's family
+    (``polynomial``, ``mlp``, ``population prior``, ...; None without a temperature model)."""
+
+    method: str | None
+    axes: dict[str, AxisFit]
+    order_selection: OrderSelection | None
+    selection: dict[str, SelectionReport]
+    hysteresis: HysteresisReport | None
+    network: NetworkReport | None
+    acceleration: GSensitivityReport | None
+    pipeline: str | None
+    stages: tuple["FitReport", ...]
+    accel: "FitReport | None"
+    sections: dict[str, Any]
+
+    @classmethod
+    def from_dict(cls, d: dict | None) -> "FitReport":
+        """Read the ``fit_report`` object of a model file (any schema version)."""
+        d = d or {}
+        axes_in = d.get("axes") or {}
+        axes = {a: AxisFit(i.get("order"), _number(i.get("t_min_degc")), _number(i.get("t_max_degc")),
+                           _number(i.get("fit_rms_dps"))) for a, i in axes_in.items()}
+        scores = {a: {int(p): float(v) for p, v in i["scores"].items()} for a, i in axes_in.items() if i.get("scores")}
+        order_selection = (OrderSelection(str(d.get("order_selection", "")), scores)
+                           if scores and "network" not in d else None)
+        hysteresis = d.get("hysteresis")
+        acceleration = d.get("acceleration")
+        return cls(
+            method=d.get("temperature"), axes=axes, order_selection=order_selection,
+            selection={a: SelectionReport.from_dict(s) for a, s in (d.get("selection") or {}).items()},
+            hysteresis=HysteresisReport.from_dict(hysteresis) if isinstance(hysteresis, dict) else None,
+            network=NetworkReport.from_dict(d["network"]) if d.get("network") else None,
+            acceleration=GSensitivityReport.from_dict(acceleration) if isinstance(acceleration, dict) else None,
+            pipeline=d.get("pipeline"),
+            stages=tuple(cls.from_dict(s) for s in d.get("stages") or ()),
+            accel=cls.from_dict(d["accel"]) if isinstance(d.get("accel"), dict) else None,
+            sections={k: v for k, v in d.items() if k not in _TYPED})
+
+
+__all__ = ["AxisFit", "CandidateResult", "CandidateSpec", "FitReport", "GSensitivityReport", "GSensitivityRow",
+           "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport"]
