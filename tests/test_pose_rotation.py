@@ -23,6 +23,7 @@ from gyrocomp.models.pose_rotation import (fit_gyro_between_poses, ordered_produ
                                            rotation_errors, rotation_matrix)
 from gyrocomp.simulate import AccelErrorModel, get_profile, preset_model, simulate
 from gyrocomp.triad import TriadCalibration
+from gyrocomp.models.options import FitOptions
 
 from .conftest import run, xsens_session
 
@@ -133,7 +134,7 @@ def test_xsens_session_turns_predict_gravity_to_0_2_deg_on_held_out_turns():
 
 def test_fit_and_apply_correct_the_turns_of_another_session(tmp_path):
     consumer = dataclasses.replace(PART, scale_factor_error_ppm=(10000.0, -8000.0, 6000.0))  # +-1 %, as MEMS parts
-    cal = fit_channels([_session(4, part=consumer)], hysteresis="none")
+    cal = fit_channels([_session(4, part=consumer)], options=FitOptions(hysteresis="none"))
     assert cal.gyro_triad is not None and cal.gyro_triad.method == "rotation"
     path = tmp_path / "model.json"
     cal.save(path)
@@ -147,7 +148,7 @@ def test_fit_and_apply_correct_the_turns_of_another_session(tmp_path):
     # the plain tumble cannot determine K: auto says so and fits the bias alone
     tumble = simulate(PART, profile=get_profile("tumble", position_s=10.0, move_s=2.0), rate_hz=20, seed=3).recording
     with pytest.warns(DataQualityWarning, match="scale factor not fitted from the multi-position runs"):
-        assert fit_channels([tumble], hysteresis="none").gyro_triad is None
+        assert fit_channels([tumble], options=FitOptions(hysteresis="none")).gyro_triad is None
 
 
 def test_cli_fits_the_scale_factor_from_a_turned_session(tmp_path):
@@ -162,7 +163,7 @@ def test_cli_fits_the_scale_factor_from_a_turned_session(tmp_path):
 def test_report_draws_the_scale_factor_and_the_residual_of_each_pose_and_turn():
     part = dataclasses.replace(PART, scale_factor_error_ppm=(10000.0, -8000.0, 6000.0))
     rec = _session(7, part=part)
-    cal = fit_channels([rec], ("gyro", "accel"), hysteresis="none")  # one temperature: the triads alone
+    cal = fit_channels([rec], ("gyro", "accel"), options=FitOptions(hysteresis="none"))  # one temperature: the triads alone
     assert cal.gyro_triad.method == "rotation" and cal.accel_triad.method == "six-position" and not cal.accel_axes
     residuals = _pose_residuals(cal, [rec], [apply(cal, rec)])
     before, after = residuals["accelerometer |a| - 1 g [mg]"]
@@ -176,7 +177,7 @@ def test_report_draws_the_scale_factor_and_the_residual_of_each_pose_and_turn():
 
 def test_evaluate_reports_the_turns_and_poses_raw_and_compensated(tmp_path):
     part = dataclasses.replace(PART, scale_factor_error_ppm=(10000.0, -8000.0, 6000.0))
-    cal = fit_channels([_session(7, part=part)], ("gyro", "accel"), hysteresis="none")
+    cal = fit_channels([_session(7, part=part)], ("gyro", "accel"), options=FitOptions(hysteresis="none"))
     other = _session(8, part=part)
     figures = {t.figure: t for t in evaluate(cal, other).triads}
     assert set(figures) == {"pose_norm_g", "turn_direction_deg"}

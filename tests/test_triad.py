@@ -25,6 +25,7 @@ from gyrocomp.models.triad_fit import (Pose, find_poses, fit_accel_multiposition
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulate import AccelErrorModel, GyroErrorModel, get_profile, preset_model, simulate, tumble_positions
 from gyrocomp.triad import TriadCalibration
+from gyrocomp.models.options import FitOptions, Polynomial
 
 from .conftest import run, shared_dataset, xsens_session
 
@@ -294,7 +295,7 @@ def test_fit_with_rate_table_runs_stores_k_and_apply_corrects_the_held_out_rates
     chamber = [simulate(RATE_PART, profile="chamber", duration_s=3600, rate_hz=2, seed=20 + s).recording
                for s in range(3)]
     rate_runs = [_rate_run(t, s) for s, t in enumerate((-10.0, 25.0, 60.0))]
-    cal = fit_channels(rate_runs + chamber, hysteresis="none")
+    cal = fit_channels(rate_runs + chamber, options=FitOptions(hysteresis="none"))
     assert cal.gyro_triad is not None and cal.gyro_triad == rate_fit.calibration
     path = tmp_path / "model.json"
     cal.save(path)
@@ -379,7 +380,8 @@ def test_cli_fits_the_scale_factor_from_rate_table_files(tmp_path):
 
 def test_exports_say_what_they_leave_out_of_a_triad(rate_fit):
     chamber = [simulate(RATE_PART, profile="chamber", duration_s=1800, rate_hz=1, seed=40 + s).recording for s in range(2)]
-    cal = dataclasses.replace(fit_channels(chamber, temperature=2, hysteresis="none", acceleration="none"),
+    cal = dataclasses.replace(fit_channels(chamber, options=FitOptions(temperature=Polynomial(2), hysteresis="none",
+                                                       acceleration="none")),
                               gyro_triad=rate_fit.calibration)
     with pytest.warns(DataQualityWarning, match="scale-factor and misalignment"):
         px4_params_file(cal)

@@ -29,6 +29,10 @@ _EXPORTS = {
     "Evaluation": ("metrics", "Evaluation"), "evaluate_run": ("metrics", "evaluate_run"),
     "PolynomialTemperatureModel": ("models", "PolynomialTemperatureModel"),
     "fit_calibration": ("models.pipelines", "fit_calibration"), "fit_channels": ("models.pipelines", "fit_channels"),
+    "fit_pipeline": ("models.pipelines", "fit_pipeline"),
+    **{name: ("models.options", name) for name in ("FitOptions", "Network", "Polynomial")},
+    "FitReport": ("fit_report", "FitReport"), "analyse_noise_file": ("noise_file", "analyse_noise_file"),
+    "evaluate_file": ("evaluation", "evaluate_file"),
     # ``gyrocomp.fit`` is fit_calibration: recordings in, a frozen Calibration out
     "fit": ("models.pipelines", "fit_calibration"),
     "fit_gyro_between_poses": ("models.pose_rotation", "fit_gyro_between_poses"),

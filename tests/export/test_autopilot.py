@@ -14,6 +14,7 @@ from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.simulate import GyroErrorModel, simulate
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.units import STANDARD_GRAVITY_M_PER_S2 as G0
+from gyrocomp.models.options import FitOptions, Polynomial
 
 from ..conftest import run, xsens_session
 
@@ -127,7 +128,7 @@ def test_accelerometer_parameters_reproduce_the_accelerometer_model():
     runs = [simulate("consumer", profile="cycle", rate_hz=0.5, seed=s).recording for s in range(2)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        cal = fit_channels(runs, ("gyro", "accel"), temperature=3, hysteresis="none")
+        cal = fit_channels(runs, ("gyro", "accel"), options=FitOptions(temperature=Polynomial(3), hysteresis="none"))
         px4, ardu = _read_px4(px4_params_file(cal)), _read_ardupilot(ardupilot_params_file(cal))
     assert px4["TC_A_ENABLE"] == 1 and px4["TC_G_ENABLE"] == 1
     reference = cal.accel_reference_degc

@@ -15,6 +15,7 @@ from gyrocomp.export.c_code import c_sources, write_c_sources
 from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulate import get_profile, simulate
 from gyrocomp.triad import TriadCalibration
+from gyrocomp.models.options import FitOptions
 from ..conftest import run
 
 DRIVER = r"""
@@ -162,7 +163,7 @@ def test_accelerometer_temperature_models_g_sensitivity_and_both_triads(tmp_path
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_channels(runs, ("gyro", "accel"))
-        lagged = fit_channels(chamber, ("accel",), hysteresis="lag").accel_axes
+        lagged = fit_channels(chamber, ("accel",), options=FitOptions(hysteresis="lag")).accel_axes
         cal = dataclasses.replace(cal, accel_axes=lagged, gyro_triad=GYRO_TRIAD, accel_triad=ACCEL_TRIAD)
         ours = apply(cal, runs[1])
         plain = apply(cal.without("scale-factor").without_accel_triad(), runs[1])

@@ -15,6 +15,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.metrics import evaluate_run, moving_average
 from gyrocomp.models.pipelines import fit_accelerometer, fit_channels, parse_channels
 from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.models.options import FitOptions, Polynomial
 
 from ..conftest import run
 
@@ -73,8 +74,8 @@ def test_gyro_and_accel_together_fit_g_on_compensated_accelerations():
 
 
 def test_round_trip_names_accelerometer_values_in_g(cycles, tmp_path):
-    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("gyro", "accel"), temperature=2,
-                 hysteresis="none")
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("gyro", "accel"),
+                 options=FitOptions(temperature=Polynomial(2), hysteresis="none"))
     path = tmp_path / "model.json"
     cal.save(path)
     text = path.read_text()
@@ -88,7 +89,7 @@ def test_round_trip_names_accelerometer_values_in_g(cycles, tmp_path):
 
 
 def test_streaming_equals_batch_with_lag(cycles):
-    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), hysteresis="lag")
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), options=FitOptions(hysteresis="lag"))
     assert any(ax.lag_time_constant_s > 0 for ax in cal.accel_axes.values())
     rec = cycles[3].recording
     batch = _quiet(apply, cal, rec).accel_g
@@ -107,7 +108,8 @@ def test_bad_channels_and_missing_accelerometer(cycles):
     bare = dataclasses.replace(cycles[0].recording, accel_g=None, accel_axes=())
     with pytest.raises(InputError, match=r"channels=accel needs accel_x, accel_y and accel_z columns"):
         fit_accelerometer([bare])
-    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",), temperature=1, hysteresis="none")
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",),
+                 options=FitOptions(temperature=Polynomial(1), hysteresis="none"))
     with pytest.raises(InputError, match=r"the model compensates the accelerometer; the data needs accel_x"):
         apply(cal, bare)
     with pytest.raises(InputError, match=r"channels=accel: the accelerometer model is a temperature model; "

@@ -22,6 +22,7 @@ from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.report.figures import envelope
 from gyrocomp.report.html import SECTIONS, build_report
 from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.models.options import FitOptions
 from ..conftest import SCRIPT, run
 
 matplotlib_image = pytest.importorskip("matplotlib.image", reason="the report tests draw with matplotlib")
@@ -79,7 +80,7 @@ def test_single_axis_report_with_hysteresis_has_every_section():
 @pytest.mark.slow
 def test_three_axis_report_with_acceleration_and_accelerometer():
     runs = [simulate("consumer", profile="combined", duration_s=5400, rate_hz=1, seed=s).recording for s in range(3)]
-    cal = _quiet(fit_channels, runs[:2], ("gyro", "accel"), hysteresis="none")
+    cal = _quiet(fit_channels, runs[:2], ("gyro", "accel"), options=FitOptions(hysteresis="none"))
     progress = []
     report = build_report(cal, [runs[2]], progress=progress.append)
     axes = [f"axis-{a}" for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")]

@@ -123,8 +123,10 @@ PARAMETER_FLAGS = {
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
     "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
     "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
-    "prior": "--prior", "still_only": "--still-only",
+    "prior": "--prior", "still_only": "--still-only", "bin_width_degc": "--bin-width", "mlp_seed": "--seed",
 }
+#: the option objects whose fields messages name (``FitOptions.hysteresis: ...``): the field is the flag's
+_OPTION_OBJECT = re.compile(r"\b(?:FitOptions|Polynomial|Network)\.(?=\w)")
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
 _SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone
 _PARAMETER = re.compile(r"(?<![\w.\-/])(" + "|".join(sorted(PARAMETER_FLAGS, key=len, reverse=True)) + r")([:=])")
@@ -139,7 +141,7 @@ def in_cli_words(message: str) -> str:
             return PARAMETER_FLAGS[name] + ":"
         return PARAMETER_FLAGS[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
 
-    message = _PARAMETER.sub(flag, _SWITCH.sub(r"\1=", message))
+    message = _PARAMETER.sub(flag, _SWITCH.sub(r"\1=", _OPTION_OBJECT.sub("", message)))
     return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
 
 

@@ -13,6 +13,7 @@ from ..io.files import expand_runs
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
+from ..models.options import FitOptions, Network, temperature_spec
 from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
 from ..models.selection import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
@@ -83,6 +84,11 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     if band is not None and (len(band) != 2 or not band[0] < band[1]):
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     channels = parse_channels(channels)
+    spec = temperature_spec(order)
+    options = FitOptions(temperature=Network(spec.hidden, mlp_seed) if isinstance(spec, Network) else spec,
+                         bin_width_degc=bin_width_degc, hysteresis=hysteresis, hysteresis_order=hysteresis_order,
+                         hysteresis_band_degc=None if band is None else tuple(band), acceleration=acceleration,
+                         static_min_duration_s=static_min_duration_s, folds=folds)
     runs = expand_runs(runs)
     refuse_to_overwrite_inputs(output, runs)
     every = str(opts["instance"]).strip().lower() == "all"
@@ -97,11 +103,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
             print_contributions(contributions)
         with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):
-            fits[instance] = fit_channels(
-                recordings, channels, pipeline, temperature=order, bin_width_degc=bin_width_degc,
-                hysteresis=hysteresis, hysteresis_order=hysteresis_order, hysteresis_band_degc=band,
-                mlp_seed=mlp_seed, acceleration=acceleration, static_min_duration_s=static_min_duration_s,
-                scale_factor=scale_factor, **({} if folds == "auto" else {"folds": folds}))
+            fits[instance] = fit_channels(recordings, channels, pipeline, scale_factor=scale_factor, options=options)
     if every:  # one model file per instance, all written or none
         out = Path(output)
         names = {instance: f"{out.stem}_imu{instance}{out.suffix}" for instance in fits}

@@ -33,6 +33,7 @@ from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, sha
 from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
+from .options import FitOptions, Network, Polynomial, legacy_temperature
 from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 from ..threads import single_threaded_blas
 
@@ -182,7 +183,8 @@ def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, 
 # Over 60 lines, not yet split: the default fit's option checks and its routes (no temperature, cross-validated
 # selection, one binned fit, with or without a network); #18's typed options are to take the checks out.
 @single_threaded_blas
-def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int | str | None = "auto",
+def fit_calibration(recordings: list[Recording] | Recording, *,
+                    temperature: Polynomial | Network | int | str | None = "auto",
                     bin_width_degc: float | None = None, hysteresis: str = "auto",
                     hysteresis_order: int | str = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
@@ -195,10 +197,11 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
     ----------
     recordings : list of Recording
         Calibration runs; each gets its own turn-on constant, the temperature shape is shared.
-    temperature : "auto", int, "mlp", ("mlp", hidden) or None
-        Polynomial order of the temperature model: ``"auto"`` (cross-validated), 0..5; ``"mlp"`` for
-        the thesis's 1-3-1 network, ``("mlp", (H,))`` for H hidden neurons; or None for no
-        temperature model (each run's constant only).
+    temperature : Polynomial, Network or None (or "auto", int, "mlp", ("mlp", hidden))
+        The temperature model (:mod:`gyrocomp.models.options`): ``Polynomial(order="auto")`` (chosen by held-out
+        drift) or an order 0..5; ``Network()`` for the thesis's 1-3-1 network, ``Network(hidden=(H,))`` for H
+        hidden neurons (its ``seed`` replaces ``mlp_seed``); or None for no temperature model (each run's
+        constant only). The plain forms in brackets mean the same.
     bin_width_degc : float, optional
         Temperature bin width for the fit [degC].
     hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
@@ -238,6 +241,9 @@ def fit_calibration(recordings: list[Recording] | Recording, *, temperature: int
         if not isinstance(rec, Recording):
             raise InputError(f"recordings[{k}]: expected a Recording (from gyrocomp.read or simulate), "
                              f"got {type(rec).__name__}")
+    if isinstance(temperature, (Polynomial, Network)):
+        temperature, seed = legacy_temperature(temperature)
+        mlp_seed = seed if isinstance(temperature, tuple) else mlp_seed
     _check_fit_inputs(recordings, temperature, acceleration, static_min_duration_s)
     if temperature is None:
         return _fit_without_temperature(recordings, acceleration, static_min_duration_s)
@@ -444,8 +450,18 @@ def _chain(first: Calibration, second: Calibration, recordings: list[Recording],
                        fit_report=report)
 
 
-def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint", **options) -> Calibration:
-    """Fit a named pipeline (``PIPELINES``); ``options`` go to :func:`fit_calibration` for the temperature stage.
+def _options(options: FitOptions | None) -> FitOptions:
+    if options is None:
+        return FitOptions()
+    if not isinstance(options, FitOptions):
+        raise InputError(f"options: a FitOptions (gyrocomp.models.options), got {type(options).__name__}")
+    return options
+
+
+def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint",
+                 options: FitOptions | None = None) -> Calibration:
+    """Fit a named pipeline (``PIPELINES``); ``options`` (:class:`gyrocomp.models.options.FitOptions`, default
+    ``FitOptions()``) are :func:`fit_calibration`'s for the temperature stage.
 
     - ``joint``: temperature model, lag/hysteresis, G and run constants in one least-squares fit (the default);
     - ``poly>matrix``, ``mlp>matrix``: the temperature model (polynomial or network, with lag/hysteresis as
@@ -460,7 +476,7 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
     recordings = list(recordings)
     if pipeline not in PIPELINES:
         raise InputError(f"pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
-    options = dict(options)
+    options = _options(options).calibration_arguments()
     if pipeline == "joint":
         return fit_calibration(recordings, **options)
     acceleration = options.pop("acceleration", "auto")
@@ -695,8 +711,10 @@ def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibratio
 
 @single_threaded_blas
 def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, ...] | str = ("gyro",),
-                 pipeline: str = "joint", *, scale_factor: ScaleFactor = "auto", **options) -> Calibration:
-    """Fit the gyro (``fit_pipeline``), the accelerometer, or both.
+                 pipeline: str = "joint", *, scale_factor: ScaleFactor = "auto",
+                 options: FitOptions | None = None) -> Calibration:
+    """Fit the gyro (``fit_pipeline``), the accelerometer, or both, with ``options``
+    (:class:`gyrocomp.models.options.FitOptions`, default ``FitOptions()``).
 
     The accelerometer gets temperature models (``fit_accelerometer``) when the runs have a temperature, and
     bias, scale factor and misalignment (``fit_accel_multiposition``) when they turn its every axis up and
@@ -714,17 +732,18 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
         recordings = [recordings]
     recordings = list(recordings)
     channels = parse_channels(channels)
+    options = _options(options)
     gyro_triad, recordings = _gyro_triad(recordings, scale_factor) if "gyro" in channels else (None, recordings)
     if "accel" not in channels:
-        return dataclasses.replace(fit_pipeline(recordings, pipeline, **options), gyro_triad=gyro_triad)
-    accel_cal = _fit_accel_channel(recordings, options)
+        return dataclasses.replace(fit_pipeline(recordings, pipeline, options), gyro_triad=gyro_triad)
+    accel_cal = _fit_accel_channel(recordings, options.calibration_arguments())
     if "gyro" not in channels:
         return accel_cal
     compensated = recordings
     if accel_cal.accel_axes:
         compensated = [dataclasses.replace(rec, accel_g=apply(accel_cal.without_accel_triad(), rec).accel_g)
                        for rec in recordings]
-    gyro_cal = fit_pipeline(compensated, pipeline, **options)
+    gyro_cal = fit_pipeline(compensated, pipeline, options)
     return dataclasses.replace(gyro_cal, model=f"{gyro_cal.model}; {accel_cal.model}",
                                fit_report={**gyro_cal.fit_report, **accel_cal.fit_report},
                                accel_axes=accel_cal.accel_axes, accel_reference_degc=accel_cal.accel_reference_degc,

@@ -1,0 +1,156 @@
+"""Typed options of a fit: what temperature model, thermal memory, g-sensitivity and held-out folds
+:func:`gyrocomp.models.pipelines.fit_pipeline` and :func:`~gyrocomp.models.pipelines.fit_channels` use.
+
+>>> from gyrocomp.models.options import FitOptions, Network, Polynomial
+>>> FitOptions(temperature=Polynomial(order=3), hysteresis="none")
+>>> FitOptions(temperature=Network(hidden=(5,)), acceleration="matrix")
+
+Each field is checked when the object is made; an error names the field and the value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Literal, get_args
+
+from ..errors import InputError
+from .mlp import DEFAULT_HIDDEN
+from .temperature import MAX_ORDER
+from .thermal import MAX_HYSTERESIS_ORDER
+
+#: the thermal memory on top of the temperature curve
+Memory = Literal["auto", "none", "turning-point", "lag", "turning-point+lag"]
+#: the g-sensitivity fit (``auto``: the 3x3 matrix when the runs turn between positions)
+Acceleration = Literal["auto", "none", "matrix", "matrix2"]
+#: what the model choice holds out
+FoldChoice = Literal["auto", "runs", "legs", "blocks"]
+#: the most hidden neurons of a layer, and layers, a network may have
+MAX_HIDDEN, MAX_LAYERS = 50, 3
+
+
+@dataclass(frozen=True)
+class Polynomial:
+    """A polynomial in temperature: ``order`` 0..5, or ``"auto"`` (chosen by held-out drift)."""
+
+    order: int | Literal["auto"] = "auto"
+
+    def __post_init__(self):
+        if self.order != "auto" and not (isinstance(self.order, int) and not isinstance(self.order, bool)
+                                         and 0 <= self.order <= MAX_ORDER):
+            raise InputError(f"Polynomial.order: a whole number from 0 to {MAX_ORDER}, or 'auto'; got {self.order!r}")
+
+
+@dataclass(frozen=True)
+class Network:
+    """The thesis's network of the temperature: ``hidden`` tanh neurons per layer (default one layer of 3), its
+    restarts' initializations drawn from ``seed`` (the same seed gives the same model)."""
+
+    hidden: tuple[int, ...] = DEFAULT_HIDDEN
+    seed: int = 0
+
+    def __post_init__(self):
+        hidden = tuple(self.hidden) if isinstance(self.hidden, (tuple, list)) else None
+        if (not hidden or len(hidden) > MAX_LAYERS
+                or not all(isinstance(h, int) and not isinstance(h, bool) and 1 <= h <= MAX_HIDDEN for h in hidden)):
+            raise InputError(f"Network.hidden: 1 to {MAX_LAYERS} layers of 1..{MAX_HIDDEN} neurons, e.g. (3,); "
+                             f"got {self.hidden!r}")
+        object.__setattr__(self, "hidden", hidden)
+        if not isinstance(self.seed, int) or isinstance(self.seed, bool):
+            raise InputError(f"Network.seed: a whole number, got {self.seed!r}")
+
+
+def _choice(name: str, value, choices) -> None:
+    if value not in choices:
+        raise InputError(f"{name}: {value!r}; use one of {', '.join(map(str, choices))}")
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """How the gyro (and the accelerometer's temperature model) is fitted.
+
+    Parameters
+    ----------
+    temperature : Polynomial, Network or None
+        The temperature model; None fits no curve (each run's constant, and G when the runs turn).
+    bin_width_degc : float, optional
+        Temperature bin width of the fit [degC].
+    hysteresis : Memory
+        Thermal lag and/or turning-point hysteresis (``auto``: chosen by held-out drift when the runs heat and
+        cool).
+    hysteresis_order : int or "auto"
+        Order of the turning-point polynomial, 1..3.
+    hysteresis_band_degc : (lo, hi), optional
+        Limit the hysteresis to this band [degC].
+    acceleration : Acceleration
+        The g-sensitivity fitted jointly on the static segments.
+    static_min_duration_s : float
+        Shortest still stretch used as a static segment [s].
+    run_folds : tuple of int, optional
+        The validation fold of each recording (pieces of one run left out together).
+    folds : FoldChoice
+        What the model choice holds out.
+    """
+
+    temperature: Polynomial | Network | None = Polynomial()
+    bin_width_degc: float | None = None
+    hysteresis: Memory = "auto"
+    hysteresis_order: int | Literal["auto"] = "auto"
+    hysteresis_band_degc: tuple[float, float] | None = None
+    acceleration: Acceleration = "auto"
+    static_min_duration_s: float = 10.0
+    run_folds: tuple[int, ...] | None = None
+    folds: FoldChoice = "auto"
+
+    def __post_init__(self):
+        if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Network)):
+            raise InputError(f"FitOptions.temperature: Polynomial(order=...), Network(hidden=...) or None; got "
+                             f"{self.temperature!r}")
+        _choice("FitOptions.hysteresis", self.hysteresis, get_args(Memory))
+        _choice("FitOptions.hysteresis_order", self.hysteresis_order, ("auto", *range(1, MAX_HYSTERESIS_ORDER + 1)))
+        _choice("FitOptions.acceleration", self.acceleration, get_args(Acceleration))
+        _choice("FitOptions.folds", self.folds, get_args(FoldChoice))
+        if self.bin_width_degc is not None and not (isinstance(self.bin_width_degc, (int, float))
+                                                    and self.bin_width_degc > 0):
+            raise InputError(f"FitOptions.bin_width_degc: a positive number of degC, got {self.bin_width_degc!r}")
+        if not (isinstance(self.static_min_duration_s, (int, float)) and self.static_min_duration_s > 0):
+            raise InputError(f"FitOptions.static_min_duration_s: a positive number of seconds, got "
+                             f"{self.static_min_duration_s!r}")
+        band = self.hysteresis_band_degc
+        if band is not None and (len(band) != 2 or not band[0] < band[1]):
+            raise InputError(f"FitOptions.hysteresis_band_degc: (lo, hi) in degC with lo < hi, got {band!r}")
+
+    def calibration_arguments(self) -> dict:
+        """The keyword arguments of :func:`gyrocomp.models.pipelines.fit_calibration` these options mean."""
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["temperature"], seed = legacy_temperature(self.temperature)
+        out["mlp_seed"] = seed
+        return out
+
+
+def legacy_temperature(spec: Polynomial | Network | None) -> tuple[int | str | tuple | None, int]:
+    """A typed temperature model as :func:`~gyrocomp.models.pipelines.fit_calibration`'s ``temperature`` (an order,
+    ``"auto"``, ``("mlp", hidden)`` or None) and the network's seed (0 otherwise)."""
+    if isinstance(spec, Network):
+        return ("mlp", spec.hidden), spec.seed
+    if isinstance(spec, Polynomial):
+        return spec.order, 0
+    return None, 0
+
+
+def temperature_spec(value) -> Polynomial | Network | None:
+    """``fit_calibration``'s ``temperature`` (an order, ``"auto"``, ``"mlp"``, ``("mlp", hidden)``, None, or already
+    typed) as a typed temperature model."""
+    if value is None or isinstance(value, (Polynomial, Network)):
+        return value
+    if value == "mlp":
+        return Network()
+    if isinstance(value, tuple) and len(value) == 2 and value[0] == "mlp":
+        return Network(tuple(value[1]))
+    if value == "auto" or isinstance(value, int):
+        return Polynomial(value)
+    raise InputError(f"temperature: 'auto', an order 0..{MAX_ORDER}, 'mlp', ('mlp', hidden), a Polynomial, a "
+                     f"Network or None; got {value!r}")
+
+
+__all__ = ["Acceleration", "FitOptions", "FoldChoice", "Memory", "Network", "Polynomial", "legacy_temperature",
+           "temperature_spec"]
