@@ -1,3 +1,5 @@
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -6,6 +8,8 @@ from hypothesis import strategies as st
 from gyrocomp.errors import InputError
 from gyrocomp.metrics import (
     BIAS_INSTABILITY_FACTOR,
+    AccelAxisMetrics,
+    AxisMetrics,
     bias_instability,
     bias_offset,
     evaluate_run,
@@ -19,7 +23,9 @@ from gyrocomp.recording import Recording
 @given(x=st.lists(st.floats(-1e3, 1e3), min_size=1, max_size=60), w=st.integers(1, 60))
 def test_moving_average_equals_convolution(x, w):
     x = np.array(x)
-    if w > x.size:
+    if w > x.size:  # no full window: refused, not an empty or partial average
+        with pytest.raises(InputError, match=rf"window: {w} samples is longer than the data \({x.size} samples\)"):
+            moving_average(x, w)
         return
     np.testing.assert_allclose(moving_average(x, w), np.convolve(x, np.ones(w) / w, mode="valid"), atol=1e-9)
 
@@ -82,3 +88,20 @@ def test_runs_with_gaps_pool_the_allan_sums_over_their_stretches():
         pooled.deviation / BIAS_INSTABILITY_FACTOR * 3600, rel=1e-12)
     # no tau longer than a stretch: the curve stops where the positions do
     assert ev.axes["gyro_x"].integration_time_raw_s <= max(s.stop - s.start for s in stretches) / rec.rate_hz
+
+
+@pytest.mark.parametrize("cls, unit, bi_unit", [(AxisMetrics, "deg/s", "deg/h"), (AccelAxisMetrics, "g", "ug")])
+def test_gyro_and_accelerometer_figures_read_alike_in_their_units(cls, unit, bi_unit):
+    """The neutral names tables use read each sensor's own fields (distinct values, so a swap would show)."""
+    names = [f.name for f in dataclasses.fields(cls)]
+    figures = cls(*[float(k + 1) for k in range(len(names))])
+    by_name = dict(zip(names, range(1, len(names) + 1)))
+    suffix, bi = ("dps", "dph") if cls is AxisMetrics else ("g", "ug")
+    assert (figures.unit, figures.bias_instability_unit) == (unit, bi_unit)
+    assert figures.offset_raw == by_name[f"bias_offset_raw_{suffix}"]
+    assert figures.offset_comp == by_name[f"bias_offset_comp_{suffix}"]
+    assert figures.bias_instability_raw == by_name[f"bias_instability_raw_{bi}"]
+    assert figures.bias_instability_comp == by_name[f"bias_instability_comp_{bi}"]
+    assert figures.residual_rms == by_name[f"residual_rms_{suffix}"]
+    assert set(dataclasses.asdict(figures)) == set(names)  # the JSON keeps the unit-named fields only
+

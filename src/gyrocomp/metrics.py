@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import asdict, dataclass, field
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
@@ -69,9 +69,43 @@ def default_window_s(recording: Recording) -> float:
     return max(MIN_WINDOW_S, max(taus))
 
 
+class FiguresInUnits:
+    """The figures of an axis under neutral names, in the units ``unit`` (offsets, residual) and
+    ``bias_instability_unit`` say, for tables that show gyro and accelerometer axes alike."""
+
+    unit: ClassVar[str]
+    bias_instability_unit: ClassVar[str]
+    _names: ClassVar[tuple[str, str, str, str, str]]  # offset raw, offset comp, BI raw, BI comp, residual
+
+    @property
+    def offset_raw(self) -> float:
+        return getattr(self, self._names[0])
+
+    @property
+    def offset_comp(self) -> float:
+        return getattr(self, self._names[1])
+
+    @property
+    def bias_instability_raw(self) -> float:
+        return getattr(self, self._names[2])
+
+    @property
+    def bias_instability_comp(self) -> float:
+        return getattr(self, self._names[3])
+
+    @property
+    def residual_rms(self) -> float:
+        return getattr(self, self._names[4])
+
+
 @dataclass(frozen=True)
-class AxisMetrics:
+class AxisMetrics(FiguresInUnits):
     """Raw and compensated figures of one gyro axis over one run."""
+
+    unit: ClassVar[str] = "deg/s"
+    bias_instability_unit: ClassVar[str] = "deg/h"
+    _names: ClassVar[tuple[str, ...]] = ("bias_offset_raw_dps", "bias_offset_comp_dps", "bias_instability_raw_dph",
+                                         "bias_instability_comp_dph", "residual_rms_dps")
 
     bias_offset_raw_dps: float
     bias_offset_comp_dps: float
@@ -84,9 +118,14 @@ class AxisMetrics:
 
 
 @dataclass(frozen=True)
-class AccelAxisMetrics:
+class AccelAxisMetrics(FiguresInUnits):
     """Raw and compensated figures of one accelerometer axis over one run (a static run: the moving average
     of a unit being turned follows gravity, not the bias)."""
+
+    unit: ClassVar[str] = "g"
+    bias_instability_unit: ClassVar[str] = "ug"
+    _names: ClassVar[tuple[str, ...]] = ("bias_offset_raw_g", "bias_offset_comp_g", "bias_instability_raw_ug",
+                                         "bias_instability_comp_ug", "residual_rms_g")
 
     bias_offset_raw_g: float
     bias_offset_comp_g: float

@@ -267,9 +267,13 @@ def print_comparison(result) -> None:
     console.print(table)
 
 
-def _metrics_table(title: str, evaluation: Evaluation, rows_of, unit: str, bi_unit: str, suffix: str) -> Table:
-    """One table of raw and compensated figures; ``rows_of(run)`` gives (axis, metrics) pairs whose field
-    names end in ``suffix`` (``dps``/``dph`` for the gyro, ``g``/``ug`` for the accelerometer)."""
+def _metrics_table(title: str, evaluation: Evaluation, rows_of) -> Table | None:
+    """One table of raw and compensated figures; ``rows_of(run)`` gives (axis, figures) pairs of one sensor (the
+    figures say their units)."""
+    rows = [(run, axis, m) for run in evaluation.runs for axis, m in rows_of(run)]
+    if not rows:
+        return None
+    unit, bi_unit = rows[0][2].unit, rows[0][2].bias_instability_unit
     table = Table(title=title)
     table.add_column("run", no_wrap=True)
     table.add_column("axis", no_wrap=True)
@@ -277,24 +281,19 @@ def _metrics_table(title: str, evaluation: Evaluation, rows_of, unit: str, bi_un
                 f"BI raw\n[{bi_unit}]", f"BI comp\n[{bi_unit}]", "int. time raw\n[s]", "int. time comp\n[s]",
                 f"residual RMS\n[{unit}]"):
         table.add_column(col, justify="right")
-    value, bi = suffix.split("/")
-    for run in evaluation.runs:
-        for axis, m in rows_of(run):
-            get = lambda name: getattr(m, name)  # noqa: E731
-            table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{get('bias_offset_raw_' + value):.4g}",
-                          f"{get('bias_offset_comp_' + value):.4g}", f"{m.offset_improvement:.3g}x",
-                          f"{get('bias_instability_raw_' + bi):.4g}", f"{get('bias_instability_comp_' + bi):.4g}",
-                          f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}",
-                          f"{get('residual_rms_' + value):.3g}")
+    for run, axis, m in rows:
+        table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.offset_raw:.4g}", f"{m.offset_comp:.4g}",
+                      f"{m.offset_improvement:.3g}x", f"{m.bias_instability_raw:.4g}", f"{m.bias_instability_comp:.4g}",
+                      f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}", f"{m.residual_rms:.3g}")
     return table
 
 
 def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
     console = make_console()
-    console.print(_metrics_table(title, evaluation, lambda run: run.axes.items(), "deg/s", "deg/h", "dps/dph"))
-    if any(run.accel_axes for run in evaluation.runs):
-        console.print(_metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items(),
-                                     "g", "ug", "g/ug"))
+    for table in (_metrics_table(title, evaluation, lambda run: run.axes.items()),
+                  _metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items())):
+        if table is not None:
+            console.print(table)
     if evaluation.triads:
         table = Table(title=f"{title}: scale factor and misalignment (RMS over the run's poses, turns or stretches)")
         for col in ("run", "figure", "count", "raw", "compensated", "improvement"):
