@@ -5,11 +5,13 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulate import GyroErrorModel, simulate
 
@@ -35,6 +37,17 @@ def xsens_session():
     gyro = np.loadtxt(folder / "xsens_gyro.mat")
     return Recording(acc[:, 0], np.degrees((gyro[:, 1:] - 32768) / 6258), GYRO_AXES,
                      accel_g=(acc[:, 1:] - 32768) / 3700.0, accel_axes=ACCEL_AXES, source="xsens")
+
+
+@pytest.fixture(scope="session")
+def consumer_model():
+    """A consumer part's default model (thermal lag included), fitted on two 1-hour chamber runs at 2 Hz (unit 3,
+    seeds 0 and 1); the model the chunked paths (apply_file, evaluate_file) are checked with."""
+    runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
+            for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit_channels(runs)
 
 
 #: the test sensor: MTi-10-class temperature drift, moderate bias instability

@@ -15,25 +15,10 @@ from gyrocomp.allan import PhaseAccumulator, allan_deviation, to_phase
 from gyrocomp.errors import InputError
 from gyrocomp.evaluation import evaluate, evaluate_file
 from gyrocomp.io.tables import read_table, write_recording
-from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.noise import analyse_noise
 from gyrocomp.noise_file import ChunkSettings, analyse_noise_file
 from gyrocomp.simulate import simulate
 from gyrocomp.spill import SpillArray, block_median
-
-_CACHE = {}
-
-
-def _model():
-    """A consumer part's default model (thermal lag included), fitted once."""
-    if "model" not in _CACHE:
-        runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
-                for s in range(2)]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            _CACHE["model"] = fit_channels(runs)
-    return _CACHE["model"]
-
 
 @pytest.fixture(scope="module")
 def run_files(tmp_path_factory):
@@ -209,14 +194,14 @@ def _same_evaluation(chunked, whole):
 
 @pytest.mark.parametrize("suffix", ["csv", "parquet"])
 @pytest.mark.parametrize("window", [None, 120.0])
-def test_a_files_evaluation_in_chunks_is_the_whole_files(run_files, tmp_path, suffix, window):
+def test_a_files_evaluation_in_chunks_is_the_whole_files(consumer_model, run_files, tmp_path, suffix, window):
     chunks = ChunkSettings(chunk_rows=611, memory_bytes=0, scratch_dir=str(tmp_path))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        whole = evaluate(_model(), read_table(run_files[suffix]).recording, turn_on_window_s=window)
-        chunked = evaluate_file(_model(), run_files[suffix], turn_on_window_s=window, chunks=chunks)
-        fixed = evaluate_file(_model(), run_files[suffix], window_s=30.0, chunks=chunks)
-        fixed_whole = evaluate(_model(), read_table(run_files[suffix]).recording, window_s=30.0)
+        whole = evaluate(consumer_model, read_table(run_files[suffix]).recording, turn_on_window_s=window)
+        chunked = evaluate_file(consumer_model, run_files[suffix], turn_on_window_s=window, chunks=chunks)
+        fixed = evaluate_file(consumer_model, run_files[suffix], window_s=30.0, chunks=chunks)
+        fixed_whole = evaluate(consumer_model, read_table(run_files[suffix]).recording, window_s=30.0)
     _same_evaluation(chunked, whole)
     _same_evaluation(fixed, fixed_whole)
     # the compensation did something: the figures are not those of the raw run
@@ -224,11 +209,11 @@ def test_a_files_evaluation_in_chunks_is_the_whole_files(run_files, tmp_path, su
     assert not list(tmp_path.iterdir())
 
 
-def test_a_files_evaluation_with_a_gap_is_the_whole_files(run_files):
+def test_a_files_evaluation_with_a_gap_is_the_whole_files(consumer_model, run_files):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        whole = evaluate(_model(), read_table(run_files["gap"]).recording)
-        chunked = evaluate_file(_model(), run_files["gap"], chunks=ChunkSettings(chunk_rows=500))
+        whole = evaluate(consumer_model, read_table(run_files["gap"]).recording)
+        chunked = evaluate_file(consumer_model, run_files["gap"], chunks=ChunkSettings(chunk_rows=500))
     _same_evaluation(chunked, whole)
 
 
@@ -237,7 +222,7 @@ def test_evaluate_file_refuses_what_is_no_calibration(run_files):
         evaluate_file({"axes": {}}, run_files["csv"])
 
 
-def test_a_bad_row_half_way_leaves_no_temporary_file(run_files, tmp_path):
+def test_a_bad_row_half_way_leaves_no_temporary_file(consumer_model, run_files, tmp_path):
     lines = run_files["csv"].read_text().splitlines()
     cells = lines[5000].split(",")
     cells[2] = "nan"
@@ -250,5 +235,5 @@ def test_a_bad_row_half_way_leaves_no_temporary_file(run_files, tmp_path):
     with pytest.raises(InputError, match=r"bad\.csv: row 5000, column 'gyro_y'"):
         analyse_noise_file(bad, chunks=chunks)
     with pytest.raises(InputError, match=r"bad\.csv: row 5000, column 'gyro_y'"):
-        evaluate_file(_model(), bad, chunks=chunks)
+        evaluate_file(consumer_model, bad, chunks=chunks)
     assert not list(scratch.iterdir())

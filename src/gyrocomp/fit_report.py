@@ -23,6 +23,13 @@ _TYPED = ("temperature", "axes", "order_selection", "selection", "hysteresis", "
           "accel", "pipeline")
 
 
+def memory_name(lag: bool, hysteresis_order: int) -> str:
+    """The thermal memory a model carries: ``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
+    if lag and hysteresis_order:
+        return "turning-point+lag"
+    return "lag" if lag else ("turning-point" if hysteresis_order else "none")
+
+
 def _number(value) -> float | None:
     """A score as stored: None where it could not be computed."""
     if value is None:
@@ -46,9 +53,7 @@ class CandidateSpec:
     @property
     def memory(self) -> str:
         """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
-        if self.lag and self.hysteresis_order:
-            return "turning-point+lag"
-        return "lag" if self.lag else ("turning-point" if self.hysteresis_order else "none")
+        return memory_name(self.lag, self.hysteresis_order)
 
     @classmethod
     def from_dict(cls, d: dict) -> "CandidateSpec":
@@ -285,4 +290,5 @@ class FitReport:
 
 
 __all__ = ["AxisFit", "CandidateResult", "CandidateSpec", "FitReport", "GSensitivityReport", "GSensitivityRow",
-           "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport"]
+           "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
+           "memory_name"]

@@ -21,20 +21,6 @@ from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_r
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import simulate
 
-_CACHE = {}
-
-
-def _model():
-    """A consumer part's default model (thermal lag included), fitted once."""
-    if "model" not in _CACHE:
-        runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
-                for s in range(2)]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            _CACHE["model"] = fit_channels(runs)
-    return _CACHE["model"]
-
-
 def _whole(calibration, source, target, **kwargs):
     """The whole-file path: read_table, apply, write_gyro_back."""
     layout = kwargs.pop("layout", None)
@@ -70,12 +56,13 @@ def held_out(tmp_path_factory):
 
 @hsettings(max_examples=6, deadline=None)
 @given(st.integers(2, 4000), st.sampled_from(["csv", "parquet"]), st.sampled_from([None, 120.0]))
-def test_any_chunk_size_writes_what_the_whole_file_gives(held_out, tmp_path_factory, chunk_rows, suffix, window):
+def test_any_chunk_size_writes_what_the_whole_file_gives(consumer_model, held_out, tmp_path_factory, chunk_rows, suffix,
+                                                         window):
     out = tmp_path_factory.mktemp("out")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        _whole(_model(), held_out[suffix], out / f"whole.{suffix}", turn_on_window_s=window)
-        result = apply_file(_model(), held_out[suffix], out / f"chunks.{suffix}", chunk_rows=chunk_rows,
+        _whole(consumer_model, held_out[suffix], out / f"whole.{suffix}", turn_on_window_s=window)
+        result = apply_file(consumer_model, held_out[suffix], out / f"chunks.{suffix}", chunk_rows=chunk_rows,
                             turn_on_window_s=window)
     assert result.streamed and result.rows == _read(held_out[suffix]).num_rows
     assert _read(out / f"chunks.{suffix}").equals(_read(out / f"whole.{suffix}"))
@@ -83,33 +70,33 @@ def test_any_chunk_size_writes_what_the_whole_file_gives(held_out, tmp_path_fact
         assert (out / f"chunks.{suffix}").read_bytes() == (out / f"whole.{suffix}").read_bytes()
 
 
-def test_dropped_rows_and_gaps_are_said_once_for_the_whole_file(held_out, tmp_path):
+def test_dropped_rows_and_gaps_are_said_once_for_the_whole_file(consumer_model, held_out, tmp_path):
     with pytest.warns(DataQualityWarning) as caught:
-        result = apply_file(_model(), held_out["holes"], tmp_path / "out.csv", drop_nonfinite=True, chunk_rows=700)
+        result = apply_file(consumer_model, held_out["holes"], tmp_path / "out.csv", drop_nonfinite=True, chunk_rows=700)
     said = [str(w.message) for w in caught if issubclass(w.category, DataQualityWarning)]
     assert sum("dropped 2 of 3541 rows" in m for m in said) == 1
     assert sum("1 time gap(s)" in m and "longest 30.5 s after row 1000" in m for m in said) == 1
     assert result.rows == 3539
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        _whole(_model(), held_out["holes"], tmp_path / "whole.csv", drop_nonfinite=True)
+        _whole(consumer_model, held_out["holes"], tmp_path / "whole.csv", drop_nonfinite=True)
     assert (tmp_path / "out.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
 
 
-def test_errors_name_the_rows_of_the_file(held_out, tmp_path):
+def test_errors_name_the_rows_of_the_file(consumer_model, held_out, tmp_path):
     with pytest.raises(InputError, match=r"holes.csv: row 500, column 'gyro_y': nan is not a finite number"):
-        apply_file(_model(), held_out["holes"], tmp_path / "out.csv", chunk_rows=300)
+        apply_file(consumer_model, held_out["holes"], tmp_path / "out.csv", chunk_rows=300)
     assert not (tmp_path / "out.csv").exists() and not list(tmp_path.iterdir())  # nothing left behind
     lines = held_out["csv"].read_text().splitlines()
     lines[400], lines[399] = lines[399], lines[400]  # rows 399 and 400 swapped, across the chunk boundary
     (tmp_path / "swapped.csv").write_text("\n".join(lines) + "\n")
     with pytest.raises(InputError, match=r"swapped.csv: row 400: time .* does not increase \(row 399"):
-        apply_file(_model(), tmp_path / "swapped.csv", tmp_path / "out.csv", chunk_rows=399)
+        apply_file(consumer_model, tmp_path / "swapped.csv", tmp_path / "out.csv", chunk_rows=399)
     with pytest.raises(InputError, match="chunk_rows: a whole number of at least 2"):
         TableStream(held_out["csv"], chunk_rows=1)
 
 
-def test_a_csv_whose_column_type_changes_is_read_whole(held_out, tmp_path, monkeypatch):
+def test_a_csv_whose_column_type_changes_is_read_whole(consumer_model, held_out, tmp_path, monkeypatch):
     """A column of whole numbers in the first block and decimals later cannot be streamed with the first block's
     types: the file is read whole, with the same result."""
     lines = held_out["csv"].read_text().splitlines()
@@ -122,13 +109,13 @@ def test_a_csv_whose_column_type_changes_is_read_whole(held_out, tmp_path, monke
     monkeypatch.setattr(stream_module, "CSV_BLOCK_BYTES", 4096)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = apply_file(_model(), tmp_path / "mixed.csv", tmp_path / "out.csv", chunk_rows=500)
-        _whole(_model(), tmp_path / "mixed.csv", tmp_path / "whole.csv")
+        result = apply_file(consumer_model, tmp_path / "mixed.csv", tmp_path / "out.csv", chunk_rows=500)
+        _whole(consumer_model, tmp_path / "mixed.csv", tmp_path / "whole.csv")
     assert not result.streamed
     assert (tmp_path / "out.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
 
 
-def test_units_and_mapped_columns_stream_too(held_out, tmp_path):
+def test_units_and_mapped_columns_stream_too(consumer_model, held_out, tmp_path):
     """A file in rad/s and milliseconds with its own column names: the output keeps them, in its units."""
     table = pacsv.read_csv(held_out["csv"])
     table = table.rename_columns(["t_ms" if n == "time" else n.upper() if n.startswith("gyro") else n
@@ -142,8 +129,8 @@ def test_units_and_mapped_columns_stream_too(held_out, tmp_path):
                          gyro_unit="rad/s", time_unit="ms")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        apply_file(_model(), tmp_path / "own.parquet", tmp_path / "out.parquet", layout=layout, chunk_rows=333)
-        _whole(_model(), tmp_path / "own.parquet", tmp_path / "whole.parquet", layout=layout)
+        apply_file(consumer_model, tmp_path / "own.parquet", tmp_path / "out.parquet", layout=layout, chunk_rows=333)
+        _whole(consumer_model, tmp_path / "own.parquet", tmp_path / "whole.parquet", layout=layout)
     out = pq.read_table(tmp_path / "out.parquet")
     assert out.column_names == table.column_names
     assert out.equals(pq.read_table(tmp_path / "whole.parquet"))

@@ -48,6 +48,7 @@ import numpy as np
 
 from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import InputError
+from ..fit_report import memory_name
 from ..metrics import moving_average
 from .base import RunBlocks, bin_width_for, block_means
 from .hysteresis import parting_band_degc, turn_threshold_degc
@@ -86,9 +87,7 @@ class Candidate:
     @property
     def memory(self) -> str:
         """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
-        if self.lag and self.hysteresis_order:
-            return "turning-point+lag"
-        return "lag" if self.lag else ("turning-point" if self.hysteresis_order else "none")
+        return memory_name(self.lag, self.hysteresis_order)
 
     @property
     def complexity(self) -> int:

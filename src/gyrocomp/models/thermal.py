@@ -32,6 +32,7 @@ import numpy as np
 
 from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
+from ..fit_report import memory_name
 from ..recording import Recording
 from ..static import static_segments
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
@@ -74,9 +75,7 @@ class _Spec:
 
     @property
     def name(self) -> str:
-        if self.lag and self.hysteresis_order:
-            return "turning-point+lag"
-        return "lag" if self.lag else ("turning-point" if self.hysteresis_order else "none")
+        return memory_name(self.lag, self.hysteresis_order)
 
 
 @dataclass
