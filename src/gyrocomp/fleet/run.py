@@ -250,7 +250,10 @@ def _outcomes(units: list[UnitRuns], settings: FleetSettings, known: dict[str, s
             if future.status == "finished":
                 yield future.result()
             else:  # the worker died (memory limit, a crash): the unit fails, the fleet goes on
-                yield UnitOutcome(unit.serial, "failed", "", error=_error_text(future.exception()))
+                exc = future.exception()
+                why = ("its worker was killed on every try (past its memory limit, or a crash): "
+                       if type(exc).__name__ == "KilledWorker" else "")
+                yield UnitOutcome(unit.serial, "failed", "", error=why + _error_text(exc))
             future.release()
 
 
