@@ -15,6 +15,7 @@ from gyrocomp.allan import PhaseAccumulator, allan_deviation, to_phase
 from gyrocomp.errors import InputError
 from gyrocomp.evaluation import evaluate, evaluate_file
 from gyrocomp.io.tables import read_table, write_recording
+from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.noise import analyse_noise
 from gyrocomp.noise_file import ChunkSettings, analyse_noise_file
 from gyrocomp.simulate import simulate
@@ -237,3 +238,17 @@ def test_a_bad_row_half_way_leaves_no_temporary_file(consumer_model, run_files, 
     with pytest.raises(InputError, match=r"bad\.csv: row 5000, column 'gyro_y'"):
         evaluate_file(consumer_model, bad, chunks=chunks)
     assert not list(scratch.iterdir())
+
+
+def test_a_model_with_the_accelerometer_is_judged_on_both_sensors_in_chunks(run_files, tmp_path):
+    runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
+            for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = fit_channels(runs, ("gyro", "accel"))
+        whole = evaluate(model, read_table(run_files["parquet"]).recording)
+        chunked = evaluate_file(model, run_files["parquet"], chunks=ChunkSettings(chunk_rows=450, memory_bytes=0,
+                                                                                   scratch_dir=str(tmp_path)))
+    assert model.accel_axes and list(chunked.runs[0].accel_axes) == ["accel_x", "accel_y", "accel_z"]
+    _same_evaluation(chunked, whole)
+    assert not list(tmp_path.iterdir())

@@ -1,7 +1,10 @@
 """Judging a calibration on runs: apply it and compute the thesis's figures of merit, whole or stage by stage.
 
 The layer above fitting and applying: :mod:`gyrocomp.metrics` holds the figures (raw and compensated
-recordings in), this module runs the calibration to get the compensated one.
+recordings in), this module runs the calibration to get the compensated one: on recordings (:func:`evaluate`),
+or on a CSV or Parquet file read in chunks, in memory bounded by the chunk whatever its length
+(:func:`evaluate_file`: raw and compensated rates integrated into phases as they come, the figures read from the
+phases; equal to :func:`evaluate` of the whole file to rounding).
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from .allan.streaming import PhaseAccumulator
 from .calibration import Calibration
 from .compensate import Compensator, accel_xyz, apply, compensator_for
 from .errors import DataQualityWarning, InputError
@@ -19,7 +23,6 @@ from .io.stream import NotStreamable, TableStream
 from .io.tables import TableLayout, read_table
 from .metrics import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_phases, evaluate_run
 from .noise_file import ChunkSettings, TimeSteps
-from .allan.streaming import PhaseAccumulator
 from .models.pose_rotation import rotation_errors
 from .models.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
 from .recording import ACCEL_AXES, GYRO_AXES, Recording

@@ -46,8 +46,7 @@ class TimeSteps:
         self.longest = 0.0
 
     def add(self, time_s: np.ndarray) -> None:
-        steps = np.diff(time_s, prepend=time_s[0] if self.last is None else self.last)
-        steps = steps[1:] if self.last is None else steps
+        steps = np.diff(time_s) if self.last is None else np.diff(time_s, prepend=self.last)
         if steps.size:
             self.longest = max(self.longest, float(steps.max()))
         self.steps.append(steps)
