@@ -11,7 +11,7 @@ from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureR
 from gyrocomp.metrics import default_window_s, smoothed_residual_rms
 from gyrocomp.models.base import bin_by_temperature
 from gyrocomp.cli.common import parse_temperature_option
-from gyrocomp.models.temperature import PolynomialTemperatureModel
+from gyrocomp.models.temperature import PolynomialTemperatureModel, simplest_within
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import GyroErrorModel, simulate
 
@@ -211,3 +211,14 @@ def test_no_temperature_model_subtracts_run_mean():
         warnings.simplefilter("error")
         out = apply(cal, sim.recording)
     np.testing.assert_allclose(out.gyro_dps.mean(axis=0), 0, atol=1e-12)
+
+
+def test_the_parsimony_rule_takes_the_simplest_within_tolerance_of_the_best():
+    scores = {0: 1.0, 1: 0.995, 2: 0.99, 3: float("nan")}
+    assert simplest_within(scores, [0, 1, 2, 3]) == 1  # 0.995 <= 1.01 x 0.99; 1.0 is not
+    assert simplest_within(scores, [0, 1, 2, 3], tolerance=1.02) == 0
+    assert simplest_within(scores, [0, 1, 2, 3], by_bic=True) == 2  # BIC: the best itself
+    memories = {"lag": 2.0, "none": 2.01, "turning-point": float("inf")}
+    assert simplest_within(memories, ("none", "turning-point", "lag")) == "none"  # order is the caller's
+    with pytest.raises(ModelError, match="scores: no candidate has a finite score"):
+        simplest_within({0: float("nan")}, [0])

@@ -116,6 +116,21 @@ def horner(u: np.ndarray, coefficients: list[float]) -> np.ndarray:
     return value
 
 
+def simplest_within(scores: dict, simplest_first, *, by_bic: bool = False, tolerance: float = PARSIMONY_TOLERANCE):
+    """The model choice's parsimony rule, shared by the order and the memory choices: the first key of
+    ``simplest_first`` whose score is at most ``tolerance`` times the best finite score (held-out scores); with
+    ``by_bic``, the first whose score is the best itself (BIC already charges for complexity).
+
+    ``scores`` maps keys (orders, memory names) to scores, lower better; non-finite scores never win.
+    """
+    finite = {k: v for k, v in scores.items() if math.isfinite(v)}
+    if not finite:
+        raise ModelError("scores: no candidate has a finite score")
+    best = min(finite.values())
+    limit = best if by_bic else best * tolerance
+    return next(k for k in simplest_first if k in finite and finite[k] <= limit)
+
+
 def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray | None = None) -> np.ndarray:
     """Columns u^1..u^order at the clipped u, each continued along its tangent by ``beyond_u`` (u - clipped u)
     when given: u_c^k + k u_c^(k-1) (u - u_c). The curve is linear in its coefficients either way."""
@@ -280,12 +295,11 @@ class PolynomialTemperatureModel:
         if np.unique(design.folds).size >= 2:
             self.selection_ = "leave-one-run-out"
             scores = {p: _leave_one_run_out(design, p) for p in candidates}
-            best = min(scores.values())
-            chosen = min(p for p in candidates if scores[p] <= best * PARSIMONY_TOLERANCE)
+            chosen = simplest_within(scores, candidates)
         else:
             self.selection_ = "bic"
             scores = {p: _bic(design, p) for p in candidates}
-            chosen = min(scores, key=scores.get)
+            chosen = simplest_within(scores, candidates, by_bic=True)
         self.scores_[axis] = scores
         return chosen
 

@@ -38,7 +38,7 @@ from ..static import static_segments
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from .base import RunBlocks, bin_width_for, block_means, one_temperature_column
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
-from .temperature import PARSIMONY_TOLERANCE, PolynomialBias
+from .temperature import PolynomialBias, simplest_within
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
 CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag")
@@ -252,8 +252,7 @@ class _AxisChoice:
 
 def _simplest(tried: dict[int, float], n_runs: int) -> int:
     """The smallest key whose score is within the parsimony tolerance of the best (the best with BIC)."""
-    best = min(tried.values())
-    return min(k for k, v in tried.items() if (v <= best * PARSIMONY_TOLERANCE if n_runs >= 2 else v == best))
+    return simplest_within(tried, sorted(tried), by_bic=n_runs < 2)
 
 
 @dataclass
@@ -451,10 +450,7 @@ class ThermalHysteresisModel:
         finite = {k: v for k, v in scores.items() if math.isfinite(v)}
         if not finite:
             raise ModelError(f"{axis}: no hysteresis candidate could be scored")
-        if self.selection_ == "bic":
-            return min(finite, key=finite.get)
-        best = min(finite.values())  # the simplest candidate within the parsimony tolerance of the best
-        return next(c for c in CANDIDATES if c in finite and finite[c] <= best * PARSIMONY_TOLERANCE)
+        return simplest_within(finite, CANDIDATES, by_bic=self.selection_ == "bic")
 
     @staticmethod
     def _shared_lag(choices: dict[str, _AxisChoice]) -> dict[str, float]:
