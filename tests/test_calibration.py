@@ -159,6 +159,11 @@ def _poly(d):
      r"axes\.gyro_z\.temperature_column: '\.\./x' is not a temperature channel"),
     (lambda d: d["axes"]["gyro_z"].__setitem__("turn_on_biases_dps", []),
      r"axes\.gyro_z\.turn_on_biases_dps: no values"),
+    # text where a number belongs: float() would read "NaN" as a number and apply would write NaN (the sweep found it)
+    (lambda d: d["axes"]["gyro_z"].__setitem__("turn_on_biases_dps", ["NaN"]),
+     r"axes\.gyro_z\.turn_on_biases_dps\[0\]: 'NaN' is text, not a number"),
+    (lambda d: _poly(d).__setitem__("t_max_degc", "1e5"),
+     r"axes\.gyro_z\.temperature\.t_max_degc: '1e5' is text, not a number"),
 ])
 def test_model_files_are_validated_on_load(calibration, tmp_path, change, message):
     (tmp_path / "m.json").write_text(json.dumps(_mutated(calibration, change)))

@@ -252,3 +252,24 @@ def test_a_model_with_the_accelerometer_is_judged_on_both_sensors_in_chunks(run_
     assert model.accel_axes and list(chunked.runs[0].accel_axes) == ["accel_x", "accel_y", "accel_z"]
     _same_evaluation(chunked, whole)
     assert not list(tmp_path.iterdir())
+
+
+def test_a_compensation_beyond_any_sensors_range_is_refused_naming_its_row(consumer_model, run_files, tmp_path):
+    """A corrupt temperature (1e308 degC) sends the model's tangent far past any rate a gyro measures: nothing to
+    judge, said in one line with the row, in chunks and whole (the mutation sweep found an internal error here)."""
+    lines = run_files["csv"].read_text().splitlines()
+    header = lines[0].split(",")
+    cells = lines[3001].split(",")
+    cells[header.index("temperature")] = "1e308"
+    lines[3001] = ",".join(cells)
+    bad = tmp_path / "hot.csv"
+    bad.write_text("\n".join(lines) + "\n")
+    message = (r"hot\.csv: gyro_x compensated is -?[\d.]+e\+\d+ deg/s at row 3001, beyond any MEMS sensor's range "
+               r"\(5000 deg/s\)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for chunk_rows in (700, 10 ** 6):
+            with pytest.raises(InputError, match=message):
+                evaluate_file(consumer_model, bad, chunks=ChunkSettings(chunk_rows=chunk_rows))
+        with pytest.raises(InputError, match=message):
+            evaluate(consumer_model, read_table(bad).recording)

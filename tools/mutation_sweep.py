@@ -150,6 +150,15 @@ def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counte
         path.write_text(mutated_model(model, rng), encoding="utf-8")
         status, lines = run_command(["apply", path, data, "-o", out])
         counter[classify(status, lines, out)] += 1
+    # the malformed tables again, through the commands that read them in chunks and write no table
+    model_path = work / "model.json"
+    model_path.write_text(json.dumps(model), encoding="utf-8")
+    for label, command in (("allan", ["allan"]), ("evaluate", ["evaluate", model_path])):
+        counter = results.setdefault(f"the same CSV tables through {label}", collections.Counter())
+        for k in range(150):
+            path = work / f"table{k}.csv"
+            status, lines = run_command([*command, path, *(["--drop-nan"] if k % 2 else [])])
+            counter[classify(status, lines, work / "none.csv")] += 1
     return results
 
 

@@ -96,8 +96,9 @@ MAX_COEFFICIENTS = 10
 
 
 def _check_numbers(value: Any, where: str) -> None:
-    """Every number under ``value`` finite and of a size a sensor model can have, and every list of a sane
-    length; the error names the field (``axes.gyro_z.temperature.coefficients_dps[0]``)."""
+    """Every number under ``value`` finite, of a size a sensor model can have, and written as a number (not as
+    text such as ``"NaN"``), and every list of a sane length; the error names the field
+    (``axes.gyro_z.temperature.coefficients_dps[0]``)."""
     if isinstance(value, dict):
         for key, item in value.items():
             _check_numbers(item, f"{where}.{key}")
@@ -111,6 +112,12 @@ def _check_numbers(value: Any, where: str) -> None:
             raise InputError(f"{where}: {value} is not a finite number")
         if abs(value) > MAX_MAGNITUDE:
             raise InputError(f"{where}: {value:g} is beyond any MEMS sensor's range")
+    elif isinstance(value, str):  # float() would take "NaN" or "1e5" where a number belongs: refuse text numbers
+        try:
+            float(value)
+        except ValueError:
+            return
+        raise InputError(f"{where}: {value!r} is text, not a number")
 
 
 def _check_axis(section: str, name: str, d: Any, allowed: tuple[str, ...]) -> None:

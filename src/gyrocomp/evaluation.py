@@ -21,7 +21,8 @@ from .compensate import Compensator, accel_xyz, apply, compensator_for
 from .errors import DataQualityWarning, InputError
 from .io.stream import NotStreamable, TableStream
 from .io.tables import TableLayout, read_table
-from .metrics import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_phases, evaluate_run
+from .metrics import (AxisMetrics, Evaluation, TriadResiduals, check_compensated, default_window_s, evaluate_phases,
+                      evaluate_run)
 from .noise_file import ChunkSettings, TimeSteps
 from .models.pose_rotation import rotation_errors
 from .models.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
@@ -240,6 +241,7 @@ def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, tu
     comp: Compensator | None = None
     accel_axes: tuple[str, ...] = ()
     steps, raw, compensated = TimeSteps(chunks), None, None
+    pending_rows = np.empty(0, dtype=np.int64)  # file rows of the samples the compensator still holds
     try:
         for chunk in stream.chunks():
             recording = chunk.recording
@@ -258,8 +260,14 @@ def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, tu
             steps.add(recording.time_s)
             raw.update(np.column_stack([recording.gyro_dps] + ([recording.accel_g] if accel_axes else [])))
             out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel_xyz(recording))
-            compensated.update(_compensated(comp, out, accel_axes))
-        compensated.update(_compensated(comp, comp.finish(), accel_axes))
+            pending_rows = np.concatenate([pending_rows, recording.row_numbers])
+            block = _compensated(comp, out, accel_axes)
+            _check_block(first, block, accel_axes, pending_rows[:len(block)])
+            compensated.update(block)
+            pending_rows = pending_rows[len(block):]
+        block = _compensated(comp, comp.finish(), accel_axes)
+        _check_block(first, block, accel_axes, pending_rows[:len(block)])
+        compensated.update(block)
         rate_hz = steps.rate_hz()
         stream.warn_summary()
         return evaluate_phases(first.source, raw.finish(rate_hz), compensated.finish(rate_hz), rate_hz,
@@ -269,6 +277,12 @@ def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, tu
         for accumulator in (raw, compensated):
             if accumulator is not None:
                 accumulator.close()
+
+
+def _check_block(first: Recording, block: np.ndarray, accel_axes: tuple[str, ...], rows: np.ndarray) -> None:
+    """:func:`gyrocomp.metrics.check_compensated` on each column of a compensated block (``rows``: its file rows)."""
+    for j, axis in enumerate((*first.gyro_axes, *accel_axes)):
+        check_compensated(first.source, axis, block[:, j], rows)
 
 
 def _compensated(comp: Compensator, gyro: np.ndarray, accel_axes: tuple[str, ...]) -> np.ndarray:

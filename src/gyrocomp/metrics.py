@@ -22,6 +22,7 @@ import numpy as np
 from .allan import BIAS_INSTABILITY_FACTOR, allan_deviation, allan_deviation_segments
 from .effects import moving_average
 from .errors import DataQualityWarning, InputError
+from .plausibility import MAX_RATE_DPS
 from .recording import Recording
 from .units import DEG_PER_S_TO_DEG_PER_H
 
@@ -240,6 +241,27 @@ def _figures(raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretche
                     smoothed_residual_rms(comp, w))
 
 
+#: the most a compensated accelerometer axis may read [g] (no MEMS accelerometer measures more)
+MAX_ACCEL_G = 1000.0
+
+
+def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarray | None = None) -> None:
+    """Refuse to judge a compensation whose output is not finite or beyond any MEMS sensor's range (gyro
+    :data:`gyrocomp.plausibility.MAX_RATE_DPS` [deg/s], accelerometer :data:`MAX_ACCEL_G` [g]): the model was
+    applied far outside its temperature range (a corrupt temperature value), and every figure would be noise
+    of the overflow. ``rows``: the file's row of each value, to name it (None: not known)."""
+    limit, unit = (MAX_ACCEL_G, "g") if axis.startswith("accel") else (MAX_RATE_DPS, "deg/s")
+    magnitude = np.abs(np.asarray(values, dtype=float))
+    bad = ~(magnitude <= limit)  # NaN too
+    if not bad.any():
+        return
+    k = int(np.flatnonzero(bad)[0])
+    where = "" if rows is None else f" at row {int(rows[k])}"
+    raise InputError(f"{source}: {axis} compensated is {values[k]:.3g} {unit}{where}, beyond any MEMS sensor's "
+                     f"range ({limit:g} {unit}): the model was applied far outside its temperature range (a "
+                     "corrupt temperature value?); nothing to judge")
+
+
 def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None,
                  accel: bool = False) -> RunEvaluation:
     """Compare one run before and after compensation, axis by axis.
@@ -253,6 +275,11 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
     accel : bool
         Also compare the accelerometer axes [g] (when the compensation covers them).
     """
+    for j, axis in enumerate(compensated.gyro_axes):
+        check_compensated(raw.source, axis, compensated.gyro_dps[:, j], raw.row_numbers)
+    if accel and compensated.accel_g is not None:
+        for j, axis in enumerate(compensated.accel_axes):
+            check_compensated(raw.source, axis, compensated.accel_g[:, j], raw.row_numbers)
     stretches = raw.contiguous_stretches()
     if raw.gaps:
         warnings.warn(
