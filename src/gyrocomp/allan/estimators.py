@@ -365,9 +365,52 @@ def _lagged_oadev_sums(x, ms: np.ndarray) -> np.ndarray:
     return sums
 
 
-def _cumulated(phase) -> np.ndarray:
-    """X[k] = sum_{i<k} (x[i] - mean(x)), the running sum the modified variance differences."""
+#: phases longer than this have their running sum read by slices (_LazyCumulated) instead of held whole
+_CUMULATED_IN_MEMORY_MAX = 1 << 22
+#: points between the checkpoints of a _LazyCumulated
+_CHECKPOINT = 1 << 16
+
+
+def _cumulated(phase, in_memory_max: int | None = None):
+    """X[k] = sum_{i<k} (x[i] - mean(x)), the running sum the modified variance differences: an array, or for a
+    phase longer than ``in_memory_max`` points (default ``_CUMULATED_IN_MEMORY_MAX``; a memory-mapped file, say)
+    a :class:`_LazyCumulated` that computes the slices the sums read, so the working memory stays at a few
+    blocks."""
+    if len(phase) > (_CUMULATED_IN_MEMORY_MAX if in_memory_max is None else in_memory_max):
+        return _LazyCumulated(phase)
     return _running_sum((phase[a:b] for a, b in _blocks(len(phase))), _mean(phase), np.empty(len(phase) + 1))
+
+
+class _LazyCumulated:
+    """The running sum X of ``x`` about its mean, N+1 points, read by contiguous slices: X is kept at every
+    ``_CHECKPOINT``-th point (one pass), and a slice is its checkpoint plus the running sum of the points from
+    it, so no array of X's length is ever made. Equal to the array form to rounding."""
+
+    def __init__(self, x):
+        self.x = x
+        self.mean = _mean(x)
+        n = len(x)
+        sums = [float(np.sum(np.asarray(x[a:b], dtype=np.float64) - self.mean)) for a, b in _blocks(n, _CHECKPOINT)]
+        self.checkpoints = np.concatenate([[0.0], np.cumsum(sums)])
+        self.length = n + 1
+
+    def __len__(self) -> int:
+        return self.length
+
+    def __getitem__(self, where: slice) -> np.ndarray:
+        start, stop, step = where.indices(self.length)
+        if step != 1:
+            raise InputError("cumulated: only contiguous slices are read")
+        if stop <= start:
+            return np.empty(0)
+        base = start // _CHECKPOINT * _CHECKPOINT
+        out = np.empty(stop - base)
+        out[0] = self.checkpoints[base // _CHECKPOINT]
+        if stop - base > 1:
+            np.subtract(self.x[base:stop - 1], self.mean, out=out[1:], dtype=np.float64)
+            np.cumsum(out[1:], out=out[1:])
+            out[1:] += out[0]
+        return out[start - base:]
 
 
 def _one_sum(kind: str, phase, cumulated, m: int, count: int) -> float:
