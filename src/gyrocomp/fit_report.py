@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 #: the thermal memories a gyro axis's model may carry
 MEMORIES = ("none", "lag", "turning-point", "turning-point+lag")
@@ -38,27 +38,55 @@ def _number(value) -> float | None:
     return value if math.isfinite(value) else None
 
 
+#: how a candidate's fit weights the samples: as they come in time, or each temperature bin alike
+Weighting = Literal["time", "temperature-balanced"]
+
+
 @dataclass(frozen=True)
-class CandidateSpec:
-    """One candidate model of an axis's bias: polynomial order, thermal lag, turning-point order, fit weighting,
-    whether the turning-point terms act only in a band, and its short name (``poly:3 + lag (time)``)."""
+class Candidate:
+    """One model of an axis's bias: polynomial order, thermal lag, turning-point order, fit weighting, and whether
+    the turning-point terms act only in the band found in the data. The model choice scores these
+    (:mod:`gyrocomp.models.selection`) and the report names them."""
 
     order: int
-    lag: bool
-    hysteresis_order: int
-    weighting: str
-    band: bool
-    label: str
+    lag: bool = False
+    hysteresis_order: int = 0
+    weighting: Weighting = "time"
+    band: bool = False
 
     @property
     def memory(self) -> str:
         """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
         return memory_name(self.lag, self.hysteresis_order)
 
+    @property
+    def complexity(self) -> int:
+        """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band."""
+        return self.order + int(self.lag) + 2 * self.hysteresis_order + int(self.band)
+
+    @property
+    def has_temperature_model(self) -> bool:
+        return self.order > 0 or self.lag or self.hysteresis_order > 0
+
+    @property
+    def label(self) -> str:
+        """Short name, e.g. ``poly:3 + lag + turning-point:2 (time)``; ``constant`` for order 0."""
+        parts = ["constant" if self.order == 0 else f"poly:{self.order}"]
+        if self.lag:
+            parts.append("lag")
+        if self.hysteresis_order:
+            parts.append(f"turning-point:{self.hysteresis_order}" + (" in band" if self.band else ""))
+        return " + ".join(parts) + f" ({self.weighting})"
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
+                "weighting": self.weighting, "band": self.band, "label": self.label}
+
     @classmethod
-    def from_dict(cls, d: dict) -> "CandidateSpec":
+    def from_dict(cls, d: dict) -> "Candidate":
+        """A stored candidate (its ``label`` is derived from the fields)."""
         return cls(int(d["order"]), bool(d.get("lag", False)), int(d.get("hysteresis_order", 0)),
-                   str(d.get("weighting", "time")), bool(d.get("band", False)), str(d["label"]))
+                   d.get("weighting", "time"), bool(d.get("band", False)))
 
 
 @dataclass(frozen=True)
@@ -66,7 +94,7 @@ class CandidateResult:
     """A candidate's held-out drift: mean and standard error over the folds, each fold's, and the lag each fold's
     fit chose [deg/s, s]; None where a fold held too little data."""
 
-    candidate: CandidateSpec
+    candidate: Candidate
     mean_drift_dps: float | None
     standard_error_dps: float | None
     fold_drift_dps: tuple[float | None, ...]
@@ -74,7 +102,7 @@ class CandidateResult:
 
     @classmethod
     def from_dict(cls, d: dict) -> "CandidateResult":
-        return cls(CandidateSpec.from_dict(d), _number(d.get("mean_drift_dps")), _number(d.get("standard_error_dps")),
+        return cls(Candidate.from_dict(d), _number(d.get("mean_drift_dps")), _number(d.get("standard_error_dps")),
                    tuple(_number(v) for v in d.get("fold_drift_dps", ())),
                    tuple(float(v) for v in d.get("fold_lag_s", ())))
 
@@ -91,8 +119,8 @@ class SelectionReport:
     window_s: float
     temperature_step_degc: float
     band_degc: tuple[float, float] | None
-    best: CandidateSpec
-    chosen: CandidateSpec
+    best: Candidate
+    chosen: Candidate
     raw_drift_dps: float | None
     chosen_drift_dps: float | None
     validated: bool
@@ -111,7 +139,7 @@ class SelectionReport:
         band = d.get("band_degc")
         return cls(str(d["axis"]), str(d["fold_kind"]), tuple(d.get("folds", ())), float(d["window_s"]),
                    float(d.get("temperature_step_degc", 0.0)), None if band is None else (float(band[0]), float(band[1])),
-                   CandidateSpec.from_dict(d["best"]), CandidateSpec.from_dict(d["chosen"]),
+                   Candidate.from_dict(d["best"]), Candidate.from_dict(d["chosen"]),
                    _number(d.get("raw_drift_dps")), _number(d.get("chosen_drift_dps")), bool(d.get("validated", True)),
                    bool(d.get("generalizes", True)), tuple(CandidateResult.from_dict(c) for c in d.get("candidates", ())))
 
@@ -289,6 +317,6 @@ class FitReport:
             sections={k: v for k, v in d.items() if k not in _TYPED})
 
 
-__all__ = ["AxisFit", "CandidateResult", "CandidateSpec", "FitReport", "GSensitivityReport", "GSensitivityRow",
+__all__ = ["AxisFit", "Candidate", "CandidateResult", "FitReport", "GSensitivityReport", "GSensitivityRow",
            "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
-           "memory_name"]
+           "Weighting", "memory_name"]

@@ -48,13 +48,12 @@ import numpy as np
 
 from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import InputError
-from ..fit_report import memory_name
+from ..fit_report import Candidate, Weighting
 from ..metrics import moving_average
 from .base import RunBlocks, bin_width_for, block_means
 from .hysteresis import parting_band_degc, turn_threshold_degc
 from .temperature import polynomial_columns
 
-Weighting = Literal["time", "temperature-balanced"]
 FoldKind = Literal["runs", "legs", "blocks"]
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 FOLD_KINDS = ("auto", "runs", "legs", "blocks")
@@ -72,45 +71,6 @@ BAND_ORDER = 3
 LAG_MAX_S = 4 * 3600.0
 #: a temperature register whose steps are at least this coarse is treated as quantized [degC]
 COARSE_STEP_DEGC = 0.25
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """One model of an axis's bias: polynomial order, thermal lag, hysteresis order, fit weighting."""
-
-    order: int
-    lag: bool = False
-    hysteresis_order: int = 0
-    weighting: Weighting = "time"
-    band: bool = False  # the turning-point terms act only inside the band found in the data
-
-    @property
-    def memory(self) -> str:
-        """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
-        return memory_name(self.lag, self.hysteresis_order)
-
-    @property
-    def complexity(self) -> int:
-        """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band."""
-        return self.order + int(self.lag) + 2 * self.hysteresis_order + int(self.band)
-
-    @property
-    def has_temperature_model(self) -> bool:
-        return self.order > 0 or self.lag or self.hysteresis_order > 0
-
-    @property
-    def label(self) -> str:
-        """Short name, e.g. ``poly:3 + lag + turning-point:2 (time)``; ``constant`` for order 0."""
-        parts = ["constant" if self.order == 0 else f"poly:{self.order}"]
-        if self.lag:
-            parts.append("lag")
-        if self.hysteresis_order:
-            parts.append(f"turning-point:{self.hysteresis_order}" + (" in band" if self.band else ""))
-        return " + ".join(parts) + f" ({self.weighting})"
-
-    def to_dict(self) -> dict:
-        return {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
-                "weighting": self.weighting, "band": self.band, "label": self.label}
 
 
 def _json_number(value: float) -> float | None:
