@@ -37,6 +37,9 @@ def test_every_gyro_axis_by_default_and_accelerometers_on_request():
     assert accel.noise.noise_density_g_per_sqrt_hz == pytest.approx(1e-3 / math.sqrt(50), rel=0.03)
     with pytest.raises(InputError, match=r"axes: 'gyro_y' is not in static.csv; it has gyro_x, gyro_z, accel_x"):
         analyse_noise(rec, ["gyro_y"])
+    # with_accel (Kalibr's file): the named axes, then every accelerometer axis not named already
+    assert list(analyse_noise(rec, ["accel_y", "gyro_z"], with_accel=True).axes) == [
+        "accel_y", "gyro_z", "accel_x", "accel_z"]
 
 
 def test_other_kinds_keep_noise_terms_from_the_overlapping_curve():

@@ -22,7 +22,7 @@ import numpy as np
 from .allan import BIAS_INSTABILITY_FACTOR, allan_deviation, allan_deviation_segments
 from .effects import moving_average
 from .errors import DataQualityWarning, InputError
-from .plausibility import MAX_RATE_DPS
+from .plausibility import MAX_ACCEL_G, MAX_RATE_DPS
 from .recording import Recording
 from .units import DEG_PER_S_TO_DEG_PER_H
 
@@ -241,15 +241,11 @@ def _figures(raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretche
                     smoothed_residual_rms(comp, w))
 
 
-#: the most a compensated accelerometer axis may read [g] (no MEMS accelerometer measures more)
-MAX_ACCEL_G = 1000.0
-
-
 def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarray | None = None) -> None:
     """Refuse to judge a compensation whose output is not finite or beyond any MEMS sensor's range (gyro
-    :data:`gyrocomp.plausibility.MAX_RATE_DPS` [deg/s], accelerometer :data:`MAX_ACCEL_G` [g]): the model was
-    applied far outside its temperature range (a corrupt temperature value), and every figure would be noise
-    of the overflow. ``rows``: the file's row of each value, to name it (None: not known)."""
+    :data:`gyrocomp.plausibility.MAX_RATE_DPS` [deg/s], accelerometer :data:`gyrocomp.plausibility.MAX_ACCEL_G`
+    [g]): the model was applied far outside its temperature range (a corrupt temperature value), and every figure
+    would be noise of the overflow. ``rows``: the file's row of each value, to name it (None: not known)."""
     limit, unit = (MAX_ACCEL_G, "g") if axis.startswith("accel") else (MAX_RATE_DPS, "deg/s")
     magnitude = np.abs(np.asarray(values, dtype=float))
     bad = ~(magnitude <= limit)  # NaN too

@@ -105,9 +105,18 @@ def _describe_gap(recording: Recording) -> str:
 POOR_FIT_LOG_RESIDUAL = 0.25
 
 
+def noise_axes(axes, gyro_axes, accel_axes, with_accel: bool = False) -> list[str]:
+    """The axes a noise analysis covers: those named in ``axes`` (default every gyro axis), and with
+    ``with_accel`` every accelerometer axis besides (Kalibr's noise file needs both sensors)."""
+    names = list(axes) if axes else list(gyro_axes)
+    if with_accel:
+        names += [a for a in accel_axes if a not in names]
+    return names
+
+
 def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: str = "oadev",
                   taus="octave", split_gaps: bool = False,
-                  fit_taus_s: tuple[float, float] | None = None) -> NoiseAnalysis:
+                  fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False) -> NoiseAnalysis:
     """Allan curve (``kind``) and noise terms (from the overlapping Allan deviation) for each axis.
 
     Parameters
@@ -120,8 +129,10 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
         Pool the contiguous stretches of a recording with gaps instead of refusing it.
     fit_taus_s : (float, float), optional
         Fit the noise model only on taus in this range [s] (see :func:`gyrocomp.allan.noise_terms`).
+    with_accel : bool
+        Also analyse every accelerometer axis of the recording.
     """
-    names = list(axes) if axes else list(recording.gyro_axes)
+    names = noise_axes(axes, recording.gyro_axes, recording.accel_axes, with_accel)
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
     stretches = recording.contiguous_stretches()

@@ -21,7 +21,7 @@ from .allan.streaming import PhaseAccumulator
 from .errors import DataQualityWarning, InputError
 from .io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from .io.tables import TableLayout, read_table
-from .noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values
+from .noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes
 from .recording import ACCEL_AXES, GAP_FACTOR, GYRO_AXES, nominal_rate_hz
 from .spill import DEFAULT_MEMORY_BYTES, SpillArray, block_median
 
@@ -101,17 +101,13 @@ def analyse_noise_file(path, axes: list[str] | None = None, *, layout: TableLayo
             warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
             recording = read_table(path, layout, fmt=stream.fmt, drop_nonfinite=drop_nonfinite,
                                    channels=wanted).recording
-        names = named or list(recording.gyro_axes)
-        if with_accel:
-            names += [a for a in recording.accel_axes if a not in names]
-        return analyse_noise(recording, names, kind=kind, taus=taus, split_gaps=split_gaps, fit_taus_s=fit_taus_s)
+        return analyse_noise(recording, named, kind=kind, taus=taus, split_gaps=split_gaps, fit_taus_s=fit_taus_s,
+                             with_accel=with_accel)
 
 
 def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_taus_s,
                   chunks: ChunkSettings) -> NoiseAnalysis:
-    names = named or list(stream.gyro_axes)
-    if with_accel:
-        names += [a for a in stream.accel_axes if a not in names]
+    names = noise_axes(named, stream.gyro_axes, stream.accel_axes, with_accel)
     have = (*stream.gyro_axes, *stream.accel_axes)
     for name in names:
         if name not in have:

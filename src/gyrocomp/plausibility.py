@@ -26,6 +26,8 @@ from .static import static_segments
 
 #: beyond any MEMS gyro's measurement range [deg/s]
 MAX_RATE_DPS = 5000.0
+#: the most any MEMS accelerometer measures [g]
+MAX_ACCEL_G = 1000.0
 #: beyond any zero-rate offset at rest [deg/s]
 MAX_OFFSET_DPS = 50.0
 #: a bias moves less than this within a run at rest; more is rotation [deg/s], judged on 10 s means

@@ -82,12 +82,9 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
             # gaps are refused below, or split with a note, in one line of their own
             warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
             recording = read_run(input_path, opts).recording
-        names = named or list(recording.gyro_axes)
-        if kalibr_path:
-            names += [a for a in recording.accel_axes if a not in names]
         with progress_bar("Allan deviation", indeterminate=True):
-            analysis = analyse_noise(recording, names, kind=kind, taus=tau_spec, split_gaps=split_gaps,
-                                     fit_taus_s=fit_range)
+            analysis = analyse_noise(recording, named, kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                                     fit_taus_s=fit_range, with_accel=bool(kalibr_path))
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
     if kalibr_path:
