@@ -96,3 +96,27 @@ def test_a_model_without_a_fit_report_reads_as_an_empty_one():
     report = FitReport.from_dict({})
     assert report.method is None and report.selection == {} and report.hysteresis is None
     assert report.acceleration is None and report.accel is None and report.stages == ()
+
+
+@pytest.mark.parametrize("how", ["chosen by the selection", "fixed order and memory (the thermal fit's own)",
+                                 "no memory asked for"])
+def test_the_hysteresis_section_is_written_from_its_typed_record(how, chamber_runs):
+    """The fit builds the typed record and stores its serialization: reading the section back and writing it
+    again gives the stored section, key for key, on each of the three ways the section is made."""
+    if how == "chosen by the selection":
+        cal = _turning_fit()
+    else:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            cal = fit_calibration([sim.recording for sim in chamber_runs[:3]], temperature=2,
+                                  hysteresis="none" if how == "no memory asked for" else "lag")
+    stored = cal.fit_report["hysteresis"]
+    typed = cal.report.hysteresis
+    assert typed.to_dict() == stored
+    if how == "no memory asked for":
+        assert typed.axes == {} and stored == {"mode": "none", "selection": "none"}
+    else:
+        assert set(typed.axes) == set(cal.axes)
+        for axis, choice in typed.axes.items():
+            assert stored["axes"][axis]["chosen"] == choice.label
+            assert (cal.axes[axis].lag_time_constant_s > 0) == ("lag" in choice.memory)

@@ -23,6 +23,7 @@ from .models.base import provenance
 from .models.pipelines import fit_calibration
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
+from .prepared import prepare
 from .threads import single_threaded_blas
 from .recording import Recording
 
@@ -173,6 +174,7 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
         Passed to the methods with hysteresis.
     """
     methods = DEFAULT_METHODS if methods is None else methods
+    recordings = prepare(recordings)  # once for every method and held-out run
     if not recordings:
         raise InputError("compare: give at least one run")
     require_temperature_span(recordings, "compare")

@@ -30,6 +30,11 @@ def memory_name(lag: bool, hysteresis_order: int) -> str:
     return "lag" if lag else ("turning-point" if hysteresis_order else "none")
 
 
+def memory_label(memory: str, hysteresis_order: int) -> str:
+    """A thermal memory in the words the model file stores: ``turning-point (order 2)``, ``lag``, ``none``."""
+    return memory + (f" (order {hysteresis_order})" if hysteresis_order else "")
+
+
 def _number(value) -> float | None:
     """A score as stored: None where it could not be computed."""
     if value is None:
@@ -151,7 +156,8 @@ _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
 class MemoryChoice:
     """The thermal memory chosen for one axis (``memory`` one of :data:`MEMORIES`, with the turning-point order,
     0 without), its lag's time constant [s], the polynomial order and weighting it came with, and the score of
-    each memory (held-out drift [deg/s], or BIC when ``HysteresisReport.by_bic``; None where not computed)."""
+    each memory (held-out drift [deg/s], or BIC when ``HysteresisReport.by_bic``; None where not computed), and
+    where the thermal fit chose the polynomial order itself, the score of each order."""
 
     memory: str
     hysteresis_order: int
@@ -159,11 +165,23 @@ class MemoryChoice:
     order: int | None
     weighting: str | None
     scores: dict[str, float | None] = field(default_factory=dict)
+    order_scores: dict[int, float] = field(default_factory=dict)
 
     @property
     def label(self) -> str:
         """``turning-point (order 2)``, ``lag``, ``none``."""
-        return self.memory + (f" (order {self.hysteresis_order})" if self.hysteresis_order else "")
+        return memory_label(self.memory, self.hysteresis_order)
+
+    def to_dict(self, by_bic: bool = False) -> dict:
+        """As the model file stores it (``scores_bic`` instead of ``scores_dps`` when the scores are BIC)."""
+        out = {"chosen": self.label, "memory": self.memory, "hysteresis_order": self.hysteresis_order,
+               "lag_time_constant_s": self.lag_time_constant_s, "order": self.order}
+        if self.weighting is not None:
+            out["weighting"] = self.weighting
+        if self.order_scores:
+            out["order_scores"] = {str(o): float(v) for o, v in self.order_scores.items()}
+        out["scores_bic" if by_bic else "scores_dps"] = dict(self.scores)
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> "MemoryChoice":
@@ -175,7 +193,8 @@ class MemoryChoice:
         scores = d.get("scores_dps", d.get("scores_bic", {})) or {}
         return cls(memory, order, float(d.get("lag_time_constant_s", 0.0)),
                    None if d.get("order") is None else int(d["order"]), d.get("weighting"),
-                   {str(k): _number(v) for k, v in scores.items()})
+                   {str(k): _number(v) for k, v in scores.items()},
+                   {int(o): float(v) for o, v in (d.get("order_scores") or {}).items()})
 
 
 @dataclass(frozen=True)
@@ -196,6 +215,13 @@ class HysteresisReport:
         """The memories some axis has a score for, in :data:`MEMORIES` order."""
         seen = {m for choice in self.axes.values() for m in choice.scores}
         return tuple(m for m in MEMORIES if m in seen) + tuple(sorted(seen - set(MEMORIES)))
+
+    def to_dict(self) -> dict:
+        """As the model file stores it (no ``axes`` when no memory was chosen)."""
+        out = {"mode": self.mode, "selection": self.selection}
+        if self.axes:
+            out["axes"] = {axis: choice.to_dict(self.by_bic) for axis, choice in self.axes.items()}
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> "HysteresisReport":
@@ -319,4 +345,4 @@ class FitReport:
 
 __all__ = ["AxisFit", "Candidate", "CandidateResult", "FitReport", "GSensitivityReport", "GSensitivityRow",
            "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
-           "Weighting", "memory_name"]
+           "Weighting", "memory_label", "memory_name"]

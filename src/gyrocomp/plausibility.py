@@ -22,7 +22,7 @@ import numpy as np
 from .errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
 from .effects import moving_average
 from .recording import Recording
-from .static import static_segments
+from .prepared import PreparedRun
 
 #: beyond any MEMS gyro's measurement range [deg/s]
 MAX_RATE_DPS = 5000.0
@@ -113,7 +113,8 @@ def turned_between_poses(recording: Recording) -> bool:
     rest."""
     if recording.accel_g is None or recording.accel_g.shape[1] != 3:
         return False
-    segments = static_segments(recording, window_s=POSE_WINDOW_S, min_duration_s=POSE_MIN_S, factor=POSE_FACTOR)
+    segments = PreparedRun.of(recording).static_segments(window_s=POSE_WINDOW_S, min_duration_s=POSE_MIN_S,
+                                                        factor=POSE_FACTOR)
     if len(segments) < 6:
         return False
     means = np.array([recording.accel_g[s.start:s.stop].mean(axis=0) for s in segments])

@@ -84,7 +84,15 @@ def still_mask(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S, fact
 def static_segments(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S,
                     min_duration_s: float = DEFAULT_MIN_DURATION_S, factor: float = DEFAULT_FACTOR) -> list[StaticSegment]:
     """The still stretches of a recording, in time order (see the module doc)."""
-    still = still_mask(recording, window_s=window_s, factor=factor)
+    return segments_from_mask(recording, still_mask(recording, window_s=window_s, factor=factor),
+                              window_s=window_s, min_duration_s=min_duration_s)
+
+
+def segments_from_mask(recording: Recording, still: np.ndarray, *, window_s: float = DEFAULT_WINDOW_S,
+                       min_duration_s: float = DEFAULT_MIN_DURATION_S) -> list[StaticSegment]:
+    """The static segments of ``recording`` from its still mask (:func:`still_mask` with the same ``window_s``
+    [s]): runs of still samples, trimmed by half a window where they border motion, of at least
+    ``min_duration_s`` [s]."""
     trim = max(1, int(round(window_s * recording.rate_hz)) // 2)
     out = []
     for piece in recording.contiguous_stretches():
@@ -128,4 +136,4 @@ def orientations(segments: list[StaticSegment]) -> list[tuple[np.ndarray, int]]:
     return [(g, k) for g, k in found]
 
 
-__all__ = ["StaticSegment", "orientations", "segment_mask", "static_segments", "still_mask"]
+__all__ = ["segments_from_mask", "StaticSegment", "orientations", "segment_mask", "static_segments", "still_mask"]

@@ -33,6 +33,7 @@ from .models.pipelines import fit_calibration
 from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, FoldDrift, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
+from .prepared import prepare
 from .threads import single_threaded_blas
 from .recording import Recording
 from .comparison import fit_ardupilot_style, fit_px4_style
@@ -202,7 +203,8 @@ def validate(recordings: list[Recording], *, folds: str = "auto", window_s: floa
     candidates : dict, optional
         Further methods: name -> :func:`gyrocomp.fit_calibration` options.
     """
-    recordings = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    # prepared once: every method and fold reads each run's still segments and block means from it
+    recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)
     if not recordings:
         raise InputError("validate: give at least one calibration run")
     for rec in recordings:

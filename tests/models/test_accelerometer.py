@@ -113,10 +113,18 @@ def test_bad_channels_and_missing_accelerometer(cycles):
     with pytest.raises(InputError, match=r"the model compensates the accelerometer; the data needs accel_x"):
         apply(cal, bare)
     with pytest.raises(InputError, match=r"channels=accel: the accelerometer model is a temperature model; "
-                                         r"temperature=none leaves nothing to fit"):
-        fit_accelerometer([cycles[0].recording], temperature=None)
-    with pytest.raises(InputError, match=r"fit_accelerometer: options acceleration are for the gyro only"):
-        fit_accelerometer([cycles[0].recording], acceleration="matrix")
+                                         r"temperature=None leaves nothing to fit"):
+        fit_accelerometer([cycles[0].recording], FitOptions(temperature=None))
+
+
+def test_the_gyro_only_options_do_not_change_the_accelerometer_model(cycles):
+    """``FitOptions.acceleration`` and ``folds`` are the gyro's: ``fit_channels(..., ("gyro", "accel"))`` passes the
+    same options to both, and the accelerometer's model does not read them."""
+    runs = [s.recording for s in cycles[:2]]
+    plain = _quiet(fit_accelerometer, runs, FitOptions(temperature=Polynomial(2), hysteresis="none"))
+    gyro_only = _quiet(fit_accelerometer, runs, FitOptions(temperature=Polynomial(2), hysteresis="none",
+                                                           acceleration="matrix", folds="blocks"))
+    assert gyro_only.accel_axes == plain.accel_axes
 
 
 @pytest.mark.slow

@@ -204,9 +204,10 @@ def _header(calibration: Calibration, params: AutopilotParameters, target: str, 
     return lines
 
 
-def px4_params_file(calibration: Calibration, **options) -> str:
-    """A QGroundControl parameter file (vehicle 1, component 1; type 6 = int32, 9 = float32)."""
-    params = px4_parameters(calibration, **options)
+def px4_params_file(calibration: Calibration, *, instance: int = 0, device_id: int = 0) -> str:
+    """A QGroundControl parameter file (vehicle 1, component 1; type 6 = int32, 9 = float32) of
+    :func:`px4_parameters` (``instance`` 0..3 of the sensor, its ``device_id``)."""
+    params = px4_parameters(calibration, instance=instance, device_id=device_id)
     lines = _header(calibration, params, "PX4", "#")
     lines.append("# Vehicle-Id Component-Id Name Value Type")
     for name, value in params.values.items():
@@ -215,9 +216,10 @@ def px4_params_file(calibration: Calibration, **options) -> str:
     return "\n".join(lines) + "\n"
 
 
-def ardupilot_params_file(calibration: Calibration, **options) -> str:
-    """An ArduPilot parameter file (``NAME VALUE`` per line, as MAVProxy and Mission Planner load)."""
-    params = ardupilot_parameters(calibration, **options)
+def ardupilot_params_file(calibration: Calibration, *, instance: int = 1) -> str:
+    """An ArduPilot parameter file (``NAME VALUE`` per line, as MAVProxy and Mission Planner load) of
+    :func:`ardupilot_parameters` (``instance`` 1..3 of the IMU)."""
+    params = ardupilot_parameters(calibration, instance=instance)
     lines = _header(calibration, params, "ArduPilot", "#")
     lines.append("# the correction is relative to INS_GYRn_CALTEMP (INS_ACCn_CALTEMP for the accelerometer): the offsets "
                  "taken there remove the bias at that temperature")

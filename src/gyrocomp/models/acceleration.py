@@ -18,8 +18,8 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
 from ..recording import Recording
-from ..static import static_segments
-from .base import block_means, provenance
+from ..prepared import PreparedRun
+from .base import provenance
 from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, turned_between_positions
 from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S, MLPTemperatureModel
 from .thermal import ThermalHysteresisModel
@@ -65,7 +65,7 @@ def fit_acceleration_network(recordings: list[Recording], options: dict, min_sta
     one constant per run), trained on the static segments of the runs."""
     hidden = options["temperature"][1] if isinstance(options.get("temperature"), tuple) else DEFAULT_HIDDEN
     network = MLPTemperatureModel(hidden=hidden, seed=options.get("mlp_seed", 0))
-    segments = [static_segments(rec, min_duration_s=min_static) for rec in recordings]
+    segments = [PreparedRun.of(rec).static_segments(min_duration_s=min_static) for rec in recordings]
     for rec in recordings:
         if rec.accel_g is None:
             raise InputError(f"{rec.source}: pipeline=mlp>mlp-accel needs accel_x, accel_y and accel_z columns")
@@ -74,7 +74,7 @@ def fit_acceleration_network(recordings: list[Recording], options: dict, min_sta
         t_in, y_in, w_in, a_in = [], [], [], []
         for rec, segs in zip(recordings, segments):
             pieces = [slice(g.start, g.stop) for g in segs] or None
-            blocks = block_means(rec, axis, NETWORK_BLOCK_S, math.inf, pieces)  # one temperature bin: equal weights
+            blocks = PreparedRun.of(rec).block_means(axis, NETWORK_BLOCK_S, math.inf, pieces)  # one temperature bin: equal weights
             t_in.append(blocks.temperature_degc)
             y_in.append(blocks.value_dps)
             w_in.append(blocks.weight)

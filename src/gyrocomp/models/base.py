@@ -1,4 +1,5 @@
-"""Helpers every model shares: temperature binning, block means, the per-run turn-on constants, provenance."""
+"""Helpers every model shares: temperature binning, the per-run turn-on constants, provenance (block means:
+:mod:`gyrocomp.prepared`)."""
 
 from __future__ import annotations
 
@@ -53,53 +54,6 @@ class TemperatureBins:
         cannot pull the fit.
         """
         return np.minimum(1.0, self.count / np.median(self.count))
-
-
-@dataclass(frozen=True)
-class RunBlocks:
-    """Block means of one run and axis: time [s], temperature [degC], gyro [deg/s], bin-balancing weight,
-    the accelerations [g] when the run has the triad, the piece (segment) each block comes from, and the
-    number of samples in each block (its duration, for time weights)."""
-
-    time_s: np.ndarray
-    temperature_degc: np.ndarray
-    value_dps: np.ndarray
-    weight: np.ndarray
-    accel_g: np.ndarray | None = None
-    cluster: np.ndarray | None = None
-    samples: np.ndarray | None = None
-
-
-def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float,
-                pieces: list[slice] | None = None) -> RunBlocks:
-    """Means over consecutive blocks of ``block_s`` inside each of ``pieces`` (default: the stretches
-    between time gaps; for multi-position runs, the static segments), with bin-balancing weights.
-    ``cluster`` numbers the piece each block comes from."""
-    t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
-    per_block = max(1, int(round(block_s * rec.rate_hz)))
-    pieces = rec.contiguous_stretches() if pieces is None else pieces
-    starts, ends, cluster = [], [], []
-    for k, piece in enumerate(pieces):
-        s = np.arange(piece.start, piece.stop, per_block)
-        starts.append(s)
-        ends.append(np.minimum(s + per_block, piece.stop))
-        cluster.append(np.full(s.size, k))
-    starts, ends, cluster = np.concatenate(starts), np.concatenate(ends), np.concatenate(cluster)
-    counts = ends - starts
-
-    def mean(x):
-        c = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)])
-        return (c[ends] - c[starts]) / (counts if x.ndim == 1 else counts[:, None])
-
-    bt, btemp, by = mean(t - t[0]) + t[0], mean(temp), mean(y)
-    accel = None
-    if rec.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
-        order = [rec.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]
-        accel = mean(rec.accel_g[:, order])
-    idx = np.floor(btemp / bin_width_degc).astype(np.int64)
-    _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
-    weight = (counts / counts.max()) / per_bin[inverse]
-    return RunBlocks(bt, btemp, by, weight, accel, cluster, counts)
 
 
 def bin_width_for(temperatures: list[np.ndarray], bin_width_degc: float | None) -> float:

@@ -11,7 +11,8 @@ import numpy as np
 from ..effects import G_SQUARED_TERMS
 from ..errors import DataQualityWarning
 from ..recording import ACCEL_AXES, Recording
-from ..static import orientations, static_segments
+from ..prepared import PreparedRun
+from ..static import orientations
 
 ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
 #: an accelerometer axis is excited when its within-run spread over the positions exceeds this [g]
@@ -57,7 +58,7 @@ def turned_between_positions(recordings: list[Recording], min_duration_s: float)
     for rec in recordings:
         if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
             continue
-        if len(orientations(static_segments(rec, min_duration_s=min_duration_s))) > 1:
+        if len(orientations(PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s))) > 1:
             return True
     return False
 

@@ -13,10 +13,12 @@ from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
+from ..fit_report import HysteresisReport, MemoryChoice
 from ..plausibility import calibration_concerns, temperature_span_concern
+from ..prepared import PreparedRun, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..triad import TriadCalibration
-from ..static import orientations, static_segments
+from ..static import orientations
 from .acceleration import (
     ACCELERATION_CHOICES,
     acceleration_report,
@@ -25,7 +27,7 @@ from .acceleration import (
     fit_g_sensitivity,
     turned_between_positions,
 )
-from .base import bin_width_for, block_means, one_temperature_column, provenance
+from .base import bin_width_for, one_temperature_column, provenance
 from .hysteresis import heats_and_cools
 from .pose_rotation import TooFewTurns, fit_gyro_between_poses
 from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
@@ -51,7 +53,7 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     t_in, y_in, w_in, a_in = [], [], [], []
     for r, rec in enumerate(recordings):
         pieces = [slice(g.start, g.stop) for g in segments[r]] if segments and segments[r] else None
-        blocks = block_means(rec, axis, block_s, width, pieces)
+        blocks = PreparedRun.of(rec).block_means(axis, block_s, width, pieces)
         temp = blocks.temperature_degc
         if lag_s > 0:
             temp, _ = thermal_lag(blocks.time_s, temp, lag_s, period_s=block_s)
@@ -151,11 +153,18 @@ def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHyst
                 m = s.candidate.memory
                 if math.isfinite(s.mean_drift_dps):
                     by_memory[m] = min(by_memory.get(m, s.mean_drift_dps), s.mean_drift_dps)
-        axes[axis] = {"chosen": c.memory + (f" (order {c.hysteresis_order})" if c.hysteresis_order else ""),
-                      "memory": c.memory, "hysteresis_order": c.hysteresis_order,
-                      "lag_time_constant_s": thermal.lag_time_constants_s_[axis], "order": c.order,
-                      "weighting": c.weighting, "scores_dps": by_memory}
-    return {"mode": mode, "selection": kind, "axes": axes}
+        axes[axis] = MemoryChoice(c.memory, c.hysteresis_order, thermal.lag_time_constants_s_[axis], c.order,
+                                  c.weighting, by_memory)
+    return HysteresisReport(mode, kind, axes).to_dict()
+
+
+def _thermal_report(thermal: ThermalHysteresisModel, mode: str) -> dict:
+    """The hysteresis part of the fit report from the thermal model's own choice (a fixed order or memory)."""
+    axes = {axis: MemoryChoice(memory, order, thermal.lag_time_constants_s_[axis], thermal.curves_[axis].order, None,
+                               {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()},
+                               {int(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()})
+            for axis, (memory, order) in thermal.memories_.items()}
+    return HysteresisReport(mode, thermal.selection_, axes).to_dict()
 
 
 def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, hysteresis_order,
@@ -236,11 +245,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     fitted (:mod:`gyrocomp.models.selection`); an axis where no temperature model beats the run constant
     gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
-    recordings = [recordings] if isinstance(recordings, Recording) else list(recordings or ())
-    for k, rec in enumerate(recordings):
-        if not isinstance(rec, Recording):
-            raise InputError(f"recordings[{k}]: expected a Recording (from gyrocomp.read or simulate), "
-                             f"got {type(rec).__name__}")
+    recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings or ())
     if isinstance(temperature, (Polynomial, Network)):
         temperature, seed = legacy_temperature(temperature)
         mlp_seed = seed if isinstance(temperature, tuple) else mlp_seed
@@ -345,18 +350,10 @@ def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration:
         report["selection"] = {axis: sel.to_dict() for axis, sel in selections.items()}
         report["hysteresis"] = _selection_report(selections, thermal, hysteresis)
     elif thermal is not None:
-        report["hysteresis"] = {"mode": hysteresis, "selection": thermal.selection_, "axes": {
-            axis: {"chosen": thermal.chosen_[axis], "memory": thermal.memories_[axis][0],
-                   "hysteresis_order": thermal.memories_[axis][1],
-                   "lag_time_constant_s": thermal.lag_time_constants_s_[axis],
-                   "order": thermal.curves_[axis].order,
-                   "order_scores": {str(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()},
-                   "scores_dps" if thermal.selection_ != "bic" else "scores_bic":
-                       {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()}}
-            for axis in thermal.chosen_}}
+        report["hysteresis"] = _thermal_report(thermal, hysteresis)
     else:
-        report["hysteresis"] = {"mode": hysteresis, "selection": "none: the runs do not both heat and cool"
-                                if hysteresis == "auto" else "none"}
+        report["hysteresis"] = HysteresisReport(hysteresis, "none: the runs do not both heat and cool"
+                                                if hysteresis == "auto" else "none", {}).to_dict()
     if accel_mode != "none":
         report["acceleration"] = acceleration_report(thermal, accel_mode)
     else:
@@ -471,9 +468,7 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
       output (thesis 2.7.2);
     - ``joint-mlp``: one network with the (lagged) temperature and the three accelerations as inputs.
     """
-    if isinstance(recordings, Recording):
-        recordings = [recordings]
-    recordings = list(recordings)
+    recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)
     if pipeline not in PIPELINES:
         raise InputError(f"pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
     options = _options(options).calibration_arguments()
@@ -507,11 +502,6 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
 
 #: what ``gyrocomp fit --channels`` can model
 CHANNELS = ("gyro", "accel")
-#: options of :func:`fit_calibration` that the accelerometer's temperature model takes too
-_ACCEL_OPTIONS = ("temperature", "bin_width_degc", "hysteresis", "hysteresis_order", "hysteresis_band_degc",
-                  "mlp_seed", "static_min_duration_s")
-
-
 def parse_channels(text: str | tuple | list) -> tuple[str, ...]:
     """``"gyro,accel"`` -> ``("gyro", "accel")``, checked."""
     items = tuple(c.strip() for c in (text.split(",") if isinstance(text, str) else text) if c.strip())
@@ -535,7 +525,7 @@ def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> t
         temperature = rec.temperature_degc if rec.temperature_degc.ndim == 1 else rec.temperature_degc.mean(axis=1)
         signal = Recording(time_s=rec.time_s, gyro_dps=accel, gyro_axes=ACCEL_AXES, temperature_degc=temperature,
                            source=rec.source, row_numbers=rec.row_numbers)
-        segments = static_segments(rec, min_duration_s=min_static_s)
+        segments = PreparedRun.of(rec).static_segments(min_duration_s=min_static_s)
         if len(orientations(segments)) > 1:
             pieces += [signal.take(slice(seg.start, seg.stop)) for seg in segments]
             folds += [run] * len(segments)
@@ -546,27 +536,28 @@ def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> t
     return pieces, tuple(folds), split
 
 
-def fit_accelerometer(recordings: list[Recording], **options) -> Calibration:
+def fit_accelerometer(recordings: list[Recording], options: FitOptions | None = None) -> Calibration:
     """Temperature models of the accelerometer axes (polynomial or network, lag and hysteresis as for the
     gyro), with a constant per run, or per static segment when a run turns the unit.
 
     Returns a calibration with only ``accel_axes``; its correction is relative to the middle of the
     calibrated temperature range (``accel_reference_degc``), since at rest the accelerometer's constant
-    cannot be told from gravity. ``options``: those of :func:`fit_calibration` for the temperature model.
-    When a run turns the unit, its static segments are fitted as separate pieces, and lag and hysteresis
-    (which need each piece's whole temperature history, and a validation over dozens of short pieces)
-    are left out unless asked for by name.
+    cannot be told from gravity. ``options`` (:class:`gyrocomp.models.options.FitOptions`, default
+    ``FitOptions()``): its temperature model, lag and hysteresis, bin width and shortest static segment; its
+    g-sensitivity and folds are the gyro's and not used here. When a run turns the unit, its static segments are
+    fitted as separate pieces, and lag and hysteresis (which need each piece's whole temperature history, and a
+    validation over dozens of short pieces) are left out unless asked for by name.
     """
-    unknown = sorted(set(options) - set(_ACCEL_OPTIONS))
-    if unknown:
-        raise InputError(f"fit_accelerometer: options {', '.join(unknown)} are for the gyro only")
-    if "temperature" in options and options["temperature"] is None:
+    options = _options(options)
+    if options.temperature is None:
         raise InputError("channels=accel: the accelerometer model is a temperature model; "
-                         "temperature=none leaves nothing to fit (use a polynomial or a network)")
-    pieces, folds, split = _accelerometer_pieces(recordings, options.get("static_min_duration_s", 10.0))
-    if split and options.get("hysteresis", "auto") == "auto":
-        options = {**options, "hysteresis": "none"}
-    fitted = fit_calibration(pieces, acceleration="none", run_folds=folds, **options)
+                         "temperature=None leaves nothing to fit (use a polynomial or a network)")
+    pieces, folds, split = _accelerometer_pieces(prepare(recordings), options.static_min_duration_s)
+    fitted = fit_calibration(pieces, temperature=options.temperature, bin_width_degc=options.bin_width_degc,
+                             hysteresis="none" if split and options.hysteresis == "auto" else options.hysteresis,
+                             hysteresis_order=options.hysteresis_order,
+                             hysteresis_band_degc=options.hysteresis_band_degc, acceleration="none",
+                             static_min_duration_s=options.static_min_duration_s, run_folds=folds)
     curves = [ax.temperature for ax in fitted.axes.values() if ax.temperature is not None]
     if not curves:
         raise InputError("channels=accel: no temperature model of the accelerometer generalizes across these runs "
@@ -677,7 +668,7 @@ def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[Pose
     return fit, dataclasses.replace(accel_cal, accel_axes=axes)
 
 
-def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibration:
+def _fit_accel_channel(recordings: list[Recording], options: FitOptions) -> Calibration:
     """The accelerometer: temperature models where the runs have a temperature, then bias, scale and
     misalignment from the still poses (of the temperature-compensated accelerations) where the runs turn every
     axis up and down."""
@@ -685,7 +676,7 @@ def _fit_accel_channel(recordings: list[Recording], options: dict) -> Calibratio
     accel_cal = None
     if with_temperature:
         try:
-            accel_cal = fit_accelerometer(recordings, **{k: v for k, v in options.items() if k in _ACCEL_OPTIONS})
+            accel_cal = fit_accelerometer(recordings, options)
         except InputError:
             if _spanning_poses(recordings) is None:  # a multi-position session at one temperature: the triad alone
                 raise
@@ -728,15 +719,13 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
     when their turns do not determine K), the order by leave-one-run-out; ``"matrix"`` K constant,
     ``"matrix-temperature"`` K linear in temperature, ``"none"`` no K (every run is then a bias run).
     """
-    if isinstance(recordings, Recording):
-        recordings = [recordings]
-    recordings = list(recordings)
+    recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)
     channels = parse_channels(channels)
     options = _options(options)
     gyro_triad, recordings = _gyro_triad(recordings, scale_factor) if "gyro" in channels else (None, recordings)
     if "accel" not in channels:
         return dataclasses.replace(fit_pipeline(recordings, pipeline, options), gyro_triad=gyro_triad)
-    accel_cal = _fit_accel_channel(recordings, options.calibration_arguments())
+    accel_cal = _fit_accel_channel(recordings, options)
     if "gyro" not in channels:
         return accel_cal
     compensated = recordings

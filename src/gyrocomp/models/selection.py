@@ -50,7 +50,8 @@ from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import InputError
 from ..fit_report import Candidate, Weighting
 from ..metrics import moving_average
-from .base import RunBlocks, bin_width_for, block_means
+from ..prepared import PreparedRun, RunBlocks
+from .base import bin_width_for
 from .hysteresis import parting_band_degc, turn_threshold_degc
 from .temperature import polynomial_columns
 
@@ -640,7 +641,7 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     width = bin_width_for(temps, bin_width_degc)
     block_s = max(block_s, 1.0 / recordings[0].rate_hz)
     pieces = pieces or [None] * len(recordings)
-    runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
+    runs = [PreparedRun.of(rec).block_means(axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
     thresholds = [turn_threshold_degc(t) for t in temps]
     groups = tuple(range(len(recordings))) if groups is None else tuple(int(g) for g in groups)
     folds = make_folds(runs, groups, thresholds, fold_kind)

@@ -34,9 +34,9 @@ from ..effects import find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..fit_report import memory_name
 from ..recording import Recording
-from ..static import static_segments
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
-from .base import RunBlocks, bin_width_for, block_means, one_temperature_column
+from ..prepared import PreparedRun, RunBlocks
+from .base import bin_width_for, one_temperature_column
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .temperature import PolynomialBias, simplest_within
 
@@ -296,10 +296,9 @@ class ThermalHysteresisModel:
         Fitted thermal time constant per axis [s], 0 without lag.
     hysteresis_ : dict[str, HysteresisCurve or None]
     turn_on_biases_dps_ : dict[str, np.ndarray]
-    chosen_ : dict[str, str]
-        The candidate kept per axis, in words (``turning-point (order 2)``).
     memories_ : dict[str, (str, int)]
-        The same as its memory (``none``, ``lag``, ``turning-point``, ``turning-point+lag``) and turning-point order.
+        The candidate kept per axis: its memory (``none``, ``lag``, ``turning-point``, ``turning-point+lag``) and
+        turning-point order (in words: :func:`gyrocomp.fit_report.memory_label`).
     scores_ : dict[str, dict[str, float]]
         Per axis, the validation score of every candidate tried (RMS [deg/s], or BIC with one run).
     selection_ : str
@@ -351,7 +350,7 @@ class ThermalHysteresisModel:
             recordings = [recordings]
         self._check_settings()
         self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
-        self.turn_on_biases_dps_, self.chosen_, self.scores_, self.order_scores_ = {}, {}, {}, {}
+        self.turn_on_biases_dps_, self.scores_, self.order_scores_ = {}, {}, {}
         self.memories_ = {}
         self.bands_ = {}
         self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
@@ -394,7 +393,7 @@ class ThermalHysteresisModel:
         hi = max(float(t.max()) for t in temps)
         width = bin_width_for(temps, self.bin_width_degc)
         block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
-        runs = [block_means(rec, axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
+        runs = [PreparedRun.of(rec).block_means(axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
         if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
             runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
         threshold = max(turn_threshold_degc(t) for t in temps)
@@ -482,7 +481,6 @@ class ThermalHysteresisModel:
             problem.branch_reach(spec, tau))
         self.bands_[axis] = problem.band
         self.turn_on_biases_dps_[axis] = consts
-        self.chosen_[axis] = choice.name if not p else f"{choice.name} (order {p})"
         self.memories_[axis] = (choice.name, p)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
@@ -530,7 +528,7 @@ def static_pieces(recordings: list[Recording], min_duration_s: float) -> tuple[l
     between positions (runs with an accelerometer), else None (every stretch between time gaps)."""
     segments, out = [], []
     for rec in recordings:
-        segs = static_segments(rec, min_duration_s=min_duration_s) if rec.accel_g is not None else []
+        segs = PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if rec.accel_g is not None else []
         segments.append(segs)
         if rec.accel_g is not None and not segs:
             warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",

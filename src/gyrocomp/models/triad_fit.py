@@ -29,7 +29,7 @@ from scipy import linalg, optimize
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
-from ..static import static_segments
+from ..prepared import PreparedRun
 from ..triad import TriadCalibration, rows_of
 
 PoseMethod = Literal["auto", "norm", "six-position"]
@@ -121,7 +121,7 @@ def find_poses(recording: Recording, *, ranges: list[tuple[int, int]] | None = N
         raise InputError(f"{recording.source}: a multi-position calibration needs the three accelerometer axes "
                          "(accel_x, accel_y, accel_z)")
     if ranges is None:
-        segs = static_segments(recording, window_s=window_s, min_duration_s=min_duration_s, factor=factor)
+        segs = PreparedRun.of(recording).static_segments(window_s=window_s, min_duration_s=min_duration_s, factor=factor)
         ranges = [(s.start, s.stop) for s in segs]
     out = []
     for start, stop in ranges:

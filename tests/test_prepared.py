@@ -1,0 +1,99 @@
+"""Runs prepared for fitting: what a fit derives from a run is the same as computing it afresh, is computed once per
+run and settings however many stages ask, is read-only, and is not carried to a copy with other data."""
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+import gyrocomp.prepared as prepared_module
+from gyrocomp.errors import InputError
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.prepared import PreparedRun, block_means, prepare
+from gyrocomp.recording import Recording
+from gyrocomp.simulate import simulate
+from gyrocomp.static import static_segments, still_mask
+
+
+@pytest.fixture(scope="module")
+def session():
+    """A chamber run that visits six positions (the ``combined`` profile), with its pauses (time gaps)."""
+    return simulate("mti10", profile="combined", duration_s=6000, rate_hz=5, seed=4).recording
+
+
+@pytest.mark.parametrize(("window_s", "min_duration_s", "factor"), [(1.0, 10.0, 4.0), (2.0, 30.0, 3.0), (0.5, 5.0, 8.0)])
+def test_kept_segments_equal_those_found_afresh(session, window_s, min_duration_s, factor):
+    run = PreparedRun.of(session)
+    kept = run.static_segments(window_s=window_s, min_duration_s=min_duration_s, factor=factor)
+    fresh = static_segments(session, window_s=window_s, min_duration_s=min_duration_s, factor=factor)
+    assert len(kept) == len(fresh) > 0
+    for a, b in zip(kept, fresh):
+        assert (a.start, a.stop, a.start_s, a.duration_s, a.temperature_degc) == (b.start, b.stop, b.start_s,
+                                                                                  b.duration_s, b.temperature_degc)
+        assert np.array_equal(a.gravity_g, b.gravity_g)
+    assert np.array_equal(run.still_mask(window_s=window_s, factor=factor),
+                          still_mask(session, window_s=window_s, factor=factor))
+
+
+def test_block_means_equal_those_computed_afresh_and_are_kept_read_only(session):
+    run = PreparedRun.of(session)
+    pieces = [slice(s.start, s.stop) for s in run.static_segments()]
+    kept = run.block_means("gyro_x", 2.0, 0.5, pieces)
+    fresh = block_means(session, "gyro_x", 2.0, 0.5, pieces)
+    for f in dataclasses.fields(fresh):
+        assert np.array_equal(getattr(kept, f.name), getattr(fresh, f.name)), f.name
+    assert run.block_means("gyro_x", 2.0, 0.5, list(pieces)) is kept  # equal pieces, even in another list
+    assert run.block_means("gyro_x", 2.0, 0.5) is not kept  # other pieces, other blocks
+    with pytest.raises(ValueError, match="read-only"):
+        kept.value_dps[0] = 0.0
+    with pytest.raises(ValueError, match="read-only"):
+        run.still_mask()[0] = False
+
+
+def test_a_run_is_prepared_once_and_shares_its_data(session):
+    run = PreparedRun.of(session)
+    assert PreparedRun.of(run) is run
+    assert isinstance(run, Recording) and run.gyro_dps is session.gyro_dps and run.rate_hz == session.rate_hz
+    assert run.static_segments() == run.static_segments() and run.static_segments() is not run.static_segments()
+    assert run.still_mask() is run.still_mask()
+
+
+def test_a_copy_with_other_data_keeps_nothing(session):
+    run = PreparedRun.of(session)
+    before = run.static_segments()
+    spiked = run.gyro_dps.copy()
+    middle = (before[0].start + before[0].stop) // 2
+    spiked[middle] += 50.0  # a knock in the middle of the first still segment splits it
+    copy = run.with_gyro(spiked)
+    assert isinstance(copy, PreparedRun)
+    after = copy.static_segments()
+    assert [(s.start, s.stop) for s in after] == [(s.start, s.stop) for s in static_segments(copy)]
+    assert [(s.start, s.stop) for s in after] != [(s.start, s.stop) for s in before]
+    piece = run.take(slice(0, run.n_samples // 2))
+    assert [(s.start, s.stop) for s in piece.static_segments()] == [(s.start, s.stop) for s in static_segments(piece)]
+
+
+def test_prepare_refuses_what_is_not_a_recording(session):
+    with pytest.raises(InputError, match=r"recordings\[1\]: expected a Recording \(from gyrocomp.read or simulate\), "
+                                         r"got str"):
+        prepare([session, "run.csv"])
+
+
+def test_a_fit_finds_each_runs_still_segments_once(monkeypatch):
+    """Before runs were prepared, a default fit of multi-position chamber runs computed each run's still mask
+    three times (input checks, g-sensitivity stage, model choice, thermal model); now once per run."""
+    calls = []
+
+    def counted(recording, **settings):
+        calls.append((id(recording.gyro_dps), tuple(sorted(settings.items()))))
+        return still_mask(recording, **settings)
+
+    monkeypatch.setattr(prepared_module, "still_mask", counted)
+    runs = [simulate("consumer", profile="combined", duration_s=3600, rate_hz=10, seed=k).recording for k in range(3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        calibration = fit_channels(runs)
+    assert calibration.report.acceleration.mode == "matrix"  # the segments were used: G was fitted
+    assert len(calls) == len(set(calls)), calls
+    assert len({run for run, _ in calls}) == 3
