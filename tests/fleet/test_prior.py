@@ -199,6 +199,9 @@ def test_fleet_fit_with_the_prior_on_the_command_line(fleet_run, prior, tmp_path
                  "--prior", out, "--scheduler", "serial")
     assert result.returncode == 0, result.stderr
     assert "2 unit(s) fitted" in result.stdout
+    # the one-way unit is named in the summary with its warning, the other is not
+    assert "units fitted with warnings" in result.stdout and f"SN{NEW_UNITS[1]}" in result.stdout
+    assert "only rises or only falls" in result.stdout
     with CalibrationStore(tmp_path / "NEW") as db:
         record = db.valid_at(f"SN{NEW_UNITS[0]}")
     expected = fit_with_prior(read(tmp_path / "new" / f"SN{NEW_UNITS[0]}" / "short.parquet"), prior)

@@ -15,6 +15,7 @@ from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit
                      units_from_manifest, units_from_pattern)
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.fleet import build_fleet_report
+from . import in_cli_words
 from .common import make_console, pop_read_options, progress_bar, read_options, read_settings
 from .export import EXPORT_FORMATS, write_export
 
@@ -100,6 +101,9 @@ def _print_summary(summary, output, judged: bool) -> None:
         rejected = table[table["verdict"] == "fail"]
         _print_rows(console, "units outside the limits", list(zip(rejected["serial"], rejected["failing"])),
                     ("serial", "failing figures"))
+    _print_rows(console, "units fitted with warnings (gyrocomp fleet show SERIAL lists them all)",
+                [(serial, in_cli_words(messages[0]) + (f" (and {len(messages) - 1} more)" if len(messages) > 1 else ""))
+                 for serial, messages in summary.warned.items()], ("serial", "warning"))
     outliers = table[table["outlier"]].sort_values("outlier_score", ascending=False)
     _print_rows(console, "outliers of the population (robust z > 3.5)",
                 [(s, f"{z:.1f}", f) for s, z, f in zip(outliers["serial"], outliers["outlier_score"],

@@ -101,7 +101,8 @@ class UnitOutcome:
 
 @dataclass(frozen=True)
 class FleetSummary:
-    """What a fleet fit did: units fitted now, skipped as unchanged, failed, and the verdicts of those fitted."""
+    """What a fleet fit did: units fitted now, skipped as unchanged, failed, the verdicts of those fitted, and
+    the warnings of the fit of each unit fitted now that had any (kept in the store with its calibration)."""
 
     fitted: tuple[str, ...]
     unchanged: tuple[str, ...]
@@ -110,6 +111,7 @@ class FleetSummary:
     rejected: tuple[str, ...]
     store: str
     table: Path | None
+    warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 @single_threaded_blas
@@ -203,7 +205,8 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
                 progress(done, len(units))
         table = write_fleet_table(db, output / FLEET_TABLE, limits)
     return FleetSummary(tuple(tally.fitted), tuple(tally.unchanged), tally.failed, tuple(tally.passed),
-                        tuple(tally.rejected), store=os.fspath(store if store is not None else output), table=table)
+                        tuple(tally.rejected), store=os.fspath(store if store is not None else output), table=table,
+                        warned=tally.warned)
 
 
 @dataclass
@@ -215,10 +218,13 @@ class _Tally:
     failed: dict[str, str] = field(default_factory=dict)
     passed: list[str] = field(default_factory=list)
     rejected: list[str] = field(default_factory=list)
+    warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
     def count(self, record: CalibrationRecord) -> None:
         if record.status == "ok":
             self.fitted.append(record.serial)
+            if record.warnings:
+                self.warned[record.serial] = tuple(record.warnings)
             (self.passed if record.verdict != "fail" else self.rejected).append(record.serial)
         else:
             self.failed[record.serial] = record.error or "failed"
