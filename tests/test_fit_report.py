@@ -11,7 +11,8 @@ import pytest
 
 from gyrocomp.calibration import Calibration
 from gyrocomp.fit_report import MEMORIES, FitReport, MemoryChoice
-from gyrocomp.models.pipelines import fit_calibration
+from gyrocomp.models.options import FitOptions, Network
+from gyrocomp.models.pipelines import fit_calibration, fit_pipeline
 from gyrocomp.models.selection import Candidate
 from gyrocomp.simulate import simulate
 
@@ -120,3 +121,36 @@ def test_the_hysteresis_section_is_written_from_its_typed_record(how, chamber_ru
         for axis, choice in typed.axes.items():
             assert stored["axes"][axis]["chosen"] == choice.label
             assert (cal.axes[axis].lag_time_constant_s > 0) == ("lag" in choice.memory)
+
+
+@pytest.mark.parametrize("mode", ["matrix", "matrix2", "none", "network"])
+def test_the_acceleration_section_is_written_from_its_typed_record(mode):
+    """As for the hysteresis: the section read back and written again is the stored one, for G, G with the g x g
+    terms, no G (with why), and the acceleration network (and the temperature network's section before it); and
+    the typed rows are the model's."""
+    runs = [simulate("consumer", profile="combined", rate_hz=5, duration_s=3 * 3600, seed=s, unit=2).recording
+            for s in range(3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if mode == "network":
+            cal = fit_pipeline(runs, "mlp>mlp-accel", FitOptions(temperature=Network(hidden=(3,))))
+            cal = Calibration.from_dict(cal.to_dict())  # the stage's report as the file keeps it
+            stored = cal.fit_report["stages"][1]["acceleration"]
+            typed = FitReport.from_dict(cal.fit_report["stages"][1]).acceleration
+            network = FitReport.from_dict(cal.fit_report["stages"][0]).network  # the temperature network's stage
+            assert network.to_dict() == cal.fit_report["stages"][0]["network"] and network.hidden == (3,)
+            assert set(network.validation_rmse_dps) == set(cal.axes) and network.restarts >= 1
+        else:
+            cal = fit_calibration(runs, temperature=2, hysteresis="none", acceleration=mode)
+            stored, typed = cal.fit_report["acceleration"], cal.report.acceleration
+    assert typed.to_dict() == stored and typed.mode == mode
+    if mode == "none":
+        assert typed.why == "not asked for" and typed.axes == {}
+    elif mode == "network":
+        assert typed.hidden == (3,) and len(typed.static_segments) == 3
+    else:
+        for axis, row in typed.axes.items():
+            np.testing.assert_allclose(row.g_sensitivity_dps_per_g, cal.axes[axis].g_sensitivity_dps_per_g)
+            assert (row.g_squared_dps_per_g2 is not None) == (mode == "matrix2")
+            if mode == "matrix2":
+                np.testing.assert_allclose(row.g_squared_dps_per_g2, cal.axes[axis].g_squared_dps_per_g2)

@@ -254,6 +254,12 @@ class NetworkReport:
     validation_rmse_dps: dict[str, tuple[float, ...]]
     epochs: dict[str, Any]
 
+    def to_dict(self) -> dict:
+        """As the model file stores it."""
+        return {"hidden": list(self.hidden), "restarts": self.restarts, "seed": self.seed, "training": self.training,
+                "axes": {a: {"validation_rmse_dps": list(self.validation_rmse_dps[a]), "epochs": self.epochs.get(a)}
+                         for a in self.validation_rmse_dps}}
+
     @classmethod
     def from_dict(cls, d: dict) -> "NetworkReport":
         axes = d.get("axes", {})
@@ -265,30 +271,66 @@ class NetworkReport:
 
 @dataclass(frozen=True)
 class GSensitivityRow:
-    """One gyro axis's row of G [deg/s/g] and its standard errors (None: not fitted, the axis was not excited)."""
+    """One gyro axis's row of G [deg/s/g] and its standard errors (None: not fitted, the axis was not excited);
+    with ``matrix2``, also its g x g sensitivities to xx, yy, zz, xy, xz, yz [deg/s/g^2] and their errors."""
 
     g_sensitivity_dps_per_g: tuple[float, ...]
     standard_error_dps_per_g: tuple[float | None, ...]
+    g_squared_dps_per_g2: tuple[float | None, ...] | None = None
+    g_squared_standard_error_dps_per_g2: tuple[float | None, ...] | None = None
+
+    def to_dict(self) -> dict:
+        out = {"g_sensitivity_dps_per_g": list(self.g_sensitivity_dps_per_g),
+               "standard_error_dps_per_g": list(self.standard_error_dps_per_g)}
+        if self.g_squared_dps_per_g2 is not None:
+            out["g_squared_dps_per_g2"] = list(self.g_squared_dps_per_g2)
+            out["g_squared_standard_error_dps_per_g2"] = list(self.g_squared_standard_error_dps_per_g2 or ())
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "GSensitivityRow":
+        squared = d.get("g_squared_dps_per_g2")
+        errors = d.get("g_squared_standard_error_dps_per_g2")
+        return cls(tuple(float(v) for v in d["g_sensitivity_dps_per_g"]),
+                   tuple(_number(v) for v in d.get("standard_error_dps_per_g", (None,) * 3)),
+                   None if squared is None else tuple(_number(v) for v in squared),
+                   None if errors is None else tuple(_number(v) for v in errors))
 
 
 @dataclass(frozen=True)
 class GSensitivityReport:
     """The g-sensitivity fit: its mode (``matrix``, ``matrix2``, ``network`` or ``none``, with why), the static
-    segments of each run, the accelerometer axes the positions excite, and the rows of G."""
+    segments of each run, the accelerometer axes the positions excite, the rows of G, and the network's hidden
+    layers (``network``)."""
 
     mode: str
     why: str | None
     static_segments: tuple[int, ...]
     excited_axes: tuple[str, ...]
     axes: dict[str, GSensitivityRow]
+    hidden: tuple[int, ...] | None = None
+
+    def to_dict(self) -> dict:
+        """As the model file stores it (what the mode has: ``why`` for none, ``hidden`` for a network)."""
+        out: dict[str, Any] = {"mode": self.mode}
+        if self.why is not None:
+            out["why"] = self.why
+        if self.hidden is not None:
+            out["hidden"] = list(self.hidden)
+        if self.mode != "none":
+            out["static_segments"] = list(self.static_segments)
+        if self.mode in ("matrix", "matrix2"):
+            out["excited_axes"] = list(self.excited_axes)
+            out["axes"] = {axis: row.to_dict() for axis, row in self.axes.items()}
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> "GSensitivityReport":
         return cls(str(d.get("mode", "none")), d.get("why"), tuple(int(s) for s in d.get("static_segments", ())),
                    tuple(d.get("excited_axes", ())),
-                   {a: GSensitivityRow(tuple(float(v) for v in i["g_sensitivity_dps_per_g"]),
-                                       tuple(_number(v) for v in i.get("standard_error_dps_per_g", (None,) * 3)))
-                    for a, i in (d.get("axes") or {}).items() if "g_sensitivity_dps_per_g" in i})
+                   {a: GSensitivityRow.from_dict(i) for a, i in (d.get("axes") or {}).items()
+                    if "g_sensitivity_dps_per_g" in i},
+                   None if d.get("hidden") is None else tuple(int(h) for h in d["hidden"]))
 
 
 @dataclass(frozen=True)

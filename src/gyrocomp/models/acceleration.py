@@ -17,6 +17,7 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
+from ..fit_report import GSensitivityReport, GSensitivityRow
 from ..recording import Recording
 from ..prepared import PreparedRun
 from .base import provenance
@@ -24,21 +25,21 @@ from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, t
 from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S, MLPTemperatureModel
 from .thermal import ThermalHysteresisModel
 
-def _listed(values: np.ndarray) -> list:
-    return [None if not np.isfinite(v) else float(v) for v in values]
+def _listed(values: np.ndarray) -> tuple:
+    return tuple(None if not np.isfinite(v) else float(v) for v in values)
 
 
 def acceleration_report(thermal, mode: str) -> dict:
-    """The fit report's acceleration part: G rows and standard errors per gyro axis [deg/s/g]."""
-    return {
-        "mode": mode, "excited_axes": list(thermal.excited_axes_),
-        "static_segments": [len(segs) for segs in thermal.segments_],
-        "axes": {a: {"g_sensitivity_dps_per_g": _listed(thermal.g_sensitivity_dps_per_g_[a]),
-                     "standard_error_dps_per_g": _listed(thermal.g_sensitivity_se_dps_per_g_[a]),
-                     **({"g_squared_dps_per_g2": _listed(thermal.g_squared_dps_per_g2_[a]),
-                         "g_squared_standard_error_dps_per_g2": _listed(thermal.g_squared_se_dps_per_g2_[a])}
-                        if mode == "matrix2" else {})}
-                 for a in thermal.g_sensitivity_dps_per_g_}}
+    """The fit report's acceleration part: G rows and standard errors per gyro axis [deg/s/g] (and the g x g
+    terms [deg/s/g^2] with ``matrix2``), written from its typed record."""
+    squared = mode == "matrix2"
+    rows = {a: GSensitivityRow(_listed(thermal.g_sensitivity_dps_per_g_[a]),
+                               _listed(thermal.g_sensitivity_se_dps_per_g_[a]),
+                               _listed(thermal.g_squared_dps_per_g2_[a]) if squared else None,
+                               _listed(thermal.g_squared_se_dps_per_g2_[a]) if squared else None)
+            for a in thermal.g_sensitivity_dps_per_g_}
+    return GSensitivityReport(mode, None, tuple(len(segs) for segs in thermal.segments_),
+                              tuple(thermal.excited_axes_), rows).to_dict()
 
 
 def fit_g_sensitivity(recordings: list[Recording], mode: str, static_min_duration_s: float) -> Calibration:
@@ -82,8 +83,8 @@ def fit_acceleration_network(recordings: list[Recording], options: dict, min_sta
         network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=0.0, accel_g=a_in, inputs=ACCEL_INPUTS)
         axes[axis] = AxisCalibration(None, tuple(float(c) for c in network.turn_on_biases_dps_[axis]),
                                      acceleration_network=network.curves_[axis])
-    report = {"acceleration": {"mode": "network", "hidden": list(hidden),
-                               "static_segments": [len(s) for s in segments]}}
+    report = {"acceleration": GSensitivityReport("network", None, tuple(len(s) for s in segments), (), {},
+                                                 tuple(hidden)).to_dict()}
     return Calibration(axes=axes, model="mlp-accel:3-" + "-".join(map(str, hidden)) + "-1",
                        provenance=provenance(recordings), fit_report=report)
 

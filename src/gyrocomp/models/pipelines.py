@@ -13,7 +13,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
-from ..fit_report import HysteresisReport, MemoryChoice
+from ..fit_report import GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..plausibility import calibration_concerns, temperature_span_concern
 from ..prepared import PreparedRun, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
@@ -281,10 +281,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
             axis, recordings, selections, model, thermal, network, accel_mode, bin_width_degc, network_inputs)
     if network is not None:
         report["temperature"] = "mlp"
-        report["network"] = {"hidden": list(hidden), "restarts": network.restarts, "seed": network.seed,
-                             "training": "Levenberg-Marquardt, early stopping on 20 % held-out segments",
-                             "axes": {a: {"validation_rmse_dps": network.validation_rmse_dps_[a],
-                                          "epochs": network.epochs_[a]} for a in network.curves_}}
+        report["network"] = NetworkReport(
+            tuple(hidden), network.restarts, network.seed, "Levenberg-Marquardt, early stopping on 20 % held-out segments",
+            {a: tuple(network.validation_rmse_dps_[a]) for a in network.curves_},
+            {a: network.epochs_[a] for a in network.curves_}).to_dict()
     name = _model_name(axes, network, network_inputs, temperature, thermal, accel_mode)
     return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
 
@@ -357,8 +357,8 @@ def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration:
     if accel_mode != "none":
         report["acceleration"] = acceleration_report(thermal, accel_mode)
     else:
-        report["acceleration"] = {"mode": "none", "why": "the runs do not turn the unit between positions"
-                                  if acceleration == "auto" else "not asked for"}
+        report["acceleration"] = GSensitivityReport("none", "the runs do not turn the unit between positions"
+                                                    if acceleration == "auto" else "not asked for", (), (), {}).to_dict()
     return report
 
 
