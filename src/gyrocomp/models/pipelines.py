@@ -502,6 +502,8 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
 
 #: what ``gyrocomp fit --channels`` can model
 CHANNELS = ("gyro", "accel")
+
+
 def parse_channels(text: str | tuple | list) -> tuple[str, ...]:
     """``"gyro,accel"`` -> ``("gyro", "accel")``, checked."""
     items = tuple(c.strip() for c in (text.split(",") if isinstance(text, str) else text) if c.strip())
