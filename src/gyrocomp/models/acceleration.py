@@ -61,11 +61,12 @@ def fit_g_sensitivity(recordings: list[Recording], mode: str, static_min_duratio
                        fit_report={"temperature": None, "acceleration": acceleration_report(thermal, mode)})
 
 
-def fit_acceleration_network(recordings: list[Recording], options: dict, min_static: float) -> Calibration:
+def fit_acceleration_network(recordings: list[Recording], *, hidden: tuple[int, ...] = DEFAULT_HIDDEN, seed: int = 0,
+                             min_static: float = 10.0) -> Calibration:
     """The thesis's acceleration network (section 2.7.2): accel_x, accel_y, accel_z in, the gyro bias out (and
-    one constant per run), trained on the static segments of the runs."""
-    hidden = options["temperature"][1] if isinstance(options.get("temperature"), tuple) else DEFAULT_HIDDEN
-    network = MLPTemperatureModel(hidden=hidden, seed=options.get("mlp_seed", 0))
+    one constant per run), trained on the static segments of at least ``min_static`` [s] of the runs; ``hidden``
+    neurons per layer, restarts drawn from ``seed``."""
+    network = MLPTemperatureModel(hidden=hidden, seed=seed)
     segments = [PreparedRun.of(rec).static_segments(min_duration_s=min_static) for rec in recordings]
     for rec in recordings:
         if rec.accel_g is None:

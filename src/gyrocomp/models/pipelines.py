@@ -471,32 +471,32 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
     recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)
     if pipeline not in PIPELINES:
         raise InputError(f"pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
-    options = _options(options).calibration_arguments()
+    options = _options(options)
     if pipeline == "joint":
-        return fit_calibration(recordings, **options)
-    acceleration = options.pop("acceleration", "auto")
-    accel_mode = "matrix" if acceleration in ("auto", "none") else acceleration
-    min_static = options.get("static_min_duration_s", 10.0)
+        return fit_calibration(recordings, **options.calibration_arguments())
+    accel_mode = "matrix" if options.acceleration in ("auto", "none") else options.acceleration
+    min_static = options.static_min_duration_s
+    # the network pipelines use the network asked for, else the thesis's 1-3-1
+    network = options.temperature if isinstance(options.temperature, Network) else Network()
     if pipeline == "joint-mlp":
-        options["temperature"] = options.get("temperature") if isinstance(options.get("temperature"), tuple) else "mlp"
-        cal = fit_calibration(recordings, acceleration=accel_mode, network_inputs=NETWORK_INPUTS, **options)
+        cal = fit_calibration(recordings, network_inputs=NETWORK_INPUTS, **dataclasses.replace(
+            options, temperature=network, acceleration=accel_mode).calibration_arguments())
         return dataclasses.replace(cal, model=f"joint-mlp: {cal.model}", fit_report={**cal.fit_report,
                                                                                       "pipeline": pipeline})
+    temperature_first = dataclasses.replace(options, acceleration="none",
+                                            temperature=network if pipeline.startswith("mlp") else options.temperature)
     if pipeline == "mlp>mlp-accel":
-        if not isinstance(options.get("temperature"), tuple):
-            options["temperature"] = "mlp"
-        first = fit_calibration(recordings, acceleration="none", **options)
-        second = fit_acceleration_network(_residual_runs(first, recordings), options, min_static)
+        first = fit_calibration(recordings, **temperature_first.calibration_arguments())
+        second = fit_acceleration_network(_residual_runs(first, recordings), hidden=network.hidden, seed=network.seed,
+                                          min_static=min_static)
         return _chain(first, second, recordings, pipeline)
     if pipeline in ("poly>matrix", "mlp>matrix"):
-        if pipeline == "mlp>matrix" and not isinstance(options.get("temperature"), tuple):
-            options["temperature"] = "mlp"
-        first = fit_calibration(recordings, acceleration="none", **options)
+        first = fit_calibration(recordings, **temperature_first.calibration_arguments())
         second = fit_calibration(_residual_runs(first, recordings), temperature=None, acceleration=accel_mode,
                                  static_min_duration_s=min_static)
         return _chain(first, second, recordings, pipeline)
     first = fit_calibration(recordings, temperature=None, acceleration=accel_mode, static_min_duration_s=min_static)
-    second = fit_calibration(_residual_runs(first, recordings), acceleration="none", **options)
+    second = fit_calibration(_residual_runs(first, recordings), **temperature_first.calibration_arguments())
     return _chain(first, second, recordings, pipeline)
 
 
