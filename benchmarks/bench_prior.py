@@ -14,7 +14,7 @@ moving average of the compensated rate):
 
 for short runs covering a third, half, two thirds and all of the range, in a quarter or half of the full chamber
 time, run two ways: ``one way`` (the ``chamber`` profile: held cold, one ramp up, held hot) and ``there and back``
-(the ``cycle`` profile: held cold, up, held hot, down, held cold again). Printed: the median (and worst) ratio of
+(the ``cycle`` profile's two round trips: held cold, up, held hot, down, held cold, and again). Printed: the median (and worst) ratio of
 the held-out drift to the full calibration's, and the held-out runs' noise floor (the simulator's deterministic
 error taken out) on the same scale.
 

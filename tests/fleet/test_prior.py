@@ -32,7 +32,7 @@ pytestmark = pytest.mark.slow
 #: new units, not in the fleet
 NEW_UNITS = (300, 301, 302, 303, 304, 305)
 #: the short run: the middle third of the preset's -20..70 degC, a quarter of the full runs' chamber time, there and
-#: back (the ``cycle`` profile: held at 10, up to 40, held, down to 10, held)
+#: back twice (the ``cycle`` profile: held at 10, up to 40, held, down to 10, held, and again)
 SHORT_SET_POINTS_DEGC = (10.0, 40.0)
 SHORT_DURATION_S = RUNS_PER_UNIT * RUN_DURATION_S / 4
 DRIFT_WINDOW_S = 60.0
@@ -70,7 +70,8 @@ def prior(fleet_run):
 
 
 def _short_run(unit: int, seed: int, profile_name: str = "cycle"):
-    """The short run of ``unit``: ``cycle`` goes there and back, ``chamber`` one way (held cold, up, held hot)."""
+    """The short run of ``unit``: ``cycle`` goes there and back (twice), ``chamber`` one way (held cold, up, held
+    hot)."""
     profile = resolve_profile(profile_name, PRESET, set_points_degc=SHORT_SET_POINTS_DEGC)
     return simulate(preset_model(PRESET, unit), profile=profile, duration_s=SHORT_DURATION_S, rate_hz=RATE_HZ,
                     seed=seed).recording

@@ -33,10 +33,10 @@ Where the short run saw the temperature the data decide; beyond it the populatio
 How the short run visits its range matters as much as how much of it: in a run whose temperature only rises (or
 only falls), temperature is a function of time, so slow drift (flicker, rate random walk) is indistinguishable
 from the bias curve, and a slower ramp only gives the drift longer to grow. A run that comes back (cold, hot,
-cold) sees each temperature twice at different times, which tells the two apart: over the middle third of the
-range in a quarter of the chamber time, the held-out drift relative to a full calibration falls from 2.8x to 1.9x
-(median of 40 simulated units in ``benchmarks/bench_prior.py``; the same as with the simulator's true population as
-the prior, :func:`prior_from_models`). :func:`fit_with_prior` warns when no run comes back.
+cold) sees each temperature at different times, which tells the two apart: over the middle third of the range in a
+quarter of the chamber time, two round trips instead of one ramp take the held-out drift relative to a full
+calibration from 2.8x to 1.9x (median of 40 simulated units in ``benchmarks/bench_prior.py``; the same as with the
+simulator's true population as the prior, :func:`prior_from_models`). :func:`fit_with_prior` warns when no run comes back.
 
 C. N. Morris, *Parametric empirical Bayes inference: theory and applications*, JASA 78 (381), 1983, 47-55;
 A. Gelman et al., *Bayesian Data Analysis*, 3rd ed., ch. 5 (hierarchical models), 2013;
