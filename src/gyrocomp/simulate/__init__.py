@@ -32,7 +32,7 @@ from .error_model import (
     structure_temperature,
 )
 from .presets import PRESETS, Preset, get_preset, preset_model
-from .profiles import PROFILES, Profile, Trajectory, get_profile, tumble_positions
+from .profiles import PROFILE_PARAMETERS, PROFILES, Profile, Trajectory, changed_profile, get_profile, tumble_positions
 
 #: profiles whose temperature visits set points, which a preset's chamber range replaces by default
 SET_POINT_PROFILES = ("chamber", "cycle", "combined")
@@ -156,7 +156,7 @@ def resolve_profile(profile: str | Profile, preset: str | None = None, **overrid
     """A profile by name with optional parameter overrides; a preset's chamber range supplies the
     set points of ``chamber``, ``cycle`` and ``combined`` unless ``set_points_degc`` is given."""
     if isinstance(profile, Profile):
-        return dataclasses.replace(profile, **{k: v for k, v in overrides.items() if v is not None})
+        return changed_profile(profile, overrides)
     if preset is not None and profile in SET_POINT_PROFILES and overrides.get("set_points_degc") is None:
         overrides["set_points_degc"] = get_preset(preset).set_points_degc
     return get_profile(profile, **overrides)
@@ -259,6 +259,7 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
 
 
 __all__ = ["AccelErrorModel", "COMPONENTS", "ONE_TEMPERATURE_PROFILES", "GyroErrorModel", "Hysteresis", "NoiseTruth", "PRESETS", "PROFILES",
-           "Preset", "Profile", "Simulation", "Trajectory", "Truth", "flicker_bank", "get_preset", "get_profile",
+           "PROFILE_PARAMETERS", "Preset", "Profile", "Simulation", "Trajectory", "Truth", "changed_profile", "flicker_bank",
+           "get_preset", "get_profile",
            "preset_model", "resolve_profile", "run_profiles", "simulate", "simulate_noise", "truth_document",
            "tumble_positions"]

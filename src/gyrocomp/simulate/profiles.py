@@ -371,11 +371,25 @@ def _profiles() -> dict[str, Profile]:
 PROFILES: dict[str, Profile] = _profiles()
 
 
+#: the parameters of a profile that can be changed (the fields of :class:`Profile` but its name)
+PROFILE_PARAMETERS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(Profile) if f.name != "name")
+
+
+def changed_profile(base: Profile, overrides: dict) -> Profile:
+    """``base`` with the parameters in ``overrides`` that are not None changed (see :class:`Profile` for their
+    units); a name that is not a parameter is refused, naming it."""
+    unknown = sorted(set(overrides) - set(PROFILE_PARAMETERS))
+    if unknown:
+        raise InputError(f"{unknown[0]}: not a parameter of a profile; use any of {', '.join(PROFILE_PARAMETERS)}")
+    changes = {k: v for k, v in overrides.items() if v is not None}
+    return dataclasses.replace(base, **changes) if changes else base
+
+
 def get_profile(name: str, **overrides) -> Profile:
-    """A built-in profile, optionally with parameters changed (e.g. ``ramp_rate_degc_per_min=3``)."""
+    """A built-in profile, optionally with parameters changed (e.g. ``ramp_rate_degc_per_min=3``; any of
+    :data:`PROFILE_PARAMETERS`)."""
     try:
         base = PROFILES[name]
     except KeyError:
         raise InputError(f"profile: unknown profile {name!r}; use one of {', '.join(PROFILES)}") from None
-    overrides = {k: v for k, v in overrides.items() if v is not None}
-    return dataclasses.replace(base, **overrides) if overrides else base
+    return changed_profile(base, overrides)
