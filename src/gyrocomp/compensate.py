@@ -56,10 +56,12 @@ class Compensator:
         self.turn_on_window_s = turn_on_window_s
         self.source = source
         self._modelled = [(j, calibration.axes[a]) for j, a in enumerate(self.gyro_axes) if a in calibration.axes]
-        # each accelerometer axis with its error at the reference temperature, which the correction keeps
+        # each accelerometer axis with its error at the reference temperature, which the correction keeps; an axis
+        # the fit left without a temperature model (none beat its constant) is not corrected
         reference = np.array([calibration.accel_reference_degc])
         self._accel_modelled = [(j, a, ax, float(np.asarray(ax.temperature.shape_dps(reference), dtype=float)[0]))
-                                for j, a in enumerate(ACCEL_AXES) if (ax := calibration.accel_axes.get(a)) is not None]
+                                for j, a in enumerate(ACCEL_AXES)
+                                if (ax := calibration.accel_axes.get(a)) is not None and ax.temperature is not None]
         self._triad_columns = None
         if calibration.gyro_triad is not None:
             missing = [a for a in GYRO_AXES if a not in self.gyro_axes]
