@@ -10,7 +10,7 @@ import pytest
 import gyrocomp.prepared as prepared_module
 from gyrocomp.errors import InputError
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.prepared import PreparedRun, block_means, prepare
+from gyrocomp.prepared import PreparedRun, block_means, fit_axes, prepare
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 from gyrocomp.static import static_segments, still_mask
@@ -97,3 +97,37 @@ def test_a_fit_finds_each_runs_still_segments_once(monkeypatch):
     assert calibration.report.acceleration.mode == "matrix"  # the segments were used: G was fitted
     assert len(calls) == len(set(calls)), calls
     assert len({run for run, _ in calls}) == 3
+
+
+def test_a_run_prepared_for_its_accelerometer_models_the_accelerometer_axes_in_g(session):
+    """``channel="accel"``: the fit's axes are accel_x, accel_y, accel_z, read from the accelerometer columns [g],
+    with the temperature the compensation gives them (the mean of per-axis columns); what was kept from the run is
+    shared with its gyro view, and a piece of it keeps the channel."""
+    gyro = PreparedRun.of(session)
+    mask = gyro.still_mask()
+    accel = PreparedRun.of(gyro, "accel")
+    assert (gyro.channel, gyro.fit_axes) == ("gyro", session.gyro_axes)
+    assert (accel.channel, accel.fit_axes) == ("accel", ("accel_x", "accel_y", "accel_z"))
+    assert fit_axes([accel]) == accel.fit_axes and fit_axes([session]) == session.gyro_axes
+    assert accel.still_mask() is mask  # kept once for both views
+    for j, axis in enumerate(session.accel_axes):
+        assert np.array_equal(accel.signal(axis), session.accel_g[:, j]) and accel.unit_of(axis) == "g"
+    assert accel.unit_of("gyro_x") == "deg/s" and np.array_equal(accel.signal("gyro_x"), session.gyro("gyro_x"))
+    blocks = accel.block_means("accel_z", 5.0, 1.0)
+    assert abs(float(np.average(blocks.value_dps, weights=blocks.samples)) - float(session.accel_g[:, 2].mean())) < 1e-9
+    assert accel.take(slice(0, 100)).channel == "accel"
+    per_axis = dataclasses.replace(session, temperature_degc=np.column_stack(
+        [session.temperature_degc, session.temperature_degc + 1.0, session.temperature_degc + 2.0]))
+    np.testing.assert_allclose(PreparedRun.of(per_axis, "accel").temperature_for("accel_x"),
+                               session.temperature_degc + 1.0)
+    assert per_axis.temperature_column_for("accel_y") == "temperature"  # the mean, as the compensation reads it
+
+
+def test_a_channel_is_refused_where_the_run_cannot_give_it(session):
+    with pytest.raises(InputError, match=r"channel: 'mag'; use one of gyro, accel"):
+        PreparedRun.of(session, "mag")
+    bare = dataclasses.replace(session, accel_g=None, accel_axes=())
+    with pytest.raises(InputError, match=r"channel=accel needs accel_x, accel_y and accel_z columns \[g\]"):
+        PreparedRun.of(bare, "accel")
+    with pytest.raises(InputError, match=r"no gyro axis 'accel_x'"):
+        bare.signal("accel_x")

@@ -19,14 +19,18 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
 from .errors import InputError
-from .recording import Recording
+from .recording import ACCEL_AXES, Recording
 from .static import DEFAULT_FACTOR, DEFAULT_MIN_DURATION_S, DEFAULT_WINDOW_S, StaticSegment, segments_from_mask, still_mask
 
+
+#: what a fit models: the gyro's axes or the accelerometer's
+Channel = Literal["gyro", "accel"]
+CHANNELS: tuple[str, ...] = get_args(Channel)
 
 @dataclass(frozen=True)
 class RunBlocks:
@@ -48,7 +52,7 @@ def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float
     """Means over consecutive blocks of ``block_s`` inside each of ``pieces`` (default: the stretches
     between time gaps; for multi-position runs, the static segments), with bin-balancing weights.
     ``cluster`` numbers the piece each block comes from."""
-    t, temp, y = rec.time_s, rec.temperature_for(axis), rec.gyro(axis)
+    t, temp, y = rec.time_s, rec.temperature_for(axis), rec.signal(axis)
     per_block = max(1, int(round(block_s * rec.rate_hz)))
     pieces = rec.contiguous_stretches() if pieces is None else pieces
     starts, ends, cluster = [], [], []
@@ -86,19 +90,38 @@ def _read_only(blocks: RunBlocks) -> RunBlocks:
 
 @dataclass(frozen=True, eq=False)
 class PreparedRun(Recording):
-    """A :class:`~gyrocomp.recording.Recording` that keeps what a fit derives from it (see the module)."""
+    """A :class:`~gyrocomp.recording.Recording` that keeps what a fit derives from it (see the module), and says
+    which channel the fit models: the gyro's axes [deg/s] or the accelerometer's [g] (``fit_axes``)."""
 
+    channel: Channel = "gyro"
     _derived: dict[tuple, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.channel not in CHANNELS:
+            raise InputError(f"channel: {self.channel!r}; use one of {', '.join(CHANNELS)}")
+
     @classmethod
-    def of(cls, recording: Recording) -> "PreparedRun":
-        """``recording`` prepared: itself when it already is, else a prepared run sharing its (validated) data."""
-        if isinstance(recording, PreparedRun):
+    def of(cls, recording: Recording, channel: Channel | None = None) -> "PreparedRun":
+        """``recording`` prepared: itself when it already is (and models ``channel``, when given), else a prepared
+        run sharing its (validated) data and what was kept from it, modelling ``channel`` (default: the gyro)."""
+        if isinstance(recording, PreparedRun) and channel in (None, recording.channel):
             return recording
+        if channel not in (None, *CHANNELS):
+            raise InputError(f"channel: {channel!r}; use one of {', '.join(CHANNELS)}")
+        if channel == "accel" and not set(ACCEL_AXES) <= set(recording.accel_axes):
+            raise InputError(f"{recording.source}: channel=accel needs accel_x, accel_y and accel_z columns [g]")
         prepared = object.__new__(cls)
         prepared.__dict__.update(recording.__dict__)
-        prepared.__dict__["_derived"] = {}
+        prepared.__dict__["channel"] = channel or "gyro"
+        # what was derived from the data holds whichever channel is modelled
+        prepared.__dict__["_derived"] = recording._derived if isinstance(recording, PreparedRun) else {}
         return prepared
+
+    @property
+    def fit_axes(self) -> tuple[str, ...]:
+        """The axes the fit models: the gyro's, or the accelerometer's x, y, z."""
+        return self.gyro_axes if self.channel == "gyro" else ACCEL_AXES
 
     def _once(self, key: tuple, compute):
         if key not in self._derived:
@@ -129,6 +152,12 @@ class PreparedRun(Recording):
         return self._once(key, lambda: _read_only(block_means(self, axis, block_s, bin_width_degc, pieces)))
 
 
+def fit_axes(recordings: Sequence[Recording]) -> tuple[str, ...]:
+    """The axes a fit of ``recordings`` models (:attr:`PreparedRun.fit_axes` of the first; plain recordings: the
+    gyro's)."""
+    return PreparedRun.of(recordings[0]).fit_axes
+
+
 def prepare(recordings: Iterable[Recording]) -> list[PreparedRun]:
     """Each recording prepared once (:meth:`PreparedRun.of`): a fit's entry point calls this on its runs.
     Anything else in the list is refused, naming its place."""
@@ -141,4 +170,4 @@ def prepare(recordings: Iterable[Recording]) -> list[PreparedRun]:
     return out
 
 
-__all__ = ["PreparedRun", "RunBlocks", "block_means", "prepare"]
+__all__ = ["CHANNELS", "Channel", "PreparedRun", "RunBlocks", "block_means", "fit_axes", "prepare"]

@@ -197,16 +197,30 @@ class Recording:
         return _temperature_names(self.gyro_axes, self.temperature_degc.ndim == 2)
 
     def temperature_column_for(self, axis: str) -> str:
-        """Name of the temperature channel that goes with a gyro axis."""
+        """Name of the temperature channel that goes with a gyro axis (an accelerometer axis: ``temperature``,
+        the mean of the columns when there is one per gyro axis; see :meth:`temperature_for`)."""
         columns = self.temperature_columns
-        return columns[0] if len(columns) == 1 else columns[self._axis_index(axis)]
+        if len(columns) == 1:
+            return columns[0]
+        return TEMPERATURE_COLUMN if axis in self.accel_axes else columns[self._axis_index(axis)]
 
     def gyro(self, axis: str) -> np.ndarray:
         """Angular rate of one axis [deg/s]."""
         return self.gyro_dps[:, self._axis_index(axis)]
 
+    def signal(self, axis: str) -> np.ndarray:
+        """The column of a gyro axis [deg/s] or of an accelerometer axis [g], by its name."""
+        if axis in self.accel_axes and axis not in self.gyro_axes:
+            return self.accel_g[:, self.accel_axes.index(axis)]
+        return self.gyro(axis)
+
+    def unit_of(self, axis: str) -> str:
+        """The unit of an axis's values: ``deg/s`` for a gyro axis, ``g`` for an accelerometer axis."""
+        return "g" if axis in self.accel_axes and axis not in self.gyro_axes else "deg/s"
+
     def temperature_for(self, axis: str) -> np.ndarray:
-        """Temperature [degC] that goes with a gyro axis (its own column when there is one per axis)."""
+        """Temperature [degC] that goes with an axis: a gyro axis's own column when there is one per axis; for an
+        accelerometer axis (one die, whatever the gyro's columns) their mean, as the compensation reads it."""
         if self.temperature_degc is None:
             raise InputError(
                 f"{self.source}: no temperature column; a temperature model needs one "
@@ -214,6 +228,8 @@ class Recording:
             )
         if self.temperature_degc.ndim == 1:
             return self.temperature_degc
+        if axis in self.accel_axes and axis not in self.gyro_axes:
+            return self.temperature_degc.mean(axis=1)
         return self.temperature_degc[:, self._axis_index(axis)]
 
     def _axis_index(self, axis: str) -> int:

@@ -12,6 +12,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError
 from ..io import file_sha256
+from ..prepared import fit_axes
 from ..recording import Recording
 
 #: default number of temperature bins across the span of the calibration data
@@ -89,8 +90,10 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
 
 
 def one_temperature_column(recordings: list[Recording]) -> bool:
-    """Whether every recording reads one temperature for all its axes (one sensor, so one die and one lag)."""
-    return all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1 for rec in recordings)
+    """Whether every recording reads one temperature for all the axes a fit models (one sensor, so one die and one
+    lag): one column, or the accelerometer's axes (which read the mean of the gyro's columns)."""
+    return all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1
+               or all(rec.unit_of(axis) == "g" for axis in fit_axes([rec])) for rec in recordings)
 
 
 def provenance(recordings) -> dict:

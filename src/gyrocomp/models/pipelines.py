@@ -15,7 +15,7 @@ from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..fit_report import GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..plausibility import calibration_concerns, temperature_span_concern
-from ..prepared import PreparedRun, prepare
+from ..prepared import PreparedRun, fit_axes, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..triad import TriadCalibration
 from ..static import orientations
@@ -105,7 +105,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     accel_cols: tuple[int, ...] = ()
     square_cols: tuple[int, ...] = ()
     problems = {}
-    for k, axis in enumerate(recordings[0].gyro_axes):
+    for k, axis in enumerate(fit_axes(recordings)):
         problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
                                fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders,
                                both_directions="none" in memories)
@@ -276,7 +276,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     report = _report_of_choice(selections, model, thermal, hysteresis, acceleration, accel_mode)
     network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
     axes = {}
-    for axis in recordings[0].gyro_axes:
+    for axis in fit_axes(recordings):
         axes[axis], report["axes"][axis] = _axis_calibration(
             axis, recordings, selections, model, thermal, network, accel_mode, bin_width_degc, network_inputs)
     if network is not None:
@@ -317,8 +317,8 @@ def _fit_without_temperature(recordings: list[Recording], acceleration: str, sta
     if acceleration != "none" and (
             acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
         return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
-    axes = {axis: AxisCalibration(None, tuple(float(rec.gyro(axis).mean()) for rec in recordings))
-            for axis in recordings[0].gyro_axes}
+    axes = {axis: AxisCalibration(None, tuple(float(rec.signal(axis).mean()) for rec in recordings))
+            for axis in fit_axes(recordings)}
     return Calibration(axes=axes, model="none", provenance=provenance(recordings), fit_report={"temperature": None})
 
 
@@ -329,7 +329,7 @@ def _fit_binned(recordings: list[Recording], *, temperature, hysteresis: str, hy
     model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
                                        folds=run_folds).fit(recordings)
     mode = hysteresis
-    if mode == "auto" and not any(heats_and_cools(recordings, a) for a in recordings[0].gyro_axes):
+    if mode == "auto" and not any(heats_and_cools(recordings, a) for a in fit_axes(recordings)):
         mode = "none"
     thermal = None
     if mode != "none" or accel_mode != "none":
@@ -513,27 +513,24 @@ def parse_channels(text: str | tuple | list) -> tuple[str, ...]:
     return tuple(c for c in CHANNELS if c in items)
 
 
-def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> tuple[list[Recording], tuple, bool]:
-    """Each run's accelerometer as a signal to fit against temperature: the whole run when it stays in one
-    orientation, else each static segment on its own (its own constant absorbs its gravity projection).
-    Also gives the run each piece comes from (its validation fold), and whether some run was split."""
+def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> tuple[list[PreparedRun], tuple, bool]:
+    """Each run prepared to model its accelerometer against temperature (``channel="accel"``): the whole run when
+    it stays in one orientation, else each static segment on its own (its own constant absorbs its gravity
+    projection). Also gives the run each piece comes from (its validation fold), and whether some run was split."""
     pieces, folds, split = [], [], False
     for run, rec in enumerate(recordings):
         if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
             raise InputError(f"{rec.source}: channels=accel needs accel_x, accel_y and accel_z columns [g]")
         if rec.temperature_degc is None:
             raise InputError(f"{rec.source}: no temperature column; an accelerometer temperature model needs one")
-        accel = rec.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
-        temperature = rec.temperature_degc if rec.temperature_degc.ndim == 1 else rec.temperature_degc.mean(axis=1)
-        signal = Recording(time_s=rec.time_s, gyro_dps=accel, gyro_axes=ACCEL_AXES, temperature_degc=temperature,
-                           source=rec.source, row_numbers=rec.row_numbers)
-        segments = PreparedRun.of(rec).static_segments(min_duration_s=min_static_s)
+        accel = PreparedRun.of(rec, "accel")
+        segments = accel.static_segments(min_duration_s=min_static_s)
         if len(orientations(segments)) > 1:
-            pieces += [signal.take(slice(seg.start, seg.stop)) for seg in segments]
+            pieces += [accel.take(slice(seg.start, seg.stop)) for seg in segments]
             folds += [run] * len(segments)
             split = True
         else:
-            pieces.append(signal)
+            pieces.append(accel)
             folds.append(run)
     return pieces, tuple(folds), split
 

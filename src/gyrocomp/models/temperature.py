@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, ModelError, NotFittedError
+from ..prepared import fit_axes
 from ..recording import Recording
 from .base import RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, TemperatureBins, bin_by_temperature, bin_width_for
 
@@ -249,17 +250,17 @@ class PolynomialTemperatureModel:
             raise InputError("fit: no recordings given")
         if self.order != "auto" and not (isinstance(self.order, int) and 0 <= self.order <= MAX_ORDER):
             raise InputError(f"order: {self.order!r}; use 'auto' or a whole number from 0 to {MAX_ORDER}")
-        axes = recordings[0].gyro_axes
+        axes = fit_axes(recordings)
         for rec in recordings[1:]:
-            if rec.gyro_axes != axes:
+            if fit_axes([rec]) != axes:
                 raise InputError(
-                    f"{rec.source}: gyro axes {', '.join(rec.gyro_axes)} differ from "
+                    f"{rec.source}: axes {', '.join(fit_axes([rec]))} differ from "
                     f"{recordings[0].source}'s ({', '.join(axes)}); fit runs of the same sensor together"
                 )
         self.curves_, self.turn_on_biases_dps_, self.scores_, self.fit_rms_dps_ = {}, {}, {}, {}
         for axis in axes:
             temps = [rec.temperature_for(axis) for rec in recordings]
-            values = [rec.gyro(axis) for rec in recordings]
+            values = [rec.signal(axis) for rec in recordings]
             width = bin_width_for(temps, self.bin_width_degc)
             bins = bin_by_temperature(temps, values, width)
             t_min = min(float(t.min()) for t in temps)

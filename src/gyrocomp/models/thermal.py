@@ -35,7 +35,7 @@ from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
 from ..fit_report import memory_name
 from ..recording import Recording
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
-from ..prepared import PreparedRun, RunBlocks
+from ..prepared import PreparedRun, RunBlocks, fit_axes
 from .base import bin_width_for, one_temperature_column
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .temperature import PolynomialBias, simplest_within
@@ -355,7 +355,7 @@ class ThermalHysteresisModel:
         self.bands_ = {}
         self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
         self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
-        axes = recordings[0].gyro_axes
+        axes = fit_axes(recordings)
         pieces = self._pieces(recordings)
         self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
             "leave-one-run-out" if len(recordings) >= 2 else "bic")
@@ -528,9 +528,11 @@ def static_pieces(recordings: list[Recording], min_duration_s: float) -> tuple[l
     between positions (runs with an accelerometer), else None (every stretch between time gaps)."""
     segments, out = [], []
     for rec in recordings:
-        segs = PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if rec.accel_g is not None else []
+        # an accelerometer's own model uses the pieces it is given: its motion is what it measures
+        moves = rec.accel_g is not None and PreparedRun.of(rec).channel == "gyro"
+        segs = PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if moves else []
         segments.append(segs)
-        if rec.accel_g is not None and not segs:
+        if moves and not segs:
             warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
                           DataQualityWarning, stacklevel=3)
         out.append([slice(g.start, g.stop) for g in segs] if segs else None)
