@@ -5,11 +5,12 @@ import numpy as np
 import pytest
 
 from gyrocomp import Calibration, apply, fit_calibration
-from gyrocomp.calibration import SCHEMA_VERSION
+from gyrocomp.calibration import SCHEMA_VERSION, AxisCalibration
 from gyrocomp.compensate import predict_error
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io import write_recording
 from gyrocomp.io.tables import read_table
+from gyrocomp.models.temperature import PolynomialBias
 from gyrocomp.simulate import simulate
 
 
@@ -202,3 +203,31 @@ def test_schema_5_file_written_by_the_previous_release_loads_and_applies_identic
     for j, axis in enumerate(out.gyro_axes):
         expected = data.table.column(f"expected_{axis}").to_numpy()
         np.testing.assert_allclose(out.gyro_dps[:, j], expected, rtol=0, atol=1e-12)
+
+
+def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other():
+    """A gyro axis is in deg/s, an accelerometer axis in g: the unit-free names read either, the ``_dps`` and ``_g``
+    accessors only their own; a calibration refuses an axis in the wrong section, and a file read back keeps the
+    accelerometer's axes in g."""
+    curve = PolynomialBias((1e-3, 2e-4), 25.0, 20.0, 0.0, 50.0)
+    gyro = AxisCalibration(curve, (0.1, 0.3))
+    accel = AxisCalibration(curve, (0.02, 0.04), unit="g")
+    assert gyro.unit == "deg/s" and gyro.turn_on_biases_dps == (0.1, 0.3) and gyro.mean_turn_on_bias_dps == 0.2
+    assert accel.turn_on_biases_g == accel.turn_on_biases == (0.02, 0.04) and accel.mean_turn_on_bias == pytest.approx(0.03)
+    with pytest.raises(InputError, match=r"turn_on_biases_dps: the axis's values are in g, not deg/s"):
+        accel.turn_on_biases_dps
+    with pytest.raises(InputError, match=r"mean_turn_on_bias_dps: the axis's values are in g, not deg/s"):
+        accel.mean_turn_on_bias_dps
+    with pytest.raises(InputError, match=r"turn_on_biases_g: the axis's values are in deg/s, not g"):
+        gyro.turn_on_biases_g
+    with pytest.raises(InputError, match=r"unit: 'm/s\^2'; an axis is in one of deg/s, g"):
+        AxisCalibration(curve, (0.0,), unit="m/s^2")
+    with pytest.raises(InputError, match=r"accel_axes\['accel_x'\]\.unit: 'deg/s'; the axes of accel_axes are in g"):
+        Calibration(axes={}, model="x", accel_axes={"accel_x": gyro}, accel_reference_degc=25.0)
+    with pytest.raises(InputError, match=r"axes\['gyro_x'\]\.unit: 'g'; the axes of axes are in deg/s"):
+        Calibration(axes={"gyro_x": accel}, model="x")
+    cal = Calibration(axes={"gyro_x": gyro}, model="x", accel_axes={"accel_x": accel}, accel_reference_degc=25.0)
+    text = cal.to_json()
+    assert '"turn_on_biases_g"' in text and '"turn_on_biases_dps"' in text  # the file names each unit
+    back = Calibration.from_dict(json.loads(text))
+    assert back.accel_axes["accel_x"] == accel and back.axes["gyro_x"] == gyro

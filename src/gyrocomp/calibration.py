@@ -14,7 +14,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -194,17 +194,23 @@ def _in_g(d: Any, to_g: bool) -> Any:
     return {renamed(k): _in_g(v, to_g) for k, v in d.items()}
 
 
+#: the unit of an axis's values: a gyro axis's [deg/s], an accelerometer axis's [g]
+Unit = Literal["deg/s", "g"]
+AXIS_UNITS: tuple[str, ...] = get_args(Unit)
+
+
 @dataclass(frozen=True)
 class AxisCalibration:
-    """Everything known about one gyro axis (or, in ``Calibration.accel_axes``, one accelerometer axis,
-    whose ``..._dps`` values are then in [g]).
+    """Everything known about one gyro axis, or (in ``Calibration.accel_axes``, ``unit="g"``) one accelerometer
+    axis. Its values (the turn-on constants, its curves' outputs) are in ``unit``; the accessors whose names
+    carry a unit (``turn_on_biases_dps``, ``turn_on_biases_g``) refuse an axis of the other.
 
     Attributes
     ----------
     temperature : PolynomialBias, MLPBias or None
-        The bias shape against temperature, or None for no temperature model.
-    turn_on_biases_dps : tuple of float
-        Fitted turn-on constant of each calibration run [deg/s].
+        The bias shape against temperature [unit], or None for no temperature model.
+    turn_on_biases : tuple of float
+        Fitted turn-on constant of each calibration run [unit].
     temperature_column : str
         The temperature channel the model reads (``temperature`` or ``temperature_x`` ...).
     lag_time_constant_s : float
@@ -218,16 +224,40 @@ class AxisCalibration:
         g x g sensitivity to the products xx, yy, zz, xy, xz, yz [deg/s/g^2].
     acceleration_network : MLPBias or None
         A network of the three accelerations (the second stage of the ``mlp>mlp-accel`` pipeline).
+    unit : {"deg/s", "g"}
+        The unit of the axis's values.
     """
 
     temperature: PolynomialBias | MLPBias | None
-    turn_on_biases_dps: tuple[float, ...]
+    turn_on_biases: tuple[float, ...]
     temperature_column: str = "temperature"
     lag_time_constant_s: float = 0.0
     hysteresis: HysteresisCurve | None = None
     g_sensitivity_dps_per_g: tuple[float, float, float] | None = None
     g_squared_dps_per_g2: tuple[float, ...] | None = None
     acceleration_network: MLPBias | None = None
+    unit: Unit = "deg/s"
+
+    def __post_init__(self) -> None:
+        if self.unit not in AXIS_UNITS:
+            raise InputError(f"unit: {self.unit!r}; an axis is in one of {', '.join(AXIS_UNITS)}")
+
+    def _in(self, unit: str, name: str) -> None:
+        if self.unit != unit:
+            raise InputError(f"{name}: the axis's values are in {self.unit}, not {unit} (the unit-free names, "
+                             "turn_on_biases and mean_turn_on_bias, read either)")
+
+    @property
+    def turn_on_biases_dps(self) -> tuple[float, ...]:
+        """The turn-on constants of a gyro axis [deg/s]."""
+        self._in("deg/s", "turn_on_biases_dps")
+        return self.turn_on_biases
+
+    @property
+    def turn_on_biases_g(self) -> tuple[float, ...]:
+        """The turn-on constants of an accelerometer axis [g]."""
+        self._in("g", "turn_on_biases_g")
+        return self.turn_on_biases
 
     @property
     def has_acceleration_stage(self) -> bool:
@@ -246,11 +276,19 @@ class AxisCalibration:
         return self.lag_time_constant_s > 0 or self.hysteresis is not None
 
     @property
+    def mean_turn_on_bias(self) -> float:
+        """The constant subtracted when no turn-on window is given [unit]."""
+        return float(np.mean(self.turn_on_biases))
+
+    @property
     def mean_turn_on_bias_dps(self) -> float:
-        """The constant subtracted when no turn-on window is given [deg/s]."""
-        return float(np.mean(self.turn_on_biases_dps))
+        """The constant subtracted from a gyro axis when no turn-on window is given [deg/s]."""
+        self._in("deg/s", "mean_turn_on_bias_dps")
+        return self.mean_turn_on_bias
 
     def shape_dps(self, temperature_degc: np.ndarray | None) -> np.ndarray | float:
+        """A gyro axis's bias shape at ``temperature_degc`` [deg/s]; 0 without a temperature model."""
+        self._in("deg/s", "shape_dps")
         if self.temperature is None:
             return 0.0
         return self.temperature.shape_dps(temperature_degc)
@@ -258,7 +296,7 @@ class AxisCalibration:
     def to_dict(self) -> dict[str, Any]:
         return {
             "temperature": None if self.temperature is None else self.temperature.to_dict(),
-            "turn_on_biases_dps": list(self.turn_on_biases_dps),
+            "turn_on_biases_dps": list(self.turn_on_biases),  # an accelerometer's: renamed _g in the file
             "temperature_column": self.temperature_column,
             "lag_time_constant_s": self.lag_time_constant_s,
             "hysteresis": None if self.hysteresis is None else self.hysteresis.to_dict(),
@@ -268,20 +306,21 @@ class AxisCalibration:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "AxisCalibration":
+    def from_dict(cls, d: dict[str, Any], unit: Unit = "deg/s") -> "AxisCalibration":
         temp = d.get("temperature")
         kinds = {"polynomial": PolynomialBias, "mlp": MLPBias}
         if temp is not None and temp.get("type") not in kinds:
             raise InputError(f"unknown temperature model type {temp.get('type')!r}")
         return cls(
             temperature=None if d["temperature"] is None else kinds[temp["type"]].from_dict(temp),
-            turn_on_biases_dps=tuple(float(c) for c in d["turn_on_biases_dps"]),
+            turn_on_biases=tuple(float(c) for c in d["turn_on_biases_dps"]),
             temperature_column=str(d.get("temperature_column", "temperature")),
             lag_time_constant_s=float(d["lag_time_constant_s"]),
             hysteresis=None if d["hysteresis"] is None else HysteresisCurve.from_dict(d["hysteresis"]),
             g_sensitivity_dps_per_g=_floats(d["g_sensitivity_dps_per_g"], 3, "g_sensitivity_dps_per_g"),
             g_squared_dps_per_g2=_floats(d["g_squared_dps_per_g2"], 6, "g_squared_dps_per_g2"),
             acceleration_network=None if d["acceleration_network"] is None else MLPBias.from_dict(d["acceleration_network"]),
+            unit=unit,
         )
 
 
@@ -309,10 +348,17 @@ class Calibration:
     accel_triad: TriadCalibration | None = None
 
 
+    def __post_init__(self) -> None:
+        for section, unit, axes in (("axes", "deg/s", self.axes), ("accel_axes", "g", self.accel_axes)):
+            for name, ax in axes.items():
+                if ax.unit != unit:
+                    raise InputError(f"{section}[{name!r}].unit: {ax.unit!r}; the axes of {section} are in {unit}")
+
     @property
     def report(self) -> FitReport:
         """How the model was fitted, typed (:class:`gyrocomp.fit_report.FitReport`), read from ``fit_report``."""
         return FitReport.from_dict(self.fit_report)
+
     def without(self, *parts: str) -> "Calibration":
         """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
         (turning-point), ``"lag"``, ``"scale-factor"`` (the gyro triad's K(T)). What is left is applied as fitted
@@ -392,7 +438,7 @@ class Calibration:
         try:
             _check_model(d)
             axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
-            accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False))
+            accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False), unit="g")
                           for name, ax in d["accel_axes"].items()}
             triads = {key: None if d[key] is None else TriadCalibration.from_dict(d[key], key)
                       for key in ("gyro_triad", "accel_triad")}

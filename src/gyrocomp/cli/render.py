@@ -128,7 +128,7 @@ def _print_axis_fits(console, axes: dict, report: FitReport, title: str, unit: s
         model = _describe_axis(ax)
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
         rms = "-" if fit is None or fit.fit_rms is None else f"{fit.fit_rms:.3g}"
-        constants = ax.turn_on_biases_dps
+        constants = ax.turn_on_biases
         shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (f" ... ({len(constants)})" if len(constants) > 6 else "")
         table.add_row(axis, model, rng, rms, shown)
     console.print(table)

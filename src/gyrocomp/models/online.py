@@ -938,7 +938,7 @@ class OnlineCalibrator:
             g = tuple(float(v) for v in self._g[j]) if self._tilted.any() else None
             out[name] = AxisCalibration(temperature=curve, g_sensitivity_dps_per_g=g,
                                          lag_time_constant_s=self.lag_time_constant_s,
-                                         turn_on_biases_dps=tuple(float(c) for c in self._constants[:, j]))
+                                         turn_on_biases=tuple(float(c) for c in self._constants[:, j]))
         status = self.status
         report = {"method": "online learner", "sessions": status.sessions, "points": status.points,
                   "still_s": status.still_s, "degree": self._degree,

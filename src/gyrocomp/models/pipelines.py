@@ -286,7 +286,18 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
             {a: tuple(network.validation_rmse_dps_[a]) for a in network.curves_},
             {a: network.epochs_[a] for a in network.curves_}).to_dict()
     name = _model_name(axes, network, network_inputs, temperature, thermal, accel_mode)
+    if PreparedRun.of(recordings[0]).channel == "accel":
+        return _accelerometer_calibration(axes, name, provenance(recordings), report)
     return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
+
+
+def _accelerometer_calibration(axes: dict[str, AxisCalibration], name: str, source: dict, report: dict) -> Calibration:
+    """The accelerometer's axes as a calibration: relative to the middle of the calibrated temperature range
+    (``accel_reference_degc``), since at rest the accelerometer's constant cannot be told from gravity."""
+    curves = [ax.temperature for ax in axes.values() if ax.temperature is not None]
+    reference = 0.5 * (min(c.t_min_degc for c in curves) + max(c.t_max_degc for c in curves)) if curves else None
+    return Calibration(axes={}, model=name, provenance=source, fit_report=report, accel_axes=axes,
+                       accel_reference_degc=reference)
 
 
 def _check_fit_inputs(recordings: list[Recording], temperature, acceleration: str,
@@ -386,7 +397,7 @@ def _axis_calibration(axis: str, recordings: list[Recording], selections, model,
         curve = dataclasses.replace(curve, extrapolation="linear")
     keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
     result = AxisCalibration(keep_curve, tuple(float(c) for c in consts), recordings[0].temperature_column_for(axis),
-                             lag, hyst, g_row, g_sq)
+                             lag, hyst, g_row, g_sq, unit=recordings[0].unit_of(axis))
     entry = {"order": curve.order, "t_min_degc": curve.t_min_degc, "t_max_degc": curve.t_max_degc}
     if model is not None:
         entry["scores"] = {str(p): float(v) for p, v in model.scores_[axis].items()}
@@ -557,15 +568,11 @@ def fit_accelerometer(recordings: list[Recording], options: FitOptions | None = 
                              hysteresis_order=options.hysteresis_order,
                              hysteresis_band_degc=options.hysteresis_band_degc, acceleration="none",
                              static_min_duration_s=options.static_min_duration_s, run_folds=folds)
-    curves = [ax.temperature for ax in fitted.axes.values() if ax.temperature is not None]
-    if not curves:
+    if fitted.accel_reference_degc is None:
         raise InputError("channels=accel: no temperature model of the accelerometer generalizes across these runs "
                          "(every axis is left a constant); their temperatures do not span enough to fit one")
-    t_min = min(c.t_min_degc for c in curves)
-    t_max = max(c.t_max_degc for c in curves)
-    return Calibration(axes={}, model=f"accel {fitted.model}", provenance=provenance(recordings),
-                       fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}},
-                       accel_axes=fitted.axes, accel_reference_degc=0.5 * (t_min + t_max))
+    return dataclasses.replace(fitted, model=f"accel {fitted.model}", provenance=provenance(recordings),
+                               fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}})
 
 
 #: how ``fit_channels`` treats the gyro's scale factor and misalignment

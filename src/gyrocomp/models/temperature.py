@@ -253,8 +253,9 @@ class PolynomialTemperatureModel:
         axes = fit_axes(recordings)
         for rec in recordings[1:]:
             if fit_axes([rec]) != axes:
+                kind = "accelerometer" if rec.unit_of(axes[0]) == "g" else "gyro"
                 raise InputError(
-                    f"{rec.source}: axes {', '.join(fit_axes([rec]))} differ from "
+                    f"{rec.source}: {kind} axes {', '.join(fit_axes([rec]))} differ from "
                     f"{recordings[0].source}'s ({', '.join(axes)}); fit runs of the same sensor together"
                 )
         self.curves_, self.turn_on_biases_dps_, self.scores_, self.fit_rms_dps_ = {}, {}, {}, {}

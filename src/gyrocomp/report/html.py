@@ -123,7 +123,7 @@ def _summary(calibration: Calibration) -> str:
             rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
             rms = fits[name].fit_rms if name in fits else None
             rows.append([name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}",
-                         len(ax.turn_on_biases_dps)])
+                         len(ax.turn_on_biases)])
     parts.append(_table(["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"], rows))
     if calibration.accel_axes:
         parts.append(f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
