@@ -10,6 +10,10 @@ detection settings, and the block means per axis, block, bin width and pieces. T
 their runs once (:func:`prepare`); a function handed a plain recording prepares it itself, and the result is the
 same, only not shared.
 
+A prepared run also says which channel a fit of it models (``channel``): the gyro's axes [deg/s], or the
+accelerometer's [g] (``PreparedRun.of(run, "accel")``, which shares what was kept from the gyro's view), read by name
+with :meth:`~gyrocomp.recording.Recording.signal`; the fitting iterates :func:`fit_axes`.
+
 What is kept lives as long as the prepared run, which a fit drops when it returns, and is read-only; a copy with
 other data (``dataclasses.replace``, :meth:`~gyrocomp.recording.Recording.with_gyro`, ``take``) starts with
 nothing kept, since what was derived from the old data does not hold for the new.
@@ -32,11 +36,13 @@ from .static import DEFAULT_FACTOR, DEFAULT_MIN_DURATION_S, DEFAULT_WINDOW_S, St
 Channel = Literal["gyro", "accel"]
 CHANNELS: tuple[str, ...] = get_args(Channel)
 
+
 @dataclass(frozen=True)
 class RunBlocks:
-    """Block means of one run and axis: time [s], temperature [degC], gyro [deg/s], bin-balancing weight,
-    the accelerations [g] when the run has the triad, the piece (segment) each block comes from, and the
-    number of samples in each block (its duration, for time weights)."""
+    """Block means of one run and axis: time [s], temperature [degC], the axis's values (``value_dps``: [deg/s]
+    for a gyro axis, [g] for an accelerometer axis), bin-balancing weight, the accelerations [g] when the run has
+    the triad, the piece (segment) each block comes from, and the number of samples in each block (its duration,
+    for time weights)."""
 
     time_s: np.ndarray
     temperature_degc: np.ndarray
