@@ -91,9 +91,9 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
 
 def one_temperature_column(recordings: list[Recording]) -> bool:
     """Whether every recording reads one temperature for all the axes a fit models (one sensor, so one die and one
-    lag): one column, or the accelerometer's axes (which read the mean of the gyro's columns)."""
-    return all(rec.temperature_degc is None or rec.temperature_degc.ndim == 1
-               or all(rec.unit_of(axis) == "g" for axis in fit_axes([rec])) for rec in recordings)
+    lag): one column, or the accelerometer's axes (which all read the mean of the gyro's columns)."""
+    return all(rec.temperature_degc is None or len({rec.temperature_column_for(a) for a in fit_axes([rec])}) == 1
+               for rec in recordings)
 
 
 def provenance(recordings) -> dict:
