@@ -291,7 +291,7 @@ class AxisCalibration:
         self._in("deg/s", "shape_dps")
         if self.temperature is None:
             return 0.0
-        return self.temperature.shape_dps(temperature_degc)
+        return self.temperature.shape(temperature_degc)
 
     def to_dict(self) -> dict[str, Any]:
         return {

@@ -59,7 +59,7 @@ class Compensator:
         # each accelerometer axis with its error at the reference temperature, which the correction keeps; an axis
         # the fit left without a temperature model (none beat its constant) is not corrected
         reference = np.array([calibration.accel_reference_degc])
-        self._accel_modelled = [(j, a, ax, float(np.asarray(ax.temperature.shape_dps(reference), dtype=float)[0]))
+        self._accel_modelled = [(j, a, ax, float(np.asarray(ax.temperature.shape(reference), dtype=float)[0]))
                                 for j, a in enumerate(ACCEL_AXES)
                                 if (ax := calibration.accel_axes.get(a)) is not None and ax.temperature is not None]
         self._triad_columns = None
@@ -116,13 +116,13 @@ class Compensator:
             )
             self._warned = True
         if getattr(ax.temperature, "needs_accel", False):
-            error = np.asarray(ax.temperature.shape_dps(t_model, accel_g), dtype=float)
+            error = np.asarray(ax.temperature.shape(t_model, accel_g), dtype=float)
         else:
-            error = np.asarray(ax.temperature.shape_dps(t_model), dtype=float)
+            error = np.asarray(ax.temperature.shape(t_model), dtype=float)
         if ax.hysteresis is not None:
             turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states.get(key))
             self._turn_states[key] = turns.state
-            error = error + ax.hysteresis.offset_dps(t_model, turns)
+            error = error + ax.hysteresis.offset(t_model, turns)
         return error
 
     def _compensate_accel(self, time_s: np.ndarray, temperature_degc: np.ndarray | None,
@@ -188,7 +188,7 @@ class Compensator:
                     q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
                     out[:, j] -= g_sensitivity_offset(accel_g, g[None, :], q)[:, 0]
                 if ax.acceleration_network is not None:
-                    out[:, j] -= ax.acceleration_network.shape_dps(np.zeros(time_s.size), accel_g)
+                    out[:, j] -= ax.acceleration_network.shape(np.zeros(time_s.size), accel_g)
             if ax.temperature is None:
                 continue
             if temperature_degc is None:

@@ -39,14 +39,14 @@ CHANNELS: tuple[str, ...] = get_args(Channel)
 
 @dataclass(frozen=True)
 class RunBlocks:
-    """Block means of one run and axis: time [s], temperature [degC], the axis's values (``value_dps``: [deg/s]
+    """Block means of one run and axis: time [s], temperature [degC], the axis's values (``value``: [deg/s]
     for a gyro axis, [g] for an accelerometer axis), bin-balancing weight, the accelerations [g] when the run has
     the triad, the piece (segment) each block comes from, and the number of samples in each block (its duration,
     for time weights)."""
 
     time_s: np.ndarray
     temperature_degc: np.ndarray
-    value_dps: np.ndarray
+    value: np.ndarray
     weight: np.ndarray
     accel_g: np.ndarray | None = None
     cluster: np.ndarray | None = None

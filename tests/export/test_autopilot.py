@@ -69,7 +69,7 @@ def test_px4_formula_reproduces_the_model(order, tolerance_dps):
     t = np.linspace(-30, 80, 500)  # beyond the range on both sides: both clamp
     for name, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
         ax = cal.axes[name]
-        ours = ax.temperature.shape_dps(t) + ax.mean_turn_on_bias_dps
+        ours = ax.temperature.shape(t) + ax.mean_turn_on_bias_dps
         theirs = px4_offset_rad_s(p, 1, j, t) * RAD_TO_DEG
         stated = float(re.search(rf"{name}: ([\d.e+-]+) deg/s", text).group(1))
         # float32 parameters: about 1e-7 relative on coefficients of up to ~0.05 deg/s over the range
@@ -87,7 +87,7 @@ def test_ardupilot_formula_reproduces_the_model_relative_to_the_calibration_temp
     cal_temp = 22.0
     for name, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
         curve = cal.axes[name].temperature
-        ours = curve.shape_dps(t) - curve.shape_dps(np.array([cal_temp]))[0]
+        ours = curve.shape(t) - curve.shape(np.array([cal_temp]))[0]
         theirs = ardupilot_correction_rad_s(p, 2, j, t, cal_temp) * RAD_TO_DEG
         np.testing.assert_allclose(theirs, ours, atol=1e-7)
 
@@ -137,7 +137,7 @@ def test_accelerometer_parameters_reproduce_the_accelerometer_model():
     g0 = 9.80665
     for j, name in enumerate(("accel_x", "accel_y", "accel_z")):
         curve = cal.accel_axes[name].temperature
-        ours_g = curve.shape_dps(temps) - curve.shape_dps(np.array([reference]))[0]
+        ours_g = curve.shape(temps) - curve.shape(np.array([reference]))[0]
         theirs_px4 = px4_offset_rad_s(px4, 0, j, temps, sensor="A") / g0
         theirs_ardu = ardupilot_correction_rad_s(ardu, 1, j, temps, reference, sensor="ACC") / g0
         # a cubic model: exact to the float32 / 9-digit rounding of the parameter files

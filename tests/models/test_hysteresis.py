@@ -23,8 +23,8 @@ def test_curve_offset_is_the_branch_polynomial_in_the_distance_from_the_turn():
     """Up 20 -> 80, down to 20, up to 50: on the cooling branch h_c(d), d = 80 - T; on the second heating
     branch h_h(d), d = T - 20; nothing on the first branch (the reference path) and outside the band."""
     temperature = np.concatenate([np.linspace(20, 80, 601), np.linspace(79.9, 20, 600), np.linspace(20.1, 50, 300)])
-    curve = HysteresisCurve(descending_dps=(0.01, -2e-4), ascending_dps=(-0.005,), threshold_degc=0.5)
-    offset = curve.offset_dps(temperature, find_turns(temperature, curve.threshold_degc))
+    curve = HysteresisCurve(descending=(0.01, -2e-4), ascending=(-0.005,), threshold_degc=0.5)
+    offset = curve.offset(temperature, find_turns(temperature, curve.threshold_degc))
     first, cooling, heating = offset[:601], offset[601:1201], offset[1201:]
     assert np.all(first == 0.0)
     confirmed = temperature[601:1201] < 80 - 0.5  # the reversal counts once T is the threshold past the extreme
@@ -34,7 +34,7 @@ def test_curve_offset_is_the_branch_polynomial_in_the_distance_from_the_turn():
     rising = temperature[1201:] > 20 + 0.5
     np.testing.assert_allclose(heating[rising], -0.005 * (temperature[1201:][rising] - 20.0), rtol=1e-12)
     banded = HysteresisCurve((0.01, -2e-4), (-0.005,), 0.5, band_degc=(55.0, 80.0))
-    inside = banded.offset_dps(temperature, find_turns(temperature, 0.5))
+    inside = banded.offset(temperature, find_turns(temperature, 0.5))
     np.testing.assert_array_equal(inside, np.where((temperature >= 55) & (temperature <= 80), offset, 0.0))
     assert curve.order == 2
 

@@ -96,7 +96,7 @@ def test_network_is_deterministic_for_a_seed_and_saved_as_json(chamber, tmp_path
     loaded = Calibration.load(tmp_path / "m.json")
     np.testing.assert_array_equal(apply(loaded, held.recording).gyro_dps, apply(a, held.recording).gyro_dps)
     curve = loaded.axes["gyro_z"].temperature
-    assert curve.shape_dps(np.array([curve.t_ref_degc]))[0] == pytest.approx(0.0, abs=1e-15)
+    assert curve.shape(np.array([curve.t_ref_degc]))[0] == pytest.approx(0.0, abs=1e-15)
 
 
 def test_network_with_lag_and_hysteresis_generalizes_to_a_faster_ramp():

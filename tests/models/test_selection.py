@@ -113,9 +113,9 @@ def test_tangent_extension_past_the_range():
     lo_u = -1.0
     value_lo = 0.1 * lo_u - 0.05 * lo_u ** 2 + 0.02 * lo_u ** 3
     slope_lo = 0.1 - 0.1 * lo_u + 0.06 * lo_u ** 2
-    np.testing.assert_allclose(curve.shape_dps(t), [expected_hi, value_lo + slope_lo * (5 - 10) / 10], rtol=1e-12)
+    np.testing.assert_allclose(curve.shape(t), [expected_hi, value_lo + slope_lo * (5 - 10) / 10], rtol=1e-12)
     held = PolynomialBias((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0)
-    np.testing.assert_allclose(held.shape_dps(t), [0.07, value_lo], rtol=1e-12)
+    np.testing.assert_allclose(held.shape(t), [0.07, value_lo], rtol=1e-12)
     assert "extrapolation" not in held.to_dict() and PolynomialBias.from_dict(curve.to_dict()) == curve
     with pytest.raises(ValueError, match="extrapolation: 'cubic'; use one of hold, linear"):
         PolynomialBias((0.1,), 20.0, 10.0, 10.0, 30.0, extrapolation="cubic")

@@ -34,7 +34,7 @@ def test_fitted_shape_matches_truth_within_noise(chamber_runs, held_out):
     cal = fit_calibration([s.recording for s in fit_runs], temperature=3)
     truth = TEST_MODEL.temperature_error_dps(GRID)
     for j, axis in enumerate(TEST_MODEL.axes):
-        err = cal.axes[axis].temperature.shape_dps(GRID) - truth[:, j]
+        err = cal.axes[axis].temperature.shape(GRID) - truth[:, j]
         err -= err.mean()  # the shape is defined up to the turn-on constant
         # the bin averages carry the noise averaged over one bin's crossing time, divided among runs
         tolerance = 4.0 * noise_scale(fit_runs, j, 20.0) / np.sqrt(len(fit_runs))
@@ -53,7 +53,7 @@ def test_least_squares_is_linear_in_the_data(chamber_runs):
     cal = {k: fit_calibration(v, temperature=3, hysteresis="none") for k, v in parts.items()}
     truth = TEST_MODEL.temperature_error_dps(GRID)
     for j, axis in enumerate(TEST_MODEL.axes):
-        shape = {k: c.axes[axis].temperature.shape_dps(GRID) for k, c in cal.items()}
+        shape = {k: c.axes[axis].temperature.shape(GRID) for k, c in cal.items()}
         np.testing.assert_allclose(shape["all"], shape["truth"] + shape["noise"], atol=1e-13)
         consts = {k: np.array(c.axes[axis].turn_on_biases_dps) for k, c in cal.items()}
         np.testing.assert_allclose(consts["all"], consts["truth"] + consts["noise"], atol=1e-13)
@@ -130,7 +130,7 @@ def test_single_run_uses_bic_and_recovers_linear_truth():
     fitted = PolynomialTemperatureModel().fit([sim.recording])
     assert fitted.selection_ == "bic"
     assert fitted.curves_["gyro_z"].order in (1, 2)
-    slope = np.polyfit(GRID, fitted.curves_["gyro_z"].shape_dps(GRID), 1)[0]
+    slope = np.polyfit(GRID, fitted.curves_["gyro_z"].shape(GRID), 1)[0]
     assert slope == pytest.approx(2e-3, rel=0.03)
 
 
@@ -144,7 +144,7 @@ def test_heating_rate_does_not_weight_the_fit():
     bins = bin_by_temperature([temp], [gyro], 1.0)
     assert bins.weight.max() == 1.0
     cal = fit_calibration([rec], temperature=2, hysteresis="none")
-    shape = cal.axes["gyro_z"].temperature.shape_dps(GRID)
+    shape = cal.axes["gyro_z"].temperature.shape(GRID)
     truth = 1e-3 * (GRID - 25) + 1e-5 * (GRID - 25) ** 2
     np.testing.assert_allclose(shape - shape.mean(), truth - truth.mean(), atol=1e-6)
 
@@ -160,7 +160,7 @@ def test_clamps_outside_range_and_warns_once():
     assert len(record) == 1
     curve = cal.axes["gyro_z"].temperature
     assert np.all(out.gyro_dps[-300:, 0] == out.gyro_dps[-1, 0])  # held at the edge
-    assert curve.shape_dps(np.array([80.0])) == curve.shape_dps(np.array([40.0]))
+    assert curve.shape(np.array([80.0])) == curve.shape(np.array([40.0]))
 
 
 def test_noise_level_overshoot_of_the_range_is_not_outside_it():

@@ -54,7 +54,7 @@ def test_both_effects_recovered_and_generalize_to_a_faster_ramp(both_effects):
     assert cal.fit_report["hysteresis"]["axes"]["gyro_z"]["chosen"].startswith("turning-point+lag")
     assert ax.lag_time_constant_s == pytest.approx(60.0, rel=0.2)
     d = np.linspace(0, 25, 26)  # the preset: 0.032 d - 0.00128 d^2 below an 80 degC turn
-    fitted = sum(h * d ** (j + 1) for j, h in enumerate(ax.hysteresis.descending_dps))
+    fitted = sum(h * d ** (j + 1) for j, h in enumerate(ax.hysteresis.descending))
     np.testing.assert_allclose(fitted, 0.032 * d - 0.00128 * d ** 2, atol=0.02)
     assert ax.hysteresis.band_degc == (55.0, 80.0)
     # the bar where both effects are present: within 35 % of perfect, 2x better than a cubic

@@ -60,10 +60,10 @@ def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool,
     if curve is None:
         raise InputError("export: the model has no temperature curve on this axis; fit one (temperature= a polynomial)")
     t = np.linspace(curve.t_min_degc, curve.t_max_degc, GRID_POINTS)
-    bias_dps = np.asarray(curve.shape_dps(t), dtype=float) + (axis.mean_turn_on_bias if with_constant else 0.0)
+    bias_dps = np.asarray(curve.shape(t), dtype=float) + (axis.mean_turn_on_bias if with_constant else 0.0)
     d = t - reference_degc
     powers = np.column_stack([d ** k for k in (range(4) if with_constant else range(1, 4))])
-    target = bias_dps if with_constant else bias_dps - np.asarray(curve.shape_dps(np.array([reference_degc]))[0])
+    target = bias_dps if with_constant else bias_dps - np.asarray(curve.shape(np.array([reference_degc]))[0])
     coef, *_ = np.linalg.lstsq(powers, target, rcond=None)
     error = float(np.max(np.abs(powers @ coef - target)))
     full = tuple(float(c) for c in coef) if with_constant else (0.0, *map(float, coef))

@@ -56,15 +56,15 @@ def _temperature_code(j: int, curve) -> list[str]:
     if curve is None:
         return ["    shape = 0.0;"]
     if isinstance(curve, PolynomialBias):
-        lines = [f"    {{ const double c[] = {_array(curve.coefficients_dps)};" if curve.coefficients_dps else "    {",
+        lines = [f"    {{ const double c[] = {_array(curve.coefficients)};" if curve.coefficients else "    {",
                  f"      double u = (clip(tm, {_num(curve.t_min_degc)}, {_num(curve.t_max_degc)}) - "
                  f"{_num(curve.t_ref_degc)}) / {_num(curve.t_scale_degc)};",
                  "      shape = 0.0;"]
-        if curve.coefficients_dps:
-            lines.append(f"      for (int k = {len(curve.coefficients_dps) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
+        if curve.coefficients:
+            lines.append(f"      for (int k = {len(curve.coefficients) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
             if curve.extrapolation == "linear":  # continued along the tangent past the range
                 lines += ["      double slope = 0.0;",
-                          f"      for (int k = {len(curve.coefficients_dps) - 1}; k >= 0; --k) "
+                          f"      for (int k = {len(curve.coefficients) - 1}; k >= 0; --k) "
                           "slope = slope * u + (k + 1) * c[k];",
                           f"      shape += slope * ((tm - {_num(curve.t_ref_degc)}) / {_num(curve.t_scale_degc)} - u);"]
         lines.append("    }")
@@ -98,7 +98,7 @@ def _network_function(name: str, curve: MLPBias) -> list[str]:
         lines.append(f"        a{k + 1}[r] = {'z + b%d[r]' % k if last else 'tanh(z + b%d[r])' % k};")
         lines.append("    }")
         prev = f"a{k + 1}"
-    lines.append(f"    return {prev}[0] * {_num(curve.output_scale_dps)} + {_num(curve.output_mean_dps)};")
+    lines.append(f"    return {prev}[0] * {_num(curve.output_scale)} + {_num(curve.output_mean)};")
     lines.append("}")
     return lines
 
@@ -111,7 +111,7 @@ def _hysteresis_code(j: int, ax: AxisCalibration) -> list[str]:
              f"    if (s->turn[{j}].has_turn) {{"]
     band = "" if h.band_degc is None else f" && tm >= {_num(h.band_degc[0])} && tm <= {_num(h.band_degc[1])}"
     reach = h.max_distance_degc or (None, None)
-    for sign, coefs, d_max in ((-1, h.descending_dps, reach[0]), (1, h.ascending_dps, reach[1])):
+    for sign, coefs, d_max in ((-1, h.descending, reach[0]), (1, h.ascending, reach[1])):
         lines.append(f"        if (s->turn[{j}].direction == {sign}{band}) {{")
         lines.append(f"            const double h[] = {_array(coefs)};")
         lines.append(f"            double d = fabs(tm - s->turn[{j}].turn), off = 0.0;")
@@ -258,7 +258,7 @@ def _accel_step_code(calibration: Calibration, accel_axes: dict) -> list[str]:
             continue
         body.append(f"    /* {name}: temperature error relative to {reference:g} degC */")
         body += _shape_code(3 + i, ax)
-        at_reference = float(ax.temperature.shape_dps(np.array([reference]))[0])
+        at_reference = float(ax.temperature.shape(np.array([reference]))[0])
         body.append(f"    acc[{i}] -= shape - {_num(at_reference)};")
     body.append("    for (int j = 0; j < 3; ++j) s->accel_out[j] = acc[j];")
     if calibration.accel_triad is not None:

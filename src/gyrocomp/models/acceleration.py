@@ -54,7 +54,7 @@ def fit_g_sensitivity(recordings: list[Recording], mode: str, static_min_duratio
     for axis in recordings[0].gyro_axes:
         g_row = tuple(map(float, thermal.g_sensitivity_dps_per_g_[axis])) if thermal.excited_axes_ else None
         g_sq = tuple(map(float, thermal.g_squared_dps_per_g2_[axis])) if mode == "matrix2" and g_row else None
-        axes[axis] = AxisCalibration(None, tuple(float(c) for c in thermal.turn_on_biases_dps_[axis]),
+        axes[axis] = AxisCalibration(None, tuple(float(c) for c in thermal.turn_on_biases_[axis]),
                                      g_sensitivity_dps_per_g=g_row, g_squared_dps_per_g2=g_sq)
     name = "g-sensitivity" + (" (g x g)" if mode == "matrix2" else "") if thermal.excited_axes_ else "none"
     return Calibration(axes=axes, model=name, provenance=provenance(recordings),
@@ -78,11 +78,11 @@ def fit_acceleration_network(recordings: list[Recording], *, hidden: tuple[int, 
             pieces = [slice(g.start, g.stop) for g in segs] or None
             blocks = PreparedRun.of(rec).block_means(axis, NETWORK_BLOCK_S, math.inf, pieces)  # one temperature bin: equal weights
             t_in.append(blocks.temperature_degc)
-            y_in.append(blocks.value_dps)
+            y_in.append(blocks.value)
             w_in.append(blocks.weight)
             a_in.append(blocks.accel_g)
         network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=0.0, accel_g=a_in, inputs=ACCEL_INPUTS)
-        axes[axis] = AxisCalibration(None, tuple(float(c) for c in network.turn_on_biases_dps_[axis]),
+        axes[axis] = AxisCalibration(None, tuple(float(c) for c in network.turn_on_biases_[axis]),
                                      acceleration_network=network.curves_[axis])
     report = {"acceleration": GSensitivityReport("network", None, tuple(len(s) for s in segments), (), {},
                                                  tuple(hidden)).to_dict()}

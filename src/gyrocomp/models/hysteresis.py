@@ -54,34 +54,35 @@ def heats_and_cools(recordings: list[Recording], axis: str) -> bool:
 class HysteresisCurve:
     """Fitted hysteresis of one axis: offset after a reversal of the model temperature.
 
-    offset = sum_j h_j |T - T_turn|^j, h from ``descending_dps`` on cooling branches and
-    ``ascending_dps`` on heating branches [deg/s/degC^j], zero outside ``band_degc`` if given. With
+    offset = sum_j h_j |T - T_turn|^j, h from ``descending`` on cooling branches and
+    ``ascending`` on heating branches [the axis's unit per degC^j: deg/s/degC^j, or g/degC^j for an
+    accelerometer], zero outside ``band_degc`` if given. With
     ``max_distance_degc`` (cooling, heating) the offset is held at its value at the largest distance d the
     fit saw on each branch (files without it follow the polynomial in d everywhere, as earlier ones did).
     Reversals are confirmed ``threshold_degc`` past the extreme (see :func:`gyrocomp.effects.find_turns`).
     """
 
-    descending_dps: tuple[float, ...]
-    ascending_dps: tuple[float, ...]
+    descending: tuple[float, ...]
+    ascending: tuple[float, ...]
     threshold_degc: float
     band_degc: tuple[float, float] | None = None
     max_distance_degc: tuple[float, float] | None = None
 
     @property
     def order(self) -> int:
-        return len(self.descending_dps)
+        return len(self.descending)
 
-    def offset_dps(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
+    def offset(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
         reach = self.max_distance_degc or (None, None)
-        down = hysteresis_offset(temperature_degc, turns, self.descending_dps, direction="descending",
+        down = hysteresis_offset(temperature_degc, turns, self.descending, direction="descending",
                                  band_degc=self.band_degc, max_distance_degc=reach[0])
-        up = hysteresis_offset(temperature_degc, turns, self.ascending_dps, direction="ascending",
+        up = hysteresis_offset(temperature_degc, turns, self.ascending, direction="ascending",
                                band_degc=self.band_degc, max_distance_degc=reach[1])
         return down + up
 
     def to_dict(self) -> dict[str, Any]:
-        d = {"type": "turning-point", "descending_dps": list(self.descending_dps),
-             "ascending_dps": list(self.ascending_dps), "threshold_degc": self.threshold_degc,
+        d = {"type": "turning-point", "descending_dps": list(self.descending),
+             "ascending_dps": list(self.ascending), "threshold_degc": self.threshold_degc,
              "band_degc": None if self.band_degc is None else list(self.band_degc)}
         if self.max_distance_degc is not None:  # written only when set: earlier readers see an earlier file
             d["max_distance_degc"] = list(self.max_distance_degc)

@@ -217,15 +217,16 @@ class MLPBias:
     """Fitted network shape of one axis's bias, without its turn-on constant.
 
     bias(inputs) = net(x(inputs)) - net(x(reference)),  x_i = 2 (clip(v_i) - min_i) / (max_i - min_i) - 1,
-    net output in deg/s = standardized output * output_scale_dps + output_mean_dps. The thesis's network
+    net output [the axis's unit: deg/s, or g for an accelerometer] = standardized output * output_scale +
+    output_mean. The thesis's network
     reads the temperature only; with ``inputs`` = temperature, accel_x, accel_y, accel_z it is the joint
     network of thesis 2.7.2 / 2.8 (``reference`` then includes a 1 g z-up orientation).
     """
 
     hidden: tuple[int, ...]
     weights: tuple[tuple[float, ...], ...]  # flat per layer: W row-major then b
-    output_mean_dps: float
-    output_scale_dps: float
+    output_mean: float
+    output_scale: float
     t_ref_degc: float
     t_min_degc: float
     t_max_degc: float
@@ -267,7 +268,7 @@ class MLPBias:
         span = np.where(hi > lo, hi - lo, 1.0)
         x = np.where(hi > lo, 2.0 * (np.clip(v, lo, hi) - lo) / span - 1.0, 0.0)
         out, _ = forward(self._theta(), layer_shapes(len(self.inputs), self.hidden), x)
-        return out * self.output_scale_dps + self.output_mean_dps
+        return out * self.output_scale + self.output_mean
 
     def input_values(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
         """The (n, len(inputs)) matrix the network reads, from temperature [degC] and specific force (n, 3) [g]."""
@@ -283,8 +284,8 @@ class MLPBias:
                 cols.append(np.asarray(accel_g, dtype=float)[:, ACCEL_INPUTS.index(name)])
         return np.column_stack(cols)
 
-    def shape_dps(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
-        """Bias shape [deg/s], zero at the reference inputs, held at the edges of the fitted ranges."""
+    def shape(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
+        """Bias shape [the axis's unit], zero at the reference inputs, held at the edges of the fitted ranges."""
         shape = self.net_dps(self.input_values(temperature_degc, accel_g)) - float(
             self.net_dps(np.asarray(self.reference)[None, :])[0])
         return shape.reshape(np.shape(temperature_degc))
@@ -293,8 +294,8 @@ class MLPBias:
         return {"type": "mlp", "hidden": list(self.hidden), "activation": "tanh", "output": "linear",
                 "inputs": list(self.inputs), "input_min": list(self.input_min), "input_max": list(self.input_max),
                 "reference": list(self.reference),
-                "weights": [list(layer) for layer in self.weights], "output_mean_dps": self.output_mean_dps,
-                "output_scale_dps": self.output_scale_dps, "t_ref_degc": self.t_ref_degc,
+                "weights": [list(layer) for layer in self.weights], "output_mean_dps": self.output_mean,
+                "output_scale_dps": self.output_scale, "t_ref_degc": self.t_ref_degc,
                 "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
 
     @classmethod
@@ -330,7 +331,7 @@ class MLPTemperatureModel:
     Attributes (after ``fit``)
     --------------------------
     curves_ : dict[str, MLPBias]
-    turn_on_biases_dps_ : dict[str, np.ndarray]
+    turn_on_biases_ : dict[str, np.ndarray]
     validation_rmse_dps_ : dict[str, list[float]]
         Validation RMS of every restart [deg/s].
     train_rmse_dps_ : dict[str, float]
@@ -344,7 +345,7 @@ class MLPTemperatureModel:
     max_epochs: int = MAX_EPOCHS
     _fitted: bool = field(default=False, init=False, repr=False)
 
-    def fit_blocks(self, axis: str, temperature_degc: list[np.ndarray], value_dps: list[np.ndarray],
+    def fit_blocks(self, axis: str, temperature_degc: list[np.ndarray], value: list[np.ndarray],
                    weight: list[np.ndarray], t_ref_degc: float, accel_g: list[np.ndarray] | None = None,
                    inputs: tuple[str, ...] = ("temperature",)) -> "MLPTemperatureModel":
         """Fit one axis on per-run arrays of temperature [degC], value [deg/s], weight and, for a network that
@@ -352,10 +353,10 @@ class MLPTemperatureModel:
         if self.restarts < 1:
             raise InputError(f"restarts: must be at least 1, got {self.restarts}")
         if not hasattr(self, "curves_"):
-            self.curves_, self.turn_on_biases_dps_, self.validation_rmse_dps_, self.epochs_ = {}, {}, {}, {}
+            self.curves_, self.turn_on_biases_, self.validation_rmse_dps_, self.epochs_ = {}, {}, {}, {}
             self.train_rmse_dps_ = {}
         t = np.concatenate(temperature_degc)
-        y = np.concatenate(value_dps)
+        y = np.concatenate(value)
         w = np.concatenate(weight)
         run = np.concatenate([np.full(a.size, r) for r, a in enumerate(temperature_degc)])
         n_runs = len(temperature_degc)
@@ -398,7 +399,7 @@ class MLPTemperatureModel:
                         tuple(map(float, lo)), tuple(map(float, hi)), reference)
         at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
         self.curves_[axis] = curve
-        self.turn_on_biases_dps_[axis] = best.run_constants * scale + at_ref
+        self.turn_on_biases_[axis] = best.run_constants * scale + at_ref
         self.validation_rmse_dps_[axis] = [r.validation_rmse * scale for r in results]
         self.epochs_[axis] = best.epochs
         self.train_rmse_dps_[axis] = best.train_rmse * scale

@@ -57,9 +57,9 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
         temp = blocks.temperature_degc
         if lag_s > 0:
             temp, _ = thermal_lag(blocks.time_s, temp, lag_s, period_s=block_s)
-        value = blocks.value_dps
+        value = blocks.value
         if hysteresis is not None:
-            value = value - hysteresis.offset_dps(temp, find_turns(temp, hysteresis.threshold_degc))
+            value = value - hysteresis.offset(temp, find_turns(temp, hysteresis.threshold_degc))
         if g_row is not None:
             q = None if g_squared is None else np.asarray(g_squared)[None, :]
             value = value - g_sensitivity_offset(blocks.accel_g, np.asarray(g_row)[None, :], q)[:, 0]
@@ -72,7 +72,7 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
         raise InputError("pipeline=joint-mlp: the runs need accel_x, accel_y and accel_z columns")
     network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc, accel_g=a_in if needs_accel else None,
                        inputs=inputs)
-    return network.curves_[axis], network.turn_on_biases_dps_[axis]
+    return network.curves_[axis], network.turn_on_biases_[axis]
 
 
 def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memories: tuple[str, ...],
@@ -377,8 +377,8 @@ def _axis_calibration(axis: str, recordings: list[Recording], selections, model,
                       bin_width_degc, network_inputs: tuple[str, ...]) -> tuple[AxisCalibration, dict]:
     """One axis's frozen result from the fitted models (the network trained on top when asked for), and its
     entry in the fit report."""
-    curve, consts = (thermal.curves_[axis], thermal.turn_on_biases_dps_[axis]) if thermal is not None else (
-        model.curves_[axis], model.turn_on_biases_dps_[axis])
+    curve, consts = (thermal.curves_[axis], thermal.turn_on_biases_[axis]) if thermal is not None else (
+        model.curves_[axis], model.turn_on_biases_[axis])
     lag, hyst, g_row, g_sq = 0.0, None, None, None
     if thermal is not None:
         lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
@@ -666,9 +666,9 @@ def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[Pose
         curve = None if name not in axes else axes[name].temperature
         if not isinstance(curve, PolynomialBias):
             return fit_accel_multiposition(poses), accel_cal  # a network cannot take the slope: K constant
-        coefficients = list(curve.coefficients_dps) or [0.0]
+        coefficients = list(curve.coefficients) or [0.0]
         coefficients[0] += slope[j] * curve.t_scale_degc
-        axes[name] = dataclasses.replace(axes[name], temperature=dataclasses.replace(curve, coefficients_dps=tuple(coefficients)))
+        axes[name] = dataclasses.replace(axes[name], temperature=dataclasses.replace(curve, coefficients=tuple(coefficients)))
     bias = np.asarray(triad.bias) + slope * (accel_cal.accel_reference_degc - t_six)
     fit = dataclasses.replace(fit, calibration=dataclasses.replace(triad, bias=tuple(float(b) for b in bias)))
     return fit, dataclasses.replace(accel_cal, accel_axes=axes)

@@ -258,7 +258,7 @@ def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: 
         kind = "runs" if n_groups >= MIN_FOLDS else "legs"
     if kind == "runs":
         ids = sorted(set(groups))
-        return Folds("runs", tuple(np.full(r.value_dps.size, ids.index(g)) for r, g in zip(runs, groups)),
+        return Folds("runs", tuple(np.full(r.value.size, ids.index(g)) for r, g in zip(runs, groups)),
                      tuple(f"run {g + 1}" for g in ids))
     legs, names = [], []
     for k, (run, threshold) in enumerate(zip(runs, thresholds_degc)):
@@ -272,7 +272,7 @@ def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: 
     per_run = max(BLOCKS_PER_RUN, math.ceil(MIN_FOLDS / len(runs)))
     of_block, names = [], []
     for k, run in enumerate(runs):
-        of_block.append(_split_long(np.zeros(run.value_dps.size), per_run) + k * per_run)
+        of_block.append(_split_long(np.zeros(run.value.size), per_run) + k * per_run)
         names += [f"run {k + 1} block {j + 1}" for j in range(per_run)]
     return Folds("blocks", tuple(of_block), tuple(names))
 
@@ -428,7 +428,7 @@ class SelectionProblem:
         t_hi = np.full((len(self.runs), n_folds), -np.inf)
         for k, (temp, cols) in enumerate(prepared):
             g = group_ids.index(self.groups[k])
-            z = np.hstack([cols, self.runs[k].value_dps[:, None]])
+            z = np.hstack([cols, self.runs[k].value[:, None]])
             w = self.weights(k, weighting)
             fold = self.folds.of_block[k]
             for f in np.unique(fold):
@@ -482,7 +482,7 @@ class SelectionProblem:
                 u = (np.clip(t, lo, hi) - self.t_ref_degc) / self.t_scale_degc
                 x = x.copy()
                 x[:, : c.order] = polynomial_columns(u, c.order, (t - self.t_ref_degc) / self.t_scale_degc - u)
-            e = self.runs[k].value_dps[sel] - (x @ coef if idx.size else 0.0)
+            e = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
             w = self.runs[k].samples[sel].astype(float)
             s, n = drift_rms(e, w, window)
             sse += s
@@ -712,7 +712,7 @@ def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: li
         onehot = np.zeros((u.size, len(group_ids)))
         onehot[:, group_ids.index(g)] = 1.0
         rows.append(np.hstack([onehot, u[:, None] ** np.arange(1, order + 1)]))
-        ys.append(r.value_dps)
+        ys.append(r.value)
         ws.append(np.sqrt(r.samples.astype(float)))
     x, y, w = np.vstack(rows), np.concatenate(ys), np.concatenate(ws)
     coef, *_ = np.linalg.lstsq(x * w[:, None], y * w, rcond=None)

@@ -33,9 +33,11 @@ EXTRAPOLATIONS = ("hold", "linear")
 
 @dataclass(frozen=True)
 class PolynomialBias:
-    """Fitted temperature shape of one axis's bias, without its turn-on constant.
+    """Fitted temperature shape of one axis's bias, without its turn-on constant, in the axis's unit (deg/s for a
+    gyro axis, g for an accelerometer axis: :attr:`gyrocomp.calibration.AxisCalibration.unit`; the model file
+    names the coefficients ``coefficients_dps`` or ``coefficients_g``).
 
-    bias(T) = sum_k coefficients_dps[k-1] * u^k,  u = (clip(T, t_min_degc, t_max_degc) - t_ref_degc) / t_scale_degc
+    bias(T) = sum_k coefficients[k-1] * u^k,  u = (clip(T, t_min_degc, t_max_degc) - t_ref_degc) / t_scale_degc
 
     Past the fitted range the curve is held at its edge (``extrapolation="hold"``, what PX4 and ArduPilot do),
     or continued along its tangent there (``"linear"``): bias(T) = bias(T_e) + bias'(T_e) (T - T_e), T_e the
@@ -43,7 +45,7 @@ class PolynomialBias:
     of higher order extrapolated as such diverges; the tangent is the first-order Taylor extension.
     """
 
-    coefficients_dps: tuple[float, ...]
+    coefficients: tuple[float, ...]
     t_ref_degc: float
     t_scale_degc: float
     t_min_degc: float
@@ -56,7 +58,7 @@ class PolynomialBias:
 
     @property
     def order(self) -> int:
-        return len(self.coefficients_dps)
+        return len(self.coefficients)
 
     @property
     def range_tolerance_degc(self) -> float:
@@ -70,12 +72,13 @@ class PolynomialBias:
         tol = self.range_tolerance_degc
         return bool(np.any(t < self.t_min_degc - tol) or np.any(t > self.t_max_degc + tol))
 
-    def shape_dps(self, temperature_degc: np.ndarray) -> np.ndarray:
-        """Bias shape [deg/s] at ``temperature_degc`` [degC]; past the range held or extended (``extrapolation``)."""
+    def shape(self, temperature_degc: np.ndarray) -> np.ndarray:
+        """Bias shape [the axis's unit] at ``temperature_degc`` [degC]; past the range held or extended
+        (``extrapolation``)."""
         t = np.asarray(temperature_degc, dtype=float)
         u = (np.clip(t, self.t_min_degc, self.t_max_degc) - self.t_ref_degc) / self.t_scale_degc
         # Horner's rule (as polynomial_columns @ coefficients, without building the columns)
-        coefficients = [0.0, *map(float, self.coefficients_dps)]
+        coefficients = [0.0, *map(float, self.coefficients)]
         value = horner(u, coefficients)
         beyond = self.extrapolation_u(t, u)
         if beyond is not None and self.order:
@@ -91,7 +94,7 @@ class PolynomialBias:
     def to_dict(self) -> dict[str, Any]:
         d = {
             "type": "polynomial",
-            "coefficients_dps": list(self.coefficients_dps),
+            "coefficients_dps": list(self.coefficients),
             "t_ref_degc": self.t_ref_degc,
             "t_scale_degc": self.t_scale_degc,
             "t_min_degc": self.t_min_degc,
@@ -226,8 +229,8 @@ class PolynomialTemperatureModel:
     --------------------------
     curves_ : dict[str, PolynomialBias]
         The fitted shape of each axis.
-    turn_on_biases_dps_ : dict[str, np.ndarray]
-        The fitted constant of each run [deg/s], per axis.
+    turn_on_biases_ : dict[str, np.ndarray]
+        The fitted constant of each run [deg/s; g for an accelerometer's axes], per axis.
     scores_ : dict[str, dict[int, float]]
         Per axis, the selection score of each order tried (CV RMS [deg/s], or BIC).
     selection_ : str
@@ -258,7 +261,7 @@ class PolynomialTemperatureModel:
                     f"{rec.source}: {kind} axes {', '.join(fit_axes([rec]))} differ from "
                     f"{recordings[0].source}'s ({', '.join(axes)}); fit runs of the same sensor together"
                 )
-        self.curves_, self.turn_on_biases_dps_, self.scores_, self.fit_rms_dps_ = {}, {}, {}, {}
+        self.curves_, self.turn_on_biases_, self.scores_, self.fit_rms_dps_ = {}, {}, {}, {}
         for axis in axes:
             temps = [rec.temperature_for(axis) for rec in recordings]
             values = [rec.signal(axis) for rec in recordings]
@@ -277,7 +280,7 @@ class PolynomialTemperatureModel:
             shape, consts, rss = _solve(design, order, np.arange(len(recordings)))
             self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), design.t_ref, design.t_scale,
                                                 t_min, t_max)
-            self.turn_on_biases_dps_[axis] = consts
+            self.turn_on_biases_[axis] = consts
             self.fit_rms_dps_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))
         self._fitted = True
         return self
@@ -315,5 +318,5 @@ class PolynomialTemperatureModel:
         cols = []
         for axis in recording.gyro_axes:
             curve = self.curves_[axis]
-            cols.append(curve.shape_dps(recording.temperature_for(axis)) + self.turn_on_biases_dps_[axis].mean())
+            cols.append(curve.shape(recording.temperature_for(axis)) + self.turn_on_biases_[axis].mean())
         return np.column_stack(cols)

@@ -145,7 +145,7 @@ class _Problem:
             feats.append(self.features(self.runs[which[k]], temp, spec, t_lo, t_hi))
             onehots.append(oh)
         x = np.hstack([np.vstack(onehots), np.vstack(feats)])
-        y = np.concatenate([self.runs[r].value_dps for r in which])
+        y = np.concatenate([self.runs[r].value for r in which])
         w = np.concatenate([self.runs[r].weight for r in which])
         return x, y, w, (t_lo, t_hi)
 
@@ -181,7 +181,7 @@ class _Problem:
             tau, (coef, _, _, (t_lo, t_hi)) = self.fit(spec, train)
             run = self.runs[held]
             x = self.features(run, self.model_temperature(run, spec, tau), spec, t_lo, t_hi)
-            e = run.value_dps - x @ coef
+            e = run.value - x @ coef
             e -= np.sum(run.weight * e) / np.sum(run.weight)
             w = max(1, min(e.size, int(round(SCORE_WINDOW_S / self.block_s))))
             kernel = np.ones(w) / w
@@ -203,7 +203,7 @@ class _Problem:
         temps, resid, after, rising = [], [], [], []
         for k, run in enumerate(self.runs):
             t = run.temperature_degc
-            e = run.value_dps - self.features(run, t, spec, t_lo, t_hi) @ coef - consts[k]
+            e = run.value - self.features(run, t, spec, t_lo, t_hi) @ coef - consts[k]
             turns = find_turns(t, self.threshold)
             temps.append(t)
             resid.append(e)
@@ -217,7 +217,7 @@ class _Problem:
         segment is correlated (flicker) while different positions are close to independent."""
         n = len(self.runs)
         x, y, w, _ = self.design(spec, tau, list(range(n)))
-        clusters = np.concatenate([run.cluster * n + k if run.cluster is not None else np.full(run.value_dps.size, k)
+        clusters = np.concatenate([run.cluster * n + k if run.cluster is not None else np.full(run.value.size, k)
                                    for k, run in enumerate(self.runs)])
         xtw = x.T * w
         bread = np.linalg.pinv(xtw @ x)
@@ -234,7 +234,7 @@ class _Problem:
 
     def bic(self, spec: _Spec) -> float:
         _, (coef, consts, rss, _) = self.fit(spec, list(range(len(self.runs))))
-        n = sum(r.value_dps.size for r in self.runs)
+        n = sum(r.value.size for r in self.runs)
         w = sum(float(np.sum(r.weight)) for r in self.runs)
         k = coef.size + consts.size + (1 if spec.lag else 0)
         return n * math.log(max(rss / w, 1e-300)) + k * math.log(n)
@@ -295,7 +295,7 @@ class ThermalHysteresisModel:
     lag_time_constants_s_ : dict[str, float]
         Fitted thermal time constant per axis [s], 0 without lag.
     hysteresis_ : dict[str, HysteresisCurve or None]
-    turn_on_biases_dps_ : dict[str, np.ndarray]
+    turn_on_biases_ : dict[str, np.ndarray]
     memories_ : dict[str, (str, int)]
         The candidate kept per axis: its memory (``none``, ``lag``, ``turning-point``, ``turning-point+lag``) and
         turning-point order (in words: :func:`gyrocomp.fit_report.memory_label`).
@@ -350,7 +350,7 @@ class ThermalHysteresisModel:
             recordings = [recordings]
         self._check_settings()
         self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
-        self.turn_on_biases_dps_, self.scores_, self.order_scores_ = {}, {}, {}
+        self.turn_on_biases_, self.scores_, self.order_scores_ = {}, {}, {}
         self.memories_ = {}
         self.bands_ = {}
         self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
@@ -480,7 +480,7 @@ class ThermalHysteresisModel:
             tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), problem.threshold, problem.band,
             problem.branch_reach(spec, tau))
         self.bands_[axis] = problem.band
-        self.turn_on_biases_dps_[axis] = consts
+        self.turn_on_biases_[axis] = consts
         self.memories_[axis] = (choice.name, p)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
