@@ -29,7 +29,8 @@ import numpy as np
 
 from .errors import InputError
 from .recording import ACCEL_AXES, Recording
-from .static import DEFAULT_FACTOR, DEFAULT_MIN_DURATION_S, DEFAULT_WINDOW_S, StaticSegment, segments_from_mask, still_mask
+from .static import (DEFAULT_FACTOR, DEFAULT_MIN_DURATION_S, DEFAULT_WINDOW_S, StaticSegment, segments_from_mask,
+                     still_mask)
 
 
 #: what a fit models: the gyro's axes or the accelerometer's

@@ -36,7 +36,8 @@ from the bias curve, and a slower ramp only gives the drift longer to grow. A ru
 cold) sees each temperature at different times, which tells the two apart: over the middle third of the range in a
 quarter of the chamber time, two round trips instead of one ramp take the held-out drift relative to a full
 calibration from 2.8x to 1.9x (median of 40 simulated units in ``benchmarks/bench_prior.py``; the same as with the
-simulator's true population as the prior, :func:`prior_from_models`). :func:`fit_with_prior` warns when no run comes back.
+simulator's true population as the prior, :func:`prior_from_models`). :func:`fit_with_prior` warns when no run
+comes back.
 
 C. N. Morris, *Parametric empirical Bayes inference: theory and applications*, JASA 78 (381), 1983, 47-55;
 A. Gelman et al., *Bayesian Data Analysis*, 3rd ed., ch. 5 (hierarchical models), 2013;

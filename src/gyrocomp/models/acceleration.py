@@ -76,7 +76,8 @@ def fit_acceleration_network(recordings: list[Recording], *, hidden: tuple[int, 
         t_in, y_in, w_in, a_in = [], [], [], []
         for rec, segs in zip(recordings, segments):
             pieces = [slice(g.start, g.stop) for g in segs] or None
-            blocks = PreparedRun.of(rec).block_means(axis, NETWORK_BLOCK_S, math.inf, pieces)  # one temperature bin: equal weights
+            # one temperature bin: equal weights
+            blocks = PreparedRun.of(rec).block_means(axis, NETWORK_BLOCK_S, math.inf, pieces)
             t_in.append(blocks.temperature_degc)
             y_in.append(blocks.value)
             w_in.append(blocks.weight)

@@ -282,7 +282,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     if network is not None:
         report["temperature"] = "mlp"
         report["network"] = NetworkReport(
-            tuple(hidden), network.restarts, network.seed, "Levenberg-Marquardt, early stopping on 20 % held-out segments",
+            tuple(hidden), network.restarts, network.seed,
+            "Levenberg-Marquardt, early stopping on 20 % held-out segments",
             {a: tuple(network.validation_rmse_dps_[a]) for a in network.curves_},
             {a: network.epochs_[a] for a in network.curves_}).to_dict()
     name = _model_name(axes, network, network_inputs, temperature, thermal, accel_mode)
@@ -668,7 +669,8 @@ def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[Pose
             return fit_accel_multiposition(poses), accel_cal  # a network cannot take the slope: K constant
         coefficients = list(curve.coefficients) or [0.0]
         coefficients[0] += slope[j] * curve.t_scale_degc
-        axes[name] = dataclasses.replace(axes[name], temperature=dataclasses.replace(curve, coefficients=tuple(coefficients)))
+        axes[name] = dataclasses.replace(axes[name],
+                                         temperature=dataclasses.replace(curve, coefficients=tuple(coefficients)))
     bias = np.asarray(triad.bias) + slope * (accel_cal.accel_reference_degc - t_six)
     fit = dataclasses.replace(fit, calibration=dataclasses.replace(triad, bias=tuple(float(b) for b in bias)))
     return fit, dataclasses.replace(accel_cal, accel_axes=axes)

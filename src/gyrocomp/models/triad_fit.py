@@ -121,7 +121,8 @@ def find_poses(recording: Recording, *, ranges: list[tuple[int, int]] | None = N
         raise InputError(f"{recording.source}: a multi-position calibration needs the three accelerometer axes "
                          "(accel_x, accel_y, accel_z)")
     if ranges is None:
-        segs = PreparedRun.of(recording).static_segments(window_s=window_s, min_duration_s=min_duration_s, factor=factor)
+        segs = PreparedRun.of(recording).static_segments(window_s=window_s, min_duration_s=min_duration_s,
+                                                         factor=factor)
         ranges = [(s.start, s.stop) for s in segs]
     out = []
     for start, stop in ranges:
