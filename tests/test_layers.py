@@ -17,12 +17,13 @@ LAYERS = (
     ("io", ("io",)),
     # files read in chunks and analysed as they come
     ("files", ("noise_file",)),
-    # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve) live beside the
-    # estimators of the same curve; neither imports anything above this layer
+    # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve); their estimators are
+    # in the fitting layer (models.polynomial_fit, models.mlp_fit)
     ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),
     ("calibration", ("calibration", "fit_report", "triad", "installed")),
     ("compensate", ("compensate",)),
     ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration", "models.online",
+                 "models.polynomial_fit", "models.mlp_fit",
                  "models.triad_fit", "models.pose_rotation")),
     ("pipelines", ("models.pipelines", "models")),
     ("evaluation", ("evaluation", "comparison", "validation")),

@@ -11,7 +11,7 @@ from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureR
 from gyrocomp.metrics import default_window_s, smoothed_residual_rms
 from gyrocomp.models.base import bin_by_temperature
 from gyrocomp.cli.common import parse_temperature_option
-from gyrocomp.models.temperature import PolynomialTemperatureModel, simplest_within
+from gyrocomp.models.polynomial_fit import PolynomialTemperatureModel, simplest_within
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import GyroErrorModel, simulate
 

@@ -9,6 +9,7 @@
   :class:`gyrocomp.calibration.Calibration` out.
 """
 
-from .temperature import PolynomialBias, PolynomialTemperatureModel
+from .polynomial_fit import PolynomialTemperatureModel
+from .temperature import PolynomialBias
 
 __all__ = ["PolynomialBias", "PolynomialTemperatureModel"]

@@ -22,7 +22,8 @@ from ..recording import Recording
 from ..prepared import PreparedRun
 from .base import provenance
 from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, turned_between_positions
-from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S, MLPTemperatureModel
+from .mlp import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S
+from .mlp_fit import MLPTemperatureModel
 from .thermal import ThermalHysteresisModel
 
 def _listed(values: np.ndarray) -> tuple:

@@ -30,9 +30,11 @@ from .acceleration import (
 from .base import bin_width_for, one_temperature_column, provenance
 from .hysteresis import heats_and_cools
 from .pose_rotation import TooFewTurns, fit_gyro_between_poses
-from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS, MLPTemperatureModel
+from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS
+from .mlp_fit import MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
-from .temperature import MAX_ORDER, PolynomialBias, PolynomialTemperatureModel
+from .polynomial_fit import PolynomialTemperatureModel
+from .temperature import MAX_ORDER, PolynomialBias
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
 from .options import FitOptions, Network, Polynomial, legacy_temperature

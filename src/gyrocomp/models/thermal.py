@@ -38,7 +38,8 @@ from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from ..prepared import PreparedRun, RunBlocks, fit_axes
 from .base import bin_width_for, one_temperature_column
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
-from .temperature import PolynomialBias, simplest_within
+from .polynomial_fit import simplest_within
+from .temperature import PolynomialBias
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
 CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag")
