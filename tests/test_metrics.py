@@ -8,7 +8,6 @@ from hypothesis import strategies as st
 from gyrocomp.errors import InputError
 from gyrocomp.metrics import (
     BIAS_INSTABILITY_FACTOR,
-    AccelAxisMetrics,
     AxisMetrics,
     bias_instability,
     bias_offset,
@@ -90,18 +89,26 @@ def test_runs_with_gaps_pool_the_allan_sums_over_their_stretches():
     assert ev.axes["gyro_x"].integration_time_raw_s <= max(s.stop - s.start for s in stretches) / rec.rate_hz
 
 
-@pytest.mark.parametrize("cls, unit, bi_unit", [(AxisMetrics, "deg/s", "deg/h"), (AccelAxisMetrics, "g", "ug")])
-def test_gyro_and_accelerometer_figures_read_alike_in_their_units(cls, unit, bi_unit):
-    """The neutral names tables use read each sensor's own fields (distinct values, so a swap would show)."""
-    names = [f.name for f in dataclasses.fields(cls)]
-    figures = cls(*[float(k + 1) for k in range(len(names))])
-    by_name = dict(zip(names, range(1, len(names) + 1)))
-    suffix, bi = ("dps", "dph") if cls is AxisMetrics else ("g", "ug")
+@pytest.mark.parametrize(("unit", "bi_unit", "suffix", "bi", "other"), [("deg/s", "deg/h", "dps", "dph", "g"),
+                                                                    ("g", "ug", "g", "ug", "dps")])
+def test_one_figures_class_reads_each_figure_under_its_units_name(unit, bi_unit, suffix, bi, other):
+    """Gyro and accelerometer figures are one class with a unit: the names that carry a unit read the axis's own
+    figures (distinct values, so a swap would show) and refuse the other unit's; the JSON writes those names."""
+    names = [f.name for f in dataclasses.fields(AxisMetrics) if f.name != "unit"]
+    figures = AxisMetrics(unit, *[float(k + 1) for k in range(len(names))])
+    value = dict(zip(names, range(1, len(names) + 1)))
     assert (figures.unit, figures.bias_instability_unit) == (unit, bi_unit)
-    assert figures.offset_raw == by_name[f"bias_offset_raw_{suffix}"]
-    assert figures.offset_comp == by_name[f"bias_offset_comp_{suffix}"]
-    assert figures.bias_instability_raw == by_name[f"bias_instability_raw_{bi}"]
-    assert figures.bias_instability_comp == by_name[f"bias_instability_comp_{bi}"]
-    assert figures.residual_rms == by_name[f"residual_rms_{suffix}"]
-    assert set(dataclasses.asdict(figures)) == set(names)  # the JSON keeps the unit-named fields only
+    assert getattr(figures, f"bias_offset_raw_{suffix}") == value["offset_raw"]
+    assert getattr(figures, f"bias_offset_comp_{suffix}") == value["offset_comp"]
+    assert getattr(figures, f"bias_instability_raw_{bi}") == value["bias_instability_raw"]
+    assert getattr(figures, f"bias_instability_comp_{bi}") == value["bias_instability_comp"]
+    assert getattr(figures, f"residual_rms_{suffix}") == value["residual_rms"]
+    with pytest.raises(InputError, match=rf"bias_offset_raw_{other}: the axis's figures are in {unit}, not "):
+        getattr(figures, f"bias_offset_raw_{other}")
+    assert figures.to_dict() == {
+        f"bias_offset_raw_{suffix}": 1.0, f"bias_offset_comp_{suffix}": 2.0, "offset_improvement": 3.0,
+        f"bias_instability_raw_{bi}": 4.0, f"bias_instability_comp_{bi}": 5.0, "integration_time_raw_s": 6.0,
+        "integration_time_comp_s": 7.0, f"residual_rms_{suffix}": 8.0}
+    with pytest.raises(InputError, match=r"unit: 'rad/s'; figures are in one of deg/s, g"):
+        AxisMetrics("rad/s", *[1.0] * len(names))
 

@@ -190,8 +190,9 @@ def _same_evaluation(chunked, whole):
     assert list(a.axes) == list(b.axes) and list(a.accel_axes) == list(b.accel_axes)
     for mine, theirs in [(a.axes[k], b.axes[k]) for k in a.axes] + [(a.accel_axes[k], b.accel_axes[k])
                                                                      for k in a.accel_axes]:
-        for key, value in vars(mine).items():
-            assert value == pytest.approx(vars(theirs)[key], rel=1e-8), key
+        assert mine.unit == theirs.unit
+        for key, value in mine.to_dict().items():
+            assert value == pytest.approx(theirs.to_dict()[key], rel=1e-8), key
 
 
 @pytest.mark.parametrize("suffix", ["csv", "parquet"])

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -105,7 +105,7 @@ class StageEvaluation:
 
     def to_dict(self) -> dict:
         return {"file": self.file, "window_s": self.window_s,
-                "stages": {name: {a: asdict(m) for a, m in axes.items()} for name, axes in self.stages.items()}}
+                "stages": {name: {a: m.to_dict() for a, m in axes.items()} for name, axes in self.stages.items()}}
 
 
 def stage_calibrations(calibration) -> dict:

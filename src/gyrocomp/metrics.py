@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import asdict, dataclass, field
-from typing import ClassVar, Literal
+from dataclasses import dataclass, field, fields
+from typing import Literal
 
 import numpy as np
 
@@ -70,72 +70,69 @@ def default_window_s(recording: Recording) -> float:
     return max(MIN_WINDOW_S, max(taus))
 
 
-class FiguresInUnits:
-    """The figures of an axis under neutral names, in the units ``unit`` (offsets, residual) and
-    ``bias_instability_unit`` say, for tables that show gyro and accelerometer axes alike."""
+#: the unit of an axis's bias instability, by the unit of its values
+BIAS_INSTABILITY_UNITS = {"deg/s": "deg/h", "g": "ug"}
+#: each figure under the name that says its unit, for a gyro axis and for an accelerometer axis
+_NAMED = {"offset_raw": ("bias_offset_raw_dps", "bias_offset_raw_g"),
+          "offset_comp": ("bias_offset_comp_dps", "bias_offset_comp_g"),
+          "bias_instability_raw": ("bias_instability_raw_dph", "bias_instability_raw_ug"),
+          "bias_instability_comp": ("bias_instability_comp_dph", "bias_instability_comp_ug"),
+          "residual_rms": ("residual_rms_dps", "residual_rms_g")}
 
-    unit: ClassVar[str]
-    bias_instability_unit: ClassVar[str]
-    _names: ClassVar[tuple[str, str, str, str, str]]  # offset raw, offset comp, BI raw, BI comp, residual
 
-    @property
-    def offset_raw(self) -> float:
-        return getattr(self, self._names[0])
+def _in_unit(name: str, unit: str) -> property:
+    """A figure read under the name of its unit, refusing an axis of the other unit."""
+    named = _NAMED[name][0 if unit == "deg/s" else 1]
 
-    @property
-    def offset_comp(self) -> float:
-        return getattr(self, self._names[1])
-
-    @property
-    def bias_instability_raw(self) -> float:
-        return getattr(self, self._names[2])
-
-    @property
-    def bias_instability_comp(self) -> float:
-        return getattr(self, self._names[3])
-
-    @property
-    def residual_rms(self) -> float:
-        return getattr(self, self._names[4])
+    def get(self: "AxisMetrics") -> float:
+        if self.unit != unit:
+            raise InputError(f"{named}: the axis's figures are in {self.unit}, not {unit}; read {name}")
+        return getattr(self, name)
+    return property(get, doc=f"``{name}`` of an axis in {unit}.")
 
 
 @dataclass(frozen=True)
-class AxisMetrics(FiguresInUnits):
-    """Raw and compensated figures of one gyro axis over one run."""
+class AxisMetrics:
+    """Raw and compensated figures of one axis over one run, in the axis's unit: ``unit`` for the offsets and the
+    residual (deg/s for a gyro axis, g for an accelerometer axis, whose moving average follows gravity when the
+    unit is turned: a static run), ``bias_instability_unit`` for the bias instability (deg/h or ug). The names
+    that carry a unit (``bias_offset_raw_dps`` ... for a gyro axis, ``bias_offset_raw_g`` ... for an
+    accelerometer's) refuse the other, and :meth:`to_dict` writes the figures under them."""
 
-    unit: ClassVar[str] = "deg/s"
-    bias_instability_unit: ClassVar[str] = "deg/h"
-    _names: ClassVar[tuple[str, ...]] = ("bias_offset_raw_dps", "bias_offset_comp_dps", "bias_instability_raw_dph",
-                                         "bias_instability_comp_dph", "residual_rms_dps")
-
-    bias_offset_raw_dps: float
-    bias_offset_comp_dps: float
+    unit: str
+    offset_raw: float
+    offset_comp: float
     offset_improvement: float
-    bias_instability_raw_dph: float
-    bias_instability_comp_dph: float
+    bias_instability_raw: float
+    bias_instability_comp: float
     integration_time_raw_s: float
     integration_time_comp_s: float
-    residual_rms_dps: float
+    residual_rms: float
 
+    def __post_init__(self) -> None:
+        if self.unit not in BIAS_INSTABILITY_UNITS:
+            raise InputError(f"unit: {self.unit!r}; figures are in one of {', '.join(BIAS_INSTABILITY_UNITS)}")
 
-@dataclass(frozen=True)
-class AccelAxisMetrics(FiguresInUnits):
-    """Raw and compensated figures of one accelerometer axis over one run (a static run: the moving average
-    of a unit being turned follows gravity, not the bias)."""
+    @property
+    def bias_instability_unit(self) -> str:
+        return BIAS_INSTABILITY_UNITS[self.unit]
 
-    unit: ClassVar[str] = "g"
-    bias_instability_unit: ClassVar[str] = "ug"
-    _names: ClassVar[tuple[str, ...]] = ("bias_offset_raw_g", "bias_offset_comp_g", "bias_instability_raw_ug",
-                                         "bias_instability_comp_ug", "residual_rms_g")
+    def to_dict(self) -> dict[str, float]:
+        """The figures under the names that say their units (``bias_offset_raw_dps`` ..., or ``..._g``)."""
+        column = 0 if self.unit == "deg/s" else 1
+        return {(_NAMED[f.name][column] if f.name in _NAMED else f.name): getattr(self, f.name)
+                for f in fields(self) if f.name != "unit"}
 
-    bias_offset_raw_g: float
-    bias_offset_comp_g: float
-    offset_improvement: float
-    bias_instability_raw_ug: float
-    bias_instability_comp_ug: float
-    integration_time_raw_s: float
-    integration_time_comp_s: float
-    residual_rms_g: float
+    bias_offset_raw_dps = _in_unit("offset_raw", "deg/s")
+    bias_offset_comp_dps = _in_unit("offset_comp", "deg/s")
+    bias_instability_raw_dph = _in_unit("bias_instability_raw", "deg/s")
+    bias_instability_comp_dph = _in_unit("bias_instability_comp", "deg/s")
+    residual_rms_dps = _in_unit("residual_rms", "deg/s")
+    bias_offset_raw_g = _in_unit("offset_raw", "g")
+    bias_offset_comp_g = _in_unit("offset_comp", "g")
+    bias_instability_raw_ug = _in_unit("bias_instability_raw", "g")
+    bias_instability_comp_ug = _in_unit("bias_instability_comp", "g")
+    residual_rms_g = _in_unit("residual_rms", "g")
 
 
 @dataclass(frozen=True)
@@ -146,13 +143,13 @@ class RunEvaluation:
     file: str
     window_s: float
     axes: dict[str, AxisMetrics]
-    accel_axes: dict[str, AccelAxisMetrics] = field(default_factory=dict)
+    accel_axes: dict[str, AxisMetrics] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         out = {"file": self.file, "window_s": self.window_s,
-               "axes": {name: asdict(m) for name, m in self.axes.items()}}
+               "axes": {name: m.to_dict() for name, m in self.axes.items()}}
         if self.accel_axes:
-            out["accel_axes"] = {name: asdict(m) for name, m in self.accel_axes.items()}
+            out["accel_axes"] = {name: m.to_dict() for name, m in self.accel_axes.items()}
         return out
 
 
@@ -298,21 +295,21 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
     return _run_evaluation(raw.source, window_s, gyro, accel_figures)
 
 
+def _axis_metrics(f: _Figures, unit: str, to_bias_instability: float) -> AxisMetrics:
+    """One axis's figures in its unit; ``to_bias_instability`` turns the Allan minimum into the bias instability
+    in its unit (deg/h or ug)."""
+    return AxisMetrics(unit, f.offset_raw, f.offset_comp, f.improvement, f.allan_min_raw * to_bias_instability,
+                       f.allan_min_comp * to_bias_instability, f.integration_time_raw_s, f.integration_time_comp_s,
+                       f.residual_rms)
+
+
 def _run_evaluation(source: str, window_s: float, gyro: dict[str, _Figures],
                     accel: dict[str, _Figures]) -> RunEvaluation:
     """The figures of each axis in their quoted units: gyro [deg/s, deg/h], accelerometer [g, ug]."""
     to_dph = DEG_PER_S_TO_DEG_PER_H / BIAS_INSTABILITY_FACTOR
     to_ug = 1e6 / BIAS_INSTABILITY_FACTOR
-    axes = {axis: AxisMetrics(
-        bias_offset_raw_dps=f.offset_raw, bias_offset_comp_dps=f.offset_comp, offset_improvement=f.improvement,
-        bias_instability_raw_dph=f.allan_min_raw * to_dph, bias_instability_comp_dph=f.allan_min_comp * to_dph,
-        integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
-        residual_rms_dps=f.residual_rms) for axis, f in gyro.items()}
-    accel_axes = {axis: AccelAxisMetrics(
-        bias_offset_raw_g=f.offset_raw, bias_offset_comp_g=f.offset_comp, offset_improvement=f.improvement,
-        bias_instability_raw_ug=f.allan_min_raw * to_ug, bias_instability_comp_ug=f.allan_min_comp * to_ug,
-        integration_time_raw_s=f.integration_time_raw_s, integration_time_comp_s=f.integration_time_comp_s,
-        residual_rms_g=f.residual_rms) for axis, f in accel.items()}
+    axes = {axis: _axis_metrics(f, "deg/s", to_dph) for axis, f in gyro.items()}
+    accel_axes = {axis: _axis_metrics(f, "g", to_ug) for axis, f in accel.items()}
     return RunEvaluation(file=source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
 
 
