@@ -103,12 +103,13 @@ def test_one_figures_class_reads_each_figure_under_its_units_name(unit, bi_unit,
     assert getattr(figures, f"bias_instability_raw_{bi}") == value["bias_instability_raw"]
     assert getattr(figures, f"bias_instability_comp_{bi}") == value["bias_instability_comp"]
     assert getattr(figures, f"residual_rms_{suffix}") == value["residual_rms"]
-    with pytest.raises(InputError, match=rf"bias_offset_raw_{other}: the axis's figures are in {unit}, not "):
+    with pytest.raises(InputError, match=rf"bias_offset_raw_{other}: the axis's values are in {unit}, not .*; "
+                                         r"read offset_raw"):
         getattr(figures, f"bias_offset_raw_{other}")
     assert figures.to_dict() == {
         f"bias_offset_raw_{suffix}": 1.0, f"bias_offset_comp_{suffix}": 2.0, "offset_improvement": 3.0,
         f"bias_instability_raw_{bi}": 4.0, f"bias_instability_comp_{bi}": 5.0, "integration_time_raw_s": 6.0,
         "integration_time_comp_s": 7.0, f"residual_rms_{suffix}": 8.0}
-    with pytest.raises(InputError, match=r"unit: 'rad/s'; figures are in one of deg/s, g"):
+    with pytest.raises(InputError, match=r"unit: 'rad/s'; an axis is in one of deg/s, g"):
         AxisMetrics("rad/s", *[1.0] * len(names))
 

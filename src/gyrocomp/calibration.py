@@ -14,7 +14,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, get_args
+from typing import Any
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from .models.temperature import PolynomialBias
 from .models.hysteresis import HysteresisCurve
 from .recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
 from .triad import TriadCalibration
+from .units import AxisUnit, check_axis_unit, in_unit, require_unit
 
 FORMAT_NAME = "gyrocomp-calibration"
 SCHEMA_VERSION = 6
@@ -194,11 +195,6 @@ def _in_g(d: Any, to_g: bool) -> Any:
     return {renamed(k): _in_g(v, to_g) for k, v in d.items()}
 
 
-#: the unit of an axis's values: a gyro axis's [deg/s], an accelerometer axis's [g]
-Unit = Literal["deg/s", "g"]
-AXIS_UNITS: tuple[str, ...] = get_args(Unit)
-
-
 @dataclass(frozen=True)
 class AxisCalibration:
     """Everything known about one gyro axis, or (in ``Calibration.accel_axes``, ``unit="g"``) one accelerometer
@@ -236,28 +232,14 @@ class AxisCalibration:
     g_sensitivity_dps_per_g: tuple[float, float, float] | None = None
     g_squared_dps_per_g2: tuple[float, ...] | None = None
     acceleration_network: MLPBias | None = None
-    unit: Unit = "deg/s"
+    unit: AxisUnit = "deg/s"
 
     def __post_init__(self) -> None:
-        if self.unit not in AXIS_UNITS:
-            raise InputError(f"unit: {self.unit!r}; an axis is in one of {', '.join(AXIS_UNITS)}")
+        check_axis_unit(self.unit)
 
-    def _in(self, unit: str, name: str) -> None:
-        if self.unit != unit:
-            raise InputError(f"{name}: the axis's values are in {self.unit}, not {unit} (the unit-free names, "
-                             "turn_on_biases and mean_turn_on_bias, read either)")
-
-    @property
-    def turn_on_biases_dps(self) -> tuple[float, ...]:
-        """The turn-on constants of a gyro axis [deg/s]."""
-        self._in("deg/s", "turn_on_biases_dps")
-        return self.turn_on_biases
-
-    @property
-    def turn_on_biases_g(self) -> tuple[float, ...]:
-        """The turn-on constants of an accelerometer axis [g]."""
-        self._in("g", "turn_on_biases_g")
-        return self.turn_on_biases
+    #: the turn-on constants of a gyro axis [deg/s], of an accelerometer axis [g]
+    turn_on_biases_dps = in_unit("turn_on_biases", "deg/s", "turn_on_biases_dps")
+    turn_on_biases_g = in_unit("turn_on_biases", "g", "turn_on_biases_g")
 
     @property
     def has_acceleration_stage(self) -> bool:
@@ -280,15 +262,12 @@ class AxisCalibration:
         """The constant subtracted when no turn-on window is given [unit]."""
         return float(np.mean(self.turn_on_biases))
 
-    @property
-    def mean_turn_on_bias_dps(self) -> float:
-        """The constant subtracted from a gyro axis when no turn-on window is given [deg/s]."""
-        self._in("deg/s", "mean_turn_on_bias_dps")
-        return self.mean_turn_on_bias
+    #: the constant subtracted from a gyro axis when no turn-on window is given [deg/s]
+    mean_turn_on_bias_dps = in_unit("mean_turn_on_bias", "deg/s", "mean_turn_on_bias_dps")
 
     def shape_dps(self, temperature_degc: np.ndarray | None) -> np.ndarray | float:
         """A gyro axis's bias shape at ``temperature_degc`` [deg/s]; 0 without a temperature model."""
-        self._in("deg/s", "shape_dps")
+        require_unit(self.unit, "deg/s", "shape_dps", "temperature.shape")
         if self.temperature is None:
             return 0.0
         return self.temperature.shape(temperature_degc)
@@ -306,7 +285,7 @@ class AxisCalibration:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], unit: Unit = "deg/s") -> "AxisCalibration":
+    def from_dict(cls, d: dict[str, Any], unit: AxisUnit = "deg/s") -> "AxisCalibration":
         temp = d.get("temperature")
         kinds = {"polynomial": PolynomialBias, "mlp": MLPBias}
         if temp is not None and temp.get("type") not in kinds:

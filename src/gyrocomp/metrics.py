@@ -24,7 +24,7 @@ from .effects import moving_average
 from .errors import DataQualityWarning, InputError
 from .plausibility import MAX_ACCEL_G, MAX_RATE_DPS
 from .recording import Recording
-from .units import DEG_PER_S_TO_DEG_PER_H
+from .units import AXIS_UNITS, DEG_PER_S_TO_DEG_PER_H, AxisUnit, check_axis_unit, in_unit
 
 MIN_WINDOW_S = 1.0
 
@@ -70,7 +70,7 @@ def default_window_s(recording: Recording) -> float:
     return max(MIN_WINDOW_S, max(taus))
 
 
-#: the unit of an axis's bias instability, by the unit of its values
+#: the unit of an axis's bias instability, by the unit of its values (:data:`gyrocomp.units.AXIS_UNITS`)
 BIAS_INSTABILITY_UNITS = {"deg/s": "deg/h", "g": "ug"}
 #: each figure under the name that says its unit, for a gyro axis and for an accelerometer axis
 _NAMED = {"offset_raw": ("bias_offset_raw_dps", "bias_offset_raw_g"),
@@ -81,14 +81,8 @@ _NAMED = {"offset_raw": ("bias_offset_raw_dps", "bias_offset_raw_g"),
 
 
 def _in_unit(name: str, unit: str) -> property:
-    """A figure read under the name of its unit, refusing an axis of the other unit."""
-    named = _NAMED[name][0 if unit == "deg/s" else 1]
-
-    def get(self: "AxisMetrics") -> float:
-        if self.unit != unit:
-            raise InputError(f"{named}: the axis's figures are in {self.unit}, not {unit}; read {name}")
-        return getattr(self, name)
-    return property(get, doc=f"``{name}`` of an axis in {unit}.")
+    """A figure read under the name of its unit (:data:`_NAMED`), refusing an axis of the other unit."""
+    return in_unit(name, unit, _NAMED[name][AXIS_UNITS.index(unit)])
 
 
 @dataclass(frozen=True)
@@ -99,7 +93,7 @@ class AxisMetrics:
     that carry a unit (``bias_offset_raw_dps`` ... for a gyro axis, ``bias_offset_raw_g`` ... for an
     accelerometer's) refuse the other, and :meth:`to_dict` writes the figures under them."""
 
-    unit: str
+    unit: AxisUnit
     offset_raw: float
     offset_comp: float
     offset_improvement: float
@@ -110,8 +104,7 @@ class AxisMetrics:
     residual_rms: float
 
     def __post_init__(self) -> None:
-        if self.unit not in BIAS_INSTABILITY_UNITS:
-            raise InputError(f"unit: {self.unit!r}; figures are in one of {', '.join(BIAS_INSTABILITY_UNITS)}")
+        check_axis_unit(self.unit)
 
     @property
     def bias_instability_unit(self) -> str:
@@ -119,7 +112,7 @@ class AxisMetrics:
 
     def to_dict(self) -> dict[str, float]:
         """The figures under the names that say their units (``bias_offset_raw_dps`` ..., or ``..._g``)."""
-        column = 0 if self.unit == "deg/s" else 1
+        column = AXIS_UNITS.index(self.unit)
         return {(_NAMED[f.name][column] if f.name in _NAMED else f.name): getattr(self, f.name)
                 for f in fields(self) if f.name != "unit"}
 

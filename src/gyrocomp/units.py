@@ -7,10 +7,38 @@ Readers and CLI options convert to these with the factors below; writers convert
 from __future__ import annotations
 
 import math
+from typing import Literal, get_args
 
 from .errors import InputError
 
 STANDARD_GRAVITY_M_PER_S2 = 9.80665  # [m/s^2], CGPM 1901
+
+#: the unit of an axis's values: a gyro axis's [deg/s], an accelerometer axis's [g]
+AxisUnit = Literal["deg/s", "g"]
+AXIS_UNITS: tuple[str, ...] = get_args(AxisUnit)
+
+
+def check_axis_unit(unit: str) -> None:
+    """Refuse a unit no axis is in (``unit`` is one of :data:`AXIS_UNITS`)."""
+    if unit not in AXIS_UNITS:
+        raise InputError(f"unit: {unit!r}; an axis is in one of {', '.join(AXIS_UNITS)}")
+
+
+def require_unit(actual: str, expected: str, name: str, neutral: str) -> None:
+    """Refuse to read ``name`` (a name that says its unit, ``expected``) of an axis in ``actual``; ``neutral`` is
+    the unit-free name that reads either."""
+    if actual != expected:
+        raise InputError(f"{name}: the axis's values are in {actual}, not {expected}; read {neutral}")
+
+
+def in_unit(neutral: str, unit: str, name: str) -> property:
+    """The attribute ``neutral`` of an object with a ``unit``, read under ``name``, the name that says ``unit``:
+    refused (:func:`require_unit`) for an object in the other unit."""
+    def get(self) -> object:
+        require_unit(self.unit, unit, name, neutral)
+        return getattr(self, neutral)
+    return property(get, doc=f"``{neutral}`` of an axis in {unit}.")
+
 
 #: multiply a value in the named unit by the factor to get [deg/s]
 GYRO_UNITS_TO_DPS = {
