@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from gyrocomp.allan import allan_deviation, noise_parameters
+from gyrocomp.models.options import Network, Polynomial
 
 from .conftest import DATASETS
 
@@ -17,9 +18,10 @@ CATS = DATASETS / "skdivemove-cats-tempcal"
 #: the three static periods of the CATS experiment [s since the file's start] (its README, from the package)
 CATS_PERIODS_S = ((480, 92460), (92880, 183780), (184920, 268020))
 #: the fit choices compared on the CATS runs: name -> fit_calibration options
-CATS_CHOICES = {"gyrocomp poly:3, no hysteresis": dict(temperature=3, hysteresis="none", acceleration="none"),
+CATS_CHOICES = {"gyrocomp poly:3, no hysteresis": dict(temperature=Polynomial(3), hysteresis="none",
+                                                      acceleration="none"),
                 "default (auto)": {}, "polynomial, order by CV, no hysteresis": dict(hysteresis="none"),
-                "network 1-3-1": dict(temperature="mlp")}
+                "network 1-3-1": dict(temperature=Network())}
 #: moving-average window of the held-out drift on the CATS runs [s]
 CATS_WINDOW_S = 600
 GALAXY = DATASETS / "skdivemove-galaxy-s5-static"

@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gyrocomp import Calibration, apply, fit_calibration
+from gyrocomp import Calibration, Polynomial, apply, fit_calibration
 from gyrocomp.calibration import SCHEMA_VERSION, AxisCalibration
 from gyrocomp.compensate import predict_error
 from gyrocomp.errors import DataQualityWarning, InputError
@@ -24,7 +24,7 @@ def calibration(tmp_path_factory):
         paths.append(path)
     from gyrocomp.io import read
 
-    return fit_calibration([read(p) for p in paths], temperature=2)
+    return fit_calibration([read(p) for p in paths], temperature=Polynomial(2))
 
 
 def test_json_round_trip_applies_identically(calibration, tmp_path):

@@ -6,7 +6,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply
+from gyrocomp import FitOptions, Polynomial, apply
 from gyrocomp.comparison import (
     ARDUPILOT_TEMP_REF_DEGC,
     DEFAULT_METHODS,
@@ -46,7 +46,8 @@ def test_leave_one_run_out_table_has_every_method_and_hysteresis_helps(cycles):
 
 
 def test_one_run_is_scored_on_itself_and_says_so(cycles):
-    result = compare_methods([cycles[0].recording], methods={"polynomial": {"temperature": 2, "hysteresis": "none"}},
+    result = compare_methods([cycles[0].recording], methods={"polynomial": FitOptions(temperature=Polynomial(2),
+                                                                                           hysteresis="none")},
                              window_s=100.0)
     assert "fitted and scored on the same run" in result.how
     assert [r.method for r in result.rows] == ["raw", "polynomial"]

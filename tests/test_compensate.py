@@ -5,13 +5,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import Calibration, Compensator, apply, fit_calibration, read
+from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration, read
 from gyrocomp.errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 
 SIM = simulate(duration_s=120, rate_hz=10, seed=5)
-CAL = fit_calibration([simulate(duration_s=600, rate_hz=10, seed=s).recording for s in (1, 2)], temperature=3)
+CAL = fit_calibration([simulate(duration_s=600, rate_hz=10, seed=s).recording for s in (1, 2)], temperature=Polynomial(3))
 
 
 def stream(rec, cuts, **kw):
@@ -69,7 +69,7 @@ def test_an_axis_the_model_lacks_is_refused_unless_the_axes_are_named():
     t = np.arange(600) / 10.0
     temp = np.linspace(10, 40, t.size)
     z_only = Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
-    cal_z = fit_calibration([z_only], temperature=1)
+    cal_z = fit_calibration([z_only], temperature=Polynomial(1))
     both = Recording(time_s=t, gyro_dps=np.column_stack([np.ones(t.size), 1e-3 * temp]),
                      gyro_axes=("gyro_x", "gyro_z"), temperature_degc=temp, source="both.csv")
     with pytest.raises(InputError, match=r"both.csv: the model has no curve for gyro_x \(it covers gyro_z\); "

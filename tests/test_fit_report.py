@@ -11,7 +11,7 @@ import pytest
 
 from gyrocomp.calibration import Calibration
 from gyrocomp.fit_report import MEMORIES, FitReport, MemoryChoice
-from gyrocomp.models.options import FitOptions, Network
+from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.models.pipelines import fit_calibration, fit_pipeline
 from gyrocomp.models.selection import Candidate
 from gyrocomp.simulate import simulate
@@ -109,7 +109,7 @@ def test_the_hysteresis_section_is_written_from_its_typed_record(how, chamber_ru
     else:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            cal = fit_calibration([sim.recording for sim in chamber_runs[:3]], temperature=2,
+            cal = fit_calibration([sim.recording for sim in chamber_runs[:3]], temperature=Polynomial(2),
                                   hysteresis="none" if how == "no memory asked for" else "lag")
     stored = cal.fit_report["hysteresis"]
     typed = cal.report.hysteresis
@@ -141,7 +141,7 @@ def test_the_acceleration_section_is_written_from_its_typed_record(mode):
             assert network.to_dict() == cal.fit_report["stages"][0]["network"] and network.hidden == (3,)
             assert set(network.validation_rmse_dps) == set(cal.axes) and network.restarts >= 1
         else:
-            cal = fit_calibration(runs, temperature=2, hysteresis="none", acceleration=mode)
+            cal = fit_calibration(runs, temperature=Polynomial(2), hysteresis="none", acceleration=mode)
             stored, typed = cal.fit_report["acceleration"], cal.report.acceleration
     assert typed.to_dict() == stored and typed.mode == mode
     if mode == "none":

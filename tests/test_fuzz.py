@@ -19,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import apply, fit_calibration
+from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout, read, read_table
@@ -89,7 +89,7 @@ def _model_and_run():
     run = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=3).recording
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        calibration = fit_calibration([run], temperature=2)
+        calibration = fit_calibration([run], temperature=Polynomial(2))
     return calibration.to_dict(), run
 
 

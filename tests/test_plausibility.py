@@ -6,7 +6,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply, comparison, fit_calibration, validation, write
+from gyrocomp import Polynomial, apply, comparison, fit_calibration, validation, write
 from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning
 from gyrocomp.plausibility import (
     CHECKS,
@@ -79,13 +79,13 @@ def test_a_curve_asked_for_on_runs_at_one_temperature():
     concern = temperature_span_concern([flat, flat])
     assert concern.check == "temperature-span" and "every run spans at most 0 degC" in concern.message
     with pytest.warns(PlausibilityWarning, match=r"every run spans at most 0 degC"):
-        fit_calibration([flat, flat], temperature=2)
+        fit_calibration([flat, flat], temperature=Polynomial(2))
 
 
 def test_fit_and_apply_warn_and_the_warning_can_be_silenced():
     kelvin = dataclasses.replace(RUN, temperature_degc=RUN.temperature_degc + 273.15)
     with pytest.warns(PlausibilityWarning, match=r"looks like kelvin"):
-        cal = fit_calibration([kelvin], temperature=2)
+        cal = fit_calibration([kelvin], temperature=Polynomial(2))
     with pytest.warns(PlausibilityWarning, match=r"looks like kelvin"):
         apply(cal, kelvin)
     assert issubclass(PlausibilityWarning, DataQualityWarning)
@@ -112,7 +112,7 @@ def test_one_check_is_silenced_by_its_name_and_the_others_still_speak():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         warnings.filterwarnings("ignore", message=silence_pattern("kelvin"), category=PlausibilityWarning)
-        fit_calibration([spinning], temperature=2)
+        fit_calibration([spinning], temperature=Polynomial(2))
     found = [w.message for w in caught if isinstance(w.message, PlausibilityWarning)]
     assert {w.check for w in found} == {"offset"} and len(found) == 3
     assert all(str(w).endswith("(check 'offset')") for w in found)

@@ -55,7 +55,7 @@ def test_apply_and_convert_of_a_table_do_not_load_pandas(tmp_path):
     """pyarrow imports pandas (a third of a second) the first time it converts to or from numpy its own way; the
     table readers and writers read and build the columns' buffers directly, nulls and whole numbers included."""
     rec = simulate_function("mti10", profile="chamber", rate_hz=1, duration_s=1800, seed=1).recording
-    gyrocomp.fit_calibration([rec], temperature=1, hysteresis="none").save(tmp_path / "model.json")
+    gyrocomp.fit_calibration([rec], temperature=gyrocomp.Polynomial(1), hysteresis="none").save(tmp_path / "model.json")
     gyrocomp.write(rec, tmp_path / "run.csv")
     lines = (tmp_path / "run.csv").read_text().splitlines()
     lines[0] += ",count"

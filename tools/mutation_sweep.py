@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gyrocomp import fit_calibration, write
+from gyrocomp import Polynomial, fit_calibration, write
 from gyrocomp.cli import main
 from gyrocomp.simulate import simulate
 
@@ -143,7 +143,7 @@ def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counte
     write(run, data)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model = fit_calibration([run], temperature=2).to_dict()
+        model = fit_calibration([run], temperature=Polynomial(2)).to_dict()
     counter = results.setdefault("model files (150 mutated)", collections.Counter())
     for k in range(150):
         path, out = work / f"model{k}.json", work / f"applied{k}.csv"

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -20,7 +20,8 @@ from .compensate import apply
 from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .metrics import default_window_s, evaluate_run, moving_average
 from .models.base import provenance
-from .models.pipelines import fit_calibration
+from .models.options import FitOptions, Network, Polynomial
+from .models.pipelines import fit_pipeline
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
 from .prepared import prepare
@@ -95,12 +96,15 @@ def fit_ardupilot_style(recordings: list[Recording]) -> Calibration:
 
     return _cubic_calibration(recordings, "ArduPilot cubic (tempcal_IMU.py)", fit_axis)
 
-#: the thesis's methods: name -> options of :func:`fit_calibration`
-THESIS_METHODS: dict[str, dict] = {
-    "polynomial": {"temperature": "auto", "hysteresis": "none"},
-    "polynomial + hysteresis": {"temperature": "auto", "hysteresis": "turning-point"},
-    "network": {"temperature": "mlp", "hysteresis": "none"},
-    "network + hysteresis": {"temperature": "mlp", "hysteresis": "turning-point"},
+#: a method compared: the options of gyrocomp's fit, or a function of the training runs returning a Calibration
+Method = FitOptions | Callable[[list[Recording]], Calibration]
+
+#: the thesis's methods: name -> gyrocomp's fit with these options
+THESIS_METHODS: dict[str, FitOptions] = {
+    "polynomial": FitOptions(temperature=Polynomial(), hysteresis="none"),
+    "polynomial + hysteresis": FitOptions(temperature=Polynomial(), hysteresis="turning-point"),
+    "network": FitOptions(temperature=Network(), hysteresis="none"),
+    "network + hysteresis": FitOptions(temperature=Network(), hysteresis="turning-point"),
 }
 #: what the autopilots' own calibration tools fit
 AUTOPILOT_METHODS: dict[str, Callable[[list[Recording]], Calibration]] = {
@@ -108,8 +112,33 @@ AUTOPILOT_METHODS: dict[str, Callable[[list[Recording]], Calibration]] = {
     "ArduPilot cubic (tempcal_IMU.py)": fit_ardupilot_style,
 }
 #: the autopilots' fits, the thesis's methods and gyrocomp's default (lag and/or hysteresis chosen by the data)
-DEFAULT_METHODS: dict[str, dict | Callable] = {**AUTOPILOT_METHODS, **THESIS_METHODS,
-                                               "gyrocomp default (auto)": {"temperature": "auto", "hysteresis": "auto"}}
+DEFAULT_METHODS: dict[str, Method] = {**AUTOPILOT_METHODS, **THESIS_METHODS, "gyrocomp default (auto)": FitOptions()}
+
+
+def fit_method(method: Method, train: list[Recording], *, hysteresis_band_degc: tuple[float, float] | None = None,
+               seed: int | None = None) -> Calibration:
+    """Fit one compared method on the training runs.
+
+    Parameters
+    ----------
+    method : FitOptions or callable
+        gyrocomp's fit with these options (:func:`gyrocomp.models.pipelines.fit_pipeline`), or a function of the
+        training runs returning a Calibration (``AUTOPILOT_METHODS``).
+    hysteresis_band_degc : (lo, hi), optional
+        The band [degC] given to a method with a thermal memory (``hysteresis`` other than ``none``) that names
+        none itself.
+    seed : int, optional
+        The seed of a network's initializations, replacing the method's own.
+    """
+    if callable(method):
+        return method(train)
+    if not isinstance(method, FitOptions):
+        raise InputError(f"methods: FitOptions or a function of the training runs, got {type(method).__name__}")
+    if hysteresis_band_degc is not None and method.hysteresis != "none" and method.hysteresis_band_degc is None:
+        method = replace(method, hysteresis_band_degc=hysteresis_band_degc)
+    if seed is not None and isinstance(method.temperature, Network):
+        method = replace(method, temperature=replace(method.temperature, seed=seed))
+    return fit_pipeline(train, "joint", method)
 
 
 @dataclass(frozen=True)
@@ -156,7 +185,7 @@ def _method_row(name: str, axis: str, metrics: list) -> MethodRow:
                      mean("bias_instability_comp_dph"), mean("integration_time_comp_s"))
 
 
-def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | None = None,
+def compare_methods(recordings: list[Recording], *, methods: dict[str, Method] | None = None,
                     window_s: float | None = None, hysteresis_band_degc: tuple[float, float] | None = None,
                     seed: int = 0) -> MethodComparison:
     """Score each method on the runs (see the module doc); the raw output is the first row of each axis.
@@ -166,12 +195,14 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
     recordings : list of Recording
         Runs of one sensor at rest through temperature changes.
     methods : dict, optional
-        Name -> :func:`fit_calibration` options, or a function of the training runs returning a
-        Calibration (``AUTOPILOT_METHODS``); default ``DEFAULT_METHODS``.
+        Name -> :class:`~gyrocomp.models.options.FitOptions` of gyrocomp's fit, or a function of the training runs
+        returning a Calibration (``AUTOPILOT_METHODS``); default ``DEFAULT_METHODS``.
     window_s : float, optional
         Moving-average window [s]; default each run's raw Allan-minimum tau (the thesis's choice).
     hysteresis_band_degc : (lo, hi), optional
-        Passed to the methods with hysteresis.
+        Given to the methods with hysteresis that name no band themselves [degC].
+    seed : int
+        The seed of the networks' initializations.
     """
     methods = DEFAULT_METHODS if methods is None else methods
     recordings = prepare(recordings)  # once for every method and held-out run
@@ -190,13 +221,7 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", TemperatureRangeWarning)
                 warnings.simplefilter("ignore", DataQualityWarning)
-                if callable(options):
-                    cal = options(train)
-                else:
-                    opts = dict(options)
-                    if opts.get("hysteresis") not in (None, "none"):
-                        opts["hysteresis_band_degc"] = hysteresis_band_degc
-                    cal = fit_calibration(train, mlp_seed=seed, **opts)
+                cal = fit_method(options, train, hysteresis_band_degc=hysteresis_band_degc, seed=seed)
                 result = evaluate_run(rec, apply(cal, rec), window_s=w)
             scored[name].append(result)
             if name == next(iter(methods)):
@@ -208,5 +233,5 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, dict] | N
     return MethodComparison(rows, how, windows)
 
 
-__all__ = ["AUTOPILOT_METHODS", "DEFAULT_METHODS", "MethodComparison", "MethodRow", "THESIS_METHODS", "compare_methods",
-           "fit_ardupilot_style", "fit_px4_style"]
+__all__ = ["AUTOPILOT_METHODS", "DEFAULT_METHODS", "Method", "MethodComparison", "MethodRow", "THESIS_METHODS", "compare_methods",
+           "fit_ardupilot_style", "fit_method", "fit_px4_style"]

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,14 +28,14 @@ from .errors import DataQualityWarning, InputError, ModelChoiceWarning, Temperat
 from .metrics import smoothed_residual_rms
 from .models.base import provenance
 from .models.hysteresis import turn_threshold_degc
-from .models.pipelines import fit_calibration
+from .models.options import FitOptions
 from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, FoldDrift, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
 from .prepared import prepare
 from .threads import single_threaded_blas
 from .recording import Recording
-from .comparison import fit_ardupilot_style, fit_px4_style
+from .comparison import Method, fit_ardupilot_style, fit_method, fit_px4_style
 
 #: the plain cubic's reference temperature is the middle of the runs' range
 PLAIN_CUBIC_ORDER = 3
@@ -64,12 +63,12 @@ def fit_plain_cubic(recordings: list[Recording]) -> Calibration:
 
 
 #: the methods every validation compares: name -> fit_calibration options, or a function of the training runs
-BASELINES: dict[str, dict | Callable[[list[Recording]], Calibration] | None] = {
+BASELINES: dict[str, Method | None] = {
     "raw": None,
     "PX4 cubic": fit_px4_style,
     "ArduPilot cubic": fit_ardupilot_style,
     "cubic + run constants": fit_plain_cubic,
-    "gyrocomp default": {},
+    "gyrocomp default": FitOptions(),
 }
 
 
@@ -180,17 +179,13 @@ def _training(recordings: list[Recording], fold: Fold, kind: str) -> list[Record
     return out
 
 
-def _fit(method, train: list[Recording]) -> Calibration | None:
-    if method is None:
-        return None
-    if callable(method):
-        return method(train)
-    return fit_calibration(train, **method)
+def _fit(method: Method | None, train: list[Recording]) -> Calibration | None:
+    return None if method is None else fit_method(method, train)
 
 
 @single_threaded_blas
 def validate(recordings: list[Recording], *, folds: str = "auto", window_s: float | None = None,
-             candidates: dict[str, dict] | None = None) -> ValidationResult:
+             candidates: dict[str, Method] | None = None) -> ValidationResult:
     """Held-out drift of the baselines, gyrocomp's default and ``candidates`` on folds of ``recordings``.
 
     Parameters
@@ -201,7 +196,8 @@ def validate(recordings: list[Recording], *, folds: str = "auto", window_s: floa
     window_s : float, optional
         Moving-average window of the drift [s]; default a tenth of the median fold, within 60..600 s.
     candidates : dict, optional
-        Further methods: name -> :func:`gyrocomp.fit_calibration` options.
+        Further methods: name -> :class:`~gyrocomp.models.options.FitOptions` of gyrocomp's fit (or a function of
+        the training runs returning a Calibration).
     """
     # prepared once: every method and fold reads each run's still segments and block means from it
     recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)

@@ -24,7 +24,7 @@ RAD_TO_DEG = 180.0 / math.pi
 def _model(order):
     truth = GyroErrorModel(bias_instability_deg_per_h=2.0)
     runs = [simulate(truth, profile="chamber", duration_s=3600, rate_hz=5, seed=s).recording for s in range(3)]
-    return fit_calibration(runs, temperature=order, hysteresis="none")
+    return fit_calibration(runs, temperature=Polynomial(order), hysteresis="none")
 
 
 def _read_px4(text):

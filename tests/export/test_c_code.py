@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply, fit_calibration
+from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources, write_c_sources
 from gyrocomp.models.pipelines import fit_pipeline
@@ -97,7 +97,7 @@ def test_joint_network_reading_temperature_and_accelerations(tmp_path):
 
 def test_single_axis_model_passes_other_axes_through(tmp_path):
     runs = [simulate("mti10", profile="chamber", duration_s=2000, rate_hz=2, seed=s).recording for s in range(2)]
-    cal = fit_calibration([r.take(slice(None)) for r in runs], temperature=2)
+    cal = fit_calibration([r.take(slice(None)) for r in runs], temperature=Polynomial(2))
     cal = type(cal)(axes={"gyro_y": cal.axes["gyro_y"]}, model=cal.model)
     held = simulate("mti10", profile="chamber", duration_s=2000, rate_hz=2, seed=3).recording
     with warnings.catch_warnings():
@@ -190,7 +190,7 @@ def test_the_two_files_are_written_both_or_neither(tmp_path):
     runs = [simulate("mti10", profile="chamber", duration_s=1200, rate_hz=1, seed=s).recording for s in range(2)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        cal = fit_calibration(runs, temperature=2, hysteresis="none", acceleration="none")
+        cal = fit_calibration(runs, temperature=Polynomial(2), hysteresis="none", acceleration="none")
     (tmp_path / "gyrocomp.h").write_text("old header\n")
     (tmp_path / "gyrocomp_learn.c").mkdir()  # the last file cannot be written
     with pytest.raises(InputError, match=r"gyrocomp_learn.c: is a folder"):

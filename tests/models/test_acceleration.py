@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import Calibration, Compensator, apply, fit_calibration
+from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.evaluation import evaluate_stages
 from gyrocomp.metrics import smoothed_residual_rms
@@ -41,7 +41,7 @@ def test_default_is_within_15_percent_of_perfect_on_every_axis(consumer):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         comp = apply(cal, held.recording).gyro_dps
-        cubic = apply(fit_calibration([r.recording for r in runs], temperature=3, hysteresis="none",
+        cubic = apply(fit_calibration([r.recording for r in runs], temperature=Polynomial(3), hysteresis="none",
                                       acceleration="none"), held.recording).gyro_dps
     w = int(60 * RATE_HZ)
     for j in range(3):

@@ -6,7 +6,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import Calibration, apply, fit_calibration
+from gyrocomp import Calibration, Network, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelError, NotFittedError
 from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.mlp import MLPBias, forward, layer_shapes
@@ -64,8 +64,8 @@ def test_network_reproduces_a_polynomial_truth_as_well_as_the_polynomial(chamber
     runs, held = chamber
     w = 600  # 60 s moving average
     drift, left = {}, {}
-    for option in ("auto", "mlp"):
-        cal = fit_calibration(runs, temperature=option)
+    for option, model in (("auto", Polynomial()), ("mlp", Network())):
+        cal = fit_calibration(runs, temperature=model)
         comp = apply(cal, held.recording).gyro_dps[:, 0]
         drift[option] = smoothed_residual_rms(comp, w)
         left[option] = smoothed_residual_rms(comp - held.truth.noise.total_dps[:, 0], w)
@@ -77,8 +77,8 @@ def test_network_reproduces_a_polynomial_truth_as_well_as_the_polynomial(chamber
 
 def test_network_is_deterministic_for_a_seed_and_saved_as_json(chamber, tmp_path):
     runs, held = chamber
-    a = fit_calibration(runs, temperature=("mlp", (3,)), mlp_seed=7)
-    b = fit_calibration(runs, temperature=("mlp", (3,)), mlp_seed=7)
+    a = fit_calibration(runs, temperature=Network((3,), seed=7))
+    b = fit_calibration(runs, temperature=Network((3,), seed=7))
     assert a.axes == b.axes
     a.save(tmp_path / "m.json")
     d = json.loads((tmp_path / "m.json").read_text())
@@ -100,7 +100,7 @@ def test_network_with_lag_and_hysteresis_generalizes_to_a_faster_ramp():
                     rate_hz=1.0, seed=50)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        cal = fit_calibration([r.recording for r in runs], temperature="mlp", hysteresis_band_degc=(55.0, 80.0))
+        cal = fit_calibration([r.recording for r in runs], temperature=Network(), hysteresis_band_degc=(55.0, 80.0))
         comp = apply(cal, held.recording).gyro_dps[:, 0]
     assert cal.model == "mlp:1-3-1 + turning-point+lag"
     perfect = smoothed_residual_rms(held.truth.noise.total_dps[:, 0], 60)
@@ -109,7 +109,7 @@ def test_network_with_lag_and_hysteresis_generalizes_to_a_faster_ramp():
 
 def test_network_options_and_errors():
     assert parse_hidden("mlp") == (3,) and parse_hidden("mlp:5") == (5,) and parse_hidden("mlp:4x2") == (4, 2)
-    assert parse_temperature_option("mlp:5") == ("mlp", (5,))
+    assert parse_temperature_option("mlp:5") == Network((5,)) and parse_temperature_option("mlp", 4) == Network(seed=4)
     for bad in ("mlp:0", "mlp:x", "mlp:2x2x2x2"):
         with pytest.raises(InputError, match=r"--temperature: .*use mlp, mlp:H \(H hidden tanh neurons, 1..50\)"):
             parse_hidden(bad)

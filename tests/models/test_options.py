@@ -1,6 +1,6 @@
-"""Typed fit options: each field checked when made (errors name the field), the plain forms fit_calibration still
-takes mean the same, the choices agree with the fitting's own, and a fit with options equals the fit with the
-keywords they stand for."""
+"""Typed fit options: each field checked when made (errors name the field), fit_calibration's keywords checked the
+same way (the plain forms of earlier releases refused with the typed form to write), the choices agree with the
+fitting's own, and a fit with options equals the fit with the keywords they stand for."""
 
 from __future__ import annotations
 
@@ -11,8 +11,7 @@ import pytest
 
 from gyrocomp.errors import InputError
 from gyrocomp.models.gsensitivity import ACCELERATION_CHOICES
-from gyrocomp.models.options import (Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial,
-                                     legacy_temperature, temperature_spec)
+from gyrocomp.models.options import Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial
 from gyrocomp.models.pipelines import fit_calibration, fit_channels, fit_pipeline
 from gyrocomp.models.selection import FOLD_KINDS
 from gyrocomp.models.thermal import HYSTERESIS_CHOICES
@@ -40,18 +39,42 @@ def test_the_literal_choices_are_the_fittings_own():
     (lambda: FitOptions(bin_width_degc=0), r"FitOptions.bin_width_degc: a positive number of degC, got 0"),
     (lambda: FitOptions(static_min_duration_s=-1), r"FitOptions.static_min_duration_s: a positive number"),
     (lambda: FitOptions(hysteresis_band_degc=(80, 55)), r"FitOptions.hysteresis_band_degc: \(lo, hi\) in degC"),
-    (lambda: temperature_spec("cubic"), r"temperature: 'auto', an order 0..5, 'mlp'"),
+    (lambda: FitOptions(hysteresis_band_degc="55,80"), r"FitOptions.hysteresis_band_degc: .* got '55,80'"),
+    (lambda: FitOptions(hysteresis_band_degc=(55, None)), r"FitOptions.hysteresis_band_degc: .* got \(55, None\)"),
 ])
 def test_a_bad_option_is_refused_naming_its_field(make, message):
     with pytest.raises(InputError, match=message):
         make()
 
 
-@pytest.mark.parametrize("plain, typed", [("auto", Polynomial()), (3, Polynomial(3)), (None, None),
-                                          ("mlp", Network()), (("mlp", (5, 2)), Network((5, 2)))])
-def test_the_plain_forms_mean_the_typed_ones(plain, typed):
-    assert temperature_spec(plain) == typed
-    assert legacy_temperature(typed)[0] == (("mlp", (3,)) if plain == "mlp" else plain)
+@pytest.mark.parametrize("plain", ["auto", 3, "mlp", ("mlp", (5, 2))])
+def test_fit_calibration_refuses_the_plain_temperature_forms_naming_the_typed_ones(plain):
+    run = simulate("mti10", profile="chamber", rate_hz=1, duration_s=600, seed=1).recording
+    with pytest.raises(InputError, match=r"temperature: Polynomial\(order=...\), Network\(hidden=...\) or None; got "
+                                         r".*\(an order N is Polynomial\(N\), 'auto' is Polynomial\(\), 'mlp' is "
+                                         r"Network\(\)\)"):
+        fit_calibration([run], temperature=plain)
+
+
+@pytest.mark.parametrize("keywords, message", [
+    (dict(hysteresis="magic"), r"hysteresis: 'magic'; use one of auto, none"),
+    (dict(acceleration="cube"), r"acceleration: 'cube'; use one of auto, none, matrix, matrix2"),
+    (dict(static_min_duration_s=0), r"static_min_duration_s: a positive number of seconds, got 0"),
+    (dict(hysteresis_band_degc=(80.0, 55.0)), r"hysteresis_band_degc: \(lo, hi\) in degC with lo < hi"),
+    (dict(mlp_seed=3), r"unexpected keyword argument 'mlp_seed'"),
+])
+def test_fit_calibration_checks_its_keywords_as_the_options_do(keywords, message):
+    run = simulate("mti10", profile="chamber", rate_hz=1, duration_s=600, seed=1).recording
+    with pytest.raises((InputError, TypeError), match=message):
+        fit_calibration([run], **keywords)
+
+
+def test_a_network_keeps_its_seed_through_the_fit():
+    runs = [simulate("mti10", profile="chamber", rate_hz=1, duration_s=1800, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, temperature=Network((2,), seed=11), hysteresis="none", acceleration="none")
+    assert cal.report.network.hidden == (2,) and cal.report.network.seed == 11
 
 
 def test_a_fit_with_options_is_the_fit_with_their_keywords():
@@ -59,7 +82,7 @@ def test_a_fit_with_options_is_the_fit_with_their_keywords():
     options = FitOptions(temperature=Polynomial(2), hysteresis="none", acceleration="none")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        by_keywords = fit_calibration(runs, temperature=2, hysteresis="none", acceleration="none")
+        by_keywords = fit_calibration(runs, temperature=Polynomial(2), hysteresis="none", acceleration="none")
         typed = fit_calibration(runs, temperature=Polynomial(2), hysteresis="none", acceleration="none")
         by_options = fit_pipeline(runs, "joint", options)
         channels = fit_channels(runs, options=options)

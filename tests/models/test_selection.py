@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply, fit_calibration
+from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.selection import Candidate, CandidateScore, choose, leg_labels, temperature_step_degc
@@ -87,14 +87,14 @@ def _ramp(n, rate_hz=10.0):
 
 def test_an_order_asked_for_is_fitted_even_where_the_constant_scores_as_well():
     # a 60-s ramp: every held-out block is shorter than the smallest window, and the noise-free line scores 0
-    cal = fit_calibration([_ramp(600)], temperature=1)
+    cal = fit_calibration([_ramp(600)], temperature=Polynomial(1))
     assert cal.axes["gyro_z"].temperature.order == 1
     assert cal.fit_report["selection"]["gyro_z"]["chosen"]["order"] == 1
 
 
 def test_too_little_data_to_hold_out_warns_and_writes_no_nan():
     with pytest.warns(ModelChoiceWarning, match="gyro_z: too little data to hold out time blocks; poly:1 "):
-        cal = fit_calibration([_ramp(3)], temperature=1)
+        cal = fit_calibration([_ramp(3)], temperature=Polynomial(1))
     sel = cal.fit_report["selection"]["gyro_z"]
     assert sel["validated"] is False and sel["raw_drift_dps"] is None
     json.dumps(cal.fit_report, allow_nan=False)  # a model file a strict reader accepts

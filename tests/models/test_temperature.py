@@ -5,7 +5,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import apply, fit_calibration
+from gyrocomp import Network, Polynomial, apply, fit_calibration
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureRangeWarning
 from gyrocomp.metrics import default_window_s, smoothed_residual_rms
@@ -31,7 +31,7 @@ def noise_scale(sims, axis_index, rate_hz, n_bins=100):
 @pytest.mark.parametrize("held_out", [4, 5, 6])
 def test_fitted_shape_matches_truth_within_noise(chamber_runs, held_out):
     fit_runs = [s for i, s in enumerate(chamber_runs) if i != held_out][:4]
-    cal = fit_calibration([s.recording for s in fit_runs], temperature=3)
+    cal = fit_calibration([s.recording for s in fit_runs], temperature=Polynomial(3))
     truth = TEST_MODEL.temperature_error_dps(GRID)
     for j, axis in enumerate(TEST_MODEL.axes):
         err = cal.axes[axis].temperature.shape(GRID) - truth[:, j]
@@ -50,7 +50,7 @@ def test_least_squares_is_linear_in_the_data(chamber_runs):
         "truth": [s.recording.with_gyro(s.truth.deterministic_error_dps) for s in runs],
         "noise": [s.recording.with_gyro(s.truth.noise.total_dps) for s in runs],
     }
-    cal = {k: fit_calibration(v, temperature=3, hysteresis="none") for k, v in parts.items()}
+    cal = {k: fit_calibration(v, temperature=Polynomial(3), hysteresis="none") for k, v in parts.items()}
     truth = TEST_MODEL.temperature_error_dps(GRID)
     for j, axis in enumerate(TEST_MODEL.axes):
         shape = {k: c.axes[axis].temperature.shape(GRID) for k, c in cal.items()}
@@ -71,7 +71,7 @@ def test_least_squares_is_linear_in_the_data(chamber_runs):
 
 def test_turn_on_constants_are_recovered(chamber_runs):
     runs = chamber_runs[:4]
-    cal = fit_calibration([s.recording for s in runs], temperature=3)
+    cal = fit_calibration([s.recording for s in runs], temperature=Polynomial(3))
     for j, axis in enumerate(TEST_MODEL.axes):
         fitted = np.array(cal.axes[axis].turn_on_biases_dps)
         true = np.array([s.truth.turn_on_bias_dps[j] for s in runs])
@@ -100,7 +100,7 @@ def held_out_drift(chamber_runs, temperature):
 
 
 def test_held_out_residual_drift_within_15_percent_of_perfect(chamber_runs):
-    achieved, perfect, raw = held_out_drift(chamber_runs, "auto")
+    achieved, perfect, raw = held_out_drift(chamber_runs, Polynomial())
     # pooled over three held-out runs (three seeds) and three axes: the held-out run's own noise enters both
     # sides, so single cases scatter by about 10% around the pooled value
     pooled = np.sqrt(np.sum(achieved**2) / np.sum(perfect**2))
@@ -111,7 +111,7 @@ def test_held_out_residual_drift_within_15_percent_of_perfect(chamber_runs):
 
 def test_a_too_low_order_fails_the_same_criterion(chamber_runs):
     """The 15% criterion has teeth: a straight line cannot meet it on this cubic truth."""
-    achieved, perfect, _ = held_out_drift(chamber_runs, 1)
+    achieved, perfect, _ = held_out_drift(chamber_runs, Polynomial(1))
     assert np.sqrt(np.sum(achieved**2) / np.sum(perfect**2)) > 1.15
 
 
@@ -143,7 +143,7 @@ def test_heating_rate_does_not_weight_the_fit():
     rec = Recording(time_s=t, gyro_dps=gyro, gyro_axes=("gyro_z",), temperature_degc=temp)
     bins = bin_by_temperature([temp], [gyro], 1.0)
     assert bins.weight.max() == 1.0
-    cal = fit_calibration([rec], temperature=2, hysteresis="none")
+    cal = fit_calibration([rec], temperature=Polynomial(2), hysteresis="none")
     shape = cal.axes["gyro_z"].temperature.shape(GRID)
     truth = 1e-3 * (GRID - 25) + 1e-5 * (GRID - 25) ** 2
     np.testing.assert_allclose(shape - shape.mean(), truth - truth.mean(), atol=1e-6)
@@ -153,7 +153,7 @@ def test_clamps_outside_range_and_warns_once():
     t = np.arange(0, 600.0)
     temp = np.linspace(10, 40, t.size)
     rec = Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
-    cal = fit_calibration([rec], temperature=1, hysteresis="none")  # a fixed fit holds its edge
+    cal = fit_calibration([rec], temperature=Polynomial(1), hysteresis="none")  # a fixed fit holds its edge
     hot = Recording(time_s=t, gyro_dps=np.zeros(t.size), gyro_axes=("gyro_z",), temperature_degc=temp + 30)
     with pytest.warns(TemperatureRangeWarning, match=r"outside the model's range 10.00..40.00 degC") as record:
         out = apply(cal, hot)
@@ -167,7 +167,7 @@ def test_noise_level_overshoot_of_the_range_is_not_outside_it():
     t = np.arange(0, 600.0)
     temp = np.linspace(10, 40, t.size)
     cal = fit_calibration([Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)],
-                          temperature=1)
+                          temperature=Polynomial(1))
     curve = cal.axes["gyro_z"].temperature
     assert curve.range_tolerance_degc == 0.5  # 1 % of a 30 degC span is less
     assert not curve.outside_range(np.array([9.6, 40.4]))
@@ -193,7 +193,8 @@ def test_errors():
         PolynomialTemperatureModel().fit([])
 
 
-@pytest.mark.parametrize("text,expected", [("poly", "auto"), ("POLY:3", 3), ("none", None), ("poly:0", 0)])
+@pytest.mark.parametrize("text,expected", [("poly", Polynomial()), ("POLY:3", Polynomial(3)), ("none", None),
+                                           ("poly:0", Polynomial(0)), ("mlp:4x2", Network((4, 2)))])
 def test_parse_temperature_option(text, expected):
     assert parse_temperature_option(text) == expected
 

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import Calibration, Compensator, apply, fit_calibration
+from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, NotFittedError
 from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.thermal import ThermalHysteresisModel
@@ -29,7 +29,7 @@ def _experiment(model, **fit_options):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         chosen = fit_calibration([r.recording for r in runs], **fit_options)
-        cubic = fit_calibration([r.recording for r in runs], temperature=3, hysteresis="none")
+        cubic = fit_calibration([r.recording for r in runs], temperature=Polynomial(3), hysteresis="none")
     w = int(WINDOW_S * 1.0)
 
     def drift(cal):

@@ -123,7 +123,7 @@ PARAMETER_FLAGS = {
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
     "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
     "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
-    "prior": "--prior", "still_only": "--still-only", "bin_width_degc": "--bin-width", "mlp_seed": "--seed",
+    "prior": "--prior", "still_only": "--still-only", "bin_width_degc": "--bin-width",
 }
 #: the option objects whose fields messages name (``FitOptions.hysteresis: ...``): the field is the flag's
 _OPTION_OBJECT = re.compile(r"\b(?:FitOptions|Polynomial|Network)\.(?=\w)")

@@ -13,6 +13,7 @@ from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, T
 from ..errors import InputError
 from ..io import FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
 from ..models.mlp import DEFAULT_HIDDEN
+from ..models.options import Network, Polynomial
 from ..models.temperature import MAX_ORDER
 
 
@@ -122,13 +123,14 @@ def parse_hidden(text: str) -> tuple[int, ...]:
     return hidden
 
 
-def parse_temperature_option(text: str) -> int | str | tuple | None:
-    """``"poly"`` -> ``"auto"``, ``"poly:3"`` -> 3, ``"mlp"``/``"mlp:5"`` -> ("mlp", hidden), ``"none"`` -> None."""
+def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Network | None:
+    """``"poly"`` -> ``Polynomial()``, ``"poly:3"`` -> ``Polynomial(3)``, ``"mlp"``/``"mlp:5"`` -> ``Network(hidden,
+    seed)``, ``"none"`` -> None."""
     text = text.strip().lower()
     if text == "mlp" or text.startswith("mlp:"):
-        return ("mlp", parse_hidden(text))
+        return Network(parse_hidden(text), seed)
     if text in ("poly", "auto"):
-        return "auto"
+        return Polynomial()
     if text == "none":
         return None
     if text.startswith("poly:"):
@@ -137,7 +139,7 @@ def parse_temperature_option(text: str) -> int | str | tuple | None:
         except ValueError:
             order = -1
         if 0 <= order <= MAX_ORDER:
-            return order
+            return Polynomial(order)
         raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
     raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}), "
                      "mlp (the thesis's 1-3-1 network), mlp:H or none")

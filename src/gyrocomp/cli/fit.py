@@ -13,7 +13,7 @@ from ..io.files import expand_runs
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
-from ..models.options import FitOptions, Network, temperature_spec
+from ..models.options import FitOptions
 from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
 from ..models.selection import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
@@ -75,7 +75,6 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
 
     RUNS are files, folders (every run file in them) or quoted glob patterns ('logs/**/*.ulg')."""
     opts = pop_read_options(kwargs)
-    order = parse_temperature_option(temperature)
     if hysteresis_order != "auto":
         if hysteresis_order not in ("1", "2", "3"):
             raise click.BadParameter("use auto, 1, 2 or 3", param_hint="--hysteresis-order")
@@ -84,8 +83,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     if band is not None and (len(band) != 2 or not band[0] < band[1]):
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     channels = parse_channels(channels)
-    spec = temperature_spec(order)
-    options = FitOptions(temperature=Network(spec.hidden, mlp_seed) if isinstance(spec, Network) else spec,
+    options = FitOptions(temperature=parse_temperature_option(temperature, mlp_seed),
                          bin_width_degc=bin_width_degc, hysteresis=hysteresis, hysteresis_order=hysteresis_order,
                          hysteresis_band_degc=None if band is None else tuple(band), acceleration=acceleration,
                          static_min_duration_s=static_min_duration_s, folds=folds)

@@ -6,6 +6,7 @@ import json
 
 import click
 
+from ..models.options import FitOptions
 from ..models.selection import FOLD_KINDS
 from ..validation import validate as validate_runs
 from .common import pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
@@ -35,11 +36,11 @@ def validate(ctx, runs, folds, window_s, candidates, as_json, **kwargs):
         raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
     named = {}
     for spec in candidates:
-        order = parse_temperature_option(spec)
-        if order is None:
+        model = parse_temperature_option(spec)
+        if model is None:
             raise click.BadParameter("a candidate needs a temperature model (poly, poly:N or mlp)",
                                      param_hint="--candidate")
-        named[f"gyrocomp {spec}"] = {"temperature": order}
+        named[f"gyrocomp {spec}"] = FitOptions(temperature=model)
     recordings = [read_run(path, opts).recording for path in runs]
     with progress_bar("validating", indeterminate=True):
         result = validate_runs(recordings, folds=folds, window_s=window_s, candidates=named)

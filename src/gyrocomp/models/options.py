@@ -10,7 +10,7 @@ Each field is checked when the object is made; an error names the field and the 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Literal, get_args
 
 from ..errors import InputError
@@ -59,6 +59,10 @@ class Network:
             raise InputError(f"Network.seed: a whole number, got {self.seed!r}")
 
 
+#: what an error about a plain temperature form (an order, "auto", "mlp") adds
+PLAIN_FORMS = " (an order N is Polynomial(N), 'auto' is Polynomial(), 'mlp' is Network())"
+
+
 def _choice(name: str, value, choices) -> None:
     if value not in choices:
         raise InputError(f"{name}: {value!r}; use one of {', '.join(map(str, choices))}")
@@ -104,7 +108,8 @@ class FitOptions:
     def __post_init__(self):
         if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Network)):
             raise InputError(f"FitOptions.temperature: Polynomial(order=...), Network(hidden=...) or None; got "
-                             f"{self.temperature!r}")
+                             f"{self.temperature!r}" + (PLAIN_FORMS if isinstance(self.temperature, (int, str, tuple))
+                                                         else ""))
         _choice("FitOptions.hysteresis", self.hysteresis, get_args(Memory))
         _choice("FitOptions.hysteresis_order", self.hysteresis_order, ("auto", *range(1, MAX_HYSTERESIS_ORDER + 1)))
         _choice("FitOptions.acceleration", self.acceleration, get_args(Acceleration))
@@ -116,41 +121,12 @@ class FitOptions:
             raise InputError(f"FitOptions.static_min_duration_s: a positive number of seconds, got "
                              f"{self.static_min_duration_s!r}")
         band = self.hysteresis_band_degc
-        if band is not None and (len(band) != 2 or not band[0] < band[1]):
-            raise InputError(f"FitOptions.hysteresis_band_degc: (lo, hi) in degC with lo < hi, got {band!r}")
-
-    def calibration_arguments(self) -> dict:
-        """The keyword arguments of :func:`gyrocomp.models.pipelines.fit_calibration` these options mean."""
-        out = {f.name: getattr(self, f.name) for f in fields(self)}
-        out["temperature"], seed = legacy_temperature(self.temperature)
-        out["mlp_seed"] = seed
-        return out
+        if band is not None:
+            if not (isinstance(band, (tuple, list)) and len(band) == 2
+                    and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in band)
+                    and band[0] < band[1]):
+                raise InputError(f"FitOptions.hysteresis_band_degc: (lo, hi) in degC with lo < hi, got {band!r}")
+            object.__setattr__(self, "hysteresis_band_degc", (float(band[0]), float(band[1])))
 
 
-def legacy_temperature(spec: Polynomial | Network | None) -> tuple[int | str | tuple | None, int]:
-    """A typed temperature model as :func:`~gyrocomp.models.pipelines.fit_calibration`'s ``temperature`` (an order,
-    ``"auto"``, ``("mlp", hidden)`` or None) and the network's seed (0 otherwise)."""
-    if isinstance(spec, Network):
-        return ("mlp", spec.hidden), spec.seed
-    if isinstance(spec, Polynomial):
-        return spec.order, 0
-    return None, 0
-
-
-def temperature_spec(value) -> Polynomial | Network | None:
-    """``fit_calibration``'s ``temperature`` (an order, ``"auto"``, ``"mlp"``, ``("mlp", hidden)``, None, or already
-    typed) as a typed temperature model."""
-    if value is None or isinstance(value, (Polynomial, Network)):
-        return value
-    if value == "mlp":
-        return Network()
-    if isinstance(value, tuple) and len(value) == 2 and value[0] == "mlp":
-        return Network(tuple(value[1]))
-    if value == "auto" or isinstance(value, int):
-        return Polynomial(value)
-    raise InputError(f"temperature: 'auto', an order 0..{MAX_ORDER}, 'mlp', ('mlp', hidden), a Polynomial, a "
-                     f"Network or None; got {value!r}")
-
-
-__all__ = ["Acceleration", "FitOptions", "FoldChoice", "Memory", "Network", "Polynomial", "legacy_temperature",
-           "temperature_spec"]
+__all__ = ["Acceleration", "FitOptions", "FoldChoice", "Memory", "Network", "Polynomial"]

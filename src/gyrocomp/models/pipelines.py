@@ -20,7 +20,6 @@ from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..triad import TriadCalibration
 from ..static import orientations
 from .acceleration import (
-    ACCELERATION_CHOICES,
     acceleration_report,
     fit_acceleration_network,
     excited_columns,
@@ -30,15 +29,15 @@ from .acceleration import (
 from .base import bin_width_for, one_temperature_column, provenance
 from .hysteresis import heats_and_cools
 from .pose_rotation import TooFewTurns, fit_gyro_between_poses
-from .mlp import DEFAULT_HIDDEN, NETWORK_BLOCK_S, NETWORK_INPUTS
+from .mlp import NETWORK_BLOCK_S, NETWORK_INPUTS
 from .mlp_fit import MLPTemperatureModel
 from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .polynomial_fit import PolynomialTemperatureModel
 from .temperature import MAX_ORDER, PolynomialBias
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
-from .options import FitOptions, Network, Polynomial, legacy_temperature
-from .thermal import CANDIDATES, HYSTERESIS_CHOICES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+from .options import Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial
+from .thermal import CANDIDATES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 from ..threads import single_threaded_blas
 
 #: how the fit report names each kind of fold
@@ -169,15 +168,17 @@ def _thermal_report(thermal: ThermalHysteresisModel, mode: str) -> dict:
     return HysteresisReport(mode, thermal.selection_, axes).to_dict()
 
 
-def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, hysteresis_order,
-                  accel_mode: str, bin_width_degc, static_min_duration_s: float, run_folds, folds: str):
-    """Select by held-out drift, then fit each axis's chosen model on all runs."""
-    orders = tuple(range(MAX_ORDER + 1)) if temperature == "auto" else (int(temperature),)
-    memories = tuple(CANDIDATES) if hysteresis == "auto" else (hysteresis,)
-    h_orders = tuple(range(1, MAX_HYSTERESIS_ORDER + 1)) if hysteresis_order == "auto" else (int(hysteresis_order),)
+def _fit_selected(recordings: list[Recording], order: int | str, options: FitOptions, accel_mode: str):
+    """Select by held-out drift among the polynomial orders (``order``, or all for "auto") and the memories
+    ``options`` allow, then fit each axis's chosen model on all runs."""
+    orders = tuple(range(MAX_ORDER + 1)) if order == "auto" else (int(order),)
+    memories = tuple(CANDIDATES) if options.hysteresis == "auto" else (options.hysteresis,)
+    h_orders = (tuple(range(1, MAX_HYSTERESIS_ORDER + 1)) if options.hysteresis_order == "auto"
+                else (int(options.hysteresis_order),))
     selections = select_models(recordings, orders=orders, memories=memories, hysteresis_orders=h_orders,
-                               acceleration=accel_mode, static_min_duration_s=static_min_duration_s,
-                               bin_width_degc=bin_width_degc, run_folds=run_folds, folds=folds)
+                               acceleration=accel_mode, static_min_duration_s=options.static_min_duration_s,
+                               bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
+                               folds=options.folds)
     _warn_about_choice(selections)
     chosen = {axis: sel.chosen for axis, sel in selections.items()}
     thermal = ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
@@ -186,33 +187,29 @@ def _fit_selected(recordings: list[Recording], *, temperature, hysteresis: str, 
                                      weighting={a: c.weighting for a, c in chosen.items()},
                                      band_degc={a: selections[a].band_degc if c.band else None
                                                 for a, c in chosen.items()},
-                                     bin_width_degc=bin_width_degc, acceleration=accel_mode,
-                                     static_min_duration_s=static_min_duration_s).fit(recordings)
+                                     bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
+                                     static_min_duration_s=options.static_min_duration_s).fit(recordings)
     return selections, thermal
 
 
-# Over 60 lines, not yet split: the default fit's option checks and its routes (no temperature, cross-validated
-# selection, one binned fit, with or without a network); #18's typed options are to take the checks out.
 @single_threaded_blas
 def fit_calibration(recordings: list[Recording] | Recording, *,
-                    temperature: Polynomial | Network | int | str | None = "auto",
-                    bin_width_degc: float | None = None, hysteresis: str = "auto",
-                    hysteresis_order: int | str = "auto",
-                    hysteresis_band_degc: tuple[float, float] | None = None, mlp_seed: int = 0,
-                    acceleration: str = "auto", static_min_duration_s: float = 10.0,
-                    network_inputs: tuple[str, ...] = ("temperature",),
-                    run_folds: tuple[int, ...] | None = None, folds: str = "auto") -> Calibration:
+                    temperature: Polynomial | Network | None = Polynomial(), bin_width_degc: float | None = None,
+                    hysteresis: Memory = "auto", hysteresis_order: int | Literal["auto"] = "auto",
+                    hysteresis_band_degc: tuple[float, float] | None = None, acceleration: Acceleration = "auto",
+                    static_min_duration_s: float = 10.0, network_inputs: tuple[str, ...] = ("temperature",),
+                    run_folds: tuple[int, ...] | None = None, folds: FoldChoice = "auto") -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
     ----------
     recordings : list of Recording
         Calibration runs; each gets its own turn-on constant, the temperature shape is shared.
-    temperature : Polynomial, Network or None (or "auto", int, "mlp", ("mlp", hidden))
-        The temperature model (:mod:`gyrocomp.models.options`): ``Polynomial(order="auto")`` (chosen by held-out
-        drift) or an order 0..5; ``Network()`` for the thesis's 1-3-1 network, ``Network(hidden=(H,))`` for H
-        hidden neurons (its ``seed`` replaces ``mlp_seed``); or None for no temperature model (each run's
-        constant only). The plain forms in brackets mean the same.
+    temperature : Polynomial, Network or None
+        The temperature model (:mod:`gyrocomp.models.options`): ``Polynomial()`` (the order chosen by held-out
+        drift) or ``Polynomial(order)`` with an order 0..5; ``Network()`` for the thesis's 1-3-1 network,
+        ``Network(hidden=(H,), seed=S)`` for H hidden neurons and the seed of its initializations; or None for
+        no temperature model (each run's constant only).
     bin_width_degc : float, optional
         Temperature bin width for the fit [degC].
     hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
@@ -223,8 +220,6 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
         Order of the turning-point polynomial (1..3) or chosen by validation.
     hysteresis_band_degc : (lo, hi), optional
         Limit the hysteresis to this band [degC].
-    mlp_seed : int
-        Seed of the network's initializations (the same seed gives the same model).
     acceleration : {"auto", "none", "matrix", "matrix2"}
         g-sensitivity fitted jointly with the temperature model and the run constants, on the static
         segments: the 3x3 matrix (``matrix``), plus g x g terms (``matrix2``). ``"auto"``: ``matrix``
@@ -233,7 +228,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     static_min_duration_s : float
         Shortest still stretch used as a static segment [s] (hand-placed poses may last only a few seconds).
     network_inputs : tuple of str
-        What a network (``temperature="mlp"``) reads: the temperature, or also ``accel_x``, ``accel_y``,
+        What a network (``temperature=Network()``) reads: the temperature, or also ``accel_x``, ``accel_y``,
         ``accel_z`` (the joint network of the ``joint-mlp`` pipeline, which then fits no separate G).
     run_folds : tuple of int, optional
         The validation fold of each recording for the polynomial order (pieces of one run left out together).
@@ -242,53 +237,53 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
         default with three runs or more), each heating or cooling leg (the default with fewer), or contiguous
         time blocks.
 
-    Whenever something is left to choose (``temperature="auto"`` or ``hysteresis="auto"``, no band given),
+    Every option is checked as :class:`~gyrocomp.models.options.FitOptions` checks it (its errors name the
+    field). Whenever something is left to choose (``Polynomial()`` or ``hysteresis="auto"``, no band given),
     every candidate is scored by held-out drift and the simplest within one standard error of the best is
     fitted (:mod:`gyrocomp.models.selection`); an axis where no temperature model beats the run constant
     gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
+    options = FitOptions(temperature=temperature, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
+                         hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,
+                         acceleration=acceleration, static_min_duration_s=static_min_duration_s, run_folds=run_folds,
+                         folds=folds)
+    return _fit_with(recordings, options, network_inputs)
+
+
+def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
+              network_inputs: tuple[str, ...] = ("temperature",)) -> Calibration:
+    """:func:`fit_calibration` with its options checked: the route (no temperature model, a selection by held-out
+    drift, one binned fit), then each axis's frozen result, the network trained on top where asked for."""
     recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings or ())
-    if isinstance(temperature, (Polynomial, Network)):
-        temperature, seed = legacy_temperature(temperature)
-        mlp_seed = seed if isinstance(temperature, tuple) else mlp_seed
-    _check_fit_inputs(recordings, temperature, acceleration, static_min_duration_s)
-    if temperature is None:
-        return _fit_without_temperature(recordings, acceleration, static_min_duration_s)
-    if hysteresis not in HYSTERESIS_CHOICES:
-        raise InputError(f"hysteresis: {hysteresis!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
-    hidden = None
-    if temperature == "mlp" or (isinstance(temperature, tuple) and temperature[0] == "mlp"):
-        hidden = DEFAULT_HIDDEN if temperature == "mlp" else tuple(temperature[1])
-        temperature = "auto"  # the polynomial still finds lag and hysteresis for the network
-    accel_mode = acceleration
+    spec = options.temperature
+    _check_fit_inputs(recordings, spec)
+    if spec is None:
+        return _fit_without_temperature(recordings, options.acceleration, options.static_min_duration_s)
+    # a network keeps the polynomial stage with its order chosen: it still finds lag and hysteresis for the network
+    order = spec.order if isinstance(spec, Polynomial) else "auto"
+    accel_mode = options.acceleration
     if accel_mode == "auto":
-        accel_mode = "matrix" if turned_between_positions(recordings, static_min_duration_s) else "none"
+        accel_mode = "matrix" if turned_between_positions(recordings, options.static_min_duration_s) else "none"
     selections, model, thermal = None, None, None
-    if hysteresis_band_degc is None and (temperature == "auto" or hysteresis == "auto"):
-        selections, thermal = _fit_selected(recordings, temperature=temperature, hysteresis=hysteresis,
-                                            hysteresis_order=hysteresis_order, accel_mode=accel_mode,
-                                            bin_width_degc=bin_width_degc,
-                                            static_min_duration_s=static_min_duration_s, run_folds=run_folds,
-                                            folds=folds)
+    if options.hysteresis_band_degc is None and (order == "auto" or options.hysteresis == "auto"):
+        selections, thermal = _fit_selected(recordings, order, options, accel_mode)
     else:
-        model, thermal = _fit_binned(recordings, temperature=temperature, hysteresis=hysteresis,
-                                     hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,
-                                     bin_width_degc=bin_width_degc, accel_mode=accel_mode,
-                                     static_min_duration_s=static_min_duration_s, run_folds=run_folds)
-    report = _report_of_choice(selections, model, thermal, hysteresis, acceleration, accel_mode)
-    network = MLPTemperatureModel(hidden=hidden, seed=mlp_seed) if hidden is not None else None
+        model, thermal = _fit_binned(recordings, order, options, accel_mode)
+    report = _report_of_choice(selections, model, thermal, options.hysteresis, options.acceleration, accel_mode)
+    network = MLPTemperatureModel(hidden=spec.hidden, seed=spec.seed) if isinstance(spec, Network) else None
     axes = {}
     for axis in fit_axes(recordings):
         axes[axis], report["axes"][axis] = _axis_calibration(
-            axis, recordings, selections, model, thermal, network, accel_mode, bin_width_degc, network_inputs)
+            axis, recordings, selections, model, thermal, network, accel_mode, options.bin_width_degc,
+            network_inputs)
     if network is not None:
         report["temperature"] = "mlp"
         report["network"] = NetworkReport(
-            tuple(hidden), network.restarts, network.seed,
+            tuple(network.hidden), network.restarts, network.seed,
             "Levenberg-Marquardt, early stopping on 20 % held-out segments",
             {a: tuple(network.validation_rmse_dps_[a]) for a in network.curves_},
             {a: network.epochs_[a] for a in network.curves_}).to_dict()
-    name = _model_name(axes, network, network_inputs, temperature, thermal, accel_mode)
+    name = _model_name(axes, network, network_inputs, order, thermal, accel_mode)
     if PreparedRun.of(recordings[0]).channel == "accel":
         return _accelerometer_calibration(axes, name, provenance(recordings), report)
     return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
@@ -303,26 +298,21 @@ def _accelerometer_calibration(axes: dict[str, AxisCalibration], name: str, sour
                        accel_reference_degc=reference)
 
 
-def _check_fit_inputs(recordings: list[Recording], temperature, acceleration: str,
-                      static_min_duration_s: float) -> None:
+def _check_fit_inputs(recordings: list[Recording], spec: Polynomial | Network | None) -> None:
     """Refuse what cannot be fitted; warn about what is probably not calibration data."""
     if not recordings:
         raise InputError("fit: give at least one calibration run")
-    if acceleration not in ("auto", *ACCELERATION_CHOICES):
-        raise InputError(f"acceleration: {acceleration!r}; use one of auto, {', '.join(ACCELERATION_CHOICES)}")
-    if not static_min_duration_s > 0:
-        raise InputError(f"static_min_duration_s: must be a positive number of seconds, got {static_min_duration_s}")
     concerns = [c for rec in recordings for c in calibration_concerns(rec)]
-    if temperature not in (None, "auto", 0):  # a curve asked for
-        concerns.append(temperature_span_concern(recordings))
+    if isinstance(spec, Network) or (isinstance(spec, Polynomial) and spec.order not in ("auto", 0)):
+        concerns.append(temperature_span_concern(recordings))  # a curve asked for
     for concern in filter(None, concerns):
-        warnings.warn(concern.warning(), stacklevel=3)
-    if temperature is not None:
+        warnings.warn(concern.warning(), stacklevel=4)
+    if spec is not None:
         for rec in recordings:
             if rec.temperature_degc is None:
                 raise InputError(
                     f"{rec.source}: no temperature column; a temperature model needs one "
-                    "(map it with columns={'temperature': 'NAME'}, or fit with temperature=none)"
+                    "(map it with columns={'temperature': 'NAME'}, or fit with temperature=None)"
                 )
 
 
@@ -336,22 +326,21 @@ def _fit_without_temperature(recordings: list[Recording], acceleration: str, sta
     return Calibration(axes=axes, model="none", provenance=provenance(recordings), fit_report={"temperature": None})
 
 
-def _fit_binned(recordings: list[Recording], *, temperature, hysteresis: str, hysteresis_order,
-                hysteresis_band_degc, bin_width_degc, accel_mode: str, static_min_duration_s: float, run_folds):
-    """The earlier path (a fixed band, or a fixed order and memory): the binned polynomial, then lag,
-    hysteresis and G on top where asked for or where the runs heat and cool."""
-    model = PolynomialTemperatureModel(order=temperature, bin_width_degc=bin_width_degc,
-                                       folds=run_folds).fit(recordings)
-    mode = hysteresis
+def _fit_binned(recordings: list[Recording], order: int | str, options: FitOptions, accel_mode: str):
+    """The earlier path (a fixed band, or a fixed order and memory): the binned polynomial of ``order`` (or
+    "auto"), then lag, hysteresis and G on top where asked for or where the runs heat and cool."""
+    model = PolynomialTemperatureModel(order=order, bin_width_degc=options.bin_width_degc,
+                                       folds=options.run_folds).fit(recordings)
+    mode = options.hysteresis
     if mode == "auto" and not any(heats_and_cools(recordings, a) for a in fit_axes(recordings)):
         mode = "none"
     thermal = None
     if mode != "none" or accel_mode != "none":
         orders = {axis: curve.order for axis, curve in model.curves_.items()}
-        thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=hysteresis_order,
-                                         band_degc=hysteresis_band_degc, bin_width_degc=bin_width_degc,
-                                         reselect_order=temperature == "auto", acceleration=accel_mode,
-                                         static_min_duration_s=static_min_duration_s).fit(recordings)
+        thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=options.hysteresis_order,
+                                         band_degc=options.hysteresis_band_degc, bin_width_degc=options.bin_width_degc,
+                                         reselect_order=order == "auto", acceleration=accel_mode,
+                                         static_min_duration_s=options.static_min_duration_s).fit(recordings)
     return model, thermal
 
 
@@ -411,7 +400,7 @@ def _axis_calibration(axis: str, recordings: list[Recording], selections, model,
     return result, entry
 
 
-def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, temperature, thermal,
+def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, order: int | str, thermal,
                 accel_mode: str) -> str:
     """The short name of the fitted model, e.g. ``poly:2/3 (auto) + lag + g-sensitivity``."""
     if network is not None:
@@ -419,7 +408,7 @@ def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, tempe
     else:
         orders = sorted({ax.temperature.order if ax.temperature is not None else 0 for ax in axes.values()})
         name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
-        if temperature == "auto":
+        if order == "auto":
             name += " (auto)"
     if thermal is not None:
         extras = sorted({memory for memory, _ in thermal.memories_.values()} - {"none"})
@@ -487,30 +476,30 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
         raise InputError(f"pipeline: {pipeline!r}; use one of {', '.join(PIPELINES)} (quote the > in a shell)")
     options = _options(options)
     if pipeline == "joint":
-        return fit_calibration(recordings, **options.calibration_arguments())
+        return _fit_with(recordings, options)
     accel_mode = "matrix" if options.acceleration in ("auto", "none") else options.acceleration
     min_static = options.static_min_duration_s
     # the network pipelines use the network asked for, else the thesis's 1-3-1
     network = options.temperature if isinstance(options.temperature, Network) else Network()
     if pipeline == "joint-mlp":
-        cal = fit_calibration(recordings, network_inputs=NETWORK_INPUTS, **dataclasses.replace(
-            options, temperature=network, acceleration=accel_mode).calibration_arguments())
+        cal = _fit_with(recordings, dataclasses.replace(options, temperature=network, acceleration=accel_mode),
+                        NETWORK_INPUTS)
         return dataclasses.replace(cal, model=f"joint-mlp: {cal.model}", fit_report={**cal.fit_report,
                                                                                       "pipeline": pipeline})
     temperature_first = dataclasses.replace(options, acceleration="none",
                                             temperature=network if pipeline.startswith("mlp") else options.temperature)
     if pipeline == "mlp>mlp-accel":
-        first = fit_calibration(recordings, **temperature_first.calibration_arguments())
+        first = _fit_with(recordings, temperature_first)
         second = fit_acceleration_network(_residual_runs(first, recordings), hidden=network.hidden, seed=network.seed,
                                           min_static=min_static)
         return _chain(first, second, recordings, pipeline)
     if pipeline in ("poly>matrix", "mlp>matrix"):
-        first = fit_calibration(recordings, **temperature_first.calibration_arguments())
+        first = _fit_with(recordings, temperature_first)
         second = fit_calibration(_residual_runs(first, recordings), temperature=None, acceleration=accel_mode,
                                  static_min_duration_s=min_static)
         return _chain(first, second, recordings, pipeline)
     first = fit_calibration(recordings, temperature=None, acceleration=accel_mode, static_min_duration_s=min_static)
-    second = fit_calibration(_residual_runs(first, recordings), **temperature_first.calibration_arguments())
+    second = _fit_with(_residual_runs(first, recordings), temperature_first)
     return _chain(first, second, recordings, pipeline)
 
 
@@ -566,11 +555,9 @@ def fit_accelerometer(recordings: list[Recording], options: FitOptions | None = 
         raise InputError("channels=accel: the accelerometer model is a temperature model; "
                          "temperature=None leaves nothing to fit (use a polynomial or a network)")
     pieces, folds, split = _accelerometer_pieces(prepare(recordings), options.static_min_duration_s)
-    fitted = fit_calibration(pieces, temperature=options.temperature, bin_width_degc=options.bin_width_degc,
-                             hysteresis="none" if split and options.hysteresis == "auto" else options.hysteresis,
-                             hysteresis_order=options.hysteresis_order,
-                             hysteresis_band_degc=options.hysteresis_band_degc, acceleration="none",
-                             static_min_duration_s=options.static_min_duration_s, run_folds=folds)
+    fitted = _fit_with(pieces, dataclasses.replace(
+        options, hysteresis="none" if split and options.hysteresis == "auto" else options.hysteresis,
+        acceleration="none", run_folds=folds, folds="auto"))
     if fitted.accel_reference_degc is None:
         raise InputError("channels=accel: no temperature model of the accelerometer generalizes across these runs "
                          "(every axis is left a constant); their temperatures do not span enough to fit one")
