@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from gyrocomp.calibration import Calibration
-from gyrocomp.fit_report import MEMORIES, FitReport, MemoryChoice
+from gyrocomp.fit_report import MEMORIES, AxisFit, FitReport, MemoryChoice
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.models.pipelines import fit_calibration, fit_pipeline
 from gyrocomp.models.selection import Candidate
@@ -38,9 +38,9 @@ def test_the_report_of_a_default_fit_is_typed_and_says_what_the_model_holds():
     for axis, sel in report.selection.items():
         # the chosen candidate is one of those scored, and the held-out drift quoted is its mean over the folds
         chosen = sel.result(sel.chosen.label)
-        assert chosen.mean_drift_dps == pytest.approx(sel.chosen_drift_dps)
-        assert len(chosen.fold_drift_dps) == len(sel.folds) >= 3
-        assert sel.result("constant (time)").mean_drift_dps == pytest.approx(sel.raw_drift_dps)
+        assert chosen.mean_drift == pytest.approx(sel.chosen_drift_dps)
+        assert len(chosen.fold_drift) == len(sel.folds) >= 3
+        assert sel.result("constant (time)").mean_drift == pytest.approx(sel.raw_drift_dps)
         # the memory the report names is the model's: a lag exactly when the axis has a time constant, a
         # turning-point curve of the order named exactly when the axis has one
         choice = report.hysteresis.axes[axis]
@@ -48,6 +48,8 @@ def test_the_report_of_a_default_fit_is_typed_and_says_what_the_model_holds():
         ax = cal.axes[axis]
         assert (ax.lag_time_constant_s > 0) == ("lag" in choice.memory)
         assert choice.lag_time_constant_s == ax.lag_time_constant_s
+    for axis, written in cal.fit_report["axes"].items():  # each axis's entry was written from its record
+        assert report.axes[axis].to_dict() == written and report.axes[axis].unit == "deg/s"
         assert choice.hysteresis_order == (0 if ax.hysteresis is None else ax.hysteresis.order)
         assert choice.label == (choice.memory + (f" (order {choice.hysteresis_order})"
                                                  if choice.hysteresis_order else ""))
@@ -70,7 +72,7 @@ def test_the_selection_report_is_the_selection_as_it_was_made():
     # the report's candidates are the selection's own class, read back from the file's fields
     assert isinstance(sel.chosen, Candidate) and Candidate.from_dict(sel.chosen.to_dict()) == sel.chosen
     assert {r.candidate.label for r in sel.candidates} >= {"constant (time)", sel.chosen.label, sel.best.label}
-    best = min((r for r in sel.candidates if r.mean_drift_dps is not None), key=lambda r: r.mean_drift_dps)
+    best = min((r for r in sel.candidates if r.mean_drift is not None), key=lambda r: r.mean_drift)
     assert best.candidate == sel.best
     with pytest.raises(KeyError, match="label: no candidate 'poly:9 .time.' for gyro_z"):
         sel.result("poly:9 (time)")
@@ -91,6 +93,11 @@ def test_an_older_file_that_wrote_the_memory_as_text_reads_into_the_same_fields(
     assert report.order_selection.scores == {"gyro_x": {1: 3.0, 2: 1.0}} and report.order_selection.orders == (1, 2)
     assert report.axes["gyro_x"].fit_rms == 0.01
     assert report.sections == {"learner": {"points": 12}}  # what has no typed record is kept as stored
+    # an axis's entry is written from its record, and reads back into it
+    entry = {"order": 2, "t_min_degc": 5.0, "t_max_degc": 60.0, "scores": {"1": 3.0, "2": 1.0}, "fit_rms_dps": 0.01}
+    assert AxisFit.from_dict(entry).to_dict() == entry
+    assert AxisFit.from_dict(entry, "g").to_dict() == {**{k: v for k, v in entry.items() if k != "fit_rms_dps"},
+                                                       "fit_rms_g": 0.01}
 
 
 def test_a_model_without_a_fit_report_reads_as_an_empty_one():
@@ -139,7 +146,7 @@ def test_the_acceleration_section_is_written_from_its_typed_record(mode):
             typed = FitReport.from_dict(cal.fit_report["stages"][1]).acceleration
             network = FitReport.from_dict(cal.fit_report["stages"][0]).network  # the temperature network's stage
             assert network.to_dict() == cal.fit_report["stages"][0]["network"] and network.hidden == (3,)
-            assert set(network.validation_rmse_dps) == set(cal.axes) and network.restarts >= 1
+            assert set(network.validation_rmse) == set(cal.axes) and network.restarts >= 1
         else:
             cal = fit_calibration(runs, temperature=Polynomial(2), hysteresis="none", acceleration=mode)
             stored, typed = cal.fit_report["acceleration"], cal.report.acceleration

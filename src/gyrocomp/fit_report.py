@@ -7,7 +7,10 @@ figures read attributes instead of parsing strings. Older files that wrote the c
 what has no typed record here (the online learner's, the population prior's, a triad's account) stays in
 ``FitReport.sections``.
 
-Units are in the names: [deg/s] (``_dps``), [s], [degC], [deg/s/g].
+Units are in the names: [deg/s] (``_dps``), [g] (``_g``), [s], [degC], [deg/s/g]. A record of an axis's drifts or
+residuals has neutral names and the axis's ``unit`` (deg/s for the gyro, g for the accelerometer); the file names
+each value with its unit (``raw_drift_dps`` or ``raw_drift_g``), and files written before that kept the
+accelerometer's under ``_dps`` (read as the section's unit).
 """
 
 from __future__ import annotations
@@ -16,6 +19,8 @@ import math
 import re
 from dataclasses import dataclass, field
 from typing import Any, Literal
+
+from .units import AxisUnit, in_unit, unit_suffix
 
 #: the thermal memories a gyro axis's model may carry
 MEMORIES = ("none", "lag", "turning-point", "turning-point+lag")
@@ -94,21 +99,30 @@ class Candidate:
                    d.get("weighting", "time"), bool(d.get("band", False)))
 
 
+def _in_unit(d: dict, name: str, unit: str, default=None):
+    """``d``'s entry ``name`` + the ending that says ``unit`` (``mean_drift_g``); files written before the
+    accelerometer's entries said their unit kept them under ``_dps`` whatever the unit (in g for the
+    accelerometer), so that name is read when the other is absent."""
+    return d.get(name + unit_suffix(unit), d.get(name + "_dps", default))
+
+
 @dataclass(frozen=True)
 class CandidateResult:
-    """A candidate's held-out drift: mean and standard error over the folds, each fold's, and the lag each fold's
-    fit chose [deg/s, s]; None where a fold held too little data."""
+    """A candidate's held-out drift: mean and standard error over the folds, and each fold's [the axis's unit:
+    deg/s, or g for an accelerometer axis], and the lag each fold's fit chose [s]; None where a fold held too
+    little data."""
 
     candidate: Candidate
-    mean_drift_dps: float | None
-    standard_error_dps: float | None
-    fold_drift_dps: tuple[float | None, ...]
+    mean_drift: float | None
+    standard_error: float | None
+    fold_drift: tuple[float | None, ...]
     fold_lag_s: tuple[float, ...]
 
     @classmethod
-    def from_dict(cls, d: dict) -> "CandidateResult":
-        return cls(Candidate.from_dict(d), _number(d.get("mean_drift_dps")), _number(d.get("standard_error_dps")),
-                   tuple(_number(v) for v in d.get("fold_drift_dps", ())),
+    def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "CandidateResult":
+        return cls(Candidate.from_dict(d), _number(_in_unit(d, "mean_drift", unit)),
+                   _number(_in_unit(d, "standard_error", unit)),
+                   tuple(_number(v) for v in _in_unit(d, "fold_drift", unit, ())),
                    tuple(float(v) for v in d.get("fold_lag_s", ())))
 
 
@@ -116,7 +130,8 @@ class CandidateResult:
 class SelectionReport:
     """The choice for one axis by held-out drift (:class:`gyrocomp.models.selection.AxisSelection` as stored):
     how the data was held out, the moving-average window of the score [s], every candidate's result, the best
-    and the chosen one (the simplest within one standard error of the best)."""
+    and the chosen one (the simplest within one standard error of the best); the drifts are in the axis's
+    ``unit`` (deg/s, or g for an accelerometer axis)."""
 
     axis: str
     fold_kind: str
@@ -126,11 +141,15 @@ class SelectionReport:
     band_degc: tuple[float, float] | None
     best: Candidate
     chosen: Candidate
-    raw_drift_dps: float | None
-    chosen_drift_dps: float | None
+    raw_drift: float | None
+    chosen_drift: float | None
     validated: bool
     generalizes: bool
     candidates: tuple[CandidateResult, ...]
+    unit: AxisUnit = "deg/s"
+
+    raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
+    chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
 
     def result(self, label: str) -> CandidateResult:
         """The result of the candidate named ``label``."""
@@ -140,13 +159,14 @@ class SelectionReport:
         raise KeyError(f"label: no candidate {label!r} for {self.axis}")
 
     @classmethod
-    def from_dict(cls, d: dict) -> "SelectionReport":
+    def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "SelectionReport":
         band = d.get("band_degc")
         return cls(str(d["axis"]), str(d["fold_kind"]), tuple(d.get("folds", ())), float(d["window_s"]),
                    float(d.get("temperature_step_degc", 0.0)), None if band is None else (float(band[0]), float(band[1])),
                    Candidate.from_dict(d["best"]), Candidate.from_dict(d["chosen"]),
-                   _number(d.get("raw_drift_dps")), _number(d.get("chosen_drift_dps")), bool(d.get("validated", True)),
-                   bool(d.get("generalizes", True)), tuple(CandidateResult.from_dict(c) for c in d.get("candidates", ())))
+                   _number(_in_unit(d, "raw_drift", unit)), _number(_in_unit(d, "chosen_drift", unit)),
+                   bool(d.get("validated", True)), bool(d.get("generalizes", True)),
+                   tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit)
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
@@ -156,8 +176,8 @@ _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
 class MemoryChoice:
     """The thermal memory chosen for one axis (``memory`` one of :data:`MEMORIES`, with the turning-point order,
     0 without), its lag's time constant [s], the polynomial order and weighting it came with, and the score of
-    each memory (held-out drift [deg/s], or BIC when ``HysteresisReport.by_bic``; None where not computed), and
-    where the thermal fit chose the polynomial order itself, the score of each order."""
+    each memory (held-out drift [the axis's unit], or BIC when ``HysteresisReport.by_bic``; None where not
+    computed), and where the thermal fit chose the polynomial order itself, the score of each order."""
 
     memory: str
     hysteresis_order: int
@@ -172,25 +192,26 @@ class MemoryChoice:
         """``turning-point (order 2)``, ``lag``, ``none``."""
         return memory_label(self.memory, self.hysteresis_order)
 
-    def to_dict(self, by_bic: bool = False) -> dict:
-        """As the model file stores it (``scores_bic`` instead of ``scores_dps`` when the scores are BIC)."""
+    def to_dict(self, by_bic: bool = False, unit: AxisUnit = "deg/s") -> dict:
+        """As the model file stores it (``scores_bic`` when the scores are BIC, else ``scores_dps`` or
+        ``scores_g`` by the axis's ``unit``)."""
         out = {"chosen": self.label, "memory": self.memory, "hysteresis_order": self.hysteresis_order,
                "lag_time_constant_s": self.lag_time_constant_s, "order": self.order}
         if self.weighting is not None:
             out["weighting"] = self.weighting
         if self.order_scores:
             out["order_scores"] = {str(o): float(v) for o, v in self.order_scores.items()}
-        out["scores_bic" if by_bic else "scores_dps"] = dict(self.scores)
+        out["scores_bic" if by_bic else "scores" + unit_suffix(unit)] = dict(self.scores)
         return out
 
     @classmethod
-    def from_dict(cls, d: dict) -> "MemoryChoice":
+    def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "MemoryChoice":
         if "memory" in d:
             memory, order = str(d["memory"]), int(d.get("hysteresis_order", 0))
         else:  # files before the fields: the chosen memory as text
             match = _CHOSEN.match(str(d.get("chosen", "none")))
             memory, order = (match["memory"], int(match["order"] or 0)) if match else (str(d.get("chosen")), 0)
-        scores = d.get("scores_dps", d.get("scores_bic", {})) or {}
+        scores = _in_unit(d, "scores", unit, d.get("scores_bic", {})) or {}
         return cls(memory, order, float(d.get("lag_time_constant_s", 0.0)),
                    None if d.get("order") is None else int(d["order"]), d.get("weighting"),
                    {str(k): _number(v) for k, v in scores.items()},
@@ -200,11 +221,12 @@ class MemoryChoice:
 @dataclass(frozen=True)
 class HysteresisReport:
     """Thermal lag and turning-point hysteresis: the mode asked for, how the memory was chosen
-    (``leave-one-run-out``, ``bic``, or why none was), and the choice per axis."""
+    (``leave-one-run-out``, ``bic``, or why none was), and the choice per axis (its scores in ``unit``)."""
 
     mode: str
     selection: str
     axes: dict[str, MemoryChoice]
+    unit: AxisUnit = "deg/s"
 
     @property
     def by_bic(self) -> bool:
@@ -220,13 +242,13 @@ class HysteresisReport:
         """As the model file stores it (no ``axes`` when no memory was chosen)."""
         out = {"mode": self.mode, "selection": self.selection}
         if self.axes:
-            out["axes"] = {axis: choice.to_dict(self.by_bic) for axis, choice in self.axes.items()}
+            out["axes"] = {axis: choice.to_dict(self.by_bic, self.unit) for axis, choice in self.axes.items()}
         return out
 
     @classmethod
-    def from_dict(cls, d: dict) -> "HysteresisReport":
+    def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "HysteresisReport":
         return cls(str(d.get("mode", "auto")), str(d.get("selection", "none")),
-                   {str(a): MemoryChoice.from_dict(v) for a, v in (d.get("axes") or {}).items()})
+                   {str(a): MemoryChoice.from_dict(v, unit) for a, v in (d.get("axes") or {}).items()}, unit)
 
 
 @dataclass(frozen=True)
@@ -245,28 +267,30 @@ class OrderSelection:
 @dataclass(frozen=True)
 class NetworkReport:
     """The temperature network: hidden layer sizes, restarts, seed, how it was trained, and per axis the
-    validation RMS of each restart [deg/s] and the epochs of the one kept."""
+    validation RMS of each restart [``unit``: deg/s, or g for accelerometer axes] and the epochs of the one kept."""
 
     hidden: tuple[int, ...]
     restarts: int
     seed: int
     training: str
-    validation_rmse_dps: dict[str, tuple[float, ...]]
+    validation_rmse: dict[str, tuple[float, ...]]
     epochs: dict[str, Any]
+    unit: AxisUnit = "deg/s"
 
     def to_dict(self) -> dict:
-        """As the model file stores it."""
+        """As the model file stores it (``validation_rmse_dps`` or ``validation_rmse_g``)."""
+        name = "validation_rmse" + unit_suffix(self.unit)
         return {"hidden": list(self.hidden), "restarts": self.restarts, "seed": self.seed, "training": self.training,
-                "axes": {a: {"validation_rmse_dps": list(self.validation_rmse_dps[a]), "epochs": self.epochs.get(a)}
-                         for a in self.validation_rmse_dps}}
+                "axes": {a: {name: list(self.validation_rmse[a]), "epochs": self.epochs.get(a)}
+                         for a in self.validation_rmse}}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "NetworkReport":
+    def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "NetworkReport":
         axes = d.get("axes", {})
         return cls(tuple(int(h) for h in d["hidden"]), int(d.get("restarts", 1)), int(d.get("seed", 0)),
                    str(d.get("training", "")),
-                   {a: tuple(float(v) for v in i.get("validation_rmse_dps", ())) for a, i in axes.items()},
-                   {a: i.get("epochs") for a, i in axes.items()})
+                   {a: tuple(float(v) for v in _in_unit(i, "validation_rmse", unit, ())) for a, i in axes.items()},
+                   {a: i.get("epochs") for a, i in axes.items()}, unit)
 
 
 @dataclass(frozen=True)
@@ -336,18 +360,38 @@ class GSensitivityReport:
 @dataclass(frozen=True)
 class AxisFit:
     """One axis's fitted curve: its order (an int for a polynomial, the network's name for a network), the
-    temperature range it was fitted on [degC], and its fit RMS [deg/s or g] where the fit reported one."""
+    temperature range it was fitted on [degC], its fit RMS [``unit``: deg/s, or g for an accelerometer axis] where
+    the fit reported one, and where the order was chosen by the polynomial's own fit, each order's score
+    (held-out residual [``unit``] or BIC, as ``FitReport.order_selection`` says)."""
 
     order: int | str | None
     t_min_degc: float | None
     t_max_degc: float | None
     fit_rms: float | None
+    unit: AxisUnit = "deg/s"
+    scores: dict[int, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """As the model file stores it (``fit_rms_dps`` or ``fit_rms_g``; no entry the fit did not report)."""
+        out: dict[str, Any] = {"order": self.order, "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
+        if self.scores:
+            out["scores"] = {str(p): float(v) for p, v in self.scores.items()}
+        if self.fit_rms is not None:
+            out["fit_rms" + unit_suffix(self.unit)] = float(self.fit_rms)
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "AxisFit":
+        return cls(d.get("order"), _number(d.get("t_min_degc")), _number(d.get("t_max_degc")),
+                   _number(_in_unit(d, "fit_rms", unit)), unit,
+                   {int(p): float(v) for p, v in (d.get("scores") or {}).items()})
 
 
 @dataclass(frozen=True)
 class FitReport:
     """How a calibration was fitted (see the module). ``method`` is the temperature model's family
-    (``polynomial``, ``mlp``, ``population prior``, ...; None without a temperature model)."""
+    (``polynomial``, ``mlp``, ``population prior``, ...; None without a temperature model). ``accel`` is the
+    accelerometer's own account, its figures in g."""
 
     method: str | None
     axes: dict[str, AxisFit]
@@ -362,26 +406,25 @@ class FitReport:
     sections: dict[str, Any]
 
     @classmethod
-    def from_dict(cls, d: dict | None) -> "FitReport":
-        """Read the ``fit_report`` object of a model file (any schema version)."""
+    def from_dict(cls, d: dict | None, unit: AxisUnit = "deg/s") -> "FitReport":
+        """Read the ``fit_report`` object of a model file (any schema version); ``unit`` is the unit of the axes it
+        accounts for (its ``accel`` section is read in g)."""
         d = d or {}
-        axes_in = d.get("axes") or {}
-        axes = {a: AxisFit(i.get("order"), _number(i.get("t_min_degc")), _number(i.get("t_max_degc")),
-                           _number(i.get("fit_rms_dps"))) for a, i in axes_in.items()}
-        scores = {a: {int(p): float(v) for p, v in i["scores"].items()} for a, i in axes_in.items() if i.get("scores")}
+        axes = {a: AxisFit.from_dict(i, unit) for a, i in (d.get("axes") or {}).items()}
+        scores = {a: fit.scores for a, fit in axes.items() if fit.scores}
         order_selection = (OrderSelection(str(d.get("order_selection", "")), scores)
                            if scores and "network" not in d else None)
         hysteresis = d.get("hysteresis")
         acceleration = d.get("acceleration")
         return cls(
             method=d.get("temperature"), axes=axes, order_selection=order_selection,
-            selection={a: SelectionReport.from_dict(s) for a, s in (d.get("selection") or {}).items()},
-            hysteresis=HysteresisReport.from_dict(hysteresis) if isinstance(hysteresis, dict) else None,
-            network=NetworkReport.from_dict(d["network"]) if d.get("network") else None,
+            selection={a: SelectionReport.from_dict(s, unit) for a, s in (d.get("selection") or {}).items()},
+            hysteresis=HysteresisReport.from_dict(hysteresis, unit) if isinstance(hysteresis, dict) else None,
+            network=NetworkReport.from_dict(d["network"], unit) if d.get("network") else None,
             acceleration=GSensitivityReport.from_dict(acceleration) if isinstance(acceleration, dict) else None,
             pipeline=d.get("pipeline"),
-            stages=tuple(cls.from_dict(s) for s in d.get("stages") or ()),
-            accel=cls.from_dict(d["accel"]) if isinstance(d.get("accel"), dict) else None,
+            stages=tuple(cls.from_dict(s, unit) for s in d.get("stages") or ()),
+            accel=cls.from_dict(d["accel"], "g") if isinstance(d.get("accel"), dict) else None,
             sections={k: v for k, v in d.items() if k not in _TYPED})
 
 

@@ -27,6 +27,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from .errors import InputError
+from .units import unit_suffix
 
 #: how a triad was calibrated
 TriadMethod = Literal["norm", "six-position", "rate-table", "rotation"]
@@ -150,7 +151,7 @@ class TriadCalibration:
 
     # -- serialization ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        suffix = "_g" if self.unit == "g" else "_dps"
+        suffix = unit_suffix(self.unit)
         return {
             "method": self.method,
             "unit": self.unit,
@@ -170,7 +171,7 @@ class TriadCalibration:
         unit = d.get("unit")
         if unit not in ("g", "deg/s"):
             raise InputError(f"{where}.unit: {unit!r}; use 'g' or 'deg/s'")
-        suffix = "_g" if unit == "g" else "_dps"
+        suffix = unit_suffix(unit)
         for key in ("method", "sensitivity", "sensitivity_stderr", f"bias{suffix}", f"bias_stderr{suffix}"):
             if key not in d:
                 raise InputError(f"{where}: no {key!r} entry")

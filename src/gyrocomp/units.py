@@ -24,6 +24,16 @@ def check_axis_unit(unit: str) -> None:
         raise InputError(f"unit: {unit!r}; an axis is in one of {', '.join(AXIS_UNITS)}")
 
 
+#: how a name that carries an axis's unit ends: ``drift_dps`` [deg/s], ``drift_g`` [g]
+UNIT_SUFFIXES = {"deg/s": "_dps", "g": "_g"}
+
+
+def unit_suffix(unit: str) -> str:
+    """The ending of a name that says ``unit`` (one of :data:`AXIS_UNITS`): ``_dps`` or ``_g``."""
+    check_axis_unit(unit)
+    return UNIT_SUFFIXES[unit]
+
+
 def require_unit(actual: str, expected: str, name: str, neutral: str) -> None:
     """Refuse to read ``name`` (a name that says its unit, ``expected``) of an axis in ``actual``; ``neutral`` is
     the unit-free name that reads either."""

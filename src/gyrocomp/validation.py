@@ -29,7 +29,8 @@ from .metrics import smoothed_residual_rms
 from .models.base import provenance
 from .models.hysteresis import turn_threshold_degc
 from .models.options import FitOptions
-from .models.selection import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, FoldDrift, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
+from .models.selection import (BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MAX_S, WINDOW_MIN_S, fold_mean,
+                               fold_standard_error, leg_labels)
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
 from .prepared import prepare
@@ -82,12 +83,21 @@ class Fold:
 
 
 @dataclass(frozen=True)
-class MethodScore(FoldDrift):
-    """Held-out drift of one method on one axis, per fold and on average [deg/s]."""
+class MethodScore:
+    """Held-out drift of one method on one gyro axis, per fold and on average [deg/s]."""
 
     method: str
     axis: str
     fold_drift_dps: tuple[float, ...]
+
+    @property
+    def mean_drift_dps(self) -> float:
+        return fold_mean(self.fold_drift_dps)
+
+    @property
+    def standard_error_dps(self) -> float:
+        """Standard error of the mean over the folds [deg/s] (NaN with one fold)."""
+        return fold_standard_error(self.fold_drift_dps)
 
     def to_dict(self) -> dict:
         return {"method": self.method, "axis": self.axis, "mean_drift_dps": self.mean_drift_dps,

@@ -13,10 +13,11 @@ from gyrocomp import apply
 from gyrocomp.calibration import Calibration
 from gyrocomp.compensate import Compensator
 from gyrocomp.errors import InputError
+from gyrocomp.fit_report import FitReport
 from gyrocomp.metrics import evaluate_run, moving_average
 from gyrocomp.models.pipelines import fit_accelerometer, fit_channels, parse_channels
 from gyrocomp.simulate import get_profile, simulate
-from gyrocomp.models.options import FitOptions, Polynomial
+from gyrocomp.models.options import FitOptions, Network, Polynomial
 
 from ..conftest import run
 
@@ -87,6 +88,45 @@ def test_round_trip_names_accelerometer_values_in_g(cycles, tmp_path):
     b = _quiet(apply, loaded, cycles[3].recording)
     np.testing.assert_array_equal(a.accel_g, b.accel_g)
     np.testing.assert_array_equal(a.gyro_dps, b.gyro_dps)
+
+
+def _keys(d) -> list[str]:
+    """Every key of a nested JSON object."""
+    if isinstance(d, dict):
+        return [k for key, value in d.items() for k in (key, *_keys(value))]
+    return [k for value in d for k in _keys(value)] if isinstance(d, list) else []
+
+
+def _renamed(d, old: str, new: str):
+    """``d`` with every key ending in ``old`` ending in ``new`` instead."""
+    if isinstance(d, dict):
+        return {(k[:-len(old)] + new if k.endswith(old) else k): _renamed(v, old, new) for k, v in d.items()}
+    return [_renamed(v, old, new) for v in d] if isinstance(d, list) else d
+
+
+@pytest.mark.parametrize("temperature", [Polynomial(), Network((2,))], ids=["selected", "network"])
+def test_the_accelerometer_fit_report_names_its_figures_in_g(cycles, temperature):
+    """The accelerometer's held-out drifts, thermal-memory scores, fit and network residuals are in g: the model
+    file says so (``_g``, never ``_dps``), the typed report carries the unit and refuses the deg/s names, and a file
+    written before (the same values under ``_dps``) reads into the same records."""
+    cal = _quiet(fit_channels, [s.recording for s in cycles[:3]], ("accel",),
+                 options=FitOptions(temperature=temperature))
+    section = cal.fit_report["accel"]
+    keys = _keys(section)
+    assert not [k for k in keys if k.endswith("_dps")]
+    expected = {"fit_rms_g", "validation_rmse_g"} if isinstance(temperature, Network) else {
+        "raw_drift_g", "chosen_drift_g", "mean_drift_g", "fold_drift_g"}
+    assert expected <= set(keys)
+    report = cal.report.accel
+    if isinstance(temperature, Network):
+        assert report.network.unit == "g" and set(report.network.validation_rmse) == set(cal.accel_axes)
+        assert all(fit.unit == "g" and fit.fit_rms > 0 for fit in report.axes.values())
+    for axis, sel in report.selection.items():
+        assert sel.unit == "g" and sel.raw_drift == section["selection"][axis]["raw_drift_g"]
+        with pytest.raises(InputError, match=r"raw_drift_dps: the axis's values are in g, not deg/s; read raw_drift"):
+            sel.raw_drift_dps
+    older = FitReport.from_dict({"accel": _renamed(section, "_g", "_dps")})
+    assert older.accel == report
 
 
 def test_streaming_equals_batch_with_lag(cycles):

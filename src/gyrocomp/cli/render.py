@@ -136,7 +136,7 @@ def _print_axis_fits(console, axes: dict, report: FitReport, title: str, unit: s
     if net:
         console.print(f"network: 1-{'-'.join(map(str, net.hidden))}-1 tanh/linear, {net.restarts} restarts "
                       f"(seed {net.seed}), {net.training}; validation RMS of the restarts [{unit}]: " + "; ".join(
-                          f"{a} " + ", ".join(f"{v:.4g}" for v in rmse) for a, rmse in net.validation_rmse_dps.items()))
+                          f"{a} " + ", ".join(f"{v:.4g}" for v in rmse) for a, rmse in net.validation_rmse.items()))
     if report.order_selection is not None:
         _print_order_selection(console, axes, report.order_selection, unit)
     if report.selection:
@@ -189,8 +189,8 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
     for axis, sel in selection.items():
         chosen, best = sel.result(sel.chosen.label), sel.result(sel.best.label)
         table.add_row(axis, sel.chosen.label,
-                      f"{_score(chosen.mean_drift_dps)} +- {_score(chosen.standard_error_dps, '.2g')}",
-                      sel.best.label, _score(best.mean_drift_dps), _score(sel.raw_drift_dps))
+                      f"{_score(chosen.mean_drift)} +- {_score(chosen.standard_error, '.2g')}",
+                      sel.best.label, _score(best.mean_drift), _score(sel.raw_drift))
     console.print(table)
     folds = Table(title=f"held-out drift per fold [{unit}]")
     folds.add_column("axis")
@@ -199,7 +199,7 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
         folds.add_column(name, justify="right")
     for axis, sel in selection.items():
         for label in dict.fromkeys([sel.chosen.label, sel.best.label, "constant (time)"]):
-            folds.add_row(axis, label, *[_score(v) for v in sel.result(label).fold_drift_dps])
+            folds.add_row(axis, label, *[_score(v) for v in sel.result(label).fold_drift])
     console.print(folds)
 
 

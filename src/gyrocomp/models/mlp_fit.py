@@ -184,10 +184,10 @@ class MLPTemperatureModel:
     --------------------------
     curves_ : dict[str, MLPBias]
     turn_on_biases_ : dict[str, np.ndarray]
-    validation_rmse_dps_ : dict[str, list[float]]
-        Validation RMS of every restart [deg/s].
-    train_rmse_dps_ : dict[str, float]
-        Weighted RMS of the final network's residuals over all block means [deg/s].
+    validation_rmse_ : dict[str, list[float]]
+        Validation RMS of every restart [the axis's unit: deg/s; g for an accelerometer's axes].
+    train_rmse_ : dict[str, float]
+        Weighted RMS of the final network's residuals over all block means [the axis's unit].
     epochs_ : dict[str, int]
     """
 
@@ -205,8 +205,8 @@ class MLPTemperatureModel:
         if self.restarts < 1:
             raise InputError(f"restarts: must be at least 1, got {self.restarts}")
         if not hasattr(self, "curves_"):
-            self.curves_, self.turn_on_biases_, self.validation_rmse_dps_, self.epochs_ = {}, {}, {}, {}
-            self.train_rmse_dps_ = {}
+            self.curves_, self.turn_on_biases_, self.validation_rmse_, self.epochs_ = {}, {}, {}, {}
+            self.train_rmse_ = {}
         t = np.concatenate(temperature_degc)
         y = np.concatenate(value)
         w = np.concatenate(weight)
@@ -252,9 +252,9 @@ class MLPTemperatureModel:
         at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
         self.curves_[axis] = curve
         self.turn_on_biases_[axis] = best.run_constants * scale + at_ref
-        self.validation_rmse_dps_[axis] = [r.validation_rmse * scale for r in results]
+        self.validation_rmse_[axis] = [r.validation_rmse * scale for r in results]
         self.epochs_[axis] = best.epochs
-        self.train_rmse_dps_[axis] = best.train_rmse * scale
+        self.train_rmse_[axis] = best.train_rmse * scale
         self._fitted = True
         return self
 

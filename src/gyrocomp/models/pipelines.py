@@ -13,7 +13,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
-from ..fit_report import GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
+from ..fit_report import AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..plausibility import calibration_concerns, temperature_span_concern
 from ..prepared import PreparedRun, fit_axes, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
@@ -127,6 +127,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
 
 def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
     for axis, sel in selections.items():
+        unit = sel.unit
         across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[sel.fold_kind]
         if not sel.validated:
             warnings.warn(f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without "
@@ -134,15 +135,15 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
         elif not sel.generalizes:
             warnings.warn(f"{axis}: no temperature model generalizes across {across}; left uncompensated "
                           "(run constant only)", ModelChoiceWarning, stacklevel=3)
-        elif sel.chosen_drift_dps > sel.raw_drift_dps:
-            warnings.warn(f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift_dps:.3g} deg/s of "
-                          f"held-out drift, more than the raw output's {sel.raw_drift_dps:.3g} deg/s",
+        elif sel.chosen_drift > sel.raw_drift:
+            warnings.warn(f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift:.3g} {unit} of "
+                          f"held-out drift, more than the raw output's {sel.raw_drift:.3g} {unit}",
                           ModelChoiceWarning, stacklevel=3)
 
 
 def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHysteresisModel, mode: str) -> dict:
     """The hysteresis part of the fit report from the selection: per axis the memory chosen, its lag, and the best
-    held-out drift of each memory at the chosen order and weighting [deg/s]."""
+    held-out drift of each memory at the chosen order and weighting [the axes' unit]."""
     kind = FOLD_SELECTION[next(iter(selections.values())).fold_kind]
     axes = {}
     for axis, sel in selections.items():
@@ -152,20 +153,20 @@ def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHyst
             same = s.candidate.order == c.order and s.candidate.weighting == c.weighting
             if same or (s.candidate.order == 0 and c.order == 0):
                 m = s.candidate.memory
-                if math.isfinite(s.mean_drift_dps):
-                    by_memory[m] = min(by_memory.get(m, s.mean_drift_dps), s.mean_drift_dps)
+                if math.isfinite(s.mean_drift):
+                    by_memory[m] = min(by_memory.get(m, s.mean_drift), s.mean_drift)
         axes[axis] = MemoryChoice(c.memory, c.hysteresis_order, thermal.lag_time_constants_s_[axis], c.order,
                                   c.weighting, by_memory)
-    return HysteresisReport(mode, kind, axes).to_dict()
+    return HysteresisReport(mode, kind, axes, next(iter(selections.values())).unit).to_dict()
 
 
-def _thermal_report(thermal: ThermalHysteresisModel, mode: str) -> dict:
+def _thermal_report(thermal: ThermalHysteresisModel, mode: str, unit: str) -> dict:
     """The hysteresis part of the fit report from the thermal model's own choice (a fixed order or memory)."""
     axes = {axis: MemoryChoice(memory, order, thermal.lag_time_constants_s_[axis], thermal.curves_[axis].order, None,
                                {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()},
                                {int(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()})
             for axis, (memory, order) in thermal.memories_.items()}
-    return HysteresisReport(mode, thermal.selection_, axes).to_dict()
+    return HysteresisReport(mode, thermal.selection_, axes, unit).to_dict()
 
 
 def _fit_selected(recordings: list[Recording], order: int | str, options: FitOptions, accel_mode: str):
@@ -269,7 +270,8 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
         selections, thermal = _fit_selected(recordings, order, options, accel_mode)
     else:
         model, thermal = _fit_binned(recordings, order, options, accel_mode)
-    report = _report_of_choice(selections, model, thermal, options.hysteresis, options.acceleration, accel_mode)
+    unit = recordings[0].unit_of(fit_axes(recordings)[0])
+    report = _report_of_choice(selections, model, thermal, options.hysteresis, options.acceleration, accel_mode, unit)
     network = MLPTemperatureModel(hidden=spec.hidden, seed=spec.seed) if isinstance(spec, Network) else None
     axes = {}
     for axis in fit_axes(recordings):
@@ -281,8 +283,8 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
         report["network"] = NetworkReport(
             tuple(network.hidden), network.restarts, network.seed,
             "Levenberg-Marquardt, early stopping on 20 % held-out segments",
-            {a: tuple(network.validation_rmse_dps_[a]) for a in network.curves_},
-            {a: network.epochs_[a] for a in network.curves_}).to_dict()
+            {a: tuple(network.validation_rmse_[a]) for a in network.curves_},
+            {a: network.epochs_[a] for a in network.curves_}, unit).to_dict()
     name = _model_name(axes, network, network_inputs, order, thermal, accel_mode)
     if PreparedRun.of(recordings[0]).channel == "accel":
         return _accelerometer_calibration(axes, name, provenance(recordings), report)
@@ -344,7 +346,8 @@ def _fit_binned(recordings: list[Recording], order: int | str, options: FitOptio
     return model, thermal
 
 
-def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration: str, accel_mode: str) -> dict:
+def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration: str, accel_mode: str,
+                      unit: str) -> dict:
     """The fit report's account of what was chosen and how (the axes are filled in after)."""
     report = {"temperature": "polynomial", "axes": {},
               "order_selection": FOLD_SELECTION[next(iter(selections.values())).fold_kind] if selections
@@ -353,7 +356,7 @@ def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration:
         report["selection"] = {axis: sel.to_dict() for axis, sel in selections.items()}
         report["hysteresis"] = _selection_report(selections, thermal, hysteresis)
     elif thermal is not None:
-        report["hysteresis"] = _thermal_report(thermal, hysteresis)
+        report["hysteresis"] = _thermal_report(thermal, hysteresis, unit)
     else:
         report["hysteresis"] = HysteresisReport(hysteresis, "none: the runs do not both heat and cool"
                                                 if hysteresis == "auto" else "none", {}).to_dict()
@@ -390,14 +393,11 @@ def _axis_calibration(axis: str, recordings: list[Recording], selections, model,
     keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
     result = AxisCalibration(keep_curve, tuple(float(c) for c in consts), recordings[0].temperature_column_for(axis),
                              lag, hyst, g_row, g_sq, unit=recordings[0].unit_of(axis))
-    entry = {"order": curve.order, "t_min_degc": curve.t_min_degc, "t_max_degc": curve.t_max_degc}
-    if model is not None:
-        entry["scores"] = {str(p): float(v) for p, v in model.scores_[axis].items()}
-    if network is not None:
-        entry["fit_rms_dps"] = network.train_rmse_dps_[axis]
-    elif model is not None and thermal is None:
-        entry["fit_rms_dps"] = model.fit_rms_dps_[axis]
-    return result, entry
+    fit_rms = (network.train_rmse_[axis] if network is not None
+               else model.fit_rms_[axis] if model is not None and thermal is None else None)
+    entry = AxisFit(curve.order, curve.t_min_degc, curve.t_max_degc, fit_rms, result.unit,
+                    {} if model is None else dict(model.scores_[axis]))
+    return result, entry.to_dict()
 
 
 def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, order: int | str, thermal,

@@ -124,11 +124,11 @@ class PolynomialTemperatureModel:
     turn_on_biases_ : dict[str, np.ndarray]
         The fitted constant of each run [deg/s; g for an accelerometer's axes], per axis.
     scores_ : dict[str, dict[int, float]]
-        Per axis, the selection score of each order tried (CV RMS [deg/s], or BIC).
+        Per axis, the selection score of each order tried (CV RMS [the axis's unit], or BIC).
     selection_ : str
         ``"fixed"``, ``"leave-one-run-out"`` or ``"bic"``.
-    fit_rms_dps_ : dict[str, float]
-        Weighted RMS of the bin residuals of the final fit [deg/s].
+    fit_rms_ : dict[str, float]
+        Weighted RMS of the bin residuals of the final fit [the axis's unit: deg/s; g for an accelerometer's axes].
     """
 
     order: int | str = "auto"
@@ -153,7 +153,7 @@ class PolynomialTemperatureModel:
                     f"{rec.source}: {kind} axes {', '.join(fit_axes([rec]))} differ from "
                     f"{recordings[0].source}'s ({', '.join(axes)}); fit runs of the same sensor together"
                 )
-        self.curves_, self.turn_on_biases_, self.scores_, self.fit_rms_dps_ = {}, {}, {}, {}
+        self.curves_, self.turn_on_biases_, self.scores_, self.fit_rms_ = {}, {}, {}, {}
         for axis in axes:
             temps = [rec.temperature_for(axis) for rec in recordings]
             values = [rec.signal(axis) for rec in recordings]
@@ -173,7 +173,7 @@ class PolynomialTemperatureModel:
             self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), design.t_ref, design.t_scale,
                                                 t_min, t_max)
             self.turn_on_biases_[axis] = consts
-            self.fit_rms_dps_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))
+            self.fit_rms_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))
         self._fitted = True
         return self
 

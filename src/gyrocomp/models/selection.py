@@ -51,6 +51,7 @@ from ..errors import InputError
 from ..fit_report import Candidate, Weighting
 from ..metrics import moving_average
 from ..prepared import PreparedRun, RunBlocks
+from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
 from .hysteresis import parting_band_degc, turn_threshold_degc
 from .temperature import polynomial_columns
@@ -79,34 +80,40 @@ def _json_number(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
-class FoldDrift:
-    """Mean and standard error of a ``fold_drift_dps`` tuple (held-out drift per fold [deg/s])."""
+def fold_mean(fold_drift: tuple[float, ...]) -> float:
+    """Mean of the held-out drift over the folds [the drift's unit]."""
+    return float(np.mean(fold_drift))
 
-    fold_drift_dps: tuple[float, ...]
 
-    @property
-    def mean_drift_dps(self) -> float:
-        return float(np.mean(self.fold_drift_dps))
-
-    @property
-    def standard_error_dps(self) -> float:
-        """Standard error of the mean over folds [deg/s] (NaN with one fold)."""
-        f = len(self.fold_drift_dps)
-        return float(np.std(self.fold_drift_dps, ddof=1) / math.sqrt(f)) if f > 1 else math.nan
+def fold_standard_error(fold_drift: tuple[float, ...]) -> float:
+    """Standard error of the mean over the folds [the drift's unit] (NaN with one fold)."""
+    f = len(fold_drift)
+    return float(np.std(fold_drift, ddof=1) / math.sqrt(f)) if f > 1 else math.nan
 
 
 @dataclass(frozen=True)
-class CandidateScore(FoldDrift):
-    """Held-out drift of one candidate on every fold [deg/s], and what each fold's fit chose for the lag [s]."""
+class CandidateScore:
+    """Held-out drift of one candidate on every fold [the axis's unit: deg/s for a gyro axis, g for an
+    accelerometer axis], and what each fold's fit chose for the lag [s]."""
 
     candidate: Candidate
-    fold_drift_dps: tuple[float, ...]
+    fold_drift: tuple[float, ...]
     fold_lag_s: tuple[float, ...]
 
-    def to_dict(self) -> dict:
-        return {**self.candidate.to_dict(), "mean_drift_dps": _json_number(self.mean_drift_dps),
-                "standard_error_dps": _json_number(self.standard_error_dps),
-                "fold_drift_dps": [_json_number(v) for v in self.fold_drift_dps], "fold_lag_s": list(self.fold_lag_s)}
+    @property
+    def mean_drift(self) -> float:
+        return fold_mean(self.fold_drift)
+
+    @property
+    def standard_error(self) -> float:
+        return fold_standard_error(self.fold_drift)
+
+    def to_dict(self, unit: AxisUnit = "deg/s") -> dict:
+        """As the model file stores it: the drifts under names that say ``unit``."""
+        u = unit_suffix(unit)
+        return {**self.candidate.to_dict(), f"mean_drift{u}": _json_number(self.mean_drift),
+                f"standard_error{u}": _json_number(self.standard_error),
+                f"fold_drift{u}": [_json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s)}
 
 
 @dataclass(frozen=True)
@@ -143,6 +150,8 @@ class AxisSelection:
         The simplest candidate within one standard error of the best.
     band_degc : (lo, hi) or None
         The band where the branches part in the data [degC], tried with the turning-point candidates.
+    unit : {"deg/s", "g"}
+        The unit of the axis, and of every drift here.
     """
 
     axis: str
@@ -154,23 +163,28 @@ class AxisSelection:
     best: Candidate
     chosen: Candidate
     band_degc: tuple[float, float] | None = None
+    unit: AxisUnit = "deg/s"
 
     def score_of(self, candidate: Candidate) -> CandidateScore:
         return next(s for s in self.scores if s.candidate == candidate)
 
     @property
-    def raw_drift_dps(self) -> float:
-        """Mean held-out drift with the run constant alone (time-weighted) [deg/s]."""
-        return self.score_of(Candidate(0)).mean_drift_dps
+    def raw_drift(self) -> float:
+        """Mean held-out drift with the run constant alone (time-weighted) [``unit``]."""
+        return self.score_of(Candidate(0)).mean_drift
 
     @property
-    def chosen_drift_dps(self) -> float:
-        return self.score_of(self.chosen).mean_drift_dps
+    def chosen_drift(self) -> float:
+        """Mean held-out drift of the chosen candidate [``unit``]."""
+        return self.score_of(self.chosen).mean_drift
+
+    raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
+    chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
 
     @property
     def validated(self) -> bool:
         """Whether the folds held enough data to score the run constant alone."""
-        return bool(np.isfinite(self.raw_drift_dps))
+        return bool(np.isfinite(self.raw_drift))
 
     @property
     def generalizes(self) -> bool:
@@ -178,13 +192,15 @@ class AxisSelection:
         return self.chosen.has_temperature_model
 
     def to_dict(self) -> dict:
+        """As the model file stores it: the drifts under names that say the axis's unit."""
+        u = unit_suffix(self.unit)
         return {"axis": self.axis, "fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
                 "temperature_step_degc": self.temperature_step_degc,
                 "band_degc": list(self.band_degc) if self.band_degc is not None else None, "best": self.best.to_dict(),
-                "chosen": self.chosen.to_dict(), "raw_drift_dps": _json_number(self.raw_drift_dps),
-                "chosen_drift_dps": _json_number(self.chosen_drift_dps), "validated": self.validated,
+                "chosen": self.chosen.to_dict(), f"raw_drift{u}": _json_number(self.raw_drift),
+                f"chosen_drift{u}": _json_number(self.chosen_drift), "validated": self.validated,
                 "generalizes": self.generalizes,
-                "candidates": [s.to_dict() for s in self.scores]}
+                "candidates": [s.to_dict(self.unit) for s in self.scores]}
 
 
 def temperature_step_degc(temperature_degc: np.ndarray) -> float:
@@ -336,6 +352,7 @@ class SelectionProblem:
     temperature_step_degc: float = 0.0
     band_degc: tuple[float, float] | None = None
     fold_lags_s: dict[tuple[int, str], np.ndarray] = field(default_factory=dict)
+    unit: AxisUnit = "deg/s"
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -546,14 +563,14 @@ def choose(scores: list[CandidateScore], complexity) -> tuple[Candidate, Candida
     """(best, chosen): the lowest mean score, and the least complex candidate whose mean is within one standard
     error of the best's (the standard error of the best candidate's mean over folds); ties in complexity go to
     the lower score."""
-    finite = [s for s in scores if np.all(np.isfinite(s.fold_drift_dps))]
+    finite = [s for s in scores if np.all(np.isfinite(s.fold_drift))]
     if not finite:  # too little data to hold anything out: the simplest candidate, unvalidated
         simplest = min(scores, key=lambda s: complexity(s.candidate)).candidate
         return simplest, simplest
-    best = min(finite, key=lambda s: s.mean_drift_dps)
-    se = best.standard_error_dps if len(best.fold_drift_dps) > 1 else 0.0
-    accepted = [s for s in finite if s.mean_drift_dps <= best.mean_drift_dps + se]
-    chosen = min(accepted, key=lambda s: (complexity(s.candidate), s.mean_drift_dps))
+    best = min(finite, key=lambda s: s.mean_drift)
+    se = best.standard_error if len(best.fold_drift) > 1 else 0.0
+    accepted = [s for s in finite if s.mean_drift <= best.mean_drift + se]
+    chosen = min(accepted, key=lambda s: (complexity(s.candidate), s.mean_drift))
     return best.candidate, chosen.candidate
 
 
@@ -588,7 +605,7 @@ def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], m
     scores = [problem.score(c) for c in cands]
     best, chosen = choose([s for s in scores if s.candidate in eligible], problem.complexity)
     return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
-                         problem.temperature_step_degc, tuple(scores), best, chosen, problem.band_degc)
+                         problem.temperature_step_degc, tuple(scores), best, chosen, problem.band_degc, problem.unit)
 
 
 def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
@@ -655,7 +672,8 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
                          min(BAND_ORDER, max_order)) if reverses and hysteresis_orders and folds.kind == "runs" else None
     return SelectionProblem(runs, groups, folds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, max(thresholds),
                             block_s, window_for(folds, runs, block_s), max_order,
-                            hysteresis_orders if reverses else (), accel_cols, square_cols, step, band)
+                            hysteresis_orders if reverses else (), accel_cols, square_cols, step, band,
+                            unit=recordings[0].unit_of(axis))
 
 
 #: the least share of a branch after a reversal (time-weighted) that must lie at temperatures the opposite
