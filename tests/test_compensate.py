@@ -10,12 +10,24 @@ from gyrocomp.errors import DataQualityWarning, InputError, TemperatureRangeWarn
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 
-SIM = simulate(duration_s=120, rate_hz=10, seed=5)
-CAL = fit_calibration([simulate(duration_s=600, rate_hz=10, seed=s).recording for s in (1, 2)], temperature=Polynomial(3))
+#: the run compensated: 120 s at 10 Hz
+DURATION_S, RATE_HZ = 120, 10
 
 
-def stream(rec, cuts, **kw):
-    comp = Compensator(CAL, rec.gyro_axes, **kw)
+@pytest.fixture(scope="module")
+def sim():
+    return simulate(duration_s=DURATION_S, rate_hz=RATE_HZ, seed=5)
+
+
+@pytest.fixture(scope="module")
+def cal():
+    """A cubic fitted on two 10-minute runs (at first use, not when the module is imported)."""
+    return fit_calibration([simulate(duration_s=600, rate_hz=RATE_HZ, seed=s).recording for s in (1, 2)],
+                           temperature=Polynomial(3))
+
+
+def stream(cal, rec, cuts, **kw):
+    comp = Compensator(cal, rec.gyro_axes, **kw)
     edges = [0, *sorted(cuts), rec.n_samples]
     blocks = [comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b])
               for a, b in zip(edges[:-1], edges[1:])]
@@ -24,41 +36,41 @@ def stream(rec, cuts, **kw):
 
 
 @settings(max_examples=60, deadline=None)
-@given(cuts=st.lists(st.integers(0, SIM.recording.n_samples), max_size=12),
+@given(cuts=st.lists(st.integers(0, DURATION_S * RATE_HZ), max_size=12),
        window=st.one_of(st.none(), st.floats(0.05, 200.0)))
-def test_any_chunking_equals_batch(cuts, window):
+def test_any_chunking_equals_batch(sim, cal, cuts, window):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        batch = apply(CAL, SIM.recording, turn_on_window_s=window).gyro_dps
-        streamed = stream(SIM.recording, cuts, turn_on_window_s=window)
+        batch = apply(cal, sim.recording, turn_on_window_s=window).gyro_dps
+        streamed = stream(cal, sim.recording, cuts, turn_on_window_s=window)
     assert streamed.shape == batch.shape
     np.testing.assert_allclose(streamed, batch, rtol=0, atol=1e-12)
 
 
-def test_turn_on_window_uses_the_first_seconds():
-    out = apply(CAL, SIM.recording, turn_on_window_s=10.0)
-    head = SIM.recording.time_s < 10.0
+def test_turn_on_window_uses_the_first_seconds(sim, cal):
+    out = apply(cal, sim.recording, turn_on_window_s=10.0)
+    head = sim.recording.time_s < 10.0
     np.testing.assert_allclose(out.gyro_dps[head].mean(axis=0), 0.0, atol=1e-12)
 
 
-def test_turn_on_window_removes_this_runs_constant():
+def test_turn_on_window_removes_this_runs_constant(sim, cal):
     """With the window, a run whose turn-on bias is far from the calibration runs' is still centred."""
-    shifted = SIM.recording.with_gyro(SIM.recording.gyro_dps + 0.5)
-    default = apply(CAL, shifted).gyro_dps.mean(axis=0)
-    windowed = apply(CAL, shifted, turn_on_window_s=60.0).gyro_dps.mean(axis=0)
+    shifted = sim.recording.with_gyro(sim.recording.gyro_dps + 0.5)
+    default = apply(cal, shifted).gyro_dps.mean(axis=0)
+    windowed = apply(cal, shifted, turn_on_window_s=60.0).gyro_dps.mean(axis=0)
     assert np.all(np.abs(default) > 0.4)
     assert np.all(np.abs(windowed) < 0.05)
 
 
-def test_window_longer_than_data_warns():
+def test_window_longer_than_data_warns(sim, cal):
     with pytest.warns(UserWarning, match=r"shorter than the turn-on window of 1000 s"):
-        apply(CAL, SIM.recording, turn_on_window_s=1000.0)
+        apply(cal, sim.recording, turn_on_window_s=1000.0)
 
 
-def test_warns_once_across_chunks():
-    rec = SIM.recording
+def test_warns_once_across_chunks(sim, cal):
+    rec = sim.recording
     hot = rec.temperature_degc + 200
-    comp = Compensator(CAL, rec.gyro_axes)
+    comp = Compensator(cal, rec.gyro_axes)
     with pytest.warns(TemperatureRangeWarning) as record:
         for a in range(0, rec.n_samples, 100):
             comp.update(rec.time_s[a:a + 100], rec.gyro_dps[a:a + 100], hot[a:a + 100])
@@ -85,22 +97,22 @@ def test_an_axis_the_model_lacks_is_refused_unless_the_axes_are_named():
     np.testing.assert_allclose(apply(cal_z, z_only).gyro_dps[:, 0], 0.0, atol=1e-12)
 
 
-def test_errors():
+def test_errors(cal):
     with pytest.raises(InputError, match=r"turn_on_window_s: must be a positive number of seconds, got -1"):
-        Compensator(CAL, ("gyro_z",), turn_on_window_s=-1)
+        Compensator(cal, ("gyro_z",), turn_on_window_s=-1)
     with pytest.raises(InputError, match=r"the model covers gyro_x, gyro_y, gyro_z, the data has gyro_w; no axis in common"):
-        Compensator(CAL, ("gyro_w",))
-    comp = Compensator(CAL, ("gyro_x", "gyro_y", "gyro_z"))
+        Compensator(cal, ("gyro_w",))
+    comp = Compensator(cal, ("gyro_x", "gyro_y", "gyro_z"))
     with pytest.raises(InputError, match="the model needs temperature, the data has none"):
         comp.update(np.arange(3.0), np.zeros((3, 3)))
 
 
-def test_wrong_calls_raise_input_errors_that_name_the_argument():
-    rec = SIM.recording
+def test_wrong_calls_raise_input_errors_that_name_the_argument(sim, cal):
+    rec = sim.recording
     with pytest.raises(InputError, match=r"calibration: expected a Calibration .* got NoneType"):
         apply(None, rec)
     with pytest.raises(InputError, match=r"recording: expected a Recording .* got str"):
-        apply(CAL, "flight.csv")
+        apply(cal, "flight.csv")
     with pytest.raises(InputError, match=r"path: expected a file name or path, got NoneType"):
         read(None)
     with pytest.raises(InputError, match=r"path: expected a model file name or path, got int"):
@@ -111,9 +123,9 @@ def test_wrong_calls_raise_input_errors_that_name_the_argument():
         fit_calibration(None)
 
 
-def test_stream_chunks_are_checked():
-    rec = SIM.recording
-    comp = Compensator(CAL, rec.gyro_axes)
+def test_stream_chunks_are_checked(sim, cal):
+    rec = sim.recording
+    comp = Compensator(cal, rec.gyro_axes)
     t, g, temp = rec.time_s, rec.gyro_dps, rec.temperature_degc
     with pytest.raises(InputError, match=r"gyro_dps: shape \(10, 2\); give \(10, 3\) for 10 time stamps"):
         comp.update(t[:10], g[:10, :2], temp[:10])
