@@ -119,8 +119,10 @@ def test_network_options_and_errors():
         MLPBias.from_dict({"type": "mlp", "hidden": [3], "weights": [[0.0] * 6, [0.0] * 3], "output_mean_dps": 0,
                            "output_scale_dps": 1, "t_ref_degc": 25, "t_min_degc": 0, "t_max_degc": 50})
     model = MLPTemperatureModel()
-    with pytest.raises(NotFittedError, match="MLPTemperatureModel is not fitted yet"):
-        model._check_fitted()
+    with pytest.raises(NotFittedError, match=r"MLPTemperatureModel is not fitted yet; call fit_blocks\(axis, ...\) "
+                                             r"first \(curves_ is learned by the fit\)"):
+        model.curves_
+    assert not hasattr(model, "epochs_")  # hasattr reads a NotFittedError as absent
     flat = [np.full(100, 25.0)]
     with pytest.raises(ModelError, match="gyro_z: the temperature does not vary"):
         model.fit_blocks("gyro_z", flat, [np.zeros(100)], [np.ones(100)], 25.0)

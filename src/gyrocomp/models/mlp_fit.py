@@ -16,11 +16,12 @@ Training data are the bin-balanced block means the lag/hysteresis model uses
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, ModelError, NotFittedError
+from ..errors import InputError, ModelError
+from .base import LearnedAttributes
 from .mlp import DEFAULT_HIDDEN, MLPBias, forward, layer_shapes, n_parameters, unpack
 
 MAX_FAIL = 6
@@ -167,8 +168,9 @@ def validation_mask(run: np.ndarray, n_runs: int, share: float = VALIDATION_SHAR
 
 
 @dataclass
-class MLPTemperatureModel:
-    """Network temperature model, fitted per axis on block means of many runs jointly.
+class MLPTemperatureModel(LearnedAttributes):
+    """Network temperature model, fitted per axis on block means of many runs jointly (``fit_blocks``, one call
+    per axis).
 
     Parameters
     ----------
@@ -180,8 +182,8 @@ class MLPTemperatureModel:
         The same seed gives the same networks.
     max_epochs : int
 
-    Attributes (after ``fit``)
-    --------------------------
+    Attributes (after ``fit_blocks``)
+    ---------------------------------
     curves_ : dict[str, MLPBias]
     turn_on_biases_ : dict[str, np.ndarray]
     validation_rmse_ : dict[str, list[float]]
@@ -191,11 +193,12 @@ class MLPTemperatureModel:
     epochs_ : dict[str, int]
     """
 
+    FIT_CALL = "fit_blocks(axis, ...)"
+
     hidden: tuple[int, ...] = DEFAULT_HIDDEN
     restarts: int = DEFAULT_RESTARTS
     seed: int = 0
     max_epochs: int = MAX_EPOCHS
-    _fitted: bool = field(default=False, init=False, repr=False)
 
     def fit_blocks(self, axis: str, temperature_degc: list[np.ndarray], value: list[np.ndarray],
                    weight: list[np.ndarray], t_ref_degc: float, accel_g: list[np.ndarray] | None = None,
@@ -255,12 +258,7 @@ class MLPTemperatureModel:
         self.validation_rmse_[axis] = [r.validation_rmse * scale for r in results]
         self.epochs_[axis] = best.epochs
         self.train_rmse_[axis] = best.train_rmse * scale
-        self._fitted = True
         return self
-
-    def _check_fitted(self) -> None:
-        if not self._fitted:
-            raise NotFittedError("MLPTemperatureModel is not fitted yet; call fit first")
 
 
 __all__ = ["MLPTemperatureModel", "TrainResult", "jacobian", "train_lm", "validation_mask"]

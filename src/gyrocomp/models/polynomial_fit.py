@@ -7,14 +7,14 @@ produces is :class:`gyrocomp.models.temperature.PolynomialBias`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, ModelError, NotFittedError
+from ..errors import InputError, ModelError
 from ..prepared import fit_axes
 from ..recording import Recording
-from .base import TemperatureBins, bin_by_temperature, bin_width_for
+from .base import LearnedAttributes, TemperatureBins, bin_by_temperature, bin_width_for
 from .temperature import MAX_ORDER, PolynomialBias
 
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins
@@ -101,7 +101,7 @@ def _bic(design: _Design, order: int) -> float:
 
 
 @dataclass
-class PolynomialTemperatureModel:
+class PolynomialTemperatureModel(LearnedAttributes):
     """Polynomial temperature model, fitted per gyro axis on one or many runs jointly.
 
     Parameters
@@ -135,7 +135,6 @@ class PolynomialTemperatureModel:
     max_order: int = MAX_ORDER
     bin_width_degc: float | None = None
     folds: tuple[int, ...] | None = None
-    _fitted: bool = field(default=False, init=False, repr=False)
 
     def fit(self, recordings: list[Recording]) -> "PolynomialTemperatureModel":
         """Fit on ``recordings`` (each one power-on) and return self."""
@@ -174,7 +173,6 @@ class PolynomialTemperatureModel:
                                                 t_min, t_max)
             self.turn_on_biases_[axis] = consts
             self.fit_rms_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))
-        self._fitted = True
         return self
 
     def _choose_order(self, axis: str, design: _Design, distinct: int) -> int:
@@ -200,17 +198,12 @@ class PolynomialTemperatureModel:
         self.scores_[axis] = scores
         return chosen
 
-    def _check_fitted(self) -> None:
-        if not self._fitted:
-            raise NotFittedError("PolynomialTemperatureModel is not fitted yet; call fit(recordings) first")
-
     def predict_error(self, recording: Recording) -> np.ndarray:
         """Predicted error (n, k) [deg/s]: the shape plus the mean turn-on constant of the fit runs."""
-        self._check_fitted()
+        curves, constants = self.curves_, self.turn_on_biases_  # NotFittedError before a fit
         cols = []
         for axis in recording.gyro_axes:
-            curve = self.curves_[axis]
-            cols.append(curve.shape(recording.temperature_for(axis)) + self.turn_on_biases_[axis].mean())
+            cols.append(curves[axis].shape(recording.temperature_for(axis)) + constants[axis].mean())
         return np.column_stack(cols)
 
 

@@ -26,17 +26,17 @@ import dataclasses
 import math
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..effects import find_turns, g_squared_products, thermal_lag
-from ..errors import DataQualityWarning, InputError, ModelError, NotFittedError
+from ..errors import DataQualityWarning, InputError, ModelError
 from ..fit_report import memory_name
 from ..recording import Recording
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from ..prepared import PreparedRun, RunBlocks, fit_axes
-from .base import bin_width_for, one_temperature_column
+from .base import LearnedAttributes, bin_width_for, one_temperature_column
 from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .polynomial_fit import simplest_within
 from .temperature import PolynomialBias
@@ -257,7 +257,7 @@ def _simplest(tried: dict[int, float], n_runs: int) -> int:
 
 
 @dataclass
-class ThermalHysteresisModel:
+class ThermalHysteresisModel(LearnedAttributes):
     """Polynomial temperature model with thermal lag and/or turning-point hysteresis, chosen by the data.
 
     Parameters
@@ -328,7 +328,6 @@ class ThermalHysteresisModel:
     static_min_duration_s: float = 10.0
     weighting: str | dict[str, str] = "temperature-balanced"
     shared_lag: bool = True
-    _fitted: bool = field(default=False, init=False, repr=False)
 
     @staticmethod
     def _of(value, axis: str):
@@ -364,7 +363,6 @@ class ThermalHysteresisModel:
         taus = self._shared_lag(choices) if self.shared_lag and one_temperature_column(recordings) else {}
         for axis, choice in choices.items():
             self._store(axis, choice, taus.get(axis))
-        self._fitted = True
         return self
 
     def _check_settings(self) -> None:
@@ -518,10 +516,6 @@ class ThermalHysteresisModel:
                 q[m], q_se[m] = coef[base + k], se_all[base + k]
             self.g_squared_dps_per_g2_[axis] = q
             self.g_squared_se_dps_per_g2_[axis] = q_se
-
-    def _check_fitted(self) -> None:
-        if not self._fitted:
-            raise NotFittedError("ThermalHysteresisModel is not fitted yet; call fit(recordings) first")
 
 
 def static_pieces(recordings: list[Recording], min_duration_s: float) -> tuple[list, list[list[slice] | None]]:
