@@ -53,6 +53,8 @@ def test_one_run_is_scored_on_itself_and_says_so(cycles):
     assert [r.method for r in result.rows] == ["raw", "polynomial"]
     with pytest.raises(InputError, match="compare: give at least one run"):
         compare_methods([])
+    with pytest.raises(InputError, match=r"methods: FitOptions or a function of the training runs, got dict"):
+        compare_methods([cycles[0].recording], methods={"polynomial": {"temperature": 2}}, window_s=100.0)
 
 
 @pytest.mark.slow

@@ -8,6 +8,7 @@ from threadpoolctl import threadpool_limits
 
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError
+from gyrocomp.models import pipelines
 from gyrocomp.threads import blas_threads, single_threaded_blas
 
 pytestmark = pytest.mark.skipif(blas_threads() is None, reason="numpy loaded no BLAS library threadpoolctl can see")
@@ -33,3 +34,18 @@ def test_the_setting_returns_when_the_call_raises():
         with pytest.raises(InputError, match="rate_hz: must be positive"):
             allan_deviation(np.ones(100), 0.0)
         assert blas_threads() == before
+
+
+@pytest.mark.parametrize("entry", ["fit_calibration", "fit_pipeline", "fit_channels"])
+def test_every_fit_entry_point_fits_with_blas_on_one_thread(monkeypatch, entry):
+    """What the fit runs sees one BLAS thread, whichever public entry point it came through."""
+    seen = []
+
+    def prepare(recordings):  # the first step of every fit: note the setting, then stop the fit
+        seen.append(blas_threads())
+        raise InputError("stopped here")
+
+    monkeypatch.setattr(pipelines, "prepare", prepare)
+    with threadpool_limits(2, user_api="blas"), pytest.raises(InputError, match="stopped here"):
+        getattr(pipelines, entry)([])
+    assert seen and set(seen) == {1}

@@ -458,6 +458,7 @@ def _options(options: FitOptions | None) -> FitOptions:
     return options
 
 
+@single_threaded_blas
 def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint",
                  options: FitOptions | None = None) -> Calibration:
     """Fit a named pipeline (``PIPELINES``); ``options`` (:class:`gyrocomp.models.options.FitOptions`, default
