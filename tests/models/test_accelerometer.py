@@ -15,7 +15,8 @@ from gyrocomp.compensate import Compensator
 from gyrocomp.errors import InputError
 from gyrocomp.fit_report import FitReport
 from gyrocomp.metrics import evaluate_run, moving_average
-from gyrocomp.models.pipelines import fit_accelerometer, fit_channels, parse_channels
+from gyrocomp.cli.common import parse_channels
+from gyrocomp.models.pipelines import fit_accelerometer, fit_channels
 from gyrocomp.simulate import get_profile, simulate
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 
@@ -57,7 +58,7 @@ def test_recovers_the_tempco_and_removes_the_drift_on_a_held_out_run(cycles):
 
 def test_gyro_and_accel_together_fit_g_on_compensated_accelerations():
     runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s) for s in range(3)]
-    both = _quiet(fit_channels, [s.recording for s in runs[:2]], "gyro,accel")
+    both = _quiet(fit_channels, [s.recording for s in runs[:2]], ("accel", "gyro"))  # any order
     assert both.accel_axes and both.has_acceleration
     assert "accel" in both.fit_report and "acceleration" in both.fit_report
     # G matches the truth within a few standard errors
@@ -144,8 +145,14 @@ def test_streaming_equals_batch_with_lag(cycles):
 
 
 def test_bad_channels_and_missing_accelerometer(cycles):
-    with pytest.raises(InputError, match=r"channels: mag: use gyro, accel or gyro,accel"):
+    with pytest.raises(InputError, match=r"--channels: mag: use gyro, accel or gyro,accel"):
         parse_channels("gyro,mag")
+    assert parse_channels(" ACCEL, gyro") == ("gyro", "accel")
+    with pytest.raises(InputError, match=r"channels: 'mag': use 'gyro', 'accel' or both"):
+        fit_channels([cycles[0].recording], ("gyro", "mag"))
+    with pytest.raises(InputError, match=r"channels: a tuple of 'gyro' and/or 'accel', e.g. \('gyro', 'accel'\); "
+                                         r"got 'gyro,accel'"):
+        fit_channels([cycles[0].recording], "gyro,accel")
     bare = dataclasses.replace(cycles[0].recording, accel_g=None, accel_axes=())
     with pytest.raises(InputError, match=r"channels=accel needs accel_x, accel_y and accel_z columns"):
         fit_accelerometer([bare])

@@ -14,6 +14,8 @@ from ..errors import InputError
 from ..io import FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
 from ..models.mlp import DEFAULT_HIDDEN
 from ..models.options import Network, Polynomial
+from ..models.pipelines import check_channels
+from ..prepared import CHANNELS
 from ..models.temperature import MAX_ORDER
 
 
@@ -145,6 +147,15 @@ def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Network |
                      "mlp (the thesis's 1-3-1 network), mlp:H or none")
 
 
+def parse_channels(text: str) -> tuple[str, ...]:
+    """``--channels``: ``"gyro,accel"`` -> ``("gyro", "accel")``, checked by the library."""
+    items = tuple(c.strip().lower() for c in text.split(",") if c.strip())
+    unknown = [c for c in items if c not in CHANNELS]
+    if unknown or not items:
+        raise InputError(f"--channels: {','.join(unknown) or repr(text)}: use gyro, accel or gyro,accel")
+    return check_channels(items)
+
+
 def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     if text is None:
         return None
@@ -157,4 +168,4 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_hidden", "parse_temperature_option", "pop_read_options", "parse_instance", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]
+__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "pop_read_options", "parse_instance", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]

@@ -14,10 +14,11 @@ from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
 from ..models.options import FitOptions
-from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels, parse_channels
+from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels
 from ..models.selection import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
-from .common import float_list, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
+from .common import (float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar, read_options,
+                     read_run)
 from .render import print_contributions, print_fit
 
 

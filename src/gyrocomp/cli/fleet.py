@@ -16,7 +16,7 @@ from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.fleet import build_fleet_report
 from . import in_cli_words
-from .common import make_console, pop_read_options, progress_bar, read_options, read_settings
+from .common import make_console, parse_channels, pop_read_options, progress_bar, read_options, read_settings
 from .export import EXPORT_FORMATS, write_export
 
 #: failures and outliers listed after a fleet fit (the fleet table has them all)
@@ -73,7 +73,7 @@ def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, worke
     if prior_store is not None:
         with CalibrationStore(prior_store) as db:
             prior = population_prior(db.latest_rows())
-    settings = FleetSettings(channels=tuple(c.strip() for c in channels.split(",")), pipeline=pipeline,
+    settings = FleetSettings(channels=parse_channels(channels), pipeline=pipeline,
                              read=read_settings(opts), fmt=opts["fmt"], prior=prior)
     memory = int(memory_limit) if memory_limit.isdigit() else memory_limit
     with progress_bar(f"fitting {len(units)} units") as bar:

@@ -32,7 +32,8 @@ from ..errors import GyrocompError, InputError
 from ..io import ReadOptions, read_input
 from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
-from ..models.pipelines import fit_channels, parse_channels
+from ..models.pipelines import Pipeline, check_channels, fit_channels
+from ..prepared import Channel
 from ..threads import single_threaded_blas
 from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
 from .limits import Limits
@@ -68,15 +69,15 @@ class FleetSettings:
         the default fit; ``channels`` and ``pipeline`` then do not apply.
     """
 
-    channels: tuple[str, ...] = ("gyro",)
-    pipeline: str = "joint"
+    channels: tuple[Channel, ...] = ("gyro",)
+    pipeline: Pipeline = "joint"
     read: ReadOptions = field(default_factory=ReadOptions)
     fmt: str | None = None
     reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC
     prior: PopulationPrior | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "channels", parse_channels(self.channels))
+        object.__setattr__(self, "channels", check_channels(self.channels))
 
     def fingerprint(self) -> dict:
         """What of the settings changes a unit's model (part of its input hash)."""

@@ -15,7 +15,7 @@ from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..fit_report import AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..plausibility import calibration_concerns, temperature_span_concern
-from ..prepared import PreparedRun, fit_axes, prepare
+from ..prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..triad import TriadCalibration
 from ..static import orientations
@@ -422,7 +422,8 @@ def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, order
 #: the named pipelines of ``gyrocomp fit --pipeline`` (thesis 2.8): stages left to right, each fitted on the
 #: output of the one before; ``joint`` is the default joint least-squares fit, ``joint-mlp`` one network
 #: reading the temperature and the three accelerations
-PIPELINES = ("joint", "poly>matrix", "matrix>poly", "mlp>matrix", "mlp>mlp-accel", "joint-mlp")
+Pipeline = Literal["joint", "poly>matrix", "matrix>poly", "mlp>matrix", "mlp>mlp-accel", "joint-mlp"]
+PIPELINES: tuple[str, ...] = get_args(Pipeline)
 
 
 def _residual_runs(calibration: Calibration, recordings: list[Recording]) -> list[Recording]:
@@ -459,7 +460,7 @@ def _options(options: FitOptions | None) -> FitOptions:
 
 
 @single_threaded_blas
-def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint",
+def fit_pipeline(recordings: list[Recording] | Recording, pipeline: Pipeline = "joint",
                  options: FitOptions | None = None) -> Calibration:
     """Fit a named pipeline (``PIPELINES``); ``options`` (:class:`gyrocomp.models.options.FitOptions`, default
     ``FitOptions()``) are :func:`fit_calibration`'s for the temperature stage.
@@ -504,17 +505,14 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: str = "joint
     return _chain(first, second, recordings, pipeline)
 
 
-#: what ``gyrocomp fit --channels`` can model
-CHANNELS = ("gyro", "accel")
-
-
-def parse_channels(text: str | tuple | list) -> tuple[str, ...]:
-    """``"gyro,accel"`` -> ``("gyro", "accel")``, checked."""
-    items = tuple(c.strip() for c in (text.split(",") if isinstance(text, str) else text) if c.strip())
-    unknown = [c for c in items if c not in CHANNELS]
-    if unknown or not items:
-        raise InputError(f"channels: {','.join(unknown) or repr(text)}: use gyro, accel or gyro,accel")
-    return tuple(c for c in CHANNELS if c in items)
+def check_channels(channels: tuple[Channel, ...]) -> tuple[Channel, ...]:
+    """The channels a fit models (a tuple of ``"gyro"`` and/or ``"accel"``), checked, in that order."""
+    if not isinstance(channels, (tuple, list)) or not channels:
+        raise InputError(f"channels: a tuple of 'gyro' and/or 'accel', e.g. ('gyro', 'accel'); got {channels!r}")
+    unknown = [c for c in channels if c not in CHANNELS]
+    if unknown:
+        raise InputError(f"channels: {', '.join(map(repr, unknown))}: use 'gyro', 'accel' or both")
+    return tuple(c for c in CHANNELS if c in channels)
 
 
 def _accelerometer_pieces(recordings: list[Recording], min_static_s: float) -> tuple[list[PreparedRun], tuple, bool]:
@@ -699,8 +697,8 @@ def _fit_accel_channel(recordings: list[Recording], options: FitOptions) -> Cali
 
 
 @single_threaded_blas
-def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, ...] | str = ("gyro",),
-                 pipeline: str = "joint", *, scale_factor: ScaleFactor = "auto",
+def fit_channels(recordings: list[Recording] | Recording, channels: tuple[Channel, ...] = ("gyro",),
+                 pipeline: Pipeline = "joint", *, scale_factor: ScaleFactor = "auto",
                  options: FitOptions | None = None) -> Calibration:
     """Fit the gyro (``fit_pipeline``), the accelerometer, or both, with ``options``
     (:class:`gyrocomp.models.options.FitOptions`, default ``FitOptions()``).
@@ -718,7 +716,7 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
     ``"matrix-temperature"`` K linear in temperature, ``"none"`` no K (every run is then a bias run).
     """
     recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)
-    channels = parse_channels(channels)
+    channels = check_channels(channels)
     options = _options(options)
     gyro_triad, recordings = _gyro_triad(recordings, scale_factor) if "gyro" in channels else (None, recordings)
     if "accel" not in channels:
@@ -737,5 +735,5 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[str, .
                                gyro_triad=gyro_triad, accel_triad=accel_cal.accel_triad)
 
 
-__all__ = ["CHANNELS", "PIPELINES", "SCALE_FACTOR_CHOICES", "ScaleFactor", "fit_accelerometer", "fit_calibration",
-           "fit_channels", "fit_pipeline", "parse_channels"]
+__all__ = ["PIPELINES", "SCALE_FACTOR_CHOICES", "Pipeline", "ScaleFactor", "check_channels", "fit_accelerometer",
+           "fit_calibration", "fit_channels", "fit_pipeline"]
