@@ -3,6 +3,7 @@ public names all resolve; the command table matches the commands."""
 
 from __future__ import annotations
 
+import inspect
 import subprocess
 import sys
 
@@ -39,6 +40,19 @@ def test_every_public_name_resolves_and_simulate_stays_the_function():
     assert set(gyrocomp.__all__) <= set(dir(gyrocomp))
     with pytest.raises(AttributeError, match="module 'gyrocomp' has no attribute 'no_such_name'"):
         getattr(gyrocomp, "no_such_name")
+
+
+def test_every_public_callable_spells_out_its_parameters():
+    """No ``*args`` or ``**options`` in the public API: each option is a named, documented parameter."""
+    hidden = []
+    for name in gyrocomp.__all__:
+        obj = getattr(gyrocomp, name)
+        if not callable(obj) or isinstance(obj, type) and issubclass(obj, BaseException):
+            continue
+        target = obj.__init__ if isinstance(obj, type) else obj
+        parameters = inspect.signature(target).parameters.values()
+        hidden += [f"{name}({p})" for p in parameters if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
+    assert hidden == []
 
 
 def test_the_command_table_matches_the_commands():

@@ -122,7 +122,7 @@ def stage_calibrations(calibration) -> dict:
     return stages
 
 
-def evaluate_stages(calibration, recording: Recording, *, window_s: float | None = None,
+def evaluate_stages(calibration: Calibration, recording: Recording, *, window_s: float | None = None,
                     turn_on_window_s: float | None = None) -> StageEvaluation:
     """Bias offset, improvement, bias instability and integration time of a run at each stage of the calibration."""
     if window_s is None:

@@ -15,9 +15,11 @@ import numpy as np
 
 from .allan import (
     AccelNoise,
+    AllanKind,
     AllanResult,
     GyroNoise,
     NoiseTerms,
+    TauGrid,
     allan_deviation,
     allan_deviation_segments,
     noise_terms,
@@ -114,8 +116,8 @@ def noise_axes(axes, gyro_axes, accel_axes, with_accel: bool = False) -> list[st
     return names
 
 
-def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: str = "oadev",
-                  taus="octave", split_gaps: bool = False,
+def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: AllanKind = "oadev",
+                  taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
                   fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False) -> NoiseAnalysis:
     """Allan curve (``kind``) and noise terms (from the overlapping Allan deviation) for each axis.
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .allan import AllanKind, TauGrid
 from .allan.streaming import PhaseAccumulator
 from .errors import DataQualityWarning, InputError
 from .io.stream import CHUNK_ROWS, NotStreamable, TableStream
@@ -66,7 +67,7 @@ class TimeSteps:
 
 def analyse_noise_file(path, axes: list[str] | None = None, *, layout: TableLayout | None = None,
                        fmt: str | None = None, drop_nonfinite: bool = False, with_accel: bool = False,
-                       kind: str = "oadev", taus="octave", split_gaps: bool = False,
+                       kind: AllanKind = "oadev", taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
                        fit_taus_s: tuple[float, float] | None = None, chunks: ChunkSettings = ChunkSettings(),
                        progress=None) -> NoiseAnalysis:
     """:func:`gyrocomp.noise.analyse_noise` of a CSV or Parquet file, read in chunks (see the module); only time

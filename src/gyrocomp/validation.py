@@ -28,7 +28,7 @@ from .errors import DataQualityWarning, InputError, ModelChoiceWarning, Temperat
 from .metrics import smoothed_residual_rms
 from .models.base import provenance
 from .models.hysteresis import turn_threshold_degc
-from .models.options import FitOptions
+from .models.options import FitOptions, FoldChoice
 from .models.selection import (BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MAX_S, WINDOW_MIN_S, fold_mean,
                                fold_standard_error, leg_labels)
 from .models.temperature import PolynomialBias
@@ -194,7 +194,7 @@ def _fit(method: Method | None, train: list[Recording]) -> Calibration | None:
 
 
 @single_threaded_blas
-def validate(recordings: list[Recording], *, folds: str = "auto", window_s: float | None = None,
+def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_s: float | None = None,
              candidates: dict[str, Method] | None = None) -> ValidationResult:
     """Held-out drift of the baselines, gyrocomp's default and ``candidates`` on folds of ``recordings``.
 

@@ -12,7 +12,7 @@ This module joins them: :func:`allan_deviation` and :func:`allan_deviation_segme
 from __future__ import annotations
 
 import math
-from typing import Iterable
+from typing import Iterable, get_args
 
 import numpy as np
 
@@ -21,6 +21,9 @@ from ..errors import InputError
 from .estimators import (
     DEFAULT_STOP_RATIO,
     KINDS,
+    AllanKind,
+    DataType,
+    TauGrid,
     ONE_SIGMA,
     STOP_RATIO,
     AllanMinimum,
@@ -56,7 +59,7 @@ from .terms import (
 )
 
 __all__ = [
-    "AccelNoise", "AllanMinimum", "AllanResult", "BIAS_INSTABILITY_FACTOR", "DEFAULT_STOP_RATIO", "GyroNoise",
+    "AccelNoise", "AllanKind", "AllanMinimum", "AllanResult", "DataType", "TauGrid", "BIAS_INSTABILITY_FACTOR", "DEFAULT_STOP_RATIO", "GyroNoise",
     "KINDS", "MODEL_UNCERTAINTY", "NOISE_ID_MAX_POINTS", "NOISE_ID_MIN_POINTS", "NoiseIdentification",
     "NoiseTerms", "ONE_SIGMA", "PhaseAccumulator", "READOFF_SLOPE_TOLERANCE", "STOP_RATIO", "allan_deviation",
     "allan_deviation_segments", "averaging_factors", "b1_expected", "confidence_interval",
@@ -71,7 +74,7 @@ def _check(kind: str, rate_hz: float, data_type: str) -> None:
         raise InputError(f"kind: unknown Allan estimator {kind!r}; use one of {', '.join(KINDS)}")
     if not rate_hz > 0:
         raise InputError(f"rate_hz: must be positive, got {rate_hz}")
-    if data_type not in ("rate", "phase"):
+    if data_type not in get_args(DataType):
         raise InputError(f"data_type: {data_type!r}; use 'rate' or 'phase'")
 
 
@@ -90,7 +93,8 @@ def _as_phase(data, rate_hz: float, data_type: str, phase_out) -> tuple[np.ndarr
 
 
 @single_threaded_blas
-def allan_deviation(data, rate_hz: float, *, kind: str = "oadev", taus="octave", data_type: str = "rate",
+def allan_deviation(data, rate_hz: float, *, kind: AllanKind = "oadev", taus: TauGrid | np.ndarray = "octave",
+                    data_type: DataType = "rate",
                     confidence: float | None = ONE_SIGMA, phase_out: np.ndarray | None = None,
                     noise_alpha=None) -> AllanResult:
     """Allan deviation of ``data`` sampled at ``rate_hz``, with confidence intervals.
@@ -155,8 +159,9 @@ def _noise_alpha(value, count: int) -> np.ndarray | None:
 
 
 @single_threaded_blas
-def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: str = "oadev", taus="octave",
-                             data_type: str = "rate", confidence: float | None = ONE_SIGMA) -> AllanResult:
+def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: AllanKind = "oadev",
+                             taus: TauGrid | np.ndarray = "octave", data_type: DataType = "rate",
+                             confidence: float | None = ONE_SIGMA) -> AllanResult:
     """One deviation curve from several contiguous stretches of data separated by gaps.
 
     The sums of squared differences and their term counts are pooled over the stretches, so no term

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -24,7 +25,13 @@ from ..errors import InputError
 
 #: two-sided confidence of one standard deviation, erf(1/sqrt(2)) = 0.6827
 ONE_SIGMA = math.erf(1.0 / math.sqrt(2.0))
-KINDS = ("oadev", "adev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+#: the deviations the engine computes (NIST SP 1065 names)
+AllanKind = Literal["oadev", "adev", "mdev", "tdev", "hdev", "ohdev", "totdev"]
+KINDS: tuple[str, ...] = get_args(AllanKind)
+#: the named grids of averaging times: m = 1, 2, 4, ...; 1, 2, 4, 10, 20, 40, ...; every m
+TauGrid = Literal["octave", "decade", "all"]
+#: what the data are: rate samples, or their integral (phase)
+DataType = Literal["rate", "phase"]
 #: Stable32 stops its tau grids at N / stop ratio (N phase points)
 STOP_RATIO = {"adev": 5, "hdev": 5, "totdev": 2}
 DEFAULT_STOP_RATIO = 4
@@ -159,7 +166,7 @@ def phase_from_chunks(chunks, rate_hz: float, n_samples: int, out: np.ndarray | 
     return _running_sum(chunks(), total / count, phase, rate_hz)
 
 
-def averaging_factors(n_phase: int, taus: str | np.ndarray, rate_hz: float, kind: str = "oadev") -> np.ndarray:
+def averaging_factors(n_phase: int, taus: TauGrid | np.ndarray, rate_hz: float, kind: AllanKind = "oadev") -> np.ndarray:
     """Averaging factors m for a tau specification; the named grids stop at n_phase / stop ratio (as Stable32)."""
     m_max = max(1, n_phase // STOP_RATIO.get(kind, DEFAULT_STOP_RATIO))
     if isinstance(taus, str):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -237,7 +238,7 @@ def noise_terms(result: AllanResult, fit_taus_s: tuple[float, float] | None = No
     )
 
 
-def noise_parameters(result: AllanResult, sensor: str = "gyro",
+def noise_parameters(result: AllanResult, sensor: Literal["gyro", "accel"] = "gyro",
                      fit_taus_s: tuple[float, float] | None = None) -> GyroNoise | AccelNoise:
     """Noise parameters of a gyro curve in [deg/s] (``sensor="gyro"``) or an accelerometer curve in [g]."""
     terms = noise_terms(result, fit_taus_s)

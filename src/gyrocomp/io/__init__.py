@@ -123,8 +123,13 @@ def read(
     *,
     fmt: str | None = None,
     drop_nonfinite: bool = False,
+    instance: int | None = None,
+    device_id: int | None = None,
+    imu_topic: str | None = None,
+    temperature_topic: str | None = None,
+    record: str | None = None,
+    channels: tuple[str, ...] | None = None,
     progress: ProgressCallback | None = None,
-    **options,
 ) -> Recording:
     """Read any supported file into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -138,12 +143,22 @@ def read(
         The format (default: told from the file).
     drop_nonfinite : bool
         Drop rows with NaN or infinite values instead of refusing the file.
+    instance, device_id : int, optional
+        Autopilot logs: the sensor instance (PX4 ``multi_id``, ArduPilot ``I``), or the PX4 device id.
+    imu_topic, temperature_topic : str, optional
+        ROS bags: the topics of the ``sensor_msgs/Imu`` and ``sensor_msgs/Temperature`` messages.
+    record : str, optional
+        ArduPilot DataFlash: ``"IMU"`` (default) or ``"TCLR"``.
+    channels : tuple of str, optional
+        Tables: read only these channels' columns (``time`` always).
     progress : callable, optional
         Called with the fraction done.
-    **options
-        ``instance``, ``device_id``, ``imu_topic``, ``temperature_topic``, ``record``: see :class:`ReadOptions`.
+
+    The same options as :class:`ReadOptions` (its doc says more of each).
     """
-    read_options = ReadOptions(layout=layout or TableLayout(), drop_nonfinite=drop_nonfinite, **options)
+    read_options = ReadOptions(layout=layout or TableLayout(), drop_nonfinite=drop_nonfinite, instance=instance,
+                               device_id=device_id, imu_topic=imu_topic, temperature_topic=temperature_topic,
+                               record=record, channels=channels)
     return read_input(path, read_options, fmt=fmt, progress=progress).recording
 
 
