@@ -5,13 +5,19 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gyrocomp import Polynomial, apply, comparison, fit_calibration, validation, write
-from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning
+from gyrocomp.compensate import Compensator
+from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning, TemperatureRangeWarning
 from gyrocomp.plausibility import (
     CHECKS,
+    BlockMeans,
+    ScaleAgreement,
     calibration_concerns,
     recording_concerns,
+    scale_agreement,
     silence_pattern,
     temperature_span_concern,
     turned_between_poses,
@@ -143,3 +149,105 @@ def test_a_hand_turned_multi_position_session_is_not_taken_for_a_rotating_run():
     one_face = dataclasses.replace(session, accel_g=np.tile([0.0, 0.0, 1.0], (session.n_samples, 1)))
     assert not turned_between_poses(one_face)
     assert "rotation" in _checks(calibration_concerns(one_face))
+
+
+# -- the model against the data it is applied to ------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def chamber_model():
+    """A consumer part's default model from two chamber runs, and a third run of the same part held out."""
+    runs = [simulate("consumer", profile="chamber", rate_hz=1, seed=s).recording for s in range(3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit_calibration(runs[:2]), runs[2]
+
+
+def _agreement_warnings(calibration, recording):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        apply(calibration, recording)
+    return [str(w.message) for w in caught
+            if issubclass(w.category, PlausibilityWarning) and w.message.check == "agreement"]
+
+
+def test_a_model_applied_to_its_own_part_agrees_and_says_nothing(chamber_model):
+    calibration, held = chamber_model
+    assert _agreement_warnings(calibration, held) == []
+    # and in motion: a field log of the same part (turns, vibration, a warm-up) raises nothing either
+    field = simulate("consumer", profile="field", rate_hz=20, seed=4, duration_s=3600).recording
+    assert _agreement_warnings(calibration, field) == []
+
+
+def test_a_unit_mistake_or_a_flipped_axis_is_said_with_its_slope(chamber_model):
+    """The same held-out run read in rad/s, and with one axis's sign flipped: the slopes are the conversion
+    factor and -1 (within four standard errors), and the warning names the mistake."""
+    calibration, held = chamber_model
+    radians = held.with_gyro(np.radians(held.gyro_dps))
+    said = _agreement_warnings(calibration, radians)
+    assert len(said) == 3 and all("rad/s read as deg/s? (check 'agreement')" in m for m in said)
+    flipped = held.with_gyro(held.gyro_dps * np.array([1.0, -1.0, 1.0]))
+    (message,) = _agreement_warnings(calibration, flipped)
+    assert message.startswith(f"{held.source}: gyro_y follows the error the model predicts for it with a slope of")
+    assert "the opposite sign: an axis mapped with the wrong sign?" in message
+    slope_of = Compensator(calibration, held.gyro_axes, rate_hz=held.rate_hz)
+    slope_of.update(radians.time_s, radians.gyro_dps, radians.temperature_degc, radians.accel_g)
+    for agreement in slope_of.agreement().values():
+        assert abs(agreement.slope - np.pi / 180) < 4 * agreement.standard_error + 1e-3
+        assert agreement.blocks >= 100  # the chamber run: hours of 60 s blocks
+
+
+def test_the_agreement_check_is_silenced_by_name_and_on_the_command_line(chamber_model, tmp_path):
+    calibration, held = chamber_model
+    radians = held.with_gyro(np.radians(held.gyro_dps))
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", category=PlausibilityWarning)
+        warnings.filterwarnings("ignore", message=silence_pattern("agreement"), category=PlausibilityWarning)
+        warnings.simplefilter("ignore", TemperatureRangeWarning)
+        apply(calibration, radians)
+    calibration.save(tmp_path / "model.json")
+    write(radians, tmp_path / "rad.csv")
+    said = run("apply", tmp_path / "model.json", tmp_path / "rad.csv", "-o", tmp_path / "out.csv")
+    assert said.returncode == 0 and said.stderr.count("(check 'agreement')") == 3
+    quiet = run("--allow", "agreement", "apply", tmp_path / "model.json", tmp_path / "rad.csv", "-o",
+                tmp_path / "out2.csv")
+    assert quiet.returncode == 0 and "agreement" not in quiet.stderr
+
+
+@given(cuts=st.lists(st.integers(0, 3000), max_size=8, unique=True))
+@settings(max_examples=40, deadline=None)
+def test_block_means_are_the_same_for_any_chunking(cuts):
+    rng = np.random.default_rng(0)
+    time_s = np.cumsum(rng.uniform(0.5, 1.5, 3000))
+    values = rng.standard_normal((3000, 2))
+    whole = BlockMeans(2)
+    whole.add(time_s, values)
+    pieces = BlockMeans(2)
+    edges = [0, *sorted(cuts), 3000]
+    for a, b in zip(edges[:-1], edges[1:]):
+        pieces.add(time_s[a:b], values[a:b])
+    np.testing.assert_allclose(pieces.means(), whole.means(), rtol=0, atol=1e-12)
+    # the blocks are 60 s from the first sample, the partial last one left out
+    blocks = np.floor((time_s - time_s[0]) / 60.0)
+    expected = [values[blocks == k].mean(axis=0) for k in range(int(blocks.max()))]
+    np.testing.assert_allclose(whole.means()[:len(expected)], expected, atol=1e-12)
+
+
+def test_the_slope_and_when_there_is_none():
+    rng = np.random.default_rng(3)
+    ramp = np.linspace(-0.1, 0.1, 40)
+    noise = 0.001
+    fit = scale_agreement(2.0 * ramp + noise * rng.standard_normal(40) + 5.0, ramp)
+    # the slope of a line through noisy points: within 4 standard errors of 2, the error as least squares says
+    assert abs(fit.slope - 2.0) < 4 * fit.standard_error
+    assert fit.standard_error == pytest.approx(noise / np.sqrt(np.sum((ramp - ramp.mean()) ** 2)), rel=0.35)
+    assert not fit.disagrees  # a factor of 2 is within what is left unsaid
+    assert scale_agreement(ramp[:9], ramp[:9]) is None  # fewer than 10 blocks
+    step = np.zeros(40)
+    step[0] = 1.0  # the prediction moves in one block only
+    assert scale_agreement(step, step) is None
+    assert scale_agreement(np.ones(40), np.full(40, 0.3)) is None  # a prediction that does not vary
+    huge = 1e300 * ramp  # a corrupt temperature sent far along the tangent: no overflow, the slope as ever
+    assert scale_agreement(2.0 * huge, huge).slope == pytest.approx(2.0)
+    assert scale_agreement(ramp, np.where(ramp > 0, np.inf, ramp)) is None
+    assert ScaleAgreement(0.0175, 1e-4, 40).disagrees and ScaleAgreement(-1.0, 0.1, 40).disagrees
+    assert not ScaleAgreement(0.3, 0.06, 40).disagrees  # 0.3 + 4 x 0.06 > 0.5: not sure enough

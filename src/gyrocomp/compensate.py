@@ -12,7 +12,7 @@ from .calibration import Calibration
 from .effects import find_turns, g_sensitivity_offset, thermal_lag
 from .errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from .models.base import estimate_turn_on_bias
-from .plausibility import recording_concerns
+from .plausibility import BlockMeans, ScaleAgreement, agreement_concern, recording_concerns, scale_agreement
 from .io.stream import CHUNK_ROWS, NotStreamable, TableStream, TableWriter
 from .io.tables import TableLayout, arrow_floats, arrow_indices, read_table, write_gyro_back
 from .recording import ACCEL_AXES, GYRO_AXES, Recording
@@ -92,6 +92,8 @@ class Compensator:
         self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
         self._pending_time: list[np.ndarray] = []
         self._pending_temp: list[np.ndarray | None] = []
+        # the block means of each modelled axis's output and of the error the model predicts for it
+        self._agreement_blocks = BlockMeans(2 * len(self._modelled))
 
     def _model_temperature(self, key: str, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
         """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""
@@ -219,6 +221,10 @@ class Compensator:
         """
         time_s, gyro_dps, temperature_degc, accel_g = self._checked(time_s, gyro_dps, temperature_degc, accel_g)
         residual = self._residual(time_s, gyro_dps, temperature_degc, accel_g)
+        if self._modelled:
+            columns = [j for j, _ in self._modelled]
+            output = gyro_dps[:, columns]
+            self._agreement_blocks.add(time_s, np.hstack([output, output - residual[:, columns]]))
         if self._constants is not None:
             return self._subtract_constants(residual, temperature_degc)
         if self._t0 is None and time_s.size:
@@ -229,6 +235,15 @@ class Compensator:
         if time_s.size and time_s[-1] - self._t0 >= self.turn_on_window_s:
             return self._release()
         return np.empty((0, len(self.gyro_axes)))
+
+    def agreement(self) -> dict[str, ScaleAgreement | None]:
+        """How each modelled gyro axis's output so far follows the error the model predicts for it
+        (:func:`gyrocomp.plausibility.scale_agreement` on 60 s block means; None with too little data or a
+        prediction that does not vary): the slope is 1 when the model describes the data."""
+        means = self._agreement_blocks.means()
+        k = len(self._modelled)
+        return {self.gyro_axes[j]: scale_agreement(means[:, i], means[:, k + i])
+                for i, (j, _) in enumerate(self._modelled)}
 
     def _checked(self, time_s, gyro_dps, temperature_degc, accel_g):
         """The chunk as float arrays of the documented shapes, its time increasing from the previous chunk's and
@@ -316,6 +331,7 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     comp = compensator_for(calibration, recording, axes=axes, turn_on_window_s=turn_on_window_s)
     out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel_xyz(recording))
     rest = comp.finish()
+    warn_disagreement(comp)
     result = recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)
     if comp.compensates_accel:
         order = [ACCEL_AXES.index(a) for a in recording.accel_axes]
@@ -337,6 +353,15 @@ def compensator_for(calibration: Calibration, recording: Recording, *, axes: tup
         raise InputError(f"{recording.source}: the model compensates the accelerometer; the data needs accel_x, "
                          "accel_y and accel_z columns [g]")
     return comp
+
+
+def warn_disagreement(comp: Compensator, stacklevel: int = 3) -> None:
+    """Warn (:class:`~gyrocomp.errors.PlausibilityWarning`, check ``agreement``) about each axis whose output did
+    not follow the model (:meth:`Compensator.agreement`): a unit or sign mistake, or a model of another part."""
+    for axis, agreement in comp.agreement().items():
+        concern = agreement_concern(comp.source, axis, agreement)
+        if concern is not None:
+            warnings.warn(concern.warning(), stacklevel=stacklevel)
 
 
 def accel_xyz(recording: Recording) -> np.ndarray | None:
@@ -472,5 +497,6 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
                 accel_out = comp.take_accel()[:, accel_order]
             flush(gyro, accel_out)
         flush(comp.finish(), None)
+        warn_disagreement(comp, stacklevel=4)
     stream.warn_summary()
     return FileResult(written, compensated_axes(calibration, first, axes, comp.compensates_accel), True)

@@ -45,7 +45,7 @@ class PlausibilityWarning(DataQualityWarning):
 
 
 #: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.plausibility`)
-CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span"]
+CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span", "agreement"]
 #: every check's name
 CHECKS: tuple[CheckName, ...] = get_args(CheckName)
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from .allan.streaming import PhaseAccumulator
 from .calibration import Calibration
-from .compensate import Compensator, accel_xyz, apply, compensator_for
+from .compensate import Compensator, accel_xyz, apply, compensator_for, warn_disagreement
 from .errors import DataQualityWarning, InputError
 from .io.stream import NotStreamable, TableStream
 from .io.tables import TableLayout, read_table
@@ -268,6 +268,7 @@ def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, tu
         block = _compensated(comp, comp.finish(), accel_axes)
         _check_block(first, block, accel_axes, pending_rows[:len(block)])
         compensated.update(block)
+        warn_disagreement(comp, stacklevel=4)
         rate_hz = steps.rate_hz()
         stream.warn_summary()
         return evaluate_phases(first.source, raw.finish(rate_hz), compensated.finish(rate_hz), rate_hz,

@@ -11,10 +11,18 @@ The limits are physical, not tuned: MEMS gyros measure at most a few thousand de
 most tens of deg/s (the MPU-6050's tolerance is +-20 deg/s); a bias does not move by tens of deg/s within a run
 at rest; temperatures of electronics in degC lie far below 150 (in kelvin they are above 200); sample rates of
 logged IMUs lie between 1 mHz and 100 kHz.
+
+One check compares the data with the model applied to it (``agreement``): on data at rest through a temperature
+change, an axis's output follows the model's predicted error one to one; a slope far from 1 is a unit mistake
+(0.0175 for rad/s read as deg/s), an axis mapped with the wrong sign (-1), or a model of another part. The slope
+is taken over 60 s block means (:class:`BlockMeans`, the same for any chunking of a stream), and said only when it
+lies beyond a factor of 2 either way by four standard errors, so motion, short logs and small temperature changes
+(a wide interval) never raise it.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,12 +52,19 @@ POSE_WINDOW_S, POSE_MIN_S, POSE_FACTOR = 0.5, 1.0, 10.0
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
 LONG_SLOW_S = 7 * 86400.0
+#: the agreement check: block length [s], fewest complete blocks, the factor either way the data's slope on the
+#: model's prediction may differ from 1 unsaid, and by how many standard errors it must lie beyond it
+AGREEMENT_BLOCK_S, AGREEMENT_MIN_BLOCKS, AGREEMENT_FACTOR, AGREEMENT_SIGMAS = 60.0, 10, 2.0, 4.0
+#: slopes that mean a known mistake, and the words for it (named when the slope is within 25 % of one)
+KNOWN_SLOPES = ((math.pi / 180.0, "rad/s read as deg/s?"), (180.0 / math.pi, "deg/s data for a model fitted on rad/s?"),
+                (1e-3, "a factor of 1/1000: the wrong unit prefix?"), (1e3, "a factor of 1000: the wrong unit prefix?"),
+                (-1.0, "the opposite sign: an axis mapped with the wrong sign?"))
 
 
 @dataclass(frozen=True)
 class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
-    ``temperature-span``) and the one-line message, which starts with the recording's source."""
+    ``temperature-span``, ``agreement``) and the one-line message, which starts with the recording's source."""
 
     check: CheckName
     message: str
@@ -122,6 +137,108 @@ def turned_between_poses(recording: Recording) -> bool:
     return bool(np.all(np.any(units > 0.5, axis=0)) and np.all(np.any(units < -0.5, axis=0)))
 
 
+class BlockMeans:
+    """Means of some columns over fixed time blocks counted from the first sample: the same blocks and, to
+    rounding, the same means whatever the chunks they come in (:meth:`add` each chunk in time order).
+
+    Parameters
+    ----------
+    columns : int
+        How many columns each chunk has.
+    block_s : float
+        Block length [s].
+    """
+
+    def __init__(self, columns: int, block_s: float = AGREEMENT_BLOCK_S):
+        self.block_s = float(block_s)
+        self._t0: float | None = None
+        self._count = np.zeros(0)
+        self._sums = np.zeros((0, columns))
+
+    def add(self, time_s: np.ndarray, values: np.ndarray) -> None:
+        """One chunk: time [s] (m,), values (m, columns)."""
+        if not len(time_s):
+            return
+        if self._t0 is None:
+            self._t0 = float(time_s[0])
+        index = np.floor((np.asarray(time_s) - self._t0) / self.block_s).astype(np.int64)
+        blocks = int(index[-1]) + 1
+        if blocks > self._count.size:
+            grow = blocks - self._count.size
+            self._count = np.concatenate([self._count, np.zeros(grow)])
+            self._sums = np.vstack([self._sums, np.zeros((grow, self._sums.shape[1]))])
+        self._count += np.bincount(index, minlength=blocks)[:blocks].astype(float)
+        for j in range(self._sums.shape[1]):
+            self._sums[:, j] += np.bincount(index, weights=values[:, j], minlength=blocks)[:blocks]
+
+    def means(self) -> np.ndarray:
+        """The means (b, columns) of the complete blocks: those with at least half the fullest block's samples
+        (the last, partial block and blocks in gaps left out)."""
+        if not self._count.size:
+            return self._sums[:0]
+        full = self._count >= 0.5 * self._count.max()
+        return self._sums[full] / self._count[full, None]
+
+
+@dataclass(frozen=True)
+class ScaleAgreement:
+    """How an axis's output follows the error a model predicts for it: the least-squares slope of the block means
+    of the output on those of the prediction (1 when the model describes the data), its standard error, and the
+    number of blocks."""
+
+    slope: float
+    standard_error: float
+    blocks: int
+
+    @property
+    def disagrees(self) -> bool:
+        """The slope lies beyond ``AGREEMENT_FACTOR`` either way of 1 by ``AGREEMENT_SIGMAS`` standard errors."""
+        margin = AGREEMENT_SIGMAS * self.standard_error
+        return self.slope + margin < 1.0 / AGREEMENT_FACTOR or self.slope - margin > AGREEMENT_FACTOR
+
+
+def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray) -> ScaleAgreement | None:
+    """The slope of an axis's block-mean output on its predicted error's (both [deg/s]), with its standard error
+    from the scatter about the line (each about its mean: the turn-on constant does not enter).
+
+    None with fewer than ``AGREEMENT_MIN_BLOCKS`` blocks, or when the prediction's variation rests on fewer than
+    half that many blocks (its participation ratio (sum |x|)^2 / sum x^2 of the centred means: n for a step over
+    n blocks, 3n/4 for a ramp, 1 for one block), e.g. a prediction held at the edge of its range but in one block;
+    a prediction constant to rounding (1e-9 of its size) does not vary, and one that is not finite (a corrupt
+    temperature sent it past any float) says nothing.
+    """
+    x = np.asarray(predicted_means, dtype=float)
+    y = np.asarray(output_means, dtype=float)
+    if x.size < AGREEMENT_MIN_BLOCKS or not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+        return None
+    scale = float(np.max(np.abs(x)))
+    if not np.ptp(x) > 1e-9 * scale:
+        return None
+    y = y - y.mean()
+    y_scale = float(np.max(np.abs(y))) or 1.0
+    x, y = (x - x.mean()) / scale, y / y_scale  # each in units of its largest value: no square overflows
+    sxx = float(x @ x)
+    if float(np.sum(np.abs(x))) ** 2 / sxx < AGREEMENT_MIN_BLOCKS / 2:
+        return None
+    slope = float(x @ y) / sxx
+    residual = y - slope * x
+    standard_error = math.sqrt(float(residual @ residual) / (x.size - 2) / sxx)
+    return ScaleAgreement(slope * y_scale / scale, standard_error * y_scale / scale, int(x.size))
+
+
+def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) -> Concern | None:
+    """The ``agreement`` concern of an axis whose output does not follow the model (see the module), naming the
+    known mistake its slope matches."""
+    if agreement is None or not agreement.disagrees:
+        return None
+    slope = agreement.slope
+    known = next((words for ratio, words in KNOWN_SLOPES if abs(slope / ratio - 1.0) < 0.25), None)
+    return Concern("agreement", f"{source}: {axis} follows the error the model predicts for it with a slope of "
+                                f"{slope:.3g} +- {agreement.standard_error:.2g}, not 1: "
+                                + (known or "is the data in another unit than the model's, or the model of another "
+                                   "part?"))
+
+
 def _largest_span_degc(recordings: list[Recording]) -> float | None:
     """The largest temperature span of any run [degC], or None when no run has a temperature."""
     spans = [float(np.ptp(r.temperature_degc)) for r in recordings if r.temperature_degc is not None]
@@ -145,8 +262,9 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
         return None
     return Concern("temperature-span", f"{recordings[0].source}: the temperature of every run spans at most "
                                        f"{span:.3g} degC; a temperature curve needs runs over a temperature "
-                                       "range (or fit with temperature=none)")
+                                       "range (or fit with temperature=None)")
 
 
-__all__ = ["CHECKS", "CheckName", "Concern", "calibration_concerns", "recording_concerns", "require_temperature_span",
-           "silence_pattern", "temperature_span_concern", "turned_between_poses"]
+__all__ = ["AGREEMENT_BLOCK_S", "BlockMeans", "CHECKS", "CheckName", "Concern", "ScaleAgreement", "agreement_concern",
+           "calibration_concerns", "recording_concerns", "require_temperature_span", "scale_agreement", "silence_pattern",
+           "temperature_span_concern", "turned_between_poses"]

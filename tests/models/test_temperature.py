@@ -174,7 +174,7 @@ def test_noise_level_overshoot_of_the_range_is_not_outside_it():
     assert curve.outside_range(np.array([40.6]))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        apply(cal, Recording(time_s=t, gyro_dps=np.zeros(t.size), gyro_axes=("gyro_z",), temperature_degc=temp + 0.3))
+        apply(cal, Recording(time_s=t, gyro_dps=1e-3 * (temp + 0.3), gyro_axes=("gyro_z",), temperature_degc=temp + 0.3))
 
 
 def test_errors():
