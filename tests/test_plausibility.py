@@ -13,6 +13,7 @@ from gyrocomp.compensate import Compensator
 from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning, TemperatureRangeWarning
 from gyrocomp.plausibility import (
     CHECKS,
+    accel_unit_concern,
     BlockMeans,
     ScaleAgreement,
     calibration_concerns,
@@ -251,3 +252,26 @@ def test_the_slope_and_when_there_is_none():
     assert scale_agreement(ramp, np.where(ramp > 0, np.inf, ramp)) is None
     assert ScaleAgreement(0.0175, 1e-4, 40).disagrees and ScaleAgreement(-1.0, 0.1, 40).disagrees
     assert not ScaleAgreement(0.3, 0.06, 40).disagrees  # 0.3 + 4 x 0.06 > 0.5: not sure enough
+
+
+@pytest.mark.parametrize("factor, words", [(9.80665, "m/s^2 read as g"), (1000.0, "mg read as g"),
+                                           (1 / 9.80665, "g read as m/s^2")])
+def test_an_accelerometer_in_the_wrong_unit_is_said(factor, words):
+    assert RUN.accel_g is not None and "accel-unit" not in _checks(recording_concerns(RUN))
+    wrong = dataclasses.replace(RUN, accel_g=RUN.accel_g * factor)
+    (concern,) = [c for c in recording_concerns(wrong) if c.check == "accel-unit"]
+    norm = np.median(np.linalg.norm(wrong.accel_g, axis=1))
+    assert concern.message == (f"{RUN.source}: the accelerometer's median norm is {norm:.3g} g where gravity is 1 g: "
+                               f"{words}? (give its unit with accel_unit=)")
+    # in motion too: a field log's median norm is gravity's (turns, vibration and accelerations average out)
+    field = simulate("consumer", profile="field", rate_hz=20, seed=4, duration_s=600).recording
+    assert accel_unit_concern(field) is None
+    assert accel_unit_concern(dataclasses.replace(field, accel_g=field.accel_g * factor)).check == "accel-unit"
+
+
+def test_the_accelerometer_unit_is_said_on_the_command_line_with_its_flag(tmp_path):
+    wrong = dataclasses.replace(RUN, accel_g=RUN.accel_g * 9.80665)
+    write(wrong, tmp_path / "ms2.csv")
+    fitted = run("fit", tmp_path / "ms2.csv", "-o", tmp_path / "m.json", "--temperature", "poly:1")
+    assert fitted.returncode == 0, fitted.stderr
+    assert "m/s^2 read as g? (give its unit with --accel-unit) (check 'accel-unit')" in fitted.stderr

@@ -45,7 +45,8 @@ class PlausibilityWarning(DataQualityWarning):
 
 
 #: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.plausibility`)
-CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span", "agreement"]
+CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span", "agreement",
+                    "accel-unit"]
 #: every check's name
 CHECKS: tuple[CheckName, ...] = get_args(CheckName)
 

@@ -31,6 +31,7 @@ from .errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_
 from .effects import moving_average
 from .recording import Recording
 from .prepared import PreparedRun
+from .units import STANDARD_GRAVITY_M_PER_S2
 
 #: beyond any MEMS gyro's measurement range [deg/s]
 MAX_RATE_DPS = 5000.0
@@ -52,6 +53,10 @@ POSE_WINDOW_S, POSE_MIN_S, POSE_FACTOR = 0.5, 1.0, 10.0
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
 LONG_SLOW_S = 7 * 86400.0
+#: the median norm of three accelerometer axes [g] that a unit mistake gives (gravity is 1 g, at rest and on
+#: average in ordinary motion), and the mistake; said within 20 % of one
+ACCEL_NORM_MISTAKES = ((STANDARD_GRAVITY_M_PER_S2, "m/s^2 read as g"), (1000.0, "mg read as g"),
+                       (1.0 / STANDARD_GRAVITY_M_PER_S2, "g read as m/s^2"))
 #: the agreement check: block length [s], fewest complete blocks, the factor either way the data's slope on the
 #: model's prediction may differ from 1 unsaid, and by how many standard errors it must lie beyond it
 AGREEMENT_BLOCK_S, AGREEMENT_MIN_BLOCKS, AGREEMENT_FACTOR, AGREEMENT_SIGMAS = 60.0, 10, 2.0, 4.0
@@ -64,7 +69,7 @@ KNOWN_SLOPES = ((math.pi / 180.0, "rad/s read as deg/s?"), (180.0 / math.pi, "de
 @dataclass(frozen=True)
 class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
-    ``temperature-span``, ``agreement``) and the one-line message, which starts with the recording's source."""
+    ``temperature-span``, ``agreement``, ``accel-unit``) and the one-line message, which starts with the recording's source."""
 
     check: CheckName
     message: str
@@ -88,6 +93,9 @@ def recording_concerns(recording: Recording) -> list[Concern]:
         if median > KELVIN_LOOKING_DEGC:
             out.append(Concern("kelvin", f"{src}: median temperature {median:.4g} degC looks like kelvin; "
                                          "gyrocomp reads degC (subtract 273.15)"))
+    concern = accel_unit_concern(recording)
+    if concern is not None:
+        out.append(concern)
     lo, hi = RATE_RANGE_HZ
     if not lo <= recording.rate_hz <= hi:
         out.append(Concern("time-unit", f"{src}: {recording.rate_hz:.3g} Hz is no IMU's sample rate: is the time "
@@ -96,6 +104,20 @@ def recording_concerns(recording: Recording) -> list[Concern]:
         out.append(Concern("time-unit", f"{src}: {recording.duration_s / 86400:.3g} days at {recording.rate_hz:.3g} "
                                         "Hz: is the time column in ms read as s?"))
     return out
+
+
+def accel_unit_concern(recording: Recording) -> Concern | None:
+    """The accelerometer read in the wrong unit: the median norm of its three axes [g] is gravity's 1 g at rest
+    and, on average, in a vehicle's ordinary motion; a median near 9.81, 1000 or 0.102 is m/s^2, mg, or g data
+    read as m/s^2 (``ACCEL_NORM_MISTAKES``)."""
+    if recording.accel_g is None or recording.accel_g.shape[1] != 3 or not recording.accel_g.size:
+        return None
+    norm = float(np.median(np.linalg.norm(recording.accel_g, axis=1)))
+    for value, words in ACCEL_NORM_MISTAKES:
+        if abs(norm / value - 1.0) < 0.2:
+            return Concern("accel-unit", f"{recording.source}: the accelerometer's median norm is {norm:.3g} g where "
+                                         f"gravity is 1 g: {words}? (give its unit with accel_unit=)")
+    return None
 
 
 def calibration_concerns(recording: Recording) -> list[Concern]:
@@ -265,6 +287,6 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
                                        "range (or fit with temperature=None)")
 
 
-__all__ = ["AGREEMENT_BLOCK_S", "BlockMeans", "CHECKS", "CheckName", "Concern", "ScaleAgreement", "agreement_concern",
+__all__ = ["AGREEMENT_BLOCK_S", "BlockMeans", "CHECKS", "CheckName", "Concern", "ScaleAgreement", "accel_unit_concern", "agreement_concern",
            "calibration_concerns", "recording_concerns", "require_temperature_span", "scale_agreement", "silence_pattern",
            "temperature_span_concern", "turned_between_poses"]
