@@ -99,7 +99,7 @@ class Candidate:
                    d.get("weighting", "time"), bool(d.get("band", False)))
 
 
-def _in_unit(d: dict, name: str, unit: str, default=None):
+def _entry_in_unit(d: dict, name: str, unit: str, default=None):
     """``d``'s entry ``name`` + the ending that says ``unit`` (``mean_drift_g``); files written before the
     accelerometer's entries said their unit kept them under ``_dps`` whatever the unit (in g for the
     accelerometer), so that name is read when the other is absent."""
@@ -120,9 +120,9 @@ class CandidateResult:
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "CandidateResult":
-        return cls(Candidate.from_dict(d), _number(_in_unit(d, "mean_drift", unit)),
-                   _number(_in_unit(d, "standard_error", unit)),
-                   tuple(_number(v) for v in _in_unit(d, "fold_drift", unit, ())),
+        return cls(Candidate.from_dict(d), _number(_entry_in_unit(d, "mean_drift", unit)),
+                   _number(_entry_in_unit(d, "standard_error", unit)),
+                   tuple(_number(v) for v in _entry_in_unit(d, "fold_drift", unit, ())),
                    tuple(float(v) for v in d.get("fold_lag_s", ())))
 
 
@@ -164,7 +164,7 @@ class SelectionReport:
         return cls(str(d["axis"]), str(d["fold_kind"]), tuple(d.get("folds", ())), float(d["window_s"]),
                    float(d.get("temperature_step_degc", 0.0)), None if band is None else (float(band[0]), float(band[1])),
                    Candidate.from_dict(d["best"]), Candidate.from_dict(d["chosen"]),
-                   _number(_in_unit(d, "raw_drift", unit)), _number(_in_unit(d, "chosen_drift", unit)),
+                   _number(_entry_in_unit(d, "raw_drift", unit)), _number(_entry_in_unit(d, "chosen_drift", unit)),
                    bool(d.get("validated", True)), bool(d.get("generalizes", True)),
                    tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit)
 
@@ -211,7 +211,7 @@ class MemoryChoice:
         else:  # files before the fields: the chosen memory as text
             match = _CHOSEN.match(str(d.get("chosen", "none")))
             memory, order = (match["memory"], int(match["order"] or 0)) if match else (str(d.get("chosen")), 0)
-        scores = _in_unit(d, "scores", unit, d.get("scores_bic", {})) or {}
+        scores = _entry_in_unit(d, "scores", unit, d.get("scores_bic", {})) or {}
         return cls(memory, order, float(d.get("lag_time_constant_s", 0.0)),
                    None if d.get("order") is None else int(d["order"]), d.get("weighting"),
                    {str(k): _number(v) for k, v in scores.items()},
@@ -289,7 +289,7 @@ class NetworkReport:
         axes = d.get("axes", {})
         return cls(tuple(int(h) for h in d["hidden"]), int(d.get("restarts", 1)), int(d.get("seed", 0)),
                    str(d.get("training", "")),
-                   {a: tuple(float(v) for v in _in_unit(i, "validation_rmse", unit, ())) for a, i in axes.items()},
+                   {a: tuple(float(v) for v in _entry_in_unit(i, "validation_rmse", unit, ())) for a, i in axes.items()},
                    {a: i.get("epochs") for a, i in axes.items()}, unit)
 
 
@@ -383,7 +383,7 @@ class AxisFit:
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "AxisFit":
         return cls(d.get("order"), _number(d.get("t_min_degc")), _number(d.get("t_max_degc")),
-                   _number(_in_unit(d, "fit_rms", unit)), unit,
+                   _number(_entry_in_unit(d, "fit_rms", unit)), unit,
                    {int(p): float(v) for p, v in (d.get("scores") or {}).items()})
 
 
