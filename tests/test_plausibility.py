@@ -233,6 +233,13 @@ def test_block_means_are_the_same_for_any_chunking(cuts):
     np.testing.assert_allclose(whole.means()[:len(expected)], expected, atol=1e-12)
 
 
+def test_block_means_keep_only_the_blocks_with_data():
+    """A corrupt time stamp 1e15 s on (3e7 years of blocks) costs one block, not an array of every block between."""
+    blocks = BlockMeans(1)
+    blocks.add(np.array([0.0, 1.0, 2.0, 3.0, 1e15]), np.array([[1.0], [2.0], [3.0], [4.0], [9.0]]))
+    np.testing.assert_array_equal(blocks.means(), [[2.5]])  # the lone sample's block is not half as full
+
+
 def test_the_slope_and_when_there_is_none():
     rng = np.random.default_rng(3)
     ramp = np.linspace(-0.1, 0.1, 40)

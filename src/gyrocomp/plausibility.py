@@ -69,7 +69,8 @@ KNOWN_SLOPES = ((math.pi / 180.0, "rad/s read as deg/s?"), (180.0 / math.pi, "de
 @dataclass(frozen=True)
 class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
-    ``temperature-span``, ``agreement``, ``accel-unit``) and the one-line message, which starts with the recording's source."""
+    ``temperature-span``, ``agreement``, ``accel-unit``) and the one-line message, which starts with the
+    recording's source."""
 
     check: CheckName
     message: str
@@ -173,9 +174,9 @@ class BlockMeans:
 
     def __init__(self, columns: int, block_s: float = AGREEMENT_BLOCK_S):
         self.block_s = float(block_s)
+        self.columns = int(columns)
         self._t0: float | None = None
-        self._count = np.zeros(0)
-        self._sums = np.zeros((0, columns))
+        self._blocks: dict[int, np.ndarray] = {}  # block number -> [count, sums of the columns]; only those with data
 
     def add(self, time_s: np.ndarray, values: np.ndarray) -> None:
         """One chunk: time [s] (m,), values (m, columns)."""
@@ -183,23 +184,25 @@ class BlockMeans:
             return
         if self._t0 is None:
             self._t0 = float(time_s[0])
-        index = np.floor((np.asarray(time_s) - self._t0) / self.block_s).astype(np.int64)
-        blocks = int(index[-1]) + 1
-        if blocks > self._count.size:
-            grow = blocks - self._count.size
-            self._count = np.concatenate([self._count, np.zeros(grow)])
-            self._sums = np.vstack([self._sums, np.zeros((grow, self._sums.shape[1]))])
-        self._count += np.bincount(index, minlength=blocks)[:blocks].astype(float)
-        for j in range(self._sums.shape[1]):
-            self._sums[:, j] += np.bincount(index, weights=values[:, j], minlength=blocks)[:blocks]
+        index = np.floor((np.asarray(time_s, dtype=float) - self._t0) / self.block_s)
+        numbers, which = np.unique(index, return_inverse=True)
+        rows = np.column_stack([np.ones(len(index)), np.asarray(values, dtype=float).reshape(len(index), -1)])
+        sums = np.stack([np.bincount(which, weights=rows[:, j], minlength=numbers.size)
+                         for j in range(rows.shape[1])], axis=1)
+        for number, row in zip(numbers.tolist(), sums):
+            if number in self._blocks:
+                self._blocks[number] += row
+            else:
+                self._blocks[number] = row
 
     def means(self) -> np.ndarray:
-        """The means (b, columns) of the complete blocks: those with at least half the fullest block's samples
-        (the last, partial block and blocks in gaps left out)."""
-        if not self._count.size:
-            return self._sums[:0]
-        full = self._count >= 0.5 * self._count.max()
-        return self._sums[full] / self._count[full, None]
+        """The means (b, columns) of the complete blocks in time order: those with at least half the fullest
+        block's samples (the last, partial block and blocks at the edges of gaps left out)."""
+        if not self._blocks:
+            return np.zeros((0, self.columns))
+        table = np.array([self._blocks[k] for k in sorted(self._blocks)])
+        full = table[:, 0] >= 0.5 * table[:, 0].max()
+        return table[full, 1:] / table[full, :1]
 
 
 @dataclass(frozen=True)
