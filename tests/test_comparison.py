@@ -6,11 +6,12 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import FitOptions, Polynomial, apply
+from gyrocomp import FitOptions, Network, Polynomial, apply
 from gyrocomp.comparison import (
     ARDUPILOT_TEMP_REF_DEGC,
     DEFAULT_METHODS,
     compare_methods,
+    fit_method,
     fit_ardupilot_style,
     fit_px4_style,
 )
@@ -107,3 +108,12 @@ def test_autopilot_cubics_recover_an_exact_cubic_and_clamp_like_the_firmware():
         np.testing.assert_allclose(comp - comp.mean(), left - left.mean(), atol=2e-6)
     assert fit_px4_style([run]).axes["gyro_z"].temperature.t_ref_degc == pytest.approx(30.0)
     assert fit_ardupilot_style([run]).axes["gyro_z"].temperature.t_ref_degc == ARDUPILOT_TEMP_REF_DEGC
+
+
+def test_a_method_keeps_its_own_network_seed_unless_one_is_given():
+    runs = [simulate("mti10", profile="chamber", rate_hz=0.5, duration_s=3600, seed=s).recording for s in range(2)]
+    method = FitOptions(temperature=Network((2,), seed=11), hysteresis="none", acceleration="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert fit_method(method, runs).report.network.seed == 11
+        assert fit_method(method, runs, seed=3).report.network.seed == 3

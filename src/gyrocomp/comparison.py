@@ -187,7 +187,7 @@ def _method_row(name: str, axis: str, metrics: list) -> MethodRow:
 
 def compare_methods(recordings: list[Recording], *, methods: dict[str, Method] | None = None,
                     window_s: float | None = None, hysteresis_band_degc: tuple[float, float] | None = None,
-                    seed: int = 0) -> MethodComparison:
+                    seed: int | None = None) -> MethodComparison:
     """Score each method on the runs (see the module doc); the raw output is the first row of each axis.
 
     Parameters
@@ -201,8 +201,9 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, Method] |
         Moving-average window [s]; default each run's raw Allan-minimum tau (the thesis's choice).
     hysteresis_band_degc : (lo, hi), optional
         Given to the methods with hysteresis that name no band themselves [degC].
-    seed : int
-        The seed of the networks' initializations.
+    seed : int, optional
+        The seed of the networks' initializations, replacing each method's own (default: each method's own; the
+        thesis's networks use 0).
     """
     methods = DEFAULT_METHODS if methods is None else methods
     recordings = prepare(recordings)  # once for every method and held-out run

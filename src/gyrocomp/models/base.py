@@ -15,6 +15,7 @@ from ..io import file_sha256
 from ..prepared import fit_axes
 from ..recording import Recording
 
+
 class LearnedAttributes:
     """Base of the estimators (scikit-learn style): reading a learned attribute (a name ending in ``_``, set by
     the fit) before the fit raises :class:`~gyrocomp.errors.NotFittedError` naming the estimator and the call that
