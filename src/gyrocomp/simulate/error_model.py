@@ -59,17 +59,35 @@ class Hysteresis:
         Branches that carry the offset.
     band_degc : (lo, hi), optional
         Structure-temperature band [degC] outside which there is none.
+    fade_degc : float, optional
+        A bump instead of the polynomial: per axis h_1 (1 - exp(-8 d / F)) (1 - d / F)^2 for d < F, zero beyond
+        (F = ``fade_degc``): it starts at the turning point, peaks about F / 5 after it and fades out smoothly over
+        F degrees; only h_1 [deg/s] of each axis is read. A shape the turning-point polynomial only approximates.
     """
 
     coefficients_dps: tuple[tuple[float, ...], ...]
     direction: str = "descending"
     band_degc: tuple[float, float] | None = None
+    fade_degc: float | None = None
 
     def __post_init__(self) -> None:
         if self.direction not in HYSTERESIS_DIRECTIONS:
             raise InputError(f"hysteresis direction: {self.direction!r}; use one of {', '.join(HYSTERESIS_DIRECTIONS)}")
         if self.band_degc is not None and not self.band_degc[0] < self.band_degc[1]:
             raise InputError(f"hysteresis band_degc: {self.band_degc}; give (low, high) with low < high")
+        if self.fade_degc is not None and not 0 < self.fade_degc < math.inf:
+            raise InputError(f"hysteresis fade_degc: must be positive and finite, got {self.fade_degc}")
+
+    def offset_dps(self, d_degc: np.ndarray, coefficients_dps: tuple[float, ...]) -> np.ndarray:
+        """The offset at distance ``d_degc`` from the turning point [degC] on a branch that carries it [deg/s]."""
+        d = np.asarray(d_degc, dtype=float)
+        if self.fade_degc is None:
+            out = np.zeros_like(d)
+            for h in reversed(tuple(coefficients_dps)):
+                out = (out + h) * d
+            return out
+        f = self.fade_degc
+        return np.where(d < f, coefficients_dps[0] * (1 - np.exp(-8 * d / f)) * (1 - d / f) ** 2, 0.0)
 
 
 @dataclass(frozen=True)
@@ -237,8 +255,9 @@ class GyroErrorModel:
             return np.zeros((n, k))
         turns = find_turns(structure_degc, TURN_THRESHOLD_DEGC)
         h = self.hysteresis
-        return np.column_stack([hysteresis_offset(structure_degc, turns, c, direction=h.direction,
-                                                  band_degc=h.band_degc) for c in h.coefficients_dps])
+        # the distance from the turning point on the branches that carry the offset (zero elsewhere), then its shape
+        d = hysteresis_offset(structure_degc, turns, (1.0,), direction=h.direction, band_degc=h.band_degc)
+        return np.column_stack([np.where(d > 0, h.offset_dps(d, c), 0.0) for c in h.coefficients_dps])
 
     def acceleration_error_dps(self, specific_force_g: np.ndarray) -> np.ndarray:
         """g and g x g sensitive bias (n, k) [deg/s]."""

@@ -1,0 +1,151 @@
+"""Benchmark: accuracy by calibration protocol, the way users calibrate, judged on data the fit has not seen.
+
+For every simulator preset and a few seeds (each seed a new set of runs, noise and turn-on biases):
+
+- ``one cycle``: one chamber run 40 -> -20 -> 70 -> 30 degC at 2 degC/min (cooled, heated, cooled, as most
+  single-cycle procedures), fitted up to its hottest point, judged on the cooling leg after it;
+- ``two cycles``: two heat-cool runs over the preset's range (the second 10 degC narrower), judged on a third run
+  over the range widened by 5 degC at the hot end;
+- ``three runs``: three heat-cool runs, judged on a fourth.
+
+Each is compensated by the default fit (``fit_channels``), by a plain cubic with one constant per run
+(``gyrocomp.validation.fit_plain_cubic``) and perfectly (the simulator's truth: what is left is the sensor's own
+noise). The score is the drift a user judges: the RMS about its mean of the 60 s moving average of the output
+minus the true rate, per axis [deg/s]. The table gives the mean over axes and seeds of default/perfect and
+cubic/perfect, and the count of axes the default leaves worse than raw (more than 1 % above raw's drift).
+
+Also the thesis's ADXRS450 case (``adxrs450``: two heat-cool runs over -30..85 and -20..80 degC at 20 Hz, judged
+on a third over -25..85 degC), with its hysteresis as the preset has it and as a smooth bump that fades over
+25 degC, and the real CATS recording (fit on two of its runs, judged on the third; shared dataset, skipped when
+absent).
+
+Usage: python benchmarks/bench_protocols.py [--seeds N] [--markdown FILE]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from gyrocomp import apply
+from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.simulate import PRESETS, Hysteresis, get_preset, get_profile, preset_model, simulate
+from gyrocomp.validation import fit_plain_cubic
+
+WINDOW_S = 60.0
+RATE_HZ = 2.0
+
+
+def drift(series: np.ndarray, rate_hz: float) -> float:
+    return smoothed_residual_rms(series, max(1, int(WINDOW_S * rate_hz)))
+
+
+def judge(fit_runs, held_recording, truth_rate, noise, rate_hz):
+    """(default, cubic, perfect, raw) drift per axis of ``held_recording`` [deg/s]."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        default = fit_channels(fit_runs)
+        cubic = fit_plain_cubic(fit_runs)
+        out = {name: apply(cal, held_recording).gyro_dps for name, cal in (("default", default), ("cubic", cubic))}
+    k = held_recording.gyro_dps.shape[1]
+    rows = {name: [drift(v[:, j] - truth_rate[:, j], rate_hz) for j in range(k)] for name, v in out.items()}
+    rows["perfect"] = [drift(noise[:, j], rate_hz) for j in range(k)]
+    rows["raw"] = [drift(held_recording.gyro_dps[:, j] - truth_rate[:, j], rate_hz) for j in range(k)]
+    return rows
+
+
+def one_cycle(model, seed):
+    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
+                       dwell_s=300.0)
+    sim = simulate(model, profile=prof, rate_hz=RATE_HZ, seed=seed)
+    rec = sim.recording
+    k = int(np.argmax(rec.temperature_degc))
+    return judge([rec.take(np.arange(k))], rec.take(np.arange(k, rec.n_samples)), sim.truth.true_rate_dps[k:],
+                 sim.truth.noise.total_dps[k:], RATE_HZ)
+
+
+def cycles(model, seed, span, runs: int, rate_hz: float = RATE_HZ):
+    lo, hi = span
+    ranges = [(lo, hi), (lo + 10.0, hi - 10.0), (lo + 5.0, hi)][:runs] if runs <= 3 else [(lo, hi)] * runs
+    fit = [simulate(model, profile=get_profile("cycle", set_points_degc=r, cycles=1), rate_hz=rate_hz,
+                    seed=100 * seed + i).recording for i, r in enumerate(ranges)]
+    held = simulate(model, profile=get_profile("cycle", set_points_degc=(lo + 5.0, hi + 5.0), cycles=1),
+                    rate_hz=rate_hz, seed=100 * seed + 99)
+    return judge(fit, held.recording, held.truth.true_rate_dps, held.truth.noise.total_dps, rate_hz)
+
+
+def summarize(results: list[dict]) -> tuple[float, float, int, int]:
+    d = np.concatenate([r["default"] for r in results])
+    c = np.concatenate([r["cubic"] for r in results])
+    p = np.concatenate([r["perfect"] for r in results])
+    raw = np.concatenate([r["raw"] for r in results])
+    return float(np.mean(d / p)), float(np.mean(c / p)), int(np.sum(d > 1.01 * raw)), int(d.size)
+
+
+def adxrs450_case(hysteresis: Hysteresis | None):
+    model = preset_model("adxrs450")
+    if hysteresis is not None:
+        model = dataclasses.replace(model, hysteresis=hysteresis)
+    fit = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=20.0, seed=s).recording
+           for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)))]
+    held = simulate(model, profile=get_profile("cycle", set_points_degc=(-25.0, 85.0), cycles=1), rate_hz=20.0, seed=7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_channels(fit)
+        comp = apply(cal, held.recording).gyro_dps[:, 0]
+    ratio = drift(comp - held.truth.true_rate_dps[:, 0], 20.0) / drift(held.truth.noise.total_dps[:, 0], 20.0)
+    return ratio, cal.axes["gyro_z"].lag_time_constant_s, cal.model
+
+
+def cats_case():
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from tests.real_data import CATS, CATS_CHOICES, cats_held_out_drift, cats_numpy_cubic_drift
+    if not CATS.is_dir():
+        return None
+    default = cats_held_out_drift({"default": CATS_CHOICES["default (auto)"]})["default"]
+    return float(default.mean() / cats_numpy_cubic_drift().mean())
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--seeds", type=int, default=3)
+    parser.add_argument("--markdown", type=Path, help="write the tables as Markdown to this file")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    lines = ["| preset | protocol | default / perfect | plain cubic / perfect | axes worse than raw |",
+             "|---|---|---|---|---|"]
+    for name in PRESETS:
+        model = preset_model(name)
+        span = get_preset(name).set_points_degc
+        protocols = {"one cycle": lambda s: one_cycle(model, s),
+                     "two cycles": lambda s: cycles(model, s, span, 2),
+                     "three runs": lambda s: cycles(model, s, span, 3)}
+        for protocol, run in protocols.items():
+            d, c, worse, n = summarize([run(s) for s in range(args.seeds)])
+            lines.append(f"| {name} | {protocol} | {d:.2f} | {c:.2f} | {worse} of {n} |")
+            print(lines[-1], flush=True)
+    lines += ["", "| case | default / perfect | lag [s] (truth 60) | model |", "|---|---|---|---|"]
+    for label, hyst in (("adxrs450, the preset's hysteresis", None),
+                        ("adxrs450, a bump fading over 25 degC", Hysteresis(((0.2,),), direction="descending",
+                                                                             fade_degc=25.0))):
+        ratio, lag, model_name = adxrs450_case(hyst)
+        lines.append(f"| {label} | {ratio:.2f} | {lag:.1f} | {model_name} |")
+        print(lines[-1], flush=True)
+    cats = cats_case()
+    lines += ["", f"CATS (real, fit on two runs, judged on the third): default / plain cubic = "
+              + ("dataset absent" if cats is None else f"{cats:.3f}")]
+    print(lines[-1])
+    print(f"({time.perf_counter() - start:.0f} s)")
+    if args.markdown:
+        args.markdown.write_text("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
