@@ -23,7 +23,7 @@ import numpy as np
 from .calibration import Calibration
 from .comparison import AUTOPILOT_METHODS
 from .compensate import apply
-from .errors import DataQualityWarning, MissingDependencyError
+from .errors import DataQualityWarning, MissingDependencyError, ModelChoiceWarning
 from .io import read_table, write_gyro_back, write_recording, write_text_atomic
 from .allan import allan_deviation_segments
 from .metrics import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
@@ -108,6 +108,8 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     cal_paths, held, held_path = _simulate_inputs(out_dir, rate_hz)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)  # the pauses while turning the unit are the profile's
+        # three runs are three folds, fewer than the four a firm choice wants: the validation table shows them
+        warnings.simplefilter("ignore", ModelChoiceWarning)
         cal_runs = [read_table(p).recording for p in cal_paths]
         calibration = fit_calibration(cal_runs)
         validation = validate(cal_runs)

@@ -102,14 +102,24 @@ class HysteresisCurve:
 __all__ = ["HysteresisCurve", "heats_and_cools", "parting_band_degc", "turn_threshold_degc"]
 
 
+def _grow(core: np.ndarray, tail: np.ndarray, start: int, step: int) -> int:
+    """The last bin reached from ``start`` going ``step`` (-1 or +1) through bins in ``core`` or ``tail``."""
+    k = start
+    while 0 <= k + step < core.size and (core[k + step] or tail[k + step]):
+        k += step
+    return k
+
+
 def parting_band_degc(temperature_degc: np.ndarray, residual_dps: np.ndarray, after_turn: np.ndarray,
-                      direction: np.ndarray) -> tuple[float, float] | None:
+                      direction: np.ndarray, tail: bool = False) -> tuple[float, float] | None:
     """The temperature band where the branches after a reversal part from the opposite branches [degC], or None
     when no band stands out or it spans most of the range.
 
     Per temperature bin (span / 40, at least 1 degC), the mean residual on branches after a confirmed reversal
     minus the mean on the opposite-direction branches; bins where that difference exceeds three standard errors
-    and 30 % of its largest value, contiguous around the largest, are the band.
+    and 30 % of its largest value, contiguous around the largest, are the band's core; the bins beyond it on the side away from
+    the turns (colder for branches after a cooling turn), where the difference keeps its sign and exceeds one standard
+    error, its tail (with ``tail``).
 
     Parameters
     ----------
@@ -121,6 +131,9 @@ def parting_band_degc(temperature_degc: np.ndarray, residual_dps: np.ndarray, af
         Whether the sample lies on a branch after a confirmed reversal.
     direction : (N,) int array
         Direction of travel (-1 cooling, +1 heating, 0 unknown), as :func:`gyrocomp.effects.find_turns` gives.
+    tail : bool
+        Extend the core by its tail (above). Only for a residual in which a thermal lag was modelled: an
+        unmodelled lag parts the branches by the same sign everywhere, and the tail would then cover the range.
     """
     t, e, after, d = temperature_degc, residual_dps, after_turn, direction
     if t.size == 0 or not t.max() > t.min():
@@ -142,18 +155,17 @@ def parting_band_degc(temperature_degc: np.ndarray, residual_dps: np.ndarray, af
             continue
         peak = int(np.nanargmax(np.abs(diff)))
         if best is None or abs(diff[peak]) > best[0]:
-            best = (abs(diff[peak]), diff, se, peak)
+            best = (abs(diff[peak]), diff, se, peak, sign)
     if best is None:
         return None
-    top, diff, se, peak = best
+    top, diff, se, peak, branch = best
     strong = (np.abs(np.nan_to_num(diff)) > 3 * se) & (np.abs(np.nan_to_num(diff)) > 0.3 * top)
     if not strong[peak]:
         return None
-    a = b = peak
-    while a > 0 and strong[a - 1]:
-        a -= 1
-    while b < strong.size - 1 and strong[b + 1]:
-        b += 1
+    # the core, then its tail away from the turn: a bump that fades with the distance from the turning point is
+    # cut where it is lost in the noise, not at 30 % of its peak, which would leave a step of that size
+    fading = (np.sign(np.nan_to_num(diff)) == np.sign(diff[peak])) & (np.abs(np.nan_to_num(diff)) > se) & tail
+    a, b = _grow(strong, fading & (branch < 0), peak, -1), _grow(strong, fading & (branch > 0), peak, 1)
     covered = np.count_nonzero(~np.isnan(diff))
     if b - a + 1 >= 0.8 * covered:
         return None

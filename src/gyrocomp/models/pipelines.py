@@ -13,7 +13,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
-from ..fit_report import AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
+from ..fit_report import THIN_FOLDS, AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..plausibility import calibration_concerns, temperature_span_concern
 from ..prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
@@ -80,7 +80,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
                   hysteresis_orders: tuple[int, ...] = (1, 2, 3), acceleration: str = "none",
                   static_min_duration_s: float = 10.0, bin_width_degc: float | None = None,
                   run_folds: tuple[int, ...] | None = None, folds: str = "auto",
-                  shared_lag: bool = True) -> dict[str, AxisSelection]:
+                  shared_lag: bool = True, do_no_harm: bool = True) -> dict[str, AxisSelection]:
     """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.models.selection`).
 
     Parameters
@@ -99,6 +99,9 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     shared_lag : bool
         With one temperature column, score every lag candidate at one lag per fold shared by the axes
         (:func:`gyrocomp.models.selection.share_fold_lags`).
+    do_no_harm : bool
+        Keep a temperature model only where it beats the run constant on the held-out folds
+        (:func:`gyrocomp.models.selection.beats_constant`); False when the order was asked for.
     """
     if folds not in FOLD_KINDS:
         raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
@@ -122,19 +125,28 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
         problems[axis] = problem
     if shared_lag and one_temperature_column(recordings) and any("lag" in m for m in memories):
         share_fold_lags(list(problems.values()), orders)
-    return {axis: select_axis(axis, problem, orders, memories) for axis, problem in problems.items()}
+    return {axis: select_axis(axis, problem, orders, memories, do_no_harm=do_no_harm)
+            for axis, problem in problems.items()}
 
 
 def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
+    first = next(iter(selections.values()))
+    across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[first.fold_kind]
+    if first.fold_note:
+        warnings.warn(f"model choice: {first.fold_note}", ModelChoiceWarning, stacklevel=3)
+    if first.validated and len(first.folds) < THIN_FOLDS:
+        warnings.warn(f"model choice: only {len(first.folds)} {across} to hold out; the evidence for each axis's "
+                      f"choice is thin (more runs, or runs that heat and cool more than once, make it firmer)",
+                      ModelChoiceWarning, stacklevel=3)
     for axis, sel in selections.items():
         unit = sel.unit
-        across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[sel.fold_kind]
         if not sel.validated:
             warnings.warn(f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without "
                           "validation", ModelChoiceWarning, stacklevel=3)
         elif not sel.generalizes:
-            warnings.warn(f"{axis}: no temperature model generalizes across {across}; left uncompensated "
-                          "(run constant only)", ModelChoiceWarning, stacklevel=3)
+            warnings.warn(f"{axis}: no temperature model beats the run constant on held-out {across} by more than "
+                          f"its standard error (best: {sel.best.label}); left with its constant only",
+                          ModelChoiceWarning, stacklevel=3)
         elif sel.chosen_drift > sel.raw_drift:
             warnings.warn(f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift:.3g} {unit} of "
                           f"held-out drift, more than the raw output's {sel.raw_drift:.3g} {unit}",
@@ -179,7 +191,7 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
     selections = select_models(recordings, orders=orders, memories=memories, hysteresis_orders=h_orders,
                                acceleration=accel_mode, static_min_duration_s=options.static_min_duration_s,
                                bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
-                               folds=options.folds)
+                               folds=options.folds, do_no_harm=order == "auto")
     _warn_about_choice(selections)
     chosen = {axis: sel.chosen for axis, sel in selections.items()}
     thermal = ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
@@ -189,7 +201,8 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
                                      band_degc={a: selections[a].band_degc if c.band else None
                                                 for a, c in chosen.items()},
                                      bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
-                                     static_min_duration_s=options.static_min_duration_s).fit(recordings)
+                                     static_min_duration_s=options.static_min_duration_s,
+                                     refine_band=True).fit(recordings)
     return selections, thermal
 
 

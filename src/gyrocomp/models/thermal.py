@@ -166,6 +166,26 @@ class _Problem:
             tau_s = best_lag_s(lambda tau: self.solve(spec, tau, which)[2], LAG_MIN_BLOCKS * self.block_s)
         return tau_s, self.solve(spec, tau_s, which)
 
+    def refine_band(self, spec: _Spec, tau_s: float, step_degc: float) -> None:
+        """Move each edge of the band [degC] to where the all-run weighted residual is least, on a grid of
+        ``step_degc`` / 4 within one ``step_degc`` of where it was found (the band is found on temperature bins;
+        a bump that ends sharply leaves a step of its height at an edge placed a bin off)."""
+        if self.band is None or not spec.hysteresis_order:
+            return
+        which = list(range(len(self.runs)))
+        lo0, hi0 = self.band
+        offsets = np.linspace(-step_degc, step_degc, 9)
+        best = (self.solve(spec, tau_s, which)[2], self.band)
+        for lo in lo0 + offsets:
+            for hi in hi0 + offsets:
+                if hi - lo < step_degc:
+                    continue
+                self.band = (float(lo), float(hi))
+                rss = self.solve(spec, tau_s, which)[2]
+                if rss < best[0]:
+                    best = (rss, self.band)
+        self.band = best[1]
+
     def lag_profile(self, spec: _Spec) -> Callable[[float], float]:
         """The all-run residual sum of squares as a function of tau [s], divided by its minimum (1 at the
         axis's own best tau), so that axes with different noise weigh the same in a shared lag."""
@@ -289,6 +309,9 @@ class ThermalHysteresisModel(LearnedAttributes):
     shared_lag : bool
         Axes that read one temperature column and all have lag get one time constant, fitted on all of them
         together (the lag is the die's, behind one sensor); False fits one per axis.
+    refine_band : bool
+        ``band_degc`` was found on temperature bins (:func:`~gyrocomp.models.hysteresis.parting_band_degc`): move
+        its edges, within one bin, to where the residual is least, then fit the lag again.
 
     Attributes (after ``fit``)
     --------------------------
@@ -328,6 +351,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     static_min_duration_s: float = 10.0
     weighting: str | dict[str, str] = "temperature-balanced"
     shared_lag: bool = True
+    refine_band: bool = False
 
     @staticmethod
     def _of(value, axis: str):
@@ -468,6 +492,10 @@ class ThermalHysteresisModel(LearnedAttributes):
         keep what it learned."""
         problem, spec = choice.problem, choice.spec
         n_runs = len(problem.runs)
+        if self.refine_band and problem.band is not None and spec.hysteresis_order:
+            temps = np.concatenate([r.temperature_degc for r in problem.runs])
+            problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0],
+                                max(1.0, float(np.ptp(temps)) / 40.0))
         tau, (coef, consts, _, (t_lo, t_hi)) = problem.fit(spec, list(range(n_runs)), tau_s)
         shape = coef[: spec.order]
         self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,

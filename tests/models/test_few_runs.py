@@ -1,0 +1,147 @@
+"""One or two chamber cycles (issue: a default that never harms, the thesis's hysteresis found by itself):
+simulate-then-recover with the default call a user makes, judged on data the fit has not seen."""
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import Calibration, apply
+from gyrocomp.errors import ModelChoiceWarning
+from gyrocomp.fit_report import SelectionReport
+from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.models.pipelines import fit_calibration, fit_channels
+from gyrocomp.models.selection import Candidate, CandidateScore, beats_constant, choose
+from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
+
+RATE_HZ = 20.0
+
+
+def _adxrs450_case(model):
+    """The thesis's ADXRS450 protocol: two heat-cool runs over -30..85 and -20..80 degC (20 Hz), judged on a third
+    over -25..85 degC; (calibration, default/perfect drift ratio on the third run)."""
+    fit = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=RATE_HZ,
+                    seed=s).recording for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)))]
+    held = simulate(model, profile=get_profile("cycle", set_points_degc=(-25.0, 85.0), cycles=1), rate_hz=RATE_HZ,
+                    seed=7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_channels(fit)
+        comp = apply(cal, held.recording).gyro_dps[:, 0]
+    w = int(60 * RATE_HZ)
+    ratio = smoothed_residual_rms(comp - held.truth.true_rate_dps[:, 0], w) / smoothed_residual_rms(
+        held.truth.noise.total_dps[:, 0], w)
+    return cal, ratio
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("shape", ["preset", "bump"])
+def test_two_runs_find_the_hysteresis_and_the_lag_by_themselves(shape):
+    model = preset_model("adxrs450")  # 60 s lag; hysteresis on cooling, 55..80 degC
+    if shape == "bump":  # another shape: starts at the turning point, fades out over 25 degC
+        model = dataclasses.replace(model, hysteresis=Hysteresis(((0.2,),), direction="descending", fade_degc=25.0))
+    cal, ratio = _adxrs450_case(model)
+    ax = cal.axes["gyro_z"]
+    assert ratio <= 1.35
+    assert ax.lag_time_constant_s == pytest.approx(60.0, rel=0.2)
+    assert ax.hysteresis is not None and ax.hysteresis.band_degc is not None
+    # lag and hysteresis recovered together (on main the lag ran away to several minutes when forced)
+    lo, hi = ax.hysteresis.band_degc
+    d = np.linspace(0.0, 20.0, 41)  # below the 80 degC turn of the first run, inside the band
+    fitted = sum(h * d ** (j + 1) for j, h in enumerate(ax.hysteresis.descending))
+    if shape == "preset":
+        assert lo == pytest.approx(55.0, abs=1.5) and hi == pytest.approx(80.0, abs=1.5)
+        np.testing.assert_allclose(fitted, 0.032 * d - 0.00128 * d ** 2, atol=0.015)
+    else:  # the bump (peak 0.1 deg/s), inside the band, after the first run's turn at 85 degC
+        inside = (85.0 - d >= lo) & (85.0 - d <= hi)
+        assert hi > 80.0 and lo < 70.0 and np.count_nonzero(inside) > 20
+        np.testing.assert_allclose(fitted[inside], model.hysteresis.offset_dps(d, (0.2,))[inside], atol=0.03)
+    selection = cal.report.selection["gyro_z"]
+    assert selection.fold_kind == "legs" and len(selection.folds) == 4
+    # every memory the data can identify was scored, the turning-point terms in the band among them
+    scored = {r.candidate.memory for r in selection.candidates}
+    assert {"none", "lag", "turning-point", "turning-point+lag"} <= scored
+
+
+def _one_cycle(model, seed):
+    """One chamber run cooled, heated, cooled (2 degC/min, 2 Hz), fitted up to its hottest point; the drift of the
+    raw and the default's output on the cooling leg after it [deg/s], and the fit's warnings."""
+    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
+                       dwell_s=300.0)
+    sim = simulate(model, profile=prof, rate_hz=2.0, seed=seed)
+    rec = sim.recording
+    k = int(np.argmax(rec.temperature_degc))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cal = fit_calibration([rec.take(np.arange(k))])
+    test = rec.take(np.arange(k, rec.n_samples))
+    truth = sim.truth.true_rate_dps[k:, 0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = apply(cal, test).gyro_dps[:, 0]
+    return (smoothed_residual_rms(test.gyro_dps[:, 0] - truth, 120), smoothed_residual_rms(out - truth, 120),
+            [str(w.message) for w in caught])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_random_walk_unrelated_to_temperature_is_left_alone(seed):
+    # measured on main before this change: a curve fitted to the walk left the next leg 1.2-1.4x worse than raw
+    walk = GyroErrorModel(axes=("gyro_x",), temperature_coefficients=((0.0,),), rate_random_walk_dps_per_sqrt_s=2e-3,
+                          noise_density_dps_per_sqrt_hz=0.005)
+    raw, default, messages = _one_cycle(walk, seed)
+    assert default <= 1.05 * raw
+    assert any("only 2 heating and cooling legs to hold out; the evidence for each axis's choice is thin" in m
+               for m in messages)
+
+
+def test_one_cycle_of_a_part_with_a_real_tempco_is_compensated():
+    raw, default, _ = _one_cycle(preset_model("consumer"), 0)
+    assert default < 0.1 * raw
+
+
+def _score(folds, c=Candidate(2)):
+    return CandidateScore(c, tuple(folds), tuple(0.0 for _ in folds))
+
+
+def test_do_no_harm_with_two_folds_asks_for_half_the_constants_drift_on_both():
+    constant = _score([0.020, 0.033], Candidate(0))
+    assert not beats_constant(_score([0.0123, 0.0167]), constant)  # 39 and 49 % less: what a walk can do by chance
+    assert beats_constant(_score([0.0057, 0.0093]), constant)
+    assert not beats_constant(_score([0.002, 0.020]), constant)  # far better on one leg only
+
+
+def test_do_no_harm_with_more_folds_asks_for_one_standard_error_of_the_paired_gain():
+    constant = _score([0.010, 0.012, 0.011, 0.013], Candidate(0))
+    assert beats_constant(_score([0.008, 0.010, 0.009, 0.011]), constant)  # 0.002 less on every fold
+    assert not beats_constant(_score([0.004, 0.014, 0.012, 0.014]), constant)  # mean gain 0.0005, SE 0.0016
+    # when nothing beats the constant, the constant is chosen
+    best, chosen = choose([_score([0.004, 0.014, 0.012, 0.014]), constant], lambda c: c.complexity, constant)
+    assert best == Candidate(2) and chosen == Candidate(0)
+
+
+def test_folds_that_cannot_be_had_are_said():
+    heating = simulate("consumer", profile="chamber", duration_s=3000, rate_hz=1, seed=1).recording
+    with pytest.warns(ModelChoiceWarning, match=r"the temperature never reverses, so there are no heating and "
+                                                r"cooling legs to hold out; held out 4 contiguous time blocks"):
+        cal = fit_calibration([heating])
+    assert cal.report.selection["gyro_x"].fold_kind == "blocks"
+    cycle = simulate("consumer", profile="cycle", duration_s=6000, rate_hz=1, seed=1).recording
+    with pytest.warns(ModelChoiceWarning, match=r"folds='runs': one run cannot be held out against others; held "
+                                                r"out each heating and cooling leg"):
+        cal = fit_calibration([cycle], folds="runs")
+    assert cal.report.selection["gyro_x"].fold_kind == "legs"
+
+
+def test_the_expected_held_out_drift_is_stored_and_read_back(tmp_path):
+    run = simulate("consumer", profile="cycle", duration_s=6000, rate_hz=1, seed=2).recording
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration([run])
+    cal.save(tmp_path / "m.json")
+    selection = Calibration.load(tmp_path / "m.json").report.selection
+    for axis, sel in selection.items():
+        assert isinstance(sel, SelectionReport)
+        chosen = sel.result(sel.chosen.label)
+        assert sel.chosen_drift_dps == pytest.approx(chosen.mean_drift)
+        assert sel.chosen_standard_error == pytest.approx(chosen.standard_error)
