@@ -79,15 +79,18 @@ def test_simulate_combined_run_has_gaps_and_accelerometer(tmp_path):
 def test_fit_prints_table_and_writes_model(workdir):
     r = run("fit", workdir / "run1.csv", workdir / "run2.csv", "-o", workdir / "auto.json")
     assert r.returncode == 0, r.stderr
-    # two runs: the folds come from inside them (4 time blocks each, the chamber runs only heat)
-    assert "model choice by held-out drift (blocks: 8 folds" in r.stdout
-    assert "held-out drift per fold" in r.stdout and "run 2 block 4" in r.stdout
+    # two runs that only heat: each run's one heating leg is held out (never time blocks unless asked), and two
+    # folds are said to be thin evidence
+    assert "model choice by held-out drift (legs: 2 folds" in r.stdout
+    assert "held-out drift per fold" in r.stdout and "run 2 leg 1 (heating)" in r.stdout
+    assert "only 2 heating and cooling legs to hold out; the evidence for each axis's choice is thin" in r.stderr
     model = json.loads((workdir / "auto.json").read_text())
-    assert model["fit_report"]["order_selection"] == "leave-one-block-out"
+    assert model["fit_report"]["order_selection"] == "leave-one-leg-out"
     for axis in ("gyro_x", "gyro_y", "gyro_z"):
         sel = model["fit_report"]["selection"][axis]
-        assert len(sel["folds"]) == 8 and all(len(c["fold_drift_dps"]) == 8 for c in sel["candidates"])
+        assert len(sel["folds"]) == 2 and all(len(c["fold_drift_dps"]) == 2 for c in sel["candidates"])
         assert sel["chosen_drift_dps"] <= sel["raw_drift_dps"]
+        assert sel["chosen_standard_error_dps"] >= 0 and sel["fold_note"] == ""
 
 
 def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
@@ -156,7 +159,8 @@ def test_evaluate_json_shape(workdir):
     r = run("evaluate", workdir / "model.json", workdir / "run3.csv", "--json")
     assert r.returncode == 0, r.stderr
     data = json.loads(r.stdout)
-    assert set(data) == {"runs"}
+    # model.json's order was asked for (poly:3): the selection still scored it on held-out folds and says so
+    assert set(data) == {"runs", "expected_held_out_drift"}
     run0 = data["runs"][0]
     assert set(run0) == {"file", "window_s", "axes"}
     assert run0["window_s"] >= 1.0
@@ -596,3 +600,23 @@ def test_control_characters_in_a_message_are_escaped_to_keep_one_line(tmp_path):
     result = run("allan", odd)
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and "two\\nlines\\x1b.csv" in result.stderr, result.stderr
+
+
+def test_fit_and_evaluate_state_the_drift_to_expect_from_one_run(tmp_path):
+    for seed, name in ((3, "one.csv"), (4, "two.csv")):
+        r = run("simulate", "--profile", "cycle", "--duration", 6000, "--rate", 2, "--seed", seed, "-o", tmp_path / name)
+        assert r.returncode == 0, r.stderr
+    r = run("fit", tmp_path / "one.csv", "-o", tmp_path / "m.json")
+    assert r.returncode == 0, r.stderr
+    assert "model choice by held-out drift (legs: 4 folds" in r.stdout
+    r = run("evaluate", tmp_path / "m.json", tmp_path / "two.csv")
+    assert r.returncode == 0, r.stderr
+    assert "drift to expect on unseen data (the model file's 4 held-out legs" in r.stdout
+    r = run("evaluate", tmp_path / "m.json", tmp_path / "two.csv", "--json")
+    expected = json.loads(r.stdout)["expected_held_out_drift"]
+    model = json.loads((tmp_path / "m.json").read_text())["fit_report"]["selection"]
+    assert [e["axis"] for e in expected] == ["gyro_x", "gyro_y", "gyro_z"]
+    for e in expected:
+        sel = model[e["axis"]]
+        assert e["drift_dps"] == sel["chosen_drift_dps"] and e["standard_error_dps"] == sel["chosen_standard_error_dps"]
+        assert e["fold_kind"] == "legs" and e["folds"] == 4 and not e["thin"]

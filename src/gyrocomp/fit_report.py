@@ -131,7 +131,9 @@ class SelectionReport:
     """The choice for one axis by held-out drift (:class:`gyrocomp.models.selection.AxisSelection` as stored):
     how the data was held out, the moving-average window of the score [s], every candidate's result, the best
     and the chosen one (the simplest within one standard error of the best); the drifts are in the axis's
-    ``unit`` (deg/s, or g for an accelerometer axis)."""
+    ``unit`` (deg/s, or g for an accelerometer axis). ``chosen_drift`` +- ``chosen_standard_error`` is the drift
+    to expect on data like a held-out fold (None in files written before it was stored); ``fold_note`` says why
+    the folds are not of the kind asked for."""
 
     axis: str
     fold_kind: str
@@ -147,6 +149,8 @@ class SelectionReport:
     generalizes: bool
     candidates: tuple[CandidateResult, ...]
     unit: AxisUnit = "deg/s"
+    chosen_standard_error: float | None = None
+    fold_note: str = ""
 
     raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
     chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
@@ -166,7 +170,8 @@ class SelectionReport:
                    Candidate.from_dict(d["best"]), Candidate.from_dict(d["chosen"]),
                    _number(_entry_in_unit(d, "raw_drift", unit)), _number(_entry_in_unit(d, "chosen_drift", unit)),
                    bool(d.get("validated", True)), bool(d.get("generalizes", True)),
-                   tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit)
+                   tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit,
+                   _number(_entry_in_unit(d, "chosen_standard_error", unit)), str(d.get("fold_note", "")))
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
@@ -387,6 +392,38 @@ class AxisFit:
                    {int(p): float(v) for p, v in (d.get("scores") or {}).items()})
 
 
+#: fewer held-out folds than this: the evidence for a model choice (and for the drift it expects) is thin
+THIN_FOLDS = 4
+
+
+@dataclass(frozen=True)
+class ExpectedDrift:
+    """The drift a model choice expects on data like a held-out fold (the next heating or cooling leg, or the next
+    run): the chosen candidate's mean held-out drift and its standard error [``unit``], the moving-average window
+    the drift is taken over [s], and what was held out."""
+
+    axis: str
+    model: str
+    drift: float
+    standard_error: float | None
+    constant_drift: float | None
+    unit: AxisUnit
+    window_s: float
+    fold_kind: str
+    folds: int
+
+    @property
+    def thin(self) -> bool:
+        """Fewer than :data:`THIN_FOLDS` folds: the figure rests on little evidence."""
+        return self.folds < THIN_FOLDS
+
+    def to_dict(self) -> dict:
+        u = unit_suffix(self.unit)
+        return {"axis": self.axis, "model": self.model, f"drift{u}": self.drift,
+                f"standard_error{u}": self.standard_error, f"constant_drift{u}": self.constant_drift,
+                "window_s": self.window_s, "fold_kind": self.fold_kind, "folds": self.folds, "thin": self.thin}
+
+
 @dataclass(frozen=True)
 class FitReport:
     """How a calibration was fitted (see the module). ``method`` is the temperature model's family
@@ -427,7 +464,18 @@ class FitReport:
             accel=cls.from_dict(d["accel"], "g") if isinstance(d.get("accel"), dict) else None,
             sections={k: v for k, v in d.items() if k not in _TYPED})
 
+    def expected_drift(self) -> dict[str, ExpectedDrift]:
+        """Per axis chosen by held-out drift, the drift to expect on unseen data of the same kind (empty when the
+        model was not chosen that way, or in files written before the standard error was stored it is None)."""
+        out = {}
+        for axis, sel in self.selection.items():
+            if sel.chosen_drift is None:
+                continue
+            out[axis] = ExpectedDrift(axis, sel.chosen.label, sel.chosen_drift, sel.chosen_standard_error,
+                                      sel.raw_drift, sel.unit, sel.window_s, sel.fold_kind, len(sel.folds))
+        return out
 
-__all__ = ["AxisFit", "Candidate", "CandidateResult", "FitReport", "GSensitivityReport", "GSensitivityRow",
+
+__all__ = ["AxisFit", "Candidate", "CandidateResult", "ExpectedDrift", "FitReport", "GSensitivityReport", "GSensitivityRow",
            "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
-           "Weighting", "memory_label", "memory_name"]
+           "THIN_FOLDS", "Weighting", "memory_label", "memory_name"]

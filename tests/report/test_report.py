@@ -90,6 +90,11 @@ def test_three_axis_report_with_acceleration_and_accelerometer():
     _check_page(report.html, list(report.sections))
     assert "g-sensitivity matrix G [deg/s/g] +- standard error" in report.html
     assert "temperature + acceleration" in report.html and "accelerometer" in report.html
+    # chosen by held-out drift: the drift to expect on unseen data, per axis, with its standard error
+    expected = cal.report.expected_drift()
+    assert "drift to expect on unseen data: mean +- standard error over 4 held-out legs" in report.html
+    assert f"{expected['gyro_x'].drift:.3g} +- {expected['gyro_x'].standard_error:.2g} deg/s" in report.html
+    assert "thin evidence" not in report.html  # two runs that heat and cool: four legs
     assert progress == sorted(progress) and progress[-1] == 1.0
     assert set(SECTIONS) <= set(report.sections)
 

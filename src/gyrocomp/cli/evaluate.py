@@ -19,7 +19,7 @@ from ..comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
 from .common import float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
-from .render import print_comparison, print_evaluation, print_installed, print_stages
+from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
 
 
 def _is_table(path, opts: dict) -> bool:
@@ -97,10 +97,13 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
             print_installed(results)
         return
     evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
+    expected = calibration.report.expected_drift()
     if as_json:
-        click.echo(json.dumps(evaluation.to_dict(), indent=2))
+        click.echo(json.dumps({**evaluation.to_dict(),
+                               "expected_held_out_drift": [e.to_dict() for e in expected.values()]}, indent=2))
     else:
         print_evaluation(evaluation)
+        print_expected_drift(expected)
 
 
 def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, rate_schedule) -> Evaluation:

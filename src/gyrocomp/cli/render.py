@@ -288,6 +288,22 @@ def _metrics_table(title: str, evaluation: Evaluation, rows_of) -> Table | None:
     return table
 
 
+def print_expected_drift(expected: dict) -> None:
+    """What the fit's held-out folds say the drift on unseen data will be, per axis (``FitReport.expected_drift``)."""
+    if not expected:
+        return
+    first = next(iter(expected.values()))
+    table = Table(title=f"drift to expect on unseen data (the model file's {first.folds} held-out {first.fold_kind}, "
+                        f"{first.window_s:g} s moving average" + ("; thin evidence" if first.thin else "") + ")")
+    for col in ("axis", "model", "expected drift", "run constant alone"):
+        table.add_column(col, justify="left" if col in ("axis", "model") else "right")
+    for e in expected.values():
+        table.add_row(e.axis, e.model, f"{_score(e.drift)}" + ("" if e.standard_error is None
+                                                               else f" +- {_score(e.standard_error, '.2g')}")
+                      + f" {e.unit}", f"{_score(e.constant_drift)} {e.unit}")
+    make_console().print(table)
+
+
 def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
     console = make_console()
     for table in (_metrics_table(title, evaluation, lambda run: run.axes.items()),
@@ -353,4 +369,4 @@ def print_noise(analysis: NoiseAnalysis) -> None:
     console.print(table)
 
 
-__all__ = ["print_comparison", "print_evaluation", "print_fit", "print_noise", "print_stages", "print_validation"]
+__all__ = ["print_comparison", "print_evaluation", "print_expected_drift", "print_fit", "print_noise", "print_stages", "print_validation"]

@@ -111,6 +111,10 @@ def _describe(ax) -> str:
     return text
 
 
+def _expected(drift: float, standard_error: float | None, unit: str) -> str:
+    return f"{drift:.3g}" + ("" if standard_error is None else f" +- {standard_error:.2g}") + f" {unit}"
+
+
 def _summary(calibration: Calibration) -> str:
     report = calibration.report
     parts = [f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
@@ -128,6 +132,18 @@ def _summary(calibration: Calibration) -> str:
     if calibration.accel_axes:
         parts.append(f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
                      "degC (its constant cannot be told from gravity at rest).</p>")
+    expected = report.expected_drift()
+    if expected:
+        first = next(iter(expected.values()))
+        parts.append(_table(["axis", "model", "expected held-out drift", "run constant alone"],
+                            [[e.axis, e.model, _expected(e.drift, e.standard_error, e.unit),
+                              "-" if e.constant_drift is None else f"{e.constant_drift:.3g} {e.unit}"]
+                             for e in expected.values()],
+                            f"drift to expect on unseen data: mean +- standard error over {first.folds} held-out "
+                            f"{first.fold_kind} ({first.window_s:g} s moving average)"))
+        if first.thin:
+            parts.append(f"<p class=note>Only {first.folds} folds: thin evidence; more runs, or runs that heat and "
+                         "cool more than once, make these figures firmer.</p>")
     selection = report.order_selection
     if selection is not None:
         orders = selection.orders
