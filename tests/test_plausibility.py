@@ -14,6 +14,7 @@ from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning,
 from gyrocomp.plausibility import (
     CHECKS,
     accel_unit_concern,
+    agreement_concern,
     BlockMeans,
     ScaleAgreement,
     calibration_concerns,
@@ -282,3 +283,25 @@ def test_the_accelerometer_unit_is_said_on_the_command_line_with_its_flag(tmp_pa
     fitted = run("fit", tmp_path / "ms2.csv", "-o", tmp_path / "m.json", "--temperature", "poly:1")
     assert fitted.returncode == 0, fitted.stderr
     assert "m/s^2 read as g? (give its unit with --accel-unit) (check 'accel-unit')" in fitted.stderr
+
+
+def test_an_output_that_parts_with_the_direction_of_temperature_change_is_named_hysteresis():
+    # heating 20 -> 60 degC over 400 blocks, cooling to 55 over 200 (a run stopped early on its way down): the
+    # model predicts a tempco, the output carries it plus an offset between the branches the model lacks, which
+    # pulls the plain slope far from 1
+    temperature = np.concatenate([np.linspace(20, 60, 400), np.linspace(60, 55, 200)])
+    direction = np.sign(np.gradient(temperature))
+    predicted = 0.01 * (temperature - 40)
+    rng = np.random.default_rng(0)
+    output = predicted + 0.15 * direction + 0.002 * rng.standard_normal(temperature.size)
+    fit = scale_agreement(output, predicted, temperature)
+    assert fit.disagrees and fit.follows_direction
+    assert fit.direction_offset == pytest.approx(0.3, rel=0.02) and fit.slope_with_direction == pytest.approx(1, rel=0.05)
+    message = agreement_concern("f.csv", "gyro_z", fit).message
+    assert "parts between heating and cooling by 0.3 deg/s beyond the model" in message
+    assert "hysteresis or a thermal lag the model does not carry?" in message and "another part" not in message
+    # a unit mistake is still named as one, the direction notwithstanding
+    rad = scale_agreement(np.radians(predicted) + 1e-4 * rng.standard_normal(temperature.size), predicted, temperature)
+    assert "rad/s read as deg/s?" in agreement_concern("f.csv", "gyro_z", rad).message
+    # without a temperature nothing is said about the direction
+    assert not scale_agreement(output, predicted).follows_direction

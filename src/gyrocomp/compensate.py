@@ -93,7 +93,8 @@ class Compensator:
         self._pending_time: list[np.ndarray] = []
         self._pending_temp: list[np.ndarray | None] = []
         # the block means of each modelled axis's output and of the error the model predicts for it
-        self._agreement_blocks = BlockMeans(2 * len(self._modelled))
+        # (and of the temperature: the direction of its change tells a branch the model lacks from a unit mistake)
+        self._agreement_blocks = BlockMeans(2 * len(self._modelled) + 1)
 
     def _model_temperature(self, key: str, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
         """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""
@@ -224,7 +225,10 @@ class Compensator:
         if self._modelled:
             columns = [j for j, _ in self._modelled]
             output = gyro_dps[:, columns]
-            self._agreement_blocks.add(time_s, np.hstack([output, output - residual[:, columns]]))
+            temp = np.full(time_s.size, np.nan) if temperature_degc is None else np.asarray(temperature_degc, dtype=float)
+            if temp.ndim == 2:  # one temperature per axis: their mean tells the direction of change as well
+                temp = temp.mean(axis=1)
+            self._agreement_blocks.add(time_s, np.hstack([output, output - residual[:, columns], temp[:, None]]))
         if self._constants is not None:
             return self._subtract_constants(residual, temperature_degc)
         if self._t0 is None and time_s.size:
@@ -242,7 +246,7 @@ class Compensator:
         prediction that does not vary): the slope is 1 when the model describes the data."""
         means = self._agreement_blocks.means()
         k = len(self._modelled)
-        return {self.gyro_axes[j]: scale_agreement(means[:, i], means[:, k + i])
+        return {self.gyro_axes[j]: scale_agreement(means[:, i], means[:, k + i], means[:, 2 * k])
                 for i, (j, _) in enumerate(self._modelled)}
 
     def _checked(self, time_s, gyro_dps, temperature_degc, accel_g):

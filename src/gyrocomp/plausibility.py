@@ -214,6 +214,19 @@ class ScaleAgreement:
     slope: float
     standard_error: float
     blocks: int
+    #: with the direction of temperature change as a second regressor: the offset between heating and cooling
+    #: blocks [deg/s] and its standard error, and the slope on the prediction then (NaN without a temperature)
+    direction_offset: float = math.nan
+    direction_standard_error: float = math.nan
+    slope_with_direction: float = math.nan
+
+    @property
+    def follows_direction(self) -> bool:
+        """Whether the output parts between heating and cooling blocks by ``AGREEMENT_SIGMAS`` standard errors
+        beyond what the model predicts, and with that part taken out the slope is within ``AGREEMENT_FACTOR``
+        either way of 1: a branch (hysteresis) or a lag the model does not carry, rather than a unit or a part."""
+        return bool(abs(self.direction_offset) > AGREEMENT_SIGMAS * self.direction_standard_error
+                    and 1.0 / AGREEMENT_FACTOR <= self.slope_with_direction <= AGREEMENT_FACTOR)
 
     @property
     def disagrees(self) -> bool:
@@ -222,9 +235,32 @@ class ScaleAgreement:
         return self.slope + margin < 1.0 / AGREEMENT_FACTOR or self.slope - margin > AGREEMENT_FACTOR
 
 
-def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray) -> ScaleAgreement | None:
+def _direction_fit(x: np.ndarray, y: np.ndarray, temperature_means: np.ndarray | None) -> tuple[float, float, float]:
+    """(offset, its standard error, slope): ``y`` on ``x`` and on the direction of temperature change of each block
+    (+1 heating, -1 cooling, from the block-mean temperatures' differences; blocks that hold still are 0), each
+    about its mean; NaN without a temperature or with blocks of one direction only."""
+    nan = (math.nan, math.nan, math.nan)
+    if temperature_means is None or not np.all(np.isfinite(temperature_means)):
+        return nan
+    step = np.gradient(np.asarray(temperature_means, dtype=float))
+    still = np.abs(step) <= 0.05 * np.max(np.abs(step)) if np.any(step) else np.ones(step.size, dtype=bool)
+    d = np.where(still, 0.0, np.sign(step))
+    if not (np.any(d > 0) and np.any(d < 0)):
+        return nan
+    a = np.column_stack([x, d - d.mean()])
+    coef, *_ = np.linalg.lstsq(a, y, rcond=None)
+    residual = y - a @ coef
+    cov = np.linalg.pinv(a.T @ a) * float(residual @ residual) / max(x.size - 3, 1)
+    # heating and cooling blocks part by twice the coefficient of the sign
+    return 2.0 * float(coef[1]), 2.0 * math.sqrt(max(float(cov[1, 1]), 0.0)), float(coef[0])
+
+
+def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray,
+                    temperature_means: np.ndarray | None = None) -> ScaleAgreement | None:
     """The slope of an axis's block-mean output on its predicted error's (both [deg/s]), with its standard error
-    from the scatter about the line (each about its mean: the turn-on constant does not enter).
+    from the scatter about the line (each about its mean: the turn-on constant does not enter). With the blocks'
+    mean temperatures [degC], also the fit with the direction of temperature change as a second regressor
+    (:attr:`ScaleAgreement.follows_direction`).
 
     None with fewer than ``AGREEMENT_MIN_BLOCKS`` blocks, or when the prediction's variation rests on fewer than
     half that many blocks (its participation ratio (sum |x|)^2 / sum x^2 of the centred means: n for a step over
@@ -248,7 +284,9 @@ def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray) -> Sc
     slope = float(x @ y) / sxx
     residual = y - slope * x
     standard_error = math.sqrt(float(residual @ residual) / (x.size - 2) / sxx)
-    return ScaleAgreement(slope * y_scale / scale, standard_error * y_scale / scale, int(x.size))
+    offset, offset_se, slope_d = _direction_fit(x, y, temperature_means)
+    return ScaleAgreement(slope * y_scale / scale, standard_error * y_scale / scale, int(x.size),
+                          offset * y_scale, offset_se * y_scale, slope_d * y_scale / scale)
 
 
 def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) -> Concern | None:
@@ -258,6 +296,10 @@ def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) 
         return None
     slope = agreement.slope
     known = next((words for ratio, words in KNOWN_SLOPES if abs(slope / ratio - 1.0) < 0.25), None)
+    if known is None and agreement.follows_direction:
+        known = (f"its output parts between heating and cooling by {agreement.direction_offset:.2g} deg/s beyond the "
+                 "model (slope "f"{agreement.slope_with_direction:.3g} with that taken out): hysteresis or a thermal "
+                 "lag the model does not carry? (fit on runs that both heat and cool)")
     return Concern("agreement", f"{source}: {axis} follows the error the model predicts for it with a slope of "
                                 f"{slope:.3g} +- {agreement.standard_error:.2g}, not 1: "
                                 + (known or "is the data in another unit than the model's, or the model of another "
