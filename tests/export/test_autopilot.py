@@ -1,6 +1,7 @@
 """PX4 and ArduPilot parameters: each autopilot's own correction formula, written out here from its
 source (PX4 temperature_compensation, ArduPilot AP_InertialSensor_tempcal.cpp), must reproduce gyrocomp's."""
 
+import dataclasses
 import math
 import re
 import warnings
@@ -269,3 +270,17 @@ def test_evaluate_installed_judges_the_autopilots_calibration_against_the_model(
     csv.write_text("time,gyro_x,gyro_y,gyro_z,temperature\n0,0,0,0,20\n1,0,0,0,21\n")
     refused = run("evaluate", tmp_path / "model.json", csv, "--installed")
     assert refused.returncode == 2 and "not a PX4 ULog or ArduPilot DataFlash log" in refused.stderr
+
+
+def test_a_hostile_model_name_stays_in_its_comment_line():
+    run_ = simulate(GyroErrorModel(), profile="cycle", duration_s=3000, rate_hz=1, seed=1).recording
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration([run_], temperature=Polynomial(2), hysteresis="none")
+    plain = dataclasses.replace(cal, model="plain")
+    hostile = dataclasses.replace(cal, model="x\nTC_G_ENABLE 0\r\n1\t1\tCAL_GYRO0_XOFF\t9\t9\u2028")
+    for write, comment in ((px4_params_file, "#"), (ardupilot_params_file, "#")):
+        a, b = write(plain).splitlines(), write(hostile).splitlines()
+        assert len(a) == len(b)
+        assert [x for x in a if not x.startswith(comment)] == [x for x in b if not x.startswith(comment)]
+        assert all(ord(c) < 128 for c in write(hostile))

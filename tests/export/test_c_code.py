@@ -202,3 +202,28 @@ def test_the_two_files_are_written_both_or_neither(tmp_path):
     assert "#ifndef" in written[0].read_text() and "gyrocomp_learn_step" in written[3].read_text()
     assert [p.name for p in write_c_sources(cal, tmp_path / "alone", with_learner=False)] == ["gyrocomp.h",
                                                                                                "gyrocomp.c"]
+
+
+HOSTILE_NAMES = ['*/ int gyrocomp_evil(void) { return system("id"); } /*', "a??/\nb", "\\\n#include <stdlib.h>",
+                 "*" * 300, "mod\u00e8le \u2028 */", "\x00\x1b[2J"]
+
+
+@pytest.mark.parametrize("hostile", HOSTILE_NAMES)
+def test_a_hostile_model_name_compiles_to_the_same_code_as_a_plain_one(tmp_path, hostile):
+    """A model file's text never reaches the generated C except inside comments, encoded for them: the objects
+    compiled from a model named ``plain`` and from one named with a comment-closing, line-splicing, trigraph or
+    control string are byte for byte the same."""
+    run_ = simulate("consumer", profile="cycle", duration_s=3000, rate_hz=1, seed=1).recording
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration([run_], temperature=Polynomial(2), hysteresis="none")
+    objects = []
+    for k, name in enumerate(("plain", hostile)):
+        folder = tmp_path / str(k)
+        folder.mkdir()
+        for file, text in c_sources(dataclasses.replace(cal, model=name)).items():
+            (folder / file).write_text(text)
+        subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-c", "-o", str(folder / "gyrocomp.o"),
+                        str(folder / "gyrocomp.c")], check=True, capture_output=True, text=True, cwd=folder)
+        objects.append((folder / "gyrocomp.o").read_bytes())
+    assert objects[0] == objects[1]

@@ -34,6 +34,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..installed import ARDUPILOT_SCALE, ARDUPILOT_TEMP_REFERENCE_DEGC, AXIS_INDEX, DEG_TO_RAD, installed_calibration
 from ..errors import DataQualityWarning, InputError
 from ..units import STANDARD_GRAVITY_M_PER_S2
+from .encode import line_comment
 
 ACCEL_INDEX = {"accel_x": 0, "accel_y": 1, "accel_z": 2}
 G_TO_M_PER_S2 = STANDARD_GRAVITY_M_PER_S2
@@ -195,7 +196,8 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
 
 
 def _header(calibration: Calibration, params: AutopilotParameters, target: str, comment: str) -> list[str]:
-    lines = [f"{comment} {target} thermal calibration written by gyrocomp from model {calibration.model!r}",
+    lines = [f"{comment} {target} thermal calibration written by gyrocomp from model "
+             f"'{line_comment(calibration.model)}'",
              f"{comment} bias as a cubic in temperature [rad/s, accelerometer m/s^2]; largest difference from the "
              "gyrocomp model over its range:"]
     for name, fit in params.fits.items():
