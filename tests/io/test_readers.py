@@ -368,6 +368,37 @@ def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
         read(path, TableLayout(columns={"time": "imu/t_ms", "gyro_z": "imu/wz"}, time_unit="ms"))
 
 
+def test_hdf5_reads_only_the_file_it_is_given(tmp_path):
+    """External storage, virtual datasets and external links would copy another local file's bytes into the
+    output as gyro values: each is refused in one line naming the dataset; the other file is never read."""
+    secret = tmp_path / "secret.bin"
+    secret.write_bytes(np.arange(100.0).tobytes())
+    outside = tmp_path / "outside.h5"
+    with h5py.File(outside, "w") as f:
+        f["gyro_z"] = np.arange(100.0)
+    cases = {}
+    path = cases["is stored in external files"] = tmp_path / "external.h5"
+    with h5py.File(path, "w") as f:
+        f["time"] = np.arange(100.0)
+        f.create_dataset("gyro_z", shape=(100,), dtype="<f8", external=[(str(secret), 0, 800)])
+    path = cases["is a virtual dataset mapped onto other files"] = tmp_path / "virtual.h5"
+    with h5py.File(path, "w") as f:
+        f["time"] = np.arange(100.0)
+        layout = h5py.VirtualLayout(shape=(100,), dtype="<f8")
+        layout[:] = h5py.VirtualSource(str(outside), "gyro_z", shape=(100,))
+        f.create_virtual_dataset("gyro_z", layout)
+    path = cases["lies in another file, .*outside.h5.* \\(an external link\\)"] = tmp_path / "link.h5"
+    with h5py.File(path, "w") as f:
+        f["time"] = np.arange(100.0)
+        f["gyro_z"] = h5py.ExternalLink(str(outside), "gyro_z")
+    for how, path in cases.items():
+        with pytest.raises(InputError, match=rf"{path.name}: dataset '/gyro_z' {how}; gyrocomp reads only the file"):
+            read(path)
+        result = run("convert", path, tmp_path / "out.csv")
+        assert result.returncode == 2 and result.stderr.count("\n") == 1 and "reads only the file" in result.stderr
+        assert not (tmp_path / "out.csv").exists()
+
+
 # -- format detection and helpers ------------------------------------------------------------------------
 def test_formats_are_told_from_the_first_bytes_not_only_the_suffix(tmp_path):
     assert sniff_format(b"ULog\x01\x12\x35\x01") == "ulog"

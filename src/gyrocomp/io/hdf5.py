@@ -70,8 +70,23 @@ def _opened(h5py, path: Path):
         raise InputError(f"{path}: not a readable HDF5 file ({exc}); is it damaged or cut short?") from None
 
 
+def _in_this_file(dataset, source: str) -> None:
+    """Refuse, naming the dataset, one whose values would come from another file: HDF5 external storage (raw
+    bytes of any file named in the dataset's layout), a virtual dataset (a map onto other files) or an external
+    link (the dataset itself in another file). A reader reads the file it was given, nothing beside it."""
+    how = ("is stored in external files" if dataset.external else
+           "is a virtual dataset mapped onto other files" if dataset.is_virtual else
+           f"lies in another file, {dataset.file.filename!r} (an external link)"
+           if Path(dataset.file.filename).resolve() != Path(source).resolve() else None)
+    if how is not None:
+        raise InputError(f"{source}: dataset {dataset.name!r} {how}; gyrocomp reads only the file it is given "
+                         "(copy the data into the file, e.g. with h5repack)")
+
+
 def _numbers(dataset, source: str) -> np.ndarray:
-    """The dataset's values as floats; a dataset of strings, compounds or references is refused by name."""
+    """The dataset's values as floats; a dataset of strings, compounds or references is refused by name, and one
+    whose values lie in another file (:func:`_in_this_file`)."""
+    _in_this_file(dataset, source)
     if dataset.dtype.kind not in "biuf":
         raise InputError(f"{source}: dataset {dataset.name!r} holds {dataset.dtype} values, not numbers; "
                          "store numbers, or map another dataset with columns=")
