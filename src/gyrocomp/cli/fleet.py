@@ -30,7 +30,7 @@ def fleet():
 
 
 @fleet.command("fit")
-@click.argument("data", nargs=-1, required=True, type=click.Path())
+@click.argument("data", nargs=-1, type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(file_okay=False),
               help="Fleet folder: calibrations.sqlite, models/SERIAL.json, fleet.parquet.")
 @click.option("--unit-from", "unit_pattern", default=None, metavar="PATTERN",
@@ -56,15 +56,19 @@ def fleet():
 @click.pass_context
 def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, workers, memory_limit, store, prior_store,
         channels, pipeline, **kwargs):
-    """Fit every unit of DATA (folders, globs or files of runs) as gyrocomp fit would, in parallel; rerun to fit
-    only the units whose runs changed."""
+    """Fit every unit of DATA (folders, globs or files of runs; none with --manifest) as gyrocomp fit would, in
+    parallel; rerun to fit only the units whose runs changed."""
     opts = pop_read_options(kwargs)
     if (unit_pattern is None) == (manifest is None):
         raise click.UsageError("say which unit each run belongs to: give --unit-from PATTERN or --manifest FILE "
                                "(one of them)")
     if manifest is not None:
+        if data:
+            raise click.UsageError("--manifest names the runs: give no DATA with it")
         units = units_from_manifest(manifest)
     else:
+        if not data:
+            raise click.UsageError("give DATA: the folders, globs or files of the runs (or --manifest FILE)")
         units = units_from_pattern(expand_inputs(data), unit_pattern)
     limits = Limits.load(limits_file) if limits_file else None
     for unit in units:
@@ -136,6 +140,8 @@ def show(ctx, serial, store, at, history, as_json, output):
     """The calibration of unit SERIAL valid now (or --at a past time): when, from what, verdict, figures."""
     when = parse_time(at) if at is not None else None
     with CalibrationStore(store) as db:
+        if output is not None:
+            _refuse_output_over_store(output, db)
         if history:
             rows = db.history(serial)
             if not rows:
@@ -206,6 +212,7 @@ def report(ctx, store, output, limits_file):
     outliers, the worst units, rejected and failed units."""
     limits = Limits.load(limits_file) if limits_file else None
     with CalibrationStore(store) as db:
+        _refuse_output_over_store(output, db)
         table = fleet_table(db.latest_rows(), limits)
     page = build_fleet_report(table, limits=limits, title=str(store))
     write_text_atomic(output, page.html)
@@ -228,9 +235,16 @@ def export(ctx, serial, store, fmt, output, at, rate_hz, instance, device_id):
     """Write the calibration of unit SERIAL from the store as autopilot parameters, C code or a model file."""
     when = parse_time(at) if at is not None else None
     with CalibrationStore(store) as db:
+        _refuse_output_over_store(output, db)
         calibration = db.valid_at(serial, when).calibration()
     write_export(calibration, fmt, output, rate_hz=rate_hz, instance=instance, device_id=device_id,
                  quiet=ctx.obj["quiet"])
+
+
+def _refuse_output_over_store(output, db: CalibrationStore) -> None:
+    """An output is never written over the store it reads (the store is an input too)."""
+    if db.file is not None:
+        refuse_to_overwrite_inputs(output, [db.file], "-o")
 
 
 __all__ = ["fleet"]

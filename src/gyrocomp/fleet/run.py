@@ -18,6 +18,7 @@ the baseline of ``benchmarks/bench_fleet.py``).
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import re
 import socket
@@ -189,6 +190,7 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
     output.mkdir(parents=True, exist_ok=True)
     units = [replace(u, paths=tuple(os.path.abspath(p) for p in u.paths)) for u in units]
     tally = _Tally()
+    started = utc_now()
     with CalibrationStore(store if store is not None else output, create=True) as db:
         known = db.ok_hashes()
         known = {u.serial: known.get(u.serial) for u in units}
@@ -196,12 +198,15 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
         for done, outcome in enumerate(_outcomes(units, settings, known, scheduler, workers, memory_limit), 1):
             if outcome.status == "unchanged":
                 tally.unchanged.append(outcome.serial)
+                _repair_model(output, db, outcome.serial)
             else:
                 record = _record(outcome, by_serial[outcome.serial], limits)
-                db.add(record)
-                tally.count(record)
-                if record.status == "ok":
-                    _write_model(output, outcome)
+                if record.status == "ok":  # the model file first: a row is never committed without its file
+                    _write_model(output, outcome.serial, outcome.model_json)
+                if db.add_new(record, since=started) is None:  # another fit stored these inputs meanwhile
+                    tally.unchanged.append(outcome.serial)
+                else:
+                    tally.count(record)
             if progress is not None:
                 progress(done, len(units))
         table = write_fleet_table(db, output / FLEET_TABLE, limits)
@@ -310,16 +315,45 @@ def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None) -> Cali
         figures=outcome.figures, error=outcome.error, warnings=outcome.warnings)
 
 
+#: the longest serial kept whole in a model file's name [characters]
+MAX_NAME_CHARS = 80
+
+
+def model_file_name(serial: str) -> str:
+    """The model file of a unit, ``SERIAL.json``, one per serial: a serial of letters, digits, ``.``, ``-`` and
+    ``_`` (ASCII) up to :data:`MAX_NAME_CHARS` long is its own name; any other (``a/b``, a long or non-ASCII one)
+    becomes its safe characters, ``~`` and 16 hex digits of its SHA-256, so that two serials never share a file
+    (``a/b`` and ``a_b`` once did) and no name is too long for the file system."""
+    if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]*", serial) and len(serial) <= MAX_NAME_CHARS:
+        return serial + ".json"
+    safe = re.sub(r"[^A-Za-z0-9._-]", "_", serial)[:MAX_NAME_CHARS].lstrip(".")
+    return f"{safe}~{hashlib.sha256(serial.encode('utf-8', 'surrogatepass')).hexdigest()[:16]}.json"
+
+
 def _safe_name(serial: str) -> str:
-    """A file name for a serial: anything but letters, digits, ``.``, ``-`` and ``_`` becomes ``_``."""
-    name = re.sub(r"[^\w.-]", "_", serial)
-    return "_" + name if name.startswith(".") or not name else name
+    """A Dask key part for a serial (file names: :func:`model_file_name`)."""
+    return model_file_name(serial)[:-len(".json")]
 
 
-def _write_model(output: Path, outcome: UnitOutcome) -> None:
+def _write_model(output: Path, serial: str, model_json: str) -> None:
+    """Write the unit's model file atomically; a failed write (a full or read-only disk) is one line, and nothing
+    is stored for the unit, so the next run fits it again."""
     folder = output / MODELS_FOLDER
-    folder.mkdir(exist_ok=True)
-    write_text_atomic(folder / f"{_safe_name(outcome.serial)}.json", outcome.model_json)
+    try:
+        folder.mkdir(exist_ok=True)
+        write_text_atomic(folder / model_file_name(serial), model_json)
+    except OSError as exc:
+        raise InputError(f"{folder / model_file_name(serial)}: cannot write unit {serial!r}'s model "
+                         f"({exc.strerror or exc}); nothing was stored for it, the next run fits it again") from None
+
+
+def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
+    """An unchanged unit whose model file is missing (deleted, or a run stopped between the two writes) gets it
+    back from its newest successful row."""
+    if not (output / MODELS_FOLDER / model_file_name(serial)).exists():
+        ok = [r for r in db.history(serial) if r.status == "ok"]
+        if ok:
+            _write_model(output, serial, ok[-1].model_json)
 
 
 def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None) -> Path:
@@ -330,4 +364,4 @@ def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None
     return path
 
 
-__all__ = ["FLEET_TABLE", "MODELS_FOLDER", "FleetSettings", "FleetSummary", "UnitOutcome", "fit_fleet", "fit_unit"]
+__all__ = ["FLEET_TABLE", "MODELS_FOLDER", "FleetSettings", "model_file_name", "FleetSummary", "UnitOutcome", "fit_fleet", "fit_unit"]

@@ -12,6 +12,7 @@ is the user's to install).
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import json
 import math
@@ -122,23 +123,48 @@ def store_url(location: str | os.PathLike) -> str:
     return f"sqlite:///{path.resolve()}"
 
 
+#: how long a writer waits for another process's write to the same SQLite store [s]
+SQLITE_BUSY_TIMEOUT_S = 60.0
+
+
+def _serialize_sqlite_writes(engine) -> None:
+    """A write transaction of ``engine`` (SQLite; marked ``immediate`` in its connection's ``info``) takes the
+    write lock when it begins (``BEGIN IMMEDIATE``), waiting up to :data:`SQLITE_BUSY_TIMEOUT_S` for another
+    process's: a check and the write it decides are then one step, whatever runs beside. Reads begin as usual.
+    (SQLAlchemy's recipe for SQLite transactions: pysqlite's own begin is disabled.)"""
+
+    @sa.event.listens_for(engine, "connect")
+    def _connect(dbapi_connection, _record):
+        dbapi_connection.isolation_level = None
+
+    @sa.event.listens_for(engine, "begin")
+    def _begin(connection):
+        connection.exec_driver_sql("BEGIN IMMEDIATE" if connection.info.pop("immediate", False) else "BEGIN")
+
+
 class CalibrationStore:
-    """A calibration store (see the module). ``create``: make the database (and its tables) when absent."""
+    """A calibration store (see the module). ``create``: make the database (and its tables) when absent; two
+    processes creating one store at once both end with it made once."""
 
     def __init__(self, location: str | os.PathLike, *, create: bool = False) -> None:
         self.location = os.fspath(location)
         url = store_url(location)
+        #: the SQLite file of the store (None for a server database)
+        self.file: Path | None = None
         if url.startswith("sqlite:///"):
-            file = Path(url[len("sqlite:///"):])
+            self.file = file = Path(url[len("sqlite:///"):])
             if not file.exists():
                 if not create:
                     raise InputError(f"{self.location}: no calibration store there (no {file.name}); give the folder "
                                      f"a fleet fit wrote, an SQLite file or a database URL")
                 file.parent.mkdir(parents=True, exist_ok=True)
         try:
-            self.engine = sa.create_engine(url)
+            self.engine = sa.create_engine(url, **({"connect_args": {"timeout": SQLITE_BUSY_TIMEOUT_S}}
+                                                   if self.file is not None else {}))
         except (sa.exc.ArgumentError, sa.exc.NoSuchModuleError, ModuleNotFoundError) as exc:
             raise InputError(f"{self.location}: not a database URL SQLAlchemy can open ({exc})") from None
+        if self.file is not None:
+            _serialize_sqlite_writes(self.engine)
         self._prepare(create)
 
     def _prepare(self, create: bool) -> None:
@@ -150,9 +176,10 @@ class CalibrationStore:
         if not present:
             if not create:
                 raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
-            _META.create_all(self.engine)
-            with self.engine.begin() as conn:
-                conn.execute(_INFO.insert().values(key="schema_version", value=str(STORE_SCHEMA_VERSION)))
+            with self._writing() as conn:  # one transaction: a second creator waits, then finds the tables
+                _META.create_all(conn, checkfirst=True)
+                if conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar() is None:
+                    conn.execute(_INFO.insert().values(key="schema_version", value=str(STORE_SCHEMA_VERSION)))
             return
         with self.engine.connect() as conn:
             version = conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
@@ -170,9 +197,35 @@ class CalibrationStore:
         self.close()
 
     # -- writing -------------------------------------------------------------------------------------------
+    @contextlib.contextmanager
+    def _writing(self):
+        """A write transaction; a full disk or a read-only store is one line naming the store."""
+        try:
+            with self.engine.connect() as conn:
+                conn.info["immediate"] = True
+                with conn.begin():
+                    yield conn
+        except sa.exc.OperationalError as exc:
+            raise InputError(f"{self.location}: cannot write to the calibration store ({exc.orig}); is the disk "
+                             "full or the store read-only?") from None
+
     def add(self, record: CalibrationRecord) -> int:
         """Append ``record`` (a new row, whatever the serial's history); returns its id."""
-        with self.engine.begin() as conn:
+        with self._writing() as conn:
+            result = conn.execute(_ROWS.insert().values(**_to_row(record)))
+            return int(result.inserted_primary_key[0])
+
+    def add_new(self, record: CalibrationRecord, since: _dt.datetime) -> int | None:
+        """Append a successful ``record`` unless another process stored a successful calibration of the same unit
+        from the same inputs (its ``input_hash``) after ``since`` (naive UTC): the check and the write are one
+        transaction. Returns the new row's id, or None when it was not stored."""
+        with self._writing() as conn:
+            if record.status == "ok":
+                newer = conn.execute(sa.select(_ROWS.c.id).where(
+                    (_ROWS.c.serial == record.serial) & (_ROWS.c.status == "ok")
+                    & (_ROWS.c.input_hash == record.input_hash) & (_ROWS.c.calibrated_utc >= since)).limit(1)).scalar()
+                if newer is not None:
+                    return None
             result = conn.execute(_ROWS.insert().values(**_to_row(record)))
             return int(result.inserted_primary_key[0])
 

@@ -1,0 +1,114 @@
+"""The calibration store cannot be left inconsistent: one model file per serial, the file written before its row,
+a rerun that repairs what a crash left, concurrent fits that store each unit once, and no output over the store."""
+
+from __future__ import annotations
+
+import hashlib
+import subprocess
+import sys
+
+import pytest
+
+from gyrocomp.calibration import Calibration
+from gyrocomp.fleet import CalibrationStore, model_file_name
+from gyrocomp.io.tables import write_recording
+from gyrocomp.simulate import simulate
+
+from ..conftest import SCRIPT, run
+
+SERIALS = ("a/b", "a_b", "SN-1", "x" * 300)
+
+
+def test_model_file_names_are_one_per_serial_and_short():
+    names = [model_file_name(s) for s in SERIALS + ("a b", "a\\b", ".hidden", "caf\u00e9", "\udcff")]
+    assert len(set(names)) == len(names)
+    assert model_file_name("SN-1") == "SN-1.json"  # a plain serial keeps its name
+    assert all(len(n) <= 120 and "/" not in n and not n.startswith(".") for n in names)
+    assert model_file_name("a/b") == f"a_b~{hashlib.sha256(b'a/b').hexdigest()[:16]}.json"
+
+
+def _units(folder, serials):
+    """One short chamber run per unit, written as folder/u<k>/run.csv, and a manifest naming the serials."""
+    rows = ["path,serial"]
+    for k, s in enumerate(serials):
+        (folder / f"u{k}").mkdir(parents=True)
+        path = folder / f"u{k}" / "run.csv"
+        write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=2, seed=k).recording, path)
+        rows.append(f'{path},"{s}"')
+    manifest = folder / "manifest.csv"
+    manifest.write_text("\n".join(rows) + "\n")
+    return manifest
+
+
+@pytest.fixture(scope="module")
+def manifest(tmp_path_factory):
+    return _units(tmp_path_factory.mktemp("units"), SERIALS)
+
+
+def _fit(manifest, out, *more):
+    return run("fleet", "fit", "--manifest", manifest, "-o", out, "--scheduler", "serial", *more)
+
+
+def test_serials_that_once_shared_a_file_each_keep_their_model(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    result = _fit(manifest, out)
+    assert result.returncode == 0, result.stderr
+    with CalibrationStore(out) as db:
+        for s in SERIALS:
+            stored = db.valid_at(s).calibration()
+            on_disk = Calibration.load(out / "models" / model_file_name(s))
+            assert on_disk.axes == stored.axes
+    assert len(list((out / "models").glob("*.json"))) == len(SERIALS)
+
+
+def test_a_failed_model_write_stores_nothing_and_the_rerun_fits_the_unit(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    out.mkdir()
+    (out / "models").write_text("not a folder")  # every model write fails
+    result = _fit(manifest, out)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "cannot write unit" in result.stderr and "the next run fits it again" in result.stderr
+    with CalibrationStore(out) as db:
+        assert db.serials() == []  # no row without its model file
+    (out / "models").unlink()
+    result = _fit(manifest, out)
+    assert result.returncode == 0, result.stderr
+    assert f"{len(SERIALS)} unit(s) fitted, 0 unchanged" in result.stdout
+
+
+def test_the_rerun_puts_back_a_missing_model_file(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    assert _fit(manifest, out).returncode == 0
+    lost = out / "models" / model_file_name("a/b")
+    text = lost.read_text()
+    lost.unlink()
+    result = _fit(manifest, out)
+    assert result.returncode == 0 and f"0 unit(s) fitted, {len(SERIALS)} unchanged" in result.stdout
+    assert lost.read_text() == text
+
+
+def test_outputs_onto_the_store_are_refused_and_the_store_is_intact(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    assert _fit(manifest, out).returncode == 0
+    store = out / "calibrations.sqlite"
+    before = store.read_bytes()
+    for args in (("report", out, "-o", store), ("export", "SN-1", "--store", out, "--format", "json", "-o", store),
+                 ("show", "SN-1", "--store", out, "-o", store)):
+        result = run("fleet", *args)
+        assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+        assert "this is an input file; choose another output path" in result.stderr
+    assert store.read_bytes() == before
+
+
+def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+    args = ["fleet", "fit", "--manifest", str(manifest), "-o", str(out), "--scheduler", "serial"]
+    procs = [subprocess.Popen([*cmd, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]
+    results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
+    for stdout, stderr, code in results:
+        assert code == 0, stderr
+    with CalibrationStore(out) as db:
+        assert sorted(db.serials()) == sorted(SERIALS)
+        assert all(len(db.history(s)) == 1 for s in SERIALS)
