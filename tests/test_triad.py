@@ -384,7 +384,7 @@ def test_exports_say_what_they_leave_out_of_a_triad(rate_fit):
                                                        acceleration="none")),
                               gyro_triad=rate_fit.calibration)
     with pytest.warns(DataQualityWarning, match="scale-factor and misalignment"):
-        px4_params_file(cal)
+        px4_params_file(cal, device_id=5)
     assert "solve3(k, out);" in c_sources(cal)["gyrocomp.c"]  # the C code carries K(T) (parity: tests/export)
     assert "solve3(k, out);" not in c_sources(cal.without("scale-factor"))["gyrocomp.c"]
 

@@ -18,6 +18,7 @@ from gyrocomp.units import STANDARD_GRAVITY_M_PER_S2 as G0
 from gyrocomp.models.options import FitOptions, Polynomial
 
 from ..conftest import run, xsens_session
+from ..io.log_writers import write_ulog
 
 RAD_TO_DEG = 180.0 / math.pi
 
@@ -66,7 +67,8 @@ def test_px4_formula_reproduces_the_model(order, tolerance_dps):
     cal = _model(order)
     text = px4_params_file(cal, instance=1, device_id=1311244)
     p = _read_px4(text)
-    assert p["TC_G_ENABLE"] == 1 and p["TC_G1_ID"] == 1311244 and p["TC_G1_SCL_2"] == 1.0
+    assert p["TC_G_ENABLE"] == 1 and p["TC_G1_ID"] == 1311244
+    assert not any("_SCL_" in name for name in p)  # PX4 removed TC_*_SCL_* (QGroundControl: no such parameter)
     t = np.linspace(-30, 80, 500)  # beyond the range on both sides: both clamp
     for name, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
         ax = cal.axes[name]
@@ -99,16 +101,16 @@ def test_terms_the_autopilots_lack_are_named():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, hysteresis="lag")
     with pytest.warns(DataQualityWarning, match="PX4 has no thermal lag term: left out of the export"):
-        text = px4_params_file(cal)
+        text = px4_params_file(cal, device_id=3)
     p = _read_px4(text)
     assert p["TC_G0_X1_0"] == 0.0 and p["TC_G0_X1_2"] != 0.0  # the ADXRS450 preset is z only
     with pytest.raises(InputError, match=r"instance: ArduPilot numbers its IMUs 1..3, got 0"):
         ardupilot_params_file(cal, instance=0)
     with pytest.raises(InputError, match=r"instance: PX4 has thermal compensation for gyros 0..3, got 7"):
-        px4_params_file(cal, instance=7)
+        px4_params_file(cal, instance=7, device_id=3)
     flat = fit_calibration(runs, temperature=None)
     with pytest.raises(InputError, match="export: the model has no gyro or accelerometer axis with a temperature curve"):
-        px4_params_file(flat)
+        px4_params_file(flat, device_id=3)
 
 
 def test_cli_export(tmp_path):
@@ -116,13 +118,39 @@ def test_cli_export(tmp_path):
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params", "--device-id", "7")
     assert r.returncode == 0, r.stderr
     assert "gyro_z:" in r.stdout and (tmp_path / "tc.params").read_text().count("TC_G0_X") == 12
+    # what to do on the vehicle, in order, in the file and on the screen
+    assert "on the vehicle, in this order:" in r.stdout and "2. reboot" in r.stdout
+    assert "calibrate the gyro again (or zero them)" in (tmp_path / "tc.params").read_text()
     r = run("export", tmp_path / "m.json", "--format", "ardupilot", "-o", tmp_path / "tc.parm")
     assert r.returncode == 0, r.stderr
     assert "INS_TCAL1_GYR1_X" in (tmp_path / "tc.parm").read_text()
+    assert "the INS_TCAL<n>_* group is hidden until then" in (tmp_path / "tc.parm").read_text()
     r = run("export", tmp_path / "m.json", "--format", "simulink", "-o", tmp_path / "x.slx")
     assert r.returncode == 2 and "Invalid value for '--format'" in r.stderr
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and "this is an input file" in r.stderr
+
+
+def test_px4_export_without_a_device_id_is_refused_naming_where_to_find_it(tmp_path):
+    _model(3).save(tmp_path / "m.json")
+    r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and not (tmp_path / "tc.params").exists()
+    assert ("no gyro device id (PX4 applies TC_Gn_* only to the sensor whose device id matches, so 0 does nothing); "
+            "give --device-id ID: find it in the ULog's sensor_gyro topic, with 'listener sensor_gyro' on the vehicle, "
+            "or in the CAL_GYRO0_ID parameter") in r.stderr
+    with pytest.raises(InputError, match=r"device_id: a PX4 device id is a positive 32-bit number, got 0"):
+        px4_params_file(_model(3), device_id=0)
+
+
+def test_px4_export_takes_the_device_ids_the_model_s_ulog_runs_recorded():
+    cal = _model(3)
+    inputs = [{"file": f"log{k}.ulg", "device_id": 2293768, "accel_device_id": 2359304} for k in range(2)]
+    with_ids = dataclasses.replace(cal, provenance={**cal.provenance, "inputs": inputs})
+    assert _read_px4(px4_params_file(with_ids))["TC_G0_ID"] == 2293768
+    assert _read_px4(px4_params_file(with_ids, device_id=5))["TC_G0_ID"] == 5  # the option wins
+    mixed = dataclasses.replace(cal, provenance={"inputs": [{"device_id": 1}, {"device_id": 2}]})
+    with pytest.raises(InputError, match=r"the model's runs come from sensors with device_id 1, 2"):
+        px4_params_file(mixed)
 
 
 def test_accelerometer_parameters_reproduce_the_accelerometer_model():
@@ -130,7 +158,7 @@ def test_accelerometer_parameters_reproduce_the_accelerometer_model():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_channels(runs, ("gyro", "accel"), options=FitOptions(temperature=Polynomial(3), hysteresis="none"))
-        px4, ardu = _read_px4(px4_params_file(cal)), _read_ardupilot(ardupilot_params_file(cal))
+        px4, ardu = _read_px4(px4_params_file(cal, device_id=5, accel_device_id=6)), _read_ardupilot(ardupilot_params_file(cal))
     assert px4["TC_A_ENABLE"] == 1 and px4["TC_G_ENABLE"] == 1
     reference = cal.accel_reference_degc
     assert px4["TC_A0_TREF"] == pytest.approx(reference, abs=1e-4)
@@ -154,7 +182,7 @@ def test_accelerometer_offsets_and_scales_from_a_multi_position_calibration(tmp_
     triad = cal.accel_triad
     off_diagonal = np.max(np.abs(np.asarray(triad.sensitivity) - np.diag(np.diag(triad.sensitivity))))
     with pytest.warns(DataQualityWarning, match=r"accelerometer misalignment \(up to .* mrad; its offsets and scales"):
-        px4 = _read_px4(px4_params_file(cal, device_id=5))
+        px4 = _read_px4(px4_params_file(cal, device_id=5, accel_device_id=6))
     with pytest.warns(DataQualityWarning, match="accelerometer misalignment"):
         ardu = _read_ardupilot(ardupilot_params_file(cal, instance=2))
     raw = np.array([p.accel_g for p in find_poses(rec)])
@@ -165,7 +193,8 @@ def test_accelerometer_offsets_and_scales_from_a_multi_position_calibration(tmp_
                              np.array([ardu[f"INS_ACC2SCAL_{a}"] for a in "XYZ"]))):
         theirs = (raw * G0 - offsets) * scales
         assert np.max(np.abs(theirs - ours)) < 2 * off_diagonal * G0 + 1e-5  # float32 in the PX4 file
-    assert px4["CAL_ACC0_ID"] == 5 and not any(k.startswith("INS_TCAL") for k in ardu)
+    # the accelerometer's own id, not the gyro's (separate dies: BMI055, SCHA63T)
+    assert px4["CAL_ACC0_ID"] == 6 and not any(k.startswith("INS_TCAL") for k in ardu)
     cal.save(tmp_path / "accel.json")
     r = run("export", tmp_path / "accel.json", "--format", "ardupilot", "-o", tmp_path / "acc.parm")
     assert r.returncode == 0, r.stderr
@@ -180,7 +209,7 @@ def test_the_installed_calibration_reproduces_each_autopilot_formula():
 
     model = _model(3)
     temperature = np.linspace(-40.0, 90.0, 27)
-    px4 = px4_parameters(model, instance=1).values
+    px4 = px4_parameters(model, instance=1, device_id=5, accel_device_id=6).values
     installed = installed_calibration(px4, "px4", instance=1)
     for axis, j in (("gyro_x", 0), ("gyro_y", 1), ("gyro_z", 2)):
         got = installed.axes[axis].shape_dps(temperature) + installed.axes[axis].turn_on_biases_dps[0]
@@ -208,7 +237,7 @@ def test_a_logs_installed_calibration_is_read_from_its_parameters(tmp_path):
     from ..io.log_writers import write_ulog
 
     model = _model(3)
-    params = px4_parameters(model, instance=0).values
+    params = px4_parameters(model, instance=0, device_id=5, accel_device_id=6).values
     n = 2000
     temperature = np.linspace(model.axes["gyro_x"].temperature.t_min_degc,
                               model.axes["gyro_x"].temperature.t_max_degc, n)
@@ -237,7 +266,7 @@ def test_evaluate_installed_judges_the_autopilots_calibration_against_the_model(
 
     model = _model(3)
     model.save(tmp_path / "model.json")
-    params = px4_parameters(model, instance=0).values
+    params = px4_parameters(model, instance=0, device_id=5, accel_device_id=6).values
     n = 6000
     curve = model.axes["gyro_x"].temperature
     temperature = np.linspace(curve.t_min_degc, curve.t_max_degc, n)
@@ -279,8 +308,25 @@ def test_a_hostile_model_name_stays_in_its_comment_line():
         cal = fit_calibration([run_], temperature=Polynomial(2), hysteresis="none")
     plain = dataclasses.replace(cal, model="plain")
     hostile = dataclasses.replace(cal, model="x\nTC_G_ENABLE 0\r\n1\t1\tCAL_GYRO0_XOFF\t9\t9\u2028")
-    for write, comment in ((px4_params_file, "#"), (ardupilot_params_file, "#")):
+    for write, comment in ((lambda c: px4_params_file(c, device_id=5), "#"), (ardupilot_params_file, "#")):
         a, b = write(plain).splitlines(), write(hostile).splitlines()
         assert len(a) == len(b)
         assert [x for x in a if not x.startswith(comment)] == [x for x in b if not x.startswith(comment)]
         assert all(ord(c) < 128 for c in write(hostile))
+
+
+def test_a_model_fitted_on_a_ulog_exports_its_sensor_s_device_id(tmp_path):
+    n = 3000
+    temperature = np.linspace(10.0, 50.0, n)
+    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 500_000).astype(np.uint64)),
+              "device_id": ("uint32_t", np.full(n, 2293768, np.uint32)),
+              "temperature": ("float", temperature.astype(np.float32))}
+    for j, axis in enumerate("xyz"):
+        fields[axis] = ("float", (1e-4 * (j + 1) * (temperature - 30.0)).astype(np.float32))
+    write_ulog(tmp_path / "chamber.ulg", {("sensor_gyro", 0): fields})
+    r = run("fit", tmp_path / "chamber.ulg", "-o", tmp_path / "m.json", "--temperature", "poly:2")
+    assert r.returncode == 0, r.stderr
+    assert Calibration.load(tmp_path / "m.json").provenance["inputs"][0]["device_id"] == 2293768
+    r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params")
+    assert r.returncode == 0, r.stderr
+    assert _read_px4((tmp_path / "tc.params").read_text())["TC_G0_ID"] == 2293768

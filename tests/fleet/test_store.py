@@ -135,9 +135,9 @@ def test_fleet_show_and_export_through_the_command_line(store, models, tmp_path)
     assert exported.returncode == 0, exported.stderr
     assert Calibration.load(out).to_dict() == models[0].to_dict()
     px4 = run("fleet", "export", "U2", "--store", folder / "calibrations.sqlite", "--format", "px4", "-o",
-              tmp_path / "u2.params")
+              tmp_path / "u2.params", "--device-id", 7)
     models[1].save(tmp_path / "u2.json")
-    direct = run("export", tmp_path / "u2.json", "--format", "px4", "-o", tmp_path / "direct.params")
+    direct = run("export", tmp_path / "u2.json", "--format", "px4", "-o", tmp_path / "direct.params", "--device-id", 7)
     assert px4.returncode == 0 and direct.returncode == 0
     assert "TC_G0_X0_0" in (tmp_path / "u2.params").read_text()
     assert (tmp_path / "u2.params").read_text() == (tmp_path / "direct.params").read_text()

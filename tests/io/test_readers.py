@@ -79,6 +79,7 @@ def test_ulog_written_here_converts_units_and_matches_accel_by_time(tmp_path):
         warnings.simplefilter("ignore", DataQualityWarning)  # the last gyro samples lie past the last accel
         rec = read(path)
     assert rec.rate_hz == pytest.approx(50.0)
+    assert rec.metadata["device_id"] == 7 and rec.metadata["accel_device_id"] == 9  # each sensor's own id
     np.testing.assert_allclose(rec.gyro_dps[:, 0], 0.01 * RAD_TO_DEG, rtol=1e-6)
     np.testing.assert_allclose(rec.accel_g[:, 2], -1.0, rtol=1e-6)
     expected_y = np.interp(rec.time_s, t_acc * 1e-6, np.linspace(0, 1, n).astype(np.float32)) / G

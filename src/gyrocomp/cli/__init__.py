@@ -115,7 +115,7 @@ PARAMETER_FLAGS = {
     "static_min_duration_s": "--min-static", "acceleration": "--acceleration", "hysteresis": "--hysteresis",
     "hysteresis_order": "--hysteresis-order", "hysteresis_band_degc": "--hysteresis-band",
     "pipeline": "--pipeline", "channels": "--channels", "scale_factor": "--scale-factor", "columns": "--columns", "fmt": "--format",
-    "instance": "--instance", "device_id": "--device-id", "record": "--record", "imu_topic": "--imu-topic",
+    "instance": "--instance", "device_id": "--device-id", "accel_device_id": "--accel-device-id", "record": "--record", "imu_topic": "--imu-topic",
     "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
     "time_unit": "--time-unit", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
     "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",

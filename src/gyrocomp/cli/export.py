@@ -24,12 +24,15 @@ EXPORT_FORMATS = ("px4", "ardupilot", "c")
               help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")
 @click.option("--instance", type=int, default=None, help="Sensor instance: PX4 gyro 0..3 (default 0), ArduPilot IMU 1..3 "
                                                        "(default 1).")
-@click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id (TC_G*_ID).")
+@click.option("--device-id", type=int, default=None,
+              help="PX4: the gyro's device id (TC_G*_ID; default: the one the model's ULog runs recorded).")
+@click.option("--accel-device-id", type=int, default=None,
+              help="PX4: the accelerometer's device id (TC_A*_ID, CAL_ACC*_ID; default: the model's).")
 @click.option("--learner", "learner_state", type=click.Path(dir_okay=False), default=None,
               help="c: bake the online learner's settings from this learner state (gyrocomp learn --save-state) "
                    "instead of the defaults.")
 @click.pass_context
-def export(ctx, model, fmt, output, rate_hz, instance, device_id, learner_state):
+def export(ctx, model, fmt, output, rate_hz, instance, device_id, accel_device_id, learner_state):
     """Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code."""
 
     refuse_to_overwrite_inputs(output, [model] + ([learner_state] if learner_state else []))
@@ -37,11 +40,12 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id, learner_state)
         raise click.BadParameter("the learner is exported with --format c only", param_hint="--learner")
     settings = OnlineCalibrator.load(learner_state).settings if learner_state else None
     write_export(Calibration.load(model), fmt, output, rate_hz=rate_hz, instance=instance, device_id=device_id,
-                 quiet=ctx.obj["quiet"], learner=settings)
+                 accel_device_id=accel_device_id, quiet=ctx.obj["quiet"], learner=settings)
 
 
-def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, instance=None, device_id: int = 0,
-                 quiet: bool = False, learner: LearnerSettings | None = None) -> None:
+def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, instance=None,
+                 device_id: int | None = None, accel_device_id: int | None = None, quiet: bool = False,
+                 learner: LearnerSettings | None = None) -> None:
     """Write ``calibration`` as ``fmt`` (px4, ardupilot, c, or json: the model file) and say what was written."""
     if fmt == "json":
         calibration.save(output)
@@ -50,7 +54,8 @@ def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, in
         written = write_c_sources(calibration, output, rate_hz=rate_hz, learner=learner)
     else:
         if fmt == "px4":
-            text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id)
+            text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id,
+                                   accel_device_id=accel_device_id)
         else:
             text = ardupilot_params_file(calibration, instance=1 if instance is None else instance)
         write_text_atomic(output, text)

@@ -229,15 +229,17 @@ def report(ctx, store, output, limits_file):
 @click.option("--at", "at", default=None, metavar="DATE", help="Export the calibration valid at this date or time.")
 @click.option("--rate", "rate_hz", type=float, default=None, help="c: the sample rate the code will run at [Hz].")
 @click.option("--instance", type=int, default=None, help="As gyrocomp export.")
-@click.option("--device-id", type=int, default=0, show_default=True, help="PX4: the gyro's device id.")
+@click.option("--device-id", type=int, default=None, help="PX4: the gyro's device id (default: the model's).")
+@click.option("--accel-device-id", type=int, default=None, help="PX4: the accelerometer's device id.")
 @click.pass_context
-def export(ctx, serial, store, fmt, output, at, rate_hz, instance, device_id):
+def export(ctx, serial, store, fmt, output, at, rate_hz, instance, device_id, accel_device_id):
     """Write the calibration of unit SERIAL from the store as autopilot parameters, C code or a model file."""
     when = parse_time(at) if at is not None else None
     with CalibrationStore(store) as db:
         _refuse_output_over_store(output, db)
         calibration = db.valid_at(serial, when).calibration()
     write_export(calibration, fmt, output, rate_hz=rate_hz, instance=instance, device_id=device_id,
+                 accel_device_id=accel_device_id,
                  quiet=ctx.obj["quiet"])
 
 

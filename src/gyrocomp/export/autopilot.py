@@ -129,36 +129,73 @@ def _range(axes: dict[str, AxisCalibration]) -> tuple[float, float]:
     return (min(ax.temperature.t_min_degc for ax in axes.values()), max(ax.temperature.t_max_degc for ax in axes.values()))
 
 
-def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: int = 0) -> AutopilotParameters:
-    """``TC_G{instance}_*`` (and ``TC_A{instance}_*``) for PX4: TREF is the middle of the model's range,
-    SCL 1, axes not in the model 0."""
+#: where a user finds a PX4 sensor's device id, per sensor, for the refusal's message
+_WHERE_ID = {"G": ("device_id", "sensor_gyro", "CAL_GYRO0_ID"), "A": ("accel_device_id", "sensor_accel",
+                                                                      "CAL_ACC0_ID")}
+
+
+def model_device_id(calibration: Calibration, key: str = "device_id") -> int | None:
+    """The device id the model's runs name (``device_id`` of the gyro, ``accel_device_id`` of the accelerometer,
+    recorded from a ULog's ``sensor_gyro``/``sensor_accel``), or None when no run names one; runs of different
+    sensors are refused, naming their ids."""
+    ids = sorted({int(i[key]) for i in (calibration.provenance or {}).get("inputs", ())
+                  if isinstance(i, dict) and isinstance(i.get(key), int) and i[key] != 0})
+    if len(ids) > 1:
+        raise InputError(f"export: the model's runs come from sensors with {key} {', '.join(map(str, ids))}; "
+                         "a PX4 slot applies to one (give it with device_id= / accel_device_id=)")
+    return ids[0] if ids else None
+
+
+def _device_id(calibration: Calibration, sensor: str, given: int | None) -> int:
+    if given is not None:
+        if not 0 < given < 2 ** 32:
+            raise InputError(f"{_WHERE_ID[sensor][0]}: a PX4 device id is a positive 32-bit number, got {given}")
+        return given
+    found = model_device_id(calibration, "device_id" if sensor == "G" else "accel_device_id")
+    if found is None:
+        option, topic, param = _WHERE_ID[sensor]
+        raise InputError(f"PX4 export: no {'gyro' if sensor == 'G' else 'accelerometer'} device id (PX4 applies "
+                         f"TC_{sensor}n_* only to the sensor whose device id matches, so 0 does nothing); give "
+                         f"{option}=ID: find it in the ULog's {topic} topic, with 'listener {topic}' on the vehicle, or "
+                         f"in the {param} parameter")
+    return found
+
+
+def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: int | None = None,
+                   accel_device_id: int | None = None) -> AutopilotParameters:
+    """``TC_G{instance}_*`` (and ``TC_A{instance}_*``) for PX4: TREF is the middle of the model's range, axes not in
+    the model 0. ``TC_Gn_ID``/``TC_An_ID``: ``device_id``/``accel_device_id``, else the ids the model's runs
+    recorded (:func:`model_device_id`); without one the export is refused (PX4 would apply nothing). No
+    ``TC_*_SCL_*``: PX4 removed them (QGroundControl reports each as a parameter that does not exist).
+
+    Reference: PX4 ``src/modules/temperature_compensation/TemperatureCompensation.cpp`` (``calc_thermal_offsets_3D``,
+    the slot chosen by ``TC_Gn_ID == device_id``)."""
     if not 0 <= instance <= 3:
         raise InputError(f"instance: PX4 has thermal compensation for gyros 0..3, got {instance}")
     _warn_left_out(calibration, "PX4")
     values: dict[str, float] = {}
     fits = {}
-    for sensor, axes, index, to_si, with_constant in (
-            ("G", _gyro_axes(calibration), AXIS_INDEX, DEG_TO_RAD, True),
-            ("A", _accel_axes(calibration), ACCEL_INDEX, G_TO_M_PER_S2, False)):
+    for sensor, axes, index, to_si, with_constant, given in (
+            ("G", _gyro_axes(calibration), AXIS_INDEX, DEG_TO_RAD, True, device_id),
+            ("A", _accel_axes(calibration), ACCEL_INDEX, G_TO_M_PER_S2, False, accel_device_id)):
         if not axes:
             continue
         t_min, t_max = _range(axes)
         t_ref = 0.5 * (t_min + t_max)
         p = f"TC_{sensor}{instance}_"
-        values.update({f"TC_{sensor}_ENABLE": 1, f"{p}ID": int(device_id), f"{p}TMIN": t_min, f"{p}TMAX": t_max,
-                       f"{p}TREF": t_ref})
+        values.update({f"TC_{sensor}_ENABLE": 1, f"{p}ID": _device_id(calibration, sensor, given), f"{p}TMIN": t_min,
+                       f"{p}TMAX": t_max, f"{p}TREF": t_ref})
         for name, j in index.items():
             fit = cubic_of(axes[name], t_ref, with_constant=with_constant, to_si=to_si) if name in axes else None
             coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
             for k in range(4):
                 values[f"{p}X{k}_{j}"] = coef[k]
-            values[f"{p}SCL_{j}"] = 1.0
             if fit:
                 fits[name] = fit
     triad = accel_offsets_and_scales(calibration)
     if triad is not None:
         p = f"CAL_ACC{instance}_"
-        values[f"{p}ID"] = int(device_id)
+        values[f"{p}ID"] = _device_id(calibration, "A", accel_device_id)
         values.update({f"{p}{a}OFF": float(triad[0][j]) for j, a in enumerate("XYZ")})
         values.update({f"{p}{a}SCALE": float(triad[1][j]) for j, a in enumerate("XYZ")})
     return AutopilotParameters(values, fits)
@@ -195,6 +232,24 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
     return AutopilotParameters(values, fits)
 
 
+#: what to do with the file on the vehicle, in order (PX4: TemperatureCompensationModule.cpp and
+#: sensor_calibration/Gyroscope.hpp; ArduPilot: AP_InertialSensor_tempcal.cpp and AP_InertialSensor.cpp)
+_STEPS = {
+    "PX4": ("load it in QGroundControl (Vehicle Setup > Parameters > Tools > Load from file)",
+            "reboot: TC_G_ENABLE / TC_A_ENABLE take effect at start-up",
+            "PX4 subtracts CAL_GYRO*_XOFF/YOFF/ZOFF after these offsets: calibrate the gyro again (or zero them), "
+            "and calibrate the accelerometer again after loading TC_A*",
+            "outside TMIN..TMAX PX4 holds the correction at its edge; it updates it at 1 Hz when the temperature "
+            "moved by more than 1 degC"),
+    "ArduPilot": ("set INS_TCAL<n>_ENABLE = 1 first (the INS_TCAL<n>_* group is hidden until then): load the file, "
+                  "refresh the parameters, load it again",
+                  "reboot",
+                  "INS_GYR<n>_CALTEMP must hold a valid temperature (calibrate the gyro once at start-up); the "
+                  "boot-time gyro offset is taken without this correction: keep the vehicle still at boot",
+                  "outside TMIN..TMAX ArduPilot holds the correction at its edge"),
+}
+
+
 def _header(calibration: Calibration, params: AutopilotParameters, target: str, comment: str) -> list[str]:
     lines = [f"{comment} {target} thermal calibration written by gyrocomp from model "
              f"'{line_comment(calibration.model)}'",
@@ -203,13 +258,16 @@ def _header(calibration: Calibration, params: AutopilotParameters, target: str, 
     for name, fit in params.fits.items():
         unit = "g" if name in ACCEL_INDEX else "deg/s"
         lines.append(f"{comment}   {name}: {fit.max_error_dps:.3g} {unit} over {fit.t_min_degc:.2f}..{fit.t_max_degc:.2f} degC")
+    lines.append(f"{comment} on the vehicle, in this order:")
+    lines += [f"{comment}   {k}. {step}" for k, step in enumerate(_STEPS[target], 1)]
     return lines
 
 
-def px4_params_file(calibration: Calibration, *, instance: int = 0, device_id: int = 0) -> str:
+def px4_params_file(calibration: Calibration, *, instance: int = 0, device_id: int | None = None,
+                    accel_device_id: int | None = None) -> str:
     """A QGroundControl parameter file (vehicle 1, component 1; type 6 = int32, 9 = float32) of
-    :func:`px4_parameters` (``instance`` 0..3 of the sensor, its ``device_id``)."""
-    params = px4_parameters(calibration, instance=instance, device_id=device_id)
+    :func:`px4_parameters` (``instance`` 0..3 of the sensor, its device ids)."""
+    params = px4_parameters(calibration, instance=instance, device_id=device_id, accel_device_id=accel_device_id)
     lines = _header(calibration, params, "PX4", "#")
     lines.append("# Vehicle-Id Component-Id Name Value Type")
     for name, value in params.values.items():
@@ -231,4 +289,4 @@ def ardupilot_params_file(calibration: Calibration, *, instance: int = 1) -> str
 
 
 __all__ = ["AutopilotParameters", "CubicFit", "accel_offsets_and_scales", "ardupilot_parameters", "ardupilot_params_file", "cubic_of",
-           "installed_calibration", "px4_parameters", "px4_params_file"]
+           "installed_calibration", "model_device_id", "px4_parameters", "px4_params_file"]

@@ -196,23 +196,31 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
         known = {u.serial: known.get(u.serial) for u in units}
         by_serial = {u.serial: u for u in units}
         for done, outcome in enumerate(_outcomes(units, settings, known, scheduler, workers, memory_limit), 1):
-            if outcome.status == "unchanged":
-                tally.unchanged.append(outcome.serial)
-                _repair_model(output, db, outcome.serial)
-            else:
-                record = _record(outcome, by_serial[outcome.serial], limits)
-                if record.status == "ok":  # the model file first: a row is never committed without its file
-                    _write_model(output, outcome.serial, outcome.model_json)
-                if db.add_new(record, since=started) is None:  # another fit stored these inputs meanwhile
-                    tally.unchanged.append(outcome.serial)
-                else:
-                    tally.count(record)
+            _keep(outcome, by_serial[outcome.serial], limits, output, db, started, tally)
             if progress is not None:
                 progress(done, len(units))
         table = write_fleet_table(db, output / FLEET_TABLE, limits)
     return FleetSummary(tuple(tally.fitted), tuple(tally.unchanged), tally.failed, tuple(tally.passed),
                         tuple(tally.rejected), store=os.fspath(store if store is not None else output), table=table,
                         warned=tally.warned)
+
+
+def _keep(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, output: Path, db: CalibrationStore,
+          started, tally: "_Tally") -> None:
+    """Store one unit's outcome: the model file first, so that a row is never committed without its file; a unit
+    another fit stored from the same inputs since ``started`` counts as unchanged; an unchanged unit's missing
+    model file is put back."""
+    if outcome.status == "unchanged":
+        tally.unchanged.append(outcome.serial)
+        _repair_model(output, db, outcome.serial)
+        return
+    record = _record(outcome, unit, limits)
+    if record.status == "ok":
+        _write_model(output, outcome.serial, outcome.model_json)
+    if db.add_new(record, since=started) is None:
+        tally.unchanged.append(outcome.serial)
+    else:
+        tally.count(record)
 
 
 @dataclass

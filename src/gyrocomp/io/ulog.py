@@ -118,6 +118,8 @@ def _from_sensor_gyro(path: Path, datasets: list, options: ReadOptions, metadata
     accel_sets = [d for d in datasets if d.name == "sensor_accel" and d.multi_id == gyro_set.multi_id]
     if accel_sets:
         adata = accel_sets[0].data
+        if "device_id" in adata:  # a separate die (BMI055, SCHA63T) has an id of its own
+            metadata["accel_device_id"] = int(adata["device_id"][0])
         what = f"sensor_accel instance {gyro_set.multi_id}"
         a_time, a_values = order_by_time(str(path), _time_s(adata),
                                          np.column_stack([adata[a] for a in "xyz"]).astype(float) * _MS2)

@@ -114,7 +114,8 @@ def one_temperature_column(recordings: list[Recording]) -> bool:
 
 def provenance(recordings) -> dict:
     """Where a calibration came from: gyrocomp's version, the time, and each input (name, rows, duration,
-    rate, SHA-256 of the file when it is on disk)."""
+    rate, SHA-256 of the file when it is on disk, the gyro's and accelerometer's device ids when the log names
+    them)."""
     inputs = []
     for rec in recordings:
         entry = {"file": Path(rec.source).name, "rows": rec.n_samples, "duration_s": rec.duration_s,
@@ -122,6 +123,9 @@ def provenance(recordings) -> dict:
         path = rec.metadata.get("path")
         if path and Path(path).is_file():
             entry["sha256"] = file_sha256(path)
+        for key in ("device_id", "accel_device_id"):  # the sensor's id in its autopilot (a ULog's sensor_gyro)
+            if isinstance(rec.metadata.get(key), int):
+                entry[key] = rec.metadata[key]
         inputs.append(entry)
     return {
         "gyrocomp_version": __version__,
