@@ -4,13 +4,17 @@ import dataclasses
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyrocomp import Polynomial, apply, comparison, fit_calibration, validation, write
 from gyrocomp.compensate import Compensator
-from gyrocomp.errors import DataQualityWarning, InputError, PlausibilityWarning, TemperatureRangeWarning
+from gyrocomp.errors import (DataQualityWarning, InputError, ModelChoiceWarning, PlausibilityWarning,
+                             TemperatureRangeWarning)
+from gyrocomp.io import read
+from gyrocomp.noise import analyse_noise
 from gyrocomp.plausibility import (
     CHECKS,
     accel_unit_concern,
@@ -305,3 +309,31 @@ def test_an_output_that_parts_with_the_direction_of_temperature_change_is_named_
     assert "rad/s read as deg/s?" in agreement_concern("f.csv", "gyro_z", rad).message
     # without a temperature nothing is said about the direction
     assert not scale_agreement(output, predicted).follows_direction
+
+
+def test_an_impossible_temperature_is_named_with_its_row():
+    rec = simulate("consumer", profile="cycle", duration_s=3000, rate_hz=1, seed=1).recording
+    t = rec.temperature_degc.copy()
+    t[[500, 900]] = [1e6, -300.0]
+    (concern,) = [c for c in recording_concerns(dataclasses.replace(rec, temperature_degc=t))
+                  if c.check == "temperature-range"]
+    assert concern.message.endswith("row 501: temperature 1e+06 degC, beyond any sensor's range (-100..200 degC), "
+                                    "and 1 row(s) more: a corrupt sample, or another unit?")
+    assert not [c for c in recording_concerns(rec) if c.check == "temperature-range"]
+    with pytest.warns(PlausibilityWarning, match=r"row 501: temperature 1e\+06 degC"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ModelChoiceWarning)
+            fit_calibration([dataclasses.replace(rec, temperature_degc=t)])
+
+
+def test_allan_says_a_time_column_in_another_unit(tmp_path):
+    path = tmp_path / "ns.csv"
+    rng = np.random.default_rng(0)
+    pd.DataFrame({"time": (np.arange(5000) * 10_000_000).astype(np.int64),  # 100 Hz in ns, read as s
+                  "gyro_z": rng.standard_normal(5000)}).to_csv(path, index=False)
+    result = run("allan", path)
+    assert result.returncode == 0
+    assert "ns.csv: 1e-07 Hz is no IMU's sample rate: is the time column in another unit than the one given? " \
+           "(check 'time-unit')" in result.stderr
+    with pytest.warns(PlausibilityWarning, match=r"1e-07 Hz is no IMU's sample rate"):
+        analyse_noise(read(path))

@@ -46,7 +46,7 @@ class PlausibilityWarning(DataQualityWarning):
 
 #: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.plausibility`)
 CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span", "agreement",
-                    "accel-unit"]
+                    "accel-unit", "temperature-range"]
 #: every check's name
 CHECKS: tuple[CheckName, ...] = get_args(CheckName)
 

@@ -25,6 +25,7 @@ from .allan import (
     noise_terms,
 )
 from .errors import DataQualityWarning, InputError
+from .plausibility import recording_concerns
 from .recording import Recording
 
 
@@ -135,6 +136,8 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
         Also analyse every accelerometer axis of the recording.
     """
     names = noise_axes(axes, recording.gyro_axes, recording.accel_axes, with_accel)
+    for concern in recording_concerns(recording):  # a time column in ns read as s gives taus of 1e10 s
+        warnings.warn(concern.warning(), stacklevel=2)
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
     stretches = recording.contiguous_stretches()

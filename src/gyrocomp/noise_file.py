@@ -23,6 +23,7 @@ from .errors import DataQualityWarning, InputError
 from .io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from .io.tables import TableLayout, read_table
 from .noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes
+from .plausibility import temperature_range_concerns, time_unit_concern
 from .recording import ACCEL_AXES, GAP_FACTOR, GYRO_AXES, nominal_rate_hz
 from .spill import DEFAULT_MEMORY_BYTES, SpillArray, block_median
 
@@ -114,16 +115,25 @@ def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_
         if name not in have:
             raise InputError(f"axes: {name!r} is not in {stream.path}; it has {', '.join(have)}")
     steps = TimeSteps(chunks)
+    first_s, said = None, False
     try:
         with PhaseAccumulator(len(names), memory_bytes=chunks.memory_bytes, directory=chunks.scratch_dir) as phases:
             for chunk in stream.chunks():
                 recording = chunk.recording
                 if recording.gaps or stream.gaps:
                     raise NotStreamable("a time gap")
+                first_s = float(recording.time_s[0]) if first_s is None and recording.n_samples else first_s
                 steps.add(recording.time_s)
                 phases.update(np.column_stack([axis_values(recording, name)[0] for name in names]))
+                if not said and recording.temperature_degc is not None:  # the first impossible sample, once
+                    for concern in temperature_range_concerns(recording):
+                        warnings.warn(concern.warning(), stacklevel=3)
+                        said = True
             rate_hz = steps.rate_hz()
             stream.warn_summary()
+            concern = time_unit_concern(str(stream.path), rate_hz, (steps.last or 0.0) - (first_s or 0.0))
+            if concern is not None:  # the same words as a whole recording's check (allan on ns read as s)
+                warnings.warn(concern.warning(), stacklevel=3)
             integrated = dict(zip(names, phases.finish(rate_hz)))
             return analyse_noise_phases(integrated, rate_hz, source=str(stream.path), kind=kind, taus=taus,
                                         fit_taus_s=fit_taus_s)

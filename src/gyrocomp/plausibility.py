@@ -44,6 +44,8 @@ MAX_SWING_DPS = 25.0
 SWING_WINDOW_S = 10.0
 #: electronics read in degC stay below this; a median above it is probably kelvin [degC]
 KELVIN_LOOKING_DEGC = 150.0
+#: no MEMS sensor reports a temperature outside this (their ratings are -55..150 degC at most) [degC]
+TEMPERATURE_RANGE_DEGC = (-100.0, 200.0)
 #: a calibration run that varies less than this in temperature cannot identify a temperature curve [degC]
 MIN_TEMPERATURE_SPAN_DEGC = 1.0
 #: still poses of a hand-turned multi-position session: 1 s still, judged on 0.5 s windows, up to 10 times the
@@ -69,8 +71,8 @@ KNOWN_SLOPES = ((math.pi / 180.0, "rad/s read as deg/s?"), (180.0 / math.pi, "de
 @dataclass(frozen=True)
 class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
-    ``temperature-span``, ``agreement``, ``accel-unit``) and the one-line message, which starts with the
-    recording's source."""
+    ``temperature-span``, ``agreement``, ``accel-unit``, ``temperature-range``) and the one-line message, which
+    starts with the recording's source."""
 
     check: CheckName
     message: str
@@ -82,7 +84,8 @@ class Concern:
 
 def recording_concerns(recording: Recording) -> list[Concern]:
     """Unit mistakes any use of ``recording`` suffers from: values beyond any MEMS range, kelvin-looking
-    temperatures, an implausible sample rate (a time column in ms read as s, or the reverse)."""
+    temperatures, a temperature no sensor reaches (named with its row), an implausible sample rate (a time column
+    in ms read as s, or the reverse)."""
     out = []
     src = recording.source
     peak = float(np.max(np.abs(recording.gyro_dps))) if recording.gyro_dps.size else 0.0
@@ -94,17 +97,44 @@ def recording_concerns(recording: Recording) -> list[Concern]:
         if median > KELVIN_LOOKING_DEGC:
             out.append(Concern("kelvin", f"{src}: median temperature {median:.4g} degC looks like kelvin; "
                                          "gyrocomp reads degC (subtract 273.15)"))
+        else:
+            out += temperature_range_concerns(recording)
     concern = accel_unit_concern(recording)
     if concern is not None:
         out.append(concern)
-    lo, hi = RATE_RANGE_HZ
-    if not lo <= recording.rate_hz <= hi:
-        out.append(Concern("time-unit", f"{src}: {recording.rate_hz:.3g} Hz is no IMU's sample rate: is the time "
-                                        "column in another unit than the one given?"))
-    elif recording.duration_s > LONG_SLOW_S and recording.rate_hz <= 1.0:
-        out.append(Concern("time-unit", f"{src}: {recording.duration_s / 86400:.3g} days at {recording.rate_hz:.3g} "
-                                        "Hz: is the time column in ms read as s?"))
+    concern = time_unit_concern(src, recording.rate_hz, recording.duration_s)
+    if concern is not None:
+        out.append(concern)
     return out
+
+
+def time_unit_concern(source: str, rate_hz: float, duration_s: float) -> Concern | None:
+    """A sample rate [Hz] or a length [s] that says the time column was read in the wrong unit (nanoseconds or
+    milliseconds read as seconds, or the reverse)."""
+    lo, hi = RATE_RANGE_HZ
+    if not lo <= rate_hz <= hi:
+        return Concern("time-unit", f"{source}: {rate_hz:.3g} Hz is no IMU's sample rate: is the time column in "
+                                    "another unit than the one given?")
+    if duration_s > LONG_SLOW_S and rate_hz <= 1.0:
+        return Concern("time-unit", f"{source}: {duration_s / 86400:.3g} days at {rate_hz:.3g} Hz: is the time "
+                                    "column in ms read as s?")
+    return None
+
+
+def temperature_range_concerns(recording: Recording) -> list[Concern]:
+    """Samples whose temperature no sensor reaches (``TEMPERATURE_RANGE_DEGC``), named with the first one's row:
+    one corrupt sample at 1e6 degC stretches a temperature model's range and its bins over nothing."""
+    t = np.asarray(recording.temperature_degc, dtype=float)
+    lo, hi = TEMPERATURE_RANGE_DEGC
+    bad = np.flatnonzero(np.any((t < lo) | (t > hi), axis=1) if t.ndim == 2 else (t < lo) | (t > hi))
+    if not bad.size:
+        return []
+    first = int(bad[0])
+    value = float(np.ravel(t[first])[np.argmax(np.abs(np.ravel(t[first]) - 25.0))])
+    return [Concern("temperature-range", f"{recording.source}: row {int(recording.row_numbers[first])}: temperature "
+                                         f"{value:.4g} degC, beyond any sensor's range ({lo:g}..{hi:g} degC)"
+                                         + (f", and {bad.size - 1} row(s) more" if bad.size > 1 else "")
+                                         + ": a corrupt sample, or another unit?")]
 
 
 def accel_unit_concern(recording: Recording) -> Concern | None:
@@ -332,6 +362,7 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
                                        "range (or fit with temperature=None)")
 
 
-__all__ = ["AGREEMENT_BLOCK_S", "BlockMeans", "CHECKS", "CheckName", "Concern", "ScaleAgreement", "accel_unit_concern", "agreement_concern",
+__all__ = ["AGREEMENT_BLOCK_S", "BlockMeans", "CHECKS", "CheckName", "Concern", "ScaleAgreement", "accel_unit_concern",
+           "agreement_concern", "temperature_range_concerns", "time_unit_concern",
            "calibration_concerns", "recording_concerns", "require_temperature_span", "scale_agreement", "silence_pattern",
            "temperature_span_concern", "turned_between_poses"]

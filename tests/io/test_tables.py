@@ -332,3 +332,19 @@ def test_reading_only_some_channels(tmp_path, suffix):
     np.testing.assert_array_equal(mapped.recording.gyro_dps[:, 0], whole.recording.gyro_dps[:, 2])
     with pytest.raises(InputError, match=r"none of the channels read \(accel_x\) is a gyro axis of the file"):
         read_table(path, channels=("accel_x",))
+
+
+@pytest.mark.parametrize("header, name", [("time,Gyro_Z,GYRO_Z,temperature", "gyro_z"),
+                                          ("time,gyro_z,temperature,Temperature", "temperature")])
+def test_two_columns_that_match_one_channel_are_refused_naming_both(tmp_path, header, name):
+    path = tmp_path / "amb.csv"
+    path.write_text(header + "\n" + "\n".join(f"{t},1,2,{20 + t}" for t in range(5)) + "\n")
+    first, second = [c for c in header.split(",") if c.strip().lower() == name]
+    with pytest.raises(InputError, match=rf"amb.csv: columns '{first}' and '{second}' would both be read as {name}; "
+                                         rf"say which with columns="):
+        read(path)
+    result = run("convert", path, tmp_path / "out.csv")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1 and f"--columns {name}={first}" in result.stderr
+    assert not (tmp_path / "out.csv").exists()
+    rec = read(path, TableLayout(columns={name: second}))  # a mapping says which
+    assert rec.n_samples == 5

@@ -69,11 +69,15 @@ class TableLayout:
     def resolve(self, header: list[str], source: str) -> dict[str, str]:
         """Canonical name to file column for every channel present in ``header``."""
         resolved = {name: name for name in CANONICAL_COLUMNS if name in header}
-        # the standard names also match whatever their case and surrounding spaces (" Gyro_Z" is gyro_z)
-        loose = {column.strip().lower(): column for column in header}
+        # the standard names also match whatever their case and surrounding spaces (" Gyro_Z" is gyro_z); two
+        # columns that both match one name (Gyro_Z and GYRO_Z) are refused, naming both, unless a mapping says
         for name in CANONICAL_COLUMNS:
-            if name not in resolved and name in loose and loose[name] not in resolved.values():
-                resolved[name] = loose[name]
+            matches = [column for column in header if column.strip().lower() == name]
+            if len(matches) > 1 and name not in self.columns:
+                raise InputError(f"{source}: columns {' and '.join(map(repr, matches))} would both be read as "
+                                 f"{name}; say which with columns={{{name!r}: {matches[0]!r}}} (or rename one)")
+            if name not in resolved and matches and matches[0] not in resolved.values():
+                resolved[name] = matches[0]
         for canonical, column in self.columns.items():
             if canonical in ARRAY_CHANNELS:
                 raise InputError(
