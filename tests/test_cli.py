@@ -103,10 +103,11 @@ def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     assert "hysteresis / thermal lag by leave-one-run-out" in r.stdout
     for candidate in ("none", "turning-point", "lag", "turning-point+lag"):
         assert candidate in r.stdout
-    assert re.search(r"lag \d+(\.\d+)? s, hysteresis order 2 in 55..80 degC", r.stdout)
+    assert re.search(r"lag \d+(\.\d+)? s, turning-point hysteresis order 2 in 55..80 degC", r.stdout)
     model = json.loads((tmp_path / "m.json").read_text())
     scores = model["fit_report"]["hysteresis"]["axes"]["gyro_z"]["scores_dps"]
-    assert set(scores) == {"none", "turning-point", "lag", "turning-point+lag"}
+    # every memory scored, the heating and cooling branches too (the runs heat and cool)
+    assert set(scores) == {"none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag"}
     assert model["axes"]["gyro_z"]["hysteresis"]["band_degc"] == [55.0, 80.0]
 
 

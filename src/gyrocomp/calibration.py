@@ -23,7 +23,7 @@ from .fit_report import FitReport
 from .io.atomic import write_text_atomic
 from .models.mlp import MLPBias
 from .models.temperature import PolynomialBias
-from .models.hysteresis import HysteresisCurve
+from .models.hysteresis import BranchCurve, HysteresisCurve, memory_curve_from_dict
 from .recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
 from .triad import TriadCalibration
 from .units import AxisUnit, check_axis_unit, in_unit, require_unit
@@ -141,7 +141,7 @@ def _check_axis(section: str, name: str, d: Any, allowed: tuple[str, ...]) -> No
     if isinstance(lag, (int, float)) and lag < 0:
         raise InputError(f"{where}.lag_time_constant_s: {lag:g} s; a time constant is 0 (none) or positive")
     curves = [("temperature", d["temperature"], ("coefficients_dps",)),
-              ("hysteresis", d.get("hysteresis"), ("descending_dps", "ascending_dps"))]
+              ("hysteresis", d.get("hysteresis"), ("descending_dps", "ascending_dps", "coefficients_dps"))]
     for key, curve, lists in curves:
         if not isinstance(curve, dict):
             continue
@@ -212,8 +212,9 @@ class AxisCalibration:
     lag_time_constant_s : float
         Thermal lag [s]: the polynomial and the hysteresis read the reported temperature through a
         first-order lag of this time constant; 0 for none.
-    hysteresis : HysteresisCurve or None
-        Turning-point hysteresis on top of the polynomial.
+    hysteresis : HysteresisCurve, BranchCurve or None
+        The thermal memory on top of the polynomial: turning-point hysteresis, or heating and cooling branches
+        (a memory curve of :data:`gyrocomp.models.hysteresis.MEMORY_CURVES`).
     g_sensitivity_dps_per_g : 3 floats or None
         This axis's row of the g-sensitivity matrix G, on accel_x, accel_y, accel_z [deg/s/g].
     g_squared_dps_per_g2 : 6 floats or None
@@ -228,7 +229,7 @@ class AxisCalibration:
     turn_on_biases: tuple[float, ...]
     temperature_column: str = "temperature"
     lag_time_constant_s: float = 0.0
-    hysteresis: HysteresisCurve | None = None
+    hysteresis: HysteresisCurve | BranchCurve | None = None
     g_sensitivity_dps_per_g: tuple[float, float, float] | None = None
     g_squared_dps_per_g2: tuple[float, ...] | None = None
     acceleration_network: MLPBias | None = None
@@ -295,7 +296,7 @@ class AxisCalibration:
             turn_on_biases=tuple(float(c) for c in d["turn_on_biases_dps"]),
             temperature_column=str(d.get("temperature_column", "temperature")),
             lag_time_constant_s=float(d["lag_time_constant_s"]),
-            hysteresis=None if d["hysteresis"] is None else HysteresisCurve.from_dict(d["hysteresis"]),
+            hysteresis=None if d["hysteresis"] is None else memory_curve_from_dict(d["hysteresis"]),
             g_sensitivity_dps_per_g=_floats(d["g_sensitivity_dps_per_g"], 3, "g_sensitivity_dps_per_g"),
             g_squared_dps_per_g2=_floats(d["g_squared_dps_per_g2"], 6, "g_squared_dps_per_g2"),
             acceleration_network=None if d["acceleration_network"] is None else MLPBias.from_dict(d["acceleration_network"]),

@@ -370,6 +370,33 @@ def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_d
     return np.where(active, out, 0.0)
 
 
+def branch_position(temperature_degc: np.ndarray, turns: Turns, transition_degc: float) -> np.ndarray:
+    """Where the bias stands between the heating and the cooling curve, from -1 (cooling) to +1 (heating).
+
+        s = D                                   on a branch of direction D before the first confirmed turn
+        s = D (1 - 2 exp(-|T - T_turn| / w))    after a turn at T_turn: from the last branch's curve at the turn
+                                                to this branch's, over a transition of about w degrees
+        s = 0                                   while the direction is not yet known
+
+    The general form of the thesis's turning-point correction (section 2.6): a part that follows one curve while
+    heating and another while cooling, and crosses over after each turning point.
+
+    Parameters
+    ----------
+    temperature_degc : array (n,)
+        Temperature the effect depends on [degC].
+    turns : Turns
+        From :func:`find_turns` on the same series (direction D: +1 rising, -1 falling).
+    transition_degc : float
+        Transition width w [degC], positive.
+    """
+    t = np.asarray(temperature_degc, dtype=float)
+    d = turns.direction.astype(float)
+    after = ~np.isnan(turns.turn_degc)
+    distance = np.abs(t - np.where(after, turns.turn_degc, t))
+    return np.where(after, d * (1.0 - 2.0 * np.exp(-distance / transition_degc)), d)
+
+
 # -- acceleration -----------------------------------------------------------------------------------
 def g_squared_products(accel_g: np.ndarray) -> np.ndarray:
     """Products of specific-force components in the order of ``G_SQUARED_TERMS`` (n, 6) [g^2]."""
@@ -420,7 +447,7 @@ def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
 
 
 __all__ = [
-    "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "find_turns",
+    "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "branch_position", "find_turns",
     "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter",
     "moving_average", "quantize", "thermal_lag",
 ]

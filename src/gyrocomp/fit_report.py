@@ -23,13 +23,16 @@ from typing import Any, Literal
 from .units import AxisUnit, in_unit, unit_suffix
 
 #: the thermal memories a gyro axis's model may carry
-MEMORIES = ("none", "lag", "turning-point", "turning-point+lag")
+MEMORIES = ("none", "lag", "turning-point", "turning-point+lag", "branch", "branch+lag")
 _TYPED = ("temperature", "axes", "order_selection", "selection", "hysteresis", "network", "acceleration", "stages",
           "accel", "pipeline")
 
 
-def memory_name(lag: bool, hysteresis_order: int) -> str:
-    """The thermal memory a model carries: ``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
+def memory_name(lag: bool, hysteresis_order: int, branch: int = 0) -> str:
+    """The thermal memory a model carries: ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``
+    (heating and cooling curves) or ``branch+lag``."""
+    if branch:
+        return "branch+lag" if lag else "branch"
     if lag and hysteresis_order:
         return "turning-point+lag"
     return "lag" if lag else ("turning-point" if hysteresis_order else "none")
@@ -54,8 +57,9 @@ Weighting = Literal["time", "temperature-balanced"]
 
 @dataclass(frozen=True)
 class Candidate:
-    """One model of an axis's bias: polynomial order, thermal lag, turning-point order, fit weighting, and whether
-    the turning-point terms act only in the band found in the data. The model choice scores these
+    """One model of an axis's bias: polynomial order, thermal lag, turning-point order, fit weighting, whether
+    the turning-point terms act only in the band found in the data, and the number of terms of the difference
+    between a heating and a cooling curve (``branch``; 0 for none). The model choice scores these
     (:mod:`gyrocomp.models.selection`) and the report names them."""
 
     order: int
@@ -63,20 +67,23 @@ class Candidate:
     hysteresis_order: int = 0
     weighting: Weighting = "time"
     band: bool = False
+    branch: int = 0
 
     @property
     def memory(self) -> str:
-        """``none``, ``lag``, ``turning-point`` or ``turning-point+lag``."""
-        return memory_name(self.lag, self.hysteresis_order)
+        """``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch`` or ``branch+lag``."""
+        return memory_name(self.lag, self.hysteresis_order, self.branch)
 
     @property
     def complexity(self) -> int:
-        """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band."""
-        return self.order + int(self.lag) + 2 * self.hysteresis_order + int(self.band)
+        """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band, the
+        branch difference's terms and its crossover width."""
+        return (self.order + int(self.lag) + 2 * self.hysteresis_order + int(self.band)
+                + (self.branch + 1 if self.branch else 0))
 
     @property
     def has_temperature_model(self) -> bool:
-        return self.order > 0 or self.lag or self.hysteresis_order > 0
+        return self.order > 0 or self.lag or self.hysteresis_order > 0 or self.branch > 0
 
     @property
     def label(self) -> str:
@@ -86,17 +93,22 @@ class Candidate:
             parts.append("lag")
         if self.hysteresis_order:
             parts.append(f"turning-point:{self.hysteresis_order}" + (" in band" if self.band else ""))
+        if self.branch:
+            parts.append(f"branch:{self.branch}")
         return " + ".join(parts) + f" ({self.weighting})"
 
     def to_dict(self) -> dict:
-        return {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
-                "weighting": self.weighting, "band": self.band, "label": self.label}
+        d = {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
+             "weighting": self.weighting, "band": self.band, "label": self.label}
+        if self.branch:  # written only when set: files without it read as before
+            d["branch"] = self.branch
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "Candidate":
         """A stored candidate (its ``label`` is derived from the fields)."""
         return cls(int(d["order"]), bool(d.get("lag", False)), int(d.get("hysteresis_order", 0)),
-                   d.get("weighting", "time"), bool(d.get("band", False)))
+                   d.get("weighting", "time"), bool(d.get("band", False)), int(d.get("branch", 0)))
 
 
 def _entry_in_unit(d: dict, name: str, unit: str, default=None):

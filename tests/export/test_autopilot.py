@@ -12,7 +12,7 @@ import pytest
 from gyrocomp import Calibration, find_poses, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
-from gyrocomp.simulate import GyroErrorModel, simulate
+from gyrocomp.simulate import GyroErrorModel, Hysteresis, simulate
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.units import STANDARD_GRAVITY_M_PER_S2 as G0
 from gyrocomp.models.options import FitOptions, Polynomial
@@ -330,3 +330,14 @@ def test_a_model_fitted_on_a_ulog_exports_its_sensor_s_device_id(tmp_path):
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params")
     assert r.returncode == 0, r.stderr
     assert _read_px4((tmp_path / "tc.params").read_text())["TC_G0_ID"] == 2293768
+
+
+def test_the_firmware_files_say_they_cannot_carry_heating_and_cooling_branches():
+    runs = [simulate(GyroErrorModel(hysteresis=Hysteresis(((0.02, 0.0005),) * 3, transition_degc=5.0)),
+                     profile="cycle", duration_s=6000, rate_hz=1, seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="branch")
+    for write in (lambda c: px4_params_file(c, device_id=5), ardupilot_params_file):
+        with pytest.warns(DataQualityWarning, match=r"has no heating/cooling branches term: left out of the export"):
+            write(cal)

@@ -13,7 +13,7 @@ from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources, write_c_sources
 from gyrocomp.models.pipelines import fit_pipeline
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
 from ..conftest import run
@@ -227,3 +227,19 @@ def test_a_hostile_model_name_compiles_to_the_same_code_as_a_plain_one(tmp_path,
                         str(folder / "gyrocomp.c")], check=True, capture_output=True, text=True, cwd=folder)
         objects.append((folder / "gyrocomp.o").read_bytes())
     assert objects[0] == objects[1]
+
+
+def test_heating_and_cooling_branches(tmp_path):
+    part = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01, 5e-5),), t_ref_degc=25.0,
+                          hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
+                          noise_density_dps_per_sqrt_hz=0.005, turn_on_bias_sigma_dps=0.05)
+    runs = [simulate(part, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1, seed=s).recording
+            for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="branch+lag")
+    assert type(cal.axes["gyro_z"].hysteresis).__name__ == "BranchCurve" and cal.axes["gyro_z"].lag_time_constant_s > 0
+    # past the calibrated range on both sides, two turns
+    held = simulate(part, profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
+                                              ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
+    _compare(cal, held, tmp_path)

@@ -113,9 +113,7 @@ def _describe_axis(ax) -> str:
     if ax.lag_time_constant_s > 0:
         model += f", lag {ax.lag_time_constant_s:.3g} s"
     if ax.hysteresis is not None:
-        model += f", hysteresis order {ax.hysteresis.order}"
-        if ax.hysteresis.band_degc is not None:
-            model += f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
+        model += f", {ax.hysteresis.describe()}"
     return model
 
 

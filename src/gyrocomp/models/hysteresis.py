@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..effects import find_turns, hysteresis_offset
+from ..effects import branch_position, find_turns, hysteresis_offset
 from ..errors import InputError
 from ..recording import Recording
 
@@ -72,6 +72,14 @@ class HysteresisCurve:
     def order(self) -> int:
         return len(self.descending)
 
+    #: what the curve models, in words (exports say which they cannot carry)
+    kind = "turning-point hysteresis"
+
+    def describe(self) -> str:
+        """In words for tables: ``turning-point hysteresis order 2 in 55..80 degC``."""
+        band = "" if self.band_degc is None else f" in {self.band_degc[0]:g}..{self.band_degc[1]:g} degC"
+        return f"turning-point hysteresis order {self.order}{band}"
+
     def offset(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
         reach = self.max_distance_degc or (None, None)
         down = hysteresis_offset(temperature_degc, turns, self.descending, direction="descending",
@@ -99,7 +107,85 @@ class HysteresisCurve:
                    None if reach is None else (float(reach[0]), float(reach[1])))
 
 
-__all__ = ["HysteresisCurve", "heats_and_cools", "parting_band_degc", "turn_threshold_degc"]
+@dataclass(frozen=True)
+class BranchCurve:
+    """Fitted branches of one axis: one curve while heating, another while cooling, crossing over after each
+    turning point (:func:`gyrocomp.effects.branch_position`).
+
+    offset = s(t) sum_k c_k u^k,  u = (T - t_ref) / t_scale,  k = 0..len(coefficients) - 1
+
+    so the heating curve lies ``+ sum c_k u^k`` and the cooling curve ``- sum c_k u^k`` from the polynomial the
+    axis also carries; ``coefficients`` are in the axis's unit [deg/s, or g]. Past the fitted range
+    [``t_min_degc``, ``t_max_degc``] the half difference is held at its edge value. Reversals are confirmed
+    ``threshold_degc`` past the extreme; ``transition_degc`` is the crossover's width w [degC].
+    """
+
+    coefficients: tuple[float, ...]
+    t_ref_degc: float
+    t_scale_degc: float
+    transition_degc: float
+    threshold_degc: float
+    t_min_degc: float
+    t_max_degc: float
+
+    @property
+    def order(self) -> int:
+        """Number of terms of the half difference between the branches."""
+        return len(self.coefficients)
+
+    band_degc = None  # the branches differ over the whole range
+    #: what the curve models, in words (exports say which they cannot carry)
+    kind = "heating/cooling branches"
+
+    def describe(self) -> str:
+        """In words for tables: ``heating/cooling branches (2 terms, crossover 6 degC)``."""
+        return f"heating/cooling branches ({self.order} term{'s' if self.order > 1 else ''}, crossover " \
+               f"{self.transition_degc:.3g} degC)"
+
+    def half_difference(self, temperature_degc: np.ndarray) -> np.ndarray:
+        """(heating curve - cooling curve) / 2 at ``temperature_degc`` [the axis's unit], held past the range."""
+        u = (np.clip(np.asarray(temperature_degc, dtype=float), self.t_min_degc, self.t_max_degc)
+             - self.t_ref_degc) / self.t_scale_degc
+        out = np.zeros_like(u)
+        for c in reversed(self.coefficients):
+            out = out * u + c
+        return out
+
+    def offset(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
+        return branch_position(temperature_degc, turns, self.transition_degc) * self.half_difference(temperature_degc)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"type": "branch", "coefficients_dps": list(self.coefficients), "t_ref_degc": self.t_ref_degc,
+                "t_scale_degc": self.t_scale_degc, "transition_degc": self.transition_degc,
+                "threshold_degc": self.threshold_degc, "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "BranchCurve":
+        curve = cls(tuple(float(v) for v in d["coefficients_dps"]), float(d["t_ref_degc"]),
+                    float(d["t_scale_degc"]), float(d["transition_degc"]), float(d["threshold_degc"]),
+                    float(d["t_min_degc"]), float(d["t_max_degc"]))
+        if not (curve.t_scale_degc > 0 and curve.transition_degc > 0 and curve.threshold_degc >= 0):
+            raise InputError("hysteresis: a branch model needs t_scale_degc and transition_degc above 0 and "
+                             "threshold_degc of 0 or more")
+        return curve
+
+
+#: the memory curves a model file may hold, by their ``type``: each gives ``offset(temperature, turns)``,
+#: ``threshold_degc``, ``order``, ``band_degc``, ``to_dict`` and ``from_dict``
+MEMORY_CURVES: dict[str, type] = {"turning-point": HysteresisCurve, "branch": BranchCurve}
+
+
+def memory_curve_from_dict(d: dict[str, Any]):
+    """The memory curve a model file's ``hysteresis`` entry describes (by its ``type``)."""
+    kind = MEMORY_CURVES.get(d.get("type")) if isinstance(d, dict) else None
+    if kind is None:
+        raise InputError(f"hysteresis: unknown model type {d.get('type') if isinstance(d, dict) else d!r}; "
+                         f"use one of {', '.join(MEMORY_CURVES)}")
+    return kind.from_dict(d)
+
+
+__all__ = ["BranchCurve", "HysteresisCurve", "MEMORY_CURVES", "heats_and_cools", "memory_curve_from_dict",
+           "parting_band_degc", "turn_threshold_degc"]
 
 
 def _grow(core: np.ndarray, tail: np.ndarray, start: int, step: int) -> int:

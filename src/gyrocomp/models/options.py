@@ -19,7 +19,7 @@ from .temperature import MAX_ORDER
 from .thermal import MAX_HYSTERESIS_ORDER
 
 #: the thermal memory on top of the temperature curve
-Memory = Literal["auto", "none", "turning-point", "lag", "turning-point+lag"]
+Memory = Literal["auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag"]
 #: the g-sensitivity fit (``auto``: the 3x3 matrix when the runs turn between positions)
 Acceleration = Literal["auto", "none", "matrix", "matrix2"]
 #: what the model choice holds out

@@ -37,7 +37,10 @@ from .temperature import MAX_ORDER, PolynomialBias
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
 from .options import Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial
-from .thermal import CANDIDATES, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+from .thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+
+#: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
+BRANCH_ORDERS = tuple(range(1, MAX_BRANCH_ORDER + 1))
 from ..threads import single_threaded_blas
 
 #: how the fit report names each kind of fold
@@ -112,7 +115,8 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     for k, axis in enumerate(fit_axes(recordings)):
         problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
                                fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders,
-                               both_directions="none" in memories)
+                               both_directions="none" in memories,
+                               branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else ())
         if acceleration != "none":
             if any(r.accel_g is None for r in problem.runs):
                 raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a "
@@ -200,6 +204,7 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
                                      weighting={a: c.weighting for a, c in chosen.items()},
                                      band_degc={a: selections[a].band_degc if c.band else None
                                                 for a, c in chosen.items()},
+                                     branch_order={a: c.branch for a, c in chosen.items()},
                                      bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
                                      static_min_duration_s=options.static_min_duration_s,
                                      refine_band=True).fit(recordings)

@@ -30,19 +30,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..effects import find_turns, g_squared_products, thermal_lag
+from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError
 from ..fit_report import memory_name
 from ..recording import Recording
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from ..prepared import PreparedRun, RunBlocks, fit_axes
 from .base import LearnedAttributes, bin_width_for, one_temperature_column
-from .hysteresis import HysteresisCurve, parting_band_degc, turn_threshold_degc
+from .hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .polynomial_fit import simplest_within
 from .temperature import PolynomialBias
 
-HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag")
-CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag")
+HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+#: terms of the difference between the heating and the cooling curve (a constant, then a slope)
+MAX_BRANCH_ORDER = 2
+#: crossover widths tried for a branch model [degC] (refined: see _Problem.best_width)
+BRANCH_WIDTHS_DEGC = tuple(float(w) for w in np.geomspace(1.0, 40.0, 9))
 MAX_HYSTERESIS_ORDER = 3
 #: bounds of the thermal time constant search [s]
 LAG_MIN_BLOCKS = 2.0
@@ -68,15 +72,18 @@ def best_lag_s(rss: Callable[[float], float], lo_s: float, hi_s: float = LAG_MAX
 
 @dataclass(frozen=True)
 class _Spec:
-    """One candidate: polynomial order, thermal lag on/off, hysteresis order (0 = none)."""
+    """One candidate: polynomial order, thermal lag on/off, hysteresis order (0 = none), branch terms (0 = none)
+    and the branch crossover width [degC] (0: to be found)."""
 
     order: int
     lag: bool
     hysteresis_order: int
+    branch: int = 0
+    width_degc: float = 0.0
 
     @property
     def name(self) -> str:
-        return memory_name(self.lag, self.hysteresis_order)
+        return memory_name(self.lag, self.hysteresis_order, self.branch)
 
 
 @dataclass
@@ -109,6 +116,9 @@ class _Problem:
             for sign in (-1, 1):
                 on = active & (turns.direction == sign)
                 cols += [np.where(on, d ** j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
+        if spec.branch:
+            position = branch_position(temp, find_turns(temp, self.threshold), spec.width_degc)
+            cols += [position * u ** k for k in range(spec.branch)]
         if self.accel_cols:
             cols += [run.accel_g[:, j] for j in self.accel_cols]
         if self.square_cols:
@@ -158,13 +168,25 @@ class _Problem:
         rss = float(np.sum(w * (y - x @ coef) ** 2))
         return coef[len(which):], coef[: len(which)], rss, t_range
 
+    def best_width(self, spec: _Spec, tau: float, which: list[int]) -> _Spec:
+        """``spec`` with the branch crossover width [degC] of :data:`BRANCH_WIDTHS_DEGC` that leaves the least
+        weighted residual at lag ``tau`` [s] (``spec`` itself without branches or with a width set)."""
+        if not spec.branch or spec.width_degc > 0:
+            return spec
+        return min((dataclasses.replace(spec, width_degc=w) for w in BRANCH_WIDTHS_DEGC),
+                   key=lambda s: self.solve(s, tau, which)[2])
+
     def fit(self, spec: _Spec, which: list[int], tau_s: float | None = None):
-        """Best tau for the spec (0 without lag; ``tau_s`` when given) and the solution there."""
+        """Best tau for the spec (0 without lag; ``tau_s`` when given) and the solution there; a branch model's
+        crossover width is found at each tau tried. Returns (tau, solution, spec with its width)."""
         if not spec.lag:
-            return 0.0, self.solve(spec, 0.0, which)
+            spec = self.best_width(spec, 0.0, which)
+            return 0.0, self.solve(spec, 0.0, which), spec
         if tau_s is None:
-            tau_s = best_lag_s(lambda tau: self.solve(spec, tau, which)[2], LAG_MIN_BLOCKS * self.block_s)
-        return tau_s, self.solve(spec, tau_s, which)
+            tau_s = best_lag_s(lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2],
+                               LAG_MIN_BLOCKS * self.block_s)
+        spec = self.best_width(spec, tau_s, which)
+        return tau_s, self.solve(spec, tau_s, which), spec
 
     def refine_band(self, spec: _Spec, tau_s: float, step_degc: float) -> None:
         """Move each edge of the band [degC] to where the all-run weighted residual is least, on a grid of
@@ -191,7 +213,7 @@ class _Problem:
         axis's own best tau), so that axes with different noise weigh the same in a shared lag."""
         which = list(range(len(self.runs)))
         own = self.fit(spec, which)[1][2]
-        return lambda tau: self.solve(spec, tau, which)[2] / max(own, 1e-300)
+        return lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2] / max(own, 1e-300)
 
     def held_out_error(self, spec: _Spec) -> float:
         """RMS [deg/s] of each run predicted by a fit on the others, its constant refitted."""
@@ -199,9 +221,9 @@ class _Problem:
         n = len(self.runs)
         for held in range(n):
             train = [r for r in range(n) if r != held]
-            tau, (coef, _, _, (t_lo, t_hi)) = self.fit(spec, train)
+            tau, (coef, _, _, (t_lo, t_hi)), fitted = self.fit(spec, train)
             run = self.runs[held]
-            x = self.features(run, self.model_temperature(run, spec, tau), spec, t_lo, t_hi)
+            x = self.features(run, self.model_temperature(run, spec, tau), fitted, t_lo, t_hi)
             e = run.value - x @ coef
             e -= np.sum(run.weight * e) / np.sum(run.weight)
             w = max(1, min(e.size, int(round(SCORE_WINDOW_S / self.block_s))))
@@ -254,7 +276,7 @@ class _Problem:
         return coef, bread @ meat @ bread
 
     def bic(self, spec: _Spec) -> float:
-        _, (coef, consts, rss, _) = self.fit(spec, list(range(len(self.runs))))
+        _, (coef, consts, rss, _), _ = self.fit(spec, list(range(len(self.runs))))
         n = sum(r.value.size for r in self.runs)
         w = sum(float(np.sum(r.weight)) for r in self.runs)
         k = coef.size + consts.size + (1 if spec.lag else 0)
@@ -309,6 +331,9 @@ class ThermalHysteresisModel(LearnedAttributes):
     shared_lag : bool
         Axes that read one temperature column and all have lag get one time constant, fitted on all of them
         together (the lag is the die's, behind one sensor); False fits one per axis.
+    branch_order : int or dict
+        Terms of the difference between the heating and the cooling curve of a branch model (1: a constant,
+        2: and a slope), or one per axis.
     refine_band : bool
         ``band_degc`` was found on temperature bins (:func:`~gyrocomp.models.hysteresis.parting_band_degc`): move
         its edges, within one bin, to where the residual is least, then fit the lag again.
@@ -352,6 +377,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     weighting: str | dict[str, str] = "temperature-balanced"
     shared_lag: bool = True
     refine_band: bool = False
+    branch_order: int | dict[str, int] = MAX_BRANCH_ORDER
 
     @staticmethod
     def _of(value, axis: str):
@@ -362,7 +388,9 @@ class ThermalHysteresisModel(LearnedAttributes):
         return list(CANDIDATES) if mode == "auto" else [mode]
 
     def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "") -> _Spec:
-        lag = name in ("lag", "turning-point+lag")
+        lag = name in ("lag", "turning-point+lag", "branch+lag")
+        if "branch" in name:
+            return _Spec(order, lag, 0, int(self._of(self.branch_order, axis)))
         if "turning-point" not in name:
             return _Spec(order, lag, 0)
         fixed = self._of(self.hysteresis_order, axis)
@@ -496,7 +524,7 @@ class ThermalHysteresisModel(LearnedAttributes):
             temps = np.concatenate([r.temperature_degc for r in problem.runs])
             problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0],
                                 max(1.0, float(np.ptp(temps)) / 40.0))
-        tau, (coef, consts, _, (t_lo, t_hi)) = problem.fit(spec, list(range(n_runs)), tau_s)
+        tau, (coef, consts, _, (t_lo, t_hi)), spec = problem.fit(spec, list(range(n_runs)), tau_s)
         shape = coef[: spec.order]
         self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,
                                             t_lo, t_hi)
@@ -506,9 +534,14 @@ class ThermalHysteresisModel(LearnedAttributes):
             tuple(float(v) for v in coef[spec.order: spec.order + p]),
             tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), problem.threshold, problem.band,
             problem.branch_reach(spec, tau))
+        if spec.branch:
+            start = spec.order + 2 * p
+            self.hysteresis_[axis] = BranchCurve(tuple(float(v) for v in coef[start: start + spec.branch]),
+                                                 problem.t_ref, problem.t_scale, spec.width_degc, problem.threshold,
+                                                 t_lo, t_hi)
         self.bands_[axis] = problem.band
         self.turn_on_biases_[axis] = consts
-        self.memories_[axis] = (choice.name, p)
+        self.memories_[axis] = (choice.name, spec.branch or p)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
             self._store_acceleration(axis, problem, spec, tau, coef, n_runs)
@@ -529,7 +562,7 @@ class ThermalHysteresisModel(LearnedAttributes):
 
     def _store_acceleration(self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray,
                             n_runs: int) -> None:
-        start = spec.order + 2 * spec.hysteresis_order
+        start = spec.order + 2 * spec.hysteresis_order + spec.branch
         full, cov = problem.covariance(spec, tau)
         se_all = np.sqrt(np.maximum(np.diag(cov), 0.0))[n_runs:]
         g, g_se = np.zeros(3), np.full(3, np.nan)

@@ -103,9 +103,7 @@ def _describe(ax) -> str:
     if ax.lag_time_constant_s > 0:
         text += f", thermal lag {ax.lag_time_constant_s:.3g} s"
     if ax.hysteresis is not None:
-        band = "" if ax.hysteresis.band_degc is None else \
-            f" in {ax.hysteresis.band_degc[0]:g}..{ax.hysteresis.band_degc[1]:g} degC"
-        text += f", turning-point hysteresis order {ax.hysteresis.order}{band}"
+        text += f", {ax.hysteresis.describe()}"
     if ax.has_acceleration_stage:
         text += ", g-sensitivity"
     return text

@@ -34,7 +34,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..effects import HYSTERESIS_DIRECTIONS, find_turns, g_sensitivity_offset, hysteresis_offset, thermal_lag
+from ..effects import HYSTERESIS_DIRECTIONS, branch_position, find_turns, g_sensitivity_offset, hysteresis_offset, thermal_lag
 from ..errors import InputError
 from ..recording import GYRO_AXES
 from ..units import DEG_PER_S_TO_DEG_PER_H
@@ -63,12 +63,18 @@ class Hysteresis:
         A bump instead of the polynomial: per axis h_1 (1 - exp(-8 d / F)) (1 - d / F)^2 for d < F, zero beyond
         (F = ``fade_degc``): it starts at the turning point, peaks about F / 5 after it and fades out smoothly over
         F degrees; only h_1 [deg/s] of each axis is read. A shape the turning-point polynomial only approximates.
+    transition_degc : float, optional
+        Heating and cooling branches instead: per axis the half difference between the heating and the cooling
+        curve, sum_k h_k (T_s - T_ref)^k with k from 0 [deg/s/degC^k], times the branch position
+        (:func:`gyrocomp.effects.branch_position`, crossing over within about ``transition_degc`` after each
+        turn); ``direction`` and ``band_degc`` are not read.
     """
 
     coefficients_dps: tuple[tuple[float, ...], ...]
     direction: str = "descending"
     band_degc: tuple[float, float] | None = None
     fade_degc: float | None = None
+    transition_degc: float | None = None
 
     def __post_init__(self) -> None:
         if self.direction not in HYSTERESIS_DIRECTIONS:
@@ -77,6 +83,8 @@ class Hysteresis:
             raise InputError(f"hysteresis band_degc: {self.band_degc}; give (low, high) with low < high")
         if self.fade_degc is not None and not 0 < self.fade_degc < math.inf:
             raise InputError(f"hysteresis fade_degc: must be positive and finite, got {self.fade_degc}")
+        if self.transition_degc is not None and not 0 < self.transition_degc < math.inf:
+            raise InputError(f"hysteresis transition_degc: must be positive and finite, got {self.transition_degc}")
 
     def offset_dps(self, d_degc: np.ndarray, coefficients_dps: tuple[float, ...]) -> np.ndarray:
         """The offset at distance ``d_degc`` from the turning point [degC] on a branch that carries it [deg/s]."""
@@ -255,6 +263,11 @@ class GyroErrorModel:
             return np.zeros((n, k))
         turns = find_turns(structure_degc, TURN_THRESHOLD_DEGC)
         h = self.hysteresis
+        if h.transition_degc is not None:  # heating and cooling branches
+            position = branch_position(structure_degc, turns, h.transition_degc)
+            dt = structure_degc - self.t_ref_degc
+            return np.column_stack([position * sum(c * dt ** k for k, c in enumerate(coefs))
+                                    for coefs in h.coefficients_dps])
         # the distance from the turning point on the branches that carry the offset (zero elsewhere), then its shape
         d = hysteresis_offset(structure_degc, turns, (1.0,), direction=h.direction, band_degc=h.band_degc)
         return np.column_stack([np.where(d > 0, h.offset_dps(d, c), 0.0) for c in h.coefficients_dps])
