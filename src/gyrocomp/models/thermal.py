@@ -96,11 +96,17 @@ class _Problem:
     block_s: float
     accel_cols: tuple[int, ...] = ()
     square_cols: tuple[int, ...] = ()
+    _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
 
     def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
-        if spec.lag and tau > 0:
-            return thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
-        return run.temperature_degc
+        """The temperature the model reads [degC]: reported, or through the lag ``tau`` [s] (kept per run and tau:
+        the searches over the lag, the band and the branch width ask for the same ones again)."""
+        if not (spec.lag and tau > 0):
+            return run.temperature_degc
+        key = (id(run), float(tau))
+        if key not in self._lagged:
+            self._lagged[key] = thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
+        return self._lagged[key]
 
     def features(self, run: RunBlocks, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
         """Columns of the shape and the hysteresis at model temperature ``temp``, then of the g and g x g
@@ -212,8 +218,8 @@ class _Problem:
         """The all-run residual sum of squares as a function of tau [s], divided by its minimum (1 at the
         axis's own best tau), so that axes with different noise weigh the same in a shared lag."""
         which = list(range(len(self.runs)))
-        own = self.fit(spec, which)[1][2]
-        return lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2] / max(own, 1e-300)
+        _, (_, _, own, _), spec = self.fit(spec, which)  # a branch model's width: the one at its own best lag
+        return lambda tau: self.solve(spec, tau, which)[2] / max(own, 1e-300)
 
     def held_out_error(self, spec: _Spec) -> float:
         """RMS [deg/s] of each run predicted by a fit on the others, its constant refitted."""
