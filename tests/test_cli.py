@@ -621,3 +621,22 @@ def test_fit_and_evaluate_state_the_drift_to_expect_from_one_run(tmp_path):
         sel = model[e["axis"]]
         assert e["drift_dps"] == sel["chosen_drift_dps"] and e["standard_error_dps"] == sel["chosen_standard_error_dps"]
         assert e["fold_kind"] == "legs" and e["folds"] == 4 and not e["thin"]
+
+
+@pytest.mark.parametrize("args, message", [
+    (("simulate", "--rate", "inf", "-o", "x.csv"), "Invalid value for '--rate': inf is not a finite number"),
+    (("simulate", "--rate", "nan", "-o", "x.csv"), "Invalid value for '--rate': nan is not a finite number"),
+    (("simulate", "--set-points", "10,inf", "-o", "x.csv"), "Invalid value for --set-points: '10,inf': give finite"),
+    (("simulate", "--duration", "1e999", "-o", "x.csv"), "Invalid value for '--duration': inf is not a finite number"),
+])
+def test_number_options_are_finite_or_refused_in_one_line(tmp_path, args, message):
+    r = run(*args, cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and message in r.stderr
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_window_inf_and_learn_rate_0_are_refused(workdir, tmp_path):
+    r = run("evaluate", workdir / "model.json", workdir / "run3.csv", "--window", "inf")
+    assert r.returncode == 2 and "Invalid value for '--window': inf is not a finite number" in r.stderr
+    r = run("learn", workdir / "run1.csv", "--rate", "0", "-o", tmp_path / "m.json")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--rate: must be positive, got 0" in r.stderr

@@ -9,14 +9,14 @@ import click
 from ..calibration import Calibration
 from ..compensate import apply as apply_calibration, apply_file, compensated_axes
 from ..io import TABLE_FORMATS, detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
-from .common import pop_read_options, progress_bar, read_run, read_options, read_settings
+from .common import FINITE, pop_read_options, progress_bar, read_run, read_options, read_settings
 
 
 @click.command()
 @click.argument("model", type=click.Path())
 @click.argument("input_path", metavar="IN", type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Compensated output file.")
-@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate the turn-on bias from the first S seconds of IN [s] (default: the model's mean).")
 @click.option("--axes", "axes", default=None, metavar="AXES",
               help="Gyro axes to compensate, e.g. gyro_z (default: all; data with an axis the model lacks is "

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import contextlib
 import sys
 from pathlib import Path
@@ -156,6 +158,27 @@ def parse_channels(text: str) -> tuple[str, ...]:
     return check_channels(items)
 
 
+class FiniteFloat(click.ParamType):
+    """A number option: finite (``inf`` and ``nan`` are refused in one line naming the option), printed short."""
+
+    name = "number"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float) and math.isfinite(value):
+            return value
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{str(value)[:40]!r} is not a number", param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{number} is not a finite number", param, ctx)
+        return number
+
+
+#: the type of every number option
+FINITE = FiniteFloat()
+
+
 def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     if text is None:
         return None
@@ -165,7 +188,9 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
         values = ()
     if not values:
         raise click.BadParameter("give comma-separated numbers, e.g. -20,70", param_hint=option)
+    if not all(math.isfinite(v) for v in values):
+        raise click.BadParameter(f"{text[:40]!r}: give finite numbers", param_hint=option)
     return values
 
 
-__all__ = ["READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "pop_read_options", "parse_instance", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]
+__all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "pop_read_options", "parse_instance", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]

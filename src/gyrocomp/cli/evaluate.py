@@ -18,7 +18,7 @@ from ..metrics import Evaluation
 from ..comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
-from .common import float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
 
 
@@ -32,9 +32,9 @@ def _nan_none(value):
 
 @click.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path(), metavar="MODEL RUNS... | --compare RUNS...")
-@click.option("--window", "window_s", type=float, default=None,
+@click.option("--window", "window_s", type=FINITE, default=None,
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
-@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate each run's turn-on bias from its first S seconds [s].")
 @click.option("--compare", is_flag=True,
               help="The thesis's comparison on RUNS: raw, polynomial, network, each with and without hysteresis "

@@ -9,6 +9,7 @@ from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.autopilot import ardupilot_params_file, px4_params_file
 from ..export.c_code import write_c_sources
 from ..models.online import LearnerSettings, OnlineCalibrator
+from .common import FINITE
 
 
 EXPORT_FORMATS = ("px4", "ardupilot", "c")
@@ -20,7 +21,7 @@ EXPORT_FORMATS = ("px4", "ardupilot", "c")
               help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters), "
                    "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o, with the online learner beside them: gyrocomp_learn.h, gyrocomp_learn.c).")
 @click.option("-o", "--output", required=True, type=click.Path(), help="Parameter file to write (c: a folder).")
-@click.option("--rate", "rate_hz", type=float, default=None,
+@click.option("--rate", "rate_hz", type=FINITE, default=None,
               help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")
 @click.option("--instance", type=int, default=None, help="Sensor instance: PX4 gyro 0..3 (default 0), ArduPilot IMU 1..3 "
                                                        "(default 1).")

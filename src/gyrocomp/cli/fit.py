@@ -17,8 +17,8 @@ from ..models.options import FitOptions
 from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels
 from ..models.selection import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
-from .common import (float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar, read_options,
-                     read_run)
+from .common import (FINITE, float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar,
+                     read_options, read_run)
 from .render import print_contributions, print_fit
 
 
@@ -30,7 +30,7 @@ from .render import print_contributions, print_fit
                    "Levenberg-Marquardt), mlp:H (H hidden neurons) or none.")
 @click.option("--seed", "mlp_seed", type=int, default=0, show_default=True,
               help="Seed of the network's initializations (mlp); the same seed gives the same model.")
-@click.option("--bin-width", "bin_width_degc", type=float, default=None, help="Temperature bin width [degC] (default: span/100).")
+@click.option("--bin-width", "bin_width_degc", type=FINITE, default=None, help="Temperature bin width [degC] (default: span/100).")
 @click.option("--hysteresis", type=click.Choice(HYSTERESIS_CHOICES), default="auto", show_default=True,
               help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
                    "when the runs both heat and cool.")
@@ -45,7 +45,7 @@ from .render import print_contributions, print_fit
               help="joint (temperature, lag/hysteresis, G and run constants in one fit), or a cascade fitted stage by "
                    "stage: 'poly>matrix', 'matrix>poly', 'mlp>matrix', or 'joint-mlp' (one network reading the "
                    "temperature and the three accelerations). Quote the > in a shell.")
-@click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
+@click.option("--min-static", "static_min_duration_s", type=FINITE, default=10.0, show_default=True,
               help="Shortest still stretch used as a static position [s].")
 @click.option("--channels", default="gyro", show_default=True,
               help="What to model: gyro, accel (the accelerometer's bias against temperature, in g) or gyro,accel "

@@ -16,7 +16,7 @@ from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.fleet import build_fleet_report
 from . import in_cli_words
-from .common import make_console, parse_channels, pop_read_options, progress_bar, read_options, read_settings
+from .common import FINITE, make_console, parse_channels, pop_read_options, progress_bar, read_options, read_settings
 from .export import EXPORT_FORMATS, write_export
 
 #: failures and outliers listed after a fleet fit (the fleet table has them all)
@@ -227,7 +227,7 @@ def report(ctx, store, output, limits_file):
               help="px4, ardupilot, c (a folder) or json (the model file).")
 @click.option("-o", "--output", required=True, type=click.Path(), help="File (c: folder) to write.")
 @click.option("--at", "at", default=None, metavar="DATE", help="Export the calibration valid at this date or time.")
-@click.option("--rate", "rate_hz", type=float, default=None, help="c: the sample rate the code will run at [Hz].")
+@click.option("--rate", "rate_hz", type=FINITE, default=None, help="c: the sample rate the code will run at [Hz].")
 @click.option("--instance", type=int, default=None, help="As gyrocomp export.")
 @click.option("--device-id", type=int, default=None, help="PX4: the gyro's device id (default: the model's).")
 @click.option("--accel-device-id", type=int, default=None, help="PX4: the accelerometer's device id.")

@@ -11,7 +11,7 @@ from ..io import refuse_to_overwrite_inputs
 from ..io.atomic import write_texts_atomic
 from ..io.files import expand_runs
 from ..models.online import GYRO_AXES, LearnerSettings, OnlineCalibrator, replay
-from .common import pop_read_options, read_options, read_run
+from .common import FINITE, pop_read_options, read_options, read_run
 from .render import print_learner
 
 
@@ -25,9 +25,9 @@ from .render import print_learner
               help="Write the learner's whole state here (JSON), to go on later with --resume.")
 @click.option("--degree", type=click.Choice(["1", "2", "3"]), default="3", show_default=True,
               help="Highest degree of the temperature curve (used once the still data span enough).")
-@click.option("--bin-width", "bin_width_degc", type=float, default=1.0, show_default=True,
+@click.option("--bin-width", "bin_width_degc", type=FINITE, default=1.0, show_default=True,
               help="Temperature bin of the learner's points [degC].")
-@click.option("--rate", "rate_hz", type=float, default=None,
+@click.option("--rate", "rate_hz", type=FINITE, default=None,
               help="Nominal sample rate [Hz] (default: the first log's; with --resume, the state's).")
 @read_options
 @click.pass_context
@@ -51,7 +51,7 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, rate_hz
             raise InputError(f"--rate {rate_hz:g}: the resumed learner runs at {learner.settings.rate_hz:g} Hz")
     else:
         first = next(recordings)
-        settings = LearnerSettings(rate_hz=rate_hz or first.rate_hz, degree=int(degree),
+        settings = LearnerSettings(rate_hz=first.rate_hz if rate_hz is None else rate_hz, degree=int(degree),
                                    bin_width_degc=bin_width_degc)
         learner = OnlineCalibrator(settings)
         recordings = itertools.chain([first], recordings)

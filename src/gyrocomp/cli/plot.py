@@ -15,7 +15,7 @@ from ..metrics import default_window_s
 from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
 from ..noise import analyse_noise
 from ..report.figures import check_figure_path
-from .common import pop_read_options, read_run, read_options
+from .common import FINITE, pop_read_options, read_run, read_options
 
 
 @click.group()
@@ -104,9 +104,9 @@ def plot_temperature(ctx, model, runs, axis, output, **kwargs):
 @click.argument("model", type=click.Path())
 @click.argument("run", type=click.Path())
 @click.option("--axis", default=None, help="The axis to draw (default: the model's first).")
-@click.option("--window", "window_s", type=float, default=None,
+@click.option("--window", "window_s", type=FINITE, default=None,
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
-@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate the run's turn-on bias from its first S seconds [s].")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
 @read_options

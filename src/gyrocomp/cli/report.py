@@ -9,18 +9,18 @@ from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.figures import require_matplotlib
 from ..report.html import build_report
 from ..validation import validate as validate_runs
-from .common import pop_read_options, read_run, progress_bar, read_options
+from .common import FINITE, pop_read_options, read_run, progress_bar, read_options
 
 
 @click.command()
 @click.argument("model", type=click.Path())
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="The HTML file to write.")
-@click.option("--window", "window_s", type=float, default=None,
+@click.option("--window", "window_s", type=FINITE, default=None,
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
-@click.option("--turn-on-window", "turn_on_window_s", type=float, default=None,
+@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate each run's turn-on bias from its first S seconds [s].")
-@click.option("--min-static", "static_min_duration_s", type=float, default=10.0, show_default=True,
+@click.option("--min-static", "static_min_duration_s", type=FINITE, default=10.0, show_default=True,
               help="Shortest still stretch drawn as a static position [s].")
 @click.option("--validate-on", "validate_on", multiple=True, type=click.Path(),
               help="A calibration run to validate on (repeat it for each run): adds the table of gyrocomp validate.")

@@ -12,7 +12,7 @@ from ..errors import InputError
 from ..io import output_format, write_recording, write_text_atomic
 from ..simulate import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles, truth_document
 from ..simulate import simulate as run_simulation
-from .common import float_list
+from .common import FINITE, float_list
 
 
 @click.command()
@@ -20,9 +20,9 @@ from .common import float_list
               help="Sensor: adxrs450, mti10, adis16488 or consumer (values from datasheets; see the docs).")
 @click.option("--profile", default="chamber", show_default=True,
               help="static, warmup, chamber, cycle, tumble, combined or ratetable.")
-@click.option("--duration", "duration_s", type=float, default=None,
+@click.option("--duration", "duration_s", type=FINITE, default=None,
               help="Run length [s] (default: the profile's own; a set duration stretches the profile).")
-@click.option("--rate", "rate_hz", type=float, default=100.0, show_default=True, help="Sample rate [Hz].")
+@click.option("--rate", "rate_hz", type=FINITE, default=100.0, show_default=True, help="Sample rate [Hz].")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of run 0; run i uses seed + i.")
 @click.option("--runs", type=int, default=1, show_default=True,
               help="Write K power-ons (own turn-on bias and noise) as OUT_0.csv ... OUT_{K-1}.csv.")
@@ -34,10 +34,10 @@ from .common import float_list
 @click.option("--set-points", "set_points", default=None, metavar="T1,T2,...",
               help="Chamber set points [degC] (default: the preset's range); static, tumble and ratetable: one run "
                    "per set point.")
-@click.option("--ramp-rate", "ramp_rate", type=float, default=None, help="Ramp rate between set points [degC/min].")
-@click.option("--dwell", "dwell_s", type=float, default=None, help="Time held at each set point [s].")
+@click.option("--ramp-rate", "ramp_rate", type=FINITE, default=None, help="Ramp rate between set points [degC/min].")
+@click.option("--dwell", "dwell_s", type=FINITE, default=None, help="Time held at each set point [s].")
 @click.option("--cycles", type=int, default=None, help="Cold-hot-cold repetitions of the cycle profile.")
-@click.option("--position-time", "position_s", type=float, default=None,
+@click.option("--position-time", "position_s", type=FINITE, default=None,
               help="Time at each tumble position or rate-table rate [s].")
 @click.option("--rates", "rates", default=None, metavar="R1,R2,...",
               help="ratetable: rates applied about each axis in turn [deg/s], e.g. 100,-100,300,-300 (the file gets "

@@ -9,7 +9,7 @@ import click
 from ..models.options import FitOptions
 from ..models.selection import FOLD_KINDS
 from ..validation import validate as validate_runs
-from .common import pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
+from .common import FINITE, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
 from .render import print_validation
 
 
@@ -18,7 +18,7 @@ from .render import print_validation
 @click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
               help="Hold out each run, each heating or cooling leg, or time blocks; auto: runs with three runs "
                    "or more, else legs.")
-@click.option("--window", "window_s", type=float, default=None,
+@click.option("--window", "window_s", type=FINITE, default=None,
               help="Moving-average window of the drift [s] (default: a tenth of the median fold, 60..600 s).")
 @click.option("--candidate", "candidates", multiple=True, metavar="SPEC",
               help="Also validate gyrocomp fitted with --temperature SPEC (poly:N, poly, mlp); repeatable.")
