@@ -792,23 +792,31 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     folds = make_folds(runs, groups, thresholds, fold_kind)
     step = max(temperature_step_degc(t) for t in temps)
     reverses = (branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds))
-    # branches of one direction only, held out by legs of the same runs: an unbounded turning-point term is a
-    # change of slope that the legs confirm but other runs need not share (measured on the CATS recording: fitted
-    # on two runs, it doubled the third run's drift); one confined to a band where the branches visibly part (the
-    # thesis's form) is offered
+    t_ref, t_scale = (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0
+    band, band_only = _band_offer(runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order),
+                                  block_s, both_directions) if reverses and hysteresis_orders else (None, False)
+    return SelectionProblem(runs, groups, folds, t_ref, t_scale, max(thresholds), block_s,
+                            window_for(folds, runs, block_s), max_order, hysteresis_orders if reverses else (),
+                            accel_cols, square_cols, step, band, unit=recordings[0].unit_of(axis), band_only=band_only,
+                            branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else ())
+
+
+def _band_offer(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], folds: Folds, t_ref: float,
+                t_scale: float, order: int, block_s: float, both_directions: bool):
+    """(band, band only): the band where the branches part [degC] or None, and whether turning-point candidates
+    are offered only inside it.
+
+    Branches of one direction only, held out by legs of the same runs: an unbounded turning-point term is a change
+    of slope that the legs confirm but other runs need not share (measured on the CATS recording: fitted on two
+    runs, it doubled the third run's drift); one confined to a band where the branches visibly part (the thesis's
+    form) is offered. The band is found once on all the runs, so its candidates' scores are somewhat optimistic;
+    it must stand out by three standard errors per bin (:func:`parting_band_degc`). It is found through a fitted
+    lag only with one or two runs, where that is what finds it (the ADXRS450 case); with whole runs held out, it
+    moved the choice of the demo's MTi-10-class part to a worse gyro_y (measured: 0.0067 against 0.0019 deg/s)."""
     band_only = both_directions and folds.kind != "runs" and not branches_identified(runs, thresholds,
                                                                                      one_sided=False)
-    # the band is found once on all the runs, so its candidates' scores are somewhat optimistic; the band must
-    # stand out by three standard errors per bin (parting_band_degc) for any to be offered. Through a fitted lag
-    # only with one or two runs, where it is what finds the band (the ADXRS450 case); with whole runs held out,
-    # it moved the choice of the demo's MTi-10-class part to a worse gyro_y (measured: 0.0067 against 0.0019 deg/s)
-    band = observed_band(runs, groups, thresholds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0,
-                         min(BAND_ORDER, max_order), block_s if folds.kind != "runs" else None) if reverses and hysteresis_orders else None
-    return SelectionProblem(runs, groups, folds, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, max(thresholds),
-                            block_s, window_for(folds, runs, block_s), max_order,
-                            hysteresis_orders if reverses else (), accel_cols, square_cols, step, band,
-                            unit=recordings[0].unit_of(axis), band_only=band_only,
-                            branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else ())
+    band = observed_band(runs, groups, thresholds, t_ref, t_scale, order, block_s if folds.kind != "runs" else None)
+    return band, band_only
 
 
 def heats_and_cools_blocks(runs: list[RunBlocks], thresholds: list[float]) -> bool:
