@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from gyrocomp import Compensator, apply
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulate import GyroErrorModel, simulate
@@ -58,6 +59,23 @@ TEST_MODEL = GyroErrorModel(bias_instability_deg_per_h=5.0)
 def chamber_runs():
     """Seven 1-hour chamber runs at 20 Hz of TEST_MODEL (seeds 0..6), each with its own turn-on bias."""
     return [simulate(TEST_MODEL, profile="chamber", duration_s=3600, rate_hz=20, seed=s) for s in range(7)]
+
+
+def assert_streaming_equals_batch(calibration, recording, cuts: list[int]) -> None:
+    """Compensate ``recording`` in chunks of the lengths ``cuts`` (the rest in one) through a Compensator and
+    check the output equals ``apply`` on the whole recording to 1e-12 [deg/s]."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        batch = apply(calibration, recording).gyro_dps
+        comp = Compensator(calibration, recording.gyro_axes, rate_hz=recording.rate_hz)
+        parts, start = [], 0
+        for c in list(cuts) + [recording.n_samples]:
+            stop = min(start + c, recording.n_samples)
+            if stop > start:
+                parts.append(comp.update(recording.time_s[start:stop], recording.gyro_dps[start:stop],
+                                         recording.temperature_degc[start:stop]))
+            start = stop
+    np.testing.assert_allclose(np.concatenate(parts), batch, rtol=0, atol=1e-12)
 
 
 #: the console script of this environment, run as a user would

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import Calibration, Compensator, apply
+from gyrocomp import Calibration, apply
 from gyrocomp.effects import branch_position, find_turns
 from gyrocomp.errors import InputError
 from gyrocomp.metrics import smoothed_residual_rms
@@ -17,6 +17,8 @@ from gyrocomp.models.hysteresis import BranchCurve, memory_curve_from_dict
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.validation import fit_plain_cubic
+
+from ..conftest import assert_streaming_equals_batch
 
 RATE_HZ = 2.0
 #: the half difference between the heating and the cooling curve: 0.03 deg/s at 25 degC, 0.0008 deg/s/degC more
@@ -74,19 +76,7 @@ def test_the_default_finds_the_branches_and_they_hold_on_a_held_out_run(two_runs
 @given(st.lists(st.integers(min_value=1, max_value=4000), min_size=1, max_size=10))
 def test_streaming_equals_batch(two_runs, cuts):
     cal, _, held = two_runs
-    rec = held.recording
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        batch = apply(cal, rec).gyro_dps
-        comp = Compensator(cal, rec.gyro_axes, rate_hz=rec.rate_hz)
-        parts, start = [], 0
-        for c in cuts + [rec.n_samples]:
-            stop = min(start + c, rec.n_samples)
-            if stop > start:
-                parts.append(comp.update(rec.time_s[start:stop], rec.gyro_dps[start:stop],
-                                         rec.temperature_degc[start:stop]))
-            start = stop
-    np.testing.assert_allclose(np.concatenate(parts), batch, rtol=0, atol=1e-12)
+    assert_streaming_equals_batch(cal, held.recording, cuts)
 
 
 def test_model_file_round_trip_and_validation(two_runs, tmp_path):

@@ -16,6 +16,8 @@ from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.thermal import ThermalHysteresisModel
 from gyrocomp.simulate import Hysteresis, get_profile, preset_model, simulate
 
+from ..conftest import assert_streaming_equals_batch
+
 RANGE = (-30.0, 80.0)
 WINDOW_S = 60.0
 
@@ -82,19 +84,7 @@ def test_turning_point_hysteresis_alone():
 @given(st.lists(st.integers(min_value=1, max_value=5000), min_size=1, max_size=12))
 def test_streaming_equals_batch_with_lag_and_hysteresis(both_effects, cuts):
     cal, held, _, _ = both_effects
-    rec = held.recording
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        batch = apply(cal, rec).gyro_dps
-        comp = Compensator(cal, rec.gyro_axes, rate_hz=rec.rate_hz)
-        parts, start = [], 0
-        for c in cuts + [rec.n_samples]:
-            stop = min(start + c, rec.n_samples)
-            if stop > start:
-                parts.append(comp.update(rec.time_s[start:stop], rec.gyro_dps[start:stop],
-                                         rec.temperature_degc[start:stop]))
-            start = stop
-    np.testing.assert_allclose(np.concatenate(parts), batch, rtol=0, atol=1e-12)
+    assert_streaming_equals_batch(cal, held.recording, cuts)
 
 
 def test_model_file_round_trip_keeps_lag_and_hysteresis(both_effects, tmp_path):
