@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import dataclasses
 import io
 import os
 import pty
@@ -204,3 +205,14 @@ def test_package_imports_and_cli_answers_without_matplotlib(cli_files, tmp_path)
     assert done.stderr.strip() == ("gyrocomp: error: plots need the optional package matplotlib; install it with: "
                                    "pip install 'gyrocomp[plot]'")
     assert not (tmp_path / "r.html").exists()
+
+
+def test_text_from_files_is_escaped_once():
+    prof = get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1)
+    runs = [simulate("adxrs450", profile=prof, rate_hz=0.5, seed=s).recording for s in range(3)]
+    cal = _quiet(fit_calibration, runs[:2], hysteresis="none")
+    hostile = dataclasses.replace(runs[2], source="run&1<script>alert(1)<b>.csv")
+    page = build_report(dataclasses.replace(cal, model="m<b>&amp;"), [hostile]).html
+    assert "run&amp;1&lt;script&gt;alert(1)&lt;b&gt;.csv" in page and "<script>" not in page
+    assert "&amp;amp;" not in page.replace("m&lt;b&gt;&amp;amp;", "")  # nothing escaped twice but the name's own
+    assert "m&lt;b&gt;&amp;amp;" in page

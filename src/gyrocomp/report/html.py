@@ -180,7 +180,7 @@ def _evaluation(calibration: Calibration, runs: list[Recording], evaluations: li
     rows, accel_rows = [], []
     for rec, ev in zip(runs, evaluations):
         window_s = ev.window_s
-        name = html.escape(rec.source.rsplit("/", 1)[-1])
+        name = rec.source.rsplit("/", 1)[-1]  # a table cell: escaped once, by _table
         if staged:
             st = evaluate_stages(calibration, rec, window_s=window_s, turn_on_window_s=turn_on_window_s)
             first = next(iter(st.stages.values()))
