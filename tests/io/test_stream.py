@@ -4,6 +4,9 @@ the same warnings once, names the file's own rows in its errors, and reads a fil
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -15,6 +18,9 @@ from hypothesis import given, settings as hsettings, strategies as st
 
 from gyrocomp.compensate import apply, apply_file
 from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.io.atomic import TEMP_PREFIX, write_text_atomic
+
+from ..conftest import SCRIPT
 from gyrocomp.io import stream as stream_module
 from gyrocomp.io.stream import TableStream, convert_table
 from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_recording
@@ -166,3 +172,40 @@ def test_convert_in_chunks_writes_what_the_whole_file_gives(held_out, tmp_path, 
     assert _read(tmp_path / f"chunks.{out_suffix}").equals(_read(tmp_path / f"whole.{out_suffix}"))
     assert result.gaps == 1 and result.rate_hz == 2.0 and result.channels[:3] == ("gyro_x", "gyro_y", "gyro_z")
     assert result.rows == _read(tmp_path / f"whole.{out_suffix}").num_rows
+
+
+def test_temporary_outputs_a_killed_process_left_are_removed_and_a_live_one_s_kept(tmp_path):
+    done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead = int(done.stdout)  # that process has exited
+    stale = tmp_path / f"{TEMP_PREFIX}{dead}-out.csv.abc123.tmp"
+    stale.write_bytes(b"x" * 1000)
+    live = tmp_path / f"{TEMP_PREFIX}{os.getpid()}-out.csv.def456.tmp"
+    live.write_bytes(b"y")
+    other = tmp_path / f"{TEMP_PREFIX}{dead}-other.csv.abc123.tmp"  # another target's: not this write's business
+    other.write_bytes(b"z")
+    write_text_atomic(tmp_path / "out.csv", "a,b\n")
+    assert not stale.exists() and live.exists() and other.exists()
+    assert (tmp_path / "out.csv").read_text() == "a,b\n"
+
+
+def test_any_file_name_the_os_allows(tmp_path):
+    """A name that is not valid UTF-8 (legal on Linux; Python keeps the bytes as surrogate escapes) reads and
+    writes through every table path: whole, in chunks, Parquet and CSV."""
+    name = os.fsdecode(b"run\xff")
+    csv = tmp_path / f"{name}.csv"
+    write_text_atomic(csv, "time,gyro_z,temperature\n" + "".join(f"{t},{0.01 * t},{20 + 0.01 * t}\n"
+                                                                 for t in range(2000)))
+    for args, out in ((("convert", csv, tmp_path / f"{name}.parquet"), f"{name}.parquet"),
+                      (("fit", csv, "-o", tmp_path / f"{name}.json", "--temperature", "poly:1"), f"{name}.json"),
+                      (("apply", tmp_path / f"{name}.json", tmp_path / f"{name}.parquet", "-o",
+                        tmp_path / f"{name}-comp.csv"), f"{name}-comp.csv")):
+        result = _run_bytes(*args)  # the names come back as the bytes they are
+        assert result.returncode == 0, result.stderr
+        assert (tmp_path / out).exists()
+    assert _run_bytes("allan", tmp_path / f"{name}.parquet").returncode == 0
+
+
+def _run_bytes(*args) -> subprocess.CompletedProcess:
+    """The command line with output kept as bytes (a file name that is not UTF-8 is printed as its bytes)."""
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+    return subprocess.run([*cmd, *map(os.fspath, args)], capture_output=True, timeout=300)

@@ -22,6 +22,7 @@ accelerations before it, as it was fitted).
 from __future__ import annotations
 
 
+import contextlib
 import math
 import os
 from pathlib import Path
@@ -371,8 +372,15 @@ def write_c_sources(calibration: Calibration, folder: str | os.PathLike, *, rate
     sources = c_sources(calibration, rate_hz=rate_hz)
     if with_learner:
         sources.update(learner_c_sources(learner))
+    created = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
-    return write_texts_atomic(folder, sources)
+    try:
+        return write_texts_atomic(folder, sources)
+    except BaseException:
+        if created:  # a failed export (a full disk) leaves no empty folder behind
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise
 
 
 __all__ = ["c_sources", "write_c_sources"]

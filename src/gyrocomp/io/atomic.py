@@ -7,6 +7,7 @@ import os
 import stat
 import tempfile
 from collections.abc import Iterable, Iterator
+from glob import escape as glob_escape
 from pathlib import Path
 
 from ..errors import InputError
@@ -24,7 +25,12 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise InputError(f"{target}: folder {folder} does not exist; create it first")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
+    tag = _tag(target.name)
+    _remove_stale(folder, tag)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f"{TEMP_PREFIX}{os.getpid()}-{tag}.", suffix=".tmp", dir=folder)
+    except OSError as exc:  # name the output the user gave, not the temporary file
+        raise InputError(f"{target}: cannot write there ({exc.strerror or exc})") from None
     os.close(fd)
     tmp_path = Path(tmp)
     try:
@@ -35,6 +41,47 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         with contextlib.suppress(FileNotFoundError):
             tmp_path.unlink()
         raise
+
+
+def arrow_source(path: str | os.PathLike):
+    """``path`` as the table libraries (pyarrow, pandas) take it: the path, or, for a file name that is not valid
+    UTF-8 (any bytes are legal on Linux, and Python keeps them as surrogate escapes), the file opened for reading
+    in binary, which those libraries read as well."""
+    text = os.fspath(path)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return open(text, "rb")
+    return text
+
+
+#: a temporary output's name: this prefix, the writing process's id, a tag of the target's name, random letters
+TEMP_PREFIX = ".gyrocomp-"
+
+
+def _tag(name: str) -> str:
+    """A short ASCII tag of a file name for its temporary files (any name the OS allows, long or not UTF-8)."""
+    return "".join(c if c.isascii() and (c.isalnum() or c in "._-") else "_" for c in name)[:40]
+
+
+def _remove_stale(folder: Path, tag: str) -> None:
+    """Remove the temporary outputs for the same target that a killed process (SIGKILL, a power cut) left: those
+    whose process is gone. A process still running keeps its own."""
+    for stale in folder.glob(f"{TEMP_PREFIX}*-{glob_escape(tag)}.*.tmp"):
+        pid = stale.name[len(TEMP_PREFIX):].split("-", 1)[0]
+        if pid.isdigit() and not _alive(int(pid)):
+            with contextlib.suppress(OSError):
+                stale.unlink()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
 
 
 def _regular_target(path: str | os.PathLike) -> Path:

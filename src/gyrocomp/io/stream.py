@@ -25,7 +25,7 @@ import pyarrow.parquet as pq
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
-from .atomic import atomic_path
+from .atomic import arrow_source, atomic_path
 from .tables import (_COMPRESSED, TableLayout, _channel_selector, _csv_options, _resolved_columns,
                      detect_table_format, recording_table, sniff_csv, table_recording)
 
@@ -91,7 +91,7 @@ class TableStream:
     def _open_schema(self) -> pa.Schema:
         if self.fmt == "parquet":
             try:
-                return pq.ParquetFile(self.path).schema_arrow
+                return pq.ParquetFile(arrow_source(self.path)).schema_arrow
             except (pa.ArrowInvalid, OSError) as exc:
                 raise InputError(f"{self.path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
         with self._csv_reader() as reader:
@@ -124,17 +124,18 @@ class TableStream:
 
     def _open(self, codec: str | None):
         """The file's bytes, decompressed as they are read."""
+        source = arrow_source(self.path)
         if codec is None:
-            return pa.OSFile(str(self.path), "rb")
+            return pa.OSFile(source, "rb") if isinstance(source, str) else pa.PythonFile(source, mode="r")
         if codec == "xz":
             return pa.PythonFile(lzma.open(self.path), mode="r")
-        return pa.input_stream(str(self.path), compression=codec)
+        return pa.input_stream(source, compression=codec)
 
     def _batches(self) -> Iterator[pa.RecordBatch]:
         if self.fmt == "parquet":
             # without pre-buffering: pyarrow would keep every row group's read-ahead until the file is closed
             # (memory growing with the file, about 12 bytes a row)
-            yield from pq.ParquetFile(self.path, pre_buffer=False).iter_batches(batch_size=self.chunk_rows,
+            yield from pq.ParquetFile(arrow_source(self.path), pre_buffer=False).iter_batches(batch_size=self.chunk_rows,
                                                                                  columns=self._read)
             return
         with self._csv_reader() as reader:
@@ -207,7 +208,7 @@ class TableStream:
             return
         if self.fmt == "parquet":
             if self._total_rows is None:
-                self._total_rows = pq.ParquetFile(self.path).metadata.num_rows
+                self._total_rows = pq.ParquetFile(arrow_source(self.path)).metadata.num_rows
             self.progress(self.rows / self._total_rows if self._total_rows else 1.0)
         elif self._source is not None:
             with contextlib.suppress(OSError, ValueError):

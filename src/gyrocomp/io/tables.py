@@ -17,7 +17,7 @@ import pyarrow.parquet as pq
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
-from .atomic import atomic_path
+from .atomic import arrow_source, atomic_path
 
 TIME_COLUMN = "time"
 PER_AXIS_TEMPERATURES = tuple(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES)
@@ -169,13 +169,13 @@ def _csv_bytes(path: Path) -> tuple[pa.NativeFile | Path, bytes]:
     codec = next((name for sig, name in _COMPRESSED if magic.startswith(sig)), None)
     if codec is None:
         with open(path, "rb") as fh:
-            return path, fh.read(4096)
+            return arrow_source(path), fh.read(4096)
     try:
         if codec == "xz":
             with lzma.open(path) as fh:
                 data = pa.py_buffer(fh.read())
         else:
-            with pa.input_stream(str(path), compression=codec) as fh:
+            with pa.input_stream(arrow_source(path), compression=codec) as fh:
                 data = pa.py_buffer(fh.read())
     except (OSError, EOFError, lzma.LZMAError, pa.ArrowInvalid) as exc:
         raise InputError(f"{path}: a {codec} file that does not decompress ({str(exc).splitlines()[0]})") from None
@@ -220,8 +220,8 @@ def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str
         except pa.ArrowInvalid as exc:
             raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
     try:
-        columns = None if select is None else select(pq.read_schema(path).names)
-        return pq.read_table(path, columns=columns)
+        columns = None if select is None else select(pq.read_schema(arrow_source(path)).names)
+        return pq.read_table(arrow_source(path), columns=columns)
     except (pa.ArrowInvalid, OSError) as exc:
         raise InputError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
 
