@@ -8,6 +8,7 @@ from gyrocomp import Calibration, Polynomial, apply, fit_calibration
 from gyrocomp.calibration import SCHEMA_VERSION, AxisCalibration
 from gyrocomp.compensate import predict_error
 from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.models.online import OnlineCalibrator
 from gyrocomp.io import write_recording
 from gyrocomp.io.tables import read_table
 from gyrocomp.models.temperature import PolynomialBias
@@ -174,7 +175,8 @@ def test_model_files_are_validated_on_load(calibration, tmp_path, change, messag
 
 @pytest.mark.parametrize("text, message", [
     ("[" * 100000 + "]" * 100000, r"not a gyrocomp model file \(nested too deeply\)"),
-    ('{"format": "gyrocomp-calibration", "schema_version": ' + "9" * 5000 + "}", r"not valid JSON .*digits"),
+    ('{"format": "gyrocomp-calibration", "schema_version": ' + "9" * 5000 + "}",
+     r"an integer of 5000 digits; gyrocomp's files hold none of more than 30"),
 ])
 def test_pathological_json_is_refused_in_one_line(tmp_path, text, message):
     (tmp_path / "m.json").write_text(text)
@@ -231,3 +233,18 @@ def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other()
     assert '"turn_on_biases_g"' in text and '"turn_on_biases_dps"' in text  # the file names each unit
     back = Calibration.from_dict(json.loads(text))
     assert back.accel_axes["accel_x"] == accel and back.axes["gyro_x"] == gyro
+
+
+@pytest.mark.parametrize("digits", [31, 4000, 5000])
+def test_integers_beyond_any_count_are_refused_in_one_line(calibration, tmp_path, digits):
+    """Python turns a 4,000-digit integer into an int no float holds and refuses 5,000 digits with an error about
+    its own limits: a model file or a learner state holding one is refused naming the file."""
+    text = json.dumps(calibration.to_dict()).replace('"schema_version": ', '"schema_version": ' + "9" * digits + ", "
+                                                     '"was": ', 1)
+    (tmp_path / "m.json").write_text(text)
+    with pytest.raises(InputError, match=rf"m.json: an integer of {digits} digits; gyrocomp's files hold none of more "
+                                         r"than 30"):
+        Calibration.load(tmp_path / "m.json")
+    (tmp_path / "s.json").write_text('{"format": "gyrocomp-learner", "schema_version": ' + "9" * digits + "}")
+    with pytest.raises(InputError, match=rf"s.json: an integer of {digits} digits"):
+        OnlineCalibrator.load(tmp_path / "s.json")

@@ -317,7 +317,7 @@ def test_refuses_to_overwrite_input(workdir, tmp_path):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["simulate", "--duration", "abc", "-o", "x.csv"], r"Invalid value for '--duration': 'abc' is not a valid float"),
+    (["simulate", "--duration", "abc", "-o", "x.csv"], r"Invalid value for '--duration': 'abc' is not a number"),
     (["fit", "x.csv"], r"Missing option '-o'"),
     (["fit", "{run}", "-o", "m.json", "--temperature", "poly:7"], r"--temperature: 'poly:7': the order must be"),
     (["fit", "{run}", "-o", "m.json", "--columns", "gyro_z=Nope"], r"--columns gyro_z=Nope: no column 'Nope'"),

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from . import jsontext
 from .errors import InputError
 from .fit_report import FitReport
 from .io.atomic import write_text_atomic
@@ -451,15 +452,6 @@ class Calibration:
             raise InputError(f"{path}: not a gyrocomp model file (not UTF-8 JSON text)") from None
         except OSError as exc:  # permissions, a symbolic link loop, a device that fails
             raise InputError(f"{path}: cannot read the model file ({(exc.strerror or type(exc).__name__).lower()})") from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(
-                f"{path}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg}); "
-                "the file may be truncated, write it again with gyrocomp fit"
-            ) from None
-        except RecursionError:
-            raise InputError(f"{path}: not a gyrocomp model file (nested too deeply)") from None
-        except ValueError as exc:  # e.g. an integer with more digits than Python converts
-            raise InputError(f"{path}: not valid JSON ({exc})") from None
+        data = jsontext.loads(text, str(path), "model file",
+                              "the file may be truncated, write it again with gyrocomp fit")
         return cls.from_dict(data, source=str(path))

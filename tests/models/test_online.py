@@ -424,3 +424,15 @@ def test_a_power_on_that_begins_with_a_slow_turn_is_recovered():
     assert recovered.status.rejected_outliers > clean.status.rejected_outliers
     assert np.max(np.abs(recovered._constants[-1] - clean._constants[-1])) < 1e-3
     assert recovered.status.still_s > 0.95 * clean.status.still_s
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("block_s", 1e7, r"block_s: at most 60, got 1e\+07"),
+    ("rate_hz", 1e9, r"rate_hz: at most 40000, got 1e\+09"),
+    ("piece_s", 1e5, r"piece_s: at most 3600, got 100000"),
+])
+def test_settings_that_would_ask_for_gigabytes_are_refused(field, value, message):
+    with pytest.raises(InputError, match=message):
+        LearnerSettings(**{"rate_hz": 100.0, field: value})
+    with pytest.raises(InputError, match=r"block_s: 60 s at rate_hz=40000 is 2.4e\+06 samples a block; at most 1e6"):
+        LearnerSettings(rate_hz=4e4, block_s=60.0)

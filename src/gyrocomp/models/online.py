@@ -87,6 +87,7 @@ from scipy.stats import norm
 
 from ..calibration import AxisCalibration, Calibration
 from ..effects import lazy_lfilter
+from .. import jsontext
 from ..errors import InputError, NotFittedError
 from ..io.atomic import write_text_atomic
 from ..recording import Recording
@@ -184,7 +185,15 @@ class LearnerSettings:
                     "max_bias_dps", "outlier_dps", "outlier_sigmas", "max_tempco_dps_per_degc", "save_change_dps")
         for name in positive:
             if not getattr(self, name) > 0:
-                raise InputError(f"{name}: must be positive, got {getattr(self, name)}")
+                raise InputError(f"{name}: must be positive, got {getattr(self, name):.6g}")
+        # what the learner holds in memory grows with these: bounded, so a state file cannot ask for gigabytes
+        for name, high in (("rate_hz", 4e4), ("block_s", 60.0), ("min_still_s", 3600.0), ("piece_s", 3600.0),
+                           ("bin_width_degc", 50.0)):
+            if getattr(self, name) > high:
+                raise InputError(f"{name}: at most {high:g}, got {getattr(self, name):.6g}")
+        if self.rate_hz * self.block_s > 1e6:
+            raise InputError(f"block_s: {self.block_s:.6g} s at rate_hz={self.rate_hz:.6g} is "
+                             f"{self.rate_hz * self.block_s:.3g} samples a block; at most 1e6")
         if not 0 < self.alpha < 0.5:
             raise InputError(f"alpha: must lie in (0, 0.5), got {self.alpha}")
         if not 0 < self.noise_quantile < 0.5:
@@ -1016,11 +1025,7 @@ class OnlineCalibrator:
             raise InputError(f"{path}: no such learner state file") from None
         except (OSError, UnicodeDecodeError) as exc:
             raise InputError(f"{path}: cannot read the learner state ({type(exc).__name__})") from None
-        try:
-            data = json.loads(text)
-        except (json.JSONDecodeError, RecursionError) as exc:
-            raise InputError(f"{path}: not valid JSON ({exc})") from None
-        return cls.from_dict(data, str(path))
+        return cls.from_dict(jsontext.loads(text, str(path), "learner state"), str(path))
 
 
 def _fresh_dequantizer() -> dict:
