@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import warnings
+
 import click
 
 from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
-from ..export.autopilot import ardupilot_params_file, px4_params_file
+from ..export.autopilot import ardupilot_parameters, ardupilot_params_file, px4_parameters, px4_params_file
 from ..export.c_code import write_c_sources
+from ..export.firmware import firmware_difference
+from ..recording import GYRO_AXES
 from ..models.online import LearnerSettings, OnlineCalibrator
 from .common import FINITE
 
@@ -54,11 +58,14 @@ def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, in
     elif fmt == "c":
         written = write_c_sources(calibration, output, rate_hz=rate_hz, learner=learner)
     else:
+        slot = (0 if fmt == "px4" else 1) if instance is None else instance
         if fmt == "px4":
-            text = px4_params_file(calibration, instance=0 if instance is None else instance, device_id=device_id,
-                                   accel_device_id=accel_device_id)
+            text = px4_params_file(calibration, instance=slot, device_id=device_id, accel_device_id=accel_device_id)
+            params = px4_parameters(calibration, instance=slot, device_id=device_id,
+                                    accel_device_id=accel_device_id).values
         else:
-            text = ardupilot_params_file(calibration, instance=1 if instance is None else instance)
+            text = ardupilot_params_file(calibration, instance=slot)
+            params = ardupilot_parameters(calibration, instance=slot).values
         write_text_atomic(output, text)
         if not quiet:
             click.echo(f"wrote {output}")
@@ -66,6 +73,12 @@ def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, in
                 if not line.startswith("#"):
                     break
                 click.echo(line.lstrip("# "))
+            if any(a in calibration.axes and calibration.axes[a].temperature is not None for a in GYRO_AXES):
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")  # the model continued past its range: that is the point here
+                    difference = firmware_difference(calibration, params, fmt, slot)
+                for line in difference.lines():
+                    click.echo(line)
         return
     if not quiet:
         click.echo("wrote " + " and ".join(str(p) for p in written))

@@ -1,0 +1,82 @@
+"""The autopilots' corrections as their source computes them (gyrocomp.export.firmware), against values computed
+by hand from the formulas in PX4's calc_thermal_offsets_3D and ArduPilot's TCal::correct_sensor, and the
+firmware-versus-model difference the export prints."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gyrocomp.errors import InputError
+from gyrocomp.io.tables import write_recording
+from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
+from gyrocomp.simulate import get_profile, simulate
+
+from ..conftest import run
+
+DEG = 180.0 / math.pi
+PX4 = {"TC_G0_TMIN": 10.0, "TC_G0_TMAX": 50.0, "TC_G0_TREF": 30.0,
+       **{f"TC_G0_X{k}_{j}": c for j, coefs in enumerate(((1e-3, 2e-5, -3e-7, 4e-9), (0.0, 1e-4, 0.0, 0.0),
+                                                          (-2e-3, 0.0, 5e-7, 0.0)))
+          for k, c in enumerate(coefs)}}
+ARDU = {"INS_TCAL1_TMIN": 0.0, "INS_TCAL1_TMAX": 60.0,
+        **{f"INS_TCAL1_GYR{k}_{a}": c for a, coefs in zip("XYZ", ((100.0, -2.0, 0.03), (50.0, 0.0, 0.0),
+                                                                   (0.0, 1.0, 0.0)))
+           for k, c in zip((1, 2, 3), coefs)}}
+
+
+def test_px4_offsets_by_hand_inside_and_clamped_outside():
+    out = px4_gyro_correction_dps(PX4, np.array([20.0, 40.0, 0.0, 70.0]))
+    # x at 20 degC: d = -10: 1e-3 - 2e-4 - 3e-5 - 4e-6 rad/s
+    assert out[0, 0] == pytest.approx((1e-3 - 2e-4 - 3e-7 * 100 - 4e-9 * 1000) * DEG, rel=1e-6)
+    assert out[1, 1] == pytest.approx(1e-4 * 10 * DEG, rel=1e-6)
+    assert out[1, 2] == pytest.approx((-2e-3 + 5e-7 * 100) * DEG, rel=1e-6)
+    # below TMIN and above TMAX the temperature is clamped: the offsets at 10 and 50 degC
+    np.testing.assert_allclose(out[2], px4_gyro_correction_dps(PX4, np.array([10.0]))[0], rtol=0, atol=0)
+    np.testing.assert_allclose(out[3], px4_gyro_correction_dps(PX4, np.array([50.0]))[0], rtol=0, atol=0)
+    with pytest.raises(InputError, match=r"parameters: no TC_G1_TMIN; the file does not hold that sensor's"):
+        px4_gyro_correction_dps(PX4, np.array([20.0]), instance=1)
+
+
+def test_px4_as_it_runs_publishes_at_1_hz_when_the_temperature_moved_by_more_than_1_degc():
+    time_s = np.arange(0.0, 10.0, 0.25)  # 4 Hz samples, polls at 0, 1, 2, ... s
+    temperature = 20.0 + 0.6 * time_s  # 0.6 degC per second
+    out = px4_as_run(PX4, time_s, temperature)
+    # published at 0 s (20 degC, first), 2 s (21.2: more than 1 degC from 20), 4 s (22.4), 6 s, 8 s
+    published = {0.0: 20.0, 2.0: 21.2, 4.0: 22.4, 6.0: 23.6, 8.0: 24.8}
+    for k, t in enumerate(time_s):
+        last = max(p for p in published if p <= t)
+        np.testing.assert_allclose(out[k], px4_gyro_correction_dps(PX4, np.array([published[last]]))[0])
+
+
+def test_ardupilot_correction_by_hand_relative_to_the_calibration_temperature():
+    out = ardupilot_gyro_correction_dps(ARDU, np.array([45.0, 80.0]), cal_temp_degc=25.0)
+
+    def p(d, c):
+        return (c[0] + (c[1] + c[2] * d) * d) * d * 1e-6
+
+    x = (100.0, -2.0, 0.03)
+    assert out[0, 0] == pytest.approx((p(10.0, x) - p(-10.0, x)) * DEG, rel=1e-5)
+    assert out[0, 2] == pytest.approx((p(10.0, (0, 1, 0)) - p(-10.0, (0, 1, 0))) * DEG, rel=1e-5)
+    assert out[1, 0] == pytest.approx((p(25.0, x) - p(-10.0, x)) * DEG, rel=1e-5)  # 80 clamped to TMAX 60
+    # the calibration temperature is clamped too
+    np.testing.assert_allclose(ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), -20.0),
+                               ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), 0.0))
+
+
+def test_export_prints_what_the_firmware_leaves_against_the_model(tmp_path):
+    runs = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=1,
+                     seed=s) for s in range(2)]
+    paths = []
+    for k, sim in enumerate(runs):
+        paths.append(tmp_path / f"c{k}.csv")
+        write_recording(sim.recording, paths[-1])
+    assert run("fit", *paths, "-o", tmp_path / "m.json", "--hysteresis", "lag").returncode == 0
+    r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "t.params", "--device-id", 3)
+    assert r.returncode == 0, r.stderr
+    line = next(x for x in r.stdout.splitlines() if x.startswith("gyro_z: firmware vs model"))
+    numbers = [float(v) for v in line.replace("(", " ").replace(")", " ").split() if v[0].isdigit()]
+    in_range, beyond, as_run = numbers[0], numbers[2], numbers[5]
+    assert "in range" in line and "beyond it" in line and "as it runs" in line
+    assert as_run > in_range  # the lag the file cannot carry, and PX4's 1 degC steps
+    assert beyond > 0
