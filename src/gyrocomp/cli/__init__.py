@@ -121,7 +121,7 @@ PARAMETER_FLAGS = {
     "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
     "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
-    "folds": "--folds", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
+    "folds": "--folds", "target": "--target", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
     "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
     "prior": "--prior", "still_only": "--still-only", "bin_width_degc": "--bin-width",
 }

@@ -53,6 +53,10 @@ from .render import print_contributions, print_fit
 @click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
               help="What the model choice holds out: each run, each heating or cooling leg, or time blocks; "
                    "auto: runs with three runs or more, else legs.")
+@click.option("--target", type=click.Choice(["model", "px4", "ardupilot"]), default="model", show_default=True,
+              help="px4 or ardupilot: the best model that firmware carries (a cubic at most, chosen by the same "
+                   "held-out validation, held at the range's edges as the firmware clamps, no lag or hysteresis), so "
+                   "that apply computes what the exported file will.")
 @click.option("--scale-factor", "scale_factor", type=click.Choice(SCALE_FACTOR_CHOICES), default="auto",
               show_default=True,
               help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table) or, "
@@ -69,8 +73,8 @@ from .render import print_contributions, print_fit
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
-        acceleration, pipeline, static_min_duration_s, channels, folds, scale_factor, rate_schedule, still_only,
-        **kwargs):
+        acceleration, pipeline, static_min_duration_s, channels, folds, target, scale_factor, rate_schedule,
+        still_only, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still
     moments of field logs.
 
@@ -87,7 +91,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     options = FitOptions(temperature=parse_temperature_option(temperature, mlp_seed),
                          bin_width_degc=bin_width_degc, hysteresis=hysteresis, hysteresis_order=hysteresis_order,
                          hysteresis_band_degc=None if band is None else tuple(band), acceleration=acceleration,
-                         static_min_duration_s=static_min_duration_s, folds=folds)
+                         static_min_duration_s=static_min_duration_s, folds=folds, target=target)
     runs = expand_runs(runs)
     refuse_to_overwrite_inputs(output, runs)
     every = str(opts["instance"]).strip().lower() == "all"

@@ -20,6 +20,10 @@ from .thermal import MAX_HYSTERESIS_ORDER
 
 #: the thermal memory on top of the temperature curve
 Memory = Literal["auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag"]
+#: what the model is fitted for: gyrocomp itself, or the best model a firmware carries (a cubic at most, clamped)
+Target = Literal["model", "px4", "ardupilot"]
+#: the highest polynomial order a firmware target carries
+FIRMWARE_MAX_ORDER = 3
 #: the g-sensitivity fit (``auto``: the 3x3 matrix when the runs turn between positions)
 Acceleration = Literal["auto", "none", "matrix", "matrix2"]
 #: what the model choice holds out
@@ -93,6 +97,10 @@ class FitOptions:
         The validation fold of each recording (pieces of one run left out together).
     folds : FoldChoice
         What the model choice holds out.
+    target : Target
+        ``model``: gyrocomp's best model. ``px4``/``ardupilot``: the best model that firmware carries: a polynomial
+        of order 3 at most (chosen by the same held-out validation), held at its range's edges as the firmware clamps
+        there, no lag, hysteresis or g-sensitivity; ``apply`` then computes what the exported file will.
     """
 
     temperature: Polynomial | Network | None = Polynomial()
@@ -104,6 +112,7 @@ class FitOptions:
     static_min_duration_s: float = 10.0
     run_folds: tuple[int, ...] | None = None
     folds: FoldChoice = "auto"
+    target: Target = "model"
 
     def __post_init__(self):
         if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Network)):
@@ -114,6 +123,9 @@ class FitOptions:
         _choice("FitOptions.hysteresis_order", self.hysteresis_order, ("auto", *range(1, MAX_HYSTERESIS_ORDER + 1)))
         _choice("FitOptions.acceleration", self.acceleration, get_args(Acceleration))
         _choice("FitOptions.folds", self.folds, get_args(FoldChoice))
+        _choice("FitOptions.target", self.target, get_args(Target))
+        if self.target != "model":
+            self._check_firmware_target()
         if self.bin_width_degc is not None and not (isinstance(self.bin_width_degc, (int, float))
                                                     and self.bin_width_degc > 0):
             raise InputError(f"FitOptions.bin_width_degc: a positive number of degC, got {self.bin_width_degc!r}")
@@ -129,4 +141,21 @@ class FitOptions:
             object.__setattr__(self, "hysteresis_band_degc", (float(band[0]), float(band[1])))
 
 
-__all__ = ["Acceleration", "FitOptions", "FoldChoice", "Memory", "Network", "Polynomial"]
+    def _check_firmware_target(self) -> None:
+        """A firmware target carries a cubic at most and nothing else: other asks are refused naming the field."""
+        t = self.target
+        if not isinstance(self.temperature, Polynomial) or (
+                self.temperature.order != "auto" and self.temperature.order > FIRMWARE_MAX_ORDER):
+            raise InputError(f"FitOptions.target: {t} carries a polynomial of order {FIRMWARE_MAX_ORDER} at most; "
+                             f"use temperature=Polynomial() or Polynomial(0..{FIRMWARE_MAX_ORDER}), got "
+                             f"{self.temperature!r}")
+        if self.hysteresis not in ("auto", "none") or self.hysteresis_band_degc is not None:
+            raise InputError(f"FitOptions.target: {t} has no lag or hysteresis term; leave hysteresis='auto' or 'none'")
+        if self.acceleration not in ("auto", "none"):
+            raise InputError(f"FitOptions.target: {t} has no g-sensitivity term; leave acceleration='auto' or 'none'")
+        object.__setattr__(self, "hysteresis", "none")
+        object.__setattr__(self, "acceleration", "none")
+
+
+__all__ = ["Acceleration", "FIRMWARE_MAX_ORDER", "FitOptions", "FoldChoice", "Memory", "Network", "Polynomial",
+           "Target"]

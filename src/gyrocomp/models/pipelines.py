@@ -36,7 +36,7 @@ from .polynomial_fit import PolynomialTemperatureModel
 from .temperature import MAX_ORDER, PolynomialBias
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
-from .options import Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial
+from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
 from .thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 
 #: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
@@ -188,7 +188,8 @@ def _thermal_report(thermal: ThermalHysteresisModel, mode: str, unit: str) -> di
 def _fit_selected(recordings: list[Recording], order: int | str, options: FitOptions, accel_mode: str):
     """Select by held-out drift among the polynomial orders (``order``, or all for "auto") and the memories
     ``options`` allow, then fit each axis's chosen model on all runs."""
-    orders = tuple(range(MAX_ORDER + 1)) if order == "auto" else (int(order),)
+    top = MAX_ORDER if options.target == "model" else FIRMWARE_MAX_ORDER
+    orders = tuple(range(top + 1)) if order == "auto" else (int(order),)
     memories = tuple(CANDIDATES) if options.hysteresis == "auto" else (options.hysteresis,)
     h_orders = (tuple(range(1, MAX_HYSTERESIS_ORDER + 1)) if options.hysteresis_order == "auto"
                 else (int(options.hysteresis_order),))
@@ -217,7 +218,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
                     hysteresis: Memory = "auto", hysteresis_order: int | Literal["auto"] = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, acceleration: Acceleration = "auto",
                     static_min_duration_s: float = 10.0, network_inputs: tuple[str, ...] = ("temperature",),
-                    run_folds: tuple[int, ...] | None = None, folds: FoldChoice = "auto") -> Calibration:
+                    run_folds: tuple[int, ...] | None = None, folds: FoldChoice = "auto",
+                    target: Target = "model") -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
 
     Parameters
@@ -255,6 +257,10 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
         What the model choice holds out (:func:`gyrocomp.models.selection.make_folds`): each run (the
         default with three runs or more), each heating or cooling leg (the default with fewer), or contiguous
         time blocks.
+    target : {"model", "px4", "ardupilot"}
+        ``model``: gyrocomp's best model; a firmware: the best model it carries (a polynomial of order 3 at most,
+        held at its range's edges as the firmware clamps, nothing else), so that ``apply`` computes what the
+        exported file will (see :class:`~gyrocomp.models.options.FitOptions`).
 
     Every option is checked as :class:`~gyrocomp.models.options.FitOptions` checks it (its errors name the
     field). Whenever something is left to choose (``Polynomial()`` or ``hysteresis="auto"``, no band given),
@@ -265,7 +271,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     options = FitOptions(temperature=temperature, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
                          hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,
                          acceleration=acceleration, static_min_duration_s=static_min_duration_s, run_folds=run_folds,
-                         folds=folds)
+                         folds=folds, target=target)
     return _fit_with(recordings, options, network_inputs)
 
 
@@ -304,6 +310,11 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
             {a: tuple(network.validation_rmse_[a]) for a in network.curves_},
             {a: network.epochs_[a] for a in network.curves_}, unit).to_dict()
     name = _model_name(axes, network, network_inputs, order, thermal, accel_mode)
+    if options.target != "model":  # what the firmware computes: the curve held at its range's edges (it clamps)
+        axes = {a: dataclasses.replace(ax, temperature=dataclasses.replace(ax.temperature, extrapolation="hold"))
+                if isinstance(ax.temperature, PolynomialBias) else ax for a, ax in axes.items()}
+        report["target"] = options.target
+        name += f" for {options.target}"
     if PreparedRun.of(recordings[0]).channel == "accel":
         return _accelerometer_calibration(axes, name, provenance(recordings), report)
     return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report=report)
