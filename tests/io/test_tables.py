@@ -348,3 +348,13 @@ def test_two_columns_that_match_one_channel_are_refused_naming_both(tmp_path, he
     assert not (tmp_path / "out.csv").exists()
     rec = read(path, TableLayout(columns={name: second}))  # a mapping says which
     assert rec.n_samples == 5
+
+
+@pytest.mark.parametrize("suffix", [".tsv", ".dat", ".txt"])
+def test_every_suffix_of_a_delimited_table_is_read(tmp_path, suffix):
+    path = tmp_path / f"log{suffix}"
+    path.write_text("time\tgyro_z\ttemperature\n" + "".join(f"{t}\t0.5\t{20 + t / 10}\n" for t in range(50)))
+    rec = read(path)
+    assert rec.n_samples == 50 and rec.gyro_axes == ("gyro_z",)
+    result = run("convert", path, tmp_path / "out.csv")
+    assert result.returncode == 0, result.stderr

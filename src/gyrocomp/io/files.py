@@ -11,7 +11,7 @@ from ..errors import InputError
 from .tables import detect_table_format
 
 #: suffixes of the files a folder is searched for (every format gyrocomp reads)
-RUN_SUFFIXES = (".csv", ".txt", ".parquet", ".pq", ".ulg", ".bin", ".bag", ".mcap", ".h5", ".hdf5", ".nc", ".nc4")
+RUN_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".parquet", ".pq", ".ulg", ".bin", ".bag", ".mcap", ".h5", ".hdf5", ".nc", ".nc4")
 
 
 def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:

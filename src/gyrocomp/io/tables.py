@@ -291,11 +291,15 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
     return out
 
 
+#: suffixes of delimited text tables (the delimiter is told from the header: comma, semicolon, tab, space)
+TEXT_TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
+
+
 def detect_table_format(path: Path) -> str | None:
     suffix = path.suffix.lower()
-    if suffix in (".gz", ".bz2", ".xz", ".zst") and Path(path.stem).suffix.lower() in (".csv", ".txt"):
+    if suffix in (".gz", ".bz2", ".xz", ".zst") and Path(path.stem).suffix.lower() in TEXT_TABLE_SUFFIXES:
         return "csv"  # compressed CSV, e.g. run.csv.gz
-    if suffix in (".csv", ".txt"):
+    if suffix in TEXT_TABLE_SUFFIXES:
         return "csv"
     if suffix in (".parquet", ".pq"):
         return "parquet"
