@@ -152,7 +152,7 @@ def main() -> None:
         lines.append(f"| {label} | {ratio:.2f} | {lag:.1f} | {model_name} |")
         print(lines[-1], flush=True)
     cats = cats_case()
-    lines += ["", f"CATS (real, fit on two runs, judged on the third): default / plain cubic = "
+    lines += ["", "CATS (real, fit on two runs, judged on the third): default / plain cubic = "
               + ("dataset absent" if cats is None else f"{cats:.3f}")]
     print(lines[-1])
     print(f"({time.perf_counter() - start:.0f} s)")

@@ -306,6 +306,40 @@ class AxisCalibration:
 
 
 @dataclass(frozen=True)
+class AxisSummary:
+    """One axis of a model in a line: its unit, the model in words, the calibrated range [degC], the lag [s], the
+    g-sensitivity row [unit/g] and the turn-on constants of the calibration runs [unit]."""
+
+    axis: str
+    unit: str
+    model: str
+    range_degc: tuple[float, float] | None
+    lag_time_constant_s: float
+    g_row: tuple[float, float, float] | None
+    turn_on_biases: tuple[float, ...]
+
+    @classmethod
+    def of(cls, name: str, ax: "AxisCalibration") -> "AxisSummary":
+        curve = ax.temperature
+        order = None if curve is None else curve.order
+        words = "constant" if curve is None else (f"polynomial order {order}" if isinstance(order, int) else
+                                                  f"network {order}")
+        if ax.hysteresis is not None:
+            words += f", {ax.hysteresis.describe()}"
+        if ax.has_acceleration_stage:
+            words += ", g-sensitivity"
+        return cls(name, ax.unit, words, None if curve is None else (curve.t_min_degc, curve.t_max_degc),
+                   ax.lag_time_constant_s, ax.g_sensitivity_dps_per_g, tuple(ax.turn_on_biases))
+
+    def to_dict(self) -> dict:
+        return {"axis": self.axis, "unit": self.unit, "model": self.model,
+                "range_degc": None if self.range_degc is None else list(self.range_degc),
+                "lag_time_constant_s": self.lag_time_constant_s,
+                "g_row": None if self.g_row is None else list(self.g_row),
+                "turn_on_biases": list(self.turn_on_biases)}
+
+
+@dataclass(frozen=True)
 class Calibration:
     """A fitted compensation: per-axis models, units, valid ranges and provenance.
 
@@ -334,6 +368,10 @@ class Calibration:
             for name, ax in axes.items():
                 if ax.unit != unit:
                     raise InputError(f"{section}[{name!r}].unit: {ax.unit!r}; the axes of {section} are in {unit}")
+
+    def summaries(self) -> tuple[AxisSummary, ...]:
+        """Every gyro, then accelerometer, axis in a line (:class:`AxisSummary`)."""
+        return tuple(AxisSummary.of(n, ax) for n, ax in (*self.axes.items(), *self.accel_axes.items()))
 
     @property
     def report(self) -> FitReport:

@@ -36,6 +36,8 @@ COMMANDS = {
     "learn": ("learn", 'Learn a temperature model from the still moments of LOGS, as the online learner would on the '
                        'vehicle: each log one power-on, replayed in the order given.'),
     "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
+    "show": ("show", 'What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device '
+                "ids), and the drift its held-out folds expect."),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's "
                     'default.'),
