@@ -31,3 +31,13 @@ def test_show_names_the_axes_the_device_ids_and_the_expected_drift(tmp_path):
     assert len(data["expected_held_out_drift"]) == 3 and data["target"] == "model"
     missing = run("show", tmp_path / "nope.json")
     assert missing.returncode == 2 and "no such model file" in missing.stderr
+
+
+def test_quiet_prints_only_errors(tmp_path):
+    assert run("simulate", "--profile", "chamber", "--duration", 3000, "--rate", 1, "-o", tmp_path / "c.csv").returncode == 0
+    loud = run("fit", tmp_path / "c.csv", "-o", tmp_path / "m.json")
+    assert "warning" in loud.stderr and loud.stdout  # one heating run: time blocks, said; tables printed
+    quiet = run("-q", "fit", tmp_path / "c.csv", "-o", tmp_path / "m2.json")
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
+    failed = run("-q", "fit", tmp_path / "nope.csv", "-o", tmp_path / "m3.json")
+    assert failed.returncode == 2 and failed.stderr.startswith("gyrocomp: error:")

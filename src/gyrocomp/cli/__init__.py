@@ -89,7 +89,7 @@ class LazyGroup(click.Group):
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="gyrocomp")
 @click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
-@click.option("--quiet", "-q", is_flag=True, help="Print only errors.")
+@click.option("--quiet", "-q", is_flag=True, help="Print only errors (no tables, no warnings).")
 @click.option("--allow", "allowed", multiple=True, type=click.Choice(CHECKS), metavar="CHECK",
               help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.")
 @click.pass_context
@@ -103,6 +103,9 @@ def cli(ctx, debug, quiet, allowed):
     Units: angular rate deg/s, acceleration g, temperature degC, time s.
     """
     ctx.obj = {"debug": debug, "quiet": quiet}
+    if quiet:  # only errors: warnings too are silent (their checks still run; --json keeps every figure)
+        ctx.with_resource(warnings.catch_warnings())
+        warnings.simplefilter("ignore")
     if allowed:
         ctx.with_resource(warnings.catch_warnings())
         for check in allowed:
