@@ -34,7 +34,8 @@ def test_show_names_the_axes_the_device_ids_and_the_expected_drift(tmp_path):
 
 
 def test_quiet_prints_only_errors(tmp_path):
-    assert run("simulate", "--profile", "chamber", "--duration", 3000, "--rate", 1, "-o", tmp_path / "c.csv").returncode == 0
+    made = run("simulate", "--profile", "chamber", "--duration", 3000, "--rate", 1, "-o", tmp_path / "c.csv")
+    assert made.returncode == 0
     loud = run("fit", tmp_path / "c.csv", "-o", tmp_path / "m.json")
     assert "warning" in loud.stderr and loud.stdout  # one heating run: time blocks, said; tables printed
     quiet = run("-q", "fit", tmp_path / "c.csv", "-o", tmp_path / "m2.json")

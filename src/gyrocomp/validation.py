@@ -70,6 +70,8 @@ BASELINES: dict[str, Method | None] = {
     "ArduPilot cubic": fit_ardupilot_style,
     "cubic + run constants": fit_plain_cubic,
     "gyrocomp default": FitOptions(),
+    # the best model PX4's and ArduPilot's files carry (a cubic at most, clamped): what the firmware costs
+    "gyrocomp for firmware": FitOptions(target="px4"),
 }
 
 

@@ -118,10 +118,10 @@ def test_mapping_errors(tmp_path):
 def test_missing_file_and_unknown_suffix(tmp_path):
     with pytest.raises(InputError, match=r"nothere.csv: no such file"):
         read(tmp_path / "nothere.csv")
-    (tmp_path / "x.dat").write_text("time,gyro_z\n0,1\n1,2\n")
-    with pytest.raises(InputError, match=r"x.dat: cannot tell the format from the file or its suffix '.dat'; name it with fmt="):
-        read(tmp_path / "x.dat")
-    assert read(tmp_path / "x.dat", fmt="csv").n_samples == 2
+    (tmp_path / "x.log").write_text("time,gyro_z\n0,1\n1,2\n")
+    with pytest.raises(InputError, match=r"x.log: cannot tell the format from the file or its suffix '.log'; name it with fmt="):
+        read(tmp_path / "x.log")
+    assert read(tmp_path / "x.log", fmt="csv").n_samples == 2
 
 
 def test_not_a_parquet_file(tmp_path):

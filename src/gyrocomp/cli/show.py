@@ -41,7 +41,8 @@ def show(ctx, model, as_json):
     for col in ("axis", "model", "range [degC]", "lag [s]", "G [unit/g]", "turn-on constants"):
         table.add_column(col, justify="left" if col in ("axis", "model") else "right")
     for a in summaries:
-        table.add_row(a.axis, a.model, "-" if a.range_degc is None else f"{a.range_degc[0]:.1f} .. {a.range_degc[1]:.1f}",
+        span = "-" if a.range_degc is None else f"{a.range_degc[0]:.1f} .. {a.range_degc[1]:.1f}"
+        table.add_row(a.axis, a.model, span,
                       f"{a.lag_time_constant_s:.3g}" if a.lag_time_constant_s else "-",
                       "-" if a.g_row is None else " ".join(f"{g:+.3g}" for g in a.g_row),
                       ", ".join(f"{c:+.3g}" for c in a.turn_on_biases[:4]) + (" ..." if len(a.turn_on_biases) > 4
