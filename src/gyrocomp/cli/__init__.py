@@ -39,8 +39,8 @@ COMMANDS = {
     "show": ("show", 'What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device '
                 "ids), and the drift its held-out folds expect."),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
-    "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's "
-                    'default.'),
+    "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
+                    'default and the best model a firmware carries.'),
     "evaluate": ("evaluate", 'Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.'),
     "allan": ("allan", 'Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of '
                  'FILE.'),

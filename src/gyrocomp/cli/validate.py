@@ -26,7 +26,8 @@ from .render import print_validation
 @read_options
 @click.pass_context
 def validate(ctx, runs, folds, window_s, candidates, as_json, **kwargs):
-    """Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic and gyrocomp's default.
+    """Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's default and the best
+    model a firmware carries.
 
     Each method is fitted without the fold it is scored on (leave one run out, or one heating or cooling leg
     with fewer than three runs); the score is the RMS of the moving-averaged compensated output about its mean.
