@@ -22,7 +22,7 @@ LAYERS = (
     ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),
     ("calibration", ("calibration", "fit_report", "triad", "installed")),
     ("compensate", ("compensate",)),
-    ("fitting", ("models.gsensitivity", "models.thermal", "models.selection", "models.acceleration", "models.online",
+    ("fitting", ("models.gsensitivity", "models.thermal", "models.folds", "models.branch_evidence", "models.selection", "models.acceleration", "models.online",
                  "models.polynomial_fit", "models.mlp_fit",
                  "models.triad_fit", "models.pose_rotation")),
     ("pipelines", ("models.pipelines", "models")),

@@ -29,8 +29,8 @@ from .metrics import smoothed_residual_rms
 from .models.base import provenance
 from .models.hysteresis import turn_threshold_degc
 from .models.options import FitOptions, FoldChoice
-from .models.selection import (BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MAX_S, WINDOW_MIN_S, fold_mean,
-                               fold_standard_error, leg_labels)
+from .models.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
+from .models.selection import fold_mean, fold_standard_error
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
 from .prepared import prepare

@@ -11,7 +11,8 @@ import pytest
 from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.selection import Candidate, CandidateScore, choose, leg_labels, temperature_step_degc
+from gyrocomp.models.folds import leg_labels
+from gyrocomp.models.selection import Candidate, CandidateScore, choose, temperature_step_degc
 from gyrocomp.models.temperature import PolynomialBias
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import get_profile, preset_model, simulate

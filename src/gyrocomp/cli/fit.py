@@ -15,7 +15,7 @@ from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
 from ..models.options import FitOptions
 from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels
-from ..models.selection import FOLD_KINDS
+from ..models.folds import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
 from .common import (FINITE, float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar,
                      read_options, read_run)

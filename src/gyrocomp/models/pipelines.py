@@ -31,7 +31,8 @@ from .hysteresis import heats_and_cools
 from .pose_rotation import TooFewTurns, fit_gyro_between_poses
 from .mlp import NETWORK_BLOCK_S, NETWORK_INPUTS
 from .mlp_fit import MLPTemperatureModel
-from .selection import FOLD_KINDS, AxisSelection, prepare_axis, select_axis, share_fold_lags
+from .folds import FOLD_KINDS
+from .selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .polynomial_fit import PolynomialTemperatureModel
 from .temperature import MAX_ORDER, PolynomialBias
 from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
@@ -254,7 +255,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     run_folds : tuple of int, optional
         The validation fold of each recording for the polynomial order (pieces of one run left out together).
     folds : {"auto", "runs", "legs", "blocks"}
-        What the model choice holds out (:func:`gyrocomp.models.selection.make_folds`): each run (the
+        What the model choice holds out (:func:`gyrocomp.models.folds.make_folds`): each run (the
         default with three runs or more), each heating or cooling leg (the default with fewer), or contiguous
         time blocks.
     target : {"model", "px4", "ardupilot"}

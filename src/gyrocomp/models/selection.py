@@ -43,7 +43,6 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 
@@ -54,26 +53,19 @@ from ..metrics import moving_average
 from ..prepared import PreparedRun, RunBlocks
 from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
-from .hysteresis import parting_band_degc, turn_threshold_degc
+from .folds import FoldKind, Folds, make_folds, window_for
+from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
+from .hysteresis import turn_threshold_degc
 from .temperature import polynomial_columns
+from .thermal import LAG_MAX_S
 
-FoldKind = Literal["runs", "legs", "blocks"]
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
-FOLD_KINDS = ("auto", "runs", "legs", "blocks")
-#: the fewest folds a choice is made on; runs are split into legs (or blocks) below this
-MIN_FOLDS = 3
-#: with blocks, each run is cut into this many contiguous pieces (at least MIN_FOLDS in all)
-BLOCKS_PER_RUN = 4
 #: crossover widths of the branch candidates [degC] (each fold takes the one of least training residual)
 BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
-#: the moving-average window of the score: a tenth of the median fold, within these bounds [s]
-WINDOW_MIN_S = 60.0
-WINDOW_MAX_S = 600.0
 #: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run)
 LAG_GRID_POINTS = 16
 #: polynomial order of the residual in which the band where the branches part is looked for (the field's cubic)
 BAND_ORDER = 3
-LAG_MAX_S = 4 * 3600.0
 #: a temperature register whose steps are at least this coarse is treated as quantized [degC]
 COARSE_STEP_DEGC = 0.25
 
@@ -117,21 +109,6 @@ class CandidateScore:
         return {**self.candidate.to_dict(), f"mean_drift{u}": _json_number(self.mean_drift),
                 f"standard_error{u}": _json_number(self.standard_error),
                 f"fold_drift{u}": [_json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s)}
-
-
-@dataclass(frozen=True)
-class Folds:
-    """How the calibration data is held out: the fold of every block of every run, and each fold's name."""
-
-    kind: FoldKind
-    of_block: tuple[np.ndarray, ...]
-    names: tuple[str, ...]
-    #: why the folds are not of the kind asked for ("" when they are)
-    note: str = ""
-
-    @property
-    def count(self) -> int:
-        return len(self.names)
 
 
 @dataclass(frozen=True)
@@ -238,86 +215,6 @@ def temperature_step_degc(temperature_degc: np.ndarray) -> float:
     phase = float(np.median(offset))
     on_grid = np.abs(offset - phase) < 0.01 * step
     return step if np.mean(on_grid) >= 0.99 else 0.0
-
-
-def _split_long(leg_of_block: np.ndarray, pieces: int) -> np.ndarray:
-    """Cut a run's blocks into ``pieces`` contiguous parts of equal length."""
-    n = leg_of_block.size
-    return np.minimum((np.arange(n) * pieces) // max(n, 1), pieces - 1)
-
-
-def leg_labels(temperature_degc: np.ndarray, threshold_degc: float, min_length: int) -> tuple[np.ndarray, list[int]]:
-    """The heating or cooling leg of each sample: legs split where a reversal is confirmed
-    (:func:`gyrocomp.effects.find_turns`), a leg shorter than ``min_length`` samples joined to the one before.
-    Returns the leg number of each sample and each leg's direction (+1 heating, -1 cooling, 0 unknown)."""
-    turns = find_turns(temperature_degc, threshold_degc)
-    n = turns.direction.size
-    kept: list[int] = []
-    for c in (int(i) for i in turns.turn_index):
-        if c - (kept[-1] if kept else 0) >= min_length and n - c >= min_length:
-            kept.append(c)
-    labels = np.searchsorted(np.asarray(kept, dtype=np.int64), np.arange(n), side="right")
-    starts = [0] + kept
-    # a leg's direction: the one most of its samples carry (the first samples of a run have none yet)
-    directions = []
-    for j, start in enumerate(starts):
-        stop = kept[j] if j < len(kept) else n
-        d = turns.direction[start:stop]
-        directions.append(int(np.sign(np.sum(d))) if d.size else 0)
-    return labels, directions
-
-
-def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: list[float], kind: str = "auto",
-               min_leg_blocks: int = 10) -> Folds:
-    """The folds of a selection.
-
-    Parameters
-    ----------
-    runs : list of RunBlocks
-        Block means of each recording (one axis).
-    groups : tuple of int
-        The run each recording belongs to (pieces of one run are held out together).
-    thresholds_degc : list of float
-        Turning-point threshold of each recording [degC].
-    kind : {"auto", "runs", "legs", "blocks"}
-        ``auto``: runs with at least ``MIN_FOLDS`` runs, else the heating and cooling legs (two or more), else
-        (the temperature never reverses) time blocks. Asked-for folds that the data cannot give are replaced by
-        the next kind in that order, and ``Folds.note`` says why; blocks only when asked for or when nothing
-        else is possible.
-    min_leg_blocks : int
-        A leg shorter than this many blocks joins the leg before it.
-    """
-    n_groups = len(set(groups))
-    asked = kind
-    if kind == "auto":
-        kind = "runs" if n_groups >= MIN_FOLDS else "legs"
-    if kind == "runs" and n_groups < 2:
-        kind = "legs"
-    if kind == "runs":
-        ids = sorted(set(groups))
-        return Folds("runs", tuple(np.full(r.value.size, ids.index(g)) for r, g in zip(runs, groups)),
-                     tuple(f"run {g + 1}" for g in ids))
-    legs, names = [], []
-    for k, (run, threshold) in enumerate(zip(runs, thresholds_degc)):
-        leg, directions = leg_labels(run.temperature_degc, threshold, min_leg_blocks)
-        legs.append(leg)
-        names += [f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, "")
-                  for j, d in enumerate(directions)]
-    note = "" if asked in ("auto", kind) else f"folds={asked!r}: one run cannot be held out against others; "
-    if kind == "legs" and len(names) >= 2:
-        offsets = np.cumsum([0] + [int(leg.max()) + 1 for leg in legs[:-1]])
-        return Folds("legs", tuple(leg + o for leg, o in zip(legs, offsets)), tuple(names),
-                     note + "held out each heating and cooling leg" if note else "")
-    if kind == "legs":
-        note = (f"folds={asked!r}: " if asked != "auto" else "") + (
-            "the temperature never reverses, so there are no heating and cooling legs to hold out; held out "
-            f"{BLOCKS_PER_RUN} contiguous time blocks per run instead (neighbouring blocks share slow drift)")
-    per_run = max(BLOCKS_PER_RUN, math.ceil(MIN_FOLDS / len(runs)))
-    of_block, names = [], []
-    for k, run in enumerate(runs):
-        of_block.append(_split_long(np.zeros(run.value.size), per_run) + k * per_run)
-        names += [f"run {k + 1} block {j + 1}" for j in range(per_run)]
-    return Folds("blocks", tuple(of_block), tuple(names), note)
 
 
 def drift_rms(residual: np.ndarray, weight: np.ndarray, window: int) -> tuple[float, float]:
@@ -732,21 +629,6 @@ def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], m
                          problem.folds.note)
 
 
-def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
-    """The score's moving-average window [s]: a tenth of the median fold length, within
-    [WINDOW_MIN_S, WINDOW_MAX_S]."""
-    lengths = []
-    for f in range(folds.count):
-        n = sum(int(np.count_nonzero(fold == f)) for fold in folds.of_block)
-        lengths.append(n * block_s)
-    window = float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
-    return max(block_s, min(window, min(lengths) / 4.0))  # short folds: a window that still moves
-
-
-__all__ = ["AxisSelection", "Candidate", "CandidateScore", "Folds", "SelectionProblem", "Weighting", "choose",
-           "make_folds", "select_axis", "temperature_step_degc", "window_for"]
-
-
 def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,
                  block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
                  max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
@@ -793,7 +675,7 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     step = max(temperature_step_degc(t) for t in temps)
     reverses = (branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds))
     t_ref, t_scale = (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0
-    band, band_only = _band_offer(runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order),
+    band, band_only = band_offer(runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order),
                                   block_s, both_directions) if reverses and hysteresis_orders else (None, False)
     return SelectionProblem(runs, groups, folds, t_ref, t_scale, max(thresholds), block_s,
                             window_for(folds, runs, block_s), max_order, hysteresis_orders if reverses else (),
@@ -801,129 +683,5 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
                             branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else ())
 
 
-def _band_offer(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], folds: Folds, t_ref: float,
-                t_scale: float, order: int, block_s: float, both_directions: bool):
-    """(band, band only): the band where the branches part [degC] or None, and whether turning-point candidates
-    are offered only inside it.
-
-    Branches of one direction only, held out by legs of the same runs: an unbounded turning-point term is a change
-    of slope that the legs confirm but other runs need not share (measured on the CATS recording: fitted on two
-    runs, it doubled the third run's drift); one confined to a band where the branches visibly part (the thesis's
-    form) is offered. The band is found once on all the runs, so its candidates' scores are somewhat optimistic;
-    it must stand out by three standard errors per bin (:func:`parting_band_degc`). It is found through a fitted
-    lag only with one or two runs, where that is what finds it (the ADXRS450 case); with whole runs held out, it
-    moved the choice of the demo's MTi-10-class part to a worse gyro_y (measured: 0.0067 against 0.0019 deg/s)."""
-    band_only = both_directions and folds.kind != "runs" and not branches_identified(runs, thresholds,
-                                                                                     one_sided=False)
-    band = observed_band(runs, groups, thresholds, t_ref, t_scale, order, block_s if folds.kind != "runs" else None)
-    return band, band_only
-
-
-def heats_and_cools_blocks(runs: list[RunBlocks], thresholds: list[float]) -> bool:
-    """Whether the runs' blocks hold both a heating and a cooling stretch."""
-    directions = [find_turns(r.temperature_degc, th).direction for r, th in zip(runs, thresholds)]
-    return any(np.any(d > 0) for d in directions) and any(np.any(d < 0) for d in directions)
-
-
-#: the least share of a branch after a reversal (time-weighted) that must lie at temperatures the opposite
-#: direction of travel also visited, for its turning-point terms to be told apart from the polynomial
-BRANCH_OVERLAP = 0.75
-
-
-def branches_present(runs: list[RunBlocks], thresholds: list[float]) -> bool:
-    """Whether any run holds a branch after a confirmed reversal."""
-    return any(np.any(~np.isnan(find_turns(r.temperature_degc, th).turn_degc)) for r, th in zip(runs, thresholds))
-
-
-def branches_identified(runs: list[RunBlocks], thresholds: list[float], one_sided: bool = True) -> bool:
-    """Whether turning-point terms can be told apart from the polynomial: some branch after a reversal exists,
-    and for each direction that does, at least :data:`BRANCH_OVERLAP` of it (time-weighted) lies inside the
-    temperature range the opposite direction of travel covers. A branch that goes where the other direction
-    never went (a run cooled, then heated past its start) would fit curvature of the shape as hysteresis and
-    fail on the next leg.
-
-    ``one_sided=False`` also asks for branches after reversals in both directions. Use it when whole runs
-    cannot be held out: branches of one direction only (every run cooled then warmed) differ from the rest by
-    a change of slope that legs of the same runs confirm but other runs need not share (measured on the CATS
-    recording: fitted on two runs, a one-sided term passed the leg folds and doubled the third run's drift)."""
-    temps, after, direction, samples = [], [], [], []
-    for r, th in zip(runs, thresholds):
-        turns = find_turns(r.temperature_degc, th)
-        temps.append(r.temperature_degc)
-        after.append(~np.isnan(turns.turn_degc))
-        direction.append(turns.direction)
-        samples.append(r.samples.astype(float))
-    t, a, d, n = map(np.concatenate, (temps, after, direction, samples))
-    present = [sign for sign in (-1, 1) if np.any(a & (d == sign))]
-    if not one_sided and len(present) < 2:
-        return False
-    for sign in present:
-        ref = t[d == -sign]
-        if ref.size == 0:
-            return False
-        branch = a & (d == sign)
-        inside = branch & (t >= ref.min()) & (t <= ref.max())
-        if n[inside].sum() < BRANCH_OVERLAP * n[branch].sum():
-            return False
-    return bool(present)
-
-
-def _weighted_fit(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, float]:
-    """Residual and weighted residual sum of squares of the least-squares fit of ``y`` on ``x`` (weights ``w``)."""
-    sw = np.sqrt(w)
-    coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
-    resid = y - x @ coef
-    return resid, float(np.sum(w * resid ** 2))
-
-
-def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], t_ref_degc: float,
-                  t_scale_degc: float, order: int, block_s: float | None = None) -> tuple[float, float] | None:
-    """The band where the branches after a reversal part [degC] (:func:`parting_band_degc`), in the residual of
-    a polynomial of ``order`` with one constant per run, fitted by time-weighted least squares on the blocks.
-
-    With ``block_s`` [s], the polynomial is also fitted through a thermal lag, its time constant the one of a
-    log-spaced grid that leaves the least residual: a lag parts the heating and cooling branches everywhere by
-    about tempco x ramp rate x lag, which would otherwise hide a band of hysteresis of similar size. Each edge
-    of the band is then moved, within one temperature bin, to where a fit of the polynomial with turning-point
-    terms of order 2 inside the band leaves the least residual: bins place an edge up to a bin off, and a bump
-    that ends sharply leaves a step of its height there."""
-    group_ids = sorted(set(groups))
-    onehot = np.zeros((sum(r.value.size for r in runs), len(group_ids)))
-    start = 0
-    for r, g in zip(runs, groups):
-        onehot[start:start + r.value.size, group_ids.index(g)] = 1.0
-        start += r.value.size
-    y = np.concatenate([r.value for r in runs])
-    w = np.concatenate([r.samples.astype(float) for r in runs])
-    taus = [0.0] if block_s is None else [0.0, *np.geomspace(2 * block_s, min(LAG_MAX_S, max(
-        float(r.time_s[-1] - r.time_s[0]) for r in runs)) / 4, 8)]
-    best = None
-    for tau in taus:
-        temps = [thermal_lag(r.time_s, r.temperature_degc, tau, period_s=block_s)[0] if tau > 0
-                 else r.temperature_degc for r in runs]
-        u = (np.concatenate(temps) - t_ref_degc) / t_scale_degc
-        x = np.hstack([onehot, u[:, None] ** np.arange(1, order + 1)])
-        resid, rss = _weighted_fit(x, y, w)
-        if best is None or rss < best[0]:
-            best = (rss, temps, resid, x)
-    _, temps, resid, x = best
-    turns = [find_turns(t, th) for t, th in zip(temps, thresholds)]
-    t = np.concatenate(temps)
-    turn_degc = np.concatenate([tr.turn_degc for tr in turns])
-    after = ~np.isnan(turn_degc)
-    direction = np.concatenate([tr.direction for tr in turns])
-    band = parting_band_degc(t, resid, after, direction, tail=block_s is not None)
-    if band is None:
-        return None
-    d = np.where(after, np.abs(t - np.where(after, turn_degc, 0.0)), 0.0) / t_scale_degc
-    step = max(1.0, float(np.ptp(t)) / 40.0)  # parting_band_degc's bin
-    offsets = np.linspace(-step, step, 9)
-    edges = (np.inf, band)
-    for lo in band[0] + offsets:
-        for hi in band[1] + offsets:
-            inside = after & (t >= lo) & (t <= hi)
-            cols = [np.where(inside & (direction == sign), d ** j, 0.0) for sign in (-1, 1) for j in (1, 2)]
-            rss = _weighted_fit(np.hstack([x, np.column_stack(cols)]), y, w)[1]
-            if rss < edges[0]:
-                edges = (rss, (float(lo), float(hi)))
-    return edges[1]
+__all__ = ["AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "CandidateScore", "SelectionProblem", "Weighting",
+           "beats_constant", "choose", "paired_difference", "prepare_axis", "select_axis", "temperature_step_degc"]
