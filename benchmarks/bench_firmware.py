@@ -60,6 +60,13 @@ ArduPilot (`gyrocomp export model.json --format ardupilot -o thermal.parm`):
 `gyrocomp fit RUNS -o m.json --target px4|ardupilot` fits the best model the firmware carries, so that
 `gyrocomp apply` computes what the vehicle will; the default model (lag, hysteresis, higher orders) is better where
 the firmware can carry it, and the export prints what the file loses against it.
+
+Checking it: `gyrocomp report MODEL RUNS -o r.html` has an "On the autopilot" section (the PX4 and ArduPilot files
+exported from the model, applied to each run as each firmware applies them, beside the model), and after a flight
+`gyrocomp evaluate MODEL flight.ulg --installed` judges the calibration the vehicle holds, applied as its firmware
+applies it (PX4: only the `TC_Gn` slot whose id is the logged gyro's, stepped at 1 Hz / 1 degC; ArduPilot: relative
+to `INS_GYRn_CALTEMP`; a parameter left out has the firmware's default: PX4 TMIN/TMAX 0/100 degC, TREF 25 degC,
+ArduPilot 0/70 degC).
 """
 
 

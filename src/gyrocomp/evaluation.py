@@ -28,7 +28,7 @@ from .models.pose_rotation import rotation_errors
 from .models.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
 from .recording import ACCEL_AXES, GYRO_AXES, Recording
 from .triad import TriadCalibration
-from .installed import installed_calibration
+from .installed import installed_calibration, installed_correction_dps, px4_slot
 from .models.field import field_recordings
 
 
@@ -140,9 +140,10 @@ def evaluate_stages(calibration: Calibration, recording: Recording, *, window_s:
 class InstalledComparison:
     """A log's installed autopilot calibration against a gyrocomp model on the same data (its still segments when
     it moves most of the time): per gyro axis, the residual RMS [deg/s] (of the moving average about its mean)
-    raw, with the installed calibration and with the model. ``installed`` is None when the log's parameters hold
-    no enabled calibration; ``corrected_onboard`` when the logged data already went through it (raw is then
-    the installed one, and a model on top would correct twice: its figures are then NaN)."""
+    raw, with the installed calibration as the firmware applies it, and with the model. ``installed`` is None
+    when the log's parameters hold no calibration the firmware applies to this sensor (``note`` says why);
+    ``corrected_onboard`` when the logged data already went through it (raw is then the installed one, and a model
+    on top would correct twice: its figures are then NaN)."""
 
     file: str
     autopilot: str
@@ -154,14 +155,35 @@ class InstalledComparison:
     raw_dps: dict[str, float]
     installed_dps: dict[str, float]
     model_dps: dict[str, float]
+    note: str = ""
+
+
+def _installed_slot(recording: Recording, autopilot: str) -> tuple[int | None, str]:
+    """The slot the firmware applies to the logged sensor (PX4: the ``TC_G{i}`` whose id is the gyro's device
+    id, else the log's instance when it names no device id; ArduPilot: the IMU's ``INS_TCAL{n}``, n from 1),
+    or None and why."""
+    params = recording.metadata["autopilot_parameters"]
+    instance = int(recording.metadata.get("instance") or 0)
+    if autopilot == "ardupilot":
+        return instance + 1, ""
+    device_id = recording.metadata.get("device_id")
+    if device_id is None:
+        return instance, ""
+    slot = px4_slot(params, device_id)
+    if slot is None and int(params.get("TC_G_ENABLE", 0)) == 1:
+        return None, (f"no TC_G*_ID is the gyro's device id {device_id}: PX4 applies no thermal correction to it "
+                      "(export with device_id= that id)")
+    return slot, ""
 
 
 def compare_installed(calibration: Calibration, recording: Recording, *, window_s: float | None = None
                       ) -> InstalledComparison:
     """Judge the thermal calibration installed on the vehicle that wrote ``recording`` (a PX4 ULog's ``TC_G*`` or
-    an ArduPilot log's ``INS_TCAL*`` parameters, :func:`gyrocomp.installed.installed_calibration`) against
-    ``calibration`` on the same data: the log's still segments when it moves most of the time
-    (:func:`gyrocomp.models.field.field_recordings`), else all of it.
+    an ArduPilot log's ``INS_TCAL*`` parameters) against ``calibration`` on the same data: the log's still segments
+    when it moves most of the time (:func:`gyrocomp.models.field.field_recordings`), else all of it. The installed
+    calibration is applied as its firmware applies it (:func:`gyrocomp.installed.installed_correction_dps`: the
+    slot whose id is the sensor's, float32, clamped, PX4's 1 Hz / 1 degC republish, ArduPilot's calibration
+    temperature; a parameter the log leaves out has the firmware's default).
 
     Parameters
     ----------
@@ -177,8 +199,10 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
         raise InputError(f"{recording.source}: not a PX4 ULog or ArduPilot DataFlash log; the installed calibration "
                          "is read from a log's parameters")
     autopilot = "px4" if fmt == "ulog" else "ardupilot"
-    installed = installed_calibration(recording.metadata["autopilot_parameters"], autopilot,
-                                      int(recording.metadata.get("instance") or 0))
+    params = recording.metadata["autopilot_parameters"]
+    slot, note = _installed_slot(recording, autopilot)
+    installed = None if slot is None else installed_calibration(params, autopilot,
+                                                                slot if autopilot == "px4" else slot - 1)
     onboard = bool(recording.metadata.get("corrected_onboard"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)
@@ -186,6 +210,7 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
     data = runs[0]
     still_only = bool(contributions and contributions[0].still_only)
     window = window_s if window_s is not None else default_window_s(data)
+    rows = np.searchsorted(recording.time_s, data.time_s)  # the samples kept, in the whole log
 
     def residual(model: Calibration | None) -> dict[str, float]:
         if model is None:
@@ -193,11 +218,21 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
         evaluation = evaluate_run(data, apply(model, data), window_s=window)
         return {a: m.residual_rms_dps for a, m in evaluation.axes.items()}
 
+    def residual_installed() -> dict[str, float]:
+        if installed is None:
+            return {a: float("nan") for a in data.gyro_axes}
+        # the firmware runs over the whole log (PX4's republish follows its time), then the same samples are judged
+        correction = installed_correction_dps(params, autopilot, recording.time_s, recording.temperature_degc,
+                                              slot)[rows]
+        cols = [GYRO_AXES.index(a) for a in data.gyro_axes]
+        corrected = data.with_gyro(data.gyro_dps - correction[:, cols])
+        return {a: m.residual_rms_dps for a, m in evaluate_run(data, corrected, window_s=window).axes.items()}
+
     raw = {a: m.residual_rms_dps for a, m in evaluate_run(data, data, window_s=window).axes.items()}
     return InstalledComparison(recording.source, autopilot, None if installed is None else installed.model, onboard,
                                still_only, data.duration_s if not still_only else contributions[0].still_s, window,
-                               raw, raw if onboard else residual(installed),
-                               residual(None) if onboard else residual(calibration))
+                               raw, raw if onboard else residual_installed(),
+                               residual(None) if onboard else residual(calibration), note)
 
 
 __all__ = ["InstalledComparison", "compare_installed", "StageEvaluation", "evaluate", "evaluate_stages", "stage_calibrations"]

@@ -65,3 +65,25 @@ def test_the_command_line_fits_for_a_firmware(tmp_path, runs_and_held_out):
     assert "for px4" in r.stdout
     r = run("fit", *paths, "-o", tmp_path / "m.json", "--target", "px4", "--hysteresis", "lag")
     assert r.returncode == 2 and "--target: px4 has no lag or hysteresis term" in r.stderr
+
+
+def test_a_run_corrected_as_the_firmware_would_keeps_what_apply_leaves(runs_and_held_out):
+    """firmware_corrected (what the report's "On the autopilot" shows): with a --target ardupilot model, ArduPilot
+    leaves what apply leaves but a constant (its boot-time offset), so the same bias offset; PX4 as it runs adds
+    its 1 degC steps to a --target px4 model, never less than apply leaves."""
+    from gyrocomp.export.firmware import firmware_corrected
+    from gyrocomp.metrics import evaluate_run
+
+    fit, held = runs_and_held_out
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for target in ("ardupilot", "px4"):
+            cal = fit_calibration(fit, target=target)
+            model = evaluate_run(held, apply(cal, held), window_s=60.0).axes
+            vehicle = evaluate_run(held, firmware_corrected(cal, held, target), window_s=60.0).axes
+            for axis, m in model.items():
+                if target == "ardupilot":
+                    assert vehicle[axis].bias_offset_comp_dps == pytest.approx(m.bias_offset_comp_dps, rel=1e-4)
+                else:
+                    assert vehicle[axis].bias_offset_comp_dps >= 0.99 * m.bias_offset_comp_dps
+                    assert vehicle[axis].bias_offset_comp_dps < m.bias_offset_raw_dps / 2

@@ -71,9 +71,12 @@ def test_single_axis_report_with_hysteresis_has_every_section():
     runs = [simulate("adxrs450", profile=prof, rate_hz=0.5, seed=s).recording for s in range(3)]
     cal = _quiet(fit_calibration, runs[:2], hysteresis="turning-point")
     report = build_report(cal, [runs[2]])
-    assert report.sections == ("summary", "evaluation", "axis-gyro_z", "allan")
+    assert report.sections == ("summary", "evaluation", "axis-gyro_z", "firmware", "allan")
     page = _check_page(report.html, list(report.sections))
     assert len(page.images) == 3  # bias against temperature, time series, Allan
+    # the hysteresis is what the firmware cannot carry: its cost through a heat-cool cycle is shown
+    assert "correction against the model" in report.html and "heat-cool cycle as run" in report.html
+    assert "PX4 file (as run)" in report.html
     assert "stages of the compensation" in report.html  # the thesis's Table 4.4 shape with hysteresis
     assert "temperature + hysteresis" in report.html and "polynomial order" in report.html
 
@@ -87,7 +90,7 @@ def test_three_axis_report_with_acceleration_and_accelerometer():
     axes = [f"axis-{a}" for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")]
     # the combined profile visits the six faces: the accelerometer triad gets its section too
     assert cal.accel_triad is not None
-    assert report.sections == ("summary", "evaluation", *axes, "allan", "g-sensitivity", "scale-factor")
+    assert report.sections == ("summary", "evaluation", *axes, "firmware", "allan", "g-sensitivity", "scale-factor")
     _check_page(report.html, list(report.sections))
     assert "g-sensitivity matrix G [deg/s/g] +- standard error" in report.html
     assert "temperature + acceleration" in report.html and "accelerometer" in report.html

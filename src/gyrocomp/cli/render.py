@@ -49,6 +49,8 @@ def print_installed(results) -> None:
         for axis in r.raw_dps:
             table.add_row(axis, *(_number(v[axis]) for v in (r.raw_dps, r.installed_dps, r.model_dps)))
         console.print(table)
+        if r.note:
+            console.print(r.note)
         if r.corrected_onboard:
             console.print("the logged data are already corrected onboard: the model would correct them twice "
                           "(log the raw sensor, or disable the onboard calibration)")

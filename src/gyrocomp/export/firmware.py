@@ -1,100 +1,28 @@
-"""What the autopilots do with a parameter file: their temperature corrections evaluated as their source computes
-them, and how far that is from the gyrocomp model it was exported from.
-
-PX4 (``src/modules/temperature_compensation/TemperatureCompensation.cpp``, ``calc_thermal_offsets_3D``): the
-temperature is clamped to [TMIN, TMAX], d = T - TREF, and the offset X0 + X1 d + X2 d^2 + X3 d^3 [rad/s] is
-subtracted from the raw rate, in float32. ``TemperatureCompensationModule`` polls at 1 Hz and publishes new
-offsets only when the temperature moved by more than 1 degC since the last publication (its ``last_temperature``
-starts at -100 degC), so as it runs the correction steps (:func:`px4_as_run`).
-
-ArduPilot (``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``, ``TCal::correct_sensor`` and
-``polynomial_eval``): T and the gyro calibration temperature T_cal (``INS_GYRn_CALTEMP``) are clamped to
-[TMIN, TMAX]; v -= P(T - 35) - P(T_cal - 35) with P(d) = (c1 + (c2 + c3 d) d) d 1e-6 [rad/s], in float32: the
-correction is relative to T_cal, where the boot-time gyro offset was taken.
+"""How far an autopilot's correction, computed from an exported parameter file as its firmware computes it
+(:mod:`gyrocomp.installed`: PX4's ``calc_thermal_offsets_3D`` with its 1 Hz / 1 degC republish, ArduPilot's
+``TCal::correct_sensor``), is from the gyrocomp model it was exported from: inside the calibrated range, beyond
+it (the firmware clamps) and through a heat-cool cycle as it runs (what the file cannot carry: lag, hysteresis).
 
 Units at the interface: temperature [degC], corrections [deg/s] (what is subtracted from the gyro's output).
 """
 
 from __future__ import annotations
 
-import math
+import dataclasses
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..calibration import Calibration
 from ..compensate import predict_error
-from ..errors import InputError
-from ..installed import ARDUPILOT_SCALE, ARDUPILOT_TEMP_REFERENCE_DEGC
+from ..errors import DataQualityWarning, TemperatureRangeWarning
+from ..installed import Autopilot, ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
 from ..recording import GYRO_AXES, Recording
+from .autopilot import ardupilot_parameters, px4_parameters
 
-RAD_TO_DEG = 180.0 / math.pi
-#: PX4's TemperatureCompensationModule: poll period [s] and the temperature change that republishes [degC]
-PX4_POLL_S, PX4_REPUBLISH_DEGC = 1.0, 1.0
 #: how far beyond the calibrated range the exports judge the firmware against the model [degC]
 BEYOND_DEGC = 20.0
-
-
-def _param(params: dict, name: str) -> float:
-    if name not in params:
-        raise InputError(f"parameters: no {name}; the file does not hold that sensor's thermal calibration")
-    return float(params[name])
-
-
-def px4_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, instance: int = 0) -> np.ndarray:
-    """(n, 3) offsets PX4 subtracts from gyro x, y, z [deg/s] at ``temperature_degc`` [degC], from the
-    ``TC_G{instance}_*`` parameters, as ``calc_thermal_offsets_3D`` computes them (float32, clamped)."""
-    p = f"TC_G{instance}_"
-    f32 = np.float32
-    t = np.asarray(temperature_degc, dtype=f32)
-    d = np.clip(t, f32(_param(params, p + "TMIN")), f32(_param(params, p + "TMAX"))) - f32(_param(params, p + "TREF"))
-    d2 = d * d
-    d3 = d2 * d
-    out = np.empty((t.size, 3))
-    for j in range(3):
-        x = [f32(_param(params, f"{p}X{k}_{j}")) for k in range(4)]
-        out[:, j] = (x[0] + x[1] * d + x[2] * d2 + x[3] * d3).astype(float)
-    return out * RAD_TO_DEG
-
-
-def px4_as_run(params: dict, time_s: np.ndarray, temperature_degc: np.ndarray, instance: int = 0) -> np.ndarray:
-    """(n, 3) the offsets [deg/s] PX4 applies at each sample as it runs: recomputed at each 1 s poll, published
-    only when the temperature moved by more than 1 degC since the last publication (the first poll publishes)."""
-    t = np.asarray(time_s, dtype=float)
-    temp = np.asarray(temperature_degc, dtype=float)
-    polls = np.flatnonzero(np.diff(np.floor((t - t[0]) / PX4_POLL_S), prepend=-1.0) > 0) if t.size else []
-    published_at, last = [], -100.0
-    for k in polls:
-        if abs(temp[k] - last) > PX4_REPUBLISH_DEGC:
-            published_at.append(k)
-            last = temp[k]
-    if not published_at:
-        return np.zeros((t.size, 3))
-    index = np.asarray(published_at)
-    offsets = px4_gyro_correction_dps(params, temp[index], instance)
-    which = np.searchsorted(index, np.arange(t.size), side="right") - 1
-    out = offsets[np.maximum(which, 0)]
-    out[which < 0] = 0.0  # before the first publication nothing is applied
-    return out
-
-
-def ardupilot_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, cal_temp_degc: float,
-                                  instance: int = 1) -> np.ndarray:
-    """(n, 3) what ArduPilot subtracts from gyro x, y, z [deg/s] at ``temperature_degc`` [degC], its gyro offsets
-    taken at ``cal_temp_degc`` [degC], from the ``INS_TCAL{instance}_*`` parameters (``TCal::correct_sensor``)."""
-    p = f"INS_TCAL{instance}_"
-    f32 = np.float32
-    lo, hi = f32(_param(params, p + "TMIN")), f32(_param(params, p + "TMAX"))
-    t = np.clip(np.asarray(temperature_degc, dtype=f32), lo, hi) - f32(ARDUPILOT_TEMP_REFERENCE_DEGC)
-    t_cal = np.clip(f32(cal_temp_degc), lo, hi) - f32(ARDUPILOT_TEMP_REFERENCE_DEGC)
-    out = np.empty((t.size, 3))
-    for j, axis in enumerate("XYZ"):
-        c = [f32(_param(params, f"{p}GYR{k}_{axis}")) for k in (1, 2, 3)]
-        scale = f32(1.0 / ARDUPILOT_SCALE)
-        poly = (c[0] + (c[1] + c[2] * t) * t) * t * scale
-        poly_cal = (c[0] + (c[1] + c[2] * t_cal) * t_cal) * t_cal * scale
-        out[:, j] = (poly - poly_cal).astype(float)
-    return out * RAD_TO_DEG
 
 
 @dataclass(frozen=True)
@@ -130,7 +58,11 @@ def _stats(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def firmware_difference(calibration: Calibration, params: dict, target: str, instance: int) -> FirmwareDifference:
     """The firmware's correction against the model's (:class:`FirmwareDifference`); ``target`` ``px4`` or
     ``ardupilot``, ``params`` the exported parameter values."""
-    axes = tuple(a for a in GYRO_AXES if a in calibration.axes and calibration.axes[a].temperature is not None)
+    # the gyro's temperature correction is compared: neither firmware has a g-term, and the accelerometer's
+    # calibration is the accelerometer's
+    calibration = dataclasses.replace(calibration.without("acceleration") if calibration.has_acceleration
+                                      else calibration, accel_axes={}, accel_triad=None)
+    axes = _gyro_axes_with_curve(calibration)
     curves = [calibration.axes[a].temperature for a in axes]
     lo, hi = min(c.t_min_degc for c in curves), max(c.t_max_degc for c in curves)
     cols = [GYRO_AXES.index(a) for a in axes]
@@ -168,5 +100,54 @@ def firmware_difference(calibration: Calibration, params: dict, target: str, ins
                               as_tuple(f))
 
 
-__all__ = ["BEYOND_DEGC", "FirmwareDifference", "ardupilot_gyro_correction_dps", "firmware_difference",
-           "px4_as_run", "px4_gyro_correction_dps"]
+#: the firmwares judged, and the slot each exports by default (PX4 TC_G0, ArduPilot INS_TCAL1)
+TARGETS: dict[str, int] = {"px4": 0, "ardupilot": 1}
+#: the device ids written when judging a PX4 file: an id chooses the slot, it does not enter the correction
+_ANY_DEVICE_ID = 1
+
+
+def _gyro_axes_with_curve(calibration: Calibration) -> tuple[str, ...]:
+    return tuple(a for a in GYRO_AXES if a in calibration.axes and calibration.axes[a].temperature is not None)
+
+
+def firmware_parameters(calibration: Calibration, target: Autopilot) -> dict[str, float]:
+    """The gyro thermal parameters ``gyrocomp export --format target`` writes for ``calibration`` (default slot;
+    the left-out terms are not warned about here: :func:`firmware_difference` measures them)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)
+        if target == "px4":
+            return px4_parameters(calibration, instance=TARGETS["px4"], device_id=_ANY_DEVICE_ID,
+                                  accel_device_id=_ANY_DEVICE_ID).values
+        return ardupilot_parameters(calibration, instance=TARGETS["ardupilot"]).values
+
+
+def firmware_corrected(calibration: Calibration, recording: Recording, target: Autopilot) -> Recording:
+    """``recording`` corrected as the autopilot would correct it with the file exported from ``calibration``: PX4
+    as it runs (1 Hz, 1 degC republish), ArduPilot relative to the run's first temperature (where its boot-time
+    gyro offset is taken). Only the gyro axes the model has a temperature curve for are corrected [deg/s]."""
+    params = firmware_parameters(calibration, target)
+    temperature = recording.temperature_degc
+    if target == "px4":
+        correction = px4_as_run(params, recording.time_s, temperature, TARGETS["px4"])
+    else:
+        correction = ardupilot_gyro_correction_dps(params, temperature, float(temperature[0]), TARGETS["ardupilot"])
+    gyro = np.array(recording.gyro_dps, dtype=float, copy=True)
+    for axis in _gyro_axes_with_curve(calibration):
+        if axis in recording.gyro_axes:
+            gyro[:, recording.gyro_axes.index(axis)] -= correction[:, GYRO_AXES.index(axis)]
+    return recording.with_gyro(gyro)
+
+
+def firmware_costs(calibration: Calibration) -> dict[str, FirmwareDifference]:
+    """What loading ``calibration`` into each autopilot costs: :func:`firmware_difference` of the PX4 and the
+    ArduPilot file export writes, by target; empty when no gyro axis has a temperature curve."""
+    if not _gyro_axes_with_curve(calibration):
+        return {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)  # the model continues past its range: the point
+        return {target: firmware_difference(calibration, firmware_parameters(calibration, target), target, slot)
+                for target, slot in TARGETS.items()}
+
+
+__all__ = ["BEYOND_DEGC", "FirmwareDifference", "TARGETS", "ardupilot_gyro_correction_dps", "firmware_corrected",
+           "firmware_costs", "firmware_difference", "firmware_parameters", "px4_as_run", "px4_gyro_correction_dps"]

@@ -232,5 +232,8 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature,
                          {"path": str(path), "format": "dataflash", "record": record, "instance": instance,
-                          "autopilot_parameters": {k: v for k, v in params.items() if k.startswith("INS_TCAL")},
+                          "corrected_onboard": params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU",
+                          # the installed thermal calibration and the temperatures its gyro offsets were taken at
+                          "autopilot_parameters": {k: v for k, v in params.items()
+                                                   if k.startswith("INS_TCAL") or k.endswith("_CALTEMP")},
                           "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0})

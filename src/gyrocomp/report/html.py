@@ -8,7 +8,9 @@ plain cubic and gyrocomp's default, as ``gyrocomp validate`` prints it), ``evalu
 by stage when the model has stages), one ``axis-<name>`` per axis (bias against temperature with the
 heating and cooling branches, fitted curve, turning points and residual; raw and compensated output
 against time), ``allan`` (raw and compensated Allan deviation per run), ``g-sensitivity`` when the
-model has a g-sensitivity matrix, and ``scale-factor`` when it has a gyro or accelerometer triad (K with standard
+model has a g-sensitivity matrix, ``firmware`` when it has a gyro temperature curve (the PX4 and ArduPilot files
+exported from it as each firmware applies them: their correction against the model's and the bias offset they
+leave on each run), and ``scale-factor`` when it has a gyro or accelerometer triad (K with standard
 errors, scale-factor error against temperature, and the residual of each still pose (|a| - 1 g) and each turn
 between poses (the gravity direction the gyro predicts) before and after), and ``stillness`` for runs that move
 most of the time (field logs): their still segments drawn over the rate and temperature, and listed.
@@ -31,6 +33,7 @@ from ..calibration import Calibration
 from ..compensate import apply
 from ..errors import DataQualityWarning, TemperatureRangeWarning
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
+from ..export.firmware import BEYOND_DEGC, firmware_corrected, firmware_costs
 from ..metrics import evaluate_run
 from ..noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
@@ -367,6 +370,9 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
         sections.update(_axis_sections(calibration, runs, compensated, windows))
+        costs = firmware_costs(calibration)
+        if costs:
+            sections["firmware"] = ("On the autopilot", _firmware(calibration, runs, evaluations, costs))
         tick()
         sections["allan"] = ("Allan deviation", _allan(runs, compensated, tick))
         if calibration.has_acceleration:
@@ -378,6 +384,35 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
             sections["stillness"] = ("Still moments of the field logs", _stillness(moving))
         tick()
     return Report(_page(calibration, runs, sections), tuple(sections))
+
+
+def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list, costs: dict) -> str:
+    """What the PX4 and ArduPilot files exported from the model do, as each firmware computes them
+    (:mod:`gyrocomp.export.firmware`): their correction against the model's, and the bias offset each leaves on
+    the runs."""
+    rows = [[target, axis, d.in_range_max_dps[j], d.in_range_rms_dps[j], d.beyond_max_dps[j], d.beyond_rms_dps[j],
+             d.as_run_max_dps[j], d.as_run_rms_dps[j]] for target, d in costs.items() for j, axis in enumerate(d.axes)]
+    parts = [_table(["firmware", "axis", "in range, largest", "in range, RMS", f"{BEYOND_DEGC:g} degC beyond, largest",
+                     f"{BEYOND_DEGC:g} degC beyond, RMS", "heat-cool cycle as run, largest",
+                     "heat-cool cycle as run, RMS"], rows,
+                    "the firmware's correction against the model's [deg/s] (about its mean): the firmware clamps at "
+                    "the calibrated range, carries a cubic without lag or hysteresis, and PX4 republishes at 1 Hz "
+                    "when the temperature moved by more than 1 degC")]
+    run_rows = []
+    for rec, ev in zip(runs, evaluations):
+        if rec.temperature_degc is None:
+            continue
+        on_vehicle = {target: evaluate_run(rec, firmware_corrected(calibration, rec, target), window_s=ev.window_s)
+                      for target in costs}
+        for axis, m in ev.axes.items():
+            if all(axis in v.axes for v in on_vehicle.values()):
+                run_rows.append([rec.source.rsplit("/", 1)[-1], axis, m.bias_offset_raw_dps, m.bias_offset_comp_dps,
+                                 *(on_vehicle[t].axes[axis].bias_offset_comp_dps for t in costs)])
+    if run_rows:
+        parts.append(_table(["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"], run_rows,
+                            "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
+                            "files as each firmware applies them"))
+    return "\n".join(parts)
 
 
 def _allan(runs: list[Recording], compensated: list[Recording], tick: Callable[[], None]) -> str:
