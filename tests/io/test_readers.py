@@ -280,6 +280,89 @@ def test_rosbag_imu_and_temperature_matched_by_time(tmp_path, ros2):
     assert detect_format(path) == "rosbag"
 
 
+def test_a_bag_is_read_from_its_own_files_and_type_names_only(tmp_path):
+    """A ROS 1 connection whose message type is Python rather than a ROS name is refused before rosbags makes
+    code of it; a ROS 2 bag folder whose storage file links out of the folder is refused, naming the link."""
+    from rosbags.rosbag1 import Writer
+
+    marker = tmp_path / "ran"
+    hostile = f"x/msg/A': (), **__import__('os').system('touch {marker}') and {{}}, 'b"
+    with Writer(tmp_path / "hostile.bag") as writer:
+        connection = writer.add_connection("/evil", hostile, msgdef="int32 a", md5sum="0" * 32)
+        writer.write(connection, 1, b"\x01\x00\x00\x00")
+    with pytest.raises(InputError, match=r"hostile.bag: topic '/evil' has the message type .*, not a ROS type name"):
+        read(tmp_path / "hostile.bag")
+    assert not marker.exists()
+    folder = tmp_path / "bag"
+    _write_bag(folder, ros2=True)
+    storage = next(f for f in folder.iterdir() if f.name != "metadata.yaml")
+    elsewhere = tmp_path / "elsewhere" / storage.name
+    elsewhere.parent.mkdir()
+    storage.rename(elsewhere)
+    storage.symlink_to(elsewhere)
+    with pytest.raises(InputError, match=rf"bag: {re.escape(storage.name)} links to .*elsewhere.*, outside the bag "
+                                         r"folder; gyrocomp reads only the bag's own files"):
+        read(folder)
+    result = run("convert", folder, tmp_path / "out.csv")
+    assert result.returncode == 2 and "outside the bag folder" in result.stderr and not (tmp_path / "out.csv").exists()
+
+
+def _ulog_with_appended_offset(tmp_path, name: str, offset_of):
+    import struct
+
+    n = 200
+    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 10_000).astype(np.uint64)),
+              **{a: ("float", np.zeros(n, np.float32)) for a in "xyz"},
+              "temperature": ("float", np.full(n, 30.0, np.float32))}
+    write_ulog(tmp_path / "plain.ulg", {("sensor_gyro", 0): fields})
+    data = bytearray((tmp_path / "plain.ulg").read_bytes())
+    payload = 16 + 3  # the flag-bits message is the first: incompat flags at +8, appended offsets at +16
+    data[payload + 8] = 1  # DATA_APPENDED
+    data[payload + 16:payload + 24] = struct.pack("<Q", offset_of(len(data)))
+    (tmp_path / name).write_bytes(bytes(data))
+    return tmp_path / name
+
+
+def test_ulog_appended_data_offsets_are_checked(tmp_path):
+    """The flag bits' appended-data offset inside a message (pyulog would stop there and drop the rest without a
+    word) is refused naming the byte; one past the end is a warning, and the log is read whole."""
+    inside = _ulog_with_appended_offset(tmp_path, "inside.ulg", lambda size: size // 2 + 1)
+    with pytest.raises(InputError, match=r"inside.ulg: the flag bits say data were appended at byte \d+, where no "
+                                         r"message starts: a damaged log"):
+        read(inside)
+    past = _ulog_with_appended_offset(tmp_path, "past.ulg", lambda size: 10 ** 12)
+    with pytest.warns(DataQualityWarning, match=r"past.ulg: the flag bits say data were appended at byte "
+                                                r"1000000000000, past the end of the file \(\d+ bytes\): none read"):
+        rec = read(past)
+    assert rec.n_samples == 200
+
+
+def test_compressed_tables_are_streamed_and_archives_refused(tmp_path):
+    """A gzip CSV reads as the plain one; a zip archive (which may hold several tables) is refused in one line; a
+    gzip bomb (400 MB of one line in 0.4 MB) is refused by the chunked reader, not read into memory."""
+    import gzip
+    import zipfile
+
+    text = "time,gyro_x,temperature\n" + "".join(f"{k},{0.01 * k},{20 + 0.1 * k}\n" for k in range(50))
+    (tmp_path / "t.csv").write_text(text)
+    with gzip.open(tmp_path / "t.csv.gz", "wt") as fh:
+        fh.write(text)
+    plain, packed = read(tmp_path / "t.csv"), read(tmp_path / "t.csv.gz")
+    np.testing.assert_array_equal(plain.gyro_dps, packed.gyro_dps)
+    with zipfile.ZipFile(tmp_path / "t.zip", "w") as archive:
+        archive.writestr("a.csv", text)
+        archive.writestr("b.csv", text)
+    result = run("convert", tmp_path / "t.zip", tmp_path / "out.csv")
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1 and "t.zip" in result.stderr
+    with gzip.open(tmp_path / "bomb.csv.gz", "wb", compresslevel=1) as fh:
+        fh.write(b"time,gyro_x,temperature\n")
+        for _ in range(40):
+            fh.write(b"1" * 10_000_000)
+    result = run("convert", tmp_path / "bomb.csv.gz", tmp_path / "bomb.csv")
+    assert result.returncode == 2 and "bomb.csv.gz: not a readable gzip CSV file" in result.stderr
+    assert not (tmp_path / "bomb.csv").exists()
+
+
 def test_rosbag_topic_choices_and_missing_topics(tmp_path):
     path = tmp_path / "two.bag"
     _write_bag(path, ros2=False, temperature=False, imu_topics=("/imu0", "/imu1"))

@@ -7,6 +7,7 @@ time, straight into arrays; a ROS 2 bag is its folder (with ``metadata.yaml``) o
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
@@ -21,6 +22,9 @@ IMU_TYPE = "sensor_msgs/msg/Imu"
 TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
 _RAD = unit_factor("gyro", "rad/s")
 _MS2 = unit_factor("accel", "m/s2")
+#: a message type name as ROS spells them (package/msg/Name): rosbags turns the bag's type names into Python code,
+#: so anything else is refused before it gets there
+_MSGTYPE = re.compile(r"[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*){1,2}")
 
 
 def bag_path(path: Path) -> Path:
@@ -28,6 +32,28 @@ def bag_path(path: Path) -> Path:
     if path.is_file() and path.suffix.lower() in (".db3", ".mcap") and (path.parent / "metadata.yaml").exists():
         return path.parent
     return path
+
+
+def _only_its_own_files(path: Path, bag: Path) -> None:
+    """Refuse a ROS 2 bag folder holding a link to a file outside it: a bag is read from its own files only."""
+    if not bag.is_dir():
+        return
+    root = bag.resolve()
+    for entry in sorted(bag.iterdir()):
+        if entry.is_symlink() and root not in entry.resolve().parents:
+            raise InputError(f"{path}: {entry.name} links to {entry.resolve()}, outside the bag folder; gyrocomp reads "
+                             "only the bag's own files (copy the file into the folder)")
+
+
+def _check_types(path: Path, readers: list) -> None:
+    """Open each underlying reader once to refuse message type names that are not ROS names, before rosbags
+    makes Python code of them."""
+    for reader in readers:
+        with reader:
+            for connection in reader.connections:
+                if not _MSGTYPE.fullmatch(str(connection.msgtype)):
+                    raise InputError(f"{path}: topic {connection.topic!r} has the message type "
+                                     f"{str(connection.msgtype)[:80]!r}, not a ROS type name; refused")
 
 
 def _topic(path: Path, connections: list, msgtype: str, asked: str | None, option: str):
@@ -99,9 +125,14 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
     if not path.exists():
         raise InputError(f"{path}: no such file or folder")
+    bag = bag_path(path)
+    _only_its_own_files(path, bag)
     try:
-        reader = highlevel.AnyReader([bag_path(path)])
+        reader = highlevel.AnyReader([bag])
+        _check_types(path, reader.readers)
         reader.open()
+    except InputError:
+        raise
     except Exception as exc:  # rosbags raises its own error types for files that are not bags
         raise InputError(f"{path}: not a readable ROS bag ({type(exc).__name__}: {exc})") from None
     try:

@@ -44,26 +44,59 @@ _MESSAGE_HEADER = struct.Struct("<HB")  # msg_size (payload bytes), msg_type
 _FILE_HEADER_BYTES = 16  # magic (7), version (1), timestamp (8)
 
 
+def _walk(path: Path, stops: tuple[int, ...] = ()) -> tuple[tuple[int, int] | None, set[int]]:
+    """(the cut of :func:`cut_message`, the offsets of ``stops`` at which a message starts)."""
+    with open(path, "rb") as fh:
+        size = fh.seek(0, 2)
+        if size <= _FILE_HEADER_BYTES:
+            return None, set()
+        wanted, hit = set(stops), set()
+        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            pos, unpack = _FILE_HEADER_BYTES, _MESSAGE_HEADER.unpack_from
+            while pos + 3 <= size:
+                if pos in wanted:
+                    hit.add(pos)
+                end = pos + 3 + unpack(data, pos)[0]
+                if end > size:
+                    return (pos, end - size), hit
+                pos = end
+            return ((pos, 3 - (size - pos)) if pos < size else None), hit
+
+
 def cut_message(path: Path) -> tuple[int, int] | None:
     """(offset, bytes missing) of a last message the file ends inside of, or None when the ULog's message
     framing ends exactly at the end of the file. pyulog reads a cut log as a shorter one without a word; a
     cut (a log copied while written, a partial download) almost always lands inside a message."""
+    return _walk(path)[0]
+
+
+def appended_offsets(path: Path) -> tuple[int, ...]:
+    """The offsets [bytes] at which the ULog's flag-bits message says data were appended (its first
+    incompatible flag, DATA_APPENDED), or () when it says none."""
     with open(path, "rb") as fh:
-        size = fh.seek(0, 2)
-        if size <= _FILE_HEADER_BYTES:
-            return None
-        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
-            pos, unpack = _FILE_HEADER_BYTES, _MESSAGE_HEADER.unpack_from
-            while pos + 3 <= size:
-                end = pos + 3 + unpack(data, pos)[0]
-                if end > size:
-                    return pos, end - size
-                pos = end
-            return (pos, 3 - (size - pos)) if pos < size else None
+        head = fh.read(_FILE_HEADER_BYTES + 3 + 40)
+    if len(head) < _FILE_HEADER_BYTES + 3 + 40:
+        return ()
+    size, kind = _MESSAGE_HEADER.unpack_from(head, _FILE_HEADER_BYTES)
+    payload = _FILE_HEADER_BYTES + 3
+    if kind != ord("B") or size < 40 or not head[payload + 8] & 1:
+        return ()
+    return tuple(o for o in struct.unpack_from("<3Q", head, payload + 16) if o)
 
 
-def _warn_if_cut(path: Path) -> None:
-    cut = cut_message(path)
+def _check_framing(path: Path) -> None:
+    """Warn of a cut log; refuse appended-data offsets that fall inside a message (a damaged flag-bits message:
+    pyulog would stop reading there and drop what follows without a word); warn of offsets past the end."""
+    offsets = appended_offsets(path)
+    cut, starts = _walk(path, offsets)
+    size = path.stat().st_size
+    for offset in offsets:
+        if offset >= size:
+            warnings.warn(f"{path}: the flag bits say data were appended at byte {offset}, past the end of the file "
+                          f"({size} bytes): none read", DataQualityWarning, stacklevel=3)
+        elif offset not in starts:
+            raise InputError(f"{path}: the flag bits say data were appended at byte {offset}, where no message "
+                             "starts: a damaged log (read on, the data after that byte would be dropped)")
     if cut is not None:
         warnings.warn(f"{path}: the file ends {cut[1]} byte(s) short inside its last message (at byte {cut[0]}): "
                       "a truncated or damaged log; read up to there", DataQualityWarning, stacklevel=3)
@@ -213,7 +246,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
             ulog = pyulog.ULog(str(path), list(GYRO_TOPICS) + ["sensor_accel"], parse_header_only=False)
     except Exception as exc:  # pyulog raises bare Exceptions on corrupt files
         raise InputError(f"{path}: not a readable ULog ({type(exc).__name__}: {exc})") from None
-    _warn_if_cut(path)
+    _check_framing(path)
     if progress:
         progress(0.8)
     names = {d.name for d in ulog.data_list}
