@@ -328,8 +328,24 @@ def test_bad_input_is_refused_with_a_clear_message():
         OnlineCalibrator.from_dict(broken, "state.json")
     broken = json.loads(json.dumps(good))
     broken["points"]["session"] = [5] * len(broken["points"]["session"])
-    with pytest.raises(InputError, match=r"state.json: points.session: .* session numbers in 0..1"):
+    with pytest.raises(InputError, match=r"state.json: points.session: whole numbers in 0..1 expected"):
         OnlineCalibrator.from_dict(broken, "state.json")
+    # finite but forged: numbers that would overflow the refit, integers beyond numpy's, a temperature no sensor has
+    for section, field, value, message in (
+            ("points", "bias_dps", 1e308, r"points.bias_dps: holds 1e\+308, beyond the 1e\+12 a learner state holds"),
+            ("points", "temperature_degc", 5000.0, r"points.temperature_degc: holds 5e\+03, beyond the 200"),
+            ("noise", "var_count", 10 ** 29, r"noise.var_count: whole numbers in 0..\d+ expected"),
+            ("stream", "t0", -1e300, r"stream.t0: holds -1e\+300, beyond")):
+        forged = json.loads(json.dumps(good))
+        target = forged[section][field]
+        while isinstance(target, list) and isinstance(target[0], list):
+            target = target[0]
+        if isinstance(target, list):
+            target[0] = value
+        else:
+            forged[section][field] = value
+        with pytest.raises(InputError, match=message):
+            OnlineCalibrator.from_dict(forged, "state.json")
     log = _short_log()
     with pytest.raises(InputError, match="sampled at 10 Hz; the learner was set up for 25 Hz"):
         replay(OnlineCalibrator(25.0), [log])
