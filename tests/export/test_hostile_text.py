@@ -117,3 +117,40 @@ def test_a_hostile_axis_name_is_refused_on_load(model):
     renamed["axes"] = {HOSTILE if k == "gyro_z" else k: v for k, v in axes.items()}
     with pytest.raises(InputError, match=r"axes"):
         Calibration.from_dict(renamed)
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+def test_a_hostile_serial_and_header_reach_no_generated_code(tmp_path):
+    """A store row whose serial, and a table whose column names, are hostile: fleet export's C compiles to the same
+    object as a unit named plainly from a plainly named table; its PX4 parameter lines are the same."""
+    from gyrocomp.io.tables import write_recording
+
+    from ..conftest import run
+
+    rec = simulate("consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 60.0), cycles=1), rate_hz=0.5,
+                   seed=1).recording
+    plain_csv = tmp_path / "plain.csv"
+    write_recording(rec, plain_csv)
+    header = 'g*/ system(0); /* ??/'
+    text = plain_csv.read_text().splitlines()
+    hostile_csv = tmp_path / "hostile.csv"
+    hostile_csv.write_text("\n".join([text[0].replace("gyro_x", f'"{header}"')] + text[1:]) + "\n")
+    objects, parameters = [], []
+    for name, (serial, source, extra) in {"plain": ("U1", plain_csv, []),
+                                          "hostile": ('*/ int x; /* ??/', hostile_csv,
+                                                      ["--columns", f"gyro_x={header}"])}.items():
+        manifest = tmp_path / f"manifest_{name}.csv"
+        manifest.write_text(f'path,serial\n{source},"{serial}"\n')
+        fitted = run("fleet", "fit", "--manifest", manifest, "-o", tmp_path / name, "--scheduler", "serial",
+                     *extra)
+        assert fitted.returncode == 0, fitted.stderr
+        out = tmp_path / f"{name}_c"
+        exported = run("fleet", "export", serial, "--store", tmp_path / name, "--format", "c", "-o", out, "--rate", 0.5)
+        assert exported.returncode == 0, exported.stderr
+        objects.append(_compile(tmp_path / f"{name}_o", {f.name: f.read_text() for f in out.iterdir()}))
+        params = tmp_path / f"{name}.params"
+        exported = run("fleet", "export", serial, "--store", tmp_path / name, "--format", "px4", "-o", params,
+                       "--device-id", 7)
+        assert exported.returncode == 0, exported.stderr
+        parameters.append(_parameters(params.read_text()))
+    assert objects[0] == objects[1] and parameters[0] == parameters[1]
