@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test docs bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -18,6 +18,11 @@ demo: $(STAMP)
 # two processes (pytest-xdist), each test file in one of them (its module fixtures built once)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile
+
+# the documentation site (MkDocs, Material, mkdocstrings) into site/, warnings as errors
+docs: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[docs]'
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 
 bench: $(STAMP)
 	$(BIN)/pip install -q -e '.[bench]'
@@ -33,4 +38,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_apply_stream.py --rows 3e7 --skip-whole
 
 clean:
-	rm -rf $(VENV) demo-output build src/*.egg-info
+	rm -rf $(VENV) demo-output build site src/*.egg-info

@@ -1,6 +1,6 @@
-"""The shared static recordings, read for the noise tests and the README table.
+"""The shared static recordings, read for the noise tests and the table of docs/accuracy-tested.md.
 
-Run ``python -m tests.real_data`` from the repository root to print the README's table.
+Run ``python -m tests.real_data`` from the repository root to print the table of docs/accuracy-tested.md.
 Readers for the one-off formats (.rda: rdata, NetCDF: h5py) come with the ``[test]`` extra only.
 """
 

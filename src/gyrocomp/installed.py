@@ -175,6 +175,8 @@ def installed_calibration(parameters: dict[str, float], autopilot: str, instance
     instance : int
         The sensor instance from 0 (PX4 ``TC_G{instance}``, ArduPilot ``INS_TCAL{instance + 1}``).
 
+    Notes
+    -----
     The cubic becomes a polynomial in T - reference, held at TMIN and TMAX as the autopilots clip; PX4's X0 is the
     model's constant (ArduPilot's curve has none: its bias at the ordinary calibration's temperature belongs to
     the gyro offsets, so the constant is 0 and only drift is judged). PX4's SCL other than 1 is not modelled: a

@@ -154,6 +154,8 @@ def read(
     progress : callable, optional
         Called with the fraction done.
 
+    Notes
+    -----
     The same options as :class:`ReadOptions` (its doc says more of each).
     """
     read_options = ReadOptions(layout=layout or TableLayout(), drop_nonfinite=drop_nonfinite, instance=instance,

@@ -263,6 +263,8 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
         held at its range's edges as the firmware clamps, nothing else), so that ``apply`` computes what the
         exported file will (see :class:`~gyrocomp.models.options.FitOptions`).
 
+    Notes
+    -----
     Every option is checked as :class:`~gyrocomp.models.options.FitOptions` checks it (its errors name the
     field). Whenever something is left to choose (``Polynomial()`` or ``hysteresis="auto"``, no band given),
     every candidate is scored by held-out drift and the simplest within one standard error of the best is

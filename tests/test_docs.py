@@ -1,0 +1,53 @@
+"""The README and the documentation site: the README stays a first visitor's page (under 10 KB, every link to a
+page that exists), every page of docs/ is in the site's navigation, and the README's Python example runs."""
+
+import re
+import warnings
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_the_readme_is_short_and_links_to_pages_that_exist():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.encode()) < 10_000
+    head = text.splitlines()[:6]
+    assert any(line.startswith("make demo") for line in head) and any(line.startswith("make test") for line in head)
+    links = re.findall(r"\]\(([^)]+)\)", text)
+    assert len(links) >= 10
+    for link in links:
+        assert (ROOT / link).is_file(), link
+
+
+def test_every_page_is_in_the_sites_navigation():
+    nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8").split("\nnav:", 1)[1]
+    listed = set(re.findall(r":\s*([\w-]+\.md)\s*$", nav, flags=re.M))
+    pages = {p.name for p in (ROOT / "docs").glob("*.md")}
+    assert pages == listed
+
+
+def test_the_readmes_python_example_runs(tmp_path, monkeypatch):
+    """The three lines of the README's Python example, on simulated chamber runs written as the files it names."""
+    from gyrocomp.io.tables import write_recording
+    from gyrocomp.simulate import get_profile, simulate
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    code = re.search(r"```python\n(.*?)```", text, flags=re.S).group(1)
+    prof = get_profile("cycle", set_points_degc=(-10.0, 50.0), cycles=1)
+    for k, name in enumerate(("chamber_1.csv", "chamber_2.csv", "flight.csv")):
+        write_recording(simulate("consumer", profile=prof, rate_hz=0.5, seed=k).recording, tmp_path / name)
+    monkeypatch.chdir(tmp_path)
+    scope: dict = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        exec(code, scope)  # noqa: S102 - the README's own example
+    assert scope["model"].axes and scope["compensated"].n_samples == scope["gyrocomp"].read("flight.csv").n_samples
+
+
+@pytest.mark.parametrize("page", sorted(p.name for p in (ROOT / "docs").glob("*.md")))
+def test_each_page_opens_with_its_one_title(page):
+    text = re.sub(r"```.*?```", "", (ROOT / "docs" / page).read_text(encoding="utf-8"), flags=re.S)
+    titles = [line for line in text.splitlines() if line.startswith("# ")]
+    assert len(titles) == 1 and text.startswith(titles[0])
