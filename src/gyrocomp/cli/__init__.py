@@ -23,6 +23,7 @@ import click
 
 from .._version import __version__
 from ..errors import CHECKS, GyrocompError, InputError, PlausibilityWarning, printable, silence_pattern
+from .projectfile import PROJECT_KEY, defaults_for, load_project
 
 EXIT_INPUT = 2
 EXIT_FAILURE = 1
@@ -52,6 +53,9 @@ COMMANDS = {
     "plot": ("plot", 'Single figures as PNG, SVG or PDF (from the suffix of -o).'),
     "fleet": ("fleet", 'Production calibration of many units: fit them on Dask into a calibration store, judge them '
                   "against limits, look a unit's calibration up and export it."),
+    "init": ("project", "Write a project file for LOG's kind of table: its columns and units guessed from their "
+                        "names and magnitudes, said one by one, read by every command run in this folder."),
+    "config": ("project", "The project file in use (gyrocomp.toml in this folder, or --config)."),
     "demo": ("demo", 'The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score '
                 'it, and write the HTML report.'),
 }
@@ -75,9 +79,16 @@ class LazyGroup(click.Group):
         return sorted(COMMANDS)
 
     def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        """The command, imported now, with the project file's options as its defaults (``gyrocomp.toml``)."""
         if name not in COMMANDS:
             return None
-        return getattr(importlib.import_module(f"gyrocomp.cli.{COMMANDS[name][0]}"), name)
+        command = getattr(importlib.import_module(f"gyrocomp.cli.{COMMANDS[name][0]}"), name)
+        if PROJECT_KEY not in ctx.meta:
+            ctx.meta[PROJECT_KEY] = load_project(ctx.params.get("config"), tuple(COMMANDS))
+        project = ctx.meta[PROJECT_KEY]
+        if project is not None:
+            ctx.default_map = {**(ctx.default_map or {}), name: defaults_for(project, command, name)}
+        return command
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         limit = formatter.width - 6 - max(len(name) for name in COMMANDS)
@@ -92,8 +103,10 @@ class LazyGroup(click.Group):
 @click.option("--quiet", "-q", is_flag=True, help="Print only errors (no tables, no warnings).")
 @click.option("--allow", "allowed", multiple=True, type=click.Choice(CHECKS), metavar="CHECK",
               help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.")
+@click.option("--config", "config", default=None, metavar="FILE",
+              help="Project file of default options (default: gyrocomp.toml in this folder, when there is one).")
 @click.pass_context
-def cli(ctx, debug, quiet, allowed):
+def cli(ctx, debug, quiet, allowed, config):
     """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
     g-sensitivity) from logs, and measure what is left.
 

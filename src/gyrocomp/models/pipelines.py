@@ -265,11 +265,9 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
 
     Notes
     -----
-    Every option is checked as :class:`~gyrocomp.models.options.FitOptions` checks it (its errors name the
-    field). Whenever something is left to choose (``Polynomial()`` or ``hysteresis="auto"``, no band given),
-    every candidate is scored by held-out drift and the simplest within one standard error of the best is
-    fitted (:mod:`gyrocomp.models.selection`); an axis where no temperature model beats the run constant
-    gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
+    Options are checked as :class:`~gyrocomp.models.options.FitOptions` checks them. What is left to choose is
+    chosen by held-out drift (:mod:`gyrocomp.models.selection`: the simplest within one standard error of the best);
+    an axis no temperature model helps gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
     options = FitOptions(temperature=temperature, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
                          hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,

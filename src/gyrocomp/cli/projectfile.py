@@ -1,0 +1,109 @@
+"""The project file (``gyrocomp.toml``): tell your data once, for every command (``gyrocomp init`` writes one,
+``gyrocomp config show`` prints the one in use: :mod:`gyrocomp.cli.project`). Loaded by the command group before
+any command runs, so this module imports nothing heavy.
+
+Sections: ``[read]`` the reading options of every command that reads data (``columns``, ``gyro-unit``,
+``accel-unit``, ``time-unit``, ``delimiter``, ``decimal``, ``format``, ``drop-nan``, ``instance``, ...;
+``columns`` a string ``CH=COL,...`` or a table), ``[defaults]`` any option of any command by its long name (each
+command takes those it has: ``window = 60``, ``turn-on-window = 60``), and ``[COMMAND]`` (``[fit]``,
+``[fleet.fit]``) the options of one command, checked against it. An option given on the command line wins.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import click
+
+from ..errors import InputError
+
+PROJECT_FILE = "gyrocomp.toml"
+#: where the command group keeps the loaded project for the commands (click's shared ``Context.meta``)
+PROJECT_KEY = "gyrocomp.project"
+#: the options ``[read]`` may hold (every command that reads data has them)
+READ_KEYS = ("columns", "gyro-unit", "accel-unit", "time-unit", "format", "delimiter", "decimal", "drop-nan",
+             "instance", "device-id", "imu-topic", "temperature-topic", "record")
+
+
+@dataclass(frozen=True)
+class Project:
+    """A project file's sections: ``read``, ``defaults`` and one per command (``fit``, ``fleet.fit``), each option
+    name (as its flag, without dashes) to its value."""
+
+    path: str
+    read: dict = field(default_factory=dict)
+    defaults: dict = field(default_factory=dict)
+    commands: dict = field(default_factory=dict)
+
+
+def _key(name: str) -> str:
+    return name.strip().lstrip("-").replace("_", "-")
+
+
+def _columns_text(value, path: str) -> str:
+    if isinstance(value, dict):
+        if not all(isinstance(v, str) for v in value.values()):
+            raise InputError(f"{path}: [read] columns: each channel names a column (a string)")
+        return ",".join(f"{k}={v}" for k, v in value.items())
+    if not isinstance(value, str):
+        raise InputError(f"{path}: [read] columns: a string CH=COL,... or a table of channel = column")
+    return value
+
+
+def load_project(given: str | None, commands: tuple[str, ...]) -> Project | None:
+    """The project file given (``--config``), else ``gyrocomp.toml`` in the working folder, else None; refuses in
+    one line a file that is not TOML, a section that is no command, a ``[read]`` key that is no reading option."""
+    path = Path(given) if given else Path(PROJECT_FILE)
+    if not path.is_file():
+        if given:
+            raise InputError(f"--config {given}: no such file")
+        return None
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not a readable TOML file ({exc})") from None
+    read = {_key(k): v for k, v in data.pop("read", {}).items()}
+    for key in read:
+        if key not in READ_KEYS:
+            raise InputError(f"{path}: [read] {key}: not a reading option; use {', '.join(READ_KEYS)}")
+    if "columns" in read:
+        read["columns"] = _columns_text(read["columns"], str(path))
+    defaults = {_key(k): v for k, v in data.pop("defaults", {}).items()}
+    sections: dict[str, dict] = {}
+
+    def walk(prefix: str, table: dict) -> None:
+        for name, value in table.items():
+            full = f"{prefix}.{name}" if prefix else name
+            if not isinstance(value, dict):
+                raise InputError(f"{path}: {name} = ...: options go in [read], [defaults] or a command's section")
+            if prefix == "" and name not in commands:
+                raise InputError(f"{path}: [{name}]: no such command; sections are read, defaults and "
+                                 f"{', '.join(commands)}")
+            options = {_key(k): v for k, v in value.items() if not isinstance(v, dict)}
+            sections[full] = options
+            walk(full, {k: v for k, v in value.items() if isinstance(v, dict)})
+
+    walk("", data)
+    return Project(str(path), read, defaults, sections)
+
+
+def defaults_for(project: Project, command: click.Command, name: str) -> dict:
+    """Click's ``default_map`` for ``command`` (named ``name``, dotted for a group's command) from ``project``:
+    the [read] and [defaults] options it has, then its own section's (refused when it has no such option); a
+    group's commands nested."""
+    flags = {opt.lstrip("-"): param.name for param in command.params if isinstance(param, click.Option)
+             for opt in param.opts if opt.startswith("--")}
+    out = {flags[k]: v for k, v in {**project.read, **project.defaults}.items() if k in flags}
+    for key, value in project.commands.get(name, {}).items():
+        if key not in flags:
+            raise InputError(f"{project.path}: [{name}] {key}: gyrocomp {name.replace('.', ' ')} has no option "
+                             f"--{key}")
+        out[flags[key]] = value
+    for sub_name, sub in getattr(command, "commands", {}).items():
+        out[sub_name] = defaults_for(project, sub, f"{name}.{sub_name}")
+    return out
+
+
+__all__ = ["PROJECT_FILE", "PROJECT_KEY", "Project", "READ_KEYS", "defaults_for", "load_project"]

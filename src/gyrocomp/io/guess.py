@@ -1,0 +1,197 @@
+"""A table's layout guessed from its column names and the magnitudes of its first rows, for ``gyrocomp init``.
+
+Names: a column is a gyro, accelerometer or temperature channel when one of its name's words says so (``gyr*``,
+``omega``, ``rate``; ``acc*``; ``temp*``), its axis the last letter x, y or z; the time is the column named
+``time``/``timestamp``/``stamp``/``t`` (else the first column that only increases). Units: a word of the name
+(``us``, ``ms``, ``rad``, ``dps``, ``mg``, ``m_s2``) decides; else the magnitudes: the time unit whose sample
+period lies within 0.1 ms..1 s, the accelerometer unit in which the norm at rest is near 1 (g, m/s2, mg), the gyro
+in rad/s when the accelerometer is in m/s2 (a logger that writes SI writes it throughout), else deg/s. Each guess
+comes with the reason, to be checked by the user: nothing here is certain.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from ..errors import InputError
+from .tables import TableLayout, _csv_bytes, detect_table_format, sniff_csv
+
+#: rows read to guess from
+GUESS_ROWS = 20_000
+_TIME_WORDS = {"time", "timestamp", "stamp", "t", "ts", "timeus", "timems", "sec", "seconds"}
+_TIME_UNIT_WORDS = {"us": "us", "usec": "us", "micros": "us", "timeus": "us", "ms": "ms", "msec": "ms",
+                    "timems": "ms", "ns": "ns", "nsec": "ns"}
+#: sample periods a log plausibly has [s]: 10 kHz to 1 Hz
+_PERIOD_RANGE_S = (1e-4, 1.0)
+_TIME_FACTORS = (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9))
+_ACCEL_NORMS = (("g", 1.0), ("m/s2", 9.80665), ("mg", 1000.0))
+
+
+@dataclass(frozen=True)
+class LayoutGuess:
+    """What :func:`guess_layout` found: the layout, why (one line per channel or unit), the columns left unused
+    and the field separator of a text table (None for Parquet)."""
+
+    path: str
+    layout: TableLayout
+    reasons: tuple[str, ...]
+    unused: tuple[str, ...]
+
+
+def _words(name: str) -> list[str]:
+    return [w for w in re.split(r"[^a-z0-9]+", name.lower()) if w]
+
+
+def _axis(name: str) -> str | None:
+    """x, y or z: a word of its own (the last such), else the last letter of the channel's word (``GyrZ``, ``ax``)
+    or of the name's last word."""
+    words = _words(name)
+    alone = [w for w in words if w in ("x", "y", "z")]
+    if alone:
+        return alone[-1]
+    for word in reversed(words):
+        if word.startswith(("gyr", "acc", "omega", "rate", "w", "a")) and len(word) > 1 and word[-1] in "xyz":
+            return word[-1]
+    return words[-1][-1] if words and len(words[-1]) > 1 and words[-1][-1] in "xyz" else None
+
+
+def _kind(name: str) -> str | None:
+    words = _words(name)
+    joined = "".join(words)
+    if any(w.startswith("temp") or w == "tmp" for w in words) or joined.startswith("temp"):
+        return "temperature"
+    if any(w.startswith("gyr") or w in ("omega", "rate", "angular", "gyro") for w in words):
+        return "gyro"
+    if any(w.startswith("acc") or w in ("lin", "acceleration") for w in words):
+        return "accel"
+    return None
+
+
+def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
+    if fmt == "parquet":
+        parquet = pq.ParquetFile(path)
+        return (parquet.read_row_group(0) if parquet.num_row_groups else parquet.read()).slice(0, GUESS_ROWS), None
+    source, head = _csv_bytes(path)
+    if not head.strip():
+        raise InputError(f"{path}: the file is empty; nothing to guess from")
+    delimiter, decimal = sniff_csv(head)
+    reader = pacsv.open_csv(source, parse_options=pacsv.ParseOptions(delimiter=delimiter),
+                            convert_options=pacsv.ConvertOptions(decimal_point=decimal))
+    batches, rows = [], 0
+    for batch in reader:
+        batches.append(batch)
+        rows += batch.num_rows
+        if rows >= GUESS_ROWS:
+            break
+    return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), delimiter
+
+
+def _numbers(table: pa.Table, column: str) -> np.ndarray | None:
+    try:
+        values = table.column(column).to_numpy(zero_copy_only=False).astype(float)
+    except (pa.ArrowInvalid, TypeError, ValueError):
+        return None
+    return values[np.isfinite(values)]
+
+
+def _time_unit(name: str, values: np.ndarray) -> tuple[str, str]:
+    for word in _words(name):
+        if word in _TIME_UNIT_WORDS:
+            return _TIME_UNIT_WORDS[word], f"time unit {_TIME_UNIT_WORDS[word]}: the column's name says so"
+    steps = np.diff(values)
+    period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else float("nan")
+    for unit, factor in _TIME_FACTORS:
+        if _PERIOD_RANGE_S[0] <= period * factor <= _PERIOD_RANGE_S[1]:
+            return unit, f"time unit {unit}: the median step {period:.4g} is {1 / (period * factor):.4g} Hz in {unit}"
+    return "s", f"time unit s: the median step {period:.4g} fits no usual rate; check it"
+
+
+def _find_columns(path: Path, table: pa.Table) -> tuple[dict[str, str], list[str]]:
+    """Channel to column, time first, and why (see the module); refuses a table without time or gyro columns."""
+    names = table.column_names
+    columns: dict[str, str] = {}
+    reasons: list[str] = []
+    for name in names:
+        kind = _kind(name)
+        axis = _axis(name)
+        channel = "temperature" if kind == "temperature" else f"{kind}_{axis}" if kind and axis else None
+        if channel and channel not in columns:
+            columns[channel] = name
+            reasons.append(f"{channel} = {name!r}: its name")
+    time_name = next((n for n in names if set(_words(n)) & _TIME_WORDS and n not in columns.values()), None)
+    if time_name is None:
+        for name in names:
+            values = _numbers(table, name)
+            if name not in columns.values() and values is not None and values.size > 2 and np.all(np.diff(values) > 0):
+                time_name = name
+                reasons.append(f"time = {name!r}: the first column that only increases")
+                break
+    else:
+        reasons.append(f"time = {time_name!r}: its name")
+    if time_name is None:
+        raise InputError(f"{path}: no column looks like the time (named time or timestamp, or only increasing); "
+                         "name it with columns= time=NAME")
+    if not any(c.startswith("gyro_") for c in columns):
+        raise InputError(f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
+                         f"its columns are {', '.join(names)}")
+    return {"time": time_name, **columns}, reasons
+
+
+def _accel_unit(table: pa.Table, columns: dict[str, str]) -> tuple[str, str]:
+    accel = [_numbers(table, columns[c]) for c in ("accel_x", "accel_y", "accel_z") if c in columns]
+    hinted = {w for c in columns if c.startswith("accel") for w in _words(columns[c])}
+    if hinted & {"mps2", "ms2", "m", "si"}:
+        return "m/s2", "accelerometer in m/s2: the column's name says so"
+    if "mg" in hinted:
+        return "mg", "accelerometer in mg: the column's name says so"
+    if not accel or not all(a is not None and a.size for a in accel):
+        return "g", "accelerometer in g: the default"
+    n = min(a.size for a in accel)
+    norm = float(np.median(np.sqrt(sum(a[:n] ** 2 for a in accel)))) if len(accel) == 3 else \
+        float(np.max(np.abs(np.concatenate(accel))))
+    unit = min(_ACCEL_NORMS, key=lambda u: abs(np.log(max(norm, 1e-12) / u[1])))[0]
+    return unit, f"accelerometer in {unit}: its {'norm' if len(accel) == 3 else 'largest value'} at rest is {norm:.3g}"
+
+
+def _gyro_unit(columns: dict[str, str], accel_unit: str) -> tuple[str, str]:
+    words = {w for c in columns if c.startswith("gyro") for w in _words(columns[c])}
+    if words & {"rad", "rads", "radps"}:
+        return "rad/s", "gyro in rad/s: the column's name says so"
+    if "mdps" in words:
+        return "mdps", "gyro in mdps: the column's name says so"
+    if words & {"dps", "deg", "degs"}:
+        return "deg/s", "gyro in deg/s: the column's name says so"
+    if accel_unit == "m/s2":
+        return "rad/s", ("gyro in rad/s: the accelerometer is in m/s2, and a logger that writes SI does so throughout "
+                         "(check: a bias at rest cannot tell rad/s from deg/s)")
+    return "deg/s", "gyro in deg/s: the default (check: a bias at rest cannot tell rad/s from deg/s)"
+
+
+def guess_layout(path) -> LayoutGuess:
+    """Guess the column mapping and units of a CSV/TSV or Parquet table from its first ``GUESS_ROWS`` rows (see
+    the module); refuses a file of another format, or one whose time or gyro columns cannot be told."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    fmt = detect_table_format(path)
+    if fmt not in ("csv", "parquet"):
+        raise InputError(f"{path}: not a CSV/TSV or Parquet table; logs (ULog, DataFlash, ROS bags) need no layout")
+    table, delimiter = _sample(path, fmt)
+    columns, reasons = _find_columns(path, table)
+    time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+    accel_unit, why_accel = _accel_unit(table, columns)
+    gyro_unit, why_gyro = _gyro_unit(columns, accel_unit)
+    layout = TableLayout(columns, gyro_unit=gyro_unit, accel_unit=accel_unit, time_unit=time_unit,
+                         delimiter=delimiter)
+    unused = tuple(n for n in table.column_names if n not in columns.values())
+    return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
+
+
+__all__ = ["GUESS_ROWS", "LayoutGuess", "guess_layout"]

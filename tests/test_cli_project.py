@@ -1,0 +1,131 @@
+"""The project file (gyrocomp.toml): init guesses a table's layout from its names and magnitudes, every command
+reads the file, the command line wins, and a bad file is refused in one line; through the real entry point."""
+
+import json
+
+import numpy as np
+import pytest
+
+from gyrocomp.errors import InputError
+from gyrocomp.io.guess import guess_layout
+
+from .conftest import run
+
+RAD = np.pi / 180.0
+
+
+def _log(path, n=4000, rate_hz=100.0, *, names=None, time_unit="us", si=True, sep="\t", seed=0):
+    """A chamber log as another project writes it: time in us, gyro in rad/s, accelerometer in m/s^2, the
+    temperature rising through 30 degC; gyro bias 0.1 + 0.01 (T - 25) deg/s on each axis."""
+    names = names or ["timestamp", "imu.gyro.x", "imu.gyro.y", "imu.gyro.z", "imu.acc.x", "imu.acc.y", "imu.acc.z",
+                      "imu.temperature"]
+    rng = np.random.default_rng(seed)
+    k = np.arange(n)
+    temperature = 20.0 + 30.0 * k / n
+    time = 1_700_000_000 + k / rate_hz
+    time = time * {"s": 1, "ms": 1e3, "us": 1e6}[time_unit]
+    gyro_dps = 0.1 + 0.01 * (temperature - 25.0)[:, None] + 0.002 * rng.standard_normal((n, 3))
+    accel_g = np.array([0.0, 0.0, 1.0]) + 0.001 * rng.standard_normal((n, 3))
+    gyro, accel = (gyro_dps * RAD, accel_g * 9.80665) if si else (gyro_dps, accel_g)
+    rows = [sep.join([f"{time[i]:.0f}" if time_unit != "s" else f"{time[i]:.3f}", *(f"{v:.8g}" for v in gyro[i]),
+                      *(f"{v:.6g}" for v in accel[i]), f"{temperature[i]:.3f}"]) for i in range(n)]
+    path.write_text(sep.join(names) + "\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def test_init_then_every_command_without_flags(tmp_path):
+    """The issue's log: tab-separated, timestamp in us, imu.gyro.x in rad/s, imu.acc.x in m/s^2: init, then fit,
+    show, evaluate, apply and report with no reading option given."""
+    _log(tmp_path / "log.tsv")
+    first = _log(tmp_path / "other.tsv", seed=1)
+    made = run("init", "log.tsv", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    for said in ("time unit us", "accelerometer in m/s2", "gyro in rad/s", "gyro_x = 'imu.gyro.x'"):
+        assert said in made.stdout
+    fitted = run("fit", "log.tsv", "-o", "m.json", cwd=tmp_path)
+    assert fitted.returncode == 0, fitted.stderr
+    model = json.loads((tmp_path / "m.json").read_text())
+    # the bias in deg/s: 0.1 at 25 degC, 0.01 deg/s per degC (in rad/s it would be 57 times smaller)
+    shown = run("show", "m.json", "--json", cwd=tmp_path)
+    assert shown.returncode == 0, shown.stderr
+    assert model["axes"]["gyro_x"]["temperature"] is not None
+    evaluated = run("evaluate", "m.json", first.name, "--json", cwd=tmp_path)
+    assert evaluated.returncode == 0, evaluated.stderr
+    axes = json.loads(evaluated.stdout)["runs"][0]["axes"]
+    assert axes["gyro_x"]["bias_offset_raw_dps"] > 0.2  # 0.3 deg/s of drift, read in deg/s
+    assert axes["gyro_x"]["bias_offset_comp_dps"] < axes["gyro_x"]["bias_offset_raw_dps"] / 5
+    applied = run("apply", "m.json", first.name, "-o", "out.csv", cwd=tmp_path)
+    assert applied.returncode == 0, applied.stderr
+    reported = run("report", "m.json", first.name, "-o", "r.html", cwd=tmp_path)
+    assert reported.returncode == 0 or "matplotlib" in reported.stderr
+    # the command line wins: the same file read as deg/s has 57 times less drift
+    overridden = run("evaluate", "m.json", first.name, "--json", "--gyro-unit", "deg/s", cwd=tmp_path)
+    raw = json.loads(overridden.stdout)["runs"][0]["axes"]["gyro_x"]["bias_offset_raw_dps"]
+    assert raw == pytest.approx(axes["gyro_x"]["bias_offset_raw_dps"] * RAD, rel=1e-6)
+    shown = run("config", "show", "--json", cwd=tmp_path)
+    assert json.loads(shown.stdout)["read"]["gyro-unit"] == "rad/s"
+
+
+def test_defaults_and_command_sections_apply_where_the_option_exists(tmp_path):
+    _log(tmp_path / "run.csv", names=["time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+                                      "temperature"], time_unit="s", si=False, sep=",")
+    assert run("fit", "run.csv", "-o", "m.json", cwd=tmp_path).returncode == 0
+    (tmp_path / "gyrocomp.toml").write_text('[defaults]\nwindow = 7.5\n\n[evaluate]\nturn-on-window = 20\n')
+    evaluated = run("evaluate", "m.json", "run.csv", "--json", cwd=tmp_path)
+    assert evaluated.returncode == 0, evaluated.stderr
+    assert json.loads(evaluated.stdout)["runs"][0]["window_s"] == 7.5
+    elsewhere = tmp_path / "elsewhere.toml"
+    elsewhere.write_text("[defaults]\nwindow = 12\n")
+    evaluated = run("--config", elsewhere, "evaluate", "m.json", "run.csv", "--json", cwd=tmp_path)
+    assert json.loads(evaluated.stdout)["runs"][0]["window_s"] == 12
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[read]\ngyro_units = 'rad/s'\n", r"gyrocomp.toml: \[read\] gyro-units: not a reading option"),
+    ("[fitt]\norder = 3\n", r"gyrocomp.toml: \[fitt\]: no such command"),
+    ("[evaluate]\nwindoww = 3\n", r"gyrocomp.toml: \[evaluate\] windoww: gyrocomp evaluate has no option --windoww"),
+    ("[read\n", r"gyrocomp.toml: not a readable TOML file"),
+    ("window = 3\n", r"gyrocomp.toml: window = ...: options go in \[read\], \[defaults\] or a command's section"),
+])
+def test_a_bad_project_file_is_refused_in_one_line(tmp_path, text, message):
+    import re
+
+    (tmp_path / "gyrocomp.toml").write_text(text)
+    result = run("evaluate", "m.json", "run.csv", cwd=tmp_path)
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1
+    assert re.search(message, result.stderr), result.stderr
+    missing = run("--config", "nothere.toml", "show", "m.json", cwd=tmp_path)
+    assert missing.returncode == 2 and "--config nothere.toml: no such file" in missing.stderr
+
+
+def test_init_keeps_an_existing_file_and_refuses_what_it_cannot_read(tmp_path):
+    _log(tmp_path / "log.tsv", n=200)
+    (tmp_path / "gyrocomp.toml").write_text("# mine\n")
+    kept = run("init", "log.tsv", cwd=tmp_path)
+    assert kept.returncode == 2 and "gyrocomp.toml: exists; give --force" in kept.stderr
+    assert (tmp_path / "gyrocomp.toml").read_text() == "# mine\n"
+    assert run("init", "log.tsv", "--force", cwd=tmp_path).returncode == 0
+    (tmp_path / "flight.ulg").write_bytes(b"ULog\x01\x12\x35\x01" + bytes(8))
+    refused = run("init", "flight.ulg", "-o", "x.toml", cwd=tmp_path)
+    assert refused.returncode == 2 and "not a CSV/TSV or Parquet table" in refused.stderr
+
+
+def test_guessing_from_names_and_magnitudes(tmp_path):
+    """Units from the magnitudes when the names do not say: ms time at 50 Hz, accelerometer in g, gyro then in
+    deg/s; names like GyrZ, Temp; a name that says its unit wins over the magnitudes."""
+    path = _log(tmp_path / "v.csv", names=["Time", "GyrX", "GyrY", "GyrZ", "AccX", "AccY", "AccZ", "Temp"],
+                time_unit="ms", si=False, sep=";", rate_hz=50.0)
+    guess = guess_layout(path)
+    layout = guess.layout
+    assert layout.columns == {"time": "Time", "gyro_x": "GyrX", "gyro_y": "GyrY", "gyro_z": "GyrZ", "accel_x": "AccX",
+                              "accel_y": "AccY", "accel_z": "AccZ", "temperature": "Temp"}
+    assert (layout.time_unit, layout.accel_unit, layout.gyro_unit, layout.delimiter) == ("ms", "g", "deg/s", ";")
+    assert any("50 Hz in ms" in r for r in guess.reasons)
+    named = _log(tmp_path / "n.csv", names=["time_s", "gyro_x_rad", "gyro_y_rad", "gyro_z_rad", "ax", "ay", "az",
+                                            "temperature"], time_unit="s", si=False, sep=",")
+    guess = guess_layout(named)
+    assert guess.layout.gyro_unit == "rad/s" and guess.layout.time_unit == "s"
+    assert guess.unused == ("ax", "ay", "az")
+    (tmp_path / "bad.csv").write_text("a,b\n1,2\n2,1\n3,5\n")
+    with pytest.raises(InputError, match=r"bad.csv: no column looks like a gyro axis"):
+        guess_layout(tmp_path / "bad.csv")
