@@ -13,7 +13,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 LAYERS = (
     ("foundation", ("_version", "errors", "units", "threads", "jsontext")),
     ("signals", ("recording", "effects", "allan", "noise", "static", "stillness", "metrics", "plausibility",
-                 "simulate", "spill", "prepared")),
+                 "simulate", "spill", "prepared", "runsplit")),
     ("io", ("io",)),
     # files read in chunks and analysed as they come
     ("files", ("noise_file",)),

@@ -32,6 +32,25 @@ def test_runs_are_the_three_documented_static_periods():
     assert all(not r.gaps for r in runs)
 
 
+def test_split_by_still_finds_the_three_periods_from_the_original_file(tmp_path):
+    """gyrocomp split on the original NetCDF file, no option but --by still: three runs, each within 15 minutes of
+    a documented static period at each end (the documented periods are conservative), each with its gravity axis."""
+    from gyrocomp import read
+
+    from .conftest import run
+    from .real_data import CATS, CATS_PERIODS_S
+
+    source = CATS / "cats_temperature_calib.nc"
+    result = run("split", source, "-o", tmp_path / "runs", "--by", "still")
+    assert result.returncode == 0, result.stderr
+    runs = [read(path) for path in sorted((tmp_path / "runs").glob("*.csv"))]
+    assert len(runs) == 3
+    t0 = float(read(source).time_s[0])
+    for rec, (lo, hi), axis in zip(runs, CATS_PERIODS_S, (2, 0, 1)):
+        assert abs(rec.time_s[0] - t0 - lo) < 900 and abs(rec.time_s[-1] - t0 - hi) < 900
+        assert np.argmax(np.abs(rec.accel_g.mean(axis=0))) == axis
+
+
 def test_default_leaves_at_most_0_9_of_a_plain_cubic(drift):
     # the issue's protocol: fit on two runs, apply to the third, 10-minute moving average, 3 x 3 mean
     cubic = cats_numpy_cubic_drift()

@@ -39,6 +39,8 @@ COMMANDS = {
     "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
     "show": ("show", 'What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device '
                 "ids), and the drift its held-out folds expect."),
+    "split": ("split", "Cut LOG into runs, one file each in canonical columns, so that a recording of several "
+                       "power-ons, poses or temperature legs becomes the runs a fit takes."),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
                     'default and the best model a firmware carries.'),
@@ -135,7 +137,8 @@ PARAMETER_FLAGS = {
     "pipeline": "--pipeline", "channels": "--channels", "scale_factor": "--scale-factor", "columns": "--columns", "fmt": "--format",
     "instance": "--instance", "device_id": "--device-id", "accel_device_id": "--accel-device-id", "record": "--record", "imu_topic": "--imu-topic",
     "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
-    "time_unit": "--time-unit", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
+    "time_unit": "--time-unit", "time_range_s": "--time", "min_gap_s": "--min-gap", "min_still_s": "--min-still",
+    "min_leg_degc": "--min-leg", "by": "--by", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
     "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
     "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
     "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",

@@ -11,11 +11,11 @@ import click
 from ..allan import KINDS
 from ..errors import DataQualityWarning
 from ..noise_file import analyse_noise_file
-from ..io import TABLE_FORMATS, detect_format, refuse_to_overwrite_inputs, write_text_atomic
+from ..io import detect_format, refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..noise import analyse_noise
 from ..report.figures import allan_figure, check_figure_path
-from .common import pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import pop_read_options, progress_bar, read_options, read_run, read_settings, streams
 from .render import print_noise
 
 
@@ -71,7 +71,7 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
         check_figure_path(plot_path)
     named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
-    if in_fmt in TABLE_FORMATS:  # in chunks: memory bounded whatever the file's length
+    if streams(in_fmt, opts):  # in chunks: memory bounded whatever the file's length
         with progress_bar(f"reading {Path(input_path).name}") as progress:
             analysis = analyse_noise_file(input_path, named, layout=read_settings(opts).layout, fmt=in_fmt,
                                           drop_nonfinite=opts["drop_nan"], with_accel=bool(kalibr_path), kind=kind,

@@ -8,8 +8,8 @@ import click
 
 from ..calibration import Calibration
 from ..compensate import apply as apply_calibration, apply_file, compensated_axes
-from ..io import TABLE_FORMATS, detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
-from .common import FINITE, pop_read_options, progress_bar, read_run, read_options, read_settings
+from ..io import detect_format, output_format, refuse_to_overwrite_inputs, write_gyro_back
+from .common import FINITE, pop_read_options, progress_bar, read_run, read_options, read_settings, streams
 
 
 @click.command()
@@ -31,7 +31,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     named = None if axes is None else tuple(a.strip() for a in axes.split(",") if a.strip())
-    if in_fmt in TABLE_FORMATS:  # in chunks: memory bounded whatever the file's length
+    if streams(in_fmt, opts):  # in chunks: memory bounded whatever the file's length
         with progress_bar(f"reading {Path(input_path).name}") as progress:
             result = apply_file(calibration, input_path, output, layout=read_settings(opts).layout, fmt=in_fmt,
                                 out_fmt=out_fmt, drop_nonfinite=opts["drop_nan"], axes=named,

@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 
 from ..errors import InputError
-from ..io import FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
+from ..io import FORMATS, TABLE_FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
 from ..models.mlp import DEFAULT_HIDDEN
 from ..models.options import Network, Polynomial
 from ..models.pipelines import check_channels
@@ -47,6 +47,8 @@ def read_options(func):
         click.option("--temperature-topic", default=None,
                      help="ROS bag: the sensor_msgs/Temperature topic (default: the only one)."),
         click.option("--record", default=None, help="ArduPilot log: IMU (default) or TCLR (onboard learning records)."),
+        click.option("--time", "time_range", default=None, metavar="A:B",
+                     help="Only the samples from A to B seconds after the file's first ([A, B); A: or :B open)."),
     ]
     for option in reversed(options):
         func = option(func)
@@ -59,7 +61,29 @@ def table_layout(columns, gyro_unit, accel_unit, time_unit, delimiter=None, deci
 
 
 READ_OPTIONS = ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan", "instance", "device_id",
-                 "imu_topic", "temperature_topic", "record", "delimiter", "decimal")
+                 "imu_topic", "temperature_topic", "record", "delimiter", "decimal", "time_range")
+
+
+def parse_time_range(text: str | None) -> tuple[float | None, float | None] | None:
+    """``--time A:B`` -> (A, B) [s from the file's first sample]; an empty side is open."""
+    if text is None:
+        return None
+    parts = text.split(":")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        bounds = tuple(None if p.strip() == "" else float(p) for p in parts)
+    except ValueError:
+        raise click.BadParameter(f"{text!r}: give A:B in seconds from the file's start (A: or :B for an open end)",
+                                 param_hint="--time") from None
+    if any(b is not None and not math.isfinite(b) for b in bounds) or bounds == (None, None):
+        raise click.BadParameter(f"{text!r}: give finite seconds on at least one side", param_hint="--time")
+    return bounds
+
+
+def streams(in_fmt: str | None, opts: dict) -> bool:
+    """Whether a command reads this input in chunks: tables, unless rows are selected by time (then whole)."""
+    return in_fmt in TABLE_FORMATS and opts["time_range"] is None
 
 
 @contextlib.contextmanager
@@ -84,7 +108,8 @@ def read_settings(opts: dict, channels: tuple[str, ...] | None = None) -> ReadOp
                           opts["decimal"])
     return ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=parse_instance(opts["instance"]),
                        device_id=opts["device_id"], imu_topic=opts["imu_topic"],
-                       temperature_topic=opts["temperature_topic"], record=opts["record"], channels=channels)
+                       temperature_topic=opts["temperature_topic"], record=opts["record"], channels=channels,
+                       time_range_s=parse_time_range(opts["time_range"]))
 
 
 def parse_instance(text: str | int | None) -> int | None:

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import click
 
-from ..io import TABLE_FORMATS, detect_format, output_format, refuse_to_overwrite_inputs, write_recording
+from ..io import detect_format, output_format, refuse_to_overwrite_inputs, write_recording
 from ..io.stream import convert_table
-from .common import pop_read_options, progress_bar, read_run, read_options, read_settings
+from .common import pop_read_options, progress_bar, read_run, read_options, read_settings, streams
 
 
 @click.command()
@@ -25,7 +25,7 @@ def convert(ctx, input_path, output, **kwargs):
     refuse_to_overwrite_inputs(output, [input_path], option="OUT")
     out_fmt = output_format(output, option="OUT")
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
-    if in_fmt in TABLE_FORMATS:  # in chunks: memory bounded whatever the file's length
+    if streams(in_fmt, opts):  # in chunks: memory bounded whatever the file's length
         with progress_bar(f"reading {Path(input_path).name}") as progress:
             result = convert_table(input_path, output, read_settings(opts).layout, fmt=in_fmt, out_fmt=out_fmt,
                                    drop_nonfinite=opts["drop_nan"], progress=progress)

@@ -12,18 +12,19 @@ import click
 from ..calibration import Calibration
 from ..errors import InputError
 from ..evaluation import evaluate_file
-from ..io import TABLE_FORMATS, detect_format
+from ..io import detect_format
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..metrics import Evaluation
 from ..comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
-from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings, streams
 from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
 
 
 def _is_table(path, opts: dict) -> bool:
-    return Path(path).exists() and detect_format(path, opts["fmt"]) in TABLE_FORMATS
+    """Whether ``path`` is read in chunks (a table, its rows not selected by time)."""
+    return Path(path).exists() and streams(detect_format(path, opts["fmt"]), opts)
 
 
 def _nan_none(value):

@@ -7,8 +7,11 @@ first bytes, then its suffix, and can be named instead.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
+
+import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
@@ -100,8 +103,29 @@ def read_input(
                           channels=options.channels)
         if progress:
             progress(1.0)
-        return data
-    return table_data(_log_reader(fmt)(path, options, progress))
+    else:
+        data = table_data(_log_reader(fmt)(path, options, progress))
+    return data if options.time_range_s is None else select_time(data, options.time_range_s)
+
+
+def select_time(data: TableData, time_range_s: tuple[float | None, float | None]) -> TableData:
+    """The rows of ``data`` from A to B seconds after its first sample, [A, B) [s] (None: an open end); refuses a
+    range that holds no sample, naming the file's length."""
+    start, stop = time_range_s
+    if start is not None and stop is not None and not start < stop:
+        raise InputError(f"time_range_s: {start:g}:{stop:g} is empty; give A:B with A < B [s from the file's start]")
+    rec = data.recording
+    since = rec.time_s - rec.time_s[0]
+    keep = np.ones(rec.n_samples, dtype=bool)
+    if start is not None:
+        keep &= since >= start
+    if stop is not None:
+        keep &= since < stop
+    if not keep.any():
+        raise InputError(f"{rec.source}: time_range_s={'' if start is None else f'{start:g}'}:"
+                         f"{'' if stop is None else f'{stop:g}'} holds no sample; the file lasts {since[-1]:.6g} s "
+                         "from its first sample")
+    return dataclasses.replace(data, recording=rec.take(keep), kept_rows=data.kept_rows[keep])
 
 
 def instances(path: str | os.PathLike, fmt: str | None = None) -> tuple[int, ...]:
@@ -129,6 +153,7 @@ def read(
     temperature_topic: str | None = None,
     record: str | None = None,
     channels: tuple[str, ...] | None = None,
+    time_range_s: tuple[float | None, float | None] | None = None,
     progress: ProgressCallback | None = None,
 ) -> Recording:
     """Read any supported file into a :class:`Recording` [s, deg/s, g, degC].
@@ -151,6 +176,8 @@ def read(
         ArduPilot DataFlash: ``"IMU"`` (default) or ``"TCLR"``.
     channels : tuple of str, optional
         Tables: read only these channels' columns (``time`` always).
+    time_range_s : (float or None, float or None), optional
+        Only the samples from A to B seconds after the file's first, [A, B) [s] (None: an open end).
     progress : callable, optional
         Called with the fraction done.
 
@@ -160,7 +187,7 @@ def read(
     """
     read_options = ReadOptions(layout=layout or TableLayout(), drop_nonfinite=drop_nonfinite, instance=instance,
                                device_id=device_id, imu_topic=imu_topic, temperature_topic=temperature_topic,
-                               record=record, channels=channels)
+                               record=record, channels=channels, time_range_s=time_range_s)
     return read_input(path, read_options, fmt=fmt, progress=progress).recording
 
 

@@ -46,6 +46,8 @@ class ReadOptions:
     channels : tuple of str, optional
         Tables: read only these channels' columns (``time`` always), e.g. ``("gyro_x", "gyro_z")``; a command
         that uses three of eight columns then neither converts nor holds the others. Default: every channel.
+    time_range_s : (float or None, float or None), optional
+        Keep only the samples from A to B seconds after the file's first one, [A, B) [s]; None for an open end.
     """
 
     layout: TableLayout = field(default_factory=TableLayout)
@@ -56,6 +58,7 @@ class ReadOptions:
     temperature_topic: str | None = None
     record: str | None = None
     channels: tuple[str, ...] | None = None
+    time_range_s: tuple[float | None, float | None] | None = None
 
 
 def require(module: str, extra: str, what: str) -> ModuleType:

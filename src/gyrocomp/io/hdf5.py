@@ -11,6 +11,7 @@ Without a mapping, datasets are looked up under gyrocomp's names and common ones
 from __future__ import annotations
 
 import contextlib
+import re
 import warnings
 from pathlib import Path
 
@@ -83,9 +84,26 @@ def _in_this_file(dataset, source: str) -> None:
                          "(copy the data into the file, e.g. with h5repack)")
 
 
+#: ``NAME[:, k]``: column k of a two-dimensional dataset, given as a channel's column
+_COLUMN_OF = re.compile(r"^(?P<name>.+?)\[\s*:\s*,\s*(?P<k>\d+)\s*\]$")
+
+
+class _Column:
+    """Column ``k`` of a two-dimensional dataset, read as a dataset of its own (``columns=`` ``NAME[:, k]``)."""
+
+    def __init__(self, dataset, k: int, source: str):
+        if dataset.ndim != 2 or not 0 <= k < dataset.shape[1]:
+            raise InputError(f"{source}: columns= {dataset.name}[:, {k}]: the dataset has shape {dataset.shape}; "
+                             f"[:, k] needs two dimensions and k below {dataset.shape[-1] if dataset.ndim else 0}")
+        self.dataset, self.k = dataset, k
+        self.name, self.attrs, self.shape = f"{dataset.name}[:, {k}]", dataset.attrs, (dataset.shape[0],)
+
+
 def _numbers(dataset, source: str) -> np.ndarray:
     """The dataset's values as floats; a dataset of strings, compounds or references is refused by name, and one
     whose values lie in another file (:func:`_in_this_file`)."""
+    if isinstance(dataset, _Column):
+        return _numbers(dataset.dataset, source)[:, dataset.k]
     _in_this_file(dataset, source)
     if dataset.dtype.kind not in "biuf":
         raise InputError(f"{source}: dataset {dataset.name!r} holds {dataset.dtype} values, not numbers; "
@@ -106,6 +124,9 @@ def _temperature(dataset, source: str) -> np.ndarray:
 def _find(handle, source: str, channel: str, mapping: dict[str, str]):
     if channel in mapping:
         name = mapping[channel]
+        column = _COLUMN_OF.match(name)
+        if column and column["name"] in handle and name not in handle:
+            return _Column(handle[column["name"]], int(column["k"]), source)
         if name not in handle:
             raise InputError(f"{source}: columns={{{channel!r}: {name!r}}}: no dataset {name!r}; "
                              f"the file has {', '.join(_datasets(handle))}")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import lzma
 import os
+import re
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -117,11 +118,12 @@ class TableLayout:
 
 
 def parse_column_mapping(text: str | None) -> dict[str, str]:
-    """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``."""
+    """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``; a comma inside
+    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array)."""
     if not text:
         return {}
     mapping = {}
-    for item in text.split(","):
+    for item in re.split(r",(?![^\[]*\])", text):
         if not item.strip():
             continue
         if "=" not in item:
