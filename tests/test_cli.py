@@ -111,6 +111,17 @@ def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     assert model["axes"]["gyro_z"]["hysteresis"]["band_degc"] == [55.0, 80.0]
 
 
+def test_fit_prints_only_what_was_fitted(tmp_path):
+    """A chamber run in one orientation fits no G: no table of "not fitted" cells; no fit-RMS column of dashes."""
+    r = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 0.1, "--runs", 2,
+            "-o", tmp_path / "c.csv")
+    assert r.returncode == 0, r.stderr
+    r = run("fit", tmp_path / "c_0.csv", tmp_path / "c_1.csv", "-o", tmp_path / "m.json")
+    assert r.returncode == 0, r.stderr
+    assert "g-sensitivity G" not in r.stdout and "not fitted" not in r.stdout
+    assert "fit RMS" not in r.stdout and "constants [deg/s]" in r.stdout
+
+
 @pytest.mark.slow
 def test_fit_g_sensitivity_table_and_stages(tmp_path):
     r = run("simulate", "--preset", "consumer", "--profile", "combined", "--rate", 1, "--duration", 14000,

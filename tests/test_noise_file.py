@@ -275,3 +275,26 @@ def test_a_compensation_beyond_any_sensors_range_is_refused_naming_its_row(consu
                 evaluate_file(consumer_model, bad, chunks=ChunkSettings(chunk_rows=chunk_rows))
         with pytest.raises(InputError, match=message):
             evaluate(consumer_model, read_table(bad).recording)
+
+
+def test_allan_warns_when_the_log_moves_most_of_the_time(tmp_path):
+    """As fit tells a field log: a log turning most of the time gets one warning, chunked or whole, and a still
+    one none."""
+    import dataclasses as _dc
+
+    from gyrocomp.io.tables import write_recording
+    from gyrocomp.simulate import simulate
+
+    from .conftest import run
+
+    rec = simulate("consumer", profile="static", duration_s=1200, rate_hz=50, seed=4).recording
+    t = rec.time_s
+    turning = rec.gyro_dps + 30.0 * np.sin(2 * np.pi * t / 7.0)[:, None] * (np.sin(t / 40.0)[:, None] > -0.8)
+    write_recording(rec, tmp_path / "still.csv")
+    write_recording(_dc.replace(rec, gyro_dps=turning), tmp_path / "moving.csv")
+    for extra in ([], ["--time", "0:"]):  # chunked, and the whole-file path
+        moving = run("allan", tmp_path / "moving.csv", *extra)
+        assert moving.returncode == 0, moving.stderr
+        assert "moving.csv: the log moves most of the time" in moving.stderr and "--time" in moving.stderr
+        still = run("allan", tmp_path / "still.csv", *extra)
+        assert still.returncode == 0 and "moves most of the time" not in still.stderr

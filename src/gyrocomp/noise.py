@@ -27,6 +27,7 @@ from .allan import (
 from .errors import DataQualityWarning, InputError
 from .plausibility import recording_concerns
 from .recording import Recording
+from .stillness import StillDetection, detect_still, moves_most_of_the_time
 
 
 @dataclass(frozen=True)
@@ -117,6 +118,18 @@ def noise_axes(axes, gyro_axes, accel_axes, with_accel: bool = False) -> list[st
     return names
 
 
+def warn_if_moving(source: str, found: StillDetection) -> None:
+    """Warn when a log moves most of the time (as ``fit`` tells a field log,
+    :func:`gyrocomp.stillness.moves_most_of_the_time`): its Allan deviation then measures the motion. A log
+    with no still block at all is not judged (pure noise above any MEMS part's, or a test signal)."""
+    if found.still_blocks.any() and moves_most_of_the_time(found):
+        whole = found.blocks.whole
+        warnings.warn(f"{source}: the log moves most of the time ({found.still_blocks[whole].mean():.0%} of it "
+                      "still): its Allan deviation and noise terms describe the motion, not the sensor's noise; "
+                      "analyse a still stretch (time_range_s=) or the still poses (by=still)", DataQualityWarning,
+                      stacklevel=3)
+
+
 def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: AllanKind = "oadev",
                   taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
                   fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False) -> NoiseAnalysis:
@@ -140,6 +153,7 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
         warnings.warn(concern.warning(), stacklevel=2)
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
+    warn_if_moving(recording.source, detect_still(recording))
     stretches = recording.contiguous_stretches()
     how = None
     if len(stretches) > 1:

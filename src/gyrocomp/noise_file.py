@@ -22,7 +22,8 @@ from .allan.streaming import PhaseAccumulator
 from .errors import DataQualityWarning, InputError
 from .io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from .io.tables import TableLayout, read_table
-from .noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes
+from .noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes, warn_if_moving
+from .stillness import StillnessState, detection
 from .plausibility import temperature_range_concerns, time_unit_concern
 from .recording import ACCEL_AXES, GAP_FACTOR, GYRO_AXES, nominal_rate_hz
 from .spill import DEFAULT_MEMORY_BYTES, SpillArray, block_median
@@ -115,7 +116,7 @@ def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_
         if name not in have:
             raise InputError(f"axes: {name!r} is not in {stream.path}; it has {', '.join(have)}")
     steps = TimeSteps(chunks)
-    first_s, said = None, False
+    first_s, said, still = None, False, None
     try:
         with PhaseAccumulator(len(names), memory_bytes=chunks.memory_bytes, directory=chunks.scratch_dir) as phases:
             for chunk in stream.chunks():
@@ -124,6 +125,10 @@ def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_
                     raise NotStreamable("a time gap")
                 first_s = float(recording.time_s[0]) if first_s is None and recording.n_samples else first_s
                 steps.add(recording.time_s)
+                if still is None and recording.n_samples > 1:  # blocks of the first chunk's rate (motion is coarse)
+                    still = StillnessState(recording.rate_hz)
+                if still is not None:
+                    still.update(recording.time_s, recording.gyro_dps, recording.accel_g)
                 phases.update(np.column_stack([axis_values(recording, name)[0] for name in names]))
                 if not said and recording.temperature_degc is not None:  # the first impossible sample, once
                     for concern in temperature_range_concerns(recording):
@@ -131,6 +136,8 @@ def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_
                         said = True
             rate_hz = steps.rate_hz()
             stream.warn_summary()
+            if still is not None:
+                warn_if_moving(str(stream.path), detection(still.blocks()))
             concern = time_unit_concern(str(stream.path), rate_hz, (steps.last or 0.0) - (first_s or 0.0))
             if concern is not None:  # the same words as a whole recording's check (allan on ns read as s)
                 warnings.warn(concern.warning(), stacklevel=3)

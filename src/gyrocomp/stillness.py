@@ -46,6 +46,10 @@ from .recording import Recording
 
 BLOCK_S = 1.0
 MIN_DURATION_S = 20.0
+#: a log still less than this fraction of its time is a field log (``still_only="auto"``)
+AUTO_STILL_FRACTION = 0.5
+#: ``"auto"`` judges only logs of at least this many blocks (a short run is used whole)
+AUTO_MIN_BLOCKS = 60
 QUANTILE = 0.05
 ALPHA = 1e-3
 #: a step between samples beyond this many nominal periods is a gap
@@ -344,6 +348,13 @@ def _segment(blocks: BlockStats, first: int, last: int) -> StillSegment:
         temperature_max_degc=None if temps is None else float(temps[sel, 2].max()))
 
 
+def moves_most_of_the_time(found: StillDetection) -> bool:
+    """Whether a log moves most of the time: enough whole blocks to judge, and fewer than AUTO_STILL_FRACTION of
+    them still."""
+    whole = found.blocks.whole
+    return int(whole.sum()) >= AUTO_MIN_BLOCKS and found.still_blocks[whole].mean() < AUTO_STILL_FRACTION
+
+
 def detect_still(recording: Recording, *, block_s: float = BLOCK_S, min_duration_s: float = MIN_DURATION_S,
                  quantile: float = QUANTILE, alpha: float = ALPHA) -> StillDetection:
     """The still segments of a log (see the module).
@@ -374,5 +385,5 @@ def detection(blocks: BlockStats, *, min_duration_s: float = MIN_DURATION_S, qua
                           accel_level)
 
 
-__all__ = ["ALPHA", "BLOCK_S", "BlockStats", "MAX_ACCEL_NOISE_DENSITY", "MAX_GYRO_NOISE_DENSITY", "MIN_DURATION_S", "QUANTILE", "StillDetection", "StillSegment",
-           "StillnessState", "classify_blocks", "detect_still", "detection", "still_segments"]
+__all__ = ["ALPHA", "AUTO_MIN_BLOCKS", "AUTO_STILL_FRACTION", "BLOCK_S", "BlockStats", "MAX_ACCEL_NOISE_DENSITY", "MAX_GYRO_NOISE_DENSITY", "MIN_DURATION_S", "QUANTILE", "StillDetection", "StillSegment",
+           "StillnessState", "classify_blocks", "detect_still", "detection", "moves_most_of_the_time", "still_segments"]

@@ -350,3 +350,20 @@ def test_the_firmware_files_say_they_cannot_carry_heating_and_cooling_branches()
     for write in (lambda c: px4_params_file(c, device_id=5), ardupilot_params_file):
         with pytest.warns(DataQualityWarning, match=r"has no heating/cooling branches term: left out of the export"):
             write(cal)
+
+
+def test_terms_that_are_rounding_are_written_as_zero(tmp_path):
+    """A model whose curve is a line exports X2 = X3 = 0 exactly (not 1e-20), and its correction is unchanged."""
+    from gyrocomp.export.autopilot import px4_parameters
+    from gyrocomp.models.options import Polynomial
+    from gyrocomp.simulate import get_profile
+
+    part = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01,),), t_ref_degc=25.0,
+                          noise_density_dps_per_sqrt_hz=0.002)
+    runs = [simulate(part, profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=0.5,
+                     seed=s).recording for s in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, temperature=Polynomial(1), hysteresis="none")
+        values = px4_parameters(cal, device_id=3).values
+    assert values["TC_G0_X2_2"] == 0.0 and values["TC_G0_X3_2"] == 0.0 and values["TC_G0_X1_2"] != 0.0

@@ -184,7 +184,7 @@ def test_cli_accelerometer_channel_end_to_end(tmp_path):
     r = run("fit", tmp_path / "run1.csv", tmp_path / "run2.csv", "--channels", "accel", "--hysteresis", "none",
             "-o", tmp_path / "acc.json")
     assert r.returncode == 0, r.stderr
-    assert "accelerometer (correction relative to" in r.stdout and "fit RMS [g]" in r.stdout
+    assert "accelerometer (correction relative to" in r.stdout and "constants [g]" in r.stdout
     r = run("evaluate", tmp_path / "acc.json", tmp_path / "run3.csv", "--json")
     assert r.returncode == 0, r.stderr
     import json

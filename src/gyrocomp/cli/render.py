@@ -121,16 +121,18 @@ def _describe_axis(ax) -> str:
 
 def _print_axis_fits(console, axes: dict, report: FitReport, title: str, unit: str) -> None:
     table = Table(title=title)
-    for col in ("axis", "model", "range [degC]", f"fit RMS [{unit}]", f"constants [{unit}]"):
+    # the fit RMS only where a fit records one (the binned fits do; the choice by held-out drift shows its scores)
+    with_rms = any(report.axes.get(a) is not None and report.axes[a].fit_rms is not None for a in axes)
+    for col in ("axis", "model", "range [degC]", *([f"fit RMS [{unit}]"] if with_rms else []), f"constants [{unit}]"):
         table.add_column(col)
     for axis, ax in axes.items():
         fit = report.axes.get(axis)
         model = _describe_axis(ax)
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
-        rms = "-" if fit is None or fit.fit_rms is None else f"{fit.fit_rms:.3g}"
+        rms = ["-" if fit is None or fit.fit_rms is None else f"{fit.fit_rms:.3g}"] if with_rms else []
         constants = ax.turn_on_biases
         shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (f" ... ({len(constants)})" if len(constants) > 6 else "")
-        table.add_row(axis, model, rng, rms, shown)
+        table.add_row(axis, model, rng, *rms, shown)
     console.print(table)
     net = report.network
     if net:
@@ -204,13 +206,17 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
 
 
 def _print_g_sensitivity(console, acc: GSensitivityReport | None) -> None:
-    if acc is not None and acc.axes:
+    """The G table, for the gyro axes where some column was fitted (a chamber run in one orientation fits none:
+    no table of "not fitted" cells then)."""
+    fitted = {} if acc is None else {axis: row for axis, row in acc.axes.items()
+                                     if any(e is not None for e in row.standard_error_dps_per_g)}
+    if fitted:
         gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc.static_segments)} "
                          f"static segments; excited: {', '.join(acc.excited_axes) or 'none'})")
         gt.add_column("gyro axis")
         for name in ("accel_x", "accel_y", "accel_z"):
             gt.add_column(name, justify="right")
-        for axis, row in acc.axes.items():
+        for axis, row in fitted.items():
             cells = [f"{g:+.4g} +- {e:.2g}" if e is not None else "not fitted"
                      for g, e in zip(row.g_sensitivity_dps_per_g, row.standard_error_dps_per_g)]
             gt.add_row(axis, *cells)

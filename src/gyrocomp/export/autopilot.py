@@ -39,6 +39,9 @@ from .encode import line_comment
 ACCEL_INDEX = {"accel_x": 0, "accel_y": 1, "accel_z": 2}
 G_TO_M_PER_S2 = STANDARD_GRAVITY_M_PER_S2
 GRID_POINTS = 401
+#: a cubic's term that changes the correction by less than this over the calibrated range is written as 0
+#: [rad/s, or m/s^2]: 1e-10 rad/s is 6e-9 deg/s, far below any gyro's noise and float32's resolution
+NEGLIGIBLE_SI = 1e-10
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,11 @@ def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool,
     powers = np.column_stack([d ** k for k in (range(4) if with_constant else range(1, 4))])
     target = bias_dps if with_constant else bias_dps - np.asarray(curve.shape(np.array([reference_degc]))[0])
     coef, *_ = np.linalg.lstsq(powers, target, rcond=None)
+    # a term that moves the correction by less than NEGLIGIBLE_SI over the range is rounding (a 1e-20 cubic of a
+    # curve that is a line): written as 0
+    reach = np.max(np.abs(d))
+    orders = np.arange(4) if with_constant else np.arange(1, 4)
+    coef = np.where(np.abs(coef * to_si) * reach ** orders < NEGLIGIBLE_SI, 0.0, coef)
     error = float(np.max(np.abs(powers @ coef - target)))
     full = tuple(float(c) for c in coef) if with_constant else (0.0, *map(float, coef))
     return CubicFit(tuple(c * to_si for c in full), reference_degc, curve.t_min_degc, curve.t_max_degc, error)

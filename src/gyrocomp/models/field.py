@@ -23,12 +23,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..stillness import MIN_DURATION_S, StillDetection, detect_still
+from ..stillness import (AUTO_MIN_BLOCKS, AUTO_STILL_FRACTION, MIN_DURATION_S, StillDetection, detect_still,
+                         moves_most_of_the_time)
 
-#: a log still less than this fraction of its time is a field log (``still_only="auto"``)
-AUTO_STILL_FRACTION = 0.5
-#: ``"auto"`` judges only logs of at least this many blocks (a short run is used whole)
-AUTO_MIN_BLOCKS = 60
 #: the still data of all logs together must span at least this [degC]
 MIN_FIELD_SPAN_DEGC = 5.0
 
@@ -95,13 +92,6 @@ def field_recordings(recordings: list[Recording], still_only: StillOnly = "auto"
     return runs, contributions
 
 
-def moves_most_of_the_time(found: StillDetection) -> bool:
-    """Whether a log moves most of the time: enough whole blocks to judge, and fewer than AUTO_STILL_FRACTION of
-    them still."""
-    whole = found.blocks.whole
-    return int(whole.sum()) >= AUTO_MIN_BLOCKS and found.still_blocks[whole].mean() < AUTO_STILL_FRACTION
-
-
 def _contribution(rec: Recording, found: StillDetection, keep: bool) -> LogContribution:
     temps = [(s.temperature_min_degc, s.temperature_max_degc) for s in found.segments
              if s.temperature_min_degc is not None]
@@ -125,5 +115,5 @@ def _require_still_data(contributions: list[LogContribution]) -> None:
                          "(log cold starts and warm-ups, still now and then)")
 
 
-__all__ = ["AUTO_STILL_FRACTION", "LogContribution", "MIN_FIELD_SPAN_DEGC", "StillOnly", "field_recordings",
+__all__ = ["AUTO_MIN_BLOCKS", "AUTO_STILL_FRACTION", "LogContribution", "MIN_FIELD_SPAN_DEGC", "StillOnly", "field_recordings",
            "moves_most_of_the_time"]

@@ -129,7 +129,10 @@ def _summary(calibration: Calibration) -> str:
             rms = fits[name].fit_rms if name in fits else None
             rows.append([name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}",
                          len(ax.turn_on_biases)])
-    parts.append(_table(["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"], rows))
+    header = ["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"]
+    if all(row[4] == "-" for row in rows):  # no fit recorded one: no empty column
+        header, rows = header[:4] + header[5:], [row[:4] + row[5:] for row in rows]
+    parts.append(_table(header, rows))
     if calibration.accel_axes:
         parts.append(f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
                      "degC (its constant cannot be told from gravity at rest).</p>")
