@@ -35,7 +35,7 @@ from .folds import FOLD_KINDS
 from .selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .polynomial_fit import PolynomialTemperatureModel
 from .temperature import MAX_ORDER, PolynomialBias
-from .triad_fit import (MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
+from .triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
 from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
 from .thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
@@ -610,7 +610,8 @@ def _turning_sessions(recordings: list[Recording]) -> list[Recording]:
     return out
 
 
-def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCalibration | None, list[Recording]]:
+def _gyro_triad(recordings: list[Recording], scale_factor: str,
+                wants_temperature: bool = True) -> tuple[TriadCalibration | None, list[Recording]]:
     """The gyro's K(T) from the runs that carry reference rates (those runs then leave the bias model) or, without
     them, K from the turns between the still poses of multi-position sessions; and the runs for the bias model."""
     if scale_factor not in SCALE_FACTOR_CHOICES:
@@ -637,11 +638,30 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str) -> tuple[TriadCa
             warnings.warn(f"scale factor not fitted from the multi-position runs: {exc}", DataQualityWarning, stacklevel=3)
             return None, recordings
     rest = [r for r in recordings if r.reference_rate_dps is None]
-    if not rest:
-        raise InputError("scale_factor: every run is a rate-table run; the temperature bias model also needs runs "
-                         "at rest (chamber runs): give both, or fit the rate table alone with fit_gyro_rate_table")
     order = {"auto": "auto", "matrix": 0, "matrix-temperature": 1}[scale_factor]
-    return fit_gyro_rate_table(rate_runs, temperature_order=order).calibration, rest
+    triad = fit_gyro_rate_table(rate_runs, temperature_order=order).calibration
+    if not rest:  # rate-table runs alone: their still stretches carry the bias (one constant per run at least)
+        rest = _still_stretches(rate_runs)
+        if not rest:
+            raise InputError("scale_factor: every run is a rate-table run and none holds still between its rates; "
+                             "the bias needs still stretches or runs at rest")
+        if wants_temperature and any(r.temperature_degc is not None and np.ptp(r.temperature_degc) < 5.0 for r in rest):
+            warnings.warn("the bias comes from the rate-table runs' still stretches, each held near a single "
+                          "temperature, so their drift with temperature cannot be told from their turn-on biases (one "
+                          "constant per run); fit no temperature model, or add runs at rest through a range",
+                          DataQualityWarning, stacklevel=3)
+    return triad, rest
+
+
+def _still_stretches(rate_runs: list[Recording]) -> list[Recording]:
+    """The samples of each rate-table run where the table stands still (every reference rate below
+    MIN_REFERENCE_RATE_DPS), as runs at rest for the bias model (their reference rates dropped)."""
+    out = []
+    for rec in rate_runs:
+        still = np.all(np.abs(rec.reference_rate_dps) < MIN_REFERENCE_RATE_DPS, axis=1)
+        if np.count_nonzero(still) >= 10:
+            out.append(dataclasses.replace(rec.take(still), reference_rate_dps=None))
+    return out
 
 
 def _spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
@@ -748,7 +768,8 @@ def fit_channels(recordings: list[Recording] | Recording, channels: tuple[Channe
     recordings = prepare([recordings] if isinstance(recordings, Recording) else recordings)
     channels = check_channels(channels)
     options = _options(options)
-    gyro_triad, recordings = _gyro_triad(recordings, scale_factor) if "gyro" in channels else (None, recordings)
+    gyro_triad, recordings = (_gyro_triad(recordings, scale_factor, options.temperature is not None)
+                              if "gyro" in channels else (None, recordings))
     if "accel" not in channels:
         return dataclasses.replace(fit_pipeline(recordings, pipeline, options), gyro_triad=gyro_triad)
     accel_cal = _fit_accel_channel(recordings, options)
