@@ -6,13 +6,23 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test docs bench clean
 
-$(STAMP): pyproject.toml
+DEMO_STAMP := $(VENV)/.installed-demo
+
+$(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
+
+# the tests: gyrocomp with every extra the suite reads
+$(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
-demo: $(STAMP)
+# the demo needs only gyrocomp and matplotlib (its figures and report)
+$(DEMO_STAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[plot]'
+	touch $(DEMO_STAMP)
+
+demo: $(DEMO_STAMP)
 	$(BIN)/gyrocomp demo -o demo-output
 
 # two processes (pytest-xdist), each test file in one of them (its module fixtures built once)

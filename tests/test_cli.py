@@ -242,6 +242,17 @@ def test_demo(tmp_path):
     report = (tmp_path / "demo" / "report.html").read_text()
     assert report.startswith("<!DOCTYPE html>") and "heldout_run.csv" in report and "data:image/png;base64," in report
     assert "report.html (open it in a browser)" in r.stdout
+    # the case where gyrocomp's models matter, against the simulator's truth, and the one where they do not
+    cases = json.loads((tmp_path / "demo" / "cases.json").read_text())
+    matters, not_matters = cases
+    assert matters["part"].startswith("consumer") and not_matters["part"].startswith("mti10")
+    assert all(f > 2.0 for f in matters["gyrocomp_factor_vs"].values())  # measured 11-12x
+    assert all(0.5 < f < 2.0 for f in not_matters["gyrocomp_factor_vs"].values())  # as good as a cubic
+    for case in cases:
+        assert case["drift_dps"]["gyrocomp"] < case["drift_dps"]["raw"]
+    assert "Where gyrocomp's models matter" in r.stdout and "Where they do not" in r.stdout
+    assert f"{matters['gyrocomp_factor_vs']['PX4 cubic (process_sensor_caldata.py)']:.2f}x less than PX4 cubic" in r.stdout
+    assert "case_consumer.png" in names
 
 
 def test_demo_without_matplotlib_says_why_there_is_no_report(tmp_path, monkeypatch):

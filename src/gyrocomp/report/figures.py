@@ -285,6 +285,36 @@ def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "d
     return fig
 
 
+def drift_panels(time_s: np.ndarray, errors: dict[str, np.ndarray], window_s: float, title: str,
+                 unit: str = "deg/s"):
+    """The error each method leaves [unit] against time, one panel per method (``errors``: name to its series,
+    about its mean), each its ``window_s`` [s] moving average; the panels after the first (raw) share one vertical
+    scale, so that what compensation leaves is compared at its own size, not flattened by raw's."""
+    plt = _pyplot()
+    t = np.asarray(time_s, dtype=float)
+    hours = t[-1] - t[0] > 3 * 3600
+    scale, t_unit = (1 / 3600.0, "h") if hours else (1.0, "s")
+    t = (t - t[0]) * scale
+    period = float(np.median(np.diff(time_s))) if len(time_s) > 1 else 1.0
+    w = window_samples(window_s, 1.0 / period, len(time_s))
+    fig, panels = plt.subplots(len(errors), 1, figsize=(9.0, 1.8 * len(errors) + 0.8), sharex=True, squeeze=False)
+    smooth = {name: moving_average(np.asarray(y, float) - np.mean(y), w) for name, y in errors.items()}
+    shared = max((np.max(np.abs(v)) for name, v in list(smooth.items())[1:]), default=0.0) * 1.1 or 1.0
+    for k, (panel, (name, y)) in enumerate(zip(panels[:, 0], smooth.items())):
+        ts = t[w // 2: w // 2 + y.size]
+        panel.plot(*envelope(ts, y), "-", color=RAW_COLOUR if k == 0 else COMP_COLOUR, lw=1.2)
+        rms = float(np.sqrt(np.mean(y ** 2)))
+        panel.set_title(f"{name}: RMS {rms:.2g} {unit}", fontsize="small", loc="left")
+        if k > 0:
+            panel.set_ylim(-shared, shared)
+        panel.set_ylabel(unit)
+        panel.grid(True, alpha=0.3)
+    panels[-1, 0].set_xlabel(f"time [{t_unit}]")
+    fig.suptitle(f"{title}; {window_s:g} s moving average")
+    fig.tight_layout()
+    return fig
+
+
 def g_sensitivity_plot(positions: dict, g_matrix: dict, title: str = "g-sensitivity"):
     """The offset of each static position against each accelerometer axis, with the fitted G.
 
