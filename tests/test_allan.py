@@ -1,5 +1,7 @@
 """Allan deviation: Stable32 and NBS14 references, a brute-force definition, and noise slopes."""
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -208,7 +210,9 @@ def test_confidence_intervals_match_stable32(data_file, data_type, result_file, 
 
 # Rows (averaging factors) where our noise type differs from Stable32's, each with its reason:
 # - Cs5071A m = 10000 (56 points): Stable32 says white FM, the lag-1 statistic says white PM (allantools finds
-#   the same); the Cs5071A TOTDEV run used one fixed type for every row (alpha 0, though its own OADEV run
+#   the same); the curve's own slope there (tau^-0.58) is white FM's, and for the unmodified deviations (ADEV,
+#   OADEV, HDEV) it now decides (noise_types' slope check); the modified ones (MDEV, TDEV) and OHDEV keep the
+#   lag-1 type there. The Cs5071A TOTDEV run used one fixed type for every row (alpha 0, though its own OADEV run
 #   finds 2 at m = 1), so only its intervals are compared (test above).
 # - Below 30 points (B1 ratio, R(n)): Stable32's overlapping runs of the ocxo data rise from random walk FM to
 #   flicker and white FM at the three longest taus while its ADEV and HDEV runs of the same data stay at
@@ -216,8 +220,8 @@ def test_confidence_intervals_match_stable32(data_file, data_type, result_file, 
 #   (1.5, 1.25 for 27 and 13 averages) lies on the white FM side; its TOTDEV runs of gps and Keysight differ
 #   at the longest taus. Every other of the 95 rows below 30 points agrees, and so do their intervals.
 _FEW_POINTS_DIFFER = {
-    **{f"Cs5071A/{k}_decade.txt": {10000, 20000, 40000, 100000} for k in ("adev", "hdev")},
-    **{f"Cs5071A/{k}_decade.txt": {10000} for k in ("oadev", "mdev", "tdev", "ohdev")},
+    **{f"Cs5071A/{k}_decade.txt": {20000, 40000, 100000} for k in ("adev", "hdev")},
+    **{f"Cs5071A/{k}_decade.txt": {10000} for k in ("mdev", "tdev", "ohdev")},
     **{f"ocxo/{k}_octave.txt": {1024, 2048, 4096} for k in ("oadev", "mdev", "tdev", "ohdev")},
     "ocxo/totdev_octave.txt": {1024, 2048, 4096, 8192},
     "gps/stable32_TOTDEV_octave.txt": {32768, 65536},
@@ -515,3 +519,29 @@ def test_a_long_phases_running_sum_is_read_by_slices_with_the_same_deviations(mo
         # 5e-9 off an extended-precision sum at m = 1 (measured: array 3.6e-9, slices -6.2e-9)
         np.testing.assert_allclose(sliced.deviation, reference.deviation, rtol=3e-8)
         np.testing.assert_array_equal(sliced.alpha, reference.alpha)
+
+
+def test_a_lag1_type_on_few_points_gives_way_to_the_curves_slope():
+    """Cs5071A OADEV at tau = 10000 s (56 averages): the lag-1 statistic says white PM, the curve falls as
+    tau^-0.58 (white FM's -0.5); the interval is now white FM's, as Stable32's, not one 50 times narrower."""
+    data, data_type, ref = stable32_case("Cs5071A/5071A_phase.txt.gz", "phase", "Cs5071A/oadev_decade.txt")
+    res = allan_deviation(data, 1.0, kind="oadev", taus=ref[:, 0], data_type=data_type)
+    row = int(np.flatnonzero(ref[:, 0] == 10000)[0])
+    assert res.alpha[row] == 0 == ref[row, 3]
+    assert res.ci_low[row] == pytest.approx(ref[row, 4], rel=5e-3)
+    assert res.ci_high[row] == pytest.approx(ref[row, 6], rel=5e-3)
+
+
+def test_rn_modified_variance_from_the_running_sum_on_a_grid():
+    """R(n)'s modified variance: with every start (m <= 64) it is the MDEV estimator's variance to rounding; on a
+    grid of starts (at least 64 per m) it stays within 1 % of it on white and random-walk phase."""
+    from gyrocomp.allan.noise_id import _grid_step, modified_variance_on_grid
+
+    rng = np.random.default_rng(11)
+    for phase in (rng.standard_normal(40001), np.cumsum(rng.standard_normal(40001))):
+        for m, tolerance in ((8, 1e-12), (64, 1e-12), (256, 1e-2), (1024, 1e-2), (3000, 1e-2)):
+            exact = allan_deviation(phase, 1.0, kind="mdev", taus=np.array([float(m)]), data_type="phase",
+                                    confidence=None).deviation[0] ** 2
+            assert modified_variance_on_grid(phase, m) == pytest.approx(exact, rel=tolerance), m
+    assert _grid_step(64) == 1 and _grid_step(4096) == 64 and _grid_step(3000) == 3000 // 75
+    assert math.isnan(modified_variance_on_grid(np.zeros(100), 40))  # 3m beyond the series: no term

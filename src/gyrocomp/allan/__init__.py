@@ -135,7 +135,7 @@ def allan_deviation(data, rate_hz: float, *, kind: AllanKind = "oadev", taus: Ta
         alphas = np.full(len(ms), np.nan)
         edf = alphas.copy()
     else:
-        alphas = noise_types(kind, phase, ms) if forced is None else forced
+        alphas = noise_types(kind, phase, ms, deviation) if forced is None else forced
         edf = degrees_of_freedom(kind, alphas, ms, phase.size)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,

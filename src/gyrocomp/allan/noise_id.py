@@ -15,12 +15,12 @@ from typing import Literal
 
 import numpy as np
 
-from .estimators import _BLOCK, _ESTIMATORS, _blocks, _normalize, _variance_sums, term_count
+from .estimators import _BLOCK, _ESTIMATORS, _blocks, _mean
 
 #: fewest decimated points for which the lag-1 autocorrelation identifies a noise type (Riley 2004)
 NOISE_ID_MIN_POINTS = 30
-#: and the most it uses (a contiguous stretch from the start)
-NOISE_ID_MAX_POINTS = 1 << 20
+#: and the most it uses (a contiguous stretch from the start; see identify_noise)
+NOISE_ID_MAX_POINTS = 1 << 18
 
 
 @dataclass(frozen=True)
@@ -106,8 +106,10 @@ def identify_noise(phase, m: int, *, max_differences: int = 2) -> NoiseIdentific
     The phase is decimated by m, its quadratic trend removed, and it is differenced until the
     autocorrelation ratio rho = r1 / (1 + r1) falls below 0.25 (or ``max_differences`` is reached);
     then alpha = 2 - 2 (rho + d), rounded (Riley and Greenhall 2004). Returns None with fewer than
-    30 decimated points. At most the first 2^20 decimated points are used: the lag-1 estimate's
-    standard error there (1e-3) is far inside the rounding margin, and no reference series is longer.
+    30 decimated points. At most the first 2^18 decimated points are used: the lag-1 estimate's
+    standard error there (2e-3) is far inside the rounding margin (types change every 0.25 of rho), every
+    Stable32 reference file agrees as with 2^20, and it keeps the identification a fraction of the deviations'
+    cost on long series.
     """
     x = phase[:NOISE_ID_MAX_POINTS * m:m]
     if len(x) < NOISE_ID_MIN_POINTS:
@@ -145,13 +147,46 @@ def rn_expected(m: int, alpha: Literal[1, 2]) -> float:
     return 1.0 / m if alpha == 2 else 3.37 / (1.04 + 3.0 * math.log(math.pi * m))
 
 
-def _variance_at(kind: str, phase, m: int) -> float:
-    """The variance of estimator ``kind`` at averaging factor m (NaN where no term fits)."""
-    ms = np.array([m])
-    counts = term_count(kind, len(phase), ms)
-    if counts[0] < 1:
+#: starts per averaging factor at which R(n)'s modified variance is evaluated (at least; see _grid_step)
+RN_STARTS_PER_M = 64
+
+
+def _grid_step(m: int) -> int:
+    """The step g of the starts R(n) uses: m / d for the smallest divisor d of m that is at least
+    ``RN_STARTS_PER_M`` (m itself when none is: every start, as the overlapping estimator has)."""
+    d = next((d for d in range(RN_STARTS_PER_M, m + 1) if m % d == 0), m) if m > RN_STARTS_PER_M else m
+    return m // d
+
+
+def modified_variance_on_grid(phase, m: int) -> float:
+    """The modified Allan variance at averaging factor m (tau = m samples, per sample squared, as
+    ``identify_noise_b1``'s Allan variance), its overlapping sum taken at every g-th start only (g from
+    :func:`_grid_step`: at least ``RN_STARTS_PER_M`` starts per m), NaN where no term fits.
+
+    With X the running sum of the phase about its mean, the inner sum of a modified-variance term is
+    D(i) = X(i+3m) - 3 X(i+2m) + 3 X(i+m) - X(i); for starts i on a grid of step g dividing m, every X it needs is
+    on the grid too, so X is needed there only: one pass over the phase gives its sums over blocks of g, and
+    their running sum is X on the grid. The cost is one read of the phase, whatever m (the full overlapping sum
+    recomputed X for every factor). Mod sigma^2 = sum D^2 / (2 m^4 count) (NIST SP 1065 eq. 14).
+    """
+    n = len(phase)
+    if n - 3 * m + 1 < 1:
         return math.nan
-    return float(_normalize(kind, _variance_sums(kind, phase, ms, counts), ms, ms.astype(float), counts, 1.0)[0] ** 2)
+    g = _grid_step(m)
+    blocks = n // g
+    mean = _mean(phase)
+    sums = np.empty(blocks)
+    step = max(g, (_BLOCK // g) * g)
+    for start in range(0, blocks * g, step):
+        stop = min(start + step, blocks * g)
+        chunk = np.asarray(phase[start:stop], dtype=np.float64) - mean
+        sums[start // g: stop // g] = chunk.reshape(-1, g).sum(axis=1)
+    grid = np.concatenate([[0.0], np.cumsum(sums)])  # X at 0, g, 2g, ...
+    d = m // g
+    starts = (n - 3 * m) // g + 1  # grid starts i = 0, g, ... with i + 3m <= n
+    x = grid[:starts + 3 * d]
+    terms = x[3 * d:3 * d + starts] - 3.0 * x[2 * d:2 * d + starts] + 3.0 * x[d:d + starts] - x[:starts]
+    return float(np.dot(terms, terms) / (2.0 * float(m) ** 4 * starts))
 
 
 def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
@@ -161,7 +196,8 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
     method removes the quadratic phase trend); B1 is their standard variance over their Allan variance. The
     Allan variance's exponent mu is the one whose expected B1 lies nearest on a log scale (boundaries at
     the geometric means, Howe et al. 2000, Table 4), alpha = -mu - 1. mu = -2 (white or flicker PM) is
-    split by R(n) = MVAR/AVAR (MVAR of the whole series) against the geometric mean of the two expected values.
+    split by R(n) = MVAR/AVAR (MVAR of the whole series, :func:`modified_variance_on_grid`) against the geometric
+    mean of the two expected values.
     Returns None with fewer than 3 averages or a series without variation.
     """
     n_points = (len(phase) - 1) // m
@@ -183,7 +219,7 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
     if mu > -2:
         return NoiseIdentification(alpha=-mu - 1, alpha_estimate=math.nan, differences=-1, rho=math.nan,
                                    method="b1", ratio=ratio)
-    rn = _variance_at("mdev", phase, m) / allan  # the ADEV at m is the Allan variance of these averages
+    rn = modified_variance_on_grid(phase, m) / allan  # the ADEV at m is the Allan variance of these averages
     if not math.isfinite(rn):
         return None
     alpha = 1 if rn > math.sqrt(rn_expected(m, 1) * rn_expected(m, 2)) else 2
@@ -191,26 +227,66 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
                                method="rn", ratio=rn)
 
 
-def noise_types(kind: str, phase, ms: np.ndarray) -> np.ndarray:
+#: a lag-1 identification from fewer decimated points than this is checked against the curve's own slope
+SLOPE_CHECK_MAX_POINTS = 100
+#: how far [in the exponent of tau] the slope may lie from the identified type's before the slope decides
+SLOPE_TOLERANCE = 0.25
+
+
+def expected_slope(kind: str, alpha: int) -> float:
+    """The exponent of tau of the deviation ``kind`` for power-law noise alpha: (-alpha - 1) / 2, where white and
+    flicker PM both fall as tau^-1 for the unmodified deviations; the modified ones tell them apart (tau^-1.5 for
+    white PM); TDEV is tau times MDEV (NIST SP 1065, Table 5)."""
+    slope = (-alpha - 1) / 2.0
+    if kind in ("mdev", "tdev"):
+        return slope + (1.0 if kind == "tdev" else 0.0)
+    return max(slope, -1.0)
+
+
+def _slope_checked(kind: str, alphas: np.ndarray, points: list, ms: np.ndarray, deviation, lowest: int
+                   ) -> np.ndarray:
+    """Where a lag-1 type rests on few points (< SLOPE_CHECK_MAX_POINTS) and the curve's own slope from the
+    previous tau lies more than SLOPE_TOLERANCE from that type's, the type whose slope is nearest the curve's."""
+    out = alphas.copy()
+    for j in range(1, len(ms)):
+        if points[j] is None or points[j] >= SLOPE_CHECK_MAX_POINTS or not np.isfinite(alphas[j]):
+            continue
+        if not (deviation[j] > 0 and deviation[j - 1] > 0):
+            continue
+        slope = math.log(deviation[j] / deviation[j - 1]) / math.log(ms[j] / ms[j - 1])
+        if alphas[j] < 1 or abs(expected_slope(kind, int(alphas[j])) - slope) <= SLOPE_TOLERANCE:
+            continue  # only a phase-noise type (the narrowest intervals) is questioned
+        out[j] = float(min(range(lowest, 3), key=lambda a: (abs(expected_slope(kind, a) - slope), -a)))
+    return out
+
+
+def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None = None) -> np.ndarray:
     """alpha at each averaging factor in ``ms`` (ascending), as Stable32 identifies it.
 
     The lag-1 autocorrelation where 30 decimated points remain, the B1 ratio with R(n) below that. A B1
     type is capped by the type found at the next shorter tau: in a sum of independent power-law noises the
     dominant exponent can only fall as tau grows, and the lag-1 type from many points is the better
     determined. Where neither method applies the type found at the next shorter tau is carried forward.
-    Types are kept within the estimator's range (alpha + 2d > 1).
+    Types are kept within the estimator's range (alpha + 2d > 1). With ``deviation`` (the curve at ``ms``), a
+    lag-1 type from fewer than ``SLOPE_CHECK_MAX_POINTS`` points that the curve's own slope contradicts gives
+    way to the slope's (:func:`_slope_checked`): on 56 points the lag-1 statistic can call white FM white PM,
+    whose interval would then be far too narrow.
     """
     spec = _ESTIMATORS[kind]
     lowest = 2 - 2 * spec.difference_order
     alphas = np.full(len(ms), np.nan)
+    points: list = [None] * len(ms)
     current = math.nan
     for j, m in enumerate(ms):
         m = int(m)
         found = identify_noise(phase, m, max_differences=spec.difference_order)
         if found is not None:
             current = float(min(2, max(lowest, found.alpha)))
+            points[j] = min((len(phase) - 1) // m + 1, NOISE_ID_MAX_POINTS)
         elif (few := identify_noise_b1(phase, m)) is not None:
             capped = few.alpha if math.isnan(current) else min(few.alpha, current)
             current = float(min(2, max(lowest, capped)))
         alphas[j] = current
+    if deviation is not None and kind not in ("mdev", "tdev"):  # the modified curves' slopes follow other laws
+        alphas = _slope_checked(kind, alphas, points, np.asarray(ms, dtype=float), np.asarray(deviation), lowest)
     return alphas
