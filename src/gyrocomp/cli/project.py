@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from ..errors import InputError
-from ..io import write_text_atomic
+from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.guess import guess_layout
 from .common import make_console
 from .projectfile import PROJECT_FILE, PROJECT_KEY
@@ -29,6 +29,7 @@ def _toml_text(value) -> str:
 def init(ctx, log, output, force):
     """Write a project file for LOG's kind of table: its columns and units guessed from their names and
     magnitudes, said one by one, read by every command run in this folder."""
+    refuse_to_overwrite_inputs(output, [log], option="-o")
     if Path(output).exists() and not force:
         raise InputError(f"{output}: exists; give --force to replace it, or -o another file")
     guess = guess_layout(log)
