@@ -11,7 +11,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 
 #: bottom to top; a module belongs to the first layer one of whose prefixes it matches
 LAYERS = (
-    ("foundation", ("_version", "errors", "units", "threads", "jsontext")),
+    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding")),
     ("signals", ("recording", "effects", "allan", "noise", "static", "stillness", "metrics", "plausibility",
                  "simulate", "spill", "prepared", "runsplit")),
     ("io", ("io",)),

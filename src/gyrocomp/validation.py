@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .rounding import with_error
 from .calibration import AxisCalibration, Calibration
 from .compensate import apply
 from .errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
@@ -136,7 +137,7 @@ class ValidationResult:
         cubic = self.mean_over_axes("cubic + run constants") if "cubic + run constants" in self.methods else 0.0
         rows = []
         for method in self.methods:
-            cells = [f"{self.score(method, a).mean_drift_dps:.4g} +- {self.score(method, a).standard_error_dps:.2g}"
+            cells = [with_error(self.score(method, a).mean_drift_dps, self.score(method, a).standard_error_dps)
                      for a in self.axes]
             mean = self.mean_over_axes(method)
             rows.append([method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-"])

@@ -22,6 +22,7 @@ from gyrocomp import fit_calibration
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.report.figures import envelope
 from gyrocomp.report.html import SECTIONS, build_report
+from gyrocomp.rounding import with_error
 from gyrocomp.simulate import get_profile, simulate
 from gyrocomp.models.options import FitOptions
 from ..conftest import SCRIPT, run
@@ -97,7 +98,7 @@ def test_three_axis_report_with_acceleration_and_accelerometer():
     # chosen by held-out drift: the drift to expect on unseen data, per axis, with its standard error
     expected = cal.report.expected_drift()
     assert "drift to expect on unseen data: mean +- standard error over 4 held-out legs" in report.html
-    assert f"{expected['gyro_x'].drift:.3g} +- {expected['gyro_x'].standard_error:.2g} deg/s" in report.html
+    assert f"{with_error(expected['gyro_x'].drift, expected['gyro_x'].standard_error)} deg/s" in report.html
     assert "thin evidence" not in report.html  # two runs that heat and cool: four legs
     assert progress == sorted(progress) and progress[-1] == 1.0
     assert set(SECTIONS) <= set(report.sections)

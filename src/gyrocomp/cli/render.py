@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from rich.table import Table
 
+from ..rounding import with_error
 from .common import make_console
 
 if TYPE_CHECKING:  # types only: `gyrocomp allan` need not import the fitting to print its table
@@ -103,7 +104,7 @@ def _print_triad(console, name: str, triad) -> None:
     for col in ("axis", "K row (+- standard error)", "scale error [ppm]", f"bias [{triad.unit}]"):
         table.add_column(col)
     for i, axis in enumerate("xyz"):
-        row = "  ".join(f"{k:+.6f}+-{e:.1g}" for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i]))
+        row = "  ".join(with_error(k, e, sign=True) for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i]))
         table.add_row(axis, row, f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g}")
     console.print(table)
 
@@ -191,7 +192,7 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
     for axis, sel in selection.items():
         chosen, best = sel.result(sel.chosen.label), sel.result(sel.best.label)
         table.add_row(axis, sel.chosen.label,
-                      f"{_score(chosen.mean_drift)} +- {_score(chosen.standard_error, '.2g')}",
+                      with_error(chosen.mean_drift, chosen.standard_error),
                       sel.best.label, _score(best.mean_drift), _score(sel.raw_drift))
     console.print(table)
     folds = Table(title=f"held-out drift per fold [{unit}]")
@@ -217,7 +218,7 @@ def _print_g_sensitivity(console, acc: GSensitivityReport | None) -> None:
         for name in ("accel_x", "accel_y", "accel_z"):
             gt.add_column(name, justify="right")
         for axis, row in fitted.items():
-            cells = [f"{g:+.4g} +- {e:.2g}" if e is not None else "not fitted"
+            cells = [with_error(g, e, sign=True) if e is not None else "not fitted"
                      for g, e in zip(row.g_sensitivity_dps_per_g, row.standard_error_dps_per_g)]
             gt.add_row(axis, *cells)
         console.print(gt)
@@ -304,9 +305,8 @@ def print_expected_drift(expected: dict) -> None:
     for col in ("axis", "model", "expected drift", "run constant alone"):
         table.add_column(col, justify="left" if col in ("axis", "model") else "right")
     for e in expected.values():
-        table.add_row(e.axis, e.model, f"{_score(e.drift)}" + ("" if e.standard_error is None
-                                                               else f" +- {_score(e.standard_error, '.2g')}")
-                      + f" {e.unit}", f"{_score(e.constant_drift)} {e.unit}")
+        table.add_row(e.axis, e.model, f"{with_error(e.drift, e.standard_error)} {e.unit}",
+                      f"{_score(e.constant_drift)} {e.unit}")
     make_console().print(table)
 
 

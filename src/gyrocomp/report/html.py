@@ -37,6 +37,7 @@ from ..export.firmware import BEYOND_DEGC, firmware_corrected, firmware_costs
 from ..metrics import evaluate_run
 from ..noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
+from ..rounding import with_error
 from ..static import static_segments
 from ..stillness import detect_still
 from ..models.field import moves_most_of_the_time
@@ -113,7 +114,7 @@ def _describe(ax) -> str:
 
 
 def _expected(drift: float, standard_error: float | None, unit: str) -> str:
-    return f"{drift:.3g}" + ("" if standard_error is None else f" +- {standard_error:.2g}") + f" {unit}"
+    return f"{with_error(drift, standard_error)} {unit}"
 
 
 def _summary(calibration: Calibration) -> str:
@@ -276,7 +277,7 @@ def _triads(calibration: Calibration, runs: list[Recording], compensated: list[R
     for name, triad in triads.items():
         for i, axis in enumerate("xyz"):
             rows.append([f"{name} {axis}", triad.method]
-                        + [f"{k:+.6f} +- {e:.1g}" for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i])]
+                        + [with_error(k, e, sign=True) for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i])]
                         + [f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g} {triad.unit}"])
     temps = [rec.temperature_degc for rec in runs if rec.temperature_degc is not None]
     span = (float(min(np.min(t) for t in temps)), float(max(np.max(t) for t in temps))) if temps else None
@@ -319,8 +320,7 @@ def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s
             continue
         errors = acc[axis].standard_error_dps_per_g if axis in acc else (None, None, None)
         g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
-        rows.append([axis] + [f"{g:+.4g}" + ("" if e is None else f" +- {e:.2g}")
-                              for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
+        rows.append([axis] + [with_error(g, e, sign=True) for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
     body = [_table(["gyro axis", "accel_x", "accel_y", "accel_z"], rows,
                    "g-sensitivity matrix G [deg/s/g] +- standard error")]
     if positions:
