@@ -30,7 +30,7 @@ from .metrics import smoothed_residual_rms
 from .models.base import provenance
 from .models.hysteresis import turn_threshold_degc
 from .models.options import FitOptions, FoldChoice
-from .models.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MAX_S, WINDOW_MIN_S, leg_labels
+from .models.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MIN_S, drift_window_s, leg_labels
 from .models.selection import fold_mean, fold_standard_error
 from .models.temperature import PolynomialBias
 from .plausibility import require_temperature_span
@@ -207,7 +207,8 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
         Calibration runs of one sensor at rest (each one power-on).
     folds : {"auto", "runs", "legs", "blocks"}
     window_s : float, optional
-        Moving-average window of the drift [s]; default a tenth of the median fold, within 60..600 s.
+        Moving-average window of the drift [s]; default :func:`gyrocomp.models.folds.drift_window_s` of the
+        folds (the model choice's): a tenth of the median fold, within 60..600 s, at most a quarter of the shortest.
     candidates : dict, optional
         Further methods: name -> :class:`~gyrocomp.models.options.FitOptions` of gyrocomp's fit (or a function of
         the training runs returning a Calibration).
@@ -223,7 +224,7 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
     kind, fold_list = make_sample_folds(recordings, folds)
     if window_s is None:
         lengths = [fold.rows.size / recordings[fold.run].rate_hz for fold in fold_list]
-        window_s = float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
+        window_s = drift_window_s(lengths, max(1.0 / rec.rate_hz for rec in recordings))  # as the model choice
     if not window_s > 0:
         raise InputError(f"window_s: must be positive, got {window_s}")
     methods = {**BASELINES, **(candidates or {})}

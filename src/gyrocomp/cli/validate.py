@@ -19,7 +19,7 @@ from .render import print_validation
               help="Hold out each run, each heating or cooling leg, or time blocks; auto: runs with three runs "
                    "or more, else legs.")
 @click.option("--window", "window_s", type=FINITE, default=None,
-              help="Moving-average window of the drift [s] (default: a tenth of the median fold, 60..600 s).")
+              help="Moving-average window of the drift [s] (default: as fit's model choice: a tenth of the median fold, 60..600 s, at most a quarter of the shortest).")
 @click.option("--candidate", "candidates", multiple=True, metavar="SPEC",
               help="Also validate gyrocomp fitted with --temperature SPEC (poly:N, poly, mlp); repeatable.")
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")

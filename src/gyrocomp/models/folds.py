@@ -118,16 +118,24 @@ def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: 
     return Folds("blocks", tuple(of_block), tuple(names), note)
 
 
+def drift_window_s(fold_lengths_s, shortest_s: float) -> float:
+    """The one definition of the held-out drift's moving-average window [s], shared by the model choice
+    (``fit``) and ``validate``: a tenth of the median fold length [s], within [WINDOW_MIN_S, WINDOW_MAX_S], at
+    most a quarter of the shortest fold (a window that still moves within it), at least ``shortest_s`` [s]
+    (a block or a sample)."""
+    lengths = [float(v) for v in fold_lengths_s]
+    window = float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
+    return max(shortest_s, min(window, min(lengths) / 4.0))
+
+
 def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
-    """The score's moving-average window [s]: a tenth of the median fold length, within
-    [WINDOW_MIN_S, WINDOW_MAX_S]."""
+    """The score's moving-average window [s] (:func:`drift_window_s` of the folds' lengths)."""
     lengths = []
     for f in range(folds.count):
         n = sum(int(np.count_nonzero(fold == f)) for fold in folds.of_block)
         lengths.append(n * block_s)
-    window = float(np.clip(np.median(lengths) / 10.0, WINDOW_MIN_S, WINDOW_MAX_S))
-    return max(block_s, min(window, min(lengths) / 4.0))  # short folds: a window that still moves
+    return drift_window_s(lengths, block_s)
 
 
 __all__ = ["BLOCKS_PER_RUN", "FOLD_KINDS", "FoldKind", "Folds", "MIN_FOLDS", "WINDOW_MAX_S", "WINDOW_MIN_S",
-           "leg_labels", "make_folds", "window_for"]
+           "drift_window_s", "leg_labels", "make_folds", "window_for"]
