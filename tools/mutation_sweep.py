@@ -139,6 +139,15 @@ def mutated_model(model: dict, rng: np.random.Generator) -> str:
     return text
 
 
+def simulated_model(seed: int, data: Path) -> tuple[Path, dict]:
+    """A simulated chamber run written to ``data``, and the model fitted on it (as a dict)."""
+    run = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=seed).recording
+    write(run, data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return data, fit_calibration([run], temperature=Polynomial(2)).to_dict()
+
+
 def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counter]:
     rng = np.random.default_rng(seed)
     results: dict[str, collections.Counter] = {}
@@ -157,12 +166,7 @@ def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counte
         path.write_text(malformed_csv(rng), encoding="utf-8")
         status, lines = run_command(["convert", path, out, *(["--drop-nan"] if k % 2 else [])])
         counter[classify(status, lines, out)] += 1
-    run = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=seed).recording
-    data = work / "data.csv"
-    write(run, data)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        model = fit_calibration([run], temperature=Polynomial(2)).to_dict()
+    data, model = simulated_model(seed, work / "data.csv")
     counter = results.setdefault("model files (150 mutated)", collections.Counter())
     for k in range(150):
         path, out = work / f"model{k}.json", work / f"applied{k}.csv"
@@ -371,12 +375,7 @@ def unlucky_reads(work: Path) -> collections.Counter:
 
 def hostile_sweep(seed: int, work: Path) -> dict[str, collections.Counter]:
     rng = np.random.default_rng(seed + 1)
-    run = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=seed).recording
-    data = work / "hostile_data.csv"
-    write(run, data)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        model = fit_calibration([run], temperature=Polynomial(2)).to_dict()
+    data, model = simulated_model(seed, work / "hostile_data.csv")
     model_path = work / "hostile_model.json"
     model_path.write_text(json.dumps(model), encoding="utf-8")
     return {"model text fields made hostile, exported (60)": hostile_exports(model, work, rng, 60),
