@@ -2,21 +2,17 @@
 
 from __future__ import annotations
 
-import warnings
-
 import click
 
 from ..calibration import Calibration
-from ..io import refuse_to_overwrite_inputs, write_text_atomic
-from ..export.autopilot import ardupilot_parameters, ardupilot_params_file, px4_parameters, px4_params_file
-from ..export.c_code import write_c_sources
-from ..export.firmware import firmware_difference
-from ..recording import GYRO_AXES
+from ..io import refuse_to_overwrite_inputs
+from ..export.formats import EXPORTERS, ExportOptions, export_to
 from ..models.online import LearnerSettings, OnlineCalibrator
 from .common import FINITE
 
 
-EXPORT_FORMATS = ("px4", "ardupilot", "c")
+#: the formats gyrocomp export offers (the model file itself is already a file: fleet export offers json too)
+EXPORT_FORMATS = tuple(name for name in EXPORTERS if name != "json")
 
 
 @click.command()
@@ -51,37 +47,18 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id, accel_device_i
 def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, instance=None,
                  device_id: int | None = None, accel_device_id: int | None = None, quiet: bool = False,
                  learner: LearnerSettings | None = None) -> None:
-    """Write ``calibration`` as ``fmt`` (px4, ardupilot, c, or json: the model file) and say what was written."""
-    if fmt == "json":
-        calibration.save(output)
-        written = [output]
-    elif fmt == "c":
-        written = write_c_sources(calibration, output, rate_hz=rate_hz, learner=learner)
-    else:
-        slot = (0 if fmt == "px4" else 1) if instance is None else instance
-        if fmt == "px4":
-            text = px4_params_file(calibration, instance=slot, device_id=device_id, accel_device_id=accel_device_id)
-            params = px4_parameters(calibration, instance=slot, device_id=device_id,
-                                    accel_device_id=accel_device_id).values
-        else:
-            text = ardupilot_params_file(calibration, instance=slot)
-            params = ardupilot_parameters(calibration, instance=slot).values
-        write_text_atomic(output, text)
-        if not quiet:
-            click.echo(f"wrote {output}")
-            for line in text.splitlines()[1:]:
-                if not line.startswith("#"):
-                    break
-                click.echo(line.lstrip("# "))
-            if any(a in calibration.axes and calibration.axes[a].temperature is not None for a in GYRO_AXES):
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")  # the model continued past its range: that is the point here
-                    difference = firmware_difference(calibration, params, fmt, slot)
-                for line in difference.lines():
-                    click.echo(line)
+    """Write ``calibration`` as ``fmt`` (:func:`gyrocomp.export.formats.export_to`) and say what was written."""
+    done = export_to(calibration, fmt, output, ExportOptions(rate_hz=rate_hz, instance=instance, device_id=device_id,
+                                                              accel_device_id=accel_device_id, learner=learner,
+                                                              judge_firmware=not quiet))
+    if quiet:
         return
-    if not quiet:
-        click.echo("wrote " + " and ".join(str(p) for p in written))
+    click.echo("wrote " + " and ".join(str(p) for p in done.written))
+    for line in done.notes:
+        click.echo(line)
+    if done.firmware is not None:
+        for line in done.firmware.lines():
+            click.echo(line)
 
 
 __all__ = ["EXPORT_FORMATS", "export", "write_export"]
