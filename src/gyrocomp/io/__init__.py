@@ -76,8 +76,15 @@ def output_format(path: str | os.PathLike, option: str = "-o", default: str | No
     return found
 
 
+#: the reader of each format that is not a table (tables: io.tables): format name -> read(path, options, progress)
+LOG_READERS = {"ulog": read_ulog, "dataflash": read_dataflash, "rosbag": read_rosbag, "hdf5": read_hdf5}
+
+
 def _log_reader(fmt: str):
-    return {"ulog": read_ulog, "dataflash": read_dataflash, "rosbag": read_rosbag}.get(fmt, read_hdf5)
+    """The registered reader of ``fmt``; a name no reader has is refused (no fall-through to another reader)."""
+    if fmt not in LOG_READERS:
+        raise InputError(f"fmt: no reader for {fmt!r}; the formats are {', '.join(FORMATS)}")
+    return LOG_READERS[fmt]
 
 
 def read_input(
@@ -193,6 +200,8 @@ def read(
 
 __all__ = [
     "FORMATS",
+    "LOG_FORMATS",
+    "LOG_READERS",
     "ReadOptions",
     "TableData",
     "TableLayout",
