@@ -38,9 +38,9 @@ def test_split_by_still_finds_the_three_periods_from_the_original_file(tmp_path)
     from gyrocomp import read
 
     from .conftest import run
-    from .real_data import CATS, CATS_PERIODS_S
+    from .real_data import CATS_PERIODS_S
 
-    source = CATS / "cats_temperature_calib.nc"
+    source = shared_dataset("skdivemove-cats-tempcal") / "cats_temperature_calib.nc"  # skipped when absent
     result = run("split", source, "-o", tmp_path / "runs", "--by", "still")
     assert result.returncode == 0, result.stderr
     runs = [read(path) for path in sorted((tmp_path / "runs").glob("*.csv"))]
