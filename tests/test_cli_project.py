@@ -109,6 +109,9 @@ def test_init_keeps_an_existing_file_and_refuses_what_it_cannot_read(tmp_path):
     onto = run("init", "log.tsv", "-o", "log.tsv", "--force", cwd=tmp_path)  # the log is an input
     assert onto.returncode == 2 and "-o log.tsv: this is an input file" in onto.stderr
     assert (tmp_path / "log.tsv").read_bytes() == before
+    (tmp_path / "gyrocomp.toml").write_text("[broken\n")  # a file that does not load is replaced, not obeyed
+    assert run("init", "log.tsv", "--force", cwd=tmp_path).returncode == 0
+    assert run("config", "show", cwd=tmp_path).returncode == 0
     (tmp_path / "flight.ulg").write_bytes(b"ULog\x01\x12\x35\x01" + bytes(8))
     refused = run("init", "flight.ulg", "-o", "x.toml", cwd=tmp_path)
     assert refused.returncode == 2 and "not a CSV/TSV or Parquet table" in refused.stderr

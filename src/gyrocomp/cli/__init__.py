@@ -85,6 +85,8 @@ class LazyGroup(click.Group):
         if name not in COMMANDS:
             return None
         command = getattr(importlib.import_module(f"gyrocomp.cli.{COMMANDS[name][0]}"), name)
+        if name == "init":  # init writes the project file: one that does not load must not stop it
+            return command
         if PROJECT_KEY not in ctx.meta:
             ctx.meta[PROJECT_KEY] = load_project(ctx.params.get("config"), tuple(COMMANDS))
         project = ctx.meta[PROJECT_KEY]
