@@ -165,6 +165,11 @@ def test_apply_parquet_and_turn_on_window(workdir):
     assert r.returncode == 0, r.stderr
     comp = pd.read_parquet(out)
     assert abs(comp["gyro_z"][comp["time"] < 30].mean()) < 1e-12
+    # evaluate takes the same window and says what it does to its figures (nothing: they ignore a constant)
+    with_window = run("evaluate", workdir / "model.json", workdir / "run3.csv", "--turn-on-window", 30)
+    plain = run("evaluate", workdir / "model.json", workdir / "run3.csv")
+    assert with_window.returncode == 0 and with_window.stdout == plain.stdout
+    assert "--turn-on-window 30: each run's constant was taken from its first seconds" in with_window.stderr
 
 
 def test_evaluate_json_shape(workdir):

@@ -79,6 +79,7 @@ def test_single_axis_report_with_hysteresis_has_every_section():
     assert "correction against the model" in report.html and "heat-cool cycle as run" in report.html
     assert "PX4 file (as run)" in report.html
     assert "stages of the compensation" in report.html  # the thesis's Table 4.4 shape with hysteresis
+    assert "<th>window [s]</th>" in report.html  # each figure with the window it depends on
     assert "temperature + hysteresis" in report.html and "polynomial order" in report.html
 
 

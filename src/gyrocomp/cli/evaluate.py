@@ -105,6 +105,10 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     else:
         print_evaluation(evaluation)
         print_expected_drift(expected)
+        if turn_on_window_s is not None and not ctx.obj["quiet"]:
+            click.echo(f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
+                       "its first seconds; bias offset, bias instability and integration time do not depend on a "
+                       "constant, so only the compensated output (gyrocomp apply) shows it", err=True)
 
 
 def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, rate_schedule) -> Evaluation:

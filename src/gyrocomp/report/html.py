@@ -193,26 +193,26 @@ def _evaluation(calibration: Calibration, runs: list[Recording], evaluations: li
             first = next(iter(st.stages.values()))
             for axis in first:
                 m0 = first[axis]
-                rows.append([name, axis, "raw", m0.bias_offset_raw_dps, "1x", m0.bias_instability_raw_dph,
-                             m0.integration_time_raw_s])
+                rows.append([name, axis, f"{window_s:.3g}", "raw", m0.bias_offset_raw_dps, "1x",
+                             m0.bias_instability_raw_dph, m0.integration_time_raw_s])
                 for stage, axes in st.stages.items():
                     m = axes[axis]
-                    rows.append(["", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x",
+                    rows.append(["", "", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x",
                                  m.bias_instability_comp_dph, m.integration_time_comp_s])
         if not staged:
             for axis, m in ev.axes.items():
-                rows.append([name, axis, "compensated", m.bias_offset_raw_dps, m.bias_offset_comp_dps,
+                rows.append([name, axis, f"{window_s:.3g}", m.bias_offset_raw_dps, m.bias_offset_comp_dps,
                              f"{m.offset_improvement:.3g}x", m.bias_instability_raw_dph, m.bias_instability_comp_dph,
                              m.integration_time_raw_s, m.integration_time_comp_s])
         for axis, m in ev.accel_axes.items():
             accel_rows.append([name, axis, m.bias_offset_raw_g, m.bias_offset_comp_g, f"{m.offset_improvement:.3g}x",
                                m.bias_instability_raw_ug, m.bias_instability_comp_ug])
     if staged:
-        parts.append(_table(["run", "axis", "stage", "bias offset [deg/s]", "improvement (raw/stage)",
+        parts.append(_table(["run", "axis", "window [s]", "stage", "bias offset [deg/s]", "improvement (raw/stage)",
                              "bias instability [deg/h]", "integration time [s]"], rows,
                             "stages of the compensation (the thesis's Table 4.4)"))
     else:
-        parts.append(_table(["run", "axis", "", "offset raw [deg/s]", "offset comp [deg/s]", "improvement",
+        parts.append(_table(["run", "axis", "window [s]", "offset raw [deg/s]", "offset comp [deg/s]", "improvement",
                              "BI raw [deg/h]", "BI comp [deg/h]", "int. time raw [s]", "int. time comp [s]"], rows))
     if accel_rows:
         parts.append(_table(["run", "axis", "offset raw [g]", "offset comp [g]", "improvement", "BI raw [ug]",
