@@ -83,6 +83,9 @@ def test_fit_prints_table_and_writes_model(workdir):
     # folds are said to be thin evidence
     assert "model choice by held-out drift (legs: 2 folds" in r.stdout
     assert "held-out drift per fold" in r.stdout and "run 2 leg 1 (heating)" in r.stdout
+    # one row per fold, one column per axis and model role: the table's width does not grow with the folds
+    per_fold = r.stdout[r.stdout.index("held-out drift per fold"):]
+    assert re.search(r"fold\s+\S\s+gyro_x chosen\s+\S\s+gyro_x", per_fold) and "gyro_z chosen" in per_fold
     assert "only 2 heating and cooling legs to hold out; the evidence for each axis's choice is thin" in r.stderr
     model = json.loads((workdir / "auto.json").read_text())
     assert model["fit_report"]["order_selection"] == "leave-one-leg-out"

@@ -195,14 +195,20 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
                       with_error(chosen.mean_drift, chosen.standard_error),
                       sel.best.label, _score(best.mean_drift), _score(sel.raw_drift))
     console.print(table)
-    folds = Table(title=f"held-out drift per fold [{unit}]")
-    folds.add_column("axis")
-    folds.add_column("model")
-    for name in first.folds:
-        folds.add_column(name, justify="right")
+    # one row per fold, one column per axis and model: as narrow for twelve legs as for three runs
+    folds = Table(title=f"held-out drift per fold [{unit}]: each axis's chosen model, the best, the constant")
+    folds.add_column("fold")
+    roles = {}  # axis -> {label: role}, a model named once (the chosen one may be the best, or the constant)
     for axis, sel in selection.items():
-        for label in dict.fromkeys([sel.chosen.label, sel.best.label, "constant (time)"]):
-            folds.add_row(axis, label, *[_score(v) for v in sel.result(label).fold_drift])
+        roles[axis] = {}
+        for role, label in (("chosen", sel.chosen.label), ("best", sel.best.label), ("constant", "constant (time)")):
+            roles[axis].setdefault(label, role)
+    for axis, named in roles.items():
+        for role in named.values():
+            folds.add_column(f"{axis} {role}", justify="right")
+    for f, name in enumerate(first.folds):
+        folds.add_row(name, *[_score(selection[axis].result(label).fold_drift[f])
+                              for axis, named in roles.items() for label in named])
     console.print(folds)
 
 
