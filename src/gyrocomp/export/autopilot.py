@@ -274,7 +274,12 @@ def px4_params_file(calibration: Calibration, *, instance: int = 0, device_id: i
                     accel_device_id: int | None = None) -> str:
     """A QGroundControl parameter file (vehicle 1, component 1; type 6 = int32, 9 = float32) of
     :func:`px4_parameters` (``instance`` 0..3 of the sensor, its device ids)."""
-    params = px4_parameters(calibration, instance=instance, device_id=device_id, accel_device_id=accel_device_id)
+    return px4_params_text(calibration, px4_parameters(calibration, instance=instance, device_id=device_id,
+                                                       accel_device_id=accel_device_id))
+
+
+def px4_params_text(calibration: Calibration, params: AutopilotParameters) -> str:
+    """The QGroundControl file of parameters already computed (:func:`px4_parameters` of ``calibration``)."""
     lines = _header(calibration, params, "PX4", "#")
     lines.append("# Vehicle-Id Component-Id Name Value Type")
     for name, value in params.values.items():
@@ -286,7 +291,11 @@ def px4_params_file(calibration: Calibration, *, instance: int = 0, device_id: i
 def ardupilot_params_file(calibration: Calibration, *, instance: int = 1) -> str:
     """An ArduPilot parameter file (``NAME VALUE`` per line, as MAVProxy and Mission Planner load) of
     :func:`ardupilot_parameters` (``instance`` 1..3 of the IMU)."""
-    params = ardupilot_parameters(calibration, instance=instance)
+    return ardupilot_params_text(calibration, ardupilot_parameters(calibration, instance=instance))
+
+
+def ardupilot_params_text(calibration: Calibration, params: AutopilotParameters) -> str:
+    """The ArduPilot file of parameters already computed (:func:`ardupilot_parameters` of ``calibration``)."""
     lines = _header(calibration, params, "ArduPilot", "#")
     lines.append("# the correction is relative to INS_GYRn_CALTEMP (INS_ACCn_CALTEMP for the accelerometer): the offsets "
                  "taken there remove the bias at that temperature")
@@ -295,5 +304,6 @@ def ardupilot_params_file(calibration: Calibration, *, instance: int = 1) -> str
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["AutopilotParameters", "CubicFit", "accel_offsets_and_scales", "ardupilot_parameters", "ardupilot_params_file", "cubic_of",
+__all__ = ["AutopilotParameters", "CubicFit", "accel_offsets_and_scales", "ardupilot_parameters", "ardupilot_params_file",
+           "ardupilot_params_text", "px4_params_text", "cubic_of",
            "installed_calibration", "model_device_id", "px4_parameters", "px4_params_file"]

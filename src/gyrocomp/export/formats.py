@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..io import write_text_atomic
 from ..models.online import LearnerSettings
 from ..recording import GYRO_AXES
-from .autopilot import ardupilot_parameters, ardupilot_params_file, px4_parameters, px4_params_file
+from .autopilot import ardupilot_parameters, ardupilot_params_text, px4_parameters, px4_params_text
 from .c_code import write_c_sources
 from .firmware import FirmwareDifference, firmware_difference
 
@@ -89,14 +89,13 @@ def _c(calibration: Calibration, path: Path, options: ExportOptions) -> Exported
 def _autopilot(target: str) -> Callable[[Calibration, Path, ExportOptions], Exported]:
     def write(calibration: Calibration, path: Path, options: ExportOptions) -> Exported:
         slot = (0 if target == "px4" else 1) if options.instance is None else options.instance
-        if target == "px4":
-            text = px4_params_file(calibration, instance=slot, device_id=options.device_id,
-                                   accel_device_id=options.accel_device_id)
+        if target == "px4":  # the parameters computed once, the file written from them
             params = px4_parameters(calibration, instance=slot, device_id=options.device_id,
-                                    accel_device_id=options.accel_device_id).values
+                                    accel_device_id=options.accel_device_id)
+            text = px4_params_text(calibration, params)
         else:
-            text = ardupilot_params_file(calibration, instance=slot)
-            params = ardupilot_parameters(calibration, instance=slot).values
+            params = ardupilot_parameters(calibration, instance=slot)
+            text = ardupilot_params_text(calibration, params)
         write_text_atomic(path, text)
         notes = []
         for line in text.splitlines()[1:]:  # the header comments after the title: what the file is, the steps
@@ -108,7 +107,7 @@ def _autopilot(target: str) -> Callable[[Calibration, Path, ExportOptions], Expo
                                           for a in GYRO_AXES):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # the model continued past its range: that is the point here
-                difference = firmware_difference(calibration, params, target, slot)
+                difference = firmware_difference(calibration, params.values, target, slot)
         return Exported(target, (path,), tuple(notes), difference)
 
     return write
