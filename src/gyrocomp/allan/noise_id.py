@@ -233,20 +233,16 @@ SLOPE_CHECK_MAX_POINTS = 100
 SLOPE_TOLERANCE = 0.25
 
 
-def expected_slope(kind: str, alpha: int) -> float:
-    """The exponent of tau of the deviation ``kind`` for power-law noise alpha: (-alpha - 1) / 2, where white and
-    flicker PM both fall as tau^-1 for the unmodified deviations; the modified ones tell them apart (tau^-1.5 for
-    white PM); TDEV is tau times MDEV (NIST SP 1065, Table 5)."""
-    slope = (-alpha - 1) / 2.0
-    if kind in ("mdev", "tdev"):
-        return slope + (1.0 if kind == "tdev" else 0.0)
-    return max(slope, -1.0)
+def expected_slope(alpha: int) -> float:
+    """The exponent of tau of an unmodified deviation (ADEV, OADEV, HDEV, OHDEV, TOTDEV) for power-law noise
+    alpha: (-alpha - 1) / 2, where white and flicker PM both fall as tau^-1 (NIST SP 1065, Table 5). The modified
+    deviations follow other laws and are not slope-checked."""
+    return max((-alpha - 1) / 2.0, -1.0)
 
 
-def _slope_checked(kind: str, alphas: np.ndarray, points: list, ms: np.ndarray, deviation, lowest: int
-                   ) -> np.ndarray:
-    """Where a lag-1 type rests on few points (< SLOPE_CHECK_MAX_POINTS) and the curve's own slope from the
-    previous tau lies more than SLOPE_TOLERANCE from that type's, the type whose slope is nearest the curve's."""
+def _slope_checked(alphas: np.ndarray, points: list, ms: np.ndarray, deviation, lowest: int) -> np.ndarray:
+    """Where a lag-1 phase-noise type rests on few points (< SLOPE_CHECK_MAX_POINTS) and the curve's own slope from
+    the previous tau lies more than SLOPE_TOLERANCE from that type's, the type whose slope is nearest the curve's."""
     out = alphas.copy()
     for j in range(1, len(ms)):
         if points[j] is None or points[j] >= SLOPE_CHECK_MAX_POINTS or not np.isfinite(alphas[j]):
@@ -254,9 +250,9 @@ def _slope_checked(kind: str, alphas: np.ndarray, points: list, ms: np.ndarray, 
         if not (deviation[j] > 0 and deviation[j - 1] > 0):
             continue
         slope = math.log(deviation[j] / deviation[j - 1]) / math.log(ms[j] / ms[j - 1])
-        if alphas[j] < 1 or abs(expected_slope(kind, int(alphas[j])) - slope) <= SLOPE_TOLERANCE:
+        if alphas[j] < 1 or abs(expected_slope(int(alphas[j])) - slope) <= SLOPE_TOLERANCE:
             continue  # only a phase-noise type (the narrowest intervals) is questioned
-        out[j] = float(min(range(lowest, 3), key=lambda a: (abs(expected_slope(kind, a) - slope), -a)))
+        out[j] = float(min(range(lowest, 3), key=lambda a: (abs(expected_slope(a) - slope), -a)))
     return out
 
 
@@ -288,5 +284,5 @@ def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None =
             current = float(min(2, max(lowest, capped)))
         alphas[j] = current
     if deviation is not None and kind not in ("mdev", "tdev"):  # the modified curves' slopes follow other laws
-        alphas = _slope_checked(kind, alphas, points, np.asarray(ms, dtype=float), np.asarray(deviation), lowest)
+        alphas = _slope_checked(alphas, points, np.asarray(ms, dtype=float), np.asarray(deviation), lowest)
     return alphas
