@@ -132,7 +132,8 @@ def warn_if_moving(source: str, found: StillDetection) -> None:
 
 def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: AllanKind = "oadev",
                   taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
-                  fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False) -> NoiseAnalysis:
+                  fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False,
+                  motion_check: bool = True) -> NoiseAnalysis:
     """Allan curve (``kind``) and noise terms (from the overlapping Allan deviation) for each axis.
 
     Parameters
@@ -147,13 +148,17 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
         Fit the noise model only on taus in this range [s] (see :func:`gyrocomp.allan.noise_terms`).
     with_accel : bool
         Also analyse every accelerometer axis of the recording.
+    motion_check : bool
+        Warn when the log moves most of the time (:func:`warn_if_moving`); a caller that judged its stillness
+        already passes False.
     """
     names = noise_axes(axes, recording.gyro_axes, recording.accel_axes, with_accel)
     for concern in recording_concerns(recording):  # a time column in ns read as s gives taus of 1e10 s
         warnings.warn(concern.warning(), stacklevel=2)
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
-    warn_if_moving(recording.source, detect_still(recording))
+    if motion_check:
+        warn_if_moving(recording.source, detect_still(recording))
     stretches = recording.contiguous_stretches()
     how = None
     if len(stretches) > 1:
