@@ -139,13 +139,48 @@ class CandidateResult:
 
 
 @dataclass(frozen=True)
+class BranchTest:
+    """Whether the heating and cooling curves differ by more than the drift explains, where no held-out leg can
+    tell (:func:`gyrocomp.models.branch_evidence.branch_test`).
+
+    ``order``: branch terms kept (0 none, 1 a constant difference, 2 also a slope); ``statistic``: the Wald
+    statistic of the branch terms tested last (the kept ones, or both when none is kept) and ``threshold`` the
+    value it had to exceed; ``width_degc``: the crossover width the terms were computed with [degC];
+    ``walk_per_sqrt_s``: the random walk the residual showed [the axis's unit / sqrt(s)]."""
+
+    order: int
+    statistic: float
+    threshold: float
+    width_degc: float
+    walk_per_sqrt_s: float
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "statistic": self.statistic, "threshold": self.threshold,
+                "width_degc": self.width_degc, "walk_per_sqrt_s": self.walk_per_sqrt_s}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "BranchTest":
+        return cls(int(d["order"]), float(d["statistic"]), float(d["threshold"]), float(d["width_degc"]),
+                   float(d["walk_per_sqrt_s"]))
+
+    def sentence(self, axis: str) -> str:
+        """One line for the user: what the test found and did."""
+        found = "differ" if self.order else "do not differ"
+        done = "branch terms added" if self.order else "no branch terms"
+        return (f"{axis}: one heating and one cooling leg cannot test a branch model on held-out legs; its heating "
+                f"and cooling curves {found} beyond the drift the data shows (Wald {self.statistic:.3g} against "
+                f"{self.threshold:.3g}): {done}")
+
+
+@dataclass(frozen=True)
 class SelectionReport:
     """The choice for one axis by held-out drift (:class:`gyrocomp.models.selection.AxisSelection` as stored):
     how the data was held out, the moving-average window of the score [s], every candidate's result, the best
     and the chosen one (the simplest within one standard error of the best); the drifts are in the axis's
     ``unit`` (deg/s, or g for an accelerometer axis). ``chosen_drift`` +- ``chosen_standard_error`` is the drift
     to expect on data like a held-out fold (None in files written before it was stored); ``fold_note`` says why
-    the folds are not of the kind asked for."""
+    the folds are not of the kind asked for; ``branch_test`` what decided the branch terms where no fold could.
+    """
 
     axis: str
     fold_kind: str
@@ -163,6 +198,7 @@ class SelectionReport:
     unit: AxisUnit = "deg/s"
     chosen_standard_error: float | None = None
     fold_note: str = ""
+    branch_test: BranchTest | None = None
 
     raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
     chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
@@ -183,7 +219,8 @@ class SelectionReport:
                    _number(_entry_in_unit(d, "raw_drift", unit)), _number(_entry_in_unit(d, "chosen_drift", unit)),
                    bool(d.get("validated", True)), bool(d.get("generalizes", True)),
                    tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit,
-                   _number(_entry_in_unit(d, "chosen_standard_error", unit)), str(d.get("fold_note", "")))
+                   _number(_entry_in_unit(d, "chosen_standard_error", unit)), str(d.get("fold_note", "")),
+                   BranchTest.from_dict(d["branch_test"]) if d.get("branch_test") else None)
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
@@ -488,6 +525,6 @@ class FitReport:
         return out
 
 
-__all__ = ["AxisFit", "Candidate", "CandidateResult", "ExpectedDrift", "FitReport", "GSensitivityReport", "GSensitivityRow",
+__all__ = ["AxisFit", "BranchTest", "Candidate", "CandidateResult", "ExpectedDrift", "FitReport", "GSensitivityReport", "GSensitivityRow",
            "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
            "THIN_FOLDS", "Weighting", "memory_label", "memory_name"]

@@ -14,6 +14,7 @@ from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_calibration, fit_channels
 from gyrocomp.models.selection import Candidate, CandidateScore, beats_constant, choose
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
+from gyrocomp.validation import fit_plain_cubic
 
 RATE_HZ = 20.0
 
@@ -91,8 +92,40 @@ def test_a_random_walk_unrelated_to_temperature_is_left_alone(seed):
                           noise_density_dps_per_sqrt_hz=0.005)
     raw, default, messages = _one_cycle(walk, seed)
     assert default <= 1.05 * raw
+    # the leg between the runs' legs is the walk's, not a heating-cooling difference: no branch terms
+    assert any("gyro_x: one heating and one cooling leg cannot test a branch model" in m and "no branch terms" in m
+               for m in messages)
     assert any("only 2 heating and cooling legs to hold out; the evidence for each axis's choice is thin" in m
                for m in messages)
+
+
+def test_one_cycle_finds_heating_and_cooling_curves_that_differ(tmp_path):
+    """Done-when (b): heating and cooling curves apart by far more than five times the noise's 60 s drift; one
+    heating and one cooling leg cannot test a branch model on held-out legs, so a test against the drift decides:
+    the default leaves at most half a cubic's drift on the cooling leg after the hottest point (the model applied
+    to the whole run, which holds the turn there). Measured: 0.19-0.25x (on main before it: 1.0x, the branch
+    terms were never tried with one cycle)."""
+    part = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01, 5e-5),), t_ref_degc=25.0,
+                          hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
+                          noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0)
+    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
+                       dwell_s=300.0)
+    sim = simulate(part, profile=prof, rate_hz=2.0, seed=1)
+    rec = sim.recording
+    k = int(np.argmax(rec.temperature_degc))
+    with pytest.warns(ModelChoiceWarning, match=r"gyro_z: one heating and one cooling leg cannot test a branch model"
+                                                r".*curves differ beyond the drift .*branch terms added"):
+        cal = fit_calibration([rec.take(np.arange(k))])
+    cubic = fit_plain_cubic([rec.take(np.arange(k))])
+    truth = sim.truth.true_rate_dps[k:, 0]
+    drift = {name: smoothed_residual_rms(apply(c, rec).gyro_dps[k:, 0] - truth, 120)
+             for name, c in (("default", cal), ("cubic", cubic))}
+    assert drift["default"] <= 0.5 * drift["cubic"]
+    test = cal.report.selection["gyro_z"].branch_test
+    assert test.order >= 1 and test.statistic > test.threshold
+    # the test and its verdict travel with the model file
+    cal.save(tmp_path / "m.json")
+    assert Calibration.load(tmp_path / "m.json").report.selection["gyro_z"].branch_test == test
 
 
 def test_one_cycle_of_a_part_with_a_real_tempco_is_compensated():

@@ -7,12 +7,16 @@ These decide which memory candidates :mod:`gyrocomp.models.selection` offers; th
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ..effects import find_turns, thermal_lag
+from ..effects import branch_position, find_turns, thermal_lag
+from ..fit_report import BranchTest
 from ..prepared import RunBlocks
+from .drift_gls import MAX_POINTS, chi2_threshold, coarsen, fit_drift_noise, wald_statistic
 from .hysteresis import parting_band_degc
-from .thermal import LAG_MAX_S
+from .thermal import BRANCH_WIDTHS_DEGC, LAG_MAX_S, MAX_BRANCH_ORDER, SCORE_WINDOW_S, plausible_middle
 
 
 def heats_and_cools_blocks(runs: list[RunBlocks], thresholds: list[float]) -> bool:
@@ -143,4 +147,98 @@ def band_offer(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[
     return band, band_only
 
 
-__all__ = ["BRANCH_OVERLAP", "band_offer", "branches_identified", "branches_present", "heats_and_cools_blocks", "observed_band"]
+#: how many standard deviations (of a normal law, two-sided) the branch terms must stand out by
+BRANCH_TEST_SIGMAS = 3.0
+
+
+def branch_test(runs: list[RunBlocks], groups: tuple[int, ...], threshold_degc: float, t_ref_degc: float,
+                t_scale_degc: float, order: int, tau_s: float, block_s: float,
+                extra: list[np.ndarray] | None = None) -> BranchTest:
+    """Do the heating and cooling curves differ by more than the drift explains?
+
+    For data where every held-out leg leaves one direction of travel only in training (one cooling and one
+    heating leg: a single chamber cycle), leg folds cannot judge a branch model. Its terms ``s(T) u^j``
+    (:func:`gyrocomp.effects.branch_position`, ``u = (T - t_ref) / t_scale``) are judged instead by their Wald
+    statistic in a generalized least-squares fit of the run constants, the polynomial of ``order`` (at least 1)
+    and the branch terms, under a white plus random-walk error model estimated from that fit's residual
+    (:mod:`gyrocomp.models.drift_gls`). A slow random walk moves the bias between the legs by about K sqrt(dt);
+    that is what the covariance says, so a step between two legs counts only where it is larger than the walk
+    the data shows within them.
+
+    Terms are kept from the lowest: a constant difference where its statistic exceeds
+    :func:`gyrocomp.models.drift_gls.chi2_threshold` (1 degree of freedom, :data:`BRANCH_TEST_SIGMAS`), and a
+    slope too where that term alone does in the fit with both; both when only together they exceed the threshold
+    of 2 degrees of freedom. The crossover width is the middle of those the data cannot tell apart
+    (:func:`gyrocomp.models.thermal.plausible_middle`).
+
+    Parameters
+    ----------
+    runs : list of RunBlocks
+        Block means of each recording (one axis).
+    groups : tuple of int
+        The run of each recording (one constant each).
+    threshold_degc : float
+        Turning-point threshold [degC].
+    t_ref_degc, t_scale_degc : float
+        Centre and half-range of the polynomial's variable [degC].
+    order : int
+        Polynomial order of the model the branch terms are added to (at least 1 is used).
+    tau_s : float
+        Thermal lag of that model [s] (0: none).
+    block_s : float
+        Block length [s].
+    extra : list of array (n_k, m), optional
+        Further columns fitted with the model in each recording (the g-sensitivity's accelerations).
+    """
+    order = max(order, 1)
+    temps = [thermal_lag(r.time_s, r.temperature_degc, tau_s, period_s=block_s)[0] if tau_s > 0
+             else r.temperature_degc for r in runs]
+    factor = max(1, math.ceil(sum(r.value.size for r in runs) / MAX_POINTS))
+    y = [coarsen(r.value, factor) for r in runs]
+    t = [coarsen(r.time_s, factor) for r in runs]
+    designs = [[coarsen(x, factor) for x in _branch_design(runs, temps, groups, threshold_degc, t_ref_degc,
+                                                           t_scale_degc, order, w, extra)]
+               for w in BRANCH_WIDTHS_DEGC]
+    rss = [float(np.sum(_residual(x, y) ** 2)) for x in designs]
+    duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in runs)
+    pick = plausible_middle(np.asarray(rss), duration_s / SCORE_WINDOW_S)
+    x, width = designs[pick], BRANCH_WIDTHS_DEGC[pick]
+    resid = _residual(x, y)
+    noise = fit_drift_noise(np.split(resid, np.cumsum([v.size for v in y])[:-1]), t)
+    walk = math.sqrt(noise.walk_var_per_s)
+    first = x[0].shape[1] - MAX_BRANCH_ORDER  # the branch columns come last: s, then s u
+    one = wald_statistic([xk[:, :first + 1] for xk in x], y, t, noise, np.array([first]))
+    both = wald_statistic(x, y, t, noise, np.array([first, first + 1]))
+    alone = wald_statistic(x, y, t, noise, np.array([first + 1]))
+    c1, c2 = chi2_threshold(1, BRANCH_TEST_SIGMAS), chi2_threshold(2, BRANCH_TEST_SIGMAS)
+    if one > c1:
+        return BranchTest(2, alone, c1, width, walk) if alone > c1 else BranchTest(1, one, c1, width, walk)
+    return BranchTest(2 if both > c2 else 0, both, c2, width, walk)
+
+
+def _branch_design(runs, temps, groups, threshold_degc, t_ref_degc, t_scale_degc, order, width_degc, extra):
+    """Per recording: one constant per run, u^1..u^order, the ``extra`` columns, then s(T) u^0..u^(B-1)
+    (:func:`gyrocomp.effects.branch_position` at crossover ``width_degc``, B = MAX_BRANCH_ORDER)."""
+    group_ids = sorted(set(groups))
+    out = []
+    for k, temp in enumerate(temps):
+        u = (temp - t_ref_degc) / t_scale_degc
+        s = branch_position(temp, find_turns(temp, threshold_degc), width_degc)
+        onehot = np.zeros((temp.size, len(group_ids)))
+        onehot[:, group_ids.index(groups[k])] = 1.0
+        cols = [onehot, u[:, None] ** np.arange(1, order + 1)]
+        if extra is not None:
+            cols.append(extra[k])
+        cols.append(s[:, None] * u[:, None] ** np.arange(MAX_BRANCH_ORDER))
+        out.append(np.hstack(cols))
+    return out
+
+
+def _residual(x: list[np.ndarray], y: list[np.ndarray]) -> np.ndarray:
+    """The residual of the ordinary least-squares fit of the stacked ``y`` on the stacked ``x``."""
+    xs, ys = np.vstack(x), np.concatenate(y)
+    coef, *_ = np.linalg.lstsq(xs, ys, rcond=None)
+    return ys - xs @ coef
+
+
+__all__ = ["BRANCH_OVERLAP", "BRANCH_TEST_SIGMAS", "band_offer", "branch_test", "branches_identified", "branches_present", "heats_and_cools_blocks", "observed_band"]

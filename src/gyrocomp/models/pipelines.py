@@ -145,6 +145,8 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
                       ModelChoiceWarning, stacklevel=3)
     for axis, sel in selections.items():
         unit = sel.unit
+        if sel.branch_test is not None:
+            warnings.warn(sel.branch_test.sentence(axis), ModelChoiceWarning, stacklevel=3)
         if not sel.validated:
             warnings.warn(f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without "
                           "validation", ModelChoiceWarning, stacklevel=3)

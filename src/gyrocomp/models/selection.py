@@ -48,16 +48,16 @@ import numpy as np
 
 from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
 from ..errors import InputError
-from ..fit_report import Candidate, Weighting
+from ..fit_report import BranchTest, Candidate, Weighting
 from ..metrics import moving_average
 from ..prepared import PreparedRun, RunBlocks
 from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
 from .folds import FoldKind, Folds, make_folds, window_for
-from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
+from .branch_evidence import band_offer, branch_test, branches_identified, branches_present, heats_and_cools_blocks
 from .hysteresis import turn_threshold_degc
 from .temperature import polynomial_columns
-from .thermal import LAG_MAX_S
+from .thermal import LAG_MAX_S, MAX_BRANCH_ORDER
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 #: crossover widths of the branch candidates [degC] (each fold takes the one of least training residual)
@@ -136,6 +136,9 @@ class AxisSelection:
         The unit of the axis, and of every drift here.
     fold_note : str
         Why the folds are not of the kind asked for (empty when they are).
+    branch_test : BranchTest or None
+        Where no fold could judge a branch model (one heating and one cooling leg), the test that decided
+        whether the chosen model gets one (:func:`gyrocomp.models.branch_evidence.branch_test`); None elsewhere.
     """
 
     axis: str
@@ -149,6 +152,7 @@ class AxisSelection:
     band_degc: tuple[float, float] | None = None
     unit: AxisUnit = "deg/s"
     fold_note: str = ""
+    branch_test: BranchTest | None = None
 
     def score_of(self, candidate: Candidate) -> CandidateScore:
         return next(s for s in self.scores if s.candidate == candidate)
@@ -193,6 +197,7 @@ class AxisSelection:
                 f"chosen_standard_error{u}": _json_number(self.chosen_standard_error), "fold_note": self.fold_note,
                 "validated": self.validated,
                 "generalizes": self.generalizes,
+                "branch_test": self.branch_test.to_dict() if self.branch_test is not None else None,
                 "candidates": [s.to_dict(self.unit) for s in self.scores]}
 
 
@@ -325,7 +330,13 @@ class SelectionProblem:
         for width in (BRANCH_WIDTHS_DEGC if self.branch_orders else ()):
             position = branch_position(temp, turns, width)
             cols.append(position[:, None] * u[:, None] ** np.arange(self.max_branch))
+        cols.append(self.accel_columns(k))
+        return np.hstack(cols)
+
+    def accel_columns(self, k: int) -> np.ndarray:
+        """The g and g x g sensitivity columns of run ``k`` (n, m), m = 0 without them."""
         run = self.runs[k]
+        cols = [np.zeros((run.value.size, 0))]
         if self.accel_cols:
             cols.append(run.accel_g[:, list(self.accel_cols)])
         if self.square_cols:
@@ -624,9 +635,31 @@ def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], m
     constant = next(s for s in scores if s.candidate == Candidate(0))
     best, chosen = choose([s for s in scores if s.candidate in eligible], problem.complexity,
                           constant if do_no_harm else None)
+    test = None
+    if problem.branch_orders and not chosen.branch and not chosen.hysteresis_order \
+            and not np.any(problem.fold_has_both_directions()):
+        chosen, test = _branch_by_test(problem, chosen, scores, eligible)
     return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
                          problem.temperature_step_degc, tuple(scores), best, chosen, problem.band_degc, problem.unit,
-                         problem.folds.note)
+                         problem.folds.note, test)
+
+
+def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[CandidateScore],
+                    eligible: set[Candidate]) -> tuple[Candidate, BranchTest | None]:
+    """Where no fold can judge a branch model (every fold's training holds one direction of travel only), the
+    chosen candidate with the branch terms :func:`branch_test` finds beyond the drift (and no change where it
+    finds none, or where that candidate is not among the ones offered)."""
+    with_branch = dataclasses.replace(chosen, order=max(chosen.order, 1), branch=MAX_BRANCH_ORDER)
+    if with_branch not in eligible:
+        return chosen, None
+    tau = float(np.median(next(s for s in scores if s.candidate == chosen).fold_lag_s)) if chosen.lag else 0.0
+    accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
+    test = branch_test(problem.runs, problem.groups, problem.threshold_degc, problem.t_ref_degc,
+                       problem.t_scale_degc, chosen.order, tau, problem.block_s, accel)
+    if not test.order:
+        return chosen, test
+    kept = dataclasses.replace(with_branch, branch=test.order)
+    return (kept, test) if kept in eligible else (chosen, test)
 
 
 def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,

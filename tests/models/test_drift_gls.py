@@ -1,0 +1,80 @@
+"""Least squares under slow drift (gyrocomp.models.drift_gls) and the flat-profile rule of the branch width."""
+
+import numpy as np
+import pytest
+
+from gyrocomp.models.drift_gls import (DriftNoise, chi2_threshold, coarsen, fit_drift_noise, wald_statistic,
+                                       whitened)
+from gyrocomp.models.thermal import plausible_middle
+
+K = 2e-3       # random walk [unit/sqrt(s)]
+SIGMA = 0.01   # white noise per point [unit]
+DT_S = 5.0
+
+
+def _walk(rng, n):
+    """White noise plus a random walk at DT_S spacing: (time [s], series)."""
+    t = np.arange(n) * DT_S
+    return t, SIGMA * rng.standard_normal(n) + np.cumsum(K * np.sqrt(DT_S) * rng.standard_normal(n))
+
+
+def test_the_variogram_recovers_the_white_noise_and_the_walk():
+    rng = np.random.default_rng(3)
+    runs = [_walk(rng, 4000) for _ in range(3)]
+    noise = fit_drift_noise([r for _, r in runs], [t for t, _ in runs])
+    # 12000 points, the shortest lags carry thousands of increments: a few per cent, 15 % allowed
+    assert noise.walk_var_per_s == pytest.approx(K ** 2, rel=0.15)
+    assert noise.white_var == pytest.approx(SIGMA ** 2, rel=0.15)
+
+
+def test_a_step_between_two_halves_is_weighed_against_the_walk():
+    """A step between the first and second half of a walk: ordinary least squares finds it 'significant' by
+    chance in most runs; under the walk's covariance the statistic follows chi-square(1) (a 3-sigma threshold
+    passed in about 0.3 % of runs), and a step ten times the walk's spread over the run is found."""
+    rng = np.random.default_rng(5)
+    n = 200
+    step = (np.arange(n) >= n // 2).astype(float)
+    x = np.column_stack([np.ones(n), step])
+    noise = DriftNoise(SIGMA ** 2, K ** 2)
+    null, ols = [], []
+    for _ in range(200):
+        t, y = _walk(rng, n)
+        null.append(wald_statistic([x], [y], [t], noise, np.array([1])))
+        ols.append(wald_statistic([x], [y], [t], DriftNoise(SIGMA ** 2, 0.0), np.array([1])))
+    threshold = chi2_threshold(1)
+    assert np.mean(np.asarray(ols) > threshold) > 0.5
+    # chi-square(1): mean 1, and at 3 sigma a pass in 200 runs is rare (binomial: 4 or more has p < 0.1 %)
+    assert np.mean(null) == pytest.approx(1.0, abs=0.3)
+    assert np.sum(np.asarray(null) > threshold) <= 3
+    t, y = _walk(rng, n)
+    big = 10 * K * np.sqrt(n * DT_S)
+    assert wald_statistic([x], [y + big * step], [t], noise, np.array([1])) > threshold
+
+
+def test_whitening_makes_the_covariance_the_identity():
+    t = np.arange(50) * DT_S
+    noise = DriftNoise(SIGMA ** 2, K ** 2)
+    cov = K ** 2 * np.minimum.outer(t - t[0], t - t[0]) + SIGMA ** 2 * np.eye(t.size)
+    # whitened(x) = L^-1 x, so whitened(L) = I for the Cholesky factor L of the covariance
+    chol = np.linalg.cholesky(cov)
+    xw, yw = whitened(chol, chol[:, 0], t, noise)
+    np.testing.assert_allclose(xw, np.eye(t.size), atol=1e-9)
+    np.testing.assert_allclose(yw, np.eye(t.size)[:, 0], atol=1e-9)
+
+
+def test_chi2_thresholds():
+    assert chi2_threshold(1) == pytest.approx(9.0)
+    assert chi2_threshold(2) == pytest.approx(11.829, abs=1e-3)  # -2 ln(0.0027)
+    with pytest.raises(ValueError, match="dof: 1 or 2"):
+        chi2_threshold(3)
+
+
+def test_coarsen_averages_groups():
+    np.testing.assert_allclose(coarsen(np.arange(7.0), 3), [1.0, 4.0, 6.0])
+    np.testing.assert_allclose(coarsen(np.ones((5, 2)), 2), np.ones((3, 2)))
+
+
+def test_a_flat_profile_takes_the_middle_and_a_sharp_one_its_least():
+    assert plausible_middle(np.full(9, 10.0) + np.linspace(0, 1e-3, 9), independent=80) == 4
+    sharp = 10.0 + (np.arange(9) - 2.0) ** 2
+    assert plausible_middle(sharp, independent=80) == 2
