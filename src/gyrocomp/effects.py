@@ -215,7 +215,8 @@ def _leave_band(x: np.ndarray, start: int, low: float, high: float,
                 threshold: float) -> tuple[int, int, float, float, float]:
     """Where the series x [degC] leaves the band of its running extremes (from ``low``, ``high`` [degC]) by more
     than ``threshold`` [degC] while the direction is unknown: (index or -1, direction, extreme there, low,
-    high), scanning blocks from ``start``."""
+    high), scanning blocks from ``start``; low and high are the extremes up to that index (where the first
+    branch started: low when it rises, high when it falls)."""
     block, pos = _TURN_BLOCK, start
     while pos < x.size:
         seg = x[pos:pos + block]
@@ -225,7 +226,7 @@ def _leave_band(x: np.ndarray, start: int, low: float, high: float,
         down = _first_true(hi - seg > threshold)
         if up >= 0 or down >= 0:
             k, d = (up, 1) if down < 0 or (0 <= up < down) else (down, -1)
-            return pos + k, d, float(hi[k]) if d == 1 else float(lo[k]), low, high
+            return pos + k, d, float(hi[k]) if d == 1 else float(lo[k]), float(lo[k]), float(hi[k])
         low, high = float(lo[-1]), float(hi[-1])
         pos += seg.size
         block *= 2
@@ -373,10 +374,14 @@ def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_d
 def branch_position(temperature_degc: np.ndarray, turns: Turns, transition_degc: float) -> np.ndarray:
     """Where the bias stands between the heating and the cooling curve, from -1 (cooling) to +1 (heating).
 
-        s = D                                   on a branch of direction D before the first confirmed turn
+        s = 0                                   while the direction is not yet known
+        s = D (1 - exp(-|T - T_0| / w))         on the first branch, of direction D, before the first confirmed
+                                                turn: from midway (the history before the recording is not
+                                                known) to this branch's curve; T_0 where the branch started
+                                                (the lowest temperature before it when it rises, the highest
+                                                when it falls)
         s = D (1 - 2 exp(-|T - T_turn| / w))    after a turn at T_turn: from the last branch's curve at the turn
                                                 to this branch's, over a transition of about w degrees
-        s = 0                                   while the direction is not yet known
 
     The general form of the thesis's turning-point correction (section 2.6): a part that follows one curve while
     heating and another while cooling, and crosses over after each turning point.
@@ -393,8 +398,12 @@ def branch_position(temperature_degc: np.ndarray, turns: Turns, transition_degc:
     t = np.asarray(temperature_degc, dtype=float)
     d = turns.direction.astype(float)
     after = ~np.isnan(turns.turn_degc)
+    state = turns.state
+    start = np.where(d > 0, state.low_degc, state.high_degc) if np.any(~after & (d != 0)) else t
+    first = np.where(after | (d == 0), 0.0, np.abs(t - np.where(after | (d == 0), t, start)))
     distance = np.abs(t - np.where(after, turns.turn_degc, t))
-    return np.where(after, d * (1.0 - 2.0 * np.exp(-distance / transition_degc)), d)
+    return np.where(after, d * (1.0 - 2.0 * np.exp(-distance / transition_degc)),
+                    d * (1.0 - np.exp(-first / transition_degc)))
 
 
 # -- acceleration -----------------------------------------------------------------------------------

@@ -33,7 +33,11 @@ def test_branch_position_crosses_over_after_each_turn():
     t = np.concatenate([np.linspace(20, 60, 401), np.linspace(60, 20, 401)[1:]])
     turns = find_turns(t, 0.1)
     s = branch_position(t, turns, 5.0)
-    assert np.all(s[(turns.direction == 1) & np.isnan(turns.turn_degc)] == 1.0)  # heating, before any turn
+    # heating before any turn: from midway (the history before the recording is unknown) towards +1, from where
+    # the branch started (20 degC, the lowest temperature before it)
+    first = (turns.direction == 1) & np.isnan(turns.turn_degc)
+    np.testing.assert_allclose(s[first], 1 - np.exp(-(t[first] - 20.0) / 5.0))
+    assert s[turns.direction == 0].size and np.all(s[turns.direction == 0] == 0.0)
     after = ~np.isnan(turns.turn_degc)
     d = np.abs(t - np.where(after, turns.turn_degc, t))
     np.testing.assert_allclose(s[after], -(1 - 2 * np.exp(-d[after] / 5.0)))  # from +1 at the turn towards -1

@@ -133,8 +133,10 @@ def _branch_code(j: int, h: BranchCurve) -> list[str]:
             f"(tm > {_num(h.t_max_degc)} ? {_num(h.t_max_degc)} : tm);",
             f"        double u = (tc - {_num(h.t_ref_degc)}) / {_num(h.t_scale_degc)}, half = 0.0;",
             f"        for (int k = {h.order - 1}; k >= 0; --k) half = half * u + c[k];",
-            f"        double position = (double)s->turn[{j}].direction;",
-            f"        if (s->turn[{j}].has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - s->turn[{j}].turn) / "
+            f"        const gyrocomp_turn *tp = &s->turn[{j}];",
+            "        double position = (double)tp->direction;",
+            f"        if (tp->has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - tp->turn) / {_num(h.transition_degc)});",
+            f"        else position *= 1.0 - exp(-fabs(tm - (tp->direction > 0 ? tp->low : tp->high)) / "
             f"{_num(h.transition_degc)});",
             "        shape += position * half;",
             "    }"]
