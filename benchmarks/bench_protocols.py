@@ -6,7 +6,8 @@ cooling curves that differ, 0.03 deg/s apart at 25 degC and 0.0008 deg/s/degC mo
 (each seed a new set of runs, noise and turn-on biases):
 
 - ``one cycle``: one chamber run 40 -> -20 -> 70 -> 30 degC at 2 degC/min (cooled, heated, cooled, as most
-  single-cycle procedures), fitted up to its hottest point, judged on the cooling leg after it;
+  single-cycle procedures), fitted up to its hottest point, judged on the cooling leg after it (the model applied
+  to the whole run, so that a memory model knows the turn at the hottest point);
 - ``two cycles``: two heat-cool runs over the preset's range (the second 10 degC narrower), judged on a third run
   over the range widened by 5 degC at the hot end;
 - ``three runs``: three heat-cool runs, judged on a fourth.
@@ -61,13 +62,16 @@ def drift(series: np.ndarray, rate_hz: float) -> float:
     return smoothed_residual_rms(series, max(1, int(WINDOW_S * rate_hz)))
 
 
-def judge(fit_runs, held_recording, truth_rate, noise, rate_hz):
-    """(default, cubic, perfect, raw) drift per axis of ``held_recording`` [deg/s]."""
+def judge(fit_runs, held_recording, truth_rate, noise, rate_hz, start: int = 0):
+    """(default, cubic, perfect, raw) drift per axis of ``held_recording`` from sample ``start`` on [deg/s]
+    (the model is applied to the whole recording: what comes before ``start`` is the history it knows)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         default = fit_channels(fit_runs)
         cubic = fit_plain_cubic(fit_runs)
-        out = {name: apply(cal, held_recording).gyro_dps for name, cal in (("default", default), ("cubic", cubic))}
+        out = {name: apply(cal, held_recording).gyro_dps[start:]
+               for name, cal in (("default", default), ("cubic", cubic))}
+    held_recording = held_recording.take(np.arange(start, held_recording.n_samples))
     k = held_recording.gyro_dps.shape[1]
     rows = {name: [drift(v[:, j] - truth_rate[:, j], rate_hz) for j in range(k)] for name, v in out.items()}
     rows["perfect"] = [drift(noise[:, j], rate_hz) for j in range(k)]
@@ -81,8 +85,8 @@ def one_cycle(model, seed):
     sim = simulate(model, profile=prof, rate_hz=RATE_HZ, seed=seed)
     rec = sim.recording
     k = int(np.argmax(rec.temperature_degc))
-    return judge([rec.take(np.arange(k))], rec.take(np.arange(k, rec.n_samples)), sim.truth.true_rate_dps[k:],
-                 sim.truth.noise.total_dps[k:], RATE_HZ)
+    return judge([rec.take(np.arange(k))], rec, sim.truth.true_rate_dps[k:], sim.truth.noise.total_dps[k:],
+                 RATE_HZ, start=k)
 
 
 def cycles(model, seed, span, runs: int, rate_hz: float = RATE_HZ):
@@ -131,6 +135,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--markdown", type=Path, help="write the tables as Markdown to this file")
+    parser.add_argument("--only", choices=("one cycle", "two cycles", "three runs"),
+                        help="this protocol alone, no cases (a quick look; not for --markdown)")
     args = parser.parse_args()
     start = time.perf_counter()
     lines = ["| part | protocol | default / perfect | plain cubic / perfect | axes worse than raw |",
@@ -141,9 +147,13 @@ def main() -> None:
                      "two cycles": lambda s: cycles(model, s, span, 2),
                      "three runs": lambda s: cycles(model, s, span, 3)}
         for protocol, run in protocols.items():
+            if args.only and protocol != args.only:
+                continue
             d, c, worse, n = summarize([run(s) for s in range(args.seeds)])
             lines.append(f"| {name} | {protocol} | {d:.2f} | {c:.2f} | {worse} of {n} |")
             print(lines[-1], flush=True)
+    if args.only:
+        return
     lines += ["", "| case | default / perfect | lag [s] (truth 60) | model |", "|---|---|---|---|"]
     for label, hyst in (("adxrs450, the preset's hysteresis", None),
                         ("adxrs450, a bump fading over 25 degC", Hysteresis(((0.2,),), direction="descending",
