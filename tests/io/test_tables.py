@@ -350,6 +350,22 @@ def test_two_columns_that_match_one_channel_are_refused_naming_both(tmp_path, he
     assert rec.n_samples == 5
 
 
+def test_names_that_say_the_project_units_are_read_without_a_mapping(tmp_path):
+    """time_s, gyro_x_dps, accel_x_g, temperature_degc: the names the project itself gives things."""
+    path = tmp_path / "units.csv"
+    path.write_text("time_s,gyro_x_dps,gyro_z_dps,accel_z_g,temperature_degc\n"
+                    + "".join(f"{t / 10},0.5,-0.25,1.0,{20 + t / 100}\n" for t in range(50)))
+    rec = read(path)
+    assert rec.gyro_axes == ("gyro_x", "gyro_z") and rec.accel_axes == ("accel_z",)
+    np.testing.assert_allclose(rec.time_s[:3], [0.0, 0.1, 0.2])
+    np.testing.assert_allclose(rec.gyro_dps[0], [0.5, -0.25])
+    assert rec.temperature_degc[1] == pytest.approx(20.01)
+    # the plain name wins when both are there: gyro_x is read, gyro_x_dps is another column
+    both = tmp_path / "both.csv"
+    both.write_text("time,gyro_x,gyro_x_dps\n" + "".join(f"{t},1.0,2.0\n" for t in range(5)))
+    np.testing.assert_allclose(read(both).gyro_dps[:, 0], 1.0)
+
+
 @pytest.mark.parametrize("suffix", [".tsv", ".dat", ".txt"])
 def test_every_suffix_of_a_delimited_table_is_read(tmp_path, suffix):
     path = tmp_path / f"log{suffix}"

@@ -28,6 +28,17 @@ CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *
 ARRAY_CHANNELS = ("gyro", "accel")
 
 
+def unit_named(name: str) -> str:
+    """The canonical column ``name`` with the suffix of its unit at the interfaces, as the project names things
+    (``time_s``, ``gyro_x_dps``, ``accel_x_g``, ``temperature_degc``, ``ref_rate_x_dps``): a file whose
+    names say those units is read without a mapping."""
+    if name == TIME_COLUMN:
+        return "time_s"
+    if name.startswith(TEMPERATURE_COLUMN):
+        return name + "_degc"
+    return name + ("_g" if name in ACCEL_AXES else "_dps")
+
+
 @dataclass(frozen=True)
 class TableLayout:
     """How a table's columns map to gyrocomp's channels, and the units they are in.
@@ -70,10 +81,13 @@ class TableLayout:
     def resolve(self, header: list[str], source: str) -> dict[str, str]:
         """Canonical name to file column for every channel present in ``header``."""
         resolved = {name: name for name in CANONICAL_COLUMNS if name in header}
-        # the standard names also match whatever their case and surrounding spaces (" Gyro_Z" is gyro_z); two
-        # columns that both match one name (Gyro_Z and GYRO_Z) are refused, naming both, unless a mapping says
+        # the standard names (or with their unit: gyro_z_dps) also match whatever their case and surrounding spaces
+        # (" Gyro_Z" is gyro_z); two columns that both match one name (Gyro_Z and GYRO_Z) are refused, naming both,
+        # unless a mapping says
         for name in CANONICAL_COLUMNS:
             matches = [column for column in header if column.strip().lower() == name]
+            if not matches:  # the name with its unit: time_s, gyro_x_dps, temperature_degc
+                matches = [column for column in header if column.strip().lower() == unit_named(name)]
             if len(matches) > 1 and name not in self.columns:
                 raise InputError(f"{source}: columns {' and '.join(map(repr, matches))} would both be read as "
                                  f"{name}; say which with columns={{{name!r}: {matches[0]!r}}} (or rename one)")
