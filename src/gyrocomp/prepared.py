@@ -135,6 +135,12 @@ class PreparedRun(Recording):
             self._derived[key] = compute()
         return self._derived[key]
 
+    def of_temperature(self, axis: str, name: str, compute):
+        """``compute(temperature)`` of the temperature that goes with ``axis`` [degC], computed once per
+        temperature column and ``name`` (the axes of one column share it): e.g. its turning-point threshold."""
+        column = self.temperature_column_for(axis)
+        return self._once(("temperature", column, name), lambda: compute(self.temperature_for(axis)))
+
     def still_mask(self, *, window_s: float = DEFAULT_WINDOW_S, factor: float = DEFAULT_FACTOR) -> np.ndarray:
         """:func:`gyrocomp.static.still_mask` (window [s], factor over the median variance), read-only."""
         def compute():

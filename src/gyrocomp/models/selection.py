@@ -443,22 +443,32 @@ class SelectionProblem:
             return math.nan  # nothing left to train on without this fold
         sse = wsum = 0.0
         window = max(1, int(round(self.window_s / self.block_s)))
-        for k, (temp, cols) in enumerate(self._prepared(tau_s)):
-            sel = self.folds.of_block[k] == f
-            if not np.any(sel):
-                continue
-            x = cols[sel][:, idx]
-            if c.order:  # past the training range the curve continues along its tangent, as applied
-                t = temp[sel]
-                u = (np.clip(t, lo, hi) - self.t_ref_degc) / self.t_scale_degc
-                x = x.copy()
-                x[:, : c.order] = polynomial_columns(u, c.order, (t - self.t_ref_degc) / self.t_scale_degc - u)
+        prepared = self._prepared(tau_s)
+        for k, sel in self.fold_members()[f]:
+            temp, cols = prepared[k]
+            x = cols[np.ix_(sel, idx)]
+            t = temp[sel]
+            past = (t < lo) | (t > hi)
+            if c.order and np.any(past):  # past the training range the curve continues along its tangent, as applied
+                tp = t[past]
+                u = (np.clip(tp, lo, hi) - self.t_ref_degc) / self.t_scale_degc
+                x[past, : c.order] = polynomial_columns(u, c.order, (tp - self.t_ref_degc) / self.t_scale_degc - u)
             e = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
             w = self.runs[k].samples[sel].astype(float)
             s, n = drift_rms(e, w, window)
             sse += s
             wsum += n
         return math.sqrt(sse / wsum) if wsum > 0 else math.nan
+
+    def fold_members(self) -> list[list[tuple[int, np.ndarray]]]:
+        """Per fold, (run, indices of its blocks in the fold) for every run with blocks in it."""
+        if "members" not in self._cache:
+            members = [[] for _ in range(self.folds.count)]
+            for k, fold in enumerate(self.folds.of_block):
+                for f in np.unique(fold):
+                    members[int(f)].append((k, np.flatnonzero(fold == f)))
+            self._cache["members"] = members
+        return self._cache["members"]
 
     def score(self, c: Candidate) -> CandidateScore:
         """Held-out drift of ``c`` on every fold: each fold's lag and branch crossover width are those of the
@@ -701,11 +711,12 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     width = bin_width_for(temps, bin_width_degc)
     block_s = max(block_s, 1.0 / recordings[0].rate_hz)
     pieces = pieces or [None] * len(recordings)
-    runs = [PreparedRun.of(rec).block_means(axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
-    thresholds = [turn_threshold_degc(t) for t in temps]
+    prepared = [PreparedRun.of(rec) for rec in recordings]
+    runs = [p.block_means(axis, block_s, width, piece) for p, piece in zip(prepared, pieces)]
+    thresholds = [p.of_temperature(axis, "turn threshold", turn_threshold_degc) for p in prepared]
     groups = tuple(range(len(recordings))) if groups is None else tuple(int(g) for g in groups)
     folds = make_folds(runs, groups, thresholds, fold_kind)
-    step = max(temperature_step_degc(t) for t in temps)
+    step = max(p.of_temperature(axis, "step", temperature_step_degc) for p in prepared)
     reverses = (branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds))
     t_ref, t_scale = (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0
     band, band_only = band_offer(runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order),

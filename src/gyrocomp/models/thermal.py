@@ -474,7 +474,8 @@ class ThermalHysteresisModel(LearnedAttributes):
         runs = [PreparedRun.of(rec).block_means(axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
         if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
             runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
-        threshold = max(turn_threshold_degc(t) for t in temps)
+        threshold = max(PreparedRun.of(rec).of_temperature(axis, "turn threshold", turn_threshold_degc)
+                        for rec in recordings)
         accel_cols, square_cols = self._accel_columns(runs, first)
         return _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold,
                         self._of(self.band_degc, axis), block_s, accel_cols, square_cols)
