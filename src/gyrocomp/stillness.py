@@ -39,7 +39,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import chi2, norm
 
 from .errors import InputError
 from .recording import Recording
@@ -257,8 +256,10 @@ def _stack(done: list[dict], w: int) -> BlockStats:
 
 def _noise_level(variance: np.ndarray, usable: np.ndarray, w: int, quantile: float) -> np.ndarray:
     """s^2 per axis from the quietest blocks (see the module)."""
+    from scipy.special import chdtri  # chi2.ppf(q, k) = chdtri(k, 1 - q); scipy.stats takes 0.5 s to import
+
     low = np.quantile(variance[usable], quantile, axis=0)
-    return low * (w - 2) / chi2.ppf(quantile, w - 2)
+    return low * (w - 2) / chdtri(w - 2, 1.0 - quantile)
 
 
 def classify_blocks(blocks: BlockStats, *, quantile: float = QUANTILE, alpha: float = ALPHA
@@ -277,8 +278,10 @@ def classify_blocks(blocks: BlockStats, *, quantile: float = QUANTILE, alpha: fl
                                     (blocks.accel_mean_g, blocks.accel_var_g2)) if m is not None]
     tests = sum(m.shape[1] for m, _ in channels)
     per_test = alpha / tests  # Bonferroni: about ``alpha`` false alarms per still block in all
-    bound = chi2.ppf(1 - per_test, w - 2) / (w - 2)
-    z = norm.ppf(1 - per_test / 2)
+    from scipy.special import chdtri, ndtri  # the chi-square and normal quantiles, without scipy.stats' import
+
+    bound = chdtri(w - 2, per_test) / (w - 2)
+    z = ndtri(1 - per_test / 2)
     quiet = usable.copy()
     levels = []
     rate_hz = _rate(blocks)

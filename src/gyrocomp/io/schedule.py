@@ -20,7 +20,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from ..errors import InputError
 from ..recording import REFERENCE_RATE_AXES, Recording
@@ -95,6 +94,8 @@ def apply_schedule(schedule: RateSchedule, recordings: list[Recording],
 def read_rate_schedule(path: str | os.PathLike) -> RateSchedule:
     """Read and check a schedule file (CSV, see the module doc): every column present, numbers finite,
     end_s > start_s >= 0, no two stretches of one run overlapping."""
+    import pandas as pd  # slow to import; only a schedule file needs it
+
     path = Path(path)
     try:
         table = pd.read_csv(path, dtype={"file": str}, keep_default_na=False)

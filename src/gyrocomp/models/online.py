@@ -83,7 +83,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from scipy.stats import norm
+from scipy.special import ndtri
 
 from ..calibration import AxisCalibration, Calibration
 from ..effects import lazy_lfilter
@@ -224,11 +224,11 @@ class LearnerSettings:
     def z_values(self) -> dict[str, float]:
         """The normal quantiles of the tests: the noise quantile's, and the variance and step tests' with three
         channels (gyro only) and six (gyro and accelerometer)."""
-        out = {"noise": float(norm.ppf(self.noise_quantile))}
+        out = {"noise": float(ndtri(self.noise_quantile))}
         for channels in (3, 6):
             per_test = self.alpha / channels
-            out[f"variance{channels}"] = float(norm.ppf(1 - per_test))
-            out[f"step{channels}"] = float(norm.ppf(1 - per_test / 2))
+            out[f"variance{channels}"] = float(ndtri(1 - per_test))
+            out[f"step{channels}"] = float(ndtri(1 - per_test / 2))
         return out
 
     def to_dict(self) -> dict[str, Any]:

@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy import optimize
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
@@ -360,6 +359,8 @@ def _solve(moves: _Moves, order: int, reference_degc: float):
         return (moves.predicted(tuple(theta.reshape(-1, 3, 3)), reference_degc)[0] - moves.after).ravel()
 
     start = np.concatenate([np.eye(3).ravel(), np.zeros(9 * order)])
+    from scipy import optimize  # slow to import; only the between-poses fit needs it
+
     sol = optimize.least_squares(residuals, start, method="lm", jac="3-point", xtol=1e-12, ftol=1e-12)
     return sol, tuple(sol.x.reshape(-1, 3, 3))
 

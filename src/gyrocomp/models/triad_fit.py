@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from scipy import linalg, optimize
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
@@ -358,6 +357,8 @@ def _fit_norm(poses: list[Pose], means: np.ndarray, units: np.ndarray, gravity_g
         theta = start.copy()
         theta[free] = t
         return theta
+
+    from scipy import optimize  # slow to import; only the multi-position fit needs it
 
     sol = optimize.least_squares(lambda t: _norm_residuals(full(t), means, gravity_g), start[free],
                                  jac=lambda t: _norm_jacobian(full(t), means, gravity_g)[:, free],
@@ -732,6 +733,8 @@ def fit_gyro_rate_table(recordings: list[Recording], *, temperature_order: int |
 def rq_upper(sensitivity: np.ndarray) -> np.ndarray:
     """The upper-triangular factor R (positive diagonal) of K = R Q: the K the norm method can see of a
     triad whose true K is ``sensitivity`` (the rest is a rotation of the reference frame)."""
+    from scipy import linalg  # slow to import; only this decomposition needs it
+
     r, q = linalg.rq(np.asarray(sensitivity, dtype=float))
     signs = np.sign(np.diag(r))
     return r * signs[None, :]
