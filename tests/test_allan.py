@@ -406,6 +406,29 @@ def test_octave_pass_equals_direct_sums_for_any_length_block_and_drift(n, block_
     np.testing.assert_allclose(got, _second_difference_sums(phase, ms), rtol=1e-9)
 
 
+@settings(max_examples=30, deadline=None)
+@given(n=st.integers(8, 3000), first_log2=st.integers(0, 4), block_log2=st.integers(2, 12),
+       seed=st.integers(0, 2 ** 16))
+def test_octave_levels_from_any_first_factor_equal_direct_sums(n, first_log2, block_log2, seed):
+    """The pass that starts at a longer factor (the long levels, after the short ones went in small blocks)
+    starts from x[i+m] - x[i] and gives the direct sums too."""
+    phase = np.concatenate([[0.0], np.cumsum(np.random.default_rng(seed).standard_normal(n))])
+    top = 1 << int(np.floor(np.log2((n + 1) // 4)))
+    first = min(1 << first_log2, top)
+    ms = 2 ** np.arange(first.bit_length() - 1, top.bit_length())
+    got = estimators._octave_level_sums(phase, first, top, 1 << block_log2)
+    np.testing.assert_allclose(got, _second_difference_sums(phase, ms), rtol=1e-9)
+
+
+def test_the_default_octave_pass_splits_short_and_long_factors_with_the_same_sums(monkeypatch):
+    monkeypatch.setattr(estimators, "_OCTAVE_SHORT_MAX_M", 8)
+    monkeypatch.setattr(estimators, "_OCTAVE_SHORT_BLOCK", 64)
+    phase = np.concatenate([[0.0], np.cumsum(np.random.default_rng(1).standard_normal(5000))])
+    ms = 2 ** np.arange(10)  # 1 .. 512: 1..8 in 64-sample blocks, 16..512 in the long pass
+    np.testing.assert_allclose(estimators._octave_oadev_sums(phase, 512), _second_difference_sums(phase, ms),
+                               rtol=1e-9)
+
+
 @settings(max_examples=60, deadline=None)
 @given(n=st.integers(8, 3000), seed=st.integers(0, 2 ** 16), data=st.data())
 def test_lag_products_equal_direct_sums_for_any_factors(n, seed, data):

@@ -278,14 +278,31 @@ def _total_sum(x, m: int, buffer: np.ndarray, spare: np.ndarray) -> float:
 #: octave levels up to this m are computed together, block by block, from windowed sums kept in cache
 _OCTAVE_IN_CACHE_MAX_M = 1 << 16
 _OCTAVE_BLOCK = 1 << 19
+#: the short levels (m up to _OCTAVE_SHORT_MAX_M) go block by block in blocks of _OCTAVE_SHORT_BLOCK, whose two
+#: buffers stay in a core's L2 cache; the long ones start again from the phase in blocks of _OCTAVE_BLOCK (their
+#: windows reach 2m past a block: small blocks would read most of them twice). Measured at 1e7 samples:
+#: 0.19 s in one pass of 2^19-sample blocks, 0.16 s split at m = 2^10 with 2^17-sample short blocks (2 x 1 MiB).
+_OCTAVE_SHORT_MAX_M = 1 << 10
+_OCTAVE_SHORT_BLOCK = 1 << 17
 
 
-def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
-    """Overlapping Allan sums for m = 1, 2, 4, ..., top (a power of two) in one pass over x.
+def _octave_oadev_sums(x, top: int, block: int | None = None) -> np.ndarray:
+    """Overlapping Allan sums for m = 1, 2, 4, ..., top (a power of two): the short factors in small blocks,
+    the long ones in large blocks (:func:`_octave_level_sums`); ``block`` forces one size for all."""
+    if block is not None:
+        return _octave_level_sums(x, 1, top, block)
+    if top <= _OCTAVE_SHORT_MAX_M:
+        return _octave_level_sums(x, 1, top, _OCTAVE_SHORT_BLOCK)
+    short = _octave_level_sums(x, 1, _OCTAVE_SHORT_MAX_M, _OCTAVE_SHORT_BLOCK)
+    return np.concatenate([short, _octave_level_sums(x, 2 * _OCTAVE_SHORT_MAX_M, top, _OCTAVE_BLOCK)])
+
+
+def _octave_level_sums(x, first: int, top: int, block: int) -> np.ndarray:
+    """Overlapping Allan sums for m = first, 2 first, ..., top (powers of two) in one pass over x.
 
     With u_m(i) = x[i+m] - x[i] the second difference is D_m(i) = u_m(i+m) - u_m(i), and the windows
     double by u_2m(i) = u_m(i) + u_m(i+m), so each block of x is read once for every level. Within a
-    block, u_1 is centred on its mean (D does not change). The parallelogram law
+    block, u_first is centred on its mean (D does not change). The parallelogram law
     sum D_m(i)^2 + sum u_2m(i)^2 = 2 sum u_m(i)^2 + 2 sum u_m(i+m)^2 (i < count) gives each level's sum
     from one BLAS dot product of the next level's window, sum u_2m^2, which is also the next level's
     sum of squares (extended by the few terms past the block); the top level uses
@@ -293,19 +310,19 @@ def _octave_oadev_sums(x, top: int, block: int = _OCTAVE_BLOCK) -> np.ndarray:
     identities at (block / m)^2 rounding units at most.
     """
     n = len(x)
-    levels = top.bit_length()
+    levels = top.bit_length() - first.bit_length() + 1
     sums = np.zeros(levels)
     window = block + 2 * top
-    first, second = np.empty(min(window, n)), np.empty(min(window, n))  # short series: no 3 MiB buffers
-    for start in range(0, n - 2, block):
-        current, spare = first, second
+    buffers = np.empty(min(window, n)), np.empty(min(window, n))  # short series: no 3 MiB buffers
+    for start in range(0, n - 2 * first, block):
+        current, spare = buffers
         w = np.asarray(x[start:min(start + window, n)], dtype=np.float64)
-        length = w.size - 1
+        length = w.size - first
         u = current[:length]
-        np.subtract(w[1:], w[:-1], out=u)
+        np.subtract(w[first:], w[:-first], out=u)
         u -= u[:min(block, length)].mean()
         known_sum, known_len = 0.0, 0  # sum of u[:known_len]^2, carried from the level before
-        m = 1
+        m = first
         for level in range(levels):
             count = min(block, n - 2 * m - start)
             if count <= 0:
