@@ -551,6 +551,10 @@ def test_a_lag1_type_on_few_points_gives_way_to_the_curves_slope():
     res = allan_deviation(data, 1.0, kind="oadev", taus=ref[:, 0], data_type=data_type)
     row = int(np.flatnonzero(ref[:, 0] == 10000)[0])
     assert res.alpha[row] == 0 == ref[row, 3]
+    # and says so: the slope decided, over the lag-1 statistic's white PM
+    slope = math.log(res.deviation[row] / res.deviation[row - 1]) / math.log(10000 / res.tau[row - 1])
+    assert res.noise_method[row] == f"slope {slope:+.2f} (lag-1 said +2)"
+    assert res.noise_method[0] == "lag-1" and res.noise_method[-1] == "B1/R(n)"
     assert res.ci_low[row] == pytest.approx(ref[row, 4], rel=5e-3)
     assert res.ci_high[row] == pytest.approx(ref[row, 6], rel=5e-3)
 

@@ -418,6 +418,7 @@ def test_allan_table_plot_and_kalibr(static_log):
             "--rostopic", "/imu0", "--plot", static_log / "allan.png")
     assert r.returncode == 0, r.stderr
     assert "s.csv: gyro_x HDEV [deg/s]" in r.stdout and "noise terms" in r.stdout
+    assert "noise type by" in r.stdout and "lag-1" in r.stdout  # what decided each tau's interval
     assert "accel_z" in r.stdout  # Kalibr needs the accelerometers, so they are analysed too
     text = (static_log / "imu.yaml").read_text()
     assert "gyroscope_noise_density:" in text and "update_rate:                 20" in text

@@ -131,15 +131,21 @@ def allan_deviation(data, rate_hz: float, *, kind: AllanKind = "oadev", taus: Ta
     tau = ms / rate_hz
     counts = term_count(kind, phase.size, ms)
     deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
+    methods = ("",) * len(ms)
     if confidence is None:
         alphas = np.full(len(ms), np.nan)
         edf = alphas.copy()
     else:
-        alphas = noise_types(kind, phase, ms, deviation) if forced is None else forced
+        if forced is None:
+            found = noise_types(kind, phase, ms, deviation)
+            alphas, methods = found.alpha, found.method
+        else:
+            alphas, methods = forced, ("given",) * len(ms)
         edf = degrees_of_freedom(kind, alphas, ms, phase.size)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
-                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence)
+                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence,
+                       noise_method=methods)
 
 
 def _noise_alpha(value, count: int) -> np.ndarray | None:
@@ -181,7 +187,8 @@ def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: AllanK
     ms = averaging_factors(longest.size, taus, rate_hz, kind)
     tau = ms / rate_hz
     sums, counts, edf = np.zeros(len(ms)), np.zeros(len(ms), dtype=np.int64), np.zeros(len(ms))
-    alphas = noise_types(kind, longest, ms) if confidence is not None else np.full(len(ms), np.nan)
+    found = noise_types(kind, longest, ms) if confidence is not None else None
+    alphas = found.alpha if found is not None else np.full(len(ms), np.nan)
     for phase in phases:
         own = np.maximum(term_count(kind, phase.size, ms), 0)
         sums += _variance_sums(kind, phase, ms, own)
@@ -193,5 +200,6 @@ def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: AllanK
     deviation = _normalize(kind, sums, ms, tau, counts, scale)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
-                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence)
+                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence,
+                       noise_method=found.method if found is not None else ("",) * len(ms))
 

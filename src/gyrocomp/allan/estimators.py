@@ -89,6 +89,10 @@ class AllanResult:
         The estimator, e.g. ``"oadev"``.
     confidence : float
         Two-sided confidence of the interval (0.683 by default).
+    noise_method : tuple of str
+        What decided each tau's noise type: ``lag-1`` (the lag-1 autocorrelation), ``B1/R(n)`` (below 30
+        points), ``slope ...`` (the curve's own slope overruled a lag-1 type on few points, as Stable32 would
+        read it), ``carried`` (the next shorter tau's), ``given`` (``noise_alpha``), ``""`` (none).
     """
 
     tau: np.ndarray
@@ -100,6 +104,7 @@ class AllanResult:
     edf: np.ndarray
     kind: str = "oadev"
     confidence: float = ONE_SIGMA
+    noise_method: tuple[str, ...] = ()
 
     def minimum(self) -> AllanMinimum:
         """The smallest deviation and the tau [s] where it lies."""

@@ -236,13 +236,16 @@ SLOPE_TOLERANCE = 0.25
 def expected_slope(alpha: int) -> float:
     """The exponent of tau of an unmodified deviation (ADEV, OADEV, HDEV, OHDEV, TOTDEV) for power-law noise
     alpha: (-alpha - 1) / 2, where white and flicker PM both fall as tau^-1 (NIST SP 1065, Table 5). The modified
-    deviations follow other laws and are not slope-checked."""
+    deviations are not slope-checked: with MDEV's law (tau^((-alpha - 1) / 2) for every alpha) the check moved a
+    row of the gps reference away from Stable32's type and left Cs5071A's tau = 10000 s as it was."""
     return max((-alpha - 1) / 2.0, -1.0)
 
 
-def _slope_checked(alphas: np.ndarray, points: list, ms: np.ndarray, deviation, lowest: int) -> np.ndarray:
+def _slope_checked(alphas: np.ndarray, methods: list[str], points: list, ms: np.ndarray, deviation,
+                   lowest: int) -> np.ndarray:
     """Where a lag-1 phase-noise type rests on few points (< SLOPE_CHECK_MAX_POINTS) and the curve's own slope from
-    the previous tau lies more than SLOPE_TOLERANCE from that type's, the type whose slope is nearest the curve's."""
+    the previous tau lies more than SLOPE_TOLERANCE from that type's, the type whose slope is nearest the curve's
+    (``methods`` then says so)."""
     out = alphas.copy()
     for j in range(1, len(ms)):
         if points[j] is None or points[j] >= SLOPE_CHECK_MAX_POINTS or not np.isfinite(alphas[j]):
@@ -253,11 +256,22 @@ def _slope_checked(alphas: np.ndarray, points: list, ms: np.ndarray, deviation, 
         if alphas[j] < 1 or abs(expected_slope(int(alphas[j])) - slope) <= SLOPE_TOLERANCE:
             continue  # only a phase-noise type (the narrowest intervals) is questioned
         out[j] = float(min(range(lowest, 3), key=lambda a: (abs(expected_slope(a) - slope), -a)))
+        methods[j] = f"slope {slope:+.2f} (lag-1 said {int(alphas[j]):+d})"
     return out
 
 
-def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None = None) -> np.ndarray:
-    """alpha at each averaging factor in ``ms`` (ascending), as Stable32 identifies it.
+@dataclass(frozen=True)
+class NoiseTypes:
+    """The noise type at each averaging factor: ``alpha`` (NaN where none) and the ``method`` that decided it:
+    ``lag-1``, ``B1/R(n)``, ``slope ...`` (the curve's slope overruled a lag-1 type on few points), ``carried``
+    (the type of the next shorter tau) or ``""`` (none)."""
+
+    alpha: np.ndarray
+    method: tuple[str, ...]
+
+
+def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None = None) -> NoiseTypes:
+    """alpha at each averaging factor in ``ms`` (ascending), as Stable32 identifies it, and how.
 
     The lag-1 autocorrelation where 30 decimated points remain, the B1 ratio with R(n) below that. A B1
     type is capped by the type found at the next shorter tau: in a sum of independent power-law noises the
@@ -271,6 +285,7 @@ def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None =
     spec = _ESTIMATORS[kind]
     lowest = 2 - 2 * spec.difference_order
     alphas = np.full(len(ms), np.nan)
+    methods = [""] * len(ms)
     points: list = [None] * len(ms)
     current = math.nan
     for j, m in enumerate(ms):
@@ -279,10 +294,15 @@ def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None =
         if found is not None:
             current = float(min(2, max(lowest, found.alpha)))
             points[j] = min((len(phase) - 1) // m + 1, NOISE_ID_MAX_POINTS)
+            methods[j] = "lag-1"
         elif (few := identify_noise_b1(phase, m)) is not None:
             capped = few.alpha if math.isnan(current) else min(few.alpha, current)
             current = float(min(2, max(lowest, capped)))
+            methods[j] = "B1/R(n)"
+        elif not math.isnan(current):
+            methods[j] = "carried"
         alphas[j] = current
     if deviation is not None and kind not in ("mdev", "tdev"):  # the modified curves' slopes follow other laws
-        alphas = _slope_checked(alphas, points, np.asarray(ms, dtype=float), np.asarray(deviation), lowest)
-    return alphas
+        alphas = _slope_checked(alphas, methods, points, np.asarray(ms, dtype=float), np.asarray(deviation),
+                                lowest)
+    return NoiseTypes(alphas, tuple(methods))

@@ -345,11 +345,12 @@ def print_noise(analysis: NoiseAnalysis) -> None:
     for name, a in analysis.axes.items():
         c = a.curve
         table = Table(title=f"{Path(analysis.source).name}: {name} {c.kind.upper()} [{a.unit}]")
-        for col in ("tau [s]", "deviation", "ci low", "ci high", "n", "alpha"):
-            table.add_column(col, justify="right")
-        for row in zip(c.tau, c.deviation, c.ci_low, c.ci_high, c.n, c.alpha):
+        for col in ("tau [s]", "deviation", "ci low", "ci high", "n", "alpha", "noise type by"):
+            table.add_column(col, justify="left" if col == "noise type by" else "right")
+        methods = c.noise_method or ("",) * len(c.tau)
+        for row in zip(c.tau, c.deviation, c.ci_low, c.ci_high, c.n, c.alpha, methods):
             table.add_row(f"{row[0]:.6g}", f"{row[1]:.5g}", f"{row[2]:.5g}", f"{row[3]:.5g}", f"{row[4]:d}",
-                          "-" if np.isnan(row[5]) else f"{row[5]:+.0f}")
+                          "-" if np.isnan(row[5]) else f"{row[5]:+.0f}", row[6] or "-")
         console.print(table)
     table = Table(title="noise terms (IEEE Std 952 fit; B = Allan minimum / 0.664)")
     table.add_column("axis", no_wrap=True)
