@@ -11,7 +11,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 
 #: bottom to top; a module belongs to the first layer one of whose prefixes it matches
 LAYERS = (
-    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding")),
+    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "ctext")),
     ("signals", ("recording", "effects", "allan", "noise", "static", "stillness", "metrics", "plausibility",
                  "simulate", "spill", "prepared", "runsplit")),
     ("io", ("io",)),
@@ -19,7 +19,8 @@ LAYERS = (
     ("files", ("noise_file",)),
     # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve); their estimators are
     # in the fitting layer (models.polynomial_fit, models.mlp_fit)
-    ("curves", ("models.base", "models.hysteresis", "models.temperature", "models.mlp")),
+    ("curves", ("models.base", "models.curves", "models.hysteresis", "models.temperature", "models.mlp",
+                "models.lookup", "models.curve_kinds")),
     ("calibration", ("calibration", "fit_report", "triad", "installed")),
     ("compensate", ("compensate",)),
     ("fitting", ("models.gsensitivity", "models.thermal", "models.folds", "models.branch_evidence", "models.drift_gls",

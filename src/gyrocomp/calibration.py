@@ -22,8 +22,9 @@ from . import jsontext
 from .errors import InputError
 from .fit_report import FitReport
 from .io.atomic import write_text_atomic
+from .models.curve_kinds import curve_from_dict
+from .models.curves import TemperatureCurve
 from .models.mlp import MLPBias
-from .models.temperature import PolynomialBias
 from .models.hysteresis import BranchCurve, HysteresisCurve, memory_curve_from_dict
 from .recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
 from .triad import TriadCalibration
@@ -204,8 +205,9 @@ class AxisCalibration:
 
     Attributes
     ----------
-    temperature : PolynomialBias, MLPBias or None
-        The bias shape against temperature [unit], or None for no temperature model.
+    temperature : TemperatureCurve or None
+        The bias shape against temperature [unit] (a :class:`gyrocomp.models.curves.TemperatureCurve`: a
+        polynomial, a network, a lookup table, any registered curve), or None for no temperature model.
     turn_on_biases : tuple of float
         Fitted turn-on constant of each calibration run [unit].
     temperature_column : str
@@ -226,7 +228,7 @@ class AxisCalibration:
         The unit of the axis's values.
     """
 
-    temperature: PolynomialBias | MLPBias | None
+    temperature: TemperatureCurve | None
     turn_on_biases: tuple[float, ...]
     temperature_column: str = "temperature"
     lag_time_constant_s: float = 0.0
@@ -252,7 +254,7 @@ class AxisCalibration:
     @property
     def needs_accel(self) -> bool:
         """Whether the correction reads the accelerometer (an acceleration stage, or a network with accel inputs)."""
-        return self.has_acceleration_stage or bool(getattr(self.temperature, "needs_accel", False))
+        return self.has_acceleration_stage or (self.temperature is not None and self.temperature.needs_accel)
 
     @property
     def has_memory(self) -> bool:
@@ -288,12 +290,8 @@ class AxisCalibration:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], unit: AxisUnit = "deg/s") -> "AxisCalibration":
-        temp = d.get("temperature")
-        kinds = {"polynomial": PolynomialBias, "mlp": MLPBias}
-        if temp is not None and temp.get("type") not in kinds:
-            raise InputError(f"unknown temperature model type {temp.get('type')!r}")
         return cls(
-            temperature=None if d["temperature"] is None else kinds[temp["type"]].from_dict(temp),
+            temperature=None if d["temperature"] is None else curve_from_dict(d["temperature"]),
             turn_on_biases=tuple(float(c) for c in d["turn_on_biases_dps"]),
             temperature_column=str(d.get("temperature_column", "temperature")),
             lag_time_constant_s=float(d["lag_time_constant_s"]),
@@ -321,9 +319,7 @@ class AxisSummary:
     @classmethod
     def of(cls, name: str, ax: "AxisCalibration") -> "AxisSummary":
         curve = ax.temperature
-        order = None if curve is None else curve.order
-        words = "constant" if curve is None else (f"polynomial order {order}" if isinstance(order, int) else
-                                                  f"network {order}")
+        words = "constant" if curve is None else curve.describe()
         if ax.hysteresis is not None:
             words += f", {ax.hysteresis.describe()}"
         if ax.has_acceleration_stage:

@@ -113,15 +113,12 @@ class Compensator:
             warnings.warn(
                 f"{self.source}: temperature{lagged} outside the model's range "
                 f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
-                + ("the model is continued along its tangent there"
-                   if getattr(ax.temperature, "extrapolation", "hold") == "linear" else "the model is held at its edge there"),
+                f"the model is {ax.temperature.beyond_range} there",
                 TemperatureRangeWarning, stacklevel=4,
             )
             self._warned = True
-        if getattr(ax.temperature, "needs_accel", False):
-            error = np.asarray(ax.temperature.shape(t_model, accel_g), dtype=float)
-        else:
-            error = np.asarray(ax.temperature.shape(t_model), dtype=float)
+        error = np.asarray(ax.temperature.shape(t_model, accel_g if ax.temperature.needs_accel else None),
+                           dtype=float)
         if ax.hysteresis is not None:
             turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states.get(key))
             self._turn_states[key] = turns.state

@@ -57,9 +57,11 @@ Weighting = Literal["time", "temperature-balanced"]
 
 @dataclass(frozen=True)
 class Candidate:
-    """One model of an axis's bias: polynomial order, thermal lag, turning-point order, fit weighting, whether
-    the turning-point terms act only in the band found in the data, and the number of terms of the difference
-    between a heating and a cooling curve (``branch``; 0 for none). The model choice scores these
+    """One model of an axis's bias: the size of its temperature curve (``order``: a polynomial's order, a
+    table's intervals), thermal lag, turning-point order, fit weighting, whether the turning-point terms act only
+    in the band found in the data, the number of terms of the difference between a heating and a cooling curve
+    (``branch``; 0 for none), and the curve's family (``curve``, a name of
+    :data:`gyrocomp.models.curves.BASES`: ``poly``, ``table``). The model choice scores these
     (:mod:`gyrocomp.models.selection`) and the report names them."""
 
     order: int
@@ -68,6 +70,7 @@ class Candidate:
     weighting: Weighting = "time"
     band: bool = False
     branch: int = 0
+    curve: str = "poly"
 
     @property
     def memory(self) -> str:
@@ -87,8 +90,9 @@ class Candidate:
 
     @property
     def label(self) -> str:
-        """Short name, e.g. ``poly:3 + lag + turning-point:2 (time)``; ``constant`` for order 0."""
-        parts = ["constant" if self.order == 0 else f"poly:{self.order}"]
+        """Short name, e.g. ``poly:3 + lag + turning-point:2 (time)``, ``table:8 (time)``; ``constant`` for
+        order 0."""
+        parts = ["constant" if self.order == 0 else f"{self.curve}:{self.order}"]
         if self.lag:
             parts.append("lag")
         if self.hysteresis_order:
@@ -102,13 +106,16 @@ class Candidate:
              "weighting": self.weighting, "band": self.band, "label": self.label}
         if self.branch:  # written only when set: files without it read as before
             d["branch"] = self.branch
+        if self.curve != "poly":
+            d["curve"] = self.curve
         return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "Candidate":
         """A stored candidate (its ``label`` is derived from the fields)."""
         return cls(int(d["order"]), bool(d.get("lag", False)), int(d.get("hysteresis_order", 0)),
-                   d.get("weighting", "time"), bool(d.get("band", False)), int(d.get("branch", 0)))
+                   d.get("weighting", "time"), bool(d.get("band", False)), int(d.get("branch", 0)),
+                   str(d.get("curve", "poly")))
 
 
 def _entry_in_unit(d: dict, name: str, unit: str, default=None):

@@ -12,6 +12,7 @@ import pytest
 from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources, write_c_sources
+from gyrocomp.models.lookup import LookupTableBias
 from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.triad import TriadCalibration
@@ -243,3 +244,25 @@ def test_heating_and_cooling_branches(tmp_path):
     held = simulate(part, profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
                                               ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
     _compare(cal, held, tmp_path)
+
+
+def test_lookup_table_with_lag_and_branches_past_its_grid(tmp_path):
+    """A table curve (every axis: 3, 8 and 16 intervals) under the lag and heating/cooling branches, on a run
+    that goes past the table's grid at both ends: the C is apply's to 1e-9."""
+    part = GyroErrorModel(axes=("gyro_x", "gyro_y", "gyro_z"), temperature_coefficients=((0.01,), (0.02,), (0.03,)),
+                          t_ref_degc=25.0, hysteresis=Hysteresis(((0.03,), (0.02,), (0.01,)), transition_degc=5.0),
+                          noise_density_dps_per_sqrt_hz=0.005)
+    runs = [simulate(part, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1, seed=s).recording
+            for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="branch+lag")
+    tables = {"gyro_x": LookupTableBias((0.0, 0.4, -0.1, 0.2), -20.0, 70.0),
+              "gyro_y": LookupTableBias(tuple(np.sin(np.arange(9.0))), -20.0, 70.0),
+              "gyro_z": LookupTableBias(tuple(np.cos(np.arange(17.0))), -20.0, 70.0)}
+    cal = dataclasses.replace(cal, axes={a: dataclasses.replace(ax, temperature=tables[a])
+                                         for a, ax in cal.axes.items()})
+    held = simulate(part, profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
+                                              ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
+    _compare(cal, held, tmp_path)
+

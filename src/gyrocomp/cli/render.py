@@ -111,8 +111,7 @@ def _print_triad(console, name: str, triad) -> None:
 
 def _describe_axis(ax) -> str:
     """An axis's model in words: curve, lag, hysteresis."""
-    order = None if ax.temperature is None else ax.temperature.order
-    model = "constant" if order is None else (f"poly order {order}" if isinstance(order, int) else order)
+    model = "constant" if ax.temperature is None else ax.temperature.describe()
     if ax.lag_time_constant_s > 0:
         model += f", lag {ax.lag_time_constant_s:.3g} s"
     if ax.hysteresis is not None:

@@ -11,8 +11,8 @@ Units: t [s], gyro and out [deg/s] on x, y, z, accel [g] on x, y, z, temperature
 does not cover pass through unchanged. When the model compensates the accelerometer for temperature, each
 step leaves the compensated accelerations [g] in ``s->accel_out`` (else the input), and the g-sensitivity
 reads them, as ``gyrocomp apply`` does. The code does what :class:`gyrocomp.Compensator` does, sample by
-sample and in the same order of operations: g-sensitivity, the temperature curve (polynomial or network)
-on the lagged temperature (the first-order-hold lag steps one nominal period per sample and bridges longer
+sample and in the same order of operations: g-sensitivity, the temperature curve (its own C:
+:meth:`gyrocomp.models.curves.TemperatureCurve.c_code`) on the lagged temperature (the first-order-hold lag steps one nominal period per sample and bridges longer
 gaps exactly), the turning-point hysteresis, and the mean turn-on constant of the calibration runs; then
 the gyro's scale factor and misalignment (out = K(T)^-1 out, K(T) at the input temperature). An
 accelerometer triad corrects ``s->accel_out`` after its temperature models (the g-sensitivity reads the
@@ -23,19 +23,17 @@ from __future__ import annotations
 
 
 import contextlib
-import math
 import os
 from pathlib import Path
 
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
+from ..ctext import c_array, c_number
 from ..errors import InputError
 from ..io.atomic import write_texts_atomic
-from ..models.mlp import MLPBias, layer_shapes
 from .encode import c_comment
 from ..models.hysteresis import BranchCurve, HysteresisCurve
-from ..models.temperature import PolynomialBias
 from ..models.online import LearnerSettings
 from ..triad import TriadCalibration
 from .c_learner import learner_c_sources
@@ -44,79 +42,25 @@ AXES = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL = ("accel_x", "accel_y", "accel_z")
 
 
-def _num(x: float) -> str:
-    if not math.isfinite(x):
-        raise InputError("export: the model holds a non-finite number; fit it again")
-    return repr(float(x))
-
-
-def _array(values) -> str:
-    return "{" + ", ".join(_num(v) for v in values) + "}"
-
-
 def _temperature_code(j: int, curve) -> list[str]:
-    """C statements setting `shape` for axis j from `tm` (model temperature) and `accel`."""
+    """C statements setting `shape` for axis slot j from `tm` (model temperature) and `acc`: the curve's own
+    (:meth:`gyrocomp.models.curves.TemperatureCurve.c_code`)."""
     if curve is None:
         return ["    shape = 0.0;"]
-    if isinstance(curve, PolynomialBias):
-        lines = [f"    {{ const double c[] = {_array(curve.coefficients)};" if curve.coefficients else "    {",
-                 f"      double u = (clip(tm, {_num(curve.t_min_degc)}, {_num(curve.t_max_degc)}) - "
-                 f"{_num(curve.t_ref_degc)}) / {_num(curve.t_scale_degc)};",
-                 "      shape = 0.0;"]
-        if curve.coefficients:
-            lines.append(f"      for (int k = {len(curve.coefficients) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
-            if curve.extrapolation == "linear":  # continued along the tangent past the range
-                lines += ["      double slope = 0.0;",
-                          f"      for (int k = {len(curve.coefficients) - 1}; k >= 0; --k) "
-                          "slope = slope * u + (k + 1) * c[k];",
-                          f"      shape += slope * ((tm - {_num(curve.t_ref_degc)}) / {_num(curve.t_scale_degc)} - u);"]
-        lines.append("    }")
-        return lines
-    if isinstance(curve, MLPBias):
-        return [f"    shape = net{j}(tm, acc) - net{j}_ref;"]
-    raise InputError(f"export: no C code for a {type(curve).__name__} temperature model")
-
-
-def _network_function(name: str, curve: MLPBias) -> list[str]:
-    shapes = layer_shapes(len(curve.inputs), curve.hidden)
-    lines = [f"static double {name}(double tm, const double accel[3])", "{", "    (void)tm; (void)accel;"]
-    values = []
-    for name in curve.inputs:
-        values.append("tm" if name == "temperature" else f"accel[{('accel_x', 'accel_y', 'accel_z').index(name)}]")
-    lines.append(f"    double a0[{len(curve.inputs)}];")
-    for i, (v, lo, hi) in enumerate(zip(values, curve.input_min, curve.input_max)):
-        if hi > lo:
-            lines.append(f"    a0[{i}] = 2.0 * (clip({v}, {_num(lo)}, {_num(hi)}) - {_num(lo)}) / {_num(hi - lo)} - 1.0;")
-        else:
-            lines.append(f"    a0[{i}] = 0.0;")
-    prev = "a0"
-    for k, ((rows, cols), flat) in enumerate(zip(shapes, curve.weights)):
-        last = k == len(shapes) - 1
-        lines.append(f"    static const double w{k}[{rows * cols}] = {_array(flat[: rows * cols])};")
-        lines.append(f"    static const double b{k}[{rows}] = {_array(flat[rows * cols:])};")
-        lines.append(f"    double a{k + 1}[{rows}];")
-        lines.append(f"    for (int r = 0; r < {rows}; ++r) {{")
-        lines.append("        double z = 0.0;")
-        lines.append(f"        for (int c = 0; c < {cols}; ++c) z += {prev}[c] * w{k}[r * {cols} + c];")
-        lines.append(f"        a{k + 1}[r] = {'z + b%d[r]' % k if last else 'tanh(z + b%d[r])' % k};")
-        lines.append("    }")
-        prev = f"a{k + 1}"
-    lines.append(f"    return {prev}[0] * {_num(curve.output_scale)} + {_num(curve.output_mean)};")
-    lines.append("}")
-    return lines
+    return ["    " + line for line in curve.c_code(f"net{j}").statements]
 
 
 def _turning_point_code(j: int, h: HysteresisCurve) -> list[str]:
-    lines = [f"    turn_update(&s->turn[{j}], tm, {_num(h.threshold_degc)});",
+    lines = [f"    turn_update(&s->turn[{j}], tm, {c_number(h.threshold_degc)});",
              f"    if (s->turn[{j}].has_turn) {{"]
-    band = "" if h.band_degc is None else f" && tm >= {_num(h.band_degc[0])} && tm <= {_num(h.band_degc[1])}"
+    band = "" if h.band_degc is None else f" && tm >= {c_number(h.band_degc[0])} && tm <= {c_number(h.band_degc[1])}"
     reach = h.max_distance_degc or (None, None)
     for sign, coefs, d_max in ((-1, h.descending, reach[0]), (1, h.ascending, reach[1])):
         lines.append(f"        if (s->turn[{j}].direction == {sign}{band}) {{")
-        lines.append(f"            const double h[] = {_array(coefs)};")
+        lines.append(f"            const double h[] = {c_array(coefs)};")
         lines.append(f"            double d = fabs(tm - s->turn[{j}].turn), off = 0.0;")
         if d_max is not None:
-            lines.append(f"            if (d > {_num(d_max)}) d = {_num(d_max)};")
+            lines.append(f"            if (d > {c_number(d_max)}) d = {c_number(d_max)};")
         lines.append(f"            for (int k = {len(coefs) - 1}; k >= 0; --k) off = (off + h[k]) * d;")
         lines.append("            shape += off;")
         lines.append("        }")
@@ -126,18 +70,18 @@ def _turning_point_code(j: int, h: HysteresisCurve) -> list[str]:
 
 def _branch_code(j: int, h: BranchCurve) -> list[str]:
     """The heating and cooling branches: s * sum c_k u^k (gyrocomp.effects.branch_position for s)."""
-    return [f"    turn_update(&s->turn[{j}], tm, {_num(h.threshold_degc)});",
+    return [f"    turn_update(&s->turn[{j}], tm, {c_number(h.threshold_degc)});",
             "    {",
-            f"        const double c[] = {_array(h.coefficients)};",
-            f"        double tc = tm < {_num(h.t_min_degc)} ? {_num(h.t_min_degc)} : "
-            f"(tm > {_num(h.t_max_degc)} ? {_num(h.t_max_degc)} : tm);",
-            f"        double u = (tc - {_num(h.t_ref_degc)}) / {_num(h.t_scale_degc)}, half = 0.0;",
+            f"        const double c[] = {c_array(h.coefficients)};",
+            f"        double tc = tm < {c_number(h.t_min_degc)} ? {c_number(h.t_min_degc)} : "
+            f"(tm > {c_number(h.t_max_degc)} ? {c_number(h.t_max_degc)} : tm);",
+            f"        double u = (tc - {c_number(h.t_ref_degc)}) / {c_number(h.t_scale_degc)}, half = 0.0;",
             f"        for (int k = {h.order - 1}; k >= 0; --k) half = half * u + c[k];",
             f"        const gyrocomp_turn *tp = &s->turn[{j}];",
             "        double position = (double)tp->direction;",
-            f"        if (tp->has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - tp->turn) / {_num(h.transition_degc)});",
+            f"        if (tp->has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - tp->turn) / {c_number(h.transition_degc)});",
             f"        else position *= 1.0 - exp(-fabs(tm - (tp->direction > 0 ? tp->low : tp->high)) / "
-            f"{_num(h.transition_degc)});",
+            f"{c_number(h.transition_degc)});",
             "        shape += position * half;",
             "    }"]
 
@@ -229,7 +173,7 @@ _HELPERS = [
 def _shape_code(k: int, ax: AxisCalibration) -> list[str]:
     """C statements setting `shape` for state slot k: the (lagged) temperature, its curve and hysteresis."""
     if ax.lag_time_constant_s > 0:
-        lines = [f"    tm = lag_update(&s->lag[{k}], step, temperature, {_num(ax.lag_time_constant_s)});"]
+        lines = [f"    tm = lag_update(&s->lag[{k}], step, temperature, {c_number(ax.lag_time_constant_s)});"]
     else:
         lines = ["    tm = temperature;"]
     return lines + _temperature_code(k, ax.temperature) + _hysteresis_code(k, ax)
@@ -252,16 +196,16 @@ def _triad_code(triad: TriadCalibration, vector: str, label: str) -> list[str]:
     """C statements correcting ``vector`` (a double[3]) by a triad: v = K(T)^-1 (v - bias), K(T) from the raw
     temperature, as :meth:`TriadCalibration.correct` does."""
     lines = [f"    {{   /* {label}: scale factor and misalignment ({triad.method}) */",
-             f"        double k[9] = {_array(np.ravel(triad.sensitivity))};"]
+             f"        double k[9] = {c_array(np.ravel(triad.sensitivity))};"]
     for p, block in enumerate(triad.sensitivity_per_degc, start=1):
-        lines += [f"        const double k{p}[9] = {_array(np.ravel(block))};",
-                  f"        double d{p} = pow(temperature - {_num(triad.reference_degc)}, {p});",
+        lines += [f"        const double k{p}[9] = {c_array(np.ravel(block))};",
+                  f"        double d{p} = pow(temperature - {c_number(triad.reference_degc)}, {p});",
                   f"        for (int i = 0; i < 9; ++i) k[i] += k{p}[i] * d{p};"]
-    lines += [f"        {vector}[{i}] -= {_num(b)};" for i, b in enumerate(triad.bias) if b != 0.0]
+    lines += [f"        {vector}[{i}] -= {c_number(b)};" for i, b in enumerate(triad.bias) if b != 0.0]
     return lines + [f"        solve3(k, {vector});", "    }"]
 
 
-def _init_code(networks: dict) -> list[str]:
+def _init_code(codes: dict) -> list[str]:
     body = ["void gyrocomp_init(gyrocomp_state *s)", "{",
             "    s->started = 0;", "    s->last_t = 0.0;",
             "    for (int j = 0; j < 3; ++j) s->accel_out[j] = 0.0;",
@@ -270,11 +214,8 @@ def _init_code(networks: dict) -> list[str]:
             "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
             "        s->turn[j].turn = 0.0; s->turn[j].low = INFINITY; s->turn[j].high = -INFINITY;",
             "    }"]
-    for fname, curve in networks.items():
-        ref = list(curve.reference)
-        t_ref = ref[curve.inputs.index("temperature")] if "temperature" in curve.inputs else 0.0
-        acc = [ref[curve.inputs.index(a)] if a in curve.inputs else 0.0 for a in ("accel_x", "accel_y", "accel_z")]
-        body.append(f"    {{ const double ref_accel[3] = {_array(acc)}; {fname}_ref = {fname}({_num(t_ref)}, ref_accel); }}")
+    for code in codes.values():
+        body += list(code.init)
     return body + ["}", ""]
 
 
@@ -290,7 +231,7 @@ def _accel_step_code(calibration: Calibration, accel_axes: dict) -> list[str]:
         body.append(f"    /* {name}: temperature error relative to {reference:g} degC */")
         body += _shape_code(3 + i, ax)
         at_reference = float(ax.temperature.shape(np.array([reference]))[0])
-        body.append(f"    acc[{i}] -= shape - {_num(at_reference)};")
+        body.append(f"    acc[{i}] -= shape - {c_number(at_reference)};")
     body.append("    for (int j = 0; j < 3; ++j) s->accel_out[j] = acc[j];")
     if calibration.accel_triad is not None:
         body += _triad_code(calibration.accel_triad, "s->accel_out", "accelerometer bias")
@@ -307,18 +248,18 @@ def _gyro_step_code(calibration: Calibration, axes: dict) -> list[str]:
         g, q = ax.g_sensitivity_dps_per_g, ax.g_squared_dps_per_g2
         if g is not None or q is not None:
             g = g or (0.0, 0.0, 0.0)
-            expr = f"acc[0] * {_num(g[0])} + acc[1] * {_num(g[1])} + acc[2] * {_num(g[2])}"
+            expr = f"acc[0] * {c_number(g[0])} + acc[1] * {c_number(g[1])} + acc[2] * {c_number(g[2])}"
             if q is not None:
                 products = ("acc[0] * acc[0]", "acc[1] * acc[1]", "acc[2] * acc[2]",
                             "acc[0] * acc[1]", "acc[0] * acc[2]", "acc[1] * acc[2]")
-                expr = f"({expr}) + (" + " + ".join(f"{p} * {_num(c)}" for p, c in zip(products, q)) + ")"
+                expr = f"({expr}) + (" + " + ".join(f"{p} * {c_number(c)}" for p, c in zip(products, q)) + ")"
             body.append(f"    out[{j}] -= {expr};")
         if ax.acceleration_network is not None:
             body.append(f"    out[{j}] -= anet{j}(0.0, acc) - anet{j}_ref;")
         if ax.temperature is not None:
             body += _shape_code(j, ax)
             body.append(f"    out[{j}] -= shape;")
-        body.append(f"    out[{j}] -= {_num(ax.mean_turn_on_bias_dps)};")
+        body.append(f"    out[{j}] -= {c_number(ax.mean_turn_on_bias_dps)};")
     if calibration.gyro_triad is not None:
         body += _triad_code(calibration.gyro_triad, "out", "gyro")
     return body
@@ -339,17 +280,17 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
     body = [f"/* gyrocomp model '{c_comment(calibration.model)}', generated by gyrocomp. */",
             "#include <math.h>", "#include \"gyrocomp.h\"", "",
             "static inline double clip(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }", "",
-            f"static const double PERIOD_S = {_num(period)};", ""] + _HELPERS + _SOLVE3
-    networks = {}  # C function name -> network
+            f"static const double PERIOD_S = {c_number(period)};", ""] + _HELPERS + _SOLVE3
+    codes = {}  # C name -> the curve's code (functions and init statements; the step's come per axis)
     for j, name in enumerate(AXES + ACCEL):
         ax = axes.get(name) or accel_axes.get(name)
-        if ax is not None and isinstance(ax.temperature, MLPBias):
-            networks[f"net{j}"] = ax.temperature
+        if ax is not None and ax.temperature is not None:
+            codes[f"net{j}"] = ax.temperature.c_code(f"net{j}")
         if ax is not None and ax.acceleration_network is not None:
-            networks[f"anet{j}"] = ax.acceleration_network
-    for fname, curve in networks.items():
-        body += _network_function(fname, curve) + [f"static double {fname}_ref;", ""]
-    body += _init_code(networks)
+            codes[f"anet{j}"] = ax.acceleration_network.c_code(f"anet{j}")
+    for code in codes.values():
+        body += list(code.functions)
+    body += _init_code(codes)
     body += ["void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],",
              "                   double temperature, double out[3])", "{",
              "    double step = s->started ? t - s->last_t : 0.0;",

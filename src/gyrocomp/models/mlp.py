@@ -7,12 +7,14 @@ standardized), evaluated with numpy. Training it (Levenberg-Marquardt, as MATLAB
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from ..ctext import c_array, c_number
 from ..errors import InputError
 from .base import RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION
+from .curves import CCode, register_curve
 
 DEFAULT_HIDDEN = (3,)
 #: block means the network trains on [s]: temperature moves slowly, so 10-s means lose nothing and keep a
@@ -61,6 +63,7 @@ NETWORK_INPUTS = ("temperature", "accel_x", "accel_y", "accel_z")
 ACCEL_INPUTS = ("accel_x", "accel_y", "accel_z")
 
 
+@register_curve
 @dataclass(frozen=True)
 class MLPBias:
     """Fitted network shape of one axis's bias, without its turn-on constant.
@@ -71,6 +74,8 @@ class MLPBias:
     reads the temperature only; with ``inputs`` = temperature, accel_x, accel_y, accel_z it is the joint
     network of thesis 2.7.2 / 2.8 (``reference`` then includes a 1 g z-up orientation).
     """
+
+    kind: ClassVar[str] = "mlp"
 
     hidden: tuple[int, ...]
     weights: tuple[tuple[float, ...], ...]  # flat per layer: W row-major then b
@@ -97,6 +102,53 @@ class MLPBias:
     @property
     def needs_accel(self) -> bool:
         return any(name in ACCEL_INPUTS for name in self.inputs)
+
+    @property
+    def beyond_range(self) -> str:
+        return "held at its edge"
+
+    def describe(self) -> str:
+        return f"network {self.order}"
+
+    @property
+    def label(self) -> str:
+        return "mlp:" + self.order.split(" ", 1)[1]
+
+    def clamped(self) -> "MLPBias":
+        return self  # the inputs are clipped to their fitted ranges already
+
+    def plus_slope(self, slope_per_degc: float) -> None:
+        return None  # a network's output cannot take a slope without retraining
+
+    def c_code(self, name: str) -> CCode:
+        """``name(tm, accel)``: the network, inputs scaled to [-1, 1] as fitted, tanh layers, a linear output;
+        ``name_ref`` its value at the reference inputs, set by ``gyrocomp_init``."""
+        shapes = layer_shapes(len(self.inputs), self.hidden)
+        lines = [f"static double {name}(double tm, const double accel[3])", "{", "    (void)tm; (void)accel;",
+                 f"    double a0[{len(self.inputs)}];"]
+        values = ["tm" if i == "temperature" else f"accel[{ACCEL_INPUTS.index(i)}]" for i in self.inputs]
+        for i, (v, lo, hi) in enumerate(zip(values, self.input_min, self.input_max)):
+            lines.append(f"    a0[{i}] = 2.0 * (clip({v}, {c_number(lo)}, {c_number(hi)}) - {c_number(lo)}) / "
+                         f"{c_number(hi - lo)} - 1.0;" if hi > lo else f"    a0[{i}] = 0.0;")
+        prev = "a0"
+        for k, ((rows, cols), flat) in enumerate(zip(shapes, self.weights)):
+            activation = f"z + b{k}[r]" if k == len(shapes) - 1 else f"tanh(z + b{k}[r])"
+            lines += [f"    static const double w{k}[{rows * cols}] = {c_array(flat[: rows * cols])};",
+                      f"    static const double b{k}[{rows}] = {c_array(flat[rows * cols:])};",
+                      f"    double a{k + 1}[{rows}];",
+                      f"    for (int r = 0; r < {rows}; ++r) {{",
+                      "        double z = 0.0;",
+                      f"        for (int c = 0; c < {cols}; ++c) z += {prev}[c] * w{k}[r * {cols} + c];",
+                      f"        a{k + 1}[r] = {activation};",
+                      "    }"]
+            prev = f"a{k + 1}"
+        lines += [f"    return {prev}[0] * {c_number(self.output_scale)} + {c_number(self.output_mean)};", "}",
+                  f"static double {name}_ref;", ""]
+        ref = list(self.reference)
+        t_ref = ref[self.inputs.index("temperature")] if "temperature" in self.inputs else 0.0
+        acc = [ref[self.inputs.index(a)] if a in self.inputs else 0.0 for a in ACCEL_INPUTS]
+        init = f"    {{ const double ref_accel[3] = {c_array(acc)}; {name}_ref = {name}({c_number(t_ref)}, ref_accel); }}"
+        return CCode((f"shape = {name}(tm, acc) - {name}_ref;",), tuple(lines), (init,))
 
     @property
     def range_tolerance_degc(self) -> float:

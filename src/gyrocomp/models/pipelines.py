@@ -34,7 +34,8 @@ from .mlp_fit import MLPTemperatureModel
 from .folds import FOLD_KINDS
 from .selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .polynomial_fit import PolynomialTemperatureModel
-from .temperature import MAX_ORDER, PolynomialBias
+from .curve_kinds import BASES
+from .temperature import MAX_ORDER
 from .triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                         spans_axes)
 from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
@@ -49,10 +50,11 @@ FOLD_SELECTION = {"runs": "leave-one-run-out", "legs": "leave-one-leg-out", "blo
 
 
 def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
-                 hysteresis, poly: PolynomialBias, bin_width_degc: float | None, g_row=None, g_squared=None,
+                 hysteresis, scaffold, bin_width_degc: float | None, g_row=None, g_squared=None,
                  segments=None, inputs: tuple[str, ...] = ("temperature",)):
     """Train the network on the block means of the runs, through the lag and without the hysteresis
-    that the polynomial stage found (a cascade: the network replaces the polynomial shape)."""
+    that the least-squares stage found (a cascade: the network replaces its curve, ``scaffold``, and takes the
+    middle of its range as the reference temperature)."""
     width = bin_width_for([rec.temperature_for(axis) for rec in recordings], bin_width_degc)
     block_s = max(NETWORK_BLOCK_S, 1.0 / recordings[0].rate_hz)
     t_in, y_in, w_in, a_in = [], [], [], []
@@ -75,7 +77,8 @@ def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis
     needs_accel = any(name != "temperature" for name in inputs)
     if needs_accel and any(a is None for a in a_in):
         raise InputError("pipeline=joint-mlp: the runs need accel_x, accel_y and accel_z columns")
-    network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=poly.t_ref_degc, accel_g=a_in if needs_accel else None,
+    t_ref_degc = 0.5 * (scaffold.t_min_degc + scaffold.t_max_degc)
+    network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=t_ref_degc, accel_g=a_in if needs_accel else None,
                        inputs=inputs)
     return network.curves_[axis], network.turn_on_biases_[axis]
 
@@ -84,7 +87,8 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
                   hysteresis_orders: tuple[int, ...] = (1, 2, 3), acceleration: str = "none",
                   static_min_duration_s: float = 10.0, bin_width_degc: float | None = None,
                   run_folds: tuple[int, ...] | None = None, folds: str = "auto",
-                  shared_lag: bool = True, do_no_harm: bool = True) -> dict[str, AxisSelection]:
+                  shared_lag: bool = True, do_no_harm: bool = True,
+                  curves: tuple[str, ...] = ("poly",)) -> dict[str, AxisSelection]:
     """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.models.selection`).
 
     Parameters
@@ -106,6 +110,9 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     do_no_harm : bool
         Keep a temperature model only where it beats the run constant on the held-out folds
         (:func:`gyrocomp.models.selection.beats_constant`); False when the order was asked for.
+    curves : tuple of str
+        Curve families to score (:data:`gyrocomp.models.curves.BASES`): ``poly`` at ``orders``, the others at
+        their own sizes.
     """
     if folds not in FOLD_KINDS:
         raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
@@ -117,7 +124,8 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
         problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
                                fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders,
                                both_directions="none" in memories,
-                               branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else ())
+                               branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
+                               curves=curves)
         if acceleration != "none":
             if any(r.accel_g is None for r in problem.runs):
                 raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a "
@@ -199,7 +207,8 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
     selections = select_models(recordings, orders=orders, memories=memories, hysteresis_orders=h_orders,
                                acceleration=accel_mode, static_min_duration_s=options.static_min_duration_s,
                                bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
-                               folds=options.folds, do_no_harm=order == "auto")
+                               folds=options.folds, do_no_harm=order == "auto",
+                               curves=tuple(BASES) if order == "auto" and options.target == "model" else ("poly",))
     _warn_about_choice(selections)
     chosen = {axis: sel.chosen for axis, sel in selections.items()}
     thermal = ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
@@ -209,9 +218,10 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
                                      band_degc={a: selections[a].band_degc if c.band else None
                                                 for a, c in chosen.items()},
                                      branch_order={a: c.branch for a, c in chosen.items()},
+                                     curve={a: c.curve for a, c in chosen.items()},
                                      bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
                                      static_min_duration_s=options.static_min_duration_s,
-                                     refine_band=True).fit(recordings)
+                                     refine_band=True, extended=True).fit(recordings)
     return selections, thermal
 
 
@@ -314,8 +324,8 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
             {a: network.epochs_[a] for a in network.curves_}, unit).to_dict()
     name = _model_name(axes, network, network_inputs, order, thermal, accel_mode)
     if options.target != "model":  # what the firmware computes: the curve held at its range's edges (it clamps)
-        axes = {a: dataclasses.replace(ax, temperature=dataclasses.replace(ax.temperature, extrapolation="hold"))
-                if isinstance(ax.temperature, PolynomialBias) else ax for a, ax in axes.items()}
+        axes = {a: dataclasses.replace(ax, temperature=ax.temperature.clamped()) if ax.temperature is not None
+                else ax for a, ax in axes.items()}
         report["target"] = options.target
         name += f" for {options.target}"
     if PreparedRun.of(recordings[0]).channel == "accel":
@@ -420,8 +430,6 @@ def _axis_calibration(axis: str, recordings: list[Recording], selections, model,
                                      thermal.segments_ if thermal is not None else None, network_inputs)
         if joint:  # the network reads the accelerations itself: the least-squares G was only a scaffold
             g_row = g_sq = None
-    if selections is not None and isinstance(curve, PolynomialBias):  # validated with the tangent extension
-        curve = dataclasses.replace(curve, extrapolation="linear")
     keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
     result = AxisCalibration(keep_curve, tuple(float(c) for c in consts), recordings[0].temperature_column_for(axis),
                              lag, hyst, g_row, g_sq, unit=recordings[0].unit_of(axis))
@@ -438,8 +446,10 @@ def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, order
     if network is not None:
         name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, network.hidden)) + "-1"
     else:
-        orders = sorted({ax.temperature.order if ax.temperature is not None else 0 for ax in axes.values()})
-        name = f"poly:{orders[0]}" if len(orders) == 1 else "poly:" + "/".join(map(str, orders))
+        labels = sorted({ax.temperature.label if ax.temperature is not None else "poly:0" for ax in axes.values()},
+                        key=lambda label: (not label.startswith("poly:"), len(label), label))
+        polys = [label for label in labels if label.startswith("poly:")]
+        name = "/".join((["poly:" + "/".join(p[5:] for p in polys)] if polys else []) + labels[len(polys):])
         if order == "auto":
             name += " (auto)"
     if thermal is not None:
@@ -705,12 +715,10 @@ def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[Pose
     axes = dict(accel_cal.accel_axes)
     for j, name in enumerate(ACCEL_AXES):
         curve = None if name not in axes else axes[name].temperature
-        if not isinstance(curve, PolynomialBias):
+        sloped = None if curve is None else curve.plus_slope(float(slope[j]))
+        if sloped is None:
             return fit_accel_multiposition(poses), accel_cal  # a network cannot take the slope: K constant
-        coefficients = list(curve.coefficients) or [0.0]
-        coefficients[0] += slope[j] * curve.t_scale_degc
-        axes[name] = dataclasses.replace(axes[name],
-                                         temperature=dataclasses.replace(curve, coefficients=tuple(coefficients)))
+        axes[name] = dataclasses.replace(axes[name], temperature=sloped)
     bias = np.asarray(triad.bias) + slope * (accel_cal.accel_reference_degc - t_six)
     fit = dataclasses.replace(fit, calibration=dataclasses.replace(triad, bias=tuple(float(b) for b in bias)))
     return fit, dataclasses.replace(accel_cal, accel_axes=axes)

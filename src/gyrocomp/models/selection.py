@@ -56,7 +56,7 @@ from .base import bin_width_for
 from .folds import FoldKind, Folds, make_folds, window_for
 from .branch_evidence import band_offer, branch_test, branches_identified, branches_present, heats_and_cools_blocks
 from .hysteresis import turn_threshold_degc
-from .temperature import polynomial_columns
+from .curves import BASES
 from .thermal import LAG_MAX_S, MAX_BRANCH_ORDER
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
@@ -289,6 +289,8 @@ class SelectionProblem:
     unit: AxisUnit = "deg/s"
     band_only: bool = False
     branch_orders: tuple[int, ...] = ()
+    #: curve families besides the polynomial (names of :data:`gyrocomp.models.curves.BASES`), each at its sizes
+    other_curves: tuple[str, ...] = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -315,6 +317,7 @@ class SelectionProblem:
         clipped = temp if lo is None else np.clip(temp, lo, hi)
         u = (clipped - self.t_ref_degc) / self.t_scale_degc
         cols = [u[:, None] ** np.arange(1, self.max_order + 1)]
+        cols += [self.basis(name).columns(temp, size, lo, hi) for name, size, _ in self.other_blocks()]
         h = self.max_hysteresis
         turns = find_turns(temp, self.threshold_degc) if h or self.branch_orders else None
         if h:
@@ -347,12 +350,33 @@ class SelectionProblem:
     def max_branch(self) -> int:
         return max(self.branch_orders, default=0)
 
+    def basis(self, name: str):
+        """The curve family ``name`` over this axis's temperature range (polynomials continued along their
+        tangent past a fold's training range, as the chosen curve is applied)."""
+        return BASES[name].over(self.t_ref_degc - self.t_scale_degc, self.t_ref_degc + self.t_scale_degc)
+
+    def other_blocks(self) -> list[tuple[str, int, int]]:
+        """(family, size, first column) of each block of columns of a family other than the polynomial: they
+        follow the polynomial's u^1..u^max_order, one block per size (a table's sizes share no columns)."""
+        out, start = [], self.max_order
+        for name in self.other_curves:
+            for size in BASES[name].sizes:
+                out.append((name, size, start))
+                start += size
+        return out
+
     def column_index(self, c: Candidate, width: int = 0) -> np.ndarray:
         """The columns of candidate ``c`` (its branch terms at crossover width number ``width``)."""
-        o, h = self.max_order, self.max_hysteresis
+        blocks = self.other_blocks()
+        o = self.max_order + sum(size for _, size, _ in blocks)  # the shape columns, every family's
+        h = self.max_hysteresis
         n_h = 2 * h * (2 if h and self.band_degc is not None else 1)
         start = o + (2 * h if c.band else 0)
-        idx = list(range(c.order))
+        if c.curve == "poly":
+            idx = list(range(c.order))
+        else:
+            first = next(f for name, size, f in blocks if name == c.curve and size == c.order)
+            idx = list(range(first, first + c.order))
         idx += [start + j for j in range(c.hysteresis_order)] + [start + h + j for j in range(c.hysteresis_order)]
         b = self.max_branch
         idx += [o + n_h + width * b + j for j in range(c.branch)]
@@ -449,10 +473,8 @@ class SelectionProblem:
             x = cols[np.ix_(sel, idx)]
             t = temp[sel]
             past = (t < lo) | (t > hi)
-            if c.order and np.any(past):  # past the training range the curve continues along its tangent, as applied
-                tp = t[past]
-                u = (np.clip(tp, lo, hi) - self.t_ref_degc) / self.t_scale_degc
-                x[past, : c.order] = polynomial_columns(u, c.order, (tp - self.t_ref_degc) / self.t_scale_degc - u)
+            if c.order and np.any(past):  # past the training range the curve goes on as applied (tangent, or held)
+                x[past, : c.order] = self.basis(c.curve).columns(t[past], c.order, lo, hi)
             e = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
             w = self.runs[k].samples[sel].astype(float)
             s, n = drift_rms(e, w, window)
@@ -475,7 +497,7 @@ class SelectionProblem:
         least training residual."""
         taus = self.lag_grid_s() if c.lag else np.array([0.0])
         drifts, lags = [], []
-        shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag else None
+        shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag and c.curve == "poly" else None
         both = self.fold_has_both_directions()
         for f in range(self.folds.count):
             # a fold whose training data holds one direction only cannot tell the branches apart: there the
@@ -528,6 +550,10 @@ class SelectionProblem:
             for p in orders:
                 for mem in memories:
                     lag = "lag" in mem
+                    if mem in ("none", "lag") and p > 0:  # the other families, without turning-point terms
+                        for name in self.other_curves:
+                            out += [c for c in (Candidate(size, lag, 0, w, curve=name) for size in BASES[name].sizes)
+                                    if c not in out]
                     if "branch" in mem:
                         for b in (self.branch_orders if p > 0 else ()):
                             c = Candidate(p, lag, 0, w, False, b)
@@ -676,7 +702,7 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
                  block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
                  max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
                  square_cols: tuple[int, ...] = (), both_directions: bool = True,
-                 branch_orders: tuple[int, ...] = ()) -> SelectionProblem:
+                 branch_orders: tuple[int, ...] = (), curves: tuple[str, ...] = ("poly",)) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
     Parameters
@@ -704,6 +730,9 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     branch_orders : tuple of int
         Terms of the heating-cooling difference of the branch candidates; offered only where the runs both heat
         and cool.
+    curves : tuple of str
+        The curve families offered (:data:`gyrocomp.models.curves.BASES`): the polynomial's orders come from
+        ``max_order``, every other family's sizes from its basis.
     """
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
@@ -724,7 +753,8 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     return SelectionProblem(runs, groups, folds, t_ref, t_scale, max(thresholds), block_s,
                             window_for(folds, runs, block_s), max_order, hysteresis_orders if reverses else (),
                             accel_cols, square_cols, step, band, unit=recordings[0].unit_of(axis), band_only=band_only,
-                            branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else ())
+                            branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
+                            other_curves=tuple(name for name in curves if name != "poly"))
 
 
 __all__ = ["AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "CandidateScore", "SelectionProblem", "Weighting",

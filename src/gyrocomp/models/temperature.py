@@ -8,13 +8,16 @@ with one turn-on constant c_r per run (each power-on has its own) and the shape 
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from ..ctext import c_array, c_number
 from ..errors import InputError
 from .base import RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION
+from .curves import CCode, register_basis, register_curve
 
 MAX_ORDER = 5
 #: data beyond the fitted temperature range by less than max(these) is not reported as outside it
@@ -22,6 +25,7 @@ MAX_ORDER = 5
 EXTRAPOLATIONS = ("hold", "linear")
 
 
+@register_curve
 @dataclass(frozen=True)
 class PolynomialBias:
     """Fitted temperature shape of one axis's bias, without its turn-on constant, in the axis's unit (deg/s for a
@@ -35,6 +39,10 @@ class PolynomialBias:
     nearer edge. A temperature coefficient rarely vanishes just past the calibrated range, while a polynomial
     of higher order extrapolated as such diverges; the tangent is the first-order Taylor extension.
     """
+
+    kind: ClassVar[str] = "polynomial"
+    inputs: ClassVar[tuple[str, ...]] = ("temperature",)
+    needs_accel: ClassVar[bool] = False
 
     coefficients: tuple[float, ...]
     t_ref_degc: float
@@ -52,6 +60,42 @@ class PolynomialBias:
         return len(self.coefficients)
 
     @property
+    def beyond_range(self) -> str:
+        return "continued along its tangent" if self.extrapolation == "linear" else "held at its edge"
+
+    def describe(self) -> str:
+        return f"polynomial order {self.order}"
+
+    @property
+    def label(self) -> str:
+        return f"poly:{self.order}"
+
+    def clamped(self) -> "PolynomialBias":
+        return dataclasses.replace(self, extrapolation="hold")
+
+    def plus_slope(self, slope_per_degc: float) -> "PolynomialBias":
+        coefficients = list(self.coefficients) or [0.0]
+        coefficients[0] += slope_per_degc * self.t_scale_degc
+        return dataclasses.replace(self, coefficients=tuple(coefficients))
+
+    def c_code(self, name: str) -> CCode:
+        """Horner's rule on u = (clip(tm) - T_ref) / T_scale, continued along the tangent past the range when the
+        curve is."""
+        c = self.coefficients
+        lines = [f"{{ const double c[] = {c_array(c)};" if c else "{",
+                 f"  double u = (clip(tm, {c_number(self.t_min_degc)}, {c_number(self.t_max_degc)}) - "
+                 f"{c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)};",
+                 "  shape = 0.0;"]
+        if c:
+            lines.append(f"  for (int k = {len(c) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
+            if self.extrapolation == "linear":  # continued along the tangent past the range
+                lines += ["  double slope = 0.0;",
+                          f"  for (int k = {len(c) - 1}; k >= 0; --k) slope = slope * u + (k + 1) * c[k];",
+                          f"  shape += slope * ((tm - {c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)} - u);"]
+        lines.append("}")
+        return CCode(tuple(lines))
+
+    @property
     def range_tolerance_degc(self) -> float:
         """How far past its range data may go before it counts as outside [degC]: sensor noise and
         rounding make a new run at the same set points overshoot the fit's extremes slightly."""
@@ -63,9 +107,9 @@ class PolynomialBias:
         tol = self.range_tolerance_degc
         return bool(np.any(t < self.t_min_degc - tol) or np.any(t > self.t_max_degc + tol))
 
-    def shape(self, temperature_degc: np.ndarray) -> np.ndarray:
+    def shape(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
         """Bias shape [the axis's unit] at ``temperature_degc`` [degC]; past the range held or extended
-        (``extrapolation``)."""
+        (``extrapolation``). ``accel_g`` is not read."""
         t = np.asarray(temperature_degc, dtype=float)
         u = (np.clip(t, self.t_min_degc, self.t_max_degc) - self.t_ref_degc) / self.t_scale_degc
         # Horner's rule (as polynomial_columns @ coefficients, without building the columns)
@@ -109,6 +153,40 @@ def horner(u: np.ndarray, coefficients: list[float]) -> np.ndarray:
         value *= u
         value += c
     return value
+
+
+@register_basis
+@dataclass(frozen=True)
+class PolynomialBasis:
+    """The polynomials u^1..u^p, u = (T - T_ref) / T_scale over the data's range [lo, hi] (T_ref its middle,
+    T_scale its half-width): candidates ``poly:0`` .. ``poly:5`` of the model choice. Past a curve's range the
+    columns continue along their tangent when ``extended`` (how the model choice scores, and the chosen curve is
+    applied), else they are held at the edge."""
+
+    name: ClassVar[str] = "poly"
+    sizes: ClassVar[tuple[int, ...]] = tuple(range(1, MAX_ORDER + 1))
+    nested: ClassVar[bool] = True
+
+    t_ref_degc: float
+    t_scale_degc: float
+    extended: bool = True
+
+    @classmethod
+    def over(cls, lo_degc: float, hi_degc: float, extended: bool = True) -> "PolynomialBasis":
+        return cls((lo_degc + hi_degc) / 2, (hi_degc - lo_degc) / 2 if hi_degc > lo_degc else 1.0, extended)
+
+    def columns(self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None,
+                hi_degc: float | None = None) -> np.ndarray:
+        t = np.asarray(temperature_degc, dtype=float)
+        u = (t - self.t_ref_degc) / self.t_scale_degc
+        if lo_degc is None:
+            return u[:, None] ** np.arange(1, size + 1)
+        clipped = (np.clip(t, lo_degc, hi_degc) - self.t_ref_degc) / self.t_scale_degc
+        return polynomial_columns(clipped, size, u - clipped if self.extended else None)
+
+    def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> PolynomialBias:
+        return PolynomialBias(tuple(float(a) for a in coefficients), self.t_ref_degc, self.t_scale_degc, lo_degc,
+                              hi_degc, "linear" if self.extended else "hold")
 
 
 def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray | None = None) -> np.ndarray:

@@ -39,7 +39,7 @@ from ..prepared import PreparedRun, RunBlocks, fit_axes
 from .base import LearnedAttributes, bin_width_for, one_temperature_column
 from .hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .polynomial_fit import simplest_within
-from .temperature import PolynomialBias
+from .curves import BASES
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
 CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
@@ -95,6 +95,8 @@ class _Spec:
     hysteresis_order: int
     branch: int = 0
     width_degc: float = 0.0
+    #: the curve family of the shape (:data:`gyrocomp.models.curves.BASES`), ``order`` its size
+    curve: str = "poly"
 
     @property
     def name(self) -> str:
@@ -111,7 +113,13 @@ class _Problem:
     block_s: float
     accel_cols: tuple[int, ...] = ()
     square_cols: tuple[int, ...] = ()
+    #: a polynomial continues along its tangent past its range (as the model choice scored it), else is held
+    extended: bool = False
     _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
+
+    def basis(self, spec: _Spec):
+        """The curve family of ``spec`` over the data's temperature range."""
+        return BASES[spec.curve].over(self.t_ref - self.t_scale, self.t_ref + self.t_scale, self.extended)
 
     def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
         """The temperature the model reads [degC]: reported, or through the lag ``tau`` [s] (kept per run and tau:
@@ -127,7 +135,7 @@ class _Problem:
         """Columns of the shape and the hysteresis at model temperature ``temp``, then of the g and g x g
         sensitivity (the excited accelerometer axes only)."""
         u = (np.clip(temp, t_lo, t_hi) - self.t_ref) / self.t_scale
-        cols = [u ** k for k in range(1, spec.order + 1)]
+        cols = [self.basis(spec).columns(temp, spec.order, t_lo, t_hi)] if spec.order else []
         if spec.hysteresis_order:
             turns = find_turns(temp, self.threshold)
             active = ~np.isnan(turns.turn_degc)
@@ -361,13 +369,20 @@ class ThermalHysteresisModel(LearnedAttributes):
     branch_order : int or dict
         Terms of the difference between the heating and the cooling curve of a branch model (1: a constant,
         2: and a slope), or one per axis.
+    curve : str or dict
+        The family of the temperature shape, a name of :data:`gyrocomp.models.curves.BASES` (``poly``,
+        ``table``), ``order`` its size; or one per axis.
+    extended : bool
+        A polynomial continues along its tangent past its range (how the model choice scored it), else is held.
     refine_band : bool
         ``band_degc`` was found on temperature bins (:func:`~gyrocomp.models.hysteresis.parting_band_degc`): move
         its edges, within one bin, to where the residual is least, then fit the lag again.
 
     Attributes (after ``fit``)
     --------------------------
-    curves_ : dict[str, PolynomialBias]
+    curves_ : dict[str, TemperatureCurve]
+        A polynomial (:class:`~gyrocomp.models.temperature.PolynomialBias`), or the curve of the family
+        ``curve`` names (:data:`gyrocomp.models.curves.BASES`).
     lag_time_constants_s_ : dict[str, float]
         Fitted thermal time constant per axis [s], 0 without lag.
     hysteresis_ : dict[str, HysteresisCurve or None]
@@ -405,6 +420,8 @@ class ThermalHysteresisModel(LearnedAttributes):
     shared_lag: bool = True
     refine_band: bool = False
     branch_order: int | dict[str, int] = MAX_BRANCH_ORDER
+    curve: str | dict[str, str] = "poly"
+    extended: bool = False
 
     @staticmethod
     def _of(value, axis: str):
@@ -416,12 +433,13 @@ class ThermalHysteresisModel(LearnedAttributes):
 
     def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "") -> _Spec:
         lag = name in ("lag", "turning-point+lag", "branch+lag")
+        curve = self._of(self.curve, axis)
         if "branch" in name:
-            return _Spec(order, lag, 0, int(self._of(self.branch_order, axis)))
+            return _Spec(order, lag, 0, int(self._of(self.branch_order, axis)), curve=curve)
         if "turning-point" not in name:
-            return _Spec(order, lag, 0)
+            return _Spec(order, lag, 0, curve=curve)
         fixed = self._of(self.hysteresis_order, axis)
-        return _Spec(order, lag, hysteresis_order if fixed == "auto" else int(fixed))
+        return _Spec(order, lag, hysteresis_order if fixed == "auto" else int(fixed), curve=curve)
 
     def fit(self, recordings: list[Recording]) -> "ThermalHysteresisModel":
         """Fit on ``recordings`` (each one power-on at rest) and return self."""
@@ -478,7 +496,7 @@ class ThermalHysteresisModel(LearnedAttributes):
                         for rec in recordings)
         accel_cols, square_cols = self._accel_columns(runs, first)
         return _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold,
-                        self._of(self.band_degc, axis), block_s, accel_cols, square_cols)
+                        self._of(self.band_degc, axis), block_s, accel_cols, square_cols, self.extended)
 
     def _choose(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _AxisChoice:
         """The candidate of one axis: given, or the best by leave-one-run-out error (BIC with one run)."""
@@ -553,9 +571,7 @@ class ThermalHysteresisModel(LearnedAttributes):
             problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0],
                                 max(1.0, float(np.ptp(temps)) / 40.0))
         tau, (coef, consts, _, (t_lo, t_hi)), spec = problem.fit(spec, list(range(n_runs)), tau_s)
-        shape = coef[: spec.order]
-        self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), problem.t_ref, problem.t_scale,
-                                            t_lo, t_hi)
+        self.curves_[axis] = problem.basis(spec).curve(coef[: spec.order], t_lo, t_hi)
         self.lag_time_constants_s_[axis] = float(tau)
         p = spec.hysteresis_order
         self.hysteresis_[axis] = None if not p else HysteresisCurve(

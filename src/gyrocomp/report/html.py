@@ -102,8 +102,7 @@ def _fmt(value) -> str:
 def _describe(ax) -> str:
     if ax.temperature is None:
         return "constant"
-    order = ax.temperature.order
-    text = f"polynomial order {order}" if isinstance(order, int) else f"network {order}"
+    text = ax.temperature.describe()
     if ax.lag_time_constant_s > 0:
         text += f", thermal lag {ax.lag_time_constant_s:.3g} s"
     if ax.hysteresis is not None:
@@ -125,7 +124,7 @@ def _summary(calibration: Calibration) -> str:
     for group, axes, unit in (("gyro", calibration.axes, "deg/s"), ("accelerometer", calibration.accel_axes, "g")):
         fits = (report.accel.axes if report.accel is not None else {}) if group == "accelerometer" else report.axes
         for name, ax in axes.items():
-            inputs = ", ".join(getattr(ax.temperature, "inputs", ("temperature",))) if ax.temperature else "-"
+            inputs = ", ".join(ax.temperature.inputs) if ax.temperature else "-"
             rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
             rms = fits[name].fit_rms if name in fits else None
             rows.append([name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}",
