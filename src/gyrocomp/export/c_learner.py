@@ -30,7 +30,8 @@ import math
 from ..errors import InputError
 from ..models.online import (GAP_PERIODS, LEVEL_GROWTH, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G,
                              PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC,
-                             LearnerSettings, _MAD_TO_SIGMA, _RIDGE)
+                             LearnerSettings)
+from ..models.online.settings import _MAD_TO_SIGMA, _RIDGE
 from ..stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY, MIN_BLOCK_SAMPLES
 
 
