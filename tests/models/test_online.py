@@ -19,7 +19,7 @@ from scipy.stats import chi2, norm
 from gyrocomp.calibration import Calibration
 from gyrocomp.compensate import apply
 from gyrocomp.errors import InputError, NotFittedError
-from gyrocomp.export.c_learner import learner_c_sources
+from gyrocomp.export.c_learner import TEMPLATES, learner_c_sources, template_values
 from gyrocomp.io.tables import write_recording
 from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.online import LearnerSettings, OnlineCalibrator, block_statistics, chi2_quantile, replay
@@ -289,6 +289,17 @@ def test_the_c_learner_matches_python(tmp_path):
     constants = np.array([[float(v) for v in line.split()] for line in out[5:]])
     assert np.max(np.abs(constants - learner._constants)) < 1e-9
     assert size < 40_000  # fixed memory: the state is one struct of this size [bytes] (34 kB with the defaults)
+
+
+def test_the_c_templates_ask_for_exactly_the_numbers_python_gives():
+    """The C learner's templates and the Python learner share one set of settings and constants: a name one side
+    adds or drops alone fails here, and nothing is left unfilled."""
+    asked = set()
+    for name in ("gyrocomp_learn.h.in", "gyrocomp_learn.c.in"):
+        asked |= set(re.findall(r"@([A-Z0-9_]+)@", (TEMPLATES / name).read_text()))
+    assert asked == set(template_values())
+    for text in learner_c_sources(LearnerSettings(rate_hz=50.0, degree=2)).values():
+        assert not re.search(r"@[A-Z0-9_]+@", text)
 
 
 def test_bad_input_is_refused_with_a_clear_message():
