@@ -33,8 +33,8 @@ _EXPORTS = {
     **{name: ("models.options", name) for name in ("FitOptions", "Network", "Polynomial")},
     "FitReport": ("fit_report", "FitReport"), "analyse_noise_file": ("noise_file", "analyse_noise_file"),
     "evaluate_file": ("evaluation", "evaluate_file"),
-    # ``gyrocomp.fit`` is fit_calibration: recordings in, a frozen Calibration out
-    "fit": ("models.pipelines", "fit_calibration"),
+    # the one entry point: runs and typed options in, a frozen Calibration out (the others wrap it)
+    "fit": ("models.fit", "fit"),
     "fit_gyro_between_poses": ("models.pose_rotation", "fit_gyro_between_poses"),
     "rotation_errors": ("models.pose_rotation", "rotation_errors"),
     "find_poses": ("models.triad_fit", "find_poses"),

@@ -14,7 +14,8 @@ from ..io.schedule import apply_schedule, read_rate_schedule
 from ..models.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
 from ..models.options import FitOptions
-from ..models.pipelines import SCALE_FACTOR_CHOICES, fit_channels
+from ..models.fit import fit as fit_runs
+from ..models.pipelines import SCALE_FACTOR_CHOICES
 from ..models.folds import FOLD_KINDS
 from ..models.thermal import HYSTERESIS_CHOICES
 from .common import (FINITE, float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar,
@@ -106,7 +107,8 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
             print_contributions(contributions)
         with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):
-            fits[instance] = fit_channels(recordings, channels, pipeline, scale_factor=scale_factor, options=options)
+            fits[instance] = fit_runs(recordings, options, channels=channels, pipeline=pipeline,
+                                      scale_factor=scale_factor)
     if every:  # one model file per instance, all written or none
         out = Path(output)
         names = {instance: f"{out.stem}_imu{instance}{out.suffix}" for instance in fits}

@@ -1,7 +1,7 @@
 """Fit a fleet: one model per unit, on a Dask cluster, into a calibration store; resumable and failure-tolerant.
 
 Each unit is one task. The task gets the unit's file paths and the settings (a few hundred bytes), reads and
-hashes its own files, fits them as ``gyrocomp fit`` would with its defaults (:func:`gyrocomp.fit_channels`),
+hashes its own files, fits them as ``gyrocomp fit`` would with its defaults (:func:`gyrocomp.fit`),
 computes the figures of merit, and returns the model JSON and the figures (a few kB): nothing large passes
 through the client, whatever the size of the runs. The client appends one row per unit to the store as the
 tasks finish, so an interrupted fleet keeps what it finished. A rerun passes each unit the input hash of its
@@ -33,7 +33,8 @@ from ..errors import GyrocompError, InputError
 from ..io import ReadOptions, read_input
 from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
-from ..models.pipelines import Pipeline, check_channels, fit_channels
+from ..models.fit import fit
+from ..models.pipelines import Pipeline, check_channels
 from ..prepared import Channel
 from ..threads import single_threaded_blas
 from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
@@ -56,7 +57,7 @@ class FleetSettings:
     Parameters
     ----------
     channels : tuple of str
-        ``("gyro",)``, ``("accel",)`` or both (see :func:`gyrocomp.fit_channels`).
+        ``("gyro",)``, ``("accel",)`` or both (see :func:`gyrocomp.fit`).
     pipeline : str
         The fit's pipeline (``"joint"``).
     read : ReadOptions
@@ -134,7 +135,7 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
             if settings.prior is not None:
                 calibration = fit_with_prior(recordings, settings.prior)
             else:
-                calibration = fit_channels(recordings, settings.channels, settings.pipeline)
+                calibration = fit(recordings, channels=settings.channels, pipeline=settings.pipeline)
             figures = unit_figures(calibration, recordings,
                                    reference_temperature_degc=settings.reference_temperature_degc)
         except Exception as exc:  # noqa: BLE001 - one unit's failure, whatever it is, must not stop the fleet

@@ -233,7 +233,9 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
                     static_min_duration_s: float = 10.0, network_inputs: tuple[str, ...] = ("temperature",),
                     run_folds: tuple[int, ...] | None = None, folds: FoldChoice = "auto",
                     target: Target = "model") -> Calibration:
-    """Fit a compensation on calibration runs (each one power-on, the gyro at rest).
+    """Fit a compensation on calibration runs (each one power-on, the gyro at rest), the options as keyword
+    arguments: the gyro's ``joint`` fit of :func:`gyrocomp.fit` (``gyrocomp.models.fit.fit``) with those options
+    as a :class:`~gyrocomp.models.options.FitOptions` (and ``network_inputs``, which only this call takes).
 
     Parameters
     ----------
