@@ -13,7 +13,7 @@ Both idle and with a busy neighbour process on one core (``benchmarks/busy.py``)
 from 3 to 10 should be at most linear). The stages of the gyrocomp fit are timed in this process as well
 (reading with ``gyrocomp.io.read``, the fit with ``fit_channels``), so that the ratio can be read stage by stage.
 
-Usage: python benchmarks/bench_fit_protocol.py [--runs 3 10] [--repeat 2] [--markdown FILE]
+Usage: python benchmarks/bench_fit_protocol.py [--runs 3 10] [--repeat 2]
 """
 
 from __future__ import annotations
@@ -101,10 +101,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, nargs="+", default=[3, 10])
     parser.add_argument("--repeat", type=int, default=2)
-    parser.add_argument("--markdown", type=Path, help="write the table as Markdown to this file")
     args = parser.parse_args()
     lines = ["| runs | PX4-style pipeline [s] | `gyrocomp fit` [s] | ratio | busy neighbour: PX4-style / gyrocomp [s] "
              "| ratio | stages in-process: read / fit [s] |", "|---|---|---|---|---|---|---|"]
+    print("\n".join(lines), flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         all_paths = write_runs(folder, max(args.runs))
@@ -117,8 +117,6 @@ def main() -> None:
     machine = (f"{os.cpu_count()} cores, {platform.machine()}, CPython {platform.python_version()}, "
                f"{time.strftime('%Y-%m-%d')}")
     print(machine)
-    if args.markdown:
-        args.markdown.write_text("\n".join([*lines, "", f"Measured on {machine}."]) + "\n")
 
 
 if __name__ == "__main__":
