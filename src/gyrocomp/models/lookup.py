@@ -112,7 +112,9 @@ class LookupTableBias:
 class LookupTableBasis:
     """Tables of ``size`` intervals on the data's range [lo, hi]: the hat functions of grid points 1..size
     (point 0 is the level the run constants take) at the temperature clipped to the curve's range (held past it,
-    as applied). Candidates ``table:8`` and ``table:16`` of the model choice."""
+    as applied). Candidates ``table:8`` and ``table:16`` of the model choice, without lag or hysteresis, kept
+    only where they beat the best polynomial on the held-out folds by more than the standard error of the
+    paired difference (:mod:`gyrocomp.models.selection`)."""
 
     name: ClassVar[str] = "table"
     sizes: ClassVar[tuple[int, ...]] = (8, 16)

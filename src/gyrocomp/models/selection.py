@@ -310,14 +310,15 @@ class SelectionProblem:
             return thermal_lag(run.time_s, run.temperature_degc, tau_s, period_s=self.block_s)[0]
         return run.temperature_degc
 
-    def columns(self, k: int, temp: np.ndarray, lo: float | None = None, hi: float | None = None) -> np.ndarray:
+    def columns(self, k: int, temp: np.ndarray, lo: float | None = None, hi: float | None = None,
+                lagged: bool = False) -> np.ndarray:
         """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order (u clipped to
         [lo, hi]), the cooling then heating hysteresis terms (d / t_scale)^j, the branch terms s_w u^j for each
         crossover width w, then the accelerometer columns."""
         clipped = temp if lo is None else np.clip(temp, lo, hi)
         u = (clipped - self.t_ref_degc) / self.t_scale_degc
         cols = [u[:, None] ** np.arange(1, self.max_order + 1)]
-        cols += [self.basis(name).columns(temp, size, lo, hi) for name, size, _ in self.other_blocks()]
+        cols += [self.basis(name).columns(temp, size, lo, hi) for name, size, _ in self.other_blocks(lagged)]
         h = self.max_hysteresis
         turns = find_turns(temp, self.threshold_degc) if h or self.branch_orders else None
         if h:
@@ -355,10 +356,15 @@ class SelectionProblem:
         tangent past a fold's training range, as the chosen curve is applied)."""
         return BASES[name].over(self.t_ref_degc - self.t_scale_degc, self.t_ref_degc + self.t_scale_degc)
 
-    def other_blocks(self) -> list[tuple[str, int, int]]:
+    def other_blocks(self, lagged: bool = False) -> list[tuple[str, int, int]]:
         """(family, size, first column) of each block of columns of a family other than the polynomial: they
-        follow the polynomial's u^1..u^max_order, one block per size (a table's sizes share no columns)."""
+        follow the polynomial's u^1..u^max_order, one block per size (a table's sizes share no columns). None
+        at a lag (``lagged``): the other families are offered without one (a table with a lag followed the
+        runs' common drift on a simulated fleet, and its columns at every lag of the grid cost a quarter of
+        the fit)."""
         out, start = [], self.max_order
+        if lagged:
+            return out
         for name in self.other_curves:
             for size in BASES[name].sizes:
                 out.append((name, size, start))
@@ -366,8 +372,9 @@ class SelectionProblem:
         return out
 
     def column_index(self, c: Candidate, width: int = 0) -> np.ndarray:
-        """The columns of candidate ``c`` (its branch terms at crossover width number ``width``)."""
-        blocks = self.other_blocks()
+        """The columns of candidate ``c`` (its branch terms at crossover width number ``width``), among the columns
+        at a lag when ``c`` has one (no block of another family there)."""
+        blocks = self.other_blocks(c.lag)
         o = self.max_order + sum(size for _, size, _ in blocks)  # the shape columns, every family's
         h = self.max_hysteresis
         n_h = 2 * h * (2 if h and self.band_degc is not None else 1)
@@ -399,7 +406,7 @@ class SelectionProblem:
             out = []
             for k in range(len(self.runs)):
                 temp = self.model_temperature(k, tau_s)
-                out.append((temp, self.columns(k, temp)))
+                out.append((temp, self.columns(k, temp, lagged=tau_s > 0)))
             self._cache[key] = out
         return self._cache[key]
 
@@ -550,9 +557,9 @@ class SelectionProblem:
             for p in orders:
                 for mem in memories:
                     lag = "lag" in mem
-                    if mem in ("none", "lag") and p > 0:  # the other families, without turning-point terms
+                    if mem == "none" and p > 0:  # the other families: no lag, no turning-point terms
                         for name in self.other_curves:
-                            out += [c for c in (Candidate(size, lag, 0, w, curve=name) for size in BASES[name].sizes)
+                            out += [c for c in (Candidate(size, False, 0, w, curve=name) for size in BASES[name].sizes)
                                     if c not in out]
                     if "branch" in mem:
                         for b in (self.branch_orders if p > 0 else ()):
@@ -626,6 +633,7 @@ def choose(scores: list[CandidateScore], complexity, constant: CandidateScore | 
     if not finite:  # too little data to hold anything out: the simplest candidate, unvalidated
         simplest = min(scores, key=lambda s: complexity(s.candidate)).candidate
         return simplest, simplest
+    finite = _other_families_that_earn_it(finite)
     best = min(finite, key=lambda s: s.mean_drift)
     if constant is not None and np.all(np.isfinite(constant.fold_drift)):
         finite = [s for s in finite if not s.candidate.has_temperature_model or beats_constant(s, constant)]
@@ -636,6 +644,20 @@ def choose(scores: list[CandidateScore], complexity, constant: CandidateScore | 
     accepted = [s for s in finite if s.mean_drift <= pool_best.mean_drift + se]
     chosen = min(accepted, key=lambda s: (complexity(s.candidate), s.mean_drift))
     return best.candidate, chosen.candidate
+
+
+def _other_families_that_earn_it(finite: list[CandidateScore]) -> list[CandidateScore]:
+    """The scores without the candidates of a curve family other than the polynomial (a lookup table) that do not
+    beat the best polynomial on the held-out folds as a temperature model must beat the constant
+    (:func:`beats_constant`: by more than the standard error of the paired difference; with two folds, half its
+    drift on both). A table has many terms and follows what the folds share by chance: measured on a simulated
+    fleet of consumer-grade units (three 15-minute runs each), tables chosen by the one-SE rule alone moved the
+    units' temperature figures off their truth and tripled the good units flagged as outliers."""
+    polys = [s for s in finite if s.candidate.curve == "poly" and s.candidate.has_temperature_model]
+    if not polys:
+        return finite
+    best_poly = min(polys, key=lambda s: s.mean_drift)
+    return [s for s in finite if s.candidate.curve == "poly" or beats_constant(s, best_poly)]
 
 
 def share_fold_lags(problems: list[SelectionProblem], orders: tuple[int, ...],
