@@ -171,24 +171,11 @@ def branch_test(runs: list[RunBlocks], groups: tuple[int, ...], threshold_degc: 
     of 2 degrees of freedom. The crossover width is the middle of those the data cannot tell apart
     (:func:`gyrocomp.models.thermal.plausible_middle`).
 
-    Parameters
-    ----------
-    runs : list of RunBlocks
-        Block means of each recording (one axis).
-    groups : tuple of int
-        The run of each recording (one constant each).
-    threshold_degc : float
-        Turning-point threshold [degC].
-    t_ref_degc, t_scale_degc : float
-        Centre and half-range of the polynomial's variable [degC].
-    order : int
-        Polynomial order of the model the branch terms are added to (at least 1 is used).
-    tau_s : float
-        Thermal lag of that model [s] (0: none).
-    block_s : float
-        Block length [s].
-    extra : list of array (n_k, m), optional
-        Further columns fitted with the model in each recording (the g-sensitivity's accelerations).
+    Parameters: ``runs`` the block means of each recording (one axis), ``groups`` the run of each (one constant
+    each), ``threshold_degc`` the turning-point threshold [degC], ``t_ref_degc`` and ``t_scale_degc`` the centre
+    and half-range of the polynomial's variable [degC], ``order`` the polynomial order of the model the branch
+    terms are added to (at least 1 is used), ``tau_s`` its thermal lag [s] (0: none), ``block_s`` the block
+    length [s], ``extra`` further columns fitted with it in each recording (n_k, m) (the accelerations of G).
     """
     order = max(order, 1)
     temps = [thermal_lag(r.time_s, r.temperature_degc, tau_s, period_s=block_s)[0] if tau_s > 0

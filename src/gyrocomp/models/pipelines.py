@@ -235,53 +235,18 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
                     target: Target = "model") -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest), the options as keyword
     arguments: the gyro's ``joint`` fit of :func:`gyrocomp.fit` (``gyrocomp.models.fit.fit``) with those options
-    as a :class:`~gyrocomp.models.options.FitOptions` (and ``network_inputs``, which only this call takes).
+    as a :class:`~gyrocomp.models.options.FitOptions`, which documents each one (``temperature``, the curve and its
+    order; ``hysteresis``, ``hysteresis_order`` and ``hysteresis_band_degc``, the thermal memory; ``acceleration``,
+    the g-sensitivity; ``bin_width_degc``, ``static_min_duration_s``, ``run_folds``, ``folds``; ``target``, the
+    model or what a firmware carries) and checks them.
 
-    Parameters
-    ----------
-    recordings : list of Recording
-        Calibration runs; each gets its own turn-on constant, the temperature shape is shared.
-    temperature : Polynomial, Network or None
-        The temperature model (:mod:`gyrocomp.models.options`): ``Polynomial()`` (the order chosen by held-out
-        drift) or ``Polynomial(order)`` with an order 0..5; ``Network()`` for the thesis's 1-3-1 network,
-        ``Network(hidden=(H,), seed=S)`` for H hidden neurons and the seed of its initializations; or None for
-        no temperature model (each run's constant only).
-    bin_width_degc : float, optional
-        Temperature bin width for the fit [degC].
-    hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"}
-        Thermal lag and/or turning-point hysteresis on top of the polynomial
-        (:mod:`gyrocomp.models.thermal`). ``"auto"``: when the runs both heat and cool, every candidate is
-        compared by leave-one-run-out error and the best kept; otherwise none.
-    hysteresis_order : int or "auto"
-        Order of the turning-point polynomial (1..3) or chosen by validation.
-    hysteresis_band_degc : (lo, hi), optional
-        Limit the hysteresis to this band [degC].
-    acceleration : {"auto", "none", "matrix", "matrix2"}
-        g-sensitivity fitted jointly with the temperature model and the run constants, on the static
-        segments: the 3x3 matrix (``matrix``), plus g x g terms (``matrix2``). ``"auto"``: ``matrix``
-        when the runs have accelerometer axes and the unit is turned between positions within a run.
-        With ``temperature=None`` only G and the run constants are fitted.
-    static_min_duration_s : float
-        Shortest still stretch used as a static segment [s] (hand-placed poses may last only a few seconds).
-    network_inputs : tuple of str
-        What a network (``temperature=Network()``) reads: the temperature, or also ``accel_x``, ``accel_y``,
-        ``accel_z`` (the joint network of the ``joint-mlp`` pipeline, which then fits no separate G).
-    run_folds : tuple of int, optional
-        The validation fold of each recording for the polynomial order (pieces of one run left out together).
-    folds : {"auto", "runs", "legs", "blocks"}
-        What the model choice holds out (:func:`gyrocomp.models.folds.make_folds`): each run (the
-        default with three runs or more), each heating or cooling leg (the default with fewer), or contiguous
-        time blocks.
-    target : {"model", "px4", "ardupilot"}
-        ``model``: gyrocomp's best model; a firmware: the best model it carries (a polynomial of order 3 at most,
-        held at its range's edges as the firmware clamps, nothing else), so that ``apply`` computes what the
-        exported file will (see :class:`~gyrocomp.models.options.FitOptions`).
+    ``network_inputs``, which only this call takes: what a network (``temperature=Network()``) reads, the
+    temperature, or also ``accel_x``, ``accel_y``, ``accel_z`` (the joint network of the ``joint-mlp`` pipeline,
+    which then fits no separate G).
 
-    Notes
-    -----
-    Options are checked as :class:`~gyrocomp.models.options.FitOptions` checks them. What is left to choose is
-    chosen by held-out drift (:mod:`gyrocomp.models.selection`: the simplest within one standard error of the best);
-    an axis no temperature model helps gets none, with a :class:`~gyrocomp.errors.ModelChoiceWarning`.
+    What is left to choose is chosen by held-out drift (:mod:`gyrocomp.models.selection`: the simplest within one
+    standard error of the best); an axis no temperature model helps gets none, with a
+    :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
     options = FitOptions(temperature=temperature, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
                          hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,
