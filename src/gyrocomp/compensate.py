@@ -225,7 +225,7 @@ class Compensator:
             temp = np.full(time_s.size, np.nan) if temperature_degc is None else np.asarray(temperature_degc, dtype=float)
             if temp.ndim == 2:  # one temperature per axis: their mean tells the direction of change as well
                 temp = temp.mean(axis=1)
-            self._agreement_blocks.add(time_s, np.hstack([output, output - residual[:, columns], temp[:, None]]))
+            self._agreement_blocks.add(time_s, [output, output - residual[:, columns], temp])
         if self._constants is not None:
             return self._subtract_constants(residual, temperature_degc)
         if self._t0 is None and time_s.size:

@@ -208,17 +208,26 @@ class BlockMeans:
         self._t0: float | None = None
         self._blocks: dict[int, np.ndarray] = {}  # block number -> [count, sums of the columns]; only those with data
 
-    def add(self, time_s: np.ndarray, values: np.ndarray) -> None:
-        """One chunk: time [s] (m,), values (m, columns)."""
+    def add(self, time_s: np.ndarray, values) -> None:
+        """One chunk: time [s] (m,), values (m, columns), or a list of arrays (m, c_i) whose columns together are
+        the chunk's (no copy of them is made)."""
         if not len(time_s):
             return
         if self._t0 is None:
             self._t0 = float(time_s[0])
         index = np.floor((np.asarray(time_s, dtype=float) - self._t0) / self.block_s)
-        numbers, which = np.unique(index, return_inverse=True)
-        rows = np.column_stack([np.ones(len(index)), np.asarray(values, dtype=float).reshape(len(index), -1)])
-        sums = np.stack([np.bincount(which, weights=rows[:, j], minlength=numbers.size)
-                         for j in range(rows.shape[1])], axis=1)
+        parts = values if isinstance(values, list) else [values]
+        parts = [np.asarray(v, dtype=float).reshape(len(index), -1) for v in parts]
+        if np.all(index[1:] >= index[:-1]):  # time in order (a stream's always is): one pass per part
+            starts = np.flatnonzero(np.concatenate([[True], index[1:] != index[:-1]]))
+            numbers = index[starts]
+            counts = np.diff(np.append(starts, len(index))).astype(float)
+            sums = np.column_stack([counts, *(np.add.reduceat(v, starts, axis=0) for v in parts)])
+        else:
+            numbers, which = np.unique(index, return_inverse=True)
+            rows = np.column_stack([np.ones(len(index)), *parts])
+            sums = np.stack([np.bincount(which, weights=rows[:, j], minlength=numbers.size)
+                             for j in range(rows.shape[1])], axis=1)
         for number, row in zip(numbers.tolist(), sums):
             if number in self._blocks:
                 self._blocks[number] += row
