@@ -93,12 +93,17 @@ class TemperatureCurve(Protocol):
 CURVES: dict[str, type] = {}
 
 
+def _register(registry: dict[str, type], key: str, cls: type, what: str) -> type:
+    """Put ``cls`` in ``registry`` under ``key``; a second class under a key taken is refused."""
+    if key in registry and registry[key] is not cls:
+        raise ValueError(f"{what} {key!r} is already registered")
+    registry[key] = cls
+    return cls
+
+
 def register_curve(cls: type) -> type:
     """Class decorator: make a curve readable from model files (``kind`` unique)."""
-    if cls.kind in CURVES and CURVES[cls.kind] is not cls:
-        raise ValueError(f"a temperature curve of kind {cls.kind!r} is already registered")
-    CURVES[cls.kind] = cls
-    return cls
+    return _register(CURVES, cls.kind, cls, "a temperature curve of kind")
 
 
 def curve_from_dict(d: dict[str, Any]) -> TemperatureCurve:
@@ -144,10 +149,7 @@ BASES: dict[str, type] = {}
 
 def register_basis(cls: type) -> type:
     """Class decorator: make a curve family a candidate of the model choice (``name`` unique)."""
-    if cls.name in BASES and BASES[cls.name] is not cls:
-        raise ValueError(f"a curve basis named {cls.name!r} is already registered")
-    BASES[cls.name] = cls
-    return cls
+    return _register(BASES, cls.name, cls, "a curve basis named")
 
 
 __all__ = ["BASES", "CCode", "CURVES", "CurveBasis", "TemperatureCurve", "curve_from_dict", "register_basis",
