@@ -124,7 +124,7 @@ def adxrs450_case(hysteresis: Hysteresis | None):
 
 def cats_case():
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from tests.real_data import CATS, CATS_CHOICES, cats_held_out_drift, cats_numpy_cubic_drift
+    from tests.real.real_data import CATS, CATS_CHOICES, cats_held_out_drift, cats_numpy_cubic_drift
     if not CATS.is_dir():
         return None
     default = cats_held_out_drift({"default": CATS_CHOICES["default (auto)"]})["default"]

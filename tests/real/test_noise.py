@@ -7,8 +7,10 @@ import pytest
 
 from gyrocomp.allan import allan_deviation, noise_parameters
 
-from .conftest import shared_dataset
+from ..conftest import shared_dataset
 from .real_data import GALAXY_FIT_TAUS_S, noise_table
+
+pytestmark = pytest.mark.real
 
 
 @pytest.fixture(scope="module")

@@ -10,10 +10,10 @@ from gyrocomp import apply
 from gyrocomp.metrics import smoothed_residual_rms
 from gyrocomp.models.online import OnlineCalibrator, replay
 
-from .conftest import shared_dataset
+from ..conftest import shared_dataset
 from .real_data import CATS_CHOICES, CATS_WINDOW_S, cats_held_out_drift, cats_numpy_cubic_drift, cats_runs
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.real, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +37,7 @@ def test_split_by_still_finds_the_three_periods_from_the_original_file(tmp_path)
     a documented static period at each end (the documented periods are conservative), each with its gravity axis."""
     from gyrocomp import read
 
-    from .conftest import run
+    from ..conftest import run
     from .real_data import CATS_PERIODS_S
 
     source = shared_dataset("skdivemove-cats-tempcal") / "cats_temperature_calib.nc"  # skipped when absent

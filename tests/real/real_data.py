@@ -11,7 +11,7 @@ import numpy as np
 from gyrocomp.allan import allan_deviation, noise_parameters
 from gyrocomp.models.options import Network, Polynomial
 
-from .conftest import DATASETS
+from ..conftest import DATASETS
 
 ADIS = DATASETS / "smac-imudata-adis16405"
 CATS = DATASETS / "skdivemove-cats-tempcal"

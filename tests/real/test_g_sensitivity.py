@@ -4,8 +4,10 @@ imu_tk's Xsens, imucal's Ferraris session, an MPU-6050. The checks are what the 
 import numpy as np
 import pytest
 
-from .conftest import shared_dataset
+from ..conftest import shared_dataset
 from .real_data import g_sensitivity_fits
+
+pytestmark = pytest.mark.real
 
 
 @pytest.fixture(scope="module")
