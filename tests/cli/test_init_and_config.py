@@ -9,7 +9,7 @@ import pytest
 from gyrocomp.errors import InputError
 from gyrocomp.io.guess import guess_layout
 
-from .conftest import run
+from ..conftest import run
 
 RAD = np.pi / 180.0
 

@@ -7,7 +7,7 @@ import warnings
 from gyrocomp import fit_calibration
 from gyrocomp.simulate import get_profile, simulate
 
-from .conftest import run
+from ..conftest import run
 
 
 def test_show_names_the_axes_the_device_ids_and_the_expected_drift(tmp_path):

@@ -1,0 +1,26 @@
+"""The command line's tests: runs and a model made with the CLI itself, shared by the modules."""
+
+import pytest
+
+from ..conftest import run
+
+
+@pytest.fixture(scope="session")
+def workdir(tmp_path_factory):
+    """Three simulated chamber runs and a model fitted on two of them, made with the CLI itself."""
+    d = tmp_path_factory.mktemp("cli")
+    for seed in (1, 2, 3):
+        r = run("simulate", "--profile", "chamber", "--duration", 1200, "--rate", 10, "--seed", seed,
+                "-o", d / f"run{seed}.csv", "--truth", d / f"truth{seed}.json")
+        assert r.returncode == 0, r.stderr
+    r = run("fit", d / "run1.csv", d / "run2.csv", "-o", d / "model.json", "--temperature", "poly:3")
+    assert r.returncode == 0, r.stderr
+    return d
+
+
+@pytest.fixture(scope="session")
+def static_log(tmp_path_factory):
+    d = tmp_path_factory.mktemp("allan")
+    r = run("simulate", "--profile", "static", "--duration", 1800, "--rate", 20, "--axes", "x,z", "-o", d / "s.csv")
+    assert r.returncode == 0, r.stderr
+    return d
