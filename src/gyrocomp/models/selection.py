@@ -310,15 +310,14 @@ class SelectionProblem:
             return thermal_lag(run.time_s, run.temperature_degc, tau_s, period_s=self.block_s)[0]
         return run.temperature_degc
 
-    def columns(self, k: int, temp: np.ndarray, lo: float | None = None, hi: float | None = None,
-                lagged: bool = False) -> np.ndarray:
-        """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order (u clipped to
-        [lo, hi]), the cooling then heating hysteresis terms (d / t_scale)^j, the branch terms s_w u^j for each
-        crossover width w, then the accelerometer columns."""
-        clipped = temp if lo is None else np.clip(temp, lo, hi)
-        u = (clipped - self.t_ref_degc) / self.t_scale_degc
+    def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
+        """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order, the other
+        families' blocks (none at a lag: ``lagged``), the cooling then heating hysteresis terms (d / t_scale)^j,
+        the branch terms s_w u^j for each crossover width w, then the accelerometer columns. (A fold's training
+        range is applied where its held-out blocks are scored, :meth:`_held_out`.)"""
+        u = (temp - self.t_ref_degc) / self.t_scale_degc
         cols = [u[:, None] ** np.arange(1, self.max_order + 1)]
-        cols += [self.basis(name).columns(temp, size, lo, hi) for name, size, _ in self.other_blocks(lagged)]
+        cols += [self.basis(name).columns(temp, size) for name, size, _ in self.other_blocks(lagged)]
         h = self.max_hysteresis
         turns = find_turns(temp, self.threshold_degc) if h or self.branch_orders else None
         if h:
@@ -554,13 +553,12 @@ class SelectionProblem:
                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> list[Candidate]:
         out = []
         for w in weightings:
+            if "none" in memories and any(p > 0 for p in orders):  # the other families: no lag, no hysteresis
+                out += [Candidate(size, False, 0, w, curve=name)
+                        for name in self.other_curves for size in BASES[name].sizes]
             for p in orders:
                 for mem in memories:
                     lag = "lag" in mem
-                    if mem == "none" and p > 0:  # the other families: no lag, no turning-point terms
-                        for name in self.other_curves:
-                            out += [c for c in (Candidate(size, False, 0, w, curve=name) for size in BASES[name].sizes)
-                                    if c not in out]
                     if "branch" in mem:
                         for b in (self.branch_orders if p > 0 else ()):
                             c = Candidate(p, lag, 0, w, False, b)
