@@ -125,10 +125,8 @@ class CurveBasis(Protocol):
     (``over(..., extended=True)``), continued along its tangent as the model choice scores it."""
 
     name: ClassVar[str]
-    #: the sizes the default model choice tries; empty: only when asked for
+    #: the sizes the default model choice tries (the polynomial's orders come from the fit's own order range)
     sizes: ClassVar[tuple[int, ...]]
-    #: whether the columns of a size are the first columns of every larger size (a polynomial's powers)
-    nested: ClassVar[bool]
 
     @classmethod
     def over(cls, lo_degc: float, hi_degc: float, extended: bool = True) -> "CurveBasis": ...

@@ -118,7 +118,6 @@ class LookupTableBasis:
 
     name: ClassVar[str] = "table"
     sizes: ClassVar[tuple[int, ...]] = (8, 16)
-    nested: ClassVar[bool] = False
 
     lo_degc: float
     hi_degc: float

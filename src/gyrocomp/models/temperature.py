@@ -165,7 +165,6 @@ class PolynomialBasis:
 
     name: ClassVar[str] = "poly"
     sizes: ClassVar[tuple[int, ...]] = tuple(range(1, MAX_ORDER + 1))
-    nested: ClassVar[bool] = True
 
     t_ref_degc: float
     t_scale_degc: float
