@@ -186,11 +186,11 @@ def branch_test(runs: list[RunBlocks], groups: tuple[int, ...], threshold_degc: 
     designs = [[coarsen(x, factor) for x in _branch_design(runs, temps, groups, threshold_degc, t_ref_degc,
                                                            t_scale_degc, order, w, extra)]
                for w in BRANCH_WIDTHS_DEGC]
-    rss = [float(np.sum(_residual(x, y) ** 2)) for x in designs]
+    ys = np.concatenate(y)
+    fits = [_weighted_fit(np.vstack(x), ys, np.ones(ys.size)) for x in designs]  # (residual, rss) per width
     duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in runs)
-    pick = plausible_middle(np.asarray(rss), duration_s / SCORE_WINDOW_S)
-    x, width = designs[pick], BRANCH_WIDTHS_DEGC[pick]
-    resid = _residual(x, y)
+    pick = plausible_middle(np.array([rss for _, rss in fits]), duration_s / SCORE_WINDOW_S)
+    x, width, resid = designs[pick], BRANCH_WIDTHS_DEGC[pick], fits[pick][0]
     noise = fit_drift_noise(np.split(resid, np.cumsum([v.size for v in y])[:-1]), t)
     walk = math.sqrt(noise.walk_var_per_s)
     first = x[0].shape[1] - MAX_BRANCH_ORDER  # the branch columns come last: s, then s u
@@ -219,13 +219,6 @@ def _branch_design(runs, temps, groups, threshold_degc, t_ref_degc, t_scale_degc
         cols.append(s[:, None] * u[:, None] ** np.arange(MAX_BRANCH_ORDER))
         out.append(np.hstack(cols))
     return out
-
-
-def _residual(x: list[np.ndarray], y: list[np.ndarray]) -> np.ndarray:
-    """The residual of the ordinary least-squares fit of the stacked ``y`` on the stacked ``x``."""
-    xs, ys = np.vstack(x), np.concatenate(y)
-    coef, *_ = np.linalg.lstsq(xs, ys, rcond=None)
-    return ys - xs @ coef
 
 
 __all__ = ["BRANCH_OVERLAP", "BRANCH_TEST_SIGMAS", "band_offer", "branch_test", "branches_identified", "branches_present", "heats_and_cools_blocks", "observed_band"]
