@@ -398,9 +398,8 @@ def branch_position(temperature_degc: np.ndarray, turns: Turns, transition_degc:
     t = np.asarray(temperature_degc, dtype=float)
     d = turns.direction.astype(float)
     after = ~np.isnan(turns.turn_degc)
-    state = turns.state
-    start = np.where(d > 0, state.low_degc, state.high_degc) if np.any(~after & (d != 0)) else t
-    first = np.where(after | (d == 0), 0.0, np.abs(t - np.where(after | (d == 0), t, start)))
+    start = np.where(d > 0, turns.state.low_degc, turns.state.high_degc)  # where the first branch started
+    first = np.where(~after & (d != 0), np.abs(t - start), 0.0)
     distance = np.abs(t - np.where(after, turns.turn_degc, t))
     return np.where(after, d * (1.0 - 2.0 * np.exp(-distance / transition_degc)),
                     d * (1.0 - np.exp(-first / transition_degc)))
