@@ -36,8 +36,8 @@ from .selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
 from .polynomial_fit import PolynomialTemperatureModel
 from .curve_kinds import BASES
 from .temperature import MAX_ORDER
-from .triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
-                        spans_axes)
+from .triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
+                        fit_accel_multiposition, fit_gyro_rate_table, spans_axes)
 from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
 from .thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 
@@ -413,10 +413,10 @@ def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, order
     if network is not None:
         name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, network.hidden)) + "-1"
     else:
-        labels = sorted({ax.temperature.label if ax.temperature is not None else "poly:0" for ax in axes.values()},
-                        key=lambda label: (not label.startswith("poly:"), len(label), label))
-        polys = [label for label in labels if label.startswith("poly:")]
-        name = "/".join((["poly:" + "/".join(p[5:] for p in polys)] if polys else []) + labels[len(polys):])
+        labels = {ax.temperature.label if ax.temperature is not None else "poly:0" for ax in axes.values()}
+        orders = sorted(int(label[5:]) for label in labels if label.startswith("poly:"))
+        others = sorted(label for label in labels if not label.startswith("poly:"))
+        name = "/".join((["poly:" + "/".join(map(str, orders))] if orders else []) + others)
         if order == "auto":
             name += " (auto)"
     if thermal is not None:
