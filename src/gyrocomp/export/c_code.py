@@ -12,8 +12,9 @@ does not cover pass through unchanged. When the model compensates the accelerome
 step leaves the compensated accelerations [g] in ``s->accel_out`` (else the input), and the g-sensitivity
 reads them, as ``gyrocomp apply`` does. The code does what :class:`gyrocomp.Compensator` does, sample by
 sample and in the same order of operations: g-sensitivity, the temperature curve (its own C:
-:meth:`gyrocomp.models.curves.TemperatureCurve.c_code`) on the lagged temperature (the first-order-hold lag steps one nominal period per sample and bridges longer
-gaps exactly), the turning-point hysteresis, and the mean turn-on constant of the calibration runs; then
+:meth:`gyrocomp.models.curves.TemperatureCurve.c_code`) on the lagged temperature (the first-order-hold lag
+steps one nominal period per sample and bridges longer gaps exactly), the turning-point hysteresis, and the
+mean turn-on constant of the calibration runs; then
 the gyro's scale factor and misalignment (out = K(T)^-1 out, K(T) at the input temperature). An
 accelerometer triad corrects ``s->accel_out`` after its temperature models (the g-sensitivity reads the
 accelerations before it, as it was fitted).
