@@ -53,7 +53,7 @@ PROGRAMS = {
     "gyrocomp allan": ("import sys\nfrom gyrocomp.cli import main\n"
                        "sys.exit(main(['--quiet', 'allan', sys.argv[1]]))\n"),
     "allan whole file": ("import sys, warnings\nwarnings.simplefilter('ignore')\n"
-                         "from gyrocomp.io.tables import read_table\nfrom gyrocomp.noise import analyse_noise\n"
+                         "from gyrocomp.io.tables import read_table\nfrom gyrocomp.measures.noise import analyse_noise\n"
                          "analyse_noise(read_table(sys.argv[1], channels=('gyro_x', 'gyro_y', 'gyro_z')).recording)\n"),
     "gyrocomp evaluate": ("import sys\nfrom gyrocomp.cli import main\n"
                           "sys.exit(main(['--quiet', 'evaluate', sys.argv[3], sys.argv[1]]))\n"),

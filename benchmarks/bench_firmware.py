@@ -29,7 +29,7 @@ import numpy as np
 from gyrocomp import __version__, apply
 from gyrocomp.export.autopilot import ardupilot_parameters, px4_parameters
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_calibration
 from gyrocomp.simulate import get_preset, get_profile, simulate
 

@@ -8,7 +8,7 @@ a heat-cool cycle, a ramp-and-hold and a warm-up, one power-on each. Timed in th
   hysteresis 1..3, time or temperature-balanced weights, with the g-sensitivity columns when the unit turns)
   scored by held-out drift on leave-one-run-out folds, the choice refitted on all runs;
 - baseline: a plain cubic with one constant per run by ordinary least squares on every sample
-  (``gyrocomp.validation.fit_plain_cubic``), what a user writes by hand in numpy;
+  (``gyrocomp.evaluation.validation.fit_plain_cubic``), what a user writes by hand in numpy;
 - ``validate``: the whole comparison table (raw, PX4's and ArduPilot's cubics, the plain cubic, the default),
   each method refitted on every fold.
 
@@ -31,7 +31,7 @@ import numpy as np
 from busy import busy_neighbour
 from gyrocomp import fit_calibration
 from gyrocomp.simulate import get_profile, simulate
-from gyrocomp.validation import fit_plain_cubic, validate
+from gyrocomp.evaluation.validation import fit_plain_cubic, validate
 
 
 def timed(func):

@@ -24,10 +24,10 @@ import warnings
 
 import numpy as np
 
-from gyrocomp.compensate import apply
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.calibration.compensate import apply
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.field import field_recordings
-from gyrocomp.models.online import OnlineCalibrator, replay
+from gyrocomp.fitting.online import OnlineCalibrator, replay
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import get_profile, resolve_profile, simulate
 

@@ -31,10 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from gyrocomp.compensate import apply
+from gyrocomp.calibration.compensate import apply
 from gyrocomp.fleet import CalibrationStore, UnitRuns, fit_fleet, fit_with_prior, population_prior, prior_from_models
 from gyrocomp.io.tables import write_recording
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import preset_model, resolve_profile, simulate
 

@@ -13,7 +13,7 @@ cooling curves that differ, 0.03 deg/s apart at 25 degC and 0.0008 deg/s/degC mo
 - ``three runs``: three heat-cool runs, judged on a fourth.
 
 Each is compensated by the default fit (``fit_channels``), by a plain cubic with one constant per run
-(``gyrocomp.validation.fit_plain_cubic``) and perfectly (the simulator's truth: what is left is the sensor's own
+(``gyrocomp.evaluation.validation.fit_plain_cubic``) and perfectly (the simulator's truth: what is left is the sensor's own
 noise). The score is the drift a user judges: the RMS about its mean of the 60 s moving average of the output
 minus the true rate, per axis [deg/s]. The table gives the mean over axes and seeds of default/perfect and
 cubic/perfect, and the count of axes the default leaves worse than raw (more than 1 % above raw's drift).
@@ -39,10 +39,10 @@ from pathlib import Path
 import numpy as np
 
 from gyrocomp import __version__, apply
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import PRESETS, GyroErrorModel, Hysteresis, get_preset, get_profile, preset_model, simulate
-from gyrocomp.validation import fit_plain_cubic
+from gyrocomp.evaluation.validation import fit_plain_cubic
 
 WINDOW_S = 60.0
 RATE_HZ = 2.0

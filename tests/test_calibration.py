@@ -6,12 +6,12 @@ import pytest
 
 from gyrocomp import Calibration, Polynomial, apply, fit_calibration
 from gyrocomp.calibration import SCHEMA_VERSION, AxisCalibration
-from gyrocomp.compensate import predict_error
+from gyrocomp.calibration.compensate import predict_error
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.models.online import OnlineCalibrator
+from gyrocomp.fitting.online import OnlineCalibrator
 from gyrocomp.io import write_recording
 from gyrocomp.io.tables import read_table
-from gyrocomp.models.temperature import PolynomialBias
+from gyrocomp.curves.polynomial import PolynomialBias
 from gyrocomp.simulate import simulate
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gyrocomp import FitOptions, Network, Polynomial, apply
-from gyrocomp.comparison import (
+from gyrocomp.evaluation.comparison import (
     ARDUPILOT_TEMP_REF_DEGC,
     DEFAULT_METHODS,
     compare_methods,

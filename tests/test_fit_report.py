@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from gyrocomp.calibration import Calibration
-from gyrocomp.fit_report import MEMORIES, AxisFit, FitReport, MemoryChoice
+from gyrocomp.calibration.fit_report import MEMORIES, AxisFit, FitReport, MemoryChoice
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.models.pipelines import fit_calibration, fit_pipeline
-from gyrocomp.models.selection import Candidate
+from gyrocomp.fitting.selection import Candidate
 from gyrocomp.simulate import simulate
 
 _CACHE = {}

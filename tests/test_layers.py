@@ -9,29 +9,30 @@ import pytest
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 
-#: bottom to top; a module belongs to the first layer one of whose prefixes it matches
+#: bottom to top; a module belongs to the first layer one of whose prefixes it matches. Every layer above the
+#: foundation is one or more folders of its own; the package root holds only the foundation's modules.
 LAYERS = (
-    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "ctext")),
-    ("signals", ("recording", "effects", "allan", "noise", "static", "stillness", "metrics", "plausibility",
-                 "simulate", "spill", "prepared", "runsplit")),
+    # pure functions and helpers any layer may use: errors, physical units, the effects' equations, spilling
+    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "ctext", "effects",
+                    "spill")),
+    # what a recording is and what is measured of it: the recording and its preparation, motion (stillness,
+    # static positions), measures (figures of merit, noise terms, plausibility), Allan statistics, simulation
+    ("signals", ("recording", "motion", "measures", "allan", "simulate")),
     ("io", ("io",)),
-    # files read in chunks and analysed as they come
-    ("files", ("noise_file",)),
-    # the frozen curves a calibration holds (PolynomialBias, MLPBias, HysteresisCurve); their estimators are
-    # in the fitting layer (models.polynomial_fit, models.mlp_fit)
-    ("curves", ("models.base", "models.curves", "models.hysteresis", "models.temperature", "models.mlp",
-                "models.lookup", "models.curve_kinds")),
-    ("calibration", ("calibration", "fit_report", "triad", "installed")),
-    ("compensate", ("compensate",)),
-    ("fitting", ("models.gsensitivity", "models.thermal", "models.folds", "models.branch_evidence", "models.drift_gls",
-                 "models.selection", "models.acceleration", "models.online",
-                 "models.polynomial_fit", "models.mlp_fit",
-                 "models.triad_fit", "models.pose_rotation")),
-    ("pipelines", ("models.pipelines", "models")),
-    ("evaluation", ("evaluation", "comparison", "validation")),
+    # the frozen curves a calibration holds (polynomial, network, lookup table, hysteresis) and their registry
+    ("curves", ("curves",)),
+    # the frozen, versioned calibration, its triads and fit report, and its application (compensate)
+    ("calibration", ("calibration",)),
+    # the estimators: each effect's fit, the held-out folds and the model choice, the online learner
+    ("fitting", ("fitting",)),
+    # the pipelines that combine the estimators into a calibration, and the one fit entry point
+    ("pipelines", ("models",)),
+    ("evaluation", ("evaluation",)),
+    # files read in chunks: apply, convert, evaluate and the noise analysis of files of any length
+    ("files", ("files",)),
     # fleets fit, measure and judge many units: above evaluation, below the reports that draw them
     ("fleet", ("fleet",)),
-    ("output", ("report", "export", "demo")),
+    ("output", ("report", "export")),
     ("cli", ("cli", "__main__")),
     ("package", ("",)),
 )
@@ -127,8 +128,8 @@ def test_the_import_graph_has_no_cycle():
 
 def test_the_parser_sees_relative_absolute_and_inner_imports(tmp_path):
     # the checks above are not vacuous: known edges of the graph are found
-    assert {"calibration", "effects", "recording"} <= GRAPH["compensate"][0]
+    assert {"calibration", "effects", "recording"} <= GRAPH["calibration.compensate"][0]
     assert "models.pipelines" in GRAPH["cli.fit"][0] and "io.atomic" in GRAPH["calibration"][0]
-    assert _layer("metrics") < _layer("models.pipelines") and _layer("models.selection") == _layer("models.thermal")
+    assert _layer("measures.merit") < _layer("models.pipelines") and _layer("fitting.selection") == _layer("fitting.thermal")
     with pytest.raises(AssertionError, match="newthing: in no layer"):
         _layer("newthing")

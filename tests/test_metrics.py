@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyrocomp.errors import InputError
-from gyrocomp.metrics import (
+from gyrocomp.measures.merit import (
     BIAS_INSTABILITY_FACTOR,
     AxisMetrics,
     bias_instability,

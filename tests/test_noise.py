@@ -8,7 +8,7 @@ import pytest
 
 from gyrocomp.allan import allan_deviation, allan_deviation_segments
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.noise import analyse_noise
+from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.recording import Recording
 
 

@@ -9,13 +9,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import Polynomial, apply, comparison, fit_calibration, validation, write
-from gyrocomp.compensate import Compensator
+from gyrocomp import Polynomial, apply, fit_calibration, write
+from gyrocomp.evaluation import comparison, validation
+from gyrocomp.calibration.compensate import Compensator
 from gyrocomp.errors import (DataQualityWarning, InputError, ModelChoiceWarning, PlausibilityWarning,
                              TemperatureRangeWarning)
 from gyrocomp.io import read
-from gyrocomp.noise import analyse_noise
-from gyrocomp.plausibility import (
+from gyrocomp.measures.noise import analyse_noise
+from gyrocomp.measures.plausibility import (
     CHECKS,
     accel_unit_concern,
     agreement_concern,

@@ -19,10 +19,10 @@ from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io.tables import write_recording
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.report.html import _pose_residuals, build_report
-from gyrocomp.models.pose_rotation import (fit_gyro_between_poses, ordered_product, quaternion_from_rotvec,
+from gyrocomp.fitting.pose_rotation import (fit_gyro_between_poses, ordered_product, quaternion_from_rotvec,
                                            rotation_errors, rotation_matrix)
 from gyrocomp.simulate import AccelErrorModel, get_profile, preset_model, simulate
-from gyrocomp.triad import TriadCalibration
+from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
 
 from .conftest import run, xsens_session

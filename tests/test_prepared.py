@@ -7,13 +7,13 @@ import warnings
 import numpy as np
 import pytest
 
-import gyrocomp.prepared as prepared_module
+import gyrocomp.recording.prepared as prepared_module
 from gyrocomp.errors import InputError
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.prepared import PreparedRun, block_means, fit_axes, prepare
+from gyrocomp.recording.prepared import PreparedRun, block_means, fit_axes, prepare
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
-from gyrocomp.static import static_segments, still_mask
+from gyrocomp.motion.positions import static_segments, still_mask
 
 
 @pytest.fixture(scope="module")

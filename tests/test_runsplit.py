@@ -1,4 +1,4 @@
-"""Cutting a recording into runs (gyrocomp.runsplit, gyrocomp split), selecting by time (--time) and reading a
+"""Cutting a recording into runs (gyrocomp.recording.runsplit, gyrocomp split), selecting by time (--time) and reading a
 column of an HDF5 array (NAME[:, k]): on simulated recordings whose pieces are known."""
 
 import numpy as np
@@ -9,7 +9,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout
 from gyrocomp.io.tables import write_recording
 from gyrocomp.recording import Recording
-from gyrocomp.runsplit import split_runs
+from gyrocomp.recording.runsplit import split_runs
 from gyrocomp.simulate import get_profile, simulate
 
 from .conftest import run

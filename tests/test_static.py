@@ -7,7 +7,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 from gyrocomp.simulate.profiles import TUMBLE_LEVELS_G
-from gyrocomp.static import orientations, segment_mask, static_segments, still_mask
+from gyrocomp.motion.positions import orientations, segment_mask, static_segments, still_mask
 
 
 @pytest.mark.parametrize("preset, rate_hz", [("mti10", 10.0), ("consumer", 10.0), ("mti10", 1.0)])

@@ -454,8 +454,15 @@ def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
     return (c[w:] - c[:-w]) / w + x[0]
 
 
+def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s: float) -> float:
+    """Mean of ``residual_dps`` over the first ``window_s`` seconds of a run [deg/s]: the turn-on constant a run
+    starts with."""
+    head = time_s - time_s[0] < window_s
+    return float(residual_dps[head].mean())
+
+
 __all__ = [
-    "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "branch_position", "find_turns",
+    "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "branch_position", "estimate_turn_on_bias", "find_turns",
     "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter",
     "moving_average", "quantize", "thermal_lag",
 ]

@@ -36,7 +36,7 @@ class DataQualityWarning(UserWarning):
 
 class PlausibilityWarning(DataQualityWarning):
     """The data is probably not what it claims: a unit mistake (kelvin, ms), values beyond any MEMS sensor, a
-    calibration run that turns or whose temperature barely varies (:mod:`gyrocomp.plausibility`). ``check``
+    calibration run that turns or whose temperature barely varies (:mod:`gyrocomp.measures.plausibility`). ``check``
     names the check that found it."""
 
     def __init__(self, message: str = "", check: str | None = None):
@@ -44,7 +44,7 @@ class PlausibilityWarning(DataQualityWarning):
         self.check = check
 
 
-#: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.plausibility`)
+#: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.measures.plausibility`)
 CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span", "agreement",
                     "accel-unit", "temperature-range"]
 #: every check's name

@@ -76,7 +76,7 @@ def test_demo(tmp_path):
 
 
 def test_demo_without_matplotlib_says_why_there_is_no_report(tmp_path, monkeypatch):
-    from gyrocomp import demo
+    from gyrocomp.report import demo
 
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # import matplotlib now fails, as when not installed
     why = demo._write_report(None, None, tmp_path / "report.html")

@@ -12,10 +12,10 @@ import pytest
 from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources, write_c_sources
-from gyrocomp.models.lookup import LookupTableBias
+from gyrocomp.curves.lookup import LookupTableBias
 from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
-from gyrocomp.triad import TriadCalibration
+from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
 from ..conftest import run
 

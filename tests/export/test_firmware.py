@@ -83,7 +83,7 @@ def test_export_prints_what_the_firmware_leaves_against_the_model(tmp_path):
 def test_a_parameter_left_out_has_the_firmwares_default():
     """PX4 without TMIN/TMAX/TREF clamps at 0 and 100 degC about 25 degC; ArduPilot at 0 and 70 degC; a slot the
     parameters hold nothing of is refused by name."""
-    from gyrocomp.installed import installed_calibration
+    from gyrocomp.calibration.installed import installed_calibration
 
     bare = {k: v for k, v in PX4.items() if not k.endswith(("TMIN", "TMAX", "TREF"))}
     full = {**bare, "TC_G0_TMIN": 0.0, "TC_G0_TMAX": 100.0, "TC_G0_TREF": 25.0}
@@ -103,7 +103,7 @@ def test_a_parameter_left_out_has_the_firmwares_default():
 
 
 def test_ardupilot_as_installed_takes_its_calibration_temperature_from_the_parameters():
-    from gyrocomp.installed import ardupilot_cal_temp_degc, installed_correction_dps
+    from gyrocomp.calibration.installed import ardupilot_cal_temp_degc, installed_correction_dps
 
     params = {**ARDU, "INS_GYR_CALTEMP": 22.0, "INS_GYR2_CALTEMP": 31.0}
     assert ardupilot_cal_temp_degc(params, 1) == 22.0 and ardupilot_cal_temp_degc(params, 2) == 31.0

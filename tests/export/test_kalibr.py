@@ -7,7 +7,7 @@ import pytest
 
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.kalibr import kalibr_imu, kalibr_imu_yaml
-from gyrocomp.noise import analyse_noise
+from gyrocomp.measures.noise import analyse_noise
 
 from ..test_noise import static_recording
 

@@ -72,7 +72,7 @@ def test_a_run_corrected_as_the_firmware_would_keeps_what_apply_leaves(runs_and_
     leaves what apply leaves but a constant (its boot-time offset), so the same bias offset; PX4 as it runs adds
     its 1 degC steps to a --target px4 model, never less than apply leaves."""
     from gyrocomp.export.firmware import firmware_corrected
-    from gyrocomp.metrics import evaluate_run
+    from gyrocomp.measures.merit import evaluate_run
 
     fit, held = runs_and_held_out
     with warnings.catch_warnings():

@@ -13,13 +13,13 @@ import pandas as pd
 import pytest
 
 from gyrocomp.calibration import Calibration
-from gyrocomp.compensate import apply
+from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.fleet import (CalibrationStore, block_covariance, comes_back, fit_with_prior, population_prior,
                             prior_from_models)
 from gyrocomp.io import read
 from gyrocomp.io.tables import write_recording
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import preset_model, resolve_profile, simulate
 

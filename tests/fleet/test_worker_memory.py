@@ -10,7 +10,7 @@ import pytest
 
 from gyrocomp.fleet.run import fit_fleet
 from gyrocomp.fleet.store import CalibrationStore
-from gyrocomp.fleet.units import UnitRuns
+from gyrocomp.fleet.devices import UnitRuns
 from gyrocomp.io.tables import write_recording
 from gyrocomp.simulate import simulate
 

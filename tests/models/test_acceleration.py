@@ -11,8 +11,8 @@ import pytest
 from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.evaluation import evaluate_stages
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.acceleration import excited_columns
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.fitting.acceleration import excited_columns
 from gyrocomp.effects import G_SQUARED_TERMS, g_squared_products
 from gyrocomp.simulate import get_profile, preset_model, simulate, tumble_positions
 

@@ -11,10 +11,10 @@ import pytest
 
 from gyrocomp import apply
 from gyrocomp.calibration import Calibration
-from gyrocomp.compensate import Compensator
+from gyrocomp.calibration.compensate import Compensator
 from gyrocomp.errors import InputError
-from gyrocomp.fit_report import FitReport
-from gyrocomp.metrics import evaluate_run, moving_average
+from gyrocomp.calibration.fit_report import FitReport
+from gyrocomp.measures.merit import evaluate_run, moving_average
 from gyrocomp.cli.common import parse_channels
 from gyrocomp.models.pipelines import fit_accelerometer, fit_channels
 from gyrocomp.simulate import get_profile, simulate

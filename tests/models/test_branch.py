@@ -12,11 +12,11 @@ from hypothesis import strategies as st
 from gyrocomp import Calibration, apply
 from gyrocomp.effects import branch_position, find_turns
 from gyrocomp.errors import InputError
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.hysteresis import BranchCurve, memory_curve_from_dict
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.curves.hysteresis import BranchCurve, memory_curve_from_dict
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
-from gyrocomp.validation import fit_plain_cubic
+from gyrocomp.evaluation.validation import fit_plain_cubic
 
 from ..conftest import assert_streaming_equals_batch
 

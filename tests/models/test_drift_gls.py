@@ -1,11 +1,11 @@
-"""Least squares under slow drift (gyrocomp.models.drift_gls) and the flat-profile rule of the branch width."""
+"""Least squares under slow drift (gyrocomp.fitting.drift_gls) and the flat-profile rule of the branch width."""
 
 import numpy as np
 import pytest
 
-from gyrocomp.models.drift_gls import (DriftNoise, chi2_threshold, coarsen, fit_drift_noise, wald_statistic,
+from gyrocomp.fitting.drift_gls import (DriftNoise, chi2_threshold, coarsen, fit_drift_noise, wald_statistic,
                                        whitened)
-from gyrocomp.models.thermal import plausible_middle
+from gyrocomp.fitting.thermal import plausible_middle
 
 K = 2e-3       # random walk [unit/sqrt(s)]
 SIGMA = 0.01   # white noise per point [unit]

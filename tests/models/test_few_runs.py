@@ -9,12 +9,12 @@ import pytest
 
 from gyrocomp import Calibration, apply
 from gyrocomp.errors import ModelChoiceWarning
-from gyrocomp.fit_report import SelectionReport
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.calibration.fit_report import SelectionReport
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_calibration, fit_channels
-from gyrocomp.models.selection import Candidate, CandidateScore, beats_constant, choose
+from gyrocomp.fitting.selection import Candidate, CandidateScore, beats_constant, choose
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
-from gyrocomp.validation import fit_plain_cubic
+from gyrocomp.evaluation.validation import fit_plain_cubic
 
 RATE_HZ = 20.0
 

@@ -9,10 +9,10 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp.compensate import apply
+from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError
 from gyrocomp.io.tables import write_recording
-from gyrocomp.metrics import smoothed_residual_rms
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.field import field_recordings
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import get_profile, resolve_profile, simulate
@@ -97,7 +97,7 @@ def test_fit_on_field_logs_through_the_command_line(tmp_path):
 
 def test_the_report_draws_the_still_segments_of_a_field_log():
     from gyrocomp.report.html import build_report
-    from gyrocomp.stillness import detect_still
+    from gyrocomp.motion.stillness import detect_still
 
     logs = _field_logs(2, duration_s=1800.0)
     with warnings.catch_warnings():

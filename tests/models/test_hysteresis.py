@@ -7,7 +7,7 @@ import pytest
 
 from gyrocomp.effects import find_turns
 from gyrocomp.errors import InputError
-from gyrocomp.models.hysteresis import HysteresisCurve, heats_and_cools, turn_threshold_degc
+from gyrocomp.curves.hysteresis import HysteresisCurve, heats_and_cools, turn_threshold_degc
 from gyrocomp.recording import Recording
 
 

@@ -1,4 +1,4 @@
-"""The lookup-table temperature model (gyrocomp.models.lookup): the curve, its basis, the registries that make it a
+"""The lookup-table temperature model (gyrocomp.curves.lookup): the curve, its basis, the registries that make it a
 model type like the others (a candidate the default can choose, stored, applied, described), on data whose
 temperature curve is piecewise linear."""
 
@@ -9,10 +9,10 @@ import pytest
 
 from gyrocomp import Calibration, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.curve_kinds import BASES, CURVES, curve_from_dict
-from gyrocomp.models.curves import TemperatureCurve, register_curve
-from gyrocomp.models.lookup import LookupTableBasis, LookupTableBias
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.curves.kinds import BASES, CURVES, curve_from_dict
+from gyrocomp.curves.protocol import TemperatureCurve, register_curve
+from gyrocomp.curves.lookup import LookupTableBasis, LookupTableBias
 from gyrocomp.recording import Recording
 
 GRID = [-20.0, 15.0, 40.0, 60.0]

@@ -8,9 +8,9 @@ import pytest
 
 from gyrocomp import Calibration, Network, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelError, NotFittedError
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.mlp import MLPBias, forward, layer_shapes
-from gyrocomp.models.mlp_fit import MLPTemperatureModel, jacobian, nguyen_widrow, train_lm, validation_mask
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.curves.network import MLPBias, forward, layer_shapes
+from gyrocomp.fitting.network import MLPTemperatureModel, jacobian, nguyen_widrow, train_lm, validation_mask
 from gyrocomp.cli.common import parse_hidden, parse_temperature_option
 from gyrocomp.simulate import GyroErrorModel, get_profile, preset_model, simulate
 

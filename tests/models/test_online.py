@@ -17,16 +17,16 @@ from hypothesis import given, settings as hsettings, strategies as st
 from scipy.stats import chi2, norm
 
 from gyrocomp.calibration import Calibration
-from gyrocomp.compensate import apply
+from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError, NotFittedError
 from gyrocomp.export.c_learner import TEMPLATES, learner_c_sources, template_values
 from gyrocomp.io.tables import write_recording
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.online import LearnerSettings, OnlineCalibrator, block_statistics, chi2_quantile, replay
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.fitting.online import LearnerSettings, OnlineCalibrator, block_statistics, chi2_quantile, replay
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.simulate import get_profile, resolve_profile, simulate
 from gyrocomp.simulate.presets import preset_model
-from gyrocomp.stillness import detect_still
+from gyrocomp.motion.stillness import detect_still
 
 from ..conftest import run
 

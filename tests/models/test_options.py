@@ -10,11 +10,11 @@ from typing import get_args
 import pytest
 
 from gyrocomp.errors import InputError
-from gyrocomp.models.gsensitivity import ACCELERATION_CHOICES
+from gyrocomp.fitting.gsensitivity import ACCELERATION_CHOICES
 from gyrocomp.models.options import Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial
 from gyrocomp.models.pipelines import fit_calibration, fit_channels, fit_pipeline
-from gyrocomp.models.folds import FOLD_KINDS
-from gyrocomp.models.thermal import HYSTERESIS_CHOICES
+from gyrocomp.fitting.folds import FOLD_KINDS
+from gyrocomp.fitting.thermal import HYSTERESIS_CHOICES
 from gyrocomp.simulate import simulate
 
 

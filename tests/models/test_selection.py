@@ -1,4 +1,4 @@
-"""Model choice by held-out drift (gyrocomp.models.selection): the rule, the folds, the quantization detector,
+"""Model choice by held-out drift (gyrocomp.fitting.selection): the rule, the folds, the quantization detector,
 the tangent extension past the fitted range, and simulate-then-recover on single chamber cycles."""
 
 import dataclasses
@@ -10,14 +10,14 @@ import pytest
 
 from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelChoiceWarning
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.folds import leg_labels
-from gyrocomp.models.selection import Candidate, CandidateScore, choose, temperature_step_degc
-from gyrocomp.models.temperature import PolynomialBias
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.fitting.folds import leg_labels
+from gyrocomp.fitting.selection import Candidate, CandidateScore, choose, temperature_step_degc
+from gyrocomp.curves.polynomial import PolynomialBias
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import get_profile, preset_model, simulate
 from gyrocomp.simulate.profiles import Profile
-from gyrocomp.validation import fit_plain_cubic, make_sample_folds
+from gyrocomp.evaluation.validation import fit_plain_cubic, make_sample_folds
 
 
 def _score(c, folds):

@@ -8,10 +8,10 @@ import pytest
 from gyrocomp import Network, Polynomial, apply, fit_calibration
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureRangeWarning
-from gyrocomp.metrics import default_window_s, smoothed_residual_rms
-from gyrocomp.models.base import bin_by_temperature
+from gyrocomp.measures.merit import default_window_s, smoothed_residual_rms
+from gyrocomp.fitting.base import bin_by_temperature
 from gyrocomp.cli.common import parse_temperature_option
-from gyrocomp.models.polynomial_fit import PolynomialTemperatureModel, simplest_within
+from gyrocomp.fitting.polynomial import PolynomialTemperatureModel, simplest_within
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import GyroErrorModel, simulate
 

@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 
 from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, NotFittedError
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.thermal import ThermalHysteresisModel
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.fitting.thermal import ThermalHysteresisModel
 from gyrocomp.simulate import Hysteresis, get_profile, preset_model, simulate
 
 from ..conftest import assert_streaming_equals_batch

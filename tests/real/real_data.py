@@ -62,7 +62,7 @@ def cats_held_out_drift(choices: dict | None = None) -> dict[str, np.ndarray]:
     import warnings
 
     from gyrocomp import apply, fit_calibration
-    from gyrocomp.metrics import smoothed_residual_rms
+    from gyrocomp.measures.merit import smoothed_residual_rms
 
     runs = cats_runs()
     out = {}
@@ -82,7 +82,7 @@ def cats_numpy_cubic_drift() -> np.ndarray:
     """(3 held-out runs, 3 axes) drift of the field's baseline, written here with numpy alone: a cubic in the
     reported temperature centred at 15 degC with one constant per run, least squares on every sample of the
     two other runs, extrapolated as the cubic."""
-    from gyrocomp.metrics import smoothed_residual_rms
+    from gyrocomp.measures.merit import smoothed_residual_rms
 
     runs = cats_runs()
     out = np.zeros((3, 3))
@@ -106,7 +106,7 @@ POSE_MIN_S = {"Xsens (imu_tk)": 3.0, "imucal Ferraris session": 3.0, "MPU-6050 (
 
 def _unit_sphere(accel: np.ndarray, rec_for_segments) -> np.ndarray:
     """Accelerometer counts to [g] by the ellipsoid through the static means: sum_j p_j (a_j - c_j)^2 = 1."""
-    from gyrocomp.static import static_segments
+    from gyrocomp.motion.positions import static_segments
 
     means = np.array([s.gravity_g for s in static_segments(rec_for_segments, min_duration_s=3.0)])
     mid, spread = means.mean(axis=0), np.abs(means - means.mean(axis=0)).max()
@@ -204,7 +204,7 @@ def main() -> None:
 
 def main_temperature() -> None:
     raw = np.array([[0.0] * 3] * 3)
-    from gyrocomp.metrics import smoothed_residual_rms
+    from gyrocomp.measures.merit import smoothed_residual_rms
 
     for k, run in enumerate(cats_runs()):
         raw[k] = [smoothed_residual_rms(run.gyro_dps[:, j], CATS_WINDOW_S) for j in range(3)]

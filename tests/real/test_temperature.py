@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from gyrocomp import apply
-from gyrocomp.metrics import smoothed_residual_rms
-from gyrocomp.models.online import OnlineCalibrator, replay
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.fitting.online import OnlineCalibrator, replay
 
 from ..conftest import shared_dataset
 from .real_data import CATS_CHOICES, CATS_WINDOW_S, cats_held_out_drift, cats_numpy_cubic_drift, cats_runs

@@ -5,7 +5,7 @@ import sys
 import pytest
 
 from gyrocomp.errors import MissingDependencyError
-from gyrocomp.noise import analyse_noise
+from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.report.figures import allan_figure
 
 from ..test_noise import static_recording

@@ -3,19 +3,16 @@
 from __future__ import annotations
 
 import json
-import warnings
 from pathlib import Path
 
 import click
 
 from ..allan import KINDS
-from ..errors import DataQualityWarning
-from ..noise_file import analyse_noise_file
-from ..io import detect_format, refuse_to_overwrite_inputs, write_text_atomic
+from ..files import analyse_noise_file
+from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
-from ..noise import analyse_noise
 from ..report.figures import allan_figure, check_figure_path
-from .common import pop_read_options, progress_bar, read_options, read_run, read_settings, streams
+from .common import pop_read_options, progress_bar, read_options, read_settings
 from .render import print_noise
 
 
@@ -70,21 +67,10 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
     if plot_path:
         check_figure_path(plot_path)
     named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
-    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
-    if streams(in_fmt, opts):  # in chunks: memory bounded whatever the file's length
-        with progress_bar(f"reading {Path(input_path).name}") as progress:
-            analysis = analyse_noise_file(input_path, named, layout=read_settings(opts).layout, fmt=in_fmt,
-                                          drop_nonfinite=opts["drop_nan"], with_accel=bool(kalibr_path), kind=kind,
-                                          taus=tau_spec, split_gaps=split_gaps, fit_taus_s=fit_range,
-                                          progress=progress)
-    else:
-        with warnings.catch_warnings():
-            # gaps are refused below, or split with a note, in one line of their own
-            warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
-            recording = read_run(input_path, opts).recording
-        with progress_bar("Allan deviation", indeterminate=True):
-            analysis = analyse_noise(recording, named, kind=kind, taus=tau_spec, split_gaps=split_gaps,
-                                     fit_taus_s=fit_range, with_accel=bool(kalibr_path))
+    with progress_bar(f"reading {Path(input_path).name}") as progress:
+        analysis = analyse_noise_file(input_path, named, options=read_settings(opts), fmt=opts["fmt"],
+                                      with_accel=bool(kalibr_path), kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                                      fit_taus_s=fit_range, progress=progress)
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
     if kalibr_path:

@@ -13,12 +13,12 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 
 from ..errors import InputError
-from ..io import FORMATS, TABLE_FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
-from ..models.mlp import DEFAULT_HIDDEN
+from ..io import FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
+from ..curves.network import DEFAULT_HIDDEN
 from ..models.options import Network, Polynomial
 from ..models.pipelines import check_channels
-from ..prepared import CHANNELS
-from ..models.temperature import MAX_ORDER
+from ..recording.prepared import CHANNELS
+from ..curves.polynomial import MAX_ORDER
 
 
 def make_console() -> Console:
@@ -79,11 +79,6 @@ def parse_time_range(text: str | None) -> tuple[float | None, float | None] | No
     if any(b is not None and not math.isfinite(b) for b in bounds) or bounds == (None, None):
         raise click.BadParameter(f"{text!r}: give finite seconds on at least one side", param_hint="--time")
     return bounds
-
-
-def streams(in_fmt: str | None, opts: dict) -> bool:
-    """Whether a command reads this input in chunks: tables, unless rows are selected by time (then whole)."""
-    return in_fmt in TABLE_FORMATS and opts["time_range"] is None
 
 
 @contextlib.contextmanager

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import click
 
-from ..io import detect_format, output_format, refuse_to_overwrite_inputs, write_recording
-from ..io.stream import convert_table
-from .common import pop_read_options, progress_bar, read_run, read_options, read_settings, streams
+from ..files import convert_file
+from ..io import output_format, refuse_to_overwrite_inputs
+from .common import pop_read_options, progress_bar, read_options, read_settings
 
 
 @click.command()
@@ -24,19 +24,11 @@ def convert(ctx, input_path, output, **kwargs):
     opts = pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path], option="OUT")
     out_fmt = output_format(output, option="OUT")
-    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
-    if streams(in_fmt, opts):  # in chunks: memory bounded whatever the file's length
-        with progress_bar(f"reading {Path(input_path).name}") as progress:
-            result = convert_table(input_path, output, read_settings(opts).layout, fmt=in_fmt, out_fmt=out_fmt,
-                                   drop_nonfinite=opts["drop_nan"], progress=progress)
-        rows, duration_s, rate_hz, gaps, channels = (result.rows, result.duration_s, result.rate_hz, result.gaps,
-                                                     result.channels)
-    else:
-        recording = read_run(input_path, opts).recording
-        write_recording(recording, output, fmt=out_fmt)
-        rows, duration_s, rate_hz, gaps = (recording.n_samples, recording.duration_s, recording.rate_hz,
-                                           len(recording.gaps))
-        channels = [*recording.gyro_axes, *recording.accel_axes, *recording.temperature_columns]
+    with progress_bar(f"reading {Path(input_path).name}") as progress:
+        result = convert_file(input_path, output, options=read_settings(opts), fmt=opts["fmt"], out_fmt=out_fmt,
+                              progress=progress)
+    rows, duration_s, rate_hz, gaps, channels = (result.rows, result.duration_s, result.rate_hz, result.gaps,
+                                                 result.channels)
     if not ctx.obj["quiet"]:
         said = f", {gaps} time gap(s)" if gaps else ""
         click.echo(f"wrote {output}: {rows} rows, {duration_s:.6g} s at {rate_hz:.6g} Hz{said}; {', '.join(channels)}")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from ..demo import run_demo
+from ..report.demo import run_demo
 from .common import make_console
 from .render import print_evaluation, print_validation
 

@@ -11,20 +11,20 @@ import click
 
 from ..calibration import Calibration
 from ..errors import InputError
-from ..evaluation import evaluate_file
+from ..files import evaluate_file, reads_in_chunks
 from ..io import detect_format
 from ..io.schedule import apply_schedule, read_rate_schedule
-from ..metrics import Evaluation
-from ..comparison import compare_methods
+from ..measures.merit import Evaluation
+from ..evaluation.comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
-from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings, streams
+from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
 
 
 def _is_table(path, opts: dict) -> bool:
     """Whether ``path`` is read in chunks (a table, its rows not selected by time)."""
-    return Path(path).exists() and streams(detect_format(path, opts["fmt"]), opts)
+    return Path(path).exists() and reads_in_chunks(detect_format(path, opts["fmt"]), read_settings(opts))
 
 
 def _nan_none(value):
@@ -117,8 +117,7 @@ def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, ra
         parts = []
         for path in runs:
             with progress_bar(f"reading {Path(path).name}") as progress:
-                parts.append(evaluate_file(calibration, path, layout=read_settings(opts).layout,
-                                           fmt=detect_format(path, opts["fmt"]), drop_nonfinite=opts["drop_nan"],
+                parts.append(evaluate_file(calibration, path, options=read_settings(opts), fmt=opts["fmt"],
                                            window_s=window_s, turn_on_window_s=turn_on_window_s, progress=progress))
         return Evaluation([r for p in parts for r in p.runs], [t for p in parts for t in p.triads])
     recordings = [read_run(path, opts).recording for path in runs]

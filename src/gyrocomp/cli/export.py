@@ -7,7 +7,7 @@ import click
 from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs
 from ..export.formats import EXPORTERS, ExportOptions, export_to
-from ..models.online import LearnerSettings, OnlineCalibrator
+from ..fitting.online import LearnerSettings, OnlineCalibrator
 from .common import FINITE
 
 

@@ -11,13 +11,13 @@ from ..io import instances, refuse_to_overwrite_inputs
 from ..io.atomic import write_texts_atomic
 from ..io.files import expand_runs
 from ..io.schedule import apply_schedule, read_rate_schedule
-from ..models.acceleration import ACCELERATION_CHOICES
+from ..fitting.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
 from ..models.options import FitOptions
 from ..models.fit import fit as fit_runs
 from ..models.pipelines import SCALE_FACTOR_CHOICES
-from ..models.folds import FOLD_KINDS
-from ..models.thermal import HYSTERESIS_CHOICES
+from ..fitting.folds import FOLD_KINDS
+from ..fitting.thermal import HYSTERESIS_CHOICES
 from .common import (FINITE, float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar,
                      read_options, read_run)
 from .render import print_contributions, print_fit

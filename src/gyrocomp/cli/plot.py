@@ -8,12 +8,12 @@ from pathlib import Path
 import click
 
 from ..calibration import Calibration
-from ..compensate import apply as apply_calibration
+from ..calibration.compensate import apply as apply_calibration
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..io import refuse_to_overwrite_inputs
-from ..metrics import default_window_s
+from ..measures.merit import default_window_s
 from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
-from ..noise import analyse_noise
+from ..measures.noise import analyse_noise
 from ..report.figures import check_figure_path
 from .common import FINITE, pop_read_options, read_run, read_options
 

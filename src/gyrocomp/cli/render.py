@@ -13,10 +13,10 @@ from .common import make_console
 
 if TYPE_CHECKING:  # types only: `gyrocomp allan` need not import the fitting to print its table
     from ..calibration import Calibration
-    from ..fit_report import FitReport, GSensitivityReport, OrderSelection, SelectionReport
-    from ..metrics import Evaluation
-    from ..noise import NoiseAnalysis
-    from ..validation import ValidationResult
+    from ..calibration.fit_report import FitReport, GSensitivityReport, OrderSelection, SelectionReport
+    from ..measures.merit import Evaluation
+    from ..measures.noise import NoiseAnalysis
+    from ..evaluation.validation import ValidationResult
 
 
 def print_fit(calibration: Calibration, output) -> None:

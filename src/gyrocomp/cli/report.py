@@ -8,7 +8,7 @@ from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.figures import require_matplotlib
 from ..report.html import build_report
-from ..validation import validate as validate_runs
+from ..evaluation.validation import validate as validate_runs
 from .common import FINITE, pop_read_options, read_run, progress_bar, read_options
 
 

@@ -7,8 +7,8 @@ import json
 import click
 
 from ..models.options import FitOptions
-from ..models.folds import FOLD_KINDS
-from ..validation import validate as validate_runs
+from ..fitting.folds import FOLD_KINDS
+from ..evaluation.validation import validate as validate_runs
 from .common import FINITE, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
 from .render import print_validation
 

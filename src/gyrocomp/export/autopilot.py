@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..installed import ARDUPILOT_SCALE, ARDUPILOT_TEMP_REFERENCE_DEGC, AXIS_INDEX, DEG_TO_RAD, installed_calibration
+from ..calibration.installed import ARDUPILOT_SCALE, ARDUPILOT_TEMP_REFERENCE_DEGC, AXIS_INDEX, DEG_TO_RAD, installed_calibration
 from ..errors import DataQualityWarning, InputError
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment

@@ -12,7 +12,7 @@ does not cover pass through unchanged. When the model compensates the accelerome
 step leaves the compensated accelerations [g] in ``s->accel_out`` (else the input), and the g-sensitivity
 reads them, as ``gyrocomp apply`` does. The code does what :class:`gyrocomp.Compensator` does, sample by
 sample and in the same order of operations: g-sensitivity, the temperature curve (its own C:
-:meth:`gyrocomp.models.curves.TemperatureCurve.c_code`) on the lagged temperature (the first-order-hold lag
+:meth:`gyrocomp.curves.protocol.TemperatureCurve.c_code`) on the lagged temperature (the first-order-hold lag
 steps one nominal period per sample and bridges longer gaps exactly), the turning-point hysteresis, and the
 mean turn-on constant of the calibration runs; then
 the gyro's scale factor and misalignment (out = K(T)^-1 out, K(T) at the input temperature). An
@@ -34,9 +34,9 @@ from ..ctext import c_array, c_number
 from ..errors import InputError
 from ..io.atomic import write_texts_atomic
 from .encode import c_comment
-from ..models.hysteresis import BranchCurve, HysteresisCurve
-from ..models.online import LearnerSettings
-from ..triad import TriadCalibration
+from ..curves.hysteresis import BranchCurve, HysteresisCurve
+from ..fitting.online import LearnerSettings
+from ..calibration.triad import TriadCalibration
 from .c_learner import learner_c_sources
 
 AXES = ("gyro_x", "gyro_y", "gyro_z")
@@ -45,7 +45,7 @@ ACCEL = ("accel_x", "accel_y", "accel_z")
 
 def _temperature_code(j: int, curve) -> list[str]:
     """C statements setting `shape` for axis slot j from `tm` (model temperature) and `acc`: the curve's own
-    (:meth:`gyrocomp.models.curves.TemperatureCurve.c_code`)."""
+    (:meth:`gyrocomp.curves.protocol.TemperatureCurve.c_code`)."""
     if curve is None:
         return ["    shape = 0.0;"]
     return ["    " + line for line in curve.c_code(f"net{j}").statements]
@@ -87,7 +87,7 @@ def _branch_code(j: int, h: BranchCurve) -> list[str]:
             "    }"]
 
 
-#: the C of each memory curve a model can hold (gyrocomp.models.hysteresis.MEMORY_CURVES), by its class
+#: the C of each memory curve a model can hold (gyrocomp.curves.hysteresis.MEMORY_CURVES), by its class
 _MEMORY_CODE = {HysteresisCurve: _turning_point_code, BranchCurve: _branch_code}
 
 

@@ -19,7 +19,7 @@ no g-sensitivity) with this session's constant (or the mean of the sessions' bef
 and returns 0, or -1 while there is no model. ``s->should_save`` says the model changed enough to be stored.
 
 Scratch arrays are static (kept off a small firmware stack), so one learner steps at a time (not reentrant).
-The code does what :class:`gyrocomp.models.online.OnlineCalibrator` does, in the same order of operations (the
+The code does what :class:`gyrocomp.fitting.online.OnlineCalibrator` does, in the same order of operations (the
 tests feed both the same samples and compare the models to 1e-9).
 """
 
@@ -28,11 +28,11 @@ from __future__ import annotations
 from importlib.resources import files
 
 from ..ctext import c_number
-from ..models.online import (GAP_PERIODS, LEVEL_GROWTH, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G,
+from ..fitting.online import (GAP_PERIODS, LEVEL_GROWTH, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G,
                              PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC,
                              LearnerSettings)
-from ..models.online.settings import _MAD_TO_SIGMA, _RIDGE
-from ..stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY, MIN_BLOCK_SAMPLES
+from ..fitting.online.settings import _MAD_TO_SIGMA, _RIDGE
+from ..motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY, MIN_BLOCK_SAMPLES
 
 
 #: the learner's C, with @NAME@ where a setting or a constant goes (real C files beside this module)

@@ -1,5 +1,5 @@
 """How far an autopilot's correction, computed from an exported parameter file as its firmware computes it
-(:mod:`gyrocomp.installed`: PX4's ``calc_thermal_offsets_3D`` with its 1 Hz / 1 degC republish, ArduPilot's
+(:mod:`gyrocomp.calibration.installed`: PX4's ``calc_thermal_offsets_3D`` with its 1 Hz / 1 degC republish, ArduPilot's
 ``TCal::correct_sensor``), is from the gyrocomp model it was exported from: inside the calibrated range, beyond
 it (the firmware clamps) and through a heat-cool cycle as it runs (what the file cannot carry: lag, hysteresis).
 
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..calibration import Calibration
-from ..compensate import predict_error
+from ..calibration.compensate import predict_error
 from ..errors import DataQualityWarning, TemperatureRangeWarning
-from ..installed import Autopilot, ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
+from ..calibration.installed import Autopilot, ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
 from ..recording import GYRO_AXES, Recording
 from .autopilot import ardupilot_parameters, px4_parameters
 

@@ -16,7 +16,7 @@ from pathlib import Path
 from ..calibration import Calibration
 from ..errors import InputError
 from ..io import write_text_atomic
-from ..models.online import LearnerSettings
+from ..fitting.online import LearnerSettings
 from ..recording import GYRO_AXES
 from .autopilot import ardupilot_parameters, ardupilot_params_text, px4_parameters, px4_params_text
 from .c_code import write_c_sources

@@ -15,7 +15,7 @@ import warnings
 from dataclasses import dataclass
 
 from ..errors import DataQualityWarning, InputError
-from ..noise import NoiseAnalysis
+from ..measures.noise import NoiseAnalysis
 from ..units import STANDARD_GRAVITY_M_PER_S2
 
 DEG_TO_RAD = math.pi / 180.0

@@ -1,7 +1,7 @@
 """Production calibration of fleets: many units fitted on Dask into a calibration store, judged against limits,
 and compared with their population.
 
-- :mod:`~gyrocomp.fleet.units`: which runs belong to which unit (a path pattern or a manifest), input hashes;
+- :mod:`~gyrocomp.fleet.devices`: which runs belong to which unit (a path pattern or a manifest), input hashes;
 - :mod:`~gyrocomp.fleet.figures`: a unit's figures of merit;
 - :mod:`~gyrocomp.fleet.limits`: pass/fail limits (TOML) and verdicts;
 - :mod:`~gyrocomp.fleet.store`: the calibration store (SQLite or any SQLAlchemy database), with history;
@@ -20,7 +20,7 @@ from .prior import (AxisPrior, PopulationPrior, block_covariance, comes_back, fi
 from .run import (FLEET_TABLE, MODELS_FOLDER, FleetSettings, FleetSummary, UnitOutcome, fit_fleet, fit_unit,
                   model_file_name)
 from .store import CalibrationRecord, CalibrationStore, InputFile, parse_time, store_url, utc_now
-from .units import UnitRuns, expand_inputs, input_hash, units_from_manifest, units_from_pattern
+from .devices import UnitRuns, expand_inputs, input_hash, units_from_manifest, units_from_pattern
 
 __all__ = ["AxisPrior", "PopulationPrior", "block_covariance", "comes_back", "fit_with_prior", "population_prior", "prior_from_models", "AxisFigures", "CalibrationRecord", "CalibrationStore", "FIGURE_NAMES", "FLEET_TABLE", "Failure",
            "FleetSettings", "FleetSummary", "FleetYield", "InputFile", "Limit", "Limits", "MODELS_FOLDER",

@@ -16,7 +16,7 @@ Per gyro axis (``AxisFigures``):
 - ``g_sensitivity_dps_per_g``: the norm of the axis's g-sensitivity row [deg/s/g] (NaN when not fitted);
 - ``noise_density_dps_per_sqrt_hz``, ``bias_instability_deg_per_h`` and ``rate_random_walk_dps_per_sqrt_s``:
   IEEE Std 952 white noise, bias instability (Allan minimum / 0.664) and rate random walk of the compensated
-  longest run (:func:`gyrocomp.noise.analyse_noise`); ``flicker_deg_per_h``: the flicker level B of the noise
+  longest run (:func:`gyrocomp.measures.noise.analyse_noise`); ``flicker_deg_per_h``: the flicker level B of the noise
   model fitted to the whole Allan curve (on a short run the Allan minimum is not reached and reads low: 11.5
   against 18.9 deg/h on 15 minutes of a 20 deg/h part);
 - ``curve_sd_dps``: for a unit fitted with its population's prior (:mod:`gyrocomp.fleet.prior`), the largest
@@ -33,9 +33,9 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..compensate import apply
+from ..calibration.compensate import apply
 from ..errors import GyrocompError
-from ..noise import analyse_noise
+from ..measures.noise import analyse_noise
 from ..recording import Recording
 
 #: the reference temperature of the temperature sensitivity and of the cubic coefficients [degC]

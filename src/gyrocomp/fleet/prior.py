@@ -58,8 +58,8 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, thermal_lag
 from ..errors import DataQualityWarning, InputError
-from ..models.base import provenance
-from ..models.temperature import PolynomialBias
+from ..fitting.base import provenance
+from ..curves.polynomial import PolynomialBias
 from ..recording import Recording
 from ..units import DEG_PER_S_TO_DEG_PER_H
 from .figures import REFERENCE_TEMPERATURE_DEGC

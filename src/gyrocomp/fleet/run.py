@@ -35,14 +35,14 @@ from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
 from ..models.fit import fit
 from ..models.pipelines import Pipeline, check_channels
-from ..prepared import Channel
+from ..recording.prepared import Channel
 from ..threads import single_threaded_blas
 from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
 from .limits import Limits
 from .population import fleet_table
 from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
-from .units import UnitRuns, content_hash, input_hash
+from .devices import UnitRuns, content_hash, input_hash
 
 MODELS_FOLDER = "models"
 FLEET_TABLE = "fleet.parquet"

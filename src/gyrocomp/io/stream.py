@@ -26,8 +26,7 @@ import pyarrow.parquet as pq
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path
-from .tables import (_COMPRESSED, TableLayout, _channel_selector, _csv_options, _resolved_columns,
-                     detect_table_format, recording_table, sniff_csv, table_recording)
+from .tables import (_COMPRESSED, TableLayout, _channel_selector, _csv_options, _resolved_columns, detect_table_format, sniff_csv, table_recording)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
@@ -275,41 +274,4 @@ class TableWriter:
         return self._stack.__exit__(kind, value, traceback)
 
 
-@dataclass(frozen=True)
-class ConvertResult:
-    """What :func:`convert_table` wrote: rows [count], the time it spans [s], the nominal rate of its first chunk
-    [Hz], the time gaps found, and the channels written."""
-
-    rows: int
-    duration_s: float
-    rate_hz: float
-    gaps: int
-    channels: tuple[str, ...]
-
-
-def convert_table(input_path, output_path, layout: TableLayout | None = None, *, fmt: str | None = None,
-                  out_fmt: str | None = None, drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS,
-                  progress=None) -> ConvertResult:
-    """A CSV or Parquet table written as the canonical table (time [s], gyro [deg/s], accel [g], temperature
-    [degC]) in CSV or Parquet, chunk by chunk: the same bytes as reading it whole and writing the recording
-    (:func:`gyrocomp.io.write_recording`), with memory bounded by ``chunk_rows`` [rows]. ``progress`` is called
-    with the fraction read."""
-    stream = TableStream(input_path, layout, fmt=fmt, drop_nonfinite=drop_nonfinite, chunk_rows=chunk_rows,
-                         progress=progress)
-    first = last = None
-    written = 0
-    with TableWriter(output_path, out_fmt) as writer:
-        for chunk in stream.chunks():
-            rec = chunk.recording
-            first = first or rec
-            last = rec
-            table = recording_table(rec)
-            writer.write(table)
-            written += table.num_rows
-    stream.warn_summary()
-    channels = (*first.gyro_axes, *first.accel_axes, *first.temperature_columns)
-    return ConvertResult(written, float(last.time_s[-1] - first.time_s[0]), first.rate_hz, stream.gaps, channels)
-
-
-__all__ = ["CHUNK_ROWS", "ConvertResult", "NotStreamable", "TableChunk", "TableStream", "TableWriter",
-           "convert_table"]
+__all__ = ["CHUNK_ROWS", "NotStreamable", "TableChunk", "TableStream", "TableWriter"]

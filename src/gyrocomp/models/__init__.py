@@ -1,15 +1,15 @@
-"""Fitted models, one module per effect, and the pipelines that combine them.
+"""The pipelines: how the models of each effect are combined and fitted, recordings in, a frozen
+:class:`gyrocomp.calibration.Calibration` out.
 
-- :mod:`.temperature`: the bias polynomial in temperature, order by cross-validation;
-- :mod:`.mlp`: the thesis's small back-propagation network (Levenberg-Marquardt);
-- :mod:`.hysteresis`: the turning-point hysteresis curve;
-- :mod:`.acceleration`: g-sensitivity (the 3x3 matrix G, the acceleration network);
-- :mod:`.thermal`: the joint fit of polynomial, thermal lag, hysteresis and G, chosen by the data;
-- :mod:`.pipelines`: ``fit_calibration`` / ``fit_pipeline`` / ``fit_channels``, recordings in, a
-  :class:`gyrocomp.calibration.Calibration` out.
+- :mod:`.fit`: :func:`gyrocomp.fit`, the one way to fit (typed options, the channel explicit);
+- :mod:`.options`: the typed options of a fit (:class:`FitOptions`, :class:`Polynomial`, :class:`Network`);
+- :mod:`.pipelines`: the cascade and the one-network pipeline, per channel;
+- :mod:`.field`: calibration without a chamber, from the still moments of everyday logs.
+
+The curves a calibration holds are in :mod:`gyrocomp.curves`, their estimators in :mod:`gyrocomp.fitting`.
 """
 
-from .polynomial_fit import PolynomialTemperatureModel
-from .temperature import PolynomialBias
+from ..curves.polynomial import PolynomialBias
+from ..fitting.polynomial import PolynomialTemperatureModel
 
 __all__ = ["PolynomialBias", "PolynomialTemperatureModel"]

@@ -1,7 +1,7 @@
 """Calibration without a chamber: fit on the still moments of everyday logs.
 
 A field log (a flight, a drive, a robot's shift) starts cold, warms up by self-heating, and stands still now and
-then. :func:`field_recordings` finds each log's still segments (:func:`gyrocomp.stillness.detect_still`) and keeps
+then. :func:`field_recordings` finds each log's still segments (:func:`gyrocomp.motion.stillness.detect_still`) and keeps
 only those samples, as one run per log (each log is one power-on, with its own turn-on constant); the fit then
 sees a chamber-like run with holes where the vehicle moved (the thermal lag is carried across them, the
 temperature taken as linear over each hole). Still segments at different attitudes also give the g-sensitivity.
@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..stillness import (AUTO_MIN_BLOCKS, AUTO_STILL_FRACTION, MIN_DURATION_S, StillDetection, detect_still,
+from ..motion.stillness import (AUTO_MIN_BLOCKS, AUTO_STILL_FRACTION, MIN_DURATION_S, StillDetection, detect_still,
                          moves_most_of_the_time)
 
 #: the still data of all logs together must span at least this [degC]

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 from typing import Literal, get_args
 
 from ..errors import InputError
-from .mlp import DEFAULT_HIDDEN
-from .temperature import MAX_ORDER
-from .thermal import MAX_HYSTERESIS_ORDER
+from ..curves.network import DEFAULT_HIDDEN
+from ..curves.polynomial import MAX_ORDER
+from ..fitting.thermal import MAX_HYSTERESIS_ORDER
 
 #: the thermal memory on top of the temperature curve
 Memory = Literal["auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag"]

@@ -10,36 +10,36 @@ from typing import Literal, get_args
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..compensate import apply
+from ..calibration.compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
-from ..fit_report import THIN_FOLDS, AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
-from ..plausibility import calibration_concerns, temperature_span_concern
-from ..prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
+from ..calibration.fit_report import THIN_FOLDS, AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
+from ..measures.plausibility import calibration_concerns, temperature_span_concern
+from ..recording.prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
-from ..triad import TriadCalibration
-from ..static import orientations
-from .acceleration import (
+from ..calibration.triad import TriadCalibration
+from ..motion.positions import orientations
+from ..fitting.acceleration import (
     acceleration_report,
     fit_acceleration_network,
     excited_columns,
     fit_g_sensitivity,
     turned_between_positions,
 )
-from .base import bin_width_for, one_temperature_column, provenance
-from .hysteresis import heats_and_cools
-from .pose_rotation import TooFewTurns, fit_gyro_between_poses
-from .mlp import NETWORK_BLOCK_S, NETWORK_INPUTS
-from .mlp_fit import MLPTemperatureModel
-from .folds import FOLD_KINDS
-from .selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
-from .polynomial_fit import PolynomialTemperatureModel
-from .curve_kinds import BASES
-from .temperature import MAX_ORDER
-from .triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
+from ..fitting.base import bin_width_for, one_temperature_column, provenance
+from ..curves.hysteresis import heats_and_cools
+from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
+from ..curves.network import NETWORK_BLOCK_S, NETWORK_INPUTS
+from ..fitting.network import MLPTemperatureModel
+from ..fitting.folds import FOLD_KINDS
+from ..fitting.selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
+from ..fitting.polynomial import PolynomialTemperatureModel
+from ..curves.kinds import BASES
+from ..curves.polynomial import MAX_ORDER
+from ..fitting.triad import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
                         fit_accel_multiposition, fit_gyro_rate_table, spans_axes)
 from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
-from .thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+from ..fitting.thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 
 #: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
 BRANCH_ORDERS = tuple(range(1, MAX_BRANCH_ORDER + 1))
@@ -89,7 +89,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
                   run_folds: tuple[int, ...] | None = None, folds: str = "auto",
                   shared_lag: bool = True, do_no_harm: bool = True,
                   curves: tuple[str, ...] = ("poly",)) -> dict[str, AxisSelection]:
-    """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.models.selection`).
+    """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.fitting.selection`).
 
     Parameters
     ----------
@@ -106,12 +106,12 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     folds : {"auto", "runs", "legs", "blocks"}
     shared_lag : bool
         With one temperature column, score every lag candidate at one lag per fold shared by the axes
-        (:func:`gyrocomp.models.selection.share_fold_lags`).
+        (:func:`gyrocomp.fitting.selection.share_fold_lags`).
     do_no_harm : bool
         Keep a temperature model only where it beats the run constant on the held-out folds
-        (:func:`gyrocomp.models.selection.beats_constant`); False when the order was asked for.
+        (:func:`gyrocomp.fitting.selection.beats_constant`); False when the order was asked for.
     curves : tuple of str
-        Curve families to score (:data:`gyrocomp.models.curves.BASES`): ``poly`` at ``orders``, the others at
+        Curve families to score (:data:`gyrocomp.curves.protocol.BASES`): ``poly`` at ``orders``, the others at
         their own sizes.
     """
     if folds not in FOLD_KINDS:
@@ -244,7 +244,7 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     temperature, or also ``accel_x``, ``accel_y``, ``accel_z`` (the joint network of the ``joint-mlp`` pipeline,
     which then fits no separate G).
 
-    What is left to choose is chosen by held-out drift (:mod:`gyrocomp.models.selection`: the simplest within one
+    What is left to choose is chosen by held-out drift (:mod:`gyrocomp.fitting.selection`: the simplest within one
     standard error of the best); an axis no temperature model helps gets none, with a
     :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """

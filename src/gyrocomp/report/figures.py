@@ -24,9 +24,9 @@ from ..allan import BIAS_INSTABILITY_FACTOR
 from ..effects import find_turns
 from ..errors import InputError, MissingDependencyError
 from ..io.atomic import atomic_path
-from ..metrics import moving_average, window_samples
-from ..models.hysteresis import turn_threshold_degc
-from ..noise import NoiseAnalysis
+from ..measures.merit import moving_average, window_samples
+from ..curves.hysteresis import turn_threshold_degc
+from ..measures.noise import NoiseAnalysis
 
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 
@@ -433,7 +433,7 @@ def fleet_distributions(table, figure_names: tuple[str, ...], axes: tuple[str, .
 
 def stillness_plot(recording, detection, title: str | None = None):
     """A log's gyro rate against time [deg/s] (min/max envelope) with its still segments shaded, and its
-    temperature [degC] on the right axis (:func:`gyrocomp.stillness.detect_still`)."""
+    temperature [degC] on the right axis (:func:`gyrocomp.motion.stillness.detect_still`)."""
     plt = _pyplot()
     fig, panel = plt.subplots(figsize=(11, 3.6))
     t = recording.time_s - recording.time_s[0]

@@ -3,7 +3,7 @@
 Images are PNGs embedded as data URIs and the style sheet is inline, so the file opens anywhere with
 no network access. Sections (each an ``<section id=...>``): ``summary`` (the model: type, order, inputs,
 valid ranges, validation scores, the candidates compared), ``validation`` when a
-:class:`~gyrocomp.validation.ValidationResult` is given (held-out drift of raw, the autopilots' cubics, a
+:class:`~gyrocomp.evaluation.validation.ValidationResult` is given (held-out drift of raw, the autopilots' cubics, a
 plain cubic and gyrocomp's default, as ``gyrocomp validate`` prints it), ``evaluation`` (the thesis's figures of merit,
 by stage when the model has stages), one ``axis-<name>`` per axis (bias against temperature with the
 heating and cooling branches, fitted curve, turning points and residual; raw and compensated output
@@ -30,18 +30,18 @@ import numpy as np
 
 from .._version import __version__
 from ..calibration import Calibration
-from ..compensate import apply
+from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, TemperatureRangeWarning
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
 from ..export.firmware import BEYOND_DEGC, firmware_corrected, firmware_costs
-from ..metrics import bias_offset, evaluate_run, window_samples
-from ..noise import analyse_noise
+from ..measures.merit import bias_offset, evaluate_run, window_samples
+from ..measures.noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
 from ..rounding import with_error
-from ..static import static_segments
-from ..stillness import detect_still
+from ..motion.positions import static_segments
+from ..motion.stillness import detect_still
 from ..models.field import moves_most_of_the_time
-from ..validation import ValidationResult
+from ..evaluation.validation import ValidationResult
 from . import figures
 
 SECTIONS = ("summary", "evaluation", "allan")
@@ -346,7 +346,7 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
     progress : callable, optional
         Called with the fraction done.
     validation : ValidationResult, optional
-        Held-out drift of the methods on the calibration runs (:func:`gyrocomp.validation.validate`).
+        Held-out drift of the methods on the calibration runs (:func:`gyrocomp.evaluation.validation.validate`).
     """
     figures._pyplot()  # fail early, in one line, without matplotlib
     steps = 3 + 2 * len(runs)

@@ -1,0 +1,159 @@
+"""The extension point of temperature models: what a calibration's temperature curve provides
+(:class:`TemperatureCurve`), what a curve family the fit can choose provides (:class:`CurveBasis`), and the
+registries the calibration, the compensation, the export, the report and the model choice read
+(:data:`CURVES`, :data:`BASES`) instead of asking which class a curve is.
+
+How to add a temperature model (see docs/architecture.md): write its curve (a frozen dataclass with the methods
+of :class:`TemperatureCurve`, decorated with :func:`register_curve`) and, when it is linear in its parameters, its
+basis (:class:`CurveBasis`, decorated with :func:`register_basis`) in one module of ``gyrocomp.curves``, and name
+that module in :mod:`gyrocomp.curves.kinds`. The model choice then scores it beside the polynomials, model
+files store and load it, ``apply`` and the C export compute it, and the report describes it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+
+from ..errors import InputError
+
+#: how far outside its calibration range a temperature model is still used without a warning: the larger of
+#: this many degC and this fraction of the range
+RANGE_TOLERANCE_DEGC = 0.5
+RANGE_TOLERANCE_FRACTION = 0.01
+
+
+@dataclass(frozen=True)
+class CCode:
+    """A curve in generated C (:mod:`gyrocomp.export.c_code`): functions at file scope, statements run once by
+    ``gyrocomp_init``, and the statements that set ``double shape`` from ``double tm`` (the model temperature
+    [degC]) and ``double acc[3]`` (accelerations [g]) in ``gyrocomp_step``."""
+
+    statements: tuple[str, ...]
+    functions: tuple[str, ...] = ()
+    init: tuple[str, ...] = ()
+
+
+@runtime_checkable
+class TemperatureCurve(Protocol):
+    """An axis's fitted bias shape, without its turn-on constant, in the axis's unit (deg/s, or g for an
+    accelerometer axis), frozen and serializable.
+
+    Attributes: ``kind`` (the ``type`` of its entry in a model file), ``t_min_degc`` and ``t_max_degc`` (the
+    calibrated range [degC]), ``order`` (its size: an int for a polynomial, words otherwise), ``inputs`` (what it
+    reads: ``temperature``, and the accelerations for a joint network), ``needs_accel``."""
+
+    kind: ClassVar[str]
+    t_min_degc: float
+    t_max_degc: float
+
+    @property
+    def order(self) -> int | str: ...
+
+    @property
+    def label(self) -> str:
+        """Short name in model names and candidate labels: ``poly:3``, ``table:8``, ``mlp:1-3-1``."""
+
+    @property
+    def inputs(self) -> tuple[str, ...]: ...
+
+    @property
+    def needs_accel(self) -> bool: ...
+
+    @property
+    def beyond_range(self) -> str:
+        """What the curve does past its range, in words for a warning (``held at its edge``)."""
+
+    def shape(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
+        """The bias shape [the axis's unit] at ``temperature_degc`` [degC] (and ``accel_g`` [g] when it reads
+        them)."""
+
+    def outside_range(self, temperature_degc: np.ndarray) -> bool:
+        """Whether a temperature lies past the calibrated range by more than its tolerance."""
+
+    def describe(self) -> str:
+        """The curve in words for tables: ``polynomial order 3``."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """Its entry in a model file, ``type`` = ``kind``."""
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "TemperatureCurve":
+        """The curve of a model file's entry, checked."""
+
+    def clamped(self) -> "TemperatureCurve":
+        """The curve as a firmware computes it: held at the edges of its range."""
+
+    def plus_slope(self, slope_per_degc: float) -> "TemperatureCurve | None":
+        """The curve plus ``slope_per_degc`` (T - T_0) [the axis's unit per degC] with the same zero, or None when
+        it cannot take one (a network)."""
+
+    def c_code(self, name: str) -> CCode:
+        """The curve in C; ``name`` is unique in the file, for the functions it needs."""
+
+
+#: every temperature curve a model file may hold, by its ``kind``
+CURVES: dict[str, type] = {}
+
+
+def _register(registry: dict[str, type], key: str, cls: type, what: str) -> type:
+    """Put ``cls`` in ``registry`` under ``key``; a second class under a key taken is refused."""
+    if key in registry and registry[key] is not cls:
+        raise ValueError(f"{what} {key!r} is already registered")
+    registry[key] = cls
+    return cls
+
+
+def register_curve(cls: type) -> type:
+    """Class decorator: make a curve readable from model files (``kind`` unique)."""
+    return _register(CURVES, cls.kind, cls, "a temperature curve of kind")
+
+
+def curve_from_dict(d: dict[str, Any]) -> TemperatureCurve:
+    """The curve of a model file's ``temperature`` entry (its ``type`` one of :data:`CURVES`)."""
+    kind = d.get("type") if isinstance(d, dict) else None
+    if kind not in CURVES:
+        raise InputError(f"unknown temperature model type {kind!r}; known: {', '.join(sorted(CURVES))}")
+    return CURVES[kind].from_dict(d)
+
+
+class CurveBasis(Protocol):
+    """A family of curves linear in their parameters, which the model choice scores and the fit solves by least
+    squares: ``name`` (as in candidate labels, ``poly:3``), the ``sizes`` the default tries, and, over the
+    calibration data's range [lo, hi] degC (:meth:`over`), the columns of a size at model temperatures and the
+    curve of the fitted coefficients.
+
+    The columns have no constant (each run's turn-on constant takes it). ``columns(t, size, lo, hi)`` evaluates
+    them as the curve is applied when its range is [lo, hi]: held past it, or, for a family that can
+    (``over(..., extended=True)``), continued along its tangent as the model choice scores it."""
+
+    name: ClassVar[str]
+    #: the sizes the default model choice tries (the polynomial's orders come from the fit's own order range)
+    sizes: ClassVar[tuple[int, ...]]
+
+    @classmethod
+    def over(cls, lo_degc: float, hi_degc: float, extended: bool = True) -> "CurveBasis": ...
+
+    def columns(self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None,
+                hi_degc: float | None = None) -> np.ndarray:
+        """(n, size) columns at ``temperature_degc`` [degC], applied as a curve of range [lo, hi] would be
+        (default: this basis's range)."""
+
+    def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> TemperatureCurve:
+        """The curve of ``coefficients`` (one per column of their size) fitted on [lo, hi] degC, applied past
+        that range as :meth:`columns` evaluates it."""
+
+
+#: the curve families the fit can choose, by name
+BASES: dict[str, type] = {}
+
+
+def register_basis(cls: type) -> type:
+    """Class decorator: make a curve family a candidate of the model choice (``name`` unique)."""
+    return _register(BASES, cls.name, cls, "a curve basis named")
+
+
+__all__ = ["BASES", "CCode", "CURVES", "CurveBasis", "TemperatureCurve", "curve_from_dict", "register_basis",
+           "register_curve"]

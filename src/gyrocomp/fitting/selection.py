@@ -1,0 +1,781 @@
+"""Model choice by held-out drift: folds, candidate scores and the one-standard-error rule.
+
+What a user judges a compensation by is the drift left in data the model has not seen: the RMS, about its
+mean, of the moving-averaged compensated output. This module scores every candidate model of one axis by
+exactly that, on folds of the calibration data, and keeps the simplest candidate whose score is within one
+standard error of the best.
+
+Folds (:func:`make_folds`)
+    With three runs or more, each run is held out in turn (leave one run out). With one or two runs there
+    is only one such fold per held-out run, too few to judge a choice, so the runs are split at their
+    confirmed temperature reversals into heating and cooling legs, and each leg is held out in turn (the
+    other legs, of the same run too, train). Runs without enough reversals are split into contiguous time
+    blocks (temperature blocks, on a ramp). The held-out piece's constant is always refitted (its mean is
+    removed): the score is drift, not the turn-on bias.
+
+Candidates (:class:`Candidate`)
+    Polynomial order 0..5 (0: the run constant alone, no temperature curve), thermal lag, turning-point
+    hysteresis of order 1..3 (only where the runs reverse), and the weighting of the fit: ``time`` (every
+    second of data counts equally, as in the score) or ``temperature-balanced`` (every temperature bin of
+    every run counts equally, so a slow ramp cannot dominate). The lag of a fold's fit is chosen on that
+    fold's training data (a log-spaced grid), so the held-out score judges the whole procedure; with one
+    temperature column it is one lag for all axes (:func:`share_fold_lags`), as in the final fit.
+
+Score and rule
+    Per fold, the time-weighted RMS of the moving average (``window_s``) of the held-out residual about its
+    mean [deg/s]; a candidate's score is the mean over folds. The least complex candidate whose score is within
+    one standard error (of the best candidate's mean over folds) of the best is chosen: Breiman's
+    one-standard-error rule. (Its paired form, on per-fold differences, was tried and rejected: with three
+    folds its standard error is so uncertain that a candidate far worse on one fold passes.) Complexity is
+    the number of shape terms: the order, plus 1 for the lag, plus 2 per hysteresis order. On a temperature
+    register with coarse steps (:func:`temperature_step_degc`) the lag
+    costs nothing: it is what turns the steps back into the smooth temperature of the structure.
+
+Every fold's training solve comes from normal equations per (run, fold) piece, computed once per lag value
+and weighting and shared by all candidates and folds.
+
+References: L. Breiman et al., *Classification and Regression Trees*, 1984, section 3.4.3 (the one-SE rule);
+T. Hastie, R. Tibshirani, J. Friedman, *The Elements of Statistical Learning*, 2nd ed., 2009, section 7.10.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
+from ..errors import InputError
+from ..calibration.fit_report import BranchTest, Candidate, Weighting
+from ..measures.merit import moving_average
+from ..recording.prepared import PreparedRun, RunBlocks
+from ..units import AxisUnit, in_unit, unit_suffix
+from .base import bin_width_for
+from .folds import FoldKind, Folds, make_folds, window_for
+from .branch_evidence import band_offer, branch_test, branches_identified, branches_present, heats_and_cools_blocks
+from ..curves.hysteresis import turn_threshold_degc
+from ..curves.protocol import BASES
+from .thermal import LAG_MAX_S, MAX_BRANCH_ORDER
+
+WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
+#: crossover widths of the branch candidates [degC] (each fold takes the one of least training residual)
+BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
+#: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run)
+LAG_GRID_POINTS = 16
+#: polynomial order of the residual in which the band where the branches part is looked for (the field's cubic)
+BAND_ORDER = 3
+#: a temperature register whose steps are at least this coarse is treated as quantized [degC]
+COARSE_STEP_DEGC = 0.25
+
+
+def _json_number(value: float) -> float | None:
+    """A score for a JSON file: None where it could not be computed (too little held-out data)."""
+    return float(value) if math.isfinite(value) else None
+
+
+def fold_mean(fold_drift: tuple[float, ...]) -> float:
+    """Mean of the held-out drift over the folds [the drift's unit]."""
+    return float(np.mean(fold_drift))
+
+
+def fold_standard_error(fold_drift: tuple[float, ...]) -> float:
+    """Standard error of the mean over the folds [the drift's unit] (NaN with one fold)."""
+    f = len(fold_drift)
+    return float(np.std(fold_drift, ddof=1) / math.sqrt(f)) if f > 1 else math.nan
+
+
+@dataclass(frozen=True)
+class CandidateScore:
+    """Held-out drift of one candidate on every fold [the axis's unit: deg/s for a gyro axis, g for an
+    accelerometer axis], and what each fold's fit chose for the lag [s]."""
+
+    candidate: Candidate
+    fold_drift: tuple[float, ...]
+    fold_lag_s: tuple[float, ...]
+
+    @property
+    def mean_drift(self) -> float:
+        return fold_mean(self.fold_drift)
+
+    @property
+    def standard_error(self) -> float:
+        return fold_standard_error(self.fold_drift)
+
+    def to_dict(self, unit: AxisUnit = "deg/s") -> dict:
+        """As the model file stores it: the drifts under names that say ``unit``."""
+        u = unit_suffix(unit)
+        return {**self.candidate.to_dict(), f"mean_drift{u}": _json_number(self.mean_drift),
+                f"standard_error{u}": _json_number(self.standard_error),
+                f"fold_drift{u}": [_json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s)}
+
+
+@dataclass(frozen=True)
+class AxisSelection:
+    """The choice for one axis, with every candidate's fold scores.
+
+    Attributes
+    ----------
+    axis : str
+    fold_kind : {"runs", "legs", "blocks"}
+    folds : tuple of str
+        Name of each fold (``run 2``, ``run 1 leg 3 (cooling)``, ``run 1 block 2``).
+    window_s : float
+        Moving-average window of the drift score [s].
+    temperature_step_degc : float
+        Step of a coarsely quantized temperature register [degC], 0 when the temperature is fine-grained.
+    scores : tuple of CandidateScore
+    best : Candidate
+        The lowest mean held-out drift.
+    chosen : Candidate
+        The simplest candidate within one standard error of the best.
+    band_degc : (lo, hi) or None
+        The band where the branches part in the data [degC], tried with the turning-point candidates.
+    unit : {"deg/s", "g"}
+        The unit of the axis, and of every drift here.
+    fold_note : str
+        Why the folds are not of the kind asked for (empty when they are).
+    branch_test : BranchTest or None
+        Where no fold could judge a branch model (one heating and one cooling leg), the test that decided
+        whether the chosen model gets one (:func:`gyrocomp.fitting.branch_evidence.branch_test`); None elsewhere.
+    """
+
+    axis: str
+    fold_kind: FoldKind
+    folds: tuple[str, ...]
+    window_s: float
+    temperature_step_degc: float
+    scores: tuple[CandidateScore, ...]
+    best: Candidate
+    chosen: Candidate
+    band_degc: tuple[float, float] | None = None
+    unit: AxisUnit = "deg/s"
+    fold_note: str = ""
+    branch_test: BranchTest | None = None
+
+    def score_of(self, candidate: Candidate) -> CandidateScore:
+        return next(s for s in self.scores if s.candidate == candidate)
+
+    @property
+    def raw_drift(self) -> float:
+        """Mean held-out drift with the run constant alone (time-weighted) [``unit``]."""
+        return self.score_of(Candidate(0)).mean_drift
+
+    @property
+    def chosen_drift(self) -> float:
+        """Mean held-out drift of the chosen candidate [``unit``]."""
+        return self.score_of(self.chosen).mean_drift
+
+    @property
+    def chosen_standard_error(self) -> float:
+        """Standard error of the chosen candidate's mean held-out drift [``unit``]: with its mean, the drift
+        expected on data like a held-out fold (the next heating or cooling leg, or the next run)."""
+        return self.score_of(self.chosen).standard_error
+
+    raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
+    chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
+
+    @property
+    def validated(self) -> bool:
+        """Whether the folds held enough data to score the run constant alone."""
+        return bool(np.isfinite(self.raw_drift))
+
+    @property
+    def generalizes(self) -> bool:
+        """Whether some temperature model beat the run constant alone on held-out data."""
+        return self.chosen.has_temperature_model
+
+    def to_dict(self) -> dict:
+        """As the model file stores it: the drifts under names that say the axis's unit."""
+        u = unit_suffix(self.unit)
+        return {"axis": self.axis, "fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
+                "temperature_step_degc": self.temperature_step_degc,
+                "band_degc": list(self.band_degc) if self.band_degc is not None else None, "best": self.best.to_dict(),
+                "chosen": self.chosen.to_dict(), f"raw_drift{u}": _json_number(self.raw_drift),
+                f"chosen_drift{u}": _json_number(self.chosen_drift),
+                f"chosen_standard_error{u}": _json_number(self.chosen_standard_error), "fold_note": self.fold_note,
+                "validated": self.validated,
+                "generalizes": self.generalizes,
+                "branch_test": self.branch_test.to_dict() if self.branch_test is not None else None,
+                "candidates": [s.to_dict(self.unit) for s in self.scores]}
+
+
+def temperature_step_degc(temperature_degc: np.ndarray) -> float:
+    """The step of a quantized temperature register [degC], or 0 when the values are not on a coarse grid.
+
+    The step is the most common non-zero difference between consecutive samples; the series counts as
+    quantized when that step is at least ``COARSE_STEP_DEGC`` and almost every value (99 %) lies on its grid.
+    """
+    t = np.asarray(temperature_degc, dtype=float)
+    steps = np.abs(np.diff(t))
+    steps = steps[steps > 1e-9]
+    if not steps.size:
+        return 0.0
+    values, counts = np.unique(np.round(steps, 6), return_counts=True)
+    step = float(values[np.argmax(counts)])
+    if step < COARSE_STEP_DEGC:
+        return 0.0
+    offset = t - np.round(t / step) * step
+    phase = float(np.median(offset))
+    on_grid = np.abs(offset - phase) < 0.01 * step
+    return step if np.mean(on_grid) >= 0.99 else 0.0
+
+
+def drift_rms(residual: np.ndarray, weight: np.ndarray, window: int) -> tuple[float, float]:
+    """(weighted sum of squares, sum of weights) of the moving average of ``residual`` about its weighted mean."""
+    e = residual - np.sum(weight * residual) / np.sum(weight)
+    window = max(1, min(window, e.size))  # a fold shorter than the window: one mean over all of it
+    smooth = moving_average(e, window)
+    w = moving_average(weight, window)
+    smooth = smooth - np.sum(w * smooth) / np.sum(w)
+    return float(np.sum(w * smooth ** 2)), float(np.sum(w))
+
+
+@dataclass
+class SelectionProblem:
+    """One axis's calibration data, prepared once for every candidate and fold.
+
+    Parameters
+    ----------
+    runs : list of RunBlocks
+        Block means of each recording [s, degC, deg/s]; ``samples`` gives the time weights.
+    groups : tuple of int
+        The run of each recording.
+    folds : Folds
+    t_ref_degc, t_scale_degc : float
+        Centre and half-span of the temperature [degC] (conditioning of the polynomial columns).
+    threshold_degc : float
+        Turning-point threshold [degC].
+    block_s : float
+        Block length [s].
+    window_s : float
+        Moving-average window of the score [s].
+    max_order : int
+    hysteresis_orders : tuple of int
+        Hysteresis orders to try (empty: no turning-point candidates).
+    accel_cols, square_cols : tuple of int
+        Accelerometer columns (and g x g products) fitted in every candidate (g-sensitivity).
+    temperature_step_degc : float
+        Step of a quantized temperature register [degC], 0 if none.
+    band_degc : (lo, hi), optional
+        Temperature band where the branches part in the data [degC]: turning-point candidates are also tried
+        with their terms limited to it.
+    fold_lags_s : dict
+        Per (order, weighting), each fold's lag [s] shared with the other axes (:func:`share_fold_lags`); a lag
+        candidate not in it picks its own per fold.
+    band_only : bool
+        Turning-point candidates only inside ``band_degc`` (none without a band): see :func:`prepare_axis`.
+    branch_orders : tuple of int
+        Terms of the heating-cooling difference of the branch candidates to try (empty: none); each fold's
+        crossover width is the one of :data:`BRANCH_WIDTHS_DEGC` that leaves the least training residual.
+    """
+
+    runs: list[RunBlocks]
+    groups: tuple[int, ...]
+    folds: Folds
+    t_ref_degc: float
+    t_scale_degc: float
+    threshold_degc: float
+    block_s: float
+    window_s: float
+    max_order: int = 5
+    hysteresis_orders: tuple[int, ...] = (1, 2, 3)
+    accel_cols: tuple[int, ...] = ()
+    square_cols: tuple[int, ...] = ()
+    temperature_step_degc: float = 0.0
+    band_degc: tuple[float, float] | None = None
+    fold_lags_s: dict[tuple[int, str], np.ndarray] = field(default_factory=dict)
+    unit: AxisUnit = "deg/s"
+    band_only: bool = False
+    branch_orders: tuple[int, ...] = ()
+    #: curve families besides the polynomial (names of :data:`gyrocomp.curves.protocol.BASES`), each at its sizes
+    other_curves: tuple[str, ...] = ()
+    _cache: dict = field(default_factory=dict, init=False, repr=False)
+
+    @property
+    def max_hysteresis(self) -> int:
+        return max(self.hysteresis_orders, default=0)
+
+    def lag_grid_s(self) -> np.ndarray:
+        longest = max(float(r.time_s[-1] - r.time_s[0]) for r in self.runs)
+        lo = 2.0 * self.block_s
+        hi = max(lo * 2.0, min(LAG_MAX_S, longest))
+        return np.geomspace(lo, hi, LAG_GRID_POINTS)
+
+    # -- columns ---------------------------------------------------------------------------------------
+    def model_temperature(self, k: int, tau_s: float) -> np.ndarray:
+        run = self.runs[k]
+        if tau_s > 0:
+            return thermal_lag(run.time_s, run.temperature_degc, tau_s, period_s=self.block_s)[0]
+        return run.temperature_degc
+
+    def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
+        """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order, the other
+        families' blocks (none at a lag: ``lagged``), the cooling then heating hysteresis terms (d / t_scale)^j,
+        the branch terms s_w u^j for each crossover width w, then the accelerometer columns. (A fold's training
+        range is applied where its held-out blocks are scored, :meth:`_held_out`.)"""
+        u = (temp - self.t_ref_degc) / self.t_scale_degc
+        cols = [u[:, None] ** np.arange(1, self.max_order + 1)]
+        cols += [self.basis(name).columns(temp, size) for name, size, _ in self.other_blocks(lagged)]
+        h = self.max_hysteresis
+        turns = find_turns(temp, self.threshold_degc) if h or self.branch_orders else None
+        if h:
+            active = ~np.isnan(turns.turn_degc)
+            d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0) / self.t_scale_degc
+            powers = d[:, None] ** np.arange(1, h + 1)
+            for sign in (-1, 1):
+                cols.append(np.where((active & (turns.direction == sign))[:, None], powers, 0.0))
+            if self.band_degc is not None:  # the same terms, zero outside the band
+                inside = (temp >= self.band_degc[0]) & (temp <= self.band_degc[1])
+                for sign in (-1, 1):
+                    cols.append(np.where((active & inside & (turns.direction == sign))[:, None], powers, 0.0))
+        for width in (BRANCH_WIDTHS_DEGC if self.branch_orders else ()):
+            position = branch_position(temp, turns, width)
+            cols.append(position[:, None] * u[:, None] ** np.arange(self.max_branch))
+        cols.append(self.accel_columns(k))
+        return np.hstack(cols)
+
+    def accel_columns(self, k: int) -> np.ndarray:
+        """The g and g x g sensitivity columns of run ``k`` (n, m), m = 0 without them."""
+        run = self.runs[k]
+        cols = [np.zeros((run.value.size, 0))]
+        if self.accel_cols:
+            cols.append(run.accel_g[:, list(self.accel_cols)])
+        if self.square_cols:
+            cols.append(g_squared_products(run.accel_g)[:, list(self.square_cols)])
+        return np.hstack(cols)
+
+    @property
+    def max_branch(self) -> int:
+        return max(self.branch_orders, default=0)
+
+    def basis(self, name: str):
+        """The curve family ``name`` over this axis's temperature range (polynomials continued along their
+        tangent past a fold's training range, as the chosen curve is applied)."""
+        return BASES[name].over(self.t_ref_degc - self.t_scale_degc, self.t_ref_degc + self.t_scale_degc)
+
+    def other_blocks(self, lagged: bool = False) -> list[tuple[str, int, int]]:
+        """(family, size, first column) of each block of columns of a family other than the polynomial: they
+        follow the polynomial's u^1..u^max_order, one block per size (a table's sizes share no columns). None
+        at a lag (``lagged``): the other families are offered without one (a table with a lag followed the
+        runs' common drift on a simulated fleet, and its columns at every lag of the grid cost a quarter of
+        the fit)."""
+        out, start = [], self.max_order
+        if lagged:
+            return out
+        for name in self.other_curves:
+            for size in BASES[name].sizes:
+                out.append((name, size, start))
+                start += size
+        return out
+
+    def column_index(self, c: Candidate, width: int = 0) -> np.ndarray:
+        """The columns of candidate ``c`` (its branch terms at crossover width number ``width``), among the columns
+        at a lag when ``c`` has one (no block of another family there)."""
+        blocks = self.other_blocks(c.lag)
+        o = self.max_order + sum(size for _, size, _ in blocks)  # the shape columns, every family's
+        h = self.max_hysteresis
+        n_h = 2 * h * (2 if h and self.band_degc is not None else 1)
+        start = o + (2 * h if c.band else 0)
+        if c.curve == "poly":
+            idx = list(range(c.order))
+        else:
+            first = next(f for name, size, f in blocks if name == c.curve and size == c.order)
+            idx = list(range(first, first + c.order))
+        idx += [start + j for j in range(c.hysteresis_order)] + [start + h + j for j in range(c.hysteresis_order)]
+        b = self.max_branch
+        idx += [o + n_h + width * b + j for j in range(c.branch)]
+        n_b = b * len(BRANCH_WIDTHS_DEGC) if b else 0
+        n_accel = len(self.accel_cols) + len(self.square_cols)
+        idx += [o + n_h + n_b + j for j in range(n_accel)]
+        return np.asarray(idx, dtype=np.int64)
+
+    def weights(self, k: int, weighting: Weighting) -> np.ndarray:
+        run = self.runs[k]
+        if weighting == "time":
+            return run.samples / run.samples.max()
+        return run.weight
+
+    # -- normal equations, per fold --------------------------------------------------------------------
+    def _prepared(self, tau_s: float):
+        """Per run at lag ``tau_s``: model temperature, columns, and per fold its min and max temperature."""
+        key = ("prep", tau_s)
+        if key not in self._cache:
+            out = []
+            for k in range(len(self.runs)):
+                temp = self.model_temperature(k, tau_s)
+                out.append((temp, self.columns(k, temp, lagged=tau_s > 0)))
+            self._cache[key] = out
+        return self._cache[key]
+
+    def training_matrices(self, tau_s: float, weighting: Weighting) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(F, P+1, P+1) centred normal matrices of [columns, y] over each fold's training data (each run's
+        constant profiled out), and the (F,) lowest and highest training model temperature."""
+        key = ("train", tau_s, weighting)
+        if key in self._cache:
+            return self._cache[key]
+        n_folds = self.folds.count
+        prepared = self._prepared(tau_s)
+        p = prepared[0][1].shape[1]
+        # per group (run) and fold: raw sums
+        group_ids = sorted(set(self.groups))
+        gram = np.zeros((len(group_ids), n_folds, p + 1, p + 1))
+        first = np.zeros((len(group_ids), n_folds, p + 1))
+        total = np.zeros((len(group_ids), n_folds))
+        lo = np.full(n_folds, np.inf)
+        hi = np.full(n_folds, -np.inf)
+        t_lo = np.full((len(self.runs), n_folds), np.inf)
+        t_hi = np.full((len(self.runs), n_folds), -np.inf)
+        for k, (temp, cols) in enumerate(prepared):
+            g = group_ids.index(self.groups[k])
+            z = np.hstack([cols, self.runs[k].value[:, None]])
+            w = self.weights(k, weighting)
+            fold = self.folds.of_block[k]
+            for f in np.unique(fold):
+                sel = fold == f
+                zw = z[sel] * w[sel, None]
+                gram[g, f] += zw.T @ z[sel]
+                first[g, f] += zw.sum(axis=0)
+                total[g, f] += w[sel].sum()
+                t_lo[k, f], t_hi[k, f] = temp[sel].min(), temp[sel].max()
+        matrices = np.zeros((n_folds, p + 1, p + 1))
+        g_all, m_all, s_all = gram.sum(axis=1), first.sum(axis=1), total.sum(axis=1)
+        for f in range(n_folds):
+            for g in range(len(group_ids)):
+                s = s_all[g] - total[g, f]
+                if s <= 0:
+                    continue
+                m = m_all[g] - first[g, f]
+                matrices[f] += g_all[g] - gram[g, f] - np.outer(m, m) / s
+            keep = np.ones(n_folds, dtype=bool)
+            keep[f] = False
+            lo[f], hi[f] = t_lo[:, keep].min(), t_hi[:, keep].max()
+        self._cache[key] = (matrices, lo, hi)
+        return self._cache[key]
+
+    @staticmethod
+    def solve(matrix: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, float]:
+        """Coefficients of the columns ``idx`` and the training residual sum of squares, from a centred normal
+        matrix (minimum-norm where columns are not identified, e.g. a branch absent from the training data)."""
+        if idx.size == 0:
+            return np.zeros(0), float(matrix[-1, -1])
+        a = matrix[np.ix_(idx, idx)]
+        b = matrix[idx, -1]
+        scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
+        coef, *_ = np.linalg.lstsq(a / np.outer(scale, scale), b / scale, rcond=1e-10)
+        coef = coef / scale
+        return coef, float(matrix[-1, -1] - b @ coef)
+
+    def _held_out(self, f: int, c: Candidate, tau_s: float, coef: np.ndarray, lo: float, hi: float,
+                  idx: np.ndarray) -> float:
+        if not (math.isfinite(lo) and math.isfinite(hi) and np.all(np.isfinite(coef))):
+            return math.nan  # nothing left to train on without this fold
+        sse = wsum = 0.0
+        window = max(1, int(round(self.window_s / self.block_s)))
+        prepared = self._prepared(tau_s)
+        for k, sel in self.fold_members()[f]:
+            temp, cols = prepared[k]
+            x = cols[np.ix_(sel, idx)]
+            t = temp[sel]
+            past = (t < lo) | (t > hi)
+            if c.order and np.any(past):  # past the training range the curve goes on as applied (tangent, or held)
+                x[past, : c.order] = self.basis(c.curve).columns(t[past], c.order, lo, hi)
+            e = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
+            w = self.runs[k].samples[sel].astype(float)
+            s, n = drift_rms(e, w, window)
+            sse += s
+            wsum += n
+        return math.sqrt(sse / wsum) if wsum > 0 else math.nan
+
+    def fold_members(self) -> list[list[tuple[int, np.ndarray]]]:
+        """Per fold, (run, indices of its blocks in the fold) for every run with blocks in it."""
+        if "members" not in self._cache:
+            members = [[] for _ in range(self.folds.count)]
+            for k, fold in enumerate(self.folds.of_block):
+                for f in np.unique(fold):
+                    members[int(f)].append((k, np.flatnonzero(fold == f)))
+            self._cache["members"] = members
+        return self._cache["members"]
+
+    def score(self, c: Candidate) -> CandidateScore:
+        """Held-out drift of ``c`` on every fold: each fold's lag and branch crossover width are those of the
+        least training residual."""
+        taus = self.lag_grid_s() if c.lag else np.array([0.0])
+        drifts, lags = [], []
+        shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag and c.curve == "poly" else None
+        both = self.fold_has_both_directions()
+        for f in range(self.folds.count):
+            # a fold whose training data holds one direction only cannot tell the branches apart: there the
+            # candidate is its polynomial (its branch terms would be confounded with the curve)
+            fc = c if both[f] else dataclasses.replace(c, branch=0)
+            widths = range(len(BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
+            best = None
+            for tau in (taus if shared is None else shared[f:f + 1]):
+                matrices, lo, hi = self.training_matrices(float(tau), c.weighting)
+                for w in widths:
+                    idx = self.column_index(fc, w)
+                    coef, rss = self.solve(matrices[f], idx)
+                    if best is None or rss < best[0]:
+                        best = (rss, float(tau), coef, lo[f], hi[f], idx)
+            _, tau, coef, lo_f, hi_f, idx = best
+            drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f, idx))
+            lags.append(tau)
+        return CandidateScore(c, tuple(drifts), tuple(lags))
+
+    def fold_has_both_directions(self) -> np.ndarray:
+        """(F,) whether each fold's training data holds both heating and cooling blocks."""
+        if "directions" not in self._cache:
+            heat = np.zeros(self.folds.count, dtype=bool)
+            cool = np.zeros(self.folds.count, dtype=bool)
+            for run, fold in zip(self.runs, self.folds.of_block):
+                direction = find_turns(run.temperature_degc, self.threshold_degc).direction
+                for f in range(self.folds.count):
+                    train = fold != f
+                    heat[f] |= bool(np.any(direction[train] > 0))
+                    cool[f] |= bool(np.any(direction[train] < 0))
+            # (the crossover after a turn alone, inside one leg, was tried as evidence too: chosen on one heating
+            # and one cooling leg, it left the next leg 20 % worse than a cubic)
+            self._cache["directions"] = heat & cool
+        return self._cache["directions"]
+
+    def lag_rss(self, order: int, weighting: Weighting, grid_s: np.ndarray) -> np.ndarray:
+        """(folds, lags) training residual sum of squares of ``poly:order + lag`` at each lag of ``grid_s`` [s],
+        each fold's row divided by its minimum (so that axes of different noise weigh the same)."""
+        idx = self.column_index(Candidate(order, True, 0, weighting))
+        out = np.empty((self.folds.count, grid_s.size))
+        for g, tau in enumerate(grid_s):
+            matrices = self.training_matrices(float(tau), weighting)[0]
+            out[:, g] = [self.solve(matrices[f], idx)[1] for f in range(self.folds.count)]
+        return out / np.maximum(out.min(axis=1, keepdims=True), 1e-300)
+
+    def candidates(self, orders: tuple[int, ...], memories: tuple[str, ...],
+                   weightings: tuple[Weighting, ...] = WEIGHTINGS) -> list[Candidate]:
+        out = []
+        for w in weightings:
+            if "none" in memories and any(p > 0 for p in orders):  # the other families: no lag, no hysteresis
+                out += [Candidate(size, False, 0, w, curve=name)
+                        for name in self.other_curves for size in BASES[name].sizes]
+            for p in orders:
+                for mem in memories:
+                    lag = "lag" in mem
+                    if "branch" in mem:
+                        for b in (self.branch_orders if p > 0 else ()):
+                            c = Candidate(p, lag, 0, w, False, b)
+                            if c not in out:
+                                out.append(c)
+                        continue
+                    if mem in ("none", "lag"):
+                        hs = (0,)
+                    else:
+                        hs = self.hysteresis_orders
+                    for h in hs:
+                        if (lag or h) and p == 0:
+                            continue
+                        bands = (False, True) if h and self.band_degc is not None else (False,)
+                        if h and self.band_only:
+                            bands = (True,) if self.band_degc is not None else ()
+                        for band in bands:
+                            c = Candidate(p, lag, h, w, band)
+                            if c not in out:
+                                out.append(c)
+        return out
+
+    def complexity(self, c: Candidate) -> int:
+        """Complexity for the rule: on a coarsely quantized register the lag is free (it de-quantizes)."""
+        return c.complexity - (1 if c.lag and self.temperature_step_degc > 0 else 0)
+
+
+def paired_difference(worse: CandidateScore, better: CandidateScore) -> tuple[float, float]:
+    """Mean over folds of ``worse``'s held-out drift minus ``better``'s, and the standard error of that mean
+    [the drift's unit] (NaN with one fold). Both were scored on the same folds, so the spread of the folds'
+    levels (a cooling leg that drifts more than a heating leg) cancels in the difference."""
+    d = np.asarray(worse.fold_drift) - np.asarray(better.fold_drift)
+    return float(np.mean(d)), fold_standard_error(tuple(d))
+
+
+#: with two folds, a temperature model must leave at most this share of the run constant's drift on each
+TWO_FOLD_RATIO = 0.5
+
+
+def beats_constant(score: CandidateScore, constant: CandidateScore) -> bool:
+    """Do no harm: whether ``score``'s candidate leaves less held-out drift than the run constant alone by more
+    than the standard error of the paired difference over the folds.
+
+    With two folds that standard error rests on one degree of freedom and says little; the candidate must then
+    at least halve the constant's drift on both (:data:`TWO_FOLD_RATIO`). A slow random walk unrelated to
+    temperature often follows the temperature on one heating and one cooling leg by chance, and a curve fitted
+    to it makes the next leg worse (measured on a simulated one-cycle run: a chance fit cut the two legs' drift by 39
+    and 49 %, and left the next leg 40 % worse than raw; the ADXRS450's temperature dependence cut them by 97 %).
+    With one fold: better by anything."""
+    gain, se = paired_difference(constant, score)
+    if not np.isfinite(gain):
+        return False
+    if not np.isfinite(se):
+        return gain > 0
+    if len(score.fold_drift) == 2:
+        return bool(np.all(np.asarray(score.fold_drift) <= TWO_FOLD_RATIO * np.asarray(constant.fold_drift)))
+    return bool(gain > se)
+
+
+def choose(scores: list[CandidateScore], complexity, constant: CandidateScore | None = None
+           ) -> tuple[Candidate, Candidate]:
+    """(best, chosen).
+
+    ``best`` has the lowest mean held-out drift. ``chosen`` is the least complex candidate whose mean lies within
+    one standard error (of the best candidate's mean over folds) of the best's; ties in complexity go to the
+    lower score. (A tolerance from the paired per-fold differences was tried: it moved the choice on the CATS
+    recording to terms that doubled a held-out run's drift.) With ``constant`` (the run constant's score), only
+    candidates that beat it (:func:`beats_constant`) may be chosen; when none does, the constant is."""
+    finite = [s for s in scores if np.all(np.isfinite(s.fold_drift))]
+    if not finite:  # too little data to hold anything out: the simplest candidate, unvalidated
+        simplest = min(scores, key=lambda s: complexity(s.candidate)).candidate
+        return simplest, simplest
+    finite = _other_families_that_earn_it(finite)
+    best = min(finite, key=lambda s: s.mean_drift)
+    if constant is not None and np.all(np.isfinite(constant.fold_drift)):
+        finite = [s for s in finite if not s.candidate.has_temperature_model or beats_constant(s, constant)]
+        if not finite:
+            return best.candidate, constant.candidate
+    pool_best = min(finite, key=lambda s: s.mean_drift)
+    se = pool_best.standard_error if len(pool_best.fold_drift) > 1 else 0.0
+    accepted = [s for s in finite if s.mean_drift <= pool_best.mean_drift + se]
+    chosen = min(accepted, key=lambda s: (complexity(s.candidate), s.mean_drift))
+    return best.candidate, chosen.candidate
+
+
+def _other_families_that_earn_it(finite: list[CandidateScore]) -> list[CandidateScore]:
+    """The scores without the candidates of a curve family other than the polynomial (a lookup table) that do not
+    beat the best polynomial on the held-out folds as a temperature model must beat the constant
+    (:func:`beats_constant`: by more than the standard error of the paired difference; with two folds, half its
+    drift on both). A table has many terms and follows what the folds share by chance: measured on a simulated
+    fleet of consumer-grade units (three 15-minute runs each), tables chosen by the one-SE rule alone moved the
+    units' temperature figures off their truth and tripled the good units flagged as outliers."""
+    polys = [s for s in finite if s.candidate.curve == "poly" and s.candidate.has_temperature_model]
+    if not polys:
+        return finite
+    best_poly = min(polys, key=lambda s: s.mean_drift)
+    return [s for s in finite if s.candidate.curve == "poly" or beats_constant(s, best_poly)]
+
+
+def share_fold_lags(problems: list[SelectionProblem], orders: tuple[int, ...],
+                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> None:
+    """Give the axes one lag per fold and per (order, weighting): the lag is the die's, behind one temperature
+    sensor, and the axes together pin it down better than any one of them (as the final fit does, see
+    :class:`gyrocomp.fitting.thermal.ThermalHysteresisModel`'s ``shared_lag``). Each fold's lag minimizes the
+    sum over axes of their relative training residuals (:meth:`SelectionProblem.lag_rss`). The problems must
+    share their runs' times and folds; nothing is shared otherwise."""
+    if len(problems) < 2 or len({(p.folds.count, p.block_s) for p in problems}) > 1:
+        return
+    grid = problems[0].lag_grid_s()
+    for order in (o for o in orders if o > 0):
+        for weighting in weightings:
+            total = sum(p.lag_rss(order, weighting, grid) for p in problems)
+            taus = grid[np.argmin(total, axis=1)]
+            for p in problems:
+                p.fold_lags_s[(order, weighting)] = taus
+
+
+def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],
+                weightings: tuple[Weighting, ...] = WEIGHTINGS, do_no_harm: bool = True) -> AxisSelection:
+    """Score every candidate of one axis and choose (see the module doc); with ``do_no_harm``, a temperature
+    model only where it beats the run constant (:func:`beats_constant`)."""
+    cands = problem.candidates(orders, memories, weightings)
+    if not cands:
+        raise InputError(f"hysteresis={'/'.join(memories)!r}: the temperature of {axis} never reverses in these "
+                         "runs, so there is no branch to fit; use hysteresis='none' or 'lag'")
+    eligible = set(cands)
+    if Candidate(0) not in cands:  # the reference every score is read against; chosen only when asked for
+        cands.insert(0, Candidate(0))
+    scores = [problem.score(c) for c in cands]
+    constant = next(s for s in scores if s.candidate == Candidate(0))
+    best, chosen = choose([s for s in scores if s.candidate in eligible], problem.complexity,
+                          constant if do_no_harm else None)
+    test = None
+    if problem.branch_orders and not chosen.branch and not chosen.hysteresis_order \
+            and not np.any(problem.fold_has_both_directions()):
+        chosen, test = _branch_by_test(problem, chosen, scores, eligible)
+    return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
+                         problem.temperature_step_degc, tuple(scores), best, chosen, problem.band_degc, problem.unit,
+                         problem.folds.note, test)
+
+
+def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[CandidateScore],
+                    eligible: set[Candidate]) -> tuple[Candidate, BranchTest | None]:
+    """Where no fold can judge a branch model (every fold's training holds one direction of travel only), the
+    chosen candidate with the branch terms :func:`branch_test` finds beyond the drift (and no change where it
+    finds none, or where that candidate is not among the ones offered)."""
+    with_branch = dataclasses.replace(chosen, order=max(chosen.order, 1), branch=MAX_BRANCH_ORDER)
+    if with_branch not in eligible:
+        return chosen, None
+    tau = float(np.median(next(s for s in scores if s.candidate == chosen).fold_lag_s)) if chosen.lag else 0.0
+    accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
+    test = branch_test(problem.runs, problem.groups, problem.threshold_degc, problem.t_ref_degc,
+                       problem.t_scale_degc, chosen.order, tau, problem.block_s, accel)
+    if not test.order:
+        return chosen, test
+    kept = dataclasses.replace(with_branch, branch=test.order)
+    return (kept, test) if kept in eligible else (chosen, test)
+
+
+def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,
+                 block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
+                 max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
+                 square_cols: tuple[int, ...] = (), both_directions: bool = True,
+                 branch_orders: tuple[int, ...] = (), curves: tuple[str, ...] = ("poly",)) -> SelectionProblem:
+    """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
+
+    Parameters
+    ----------
+    recordings : list of Recording
+    axis : str
+    pieces : list of (list of slice or None), optional
+        Per recording, the stretches to use (static segments of a multi-position run); default every stretch.
+    groups : tuple of int, optional
+        The run of each recording (default: each its own run).
+    block_s : float
+        Block length [s] (at least one sample).
+    bin_width_degc : float, optional
+        Temperature bin of the temperature-balanced weights [degC].
+    fold_kind : {"auto", "runs", "legs", "blocks"}
+    max_order : int
+    hysteresis_orders : tuple of int
+        Turning-point orders to try.
+    accel_cols, square_cols : tuple of int
+        g-sensitivity columns fitted with every candidate.
+    both_directions : bool
+        Offer turning-point candidates only where the branches after reversals can be told apart from the
+        polynomial (:func:`branches_identified`; when hysteresis is being chosen rather than asked for), else
+        wherever a branch exists.
+    branch_orders : tuple of int
+        Terms of the heating-cooling difference of the branch candidates; offered only where the runs both heat
+        and cool.
+    curves : tuple of str
+        The curve families offered (:data:`gyrocomp.curves.protocol.BASES`): the polynomial's orders come from
+        ``max_order``, every other family's sizes from its basis.
+    """
+    temps = [rec.temperature_for(axis) for rec in recordings]
+    lo = min(float(t.min()) for t in temps)
+    hi = max(float(t.max()) for t in temps)
+    width = bin_width_for(temps, bin_width_degc)
+    block_s = max(block_s, 1.0 / recordings[0].rate_hz)
+    pieces = pieces or [None] * len(recordings)
+    prepared = [PreparedRun.of(rec) for rec in recordings]
+    runs = [p.block_means(axis, block_s, width, piece) for p, piece in zip(prepared, pieces)]
+    thresholds = [p.of_temperature(axis, "turn threshold", turn_threshold_degc) for p in prepared]
+    groups = tuple(range(len(recordings))) if groups is None else tuple(int(g) for g in groups)
+    folds = make_folds(runs, groups, thresholds, fold_kind)
+    step = max(p.of_temperature(axis, "step", temperature_step_degc) for p in prepared)
+    reverses = (branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds))
+    t_ref, t_scale = (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0
+    band, band_only = band_offer(runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order),
+                                  block_s, both_directions) if reverses and hysteresis_orders else (None, False)
+    return SelectionProblem(runs, groups, folds, t_ref, t_scale, max(thresholds), block_s,
+                            window_for(folds, runs, block_s), max_order, hysteresis_orders if reverses else (),
+                            accel_cols, square_cols, step, band, unit=recordings[0].unit_of(axis), band_only=band_only,
+                            branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
+                            other_curves=tuple(name for name in curves if name != "poly"))
+
+
+__all__ = ["AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "CandidateScore", "SelectionProblem", "Weighting",
+           "beats_constant", "choose", "paired_difference", "prepare_axis", "select_axis", "temperature_step_degc"]

@@ -1,0 +1,642 @@
+"""Hysteresis and thermal lag on top of the temperature polynomial, and the data's choice between them.
+
+Per gyro axis and run r, the bias is modelled as
+
+    b_r(t) = c_r + p(T_s(t)) + H(T_s, history)
+
+- T_s is the reported temperature T, or, with thermal lag, T through a first-order lag of time
+  constant tau (the MEMS structure is not at the reported temperature while it changes), tau fitted;
+- p is the polynomial of :mod:`gyrocomp.curves.polynomial` (no constant; the run constants c_r
+  take that);
+- H is the thesis's hysteresis (section 2.6): after a confirmed reversal of T_s, sum_j h_j d^j with
+  d = |T_s - T_turn|, one set of h for cooling branches and one for heating branches, optionally only
+  inside a temperature band.
+
+The fit works on block means of each run (``block_s`` seconds), in time order, weighted so that
+every temperature bin of every run counts equally (as the polynomial's binning does). For a fixed
+tau everything is linear; tau is found by a log-spaced search refined by a bounded scalar
+minimization (variable projection). The candidates none, turning-point, lag and turning-point+lag
+are compared by leave-one-run-out error (the held-out run's constant refitted), or by BIC with
+one run; the hysteresis order (1-3) is chosen the same way.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
+from ..errors import DataQualityWarning, InputError, ModelError
+from ..calibration.fit_report import memory_name
+from ..recording import Recording
+from .gsensitivity import ACCELERATION_CHOICES, excited_columns
+from ..recording.prepared import PreparedRun, RunBlocks, fit_axes
+from .base import LearnedAttributes, bin_width_for, one_temperature_column
+from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
+from .polynomial import simplest_within
+from ..curves.protocol import BASES
+
+HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+#: terms of the difference between the heating and the cooling curve (a constant, then a slope)
+MAX_BRANCH_ORDER = 2
+#: crossover widths tried for a branch model [degC] (refined: see _Problem.best_width)
+BRANCH_WIDTHS_DEGC = tuple(float(w) for w in np.geomspace(1.0, 40.0, 9))
+MAX_HYSTERESIS_ORDER = 3
+#: bounds of the thermal time constant search [s]
+LAG_MIN_BLOCKS = 2.0
+LAG_MAX_S = 4 * 3600.0
+DEFAULT_BLOCK_S = 2.0
+#: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
+#: score measures drift (what compensation is for) rather than white noise, which no model removes
+SCORE_WINDOW_S = 60.0
+
+
+def plausible_middle(rss: np.ndarray, independent: float, chi2: float = 4.0) -> int:
+    """The middle index of the grid points whose residual sum of squares ``rss`` the data cannot tell from the
+    least: within ``chi2`` (about two standard errors of one parameter) of it, on the scale of the least rss per
+    ``independent`` residual (the residual's independent stretches: its length over the drift window, as
+    block residuals are correlated over that long)::
+
+        plausible = {i : rss_i - min(rss) <= chi2 min(rss) / independent}
+
+    With a sharp minimum that is the least point itself; with a flat profile (the parameter not identified) the
+    middle of the grid rather than a point chance picked."""
+    least = float(np.min(rss))
+    plausible = np.flatnonzero(rss - least <= chi2 * max(least, 1e-300) / max(independent, 1.0))
+    return int(plausible[plausible.size // 2])
+
+
+def best_lag_s(rss: Callable[[float], float], lo_s: float, hi_s: float = LAG_MAX_S) -> float:
+    """The time constant [s] that minimizes ``rss(tau)``: a 12-point log-spaced search between ``lo_s`` and
+    ``hi_s`` [s], refined by a bounded scalar minimization in log(tau) around the best grid point."""
+    from scipy.optimize import minimize_scalar  # slow to import; only lag fits need it
+
+    grid = np.geomspace(lo_s, hi_s, 12)
+    values = [rss(float(tau)) for tau in grid]
+    best = int(np.argmin(values))
+    a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
+    res = minimize_scalar(lambda lt: rss(math.exp(lt)), bounds=(a, b), method="bounded", options={"xatol": 1e-2})
+    return math.exp(res.x) if res.fun <= values[best] else float(grid[best])
+
+
+@dataclass(frozen=True)
+class _Spec:
+    """One candidate: polynomial order, thermal lag on/off, hysteresis order (0 = none), branch terms (0 = none)
+    and the branch crossover width [degC] (0: to be found)."""
+
+    order: int
+    lag: bool
+    hysteresis_order: int
+    branch: int = 0
+    width_degc: float = 0.0
+    #: the curve family of the shape (:data:`gyrocomp.curves.protocol.BASES`), ``order`` its size
+    curve: str = "poly"
+
+    @property
+    def name(self) -> str:
+        return memory_name(self.lag, self.hysteresis_order, self.branch)
+
+
+@dataclass
+class _Problem:
+    runs: list[RunBlocks]
+    t_ref: float
+    t_scale: float
+    threshold: float
+    band: tuple[float, float] | None
+    block_s: float
+    accel_cols: tuple[int, ...] = ()
+    square_cols: tuple[int, ...] = ()
+    #: a polynomial continues along its tangent past its range (as the model choice scored it), else is held
+    extended: bool = False
+    _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
+
+    def basis(self, spec: _Spec):
+        """The curve family of ``spec`` over the data's temperature range."""
+        return BASES[spec.curve].over(self.t_ref - self.t_scale, self.t_ref + self.t_scale, self.extended)
+
+    def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
+        """The temperature the model reads [degC]: reported, or through the lag ``tau`` [s] (kept per run and tau:
+        the searches over the lag, the band and the branch width ask for the same ones again)."""
+        if not (spec.lag and tau > 0):
+            return run.temperature_degc
+        key = (id(run), float(tau))
+        if key not in self._lagged:
+            self._lagged[key] = thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
+        return self._lagged[key]
+
+    def features(self, run: RunBlocks, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
+        """Columns of the shape and the hysteresis at model temperature ``temp``, then of the g and g x g
+        sensitivity (the excited accelerometer axes only)."""
+        u = (np.clip(temp, t_lo, t_hi) - self.t_ref) / self.t_scale
+        cols = [self.basis(spec).columns(temp, spec.order, t_lo, t_hi)] if spec.order else []
+        if spec.hysteresis_order:
+            turns = find_turns(temp, self.threshold)
+            active = ~np.isnan(turns.turn_degc)
+            if self.band is not None:
+                active &= (temp >= self.band[0]) & (temp <= self.band[1])
+            d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0)
+            for sign in (-1, 1):
+                on = active & (turns.direction == sign)
+                cols += [np.where(on, d ** j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
+        if spec.branch:
+            position = branch_position(temp, find_turns(temp, self.threshold), spec.width_degc)
+            cols += [position * u ** k for k in range(spec.branch)]
+        if self.accel_cols:
+            cols += [run.accel_g[:, j] for j in self.accel_cols]
+        if self.square_cols:
+            products = g_squared_products(run.accel_g)
+            cols += [products[:, m] for m in self.square_cols]
+        return np.column_stack(cols) if cols else np.zeros((temp.size, 0))
+
+    def branch_reach(self, spec: _Spec, tau: float) -> tuple[float, float]:
+        """The largest |T - T_turn| on the cooling and on the heating branches after a reversal (inside the
+        band, if any) over every run [degC]: how far each branch's polynomial in d was fitted."""
+        reach = [0.0, 0.0]
+        for run in self.runs:
+            temp = self.model_temperature(run, spec, tau)
+            turns = find_turns(temp, self.threshold)
+            active = ~np.isnan(turns.turn_degc)
+            if self.band is not None:
+                active &= (temp >= self.band[0]) & (temp <= self.band[1])
+            d = np.abs(temp - np.where(active, turns.turn_degc, temp))
+            for i, sign in enumerate((-1, 1)):
+                on = active & (turns.direction == sign)
+                if np.any(on):
+                    reach[i] = max(reach[i], float(d[on].max()))
+        return reach[0], reach[1]
+
+    def design(self, spec: _Spec, tau: float, which: list[int]):
+        """The weighted least-squares problem on the runs ``which``: design matrix (one constant column per
+        run, then the features), values, weights, and the model-temperature range of those runs."""
+        temps = [self.model_temperature(self.runs[r], spec, tau) for r in which]
+        t_lo = min(float(t.min()) for t in temps)
+        t_hi = max(float(t.max()) for t in temps)
+        feats, onehots = [], []
+        for k, temp in enumerate(temps):
+            oh = np.zeros((temp.size, len(which)))
+            oh[:, k] = 1.0
+            feats.append(self.features(self.runs[which[k]], temp, spec, t_lo, t_hi))
+            onehots.append(oh)
+        x = np.hstack([np.vstack(onehots), np.vstack(feats)])
+        y = np.concatenate([self.runs[r].value for r in which])
+        w = np.concatenate([self.runs[r].weight for r in which])
+        return x, y, w, (t_lo, t_hi)
+
+    def solve(self, spec: _Spec, tau: float, which: list[int]):
+        """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range)."""
+        x, y, w, t_range = self.design(spec, tau, which)
+        sw = np.sqrt(w)
+        coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
+        rss = float(np.sum(w * (y - x @ coef) ** 2))
+        return coef[len(which):], coef[: len(which)], rss, t_range
+
+    def best_width(self, spec: _Spec, tau: float, which: list[int]) -> _Spec:
+        """``spec`` with the branch crossover width [degC] of :data:`BRANCH_WIDTHS_DEGC` at lag ``tau`` [s]
+        (``spec`` itself without branches or with a width set): the middle of the widths the data cannot tell
+        from the best (:func:`plausible_middle`). Only a turn where the curves stand apart shows the crossover;
+        one where they nearly meet (the only turn of a single cycle, often) leaves every width alike, and the
+        least residual there is chance (measured: 1.6 degC picked against a true 5, the next turn's crossover
+        then left 8x the drift of 6.3 degC)."""
+        if not spec.branch or spec.width_degc > 0:
+            return spec
+        specs = [dataclasses.replace(spec, width_degc=w) for w in BRANCH_WIDTHS_DEGC]
+        rss = np.array([self.solve(s, tau, which)[2] for s in specs])
+        duration_s = sum(float(self.runs[r].time_s[-1] - self.runs[r].time_s[0]) for r in which)
+        return specs[plausible_middle(rss, duration_s / SCORE_WINDOW_S)]
+
+    def fit(self, spec: _Spec, which: list[int], tau_s: float | None = None):
+        """Best tau for the spec (0 without lag; ``tau_s`` when given) and the solution there; a branch model's
+        crossover width is found at each tau tried. Returns (tau, solution, spec with its width)."""
+        if not spec.lag:
+            spec = self.best_width(spec, 0.0, which)
+            return 0.0, self.solve(spec, 0.0, which), spec
+        if tau_s is None:
+            tau_s = best_lag_s(lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2],
+                               LAG_MIN_BLOCKS * self.block_s)
+        spec = self.best_width(spec, tau_s, which)
+        return tau_s, self.solve(spec, tau_s, which), spec
+
+    def refine_band(self, spec: _Spec, tau_s: float, step_degc: float) -> None:
+        """Move each edge of the band [degC] to where the all-run weighted residual is least, on a grid of
+        ``step_degc`` / 4 within one ``step_degc`` of where it was found (the band is found on temperature bins;
+        a bump that ends sharply leaves a step of its height at an edge placed a bin off)."""
+        if self.band is None or not spec.hysteresis_order:
+            return
+        which = list(range(len(self.runs)))
+        lo0, hi0 = self.band
+        offsets = np.linspace(-step_degc, step_degc, 9)
+        best = (self.solve(spec, tau_s, which)[2], self.band)
+        for lo in lo0 + offsets:
+            for hi in hi0 + offsets:
+                if hi - lo < step_degc:
+                    continue
+                self.band = (float(lo), float(hi))
+                rss = self.solve(spec, tau_s, which)[2]
+                if rss < best[0]:
+                    best = (rss, self.band)
+        self.band = best[1]
+
+    def lag_profile(self, spec: _Spec) -> Callable[[float], float]:
+        """The all-run residual sum of squares as a function of tau [s], divided by its minimum (1 at the
+        axis's own best tau), so that axes with different noise weigh the same in a shared lag."""
+        which = list(range(len(self.runs)))
+        _, (_, _, own, _), spec = self.fit(spec, which)  # a branch model's width: the one at its own best lag
+        return lambda tau: self.solve(spec, tau, which)[2] / max(own, 1e-300)
+
+    def held_out_error(self, spec: _Spec) -> float:
+        """RMS [deg/s] of each run predicted by a fit on the others, its constant refitted."""
+        sse = wsum = 0.0
+        n = len(self.runs)
+        for held in range(n):
+            train = [r for r in range(n) if r != held]
+            tau, (coef, _, _, (t_lo, t_hi)), fitted = self.fit(spec, train)
+            run = self.runs[held]
+            x = self.features(run, self.model_temperature(run, spec, tau), fitted, t_lo, t_hi)
+            e = run.value - x @ coef
+            e -= np.sum(run.weight * e) / np.sum(run.weight)
+            w = max(1, min(e.size, int(round(SCORE_WINDOW_S / self.block_s))))
+            kernel = np.ones(w) / w
+            smooth_e = np.convolve(e, kernel, mode="valid")
+            smooth_w = np.convolve(run.weight, kernel, mode="valid")
+            sse += float(np.sum(smooth_w * smooth_e ** 2))
+            wsum += float(np.sum(smooth_w))
+        return math.sqrt(sse / wsum)
+
+    def observed_band(self, order: int) -> tuple[float, float] | None:
+        """The temperature band where the branches after a reversal part from the others, from the residual
+        of the polynomial alone; None when no band stands out or it spans most of the range.
+
+        See :func:`gyrocomp.curves.hysteresis.parting_band_degc`.
+        """
+        spec = _Spec(order, False, 0)
+        which = list(range(len(self.runs)))
+        coef, consts, _, (t_lo, t_hi) = self.solve(spec, 0.0, which)
+        temps, resid, after, rising = [], [], [], []
+        for k, run in enumerate(self.runs):
+            t = run.temperature_degc
+            e = run.value - self.features(run, t, spec, t_lo, t_hi) @ coef - consts[k]
+            turns = find_turns(t, self.threshold)
+            temps.append(t)
+            resid.append(e)
+            after.append(~np.isnan(turns.turn_degc))
+            rising.append(turns.direction)
+        return parting_band_degc(*map(np.concatenate, (temps, resid, after, rising)))
+
+    def covariance(self, spec: _Spec, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients (run constants first) and their cluster-robust covariance: the sandwich estimator
+        with the static segments (or stretches) of each run as clusters, since the noise within a
+        segment is correlated (flicker) while different positions are close to independent."""
+        n = len(self.runs)
+        x, y, w, _ = self.design(spec, tau, list(range(n)))
+        clusters = np.concatenate([run.cluster * n + k if run.cluster is not None else np.full(run.value.size, k)
+                                   for k, run in enumerate(self.runs)])
+        xtw = x.T * w
+        bread = np.linalg.pinv(xtw @ x)
+        coef = bread @ (xtw @ y)
+        score = x * (w * (y - x @ coef))[:, None]
+        _, inverse = np.unique(clusters, return_inverse=True)
+        per_cluster = np.zeros((inverse.max() + 1, x.shape[1]))
+        np.add.at(per_cluster, inverse, score)
+        g = per_cluster.shape[0]
+        if g <= x.shape[1]:  # fewer clusters than coefficients: the spread of the clusters says nothing
+            return coef, np.full((x.shape[1], x.shape[1]), np.nan)
+        meat = per_cluster.T @ per_cluster * (g / (g - 1))
+        return coef, bread @ meat @ bread
+
+    def bic(self, spec: _Spec) -> float:
+        _, (coef, consts, rss, _), _ = self.fit(spec, list(range(len(self.runs))))
+        n = sum(r.value.size for r in self.runs)
+        w = sum(float(np.sum(r.weight)) for r in self.runs)
+        k = coef.size + consts.size + (1 if spec.lag else 0)
+        return n * math.log(max(rss / w, 1e-300)) + k * math.log(n)
+
+
+@dataclass(frozen=True)
+class _AxisChoice:
+    """What one axis's choice settled: its problem (band set), the candidate and every candidate's score."""
+
+    problem: _Problem
+    spec: _Spec
+    name: str
+    scores: dict[str, float]
+
+
+def _simplest(tried: dict[int, float], n_runs: int) -> int:
+    """The smallest key whose score is within the parsimony tolerance of the best (the best with BIC)."""
+    return simplest_within(tried, sorted(tried), by_bic=n_runs < 2)
+
+
+@dataclass
+class ThermalHysteresisModel(LearnedAttributes):
+    """Polynomial temperature model with thermal lag and/or turning-point hysteresis, chosen by the data.
+
+    Parameters
+    ----------
+    order : int or dict
+        Polynomial order of the temperature shape, or one per axis (from :class:`PolynomialTemperatureModel`'s
+        choice, or :mod:`gyrocomp.fitting.selection`'s).
+    hysteresis : {"auto", "none", "turning-point", "lag", "turning-point+lag"} or dict
+        The model, or ``"auto"``: every candidate compared by leave-one-run-out error; or a fixed model per axis.
+    hysteresis_order : int or "auto" or dict
+        Order of the turning-point polynomial (1..3), or chosen by the same validation; or one per axis
+        (0 for an axis without turning-point hysteresis).
+    band_degc : (lo, hi), optional
+        Limit the hysteresis to this temperature band [degC] (the ADXRS450 shows it only from 55 to 80).
+        Without it, the band where the branches visibly part (:meth:`_Problem.observed_band`) is tried
+        against no band, and the validation keeps the better.
+    block_s : float
+        Length of the block means the fit works on [s].
+    bin_width_degc : float, optional
+        Temperature bin of the weights [degC]; default span / 100.
+    reselect_order : bool
+        Choose the polynomial order again (1..max_order) inside the winning candidate.
+    max_order : int
+    acceleration : {"none", "matrix", "matrix2"}
+        Fit the g-sensitivity row G (thesis 2.7.1) jointly with the temperature model and the run
+        constants (``matrix2`` adds the g x g terms), on the static segments of the runs only.
+    weighting : {"time", "temperature-balanced"} or dict
+        Weights of the block means: every second equal, or every temperature bin of every run equal.
+    shared_lag : bool
+        Axes that read one temperature column and all have lag get one time constant, fitted on all of them
+        together (the lag is the die's, behind one sensor); False fits one per axis.
+    branch_order : int or dict
+        Terms of the difference between the heating and the cooling curve of a branch model (1: a constant,
+        2: and a slope), or one per axis.
+    curve : str or dict
+        The family of the temperature shape, a name of :data:`gyrocomp.curves.protocol.BASES` (``poly``,
+        ``table``), ``order`` its size; or one per axis.
+    extended : bool
+        A polynomial continues along its tangent past its range (how the model choice scored it), else is held.
+    refine_band : bool
+        ``band_degc`` was found on temperature bins (:func:`~gyrocomp.curves.hysteresis.parting_band_degc`): move
+        its edges, within one bin, to where the residual is least, then fit the lag again.
+
+    Attributes (after ``fit``)
+    --------------------------
+    curves_ : dict[str, TemperatureCurve]
+        A polynomial (:class:`~gyrocomp.curves.polynomial.PolynomialBias`), or the curve of the family
+        ``curve`` names (:data:`gyrocomp.curves.protocol.BASES`).
+    lag_time_constants_s_ : dict[str, float]
+        Fitted thermal time constant per axis [s], 0 without lag.
+    hysteresis_ : dict[str, HysteresisCurve or None]
+    turn_on_biases_ : dict[str, np.ndarray]
+    memories_ : dict[str, (str, int)]
+        The candidate kept per axis: its memory (``none``, ``lag``, ``turning-point``, ``turning-point+lag``) and
+        turning-point order (in words: :func:`gyrocomp.calibration.fit_report.memory_label`).
+    scores_ : dict[str, dict[str, float]]
+        Per axis, the validation score of every candidate tried (RMS [deg/s], or BIC with one run).
+    selection_ : str
+        ``"leave-one-run-out"``, ``"bic"`` or ``"fixed"``.
+    g_sensitivity_dps_per_g_, g_sensitivity_se_dps_per_g_ : dict[str, np.ndarray (3,)]
+        Fitted G row and its cluster-robust standard error [deg/s/g] (0 and NaN for axes not excited).
+    g_squared_dps_per_g2_, g_squared_se_dps_per_g2_ : dict[str, np.ndarray (6,)]
+        The g x g terms in the order of ``gyrocomp.effects.G_SQUARED_TERMS`` (``matrix2`` only).
+    bands_ : dict[str, tuple or None]
+        The hysteresis band used per axis [degC] (given, found in the data, or None).
+    excited_axes_ : tuple of str
+        Accelerometer axes the positions excite (within-run spread above ``EXCITATION_G``).
+    segments_ : list of list of StaticSegment
+        The static segments used, per run.
+    """
+
+    order: int | dict[str, int]
+    hysteresis: str = "auto"
+    hysteresis_order: int | str = "auto"
+    band_degc: tuple[float, float] | None | dict[str, tuple[float, float] | None] = None
+    block_s: float = DEFAULT_BLOCK_S
+    bin_width_degc: float | None = None
+    reselect_order: bool = False
+    max_order: int = 5
+    acceleration: str = "none"
+    static_min_duration_s: float = 10.0
+    weighting: str | dict[str, str] = "temperature-balanced"
+    shared_lag: bool = True
+    refine_band: bool = False
+    branch_order: int | dict[str, int] = MAX_BRANCH_ORDER
+    curve: str | dict[str, str] = "poly"
+    extended: bool = False
+
+    @staticmethod
+    def _of(value, axis: str):
+        return value[axis] if isinstance(value, dict) else value
+
+    def _candidates(self, axis: str) -> list[str]:
+        mode = self._of(self.hysteresis, axis)
+        return list(CANDIDATES) if mode == "auto" else [mode]
+
+    def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "") -> _Spec:
+        lag = name in ("lag", "turning-point+lag", "branch+lag")
+        curve = self._of(self.curve, axis)
+        if "branch" in name:
+            return _Spec(order, lag, 0, int(self._of(self.branch_order, axis)), curve=curve)
+        if "turning-point" not in name:
+            return _Spec(order, lag, 0, curve=curve)
+        fixed = self._of(self.hysteresis_order, axis)
+        return _Spec(order, lag, hysteresis_order if fixed == "auto" else int(fixed), curve=curve)
+
+    def fit(self, recordings: list[Recording]) -> "ThermalHysteresisModel":
+        """Fit on ``recordings`` (each one power-on at rest) and return self."""
+        if isinstance(recordings, Recording):
+            recordings = [recordings]
+        self._check_settings()
+        self.curves_, self.lag_time_constants_s_, self.hysteresis_ = {}, {}, {}
+        self.turn_on_biases_, self.scores_, self.order_scores_ = {}, {}, {}
+        self.memories_ = {}
+        self.bands_ = {}
+        self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
+        self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
+        axes = fit_axes(recordings)
+        pieces = self._pieces(recordings)
+        self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
+            "leave-one-run-out" if len(recordings) >= 2 else "bic")
+        choices = {axis: self._choose(axis, recordings, pieces, first=axis == axes[0]) for axis in axes}
+        taus = self._shared_lag(choices) if self.shared_lag and one_temperature_column(recordings) else {}
+        for axis, choice in choices.items():
+            self._store(axis, choice, taus.get(axis))
+        return self
+
+    def _check_settings(self) -> None:
+        for mode in (self.hysteresis.values() if isinstance(self.hysteresis, dict) else [self.hysteresis]):
+            if mode not in HYSTERESIS_CHOICES:
+                raise InputError(f"hysteresis: {mode!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
+        for h in (self.hysteresis_order.values() if isinstance(self.hysteresis_order, dict)
+                  else [self.hysteresis_order]):
+            if h != "auto" and not (isinstance(h, int) and 0 <= h <= MAX_HYSTERESIS_ORDER):
+                raise InputError(f"hysteresis_order: {h!r}; use 'auto' or 1..{MAX_HYSTERESIS_ORDER}")
+        for w in (self.weighting.values() if isinstance(self.weighting, dict) else [self.weighting]):
+            if w not in ("time", "temperature-balanced"):
+                raise InputError(f"weighting: {w!r}; use 'time' or 'temperature-balanced'")
+        for band in (self.band_degc.values() if isinstance(self.band_degc, dict) else [self.band_degc]):
+            if band is not None and not band[0] < band[1]:
+                raise InputError(f"band_degc: {band}; give (low, high) with low < high [degC]")
+        if not self.block_s > 0:
+            raise InputError(f"block_s: must be positive, got {self.block_s}")
+        if self.acceleration not in ACCELERATION_CHOICES:
+            raise InputError(f"acceleration: {self.acceleration!r}; use one of {', '.join(ACCELERATION_CHOICES)}")
+
+    def _problem(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _Problem:
+        """The least-squares problem of one axis: block means of every run, weights, hysteresis threshold and
+        the accelerometer columns."""
+        temps = [rec.temperature_for(axis) for rec in recordings]
+        lo = min(float(t.min()) for t in temps)
+        hi = max(float(t.max()) for t in temps)
+        width = bin_width_for(temps, self.bin_width_degc)
+        block_s = max(self.block_s, 1.0 / recordings[0].rate_hz)
+        runs = [PreparedRun.of(rec).block_means(axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
+        if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
+            runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
+        threshold = max(PreparedRun.of(rec).of_temperature(axis, "turn threshold", turn_threshold_degc)
+                        for rec in recordings)
+        accel_cols, square_cols = self._accel_columns(runs, first)
+        return _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold,
+                        self._of(self.band_degc, axis), block_s, accel_cols, square_cols, self.extended)
+
+    def _choose(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _AxisChoice:
+        """The candidate of one axis: given, or the best by leave-one-run-out error (BIC with one run)."""
+        problem = self._problem(axis, recordings, pieces, first)
+        band = problem.band
+        n_runs = len(recordings)
+        scores: dict[str, float] = {}
+        best_spec: dict[str, _Spec] = {}
+        order = self.order[axis] if isinstance(self.order, dict) else int(self.order)
+        score = problem.held_out_error if n_runs >= 2 else problem.bic
+        found = None
+        if band is None and self.selection_ != "fixed" and any("turning-point" in c for c in self._candidates(axis)):
+            found = problem.observed_band(order)
+        bands: dict[str, tuple[float, float] | None] = {}
+        for name in self._candidates(axis):
+            # candidates compared at hysteresis order 2 (the thesis's); the winner's order is validated after
+            best_spec[name] = self._spec(name, order, axis=axis)
+            scores[name] = math.nan if self.selection_ == "fixed" else score(best_spec[name])
+            bands[name] = band
+            if found is not None and "turning-point" in name:
+                # the band the data shows, tried against none: the data chooses
+                problem.band = found
+                with_band = score(best_spec[name])
+                problem.band = band
+                if with_band < scores[name]:
+                    scores[name], bands[name] = with_band, found
+        chosen = self._pick(axis, scores, n_runs)
+        if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
+            tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
+                     for p in range(1, MAX_HYSTERESIS_ORDER + 1)}
+            pick = _simplest(tried, n_runs)
+            best_spec[chosen] = self._spec(chosen, order, pick, axis)
+            scores[chosen] = tried[pick]
+        problem.band = bands.get(chosen, band)
+        spec = best_spec[chosen]
+        if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
+            # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
+            # which a higher order partly imitates; choose it again inside the winning candidate
+            tried = {o: score(_Spec(o, spec.lag, spec.hysteresis_order)) for o in range(1, self.max_order + 1)}
+            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order)
+            self.order_scores_[axis] = tried
+        return _AxisChoice(problem, spec, chosen, scores)
+
+    def _pick(self, axis: str, scores: dict[str, float], n_runs: int) -> str:
+        if len(scores) == 1:
+            return next(iter(scores))
+        finite = {k: v for k, v in scores.items() if math.isfinite(v)}
+        if not finite:
+            raise ModelError(f"{axis}: no hysteresis candidate could be scored")
+        return simplest_within(finite, CANDIDATES, by_bic=self.selection_ == "bic")
+
+    @staticmethod
+    def _shared_lag(choices: dict[str, _AxisChoice]) -> dict[str, float]:
+        """One time constant [s] for every axis with lag: the lag is that of the die behind one temperature
+        sensor, not of an axis, and the axes together pin it down better than any one of them. It minimizes
+        the sum over those axes of each one's residual sum of squares relative to its own minimum."""
+        lagged = {axis: c for axis, c in choices.items() if c.spec.lag}
+        if len(lagged) < 2:
+            return {}
+        profiles = [c.problem.lag_profile(c.spec) for c in lagged.values()]
+        lo_s = LAG_MIN_BLOCKS * max(c.problem.block_s for c in lagged.values())
+        tau_s = best_lag_s(lambda tau: sum(f(tau) for f in profiles), lo_s)
+        return {axis: tau_s for axis in lagged}
+
+    def _store(self, axis: str, choice: _AxisChoice, tau_s: float | None) -> None:
+        """Fit the chosen model of one axis on every run (at the shared lag ``tau_s`` [s] when given) and
+        keep what it learned."""
+        problem, spec = choice.problem, choice.spec
+        n_runs = len(problem.runs)
+        if self.refine_band and problem.band is not None and spec.hysteresis_order:
+            temps = np.concatenate([r.temperature_degc for r in problem.runs])
+            problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0],
+                                max(1.0, float(np.ptp(temps)) / 40.0))
+        tau, (coef, consts, _, (t_lo, t_hi)), spec = problem.fit(spec, list(range(n_runs)), tau_s)
+        self.curves_[axis] = problem.basis(spec).curve(coef[: spec.order], t_lo, t_hi)
+        self.lag_time_constants_s_[axis] = float(tau)
+        p = spec.hysteresis_order
+        self.hysteresis_[axis] = None if not p else HysteresisCurve(
+            tuple(float(v) for v in coef[spec.order: spec.order + p]),
+            tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), problem.threshold, problem.band,
+            problem.branch_reach(spec, tau))
+        if spec.branch:
+            start = spec.order + 2 * p
+            self.hysteresis_[axis] = BranchCurve(tuple(float(v) for v in coef[start: start + spec.branch]),
+                                                 problem.t_ref, problem.t_scale, spec.width_degc, problem.threshold,
+                                                 t_lo, t_hi)
+        self.bands_[axis] = problem.band
+        self.turn_on_biases_[axis] = consts
+        self.memories_[axis] = (choice.name, spec.branch or p)
+        self.scores_[axis] = choice.scores
+        if self.acceleration != "none":
+            self._store_acceleration(axis, problem, spec, tau, coef, n_runs)
+
+    def _pieces(self, recordings: list[Recording]) -> list[list[slice] | None]:
+        self.segments_, pieces = static_pieces(recordings, self.static_min_duration_s)
+        return pieces
+
+    def _accel_columns(self, runs: list[RunBlocks], warn: bool) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        if self.acceleration == "none":
+            return (), ()
+        if any(r.accel_g is None for r in runs):
+            raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
+                             "fit; map them with columns= or fit with acceleration='none'")
+        excited, squares, self.excited_axes_ = excited_columns([r.accel_g for r in runs], [r.weight for r in runs],
+                                                               squares=self.acceleration == "matrix2", warn=warn)
+        return excited, squares
+
+    def _store_acceleration(self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray,
+                            n_runs: int) -> None:
+        start = spec.order + 2 * spec.hysteresis_order + spec.branch
+        full, cov = problem.covariance(spec, tau)
+        se_all = np.sqrt(np.maximum(np.diag(cov), 0.0))[n_runs:]
+        g, g_se = np.zeros(3), np.full(3, np.nan)
+        for k, j in enumerate(problem.accel_cols):
+            g[j], g_se[j] = coef[start + k], se_all[start + k]
+        self.g_sensitivity_dps_per_g_[axis] = g
+        self.g_sensitivity_se_dps_per_g_[axis] = g_se
+        if self.acceleration == "matrix2":
+            q, q_se = np.zeros(6), np.full(6, np.nan)
+            base = start + len(problem.accel_cols)
+            for k, m in enumerate(problem.square_cols):
+                q[m], q_se[m] = coef[base + k], se_all[base + k]
+            self.g_squared_dps_per_g2_[axis] = q
+            self.g_squared_se_dps_per_g2_[axis] = q_se
+
+
+def static_pieces(recordings: list[Recording], min_duration_s: float) -> tuple[list, list[list[slice] | None]]:
+    """Per run, its static segments and the stretches a fit uses: the static segments where the unit moves
+    between positions (runs with an accelerometer), else None (every stretch between time gaps)."""
+    segments, out = [], []
+    for rec in recordings:
+        # an accelerometer's own model uses the pieces it is given: its motion is what it measures
+        moves = rec.accel_g is not None and PreparedRun.of(rec).channel == "gyro"
+        segs = PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if moves else []
+        segments.append(segs)
+        if moves and not segs:
+            warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
+                          DataQualityWarning, stacklevel=3)
+        out.append([slice(g.start, g.stop) for g in segs] if segs else None)
+    return segments, out
+
+
+__all__ = ["CANDIDATES", "HYSTERESIS_CHOICES", "ThermalHysteresisModel", "static_pieces"]

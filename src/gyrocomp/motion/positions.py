@@ -1,0 +1,139 @@
+"""Static segments: where a unit is still during a multi-position test, and its orientation there.
+
+A sample is still when, over a window of ``window_s`` around it, the summed variance of the gyro
+axes and (if present) of the accelerometer axes stays below ``factor`` times its median over the
+recording (the noise level, as long as the unit is still most of the time). Turning the unit
+raises the gyro variance at the start and end of a move and the accelerometer variance while
+gravity sweeps across the axes. Runs of still samples of at least ``min_duration_s``, shortened
+by half a window at each end and never spanning a time gap, are the segments; each reports the
+mean specific force (the gravity vector in the body frame, [g]) and temperature.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..recording import Recording
+
+DEFAULT_WINDOW_S = 1.0
+DEFAULT_MIN_DURATION_S = 10.0
+DEFAULT_FACTOR = 4.0
+#: specific-force vectors closer than this are the same orientation [g]
+SAME_ORIENTATION_G = 0.05
+
+
+@dataclass(frozen=True)
+class StaticSegment:
+    """One still stretch of a recording.
+
+    Attributes
+    ----------
+    start, stop : int
+        Sample indices [start, stop).
+    start_s, duration_s : float
+        Start time and length [s].
+    gravity_g : array (3,) or None
+        Mean specific force along the accelerometer axes [g], None without an accelerometer.
+    temperature_degc : float or None
+        Mean temperature [degC].
+    """
+
+    start: int
+    stop: int
+    start_s: float
+    duration_s: float
+    gravity_g: np.ndarray | None
+    temperature_degc: float | None
+
+
+def _moving_variance(x: np.ndarray, w: int) -> np.ndarray:
+    """Variance over a centred window of w samples (edges: the nearest full window), summed over columns."""
+    n = x.shape[0]
+    if n < w:
+        return np.full(n, np.var(x, axis=0).sum())
+    x = x - x.mean(axis=0)
+    c1 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x, axis=0)])
+    c2 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x * x, axis=0)])
+    s1 = (c1[w:] - c1[:-w]) / w
+    s2 = (c2[w:] - c2[:-w]) / w
+    var = np.maximum(s2 - s1 * s1, 0.0).sum(axis=1)  # window k covers [k, k + w)
+    idx = np.clip(np.arange(n) - w // 2, 0, var.size - 1)
+    return var[idx]
+
+
+def still_mask(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S, factor: float = DEFAULT_FACTOR) -> np.ndarray:
+    """True where the unit is still (see the module doc)."""
+    if not window_s > 0 or not factor > 1:
+        raise InputError(f"static detection: window {window_s} s must be positive and factor {factor} above 1")
+    w = max(5, int(round(window_s * recording.rate_hz)))
+    gyro_var = np.empty(recording.n_samples)
+    accel_var = np.zeros(recording.n_samples) if recording.accel_g is not None else None
+    for piece in recording.contiguous_stretches():
+        gyro_var[piece] = _moving_variance(recording.gyro_dps[piece], w)
+        if accel_var is not None:
+            accel_var[piece] = _moving_variance(recording.accel_g[piece], w)
+    still = gyro_var <= factor * np.median(gyro_var)
+    if accel_var is not None:
+        still &= accel_var <= factor * max(np.median(accel_var), 1e-30)
+    return still
+
+
+def static_segments(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S,
+                    min_duration_s: float = DEFAULT_MIN_DURATION_S, factor: float = DEFAULT_FACTOR) -> list[StaticSegment]:
+    """The still stretches of a recording, in time order (see the module doc)."""
+    return segments_from_mask(recording, still_mask(recording, window_s=window_s, factor=factor),
+                              window_s=window_s, min_duration_s=min_duration_s)
+
+
+def segments_from_mask(recording: Recording, still: np.ndarray, *, window_s: float = DEFAULT_WINDOW_S,
+                       min_duration_s: float = DEFAULT_MIN_DURATION_S) -> list[StaticSegment]:
+    """The static segments of ``recording`` from its still mask (:func:`still_mask` with the same ``window_s``
+    [s]): runs of still samples, trimmed by half a window where they border motion, of at least
+    ``min_duration_s`` [s]."""
+    trim = max(1, int(round(window_s * recording.rate_hz)) // 2)
+    out = []
+    for piece in recording.contiguous_stretches():
+        s = still[piece]
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], s.astype(np.int8), [0]])))
+        for a, b in zip(edges[::2], edges[1::2]):
+            a, b = piece.start + a, piece.start + b
+            if a > piece.start:
+                a += trim
+            if b < piece.stop:
+                b -= trim
+            if b <= a or recording.time_s[b - 1] - recording.time_s[a] < min_duration_s:
+                continue
+            grav = None if recording.accel_g is None else recording.accel_g[a:b].mean(axis=0)
+            temp = None if recording.temperature_degc is None else float(np.mean(recording.temperature_degc[a:b]))
+            out.append(StaticSegment(int(a), int(b), float(recording.time_s[a]),
+                                     float(recording.time_s[b - 1] - recording.time_s[a]), grav, temp))
+    return out
+
+
+def segment_mask(n_samples: int, segments: list[StaticSegment]) -> np.ndarray:
+    """Boolean mask of the samples inside the segments."""
+    mask = np.zeros(n_samples, dtype=bool)
+    for seg in segments:
+        mask[seg.start: seg.stop] = True
+    return mask
+
+
+def orientations(segments: list[StaticSegment]) -> list[tuple[np.ndarray, int]]:
+    """Distinct gravity vectors among the segments (within ``SAME_ORIENTATION_G``) and how many segments each."""
+    found: list[list] = []
+    for seg in segments:
+        if seg.gravity_g is None:
+            continue
+        for entry in found:
+            if np.linalg.norm(entry[0] - seg.gravity_g) < SAME_ORIENTATION_G:
+                entry[1] += 1
+                break
+        else:
+            found.append([seg.gravity_g, 1])
+    return [(g, k) for g, k in found]
+
+
+__all__ = ["segments_from_mask", "StaticSegment", "orientations", "segment_mask", "static_segments", "still_mask"]
