@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import base64
+import io
+import math
 import os
+import re
 import subprocess
 import sys
 import warnings
+from html.parser import HTMLParser
 from pathlib import Path
 
 import numpy as np
@@ -87,3 +92,72 @@ def run(*args, cwd=None) -> subprocess.CompletedProcess:
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
     env = {**os.environ, "COLUMNS": "200"}
     return subprocess.run([*cmd, *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+
+
+class ReportPage(HTMLParser):
+    """An HTML report's sections (their ids), images (their sources) and other links, in order."""
+
+    def __init__(self):
+        super().__init__()
+        self.sections, self.images, self.links, self.heads = [], [], [], 0
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "section":
+            self.sections.append(attrs["id"])
+        if tag == "img":
+            self.images.append(attrs["src"])
+        for key in ("href", "src"):
+            if key in attrs and tag != "img":
+                self.links.append(attrs[key])
+
+
+def report_sections(text: str) -> list[str]:
+    """The ids of an HTML report's sections, in order."""
+    page = ReportPage()
+    page.feed(text)
+    return page.sections
+
+
+def check_report_page(text: str, expected_sections: list[str]) -> ReportPage:
+    """An HTML report holds these sections, drawn figures (PNG data, not blank) and no link off the page."""
+    matplotlib_image = pytest.importorskip("matplotlib.image", reason="the report's figures are read with matplotlib")
+    page = ReportPage()
+    page.feed(text)
+    assert page.sections == expected_sections
+    assert page.images, "no figure in the report"
+    for src in page.images:
+        assert src.startswith("data:image/png;base64,")
+        image = matplotlib_image.imread(io.BytesIO(base64.b64decode(src.split(",", 1)[1])), format="png")
+        assert image.ndim == 3 and image.shape[0] > 100 and image.shape[1] > 100
+        assert np.ptp(image[..., :3]) > 0.5  # drawn, not blank
+    assert all(link.startswith("#") for link in page.links)  # only links within the page
+    assert not re.search(r"(https?:)?//[a-z0-9]", re.sub(r"data:image/png;base64,[A-Za-z0-9+/=]+", "", text))
+    return page
+
+
+def joined_recordings(pieces, gap_s):
+    """Recordings one after another, each next one starting gap_s after the previous ended."""
+    times, gyro, temps, start = [], [], [], 0.0
+    for rec in pieces:
+        t = rec.time_s - rec.time_s[0] + start
+        times.append(t)
+        gyro.append(rec.gyro_dps)
+        temps.append(rec.temperature_degc)
+        start = t[-1] + gap_s
+    return Recording(np.concatenate(times), np.concatenate(gyro), pieces[0].gyro_axes,
+                     temperature_degc=np.concatenate(temps), source="joined")
+
+
+def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0) -> Recording:
+    """A still unit: gyro_x and gyro_z white noise of N = 0.01 deg/s/sqrt(Hz), the accelerometer 1e-3 g noise about
+    (0, 0, 1) g; ``gap_after``: a 10 s hole after that sample."""
+    rng = np.random.default_rng(seed)
+    time_s = np.arange(n) / rate_hz
+    if gap_after is not None:
+        time_s[gap_after:] += 10.0  # a 10 s hole
+    gyro = rng.standard_normal((n, 2)) * 0.01 * math.sqrt(rate_hz)  # N = 0.01 deg/s/sqrt(Hz)
+    accel = np.column_stack([rng.standard_normal(n) * 1e-3, rng.standard_normal(n) * 1e-3,
+                             1.0 + rng.standard_normal(n) * 1e-3])
+    return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=("gyro_x", "gyro_z"), accel_g=accel,
+                     accel_axes=("accel_x", "accel_y", "accel_z"), source="static.csv")

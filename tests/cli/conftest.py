@@ -24,3 +24,16 @@ def static_log(tmp_path_factory):
     r = run("simulate", "--profile", "static", "--duration", 1800, "--rate", 20, "--axes", "x,z", "-o", d / "s.csv")
     assert r.returncode == 0, r.stderr
     return d
+
+
+@pytest.fixture(scope="session")
+def report_files(tmp_path_factory):
+    """Two simulated one-hour runs of the mti10 preset and a model fitted on the first, made with the CLI."""
+    d = tmp_path_factory.mktemp("report")
+    for seed in (1, 2):
+        r = run("simulate", "--preset", "mti10", "--profile", "combined", "--duration", 3600, "--rate", 1,
+                "--seed", seed, "-o", d / f"run{seed}.csv")
+        assert r.returncode == 0, r.stderr
+    r = run("fit", d / "run1.csv", "-o", d / "model.json", "--hysteresis", "none")
+    assert r.returncode == 0, r.stderr
+    return d

@@ -1,8 +1,16 @@
 """The reading options every command shares (columns, units, delimiters), run through the real entry point in a
 subprocess."""
 
+import importlib
+
+import click
 import numpy as np
 import pandas as pd
+
+from gyrocomp.cli import COMMANDS
+from gyrocomp.cli.projectfile import ReadingOption
+from gyrocomp.io import FORMAT_SPELLING, ReadOptions
+from gyrocomp.spelling import spelled_fields
 
 from ..conftest import run
 
@@ -29,3 +37,39 @@ def test_a_tab_separated_export_with_decimal_commas_reads_with_or_without_option
         assert list(out["gyro_z"]) == [1.5, 2.5, 3.0] and list(out["temperature"]) == [20.5, 21.0, 22.0]
     r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", "--decimal", ":")
     assert r.returncode == 2 and r.stderr.strip() == "gyrocomp: error: --decimal: ':'; use '.' or ','"
+
+
+def test_every_command_that_reads_data_has_the_reading_options_of_the_library():
+    """The reading options are made from ReadOptions' fields: each command that reads has all of them, under the
+    field's name; and across every command one parameter name has one flag (the message wording relies on it)."""
+    flags_by_name: dict[str, set[str]] = {}
+    readers = 0
+    for name, (module, _) in COMMANDS.items():
+        command = getattr(importlib.import_module(f"gyrocomp.cli.{module}"), name)
+        for cmd in [command, *getattr(command, "commands", {}).values()]:
+            options = [p for p in cmd.params if isinstance(p, click.Option)]
+            for option in options:
+                flags_by_name.setdefault(option.name, set()).add(max(option.opts, key=len))
+            reading = {o.name: max(o.opts, key=len) for o in options if isinstance(o, ReadingOption)}
+            if reading:
+                readers += 1
+                assert reading == {"fmt": FORMAT_SPELLING.flag,
+                                   **{f.name: s.flag for f, s in spelled_fields(ReadOptions)}}, cmd.name
+    assert readers >= 10
+    assert {n: f for n, f in flags_by_name.items() if len(f) > 1} == {}
+    assert flags_by_name["drop_nonfinite"] == {"--drop-nan"} and flags_by_name["time_range_s"] == {"--time"}
+
+
+def test_a_bad_reading_option_is_one_line_naming_the_flag(workdir, tmp_path):
+    for flag, value, said in [("--time", "1:x", "--time: '1:x': give A:B"),
+                              ("--instance", "all", "--instance: all is for gyrocomp fit"),
+                              ("--device-id", "-3", "--device-id: -3: give a whole number >= 0")]:
+        r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv", flag, value)
+        assert r.returncode == 2 and r.stderr.strip().startswith(f"gyrocomp: error: {said}"), r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "o.csv").exists()
+
+
+def test_the_project_file_read_section_takes_the_reading_options_of_the_command(workdir, tmp_path):
+    (tmp_path / "gyrocomp.toml").write_text('[read]\ndrop-nan = true\nwindoww = 3\n')
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv", cwd=tmp_path)
+    assert r.returncode == 2 and "[read] windoww: not a reading option; use accel-unit, columns" in r.stderr

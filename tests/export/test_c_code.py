@@ -17,7 +17,6 @@ from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
-from ..conftest import run
 
 DRIVER = r"""
 #include <stdio.h>
@@ -107,22 +106,6 @@ def test_single_axis_model_passes_other_axes_through(tmp_path):
     theirs = _run_c(cal, held, tmp_path)
     np.testing.assert_array_equal(theirs[:, 0], held.gyro_dps[:, 0])
     np.testing.assert_allclose(theirs, ours, rtol=1e-9, atol=1e-12)
-
-
-def test_lag_needs_the_rate_and_the_cli_writes_a_folder(tmp_path):
-    prof = get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1)
-    runs = [simulate("adxrs450", profile=prof, rate_hz=1, seed=s).recording for s in range(2)]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        cal = fit_calibration(runs, hysteresis="lag")
-    with pytest.raises(InputError, match="the model has thermal lag; give the data's sample rate with rate_hz="):
-        c_sources(cal)
-    cal.save(tmp_path / "m.json")
-    r = run("export", tmp_path / "m.json", "--format", "c", "--rate", 1, "-o", tmp_path / "fw")
-    assert r.returncode == 0, r.stderr
-    assert (tmp_path / "fw" / "gyrocomp.h").read_text().count("typedef struct gyrocomp_state") == 1
-    r = run("export", tmp_path / "m.json", "--format", "c", "-o", tmp_path / "fw2")
-    assert r.returncode == 2 and "give the data's sample rate with --rate" in r.stderr
 
 
 def test_temperature_network_then_acceleration_network(tmp_path):

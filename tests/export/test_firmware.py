@@ -8,11 +8,9 @@ import numpy as np
 import pytest
 
 from gyrocomp.errors import InputError
-from gyrocomp.io.tables import write_recording
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
 from gyrocomp.simulate import get_profile, simulate
 
-from ..conftest import run
 
 DEG = 180.0 / math.pi
 PX4 = {"TC_G0_TMIN": 10.0, "TC_G0_TMAX": 50.0, "TC_G0_TREF": 30.0,
@@ -60,24 +58,6 @@ def test_ardupilot_correction_by_hand_relative_to_the_calibration_temperature():
     # the calibration temperature is clamped too
     np.testing.assert_allclose(ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), -20.0),
                                ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), 0.0))
-
-
-def test_export_prints_what_the_firmware_leaves_against_the_model(tmp_path):
-    runs = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=1,
-                     seed=s) for s in range(2)]
-    paths = []
-    for k, sim in enumerate(runs):
-        paths.append(tmp_path / f"c{k}.csv")
-        write_recording(sim.recording, paths[-1])
-    assert run("fit", *paths, "-o", tmp_path / "m.json", "--hysteresis", "lag").returncode == 0
-    r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "t.params", "--device-id", 3)
-    assert r.returncode == 0, r.stderr
-    line = next(x for x in r.stdout.splitlines() if x.startswith("gyro_z: firmware vs model"))
-    numbers = [float(v) for v in line.replace("(", " ").replace(")", " ").split() if v[0].isdigit()]
-    in_range, beyond, as_run = numbers[0], numbers[2], numbers[5]
-    assert "in range" in line and "beyond it" in line and "as it runs" in line
-    assert as_run > in_range  # the lag the file cannot carry, and PX4's 1 degC steps
-    assert beyond > 0
 
 
 def test_a_parameter_left_out_has_the_firmwares_default():

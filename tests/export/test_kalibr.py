@@ -9,7 +9,7 @@ from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.kalibr import kalibr_imu, kalibr_imu_yaml
 from gyrocomp.measures.noise import analyse_noise
 
-from ..test_noise import static_recording
+from ..conftest import static_recording
 
 
 def parse(text):

@@ -18,7 +18,6 @@ from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Li
                             units_from_pattern, utc_now)
 from gyrocomp.fleet.population import MIN_UNITS_FOR_OUTLIERS
 
-from ..conftest import run
 
 
 def _touch(root, *names):
@@ -175,24 +174,6 @@ def test_fleet_table_scores_only_a_population():
     few = fleet_table(_records(units[: MIN_UNITS_FOR_OUTLIERS - 1]))
     assert not few["outlier"].any() and few["outlier_score"].isna().all()
     assert fleet_yield(table).yield_fraction == 1.0
-
-
-def test_fleet_fit_refuses_bad_options_in_one_line(tmp_path):
-    _touch(tmp_path, "SN1/run_0.csv")
-    no_units = run("fleet", "fit", tmp_path, "-o", tmp_path / "out")
-    assert no_units.returncode == 2 and "give --unit-from PATTERN or --manifest FILE" in no_units.stderr
-    (tmp_path / "limits.toml").write_text("[noise]\nmax = 1\n")
-    bad = run("fleet", "fit", tmp_path, "--unit-from", "{serial}/run_{n}.csv", "-o", tmp_path / "out",
-              "--limits", tmp_path / "limits.toml")
-    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "[noise]: unknown figure" in bad.stderr
-    assert not (tmp_path / "out").exists()
-    every = run("fleet", "fit", tmp_path, "--unit-from", "{serial}/run_{n}.csv", "-o", tmp_path / "out",
-                "--scheduler", "serial")
-    assert every.returncode == 2 and "every unit failed (e.g. SN1:" in every.stderr
-    assert (tmp_path / "out" / "calibrations.sqlite").exists()  # the failure is on record
-    nowhere = run("fleet", "fit", tmp_path, "--unit-from", "{serial}/run_{n}.csv", "-o", tmp_path / "out2",
-                  "--scheduler", "tcp://127.0.0.1:9")
-    assert nowhere.returncode == 2 and "--scheduler: cannot reach a Dask scheduler at 'tcp://127.0.0.1:9'" in nowhere.stderr
 
 
 def test_units_given_twice_are_refused(tmp_path):

@@ -366,11 +366,3 @@ def test_names_that_say_the_project_units_are_read_without_a_mapping(tmp_path):
     np.testing.assert_allclose(read(both).gyro_dps[:, 0], 1.0)
 
 
-@pytest.mark.parametrize("suffix", [".tsv", ".dat", ".txt"])
-def test_every_suffix_of_a_delimited_table_is_read(tmp_path, suffix):
-    path = tmp_path / f"log{suffix}"
-    path.write_text("time\tgyro_z\ttemperature\n" + "".join(f"{t}\t0.5\t{20 + t / 10}\n" for t in range(50)))
-    rec = read(path)
-    assert rec.n_samples == 50 and rec.gyro_axes == ("gyro_z",)
-    result = run("convert", path, tmp_path / "out.csv")
-    assert result.returncode == 0, result.stderr

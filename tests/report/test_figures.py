@@ -8,7 +8,7 @@ from gyrocomp.errors import MissingDependencyError
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.report.figures import allan_figure
 
-from ..test_noise import static_recording
+from ..conftest import static_recording
 
 
 def test_allan_figure_is_a_png_with_both_sensor_panels(tmp_path):

@@ -85,6 +85,7 @@ class LazyGroup(click.Group):
         if name not in COMMANDS:
             return None
         command = getattr(importlib.import_module(f"gyrocomp.cli.{COMMANDS[name][0]}"), name)
+        _LOOKED_UP.append(command)
         if name == "init":  # init writes the project file: one that does not load must not stop it
             return command
         if PROJECT_KEY not in ctx.meta:
@@ -130,41 +131,45 @@ def cli(ctx, debug, quiet, allowed, config):
 
 
 # -- entry point ------------------------------------------------------------------------------------
-#: the library names its Python parameters in messages (``window_s: must be positive``, ``give axes= ...``);
-#: on the command line the user typed a flag, so the message names that instead
-PARAMETER_FLAGS = {
-    "window_s": "--window", "turn_on_window_s": "--turn-on-window", "rate_hz": "--rate", "axes": "--axes",
-    "static_min_duration_s": "--min-static", "acceleration": "--acceleration", "hysteresis": "--hysteresis",
-    "hysteresis_order": "--hysteresis-order", "hysteresis_band_degc": "--hysteresis-band",
-    "pipeline": "--pipeline", "channels": "--channels", "scale_factor": "--scale-factor", "columns": "--columns", "fmt": "--format",
-    "instance": "--instance", "device_id": "--device-id", "accel_device_id": "--accel-device-id", "record": "--record", "imu_topic": "--imu-topic",
-    "temperature_topic": "--temperature-topic", "gyro_unit": "--gyro-unit", "accel_unit": "--accel-unit",
-    "time_unit": "--time-unit", "time_range_s": "--time", "min_gap_s": "--min-gap", "min_still_s": "--min-still",
-    "min_leg_degc": "--min-leg", "by": "--by", "drop_nonfinite": "--drop-nan", "temperature": "--temperature",
-    "preset": "--preset", "profile": "--profile", "unit": "--unit", "disable": "--disable",
-    "set_points_degc": "--set-points", "ramp_rate_degc_per_min": "--ramp-rate", "position_s": "--position-time",
-    "dwell_s": "--dwell", "cycles": "--cycles", "duration_s": "--duration", "fit_taus_s": "--fit-taus",
-    "folds": "--folds", "target": "--target", "kalibr": "--kalibr", "split_gaps": "--split-gaps", "delimiter": "--delimiter",
-    "decimal": "--decimal", "scheduler": "--scheduler", "unit_pattern": "--unit-from", "memory_limit": "--memory-limit",
-    "prior": "--prior", "still_only": "--still-only", "bin_width_degc": "--bin-width",
-}
+#: the commands this process has looked up (the one it runs): their options say which flag sets which parameter
+_LOOKED_UP: list[click.Command] = []
 #: the option objects whose fields messages name (``FitOptions.hysteresis: ...``): the field is the flag's
 _OPTION_OBJECT = re.compile(r"\b(?:FitOptions|Polynomial|Network)\.(?=\w)")
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
-_SWITCH = re.compile(r"(?<![\w.\-/])(drop_nonfinite|split_gaps)=True\b")  # a switch: the flag alone
-_PARAMETER = re.compile(r"(?<![\w.\-/])(" + "|".join(sorted(PARAMETER_FLAGS, key=len, reverse=True)) + r")([:=])")
 
 
-def in_cli_words(message: str) -> str:
+def _options(command: click.Command) -> list[click.Option]:
+    """The options of a command, and of a group's commands."""
+    found = [p for p in command.params if isinstance(p, click.Option)]
+    for sub in getattr(command, "commands", {}).values():
+        found += _options(sub)
+    return found
+
+
+def in_cli_words(message: str, commands: list[click.Command] | None = None) -> str:
     """``message`` with the Python parameters it names (``name:`` or ``name=value``) as the flags that set them
-    (``--flag:``, ``--flag value``)."""
-    def flag(m: re.Match) -> str:
-        name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
-        if sep == ":":
-            return PARAMETER_FLAGS[name] + ":"
-        return PARAMETER_FLAGS[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
+    (``--flag:``, ``--flag value``; a switch, ``name=True``, as the flag alone).
 
-    message = _PARAMETER.sub(flag, _SWITCH.sub(r"\1=", _OPTION_OBJECT.sub("", message)))
+    The library names a parameter as the option's own name: every option of a command is declared under the name
+    of the library parameter it sets (``--drop-nan`` sets ``drop_nonfinite``; the reading options are made from
+    the fields of :class:`gyrocomp.io.ReadOptions`), so the flags come from the options of ``commands`` (default:
+    the command this process runs), with no table to keep in step."""
+    options = _options(cli) + [o for c in (_LOOKED_UP if commands is None else commands) for o in _options(c)]
+    flags = {o.name: max(o.opts, key=len) for o in options if o.name}
+    switches = {o.name for o in options if o.is_flag}
+    message = _OPTION_OBJECT.sub("", message)
+    if switches:
+        message = re.sub(r"(?<![\w.\-/])(" + "|".join(map(re.escape, switches)) + r")=True\b", r"\1=", message)
+    if flags:
+        names = "|".join(map(re.escape, sorted(flags, key=len, reverse=True)))
+
+        def flag(m: re.Match) -> str:
+            name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
+            if sep == ":":
+                return flags[name] + ":"
+            return flags[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
+
+        message = re.sub(r"(?<![\w.\-/])(" + names + r")([:=])", flag, message)
     return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
 
 

@@ -48,20 +48,20 @@ def _parse_fit_taus(text: str | None):
 @click.option("--taus", default="octave", show_default=True, help="octave, decade, all, or taus [s] such as 1,10,100.")
 @click.option("--json", "as_json", is_flag=True, help="Print curves and noise terms as JSON on stdout.")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write the Allan plot here (.png, .svg, .pdf).")
-@click.option("--kalibr", "kalibr_path", type=click.Path(dir_okay=False), help="Write Kalibr's imu.yaml here.")
+@click.option("--kalibr", "kalibr", type=click.Path(dir_okay=False), help="Write Kalibr's imu.yaml here.")
 @click.option("--rostopic", default="/imu0", show_default=True, help="rostopic written into the Kalibr file.")
 @click.option("--split-gaps", is_flag=True, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
-@click.option("--fit-taus", "fit_taus", default=None, metavar="MIN,MAX",
+@click.option("--fit-taus", "fit_taus_s", default=None, metavar="MIN,MAX",
               help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.")
 @read_options
 @click.pass_context
-def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, rostopic, split_gaps, fit_taus,
+def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopic, split_gaps, fit_taus_s,
           **kwargs):
     """Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of FILE."""
     opts = pop_read_options(kwargs)
     tau_spec = _parse_taus(taus)
-    fit_range = _parse_fit_taus(fit_taus)
-    for option, path in (("--plot", plot_path), ("--kalibr", kalibr_path)):
+    fit_range = _parse_fit_taus(fit_taus_s)
+    for option, path in (("--plot", plot_path), ("--kalibr", kalibr)):
         if path:
             refuse_to_overwrite_inputs(path, [input_path], option=option)
     if plot_path:
@@ -69,12 +69,12 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr_path, ro
     named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
     with progress_bar(f"reading {Path(input_path).name}") as progress:
         analysis = analyse_noise_file(input_path, named, options=read_settings(opts), fmt=opts["fmt"],
-                                      with_accel=bool(kalibr_path), kind=kind, taus=tau_spec, split_gaps=split_gaps,
+                                      with_accel=bool(kalibr), kind=kind, taus=tau_spec, split_gaps=split_gaps,
                                       fit_taus_s=fit_range, progress=progress)
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
-    if kalibr_path:
-        write_text_atomic(kalibr_path, kalibr_imu_yaml(kalibr_imu(analysis, rostopic)))
+    if kalibr:
+        write_text_atomic(kalibr, kalibr_imu_yaml(kalibr_imu(analysis, rostopic)))
     if plot_path:
         allan_figure(analysis, plot_path)
     if as_json:

@@ -13,7 +13,9 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 
 from ..errors import InputError
-from ..io import FORMATS, ReadOptions, TableLayout, parse_column_mapping, read_input
+from ..spelling import Spelling, from_values, spelled_fields
+from .projectfile import ReadingOption
+from ..io import FORMAT_SPELLING, ReadOptions, read_input
 from ..curves.network import DEFAULT_HIDDEN
 from ..models.options import Network, Polynomial
 from ..models.pipelines import check_channels
@@ -25,60 +27,33 @@ def make_console() -> Console:
     return Console(width=None if sys.stdout.isatty() else 160, highlight=False, markup=False)
 
 
+def _parsed(parse):
+    """A click callback giving the option's value as its spelling parses it (errors name the field, which the
+    command line shows as the flag)."""
+    return lambda ctx, param, value: parse(value) if isinstance(value, str) else value
+
+
+def click_option(name: str, spelling: Spelling):
+    """The click option of a typed field (:mod:`gyrocomp.spelling`): its flag, help and metavar, the field's name
+    as the parameter's, its value parsed as the spelling says."""
+    if spelling.switch:
+        return click.option(spelling.flag, name, is_flag=True, help=spelling.help, cls=ReadingOption)
+    return click.option(spelling.flag, name, default=None, metavar=spelling.metavar, help=spelling.help,
+                        callback=_parsed(spelling.parse) if spelling.parse else None, cls=ReadingOption)
+
+
+#: the reading options of every command that reads data: the input's format, then the fields of ReadOptions
+#: (and of its TableLayout), each defined once, where the library defines it
+READ_FIELDS = (("fmt", FORMAT_SPELLING),
+               *((field.name, spelling) for field, spelling in spelled_fields(ReadOptions)))
+READ_OPTIONS = tuple(name for name, _ in READ_FIELDS)
+
+
 def read_options(func):
     """Options every command that reads data files shares."""
-    options = [
-        click.option("--columns", "columns", metavar="CH=COL,...",
-                     help="Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T."),
-        click.option("--gyro-unit", default="deg/s", show_default=True, help="deg/s, rad/s or mdps."),
-        click.option("--accel-unit", default="g", show_default=True, help="g, mg or m/s2."),
-        click.option("--time-unit", default="s", show_default=True, help="s, ms, us or ns."),
-        click.option("--format", "fmt", default=None,
-                     help=f"Input format (default: told from the file): {', '.join(FORMATS)}."),
-        click.option("--delimiter", default=None,
-                     help="CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a tab)."),
-        click.option("--decimal", default=None, help="CSV decimal point, . or , (default: told from the first row)."),
-        click.option("--drop-nan", is_flag=True, help="Drop rows with empty/NaN values (says how many) instead of refusing the file."),
-        click.option("--instance", default=None, metavar="N",
-                     help="Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0); "
-                          "fit: all fits every instance, one model file each."),
-        click.option("--device-id", "device_id", type=int, default=None, help="PX4 device id of the gyro to read."),
-        click.option("--imu-topic", default=None, help="ROS bag: the sensor_msgs/Imu topic (default: the only one)."),
-        click.option("--temperature-topic", default=None,
-                     help="ROS bag: the sensor_msgs/Temperature topic (default: the only one)."),
-        click.option("--record", default=None, help="ArduPilot log: IMU (default) or TCLR (onboard learning records)."),
-        click.option("--time", "time_range", default=None, metavar="A:B",
-                     help="Only the samples from A to B seconds after the file's first ([A, B); A: or :B open)."),
-    ]
-    for option in reversed(options):
-        func = option(func)
+    for name, spelling in reversed(READ_FIELDS):
+        func = click_option(name, spelling)(func)
     return func
-
-
-def table_layout(columns, gyro_unit, accel_unit, time_unit, delimiter=None, decimal=None) -> TableLayout:
-    return TableLayout(parse_column_mapping(columns), gyro_unit, accel_unit, time_unit,
-                       "\t" if delimiter == "tab" else delimiter, decimal)
-
-
-READ_OPTIONS = ("columns", "gyro_unit", "accel_unit", "time_unit", "fmt", "drop_nan", "instance", "device_id",
-                 "imu_topic", "temperature_topic", "record", "delimiter", "decimal", "time_range")
-
-
-def parse_time_range(text: str | None) -> tuple[float | None, float | None] | None:
-    """``--time A:B`` -> (A, B) [s from the file's first sample]; an empty side is open."""
-    if text is None:
-        return None
-    parts = text.split(":")
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        bounds = tuple(None if p.strip() == "" else float(p) for p in parts)
-    except ValueError:
-        raise click.BadParameter(f"{text!r}: give A:B in seconds from the file's start (A: or :B for an open end)",
-                                 param_hint="--time") from None
-    if any(b is not None and not math.isfinite(b) for b in bounds) or bounds == (None, None):
-        raise click.BadParameter(f"{text!r}: give finite seconds on at least one side", param_hint="--time")
-    return bounds
 
 
 @contextlib.contextmanager
@@ -99,29 +74,7 @@ def progress_bar(description: str, indeterminate: bool = False):
 def read_settings(opts: dict, channels: tuple[str, ...] | None = None) -> ReadOptions:
     """The :class:`ReadOptions` the common reading options (``pop_read_options``) give; ``channels``: a table's
     channels to read (None: all)."""
-    layout = table_layout(opts["columns"], opts["gyro_unit"], opts["accel_unit"], opts["time_unit"], opts["delimiter"],
-                          opts["decimal"])
-    return ReadOptions(layout=layout, drop_nonfinite=opts["drop_nan"], instance=parse_instance(opts["instance"]),
-                       device_id=opts["device_id"], imu_topic=opts["imu_topic"],
-                       temperature_topic=opts["temperature_topic"], record=opts["record"], channels=channels,
-                       time_range_s=parse_time_range(opts["time_range"]))
-
-
-def parse_instance(text: str | int | None) -> int | None:
-    """``--instance``: a whole number >= 0 (``all`` is taken by ``gyrocomp fit`` before reading)."""
-    if text is None or isinstance(text, int):
-        return text
-    if text.strip().lower() == "all":
-        raise click.BadParameter("all is for gyrocomp fit (one model per instance); give a number here",
-                                 param_hint="--instance")
-    try:
-        value = int(text)
-    except ValueError:
-        raise click.BadParameter(f"{text!r}: give a whole number >= 0 (or all, in gyrocomp fit)",
-                                 param_hint="--instance") from None
-    if value < 0:
-        raise click.BadParameter(f"{value}: give a whole number >= 0", param_hint="--instance")
-    return value
+    return from_values(ReadOptions, {**opts, "channels": channels})
 
 
 def read_run(path, opts: dict, channels: tuple[str, ...] | None = None):
@@ -213,4 +166,4 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-__all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "pop_read_options", "parse_instance", "progress_bar", "read_options", "read_run", "read_settings", "table_layout"]
+__all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings"]

@@ -37,7 +37,7 @@ from .render import print_contributions, print_fit
                    "when the runs both heat and cool.")
 @click.option("--hysteresis-order", default="auto", show_default=True,
               help="Order of the turning-point polynomial in |T - T_turn|: auto (validated) or 1..3.")
-@click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
+@click.option("--hysteresis-band", "hysteresis_band_degc", default=None, metavar="LO,HI",
               help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.")
 @click.option("--acceleration", type=click.Choice(["auto", *ACCELERATION_CHOICES]), default="auto", show_default=True,
               help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
@@ -73,7 +73,7 @@ from .render import print_contributions, print_fit
                    "own noise: yes for every run, auto for the runs still less than half the time, no for none.")
 @read_options
 @click.pass_context
-def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band,
+def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band_degc,
         acceleration, pipeline, static_min_duration_s, channels, folds, target, scale_factor, rate_schedule,
         still_only, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still
@@ -85,7 +85,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         if hysteresis_order not in ("1", "2", "3"):
             raise click.BadParameter("use auto, 1, 2 or 3", param_hint="--hysteresis-order")
         hysteresis_order = int(hysteresis_order)
-    band = float_list(hysteresis_band, "--hysteresis-band")
+    band = float_list(hysteresis_band_degc, "--hysteresis-band")
     if band is not None and (len(band) != 2 or not band[0] < band[1]):
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     channels = parse_channels(channels)

@@ -47,14 +47,14 @@ def fleet():
 @click.option("--memory-limit", default="auto", show_default=True,
               help="Local cluster: memory per worker (e.g. 2GiB; auto shares the machine's memory out).")
 @click.option("--store", default=None, help="Store the calibrations here instead (an SQLite file or a SQLAlchemy URL).")
-@click.option("--prior", "prior_store", default=None,
+@click.option("--prior", "prior", default=None,
               help="A calibrated fleet (its folder, SQLite file or database URL): fit each unit with that "
                    "population as the prior, for short chamber runs.")
 @click.option("--channels", default="gyro", show_default=True, help="gyro, accel or gyro,accel (as gyrocomp fit).")
 @click.option("--pipeline", default="joint", show_default=True, help="As gyrocomp fit.")
 @read_options
 @click.pass_context
-def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, workers, memory_limit, store, prior_store,
+def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, workers, memory_limit, store, prior,
         channels, pipeline, **kwargs):
     """Fit every unit of DATA (folders, globs or files of runs; none with --manifest) as gyrocomp fit would, in
     parallel; rerun to fit only the units whose runs changed."""
@@ -73,12 +73,12 @@ def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, worke
     limits = Limits.load(limits_file) if limits_file else None
     for unit in units:
         refuse_to_overwrite_inputs(output, unit.paths)
-    prior = None
-    if prior_store is not None:
-        with CalibrationStore(prior_store) as db:
-            prior = population_prior(db.latest_rows())
+    population = None
+    if prior is not None:
+        with CalibrationStore(prior) as db:
+            population = population_prior(db.latest_rows())
     settings = FleetSettings(channels=parse_channels(channels), pipeline=pipeline,
-                             read=read_settings(opts), fmt=opts["fmt"], prior=prior)
+                             read=read_settings(opts), fmt=opts["fmt"], prior=population)
     memory = int(memory_limit) if memory_limit.isdigit() else memory_limit
     with progress_bar(f"fitting {len(units)} units") as bar:
         summary = fit_fleet(units, output, settings, limits=limits, scheduler=scheduler, workers=workers,

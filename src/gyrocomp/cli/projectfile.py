@@ -22,9 +22,11 @@ from ..errors import InputError
 PROJECT_FILE = "gyrocomp.toml"
 #: where the command group keeps the loaded project for the commands (click's shared ``Context.meta``)
 PROJECT_KEY = "gyrocomp.project"
-#: the options ``[read]`` may hold (every command that reads data has them)
-READ_KEYS = ("columns", "gyro-unit", "accel-unit", "time-unit", "format", "delimiter", "decimal", "drop-nan",
-             "instance", "device-id", "imu-topic", "temperature-topic", "record")
+
+
+class ReadingOption(click.Option):
+    """A reading option (made from the fields of :class:`gyrocomp.io.ReadOptions` by :mod:`gyrocomp.cli.common`):
+    the options ``[read]`` may hold are those of the command that runs."""
 
 
 @dataclass(frozen=True)
@@ -54,7 +56,8 @@ def _columns_text(value, path: str) -> str:
 
 def load_project(given: str | None, commands: tuple[str, ...]) -> Project | None:
     """The project file given (``--config``), else ``gyrocomp.toml`` in the working folder, else None; refuses in
-    one line a file that is not TOML, a section that is no command, a ``[read]`` key that is no reading option."""
+    one line a file that is not TOML or a section that is no command (a ``[read]`` key that is no reading option is
+    refused by :func:`defaults_for`, against the reading options of the command that runs)."""
     path = Path(given) if given else Path(PROJECT_FILE)
     if not path.is_file():
         if given:
@@ -65,9 +68,6 @@ def load_project(given: str | None, commands: tuple[str, ...]) -> Project | None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not a readable TOML file ({exc})") from None
     read = {_key(k): v for k, v in data.pop("read", {}).items()}
-    for key in read:
-        if key not in READ_KEYS:
-            raise InputError(f"{path}: [read] {key}: not a reading option; use {', '.join(READ_KEYS)}")
     if "columns" in read:
         read["columns"] = _columns_text(read["columns"], str(path))
     defaults = {_key(k): v for k, v in data.pop("defaults", {}).items()}
@@ -95,6 +95,11 @@ def defaults_for(project: Project, command: click.Command, name: str) -> dict:
     group's commands nested."""
     flags = {opt.lstrip("-"): param.name for param in command.params if isinstance(param, click.Option)
              for opt in param.opts if opt.startswith("--")}
+    reading = sorted(opt.lstrip("-") for param in command.params if isinstance(param, ReadingOption)
+                     for opt in param.opts if opt.startswith("--"))
+    for key in project.read if reading else ():
+        if key not in reading:
+            raise InputError(f"{project.path}: [read] {key}: not a reading option; use {', '.join(reading)}")
     out = {flags[k]: v for k, v in {**project.read, **project.defaults}.items() if k in flags}
     for key, value in project.commands.get(name, {}).items():
         if key not in flags:
@@ -106,4 +111,4 @@ def defaults_for(project: Project, command: click.Command, name: str) -> dict:
     return out
 
 
-__all__ = ["PROJECT_FILE", "PROJECT_KEY", "Project", "READ_KEYS", "defaults_for", "load_project"]
+__all__ = ["PROJECT_FILE", "PROJECT_KEY", "Project", "ReadingOption", "defaults_for", "load_project"]

@@ -31,10 +31,10 @@ from .common import FINITE, float_list
 @click.option("--disable", default=None, metavar="TERM,...",
               help="Switch error terms off: temperature, lag, hysteresis, g-sensitivity, scale-factor, "
                    "misalignment, turn-on, noise, quantization, temperature-noise.")
-@click.option("--set-points", "set_points", default=None, metavar="T1,T2,...",
+@click.option("--set-points", "set_points_degc", default=None, metavar="T1,T2,...",
               help="Chamber set points [degC] (default: the preset's range); static, tumble and ratetable: one run "
                    "per set point.")
-@click.option("--ramp-rate", "ramp_rate", type=FINITE, default=None, help="Ramp rate between set points [degC/min].")
+@click.option("--ramp-rate", "ramp_rate_degc_per_min", type=FINITE, default=None, help="Ramp rate between set points [degC/min].")
 @click.option("--dwell", "dwell_s", type=FINITE, default=None, help="Time held at each set point [s].")
 @click.option("--cycles", type=int, default=None, help="Cold-hot-cold repetitions of the cycle profile.")
 @click.option("--position-time", "position_s", type=FINITE, default=None,
@@ -47,7 +47,7 @@ from .common import FINITE, float_list
 @click.option("--truth-columns", is_flag=True,
               help="Add true_error_gyro_*, true_noise_gyro_*, true_rate_gyro_* and true_structure_temperature columns.")
 @click.pass_context
-def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, disable, set_points, ramp_rate, dwell_s,
+def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, disable, set_points_degc, ramp_rate_degc_per_min, dwell_s,
              cycles, position_s, rates, output, truth, truth_columns):
     """Simulate calibration runs of a sensor preset through a test profile, with the exact truth."""
 
@@ -58,8 +58,8 @@ def simulate(ctx, preset, profile, duration_s, rate_hz, seed, runs, unit, axes, 
         model = model.without(*(t.strip() for t in disable.split(",") if t.strip()))
     if runs < 1:
         raise click.BadParameter("must be at least 1", param_hint="--runs")
-    prof = resolve_profile(profile, preset, set_points_degc=float_list(set_points, "--set-points"),
-                           ramp_rate_degc_per_min=ramp_rate, dwell_s=dwell_s, cycles=cycles, position_s=position_s,
+    prof = resolve_profile(profile, preset, set_points_degc=float_list(set_points_degc, "--set-points"),
+                           ramp_rate_degc_per_min=ramp_rate_degc_per_min, dwell_s=dwell_s, cycles=cycles, position_s=position_s,
                            rates_dps=float_list(rates, "--rates"))
     if runs == 1 and prof.name in ONE_TEMPERATURE_PROFILES and len(prof.set_points_degc) > 1:
         runs = len(prof.set_points_degc)  # one run per temperature

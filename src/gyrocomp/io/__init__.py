@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
+from ..spelling import Spelling
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
 from .common import ProgressCallback, ReadOptions, sniff_format
 from .dataflash import dataflash_instances, read_dataflash
@@ -37,6 +38,8 @@ from .ulog import read_ulog, ulog_instances
 TABLE_FORMATS = ("csv", "parquet")
 LOG_FORMATS = ("ulog", "dataflash", "rosbag", "hdf5")
 FORMATS = TABLE_FORMATS + LOG_FORMATS
+#: the reading functions' ``fmt`` parameter on the command line
+FORMAT_SPELLING = Spelling("--format", f"Input format (default: told from the file): {', '.join(FORMATS)}.")
 #: aliases accepted by ``--format``
 FORMAT_ALIASES = {"ulg": "ulog", "px4": "ulog", "bin": "dataflash", "ardupilot": "dataflash", "bag": "rosbag",
                   "ros": "rosbag", "netcdf": "hdf5", "nc": "hdf5", "h5": "hdf5", "pq": "parquet"}
@@ -200,6 +203,7 @@ def read(
 
 __all__ = [
     "FORMATS",
+    "FORMAT_SPELLING",
     "LOG_FORMATS",
     "LOG_READERS",
     "ReadOptions",

@@ -7,7 +7,7 @@ import lzma
 import os
 import re
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +17,7 @@ import pyarrow.parquet as pq
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
+from ..spelling import Spelling, spelled
 from ..units import unit_factor
 from .atomic import arrow_source, atomic_path
 
@@ -39,6 +40,29 @@ def unit_named(name: str) -> str:
     return name + ("_g" if name in ACCEL_AXES else "_dps")
 
 
+def parse_column_mapping(text: str | None) -> dict[str, str]:
+    """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``; a comma inside
+    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array)."""
+    if not text:
+        return {}
+    mapping = {}
+    for item in re.split(r",(?![^\[]*\])", text):
+        if not item.strip():
+            continue
+        if "=" not in item:
+            raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
+        key, value = (part.strip() for part in item.split("=", 1))
+        if not key or not value:
+            raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
+        mapping[key] = value
+    return mapping
+
+
+def _delimiter(text: str) -> str:
+    """``--delimiter``'s text: ``tab`` (or ``\\t``) for a tab, else the character."""
+    return "\t" if text.strip().lower() in ("tab", "\\t") else text
+
+
 @dataclass(frozen=True)
 class TableLayout:
     """How a table's columns map to gyrocomp's channels, and the units they are in.
@@ -56,12 +80,17 @@ class TableLayout:
         CSV decimal point; default: a comma when the separator is not one and the first row's numbers have one.
     """
 
-    columns: dict[str, str] = field(default_factory=dict)
-    gyro_unit: str = "deg/s"
-    accel_unit: str = "g"
-    time_unit: str = "s"
-    delimiter: str | None = None
-    decimal: str | None = None
+    columns: dict[str, str] = spelled(Spelling(
+        "--columns", "Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T.", metavar="CH=COL,...",
+        parse=parse_column_mapping), default_factory=dict)
+    gyro_unit: str = spelled(Spelling("--gyro-unit", "deg/s, rad/s or mdps [default: deg/s]."), default="deg/s")
+    accel_unit: str = spelled(Spelling("--accel-unit", "g, mg or m/s2 [default: g]."), default="g")
+    time_unit: str = spelled(Spelling("--time-unit", "s, ms, us or ns [default: s]."), default="s")
+    delimiter: str | None = spelled(Spelling(
+        "--delimiter", "CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a "
+        "tab).", parse=_delimiter), default=None)
+    decimal: str | None = spelled(Spelling("--decimal", "CSV decimal point, . or , (default: told from the first row)."),
+                                  default=None)
 
     def __post_init__(self) -> None:
         for canonical in self.columns:
@@ -129,24 +158,6 @@ class TableLayout:
                 f"{canonical!r} stays as it was",
                 DataQualityWarning, stacklevel=4,
             )
-
-
-def parse_column_mapping(text: str | None) -> dict[str, str]:
-    """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``; a comma inside
-    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array)."""
-    if not text:
-        return {}
-    mapping = {}
-    for item in re.split(r",(?![^\[]*\])", text):
-        if not item.strip():
-            continue
-        if "=" not in item:
-            raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
-        key, value = (part.strip() for part in item.split("=", 1))
-        if not key or not value:
-            raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
-        mapping[key] = value
-    return mapping
 
 
 @dataclass(frozen=True, eq=False)

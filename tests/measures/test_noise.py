@@ -11,17 +11,7 @@ from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.recording import Recording
 
-
-def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0):
-    rng = np.random.default_rng(seed)
-    time_s = np.arange(n) / rate_hz
-    if gap_after is not None:
-        time_s[gap_after:] += 10.0  # a 10 s hole
-    gyro = rng.standard_normal((n, 2)) * 0.01 * math.sqrt(rate_hz)  # N = 0.01 deg/s/sqrt(Hz)
-    accel = np.column_stack([rng.standard_normal(n) * 1e-3, rng.standard_normal(n) * 1e-3,
-                             1.0 + rng.standard_normal(n) * 1e-3])
-    return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=("gyro_x", "gyro_z"), accel_g=accel,
-                     accel_axes=("accel_x", "accel_y", "accel_z"), source="static.csv")
+from ..conftest import static_recording
 
 
 def test_every_gyro_axis_by_default_and_accelerometers_on_request():

@@ -25,7 +25,7 @@ from gyrocomp.allan import (
 )
 from gyrocomp.errors import InputError
 
-from .conftest import shared_dataset
+from ..conftest import shared_dataset
 
 
 def brute_force_oadev(rate, m):

@@ -32,7 +32,7 @@ from gyrocomp.measures.plausibility import (
 from gyrocomp.recording import Recording
 from gyrocomp.simulate import simulate
 
-from .conftest import run, xsens_session
+from ..conftest import run, xsens_session
 
 RUN = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=1).recording
 

@@ -7,30 +7,15 @@ import pytest
 from gyrocomp import read
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout
-from gyrocomp.io.tables import write_recording
-from gyrocomp.recording import Recording
 from gyrocomp.recording.runsplit import split_runs
 from gyrocomp.simulate import get_profile, simulate
 
-from .conftest import run
-
-
-def _joined(pieces, gap_s):
-    """Recordings one after another, each next one starting gap_s after the previous ended."""
-    times, gyro, temps, start = [], [], [], 0.0
-    for rec in pieces:
-        t = rec.time_s - rec.time_s[0] + start
-        times.append(t)
-        gyro.append(rec.gyro_dps)
-        temps.append(rec.temperature_degc)
-        start = t[-1] + gap_s
-    return Recording(np.concatenate(times), np.concatenate(gyro), pieces[0].gyro_axes,
-                     temperature_degc=np.concatenate(temps), source="joined")
+from ..conftest import joined_recordings, run
 
 
 def test_power_on_and_gap_cut_where_the_logger_stopped():
     parts = [simulate("consumer", profile="warmup", duration_s=600, rate_hz=10, seed=s).recording for s in range(3)]
-    joined = _joined(parts, 300.0)
+    joined = joined_recordings(parts, 300.0)
     pieces = split_runs(joined, "power-on")
     assert [p.recording.n_samples for p in pieces] == [p.n_samples for p in parts]
     assert [p.start for p in pieces] == [0, parts[0].n_samples, parts[0].n_samples + parts[1].n_samples]
@@ -68,41 +53,6 @@ def test_bad_splits_are_refused():
         split_runs(rec, "power-on", min_gap_s=0.0)
     with pytest.raises(InputError, match=r"by=still: no run of 10 samples or more found"):
         split_runs(rec, "still", min_still_s=1e6)
-
-
-def test_split_through_the_command_line(tmp_path):
-    parts = [simulate("consumer", profile="warmup", duration_s=300, rate_hz=10, seed=s).recording for s in range(2)]
-    log = tmp_path / "two.csv"
-    write_recording(_joined(parts, 120.0), log)
-    result = run("split", log, "-o", tmp_path / "runs", "--by", "power-on")
-    assert result.returncode == 0, result.stderr
-    assert "wrote 2 run(s)" in result.stdout
-    written = sorted((tmp_path / "runs").glob("*.csv"))
-    assert [p.name for p in written] == ["two_run1.csv", "two_run2.csv"]
-    np.testing.assert_allclose(read(written[1]).gyro_dps, parts[1].gyro_dps, rtol=1e-12)
-    again = run("split", log, "-o", tmp_path / "runs", "--by", "power-on")
-    assert again.returncode == 2 and "two_run1.csv exists; split into an empty folder" in again.stderr
-
-
-def test_time_selects_rows_in_every_reading_path(tmp_path):
-    """--time A:B keeps [A, B) seconds from the first sample, in convert, apply (whole-file path), allan and
-    evaluate; an empty range is refused naming the file's length."""
-    rec = simulate("consumer", profile="warmup", duration_s=200, rate_hz=10, seed=3).recording
-    path = tmp_path / "r.csv"
-    write_recording(rec, path)
-    out = tmp_path / "cut.csv"
-    assert run("convert", path, out, "--time", "50:100").returncode == 0
-    cut = read(out)
-    assert cut.n_samples == 500 and cut.time_s[0] == pytest.approx(rec.time_s[0] + 50.0)
-    assert read(path, time_range_s=(None, 20.0)).n_samples == 200
-    assert run("fit", path, "-o", tmp_path / "m.json", "--temperature", "none").returncode == 0
-    applied = run("apply", tmp_path / "m.json", path, "-o", tmp_path / "a.csv", "--time", "150:")
-    assert applied.returncode == 0 and read(tmp_path / "a.csv").n_samples == rec.n_samples - 1500
-    assert run("allan", path, "--time", ":100").returncode == 0
-    empty = run("convert", path, tmp_path / "none.csv", "--time", "500:")
-    assert empty.returncode == 2 and "--time 500: holds no sample; the file lasts 200 s" in empty.stderr
-    bad = run("convert", path, tmp_path / "none.csv", "--time", "a:b")
-    assert bad.returncode == 2 and "--time" in bad.stderr and not (tmp_path / "none.csv").exists()
 
 
 def test_a_column_of_an_hdf5_array(tmp_path):

@@ -25,7 +25,7 @@ from gyrocomp.simulate import AccelErrorModel, get_profile, preset_model, simula
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
 
-from .conftest import run, xsens_session
+from ..conftest import run, xsens_session
 
 #: a hand-turned session: the six faces in turn (90 deg turns about every axis, both ways), then three poses
 #: tilted between the axes; 1 s per turn, 10 s per pose

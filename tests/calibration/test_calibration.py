@@ -192,7 +192,7 @@ def test_a_valid_file_still_loads_and_applies_identically(calibration, tmp_path)
 
 
 def test_schema_5_file_written_by_the_previous_release_loads_and_applies_identically():
-    """tests/data/schema5: a model file written by gyrocomp at commit dcded69 (schema 5; its fit_report emptied
+    """tests/calibration/data/schema5: a model file written by gyrocomp at commit dcded69 (schema 5; its fit_report emptied
     to keep the file small, apply does not read it) and a held-out run with the output that version's apply
     gave (``expected_gyro_*``, turn-on window 60 s)."""
     folder = Path(__file__).parent / "data" / "schema5"

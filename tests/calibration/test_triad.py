@@ -27,7 +27,7 @@ from gyrocomp.simulate import AccelErrorModel, GyroErrorModel, get_profile, pres
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions, Polynomial
 
-from .conftest import run, shared_dataset, xsens_session
+from ..conftest import run, shared_dataset, xsens_session
 
 #: a triad with 0.2-0.4 % scale errors and 1-2 mrad misalignments, 20-30 mg bias, 100 ug/sqrt(Hz) noise
 ACCEL = AccelErrorModel(bias_g=(0.02, -0.015, 0.03), noise_density_g_per_sqrt_hz=100e-6,

@@ -16,11 +16,9 @@ import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 from scipy.stats import chi2, norm
 
-from gyrocomp.calibration import Calibration
 from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError, NotFittedError
 from gyrocomp.export.c_learner import TEMPLATES, learner_c_sources, template_values
-from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.online import LearnerSettings, OnlineCalibrator, block_statistics, chi2_quantile, replay
 from gyrocomp.models.pipelines import fit_channels
@@ -28,7 +26,6 @@ from gyrocomp.simulate import get_profile, resolve_profile, simulate
 from gyrocomp.simulate.presets import preset_model
 from gyrocomp.motion.stillness import detect_still
 
-from ..conftest import run
 
 PRESET, UNIT = "consumer", 3
 CC = shutil.which("cc") or shutil.which("gcc")
@@ -376,42 +373,6 @@ def test_a_narrow_range_gives_no_temperature_model():
 
 
 @pytest.mark.slow
-def test_learn_through_the_command_line(tmp_path):
-    """gyrocomp learn on two logs; in two steps (--save-state, then --resume) the same model; apply takes it;
-    a log without still data exits 2 in one line, writing nothing."""
-    paths = []
-    for k, rec in enumerate(_field_logs(2, 10.0, first_seed=80)):
-        paths.append(tmp_path / f"log{k}.csv")
-        write_recording(rec, paths[-1])
-    done = run("learn", *paths, "-o", tmp_path / "all.json")
-    assert done.returncode == 0, done.stderr
-    assert "logs replayed" in done.stdout and "learned: curve of degree 3" in done.stdout
-    assert run("-q", "learn", paths[0], "-o", tmp_path / "first.json", "--save-state",
-               tmp_path / "state.json").returncode == 0
-    done = run("-q", "learn", paths[1], "--resume", tmp_path / "state.json", "-o", tmp_path / "second.json")
-    assert done.returncode == 0, done.stderr
-    one, two = (Calibration.load(tmp_path / n) for n in ("all.json", "second.json"))
-    assert one.axes == two.axes
-    assert [entry["file"] for entry in one.provenance["inputs"]] == ["log0.csv", "log1.csv"]
-    assert run("-q", "apply", tmp_path / "all.json", paths[0], "-o", tmp_path / "out.csv").returncode == 0
-    # the C export bakes a learner state's settings (here 2.5 degC bins) into gyrocomp_learn.c
-    OnlineCalibrator(LearnerSettings(rate_hz=10.0, bin_width_degc=2.5)).save(tmp_path / "coarse.json")
-    done = run("-q", "export", tmp_path / "all.json", "--format", "c", "--rate", 10, "--learner",
-               tmp_path / "coarse.json", "-o", tmp_path / "c")
-    assert done.returncode == 0, done.stderr
-    assert "BIN_WIDTH = 2.5," in (tmp_path / "c" / "gyrocomp_learn.c").read_text()
-    done = run("export", tmp_path / "all.json", "--format", "px4", "--learner", tmp_path / "coarse.json", "-o",
-               tmp_path / "x.params")
-    assert done.returncode == 2 and "--learner" in done.stderr and not (tmp_path / "x.params").exists()
-    moving = simulate(PRESET, profile="tumble", rate_hz=10.0, duration_s=600, seed=1, unit=UNIT).recording
-    write_recording(moving, tmp_path / "moving.csv")
-    done = run("learn", tmp_path / "moving.csv", "-o", tmp_path / "none.json", "--save-state", tmp_path / "s.json")
-    assert done.returncode == 2 and "no model yet" in done.stderr and len(done.stderr.strip().splitlines()) == 1
-    assert not (tmp_path / "none.json").exists() and not (tmp_path / "s.json").exists()
-    done = run("learn", paths[0], "-o", tmp_path / "x.json", "--save-state", tmp_path / "x.json")
-    assert done.returncode == 2 and "--save-state" in done.stderr
-
-
 def test_a_single_axis_gyro_learns_its_axis():
     """The thesis's ADXRS450 (gyro_z only): the missing axes read nothing and are never tested; the model file
     holds gyro_z alone and removes most of its drift on a held-out chamber run (measured: 0.143 -> 0.013 deg/s)."""

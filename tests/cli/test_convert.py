@@ -1,0 +1,77 @@
+"""``gyrocomp convert`` through the real entry point: any table to the canonical one, rows selected by time."""
+
+from __future__ import annotations
+
+import os
+import pty
+import subprocess
+import sys
+
+import pytest
+
+from gyrocomp import read
+from gyrocomp.io.tables import write_recording
+from gyrocomp.simulate import simulate
+
+from ..conftest import SCRIPT, run
+
+
+def test_time_selects_rows_in_every_reading_path(tmp_path):
+    """--time A:B keeps [A, B) seconds from the first sample, in convert, apply (whole-file path), allan and
+    evaluate; an empty range is refused naming the file's length."""
+    rec = simulate("consumer", profile="warmup", duration_s=200, rate_hz=10, seed=3).recording
+    path = tmp_path / "r.csv"
+    write_recording(rec, path)
+    out = tmp_path / "cut.csv"
+    assert run("convert", path, out, "--time", "50:100").returncode == 0
+    cut = read(out)
+    assert cut.n_samples == 500 and cut.time_s[0] == pytest.approx(rec.time_s[0] + 50.0)
+    assert read(path, time_range_s=(None, 20.0)).n_samples == 200
+    assert run("fit", path, "-o", tmp_path / "m.json", "--temperature", "none").returncode == 0
+    applied = run("apply", tmp_path / "m.json", path, "-o", tmp_path / "a.csv", "--time", "150:")
+    assert applied.returncode == 0 and read(tmp_path / "a.csv").n_samples == rec.n_samples - 1500
+    assert run("allan", path, "--time", ":100").returncode == 0
+    empty = run("convert", path, tmp_path / "none.csv", "--time", "500:")
+    assert empty.returncode == 2 and "--time 500: holds no sample; the file lasts 200 s" in empty.stderr
+    bad = run("convert", path, tmp_path / "none.csv", "--time", "a:b")
+    assert bad.returncode == 2 and "--time" in bad.stderr and not (tmp_path / "none.csv").exists()
+
+
+@pytest.mark.parametrize("suffix", [".tsv", ".dat", ".txt"])
+def test_every_suffix_of_a_delimited_table_is_read(tmp_path, suffix):
+    path = tmp_path / f"log{suffix}"
+    path.write_text("time\tgyro_z\ttemperature\n" + "".join(f"{t}\t0.5\t{20 + t / 10}\n" for t in range(50)))
+    rec = read(path)
+    assert rec.n_samples == 50 and rec.gyro_axes == ("gyro_z",)
+    result = run("convert", path, tmp_path / "out.csv")
+    assert result.returncode == 0, result.stderr
+
+
+def test_progress_bar_on_a_terminal_only(report_files):
+    d = report_files
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+
+    def stderr_of(*extra):
+        master, slave = pty.openpty()
+        done = subprocess.run([*cmd, *extra, "convert", str(d / "run2.csv"), str(d / "tty.parquet")],
+                               stdout=subprocess.PIPE, stderr=slave, timeout=300)
+        os.close(slave)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(master, 65536)
+            except OSError:
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        os.close(master)
+        assert done.returncode == 0
+        return b"".join(chunks)
+
+    bar = b"\xe2\x94\x81"  # the bar's glyph
+    shown = stderr_of()
+    assert b"reading run2.csv" in shown and bar in shown
+    assert bar not in stderr_of("--quiet")
+    piped = run("convert", d / "run2.csv", d / "piped.parquet")
+    assert bar.decode() not in piped.stderr  # not a terminal: no bar
