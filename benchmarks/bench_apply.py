@@ -24,7 +24,7 @@ import pyarrow.csv as pacsv
 from gyrocomp import fit_calibration
 from gyrocomp.cli import main
 from gyrocomp.io import write_recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from busy import busy_neighbour
 

@@ -35,7 +35,7 @@ import pyarrow.parquet as pq
 
 from gyrocomp.io.tables import recording_table
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 BLOCK_ROWS = 360_000  # one simulated hour at 100 Hz
 

@@ -31,7 +31,7 @@ from gyrocomp.export.autopilot import ardupilot_parameters, px4_parameters
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_calibration
-from gyrocomp.simulate import get_preset, get_profile, simulate
+from gyrocomp.simulation import get_preset, get_profile, simulate
 
 RATE_HZ = 2.0
 WINDOW = int(60 * RATE_HZ)

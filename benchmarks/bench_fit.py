@@ -30,7 +30,7 @@ import numpy as np
 
 from busy import busy_neighbour
 from gyrocomp import fit_calibration
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic, validate
 
 

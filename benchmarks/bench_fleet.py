@@ -29,7 +29,7 @@ from dask.distributed import Client, LocalCluster
 
 from gyrocomp.fleet import expand_inputs, fit_fleet, units_from_pattern
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 
 def peak_rss_mb() -> float:

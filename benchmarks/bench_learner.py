@@ -29,7 +29,7 @@ from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.field import field_recordings
 from gyrocomp.fitting.online import OnlineCalibrator, replay
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import get_profile, resolve_profile, simulate
+from gyrocomp.simulation import get_profile, resolve_profile, simulate
 
 LOGS = 10
 

@@ -36,7 +36,7 @@ from gyrocomp.fleet import CalibrationStore, UnitRuns, fit_fleet, fit_with_prior
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import preset_model, resolve_profile, simulate
+from gyrocomp.simulation import preset_model, resolve_profile, simulate
 
 RUN_S, RATE_HZ, RUNS = 900.0, 10.0, 3
 COVERAGES = {"a third (10..40 degC)": (10.0, 40.0), "half (2.5..47.5 degC)": (2.5, 47.5),

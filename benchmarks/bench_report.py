@@ -24,7 +24,7 @@ import numpy as np
 from gyrocomp import apply, fit_calibration
 from gyrocomp.allan import allan_deviation
 from gyrocomp.report.html import build_report
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 
 def timed(func):

@@ -20,7 +20,7 @@ import resource
 import numpy as np
 from bench_apply import best_of  # run as a script from the repository root: benchmarks/ is on the path
 
-from gyrocomp.simulate import error_model, get_profile, simulate
+from gyrocomp.simulation import error_model, get_profile, simulate
 
 
 def main() -> None:

@@ -19,7 +19,7 @@ import pytest
 from gyrocomp import Compensator, apply
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
-from gyrocomp.simulate import GyroErrorModel, simulate
+from gyrocomp.simulation import GyroErrorModel, simulate
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"

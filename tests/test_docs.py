@@ -31,7 +31,7 @@ def test_every_page_is_in_the_sites_navigation():
 def test_the_readmes_python_example_runs(tmp_path, monkeypatch):
     """The three lines of the README's Python example, on simulated chamber runs written as the files it names."""
     from gyrocomp.io.tables import write_recording
-    from gyrocomp.simulate import get_profile, simulate
+    from gyrocomp.simulation import get_profile, simulate
 
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     code = re.search(r"```python\n(.*?)```", text, flags=re.S).group(1)

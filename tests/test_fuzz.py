@@ -23,7 +23,7 @@ from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout, read, read_table
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from .conftest import shared_dataset
 

@@ -17,7 +17,7 @@ LAYERS = (
                     "spill", "spelling")),
     # what a recording is and what is measured of it: the recording and its preparation, motion (stillness,
     # static positions), measures (figures of merit, noise terms, plausibility), Allan statistics, simulation
-    ("signals", ("recording", "motion", "measures", "allan", "simulate")),
+    ("signals", ("recording", "motion", "measures", "allan", "simulation")),
     ("io", ("io",)),
     # the frozen curves a calibration holds (polynomial, network, lookup table, hysteresis) and their registry
     ("curves", ("curves",)),

@@ -50,7 +50,7 @@ import pandas as pd
 
 from gyrocomp import Polynomial, fit_calibration, write
 from gyrocomp.cli import main
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 BAD = ("internal error", "multi-line error", "non-finite written", "security hole", "silently wrong")
 NAMES = ["time", "gyro_x", "gyro_y", "gyro_z", "accel_z", "temperature", "Time", " gyro_z ", "GyrZ", ""]

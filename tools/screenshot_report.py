@@ -18,7 +18,7 @@ from pathlib import Path
 
 from gyrocomp import fit_calibration
 from gyrocomp.report.html import build_report
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                   "--disable-background-networking", "--disable-component-update", "--disable-sync",

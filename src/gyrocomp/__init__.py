@@ -10,8 +10,6 @@ works as usual.
 from __future__ import annotations
 
 import importlib
-import sys
-import types
 
 from ._version import __version__
 
@@ -42,7 +40,7 @@ _EXPORTS = {
     "fit_accel_multiposition": ("fitting.triad", "fit_accel_multiposition"),
     "fit_gyro_rate_table": ("fitting.triad", "fit_gyro_rate_table"),
     "analyse_noise": ("measures.noise", "analyse_noise"), "Recording": ("recording", "Recording"),
-    "simulate": ("simulate", "simulate"), "TriadCalibration": ("calibration.triad", "TriadCalibration"),
+    "simulate": ("simulation", "simulate"), "TriadCalibration": ("calibration.triad", "TriadCalibration"),
     "validate": ("evaluation.validation", "validate"),
     "detect_still": ("motion.stillness", "detect_still"), "StillnessState": ("motion.stillness", "StillnessState"),
     "field_recordings": ("models.field", "field_recordings"),
@@ -53,23 +51,6 @@ _EXPORTS = {
 def _load(name: str):
     module, attribute = _EXPORTS[name]
     return getattr(importlib.import_module(f"gyrocomp.{module}"), attribute)
-
-
-class _Package(types.ModuleType):
-    """The package's module type: ``gyrocomp.simulate`` is the function :func:`gyrocomp.simulate.simulate`, even
-    after the subpackage of that name was imported (which sets the attribute to the subpackage; the function
-    always won that race when the package imported everything at once)."""
-
-    @property
-    def simulate(self):
-        return _load("simulate")
-
-    @simulate.setter
-    def simulate(self, value) -> None:  # the import system binding the subpackage: the function stays
-        pass
-
-
-sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str):

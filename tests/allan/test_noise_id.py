@@ -15,7 +15,7 @@ from gyrocomp.allan import (
     noise_terms,
 )
 from gyrocomp.errors import InputError
-from gyrocomp.simulate.error_model import flicker_bank
+from gyrocomp.simulation.error_model import flicker_bank
 
 
 def analytic_curve(q, n, b, k, r, tau, relative_halfwidth=0.02):

@@ -11,8 +11,8 @@ from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.fitting.online import OnlineCalibrator
 from gyrocomp.io import write_recording
 from gyrocomp.io.tables import read_table
-from gyrocomp.curves.polynomial import PolynomialBias
-from gyrocomp.simulate import simulate
+from gyrocomp.curves.polynomial import PolynomialCurve
+from gyrocomp.simulation import simulate
 
 
 @pytest.fixture(scope="module")
@@ -211,7 +211,7 @@ def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other()
     """A gyro axis is in deg/s, an accelerometer axis in g: the unit-free names read either, the ``_dps`` and ``_g``
     accessors only their own; a calibration refuses an axis in the wrong section, and a file read back keeps the
     accelerometer's axes in g."""
-    curve = PolynomialBias((1e-3, 2e-4), 25.0, 20.0, 0.0, 50.0)
+    curve = PolynomialCurve((1e-3, 2e-4), 25.0, 20.0, 0.0, 50.0)
     gyro = AxisCalibration(curve, (0.1, 0.3))
     accel = AxisCalibration(curve, (0.02, 0.04), unit="g")
     assert gyro.unit == "deg/s" and gyro.turn_on_biases_dps == (0.1, 0.3) and gyro.mean_turn_on_bias_dps == 0.2

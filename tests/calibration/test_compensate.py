@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration, read
 from gyrocomp.errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 #: the run compensated: 120 s at 10 Hz
 DURATION_S, RATE_HZ = 120, 10

@@ -14,7 +14,7 @@ from gyrocomp.calibration.fit_report import MEMORIES, AxisFit, FitReport, Memory
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.models.pipelines import fit_calibration, fit_pipeline
 from gyrocomp.fitting.selection import Candidate
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 _CACHE = {}
 

@@ -23,7 +23,7 @@ from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.fitting.triad import (Pose, find_poses, fit_accel_multiposition, fit_gyro_rate_table,
                                        rate_segments, rq_upper)
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
-from gyrocomp.simulate import AccelErrorModel, GyroErrorModel, get_profile, preset_model, simulate, tumble_positions
+from gyrocomp.simulation import AccelErrorModel, GyroErrorModel, get_profile, preset_model, simulate, tumble_positions
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions, Polynomial
 

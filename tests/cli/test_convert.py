@@ -11,7 +11,7 @@ import pytest
 
 from gyrocomp import read
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from ..conftest import SCRIPT, run
 

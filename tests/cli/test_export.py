@@ -11,7 +11,7 @@ from gyrocomp import fit_calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
 

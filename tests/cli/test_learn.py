@@ -4,7 +4,7 @@ file, applied and exported with the learner."""
 from gyrocomp.calibration import Calibration
 from gyrocomp.fitting.online import LearnerSettings, OnlineCalibrator
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
 

@@ -5,7 +5,7 @@ import json
 import warnings
 
 from gyrocomp import fit_calibration
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
 

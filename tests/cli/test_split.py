@@ -4,7 +4,7 @@ import numpy as np
 
 from gyrocomp import read
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from ..conftest import joined_recordings, run
 

@@ -12,7 +12,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.curves.kinds import BASES, CURVES, curve_from_dict
 from gyrocomp.curves.protocol import TemperatureCurve, register_curve
-from gyrocomp.curves.lookup import LookupTableBasis, LookupTableBias
+from gyrocomp.curves.lookup import LookupTableBasis, LookupTableCurve
 from gyrocomp.recording import Recording
 
 GRID = [-20.0, 15.0, 40.0, 60.0]
@@ -36,7 +36,7 @@ def _run(seed, lo, hi, hours=1.0, rate_hz=1.0):
 
 
 def test_the_table_interpolates_and_holds_past_its_ends():
-    table = LookupTableBias((0.0, 1.0, 0.5), 0.0, 20.0)
+    table = LookupTableCurve((0.0, 1.0, 0.5), 0.0, 20.0)
     np.testing.assert_allclose(table.shape(np.array([-5.0, 0.0, 5.0, 10.0, 15.0, 20.0, 30.0])),
                                [0.0, 0.0, 0.5, 1.0, 0.75, 0.5, 0.5])
     assert isinstance(table, TemperatureCurve) and table.order == "table:2" and table.label == "table:2"
@@ -56,11 +56,11 @@ def test_the_basis_columns_are_the_table():
     np.testing.assert_allclose(basis.columns(t, 4) @ values, table.shape(t), atol=1e-15)
     past = np.array([-15.0, 35.0])
     np.testing.assert_allclose(basis.columns(past, 4, -10.0, 30.0) @ values, table.shape(past), atol=1e-15)
-    assert set(BASES) >= {"poly", "table"} and CURVES["table"] is LookupTableBias
+    assert set(BASES) >= {"poly", "table"} and CURVES["table"] is LookupTableCurve
 
 
 def test_model_files_store_and_check_the_table(tmp_path):
-    table = LookupTableBias((0.0, 0.02, -0.01), 5.0, 45.0)
+    table = LookupTableCurve((0.0, 0.02, -0.01), 5.0, 45.0)
     assert curve_from_dict(table.to_dict()) == table
     with pytest.raises(InputError, match="lookup table: values_dps must be a list of finite numbers"):
         curve_from_dict({"type": "table", "values_dps": [0.0, "x"], "t_min_degc": 0.0, "t_max_degc": 1.0})
@@ -80,7 +80,7 @@ def test_a_kinked_curve_is_chosen_as_a_table_and_holds_on_a_held_out_run(tmp_pat
         cal = fit_calibration(fit)
         cubic = fit_calibration(fit, temperature=Polynomial(3), hysteresis="none")
     curve = cal.axes["gyro_z"].temperature
-    assert isinstance(curve, LookupTableBias) and cal.model.startswith("table:")
+    assert isinstance(curve, LookupTableCurve) and cal.model.startswith("table:")
     sel = cal.report.selection["gyro_z"]
     assert sel.chosen.curve == "table" and {r.candidate.curve for r in sel.candidates} == {"poly", "table"}
     window = 120

@@ -17,7 +17,7 @@ from gyrocomp.evaluation.comparison import (
 )
 from gyrocomp.errors import InputError, TemperatureRangeWarning
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 from ..conftest import run
 
 

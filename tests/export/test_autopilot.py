@@ -12,7 +12,7 @@ import pytest
 from gyrocomp import Calibration, find_poses, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
-from gyrocomp.simulate import GyroErrorModel, Hysteresis, simulate
+from gyrocomp.simulation import GyroErrorModel, Hysteresis, simulate
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.units import STANDARD_GRAVITY_M_PER_S2 as G0
 from gyrocomp.models.options import FitOptions, Polynomial
@@ -356,7 +356,7 @@ def test_terms_that_are_rounding_are_written_as_zero(tmp_path):
     """A model whose curve is a line exports X2 = X3 = 0 exactly (not 1e-20), and its correction is unchanged."""
     from gyrocomp.export.autopilot import px4_parameters
     from gyrocomp.models.options import Polynomial
-    from gyrocomp.simulate import get_profile
+    from gyrocomp.simulation import get_profile
 
     part = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01,),), t_ref_degc=25.0,
                           noise_density_dps_per_sqrt_hz=0.002)

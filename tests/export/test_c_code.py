@@ -12,9 +12,9 @@ import pytest
 from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.c_code import c_sources, write_c_sources
-from gyrocomp.curves.lookup import LookupTableBias
+from gyrocomp.curves.lookup import LookupTableCurve
 from gyrocomp.models.pipelines import fit_pipeline
-from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
+from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
 
@@ -240,9 +240,9 @@ def test_lookup_table_with_lag_and_branches_past_its_grid(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, hysteresis="branch+lag")
-    tables = {"gyro_x": LookupTableBias((0.0, 0.4, -0.1, 0.2), -20.0, 70.0),
-              "gyro_y": LookupTableBias(tuple(np.sin(np.arange(9.0))), -20.0, 70.0),
-              "gyro_z": LookupTableBias(tuple(np.cos(np.arange(17.0))), -20.0, 70.0)}
+    tables = {"gyro_x": LookupTableCurve((0.0, 0.4, -0.1, 0.2), -20.0, 70.0),
+              "gyro_y": LookupTableCurve(tuple(np.sin(np.arange(9.0))), -20.0, 70.0),
+              "gyro_z": LookupTableCurve(tuple(np.cos(np.arange(17.0))), -20.0, 70.0)}
     cal = dataclasses.replace(cal, axes={a: dataclasses.replace(ax, temperature=tables[a])
                                          for a, ax in cal.axes.items()})
     held = simulate(part, profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,

@@ -9,7 +9,7 @@ import pytest
 
 from gyrocomp.errors import InputError
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 
 DEG = 180.0 / math.pi

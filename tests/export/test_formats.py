@@ -11,7 +11,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.export import EXPORTERS, ExportOptions, Exported, Exporter, export_to, register
 from gyrocomp.models.options import Polynomial
 from gyrocomp.models.pipelines import fit_calibration
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.export.c_code import c_sources
 from gyrocomp.models.pipelines import fit_calibration
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 CC = shutil.which("cc") or shutil.which("gcc")
 #: closes a C comment, splices lines, a trigraph, a preprocessor line, a parameter line, control characters

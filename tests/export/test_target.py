@@ -14,7 +14,7 @@ from gyrocomp.io.tables import write_recording
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_gyro_correction_dps
 from gyrocomp.models.options import FitOptions, Polynomial
 from gyrocomp.models.pipelines import fit_calibration
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
 

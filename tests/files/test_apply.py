@@ -27,7 +27,7 @@ from gyrocomp.io.stream import TableStream
 from gyrocomp.io import ReadOptions
 from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_recording
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 def _whole(calibration, source, target, **kwargs):
     """The whole-file path: read_table, apply, write_gyro_back."""

@@ -19,7 +19,7 @@ from gyrocomp.io.tables import read_table, write_recording
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.files import ChunkSettings, analyse_noise_file, evaluate_file
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 from gyrocomp.spill import SpillArray, block_median
 
 from ..conftest import run

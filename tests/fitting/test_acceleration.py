@@ -14,7 +14,7 @@ from gyrocomp.evaluation import evaluate_stages
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.acceleration import excited_columns
 from gyrocomp.effects import G_SQUARED_TERMS, g_squared_products
-from gyrocomp.simulate import get_profile, preset_model, simulate, tumble_positions
+from gyrocomp.simulation import get_profile, preset_model, simulate, tumble_positions
 
 RATE_HZ = 1.0
 

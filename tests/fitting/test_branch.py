@@ -15,7 +15,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.curves.hysteresis import BranchCurve, memory_curve_from_dict
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, simulate
+from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic
 
 from ..conftest import assert_streaming_equals_batch

@@ -9,10 +9,10 @@ import pytest
 from gyrocomp import Calibration, Network, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelError, NotFittedError
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.curves.network import MLPBias, forward, layer_shapes
-from gyrocomp.fitting.network import MLPTemperatureModel, jacobian, nguyen_widrow, train_lm, validation_mask
+from gyrocomp.curves.network import NetworkCurve, forward, layer_shapes
+from gyrocomp.fitting.network import NetworkTemperatureModel, jacobian, nguyen_widrow, train_lm, validation_mask
 from gyrocomp.cli.common import parse_hidden, parse_temperature_option
-from gyrocomp.simulate import GyroErrorModel, get_profile, preset_model, simulate
+from gyrocomp.simulation import GyroErrorModel, get_profile, preset_model, simulate
 
 
 @pytest.mark.parametrize("hidden", [(3,), (4, 2)])
@@ -116,10 +116,10 @@ def test_network_options_and_errors():
     with pytest.raises(InputError, match=r"--temperature: 'net': use poly .*mlp \(the thesis's 1-3-1 network\)"):
         parse_temperature_option("net")
     with pytest.raises(InputError, match="mlp weights do not fit a 1-3-1 network"):
-        MLPBias.from_dict({"type": "mlp", "hidden": [3], "weights": [[0.0] * 6, [0.0] * 3], "output_mean_dps": 0,
+        NetworkCurve.from_dict({"type": "mlp", "hidden": [3], "weights": [[0.0] * 6, [0.0] * 3], "output_mean_dps": 0,
                            "output_scale_dps": 1, "t_ref_degc": 25, "t_min_degc": 0, "t_max_degc": 50})
-    model = MLPTemperatureModel()
-    with pytest.raises(NotFittedError, match=r"MLPTemperatureModel is not fitted yet; call fit_blocks\(axis, ...\) "
+    model = NetworkTemperatureModel()
+    with pytest.raises(NotFittedError, match=r"NetworkTemperatureModel is not fitted yet; call fit_blocks\(axis, ...\) "
                                              r"first \(curves_ is learned by the fit\)"):
         model.curves_
     assert not hasattr(model, "epochs_")  # hasattr reads a NotFittedError as absent

@@ -21,7 +21,7 @@ from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.report.html import _pose_residuals, build_report
 from gyrocomp.fitting.pose_rotation import (fit_gyro_between_poses, ordered_product, quaternion_from_rotvec,
                                            rotation_errors, rotation_matrix)
-from gyrocomp.simulate import AccelErrorModel, get_profile, preset_model, simulate
+from gyrocomp.simulation import AccelErrorModel, get_profile, preset_model, simulate
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
 

@@ -13,10 +13,10 @@ from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.folds import leg_labels
 from gyrocomp.fitting.selection import Candidate, CandidateScore, choose, temperature_step_degc
-from gyrocomp.curves.polynomial import PolynomialBias
+from gyrocomp.curves.polynomial import PolynomialCurve
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import get_profile, preset_model, simulate
-from gyrocomp.simulate.profiles import Profile
+from gyrocomp.simulation import get_profile, preset_model, simulate
+from gyrocomp.simulation.profiles import Profile
 from gyrocomp.evaluation.validation import fit_plain_cubic, make_sample_folds
 
 
@@ -107,7 +107,7 @@ def test_turning_point_asked_for_on_a_monotone_run_is_refused():
 
 
 def test_tangent_extension_past_the_range():
-    curve = PolynomialBias((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0, extrapolation="linear")
+    curve = PolynomialCurve((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0, extrapolation="linear")
     t = np.array([40.0, 5.0])
     # analytic: at the edge u=1 the value is 0.07 and the slope d/du is 0.1 - 0.1 + 0.06 = 0.06 per u
     expected_hi = 0.07 + 0.06 * (40 - 30) / 10
@@ -115,11 +115,11 @@ def test_tangent_extension_past_the_range():
     value_lo = 0.1 * lo_u - 0.05 * lo_u ** 2 + 0.02 * lo_u ** 3
     slope_lo = 0.1 - 0.1 * lo_u + 0.06 * lo_u ** 2
     np.testing.assert_allclose(curve.shape(t), [expected_hi, value_lo + slope_lo * (5 - 10) / 10], rtol=1e-12)
-    held = PolynomialBias((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0)
+    held = PolynomialCurve((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0)
     np.testing.assert_allclose(held.shape(t), [0.07, value_lo], rtol=1e-12)
-    assert "extrapolation" not in held.to_dict() and PolynomialBias.from_dict(curve.to_dict()) == curve
+    assert "extrapolation" not in held.to_dict() and PolynomialCurve.from_dict(curve.to_dict()) == curve
     with pytest.raises(ValueError, match="extrapolation: 'cubic'; use one of hold, linear"):
-        PolynomialBias((0.1,), 20.0, 10.0, 10.0, 30.0, extrapolation="cubic")
+        PolynomialCurve((0.1,), 20.0, 10.0, 10.0, 30.0, extrapolation="cubic")
 
 
 def _single_cycle(seed):

@@ -14,7 +14,7 @@ from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibratio
 from gyrocomp.errors import InputError, NotFittedError
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.thermal import ThermalHysteresisModel
-from gyrocomp.simulate import Hysteresis, get_profile, preset_model, simulate
+from gyrocomp.simulation import Hysteresis, get_profile, preset_model, simulate
 
 from ..conftest import assert_streaming_equals_batch
 

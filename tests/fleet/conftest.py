@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import preset_model, resolve_profile, simulate
+from gyrocomp.simulation import preset_model, resolve_profile, simulate
 
 from ..conftest import run
 

@@ -15,7 +15,7 @@ from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, FleetSettings, UnitRuns, fit_unit
 from gyrocomp.io import read
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import resolve_profile, simulate
+from gyrocomp.simulation import resolve_profile, simulate
 
 from ..conftest import run
 from .conftest import (CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PATTERN, PRESET, RATE_HZ, RUN_DURATION_S,

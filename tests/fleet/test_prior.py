@@ -21,7 +21,7 @@ from gyrocomp.io import read
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import preset_model, resolve_profile, simulate
+from gyrocomp.simulation import preset_model, resolve_profile, simulate
 
 from ..conftest import run
 from .conftest import FLEET_UNITS, PRESET, RATE_HZ, RUN_DURATION_S, RUNS_PER_UNIT

@@ -14,7 +14,7 @@ from gyrocomp.errors import InputError, ModelError
 from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Failure, InputFile, UnitFigures,
                             parse_time, store_url)
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from ..conftest import run
 

@@ -12,7 +12,7 @@ import pytest
 from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, model_file_name
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from ..conftest import SCRIPT, run
 

@@ -194,7 +194,7 @@ def test_a_running_dask_cluster_is_used_by_its_address(tmp_path):
 
     from gyrocomp.fleet import FleetSettings, fit_fleet, fit_unit
     from gyrocomp.io.tables import write_recording
-    from gyrocomp.simulate import simulate
+    from gyrocomp.simulation import simulate
 
     units = []
     for k in range(3):

@@ -12,7 +12,7 @@ from gyrocomp.fleet.run import fit_fleet
 from gyrocomp.fleet.store import CalibrationStore
 from gyrocomp.fleet.devices import UnitRuns
 from gyrocomp.io.tables import write_recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 pytestmark = pytest.mark.slow
 

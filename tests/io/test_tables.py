@@ -20,7 +20,7 @@ from gyrocomp.io import (
     write_gyro_back,
     write_recording,
 )
-from gyrocomp.simulate import GyroErrorModel, simulate
+from gyrocomp.simulation import GyroErrorModel, simulate
 
 from ..conftest import run
 

@@ -74,7 +74,7 @@ def test_window_errors():
 def test_runs_with_gaps_pool_the_allan_sums_over_their_stretches():
     from gyrocomp.allan import allan_deviation_segments
     from gyrocomp.errors import DataQualityWarning
-    from gyrocomp.simulate import simulate
+    from gyrocomp.simulation import simulate
 
     sim = simulate("mti10", profile="combined", duration_s=6 * 3600, rate_hz=2, seed=1)
     rec = sim.recording

@@ -30,7 +30,7 @@ from gyrocomp.measures.plausibility import (
     turned_between_poses,
 )
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 from ..conftest import run, xsens_session
 

@@ -17,7 +17,7 @@ from gyrocomp.calibration.fit_report import FitReport
 from gyrocomp.measures.merit import evaluate_run, moving_average
 from gyrocomp.cli.common import parse_channels
 from gyrocomp.models.pipelines import fit_accelerometer, fit_channels
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 
 from ..conftest import run

@@ -13,7 +13,7 @@ from gyrocomp.calibration.fit_report import SelectionReport
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_calibration, fit_channels
 from gyrocomp.fitting.selection import Candidate, CandidateScore, beats_constant, choose
-from gyrocomp.simulate import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
+from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic
 
 RATE_HZ = 20.0

@@ -9,7 +9,7 @@ import gyrocomp
 from gyrocomp.errors import InputError
 from gyrocomp.models.options import FitOptions
 from gyrocomp.models.pipelines import fit_calibration
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 
 @pytest.fixture(scope="module")

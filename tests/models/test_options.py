@@ -15,7 +15,7 @@ from gyrocomp.models.options import Acceleration, FitOptions, FoldChoice, Memory
 from gyrocomp.models.pipelines import fit_calibration, fit_channels, fit_pipeline
 from gyrocomp.fitting.folds import FOLD_KINDS
 from gyrocomp.fitting.thermal import HYSTERESIS_CHOICES
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 
 
 def test_the_literal_choices_are_the_fittings_own():

@@ -13,7 +13,7 @@ from gyrocomp.fitting.base import bin_by_temperature
 from gyrocomp.cli.common import parse_temperature_option
 from gyrocomp.fitting.polynomial import PolynomialTemperatureModel, simplest_within
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import GyroErrorModel, simulate
+from gyrocomp.simulation import GyroErrorModel, simulate
 
 from ..conftest import TEST_MODEL
 

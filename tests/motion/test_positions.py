@@ -5,8 +5,8 @@ import pytest
 
 from gyrocomp.errors import InputError
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import simulate
-from gyrocomp.simulate.profiles import TUMBLE_LEVELS_G
+from gyrocomp.simulation import simulate
+from gyrocomp.simulation.profiles import TUMBLE_LEVELS_G
 from gyrocomp.motion.positions import orientations, segment_mask, static_segments, still_mask
 
 

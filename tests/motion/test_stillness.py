@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from gyrocomp.errors import InputError
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 from gyrocomp.motion.stillness import StillnessState, classify_blocks, detect_still, detection
 
 

@@ -12,7 +12,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.recording.prepared import PreparedRun, block_means, fit_axes, prepare
 from gyrocomp.recording import Recording
-from gyrocomp.simulate import simulate
+from gyrocomp.simulation import simulate
 from gyrocomp.motion.positions import static_segments, still_mask
 
 

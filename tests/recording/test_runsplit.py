@@ -8,7 +8,7 @@ from gyrocomp import read
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout
 from gyrocomp.recording.runsplit import split_runs
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import joined_recordings, run
 

@@ -15,7 +15,7 @@ from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.report.figures import envelope
 from gyrocomp.report.html import SECTIONS, build_report
 from gyrocomp.rounding import with_error
-from gyrocomp.simulate import get_profile, simulate
+from gyrocomp.simulation import get_profile, simulate
 from gyrocomp.models.options import FitOptions
 
 from ..conftest import check_report_page

@@ -24,7 +24,7 @@ from .fit_report import FitReport
 from ..io.atomic import write_text_atomic
 from ..curves.kinds import curve_from_dict
 from ..curves.protocol import TemperatureCurve
-from ..curves.network import MLPBias
+from ..curves.network import NetworkCurve
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, memory_curve_from_dict
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
 from .triad import TriadCalibration
@@ -222,7 +222,7 @@ class AxisCalibration:
         This axis's row of the g-sensitivity matrix G, on accel_x, accel_y, accel_z [deg/s/g].
     g_squared_dps_per_g2 : 6 floats or None
         g x g sensitivity to the products xx, yy, zz, xy, xz, yz [deg/s/g^2].
-    acceleration_network : MLPBias or None
+    acceleration_network : NetworkCurve or None
         A network of the three accelerations (the second stage of the ``mlp>mlp-accel`` pipeline).
     unit : {"deg/s", "g"}
         The unit of the axis's values.
@@ -235,7 +235,7 @@ class AxisCalibration:
     hysteresis: HysteresisCurve | BranchCurve | None = None
     g_sensitivity_dps_per_g: tuple[float, float, float] | None = None
     g_squared_dps_per_g2: tuple[float, ...] | None = None
-    acceleration_network: MLPBias | None = None
+    acceleration_network: NetworkCurve | None = None
     unit: AxisUnit = "deg/s"
 
     def __post_init__(self) -> None:
@@ -298,7 +298,7 @@ class AxisCalibration:
             hysteresis=None if d["hysteresis"] is None else memory_curve_from_dict(d["hysteresis"]),
             g_sensitivity_dps_per_g=_floats(d["g_sensitivity_dps_per_g"], 3, "g_sensitivity_dps_per_g"),
             g_squared_dps_per_g2=_floats(d["g_squared_dps_per_g2"], 6, "g_squared_dps_per_g2"),
-            acceleration_network=None if d["acceleration_network"] is None else MLPBias.from_dict(d["acceleration_network"]),
+            acceleration_network=None if d["acceleration_network"] is None else NetworkCurve.from_dict(d["acceleration_network"]),
             unit=unit,
         )
 

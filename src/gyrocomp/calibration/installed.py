@@ -32,7 +32,7 @@ import numpy as np
 
 from . import AxisCalibration, Calibration
 from ..errors import DataQualityWarning, InputError
-from ..curves.polynomial import PolynomialBias
+from ..curves.polynomial import PolynomialCurve
 
 DEG_TO_RAD = math.pi / 180.0
 ARDUPILOT_TEMP_REFERENCE_DEGC = 35.0
@@ -208,7 +208,7 @@ def installed_calibration(parameters: dict[str, float], autopilot: str, instance
     axes = {}
     for name, j in AXIS_INDEX.items():
         c = [v / DEG_TO_RAD for v in coefficients[j]]  # rad/s -> deg/s
-        curve = PolynomialBias((c[1], c[2], c[3]), reference, 1.0, t_min, t_max)
+        curve = PolynomialCurve((c[1], c[2], c[3]), reference, 1.0, t_min, t_max)
         axes[name] = AxisCalibration(curve, (c[0],))
     return Calibration(axes=axes, model=f"installed {autopilot} cubic ({p}*)",
                        provenance={"source": f"{autopilot} parameters {p}*"}, fit_report={"temperature": "installed"})

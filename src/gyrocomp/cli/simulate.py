@@ -10,8 +10,8 @@ import click
 
 from ..errors import InputError
 from ..io import output_format, write_recording, write_text_atomic
-from ..simulate import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles, truth_document
-from ..simulate import simulate as run_simulation
+from ..simulation import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles, truth_document
+from ..simulation import simulate as run_simulation
 from .common import FINITE, float_list
 
 

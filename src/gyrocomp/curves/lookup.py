@@ -30,7 +30,7 @@ from .protocol import CCode, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, reg
 
 @register_curve
 @dataclass(frozen=True)
-class LookupTableBias:
+class LookupTableCurve:
     """Fitted bias shape of one axis as a table: ``values`` [the axis's unit] at the ``len(values)`` temperatures
     evenly spaced from ``t_min_degc`` to ``t_max_degc`` [degC], linear in between, held past the ends."""
 
@@ -76,10 +76,10 @@ class LookupTableBias:
         step = (self.t_max_degc - self.t_min_degc) / (len(self.values) - 1)
         return f"lookup table, {len(self.values)} points {step:.3g} degC apart"
 
-    def clamped(self) -> "LookupTableBias":
+    def clamped(self) -> "LookupTableCurve":
         return self  # held past its ends already
 
-    def plus_slope(self, slope_per_degc: float) -> "LookupTableBias":
+    def plus_slope(self, slope_per_degc: float) -> "LookupTableCurve":
         added = slope_per_degc * (self.grid_degc - self.t_min_degc)
         return dataclasses.replace(self, values=tuple(float(v) for v in np.asarray(self.values) + added))
 
@@ -99,7 +99,7 @@ class LookupTableBias:
                 "t_max_degc": self.t_max_degc}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "LookupTableBias":
+    def from_dict(cls, d: dict[str, Any]) -> "LookupTableCurve":
         values = d.get("values_dps")
         if not isinstance(values, list) or not all(isinstance(v, (int, float)) and np.isfinite(v) for v in values):
             raise InputError("lookup table: values_dps must be a list of finite numbers")
@@ -134,10 +134,10 @@ class LookupTableBasis:
         k = np.arange(1, size + 1)
         return np.clip(1.0 - np.abs(x[:, None] - k[None, :]), 0.0, None)
 
-    def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> LookupTableBias:
+    def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> LookupTableCurve:
         """The table of the fitted values on the basis's grid (the hats are on it, whatever range [lo, hi] the fit
         saw: over all the data that is the grid itself)."""
-        return LookupTableBias((0.0, *map(float, coefficients)), self.lo_degc, self.hi_degc)
+        return LookupTableCurve((0.0, *map(float, coefficients)), self.lo_degc, self.hi_degc)
 
 
-__all__ = ["LookupTableBasis", "LookupTableBias"]
+__all__ = ["LookupTableBasis", "LookupTableCurve"]

@@ -64,7 +64,7 @@ ACCEL_INPUTS = ("accel_x", "accel_y", "accel_z")
 
 @register_curve
 @dataclass(frozen=True)
-class MLPBias:
+class NetworkCurve:
     """Fitted network shape of one axis's bias, without its turn-on constant.
 
     bias(inputs) = net(x(inputs)) - net(x(reference)),  x_i = 2 (clip(v_i) - min_i) / (max_i - min_i) - 1,
@@ -113,7 +113,7 @@ class MLPBias:
     def label(self) -> str:
         return "mlp:" + self.order.split(" ", 1)[1]
 
-    def clamped(self) -> "MLPBias":
+    def clamped(self) -> "NetworkCurve":
         return self  # the inputs are clipped to their fitted ranges already
 
     def plus_slope(self, slope_per_degc: float) -> None:
@@ -199,7 +199,7 @@ class MLPBias:
                 "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "MLPBias":
+    def from_dict(cls, d: dict[str, Any]) -> "NetworkCurve":
         hidden = tuple(int(h) for h in d["hidden"])
         inputs = tuple(str(i) for i in d.get("inputs", ["temperature"]))
         if not inputs or any(i not in NETWORK_INPUTS for i in inputs):
@@ -215,5 +215,5 @@ class MLPBias:
 
 
 
-__all__ = ["ACCEL_INPUTS", "DEFAULT_HIDDEN", "NETWORK_BLOCK_S", "NETWORK_INPUTS", "MLPBias", "forward", "layer_shapes",
+__all__ = ["ACCEL_INPUTS", "DEFAULT_HIDDEN", "NETWORK_BLOCK_S", "NETWORK_INPUTS", "NetworkCurve", "forward", "layer_shapes",
            "n_parameters", "unpack"]

@@ -3,7 +3,7 @@
     b_r(T) = c_r + sum_{k=1}^{p} a_k u^k,    u = (clip(T, T_min, T_max) - T_ref) / T_scale
 
 with one turn-on constant c_r per run (each power-on has its own) and the shape a_1..a_p shared by all runs
-(:class:`PolynomialBias` holds the shape). Fitting it is :mod:`gyrocomp.fitting.polynomial`'s.
+(:class:`PolynomialCurve` holds the shape). Fitting it is :mod:`gyrocomp.fitting.polynomial`'s.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ EXTRAPOLATIONS = ("hold", "linear")
 
 @register_curve
 @dataclass(frozen=True)
-class PolynomialBias:
+class PolynomialCurve:
     """Fitted temperature shape of one axis's bias, without its turn-on constant, in the axis's unit (deg/s for a
     gyro axis, g for an accelerometer axis: :attr:`gyrocomp.calibration.AxisCalibration.unit`; the model file
     names the coefficients ``coefficients_dps`` or ``coefficients_g``).
@@ -69,10 +69,10 @@ class PolynomialBias:
     def label(self) -> str:
         return f"poly:{self.order}"
 
-    def clamped(self) -> "PolynomialBias":
+    def clamped(self) -> "PolynomialCurve":
         return dataclasses.replace(self, extrapolation="hold")
 
-    def plus_slope(self, slope_per_degc: float) -> "PolynomialBias":
+    def plus_slope(self, slope_per_degc: float) -> "PolynomialCurve":
         coefficients = list(self.coefficients) or [0.0]
         coefficients[0] += slope_per_degc * self.t_scale_degc
         return dataclasses.replace(self, coefficients=tuple(coefficients))
@@ -139,7 +139,7 @@ class PolynomialBias:
         return d
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "PolynomialBias":
+    def from_dict(cls, d: dict[str, Any]) -> "PolynomialCurve":
         return cls(tuple(float(c) for c in d["coefficients_dps"]), float(d["t_ref_degc"]),
                    float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]),
                    str(d.get("extrapolation", "hold")))
@@ -182,8 +182,8 @@ class PolynomialBasis:
         clipped = (np.clip(t, lo_degc, hi_degc) - self.t_ref_degc) / self.t_scale_degc
         return polynomial_columns(clipped, size, u - clipped if self.extended else None)
 
-    def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> PolynomialBias:
-        return PolynomialBias(tuple(float(a) for a in coefficients), self.t_ref_degc, self.t_scale_degc, lo_degc,
+    def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> PolynomialCurve:
+        return PolynomialCurve(tuple(float(a) for a in coefficients), self.t_ref_degc, self.t_scale_degc, lo_degc,
                               hi_degc, "linear" if self.extended else "hold")
 
 

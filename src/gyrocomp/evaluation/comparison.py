@@ -22,7 +22,7 @@ from ..measures.merit import default_window_s, evaluate_run, moving_average
 from ..fitting.base import provenance
 from ..models.options import FitOptions, Network, Polynomial
 from ..models.pipelines import fit_pipeline
-from ..curves.polynomial import PolynomialBias
+from ..curves.polynomial import PolynomialCurve
 from ..measures.plausibility import require_temperature_span
 from ..recording.prepared import prepare
 from ..threads import single_threaded_blas
@@ -45,7 +45,7 @@ def _cubic_calibration(recordings: list[Recording], name: str, fit_axis) -> Cali
     for axis in recordings[0].gyro_axes:
         coef, t_ref, t_min, t_max = fit_axis(recordings, axis)
         shape = tuple(float(c) for c in coef[::-1][1:])  # np.polyfit: highest power first; X0 is the constant
-        axes[axis] = AxisCalibration(PolynomialBias(shape, float(t_ref), 1.0, float(t_min), float(t_max)),
+        axes[axis] = AxisCalibration(PolynomialCurve(shape, float(t_ref), 1.0, float(t_min), float(t_max)),
                                      tuple(float(coef[-1]) for _ in recordings))
     return Calibration(axes=axes, model=name, provenance=provenance(recordings),
                        fit_report={"temperature": name})

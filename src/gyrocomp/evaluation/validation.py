@@ -32,7 +32,7 @@ from ..curves.hysteresis import turn_threshold_degc
 from ..models.options import FitOptions, FoldChoice
 from ..fitting.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MIN_S, drift_window_s, leg_labels
 from ..fitting.selection import fold_mean, fold_standard_error
-from ..curves.polynomial import PolynomialBias
+from ..curves.polynomial import PolynomialCurve
 from ..measures.plausibility import require_temperature_span
 from ..recording.prepared import prepare
 from ..threads import single_threaded_blas
@@ -58,7 +58,7 @@ def fit_plain_cubic(recordings: list[Recording]) -> Calibration:
         y = np.concatenate([r.gyro(axis) for r in recordings])
         coef, *_ = np.linalg.lstsq(np.vstack(rows), y, rcond=None)
         n = len(recordings)
-        axes[axis] = AxisCalibration(PolynomialBias(tuple(float(c) for c in coef[n:]), mid, 1.0, -math.inf, math.inf),
+        axes[axis] = AxisCalibration(PolynomialCurve(tuple(float(c) for c in coef[n:]), mid, 1.0, -math.inf, math.inf),
                                      tuple(float(c) for c in coef[:n]))
     return Calibration(axes=axes, model="cubic + run constants", provenance=provenance(recordings),
                        fit_report={"temperature": "cubic + run constants"})

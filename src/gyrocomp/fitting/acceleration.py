@@ -23,7 +23,7 @@ from ..recording.prepared import PreparedRun
 from .base import provenance
 from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, turned_between_positions
 from ..curves.network import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S
-from .network import MLPTemperatureModel
+from .network import NetworkTemperatureModel
 from .thermal import ThermalHysteresisModel
 
 def _listed(values: np.ndarray) -> tuple:
@@ -67,7 +67,7 @@ def fit_acceleration_network(recordings: list[Recording], *, hidden: tuple[int, 
     """The thesis's acceleration network (section 2.7.2): accel_x, accel_y, accel_z in, the gyro bias out (and
     one constant per run), trained on the static segments of at least ``min_static`` [s] of the runs; ``hidden``
     neurons per layer, restarts drawn from ``seed``."""
-    network = MLPTemperatureModel(hidden=hidden, seed=seed)
+    network = NetworkTemperatureModel(hidden=hidden, seed=seed)
     segments = [PreparedRun.of(rec).static_segments(min_duration_s=min_static) for rec in recordings]
     for rec in recordings:
         if rec.accel_g is None:

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import InputError, ModelError
 from .base import LearnedAttributes
-from ..curves.network import DEFAULT_HIDDEN, MLPBias, forward, layer_shapes, n_parameters, unpack
+from ..curves.network import DEFAULT_HIDDEN, NetworkCurve, forward, layer_shapes, n_parameters, unpack
 
 MAX_FAIL = 6
 MU_START, MU_DEC, MU_INC, MU_MAX = 1e-3, 0.1, 10.0, 1e10
@@ -168,7 +168,7 @@ def validation_mask(run: np.ndarray, n_runs: int, share: float = VALIDATION_SHAR
 
 
 @dataclass
-class MLPTemperatureModel(LearnedAttributes):
+class NetworkTemperatureModel(LearnedAttributes):
     """Network temperature model, fitted per axis on block means of many runs jointly (``fit_blocks``, one call
     per axis).
 
@@ -184,7 +184,7 @@ class MLPTemperatureModel(LearnedAttributes):
 
     Attributes (after ``fit_blocks``)
     ---------------------------------
-    curves_ : dict[str, MLPBias]
+    curves_ : dict[str, NetworkCurve]
     turn_on_biases_ : dict[str, np.ndarray]
     validation_rmse_ : dict[str, list[float]]
         Validation RMS of every restart [the axis's unit: deg/s; g for an accelerometer's axes].
@@ -202,7 +202,7 @@ class MLPTemperatureModel(LearnedAttributes):
 
     def fit_blocks(self, axis: str, temperature_degc: list[np.ndarray], value: list[np.ndarray],
                    weight: list[np.ndarray], t_ref_degc: float, accel_g: list[np.ndarray] | None = None,
-                   inputs: tuple[str, ...] = ("temperature",)) -> "MLPTemperatureModel":
+                   inputs: tuple[str, ...] = ("temperature",)) -> "NetworkTemperatureModel":
         """Fit one axis on per-run arrays of temperature [degC], value [deg/s], weight and, for a network that
         reads them, specific force (n, 3) [g]."""
         if self.restarts < 1:
@@ -216,7 +216,7 @@ class MLPTemperatureModel(LearnedAttributes):
         run = np.concatenate([np.full(a.size, r) for r, a in enumerate(temperature_degc)])
         n_runs = len(temperature_degc)
         accel = None if accel_g is None else np.vstack(accel_g)
-        probe = MLPBias(self.hidden, (), 0.0, 1.0, t_ref_degc, 0.0, 0.0, inputs, (0.0,) * len(inputs),
+        probe = NetworkCurve(self.hidden, (), 0.0, 1.0, t_ref_degc, 0.0, 0.0, inputs, (0.0,) * len(inputs),
                         (0.0,) * len(inputs), (0.0,) * len(inputs))
         values = probe.input_values(t, accel)
         lo, hi = values.min(axis=0), values.max(axis=0)
@@ -250,7 +250,7 @@ class MLPTemperatureModel(LearnedAttributes):
         weights = tuple(tuple(float(v) for v in np.concatenate([wt.ravel(), b])) for wt, b in layers)
         reference = tuple(t_ref_degc if name == "temperature" else (1.0 if name == "accel_z" else 0.0)
                           for name in inputs)
-        curve = MLPBias(self.hidden, weights, mean, scale, t_ref_degc, t_min, t_max, tuple(inputs),
+        curve = NetworkCurve(self.hidden, weights, mean, scale, t_ref_degc, t_min, t_max, tuple(inputs),
                         tuple(map(float, lo)), tuple(map(float, hi)), reference)
         at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
         self.curves_[axis] = curve
@@ -261,4 +261,4 @@ class MLPTemperatureModel(LearnedAttributes):
         return self
 
 
-__all__ = ["MLPTemperatureModel", "TrainResult", "jacobian", "train_lm", "validation_mask"]
+__all__ = ["NetworkTemperatureModel", "TrainResult", "jacobian", "train_lm", "validation_mask"]

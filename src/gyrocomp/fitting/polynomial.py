@@ -1,7 +1,7 @@
 """Fitting the polynomial temperature model (thesis section 2.5.2): the shape a_1..a_p shared by the runs and one
 turn-on constant per run, by least squares on temperature bins (every temperature interval counts equally,
 whatever the heating rate), the order chosen by leave-one-run-out error (or BIC with one run). The curve it
-produces is :class:`gyrocomp.curves.polynomial.PolynomialBias`.
+produces is :class:`gyrocomp.curves.polynomial.PolynomialCurve`.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from ..errors import InputError, ModelError
 from ..recording.prepared import fit_axes
 from ..recording import Recording
 from .base import LearnedAttributes, TemperatureBins, bin_by_temperature, bin_width_for
-from ..curves.polynomial import MAX_ORDER, PolynomialBias
+from ..curves.polynomial import MAX_ORDER, PolynomialCurve
 
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins
 PARSIMONY_TOLERANCE = 1.01
@@ -119,7 +119,7 @@ class PolynomialTemperatureModel(LearnedAttributes):
 
     Attributes (after ``fit``)
     --------------------------
-    curves_ : dict[str, PolynomialBias]
+    curves_ : dict[str, PolynomialCurve]
         The fitted shape of each axis.
     turn_on_biases_ : dict[str, np.ndarray]
         The fitted constant of each run [deg/s; g for an accelerometer's axes], per axis.
@@ -169,7 +169,7 @@ class PolynomialTemperatureModel(LearnedAttributes):
             distinct = np.unique(bins.temperature_degc).size
             order = self._choose_order(axis, design, distinct)
             shape, consts, rss = _solve(design, order, np.arange(len(recordings)))
-            self.curves_[axis] = PolynomialBias(tuple(float(a) for a in shape), design.t_ref, design.t_scale,
+            self.curves_[axis] = PolynomialCurve(tuple(float(a) for a in shape), design.t_ref, design.t_scale,
                                                 t_min, t_max)
             self.turn_on_biases_[axis] = consts
             self.fit_rms_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))

@@ -381,7 +381,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     Attributes (after ``fit``)
     --------------------------
     curves_ : dict[str, TemperatureCurve]
-        A polynomial (:class:`~gyrocomp.curves.polynomial.PolynomialBias`), or the curve of the family
+        A polynomial (:class:`~gyrocomp.curves.polynomial.PolynomialCurve`), or the curve of the family
         ``curve`` names (:data:`gyrocomp.curves.protocol.BASES`).
     lag_time_constants_s_ : dict[str, float]
         Fitted thermal time constant per axis [s], 0 without lag.

@@ -59,7 +59,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, thermal_lag
 from ..errors import DataQualityWarning, InputError
 from ..fitting.base import provenance
-from ..curves.polynomial import PolynomialBias
+from ..curves.polynomial import PolynomialCurve
 from ..recording import Recording
 from ..units import DEG_PER_S_TO_DEG_PER_H
 from .figures import REFERENCE_TEMPERATURE_DEGC
@@ -182,7 +182,7 @@ def prior_from_models(models: Sequence, like: PopulationPrior) -> PopulationPrio
 
     Parameters
     ----------
-    models : sequence of gyrocomp.simulate.GyroErrorModel
+    models : sequence of gyrocomp.simulation.GyroErrorModel
         The parts (at least ``MIN_UNITS_FOR_PRIOR``); anything with ``axes``,
         ``temperature_error_dps(temperature_degc) -> (n, axes) [deg/s]``, ``thermal_time_constant_s`` [s],
         ``noise_density_dps_per_sqrt_hz``, ``bias_instability_deg_per_h`` and ``rate_random_walk_dps_per_sqrt_s``.
@@ -364,7 +364,7 @@ def _fit_axis(recordings: list[Recording], axis: str, p: AxisPrior, prior: Popul
     g = (grid - prior.reference_temperature_degc) / prior.temperature_scale_degc
     basis = np.column_stack([g ** k for k in range(1, _ORDER + 1)])
     curve_sd = np.sqrt(np.einsum("ij,jk,ik->i", basis, posterior, basis))
-    curve = PolynomialBias(tuple(map(float, beta[runs:])), prior.reference_temperature_degc,
+    curve = PolynomialCurve(tuple(map(float, beta[runs:])), prior.reference_temperature_degc,
                            prior.temperature_scale_degc, prior.temperature_min_degc, prior.temperature_max_degc)
     calibrated = AxisCalibration(curve, tuple(map(float, beta[:runs])), lag_time_constant_s=p.lag_time_constant_s)
     seen = (float(np.min(u)) * prior.temperature_scale_degc + prior.reference_temperature_degc,

@@ -9,7 +9,7 @@
 The curves a calibration holds are in :mod:`gyrocomp.curves`, their estimators in :mod:`gyrocomp.fitting`.
 """
 
-from ..curves.polynomial import PolynomialBias
+from ..curves.polynomial import PolynomialCurve
 from ..fitting.polynomial import PolynomialTemperatureModel
 
-__all__ = ["PolynomialBias", "PolynomialTemperatureModel"]
+__all__ = ["PolynomialCurve", "PolynomialTemperatureModel"]

@@ -30,7 +30,7 @@ from ..fitting.base import bin_width_for, one_temperature_column, provenance
 from ..curves.hysteresis import heats_and_cools
 from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
 from ..curves.network import NETWORK_BLOCK_S, NETWORK_INPUTS
-from ..fitting.network import MLPTemperatureModel
+from ..fitting.network import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
 from ..fitting.polynomial import PolynomialTemperatureModel
@@ -49,7 +49,7 @@ from ..threads import single_threaded_blas
 FOLD_SELECTION = {"runs": "leave-one-run-out", "legs": "leave-one-leg-out", "blocks": "leave-one-block-out"}
 
 
-def _fit_network(network: MLPTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
+def _fit_network(network: NetworkTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
                  hysteresis, scaffold, bin_width_degc: float | None, g_row=None, g_squared=None,
                  segments=None, inputs: tuple[str, ...] = ("temperature",)):
     """Train the network on the block means of the runs, through the lag and without the hysteresis
@@ -276,7 +276,7 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
         model, thermal = _fit_binned(recordings, order, options, accel_mode)
     unit = recordings[0].unit_of(fit_axes(recordings)[0])
     report = _report_of_choice(selections, model, thermal, options.hysteresis, options.acceleration, accel_mode, unit)
-    network = MLPTemperatureModel(hidden=spec.hidden, seed=spec.seed) if isinstance(spec, Network) else None
+    network = NetworkTemperatureModel(hidden=spec.hidden, seed=spec.seed) if isinstance(spec, Network) else None
     axes = {}
     for axis in fit_axes(recordings):
         axes[axis], report["axes"][axis] = _axis_calibration(

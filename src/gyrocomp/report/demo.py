@@ -35,7 +35,7 @@ from ..measures.merit import Evaluation, evaluate_run, moving_average, smoothed_
 from ..models.pipelines import fit_calibration
 from .html import build_report
 from . import figures
-from ..simulate import get_preset, get_profile, simulate
+from ..simulation import get_preset, get_profile, simulate
 from ..units import DEG_PER_S_TO_DEG_PER_H
 from ..evaluation.validation import ValidationResult, validate
 

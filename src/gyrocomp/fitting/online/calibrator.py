@@ -19,7 +19,7 @@ from ...errors import InputError, NotFittedError
 from ...io.atomic import write_text_atomic
 from ...motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY
 from ..base import provenance
-from ...curves.polynomial import PolynomialBias
+from ...curves.polynomial import PolynomialCurve
 from .state import _record_to_dict, _restore
 from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, LearnerSettings,
                        LearnerStatus, LogContribution, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
@@ -682,7 +682,7 @@ class OnlineCalibrator:
                 continue
             curve = None
             if self._degree > 0:
-                curve = PolynomialBias(tuple(float(c) for c in self._coef[j, :self._degree]), T_REF_DEGC,
+                curve = PolynomialCurve(tuple(float(c) for c in self._coef[j, :self._degree]), T_REF_DEGC,
                                        T_SCALE_DEGC, low, high, extrapolation="linear")
             g = tuple(float(v) for v in self._g[j]) if self._tilted.any() else None
             out[name] = AxisCalibration(temperature=curve, g_sensitivity_dps_per_g=g,

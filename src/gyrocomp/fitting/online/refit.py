@@ -24,7 +24,7 @@ def _matrix(values, rows: int, name: str) -> np.ndarray:
 
 def _curve(coef: np.ndarray, degree: int, t_range: tuple[float, float], temperature) -> np.ndarray:
     """The shape sum_k c_k u^k per axis [deg/s] (..., 3) at ``temperature`` [degC], continued along its tangent
-    past ``t_range`` (as :class:`PolynomialBias` with ``extrapolation="linear"``)."""
+    past ``t_range`` (as :class:`PolynomialCurve` with ``extrapolation="linear"``)."""
     t = np.asarray(temperature, dtype=float)
     clipped = np.clip(t, *t_range)
     u = np.expand_dims((clipped - T_REF_DEGC) / T_SCALE_DEGC, -1)

@@ -5,8 +5,8 @@
     sim.truth.deterministic_error_dps, sim.truth.noise.total_dps, sim.truth.true_rate_dps
     # output = true rate + deterministic error + noise, sample by sample
 
-The error model is documented in :mod:`gyrocomp.simulate.error_model`, the profiles in
-:mod:`gyrocomp.simulate.profiles`, the sensor presets in :mod:`gyrocomp.simulate.presets`.
+The error model is documented in :mod:`gyrocomp.simulation.error_model`, the profiles in
+:mod:`gyrocomp.simulation.profiles`, the sensor presets in :mod:`gyrocomp.simulation.presets`.
 Not modelled: the Earth's rotation (the simulated table does not turn with the Earth),
 vibration, and the accelerometer's own g x g and cross-axis errors.
 """

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from gyrocomp.errors import InputError
-from gyrocomp.simulate import PROFILES, get_profile, resolve_profile, tumble_positions
-from gyrocomp.simulate.profiles import TUMBLE_LEVELS_G
+from gyrocomp.simulation import PROFILES, get_profile, resolve_profile, tumble_positions
+from gyrocomp.simulation.profiles import TUMBLE_LEVELS_G
 
 
 def test_chamber_ramps_at_the_set_rate_between_dwells():

@@ -97,7 +97,7 @@ class Profile:
         ``static``, ``warmup``, ``chamber``, ``cycle``, ``tumble``, ``combined``, ``ratetable`` or ``field``.
     set_points_degc : tuple of float
         Temperatures visited, in order [degC] (``static``, ``tumble``, ``ratetable``: the first one; with
-        several, :func:`gyrocomp.simulate.run_profiles` holds run i at set point i).
+        several, :func:`gyrocomp.simulation.run_profiles` holds run i at set point i).
     ramp_rate_degc_per_min : float
         Rate of the ramps between set points [degC/min].
     dwell_s : float

@@ -10,8 +10,8 @@ import pytest
 from gyrocomp.allan import allan_deviation, noise_parameters
 from gyrocomp.errors import InputError
 from gyrocomp.measures.merit import BIAS_INSTABILITY_FACTOR
-from gyrocomp.simulate import PRESETS, GyroErrorModel, Hysteresis, flicker_bank, get_profile, preset_model, simulate
-from gyrocomp.simulate.profiles import TUMBLE_LEVELS_G
+from gyrocomp.simulation import PRESETS, GyroErrorModel, Hysteresis, flicker_bank, get_profile, preset_model, simulate
+from gyrocomp.simulation.profiles import TUMBLE_LEVELS_G
 from gyrocomp.units import DEG_PER_S_TO_DEG_PER_H
 
 

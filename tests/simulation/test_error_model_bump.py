@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gyrocomp.errors import InputError
-from gyrocomp.simulate import GyroErrorModel, Hysteresis
+from gyrocomp.simulation import GyroErrorModel, Hysteresis
 
 
 def test_bump_starts_at_the_turn_peaks_and_fades_to_zero():
