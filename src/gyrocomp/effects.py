@@ -450,8 +450,40 @@ def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
         raise InputError(f"window: must be at least one sample, got {w}")
     if w > x.size:
         raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
-    c = np.concatenate([[0.0], np.cumsum(x - x[0])])
-    return (c[w:] - c[:-w]) / w + x[0]
+    c = np.empty(x.size + 1)  # the running sum about the first value, in place: no temporary of the data's size
+    c[0] = 0.0
+    np.subtract(x, x[0], out=c[1:])
+    np.cumsum(c[1:], out=c[1:])
+    out = c[w:] - c[:-w]
+    out /= w
+    out += x[0]
+    return out
+
+
+def moving_average_range(x: np.ndarray, window_samples: int, block: int = 1 << 16) -> float:
+    """Peak-to-peak of :func:`moving_average` [unit of x], the same values, its extremes found block by block
+    (no array of the average's length)."""
+    x = np.asarray(x, dtype=float)
+    w = int(window_samples)
+    if w < 1:
+        raise InputError(f"window: must be at least one sample, got {w}")
+    if w > x.size:
+        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
+    c = np.empty(x.size + 1)
+    c[0] = 0.0
+    np.subtract(x, x[0], out=c[1:])
+    np.cumsum(c[1:], out=c[1:])
+    count = x.size - w + 1
+    part = np.empty(min(block, count))
+    low, high = math.inf, -math.inf
+    for start in range(0, count, block):
+        stop = min(start + block, count)
+        out = part[:stop - start]
+        np.subtract(c[start + w:stop + w], c[start:stop], out=out)
+        out /= w
+        out += x[0]
+        low, high = min(low, float(out.min())), max(high, float(out.max()))
+    return high - low
 
 
 def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s: float) -> float:
@@ -464,6 +496,6 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
 __all__ = [
     "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "branch_position", "estimate_turn_on_bias", "find_turns",
     "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter",
-    "moving_average", "quantize", "thermal_lag",
+    "moving_average", "moving_average_range", "quantize", "thermal_lag",
 ]
 

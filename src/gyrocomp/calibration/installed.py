@@ -94,10 +94,9 @@ def px4_as_run(params: dict, time_s: np.ndarray, temperature_degc: np.ndarray, i
         return np.zeros((t.size, 3))
     index = np.asarray(published_at)
     offsets = px4_gyro_correction_dps(params, temp[index], instance)
-    which = np.searchsorted(index, np.arange(t.size), side="right") - 1
-    out = offsets[np.maximum(which, 0)]
-    out[which < 0] = 0.0  # before the first publication nothing is applied
-    return out
+    # each publication holds from its sample to the next one's; before the first, nothing is applied
+    held = np.repeat(offsets, np.diff(np.append(index, t.size)), axis=0)
+    return np.concatenate([np.zeros((index[0], 3)), held]) if index[0] else held
 
 
 def ardupilot_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, cal_temp_degc: float,
@@ -110,13 +109,21 @@ def ardupilot_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, ca
     t = np.clip(np.asarray(temperature_degc, dtype=f32), lo, hi) - f32(ARDUPILOT_TEMP_REFERENCE_DEGC)
     t_cal = np.clip(f32(cal_temp_degc), lo, hi) - f32(ARDUPILOT_TEMP_REFERENCE_DEGC)
     out = np.empty((t.size, 3))
+    poly = np.empty_like(t)
     for j, axis in enumerate("XYZ"):
         c = [f32(value(f"GYR{k}_{axis}")) for k in (1, 2, 3)]
         scale = f32(1.0 / ARDUPILOT_SCALE)
-        poly = (c[0] + (c[1] + c[2] * t) * t) * t * scale
-        poly_cal = (c[0] + (c[1] + c[2] * t_cal) * t_cal) * t_cal * scale
-        out[:, j] = (poly - poly_cal).astype(float)
-    return out * RAD_TO_DEG
+        # (c0 + (c1 + c2 t) t) t scale in float32, in place: the same operations in the same order
+        np.multiply(c[2], t, out=poly)
+        poly += c[1]
+        poly *= t
+        poly += c[0]
+        poly *= t
+        poly *= scale
+        poly -= (c[0] + (c[1] + c[2] * t_cal) * t_cal) * t_cal * scale
+        out[:, j] = poly
+    out *= RAD_TO_DEG
+    return out
 
 
 def px4_slot(params: dict, device_id: int | None) -> int | None:

@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Literal
 
 import numpy as np
 
-from ..allan import BIAS_INSTABILITY_FACTOR, allan_deviation, allan_deviation_segments
-from ..effects import moving_average
+from ..allan import BIAS_INSTABILITY_FACTOR, AllanResult, allan_deviation, allan_deviation_segments
+from ..effects import moving_average, moving_average_range
 from ..errors import DataQualityWarning, InputError
 from .plausibility import MAX_ACCEL_G, MAX_RATE_DPS
 from ..recording import Recording
@@ -30,8 +31,9 @@ MIN_WINDOW_S = 1.0
 
 
 def bias_offset(x: np.ndarray, window_samples: int) -> float:
-    """Peak-to-peak of the moving average [unit of x]."""
-    return float(np.ptp(moving_average(x, window_samples)))
+    """Peak-to-peak of the moving average [unit of x] (:func:`gyrocomp.effects.moving_average`, its extremes
+    found block by block: no array of the average's length)."""
+    return moving_average_range(x, window_samples)
 
 
 @dataclass(frozen=True)
@@ -249,7 +251,8 @@ def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarr
 
 
 def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None,
-                 accel: bool = False) -> RunEvaluation:
+                 accel: bool = False, allan: tuple[Mapping[str, AllanResult], Mapping[str, AllanResult]] | None = None
+                 ) -> RunEvaluation:
     """Compare one run before and after compensation, axis by axis.
 
     Parameters
@@ -260,6 +263,10 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
         Moving-average window [s]; default :func:`default_window_s` of the raw run.
     accel : bool
         Also compare the accelerometer axes [g] (when the compensation covers them).
+    allan : (mapping, mapping), optional
+        The octave overlapping Allan deviation of each gyro axis of ``raw`` and of ``compensated`` (pooled over
+        the stretches between time gaps), by axis, when the caller has them already (the report draws them):
+        their minima are the bias instabilities, instead of computing the curves again.
     """
     for j, axis in enumerate(compensated.gyro_axes):
         check_compensated(raw.source, axis, compensated.gyro_dps[:, j], raw.row_numbers)
@@ -274,8 +281,12 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
             DataQualityWarning, stacklevel=2,
         )
     # the Allan minima do not depend on the window; the default window is the raw minima's longest tau
-    lows = [(_allan_minimum(raw.gyro_dps[:, j], raw.rate_hz, stretches),
-             _allan_minimum(compensated.gyro_dps[:, j], raw.rate_hz, stretches)) for j in range(len(raw.gyro_axes))]
+    if allan is not None:
+        lows = [(allan[0][axis].minimum(), allan[1][axis].minimum()) for axis in raw.gyro_axes]
+    else:
+        lows = [(_allan_minimum(raw.gyro_dps[:, j], raw.rate_hz, stretches),
+                 _allan_minimum(compensated.gyro_dps[:, j], raw.rate_hz, stretches))
+                for j in range(len(raw.gyro_axes))]
     if window_s is None:
         window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows))  # as default_window_s(raw)
     w = window_samples(window_s, raw.rate_hz, raw.n_samples)

@@ -133,7 +133,7 @@ def warn_if_moving(source: str, found: StillDetection) -> None:
 def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: AllanKind = "oadev",
                   taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
                   fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False,
-                  motion_check: bool = True) -> NoiseAnalysis:
+                  motion_check: bool = True, plausibility_check: bool = True) -> NoiseAnalysis:
     """Allan curve (``kind``) and noise terms (from the overlapping Allan deviation) for each axis.
 
     Parameters
@@ -151,10 +151,13 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
     motion_check : bool
         Warn when the log moves most of the time (:func:`warn_if_moving`); a caller that judged its stillness
         already passes False.
+    plausibility_check : bool
+        Warn of unit mistakes (:func:`gyrocomp.measures.plausibility.recording_concerns`); a caller that checked
+        the recording already passes False.
     """
     names = noise_axes(axes, recording.gyro_axes, recording.accel_axes, with_accel)
-    for concern in recording_concerns(recording):  # a time column in ns read as s gives taus of 1e10 s
-        warnings.warn(concern.warning(), stacklevel=2)
+    for concern in recording_concerns(recording) if plausibility_check else ():
+        warnings.warn(concern.warning(), stacklevel=2)  # a time column in ns read as s gives taus of 1e10 s
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
     if motion_check:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
@@ -247,8 +248,18 @@ class Recording:
         return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
 
     def with_gyro(self, gyro_dps: np.ndarray) -> "Recording":
-        """A copy with the gyro data replaced (same axes, same shape)."""
-        return dataclasses.replace(self, gyro_dps=gyro_dps)
+        """A copy with the gyro data replaced (same axes, same shape) [deg/s]: only the new data is checked (its
+        shape, finite values); the time, its gaps and rate are this recording's, checked when it was made."""
+        gyro = np.asarray(gyro_dps, dtype=float)
+        if gyro.ndim == 1:
+            gyro = gyro[:, None]
+        if gyro.shape != self.gyro_dps.shape:
+            raise InputError(f"{self.source}: gyro data has shape {gyro.shape}, expected {self.gyro_dps.shape} for "
+                             f"axes {self.gyro_axes}")
+        _require_finite(self.source, self.row_numbers, ((self.gyro_axes, gyro),))
+        copied = copy.copy(self)
+        object.__setattr__(copied, "gyro_dps", gyro)
+        return copied
 
     def take(self, index: slice | np.ndarray) -> "Recording":
         """The rows selected by a slice, boolean mask or index array, as a new recording."""

@@ -171,21 +171,28 @@ def allan_plot(analyses: dict, title: str = "Allan deviation"):
     return fig
 
 
-#: the branches of the temperature arrays drawn lately, by identity: the axes of one run share its temperature,
-#: so its turning points are found once per run, not once per axis
-_BRANCHES: dict[int, tuple[weakref.ref, np.ndarray]] = {}
+#: what is derived from the temperature arrays drawn lately, by identity: the axes of one run share its
+#: temperature, so its turning points and its temperature bins are found once per run, not once per axis
+_DERIVED: dict[int, tuple[weakref.ref, dict]] = {}
+
+
+def _derived(temperature: np.ndarray) -> dict:
+    hit = _DERIVED.get(id(temperature))
+    if hit is not None and hit[0]() is temperature:
+        return hit[1]
+    for key in [k for k, (ref, _) in _DERIVED.items() if ref() is None]:
+        del _DERIVED[key]
+    found: dict = {}
+    _DERIVED[id(temperature)] = (weakref.ref(temperature), found)
+    return found
 
 
 def _branches(temperature: np.ndarray) -> np.ndarray:
     """+1 where the temperature rises, -1 where it falls (robust turning points), 0 before the first move."""
-    hit = _BRANCHES.get(id(temperature))
-    if hit is not None and hit[0]() is temperature:
-        return hit[1]
-    direction = find_turns(temperature, turn_threshold_degc(temperature)).direction
-    for key in [k for k, (ref, _) in _BRANCHES.items() if ref() is None]:
-        del _BRANCHES[key]
-    _BRANCHES[id(temperature)] = (weakref.ref(temperature), direction)
-    return direction
+    found = _derived(temperature)
+    if "direction" not in found:
+        found["direction"] = find_turns(temperature, turn_threshold_degc(temperature)).direction
+    return found["direction"]
 
 
 def _binned(t: np.ndarray, width: float, *series: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -197,6 +204,32 @@ def _binned(t: np.ndarray, width: float, *series: np.ndarray) -> tuple[np.ndarra
     counts = np.bincount(index)
     keep = counts > 0
     return tuple(np.bincount(index, y)[keep] / counts[keep] for y in (t, *series))
+
+
+def _binned_by_branch(t: np.ndarray, width: float, *series: np.ndarray) -> dict:
+    """For each branch of ``t`` (:func:`_branches`: 1 heating, -1 cooling, 0 before the first move): the mean
+    temperature and the mean of each series in temperature bins of ``width`` [degC]. The bins of a temperature
+    array are found once (every axis of a run shares them), and each series takes one pass of bincount (no copy
+    of a branch's samples)."""
+    if t.size == 0:
+        return {}
+    found = _derived(t)
+    if found.get("width") != width:
+        index = np.floor((t - t.min()) / width).astype(np.intp)
+        bins = int(index.max()) + 1
+        key = (_branches(t).astype(np.intp) + 1) * bins + index
+        counts = np.bincount(key, minlength=3 * bins)
+        found.update(width=width, bins=bins, key=key, counts=counts,
+                     t_sums=np.bincount(key, t, minlength=3 * bins))
+    bins, key, counts = found["bins"], found["key"], found["counts"]
+    sums = [found["t_sums"]] + [np.bincount(key, y, minlength=3 * bins) for y in series]
+    out = {}
+    for sign in (1, -1, 0):
+        part = slice((sign + 1) * bins, (sign + 2) * bins)
+        keep = counts[part] > 0
+        if keep.any():
+            out[sign] = tuple(s[part][keep] / counts[part][keep] for s in sums)
+    return out
 
 
 def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: str | None = None):
@@ -220,12 +253,12 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
         correction = y_raw - y_comp
         width = max(float(np.ptp(t)) / 400.0, 1e-3)
         direction = _branches(t)
+        binned = _binned_by_branch(t, width, y_raw - offset, correction, y_comp - offset)
         for sign, colour, name in ((1, HEATING_COLOUR, "heating"), (-1, COOLING_COLOUR, "cooling"),
                                    (0, "tab:gray", "before the first move")):
-            sel = direction == sign
-            if not sel.any():
+            if sign not in binned:
                 continue
-            tb, yb, yc, yr = _binned(t[sel], width, y_raw[sel] - offset, correction[sel], y_comp[sel] - offset)
+            tb, yb, yc, yr = binned[sign]
             top.plot(tb, yb, ".", ms=3, color=colour, alpha=0.7, label=None if name in labelled else f"raw, {name}")
             labelled.add(name)
             top.plot(tb, yc, "-", color="black", lw=1.2,

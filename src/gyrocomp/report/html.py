@@ -366,8 +366,12 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         sections["summary"] = ("Model", _summary(calibration))
         if validation is not None:
             sections["validation"] = ("Validation", _validation(validation))
-        evaluations = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
-                       for rec, comp in zip(runs, compensated)]
+        # the Allan curves the report draws, raw and compensated; their minima are the evaluation's bias
+        # instabilities (computed once: a day at 100 Hz takes a quarter of a second per curve)
+        noise = [_noise(rec, comp) for rec, comp in zip(runs, compensated)]
+        evaluations = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes),
+                                    allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair))
+                       for rec, comp, pair in zip(runs, compensated, noise)]
         windows = [ev.window_s for ev in evaluations]
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
@@ -376,7 +380,7 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         if costs:
             sections["firmware"] = ("On the autopilot", _firmware(calibration, runs, evaluations, costs))
         tick()
-        sections["allan"] = ("Allan deviation", _allan(runs, compensated, tick))
+        sections["allan"] = ("Allan deviation", _allan(runs, noise, tick))
         if calibration.has_acceleration:
             sections["g-sensitivity"] = ("g-sensitivity", _g_sensitivity(calibration, runs, min_static_s))
         if calibration.gyro_triad is not None or calibration.accel_triad is not None:
@@ -419,15 +423,20 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
     return "\n".join(parts)
 
 
-def _allan(runs: list[Recording], compensated: list[Recording], tick: Callable[[], None]) -> str:
+def _noise(rec: Recording, comp: Recording) -> tuple:
+    """The noise analyses of a run's gyro axes, raw and compensated (pooled over time gaps). The report finds the
+    moving runs itself (the stillness section), and the raw run's plausibility was checked by apply: neither is
+    judged again per curve."""
+    names, split = list(rec.gyro_axes), bool(rec.gaps)
+    return tuple(analyse_noise(r, names, split_gaps=split, motion_check=False, plausibility_check=False)
+                 for r in (rec, comp))
+
+
+def _allan(runs: list[Recording], noise: list[tuple], tick: Callable[[], None]) -> str:
     """Raw and compensated Allan deviations of each run, one figure per run."""
     parts = []
-    for rec, comp in zip(runs, compensated):
-        names = list(rec.gyro_axes)
-        split = bool(rec.gaps)
-        # the report finds the moving runs itself (the stillness section): no motion check per curve
-        analyses = {"raw": analyse_noise(rec, names, split_gaps=split, motion_check=False),
-                    "compensated": analyse_noise(comp, names, split_gaps=split, motion_check=False)}
+    for rec, (raw, compensated) in zip(runs, noise):
+        analyses = {"raw": raw, "compensated": compensated}
         parts.append(_img(figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
                           "Allan deviation, raw and compensated"))
         tick()
