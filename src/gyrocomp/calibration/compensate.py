@@ -301,6 +301,11 @@ class Compensator:
         return self._release()
 
 
+#: apply feeds a whole recording to its Compensator in chunks of this many rows: the chunk's intermediate arrays
+#: stay a few MiB (a day at 100 Hz in one chunk allocates, and page-faults, several of 200 MiB)
+APPLY_CHUNK_ROWS = 1 << 18
+
+
 def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None,
           axes: tuple[str, ...] | None = None) -> Recording:
     """Compensate a whole recording; the result has the same rows, axes and other channels.
@@ -325,10 +330,16 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
         raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
                          f"got {type(calibration).__name__}")
     comp = compensator_for(calibration, recording, axes=axes, turn_on_window_s=turn_on_window_s)
-    out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel_xyz(recording))
-    rest = comp.finish()
+    accel, temperature = accel_xyz(recording), recording.temperature_degc
+    parts = []
+    for start in range(0, recording.n_samples, APPLY_CHUNK_ROWS):  # the same output as one chunk, to the bit
+        rows = slice(start, start + APPLY_CHUNK_ROWS)
+        parts.append(comp.update(recording.time_s[rows], recording.gyro_dps[rows],
+                                 None if temperature is None else temperature[rows],
+                                 None if accel is None else accel[rows]))
+    parts.append(comp.finish())
     warn_disagreement(comp)
-    result = recording.with_gyro(np.concatenate([out, rest]) if rest.size else out)
+    result = recording.with_gyro(np.concatenate(parts))
     if comp.compensates_accel:
         order = [ACCEL_AXES.index(a) for a in recording.accel_axes]
         result = dataclasses.replace(result, accel_g=comp.take_accel()[:, order])

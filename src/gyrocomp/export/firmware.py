@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,20 +122,41 @@ def firmware_parameters(calibration: Calibration, target: Autopilot) -> dict[str
         return ardupilot_parameters(calibration, instance=TARGETS["ardupilot"]).values
 
 
-def firmware_corrected(calibration: Calibration, recording: Recording, target: Autopilot) -> Recording:
-    """``recording`` corrected as the autopilot would correct it with the file exported from ``calibration``: PX4
-    as it runs (1 Hz, 1 degC republish), ArduPilot relative to the run's first temperature (where its boot-time
-    gyro offset is taken). Only the gyro axes the model has a temperature curve for are corrected [deg/s]."""
+def firmware_correction(calibration: Calibration, recording: Recording, target: Autopilot) -> np.ndarray:
+    """(n, 3) what the autopilot subtracts from gyro x, y, z [deg/s] at each sample of ``recording`` with the file
+    exported from ``calibration``: PX4 as it runs (1 Hz, 1 degC republish), ArduPilot relative to the run's first
+    temperature (where its boot-time gyro offset is taken)."""
     params = firmware_parameters(calibration, target)
     temperature = recording.temperature_degc
     if target == "px4":
-        correction = px4_as_run(params, recording.time_s, temperature, TARGETS["px4"])
-    else:
-        correction = ardupilot_gyro_correction_dps(params, temperature, float(temperature[0]), TARGETS["ardupilot"])
-    gyro = np.array(recording.gyro_dps, dtype=float, copy=True)
-    for axis in _gyro_axes_with_curve(calibration):
-        if axis in recording.gyro_axes:
-            gyro[:, recording.gyro_axes.index(axis)] -= correction[:, GYRO_AXES.index(axis)]
+        return px4_as_run(params, recording.time_s, temperature, TARGETS["px4"])
+    return ardupilot_gyro_correction_dps(params, temperature, float(temperature[0]), TARGETS["ardupilot"])
+
+
+def firmware_corrected_axes(calibration: Calibration, recording: Recording, target: Autopilot
+                            ) -> Iterator[tuple[str, np.ndarray]]:
+    """(axis, output [deg/s]) of each gyro axis of ``recording`` as the autopilot outputs it with the file
+    exported from ``calibration`` (:func:`firmware_correction`; an axis without a temperature curve in the model
+    is not corrected). Each output is written into one buffer, valid until the next axis is yielded: a day at
+    100 Hz is read axis by axis without a copy of the recording."""
+    correction = firmware_correction(calibration, recording, target)
+    corrected = _gyro_axes_with_curve(calibration)
+    buffer = np.empty(recording.n_samples)
+    for j, axis in enumerate(recording.gyro_axes):
+        if axis in corrected:
+            np.subtract(recording.gyro_dps[:, j], correction[:, GYRO_AXES.index(axis)], out=buffer)
+        else:
+            buffer[:] = recording.gyro_dps[:, j]
+        yield axis, buffer
+
+
+def firmware_corrected(calibration: Calibration, recording: Recording, target: Autopilot) -> Recording:
+    """``recording`` corrected as the autopilot would correct it with the file exported from ``calibration``
+    (:func:`firmware_correction`). Only the gyro axes the model has a temperature curve for are corrected
+    [deg/s]."""
+    gyro = np.empty_like(recording.gyro_dps, dtype=float)
+    for j, (_, output) in enumerate(firmware_corrected_axes(calibration, recording, target)):
+        gyro[:, j] = output
     return recording.with_gyro(gyro)
 
 
@@ -149,5 +171,5 @@ def firmware_costs(calibration: Calibration) -> dict[str, FirmwareDifference]:
                 for target, slot in TARGETS.items()}
 
 
-__all__ = ["BEYOND_DEGC", "FirmwareDifference", "TARGETS", "ardupilot_gyro_correction_dps", "firmware_corrected",
+__all__ = ["BEYOND_DEGC", "FirmwareDifference", "TARGETS", "ardupilot_gyro_correction_dps", "firmware_correction", "firmware_corrected", "firmware_corrected_axes",
            "firmware_costs", "firmware_difference", "firmware_parameters", "px4_as_run", "px4_gyro_correction_dps"]

@@ -77,6 +77,19 @@ def envelope(time_s: np.ndarray, values: np.ndarray, columns: int = DRAW_POINTS)
     return t, v
 
 
+def envelope_band(time_s: np.ndarray, values: np.ndarray, columns: int = DRAW_POINTS
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The band a series fills, cut to at most ``columns`` columns: each column's middle time, minimum and
+    maximum (for drawing only: one polygon renders in a fraction of the time of the zigzag line through the same
+    extremes)."""
+    n = values.size
+    if n <= 2 * columns:
+        return time_s, values, values
+    edges = np.linspace(0, n, columns + 1).astype(int)
+    mid_t = time_s[np.minimum((edges[:-1] + edges[1:]) // 2, n - 1)]
+    return mid_t, np.minimum.reduceat(values, edges[:-1]), np.maximum.reduceat(values, edges[:-1])
+
+
 def _slope_lines(panel, terms, tau: np.ndarray, colour) -> None:
     """The identified terms' asymptotes: N/sqrt(tau), the bias-instability floor 0.664 B, K sqrt(tau/3)."""
     tau = np.asarray(tau, dtype=float)
@@ -250,15 +263,15 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
         t = rec.temperature_degc if rec.temperature_degc.ndim == 1 else (
             rec.temperature_degc.mean(axis=1) if accel else rec.temperature_for(axis))
         offset = float(np.mean(y_comp))
-        correction = y_raw - y_comp
         width = max(float(np.ptp(t)) / 400.0, 1e-3)
         direction = _branches(t)
-        binned = _binned_by_branch(t, width, y_raw - offset, correction, y_comp - offset)
+        binned = _binned_by_branch(t, width, y_raw, y_comp)
         for sign, colour, name in ((1, HEATING_COLOUR, "heating"), (-1, COOLING_COLOUR, "cooling"),
                                    (0, "tab:gray", "before the first move")):
             if sign not in binned:
                 continue
-            tb, yb, yc, yr = binned[sign]
+            tb, raw_mean, comp_mean = binned[sign]  # the correction's bin mean is their difference
+            yb, yc, yr = raw_mean - offset, raw_mean - comp_mean, comp_mean - offset
             top.plot(tb, yb, ".", ms=3, color=colour, alpha=0.7, label=None if name in labelled else f"raw, {name}")
             labelled.add(name)
             top.plot(tb, yc, "-", color="black", lw=1.2,
@@ -268,7 +281,7 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
         turns = np.flatnonzero(np.diff(direction) != 0) + 1
         turns = turns[direction[turns - 1] != 0]
         if turns.size:
-            top.plot(t[turns], correction[turns], "D", color="black", ms=6, mfc="gold",
+            top.plot(t[turns], y_raw[turns] - y_comp[turns], "D", color="black", ms=6, mfc="gold",
                      label=None if "turn" in labelled else "turning points")
             labelled.add("turn")
     top.set_ylabel(f"bias [{unit}]")
@@ -298,8 +311,8 @@ def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "d
     w = window_samples(window_s, raw.rate_hz, raw.n_samples)
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9.0, 6.5), sharex=True, height_ratios=(3, 1))
     for (label, y), colour in zip(series.items(), (RAW_COLOUR, COMP_COLOUR)):
-        te, ye = envelope(t, y)
-        top.plot(te, ye, "-", color=colour, lw=0.5, alpha=0.35)
+        te, low, high = envelope_band(t, y)
+        top.fill_between(te, low, high, color=colour, lw=0.5, alpha=0.35)
         smooth = moving_average(y, w)
         ts = t[w // 2: w // 2 + smooth.size]
         ts, smooth = envelope(ts, smooth)

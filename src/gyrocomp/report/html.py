@@ -33,7 +33,7 @@ from ..calibration import Calibration
 from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, TemperatureRangeWarning
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
-from ..export.firmware import BEYOND_DEGC, firmware_corrected, firmware_costs
+from ..export.firmware import BEYOND_DEGC, firmware_corrected_axes, firmware_costs
 from ..measures.merit import bias_offset, evaluate_run, window_samples
 from ..measures.noise import analyse_noise
 from ..recording import ACCEL_AXES, Recording
@@ -411,11 +411,13 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
         # the bias offset of each firmware's output, over the evaluation's window (the other figures are not
         # shown here: their Allan minima would cost a report on a long run some seconds per firmware)
         w = window_samples(ev.window_s, rec.rate_hz, rec.n_samples)
-        on_vehicle = {target: firmware_corrected(calibration, rec, target) for target in costs}
+        on_vehicle = {target: {axis: bias_offset(output, w)
+                               for axis, output in firmware_corrected_axes(calibration, rec, target)}
+                      for target in costs}
         for axis, m in ev.axes.items():
-            if all(axis in v.gyro_axes for v in on_vehicle.values()):
+            if all(axis in offsets for offsets in on_vehicle.values()):
                 run_rows.append([rec.source.rsplit("/", 1)[-1], axis, m.bias_offset_raw_dps, m.bias_offset_comp_dps,
-                                 *(bias_offset(on_vehicle[t].gyro(axis), w) for t in costs)])
+                                 *(on_vehicle[t][axis] for t in costs)])
     if run_rows:
         parts.append(_table(["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"], run_rows,
                             "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
