@@ -137,7 +137,7 @@ def allan_deviation(data, rate_hz: float, *, kind: AllanKind = "oadev", taus: Ta
         edf = alphas.copy()
     else:
         if forced is None:
-            found = noise_types(kind, phase, ms, deviation)
+            found = noise_types(kind, phase, ms)
             alphas, methods = found.alpha, found.method
         else:
             alphas, methods = forced, ("given",) * len(ms)

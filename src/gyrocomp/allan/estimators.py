@@ -91,8 +91,8 @@ class AllanResult:
         Two-sided confidence of the interval (0.683 by default).
     noise_method : tuple of str
         What decided each tau's noise type: ``lag-1`` (the lag-1 autocorrelation), ``B1/R(n)`` (below 30
-        points), ``slope ...`` (the curve's own slope overruled a lag-1 type on few points, as Stable32 would
-        read it), ``carried`` (the next shorter tau's), ``given`` (``noise_alpha``), ``""`` (none).
+        points), ``R(n) ...`` (R(n) of the whole series overruled a lag-1 phase-noise type found on few points),
+        ``carried`` (the next shorter tau's), ``given`` (``noise_alpha``), ``""`` (none).
     """
 
     tau: np.ndarray

@@ -15,7 +15,7 @@ from typing import Literal
 
 import numpy as np
 
-from .estimators import _BLOCK, _ESTIMATORS, _blocks, _mean
+from .estimators import _BLOCK, _ESTIMATORS, _blocks, _mean, _second_difference_sum
 
 #: fewest decimated points for which the lag-1 autocorrelation identifies a noise type (Riley 2004)
 NOISE_ID_MIN_POINTS = 30
@@ -227,36 +227,44 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
                                method="rn", ratio=rn)
 
 
-#: a lag-1 identification from fewer decimated points than this is checked against the curve's own slope
-SLOPE_CHECK_MAX_POINTS = 100
-#: how far [in the exponent of tau] the slope may lie from the identified type's before the slope decides
-SLOPE_TOLERANCE = 0.25
+#: a lag-1 identification from fewer decimated points than this is cross-checked with R(n) of the whole series
+RN_CHECK_MAX_POINTS = 100
+#: R(n) = MVAR/AVAR expected for white, flicker and random-walk FM, any long averaging factor (NIST TN 1337,
+#: A-6, Table 2); phase noise's R(n) falls with m (:func:`rn_expected`)
+RN_FREQUENCY_NOISE = {0: 0.50, -1: 0.67, -2: 0.82}
 
 
-def expected_slope(alpha: int) -> float:
-    """The exponent of tau of an unmodified deviation (ADEV, OADEV, HDEV, OHDEV, TOTDEV) for power-law noise
-    alpha: (-alpha - 1) / 2, where white and flicker PM both fall as tau^-1 (NIST SP 1065, Table 5). The modified
-    deviations are not slope-checked: with MDEV's law (tau^((-alpha - 1) / 2) for every alpha) the check moved a
-    row of the gps reference away from Stable32's type and left Cs5071A's tau = 10000 s as it was."""
-    return max((-alpha - 1) / 2.0, -1.0)
+def overlapping_allan_variance(phase, m: int) -> float:
+    """The overlapping Allan variance at averaging factor m from every term of the series (per sample squared, as
+    :func:`modified_variance_on_grid`): sum of (x[i+2m] - 2 x[i+m] + x[i])^2 over 2 m^2 count; NaN where no term
+    fits."""
+    count = len(phase) - 2 * m
+    if count < 1:
+        return math.nan
+    return _second_difference_sum(phase, m, 1, count, np.empty(_BLOCK)) / (2.0 * float(m) ** 2 * count)
 
 
-def _slope_checked(alphas: np.ndarray, methods: list[str], points: list, ms: np.ndarray, deviation,
-                   lowest: int) -> np.ndarray:
-    """Where a lag-1 phase-noise type rests on few points (< SLOPE_CHECK_MAX_POINTS) and the curve's own slope from
-    the previous tau lies more than SLOPE_TOLERANCE from that type's, the type whose slope is nearest the curve's
-    (``methods`` then says so)."""
+def _rn_checked(alphas: np.ndarray, methods: list[str], points: list, phase, ms: np.ndarray,
+                lowest: int) -> np.ndarray:
+    """Where a lag-1 phase-noise type (white or flicker PM) rests on few decimated points (< RN_CHECK_MAX_POINTS),
+    R(n) = MVAR/AVAR of the whole series at that m (every term, not the few points) decides between the phase
+    noises and frequency noise: the type whose expected R(n) lies nearest on a log scale (``methods`` then says
+    so). On 56 points the lag-1 statistic can call white FM white PM, whose interval would be far too narrow;
+    R(n) from half a million terms tells them apart by a factor of a thousand."""
     out = alphas.copy()
-    for j in range(1, len(ms)):
-        if points[j] is None or points[j] >= SLOPE_CHECK_MAX_POINTS or not np.isfinite(alphas[j]):
+    for j, m in enumerate(int(m) for m in ms):
+        if points[j] is None or points[j] >= RN_CHECK_MAX_POINTS or not alphas[j] >= 1:
             continue
-        if not (deviation[j] > 0 and deviation[j - 1] > 0):
+        allan = overlapping_allan_variance(phase, m)
+        rn = modified_variance_on_grid(phase, m) / allan if allan > 0 else math.nan
+        if not math.isfinite(rn) or not rn > 0:
             continue
-        slope = math.log(deviation[j] / deviation[j - 1]) / math.log(ms[j] / ms[j - 1])
-        if alphas[j] < 1 or abs(expected_slope(int(alphas[j])) - slope) <= SLOPE_TOLERANCE:
-            continue  # only a phase-noise type (the narrowest intervals) is questioned
-        out[j] = float(min(range(lowest, 3), key=lambda a: (abs(expected_slope(a) - slope), -a)))
-        methods[j] = f"slope {slope:+.2f} (lag-1 said {int(alphas[j]):+d})"
+        expected = {2: rn_expected(m, 2), 1: rn_expected(m, 1),
+                    **{a: r for a, r in RN_FREQUENCY_NOISE.items() if a >= lowest}}
+        nearest = min(expected, key=lambda a: abs(math.log(rn / expected[a])))
+        if nearest != alphas[j]:
+            out[j] = float(nearest)
+            methods[j] = f"R(n) {rn:.3g} (lag-1 said {int(alphas[j]):+d})"
     return out
 
 
@@ -270,17 +278,17 @@ class NoiseTypes:
     method: tuple[str, ...]
 
 
-def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None = None) -> NoiseTypes:
+def noise_types(kind: str, phase, ms: np.ndarray) -> NoiseTypes:
     """alpha at each averaging factor in ``ms`` (ascending), as Stable32 identifies it, and how.
 
     The lag-1 autocorrelation where 30 decimated points remain, the B1 ratio with R(n) below that. A B1
     type is capped by the type found at the next shorter tau: in a sum of independent power-law noises the
     dominant exponent can only fall as tau grows, and the lag-1 type from many points is the better
     determined. Where neither method applies the type found at the next shorter tau is carried forward.
-    Types are kept within the estimator's range (alpha + 2d > 1). With ``deviation`` (the curve at ``ms``), a
-    lag-1 type from fewer than ``SLOPE_CHECK_MAX_POINTS`` points that the curve's own slope contradicts gives
-    way to the slope's (:func:`_slope_checked`): on 56 points the lag-1 statistic can call white FM white PM,
-    whose interval would then be far too narrow.
+    Types are kept within the estimator's range (alpha + 2d > 1). A lag-1 phase-noise type from fewer than
+    ``RN_CHECK_MAX_POINTS`` points is cross-checked with R(n) of the whole series (:func:`_rn_checked`), the
+    same evidence whatever the estimator: on 56 points the lag-1 statistic can call white FM white PM, whose
+    interval would then be far too narrow.
     """
     spec = _ESTIMATORS[kind]
     lowest = 2 - 2 * spec.difference_order
@@ -302,7 +310,5 @@ def noise_types(kind: str, phase, ms: np.ndarray, deviation: np.ndarray | None =
         elif not math.isnan(current):
             methods[j] = "carried"
         alphas[j] = current
-    if deviation is not None and kind not in ("mdev", "tdev"):  # the modified curves' slopes follow other laws
-        alphas = _slope_checked(alphas, methods, points, np.asarray(ms, dtype=float), np.asarray(deviation),
-                                lowest)
+    alphas = _rn_checked(alphas, methods, points, phase, ms, lowest)
     return NoiseTypes(alphas, tuple(methods))
