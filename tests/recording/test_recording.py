@@ -79,3 +79,18 @@ def test_temperature_column_for_axis():
     per_axis = Recording(time_s=t, gyro_dps=np.zeros((5, 2)), gyro_axes=("gyro_x", "gyro_z"),
                          temperature_degc=np.column_stack([t, t]))
     assert per_axis.temperature_column_for("gyro_z") == "temperature_z"
+
+
+def test_with_gyro_checks_only_the_new_data_and_keeps_the_rest():
+    time_s = np.r_[np.arange(100) * 0.1, 30.0 + np.arange(50) * 0.1]  # one gap
+    rec = Recording(time_s, np.zeros((150, 2)), ("gyro_x", "gyro_z"), temperature_degc=np.full(150, 20.0),
+                    source="run.csv")
+    new = rec.with_gyro(np.ones((150, 2)))
+    assert new.gyro_dps.sum() == 300 and rec.gyro_dps.sum() == 0
+    assert new.time_s is rec.time_s and new.gaps == rec.gaps and new.rate_hz == rec.rate_hz
+    with pytest.raises(InputError, match=r"run.csv: gyro data has shape \(150, 3\), expected \(150, 2\)"):
+        rec.with_gyro(np.ones((150, 3)))
+    bad = np.ones((150, 2))
+    bad[120, 1] = np.nan
+    with pytest.raises(InputError, match=r"run.csv: row 121, column 'gyro_z': nan is not a finite number"):
+        rec.with_gyro(bad)

@@ -249,7 +249,8 @@ class Recording:
 
     def with_gyro(self, gyro_dps: np.ndarray) -> "Recording":
         """A copy with the gyro data replaced (same axes, same shape) [deg/s]: only the new data is checked (its
-        shape, finite values); the time, its gaps and rate are this recording's, checked when it was made."""
+        shape, finite values); the time, its gaps and rate are this recording's, checked when it was made. What a
+        subclass keeps derived from the data (a field it makes fresh, not given) starts empty again."""
         gyro = np.asarray(gyro_dps, dtype=float)
         if gyro.ndim == 1:
             gyro = gyro[:, None]
@@ -259,6 +260,9 @@ class Recording:
         _require_finite(self.source, self.row_numbers, ((self.gyro_axes, gyro),))
         copied = copy.copy(self)
         object.__setattr__(copied, "gyro_dps", gyro)
+        for f in dataclasses.fields(copied):
+            if not f.init and f.default_factory is not dataclasses.MISSING:
+                object.__setattr__(copied, f.name, f.default_factory())
         return copied
 
     def take(self, index: slice | np.ndarray) -> "Recording":
