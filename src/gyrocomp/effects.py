@@ -442,27 +442,9 @@ def quantize(x: np.ndarray, lsb: float) -> np.ndarray:
     return np.round(np.asarray(x, dtype=float) / lsb) * lsb
 
 
-def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
-    """Moving average over ``window_samples`` samples, only where the window is full (n - w + 1 values)."""
-    x = np.asarray(x, dtype=float)
-    w = int(window_samples)
-    if w < 1:
-        raise InputError(f"window: must be at least one sample, got {w}")
-    if w > x.size:
-        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
-    c = np.empty(x.size + 1)  # the running sum about the first value, in place: no temporary of the data's size
-    c[0] = 0.0
-    np.subtract(x, x[0], out=c[1:])
-    np.cumsum(c[1:], out=c[1:])
-    out = c[w:] - c[:-w]
-    out /= w
-    out += x[0]
-    return out
-
-
-def moving_average_range(x: np.ndarray, window_samples: int, block: int = 1 << 16) -> float:
-    """Peak-to-peak of :func:`moving_average` [unit of x], the same values, its extremes found block by block
-    (no array of the average's length)."""
+def _window_sums(x: np.ndarray, window_samples: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """(x as floats, its running sum about its first value with a leading 0, the window [samples]), the window
+    checked: in place, no temporary of the data's size."""
     x = np.asarray(x, dtype=float)
     w = int(window_samples)
     if w < 1:
@@ -473,6 +455,22 @@ def moving_average_range(x: np.ndarray, window_samples: int, block: int = 1 << 1
     c[0] = 0.0
     np.subtract(x, x[0], out=c[1:])
     np.cumsum(c[1:], out=c[1:])
+    return x, c, w
+
+
+def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
+    """Moving average over ``window_samples`` samples, only where the window is full (n - w + 1 values)."""
+    x, c, w = _window_sums(x, window_samples)
+    out = c[w:] - c[:-w]
+    out /= w
+    out += x[0]
+    return out
+
+
+def moving_average_range(x: np.ndarray, window_samples: int, block: int = 1 << 16) -> float:
+    """Peak-to-peak of :func:`moving_average` [unit of x], the same values, its extremes found block by block
+    (no array of the average's length)."""
+    x, c, w = _window_sums(x, window_samples)
     count = x.size - w + 1
     part = np.empty(min(block, count))
     low, high = math.inf, -math.inf

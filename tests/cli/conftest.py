@@ -37,3 +37,13 @@ def report_files(tmp_path_factory):
     r = run("fit", d / "run1.csv", "-o", d / "model.json", "--hysteresis", "none")
     assert r.returncode == 0, r.stderr
     return d
+
+
+def assert_refused_in_one_line(args: list[str], message: str, folder) -> None:
+    """The command (its arguments with ``{d}`` for ``folder``) exits 2 with one error line holding ``message``
+    and no traceback."""
+    r = run(*[a.format(d=folder) for a in args])
+    assert r.returncode == 2
+    errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
+    assert len(errors) == 1 and message.format(d=folder) in errors[0], r.stderr
+    assert "Traceback" not in r.stderr

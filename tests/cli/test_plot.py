@@ -2,6 +2,7 @@
 
 import pytest
 
+from .conftest import assert_refused_in_one_line
 from ..conftest import run
 
 
@@ -22,9 +23,4 @@ def test_plot_draws_each_kind_in_the_format_its_suffix_names(report_files):
      "--axis: 'gyro_q': the model and the data share gyro_x, gyro_y, gyro_z"),
 ])
 def test_plot_refuses_bad_options_in_one_line(report_files, args, message):
-    d = report_files
-    r = run(*[a.format(d=d) for a in args])
-    assert r.returncode == 2
-    errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
-    assert len(errors) == 1 and message.format(d=d) in errors[0], r.stderr
-    assert "Traceback" not in r.stderr
+    assert_refused_in_one_line(args, message, report_files)

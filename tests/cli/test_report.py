@@ -5,6 +5,7 @@ import sys
 
 import pytest
 
+from .conftest import assert_refused_in_one_line
 from ..conftest import check_report_page, report_sections, run
 
 
@@ -27,12 +28,7 @@ def test_report_of_a_model_on_runs_with_validation(report_files):
     (["report", "{d}/model.json", "{d}/run2.csv", "-o", "{d}/run2.csv"], "this is an input file"),
 ])
 def test_report_refuses_bad_options_in_one_line(report_files, args, message):
-    d = report_files
-    r = run(*[a.format(d=d) for a in args])
-    assert r.returncode == 2
-    errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
-    assert len(errors) == 1 and message.format(d=d) in errors[0], r.stderr
-    assert "Traceback" not in r.stderr
+    assert_refused_in_one_line(args, message, report_files)
 
 
 def test_package_imports_and_cli_answers_without_matplotlib(report_files, tmp_path):

@@ -374,9 +374,11 @@ def warn_disagreement(comp: Compensator, stacklevel: int = 3) -> None:
 def accel_xyz(recording: Recording) -> np.ndarray | None:
     """The accelerometer in accel_x, accel_y, accel_z order [g] (what a :class:`Compensator` takes), or None
     without all three."""
-    if recording.accel_g is not None and set(ACCEL_AXES) <= set(recording.accel_axes):
-        return recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
-    return None
+    if recording.accel_g is None or not set(ACCEL_AXES) <= set(recording.accel_axes):
+        return None
+    if tuple(recording.accel_axes) == ACCEL_AXES:
+        return recording.accel_g  # already in order: no copy of every chunk
+    return recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
 
 
 def _restricted(calibration: Calibration, recording: Recording, axes: tuple[str, ...] | None) -> Calibration:

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from ..calibration import Calibration
-from ..files import apply_file
+from ..files.apply import apply_file
 from ..io import detect_format, output_format, refuse_to_overwrite_inputs
 from .common import FINITE, pop_read_options, progress_bar, read_options, read_settings
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from ..files import convert_file
+from ..files.convert import convert_file
 from ..io import output_format, refuse_to_overwrite_inputs
 from .common import pop_read_options, progress_bar, read_options, read_settings
 

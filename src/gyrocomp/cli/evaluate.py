@@ -11,8 +11,7 @@ import click
 
 from ..calibration import Calibration
 from ..errors import InputError
-from ..files import evaluate_file, reads_in_chunks
-from ..io import detect_format
+from ..files.evaluate import evaluate_file
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..measures.merit import Evaluation
 from ..evaluation.comparison import compare_methods
@@ -20,11 +19,6 @@ from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
 from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
-
-
-def _is_table(path, opts: dict) -> bool:
-    """Whether ``path`` is read in chunks (a table, its rows not selected by time)."""
-    return Path(path).exists() and reads_in_chunks(detect_format(path, opts["fmt"]), read_settings(opts))
 
 
 def _nan_none(value):
@@ -112,8 +106,9 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
 
 
 def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, rate_schedule) -> Evaluation:
-    """The model on each run: tables in chunks (memory bounded whatever the files' lengths), other files whole."""
-    if rate_schedule is None and all(_is_table(path, opts) for path in runs):
+    """The model on each run (gyrocomp.files: tables in chunks, memory bounded whatever the files' lengths, other
+    files whole); with a rate schedule, the runs read whole and the schedule applied to them first."""
+    if rate_schedule is None:
         parts = []
         for path in runs:
             with progress_bar(f"reading {Path(path).name}") as progress:
