@@ -14,7 +14,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 LAYERS = (
     # pure functions and helpers any layer may use: errors, physical units, the effects' equations, spilling
     ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "ctext", "effects",
-                    "spill", "spelling")),
+                    "spill", "spelling", "lazy")),
     # what a recording is and what is measured of it: the recording and its preparation, motion (stillness,
     # static positions), measures (figures of merit, noise terms, plausibility), Allan statistics, simulation
     ("signals", ("recording", "motion", "measures", "allan", "simulation")),

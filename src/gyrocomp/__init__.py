@@ -9,9 +9,8 @@ works as usual.
 
 from __future__ import annotations
 
-import importlib
-
 from ._version import __version__
+from .lazy import lazy_exports
 
 #: public name -> (module, name in it)
 _EXPORTS = {
@@ -48,21 +47,6 @@ _EXPORTS = {
 }
 
 
-def _load(name: str):
-    module, attribute = _EXPORTS[name]
-    return getattr(importlib.import_module(f"gyrocomp.{module}"), attribute)
-
-
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module 'gyrocomp' has no attribute {name!r}")
-    value = _load(name)
-    globals()[name] = value  # found once
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_EXPORTS))
-
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

@@ -7,22 +7,14 @@ does not load what evaluating or the noise analysis needs.
 
 from __future__ import annotations
 
-import importlib
+from ..lazy import lazy_exports
 
-#: public name -> its module in this package
-_EXPORTS = {"FileResult": "apply", "apply_file": "apply", "ChunkSettings": "chunks", "reads_in_chunks": "chunks",
-            "ConvertResult": "convert", "convert_file": "convert", "evaluate_file": "evaluate",
-            "analyse_noise_file": "noise"}
+#: public name -> (its module in this package, its name there)
+_EXPORTS = {name: (module, name) for module, names in (
+    ("apply", ("FileResult", "apply_file")), ("chunks", ("ChunkSettings", "reads_in_chunks")),
+    ("convert", ("ConvertResult", "convert_file")), ("evaluate", ("evaluate_file",)),
+    ("noise", ("analyse_noise_file",))) for name in names}
 
-
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module 'gyrocomp.files' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_EXPORTS))
-
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = sorted(_EXPORTS)
