@@ -152,8 +152,7 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
         Warn when the log moves most of the time (:func:`warn_if_moving`); a caller that judged its stillness
         already passes False.
     plausibility_check : bool
-        Warn of unit mistakes (:func:`gyrocomp.measures.plausibility.recording_concerns`); a caller that checked
-        the recording already passes False.
+        Warn of unit mistakes (:func:`.plausibility.recording_concerns`); a caller that checked them passes False.
     """
     names = noise_axes(axes, recording.gyro_axes, recording.accel_axes, with_accel)
     for concern in recording_concerns(recording) if plausibility_check else ():

@@ -366,8 +366,7 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         sections["summary"] = ("Model", _summary(calibration))
         if validation is not None:
             sections["validation"] = ("Validation", _validation(validation))
-        # the Allan curves the report draws, raw and compensated; their minima are the evaluation's bias
-        # instabilities (computed once: a day at 100 Hz takes a quarter of a second per curve)
+        # the Allan curves drawn below, raw and compensated: their minima are the bias instabilities (once)
         noise = [_noise(rec, comp) for rec, comp in zip(runs, compensated)]
         evaluations = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes),
                                     allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair))
