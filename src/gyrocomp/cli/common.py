@@ -33,26 +33,29 @@ def _parsed(parse):
     return lambda ctx, param, value: parse(value) if isinstance(value, str) else value
 
 
-def click_option(name: str, spelling: Spelling):
+def click_option(name: str, spelling: Spelling, default=None):
     """The click option of a typed field (:mod:`gyrocomp.spelling`): its flag, help and metavar, the field's name
-    as the parameter's, its value parsed as the spelling says."""
+    as the parameter's, its value parsed as the spelling says; a field's text default (a unit) is the option's
+    and shown in the help, any other default (None, an empty mapping) applies when the option is not given."""
     if spelling.switch:
         return click.option(spelling.flag, name, is_flag=True, help=spelling.help, cls=ReadingOption)
-    return click.option(spelling.flag, name, default=None, metavar=spelling.metavar, help=spelling.help,
+    shown = isinstance(default, str)
+    return click.option(spelling.flag, name, default=default if shown else None, show_default=shown,
+                        metavar=spelling.metavar, help=spelling.help,
                         callback=_parsed(spelling.parse) if spelling.parse else None, cls=ReadingOption)
 
 
 #: the reading options of every command that reads data: the input's format, then the fields of ReadOptions
-#: (and of its TableLayout), each defined once, where the library defines it
-READ_FIELDS = (("fmt", FORMAT_SPELLING),
-               *((field.name, spelling) for field, spelling in spelled_fields(ReadOptions)))
-READ_OPTIONS = tuple(name for name, _ in READ_FIELDS)
+#: (and of its TableLayout), each defined once, where the library defines it, with its default
+READ_FIELDS = (("fmt", FORMAT_SPELLING, None),
+               *((field.name, spelling, field.default) for field, spelling in spelled_fields(ReadOptions)))
+READ_OPTIONS = tuple(name for name, _, _ in READ_FIELDS)
 
 
 def read_options(func):
     """Options every command that reads data files shares."""
-    for name, spelling in reversed(READ_FIELDS):
-        func = click_option(name, spelling)(func)
+    for name, spelling, default in reversed(READ_FIELDS):
+        func = click_option(name, spelling, default)(func)
     return func
 
 

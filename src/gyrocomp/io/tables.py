@@ -83,9 +83,9 @@ class TableLayout:
     columns: dict[str, str] = spelled(Spelling(
         "--columns", "Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T.", metavar="CH=COL,...",
         parse=parse_column_mapping), default_factory=dict)
-    gyro_unit: str = spelled(Spelling("--gyro-unit", "deg/s, rad/s or mdps [default: deg/s]."), default="deg/s")
-    accel_unit: str = spelled(Spelling("--accel-unit", "g, mg or m/s2 [default: g]."), default="g")
-    time_unit: str = spelled(Spelling("--time-unit", "s, ms, us or ns [default: s]."), default="s")
+    gyro_unit: str = spelled(Spelling("--gyro-unit", "deg/s, rad/s or mdps."), default="deg/s")
+    accel_unit: str = spelled(Spelling("--accel-unit", "g, mg or m/s2."), default="g")
+    time_unit: str = spelled(Spelling("--time-unit", "s, ms, us or ns."), default="s")
     delimiter: str | None = spelled(Spelling(
         "--delimiter", "CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a "
         "tab).", parse=_delimiter), default=None)
