@@ -10,6 +10,7 @@ import numpy as np
 from . import Calibration
 from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
+from ..io.stream import CHUNK_ROWS
 from ..measures.plausibility import BlockMeans, ScaleAgreement, agreement_concern, recording_concerns, scale_agreement
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 
@@ -301,11 +302,6 @@ class Compensator:
         return self._release()
 
 
-#: apply feeds a whole recording to its Compensator in chunks of this many rows: the chunk's intermediate arrays
-#: stay a few MiB (a day at 100 Hz in one chunk allocates, and page-faults, several of 200 MiB)
-APPLY_CHUNK_ROWS = 1 << 18
-
-
 def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None,
           axes: tuple[str, ...] | None = None) -> Recording:
     """Compensate a whole recording; the result has the same rows, axes and other channels.
@@ -332,8 +328,10 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     comp = compensator_for(calibration, recording, axes=axes, turn_on_window_s=turn_on_window_s)
     accel, temperature = accel_xyz(recording), recording.temperature_degc
     parts = []
-    for start in range(0, recording.n_samples, APPLY_CHUNK_ROWS):  # the same output as one chunk, to the bit
-        rows = slice(start, start + APPLY_CHUNK_ROWS)
+    # in the chunks a file is read in: the same output as one chunk, to the bit, and each chunk's intermediate
+    # arrays a few MiB (a day at 100 Hz in one chunk allocates, and page-faults, several of 200 MiB)
+    for start in range(0, recording.n_samples, CHUNK_ROWS):
+        rows = slice(start, start + CHUNK_ROWS)
         parts.append(comp.update(recording.time_s[rows], recording.gyro_dps[rows],
                                  None if temperature is None else temperature[rows],
                                  None if accel is None else accel[rows]))
