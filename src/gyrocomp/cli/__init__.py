@@ -157,19 +157,18 @@ def in_cli_words(message: str, commands: list[click.Command] | None = None) -> s
     options = _options(cli) + [o for c in (_LOOKED_UP if commands is None else commands) for o in _options(c)]
     flags = {o.name: max(o.opts, key=len) for o in options if o.name}
     switches = {o.name for o in options if o.is_flag}
+    # the group's own options (--debug, --quiet, switches both) are always there: neither pattern is empty
     message = _OPTION_OBJECT.sub("", message)
-    if switches:
-        message = re.sub(r"(?<![\w.\-/])(" + "|".join(map(re.escape, switches)) + r")=True\b", r"\1=", message)
-    if flags:
-        names = "|".join(map(re.escape, sorted(flags, key=len, reverse=True)))
+    message = re.sub(r"(?<![\w.\-/])(" + "|".join(map(re.escape, switches)) + r")=True\b", r"\1=", message)
+    names = "|".join(map(re.escape, sorted(flags, key=len, reverse=True)))
 
-        def flag(m: re.Match) -> str:
-            name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
-            if sep == ":":
-                return flags[name] + ":"
-            return flags[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
+    def flag(m: re.Match) -> str:
+        name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
+        if sep == ":":
+            return flags[name] + ":"
+        return flags[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
 
-        message = re.sub(r"(?<![\w.\-/])(" + names + r")([:=])", flag, message)
+    message = re.sub(r"(?<![\w.\-/])(" + names + r")([:=])", flag, message)
     return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
 
 
