@@ -405,18 +405,36 @@ def test_octave_pass_equals_direct_sums_for_any_length_block_and_drift(n, block_
     np.testing.assert_allclose(got, _second_difference_sums(phase, ms), rtol=1e-9)
 
 
-@settings(max_examples=30, deadline=None)
-@given(n=st.integers(8, 3000), first_log2=st.integers(0, 4), block_log2=st.integers(2, 12),
-       seed=st.integers(0, 2 ** 16))
-def test_octave_levels_from_any_first_factor_equal_direct_sums(n, first_log2, block_log2, seed):
-    """The pass that starts at a longer factor (the long levels, after the short ones went in small blocks)
-    starts from x[i+m] - x[i] and gives the direct sums too."""
-    phase = np.concatenate([[0.0], np.cumsum(np.random.default_rng(seed).standard_normal(n))])
-    top = 1 << int(np.floor(np.log2((n + 1) // 4)))
-    first = min(1 << first_log2, top)
-    ms = 2 ** np.arange(first.bit_length() - 1, top.bit_length())
-    got = estimators._octave_level_sums(phase, first, top, 1 << block_log2)
-    np.testing.assert_allclose(got, _second_difference_sums(phase, ms), rtol=1e-9)
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(8, 3000), block_log2=st.integers(0, 12), shape=st.sampled_from(["white", "walk", "drift"]),
+       seed=st.integers(0, 2 ** 16), data=st.data())
+def test_lag_products_of_detrended_windows_equal_direct_sums(n, block_log2, shape, seed, data):
+    """The windowed lag products (each block's window detrended first) give the direct sums for any factors,
+    block length (shorter than the factors' windows included) and phase shape."""
+    rng = np.random.default_rng(seed)
+    y = rng.standard_normal(n)
+    y = {"white": y, "walk": np.cumsum(y), "drift": 5.0 + 3.0 * np.linspace(0.0, 1.0, n) + 1e-3 * y}[shape]
+    phase = np.concatenate([[0.0], np.cumsum(y - y.mean())])
+    ms = np.unique(data.draw(st.lists(st.integers(1, n // 2), min_size=1, max_size=5)))
+    got = estimators._windowed_oadev_sums(phase, ms, block=1 << block_log2)
+    np.testing.assert_allclose(got, _second_difference_sums(phase, ms), rtol=1e-7, atol=1e-12 * n)
+
+
+@pytest.mark.parametrize("shape", ["ramp", "random_walk", "cubic", "sine"])
+def test_long_octave_levels_from_detrended_windows_are_exact_on_drift_dominated_data(shape):
+    """The octave levels 2^13..2^16 of a 2e6-sample series (from lag products of detrended 2^19-point
+    windows) against the direct sums of squared second differences, where drifts make the cancellation
+    in the lag identity worst."""
+    rng = np.random.default_rng(5)
+    n = 2_000_000
+    t = np.linspace(0.0, 1.0, n)
+    y = {"ramp": 0.5 + 2.0 * t + 1e-3 * rng.standard_normal(n), "random_walk": np.cumsum(rng.standard_normal(n)),
+         "cubic": 1e3 * (t - 0.3) ** 3 + 1e-6 * rng.standard_normal(n),
+         "sine": 10.0 * np.sin(14.0 * np.pi * t) + 1e-4 * rng.standard_normal(n)}[shape]
+    phase = np.concatenate([[0.0], np.cumsum(y - y.mean())])
+    ms = 1 << np.arange(13, 17)
+    np.testing.assert_allclose(estimators._windowed_oadev_sums(phase, ms), _second_difference_sums(phase, ms),
+                               rtol=1e-9)
 
 
 def test_the_default_octave_pass_splits_short_and_long_factors_with_the_same_sums(monkeypatch):

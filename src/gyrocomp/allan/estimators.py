@@ -282,33 +282,35 @@ def _total_sum(x, m: int, buffer: np.ndarray, spare: np.ndarray) -> float:
 
 #: octave levels up to this m are computed together, block by block, from windowed sums kept in cache
 _OCTAVE_IN_CACHE_MAX_M = 1 << 16
-_OCTAVE_BLOCK = 1 << 19
 #: the short levels (m up to _OCTAVE_SHORT_MAX_M) go block by block in blocks of _OCTAVE_SHORT_BLOCK, whose two
-#: buffers stay in a core's L2 cache; the long ones start again from the phase in blocks of _OCTAVE_BLOCK (their
-#: windows reach 2m past a block: small blocks would read most of them twice). Measured at 1e7 samples (whole
-#: deviation call, octave taus): 0.24 s split at m = 2^10 with 2^17-sample short blocks (2 x 1 MiB), 0.215 s split
-#: at m = 2^12 with 2^16-sample short blocks (2 x 0.56 MiB with their windows); at 1e6, 0.021 -> 0.015 s.
+#: buffers stay in a core's L2 cache; the long ones come from lag products of detrended windows of the phase
+#: (_windowed_oadev_sums), whose cost is one pass to detrend a window and one dot product per lag. Measured at
+#: 1e7 samples (deviations of octave taus): split at m = 2^12 with 2^16-sample short blocks, 0.069 s for the 13
+#: short levels; the four levels 2^13..2^16 0.056 s as a chain of windows in 2^19-sample blocks, 0.038 s from lag
+#: products.
 _OCTAVE_SHORT_MAX_M = 1 << 12
 _OCTAVE_SHORT_BLOCK = 1 << 16
 
 
 def _octave_oadev_sums(x, top: int, block: int | None = None) -> np.ndarray:
-    """Overlapping Allan sums for m = 1, 2, 4, ..., top (a power of two): the short factors in small blocks,
-    the long ones in large blocks (:func:`_octave_level_sums`); ``block`` forces one size for all."""
+    """Overlapping Allan sums for m = 1, 2, 4, ..., top (a power of two): the short factors in small blocks
+    (:func:`_octave_level_sums`), the long ones from lag products of detrended windows
+    (:func:`_windowed_oadev_sums`); ``block`` forces the block-wise levels for all, in blocks of that size."""
     if block is not None:
-        return _octave_level_sums(x, 1, top, block)
+        return _octave_level_sums(x, top, block)
     if top <= _OCTAVE_SHORT_MAX_M:
-        return _octave_level_sums(x, 1, top, _OCTAVE_SHORT_BLOCK)
-    short = _octave_level_sums(x, 1, _OCTAVE_SHORT_MAX_M, _OCTAVE_SHORT_BLOCK)
-    return np.concatenate([short, _octave_level_sums(x, 2 * _OCTAVE_SHORT_MAX_M, top, _OCTAVE_BLOCK)])
+        return _octave_level_sums(x, top, _OCTAVE_SHORT_BLOCK)
+    short = _octave_level_sums(x, _OCTAVE_SHORT_MAX_M, _OCTAVE_SHORT_BLOCK)
+    long = 2 * _OCTAVE_SHORT_MAX_M << np.arange(top.bit_length() - _OCTAVE_SHORT_MAX_M.bit_length())
+    return np.concatenate([short, _windowed_oadev_sums(x, long)])
 
 
-def _octave_level_sums(x, first: int, top: int, block: int) -> np.ndarray:
-    """Overlapping Allan sums for m = first, 2 first, ..., top (powers of two) in one pass over x.
+def _octave_level_sums(x, top: int, block: int) -> np.ndarray:
+    """Overlapping Allan sums for m = 1, 2, 4, ..., top (powers of two) in one pass over x.
 
     With u_m(i) = x[i+m] - x[i] the second difference is D_m(i) = u_m(i+m) - u_m(i), and the windows
     double by u_2m(i) = u_m(i) + u_m(i+m), so each block of x is read once for every level. Within a
-    block, u_first is centred on its mean (D does not change). The parallelogram law
+    block, u_1 is centred on its mean (D does not change). The parallelogram law
     sum D_m(i)^2 + sum u_2m(i)^2 = 2 sum u_m(i)^2 + 2 sum u_m(i+m)^2 (i < count) gives each level's sum
     from one BLAS dot product of the next level's window, sum u_2m^2, which is also the next level's
     sum of squares (extended by the few terms past the block); the top level uses
@@ -316,19 +318,19 @@ def _octave_level_sums(x, first: int, top: int, block: int) -> np.ndarray:
     identities at (block / m)^2 rounding units at most.
     """
     n = len(x)
-    levels = top.bit_length() - first.bit_length() + 1
+    levels = top.bit_length()
     sums = np.zeros(levels)
     window = block + 2 * top
     buffers = np.empty(min(window, n)), np.empty(min(window, n))  # short series: no 3 MiB buffers
-    for start in range(0, n - 2 * first, block):
+    for start in range(0, n - 2, block):
         current, spare = buffers
         w = np.asarray(x[start:min(start + window, n)], dtype=np.float64)
-        length = w.size - first
+        length = w.size - 1
         u = current[:length]
-        np.subtract(w[first:], w[:-first], out=u)
+        np.subtract(w[1:], w[:-1], out=u)
         u -= u[:min(block, length)].mean()
         known_sum, known_len = 0.0, 0  # sum of u[:known_len]^2, carried from the level before
-        m = first
+        m = 1
         for level in range(levels):
             count = min(block, n - 2 * m - start)
             if count <= 0:
@@ -382,30 +384,67 @@ def _prefix_dots(x, cuts: dict[int, set[int]], block: int = _BLOCK) -> dict[int,
     return prefix
 
 
-def _lagged_oadev_sums(x, ms: np.ndarray) -> np.ndarray:
-    """Overlapping Allan sums for long averaging factors from lag products of the phase alone.
+def _lag_combination_sums(x, ms: list[int], counts: list[int]) -> np.ndarray:
+    """sum_{i<c} (x_{i+2m} - 2 x_{i+m} + x_i)^2 for each m in ms and its count c (c <= len(x) - 2m; c <= 0
+    gives 0) from lag products of x: with Q(a, b) = sum_{a<=j<b} x_j^2 and L_k(a, b) = sum_{a<=j<b} x_j x_{j+k},
+    the sum is Q(2m, c+2m) + 4 Q(m, c+m) + Q(0, c) - 4 L_m(m, c+m) - 4 L_m(0, c) + 2 L_2m(0, c), so each
+    distinct lag (m and 2m; octave factors share them) costs one BLAS dot product over x (all lags in one pass,
+    :func:`_prefix_dots`), with no temporary array. The terms are of the order of c x^2 while the result is of
+    the order of c D_m^2: the caller keeps that ratio small."""
+    cuts: dict[int, set[int]] = {0: {0}}
+    for m, c in zip(ms, counts):
+        if c > 0:
+            cuts[0].update((0, m, 2 * m, c, c + m, c + 2 * m))
+            cuts.setdefault(m, set()).update((0, m, c, c + m))
+            cuts.setdefault(2 * m, set()).update((0, c))
+    lagged = _prefix_dots(x, cuts)
+    sums = np.zeros(len(ms))
+    for j, (m, c) in enumerate(zip(ms, counts)):
+        if c > 0:
+            q, lm, l2m = lagged[0], lagged[m], lagged[2 * m]
+            sums[j] = ((q[c + 2 * m] - q[2 * m]) + 4.0 * (q[c + m] - q[m]) + q[c]
+                       - 4.0 * (lm[c + m] - lm[m]) - 4.0 * lm[c] + 2.0 * l2m[c])
+    return sums
 
-    With N = len(x), c = N - 2m, Q(a, b) = sum_{a<=j<b} x_j^2 and L_k(a, b) = sum_{a<=j<b} x_j x_{j+k},
-    sum_{i<c} (x_{i+2m} - 2 x_{i+m} + x_i)^2 = Q(2m, N) + 4 Q(m, N-m) + Q(0, c)
-                                             - 4 L_m(m, N-m) - 4 L_m(0, c) + 2 L_2m(0, c),
-    so each distinct lag (m and 2m; octave factors share them) costs one BLAS dot product over the series
-    (all lags in one pass, :func:`_prefix_dots`), with no temporary array. The terms are of the order of
-    N x^2 while the result is of the order of
-    N D_m^2; on a phase dominated by a drift that ratio grows like (N/m)^4 / 12, which is why only
-    factors with N/m <= _LAGGED_MAX_SPANS come here (relative rounding below ~1e-8).
+
+def _lagged_oadev_sums(x, ms: np.ndarray) -> np.ndarray:
+    """Overlapping Allan sums for long averaging factors from lag products of the whole phase
+    (:func:`_lag_combination_sums`, c = N - 2m). The terms are of the order of N x^2 while the result is of the
+    order of N D_m^2; on a phase dominated by a drift that ratio grows like (N/m)^4 / 12, which is why only
+    factors with N/m <= _LAGGED_MAX_SPANS come here (relative rounding below ~1e-8)."""
+    ms = [int(m) for m in ms]
+    return _lag_combination_sums(x, ms, [len(x) - 2 * m for m in ms])
+
+
+#: the windows of _windowed_oadev_sums hold this many starting points i (plus 2m past them)
+_WINDOW_BLOCK = 1 << 19
+
+
+def _windowed_oadev_sums(x, ms: np.ndarray, block: int = _WINDOW_BLOCK) -> np.ndarray:
+    """Overlapping Allan sums for long averaging factors from lag products of the phase, window by window.
+
+    The sum over i of D_m(i)^2 = (x_{i+2m} - 2 x_{i+m} + x_i)^2 is taken ``block`` starting points at a time;
+    a block's terms read the window x[a : a + block + 2 max(ms)], from which its straight line through the
+    first and last points is removed first (D does not change: a second difference annihilates a line), and
+    the block's sum comes from lag products of that window (:func:`_lag_combination_sums`). The detrended
+    window is what keeps the cancellation there small: a drift that is quadratic within the window leaves
+    terms of the order of (W/m)^4 / 64 times the result (W the window's length), a random walk of the rate
+    (W/m)^3; with block = 2^19 and m >= 2^13 (W/m <= 80 for octave factors up to 8m) that is below ~1e-10
+    relative. One pass detrends the window; each lag is then one dot product.
     """
     n = len(x)
     ms = [int(m) for m in ms]
-    cuts: dict[int, set[int]] = {0: {0, n} | {c for m in ms for c in (m, 2 * m, n - 2 * m, n - m)}}
-    for m in ms:
-        cuts.setdefault(m, set()).update((0, m, n - 2 * m, n - m))
-        cuts.setdefault(2 * m, set()).update((0, n - 2 * m))
-    lagged = _prefix_dots(x, cuts)
-    sums = np.empty(len(ms))
-    for j, m in enumerate(ms):
-        c, q, lm, l2m = n - 2 * m, lagged[0], lagged[m], lagged[2 * m]
-        sums[j] = ((q[n] - q[2 * m]) + 4.0 * (q[n - m] - q[m]) + q[c]
-                   - 4.0 * (lm[n - m] - lm[m]) - 4.0 * lm[c] + 2.0 * l2m[c])
+    size = min(block + 2 * max(ms), n)
+    ramp, detrended = np.arange(size, dtype=np.float64), np.empty(size)
+    sums = np.zeros(len(ms))
+    for start in range(0, n - 2 * min(ms), block):
+        window = np.asarray(x[start:min(start + size, n)], dtype=np.float64)
+        length = window.size
+        w = detrended[:length]
+        np.multiply(ramp[:length], (window[-1] - window[0]) / (length - 1), out=w)
+        np.subtract(window, w, out=w)
+        w -= window[0]
+        sums += _lag_combination_sums(w, ms, [min(block, n - 2 * m - start) for m in ms])
     return sums
 
 
