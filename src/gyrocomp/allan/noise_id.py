@@ -15,7 +15,7 @@ from typing import Literal
 
 import numpy as np
 
-from .estimators import _BLOCK, _ESTIMATORS, _blocks, _mean, _second_difference_sum
+from .estimators import _BLOCK, _ESTIMATORS, _mean, _second_difference_sum
 
 #: fewest decimated points for which the lag-1 autocorrelation identifies a noise type (Riley 2004)
 NOISE_ID_MIN_POINTS = 30
@@ -53,50 +53,25 @@ def _trend_gram(length: int) -> np.ndarray:
     return np.array([[u_sums[p + q] for q in range(3)] for p in range(3)])
 
 
-def _quadratic_trend(x) -> np.ndarray:
-    """Least-squares coefficients of c0 + c1 u + c2 u^2, u = 2k/(L-1) - 1, fitted to x[k], in blocks."""
-    length = len(x)
-    moments = np.zeros(3)
-    scale = 2.0 / (length - 1)
-    steps = np.arange(_BLOCK) * scale
-    for start, stop in _blocks(length):
-        block = np.asarray(x[start:stop], dtype=np.float64)
-        u = steps[:stop - start] + (start * scale - 1.0)
-        ux = u * block
-        moments += (block.sum(), ux.sum(), np.dot(u, ux))
-    return np.linalg.solve(_trend_gram(length), moments)
+def _quadratic_trend(x: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Least-squares coefficients of c0 + c1 u + c2 u^2 fitted to x, for u = 2k/(L-1) - 1 (k = 0..L-1)."""
+    ux = u * x
+    moments = np.array([x.sum(), ux.sum(), np.dot(u, ux)])
+    return np.linalg.solve(_trend_gram(len(x)), moments)
 
 
-def _lag1_autocorrelations(x, trend: np.ndarray, max_differences: int) -> list[float]:
+def _lag1_autocorrelations(x: np.ndarray, max_differences: int) -> list[float]:
     """Lag-1 autocorrelation of the residual of x about its quadratic trend, differenced 0..max times."""
-    length = len(x)
-    scale = 2.0 / (length - 1)
-    steps = np.arange(_BLOCK + max_differences + 1) * scale
-    sums = np.zeros((max_differences + 1, 5))  # per d: sum, sum of squares, lag-1 products, first, last
-    for start, stop in _blocks(length):
-        hi = min(stop + max_differences + 1, length)  # overlap, to pair and difference across blocks
-        u = steps[:hi - start] + (start * scale - 1.0)
-        z = np.asarray(x[start:hi], dtype=np.float64) - (trend[0] + u * (trend[1] + u * trend[2]))
-        for d in range(max_differences + 1):
-            size = length - d
-            own = z[:min(stop, size) - start]
-            if own.size:
-                paired = z[:min(stop + 1, size) - start]
-                row = sums[d]
-                row[0] += own.sum()
-                row[1] += np.dot(own, own)
-                row[2] += np.dot(paired[:-1], paired[1:])
-                if start == 0:
-                    row[3] = own[0]
-                row[4] = own[-1]
-            z = z[1:] - z[:-1]
+    u = np.linspace(-1.0, 1.0, len(x))
+    c0, c1, c2 = _quadratic_trend(x, u)
+    z = x - (c0 + u * (c1 + u * c2))
     result = []
-    for d, (s1, s2, pairs, first, last) in enumerate(sums):
-        size = length - d
-        mean = s1 / size
-        numerator = pairs - mean * (2.0 * s1 - first - last) + (size - 1) * mean * mean
-        denominator = s2 - size * mean * mean
-        result.append(numerator / denominator if denominator > 0 else math.nan)
+    for d in range(max_differences + 1):
+        if d:
+            z = z[1:] - z[:-1]
+        z = z - z.mean()
+        denominator = float(np.dot(z, z))
+        result.append(float(np.dot(z[:-1], z[1:])) / denominator if denominator > 0 else math.nan)
     return result
 
 
@@ -111,10 +86,10 @@ def identify_noise(phase, m: int, *, max_differences: int = 2) -> NoiseIdentific
     Stable32 reference file agrees as with 2^20, and it keeps the identification a fraction of the deviations'
     cost on long series.
     """
-    x = phase[:NOISE_ID_MAX_POINTS * m:m]
+    x = np.asarray(phase[:NOISE_ID_MAX_POINTS * m:m], dtype=np.float64)  # at most 2 MiB, whatever the phase
     if len(x) < NOISE_ID_MIN_POINTS:
         return None
-    correlations = _lag1_autocorrelations(x, _quadratic_trend(x), max_differences)
+    correlations = _lag1_autocorrelations(x, max_differences)
     for d, r1 in enumerate(correlations):
         if math.isnan(r1):
             return None  # a constant (or exactly polynomial) series has no noise type
