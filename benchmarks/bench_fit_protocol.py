@@ -11,7 +11,8 @@ separate processes, best of ``--repeat``:
 
 Both idle and with a busy neighbour process on one core (``benchmarks/busy.py``), for 3 and 10 runs (the growth
 from 3 to 10 should be at most linear). The stages of the gyrocomp fit are timed in this process as well
-(reading with ``gyrocomp.io.read``, the fit with ``fit_channels``), so that the ratio can be read stage by stage.
+(reading with ``gyrocomp.io.read``; within ``fit_channels`` the input checks, the reduction, the model choice and
+the final fit), so that the ratio can be read stage by stage.
 
 Usage: python benchmarks/bench_fit_protocol.py [--runs 3 10] [--repeat 2]
 """
@@ -71,19 +72,47 @@ def timed_process(args: list[str], repeat: int) -> float:
     return best
 
 
+#: the fit's stages: the functions of ``gyrocomp.models.pipelines`` each stage's time is spent in (the rest of
+#: ``fit_channels`` is the final fit of the chosen models and its report)
+STAGES = {"checks": ("_check_fit_inputs",), "reduction": ("prepare", "prepare_axis"),
+          "model choice": ("share_fold_lags", "select_axis")}
+
+
+def _timed(func, stage: str, spent: dict[str, float]):
+    def wrapper(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return func(*args, **kwargs)
+        finally:
+            spent[stage] += time.perf_counter() - start
+    return wrapper
+
+
 def stages(paths: list[Path]) -> dict[str, float]:
-    """The gyrocomp fit's stages in this process [s]: reading the CSVs, then the fit."""
+    """The gyrocomp fit's stages in this process [s]: reading the CSVs, then within the fit the input checks
+    (plausibility of each run), the reduction (stillness, blocks and bins per axis), the model choice (held-out
+    drift of every candidate) and the final fit (the rest: the chosen models on all runs, the report)."""
     from gyrocomp.io import read
-    from gyrocomp.models.pipelines import fit_channels
+    from gyrocomp.models import pipelines
 
     start = time.perf_counter()
     runs = [read(p) for p in paths]
-    read_s = time.perf_counter() - start
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        start = time.perf_counter()
-        fit_channels(runs)
-    return {"read": read_s, "fit": time.perf_counter() - start}
+    spent = {"read": time.perf_counter() - start, **dict.fromkeys(STAGES, 0.0)}
+    originals = {name: getattr(pipelines, name) for names in STAGES.values() for name in names}
+    for stage, names in STAGES.items():
+        for name in names:
+            setattr(pipelines, name, _timed(originals[name], stage, spent))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            start = time.perf_counter()
+            pipelines.fit_channels(runs)
+            whole = time.perf_counter() - start
+    finally:
+        for name, func in originals.items():
+            setattr(pipelines, name, func)
+    spent["final fit"] = whole - sum(spent[stage] for stage in STAGES)
+    return spent
 
 
 def measure(paths: list[Path], out: Path, repeat: int) -> dict[str, float]:
@@ -103,7 +132,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=2)
     args = parser.parse_args()
     lines = ["| runs | PX4-style pipeline [s] | `gyrocomp fit` [s] | ratio | busy neighbour: PX4-style / gyrocomp [s] "
-             "| ratio | stages in-process: read / fit [s] |", "|---|---|---|---|---|---|---|"]
+             "| ratio | stages in-process: read / checks / reduction / model choice / final fit [s] |",
+             "|---|---|---|---|---|---|---|"]
     print("\n".join(lines), flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
@@ -112,7 +142,8 @@ def main() -> None:
             f = measure(all_paths[:n], folder / "model.json", args.repeat)
             lines.append(f"| {n} | {f['px4']:.2f} | {f['gyrocomp']:.2f} | **{f['gyrocomp'] / f['px4']:.2f}x** | "
                          f"{f['px4 busy']:.2f} / {f['gyrocomp busy']:.2f} | "
-                         f"{f['gyrocomp busy'] / f['px4 busy']:.2f}x | {f['read']:.2f} / {f['fit']:.2f} |")
+                         f"{f['gyrocomp busy'] / f['px4 busy']:.2f}x | "
+                         f"{' / '.join(f'{f[stage]:.2f}' for stage in ('read', *STAGES, 'final fit'))} |")
             print(lines[-1], flush=True)
     machine = (f"{os.cpu_count()} cores, {platform.machine()}, CPython {platform.python_version()}, "
                f"{time.strftime('%Y-%m-%d')}")

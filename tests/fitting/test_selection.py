@@ -12,7 +12,8 @@ from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.folds import leg_labels
-from gyrocomp.fitting.selection import Candidate, CandidateScore, choose, temperature_step_degc
+from gyrocomp.fitting.selection import Candidate, CandidateScore, choose, prepare_axis, temperature_step_degc
+from gyrocomp.curves.kinds import BASES
 from gyrocomp.curves.polynomial import PolynomialCurve
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import get_profile, preset_model, simulate
@@ -185,3 +186,27 @@ def test_consumer_part_held_out_within_1_3x_of_perfect_compensation(seed):
         assert left <= 1.3 * perfect, axis
         # one die behind one temperature register: one lag for every axis, near the truth
         assert cal.axes[axis].lag_time_constant_s == pytest.approx(20.0, rel=0.25)
+
+
+@pytest.mark.parametrize("accel", [False, True])
+def test_lag_residuals_from_the_shape_columns_equal_those_of_the_full_normal_matrices(accel):
+    """lag_rss reads the poly + lag residuals from the normal matrices of the polynomial (and accelerometer)
+    columns alone; they equal the same candidates' residuals in the matrices with every hysteresis and branch
+    column, at every lag of the grid and for every fold."""
+    model = preset_model("adxrs450")
+    runs = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=2.0, seed=s).recording
+            for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)), (2, (-25.0, 85.0)))]
+    problem = prepare_axis(runs, "gyro_z", groups=(0, 1, 2), max_order=3, hysteresis_orders=(1, 2),
+                           branch_orders=(1, 2), curves=tuple(BASES))
+    assert problem.columns(0, problem.runs[0].temperature_degc).shape[1] > 3 + 2 * 2  # hysteresis, branch columns
+    if accel:  # the triad as if the part had been turned between blocks (at rest it would add nothing)
+        rng = np.random.default_rng(3)
+        problem.runs = [dataclasses.replace(r, accel_g=rng.normal(0.0, 0.6, (r.value.size, 3))) for r in problem.runs]
+        problem.accel_cols, problem.square_cols = (0, 2), (1,)
+    grid = problem.lag_grid_s()
+    for order in (1, 3):
+        got = problem.lag_rss(order, "time", grid)
+        idx = problem.column_index(Candidate(order, True, 0, "time"))
+        full = np.array([[problem.solve(problem.training_matrices(float(tau), "time")[0][f], idx)[1]
+                          for tau in grid] for f in range(problem.folds.count)])
+        np.testing.assert_allclose(got, full / full.min(axis=1, keepdims=True), rtol=1e-9)

@@ -397,26 +397,40 @@ class SelectionProblem:
             return run.samples / run.samples.max()
         return run.weight
 
+    def shape_columns(self, k: int, temp: np.ndarray) -> np.ndarray:
+        """The polynomial's columns u^1..u^max_order at model temperature ``temp`` [degC], then the accelerometer
+        columns: what a ``poly + lag`` candidate uses (:meth:`lag_rss`), without the hysteresis and branch terms
+        that :meth:`columns` also makes."""
+        u = (temp - self.t_ref_degc) / self.t_scale_degc
+        return np.hstack([u[:, None] ** np.arange(1, self.max_order + 1), self.accel_columns(k)])
+
     # -- normal equations, per fold --------------------------------------------------------------------
-    def _prepared(self, tau_s: float):
-        """Per run at lag ``tau_s``: model temperature, columns, and per fold its min and max temperature."""
-        key = ("prep", tau_s)
+    def _model_temperatures(self, tau_s: float) -> list[np.ndarray]:
+        key = ("temp", tau_s)
         if key not in self._cache:
-            out = []
-            for k in range(len(self.runs)):
-                temp = self.model_temperature(k, tau_s)
-                out.append((temp, self.columns(k, temp, lagged=tau_s > 0)))
-            self._cache[key] = out
+            self._cache[key] = [self.model_temperature(k, tau_s) for k in range(len(self.runs))]
         return self._cache[key]
 
-    def training_matrices(self, tau_s: float, weighting: Weighting) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _prepared(self, tau_s: float, shape_only: bool = False):
+        """Per run at lag ``tau_s``: model temperature and columns (:meth:`columns`, or with ``shape_only``
+        :meth:`shape_columns`)."""
+        key = ("prep", tau_s, shape_only)
+        if key not in self._cache:
+            temps = self._model_temperatures(tau_s)
+            self._cache[key] = [(temp, self.shape_columns(k, temp) if shape_only
+                                 else self.columns(k, temp, lagged=tau_s > 0)) for k, temp in enumerate(temps)]
+        return self._cache[key]
+
+    def training_matrices(self, tau_s: float, weighting: Weighting, shape_only: bool = False
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(F, P+1, P+1) centred normal matrices of [columns, y] over each fold's training data (each run's
-        constant profiled out), and the (F,) lowest and highest training model temperature."""
-        key = ("train", tau_s, weighting)
+        constant profiled out), and the (F,) lowest and highest training model temperature. The columns are
+        :meth:`columns`, or with ``shape_only`` :meth:`shape_columns`."""
+        key = ("train", tau_s, weighting, shape_only)
         if key in self._cache:
             return self._cache[key]
         n_folds = self.folds.count
-        prepared = self._prepared(tau_s)
+        prepared = self._prepared(tau_s, shape_only)
         p = prepared[0][1].shape[1]
         # per group (run) and fold: raw sums
         group_ids = sorted(set(self.groups))
@@ -541,11 +555,14 @@ class SelectionProblem:
 
     def lag_rss(self, order: int, weighting: Weighting, grid_s: np.ndarray) -> np.ndarray:
         """(folds, lags) training residual sum of squares of ``poly:order + lag`` at each lag of ``grid_s`` [s],
-        each fold's row divided by its minimum (so that axes of different noise weigh the same)."""
-        idx = self.column_index(Candidate(order, True, 0, weighting))
+        each fold's row divided by its minimum (so that axes of different noise weigh the same). From the normal
+        matrices of :meth:`shape_columns` alone: the hysteresis and branch columns at every lag of the grid cost
+        half the model choice, and the candidates are scored at the lags chosen here only."""
+        n_accel = len(self.accel_cols) + len(self.square_cols)
+        idx = np.r_[np.arange(order), self.max_order + np.arange(n_accel)].astype(np.int64)
         out = np.empty((self.folds.count, grid_s.size))
         for g, tau in enumerate(grid_s):
-            matrices = self.training_matrices(float(tau), weighting)[0]
+            matrices = self.training_matrices(float(tau), weighting, shape_only=True)[0]
             out[:, g] = [self.solve(matrices[f], idx)[1] for f in range(self.folds.count)]
         return out / np.maximum(out.min(axis=1, keepdims=True), 1e-300)
 
