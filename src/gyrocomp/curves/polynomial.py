@@ -178,7 +178,7 @@ class PolynomialBasis:
         t = np.asarray(temperature_degc, dtype=float)
         u = (t - self.t_ref_degc) / self.t_scale_degc
         if lo_degc is None:
-            return u[:, None] ** np.arange(1, size + 1)
+            return power_columns(u, 1, size)
         clipped = (np.clip(t, lo_degc, hi_degc) - self.t_ref_degc) / self.t_scale_degc
         return polynomial_columns(clipped, size, u - clipped if self.extended else None)
 
@@ -187,13 +187,26 @@ class PolynomialBasis:
                               hi_degc, "linear" if self.extended else "hold")
 
 
+def power_columns(u: np.ndarray, first: int, last: int) -> np.ndarray:
+    """Columns u^first..u^last (n, last - first + 1) by repeated multiplication: ``u[:, None] ** np.arange(first,
+    last + 1)`` to a rounding, at a small part of its cost (numpy's power with an array of exponents calls pow for
+    every element; the model choice makes these columns for every run at every lag it tries)."""
+    u = np.asarray(u, dtype=float)
+    out = np.empty((max(0, last - first + 1), u.size))
+    for j in range(out.shape[0]):
+        if j:
+            np.multiply(out[j - 1], u, out=out[j])
+        else:
+            out[0] = 1.0 if first == 0 else u if first == 1 else u ** first
+    return out.T
+
+
 def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray | None = None) -> np.ndarray:
     """Columns u^1..u^order at the clipped u, each continued along its tangent by ``beyond_u`` (u - clipped u)
     when given: u_c^k + k u_c^(k-1) (u - u_c). The curve is linear in its coefficients either way."""
-    k = np.arange(1, order + 1)
-    cols = clipped_u[:, None] ** k
+    cols = power_columns(clipped_u, 1, order)
     if beyond_u is not None and order:
-        cols = cols + k * clipped_u[:, None] ** (k - 1) * beyond_u[:, None]
+        cols = cols + np.arange(1, order + 1) * power_columns(clipped_u, 0, order - 1) * beyond_u[:, None]
     return cols
 
 

@@ -16,6 +16,7 @@ from ..calibration.fit_report import BranchTest
 from ..recording.prepared import RunBlocks
 from .drift_gls import MAX_POINTS, chi2_threshold, coarsen, fit_drift_noise, wald_statistic
 from ..curves.hysteresis import parting_band_degc
+from ..curves.polynomial import power_columns
 from .thermal import BRANCH_WIDTHS_DEGC, LAG_MAX_S, MAX_BRANCH_ORDER, SCORE_WINDOW_S, plausible_middle
 
 
@@ -102,7 +103,7 @@ def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: li
         temps = [thermal_lag(r.time_s, r.temperature_degc, tau, period_s=block_s)[0] if tau > 0
                  else r.temperature_degc for r in runs]
         u = (np.concatenate(temps) - t_ref_degc) / t_scale_degc
-        x = np.hstack([onehot, u[:, None] ** np.arange(1, order + 1)])
+        x = np.hstack([onehot, power_columns(u, 1, order)])
         resid, rss = _weighted_fit(x, y, w)
         if best is None or rss < best[0]:
             best = (rss, temps, resid, x)
@@ -213,10 +214,10 @@ def _branch_design(runs, temps, groups, threshold_degc, t_ref_degc, t_scale_degc
         s = branch_position(temp, find_turns(temp, threshold_degc), width_degc)
         onehot = np.zeros((temp.size, len(group_ids)))
         onehot[:, group_ids.index(groups[k])] = 1.0
-        cols = [onehot, u[:, None] ** np.arange(1, order + 1)]
+        cols = [onehot, power_columns(u, 1, order)]
         if extra is not None:
             cols.append(extra[k])
-        cols.append(s[:, None] * u[:, None] ** np.arange(MAX_BRANCH_ORDER))
+        cols.append(s[:, None] * power_columns(u, 0, MAX_BRANCH_ORDER - 1))
         out.append(np.hstack(cols))
     return out
 

@@ -15,7 +15,7 @@ from ..errors import InputError, ModelError
 from ..recording.prepared import fit_axes
 from ..recording import Recording
 from .base import LearnedAttributes, TemperatureBins, bin_by_temperature, bin_width_for
-from ..curves.polynomial import MAX_ORDER, PolynomialCurve
+from ..curves.polynomial import MAX_ORDER, PolynomialCurve, power_columns
 
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins
 PARSIMONY_TOLERANCE = 1.01
@@ -51,7 +51,7 @@ class _Design:
         lo = self.t_min if t_min is None else t_min
         hi = self.t_max if t_max is None else t_max
         u = (np.clip(temperature, lo, hi) - self.t_ref) / self.t_scale
-        return u[:, None] ** np.arange(1, order + 1)
+        return power_columns(u, 1, order)
 
 
 def _solve(design: _Design, order: int, runs: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:

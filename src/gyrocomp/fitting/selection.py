@@ -56,6 +56,7 @@ from .base import bin_width_for
 from .folds import FoldKind, Folds, make_folds, window_for
 from .branch_evidence import band_offer, branch_test, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
+from ..curves.polynomial import power_columns
 from ..curves.protocol import BASES
 from .thermal import LAG_MAX_S, MAX_BRANCH_ORDER
 
@@ -316,14 +317,14 @@ class SelectionProblem:
         the branch terms s_w u^j for each crossover width w, then the accelerometer columns. (A fold's training
         range is applied where its held-out blocks are scored, :meth:`_held_out`.)"""
         u = (temp - self.t_ref_degc) / self.t_scale_degc
-        cols = [u[:, None] ** np.arange(1, self.max_order + 1)]
+        cols = [power_columns(u, 1, self.max_order)]
         cols += [self.basis(name).columns(temp, size) for name, size, _ in self.other_blocks(lagged)]
         h = self.max_hysteresis
         turns = find_turns(temp, self.threshold_degc) if h or self.branch_orders else None
         if h:
             active = ~np.isnan(turns.turn_degc)
             d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0) / self.t_scale_degc
-            powers = d[:, None] ** np.arange(1, h + 1)
+            powers = power_columns(d, 1, h)
             for sign in (-1, 1):
                 cols.append(np.where((active & (turns.direction == sign))[:, None], powers, 0.0))
             if self.band_degc is not None:  # the same terms, zero outside the band
@@ -332,7 +333,7 @@ class SelectionProblem:
                     cols.append(np.where((active & inside & (turns.direction == sign))[:, None], powers, 0.0))
         for width in (BRANCH_WIDTHS_DEGC if self.branch_orders else ()):
             position = branch_position(temp, turns, width)
-            cols.append(position[:, None] * u[:, None] ** np.arange(self.max_branch))
+            cols.append(position[:, None] * power_columns(u, 0, self.max_branch - 1))
         cols.append(self.accel_columns(k))
         return np.hstack(cols)
 
@@ -402,7 +403,7 @@ class SelectionProblem:
         columns: what a ``poly + lag`` candidate uses (:meth:`lag_rss`), without the hysteresis and branch terms
         that :meth:`columns` also makes."""
         u = (temp - self.t_ref_degc) / self.t_scale_degc
-        return np.hstack([u[:, None] ** np.arange(1, self.max_order + 1), self.accel_columns(k)])
+        return np.hstack([power_columns(u, 1, self.max_order), self.accel_columns(k)])
 
     # -- normal equations, per fold --------------------------------------------------------------------
     def _model_temperatures(self, tau_s: float) -> list[np.ndarray]:

@@ -176,7 +176,7 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
     w = max(1, int(round(SWING_WINDOW_S * recording.rate_hz)))
     for j, axis in enumerate(recording.gyro_axes):
         x = recording.gyro_dps[:, j]
-        median = float(np.median(x))
+        median = _median(x)
         if abs(median) > MAX_OFFSET_DPS:
             out.append(Concern("offset", f"{src}: {axis} reads {median:.3g} deg/s at the median, more than any "
                                          "zero-rate offset: does the unit turn, or is the unit of the data wrong?"))
