@@ -223,14 +223,31 @@ def temperature_step_degc(temperature_degc: np.ndarray) -> float:
     return step if np.mean(on_grid) >= 0.99 else 0.0
 
 
-def drift_rms(residual: np.ndarray, weight: np.ndarray, window: int) -> tuple[float, float]:
+@dataclass(frozen=True)
+class DriftWeights:
+    """The weights of one stretch of blocks for :func:`drift_rms`, with their moving average and sums, which do not
+    depend on the residual (every candidate is scored on the same stretches)."""
+
+    weight: np.ndarray
+    window: int
+    total: float
+    smoothed: np.ndarray
+    smoothed_total: float
+
+    @classmethod
+    def of(cls, weight: np.ndarray, window: int) -> "DriftWeights":
+        window = max(1, min(window, weight.size))  # a fold shorter than the window: one mean over all of it
+        smoothed = moving_average(weight, window)
+        return cls(weight, window, float(np.sum(weight)), smoothed, float(np.sum(smoothed)))
+
+
+def drift_rms(residual: np.ndarray, weights: DriftWeights) -> tuple[float, float]:
     """(weighted sum of squares, sum of weights) of the moving average of ``residual`` about its weighted mean."""
-    e = residual - np.sum(weight * residual) / np.sum(weight)
-    window = max(1, min(window, e.size))  # a fold shorter than the window: one mean over all of it
-    smooth = moving_average(e, window)
-    w = moving_average(weight, window)
-    smooth = smooth - np.sum(w * smooth) / np.sum(w)
-    return float(np.sum(w * smooth ** 2)), float(np.sum(w))
+    e = residual - np.sum(weights.weight * residual) / weights.total
+    smooth = moving_average(e, weights.window)
+    w = weights.smoothed
+    smooth = smooth - np.sum(w * smooth) / weights.smoothed_total
+    return float(np.sum(w * smooth ** 2)), weights.smoothed_total
 
 
 @dataclass
@@ -487,18 +504,15 @@ class SelectionProblem:
         if not (math.isfinite(lo) and math.isfinite(hi) and np.all(np.isfinite(coef))):
             return math.nan  # nothing left to train on without this fold
         sse = wsum = 0.0
-        window = max(1, int(round(self.window_s / self.block_s)))
         prepared = self._prepared(tau_s)
-        for k, sel in self.fold_members()[f]:
+        for (k, sel), weights in zip(self.fold_members()[f], self._fold_weights()[f]):
             temp, cols = prepared[k]
             x = cols[np.ix_(sel, idx)]
             t = temp[sel]
             past = (t < lo) | (t > hi)
             if c.order and np.any(past):  # past the training range the curve goes on as applied (tangent, or held)
                 x[past, : c.order] = self.basis(c.curve).columns(t[past], c.order, lo, hi)
-            e = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
-            w = self.runs[k].samples[sel].astype(float)
-            s, n = drift_rms(e, w, window)
+            s, n = drift_rms(self.runs[k].value[sel] - (x @ coef if idx.size else 0.0), weights)
             sse += s
             wsum += n
         return math.sqrt(sse / wsum) if wsum > 0 else math.nan
@@ -512,6 +526,15 @@ class SelectionProblem:
                     members[int(f)].append((k, np.flatnonzero(fold == f)))
             self._cache["members"] = members
         return self._cache["members"]
+
+    def _fold_weights(self) -> list[list[DriftWeights]]:
+        """Per fold, the :class:`DriftWeights` (block durations) of each of its runs' blocks, in the order of
+        :meth:`fold_members`."""
+        if "fold weights" not in self._cache:
+            window = max(1, int(round(self.window_s / self.block_s)))
+            self._cache["fold weights"] = [[DriftWeights.of(self.runs[k].samples[sel].astype(float), window)
+                                            for k, sel in members] for members in self.fold_members()]
+        return self._cache["fold weights"]
 
     def score(self, c: Candidate) -> CandidateScore:
         """Held-out drift of ``c`` on every fold: each fold's lag and branch crossover width are those of the
