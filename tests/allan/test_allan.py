@@ -622,3 +622,23 @@ def test_rn_modified_variance_from_the_running_sum_on_a_grid():
             assert modified_variance_on_grid(phase, m) == pytest.approx(exact, rel=tolerance), m
     assert _grid_step(64) == 1 and _grid_step(4096) == 64 and _grid_step(3000) == 3000 // 75
     assert math.isnan(modified_variance_on_grid(np.zeros(100), 40))  # 3m beyond the series: no term
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(10, 5000), steps=st.lists(st.integers(1, 300), min_size=1, max_size=6),
+       seed=st.integers(0, 2 ** 16))
+def test_shared_phase_grids_equal_grids_made_alone(n, steps, seed):
+    """A grid read from a finer one made before (its step dividing the new one's) is the grid made from the phase
+    alone, to rounding, in any order of requests; R(n)'s variance is the same with shared grids or without."""
+    from gyrocomp.allan.noise_id import PhaseGrids, modified_variance_on_grid
+
+    phase = np.cumsum(np.random.default_rng(seed).standard_normal(n)) + 5.0
+    shared = PhaseGrids(phase)
+    for g in [*steps, *(2 * h for h in steps), *(6 * h for h in steps)]:
+        alone = PhaseGrids(phase).running_sum(g)
+        got = shared.running_sum(g)
+        assert got.shape == alone.shape == (n // g + 1,)
+        np.testing.assert_allclose(got, alone, rtol=1e-9, atol=1e-9 * np.sqrt(n) * n)
+    for m in (64, 128, 256, 640):
+        assert modified_variance_on_grid(phase, m, shared) == pytest.approx(modified_variance_on_grid(phase, m),
+                                                                             rel=1e-9, nan_ok=True)

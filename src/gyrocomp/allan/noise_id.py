@@ -133,7 +133,38 @@ def _grid_step(m: int) -> int:
     return m // d
 
 
-def modified_variance_on_grid(phase, m: int) -> float:
+class PhaseGrids:
+    """The running sum X of a phase about its mean on grids of step g (X at 0, g, 2g, ..., n // g blocks), each
+    made once: from the phase in one pass, or, where a finer grid whose step divides g was made before, as every
+    (g / step)-th point of it, with no pass over the phase (the octave factors' grids are nested)."""
+
+    def __init__(self, phase):
+        self.phase = phase
+        self._mean: float | None = None
+        self._grids: dict[int, np.ndarray] = {}
+
+    def running_sum(self, g: int) -> np.ndarray:
+        """X at 0, g, 2g, ... (n // g + 1 points) [phase unit x samples]."""
+        if g not in self._grids:
+            finer = [h for h in self._grids if g % h == 0]
+            self._grids[g] = self._grids[max(finer)][::g // max(finer)] if finer else self._from_phase(g)
+        return self._grids[g]
+
+    def _from_phase(self, g: int) -> np.ndarray:
+        phase = self.phase
+        if self._mean is None:
+            self._mean = _mean(phase)
+        blocks = len(phase) // g
+        sums = np.empty(blocks)
+        step = max(g, (_BLOCK // g) * g)
+        for start in range(0, blocks * g, step):
+            stop = min(start + step, blocks * g)
+            chunk = np.asarray(phase[start:stop], dtype=np.float64) - self._mean
+            sums[start // g: stop // g] = chunk.reshape(-1, g).sum(axis=1)
+        return np.concatenate([[0.0], np.cumsum(sums)])
+
+
+def modified_variance_on_grid(phase, m: int, grids: PhaseGrids | None = None) -> float:
     """The modified Allan variance at averaging factor m (tau = m samples, per sample squared, as
     ``identify_noise_b1``'s Allan variance), its overlapping sum taken at every g-th start only (g from
     :func:`_grid_step`: at least ``RN_STARTS_PER_M`` starts per m), NaN where no term fits.
@@ -141,22 +172,14 @@ def modified_variance_on_grid(phase, m: int) -> float:
     With X the running sum of the phase about its mean, the inner sum of a modified-variance term is
     D(i) = X(i+3m) - 3 X(i+2m) + 3 X(i+m) - X(i); for starts i on a grid of step g dividing m, every X it needs is
     on the grid too, so X is needed there only: one pass over the phase gives its sums over blocks of g, and
-    their running sum is X on the grid. The cost is one read of the phase, whatever m (the full overlapping sum
-    recomputed X for every factor). Mod sigma^2 = sum D^2 / (2 m^4 count) (NIST SP 1065 eq. 14).
+    their running sum is X on the grid (:class:`PhaseGrids`; ``grids`` shares them between factors, so that
+    nested grids cost one pass in all). Mod sigma^2 = sum D^2 / (2 m^4 count) (NIST SP 1065 eq. 14).
     """
     n = len(phase)
     if n - 3 * m + 1 < 1:
         return math.nan
     g = _grid_step(m)
-    blocks = n // g
-    mean = _mean(phase)
-    sums = np.empty(blocks)
-    step = max(g, (_BLOCK // g) * g)
-    for start in range(0, blocks * g, step):
-        stop = min(start + step, blocks * g)
-        chunk = np.asarray(phase[start:stop], dtype=np.float64) - mean
-        sums[start // g: stop // g] = chunk.reshape(-1, g).sum(axis=1)
-    grid = np.concatenate([[0.0], np.cumsum(sums)])  # X at 0, g, 2g, ...
+    grid = (PhaseGrids(phase) if grids is None else grids).running_sum(g)
     d = m // g
     starts = (n - 3 * m) // g + 1  # grid starts i = 0, g, ... with i + 3m <= n
     x = grid[:starts + 3 * d]
@@ -164,7 +187,7 @@ def modified_variance_on_grid(phase, m: int) -> float:
     return float(np.dot(terms, terms) / (2.0 * float(m) ** 4 * starts))
 
 
-def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
+def identify_noise_b1(phase, m: int, grids: PhaseGrids | None = None) -> NoiseIdentification | None:
     """Noise type at averaging factor m from the B1 ratio, for series too short for the lag-1 method.
 
     The N = (len(phase) - 1) // m frequency averages at m have their linear drift removed (as the lag-1
@@ -172,7 +195,7 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
     Allan variance's exponent mu is the one whose expected B1 lies nearest on a log scale (boundaries at
     the geometric means, Howe et al. 2000, Table 4), alpha = -mu - 1. mu = -2 (white or flicker PM) is
     split by R(n) = MVAR/AVAR (MVAR of the whole series, :func:`modified_variance_on_grid`) against the geometric
-    mean of the two expected values.
+    mean of the two expected values (``grids``: see :func:`modified_variance_on_grid`).
     Returns None with fewer than 3 averages or a series without variation.
     """
     n_points = (len(phase) - 1) // m
@@ -194,7 +217,7 @@ def identify_noise_b1(phase, m: int) -> NoiseIdentification | None:
     if mu > -2:
         return NoiseIdentification(alpha=-mu - 1, alpha_estimate=math.nan, differences=-1, rho=math.nan,
                                    method="b1", ratio=ratio)
-    rn = modified_variance_on_grid(phase, m) / allan  # the ADEV at m is the Allan variance of these averages
+    rn = modified_variance_on_grid(phase, m, grids) / allan  # the ADEV at m is the Allan variance of these averages
     if not math.isfinite(rn):
         return None
     alpha = 1 if rn > math.sqrt(rn_expected(m, 1) * rn_expected(m, 2)) else 2
@@ -220,7 +243,7 @@ def overlapping_allan_variance(phase, m: int) -> float:
 
 
 def _rn_checked(alphas: np.ndarray, methods: list[str], points: list, phase, ms: np.ndarray,
-                lowest: int) -> np.ndarray:
+                lowest: int, grids: PhaseGrids) -> np.ndarray:
     """Where a lag-1 phase-noise type (white or flicker PM) rests on few decimated points (< RN_CHECK_MAX_POINTS),
     R(n) = MVAR/AVAR of the whole series at that m (every term, not the few points) decides between the phase
     noises and frequency noise: the type whose expected R(n) lies nearest on a log scale (``methods`` then says
@@ -231,7 +254,7 @@ def _rn_checked(alphas: np.ndarray, methods: list[str], points: list, phase, ms:
         if points[j] is None or points[j] >= RN_CHECK_MAX_POINTS or not alphas[j] >= 1:
             continue
         allan = overlapping_allan_variance(phase, m)
-        rn = modified_variance_on_grid(phase, m) / allan if allan > 0 else math.nan
+        rn = modified_variance_on_grid(phase, m, grids) / allan if allan > 0 else math.nan
         if not math.isfinite(rn) or not rn > 0:
             continue
         expected = {2: rn_expected(m, 2), 1: rn_expected(m, 1),
@@ -271,6 +294,7 @@ def noise_types(kind: str, phase, ms: np.ndarray) -> NoiseTypes:
     methods = [""] * len(ms)
     points: list = [None] * len(ms)
     current = math.nan
+    grids = PhaseGrids(phase)  # the running sums R(n) reads, shared by every factor
     for j, m in enumerate(ms):
         m = int(m)
         found = identify_noise(phase, m, max_differences=spec.difference_order)
@@ -278,12 +302,12 @@ def noise_types(kind: str, phase, ms: np.ndarray) -> NoiseTypes:
             current = float(min(2, max(lowest, found.alpha)))
             points[j] = min((len(phase) - 1) // m + 1, NOISE_ID_MAX_POINTS)
             methods[j] = "lag-1"
-        elif (few := identify_noise_b1(phase, m)) is not None:
+        elif (few := identify_noise_b1(phase, m, grids)) is not None:
             capped = few.alpha if math.isnan(current) else min(few.alpha, current)
             current = float(min(2, max(lowest, capped)))
             methods[j] = "B1/R(n)"
         elif not math.isnan(current):
             methods[j] = "carried"
         alphas[j] = current
-    alphas = _rn_checked(alphas, methods, points, phase, ms, lowest)
+    alphas = _rn_checked(alphas, methods, points, phase, ms, lowest, grids)
     return NoiseTypes(alphas, tuple(methods))
