@@ -431,8 +431,8 @@ def _windowed_oadev_sums(x, ms: np.ndarray, block: int = _WINDOW_BLOCK) -> np.nd
     terms of the order of (W/m)^4 / 64 times the result (W the window's length), a random walk of the rate
     (W/m)^3. With block = 2^19 and the octave factors 2^12..2^16 (W/m <= 160) that was at most 3.3e-9
     relative on 1e7 samples of drifts (ramp, quadratic, cubic, sine, step) over tiny noise, 7e-12 on a random
-    walk of the rate, against the 1e-8 the lag products of the whole phase allow. One pass detrends the window;
-    each lag is then one dot product.
+    walk of the rate, and 8e-9 over 3000 random shorter cases with W/m <= 144: the order of the 1e-8 the lag
+    products of the whole phase allow. One pass detrends the window; each lag is then one dot product.
     """
     n = len(x)
     ms = [int(m) for m in ms]
