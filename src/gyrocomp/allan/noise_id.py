@@ -53,25 +53,36 @@ def _trend_gram(length: int) -> np.ndarray:
     return np.array([[u_sums[p + q] for q in range(3)] for p in range(3)])
 
 
-def _quadratic_trend(x: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Least-squares coefficients of c0 + c1 u + c2 u^2 fitted to x, for u = 2k/(L-1) - 1 (k = 0..L-1)."""
-    ux = u * x
-    moments = np.array([x.sum(), ux.sum(), np.dot(u, ux)])
+def _quadratic_trend(x: np.ndarray, u: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """Least-squares coefficients of c0 + c1 u + c2 u^2 fitted to x, for u = 2k/(L-1) - 1 (k = 0..L-1), u2 = u^2."""
+    moments = np.array([x.sum(), np.dot(u, x), np.dot(u2, x)])
     return np.linalg.solve(_trend_gram(len(x)), moments)
 
 
 def _lag1_autocorrelations(x: np.ndarray, max_differences: int) -> list[float]:
-    """Lag-1 autocorrelation of the residual of x about its quadratic trend, differenced 0..max times."""
+    """Lag-1 autocorrelation of the residual of x about its quadratic trend, differenced 0..max times.
+
+    The residual z (and each difference of it) is not centred by a pass of its own: with S = sum z and
+    mu = S / L, r1 = (sum z_i z_(i+1) - mu (2 S - z_0 - z_(L-1)) + (L - 1) mu^2) / (sum z^2 - L mu^2), where mu
+    is small against z (the trend has a constant; a difference's mean is its end points' difference over L)."""
     u = np.linspace(-1.0, 1.0, len(x))
-    c0, c1, c2 = _quadratic_trend(x, u)
-    z = x - (c0 + u * (c1 + u * c2))
+    u2 = u * u
+    c0, c1, c2 = _quadratic_trend(x, u, u2)
+    z = np.multiply(u2, c2, out=u2)  # the trend, in u2's place
+    z += u * c1
+    z += c0
+    np.subtract(x, z, out=z)
     result = []
     for d in range(max_differences + 1):
         if d:
             z = z[1:] - z[:-1]
-        z = z - z.mean()
-        denominator = float(np.dot(z, z))
-        result.append(float(np.dot(z[:-1], z[1:])) / denominator if denominator > 0 else math.nan)
+        size = z.size
+        total = float(z.sum())
+        mean = total / size
+        denominator = float(np.dot(z, z)) - size * mean * mean
+        numerator = (float(np.dot(z[:-1], z[1:])) - mean * (2.0 * total - z[0] - z[-1])
+                     + (size - 1) * mean * mean)
+        result.append(numerator / denominator if denominator > 0 else math.nan)
     return result
 
 
