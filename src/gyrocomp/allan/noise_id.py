@@ -80,7 +80,7 @@ def _lag1_autocorrelations(x: np.ndarray, max_differences: int) -> list[float]:
         total = float(z.sum())
         mean = total / size
         denominator = float(np.dot(z, z)) - size * mean * mean
-        numerator = (float(np.dot(z[:-1], z[1:])) - mean * (2.0 * total - z[0] - z[-1])
+        numerator = (float(np.dot(z[:-1], z[1:])) - mean * (2.0 * total - float(z[0]) - float(z[-1]))
                      + (size - 1) * mean * mean)
         result.append(numerator / denominator if denominator > 0 else math.nan)
     return result
