@@ -12,35 +12,13 @@ from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.folds import leg_labels
-from gyrocomp.fitting.selection import Candidate, CandidateScore, choose, prepare_axis, temperature_step_degc
+from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc
 from gyrocomp.curves.kinds import BASES
 from gyrocomp.curves.polynomial import PolynomialCurve
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import get_profile, preset_model, simulate
 from gyrocomp.simulation.profiles import Profile
 from gyrocomp.evaluation.validation import fit_plain_cubic, make_sample_folds
-
-
-def _score(c, folds):
-    return CandidateScore(c, tuple(folds), tuple(0.0 for _ in folds))
-
-
-def test_simplest_within_one_standard_error_of_the_best_is_chosen():
-    best = _score(Candidate(3), [1.0, 1.2, 1.4])  # mean 1.2, SE 0.1155
-    close = _score(Candidate(1), [1.1, 1.3, 1.5])  # mean 1.3: within one SE
-    far = _score(Candidate(0), [1.3, 1.5, 1.7])  # mean 1.5: not
-    b, c = choose([best, close, far], lambda k: k.complexity)
-    assert b == Candidate(3) and c == Candidate(1)
-    # a candidate that must earn its terms: the simpler one is 2 SE worse, so the complex one stays
-    b, c = choose([best, _score(Candidate(1), [1.3, 1.5, 1.6])], lambda k: k.complexity)
-    assert c == Candidate(3)
-
-
-def test_a_candidate_far_worse_on_one_fold_does_not_pass():
-    best = _score(Candidate(4, lag=True), [0.0035, 0.0043, 0.0065])
-    erratic = _score(Candidate(1), [0.0030, 0.0040, 0.0400])  # better on two folds, 6x worse on one
-    _, c = choose([best, erratic], lambda k: k.complexity)
-    assert c == Candidate(4, lag=True)
 
 
 def test_candidate_complexity_and_labels():

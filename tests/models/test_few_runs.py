@@ -12,7 +12,6 @@ from gyrocomp.errors import ModelChoiceWarning
 from gyrocomp.calibration.fit_report import SelectionReport
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.pipelines import fit_calibration, fit_channels
-from gyrocomp.fitting.selection import Candidate, CandidateScore, beats_constant, choose
 from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic
 
@@ -131,26 +130,6 @@ def test_one_cycle_finds_heating_and_cooling_curves_that_differ(tmp_path):
 def test_one_cycle_of_a_part_with_a_real_tempco_is_compensated():
     raw, default, _ = _one_cycle(preset_model("consumer"), 0)
     assert default < 0.1 * raw
-
-
-def _score(folds, c=Candidate(2)):
-    return CandidateScore(c, tuple(folds), tuple(0.0 for _ in folds))
-
-
-def test_do_no_harm_with_two_folds_asks_for_half_the_constants_drift_on_both():
-    constant = _score([0.020, 0.033], Candidate(0))
-    assert not beats_constant(_score([0.0123, 0.0167]), constant)  # 39 and 49 % less: what a walk can do by chance
-    assert beats_constant(_score([0.0057, 0.0093]), constant)
-    assert not beats_constant(_score([0.002, 0.020]), constant)  # far better on one leg only
-
-
-def test_do_no_harm_with_more_folds_asks_for_one_standard_error_of_the_paired_gain():
-    constant = _score([0.010, 0.012, 0.011, 0.013], Candidate(0))
-    assert beats_constant(_score([0.008, 0.010, 0.009, 0.011]), constant)  # 0.002 less on every fold
-    assert not beats_constant(_score([0.004, 0.014, 0.012, 0.014]), constant)  # mean gain 0.0005, SE 0.0016
-    # when nothing beats the constant, the constant is chosen
-    best, chosen = choose([_score([0.004, 0.014, 0.012, 0.014]), constant], lambda c: c.complexity, constant)
-    assert best == Candidate(2) and chosen == Candidate(0)
 
 
 def test_folds_that_cannot_be_had_are_said():

@@ -113,7 +113,7 @@ class LookupTableBasis:
     (point 0 is the level the run constants take) at the temperature clipped to the curve's range (held past it,
     as applied). Candidates ``table:8`` and ``table:16`` of the model choice, without lag or hysteresis, kept
     only where they beat the best polynomial on the held-out folds by more than the standard error of the
-    paired difference (:mod:`gyrocomp.fitting.selection`)."""
+    paired difference (:mod:`gyrocomp.fitting.scores`)."""
 
     name: ClassVar[str] = "table"
     sizes: ClassVar[tuple[int, ...]] = (8, 16)

@@ -31,7 +31,7 @@ from ..fitting.base import provenance
 from ..curves.hysteresis import turn_threshold_degc
 from ..models.options import FitOptions, FoldChoice
 from ..fitting.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MIN_S, drift_window_s, leg_labels
-from ..fitting.selection import fold_mean, fold_standard_error
+from ..fitting.scores import fold_mean, fold_standard_error
 from ..curves.polynomial import PolynomialCurve
 from ..measures.plausibility import require_temperature_span
 from ..recording.prepared import prepare

@@ -109,7 +109,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
         (:func:`gyrocomp.fitting.selection.share_fold_lags`).
     do_no_harm : bool
         Keep a temperature model only where it beats the run constant on the held-out folds
-        (:func:`gyrocomp.fitting.selection.beats_constant`); False when the order was asked for.
+        (:func:`gyrocomp.fitting.scores.beats_constant`); False when the order was asked for.
     curves : tuple of str
         Curve families to score (:data:`gyrocomp.curves.protocol.BASES`): ``poly`` at ``orders``, the others at
         their own sizes.
