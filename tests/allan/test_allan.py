@@ -634,7 +634,8 @@ def test_rn_modified_variance_from_the_running_sum_on_a_grid():
 def test_shared_phase_grids_equal_grids_made_alone(n, steps, seed):
     """A grid read from a finer one made before (its step dividing the new one's) is the grid made from the phase
     alone, to rounding, in any order of requests; R(n)'s variance is the same with shared grids or without."""
-    from gyrocomp.allan.noise_id import PhaseGrids, modified_variance_on_grid
+    from gyrocomp.allan.estimators import PhaseGrids
+    from gyrocomp.allan.noise_id import modified_variance_on_grid
 
     phase = np.cumsum(np.random.default_rng(seed).standard_normal(n)) + 5.0
     shared = PhaseGrids(phase)

@@ -456,6 +456,44 @@ _CUMULATED_IN_MEMORY_MAX = 1 << 22
 _CHECKPOINT = 1 << 16
 
 
+class PhaseGrids:
+    """The running sum X of a phase about its mean on grids of step g (X at 0, g, 2g, ..., n // g blocks), each
+    made once: from the phase in one pass, or, where a finer grid whose step divides g was made before, as every
+    (g / step)-th point of it, with no pass over the phase (the octave factors' grids are nested). R(n)'s modified
+    variance reads them (:func:`gyrocomp.allan.noise_id.modified_variance_on_grid`), and so do the checkpoints of
+    :class:`_LazyCumulated`."""
+
+    def __init__(self, phase):
+        self.phase = phase
+        self._mean: float | None = None
+        self._grids: dict[int, np.ndarray] = {}
+
+    @property
+    def mean(self) -> float:
+        """The phase's mean [phase unit], that X is about."""
+        if self._mean is None:
+            self._mean = _mean(self.phase)
+        return self._mean
+
+    def running_sum(self, g: int) -> np.ndarray:
+        """X at 0, g, 2g, ... (n // g + 1 points) [phase unit x samples]."""
+        if g not in self._grids:
+            finer = [h for h in self._grids if g % h == 0]
+            self._grids[g] = self._grids[max(finer)][::g // max(finer)] if finer else self._from_phase(g)
+        return self._grids[g]
+
+    def _from_phase(self, g: int) -> np.ndarray:
+        phase, mean = self.phase, self.mean
+        blocks = len(phase) // g
+        sums = np.empty(blocks)
+        step = max(g, (_BLOCK // g) * g)
+        for start in range(0, blocks * g, step):
+            stop = min(start + step, blocks * g)
+            chunk = np.asarray(phase[start:stop], dtype=np.float64) - mean
+            sums[start // g: stop // g] = chunk.reshape(-1, g).sum(axis=1)
+        return np.concatenate([[0.0], np.cumsum(sums)])
+
+
 def _cumulated(phase, in_memory_max: int | None = None):
     """X[k] = sum_{i<k} (x[i] - mean(x)), the running sum the modified variance differences: an array, or for a
     phase longer than ``in_memory_max`` points (default ``_CUMULATED_IN_MEMORY_MAX``; a memory-mapped file, say)
@@ -468,16 +506,15 @@ def _cumulated(phase, in_memory_max: int | None = None):
 
 class _LazyCumulated:
     """The running sum X of ``x`` about its mean, N+1 points, read by contiguous slices: X is kept at every
-    ``_CHECKPOINT``-th point (one pass), and a slice is its checkpoint plus the running sum of the points from
+    ``_CHECKPOINT``-th point (one pass, :class:`PhaseGrids`), and a slice is its checkpoint plus the running sum of the points from
     it, so no array of X's length is ever made. Equal to the array form to rounding."""
 
     def __init__(self, x):
         self.x = x
-        self.mean = _mean(x)
-        n = len(x)
-        sums = [float(np.sum(np.asarray(x[a:b], dtype=np.float64) - self.mean)) for a, b in _blocks(n, _CHECKPOINT)]
-        self.checkpoints = np.concatenate([[0.0], np.cumsum(sums)])
-        self.length = n + 1
+        grids = PhaseGrids(x)
+        self.mean = grids.mean
+        self.checkpoints = grids.running_sum(_CHECKPOINT)  # X at 0, _CHECKPOINT, ... (every start a slice can have)
+        self.length = len(x) + 1
 
     def __len__(self) -> int:
         return self.length

@@ -15,7 +15,7 @@ from typing import Literal
 
 import numpy as np
 
-from .estimators import _BLOCK, _ESTIMATORS, _mean, _second_difference_sum
+from .estimators import _BLOCK, _ESTIMATORS, PhaseGrids, _second_difference_sum
 
 #: fewest decimated points for which the lag-1 autocorrelation identifies a noise type (Riley 2004)
 NOISE_ID_MIN_POINTS = 30
@@ -142,37 +142,6 @@ def _grid_step(m: int) -> int:
     ``RN_STARTS_PER_M`` (m itself when none is: every start, as the overlapping estimator has)."""
     d = next((d for d in range(RN_STARTS_PER_M, m + 1) if m % d == 0), m) if m > RN_STARTS_PER_M else m
     return m // d
-
-
-class PhaseGrids:
-    """The running sum X of a phase about its mean on grids of step g (X at 0, g, 2g, ..., n // g blocks), each
-    made once: from the phase in one pass, or, where a finer grid whose step divides g was made before, as every
-    (g / step)-th point of it, with no pass over the phase (the octave factors' grids are nested)."""
-
-    def __init__(self, phase):
-        self.phase = phase
-        self._mean: float | None = None
-        self._grids: dict[int, np.ndarray] = {}
-
-    def running_sum(self, g: int) -> np.ndarray:
-        """X at 0, g, 2g, ... (n // g + 1 points) [phase unit x samples]."""
-        if g not in self._grids:
-            finer = [h for h in self._grids if g % h == 0]
-            self._grids[g] = self._grids[max(finer)][::g // max(finer)] if finer else self._from_phase(g)
-        return self._grids[g]
-
-    def _from_phase(self, g: int) -> np.ndarray:
-        phase = self.phase
-        if self._mean is None:
-            self._mean = _mean(phase)
-        blocks = len(phase) // g
-        sums = np.empty(blocks)
-        step = max(g, (_BLOCK // g) * g)
-        for start in range(0, blocks * g, step):
-            stop = min(start + step, blocks * g)
-            chunk = np.asarray(phase[start:stop], dtype=np.float64) - self._mean
-            sums[start // g: stop // g] = chunk.reshape(-1, g).sum(axis=1)
-        return np.concatenate([[0.0], np.cumsum(sums)])
 
 
 def modified_variance_on_grid(phase, m: int, grids: PhaseGrids | None = None) -> float:
