@@ -75,7 +75,7 @@ def timed_process(args: list[str], repeat: int) -> float:
 #: the fit's stages: the functions of ``gyrocomp.models.pipelines`` each stage's time is spent in (the rest of
 #: ``fit_channels`` is the final fit of the chosen models and its report)
 STAGES = {"checks": ("_check_fit_inputs",), "reduction": ("prepare", "prepare_axis"),
-          "model choice": ("share_fold_lags", "select_axis")}
+          "model choice": ("share_fold_lags", "select_axes")}
 
 
 def _timed(func, stage: str, spent: dict[str, float]):

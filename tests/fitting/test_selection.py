@@ -12,7 +12,9 @@ from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.folds import leg_labels
-from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc
+from gyrocomp.fitting.scores import CandidateScore
+from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc, unidentified_lags
+from gyrocomp.fitting.thermal import LAG_MAX_S, lag_search_top_s
 from gyrocomp.curves.kinds import BASES
 from gyrocomp.curves.polynomial import PolynomialCurve
 from gyrocomp.recording import Recording
@@ -188,3 +190,29 @@ def test_lag_residuals_from_the_shape_columns_equal_those_of_the_full_normal_mat
         full = np.array([[problem.solve(problem.training_matrices(float(tau), "time")[0][f], idx)[1]
                           for tau in grid] for f in range(problem.folds.count)])
         np.testing.assert_allclose(got, full / full.min(axis=1, keepdims=True), rtol=1e-9)
+
+
+def test_a_lag_some_fold_puts_at_the_top_of_the_search_is_not_identified():
+    top_s = 5400.0
+    at_top = CandidateScore(Candidate(2, True), (1.0, 1.0), (30.0, top_s))
+    inside = CandidateScore(Candidate(3, True), (1.0, 1.0), (30.0, 0.6 * top_s))
+    no_lag = CandidateScore(Candidate(2), (1.0, 1.0), (0.0, 0.0))
+    assert unidentified_lags([at_top, inside, no_lag], top_s) == {Candidate(2, True)}
+
+
+def test_the_lag_search_stops_at_half_the_longest_run_on_the_grid_it_had():
+    """The fold lags are the points of the grid from two blocks to the longest run (at most 4 h) that lie within
+    half the longest run; the final fit searches up to the same half."""
+    runs = [simulate("consumer", profile=get_profile("cycle", set_points_degc=(-10.0, 40.0), cycles=1), rate_hz=1.0,
+                     duration_s=d, seed=1).recording for d in (3000.0, 7200.0)]
+    problem = prepare_axis(runs, "gyro_x")
+    lo = 2.0 * problem.block_s
+    longest = max(float(r.time_s[-1] - r.time_s[0]) for r in problem.runs)  # of the blocks' times
+    assert longest == pytest.approx(7200.0, abs=5.0)
+    full = np.geomspace(lo, longest, 16)
+    grid = problem.lag_grid_s()
+    np.testing.assert_allclose(grid, full[full <= longest / 2])
+    assert lag_search_top_s(problem.runs, lo) == pytest.approx(longest / 2)
+    assert lag_search_top_s([dataclasses.replace(problem.runs[0], time_s=np.array([0.0, 3.0 * LAG_MAX_S]))], lo) \
+        == LAG_MAX_S
+    assert lag_search_top_s([dataclasses.replace(problem.runs[0], time_s=np.array([0.0, 1.0]))], lo) == 2 * lo

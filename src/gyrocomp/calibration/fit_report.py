@@ -186,7 +186,9 @@ class SelectionReport:
     and the chosen one (the simplest within one standard error of the best); the drifts are in the axis's
     ``unit`` (deg/s, or g for an accelerometer axis). ``chosen_drift`` +- ``chosen_standard_error`` is the drift
     to expect on data like a held-out fold (None in files written before it was stored); ``fold_note`` says why
-    the folds are not of the kind asked for; ``branch_test`` what decided the branch terms where no fold could.
+    the folds are not of the kind asked for; ``branch_test`` what decided the branch terms where no fold could;
+    ``lag_from_unit`` whether the lag was kept because the other axes of the die chose one (the folds unable to
+    tell this axis's model with it from the one without; False in files written before it was stored).
     """
 
     axis: str
@@ -206,6 +208,7 @@ class SelectionReport:
     chosen_standard_error: float | None = None
     fold_note: str = ""
     branch_test: BranchTest | None = None
+    lag_from_unit: bool = False
 
     raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
     chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
@@ -227,7 +230,8 @@ class SelectionReport:
                    bool(d.get("validated", True)), bool(d.get("generalizes", True)),
                    tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit,
                    _number(_entry_in_unit(d, "chosen_standard_error", unit)), str(d.get("fold_note", "")),
-                   BranchTest.from_dict(d["branch_test"]) if d.get("branch_test") else None)
+                   BranchTest.from_dict(d["branch_test"]) if d.get("branch_test") else None,
+                   bool(d.get("lag_from_unit", False)))
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")

@@ -72,6 +72,16 @@ def plausible_middle(rss: np.ndarray, independent: float, chi2: float = 4.0) -> 
     return int(plausible[plausible.size // 2])
 
 
+def lag_search_top_s(runs, lo_s: float) -> float:
+    """The longest time constant [s] a lag search tries: half the longest of ``runs`` (anything with ``time_s``
+    [s]), at most :data:`LAG_MAX_S`, at least twice ``lo_s``. A die that takes longer to follow its sensor never
+    settles in any run, and its lagged temperature is a smooth trend over the run that fits a slow drift as well
+    as the temperature (measured: a simulated random walk unrelated to temperature, three runs of 3.1-3.75 h,
+    got lags of 4,600-7,900 s, and the fourth run drifted 2.1x raw)."""
+    longest = max(float(r.time_s[-1] - r.time_s[0]) for r in runs)
+    return max(2.0 * lo_s, min(LAG_MAX_S, longest / 2.0))
+
+
 def best_lag_s(rss: Callable[[float], float], lo_s: float, hi_s: float = LAG_MAX_S) -> float:
     """The time constant [s] that minimizes ``rss(tau)``: a 12-point log-spaced search between ``lo_s`` and
     ``hi_s`` [s], refined by a bounded scalar minimization in log(tau) around the best grid point."""
@@ -218,8 +228,9 @@ class _Problem:
             spec = self.best_width(spec, 0.0, which)
             return 0.0, self.solve(spec, 0.0, which), spec
         if tau_s is None:
+            lo_s = LAG_MIN_BLOCKS * self.block_s
             tau_s = best_lag_s(lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2],
-                               LAG_MIN_BLOCKS * self.block_s)
+                               lo_s, lag_search_top_s(self.runs, lo_s))
         spec = self.best_width(spec, tau_s, which)
         return tau_s, self.solve(spec, tau_s, which), spec
 
@@ -558,7 +569,8 @@ class ThermalHysteresisModel(LearnedAttributes):
             return {}
         profiles = [c.problem.lag_profile(c.spec) for c in lagged.values()]
         lo_s = LAG_MIN_BLOCKS * max(c.problem.block_s for c in lagged.values())
-        tau_s = best_lag_s(lambda tau: sum(f(tau) for f in profiles), lo_s)
+        top_s = lag_search_top_s([r for c in lagged.values() for r in c.problem.runs], lo_s)
+        tau_s = best_lag_s(lambda tau: sum(f(tau) for f in profiles), lo_s, top_s)
         return {axis: tau_s for axis in lagged}
 
     def _store(self, axis: str, choice: _AxisChoice, tau_s: float | None) -> None:

@@ -32,7 +32,7 @@ from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
 from ..curves.network import NETWORK_BLOCK_S, NETWORK_INPUTS
 from ..fitting.network import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
-from ..fitting.selection import AxisSelection, prepare_axis, select_axis, share_fold_lags
+from ..fitting.selection import AxisSelection, prepare_axis, select_axes, share_fold_lags
 from ..fitting.polynomial import PolynomialTemperatureModel
 from ..curves.kinds import BASES
 from ..curves.polynomial import MAX_ORDER
@@ -136,10 +136,10 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
                                                              squares=acceleration == "matrix2", warn=False)
             problem.accel_cols, problem.square_cols = accel_cols, square_cols
         problems[axis] = problem
-    if shared_lag and one_temperature_column(recordings) and any("lag" in m for m in memories):
+    one_die = shared_lag and one_temperature_column(recordings)
+    if one_die and any("lag" in m for m in memories):
         share_fold_lags(list(problems.values()), orders)
-    return {axis: select_axis(axis, problem, orders, memories, do_no_harm=do_no_harm)
-            for axis, problem in problems.items()}
+    return select_axes(problems, orders, memories, do_no_harm, one_die)
 
 
 def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
@@ -153,6 +153,9 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
                       ModelChoiceWarning, stacklevel=3)
     for axis, sel in selections.items():
         unit = sel.unit
+        if sel.lag_from_unit:
+            warnings.warn(f"{axis}: the held-out {across} cannot tell {sel.chosen.label} from the same without the lag "
+                          "the other axes found; the die's lag is kept", ModelChoiceWarning, stacklevel=3)
         if sel.branch_test is not None:
             warnings.warn(sel.branch_test.sentence(axis), ModelChoiceWarning, stacklevel=3)
         if not sel.validated:
