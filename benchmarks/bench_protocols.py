@@ -1,9 +1,10 @@
 """Benchmark: accuracy by calibration protocol, the way users calibrate, judged on data the fit has not seen.
 
-For every simulator preset, and two simulated parts that test the model choice (``random walk``: a drift that is
+For every simulator preset, and three simulated parts that test the model choice (``random walk``: a drift that is
 a slow random walk unrelated to temperature, which no temperature model should follow; ``branches``: heating and
-cooling curves that differ, 0.03 deg/s apart at 25 degC and 0.0008 deg/s/degC more per degree), over ten seeds
-(each seed a new set of runs, noise and turn-on biases):
+cooling curves that differ, 0.03 deg/s apart at 25 degC and 0.0008 deg/s/degC more per degree; ``branches, lag``:
+a triad behind a 40 s thermal lag whose z axis has those branches), over ten seeds (each seed a new set of runs,
+noise and turn-on biases):
 
 - ``one cycle``: one chamber run 40 -> -20 -> 70 -> 30 degC at 2 degC/min (cooled, heated, cooled, as most
   single-cycle procedures), fitted up to its hottest point, judged on the cooling leg after it (the model applied
@@ -57,6 +58,12 @@ TEST_PARTS = {
                                 hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
                                 noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0,
                                 turn_on_bias_sigma_dps=0.05), (-20.0, 70.0)),
+    "branches, lag": (GyroErrorModel(axes=("gyro_x", "gyro_y", "gyro_z"),
+                                     temperature_coefficients=((0.004, 2e-5), (-0.003, 1e-5), (0.01, 5e-5)),
+                                     t_ref_degc=25.0, thermal_time_constant_s=40.0,
+                                     hysteresis=Hysteresis(((0.0, 0.0), (0.0, 0.0), (0.03, 0.0008)), transition_degc=5.0),
+                                     noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0,
+                                     turn_on_bias_sigma_dps=0.05), (-20.0, 70.0)),
 }
 
 

@@ -508,8 +508,8 @@ class SelectionProblem:
         both = self.fold_has_both_directions()
         for f in range(self.folds.count):
             # a fold whose training data holds one direction only cannot tell the branches apart: there the
-            # candidate is its polynomial (its branch terms would be confounded with the curve)
-            fc = c if both[f] else dataclasses.replace(c, branch=0)
+            # candidate is its polynomial (its branch or turning-point terms would be confounded with the curve)
+            fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False)
             widths = range(len(BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
             best = None
             for tau in (taus if shared is None else shared[f:f + 1]):
