@@ -114,6 +114,9 @@ class AxisSelection:
     fold_note: str = ""
     branch_test: BranchTest | None = None
     lag_from_unit: bool = False
+    #: where ``lag_from_unit``, the choice this axis made on its own (the fit falls back to it when the die's lag,
+    #: fitted on every axis that has it, comes out at the bottom of the search: no lag the data can see)
+    alone: "AxisSelection | None" = field(default=None, repr=False, compare=False)
 
     def score_of(self, candidate: Candidate) -> CandidateScore:
         return next(s for s in self.scores if s.candidate == candidate)
@@ -652,7 +655,8 @@ def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_
     one standard error), the one with the lag is taken. Held-out legs remove each leg's mean, and a lag shifts a
     steady ramp by a constant, so the legs see a lag only at turns and holds; the next leg sees all of it (measured
     on a simulated consumer-grade part, true lag 30 s, one cycle at 2 degC/min: an axis left without the lag its
-    two sister axes found drifted 4.2x the noise on the next leg, 1.2x with it). Where the branch terms are decided
+    two sister axes found drifted 4.2x the noise on the next leg, 1.2x with it; the final fit keeps it only where
+    the axis's own runs see it, :attr:`AxisSelection.alone` being the fallback). Where the branch terms are decided
     by their test (one heating and one cooling leg), they are tested beyond the die's lag, which parts the two legs
     as well (by the slope times the ramp rate times the lag)."""
     constant = next(s for s in scored.scores if s.candidate == Candidate(0))
@@ -690,9 +694,17 @@ def select_axes(problems: dict[str, SelectionProblem], orders: tuple[int, ...], 
     scored = {axis: score_axis(axis, p, orders, memories) for axis, p in problems.items()}
     out = {axis: choose_axis(axis, problems[axis], scored[axis], do_no_harm) for axis in problems}
     if one_die and any(sel.chosen.lag for sel in out.values()):
-        out = {axis: sel if sel.chosen.lag else choose_axis(axis, problems[axis], scored[axis], do_no_harm, True)
+        out = {axis: sel if sel.chosen.lag else _with_the_dies_lag(problems[axis], scored[axis], sel, do_no_harm)
                for axis, sel in out.items()}
     return out
+
+
+def _with_the_dies_lag(problem: SelectionProblem, scored: AxisScores, alone: AxisSelection,
+                       do_no_harm: bool) -> AxisSelection:
+    """``alone``'s axis chosen again with the die's lag free (:func:`choose_axis`), keeping ``alone`` to fall back
+    on."""
+    again = choose_axis(alone.axis, problem, scored, do_no_harm, unit_lag=True)
+    return dataclasses.replace(again, alone=alone) if again.lag_from_unit else alone
 
 
 def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[CandidateScore],

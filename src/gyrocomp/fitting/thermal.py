@@ -51,6 +51,9 @@ MAX_HYSTERESIS_ORDER = 3
 #: bounds of the thermal time constant search [s]
 LAG_MIN_BLOCKS = 2.0
 LAG_MAX_S = 4 * 3600.0
+#: an axis whose fit at its lag the data cannot tell from the same at the bottom of the search (two blocks) by
+#: more than this chi-square (about two standard errors of one parameter, as in plausible_middle) does not see it
+LAG_EVIDENCE_CHI2 = 4.0
 DEFAULT_BLOCK_S = 2.0
 #: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
 #: score measures drift (what compensation is for) rather than white noise, which no model removes
@@ -254,6 +257,16 @@ class _Problem:
                     best = (rss, self.band)
         self.band = best[1]
 
+    def lag_evidence(self, spec: _Spec, tau_s: float, rss: float) -> float:
+        """How far the all-run fit of ``spec`` at lag ``tau_s`` [s] (weighted residual sum of squares ``rss``)
+        stands from the same fit at the bottom of the lag search (two blocks), as a chi-square of one parameter:
+        the residual's independent stretches (its length over :data:`SCORE_WINDOW_S`, as the block residuals are
+        correlated over that long) times the relative increase of the rss there."""
+        which = list(range(len(self.runs)))
+        floor = self.solve(spec, LAG_MIN_BLOCKS * self.block_s, which)[2]
+        duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in self.runs)
+        return duration_s / SCORE_WINDOW_S * (floor - rss) / max(rss, 1e-300)
+
     def lag_profile(self, spec: _Spec) -> Callable[[float], float]:
         """The all-run residual sum of squares as a function of tau [s], divided by its minimum (1 at the
         axis's own best tau), so that axes with different noise weigh the same in a shared lag."""
@@ -396,6 +409,10 @@ class ThermalHysteresisModel(LearnedAttributes):
         ``curve`` names (:data:`gyrocomp.curves.protocol.BASES`).
     lag_time_constants_s_ : dict[str, float]
         Fitted thermal time constant per axis [s], 0 without lag.
+    lag_evidence_ : dict[str, float]
+        Per axis with a lag, how far its all-run fit stands from the same at the bottom of the lag search (two
+        blocks), as a chi-square of one parameter (:meth:`_Problem.lag_evidence`); at most
+        :data:`LAG_EVIDENCE_CHI2`, this axis's data do not see the lag. NaN without lag.
     hysteresis_ : dict[str, HysteresisCurve or None]
     turn_on_biases_ : dict[str, np.ndarray]
     memories_ : dict[str, (str, int)]
@@ -469,6 +486,7 @@ class ThermalHysteresisModel(LearnedAttributes):
             "leave-one-run-out" if len(recordings) >= 2 else "bic")
         choices = {axis: self._choose(axis, recordings, pieces, first=axis == axes[0]) for axis in axes}
         taus = self._shared_lag(choices) if self.shared_lag and one_temperature_column(recordings) else {}
+        self.lag_evidence_ = {}
         for axis, choice in choices.items():
             self._store(axis, choice, taus.get(axis))
         return self
@@ -582,7 +600,8 @@ class ThermalHysteresisModel(LearnedAttributes):
             temps = np.concatenate([r.temperature_degc for r in problem.runs])
             problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0],
                                 max(1.0, float(np.ptp(temps)) / 40.0))
-        tau, (coef, consts, _, (t_lo, t_hi)), spec = problem.fit(spec, list(range(n_runs)), tau_s)
+        tau, (coef, consts, rss, (t_lo, t_hi)), spec = problem.fit(spec, list(range(n_runs)), tau_s)
+        self.lag_evidence_[axis] = problem.lag_evidence(spec, tau, rss) if tau > 0 else math.nan
         self.curves_[axis] = problem.basis(spec).curve(coef[: spec.order], t_lo, t_hi)
         self.lag_time_constants_s_[axis] = float(tau)
         p = spec.hysteresis_order

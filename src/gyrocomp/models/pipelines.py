@@ -39,7 +39,8 @@ from ..curves.polynomial import MAX_ORDER
 from ..fitting.triad import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
                         fit_accel_multiposition, fit_gyro_rate_table, spans_axes)
 from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
-from ..fitting.thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
+from ..fitting.thermal import (CANDIDATES, LAG_EVIDENCE_CHI2, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER,
+                               ThermalHysteresisModel, static_pieces)
 
 #: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
 BRANCH_ORDERS = tuple(range(1, MAX_BRANCH_ORDER + 1))
@@ -212,20 +213,33 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
                                bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
                                folds=options.folds, do_no_harm=order == "auto",
                                curves=tuple(BASES) if order == "auto" and options.target == "model" else ("poly",))
+    thermal = _fit_chosen(recordings, selections, options, accel_mode)
+    unseen = {axis for axis, sel in selections.items()
+              if sel.lag_from_unit and not thermal.lag_evidence_[axis] > LAG_EVIDENCE_CHI2}
+    if unseen:
+        # an axis that took the die's lag keeps it where its own data, all runs together, see it (a fit at the
+        # die's lag apart from one at the bottom of the search); elsewhere it goes back to its own choice
+        selections = {axis: sel.alone if axis in unseen else sel for axis, sel in selections.items()}
+        thermal = _fit_chosen(recordings, selections, options, accel_mode)
     _warn_about_choice(selections)
-    chosen = {axis: sel.chosen for axis, sel in selections.items()}
-    thermal = ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
-                                     hysteresis={a: c.memory for a, c in chosen.items()},
-                                     hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
-                                     weighting={a: c.weighting for a, c in chosen.items()},
-                                     band_degc={a: selections[a].band_degc if c.band else None
-                                                for a, c in chosen.items()},
-                                     branch_order={a: c.branch for a, c in chosen.items()},
-                                     curve={a: c.curve for a, c in chosen.items()},
-                                     bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
-                                     static_min_duration_s=options.static_min_duration_s,
-                                     refine_band=True, extended=True).fit(recordings)
     return selections, thermal
+
+
+def _fit_chosen(recordings: list[Recording], selections: dict[str, AxisSelection], options: FitOptions,
+                accel_mode: str) -> ThermalHysteresisModel:
+    """Each axis's chosen model (``selections``) fitted on all the runs."""
+    chosen = {axis: sel.chosen for axis, sel in selections.items()}
+    return ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
+                             hysteresis={a: c.memory for a, c in chosen.items()},
+                             hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
+                             weighting={a: c.weighting for a, c in chosen.items()},
+                             band_degc={a: selections[a].band_degc if c.band else None
+                                        for a, c in chosen.items()},
+                             branch_order={a: c.branch for a, c in chosen.items()},
+                             curve={a: c.curve for a, c in chosen.items()},
+                             bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
+                             static_min_duration_s=options.static_min_duration_s,
+                             refine_band=True, extended=True).fit(recordings)
 
 
 @single_threaded_blas
