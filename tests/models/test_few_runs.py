@@ -64,24 +64,31 @@ def test_two_runs_find_the_hysteresis_and_the_lag_by_themselves(shape):
     assert {"none", "lag", "turning-point", "turning-point+lag"} <= scored
 
 
-def _one_cycle(model, seed):
-    """One chamber run cooled, heated, cooled (2 degC/min, 2 Hz), fitted up to its hottest point; the drift of the
-    raw and the default's output on the cooling leg after it [deg/s], and the fit's warnings."""
+def _fit_one_cycle(model, seed):
+    """One chamber run cooled, heated, cooled (2 degC/min, 2 Hz), fitted up to its hottest point: (the simulation,
+    the index of its hottest sample, the default calibration, the fit's warnings)."""
     prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
                        dwell_s=300.0)
     sim = simulate(model, profile=prof, rate_hz=2.0, seed=seed)
-    rec = sim.recording
-    k = int(np.argmax(rec.temperature_degc))
+    k = int(np.argmax(sim.recording.temperature_degc))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        cal = fit_calibration([rec.take(np.arange(k))])
+        cal = fit_calibration([sim.recording.take(np.arange(k))])
+    return sim, k, cal, [str(w.message) for w in caught]
+
+
+def _one_cycle(model, seed):
+    """The drift of the raw and the default's output on the cooling leg after the hottest point of
+    :func:`_fit_one_cycle`'s run (the model applied to that leg alone) [deg/s], and the fit's warnings."""
+    sim, k, cal, messages = _fit_one_cycle(model, seed)
+    rec = sim.recording
     test = rec.take(np.arange(k, rec.n_samples))
     truth = sim.truth.true_rate_dps[k:, 0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out = apply(cal, test).gyro_dps[:, 0]
     return (smoothed_residual_rms(test.gyro_dps[:, 0] - truth, 120), smoothed_residual_rms(out - truth, 120),
-            [str(w.message) for w in caught])
+            messages)
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -161,21 +168,15 @@ def test_the_expected_held_out_drift_is_stored_and_read_back(tmp_path):
 
 def _next_leg_per_axis(model, seed):
     """The one-cycle protocol on every axis: (calibration, default / perfect drift per axis on the cooling leg after
-    the hottest point, the fit's warnings); the model is applied to the whole run, as a memory model needs."""
-    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
-                       dwell_s=300.0)
-    sim = simulate(model, profile=prof, rate_hz=2.0, seed=seed)
-    rec = sim.recording
-    k = int(np.argmax(rec.temperature_degc))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        cal = fit_calibration([rec.take(np.arange(k))])
+    the hottest point of :func:`_fit_one_cycle`'s run, the fit's warnings); the model is applied to the whole run,
+    as a memory model needs."""
+    sim, k, cal, messages = _fit_one_cycle(model, seed)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        out = apply(cal, rec).gyro_dps[k:]
+        out = apply(cal, sim.recording).gyro_dps[k:]
     ratios = [smoothed_residual_rms(out[:, j] - sim.truth.true_rate_dps[k:, j], 120)
               / smoothed_residual_rms(sim.truth.noise.total_dps[k:, j], 120) for j in range(out.shape[1])]
-    return cal, np.array(ratios), [str(w.message) for w in caught]
+    return cal, np.array(ratios), messages
 
 
 @pytest.mark.slow
