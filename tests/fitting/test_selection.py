@@ -13,7 +13,8 @@ from gyrocomp.errors import InputError, ModelChoiceWarning
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.folds import leg_labels
 from gyrocomp.fitting.scores import CandidateScore
-from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc, unidentified_lags
+from gyrocomp.fitting.choice import unidentified_lags
+from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc
 from gyrocomp.fitting.thermal import LAG_MAX_S, lag_search_top_s
 from gyrocomp.curves.kinds import BASES
 from gyrocomp.curves.polynomial import PolynomialCurve

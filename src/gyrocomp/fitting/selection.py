@@ -1,4 +1,5 @@
-"""Model choice by held-out drift: folds, candidates and their scores (the rule: :mod:`gyrocomp.fitting.scores`).
+"""Model choice by held-out drift: folds, candidates and their scores (the rule: :mod:`gyrocomp.fitting.scores`;
+each axis's choice and the axes of one die together: :mod:`gyrocomp.fitting.choice`).
 
 What a user judges a compensation by is the drift left in data the model has not seen: the RMS, about its
 mean, of the moving-averaged compensated output. This module scores every candidate model of one axis by
@@ -19,7 +20,8 @@ Candidates (:class:`Candidate`)
     second of data counts equally, as in the score) or ``temperature-balanced`` (every temperature bin of
     every run counts equally, so a slow ramp cannot dominate). The lag of a fold's fit is chosen on that
     fold's training data (a log-spaced grid), so the held-out score judges the whole procedure; with one
-    temperature column it is one lag for all axes (:func:`share_fold_lags`), as in the final fit.
+    temperature column it is one lag for all axes (:func:`gyrocomp.fitting.choice.share_fold_lags`), as in
+    the final fit.
 
 Score and rule
     Per fold, the time-weighted RMS of the moving average (``window_s``) of the held-out residual about its
@@ -43,19 +45,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
-from ..errors import InputError
 from ..calibration.fit_report import BranchTest, Candidate, Weighting
 from ..measures.merit import moving_average
 from ..recording.prepared import PreparedRun, RunBlocks
 from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
 from .folds import FoldKind, Folds, make_folds, window_for
-from .scores import CandidateScore, choose, json_number
-from .branch_evidence import band_offer, branch_test, branches_identified, branches_present, heats_and_cools_blocks
+from .scores import CandidateScore, json_number
+from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
 from ..curves.polynomial import power_columns
 from ..curves.protocol import BASES
-from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, MAX_BRANCH_ORDER, lag_search_top_s
+from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, lag_search_top_s
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 #: crossover widths of the branch candidates [degC] (each fold takes the one of least training residual)
@@ -98,7 +99,7 @@ class AxisSelection:
         whether the chosen model gets one (:func:`gyrocomp.fitting.branch_evidence.branch_test`); None elsewhere.
     lag_from_unit : bool
         Whether the chosen lag was taken because another axis of the same die chose one, the folds being unable
-        to tell it from the same model without (:func:`choose_axis`).
+        to tell it from the same model without (:func:`gyrocomp.fitting.choice.choose_axis`).
     """
 
     axis: str
@@ -243,7 +244,7 @@ class SelectionProblem:
         Temperature band where the branches part in the data [degC]: turning-point candidates are also tried
         with their terms limited to it.
     fold_lags_s : dict
-        Per (order, weighting), each fold's lag [s] shared with the other axes (:func:`share_fold_lags`); a lag
+        Per (order, weighting), each fold's lag [s] shared with the other axes (:func:`gyrocomp.fitting.choice.share_fold_lags`); a lag
         candidate not in it picks its own per fold.
     band_only : bool
         Turning-point candidates only inside ``band_degc`` (none without a band): see :func:`prepare_axis`.
@@ -593,138 +594,6 @@ class SelectionProblem:
         return c.complexity - (1 if c.lag and self.temperature_step_degc > 0 else 0)
 
 
-def share_fold_lags(problems: list[SelectionProblem], orders: tuple[int, ...],
-                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> None:
-    """Give the axes one lag per fold and per (order, weighting): the lag is the die's, behind one temperature
-    sensor, and the axes together pin it down better than any one of them (as the final fit does, see
-    :class:`gyrocomp.fitting.thermal.ThermalHysteresisModel`'s ``shared_lag``). Each fold's lag minimizes the
-    sum over axes of their relative training residuals (:meth:`SelectionProblem.lag_rss`). The problems must
-    share their runs' times and folds; nothing is shared otherwise."""
-    if len(problems) < 2 or len({(p.folds.count, p.block_s) for p in problems}) > 1:
-        return
-    grid = problems[0].lag_grid_s()
-    for order in (o for o in orders if o > 0):
-        for weighting in weightings:
-            total = sum(p.lag_rss(order, weighting, grid) for p in problems)
-            taus = grid[np.argmin(total, axis=1)]
-            for p in problems:
-                p.fold_lags_s[(order, weighting)] = taus
-
-
-def unidentified_lags(scores: list[CandidateScore], top_s: float) -> set[Candidate]:
-    """The lag candidates whose lag some fold's training data put at the top of the search (``top_s`` [s], the
-    largest lag of :meth:`SelectionProblem.lag_grid_s`): there the least residual wants a longer time constant
-    still, i.e. the lagged temperature stands for a slow drift in time, not for a die that follows its sensor.
-    Such a candidate follows the drift its held-out legs share with their neighbours (the same runs), and the
-    next run pays for it (measured before the search stopped at half the longest run: an ADIS16488-like part,
-    true lag 300 s, two cycles: lag 11,100 s, the longest run, and poly:5 chosen; the third run 2.7x worse than
-    raw)."""
-    return {s.candidate for s in scores if s.candidate.lag and max(s.fold_lag_s, default=0.0) >= top_s * (1 - 1e-9)}
-
-
-@dataclass(frozen=True)
-class AxisScores:
-    """Every candidate's held-out score on one axis (the run constant's among them) and the candidates that may
-    be chosen (those asked for, less the lags the data did not identify: :func:`unidentified_lags`)."""
-
-    scores: tuple[CandidateScore, ...]
-    eligible: frozenset[Candidate]
-
-
-def score_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],
-               weightings: tuple[Weighting, ...] = WEIGHTINGS) -> AxisScores:
-    """Score every candidate of one axis on the held-out folds (:meth:`SelectionProblem.score`)."""
-    cands = problem.candidates(orders, memories, weightings)
-    if not cands:
-        raise InputError(f"hysteresis={'/'.join(memories)!r}: the temperature of {axis} never reverses in these "
-                         "runs, so there is no branch to fit; use hysteresis='none' or 'lag'")
-    eligible = set(cands)
-    if Candidate(0) not in cands:  # the reference every score is read against; chosen only when asked for
-        cands.insert(0, Candidate(0))
-    scores = tuple(problem.score(c) for c in cands)
-    return AxisScores(scores, frozenset(eligible - unidentified_lags(scores, float(problem.lag_grid_s()[-1]))))
-
-
-def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_harm: bool = True,
-                unit_lag: bool = False) -> AxisSelection:
-    """Choose among the scores of one axis (see the module doc); with ``do_no_harm``, a temperature model only
-    where it beats the run constant (:func:`beats_constant`).
-
-    ``unit_lag``: another axis behind the same temperature sensor chose a thermal lag, so the die has one; here
-    the lag costs nothing and, between candidates of equal complexity the held-out folds cannot tell apart (within
-    one standard error), the one with the lag is taken. Held-out legs remove each leg's mean, and a lag shifts a
-    steady ramp by a constant, so the legs see a lag only at turns and holds; the next leg sees all of it (measured
-    on a simulated consumer-grade part, true lag 30 s, one cycle at 2 degC/min: an axis left without the lag its
-    two sister axes found drifted 4.2x the noise on the next leg, 1.2x with it; the final fit keeps it only where
-    the axis's own runs see it, :attr:`AxisSelection.alone` being the fallback). Where the branch terms are decided
-    by their test (one heating and one cooling leg), they are tested beyond the die's lag, which parts the two legs
-    as well (by the slope times the ramp rate times the lag)."""
-    constant = next(s for s in scored.scores if s.candidate == Candidate(0))
-    complexity = _with_free_lag if unit_lag else problem.complexity
-    best, chosen = choose([s for s in scored.scores if s.candidate in scored.eligible], complexity,
-                          constant if do_no_harm else None)
-    test = None
-    if problem.branch_orders and not chosen.branch and not chosen.hysteresis_order \
-            and not np.any(problem.fold_has_both_directions()):
-        twin = dataclasses.replace(chosen, lag=True)
-        if unit_lag and chosen.has_temperature_model and twin in scored.eligible:
-            chosen = twin  # a lag also parts the heating and cooling legs: the branch terms are tested beyond it
-        chosen, test = _branch_by_test(problem, chosen, list(scored.scores), set(scored.eligible))
-    return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
-                         problem.temperature_step_degc, scored.scores, best, chosen, problem.band_degc, problem.unit,
-                         problem.folds.note, test, lag_from_unit=unit_lag and chosen.lag)
-
-
-def _with_free_lag(c: Candidate) -> tuple[int, bool]:
-    """Complexity with the lag free and, at equal complexity, a temperature model with the lag first."""
-    return c.complexity - int(c.lag), c.has_temperature_model and not c.lag
-
-
-def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],
-                weightings: tuple[Weighting, ...] = WEIGHTINGS, do_no_harm: bool = True) -> AxisSelection:
-    """Score every candidate of one axis and choose (:func:`score_axis`, :func:`choose_axis`)."""
-    return choose_axis(axis, problem, score_axis(axis, problem, orders, memories, weightings), do_no_harm)
-
-
-def select_axes(problems: dict[str, SelectionProblem], orders: tuple[int, ...], memories: tuple[str, ...],
-                do_no_harm: bool = True, one_die: bool = True) -> dict[str, AxisSelection]:
-    """Choose every axis's model (:func:`select_axis`). With ``one_die`` (one temperature column for every
-    axis), when some axis chooses a thermal lag, the others choose again with the die's lag free
-    (``unit_lag`` of :func:`choose_axis`); their scores are not computed again."""
-    scored = {axis: score_axis(axis, p, orders, memories) for axis, p in problems.items()}
-    out = {axis: choose_axis(axis, problems[axis], scored[axis], do_no_harm) for axis in problems}
-    if one_die and any(sel.chosen.lag for sel in out.values()):
-        out = {axis: sel if sel.chosen.lag else _with_the_dies_lag(problems[axis], scored[axis], sel, do_no_harm)
-               for axis, sel in out.items()}
-    return out
-
-
-def _with_the_dies_lag(problem: SelectionProblem, scored: AxisScores, alone: AxisSelection,
-                       do_no_harm: bool) -> AxisSelection:
-    """``alone``'s axis chosen again with the die's lag free (:func:`choose_axis`), keeping ``alone`` to fall back
-    on."""
-    again = choose_axis(alone.axis, problem, scored, do_no_harm, unit_lag=True)
-    return dataclasses.replace(again, alone=alone) if again.lag_from_unit else alone
-
-
-def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[CandidateScore],
-                    eligible: set[Candidate]) -> tuple[Candidate, BranchTest | None]:
-    """Where no fold can judge a branch model (every fold's training holds one direction of travel only), the
-    chosen candidate with the branch terms :func:`branch_test` finds beyond the drift (and no change where it
-    finds none, or where that candidate is not among the ones offered)."""
-    with_branch = dataclasses.replace(chosen, order=max(chosen.order, 1), branch=MAX_BRANCH_ORDER)
-    if with_branch not in eligible:
-        return chosen, None
-    tau = float(np.median(next(s for s in scores if s.candidate == chosen).fold_lag_s)) if chosen.lag else 0.0
-    accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
-    test = branch_test(problem.runs, problem.groups, problem.threshold_degc, problem.t_ref_degc,
-                       problem.t_scale_degc, chosen.order, tau, problem.block_s, accel)
-    if not test.order:
-        return chosen, test
-    kept = dataclasses.replace(with_branch, branch=test.order)
-    return (kept, test) if kept in eligible else (chosen, test)
-
-
 def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,
                  block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
                  max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
@@ -784,6 +653,5 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
                             other_curves=tuple(name for name in curves if name != "poly"))
 
 
-__all__ = ["AxisScores", "AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "SelectionProblem", "Weighting",
-           "choose_axis", "prepare_axis", "score_axis", "select_axes", "select_axis", "temperature_step_degc",
-           "unidentified_lags"]
+__all__ = ["AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "SelectionProblem", "Weighting", "prepare_axis",
+           "temperature_step_degc"]

@@ -32,7 +32,8 @@ from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
 from ..curves.network import NETWORK_BLOCK_S, NETWORK_INPUTS
 from ..fitting.network import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
-from ..fitting.selection import AxisSelection, prepare_axis, select_axes, share_fold_lags
+from ..fitting.choice import select_axes, share_fold_lags
+from ..fitting.selection import AxisSelection, prepare_axis
 from ..fitting.polynomial import PolynomialTemperatureModel
 from ..curves.kinds import BASES
 from ..curves.polynomial import MAX_ORDER
@@ -107,7 +108,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     folds : {"auto", "runs", "legs", "blocks"}
     shared_lag : bool
         With one temperature column, score every lag candidate at one lag per fold shared by the axes
-        (:func:`gyrocomp.fitting.selection.share_fold_lags`).
+        (:func:`gyrocomp.fitting.choice.share_fold_lags`).
     do_no_harm : bool
         Keep a temperature model only where it beats the run constant on the held-out folds
         (:func:`gyrocomp.fitting.scores.beats_constant`); False when the order was asked for.
