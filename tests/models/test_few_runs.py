@@ -181,7 +181,7 @@ def _next_leg_per_axis(model, seed):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [4, 8])
-def test_one_cycle_gives_every_axis_the_dies_lag(seed):
+def test_one_cycle_gives_every_axis_the_dies_lag(seed, tmp_path):
     """The consumer part (30 s lag, tempcos of 0.025-0.035 deg/s/degC), one cycle at 2 degC/min: held-out legs
     cannot tell an axis's curve with the lag from the same without (each leg's mean is removed, and on a steady
     ramp a lag is a constant), so an axis whose sister axes found the die's lag takes it too. Measured on main
@@ -196,6 +196,9 @@ def test_one_cycle_gives_every_axis_the_dies_lag(seed):
     selection = cal.report.selection
     assert any(s.lag_from_unit for s in selection.values())
     assert all(s.lag_from_unit == any(m.startswith(a + ":") for m in kept) for a, s in selection.items())
+    cal.save(tmp_path / "m.json")  # the model file says which axes took the die's lag
+    back = Calibration.load(tmp_path / "m.json").report.selection
+    assert {a: s.lag_from_unit for a, s in back.items()} == {a: s.lag_from_unit for a, s in selection.items()}
 
 
 @pytest.mark.slow
