@@ -190,7 +190,7 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
         table.add_column(col, justify="left" if col in ("axis", "chosen", "best") else "right")
     for axis, sel in selection.items():
         chosen, best = sel.result(sel.chosen.label), sel.result(sel.best.label)
-        table.add_row(axis, sel.chosen.label,
+        table.add_row(axis, sel.chosen.label + (" (the die's lag)" if sel.lag_from_unit else ""),
                       with_error(chosen.mean_drift, chosen.standard_error),
                       sel.best.label, _score(best.mean_drift), _score(sel.raw_drift))
     console.print(table)
