@@ -81,7 +81,7 @@ def score_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], me
 def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_harm: bool = True,
                 unit_lag: bool = False) -> AxisSelection:
     """Choose among the scores of one axis (see the module doc); with ``do_no_harm``, a temperature model only
-    where it beats the run constant (:func:`beats_constant`).
+    where it beats the run constant (:func:`gyrocomp.fitting.scores.beats_constant`).
 
     ``unit_lag``: another axis behind the same temperature sensor chose a thermal lag, so the die has one; here
     the lag costs nothing and, between candidates of equal complexity the held-out folds cannot tell apart (within

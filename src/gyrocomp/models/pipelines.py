@@ -108,7 +108,8 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     folds : {"auto", "runs", "legs", "blocks"}
     shared_lag : bool
         With one temperature column, score every lag candidate at one lag per fold shared by the axes
-        (:func:`gyrocomp.fitting.choice.share_fold_lags`).
+        (:func:`gyrocomp.fitting.choice.share_fold_lags`), and let an axis whose folds cannot tell its model with
+        and without the lag another axis chose take that lag (:func:`gyrocomp.fitting.choice.select_axes`).
     do_no_harm : bool
         Keep a temperature model only where it beats the run constant on the held-out folds
         (:func:`gyrocomp.fitting.scores.beats_constant`); False when the order was asked for.
