@@ -115,8 +115,8 @@ class AxisSelection:
     fold_note: str = ""
     branch_test: BranchTest | None = None
     lag_from_unit: bool = False
-    #: where ``lag_from_unit``, the choice this axis made on its own (the fit falls back to it when the die's lag,
-    #: fitted on every axis that has it, comes out at the bottom of the search: no lag the data can see)
+    #: where ``lag_from_unit``, the choice this axis made on its own (the final fit falls back to it where this
+    #: axis's own runs do not see the die's lag: ThermalHysteresisModel.lag_evidence_)
     alone: "AxisSelection | None" = field(default=None, repr=False, compare=False)
 
     def score_of(self, candidate: Candidate) -> CandidateScore:

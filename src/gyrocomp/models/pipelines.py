@@ -232,16 +232,16 @@ def _fit_chosen(recordings: list[Recording], selections: dict[str, AxisSelection
     """Each axis's chosen model (``selections``) fitted on all the runs."""
     chosen = {axis: sel.chosen for axis, sel in selections.items()}
     return ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
-                             hysteresis={a: c.memory for a, c in chosen.items()},
-                             hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
-                             weighting={a: c.weighting for a, c in chosen.items()},
-                             band_degc={a: selections[a].band_degc if c.band else None
-                                        for a, c in chosen.items()},
-                             branch_order={a: c.branch for a, c in chosen.items()},
-                             curve={a: c.curve for a, c in chosen.items()},
-                             bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
-                             static_min_duration_s=options.static_min_duration_s,
-                             refine_band=True, extended=True).fit(recordings)
+                                  hysteresis={a: c.memory for a, c in chosen.items()},
+                                  hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
+                                  weighting={a: c.weighting for a, c in chosen.items()},
+                                  band_degc={a: selections[a].band_degc if c.band else None
+                                             for a, c in chosen.items()},
+                                  branch_order={a: c.branch for a, c in chosen.items()},
+                                  curve={a: c.curve for a, c in chosen.items()},
+                                  bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
+                                  static_min_duration_s=options.static_min_duration_s,
+                                  refine_band=True, extended=True).fit(recordings)
 
 
 @single_threaded_blas
