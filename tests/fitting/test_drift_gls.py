@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from gyrocomp.fitting.drift_gls import (DriftNoise, chi2_threshold, coarsen, fit_drift_noise, wald_statistic,
-                                       whitened)
+from gyrocomp.fitting.drift_gls import (DriftNoise, chi2_threshold, coarsen, covariance, fit_drift_noise,
+                                       wald_statistic, whitened)
 from gyrocomp.fitting.thermal import plausible_middle
 
 K = 2e-3       # random walk [unit/sqrt(s)]
@@ -18,13 +18,37 @@ def _walk(rng, n):
     return t, SIGMA * rng.standard_normal(n) + np.cumsum(K * np.sqrt(DT_S) * rng.standard_normal(n))
 
 
-def test_the_variogram_recovers_the_white_noise_and_the_walk():
+def test_the_walk_model_recovers_the_white_noise_and_the_walk():
     rng = np.random.default_rng(3)
     runs = [_walk(rng, 4000) for _ in range(3)]
-    noise = fit_drift_noise([r for _, r in runs], [t for t, _ in runs])
+    noise = fit_drift_noise([r for _, r in runs], [t for t, _ in runs], exponents=(1.0,))
     # 12000 points, the shortest lags carry thousands of increments: a few per cent, 15 % allowed
     assert noise.walk_var_per_s == pytest.approx(K ** 2, rel=0.15)
     assert noise.white_var == pytest.approx(SIGMA ** 2, rel=0.15)
+    assert noise.exponent == 1.0
+
+
+@pytest.mark.parametrize("alpha", [0.5, 1.0, 1.5])
+def test_the_drift_exponent_and_the_variogram_are_recovered(alpha):
+    """Exact draws of white noise plus fractional Brownian motion of exponent ``alpha`` (flicker-like, a walk, a
+    smooth drift): the exponent and the variogram at a lag a third of the way along the recording are recovered.
+    Over 8 draws of three 1500-point recordings the exponent scatters by about 0.15 and the variogram at 500 s by
+    about 25 % (measured), so the means over the draws are held to 0.15 and 25 %."""
+    t = np.arange(1500) * DT_S
+    truth = DriftNoise(1e-4, 1e-5, alpha)
+    chol = np.linalg.cholesky(covariance(t, truth))
+    rng = np.random.default_rng(1)
+    fits = [fit_drift_noise([chol @ rng.standard_normal(t.size) for _ in range(3)], [t] * 3) for _ in range(8)]
+    assert np.mean([f.exponent for f in fits]) == pytest.approx(alpha, abs=0.15)
+    lag = np.array([500.0])
+    assert np.mean([f.variogram(lag)[0] for f in fits]) == pytest.approx(truth.variogram(lag)[0], rel=0.25)
+
+
+def test_the_covariance_of_exponent_one_is_the_walks():
+    t = np.arange(40) * DT_S + 7.0
+    tau = t - t[0]
+    expected = K ** 2 * np.minimum.outer(tau, tau) + SIGMA ** 2 * np.eye(t.size)
+    np.testing.assert_allclose(covariance(t, DriftNoise(SIGMA ** 2, K ** 2)), expected, rtol=1e-12, atol=1e-15)
 
 
 def test_a_step_between_two_halves_is_weighed_against_the_walk():

@@ -129,20 +129,23 @@ def _entry_in_unit(d: dict, name: str, unit: str, default=None):
 class CandidateResult:
     """A candidate's held-out drift: mean and standard error over the folds, and each fold's [the axis's unit:
     deg/s, or g for an accelerometer axis], and the lag each fold's fit chose [s]; None where a fold held too
-    little data."""
+    little data. ``short_fold_drift``: each fold's drift at the short window (empty in files written before it was
+    stored)."""
 
     candidate: Candidate
     mean_drift: float | None
     standard_error: float | None
     fold_drift: tuple[float | None, ...]
     fold_lag_s: tuple[float, ...]
+    short_fold_drift: tuple[float | None, ...] = ()
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "CandidateResult":
         return cls(Candidate.from_dict(d), _number(_entry_in_unit(d, "mean_drift", unit)),
                    _number(_entry_in_unit(d, "standard_error", unit)),
                    tuple(_number(v) for v in _entry_in_unit(d, "fold_drift", unit, ())),
-                   tuple(float(v) for v in d.get("fold_lag_s", ())))
+                   tuple(float(v) for v in d.get("fold_lag_s", ())),
+                   tuple(_number(v) for v in _entry_in_unit(d, "short_fold_drift", unit, ())))
 
 
 @dataclass(frozen=True)
@@ -153,22 +156,27 @@ class BranchTest:
     ``order``: branch terms kept (0 none, 1 a constant difference, 2 also a slope); ``statistic``: the Wald
     statistic of the branch terms tested last (the kept ones, or both when none is kept) and ``threshold`` the
     value it had to exceed; ``width_degc``: the crossover width the terms were computed with [degC];
-    ``walk_per_sqrt_s``: the random walk the residual showed [the axis's unit / sqrt(s)]."""
+    ``walk_per_sqrt_s``: the square root of the drift coefficient c the residual of the model without branch terms
+    showed [the axis's unit / s^(exponent / 2)], a random walk's K where ``drift_exponent`` is 1;
+    ``drift_exponent``: the drift's exponent alpha (its variogram ``2 a + c dt^alpha``) [dimensionless; 1 in files
+    written before it was stored]."""
 
     order: int
     statistic: float
     threshold: float
     width_degc: float
     walk_per_sqrt_s: float
+    drift_exponent: float = 1.0
 
     def to_dict(self) -> dict:
         return {"order": self.order, "statistic": self.statistic, "threshold": self.threshold,
-                "width_degc": self.width_degc, "walk_per_sqrt_s": self.walk_per_sqrt_s}
+                "width_degc": self.width_degc, "walk_per_sqrt_s": self.walk_per_sqrt_s,
+                "drift_exponent": self.drift_exponent}
 
     @classmethod
     def from_dict(cls, d: dict) -> "BranchTest":
         return cls(int(d["order"]), float(d["statistic"]), float(d["threshold"]), float(d["width_degc"]),
-                   float(d["walk_per_sqrt_s"]))
+                   float(d["walk_per_sqrt_s"]), float(d.get("drift_exponent", 1.0)))
 
     def sentence(self, axis: str) -> str:
         """One line for the user: what the test found and did."""
@@ -180,6 +188,31 @@ class BranchTest:
 
 
 @dataclass(frozen=True)
+class OrderTest:
+    """The temperature polynomial's order all the calibration data support beyond the drift, where only two held-out
+    legs judge the choice (:func:`gyrocomp.fitting.order_evidence.order_test`).
+
+    ``order``: the highest order whose top term stands out (0: none does); ``statistics``: the Wald statistic of
+    the top term of each order 1..N in the fit of that order [chi-square, 1 degree of freedom]; ``threshold``: the
+    value a statistic had to exceed; ``drift_exponents``: the exponent alpha of the drift model each statistic was
+    computed under [dimensionless]."""
+
+    order: int
+    statistics: tuple[float, ...]
+    threshold: float
+    drift_exponents: tuple[float, ...]
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "statistics": list(self.statistics), "threshold": self.threshold,
+                "drift_exponents": list(self.drift_exponents)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "OrderTest":
+        return cls(int(d["order"]), tuple(float(v) for v in d["statistics"]), float(d["threshold"]),
+                   tuple(float(v) for v in d["drift_exponents"]))
+
+
+@dataclass(frozen=True)
 class SelectionReport:
     """The choice for one axis by held-out drift (:class:`gyrocomp.fitting.selection.AxisSelection` as stored):
     how the data was held out, the moving-average window of the score [s], every candidate's result, the best
@@ -188,7 +221,9 @@ class SelectionReport:
     to expect on data like a held-out fold (None in files written before it was stored); ``fold_note`` says why
     the folds are not of the kind asked for; ``branch_test`` what decided the branch terms where no fold could;
     ``lag_from_unit`` whether the lag was kept because the other axes of the die chose one (the folds unable to
-    tell this axis's model with it from the one without; False in files written before it was stored).
+    tell this axis's model with it from the one without; False in files written before it was stored);
+    ``decided_by`` the rule that made the final choice, in one line ("" in files written before it was stored);
+    ``order_test`` what all the data said of the polynomial's order where two held-out legs were all there was.
     """
 
     axis: str
@@ -209,6 +244,8 @@ class SelectionReport:
     fold_note: str = ""
     branch_test: BranchTest | None = None
     lag_from_unit: bool = False
+    decided_by: str = ""
+    order_test: OrderTest | None = None
 
     raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
     chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
@@ -231,7 +268,8 @@ class SelectionReport:
                    tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit,
                    _number(_entry_in_unit(d, "chosen_standard_error", unit)), str(d.get("fold_note", "")),
                    BranchTest.from_dict(d["branch_test"]) if d.get("branch_test") else None,
-                   bool(d.get("lag_from_unit", False)))
+                   bool(d.get("lag_from_unit", False)), str(d.get("decided_by", "")),
+                   OrderTest.from_dict(d["order_test"]) if d.get("order_test") else None)
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
@@ -538,4 +576,4 @@ class FitReport:
 
 __all__ = ["AxisFit", "BranchTest", "Candidate", "CandidateResult", "ExpectedDrift", "FitReport", "GSensitivityReport", "GSensitivityRow",
            "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
-           "THIN_FOLDS", "Weighting", "memory_label", "memory_name"]
+           "OrderTest", "THIN_FOLDS", "Weighting", "memory_label", "memory_name"]

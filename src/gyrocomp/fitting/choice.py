@@ -18,10 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..calibration.fit_report import BranchTest, Candidate, Weighting
+from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..errors import InputError
 from .branch_evidence import branch_test
-from .scores import CandidateScore, choose
+from .order_evidence import order_test
+from .scores import CandidateScore, choose, harms, helps_on_every_fold, paired_difference
 from .selection import WEIGHTINGS, AxisSelection, SelectionProblem
 from .thermal import MAX_BRANCH_ORDER
 
@@ -78,10 +79,17 @@ def score_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], me
     return AxisScores(scores, frozenset(eligible - unidentified_lags(scores, float(problem.lag_grid_s()[-1]))))
 
 
+#: with this many folds (one heating and one cooling leg), the held-out scores alone are thin evidence
+TWO_FOLDS = 2
+
+
 def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_harm: bool = True,
                 unit_lag: bool = False) -> AxisSelection:
     """Choose among the scores of one axis (see the module doc); with ``do_no_harm``, a temperature model only
-    where it beats the run constant (:func:`gyrocomp.fitting.scores.beats_constant`).
+    where it beats the run constant (:func:`gyrocomp.fitting.scores.beats_constant`; with two folds,
+    :func:`_choose_on_two_folds`), and whatever rule or test chose, never a model that leaves more held-out drift
+    than the constant by more than the standard error (:func:`gyrocomp.fitting.scores.harms`): do no harm is the
+    last word. :attr:`AxisSelection.decided_by` says which rule made the choice.
 
     ``unit_lag``: another axis behind the same temperature sensor chose a thermal lag, so the die has one; here
     the lag costs nothing and, between candidates of equal complexity the held-out folds cannot tell apart (within
@@ -91,21 +99,120 @@ def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_
     two sister axes found drifted 4.2x the noise on the next leg, 1.2x with it; the final fit keeps it only where
     the axis's own runs see it, :attr:`AxisSelection.alone` being the fallback). Where the branch terms are decided
     by their test (one heating and one cooling leg), they are tested beyond the die's lag, which parts the two legs
-    as well (by the slope times the ramp rate times the lag)."""
+    as well (by the slope times the ramp rate times the lag), and only on an axis the held-out legs gave a
+    temperature model: a test adds terms only where the held-out legs do not contradict it."""
     constant = next(s for s in scored.scores if s.candidate == Candidate(0))
     complexity = _with_free_lag if unit_lag else problem.complexity
-    best, chosen = choose([s for s in scored.scores if s.candidate in scored.eligible], complexity,
-                          constant if do_no_harm else None)
+    offered = [s for s in scored.scores if s.candidate in scored.eligible]
+    evidence = None
+    if do_no_harm and problem.folds.count == TWO_FOLDS:
+        best, chosen, decided_by, evidence = _choose_on_two_folds(problem, offered, complexity, constant)
+    else:
+        best, chosen = choose(offered, complexity, constant if do_no_harm else None)
+        decided_by = ("held-out drift: the simplest within one standard error of the best" if do_no_harm
+                      else "held-out drift among the candidates asked for")
+        if do_no_harm and not chosen.has_temperature_model and best.has_temperature_model:
+            decided_by = "do no harm: no temperature model beats the constant on the held-out folds"
+    chosen, decided_by = _lag_at_the_short_window(problem, scored, chosen, decided_by)
     test = None
-    if problem.branch_orders and not chosen.branch and not chosen.hysteresis_order \
-            and not np.any(problem.fold_has_both_directions()):
+    if problem.branch_orders and chosen.has_temperature_model and not chosen.branch \
+            and not chosen.hysteresis_order and not np.any(problem.fold_has_both_directions()):
         twin = dataclasses.replace(chosen, lag=True)
-        if unit_lag and chosen.has_temperature_model and twin in scored.eligible:
+        if unit_lag and twin in scored.eligible:
             chosen = twin  # a lag also parts the heating and cooling legs: the branch terms are tested beyond it
         chosen, test = _branch_by_test(problem, chosen, list(scored.scores), set(scored.eligible))
+        if test is not None and test.order:
+            decided_by += f"; branch terms by their test (Wald {test.statistic:.3g} against {test.threshold:.3g})"
+    if do_no_harm and chosen.has_temperature_model and harms(_score(scored, chosen), constant):
+        chosen, decided_by = constant.candidate, (f"do no harm: {chosen.label} leaves more held-out drift than the "
+                                                  "constant by more than its standard error")
     return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
                          problem.temperature_step_degc, scored.scores, best, chosen, problem.band_degc, problem.unit,
-                         problem.folds.note, test, lag_from_unit=unit_lag and chosen.lag)
+                         problem.folds.note, test, lag_from_unit=unit_lag and chosen.lag, decided_by=decided_by,
+                         order_test=evidence)
+
+
+def _lag_at_the_short_window(problem: SelectionProblem, scored: AxisScores, chosen: Candidate,
+                             decided_by: str) -> tuple[Candidate, str]:
+    """``chosen`` with a thermal lag where the lag leaves less held-out drift at the short window (the thesis's
+    timescale, :attr:`SelectionProblem.short_window_s`, where that is half the score's window or less) by more than
+    the standard error of the paired difference over the folds (with two folds, on both), and no more at the
+    score's window by more than that one's: a lag of tens of seconds shows at tens of seconds, and is averaged away
+    at the long window the other candidates are told apart by (held-out legs remove each leg's mean, and a lag
+    shifts a steady ramp by a constant)."""
+    twin = dataclasses.replace(chosen, lag=True)
+    if chosen.lag or not chosen.has_temperature_model or twin not in scored.eligible \
+            or not 2.0 * problem.short_window_s <= problem.window_s:
+        return chosen, decided_by
+    mine, theirs = _score(scored, chosen), _score(scored, twin)
+    if not (mine.short_fold_drift and theirs.short_fold_drift):
+        return chosen, decided_by
+    gain, se = paired_difference(mine.at_short_window(), theirs.at_short_window())
+    loss, se_long = paired_difference(theirs, mine)
+    # with two folds the standard error rests on one degree of freedom: the lag must then be better on both
+    consistent = len(mine.fold_drift) > TWO_FOLDS or helps_on_every_fold(theirs.at_short_window(),
+                                                                        mine.at_short_window())
+    if np.isfinite(gain) and np.isfinite(se) and gain > se and consistent and not loss > se_long:
+        window = f"{problem.short_window_s:.3g} s"
+        return twin, decided_by + f"; the lag by the {window} window (its drift there {gain:.3g} less, +- {se:.3g})"
+    return chosen, decided_by
+
+
+def _score(scored: AxisScores, candidate: Candidate) -> CandidateScore:
+    return next(s for s in scored.scores if s.candidate == candidate)
+
+
+def _choose_on_two_folds(problem: SelectionProblem, offered: list[CandidateScore], complexity,
+                         constant: CandidateScore) -> tuple[Candidate, Candidate, str, OrderTest]:
+    """(best, chosen, the rule that decided, the order test) where one heating and one cooling leg are the only
+    folds.
+
+    Two held-out numbers per candidate, one of them partly beyond its training range, say whether the axis follows
+    its temperature at all, and little about how: the simplest candidate within their standard error is often too
+    simple (on the real one-cycle log tofupilot, poly:2 on an axis a cubic fits to 0.04 deg/s; 0.09 chosen).
+    So the two kinds of evidence each answer the question they can:
+
+    - *whether*: some temperature model must leave less drift than the constant on both held-out legs (a drift
+      that follows the temperature on one leg by chance does not on the other: measured on the real log's gyro_x,
+      whose drift is not repeatable with temperature, no curve did), and the order test on all the data
+      (:func:`gyrocomp.fitting.order_evidence.order_test`) must find a term beyond the drift;
+    - *how*: the simplest candidate within one standard error of the best, among those that do no harm
+      (:func:`gyrocomp.fitting.scores.harms`), its polynomial raised to the order the test supports where that
+      candidate is offered and does no harm either.
+    """
+    finite = [s for s in offered if np.all(np.isfinite(s.fold_drift))]
+    best = min(finite or offered, key=lambda s: s.mean_drift).candidate
+    pool = [s for s in finite if s.candidate.has_temperature_model and not harms(s, constant)]
+    if not pool:
+        return best, constant.candidate, "do no harm: every temperature model leaves more held-out drift than the " \
+            "constant by more than its standard error", order_test(problem.runs, problem.groups, problem.t_ref_degc,
+                                                                   problem.t_scale_degc, 0, 0.0, problem.block_s)
+    _, held_out = choose(pool, complexity)
+    tau = float(np.median(_of(pool, held_out).fold_lag_s)) if held_out.lag else 0.0
+    accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
+    test = order_test(problem.runs, problem.groups, problem.t_ref_degc, problem.t_scale_degc, problem.max_order,
+                      tau, problem.block_s, accel if accel[0].shape[1] else None)
+    if not any(helps_on_every_fold(s, constant) for s in finite if s.candidate.has_temperature_model):
+        return best, constant.candidate, "do no harm: no temperature model leaves less drift than the constant on " \
+            "both held-out legs", test
+    if test.order == 0:
+        return best, constant.candidate, "do no harm: no term of the temperature curve stands out of the drift " \
+            f"(order test, largest Wald {max(test.statistics, default=0.0):.3g} against {test.threshold:.3g})", test
+    rule = "two held-out legs: the simplest within one standard error of the best"
+    if held_out.curve == "poly" and held_out.order < test.order:
+        in_pool = {s.candidate for s in pool}
+        for order in range(test.order, held_out.order, -1):
+            raised = dataclasses.replace(held_out, order=order)
+            if raised in in_pool:
+                statistic = test.statistics[order - 1]
+                return best, raised, (f"two held-out legs, the order raised from {held_out.order} by the order test "
+                                      f"(the u^{order} term stands out of the drift: Wald {statistic:.3g} against "
+                                      f"{test.threshold:.3g})"), test
+    return best, held_out, rule, test
+
+
+def _of(scores: list[CandidateScore], candidate: Candidate) -> CandidateScore:
+    return next(s for s in scores if s.candidate == candidate)
 
 
 def _with_free_lag(c: Candidate) -> tuple[int, bool]:
@@ -158,5 +265,5 @@ def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[C
     return (kept, test) if kept in eligible else (chosen, test)
 
 
-__all__ = ["AxisScores", "choose_axis", "score_axis", "select_axes", "select_axis", "share_fold_lags",
+__all__ = ["AxisScores", "TWO_FOLDS", "choose_axis", "score_axis", "select_axes", "select_axis", "share_fold_lags",
            "unidentified_lags"]

@@ -41,11 +41,18 @@ def fold_standard_error(fold_drift: tuple[float, ...]) -> float:
 @dataclass(frozen=True)
 class CandidateScore:
     """Held-out drift of one candidate on every fold [the axis's unit: deg/s for a gyro axis, g for an
-    accelerometer axis], and what each fold's fit chose for the lag [s]."""
+    accelerometer axis], and what each fold's fit chose for the lag [s]; ``short_fold_drift`` the same drift
+    at the short window (:attr:`gyrocomp.fitting.selection.SelectionProblem.short_window_s`, empty where not
+    computed)."""
 
     candidate: Candidate
     fold_drift: tuple[float, ...]
     fold_lag_s: tuple[float, ...]
+    short_fold_drift: tuple[float, ...] = ()
+
+    def at_short_window(self) -> "CandidateScore":
+        """The same candidate scored by its drift at the short window."""
+        return CandidateScore(self.candidate, self.short_fold_drift, self.fold_lag_s)
 
     @property
     def mean_drift(self) -> float:
@@ -60,7 +67,8 @@ class CandidateScore:
         u = unit_suffix(unit)
         return {**self.candidate.to_dict(), f"mean_drift{u}": json_number(self.mean_drift),
                 f"standard_error{u}": json_number(self.standard_error),
-                f"fold_drift{u}": [json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s)}
+                f"fold_drift{u}": [json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s),
+                f"short_fold_drift{u}": [json_number(v) for v in self.short_fold_drift]}
 
 
 def paired_difference(worse: CandidateScore, better: CandidateScore) -> tuple[float, float]:
@@ -93,6 +101,22 @@ def beats_constant(score: CandidateScore, constant: CandidateScore) -> bool:
     if len(score.fold_drift) == 2:
         return bool(np.all(np.asarray(score.fold_drift) <= TWO_FOLD_RATIO * np.asarray(constant.fold_drift)))
     return bool(gain > se)
+
+
+def harms(score: CandidateScore, constant: CandidateScore) -> bool:
+    """Whether ``score``'s candidate leaves more held-out drift than the run constant alone by more than the standard
+    error of the paired difference over the folds (by anything, with one fold; not where the folds could not be
+    scored): the last check of every choice, whatever rule or test made it."""
+    loss, se = paired_difference(score, constant)
+    if not np.isfinite(loss):
+        return False
+    return bool(loss > (se if np.isfinite(se) else 0.0))
+
+
+def helps_on_every_fold(score: CandidateScore, constant: CandidateScore) -> bool:
+    """Whether ``score``'s candidate leaves less held-out drift than the run constant alone on every fold."""
+    mine, theirs = np.asarray(score.fold_drift), np.asarray(constant.fold_drift)
+    return bool(np.all(np.isfinite(mine)) and np.all(mine < theirs))
 
 
 def choose(scores: list[CandidateScore], complexity, constant: CandidateScore | None = None
@@ -136,4 +160,4 @@ def _other_families_that_earn_it(finite: list[CandidateScore]) -> list[Candidate
 
 
 __all__ = ["CandidateScore", "TWO_FOLD_RATIO", "beats_constant", "choose", "fold_mean", "fold_standard_error",
-           "json_number", "paired_difference"]
+           "harms", "helps_on_every_fold", "json_number", "paired_difference"]

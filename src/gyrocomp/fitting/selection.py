@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
-from ..calibration.fit_report import BranchTest, Candidate, Weighting
+from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..measures.merit import moving_average
 from ..recording.prepared import PreparedRun, RunBlocks
 from ..units import AxisUnit, in_unit, unit_suffix
@@ -56,7 +56,7 @@ from .branch_evidence import band_offer, branches_identified, branches_present, 
 from ..curves.hysteresis import turn_threshold_degc
 from ..curves.polynomial import power_columns
 from ..curves.protocol import BASES
-from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, lag_search_top_s
+from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, SCORE_WINDOW_S, lag_search_top_s
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 #: crossover widths of the branch candidates [degC] (each fold takes the one of least training residual)
@@ -118,6 +118,10 @@ class AxisSelection:
     #: where ``lag_from_unit``, the choice this axis made on its own (the final fit falls back to it where this
     #: axis's own runs do not see the die's lag: ThermalHysteresisModel.lag_evidence_)
     alone: "AxisSelection | None" = field(default=None, repr=False, compare=False)
+    #: the rule that made the final choice, in one line (:func:`gyrocomp.fitting.choice.choose_axis`)
+    decided_by: str = ""
+    #: where two held-out legs are all there is, what all the data say of the polynomial's order
+    order_test: OrderTest | None = None
 
     def score_of(self, candidate: Candidate) -> CandidateScore:
         return next(s for s in self.scores if s.candidate == candidate)
@@ -163,7 +167,9 @@ class AxisSelection:
                 "validated": self.validated,
                 "generalizes": self.generalizes,
                 "branch_test": self.branch_test.to_dict() if self.branch_test is not None else None,
-                "lag_from_unit": self.lag_from_unit, "candidates": [s.to_dict(self.unit) for s in self.scores]}
+                "lag_from_unit": self.lag_from_unit, "decided_by": self.decided_by,
+                "order_test": self.order_test.to_dict() if self.order_test is not None else None,
+                "candidates": [s.to_dict(self.unit) for s in self.scores]}
 
 
 def temperature_step_degc(temperature_degc: np.ndarray) -> float:
@@ -467,22 +473,27 @@ class SelectionProblem:
         return coef, float(matrix[-1, -1] - b @ coef)
 
     def _held_out(self, f: int, c: Candidate, tau_s: float, coef: np.ndarray, lo: float, hi: float,
-                  idx: np.ndarray) -> float:
+                  idx: np.ndarray) -> tuple[float, float]:
+        """The held-out drift of fold ``f`` at the score's window and at the short window [the axis's unit]."""
         if not (math.isfinite(lo) and math.isfinite(hi) and np.all(np.isfinite(coef))):
-            return math.nan  # nothing left to train on without this fold
-        sse = wsum = 0.0
+            return math.nan, math.nan  # nothing left to train on without this fold
+        sums = np.zeros(2)
+        wsum = np.zeros(2)
         prepared = self._prepared(tau_s)
-        for (k, sel), weights in zip(self.fold_members()[f], self._fold_weights()[f]):
+        weights_of = (self._fold_weights(self.window_s)[f], self._fold_weights(self.short_window_s)[f])
+        for j, (k, sel) in enumerate(self.fold_members()[f]):
             temp, cols = prepared[k]
             x = cols[np.ix_(sel, idx)]
             t = temp[sel]
             past = (t < lo) | (t > hi)
             if c.order and np.any(past):  # past the training range the curve goes on as applied (tangent, or held)
                 x[past, : c.order] = self.basis(c.curve).columns(t[past], c.order, lo, hi)
-            s, n = drift_rms(self.runs[k].value[sel] - (x @ coef if idx.size else 0.0), weights)
-            sse += s
-            wsum += n
-        return math.sqrt(sse / wsum) if wsum > 0 else math.nan
+            residual = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
+            for i, weights in enumerate(weights_of):
+                sse, total = drift_rms(residual, weights[j])
+                sums[i] += sse
+                wsum[i] += total
+        return tuple(float(math.sqrt(a / b)) if b > 0 else math.nan for a, b in zip(sums, wsum))
 
     def fold_members(self) -> list[list[tuple[int, np.ndarray]]]:
         """Per fold, (run, indices of its blocks in the fold) for every run with blocks in it."""
@@ -494,14 +505,21 @@ class SelectionProblem:
             self._cache["members"] = members
         return self._cache["members"]
 
-    def _fold_weights(self) -> list[list[DriftWeights]]:
-        """Per fold, the :class:`DriftWeights` (block durations) of each of its runs' blocks, in the order of
-        :meth:`fold_members`."""
-        if "fold weights" not in self._cache:
-            window = max(1, int(round(self.window_s / self.block_s)))
-            self._cache["fold weights"] = [[DriftWeights.of(self.runs[k].samples[sel].astype(float), window)
-                                            for k, sel in members] for members in self.fold_members()]
-        return self._cache["fold weights"]
+    def _fold_weights(self, window_s: float) -> list[list[DriftWeights]]:
+        """Per fold, the :class:`DriftWeights` (block durations, a moving average of ``window_s`` [s]) of each of its
+        runs' blocks, in the order of :meth:`fold_members`."""
+        key = ("fold weights", window_s)
+        if key not in self._cache:
+            window = max(1, int(round(window_s / self.block_s)))
+            self._cache[key] = [[DriftWeights.of(self.runs[k].samples[sel].astype(float), window)
+                                 for k, sel in members] for members in self.fold_members()]
+        return self._cache[key]
+
+    @property
+    def short_window_s(self) -> float:
+        """The short window of the score [s]: :data:`gyrocomp.fitting.thermal.SCORE_WINDOW_S` (the timescale of the
+        thesis's bias offset), at most the score's window and at least a block."""
+        return max(self.block_s, min(SCORE_WINDOW_S, self.window_s))
 
     def score(self, c: Candidate) -> CandidateScore:
         """Held-out drift of ``c`` on every fold: each fold's lag and branch crossover width are those of the
@@ -526,7 +544,7 @@ class SelectionProblem:
             _, tau, coef, lo_f, hi_f, idx = best
             drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f, idx))
             lags.append(tau)
-        return CandidateScore(c, tuple(drifts), tuple(lags))
+        return CandidateScore(c, tuple(d for d, _ in drifts), tuple(lags), tuple(d for _, d in drifts))
 
     def fold_has_both_directions(self) -> np.ndarray:
         """(F,) whether each fold's training data holds both heating and cooling blocks."""

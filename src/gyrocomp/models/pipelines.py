@@ -32,7 +32,7 @@ from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
 from ..curves.network import NETWORK_BLOCK_S, NETWORK_INPUTS
 from ..fitting.network import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
-from ..fitting.choice import select_axes, share_fold_lags
+from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
 from ..fitting.selection import AxisSelection, prepare_axis
 from ..fitting.polynomial import PolynomialTemperatureModel
 from ..curves.kinds import BASES
@@ -165,9 +165,10 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
             warnings.warn(f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without "
                           "validation", ModelChoiceWarning, stacklevel=3)
         elif not sel.generalizes:
-            warnings.warn(f"{axis}: no temperature model beats the run constant on held-out {across} by more than "
-                          f"its standard error (best: {sel.best.label}); left with its constant only",
-                          ModelChoiceWarning, stacklevel=3)
+            warnings.warn(f"{axis}: left with its constant only; {sel.decided_by or 'do no harm'} "
+                          f"(best: {sel.best.label})", ModelChoiceWarning, stacklevel=3)
+        elif len(sel.folds) == TWO_FOLDS:  # thin evidence: which rule chose, in one line
+            warnings.warn(f"{axis}: {sel.chosen.label}; {sel.decided_by}", ModelChoiceWarning, stacklevel=3)
         elif sel.chosen_drift > sel.raw_drift:
             warnings.warn(f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift:.3g} {unit} of "
                           f"held-out drift, more than the raw output's {sel.raw_drift:.3g} {unit}",
