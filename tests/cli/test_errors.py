@@ -145,7 +145,7 @@ def test_library_messages_are_shown_with_the_flags_that_set_their_parameters(mes
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
-def test_special_outputs_are_refused_and_links_written_through(workdir, tmp_path):
+def test_special_outputs_are_refused(workdir, tmp_path):
     fifo = tmp_path / "pipe.csv"
     os.mkfifo(fifo)
     r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", fifo)
@@ -155,12 +155,45 @@ def test_special_outputs_are_refused_and_links_written_through(workdir, tmp_path
     r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", "-")
     assert r.returncode == 2 and "-: gyrocomp writes its outputs to files, not to standard output" in r.stderr
     assert not Path("-").exists()
-    # a symbolic link is written through: the link stays, its target gets the output
-    (tmp_path / "real.csv").write_text("old\n")
-    (tmp_path / "link.csv").symlink_to(tmp_path / "real.csv")
-    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "link.csv")
-    assert r.returncode == 0, r.stderr
-    assert (tmp_path / "link.csv").is_symlink() and (tmp_path / "real.csv").read_text().startswith("time,gyro_x,")
+
+
+def _planted(folder: Path, name: str, victim: Path) -> Path:
+    """A link named ``name`` in ``folder`` (world-writable and sticky, as /tmp) to ``victim``, as another user
+    could plant it where a command's output will go."""
+    folder.mkdir(exist_ok=True)
+    folder.chmod(0o1777)
+    link = folder / name
+    link.symlink_to(victim)
+    return link
+
+
+def test_no_output_is_written_through_a_planted_link(workdir, tmp_path):
+    """Security: an output path that is a symbolic link is refused in one line (exit 2), for every kind of output
+    (a table, a model file, a learner state, firmware files, a fleet store); the file the link points at is left
+    byte for byte, and so is the link (before: the atomic writer resolved the link and replaced its target, so
+    root writing into a sticky folder replaced whatever file another user's link named)."""
+    victim = tmp_path / "victim.txt"
+    victim.write_text("not yours\n")
+    shared = tmp_path / "shared"
+    commands = {
+        "out.csv": ("apply", workdir / "model.json", workdir / "run3.csv", "-o"),
+        "model.json": ("fit", workdir / "run1.csv", workdir / "run2.csv", "-o"),
+        "state.json": ("learn", workdir / "run1.csv", "-o", tmp_path / "learned.json", "--save-state"),
+        "thermal.params": ("export", workdir / "model.json", "--format", "px4", "-o"),
+    }
+    for name, command in commands.items():
+        link = _planted(shared, name, victim)
+        r = run(*command, link)
+        assert r.returncode == 2, (name, r.stderr)
+        assert r.stderr.strip() == (f"gyrocomp: error: {link}: is a symbolic link (to {victim}); outputs are never "
+                                    "written through a link, which could replace a file elsewhere: name the file "
+                                    "itself, or remove the link"), name
+        assert victim.read_text() == "not yours\n" and link.is_symlink()
+    store = _planted(shared, "store.sqlite", tmp_path / "elsewhere.sqlite")
+    r = run("fleet", "fit", workdir, "--unit-from", "run{serial}.csv", "-o", tmp_path / "fleet", "--store", store,
+            "--scheduler", "serial")
+    assert r.returncode == 2 and f"{store}: is a symbolic link" in r.stderr and "calibration stores are never" in r.stderr
+    assert not (tmp_path / "elsewhere.sqlite").exists() and len(r.stderr.strip().splitlines()) == 1
 
 
 def test_sigterm_leaves_no_temporary_file(tmp_path):

@@ -23,6 +23,7 @@ from typing import Literal
 
 from ..calibration import Calibration
 from ..errors import InputError, ModelError
+from ..io.atomic import refuse_link
 from ..io.common import require
 from .figures import UnitFigures
 from .limits import Failure
@@ -117,10 +118,15 @@ def store_url(location: str | os.PathLike) -> str:
     text = os.fspath(location)
     if "://" in text:
         return text
-    path = Path(text)
-    if path.suffix.lower() not in _SQLITE_SUFFIXES:
-        path = path / STORE_FILE
+    path = sqlite_file(text)
     return f"sqlite:///{path.resolve()}"
+
+
+def sqlite_file(location: str | os.PathLike) -> Path:
+    """The SQLite file a store location that is not a URL names (the file, or ``calibrations.sqlite`` in the
+    folder), as given: not resolved."""
+    path = Path(location)
+    return path if path.suffix.lower() in _SQLITE_SUFFIXES else path / STORE_FILE
 
 
 #: how long a writer waits for another process's write to the same SQLite store [s]
@@ -152,6 +158,7 @@ class CalibrationStore:
         #: the SQLite file of the store (None for a server database)
         self.file: Path | None = None
         if url.startswith("sqlite:///"):
+            refuse_link(sqlite_file(location), "calibration stores are")
             self.file = file = Path(url[len("sqlite:///"):])
             if not file.exists():
                 if not create:

@@ -17,9 +17,13 @@ from ..errors import InputError
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path in the target's folder; on success it replaces ``path`` in one rename.
 
-    On any exception the temporary file is removed and ``path`` is left as it was. A symbolic link is written
-    through (its target is replaced, the link stays); a FIFO, a device, a socket or a folder is refused, since a
-    rename would replace it with a regular file.
+    On any exception the temporary file is removed and ``path`` is left as it was. A symbolic link is refused
+    (:func:`refuse_link`), never written through: in a folder others can write to (``/tmp``), a link planted where
+    the output will go would otherwise have the output replace whatever file it points at, whoever owns it. A
+    FIFO, a device, a socket or a folder is refused, since a rename would replace it with a regular file. The
+    temporary file is created with ``O_EXCL`` in the output's own folder (:func:`tempfile.mkstemp`), and the
+    rename replaces the directory entry ``path`` itself: a link planted between the check and the rename is
+    replaced, not followed.
     """
     target = _regular_target(path)
     folder = target.parent if str(target.parent) else Path(".")
@@ -89,8 +93,7 @@ def _regular_target(path: str | os.PathLike) -> Path:
     if str(path) == "-":
         raise InputError("-: gyrocomp writes its outputs to files, not to standard output; name a file")
     target = Path(path)
-    if target.is_symlink():
-        target = Path(os.path.realpath(target))
+    refuse_link(target)
     try:
         mode = target.stat().st_mode
     except FileNotFoundError:
@@ -101,6 +104,19 @@ def _regular_target(path: str | os.PathLike) -> Path:
                 else "not a regular file")
         raise InputError(f"{path}: is {kind}; outputs are written to regular files (name a new path)")
     return target
+
+
+def refuse_link(path: str | os.PathLike, what: str = "outputs are") -> None:
+    """Raise :class:`InputError` if ``path`` is a symbolic link: gyrocomp never writes through one (``what``
+    names the kind of file in the message)."""
+    target = Path(path)
+    if target.is_symlink():
+        try:
+            points_to = f" (to {os.readlink(target)})"
+        except OSError:
+            points_to = ""
+        raise InputError(f"{path}: is a symbolic link{points_to}; {what} never written through a link, which could "
+                         "replace a file elsewhere: name the file itself, or remove the link")
 
 
 def _mode_for(target: Path) -> int:
@@ -135,7 +151,9 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
 
 
 def refuse_to_overwrite_inputs(output: str | os.PathLike, inputs: Iterable[str | os.PathLike], option: str = "-o") -> None:
-    """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs``."""
+    """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs``, or a symbolic link
+    (:func:`refuse_link`): the checks a command makes on its output before it does the work."""
+    refuse_link(output)
     out = Path(output)
     for item in inputs:
         src = Path(item)
