@@ -231,7 +231,7 @@ def test_truth_dict_names_every_parameter():
     assert list(d["error_model"]["hysteresis"]["band_degc"]) == [55.0, 80.0]
     assert list(d["profile"]["set_points_degc"]) == [-30.0, 80.0]
     assert set(d["deterministic_error_range_dps"]) == {"temperature", "hysteresis", "acceleration",
-                                                       "scale_misalignment"}
+                                                       "scale_misalignment", "temperature_rate"}
 
 
 def test_parameter_errors():

@@ -52,7 +52,7 @@ def run_profiles(profile: Profile, runs: int) -> list[Profile]:
     points = profile.set_points_degc
     return [dataclasses.replace(profile, set_points_degc=(points[i % len(points)],)) for i in range(runs)]
 #: the parts of the deterministic error, in the order they are listed in the truth
-COMPONENTS = ("temperature", "hysteresis", "acceleration", "scale_misalignment")
+COMPONENTS = ("temperature", "hysteresis", "acceleration", "scale_misalignment", "temperature_rate")
 
 
 @dataclass(frozen=True)
@@ -70,7 +70,7 @@ class Truth:
         The constant bias of this power-on, per axis [deg/s].
     components_dps : dict of arrays (n, k)
         The deterministic error by cause: ``temperature``, ``hysteresis``, ``acceleration``,
-        ``scale_misalignment`` [deg/s].
+        ``scale_misalignment``, ``temperature_rate`` [deg/s].
     noise : NoiseTruth
         The random errors, output rounding included [deg/s].
     true_rate_dps : array (n, k)
@@ -229,9 +229,10 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
         "hysteresis": model.hysteresis_error_dps(structure),
         "acceleration": model.acceleration_error_dps(traj.specific_force_g),
         "scale_misalignment": model.scale_error_dps(traj.angular_rate_dps, structure),
+        "temperature_rate": model.temperature_rate_error_dps(traj.time_s, structure),
     }
     turn_on = rng.standard_normal(k) * model.turn_on_bias_sigma_dps
-    noise = simulate_noise(n, rate_hz, model, rng)
+    noise = simulate_noise(n, rate_hz, model, rng, structure)
     true_rate = traj.angular_rate_dps[:, model.body_index]
     analog = true_rate + sum(components.values()) + turn_on + noise.total_dps
     gyro = quantize(analog, model.quantization_dps)

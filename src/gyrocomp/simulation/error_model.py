@@ -24,6 +24,18 @@ Noise terms follow IEEE Std 952-1997 Annex C. For rate samples taken every dt = 
   processes are drawn on coarser grids (50 steps per correlation time) and interpolated, which
   keeps a 24-hour 100 Hz run to seconds; Allan floor (2 ln 2 / pi)^(1/2) B = 0.664 B;
 - rate random walk K [deg/s/sqrt(s)]: integrated white noise, Allan variance K^2 tau / 3.
+
+What real logs show beyond these (the real one-cycle chamber log of ``tofupilot-imu-thermal``: after a cubic in
+temperature fitted on the whole run, its axes keep 0.05-0.23 deg/s of drift, correlated over 200-500 s, that no
+temperature curve follows), each off by default:
+
+- a non-repeatable drift per power-on: sigma_d h(t) + sigma_c g(t) (T_s - T_ref), h and g independent smooth
+  stationary processes of unit variance (two first-order lags of time constant T_d in cascade, driven by white
+  noise), so that part of the drift follows the temperature, by a relation that differs from run to run and
+  wanders within one;
+- a warm-up transient after power-on: A exp(-t / T_w), A drawn per power-on with standard deviation sigma_w;
+- a bias that depends on the rate of change of the structure temperature: k_i dT_s/dt (a thermal gradient across
+  the die while it heats or cools), deterministic, so that heating and cooling differ by 2 k_i times the ramp rate.
 """
 
 from __future__ import annotations
@@ -197,6 +209,19 @@ class GyroErrorModel:
         Temperature output LSB [degC] (1.0: whole degrees); 0 for none.
     accelerometer : AccelErrorModel, optional
         None for a part without accelerometer (no accel columns are written).
+    run_drift_dps : float
+        Standard deviation of the non-repeatable smooth drift of each power-on, sigma_d [deg/s].
+    run_tempco_sigma_dps_per_degc : float
+        Standard deviation of the non-repeatable temperature coefficient, sigma_c [deg/s/degC]: a relation to the
+        temperature that differs from run to run and wanders within one.
+    run_drift_time_s : float
+        Time constant T_d of both non-repeatable processes [s].
+    warm_up_sigma_dps : float
+        Standard deviation of the amplitude of the warm-up transient after power-on, sigma_w [deg/s].
+    warm_up_time_s : float
+        Its time constant T_w [s].
+    temperature_rate_dps_per_degc_per_min : tuple of float, optional
+        Per axis, the bias per unit rate of change of the structure temperature, k_i [deg/s per degC/min].
     """
 
     axes: tuple[str, ...] = GYRO_AXES
@@ -217,6 +242,12 @@ class GyroErrorModel:
     temperature_noise_degc: float = 0.0
     temperature_quantization_degc: float = 0.0
     accelerometer: AccelErrorModel | None = field(default_factory=AccelErrorModel)
+    run_drift_dps: float = 0.0
+    run_tempco_sigma_dps_per_degc: float = 0.0
+    run_drift_time_s: float = 600.0
+    warm_up_sigma_dps: float = 0.0
+    warm_up_time_s: float = 300.0
+    temperature_rate_dps_per_degc_per_min: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         k = len(self.axes)
@@ -228,9 +259,14 @@ class GyroErrorModel:
             )
         for name in ("turn_on_bias_sigma_dps", "noise_density_dps_per_sqrt_hz", "bias_instability_deg_per_h",
                      "rate_random_walk_dps_per_sqrt_s", "quantization_dps", "temperature_noise_degc",
-                     "temperature_quantization_degc", "thermal_time_constant_s"):
+                     "temperature_quantization_degc", "thermal_time_constant_s", "run_drift_dps",
+                     "run_tempco_sigma_dps_per_degc", "warm_up_sigma_dps"):
             if getattr(self, name) < 0:
                 raise InputError(f"{name}: must not be negative")
+        for name in ("run_drift_time_s", "warm_up_time_s"):
+            if not 0 < getattr(self, name) < math.inf:
+                raise InputError(f"{name}: must be positive and finite, got {getattr(self, name)}")
+        _per_axis("temperature_rate_dps_per_degc_per_min", self.temperature_rate_dps_per_degc_per_min, k)
         _per_axis("g_sensitivity_dps_per_g", self.g_sensitivity_dps_per_g, k, 3)
         _per_axis("g_squared_dps_per_g2", self.g_squared_dps_per_g2, k, 6)
         _per_axis("scale_factor_error_ppm", self.scale_factor_error_ppm, k)
@@ -271,6 +307,15 @@ class GyroErrorModel:
         # the distance from the turning point on the branches that carry the offset (zero elsewhere), then its shape
         d = hysteresis_offset(structure_degc, turns, (1.0,), direction=h.direction, band_degc=h.band_degc)
         return np.column_stack([np.where(d > 0, h.offset_dps(d, c), 0.0) for c in h.coefficients_dps])
+
+    def temperature_rate_error_dps(self, time_s: np.ndarray, structure_degc: np.ndarray) -> np.ndarray:
+        """Bias from the rate of change of the structure temperature (n, k) [deg/s]: k_i dT_s/dt, the rate in
+        degC/min."""
+        n, k = structure_degc.size, len(self.axes)
+        if self.temperature_rate_dps_per_degc_per_min is None or n < 2:
+            return np.zeros((n, k))
+        rate_per_min = np.gradient(structure_degc, time_s) * 60.0
+        return np.outer(rate_per_min, np.asarray(self.temperature_rate_dps_per_degc_per_min, dtype=float))
 
     def acceleration_error_dps(self, specific_force_g: np.ndarray) -> np.ndarray:
         """g and g x g sensitive bias (n, k) [deg/s]."""
@@ -332,7 +377,8 @@ class GyroErrorModel:
 
 #: what ``GyroErrorModel.without`` (and ``gyrocomp simulate --disable``) can switch off
 SWITCHABLE_TERMS = {
-    "temperature": lambda m: {"temperature_coefficients": tuple((0.0,) for _ in m.axes)},
+    "temperature": lambda m: {"temperature_coefficients": tuple((0.0,) for _ in m.axes),
+                              "temperature_rate_dps_per_degc_per_min": None},
     "lag": lambda m: {"thermal_time_constant_s": 0.0},
     "hysteresis": lambda m: {"hysteresis": None},
     "g-sensitivity": lambda m: {"g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None},
@@ -343,26 +389,37 @@ SWITCHABLE_TERMS = {
                         "rate_random_walk_dps_per_sqrt_s": 0.0},
     "quantization": lambda m: {"quantization_dps": 0.0, "temperature_quantization_degc": 0.0},
     "temperature-noise": lambda m: {"temperature_noise_degc": 0.0},
+    "drift": lambda m: {"run_drift_dps": 0.0, "run_tempco_sigma_dps_per_degc": 0.0},
+    "warm-up": lambda m: {"warm_up_sigma_dps": 0.0},
+    "temperature-rate": lambda m: {"temperature_rate_dps_per_degc_per_min": None},
 }
 
 
 @dataclass(frozen=True)
 class NoiseTruth:
-    """The random errors that were added, per axis (n, k) [deg/s]; quantization is the rounding of the output."""
+    """The random errors that were added, per axis (n, k) [deg/s]; quantization is the rounding of the output;
+    ``drift_dps`` the non-repeatable drift and ``warm_up_dps`` the warm-up transient of this power-on (None where
+    the part has none)."""
 
     white_dps: np.ndarray = field(repr=False)
     flicker_dps: np.ndarray = field(repr=False)
     random_walk_dps: np.ndarray = field(repr=False)
     quantization_dps: np.ndarray | None = field(default=None, repr=False)
+    drift_dps: np.ndarray | None = field(default=None, repr=False)
+    warm_up_dps: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def total_dps(self) -> np.ndarray:
         total = self.white_dps + self.flicker_dps + self.random_walk_dps
-        return total if self.quantization_dps is None else total + self.quantization_dps
+        for extra in (self.quantization_dps, self.drift_dps, self.warm_up_dps):
+            if extra is not None:
+                total = total + extra
+        return total
 
     def take(self, index) -> "NoiseTruth":
-        q = None if self.quantization_dps is None else self.quantization_dps[index]
-        return NoiseTruth(self.white_dps[index], self.flicker_dps[index], self.random_walk_dps[index], q)
+        pick = lambda a: None if a is None else a[index]  # noqa: E731
+        return NoiseTruth(self.white_dps[index], self.flicker_dps[index], self.random_walk_dps[index],
+                          pick(self.quantization_dps), pick(self.drift_dps), pick(self.warm_up_dps))
 
 
 def _gauss_markov(m: int, step_s: float, time_constant_s: float, variance: float,
@@ -416,8 +473,35 @@ def flicker_bank(n: int, rate_hz: float, bias_instability_deg_per_h: float, rng:
     return acc[:n]
 
 
-def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random.Generator) -> NoiseTruth:
-    """Draw the random errors of every axis (without quantization, which depends on the output)."""
+def smooth_process(n: int, rate_hz: float, time_constant_s: float, rng: np.random.Generator) -> np.ndarray:
+    """A stationary smooth random process of unit variance [dimensionless], ``n`` samples at ``rate_hz`` [Hz]:
+    white noise through two first-order lags of time constant ``time_constant_s`` [s] in cascade (a critically
+    damped second-order Gauss-Markov process, whose variogram grows as dt^2 well below the time constant and levels
+    off above it), drawn on a grid of :data:`GM_STEPS_PER_TIME_CONSTANT` steps per time constant from a start
+    ten time constants earlier and interpolated.
+
+    With phi = exp(-step / T), the cascade's impulse response is (j + 1) phi^j, whose squares sum to
+    (1 + phi^2) / (1 - phi^2)^3: the drive is scaled by the inverse of its square root."""
+    if n == 0:
+        return np.zeros(0)
+    from scipy.signal import lfilter  # scipy.signal is slow to import; only simulation needs it here
+
+    dt = 1.0 / rate_hz
+    step = min(time_constant_s / GM_STEPS_PER_TIME_CONSTANT, max(dt * (n - 1), dt))
+    step = max(step, dt)
+    burn = int(math.ceil(10 * time_constant_s / step))
+    m = int(math.ceil((n - 1) * dt / step)) + 1
+    phi = math.exp(-step / time_constant_s)
+    drive = rng.standard_normal(burn + m) * math.sqrt((1 - phi ** 2) ** 3 / (1 + phi ** 2))
+    coarse = lfilter([1.0], [1.0, -phi], lfilter([1.0], [1.0, -phi], drive))[burn:]
+    return np.interp(np.arange(n) * dt, np.arange(m) * step, coarse)
+
+
+def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random.Generator,
+                   structure_degc: np.ndarray | None = None) -> NoiseTruth:
+    """Draw the random errors of every axis (without quantization, which depends on the output); the
+    non-repeatable drift's temperature part reads ``structure_degc`` [degC] (the reference temperature where it is
+    not given)."""
     k = len(model.axes)
     white = rng.standard_normal((n, k)) * model.noise_density_dps_per_sqrt_hz * math.sqrt(rate_hz)
     flicker = np.column_stack([flicker_bank(n, rate_hz, model.bias_instability_deg_per_h, rng) for _ in range(k)])
@@ -426,7 +510,17 @@ def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random
         walk = np.cumsum(steps, axis=0)
     else:
         walk = np.zeros((n, k))
-    return NoiseTruth(white, flicker, walk)
+    drift = warm_up = None
+    if model.run_drift_dps > 0 or model.run_tempco_sigma_dps_per_degc > 0:
+        above = np.zeros(n) if structure_degc is None else np.asarray(structure_degc, dtype=float) - model.t_ref_degc
+        drift = np.column_stack([
+            model.run_drift_dps * smooth_process(n, rate_hz, model.run_drift_time_s, rng)
+            + model.run_tempco_sigma_dps_per_degc * smooth_process(n, rate_hz, model.run_drift_time_s, rng) * above
+            for _ in range(k)])
+    if model.warm_up_sigma_dps > 0:
+        amplitude = rng.standard_normal(k) * model.warm_up_sigma_dps
+        warm_up = np.outer(np.exp(-np.arange(n) / rate_hz / model.warm_up_time_s), amplitude)
+    return NoiseTruth(white, flicker, walk, None, drift, warm_up)
 
 
 def structure_temperature(model: GyroErrorModel, time_s: np.ndarray, temperature_degc: np.ndarray,
