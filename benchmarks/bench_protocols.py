@@ -1,10 +1,13 @@
 """Benchmark: accuracy by calibration protocol, the way users calibrate, judged on data the fit has not seen.
 
-For every simulator preset, and three simulated parts that test the model choice (``random walk``: a drift that is
-a slow random walk unrelated to temperature, which no temperature model should follow; ``branches``: heating and
-cooling curves that differ, 0.03 deg/s apart at 25 degC and 0.0008 deg/s/degC more per degree; ``branches, lag``:
-a triad behind a 40 s thermal lag whose z axis has those branches), over ten seeds (each seed a new set of runs,
-noise and turn-on biases):
+For every simulator preset (``drifting`` among them: a consumer-class triad with the non-repeatable drift and
+warm-up of the real one-cycle log, heating and cooling on one curve), and four simulated parts that test the model
+choice (``random walk``: a drift that is a slow random walk unrelated to temperature, which no temperature model
+should follow; ``branches``: heating and cooling curves that differ, 0.03 deg/s apart at 25 degC and
+0.0008 deg/s/degC more per degree; ``branches, lag``: a triad behind a 40 s thermal lag whose z axis has those
+branches; ``drifting, dT/dt``: the drifting preset with a bias of 0.03 deg/s per degC/min of temperature change,
+of opposite sign on z, which no lag shared by the axes follows), over ten seeds (each seed a new set of runs, noise
+and turn-on biases):
 
 - ``one cycle``: one chamber run 40 -> -20 -> 70 -> 30 degC at 2 degC/min (cooled, heated, cooled, as most
   single-cycle procedures), fitted up to its hottest point, judged on the cooling leg after it (the model applied
@@ -15,16 +18,24 @@ noise and turn-on biases):
 
 Each is compensated by the default fit (``fit_channels``), by a plain cubic with one constant per run
 (``gyrocomp.evaluation.validation.fit_plain_cubic``) and perfectly (the simulator's truth: what is left is the sensor's own
-noise). The score is the drift a user judges: the RMS about its mean of the 60 s moving average of the output
-minus the true rate, per axis [deg/s]. The table gives the mean over axes and seeds of default/perfect and
-cubic/perfect, the count of axes the default leaves worse than raw (more than 1 % above raw's drift), and how
-many of those perfect compensation leaves worse than raw too (the temperature effect on that leg happened to
-cancel part of the noise's drift: removing it, even exactly, leaves more).
+noise, and for the drifting parts its non-repeatable drift). The score is the drift a user judges: the RMS about its
+mean of the 60 s moving average of the output minus the true rate, per axis [deg/s]. The table gives the mean over
+axes and seeds of default/perfect and cubic/perfect, the count of axes the default leaves worse than raw (more than
+1 % above raw's drift), and how many of those perfect compensation leaves worse than raw too (the temperature
+effect on that leg happened to cancel part of the noise's drift: removing it, even exactly, leaves more).
 
 Also the thesis's ADXRS450 case (``adxrs450``: two heat-cool runs over -30..85 and -20..80 degC at 20 Hz, judged
-on a third over -25..85 degC), with its hysteresis as the preset has it and as a smooth bump that fades over
-25 degC, and the real CATS recording (fit on two of its runs, judged on the third; shared dataset, skipped when
-absent).
+on a third over -25..85 degC), with its hysteresis as the preset has it, as a smooth bump that fades over 25 degC,
+and behind a 30 s lag instead of 60 s; and the real recordings (shared datasets, skipped when absent):
+
+- the real one-cycle chamber log (``tofupilot-imu-thermal``, by its own protocol: fitted on the rows up to the
+  hottest point, applied to the whole run, the std of each axis over the final cooling leg [deg/s]), raw, a plain
+  cubic, PX4's and ArduPilot's cubics and the default;
+- real still noise with a temperature effect added (every 80-minute window of the shared still recordings:
+  ADIS16405, Galaxy S5, two Stable32 clocks; a cubic of random coefficients along one cycle, heating and cooling on
+  one curve, 0.05 or 0.5 deg/s): how often memory terms were added (there are none to find), and default/perfect;
+- the false positives of the memory terms on 20 seeds of one cycle of the ``drifting`` preset;
+- the CATS recording (fit on two of its runs, judged on the third).
 
 Usage: python benchmarks/bench_protocols.py [--seeds N] [--markdown FILE]
 (``--markdown docs/accuracy.md`` writes the documentation's accuracy page from this run.)
@@ -49,7 +60,7 @@ from gyrocomp.evaluation.validation import fit_plain_cubic
 
 WINDOW_S = 60.0
 RATE_HZ = 2.0
-#: the two parts that test the model choice, with their chamber range [degC]
+#: the parts that test the model choice, with their chamber range [degC]
 TEST_PARTS = {
     "random walk": (GyroErrorModel(axes=("gyro_x",), temperature_coefficients=((0.0,),),
                                    rate_random_walk_dps_per_sqrt_s=2e-3, noise_density_dps_per_sqrt_hz=0.005),
@@ -64,6 +75,8 @@ TEST_PARTS = {
                                      hysteresis=Hysteresis(((0.0, 0.0), (0.0, 0.0), (0.03, 0.0008)), transition_degc=5.0),
                                      noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0,
                                      turn_on_bias_sigma_dps=0.05), (-20.0, 70.0)),
+    "drifting, dT/dt": (dataclasses.replace(preset_model("drifting"),
+                                            temperature_rate_dps_per_degc_per_min=(0.03, 0.03, -0.03)), (-20.0, 70.0)),
 }
 
 
@@ -120,8 +133,8 @@ def summarize(results: list[dict]) -> tuple[float, float, int, int, int]:
             int(d.size))
 
 
-def adxrs450_case(hysteresis: Hysteresis | None):
-    model = preset_model("adxrs450")
+def adxrs450_case(hysteresis: Hysteresis | None, lag_s: float = 60.0):
+    model = dataclasses.replace(preset_model("adxrs450"), thermal_time_constant_s=lag_s)
     if hysteresis is not None:
         model = dataclasses.replace(model, hysteresis=hysteresis)
     fit = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=20.0, seed=s).recording
@@ -135,13 +148,63 @@ def adxrs450_case(hysteresis: Hysteresis | None):
     return ratio, cal.axes["gyro_z"].lag_time_constant_s, cal.model
 
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from tests.real import real_data  # noqa: E402  (the shared recordings, read as the tests read them)
+
+
 def cats_case():
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from tests.real.real_data import CATS, CATS_CHOICES, cats_held_out_drift, cats_numpy_cubic_drift
-    if not CATS.is_dir():
+    if not real_data.CATS.is_dir():
         return None
-    default = cats_held_out_drift({"default": CATS_CHOICES["default (auto)"]})["default"]
-    return float(default.mean() / cats_numpy_cubic_drift().mean())
+    default = real_data.cats_held_out_drift({"default": real_data.CATS_CHOICES["default (auto)"]})["default"]
+    return float(default.mean() / real_data.cats_numpy_cubic_drift().mean())
+
+
+def real_one_cycle_lines() -> list[str]:
+    """The real one-cycle log's table (Markdown lines), or a line saying the dataset is absent."""
+    if not real_data.TOFUPILOT.is_dir():
+        return ["Real one-cycle log (tofupilot-imu-thermal): dataset absent"]
+    result = real_data.tofupilot_one_cycle()
+    cubic, raw = result["plain cubic"].mean(), result["raw"]
+    lines = ["| real one-cycle log (tofupilot) | x | y | z | mean | mean / plain cubic | worst axis / raw |",
+             "|---|---|---|---|---|---|---|"]
+    for name, std in result.items():
+        lines.append(f"| {name} | " + " | ".join(f"{v:.3f}" for v in std)
+                     + f" | {std.mean():.3f} | {std.mean() / cubic:.2f} | {np.max(std / raw):.2f} |")
+    return lines
+
+
+def real_still_lines() -> list[str]:
+    """Real still noise with one temperature curve added (Markdown lines), or a line saying a dataset is absent."""
+    if not all(p.is_dir() for p in (real_data.ADIS, real_data.GALAXY, real_data.DATASETS / "allantools-stable32")):
+        return ["Real still noise with a temperature effect: datasets absent"]
+    trials = real_data.still_one_cycle_trials()
+    lines = ["| real still noise + one temperature curve, one cycle | windows | memory terms added | lag taken "
+             "| default / perfect | plain cubic / perfect | axes worse than raw |", "|---|---|---|---|---|---|---|"]
+    for amplitude in sorted({t["amplitude_dps"] for t in trials}):
+        group = [t for t in trials if t["amplitude_dps"] == amplitude]
+        memory = sum(bool(t["chosen"].branch or t["chosen"].hysteresis_order) for t in group)
+        ratio = lambda key: np.mean([t[key] / t["perfect"] for t in group])  # noqa: E731
+        worse = sum(t["default"] > 1.01 * t["raw"] for t in group)
+        lines.append(f"| effect {amplitude:g} deg/s | {len(group)} | {memory} | {sum(t['chosen'].lag for t in group)} "
+                     f"| {ratio('default'):.2f} | {ratio('cubic'):.2f} | {worse} |")
+    return lines
+
+
+def drifting_false_positives(seeds: int = 20) -> tuple[int, int]:
+    """(axes given branch or turning-point terms, axes) over ``seeds`` one-cycle runs of the drifting preset."""
+    added = total = 0
+    model = preset_model("drifting")
+    for seed in range(seeds):
+        prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
+                           dwell_s=300.0)
+        rec = simulate(model, profile=prof, rate_hz=RATE_HZ, seed=seed).recording
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            cal = fit_channels([rec.take(np.arange(int(np.argmax(rec.temperature_degc))))])
+        for sel in cal.report.selection.values():
+            added += bool(sel.chosen.branch or sel.chosen.hysteresis_order)
+            total += 1
+    return added, total
 
 
 def main() -> None:
@@ -167,13 +230,21 @@ def main() -> None:
             print(lines[-1], flush=True)
     if args.only:
         return
-    lines += ["", "| case | default / perfect | lag [s] (truth 60) | model |", "|---|---|---|---|"]
-    for label, hyst in (("adxrs450, the preset's hysteresis", None),
-                        ("adxrs450, a bump fading over 25 degC", Hysteresis(((0.2,),), direction="descending",
-                                                                             fade_degc=25.0))):
-        ratio, lag, model_name = adxrs450_case(hyst)
-        lines.append(f"| {label} | {ratio:.2f} | {lag:.1f} | {model_name} |")
+    lines += ["", "| case | default / perfect | lag [s] | true lag [s] | model |", "|---|---|---|---|---|"]
+    bump = Hysteresis(((0.2,),), direction="descending", fade_degc=25.0)
+    for label, hyst, lag_s in (("adxrs450, the preset's hysteresis", None, 60.0),
+                               ("adxrs450, a bump fading over 25 degC", bump, 60.0),
+                               ("adxrs450, the preset's hysteresis behind a 30 s lag", None, 30.0)):
+        ratio, lag, model_name = adxrs450_case(hyst, lag_s)
+        lines.append(f"| {label} | {ratio:.2f} | {lag:.1f} | {lag_s:g} | {model_name} |")
         print(lines[-1], flush=True)
+    for block in (real_one_cycle_lines(), real_still_lines()):
+        lines += ["", *block]
+        print("\n".join(block), flush=True)
+    added, total = drifting_false_positives()
+    lines += ["", f"Memory terms on the drifting preset (one curve heating and cooling), one cycle, 20 seeds: "
+                  f"{added} of {total} axes"]
+    print(lines[-1], flush=True)
     cats = cats_case()
     lines += ["", "CATS (real, fit on two runs, judged on the third): default / plain cubic = "
               + ("dataset absent" if cats is None else f"{cats:.3f}")]

@@ -26,6 +26,13 @@ def test_fit_prints_table_and_writes_model(workdir):
         assert len(sel["folds"]) == 2 and all(len(c["fold_drift_dps"]) == 2 for c in sel["candidates"])
         assert sel["chosen_drift_dps"] <= sel["raw_drift_dps"]
         assert sel["chosen_standard_error_dps"] >= 0 and sel["fold_note"] == ""
+        # two folds are thin: the order test on all the data was asked, and which rule decided is said, in the
+        # table and in one line per axis
+        assert sel["order_test"]["threshold"] == pytest.approx(9.0) and len(sel["order_test"]["statistics"]) == 5
+        assert sel["decided_by"]
+        assert re.search(rf"{axis}: (left with its constant only; do no harm|{re.escape(sel['chosen']['label'])}; )",
+                         r.stderr)
+    assert "decided by" in r.stdout
 
 
 def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):

@@ -106,6 +106,20 @@ def test_a_random_walk_unrelated_to_temperature_is_left_alone(seed):
                for m in messages)
 
 
+@pytest.mark.slow
+def test_no_memory_terms_for_a_drifting_part_whose_heating_and_cooling_curves_are_one():
+    """Done-when of the real-logs issue: 20 seeds of one-cycle runs of the ``drifting`` preset (flicker, the
+    non-repeatable drift and warm-up of the real one-cycle log, at its levels; heating and cooling follow one
+    curve): branch or turning-point terms on at most 5 % of the axes. Measured: 0 of 60 (on main before: 11 of 60,
+    the branch test's drift estimated from the residual of a model whose branch terms had absorbed it)."""
+    added = []
+    for seed in range(20):
+        _, _, cal, _ = _fit_one_cycle(preset_model("drifting"), seed)
+        added += [(seed, axis, s.chosen.label) for axis, s in cal.report.selection.items()
+                  if s.chosen.branch or s.chosen.hysteresis_order]
+    assert len(added) <= 3, added
+
+
 def test_one_cycle_finds_heating_and_cooling_curves_that_differ(tmp_path):
     """Done-when (b): heating and cooling curves apart by far more than five times the noise's 60 s drift; one
     heating and one cooling leg cannot test a branch model on held-out legs, so a test against the drift decides:

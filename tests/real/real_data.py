@@ -97,6 +97,140 @@ def cats_numpy_cubic_drift() -> np.ndarray:
     return out
 
 
+TOFUPILOT = DATASETS / "tofupilot-imu-thermal"
+
+
+def tofupilot_run():
+    """The real one-cycle chamber log (51.6 -> -17.6 -> 74.0 -> 36.3 degC, 2 Hz), read as a user reads it: the
+    tab-separated file through :func:`gyrocomp.read` with its columns and units named [s, deg/s, g, degC]."""
+    from gyrocomp import read
+    from gyrocomp.io import TableLayout
+
+    columns = {"time": "timestamp", "temperature": "imu.temperature",
+               **{f"gyro_{a}": f"imu.gyro.{a}" for a in AXES}, **{f"accel_{a}": f"imu.acc.{a}" for a in AXES}}
+    return read(TOFUPILOT / "imu_raw_data.tsv",
+                TableLayout(columns=columns, gyro_unit="rad/s", accel_unit="m/s2", time_unit="us"))
+
+
+#: the methods of the one-cycle protocol: name -> a function of the fit rows giving a Calibration (None: raw)
+def one_cycle_methods() -> dict:
+    from gyrocomp import fit
+    from gyrocomp.evaluation.comparison import fit_ardupilot_style, fit_px4_style
+    from gyrocomp.evaluation.validation import fit_plain_cubic
+
+    return {"raw": None, "plain cubic": lambda r: fit_plain_cubic([r]), "PX4 cubic": lambda r: fit_px4_style([r]),
+            "ArduPilot cubic": lambda r: fit_ardupilot_style([r]), "gyrocomp default": lambda r: fit([r])}
+
+
+def tofupilot_one_cycle(methods: dict | None = None) -> dict[str, np.ndarray]:
+    """Method -> (3,) standard deviation of each compensated axis over the final cooling leg [deg/s], by the
+    dataset's protocol: fitted on the rows up to the hottest point (one cooling and one heating leg), applied to
+    the whole run (a memory model sees the turn), judged on the rows after it."""
+    import warnings
+
+    from gyrocomp import apply
+
+    run = tofupilot_run()
+    hot = int(np.argmax(run.temperature_degc))
+    train = run.take(np.arange(hot + 1))
+    out = {}
+    for name, method in (methods or one_cycle_methods()).items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            gyro = run.gyro_dps if method is None else apply(method(train), run).gyro_dps
+        out[name] = gyro[hot + 1:].std(axis=0)
+    return out
+
+
+#: the shared still recordings a branch-free temperature effect is added to (name -> (series at 2 Hz [deg/s]))
+STILL_RATE_HZ = 2.0
+
+
+def still_series() -> dict[str, np.ndarray]:
+    """Real still recordings brought to 2 Hz by block means [deg/s]: each axis of the six ADIS16405 sessions
+    (100 Hz), of the Galaxy S5 (10 Hz), and two clocks of the Stable32 references (an OCXO and a caesium clock,
+    their fractional frequency scaled to a 60 s drift of 0.01 deg/s: a noise shape, not a gyro)."""
+    import gzip
+
+    def means(x, factor):
+        n = x.shape[0] // factor * factor
+        return x[:n].reshape((n // factor, factor) + x.shape[1:]).mean(axis=1)
+
+    out = {}
+    for name, gyro in adis_sessions().items():
+        for j, axis in enumerate(AXES):
+            out[f"ADIS16405 {name} {axis}"] = means(gyro, 50)[:, j]
+    galaxy = means(galaxy_gyro_dps(), 5)
+    for j, axis in enumerate(AXES):
+        out[f"Galaxy S5 {axis}"] = galaxy[:, j]
+    stable32 = DATASETS / "allantools-stable32"
+    ocxo = (np.loadtxt(stable32 / "ocxo" / "ocxo_frequency.txt") - 1e7) / 1e7
+    with gzip.open(stable32 / "Cs5071A" / "5071A_phase.txt.gz", "rt") as fh:
+        caesium = np.diff(np.loadtxt(fh))[: 6 * 9600]
+    for name, y in (("OCXO (Stable32)", ocxo), ("Cs 5071A (Stable32)", caesium)):
+        smooth = np.convolve(y - y.mean(), np.ones(120) / 120, mode="valid")
+        out[name] = 0.01 * y / np.std(smooth)
+    return out
+
+
+def one_cycle_profile_degc(n: int) -> np.ndarray:
+    """A one-cycle chamber profile of ``n`` samples, 40 -> -20 -> 70 -> 30 degC at one ramp rate [degC]."""
+    points = np.array([40.0, -20.0, 70.0, 30.0])
+    legs = np.abs(np.diff(points))
+    return np.interp(np.linspace(0.0, 1.0, n), np.concatenate([[0.0], np.cumsum(legs) / legs.sum()]), points)
+
+
+def still_with_temperature_effect(noise: np.ndarray, amplitude_dps: float, rng: np.random.Generator):
+    """A real still series [deg/s] with a branch-free temperature effect added along
+    :func:`one_cycle_profile_degc`: a cubic in (T - 25) / 45 with random coefficients scaled so that their
+    absolute values sum to ``amplitude_dps`` [deg/s]; heating and cooling follow the one curve. Returns the
+    recording fitted on (up to the hottest point) and the whole one."""
+    from gyrocomp.recording import Recording
+
+    temperature = one_cycle_profile_degc(noise.size)
+    u = (temperature - 25.0) / 45.0
+    c = rng.normal(size=3)
+    effect = amplitude_dps * (c[0] * u + c[1] * u ** 2 + c[2] * u ** 3) / np.abs(c).sum()
+    run = Recording(time_s=np.arange(noise.size) / STILL_RATE_HZ, gyro_dps=(noise - noise.mean() + effect)[:, None],
+                    gyro_axes=("gyro_x",), temperature_degc=temperature, source="still + temperature effect")
+    return run.take(np.arange(int(np.argmax(temperature)))), run
+
+
+def still_one_cycle_trials(amplitudes_dps=(0.05, 0.5), minutes: float = 80.0, seed: int = 0) -> list[dict]:
+    """Every 80-minute window of every :func:`still_series` with each amplitude of temperature effect added
+    (:func:`still_with_temperature_effect`), fitted by the default call on the rows up to the hottest point and
+    applied to the whole run. Per trial: ``name``, ``amplitude_dps``, ``chosen`` (the default's candidate), and
+    the drift on the cooling leg after the hottest point [deg/s] (RMS about its mean of the 60 s moving average)
+    of ``default``, ``cubic`` (:func:`gyrocomp.evaluation.validation.fit_plain_cubic`), ``perfect`` (the
+    recording's own noise) and ``raw``."""
+    import warnings
+
+    from gyrocomp import apply, fit
+    from gyrocomp.evaluation.validation import fit_plain_cubic
+    from gyrocomp.measures.merit import smoothed_residual_rms
+
+    rng = np.random.default_rng(seed)
+    window = int(minutes * 60 * STILL_RATE_HZ)
+    smooth = int(60 * STILL_RATE_HZ)
+    out = []
+    for name, series in still_series().items():
+        for start in range(0, series.size - window + 1, window):
+            noise = series[start:start + window]
+            for amplitude in amplitudes_dps:
+                train, run = still_with_temperature_effect(noise, amplitude, rng)
+                hot = train.n_samples
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    default, cubic = fit([train]), fit_plain_cubic([train])
+                    drift = {label: smoothed_residual_rms(apply(cal, run).gyro_dps[hot:, 0], smooth)
+                             for label, cal in (("default", default), ("cubic", cubic))}
+                out.append({"name": name, "amplitude_dps": amplitude,
+                            "chosen": default.report.selection["gyro_x"].chosen, **drift,
+                            "perfect": smoothed_residual_rms(noise[hot:], smooth),
+                            "raw": smoothed_residual_rms(run.gyro_dps[hot:, 0], smooth)})
+    return out
+
+
 XSENS = DATASETS / "imu_tk-xsens"
 FERRARIS = DATASETS / "imucal-ferraris"
 MPU = DATASETS / "tomisuarez2-mpu6050"

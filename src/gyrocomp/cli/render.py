@@ -186,13 +186,17 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
     first = next(iter(selection.values()))
     table = Table(title=f"model choice by held-out drift ({first.fold_kind}: {len(first.folds)} folds, "
                         f"{first.window_s:g} s moving average, simplest within one standard error) [{unit}]")
-    for col in ("axis", "chosen", "held-out drift", "best", "best drift", "constant only"):
-        table.add_column(col, justify="left" if col in ("axis", "chosen", "best") else "right")
+    decided = any(sel.decided_by for sel in selection.values())  # files written before it was stored have none
+    columns = ("axis", "chosen", "held-out drift", "best", "best drift", "constant only") + (
+        ("decided by",) if decided else ())
+    for col in columns:
+        table.add_column(col, justify="left" if col in ("axis", "chosen", "best", "decided by") else "right")
     for axis, sel in selection.items():
         chosen, best = sel.result(sel.chosen.label), sel.result(sel.best.label)
         table.add_row(axis, sel.chosen.label + (" (the die's lag)" if sel.lag_from_unit else ""),
                       with_error(chosen.mean_drift, chosen.standard_error),
-                      sel.best.label, _score(best.mean_drift), _score(sel.raw_drift))
+                      sel.best.label, _score(best.mean_drift), _score(sel.raw_drift),
+                      *((sel.decided_by,) if decided else ()))
     console.print(table)
     # one row per fold, one column per axis and model: as narrow for twelve legs as for three runs
     folds = Table(title=f"held-out drift per fold [{unit}]: each axis's chosen model, the best, the constant")
