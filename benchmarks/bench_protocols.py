@@ -37,6 +37,11 @@ and behind a 30 s lag instead of 60 s; and the real recordings (shared datasets,
 - the false positives of the memory terms on 20 seeds of one cycle of the ``drifting`` preset;
 - the CATS recording (fit on two of its runs, judged on the third).
 
+Where the default loses: ``mti10`` on one cycle (a part whose drift over the range is about its noise, so a cubic
+with no choice to make does as well), and ``drifting, dT/dt`` on one cycle (1.6x perfect, a cubic 1.4x: a bias from
+the rate of temperature change of opposite signs across the axes is followed neither by the die's one lag nor by
+branch terms, which change sign at a hold too late; gyrocomp has no temperature-rate term yet).
+
 Usage: python benchmarks/bench_protocols.py [--seeds N] [--markdown FILE]
 (``--markdown docs/accuracy.md`` writes the documentation's accuracy page from this run.)
 """

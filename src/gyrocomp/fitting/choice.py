@@ -109,8 +109,9 @@ def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_
         best, chosen, decided_by, evidence = _choose_on_two_folds(problem, offered, complexity, constant)
     else:
         best, chosen = choose(offered, complexity, constant if do_no_harm else None)
-        decided_by = ("held-out drift: the simplest within one standard error of the best" if do_no_harm
-                      else "held-out drift among the candidates asked for")
+        decided_by = (f"held-out drift ({problem.window_s:.3g} s window): the simplest within one standard error "
+                      "of the best" if do_no_harm else
+                      f"held-out drift ({problem.window_s:.3g} s window) among the candidates asked for")
         if do_no_harm and not chosen.has_temperature_model and best.has_temperature_model:
             decided_by = "do no harm: no temperature model beats the constant on the held-out folds"
     chosen, decided_by = _lag_at_the_short_window(problem, scored, chosen, decided_by)
@@ -198,14 +199,15 @@ def _choose_on_two_folds(problem: SelectionProblem, offered: list[CandidateScore
     if test.order == 0:
         return best, constant.candidate, "do no harm: no term of the temperature curve stands out of the drift " \
             f"(order test, largest Wald {max(test.statistics, default=0.0):.3g} against {test.threshold:.3g})", test
-    rule = "two held-out legs: the simplest within one standard error of the best"
+    rule = f"two held-out legs ({problem.window_s:.3g} s window): the simplest within one standard error of the best"
     if held_out.curve == "poly" and held_out.order < test.order:
         in_pool = {s.candidate for s in pool}
         for order in range(test.order, held_out.order, -1):
             raised = dataclasses.replace(held_out, order=order)
             if raised in in_pool:
                 statistic = test.statistics[order - 1]
-                return best, raised, (f"two held-out legs, the order raised from {held_out.order} by the order test "
+                return best, raised, (f"two held-out legs ({problem.window_s:.3g} s window), the order raised from "
+                                      f"{held_out.order} by the order test "
                                       f"(the u^{order} term stands out of the drift: Wald {statistic:.3g} against "
                                       f"{test.threshold:.3g})"), test
     return best, held_out, rule, test

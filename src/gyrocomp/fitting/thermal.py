@@ -55,6 +55,11 @@ LAG_MAX_S = 4 * 3600.0
 #: more than this chi-square (about two standard errors of one parameter, as in plausible_middle) does not see it
 LAG_EVIDENCE_CHI2 = 4.0
 DEFAULT_BLOCK_S = 2.0
+#: with this many runs or fewer, a band's edges and the lag are refined together (_Problem.refine_band_with_lag):
+#: the runs' few turns are all that tell the lag from the band's edge. With more, the lag is held by runs of other
+#: ramps and the band refined at it (jointly on three runs the ADXRS450 preset's lag came out 72-78 s for a truth
+#: of 60, against 48-60 s; the next run's drift 2.03x perfect against 1.97x over ten seeds)
+JOINT_BAND_MAX_RUNS = 2
 #: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
 #: score measures drift (what compensation is for) rather than white noise, which no model removes
 SCORE_WINDOW_S = 60.0
@@ -620,7 +625,7 @@ class ThermalHysteresisModel(LearnedAttributes):
         if self.refine_band and problem.band is not None and spec.hysteresis_order:
             temps = np.concatenate([r.temperature_degc for r in problem.runs])
             step = max(1.0, float(np.ptp(temps)) / 40.0)
-            if spec.lag and tau_s is None:
+            if spec.lag and tau_s is None and n_runs <= JOINT_BAND_MAX_RUNS:
                 problem.refine_band_with_lag(spec, step)
             else:
                 problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0], step)
