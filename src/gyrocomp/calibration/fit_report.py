@@ -129,23 +129,20 @@ def _entry_in_unit(d: dict, name: str, unit: str, default=None):
 class CandidateResult:
     """A candidate's held-out drift: mean and standard error over the folds, and each fold's [the axis's unit:
     deg/s, or g for an accelerometer axis], and the lag each fold's fit chose [s]; None where a fold held too
-    little data. ``short_fold_drift``: each fold's drift at the short window (empty in files written before it was
-    stored)."""
+    little data."""
 
     candidate: Candidate
     mean_drift: float | None
     standard_error: float | None
     fold_drift: tuple[float | None, ...]
     fold_lag_s: tuple[float, ...]
-    short_fold_drift: tuple[float | None, ...] = ()
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "CandidateResult":
         return cls(Candidate.from_dict(d), _number(_entry_in_unit(d, "mean_drift", unit)),
                    _number(_entry_in_unit(d, "standard_error", unit)),
                    tuple(_number(v) for v in _entry_in_unit(d, "fold_drift", unit, ())),
-                   tuple(float(v) for v in d.get("fold_lag_s", ())),
-                   tuple(_number(v) for v in _entry_in_unit(d, "short_fold_drift", unit, ())))
+                   tuple(float(v) for v in d.get("fold_lag_s", ())))
 
 
 @dataclass(frozen=True)

@@ -145,9 +145,7 @@ def _lag_at_the_short_window(problem: SelectionProblem, scored: AxisScores, chos
     if chosen.lag or not chosen.has_temperature_model or twin not in scored.eligible \
             or not 2.0 * problem.short_window_s <= problem.window_s:
         return chosen, decided_by
-    mine, theirs = _score(scored, chosen), _score(scored, twin)
-    if not (mine.short_fold_drift and theirs.short_fold_drift):
-        return chosen, decided_by
+    mine, theirs = problem.score(chosen, short_window=True), problem.score(twin, short_window=True)
     gain, se = paired_difference(mine.at_short_window(), theirs.at_short_window())
     loss, se_long = paired_difference(theirs, mine)
     # with two folds the standard error rests on one degree of freedom: the lag must then be better on both

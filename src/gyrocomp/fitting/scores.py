@@ -42,8 +42,8 @@ def fold_standard_error(fold_drift: tuple[float, ...]) -> float:
 class CandidateScore:
     """Held-out drift of one candidate on every fold [the axis's unit: deg/s for a gyro axis, g for an
     accelerometer axis], and what each fold's fit chose for the lag [s]; ``short_fold_drift`` the same drift
-    at the short window (:attr:`gyrocomp.fitting.selection.SelectionProblem.short_window_s`, empty where not
-    computed)."""
+    at the short window (:attr:`gyrocomp.fitting.selection.SelectionProblem.short_window_s`), where it was asked
+    for (``SelectionProblem.score(..., short_window=True)``; empty elsewhere, and not stored in the model file)."""
 
     candidate: Candidate
     fold_drift: tuple[float, ...]
@@ -67,8 +67,7 @@ class CandidateScore:
         u = unit_suffix(unit)
         return {**self.candidate.to_dict(), f"mean_drift{u}": json_number(self.mean_drift),
                 f"standard_error{u}": json_number(self.standard_error),
-                f"fold_drift{u}": [json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s),
-                f"short_fold_drift{u}": [json_number(v) for v in self.short_fold_drift]}
+                f"fold_drift{u}": [json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s)}
 
 
 def paired_difference(worse: CandidateScore, better: CandidateScore) -> tuple[float, float]:

@@ -473,14 +473,14 @@ class SelectionProblem:
         return coef, float(matrix[-1, -1] - b @ coef)
 
     def _held_out(self, f: int, c: Candidate, tau_s: float, coef: np.ndarray, lo: float, hi: float,
-                  idx: np.ndarray) -> tuple[float, float]:
-        """The held-out drift of fold ``f`` at the score's window and at the short window [the axis's unit]."""
+                  idx: np.ndarray, windows_s: tuple[float, ...]) -> tuple[float, ...]:
+        """The held-out drift of fold ``f`` at each of ``windows_s`` [s] [the axis's unit]."""
         if not (math.isfinite(lo) and math.isfinite(hi) and np.all(np.isfinite(coef))):
-            return math.nan, math.nan  # nothing left to train on without this fold
-        sums = np.zeros(2)
-        wsum = np.zeros(2)
+            return (math.nan,) * len(windows_s)  # nothing left to train on without this fold
+        sums = np.zeros(len(windows_s))
+        wsum = np.zeros(len(windows_s))
         prepared = self._prepared(tau_s)
-        weights_of = (self._fold_weights(self.window_s)[f], self._fold_weights(self.short_window_s)[f])
+        weights_of = [self._fold_weights(w)[f] for w in windows_s]
         for j, (k, sel) in enumerate(self.fold_members()[f]):
             temp, cols = prepared[k]
             x = cols[np.ix_(sel, idx)]
@@ -521,9 +521,9 @@ class SelectionProblem:
         thesis's bias offset), at most the score's window and at least a block."""
         return max(self.block_s, min(SCORE_WINDOW_S, self.window_s))
 
-    def score(self, c: Candidate) -> CandidateScore:
+    def score(self, c: Candidate, short_window: bool = False) -> CandidateScore:
         """Held-out drift of ``c`` on every fold: each fold's lag and branch crossover width are those of the
-        least training residual."""
+        least training residual; with ``short_window``, at the short window too (:attr:`short_window_s`)."""
         taus = self.lag_grid_s() if c.lag else np.array([0.0])
         drifts, lags = [], []
         shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag and c.curve == "poly" else None
@@ -542,9 +542,11 @@ class SelectionProblem:
                     if best is None or rss < best[0]:
                         best = (rss, float(tau), coef, lo[f], hi[f], idx)
             _, tau, coef, lo_f, hi_f, idx = best
-            drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f, idx))
+            windows = (self.window_s, self.short_window_s) if short_window else (self.window_s,)
+            drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f, idx, windows))
             lags.append(tau)
-        return CandidateScore(c, tuple(d for d, _ in drifts), tuple(lags), tuple(d for _, d in drifts))
+        return CandidateScore(c, tuple(d[0] for d in drifts), tuple(lags),
+                              tuple(d[1] for d in drifts) if short_window else ())
 
     def fold_has_both_directions(self) -> np.ndarray:
         """(F,) whether each fold's training data holds both heating and cooling blocks."""
