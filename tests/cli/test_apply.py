@@ -65,3 +65,27 @@ def test_apply_drop_nan_leaves_the_dropped_rows_out_and_keeps_the_others(workdir
     out = pd.read_csv(tmp_path / "out.csv")
     assert len(out) == 199 and not out.isna().any().any()
     np.testing.assert_array_equal(out["time"], raw["time"].drop(index=5))
+
+
+def test_apply_keeps_a_decimal_comma_and_its_separator(workdir, tmp_path):
+    """A table written in a decimal-comma locale (semicolons, 0,5) comes out as it went in, streamed or whole, and
+    reads back to the same numbers; a text column that holds the separator is quoted, never written ambiguous."""
+    import numpy as np
+
+    from gyrocomp import read
+
+    original = (workdir / "run3.csv").read_text().splitlines()
+    header, rows = original[0], original[1:]
+    lines = [header.replace(",", ";") + ";note"] + [r.replace(",", ";").replace(".", ",") + (';"a;b"' if i == 1 else ";x")
+                                                   for i, r in enumerate(rows)]
+    (tmp_path / "comma.csv").write_text("\n".join(lines) + "\n")
+    for extra in ((), ("--time", "0:100000")):  # streamed, and read whole (rows selected by time)
+        done = run("apply", workdir / "model.json", tmp_path / "comma.csv", "-o", tmp_path / "out.csv", *extra)
+        assert done.returncode == 0, done.stderr
+        out = (tmp_path / "out.csv").read_text().splitlines()
+        assert out[0] == lines[0] and out[2].count(";") == lines[2].count(";") and "," in out[2]
+        assert '"a;b"' in out[2]  # the one value that holds the separator, quoted
+        reference = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "point.csv")
+        assert reference.returncode == 0
+        np.testing.assert_allclose(read(tmp_path / "out.csv").gyro_dps, read(tmp_path / "point.csv").gyro_dps,
+                                   rtol=1e-12)

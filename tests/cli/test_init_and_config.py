@@ -54,10 +54,22 @@ def test_init_then_every_command_without_flags(tmp_path):
     axes = json.loads(evaluated.stdout)["runs"][0]["axes"]
     assert axes["gyro_x"]["bias_offset_raw_dps"] > 0.2  # 0.3 deg/s of drift, read in deg/s
     assert axes["gyro_x"]["bias_offset_comp_dps"] < axes["gyro_x"]["bias_offset_raw_dps"] / 5
-    applied = run("apply", "m.json", first.name, "-o", "out.csv", cwd=tmp_path)
+    applied = run("apply", "m.json", first.name, "-o", "out.tsv", cwd=tmp_path)
     assert applied.returncode == 0, applied.stderr
     reported = run("report", "m.json", first.name, "-o", "r.html", cwd=tmp_path)
     assert reported.returncode == 0 or "matplotlib" in reported.stderr
+    # apply's output keeps the input's table format (tabs, its columns and units): every command reads it with
+    # the same project file, no flag given (before: comma-separated whatever its name, and the next command read
+    # its header as one column)
+    out = (tmp_path / "out.tsv").read_text().splitlines()
+    assert out[0] == (tmp_path / first.name).read_text().splitlines()[0] and "\t" in out[1] and "," not in out[1]
+    for command in (("fit", "out.tsv", "-o", "again.json"), ("evaluate", "m.json", "out.tsv", "--json"),
+                    ("apply", "m.json", "out.tsv", "-o", "twice.tsv"), ("report", "m.json", "out.tsv", "-o", "o.html"),
+                    ("export", "m.json", "--format", "ardupilot", "-o", "m.parm"), ("export", "m.json", "--format", "c", "-o", "c")):
+        done = run(*command, cwd=tmp_path)
+        assert done.returncode == 0 or (command[0] == "report" and "matplotlib" in done.stderr), (command, done.stderr)
+    again = json.loads(run("evaluate", "m.json", "out.tsv", "--json", cwd=tmp_path).stdout)["runs"][0]["axes"]
+    assert again["gyro_x"]["bias_offset_raw_dps"] < axes["gyro_x"]["bias_offset_raw_dps"] / 5  # compensated already
     # the command line wins: the same file read as deg/s has 57 times less drift
     overridden = run("evaluate", "m.json", first.name, "--json", "--gyro-unit", "deg/s", cwd=tmp_path)
     raw = json.loads(overridden.stdout)["runs"][0]["axes"]["gyro_x"]["bias_offset_raw_dps"]

@@ -83,7 +83,7 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
     accel_factor = unit_factor("accel", stream.layout.accel_unit)
     comp, accel_order, pending, written, first = None, None, [], 0, None
     computed = tuple(stream.columns[a] for a in stream.gyro_axes + stream.accel_axes)
-    with TableWriter(output_path, out_fmt, computed=computed) as writer:
+    with TableWriter(output_path, out_fmt, computed=computed, text_format=stream.text_format) as writer:
         def flush(gyro: np.ndarray, accel: np.ndarray | None) -> None:
             nonlocal pending, written
             if not len(gyro):

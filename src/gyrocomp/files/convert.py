@@ -26,7 +26,8 @@ def convert_file(input_path, output_path, *, options: ReadOptions | None = None,
                  out_fmt: str | None = None, chunks: ChunkSettings = ChunkSettings(),
                  progress=None) -> ConvertResult:
     """Any file gyrocomp reads written as the canonical table (time [s], gyro [deg/s], accel [g], temperature
-    [degC]) in CSV or Parquet: the same bytes as reading it whole and writing the recording
+    [degC]) in CSV or Parquet (a text table with the input's separator and decimal point; a ``.tsv`` name means
+    tabs): the same bytes as reading it whole and writing the recording
     (:func:`gyrocomp.io.write_recording`). A CSV or Parquet table is read and written chunk by chunk, in memory
     bounded by ``chunks.chunk_rows`` [rows]; any other file whole.
 
@@ -43,8 +44,9 @@ def convert_file(input_path, output_path, *, options: ReadOptions | None = None,
         Called with the fraction read.
     """
     def whole(read) -> ConvertResult:
-        recording = read().recording
-        write_recording(recording, output_path, fmt=out_fmt)
+        data = read()
+        recording = data.recording
+        write_recording(recording, output_path, fmt=out_fmt, text_format=data.text_format)
         channels = (*recording.gyro_axes, *recording.accel_axes, *recording.temperature_columns)
         return ConvertResult(recording.n_samples, recording.duration_s, recording.rate_hz, len(recording.gaps),
                              channels)
@@ -56,7 +58,7 @@ def convert_file(input_path, output_path, *, options: ReadOptions | None = None,
 def _convert_stream(stream: TableStream, output_path, out_fmt) -> ConvertResult:
     first = last = None
     written = 0
-    with TableWriter(output_path, out_fmt) as writer:
+    with TableWriter(output_path, out_fmt, text_format=stream.text_format) as writer:
         for chunk in stream.chunks():
             rec = chunk.recording
             first = first or rec

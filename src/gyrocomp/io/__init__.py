@@ -32,6 +32,7 @@ from .tables import (
     table_data,
     write_gyro_back,
     write_recording,
+    write_rows,
 )
 from .ulog import read_ulog, ulog_instances
 
@@ -224,5 +225,6 @@ __all__ = [
     "sniff_format",
     "write_gyro_back",
     "write_recording",
+    "write_rows",
     "write_text_atomic",
 ]

@@ -26,7 +26,8 @@ import pyarrow.parquet as pq
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path
-from .tables import (_COMPRESSED, TableLayout, _channel_selector, _csv_options, _resolved_columns, detect_table_format, sniff_csv, table_recording)
+from .tables import (_COMPRESSED, TableLayout, TextFormat, _channel_selector, _csv_options, _resolved_columns,
+                     detect_table_format, output_text_format, table_recording, with_decimal)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
@@ -73,6 +74,8 @@ class TableStream:
         self._source = None  # the open CSV file, whose position tells the progress (None: compressed)
         self._total_rows: int | None = None  # a Parquet file's rows, read once for the progress
         self._read: list[str] | None = None  # the columns read (None: all)
+        #: a text table's separator and decimal point (None for Parquet)
+        self.text_format: TextFormat | None = None
         self.schema = self._open_schema()
         if channels is None:
             self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
@@ -110,9 +113,9 @@ class TableStream:
                 if not head.strip():
                     raise InputError(f"{self.path}: the file is empty; expected a header such as "
                                      "time,gyro_z,temperature")
-                delimiter, decimal = sniff_csv(head)
-                parse = pacsv.ParseOptions(delimiter=self.layout.delimiter or delimiter)
-                convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.layout.decimal or decimal,
+                self.text_format = TextFormat.found(head, self.layout)
+                parse = pacsv.ParseOptions(delimiter=self.text_format.delimiter)
+                convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.text_format.decimal,
                                                include_columns=self._read or [])
                 reader = pacsv.open_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
                                         parse_options=parse, convert_options=convert)
@@ -236,10 +239,13 @@ class TableWriter:
     the columns whose values were computed (compensated rates): Parquet stores them without a dictionary, which
     only costs time on continuous values (twice the writing time in row groups of 2^18 rows)."""
 
-    def __init__(self, path, fmt: str | None = None, *, computed: tuple[str, ...] = ()):
+    def __init__(self, path, fmt: str | None = None, *, computed: tuple[str, ...] = (),
+                 text_format: TextFormat | None = None):
         self.path = Path(path)
         self.fmt = fmt or detect_table_format(self.path) or "csv"
         self.computed = tuple(computed)
+        #: a text table's separator and decimal point (:func:`gyrocomp.io.tables.output_text_format` of the input's)
+        self.text_format = output_text_format(self.path, text_format)
         self._writer = None
         self._schema: pa.Schema | None = None
         self._stack = contextlib.ExitStack()
@@ -255,14 +261,17 @@ class TableWriter:
                 dictionary = [n for n in table.column_names if n not in self.computed] if self.computed else True
                 self._writer = pq.ParquetWriter(self._tmp, table.schema, use_dictionary=dictionary)
             else:
-                self._writer = pacsv.CSVWriter(self._tmp, table.schema,
-                                               write_options=_csv_options(table.column_names))
+                self._writer = pacsv.CSVWriter(self._tmp, with_decimal(table, self.text_format).schema,
+                                               write_options=_csv_options(table.column_names, self.text_format))
         elif table.schema != self._schema:
             try:
                 table = table.cast(self._schema)
             except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
                 raise NotStreamable(str(exc).splitlines()[0]) from None
-        self._writer.write_table(table)
+        try:
+            self._writer.write_table(table if self.fmt == "parquet" else with_decimal(table, self.text_format))
+        except pa.ArrowInvalid as exc:  # a text value that would need quotes beside numbers with a decimal comma
+            raise NotStreamable(str(exc).splitlines()[0]) from None
 
     def __exit__(self, kind, value, traceback) -> bool:
         try:

@@ -162,7 +162,8 @@ class TableLayout:
 
 @dataclass(frozen=True, eq=False)
 class TableData:
-    """A table as read, with the recording built from it and what is needed to write results back."""
+    """A table as read, with the recording built from it and what is needed to write results back (the field
+    separator and decimal point of a text table, ``text_format``; None for Parquet or a log)."""
 
     recording: Recording
     table: pa.Table
@@ -170,6 +171,35 @@ class TableData:
     resolved_columns: dict[str, str]
     kept_rows: np.ndarray  # 0-based indices of table rows that are in the recording
     path: Path
+    text_format: "TextFormat | None" = None
+
+
+@dataclass(frozen=True)
+class TextFormat:
+    """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;`` or a
+    tab; ``decimal`` ``.`` or ``,``)."""
+
+    delimiter: str = ","
+    decimal: str = "."
+
+    @classmethod
+    def found(cls, head: bytes, layout: "TableLayout") -> "TextFormat":
+        """A table's format from its first bytes (:func:`sniff_csv`), where ``layout`` does not name it."""
+        delimiter, decimal = sniff_csv(head)
+        return cls(layout.delimiter or delimiter, layout.decimal or decimal)
+
+
+def output_text_format(path: str | os.PathLike, source: TextFormat | None = None) -> TextFormat:
+    """The format an output text table is written in: a ``.tsv`` name means tabs; otherwise the input's format
+    (``source``), so that the next command reading the output with the same project file reads it; a comma and a
+    decimal point where there is no input table. A decimal comma is kept only beside another separator."""
+    name = Path(path).name.lower()
+    for compressed in (".gz", ".bz2", ".xz", ".zst"):
+        name = name.removesuffix(compressed)
+    base = source or TextFormat()
+    if name.endswith(".tsv"):
+        return TextFormat("\t", base.decimal)
+    return base if base.delimiter != "," or base.decimal == "." else TextFormat()
 
 
 def file_sha256(path: str | os.PathLike) -> str:
@@ -218,16 +248,16 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
     delimiter = max(DELIMITERS, key=lambda d: (header.count(d), d == ","))
     decimal = "."
     if delimiter != "," and len(lines) > 1:
-        cells = [c.strip() for c in lines[1].split(delimiter)]
+        cells = [c.strip().strip('"') for c in lines[1].split(delimiter)]
         if any(c.replace("-", "", 1).replace(",", "", 1).isdigit() and "," in c for c in cells):
             decimal = ","
     return delimiter, decimal
 
 
 def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str | None = None,
-                select=None) -> pa.Table:
-    """The table; ``select`` (a function of the header's names giving the names to read, or None for all)
-    reads only some columns."""
+                select=None) -> tuple[pa.Table, TextFormat | None]:
+    """The table, and a text table's format (None for Parquet); ``select`` (a function of the header's names
+    giving the names to read, or None for all) reads only some columns."""
     if not path.exists():
         raise InputError(f"{path}: no such file")
     if path.is_dir():
@@ -237,18 +267,19 @@ def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
         found_delimiter, found_decimal = sniff_csv(head)
-        parse = pacsv.ParseOptions(delimiter=delimiter or found_delimiter)
-        convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal or found_decimal)
+        text = TextFormat(delimiter or found_delimiter, decimal or found_decimal)
+        parse = pacsv.ParseOptions(delimiter=text.delimiter)
+        convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
         try:
             if select is not None:  # the header's names, from its first line
                 header = pacsv.read_csv(pa.py_buffer(head.splitlines()[0] + b"\n"), parse_options=parse)
                 convert.include_columns = select(header.column_names)
-            return pacsv.read_csv(source, parse_options=parse, convert_options=convert)
+            return pacsv.read_csv(source, parse_options=parse, convert_options=convert), text
         except pa.ArrowInvalid as exc:
             raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
     try:
         columns = None if select is None else select(pq.read_schema(arrow_source(path)).names)
-        return pq.read_table(arrow_source(path), columns=columns)
+        return pq.read_table(arrow_source(path), columns=columns), None
     except (pa.ArrowInvalid, OSError) as exc:
         raise InputError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
 
@@ -435,7 +466,7 @@ def read_table(
     fmt = fmt or detect_table_format(path) or "csv"
     chosen: dict[str, str] = {}
     select = None if channels is None else _channel_selector(tuple(channels), layout, path, chosen)
-    table = _read_arrow(path, fmt, layout.delimiter, layout.decimal, select)
+    table, text_format = _read_arrow(path, fmt, layout.delimiter, layout.decimal, select)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
@@ -447,7 +478,7 @@ def read_table(
             f"after row {longest.after_row}); kept as they are, nothing interpolated",
             DataQualityWarning, stacklevel=2,
         )
-    return TableData(recording, table, layout, cols, kept, path)
+    return TableData(recording, table, layout, cols, kept, path, text_format)
 
 
 def table_recording(table: pa.Table, cols: dict[str, str], layout: TableLayout, path: Path, fmt: str, *,
@@ -481,21 +512,47 @@ def table_recording(table: pa.Table, cols: dict[str, str], layout: TableLayout, 
     return recording, kept
 
 
-def _write_arrow(table: pa.Table, path: Path, fmt: str) -> None:
+def _write_arrow(table: pa.Table, path: Path, fmt: str, text_format: TextFormat | None = None) -> None:
     with atomic_path(path) as tmp:
         if fmt == "parquet":
             pq.write_table(table, tmp)
         else:
-            pacsv.write_csv(table, tmp, _csv_options(table.column_names))
+            text_format = text_format or TextFormat()
+            decimal = with_decimal(table, text_format)
+            try:
+                pacsv.write_csv(decimal, tmp, _csv_options(table.column_names, text_format))
+            except pa.ArrowInvalid:  # a text value holds the separator: every text value quoted, as pyarrow does
+                pacsv.write_csv(decimal, tmp, _csv_options(table.column_names, text_format, quote_text=True))
 
 
-def _csv_options(names: list[str]) -> pacsv.WriteOptions:
-    """A header as other tools write and expect it: names unquoted unless one needs quotes."""
-    plain = not any(ch in name for name in names for ch in ',"\n\r')
+def _csv_options(names: list[str], text_format: TextFormat | None = None,
+                 quote_text: bool = False) -> pacsv.WriteOptions:
+    """A header as other tools write and expect it: names unquoted unless one needs quotes; fields separated
+    by ``text_format``'s delimiter (default a comma)."""
+    text_format = text_format or TextFormat()
+    delimiter = text_format.delimiter
+    plain = not any(ch in name for name in names for ch in (delimiter, '"', "\n", "\r"))
+    # numbers written with a decimal comma are text to pyarrow, which quotes every text value: not quoted here
+    # (a value that would need quotes is refused by the writer, never written ambiguous), unless ``quote_text``
+    values = {"quoting_style": "none"} if text_format.decimal == "," and not quote_text else {}
     try:
-        return pacsv.WriteOptions(quoting_header="none" if plain else "needed")
+        return pacsv.WriteOptions(quoting_header="none" if plain else "needed", delimiter=delimiter, **values)
     except TypeError:  # pyarrow without the option (before 17): its default, quoted names
-        return pacsv.WriteOptions()
+        return pacsv.WriteOptions(delimiter=delimiter, **values)
+
+
+def with_decimal(table: pa.Table, text_format: TextFormat) -> pa.Table:
+    """``table`` with its floating-point columns as text with a decimal comma, where ``text_format`` has one
+    (pyarrow's CSV writer writes a point); unchanged otherwise."""
+    if text_format.decimal == ".":
+        return table
+    import pyarrow.compute as pc  # loaded only for a decimal comma (70 ms)
+
+    for k, field in enumerate(table.schema):
+        if pa.types.is_floating(field.type):
+            text = pc.replace_substring(table.column(k).cast(pa.string()), ".", ",")
+            table = table.set_column(k, field.name, text)
+    return table
 
 
 def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLike, *, fmt: str | None = None,
@@ -503,7 +560,9 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
     """Write the table as read with its gyro columns replaced by ``gyro_dps`` [deg/s] (and its accelerometer
     columns by ``accel_g`` [g], when given).
 
-    Values are converted back to the file's units; every other column and the column order are unchanged.
+    Values are converted back to the file's units; every other column and the column order are unchanged, and a
+    text table is written with the input's separator and decimal point (:func:`output_text_format`: a ``.tsv``
+    name means tabs).
     Rows dropped on reading (``drop_nonfinite``) are left out of the output as well, as ``convert`` does: a
     row that could not be compensated is not written with its valid values replaced. Written atomically.
     """
@@ -520,7 +579,17 @@ def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLi
             column = data.resolved_columns[axis]
             values = values_internal[:, j] / factor
             table = table.set_column(table.column_names.index(column), column, arrow_floats(values))
-    _write_arrow(table, path, fmt)
+    _write_arrow(table, path, fmt, output_text_format(path, data.text_format))
+
+
+def write_rows(data: TableData, samples: slice, path: str | os.PathLike, *, fmt: str | None = None) -> None:
+    """Write the table as read, the rows of the recording's ``samples`` only (a slice of its sample indices), in
+    the input's columns, units, separator and decimal point (:func:`output_text_format`), atomically: a piece of a
+    log that reads as the log does."""
+    path = Path(path)
+    rows = data.kept_rows[samples]
+    _write_arrow(data.table.take(arrow_indices(rows)), path, fmt or detect_table_format(path) or "csv",
+                 output_text_format(path, data.text_format))
 
 
 def recording_table(recording: Recording, extra_columns: dict[str, np.ndarray] | None = None) -> pa.Table:
@@ -550,19 +619,26 @@ def table_data(recording: Recording) -> TableData:
 
 
 def write_recording(recording: Recording, path: str | os.PathLike, *, fmt: str | None = None,
-                    extra_columns: dict[str, np.ndarray] | None = None) -> None:
-    """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically."""
+                    extra_columns: dict[str, np.ndarray] | None = None,
+                    text_format: TextFormat | None = None) -> None:
+    """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically; a text table with the
+    separator and decimal point of ``text_format`` (the input's, say), a ``.tsv`` name meaning tabs
+    (:func:`output_text_format`)."""
     path = Path(path)
-    _write_arrow(recording_table(recording, extra_columns), path, fmt or detect_table_format(path) or "csv")
+    _write_arrow(recording_table(recording, extra_columns), path, fmt or detect_table_format(path) or "csv",
+                 output_text_format(path, text_format))
 
 
 __all__ = [
     "TableLayout",
     "TableData",
+    "TextFormat",
+    "output_text_format",
     "parse_column_mapping",
     "read_table",
     "write_gyro_back",
     "write_recording",
+    "write_rows",
     "recording_table",
     "table_data",
     "file_sha256",
