@@ -5,6 +5,7 @@ import re
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -29,21 +30,35 @@ def test_every_page_is_in_the_sites_navigation():
 
 
 def test_the_readmes_python_example_runs(tmp_path, monkeypatch):
-    """The three lines of the README's Python example, on simulated chamber runs written as the files it names."""
-    from gyrocomp.io.tables import write_recording
+    """The README's Python example, as written, in a folder where ``gyrocomp init`` ran on logs of another
+    project's layout (tab-separated, other column names, named .csv): read through the project file, the rates
+    are the file's, and the model compensates the flight file (before: ``gyrocomp.read`` ignored the project file,
+    and the snippet failed on any file with other column names)."""
     from gyrocomp.simulation import get_profile, simulate
+
+    from .conftest import run
 
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     code = re.search(r"```python\n(.*?)```", text, flags=re.S).group(1)
     prof = get_profile("cycle", set_points_degc=(-10.0, 50.0), cycles=1)
+    sims = {}
     for k, name in enumerate(("chamber_1.csv", "chamber_2.csv", "flight.csv")):
-        write_recording(simulate("consumer", profile=prof, rate_hz=0.5, seed=k).recording, tmp_path / name)
+        sims[name] = rec = simulate("consumer", profile=prof, rate_hz=2.0, seed=k).recording
+        rows = ["Stamp\tGyrX\tGyrY\tGyrZ\tTemp"] + [
+            "\t".join([f"{t:.2f}", *(f"{v:.9g}" for v in g), f"{temp:.2f}"])
+            for t, g, temp in zip(rec.time_s, rec.gyro_dps, rec.temperature_degc)]
+        (tmp_path / name).write_text("\n".join(rows) + "\n")
+    made = run("init", "chamber_1.csv", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
     monkeypatch.chdir(tmp_path)
     scope: dict = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         exec(code, scope)  # noqa: S102 - the README's own example
-    assert scope["model"].axes and scope["compensated"].n_samples == scope["gyrocomp"].read("flight.csv").n_samples
+    flight = scope["gyrocomp"].read("flight.csv", config="gyrocomp.toml")
+    np.testing.assert_allclose(flight.gyro_dps, sims["flight.csv"].gyro_dps, rtol=1e-8)
+    assert scope["model"].axes and scope["compensated"].n_samples == flight.n_samples
+    assert np.ptp(scope["compensated"].gyro_dps[:, 0]) < 0.5 * np.ptp(flight.gyro_dps[:, 0])
 
 
 @pytest.mark.parametrize("page", sorted(p.name for p in (ROOT / "docs").glob("*.md")))

@@ -10,7 +10,7 @@ come the three things an option is:
 - the words of a message: the library names the field (``drop_nonfinite: ...``) and the command line shows the
   flag the field is spelled with (``--drop-nan``).
 
-Nothing here imports more than the standard library, so that the command line can read the spellings cheaply.
+Nothing here imports more than the standard library (and the package's errors), so that the command line can read the spellings cheaply.
 """
 
 from __future__ import annotations
@@ -19,6 +19,8 @@ import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import MISSING, dataclass
 from typing import Any, TypeVar
+
+from .errors import InputError
 
 T = TypeVar("T")
 
@@ -87,4 +89,16 @@ def from_values(cls: type[T], values: Mapping[str, Any]) -> T:
     return cls(**kwargs)
 
 
-__all__ = ["SPELLING_KEY", "Spelling", "from_values", "spelled", "spelled_fields"]
+def mapping_text(value: Any, where: str) -> str:
+    """A mapping option as its command-line text ``KEY=VALUE,...``, from that text or a table of key = value
+    (a project file's ``columns``); ``where`` names it in the message of a value that is neither."""
+    if isinstance(value, dict):
+        if not all(isinstance(v, str) for v in value.values()):
+            raise InputError(f"{where}: each channel names a column (a string)")
+        return ",".join(f"{k}={v}" for k, v in value.items())
+    if not isinstance(value, str):
+        raise InputError(f"{where}: a string CH=COL,... or a table of channel = column")
+    return value
+
+
+__all__ = ["SPELLING_KEY", "Spelling", "from_values", "mapping_text", "spelled", "spelled_fields"]

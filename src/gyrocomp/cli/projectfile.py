@@ -18,6 +18,7 @@ from pathlib import Path
 import click
 
 from ..errors import InputError
+from ..spelling import mapping_text
 
 PROJECT_FILE = "gyrocomp.toml"
 #: where the command group keeps the loaded project for the commands (click's shared ``Context.meta``)
@@ -44,16 +45,6 @@ def _key(name: str) -> str:
     return name.strip().lstrip("-").replace("_", "-")
 
 
-def _columns_text(value, path: str) -> str:
-    if isinstance(value, dict):
-        if not all(isinstance(v, str) for v in value.values()):
-            raise InputError(f"{path}: [read] columns: each channel names a column (a string)")
-        return ",".join(f"{k}={v}" for k, v in value.items())
-    if not isinstance(value, str):
-        raise InputError(f"{path}: [read] columns: a string CH=COL,... or a table of channel = column")
-    return value
-
-
 def load_project(given: str | None, commands: tuple[str, ...]) -> Project | None:
     """The project file given (``--config``), else ``gyrocomp.toml`` in the working folder, else None; refuses in
     one line a file that is not TOML or a section that is no command (a ``[read]`` key that is no reading option is
@@ -69,7 +60,7 @@ def load_project(given: str | None, commands: tuple[str, ...]) -> Project | None
         raise InputError(f"{path}: not a readable TOML file ({exc})") from None
     read = {_key(k): v for k, v in data.pop("read", {}).items()}
     if "columns" in read:
-        read["columns"] = _columns_text(read["columns"], str(path))
+        read["columns"] = mapping_text(read["columns"], f"{path}: [read] columns")
     defaults = {_key(k): v for k, v in data.pop("defaults", {}).items()}
     sections: dict[str, dict] = {}
 

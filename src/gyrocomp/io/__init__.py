@@ -18,6 +18,7 @@ from ..recording import Recording
 from ..spelling import Spelling
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
 from .common import ProgressCallback, ReadOptions, sniff_format
+from .project import project_read_options
 from .dataflash import dataflash_instances, read_dataflash
 from .hdf5 import read_hdf5
 from .rosbag import read_rosbag
@@ -156,8 +157,15 @@ def read(
     path: str | os.PathLike,
     layout: TableLayout | None = None,
     *,
+    config: str | os.PathLike | None = None,
+    columns: dict[str, str] | None = None,
+    gyro_unit: str | None = None,
+    accel_unit: str | None = None,
+    time_unit: str | None = None,
+    delimiter: str | None = None,
+    decimal: str | None = None,
     fmt: str | None = None,
-    drop_nonfinite: bool = False,
+    drop_nonfinite: bool | None = None,
     instance: int | None = None,
     device_id: int | None = None,
     imu_topic: str | None = None,
@@ -174,11 +182,22 @@ def read(
     path : path
         A CSV or Parquet table, PX4 ULog, ArduPilot DataFlash log, ROS bag, or HDF5/NetCDF-4 file.
     layout : TableLayout, optional
-        Column mapping and units (tables, HDF5).
+        Column mapping and units (tables, HDF5); or give its fields one by one (``columns``, ``gyro_unit``, ...).
+    config : path, optional
+        A project file (``gyrocomp.toml``, which ``gyrocomp init`` writes): its ``[read]`` section's options, as
+        every command run beside it reads files (:func:`gyrocomp.io.project.project_read_options`); an option
+        given here as well wins.
+    columns : dict, optional
+        Canonical channel (``time``, ``gyro_z``, ``temperature`` ...) to the file's column name.
+    gyro_unit, accel_unit, time_unit : str, optional
+        The columns' units: ``deg/s``, ``rad/s`` or ``mdps``; ``g``, ``mg`` or ``m/s2``; ``s``, ``ms``, ``us``
+        or ``ns`` (default deg/s, g, s).
+    delimiter, decimal : str, optional
+        A text table's field separator and decimal point (default: told from the file).
     fmt : str, optional
         The format (default: told from the file).
-    drop_nonfinite : bool
-        Drop rows with NaN or infinite values instead of refusing the file.
+    drop_nonfinite : bool, optional
+        Drop rows with NaN or infinite values instead of refusing the file (default False).
     instance, device_id : int, optional
         Autopilot logs: the sensor instance (PX4 ``multi_id``, ArduPilot ``I``), or the PX4 device id.
     imu_topic, temperature_topic : str, optional
@@ -196,10 +215,24 @@ def read(
     -----
     The same options as :class:`ReadOptions` (its doc says more of each).
     """
-    read_options = ReadOptions(layout=layout or TableLayout(), drop_nonfinite=drop_nonfinite, instance=instance,
-                               device_id=device_id, imu_topic=imu_topic, temperature_topic=temperature_topic,
-                               record=record, channels=channels, time_range_s=time_range_s)
-    return read_input(path, read_options, fmt=fmt, progress=progress).recording
+    layout_fields = {"columns": columns, "gyro_unit": gyro_unit, "accel_unit": accel_unit, "time_unit": time_unit,
+                     "delimiter": delimiter, "decimal": decimal}
+    others = {"drop_nonfinite": drop_nonfinite, "instance": instance, "device_id": device_id, "imu_topic": imu_topic,
+              "temperature_topic": temperature_topic, "record": record, "channels": channels,
+              "time_range_s": time_range_s}
+    options, project_fmt = _merged_options(config, layout, layout_fields, others)
+    return read_input(path, options, fmt=fmt or project_fmt, progress=progress).recording
+
+
+def _merged_options(config, layout: TableLayout | None, layout_fields: dict, others: dict
+                    ) -> tuple[ReadOptions, str | None]:
+    """The reading options of :func:`read`: the project file's (``config``), then what was given (not None)."""
+    base, fmt = project_read_options(config) if config is not None else (ReadOptions(), None)
+    given_layout = {k: v for k, v in layout_fields.items() if v is not None}
+    if layout is not None and given_layout:
+        raise InputError(f"layout: give a TableLayout or its fields ({', '.join(given_layout)}), not both")
+    layout = layout or dataclasses.replace(base.layout, **given_layout)
+    return dataclasses.replace(base, layout=layout, **{k: v for k, v in others.items() if v is not None}), fmt
 
 
 __all__ = [
