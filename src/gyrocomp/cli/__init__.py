@@ -39,7 +39,7 @@ COMMANDS = {
     "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
     "show": ("show", 'What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device '
                 "ids), and the drift its held-out folds expect."),
-    "split": ("split", "Cut LOG into runs, one file each in canonical columns, so that a recording of several "
+    "split": ("split", "Cut LOG into runs, one file each, so that a recording of several "
                        "power-ons, poses or temperature legs becomes the runs a fit takes."),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
