@@ -24,6 +24,7 @@ $(DEMO_STAMP): pyproject.toml | $(BIN)/python
 
 demo: $(DEMO_STAMP)
 	$(BIN)/gyrocomp demo -o demo-output
+	@echo "gyrocomp is installed in $(VENV)/bin: run it as $(BIN)/gyrocomp, or after 'source $(BIN)/activate' as gyrocomp"
 
 # two processes (pytest-xdist), each test file in one of them (its module fixtures built once)
 test: $(STAMP)

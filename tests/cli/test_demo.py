@@ -62,6 +62,13 @@ def test_demo(tmp_path):
     report = (tmp_path / "demo" / "report.html").read_text()
     assert report.startswith("<!DOCTYPE html>") and "heldout_run.csv" in report and "data:image/png;base64," in report
     assert "report.html (open it in a browser)" in r.stdout
+    # the page opens with the case where compensation matters, its factor against PX4's cubic read from the page
+    # itself, every ratio written the same way round ("N x less drift than ...")
+    first = report[report.index("<section"):]
+    assert first.startswith('<section id="case"><h2>Where compensation matters</h2>')
+    opening = re.search(r"gyrocomp's default leaves <b>([0-9.]+)x less drift than PX4 cubic", first)
+    assert opening and float(opening.group(1)) >= 5.0, first[:400]  # measured 12.1x
+    assert not re.search(r"\d\.\d+x (?!less drift than|more drift than)", report[:report.index('id="summary"')])
     # the case where gyrocomp's models matter, against the simulator's truth, and the one where they do not
     cases = json.loads((tmp_path / "demo" / "cases.json").read_text())
     matters, not_matters = cases
@@ -71,7 +78,8 @@ def test_demo(tmp_path):
     for case in cases:
         assert case["drift_dps"]["gyrocomp"] < case["drift_dps"]["raw"]
     assert "Where gyrocomp's models matter" in r.stdout and "Where they do not" in r.stdout
-    assert f"{matters['gyrocomp_factor_vs']['PX4 cubic (process_sensor_caldata.py)']:.2f}x less than PX4 cubic" in r.stdout
+    assert f"{matters['gyrocomp_factor_vs']['PX4 cubic (process_sensor_caldata.py)']:.1f}x less drift than PX4 cubic" \
+        in r.stdout
     assert "case_consumer.png" in names
 
 

@@ -18,6 +18,7 @@ averaging times and which compensation should bring back to the sensor's own noi
 
 from __future__ import annotations
 
+import html
 import json
 import warnings
 from dataclasses import dataclass
@@ -33,7 +34,7 @@ from ..io import read_table, write_gyro_back, write_recording, write_text_atomic
 from ..allan import allan_deviation_segments
 from ..measures.merit import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
 from ..models.pipelines import fit_calibration
-from .html import build_report
+from .html import build_report, figure_html, table_html
 from . import figures
 from ..simulation import get_preset, get_profile, simulate
 from ..units import DEG_PER_S_TO_DEG_PER_H
@@ -170,15 +171,17 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
                for j, axis in enumerate(held.recording.gyro_axes)}
     lines = _summary(len(cal_paths), rate_hz, calibration, held, effects, residual, allan, run_eval, perfect,
                      methods_rms)
-    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html", validation) if report else "not asked for"
-    if skipped is None:
-        lines.append(f"Report of the model on the held-out run: {out_dir / 'report.html'} (open it in a browser).")
     mti10 = _case_from_methods(f"{PRESET} (the run above)", held, by_method, calibration.model, rate_hz)
     consumer, series = _consumer_case(rate_hz)
     cases = (consumer, mti10)
     write_text_atomic(out_dir / "cases.json", json.dumps([c.to_dict() for c in cases], indent=2) + "\n")
+    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html", validation,
+                            (consumer, mti10, series)) if report else "not asked for"
     drawn = _draw_case(series, out_dir / "case_consumer.png") if report and skipped is None else None
     lines += _case_lines(consumer, mti10, drawn)
+    if skipped is None:
+        lines.append(f"Report: {out_dir / 'report.html'} (open it in a browser): the case where compensation matters "
+                     "first, then the MTi-10 model on its held-out run.")
     files = sorted(out_dir.iterdir())
     return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, validation, allan,
                       "\n".join(lines), files, skipped, cases)
@@ -226,6 +229,12 @@ def _draw_case(series, path: Path) -> str | None:
     return str(path)
 
 
+def versus(factor: float, name: str) -> str:
+    """gyrocomp against another method, always the same way round: ``factor`` is the other's drift over
+    gyrocomp's, written "N x less drift than NAME" (or "N x more drift than NAME" where gyrocomp leaves more)."""
+    return (f"{factor:.1f}x less drift than {name}" if factor >= 1 else f"{1 / factor:.1f}x more drift than {name}")
+
+
 def _case_lines(matters: CaseResult, not_matters: CaseResult, drawn: str | None) -> list[str]:
     def row(case: CaseResult) -> str:
         return "  ".join(f"{name} {value:.2g}" for name, value in case.drift_dps.items())
@@ -234,18 +243,41 @@ def _case_lines(matters: CaseResult, not_matters: CaseResult, drawn: str | None)
              "temperature) fitted on two heat-cool runs and judged on a third over a wider range; the "
              f"deterministic drift each leaves (RMS of a {matters.window_s:g} s moving average, mean over the axes) "
              f"[deg/s]: {row(matters)}",
-             "  gyrocomp leaves " + " and ".join(f"{f:.2f}x less than {name.split(' (')[0]}"
-                                                 for name, f in matters.factor_vs.items())
+             "  gyrocomp leaves " + " and ".join(versus(f, name.split(" (")[0]) for name, f in matters.factor_vs.items())
              + ": inside the calibrated range by following the thermal lag, and most where the held-out run goes "
              "5 degC hotter than the calibration, where the autopilots hold their cubic's edge value.",
              f"Where they do not: the {not_matters.part}, the same drift [deg/s]: {row(not_matters)}",
-             "  gyrocomp against " + " and ".join(f"{name.split(' (')[0]}: {f:.2f}x"
-                                                  for name, f in not_matters.factor_vs.items())
+             "  gyrocomp leaves " + " and ".join(versus(f, name.split(" (")[0])
+                                                 for name, f in not_matters.factor_vs.items())
              + ": no better than a cubic there (a drift that is a smooth curve within the calibrated range leaves "
-             "nothing more to model; the factor is the ratio of what the cubic leaves to what gyrocomp leaves)."]
+             "nothing more to model)."]
     if drawn:
         lines.append(f"The consumer case drawn, one panel per method: {drawn}")
     return lines
+
+
+def _case_section(matters: CaseResult, not_matters: CaseResult, series) -> tuple[str, str]:
+    """The report's opening section: the case where compensation matters, against the autopilots' cubics, drawn,
+    and the case where it does not (every ratio the same way round, :func:`versus`)."""
+    time_s, lefts = series
+    against = " and ".join(versus(f, name.split(" (")[0]) for name, f in matters.factor_vs.items())
+    rows = [[case.part, *(case.drift_dps[name] for name in ("raw", "gyrocomp", *AUTOPILOT_METHODS))]
+            for case in (matters, not_matters)]
+    body = "\n".join([
+        f"<p class=lead>On a {html.escape(CASE_PRESET)} part (large tempco, 30 s thermal lag, whole-degree "
+        f"temperature), fitted on two heat-cool runs and judged on a third that goes 5 degC hotter, gyrocomp's "
+        f"default leaves <b>{html.escape(against)}</b>.</p>",
+        figure_html(figures.drift_panels(time_s, lefts, window_s=CASE_WINDOW_S,
+                                         title=f"{CASE_PRESET}: error left on gyro_z (output - true rate - noise)"),
+                    "the error each method leaves on the consumer part's held-out run"),
+        table_html(["part", "raw", "gyrocomp", *AUTOPILOT_METHODS], rows,
+                   f"deterministic drift each leaves on the held-out run (RMS of a {matters.window_s:g} s moving "
+                   "average of output - true rate - noise, mean over the axes) [deg/s]"),
+        f"<p class=note>Where compensation does not matter: the {html.escape(not_matters.part)}, whose drift is a "
+        "smooth curve inside the calibrated range; gyrocomp leaves "
+        + html.escape(" and ".join(versus(f, name.split(' (')[0]) for name, f in not_matters.factor_vs.items()))
+        + ". Its model and held-out run are the rest of this page.</p>"])
+    return "Where compensation matters", body
 
 
 def _simulate_inputs(out_dir: Path, rate_hz: float):
@@ -360,14 +392,17 @@ def _allan_table(held, compensated) -> dict[str, AllanComparison]:
     return out
 
 
-def _write_report(calibration: Calibration, run, path: Path, validation: ValidationResult | None = None) -> str | None:
-    """Write the HTML report; return why not (the missing [plot] extra), or None."""
+def _write_report(calibration: Calibration, run, path: Path, validation: ValidationResult | None = None,
+                  cases=None) -> str | None:
+    """Write the HTML report, opening with the cases (:func:`_case_section`) when given; return why not (the
+    missing [plot] extra), or None."""
     try:
-        html = build_report(calibration, [run], validation=validation).html
+        lead = {"case": _case_section(*cases)} if cases is not None else None
+        page = build_report(calibration, [run], validation=validation, lead=lead).html
     except MissingDependencyError as exc:
         return str(exc)
-    write_text_atomic(path, html)
+    write_text_atomic(path, page)
     return None
 
 
-__all__ = ["AllanComparison", "DemoResult", "EffectSize", "run_demo"]
+__all__ = ["AllanComparison", "DemoResult", "EffectSize", "run_demo", "versus"]

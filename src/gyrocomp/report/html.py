@@ -53,6 +53,7 @@ th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: right; }
 th { background: #eef; } td:first-child, th:first-child, td.text { text-align: left; }
 img { max-width: 100%; display: block; margin: 0.6em 0; border: 1px solid #ddd; }
 .note { color: #555; font-size: 0.9em; } nav a { margin-right: 1em; }
+.lead { font-size: 1.15em; }
 """
 
 
@@ -73,6 +74,16 @@ def _png(fig) -> str:
 
 def _img(fig, alt: str) -> str:
     return f'<img src="{_png(fig)}" alt="{html.escape(alt)}">'
+
+
+def figure_html(fig, alt: str) -> str:
+    """A matplotlib figure as an ``<img>`` with the PNG inside the page (``alt`` escaped)."""
+    return _img(fig, alt)
+
+
+def table_html(header: list[str], rows: list[list], caption: str | None = None) -> str:
+    """A table as the report draws them (every text escaped; numbers right-aligned)."""
+    return _table(header, rows, caption)
 
 
 def _table(header: list[str], rows: list[list], caption: str | None = None) -> str:
@@ -332,7 +343,8 @@ def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s
 def build_report(calibration: Calibration, runs: list[Recording], *, window_s: float | None = None,
                  turn_on_window_s: float | None = None, min_static_s: float = 10.0,
                  progress: Callable[[float], None] | None = None,
-                 validation: ValidationResult | None = None) -> Report:
+                 validation: ValidationResult | None = None,
+                 lead: dict[str, tuple[str, str]] | None = None) -> Report:
     """The report of ``calibration`` judged on ``runs`` (see the module doc for what it holds).
 
     Parameters
@@ -347,6 +359,9 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         Called with the fraction done.
     validation : ValidationResult, optional
         Held-out drift of the methods on the calibration runs (:func:`gyrocomp.evaluation.validation.validate`).
+    lead : dict, optional
+        Sections to open the page with, before the report's own: id -> (title, HTML body) (the demo's case where
+        compensation matters).
     """
     figures._pyplot()  # fail early, in one line, without matplotlib
     steps = 3 + 2 * len(runs)
@@ -362,7 +377,7 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         warnings.simplefilter("ignore", DataQualityWarning)
         compensated = [apply(calibration, rec, turn_on_window_s=turn_on_window_s) for rec in runs]
         tick()
-        sections: dict[str, str] = {}
+        sections: dict[str, tuple[str, str]] = dict(lead or {})
         sections["summary"] = ("Model", _summary(calibration))
         if validation is not None:
             sections["validation"] = ("Validation", _validation(validation))
@@ -482,4 +497,4 @@ def html_page(title: str, heading: str, note: str, sections: dict[str, tuple[str
     return "\n".join(page) + "\n"
 
 
-__all__ = ["Report", "SECTIONS", "build_report", "html_page"]
+__all__ = ["Report", "SECTIONS", "build_report", "figure_html", "html_page", "table_html"]
