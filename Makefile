@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test docs bench clean
+.PHONY: demo test quick docs bench clean
 
 DEMO_STAMP := $(VENV)/.installed-demo
 
@@ -29,6 +29,10 @@ demo: $(DEMO_STAMP)
 # two processes (pytest-xdist), each test file in one of them (its module fixtures built once)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile
+
+# the quick loop: the same without the tests marked slow (about 5 s or more each, or a slow fixture)
+quick: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m "not slow"
 
 # the documentation site (MkDocs, Material, mkdocstrings) into site/, warnings as errors
 docs: $(STAMP)

@@ -423,6 +423,7 @@ def test_a_rate_schedule_file_gives_the_reference_rates_instead_of_columns(tmp_p
     assert not (tmp_path / "m.json").exists()
 
 
+@pytest.mark.slow
 def test_rate_table_runs_alone_give_k_and_apply_cuts_the_rate_error_tenfold(tmp_path):
     """Three rate-table runs alone (no chamber run), --temperature none: K(T) from the rates, one constant per run
     from their still stretches; applied with --turn-on-window to a held-out run at 40 degC, the rate error of its

@@ -190,10 +190,17 @@ def test_no_output_is_written_through_a_planted_link(workdir, tmp_path):
                                     "itself, or remove the link"), name
         assert victim.read_text() == "not yours\n" and link.is_symlink()
     store = _planted(shared, "store.sqlite", tmp_path / "elsewhere.sqlite")
-    r = run("fleet", "fit", workdir, "--unit-from", "run{serial}.csv", "-o", tmp_path / "fleet", "--store", store,
-            "--scheduler", "serial")
-    assert r.returncode == 2 and f"{store}: is a symbolic link" in r.stderr and "calibration stores are never" in r.stderr
-    assert not (tmp_path / "elsewhere.sqlite").exists() and len(r.stderr.strip().splitlines()) == 1
+    units = tmp_path / "units" / "SN1"
+    units.mkdir(parents=True)
+    shutil.copy(workdir / "run1.csv", units / "run_0.csv")
+    r = run("fleet", "fit", tmp_path / "units", "--unit-from", "{serial}/run_{n}.csv", "-o", tmp_path / "fleet",
+            "--store", store, "--scheduler", "serial")
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.strip().splitlines()[-1] == (f"gyrocomp: error: {store}: is a symbolic link (to {tmp_path}/"
+                                                 "elsewhere.sqlite); calibration stores are never written through a "
+                                                 "link, which could replace a file elsewhere: name the file itself, "
+                                                 "or remove the link")
+    assert not (tmp_path / "elsewhere.sqlite").exists()
 
 
 def test_sigterm_leaves_no_temporary_file(tmp_path):

@@ -35,6 +35,7 @@ def test_fit_prints_table_and_writes_model(workdir):
     assert "decided by" in r.stdout
 
 
+@pytest.mark.slow
 def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     r = run("simulate", "--preset", "adxrs450", "--profile", "cycle", "--cycles", 1, "--rate", 1, "--runs", 2,
             "-o", tmp_path / "c.csv")
@@ -53,6 +54,7 @@ def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     assert model["axes"]["gyro_z"]["hysteresis"]["band_degc"] == [55.0, 80.0]
 
 
+@pytest.mark.slow
 def test_fit_prints_only_what_was_fitted(tmp_path):
     """A chamber run in one orientation fits no G: no table of "not fitted" cells; no fit-RMS column of dashes."""
     r = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 0.1, "--runs", 2,
@@ -90,6 +92,7 @@ def test_fit_g_sensitivity_table_and_stages(tmp_path):
     assert r.returncode == 2 and "Invalid value for '--acceleration'" in r.stderr
 
 
+@pytest.mark.slow
 def test_fit_pipeline_option(tmp_path):
     r = run("simulate", "--preset", "consumer", "--profile", "tumble", "--rate", 1, "--runs", 2, "-o", tmp_path / "t.csv")
     assert r.returncode == 0, r.stderr
@@ -102,6 +105,7 @@ def test_fit_pipeline_option(tmp_path):
     assert r.returncode == 2 and "--pipeline: 'poly+matrix'; use one of joint, poly>matrix" in r.stderr
 
 
+@pytest.mark.slow
 def test_fit_and_evaluate_state_the_drift_to_expect_from_one_run(tmp_path):
     for seed, name in ((3, "one.csv"), (4, "two.csv")):
         r = run("simulate", "--profile", "cycle", "--duration", 6000, "--rate", 2, "--seed", seed, "-o", tmp_path / name)

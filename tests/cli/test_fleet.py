@@ -1,9 +1,12 @@
 """``gyrocomp fleet`` through the real entry point: bad options in one line (the fleet's own runs through the
 command line, on a simulated fleet, are in tests/fleet)."""
 
+import pytest
+
 from ..conftest import run
 
 
+@pytest.mark.slow
 def test_fleet_fit_refuses_bad_options_in_one_line(tmp_path):
     (tmp_path / "SN1").mkdir()
     (tmp_path / "SN1" / "run_0.csv").write_text("content of SN1/run_0.csv")

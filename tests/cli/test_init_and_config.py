@@ -33,6 +33,7 @@ def _log(path, n=4000, rate_hz=100.0, *, names=None, time_unit="us", si=True, se
     return path
 
 
+@pytest.mark.slow
 def test_init_then_every_command_without_flags(tmp_path):
     """The issue's log: tab-separated, timestamp in us, imu.gyro.x in rad/s, imu.acc.x in m/s^2: init, then fit,
     show, evaluate, apply and report with no reading option given."""

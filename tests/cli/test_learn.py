@@ -1,6 +1,8 @@
 """``gyrocomp learn`` through the real entry point: a model from everyday logs, in one go or resumed from a state
 file, applied and exported with the learner."""
 
+import pytest
+
 from gyrocomp.calibration import Calibration
 from gyrocomp.fitting.online import LearnerSettings, OnlineCalibrator
 from gyrocomp.io.tables import write_recording
@@ -9,6 +11,7 @@ from gyrocomp.simulation import get_profile, simulate
 from ..conftest import run
 
 
+@pytest.mark.slow
 def test_learn_through_the_command_line(tmp_path):
     """gyrocomp learn on two logs; in two steps (--save-state, then --resume) the same model; apply takes it;
     a log without still data exits 2 in one line, writing nothing."""

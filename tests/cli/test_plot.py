@@ -6,6 +6,7 @@ from .conftest import assert_refused_in_one_line
 from ..conftest import run
 
 
+@pytest.mark.slow
 def test_plot_draws_each_kind_in_the_format_its_suffix_names(report_files):
     d = report_files
     for kind, args, out, magic in (

@@ -33,7 +33,8 @@ def test_a_tab_separated_export_with_decimal_commas_reads_with_or_without_option
     for extra in ([], ["--delimiter", "tab", "--decimal", ","]):
         r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", *extra)
         assert r.returncode == 0, r.stderr
-        out = pd.read_csv(tmp_path / "o.csv")
+        # the canonical columns, in the input's separator and decimal point (the next command reads it as it read v.txt)
+        out = pd.read_csv(tmp_path / "o.csv", sep="\t", decimal=",")
         assert list(out["gyro_z"]) == [1.5, 2.5, 3.0] and list(out["temperature"]) == [20.5, 21.0, 22.0]
     r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", "--decimal", ":")
     assert r.returncode == 2 and r.stderr.strip() == "gyrocomp: error: --decimal: ':'; use '.' or ','"

@@ -4,12 +4,15 @@ import dataclasses
 import json
 import warnings
 
+import pytest
+
 from gyrocomp import fit_calibration
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
 
 
+@pytest.mark.slow
 def test_show_names_the_axes_the_device_ids_and_the_expected_drift(tmp_path):
     runs = [simulate("consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 70.0), cycles=1), rate_hz=1,
                      seed=s).recording for s in range(2)]

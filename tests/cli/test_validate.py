@@ -1,11 +1,13 @@
 """`gyrocomp validate`, run through the real entry point in a subprocess."""
 
+import pytest
 import json
 from pathlib import Path
 
 from ..conftest import run
 
 
+@pytest.mark.slow
 def test_validate_prints_every_method_and_json_holds_the_folds(workdir):
     runs = sorted(str(p) for p in Path(workdir).glob("run*.csv"))[:3]
     out = run("validate", *runs, "--json")

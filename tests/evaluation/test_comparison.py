@@ -28,6 +28,7 @@ def cycles():
     return [simulate("adxrs450", profile=prof, rate_hz=1.0, seed=s) for s in range(2)]
 
 
+@pytest.mark.slow
 def test_leave_one_run_out_table_has_every_method_and_hysteresis_helps(cycles):
     result = compare_methods([s.recording for s in cycles], hysteresis_band_degc=(55.0, 80.0), window_s=100.0)
     assert result.how.startswith("leave one run out")

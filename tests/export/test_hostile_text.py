@@ -120,6 +120,7 @@ def test_a_hostile_axis_name_is_refused_on_load(model):
 
 
 @pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.slow
 def test_a_hostile_serial_and_header_reach_no_generated_code(tmp_path):
     """A store row whose serial, and a table whose column names, are hostile: fleet export's C compiles to the same
     object as a unit named plainly from a plainly named table; its PX4 parameter lines are the same."""

@@ -280,6 +280,7 @@ def test_a_compensation_beyond_any_sensors_range_is_refused_naming_its_row(consu
             evaluate(consumer_model, read_table(bad).recording)
 
 
+@pytest.mark.slow
 def test_allan_warns_when_the_log_moves_most_of_the_time(tmp_path):
     """As fit tells a field log: a log turning most of the time gets one warning, chunked or whole, and a still
     one none."""

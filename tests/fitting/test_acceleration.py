@@ -185,6 +185,7 @@ def test_joint_fit_beats_every_cascade(pipelines):
     assert pipelines["mlp>mlp-accel"][1] > pipelines["mlp>matrix"][1]
 
 
+@pytest.mark.slow
 def test_a_cascade_applies_as_its_stages_in_turn(consumer, pipelines):
     from gyrocomp.models.pipelines import fit_calibration
 

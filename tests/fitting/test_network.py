@@ -91,6 +91,7 @@ def test_network_is_deterministic_for_a_seed_and_saved_as_json(chamber, tmp_path
     assert curve.shape(np.array([curve.t_ref_degc]))[0] == pytest.approx(0.0, abs=1e-15)
 
 
+@pytest.mark.slow
 def test_network_with_lag_and_hysteresis_generalizes_to_a_faster_ramp():
     rng_c = (-30.0, 80.0)
     model = preset_model("adxrs450")

@@ -87,6 +87,7 @@ def test_the_rerun_puts_back_a_missing_model_file(manifest, tmp_path):
     assert lost.read_text() == text
 
 
+@pytest.mark.slow
 def test_outputs_onto_the_store_are_refused_and_the_store_is_intact(manifest, tmp_path):
     out = tmp_path / "FLEET"
     assert _fit(manifest, out).returncode == 0

@@ -56,6 +56,7 @@ def test_recovers_the_tempco_and_removes_the_drift_on_a_held_out_run(cycles):
     np.testing.assert_array_equal(out.gyro_dps, held.recording.gyro_dps)
 
 
+@pytest.mark.slow
 def test_gyro_and_accel_together_fit_g_on_compensated_accelerations():
     runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s) for s in range(3)]
     both = _quiet(fit_channels, [s.recording for s in runs[:2]], ("accel", "gyro"))  # any order
@@ -199,6 +200,7 @@ def test_cli_accelerometer_channel_end_to_end(tmp_path):
     assert r.returncode == 2 and "--channels: mag: use gyro, accel or gyro,accel" in r.stderr
 
 
+@pytest.mark.slow
 def test_an_accelerometer_axis_left_without_a_curve_is_left_uncorrected():
     """The MTi-10's accelerometer tempco is small: on two multi-position chamber runs no curve beats accel_x's
     constants, so the fit leaves it none while fitting y and z. Applying such a model used to fail inside the

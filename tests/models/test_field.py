@@ -34,6 +34,7 @@ def _field_logs(count: int, **overrides):
                      seed=100 + k, unit=UNIT).recording for k in range(count)]
 
 
+@pytest.mark.slow
 def test_ten_field_logs_calibrate_as_well_as_the_chamber():
     """Ten one-hour logs (room temperature to +25 degC by self-heating, still a third of the time, turning,
     shaking and accelerating in between) against three one-hour chamber runs over the same range; both judged
@@ -77,6 +78,7 @@ def test_field_data_that_cannot_make_a_model_is_refused():
         field_recordings(lukewarm, "maybe")
 
 
+@pytest.mark.slow
 def test_fit_on_field_logs_through_the_command_line(tmp_path):
     for k, log in enumerate(_field_logs(3, duration_s=1800.0)):
         write_recording(log, tmp_path / f"flight_{k}.parquet")
@@ -95,6 +97,7 @@ def test_fit_on_field_logs_through_the_command_line(tmp_path):
     assert "a temperature model needs at least 5 degC" in refused.stderr and not (tmp_path / "m2.json").exists()
 
 
+@pytest.mark.slow
 def test_the_report_draws_the_still_segments_of_a_field_log():
     from gyrocomp.report.html import build_report
     from gyrocomp.motion.stillness import detect_still
