@@ -22,6 +22,20 @@ def test_the_readme_is_short_and_links_to_pages_that_exist():
         assert (ROOT / link).is_file(), link
 
 
+def test_the_sites_home_page_is_the_readme():
+    """docs/index.md is the README with its docs/ links made relative to the site (tools/site_index.py writes it):
+    the landing page carries the set-up and the measured figures, and cannot drift from the README."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("site_index", ROOT / "tools" / "site_index.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert (ROOT / "docs" / "index.md").read_text(encoding="utf-8") == module.site_index(readme), \
+        "docs/index.md differs from the README: run python tools/site_index.py"
+    assert "## Measured" in readme and "](docs/" not in module.site_index(readme)
+
+
 def test_every_page_is_in_the_sites_navigation():
     nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8").split("\nnav:", 1)[1]
     listed = set(re.findall(r":\s*([\w-]+\.md)\s*$", nav, flags=re.M))

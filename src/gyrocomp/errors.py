@@ -62,6 +62,12 @@ class MissingDependencyError(GyrocompError, ImportError):
     """An optional package is needed for this (the message names the extra to install; CLI exit status 1)."""
 
 
+def install_hint(extra: str) -> str:
+    """How to install an extra, from PyPI and from a clone of the repository (where ``pip install
+    'gyrocomp[...]'`` would fetch the released package instead of the clone's)."""
+    return f"pip install 'gyrocomp[{extra}]' (from a clone of the repository: pip install -e '.[{extra}]')"
+
+
 class ModelChoiceWarning(UserWarning):
     """Validation found that a temperature model does not help an axis (none generalizes to held-out data, or
     the chosen one leaves more drift there than the raw output)."""

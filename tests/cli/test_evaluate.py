@@ -11,7 +11,8 @@ def test_evaluate_json_shape(workdir):
     assert r.returncode == 0, r.stderr
     data = json.loads(r.stdout)
     # model.json's order was asked for (poly:3): the selection still scored it on held-out folds and says so
-    assert set(data) == {"runs", "expected_held_out_drift"}
+    assert set(data) == {"runs", "expected_held_out_drift", "in_sample_files"}
+    assert data["in_sample_files"] == []  # run3 is not one of the model's inputs
     run0 = data["runs"][0]
     assert set(run0) == {"file", "window_s", "axes"}
     assert run0["window_s"] >= 1.0
@@ -27,3 +28,22 @@ def test_evaluate_table_and_window(workdir):
     assert r.returncode == 0, r.stderr
     assert "offset raw" in r.stdout and "[deg/s]" in r.stdout and "run3.csv" in r.stdout
     assert re.search(r"run3\.csv\s*\S\s*gyro_x\s*\S\s*20\s", r.stdout)  # the window column shows --window
+
+
+def test_evaluate_and_report_say_when_they_judge_the_data_the_model_was_fitted_on(workdir, tmp_path):
+    """run1 is one of the model's inputs (its name and SHA-256 in the provenance), run3 is not: the figures on run1
+    are said to be in-sample, on stderr, in the JSON and in the report; a copy of run3 renamed run1 is not taken
+    for it (its digest differs)."""
+    done = run("evaluate", workdir / "model.json", workdir / "run1.csv", workdir / "run3.csv", "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["in_sample_files"] == [str(workdir / "run1.csv")]
+    assert f"{workdir / 'run1.csv'}: the model was fitted on this file, so its figures are in-sample" in done.stderr
+    assert "run3.csv: the model was fitted" not in done.stderr
+    impostor = tmp_path / "run1.csv"
+    impostor.write_bytes((workdir / "run3.csv").read_bytes())
+    done = run("evaluate", workdir / "model.json", impostor, "--json")
+    assert json.loads(done.stdout)["in_sample_files"] == [] and "in-sample" not in done.stderr
+    page = tmp_path / "r.html"
+    done = run("report", workdir / "model.json", workdir / "run1.csv", "-o", page)
+    assert done.returncode == 0, done.stderr
+    assert "<b>In-sample</b>: the model was fitted on run1.csv" in page.read_text()

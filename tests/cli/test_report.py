@@ -39,5 +39,6 @@ def test_package_imports_and_cli_answers_without_matplotlib(report_files, tmp_pa
                            "-o", str(tmp_path / "r.html")], capture_output=True, text=True, timeout=300)
     assert done.returncode == 1
     assert done.stderr.strip() == ("gyrocomp: error: plots need the optional package matplotlib; install it with: "
-                                   "pip install 'gyrocomp[plot]'")
+                                   "pip install 'gyrocomp[plot]' (from a clone of the repository: "
+                                   "pip install -e '.[plot]')")
     assert not (tmp_path / "r.html").exists()

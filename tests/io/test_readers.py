@@ -521,7 +521,8 @@ def test_missing_extra_is_named_in_one_line(monkeypatch, tmp_path):
     path = tmp_path / "x.ulg"
     write_ulog(path, dict([_gyro_topic()]))
     with pytest.raises(MissingDependencyError, match=r"^reading PX4 ULog files needs the optional package pyulog; "
-                                                     r"install it with: pip install 'gyrocomp\[ulog\]'$"):
+                                                     r"install it with: pip install 'gyrocomp\[ulog\]' \(from a clone of the "
+                                                     r"repository: pip install -e '\.\[ulog\]'\)$"):
         read(path)
 
 

@@ -22,6 +22,7 @@ from .. import jsontext
 from ..errors import InputError
 from .fit_report import FitReport
 from ..io.atomic import write_text_atomic
+from ..io.digest import file_sha256
 from ..curves.kinds import curve_from_dict
 from ..curves.protocol import TemperatureCurve
 from ..curves.network import NetworkCurve
@@ -430,6 +431,15 @@ class Calibration:
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n"
+
+    def fitted_on(self, path: str | os.PathLike | None) -> bool:
+        """Whether the file at ``path`` is one the model was fitted on (its name and SHA-256 those of an input in
+        the provenance): figures judged on it are in-sample, not the drift to expect on new data."""
+        if path is None or not Path(path).is_file():
+            return False
+        named = [entry for entry in self.provenance.get("inputs", ())
+                 if isinstance(entry, dict) and entry.get("file") == Path(path).name and entry.get("sha256")]
+        return bool(named) and file_sha256(path) in {entry["sha256"] for entry in named}
 
     def save(self, path: str | os.PathLike) -> None:
         """Write the model file atomically."""

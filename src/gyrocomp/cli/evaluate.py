@@ -93,8 +93,12 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
         return
     evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
     expected = calibration.report.expected_drift()
+    in_sample = [str(path) for path in runs if calibration.fitted_on(path)]
+    for path in in_sample:
+        click.echo(f"gyrocomp: note: {path}: the model was fitted on this file, so its figures are in-sample; on new "
+                   "data expect the held-out drift the model file states (gyrocomp show)", err=True)
     if as_json:
-        click.echo(json.dumps({**evaluation.to_dict(),
+        click.echo(json.dumps({**evaluation.to_dict(), "in_sample_files": in_sample,
                                "expected_held_out_drift": [e.to_dict() for e in expected.values()]}, indent=2))
     else:
         print_evaluation(evaluation)

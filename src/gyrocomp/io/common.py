@@ -16,7 +16,7 @@ from types import ModuleType
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError, MissingDependencyError, printable
+from ..errors import DataQualityWarning, InputError, MissingDependencyError, install_hint, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..spelling import Spelling, spelled
 from .tables import TableLayout, keep_finite_rows
@@ -122,7 +122,7 @@ def require(module: str, extra: str, what: str) -> ModuleType:
     except ImportError:
         raise MissingDependencyError(
             f"{what} needs the optional package {module.split('.')[0]}; "
-            f"install it with: pip install 'gyrocomp[{extra}]'"
+            f"install it with: {install_hint(extra)}"
         ) from None
 
 

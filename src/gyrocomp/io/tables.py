@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import lzma
 import os
 import re
@@ -19,6 +18,7 @@ from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
 from ..spelling import Spelling, spelled
 from ..units import unit_factor
+from .digest import file_sha256
 from .atomic import arrow_source, atomic_path
 
 TIME_COLUMN = "time"
@@ -200,15 +200,6 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
     if name.endswith(".tsv"):
         return TextFormat("\t", base.decimal)
     return base if base.delimiter != "," or base.decimal == "." else TextFormat()
-
-
-def file_sha256(path: str | os.PathLike) -> str:
-    """SHA-256 of a file's bytes, hex."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 #: compressed CSV, told by its first bytes: the codec's name for pyarrow (xz through Python's lzma)

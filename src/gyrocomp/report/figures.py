@@ -22,7 +22,7 @@ import numpy as np
 
 from ..allan import BIAS_INSTABILITY_FACTOR
 from ..effects import find_turns
-from ..errors import InputError, MissingDependencyError
+from ..errors import InputError, MissingDependencyError, install_hint
 from ..io.atomic import atomic_path
 from ..measures.merit import moving_average, window_samples
 from ..curves.hysteresis import turn_threshold_degc
@@ -44,7 +44,7 @@ def _pyplot():
         import matplotlib.pyplot as plt
     except ImportError:
         raise MissingDependencyError("plots need the optional package matplotlib; install it with: "
-                                     "pip install 'gyrocomp[plot]'") from None
+                                     + install_hint("plot")) from None
     return plt
 
 

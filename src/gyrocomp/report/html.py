@@ -229,6 +229,11 @@ def _evaluation(calibration: Calibration, runs: list[Recording], evaluations: li
                              "BI comp [ug]"], accel_rows, "accelerometer"))
     parts.append("<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
                  "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>")
+    fitted_on = [rec.source.rsplit("/", 1)[-1] for rec in runs if calibration.fitted_on(rec.metadata.get("path"))]
+    if fitted_on:
+        parts.append(f"<p class=note><b>In-sample</b>: the model was fitted on {html.escape(', '.join(fitted_on))}; "
+                     "its figures there are not the drift to expect on new data (the held-out drift in the model "
+                     "section is).</p>")
     return "\n".join(parts)
 
 
@@ -349,19 +354,16 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
 
     Parameters
     ----------
-    window_s : float, optional
-        Moving-average window [s]; default: tau at each raw run's Allan minimum, at least 1 s.
-    turn_on_window_s : float, optional
-        Estimate each run's turn-on constant from its first seconds [s].
+    window_s, turn_on_window_s : float, optional
+        Moving-average window [s] (default: tau at each raw run's Allan minimum, at least 1 s); estimate each run's
+        turn-on constant from its first seconds [s].
     min_static_s : float
         Shortest static position drawn in the g-sensitivity figure [s].
     progress : callable, optional
         Called with the fraction done.
-    validation : ValidationResult, optional
-        Held-out drift of the methods on the calibration runs (:func:`gyrocomp.evaluation.validation.validate`).
-    lead : dict, optional
-        Sections to open the page with, before the report's own: id -> (title, HTML body) (the demo's case where
-        compensation matters).
+    validation, lead : ValidationResult, dict, optional
+        Held-out drift of the methods on the calibration runs (:func:`gyrocomp.evaluation.validation.validate`);
+        sections to open the page with, id -> (title, HTML body) (the demo's case where compensation matters).
     """
     figures._pyplot()  # fail early, in one line, without matplotlib
     steps = 3 + 2 * len(runs)
@@ -386,10 +388,9 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
         evaluations = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes),
                                     allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair))
                        for rec, comp, pair in zip(runs, compensated, noise)]
-        windows = [ev.window_s for ev in evaluations]
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
-        sections.update(_axis_sections(calibration, runs, compensated, windows))
+        sections.update(_axis_sections(calibration, runs, compensated, [ev.window_s for ev in evaluations]))
         costs = firmware_costs(calibration)
         if costs:
             sections["firmware"] = ("On the autopilot", _firmware(calibration, runs, evaluations, costs))
