@@ -124,3 +124,22 @@ def test_fit_and_evaluate_state_the_drift_to_expect_from_one_run(tmp_path):
         sel = model[e["axis"]]
         assert e["drift_dps"] == sel["chosen_drift_dps"] and e["standard_error_dps"] == sel["chosen_standard_error_dps"]
         assert e["fold_kind"] == "legs" and e["folds"] == 4 and not e["thin"]
+
+
+def test_a_log_too_short_to_judge_at_one_temperature_is_refused_with_the_reason(tmp_path):
+    """Six samples at one temperature (a truncated log): before, fitted into a model of constants (exit 0) with
+    'no static segment found' printed twice; now refused in one line saying why and what to do, each warning once,
+    no model file; asked for the constants alone, fitted."""
+    rows = ["time,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z,temperature"] + [
+        f"{0.1 * k:.1f},0.1,0.2,{0.3 + 0.001 * k},0.01,0.02,{1.0 + 0.01 * k},{40.0 + 0.05 * k:.2f}" for k in range(6)]
+    (tmp_path / "short.csv").write_text("\n".join(rows) + "\n")
+    done = run("fit", tmp_path / "short.csv", "-o", tmp_path / "m.json")
+    assert done.returncode == 2 and not (tmp_path / "m.json").exists()
+    errors = [line for line in done.stderr.splitlines() if "error" in line]
+    assert errors == [f"gyrocomp: error: {tmp_path / 'short.csv'}: 6 samples over 0.25 degC: too little to hold any "
+                      "of it out, and no temperature range to fit a curve over; a calibration needs runs over a "
+                      "temperature range (for the turn-on constants alone, fit with --temperature None)"]
+    warned = [line for line in done.stderr.splitlines() if "warning" in line]
+    assert len(warned) == len(set(warned)), warned  # each said once
+    constants = run("fit", tmp_path / "short.csv", "-o", tmp_path / "m.json", "--temperature", "none")
+    assert constants.returncode == 0, constants.stderr

@@ -683,16 +683,18 @@ class ThermalHysteresisModel(LearnedAttributes):
             self.g_squared_se_dps_per_g2_[axis] = q_se
 
 
-def static_pieces(recordings: list[Recording], min_duration_s: float) -> tuple[list, list[list[slice] | None]]:
+def static_pieces(recordings: list[Recording], min_duration_s: float,
+                  warn: bool = True) -> tuple[list, list[list[slice] | None]]:
     """Per run, its static segments and the stretches a fit uses: the static segments where the unit moves
-    between positions (runs with an accelerometer), else None (every stretch between time gaps)."""
+    between positions (runs with an accelerometer), else None (every stretch between time gaps); with ``warn``,
+    a run with an accelerometer but no static segment is said (once per fit: the model choice asks without)."""
     segments, out = [], []
     for rec in recordings:
         # an accelerometer's own model uses the pieces it is given: its motion is what it measures
         moves = rec.accel_g is not None and PreparedRun.of(rec).channel == "gyro"
         segs = PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if moves else []
         segments.append(segs)
-        if moves and not segs:
+        if moves and not segs and warn:
             warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
                           DataQualityWarning, stacklevel=3)
         out.append([slice(g.start, g.stop) for g in segs] if segs else None)

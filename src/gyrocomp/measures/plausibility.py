@@ -337,16 +337,31 @@ def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray,
         return None
     slope = float(x @ y) / sxx
     residual = y - slope * x
-    standard_error = math.sqrt(float(residual @ residual) / (x.size - 2) / sxx)
+    # blocks whose residual is a slow drift (neighbours alike) are fewer independent ones: the standard error is
+    # that of the effective number of blocks, n (1 - r) / (1 + r), r the residual's lag-1 correlation (a drift of
+    # the part over a stretch where the prediction varies little is then not read as a slope, nor as a unit)
+    r = _lag_one_correlation(residual)
+    effective = max(x.size * (1.0 - r) / (1.0 + r), 3.0)
+    standard_error = math.sqrt(float(residual @ residual) / (x.size - 2) / sxx * (x.size - 2) / (effective - 2))
     offset, offset_se, slope_d = _direction_fit(x, y, temperature_means)
     return ScaleAgreement(slope * y_scale / scale, standard_error * y_scale / scale, int(x.size),
                           offset * y_scale, offset_se * y_scale, slope_d * y_scale / scale)
 
 
+def _lag_one_correlation(residual: np.ndarray) -> float:
+    """The lag-1 autocorrelation of ``residual`` (about its mean), within [0, 0.95] (a negative one is taken as
+    none: it would only shrink the standard error)."""
+    e = residual - residual.mean()
+    denominator = float(e @ e)
+    if e.size < 3 or denominator <= 0:
+        return 0.0
+    return float(np.clip(float(e[1:] @ e[:-1]) / denominator, 0.0, 0.95))
+
+
 def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) -> Concern | None:
     """The ``agreement`` concern of an axis whose output does not follow the model (see the module), naming the
     known mistake its slope matches."""
-    if agreement is None or not agreement.disagrees:
+    if agreement is None or not (agreement.disagrees or agreement.follows_direction):
         return None
     slope = agreement.slope
     known = next((words for ratio, words in KNOWN_SLOPES if abs(slope / ratio - 1.0) < 0.25), None)

@@ -119,7 +119,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     """
     if folds not in FOLD_KINDS:
         raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
-    _, pieces = static_pieces(recordings, static_min_duration_s)
+    _, pieces = static_pieces(recordings, static_min_duration_s, warn=False)  # the final fit says it
     accel_cols: tuple[int, ...] = ()
     square_cols: tuple[int, ...] = ()
     problems = {}
@@ -216,6 +216,7 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
                                bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
                                folds=options.folds, do_no_harm=order == "auto",
                                curves=tuple(BASES) if order == "auto" and options.target == "model" else ("poly",))
+    _refuse_what_cannot_be_judged(recordings, selections)
     thermal = _fit_chosen(recordings, selections, options, accel_mode)
     unseen = {axis for axis, sel in selections.items()
               if sel.lag_from_unit and not thermal.lag_evidence_[axis] > LAG_EVIDENCE_CHI2}
@@ -226,6 +227,19 @@ def _fit_selected(recordings: list[Recording], order: int | str, options: FitOpt
         thermal = _fit_chosen(recordings, selections, options, accel_mode)
     _warn_about_choice(selections)
     return selections, thermal
+
+
+def _refuse_what_cannot_be_judged(recordings: list[Recording], selections: dict[str, AxisSelection]) -> None:
+    """Refuse runs that neither span a temperature range nor hold enough data to hold any of it out: nothing
+    could be fitted or validated there but the constants, and a model file of constants would pass for a
+    calibration (a log of a few samples at one temperature, e.g. a truncated ULog)."""
+    if any(sel.validated for sel in selections.values()) or temperature_span_concern(recordings) is None:
+        return
+    rows = sum(rec.n_samples for rec in recordings)
+    span = max(float(np.ptp(rec.temperature_degc)) for rec in recordings)
+    raise InputError(f"{recordings[0].source}: {rows} samples over {span:.3g} degC: too little to hold any of it "
+                     "out, and no temperature range to fit a curve over; a calibration needs runs over a temperature "
+                     "range (for the turn-on constants alone, fit with temperature=None)")
 
 
 def _fit_chosen(recordings: list[Recording], selections: dict[str, AxisSelection], options: FitOptions,
