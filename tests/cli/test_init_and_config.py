@@ -66,7 +66,7 @@ def test_init_then_every_command_without_flags(tmp_path):
     assert out[0] == (tmp_path / first.name).read_text().splitlines()[0] and "\t" in out[1] and "," not in out[1]
     for command in (("fit", "out.tsv", "-o", "again.json"), ("evaluate", "m.json", "out.tsv", "--json"),
                     ("apply", "m.json", "out.tsv", "-o", "twice.tsv"), ("report", "m.json", "out.tsv", "-o", "o.html"),
-                    ("export", "m.json", "--format", "ardupilot", "-o", "m.parm"), ("export", "m.json", "--format", "c", "-o", "c")):
+                    ("export", "m.json", "-o", "m.parm"), ("export", "m.json", "-o", "c")):  # the format by name
         done = run(*command, cwd=tmp_path)
         assert done.returncode == 0 or (command[0] == "report" and "matplotlib" in done.stderr), (command, done.stderr)
     again = json.loads(run("evaluate", "m.json", "out.tsv", "--json", cwd=tmp_path).stdout)["runs"][0]["axes"]

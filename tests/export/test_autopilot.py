@@ -127,6 +127,15 @@ def test_cli_export(tmp_path):
     assert "the INS_TCAL<n>_* group is hidden until then" in (tmp_path / "tc.parm").read_text()
     r = run("export", tmp_path / "m.json", "--format", "simulink", "-o", tmp_path / "x.slx")
     assert r.returncode == 2 and "Invalid value for '--format'" in r.stderr
+    # without --format, the name says it: .params is PX4's, .parm ArduPilot's, a folder without a suffix C
+    r = run("export", tmp_path / "m.json", "-o", tmp_path / "by_name.parm")
+    assert r.returncode == 0 and "INS_TCAL1_GYR1_X" in (tmp_path / "by_name.parm").read_text()
+    r = run("export", tmp_path / "m.json", "-o", tmp_path / "by_name.params", "--device-id", "7")
+    assert r.returncode == 0 and "TC_G0_X" in (tmp_path / "by_name.params").read_text()
+    r = run("export", tmp_path / "m.json", "-o", tmp_path / "x.slx")
+    assert r.returncode == 2 and r.stderr.strip() == (
+        "gyrocomp: error: --format: not given, and 'x.slx' names none; give it (px4, ardupilot, c), or name the "
+        "file .params (px4), .parm (ardupilot), .param (ardupilot), or a folder without a suffix (c)")
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and "this is an input file" in r.stderr
 

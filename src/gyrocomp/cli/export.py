@@ -6,7 +6,7 @@ import click
 
 from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs
-from ..export.formats import EXPORTERS, ExportOptions, export_to
+from ..export.formats import EXPORTERS, ExportOptions, export_to, format_of
 from ..fitting.online import LearnerSettings, OnlineCalibrator
 from .common import FINITE
 
@@ -17,9 +17,11 @@ EXPORT_FORMATS = tuple(name for name in EXPORTERS if name != "json")
 
 @click.command()
 @click.argument("model", type=click.Path())
-@click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), required=True,
-              help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters), "
-                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o, with the online learner beside them: gyrocomp_learn.h, gyrocomp_learn.c).")
+@click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), default=None,
+              help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters, .parm), "
+                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o, with the online learner "
+                   "beside them: gyrocomp_learn.h, gyrocomp_learn.c); default: the one -o's name says (.params, "
+                   ".parm, a folder without a suffix).")
 @click.option("-o", "--output", required=True, type=click.Path(), help="Parameter file to write (c: a folder).")
 @click.option("--rate", "rate_hz", type=FINITE, default=None,
               help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")
@@ -37,6 +39,7 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id, accel_device_i
     """Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code."""
 
     refuse_to_overwrite_inputs(output, [model] + ([learner_state] if learner_state else []))
+    fmt = fmt or format_of(output, EXPORT_FORMATS)
     if learner_state is not None and fmt != "c":
         raise click.BadParameter("the learner is exported with --format c only", param_hint="--learner")
     settings = OnlineCalibrator.load(learner_state).settings if learner_state else None

@@ -50,12 +50,15 @@ class Exported:
 
 @dataclass(frozen=True)
 class Exporter:
-    """A registered format: ``write(calibration, path, options)`` writes it and says what it wrote."""
+    """A registered format: ``write(calibration, path, options)`` writes it and says what it wrote; ``suffixes``:
+    the file names that mean it when no format is named (none for a format written into a folder, ``folder``)."""
 
     name: str
     description: str
     cannot_carry: str
     write: Callable[[Calibration, Path, ExportOptions], Exported]
+    suffixes: tuple[str, ...] = ()
+    folder: bool = False
 
 
 EXPORTERS: dict[str, Exporter] = {}
@@ -67,6 +70,22 @@ def register(exporter: Exporter) -> Exporter:
         raise InputError(f"export format {exporter.name!r} is registered already")
     EXPORTERS[exporter.name] = exporter
     return exporter
+
+
+def format_of(path, offered: tuple[str, ...] | None = None) -> str:
+    """The export format a path names, among ``offered`` (default every registered one): the one whose
+    ``suffixes`` hold its suffix, or the one written into a folder when it has none; refuses a name that says
+    none, naming the suffixes there are."""
+    offered = tuple(EXPORTERS) if offered is None else offered
+    suffix = Path(path).suffix.lower()
+    for name in offered:
+        exporter = EXPORTERS[name]
+        if (suffix and suffix in exporter.suffixes) or (not suffix and exporter.folder):
+            return name
+    named = ", ".join(f"{s} ({n})" for n in offered for s in EXPORTERS[n].suffixes)
+    folders = [n for n in offered if EXPORTERS[n].folder]
+    raise InputError(f"fmt: not given, and {Path(path).name!r} names none; give it ({', '.join(offered)}), or "
+                     f"name the file {named}" + (f", or a folder without a suffix ({folders[0]})" if folders else ""))
 
 
 def export_to(calibration: Calibration, fmt: str, path, options: ExportOptions = ExportOptions()) -> Exported:
@@ -114,12 +133,13 @@ def _autopilot(target: str) -> Callable[[Calibration, Path, ExportOptions], Expo
 
 
 register(Exporter("px4", "PX4 TC_G*/TC_A* parameters (QGroundControl .params)",
-                  "lag, hysteresis, g-sensitivity, gyro scale factor; a cubic held at TMIN/TMAX", _autopilot("px4")))
+                  "lag, hysteresis, g-sensitivity, gyro scale factor; a cubic held at TMIN/TMAX", _autopilot("px4"),
+                  suffixes=(".params",)))
 register(Exporter("ardupilot", "ArduPilot INS_TCAL* parameters (.parm)",
                   "lag, hysteresis, g-sensitivity, gyro scale factor, the constant; a cubic about 35 degC held at "
-                  "TMIN/TMAX", _autopilot("ardupilot")))
+                  "TMIN/TMAX", _autopilot("ardupilot"), suffixes=(".parm", ".param")))
 register(Exporter("c", "the whole model as C99 (gyrocomp.h, gyrocomp.c) with the online learner beside it",
-                  "a temperature from each axis's own sensor (the C interface takes one)", _c))
-register(Exporter("json", "the model file itself", "nothing", _json))
+                  "a temperature from each axis's own sensor (the C interface takes one)", _c, folder=True))
+register(Exporter("json", "the model file itself", "nothing", _json, suffixes=(".json",)))
 
-__all__ = ["EXPORTERS", "ExportOptions", "Exported", "Exporter", "export_to", "register"]
+__all__ = ["EXPORTERS", "ExportOptions", "Exported", "Exporter", "export_to", "format_of", "register"]
