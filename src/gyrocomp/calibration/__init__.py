@@ -29,14 +29,27 @@ from ..curves.network import NetworkCurve
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, memory_curve_from_dict
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
 from .triad import TriadCalibration
+from .schema import TEMPERATURE_CHANNELS, UNITS, validate_model
 from ..units import AxisUnit, check_axis_unit, in_unit, require_unit
 
 FORMAT_NAME = "gyrocomp-calibration"
 SCHEMA_VERSION = 6
 
 
+def _refuse_later_fields(d: dict, version: int, top: tuple[str, ...] = (), per_axis: tuple[str, ...] = ()) -> None:
+    """A file that says schema ``version`` but holds what a later schema added (its version edited by hand, or
+    copied from another file) is refused: upgrading it would overwrite those values with the defaults."""
+    found = [key for key in top if key in d]
+    axes = d.get("axes") if isinstance(d.get("axes"), dict) else {}
+    found += [f"axes.{name}.{key}" for name, ax in axes.items() if isinstance(ax, dict) for key in per_axis if key in ax]
+    if found:
+        raise InputError(f"schema_version {version}: the file holds {found[0]}, which schema {version + 1} added; "
+                         "its schema_version was changed by hand? (write it again with gyrocomp fit)")
+
+
 def _upgrade_1_to_2(d: dict) -> dict:
     """Schema 2 adds thermal lag and hysteresis per axis; a schema-1 file has neither."""
+    _refuse_later_fields(d, 1, (), ("lag_time_constant_s", "hysteresis"))
     d = dict(d)
     if isinstance(d.get("axes"), dict):
         d["axes"] = {name: {**ax, "lag_time_constant_s": 0.0, "hysteresis": None} if isinstance(ax, dict) else ax
@@ -47,6 +60,7 @@ def _upgrade_1_to_2(d: dict) -> dict:
 
 def _upgrade_2_to_3(d: dict) -> dict:
     """Schema 3 adds the g-sensitivity per axis; a schema-2 file has none."""
+    _refuse_later_fields(d, 2, (), ("g_sensitivity_dps_per_g", "g_squared_dps_per_g2"))
     d = dict(d)
     if isinstance(d.get("axes"), dict):
         d["axes"] = {name: {**ax, "g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None}
@@ -57,6 +71,7 @@ def _upgrade_2_to_3(d: dict) -> dict:
 
 def _upgrade_3_to_4(d: dict) -> dict:
     """Schema 4 adds a network on the accelerations per axis (pipeline mlp>mlp-accel); schema 3 has none."""
+    _refuse_later_fields(d, 3, (), ("acceleration_network",))
     d = dict(d)
     if isinstance(d.get("axes"), dict):
         d["axes"] = {name: {**ax, "acceleration_network": None} if isinstance(ax, dict) else ax
@@ -67,6 +82,7 @@ def _upgrade_3_to_4(d: dict) -> dict:
 
 def _upgrade_4_to_5(d: dict) -> dict:
     """Schema 5 adds accelerometer temperature models; older files have none."""
+    _refuse_later_fields(d, 4, ("accel_axes", "accel_reference_degc"), ())
     d = dict(d)
     d.setdefault("accel_axes", {})
     d.setdefault("accel_reference_degc", None)
@@ -76,6 +92,7 @@ def _upgrade_4_to_5(d: dict) -> dict:
 
 def _upgrade_5_to_6(d: dict) -> dict:
     """Schema 6 adds scale factor and misalignment of the gyro and accelerometer triads; older files have none."""
+    _refuse_later_fields(d, 5, ("gyro_triad", "accel_triad"), ())
     d = dict(d)
     d.setdefault("gyro_triad", None)
     d.setdefault("accel_triad", None)
@@ -86,86 +103,30 @@ def _upgrade_5_to_6(d: dict) -> dict:
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
 UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4,
                                                4: _upgrade_4_to_5, 5: _upgrade_5_to_6}
-UNITS = {"gyro": "deg/s", "temperature": "degC", "time": "s", "accel": "g"}
-
-
-#: the temperature channels a model may read: one shared, or one per gyro axis
-TEMPERATURE_CHANNELS = (TEMPERATURE_COLUMN, *(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES))
-#: no number in a model file is larger than this in magnitude (deg/s, g, degC, s, network weights)
-MAX_MAGNITUDE = 1e9
-#: the longest list a model file holds (network weights of the largest network the fitter builds)
-MAX_LIST = 10000
-#: the most polynomial or hysteresis coefficients a curve may have
-MAX_COEFFICIENTS = 10
-
-
-def _check_numbers(value: Any, where: str) -> None:
-    """Every number under ``value`` finite, of a size a sensor model can have, and written as a number (not as
-    text such as ``"NaN"``), and every list of a sane length; the error names the field
-    (``axes.gyro_z.temperature.coefficients_dps[0]``)."""
+def _require_finite(value: Any, where: str = "") -> None:
+    """Every number under ``value`` finite (a NaN passes any bound a schema sets: it compares false), the error
+    naming the field (``axes.gyro_z.temperature.coefficients_dps[0]``), in the fit report too (show formats it)."""
     if isinstance(value, dict):
         for key, item in value.items():
-            _check_numbers(item, f"{where}.{key}")
+            _require_finite(item, f"{where}.{key}" if where else str(key))
     elif isinstance(value, list):
-        if len(value) > MAX_LIST:
-            raise InputError(f"{where}: {len(value)} values; at most {MAX_LIST}")
         for k, item in enumerate(value):
-            _check_numbers(item, f"{where}[{k}]")
-    elif isinstance(value, (int, float)) and not isinstance(value, bool):
-        if not math.isfinite(value):
-            raise InputError(f"{where}: {value} is not a finite number")
-        if abs(value) > MAX_MAGNITUDE:
-            raise InputError(f"{where}: {value:g} is beyond any MEMS sensor's range")
-    elif isinstance(value, str):  # float() would take "NaN" or "1e5" where a number belongs: refuse text numbers
-        try:
-            float(value)
-        except ValueError:
-            return
-        raise InputError(f"{where}: {value!r} is text, not a number")
+            _require_finite(item, f"{where}[{k}]")
+    elif isinstance(value, float) and not math.isfinite(value):
+        raise InputError(f"{where}: {value} is not a finite number")
 
 
-def _check_axis(section: str, name: str, d: Any, allowed: tuple[str, ...]) -> None:
-    """What the numbers alone do not say: a known axis, a known temperature channel, the entries present, at
-    least one run constant, a lag that is a time constant, curves of sane size with ordered ranges."""
-    if name not in allowed:
-        raise InputError(f"{section}: {name!r} is not a {allowed[0].split('_')[0]} axis; use {', '.join(allowed)}")
-    where = f"{section}.{name}"
-    if not isinstance(d, dict):
-        raise InputError(f"{where}: not an object")
-    if "temperature" not in d:
-        raise InputError(f"{where}: no 'temperature' entry (null for none)")
-    column = d.get("temperature_column", TEMPERATURE_COLUMN)
-    if column not in TEMPERATURE_CHANNELS:
-        raise InputError(f"{where}.temperature_column: {column!r} is not a temperature channel; "
-                         f"use {', '.join(TEMPERATURE_CHANNELS)}")
-    if section == "axes" and not d.get("turn_on_biases_dps"):  # accelerometer models have a reference instead
-        raise InputError(f"{where}.turn_on_biases_dps: no values")
-    lag = d.get("lag_time_constant_s", 0.0)
-    if isinstance(lag, (int, float)) and lag < 0:
-        raise InputError(f"{where}.lag_time_constant_s: {lag:g} s; a time constant is 0 (none) or positive")
-    curves = [("temperature", d["temperature"], ("coefficients_dps",)),
-              ("hysteresis", d.get("hysteresis"), ("descending_dps", "ascending_dps", "coefficients_dps"))]
-    for key, curve, lists in curves:
-        if not isinstance(curve, dict):
-            continue
-        for field_name in lists:
-            if len(curve.get(field_name) or ()) > MAX_COEFFICIENTS:
-                raise InputError(f"{where}.{key}.{field_name}: {len(curve[field_name])} values; "
-                                 f"at most {MAX_COEFFICIENTS}")
-        lo, hi = curve.get("t_min_degc"), curve.get("t_max_degc")
-        if isinstance(lo, (int, float)) and isinstance(hi, (int, float)) and lo > hi:
-            raise InputError(f"{where}.{key}: t_min_degc {lo:g} is above t_max_degc {hi:g}")
-
-
-def _check_model(d: dict) -> None:
-    for section, allowed in (("axes", GYRO_AXES), ("accel_axes", ACCEL_AXES)):
-        axes = d.get(section) or {}
-        if not isinstance(axes, dict):
-            raise InputError(f"{section}: not an object")
-        for name, ax in axes.items():
-            _check_axis(section, name, ax, allowed)
-        _check_numbers(axes, section)
-    _check_numbers(d.get("accel_reference_degc"), "accel_reference_degc")
+def _check_ranges(d: dict) -> None:
+    """What the schema cannot say: each curve's range in order (its minimum at or below its maximum)."""
+    for section in ("axes", "accel_axes"):
+        for name, ax in d[section].items():
+            for key in ("temperature", "hysteresis", "acceleration_network"):
+                curve = ax.get(key)
+                if isinstance(curve, dict) and isinstance(curve.get("t_min_degc"), (int, float)) \
+                        and isinstance(curve.get("t_max_degc"), (int, float)) \
+                        and curve["t_min_degc"] > curve["t_max_degc"]:
+                    raise InputError(f"{section}.{name}.{key}: t_min_degc {curve['t_min_degc']:g} is above "
+                                     f"t_max_degc {curve['t_max_degc']:g}")
 
 
 def _check_triads(triads: dict[str, TriadCalibration | None], axes: dict) -> None:
@@ -457,11 +418,13 @@ class Calibration:
                 f"{source}: written with model schema {version}, this gyrocomp reads schema {SCHEMA_VERSION} "
                 "and older; upgrade gyrocomp to read it"
             )
-        while version < SCHEMA_VERSION:
-            d = UPGRADES[version](d)
-            version += 1
         try:
-            _check_model(d)
+            while version < SCHEMA_VERSION:
+                d = UPGRADES[version](d)
+                version += 1
+            _require_finite(d)  # NaN compares false with any bound: named here, with its field
+            validate_model(d)  # the published schema: every field typed, bounded, known (schema.py)
+            _check_ranges(d)
             axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
             accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False), unit="g")
                           for name, ax in d["accel_axes"].items()}
@@ -473,8 +436,13 @@ class Calibration:
             reference = d["accel_reference_degc"]
             if accel_axes and reference is None:
                 raise InputError("accel_axes need accel_reference_degc")
+            report = dict(d.get("fit_report", {}))
+            try:  # what show and the report read of it: typed, so that a damaged report is refused here
+                FitReport.from_dict(report)
+            except (KeyError, TypeError, ValueError, AttributeError, IndexError) as exc:
+                raise InputError(f"fit_report: malformed ({type(exc).__name__}: {exc})") from None
             return cls(axes=axes, model=str(d["model"]), provenance=dict(d.get("provenance", {})),
-                       fit_report=dict(d.get("fit_report", {})), schema_version=SCHEMA_VERSION,
+                       fit_report=report, schema_version=SCHEMA_VERSION,
                        accel_axes=accel_axes, accel_reference_degc=None if reference is None else float(reference),
                        **triads)
         except InputError as exc:
@@ -497,5 +465,5 @@ class Calibration:
         except OSError as exc:  # permissions, a symbolic link loop, a device that fails
             raise InputError(f"{path}: cannot read the model file ({(exc.strerror or type(exc).__name__).lower()})") from None
         data = jsontext.loads(text, str(path), "model file",
-                              "the file may be truncated, write it again with gyrocomp fit")
+                              "the file may be truncated, write it again with gyrocomp fit", non_finite=True)
         return cls.from_dict(data, source=str(path))

@@ -12,7 +12,7 @@ from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, t
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..io.stream import CHUNK_ROWS
 from ..measures.plausibility import BlockMeans, ScaleAgreement, agreement_concern, recording_concerns, scale_agreement
-from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 
 
 class Compensator:
@@ -189,11 +189,25 @@ class Compensator:
                 continue
             if temperature_degc is None:
                 raise InputError(f"{self.source}: the model needs temperature, the data has none")
-            t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc[:, j]
+            t = self._temperature_of(self.gyro_axes[j], ax, temperature_degc, j)
             if time_s.size == 0:
                 continue
             out[:, j] -= self._temperature_error(self.gyro_axes[j], ax, time_s, t, accel_g)
         return out
+
+    def _temperature_of(self, axis: str, ax, temperature_degc: np.ndarray, j: int) -> np.ndarray:
+        """The temperature column the model of ``axis`` reads (its ``temperature_column``): the one shared column, or
+        the axis's own of one per axis; a model fitted on one of them is not applied to the other without a word."""
+        shared = ax.temperature_column == TEMPERATURE_COLUMN
+        if temperature_degc.ndim == 1:
+            if not shared:
+                raise InputError(f"{self.source}: the model of {axis} reads {ax.temperature_column!r} (one temperature "
+                                 "per axis); the data has one temperature column (map its columns with columns=)")
+            return temperature_degc
+        if shared:
+            raise InputError(f"{self.source}: the model of {axis} reads one temperature column ('temperature'); the "
+                             "data has one per axis (map the one to read with columns={'temperature': 'NAME'})")
+        return temperature_degc[:, j]
 
     def _subtract_constants(self, residual: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
         """The bias-free residual, then (with a gyro triad) K(T)^-1 applied to the three axes [deg/s]."""
