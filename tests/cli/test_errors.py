@@ -279,3 +279,25 @@ def test_window_inf_and_learn_rate_0_are_refused(workdir, tmp_path):
     assert r.returncode == 2 and "Invalid value for '--window': inf is not a finite number" in r.stderr
     r = run("learn", workdir / "run1.csv", "--rate", "0", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--rate: must be positive, got 0" in r.stderr
+
+
+def test_a_closed_or_full_standard_output_is_no_internal_error(workdir, tmp_path):
+    """stdout closed (>&-): the command runs, what it would print goes nowhere (before: an internal error on
+    sys.stdout None); stdout on a full disk (> /dev/full): fit fails in one line before it writes the model file
+    (before: exit 2 with the model file left); stdout read by head -1: a quiet end, no traceback."""
+    exe = shutil.which("gyrocomp") or str(Path(sys.executable).with_name("gyrocomp"))
+    closed = subprocess.run([exe, "show", str(workdir / "model.json")], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True, timeout=120,
+                            preexec_fn=lambda: os.close(1))
+    assert closed.returncode == 0 and "internal error" not in closed.stderr, closed.stderr
+    if Path("/dev/full").exists():
+        with open("/dev/full", "w") as full:
+            done = subprocess.run([exe, "fit", str(workdir / "run1.csv"), str(workdir / "run2.csv"), "-o",
+                                   str(tmp_path / "m.json")], stdout=full, stderr=subprocess.PIPE, text=True,
+                                  timeout=300)
+        assert done.returncode == 2 and done.stderr.strip().splitlines()[-1] == (
+            "gyrocomp: error: no space left on device; the disk is full; free space and run again")
+        assert not (tmp_path / "m.json").exists()
+    piped = subprocess.run(f"'{exe}' show '{workdir / 'model.json'}' | head -1", shell=True, capture_output=True,
+                           text=True, timeout=120)
+    assert piped.stdout.count("\n") == 1 and "Traceback" not in piped.stderr and "error" not in piped.stderr

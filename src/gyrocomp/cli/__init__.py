@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import errno
 import importlib
+import os
 import re
 import signal
 import sys
@@ -205,6 +206,8 @@ def main(argv: list[str] | None = None) -> int:
         _exit_on_termination()
     args = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in args
+    if sys.stdout is None or sys.stdout.closed:  # run with stdout closed (>&-): what it would print goes nowhere
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 - for the rest of the process
     previous = warnings.showwarning
     warnings.showwarning = _show_warning
     try:

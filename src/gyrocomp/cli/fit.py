@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import click
@@ -109,17 +110,19 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):
             fits[instance] = fit_runs(recordings, options, channels=channels, pipeline=pipeline,
                                       scale_factor=scale_factor)
-    if every:  # one model file per instance, all written or none
-        out = Path(output)
-        names = {instance: f"{out.stem}_imu{instance}{out.suffix}" for instance in fits}
-        write_texts_atomic(out.parent, {names[i]: c.to_json() for i, c in fits.items()})
-        written = {i: out.parent / names[i] for i in fits}
-    else:
-        fits[None].save(output)
-        written = {None: output}
+    out = Path(output)
+    names = {instance: f"{out.stem}_imu{instance}{out.suffix}" for instance in fits} if every else {None: out.name}
+    written = {i: out.parent / names[i] for i in fits}
+    # what the fit found is printed before the files are written: a standard output that fails (a full disk
+    # behind > file) fails the command before it leaves a model file, not after
     if not ctx.obj["quiet"]:
         for instance, calibration in fits.items():
             print_fit(calibration, written[instance])
+        sys.stdout.flush()
+    if every:  # one model file per instance, all written or none
+        write_texts_atomic(out.parent, {names[i]: c.to_json() for i, c in fits.items()})
+    else:
+        fits[None].save(output)
 
 
 def _common_instances(runs: list[str], fmt: str | None) -> list[int]:
