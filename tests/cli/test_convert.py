@@ -6,10 +6,13 @@ import os
 import pty
 import subprocess
 import sys
+import warnings
 
 import pytest
 
 from gyrocomp import read
+from gyrocomp.files.chunks import ChunkSettings
+from gyrocomp.files.convert import convert_file
 from gyrocomp.io.tables import write_recording
 from gyrocomp.simulation import simulate
 
@@ -75,3 +78,34 @@ def test_progress_bar_on_a_terminal_only(report_files):
     assert bar not in stderr_of("--quiet")
     piped = run("convert", d / "run2.csv", d / "piped.parquet")
     assert bar.decode() not in piped.stderr  # not a terminal: no bar
+
+
+def _implausible_table(path):
+    lines = [f"{i * 0.1:.1f},{0.01 * i:.3f},25.0" for i in range(3000)]
+    lines[1200] = "120.0,0.1,400.0"
+    lines[2200] = "220.0,0.2,450.0"
+    lines[2500] = "250.0,6000.0,25.0"
+    path.write_text("time,gyro_z,temperature\n" + "\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("selected", [[], ["--time", "0:"]])
+def test_convert_says_what_is_implausible_in_what_it_converts_once_per_kind(tmp_path, selected):
+    """A converted file is read again later: a temperature no sensor reaches and a rate beyond any gyro's range
+    are said now, once each with the first row, in the chunked and (rows selected by time) the whole-file path;
+    the file is still written (nothing is impossible, only implausible)."""
+    _implausible_table(tmp_path / "in.csv")
+    r = run("convert", tmp_path / "in.csv", tmp_path / "out.parquet", *selected)
+    warned = [line for line in r.stderr.splitlines() if "warning" in line]
+    assert r.returncode == 0 and (tmp_path / "out.parquet").exists(), r.stderr
+    assert len(warned) == 2, r.stderr
+    assert "row 1201: temperature 400 degC, beyond any sensor's range" in warned[0] + warned[1]
+    assert "gyro values up to 6000 deg/s, beyond any MEMS gyro's range" in warned[0] + warned[1]
+
+
+def test_convert_in_many_chunks_says_each_kind_once(tmp_path):
+    _implausible_table(tmp_path / "in.csv")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        convert_file(tmp_path / "in.csv", tmp_path / "out.csv", chunks=ChunkSettings(chunk_rows=1000))
+    said = [str(w.message) for w in caught]
+    assert len(said) == 2 and "row 1201: temperature 400 degC" in said[0] and "6000 deg/s" in said[1], said

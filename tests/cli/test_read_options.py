@@ -74,3 +74,28 @@ def test_the_project_file_read_section_takes_the_reading_options_of_the_command(
     (tmp_path / "gyrocomp.toml").write_text('[read]\ndrop-nan = true\nwindoww = 3\n')
     r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv", cwd=tmp_path)
     assert r.returncode == 2 and "[read] windoww: not a reading option; use accel-unit, columns" in r.stderr
+
+
+def test_the_project_file_in_use_is_named_once_with_what_it_sets(workdir, tmp_path):
+    """A gyrocomp.toml left in a folder changes what every command there reads: the command says so, once, on
+    stderr, naming the options it set; an option given on the command line (a switch's off form too) wins and is
+    not named; --quiet and --help say nothing."""
+    (tmp_path / "gyrocomp.toml").write_text('[read]\ndrop-nan = true\n[apply]\naxes = "gyro_z"\n')
+    args = ("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv")
+    r = run(*args, cwd=tmp_path)
+    notes = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: note:")]
+    assert r.returncode == 0 and notes == ["gyrocomp: note: gyrocomp.toml sets --axes, --drop-nan (an "
+                                           "option on the command line wins; gyrocomp config show prints the "
+                                           "file)"], r.stderr
+    r = run(*args, "--no-drop-nan", "--axes", "gyro_z", cwd=tmp_path)
+    assert r.returncode == 0 and "gyrocomp: note" not in r.stderr, r.stderr
+    assert "gyrocomp: note" not in run("-q", *args, cwd=tmp_path).stderr
+    assert "gyrocomp: note" not in run("apply", "--help", cwd=tmp_path).stderr
+
+
+def test_a_project_file_cannot_switch_on_what_the_command_line_could_not_switch_off(workdir, tmp_path):
+    (tmp_path / "gyrocomp.toml").write_text("[allan]\njson = true\n")
+    r = run("allan", workdir / "run3.csv", cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.strip() == (
+        "gyrocomp: error: gyrocomp.toml: json = true: a switch the command line could not turn off again; give "
+        "--json when running gyrocomp allan"), r.stderr

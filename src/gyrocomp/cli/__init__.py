@@ -12,6 +12,7 @@ the tables they print. The one-line descriptions are listed here (a test checks 
 from __future__ import annotations
 
 import errno
+import functools
 import importlib
 import os
 import re
@@ -87,6 +88,7 @@ class LazyGroup(click.Group):
             return None
         command = getattr(importlib.import_module(f"gyrocomp.cli.{COMMANDS[name][0]}"), name)
         _LOOKED_UP.append(command)
+        _name_the_project_first(command)
         if name == "init":  # init writes the project file: one that does not load must not stop it
             return command
         if PROJECT_KEY not in ctx.meta:
@@ -137,6 +139,43 @@ _LOOKED_UP: list[click.Command] = []
 #: the option objects whose fields messages name (``FitOptions.hysteresis: ...``): the field is the flag's
 _OPTION_OBJECT = re.compile(r"\b(?:FitOptions|Polynomial|Network)\.(?=\w)")
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
+
+
+def _name_the_project_first(command: click.Command) -> None:
+    """Make ``command`` (and a group's commands) say, before it runs, which of its options the project file set:
+    a ``gyrocomp.toml`` left in a folder changes what every command there reads and fits, and nothing else would
+    say so. Wrapped once; ``--help`` and a refused option stop before it."""
+    for each in (command, *getattr(command, "commands", {}).values()):
+        if each.callback is not None and not getattr(each.callback, _SAYS_PROJECT, False):
+            each.callback = _said_first(each.callback)
+
+
+def _said_first(callback):
+    @functools.wraps(callback)
+    def said_first(*args, **kwargs):
+        _name_the_project(click.get_current_context())
+        return callback(*args, **kwargs)
+
+    setattr(said_first, _SAYS_PROJECT, True)
+    return said_first
+
+
+#: the mark of a command callback that names the project file first
+_SAYS_PROJECT = "_gyrocomp_says_project"
+
+
+def _name_the_project(ctx: click.Context) -> None:
+    """One note on stderr naming the project file and the options of this command it set (not with ``--quiet``)."""
+    root = ctx.find_root()
+    project = root.meta.get(PROJECT_KEY)
+    if project is None or (root.obj or {}).get("quiet"):
+        return
+    used = [next((o for o in param.opts if o.startswith("--")), param.opts[0]) for param in ctx.command.params
+            if isinstance(param, click.Option) and param.name
+            and ctx.get_parameter_source(param.name) is click.core.ParameterSource.DEFAULT_MAP]
+    if used:
+        click.echo(f"gyrocomp: note: {printable(project.path)} sets {', '.join(used)} (an option on the command "
+                   "line wins; gyrocomp config show prints the file)", err=True)
 
 
 def _options(command: click.Command) -> list[click.Option]:

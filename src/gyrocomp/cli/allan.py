@@ -50,7 +50,7 @@ def _parse_fit_taus(text: str | None):
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write the Allan plot here (.png, .svg, .pdf).")
 @click.option("--kalibr", "kalibr", type=click.Path(dir_okay=False), help="Write Kalibr's imu.yaml here.")
 @click.option("--rostopic", default="/imu0", show_default=True, help="rostopic written into the Kalibr file.")
-@click.option("--split-gaps", is_flag=True, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
+@click.option("--split-gaps/--no-split-gaps", default=False, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
 @click.option("--fit-taus", "fit_taus_s", default=None, metavar="MIN,MAX",
               help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.")
 @read_options

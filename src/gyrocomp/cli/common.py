@@ -38,7 +38,9 @@ def click_option(name: str, spelling: Spelling, default=None):
     as the parameter's, its value parsed as the spelling says; a field's text default (a unit) is the option's
     and shown in the help, any other default (None, an empty mapping) applies when the option is not given."""
     if spelling.switch:
-        return click.option(spelling.flag, name, is_flag=True, help=spelling.help, cls=ReadingOption)
+        # with its off form: a project file that switches it on is undone on the command line
+        return click.option(f"{spelling.flag}/--no-{spelling.flag[2:]}", name, default=False, help=spelling.help,
+                            cls=ReadingOption)
     shown = isinstance(default, str)
     return click.option(spelling.flag, name, default=default if shown else None, show_default=shown,
                         metavar=spelling.metavar, help=spelling.help,

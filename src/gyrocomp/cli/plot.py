@@ -56,7 +56,7 @@ def _axis_option(axis, calibration, recording) -> str:
 @click.argument("input_path", metavar="FILE", type=click.Path())
 @click.option("--model", type=click.Path(), default=None, help="Also draw FILE compensated with this model.")
 @click.option("--axes", default=None, help="Axes to draw, e.g. gyro_x,gyro_z (default: every gyro axis).")
-@click.option("--split-gaps", is_flag=True, help="Pool the stretches between time gaps.")
+@click.option("--split-gaps/--no-split-gaps", default=False, help="Pool the stretches between time gaps.")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
 @read_options
 @click.pass_context

@@ -97,6 +97,13 @@ def defaults_for(project: Project, command: click.Command, name: str) -> dict:
             raise InputError(f"{project.path}: [{name}] {key}: gyrocomp {name.replace('.', ' ')} has no option "
                              f"--{key}")
         out[flags[key]] = value
+    switches = {param.name: param for param in command.params if isinstance(param, click.Option)
+                and param.is_flag and not param.secondary_opts}
+    for key, value in out.items():
+        if key in switches and value is True:
+            flag = next(o for o in switches[key].opts if o.startswith("--"))
+            raise InputError(f"{project.path}: {flag[2:]} = true: a switch the command line could not turn off "
+                             f"again; give {flag} when running gyrocomp {name.replace('.', ' ')}")
     for sub_name, sub in getattr(command, "commands", {}).items():
         out[sub_name] = defaults_for(project, sub, f"{name}.{sub_name}")
     return out

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 from ..io import ReadOptions, write_recording
 from ..io.stream import TableStream, TableWriter
 from ..io.tables import recording_table
+from ..measures.plausibility import recording_concerns
 from .chunks import ChunkSettings, chunked_or_whole
 
 
@@ -46,6 +48,7 @@ def convert_file(input_path, output_path, *, options: ReadOptions | None = None,
     def whole(read) -> ConvertResult:
         data = read()
         recording = data.recording
+        _warn_once(recording_concerns(recording))
         write_recording(recording, output_path, fmt=out_fmt, text_format=data.text_format)
         channels = (*recording.gyro_axes, *recording.accel_axes, *recording.temperature_columns)
         return ConvertResult(recording.n_samples, recording.duration_s, recording.rate_hz, len(recording.gaps),
@@ -58,17 +61,31 @@ def convert_file(input_path, output_path, *, options: ReadOptions | None = None,
 def _convert_stream(stream: TableStream, output_path, out_fmt) -> ConvertResult:
     first = last = None
     written = 0
+    concerns = []
     with TableWriter(output_path, out_fmt, text_format=stream.text_format) as writer:
         for chunk in stream.chunks():
             rec = chunk.recording
             first = first or rec
             last = rec
+            concerns += recording_concerns(rec)
             table = recording_table(rec)
             writer.write(table)
             written += table.num_rows
     stream.warn_summary()
+    _warn_once(concerns)
     channels = (*first.gyro_axes, *first.accel_axes, *first.temperature_columns)
     return ConvertResult(written, float(last.time_s[-1] - first.time_s[0]), first.rate_hz, stream.gaps, channels)
+
+
+def _warn_once(concerns) -> None:
+    """The plausibility concerns of what was converted (values beyond a sensor's range, kelvin, a time column in
+    another unit), the first of each kind: a converted file is read again later, and what is wrong with it is said
+    now, with its row."""
+    said = set()
+    for concern in concerns:
+        if concern.check not in said:
+            said.add(concern.check)
+            warnings.warn(concern.warning(), stacklevel=4)
 
 
 __all__ = ["ConvertResult", "convert_file"]

@@ -104,7 +104,7 @@ def recording_concerns(recording: Recording) -> list[Concern]:
     src = recording.source
     peak = float(np.max(np.abs(recording.gyro_dps))) if recording.gyro_dps.size else 0.0
     if peak > MAX_RATE_DPS:
-        out.append(Concern("rate", f"{src}: gyro values up to {peak:.3g} deg/s, beyond any MEMS gyro's range "
+        out.append(Concern("rate", f"{src}: gyro values up to {peak:.4g} deg/s, beyond any MEMS gyro's range "
                                    f"({MAX_RATE_DPS:g} deg/s): a unit mistake or a corrupt file?"))
     if recording.temperature_degc is not None:
         median = _median(recording.temperature_degc)

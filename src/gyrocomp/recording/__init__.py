@@ -60,6 +60,31 @@ def _require_finite(src: str, rows: np.ndarray, channels) -> None:
             )
 
 
+#: values no sensor's output can be, in any unit it was taken in (raw 16-bit counts stay within 65536): a gyro or an
+#: accelerometer beyond 1e6, a temperature below absolute zero or above 1e4 degC; what a damaged binary file gives
+#: (1e36..1e302) is refused here, naming its row; within these, :mod:`gyrocomp.measures.plausibility` warns about
+#: values beyond what sensors report (5000 deg/s, 1000 g, -100..200 degC)
+POSSIBLE = {"gyro": (-1e6, 1e6, "deg/s"), "accel": (-1e6, 1e6, "g"), "temperature": (-273.15, 1e4, "degC")}
+
+
+def _require_possible(src: str, rows: np.ndarray, channels) -> None:
+    """Refuse the first value no sensor can give (:data:`POSSIBLE`), naming its row and column; ``channels``
+    holds (kind, column names, array or None)."""
+    for kind, names, arr in channels:
+        if arr is None:
+            continue
+        lo, hi, unit = POSSIBLE[kind]
+        table = arr.reshape(arr.shape[0], -1)
+        bad = (table < lo) | (table > hi)
+        if bad.any():
+            first = int(np.flatnonzero(bad.any(axis=1))[0])
+            column = names[int(np.flatnonzero(bad[first])[0])]
+            value = table[first][bad[first]][0]
+            raise InputError(f"{src}: row {rows[first]}, column {column!r}: {value:.6g} {unit} is beyond what any "
+                             f"sensor gives ({lo:g}..{hi:g} {unit}): a damaged file, or a column in another unit "
+                             "than the one given?")
+
+
 def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray, dt: np.ndarray) -> None:
     """Refuse the first row whose time repeats or goes backwards."""
     bad_steps = np.flatnonzero(dt <= 0)
@@ -102,7 +127,8 @@ class Recording:
         the reference for scale-factor and misalignment calibration.
 
     Validation happens once, here: shapes agree, values are finite (readers drop
-    non-finite rows only when asked to), time strictly increases. Gaps longer than
+    non-finite rows only when asked to) and within what a sensor can give (:data:`POSSIBLE`), time strictly
+    increases. Gaps longer than
     ``GAP_FACTOR`` median sample periods are found and kept in ``gaps``; nothing is
     interpolated.
     """
@@ -164,6 +190,8 @@ class Recording:
         temp_names = _temperature_names(axes, temp is not None and temp.ndim == 2)
         _require_finite(src, rows, ((("time",), time_s), (axes, gyro), (temp_names, temp),
                                     (tuple(self.accel_axes), accel), (REFERENCE_RATE_AXES, reference)))
+        _require_possible(src, rows, (("gyro", axes, gyro), ("temperature", temp_names, temp),
+                                      ("accel", tuple(self.accel_axes), accel)))
         dt = np.diff(time_s)
         _require_increasing(src, rows, time_s, dt)
         period = float(np.median(dt))
