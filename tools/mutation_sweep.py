@@ -2,15 +2,21 @@
 through the real command line.
 
 Makes 500 corrupted logs (truncations and byte flips of the shared PX4 ULog and ArduPilot DataFlash samples,
-250 each), 150 malformed CSV tables and 150 mutated model files, runs each through ``gyrocomp convert`` (logs,
-tables; every other table with ``--drop-nan``) or ``gyrocomp apply`` (models) in this process, and classifies the outcome:
+250 each), 250 corrupted binaries written here (an HDF5 file, a Parquet table, a ROS 1 bag, ROS 2 bags in sqlite3
+and MCAP storage, 50 each), 150 malformed CSV tables and 240 mutated model files (60 each of four kinds: a
+polynomial, the default fit with lag, memory and g-sensitivity, gyro and accelerometer triads, a network), runs
+each through ``gyrocomp convert`` (logs, binaries, tables; every other table with ``--drop-nan``) or ``gyrocomp
+apply`` (models) in this process, and classifies the outcome:
 
-- ``clean``: exit 0, every number written finite, no warning;
+- ``clean``: exit 0, every number written finite, no warning (for a model: none beyond the intact model's);
 - ``warned``: exit 0 with a warning, every number written finite;
 - ``refused``: exit 2 with one line on stderr (besides warnings);
 - ``internal error``: exit 1 (a bug);
 - ``multi-line error``: a refusal of more than one line;
-- ``non-finite written``: a NaN or infinity in the output without a warning.
+- ``non-finite written``: a NaN or infinity in the output without a warning;
+- ``silently wrong``: without a word, a converted log holding values no sensor gives (beyond 5000 deg/s, outside
+  -100..200 degC) or, with its length kept, fewer rows than the intact file; a model file that is no valid model
+  (only -5 for a number keeps it one) applied to other numbers than the intact model's.
 
 The hostile part (``--hostile-only`` runs it alone) adds, each with what it must not do:
 
@@ -48,7 +54,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gyrocomp import Polynomial, fit_calibration, write
+from gyrocomp import Network, Polynomial, fit, fit_calibration, write
 from gyrocomp.cli import main
 from gyrocomp.simulation import simulate
 
@@ -82,8 +88,24 @@ def classify(status: int, lines: list[str], output: Path) -> str:
     return "warned" if warned else "clean"
 
 
-def mutated_logs(source: Path, count: int, rng: np.random.Generator):
-    blob = source.read_bytes()[:400_000]
+def judged(outcome: str, lines: list[str], output: Path, intact_rows: int | None = None) -> str:
+    """``outcome`` (:func:`classify`) made ``silently wrong`` when a written table holds what no sensor gives
+    (a gyro beyond 5000 deg/s, a temperature outside -100..200 degC) or, for a damaged file whose length is kept,
+    fewer rows than the intact file's, and nothing was said."""
+    if outcome != "clean" or not output.exists():
+        return outcome
+    table = pd.read_csv(output)
+    gyro = table[[c for c in table.columns if c.startswith("gyro_")]].to_numpy(dtype=float)
+    temperature = table[[c for c in table.columns if c.startswith("temperature")]].to_numpy(dtype=float)
+    if (np.abs(gyro) > 5000).any() or ((temperature < -100) | (temperature > 200)).any():
+        return "silently wrong"
+    if intact_rows is not None and len(table) < intact_rows:
+        return "silently wrong"
+    return outcome
+
+
+def mutated_logs(source: Path, count: int, rng: np.random.Generator, limit: int | None = 400_000):
+    blob = source.read_bytes()[:limit]
     for k in range(count):
         if k % 2 == 0:
             yield "truncated", blob[:int(rng.integers(1, len(blob)))]
@@ -120,7 +142,10 @@ def _leaves(node, prefix=()):
             yield from _leaves(value, (*prefix, i))
 
 
-def mutated_model(model: dict, rng: np.random.Generator) -> str:
+def mutated_model(model: dict, rng: np.random.Generator) -> tuple[str, bool]:
+    """One field of ``model`` deleted or replaced (None, true, -5, 1e300, a path, [], {}, 5000 ones, "NaN",
+    +-1e308), sometimes the text damaged besides; and whether the file is still a valid model (-5 for a number:
+    another model, which may apply without a word)."""
     paths = list(_leaves(model))
     path = paths[int(rng.integers(len(paths)))]
     copy = json.loads(json.dumps(model))
@@ -128,15 +153,148 @@ def mutated_model(model: dict, rng: np.random.Generator) -> str:
     for key in path[:-1]:
         parent = parent[key]
     replacements = [None, True, -5, 10 ** 300, "../../etc/passwd", [], {}, [1.0] * 5000, "NaN", 1e308, -1e308]
+    original = parent[path[-1]]
+    valid = False
     if rng.random() < 0.3:
         del parent[path[-1]]
     else:
-        parent[path[-1]] = replacements[int(rng.integers(len(replacements)))]
+        replacement = replacements[int(rng.integers(len(replacements)))]
+        valid = replacement == -5 and isinstance(original, (int, float)) and not isinstance(original, bool)
+        parent[path[-1]] = replacement
     text = json.dumps(copy, allow_nan=True)
     if rng.random() < 0.2:  # a damaged file besides: cut short or a stray byte
         cut = int(rng.integers(1, len(text)))
         text = text[:cut] if rng.random() < 0.5 else text[:cut] + "\x00" + text[cut:]
-    return text
+        valid = False
+    return text, valid
+
+
+def model_kinds(seed: int, work: Path) -> dict[str, tuple[Path, dict]]:
+    """Four kinds of model file, each with the run it applies to: a polynomial (mti10, 2 Hz chamber run), the
+    default fit of a consumer part (thermal lag, heating/cooling memory, g-sensitivity; chamber runs with static
+    positions), the same with the accelerometer (triads), and a network."""
+    chamber = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=seed).recording
+    runs = [simulate("consumer", profile="combined", duration_s=3600, rate_hz=2, seed=seed + s, unit=3).recording
+            for s in (0, 1)]
+    write(chamber, work / "chamber.csv")
+    write(runs[1], work / "combined.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return {"polynomial": (work / "chamber.csv", fit_calibration([chamber], temperature=Polynomial(2)).to_dict()),
+                "default (lag, memory, g-sensitivity)": (work / "combined.csv", fit(runs).to_dict()),
+                "gyro and accelerometer triads": (work / "combined.csv",
+                                                  fit(runs, channels=("gyro", "accel")).to_dict()),
+                "network": (work / "combined.csv",
+                            fit_calibration(runs, temperature=Network(), hysteresis="none").to_dict())}
+
+
+def mutated_models(seed: int, work: Path, rng: np.random.Generator, count: int) -> dict[str, collections.Counter]:
+    """``count`` mutations of each kind of model file, applied: a file that applies without a word (none beyond
+    what the intact model says of the run) to other numbers than the intact model's, though it is no valid model,
+    is silently wrong."""
+    results = {}
+    for label, (data, model) in model_kinds(seed, work).items():
+        counter = results.setdefault(f"model files: {label} ({count} mutated)", collections.Counter())
+        intact, reference = work / "intact.json", work / "intact_applied.csv"
+        intact.write_text(json.dumps(model), encoding="utf-8")
+        _, baseline = run_command(["apply", intact, data, "-o", reference])  # what the intact model says
+        expected = pd.read_csv(reference).select_dtypes("number").to_numpy(dtype=float)
+        for k in range(count):
+            path, out = work / f"model{k}.json", work / f"applied{k}.csv"
+            text, valid = mutated_model(model, rng)
+            path.write_text(text, encoding="utf-8")
+            out.unlink(missing_ok=True)
+            status, lines = run_command(["apply", path, data, "-o", out])
+            outcome = classify(status, [line for line in lines if line not in baseline], out)
+            if outcome == "clean" and not valid:
+                got = pd.read_csv(out).select_dtypes("number").to_numpy(dtype=float)
+                if got.shape != expected.shape or not np.allclose(got, expected, rtol=0, atol=1e-9):
+                    outcome = "silently wrong"
+            counter[outcome] += 1
+    return results
+
+
+def _bag(path: Path, recording, kind: str) -> Path:
+    """``recording`` written as a bag with an IMU and a temperature topic (``kind``: ros1, sqlite3 or mcap); the
+    file holding its messages."""
+    from rosbags.rosbag1 import Writer as Writer1
+    from rosbags.rosbag2 import StoragePlugin, Writer as Writer2
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC if kind == "ros1" else Stores.ROS2_HUMBLE)
+    types = store.types
+    writer = (Writer1(path) if kind == "ros1" else
+              Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3))
+    serialize = store.serialize_ros1 if kind == "ros1" else store.serialize_cdr
+    zeros, g_mps2 = np.zeros(9), 9.80665
+    rad = np.deg2rad(recording.gyro_dps)
+    with writer:
+        imu = writer.add_connection("/imu", "sensor_msgs/msg/Imu", typestore=store)
+        thermo = writer.add_connection("/temperature", "sensor_msgs/msg/Temperature", typestore=store)
+        for k, t in enumerate(recording.time_s + 100.0):
+            sec = int(t)
+            stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int((t - sec) * 1e9))
+            header = types["std_msgs/msg/Header"](**({"seq": k} if kind == "ros1" else {}), stamp=stamp,
+                                                   frame_id="imu")
+            vector, quaternion = types["geometry_msgs/msg/Vector3"], types["geometry_msgs/msg/Quaternion"]
+            msg = types["sensor_msgs/msg/Imu"](
+                header=header, orientation=quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=zeros,
+                angular_velocity=vector(*rad[k]), angular_velocity_covariance=zeros,
+                linear_acceleration=vector(*(recording.accel_g[k] * g_mps2)), linear_acceleration_covariance=zeros)
+            writer.write(imu, int(t * 1e9), serialize(msg, "sensor_msgs/msg/Imu"))
+            msg = types["sensor_msgs/msg/Temperature"](header=header, temperature=float(recording.temperature_degc[k]),
+                                                       variance=0.0)
+            writer.write(thermo, int(t * 1e9), serialize(msg, "sensor_msgs/msg/Temperature"))
+    return path if kind == "ros1" else next(p for p in path.iterdir() if p.suffix in (".db3", ".mcap"))
+
+
+def _hdf5(path: Path, recording) -> Path:
+    import h5py
+
+    with h5py.File(path, "w") as fh:
+        fh["time"] = recording.time_s
+        for k, axis in enumerate(recording.gyro_axes):
+            fh[axis] = recording.gyro_dps[:, k]
+        for k, axis in enumerate(recording.accel_axes):
+            fh[axis] = recording.accel_g[:, k]
+        fh["temperature"] = recording.temperature_degc
+    return path
+
+
+def corrupted_binaries(work: Path, rng: np.random.Generator, count: int) -> dict[str, collections.Counter]:
+    """``count`` damaged copies each (half cut short, half with 1..16 bytes overwritten) of an HDF5 file, a
+    Parquet table, a ROS 1 bag and ROS 2 bags in sqlite3 and MCAP storage, all of one simulated run, converted;
+    a copy whose length is kept must not lose rows without a word."""
+    recording = simulate("mti10", profile="chamber", duration_s=600, rate_hz=2, seed=7).recording
+    makers = {"HDF5": lambda p: _hdf5(p.with_suffix(".h5"), recording),
+              "Parquet": lambda p: (write(recording, p.with_suffix(".parquet")), p.with_suffix(".parquet"))[1],
+              "ROS 1 bag": lambda p: _bag(p.with_suffix(".bag"), recording, "ros1"),
+              "ROS 2 bag (sqlite3)": lambda p: _bag(p, recording, "sqlite3"),
+              "ROS 2 bag (MCAP)": lambda p: _bag(p, recording, "mcap")}
+    results = {}
+    for label, make in makers.items():
+        seed_folder = work / f"seed_{len(results)}"
+        seed_folder.mkdir()
+        damaged_file = make(seed_folder / "intact")
+        bag_folder = damaged_file.parent if damaged_file.parent != seed_folder else None
+        intact = (bag_folder or damaged_file)
+        status, _ = run_command(["convert", intact, work / "intact.csv"])
+        intact_rows = len(pd.read_csv(work / "intact.csv")) if status == 0 else None
+        counter = results.setdefault(f"{label} ({count} corrupted)", collections.Counter())
+        for k, (how, blob) in enumerate(mutated_logs(damaged_file, count, rng, None)):
+            copy = work / f"damaged_{len(results)}_{k}"
+            if bag_folder:
+                shutil.copytree(bag_folder, copy)
+                (copy / damaged_file.name).write_bytes(blob)
+                target = copy
+            else:
+                target = copy.with_suffix(damaged_file.suffix)
+                target.write_bytes(blob)
+            out = work / f"damaged_{len(results)}_{k}.csv"
+            status, lines = run_command(["convert", target, out])
+            counter[judged(classify(status, lines, out), lines, out,
+                           intact_rows if how == "byte-flipped" else None)] += 1
+    return results
 
 
 def simulated_model(seed: int, data: Path) -> tuple[Path, dict]:
@@ -159,7 +317,8 @@ def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counte
             path, out = work / f"log{k}{source.suffix}", work / f"log{k}.csv"
             path.write_bytes(blob)
             status, lines = run_command(["convert", path, out])
-            counter[classify(status, lines, out)] += 1
+            counter[judged(classify(status, lines, out), lines, out)] += 1
+    results.update(corrupted_binaries(work, rng, 50))
     counter = results.setdefault("CSV tables (150 malformed)", collections.Counter())
     for k in range(150):
         path, out = work / f"table{k}.csv", work / f"table{k}_out.csv"
@@ -167,12 +326,7 @@ def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counte
         status, lines = run_command(["convert", path, out, *(["--drop-nan"] if k % 2 else [])])
         counter[classify(status, lines, out)] += 1
     data, model = simulated_model(seed, work / "data.csv")
-    counter = results.setdefault("model files (150 mutated)", collections.Counter())
-    for k in range(150):
-        path, out = work / f"model{k}.json", work / f"applied{k}.csv"
-        path.write_text(mutated_model(model, rng), encoding="utf-8")
-        status, lines = run_command(["apply", path, data, "-o", out])
-        counter[classify(status, lines, out)] += 1
+    results.update(mutated_models(seed, work, rng, 60))
     # the malformed tables again, through the commands that read them in chunks and write no table
     model_path = work / "model.json"
     model_path.write_text(json.dumps(model), encoding="utf-8")

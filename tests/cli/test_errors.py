@@ -17,7 +17,7 @@ from gyrocomp.cli.apply import apply
 from gyrocomp.cli.evaluate import evaluate
 from gyrocomp.cli.fit import fit
 
-from ..conftest import run
+from ..conftest import SCRIPT, run
 
 
 ERROR_CASES = {
@@ -153,8 +153,43 @@ def test_special_outputs_are_refused(workdir, tmp_path):
                                                      "regular files (name a new path)"
     assert fifo.is_fifo()
     r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", "-")
-    assert r.returncode == 2 and "-: gyrocomp writes its outputs to files, not to standard output" in r.stderr
+    assert r.returncode == 2 and "-: gyrocomp writes its outputs to files, not to the standard streams" in r.stderr
     assert not Path("-").exists()
+
+
+@pytest.mark.parametrize("args", [
+    ["apply", "{model}", "{run}", "-o", "{d}/out.csv/"], ["fit", "{run}", "-o", "{d}/m.json/"],
+    ["convert", "{run}", "{d}/out.parquet/"], ["simulate", "--duration", "60", "-o", "{d}/s.csv/"],
+    ["allan", "{run}", "--plot", "{d}/a.png/"], ["learn", "{run}", "-o", "{d}/l.json", "--save-state", "{d}/st/"],
+])
+def test_an_output_named_as_a_folder_is_refused_before_any_work(workdir, tmp_path, args):
+    """``-o out.csv/`` once wrote ``out.csv``: a name ending in / is a folder's, refused naming it as given."""
+    r = run(*[a.format(model=workdir / "model.json", run=workdir / "run3.csv", d=tmp_path) for a in args])
+    named = next(a for a in args if a.endswith("/")).format(d=tmp_path)
+    assert r.returncode == 2 and r.stderr.strip() == (f"gyrocomp: error: {named}: names a folder (it ends in /); "
+                                                      "name the output file itself"), r.stderr
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_standard_streams_are_no_output_and_a_pipe_is_no_input(workdir, tmp_path):
+    r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", "/dev/stdout")
+    assert r.returncode == 2 and r.stderr.strip() == ("gyrocomp: error: /dev/stdout: gyrocomp writes its outputs to "
+                                                      "files, not to the standard streams; name a file")
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+    data = (workdir / "run3.csv").read_text()
+    for given in (["/dev/stdin"], ["/dev/stdin", "--format", "csv"]):  # a pipe, as `cat run.csv | gyrocomp fit`
+        r = subprocess.run([*cmd, "fit", *given, "-o", str(tmp_path / "m.json")], input=data, capture_output=True,
+                           text=True, timeout=60)
+        assert r.returncode == 2 and r.stderr.strip() == (
+            "gyrocomp: error: /dev/stdin: is a pipe, not a file; gyrocomp reads an input more than once (its first "
+            "bytes tell the format, then its rows): save it to a file first"), r.stderr
+        assert not (tmp_path / "m.json").exists()
+
+
+def test_click_lists_its_choices_on_one_line(tmp_path):
+    r = run("split", tmp_path / "x.csv", "-o", tmp_path / "parts")
+    assert r.returncode == 2 and r.stderr.strip() == ("gyrocomp: error: Missing option '--by'. Choose from: "
+                                                      "power-on, gap, still, temperature-turn")
 
 
 def _planted(folder: Path, name: str, victim: Path) -> Path:
@@ -248,6 +283,7 @@ def test_a_write_the_file_system_refuses_is_a_bad_input_and_leaves_nothing(workd
     (PermissionError(13, "Permission denied", "x.csv"), "x.csv: permission denied; check its permissions"),
     (OSError(28, "No space left on device", "o.csv"), "o.csv: no space left on device; the disk is full; free space and run again"),
     (MemoryError(), "not enough memory for this size of data; process it in pieces or on a larger machine"),
+    (OSError("lseek failed"), "lseek failed"),  # a library's OSError without errno: its words, not "oserror"
 ])
 def test_environment_errors_read_as_one_line(exc, line):
     assert _environment_message(exc) == line

@@ -1,4 +1,4 @@
-"""Minimal writers of PX4 ULog and ArduPilot DataFlash files, for reader tests (formats as documented by
+"""Minimal writers of PX4 ULog and ArduPilot DataFlash files (and ROS bags, with rosbags), for reader tests (formats as documented by
 PX4, https://docs.px4.io/main/en/dev_log/ulog_file_format.html, and ArduPilot's AP_Logger)."""
 
 from __future__ import annotations
@@ -72,3 +72,41 @@ def write_dataflash(path, messages: dict[str, tuple[int, list[tuple[str, str]], 
         out += record
     with open(path, "wb") as fh:
         fh.write(bytes(out[: len(out) - cut]))
+
+
+def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",), mcap=False):
+    """A bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or, with ``mcap``, MCAP storage) of ``n`` IMU messages
+    per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth."""
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
+    Imu, Temperature = store.types["sensor_msgs/msg/Imu"], store.types["sensor_msgs/msg/Temperature"]
+    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
+    Vector3, Quaternion = store.types["geometry_msgs/msg/Vector3"], store.types["geometry_msgs/msg/Quaternion"]
+    serialize = store.serialize_cdr if ros2 else store.serialize_ros1
+    if ros2:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+        writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3)
+    else:
+        from rosbags.rosbag1 import Writer
+        writer = Writer(path)
+
+    def header(t):
+        sec = int(t)
+        stamp = Time(sec=sec, nanosec=int(round((t - sec) * 1e9)))
+        return Header(stamp=stamp, frame_id="imu") if ros2 else Header(seq=0, stamp=stamp, frame_id="imu")
+
+    cov = np.zeros(9)
+    with writer:
+        imus = [writer.add_connection(topic, Imu.__msgtype__, typestore=store) for topic in imu_topics]
+        thermo = writer.add_connection("/imu/temperature", Temperature.__msgtype__, typestore=store)
+        for i in range(n):
+            t = 100.0 + i / rate_hz
+            msg = Imu(header=header(t), orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
+                      angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01), angular_velocity_covariance=cov,
+                      linear_acceleration=Vector3(x=0.0, y=0.0, z=9.80665), linear_acceleration_covariance=cov)
+            for conn in imus:
+                writer.write(conn, int(t * 1e9), serialize(msg, Imu.__msgtype__))
+            if temperature and i % 10 == 0:  # 10 Hz temperature
+                msg = Temperature(header=header(t), temperature=20.0 + i / 10.0, variance=0.0)
+                writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))

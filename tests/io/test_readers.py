@@ -15,7 +15,7 @@ from gyrocomp.io import TableLayout, detect_format, read, sniff_format
 from gyrocomp.io.common import match_by_time, order_by_time
 
 from ..conftest import run, shared_dataset
-from tests.io.log_writers import write_dataflash, write_ulog
+from tests.io.log_writers import write_bag, write_dataflash, write_ulog
 
 RAD_TO_DEG = 180.0 / math.pi
 G = 9.80665
@@ -226,46 +226,10 @@ def test_dataflash_tclr_asked_for_but_absent(tmp_path):
 
 
 # -- ROS bags -------------------------------------------------------------------------------------------
-def _write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",)):
-    from rosbags.typesys import Stores, get_typestore
-
-    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
-    Imu, Temperature = store.types["sensor_msgs/msg/Imu"], store.types["sensor_msgs/msg/Temperature"]
-    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
-    Vector3, Quaternion = store.types["geometry_msgs/msg/Vector3"], store.types["geometry_msgs/msg/Quaternion"]
-    serialize = store.serialize_cdr if ros2 else store.serialize_ros1
-    if ros2:
-        from rosbags.rosbag2 import Writer
-        writer = Writer(path, version=9)
-    else:
-        from rosbags.rosbag1 import Writer
-        writer = Writer(path)
-
-    def header(t):
-        sec = int(t)
-        stamp = Time(sec=sec, nanosec=int(round((t - sec) * 1e9)))
-        return Header(stamp=stamp, frame_id="imu") if ros2 else Header(seq=0, stamp=stamp, frame_id="imu")
-
-    cov = np.zeros(9)
-    with writer:
-        imus = [writer.add_connection(topic, Imu.__msgtype__, typestore=store) for topic in imu_topics]
-        thermo = writer.add_connection("/imu/temperature", Temperature.__msgtype__, typestore=store)
-        for i in range(n):
-            t = 100.0 + i / rate_hz
-            msg = Imu(header=header(t), orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
-                      angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01), angular_velocity_covariance=cov,
-                      linear_acceleration=Vector3(x=0.0, y=0.0, z=G), linear_acceleration_covariance=cov)
-            for conn in imus:
-                writer.write(conn, int(t * 1e9), serialize(msg, Imu.__msgtype__))
-            if temperature and i % 10 == 0:  # 10 Hz temperature
-                msg = Temperature(header=header(t), temperature=20.0 + i / 10.0, variance=0.0)
-                writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))
-
-
 @pytest.mark.parametrize("ros2", [False, True], ids=["ros1", "ros2"])
 def test_rosbag_imu_and_temperature_matched_by_time(tmp_path, ros2):
     path = tmp_path / ("bag" if ros2 else "imu.bag")
-    _write_bag(path, ros2)
+    write_bag(path, ros2)
     rec = read(path)
     assert rec.metadata["imu_topic"] == "/imu/data" and rec.metadata["temperature_topic"] == "/imu/temperature"
     assert rec.rate_hz == pytest.approx(100.0)
@@ -294,7 +258,7 @@ def test_a_bag_is_read_from_its_own_files_and_type_names_only(tmp_path):
         read(tmp_path / "hostile.bag")
     assert not marker.exists()
     folder = tmp_path / "bag"
-    _write_bag(folder, ros2=True)
+    write_bag(folder, ros2=True)
     storage = next(f for f in folder.iterdir() if f.name != "metadata.yaml")
     elsewhere = tmp_path / "elsewhere" / storage.name
     elsewhere.parent.mkdir()
@@ -365,7 +329,7 @@ def test_compressed_tables_are_streamed_and_archives_refused(tmp_path):
 
 def test_rosbag_topic_choices_and_missing_topics(tmp_path):
     path = tmp_path / "two.bag"
-    _write_bag(path, ros2=False, temperature=False, imu_topics=("/imu0", "/imu1"))
+    write_bag(path, ros2=False, temperature=False, imu_topics=("/imu0", "/imu1"))
     with pytest.raises(InputError, match=r"2 sensor_msgs/msg/Imu topics \(/imu0, /imu1\); choose one with imu_topic="):
         read(path)
     with pytest.raises(InputError, match=r"imu_topic=/imu9: no such topic in the bag; its sensor_msgs/msg/Imu "
@@ -584,7 +548,7 @@ def test_cli_bad_logs_give_one_line_and_status_2(tmp_path, case):
         args, expected = ["allan", path], "baro.ulg: no gyro topic"
     elif case == "no-such-bag-topic":
         path = tmp_path / "imu.bag"
-        _write_bag(path, ros2=False)
+        write_bag(path, ros2=False)
         args, expected = ["convert", path, tmp_path / "o.csv", "--imu-topic", "/gyro"], "--imu-topic /gyro: no such topic"
     else:
         path = tmp_path / "x.ulg"

@@ -224,7 +224,7 @@ def _environment_message(exc: BaseException) -> str:
     hint = {errno.EACCES: "check its permissions", errno.EPERM: "check its permissions",
             errno.ENOSPC: "the disk is full; free space and run again", errno.EFBIG: "the file is too large here",
             errno.ELOOP: "a symbolic link loops", errno.EROFS: "the file system is read-only"}
-    reason = exc.strerror or type(exc).__name__
+    reason = exc.strerror or str(exc) or type(exc).__name__
     return f"{where}{reason.lower()}" + (f"; {hint[exc.errno]}" if getattr(exc, "errno", None) in hint else "")
 
 
@@ -260,7 +260,9 @@ def main(argv: list[str] | None = None) -> int:
     except click.ClickException as exc:  # usage errors: bad option, missing argument
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {printable(exc.format_message())}", err=True)
+        # click lists choices on indented lines ("Choose from:\n\ta,\n\tb"): one line here
+        message = re.sub(r"\s*\n\s*", " ", exc.format_message())
+        click.echo(f"gyrocomp: error: {printable(message)}", err=True)
         status = EXIT_INPUT if isinstance(exc, click.UsageError) else exc.exit_code
     except InputError as exc:
         if debug:

@@ -12,7 +12,7 @@ from ..files.noise import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..report.figures import allan_figure, check_figure_path
-from .common import pop_read_options, progress_bar, read_options, read_settings
+from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
 from .render import print_noise
 
 
@@ -47,8 +47,8 @@ def _parse_fit_taus(text: str | None):
 @click.option("--kind", type=click.Choice(KINDS), default="oadev", show_default=True, help="Estimator of the printed curve.")
 @click.option("--taus", default="octave", show_default=True, help="octave, decade, all, or taus [s] such as 1,10,100.")
 @click.option("--json", "as_json", is_flag=True, help="Print curves and noise terms as JSON on stdout.")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False), help="Write the Allan plot here (.png, .svg, .pdf).")
-@click.option("--kalibr", "kalibr", type=click.Path(dir_okay=False), help="Write Kalibr's imu.yaml here.")
+@click.option("--plot", "plot_path", type=OUTPUT_FILE, help="Write the Allan plot here (.png, .svg, .pdf).")
+@click.option("--kalibr", "kalibr", type=OUTPUT_FILE, help="Write Kalibr's imu.yaml here.")
 @click.option("--rostopic", default="/imu0", show_default=True, help="rostopic written into the Kalibr file.")
 @click.option("--split-gaps/--no-split-gaps", default=False, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
 @click.option("--fit-taus", "fit_taus_s", default=None, metavar="MIN,MAX",

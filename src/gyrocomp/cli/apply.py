@@ -9,13 +9,13 @@ import click
 from ..calibration import Calibration
 from ..files.apply import apply_file
 from ..io import detect_format, output_format, refuse_to_overwrite_inputs
-from .common import FINITE, pop_read_options, progress_bar, read_options, read_settings
+from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
 
 
 @click.command()
 @click.argument("model", type=click.Path())
 @click.argument("input_path", metavar="IN", type=click.Path())
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Compensated output file.")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="Compensated output file.")
 @click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate the turn-on bias from the first S seconds of IN [s] (default: the model's mean).")
 @click.option("--axes", "axes", default=None, metavar="AXES",

@@ -16,11 +16,30 @@ from ..errors import InputError
 from ..spelling import Spelling, from_values, spelled_fields
 from .projectfile import ReadingOption
 from ..io import FORMAT_SPELLING, ReadOptions, read_input
+from ..io.atomic import check_output_file
 from ..curves.network import DEFAULT_HIDDEN
 from ..models.options import Network, Polynomial
 from ..models.pipelines import check_channels
 from ..recording.prepared import CHANNELS
 from ..curves.polynomial import MAX_ORDER
+
+
+class OutputFile(click.Path):
+    """A file option or argument an output is written to, checked as it is parsed, before any work
+    (:func:`gyrocomp.io.atomic.check_output_file`: not ``-`` or standard output, not a name ending in ``/``, not a
+    symbolic link, a folder or a FIFO)."""
+
+    def __init__(self):
+        super().__init__(dir_okay=False)
+
+    def convert(self, value, param, ctx):
+        value = super().convert(value, param, ctx)
+        check_output_file(value)
+        return value
+
+
+#: the type of every option or argument naming an output file
+OUTPUT_FILE = OutputFile()
 
 
 def make_console() -> Console:

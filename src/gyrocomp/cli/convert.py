@@ -8,12 +8,12 @@ import click
 
 from ..files.convert import convert_file
 from ..io import output_format, refuse_to_overwrite_inputs
-from .common import pop_read_options, progress_bar, read_options, read_settings
+from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
 
 
 @click.command()
 @click.argument("input_path", metavar="IN", type=click.Path())
-@click.argument("output", metavar="OUT", type=click.Path(dir_okay=False))
+@click.argument("output", metavar="OUT", type=OUTPUT_FILE)
 @read_options
 @click.pass_context
 def convert(ctx, input_path, output, **kwargs):

@@ -19,14 +19,14 @@ from ..models.fit import fit as fit_runs
 from ..models.pipelines import SCALE_FACTOR_CHOICES
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
-from .common import (FINITE, float_list, parse_channels, parse_temperature_option, pop_read_options, progress_bar,
-                     read_options, read_run)
+from .common import (FINITE, OUTPUT_FILE, float_list, parse_channels, parse_temperature_option, pop_read_options,
+                     progress_bar, read_options, read_run)
 from .render import print_contributions, print_fit
 
 
 @click.command()
 @click.argument("runs", nargs=-1, required=True, type=click.Path())  # files, folders of runs, or quoted globs
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Model file to write (JSON).")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="Model file to write (JSON).")
 @click.option("--temperature", default="poly", show_default=True,
               help="poly (order by cross-validation), poly:N (N = 0..5), mlp (the thesis's 1-3-1 network, "
                    "Levenberg-Marquardt), mlp:H (H hidden neurons) or none.")

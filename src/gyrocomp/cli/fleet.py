@@ -16,7 +16,8 @@ from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.fleet import build_fleet_report
 from . import in_cli_words
-from .common import FINITE, make_console, parse_channels, pop_read_options, progress_bar, read_options, read_settings
+from .common import (FINITE, OUTPUT_FILE, make_console, parse_channels, pop_read_options, progress_bar, read_options,
+                     read_settings)
 from .export import EXPORT_FORMATS, write_export
 
 #: failures and outliers listed after a fleet fit (the fleet table has them all)
@@ -134,7 +135,7 @@ def _print_rows(console, title: str, rows: list[tuple], columns: tuple[str, ...]
                    "its end); default: the newest.")
 @click.option("--history", is_flag=True, help="List every calibration of the unit instead.")
 @click.option("--json", "as_json", is_flag=True, help="Print the calibration (record and model) as JSON.")
-@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), help="Also write its model file here.")
+@click.option("-o", "--output", default=None, type=OUTPUT_FILE, help="Also write its model file here.")
 @click.pass_context
 def show(ctx, serial, store, at, history, as_json, output):
     """The calibration of unit SERIAL valid now (or --at a past time): when, from what, verdict, figures."""
@@ -203,7 +204,7 @@ def _print_history(rows) -> None:
 
 @fleet.command("report")
 @click.argument("store")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="HTML file to write.")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="HTML file to write.")
 @click.option("--limits", "limits_file", default=None, type=click.Path(dir_okay=False),
               help="Judge the units by these limits (TOML; default: the verdicts stored with each calibration).")
 @click.pass_context

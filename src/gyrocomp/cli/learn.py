@@ -11,17 +11,17 @@ from ..io import refuse_to_overwrite_inputs
 from ..io.atomic import write_texts_atomic
 from ..io.files import expand_runs
 from ..fitting.online import GYRO_AXES, LearnerSettings, OnlineCalibrator, replay
-from .common import FINITE, pop_read_options, read_options, read_run
+from .common import FINITE, OUTPUT_FILE, pop_read_options, read_options, read_run
 from .render import print_learner
 
 
 @click.command()
 @click.argument("logs", nargs=-1, required=True, type=click.Path())  # files, folders of logs, or quoted globs
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE,
               help="Model file to write (JSON; gyrocomp apply and export take it).")
 @click.option("--resume", "resume", type=click.Path(dir_okay=False), default=None,
               help="A learner state saved by --save-state: go on from it (the logs are later power-ons).")
-@click.option("--save-state", "save_state", type=click.Path(dir_okay=False), default=None,
+@click.option("--save-state", "save_state", type=OUTPUT_FILE, default=None,
               help="Write the learner's whole state here (JSON), to go on later with --resume.")
 @click.option("--degree", type=click.Choice(["1", "2", "3"]), default="3", show_default=True,
               help="Highest degree of the temperature curve (used once the still data span enough).")

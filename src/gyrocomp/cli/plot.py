@@ -15,7 +15,7 @@ from ..measures.merit import default_window_s
 from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
 from ..measures.noise import analyse_noise
 from ..report.figures import check_figure_path
-from .common import FINITE, pop_read_options, read_run, read_options
+from .common import FINITE, OUTPUT_FILE, pop_read_options, read_options, read_run
 
 
 @click.group()
@@ -57,7 +57,7 @@ def _axis_option(axis, calibration, recording) -> str:
 @click.option("--model", type=click.Path(), default=None, help="Also draw FILE compensated with this model.")
 @click.option("--axes", default=None, help="Axes to draw, e.g. gyro_x,gyro_z (default: every gyro axis).")
 @click.option("--split-gaps/--no-split-gaps", default=False, help="Pool the stretches between time gaps.")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE)
 @read_options
 @click.pass_context
 def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
@@ -83,7 +83,7 @@ def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
 @click.argument("model", type=click.Path())
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("--axis", default=None, help="The axis to draw (default: the model's first).")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE)
 @read_options
 @click.pass_context
 def plot_temperature(ctx, model, runs, axis, output, **kwargs):
@@ -108,7 +108,7 @@ def plot_temperature(ctx, model, runs, axis, output, **kwargs):
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
 @click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate the run's turn-on bias from its first S seconds [s].")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE)
 @read_options
 @click.pass_context
 def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, **kwargs):

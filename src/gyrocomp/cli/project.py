@@ -12,7 +12,7 @@ import click
 from ..errors import InputError
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.guess import guess_layout
-from .common import make_console
+from .common import OUTPUT_FILE, make_console
 from .projectfile import PROJECT_FILE, PROJECT_KEY
 
 
@@ -22,7 +22,7 @@ def _toml_text(value) -> str:
 
 @click.command()
 @click.argument("log", type=click.Path())
-@click.option("-o", "--output", default=PROJECT_FILE, show_default=True, type=click.Path(dir_okay=False),
+@click.option("-o", "--output", default=PROJECT_FILE, show_default=True, type=OUTPUT_FILE,
               help="The project file to write.")
 @click.option("--force", is_flag=True, help="Replace an existing project file.")
 @click.pass_context

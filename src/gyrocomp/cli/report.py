@@ -9,13 +9,13 @@ from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.figures import require_matplotlib
 from ..report.html import build_report
 from ..evaluation.validation import validate as validate_runs
-from .common import FINITE, pop_read_options, read_run, progress_bar, read_options
+from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_run
 
 
 @click.command()
 @click.argument("model", type=click.Path())
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="The HTML file to write.")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="The HTML file to write.")
 @click.option("--window", "window_s", type=FINITE, default=None,
               help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
 @click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,

@@ -12,7 +12,7 @@ from ..errors import InputError
 from ..io import output_format, write_recording, write_text_atomic
 from ..simulation import ONE_TEMPERATURE_PROFILES, Simulation, preset_model, resolve_profile, run_profiles, truth_document
 from ..simulation import simulate as run_simulation
-from .common import FINITE, float_list
+from .common import FINITE, OUTPUT_FILE, float_list
 
 
 @click.command()
@@ -42,8 +42,8 @@ from .common import FINITE, float_list
 @click.option("--rates", "rates", default=None, metavar="R1,R2,...",
               help="ratetable: rates applied about each axis in turn [deg/s], e.g. 100,-100,300,-300 (the file gets "
                    "ref_rate_x/y/z columns; the first --set-points value is the table's temperature).")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False), help="Output CSV or Parquet.")
-@click.option("--truth", type=click.Path(dir_okay=False), help="Write every parameter used as JSON here.")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="Output CSV or Parquet.")
+@click.option("--truth", type=OUTPUT_FILE, help="Write every parameter used as JSON here.")
 @click.option("--truth-columns", is_flag=True,
               help="Add true_error_gyro_*, true_noise_gyro_*, true_rate_gyro_* and true_structure_temperature columns.")
 @click.pass_context

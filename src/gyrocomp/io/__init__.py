@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +49,10 @@ FORMAT_ALIASES = {"ulg": "ulog", "px4": "ulog", "bin": "dataflash", "ardupilot":
 _SUFFIXES = {".ulg": "ulog", ".bin": "dataflash", ".bag": "rosbag", ".db3": "rosbag", ".mcap": "rosbag",
              ".h5": "hdf5", ".hdf5": "hdf5", ".nc": "hdf5", ".nc4": "hdf5"}
 def detect_format(path: str | os.PathLike, fmt: str | None = None) -> str:
-    """The format name of ``path``: ``fmt`` if given (checked), else from its first bytes or suffix."""
+    """The format name of ``path``: ``fmt`` if given (checked), else from its first bytes or suffix. A pipe or a
+    device (``/dev/stdin``, ``<(...)``) is refused: inputs are read more than once (their first bytes, then in
+    chunks, some twice)."""
+    _require_a_file(path)
     if fmt is not None:
         name = FORMAT_ALIASES.get(fmt.lower(), fmt.lower())
         if name not in FORMATS:
@@ -71,6 +75,17 @@ def detect_format(path: str | os.PathLike, fmt: str | None = None) -> str:
             f"name it with fmt= ({', '.join(FORMATS)})"
         )
     return found
+
+
+def _require_a_file(path: str | os.PathLike) -> None:
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return  # a missing file is said where it is opened, with the same words everywhere
+    if stat.S_ISFIFO(mode) or stat.S_ISCHR(mode) or stat.S_ISBLK(mode) or stat.S_ISSOCK(mode):
+        kind = "a pipe" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
+        raise InputError(f"{path}: is {kind}, not a file; gyrocomp reads an input more than once (its first bytes "
+                         "tell the format, then its rows): save it to a file first")
 
 
 def output_format(path: str | os.PathLike, option: str = "-o", default: str | None = None) -> str:

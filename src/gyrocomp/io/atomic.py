@@ -25,7 +25,7 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     rename replaces the directory entry ``path`` itself: a link planted between the check and the rename is
     replaced, not followed.
     """
-    target = _regular_target(path)
+    target = check_output_file(path)
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise InputError(f"{target}: folder {folder} does not exist; create it first")
@@ -88,10 +88,17 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def _regular_target(path: str | os.PathLike) -> Path:
+#: the names of the standard streams, refused as outputs with their own words (each is a link besides)
+_STANDARD_STREAMS = ("/dev/stdout", "/dev/stderr", "/dev/stdin", "/dev/fd/1", "/dev/fd/2", "/dev/tty")
+
+
+def check_output_file(path: str | os.PathLike) -> Path:
     """The regular file (existing or new) that writing to ``path`` means; refuse anything else."""
-    if str(path) == "-":
-        raise InputError("-: gyrocomp writes its outputs to files, not to standard output; name a file")
+    text = os.fspath(path)
+    if text == "-" or text in _STANDARD_STREAMS or text.startswith("/proc/self/fd/"):
+        raise InputError(f"{text}: gyrocomp writes its outputs to files, not to the standard streams; name a file")
+    if text.endswith(("/", os.sep)):
+        raise InputError(f"{text}: names a folder (it ends in {text[-1]}); name the output file itself")
     target = Path(path)
     refuse_link(target)
     try:
@@ -152,7 +159,8 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
 
 def refuse_to_overwrite_inputs(output: str | os.PathLike, inputs: Iterable[str | os.PathLike], option: str = "-o") -> None:
     """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs``, or a symbolic link
-    (:func:`refuse_link`): the checks a command makes on its output before it does the work."""
+    (:func:`refuse_link`): the checks a command makes on its output (a file or a folder) before it does the work;
+    an output file is checked besides by :func:`check_output_file` (the command line's type of output files)."""
     refuse_link(output)
     out = Path(output)
     for item in inputs:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, GyrocompError, InputError, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, check_magic, log_recording, require
@@ -65,10 +65,11 @@ def _opened(h5py, path: Path):
     try:
         with h5py.File(path, "r") as handle:
             yield handle
-    except (PermissionError, FileNotFoundError, IsADirectoryError):
+    except (PermissionError, FileNotFoundError, IsADirectoryError, GyrocompError):
         raise
-    except OSError as exc:
-        raise InputError(f"{path}: not a readable HDF5 file ({exc}); is it damaged or cut short?") from None
+    except (OSError, KeyError, RuntimeError) as exc:  # h5py's KeyError: an object of a damaged file that won't open
+        raise InputError(f"{path}: not a readable HDF5 file ({printable(str(exc))[:200]}); is it damaged or cut "
+                         "short?") from None
 
 
 def _in_this_file(dataset, source: str) -> None:

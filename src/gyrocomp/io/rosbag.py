@@ -7,13 +7,14 @@ time, straight into arrays; a ROS 2 bag is its folder (with ``metadata.yaml``) o
 
 from __future__ import annotations
 
+import contextlib
 import re
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, printable
 from ..recording import Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, keep_matched, log_recording, match_by_time, order_by_time, require
@@ -81,30 +82,57 @@ def _stamp_s(header) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
+@contextlib.contextmanager
+def _damaged(path: Path, topic: str):
+    """Any error rosbags raises on the messages of ``topic`` (a damaged record, a length past the file, a message
+    that does not deserialize) as one line naming the bag and the topic."""
+    try:
+        yield
+    except InputError:
+        raise
+    except Exception as exc:  # rosbags' own errors, and what a damaged record makes its parsers raise
+        raise InputError(f"{path}: damaged ROS bag: topic {topic}: {type(exc).__name__}: "
+                         f"{printable(str(exc))[:160]}") from None
+
+
+def _read_all(path: Path, counted: int, read: int, topic: str) -> None:
+    """Warn when fewer messages were read than the bag's index counts (a damaged or cut-short bag)."""
+    if read < counted:
+        warnings.warn(f"{path}: topic {topic}: the bag's index counts {counted} messages, {read} were read; the "
+                      "rest is damaged or missing", DataQualityWarning, stacklevel=3)
+
+
 def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | None, total: int):
     """(time [s], gyro [deg/s], accel [g]) of every message on the IMU topic, in time order."""
     n = sum(c.msgcount for c in imu)
     time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
     i = 0
-    for connection, _, raw in reader.messages(connections=imu):
-        msg = reader.deserialize(raw, connection.msgtype)
-        time_s[i] = _stamp_s(msg.header)
-        w, a = msg.angular_velocity, msg.linear_acceleration
-        gyro[i] = (w.x, w.y, w.z)
-        accel[i] = (a.x, a.y, a.z)
-        i += 1
-        if progress and i % 20000 == 0:
-            progress(i / total)
+    with _damaged(path, imu[0].topic):
+        for connection, _, raw in reader.messages(connections=imu):
+            if i == n:
+                raise InputError(f"{path}: damaged ROS bag: topic {imu[0].topic}: more messages than the bag's "
+                                 f"index counts ({n})")
+            msg = reader.deserialize(raw, connection.msgtype)
+            time_s[i] = _stamp_s(msg.header)
+            w, a = msg.angular_velocity, msg.linear_acceleration
+            gyro[i] = (w.x, w.y, w.z)
+            accel[i] = (a.x, a.y, a.z)
+            i += 1
+            if progress and i % 20000 == 0:
+                progress(i / total)
+    _read_all(path, n, i, imu[0].topic)
     return order_by_time(str(path), time_s[:i], gyro[:i] * _RAD, accel[:i] * _MS2)
 
 
 def _temperature_samples(path: Path, reader, thermo: list):
     """(time [s], temperature [degC]) of every message on the temperature topic, in time order."""
     t_time, t_value = [], []
-    for connection, _, raw in reader.messages(connections=thermo):
-        msg = reader.deserialize(raw, connection.msgtype)
-        t_time.append(_stamp_s(msg.header))
-        t_value.append(msg.temperature)
+    with _damaged(path, thermo[0].topic):
+        for connection, _, raw in reader.messages(connections=thermo):
+            msg = reader.deserialize(raw, connection.msgtype)
+            t_time.append(_stamp_s(msg.header))
+            t_value.append(msg.temperature)
+    _read_all(path, sum(c.msgcount for c in thermo), len(t_time), thermo[0].topic)
     return order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
 
 

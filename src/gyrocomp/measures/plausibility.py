@@ -366,9 +366,13 @@ def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) 
     slope = agreement.slope
     known = next((words for ratio, words in KNOWN_SLOPES if abs(slope / ratio - 1.0) < 0.25), None)
     if known is None and agreement.follows_direction:
-        known = (f"its output parts between heating and cooling by {agreement.direction_offset:.2g} deg/s beyond the "
-                 "model (slope "f"{agreement.slope_with_direction:.3g} with that taken out): hysteresis or a thermal "
-                 "lag the model does not carry? (fit on runs that both heat and cool)")
+        said = (f"with a slope of {slope:.3g} +- {agreement.standard_error:.2g}, not 1, and " if agreement.disagrees
+                else "")
+        return Concern("agreement", f"{source}: {axis} follows the error the model predicts for it {said}parts "
+                                    f"between heating and cooling by {agreement.direction_offset:.2g} deg/s beyond "
+                                    f"the model (slope {agreement.slope_with_direction:.3g} with that taken out): "
+                                    "hysteresis or a thermal lag the model does not carry? (fit on runs that both "
+                                    "heat and cool)")
     return Concern("agreement", f"{source}: {axis} follows the error the model predicts for it with a slope of "
                                 f"{slope:.3g} +- {agreement.standard_error:.2g}, not 1: "
                                 + (known or "is the data in another unit than the model's, or the model of another "
