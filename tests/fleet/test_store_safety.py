@@ -4,6 +4,7 @@ a rerun that repairs what a crash left, concurrent fits that store each unit onc
 from __future__ import annotations
 
 import hashlib
+import re
 import subprocess
 import sys
 
@@ -113,3 +114,82 @@ def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_pa
     with CalibrationStore(out) as db:
         assert sorted(db.serials()) == sorted(SERIALS)
         assert all(len(db.history(s)) == 1 for s in SERIALS)
+
+
+def _other_inputs(folder, serials):
+    """The same serials as :func:`_units`, each with another run (other seeds): a recalibration."""
+    rows = ["path,serial"]
+    for k, s in enumerate(serials):
+        (folder / f"v{k}").mkdir(parents=True)
+        path = folder / f"v{k}" / "run.csv"
+        write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=2, seed=50 + k).recording,
+                        path)
+        rows.append(f'{path},"{s}"')
+    other = folder / "other.csv"
+    other.write_text("\n".join(rows) + "\n")
+    return other
+
+
+def _files_agree_with_newest_rows(out, serials):
+    with CalibrationStore(out) as db:
+        for s in serials:
+            newest = [r for r in db.history(s) if r.status == "ok"][-1]
+            assert (out / "models" / model_file_name(s)).read_text() == newest.model_json, s
+
+
+def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_model(manifest, tmp_path):
+    """Two stations recalibrating the same units from different runs at once: whatever the interleaving, each
+    unit's model file is its newest row's (the file is written holding the store's write lock)."""
+    other = _other_inputs(tmp_path, SERIALS)
+    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+    for repeat in range(3):
+        out = tmp_path / f"FLEET{repeat}"
+        procs = [subprocess.Popen([*cmd, "fleet", "fit", "--manifest", str(m), "-o", str(out), "--scheduler",
+                                   "serial"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                 for m in (manifest, other)]
+        for p in procs:
+            _, stderr = p.communicate(timeout=300)
+            assert p.returncode == 0, stderr
+        _files_agree_with_newest_rows(out, SERIALS)
+
+
+def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    assert _fit(manifest, out).returncode == 0
+    first, second = (out / "models" / model_file_name(s) for s in ("SN-1", "a_b"))
+    first.write_text(second.read_text())  # another unit's model copied over it
+    second.write_text(second.read_text()[:100])  # cut short
+    result = _fit(manifest, out)
+    assert result.returncode == 0 and f"0 unit(s) fitted, {len(SERIALS)} unchanged" in result.stdout
+    said = [line for line in result.stderr.splitlines() if "written again from the store" in line]
+    assert len(said) == 2 and any(str(first) in line for line in said) and any(str(second) in line for line in said)
+    _files_agree_with_newest_rows(out, SERIALS)
+
+
+@pytest.mark.parametrize("column, value, said", [
+    ("model", '{"schema_version": 6, "axes"', r"store row \d+ \(SN-1\): .*"),
+    ("inputs", "not json", r"row \d+ \(unit 'SN-1'\) is damaged \(JSONDecodeError"),
+    ("calibrated_utc", "garbage", r"row \d+ \(unit 'SN-1'\) holds no time gyrocomp wrote"),
+])
+def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, tmp_path, column, value, said):
+    import sqlite3
+
+    out = tmp_path / "FLEET"
+    assert _fit(manifest, out).returncode == 0
+    with sqlite3.connect(out / "calibrations.sqlite") as conn:
+        conn.execute(f"UPDATE calibrations SET {column} = ? WHERE serial = 'SN-1'", (value,))
+    for args in (["show", "SN-1", "--store", out], ["export", "SN-1", "--store", out, "--format", "json", "-o",
+                                                     tmp_path / "m.json"], ["report", out, "-o", tmp_path / "r.html"]):
+        result = run("fleet", *args)
+        if column == "model" and args[0] == "report":
+            continue  # the report reads figures, not models
+        assert result.returncode == 2 and result.stderr.count("\n") == 1, (args, result.stderr)
+        assert re.search(said, result.stderr), (args, result.stderr)
+    assert not (tmp_path / "m.json").exists() and (tmp_path / "r.html").exists() == (column == "model")
+
+
+def test_show_at_the_last_day_there_is(manifest, tmp_path):
+    out = tmp_path / "FLEET"
+    assert _fit(manifest, out).returncode == 0
+    result = run("fleet", "show", "SN-1", "--store", out, "--at", "9999-12-31")
+    assert result.returncode == 0, result.stderr

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Literal
 
 from .._version import __version__
-from ..errors import GyrocompError, InputError
+from ..errors import DataQualityWarning, GyrocompError, InputError
 from ..io import ReadOptions, read_input
 from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
@@ -216,9 +216,8 @@ def _keep(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, output: P
         _repair_model(output, db, outcome.serial)
         return
     record = _record(outcome, unit, limits)
-    if record.status == "ok":
-        _write_model(output, outcome.serial, outcome.model_json)
-    if db.add_new(record, since=started) is None:
+    write = (lambda: _write_model(output, outcome.serial, outcome.model_json)) if record.status == "ok" else None
+    if db.add_new(record, since=started, before_commit=write) is None:
         tally.unchanged.append(outcome.serial)
     else:
         tally.count(record)
@@ -357,12 +356,24 @@ def _write_model(output: Path, serial: str, model_json: str) -> None:
 
 
 def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
-    """An unchanged unit whose model file is missing (deleted, or a run stopped between the two writes) gets it
-    back from its newest successful row."""
-    if not (output / MODELS_FOLDER / model_file_name(serial)).exists():
-        ok = [r for r in db.history(serial) if r.status == "ok"]
-        if ok:
-            _write_model(output, serial, ok[-1].model_json)
+    """An unchanged unit's model file is checked against its newest successful row: a missing file (deleted, a
+    run stopped between the two writes) is put back; one that differs (another unit's copied over it, cut short,
+    edited) is written again from the row, and said."""
+    path = output / MODELS_FOLDER / model_file_name(serial)
+    ok = [r for r in db.history(serial) if r.status == "ok"]
+    if not ok:
+        return
+    try:
+        present = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        present = None
+    except (OSError, UnicodeDecodeError):
+        present = ""
+    if present != ok[-1].model_json:
+        _write_model(output, serial, ok[-1].model_json)
+        if present is not None:
+            warnings.warn(f"{path}: differed from unit {serial!r}'s newest calibration in the store (row "
+                          f"{ok[-1].id}); written again from the store", DataQualityWarning, stacklevel=2)
 
 
 def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None) -> Path:

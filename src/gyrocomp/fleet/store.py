@@ -17,6 +17,7 @@ import datetime as _dt
 import json
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
@@ -25,6 +26,7 @@ from ..calibration import Calibration
 from ..errors import InputError, ModelError
 from ..io.atomic import refuse_link
 from ..io.common import require
+from ..jsontext import loads
 from .figures import UnitFigures
 from .limits import Failure
 
@@ -90,7 +92,8 @@ class CalibrationRecord:
         if self.model_json is None:
             raise ModelError(f"unit {self.serial}: the calibration of {self.calibrated_utc:%Y-%m-%d %H:%M:%S} "
                              f"failed ({self.error}); it has no model")
-        return Calibration.from_dict(json.loads(self.model_json), source=f"store row {self.id} ({self.serial})")
+        source = f"store row {self.id} ({self.serial})"
+        return Calibration.from_dict(loads(self.model_json, source, "model", non_finite=True), source=source)
 
 
 def utc_now() -> _dt.datetime:
@@ -106,8 +109,8 @@ def parse_time(text: str, name: str = "at") -> _dt.datetime:
     except ValueError:
         raise InputError(f"{name}: {text!r} is not an ISO 8601 date or time (e.g. 2026-11-24 or "
                          f"2026-11-24T10:30:00Z)") from None
-    if len(text.strip()) <= 10:
-        value = value + _dt.timedelta(days=1) - _dt.timedelta(microseconds=1)
+    if len(text.strip()) <= 10:  # the end of that day (the last day there is: its last microsecond)
+        value = (_dt.datetime.combine(value.date(), _dt.time.max, value.tzinfo))
     if value.tzinfo is not None:
         value = value.astimezone(_dt.timezone.utc).replace(tzinfo=None)
     return value
@@ -206,11 +209,15 @@ class CalibrationStore:
     # -- writing -------------------------------------------------------------------------------------------
     @contextlib.contextmanager
     def _writing(self):
-        """A write transaction; a full disk or a read-only store is one line naming the store."""
+        """A write transaction that holds the store's write lock from its start (SQLite: ``BEGIN IMMEDIATE``;
+        PostgreSQL: the rows table locked against other writers, readers go on), so writers take turns; a full disk
+        or a read-only store is one line naming the store."""
         try:
             with self.engine.connect() as conn:
                 conn.info["immediate"] = True
                 with conn.begin():
+                    if conn.dialect.name == "postgresql" and sa.inspect(conn).has_table(_ROWS.name):
+                        conn.execute(sa.text(f"LOCK TABLE {_ROWS.name} IN SHARE ROW EXCLUSIVE MODE"))
                     yield conn
         except sa.exc.OperationalError as exc:
             raise InputError(f"{self.location}: cannot write to the calibration store ({exc.orig}); is the disk "
@@ -222,10 +229,13 @@ class CalibrationStore:
             result = conn.execute(_ROWS.insert().values(**_to_row(record)))
             return int(result.inserted_primary_key[0])
 
-    def add_new(self, record: CalibrationRecord, since: _dt.datetime) -> int | None:
+    def add_new(self, record: CalibrationRecord, since: _dt.datetime,
+                before_commit: Callable[[], None] | None = None) -> int | None:
         """Append a successful ``record`` unless another process stored a successful calibration of the same unit
         from the same inputs (its ``input_hash``) after ``since`` (naive UTC): the check and the write are one
-        transaction. Returns the new row's id, or None when it was not stored."""
+        transaction. ``before_commit`` (writing the unit's model file) runs inside it, holding the store's write
+        lock: writers of one unit take turns, so the file is always that of the newest row, and a failed file write
+        stores nothing. Returns the new row's id, or None when it was not stored."""
         with self._writing() as conn:
             if record.status == "ok":
                 newer = conn.execute(sa.select(_ROWS.c.id).where(
@@ -234,14 +244,45 @@ class CalibrationStore:
                 if newer is not None:
                     return None
             result = conn.execute(_ROWS.insert().values(**_to_row(record)))
+            if before_commit is not None:
+                before_commit()
             return int(result.inserted_primary_key[0])
 
     # -- reading -------------------------------------------------------------------------------------------
+    def _records(self, query) -> list[CalibrationRecord]:
+        """The records of the rows ``query`` selects; a damaged row (a time that is none, a field that is not the
+        JSON gyrocomp wrote: another program's edit, a damaged file) is one line naming the store and the row."""
+        with self.engine.connect() as conn:
+            try:
+                rows = list(conn.execute(query).mappings())
+            except (ValueError, TypeError, OverflowError) as exc:  # the time column, parsed as rows are fetched
+                raise InputError(f"{self.location}: {self._bad_time(conn) or 'a row'} holds no time gyrocomp wrote "
+                                 f"({exc}); the store was changed by another program") from None
+        out = []
+        for row in rows:
+            try:
+                out.append(_from_row(row))
+            except (ValueError, TypeError, KeyError, AttributeError) as exc:
+                raise InputError(f"{self.location}: row {row['id']} (unit {str(row['serial'])[:80]!r}) is damaged "
+                                 f"({type(exc).__name__}: {str(exc)[:120]}); the store was changed by another "
+                                 "program") from None
+        return out
+
+    @staticmethod
+    def _bad_time(conn) -> str | None:
+        """``row N (unit S)``: the first row whose time is no ISO time, read as text."""
+        query = sa.select(_ROWS.c.id, _ROWS.c.serial, sa.cast(_ROWS.c.calibrated_utc, sa.Text)).order_by(_ROWS.c.id)
+        for row_id, serial, text in conn.execute(query):
+            try:
+                _dt.datetime.fromisoformat(str(text))
+            except ValueError:
+                return f"row {row_id} (unit {str(serial)[:80]!r})"
+        return None
+
     def history(self, serial: str) -> list[CalibrationRecord]:
         """Every row of ``serial``, oldest first."""
-        query = sa.select(_ROWS).where(_ROWS.c.serial == serial).order_by(_ROWS.c.calibrated_utc, _ROWS.c.id)
-        with self.engine.connect() as conn:
-            return [_from_row(r) for r in conn.execute(query).mappings()]
+        return self._records(sa.select(_ROWS).where(_ROWS.c.serial == serial)
+                             .order_by(_ROWS.c.calibrated_utc, _ROWS.c.id))
 
     def latest(self, serial: str) -> CalibrationRecord | None:
         """The newest row of ``serial`` (ok or failed), or None."""
@@ -267,9 +308,7 @@ class CalibrationStore:
         """The newest row of every unit, by serial."""
         newest = (sa.select(_ROWS.c.serial, sa.func.max(_ROWS.c.id).label("id")).group_by(_ROWS.c.serial)
                   .subquery())
-        query = sa.select(_ROWS).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial)
-        with self.engine.connect() as conn:
-            return [_from_row(r) for r in conn.execute(query).mappings()]
+        return self._records(sa.select(_ROWS).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial))
 
     def ok_hashes(self) -> dict[str, str]:
         """The input hash of every unit's newest successful calibration, by serial (one query)."""
@@ -303,17 +342,25 @@ def _json_float(value):
 
 
 def _from_row(row) -> CalibrationRecord:
+    """A row as a record; a field that is not what gyrocomp writes raises ValueError or TypeError (see
+    :meth:`CalibrationStore._records`)."""
     figures = None
     if row["figures"] is not None:
         figures = UnitFigures.from_dict(json.loads(row["figures"]))
+    if row["status"] not in ("ok", "failed") or not isinstance(row["calibrated_utc"], _dt.datetime):
+        raise ValueError(f"status {str(row['status'])[:20]!r}, time {str(row['calibrated_utc'])[:30]!r}")
+    metadata = json.loads(row["unit_metadata"])
+    if not isinstance(metadata, dict):
+        raise TypeError("unit_metadata is no JSON object")
     return CalibrationRecord(
         serial=row["serial"], calibrated_utc=row["calibrated_utc"], status=row["status"],
         input_hash=row["input_hash"], gyrocomp_version=row["gyrocomp_version"],
-        inputs=tuple(InputFile(p, h) for p, h in json.loads(row["inputs"])),
-        metadata=json.loads(row["unit_metadata"]), verdict=row["verdict"],
-        failures=tuple(Failure(f, math.nan if v is None else v, r) for f, v, r in json.loads(row["failures"])),
-        model_json=row["model"], figures=figures, error=row["error"], warnings=tuple(json.loads(row["warnings"])),
-        id=row["id"])
+        inputs=tuple(InputFile(str(p), str(h)) for p, h in json.loads(row["inputs"])),
+        metadata={str(k): str(v) for k, v in metadata.items()}, verdict=row["verdict"],
+        failures=tuple(Failure(str(f), math.nan if v is None else float(v), str(r))
+                       for f, v, r in json.loads(row["failures"])),
+        model_json=row["model"], figures=figures, error=row["error"],
+        warnings=tuple(str(w) for w in json.loads(row["warnings"])), id=row["id"])
 
 
 __all__ = ["STORE_FILE", "STORE_SCHEMA_VERSION", "CalibrationRecord", "CalibrationStore", "InputFile", "parse_time",
