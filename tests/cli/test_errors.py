@@ -314,7 +314,7 @@ def test_window_inf_and_learn_rate_0_are_refused(workdir, tmp_path):
     r = run("evaluate", workdir / "model.json", workdir / "run3.csv", "--window", "inf")
     assert r.returncode == 2 and "Invalid value for '--window': inf is not a finite number" in r.stderr
     r = run("learn", workdir / "run1.csv", "--rate", "0", "-o", tmp_path / "m.json")
-    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--rate: must be positive, got 0" in r.stderr
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--rate: must be a positive number of Hz up to 1e6, got 0.0" in r.stderr
 
 
 def test_a_closed_or_full_standard_output_is_no_internal_error(workdir, tmp_path):

@@ -27,11 +27,9 @@ from .render import print_learner
               help="Highest degree of the temperature curve (used once the still data span enough).")
 @click.option("--bin-width", "bin_width_degc", type=FINITE, default=1.0, show_default=True,
               help="Temperature bin of the learner's points [degC].")
-@click.option("--rate", "rate_hz", type=FINITE, default=None,
-              help="Nominal sample rate [Hz] (default: the first log's; with --resume, the state's).")
 @read_options
 @click.pass_context
-def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, rate_hz, **kwargs):
+def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, **kwargs):
     """Learn a temperature model from the still moments of LOGS, as the online learner would on the vehicle:
     each log one power-on, replayed in the order given.
 
@@ -47,11 +45,12 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, rate_hz
     recordings = (read_run(path, opts).recording for path in paths)
     if resume is not None:
         learner = OnlineCalibrator.load(resume)
+        rate_hz = opts["rate_hz"]
         if rate_hz is not None and rate_hz != learner.settings.rate_hz:
             raise InputError(f"--rate {rate_hz:g}: the resumed learner runs at {learner.settings.rate_hz:g} Hz")
     else:
         first = next(recordings)
-        settings = LearnerSettings(rate_hz=first.rate_hz if rate_hz is None else rate_hz, degree=int(degree),
+        settings = LearnerSettings(rate_hz=first.rate_hz, degree=int(degree),
                                    bin_width_degc=bin_width_degc)
         learner = OnlineCalibrator(settings)
         recordings = itertools.chain([first], recordings)

@@ -5,13 +5,15 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import sys
 from pathlib import Path
 
 import click
 
 from ..errors import InputError
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
-from ..io.guess import guess_layout
+from ..io.guess import HeaderlessTable, guess_layout
+from ..io.serial import parse_names, parse_rate
 from .common import OUTPUT_FILE, make_console
 from .projectfile import PROJECT_FILE, PROJECT_KEY
 
@@ -25,14 +27,33 @@ def _toml_text(value) -> str:
 @click.option("-o", "--output", default=PROJECT_FILE, show_default=True, type=OUTPUT_FILE,
               help="The project file to write.")
 @click.option("--force", is_flag=True, help="Replace an existing project file.")
+@click.option("--names", default=None, metavar="NAME,...",
+              help="A table without a header line (a serial terminal's log): its columns' names in order, e.g. "
+                   "gyro_x,gyro_y,gyro_z,temperature (asked for in a terminal).")
+@click.option("--rate", "rate_hz", default=None, metavar="HZ",
+              help="The rows' sample rate [Hz], for a table without a time column.")
 @click.pass_context
-def init(ctx, log, output, force):
+def init(ctx, log, output, force, names, rate_hz):
     """Write a project file for LOG's kind of table: its columns and units guessed from their names and
-    magnitudes, said one by one, read by every command run in this folder."""
+    magnitudes, said one by one, read by every command run in this folder. A table without a header line (a
+    serial terminal's log) needs its columns' names, in order, once: --names, or asked for in a terminal."""
     refuse_to_overwrite_inputs(output, [log], option="-o")
     if Path(output).exists() and not force:
         raise InputError(f"{output}: exists; give --force to replace it, or -o another file")
-    guess = guess_layout(log)
+    rate_hz = None if rate_hz is None else parse_rate(rate_hz)
+    try:
+        guess = guess_layout(log, None if names is None else parse_names(names), rate_hz)
+    except HeaderlessTable as exc:
+        if not sys.stdin.isatty():
+            raise InputError(f"{log}: a table without a header line, rows of {exc.count} numbers (e.g. "
+                             f"{exc.example!r}); give their names in order with --names (e.g. --names "
+                             "gyro_x,gyro_y,gyro_z,temperature), and --rate HZ if it has no time column") from None
+        click.echo(f"{log} has no header line; its rows hold {exc.count} numbers, e.g. {exc.example}")
+        names = click.prompt(f"their {exc.count} names in order (time, gyro_x..z, accel_x..z, temperature; "
+                             "any other name leaves a column unused)")
+        if rate_hz is None and "time" not in parse_names(names):
+            rate_hz = parse_rate(click.prompt("no time column: the rows' sample rate [Hz]"))
+        guess = guess_layout(log, parse_names(names), rate_hz)
     layout = guess.layout
     lines = [f"# gyrocomp project file: written by `gyrocomp init {Path(log).name}` on "
              f"{_dt.date.today().isoformat()}; every gyrocomp command run in this folder reads it",
@@ -43,6 +64,10 @@ def init(ctx, log, output, force):
     read = {"gyro-unit": layout.gyro_unit, "accel-unit": layout.accel_unit, "time-unit": layout.time_unit}
     if layout.delimiter is not None:
         read["delimiter"] = "tab" if layout.delimiter == "\t" else layout.delimiter
+    if layout.names is not None:
+        read["names"] = ",".join(layout.names)
+    if layout.rate_hz is not None:
+        read["rate"] = layout.rate_hz
     # TOML: a table's keys come before its sub-tables, so the units go in a [read] written before [read.columns]
     head = lines.index("[read]")
     lines[head + 1:head + 1] = [f"{k} = {_toml_text(v)}" for k, v in read.items()]

@@ -21,6 +21,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import InputError
+from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless
 from .tables import TableLayout, _csv_bytes, detect_table_format, sniff_csv
 
 #: rows read to guess from
@@ -74,6 +75,35 @@ def _kind(name: str) -> str | None:
     return None
 
 
+class HeaderlessTable(InputError):
+    """The table has no header line (a serial terminal's log): its rows hold ``count`` numbers, like ``example``;
+    the caller asks for their names."""
+
+    def __init__(self, path: Path, count: int, example: str):
+        super().__init__(f"{path}: a table without a header line, rows of {count} numbers (e.g. {example!r}); give "
+                         f"their names in order (names=gyro_x,gyro_y,gyro_z,temperature)")
+        self.count = count
+        self.example = example
+
+
+def _headerless_rows(head: bytes) -> tuple[int, str] | None:
+    """(numbers per row, an example row) when most of the first lines of a text table are rows of numbers and
+    none of them is a header of that many names; None when it has a header."""
+    lines = [line.strip() for line in head.decode("utf-8", "replace").splitlines()[:-1] if line.strip()][:50]
+    rows = [line for line in lines if looks_headerless(line)]
+    if not rows or len(rows) <= len(lines) / 2:
+        return None
+    fields = lambda line: len([f for f in re.split(r"[\s,;]+", line) if f])  # noqa: E731
+    counts = [fields(row) for row in rows]
+    count = max(set(counts), key=counts.count)
+    first = next(i for i, line in enumerate(lines) if fields(line) == count and looks_headerless(line))
+    # a header: the line just before the first row, as many fields, none of them a number
+    if first > 0 and fields(lines[first - 1]) == count and \
+            not any(looks_headerless(f) for f in re.split(r"[\s,;]+", lines[first - 1]) if f):
+        return None
+    return count, lines[first][:MAX_LINE_BYTES]
+
+
 def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
     if fmt == "parquet":
         parquet = pq.ParquetFile(path)
@@ -81,15 +111,21 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
     source, head = _csv_bytes(path)
     if not head.strip():
         raise InputError(f"{path}: the file is empty; nothing to guess from")
+    headerless = _headerless_rows(head)
+    if headerless is not None:
+        raise HeaderlessTable(path, *headerless)
     delimiter, decimal = sniff_csv(head)
-    reader = pacsv.open_csv(source, parse_options=pacsv.ParseOptions(delimiter=delimiter),
-                            convert_options=pacsv.ConvertOptions(decimal_point=decimal))
     batches, rows = [], 0
-    for batch in reader:
-        batches.append(batch)
-        rows += batch.num_rows
-        if rows >= GUESS_ROWS:
-            break
+    try:
+        reader = pacsv.open_csv(source, parse_options=pacsv.ParseOptions(delimiter=delimiter),
+                                convert_options=pacsv.ConvertOptions(decimal_point=decimal))
+        for batch in reader:
+            batches.append(batch)
+            rows += batch.num_rows
+            if rows >= GUESS_ROWS:
+                break
+    except pa.ArrowInvalid as exc:
+        raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
     return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), delimiter
 
 
@@ -113,11 +149,14 @@ def _time_unit(name: str, values: np.ndarray) -> tuple[str, str]:
     return "s", f"time unit s: the median step {period:.4g} fits no usual rate; check it"
 
 
-def _find_columns(path: Path, table: pa.Table) -> tuple[dict[str, str], list[str]]:
-    """Channel to column, time first, and why (see the module); refuses a table without time or gyro columns."""
+def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> tuple[dict[str, str], list[str]]:
+    """Channel to column, time first, and why (see the module); refuses a table without time or gyro columns.
+    With a nominal rate [Hz], the table has no time column and none is looked for."""
     names = table.column_names
     columns: dict[str, str] = {}
     reasons: list[str] = []
+    if rate_hz is not None:
+        names = [n for n in names if n != "time"]  # the nominal time read_headerless adds
     for name in names:
         kind = _kind(name)
         axis = _axis(name)
@@ -125,6 +164,12 @@ def _find_columns(path: Path, table: pa.Table) -> tuple[dict[str, str], list[str
         if channel and channel not in columns:
             columns[channel] = name
             reasons.append(f"{channel} = {name!r}: its name")
+    if not any(c.startswith("gyro_") for c in columns):
+        raise InputError(f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
+                         f"its columns are {', '.join(names)}")
+    if rate_hz is not None:
+        reasons.insert(0, f"time: row n at n / {rate_hz:g} s (the rate given; the table has no time column)")
+        return columns, reasons
     time_name = next((n for n in names if set(_words(n)) & _TIME_WORDS and n not in columns.values()), None)
     if time_name is None:
         for name in names:
@@ -137,10 +182,7 @@ def _find_columns(path: Path, table: pa.Table) -> tuple[dict[str, str], list[str
         reasons.append(f"time = {time_name!r}: its name")
     if time_name is None:
         raise InputError(f"{path}: no column looks like the time (named time or timestamp, or only increasing); "
-                         "name it with columns= time=NAME")
-    if not any(c.startswith("gyro_") for c in columns):
-        raise InputError(f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
-                         f"its columns are {', '.join(names)}")
+                         "name it with columns= time=NAME, or give the rows' sample rate (rate_hz=50)")
     return {"time": time_name, **columns}, reasons
 
 
@@ -160,7 +202,12 @@ def _accel_unit(table: pa.Table, columns: dict[str, str]) -> tuple[str, str]:
     return unit, f"accelerometer in {unit}: its {'norm' if len(accel) == 3 else 'largest value'} at rest is {norm:.3g}"
 
 
-def _gyro_unit(columns: dict[str, str], accel_unit: str) -> tuple[str, str]:
+#: the largest median |gyro| over all axes [deg/s] a gyro in deg/s gives while still or turning about one axis (the
+#: others' biases); more is mdps (or raw counts)
+_MAX_REST_DPS = 50.0
+
+
+def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tuple[str, str]:
     words = {w for c in columns if c.startswith("gyro") for w in _words(columns[c])}
     if words & {"rad", "rads", "radps"}:
         return "rad/s", "gyro in rad/s: the column's name says so"
@@ -168,30 +215,53 @@ def _gyro_unit(columns: dict[str, str], accel_unit: str) -> tuple[str, str]:
         return "mdps", "gyro in mdps: the column's name says so"
     if words & {"dps", "deg", "degs"}:
         return "deg/s", "gyro in deg/s: the column's name says so"
+    gyro = [_numbers(table, columns[c]) for c in columns if c.startswith("gyro_")]
+    typical = float(np.median(np.abs(np.concatenate(gyro)))) if all(g is not None and g.size for g in gyro) else 0.0
+    if typical > _MAX_REST_DPS:
+        return "mdps", (f"gyro in mdps: its typical size, {typical:.4g}, is no rate in deg/s while still (check: raw "
+                        "counts need the part's scale)")
     if accel_unit == "m/s2":
         return "rad/s", ("gyro in rad/s: the accelerometer is in m/s2, and a logger that writes SI does so throughout "
                          "(check: a bias at rest cannot tell rad/s from deg/s)")
     return "deg/s", "gyro in deg/s: the default (check: a bias at rest cannot tell rad/s from deg/s)"
 
 
-def guess_layout(path) -> LayoutGuess:
+def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | None = None) -> LayoutGuess:
     """Guess the column mapping and units of a CSV/TSV or Parquet table from its first ``GUESS_ROWS`` rows (see
-    the module); refuses a file of another format, or one whose time or gyro columns cannot be told."""
+    the module); refuses a file of another format, or one whose time or gyro columns cannot be told.
+
+    Parameters
+    ----------
+    path : path
+        The table.
+    names : tuple of str, optional
+        A table without a header line (a serial terminal's log): its columns' names in order. Without them such
+        a table raises :class:`HeaderlessTable`, saying how many numbers its rows hold.
+    rate_hz : float, optional
+        The rows' nominal sample rate [Hz], for a table without a time column.
+    """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     fmt = detect_table_format(path)
     if fmt not in ("csv", "parquet"):
         raise InputError(f"{path}: not a CSV/TSV or Parquet table; logs (ULog, DataFlash, ROS bags) need no layout")
-    table, delimiter = _sample(path, fmt)
-    columns, reasons = _find_columns(path, table)
-    time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+    check = TableLayout(names=names, rate_hz=rate_hz)  # names and rate checked as every reader checks them
+    if names is not None:
+        table, delimiter = read_headerless(path, check.names, check.rate_hz).slice(0, GUESS_ROWS), None
+    else:
+        table, delimiter = _sample(path, fmt)
+    columns, reasons = _find_columns(path, table, check.rate_hz)
+    if "time" in columns:
+        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+    else:
+        time_unit, why_time = "s", "time unit s: the nominal time"
     accel_unit, why_accel = _accel_unit(table, columns)
-    gyro_unit, why_gyro = _gyro_unit(columns, accel_unit)
+    gyro_unit, why_gyro = _gyro_unit(table, columns, accel_unit)
     layout = TableLayout(columns, gyro_unit=gyro_unit, accel_unit=accel_unit, time_unit=time_unit,
-                         delimiter=delimiter)
-    unused = tuple(n for n in table.column_names if n not in columns.values())
+                         delimiter=delimiter, names=check.names, rate_hz=check.rate_hz)
+    unused = tuple(n for n in table.column_names if n not in columns.values() and not (rate_hz and n == "time"))
     return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
 
 
-__all__ = ["GUESS_ROWS", "LayoutGuess", "guess_layout"]
+__all__ = ["GUESS_ROWS", "HeaderlessTable", "LayoutGuess", "guess_layout"]

@@ -26,8 +26,8 @@ import pyarrow.parquet as pq
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path
-from .tables import (_COMPRESSED, TableLayout, TextFormat, _channel_selector, _csv_options, _resolved_columns,
-                     detect_table_format, output_text_format, table_recording, with_decimal)
+from .tables import (_COMPRESSED, TableLayout, TextFormat, _channel_selector, _csv_options, _read_arrow,
+                     _resolved_columns, detect_table_format, output_text_format, table_recording, with_decimal)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
@@ -76,6 +76,8 @@ class TableStream:
         self._read: list[str] | None = None  # the columns read (None: all)
         #: a text table's separator and decimal point (None for Parquet)
         self.text_format: TextFormat | None = None
+        #: a table without a header line, read whole (a serial terminal's log: :mod:`gyrocomp.io.serial`)
+        self._headerless: pa.Table | None = None
         self.schema = self._open_schema()
         if channels is None:
             self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
@@ -91,6 +93,9 @@ class TableStream:
 
     # ------------------------------------------------------------------ reading
     def _open_schema(self) -> pa.Schema:
+        if self.layout.names is not None:
+            self._headerless, self.text_format = _read_arrow(self.path, self.fmt, self.layout)
+            return self._headerless.schema
         if self.fmt == "parquet":
             try:
                 return pq.ParquetFile(arrow_source(self.path)).schema_arrow
@@ -134,6 +139,10 @@ class TableStream:
         return pa.input_stream(source, compression=codec)
 
     def _batches(self) -> Iterator[pa.RecordBatch]:
+        if self._headerless is not None:
+            table = self._headerless if self._read is None else self._headerless.select(self._read)
+            yield from table.to_batches(max_chunksize=self.chunk_rows)
+            return
         if self.fmt == "parquet":
             # without pre-buffering: pyarrow would keep every row group's read-ahead until the file is closed
             # (memory growing with the file, about 12 bytes a row)

@@ -20,8 +20,13 @@ from ..spelling import Spelling, spelled
 from ..units import unit_factor
 from .digest import file_sha256
 from .atomic import arrow_source, atomic_path
+from .serial import check_rate, looks_headerless, parse_names, parse_rate, read_headerless
 
 TIME_COLUMN = "time"
+#: the time "column" of a table read with a nominal rate: no column of the file, row n at n / rate [s]
+NOMINAL_TIME = "\x00row / rate"
+#: the most columns a table without a header line may name (a row is at most 1 kB of text)
+MAX_NAMES = 40
 PER_AXIS_TEMPERATURES = tuple(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES)
 CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *PER_AXIS_TEMPERATURES,
                      *REFERENCE_RATE_AXES)
@@ -91,8 +96,33 @@ class TableLayout:
         "tab).", parse=_delimiter), default=None)
     decimal: str | None = spelled(Spelling("--decimal", "CSV decimal point, . or , (default: told from the first row)."),
                                   default=None)
+    names: tuple[str, ...] | None = spelled(Spelling(
+        "--names", "A text table without a header line (a serial terminal's log): its columns' names in order, e.g. "
+        "gyro_x,gyro_y,gyro_z,temperature; lines that are not that many numbers are skipped and counted.",
+        metavar="NAME,...", parse=parse_names), default=None)
+    rate_hz: float | None = spelled(Spelling(
+        "--rate", "Nominal sample rate [Hz] of a table without a time column: the n-th row is at n / rate s.",
+        metavar="HZ", parse=parse_rate), default=None)
 
     def __post_init__(self) -> None:
+        if self.names is not None:
+            names = parse_names(self.names) if isinstance(self.names, str) else self.names
+            if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
+                raise InputError(f"names: the columns' names in order, e.g. gyro_x,gyro_y,gyro_z; got {names!r}")
+            if not names or any(not n.strip() for n in names):
+                raise InputError(f"names: {','.join(names)!r}: an empty name; give each column a name")
+            repeated = sorted({n for n in names if names.count(n) > 1})
+            if repeated:
+                raise InputError(f"names: {repeated[0]!r} given twice; give each column its own name")
+            if len(names) > MAX_NAMES:
+                raise InputError(f"names: {len(names)} names; a row of a table without a header holds at most "
+                                 f"{MAX_NAMES}")
+            object.__setattr__(self, "names", tuple(names))
+        if self.rate_hz is not None:
+            object.__setattr__(self, "rate_hz", check_rate(self.rate_hz))
+            if self.names is not None and TIME_COLUMN in self.names:
+                raise InputError(f"rate_hz: the names include {TIME_COLUMN}; a nominal rate is for tables without "
+                                 "a time column")
         for canonical in self.columns:
             if canonical not in CANONICAL_COLUMNS + ARRAY_CHANNELS:
                 raise InputError(
@@ -245,14 +275,21 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
     return delimiter, decimal
 
 
-def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str | None = None,
-                select=None) -> tuple[pa.Table, TextFormat | None]:
+def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple[pa.Table, TextFormat | None]:
     """The table, and a text table's format (None for Parquet); ``select`` (a function of the header's names
-    giving the names to read, or None for all) reads only some columns."""
+    giving the names to read, or None for all) reads only some columns. A table without a header line
+    (``layout.names``) is read by :func:`gyrocomp.io.serial.read_headerless`."""
     if not path.exists():
         raise InputError(f"{path}: no such file")
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a file")
+    delimiter, decimal = layout.delimiter, layout.decimal
+    if layout.names is not None:
+        if fmt != "csv":
+            raise InputError(f"{path}: names: for a text table without a header line; a {fmt} file names its "
+                             "columns")
+        table = read_headerless(path, layout.names, layout.rate_hz)
+        return (table if select is None else table.select(select(table.column_names))), TextFormat()
     if fmt == "csv":
         source, head = _csv_bytes(path)
         if not head.strip():
@@ -267,12 +304,23 @@ def _read_arrow(path: Path, fmt: str, delimiter: str | None = None, decimal: str
                 convert.include_columns = select(header.column_names)
             return pacsv.read_csv(source, parse_options=parse, convert_options=convert), text
         except pa.ArrowInvalid as exc:
-            raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
+            raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]}){_headerless_hint(head)}"
+                             ) from None
     try:
         columns = None if select is None else select(pq.read_schema(arrow_source(path)).names)
         return pq.read_table(arrow_source(path), columns=columns), None
     except (pa.ArrowInvalid, OSError) as exc:
         raise InputError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
+
+
+def _headerless_hint(head: bytes) -> str:
+    """A hint for a CSV that does not parse whose lines after the first are numbers: a serial terminal's log, a
+    banner where the header should be."""
+    lines = [line for line in head.decode("utf-8", "replace").splitlines()[1:-1] if line.strip()]
+    if lines and sum(map(looks_headerless, lines)) > len(lines) / 2:
+        return ("; if it has no header line (a serial terminal's log), give its columns' names in order: "
+                "names=gyro_x,gyro_y,gyro_z,temperature")
+    return ""
 
 
 def arrow_floats(values: np.ndarray) -> pa.Array:
@@ -362,9 +410,20 @@ def _resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dic
         raise InputError(f"{path}: column {repeated[0]!r} appears {header.count(repeated[0])} times in the header; "
                          "give each column its own name")
     cols = layout.resolve(header, str(path))
+    if layout.names is None and looks_headerless(",".join(header)):
+        raise InputError(f"{path}: the first line is numbers ({','.join(header)[:60]}), not the columns' names: a "
+                         "table without a header line; give the names in order (names=gyro_x,gyro_y,gyro_z,"
+                         "temperature), and the sample rate if it has no time column (rate_hz=50)")
+    timed_by_rate = layout.names is not None and layout.rate_hz is not None and TIME_COLUMN not in layout.names
+    if layout.rate_hz is not None and TIME_COLUMN in cols and not timed_by_rate:
+        raise InputError(f"{path}: rate_hz={layout.rate_hz:g}: the file has a time column ({cols[TIME_COLUMN]!r}); "
+                         "a nominal rate is for tables without one")
+    if layout.rate_hz is not None and TIME_COLUMN not in cols:
+        cols[TIME_COLUMN] = NOMINAL_TIME
     if TIME_COLUMN not in cols:
         raise InputError(
-            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with columns={{'time': 'NAME'}}"
+            f"{path}: no 'time' column (the file has {', '.join(header)}); map one with columns={{'time': 'NAME'}}, "
+            "or give the rows' sample rate (rate_hz=50) where the file has no time"
         )
     if not any(a in cols for a in GYRO_AXES):
         raise InputError(
@@ -421,7 +480,7 @@ def _channel_selector(channels: tuple[str, ...], layout: TableLayout, path: Path
         if not any(a in chosen for a in GYRO_AXES):
             raise InputError(f"{path}: none of the channels read ({', '.join(channels)}) is a gyro axis of the "
                              f"file ({', '.join(a for a in GYRO_AXES if a in found)})")
-        return list(dict.fromkeys(chosen.values()))
+        return [column for column in dict.fromkeys(chosen.values()) if column != NOMINAL_TIME]
 
     return select
 
@@ -457,7 +516,7 @@ def read_table(
     fmt = fmt or detect_table_format(path) or "csv"
     chosen: dict[str, str] = {}
     select = None if channels is None else _channel_selector(tuple(channels), layout, path, chosen)
-    table, text_format = _read_arrow(path, fmt, layout.delimiter, layout.decimal, select)
+    table, text_format = _read_arrow(path, fmt, layout, select)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
@@ -483,7 +542,10 @@ def table_recording(table: pa.Table, cols: dict[str, str], layout: TableLayout, 
     temp_names = _temperature_columns(cols, gyro_axes)
     gyro_factor = unit_factor("gyro", layout.gyro_unit, "gyro_unit")
     num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
-    time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
+    if cols[TIME_COLUMN] == NOMINAL_TIME:  # a table without time, at a nominal rate
+        time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
+    else:
+        time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
     gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
     accel = (np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
