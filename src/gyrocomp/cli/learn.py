@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 
 import click
 
 from ..errors import InputError, NotFittedError
 from ..io import refuse_to_overwrite_inputs
-from ..io.atomic import write_texts_atomic
+from ..io.atomic import folder_lock, write_texts_atomic
 from ..io.files import expand_runs
 from ..fitting.online import GYRO_AXES, LearnerSettings, OnlineCalibrator, replay
 from .common import FINITE, OUTPUT_FILE, pop_read_options, read_options, read_run
@@ -54,6 +55,8 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, **kwarg
                                    bin_width_degc=bin_width_degc)
         learner = OnlineCalibrator(settings)
         recordings = itertools.chain([first], recordings)
+    if save_state is not None:
+        learner.check_state_target(save_state)  # before the logs are replayed; again under the lock below
     contributions = replay(learner, recordings)
     try:
         model = learner.to_calibration(axes=[a for a in GYRO_AXES if any(a in c.gyro_axes for c in contributions)],
@@ -61,10 +64,14 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, **kwarg
     except NotFittedError as exc:  # no still piece in any log: bad input, not a failure
         raise InputError(str(exc)) from None
     texts = {output: model.to_json()}
-    if save_state is not None:
-        learner.mark_saved()
-        texts[save_state] = learner.to_json()
-    write_texts_atomic(".", texts)
+    with contextlib.ExitStack() as held:
+        if save_state is not None:  # no other learner saves between this check and the write
+            held.enter_context(folder_lock(save_state))
+            learner.check_state_target(save_state)
+            learner.mark_saved()
+            learner.new_revision()
+            texts[save_state] = learner.to_json()
+        write_texts_atomic(".", texts)
     if not ctx.obj["quiet"]:
         print_learner(learner, contributions, output)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import stat
 import tempfile
@@ -135,6 +136,23 @@ def _mode_for(target: Path) -> int:
         umask = os.umask(0)
         os.umask(umask)
         return 0o666 & ~umask
+
+
+@contextlib.contextmanager
+def folder_lock(path: str | os.PathLike) -> Iterator[None]:
+    """Hold an exclusive lock (``flock``) on the folder of ``path`` for the block: writers of that folder that take
+    it (learners saving states) check what is there and write in turn, never between another's check and write.
+    The lock goes with the process; it is advisory (a program that does not take it is not stopped)."""
+    folder = Path(path).parent
+    try:
+        fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot open its folder to lock it ({exc.strerror or exc})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
 
 
 def write_texts_atomic(folder: str | os.PathLike, texts: dict[str, str]) -> list[Path]:

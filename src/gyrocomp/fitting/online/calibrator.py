@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import uuid
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, Literal
@@ -16,13 +17,13 @@ from ...calibration import AxisCalibration, Calibration
 from ...effects import lazy_lfilter
 from ... import jsontext
 from ...errors import InputError, NotFittedError
-from ...io.atomic import write_text_atomic
+from ...io.atomic import folder_lock, write_text_atomic
 from ...motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY
 from ..base import provenance
 from ...curves.polynomial import PolynomialCurve
 from .state import _record_to_dict, _restore
-from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, LearnerSettings,
-                       LearnerStatus, LogContribution, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
+from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, LINEAGE_KEPT,
+                       LearnerSettings, LearnerStatus, LogContribution, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
                        PIECE_SPREAD_WEIGHT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC, _MAD_TO_SIGMA, chi2_quantile)
 from .refit import _curve, _design, _forward, _matrix, _tilted, _weighted_fit
 from .blocks import _fresh_dequantizer, _quantile, block_statistics
@@ -116,6 +117,7 @@ class OnlineCalibrator:
         self._saved: dict | None = None
         self._should_save = False
         self._counts = {"still_s": 0.0, "rejected_bound": 0, "rejected_outliers": 0, "stale_dropped": 0}
+        self._lineage: tuple[str, ...] = ()  # the ids of the saved states this one goes on from, its own last
 
     # ---------------------------------------------------------------- the stream
     def start_session(self) -> None:
@@ -732,6 +734,7 @@ class OnlineCalibrator:
                           "degree": self._saved["degree"], "coef": self._saved["coef"].tolist(),
                           "t_range": list(self._saved["t_range"]), "constant": self._saved["constant"].tolist()}},
             "counts": dict(self._counts),
+            "lineage": list(self._lineage),
         }
 
     @classmethod
@@ -752,9 +755,51 @@ class OnlineCalibrator:
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), allow_nan=False) + "\n"
 
+    @property
+    def state_id(self) -> str | None:
+        """The id of the saved state this learner is (loaded from, or last saved as); None before any save."""
+        return self._lineage[-1] if self._lineage else None
+
+    def new_revision(self) -> str:
+        """Give the state about to be saved an id of its own, the one it goes on from kept among its ancestors
+        (the last :data:`LINEAGE_KEPT`); returns the new id."""
+        self._lineage = (*self._lineage, uuid.uuid4().hex)[-LINEAGE_KEPT:]
+        return self._lineage[-1]
+
+    def check_state_target(self, path: str | os.PathLike) -> None:
+        """Refuse to save over ``path`` when it holds a learner state this one does not go on from: another learner
+        resumed the same state and saved there first, or it was started afresh; replacing it would lose what that
+        learner learned. A file that is no learner state, or one this learner descends from, may be replaced.
+        Call it under :func:`gyrocomp.io.atomic.folder_lock` with the write, so that no other learner saves
+        between the check and the write."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (FileNotFoundError, IsADirectoryError):
+            return
+        except (OSError, UnicodeDecodeError):
+            return
+        try:
+            other = json.loads(text)
+        except ValueError:
+            return
+        if not isinstance(other, dict) or other.get("format") != LEARNER_FORMAT:
+            return
+        lineage = other.get("lineage")
+        theirs = lineage[-1] if isinstance(lineage, list) and lineage and isinstance(lineage[-1], str) else None
+        if theirs is None or theirs not in self._lineage:
+            raise InputError(f"{path}: holds another learner's state, one this learner does not go on from (another "
+                             "learner resumed the same state and saved here first, or it started afresh); nothing "
+                             "written, so that neither loses what it learned: resume from that state, or save to "
+                             "another file")
+
     def save(self, path: str | os.PathLike) -> None:
-        """Write the state as JSON, atomically."""
-        write_text_atomic(path, self.to_json())
+        """Write the state as JSON, atomically, as a new revision; refused (:meth:`check_state_target`) where
+        ``path`` holds a state this one does not go on from."""
+        with folder_lock(path):
+            self.check_state_target(path)
+            self.new_revision()
+            write_text_atomic(path, self.to_json())
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "OnlineCalibrator":

@@ -13,6 +13,9 @@ from ...motion.stillness import MIN_BLOCK_SAMPLES
 
 LEARNER_FORMAT = "gyrocomp-learner"
 LEARNER_SCHEMA_VERSION = 1
+#: the saved states' ids a learner state keeps (its ancestors, its own last): a save may replace a state file only
+#: when that file's id is among them (``OnlineCalibrator.check_state_target``)
+LINEAGE_KEPT = 64
 #: the curve's variable u = (T - T_REF_DEGC) / T_SCALE_DEGC
 T_REF_DEGC = 25.0
 T_SCALE_DEGC = 25.0

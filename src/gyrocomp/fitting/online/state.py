@@ -3,6 +3,7 @@ or damaged state is refused naming the field."""
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from ...errors import InputError
 from ...measures.plausibility import TEMPERATURE_RANGE_DEGC
-from .settings import POOL_PIECES, LearnerSettings
+from .settings import LINEAGE_KEPT, POOL_PIECES, LearnerSettings
 
 def _record_to_dict(record: dict) -> dict:
     out = {k: bool(v) for k, v in record.items() if k not in ("mean", "temperature")}
@@ -67,6 +68,11 @@ def _restore(cls, d: dict) -> Any:
     counts = d["counts"]
     self._counts = {"still_s": float(counts["still_s"]),
                     **{k: int(counts[k]) for k in ("rejected_bound", "rejected_outliers", "stale_dropped")}}
+    lineage = d.get("lineage", [])  # absent in states written before 0.2: no ancestors known
+    if not isinstance(lineage, list) or len(lineage) > LINEAGE_KEPT or \
+            not all(isinstance(i, str) and re.fullmatch(r"[0-9a-f]{32}", i) for i in lineage):
+        raise InputError(f"lineage: up to {LINEAGE_KEPT} state ids (32 hexadecimal digits) expected")
+    self._lineage = tuple(lineage)
     return self
 
 
