@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import hashlib
 import re
+import shutil
+import sqlite3
 import subprocess
 import sys
 
@@ -48,6 +50,15 @@ def manifest(tmp_path_factory):
 
 def _fit(manifest, out, *more):
     return run("fleet", "fit", "--manifest", manifest, "-o", out, "--scheduler", "serial", *more)
+
+
+@pytest.fixture(scope="module")
+def fitted(manifest, tmp_path_factory):
+    """The fleet of ``manifest`` fitted once into a store; tests that change it work on a copy."""
+    out = tmp_path_factory.mktemp("fitted") / "FLEET"
+    result = _fit(manifest, out)
+    assert result.returncode == 0, result.stderr
+    return out
 
 
 def test_serials_that_once_shared_a_file_each_keep_their_model(manifest, tmp_path):
@@ -171,11 +182,9 @@ def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp
     ("inputs", "not json", r"row \d+ \(unit 'SN-1'\) is damaged \(JSONDecodeError"),
     ("calibrated_utc", "garbage", r"row \d+ \(unit 'SN-1'\) holds no time gyrocomp wrote"),
 ])
-def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, tmp_path, column, value, said):
-    import sqlite3
-
+def test_a_store_row_changed_by_another_program_is_one_line_naming_it(fitted, tmp_path, column, value, said):
     out = tmp_path / "FLEET"
-    assert _fit(manifest, out).returncode == 0
+    shutil.copytree(fitted, out)
     with sqlite3.connect(out / "calibrations.sqlite") as conn:
         conn.execute(f"UPDATE calibrations SET {column} = ? WHERE serial = 'SN-1'", (value,))
     for args in (["show", "SN-1", "--store", out], ["export", "SN-1", "--store", out, "--format", "json", "-o",
@@ -188,8 +197,6 @@ def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, 
     assert not (tmp_path / "m.json").exists() and (tmp_path / "r.html").exists() == (column == "model")
 
 
-def test_show_at_the_last_day_there_is(manifest, tmp_path):
-    out = tmp_path / "FLEET"
-    assert _fit(manifest, out).returncode == 0
-    result = run("fleet", "show", "SN-1", "--store", out, "--at", "9999-12-31")
+def test_show_at_the_last_day_there_is(fitted):
+    result = run("fleet", "show", "SN-1", "--store", fitted, "--at", "9999-12-31")
     assert result.returncode == 0, result.stderr

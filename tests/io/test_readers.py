@@ -323,7 +323,7 @@ def test_compressed_tables_are_streamed_and_archives_refused(tmp_path):
         for _ in range(40):
             fh.write(b"1" * 10_000_000)
     result = run("convert", tmp_path / "bomb.csv.gz", tmp_path / "bomb.csv")
-    assert result.returncode == 2 and "bomb.csv.gz: not a readable gzip CSV file" in result.stderr
+    assert result.returncode == 2 and "bomb.csv.gz: a line over 1 MB long, which no row of a table is" in result.stderr
     assert not (tmp_path / "bomb.csv").exists()
 
 

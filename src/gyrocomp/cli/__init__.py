@@ -16,6 +16,7 @@ import functools
 import importlib
 import os
 import re
+import resource
 import signal
 import sys
 import traceback
@@ -216,10 +217,28 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
     click.echo(f"gyrocomp: warning: {printable(in_cli_words(str(message)))}", err=True)
 
 
+#: what a library says when the machine runs out of memory, threads or file descriptors (pyarrow's thread pool,
+#: Python's threads), each an error of the environment, not of gyrocomp
+_EXHAUSTED = re.compile(r"failed to launch worker thread|can't start new thread|cannot allocate memory|"
+                        r"out of memory|resource temporarily unavailable|too many open files|failed to map segment", re.IGNORECASE)
+_OUT_OF_MEMORY = ("not enough memory (or threads) for this size of data under this machine's limits; read less at "
+                  "once (--columns for the channels needed, --time A:B for a stretch, apply streams tables) or "
+                  "run it where more memory is allowed (ulimit -v)")
+
+
+def _resource_exhausted(exc: BaseException) -> bool:
+    """Whether ``exc`` says the machine ran out of memory, threads or file descriptors."""
+    return isinstance(exc, MemoryError) or bool(_EXHAUSTED.search(str(exc))) and (
+        type(exc).__name__.startswith("Arrow") or isinstance(exc, (RuntimeError, OSError, ImportError)))
+
+
 def _environment_message(exc: BaseException) -> str:
     """One line for an error of the machine rather than of gyrocomp: the file and what to do."""
-    if isinstance(exc, MemoryError):
-        return "not enough memory for this size of data; process it in pieces or on a larger machine"
+    if isinstance(exc, OSError) and exc.errno in (errno.EMFILE, errno.ENFILE):
+        return ("too many files open at once for this machine's limit (ulimit -n); raise it, or give fewer files at "
+                "once")
+    if _resource_exhausted(exc):
+        return _OUT_OF_MEMORY
     where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
     hint = {errno.EACCES: "check its permissions", errno.EPERM: "check its permissions",
             errno.ENOSPC: "the disk is full; free space and run again", errno.EFBIG: "the file is too large here",
@@ -228,15 +247,51 @@ def _environment_message(exc: BaseException) -> str:
     return f"{where}{reason.lower()}" + (f"; {hint[exc.errno]}" if getattr(exc, "errno", None) in hint else "")
 
 
-def _exit_on_termination() -> None:
-    """SIGTERM and SIGHUP end the command as an exception would: every temporary output is removed on the
-    way out (the atomic writers clean up on any exception) and nothing half-written is left at a target."""
-    def stop(signum, frame):
-        raise SystemExit(128 + signum)
+class _Terminated(SystemExit):
+    """The command was stopped by a signal (SIGTERM, SIGHUP)."""
 
-    for name in ("SIGTERM", "SIGHUP"):
-        if hasattr(signal, name):
+    def __init__(self, signum: int):
+        super().__init__(128 + signum)
+        self.signum = signum
+
+
+#: what the command says when it is stopped: the atomic writers removed their temporary files on the way out
+_NOTHING_HALF_WRITTEN = "outputs not finished were removed, nothing half-written is left"
+
+
+def _exit_on_termination() -> None:
+    """SIGTERM, SIGHUP and SIGINT (Ctrl-C) end the command as an exception would: every temporary output is
+    removed on the way out (the atomic writers clean up on any exception) and nothing half-written is left at a
+    target."""
+    def stop(signum, frame):
+        raise _Terminated(signum)
+
+    for name in ("SIGTERM", "SIGHUP", "SIGINT"):
+        # Ctrl-C too: click would turn it into its own abort, after an empty line; one ignored (nohup, a
+        # background job) stays ignored
+        if hasattr(signal, name) and signal.getsignal(getattr(signal, name)) is not signal.SIG_IGN:
             signal.signal(getattr(signal, name), stop)
+
+
+#: the address space the numeric libraries need to load and read a small file [bytes] (under 0.6 GB, OpenBLAS
+#: loops for ever retrying its buffers; 1 GB leaves room for the data)
+MIN_ADDRESS_SPACE_BYTES = 1 << 30
+
+
+def _within_address_limit() -> None:
+    """Under an address-space limit (``ulimit -v``), the numeric libraries' thread pools are kept to one thread
+    each before they load: OpenBLAS reserves tens of MB per thread, and a pool that cannot start its threads
+    fails to load or waits for ever; pyarrow's allocator is the system's, whose failures it reports instead of
+    aborting. Settings already in the environment are kept."""
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft == resource.RLIM_INFINITY:
+        return
+    if soft < MIN_ADDRESS_SPACE_BYTES:  # OpenBLAS would retry its buffers for ever while loading
+        raise InputError(f"this process may map {soft / 1e6:.0f} MB (ulimit -v); gyrocomp needs at least "
+                         f"{MIN_ADDRESS_SPACE_BYTES / 1e9:.0f} GB to load its numeric libraries: raise the limit")
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(name, "1")
+    os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -250,13 +305,19 @@ def main(argv: list[str] | None = None) -> int:
     previous = warnings.showwarning
     warnings.showwarning = _show_warning
     try:
+        if argv is None:
+            _within_address_limit()
         result = cli.main(args=args, prog_name="gyrocomp", standalone_mode=False)
         status = result if isinstance(result, int) else 0
     except click.exceptions.Exit as exc:
         status = exc.exit_code
     except click.exceptions.Abort:
-        click.echo("gyrocomp: aborted", err=True)
+        click.echo(f"gyrocomp: interrupted; {_NOTHING_HALF_WRITTEN}", err=True)
         status = EXIT_FAILURE
+    except _Terminated as exc:
+        what = "interrupted (Ctrl-C)" if exc.signum == signal.SIGINT else f"stopped by {signal.Signals(exc.signum).name}"
+        click.echo(f"gyrocomp: {what}; {_NOTHING_HALF_WRITTEN}", err=True)
+        status = exc.code
     except click.ClickException as exc:  # usage errors: bad option, missing argument
         if debug:
             traceback.print_exc()
@@ -282,9 +343,13 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
-                   "(run with --debug for the traceback)", err=True)
-        status = EXIT_FAILURE
+        if _resource_exhausted(exc):  # pyarrow's or Python's threads or memory: the machine's limits
+            click.echo(f"gyrocomp: error: {_environment_message(exc)}", err=True)
+            status = EXIT_INPUT
+        else:
+            click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
+                       "(run with --debug for the traceback)", err=True)
+            status = EXIT_FAILURE
     finally:
         warnings.showwarning = previous
     if argv is None:

@@ -138,6 +138,21 @@ def _mode_for(target: Path) -> int:
         return 0o666 & ~umask
 
 
+def require_unchanged(path: str | os.PathLike, before: os.stat_result) -> None:
+    """Refuse in one line an input that changed while it was read (another program still writing it, cutting it
+    short or replacing it): its size, modification time or file differ from ``before``, its state when the
+    reading began. What was read from it is then not the file, so nothing is written from it."""
+    try:
+        after = os.stat(path)
+    except OSError:
+        raise InputError(f"{path}: removed or replaced while it was read; nothing written from it") from None
+    if (after.st_size, after.st_mtime_ns, after.st_ino) != (before.st_size, before.st_mtime_ns, before.st_ino):
+        change = (f"{before.st_size} bytes when the reading began, {after.st_size} at its end"
+                  if after.st_size != before.st_size else "modified or replaced during the reading")
+        raise InputError(f"{path}: changed while it was read ({change}: still being written, or cut short); "
+                         "nothing written from it: read it again once it is complete")
+
+
 @contextlib.contextmanager
 def folder_lock(path: str | os.PathLike) -> Iterator[None]:
     """Hold an exclusive lock (``flock``) on the folder of ``path`` for the block: writers of that folder that take

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import glob
 import os
+import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import DataQualityWarning, InputError
 from .tables import detect_table_format
 
 #: suffixes of the files a folder is searched for (every format gyrocomp reads)
@@ -16,7 +17,29 @@ RUN_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".parquet", ".pq", ".ulg", ".bin
 
 def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
     """The run files that ``data`` names: files as given, folders searched recursively for every readable format
-    (a ROS 2 bag folder, with its ``metadata.yaml``, counts as one run), glob patterns expanded; sorted, each once."""
+    (a ROS 2 bag folder, with its ``metadata.yaml``, counts as one run), glob patterns expanded; sorted, each once:
+    names that are one file (reached through symbolic links, a link loop included) count once, by the shortest
+    name, and a warning says how many were dropped."""
+    found = _each_once(_named_files(data))
+    if not found:
+        raise InputError(f"{', '.join(map(os.fspath, data))}: no run file found (looked for "
+                         f"{', '.join(RUN_SUFFIXES)})")
+    return sorted(found)
+
+
+def _each_once(paths: set[Path]) -> set[Path]:
+    """One name per file (its shortest, then first in order), with a warning when names were dropped."""
+    by_file: dict[str, Path] = {}
+    for path in sorted(paths, key=lambda p: (len(p.parts), os.fspath(p))):
+        by_file.setdefault(os.path.realpath(path), path)
+    dropped = len(paths) - len(by_file)
+    if dropped:
+        warnings.warn(f"{dropped} name(s) matched are files already named by another path (through symbolic "
+                      "links, or a link loop); each file is read once", DataQualityWarning, stacklevel=3)
+    return set(by_file.values())
+
+
+def _named_files(data: Iterable[str | os.PathLike]) -> set[Path]:
     found: set[Path] = set()
     for item in data:
         text = os.fspath(item)
@@ -33,10 +56,7 @@ def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
                 found.update(_runs_in_folder(match) if match.is_dir() else [match])
         else:
             raise InputError(f"{text}: no such file or folder")
-    if not found:
-        raise InputError(f"{', '.join(map(os.fspath, data))}: no run file found (looked for "
-                         f"{', '.join(RUN_SUFFIXES)})")
-    return sorted(found)
+    return found
 
 
 def _runs_in_folder(folder: Path) -> list[Path]:

@@ -22,7 +22,8 @@ import pyarrow.parquet as pq
 
 from ..errors import InputError
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless
-from .tables import TableLayout, _csv_bytes, detect_table_format, sniff_csv
+from .tables import (DECOMPRESS_ERRORS, TableLayout, _csv_bytes, check_parquet_footer, detect_table_format, read_error,
+                     sniff_csv)
 
 #: rows read to guess from
 GUESS_ROWS = 20_000
@@ -106,15 +107,16 @@ def _headerless_rows(head: bytes) -> tuple[int, str] | None:
 
 def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
     if fmt == "parquet":
+        check_parquet_footer(path)
         parquet = pq.ParquetFile(path)
         return (parquet.read_row_group(0) if parquet.num_row_groups else parquet.read()).slice(0, GUESS_ROWS), None
     source, head = _csv_bytes(path)
     if not head.strip():
         raise InputError(f"{path}: the file is empty; nothing to guess from")
-    headerless = _headerless_rows(head)
+    headerless = _headerless_rows(head[:4096])
     if headerless is not None:
         raise HeaderlessTable(path, *headerless)
-    delimiter, decimal = sniff_csv(head)
+    delimiter, decimal = sniff_csv(head[:4096])
     batches, rows = [], 0
     try:
         reader = pacsv.open_csv(source, parse_options=pacsv.ParseOptions(delimiter=delimiter),
@@ -124,8 +126,8 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
             rows += batch.num_rows
             if rows >= GUESS_ROWS:
                 break
-    except pa.ArrowInvalid as exc:
-        raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]})") from None
+    except DECOMPRESS_ERRORS as exc:
+        raise read_error(path, exc, head) from None
     return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), delimiter
 
 

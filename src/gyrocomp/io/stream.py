@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import lzma
+import os
 import sys
 import warnings
 from collections.abc import Iterator
@@ -25,15 +26,16 @@ import pyarrow.parquet as pq
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
-from .atomic import arrow_source, atomic_path
-from .tables import (_COMPRESSED, TableLayout, TextFormat, _channel_selector, _csv_options, _read_arrow,
-                     _resolved_columns, detect_table_format, output_text_format, table_recording, with_decimal)
+from .atomic import arrow_source, atomic_path, require_unchanged
+from .tables import (CSV_BLOCK_BYTES, DECOMPRESS_ERRORS, HEADER_MAX_BYTES, TableLayout, TextFormat, _channel_selector,
+                     _csv_options, _read_arrow, _resolved_columns, check_header, check_parquet_footer, csv_codec,
+                     detect_table_format, open_csv_bytes, output_text_format, read_error, table_recording,
+                     with_decimal)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
-#: CSV bytes parsed at once by the streaming reader (it infers the column types from the first block; it reads
-#: about twenty blocks ahead, so larger blocks cost memory: 16 MB blocks held 300 MB)
-CSV_BLOCK_BYTES = 1 << 20
+#: CSV bytes parsed at once by the streaming reader, CSV_BLOCK_BYTES (1 MB; it infers the column types from the
+#: first block; it reads about twenty blocks ahead, so larger blocks cost memory: 16 MB blocks held 300 MB)
 
 
 class NotStreamable(Exception):
@@ -78,6 +80,7 @@ class TableStream:
         self.text_format: TextFormat | None = None
         #: a table without a header line, read whole (a serial terminal's log: :mod:`gyrocomp.io.serial`)
         self._headerless: pa.Table | None = None
+        self._opened = os.stat(self.path)  # the file as it was when the reading began
         self.schema = self._open_schema()
         if channels is None:
             self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
@@ -97,6 +100,7 @@ class TableStream:
             self._headerless, self.text_format = _read_arrow(self.path, self.fmt, self.layout)
             return self._headerless.schema
         if self.fmt == "parquet":
+            check_parquet_footer(self.path)
             try:
                 return pq.ParquetFile(arrow_source(self.path)).schema_arrow
             except (pa.ArrowInvalid, OSError) as exc:
@@ -106,37 +110,27 @@ class TableStream:
 
     @contextlib.contextmanager
     def _csv_reader(self):
-        with open(self.path, "rb") as fh:
-            magic = fh.read(6)
-        codec = next((name for sig, name in _COMPRESSED if magic.startswith(sig)), None)
+        codec = csv_codec(self.path)
+        head = b""
         with contextlib.ExitStack() as stack:
             try:
-                with self._open(codec) as peek:
-                    head = peek.read(4096)
-                source = stack.enter_context(self._open(codec))
+                with open_csv_bytes(self.path, codec) as peek:
+                    head = peek.read(HEADER_MAX_BYTES)
+                check_header(self.path, head)
+                source = stack.enter_context(open_csv_bytes(self.path, codec))
                 self._source = source if codec is None else None
                 if not head.strip():
                     raise InputError(f"{self.path}: the file is empty; expected a header such as "
                                      "time,gyro_z,temperature")
-                self.text_format = TextFormat.found(head, self.layout)
+                self.text_format = TextFormat.found(head[:4096], self.layout)
                 parse = pacsv.ParseOptions(delimiter=self.text_format.delimiter)
                 convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.text_format.decimal,
                                                include_columns=self._read or [])
                 reader = pacsv.open_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
                                         parse_options=parse, convert_options=convert)
-            except (pa.ArrowInvalid, OSError, EOFError, lzma.LZMAError) as exc:
-                what = "CSV table" if codec is None else f"{codec} CSV file"
-                raise InputError(f"{self.path}: not a readable {what} ({str(exc).splitlines()[0]})") from None
+            except DECOMPRESS_ERRORS as exc:
+                raise read_error(self.path, exc, head) from None
             yield reader
-
-    def _open(self, codec: str | None):
-        """The file's bytes, decompressed as they are read."""
-        source = arrow_source(self.path)
-        if codec is None:
-            return pa.OSFile(source, "rb") if isinstance(source, str) else pa.PythonFile(source, mode="r")
-        if codec == "xz":
-            return pa.PythonFile(lzma.open(self.path), mode="r")
-        return pa.input_stream(source, compression=codec)
 
     def _batches(self) -> Iterator[pa.RecordBatch]:
         if self._headerless is not None:
@@ -156,7 +150,11 @@ class TableStream:
                 except StopIteration:
                     return
                 except pa.ArrowInvalid as exc:  # a later block does not fit the types of the first
+                    if "straddl" in str(exc):  # a line longer than a block: no row
+                        raise read_error(self.path, exc, b"") from None
                     raise NotStreamable(str(exc).splitlines()[0]) from None
+                except (OSError, EOFError, lzma.LZMAError) as exc:  # a compressed file damaged further on
+                    raise read_error(self.path, exc, b"") from None
                 yield batch
 
     def _tables(self) -> Iterator[pa.Table]:
@@ -211,6 +209,7 @@ class TableStream:
             first += table.num_rows
         if self.rows == 0:
             raise InputError(f"{self.path}: a header but no data rows")
+        require_unchanged(self.path, self._opened)
         if self.progress:
             self.progress(1.0)
 

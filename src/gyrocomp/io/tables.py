@@ -19,7 +19,8 @@ from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_
 from ..spelling import Spelling, spelled
 from ..units import unit_factor
 from .digest import file_sha256
-from .atomic import arrow_source, atomic_path
+from .atomic import arrow_source, atomic_path, require_unchanged
+from .limits import PARQUET_MEMORY_FACTOR, address_space_left, estimated_table_bytes, require_memory
 from .serial import check_rate, looks_headerless, parse_names, parse_rate, read_headerless
 
 TIME_COLUMN = "time"
@@ -235,29 +236,100 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
 #: compressed CSV, told by its first bytes: the codec's name for pyarrow (xz through Python's lzma)
 _COMPRESSED = ((b"\x1f\x8b", "gzip"), (b"BZh", "bz2"), (b"\x28\xb5\x2f\xfd", "zstd"),
                (b"\xfd7zXZ\x00", "xz"))
+#: CSV bytes parsed at once (the longest line a table may have)
+CSV_BLOCK_BYTES = 1 << 20
 #: field separators a CSV may use (vendor exports, spreadsheets in locales with a decimal comma)
 DELIMITERS = (",", ";", "\t")
 
 
-def _csv_bytes(path: Path) -> tuple[pa.NativeFile | Path, bytes]:
-    """The CSV's source for pyarrow (decompressing gzip, bz2, zstd or xz by their magic bytes) and its first
-    4 kB of text."""
+#: the most bytes a table's header line may take, and the most columns it may name
+HEADER_MAX_BYTES = 1 << 20
+MAX_COLUMNS = 10_000
+#: what a damaged compressed file raises while it is read
+DECOMPRESS_ERRORS = (OSError, EOFError, lzma.LZMAError, pa.ArrowInvalid)
+
+
+def csv_codec(path: Path) -> str | None:
+    """The compression of a text table, told by its first bytes (gzip, bz2, zstd, xz), or None."""
     with open(path, "rb") as fh:
         magic = fh.read(6)
-    codec = next((name for sig, name in _COMPRESSED if magic.startswith(sig)), None)
+    return next((name for sig, name in _COMPRESSED if magic.startswith(sig)), None)
+
+
+def open_csv_bytes(path: Path, codec: str | None) -> pa.NativeFile:
+    """The file's bytes, decompressed as they are read (memory bounded by what is read at once, whatever the
+    file expands to)."""
+    source = arrow_source(path)
     if codec is None:
-        with open(path, "rb") as fh:
-            return arrow_source(path), fh.read(4096)
+        return pa.OSFile(source, "rb") if isinstance(source, str) else pa.PythonFile(source, mode="r")
+    if codec == "xz":
+        return pa.PythonFile(lzma.open(path), mode="r")
+    return pa.input_stream(source, compression=codec)
+
+
+def check_header(path: Path, head: bytes) -> None:
+    """Refuse, in one line saying what is too big, a text table whose first line is longer than
+    :data:`HEADER_MAX_BYTES` or names more than :data:`MAX_COLUMNS` columns (reading it would take the memory
+    and time of a million empty columns)."""
+    first = head.split(b"\n", 1)[0]
+    if b"\n" not in head and len(head) >= HEADER_MAX_BYTES:
+        raise InputError(f"{path}: its first line is over {HEADER_MAX_BYTES >> 20} MB long, which no table's header "
+                         f"is (more than {MAX_COLUMNS} columns, or a damaged or binary file); keep the columns "
+                         "gyrocomp reads (time, gyro, accelerometer, temperature) in a file of their own")
+    columns = max(first.count(d.encode()) for d in DELIMITERS) + 1
+    if columns > MAX_COLUMNS:
+        raise InputError(f"{path}: the header names {columns} columns; gyrocomp reads tables of up to "
+                         f"{MAX_COLUMNS}: keep the columns it reads (time, gyro, accelerometer, temperature) in a "
+                         "file of their own")
+
+
+def _csv_bytes(path: Path) -> tuple[pa.NativeFile | str, bytes]:
+    """The CSV's source for pyarrow (gzip, bz2, zstd or xz decompressed as they are read, by their magic bytes)
+    and its first bytes (up to :data:`HEADER_MAX_BYTES`), the header checked (:func:`check_header`)."""
+    codec = csv_codec(path)
     try:
-        if codec == "xz":
-            with lzma.open(path) as fh:
-                data = pa.py_buffer(fh.read())
-        else:
-            with pa.input_stream(arrow_source(path), compression=codec) as fh:
-                data = pa.py_buffer(fh.read())
-    except (OSError, EOFError, lzma.LZMAError, pa.ArrowInvalid) as exc:
+        with open_csv_bytes(path, codec) as peek:
+            head = peek.read(HEADER_MAX_BYTES)
+    except DECOMPRESS_ERRORS as exc:
         raise InputError(f"{path}: a {codec} file that does not decompress ({str(exc).splitlines()[0]})") from None
-    return pa.BufferReader(data), data.to_pybytes()[:4096]
+    check_header(path, head)
+    return (arrow_source(path) if codec is None else open_csv_bytes(path, codec)), head
+
+
+#: the largest Parquet footer (the file's metadata) read [bytes]: 16 MB is 15,000 row groups of 8 columns; a file
+#: of 100,000 one-row groups has 35 MB, which pyarrow turns into gigabytes before a row is read
+PARQUET_FOOTER_MAX_BYTES = 16 << 20
+
+
+def check_parquet_footer(path: Path) -> None:
+    """Refuse in one line a Parquet file whose metadata is larger than :data:`PARQUET_FOOTER_MAX_BYTES` (very many
+    small row groups), before pyarrow parses it; its length is the 4 bytes before the closing ``PAR1``."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(0, os.SEEK_END)
+            if fh.tell() < 12:
+                return  # too short to be Parquet: pyarrow says so
+            fh.seek(-8, os.SEEK_END)
+            tail = fh.read(8)
+    except OSError:
+        return
+    footer = int.from_bytes(tail[:4], "little")
+    if tail[4:] == b"PAR1" and footer > PARQUET_FOOTER_MAX_BYTES:
+        raise InputError(f"{path}: its metadata takes {footer / 1e6:.0f} MB (over {PARQUET_FOOTER_MAX_BYTES >> 20} MB: "
+                         "very many small row groups), which would take gigabytes to read; rewrite it with larger "
+                         "row groups, e.g. pyarrow.parquet.write_table(table, path, row_group_size=1_000_000)")
+
+
+def read_error(path: Path, exc: Exception, head: bytes) -> InputError:
+    """One line for a text table that pyarrow could not read (``exc``): a line too long for a block, a file that
+    does not decompress, or a parse error with a hint for a log without a header line."""
+    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    if "straddl" in text:
+        return InputError(f"{path}: a line over {CSV_BLOCK_BYTES >> 20} MB long, which no row of a table is (a "
+                          "damaged file, or text that is no table)")
+    if not isinstance(exc, pa.ArrowInvalid):
+        return InputError(f"{path}: cannot be read to its end ({text}); a damaged or cut-short compressed file?")
+    return InputError(f"{path}: not a readable CSV table ({text}){_headerless_hint(head)}")
 
 
 def sniff_csv(head: bytes) -> tuple[str, str]:
@@ -291,10 +363,11 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         table = read_headerless(path, layout.names, layout.rate_hz)
         return (table if select is None else table.select(select(table.column_names))), TextFormat()
     if fmt == "csv":
+        require_memory(path, estimated_table_bytes(path, csv_codec(path) is not None))
         source, head = _csv_bytes(path)
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
-        found_delimiter, found_decimal = sniff_csv(head)
+        found_delimiter, found_decimal = sniff_csv(head[:4096])
         text = TextFormat(delimiter or found_delimiter, decimal or found_decimal)
         parse = pacsv.ParseOptions(delimiter=text.delimiter)
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
@@ -302,11 +375,16 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
             if select is not None:  # the header's names, from its first line
                 header = pacsv.read_csv(pa.py_buffer(head.splitlines()[0] + b"\n"), parse_options=parse)
                 convert.include_columns = select(header.column_names)
-            return pacsv.read_csv(source, parse_options=parse, convert_options=convert), text
-        except pa.ArrowInvalid as exc:
-            raise InputError(f"{path}: not a readable CSV table ({str(exc).splitlines()[0]}){_headerless_hint(head)}"
-                             ) from None
+            return pacsv.read_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
+                                  parse_options=parse, convert_options=convert), text
+        except DECOMPRESS_ERRORS as exc:
+            raise read_error(path, exc, head) from None
+    check_parquet_footer(path)
     try:
+        if address_space_left() is not None:  # the columns' uncompressed size, from the metadata
+            meta = pq.read_metadata(arrow_source(path))
+            require_memory(path, PARQUET_MEMORY_FACTOR * sum(meta.row_group(i).total_byte_size
+                                                             for i in range(meta.num_row_groups)))
         columns = None if select is None else select(pq.read_schema(arrow_source(path)).names)
         return pq.read_table(arrow_source(path), columns=columns), None
     except (pa.ArrowInvalid, OSError) as exc:
@@ -316,7 +394,7 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
 def _headerless_hint(head: bytes) -> str:
     """A hint for a CSV that does not parse whose lines after the first are numbers: a serial terminal's log, a
     banner where the header should be."""
-    lines = [line for line in head.decode("utf-8", "replace").splitlines()[1:-1] if line.strip()]
+    lines = [line for line in head[:4096].decode("utf-8", "replace").splitlines()[1:-1] if line.strip()]
     if lines and sum(map(looks_headerless, lines)) > len(lines) / 2:
         return ("; if it has no header line (a serial terminal's log), give its columns' names in order: "
                 "names=gyro_x,gyro_y,gyro_z,temperature")
@@ -516,7 +594,10 @@ def read_table(
     fmt = fmt or detect_table_format(path) or "csv"
     chosen: dict[str, str] = {}
     select = None if channels is None else _channel_selector(tuple(channels), layout, path, chosen)
+    opened = os.stat(path) if path.is_file() else None
     table, text_format = _read_arrow(path, fmt, layout, select)
+    if opened is not None:
+        require_unchanged(path, opened)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
