@@ -41,24 +41,31 @@ from __future__ import annotations
 import argparse
 import collections
 import contextlib
+import gzip
 import io
 import json
 import os
 import re
+import resource
 import shutil
+import sqlite3
 import subprocess
+import sys
 import tempfile
+import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
 
 from gyrocomp import Network, Polynomial, fit, fit_calibration, write
 from gyrocomp.cli import main
 from gyrocomp.simulation import simulate
 
-BAD = ("internal error", "multi-line error", "non-finite written", "security hole", "silently wrong")
+BAD = ("internal error", "multi-line error", "non-finite written", "security hole", "silently wrong", "data loss")
 NAMES = ["time", "gyro_x", "gyro_y", "gyro_z", "accel_z", "temperature", "Time", " gyro_z ", "GyrZ", ""]
 CELLS = ["", "nan", "inf", "-inf", "1e308", "1e999", "abc", '"1"', "1,5", "0x10", " 3 ", "-0", "1e-320"]
 
@@ -527,9 +534,211 @@ def unlucky_reads(work: Path) -> collections.Counter:
     return counter
 
 
+def planted_links(data: Path, model: Path, work: Path) -> collections.Counter:
+    """Every kind of output given as a symbolic link to a victim file, a name ending in ``/``, the standard
+    streams; inputs that are pipes. A victim changed is a ``security hole``; an output accepted silently where it
+    cannot be a file is ``silently wrong``."""
+    counter: collections.Counter = collections.Counter()
+    victim = work / "victim.txt"
+    outputs = [lambda out: ["apply", model, data, "-o", out], lambda out: ["convert", data, out],
+               lambda out: ["fit", data, "-o", out, "--temperature", "poly:1", "--hysteresis", "none"],
+               lambda out: ["learn", data, "-o", work / "learned_link.json", "--save-state", out],
+               lambda out: ["export", model, "--format", "px4", "-o", out],
+               lambda out: ["simulate", "--profile", "chamber", "--duration", 60, "-o", out]]
+    suffixes = [".csv", ".csv", ".json", ".json", ".params", ".csv"]
+    for k, (command, suffix) in enumerate(zip(outputs, suffixes)):
+        victim.write_text("precious\n", encoding="utf-8")
+        link = work / f"planted{k}{suffix}"
+        with contextlib.suppress(FileNotFoundError):
+            link.unlink()
+        link.symlink_to(victim)
+        status, lines = run_command(command(link))
+        outcome = classify(status, lines, work / "none.csv")
+        if victim.read_text(encoding="utf-8") != "precious\n" or not link.is_symlink():
+            outcome = "security hole"
+        counter[outcome] += 1
+        for odd in (f"{work}/dir{k}{suffix}/", "/dev/stdout", "-"):
+            status, lines = run_command(command(odd))
+            counter["refused" if status == 2 and len(lines) == 1 else "silently wrong"] += 1
+    fifo = work / "pipe.csv"
+    with contextlib.suppress(FileNotFoundError):
+        fifo.unlink()
+    os.mkfifo(fifo)
+    for command in (["fit", fifo, "-o", work / "fifo.json"], ["convert", fifo, work / "fifo.csv"]):
+        status, lines = run_command(command)  # must not block waiting for a writer
+        counter[classify(status, lines, work / "none.csv")] += 1
+    return counter
+
+
+def damaged_store_rows(run_path: Path, work: Path) -> collections.Counter:
+    """A fleet store whose rows another program changed (cut-short model, non-JSON inputs or metadata, garbage
+    time or status) read by ``fleet show``, ``export``, ``report`` and the rerun of ``fleet fit``: refused in one
+    line naming the row, or read as it was (the report of figures)."""
+    counter: collections.Counter = collections.Counter()
+    manifest = work / "store_manifest.csv"
+    pd.DataFrame([{"path": str(run_path), "serial": "SN-1"}]).to_csv(manifest, index=False)
+    fitted = work / "store_fitted"
+    run_command(["fleet", "fit", "--manifest", manifest, "-o", fitted, "--scheduler", "serial"])
+    damages = [("model", '{"schema_version": 6, "axes"'), ("model", "[]"), ("inputs", "not json"),
+               ("inputs", '{"a": 1}'), ("calibrated_utc", "garbage"), ("calibrated_utc", "9999-99-99"),
+               ("status", "weird"), ("metadata", "{")]
+    for k, (column, value) in enumerate(damages):
+        store = work / f"store_damaged{k}"
+        shutil.copytree(fitted, store)
+        with sqlite3.connect(store / "calibrations.sqlite") as conn:
+            conn.execute(f"UPDATE calibrations SET {column} = ?", (value,))
+        for command in (["fleet", "show", "SN-1", "--store", store],
+                        ["fleet", "export", "SN-1", "--store", store, "--format", "json", "-o", work / f"e{k}.json"],
+                        ["fleet", "report", store, "-o", work / f"r{k}.html"],
+                        ["fleet", "fit", "--manifest", manifest, "-o", store, "--scheduler", "serial"]):
+            status, lines = run_command(command)
+            counter[classify(status, lines, work / "none.csv")] += 1
+    return counter
+
+
+def _gyrocomp(*args, **popen) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "gyrocomp", *map(str, args)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True, **popen)
+
+
+def concurrent_writers(data: Path, other: Path, work: Path, repeats: int) -> collections.Counter:
+    """Two learners resuming one state and saving to one file at once, and two fleet fits of one unit from other
+    inputs into one store at once: one learner refused in one line (both saving, one's work gone, is ``data
+    loss``); the unit's model file always the store's newest row's (else ``silently wrong``)."""
+    counter: collections.Counter = collections.Counter()
+    state = work / "shared_state.json"
+    run_command(["learn", data, "-o", work / "first.json", "--save-state", state])
+    for k in range(repeats):
+        target = work / f"next_state{k}.json"
+        learners = [_gyrocomp("learn", log, "--resume", state, "-o", work / f"m{k}_{j}.json", "--save-state", target)
+                    for j, log in enumerate((data, other))]
+        results = [(p.wait(timeout=600), p.stderr.read()) for p in learners]
+        codes = sorted(code for code, _ in results)
+        refusal = next((err for code, err in results if code == 2), "")
+        counter["refused" if codes == [0, 2] and refusal.count("\n") == 1 else
+                "data loss" if codes == [0, 0] else "internal error"] += 1
+    for k in range(repeats):
+        store = work / f"race_store{k}"
+        manifests = []
+        for j, path in enumerate((data, other)):
+            manifests.append(work / f"race{k}_{j}.csv")
+            pd.DataFrame([{"path": str(path), "serial": "SN-R"}]).to_csv(manifests[-1], index=False)
+        fits = [_gyrocomp("fleet", "fit", "--manifest", m, "-o", store, "--scheduler", "serial") for m in manifests]
+        codes = [p.wait(timeout=600) for p in fits]
+        with sqlite3.connect(store / "calibrations.sqlite") as conn:
+            newest = conn.execute("SELECT model FROM calibrations WHERE serial = 'SN-R' ORDER BY id DESC "
+                                  "LIMIT 1").fetchone()[0]
+        model_file = store / "models" / "SN-R.json"
+        agree = model_file.exists() and json.loads(model_file.read_text()) == json.loads(newest)
+        counter["clean" if codes == [0, 0] and agree else "silently wrong" if not agree else "internal error"] += 1
+    return counter
+
+
+def _limited(rlimit: int, value: int):
+    return lambda: resource.setrlimit(rlimit, (value, value))
+
+
+def resource_limits(data: Path, work: Path) -> collections.Counter:
+    """Limits reached: a header of a million columns, a gzip of one 1 GiB line, a Parquet file of 10^5 row
+    groups, a 2e6-row table under a 1.5 GB address-space limit (and the libraries under 300 MB), a glob through a
+    link loop (each run fitted once, else ``silently wrong``), a fleet on Dask with 40 file descriptors, a table
+    cut short while ``apply`` streams it (exit 0 is ``silently wrong``)."""
+    counter: collections.Counter = collections.Counter()
+    wide = work / "wide.csv"
+    wide.write_text(",".join(f"c{i}" for i in range(10 ** 6)) + "\n" + ",".join("1" * 10 ** 6) + "\n")
+    bomb = work / "bomb.csv.gz"
+    with gzip.open(bomb, "wb", compresslevel=9) as fh:
+        fh.write(b"time,gyro_z,temperature\n0,0.1,25\n")
+        for _ in range(1024):
+            fh.write(b"1" * (1 << 20))
+    groups = work / "groups.parquet"
+    n = 100_000
+    pq.write_table(pa.table({"time": np.arange(n) / 10.0, "gyro_z": np.full(n, 0.1),
+                             "temperature": np.linspace(20, 30, n)}), groups, row_group_size=1)
+    for path in (wide, bomb, groups):
+        for command in (["init", path, "-o", work / "p.toml"], ["fit", path, "-o", work / "wide.json"]):
+            status, lines = run_command(command)
+            counter[classify(status, lines, work / "none.csv")] += 1
+    big = work / "big.csv"
+    run_command(["simulate", "--profile", "chamber", "--duration", 20000, "--rate", 100, "-o", big])
+    for limit, path in ((3 << 29, big), (300 << 20, data)):
+        process = _gyrocomp("fit", path, "-o", work / "limited.json", preexec_fn=_limited(resource.RLIMIT_AS, limit))
+        status, stderr = process.wait(timeout=600), process.stderr.read()
+        counter[classify(status, stderr.splitlines(), work / "none.csv") if status in (0, 1, 2) else
+                "internal error"] += 1
+    loop = work / "looped"
+    loop.mkdir()
+    shutil.copy(data, loop / "r1.csv")
+    shutil.copy(data, loop / "r2.csv")
+    (loop / "back").symlink_to("..")
+    status, lines = run_command(["fit", f"{loop}/**/*.csv", "-o", work / "looped.json", "--hysteresis", "none"])
+    outcome = classify(status, lines, work / "none.csv")
+    if status == 0 and len(json.loads((work / "looped.json").read_text())["provenance"]["inputs"]) != 2:
+        outcome = "silently wrong"
+    counter[outcome] += 1
+    fleet = work / "fd_fleet"
+    (fleet / "SN1").mkdir(parents=True)
+    shutil.copy(data, fleet / "SN1" / "run_1.csv")
+    process = _gyrocomp("fleet", "fit", fleet, "--unit-from", "{serial}/run_{n}.csv", "-o", work / "fd_out",
+                        "--scheduler", "local", "--workers", 2, preexec_fn=_limited(resource.RLIMIT_NOFILE, 40))
+    status, stderr = process.wait(timeout=600), process.stderr.read()
+    counter[classify(status, stderr.splitlines(), work / "none.csv")] += 1
+    growing = work / "cut_short.csv"
+    shutil.copy(big, growing)
+    model = work / "cut_model.json"
+    run_command(["fit", data, "-o", model, "--hysteresis", "none"])
+    process = _gyrocomp("apply", model, growing, "-o", work / "cut_out.csv")
+    time.sleep(1.0)
+    with open(growing, "r+b") as fh:  # another program cuts the file while apply streams it
+        fh.truncate(growing.stat().st_size // 3)
+    status, stderr = process.wait(timeout=600), process.stderr.read()
+    counter["silently wrong" if status == 0 else classify(status, stderr.splitlines(), work / "none.csv")] += 1
+    return counter
+
+
+def serial_logs(rng: np.random.Generator, work: Path, count: int) -> collections.Counter:
+    """Serial-terminal logs (a banner, no header, no time, garbled lines at random): ``init --names --rate``,
+    then ``fit`` and ``apply`` with no reading option; every row that holds four numbers must come out (fewer,
+    without a word, is ``silently wrong``); ``fit`` without the names is refused in one line."""
+    counter: collections.Counter = collections.Counter()
+    recording = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=int(rng.integers(1 << 30)))
+    samples = np.column_stack([recording.recording.gyro_dps, recording.recording.temperature_degc[:, 0]])
+    for k in range(count):
+        folder = work / f"serial{k}"
+        folder.mkdir()
+        lines, rows = [b"MPU ready"], 0
+        for row in samples:
+            if rng.random() < 0.01:
+                garbage = rng.integers(0, 256, size=int(rng.integers(1, 30)), dtype=np.uint8).tobytes()
+                lines.append(garbage.replace(b"\n", b"").replace(b"\r", b""))
+            lines.append(",".join(f"{v:.5f}" for v in row).encode())
+            rows += 1
+        (folder / "log.txt").write_bytes(b"\r\n".join(lines) + b"\r\n")
+        status, errors = run_command(["fit", folder / "log.txt", "-o", folder / "m.json"])
+        counter["refused" if status == 2 and len(errors) == 1 else "silently wrong"] += 1
+        cwd = os.getcwd()
+        try:
+            os.chdir(folder)
+            status, errors = run_command(["init", "log.txt", "--names", "gyro_x,gyro_y,gyro_z,temperature",
+                                          "--rate", 2])
+            if status == 0:
+                status, errors = run_command(["fit", "log.txt", "-o", "m.json", "--hysteresis", "none"])
+            if status == 0:
+                status, errors = run_command(["apply", "m.json", "log.txt", "-o", "out.csv"])
+            outcome = judged(classify(status, errors, folder / "out.csv"), errors, folder / "out.csv")
+            if status == 0 and len(pd.read_csv(folder / "out.csv")) < rows and not any(
+                    "skipped" in line for line in errors):
+                outcome = "silently wrong"
+        finally:
+            os.chdir(cwd)
+        counter[outcome] += 1
+    return counter
+
+
 def hostile_sweep(seed: int, work: Path) -> dict[str, collections.Counter]:
     rng = np.random.default_rng(seed + 1)
     data, model = simulated_model(seed, work / "hostile_data.csv")
+    other, _ = simulated_model(seed + 7, work / "hostile_other.csv")
     model_path = work / "hostile_model.json"
     model_path.write_text(json.dumps(model), encoding="utf-8")
     return {"model text fields made hostile, exported (60)": hostile_exports(model, work, rng, 60),
@@ -537,7 +746,13 @@ def hostile_sweep(seed: int, work: Path) -> dict[str, collections.Counter]:
             "fleet stores: colliding and long serials, -o onto the store (5)": hostile_store(data, work),
             "number options: inf, nan, 1e999, -1, 0, 25 digits (49)": hostile_numbers(data, model_path, work),
             "learner states with huge numbers (resumed)": hostile_states(data, work),
-            "ambiguous columns, ns time, 1e6 degC, non-UTF-8 name (5)": unlucky_reads(work)}
+            "ambiguous columns, ns time, 1e6 degC, non-UTF-8 name (5)": unlucky_reads(work),
+            "outputs through planted links, odd names, pipes as inputs (26)": planted_links(data, model_path, work),
+            "store rows changed by another program, read four ways (32)": damaged_store_rows(data, work),
+            "concurrent learners and fleet fits (6)": concurrent_writers(data, other, work, 3),
+            "resource limits: wide, bomb, row groups, memory, link loop, fds, cut short (11)":
+                resource_limits(data, work),
+            "serial-terminal logs with garbled lines (20)": serial_logs(rng, work, 10)}
 
 
 def summary(results: dict[str, collections.Counter], seed: int) -> str:

@@ -4,6 +4,7 @@ store as consistent as before (the rerun fits what was not finished)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import resource
 import signal
@@ -54,11 +55,16 @@ def test_a_fleet_stopped_says_so_in_one_line_and_the_rerun_finishes(fleet, tmp_p
     # a terminal's Ctrl-C reaches every process of the command: its own session, SIGINT to the whole group
     process = _start(fleet, out, start_new_session=True,
                      preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    time.sleep(2.5)
-    if stop == "group SIGINT":
-        os.killpg(process.pid, signal.SIGINT)
-    else:
-        process.send_signal(getattr(signal, stop))
+    time.sleep(1.0)
+    # as a user would, again every half second until it stops: while the workers start (a second or two), the
+    # command ignores the terminal's signals, so that the workers it spawns ignore them too
+    while process.poll() is None:
+        if stop == "group SIGINT":
+            os.killpg(process.pid, signal.SIGINT)
+        else:
+            process.send_signal(getattr(signal, stop))
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            process.wait(timeout=0.5)  # a second signal during the way out is ignored: the cleanup finishes
     stderr = process.communicate(timeout=120)[1]
     assert process.returncode == status, stderr
     _only_line(stderr, message)

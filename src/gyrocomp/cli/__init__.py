@@ -264,13 +264,18 @@ def _exit_on_termination() -> None:
     removed on the way out (the atomic writers clean up on any exception) and nothing half-written is left at a
     target."""
     def stop(signum, frame):
+        for sig in caught:  # a second Ctrl-C must not break the cleanup on the way out
+            signal.signal(sig, signal.SIG_IGN)
         raise _Terminated(signum)
+
+    caught = []
 
     for name in ("SIGTERM", "SIGHUP", "SIGINT"):
         # Ctrl-C too: click would turn it into its own abort, after an empty line; one ignored (nohup, a
         # background job) stays ignored
         if hasattr(signal, name) and signal.getsignal(getattr(signal, name)) is not signal.SIG_IGN:
             signal.signal(getattr(signal, name), stop)
+            caught.append(getattr(signal, name))
 
 
 #: the address space the numeric libraries need to load and read a small file [bytes] (under 0.6 GB, OpenBLAS

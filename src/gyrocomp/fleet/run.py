@@ -345,7 +345,8 @@ def _quiet_worker() -> None:
 def _workers_deaf_to_the_terminal() -> Iterator[None]:
     """Start processes that ignore Ctrl-C and a closed terminal (an ignored signal stays ignored in a spawned
     process): the command gets those signals and stops its workers in order, instead of each worker printing its
-    own traceback."""
+    own traceback. While the workers start (a second or two), the command ignores them too: a Ctrl-C then is
+    lost, the next one stops it."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
