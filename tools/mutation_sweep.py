@@ -61,7 +61,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from gyrocomp import Network, Polynomial, fit, fit_calibration, write
+from gyrocomp import Calibration, Network, Polynomial, fit, fit_calibration, write
 from gyrocomp.cli import main
 from gyrocomp.simulation import simulate
 
@@ -572,8 +572,8 @@ def planted_links(data: Path, model: Path, work: Path) -> collections.Counter:
 
 def damaged_store_rows(run_path: Path, work: Path) -> collections.Counter:
     """A fleet store whose rows another program changed (cut-short model, non-JSON inputs or metadata, garbage
-    time or status) read by ``fleet show``, ``export``, ``report`` and the rerun of ``fleet fit``: refused in one
-    line naming the row, or read as it was (the report of figures)."""
+    time or status, damaged failures, figures or warnings) read by ``fleet show``, ``export``, ``report`` and the
+    rerun of ``fleet fit``: refused in one line naming the row, or read as it was (the report of figures)."""
     counter: collections.Counter = collections.Counter()
     manifest = work / "store_manifest.csv"
     pd.DataFrame([{"path": str(run_path), "serial": "SN-1"}]).to_csv(manifest, index=False)
@@ -581,7 +581,8 @@ def damaged_store_rows(run_path: Path, work: Path) -> collections.Counter:
     run_command(["fleet", "fit", "--manifest", manifest, "-o", fitted, "--scheduler", "serial"])
     damages = [("model", '{"schema_version": 6, "axes"'), ("model", "[]"), ("inputs", "not json"),
                ("inputs", '{"a": 1}'), ("calibrated_utc", "garbage"), ("calibrated_utc", "9999-99-99"),
-               ("status", "weird"), ("metadata", "{")]
+               ("status", "weird"), ("unit_metadata", "{"), ("failures", "[1"), ("figures", "{]"),
+               ("warnings", "7")]
     for k, (column, value) in enumerate(damages):
         store = work / f"store_damaged{k}"
         shutil.copytree(fitted, store)
@@ -592,8 +593,20 @@ def damaged_store_rows(run_path: Path, work: Path) -> collections.Counter:
                         ["fleet", "report", store, "-o", work / f"r{k}.html"],
                         ["fleet", "fit", "--manifest", manifest, "-o", store, "--scheduler", "serial"]):
             status, lines = run_command(command)
-            counter[classify(status, lines, work / "none.csv")] += 1
+            outcome = classify(status, lines, work / "none.csv")
+            if not _loads(store / "models" / "SN-1.json"):  # the unit's good model file replaced: lost
+                outcome = "data loss"
+            counter[outcome] += 1
     return counter
+
+
+def _loads(model: Path) -> bool:
+    """Whether ``model`` is a model file gyrocomp loads."""
+    try:
+        Calibration.load(model)
+    except Exception:  # noqa: BLE001 - any failure to load is the answer
+        return False
+    return True
 
 
 def _gyrocomp(*args, **popen) -> subprocess.Popen:
@@ -698,11 +711,13 @@ def resource_limits(data: Path, work: Path) -> collections.Counter:
 
 def serial_logs(rng: np.random.Generator, work: Path, count: int) -> collections.Counter:
     """Serial-terminal logs (a banner, no header, no time, garbled lines at random): ``init --names --rate``,
-    then ``fit`` and ``apply`` with no reading option; every row that holds four numbers must come out (fewer,
+    then ``fit`` and ``apply`` with no reading option; every row that holds its numbers must come out (fewer,
     without a word, is ``silently wrong``); ``fit`` without the names is refused in one line."""
     counter: collections.Counter = collections.Counter()
-    recording = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=int(rng.integers(1 << 30)))
-    samples = np.column_stack([recording.recording.gyro_dps, recording.recording.temperature_degc[:, 0]])
+    run = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=int(rng.integers(1 << 30))).recording
+    temperature = np.asarray(run.temperature_degc).reshape(run.n_samples, -1)[:, 0]
+    samples = np.column_stack([np.asarray(run.gyro_dps).reshape(run.n_samples, -1), temperature])
+    names = ",".join([*run.gyro_axes, "temperature"])
     for k in range(count):
         folder = work / f"serial{k}"
         folder.mkdir()
@@ -719,8 +734,7 @@ def serial_logs(rng: np.random.Generator, work: Path, count: int) -> collections
         cwd = os.getcwd()
         try:
             os.chdir(folder)
-            status, errors = run_command(["init", "log.txt", "--names", "gyro_x,gyro_y,gyro_z,temperature",
-                                          "--rate", 2])
+            status, errors = run_command(["init", "log.txt", "--names", names, "--rate", 2])
             if status == 0:
                 status, errors = run_command(["fit", "log.txt", "-o", "m.json", "--hysteresis", "none"])
             if status == 0:
@@ -748,7 +762,7 @@ def hostile_sweep(seed: int, work: Path) -> dict[str, collections.Counter]:
             "learner states with huge numbers (resumed)": hostile_states(data, work),
             "ambiguous columns, ns time, 1e6 degC, non-UTF-8 name (5)": unlucky_reads(work),
             "outputs through planted links, odd names, pipes as inputs (26)": planted_links(data, model_path, work),
-            "store rows changed by another program, read four ways (32)": damaged_store_rows(data, work),
+            "store rows changed by another program, read four ways (44)": damaged_store_rows(data, work),
             "concurrent learners and fleet fits (6)": concurrent_writers(data, other, work, 3),
             "resource limits: wide, bomb, row groups, memory, link loop, fds, cut short (11)":
                 resource_limits(data, work),

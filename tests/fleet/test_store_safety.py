@@ -182,19 +182,25 @@ def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp
     ("inputs", "not json", r"row \d+ \(unit 'SN-1'\) is damaged \(JSONDecodeError"),
     ("calibrated_utc", "garbage", r"row \d+ \(unit 'SN-1'\) holds no time gyrocomp wrote"),
 ])
-def test_a_store_row_changed_by_another_program_is_one_line_naming_it(fitted, tmp_path, column, value, said):
+def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, fitted, tmp_path, column, value,
+                                                                     said):
     out = tmp_path / "FLEET"
     shutil.copytree(fitted, out)
     with sqlite3.connect(out / "calibrations.sqlite") as conn:
         conn.execute(f"UPDATE calibrations SET {column} = ? WHERE serial = 'SN-1'", (value,))
+    model_file = out / "models" / "SN-1.json"
+    kept = model_file.read_bytes()
     for args in (["show", "SN-1", "--store", out], ["export", "SN-1", "--store", out, "--format", "json", "-o",
-                                                     tmp_path / "m.json"], ["report", out, "-o", tmp_path / "r.html"]):
+                                                     tmp_path / "m.json"], ["report", out, "-o", tmp_path / "r.html"],
+                 ["fit", "--manifest", manifest, "-o", out, "--scheduler", "serial"]):
         result = run("fleet", *args)
         if column == "model" and args[0] == "report":
             continue  # the report reads figures, not models
         assert result.returncode == 2 and result.stderr.count("\n") == 1, (args, result.stderr)
         assert re.search(said, result.stderr), (args, result.stderr)
     assert not (tmp_path / "m.json").exists() and (tmp_path / "r.html").exists() == (column == "model")
+    # the rerun never writes a damaged row's model over the unit's good file (it did, with a warning)
+    assert model_file.read_bytes() == kept
 
 
 def test_show_at_the_last_day_there_is(fitted):

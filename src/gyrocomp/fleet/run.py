@@ -459,6 +459,11 @@ def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
     except (OSError, UnicodeDecodeError):
         present = ""
     if present != ok[-1].model_json:
+        try:  # a row another program damaged is no model to write back: said, the file left as it is
+            ok[-1].calibration()
+        except GyrocompError as exc:
+            raise InputError(f"{db.location}: {exc}; {path} is left as it is (refit the unit into a new store, or "
+                             "restore the store from a copy)") from None
         _write_model(output, serial, ok[-1].model_json)
         if present is not None:
             warnings.warn(f"{path}: differed from unit {serial!r}'s newest calibration in the store (row "
