@@ -53,6 +53,7 @@ def test_the_shipped_schema_is_the_builders():
         "the shipped model.schema.json is stale: run python tools/model_schema.py"
 
 
+@pytest.mark.slow
 def test_every_kind_of_model_gyrocomp_writes_validates(models, tmp_path):
     validator = jsonschema.Draft202012Validator(_published())
     kinds = {"polynomial": 0, "mlp": 0, "turning-point": 0, "branch": 0}
@@ -100,6 +101,7 @@ def test_what_the_schema_refuses_is_refused_naming_the_field(models, change, mes
     assert _refusal(models["default"], change).startswith(message)
 
 
+@pytest.mark.slow
 def test_the_other_kinds_fields_are_checked_too(models):
     network = models["network"]
     assert _refusal(network, lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("activation", "relu")) == \
@@ -129,6 +131,7 @@ def test_duplicate_keys_and_non_json_numbers_are_refused_in_the_file(models, tmp
         Calibration.load(tmp_path / "m.json")
 
 
+@pytest.mark.slow
 def test_an_edited_schema_version_is_refused_not_upgraded_into_other_numbers(models):
     """A file of the current schema whose schema_version was set back: the upgrades would put a lag of 0 and no
     hysteresis over the file's own (before: applied with other numbers, without a word)."""
@@ -152,6 +155,7 @@ def test_schema_5_upgrades_then_validates_and_applies_as_its_schema_6_copy(tmp_p
         np.testing.assert_allclose(apply(new, rec).gyro_dps, apply(old, rec).gyro_dps, rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_the_temperature_column_a_model_names_is_the_one_it_reads(models):
     """A model fitted on one temperature per axis (temperature_x ...) is not applied to data with one shared
     column without a word, nor a shared-temperature model to data with one per axis: the column the model names

@@ -202,6 +202,7 @@ def test_a_cascade_applies_as_its_stages_in_turn(consumer, pipelines):
         np.testing.assert_allclose(apply(chained, held.recording).gyro_dps, step, rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_joint_network_reads_the_accelerations(consumer, pipelines, tmp_path):
     _, _, held, _ = consumer
     cal = pipelines["joint-mlp"][0]

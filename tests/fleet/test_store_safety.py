@@ -148,6 +148,7 @@ def _files_agree_with_newest_rows(out, serials):
             assert (out / "models" / model_file_name(s)).read_text() == newest.model_json, s
 
 
+@pytest.mark.slow
 def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_model(manifest, tmp_path):
     """Two stations recalibrating the same units from different runs at once: whatever the interleaving, each
     unit's model file is its newest row's (the file is written holding the store's write lock)."""
@@ -164,6 +165,7 @@ def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_mo
         _files_agree_with_newest_rows(out, SERIALS)
 
 
+@pytest.mark.slow
 def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp_path):
     out = tmp_path / "FLEET"
     assert _fit(manifest, out).returncode == 0
@@ -182,6 +184,7 @@ def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp
     ("inputs", "not json", r"row \d+ \(unit 'SN-1'\) is damaged \(JSONDecodeError"),
     ("calibrated_utc", "garbage", r"row \d+ \(unit 'SN-1'\) holds no time gyrocomp wrote"),
 ])
+@pytest.mark.slow
 def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, fitted, tmp_path, column, value,
                                                                      said):
     out = tmp_path / "FLEET"
@@ -203,6 +206,7 @@ def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, 
     assert model_file.read_bytes() == kept
 
 
+@pytest.mark.slow
 def test_show_at_the_last_day_there_is(fitted):
     result = run("fleet", "show", "SN-1", "--store", fitted, "--at", "9999-12-31")
     assert result.returncode == 0, result.stderr
