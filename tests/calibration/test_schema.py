@@ -30,17 +30,29 @@ def _published() -> dict:
 
 
 @pytest.fixture(scope="module")
-def models():
+def runs():
+    return [simulate("consumer", profile=get_profile("combined", set_points_degc=(-10, 50)), rate_hz=0.5,
+                     duration_s=5400, seed=s).recording for s in range(3)]
+
+
+@pytest.fixture(scope="module")
+def default_model(runs):
+    """The default fit's model (polynomial, lag, memory, g-sensitivity), for the quick checks."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit(runs)
+
+
+@pytest.fixture(scope="module")
+def models(runs, default_model):
     """A model of every kind the fitter writes: polynomial and lag, network, gyro and accelerometer, g x g terms,
     an acceleration network, turning-point hysteresis, heating/cooling branches, a rate-table triad."""
-    runs = [simulate("consumer", profile=get_profile("combined", set_points_degc=(-10, 50)), rate_hz=0.5,
-                     duration_s=5400, seed=s).recording for s in range(3)]
     adx = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1.0,
                     seed=s).recording for s, sp in ((0, (-30, 85)), (1, (-20, 80)))]
     table = [simulate("mti10", profile="ratetable", rate_hz=20.0, seed=s).recording for s in range(2)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return {"default": fit(runs), "network": fit(runs, FitOptions(temperature=Network())),
+        return {"default": default_model, "network": fit(runs, FitOptions(temperature=Network())),
                 "gyro and accel": fit(runs, channels=("gyro", "accel")),
                 "g x g": fit(runs, FitOptions(acceleration="matrix2")),
                 "acceleration network": fit_pipeline(runs, "mlp>mlp-accel"),
@@ -97,8 +109,8 @@ def _refusal(cal, change) -> str:
     (lambda d: d["axes"]["gyro_x"].__setitem__("temperature_column", "temp"),
      "m.json: axes.gyro_x.temperature_column: 'temp' is not one of ['temperature', 'temperature_x'"),
 ])
-def test_what_the_schema_refuses_is_refused_naming_the_field(models, change, message):
-    assert _refusal(models["default"], change).startswith(message)
+def test_what_the_schema_refuses_is_refused_naming_the_field(default_model, change, message):
+    assert _refusal(default_model, change).startswith(message)
 
 
 @pytest.mark.slow
@@ -117,8 +129,8 @@ def test_the_other_kinds_fields_are_checked_too(models):
         f"m.json: axes.{axis}.hysteresis.transition_degc: 0 is less than or equal to the minimum of 0.0"
 
 
-def test_duplicate_keys_and_non_json_numbers_are_refused_in_the_file(models, tmp_path):
-    text = models["default"].to_json()
+def test_duplicate_keys_and_non_json_numbers_are_refused_in_the_file(default_model, tmp_path):
+    text = default_model.to_json()
     twice = text.replace('"lag_time_constant_s"', '"lag_time_constant_s": 0.0, "lag_time_constant_s"', 1)
     (tmp_path / "m.json").write_text(twice)
     with pytest.raises(InputError, match=r"m\.json: the key 'lag_time_constant_s' appears twice in one object"):
@@ -189,10 +201,10 @@ def test_the_temperature_column_a_model_names_is_the_one_it_reads(models):
     ({"selection": {"gyro_x": {"axis": "gyro_x"}}}, "fit_report: malformed (KeyError: 'fold_kind')"),
     ({}, None),  # an empty report: a model without its account, shown as such
 ])
-def test_a_damaged_fit_report_is_refused_on_load_and_show_never_meets_it(models, tmp_path, report, refusal):
+def test_a_damaged_fit_report_is_refused_on_load_and_show_never_meets_it(default_model, tmp_path, report, refusal):
     """Nulls and wrong shapes in the fit report gave show internal errors; now the model file is refused in one
     line (exit 2) naming the report."""
-    document = json.loads(models["default"].to_json())
+    document = json.loads(default_model.to_json())
     document["fit_report"] = report
     (tmp_path / "m.json").write_text(json.dumps(document))
     done = run("show", tmp_path / "m.json")

@@ -19,6 +19,7 @@ from gyrocomp.simulation import simulate
 from ..conftest import SCRIPT, run
 
 
+@pytest.mark.slow
 def test_time_selects_rows_in_every_reading_path(tmp_path):
     """--time A:B keeps [A, B) seconds from the first sample, in convert, apply (whole-file path), allan and
     evaluate; an empty range is refused naming the file's length."""

@@ -202,6 +202,7 @@ def _planted(folder: Path, name: str, victim: Path) -> Path:
     return link
 
 
+@pytest.mark.slow
 def test_no_output_is_written_through_a_planted_link(workdir, tmp_path):
     """Security: an output path that is a symbolic link is refused in one line (exit 2), for every kind of output
     (a table, a model file, a learner state, firmware files, a fleet store); the file the link points at is left

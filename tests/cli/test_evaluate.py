@@ -3,6 +3,8 @@
 import json
 import re
 
+import pytest
+
 from ..conftest import run
 
 
@@ -30,6 +32,7 @@ def test_evaluate_table_and_window(workdir):
     assert re.search(r"run3\.csv\s*\S\s*gyro_x\s*\S\s*20\s", r.stdout)  # the window column shows --window
 
 
+@pytest.mark.slow
 def test_evaluate_and_report_say_when_they_judge_the_data_the_model_was_fitted_on(workdir, tmp_path):
     """run1 is one of the model's inputs (its name and SHA-256 in the provenance), run3 is not: the figures on run1
     are said to be in-sample, on stderr, in the JSON and in the report; a copy of run3 renamed run1 is not taken

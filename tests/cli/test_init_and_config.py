@@ -111,6 +111,7 @@ def test_a_bad_project_file_is_refused_in_one_line(tmp_path, text, message):
     assert missing.returncode == 2 and "--config nothere.toml: no such file" in missing.stderr
 
 
+@pytest.mark.slow
 def test_init_keeps_an_existing_file_and_refuses_what_it_cannot_read(tmp_path):
     _log(tmp_path / "log.tsv", n=200)
     (tmp_path / "gyrocomp.toml").write_text("# mine\n")

@@ -113,6 +113,7 @@ def test_terms_the_autopilots_lack_are_named():
         px4_params_file(flat, device_id=3)
 
 
+@pytest.mark.slow
 def test_cli_export(tmp_path):
     _model(3).save(tmp_path / "m.json")
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params", "--device-id", "7")

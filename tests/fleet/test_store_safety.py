@@ -73,6 +73,7 @@ def test_serials_that_once_shared_a_file_each_keep_their_model(manifest, tmp_pat
     assert len(list((out / "models").glob("*.json"))) == len(SERIALS)
 
 
+@pytest.mark.slow
 def test_a_failed_model_write_stores_nothing_and_the_rerun_fits_the_unit(manifest, tmp_path):
     out = tmp_path / "FLEET"
     out.mkdir()
@@ -88,6 +89,7 @@ def test_a_failed_model_write_stores_nothing_and_the_rerun_fits_the_unit(manifes
     assert f"{len(SERIALS)} unit(s) fitted, 0 unchanged" in result.stdout
 
 
+@pytest.mark.slow
 def test_the_rerun_puts_back_a_missing_model_file(manifest, tmp_path):
     out = tmp_path / "FLEET"
     assert _fit(manifest, out).returncode == 0

@@ -188,6 +188,7 @@ def test_units_given_twice_are_refused(tmp_path):
             fit_fleet([], tmp_path / "out", scheduler="serial")
 
 
+@pytest.mark.slow
 def test_a_running_dask_cluster_is_used_by_its_address(tmp_path):
     """``scheduler=ADDRESS``: the units go to a cluster someone else started, which stays up after the fleet."""
     from dask.distributed import Client, LocalCluster
