@@ -299,6 +299,17 @@ def _within_address_limit() -> None:
     os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
 
 
+def _unexpected(exc: Exception) -> int:
+    """Say an exception no layer turned into a message, in one line, and return the status: the machine's limits
+    (pyarrow's or Python's threads or memory) as an error of the environment, anything else as a bug."""
+    if _resource_exhausted(exc):
+        click.echo(f"gyrocomp: error: {_environment_message(exc)}", err=True)
+        return EXIT_INPUT
+    click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
+               "(run with --debug for the traceback)", err=True)
+    return EXIT_FAILURE
+
+
 def main(argv: list[str] | None = None) -> int:
     """Console entry point: runs the command and returns (and, as a script, exits with) its status."""
     if argv is None:
@@ -348,13 +359,7 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, status 1
         if debug:
             traceback.print_exc()
-        if _resource_exhausted(exc):  # pyarrow's or Python's threads or memory: the machine's limits
-            click.echo(f"gyrocomp: error: {_environment_message(exc)}", err=True)
-            status = EXIT_INPUT
-        else:
-            click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
-                       "(run with --debug for the traceback)", err=True)
-            status = EXIT_FAILURE
+        status = _unexpected(exc)
     finally:
         warnings.showwarning = previous
     if argv is None:
