@@ -84,6 +84,13 @@ class TableLayout:
         CSV field separator; default: told from the header (comma, semicolon or tab).
     decimal : {".", ","}, optional
         CSV decimal point; default: a comma when the separator is not one and the first row's numbers have one.
+    names : tuple of str, optional
+        A text table without a header line (a serial terminal's log): its columns' names in order; a line is a
+        row when it holds exactly that many numbers, every other line is skipped and counted
+        (:mod:`gyrocomp.io.serial`).
+    rate_hz : float, optional
+        Nominal sample rate [Hz] of a table without a time column: the n-th row (with ``names``, the n-th line
+        after the first row) is at n / rate_hz [s]. Refused for a table that has a time column.
     """
 
     columns: dict[str, str] = spelled(Spelling(
