@@ -26,6 +26,16 @@ SHARED = REPO.parent / "shared"
 DATASETS = SHARED / "datasets"
 
 
+#: the test modules that take a minute or more in all (real recordings, many seeds, a fleet): collected first, so
+#: that ``make test``'s two processes (which share whole modules out as they come free) never end with one of them
+#: running such a module alone while the other waits
+HEAVY_FIRST = ("tests/real/", "tests/models/test_few_runs.py", "tests/fleet/", "tests/fitting/test_order_evidence.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    items.sort(key=lambda item: not item.nodeid.startswith(HEAVY_FIRST))  # stable: each group keeps its order
+
+
 def shared_dataset(name: str) -> Path:
     """Path of a folder in ../shared/datasets, or skip the test with a message saying what is missing."""
     path = DATASETS / name

@@ -203,7 +203,7 @@ def test_a_running_dask_cluster_is_used_by_its_address(tmp_path):
         write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=5, seed=k, unit=k).recording,
                         path)
         units.append(UnitRuns(f"U{k}", (str(path),)))
-    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster, Client(cluster) as client:
+    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=":0") as cluster, Client(cluster) as client:
         summary = fit_fleet(units, tmp_path / "FLEET", scheduler=cluster.scheduler_address)
         assert sorted(summary.fitted) == ["U0", "U1", "U2"]
         assert len(client.scheduler_info()["workers"]) == 1  # still running
