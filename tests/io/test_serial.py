@@ -4,6 +4,10 @@ time column, in the library, in chunks, and through init, fit and apply on the r
 
 import gzip
 import json
+import os
+import pty
+import select
+import signal
 
 import numpy as np
 import pytest
@@ -14,7 +18,7 @@ from gyrocomp.io.serial import read_headerless
 from gyrocomp.io.stream import TableStream
 from gyrocomp.io.tables import TableLayout, read_table
 
-from ..conftest import run
+from ..conftest import SCRIPT, run
 
 NAMES = ("gyro_x", "gyro_y", "gyro_z", "temperature")
 RATE_HZ = 50.0
@@ -172,3 +176,40 @@ def test_init_fit_apply_with_the_names_given_once(tmp_path):
     model, timed_model = (json.loads((tmp_path / name).read_text()) for name in ("m.json", "m_timed.json"))
     assert model["axes"] == timed_model["axes"]
     assert (tmp_path / "out.csv").read_text() == (tmp_path / "out_timed.csv").read_text()
+
+
+def _in_a_terminal(args, answers, cwd) -> tuple[int, str]:
+    """Run the command on a pseudo-terminal, typing each answer after the text that asks for it; its status and
+    everything it showed."""
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: the command, with the terminal as its stdin and stdout
+        os.chdir(cwd)
+        os.execv(str(SCRIPT), [str(SCRIPT), *map(str, args)])
+    shown = b""
+    pending = list(answers)
+    while True:
+        ready, _, _ = select.select([fd], [], [], 30)
+        if not ready:  # waiting for something not typed: stop it rather than hang
+            os.kill(pid, signal.SIGKILL)
+            break
+        try:
+            data = os.read(fd, 4096)
+        except OSError:  # the command ended and closed the terminal
+            break
+        if not data:
+            break
+        shown += data
+        if pending and shown.rstrip().endswith(b":"):
+            os.write(fd, pending.pop(0).encode() + b"\n")
+    _, status = os.waitpid(pid, 0)
+    return os.waitstatus_to_exitcode(status), shown.decode("utf-8", "replace")
+
+
+def test_init_asks_for_the_names_and_the_rate_in_a_terminal(tmp_path):
+    _serial_log(tmp_path / "serial.txt", _samples(200))
+    status, shown = _in_a_terminal(["init", "serial.txt"], [",".join(NAMES), "50"], tmp_path)
+    assert status == 0, shown
+    assert "serial.txt has no header line; its rows hold 4 numbers" in shown
+    assert "no time column: the rows' sample rate [Hz]:" in shown
+    project = (tmp_path / "gyrocomp.toml").read_text()
+    assert 'names = "gyro_x,gyro_y,gyro_z,temperature"' in project and "rate = 50.0" in project
