@@ -21,7 +21,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import InputError
-from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless
+from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
 from .tables import (DECOMPRESS_ERRORS, TableLayout, _csv_bytes, check_parquet_footer, detect_table_format, read_error,
                      sniff_csv)
 
@@ -94,13 +94,12 @@ def _headerless_rows(head: bytes) -> tuple[int, str] | None:
     rows = [line for line in lines if looks_headerless(line)]
     if not rows or len(rows) <= len(lines) / 2:
         return None
-    fields = lambda line: len([f for f in re.split(r"[\s,;]+", line) if f])  # noqa: E731
-    counts = [fields(row) for row in rows]
+    counts = [len(split_fields(row)) for row in rows]
     count = max(set(counts), key=counts.count)
-    first = next(i for i, line in enumerate(lines) if fields(line) == count and looks_headerless(line))
+    first = next(i for i, line in enumerate(lines) if len(split_fields(line)) == count and looks_headerless(line))
     # a header: the line just before the first row, as many fields, none of them a number
-    if first > 0 and fields(lines[first - 1]) == count and \
-            not any(looks_headerless(f) for f in re.split(r"[\s,;]+", lines[first - 1]) if f):
+    before = split_fields(lines[first - 1]) if first > 0 else []
+    if len(before) == count and not any(looks_headerless(f) for f in before):
         return None
     return count, lines[first][:MAX_LINE_BYTES]
 

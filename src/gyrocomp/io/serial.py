@@ -157,9 +157,14 @@ def _floats(values: np.ndarray) -> pa.Array:
     return pa.Array.from_buffers(pa.float64(), values.size, [None, pa.py_buffer(values)])
 
 
+def split_fields(line: str) -> list[str]:
+    """A line's fields, between runs of commas, semicolons, tabs and spaces."""
+    return [f for f in _SEPARATORS.split(line.strip()) if f]
+
+
 def looks_headerless(first_line: str) -> bool:
     """Whether a table's first line is numbers, not names: the table has no header line."""
-    fields = [f for f in _SEPARATORS.split(first_line.strip()) if f]
+    fields = split_fields(first_line)
     if not fields:
         return False
     try:
@@ -169,4 +174,5 @@ def looks_headerless(first_line: str) -> bool:
     return True
 
 
-__all__ = ["MAX_LINE_BYTES", "check_rate", "looks_headerless", "parse_names", "parse_rate", "read_headerless"]
+__all__ = ["MAX_LINE_BYTES", "check_rate", "looks_headerless", "parse_names", "parse_rate", "read_headerless",
+           "split_fields"]

@@ -21,7 +21,7 @@ from ...io.atomic import folder_lock, write_text_atomic
 from ...motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY
 from ..base import provenance
 from ...curves.polynomial import PolynomialCurve
-from .state import _record_to_dict, _restore
+from .state import _record_to_dict, _restore, check_state_target
 from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, LINEAGE_KEPT,
                        LearnerSettings, LearnerStatus, LogContribution, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
                        PIECE_SPREAD_WEIGHT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC, _MAD_TO_SIGMA, chi2_quantile)
@@ -767,31 +767,10 @@ class OnlineCalibrator:
         return self._lineage[-1]
 
     def check_state_target(self, path: str | os.PathLike) -> None:
-        """Refuse to save over ``path`` when it holds a learner state this one does not go on from: another learner
-        resumed the same state and saved there first, or it was started afresh; replacing it would lose what that
-        learner learned. A file that is no learner state, or one this learner descends from, may be replaced.
-        Call it under :func:`gyrocomp.io.atomic.folder_lock` with the write, so that no other learner saves
-        between the check and the write."""
-        path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (FileNotFoundError, IsADirectoryError):
-            return
-        except (OSError, UnicodeDecodeError):
-            return
-        try:
-            other = json.loads(text)
-        except ValueError:
-            return
-        if not isinstance(other, dict) or other.get("format") != LEARNER_FORMAT:
-            return
-        lineage = other.get("lineage")
-        theirs = lineage[-1] if isinstance(lineage, list) and lineage and isinstance(lineage[-1], str) else None
-        if theirs is None or theirs not in self._lineage:
-            raise InputError(f"{path}: holds another learner's state, one this learner does not go on from (another "
-                             "learner resumed the same state and saved here first, or it started afresh); nothing "
-                             "written, so that neither loses what it learned: resume from that state, or save to "
-                             "another file")
+        """Refuse to save over ``path`` when it holds a learner state this one does not go on from
+        (:func:`~gyrocomp.fitting.online.state.check_state_target`); call it under
+        :func:`gyrocomp.io.atomic.folder_lock` with the write."""
+        check_state_target(path, self._lineage)
 
     def save(self, path: str | os.PathLike) -> None:
         """Write the state as JSON, atomically, as a new revision; refused (:meth:`check_state_target`) where

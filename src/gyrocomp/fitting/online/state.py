@@ -3,7 +3,10 @@ or damaged state is refused naming the field."""
 
 from __future__ import annotations
 
+import json
+import os
 import re
+from pathlib import Path
 from typing import Any
 
 
@@ -11,7 +14,29 @@ import numpy as np
 
 from ...errors import InputError
 from ...measures.plausibility import TEMPERATURE_RANGE_DEGC
-from .settings import LINEAGE_KEPT, POOL_PIECES, LearnerSettings
+from .settings import LEARNER_FORMAT, LINEAGE_KEPT, POOL_PIECES, LearnerSettings
+
+def check_state_target(path: str | os.PathLike, lineage: tuple[str, ...]) -> None:
+    """Refuse to save a learner whose lineage (the ids of the saved states it goes on from, its own last) is
+    ``lineage`` over ``path`` when that file holds a learner state not among them: another learner resumed the same
+    state and saved there first, or it was started afresh; replacing it would lose what that learner learned. A
+    file that is no learner state, or one the learner descends from, may be replaced. Call it under
+    :func:`gyrocomp.io.atomic.folder_lock` with the write, so that no other learner saves between the check and the
+    write."""
+    try:
+        other = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):  # missing, unreadable or no JSON: an ordinary output
+        return
+    if not isinstance(other, dict) or other.get("format") != LEARNER_FORMAT:
+        return
+    theirs = other.get("lineage")
+    theirs = theirs[-1] if isinstance(theirs, list) and theirs and isinstance(theirs[-1], str) else None
+    if theirs is None or theirs not in lineage:
+        raise InputError(f"{path}: holds another learner's state, one this learner does not go on from (another "
+                         "learner resumed the same state and saved here first, or it started afresh); nothing "
+                         "written, so that neither loses what it learned: resume from that state, or save to "
+                         "another file")
+
 
 def _record_to_dict(record: dict) -> dict:
     out = {k: bool(v) for k, v in record.items() if k not in ("mean", "temperature")}
@@ -178,4 +203,4 @@ def _restore_model(self, model: dict) -> None:
         "constant": _finite_array(saved["constant"], (3,), "model.saved.constant")}
 
 
-__all__ = ["STATE_MAGNITUDE_MAX", "STATE_TEMPERATURE_MAX_DEGC"]
+__all__ = ["STATE_MAGNITUDE_MAX", "STATE_TEMPERATURE_MAX_DEGC", "check_state_target"]
