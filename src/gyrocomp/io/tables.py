@@ -370,7 +370,8 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         table = read_headerless(path, layout.names, layout.rate_hz)
         return (table if select is None else table.select(select(table.column_names))), TextFormat()
     if fmt == "csv":
-        require_memory(path, estimated_table_bytes(path, csv_codec(path) is not None))
+        if address_space_left() is not None:  # under a limit only: the estimate opens the file once more
+            require_memory(path, estimated_table_bytes(path, csv_codec(path) is not None))
         source, head = _csv_bytes(path)
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
