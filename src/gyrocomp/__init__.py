@@ -27,7 +27,7 @@ _EXPORTS = {
     "PolynomialTemperatureModel": ("fitting.polynomial", "PolynomialTemperatureModel"),
     "fit_calibration": ("models.pipelines", "fit_calibration"), "fit_channels": ("models.pipelines", "fit_channels"),
     "fit_pipeline": ("models.pipelines", "fit_pipeline"),
-    **{name: ("models.options", name) for name in ("FitOptions", "Network", "Polynomial")},
+    **{name: ("models.options", name) for name in ("Curve", "FitOptions", "Network", "Polynomial")},
     "FitReport": ("calibration.fit_report", "FitReport"), "analyse_noise_file": ("files", "analyse_noise_file"),
     "evaluate_file": ("files", "evaluate_file"), "apply_file": ("files", "apply_file"),
     "convert_file": ("files", "convert_file"),

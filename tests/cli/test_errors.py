@@ -85,7 +85,7 @@ def test_refuses_to_overwrite_input(workdir, tmp_path):
 @pytest.mark.parametrize("args,message", [
     (["simulate", "--duration", "abc", "-o", "x.csv"], r"Invalid value for '--duration': 'abc' is not a number"),
     (["fit", "x.csv"], r"Missing option '-o'"),
-    (["fit", "{run}", "-o", "m.json", "--temperature", "poly:7"], r"--temperature: 'poly:7': the order must be"),
+    (["fit", "{run}", "-o", "m.json", "--temperature", "poly:7"], r"--temperature: 'poly:7': the size of poly must be a whole number from 0 to 5"),
     (["fit", "{run}", "-o", "m.json", "--columns", "gyro_z=Nope"], r"--columns gyro_z=Nope: no column 'Nope'"),
     (["apply", "{model}", "{run}", "-o", "o.csv", "--gyro-unit", "rpm"], r"--gyro-unit: unknown unit 'rpm'"),
     (["apply", "{model}", "{run}", "-o", "o.csv", "--turn-on-window", "-3"], r"--turn-on-window: must be a positive"),

@@ -9,7 +9,7 @@ import pandas as pd
 
 from gyrocomp.cli import COMMANDS
 from gyrocomp.cli.projectfile import ReadingOption
-from gyrocomp.io import FORMAT_SPELLING, ReadOptions
+from gyrocomp.io import ReadOptions
 from gyrocomp.spelling import spelled_fields
 
 from ..conftest import run
@@ -54,7 +54,7 @@ def test_every_command_that_reads_data_has_the_reading_options_of_the_library():
             reading = {o.name: max(o.opts, key=len) for o in options if isinstance(o, ReadingOption)}
             if reading:
                 readers += 1
-                assert reading == {"fmt": FORMAT_SPELLING.flag,
+                assert reading == {"fmt": "--format",
                                    **{f.name: s.flag for f, s in spelled_fields(ReadOptions)}}, cmd.name
     assert readers >= 10
     assert {n: f for n, f in flags_by_name.items() if len(f) > 1} == {}

@@ -16,7 +16,7 @@ from gyrocomp.fitting.scores import CandidateScore
 from gyrocomp.fitting.choice import unidentified_lags
 from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc
 from gyrocomp.fitting.thermal import LAG_MAX_S, lag_search_top_s
-from gyrocomp.curves.kinds import BASES
+from gyrocomp.models.options import curve_candidates
 from gyrocomp.curves.polynomial import PolynomialCurve
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import get_profile, preset_model, simulate
@@ -178,7 +178,8 @@ def test_lag_residuals_from_the_shape_columns_equal_those_of_the_full_normal_mat
     runs = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=2.0, seed=s).recording
             for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)), (2, (-25.0, 85.0)))]
     problem = prepare_axis(runs, "gyro_z", groups=(0, 1, 2), max_order=3, hysteresis_orders=(1, 2),
-                           branch_orders=(1, 2), curves=tuple(BASES))
+                           branch_orders=(1, 2),
+                           other_curves=curve_candidates(Polynomial()).others)
     assert problem.columns(0, problem.runs[0].temperature_degc).shape[1] > 3 + 2 * 2  # hysteresis, branch columns
     if accel:  # the triad as if the part had been turned between blocks (at rest it would add nothing)
         rng = np.random.default_rng(3)

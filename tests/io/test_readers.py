@@ -634,11 +634,3 @@ def test_a_px4_log_already_corrected_onboard_is_recognized(tmp_path):
     assert corrected.metadata["corrected_onboard"]
     write_ulog(tmp_path / "off.ulg", {("sensor_combined", 0): combined}, parameters={"TC_G_ENABLE": 0})
     assert not read(tmp_path / "off.ulg").metadata["corrected_onboard"]
-
-
-def test_every_log_format_has_its_reader_and_no_other_falls_through():
-    from gyrocomp.io import LOG_FORMATS, LOG_READERS, _log_reader
-
-    assert set(LOG_READERS) == set(LOG_FORMATS)
-    with pytest.raises(InputError, match=r"fmt: no reader for 'netcdf5'; the formats are csv, parquet"):
-        _log_reader("netcdf5")

@@ -30,7 +30,7 @@ def test_the_literal_choices_are_the_fittings_own():
     (lambda: Network(hidden=(0,)), r"Network.hidden: 1 to 3 layers of 1..50 neurons, e.g. \(3,\); got \(0,\)"),
     (lambda: Network(hidden=(3, 3, 3, 3)), r"Network.hidden: 1 to 3 layers"),
     (lambda: Network(seed=1.5), r"Network.seed: a whole number, got 1.5"),
-    (lambda: FitOptions(temperature=3), r"FitOptions.temperature: Polynomial\(order=...\), Network\(hidden=...\) or "
+    (lambda: FitOptions(temperature=3), r"FitOptions.temperature: Polynomial\(order=...\), Curve\(family, size\), Network\(hidden=...\) or "
                                         r"None; got 3"),
     (lambda: FitOptions(hysteresis="lagg"), r"FitOptions.hysteresis: 'lagg'; use one of auto, none, turning-point"),
     (lambda: FitOptions(hysteresis_order=4), r"FitOptions.hysteresis_order: 4; use one of auto, 1, 2, 3"),
@@ -50,7 +50,7 @@ def test_a_bad_option_is_refused_naming_its_field(make, message):
 @pytest.mark.parametrize("plain", ["auto", 3, "mlp", ("mlp", (5, 2))])
 def test_fit_calibration_refuses_the_plain_temperature_forms_naming_the_typed_ones(plain):
     run = simulate("mti10", profile="chamber", rate_hz=1, duration_s=600, seed=1).recording
-    with pytest.raises(InputError, match=r"temperature: Polynomial\(order=...\), Network\(hidden=...\) or None; got "
+    with pytest.raises(InputError, match=r"temperature: Polynomial\(order=...\), Curve\(family, size\), Network\(hidden=...\) or None; got "
                                          r".*\(an order N is Polynomial\(N\), 'auto' is Polynomial\(\), 'mlp' is "
                                          r"Network\(\)\)"):
         fit_calibration([run], temperature=plain)

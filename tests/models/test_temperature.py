@@ -5,7 +5,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import Network, Polynomial, apply, fit_calibration
+from gyrocomp import Curve, Network, Polynomial, apply, fit_calibration
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureRangeWarning
 from gyrocomp.measures.merit import default_window_s, smoothed_residual_rms
@@ -193,8 +193,9 @@ def test_errors():
         PolynomialTemperatureModel().fit([])
 
 
-@pytest.mark.parametrize("text,expected", [("poly", Polynomial()), ("POLY:3", Polynomial(3)), ("none", None),
-                                           ("poly:0", Polynomial(0)), ("mlp:4x2", Network((4, 2)))])
+@pytest.mark.parametrize("text,expected", [("auto", Polynomial()), ("poly", Curve("poly")), ("POLY:3", Polynomial(3)),
+                                           ("none", None), ("poly:0", Polynomial(0)), ("mlp:4x2", Network((4, 2))),
+                                           ("table", Curve("table")), ("table:16", Curve("table", 16))])
 def test_parse_temperature_option(text, expected):
     assert parse_temperature_option(text) == expected
 

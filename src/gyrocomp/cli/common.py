@@ -15,10 +15,11 @@ from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, T
 from ..errors import InputError
 from ..spelling import Spelling, from_values, spelled_fields
 from .projectfile import ReadingOption
-from ..io import FORMAT_SPELLING, ReadOptions, read_input
+from ..io import ReadOptions, format_spelling, read_input
 from ..io.atomic import check_output_file
 from ..curves.network import DEFAULT_HIDDEN
-from ..models.options import Network, Polynomial
+from ..curves.kinds import BASES
+from ..models.options import MAX_CURVE_SIZE, Curve, Network, Polynomial, family_help
 from ..models.pipelines import check_channels
 from ..recording.prepared import CHANNELS
 from ..curves.polynomial import MAX_ORDER
@@ -68,7 +69,7 @@ def click_option(name: str, spelling: Spelling, default=None):
 
 #: the reading options of every command that reads data: the input's format, then the fields of ReadOptions
 #: (and of its TableLayout), each defined once, where the library defines it, with its default
-READ_FIELDS = (("fmt", FORMAT_SPELLING, None),
+READ_FIELDS = (("fmt", format_spelling(), None),
                *((field.name, spelling, field.default) for field, spelling in spelled_fields(ReadOptions)))
 READ_OPTIONS = tuple(name for name, _, _ in READ_FIELDS)
 
@@ -124,26 +125,36 @@ def parse_hidden(text: str) -> tuple[int, ...]:
     return hidden
 
 
-def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Network | None:
-    """``"poly"`` -> ``Polynomial()``, ``"poly:3"`` -> ``Polynomial(3)``, ``"mlp"``/``"mlp:5"`` -> ``Network(hidden,
-    seed)``, ``"none"`` -> None."""
+def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Curve | Network | None:
+    """``--temperature``: ``auto`` -> ``Polynomial()`` (the automatic choice), ``poly:3`` -> ``Polynomial(3)``,
+    ``NAME`` or ``NAME:N`` of any registered curve family -> ``Curve(NAME)`` / ``Curve(NAME, N)`` (``table:16``),
+    ``mlp``/``mlp:5`` -> ``Network(hidden, seed)``, ``none`` -> None."""
     text = text.strip().lower()
     if text == "mlp" or text.startswith("mlp:"):
         return Network(parse_hidden(text), seed)
-    if text in ("poly", "auto"):
+    if text == "auto":
         return Polynomial()
     if text == "none":
         return None
-    if text.startswith("poly:"):
+    family, _, size = text.partition(":")
+    if family in BASES:
+        if not size:
+            return Curve(family)
         try:
-            order = int(text[5:])
-        except ValueError:
-            order = -1
-        if 0 <= order <= MAX_ORDER:
-            return Polynomial(order)
-        raise InputError(f"--temperature: {text!r}: the order must be a whole number from 0 to {MAX_ORDER}")
-    raise InputError(f"--temperature: {text!r}: use poly (automatic order), poly:N (N = 0..{MAX_ORDER}), "
-                     "mlp (the thesis's 1-3-1 network), mlp:H or none")
+            return Polynomial(int(size)) if family == "poly" else Curve(family, int(size))
+        except (ValueError, InputError):
+            low, top = (0, MAX_ORDER) if family == "poly" else (1, MAX_CURVE_SIZE)
+            raise InputError(f"--temperature: {text!r}: the size of {family} must be a whole number from {low} to "
+                             f"{top}") from None
+    raise InputError(f"--temperature: {text!r}: use auto, {', '.join(f'{n}, {n}:N' for n in BASES)}, mlp, mlp:H "
+                     "or none")
+
+
+def temperature_help() -> str:
+    """``--temperature``'s help, its curve families read from the registry."""
+    return ("auto (the default: every polynomial order and each other curve family at its sizes, chosen by held-out "
+            f"drift); {family_help()}; mlp (the thesis's 1-3-1 network, Levenberg-Marquardt), mlp:H (H hidden "
+            "neurons); none.")
 
 
 def parse_channels(text: str) -> tuple[str, ...]:
@@ -190,4 +201,4 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-__all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings"]
+__all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "temperature_help", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings"]

@@ -6,7 +6,7 @@ import click
 
 from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs
-from ..export.formats import EXPORTERS, ExportOptions, export_to, format_of
+from ..export import EXPORTERS, ExportOptions, export_to, format_of
 from ..fitting.online import LearnerSettings, OnlineCalibrator
 from .common import FINITE
 
@@ -18,10 +18,8 @@ EXPORT_FORMATS = tuple(name for name in EXPORTERS if name != "json")
 @click.command()
 @click.argument("model", type=click.Path())
 @click.option("--format", "fmt", type=click.Choice(EXPORT_FORMATS), default=None,
-              help="px4 (TC_G* parameters, QGroundControl .params), ardupilot (INS_TCAL* parameters, .parm), "
-                   "or c (the whole model as C99: gyrocomp.h and gyrocomp.c in the folder -o, with the online learner "
-                   "beside them: gyrocomp_learn.h, gyrocomp_learn.c); default: the one -o's name says (.params, "
-                   ".parm, a folder without a suffix).")
+              help="; ".join(EXPORTERS[name].help() for name in EXPORT_FORMATS)
+                   + "; default: the one -o's name says.")
 @click.option("-o", "--output", required=True, type=click.Path(), help="Parameter file to write (c: a folder).")
 @click.option("--rate", "rate_hz", type=FINITE, default=None,
               help="c: the sample rate the code will run at [Hz] (needed when the model has thermal lag).")
@@ -50,7 +48,7 @@ def export(ctx, model, fmt, output, rate_hz, instance, device_id, accel_device_i
 def write_export(calibration: Calibration, fmt: str, output, *, rate_hz=None, instance=None,
                  device_id: int | None = None, accel_device_id: int | None = None, quiet: bool = False,
                  learner: LearnerSettings | None = None) -> None:
-    """Write ``calibration`` as ``fmt`` (:func:`gyrocomp.export.formats.export_to`) and say what was written."""
+    """Write ``calibration`` as ``fmt`` (:func:`gyrocomp.export.exporters.export_to`) and say what was written."""
     done = export_to(calibration, fmt, output, ExportOptions(rate_hz=rate_hz, instance=instance, device_id=device_id,
                                                               accel_device_id=accel_device_id, learner=learner,
                                                               judge_firmware=not quiet))

@@ -20,16 +20,14 @@ from ..models.pipelines import SCALE_FACTOR_CHOICES
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
 from .common import (FINITE, OUTPUT_FILE, float_list, parse_channels, parse_temperature_option, pop_read_options,
-                     progress_bar, read_options, read_run)
+                     progress_bar, read_options, read_run, temperature_help)
 from .render import print_contributions, print_fit
 
 
 @click.command()
 @click.argument("runs", nargs=-1, required=True, type=click.Path())  # files, folders of runs, or quoted globs
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="Model file to write (JSON).")
-@click.option("--temperature", default="poly", show_default=True,
-              help="poly (order by cross-validation), poly:N (N = 0..5), mlp (the thesis's 1-3-1 network, "
-                   "Levenberg-Marquardt), mlp:H (H hidden neurons) or none.")
+@click.option("--temperature", default="auto", show_default=True, help=temperature_help())
 @click.option("--seed", "mlp_seed", type=int, default=0, show_default=True,
               help="Seed of the network's initializations (mlp); the same seed gives the same model.")
 @click.option("--bin-width", "bin_width_degc", type=FINITE, default=None, help="Temperature bin width [degC] (default: span/100).")

@@ -18,7 +18,8 @@ from ..report.fleet import build_fleet_report
 from . import in_cli_words
 from .common import (FINITE, OUTPUT_FILE, make_console, parse_channels, pop_read_options, progress_bar, read_options,
                      read_settings)
-from .export import EXPORT_FORMATS, write_export
+from ..export import EXPORTERS
+from .export import write_export
 
 #: failures and outliers listed after a fleet fit (the fleet table has them all)
 _LISTED = 10
@@ -224,8 +225,8 @@ def report(ctx, store, output, limits_file):
 @fleet.command("export")
 @click.argument("serial")
 @click.option("--store", required=True, help="The fleet folder, an SQLite file or a SQLAlchemy URL.")
-@click.option("--format", "fmt", type=click.Choice((*EXPORT_FORMATS, "json")), required=True,
-              help="px4, ardupilot, c (a folder) or json (the model file).")
+@click.option("--format", "fmt", type=click.Choice(tuple(EXPORTERS)), required=True,
+              help="; ".join(exporter.help() for exporter in EXPORTERS.values()) + ".")
 @click.option("-o", "--output", required=True, type=click.Path(), help="File (c: folder) to write.")
 @click.option("--at", "at", default=None, metavar="DATE", help="Export the calibration valid at this date or time.")
 @click.option("--rate", "rate_hz", type=FINITE, default=None, help="c: the sample rate the code will run at [Hz].")

@@ -116,6 +116,8 @@ class LookupTableBasis:
     paired difference (:mod:`gyrocomp.fitting.scores`)."""
 
     name: ClassVar[str] = "table"
+    description: ClassVar[str] = ("a lookup table of N intervals over the calibrated range, linear between its points, "
+                                  "held past its ends (what sensor vendors flash)")
     sizes: ClassVar[tuple[int, ...]] = (8, 16)
 
     lo_degc: float

@@ -163,6 +163,7 @@ class PolynomialBasis:
     applied), else they are held at the edge."""
 
     name: ClassVar[str] = "poly"
+    description: ClassVar[str] = "a polynomial of order N in temperature (poly alone: its order by held-out drift)"
     sizes: ClassVar[tuple[int, ...]] = tuple(range(1, MAX_ORDER + 1))
 
     t_ref_degc: float

@@ -130,6 +130,8 @@ class CurveBasis(Protocol):
     (``over(..., extended=True)``), continued along its tangent as the model choice scores it."""
 
     name: ClassVar[str]
+    #: what a curve of the family is, a phrase with ``N`` for its size (``--temperature``'s help lists it)
+    description: ClassVar[str]
     #: the sizes the default model choice tries (the polynomial's orders come from the fit's own order range)
     sizes: ClassVar[tuple[int, ...]]
 

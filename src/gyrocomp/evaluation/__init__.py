@@ -187,11 +187,10 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
     window_s : float, optional
         Moving-average window [s] (default as :func:`evaluate`).
     """
-    fmt = recording.metadata.get("format")
-    if fmt not in ("ulog", "dataflash") or "autopilot_parameters" not in recording.metadata:
+    autopilot = recording.metadata.get("autopilot")
+    if autopilot not in ("px4", "ardupilot") or "autopilot_parameters" not in recording.metadata:
         raise InputError(f"{recording.source}: not a PX4 ULog or ArduPilot DataFlash log; the installed calibration "
                          "is read from a log's parameters")
-    autopilot = "px4" if fmt == "ulog" else "ardupilot"
     params = recording.metadata["autopilot_parameters"]
     slot, note = _installed_slot(recording, autopilot)
     installed = None if slot is None else installed_calibration(params, autopilot,

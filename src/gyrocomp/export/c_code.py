@@ -38,6 +38,7 @@ from ..curves.hysteresis import BranchCurve, HysteresisCurve
 from ..fitting.online import LearnerSettings
 from ..calibration.triad import TriadCalibration
 from .c_learner import learner_c_sources
+from .exporters import ExportOptions, Exported, Exporter, register
 
 AXES = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL = ("accel_x", "accel_y", "accel_z")
@@ -326,5 +327,12 @@ def write_c_sources(calibration: Calibration, folder: str | os.PathLike, *, rate
                 folder.rmdir()
         raise
 
+
+def _write_c(calibration: Calibration, path: Path, options: ExportOptions) -> Exported:
+    return Exported("c", tuple(write_c_sources(calibration, path, rate_hz=options.rate_hz, learner=options.learner)))
+
+
+register(Exporter("c", "the whole model as C99: gyrocomp.h, gyrocomp.c, with the online learner beside them",
+                  "a temperature from each axis's own sensor (the C interface takes one)", _write_c, folder=True))
 
 __all__ = ["c_sources", "write_c_sources"]

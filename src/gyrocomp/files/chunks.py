@@ -16,7 +16,7 @@ from typing import TypeVar
 import numpy as np
 
 from ..errors import InputError
-from ..io import TABLE_FORMATS, ReadOptions, TableData, detect_format, read_input
+from ..io import ReadOptions, TableData, detect_format, read_input, table_formats
 from ..io.common import ProgressCallback
 from ..io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from ..recording import GAP_FACTOR, nominal_rate_hz
@@ -66,7 +66,7 @@ class TimeSteps:
 def reads_in_chunks(fmt: str, options: ReadOptions) -> bool:
     """Whether a file of format ``fmt`` is read in chunks with these options: a table whose rows are not selected
     by time (a time range is cut from the whole file)."""
-    return fmt in TABLE_FORMATS and options.time_range_s is None
+    return fmt in table_formats() and options.time_range_s is None
 
 
 def chunked_or_whole(path, options: ReadOptions | None, *, fmt: str | None, chunks: ChunkSettings,

@@ -277,8 +277,8 @@ class SelectionProblem:
     unit: AxisUnit = "deg/s"
     band_only: bool = False
     branch_orders: tuple[int, ...] = ()
-    #: curve families besides the polynomial (names of :data:`gyrocomp.curves.protocol.BASES`), each at its sizes
-    other_curves: tuple[str, ...] = ()
+    #: curves of families besides the polynomial: (name in :data:`gyrocomp.curves.protocol.BASES`, size) pairs
+    other_curves: tuple[tuple[str, int], ...] = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -355,10 +355,9 @@ class SelectionProblem:
         out, start = [], self.max_order
         if lagged:
             return out
-        for name in self.other_curves:
-            for size in BASES[name].sizes:
-                out.append((name, size, start))
-                start += size
+        for name, size in self.other_curves:
+            out.append((name, size, start))
+            start += size
         return out
 
     def column_index(self, c: Candidate, width: int = 0) -> np.ndarray:
@@ -581,9 +580,8 @@ class SelectionProblem:
                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> list[Candidate]:
         out = []
         for w in weightings:
-            if "none" in memories and any(p > 0 for p in orders):  # the other families: no lag, no hysteresis
-                out += [Candidate(size, False, 0, w, curve=name)
-                        for name in self.other_curves for size in BASES[name].sizes]
+            if "none" in memories:  # the other families: no lag, no hysteresis
+                out += [Candidate(size, False, 0, w, curve=name) for name, size in self.other_curves]
             for p in orders:
                 for mem in memories:
                     lag = "lag" in mem
@@ -618,7 +616,8 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
                  block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
                  max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
                  square_cols: tuple[int, ...] = (), both_directions: bool = True,
-                 branch_orders: tuple[int, ...] = (), curves: tuple[str, ...] = ("poly",)) -> SelectionProblem:
+                 branch_orders: tuple[int, ...] = (), other_curves: tuple[tuple[str, int], ...] = ()
+                 ) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
     Parameters
@@ -646,9 +645,9 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     branch_orders : tuple of int
         Terms of the heating-cooling difference of the branch candidates; offered only where the runs both heat
         and cool.
-    curves : tuple of str
-        The curve families offered (:data:`gyrocomp.curves.protocol.BASES`): the polynomial's orders come from
-        ``max_order``, every other family's sizes from its basis.
+    other_curves : tuple of (str, int)
+        The curves of other families than the polynomial offered, (name in
+        :data:`gyrocomp.curves.protocol.BASES`, size) each (the polynomial's orders come from ``max_order``).
     """
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
@@ -670,7 +669,7 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
                             window_for(folds, runs, block_s), max_order, hysteresis_orders if reverses else (),
                             accel_cols, square_cols, step, band, unit=recordings[0].unit_of(axis), band_only=band_only,
                             branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
-                            other_curves=tuple(name for name in curves if name != "poly"))
+                            other_curves=tuple(other_curves))
 
 
 __all__ = ["AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "SelectionProblem", "Weighting", "prepare_axis",

@@ -21,7 +21,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..errors import DataQualityWarning, InputError
-from ..io.files import RUN_SUFFIXES, expand_inputs
+from ..io.files import expand_inputs
 from ..io.tables import detect_table_format, file_sha256
 
 _FIELD = re.compile(r"\{(\w+)\}")
@@ -140,5 +140,5 @@ def _folder_sha256(folder: Path) -> str:
     return digest.hexdigest()
 
 
-__all__ = ["RUN_SUFFIXES", "UnitRuns", "content_hash", "expand_inputs", "input_hash", "pattern_regex", "units_from_manifest",
+__all__ = ["UnitRuns", "content_hash", "expand_inputs", "input_hash", "pattern_regex", "units_from_manifest",
            "units_from_pattern"]

@@ -1,15 +1,15 @@
 """Readers and writers. Every reader returns a :class:`gyrocomp.recording.Recording` in internal units.
 
-Formats: CSV and Parquet tables; PX4 ULog (extra ``[ulog]``); ArduPilot DataFlash (``[dataflash]``);
-ROS 1 / ROS 2 bags (``[ros]``); HDF5 / NetCDF-4 (``[hdf5]``). The format is told from the file's
-first bytes, then its suffix, and can be named instead.
+Formats: the readers registered in :mod:`gyrocomp.io.read_formats` (CSV and Parquet tables; PX4 ULog, extra
+``[ulog]``; ArduPilot DataFlash, ``[dataflash]``; ROS 1 / ROS 2 bags, ``[ros]``; HDF5 / NetCDF-4, ``[hdf5]``). The
+format is told from the file's first bytes, then its name, and can be named instead
+(:func:`gyrocomp.io.readers.detect_format`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import os
-import stat
 from pathlib import Path
 
 import numpy as np
@@ -18,11 +18,11 @@ from ..errors import InputError
 from ..recording import Recording
 from ..spelling import Spelling
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
-from .common import ProgressCallback, ReadOptions, sniff_format
+from .common import ProgressCallback, ReadOptions
 from .project import project_read_options
-from .dataflash import dataflash_instances, read_dataflash
-from .hdf5 import read_hdf5
-from .rosbag import read_rosbag
+from .read_formats import READER_MODULES
+from .readers import (READERS, Reader, detect_format, format_help, format_names, instances, reader_named,
+                      register_reader, sniff_format, table_formats)
 from .tables import (
     TableData,
     TableLayout,
@@ -36,75 +36,19 @@ from .tables import (
     write_recording,
     write_rows,
 )
-from .ulog import read_ulog, ulog_instances
-
-TABLE_FORMATS = ("csv", "parquet")
-LOG_FORMATS = ("ulog", "dataflash", "rosbag", "hdf5")
-FORMATS = TABLE_FORMATS + LOG_FORMATS
-#: the reading functions' ``fmt`` parameter on the command line
-FORMAT_SPELLING = Spelling("--format", f"Input format (default: told from the file): {', '.join(FORMATS)}.")
-#: aliases accepted by ``--format``
-FORMAT_ALIASES = {"ulg": "ulog", "px4": "ulog", "bin": "dataflash", "ardupilot": "dataflash", "bag": "rosbag",
-                  "ros": "rosbag", "netcdf": "hdf5", "nc": "hdf5", "h5": "hdf5", "pq": "parquet"}
-_SUFFIXES = {".ulg": "ulog", ".bin": "dataflash", ".bag": "rosbag", ".db3": "rosbag", ".mcap": "rosbag",
-             ".h5": "hdf5", ".hdf5": "hdf5", ".nc": "hdf5", ".nc4": "hdf5"}
-def detect_format(path: str | os.PathLike, fmt: str | None = None) -> str:
-    """The format name of ``path``: ``fmt`` if given (checked), else from its first bytes or suffix. A pipe or a
-    device (``/dev/stdin``, ``<(...)``) is refused: inputs are read more than once (their first bytes, then in
-    chunks, some twice)."""
-    _require_a_file(path)
-    if fmt is not None:
-        name = FORMAT_ALIASES.get(fmt.lower(), fmt.lower())
-        if name not in FORMATS:
-            raise InputError(f"fmt: unknown format {fmt!r}; use one of {', '.join(FORMATS)}")
-        return name
-    path = Path(path)
-    if path.is_dir():
-        if (path / "metadata.yaml").exists():
-            return "rosbag"
-        raise InputError(f"{path}: is a folder (not a ROS 2 bag: no metadata.yaml in it); name a file")
-    if path.is_file():
-        with open(path, "rb") as fh:
-            found = sniff_format(fh.read(16))
-        if found is not None:
-            return found
-    found = detect_table_format(path) or _SUFFIXES.get(path.suffix.lower())
-    if found is None:
-        raise InputError(
-            f"{path}: cannot tell the format from the file or its suffix {path.suffix!r}; "
-            f"name it with fmt= ({', '.join(FORMATS)})"
-        )
-    return found
 
 
-def _require_a_file(path: str | os.PathLike) -> None:
-    try:
-        mode = os.stat(path).st_mode
-    except (OSError, ValueError):
-        return  # a missing file is said where it is opened, with the same words everywhere
-    if stat.S_ISFIFO(mode) or stat.S_ISCHR(mode) or stat.S_ISBLK(mode) or stat.S_ISSOCK(mode):
-        kind = "a pipe" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
-        raise InputError(f"{path}: is {kind}, not a file; gyrocomp reads an input more than once (its first bytes "
-                         "tell the format, then its rows): save it to a file first")
+def format_spelling() -> Spelling:
+    """The reading functions' ``fmt`` parameter on the command line, its help listing the registered formats."""
+    return Spelling("--format", format_help())
 
 
 def output_format(path: str | os.PathLike, option: str = "-o", default: str | None = None) -> str:
     """The table format an output path asks for by its suffix (``default`` when it names none)."""
     found = detect_table_format(Path(path)) or default
-    if found not in TABLE_FORMATS:
+    if found not in table_formats():
         raise InputError(f"{option} {path}: gyrocomp writes CSV or Parquet; name the file .csv or .parquet")
     return found
-
-
-#: the reader of each format that is not a table (tables: io.tables): format name -> read(path, options, progress)
-LOG_READERS = {"ulog": read_ulog, "dataflash": read_dataflash, "rosbag": read_rosbag, "hdf5": read_hdf5}
-
-
-def _log_reader(fmt: str):
-    """The registered reader of ``fmt``; a name no reader has is refused (no fall-through to another reader)."""
-    if fmt not in LOG_READERS:
-        raise InputError(f"fmt: no reader for {fmt!r}; the formats are {', '.join(FORMATS)}")
-    return LOG_READERS[fmt]
 
 
 def read_input(
@@ -125,13 +69,7 @@ def read_input(
     fmt = detect_format(path, fmt)
     if not Path(path).exists():
         raise InputError(f"{path}: no such file")
-    if fmt in TABLE_FORMATS:
-        data = read_table(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite,
-                          channels=options.channels)
-        if progress:
-            progress(1.0)
-    else:
-        data = table_data(_log_reader(fmt)(path, options, progress))
+    data = READERS[fmt].read_table_data(Path(path), options, progress)
     return data if options.time_range_s is None else select_time(data, options.time_range_s)
 
 
@@ -153,19 +91,6 @@ def select_time(data: TableData, time_range_s: tuple[float | None, float | None]
                          f"{'' if stop is None else f'{stop:g}'} holds no sample; the file lasts {since[-1]:.6g} s "
                          "from its first sample")
     return dataclasses.replace(data, recording=rec.take(keep), kept_rows=data.kept_rows[keep])
-
-
-def instances(path: str | os.PathLike, fmt: str | None = None) -> tuple[int, ...]:
-    """The sensor instances a log holds (PX4 uORB ``multi_id``, ArduPilot IMU number from 0), sorted; ``(0,)`` for
-    a table, a ROS bag or an HDF5 file (one sensor each)."""
-    fmt = detect_format(path, fmt)
-    if not Path(path).exists():
-        raise InputError(f"{path}: no such file")
-    if fmt == "ulog":
-        return ulog_instances(path)
-    if fmt == "dataflash":
-        return dataflash_instances(path)
-    return (0,)
 
 
 def read(
@@ -251,26 +176,31 @@ def _merged_options(config, layout: TableLayout | None, layout_fields: dict, oth
 
 
 __all__ = [
-    "FORMATS",
-    "FORMAT_SPELLING",
-    "LOG_FORMATS",
-    "LOG_READERS",
+    "READERS",
+    "READER_MODULES",
     "ReadOptions",
+    "Reader",
     "TableData",
     "TableLayout",
     "atomic_path",
     "detect_format",
     "detect_table_format",
     "file_sha256",
+    "format_help",
+    "format_names",
+    "format_spelling",
     "instances",
     "output_format",
     "parse_column_mapping",
     "read",
     "read_input",
     "read_table",
+    "reader_named",
+    "register_reader",
     "recording_table",
     "refuse_to_overwrite_inputs",
     "sniff_format",
+    "table_formats",
     "write_gyro_back",
     "write_recording",
     "write_rows",

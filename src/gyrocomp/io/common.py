@@ -259,33 +259,3 @@ def keep_matched(source: str, what: str, ok: np.ndarray) -> np.ndarray:
             DataQualityWarning, stacklevel=3,
         )
     return np.flatnonzero(ok)
-
-
-def check_magic(path, expected: bytes, what: str, hint: str) -> None:
-    """Refuse a file whose first bytes are not ``expected``, in one line that says what it is instead."""
-    with open(path, "rb") as fh:
-        head = fh.read(max(len(expected), 16))
-    if not head.startswith(expected):
-        found = _describe_head(head)
-        raise InputError(f"{path}: not a {what} file ({found}); {hint}")
-
-
-_MAGIC = ((b"ULog\x01\x12\x35", "ulog"), (b"\x89HDF\r\n\x1a\n", "hdf5"), (b"#ROSBAG", "rosbag"),
-          (b"\x89MCAP", "rosbag"), (b"PAR1", "parquet"), (b"\xa3\x95", "dataflash"))
-
-
-def sniff_format(head: bytes) -> str | None:
-    """The format a file's first bytes announce, or None (CSV has no signature)."""
-    for magic, fmt in _MAGIC:
-        if head.startswith(magic):
-            return fmt
-    return None
-
-
-def _describe_head(head: bytes) -> str:
-    fmt = sniff_format(head)
-    if fmt is not None:
-        return f"it looks like {fmt}"
-    if not head:
-        return "it is empty"
-    return f"it starts with {head[:8]!r}"

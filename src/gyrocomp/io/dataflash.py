@@ -25,7 +25,6 @@ from ..units import unit_factor
 from .common import (
     ProgressCallback,
     ReadOptions,
-    check_magic,
     foreign_output,
     keep_matched,
     log_recording,
@@ -33,6 +32,7 @@ from .common import (
     order_by_time,
     require,
 )
+from .readers import Reader, check_magic, register_reader
 
 DATAFLASH_MAGIC = b"\xa3\x95"
 RECORDS = ("IMU", "TCLR")
@@ -231,9 +231,14 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
     if progress:
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature,
-                         {"path": str(path), "format": "dataflash", "record": record, "instance": instance,
+                         {"path": str(path), "format": "dataflash", "autopilot": "ardupilot", "record": record,
+                          "instance": instance,
                           "corrected_onboard": params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU",
                           # the installed thermal calibration and the temperatures its gyro offsets were taken at
                           "autopilot_parameters": {k: v for k, v in params.items()
                                                    if k.startswith("INS_TCAL") or k.endswith("_CALTEMP")},
                           "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0})
+
+
+register_reader(Reader("dataflash", "ArduPilot DataFlash, extra [dataflash]", read_dataflash, suffixes=(".bin",),
+                       magic=(DATAFLASH_MAGIC,), aliases=("bin", "ardupilot"), instances=dataflash_instances))

@@ -9,10 +9,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from ..errors import DataQualityWarning, InputError
-from .tables import detect_table_format
-
-#: suffixes of the files a folder is searched for (every format gyrocomp reads)
-RUN_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".parquet", ".pq", ".ulg", ".bin", ".bag", ".mcap", ".h5", ".hdf5", ".nc", ".nc4")
+from .readers import folder_format, folder_markers, format_of_name, run_suffixes
 
 
 def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
@@ -23,7 +20,7 @@ def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
     found = _each_once(_named_files(data))
     if not found:
         raise InputError(f"{', '.join(map(os.fspath, data))}: no run file found (looked for "
-                         f"{', '.join(RUN_SUFFIXES)})")
+                         f"{', '.join(run_suffixes())})")
     return sorted(found)
 
 
@@ -61,14 +58,15 @@ def _named_files(data: Iterable[str | os.PathLike]) -> set[Path]:
 
 def _runs_in_folder(folder: Path) -> list[Path]:
     runs, bags = [], []
+    markers = set(folder_markers())
     for root, dirs, files in os.walk(folder):
-        if "metadata.yaml" in files and root != os.fspath(folder):
+        if markers & set(files) and root != os.fspath(folder):
             bags.append(Path(root))
             dirs.clear()
             continue
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         runs += [Path(root) / f for f in sorted(files)
-                 if not f.startswith(".") and (Path(f).suffix.lower() in RUN_SUFFIXES or detect_table_format(Path(f)))]
+                 if not f.startswith(".") and format_of_name(f) is not None]
     return runs + bags
 
 
@@ -82,7 +80,7 @@ def expand_runs(items: Iterable[str | os.PathLike]) -> list[str]:
     for item in items:
         text = os.fspath(item)
         path = Path(text)
-        folder = path.is_dir() and not (path / "metadata.yaml").exists()
+        folder = path.is_dir() and folder_format(path) is None
         if folder or (not path.exists() and glob.has_magic(text)):
             out += [os.fspath(p) for p in expand_inputs([text])]
         else:
@@ -90,4 +88,4 @@ def expand_runs(items: Iterable[str | os.PathLike]) -> list[str]:
     return out
 
 
-__all__ = ["RUN_SUFFIXES", "expand_inputs", "expand_runs"]
+__all__ = ["expand_inputs", "expand_runs"]

@@ -20,7 +20,8 @@ import numpy as np
 from ..errors import DataQualityWarning, GyrocompError, InputError, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, check_magic, log_recording, require
+from .common import ProgressCallback, ReadOptions, log_recording, require
+from .readers import Reader, check_magic, register_reader
 from .tables import TIME_COLUMN
 
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
@@ -227,3 +228,7 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature, {"path": source, "format": "hdf5"},
                          gyro_axes=gyro_axes)
+
+
+register_reader(Reader("hdf5", "HDF5 or NetCDF-4, extra [hdf5]", read_hdf5, suffixes=(".h5", ".hdf5", ".nc", ".nc4"),
+                       magic=(HDF5_MAGIC,), aliases=("h5", "netcdf", "nc")))

@@ -18,6 +18,7 @@ from ..errors import DataQualityWarning, InputError, printable
 from ..recording import Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, keep_matched, log_recording, match_by_time, order_by_time, require
+from .readers import Reader, register_reader
 
 IMU_TYPE = "sensor_msgs/msg/Imu"
 TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
@@ -189,3 +190,8 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     return log_recording(path, options, time_s, gyro, accel, temperature,
                          {"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
                           "temperature_topic": thermo[0].topic if thermo else None})
+
+
+register_reader(Reader("rosbag", "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, extra [ros]", read_rosbag,
+                       suffixes=(".bag", ".db3", ".mcap"), magic=(b"#ROSBAG", b"\x89MCAP"), aliases=("bag", "ros"),
+                       folder_marker="metadata.yaml"))

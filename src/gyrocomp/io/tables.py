@@ -232,7 +232,7 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
     (``source``), so that the next command reading the output with the same project file reads it; a comma and a
     decimal point where there is no input table. A decimal comma is kept only beside another separator."""
     name = Path(path).name.lower()
-    for compressed in (".gz", ".bz2", ".xz", ".zst"):
+    for compressed in COMPRESSED_SUFFIXES:
         name = name.removesuffix(compressed)
     base = source or TextFormat()
     if name.endswith(".tsv"):
@@ -321,7 +321,7 @@ def check_parquet_footer(path: Path) -> None:
     except OSError:
         return
     footer = int.from_bytes(tail[:4], "little")
-    if tail[4:] == b"PAR1" and footer > PARQUET_FOOTER_MAX_BYTES:
+    if tail[4:] == PARQUET_MAGIC and footer > PARQUET_FOOTER_MAX_BYTES:
         raise InputError(f"{path}: its metadata takes {footer / 1e6:.0f} MB (over {PARQUET_FOOTER_MAX_BYTES >> 20} MB: "
                          "very many small row groups), which would take gigabytes to read; rewrite it with larger "
                          "row groups, e.g. pyarrow.parquet.write_table(table, path, row_group_size=1_000_000)")
@@ -476,11 +476,15 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
 
 #: suffixes of delimited text tables (the delimiter is told from the header: comma, semicolon, tab, space)
 TEXT_TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
+#: suffixes of compressed text tables after their own (``run.csv.gz``), read as they stream
+COMPRESSED_SUFFIXES = (".gz", ".bz2", ".xz", ".zst")
+#: the first (and last) bytes of a Parquet file
+PARQUET_MAGIC = b"PAR1"
 
 
 def detect_table_format(path: Path) -> str | None:
     suffix = path.suffix.lower()
-    if suffix in (".gz", ".bz2", ".xz", ".zst") and Path(path.stem).suffix.lower() in TEXT_TABLE_SUFFIXES:
+    if suffix in COMPRESSED_SUFFIXES and Path(path.stem).suffix.lower() in TEXT_TABLE_SUFFIXES:
         return "csv"  # compressed CSV, e.g. run.csv.gz
     if suffix in TEXT_TABLE_SUFFIXES:
         return "csv"

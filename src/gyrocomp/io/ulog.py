@@ -24,7 +24,6 @@ from ..units import unit_factor
 from .common import (
     ProgressCallback,
     ReadOptions,
-    check_magic,
     foreign_output,
     keep_matched,
     log_recording,
@@ -32,6 +31,7 @@ from .common import (
     order_by_time,
     require,
 )
+from .readers import Reader, check_magic, register_reader
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"
 GYRO_TOPICS = ("sensor_gyro", "vehicle_imu", "sensor_combined")
@@ -257,7 +257,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
         raise InputError(
             f"{path}: no gyro topic ({', '.join(GYRO_TOPICS)}) in this ULog; it has {', '.join(topics) or 'no data'}"
         )
-    metadata = {"path": str(path), "format": "ulog"}
+    metadata = {"path": str(path), "format": "ulog", "autopilot": "px4"}
     time_s, gyro, accel, temperature = _TOPIC_READERS[topic](path, ulog.data_list, options, metadata)
     _warn_if_corrected(path, topic, ulog.initial_parameters, metadata)
     if temperature is None:
@@ -269,3 +269,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
     if progress:
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature, metadata)
+
+
+register_reader(Reader("ulog", "PX4 ULog, extra [ulog]", read_ulog, suffixes=(".ulg",), magic=(ULOG_MAGIC,),
+                       aliases=("ulg", "px4"), instances=ulog_instances))

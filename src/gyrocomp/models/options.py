@@ -1,8 +1,9 @@
 """Typed options of a fit: what temperature model, thermal memory, g-sensitivity and held-out folds
 :func:`gyrocomp.models.pipelines.fit_pipeline` and :func:`~gyrocomp.models.pipelines.fit_channels` use.
 
->>> from gyrocomp.models.options import FitOptions, Network, Polynomial
+>>> from gyrocomp.models.options import Curve, FitOptions, Network, Polynomial
 >>> FitOptions(temperature=Polynomial(order=3), hysteresis="none")
+>>> FitOptions(temperature=Curve("table", 16))
 >>> FitOptions(temperature=Network(hidden=(5,)), acceleration="matrix")
 
 Each field is checked when the object is made; an error names the field and the value.
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 from typing import Literal, get_args
 
 from ..errors import InputError
+from ..curves.kinds import BASES
 from ..curves.network import DEFAULT_HIDDEN
 from ..curves.polynomial import MAX_ORDER
 from ..fitting.thermal import MAX_HYSTERESIS_ORDER
@@ -63,6 +65,77 @@ class Network:
             raise InputError(f"Network.seed: a whole number, got {self.seed!r}")
 
 
+#: the most parameters a curve of another family than the polynomial may have (a table's intervals)
+MAX_CURVE_SIZE = 64
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A registered curve family by name (:data:`gyrocomp.curves.protocol.BASES`: ``poly``, ``table``, ...) at
+    ``size`` (a polynomial's order, a table's intervals) or ``"auto"`` (its size chosen by held-out drift among
+    the family's own). The family is fitted as asked, without lag or hysteresis unless it is the polynomial;
+    ``Curve("poly", 3)`` is ``Polynomial(3)``."""
+
+    family: str
+    size: int | Literal["auto"] = "auto"
+
+    def __post_init__(self):
+        if self.family not in BASES:
+            raise InputError(f"Curve.family: {self.family!r}; the registered curves are {', '.join(BASES)}")
+        top = MAX_ORDER if self.family == "poly" else MAX_CURVE_SIZE
+        low = 0 if self.family == "poly" else 1
+        if self.size != "auto" and not (isinstance(self.size, int) and not isinstance(self.size, bool)
+                                        and low <= self.size <= top):
+            raise InputError(f"Curve.size: {self.family} takes a whole number from {low} to {top}, or 'auto'; "
+                             f"got {self.size!r}")
+
+
+@dataclass(frozen=True)
+class CurveCandidates:
+    """What the model choice scores for a temperature option: the polynomial's ``orders``, the ``others``
+    ((family, size) pairs of other families), and whether a curve must beat the run constant on held-out data to
+    be kept (``do_no_harm``: when nothing was asked for)."""
+
+    orders: tuple[int, ...]
+    others: tuple[tuple[str, int], ...]
+    do_no_harm: bool
+
+    @property
+    def asked(self) -> bool:
+        """One curve was asked for (no choice among sizes or families)."""
+        return len(self.orders) + len(self.others) == 1 and not self.do_no_harm
+
+
+def curve_candidates(spec: "Polynomial | Curve | Network", target: "Target" = "model") -> CurveCandidates:
+    """The one place that knows what the automatic choice tries.
+
+    ``Polynomial()`` (the default) and a network's polynomial stage: every polynomial order, and each other
+    registered family at its basis's ``sizes`` (a firmware target: the orders it carries, nothing else);
+    ``Polynomial(n)``: that order; ``Curve(family)``: that family's sizes (the polynomial: its orders);
+    ``Curve(family, n)``: that curve.
+    """
+    top = MAX_ORDER if target == "model" else FIRMWARE_MAX_ORDER
+    every_order = tuple(range(top + 1))
+    if isinstance(spec, Curve) and spec.family != "poly":
+        sizes = BASES[spec.family].sizes if spec.size == "auto" else (spec.size,)
+        return CurveCandidates((), tuple((spec.family, size) for size in sizes), False)
+    if isinstance(spec, Curve):
+        return CurveCandidates(every_order, (), True)
+    if isinstance(spec, Polynomial) and spec.order != "auto":
+        return CurveCandidates((spec.order,), (), False)
+    others = tuple((name, size) for name, basis in BASES.items() if name != "poly" for size in basis.sizes)
+    return CurveCandidates(every_order, others if target == "model" else (), True)
+
+
+def family_help() -> str:
+    """The registered curve families as ``--temperature`` lists them: each name, its sizes, what it is."""
+    out = []
+    for name, basis in BASES.items():
+        low, top = (0, MAX_ORDER) if name == "poly" else (1, MAX_CURVE_SIZE)
+        out.append(f"{name} or {name}:N (N = {low}..{top}): {basis.description}")
+    return "; ".join(out)
+
+
 #: what an error about a plain temperature form (an order, "auto", "mlp") adds
 PLAIN_FORMS = " (an order N is Polynomial(N), 'auto' is Polynomial(), 'mlp' is Network())"
 
@@ -78,8 +151,10 @@ class FitOptions:
 
     Parameters
     ----------
-    temperature : Polynomial, Network or None
-        The temperature model; None fits no curve (each run's constant, and G when the runs turn).
+    temperature : Polynomial, Curve, Network or None
+        The temperature model: ``Polynomial()`` the automatic choice (:func:`curve_candidates`), a
+        ``Polynomial(n)``, any registered family by name (``Curve("table", 16)``), a network; None fits no curve
+        (each run's constant, and G when the runs turn).
     bin_width_degc : float, optional
         Temperature bin width of the fit [degC].
     hysteresis : Memory
@@ -103,7 +178,7 @@ class FitOptions:
         there, no lag, hysteresis or g-sensitivity; ``apply`` then computes what the exported file will.
     """
 
-    temperature: Polynomial | Network | None = Polynomial()
+    temperature: Polynomial | Curve | Network | None = Polynomial()
     bin_width_degc: float | None = None
     hysteresis: Memory = "auto"
     hysteresis_order: int | Literal["auto"] = "auto"
@@ -115,8 +190,11 @@ class FitOptions:
     target: Target = "model"
 
     def __post_init__(self):
-        if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Network)):
-            raise InputError(f"FitOptions.temperature: Polynomial(order=...), Network(hidden=...) or None; got "
+        if isinstance(self.temperature, Curve) and self.temperature.family == "poly" and self.temperature.size != "auto":
+            object.__setattr__(self, "temperature", Polynomial(self.temperature.size))
+        if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Curve, Network)):
+            raise InputError(f"FitOptions.temperature: Polynomial(order=...), Curve(family, size), Network(hidden=...) "
+                             f"or None; got "
                              f"{self.temperature!r}" + (PLAIN_FORMS if isinstance(self.temperature, (int, str, tuple))
                                                          else ""))
         _choice("FitOptions.hysteresis", self.hysteresis, get_args(Memory))
@@ -126,6 +204,8 @@ class FitOptions:
         _choice("FitOptions.target", self.target, get_args(Target))
         if self.target != "model":
             self._check_firmware_target()
+        if isinstance(self.temperature, Curve) and self.temperature.family != "poly":
+            self._check_other_family()
         if self.bin_width_degc is not None and not (isinstance(self.bin_width_degc, (int, float))
                                                     and self.bin_width_degc > 0):
             raise InputError(f"FitOptions.bin_width_degc: a positive number of degC, got {self.bin_width_degc!r}")
@@ -144,8 +224,9 @@ class FitOptions:
     def _check_firmware_target(self) -> None:
         """A firmware target carries a cubic at most and nothing else: other asks are refused naming the field."""
         t = self.target
-        if not isinstance(self.temperature, Polynomial) or (
-                self.temperature.order != "auto" and self.temperature.order > FIRMWARE_MAX_ORDER):
+        poly_only = isinstance(self.temperature, Curve) and self.temperature.family == "poly"
+        if not (isinstance(self.temperature, Polynomial) or poly_only) or (
+                not poly_only and self.temperature.order != "auto" and self.temperature.order > FIRMWARE_MAX_ORDER):
             raise InputError(f"FitOptions.target: {t} carries a polynomial of order {FIRMWARE_MAX_ORDER} at most; "
                              f"use temperature=Polynomial() or Polynomial(0..{FIRMWARE_MAX_ORDER}), got "
                              f"{self.temperature!r}")
@@ -156,6 +237,13 @@ class FitOptions:
         object.__setattr__(self, "hysteresis", "none")
         object.__setattr__(self, "acceleration", "none")
 
+    def _check_other_family(self) -> None:
+        """A family other than the polynomial is fitted without thermal memory: asking for one is refused."""
+        if self.hysteresis not in ("auto", "none") or self.hysteresis_band_degc is not None:
+            raise InputError(f"FitOptions.hysteresis: {self.temperature.family} is fitted without lag or hysteresis; "
+                             "leave hysteresis='auto' or 'none', or use a polynomial")
+        object.__setattr__(self, "hysteresis", "none")
 
-__all__ = ["Acceleration", "FIRMWARE_MAX_ORDER", "FitOptions", "FoldChoice", "Memory", "Network", "Polynomial",
-           "Target"]
+
+__all__ = ["Acceleration", "Curve", "CurveCandidates", "FIRMWARE_MAX_ORDER", "FitOptions", "FoldChoice", "MAX_CURVE_SIZE",
+           "Memory", "Network", "Polynomial", "Target", "curve_candidates", "family_help"]

@@ -33,10 +33,9 @@ from ..fitting.folds import FOLD_KINDS
 from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
 from ..fitting.selection import AxisSelection, prepare_axis
 from ..fitting.polynomial import PolynomialTemperatureModel
-from ..curves.kinds import BASES
-from ..curves.polynomial import MAX_ORDER
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, _accel_triad, _gyro_triad, _spanning_poses  # noqa: F401
-from .options import FIRMWARE_MAX_ORDER, Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial, Target
+from .options import (Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target,
+                      curve_candidates)
 from ..fitting.thermal import (CANDIDATES, LAG_EVIDENCE_CHI2, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER,
                                ThermalHysteresisModel, static_pieces)
 
@@ -87,7 +86,7 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
                   static_min_duration_s: float = 10.0, bin_width_degc: float | None = None,
                   run_folds: tuple[int, ...] | None = None, folds: str = "auto",
                   shared_lag: bool = True, do_no_harm: bool = True,
-                  curves: tuple[str, ...] = ("poly",)) -> dict[str, AxisSelection]:
+                  other_curves: tuple[tuple[str, int], ...] = ()) -> dict[str, AxisSelection]:
     """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.fitting.selection`).
 
     Parameters
@@ -110,9 +109,9 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     do_no_harm : bool
         Keep a temperature model only where it beats the run constant on the held-out folds
         (:func:`gyrocomp.fitting.scores.beats_constant`); False when the order was asked for.
-    curves : tuple of str
-        Curve families to score (:data:`gyrocomp.curves.protocol.BASES`): ``poly`` at ``orders``, the others at
-        their own sizes.
+    other_curves : tuple of (str, int)
+        Curves of other families to score beside the polynomial's ``orders``: (name in
+        :data:`gyrocomp.curves.protocol.BASES`, size) pairs (:func:`gyrocomp.models.options.curve_candidates`).
     """
     if folds not in FOLD_KINDS:
         raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
@@ -122,10 +121,10 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     problems = {}
     for k, axis in enumerate(fit_axes(recordings)):
         problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
-                               fold_kind=folds, max_order=max(orders), hysteresis_orders=hysteresis_orders,
+                               fold_kind=folds, max_order=max(orders, default=0), hysteresis_orders=hysteresis_orders,
                                both_directions="none" in memories,
                                branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
-                               curves=curves)
+                               other_curves=other_curves)
         if acceleration != "none":
             if any(r.accel_g is None for r in problem.runs):
                 raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a "
@@ -200,19 +199,18 @@ def _thermal_report(thermal: ThermalHysteresisModel, mode: str, unit: str) -> di
     return HysteresisReport(mode, thermal.selection_, axes, unit).to_dict()
 
 
-def _fit_selected(recordings: list[Recording], order: int | str, options: FitOptions, accel_mode: str):
-    """Select by held-out drift among the polynomial orders (``order``, or all for "auto") and the memories
-    ``options`` allow, then fit each axis's chosen model on all runs."""
-    top = MAX_ORDER if options.target == "model" else FIRMWARE_MAX_ORDER
-    orders = tuple(range(top + 1)) if order == "auto" else (int(order),)
+def _fit_selected(recordings: list[Recording], options: FitOptions, accel_mode: str):
+    """Select by held-out drift among the curves the temperature option offers
+    (:func:`gyrocomp.models.options.curve_candidates`) and the memories ``options`` allow, then fit each axis's
+    chosen model on all runs."""
+    offered = curve_candidates(options.temperature, options.target)
     memories = tuple(CANDIDATES) if options.hysteresis == "auto" else (options.hysteresis,)
     h_orders = (tuple(range(1, MAX_HYSTERESIS_ORDER + 1)) if options.hysteresis_order == "auto"
                 else (int(options.hysteresis_order),))
-    selections = select_models(recordings, orders=orders, memories=memories, hysteresis_orders=h_orders,
+    selections = select_models(recordings, orders=offered.orders, memories=memories, hysteresis_orders=h_orders,
                                acceleration=accel_mode, static_min_duration_s=options.static_min_duration_s,
                                bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
-                               folds=options.folds, do_no_harm=order == "auto",
-                               curves=tuple(BASES) if order == "auto" and options.target == "model" else ("poly",))
+                               folds=options.folds, do_no_harm=offered.do_no_harm, other_curves=offered.others)
     _refuse_what_cannot_be_judged(recordings, selections)
     thermal = _fit_chosen(recordings, selections, options, accel_mode)
     unseen = {axis for axis, sel in selections.items()
@@ -258,7 +256,7 @@ def _fit_chosen(recordings: list[Recording], selections: dict[str, AxisSelection
 
 @single_threaded_blas
 def fit_calibration(recordings: list[Recording] | Recording, *,
-                    temperature: Polynomial | Network | None = Polynomial(), bin_width_degc: float | None = None,
+                    temperature: Polynomial | Curve | Network | None = Polynomial(), bin_width_degc: float | None = None,
                     hysteresis: Memory = "auto", hysteresis_order: int | Literal["auto"] = "auto",
                     hysteresis_band_degc: tuple[float, float] | None = None, acceleration: Acceleration = "auto",
                     static_min_duration_s: float = 10.0, network_inputs: tuple[str, ...] = ("temperature",),
@@ -296,13 +294,13 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
     if spec is None:
         return _fit_without_temperature(recordings, options.acceleration, options.static_min_duration_s)
     # a network keeps the polynomial stage with its order chosen: it still finds lag and hysteresis for the network
-    order = spec.order if isinstance(spec, Polynomial) else "auto"
+    order = spec.order if isinstance(spec, Polynomial) else "auto"  # a Curve is chosen among what it offers
     accel_mode = options.acceleration
     if accel_mode == "auto":
         accel_mode = "matrix" if turned_between_positions(recordings, options.static_min_duration_s) else "none"
     selections, model, thermal = None, None, None
     if options.hysteresis_band_degc is None and (order == "auto" or options.hysteresis == "auto"):
-        selections, thermal = _fit_selected(recordings, order, options, accel_mode)
+        selections, thermal = _fit_selected(recordings, options, accel_mode)
     else:
         model, thermal = _fit_binned(recordings, order, options, accel_mode)
     unit = recordings[0].unit_of(fit_axes(recordings)[0])
@@ -320,7 +318,8 @@ def _fit_with(recordings: list[Recording] | Recording, options: FitOptions,
             "Levenberg-Marquardt, early stopping on 20 % held-out segments",
             {a: tuple(network.validation_rmse_[a]) for a in network.curves_},
             {a: network.epochs_[a] for a in network.curves_}, unit).to_dict()
-    name = _model_name(axes, network, network_inputs, order, thermal, accel_mode)
+    name = _model_name(axes, network, network_inputs, spec.size if isinstance(spec, Curve) else order, thermal,
+                       accel_mode)
     if options.target != "model":  # what the firmware computes: the curve held at its range's edges (it clamps)
         axes = {a: dataclasses.replace(ax, temperature=ax.temperature.clamped()) if ax.temperature is not None
                 else ax for a, ax in axes.items()}
@@ -340,12 +339,12 @@ def _accelerometer_calibration(axes: dict[str, AxisCalibration], name: str, sour
                        accel_reference_degc=reference)
 
 
-def _check_fit_inputs(recordings: list[Recording], spec: Polynomial | Network | None) -> None:
+def _check_fit_inputs(recordings: list[Recording], spec: Polynomial | Curve | Network | None) -> None:
     """Refuse what cannot be fitted; warn about what is probably not calibration data."""
     if not recordings:
         raise InputError("fit: give at least one calibration run")
     concerns = [c for rec in recordings for c in calibration_concerns(rec)]
-    if isinstance(spec, Network) or (isinstance(spec, Polynomial) and spec.order not in ("auto", 0)):
+    if isinstance(spec, (Network, Curve)) or (isinstance(spec, Polynomial) and spec.order not in ("auto", 0)):
         concerns.append(temperature_span_concern(recordings))  # a curve asked for
     for concern in filter(None, concerns):
         warnings.warn(concern.warning(), stacklevel=4)
