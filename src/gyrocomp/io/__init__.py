@@ -20,7 +20,7 @@ from ..spelling import Spelling
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
 from .common import ProgressCallback, ReadOptions
 from .project import project_read_options
-from .read_formats import READER_MODULES
+from . import read_formats  # noqa: F401  registers every reader
 from .readers import (READERS, Reader, detect_format, format_help, format_names, instances, reader_named,
                       register_reader, sniff_format, table_formats)
 from .tables import (
@@ -177,7 +177,6 @@ def _merged_options(config, layout: TableLayout | None, layout_fields: dict, oth
 
 __all__ = [
     "READERS",
-    "READER_MODULES",
     "ReadOptions",
     "Reader",
     "TableData",

@@ -1,12 +1,13 @@
 """Every input format there is: importing this module registers each reader (:mod:`gyrocomp.io.readers`), in
-this order. A new format's module is named here, once."""
+the order of the lines below. A new format is its module plus one line here."""
 
 from __future__ import annotations
 
-from . import table_formats, ulog, dataflash, rosbag, hdf5
+from . import table_formats  # noqa: F401  csv, parquet
+from . import ulog  # noqa: F401
+from . import dataflash  # noqa: F401
+from . import rosbag  # noqa: F401
+from . import hdf5  # noqa: F401
 from .readers import READERS
 
-#: the modules that register a reader
-READER_MODULES = (table_formats, ulog, dataflash, rosbag, hdf5)
-
-__all__ = ["READERS", "READER_MODULES"]
+__all__ = ["READERS"]
