@@ -13,11 +13,11 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 #: foundation is one or more folders of its own; the package root holds only the foundation's modules.
 LAYERS = (
     # pure functions and helpers any layer may use: errors, physical units, the effects' equations, spilling
-    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "ctext", "effects",
-                    "spill", "spelling", "lazy")),
+    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "c_literals", "effects",
+                    "spilled_series", "option_spelling", "lazy")),
     # what a recording is and what is measured of it: the recording and its preparation, motion (stillness,
     # static positions), measures (figures of merit, noise terms, plausibility), Allan statistics, simulation
-    ("signals", ("recording", "motion", "measures", "allan", "simulation")),
+    ("signals", ("recording", "motion", "runs", "measures", "allan", "simulation")),
     ("io", ("io",)),
     # the frozen curves a calibration holds (polynomial, network, lookup table, hysteresis) and their registry
     ("curves", ("curves",)),
@@ -133,3 +133,31 @@ def test_the_parser_sees_relative_absolute_and_inner_imports(tmp_path):
     assert _layer("measures.merit") < _layer("models.pipelines") and _layer("fitting.selection") == _layer("fitting.thermal")
     with pytest.raises(AssertionError, match="newthing: in no layer"):
         _layer("newthing")
+
+
+def test_no_two_modules_share_a_file_name():
+    """A file name says one thing: outside ``__init__.py`` and the commands (``cli/``, whose modules may carry the
+    name of what they call), no two modules have the same name."""
+    seen: dict[str, list[str]] = {}
+    for path in SRC.rglob("*.py"):
+        module = _module_name(path)
+        if path.name in ("__init__.py", "__main__.py") or module.startswith("cli."):
+            continue
+        seen.setdefault(path.name, []).append(module)
+    assert {name: mods for name, mods in seen.items() if len(mods) > 1} == {}
+
+
+def _folder(module: str) -> str:
+    return module.split(".")[0] if "." in module else ""
+
+
+def test_no_two_folders_import_each_other():
+    """The folders' graph has no two-way edge (the layers allow imports within one layer, not both ways)."""
+    edges = {(_folder(m), _folder(t)) for m, (deps, _) in GRAPH.items() for t in deps
+             if _folder(m) and _folder(t) and _folder(m) != _folder(t)}
+    assert sorted((a, b) for a, b in edges if (b, a) in edges and a < b) == []
+
+
+def test_the_folder_check_sees_a_two_way_edge():
+    assert _folder("motion.stillness") == "motion" and _folder("errors") == ""
+    assert ("runs", "motion") in {(_folder(m), _folder(t)) for m, (deps, _) in GRAPH.items() for t in deps}

@@ -1,4 +1,4 @@
-"""Options defined once (gyrocomp.spelling): the reading options are fields of ReadOptions and TableLayout, each
+"""Options defined once (gyrocomp.option_spelling): the reading options are fields of ReadOptions and TableLayout, each
 spelled once; the spelling builds the object and its parse errors name the field."""
 
 import dataclasses
@@ -7,7 +7,7 @@ import pytest
 
 from gyrocomp.errors import InputError
 from gyrocomp.io import ReadOptions, TableLayout
-from gyrocomp.spelling import Spelling, from_values, spelled, spelled_fields
+from gyrocomp.option_spelling import Spelling, from_values, spelled, spelled_fields
 
 
 def test_every_reading_field_is_spelled_once_and_flags_do_not_repeat():

@@ -10,7 +10,7 @@ import pandas as pd
 from gyrocomp.cli import COMMANDS
 from gyrocomp.cli.projectfile import ReadingOption
 from gyrocomp.io import ReadOptions
-from gyrocomp.spelling import spelled_fields
+from gyrocomp.option_spelling import spelled_fields
 
 from ..conftest import run
 

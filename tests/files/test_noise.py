@@ -20,7 +20,7 @@ from gyrocomp.models.pipelines import fit_channels
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.files import ChunkSettings, analyse_noise_file, evaluate_file
 from gyrocomp.simulation import simulate
-from gyrocomp.spill import SpillArray, block_median
+from gyrocomp.spilled_series import SpillArray, block_median
 
 from ..conftest import run
 

@@ -10,7 +10,7 @@ from gyrocomp import Calibration, Network, Polynomial, apply, fit_calibration
 from gyrocomp.errors import InputError, ModelError, NotFittedError
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.curves.network import NetworkCurve, forward, layer_shapes
-from gyrocomp.fitting.network import NetworkTemperatureModel, jacobian, nguyen_widrow, train_lm, validation_mask
+from gyrocomp.fitting.network_model import NetworkTemperatureModel, jacobian, nguyen_widrow, train_lm, validation_mask
 from gyrocomp.cli.common import parse_hidden, parse_temperature_option
 from gyrocomp.simulation import GyroErrorModel, get_profile, preset_model, simulate
 
@@ -114,7 +114,7 @@ def test_network_options_and_errors():
     for bad in ("mlp:0", "mlp:x", "mlp:2x2x2x2"):
         with pytest.raises(InputError, match=r"--temperature: .*use mlp, mlp:H \(H hidden tanh neurons, 1..50\)"):
             parse_hidden(bad)
-    with pytest.raises(InputError, match=r"--temperature: 'net': use poly .*mlp \(the thesis's 1-3-1 network\)"):
+    with pytest.raises(InputError, match=r"--temperature: 'net': use auto, poly, poly:N, .*mlp, mlp:H or none"):
         parse_temperature_option("net")
     with pytest.raises(InputError, match="mlp weights do not fit a 1-3-1 network"):
         NetworkCurve.from_dict({"type": "mlp", "hidden": [3], "weights": [[0.0] * 6, [0.0] * 3], "output_mean_dps": 0,

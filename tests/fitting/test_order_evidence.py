@@ -7,7 +7,7 @@ import pytest
 
 from gyrocomp.fitting.order_evidence import ORDER_TEST_SIGMAS, order_test
 from gyrocomp.recording import Recording
-from gyrocomp.recording.prepared import PreparedRun
+from gyrocomp.runs.prepared import PreparedRun
 
 RATE_HZ = 2.0
 N = 9600  # 80 minutes

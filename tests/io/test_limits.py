@@ -17,9 +17,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.io import limits
+from gyrocomp.io import resource_limits as limits
 from gyrocomp.io import tables as tables_module
-from gyrocomp.io.files import expand_inputs
+from gyrocomp.io.inputs import expand_inputs
 from gyrocomp.io.stream import TableStream
 from gyrocomp.io.tables import MAX_COLUMNS, read_table
 

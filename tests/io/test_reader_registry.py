@@ -7,7 +7,7 @@ import pytest
 
 from gyrocomp.errors import InputError
 from gyrocomp.io import READERS, Reader, detect_format, format_help, format_names, instances, read, register_reader
-from gyrocomp.io.files import expand_inputs
+from gyrocomp.io.inputs import expand_inputs
 from gyrocomp.io.readers import reader_named, run_suffixes, sniff_format
 from gyrocomp.recording import Recording
 

@@ -11,7 +11,7 @@ from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureR
 from gyrocomp.measures.merit import default_window_s, smoothed_residual_rms
 from gyrocomp.fitting.base import bin_by_temperature
 from gyrocomp.cli.common import parse_temperature_option
-from gyrocomp.fitting.polynomial import PolynomialTemperatureModel, simplest_within
+from gyrocomp.fitting.polynomial_model import PolynomialTemperatureModel, simplest_within
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import GyroErrorModel, simulate
 

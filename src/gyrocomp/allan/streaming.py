@@ -6,7 +6,7 @@ column about the first chunk's mean m0 as the chunks come,
 
     S[0] = 0,  S[k] = sum_{i<k} (y[i] - m0),
 
-into a :class:`gyrocomp.spill.SpillArray` (memory, or a temporary file past a limit), and :meth:`finish` turns
+into a :class:`gyrocomp.spilled_series.SpillArray` (memory, or a temporary file past a limit), and :meth:`finish` turns
 the sums into the phase of the mean-removed rate, as :func:`gyrocomp.allan.to_phase` gives it,
 
     x[k] = (S[k] - k (mean - m0)) / rate_hz  [unit*s],  mean - m0 = S[N] / N,
@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..spill import DEFAULT_MEMORY_BYTES, SpillArray
+from ..spilled_series import DEFAULT_MEMORY_BYTES, SpillArray
 
 _BLOCK = 1 << 20
 

@@ -16,7 +16,7 @@ For the gyro, K(T) may depend on temperature: each element is a polynomial in (T
 (coefficients in ``sensitivity_per_degc``), as rate-table calibrations at several temperatures give.
 Without a rate table, rotations between still poses (``method="rotation"``) give the gyro's K relative
 to the accelerometer's corrected frame: gravity, measured before and after each turn, is the reference.
-These classes are data only; the fitters live in :mod:`gyrocomp.fitting.triad`.
+These classes are data only; the fitters live in :mod:`gyrocomp.fitting.triad_fit`.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from ..allan import KINDS
-from ..files.noise import analyse_noise_file
+from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..report.figures import allan_figure, check_figure_path

@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 
 from ..errors import InputError
-from ..spelling import Spelling, from_values, spelled_fields
+from ..option_spelling import Spelling, from_values, spelled_fields
 from .projectfile import ReadingOption
 from ..io import ReadOptions, format_spelling, read_input
 from ..io.atomic import check_output_file
@@ -21,7 +21,7 @@ from ..curves.network import DEFAULT_HIDDEN
 from ..curves.kinds import BASES
 from ..models.options import MAX_CURVE_SIZE, Curve, Network, Polynomial, family_help
 from ..models.pipelines import check_channels
-from ..recording.prepared import CHANNELS
+from ..runs.prepared import CHANNELS
 from ..curves.polynomial import MAX_ORDER
 
 
@@ -54,7 +54,7 @@ def _parsed(parse):
 
 
 def click_option(name: str, spelling: Spelling, default=None):
-    """The click option of a typed field (:mod:`gyrocomp.spelling`): its flag, help and metavar, the field's name
+    """The click option of a typed field (:mod:`gyrocomp.option_spelling`): its flag, help and metavar, the field's name
     as the parameter's, its value parsed as the spelling says; a field's text default (a unit) is the option's
     and shown in the help, any other default (None, an empty mapping) applies when the option is not given."""
     if spelling.switch:

@@ -10,7 +10,7 @@ import click
 from ..errors import InputError
 from ..io import instances, refuse_to_overwrite_inputs
 from ..io.atomic import write_texts_atomic
-from ..io.files import expand_runs
+from ..io.inputs import expand_runs
 from ..io.schedule import apply_schedule, read_rate_schedule
 from ..fitting.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings

@@ -10,7 +10,7 @@ import click
 from ..errors import InputError, NotFittedError
 from ..io import refuse_to_overwrite_inputs
 from ..io.atomic import folder_lock, write_texts_atomic
-from ..io.files import expand_runs
+from ..io.inputs import expand_runs
 from ..fitting.online import GYRO_AXES, LearnerSettings, OnlineCalibrator, replay
 from .common import FINITE, OUTPUT_FILE, pop_read_options, read_options, read_run
 from .render import print_learner

@@ -18,7 +18,7 @@ from pathlib import Path
 import click
 
 from ..errors import InputError
-from ..spelling import mapping_text
+from ..option_spelling import mapping_text
 
 PROJECT_FILE = "gyrocomp.toml"
 #: where the command group keeps the loaded project for the commands (click's shared ``Context.meta``)

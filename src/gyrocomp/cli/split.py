@@ -8,7 +8,7 @@ import click
 
 from ..errors import InputError
 from ..io import refuse_to_overwrite_inputs, write_rows
-from ..recording.runsplit import SPLITS, split_runs
+from ..runs.runsplit import SPLITS, split_runs
 from .common import FINITE, pop_read_options, read_options, read_run
 
 

@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..ctext import c_array, c_number
+from ..c_literals import c_array, c_number
 from ..errors import InputError
 from .protocol import CCode, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, register_basis, register_curve
 

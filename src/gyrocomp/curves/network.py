@@ -1,7 +1,7 @@
 """The network temperature curve of an axis's bias (thesis section 2.5.3), as a calibration holds it: a small
 multilayer perceptron (inputs scaled to [-1, 1] as MATLAB's ``mapminmax``, tanh hidden layers, a linear output
 standardized), evaluated with numpy. Training it (Levenberg-Marquardt, as MATLAB's ``trainlm``) is
-:mod:`gyrocomp.fitting.network`'s.
+:mod:`gyrocomp.fitting.network_model`'s.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..ctext import c_array, c_number
+from ..c_literals import c_array, c_number
 from ..errors import InputError
 from .protocol import CCode, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, register_curve
 

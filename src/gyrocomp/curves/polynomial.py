@@ -3,7 +3,7 @@
     b_r(T) = c_r + sum_{k=1}^{p} a_k u^k,    u = (clip(T, T_min, T_max) - T_ref) / T_scale
 
 with one turn-on constant c_r per run (each power-on has its own) and the shape a_1..a_p shared by all runs
-(:class:`PolynomialCurve` holds the shape). Fitting it is :mod:`gyrocomp.fitting.polynomial`'s.
+(:class:`PolynomialCurve` holds the shape). Fitting it is :mod:`gyrocomp.fitting.polynomial_model`'s.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..ctext import c_array, c_number
+from ..c_literals import c_array, c_number
 from ..errors import InputError
 from .protocol import CCode, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, register_basis, register_curve
 

@@ -18,7 +18,7 @@ from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, InputError
 from ..measures.merit import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_run
 from ..fitting.pose_rotation import rotation_errors
-from ..fitting.triad import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
+from ..fitting.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
 from ..recording import GYRO_AXES, Recording
 from ..calibration.triad import TriadCalibration
 from ..calibration.installed import installed_calibration, installed_correction_dps, px4_slot

@@ -24,7 +24,7 @@ from ..models.options import FitOptions, Network, Polynomial
 from ..models.pipelines import fit_pipeline
 from ..curves.polynomial import PolynomialCurve
 from ..measures.plausibility import require_temperature_span
-from ..recording.prepared import prepare
+from ..runs.prepared import prepare
 from ..threads import single_threaded_blas
 from ..recording import Recording
 

@@ -34,7 +34,7 @@ from ..fitting.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MIN_S,
 from ..fitting.scores import fold_mean, fold_standard_error
 from ..curves.polynomial import PolynomialCurve
 from ..measures.plausibility import require_temperature_span
-from ..recording.prepared import prepare
+from ..runs.prepared import prepare
 from ..threads import single_threaded_blas
 from ..recording import Recording
 from .comparison import Method, fit_ardupilot_style, fit_method, fit_px4_style

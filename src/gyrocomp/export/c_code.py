@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..ctext import c_array, c_number
+from ..c_literals import c_array, c_number
 from ..errors import InputError
 from ..io.atomic import write_texts_atomic
 from .encode import c_comment

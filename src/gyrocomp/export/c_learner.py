@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from importlib.resources import files
 
-from ..ctext import c_number
+from ..c_literals import c_number
 from ..fitting.online import (GAP_PERIODS, LEVEL_GROWTH, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G,
                              PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC,
                              LearnerSettings)

@@ -13,7 +13,7 @@ from ..lazy import lazy_exports
 _EXPORTS = {name: (module, name) for module, names in (
     ("apply", ("FileResult", "apply_file")), ("chunks", ("ChunkSettings", "reads_in_chunks")),
     ("convert", ("ConvertResult", "convert_file")), ("evaluate", ("evaluate_file",)),
-    ("noise", ("analyse_noise_file",))) for name in names}
+    ("noise_file", ("analyse_noise_file",))) for name in names}
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 

@@ -20,7 +20,7 @@ from ..io import ReadOptions, TableData, detect_format, read_input, table_format
 from ..io.common import ProgressCallback
 from ..io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from ..recording import GAP_FACTOR, nominal_rate_hz
-from ..spill import DEFAULT_MEMORY_BYTES, SpillArray, block_median
+from ..spilled_series import DEFAULT_MEMORY_BYTES, SpillArray, block_median
 
 T = TypeVar("T")
 

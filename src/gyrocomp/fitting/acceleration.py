@@ -19,11 +19,11 @@ from ..calibration import AxisCalibration, Calibration
 from ..errors import InputError
 from ..calibration.fit_report import GSensitivityReport, GSensitivityRow
 from ..recording import Recording
-from ..recording.prepared import PreparedRun
+from ..runs.prepared import PreparedRun
 from .base import provenance
 from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, turned_between_positions
 from ..curves.network import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S
-from .network import NetworkTemperatureModel
+from .network_model import NetworkTemperatureModel
 from .thermal import ThermalHysteresisModel
 
 def _listed(values: np.ndarray) -> tuple:

@@ -1,5 +1,5 @@
 """Helpers every model shares: temperature binning, the per-run turn-on constants, provenance (block means:
-:mod:`gyrocomp.recording.prepared`)."""
+:mod:`gyrocomp.runs.prepared`)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError, NotFittedError
 from ..io import file_sha256
-from ..recording.prepared import fit_axes
+from ..runs.prepared import fit_axes
 from ..recording import Recording
 
 

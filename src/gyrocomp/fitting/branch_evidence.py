@@ -2,7 +2,7 @@
 whether turning-point terms can be told apart from the polynomial, and the band where the branches part.
 
 These decide which memory candidates :mod:`gyrocomp.fitting.selection` offers; they read the block means of the runs
-(:class:`gyrocomp.recording.prepared.RunBlocks`) and nothing of the candidates.
+(:class:`gyrocomp.runs.prepared.RunBlocks`) and nothing of the candidates.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 
 from ..effects import branch_position, find_turns, thermal_lag
 from ..calibration.fit_report import BranchTest
-from ..recording.prepared import RunBlocks
+from ..runs.prepared import RunBlocks
 from .drift_gls import chi2_threshold, fit_drift_noise, wald_statistic
 from .order_evidence import CoarseRuns, run_constants
 from ..curves.hysteresis import parting_band_degc

@@ -10,7 +10,7 @@ from typing import Literal
 import numpy as np
 
 from ..effects import find_turns
-from ..recording.prepared import RunBlocks
+from ..runs.prepared import RunBlocks
 
 FoldKind = Literal["runs", "legs", "blocks"]
 FOLD_KINDS = ("auto", "runs", "legs", "blocks")

@@ -11,7 +11,7 @@ import numpy as np
 from ..effects import G_SQUARED_TERMS
 from ..errors import DataQualityWarning
 from ..recording import ACCEL_AXES, Recording
-from ..recording.prepared import PreparedRun
+from ..runs.prepared import PreparedRun
 from ..motion.positions import orientations
 
 ACCELERATION_CHOICES = ("none", "matrix", "matrix2")

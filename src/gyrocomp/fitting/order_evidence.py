@@ -35,7 +35,7 @@ import numpy as np
 from ..calibration.fit_report import OrderTest
 from ..curves.polynomial import power_columns
 from ..effects import thermal_lag
-from ..recording.prepared import RunBlocks
+from ..runs.prepared import RunBlocks
 from .drift_gls import MAX_POINTS, chi2_threshold, coarsen, fit_drift_noise, wald_statistic
 
 #: how many standard deviations (of a normal law, two-sided) an order's top term must stand out by

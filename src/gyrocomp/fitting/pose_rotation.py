@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
 from ..calibration.triad import TriadCalibration, rows_of
-from .triad import MIN_TRIAD_SPAN_DEGC, ORDER_TOLERANCE, Pose, find_poses, fit_accel_multiposition
+from .triad_fit import MIN_TRIAD_SPAN_DEGC, ORDER_TOLERANCE, Pose, find_poses, fit_accel_multiposition
 
 #: every axis must be turned at least this far [deg] in some move, about an axis other than gravity
 MIN_TURN_DEG = 20.0

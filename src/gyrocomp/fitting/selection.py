@@ -47,7 +47,7 @@ import numpy as np
 from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
 from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..measures.merit import moving_average
-from ..recording.prepared import PreparedRun, RunBlocks
+from ..runs.prepared import PreparedRun, RunBlocks
 from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
 from .folds import FoldKind, Folds, make_folds, window_for

@@ -35,10 +35,10 @@ from ..errors import DataQualityWarning, InputError, ModelError
 from ..calibration.fit_report import memory_name
 from ..recording import Recording
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
-from ..recording.prepared import PreparedRun, RunBlocks, fit_axes
+from ..runs.prepared import PreparedRun, RunBlocks, fit_axes
 from .base import LearnedAttributes, bin_width_for, one_temperature_column
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
-from .polynomial import simplest_within
+from .polynomial_model import simplest_within
 from ..curves.protocol import BASES
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")

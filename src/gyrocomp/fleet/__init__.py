@@ -2,7 +2,7 @@
 and compared with their population.
 
 - :mod:`~gyrocomp.fleet.devices`: which runs belong to which unit (a path pattern or a manifest), input hashes;
-- :mod:`~gyrocomp.fleet.figures`: a unit's figures of merit;
+- :mod:`~gyrocomp.fleet.unit_figures`: a unit's figures of merit;
 - :mod:`~gyrocomp.fleet.limits`: pass/fail limits (TOML) and verdicts;
 - :mod:`~gyrocomp.fleet.store`: the calibration store (SQLite or any SQLAlchemy database), with history;
 - :mod:`~gyrocomp.fleet.run`: the fleet fit itself (Dask local cluster, a running cluster, or serial);
@@ -12,7 +12,7 @@ and compared with their population.
 Needs the ``fleet`` extra (``pip install 'gyrocomp[fleet]'``: dask[distributed], SQLAlchemy).
 """
 
-from .figures import FIGURE_NAMES, REFERENCE_TEMPERATURE_DEGC, AxisFigures, UnitFigures, unit_figures
+from .unit_figures import FIGURE_NAMES, REFERENCE_TEMPERATURE_DEGC, AxisFigures, UnitFigures, unit_figures
 from .limits import Failure, Limit, Limits, Verdict
 from .population import FleetYield, fleet_table, fleet_yield, robust_z
 from .prior import (AxisPrior, PopulationPrior, block_covariance, comes_back, fit_with_prior, population_prior,

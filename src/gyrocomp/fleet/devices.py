@@ -21,7 +21,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..errors import DataQualityWarning, InputError
-from ..io.files import expand_inputs
+from ..io.inputs import expand_inputs
 from ..io.tables import detect_table_format, file_sha256
 
 _FIELD = re.compile(r"\{(\w+)\}")

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
-from .figures import FIGURE_NAMES, UnitFigures
+from .unit_figures import FIGURE_NAMES, UnitFigures
 
 UNIT_FIGURES = ("runs", "temperature_min_degc", "temperature_max_degc")
 BOUNDS = ("min", "max", "abs_max")

@@ -81,7 +81,7 @@ def fleet_table(records: Sequence[CalibrationRecord], limits: Limits | None = No
     """One row per unit: ``serial``, ``status`` (ok/failed), ``verdict`` (pass/fail by ``limits``, or the verdict
     stored with the calibration when no limits are given; empty for a failed fit), ``failing`` (the failing figures),
     ``calibrated_utc``, ``error``, ``outlier_score``, ``outlier``, ``outlier_figures`` and every figure
-    (``gyro_x_noise_density_dps_per_sqrt_hz``, ...; see :mod:`gyrocomp.fleet.figures`)."""
+    (``gyro_x_noise_density_dps_per_sqrt_hz``, ...; see :mod:`gyrocomp.fleet.unit_figures`)."""
     rows = []
     for r in records:
         verdict = limits.check(r.figures) if (limits is not None and r.figures is not None) else None

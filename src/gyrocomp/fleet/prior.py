@@ -62,7 +62,7 @@ from ..fitting.base import provenance
 from ..curves.polynomial import PolynomialCurve
 from ..recording import Recording
 from ..units import DEG_PER_S_TO_DEG_PER_H
-from .figures import REFERENCE_TEMPERATURE_DEGC
+from .unit_figures import REFERENCE_TEMPERATURE_DEGC
 from .population import OUTLIER_THRESHOLD, fleet_table
 from .store import CalibrationRecord
 

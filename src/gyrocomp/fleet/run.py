@@ -39,9 +39,9 @@ from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
 from ..models.fit import fit
 from ..models.pipelines import Pipeline, check_channels
-from ..recording.prepared import Channel
+from ..runs.prepared import Channel
 from ..threads import single_threaded_blas
-from .figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
+from .unit_figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
 from .limits import Limits
 from .population import fleet_table
 from .prior import PopulationPrior, fit_with_prior

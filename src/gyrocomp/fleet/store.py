@@ -27,7 +27,7 @@ from ..errors import InputError, ModelError
 from ..io.atomic import refuse_link
 from ..io.common import require
 from ..jsontext import loads
-from .figures import UnitFigures
+from .unit_figures import UnitFigures
 from .limits import Failure
 
 sa = require("sqlalchemy", "fleet", "the calibration store")

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..spelling import Spelling
+from ..option_spelling import Spelling
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
 from .common import ProgressCallback, ReadOptions
 from .project import project_read_options

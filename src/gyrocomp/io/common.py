@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import DataQualityWarning, InputError, MissingDependencyError, install_hint, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
-from ..spelling import Spelling, spelled
+from ..option_spelling import Spelling, spelled
 from .tables import TableLayout, keep_finite_rows
 
 #: ``progress(fraction_done)``, fraction in [0, 1]; readers call it now and then on long files
@@ -60,7 +60,7 @@ def parse_time_range(text: str) -> tuple[float | None, float | None]:
 @dataclass(frozen=True)
 class ReadOptions:
     """What to read from a file, beyond its format. Each field is an option of every command that reads data,
-    spelled on the command line as its metadata says (:mod:`gyrocomp.spelling`).
+    spelled on the command line as its metadata says (:mod:`gyrocomp.option_spelling`).
 
     Parameters
     ----------

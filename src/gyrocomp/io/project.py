@@ -17,7 +17,7 @@ import tomllib
 from pathlib import Path
 
 from ..errors import InputError
-from ..spelling import mapping_text, spelled_fields
+from ..option_spelling import mapping_text, spelled_fields
 from .common import ReadOptions
 from .tables import TableLayout
 

@@ -16,11 +16,11 @@ import pyarrow.parquet as pq
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
-from ..spelling import Spelling, spelled
+from ..option_spelling import Spelling, spelled
 from ..units import unit_factor
 from .digest import file_sha256
 from .atomic import arrow_source, atomic_path, require_unchanged
-from .limits import PARQUET_MEMORY_FACTOR, address_space_left, estimated_table_bytes, require_memory
+from .resource_limits import PARQUET_MEMORY_FACTOR, address_space_left, estimated_table_bytes, require_memory
 from .serial import check_rate, looks_headerless, parse_names, parse_rate, read_headerless
 
 TIME_COLUMN = "time"

@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
 from ..effects import moving_average
 from ..recording import Recording
-from ..recording.prepared import PreparedRun
+from ..runs.prepared import PreparedRun
 from ..units import STANDARD_GRAVITY_M_PER_S2
 
 #: beyond any MEMS gyro's measurement range [deg/s]
@@ -49,7 +49,7 @@ TEMPERATURE_RANGE_DEGC = (-100.0, 200.0)
 #: a calibration run that varies less than this in temperature cannot identify a temperature curve [degC]
 MIN_TEMPERATURE_SPAN_DEGC = 1.0
 #: still poses of a hand-turned multi-position session: 1 s still, judged on 0.5 s windows, up to 10 times the
-#: median variance (as gyrocomp.fitting.triad.find_poses finds them)
+#: median variance (as gyrocomp.fitting.triad_fit.find_poses finds them)
 POSE_WINDOW_S, POSE_MIN_S, POSE_FACTOR = 0.5, 1.0, 10.0
 #: plausible sample rates of a logged IMU [Hz] (the fastest MEMS output data rates are 32 kHz)
 RATE_RANGE_HZ = (1e-3, 4e4)

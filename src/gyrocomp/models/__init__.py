@@ -10,6 +10,6 @@ The curves a calibration holds are in :mod:`gyrocomp.curves`, their estimators i
 """
 
 from ..curves.polynomial import PolynomialCurve
-from ..fitting.polynomial import PolynomialTemperatureModel
+from ..fitting.polynomial_model import PolynomialTemperatureModel
 
 __all__ = ["PolynomialCurve", "PolynomialTemperatureModel"]

@@ -10,7 +10,7 @@ The other entry points are thin wrappers kept for the calls written against them
 from __future__ import annotations
 
 from ..calibration import Calibration
-from ..recording.prepared import Channel
+from ..runs.prepared import Channel
 from ..recording import Recording
 from .options import FitOptions
 from .pipelines import Pipeline, ScaleFactor, fit_channels

@@ -15,7 +15,7 @@ from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..calibration.fit_report import THIN_FOLDS, AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..measures.plausibility import calibration_concerns, temperature_span_concern
-from ..recording.prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
+from ..runs.prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..motion.positions import orientations
 from ..fitting.acceleration import (
@@ -28,11 +28,11 @@ from ..fitting.acceleration import (
 from ..fitting.base import bin_width_for, one_temperature_column, provenance
 from ..curves.hysteresis import heats_and_cools
 from ..curves.network import NETWORK_BLOCK_S, NETWORK_INPUTS
-from ..fitting.network import NetworkTemperatureModel
+from ..fitting.network_model import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
 from ..fitting.selection import AxisSelection, prepare_axis
-from ..fitting.polynomial import PolynomialTemperatureModel
+from ..fitting.polynomial_model import PolynomialTemperatureModel
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, _accel_triad, _gyro_triad, _spanning_poses  # noqa: F401
 from .options import (Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target,
                       curve_candidates)

@@ -14,7 +14,7 @@ from ..calibration import Calibration
 from ..calibration.triad import TriadCalibration
 from ..errors import DataQualityWarning, InputError
 from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
-from ..fitting.triad import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
+from ..fitting.triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
                              fit_accel_multiposition, fit_gyro_rate_table, spans_axes)
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 

@@ -78,9 +78,9 @@ from .calibrator import OnlineCalibrator
 from .replay import RATE_TOLERANCE, replay
 from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, MIN_OUTLIER_DOF,
                        MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G, PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES,
-                       T_REF_DEGC, T_SCALE_DEGC, LearnerSettings, LearnerStatus, LogContribution, chi2_quantile)
+                       T_REF_DEGC, T_SCALE_DEGC, LearnerSettings, LearnerStatus, ReplayedLog, chi2_quantile)
 
 __all__ = ["GAP_PERIODS", "GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LEVEL_GROWTH", "MIN_OUTLIER_DOF",
            "MIN_SESSION_POINTS", "MIN_STEPS", "MIN_TILT_G", "PIECE_SPREAD_WEIGHT", "POINTS_PER_TILT", "POOL_PIECES",
-           "RATE_TOLERANCE", "T_REF_DEGC", "T_SCALE_DEGC", "LearnerSettings", "LearnerStatus", "LogContribution",
+           "RATE_TOLERANCE", "T_REF_DEGC", "T_SCALE_DEGC", "LearnerSettings", "LearnerStatus", "ReplayedLog",
            "OnlineCalibrator", "block_statistics", "chi2_quantile", "replay"]

@@ -23,7 +23,7 @@ from ..base import provenance
 from ...curves.polynomial import PolynomialCurve
 from .state import _record_to_dict, _restore, check_state_target
 from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, LINEAGE_KEPT,
-                       LearnerSettings, LearnerStatus, LogContribution, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
+                       LearnerSettings, LearnerStatus, ReplayedLog, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
                        PIECE_SPREAD_WEIGHT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC, _MAD_TO_SIGMA, chi2_quantile)
 from .refit import _curve, _design, _forward, _matrix, _tilted, _weighted_fit
 from .blocks import _fresh_dequantizer, _quantile, block_statistics
@@ -659,7 +659,7 @@ class OnlineCalibrator:
         return tuple(float(r * math.sqrt(leverage.max())) for r in self._rms)
 
     def to_calibration(self, *, model: str = "online", require_curve: bool = True,
-                       axes: Iterable[str] = GYRO_AXES, contributions: Iterable[LogContribution] = ()
+                       axes: Iterable[str] = GYRO_AXES, contributions: Iterable[ReplayedLog] = ()
                        ) -> Calibration:
         """The learned model as a model file's :class:`Calibration` (the curve continued along its tangent past
         the range seen, its lag, the g-sensitivity, the sessions' constants as turn-on biases); ``gyrocomp apply``

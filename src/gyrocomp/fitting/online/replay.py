@@ -8,7 +8,7 @@ import numpy as np
 
 from ...errors import InputError
 from ...recording import Recording
-from .settings import GYRO_AXES, LogContribution
+from .settings import GYRO_AXES, ReplayedLog
 from .calibrator import OnlineCalibrator
 
 #: a log whose sample rate differs from the learner's by more than this fraction is refused
@@ -16,7 +16,7 @@ RATE_TOLERANCE = 0.1
 
 
 def replay(learner: OnlineCalibrator, recordings: Iterable[Recording], *, chunk_samples: int = 65536
-           ) -> list[LogContribution]:
+           ) -> list[ReplayedLog]:
     """Feed ``recordings`` to ``learner``, each one power-on (a session), in chunks of ``chunk_samples`` (any
     chunking gives the same model); what each gave. Raises :class:`InputError` for a log without temperature,
     without gyro_x, gyro_y and gyro_z, or at a rate the learner was not set up for."""
@@ -43,7 +43,7 @@ def replay(learner: OnlineCalibrator, recordings: Iterable[Recording], *, chunk_
                            temperature[part])
         learner.end_session()
         after = learner.status
-        out.append(LogContribution(
+        out.append(ReplayedLog(
             rec.source, tuple(a for a in GYRO_AXES if a in rec.gyro_axes), rec.duration_s,
             after.still_s - before.still_s,
             after.rejected_bound + after.rejected_outliers - before.rejected_bound - before.rejected_outliers,

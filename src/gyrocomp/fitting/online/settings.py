@@ -183,7 +183,7 @@ class LearnerStatus:
 
 
 @dataclass(frozen=True)
-class LogContribution:
+class ReplayedLog:
     """What one replayed log gave the learner: its gyro axes, its length [s], the still time accepted [s], the
     pieces rejected (beyond the bound or as outliers) and the temperature range of the log [degC]."""
 
@@ -196,4 +196,4 @@ class LogContribution:
     temperature_max_degc: float
 
 
-__all__ = ["GAP_PERIODS", "GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LEVEL_GROWTH", "LearnerSettings", "LearnerStatus", "LogContribution", "MIN_OUTLIER_DOF", "MIN_SESSION_POINTS", "MIN_STEPS", "MIN_TILT_G", "PIECE_SPREAD_WEIGHT", "POINTS_PER_TILT", "POOL_PIECES", "T_REF_DEGC", "T_SCALE_DEGC", "chi2_quantile"]
+__all__ = ["GAP_PERIODS", "GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LEVEL_GROWTH", "LearnerSettings", "LearnerStatus", "ReplayedLog", "MIN_OUTLIER_DOF", "MIN_SESSION_POINTS", "MIN_STEPS", "MIN_TILT_G", "PIECE_SPREAD_WEIGHT", "POINTS_PER_TILT", "POOL_PIECES", "T_REF_DEGC", "T_SCALE_DEGC", "chi2_quantile"]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, ModelError
-from ..recording.prepared import fit_axes
+from ..runs.prepared import fit_axes
 from ..recording import Recording
 from .base import LearnedAttributes, TemperatureBins, bin_by_temperature, bin_width_for
 from ..curves.polynomial import MAX_ORDER, PolynomialCurve, power_columns

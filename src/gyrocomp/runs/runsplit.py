@@ -23,7 +23,7 @@ import numpy as np
 
 from ..effects import find_turns
 from ..errors import InputError
-from . import Recording
+from ..recording import Recording
 from ..motion.stillness import detect_still
 
 SplitBy = Literal["power-on", "gap", "still", "temperature-turn"]

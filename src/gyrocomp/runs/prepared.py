@@ -28,7 +28,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from ..errors import InputError
-from . import ACCEL_AXES, Recording
+from ..recording import ACCEL_AXES, Recording
 from ..motion.positions import (DEFAULT_FACTOR, DEFAULT_MIN_DURATION_S, DEFAULT_WINDOW_S, StaticSegment, segments_from_mask,
                      still_mask)
 

@@ -25,7 +25,7 @@ from .errors import InputError
 T = TypeVar("T")
 
 #: the key of a field's metadata that holds its spelling
-SPELLING_KEY = "gyrocomp.spelling"
+SPELLING_KEY = "gyrocomp.option_spelling"
 
 
 @dataclass(frozen=True)

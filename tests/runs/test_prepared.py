@@ -7,10 +7,10 @@ import warnings
 import numpy as np
 import pytest
 
-import gyrocomp.recording.prepared as prepared_module
+import gyrocomp.runs.prepared as prepared_module
 from gyrocomp.errors import InputError
 from gyrocomp.models.pipelines import fit_channels
-from gyrocomp.recording.prepared import PreparedRun, block_means, fit_axes, prepare
+from gyrocomp.runs.prepared import PreparedRun, block_means, fit_axes, prepare
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import simulate
 from gyrocomp.motion.positions import static_segments, still_mask

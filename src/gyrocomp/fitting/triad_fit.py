@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
-from ..recording.prepared import PreparedRun
+from ..runs.prepared import PreparedRun
 from ..calibration.triad import TriadCalibration, rows_of
 
 PoseMethod = Literal["auto", "norm", "six-position"]

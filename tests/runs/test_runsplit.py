@@ -1,4 +1,4 @@
-"""Cutting a recording into runs (gyrocomp.recording.runsplit, gyrocomp split), selecting by time (--time) and reading a
+"""Cutting a recording into runs (gyrocomp.runs.runsplit, gyrocomp split), selecting by time (--time) and reading a
 column of an HDF5 array (NAME[:, k]): on simulated recordings whose pieces are known."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 from gyrocomp import read
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout
-from gyrocomp.recording.runsplit import split_runs
+from gyrocomp.runs.runsplit import split_runs
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import joined_recordings, run
