@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test quick docs bench clean
+.PHONY: demo test quick lint docs bench clean
 
 DEMO_STAMP := $(VENV)/.installed-demo
 
@@ -33,6 +33,10 @@ test: $(STAMP)
 # the quick loop: the same without the tests marked slow (about 5 s or more each, or a slow fixture)
 quick: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m "not slow"
+
+# the linter (ruff: pyflakes, pycodestyle, bugbear; pyproject.toml's [tool.ruff])
+lint: $(STAMP)
+	$(BIN)/ruff check src tests benchmarks tools
 
 # the documentation site (MkDocs, Material, mkdocstrings) into site/, warnings as errors
 docs: $(STAMP)

@@ -188,7 +188,7 @@ def real_still_lines() -> list[str]:
     for amplitude in sorted({t["amplitude_dps"] for t in trials}):
         group = [t for t in trials if t["amplitude_dps"] == amplitude]
         memory = sum(bool(t["chosen"].branch or t["chosen"].hysteresis_order) for t in group)
-        ratio = lambda key: np.mean([t[key] / t["perfect"] for t in group])  # noqa: E731
+        ratio = lambda key, group=group: np.mean([t[key] / t["perfect"] for t in group])  # noqa: E731
         worse = sum(t["default"] > 1.01 * t["raw"] for t in group)
         lines.append(f"| effect {amplitude:g} deg/s | {len(group)} | {memory} | {sum(t['chosen'].lag for t in group)} "
                      f"| {ratio('default'):.2f} | {ratio('cubic'):.2f} | {worse} |")
@@ -224,9 +224,9 @@ def main() -> None:
              "|---|---|---|---|---|---|"]
     parts = {name: (preset_model(name), get_preset(name).set_points_degc) for name in PRESETS} | TEST_PARTS
     for name, (model, span) in parts.items():
-        protocols = {"one cycle": lambda s: one_cycle(model, s),
-                     "two cycles": lambda s: cycles(model, s, span, 2),
-                     "three runs": lambda s: cycles(model, s, span, 3)}
+        protocols = {"one cycle": lambda s, model=model: one_cycle(model, s),
+                     "two cycles": lambda s, model=model, span=span: cycles(model, s, span, 2),
+                     "three runs": lambda s, model=model, span=span: cycles(model, s, span, 3)}
         for protocol, run in protocols.items():
             if args.only and protocol != args.only:
                 continue

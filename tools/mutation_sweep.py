@@ -419,7 +419,7 @@ def hostile_hdf5(work: Path) -> collections.Counter:
         "virtual dataset": lambda fh: fh.create_virtual_dataset(
             "gyro_z", _virtual_layout(h5py, other)),
     }
-    for k, (kind, make) in enumerate(makers.items()):
+    for k, (_kind, make) in enumerate(makers.items()):
         path = work / f"pointing{k}.h5"
         with h5py.File(path, "w") as fh:
             fh["time"] = np.arange(8.0)

@@ -217,11 +217,11 @@ def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other()
     assert gyro.unit == "deg/s" and gyro.turn_on_biases_dps == (0.1, 0.3) and gyro.mean_turn_on_bias_dps == 0.2
     assert accel.turn_on_biases_g == accel.turn_on_biases == (0.02, 0.04) and accel.mean_turn_on_bias == pytest.approx(0.03)
     with pytest.raises(InputError, match=r"turn_on_biases_dps: the axis's values are in g, not deg/s"):
-        accel.turn_on_biases_dps
+        _ = accel.turn_on_biases_dps
     with pytest.raises(InputError, match=r"mean_turn_on_bias_dps: the axis's values are in g, not deg/s"):
-        accel.mean_turn_on_bias_dps
+        _ = accel.mean_turn_on_bias_dps
     with pytest.raises(InputError, match=r"turn_on_biases_g: the axis's values are in deg/s, not g"):
-        gyro.turn_on_biases_g
+        _ = gyro.turn_on_biases_g
     with pytest.raises(InputError, match=r"unit: 'm/s\^2'; an axis is in one of deg/s, g"):
         AxisCalibration(curve, (0.0,), unit="m/s^2")
     with pytest.raises(InputError, match=r"accel_axes\['accel_x'\]\.unit: 'deg/s'; the axes of accel_axes are in g"):

@@ -4,7 +4,6 @@ builder makes, model files of every kind gyrocomp writes validate against it wit
 validate, and apply as their schema-6 copy does; every declared field is used or refused (units, temperature
 column); a damaged fit report is refused on load, so that show never meets it."""
 
-import copy
 import json
 import warnings
 from importlib import resources
@@ -148,7 +147,7 @@ def test_an_edited_schema_version_is_refused_not_upgraded_into_other_numbers(mod
     """A file of the current schema whose schema_version was set back: the upgrades would put a lag of 0 and no
     hysteresis over the file's own (before: applied with other numbers, without a word)."""
     for version, field in ((1, "lag_time_constant_s"), (2, "g_sensitivity_dps_per_g"), (5, "gyro_triad")):
-        message = _refusal(models["default"], lambda d: d.__setitem__("schema_version", version))
+        message = _refusal(models["default"], lambda d, version=version: d.__setitem__("schema_version", version))
         assert message.startswith(f"m.json: schema_version {version}: the file holds ")
         assert field in message and "changed by hand?" in message
 

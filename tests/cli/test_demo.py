@@ -49,7 +49,7 @@ def test_demo(tmp_path):
     # what the sensor's noise alone gives (within the scatter of a few independent averages)
     allan = json.loads((tmp_path / "demo" / "allan.json").read_text())
     assert "Allan deviation of the held-out run" in r.stdout
-    for axis, c in allan.items():
+    for c in allan.values():
         raw, comp, noise = (np.array(c[k]) for k in ("raw_deg_per_h", "compensated_deg_per_h", "noise_alone_deg_per_h"))
         assert c["tau_s"][-1] >= 2000 and raw[-1] > 2.0 * noise[-1] and raw[-1] > 1.5 * comp[-1]
         assert comp[-1] < 1.5 * noise[-1]

@@ -140,7 +140,7 @@ def test_rank_deficient_positions_warn_and_leave_the_columns_unfitted():
     runs = [simulate("consumer", profile=prof, rate_hz=2, seed=s).recording for s in range(2)]
     with pytest.warns(DataQualityWarning, match=r"the positions do not excite accel_z \(\d[.\de-]* g\): within-run spread below 0.1 g; .*not fitted"):
         cal = fit_calibration(runs, acceleration="matrix")
-    for axis, info in cal.fit_report["acceleration"]["axes"].items():
+    for _axis, info in cal.fit_report["acceleration"]["axes"].items():
         assert info["g_sensitivity_dps_per_g"][2] == 0.0 and info["standard_error_dps_per_g"][2] is None
         assert info["standard_error_dps_per_g"][0] is not None
     assert cal.fit_report["acceleration"]["excited_axes"] == ["accel_x", "accel_y"]

@@ -122,7 +122,7 @@ def test_network_options_and_errors():
     model = NetworkTemperatureModel()
     with pytest.raises(NotFittedError, match=r"NetworkTemperatureModel is not fitted yet; call fit_blocks\(axis, ...\) "
                                              r"first \(curves_ is learned by the fit\)"):
-        model.curves_
+        _ = model.curves_
     assert not hasattr(model, "epochs_")  # hasattr reads a NotFittedError as absent
     flat = [np.full(100, 25.0)]
     with pytest.raises(ModelError, match="gyro_z: the temperature does not vary"):

@@ -4,7 +4,8 @@ from gyrocomp.calibration.fit_report import Candidate
 from gyrocomp.fitting.scores import CandidateScore, beats_constant, choose
 
 
-def _score(folds, c=Candidate(2)):
+def _score(folds, c=None):
+    c = Candidate(2) if c is None else c
     return CandidateScore(c, tuple(folds), tuple(0.0 for _ in folds))
 
 

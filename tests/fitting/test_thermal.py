@@ -121,7 +121,7 @@ def test_bad_hysteresis_options_and_not_fitted():
     with pytest.raises(InputError, match=r"hysteresis_order: 7; use 'auto' or 1..3"):
         ThermalHysteresisModel(order=2, hysteresis_order=7).fit(runs)
     with pytest.raises(NotFittedError, match="not fitted yet"):
-        ThermalHysteresisModel(order=2).lag_time_constants_s_
+        _ = ThermalHysteresisModel(order=2).lag_time_constants_s_
 
 
 def test_a_lag_model_needs_the_stream_rate(both_effects):

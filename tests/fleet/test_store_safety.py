@@ -122,7 +122,7 @@ def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_pa
     procs = [subprocess.Popen([*cmd, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for _ in range(2)]
     results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
-    for stdout, stderr, code in results:
+    for _stdout, stderr, code in results:
         assert code == 0, stderr
     with CalibrationStore(out) as db:
         assert sorted(db.serials()) == sorted(SERIALS)

@@ -33,10 +33,10 @@ def write_ulog(path, topics: dict[tuple[str, int], dict[str, tuple[str, np.ndarr
     for name, value in (parameters or {}).items():
         key = f"{'int32_t' if isinstance(value, int) else 'float'} {name}".encode()
         message(b"P", bytes([len(key)]) + key + struct.pack("<i" if isinstance(value, int) else "<f", value))
-    for msg_id, ((name, multi_id), fields) in enumerate(topics.items()):
+    for msg_id, ((name, multi_id), _fields) in enumerate(topics.items()):
         message(b"A", struct.pack("<BH", multi_id, msg_id) + name.encode())
     rows = []
-    for msg_id, ((name, multi_id), fields) in enumerate(topics.items()):
+    for msg_id, ((_name, _multi_id), fields) in enumerate(topics.items()):
         codes = "<" + "".join(_ULOG_TYPES[ctype] for ctype, _ in fields.values())
         columns = [values for _, values in fields.values()]
         stamps = np.asarray(fields["timestamp"][1])

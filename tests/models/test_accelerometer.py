@@ -126,7 +126,7 @@ def test_the_accelerometer_fit_report_names_its_figures_in_g(cycles, temperature
     for axis, sel in report.selection.items():
         assert sel.unit == "g" and sel.raw_drift == section["selection"][axis]["raw_drift_g"]
         with pytest.raises(InputError, match=r"raw_drift_dps: the axis's values are in g, not deg/s; read raw_drift"):
-            sel.raw_drift_dps
+            _ = sel.raw_drift_dps
     older = FitReport.from_dict({"accel": _renamed(section, "_g", "_dps")})
     assert older.accel == report
 

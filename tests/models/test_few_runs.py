@@ -174,7 +174,7 @@ def test_the_expected_held_out_drift_is_stored_and_read_back(tmp_path):
         cal = fit_calibration([run])
     cal.save(tmp_path / "m.json")
     selection = Calibration.load(tmp_path / "m.json").report.selection
-    for axis, sel in selection.items():
+    for sel in selection.values():
         assert isinstance(sel, SelectionReport)
         chosen = sel.result(sel.chosen.label)
         assert sel.chosen_drift_dps == pytest.approx(chosen.mean_drift)

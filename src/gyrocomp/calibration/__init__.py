@@ -27,9 +27,9 @@ from ..curves.kinds import curve_from_dict
 from ..curves.protocol import TemperatureCurve
 from ..curves.network import NetworkCurve
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, memory_curve_from_dict
-from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
+from ..recording import GYRO_AXES
 from .triad import TriadCalibration
-from .schema import TEMPERATURE_CHANNELS, UNITS, validate_model
+from .schema import UNITS, validate_model
 from ..units import AxisUnit, check_axis_unit, in_unit, require_unit
 
 FORMAT_NAME = "gyrocomp-calibration"

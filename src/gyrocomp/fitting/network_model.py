@@ -112,7 +112,7 @@ def train_lm(x: np.ndarray, y: np.ndarray, w: np.ndarray, run: np.ndarray, n_run
     best_theta, best_val = theta.copy(), val_rmse(e)
     fails = 0
     epoch = 0
-    for epoch in range(1, max_epochs + 1):
+    for epoch in range(1, max_epochs + 1):  # noqa: B007  (the epochs run are returned)
         pred, acts = predict(theta)
         jac = np.hstack([jacobian(theta[:p], shapes, acts), onehot]) * sw[:, None]
         jt, et = jac[train], e[train]

@@ -31,7 +31,6 @@ from .tables import (
     parse_column_mapping,
     read_table,
     recording_table,
-    table_data,
     write_gyro_back,
     write_recording,
     write_rows,

@@ -12,11 +12,11 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..calibration.compensate import apply
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
+from ..errors import InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..calibration.fit_report import THIN_FOLDS, AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
 from ..measures.plausibility import calibration_concerns, temperature_span_concern
 from ..runs.prepared import CHANNELS, Channel, PreparedRun, fit_axes, prepare
-from ..recording import ACCEL_AXES, GYRO_AXES, Recording
+from ..recording import ACCEL_AXES, Recording
 from ..motion.positions import orientations
 from ..fitting.acceleration import (
     acceleration_report,
@@ -38,10 +38,10 @@ from .options import (Acceleration, Curve, FitOptions, FoldChoice, Memory, Netwo
                       curve_candidates)
 from ..fitting.thermal import (CANDIDATES, LAG_EVIDENCE_CHI2, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER,
                                ThermalHysteresisModel, static_pieces)
+from ..threads import single_threaded_blas
 
 #: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
 BRANCH_ORDERS = tuple(range(1, MAX_BRANCH_ORDER + 1))
-from ..threads import single_threaded_blas
 
 #: how the fit report names each kind of fold
 FOLD_SELECTION = {"runs": "leave-one-run-out", "legs": "leave-one-leg-out", "blocks": "leave-one-block-out"}
