@@ -128,8 +128,8 @@ def test_the_import_graph_has_no_cycle():
 
 def test_the_parser_sees_relative_absolute_and_inner_imports(tmp_path):
     # the checks above are not vacuous: known edges of the graph are found
-    assert {"calibration", "effects", "recording"} <= GRAPH["calibration.compensate"][0]
-    assert "models.pipelines" in GRAPH["cli.fit"][0] and "io.atomic" in GRAPH["calibration"][0]
+    assert {"calibration.calibration", "effects", "recording"} <= GRAPH["calibration.compensate"][0]
+    assert "models.pipelines" in GRAPH["cli.fit"][0] and "io.atomic" in GRAPH["calibration.calibration"][0]
     assert _layer("measures.merit") < _layer("models.pipelines") and _layer("fitting.selection") == _layer("fitting.thermal")
     with pytest.raises(AssertionError, match="newthing: in no layer"):
         _layer("newthing")
@@ -161,3 +161,23 @@ def test_no_two_folders_import_each_other():
 def test_the_folder_check_sees_a_two_way_edge():
     assert _folder("motion.stillness") == "motion" and _folder("errors") == ""
     assert ("runs", "motion") in {(_folder(m), _folder(t)) for m, (deps, _) in GRAPH.items() for t in deps}
+
+
+def test_the_init_files_only_export():
+    """A package's ``__init__.py`` names what it exports (imports, ``__all__``, the lazy table of names imported
+    when first used); the code lives in modules whose names say what they hold."""
+    allowed_targets = {"__all__", "_EXPORTS", "__getattr__", "__dir__"}
+    code = []
+    for path in SRC.rglob("__init__.py"):
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                continue
+            if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant):
+                continue  # the docstring
+            if isinstance(node, ast.Assign) and all(
+                    isinstance(t, ast.Name) and t.id in allowed_targets
+                    or isinstance(t, ast.Tuple) and all(isinstance(e, ast.Name) and e.id in allowed_targets
+                                                        for e in t.elts) for t in node.targets):
+                continue
+            code.append(f"{path.relative_to(SRC)}:{node.lineno}")
+    assert code == []

@@ -62,7 +62,7 @@ def test_future_schema_is_refused(calibration, tmp_path):
 
 
 def test_old_schema_is_upgraded(calibration, monkeypatch):
-    import gyrocomp.calibration as module
+    import gyrocomp.calibration.calibration as module
 
     d = calibration.to_dict()
     # this file has the current schema; pretend gyrocomp is one schema ahead with an upgrade registered

@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 
-from . import Calibration
+from .calibration import Calibration
 from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..io.stream import CHUNK_ROWS

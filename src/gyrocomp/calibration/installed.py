@@ -30,7 +30,7 @@ from typing import Literal
 
 import numpy as np
 
-from . import AxisCalibration, Calibration
+from .calibration import AxisCalibration, Calibration
 from ..errors import DataQualityWarning, InputError
 from ..curves.polynomial import PolynomialCurve
 
