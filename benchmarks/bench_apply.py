@@ -4,7 +4,7 @@ Baselines, timed in the same run on the same file:
 - pandas: ``pd.read_csv`` + ``DataFrame.to_csv`` (the issue's named baseline);
 - pyarrow: ``pyarrow.csv.read_csv`` + ``pyarrow.csv.write_csv`` (the fastest plain I/O, a stricter bar).
 
-gyrocomp is timed through its real CLI entry point (``gyrocomp.cli.main``) in this process, so the figure
+gyrocomp is timed through its real CLI entry point (``gyrocomp.cli.entry_point``) in this process, so the figure
 includes reading, validation, compensation and the atomic write, but not interpreter start-up. pyarrow's I/O and
 ``gyrocomp apply`` are timed again with a busy neighbour process on one core (``benchmarks/busy.py``).
 Usage: python benchmarks/bench_apply.py [--rows N] [--repeat K]

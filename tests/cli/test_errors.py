@@ -13,7 +13,7 @@ import pytest
 
 from gyrocomp.calibration import SCHEMA_VERSION
 from gyrocomp.cli import in_cli_words
-from gyrocomp.cli.main import _environment_message
+from gyrocomp.cli.entry_point import _environment_message
 from gyrocomp.cli.apply import apply
 from gyrocomp.cli.evaluate import evaluate
 from gyrocomp.cli.fit import fit
@@ -242,7 +242,7 @@ def test_no_output_is_written_through_a_planted_link(workdir, tmp_path):
 
 def test_sigterm_leaves_no_temporary_file(tmp_path):
     # the console script's signal handling around an atomic write interrupted half-way
-    code = ("import os, signal, sys; from gyrocomp.cli import main as cli; from gyrocomp.io.atomic import atomic_path\n"
+    code = ("import os, signal, sys; from gyrocomp.cli import entry_point as cli; from gyrocomp.io.atomic import atomic_path\n"
             "cli._exit_on_termination()\n"
             "with atomic_path(sys.argv[1]) as tmp:\n"
             "    tmp.write_text('half')\n"

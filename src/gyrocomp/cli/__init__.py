@@ -1,8 +1,8 @@
-"""The command line: the group and its error handling (:mod:`.main`), one module per command."""
+"""The command line: the group and its error handling (:mod:`.entry_point`), one module per command."""
 
 from __future__ import annotations
 
-from .main import (
+from .entry_point import (
     cli, COMMANDS, in_cli_words, LazyGroup, main
 )
 

@@ -15,7 +15,7 @@ from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit
                      units_from_manifest, units_from_pattern)
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.fleet import build_fleet_report
-from .main import in_cli_words
+from .entry_point import in_cli_words
 from .common import (FINITE, OUTPUT_FILE, make_console, parse_channels, pop_read_options, progress_bar, read_options,
                      read_settings)
 from ..export import EXPORTERS
