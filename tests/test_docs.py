@@ -1,6 +1,8 @@
 """The README and the documentation site: the README stays a first visitor's page (under 10 KB, every link to a
 page that exists), every page of docs/ is in the site's navigation, and the README's Python example runs."""
 
+import importlib
+import inspect
 import re
 import warnings
 from pathlib import Path
@@ -80,3 +82,60 @@ def test_each_page_opens_with_its_one_title(page):
     text = re.sub(r"```.*?```", "", (ROOT / "docs" / page).read_text(encoding="utf-8"), flags=re.S)
     titles = [line for line in text.splitlines() if line.startswith("# ")]
     assert len(titles) == 1 and text.startswith(titles[0])
+
+
+def _api_objects():
+    """What the API page shows: each ``::: name`` and, of a class or module, its public members defined there."""
+    for dotted in re.findall(r"^::: (\S+)$", (ROOT / "docs" / "api.md").read_text(), re.M):
+        parts = dotted.split(".")
+        for i in range(len(parts), 0, -1):
+            try:
+                obj = importlib.import_module(".".join(parts[:i]))
+                break
+            except ImportError:
+                continue
+        for part in parts[i:]:
+            obj = getattr(obj, part)
+        yield dotted, obj
+        if inspect.ismodule(obj):
+            members = [(n, m) for n, m in vars(obj).items() if not n.startswith("_")
+                       and (inspect.isfunction(m) or inspect.isclass(m)) and m.__module__ == obj.__name__]
+        elif inspect.isclass(obj):
+            members = [(n, m) for n, m in vars(obj).items() if not n.startswith("_")
+                       and (inspect.isfunction(m) or isinstance(m, (classmethod, staticmethod)))]
+        else:
+            members = []
+        for name, _member in members:
+            yield f"{dotted}.{name}", getattr(obj, name)
+
+
+#: name endings that carry a unit: their entry says it in brackets
+UNIT_ENDINGS = ("_degc", "_dps", "_s", "_hz", "_g", "_deg_per_h")
+
+
+def test_every_object_on_the_api_page_documents_each_parameter_with_its_unit():
+    """numpydoc sections (Parameters, or Attributes for a record) on everything the API page shows that takes a
+    parameter; each parameter named there, and one whose name carries a unit given it in brackets."""
+    shown = list(_api_objects())
+    assert len(shown) >= 40
+    missing = []
+    for dotted, obj in shown:
+        if inspect.ismodule(obj) or not callable(obj):
+            continue
+        try:
+            params = [p for p in inspect.signature(obj).parameters.values() if p.name not in ("self", "cls")]
+        except (TypeError, ValueError):
+            continue
+        doc = inspect.getdoc(obj) or ""
+        section = re.search(r"^(?:Parameters|Attributes)\n-{3,}\n(.*?)(?=^\w[\w ]*\n-{3,}|\Z)", doc, re.M | re.S)
+        if params and section is None:
+            missing.append(f"{dotted}: no Parameters section")
+            continue
+        for p in params:
+            names = r"(?:\*{0,2}\w+, )*\*{0,2}" + re.escape(p.name) + r"(?:, \*{0,2}\w+)*"  # "a, b : type"
+            entry = re.search(rf"^{names}(?: :[^\n]*)?\n((?:[ \t]+[^\n]*\n?)*)", section.group(1), re.M)
+            if entry is None:
+                missing.append(f"{dotted}: {p.name} not described")
+            elif p.name.endswith(UNIT_ENDINGS) and "[" not in entry.group(0):
+                missing.append(f"{dotted}: {p.name} without its unit in brackets")
+    assert not missing, "\n".join(missing)

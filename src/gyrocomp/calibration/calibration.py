@@ -303,6 +303,25 @@ class Calibration:
 
     Create one with :func:`gyrocomp.fit_calibration`; apply it with :func:`gyrocomp.apply`
     or a :class:`gyrocomp.Compensator`; store it with :meth:`save` / :meth:`load`.
+
+    Attributes
+    ----------
+    axes : dict of str to AxisCalibration
+        Each gyro axis's model (``gyro_x``, ...), in deg/s.
+    model : str
+        The model's short name (``poly:3 (auto) + lag``).
+    provenance : dict
+        What it was fitted on: the inputs' names and SHA-256, gyrocomp's version, the time.
+    fit_report : dict
+        How it was fitted (read typed through :attr:`report`).
+    schema_version : int
+        The model file's schema.
+    accel_axes : dict of str to AxisCalibration
+        Each accelerometer axis's temperature model, in g.
+    accel_reference_degc : float, optional
+        The temperature the accelerometer's models are relative to [degC].
+    gyro_triad, accel_triad : TriadCalibration, optional
+        Scale factor and misalignment of the gyro and the accelerometer triads.
     """
 
     axes: dict[str, AxisCalibration]
@@ -340,7 +359,13 @@ class Calibration:
         """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
         (turning-point), ``"lag"``, ``"scale-factor"`` (the gyro triad's K(T)). What is left is applied as fitted
         (the parts were fitted jointly), so this shows each part's contribution, as the stages of the thesis's
-        Table 4.4."""
+        Table 4.4.
+
+        Parameters
+        ----------
+        *parts : str
+            Any of ``acceleration``, ``hysteresis``, ``lag``, ``scale-factor``.
+        """
         known = ("acceleration", "hysteresis", "lag", "scale-factor")
         for part in parts:
             if part not in known:
@@ -395,7 +420,13 @@ class Calibration:
 
     def fitted_on(self, path: str | os.PathLike | None) -> bool:
         """Whether the file at ``path`` is one the model was fitted on (its name and SHA-256 those of an input in
-        the provenance): figures judged on it are in-sample, not the drift to expect on new data."""
+        the provenance): figures judged on it are in-sample, not the drift to expect on new data.
+
+        Parameters
+        ----------
+        path : path or None
+            The file (None: False).
+        """
         if path is None or not Path(path).is_file():
             return False
         named = [entry for entry in self.provenance.get("inputs", ())
@@ -403,11 +434,26 @@ class Calibration:
         return bool(named) and file_sha256(path) in {entry["sha256"] for entry in named}
 
     def save(self, path: str | os.PathLike) -> None:
-        """Write the model file atomically."""
+        """Write the model file atomically.
+
+        Parameters
+        ----------
+        path : path
+            The model file to write (JSON, versioned); an input of the model is never overwritten.
+        """
         write_text_atomic(path, self.to_json())
 
     @classmethod
     def from_dict(cls, d: Any, source: str = "<dict>") -> "Calibration":
+        """The calibration of a model file's content, upgraded from an earlier schema and validated.
+
+        Parameters
+        ----------
+        d : dict
+            The model file's JSON object.
+        source : str
+            Where it came from (a file name), for messages.
+        """
         if not isinstance(d, dict) or d.get("format") != FORMAT_NAME:
             raise InputError(f"{source}: not a gyrocomp model file (no \"format\": \"{FORMAT_NAME}\")")
         version = d.get("schema_version")
@@ -452,7 +498,18 @@ class Calibration:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "Calibration":
-        """Read and validate a model file written by :meth:`save`."""
+        """Read and validate a model file written by :meth:`save`.
+
+        Parameters
+        ----------
+        path : path
+            The model file (JSON, any earlier schema: upgraded on load).
+
+        Returns
+        -------
+        Calibration
+            Refused in one line naming the file and field when it is not a valid model file.
+        """
         if not isinstance(path, (str, os.PathLike)):
             raise InputError(f"path: expected a model file name or path, got {type(path).__name__}")
         path = Path(path)

@@ -326,6 +326,10 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
 
     Parameters
     ----------
+    calibration : Calibration
+        The model.
+    recording : Recording
+        The samples [s, deg/s, g, degC].
     turn_on_window_s : float, optional
         Estimate the run's turn-on constant from its first seconds [s] (default: the calibration runs' mean).
     axes : tuple of str, optional

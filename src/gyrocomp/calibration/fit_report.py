@@ -523,7 +523,27 @@ class ExpectedDrift:
 class FitReport:
     """How a calibration was fitted (see the module). ``method`` is the temperature model's family
     (``polynomial``, ``mlp``, ``population prior``, ...; None without a temperature model). ``accel`` is the
-    accelerometer's own account, its figures in g."""
+    accelerometer's own account, its figures in g.
+
+    Attributes
+    ----------
+    method : str or None
+        The temperature model's family.
+    axes : dict of str to AxisFit
+        Each axis's fit: residuals [the axis's unit] and range [degC].
+    order_selection, selection : OrderSelection, dict of str to SelectionReport
+        The model choice: every candidate's held-out drift per fold.
+    hysteresis, network, acceleration : HysteresisReport, NetworkReport, GSensitivityReport or None
+        The thermal memory's, the network's and the g-sensitivity's accounts.
+    pipeline : str or None
+        The pipeline's name (``cascade``, ``joint``, ...).
+    stages : tuple of FitReport
+        A cascade's stages, each its own report.
+    accel : FitReport or None
+        The accelerometer's account, in g.
+    sections : dict
+        The file's sections this release does not read, kept as they were.
+    """
 
     method: str | None
     axes: dict[str, AxisFit]
@@ -540,7 +560,15 @@ class FitReport:
     @classmethod
     def from_dict(cls, d: dict | None, unit: AxisUnit = "deg/s") -> "FitReport":
         """Read the ``fit_report`` object of a model file (any schema version); ``unit`` is the unit of the axes it
-        accounts for (its ``accel`` section is read in g)."""
+        accounts for (its ``accel`` section is read in g).
+
+        Parameters
+        ----------
+        d : dict or None
+            The model file's ``fit_report`` object.
+        unit : {"deg/s", "g"}
+            The unit of the axes it accounts for.
+        """
         d = d or {}
         axes = {a: AxisFit.from_dict(i, unit) for a, i in (d.get("axes") or {}).items()}
         scores = {a: fit.scores for a, fit in axes.items() if fit.scores}

@@ -65,7 +65,17 @@ def _reader(params: dict, autopilot: str, prefix: str):
 
 def px4_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, instance: int = 0) -> np.ndarray:
     """(n, 3) offsets PX4 subtracts from gyro x, y, z [deg/s] at ``temperature_degc`` [degC], from the
-    ``TC_G{instance}_*`` parameters, as ``calc_thermal_offsets_3D`` computes them (float32, clamped)."""
+    ``TC_G{instance}_*`` parameters, as ``calc_thermal_offsets_3D`` computes them (float32, clamped).
+
+    Parameters
+    ----------
+    params : dict
+        The vehicle's parameters (name to value).
+    temperature_degc : array (n,)
+        The gyro's temperature [degC].
+    instance : int
+        The ``TC_G`` slot, 0..3.
+    """
     value = _reader(params, "px4", _prefix("px4", instance))
     f32 = np.float32
     t = np.asarray(temperature_degc, dtype=f32)
@@ -81,7 +91,19 @@ def px4_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, instance
 
 def px4_as_run(params: dict, time_s: np.ndarray, temperature_degc: np.ndarray, instance: int = 0) -> np.ndarray:
     """(n, 3) the offsets [deg/s] PX4 applies at each sample as it runs: recomputed at each 1 s poll, published
-    only when the temperature moved by more than 1 degC since the last publication (the first poll publishes)."""
+    only when the temperature moved by more than 1 degC since the last publication (the first poll publishes).
+
+    Parameters
+    ----------
+    params : dict
+        The vehicle's parameters (name to value).
+    time_s : array (n,)
+        Sample times [s].
+    temperature_degc : array (n,)
+        The gyro's temperature [degC].
+    instance : int
+        The ``TC_G`` slot, 0..3.
+    """
     t = np.asarray(time_s, dtype=float)
     temp = np.asarray(temperature_degc, dtype=float)
     polls = np.flatnonzero(np.diff(np.floor((t - t[0]) / PX4_POLL_S), prepend=-1.0) > 0) if t.size else []
@@ -102,7 +124,19 @@ def px4_as_run(params: dict, time_s: np.ndarray, temperature_degc: np.ndarray, i
 def ardupilot_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, cal_temp_degc: float,
                                   instance: int = 1) -> np.ndarray:
     """(n, 3) what ArduPilot subtracts from gyro x, y, z [deg/s] at ``temperature_degc`` [degC], its gyro offsets
-    taken at ``cal_temp_degc`` [degC], from the ``INS_TCAL{instance}_*`` parameters (``TCal::correct_sensor``)."""
+    taken at ``cal_temp_degc`` [degC], from the ``INS_TCAL{instance}_*`` parameters (``TCal::correct_sensor``).
+
+    Parameters
+    ----------
+    params : dict
+        The vehicle's parameters (name to value).
+    temperature_degc : array (n,)
+        The IMU's temperature [degC].
+    cal_temp_degc : float
+        The temperature the gyro offsets were taken at [degC] (:func:`ardupilot_cal_temp_degc`).
+    instance : int
+        The IMU, 1..3.
+    """
     value = _reader(params, "ardupilot", _prefix("ardupilot", instance))
     f32 = np.float32
     lo, hi = f32(value("TMIN")), f32(value("TMAX"))
@@ -128,7 +162,15 @@ def ardupilot_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, ca
 
 def px4_slot(params: dict, device_id: int | None) -> int | None:
     """The ``TC_G{i}`` slot PX4 applies to the gyro with ``device_id`` (the one whose ``TC_G{i}_ID`` equals it,
-    as ``set_sensor_id_gyro`` chooses), or None: then the vehicle applies no thermal correction to that gyro."""
+    as ``set_sensor_id_gyro`` chooses), or None: then the vehicle applies no thermal correction to that gyro.
+
+    Parameters
+    ----------
+    params : dict
+        The vehicle's parameters (name to value).
+    device_id : int or None
+        The gyro's device id (None: no slot).
+    """
     if device_id is None:
         return None
     for i in range(PX4_GYRO_SLOTS):
@@ -140,7 +182,15 @@ def px4_slot(params: dict, device_id: int | None) -> int | None:
 def ardupilot_cal_temp_degc(params: dict, instance: int = 1) -> float:
     """The temperature ArduPilot took its gyro offsets at (``INS_GYR_CALTEMP``, ``INS_GYR2_CALTEMP``, ... for
     ``instance`` 1, 2, ...) [degC]; -300 (ArduPilot's "never calibrated") when the parameters do not say: the
-    correction then clamps it to TMIN, as the firmware does."""
+    correction then clamps it to TMIN, as the firmware does.
+
+    Parameters
+    ----------
+    params : dict
+        The vehicle's parameters (name to value).
+    instance : int
+        The IMU, 1..3.
+    """
     return float(params.get("INS_GYR_CALTEMP" if instance == 1 else f"INS_GYR{instance}_CALTEMP", -300.0))
 
 

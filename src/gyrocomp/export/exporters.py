@@ -94,7 +94,18 @@ EXPORTERS: dict[str, Exporter] = {}
 
 
 def register(exporter: Exporter) -> Exporter:
-    """Add ``exporter`` to :data:`EXPORTERS` (a name registered twice is refused)."""
+    """Add ``exporter`` to :data:`EXPORTERS` (a name registered twice is refused).
+
+    Parameters
+    ----------
+    exporter : Exporter
+        The format: its name, description, what it cannot carry, its writer and suffixes.
+
+    Returns
+    -------
+    Exporter
+        ``exporter``, registered.
+    """
     if exporter.name in EXPORTERS:
         raise InputError(f"export format {exporter.name!r} is registered already")
     EXPORTERS[exporter.name] = exporter
@@ -119,7 +130,24 @@ def format_of(path, offered: tuple[str, ...] | None = None) -> str:
 
 def export_to(calibration: Calibration, fmt: str, path, options: ExportOptions = ExportOptions()) -> Exported:
     """Write ``calibration`` as ``fmt`` (a name in :data:`EXPORTERS`: ``px4``, ``ardupilot``, ``c``, ``json``, ...)
-    to ``path`` (C: a folder), atomically; refuses an unknown format naming the known ones."""
+    to ``path`` (C: a folder), atomically; refuses an unknown format naming the known ones.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model to write.
+    fmt : str
+        A name of :data:`EXPORTERS`.
+    path : path
+        The file (or folder) to write.
+    options : ExportOptions
+        What some formats need (a rate [Hz], a sensor slot, device ids).
+
+    Returns
+    -------
+    Exported
+        The files written, the notes for the user, and for an autopilot how far its correction is from the model's.
+    """
     if fmt not in EXPORTERS:
         raise InputError(f"format: {fmt!r}; use one of {', '.join(EXPORTERS)}")
     return EXPORTERS[fmt].write(calibration, Path(path), options)

@@ -32,7 +32,21 @@ class FirmwareDifference:
     and the RMS difference inside the calibrated range, beyond it (``BEYOND_DEGC`` each side: the firmware clamps,
     the model continues), and over a heat-cool cycle through the range as the firmware runs (PX4's steps, the
     model's lag and hysteresis: what the file cannot carry). Each is taken about its mean: a constant is the turn-on
-    bias, which neither removes."""
+    bias, which neither removes.
+
+    Attributes
+    ----------
+    target : str
+        ``px4`` or ``ardupilot``.
+    axes : tuple of str
+        The gyro axes compared.
+    in_range_max_dps, in_range_rms_dps : tuple of float
+        Per axis, the largest and the RMS difference inside the calibrated range [deg/s].
+    beyond_max_dps, beyond_rms_dps : tuple of float
+        The same beyond it, ``BEYOND_DEGC`` each side [deg/s].
+    as_run_max_dps, as_run_rms_dps : tuple of float
+        The same over a heat-cool cycle as the firmware runs [deg/s].
+    """
 
     target: str
     axes: tuple[str, ...]
@@ -58,7 +72,19 @@ def _stats(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def firmware_difference(calibration: Calibration, params: dict, target: str, instance: int) -> FirmwareDifference:
     """The firmware's correction against the model's (:class:`FirmwareDifference`); ``target`` ``px4`` or
-    ``ardupilot``, ``params`` the exported parameter values."""
+    ``ardupilot``, ``params`` the exported parameter values.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model exported.
+    params : dict
+        The exported parameters (name to value).
+    target : {"px4", "ardupilot"}
+        The autopilot.
+    instance : int
+        The slot the parameters were written for (PX4 0..3, ArduPilot 1..3).
+    """
     # the gyro's temperature correction is compared: neither firmware has a g-term, and the accelerometer's
     # calibration is the accelerometer's
     calibration = dataclasses.replace(calibration.without("acceleration") if calibration.has_acceleration
@@ -113,7 +139,15 @@ def _gyro_axes_with_curve(calibration: Calibration) -> tuple[str, ...]:
 
 def firmware_parameters(calibration: Calibration, target: Autopilot) -> dict[str, float]:
     """The gyro thermal parameters ``gyrocomp export --format target`` writes for ``calibration`` (default slot;
-    the left-out terms are not warned about here: :func:`firmware_difference` measures them)."""
+    the left-out terms are not warned about here: :func:`firmware_difference` measures them).
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model exported.
+    target : {"px4", "ardupilot"}
+        The autopilot.
+    """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)
         if target == "px4":
@@ -125,7 +159,17 @@ def firmware_parameters(calibration: Calibration, target: Autopilot) -> dict[str
 def firmware_correction(calibration: Calibration, recording: Recording, target: Autopilot) -> np.ndarray:
     """(n, 3) what the autopilot subtracts from gyro x, y, z [deg/s] at each sample of ``recording`` with the file
     exported from ``calibration``: PX4 as it runs (1 Hz, 1 degC republish), ArduPilot relative to the run's first
-    temperature (where its boot-time gyro offset is taken)."""
+    temperature (where its boot-time gyro offset is taken).
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model exported.
+    recording : Recording
+        The samples [s, deg/s, degC].
+    target : {"px4", "ardupilot"}
+        The autopilot.
+    """
     params = firmware_parameters(calibration, target)
     temperature = recording.temperature_degc
     if target == "px4":
@@ -138,7 +182,17 @@ def firmware_corrected_axes(calibration: Calibration, recording: Recording, targ
     """(axis, output [deg/s]) of each gyro axis of ``recording`` as the autopilot outputs it with the file
     exported from ``calibration`` (:func:`firmware_correction`; an axis without a temperature curve in the model
     is not corrected). Each output is written into one buffer, valid until the next axis is yielded: a day at
-    100 Hz is read axis by axis without a copy of the recording."""
+    100 Hz is read axis by axis without a copy of the recording.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model exported.
+    recording : Recording
+        The samples [s, deg/s, degC].
+    target : {"px4", "ardupilot"}
+        The autopilot.
+    """
     correction = firmware_correction(calibration, recording, target)
     corrected = _gyro_axes_with_curve(calibration)
     buffer = np.empty(recording.n_samples)
@@ -153,7 +207,17 @@ def firmware_corrected_axes(calibration: Calibration, recording: Recording, targ
 def firmware_corrected(calibration: Calibration, recording: Recording, target: Autopilot) -> Recording:
     """``recording`` corrected as the autopilot would correct it with the file exported from ``calibration``
     (:func:`firmware_correction`). Only the gyro axes the model has a temperature curve for are corrected
-    [deg/s]."""
+    [deg/s].
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model exported.
+    recording : Recording
+        The samples [s, deg/s, degC].
+    target : {"px4", "ardupilot"}
+        The autopilot.
+    """
     gyro = np.empty_like(recording.gyro_dps, dtype=float)
     for j, (_, output) in enumerate(firmware_corrected_axes(calibration, recording, target)):
         gyro[:, j] = output
@@ -162,7 +226,13 @@ def firmware_corrected(calibration: Calibration, recording: Recording, target: A
 
 def firmware_costs(calibration: Calibration) -> dict[str, FirmwareDifference]:
     """What loading ``calibration`` into each autopilot costs: :func:`firmware_difference` of the PX4 and the
-    ArduPilot file export writes, by target; empty when no gyro axis has a temperature curve."""
+    ArduPilot file export writes, by target; empty when no gyro axis has a temperature curve.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model exported.
+    """
     if not _gyro_axes_with_curve(calibration):
         return {}
     with warnings.catch_warnings():

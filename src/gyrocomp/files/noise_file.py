@@ -49,7 +49,9 @@ def analyse_noise_file(path, axes: list[str] | None = None, *, options: ReadOpti
         Its format (default: told from the file).
     with_accel : bool
         Also analyse every accelerometer axis of the file (Kalibr's noise file needs both sensors).
-    kind, taus, split_gaps, fit_taus_s : as :func:`gyrocomp.measures.noise.analyse_noise`.
+    kind, taus, split_gaps : as :func:`gyrocomp.measures.noise.analyse_noise`.
+    fit_taus_s : (float, float), optional
+        The averaging times the noise terms are fitted between [s] (as :func:`gyrocomp.measures.noise.analyse_noise`).
     chunks : ChunkSettings
         Chunk size, memory per series [bytes], folder of the temporary files.
     progress : callable, optional

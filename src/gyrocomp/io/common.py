@@ -19,7 +19,8 @@ import numpy as np
 from ..errors import DataQualityWarning, InputError, MissingDependencyError, install_hint, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..option_spelling import Spelling, spelled
-from .tables import TableLayout, keep_finite_rows
+from .layout import TableLayout
+from .tables import keep_finite_rows
 
 #: ``progress(fraction_done)``, fraction in [0, 1]; readers call it now and then on long files
 ProgressCallback = Callable[[float], None]

@@ -22,7 +22,7 @@ from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, log_recording, require
 from .readers import Reader, check_magic, register_reader
-from .tables import TIME_COLUMN
+from .layout import TIME_COLUMN
 
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
 NETCDF3_MAGIC = b"CDF"

@@ -19,7 +19,7 @@ from pathlib import Path
 from ..errors import InputError
 from ..option_spelling import mapping_text, spelled_fields
 from .common import ReadOptions
-from .tables import TableLayout
+from .layout import TableLayout
 
 #: the key of the format in ``[read]`` (the reading functions' ``fmt``)
 FORMAT_KEY = "format"
@@ -46,7 +46,18 @@ def read_section(path: str | os.PathLike) -> dict:
 
 def project_read_options(path: str | os.PathLike) -> tuple[ReadOptions, str | None]:
     """(reading options, format or None) of a project file's ``[read]`` section, as every command run beside it
-    reads files; a key that is no reading option is refused in one line naming it and the ones there are."""
+    reads files; a key that is no reading option is refused in one line naming it and the ones there are.
+
+    Parameters
+    ----------
+    path : path
+        The project file (``gyrocomp.toml``).
+
+    Returns
+    -------
+    (ReadOptions, str or None)
+        Its reading options, and the input format it names (None: told from each file).
+    """
     section = read_section(path)
     fmt = section.pop(FORMAT_KEY, None)
     if fmt is not None and not isinstance(fmt, str):

@@ -60,7 +60,17 @@ class Reader:
     table: bool = False
 
     def read_table_data(self, path: Path, options: ReadOptions, progress: ProgressCallback | None) -> TableData:
-        """What :attr:`read` returns, as :class:`TableData` (a recording becomes a table in the default layout)."""
+        """What :attr:`read` returns, as :class:`TableData` (a recording becomes a table in the default layout).
+
+        Parameters
+        ----------
+        path : Path
+            The input.
+        options : ReadOptions
+            The reading options.
+        progress : callable, optional
+            Called with the fraction done.
+        """
         data = self.read(path, options, progress)
         return data if isinstance(data, TableData) else table_data(data)
 
@@ -70,7 +80,18 @@ READERS: dict[str, Reader] = {}
 
 
 def register_reader(reader: Reader) -> Reader:
-    """Add ``reader`` to :data:`READERS`; a name, alias or suffix another reader has is refused."""
+    """Add ``reader`` to :data:`READERS`; a name, alias or suffix another reader has is refused.
+
+    Parameters
+    ----------
+    reader : Reader
+        The format: its name, description, reading function, suffixes, first bytes, aliases.
+
+    Returns
+    -------
+    Reader
+        ``reader``, registered.
+    """
     taken = {n for r in READERS.values() for n in (r.name, *r.aliases)}
     clash = sorted(taken & {reader.name, *reader.aliases})
     if clash:

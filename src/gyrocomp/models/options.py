@@ -74,7 +74,16 @@ class Curve:
     """A registered curve family by name (:data:`gyrocomp.curves.protocol.BASES`: ``poly``, ``table``, ...) at
     ``size`` (a polynomial's order, a table's intervals) or ``"auto"`` (its size chosen by held-out drift among
     the family's own). The family is fitted as asked, without lag or hysteresis unless it is the polynomial;
-    ``Curve("poly", 3)`` is ``Polynomial(3)``."""
+    ``Curve("poly", 3)`` is ``Polynomial(3)``.
+
+    Parameters
+    ----------
+    family : str
+        A name of :data:`gyrocomp.curves.protocol.BASES` (``gyrocomp fit --help`` lists them).
+    size : int or "auto"
+        The polynomial's order (0..5), a table's intervals (1..64), ...; ``auto``: chosen by held-out drift among
+        the family's own sizes.
+    """
 
     family: str
     size: int | Literal["auto"] = "auto"
@@ -113,6 +122,19 @@ def curve_candidates(spec: "Polynomial | Curve | Network", target: "Target" = "m
     registered family at its basis's ``sizes`` (a firmware target: the orders it carries, nothing else);
     ``Polynomial(n)``: that order; ``Curve(family)``: that family's sizes (the polynomial: its orders);
     ``Curve(family, n)``: that curve.
+
+    Parameters
+    ----------
+    spec : Polynomial, Curve or Network
+        The temperature option (a network's polynomial stage is the automatic choice's).
+    target : {"model", "px4", "ardupilot"}
+        What the model is fitted for (a firmware carries a cubic at most).
+
+    Returns
+    -------
+    CurveCandidates
+        The polynomial's orders, the other families' (name, size) pairs, and whether a curve must beat the run
+        constant on held-out data to be kept.
     """
     top = MAX_ORDER if target == "model" else FIRMWARE_MAX_ORDER
     every_order = tuple(range(top + 1))
