@@ -34,7 +34,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from gyrocomp.io.tables import recording_table
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import simulate
 
 BLOCK_ROWS = 360_000  # one simulated hour at 100 Hz

@@ -30,7 +30,7 @@ from gyrocomp import __version__, apply
 from gyrocomp.export.autopilot import ardupilot_parameters, px4_parameters
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_as_run, px4_gyro_correction_dps
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.models.pipelines import fit_calibration
+from gyrocomp.models.joint import fit_calibration
 from gyrocomp.simulation import get_preset, get_profile, simulate
 
 RATE_HZ = 2.0

@@ -28,7 +28,7 @@ from gyrocomp.calibration.compensate import apply
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.field import field_recordings
 from gyrocomp.fitting.online import OnlineCalibrator, replay
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import get_profile, resolve_profile, simulate
 
 LOGS = 10

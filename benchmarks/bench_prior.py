@@ -35,7 +35,7 @@ from gyrocomp.calibration.compensate import apply
 from gyrocomp.fleet import CalibrationStore, UnitRuns, fit_fleet, fit_with_prior, population_prior, prior_from_models
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import preset_model, resolve_profile, simulate
 
 RUN_S, RATE_HZ, RUNS = 900.0, 10.0, 3

@@ -59,7 +59,7 @@ import numpy as np
 
 from gyrocomp import __version__, apply
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import PRESETS, GyroErrorModel, Hysteresis, get_preset, get_profile, preset_model, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic
 

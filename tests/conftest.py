@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from gyrocomp import Compensator, apply
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulation import GyroErrorModel, simulate
 

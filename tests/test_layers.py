@@ -129,7 +129,7 @@ def test_the_import_graph_has_no_cycle():
 def test_the_parser_sees_relative_absolute_and_inner_imports(tmp_path):
     # the checks above are not vacuous: known edges of the graph are found
     assert {"calibration.calibration", "effects", "recording"} <= GRAPH["calibration.compensate"][0]
-    assert "models.pipelines" in GRAPH["cli.fit"][0] and "io.atomic" in GRAPH["calibration.calibration"][0]
+    assert "models.options" in GRAPH["cli.fit"][0] and "io.atomic" in GRAPH["calibration.calibration"][0]
     assert _layer("measures.merit") < _layer("models.pipelines") and _layer("fitting.selection") == _layer("fitting.thermal")
     with pytest.raises(AssertionError, match="newthing: in no layer"):
         _layer("newthing")

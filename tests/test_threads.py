@@ -8,7 +8,8 @@ from threadpoolctl import threadpool_limits
 
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError
-from gyrocomp.models import pipelines
+from gyrocomp.models import accelerometer, joint, pipelines
+from gyrocomp.models import fit as fit_module
 from gyrocomp.threads import blas_threads, single_threaded_blas
 
 pytestmark = pytest.mark.skipif(blas_threads() is None, reason="numpy loaded no BLAS library threadpoolctl can see")
@@ -36,8 +37,9 @@ def test_the_setting_returns_when_the_call_raises():
         assert blas_threads() == before
 
 
-@pytest.mark.parametrize("entry", ["fit_calibration", "fit_pipeline", "fit_channels"])
-def test_every_fit_entry_point_fits_with_blas_on_one_thread(monkeypatch, entry):
+@pytest.mark.parametrize("module, entry", [(fit_module, "fit"), (joint, "fit_calibration"), (pipelines, "fit_pipeline"),
+                                           (fit_module, "fit_channels"), (accelerometer, "fit_accelerometer")])
+def test_every_fit_entry_point_fits_with_blas_on_one_thread(monkeypatch, module, entry):
     """What the fit runs sees one BLAS thread, whichever public entry point it came through."""
     seen = []
 
@@ -45,7 +47,7 @@ def test_every_fit_entry_point_fits_with_blas_on_one_thread(monkeypatch, entry):
         seen.append(blas_threads())
         raise InputError("stopped here")
 
-    monkeypatch.setattr(pipelines, "prepare", prepare)
+    monkeypatch.setattr(module, "prepare", prepare)
     with threadpool_limits(2, user_api="blas"), pytest.raises(InputError, match="stopped here"):
-        getattr(pipelines, entry)([])
+        getattr(module, entry)([])
     assert seen and set(seen) == {1}

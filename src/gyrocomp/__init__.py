@@ -25,7 +25,7 @@ _EXPORTS = {
     "read": ("io", "read"), "write": ("io", "write_recording"),
     "Evaluation": ("measures.merit", "Evaluation"), "evaluate_run": ("measures.merit", "evaluate_run"),
     "PolynomialTemperatureModel": ("fitting.polynomial_model", "PolynomialTemperatureModel"),
-    "fit_calibration": ("models.pipelines", "fit_calibration"), "fit_channels": ("models.pipelines", "fit_channels"),
+    "fit_calibration": ("models.joint", "fit_calibration"), "fit_channels": ("models.fit", "fit_channels"),
     "fit_pipeline": ("models.pipelines", "fit_pipeline"),
     **{name: ("models.options", name) for name in ("Curve", "FitOptions", "Network", "Polynomial")},
     "FitReport": ("calibration.fit_report", "FitReport"), "analyse_noise_file": ("files", "analyse_noise_file"),

@@ -12,7 +12,8 @@ import pytest
 from gyrocomp.calibration import Calibration
 from gyrocomp.calibration.fit_report import MEMORIES, AxisFit, FitReport, MemoryChoice
 from gyrocomp.models.options import FitOptions, Network, Polynomial
-from gyrocomp.models.pipelines import fit_calibration, fit_pipeline
+from gyrocomp.models.joint import fit_calibration
+from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.fitting.selection import Candidate
 from gyrocomp.simulation import simulate
 

@@ -13,7 +13,7 @@ from gyrocomp import Calibration, find_poses, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.simulation import GyroErrorModel, Hysteresis, simulate
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.units import STANDARD_GRAVITY_M_PER_S2 as G0
 from gyrocomp.models.options import FitOptions, Polynomial
 

@@ -140,7 +140,7 @@ ACCEL_TRIAD = _triad([[2e-3, 1e-3, -2e-3], [0.0, -3e-3, 1.5e-3], [0.0, 0.0, 4e-3
 
 @pytest.mark.slow
 def test_accelerometer_temperature_models_g_sensitivity_and_both_triads(tmp_path):
-    from gyrocomp.models.pipelines import fit_channels
+    from gyrocomp.models.fit import fit_channels
 
     runs = [simulate("consumer", profile="combined", duration_s=9000, rate_hz=1, seed=s).recording for s in range(2)]
     chamber = [simulate("consumer", profile="cycle", rate_hz=0.5, seed=s).recording for s in range(2)]

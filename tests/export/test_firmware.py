@@ -103,7 +103,7 @@ def test_the_firmwares_cost_is_measured_for_a_model_with_g_sensitivity():
     import dataclasses
 
     from gyrocomp.export.firmware import firmware_costs
-    from gyrocomp.models.pipelines import fit_calibration
+    from gyrocomp.models.joint import fit_calibration
 
     sims = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=0.2,
                      seed=s).recording for s in range(2)]

@@ -10,7 +10,7 @@ from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export import EXPORTERS, ExportOptions, Exported, Exporter, export_to, register
 from gyrocomp.models.options import Polynomial
-from gyrocomp.models.pipelines import fit_calibration
+from gyrocomp.models.joint import fit_calibration
 from gyrocomp.simulation import get_profile, simulate
 
 

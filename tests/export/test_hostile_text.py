@@ -15,7 +15,7 @@ from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.export.c_code import c_sources
-from gyrocomp.models.pipelines import fit_calibration
+from gyrocomp.models.joint import fit_calibration
 from gyrocomp.simulation import get_profile, simulate
 
 CC = shutil.which("cc") or shutil.which("gcc")

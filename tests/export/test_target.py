@@ -13,7 +13,7 @@ from gyrocomp.export.autopilot import ardupilot_parameters, px4_parameters
 from gyrocomp.io.tables import write_recording
 from gyrocomp.export.firmware import ardupilot_gyro_correction_dps, px4_gyro_correction_dps
 from gyrocomp.models.options import FitOptions, Polynomial
-from gyrocomp.models.pipelines import fit_calibration
+from gyrocomp.models.joint import fit_calibration
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run

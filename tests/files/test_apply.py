@@ -26,7 +26,7 @@ from gyrocomp.io import stream as stream_module
 from gyrocomp.io.stream import TableStream
 from gyrocomp.io import ReadOptions
 from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_recording
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import simulate
 
 def _whole(calibration, source, target, **kwargs):

@@ -16,7 +16,7 @@ from gyrocomp.allan import PhaseAccumulator, allan_deviation, to_phase
 from gyrocomp.errors import InputError
 from gyrocomp.evaluation import evaluate
 from gyrocomp.io.tables import read_table, write_recording
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.files import ChunkSettings, analyse_noise_file, evaluate_file
 from gyrocomp.simulation import simulate

@@ -189,7 +189,7 @@ def test_joint_fit_beats_every_cascade(pipelines):
 
 @pytest.mark.slow
 def test_a_cascade_applies_as_its_stages_in_turn(consumer, pipelines):
-    from gyrocomp.models.pipelines import fit_calibration
+    from gyrocomp.models.joint import fit_calibration
 
     _, runs, held, _ = consumer
     chained = pipelines["matrix>poly"][0]

@@ -14,7 +14,7 @@ from gyrocomp.effects import branch_position, find_turns
 from gyrocomp.errors import InputError
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.curves.hysteresis import BranchCurve, memory_curve_from_dict
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic
 

@@ -21,7 +21,7 @@ from gyrocomp.errors import InputError, NotFittedError
 from gyrocomp.export.c_learner import TEMPLATES, learner_c_sources, template_values
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.fitting.online import LearnerSettings, OnlineCalibrator, block_statistics, chi2_quantile, replay
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import get_profile, resolve_profile, simulate
 from gyrocomp.simulation.presets import preset_model
 from gyrocomp.motion.stillness import detect_still

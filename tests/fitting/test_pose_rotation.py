@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 from gyrocomp import Calibration, apply, evaluate
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io.tables import write_recording
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.report.html import _pose_residuals, build_report
 from gyrocomp.fitting.pose_rotation import (fit_gyro_between_poses, ordered_product, quaternion_from_rotvec,
                                            rotation_errors, rotation_matrix)

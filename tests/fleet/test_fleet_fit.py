@@ -14,7 +14,7 @@ import pytest
 from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, FleetSettings, UnitRuns, fit_unit
 from gyrocomp.io import read
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import resolve_profile, simulate
 
 from ..conftest import run

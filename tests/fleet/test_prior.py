@@ -20,7 +20,7 @@ from gyrocomp.fleet import (CalibrationStore, block_covariance, comes_back, fit_
 from gyrocomp.io import read
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import preset_model, resolve_profile, simulate
 
 from ..conftest import run

@@ -13,7 +13,7 @@ from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError, ModelError
 from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Failure, InputFile, UnitFigures,
                             parse_time, store_url)
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import simulate
 
 from ..conftest import run

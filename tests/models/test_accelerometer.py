@@ -16,7 +16,8 @@ from gyrocomp.errors import InputError
 from gyrocomp.calibration.fit_report import FitReport
 from gyrocomp.measures.merit import evaluate_run, moving_average
 from gyrocomp.cli.common import parse_channels
-from gyrocomp.models.pipelines import fit_accelerometer, fit_channels
+from gyrocomp.models.accelerometer import fit_accelerometer
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import get_profile, simulate
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 

@@ -11,7 +11,8 @@ from gyrocomp import Calibration, apply
 from gyrocomp.errors import ModelChoiceWarning
 from gyrocomp.calibration.fit_report import SelectionReport
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.models.pipelines import fit_calibration, fit_channels
+from gyrocomp.models.joint import fit_calibration
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, preset_model, simulate
 from gyrocomp.evaluation.validation import fit_plain_cubic
 

@@ -14,7 +14,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.field import field_recordings
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import get_profile, resolve_profile, simulate
 
 from ..conftest import run

@@ -8,7 +8,7 @@ import pytest
 import gyrocomp
 from gyrocomp.errors import InputError
 from gyrocomp.models.options import FitOptions
-from gyrocomp.models.pipelines import fit_calibration
+from gyrocomp.models.joint import fit_calibration
 from gyrocomp.simulation import get_profile, simulate
 
 
@@ -39,3 +39,34 @@ def test_the_entry_point_is_the_keyword_call_with_its_options_typed(runs):
 def test_the_channel_is_said_not_guessed(runs):
     with pytest.raises(InputError, match="channels"):
         gyrocomp.fit(runs, channels=("magnetometer",))
+
+
+def test_the_runs_are_prepared_once_per_fit_whatever_the_entry_point(runs, monkeypatch):
+    """One path: every entry point prepares its runs once and the stages take them prepared; a cascade's later
+    stage prepares the earlier stage's output once (new data)."""
+    import gyrocomp.models.accelerometer as accelerometer
+    import gyrocomp.models.fit as fit_module
+    import gyrocomp.models.joint as joint
+    import gyrocomp.models.pipelines as pipelines
+    from gyrocomp.runs.prepared import prepare
+
+    calls = []
+
+    def counting(recordings):
+        recordings = list(recordings)
+        calls.append(len(recordings))
+        return prepare(recordings)
+
+    for module in (fit_module, joint, pipelines, accelerometer):
+        monkeypatch.setattr(module, "prepare", counting)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for call, expected in ((lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none")), 1),
+                               (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none"), channels=("gyro", "accel")), 1),
+                               (lambda: gyrocomp.fit_channels(runs, ("gyro",)), 1),
+                               (lambda: gyrocomp.fit_pipeline(runs, "joint", FitOptions(hysteresis="none")), 1),
+                               (lambda: fit_calibration(runs, hysteresis="none"), 1),
+                               (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none"), pipeline="poly>matrix"), 2)):
+            calls.clear()
+            call()
+            assert calls == [len(runs)] * expected

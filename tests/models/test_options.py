@@ -12,7 +12,9 @@ import pytest
 from gyrocomp.errors import InputError
 from gyrocomp.fitting.gsensitivity import ACCELERATION_CHOICES
 from gyrocomp.models.options import Acceleration, FitOptions, FoldChoice, Memory, Network, Polynomial
-from gyrocomp.models.pipelines import fit_calibration, fit_channels, fit_pipeline
+from gyrocomp.models.joint import fit_calibration
+from gyrocomp.models.fit import fit_channels
+from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.fitting.folds import FOLD_KINDS
 from gyrocomp.fitting.thermal import HYSTERESIS_CHOICES
 from gyrocomp.simulation import simulate

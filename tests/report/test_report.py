@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyrocomp import fit_calibration
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.report.figures import envelope
 from gyrocomp.report.html import SECTIONS, build_report
 from gyrocomp.rounding import with_error

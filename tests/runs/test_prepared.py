@@ -9,7 +9,7 @@ import pytest
 
 import gyrocomp.runs.prepared as prepared_module
 from gyrocomp.errors import InputError
-from gyrocomp.models.pipelines import fit_channels
+from gyrocomp.models.fit import fit_channels
 from gyrocomp.runs.prepared import PreparedRun, block_means, fit_axes, prepare
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import simulate

@@ -20,7 +20,7 @@ from ..io.atomic import check_output_file
 from ..curves.network import DEFAULT_HIDDEN
 from ..curves.kinds import BASES
 from ..models.options import MAX_CURVE_SIZE, Curve, Network, Polynomial, family_help
-from ..models.pipelines import check_channels
+from ..models.fit import check_channels
 from ..runs.prepared import CHANNELS
 from ..curves.polynomial import MAX_ORDER
 

@@ -16,7 +16,7 @@ from ..fitting.acceleration import ACCELERATION_CHOICES
 from ..models.field import field_recordings
 from ..models.options import FitOptions
 from ..models.fit import fit as fit_runs
-from ..models.pipelines import SCALE_FACTOR_CHOICES
+from ..models.triads import SCALE_FACTOR_CHOICES
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
 from .common import (FINITE, OUTPUT_FILE, float_list, parse_channels, parse_temperature_option, pop_read_options,

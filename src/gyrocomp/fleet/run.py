@@ -38,7 +38,8 @@ from ..io import ReadOptions, read_input
 from ..io.atomic import atomic_path, write_text_atomic
 from ..io.common import require
 from ..models.fit import fit
-from ..models.pipelines import Pipeline, check_channels
+from ..models.pipelines import Pipeline
+from ..models.fit import check_channels
 from ..runs.prepared import Channel
 from ..threads import single_threaded_blas
 from .unit_figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures

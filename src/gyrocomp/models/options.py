@@ -1,5 +1,5 @@
 """Typed options of a fit: what temperature model, thermal memory, g-sensitivity and held-out folds
-:func:`gyrocomp.models.pipelines.fit_pipeline` and :func:`~gyrocomp.models.pipelines.fit_channels` use.
+:func:`gyrocomp.models.fit.fit` and its other forms use.
 
 >>> from gyrocomp.models.options import Curve, FitOptions, Network, Polynomial
 >>> FitOptions(temperature=Polynomial(order=3), hysteresis="none")

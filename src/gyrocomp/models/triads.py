@@ -1,6 +1,6 @@
 """The triads' part of a fit: the gyro's scale factor and misalignment from rate-table runs or from the turns
 between the still poses of a multi-position session, and the accelerometer's from its still poses (with the
-temperature models it completes). Used by :func:`gyrocomp.models.pipelines.fit_channels`."""
+temperature models it completes). Used by :func:`gyrocomp.models.fit.fit`."""
 
 from __future__ import annotations
 

@@ -33,7 +33,7 @@ from ..errors import DataQualityWarning, MissingDependencyError, ModelChoiceWarn
 from ..io import read_table, write_gyro_back, write_recording, write_text_atomic
 from ..allan import allan_deviation_segments
 from ..measures.merit import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
-from ..models.pipelines import fit_calibration
+from ..models.joint import fit_calibration
 from .html import build_report, figure_html, table_html
 from . import figures
 from ..simulation import get_preset, get_profile, simulate
