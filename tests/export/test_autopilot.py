@@ -11,6 +11,7 @@ import pytest
 
 from gyrocomp import Calibration, find_poses, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.export import EXPORTERS
 from gyrocomp.export.autopilot import ardupilot_params_file, px4_params_file
 from gyrocomp.simulation import GyroErrorModel, Hysteresis, simulate
 from gyrocomp.models.fit import fit_channels
@@ -134,9 +135,12 @@ def test_cli_export(tmp_path):
     r = run("export", tmp_path / "m.json", "-o", tmp_path / "by_name.params", "--device-id", "7")
     assert r.returncode == 0 and "TC_G0_X" in (tmp_path / "by_name.params").read_text()
     r = run("export", tmp_path / "m.json", "-o", tmp_path / "x.slx")
+    offered = [name for name in EXPORTERS if name != "json"]  # what gyrocomp export offers, whatever is registered
+    named = ", ".join(f"{s} ({n})" for n in offered for s in EXPORTERS[n].suffixes)
     assert r.returncode == 2 and r.stderr.strip() == (
-        "gyrocomp: error: --format: not given, and 'x.slx' names none; give it (px4, ardupilot, c), or name the "
-        "file .params (px4), .parm (ardupilot), .param (ardupilot), or a folder without a suffix (c)")
+        f"gyrocomp: error: --format: not given, and 'x.slx' names none; give it ({', '.join(offered)}), or name the "
+        f"file {named}, or a folder without a suffix (c)")
+    assert ".params (px4), .parm (ardupilot), .param (ardupilot)" in named
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and "this is an input file" in r.stderr
 

@@ -39,7 +39,7 @@ def test_every_registered_format_writes_and_says_what(tmp_path, model):
 
 
 def test_an_unknown_format_is_refused_and_a_new_one_is_one_registration(tmp_path, model):
-    with pytest.raises(InputError, match=r"format: 'betaflight'; use one of px4, ardupilot, c, json"):
+    with pytest.raises(InputError, match=rf"format: 'betaflight'; use one of {', '.join(EXPORTERS)}$"):
         export_to(model, "betaflight", tmp_path / "x")
 
     def axes_csv(calibration, path, options):
