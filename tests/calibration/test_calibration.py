@@ -207,6 +207,21 @@ def test_schema_5_file_written_by_the_previous_release_loads_and_applies_identic
         np.testing.assert_allclose(out.gyro_dps[:, j], expected, rtol=0, atol=1e-12)
 
 
+def test_schema_6_file_written_before_the_registries_loads_and_applies_identically():
+    """tests/calibration/data/schema6: a model file written by gyrocomp at commit 0fddd35 (schema 6, before the
+    readers, exports and curves became registries and the fit one path; an ADXRS450 cubic with thermal lag and
+    turning-point hysteresis; its fit_report emptied, apply does not read it) and a held-out run with the output
+    that version's apply gave (turn-on window 60 s)."""
+    folder = Path(__file__).parent / "data" / "schema6"
+    assert json.loads((folder / "model.json").read_text())["schema_version"] == 6
+    loaded = Calibration.load(folder / "model.json")
+    assert loaded.axes["gyro_z"].hysteresis is not None and loaded.axes["gyro_z"].lag_time_constant_s > 0
+    data = read_table(folder / "heldout.csv")
+    out = apply(loaded, data.recording, turn_on_window_s=60)
+    np.testing.assert_allclose(out.gyro_dps[:, 0], data.table.column("expected_gyro_z").to_numpy(), rtol=0,
+                               atol=1e-12)
+
+
 def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other():
     """A gyro axis is in deg/s, an accelerometer axis in g: the unit-free names read either, the ``_dps`` and ``_g``
     accessors only their own; a calibration refuses an axis in the wrong section, and a file read back keeps the
