@@ -20,6 +20,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from ..curves.polynomial import POLY_FAMILY
 from ..units import AxisUnit, in_unit, unit_suffix
 
 #: the thermal memories a gyro axis's model may carry
@@ -70,7 +71,7 @@ class Candidate:
     weighting: Weighting = "time"
     band: bool = False
     branch: int = 0
-    curve: str = "poly"
+    curve: str = POLY_FAMILY
 
     @property
     def memory(self) -> str:
@@ -106,7 +107,7 @@ class Candidate:
              "weighting": self.weighting, "band": self.band, "label": self.label}
         if self.branch:  # written only when set: files without it read as before
             d["branch"] = self.branch
-        if self.curve != "poly":
+        if self.curve != POLY_FAMILY:
             d["curve"] = self.curve
         return d
 
@@ -115,7 +116,7 @@ class Candidate:
         """A stored candidate (its ``label`` is derived from the fields)."""
         return cls(int(d["order"]), bool(d.get("lag", False)), int(d.get("hysteresis_order", 0)),
                    d.get("weighting", "time"), bool(d.get("band", False)), int(d.get("branch", 0)),
-                   str(d.get("curve", "poly")))
+                   str(d.get("curve", POLY_FAMILY)))
 
 
 def _entry_in_unit(d: dict, name: str, unit: str, default=None):

@@ -22,7 +22,7 @@ from ..curves.kinds import BASES
 from ..models.options import MAX_CURVE_SIZE, Curve, Network, Polynomial, family_help
 from ..models.fit import check_channels
 from ..runs.prepared import CHANNELS
-from ..curves.polynomial import MAX_ORDER
+from ..curves.polynomial import POLY_FAMILY, MAX_ORDER
 
 
 class OutputFile(click.Path):
@@ -141,9 +141,9 @@ def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Curve | N
         if not size:
             return Curve(family)
         try:
-            return Polynomial(int(size)) if family == "poly" else Curve(family, int(size))
+            return Polynomial(int(size)) if family == POLY_FAMILY else Curve(family, int(size))
         except (ValueError, InputError):
-            low, top = (0, MAX_ORDER) if family == "poly" else (1, MAX_CURVE_SIZE)
+            low, top = (0, MAX_ORDER) if family == POLY_FAMILY else (1, MAX_CURVE_SIZE)
             raise InputError(f"--temperature: {text!r}: the size of {family} must be a whole number from {low} to "
                              f"{top}") from None
     raise InputError(f"--temperature: {text!r}: use auto, {', '.join(f'{n}, {n}:N' for n in BASES)}, mlp, mlp:H "

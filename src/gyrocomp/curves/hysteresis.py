@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from ..effects import branch_position, find_turns, hysteresis_offset
 from ..errors import InputError
+from ..c_literals import c_array, c_number
 from ..recording import Recording
+from .protocol import MEMORY_CURVES, CCode, memory_curve_from_dict, register_memory_curve
 
 
 def turn_threshold_degc(temperature_degc: np.ndarray) -> float:
@@ -50,6 +52,7 @@ def heats_and_cools(recordings: list[Recording], axis: str) -> bool:
     return up and down
 
 
+@register_memory_curve
 @dataclass(frozen=True)
 class HysteresisCurve:
     """Fitted hysteresis of one axis: offset after a reversal of the model temperature.
@@ -62,6 +65,8 @@ class HysteresisCurve:
     Reversals are confirmed ``threshold_degc`` past the extreme (see :func:`gyrocomp.effects.find_turns`).
     """
 
+    kind: ClassVar[str] = "turning-point"
+
     descending: tuple[float, ...]
     ascending: tuple[float, ...]
     threshold_degc: float
@@ -73,7 +78,7 @@ class HysteresisCurve:
         return len(self.descending)
 
     #: what the curve models, in words (exports say which they cannot carry)
-    kind = "turning-point hysteresis"
+    title: ClassVar[str] = "turning-point hysteresis"  # in words, for messages
 
     def describe(self) -> str:
         """In words for tables: ``turning-point hysteresis order 2 in 55..80 degC``."""
@@ -89,12 +94,32 @@ class HysteresisCurve:
         return down + up
 
     def to_dict(self) -> dict[str, Any]:
-        d = {"type": "turning-point", "descending_dps": list(self.descending),
+        d = {"type": self.kind, "descending_dps": list(self.descending),
              "ascending_dps": list(self.ascending), "threshold_degc": self.threshold_degc,
              "band_degc": None if self.band_degc is None else list(self.band_degc)}
         if self.max_distance_degc is not None:  # written only when set: earlier readers see an earlier file
             d["max_distance_degc"] = list(self.max_distance_degc)
         return d
+
+    def c_code(self, slot: int) -> CCode:
+        """The offset on the branch after the last confirmed turn: sum_j h_j d^j, d = |tm - turn| (held at the
+        largest distance the fit saw), inside the band."""
+        lines = [f"turn_update(&s->turn[{slot}], tm, {c_number(self.threshold_degc)});",
+                 f"if (s->turn[{slot}].has_turn) {{"]
+        band = ("" if self.band_degc is None
+                else f" && tm >= {c_number(self.band_degc[0])} && tm <= {c_number(self.band_degc[1])}")
+        reach = self.max_distance_degc or (None, None)
+        for sign, coefs, d_max in ((-1, self.descending, reach[0]), (1, self.ascending, reach[1])):
+            lines.append(f"    if (s->turn[{slot}].direction == {sign}{band}) {{")
+            lines.append(f"        const double h[] = {c_array(coefs)};")
+            lines.append(f"        double d = fabs(tm - s->turn[{slot}].turn), off = 0.0;")
+            if d_max is not None:
+                lines.append(f"        if (d > {c_number(d_max)}) d = {c_number(d_max)};")
+            lines.append(f"        for (int k = {len(coefs) - 1}; k >= 0; --k) off = (off + h[k]) * d;")
+            lines.append("        shape += off;")
+            lines.append("    }")
+        lines.append("}")
+        return CCode(tuple(lines))
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "HysteresisCurve":
@@ -107,6 +132,7 @@ class HysteresisCurve:
                    None if reach is None else (float(reach[0]), float(reach[1])))
 
 
+@register_memory_curve
 @dataclass(frozen=True)
 class BranchCurve:
     """Fitted branches of one axis: one curve while heating, another while cooling, crossing over after each
@@ -119,6 +145,8 @@ class BranchCurve:
     [``t_min_degc``, ``t_max_degc``] the half difference is held at its edge value. Reversals are confirmed
     ``threshold_degc`` past the extreme; ``transition_degc`` is the crossover's width w [degC].
     """
+
+    kind: ClassVar[str] = "branch"
 
     coefficients: tuple[float, ...]
     t_ref_degc: float
@@ -135,7 +163,7 @@ class BranchCurve:
 
     band_degc = None  # the branches differ over the whole range
     #: what the curve models, in words (exports say which they cannot carry)
-    kind = "heating/cooling branches"
+    title: ClassVar[str] = "heating/cooling branches"  # in words, for messages
 
     def describe(self) -> str:
         """In words for tables: ``heating/cooling branches (2 terms, crossover 6 degC)``."""
@@ -155,9 +183,27 @@ class BranchCurve:
         return branch_position(temperature_degc, turns, self.transition_degc) * self.half_difference(temperature_degc)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": "branch", "coefficients_dps": list(self.coefficients), "t_ref_degc": self.t_ref_degc,
+        return {"type": self.kind, "coefficients_dps": list(self.coefficients), "t_ref_degc": self.t_ref_degc,
                 "t_scale_degc": self.t_scale_degc, "transition_degc": self.transition_degc,
                 "threshold_degc": self.threshold_degc, "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
+
+    def c_code(self, slot: int) -> CCode:
+        """The heating and cooling branches: s * sum c_k u^k (:func:`gyrocomp.effects.branch_position` for s)."""
+        w = c_number(self.transition_degc)
+        return CCode((f"turn_update(&s->turn[{slot}], tm, {c_number(self.threshold_degc)});",
+                      "{",
+                      f"    const double c[] = {c_array(self.coefficients)};",
+                      f"    double tc = tm < {c_number(self.t_min_degc)} ? {c_number(self.t_min_degc)} : "
+                      f"(tm > {c_number(self.t_max_degc)} ? {c_number(self.t_max_degc)} : tm);",
+                      f"    double u = (tc - {c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)}, half = 0.0;",
+                      f"    for (int k = {self.order - 1}; k >= 0; --k) half = half * u + c[k];",
+                      f"    const gyrocomp_turn *tp = &s->turn[{slot}];",
+                      "    double position = (double)tp->direction;",
+                      f"    if (tp->has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - tp->turn) / {w});",
+                      "    else position *= 1.0 - exp(-fabs(tm - (tp->direction > 0 ? tp->low : tp->high)) / "
+                      f"{w});",
+                      "    shape += position * half;",
+                      "}"))
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "BranchCurve":
@@ -168,20 +214,6 @@ class BranchCurve:
             raise InputError("hysteresis: a branch model needs t_scale_degc and transition_degc above 0 and "
                              "threshold_degc of 0 or more")
         return curve
-
-
-#: the memory curves a model file may hold, by their ``type``: each gives ``offset(temperature, turns)``,
-#: ``threshold_degc``, ``order``, ``band_degc``, ``to_dict`` and ``from_dict``
-MEMORY_CURVES: dict[str, type] = {"turning-point": HysteresisCurve, "branch": BranchCurve}
-
-
-def memory_curve_from_dict(d: dict[str, Any]):
-    """The memory curve a model file's ``hysteresis`` entry describes (by its ``type``)."""
-    kind = MEMORY_CURVES.get(d.get("type")) if isinstance(d, dict) else None
-    if kind is None:
-        raise InputError(f"hysteresis: unknown model type {d.get('type') if isinstance(d, dict) else d!r}; "
-                         f"use one of {', '.join(MEMORY_CURVES)}")
-    return kind.from_dict(d)
 
 
 __all__ = ["BranchCurve", "HysteresisCurve", "MEMORY_CURVES", "heats_and_cools", "memory_curve_from_dict",

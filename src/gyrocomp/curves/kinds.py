@@ -7,6 +7,7 @@ from __future__ import annotations
 from . import polynomial  # noqa: F401
 from . import network  # noqa: F401
 from . import lookup  # noqa: F401
-from .protocol import BASES, CURVES, curve_from_dict
+from . import hysteresis  # noqa: F401  (memory curves)
+from .protocol import BASES, CURVES, MEMORY_CURVES, curve_from_dict
 
-__all__ = ["BASES", "CURVES", "curve_from_dict"]
+__all__ = ["BASES", "CURVES", "MEMORY_CURVES", "curve_from_dict"]

@@ -19,6 +19,8 @@ from ..errors import InputError
 from .protocol import CCode, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION, register_basis, register_curve
 
 MAX_ORDER = 5
+#: the polynomial family's name among the curve families (``poly:3``): the one that takes thermal memory
+POLY_FAMILY = "poly"
 #: data beyond the fitted temperature range by less than max(these) is not reported as outside it
 #: what a polynomial does past its fitted range: held at the edge, or continued along its tangent
 EXTRAPOLATIONS = ("hold", "linear")
@@ -162,7 +164,7 @@ class PolynomialBasis:
     columns continue along their tangent when ``extended`` (how the model choice scores, and the chosen curve is
     applied), else they are held at the edge."""
 
-    name: ClassVar[str] = "poly"
+    name: ClassVar[str] = POLY_FAMILY
     description: ClassVar[str] = "a polynomial of order N in temperature (poly alone: its order by held-out drift)"
     sizes: ClassVar[tuple[int, ...]] = tuple(range(1, MAX_ORDER + 1))
 

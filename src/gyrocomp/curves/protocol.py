@@ -157,5 +157,53 @@ def register_basis(cls: type) -> type:
     return _register(BASES, cls.name, cls, "a curve basis named")
 
 
-__all__ = ["BASES", "CCode", "CURVES", "CurveBasis", "TemperatureCurve", "curve_from_dict", "register_basis",
-           "register_curve"]
+class MemoryCurve(Protocol):
+    """What the bias remembers of the temperature's path (turning-point hysteresis, heating and cooling branches),
+    added to the temperature curve's shape, frozen and serializable.
+
+    Attributes: ``kind`` (the ``type`` of its entry in a model file), ``title`` (what it is, in words for
+    messages), ``threshold_degc`` (a reversal is
+    confirmed this far past the extreme [degC]), ``band_degc`` (where it acts [degC], or None), ``order``."""
+
+    kind: ClassVar[str]
+    threshold_degc: float
+
+    def offset(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
+        """The offset [the axis's unit] at ``temperature_degc`` [degC] given the confirmed ``turns``
+        (:func:`gyrocomp.effects.find_turns`)."""
+
+    def describe(self) -> str:
+        """The memory in words for tables."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """Its entry in a model file, ``type`` = ``kind``."""
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "MemoryCurve":
+        """The memory curve of a model file's entry, checked."""
+
+    def c_code(self, slot: int) -> CCode:
+        """The statements that add its offset to ``shape`` in ``gyrocomp_step`` from ``tm`` and the turn state
+        ``s->turn[slot]`` (updated by them)."""
+
+
+#: every memory curve a model file may hold, by its ``kind``
+MEMORY_CURVES: dict[str, type] = {}
+
+
+def register_memory_curve(cls: type) -> type:
+    """Class decorator: make a memory curve readable from model files and exportable (``kind`` unique)."""
+    return _register(MEMORY_CURVES, cls.kind, cls, "a memory curve of kind")
+
+
+def memory_curve_from_dict(d: dict[str, Any]) -> MemoryCurve:
+    """The memory curve a model file's ``hysteresis`` entry describes (its ``type`` one of :data:`MEMORY_CURVES`)."""
+    kind = MEMORY_CURVES.get(d.get("type")) if isinstance(d, dict) else None
+    if kind is None:
+        raise InputError(f"hysteresis: unknown model type {d.get('type') if isinstance(d, dict) else d!r}; "
+                         f"use one of {', '.join(MEMORY_CURVES)}")
+    return kind.from_dict(d)
+
+
+__all__ = ["BASES", "CCode", "CURVES", "CurveBasis", "MEMORY_CURVES", "MemoryCurve", "TemperatureCurve",
+           "curve_from_dict", "memory_curve_from_dict", "register_basis", "register_curve", "register_memory_curve"]

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..curves.polynomial import POLY_FAMILY
 from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..errors import InputError
 from .branch_evidence import branch_test
@@ -198,7 +199,7 @@ def _choose_on_two_folds(problem: SelectionProblem, offered: list[CandidateScore
         return best, constant.candidate, "do no harm: no term of the temperature curve stands out of the drift " \
             f"(order test, largest Wald {max(test.statistics, default=0.0):.3g} against {test.threshold:.3g})", test
     rule = f"two held-out legs ({problem.window_s:.3g} s window): the simplest within one standard error of the best"
-    if held_out.curve == "poly" and held_out.order < test.order:
+    if held_out.curve == POLY_FAMILY and held_out.order < test.order:
         in_pool = {s.candidate for s in pool}
         for order in range(test.order, held_out.order, -1):
             raised = dataclasses.replace(held_out, order=order)

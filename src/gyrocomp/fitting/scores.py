@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..curves.polynomial import POLY_FAMILY
 from ..calibration.fit_report import Candidate
 from ..units import AxisUnit, unit_suffix
 
@@ -151,11 +152,11 @@ def _other_families_that_earn_it(finite: list[CandidateScore]) -> list[Candidate
     drift on both). A table has many terms and follows what the folds share by chance: measured on a simulated
     fleet of consumer-grade units (three 15-minute runs each), tables chosen by the one-SE rule alone moved the
     units' temperature figures off their truth and tripled the good units flagged as outliers."""
-    polys = [s for s in finite if s.candidate.curve == "poly" and s.candidate.has_temperature_model]
+    polys = [s for s in finite if s.candidate.curve == POLY_FAMILY and s.candidate.has_temperature_model]
     if not polys:
         return finite
     best_poly = min(polys, key=lambda s: s.mean_drift)
-    return [s for s in finite if s.candidate.curve == "poly" or beats_constant(s, best_poly)]
+    return [s for s in finite if s.candidate.curve == POLY_FAMILY or beats_constant(s, best_poly)]
 
 
 __all__ = ["CandidateScore", "TWO_FOLD_RATIO", "beats_constant", "choose", "fold_mean", "fold_standard_error",

@@ -54,7 +54,7 @@ from .folds import FoldKind, Folds, make_folds, window_for
 from .scores import CandidateScore, json_number
 from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
-from ..curves.polynomial import power_columns
+from ..curves.polynomial import POLY_FAMILY, power_columns
 from ..curves.protocol import BASES
 from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, SCORE_WINDOW_S, lag_search_top_s
 
@@ -368,7 +368,7 @@ class SelectionProblem:
         h = self.max_hysteresis
         n_h = 2 * h * (2 if h and self.band_degc is not None else 1)
         start = o + (2 * h if c.band else 0)
-        if c.curve == "poly":
+        if c.curve == POLY_FAMILY:
             idx = list(range(c.order))
         else:
             first = next(f for name, size, f in blocks if name == c.curve and size == c.order)
@@ -525,7 +525,7 @@ class SelectionProblem:
         least training residual; with ``short_window``, at the short window too (:attr:`short_window_s`)."""
         taus = self.lag_grid_s() if c.lag else np.array([0.0])
         drifts, lags = [], []
-        shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag and c.curve == "poly" else None
+        shared = self.fold_lags_s.get((c.order, c.weighting)) if c.lag and c.curve == POLY_FAMILY else None
         both = self.fold_has_both_directions()
         for f in range(self.folds.count):
             # a fold whose training data holds one direction only cannot tell the branches apart: there the

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..curves.polynomial import POLY_FAMILY
 from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError
 from ..calibration.fit_report import memory_name
@@ -114,7 +115,7 @@ class _Spec:
     branch: int = 0
     width_degc: float = 0.0
     #: the curve family of the shape (:data:`gyrocomp.curves.protocol.BASES`), ``order`` its size
-    curve: str = "poly"
+    curve: str = POLY_FAMILY
 
     @property
     def name(self) -> str:
@@ -474,7 +475,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     shared_lag: bool = True
     refine_band: bool = False
     branch_order: int | dict[str, int] = MAX_BRANCH_ORDER
-    curve: str | dict[str, str] = "poly"
+    curve: str | dict[str, str] = POLY_FAMILY
     extended: bool = False
 
     @staticmethod

@@ -17,7 +17,7 @@ from typing import Literal, get_args
 from ..errors import InputError
 from ..curves.kinds import BASES
 from ..curves.network import DEFAULT_HIDDEN
-from ..curves.polynomial import MAX_ORDER
+from ..curves.polynomial import POLY_FAMILY, MAX_ORDER
 from ..fitting.thermal import MAX_HYSTERESIS_ORDER
 
 #: the thermal memory on top of the temperature curve
@@ -91,8 +91,8 @@ class Curve:
     def __post_init__(self):
         if self.family not in BASES:
             raise InputError(f"Curve.family: {self.family!r}; the registered curves are {', '.join(BASES)}")
-        top = MAX_ORDER if self.family == "poly" else MAX_CURVE_SIZE
-        low = 0 if self.family == "poly" else 1
+        top = MAX_ORDER if self.family == POLY_FAMILY else MAX_CURVE_SIZE
+        low = 0 if self.family == POLY_FAMILY else 1
         if self.size != "auto" and not (isinstance(self.size, int) and not isinstance(self.size, bool)
                                         and low <= self.size <= top):
             raise InputError(f"Curve.size: {self.family} takes a whole number from {low} to {top}, or 'auto'; "
@@ -138,14 +138,14 @@ def curve_candidates(spec: "Polynomial | Curve | Network", target: "Target" = "m
     """
     top = MAX_ORDER if target == "model" else FIRMWARE_MAX_ORDER
     every_order = tuple(range(top + 1))
-    if isinstance(spec, Curve) and spec.family != "poly":
+    if isinstance(spec, Curve) and spec.family != POLY_FAMILY:
         sizes = BASES[spec.family].sizes if spec.size == "auto" else (spec.size,)
         return CurveCandidates((), tuple((spec.family, size) for size in sizes), False)
     if isinstance(spec, Curve):
         return CurveCandidates(every_order, (), True)
     if isinstance(spec, Polynomial) and spec.order != "auto":
         return CurveCandidates((spec.order,), (), False)
-    others = tuple((name, size) for name, basis in BASES.items() if name != "poly" for size in basis.sizes)
+    others = tuple((name, size) for name, basis in BASES.items() if name != POLY_FAMILY for size in basis.sizes)
     return CurveCandidates(every_order, others if target == "model" else (), True)
 
 
@@ -153,7 +153,7 @@ def family_help() -> str:
     """The registered curve families as ``--temperature`` lists them: each name, its sizes, what it is."""
     out = []
     for name, basis in BASES.items():
-        low, top = (0, MAX_ORDER) if name == "poly" else (1, MAX_CURVE_SIZE)
+        low, top = (0, MAX_ORDER) if name == POLY_FAMILY else (1, MAX_CURVE_SIZE)
         out.append(f"{name} or {name}:N (N = {low}..{top}): {basis.description}")
     return "; ".join(out)
 
@@ -212,7 +212,7 @@ class FitOptions:
     target: Target = "model"
 
     def __post_init__(self):
-        if isinstance(self.temperature, Curve) and self.temperature.family == "poly" and self.temperature.size != "auto":
+        if isinstance(self.temperature, Curve) and self.temperature.family == POLY_FAMILY and self.temperature.size != "auto":
             object.__setattr__(self, "temperature", Polynomial(self.temperature.size))
         if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Curve, Network)):
             raise InputError(f"FitOptions.temperature: Polynomial(order=...), Curve(family, size), Network(hidden=...) "
@@ -226,7 +226,7 @@ class FitOptions:
         _choice("FitOptions.target", self.target, get_args(Target))
         if self.target != "model":
             self._check_firmware_target()
-        if isinstance(self.temperature, Curve) and self.temperature.family != "poly":
+        if isinstance(self.temperature, Curve) and self.temperature.family != POLY_FAMILY:
             self._check_other_family()
         if self.bin_width_degc is not None and not (isinstance(self.bin_width_degc, (int, float))
                                                     and self.bin_width_degc > 0):
@@ -246,7 +246,7 @@ class FitOptions:
     def _check_firmware_target(self) -> None:
         """A firmware target carries a cubic at most and nothing else: other asks are refused naming the field."""
         t = self.target
-        poly_only = isinstance(self.temperature, Curve) and self.temperature.family == "poly"
+        poly_only = isinstance(self.temperature, Curve) and self.temperature.family == POLY_FAMILY
         if not (isinstance(self.temperature, Polynomial) or poly_only) or (
                 not poly_only and self.temperature.order != "auto" and self.temperature.order > FIRMWARE_MAX_ORDER):
             raise InputError(f"FitOptions.target: {t} carries a polynomial of order {FIRMWARE_MAX_ORDER} at most; "
