@@ -66,7 +66,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..ctext import c_array, c_number
+from ..c_literals import c_array, c_number
 from .protocol import CCode, register_basis, register_curve
 
 
