@@ -50,6 +50,9 @@ COMMANDS = {
     "evaluate": ("evaluate", 'Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.'),
     "allan": ("allan", 'Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of '
                  'FILE.'),
+    "noise": ("noise", "Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov "
+                       "terms) whose Allan deviation is at or above the upper end of every log's 95 % interval at "
+                       "every averaging time, beside the IEEE 952 fit."),
     "export": ("export", 'Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as '
                   'C code.'),
     "report": ("report", 'One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias '

@@ -1,0 +1,83 @@
+"""``gyrocomp noise``: parse its options, call the library, print the noise model or write an export."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+from rich.table import Table
+
+from ..export.estimator_noise import NOISE_EXPORTS
+from ..files.noise_file import analyse_noise_file
+from ..io import refuse_to_overwrite_inputs, write_text_atomic
+from ..io.inputs import expand_runs
+from ..measures.noise_model import NoiseModel, noise_model
+from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, read_options, read_settings
+
+
+@click.command()
+@click.argument("logs", nargs=-1, required=True, type=click.Path())
+@click.option("--export", "export_format", type=click.Choice(tuple(NOISE_EXPORTS)), default=None,
+              help="Write the model for an estimator: kalibr (imu.yaml), openvins (kalibr_imu_chain.yaml), vins "
+                   "(acc_n, gyr_n, acc_w, gyr_w), ros (sensor_msgs/Imu covariances) or json (the whole model).")
+@click.option("-o", "--output", type=OUTPUT_FILE, default=None, help="The file --export writes.")
+@click.option("--rostopic", default="/imu0", show_default=True, help="The IMU topic written into the export.")
+@click.option("--axes", "axes", default=None,
+              help="Columns to model, e.g. gyro_x,gyro_z,accel_z (default: every gyro and accelerometer axis).")
+@click.option("--split-gaps/--no-split-gaps", default=False,
+              help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
+@read_options
+@click.pass_context
+def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, **kwargs):
+    """Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov terms) whose Allan
+    deviation is at or above the upper end of every log's 95 % interval at every averaging time, beside the IEEE
+    952 fit."""
+    opts = pop_read_options(kwargs)
+    if (export_format is None) != (output is None):
+        raise click.BadParameter("give --export and -o together",
+                                 param_hint="--export" if export_format is None else "-o")
+    paths = expand_runs(logs)
+    if output is not None:
+        refuse_to_overwrite_inputs(output, paths, option="-o")
+    named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
+    analyses = []
+    for path in paths:
+        with progress_bar(f"reading {Path(path).name}") as progress:
+            analyses.append(analyse_noise_file(path, named, options=read_settings(opts), fmt=opts["fmt"],
+                                               with_accel=named is None, split_gaps=split_gaps, progress=progress))
+    model = noise_model(analyses)
+    if export_format is not None:
+        write_text_atomic(output, NOISE_EXPORTS[export_format](model, rostopic))
+    if not ctx.obj["quiet"]:
+        print_noise_model(model)
+        if export_format is not None:
+            click.echo(f"wrote {output} ({export_format})")
+
+
+def print_noise_model(model: NoiseModel) -> None:
+    """Per axis: the IEEE 952 fit beside the two bounds, and each log's own bound."""
+    console = make_console()
+    table = Table(title=f"noise model at {model.rate_hz:g} Hz: at or above the measured Allan deviation's upper "
+                        "95 % interval (ratio: model / measured over the bounded taus)")
+    for col in ("axis", "unit u", "IEEE 952 N [u/sqrt(Hz)]", "IEEE 952 K [u/sqrt(s)]", "bound N", "bound K",
+                "ratio median / max", "with Gauss-Markov: terms", "ratio median / max ", "taus bounded [s]"):
+        table.add_column(col, justify="left" if col in ("axis", "unit u") else "right")
+    for name, a in model.axes.items():
+        table.add_row(name, a.unit, f"{a.ieee.white_noise_density:.4g}",
+                      f"{a.ieee.random_walk:.4g}", f"{a.bound.white_noise_density:.4g}",
+                      f"{a.bound.random_walk:.4g}", f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}",
+                      str(len(a.markov.markov)), f"{a.markov.ratio_median:.2f} / {a.markov.ratio_max:.2f}",
+                      f"{a.bound.taus_s[0]:.3g} .. {a.max_tau_s:.3g}")
+    console.print(table)
+    if any(len(a.logs) > 1 for a in model.axes.values()):
+        logs = Table(title="each log's own bound (white noise N, random walk K)")
+        for col in ("axis", "log", "N", "K"):
+            logs.add_column(col, justify="left" if col in ("axis", "log") else "right")
+        for name, a in model.axes.items():
+            for log in a.logs:
+                logs.add_row(name, Path(log.source).name, f"{log.bound.white_noise_density:.4g}",
+                             f"{log.bound.random_walk:.4g}")
+        console.print(logs)
+
+
+__all__ = ["noise", "print_noise_model"]

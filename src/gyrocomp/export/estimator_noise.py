@@ -1,0 +1,203 @@
+"""A noise model (:mod:`gyrocomp.measures.noise_model`) in each estimator's own units, from the bound that carries
+white noise and random walk only (the form these estimators take).
+
+Each conversion follows the consumer's code (docs/noise.md has the table with the source lines):
+
+- Kalibr ``imu.yaml`` and OpenVINS ``kalibr_imu_chain.yaml``: the continuous-time densities N [rad/s/sqrt(Hz)]
+  and K [rad/s^2/sqrt(Hz)] (OpenVINS ``ov_msckf/src/state/Propagator.cpp`` builds its discrete noise as
+  ``sigma_w^2 / dt``, ``sigma_wb^2 / dt``, "continuous time noises to discrete").
+- VINS-Fusion ``gyr_n``, ``gyr_w``, ``acc_n``, ``acc_w``: standard deviations per IMU sample
+  (``vins_estimator/src/factor/integration_base.h``: the mid-point step adds ``(0.5 dt)^2`` times ``GYR_N^2`` for
+  each of its two samples to the angle and ``dt^2 GYR_W^2`` to the bias), so for the same variance per step as the
+  continuous model, ``gyr_n = N sqrt(2 / dt)`` and ``gyr_w = K / sqrt(dt)``; likewise for the accelerometer.
+- ROS ``sensor_msgs/Imu``: ``angular_velocity_covariance`` and ``linear_acceleration_covariance`` are the
+  variance of one sample about the true value [rad^2/s^2, m^2/s^4]: N^2 times the sample rate (the white part a
+  sample carries; the bias is the estimator's state).
+- JSON: the whole model (both bounds, the IEEE Std 952 fit, each log's bound) in the data's units.
+
+With several axes of one sensor, the largest value is written: the conservative choice for a filter that takes
+one number for all three.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ..errors import DataQualityWarning, InputError
+from ..measures.noise_model import NoiseModel
+from ..units import STANDARD_GRAVITY_M_PER_S2
+from .encode import line_comment
+
+DEG_TO_RAD = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class ContinuousNoise:
+    """The bound's white-noise densities and random walks in SI units, the largest over each sensor's axes.
+
+    Attributes
+    ----------
+    gyro_noise_density_rad_per_s_per_sqrt_hz, gyro_random_walk_rad_per_s2_per_sqrt_hz : float or None
+        N and K of the gyro axes (None without one).
+    accel_noise_density_m_per_s2_per_sqrt_hz, accel_random_walk_m_per_s3_per_sqrt_hz : float or None
+        N and K of the accelerometer axes (None without one).
+    rate_hz : float
+        The sample rate the logs were taken at [Hz].
+    """
+
+    gyro_noise_density_rad_per_s_per_sqrt_hz: float | None
+    gyro_random_walk_rad_per_s2_per_sqrt_hz: float | None
+    accel_noise_density_m_per_s2_per_sqrt_hz: float | None
+    accel_random_walk_m_per_s3_per_sqrt_hz: float | None
+    rate_hz: float
+
+
+def continuous_noise(model: NoiseModel) -> ContinuousNoise:
+    """The two-term bound of ``model`` in SI units (deg/s to rad/s, g to m/s^2), the largest over each sensor's
+    axes.
+
+    Parameters
+    ----------
+    model : NoiseModel
+        The noise model of static logs.
+    """
+    def largest(sensor: str, attribute: str, factor: float) -> float | None:
+        values = [getattr(a.bound, attribute) for a in model.axes.values() if a.sensor == sensor]
+        return max(values) * factor if values else None
+
+    g = STANDARD_GRAVITY_M_PER_S2
+    return ContinuousNoise(largest("gyro", "white_noise_density", DEG_TO_RAD), largest("gyro", "random_walk", DEG_TO_RAD),
+                           largest("accel", "white_noise_density", g), largest("accel", "random_walk", g),
+                           model.rate_hz)
+
+
+def _need(value: float | None, what: str, target: str) -> float:
+    if value is None:
+        raise InputError(f"export {target}: the logs have no {what} axes; it needs them (name the columns with "
+                         "columns=, and analyse the accelerometer too)")
+    return value
+
+
+def _warn_zero_walk(c: ContinuousNoise, target: str) -> None:
+    """Kalibr (and OpenVINS, which reads its file) refuse a random walk of 0: say so where the logs show none."""
+    for sensor, walk in (("gyroscope", c.gyro_random_walk_rad_per_s2_per_sqrt_hz),
+                         ("accelerometer", c.accel_random_walk_m_per_s3_per_sqrt_hz)):
+        if walk == 0.0:
+            warnings.warn(f"export {target}: no {sensor} random walk is needed to bound these logs (K = 0); {target} "
+                          "refuses 0: record a longer static log (hours)", DataQualityWarning, stacklevel=3)
+
+
+def kalibr_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """Kalibr's ``imu.yaml``: continuous-time densities [rad/s/sqrt(Hz), m/s^2/sqrt(Hz)] and random walks."""
+    c = continuous_noise(model)
+    _warn_zero_walk(c, "kalibr")
+    lines = ["# written by gyrocomp: the white-noise + random-walk bound of the measured Allan deviation",
+             "# (at or above the upper end of its 95 % interval at every averaging time); continuous-time values"]
+    if c.accel_noise_density_m_per_s2_per_sqrt_hz is not None:
+        lines += [f"accelerometer_noise_density: {c.accel_noise_density_m_per_s2_per_sqrt_hz:.6e}  # [m/s^2/sqrt(Hz)]",
+                  f"accelerometer_random_walk: {c.accel_random_walk_m_per_s3_per_sqrt_hz:.6e}  # [m/s^3/sqrt(Hz)]"]
+    else:
+        lines.append("# no accelerometer axes in the logs: add accelerometer_noise_density and "
+                     "accelerometer_random_walk before running Kalibr")
+    lines += [f"gyroscope_noise_density: {_need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, 'gyro', 'kalibr'):.6e}"
+              "  # [rad/s/sqrt(Hz)]",
+              f"gyroscope_random_walk: {c.gyro_random_walk_rad_per_s2_per_sqrt_hz:.6e}  # [rad/s^2/sqrt(Hz)]",
+              f"rostopic: {json.dumps(rostopic)}",
+              f"update_rate: {c.rate_hz:.6g}  # [Hz]"]
+    return "\n".join(lines) + "\n"
+
+
+def openvins_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """OpenVINS's ``kalibr_imu_chain.yaml`` (``%YAML:1.0``, an ``imu0`` block): the same continuous values."""
+    c = continuous_noise(model)
+    _warn_zero_walk(c, "openvins")
+    gyro_n = _need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, "gyro", "openvins")
+    accel_n = _need(c.accel_noise_density_m_per_s2_per_sqrt_hz, "accelerometer", "openvins")
+    return "\n".join([
+        "%YAML:1.0 # written by gyrocomp: the white-noise + random-walk bound of the measured Allan deviation",
+        "",
+        "imu0:",
+        "  T_i_b:",
+        *(f"    - [{', '.join('1.0' if i == j else '0.0' for j in range(4))}]" for i in range(4)),
+        f"  accelerometer_noise_density: {accel_n:.6e}  # [m/s^2/sqrt(Hz)]",
+        f"  accelerometer_random_walk: {c.accel_random_walk_m_per_s3_per_sqrt_hz:.6e}  # [m/s^3/sqrt(Hz)]",
+        f"  gyroscope_noise_density: {gyro_n:.6e}  # [rad/s/sqrt(Hz)]",
+        f"  gyroscope_random_walk: {c.gyro_random_walk_rad_per_s2_per_sqrt_hz:.6e}  # [rad/s^2/sqrt(Hz)]",
+        f"  rostopic: {json.dumps(rostopic)}",
+        "  time_offset: 0.0",
+        f"  update_rate: {c.rate_hz:.6g}",
+        '  model: "kalibr"',
+    ]) + "\n"
+
+
+def vins_values(model: NoiseModel) -> dict[str, float]:
+    """VINS-Fusion's ``acc_n``, ``gyr_n``, ``acc_w``, ``gyr_w``: per-sample standard deviations at the logs' rate
+    (see the module): n = N sqrt(2 rate), w = K sqrt(rate).
+
+    Parameters
+    ----------
+    model : NoiseModel
+        The noise model of static logs (gyro and accelerometer axes).
+    """
+    c = continuous_noise(model)
+    gyro_n = _need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, "gyro", "vins")
+    accel_n = _need(c.accel_noise_density_m_per_s2_per_sqrt_hz, "accelerometer", "vins")
+    return {"acc_n": accel_n * math.sqrt(2.0 * c.rate_hz), "gyr_n": gyro_n * math.sqrt(2.0 * c.rate_hz),
+            "acc_w": c.accel_random_walk_m_per_s3_per_sqrt_hz * math.sqrt(c.rate_hz),
+            "gyr_w": c.gyro_random_walk_rad_per_s2_per_sqrt_hz * math.sqrt(c.rate_hz)}
+
+
+def vins_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """The IMU lines of a VINS-Fusion configuration file."""
+    v = vins_values(model)
+    return "\n".join([
+        "# " + line_comment(f"written by gyrocomp: per-sample standard deviations at {model.rate_hz:g} Hz "
+                            "(integration_base.h's discretization), from the white-noise + random-walk bound"),
+        f"imu_topic: {json.dumps(rostopic)}",
+        f"acc_n: {v['acc_n']:.6e}  # accelerometer measurement noise [m/s^2]",
+        f"gyr_n: {v['gyr_n']:.6e}  # gyroscope measurement noise [rad/s]",
+        f"acc_w: {v['acc_w']:.6e}  # accelerometer bias random walk [m/s^3]",
+        f"gyr_w: {v['gyr_w']:.6e}  # gyroscope bias random walk [rad/s^2]",
+    ]) + "\n"
+
+
+def ros_covariances(model: NoiseModel, rate_hz: float | None = None) -> dict[str, list[float]]:
+    """``sensor_msgs/Imu``'s ``angular_velocity_covariance`` [rad^2/s^2] and ``linear_acceleration_covariance``
+    [m^2/s^4] (row-major 3x3, diagonal), per sample at ``rate_hz`` [Hz] (default the logs' rate): N^2 rate."""
+    c = continuous_noise(model)
+    rate = model.rate_hz if rate_hz is None else rate_hz
+    if not (isinstance(rate, (int, float)) and rate > 0 and math.isfinite(rate)):
+        raise InputError(f"rate_hz: a positive number of Hz, got {rate!r}")
+    out = {}
+    for key, density in (("angular_velocity_covariance", c.gyro_noise_density_rad_per_s_per_sqrt_hz),
+                         ("linear_acceleration_covariance", c.accel_noise_density_m_per_s2_per_sqrt_hz)):
+        if density is not None:
+            v = density ** 2 * rate
+            out[key] = [v, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0.0, v]
+    return out
+
+
+def ros_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """The covariances as YAML parameters of an IMU driver node."""
+    lines = [f"# written by gyrocomp: per-sample variances at {model.rate_hz:g} Hz (N^2 rate) for {rostopic}"]
+    for key, values in ros_covariances(model).items():
+        lines.append(f"{key}: [{', '.join(f'{v:.6e}' for v in values)}]")
+    return "\n".join(lines) + "\n"
+
+
+def model_json(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """The whole model as JSON (the data's units; each term's name says it)."""
+    return json.dumps(model.to_dict(), indent=1) + "\n"
+
+
+#: the noise exports, by the name ``gyrocomp noise --export`` takes: text of (model, rostopic)
+NOISE_EXPORTS: dict[str, Callable[[NoiseModel, str], str]] = {
+    "kalibr": kalibr_yaml, "openvins": openvins_yaml, "vins": vins_yaml, "ros": ros_yaml, "json": model_json}
+
+
+__all__ = ["ContinuousNoise", "NOISE_EXPORTS", "continuous_noise", "kalibr_yaml", "model_json", "openvins_yaml",
+           "ros_covariances", "ros_yaml", "vins_values", "vins_yaml"]

@@ -1,0 +1,40 @@
+"""gyrocomp noise through the real entry point: the model printed, each export written and read back, several
+logs in one call, the options' errors in one line with nothing written."""
+
+import json
+import math
+
+from ..conftest import run
+
+
+def test_noise_prints_the_model_and_writes_each_export(static_log, tmp_path):
+    log = static_log / "s.csv"
+    done = run("noise", log)
+    assert done.returncode == 0, done.stderr
+    assert "noise model at 20 Hz" in done.stdout and "gyro_x" in done.stdout and "gyro_z" in done.stdout
+    written = run("noise", log, "--export", "json", "-o", tmp_path / "m.json")
+    assert written.returncode == 0, written.stderr
+    model = json.loads((tmp_path / "m.json").read_text())
+    assert {"gyro_x", "gyro_z", "accel_x"} <= set(model["axes"]) and model["rate_hz"] == 20.0
+    largest = max(a["bound"]["white_noise_density_u_per_sqrt_hz"] for name, a in model["axes"].items()
+                  if name.startswith("gyro"))
+    kalibr = run("noise", log, "--export", "kalibr", "-o", tmp_path / "imu.yaml", "--rostopic", "/imu")
+    assert kalibr.returncode == 0, kalibr.stderr
+    text = (tmp_path / "imu.yaml").read_text()
+    assert 'rostopic: "/imu"' in text and "accelerometer_noise_density" in text
+    density = float(text.split("gyroscope_noise_density:")[1].split()[0])
+    assert abs(density - math.radians(largest)) <= 1e-6 * density  # the larger axis's N in rad/s/sqrt(Hz)
+    two = run("noise", log, log.with_name("s.csv"), "--export", "json", "-o", tmp_path / "two.json")
+    assert two.returncode == 0, two.stderr
+
+
+def test_noise_options_are_checked_and_nothing_is_written(static_log, tmp_path):
+    log = static_log / "s.csv"
+    alone = run("noise", log, "--export", "kalibr")
+    assert alone.returncode == 2 and alone.stderr.strip().splitlines()[-1].startswith("gyrocomp: error:") \
+        and "give --export and -o together" in alone.stderr
+    vins = run("noise", log, "--axes", "gyro_x", "--export", "vins", "-o", tmp_path / "v.yaml")
+    assert vins.returncode == 2 and "export vins: the logs have no accelerometer axes" in vins.stderr
+    assert not (tmp_path / "v.yaml").exists()
+    over = run("noise", log, "--export", "json", "-o", log)
+    assert over.returncode == 2 and "input" in over.stderr
