@@ -6,12 +6,13 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
 
 from gyrocomp.allan import allan_deviation
-from gyrocomp.errors import InputError
+from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.export.estimator_noise import (NOISE_EXPORTS, continuous_noise, kalibr_yaml, openvins_yaml,
                                              ros_covariances, vins_values, vins_yaml)
 from gyrocomp.measures.noise import analyse_noise
@@ -93,3 +94,37 @@ def test_a_consumer_that_needs_the_accelerometer_says_so():
     assert "no accelerometer axes" in kalibr_yaml(gyro_only)
     with pytest.raises(InputError, match=r"export vins: the logs have no accelerometer axes; it needs them"):
         vins_yaml(gyro_only)
+
+
+def test_the_autopilot_parameters_give_each_prediction_step_the_continuous_variance(model):
+    """PX4 and ArduPilot add (dt sigma)^2 to the angle and (dt sigma_b)^2 to the rate bias per step: at their
+    filter period that is N^2 dt and K^2 dt; the files read back to the values."""
+    from gyrocomp.export.estimator_noise import (ARDUPILOT_FILTER_PERIOD_S, PX4_PREDICT_PERIOD_S,
+                                                 autopilot_noise_parameters)
+
+    c = continuous_noise(model)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a clamped accelerometer value is said; checked below
+        px4 = autopilot_noise_parameters(model, "px4")
+        ardupilot = autopilot_noise_parameters(model, "ardupilot")
+        px4_text = NOISE_EXPORTS["px4"](model, "/imu0")
+        ardupilot_text = NOISE_EXPORTS["ardupilot"](model, "/imu0")
+    for values, dt, gyro, bias in ((px4, PX4_PREDICT_PERIOD_S, "EKF2_GYR_NOISE", "EKF2_GYR_B_NOISE"),
+                                   (ardupilot, ARDUPILOT_FILTER_PERIOD_S, "EK3_GYRO_P_NSE", "EK3_GBIAS_P_NSE")):
+        assert (dt * values[gyro]) ** 2 == pytest.approx(c.gyro_noise_density_rad_per_s_per_sqrt_hz ** 2 * dt)
+        assert (dt * values[bias]) ** 2 == pytest.approx(c.gyro_random_walk_rad_per_s2_per_sqrt_hz ** 2 * dt)
+    rows = [line.split("\t") for line in px4_text.splitlines() if not line.startswith("#")]
+    assert {name: float(value) for _, _, name, value, _ in rows} == pytest.approx(px4, rel=1e-5)
+    pairs = [line.split() for line in ardupilot_text.splitlines() if not line.startswith("#")]
+    assert {name: float(value) for name, value in pairs} == pytest.approx(ardupilot, rel=1e-5)
+
+
+def test_a_value_outside_what_the_autopilot_accepts_is_clamped_and_said(model):
+    from gyrocomp.export.estimator_noise import NOISE_PARAMETER_RANGES, autopilot_noise_parameters
+
+    with pytest.warns(DataQualityWarning, match=r"export px4: EKF2_GYR_NOISE would be [0-9.e-]+, outside the "
+                                                r"0.0001..0.1 the autopilot accepts; written as 0.1"):
+        values = autopilot_noise_parameters(model, "px4", filter_period_s=1e-9)
+    assert values["EKF2_GYR_NOISE"] == NOISE_PARAMETER_RANGES["EKF2_GYR_NOISE"][1]
+    with pytest.raises(InputError, match=r"target: 'inav'; use px4 or ardupilot"):
+        autopilot_noise_parameters(model, "inav")

@@ -19,7 +19,8 @@ from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, r
 @click.argument("logs", nargs=-1, required=True, type=click.Path())
 @click.option("--export", "export_format", type=click.Choice(tuple(NOISE_EXPORTS)), default=None,
               help="Write the model for an estimator: kalibr (imu.yaml), openvins (kalibr_imu_chain.yaml), vins "
-                   "(acc_n, gyr_n, acc_w, gyr_w), ros (sensor_msgs/Imu covariances) or json (the whole model).")
+                   "(acc_n, gyr_n, acc_w, gyr_w), ros (sensor_msgs/Imu covariances), px4 (EKF2_*_NOISE, .params), "
+                   "ardupilot (EK3_*_P_NSE, .parm) or json (the whole model).")
 @click.option("-o", "--output", type=OUTPUT_FILE, default=None, help="The file --export writes.")
 @click.option("--rostopic", default="/imu0", show_default=True, help="The IMU topic written into the export.")
 @click.option("--axes", "axes", default=None,

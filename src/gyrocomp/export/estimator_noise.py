@@ -13,6 +13,14 @@ Each conversion follows the consumer's code (docs/noise.md has the table with th
 - ROS ``sensor_msgs/Imu``: ``angular_velocity_covariance`` and ``linear_acceleration_covariance`` are the
   variance of one sample about the true value [rad^2/s^2, m^2/s^4]: N^2 times the sample rate (the white part a
   sample carries; the bias is the estimator's state).
+- PX4 EKF2 (``EKF2_GYR_NOISE``, ``EKF2_GYR_B_NOISE``, ``EKF2_ACC_NOISE``, ``EKF2_ACC_B_NOISE``) and ArduPilot EK3
+  (``EK3_GYRO_P_NSE``, ``EK3_GBIAS_P_NSE``, ``EK3_ACC_P_NSE``, ``EK3_ABIAS_P_NSE``): each prediction step of the
+  filter period dt adds ``(dt sigma)^2`` to the angle (velocity) variance and ``(dt sigma_b)^2`` to the rate
+  (acceleration) bias variance (PX4 ``src/modules/ekf2/EKF/covariance.cpp``, ``predictCovariance``; ArduPilot
+  ``libraries/AP_NavEKF3/AP_NavEKF3_core.cpp``, ``CovariancePrediction``, whose delta-angle bias gets
+  ``(dt^2 sigma_b)^2``), so sigma = N / sqrt(dt) and sigma_b = K / sqrt(dt) at the filter's period (PX4
+  ``EKF2_PREDICT_US``, default 10 ms; ArduPilot ``EKF_TARGET_DT``, 12 ms), clamped to the range each parameter
+  accepts (their parameter definitions), with a warning naming what was clamped.
 - JSON: the whole model (both bounds, the IEEE Std 952 fit, each log's bound) in the data's units.
 
 With several axes of one sensor, the largest value is written: the conservative choice for a filter that takes
@@ -194,10 +202,86 @@ def model_json(model: NoiseModel, rostopic: str = "/imu0") -> str:
     return json.dumps(model.to_dict(), indent=1) + "\n"
 
 
+#: PX4 EKF2's prediction period by default (``EKF2_PREDICT_US`` = 10000 us) [s]
+PX4_PREDICT_PERIOD_S = 0.01
+#: ArduPilot EK3's update period (``EKF_TARGET_DT``) [s]
+ARDUPILOT_FILTER_PERIOD_S = 0.012
+#: the range each EKF noise parameter accepts (PX4 ``src/modules/ekf2/module.yaml``, ``params_gyro_bias.yaml``,
+#: ``params_accel_bias.yaml``; ArduPilot ``libraries/AP_NavEKF3/AP_NavEKF3.cpp`` ``@Range``)
+NOISE_PARAMETER_RANGES = {
+    "EKF2_GYR_NOISE": (0.0001, 0.1), "EKF2_GYR_B_NOISE": (0.0, 0.01),
+    "EKF2_ACC_NOISE": (0.01, 1.0), "EKF2_ACC_B_NOISE": (0.0, 0.01),
+    "EK3_GYRO_P_NSE": (0.0001, 0.1), "EK3_GBIAS_P_NSE": (0.00001, 0.001),
+    "EK3_ACC_P_NSE": (0.01, 1.0), "EK3_ABIAS_P_NSE": (0.00001, 0.02),
+}
+_AUTOPILOT_NAMES = {"px4": ("EKF2_GYR_NOISE", "EKF2_GYR_B_NOISE", "EKF2_ACC_NOISE", "EKF2_ACC_B_NOISE"),
+                    "ardupilot": ("EK3_GYRO_P_NSE", "EK3_GBIAS_P_NSE", "EK3_ACC_P_NSE", "EK3_ABIAS_P_NSE")}
+
+
+def autopilot_noise_parameters(model: NoiseModel, target: str, filter_period_s: float | None = None
+                               ) -> dict[str, float]:
+    """An autopilot EKF's IMU noise parameters: N / sqrt(dt) and K / sqrt(dt) at its filter period dt [s]
+    (see the module), clamped to each parameter's range with a warning.
+
+    Parameters
+    ----------
+    model : NoiseModel
+        The noise model of static logs.
+    target : {"px4", "ardupilot"}
+        The autopilot.
+    filter_period_s : float, optional
+        The EKF's prediction period [s] (default PX4's 0.01 s, ArduPilot's 0.012 s).
+    """
+    if target not in _AUTOPILOT_NAMES:
+        raise InputError(f"target: {target!r}; use px4 or ardupilot")
+    dt = (PX4_PREDICT_PERIOD_S if target == "px4" else ARDUPILOT_FILTER_PERIOD_S) if filter_period_s is None \
+        else filter_period_s
+    if not (isinstance(dt, (int, float)) and 0 < dt < 1):
+        raise InputError(f"filter_period_s: a period under 1 s, got {dt!r}")
+    c = continuous_noise(model)
+    values = (c.gyro_noise_density_rad_per_s_per_sqrt_hz, c.gyro_random_walk_rad_per_s2_per_sqrt_hz,
+              c.accel_noise_density_m_per_s2_per_sqrt_hz, c.accel_random_walk_m_per_s3_per_sqrt_hz)
+    out = {}
+    for name, density in zip(_AUTOPILOT_NAMES[target], values):
+        if density is None:
+            continue
+        value = density / math.sqrt(dt)
+        low, high = NOISE_PARAMETER_RANGES[name]
+        if not low <= value <= high:
+            clamped = min(max(value, low), high)
+            warnings.warn(f"export {target}: {name} would be {value:.6g}, outside the {low:g}..{high:g} the autopilot "
+                          f"accepts; written as {clamped:g}", DataQualityWarning, stacklevel=2)
+            value = clamped
+        out[name] = value
+    return out
+
+
+def px4_noise_params(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """PX4's EKF2 noise parameters as a QGroundControl parameter file (vehicle 1, component 1, float32)."""
+    values = autopilot_noise_parameters(model, "px4")
+    lines = [f"# PX4 EKF2 IMU noise written by gyrocomp from the white-noise + random-walk bound, at the "
+             f"{PX4_PREDICT_PERIOD_S * 1e6:.0f} us prediction period (EKF2_PREDICT_US)",
+             "# Vehicle-Id Component-Id Name Value Type"]
+    lines += [f"1\t1\t{name}\t{value:.6g}\t9" for name, value in values.items()]
+    return "\n".join(lines) + "\n"
+
+
+def ardupilot_noise_params(model: NoiseModel, rostopic: str = "/imu0") -> str:
+    """ArduPilot's EK3 noise parameters (``NAME VALUE`` per line)."""
+    values = autopilot_noise_parameters(model, "ardupilot")
+    lines = [f"# ArduPilot EK3 IMU noise written by gyrocomp from the white-noise + random-walk bound, at the "
+             f"{ARDUPILOT_FILTER_PERIOD_S * 1e3:g} ms filter period (EKF_TARGET_DT)"]
+    lines += [f"{name} {value:.6g}" for name, value in values.items()]
+    return "\n".join(lines) + "\n"
+
+
 #: the noise exports, by the name ``gyrocomp noise --export`` takes: text of (model, rostopic)
 NOISE_EXPORTS: dict[str, Callable[[NoiseModel, str], str]] = {
-    "kalibr": kalibr_yaml, "openvins": openvins_yaml, "vins": vins_yaml, "ros": ros_yaml, "json": model_json}
+    "kalibr": kalibr_yaml, "openvins": openvins_yaml, "vins": vins_yaml, "ros": ros_yaml, "px4": px4_noise_params,
+    "ardupilot": ardupilot_noise_params, "json": model_json}
 
 
-__all__ = ["ContinuousNoise", "NOISE_EXPORTS", "continuous_noise", "kalibr_yaml", "model_json", "openvins_yaml",
-           "ros_covariances", "ros_yaml", "vins_values", "vins_yaml"]
+__all__ = ["ARDUPILOT_FILTER_PERIOD_S", "ContinuousNoise", "NOISE_EXPORTS", "NOISE_PARAMETER_RANGES",
+           "PX4_PREDICT_PERIOD_S", "ardupilot_noise_params", "autopilot_noise_parameters", "continuous_noise",
+           "kalibr_yaml", "model_json", "openvins_yaml", "px4_noise_params", "ros_covariances", "ros_yaml",
+           "vins_values", "vins_yaml"]
