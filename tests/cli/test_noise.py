@@ -38,3 +38,15 @@ def test_noise_options_are_checked_and_nothing_is_written(static_log, tmp_path):
     assert not (tmp_path / "v.yaml").exists()
     over = run("noise", log, "--export", "json", "-o", log)
     assert over.returncode == 2 and "input" in over.stderr
+
+
+def test_noise_of_a_chamber_runs_dwells(tmp_path):
+    made = run("simulate", "--profile", "chamber", "--set-points", "-20,25,70", "--dwell", 1200, "--rate", 10,
+               "--axes", "z", "-o", tmp_path / "ch.csv")
+    assert made.returncode == 0, made.stderr
+    done = run("noise", tmp_path / "ch.csv", "--dwells", "--axes", "gyro_z", "--export", "json",
+               "-o", tmp_path / "m.json")
+    assert done.returncode == 0, done.stderr
+    logs = json.loads((tmp_path / "m.json").read_text())["axes"]["gyro_z"]["logs"]
+    assert [round(log["temperature_degc"]) for log in logs] == [-20, 25, 70]
+    assert "N at one sample [95 %]" in done.stdout and "at 70.0 degC" in done.stdout

@@ -11,8 +11,8 @@ from ..export.estimator_noise import NOISE_EXPORTS
 from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.inputs import expand_runs
-from ..measures.noise_model import NoiseModel, noise_model
-from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, read_options, read_settings
+from ..measures.noise_model import NoiseModel, noise_model, noise_over_temperature
+from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, read_options, read_run, read_settings
 
 
 @click.command()
@@ -27,9 +27,12 @@ from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, r
               help="Columns to model, e.g. gyro_x,gyro_z,accel_z (default: every gyro and accelerometer axis).")
 @click.option("--split-gaps/--no-split-gaps", default=False,
               help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
+@click.option("--dwells", is_flag=True,
+              help="Each log is a chamber run: model the noise of each of its temperature dwells (the first 300 s "
+                   "of each left out, at least 600 s kept) and bound them all, with the per-temperature table.")
 @read_options
 @click.pass_context
-def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, **kwargs):
+def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, dwells, **kwargs):
     """Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov terms) whose Allan
     deviation is at or above the upper end of every log's 95 % interval at every averaging time, beside the IEEE
     952 fit."""
@@ -41,12 +44,17 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, **kwargs
     if output is not None:
         refuse_to_overwrite_inputs(output, paths, option="-o")
     named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
-    analyses = []
-    for path in paths:
-        with progress_bar(f"reading {Path(path).name}") as progress:
-            analyses.append(analyse_noise_file(path, named, options=read_settings(opts), fmt=opts["fmt"],
-                                               with_accel=named is None, split_gaps=split_gaps, progress=progress))
-    model = noise_model(analyses)
+    if dwells:
+        model = noise_over_temperature([read_run(path, opts).recording for path in paths], named,
+                                       with_accel=named is None)
+    else:
+        analyses = []
+        for path in paths:
+            with progress_bar(f"reading {Path(path).name}") as progress:
+                analyses.append(analyse_noise_file(path, named, options=read_settings(opts), fmt=opts["fmt"],
+                                                   with_accel=named is None, split_gaps=split_gaps,
+                                                   progress=progress))
+        model = noise_model(analyses)
     if export_format is not None:
         write_text_atomic(output, NOISE_EXPORTS[export_format](model, rostopic))
     if not ctx.obj["quiet"]:
@@ -71,13 +79,17 @@ def print_noise_model(model: NoiseModel) -> None:
                       f"{a.bound.taus_s[0]:.3g} .. {a.max_tau_s:.3g}")
     console.print(table)
     if any(len(a.logs) > 1 for a in model.axes.values()):
-        logs = Table(title="each log's own bound (white noise N, random walk K)")
-        for col in ("axis", "log", "N", "K"):
+        logs = Table(title="each log's own bound (white noise N, random walk K) and N read at one sample with its "
+                           "95 % interval")
+        for col in ("axis", "log", "temperature [degC]", "bound N", "bound K", "N at one sample [95 %]"):
             logs.add_column(col, justify="left" if col in ("axis", "log") else "right")
         for name, a in model.axes.items():
             for log in a.logs:
-                logs.add_row(name, Path(log.source).name, f"{log.bound.white_noise_density:.4g}",
-                             f"{log.bound.random_walk:.4g}")
+                low, value, high = log.white_noise_interval
+                logs.add_row(name, Path(log.source).name,
+                             "-" if log.temperature_degc is None else f"{log.temperature_degc:.1f}",
+                             f"{log.bound.white_noise_density:.4g}", f"{log.bound.random_walk:.4g}",
+                             f"{value:.4g} [{low:.4g}, {high:.4g}]")
         console.print(logs)
 
 

@@ -9,14 +9,17 @@ the data's unit u: deg/s for a gyro axis, g for an accelerometer axis.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..allan import AllanResult, NoiseTerms
 from ..allan.bound import NoiseBound, bound_noise
+from ..allan.intervals import confidence_interval
 from ..errors import InputError
-from .noise import NoiseAnalysis
+from ..recording import Recording
+from .noise import NoiseAnalysis, analyse_noise
 
 #: the longest averaging time bounded, as a fraction of the shortest record: beyond it too few averages
 MAX_TAU_FRACTION = 0.1
@@ -39,12 +42,14 @@ def record_length_s(curve: AllanResult, rate_hz: float) -> float:
 
 @dataclass(frozen=True)
 class LogNoise:
-    """One log's part of an axis's model: its source, mean temperature [degC] (None without one) and the
-    two-term bound of its own curve."""
+    """One log's part of an axis's model: its source, mean temperature [degC] (None without one), the two-term
+    bound of its own curve, and the white noise read at one sample with its 95 % interval [u/sqrt(Hz)] (the
+    deviation at the shortest tau times sqrt(tau), where white noise rules)."""
 
     source: str
     temperature_degc: float | None
     bound: NoiseBound
+    white_noise_interval: tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -93,8 +98,16 @@ class NoiseModel:
                                                    "random_walk": a.ieee.random_walk},
                    "logs": [{"source": log.source, "temperature_degc": log.temperature_degc,
                              "white_noise_density": log.bound.white_noise_density,
-                             "random_walk": log.bound.random_walk} for log in a.logs]}
+                             "random_walk": log.bound.random_walk,
+                             "white_noise_at_one_sample_95": list(log.white_noise_interval)} for log in a.logs]}
             for name, a in self.axes.items()}}
+
+
+def _white_at_one_sample(curve: AllanResult) -> tuple[float, float, float]:
+    """(low, value, high): the deviation at the shortest tau times sqrt(tau), with its 95 % interval."""
+    low, high = confidence_interval(curve.deviation[:1], curve.edf[:1], 0.95)
+    root = float(np.sqrt(curve.tau[0]))
+    return float(low[0]) * root, float(curve.deviation[0]) * root, float(high[0]) * root
 
 
 def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
@@ -128,7 +141,7 @@ def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
     for name in shared:
         curves = [a.axes[name].allan for a in analyses]
         max_tau = MAX_TAU_FRACTION * min(record_length_s(c, rate) for c in curves)
-        logs = tuple(LogNoise(a.source, t, bound_noise(c, markov=False, max_tau_s=max_tau))
+        logs = tuple(LogNoise(a.source, t, bound_noise(c, markov=False, max_tau_s=max_tau), _white_at_one_sample(c))
                      for a, c, t in zip(analyses, curves, temperatures))
         first = analyses[0].axes[name]
         axes[name] = AxisNoiseModel(name, first.sensor, first.unit, first.terms,
@@ -143,5 +156,80 @@ def mean_temperature_degc(recording) -> float | None:
     return None if t is None else float(np.mean(t))
 
 
-__all__ = ["AxisNoiseModel", "LogNoise", "MAX_TAU_FRACTION", "NoiseModel", "mean_temperature_degc", "noise_model",
-           "record_length_s"]
+#: a dwell holds the temperature within this rate [degC/min], over a minute's moving average
+DWELL_RATE_DEGC_PER_MIN = 0.05
+
+
+def temperature_dwells(recording: Recording, *, settle_s: float = 300.0, min_duration_s: float = 600.0,
+                       max_rate_degc_per_min: float = DWELL_RATE_DEGC_PER_MIN) -> list[slice]:
+    """The stretches of a chamber run where the temperature holds, each without its first ``settle_s``.
+
+    Parameters
+    ----------
+    recording : Recording
+        A run with a temperature column [degC].
+    settle_s : float
+        Left out at the start of each dwell, while the part settles [s].
+    min_duration_s : float
+        The shortest stretch kept, after settling [s].
+    max_rate_degc_per_min : float
+        The largest rate of change of the temperature (a minute's moving average) in a dwell [degC/min].
+
+    Returns
+    -------
+    list of slice
+        The rows of each dwell, in time order.
+    """
+    if recording.temperature_degc is None:
+        raise InputError(f"{recording.source}: no temperature column; dwells are told by the temperature")
+    t = np.asarray(recording.temperature_degc, dtype=float)
+    t = t.mean(axis=1) if t.ndim == 2 else t
+    window = max(int(round(60.0 * recording.rate_hz)), 1)
+    smooth = np.convolve(t, np.ones(window) / window, mode="same")
+    # the change of the minute's mean over a minute (a sample-to-sample slope of a quantized, noisy sensor is noise)
+    ahead = np.minimum(np.arange(t.size) + window, t.size - 1)
+    rate = (smooth[ahead] - smooth) / np.maximum(recording.time_s[ahead] - recording.time_s, 1e-9) * 60.0
+    holds = np.abs(rate) <= max_rate_degc_per_min
+    edges = np.flatnonzero(np.diff(np.r_[0, holds.astype(np.int8), 0]))
+    out = []
+    for start, stop in zip(edges[::2], edges[1::2]):
+        first = int(np.searchsorted(recording.time_s, recording.time_s[start] + settle_s))
+        if stop > first and recording.time_s[stop - 1] - recording.time_s[first] >= min_duration_s:
+            out.append(slice(first, stop))
+    return out
+
+
+def noise_over_temperature(recordings: Recording | list[Recording], axes: list[str] | None = None, *,
+                           with_accel: bool = False, settle_s: float = 300.0,
+                           min_duration_s: float = 600.0) -> NoiseModel:
+    """The noise model of chamber runs' dwells (:func:`temperature_dwells`), each dwell a log at its mean
+    temperature: the bound covers every dwell, and each dwell's own bound makes the per-temperature table.
+
+    Parameters
+    ----------
+    recordings : Recording or list of Recording
+        Chamber runs held at several temperatures [s, deg/s, g, degC].
+    axes : list of str, optional
+        The axes (default every gyro axis, and every accelerometer axis with ``with_accel``).
+    with_accel : bool
+        Also model the accelerometer axes.
+    settle_s, min_duration_s : float
+        As :func:`temperature_dwells` [s].
+    """
+    pieces = []
+    for recording in [recordings] if isinstance(recordings, Recording) else recordings:
+        dwells = temperature_dwells(recording, settle_s=settle_s, min_duration_s=min_duration_s)
+        if not dwells:
+            raise InputError(f"{recording.source}: no dwell of {min_duration_s:g} s after {settle_s:g} s of settling "
+                             f"(the temperature held within {DWELL_RATE_DEGC_PER_MIN:g} degC/min); give static logs, "
+                             "or a chamber run with longer dwells")
+        pieces += [recording.take(d) for d in dwells]
+    analyses = [analyse_noise(p, axes, with_accel=with_accel, motion_check=False, plausibility_check=False)
+                for p in pieces]
+    named = [dataclasses.replace(a, source=f"{p.source} at {mean_temperature_degc(p):.1f} degC")
+             for a, p in zip(analyses, pieces)]
+    return noise_model(named, [mean_temperature_degc(p) for p in pieces])
+
+
+__all__ = ["AxisNoiseModel", "DWELL_RATE_DEGC_PER_MIN", "LogNoise", "MAX_TAU_FRACTION", "NoiseModel",
+           "mean_temperature_degc", "noise_model", "noise_over_temperature", "record_length_s", "temperature_dwells"]

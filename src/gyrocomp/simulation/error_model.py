@@ -222,6 +222,10 @@ class GyroErrorModel:
         Its time constant T_w [s].
     temperature_rate_dps_per_degc_per_min : tuple of float, optional
         Per axis, the bias per unit rate of change of the structure temperature, k_i [deg/s per degC/min].
+    noise_tempco_per_degc : float
+        The white noise's and the flicker's relative change per degC of the structure temperature from
+        ``t_ref_degc``, c [1/degC]: both are scaled by max(0.1, 1 + c (T - t_ref)) (0: noise that does not change
+        with temperature).
     """
 
     axes: tuple[str, ...] = GYRO_AXES
@@ -248,6 +252,12 @@ class GyroErrorModel:
     warm_up_sigma_dps: float = 0.0
     warm_up_time_s: float = 300.0
     temperature_rate_dps_per_degc_per_min: tuple[float, ...] | None = None
+    noise_tempco_per_degc: float = 0.0
+
+    def noise_scale(self, structure_degc) -> np.ndarray:
+        """The factor on the white noise and flicker at ``structure_degc`` [degC] (see ``noise_tempco_per_degc``)."""
+        above = np.asarray(structure_degc, dtype=float) - self.t_ref_degc
+        return np.maximum(0.1, 1.0 + self.noise_tempco_per_degc * above)
 
     def __post_init__(self) -> None:
         k = len(self.axes)
@@ -263,6 +273,8 @@ class GyroErrorModel:
                      "run_tempco_sigma_dps_per_degc", "warm_up_sigma_dps"):
             if getattr(self, name) < 0:
                 raise InputError(f"{name}: must not be negative")
+        if not math.isfinite(self.noise_tempco_per_degc):
+            raise InputError(f"noise_tempco_per_degc: must be finite, got {self.noise_tempco_per_degc}")
         for name in ("run_drift_time_s", "warm_up_time_s"):
             if not 0 < getattr(self, name) < math.inf:
                 raise InputError(f"{name}: must be positive and finite, got {getattr(self, name)}")
@@ -505,6 +517,9 @@ def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random
     k = len(model.axes)
     white = rng.standard_normal((n, k)) * model.noise_density_dps_per_sqrt_hz * math.sqrt(rate_hz)
     flicker = np.column_stack([flicker_bank(n, rate_hz, model.bias_instability_deg_per_h, rng) for _ in range(k)])
+    if model.noise_tempco_per_degc != 0.0 and structure_degc is not None:
+        scale = model.noise_scale(structure_degc)[:, None]
+        white, flicker = white * scale, flicker * scale
     if model.rate_random_walk_dps_per_sqrt_s > 0:
         steps = rng.standard_normal((n, k)) * model.rate_random_walk_dps_per_sqrt_s * math.sqrt(1.0 / rate_hz)
         walk = np.cumsum(steps, axis=0)
