@@ -1,0 +1,71 @@
+"""Benchmark: is the exported noise model one a filter can trust? (``gyrocomp noise``, issue #47, item 5)
+
+For each simulated part, its white noise and flicker growing ``--tempco`` per degC: the noise model is made as a
+user would, from a chamber run held at -20, 25 and 70 degC (``noise_over_temperature``: each dwell's curve
+bounded). Then ``--runs`` Monte Carlo runs of ``--minutes`` at ``--rate`` Hz, the temperature ramping from -20
+to 70 degC and back (the noise following it), feed the small attitude filter of
+:mod:`gyrocomp.evaluation.filter_consistency` (absolute attitude updates every 2 s, 0.01 deg) told each model in
+turn: the bound with white noise and random walk (what Kalibr, VINS and the autopilots carry), the bound with
+Gauss-Markov terms, the IEEE 952 fit of the 25 degC dwell (N and K), and that fit times 10. Printed: the median
+time-averaged NEES and the share of runs inside its 95 % chi-square band (below it: over-cautious; above:
+over-confident).
+
+Usage: python benchmarks/bench_noise_nees.py [--runs R] [--minutes M] [--rate HZ] [--tempco C]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import warnings
+
+import numpy as np
+
+from gyrocomp.allan.bound import NoiseBound
+from gyrocomp.evaluation.filter_consistency import attitude_nees
+from gyrocomp.measures.noise import analyse_noise
+from gyrocomp.measures.noise_model import noise_over_temperature, temperature_dwells
+from gyrocomp.simulation import get_profile, preset_model, simulate
+from gyrocomp.simulation.error_model import simulate_noise
+
+PRESETS = ("mti10", "adis16488", "consumer", "adxrs450")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=200)
+    parser.add_argument("--minutes", type=float, default=30.0)
+    parser.add_argument("--rate", type=float, default=20.0)
+    parser.add_argument("--tempco", type=float, default=0.005)
+    args = parser.parse_args()
+    n = int(args.minutes * 60 * args.rate)
+    ramp = np.interp(np.linspace(0.0, 1.0, n), [0.0, 0.5, 1.0], [-20.0, 70.0, -20.0])
+    print("| part | model told to the filter | median NEES | runs inside the 95 % band | band |")
+    print("|---|---|---|---|---|")
+    for preset in PRESETS:
+        model = dataclasses.replace(preset_model(preset), noise_tempco_per_degc=args.tempco)
+        profile = get_profile("chamber", set_points_degc=(-20.0, 25.0, 70.0), dwell_s=2400.0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            chamber = simulate(model, profile=profile, rate_hz=args.rate, seed=1).recording
+            made = noise_over_temperature(chamber, [model.axes[0]])
+        axis = made.axes[model.axes[0]]
+        middle = chamber.take(temperature_dwells(chamber)[1])  # the 25 degC dwell: what a user fits at room temperature
+        ieee = analyse_noise(middle, [model.axes[0]], motion_check=False).axes[model.axes[0]].terms
+        fitted = NoiseBound(ieee.white_noise_density, ieee.random_walk, (), (1.0,), 1.0, 1.0)
+        models = {"bound, white + random walk": axis.bound, "bound with Gauss-Markov terms": axis.markov,
+                  "IEEE 952 fit (N, K)": fitted,
+                  "IEEE 952 fit x10": dataclasses.replace(fitted, white_noise_density=10 * fitted.white_noise_density,
+                                                          random_walk=10 * fitted.random_walk)}
+        errors = np.empty((args.runs, n))
+        for r in range(args.runs):
+            truth = simulate_noise(n, args.rate, model, np.random.default_rng(1000 + r), ramp)
+            errors[r] = truth.white_dps[:, 0] + truth.flicker_dps[:, 0] + truth.random_walk_dps[:, 0]
+        for name, noise in models.items():
+            result = attitude_nees(errors, args.rate, noise)
+            print(f"| {preset} | {name} | {np.median(result.nees):.2f} | {result.inside:.0%} | "
+                  f"{result.band[0]:.2f}..{result.band[1]:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
