@@ -3,6 +3,7 @@ temperature curve, each added to a copy of the package as its own module plus on
 files), then run through the command line of that copy (``fit``, ``apply``, ``export``, ``show``, ``--format``,
 ``--help``). If the recipe needs a third file, or a list it does not name, these tests fail."""
 
+import json
 import os
 import shutil
 import subprocess
@@ -205,7 +206,8 @@ def test_a_reader_is_its_module_and_one_line(extended, tmp_path):
     assert "npz (a NumPy archive of time_s, gyro_dps, temperature_degc)" in help_text
     fitted = run("fit", root / "runs", "-o", tmp_path / "m.json", "--temperature", "poly:2", "--hysteresis", "none")
     assert fitted.returncode == 0, fitted.stderr
-    assert "3 run" in run("show", tmp_path / "m.json").stdout  # the folder's three .npz files found
+    inputs = json.loads((tmp_path / "m.json").read_text())["provenance"]["inputs"]
+    assert len(inputs) == 3 and all(".npz" in json.dumps(i) for i in inputs)  # the folder's three .npz files
     renamed = tmp_path / "run0.data"
     shutil.copy(root / "runs" / "run0.npz", renamed)
     refused = run("apply", tmp_path / "m.json", renamed, "-o", tmp_path / "c.csv")

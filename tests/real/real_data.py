@@ -336,6 +336,26 @@ def main() -> None:
                   f"{n.integration_time_s:.0f} | {n.rrw_deg_per_h_per_sqrt_h:.0f} | {n.fit_rms_log_residual:.0%} |")
 
 
+def main_bound() -> None:
+    """The noise bounds of the real static recordings beside the IEEE 952 fit and, where stated, the datasheet."""
+    from gyrocomp.allan.bound import bound_noise
+
+    print("| recording | axis | ARW fit [deg/sqrt(h)] | ARW bound | K bound [deg/h/sqrt(h)] | with Gauss-Markov: "
+          "median / largest ratio to the curve | datasheet ARW |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    rows = [(f"ADIS16405 {name}", gyro, 100.0, "2") for name, gyro in adis_sessions().items()]
+    rows.append(("Galaxy S5", galaxy_gyro_dps(), 10.0, "-"))
+    for label, gyro, rate_hz, datasheet in rows:
+        record_s = gyro.shape[0] / rate_hz
+        for axis, j in zip(AXES, range(gyro.shape[1])):
+            curve = allan_deviation(gyro[:, j], rate_hz)
+            fitted = noise_parameters(curve)
+            two = bound_noise(curve, markov=False, max_tau_s=record_s / 10)
+            full = bound_noise(curve, max_tau_s=record_s / 10)
+            print(f"| {label} | {axis} | {fitted.arw_deg_per_sqrt_h:.2f} | {60 * two.white_noise_density:.2f} | "
+                  f"{two.random_walk * 216000.0:.1f} | {full.ratio_median:.2f} / {full.ratio_max:.2f} | {datasheet} |")
+
+
 def main_temperature() -> None:
     raw = np.array([[0.0] * 3] * 3)
     from gyrocomp.measures.merit import smoothed_residual_rms
@@ -361,5 +381,7 @@ if __name__ == "__main__":
         main_temperature()
     elif "g-sensitivity" in sys.argv[1:]:
         main_g_sensitivity()
+    elif "bound" in sys.argv[1:]:
+        main_bound()
     else:
         main()

@@ -64,3 +64,25 @@ def test_galaxy_s5_phone_gyro():
         assert fitted.noise_density_dps_per_sqrt_hz == pytest.approx(fitted.noise_density_readoff_dps_per_sqrt_hz,
                                                                      rel=0.25)
         assert 10.0 < fitted.bias_instability_deg_per_h < 50.0
+
+
+def test_adis16405_bound_is_above_every_session_and_beside_its_datasheet(adis):
+    """The noise bounds of each session and axis: at or above the measured curve up to a tenth of the record;
+    white noise and random walk alone pay for the flicker floor they cannot follow (N 1.0 to 1.6 times the IEEE
+    952 fit's, the angle random walk 1 to 2 times the datasheet's 2 deg/sqrt(h)), the Gauss-Markov terms bring it
+    back near the curve (the table: python -m tests.real.real_data bound)."""
+    from gyrocomp.allan.bound import bound_noise
+
+    ratios = []
+    for gyro in adis.values():
+        for j in range(3):
+            curve = allan_deviation(gyro[:, j], 100.0)
+            bounded = curve.tau <= 1000.0  # a tenth of the 2.78 h record
+            two = bound_noise(curve, markov=False, max_tau_s=1000.0)
+            full = bound_noise(curve, max_tau_s=1000.0)
+            for bound in (two, full):
+                assert np.all(bound.deviation(curve.tau[bounded]) >= curve.deviation[bounded])
+            ratios.append(two.white_noise_density / noise_parameters(curve).noise_density_dps_per_sqrt_hz)
+            assert 2.0 <= 60 * two.white_noise_density < 4.0
+            assert full.ratio_median < 1.5
+    assert 1.0 <= min(ratios) and max(ratios) < 1.6
