@@ -4,6 +4,8 @@ logs in one call, the options' errors in one line with nothing written."""
 import json
 import math
 
+import pytest
+
 from ..conftest import run
 
 
@@ -50,3 +52,20 @@ def test_noise_of_a_chamber_runs_dwells(tmp_path):
     logs = json.loads((tmp_path / "m.json").read_text())["axes"]["gyro_z"]["logs"]
     assert [round(log["temperature_degc"]) for log in logs] == [-20, 25, 70]
     assert "N at one sample [95 %]" in done.stdout and "at 70.0 degC" in done.stdout
+
+
+@pytest.mark.slow
+def test_noise_with_a_model_says_what_compensation_buys(tmp_path):
+    made = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 2, "--runs", 3,
+               "-o", tmp_path / "c.csv")
+    assert made.returncode == 0, made.stderr
+    fitted = run("fit", tmp_path / "c_0.csv", tmp_path / "c_1.csv", "-o", tmp_path / "m.json")
+    assert fitted.returncode == 0, fitted.stderr
+    done = run("noise", tmp_path / "c_2.csv", "--model", tmp_path / "m.json", "--axes", "gyro_z",
+               "--export", "json", "-o", tmp_path / "n.json")
+    assert done.returncode == 0, done.stderr
+    assert "the bias random walk a filter needs" in done.stdout and "raw / compensated" in done.stdout
+    ratio = float(done.stdout.split("gyro_z", 2)[2].split("│")[3])
+    assert ratio > 10
+    both = run("noise", tmp_path / "c_2.csv", "--model", tmp_path / "m.json", "--dwells")
+    assert both.returncode == 2 and "give --model or --dwells, not both" in both.stderr

@@ -7,10 +7,14 @@ from pathlib import Path
 import click
 from rich.table import Table
 
+from ..calibration import Calibration
+from ..calibration.compensate import apply
+from ..evaluation.bias_process_noise import bias_process_noise
 from ..export.estimator_noise import NOISE_EXPORTS
 from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.inputs import expand_runs
+from ..measures.noise import analyse_noise
 from ..measures.noise_model import NoiseModel, noise_model, noise_over_temperature
 from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, read_options, read_run, read_settings
 
@@ -27,12 +31,16 @@ from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, r
               help="Columns to model, e.g. gyro_x,gyro_z,accel_z (default: every gyro and accelerometer axis).")
 @click.option("--split-gaps/--no-split-gaps", default=False,
               help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
+@click.option("--model", "model_path", type=click.Path(dir_okay=False), default=None,
+              help="A model file: the logs are static runs through a temperature profile, held out from its fit; "
+                   "say the bias random walk a filter needs with the raw and the compensated gyro, and model (and "
+                   "export) the compensated gyro's noise.")
 @click.option("--dwells", is_flag=True,
               help="Each log is a chamber run: model the noise of each of its temperature dwells (the first 300 s "
                    "of each left out, at least 600 s kept) and bound them all, with the per-temperature table.")
 @read_options
 @click.pass_context
-def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, dwells, **kwargs):
+def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_path, dwells, **kwargs):
     """Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov terms) whose Allan
     deviation is at or above the upper end of every log's 95 % interval at every averaging time, beside the IEEE
     952 fit."""
@@ -42,9 +50,19 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, dwells, 
                                  param_hint="--export" if export_format is None else "-o")
     paths = expand_runs(logs)
     if output is not None:
-        refuse_to_overwrite_inputs(output, paths, option="-o")
+        refuse_to_overwrite_inputs(output, paths + ([model_path] if model_path else []), option="-o")
     named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
-    if dwells:
+    benefit = None
+    if model_path is not None:
+        if dwells:
+            raise click.BadParameter("give --model or --dwells, not both", param_hint="--model")
+        calibration = Calibration.load(model_path)
+        runs = [read_run(path, opts).recording for path in paths]
+        benefit = bias_process_noise(calibration, runs, [a for a in named if a.startswith("gyro")] if named else None)
+        compensated = [apply(calibration, run) for run in runs]
+        model = noise_model([analyse_noise(run, named, with_accel=named is None, split_gaps=split_gaps,
+                                           motion_check=False) for run in compensated])
+    elif dwells:
         model = noise_over_temperature([read_run(path, opts).recording for path in paths], named,
                                        with_accel=named is None)
     else:
@@ -59,6 +77,8 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, dwells, 
         write_text_atomic(output, NOISE_EXPORTS[export_format](model, rostopic))
     if not ctx.obj["quiet"]:
         print_noise_model(model)
+        if benefit is not None:
+            print_bias_process_noise(benefit)
         if export_format is not None:
             click.echo(f"wrote {output} ({export_format})")
 
@@ -93,4 +113,17 @@ def print_noise_model(model: NoiseModel) -> None:
         console.print(logs)
 
 
-__all__ = ["noise", "print_noise_model"]
+def print_bias_process_noise(benefit: dict) -> None:
+    """Per gyro axis: the bias random walk a filter needs with the raw and with the compensated gyro."""
+    table = Table(title="the bias random walk a filter needs on these runs (white noise and random walk at or above "
+                        "the Allan curve up to a quarter of the run) [deg/s/sqrt(s)]")
+    for col in ("axis", "raw K", "compensated K", "raw / compensated", "raw N", "compensated N"):
+        table.add_column(col, justify="left" if col == "axis" else "right")
+    for name, b in benefit.items():
+        table.add_row(name, f"{b.raw.random_walk:.4g}", f"{b.compensated.random_walk:.4g}",
+                      f"{b.random_walk_ratio:.1f}", f"{b.raw.white_noise_density:.4g}",
+                      f"{b.compensated.white_noise_density:.4g}")
+    make_console().print(table)
+
+
+__all__ = ["noise", "print_bias_process_noise", "print_noise_model"]

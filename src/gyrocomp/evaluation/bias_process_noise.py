@@ -1,0 +1,98 @@
+"""What a calibration buys an estimator, in the estimator's own terms: the bias process noise a filter needs with
+the raw gyro against the compensated one over the same temperature profile.
+
+A static run through a temperature profile: its raw rate is the bias (the temperature drift, the run's constant)
+plus noise; compensated, the drift the model leaves. Each, about its mean, is bounded as a noise model a filter
+can carry (:func:`gyrocomp.allan.bound.bound_noise`: white noise N and bias random walk K at or above the upper
+end of the curve's 95 % interval at every octave tau) up to a quarter of the run, far enough for the slow
+thermal drift to show: the K the raw gyro needs is its drift seen as a random walk, the compensated one's what
+the model leaves of it. Their ratio is what the calibration buys a filter's bias process noise on that
+profile.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..allan import allan_deviation
+from ..allan.bound import NoiseBound, bound_noise
+from ..calibration import Calibration
+from ..calibration.compensate import apply
+from ..errors import InputError, TemperatureRangeWarning
+from ..recording import Recording
+
+#: the longest averaging time bounded, as a fraction of the shortest run: the thermal drift is slow
+MAX_TAU_FRACTION = 0.25
+
+
+@dataclass(frozen=True)
+class BiasProcessNoise:
+    """One gyro axis on the runs given: the noise model the raw and the compensated gyro need.
+
+    Attributes
+    ----------
+    axis : str
+        The gyro axis.
+    raw, compensated : NoiseBound
+        White noise [deg/s/sqrt(Hz)] and bias random walk [deg/s/sqrt(s)] at or above the raw and the
+        compensated gyro's Allan curves (every run's) up to a quarter of the shortest run.
+    """
+
+    axis: str
+    raw: NoiseBound
+    compensated: NoiseBound
+
+    @property
+    def random_walk_ratio(self) -> float:
+        """The raw gyro's bias random walk over the compensated one's (what the calibration buys)."""
+        c = self.compensated.random_walk
+        return self.raw.random_walk / c if c > 0 else np.inf
+
+
+def bias_process_noise(calibration: Calibration, recordings: Recording | list[Recording],
+                       axes: list[str] | None = None) -> dict[str, BiasProcessNoise]:
+    """The bias process noise a filter needs, raw and compensated, on static runs through a temperature profile.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model.
+    recordings : Recording or list of Recording
+        Static runs held out from the fit, through the temperature profile of interest [s, deg/s, degC].
+    axes : list of str, optional
+        The gyro axes (default every one the model and the runs share).
+
+    Returns
+    -------
+    dict of str to BiasProcessNoise
+    """
+    runs = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    if not runs:
+        raise InputError("bias_process_noise: give at least one static run")
+    shared = [a for a in calibration.axes if all(a in r.gyro_axes for r in runs)]
+    names = shared if axes is None else list(axes)
+    unknown = [a for a in names if a not in shared]
+    if unknown or not names:
+        raise InputError(f"axes: {', '.join(unknown) or 'none'}: the model and the runs share "
+                         f"{', '.join(shared) or 'no gyro axis'}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)  # said where the model is applied by the user
+        compensated = [apply(calibration, r) for r in runs]
+    max_tau = MAX_TAU_FRACTION * min(float(r.time_s[-1] - r.time_s[0]) for r in runs)
+    out = {}
+    for name in names:
+        bounds = []
+        for series in (runs, compensated):
+            curves = []
+            for rec in series:
+                values = rec.gyro_dps[:, rec.gyro_axes.index(name)]
+                curves.append(allan_deviation(values - values.mean(), rec.rate_hz))
+            bounds.append(bound_noise(curves, markov=False, max_tau_s=max_tau))
+        out[name] = BiasProcessNoise(name, *bounds)
+    return out
+
+
+__all__ = ["BiasProcessNoise", "MAX_TAU_FRACTION", "bias_process_noise"]
