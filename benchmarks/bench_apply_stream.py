@@ -10,7 +10,9 @@ the time running on, written row group by row group) is processed, each in a fre
 - ``gyrocomp allan`` (the three gyro axes, in chunks, phases spilled to temporary files past 8 MiB each) and
   ``allan whole file`` (``read_table`` of the columns used + ``analyse_noise``, what it did before);
 - ``gyrocomp evaluate`` (the model on the file, in chunks) and ``evaluate whole file`` (``read_table`` +
-  ``evaluate``).
+  ``evaluate``);
+- ``gyrocomp noise`` (``--commands noise``): the noise model of the six gyro and accelerometer axes, in chunks, and
+  its Kalibr export, against ``gyrocomp allan`` of the three gyro axes.
 
 Printed: each one's wall time, peak resident memory (``ru_maxrss`` of its process: this includes the pages of the
 memory-mapped temporary files, which are file cache the kernel can drop, not working memory) and peak anonymous
@@ -55,6 +57,8 @@ PROGRAMS = {
     "allan whole file": ("import sys, warnings\nwarnings.simplefilter('ignore')\n"
                          "from gyrocomp.io.tables import read_table\nfrom gyrocomp.measures.noise import analyse_noise\n"
                          "analyse_noise(read_table(sys.argv[1], channels=('gyro_x', 'gyro_y', 'gyro_z')).recording)\n"),
+    "gyrocomp noise": ("import sys\nfrom gyrocomp.cli import main\n"
+                       "sys.exit(main(['--quiet', 'noise', sys.argv[1], '--export', 'kalibr', '-o', sys.argv[2] + '.yaml']))\n"),
     "gyrocomp evaluate": ("import sys\nfrom gyrocomp.cli import main\n"
                           "sys.exit(main(['--quiet', 'evaluate', sys.argv[3], sys.argv[1]]))\n"),
     "evaluate whole file": ("import sys, warnings\nwarnings.simplefilter('ignore')\n"
@@ -64,7 +68,7 @@ PROGRAMS = {
 }
 #: the programs each command runs (the first is its streamed path, the second what it did before)
 COMMANDS = {"apply": ("gyrocomp apply", "whole file"), "allan": ("gyrocomp allan", "allan whole file"),
-            "evaluate": ("gyrocomp evaluate", "evaluate whole file")}
+            "evaluate": ("gyrocomp evaluate", "evaluate whole file"), "noise": ("gyrocomp noise",)}
 WRAPPER = ("import resource, sys, threading, time\npeak = [0]\n"
            "def anon():\n    for line in open('/proc/self/status'):\n"
            "        if line.startswith('RssAnon:'):\n            return int(line.split()[1])\n    return 0\n"
@@ -105,7 +109,8 @@ def main() -> None:
     parser.add_argument("--rows", type=float, default=3e7)
     parser.add_argument("--format", choices=("parquet", "csv"), default="parquet")
     parser.add_argument("--skip-whole", action="store_true", help="skip the whole-file runs (they need GBs)")
-    parser.add_argument("--commands", default="apply,allan,evaluate", help="comma-separated: apply, allan, evaluate")
+    parser.add_argument("--commands", default="apply,allan,evaluate",
+                        help="comma-separated: apply, allan, evaluate, noise")
     args = parser.parse_args()
     rows = int(args.rows)
     warnings.simplefilter("ignore")
@@ -132,6 +137,10 @@ def main() -> None:
             ours = results[COMMANDS[command.strip()][0]]
             print(f"  gyrocomp {command.strip()}: {ours[0] / base[0]:.2f}x pyarrow's time, {ours[1]:.0f} MB peak RSS "
                   f"({ours[1] / base[1]:.2f}x pyarrow's), {ours[2]:.0f} MB peak anonymous")
+        if "gyrocomp noise" in results and "gyrocomp allan" in results:
+            noise, allan = results["gyrocomp noise"], results["gyrocomp allan"]
+            print(f"  gyrocomp noise (six axes, the model and a Kalibr export): {noise[0] / allan[0]:.2f}x the time of "
+                  "gyrocomp allan (three axes)")
 
 
 def _print(name: str, result: tuple[float, float, float]) -> None:

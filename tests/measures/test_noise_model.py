@@ -43,16 +43,20 @@ def test_one_rate_per_model_and_shared_axes():
         noise_model([])
 
 
-@pytest.fixture(scope="module")
-def warming_part():
-    """An MTi-10-class part whose white noise and flicker grow 1 % per degC, held at -20, 25 and 70 degC."""
+def _warming(preset: str):
+    """A part whose white noise and flicker grow 1 % per degC, held at -20, 25 and 70 degC."""
     import dataclasses
 
     from gyrocomp.simulation import get_profile, preset_model
 
-    model = dataclasses.replace(preset_model("mti10"), noise_tempco_per_degc=0.01)
+    model = dataclasses.replace(preset_model(preset), noise_tempco_per_degc=0.01)
     profile = get_profile("chamber", set_points_degc=(-20.0, 25.0, 70.0), dwell_s=2400.0)
     return model, simulate(model, profile=profile, rate_hz=20.0, seed=1).recording
+
+
+@pytest.fixture(scope="module")
+def warming_part():
+    return _warming("mti10")
 
 
 def test_the_dwells_of_a_chamber_run_are_found_after_settling(warming_part):
@@ -70,26 +74,27 @@ def test_the_dwells_of_a_chamber_run_are_found_after_settling(warming_part):
         noise_over_temperature(rec.take(slice(0, 6000)))
 
 
-def test_the_bound_over_temperature_is_above_the_true_noise_at_every_dwell(warming_part):
-    """The simulated truth at each dwell: the same part held at that temperature (the mean Allan variance of
-    independent static draws); the bound of all dwells lies above each at >= 95 % of the bounded taus."""
+@pytest.mark.parametrize("preset", ["mti10", "adis16488", "consumer"])
+def test_the_bound_over_temperature_is_above_the_true_noise_at_every_dwell(preset):
+    """Three parts whose noise grows 1 %/degC: the simulated truth at each dwell is the same part held at that
+    temperature (the mean Allan variance of independent static draws); the bound of all dwells lies above each at
+    >= 95 % of the bounded taus, and each dwell's white noise follows the part's within its interval."""
     from gyrocomp.allan import allan_deviation
     from gyrocomp.measures.noise_model import noise_over_temperature
     from gyrocomp.simulation.error_model import simulate_noise
 
-    model, rec = warming_part
+    model, rec = _warming(preset)
     noise = noise_over_temperature(rec)
-    axis = noise.axes["gyro_x"]
+    axis = noise.axes[model.axes[0]]
     assert [round(log.temperature_degc) for log in axis.logs] == [-20, 25, 70]
-    for log in axis.logs:  # the white noise read at each dwell follows the part's 1 %/degC
+    for log in axis.logs:
         low, _, high = log.white_noise_interval
         expected = model.noise_density_dps_per_sqrt_hz * float(model.noise_scale(log.temperature_degc))
         assert 0.9 * low <= expected <= 1.1 * high
     taus = np.array([t for t in axis.bound.taus_s if t <= axis.max_tau_s])
     for temperature in (-20.0, 25.0, 70.0):
         n = int(20.0 * 2100)
-        draws = [simulate_noise(n, 20.0, model, np.random.default_rng(s), np.full(n, temperature)).white_dps[:, 0]
-                 + simulate_noise(n, 20.0, model, np.random.default_rng(100 + s),
-                                  np.full(n, temperature)).flicker_dps[:, 0] for s in range(8)]
+        truths = [simulate_noise(n, 20.0, model, np.random.default_rng(s), np.full(n, temperature)) for s in range(8)]
+        draws = [t.white_dps[:, 0] + t.flicker_dps[:, 0] + t.random_walk_dps[:, 0] for t in truths]
         truth = np.sqrt(np.mean([allan_deviation(d, 20.0, taus=taus).deviation ** 2 for d in draws], axis=0))
         assert np.mean(axis.bound.deviation(taus) >= truth) >= 0.95, temperature
