@@ -1,4 +1,4 @@
-"""The frozen, versioned, JSON-serializable result of a fit, which applies itself.
+"""The frozen, versioned, JSON-serializable result of a fit (it is applied by :mod:`gyrocomp.calibration.compensate`).
 
 A model file is JSON with ``"format": "gyrocomp-calibration"`` and an integer ``schema_version``.
 Loading checks both, upgrades files written with an older schema, and refuses newer ones.
@@ -301,7 +301,7 @@ class AxisSummary:
 class Calibration:
     """A fitted compensation: per-axis models, units, valid ranges and provenance.
 
-    Create one with :func:`gyrocomp.fit_calibration`; apply it with :func:`gyrocomp.apply`
+    Create one with :func:`gyrocomp.fit`; apply it with :func:`gyrocomp.apply`
     or a :class:`gyrocomp.Compensator`; store it with :meth:`save` / :meth:`load`.
 
     Attributes
