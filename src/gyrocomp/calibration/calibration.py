@@ -1,4 +1,4 @@
-"""The frozen, versioned, JSON-serializable result of a fit (it is applied by :mod:`gyrocomp.calibration.compensate`).
+"""The frozen, versioned, JSON-serializable result of a fit; :mod:`gyrocomp.calibration.compensate` applies it.
 
 A model file is JSON with ``"format": "gyrocomp-calibration"`` and an integer ``schema_version``.
 Loading checks both, upgrades files written with an older schema, and refuses newer ones.
