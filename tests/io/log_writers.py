@@ -74,9 +74,12 @@ def write_dataflash(path, messages: dict[str, tuple[int, list[tuple[str, str]], 
         fh.write(bytes(out[: len(out) - cut]))
 
 
-def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",), mcap=False):
+def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",), mcap=False,
+              repeat: int | None = None, temperature_from: int = 0):
     """A bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or, with ``mcap``, MCAP storage) of ``n`` IMU messages
-    per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth."""
+    per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth
+    (from message ``temperature_from`` on); ``repeat``: message i written a second time with the same stamp and
+    gyro y 0.5 rad/s."""
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
@@ -107,6 +110,11 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
                       linear_acceleration=Vector3(x=0.0, y=0.0, z=9.80665), linear_acceleration_covariance=cov)
             for conn in imus:
                 writer.write(conn, int(t * 1e9), serialize(msg, Imu.__msgtype__))
-            if temperature and i % 10 == 0:  # 10 Hz temperature
+                if i == repeat:
+                    twin = Imu(header=msg.header, orientation=msg.orientation, orientation_covariance=cov,
+                               angular_velocity=Vector3(x=0.001 * i, y=0.5, z=-0.01), angular_velocity_covariance=cov,
+                               linear_acceleration=msg.linear_acceleration, linear_acceleration_covariance=cov)
+                    writer.write(conn, int(t * 1e9) + 1, serialize(twin, Imu.__msgtype__))
+            if temperature and i % 10 == 0 and i >= temperature_from:  # 10 Hz temperature
                 msg = Temperature(header=header(t), temperature=20.0 + i / 10.0, variance=0.0)
                 writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))

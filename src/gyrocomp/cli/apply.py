@@ -8,6 +8,7 @@ import click
 
 from ..calibration import Calibration
 from ..files.apply import apply_file
+from ..files.apply_bag import apply_bag
 from ..io import detect_format, output_format, refuse_to_overwrite_inputs
 from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
 
@@ -15,7 +16,9 @@ from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_op
 @click.command()
 @click.argument("model", type=click.Path())
 @click.argument("input_path", metavar="IN", type=click.Path())
-@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="Compensated output file.")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE,
+              help="Compensated output file: a table (.csv, .parquet), or for a ROS bag a bag of the same kind (a "
+                   ".bag file for ROS 1, a new folder for a ROS 2 bag).")
 @click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate the turn-on bias from the first S seconds of IN [s] (default: the model's mean).")
 @click.option("--axes", "axes", default=None, metavar="AXES",
@@ -24,11 +27,19 @@ from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_op
 @read_options
 @click.pass_context
 def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
-    """Compensate IN with MODEL: same columns and rows out, gyro columns compensated."""
+    """Compensate IN with MODEL: same columns and rows out, gyro columns compensated (a ROS bag into a bag: every
+    message copied, the IMU topic compensated)."""
     opts = pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path, model])
     calibration = Calibration.load(model)
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
+    if in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag"):  # a bag out: the same kind as in
+        done = apply_bag(calibration, input_path, output, options=read_settings(opts))
+        if not ctx.obj["quiet"]:
+            click.echo(f"wrote {output}: {done.compensated} messages of {done.imu_topic} compensated (angular velocity"
+                       f"{' and linear acceleration' if done.accel else ''}), every other message copied as it was; "
+                       "covariances left as they were")
+        return
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     named = None if axes is None else tuple(a.strip() for a in axes.split(",") if a.strip())
     with progress_bar(f"reading {Path(input_path).name}") as progress:

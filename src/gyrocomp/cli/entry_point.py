@@ -39,7 +39,8 @@ COMMANDS = {
                    'moments of field logs.'),
     "learn": ("learn", 'Learn a temperature model from the still moments of LOGS, as the online learner would on the '
                        'vehicle: each log one power-on, replayed in the order given.'),
-    "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated.'),
+    "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated (a ROS bag into a '
+                       'bag: every message copied, the IMU topic compensated).'),
     "show": ("show", 'What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device '
                 "ids), and the drift its held-out folds expect."),
     "split": ("split", "Cut LOG into runs, one file each, so that a recording of several "

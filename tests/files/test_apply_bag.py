@@ -1,0 +1,110 @@
+"""A ROS bag compensated into a bag of the same kind: ROS 1, ROS 2 in sqlite3 and in MCAP storage; every other
+message byte for byte and stamp for stamp as it was, the IMU topic equal to apply on the recording the bag reads
+as, a repeated stamp corrected as its twin, messages outside the temperature's span copied and said; through the
+command line too, the input never touched."""
+
+from __future__ import annotations
+
+import hashlib
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gyrocomp import apply, fit_calibration, read
+from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.files.apply_bag import apply_bag
+from gyrocomp.simulation import get_profile, simulate
+
+from ..conftest import run
+from tests.io.log_writers import write_bag
+
+pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
+from rosbags.highlevel import AnyReader  # noqa: E402
+
+KINDS = {"ros1": ({"ros2": False}, "in.bag", "out.bag"), "ros2": ({"ros2": True}, "in", "out"),
+         "mcap": ({"ros2": True, "mcap": True}, "in", "out")}
+
+
+@pytest.fixture(scope="module")
+def model():
+    profile = get_profile("cycle", set_points_degc=(15.0, 45.0), cycles=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit_calibration([simulate("consumer", profile=profile, rate_hz=1.0, seed=s).recording for s in (1, 2)])
+
+
+def _messages(bag: Path) -> list:
+    with AnyReader([bag]) as reader:
+        return [(c.topic, c.msgtype, t, bytes(raw)) for c, t, raw in reader.messages()]
+
+
+def _digest(path: Path) -> str:
+    files = sorted(path.rglob("*")) if path.is_dir() else [path]
+    return hashlib.sha256(b"".join(f.read_bytes() for f in files if f.is_file())).hexdigest()
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_a_bag_out_is_the_bag_in_with_its_imu_topic_compensated(kind, model, tmp_path):
+    options, name, out_name = KINDS[kind]
+    source, output = tmp_path / name, tmp_path / out_name
+    write_bag(source, n=300, **options)
+    before = _digest(source)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        done = apply_bag(model, source, output)
+        expected = apply(model, read(source)).gyro_dps
+        back = read(output)
+    assert (done.compensated, done.unchanged, done.accel, done.imu_topic) == (300, 0, False, "/imu/data")
+    np.testing.assert_allclose(back.gyro_dps, expected, rtol=0, atol=1e-12)
+    ins, outs = _messages(source), _messages(output)
+    assert [(topic, kind_, t) for topic, kind_, t, _ in ins] == [(topic, kind_, t) for topic, kind_, t, _ in outs]
+    assert [m for m in ins if m[0] != "/imu/data"] == [m for m in outs if m[0] != "/imu/data"]
+    assert _digest(source) == before
+    if kind == "mcap":
+        assert "mcap" in (output / "metadata.yaml").read_text()
+
+
+def test_a_repeated_stamp_is_corrected_as_its_twin_and_uncovered_messages_are_said(model, tmp_path):
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=300, repeat=150, temperature_from=100)
+    # the first temperature at message 100 (1 s in); reading matches within 5 of its periods (0.5 s): the first
+    # 51 messages (the one at 0.5 s too) are outside its span
+    with pytest.warns(DataQualityWarning, match=r"in.bag: 51 message\(s\) of /imu/data are not in the recording the "
+                                                r"bag reads as .* copied uncompensated"):
+        done = apply_bag(model, source, tmp_path / "out.bag")
+    assert (done.compensated, done.unchanged) == (250, 51)
+    with AnyReader([tmp_path / "out.bag"]) as reader:
+        msgs = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages() if c.topic == "/imu/data"]
+    first, twin = msgs[150], msgs[151]
+    assert first.header.stamp == twin.header.stamp
+    # the twin read 0.5 rad/s on y where the first read 0: the same correction leaves that difference
+    assert twin.angular_velocity.y - first.angular_velocity.y == pytest.approx(0.5, abs=1e-12)
+    assert msgs[0].angular_velocity.z == pytest.approx(-0.01, abs=1e-15)  # before the temperature: as it was
+
+
+def test_the_command_line_writes_a_bag_of_the_inputs_kind_and_refuses_another(model, tmp_path):
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=200)
+    model.save(tmp_path / "m.json")
+    done = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "out.bag")
+    assert done.returncode == 0, done.stderr
+    assert "wrote" in done.stdout and "200 messages of /imu/data compensated" in done.stdout
+    folder = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "outdir")
+    assert folder.returncode == 2 and folder.stderr.strip().endswith(
+        "a compensated bag is written as the input's kind: a .bag file (a ROS 1 bag)")
+    assert not (tmp_path / "outdir").exists()
+    table = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "out.csv")
+    assert table.returncode == 0 and (tmp_path / "out.csv").exists()  # a table out, as before
+
+
+def test_an_output_folder_that_is_not_a_bag_is_not_replaced(model, tmp_path):
+    source = tmp_path / "in"
+    write_bag(source, ros2=True, n=100)
+    keep = tmp_path / "notes"
+    keep.mkdir()
+    (keep / "mine.txt").write_text("keep me")
+    with pytest.raises(InputError, match=r"-o .*notes: is a folder that is not a ROS 2 bag; name a new path"):
+        apply_bag(model, source, keep)
+    assert (keep / "mine.txt").read_text() == "keep me"
