@@ -72,10 +72,11 @@ def timed_process(args: list[str], repeat: int) -> float:
     return best
 
 
-#: the fit's stages: the functions of ``gyrocomp.models.pipelines`` each stage's time is spent in (the rest of
-#: ``fit_channels`` is the final fit of the chosen models and its report)
-STAGES = {"checks": ("_check_fit_inputs",), "reduction": ("prepare", "prepare_axis"),
-          "model choice": ("share_fold_lags", "select_axes")}
+#: the fit's stages: the functions of ``gyrocomp.models`` (fit, joint) each stage's time is spent in (the rest of
+#: ``gyrocomp.fit`` is the final fit of the chosen models and its report)
+#: each stage's functions, by the module of gyrocomp.models that calls them (the runs are prepared once, by fit)
+STAGES = {"checks": (("joint", "_check_fit_inputs"),), "reduction": (("fit", "prepare"), ("joint", "prepare_axis")),
+          "model choice": (("joint", "share_fold_lags"), ("joint", "select_axes"))}
 
 
 def _timed(func, stage: str, spent: dict[str, float]):
@@ -92,25 +93,27 @@ def stages(paths: list[Path]) -> dict[str, float]:
     """The gyrocomp fit's stages in this process [s]: reading the CSVs, then within the fit the input checks
     (plausibility of each run), the reduction (stillness, blocks and bins per axis), the model choice (held-out
     drift of every candidate) and the final fit (the rest: the chosen models on all runs, the report)."""
-    from gyrocomp.io import read
-    from gyrocomp.models import pipelines
+    import importlib
 
+    from gyrocomp.io import read
+
+    modules = {name: importlib.import_module(f"gyrocomp.models.{name}") for name in ("fit", "joint")}
     start = time.perf_counter()
     runs = [read(p) for p in paths]
     spent = {"read": time.perf_counter() - start, **dict.fromkeys(STAGES, 0.0)}
-    originals = {name: getattr(pipelines, name) for names in STAGES.values() for name in names}
-    for stage, names in STAGES.items():
-        for name in names:
-            setattr(pipelines, name, _timed(originals[name], stage, spent))
+    originals = {(module, name): getattr(modules[module], name) for pairs in STAGES.values() for module, name in pairs}
+    for stage, pairs in STAGES.items():
+        for module, name in pairs:
+            setattr(modules[module], name, _timed(originals[module, name], stage, spent))
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             start = time.perf_counter()
-            pipelines.fit_channels(runs)
+            modules["fit"].fit(runs)
             whole = time.perf_counter() - start
     finally:
-        for name, func in originals.items():
-            setattr(pipelines, name, func)
+        for (module, name), func in originals.items():
+            setattr(modules[module], name, func)
     spent["final fit"] = whole - sum(spent[stage] for stage in STAGES)
     return spent
 
