@@ -9,6 +9,7 @@ import pytest
 from ..conftest import run
 
 
+@pytest.mark.slow
 def test_noise_prints_the_model_and_writes_each_export(static_log, tmp_path):
     log = static_log / "s.csv"
     done = run("noise", log)

@@ -15,6 +15,9 @@ from gyrocomp.evaluation.bias_process_noise import MAX_TAU_FRACTION, bias_proces
 from gyrocomp.simulation import get_profile, simulate
 
 
+pytestmark = pytest.mark.slow  # three simulated chamber cycles and a fit
+
+
 @pytest.fixture(scope="module")
 def consumer():
     profile = get_profile("cycle", set_points_degc=(-10.0, 60.0), cycles=1)
