@@ -108,3 +108,13 @@ def test_an_output_folder_that_is_not_a_bag_is_not_replaced(model, tmp_path):
     with pytest.raises(InputError, match=r"-o .*notes: is a folder that is not a ROS 2 bag; name a new path"):
         apply_bag(model, source, keep)
     assert (keep / "mine.txt").read_text() == "keep me"
+
+
+def test_a_damaged_bag_is_refused_in_one_line_and_nothing_is_written(model, tmp_path):
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=300)
+    data = source.read_bytes()
+    source.write_bytes(data[: len(data) * 2 // 3])  # cut short: its index and last chunks are gone
+    with pytest.raises(InputError, match=r"in.bag: (damaged|not a readable) ROS bag"):
+        apply_bag(model, source, tmp_path / "out.bag")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.bag"]  # no output, no temporary left
