@@ -118,3 +118,25 @@ def test_a_damaged_bag_is_refused_in_one_line_and_nothing_is_written(model, tmp_
     with pytest.raises(InputError, match=r"in.bag: (damaged|not a readable) ROS bag"):
         apply_bag(model, source, tmp_path / "out.bag")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.bag"]  # no output, no temporary left
+
+
+def test_the_covariances_are_written_from_a_noise_model(model, tmp_path):
+    """The noise model's white noise as the variance of one sample at the bag's rate (100 Hz): N^2 rate."""
+    import json
+
+    source = tmp_path / "in"
+    write_bag(source, ros2=True, n=200)
+    noise = tmp_path / "noise.json"
+    noise.write_text(json.dumps({"format": "gyrocomp-noise-model", "rate_hz": 100.0, "axes": {
+        "gyro_x": {"bound": {"white_noise_density_u_per_sqrt_hz": 0.01}},
+        "gyro_z": {"bound": {"white_noise_density_u_per_sqrt_hz": 0.02}}}}))
+    done = apply_bag(model, source, tmp_path / "out", noise=noise)
+    assert done.covariances == ("angular_velocity_covariance",)
+    with AnyReader([tmp_path / "out"]) as reader:
+        msg = next(reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages() if c.topic == "/imu/data")
+    expected = np.radians(0.02) ** 2 * 100.0  # the larger gyro density, in rad/s/sqrt(Hz)
+    np.testing.assert_allclose(msg.angular_velocity_covariance, np.diag([expected] * 3).ravel(), rtol=1e-9)
+    np.testing.assert_array_equal(msg.linear_acceleration_covariance, np.zeros(9))  # as it was
+    noise.write_text('{"format": "something else"}')
+    with pytest.raises(InputError, match=r"noise.json: not a gyrocomp noise model"):
+        apply_bag(model, source, tmp_path / "again", noise=noise)

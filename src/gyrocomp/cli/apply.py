@@ -24,22 +24,29 @@ from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_op
 @click.option("--axes", "axes", default=None, metavar="AXES",
               help="Gyro axes to compensate, e.g. gyro_z (default: all; data with an axis the model lacks is "
                    "refused unless the axes are named, and the others are then left raw).")
+@click.option("--noise", "noise_path", type=click.Path(dir_okay=False), default=None,
+              help="A bag out: write the IMU messages' covariances from this noise model (gyrocomp noise --export "
+                   "json), the variance of one sample at the bag's rate; default: left as they were.")
 @read_options
 @click.pass_context
-def apply(ctx, model, input_path, output, turn_on_window_s, axes, **kwargs):
+def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **kwargs):
     """Compensate IN with MODEL: same columns and rows out, gyro columns compensated (a ROS bag into a bag: every
     message copied, the IMU topic compensated)."""
     opts = pop_read_options(kwargs)
-    refuse_to_overwrite_inputs(output, [input_path, model])
+    refuse_to_overwrite_inputs(output, [input_path, model] + ([noise_path] if noise_path else []))
     calibration = Calibration.load(model)
     in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
     if in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag"):  # a bag out: the same kind as in
-        done = apply_bag(calibration, input_path, output, options=read_settings(opts))
+        done = apply_bag(calibration, input_path, output, options=read_settings(opts), noise=noise_path)
         if not ctx.obj["quiet"]:
+            said = (f"{' and '.join(done.covariances)} written from {noise_path}" if done.covariances
+                    else "covariances left as they were")
             click.echo(f"wrote {output}: {done.compensated} messages of {done.imu_topic} compensated (angular velocity"
                        f"{' and linear acceleration' if done.accel else ''}), every other message copied as it was; "
-                       "covariances left as they were")
+                       f"{said}")
         return
+    if noise_path is not None:
+        raise click.BadParameter("a noise model is written into a bag's covariances: give a bag out", param_hint="--noise")
     out_fmt = output_format(output, default=in_fmt)  # a bad output is refused before the work
     named = None if axes is None else tuple(a.strip() for a in axes.split(",") if a.strip())
     with progress_bar(f"reading {Path(input_path).name}") as progress:

@@ -36,7 +36,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..errors import DataQualityWarning, InputError
-from ..measures.noise_model import NoiseModel
+from ..measures.noise_model import NoiseModel, per_sample_covariance
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment
 
@@ -178,14 +178,11 @@ def ros_covariances(model: NoiseModel, rate_hz: float | None = None) -> dict[str
     [m^2/s^4] (row-major 3x3, diagonal), per sample at ``rate_hz`` [Hz] (default the logs' rate): N^2 rate."""
     c = continuous_noise(model)
     rate = model.rate_hz if rate_hz is None else rate_hz
-    if not (isinstance(rate, (int, float)) and rate > 0 and math.isfinite(rate)):
-        raise InputError(f"rate_hz: a positive number of Hz, got {rate!r}")
     out = {}
     for key, density in (("angular_velocity_covariance", c.gyro_noise_density_rad_per_s_per_sqrt_hz),
                          ("linear_acceleration_covariance", c.accel_noise_density_m_per_s2_per_sqrt_hz)):
         if density is not None:
-            v = density ** 2 * rate
-            out[key] = [v, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0.0, v]
+            out[key] = per_sample_covariance(density, rate)
     return out
 
 

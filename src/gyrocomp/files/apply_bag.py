@@ -6,9 +6,9 @@ replaced by the compensated value, exactly what :func:`gyrocomp.apply` gives on 
 (the temperature from the matched ``sensor_msgs/Temperature`` topic, as in reading). A message whose header stamp
 repeats an earlier one (which reading leaves out) gets the same correction as that one; a message the recording
 does not hold (outside the temperature topic's span, or dropped as non-finite) is copied as it is, and a warning
-says how many. The covariance fields are left as they were. A ROS 1 ``.bag`` gives a ``.bag``; a ROS 2 bag folder
-gives a folder in the same storage (sqlite3 or MCAP). The output is written beside its final name and moved there
-when complete; the input is never touched.
+says how many. The covariance fields are written from a noise model when one is given, else left as they were.
+A ROS 1 ``.bag`` gives a ``.bag``; a ROS 2 bag folder gives a folder in the same storage (sqlite3 or MCAP). The
+output is written beside its final name and moved there when complete; the input is never touched.
 
 This version reads the IMU topic into memory (as reading does) and copies the bag message by message.
 """
@@ -33,6 +33,7 @@ from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
 from ..io.rosbag import IMU_TYPE, bag_path, read_rosbag
+from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
 
 _RAD = unit_factor("gyro", "rad/s")  # deg/s per rad/s
@@ -42,13 +43,15 @@ _MS2 = unit_factor("accel", "m/s2")  # g per m/s^2
 @dataclass(frozen=True)
 class AppliedBag:
     """What :func:`apply_bag` wrote: the output, the topic compensated, the messages compensated and copied as
-    they were, and whether the accelerations were compensated too."""
+    they were, whether the accelerations were compensated too, and the covariance fields written (none: left as
+    they were)."""
 
     path: Path
     imu_topic: str
     compensated: int
     unchanged: int
     accel: bool
+    covariances: tuple[str, ...] = ()
 
 
 def _stamp_s(header) -> float:
@@ -75,7 +78,8 @@ def _writer(bag: Path, target: Path, connections):
     return writer, out
 
 
-def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | None = None) -> AppliedBag:
+def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | None = None,
+              noise=None) -> AppliedBag:
     """Compensate the IMU topic of a ROS bag into a bag of the same kind (see the module).
 
     Parameters
@@ -88,6 +92,11 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
         The bag to write: a ``.bag`` file for a ROS 1 bag, a folder for a ROS 2 bag (replaced when it exists).
     options : ReadOptions, optional
         ``imu_topic`` and ``temperature_topic`` (default: the only topic of each type).
+    noise : path, optional
+        A noise model (``gyrocomp noise --export json``): the compensated messages' ``angular_velocity_covariance``
+        (and ``linear_acceleration_covariance`` when it models the accelerometer) are written from it, the
+        variance of one sample at the bag's rate (N^2 rate) [rad^2/s^2, m^2/s^4]; without one they are left as
+        they were.
 
     Returns
     -------
@@ -103,8 +112,14 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
     if output.is_dir() and not (output / "metadata.yaml").is_file():
         raise InputError(f"-o {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces only "
                          "a bag)")
+    densities = noise_file_densities(noise) if noise is not None else (None, None)
     recording = read_rosbag(path, options)
     compensated = apply(calibration, recording)
+    covariances = {}
+    if densities[0] is not None:
+        covariances["angular_velocity_covariance"] = per_sample_covariance(densities[0] / _RAD, recording.rate_hz)
+    if densities[1] is not None:
+        covariances["linear_acceleration_covariance"] = per_sample_covariance(densities[1] / _MS2, recording.rate_hz)
     with_accel = recording.accel_g is not None and not np.array_equal(compensated.accel_g, recording.accel_g)
     topic = recording.metadata["imu_topic"]
     highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
@@ -116,7 +131,7 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
         with highlevel.AnyReader([bag]) as reader:
             writer, connections = _writer(bag, target, reader.connections)
             try:
-                _copy(reader, writer, connections, topic, recording, compensated, with_accel, counts)
+                _copy(reader, writer, connections, topic, (recording, compensated, with_accel, covariances), counts)
             finally:
                 writer.close()
         _move_into_place(target, output)
@@ -126,12 +141,13 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
         warnings.warn(f"{path}: {counts['unchanged']} message(s) of {topic} are not in the recording the bag reads as "
                       "(outside the temperature topic's span, or not finite) and were copied uncompensated",
                       DataQualityWarning, stacklevel=2)
-    return AppliedBag(output, topic, counts["compensated"], counts["unchanged"], with_accel)
+    return AppliedBag(output, topic, counts["compensated"], counts["unchanged"], with_accel, tuple(covariances))
 
 
-def _copy(reader, writer, connections: dict, topic: str, recording, compensated, with_accel: bool,
-          counts: dict) -> None:
-    """Every message into ``writer``: the IMU topic's compensated, the rest as its bytes."""
+def _copy(reader, writer, connections: dict, topic: str, result: tuple, counts: dict) -> None:
+    """Every message into ``writer``: the IMU topic's compensated (``result``: the recording, its compensation,
+    whether the accelerations are compensated, the covariance fields to write), the rest as its bytes."""
+    recording, compensated, with_accel, covariances = result
     time_s = recording.time_s
     gyro_rad = compensated.gyro_dps / _RAD
     correction = (recording.gyro_dps - compensated.gyro_dps) / _RAD
@@ -163,6 +179,8 @@ def _copy(reader, writer, connections: dict, topic: str, recording, compensated,
             a = msg.linear_acceleration
             acc = accel_ms2[k] if first else np.array([a.x, a.y, a.z]) - accel_correction[k]
             changes["linear_acceleration"] = dataclasses.replace(a, x=float(acc[0]), y=float(acc[1]), z=float(acc[2]))
+        for field, values in covariances.items():
+            changes[field] = np.asarray(values, dtype=np.float64)
         writer.write(out, timestamp, serialize(dataclasses.replace(msg, **changes), connection.msgtype))
         counts["compensated"] += 1
 

@@ -10,7 +10,10 @@ the data's unit u: deg/s for a gyro axis, g for an accelerometer axis.
 from __future__ import annotations
 
 import dataclasses
+import json
+import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -91,7 +94,7 @@ class NoiseModel:
 
     def to_dict(self) -> dict:
         """The model as JSON (``gyrocomp noise --export json``): each axis's bounds and IEEE terms, in its unit."""
-        return {"format": "gyrocomp-noise-model", "rate_hz": self.rate_hz, "axes": {
+        return {"format": NOISE_MODEL_FORMAT, "rate_hz": self.rate_hz, "axes": {
             name: {"sensor": a.sensor, "unit": a.unit, "bound": a.bound.to_dict(), "bound_with_markov":
                    a.markov.to_dict(), "ieee_952": {"white_noise_density": a.ieee.white_noise_density,
                                                    "bias_instability": a.ieee.bias_instability,
@@ -148,6 +151,49 @@ def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
                                     bound_noise(curves, markov=False, max_tau_s=max_tau),
                                     bound_noise(curves, markov=True, max_tau_s=max_tau), logs, max_tau)
     return NoiseModel(rate, axes)
+
+
+#: the ``format`` of a noise model's JSON (``gyrocomp noise --export json``)
+NOISE_MODEL_FORMAT = "gyrocomp-noise-model"
+
+
+def per_sample_covariance(density: float, rate_hz: float) -> list[float]:
+    """The row-major 3x3 covariance of one sample of white noise of ``density`` [u/sqrt(Hz)] at ``rate_hz`` [Hz]:
+    N^2 rate on the diagonal [u^2] (``sensor_msgs/Imu``'s covariance fields)."""
+    if not (isinstance(rate_hz, (int, float)) and rate_hz > 0 and math.isfinite(rate_hz)):
+        raise InputError(f"rate_hz: a positive number of Hz, got {rate_hz!r}")
+    v = density ** 2 * rate_hz
+    return [v, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0.0, v]
+
+
+def noise_file_densities(path) -> tuple[float | None, float | None]:
+    """The largest white-noise density of the gyro axes [deg/s/sqrt(Hz)] and of the accelerometer axes
+    [g/sqrt(Hz)] of a noise model's JSON file (``gyrocomp noise --export json``; None for a sensor it lacks).
+
+    Parameters
+    ----------
+    path : path
+        The file.
+    """
+    try:
+        d = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a readable noise model ({type(exc).__name__}); write one with gyrocomp noise "
+                         "--export json") from None
+    if not isinstance(d, dict) or d.get("format") != NOISE_MODEL_FORMAT or not isinstance(d.get("axes"), dict):
+        raise InputError(f"{path}: not a gyrocomp noise model (no \"format\": \"{NOISE_MODEL_FORMAT}\"); write one "
+                         "with gyrocomp noise --export json")
+    found: dict[str, list[float]] = {"gyro": [], "accel": []}
+    for name, axis in d["axes"].items():
+        try:
+            value = float(axis["bound"]["white_noise_density_u_per_sqrt_hz"])
+        except (KeyError, TypeError, ValueError):
+            raise InputError(f"{path}: axes.{name}.bound.white_noise_density_u_per_sqrt_hz: missing or not a number") from None
+        if not (math.isfinite(value) and value >= 0):
+            raise InputError(f"{path}: axes.{name}.bound.white_noise_density_u_per_sqrt_hz: {value!r} is not a "
+                             "density")
+        found["accel" if str(name).startswith("accel") else "gyro"].append(value)
+    return (max(found["gyro"]) if found["gyro"] else None, max(found["accel"]) if found["accel"] else None)
 
 
 def mean_temperature_degc(recording) -> float | None:
@@ -231,5 +277,6 @@ def noise_over_temperature(recordings: Recording | list[Recording], axes: list[s
     return noise_model(named, [mean_temperature_degc(p) for p in pieces])
 
 
-__all__ = ["AxisNoiseModel", "DWELL_RATE_DEGC_PER_MIN", "LogNoise", "MAX_TAU_FRACTION", "NoiseModel",
+__all__ = ["AxisNoiseModel", "DWELL_RATE_DEGC_PER_MIN", "LogNoise", "MAX_TAU_FRACTION", "NOISE_MODEL_FORMAT",
+           "NoiseModel", "noise_file_densities", "per_sample_covariance",
            "mean_temperature_degc", "noise_model", "noise_over_temperature", "record_length_s", "temperature_dwells"]
