@@ -43,6 +43,8 @@ def test_single_axis_report_with_hysteresis_has_every_section():
     assert "stages of the compensation" in report.html  # the thesis's Table 4.4 shape with hysteresis
     assert "<th>window [s]</th>" in report.html  # each figure with the window it depends on
     assert "temperature + hysteresis" in report.html and "polynomial order" in report.html
+    # the compensated gyro's noise model for an estimator, beside its IEEE 952 fit
+    assert "noise model of the compensated gyro for an estimator" in report.html and "<th>bound K</th>" in report.html
 
 
 @pytest.mark.slow

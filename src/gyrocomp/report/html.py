@@ -31,11 +31,12 @@ import numpy as np
 from .._version import __version__
 from ..calibration import Calibration
 from ..calibration.compensate import apply
-from ..errors import DataQualityWarning, TemperatureRangeWarning
+from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
 from ..export.firmware import BEYOND_DEGC, firmware_corrected_axes, firmware_costs
 from ..measures.merit import bias_offset, evaluate_run, window_samples
 from ..measures.noise import analyse_noise
+from ..measures.noise_model import noise_model
 from ..recording import ACCEL_AXES, Recording
 from ..rounding import with_error
 from ..motion.positions import static_segments
@@ -450,14 +451,32 @@ def _noise(rec: Recording, comp: Recording) -> tuple:
 
 
 def _allan(runs: list[Recording], noise: list[tuple], tick: Callable[[], None]) -> str:
-    """Raw and compensated Allan deviations of each run, one figure per run."""
+    """Raw and compensated Allan deviations of each run, one figure per run, and the compensated gyro's noise model
+    for an estimator (:mod:`gyrocomp.measures.noise_model`) beside its IEEE 952 fit."""
     parts = []
     for rec, (raw, compensated) in zip(runs, noise):
         analyses = {"raw": raw, "compensated": compensated}
         parts.append(_img(figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
                           "Allan deviation, raw and compensated"))
+        parts.append(_noise_model_table(compensated))
         tick()
     return "\n".join(parts)
+
+
+def _noise_model_table(compensated) -> str:
+    """The compensated gyro's noise model for an estimator: the bound (white noise N, random walk K, at or above the
+    curve's 95 % interval up to a tenth of the run) beside the IEEE 952 fit, per axis [deg/s/sqrt(Hz),
+    deg/s/sqrt(s)]."""
+    try:
+        model = noise_model(compensated)
+    except InputError as exc:  # too short a run for two averaging times
+        return f"<p class=note>No noise model: {html.escape(str(exc))}</p>"
+    rows = [[name, a.ieee.white_noise_density, a.ieee.random_walk, a.bound.white_noise_density, a.bound.random_walk,
+             f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}"] for name, a in model.axes.items()]
+    return _table(["axis", "IEEE 952 N", "IEEE 952 K", "bound N", "bound K", "bound / curve: median / largest"], rows,
+                  caption="noise model of the compensated gyro for an estimator (gyrocomp noise): N "
+                          "[deg/s/sqrt(Hz)] and K [deg/s/sqrt(s)] at or above the upper end of the curve's 95 % "
+                          "interval at every averaging time up to a tenth of the run")
 
 
 def _stillness(moving: list) -> str:
