@@ -8,13 +8,11 @@ import click
 from rich.table import Table
 
 from ..calibration import Calibration
-from ..calibration.compensate import apply
-from ..evaluation.bias_process_noise import bias_process_noise
+from ..evaluation.bias_process_noise import compensated_noise
 from ..export.estimator_noise import NOISE_EXPORTS
 from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.inputs import expand_runs
-from ..measures.noise import analyse_noise
 from ..measures.noise_model import NoiseModel, noise_model, noise_over_temperature
 from .common import OUTPUT_FILE, make_console, pop_read_options, progress_bar, read_options, read_run, read_settings
 
@@ -56,12 +54,9 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
     if model_path is not None:
         if dwells:
             raise click.BadParameter("give --model or --dwells, not both", param_hint="--model")
-        calibration = Calibration.load(model_path)
-        runs = [read_run(path, opts).recording for path in paths]
-        benefit = bias_process_noise(calibration, runs, [a for a in named if a.startswith("gyro")] if named else None)
-        compensated = [apply(calibration, run) for run in runs]
-        model = noise_model([analyse_noise(run, named, with_accel=named is None, split_gaps=split_gaps,
-                                           motion_check=False) for run in compensated])
+        model, benefit = compensated_noise(Calibration.load(model_path), [read_run(path, opts).recording
+                                                                          for path in paths],
+                                           named, with_accel=named is None, split_gaps=split_gaps)
     elif dwells:
         model = noise_over_temperature([read_run(path, opts).recording for path in paths], named,
                                        with_accel=named is None)

@@ -22,6 +22,8 @@ from ..allan.bound import NoiseBound, bound_noise
 from ..calibration import Calibration
 from ..calibration.compensate import apply
 from ..errors import InputError, TemperatureRangeWarning
+from ..measures.noise import analyse_noise
+from ..measures.noise_model import NoiseModel, noise_model
 from ..recording import Recording
 
 #: the longest averaging time bounded, as a fraction of the shortest run: the thermal drift is slow
@@ -95,4 +97,33 @@ def bias_process_noise(calibration: Calibration, recordings: Recording | list[Re
     return out
 
 
-__all__ = ["BiasProcessNoise", "MAX_TAU_FRACTION", "bias_process_noise"]
+def compensated_noise(calibration: Calibration, recordings: list[Recording], axes: list[str] | None = None, *,
+                      with_accel: bool = False, split_gaps: bool = False
+                      ) -> tuple[NoiseModel, dict[str, BiasProcessNoise]]:
+    """The noise model of the compensated gyro (what an estimator on the vehicle receives) and what the calibration
+    buys its bias process noise (:func:`bias_process_noise`), on the same static runs.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The model.
+    recordings : list of Recording
+        Static runs held out from the fit [s, deg/s, g, degC].
+    axes : list of str, optional
+        Gyro and accelerometer axes (default every gyro axis, and the accelerometer's with ``with_accel``).
+    with_accel : bool
+        Also model the accelerometer axes.
+    split_gaps : bool
+        Pool the contiguous stretches of runs with time gaps.
+    """
+    gyro = [a for a in axes if a.startswith("gyro")] if axes else None
+    benefit = bias_process_noise(calibration, recordings, gyro)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TemperatureRangeWarning)  # said by bias_process_noise's own apply
+        compensated = [apply(calibration, r) for r in recordings]
+    model = noise_model([analyse_noise(r, axes, with_accel=with_accel, split_gaps=split_gaps, motion_check=False)
+                         for r in compensated])
+    return model, benefit
+
+
+__all__ = ["BiasProcessNoise", "MAX_TAU_FRACTION", "bias_process_noise", "compensated_noise"]
