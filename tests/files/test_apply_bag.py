@@ -105,7 +105,7 @@ def test_an_output_folder_that_is_not_a_bag_is_not_replaced(model, tmp_path):
     keep = tmp_path / "notes"
     keep.mkdir()
     (keep / "mine.txt").write_text("keep me")
-    with pytest.raises(InputError, match=r"-o .*notes: is a folder that is not a ROS 2 bag; name a new path"):
+    with pytest.raises(InputError, match=r"output: .*notes: is a folder that is not a ROS 2 bag; name a new path"):
         apply_bag(model, source, keep)
     assert (keep / "mine.txt").read_text() == "keep me"
 

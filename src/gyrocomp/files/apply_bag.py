@@ -107,41 +107,53 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
     bag = bag_path(path)
     if bag.is_dir() == (output.suffix.lower() == ".bag"):
         kind = "a folder (a ROS 2 bag)" if bag.is_dir() else "a .bag file (a ROS 1 bag)"
-        raise InputError(f"-o {output}: a compensated bag is written as the input's kind: {kind}")
+        raise InputError(f"output: {output}: a compensated bag is written as the input's kind: {kind}")
     refuse_link(output)
     if output.is_dir() and not (output / "metadata.yaml").is_file():
-        raise InputError(f"-o {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces only "
-                         "a bag)")
-    densities = noise_file_densities(noise) if noise is not None else (None, None)
+        raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
+                         "only a bag)")
+    covariance_of = _covariances(noise) if noise is not None else {}
     recording = read_rosbag(path, options)
     compensated = apply(calibration, recording)
-    covariances = {}
-    if densities[0] is not None:
-        covariances["angular_velocity_covariance"] = per_sample_covariance(densities[0] / _RAD, recording.rate_hz)
-    if densities[1] is not None:
-        covariances["linear_acceleration_covariance"] = per_sample_covariance(densities[1] / _MS2, recording.rate_hz)
+    covariances = {field: make(recording.rate_hz) for field, make in covariance_of.items()}
     with_accel = recording.accel_g is not None and not np.array_equal(compensated.accel_g, recording.accel_g)
     topic = recording.metadata["imu_topic"]
-    highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
-    parent = output.parent if str(output.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
-    target = tmp / (output.name if output.suffix else "bag")
     counts = {"compensated": 0, "unchanged": 0}
-    try:
-        with highlevel.AnyReader([bag]) as reader:
-            writer, connections = _writer(bag, target, reader.connections)
-            try:
-                _copy(reader, writer, connections, topic, (recording, compensated, with_accel, covariances), counts)
-            finally:
-                writer.close()
-        _move_into_place(target, output)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+    _write_bag(bag, output, topic, (recording, compensated, with_accel, covariances), counts)
     if counts["unchanged"]:
         warnings.warn(f"{path}: {counts['unchanged']} message(s) of {topic} are not in the recording the bag reads as "
                       "(outside the temperature topic's span, or not finite) and were copied uncompensated",
                       DataQualityWarning, stacklevel=2)
     return AppliedBag(output, topic, counts["compensated"], counts["unchanged"], with_accel, tuple(covariances))
+
+
+def _covariances(noise) -> dict:
+    """The covariance fields a noise model's JSON file gives, each as a function of the bag's rate [Hz]."""
+    gyro, accel = noise_file_densities(noise)
+    out = {}
+    if gyro is not None:
+        out["angular_velocity_covariance"] = lambda rate: per_sample_covariance(gyro / _RAD, rate)
+    if accel is not None:
+        out["linear_acceleration_covariance"] = lambda rate: per_sample_covariance(accel / _MS2, rate)
+    return out
+
+
+def _write_bag(bag: Path, output: Path, topic: str, result: tuple, counts: dict) -> None:
+    """The copy written beside ``output`` in a temporary folder, moved into place when complete."""
+    highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
+    parent = output.parent if str(output.parent) else Path(".")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
+    target = tmp / (output.name if output.suffix else "bag")
+    try:
+        with highlevel.AnyReader([bag]) as reader:
+            writer, connections = _writer(bag, target, reader.connections)
+            try:
+                _copy(reader, writer, connections, topic, result, counts)
+            finally:
+                writer.close()
+        _move_into_place(target, output)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def _copy(reader, writer, connections: dict, topic: str, result: tuple, counts: dict) -> None:

@@ -178,11 +178,11 @@ def noise_file_densities(path) -> tuple[float | None, float | None]:
     try:
         d = json.loads(Path(path).read_text())
     except (OSError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable noise model ({type(exc).__name__}); write one with gyrocomp noise "
-                         "--export json") from None
+        raise InputError(f"{path}: not a readable noise model ({type(exc).__name__}); gyrocomp's json noise export "
+                         "writes one") from None
     if not isinstance(d, dict) or d.get("format") != NOISE_MODEL_FORMAT or not isinstance(d.get("axes"), dict):
-        raise InputError(f"{path}: not a gyrocomp noise model (no \"format\": \"{NOISE_MODEL_FORMAT}\"); write one "
-                         "with gyrocomp noise --export json")
+        raise InputError(f"{path}: not a gyrocomp noise model (no \"format\": \"{NOISE_MODEL_FORMAT}\"); gyrocomp's "
+                         "json noise export writes one")
     found: dict[str, list[float]] = {"gyro": [], "accel": []}
     for name, axis in d["axes"].items():
         try:
