@@ -333,8 +333,14 @@ def test_rosbag_topic_choices_and_missing_topics(tmp_path):
     with pytest.raises(InputError, match=r"2 sensor_msgs/msg/Imu topics \(/imu0, /imu1\); choose one with imu_topic="):
         read(path)
     with pytest.raises(InputError, match=r"imu_topic=/imu9: no such topic in the bag; its sensor_msgs/msg/Imu "
-                                         r"topics are /imu0, /imu1"):
+                                         r"topics are /imu0, /imu1; its sensor_msgs/msg/Temperature topics are none$"):
         read(path, imu_topic="/imu9")
+    with_temperature = tmp_path / "one.bag"
+    write_bag(with_temperature, ros2=False)
+    with pytest.raises(InputError, match=r"temperature_topic=/t: no such topic in the bag; its sensor_msgs/msg/Imu "
+                                         r"topics are /imu/data; its sensor_msgs/msg/Temperature topics are "
+                                         r"/imu/temperature$"):
+        read(with_temperature, temperature_topic="/t")
     with pytest.raises(InputError, match=r"temperature_topic=/imu1: the topic has type sensor_msgs/msg/Imu"):
         read(path, imu_topic="/imu0", temperature_topic="/imu1")
     with pytest.warns(DataQualityWarning, match="no sensor_msgs/msg/Temperature topic"):

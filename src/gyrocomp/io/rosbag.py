@@ -58,14 +58,20 @@ def _check_types(path: Path, readers: list) -> None:
                                      f"{str(connection.msgtype)[:80]!r}, not a ROS type name; refused")
 
 
+def _topics_of(connections: list, msgtype: str) -> list[str]:
+    """The topics of a message type that hold messages, sorted."""
+    return sorted({c.topic for c in connections if c.msgtype == msgtype and c.msgcount > 0})
+
+
 def _topic(path: Path, connections: list, msgtype: str, asked: str | None, option: str):
     """The connections of the topic asked for, or of the only topic of that type."""
-    of_type = sorted({c.topic for c in connections if c.msgtype == msgtype and c.msgcount > 0})
+    of_type = _topics_of(connections, msgtype)
     if asked is not None:
         chosen = [c for c in connections if c.topic == asked]
         if not chosen:
-            raise InputError(f"{path}: {option}={asked}: no such topic in the bag; "
-                             f"its {msgtype} topics are {', '.join(of_type) or 'none'}")
+            present = "; ".join(f"its {kind} topics are {', '.join(_topics_of(connections, kind)) or 'none'}"
+                                for kind in (IMU_TYPE, TEMPERATURE_TYPE))
+            raise InputError(f"{path}: {option}={asked}: no such topic in the bag; {present}")
         if chosen[0].msgtype != msgtype:
             raise InputError(f"{path}: {option}={asked}: the topic has type {chosen[0].msgtype}, not {msgtype}")
         if not sum(c.msgcount for c in chosen):
