@@ -6,7 +6,8 @@ bounded). Then ``--runs`` Monte Carlo runs of ``--minutes`` at ``--rate`` Hz, th
 to 70 degC and back (the noise following it), feed the small attitude filter of
 :mod:`gyrocomp.evaluation.filter_consistency` (absolute attitude updates every 2 s, 0.01 deg) told each model in
 turn: the bound with white noise and random walk (what Kalibr, VINS and the autopilots carry), the bound with
-Gauss-Markov terms, the IEEE 952 fit of the 25 degC dwell (N and K), and that fit times 10. Printed: the median
+Gauss-Markov terms, the two-term bounds of the dwells scheduled by the temperature (interpolated between them),
+the IEEE 952 fit of the 25 degC dwell (N and K), and that fit times 10. Printed: the median
 time-averaged NEES and the share of runs inside its 95 % chi-square band (below it: over-cautious; above:
 over-confident).
 
@@ -24,7 +25,7 @@ import numpy as np
 from gyrocomp.allan.bound import NoiseBound
 from gyrocomp.evaluation.filter_consistency import attitude_nees
 from gyrocomp.measures.noise import analyse_noise
-from gyrocomp.measures.noise_model import noise_over_temperature, temperature_dwells
+from gyrocomp.measures.noise_model import noise_over_temperature, scheduled_bound, temperature_dwells
 from gyrocomp.simulation import get_profile, preset_model, simulate
 from gyrocomp.simulation.error_model import simulate_noise
 
@@ -54,6 +55,7 @@ def main() -> None:
         ieee = analyse_noise(middle, [model.axes[0]], motion_check=False).axes[model.axes[0]].terms
         fitted = NoiseBound(ieee.white_noise_density, ieee.random_walk, (), (1.0,), 1.0, 1.0)
         models = {"bound, white + random walk": axis.bound, "bound with Gauss-Markov terms": axis.markov,
+                  "bound scheduled by temperature (each dwell's)": "scheduled",
                   "IEEE 952 fit (N, K)": fitted,
                   "IEEE 952 fit x10": dataclasses.replace(fitted, white_noise_density=10 * fitted.white_noise_density,
                                                           random_walk=10 * fitted.random_walk)}
@@ -62,7 +64,11 @@ def main() -> None:
             truth = simulate_noise(n, args.rate, model, np.random.default_rng(1000 + r), ramp)
             errors[r] = truth.white_dps[:, 0] + truth.flicker_dps[:, 0] + truth.random_walk_dps[:, 0]
         for name, noise in models.items():
-            result = attitude_nees(errors, args.rate, noise)
+            if noise == "scheduled":
+                result = attitude_nees(errors, args.rate, axis.bound, schedule=scheduled_bound(axis),
+                                       temperature_degc=ramp)
+            else:
+                result = attitude_nees(errors, args.rate, noise)
             print(f"| {preset} | {name} | {np.median(result.nees):.2f} | {result.inside:.0%} | "
                   f"{result.band[0]:.2f}..{result.band[1]:.2f} |")
 

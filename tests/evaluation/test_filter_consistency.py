@@ -63,3 +63,19 @@ def test_a_gauss_markov_term_the_truth_has_is_carried(white_and_walk):
 def test_too_short_a_record_is_refused():
     with pytest.raises(InputError, match=r"update_period_s: 2 s leaves fewer than two updates after the burn-in"):
         attitude_nees(np.zeros((2, 40)), RATE_HZ, _told(0.01, 0.0))
+
+
+def test_a_filter_told_the_noise_at_each_temperature_is_consistent_where_one_constant_is_not():
+    """White noise that doubles from one end of a ramp to the other: scheduled by the temperature it is told the
+    truth at each period (consistent); told the hottest end's throughout, it is over-cautious."""
+    n = int(RATE_HZ * 1200)
+    temperature = np.linspace(0.0, 60.0, n)
+    density = 0.02 * (1.0 + temperature / 60.0)
+    errors = np.random.default_rng(4).standard_normal((RUNS, n)) * density * np.sqrt(RATE_HZ)
+    scheduled = attitude_nees(errors, RATE_HZ, _told(0.04, 1e-9), temperature_degc=temperature,
+                              schedule=lambda t: _told(0.02 * (1.0 + t / 60.0), 1e-9))
+    assert np.median(scheduled.nees) == pytest.approx(1.0, abs=0.05)
+    constant = attitude_nees(errors, RATE_HZ, _told(0.04, 1e-9))
+    assert np.median(constant.nees) < constant.band[0]
+    with pytest.raises(InputError, match=r"schedule: needs temperature_degc"):
+        attitude_nees(errors, RATE_HZ, _told(0.04, 1e-9), schedule=lambda t: _told(0.04, 1e-9))

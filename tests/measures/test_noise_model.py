@@ -98,3 +98,18 @@ def test_the_bound_over_temperature_is_above_the_true_noise_at_every_dwell(prese
         draws = [t.white_dps[:, 0] + t.flicker_dps[:, 0] + t.random_walk_dps[:, 0] for t in truths]
         truth = np.sqrt(np.mean([allan_deviation(d, 20.0, taus=taus).deviation ** 2 for d in draws], axis=0))
         assert np.mean(axis.bound.deviation(taus) >= truth) >= 0.95, temperature
+
+
+def test_the_scheduled_bound_is_each_dwells_at_its_temperature_and_held_past_them(warming_part):
+    from gyrocomp.measures.noise_model import noise_over_temperature, scheduled_bound
+
+    _, rec = warming_part
+    axis = noise_over_temperature(rec).axes["gyro_x"]
+    at = scheduled_bound(axis)
+    cold, middle, hot = axis.logs
+    assert at(cold.temperature_degc).white_noise_density == pytest.approx(cold.bound.white_noise_density)
+    assert at(-60.0).white_noise_density == pytest.approx(cold.bound.white_noise_density)
+    assert at(120.0).random_walk == pytest.approx(hot.bound.random_walk)
+    halfway = 0.5 * (middle.temperature_degc + hot.temperature_degc)
+    assert at(halfway).white_noise_density == pytest.approx(
+        0.5 * (middle.bound.white_noise_density + hot.bound.white_noise_density))

@@ -18,6 +18,7 @@ noise too large), above it over-confident.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,7 +95,9 @@ def _model(noise: NoiseBound, period_s: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def attitude_nees(errors_dps: np.ndarray, rate_hz: float, noise: NoiseBound, *, update_period_s: float = 2.0,
-                  update_sigma_deg: float = 0.01, burn_in_fraction: float = 0.2) -> NeesResult:
+                  update_sigma_deg: float = 0.01, burn_in_fraction: float = 0.2,
+                  schedule: Callable[[float], NoiseBound] | None = None,
+                  temperature_degc: np.ndarray | None = None) -> NeesResult:
     """The time-averaged NEES of the attitude filter (see the module) told ``noise``, on gyro errors of known
     truth.
 
@@ -113,6 +116,11 @@ def attitude_nees(errors_dps: np.ndarray, rate_hz: float, noise: NoiseBound, *, 
         Their noise [deg].
     burn_in_fraction : float
         The share of the updates left out at the start (the bias estimate converging).
+    schedule : callable, optional
+        ``schedule(temperature_degc) -> NoiseBound``: the noise the filter is told at each update period's mean
+        temperature instead of ``noise`` (white noise and random walk only), with ``temperature_degc``.
+    temperature_degc : array (n,), optional
+        The temperature along the runs [degC], for ``schedule``.
 
     Returns
     -------
@@ -125,31 +133,40 @@ def attitude_nees(errors_dps: np.ndarray, rate_hz: float, noise: NoiseBound, *, 
     if per < 1 or epochs - first < 2:
         raise InputError(f"update_period_s: {update_period_s:g} s leaves fewer than two updates after the burn-in in "
                          f"{errors.shape[1] / rate_hz:g} s")
+    if schedule is not None and (temperature_degc is None or noise.markov):
+        raise InputError("schedule: needs temperature_degc, and a noise model of white noise and random walk only")
     # the measured angle of each update period: the rate integrated over it [deg]
     integrated = errors[:, :epochs * per].reshape(errors.shape[0], epochs, per).sum(axis=2) / rate_hz
-    phi, q = _model(noise, per / rate_hz)
-    size = phi.shape[0]
+    models = [_model(noise, per / rate_hz)] * epochs if schedule is None else [
+        _model(schedule(float(np.mean(t))), per / rate_hz)
+        for t in np.asarray(temperature_degc, dtype=float)[:epochs * per].reshape(epochs, per)]
+    size = models[0][0].shape[0]
     p = np.zeros((size, size))
     p[0, 0] = update_sigma_deg ** 2
     p[1, 1] = (errors[:, : max(per, 1)].mean(axis=1).std() + noise.deviation(1.0)) ** 2  # the turn-on bias
     for j, (sigma, _) in enumerate(noise.markov):
         p[2 + j, 2 + j] = sigma ** 2
-    x = np.zeros((errors.shape[0], size))
+    samples = _filter(integrated, models, p, first, update_sigma_deg)
+    return NeesResult(np.mean(samples, axis=0), nees_band(len(samples)), len(samples))
+
+
+def _filter(integrated: np.ndarray, models: list, p: np.ndarray, first: int, update_sigma_deg: float) -> list:
+    """Each update's prior NEES of the attitude (from ``first`` on), every run at once: propagate with each
+    period's (transition, process noise), then update with an absolute attitude of the true value 0."""
+    x = np.zeros((integrated.shape[0], p.shape[0]))
     rng = np.random.default_rng(0)
     samples = []
-    for k in range(epochs):
+    for k, (phi, q) in enumerate(models):
         x = x @ phi.T
         x[:, 0] += integrated[:, k]
         p = phi @ p @ phi.T + q
         if k >= first:
             samples.append(x[:, 0] ** 2 / p[0, 0])
-        z = rng.standard_normal(errors.shape[0]) * update_sigma_deg  # the true attitude is 0
-        s = p[0, 0] + update_sigma_deg ** 2
-        gain = p[:, 0] / s
+        z = rng.standard_normal(integrated.shape[0]) * update_sigma_deg
+        gain = p[:, 0] / (p[0, 0] + update_sigma_deg ** 2)
         x = x + np.outer(z - x[:, 0], gain)
         p = p - np.outer(gain, p[0, :])
-    kept = len(samples)
-    return NeesResult(np.mean(samples, axis=0), nees_band(kept), kept)
+    return samples
 
 
 __all__ = ["NeesResult", "attitude_nees", "nees_band"]

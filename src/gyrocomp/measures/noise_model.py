@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -153,6 +154,30 @@ def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
     return NoiseModel(rate, axes)
 
 
+def scheduled_bound(axis: AxisNoiseModel) -> Callable[[float], NoiseBound]:
+    """The noise an axis needs at a temperature: each log's own two-term bound at its temperature, interpolated
+    linearly between them and held past the coldest and the hottest (what a filter scheduling its noise by
+    temperature is told).
+
+    Parameters
+    ----------
+    axis : AxisNoiseModel
+        An axis modelled from logs at known temperatures (:func:`noise_over_temperature`).
+    """
+    logs = sorted((log for log in axis.logs if log.temperature_degc is not None), key=lambda log: log.temperature_degc)
+    if not logs:
+        raise InputError(f"{axis.axis}: no log with a temperature to schedule by")
+    t = np.array([log.temperature_degc for log in logs])
+    n = np.array([log.bound.white_noise_density for log in logs])
+    k = np.array([log.bound.random_walk for log in logs])
+
+    def at(temperature_degc: float) -> NoiseBound:
+        return NoiseBound(float(np.interp(temperature_degc, t, n)), float(np.interp(temperature_degc, t, k)), (),
+                          axis.bound.taus_s, math.nan, math.nan)
+
+    return at
+
+
 #: the ``format`` of a noise model's JSON (``gyrocomp noise --export json``)
 NOISE_MODEL_FORMAT = "gyrocomp-noise-model"
 
@@ -278,5 +303,5 @@ def noise_over_temperature(recordings: Recording | list[Recording], axes: list[s
 
 
 __all__ = ["AxisNoiseModel", "DWELL_RATE_DEGC_PER_MIN", "LogNoise", "MAX_TAU_FRACTION", "NOISE_MODEL_FORMAT",
-           "NoiseModel", "noise_file_densities", "per_sample_covariance",
+           "NoiseModel", "noise_file_densities", "per_sample_covariance", "scheduled_bound",
            "mean_temperature_degc", "noise_model", "noise_over_temperature", "record_length_s", "temperature_dwells"]
