@@ -640,3 +640,35 @@ def test_a_px4_log_already_corrected_onboard_is_recognized(tmp_path):
     assert corrected.metadata["corrected_onboard"]
     write_ulog(tmp_path / "off.ulg", {("sensor_combined", 0): combined}, parameters={"TC_G_ENABLE": 0})
     assert not read(tmp_path / "off.ulg").metadata["corrected_onboard"]
+
+
+def test_a_bags_imu_topics_are_its_instances(tmp_path):
+    """Several IMUs in one bag: each sensor_msgs/Imu topic an instance, in name order, as the autopilots' sensors;
+    instance= reads one, fit --instance all fits each."""
+    from gyrocomp.io import instances
+
+    path = tmp_path / "two.bag"
+    write_bag(path, ros2=False, imu_topics=("/imu_b", "/imu_a"))
+    assert instances(path) == (0, 1)
+    assert read(path, instance=0).metadata["imu_topic"] == "/imu_a"
+    assert read(path, instance=1).metadata["imu_topic"] == "/imu_b"
+    with pytest.raises(InputError, match=r"instance=2: the bag has 2 sensor_msgs/msg/Imu topic\(s\) \(/imu_a, /imu_b\), "
+                                         r"instances 0 to 1"):
+        read(path, instance=2)
+    with pytest.raises(InputError, match=r"choose one with imu_topic= or instance= \(their index"):
+        read(path)
+    one = tmp_path / "one.bag"
+    write_bag(one, ros2=False)
+    assert instances(one) == (0,)
+
+
+def test_the_command_line_reads_a_bags_instance(tmp_path):
+    path = tmp_path / "two.bag"
+    write_bag(path, ros2=False, temperature=False, imu_topics=("/imu_b", "/imu_a"))
+    done = run("convert", path, tmp_path / "b.csv", "--instance", 1)
+    assert done.returncode == 0, done.stderr
+    assert read(tmp_path / "b.csv").n_samples == 100
+    wrong = run("convert", path, tmp_path / "c.csv", "--instance", 5)
+    assert wrong.returncode == 2 and wrong.stderr.strip().endswith(
+        "two.bag: --instance 5: the bag has 2 sensor_msgs/msg/Imu topic(s) (/imu_a, /imu_b), instances 0 to 1")
+    assert not (tmp_path / "c.csv").exists()

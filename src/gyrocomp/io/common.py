@@ -70,7 +70,8 @@ class ReadOptions:
     drop_nonfinite : bool
         Drop rows with NaN or infinite values instead of refusing the file.
     instance : int, optional
-        Sensor instance in autopilot logs (PX4 ``multi_id``, ArduPilot ``I`` / IMU2 / IMU3); default 0.
+        Sensor instance in autopilot logs (PX4 ``multi_id``, ArduPilot ``I`` / IMU2 / IMU3; default 0), or in a ROS
+        bag the index of its ``sensor_msgs/Imu`` topic in name order.
     device_id : int, optional
         PX4 device id of the gyro to read (instead of ``instance``).
     imu_topic, temperature_topic : str, optional
@@ -91,8 +92,9 @@ class ReadOptions:
         "--drop-nan", "Drop rows with empty/NaN values (says how many) instead of refusing the file.", switch=True),
         default=False)
     instance: int | None = spelled(Spelling(
-        "--instance", "Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0); fit: "
-        "all fits every instance, one model file each.", metavar="N", parse=parse_instance), default=None)
+        "--instance", "Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0) or ROS "
+        "bags (the IMU topic's index in name order); fit: all fits every instance, one model file each.",
+        metavar="N", parse=parse_instance), default=None)
     device_id: int | None = spelled(Spelling(
         "--device-id", "PX4 device id of the gyro to read.", metavar="ID",
         parse=lambda text: _whole_number(text, "device_id")), default=None)

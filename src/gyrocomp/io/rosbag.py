@@ -63,6 +63,46 @@ def _topics_of(connections: list, msgtype: str) -> list[str]:
     return sorted({c.topic for c in connections if c.msgtype == msgtype and c.msgcount > 0})
 
 
+def _open(path: Path):
+    """An open rosbags reader of the bag at ``path`` (its message type names checked first); anything that is not
+    a readable bag is refused in one line."""
+    highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
+    if not path.exists():
+        raise InputError(f"{path}: no such file or folder")
+    bag = bag_path(path)
+    _only_its_own_files(path, bag)
+    try:
+        reader = highlevel.AnyReader([bag])
+        _check_types(path, reader.readers)
+        reader.open()
+    except InputError:
+        raise
+    except Exception as exc:  # rosbags raises its own error types for files that are not bags
+        raise InputError(f"{path}: not a readable ROS bag ({type(exc).__name__}: {exc})") from None
+    return reader
+
+
+def _imu_topic_asked(path: Path, connections: list, options: ReadOptions) -> str | None:
+    """The IMU topic the options name: ``imu_topic``, or the ``instance``-th IMU topic in name order (a bag's
+    sensors as the autopilots' instances), or None (the only one)."""
+    if options.imu_topic is not None or options.instance is None:
+        return options.imu_topic
+    topics = _topics_of(connections, IMU_TYPE)
+    if not 0 <= options.instance < len(topics):
+        raise InputError(f"{path}: instance={options.instance}: the bag has {len(topics)} {IMU_TYPE} topic(s) "
+                         f"({', '.join(topics) or 'none'}), instances 0 to {len(topics) - 1}")
+    return topics[options.instance]
+
+
+def rosbag_instances(path) -> tuple[int, ...]:
+    """The sensor instances of a bag: one per ``sensor_msgs/Imu`` topic with messages, in topic-name order."""
+    reader = _open(Path(path))
+    try:
+        return tuple(range(len(_topics_of(list(reader.connections), IMU_TYPE)))) or (0,)
+    finally:
+        reader.close()
+
+
 def _topic(path: Path, connections: list, msgtype: str, asked: str | None, option: str):
     """The connections of the topic asked for, or of the only topic of that type."""
     of_type = _topics_of(connections, msgtype)
@@ -80,7 +120,9 @@ def _topic(path: Path, connections: list, msgtype: str, asked: str | None, optio
     if not of_type:
         return []
     if len(of_type) > 1:
-        raise InputError(f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with {option}=")
+        also = " or instance= (their index, from 0, in this order)" if msgtype == IMU_TYPE else ""
+        raise InputError(f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with "
+                         f"{option}={also}")
     return [c for c in connections if c.topic == of_type[0]]
 
 
@@ -157,22 +199,10 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     """
     options = options or ReadOptions()
     path = Path(path)
-    highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
-    if not path.exists():
-        raise InputError(f"{path}: no such file or folder")
-    bag = bag_path(path)
-    _only_its_own_files(path, bag)
-    try:
-        reader = highlevel.AnyReader([bag])
-        _check_types(path, reader.readers)
-        reader.open()
-    except InputError:
-        raise
-    except Exception as exc:  # rosbags raises its own error types for files that are not bags
-        raise InputError(f"{path}: not a readable ROS bag ({type(exc).__name__}: {exc})") from None
+    reader = _open(path)
     try:
         connections = list(reader.connections)
-        imu = _topic(path, connections, IMU_TYPE, options.imu_topic, "imu_topic")
+        imu = _topic(path, connections, IMU_TYPE, _imu_topic_asked(path, connections, options), "imu_topic")
         if not imu:
             topics = ", ".join(sorted(f"{c.topic} ({c.msgtype})" for c in connections)) or "none"
             raise InputError(f"{path}: no {IMU_TYPE} topic in the bag; its topics are {topics}")
@@ -200,4 +230,4 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
 
 register_reader(Reader("rosbag", "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, extra [ros]", read_rosbag,
                        suffixes=(".bag", ".db3", ".mcap"), magic=(b"#ROSBAG", b"\x89MCAP"), aliases=("bag", "ros"),
-                       folder_marker="metadata.yaml"))
+                       folder_marker="metadata.yaml", instances=rosbag_instances))
