@@ -19,10 +19,10 @@ from ..io import ReadOptions, format_spelling, read_input
 from ..io.atomic import check_output_file
 from ..curves.network import DEFAULT_HIDDEN
 from ..curves.kinds import BASES
-from ..models.options import MAX_CURVE_SIZE, Curve, Network, Polynomial, family_help
+from ..models.options import Curve, Network, Polynomial, curve_size_range, family_help
 from ..models.fit import check_channels
 from ..runs.prepared import CHANNELS
-from ..curves.polynomial import POLY_FAMILY, MAX_ORDER
+from ..curves.polynomial import POLY_FAMILY
 
 
 class OutputFile(click.Path):
@@ -143,7 +143,7 @@ def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Curve | N
         try:
             return Polynomial(int(size)) if family == POLY_FAMILY else Curve(family, int(size))
         except (ValueError, InputError):
-            low, top = (0, MAX_ORDER) if family == POLY_FAMILY else (1, MAX_CURVE_SIZE)
+            low, top = curve_size_range(family)
             raise InputError(f"--temperature: {text!r}: the size of {family} must be a whole number from {low} to "
                              f"{top}") from None
     raise InputError(f"--temperature: {text!r}: use auto, {', '.join(f'{n}, {n}:N' for n in BASES)}, mlp, mlp:H "

@@ -69,6 +69,12 @@ class Network:
 MAX_CURVE_SIZE = 64
 
 
+def curve_size_range(family: str) -> tuple[int, int]:
+    """The sizes a curve family may be asked at, (lowest, highest): a polynomial's orders 0..5, any other family's
+    1..``MAX_CURVE_SIZE``."""
+    return (0, MAX_ORDER) if family == POLY_FAMILY else (1, MAX_CURVE_SIZE)
+
+
 @dataclass(frozen=True)
 class Curve:
     """A registered curve family by name (:data:`gyrocomp.curves.protocol.BASES`: ``poly``, ``table``, ...) at
@@ -91,8 +97,7 @@ class Curve:
     def __post_init__(self):
         if self.family not in BASES:
             raise InputError(f"Curve.family: {self.family!r}; the registered curves are {', '.join(BASES)}")
-        top = MAX_ORDER if self.family == POLY_FAMILY else MAX_CURVE_SIZE
-        low = 0 if self.family == POLY_FAMILY else 1
+        low, top = curve_size_range(self.family)
         if self.size != "auto" and not (isinstance(self.size, int) and not isinstance(self.size, bool)
                                         and low <= self.size <= top):
             raise InputError(f"Curve.size: {self.family} takes a whole number from {low} to {top}, or 'auto'; "
@@ -108,11 +113,6 @@ class CurveCandidates:
     orders: tuple[int, ...]
     others: tuple[tuple[str, int], ...]
     do_no_harm: bool
-
-    @property
-    def asked(self) -> bool:
-        """One curve was asked for (no choice among sizes or families)."""
-        return len(self.orders) + len(self.others) == 1 and not self.do_no_harm
 
 
 def curve_candidates(spec: "Polynomial | Curve | Network", target: "Target" = "model") -> CurveCandidates:
@@ -153,7 +153,7 @@ def family_help() -> str:
     """The registered curve families as ``--temperature`` lists them: each name, its sizes, what it is."""
     out = []
     for name, basis in BASES.items():
-        low, top = (0, MAX_ORDER) if name == POLY_FAMILY else (1, MAX_CURVE_SIZE)
+        low, top = curve_size_range(name)
         out.append(f"{name} or {name}:N (N = {low}..{top}): {basis.description}")
     return "; ".join(out)
 
@@ -267,5 +267,5 @@ class FitOptions:
         object.__setattr__(self, "hysteresis", "none")
 
 
-__all__ = ["Acceleration", "Curve", "CurveCandidates", "FIRMWARE_MAX_ORDER", "FitOptions", "FoldChoice", "MAX_CURVE_SIZE",
+__all__ = ["Acceleration", "Curve", "CurveCandidates", "FIRMWARE_MAX_ORDER", "FitOptions", "FoldChoice", "MAX_CURVE_SIZE", "curve_size_range",
            "Memory", "Network", "Polynomial", "Target", "curve_candidates", "family_help"]
