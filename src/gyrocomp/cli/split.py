@@ -8,6 +8,7 @@ import click
 
 from ..errors import InputError
 from ..io import refuse_to_overwrite_inputs, write_rows
+from ..io.tables import PARQUET_SUFFIXES
 from ..runs.runsplit import SPLITS, split_runs
 from .common import FINITE, pop_read_options, read_options, read_run
 
@@ -63,7 +64,7 @@ def _table_suffix(log: str, data) -> str:
     ``.parquet``; ``.txt`` and compressed tables as ``.csv``, or ``.tsv`` when tab-separated), else ``csv``."""
     name = Path(log).name.lower()
     if data.text_format is None:
-        return "parquet" if name.endswith((".parquet", ".pq")) else "csv"
+        return "parquet" if name.endswith(PARQUET_SUFFIXES) else "csv"
     return "tsv" if data.text_format.delimiter == "\t" else "csv"
 
 

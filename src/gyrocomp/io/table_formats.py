@@ -7,7 +7,8 @@ from pathlib import Path
 
 from .common import ProgressCallback, ReadOptions
 from .readers import Reader, register_reader
-from .tables import COMPRESSED_SUFFIXES, PARQUET_MAGIC, TEXT_TABLE_SUFFIXES, TableData, read_table
+from .tables import (COMPRESSED_SUFFIXES, PARQUET_MAGIC, PARQUET_SUFFIXES, TEXT_TABLE_SUFFIXES, TableData,
+                     read_table)
 
 
 def _table_reader(fmt: str):
@@ -25,7 +26,7 @@ register_reader(Reader("csv", "a delimited text table, gzip/bz2/xz/zstd compress
                        suffixes=TEXT_TABLE_SUFFIXES + tuple(s + c for s in TEXT_TABLE_SUFFIXES
                                                             for c in COMPRESSED_SUFFIXES),
                        aliases=("tsv", "txt"), table=True))
-register_reader(Reader("parquet", "an Apache Parquet table", _table_reader("parquet"), suffixes=(".parquet", ".pq"),
+register_reader(Reader("parquet", "an Apache Parquet table", _table_reader("parquet"), suffixes=PARQUET_SUFFIXES,
                        magic=(PARQUET_MAGIC,), aliases=("pq",), table=True))
 
 __all__: list[str] = []

@@ -304,6 +304,8 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
 TEXT_TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
 #: suffixes of compressed text tables after their own (``run.csv.gz``), read as they stream
 COMPRESSED_SUFFIXES = (".gz", ".bz2", ".xz", ".zst")
+#: suffixes of Parquet tables
+PARQUET_SUFFIXES = (".parquet", ".pq")
 #: the first (and last) bytes of a Parquet file
 PARQUET_MAGIC = b"PAR1"
 
@@ -314,7 +316,7 @@ def detect_table_format(path: Path) -> str | None:
         return "csv"  # compressed CSV, e.g. run.csv.gz
     if suffix in TEXT_TABLE_SUFFIXES:
         return "csv"
-    if suffix in (".parquet", ".pq"):
+    if suffix in PARQUET_SUFFIXES:
         return "parquet"
     return None
 
