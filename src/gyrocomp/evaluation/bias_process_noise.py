@@ -72,6 +72,12 @@ def bias_process_noise(calibration: Calibration, recordings: Recording | list[Re
     dict of str to BiasProcessNoise
     """
     runs = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    names = _gyro_axes(calibration, runs, axes)
+    return _bias_bounds(runs, _compensated(calibration, runs), names)
+
+
+def _gyro_axes(calibration: Calibration, runs: list[Recording], axes: list[str] | None) -> list[str]:
+    """The gyro axes asked for (default every one the model and the runs share), checked."""
     if not runs:
         raise InputError("bias_process_noise: give at least one static run")
     shared = [a for a in calibration.axes if all(a in r.gyro_axes for r in runs)]
@@ -80,9 +86,18 @@ def bias_process_noise(calibration: Calibration, recordings: Recording | list[Re
     if unknown or not names:
         raise InputError(f"axes: {', '.join(unknown) or 'none'}: the model and the runs share "
                          f"{', '.join(shared) or 'no gyro axis'}")
+    return names
+
+
+def _compensated(calibration: Calibration, runs: list[Recording]) -> list[Recording]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TemperatureRangeWarning)  # said where the model is applied by the user
-        compensated = [apply(calibration, r) for r in runs]
+        return [apply(calibration, r) for r in runs]
+
+
+def _bias_bounds(runs: list[Recording], compensated: list[Recording], names: list[str]
+                 ) -> dict[str, BiasProcessNoise]:
+    """Each axis's two-term bound of the raw and of the compensated runs about their means."""
     max_tau = MAX_TAU_FRACTION * min(float(r.time_s[-1] - r.time_s[0]) for r in runs)
     out = {}
     for name in names:
@@ -116,11 +131,10 @@ def compensated_noise(calibration: Calibration, recordings: list[Recording], axe
     split_gaps : bool
         Pool the contiguous stretches of runs with time gaps.
     """
-    gyro = [a for a in axes if a.startswith("gyro")] if axes else None
-    benefit = bias_process_noise(calibration, recordings, gyro)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", TemperatureRangeWarning)  # said by bias_process_noise's own apply
-        compensated = [apply(calibration, r) for r in recordings]
+    runs = list(recordings)
+    names = _gyro_axes(calibration, runs, [a for a in axes if a.startswith("gyro")] if axes else None)
+    compensated = _compensated(calibration, runs)  # once, for both
+    benefit = _bias_bounds(runs, compensated, names)
     model = noise_model([analyse_noise(r, axes, with_accel=with_accel, split_gaps=split_gaps, motion_check=False)
                          for r in compensated])
     return model, benefit
