@@ -12,7 +12,6 @@ profile.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +20,7 @@ from ..allan import allan_deviation
 from ..allan.bound import NoiseBound, bound_noise
 from ..calibration import Calibration
 from ..calibration.compensate import apply
-from ..errors import InputError, TemperatureRangeWarning
+from ..errors import InputError
 from ..measures.noise import analyse_noise
 from ..measures.noise_model import NoiseModel, noise_model
 from ..recording import Recording
@@ -90,9 +89,9 @@ def _gyro_axes(calibration: Calibration, runs: list[Recording], axes: list[str] 
 
 
 def _compensated(calibration: Calibration, runs: list[Recording]) -> list[Recording]:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", TemperatureRangeWarning)  # said where the model is applied by the user
-        return [apply(calibration, r) for r in runs]
+    """The runs compensated; a run past the model's temperature range is warned about, as apply does (its drift
+    there is the model's extrapolation)."""
+    return [apply(calibration, r) for r in runs]
 
 
 def _bias_bounds(runs: list[Recording], compensated: list[Recording], names: list[str]
