@@ -1,5 +1,6 @@
 """Kalibr imu.yaml: values, units and warnings."""
 
+import json
 import math
 
 import numpy as np
@@ -37,7 +38,7 @@ def test_values_are_the_continuous_time_densities_in_si_units():
     assert set(values) == {"accelerometer_noise_density", "accelerometer_random_walk", "gyroscope_noise_density",
                            "gyroscope_random_walk", "rostopic", "update_rate"}
     assert float(values["gyroscope_noise_density"]) == pytest.approx(0.01 * math.pi / 180, rel=0.03)
-    assert float(values["update_rate"]) == 50.0 and values["rostopic"] == "/imu/data"
+    assert float(values["update_rate"]) == 50.0 and json.loads(values["rostopic"]) == "/imu/data"
 
 
 def test_random_walk_reaches_the_file():

@@ -39,6 +39,7 @@ from ..errors import DataQualityWarning, InputError
 from ..measures.noise_model import NoiseModel, per_sample_covariance
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment
+from .kalibr import KalibrImu, kalibr_imu_yaml
 
 DEG_TO_RAD = math.pi / 180.0
 
@@ -100,23 +101,15 @@ def _warn_zero_walk(c: ContinuousNoise, target: str) -> None:
 
 
 def kalibr_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
-    """Kalibr's ``imu.yaml``: continuous-time densities [rad/s/sqrt(Hz), m/s^2/sqrt(Hz)] and random walks."""
+    """Kalibr's ``imu.yaml`` (:func:`gyrocomp.export.kalibr.kalibr_imu_yaml`'s layout): continuous-time densities
+    [rad/s/sqrt(Hz), m/s^2/sqrt(Hz)] and random walks of the bound."""
     c = continuous_noise(model)
     _warn_zero_walk(c, "kalibr")
-    lines = ["# written by gyrocomp: the white-noise + random-walk bound of the measured Allan deviation",
-             "# (at or above the upper end of its 95 % interval at every averaging time); continuous-time values"]
-    if c.accel_noise_density_m_per_s2_per_sqrt_hz is not None:
-        lines += [f"accelerometer_noise_density: {c.accel_noise_density_m_per_s2_per_sqrt_hz:.6e}  # [m/s^2/sqrt(Hz)]",
-                  f"accelerometer_random_walk: {c.accel_random_walk_m_per_s3_per_sqrt_hz:.6e}  # [m/s^3/sqrt(Hz)]"]
-    else:
-        lines.append("# no accelerometer axes in the logs: add accelerometer_noise_density and "
-                     "accelerometer_random_walk before running Kalibr")
-    lines += [f"gyroscope_noise_density: {_need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, 'gyro', 'kalibr'):.6e}"
-              "  # [rad/s/sqrt(Hz)]",
-              f"gyroscope_random_walk: {c.gyro_random_walk_rad_per_s2_per_sqrt_hz:.6e}  # [rad/s^2/sqrt(Hz)]",
-              f"rostopic: {json.dumps(rostopic)}",
-              f"update_rate: {c.rate_hz:.6g}  # [Hz]"]
-    return "\n".join(lines) + "\n"
+    imu = KalibrImu(_need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, "gyro", "kalibr"),
+                    c.gyro_random_walk_rad_per_s2_per_sqrt_hz, c.accel_noise_density_m_per_s2_per_sqrt_hz,
+                    c.accel_random_walk_m_per_s3_per_sqrt_hz, c.rate_hz, rostopic)
+    return kalibr_imu_yaml(imu, "the white-noise + random-walk bound of the measured Allan deviation (at or above "
+                                "the upper end of its 95 % interval at every averaging time); continuous-time values")
 
 
 def openvins_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:

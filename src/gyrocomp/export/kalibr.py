@@ -10,6 +10,7 @@ divided by it). With several axes, the largest value is written, which is the co
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
 from dataclasses import dataclass
@@ -60,9 +61,14 @@ def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
     )
 
 
-def kalibr_imu_yaml(imu: KalibrImu) -> str:
-    """The YAML text, laid out like Kalibr's own example ``imu.yaml``."""
-    lines = ["# written by gyrocomp: continuous-time noise densities and bias random walks (Allan analysis)"]
+#: what the values of gyrocomp's Kalibr file are, by default: the IEEE Std 952 fit's
+ALLAN_FIT = "continuous-time noise densities and bias random walks (Allan analysis)"
+
+
+def kalibr_imu_yaml(imu: KalibrImu, source: str = ALLAN_FIT) -> str:
+    """The YAML text, laid out like Kalibr's own example ``imu.yaml``; ``source`` says what the values are (a
+    comment line), and the topic is written as a quoted string."""
+    lines = [f"# written by gyrocomp: {source}"]
     if imu.accelerometer_noise_density_m_per_s2_per_sqrt_hz is not None:
         lines += [
             "#Accelerometers",
@@ -80,7 +86,7 @@ def kalibr_imu_yaml(imu: KalibrImu) -> str:
         "#Noise density (continuous-time) [rad/s/sqrt(Hz)]",
         f"gyroscope_random_walk:       {imu.gyroscope_random_walk_rad_per_s2_per_sqrt_hz:.6e}  "
         "#Bias random walk [rad/s^2/sqrt(Hz)]",
-        f"rostopic:                    {imu.rostopic}  #the IMU ROS topic",
+        f"rostopic:                    {json.dumps(imu.rostopic)}  #the IMU ROS topic",
         f"update_rate:                 {imu.update_rate_hz:.6g}  #Hz (for discretization of the values above)",
     ]
     return "\n".join(lines) + "\n"
