@@ -84,6 +84,11 @@ def test_the_ros_covariance_is_the_variance_of_one_sample_of_white_noise_of_that
         "angular_velocity_covariance"][8]
     slower = ros_covariances(model, rate_hz=RATE_HZ / 2)
     assert slower["angular_velocity_covariance"][0] == pytest.approx(cov["angular_velocity_covariance"][0] / 2)
+    from gyrocomp.export.estimator_noise import ros_yaml
+
+    written = ros_yaml(model, "/imu\nangular_velocity_covariance: [0]")  # a topic cannot add a key
+    assert [line.split(":")[0] for line in written.splitlines() if not line.startswith("#")] == [
+        "angular_velocity_covariance", "linear_acceleration_covariance"]
     with pytest.raises(InputError, match=r"rate_hz: a positive number of Hz, got -1"):
         ros_covariances(model, rate_hz=-1)
 

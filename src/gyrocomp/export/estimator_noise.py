@@ -181,7 +181,8 @@ def ros_covariances(model: NoiseModel, rate_hz: float | None = None) -> dict[str
 
 def ros_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
     """The covariances as YAML parameters of an IMU driver node."""
-    lines = [f"# written by gyrocomp: per-sample variances at {model.rate_hz:g} Hz (N^2 rate) for {rostopic}"]
+    lines = [f"# written by gyrocomp: per-sample variances at {model.rate_hz:g} Hz (N^2 rate) for "
+             f"{line_comment(rostopic)}"]
     for key, values in ros_covariances(model).items():
         lines.append(f"{key}: [{', '.join(f'{v:.6e}' for v in values)}]")
     return "\n".join(lines) + "\n"
