@@ -39,7 +39,7 @@ from ..errors import DataQualityWarning, InputError
 from ..measures.noise_model import NoiseModel, per_sample_covariance
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment
-from .kalibr import KalibrImu, kalibr_imu_yaml
+from .kalibr import KalibrImu, kalibr_imu_yaml, warn_zero_walks
 
 DEG_TO_RAD = math.pi / 180.0
 
@@ -91,20 +91,17 @@ def _need(value: float | None, what: str, target: str) -> float:
     return value
 
 
-def _warn_zero_walk(c: ContinuousNoise, target: str) -> None:
-    """Kalibr (and OpenVINS, which reads its file) refuse a random walk of 0: say so where the logs show none."""
-    for sensor, walk in (("gyroscope", c.gyro_random_walk_rad_per_s2_per_sqrt_hz),
-                         ("accelerometer", c.accel_random_walk_m_per_s3_per_sqrt_hz)):
-        if walk == 0.0:
-            warnings.warn(f"export {target}: no {sensor} random walk is needed to bound these logs (K = 0); {target} "
-                          "refuses 0: record a longer static log (hours)", DataQualityWarning, stacklevel=3)
+def _warn_zero_walk(c: ContinuousNoise, consumer: str) -> None:
+    """Kalibr and OpenVINS refuse a random walk of 0 (:func:`gyrocomp.export.kalibr.warn_zero_walks`)."""
+    warn_zero_walks(f"export {consumer.lower()}", c.gyro_random_walk_rad_per_s2_per_sqrt_hz,
+                    c.accel_random_walk_m_per_s3_per_sqrt_hz, consumer)
 
 
 def kalibr_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
     """Kalibr's ``imu.yaml`` (:func:`gyrocomp.export.kalibr.kalibr_imu_yaml`'s layout): continuous-time densities
     [rad/s/sqrt(Hz), m/s^2/sqrt(Hz)] and random walks of the bound."""
     c = continuous_noise(model)
-    _warn_zero_walk(c, "kalibr")
+    _warn_zero_walk(c, "Kalibr")
     imu = KalibrImu(_need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, "gyro", "kalibr"),
                     c.gyro_random_walk_rad_per_s2_per_sqrt_hz, c.accel_noise_density_m_per_s2_per_sqrt_hz,
                     c.accel_random_walk_m_per_s3_per_sqrt_hz, c.rate_hz, rostopic)
@@ -115,7 +112,7 @@ def kalibr_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
 def openvins_yaml(model: NoiseModel, rostopic: str = "/imu0") -> str:
     """OpenVINS's ``kalibr_imu_chain.yaml`` (``%YAML:1.0``, an ``imu0`` block): the same continuous values."""
     c = continuous_noise(model)
-    _warn_zero_walk(c, "openvins")
+    _warn_zero_walk(c, "OpenVINS")
     gyro_n = _need(c.gyro_noise_density_rad_per_s_per_sqrt_hz, "gyro", "openvins")
     accel_n = _need(c.accel_noise_density_m_per_s2_per_sqrt_hz, "accelerometer", "openvins")
     return "\n".join([

@@ -34,6 +34,15 @@ class KalibrImu:
     rostopic: str
 
 
+def warn_zero_walks(source: str, gyro_walk: float | None, accel_walk: float | None, consumer: str = "Kalibr") -> None:
+    """Kalibr (and OpenVINS, which reads its file) refuse a random walk of 0: say so for each sensor whose random
+    walk [any unit] is 0 (None: no such sensor)."""
+    for label, walk in (("gyroscope", gyro_walk), ("accelerometer", accel_walk)):
+        if walk is not None and walk == 0.0:
+            warnings.warn(f"{source}: no {label} random walk is visible in this log (K = 0); {consumer} needs a "
+                          "non-zero value: record a longer static log (hours)", DataQualityWarning, stacklevel=3)
+
+
 def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
     """Kalibr values from the gyro (and accelerometer) axes of ``analysis``; warns when a random walk is zero."""
     gyros = [a.noise for a in analysis.axes.values() if a.sensor == "gyro"]
@@ -46,10 +55,7 @@ def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
         warnings.warn(f"{analysis.source}: no accelerometer axes, so imu.yaml has gyroscope values only; "
                       "Kalibr needs both (name the accelerometer columns with columns=)", DataQualityWarning,
                       stacklevel=2)
-    for label, walk in (("gyroscope", gyro_walk), ("accelerometer", accel_walk)):
-        if walk is not None and walk == 0.0:
-            warnings.warn(f"{analysis.source}: no {label} random walk is visible in this log (K = 0); Kalibr "
-                          "needs a non-zero value: record a longer static log (hours)", DataQualityWarning, stacklevel=2)
+    warn_zero_walks(analysis.source, gyro_walk, accel_walk)
     return KalibrImu(
         gyroscope_noise_density_rad_per_s_per_sqrt_hz=max(g.noise_density_dps_per_sqrt_hz for g in gyros) * DEG_TO_RAD,
         gyroscope_random_walk_rad_per_s2_per_sqrt_hz=gyro_walk,
