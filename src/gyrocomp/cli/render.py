@@ -16,6 +16,7 @@ if TYPE_CHECKING:  # types only: `gyrocomp allan` need not import the fitting to
     from ..calibration.fit_report import FitReport, GSensitivityReport, OrderSelection, SelectionReport
     from ..measures.merit import Evaluation
     from ..measures.noise import NoiseAnalysis
+    from ..measures.noise_model import NoiseModel
     from ..evaluation.validation import ValidationResult
 
 
@@ -385,4 +386,48 @@ def print_noise(analysis: NoiseAnalysis) -> None:
     console.print(table)
 
 
-__all__ = ["print_comparison", "print_evaluation", "print_expected_drift", "print_fit", "print_noise", "print_stages", "print_validation"]
+def print_noise_model(model: NoiseModel) -> None:
+    """Per axis: the IEEE 952 fit beside the two bounds, and each log's own bound."""
+    console = make_console()
+    table = Table(title=f"noise model at {model.rate_hz:g} Hz: at or above the measured Allan deviation's upper "
+                        "95 % interval (ratio: model / measured over the bounded taus)")
+    for col in ("axis", "unit u", "IEEE 952 N [u/sqrt(Hz)]", "IEEE 952 K [u/sqrt(s)]", "bound N", "bound K",
+                "ratio median / max", "with Gauss-Markov: terms", "ratio median / max ", "taus bounded [s]"):
+        table.add_column(col, justify="left" if col in ("axis", "unit u") else "right")
+    for name, a in model.axes.items():
+        table.add_row(name, a.unit, f"{a.ieee.white_noise_density:.4g}",
+                      f"{a.ieee.random_walk:.4g}", f"{a.bound.white_noise_density:.4g}",
+                      f"{a.bound.random_walk:.4g}", f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}",
+                      str(len(a.markov.markov)), f"{a.markov.ratio_median:.2f} / {a.markov.ratio_max:.2f}",
+                      f"{a.bound.taus_s[0]:.3g} .. {a.max_tau_s:.3g}")
+    console.print(table)
+    if any(len(a.logs) > 1 for a in model.axes.values()):
+        logs = Table(title="each log's own bound (white noise N, random walk K) and N read at one sample with its "
+                           "95 % interval")
+        for col in ("axis", "log", "temperature [degC]", "bound N", "bound K", "N at one sample [95 %]"):
+            logs.add_column(col, justify="left" if col in ("axis", "log") else "right")
+        for name, a in model.axes.items():
+            for log in a.logs:
+                low, value, high = log.white_noise_interval
+                logs.add_row(name, Path(log.source).name,
+                             "-" if log.temperature_degc is None else f"{log.temperature_degc:.1f}",
+                             f"{log.bound.white_noise_density:.4g}", f"{log.bound.random_walk:.4g}",
+                             f"{value:.4g} [{low:.4g}, {high:.4g}]")
+        console.print(logs)
+
+
+def print_bias_process_noise(benefit: dict) -> None:
+    """Per gyro axis: the bias random walk a filter needs with the raw and with the compensated gyro."""
+    table = Table(title="the bias random walk a filter needs on these runs (white noise and random walk at or above "
+                        "the Allan curve up to a quarter of the run) [deg/s/sqrt(s)]")
+    for col in ("axis", "raw K", "compensated K", "raw / compensated", "raw N", "compensated N"):
+        table.add_column(col, justify="left" if col == "axis" else "right")
+    for name, b in benefit.items():
+        table.add_row(name, f"{b.raw.random_walk:.4g}", f"{b.compensated.random_walk:.4g}",
+                      f"{b.random_walk_ratio:.1f}", f"{b.raw.white_noise_density:.4g}",
+                      f"{b.compensated.white_noise_density:.4g}")
+    make_console().print(table)
+
+
+__all__ = ["print_bias_process_noise", "print_comparison", "print_evaluation", "print_expected_drift", "print_fit",
+           "print_noise", "print_noise_model", "print_stages", "print_validation"]
