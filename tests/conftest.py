@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import importlib.util
 import io
 import math
 import os
@@ -171,3 +172,39 @@ def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0) -> Recordin
                              1.0 + rng.standard_normal(n) * 1e-3])
     return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=("gyro_x", "gyro_z"), accel_g=accel,
                      accel_axes=("accel_x", "accel_y", "accel_z"), source="static.csv")
+
+
+# -- a throwaway PostgreSQL server ------------------------------------------------------------------------------
+def _tool(name: str):
+    """The module tools/NAME.py (the project's scripts beside the package), loaded once."""
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, Path(__file__).parents[1] / "tools" / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
+postgres_cluster = _tool("postgres_cluster")
+#: headless Chromium driven over its DevTools pipe (tools/browser.py): the browser tests
+browser = _tool("browser")
+
+
+@pytest.fixture(scope="session")
+def postgres_server():
+    """A PostgreSQL cluster of its own (tools/postgres_cluster.py): yields a function that makes a new empty
+    database and returns its URL. Skipped with the reason where no server binaries or no driver exist."""
+    if postgres_cluster.binaries() is None:
+        pytest.skip("no PostgreSQL server binaries (initdb, pg_ctl) on this machine")
+    if importlib.util.find_spec("psycopg") is None:
+        pytest.skip("psycopg is not installed (pip install 'gyrocomp[postgresql]')")
+    with postgres_cluster.throwaway_cluster() as new_database:
+        yield new_database
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def store_location(request, tmp_path):
+    """A new, empty calibration store's location on each backend: a fleet folder (SQLite), a PostgreSQL URL."""
+    if request.param == "sqlite":
+        return str(tmp_path / "FLEET")
+    return request.getfixturevalue("postgres_server")()

@@ -34,6 +34,16 @@ class DataQualityWarning(UserWarning):
     """Data was accepted but something about it deserves attention (rows dropped, gaps found)."""
 
 
+class TimeOrderWarning(DataQualityWarning):
+    """A log's samples were out of time order (sorted) or repeated a time stamp (dropped): ``moved`` and
+    ``dropped`` samples, and ``largest_back_s``, the furthest the time went back [s] (a clock reset or two logs
+    appended go back far; a logger's reordering, a sample period or two)."""
+
+    def __init__(self, message: str = "", moved: int = 0, dropped: int = 0, largest_back_s: float = 0.0):
+        super().__init__(message)
+        self.moved, self.dropped, self.largest_back_s = moved, dropped, largest_back_s
+
+
 class PlausibilityWarning(DataQualityWarning):
     """The data is probably not what it claims: a unit mistake (kelvin, ms), values beyond any MEMS sensor, a
     calibration run that turns or whose temperature barely varies (:mod:`gyrocomp.measures.plausibility`). ``check``

@@ -8,9 +8,11 @@ import math
 import sqlite3
 
 import pytest
+import sqlalchemy as sa
 
 from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError, ModelError
+from gyrocomp.fleet.store import STORE_SCHEMA_VERSION
 from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Failure, InputFile, UnitFigures,
                             parse_time, store_url)
 from gyrocomp.models.fit import fit_channels
@@ -44,8 +46,9 @@ JAN, MAR, JUN = dt.datetime(2026, 1, 5, 12), dt.datetime(2026, 3, 1, 8, 30), dt.
 
 
 @pytest.fixture
-def store(tmp_path, models) -> CalibrationStore:
-    db = CalibrationStore(tmp_path / "FLEET", create=True)
+def store(store_location, models) -> CalibrationStore:
+    """A store with a history, on SQLite and on a PostgreSQL server."""
+    db = CalibrationStore(store_location, create=True)
     db.add(_record("U1", JAN, models[0], 0.004))
     db.add(_record("U1", MAR, None))
     db.add(_record("U1", JUN, models[1], 0.006))
@@ -100,7 +103,8 @@ def test_parse_time_reads_dates_times_and_zones():
 def test_store_locations(tmp_path):
     assert store_url(tmp_path / "FLEET") == f"sqlite:///{tmp_path / 'FLEET' / 'calibrations.sqlite'}"
     assert store_url(tmp_path / "cal.db") == f"sqlite:///{tmp_path / 'cal.db'}"
-    assert store_url("postgresql://factory@db/calibrations") == "postgresql://factory@db/calibrations"
+    assert store_url("postgresql+psycopg2://factory@db/c") == "postgresql+psycopg2://factory@db/c"
+    assert store_url("postgresql://factory@db/c") in ("postgresql://factory@db/c", "postgresql+psycopg://factory@db/c")
     with pytest.raises(InputError, match=r"no calibration store there \(no calibrations.sqlite\)"):
         CalibrationStore(tmp_path / "nowhere")
     (tmp_path / "junk.sqlite").write_bytes(b"this is not a database" * 100)
@@ -113,16 +117,16 @@ def test_store_locations(tmp_path):
         CalibrationStore("nodb://x")
 
 
-def test_a_store_of_a_newer_schema_is_refused(store, tmp_path):
-    with sqlite3.connect(tmp_path / "FLEET" / "calibrations.sqlite") as conn:
-        conn.execute("update gyrocomp_store set value = '99' where key = 'schema_version'")
-    with pytest.raises(InputError, match=r"store schema version 99; this gyrocomp reads up to 1"):
-        CalibrationStore(tmp_path / "FLEET")
+def test_a_store_of_a_newer_schema_is_refused(store):
+    with store.engine.begin() as conn:
+        conn.execute(sa.text("update gyrocomp_store set value = '99' where key = 'schema_version'"))
+    with pytest.raises(InputError, match=rf"store schema version 99; this gyrocomp reads up to {STORE_SCHEMA_VERSION}"):
+        CalibrationStore(store.location)
 
 
 @pytest.mark.slow
 def test_fleet_show_and_export_through_the_command_line(store, models, tmp_path):
-    folder = tmp_path / "FLEET"
+    folder = store.location
     shown = run("fleet", "show", "U1", "--store", folder, "--at", "2026-05-01", "--json")
     assert shown.returncode == 0, shown.stderr
     assert '"calibrated_utc": "2026-01-05T12:00:00Z"' in shown.stdout
@@ -134,7 +138,7 @@ def test_fleet_show_and_export_through_the_command_line(store, models, tmp_path)
     exported = run("fleet", "export", "U1", "--store", folder, "--format", "json", "--at", "2026-02-01", "-o", out)
     assert exported.returncode == 0, exported.stderr
     assert Calibration.load(out).to_dict() == models[0].to_dict()
-    px4 = run("fleet", "export", "U2", "--store", folder / "calibrations.sqlite", "--format", "px4", "-o",
+    px4 = run("fleet", "export", "U2", "--store", store.file or folder, "--format", "px4", "-o",
               tmp_path / "u2.params", "--device-id", 7)
     models[1].save(tmp_path / "u2.json")
     direct = run("export", tmp_path / "u2.json", "--format", "px4", "-o", tmp_path / "direct.params", "--device-id", 7)

@@ -78,6 +78,9 @@ def test_units_from_a_manifest(tmp_path):
     manifest.write_text("path,serial,lot\nr1.csv,A7,L1\nr2.csv,A7,L2\n")
     with pytest.raises(InputError, match=r"unit A7: column 'lot' differs between its runs"):
         units_from_manifest(manifest)
+    manifest.write_text("path,serial\nr1.csv,A7\n./r1.csv,A7\n")
+    with pytest.raises(InputError, match=r"manifest.csv: row 3: path ./r1.csv is already a run of unit A7"):
+        units_from_manifest(manifest)
 
 
 def test_input_hash_follows_content_and_settings_not_names(tmp_path):

@@ -33,7 +33,7 @@ def test_a_unit_past_the_worker_memory_limit_fails_and_the_fleet_goes_on(tmp_pat
         # peaks at about 210 MB (measured, plus the worker's own ~70 MB), one fitting BIG's two runs of 1.44 M
         # samples at about 800 MB
         summary = fit_fleet(units, tmp_path / "fleet", workers=1, memory_limit="650MB")
-    assert sorted(summary.fitted) == ["SMALL-1", "SMALL-2"]
+    assert sorted(summary.fitted) == ["SMALL-1", "SMALL-2"], (summary.failed, summary.busy)
     assert list(summary.failed) == ["BIG"]
     assert summary.failed["BIG"].startswith("its worker was killed on every try (past its memory limit, or a crash): "
                                             "KilledWorker")

@@ -22,6 +22,7 @@ from ..curves.kinds import BASES
 from ..models.options import Curve, Network, Polynomial, curve_size_range, family_help
 from ..models.fit import check_channels
 from ..runs.prepared import CHANNELS
+from ..measures.data_check import DATA_CHECKS
 from ..curves.polynomial import POLY_FAMILY
 
 
@@ -202,3 +203,10 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
 
 
 __all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "temperature_help", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings"]
+
+
+def accept_option(function):
+    """``--accept CHECK`` (repeatable): a data check's finding accepted knowingly (check, fit, fleet fit)."""
+    return click.option("--accept", "accept", multiple=True, type=click.Choice(DATA_CHECKS), metavar="CHECK",
+                        help=f"Accept this data check's finding knowingly (repeatable): {', '.join(DATA_CHECKS)}.")(
+        function)

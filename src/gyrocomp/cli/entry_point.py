@@ -46,6 +46,8 @@ COMMANDS = {
     "split": ("split", "Cut LOG into runs, one file each, so that a recording of several "
                        "power-ons, poses or temperature legs becomes the runs a fit takes."),
     "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
+    "check": ("check", "Check RUNS before a fit, as fit and fleet fit do: one verdict line per run (ok, warning with "
+                       "its expected cost, or refused with the reason)."),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
                     'default and the best model a firmware carries.'),
     "evaluate": ("evaluate", 'Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.'),

@@ -19,7 +19,9 @@ from ..models.fit import fit as fit_runs
 from ..models.triads import SCALE_FACTOR_CHOICES
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
-from .common import (FINITE, OUTPUT_FILE, float_list, parse_channels, parse_temperature_option, pop_read_options,
+from ..files.check import ask_for, enforce, read_noting
+from ..measures.data_check import check_runs
+from .common import (accept_option, FINITE, OUTPUT_FILE, float_list, parse_channels, parse_temperature_option, pop_read_options,
                      progress_bar, read_options, read_run, temperature_help)
 from .render import print_contributions, print_fit
 
@@ -70,13 +72,15 @@ from .render import print_contributions, print_fit
               show_default=True,
               help="Fit on the still segments of field logs (flights, drives: each one power-on) found from their "
                    "own noise: yes for every run, auto for the runs still less than half the time, no for none.")
+@accept_option
 @read_options
 @click.pass_context
 def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band_degc,
         acceleration, pipeline, static_min_duration_s, channels, folds, target, scale_factor, rate_schedule,
-        still_only, **kwargs):
+        still_only, accept, **kwargs):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still
-    moments of field logs.
+    moments of field logs. The runs are checked first (as gyrocomp check does): a run that cannot give a valid
+    fit is refused in one line, one that only degrades it is said with its expected cost.
 
     RUNS are files, folders (every run file in them) or quoted glob patterns ('logs/**/*.ulg')."""
     opts = pop_read_options(kwargs)
@@ -99,10 +103,13 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     fits = {}
     for instance in chosen:
         read_opts = {**opts, "instance": instance if every else opts["instance"]}
-        recordings = [read_run(path, read_opts).recording for path in runs]
+        read = [read_noting(lambda p, o=read_opts: read_run(p, o), path) for path in runs]
+        recordings = [r.recording for r in read]
         if rate_schedule is not None:
             recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
         recordings, contributions = field_recordings(recordings, still_only)
+        enforce(check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions
+                                                                        if c.still_only]))
         if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
             print_contributions(contributions)
         with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):

@@ -2,24 +2,31 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
+from pathlib import Path
 
 import click
 import pandas as pd
 from rich.table import Table
 
 from ..errors import InputError
+from ..fleet.stations import station_status
+from ..fleet import model_file_name
 from ..fleet import (CalibrationStore, FleetSettings, Limits, expand_inputs, fit_fleet, fleet_table, fleet_yield, parse_time,
                     population_prior,
                      units_from_manifest, units_from_pattern)
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.fleet import build_fleet_report
+from ..report.certificate import build_certificate, print_pdf
+from ..fleet.certify import held_out_of
 from .entry_point import in_cli_words
-from .common import (FINITE, OUTPUT_FILE, make_console, parse_channels, pop_read_options, progress_bar, read_options,
+from .common import (FINITE, accept_option, OUTPUT_FILE, make_console, parse_channels, pop_read_options, progress_bar, read_options,
                      read_settings)
 from ..export import EXPORTERS
 from .export import write_export
+from .render import print_station_status
 
 #: failures and outliers listed after a fleet fit (the fleet table has them all)
 _LISTED = 10
@@ -54,12 +61,18 @@ def fleet():
                    "population as the prior, for short chamber runs.")
 @click.option("--channels", default="gyro", show_default=True, help="gyro, accel or gyro,accel (as gyrocomp fit).")
 @click.option("--pipeline", default="joint", show_default=True, help="As gyrocomp fit.")
+@accept_option
+@click.option("--certificates", type=click.Choice(["html", "pdf"]), default=None,
+              help="Write a certificate of each unit fitted now into certificates/ (pdf: its PDF too).")
+@click.option("--station", default=None, metavar="NAME",
+              help="This station's name, stored with each calibration it writes (default: the machine's name).")
 @read_options
 @click.pass_context
 def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, workers, memory_limit, store, prior,
-        channels, pipeline, **kwargs):
+        channels, pipeline, accept, certificates, station, **kwargs):
     """Fit every unit of DATA (folders, globs or files of runs; none with --manifest) as gyrocomp fit would, in
-    parallel; rerun to fit only the units whose runs changed."""
+    parallel; rerun to fit only the units whose runs changed. Several stations may fit into one store at once
+    (--store URL): each unit is fitted by one of them, the others skip it."""
     opts = pop_read_options(kwargs)
     if (unit_pattern is None) == (manifest is None):
         raise click.UsageError("say which unit each run belongs to: give --unit-from PATTERN or --manifest FILE "
@@ -80,17 +93,33 @@ def fit(ctx, data, output, unit_pattern, manifest, limits_file, scheduler, worke
         with CalibrationStore(prior) as db:
             population = population_prior(db.latest_rows())
     settings = FleetSettings(channels=parse_channels(channels), pipeline=pipeline,
-                             read=read_settings(opts), fmt=opts["fmt"], prior=population)
+                             read=read_settings(opts), fmt=opts["fmt"], prior=population, accept=tuple(accept))
     memory = int(memory_limit) if memory_limit.isdigit() else memory_limit
-    with progress_bar(f"fitting {len(units)} units") as bar:
+    with progress_bar(f"{'station ' + station + ': ' if station else ''}fitting {len(units)} units") as bar:
         summary = fit_fleet(units, output, settings, limits=limits, scheduler=scheduler, workers=workers,
-                            memory_limit=memory, store=store,
+                            memory_limit=memory, store=store, station=station,
                             progress=None if bar is None else (lambda done, total: bar(done / total)))
     if len(summary.failed) == len(units):
         first = next(iter(summary.failed.items()))
         raise InputError(f"every unit failed (e.g. {first[0]}: {first[1]}); nothing was calibrated")
+    if certificates is not None:
+        _write_certificates(summary, output, store, limits, certificates, settings)
     if not ctx.obj["quiet"]:
         _print_summary(summary, output, limits is not None)
+
+
+def _write_certificates(summary, output, store, limits, kind: str, settings) -> None:
+    """A certificate of each unit fitted now: certificates/SERIAL.html (and .pdf)."""
+    folder = Path(output) / "certificates"
+    folder.mkdir(exist_ok=True)
+    with CalibrationStore(store if store is not None else output) as db, \
+            progress_bar(f"certificates of {len(summary.fitted)} units") as bar:
+        for k, serial in enumerate(summary.fitted, 1):
+            name = model_file_name(serial)[:-len(".json")]
+            write_certificate(db.latest(serial), folder / f"{name}.html",
+                              folder / f"{name}.pdf" if kind == "pdf" else None, limits, settings.read, settings.fmt)
+            if bar is not None:
+                bar(k / len(summary.fitted))
 
 
 def _print_summary(summary, output, judged: bool) -> None:
@@ -98,9 +127,12 @@ def _print_summary(summary, output, judged: bool) -> None:
     table = pd.read_parquet(summary.table)
     counts = fleet_yield(table)
     console.print(f"gyrocomp fleet fit -> {output}: {len(summary.fitted)} unit(s) fitted, {len(summary.unchanged)} "
-                  f"unchanged (skipped), {len(summary.failed)} failed")
+                  f"unchanged (skipped), {len(summary.failed)} failed"
+                  + (f", {len(summary.busy)} left to the other stations fitting them" if summary.busy else ""))
     if judged:
         console.print(f"yield: {counts.passed}/{counts.units} units pass ({100 * counts.yield_fraction:.1f} %)")
+    _print_rows(console, "units other stations are fitting (gyrocomp fleet status shows them; rerun to pick up "
+                "any they leave)", list(summary.busy.items()), ("serial", "fitted by"))
     if summary.failed:
         _print_rows(console, "failed units", [(s, e) for s, e in summary.failed.items()], ("serial", "error"))
     if judged:
@@ -126,6 +158,22 @@ def _print_rows(console, title: str, rows: list[tuple], columns: tuple[str, ...]
     for row in rows[:_LISTED]:
         table.add_row(*map(str, row))
     console.print(table)
+
+
+@fleet.command("status")
+@click.option("--store", required=True, help="The fleet folder, an SQLite file or a SQLAlchemy URL.")
+@click.option("--json", "as_json", is_flag=True, help="Print the status as JSON.")
+def status(store, as_json):
+    """What each station has stored in the store, and the units each is fitting now (a stale claim: its station
+    died; rerun it to finish them)."""
+    with CalibrationStore(store) as db:
+        stations = station_status(db)
+    if as_json:
+        click.echo(json.dumps([{**dataclasses.asdict(s), "last_utc": None if s.last_utc is None
+                                else s.last_utc.isoformat() + "Z", "fitting": list(s.fitting)} for s in stations],
+                              indent=2))
+        return
+    print_station_status(stations, store)
 
 
 @fleet.command("show")
@@ -220,6 +268,42 @@ def report(ctx, store, output, limits_file):
     write_text_atomic(output, page.html)
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output} ({len(table)} units; sections: {', '.join(page.sections)})")
+
+
+@fleet.command("certificate")
+@click.argument("serial")
+@click.option("--store", required=True, help="The fleet folder, an SQLite file or a SQLAlchemy URL.")
+@click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="HTML file to write.")
+@click.option("--pdf", "pdf", default=None, type=OUTPUT_FILE,
+              help="Also print it to this PDF (headless Chromium: apt-get install chromium).")
+@click.option("--limits", "limits_file", default=None, type=click.Path(dir_okay=False),
+              help="Judge the unit by these limits (TOML; default: the verdict stored with its calibration).")
+@click.option("--at", "at", default=None, metavar="DATE", help="The certificate of the calibration valid at this "
+              "date or time (default: the newest).")
+@read_options
+@click.pass_context
+def certificate(ctx, serial, store, output, pdf, limits_file, at, **kwargs):
+    """The calibration certificate of unit SERIAL: one self-contained HTML page (and its PDF) with the station,
+    time, inputs' hashes, version, model, valid range, held-out residual with its 95 % band, figures of merit
+    against the limits and the verdict. The unit's runs are read again (and checked against their hashes)."""
+    opts = pop_read_options(kwargs)
+    limits = Limits.load(limits_file) if limits_file else None
+    with CalibrationStore(store) as db:
+        for path in (output, pdf):
+            if path is not None:
+                _refuse_output_over_store(path, db)
+        record = db.valid_at(serial, parse_time(at) if at else None)
+    write_certificate(record, output, pdf, limits, read_settings(opts), opts["fmt"])
+    if not ctx.obj["quiet"]:
+        click.echo(f"wrote {output}" + (f" and {pdf}" if pdf else "") + f" (unit {serial}, row {record.id})")
+
+
+def write_certificate(record, output, pdf, limits, read=None, fmt=None) -> None:
+    """Build the certificate of ``record`` and write it (and its PDF) atomically."""
+    page = build_certificate(record, held_out=held_out_of(record, read, fmt), limits=limits)
+    write_text_atomic(output, page.html)
+    if pdf is not None:
+        print_pdf(output, pdf)
 
 
 @fleet.command("export")

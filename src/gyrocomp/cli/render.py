@@ -431,3 +431,20 @@ def print_bias_process_noise(benefit: dict) -> None:
 
 __all__ = ["print_bias_process_noise", "print_comparison", "print_evaluation", "print_expected_drift", "print_fit",
            "print_noise", "print_noise_model", "print_stages", "print_validation"]
+
+
+def print_station_status(stations, store) -> None:
+    """``gyrocomp fleet status``: one row per station."""
+    console = make_console()
+    if not stations:
+        console.print(f"{store}: no calibration stored and no unit being fitted")
+        return
+    table = Table(title=f"stations of {store}")
+    for column in ("station", "ok", "failed", "last write (UTC)", "fitting now", "stale claims"):
+        table.add_column(column, overflow="fold")
+    for s in stations:
+        fitting = ", ".join(s.fitting[:5]) + (f" (+{len(s.fitting) - 5})" if len(s.fitting) > 5 else "")
+        table.add_row(s.station, str(s.ok), str(s.failed),
+                      "" if s.last_utc is None else f"{s.last_utc:%Y-%m-%d %H:%M:%S}", fitting or "-",
+                      f"{s.stale} (rerun the station)" if s.stale else "0")
+    console.print(table)

@@ -179,7 +179,9 @@ def make_sample_folds(recordings: list[Recording], kind: str = "auto") -> tuple[
     return "blocks", folds
 
 
-def _training(recordings: list[Recording], fold: Fold, kind: str) -> list[Recording]:
+def training_runs(recordings: list[Recording], fold: Fold, kind: str) -> list[Recording]:
+    """The runs a fit without ``fold`` is made on: the other runs (``runs``), or every run with the fold's rows
+    taken out (``legs``, ``blocks``)."""
     if kind == "runs":
         return [r for k, r in enumerate(recordings) if k != fold.run]
     out = []
@@ -231,7 +233,7 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
     axes = recordings[0].gyro_axes
     drift = {(m, a): [] for m in methods for a in axes}
     for fold in fold_list:
-        train = _training(recordings, fold, kind)
+        train = training_runs(recordings, fold, kind)
         held = recordings[fold.run]
         w = max(1, int(round(window_s * held.rate_hz)))
         for name, method in methods.items():
@@ -246,4 +248,5 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
     return ValidationResult(kind, tuple(f.name for f in fold_list), window_s, tuple(methods), tuple(axes), scores)
 
 
-__all__ = ["BASELINES", "Fold", "MethodScore", "ValidationResult", "fit_plain_cubic", "make_sample_folds", "validate"]
+__all__ = ["BASELINES", "Fold", "MethodScore", "ValidationResult", "fit_plain_cubic", "make_sample_folds", "training_runs",
+           "validate"]

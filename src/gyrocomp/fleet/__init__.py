@@ -6,10 +6,13 @@ and compared with their population.
 - :mod:`~gyrocomp.fleet.limits`: pass/fail limits (TOML) and verdicts;
 - :mod:`~gyrocomp.fleet.store`: the calibration store (SQLite or any SQLAlchemy database), with history;
 - :mod:`~gyrocomp.fleet.run`: the fleet fit itself (Dask local cluster, a running cluster, or serial);
+- :mod:`~gyrocomp.fleet.stations`: several fleet fits (stations) on one store, each unit claimed by one;
+- :mod:`~gyrocomp.fleet.certify`: a unit's held-out residual for its certificate, from its runs checked again;
 - :mod:`~gyrocomp.fleet.population`: the fleet table, robust outlier scores, yield;
 - :mod:`~gyrocomp.fleet.prior`: a new unit from a short run, with the fleet's population as the prior.
 
-Needs the ``fleet`` extra (``pip install 'gyrocomp[fleet]'``: dask[distributed], SQLAlchemy).
+Needs the ``fleet`` extra (``pip install 'gyrocomp[fleet]'``: dask[distributed], SQLAlchemy; a PostgreSQL store
+the ``postgresql`` extra: psycopg).
 """
 
 from .unit_figures import FIGURE_NAMES, REFERENCE_TEMPERATURE_DEGC, AxisFigures, UnitFigures, unit_figures

@@ -105,6 +105,8 @@ def units_from_manifest(path: str | os.PathLike) -> list[UnitRuns]:
         run_path = Path(run) if Path(run).is_absolute() else path.parent / run
         if not run_path.exists():
             raise InputError(f"{where}: path {run}: no such file")
+        if any(os.path.samefile(run_path, seen) for seen, _ in groups.get(serial, ())):
+            raise InputError(f"{where}: path {run} is already a run of unit {serial}; give each run once")
         groups.setdefault(serial, []).append((os.fspath(run_path), row))
     for serial, runs in groups.items():
         for key in runs[0][1]:

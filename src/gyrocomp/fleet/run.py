@@ -9,6 +9,13 @@ newest successful calibration; a unit whose files (by content) and settings hash
 without fitting. A unit that fails (an unreadable file, too little data, any error) is recorded with its error
 and the others go on.
 
+Several fleet fits (stations, on one machine or several) may write one store at once, with overlapping units:
+each claims a unit before fitting it (:mod:`gyrocomp.fleet.stations`) and skips those another station is fitting,
+so each unit is fitted and stored once; a station killed at any moment leaves the store consistent, and its rerun
+finishes the rest. A unit's model file is written beside its row: staged before the row is committed, renamed
+into place after (under a lock of the models folder, so that the file is always that of the unit's newest row);
+a station killed between the two leaves a row whose file its rerun puts back.
+
 Schedulers: ``"local"`` starts a local Dask cluster (one single-threaded worker process per core, memory bounded
 per worker), an address (``tcp://host:8786``) uses a running cluster (the run files must be readable at the same
 paths on the workers: a shared file system), ``"serial"`` fits in this process one unit after another (no Dask;
@@ -34,8 +41,10 @@ from typing import Literal
 
 from .._version import __version__
 from ..errors import DataQualityWarning, GyrocompError, InputError
-from ..io import ReadOptions, read_input
-from ..io.atomic import atomic_path, write_text_atomic
+from ..files.check import ask_for, enforce, read_checked, rewarn
+from ..io import ReadOptions
+from ..measures.data_check import check_runs
+from ..io.atomic import atomic_path, folder_lock, write_text_atomic
 from ..io.common import require
 from ..models.fit import fit
 from ..models.pipelines import Pipeline
@@ -47,6 +56,7 @@ from .limits import Limits
 from .population import fleet_table
 from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
+from .stations import Station, claim, release, station as running_as
 from .devices import UnitRuns, content_hash, input_hash
 
 MODELS_FOLDER = "models"
@@ -74,6 +84,9 @@ class FleetSettings:
     prior : PopulationPrior, optional
         Fit each unit with this population prior (:func:`gyrocomp.fleet.fit_with_prior`: short runs) instead of
         the default fit; ``channels`` and ``pipeline`` then do not apply.
+    accept : tuple of str
+        Data checks accepted knowingly (:mod:`gyrocomp.measures.data_check`): a unit whose runs the check refuses
+        is recorded as failed with the reason, unless its check is accepted here.
     """
 
     channels: tuple[Channel, ...] = ("gyro",)
@@ -82,6 +95,7 @@ class FleetSettings:
     fmt: str | None = None
     reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC
     prior: PopulationPrior | None = None
+    accept: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "channels", check_channels(self.channels))
@@ -90,15 +104,17 @@ class FleetSettings:
         """What of the settings changes a unit's model (part of its input hash)."""
         return {"channels": list(self.channels), "pipeline": self.pipeline, "read": repr(self.read),
                 "fmt": self.fmt, "reference_temperature_degc": self.reference_temperature_degc,
-                "prior": None if self.prior is None else self.prior.digest()}
+                "prior": None if self.prior is None else self.prior.digest(),
+                **({"accept": sorted(self.accept)} if self.accept else {})}
 
 
 @dataclass(frozen=True)
 class UnitOutcome:
-    """What one unit's task returns: ``unchanged`` when its inputs hash as its newest calibration's did."""
+    """What one unit's task returns: ``unchanged`` when its inputs hash as its newest calibration's did; ``busy``
+    (``error`` says by whom) when another station is fitting it."""
 
     serial: str
-    status: Literal["ok", "failed", "unchanged"]
+    status: Literal["ok", "failed", "unchanged", "busy"]
     input_hash: str
     inputs: tuple[InputFile, ...] = ()
     model_json: str | None = None
@@ -110,7 +126,8 @@ class UnitOutcome:
 @dataclass(frozen=True)
 class FleetSummary:
     """What a fleet fit did: units fitted now, skipped as unchanged, failed, the verdicts of those fitted, and
-    the warnings of the fit of each unit fitted now that had any (kept in the store with its calibration)."""
+    the warnings of the fit of each unit fitted now that had any (kept in the store with its calibration), and
+    the units left to the other stations fitting them (by whom)."""
 
     fitted: tuple[str, ...]
     unchanged: tuple[str, ...]
@@ -120,6 +137,7 @@ class FleetSummary:
     store: str
     table: Path | None
     warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    busy: dict[str, str] = field(default_factory=dict)
 
 
 @single_threaded_blas
@@ -136,7 +154,13 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            recordings = [read_input(p, settings.read, fmt=settings.fmt).recording for p in unit.paths]
+            runs = [read_checked(p, settings.read, settings.fmt) for p in unit.paths]
+            unread = next((r for r in runs if r.recording is None), None)
+            if unread is not None:
+                raise InputError(unread.refusal or f"{unread.source}: unreadable")
+            rewarn(runs)
+            enforce(check_runs(runs, ask_for(), settings.accept))
+            recordings = [r.recording for r in runs]
             if settings.prior is not None:
                 calibration = fit_with_prior(recordings, settings.prior)
             else:
@@ -158,7 +182,7 @@ def _error_text(exc: BaseException) -> str:
 def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: FleetSettings | None = None, *,
               limits: Limits | None = None, scheduler: str = "local", workers: int | None = None,
               memory_limit: str | int = "auto", store: str | os.PathLike | None = None,
-              progress: Callable[[int, int], None] | None = None) -> FleetSummary:
+              progress: Callable[[int, int], None] | None = None, station: str | None = None) -> FleetSummary:
     """Fit every unit (see the module) and write the fleet's outputs into the folder ``output``.
 
     Parameters
@@ -184,6 +208,8 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
         Another store location (an SQLite file or a database URL; see :mod:`gyrocomp.fleet.store`).
     progress : callable, optional
         Called with (units done, units in all) as each unit finishes.
+    station : str, optional
+        This station's name, stored with each row it writes (default: the machine's name).
     """
     units = list(units)
     _check_units(units)
@@ -197,35 +223,88 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
     units = [replace(u, paths=tuple(os.path.abspath(p) for p in u.paths)) for u in units]
     tally = _Tally()
     started = utc_now()
-    with CalibrationStore(store if store is not None else output, create=True) as db:
-        known = db.ok_hashes()
-        known = {u.serial: known.get(u.serial) for u in units}
+    with CalibrationStore(store if store is not None else output, create=True) as db, \
+            running_as(db, Station.here(station)) as me:
         by_serial = {u.serial: u for u in units}
-        for done, outcome in enumerate(_outcomes(units, settings, known, scheduler, workers, memory_limit), 1):
-            _keep(outcome, by_serial[outcome.serial], limits, output, db, started, tally)
+        for done, outcome in enumerate(_outcomes(_claimed(units, db, me), settings, scheduler, workers,
+                                                 memory_limit), 1):
+            _keep(outcome, by_serial[outcome.serial], limits, output, db, started, tally, me)
+            release(db, outcome.serial, me)
             if progress is not None:
                 progress(done, len(units))
         table = write_fleet_table(db, output / FLEET_TABLE, limits)
     return FleetSummary(tuple(tally.fitted), tuple(tally.unchanged), tally.failed, tuple(tally.passed),
                         tuple(tally.rejected), store=os.fspath(store if store is not None else output), table=table,
-                        warned=tally.warned)
+                        warned=tally.warned, busy=tally.busy)
+
+
+@dataclass(frozen=True)
+class _Claimed:
+    """A unit claimed by this station (with its newest successful calibration's input hash), or, as ``busy``, the
+    outcome of a unit another station is fitting."""
+
+    unit: UnitRuns
+    known_hash: str | None = None
+    busy: UnitOutcome | None = None
+
+
+def _claimed(units: list[UnitRuns], db: CalibrationStore, me: Station) -> Iterator[_Claimed]:
+    """Each unit as this station claims it, just before it is fitted: its input hash read then (another station
+    may have stored it since this one began)."""
+    for unit in units:
+        holder = claim(db, unit.serial, me)
+        if holder is None:
+            yield _Claimed(unit, db.ok_hash(unit.serial))
+        else:
+            yield _Claimed(unit, busy=UnitOutcome(unit.serial, "busy", "", error=(
+                f"station {holder.station} ({holder.host}, process {holder.pid}) has been fitting it since "
+                f"{holder.claimed_utc:%Y-%m-%d %H:%M:%S} UTC")))
 
 
 def _keep(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, output: Path, db: CalibrationStore,
-          started, tally: "_Tally") -> None:
-    """Store one unit's outcome: the model file first, so that a row is never committed without its file; a unit
-    another fit stored from the same inputs since ``started`` counts as unchanged; an unchanged unit's missing
-    model file is put back."""
+          started, tally: "_Tally", me: Station) -> None:
+    """Store one unit's outcome with its model file (:func:`_store_with_model`); a unit another fit stored from
+    the same inputs since ``started`` counts as unchanged; an unchanged unit's missing model file is put back."""
+    if outcome.status == "busy":
+        tally.busy[outcome.serial] = outcome.error or "busy"
+        return
     if outcome.status == "unchanged":
         tally.unchanged.append(outcome.serial)
         _repair_model(output, db, outcome.serial)
         return
-    record = _record(outcome, unit, limits)
-    write = (lambda: _write_model(output, outcome.serial, outcome.model_json)) if record.status == "ok" else None
-    if db.add_new(record, since=started, before_commit=write) is None:
+    record = _record(outcome, unit, limits, me.name)
+    stored = (_store_with_model(db, record, started, output) if record.status == "ok"
+              else db.add_new(record, since=started, stamp=True))
+    if stored is None:
         tally.unchanged.append(outcome.serial)
     else:
         tally.count(record)
+
+
+class _NotStored(Exception):
+    """Another fit stored the unit from the same inputs: the staged model file is dropped."""
+
+
+def _store_with_model(db: CalibrationStore, record: CalibrationRecord, since, output: Path) -> int | None:
+    """Store a successful ``record`` and its model file: the file staged (written to a temporary name) first, so
+    that a failed write stores nothing, then the row committed, then the file renamed into place, all under the
+    models folder's lock (writers of one folder take turns, and the file is always its unit's newest row's).
+    Returns the row's id, or None when another fit had stored the unit from the same inputs."""
+    folder = output / MODELS_FOLDER
+    path = folder / model_file_name(record.serial)
+    try:
+        folder.mkdir(exist_ok=True)
+        with folder_lock(path), atomic_path(path) as staged:
+            staged.write_text(record.model_json, encoding="utf-8")
+            row = db.add_new(record, since=since, stamp=True)
+            if row is None:
+                raise _NotStored
+    except _NotStored:
+        return None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot write unit {record.serial!r}'s model ({exc.strerror or exc}); nothing was "
+                         "stored for it, the next run fits it again") from None
+    return row
 
 
 @dataclass
@@ -238,6 +317,7 @@ class _Tally:
     passed: list[str] = field(default_factory=list)
     rejected: list[str] = field(default_factory=list)
     warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    busy: dict[str, str] = field(default_factory=dict)
 
     def count(self, record: CalibrationRecord) -> None:
         if record.status == "ok":
@@ -258,20 +338,43 @@ def _check_units(units: list[UnitRuns]) -> None:
         raise InputError(f"units: serial {repeated[0]!r} is given twice; give each unit once with all its runs")
 
 
-def _outcomes(units: list[UnitRuns], settings: FleetSettings, known: dict[str, str | None], scheduler: str,
-              workers: int | None, memory_limit: str | int) -> Iterator[UnitOutcome]:
-    """Each unit's outcome as it finishes."""
+#: units in flight per worker thread of a Dask cluster (each claimed just before it is submitted): one, so that a
+#: unit is never waiting on a worker beside another that outgrows the worker's memory (Dask counts every task of
+#: a killed worker against its retries), and a claim is taken only when a thread is free for it
+IN_FLIGHT_PER_THREAD = 1
+
+
+def _outcomes(claimed: Iterator[_Claimed], settings: FleetSettings, scheduler: str, workers: int | None,
+              memory_limit: str | int) -> Iterator[UnitOutcome]:
+    """Each unit's outcome as it finishes (a busy unit's at once)."""
     if scheduler == "serial":
-        for unit in units:
-            yield fit_unit(unit, settings, known[unit.serial])
+        for item in claimed:
+            yield item.busy or fit_unit(item.unit, settings, item.known_hash)
         return
     distributed = require("dask.distributed", "fleet", "fitting a fleet on Dask (scheduler local or an address)")
     with _client(distributed, scheduler, workers, memory_limit) as client:
-        futures = {client.submit(fit_unit, unit, settings, known[unit.serial], pure=False,
-                                 key=f"gyrocomp-fit-{_safe_name(unit.serial)}-{os.getpid()}-{id(unit)}"): unit
-                   for unit in units}
-        for future in distributed.as_completed(futures):
-            unit = futures[future]
+        window = IN_FLIGHT_PER_THREAD * max(1, sum(client.nthreads().values()))
+        futures: dict = {}
+        running = distributed.as_completed()
+
+        def top_up() -> list[UnitOutcome]:
+            busy = []
+            while len(futures) < window:
+                item = next(claimed, None)
+                if item is None:
+                    break
+                if item.busy is not None:
+                    busy.append(item.busy)
+                    continue
+                future = client.submit(fit_unit, item.unit, settings, item.known_hash, pure=False,
+                                       key=f"gyrocomp-fit-{_safe_name(item.unit.serial)}-{os.getpid()}-{id(item)}")
+                futures[future] = item.unit
+                running.add(future)
+            return busy
+
+        yield from top_up()
+        for future in running:
+            unit = futures.pop(future)
             if future.status == "finished":
                 yield future.result()
             else:  # the worker died (memory limit, a crash): the unit fails, the fleet goes on
@@ -280,6 +383,7 @@ def _outcomes(units: list[UnitRuns], settings: FleetSettings, known: dict[str, s
                        if type(exc).__name__ == "KilledWorker" else "")
                 yield UnitOutcome(unit.serial, "failed", "", error=why + _error_text(exc))
             future.release()
+            yield from top_up()
 
 
 #: the signals a terminal sends to every process of the command (Ctrl-C, a closed terminal): the local workers
@@ -401,7 +505,7 @@ def _check_reachable(address: str) -> None:
         raise InputError(f"scheduler: cannot reach a Dask scheduler at {address!r} ({exc.strerror or exc})") from None
 
 
-def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None) -> CalibrationRecord:
+def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, station: str) -> CalibrationRecord:
     verdict = None
     if outcome.status == "ok" and limits is not None:
         verdict = limits.check(outcome.figures)
@@ -410,7 +514,7 @@ def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None) -> Cali
         input_hash=outcome.input_hash, gyrocomp_version=__version__, inputs=outcome.inputs,
         metadata=dict(unit.metadata), verdict=None if verdict is None else verdict.label,
         failures=() if verdict is None else verdict.failures, model_json=outcome.model_json,
-        figures=outcome.figures, error=outcome.error, warnings=outcome.warnings)
+        figures=outcome.figures, error=outcome.error, warnings=outcome.warnings, station=station)
 
 
 #: the longest serial kept whole in a model file's name [characters]

@@ -6,8 +6,14 @@ the status (``ok`` or ``failed`` with its error), the inputs and their content h
 JSON (validated when read back, as a model file is), the figures of merit and the verdict against the limits.
 
 ``location`` names the store: a folder (the fleet's output; the store is ``calibrations.sqlite`` in it), an
-SQLite file (``.sqlite``, ``.sqlite3``, ``.db``), or a SQLAlchemy URL (``postgresql://user@host/db``; the driver
-is the user's to install).
+SQLite file (``.sqlite``, ``.sqlite3``, ``.db``), or a SQLAlchemy URL (``postgresql://user@host/db``: the
+``postgresql`` extra installs psycopg, which a plain ``postgresql://`` URL then uses).
+
+Several writers at once (stations on other machines, each with only the URL): a successful row names the row it
+supersedes (the unit's newest successful row when it was written, 0 for the first), and the pair (serial,
+supersedes) is unique on both backends, so two writers that read the same history cannot both append to it: the
+second's insert fails, and it retries (:data:`WRITE_TRIES`) on the history as it now is, where the check finds
+the first's row. PostgreSQL's serialization failures and deadlocks are retried the same way.
 """
 
 from __future__ import annotations
@@ -17,8 +23,11 @@ import datetime as _dt
 import json
 import math
 import os
+import random
+import time
+from importlib.util import find_spec
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace as _replace
 from pathlib import Path
 from typing import Literal
 
@@ -33,7 +42,8 @@ from .limits import Failure
 sa = require("sqlalchemy", "fleet", "the calibration store")
 
 STORE_FILE = "calibrations.sqlite"
-STORE_SCHEMA_VERSION = 1
+#: 2: the station that wrote a row, the row a successful row supersedes (unique per serial), station claims
+STORE_SCHEMA_VERSION = 2
 _SQLITE_SUFFIXES = (".sqlite", ".sqlite3", ".db")
 
 _META = sa.MetaData()
@@ -55,6 +65,22 @@ _ROWS = sa.Table(
     sa.Column("figures", sa.Text),
     sa.Column("error", sa.Text),
     sa.Column("warnings", sa.Text, nullable=False),
+    sa.Column("station", sa.String(200)),
+    sa.Column("supersedes", sa.Integer),
+)
+#: one successor per successful row of a unit: two writers that read the same history cannot both append
+_CHAIN = sa.Index("uq_calibrations_chain", _ROWS.c.serial, _ROWS.c.supersedes, unique=True)
+#: the columns a row is read back from (a schema 1 store has neither the station nor the chain)
+_READ = [c for c in _ROWS.c if c.name not in ("station", "supersedes")]
+#: which station fits which unit now (:mod:`gyrocomp.fleet.stations`)
+CLAIMS = sa.Table(
+    "claims", _META,
+    sa.Column("serial", sa.String(200), primary_key=True),
+    sa.Column("station", sa.String(200), nullable=False),
+    sa.Column("host", sa.String(255), nullable=False),
+    sa.Column("pid", sa.Integer, nullable=False),
+    sa.Column("claimed_utc", sa.DateTime, nullable=False),
+    sa.Column("heartbeat_utc", sa.DateTime, nullable=False),
 )
 
 Status = Literal["ok", "failed"]
@@ -85,6 +111,7 @@ class CalibrationRecord:
     figures: UnitFigures | None = None
     error: str | None = None
     warnings: tuple[str, ...] = ()
+    station: str | None = None
     id: int | None = None
 
     def calibration(self) -> Calibration:
@@ -120,6 +147,8 @@ def store_url(location: str | os.PathLike) -> str:
     """The SQLAlchemy URL of a store location (see the module)."""
     text = os.fspath(location)
     if "://" in text:
+        if text.startswith("postgresql://") and find_spec("psycopg2") is None and find_spec("psycopg") is not None:
+            return "postgresql+psycopg://" + text[len("postgresql://"):]  # SQLAlchemy's default driver is psycopg2
         return text
     path = sqlite_file(text)
     return f"sqlite:///{path.resolve()}"
@@ -134,6 +163,16 @@ def sqlite_file(location: str | os.PathLike) -> Path:
 
 #: how long a writer waits for another process's write to the same SQLite store [s]
 SQLITE_BUSY_TIMEOUT_S = 60.0
+#: how many times a write that conflicted with another writer's is tried in all
+WRITE_TRIES = 12
+#: PostgreSQL's serialization failure and deadlock: the transaction is tried again
+_RETRIED_SQLSTATES = ("40001", "40P01")
+#: the advisory lock that creating or upgrading a PostgreSQL store holds (any fixed 64-bit number)
+_SCHEMA_LOCK_KEY = 0x6779726F636F6D70
+
+
+class _Retry(Exception):
+    """A write that conflicted with another writer's (a unique key taken, a serialization failure)."""
 
 
 def _serialize_sqlite_writes(engine) -> None:
@@ -183,19 +222,41 @@ class CalibrationStore:
             present = inspector.has_table(_ROWS.name)
         except sa.exc.DatabaseError as exc:
             raise InputError(f"{self.location}: not a database ({exc.orig})") from None
-        if not present:
-            if not create:
-                raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
-            with self._writing() as conn:  # one transaction: a second creator waits, then finds the tables
-                _META.create_all(conn, checkfirst=True)
-                if conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar() is None:
-                    conn.execute(_INFO.insert().values(key="schema_version", value=str(STORE_SCHEMA_VERSION)))
-            return
-        with self.engine.connect() as conn:
-            version = conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
-        if version is None or not version.isdigit() or int(version) > STORE_SCHEMA_VERSION:
+        if not present and not create:
+            raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
+        version = self._version() if present else None
+        if present and (version is None or not version.isdigit() or int(version) > STORE_SCHEMA_VERSION):
             raise InputError(f"{self.location}: store schema version {version}; this gyrocomp reads up to "
                              f"{STORE_SCHEMA_VERSION} (upgrade gyrocomp)")
+        if create and version != str(STORE_SCHEMA_VERSION):
+            with self._writing(schema=True) as conn:  # one transaction: a second creator waits, then finds it done
+                self._create_or_upgrade(conn)
+            version = str(STORE_SCHEMA_VERSION)
+        #: the store's schema version (a store of version 1 is read as it is, and upgraded by its next writer)
+        self.schema_version = int(version)
+        self._columns = _READ + ([_ROWS.c.station] if self.schema_version >= 2 else [])
+
+    def _version(self) -> str | None:
+        with self.engine.connect() as conn:
+            return conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
+
+    @staticmethod
+    def _create_or_upgrade(conn) -> None:
+        """Create the tables, or bring a store of schema 1 to :data:`STORE_SCHEMA_VERSION` (its rows kept as they
+        are: they name no station and supersede nothing)."""
+        if not sa.inspect(conn).has_table(_ROWS.name):
+            _META.create_all(conn, checkfirst=True)
+            conn.execute(_INFO.insert().values(key="schema_version", value=str(STORE_SCHEMA_VERSION)))
+            return
+        version = conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
+        if version == "1":
+            for column in (_ROWS.c.station, _ROWS.c.supersedes):
+                conn.execute(sa.text(f"ALTER TABLE {_ROWS.name} ADD COLUMN {column.name} "
+                                     f"{column.type.compile(conn.dialect)}"))
+            _CHAIN.create(conn)
+            CLAIMS.create(conn, checkfirst=True)
+            conn.execute(_INFO.update().where(_INFO.c.key == "schema_version")
+                         .values(value=str(STORE_SCHEMA_VERSION)))
 
     def close(self) -> None:
         self.engine.dispose()
@@ -208,45 +269,83 @@ class CalibrationStore:
 
     # -- writing -------------------------------------------------------------------------------------------
     @contextlib.contextmanager
-    def _writing(self):
-        """A write transaction that holds the store's write lock from its start (SQLite: ``BEGIN IMMEDIATE``;
-        PostgreSQL: the rows table locked against other writers, readers go on), so writers take turns; a full disk
-        or a read-only store is one line naming the store."""
+    def _writing(self, schema: bool = False):
+        """A write transaction (SQLite: ``BEGIN IMMEDIATE``, writers take turns; PostgreSQL: concurrent, at
+        repeatable read, kept apart by the unique chain, and, for ``schema`` changes, a transaction-wide advisory
+        lock); a full disk or a
+        read-only store is one line naming the store. Conflicts that a retry resolves propagate as
+        :class:`_Retry`."""
         try:
             with self.engine.connect() as conn:
                 conn.info["immediate"] = True
+                if conn.dialect.name == "postgresql" and not schema:  # every statement of it sees one snapshot
+                    conn.execution_options(isolation_level="REPEATABLE READ")
                 with conn.begin():
-                    if conn.dialect.name == "postgresql" and sa.inspect(conn).has_table(_ROWS.name):
-                        conn.execute(sa.text(f"LOCK TABLE {_ROWS.name} IN SHARE ROW EXCLUSIVE MODE"))
+                    if schema and conn.dialect.name == "postgresql":
+                        conn.execute(sa.text("SELECT pg_advisory_xact_lock(:key)"), {"key": _SCHEMA_LOCK_KEY})
                     yield conn
+        except sa.exc.IntegrityError as exc:
+            raise _Retry(str(exc.orig)) from None
         except sa.exc.OperationalError as exc:
+            if getattr(exc.orig, "sqlstate", None) in _RETRIED_SQLSTATES:
+                raise _Retry(str(exc.orig)) from None
             raise InputError(f"{self.location}: cannot write to the calibration store ({exc.orig}); is the disk "
                              "full or the store read-only?") from None
 
+    @contextlib.contextmanager
+    def transaction(self):
+        """A connection in a write transaction (on SQLite holding the write lock from its start); errors as the
+        database raises them."""
+        with self.engine.connect() as conn:
+            conn.info["immediate"] = True
+            with conn.begin():
+                yield conn
+
+    def _retrying(self, write: Callable[[], object]):
+        """``write()`` (one transaction), tried again on a conflict with another writer, up to
+        :data:`WRITE_TRIES` times with a random pause."""
+        for attempt in range(WRITE_TRIES):
+            try:
+                return write()
+            except _Retry as conflict:
+                if attempt == WRITE_TRIES - 1:
+                    raise InputError(f"{self.location}: another writer conflicted with this one {WRITE_TRIES} times "
+                                     f"in a row ({str(conflict)[:160]}); try again") from None
+                time.sleep(random.uniform(0.0, 0.05 * 2 ** min(attempt, 6)))
+        raise AssertionError("unreachable")
+
     def add(self, record: CalibrationRecord) -> int:
         """Append ``record`` (a new row, whatever the serial's history); returns its id."""
+        return self._retrying(lambda: self._append(record, None, False))
+
+    def add_new(self, record: CalibrationRecord, since: _dt.datetime, *, stamp: bool = False) -> int | None:
+        """Append a successful ``record`` unless another writer stored a successful calibration of the same unit
+        from the same inputs (its ``input_hash``) after ``since`` (naive UTC): the check and the write are one
+        transaction, retried on a conflict with another writer. ``stamp``: the row's time is the time of the
+        write (the newest row of a unit is then also the latest). Returns the new row's id, or None when it was
+        not stored."""
+        return self._retrying(lambda: self._append(record, since, stamp))
+
+    def _append(self, record: CalibrationRecord, since: _dt.datetime | None, stamp: bool) -> int | None:
         with self._writing() as conn:
-            result = conn.execute(_ROWS.insert().values(**_to_row(record)))
+            previous = None
+            if record.status == "ok":
+                if since is not None and conn.execute(sa.select(_ROWS.c.id).where(
+                        (_ROWS.c.serial == record.serial) & (_ROWS.c.status == "ok")
+                        & (_ROWS.c.input_hash == record.input_hash) & (_ROWS.c.calibrated_utc >= since))
+                        .limit(1)).scalar() is not None:
+                    return None
+                previous = conn.execute(sa.select(sa.func.max(_ROWS.c.id)).where(
+                    (_ROWS.c.serial == record.serial) & (_ROWS.c.status == "ok"))).scalar() or 0
+            row = _to_row(record if not stamp else _replace(record, calibrated_utc=utc_now()))
+            result = conn.execute(_ROWS.insert().values(**row, supersedes=previous))
             return int(result.inserted_primary_key[0])
 
-    def add_new(self, record: CalibrationRecord, since: _dt.datetime,
-                before_commit: Callable[[], None] | None = None) -> int | None:
-        """Append a successful ``record`` unless another process stored a successful calibration of the same unit
-        from the same inputs (its ``input_hash``) after ``since`` (naive UTC): the check and the write are one
-        transaction. ``before_commit`` (writing the unit's model file) runs inside it, holding the store's write
-        lock: writers of one unit take turns, so the file is always that of the newest row, and a failed file write
-        stores nothing. Returns the new row's id, or None when it was not stored."""
-        with self._writing() as conn:
-            if record.status == "ok":
-                newer = conn.execute(sa.select(_ROWS.c.id).where(
-                    (_ROWS.c.serial == record.serial) & (_ROWS.c.status == "ok")
-                    & (_ROWS.c.input_hash == record.input_hash) & (_ROWS.c.calibrated_utc >= since)).limit(1)).scalar()
-                if newer is not None:
-                    return None
-            result = conn.execute(_ROWS.insert().values(**_to_row(record)))
-            if before_commit is not None:
-                before_commit()
-            return int(result.inserted_primary_key[0])
+    def newest_ok_id(self, serial: str) -> int | None:
+        """The id of the newest successful row of ``serial`` (None when it has none)."""
+        with self.engine.connect() as conn:
+            return conn.execute(sa.select(sa.func.max(_ROWS.c.id)).where(
+                (_ROWS.c.serial == serial) & (_ROWS.c.status == "ok"))).scalar()
 
     # -- reading -------------------------------------------------------------------------------------------
     def _records(self, query) -> list[CalibrationRecord]:
@@ -281,7 +380,7 @@ class CalibrationStore:
 
     def history(self, serial: str) -> list[CalibrationRecord]:
         """Every row of ``serial``, oldest first."""
-        return self._records(sa.select(_ROWS).where(_ROWS.c.serial == serial)
+        return self._records(sa.select(*self._columns).where(_ROWS.c.serial == serial)
                              .order_by(_ROWS.c.calibrated_utc, _ROWS.c.id))
 
     def latest(self, serial: str) -> CalibrationRecord | None:
@@ -308,7 +407,7 @@ class CalibrationStore:
         """The newest row of every unit, by serial."""
         newest = (sa.select(_ROWS.c.serial, sa.func.max(_ROWS.c.id).label("id")).group_by(_ROWS.c.serial)
                   .subquery())
-        return self._records(sa.select(_ROWS).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial))
+        return self._records(sa.select(*self._columns).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial))
 
     def ok_hashes(self) -> dict[str, str]:
         """The input hash of every unit's newest successful calibration, by serial (one query)."""
@@ -317,6 +416,21 @@ class CalibrationStore:
         query = sa.select(_ROWS.c.serial, _ROWS.c.input_hash).join(newest, _ROWS.c.id == newest.c.id)
         with self.engine.connect() as conn:
             return {serial: digest for serial, digest in conn.execute(query)}
+
+    def ok_hash(self, serial: str) -> str | None:
+        """The input hash of ``serial``'s newest successful calibration (None when it has none)."""
+        newest = self.newest_ok_id(serial)
+        if newest is None:
+            return None
+        with self.engine.connect() as conn:
+            return conn.execute(sa.select(_ROWS.c.input_hash).where(_ROWS.c.id == newest)).scalar()
+
+    def station_counts(self) -> list[tuple[str | None, str, int, _dt.datetime | None]]:
+        """(station, status, rows, newest time) for each station and status (station None: rows that name none)."""
+        keys = [_ROWS.c.station, _ROWS.c.status] if self.schema_version >= 2 else [_ROWS.c.status]
+        query = sa.select(*keys, sa.func.count(), sa.func.max(_ROWS.c.calibrated_utc)).group_by(*keys)
+        with self.engine.connect() as conn:
+            return [tuple(row) if len(keys) == 2 else (None, *row) for row in conn.execute(query)]
 
     def serials(self) -> list[str]:
         with self.engine.connect() as conn:
@@ -333,7 +447,7 @@ def _to_row(record: CalibrationRecord) -> dict:
         "unit_metadata": json.dumps(dict(record.metadata)), "gyrocomp_version": record.gyrocomp_version,
         "model": record.model_json,
         "figures": None if record.figures is None else json.dumps(record.figures.to_dict()),
-        "error": record.error, "warnings": json.dumps(list(record.warnings)),
+        "error": record.error, "warnings": json.dumps(list(record.warnings)), "station": record.station,
     }
 
 
@@ -360,7 +474,7 @@ def _from_row(row) -> CalibrationRecord:
         failures=tuple(Failure(str(f), math.nan if v is None else float(v), str(r))
                        for f, v, r in json.loads(row["failures"])),
         model_json=row["model"], figures=figures, error=row["error"],
-        warnings=tuple(str(w) for w in json.loads(row["warnings"])), id=row["id"])
+        warnings=tuple(str(w) for w in json.loads(row["warnings"])), station=row.get("station"), id=row["id"])
 
 
 __all__ = ["STORE_FILE", "STORE_SCHEMA_VERSION", "CalibrationRecord", "CalibrationStore", "InputFile", "parse_time",

@@ -16,7 +16,7 @@ from types import ModuleType
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError, MissingDependencyError, install_hint, printable
+from ..errors import DataQualityWarning, InputError, MissingDependencyError, TimeOrderWarning, install_hint, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..option_spelling import Spelling, spelled
 from .layout import TableLayout
@@ -198,10 +198,11 @@ def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -
     moved = int(np.count_nonzero(order != np.arange(order.size)))
     dropped = int(sorted_t.size - index.size)
     if moved or dropped:
-        warnings.warn(
-            f"{source}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) dropped",
-            DataQualityWarning, stacklevel=3,
-        )
+        back = float(np.max(np.maximum.accumulate(time_s)[:-1] - time_s[1:])) if time_s.size > 1 else 0.0
+        warnings.warn(TimeOrderWarning(
+            f"{source}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) dropped"
+            + (f" (the time went back by up to {back:.6g} s)" if back > 0 else ""),
+            moved=moved, dropped=dropped, largest_back_s=max(back, 0.0)), stacklevel=3)
     return (time_s[index], *(None if a is None else np.asarray(a)[index] for a in arrays))
 
 

@@ -502,13 +502,13 @@ def _page(calibration: Calibration, runs: list[Recording], sections: dict) -> st
     return html_page(f"gyrocomp report: {calibration.model}", "gyrocomp report", f"runs: {files}", sections)
 
 
-def html_page(title: str, heading: str, note: str, sections: dict[str, tuple[str, str]]) -> str:
+def html_page(title: str, heading: str, note: str, sections: dict[str, tuple[str, str]], css: str = "") -> str:
     """A self-contained page: ``title``, the ``heading``, the time and version with ``note`` (HTML) beside them, a
-    navigation bar, and ``sections`` (id -> (title, HTML body)) in order."""
+    navigation bar, and ``sections`` (id -> (title, HTML body)) in order; ``css``: more style (the page's own)."""
     created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     nav = " ".join(f'<a href="#{sid}">{html.escape(name)}</a>' for sid, (name, _) in sections.items())
     page = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
-            f"<title>{html.escape(title)}</title>", f"<style>{_CSS}</style></head><body>",
+            f"<title>{html.escape(title)}</title>", f"<style>{_CSS}{css}</style></head><body>",
             f"<h1>{html.escape(heading)}</h1><p class=note>{created}, gyrocomp {__version__}"
             + (f"; {note}" if note else "") + "</p>", f"<nav>{nav}</nav>"]
     for sid, (name, body) in sections.items():

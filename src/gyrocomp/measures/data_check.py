@@ -1,0 +1,428 @@
+"""The data check before a fit: is each run fit to calibrate from, and if only partly, what does it cost?
+
+Each check has a name, a documented threshold and a severity. A **refusal** is a run (or a set of runs) that
+cannot give a valid fit of what is asked: no temperature, time that goes back (two logs appended, a clock reset),
+no reversal where turning-point hysteresis is asked, and, when a temperature curve is asked by name (``poly:3``,
+``table``, ``mlp``), a constant temperature, too little span, or too few samples for the curve. Under the default
+automatic choice those three are warnings: the choice then fits no curve (a constant bias, and whatever else the
+runs identify, such as g-sensitivity from positions at one temperature), which is a valid fit of what the data
+hold.
+A **warning** is what only degrades a fit, said with its expected cost: temperature quantized in coarse steps,
+gaps, a rail (saturated samples), motion, a unit probably read wrongly, time stamps reordered or repeated by a
+logger. Any check is accepted knowingly by its name (``accept``; ``accept=NAME``): it is
+then reported as accepted, never as a refusal.
+
+The thresholds (module constants, each documented where it is defined) are physical or stated by the data
+sheets, not tuned on a corpus: MEMS gyro white-noise densities lie between about 0.001 and 0.1 deg/s/sqrt(Hz)
+(the best tactical MEMS parts at the low end, consumer parts at the high end), so a density 57.3 times outside
+that range is a unit mistake; a temperature model needs a span larger than the sensor's own noise and steps.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ..effects import moving_average
+from ..errors import TimeOrderWarning
+from ..recording import Recording
+from .plausibility import turned_between_poses
+
+Severity = Literal["refuse", "warn"]
+#: every check, in the order a verdict line lists them
+DATA_CHECKS = ("time", "temperature-missing", "temperature-constant", "temperature-span", "too-short", "reversal",
+          "temperature-quantized", "gaps", "rail", "motion", "unit")
+
+#: a temperature that varies less than this over a run is constant (a stuck or absent sensor) [degC]
+CONSTANT_SPAN_DEGC = 0.01
+#: a set of runs spanning less than this cannot identify a temperature curve [degC] (the plausibility check's)
+MIN_SPAN_DEGC = 1.0
+#: temperature steps at least this coarse are said (whole or half degrees); finer LSBs are no concern [degC]
+QUANTIZED_STEP_DEGC = 0.25
+#: time that goes back by more than this many sample periods, and at least TIME_BACK_MIN_S, is two logs or a
+#: clock reset, refused; less is a logger's reordering, sorted and said
+TIME_BACK_PERIODS, TIME_BACK_MIN_S = 10, 1.0
+#: gaps are said when the longest is at least this many sample periods and GAP_MIN_S long, or when this
+#: fraction of the run is missing
+GAP_PERIODS, GAP_MIN_S, GAP_MISSING_FRACTION = 10, 1.0, 0.01
+#: a rail: an axis's extreme value held for at least this many consecutive samples, and this many robust
+#: standard deviations from the axis's median
+RAIL_RUN_SAMPLES, RAIL_SIGMAS = 3, 20.0
+#: motion: consecutive 10 s means of an axis differ by more than this [deg/s] (the bias moves by hundredths of a
+#: deg/s in 10 s, even on a chamber ramp of 10 degC/min; a turning unit by degrees per second)
+MOTION_WINDOW_S, MOTION_DPS = 10.0, 1.0
+#: the white-noise density of MEMS gyros [deg/s/sqrt(Hz)]: outside this, the data's unit is probably wrong
+NOISE_DENSITY_RANGE = (1e-3, 0.2)
+#: the noise density is read in windows of this many differences, at this percentile of their spread (the quiet
+#: windows: a hand-turned session's poses, a chamber run's any)
+UNIT_WINDOW_SAMPLES, UNIT_QUIET_PERCENTILE, UNIT_MAX_WINDOWS = 20, 10.0, 20_000
+#: that percentile of the spread of 20 differences of white noise, over sqrt(2) sigma (by simulation of 1e5
+#: windows; its own error below 1 %): the estimate is divided by it
+UNIT_QUIET_FACTOR = 0.7455
+#: samples per parameter of the temperature curve below which a run set is too short, and distinct temperature
+#: levels (at 0.1 degC) per parameter
+SAMPLES_PER_PARAMETER, LEVELS_PER_PARAMETER = 10, 2
+
+
+@dataclass(frozen=True)
+class Ask:
+    """What the fit asks of the data.
+
+    Parameters
+    ----------
+    temperature : {"auto", "asked", "none"}
+        The temperature curve: chosen automatically (the default), asked by name, or none.
+    hysteresis : bool
+        Turning-point hysteresis is asked explicitly (the runs must heat and cool).
+    parameters : int
+        Parameters of the temperature curve (a cubic: 4; a 1-3-1 network: 10).
+    """
+
+    temperature: Literal["auto", "asked", "none"] = "auto"
+    hysteresis: bool = False
+    parameters: int = 4
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One check's finding: its name, refusal or warning, the message (starting with the run) and, for a warning,
+    its expected cost."""
+
+    check: str
+    severity: Severity
+    message: str
+    cost: str = ""
+
+    def text(self) -> str:
+        return self.message + (f"; expected cost: {self.cost}" if self.cost else "")
+
+
+@dataclass(frozen=True)
+class RunCheck:
+    """The data check of one run: its findings, and those accepted by name (reported, never refusing)."""
+
+    source: str
+    findings: tuple[Finding, ...] = ()
+    accepted: tuple[Finding, ...] = ()
+
+    @property
+    def verdict(self) -> Literal["refused", "warning", "ok"]:
+        if any(f.severity == "refuse" for f in self.findings):
+            return "refused"
+        return "warning" if self.findings else "ok"
+
+    @property
+    def reasons(self) -> tuple[str, ...]:
+        """The names of the checks that found something (not those accepted)."""
+        return tuple(dict.fromkeys(f.check for f in self.findings))
+
+    def line(self) -> str:
+        """One verdict line: ``SOURCE: refused (checks): first message`` (``ok`` when nothing was found)."""
+        if not self.findings:
+            extra = f" (accepted: {', '.join(f.check for f in self.accepted)})" if self.accepted else ""
+            return f"{self.source}: ok{extra}"
+        first = next(f for f in self.findings if f.severity == "refuse") if self.verdict == "refused" \
+            else self.findings[0]
+        text = first.text()
+        text = text[len(self.source) + 2:] if text.startswith(self.source + ": ") else text
+        return f"{self.source}: {self.verdict} ({', '.join(self.reasons)}): {text}"
+
+    def to_dict(self) -> dict:
+        return {"source": self.source, "verdict": self.verdict,
+                "findings": [_finding_dict(f) for f in self.findings],
+                "accepted": [_finding_dict(f) for f in self.accepted]}
+
+
+def _finding_dict(f: Finding) -> dict:
+    return {"check": f.check, "severity": f.severity, "message": f.message, "cost": f.cost}
+
+
+# -- the checks of one run ------------------------------------------------------------------------------------
+def _temperature(recording: Recording) -> np.ndarray | None:
+    """The run's temperature [degC] (the mean of several sensors), finite samples only; None when absent."""
+    t = recording.temperature_degc
+    if t is None:
+        return None
+    t = np.asarray(t, dtype=float)
+    t = t.mean(axis=1) if t.ndim == 2 else t
+    t = t[np.isfinite(t)]
+    return t if t.size else None
+
+
+def _quantization_step(t: np.ndarray) -> float:
+    """The step of a temperature read on a grid [degC] (0 when it is not): the smallest change, when every value
+    lies on multiples of it from the first."""
+    steps = np.abs(np.diff(t))
+    steps = steps[steps > 1e-9]
+    if steps.size < 3:
+        return 0.0
+    q = float(np.min(steps))
+    on_grid = np.abs((t - t[0]) / q - np.round((t - t[0]) / q)) < 1e-3
+    return q if np.mean(on_grid) > 0.99 else 0.0
+
+
+def _slope_dps_per_degc(recording: Recording, t: np.ndarray) -> float:
+    """The largest least-squares slope of an axis on the temperature [deg/s/degC] (for costs)."""
+    temp = np.asarray(recording.temperature_degc, dtype=float)
+    temp = temp.mean(axis=1) if temp.ndim == 2 else temp
+    ok = np.isfinite(temp)
+    if np.ptp(temp[ok]) <= 0:
+        return 0.0
+    x = temp[ok] - temp[ok].mean()
+    g = recording.gyro_dps[ok] - recording.gyro_dps[ok].mean(axis=0)
+    return float(np.max(np.abs(x @ g / (x @ x))))
+
+
+def temperature_findings(recording: Recording, ask: Ask) -> list[Finding]:
+    """Missing, constant and quantized temperature of one run (span is judged over the set of runs)."""
+    if ask.temperature == "none":
+        return []
+    src = recording.source
+    t = _temperature(recording)
+    if t is None:
+        return [Finding("temperature-missing", "refuse", f"{src}: no temperature channel (or no finite sample of "
+                        "it): a temperature curve cannot be fitted (temperature=none fits a bias alone)")]
+    if np.ptp(t) < CONSTANT_SPAN_DEGC:
+        return [Finding("temperature-constant", _curve_severity(ask), f"{src}: the temperature is constant "
+                        f"({t[0]:.4g} degC throughout): a stuck or absent sensor, or a run at one temperature",
+                        _NO_CURVE if ask.temperature == "auto" else "")]
+    q = _quantization_step(t)
+    if q >= QUANTIZED_STEP_DEGC:
+        slope = _slope_dps_per_degc(recording, t)
+        return [Finding("temperature-quantized", "warn", f"{src}: the temperature is read in steps of {q:.3g} degC",
+                        f"about {slope * q / math.sqrt(12):.2g} deg/s RMS of bias error (the slope "
+                        f"{slope:.2g} deg/s/degC times the step's {q / math.sqrt(12):.2g} degC RMS)")]
+    return []
+
+
+#: the cost of too little temperature under the automatic choice
+_NO_CURVE = "no temperature curve: the automatic choice fits a constant bias"
+
+
+def _curve_severity(ask: Ask) -> Severity:
+    """A refusal when a curve is asked by name; a warning under the automatic choice (which then fits none)."""
+    return "refuse" if ask.temperature == "asked" else "warn"
+
+
+def gap_findings(recording: Recording) -> list[Finding]:
+    """Gaps: the longest at least GAP_PERIODS sample periods and GAP_MIN_S, or GAP_MISSING_FRACTION missing."""
+    if not recording.gaps:
+        return []
+    period = 1.0 / recording.rate_hz
+    longest = max(recording.gaps, key=lambda g: g.duration_s)
+    missing = sum(g.duration_s - period for g in recording.gaps)
+    fraction = missing / max(recording.duration_s, period)
+    if longest.duration_s < max(GAP_PERIODS * period, GAP_MIN_S) and fraction < GAP_MISSING_FRACTION:
+        return []
+    return [Finding("gaps", "warn", f"{recording.source}: {len(recording.gaps)} gap(s), {missing:.4g} s in all "
+                    f"({100 * fraction:.2g} % of the run; longest {longest.duration_s:.4g} s after row "
+                    f"{longest.after_row})", f"{100 * fraction:.2g} % fewer samples; the drift over the gaps is "
+                    "not seen, nothing is interpolated")]
+
+
+def rail_findings(recording: Recording) -> list[Finding]:
+    """A rail: an axis's extreme value held RAIL_RUN_SAMPLES times in a row, RAIL_SIGMAS from its median."""
+    out = []
+    for j, axis in enumerate(recording.gyro_axes):
+        x = recording.gyro_dps[:, j]
+        median = float(np.median(x))
+        sigma = 1.4826 * float(np.median(np.abs(x - median))) or 1e-12
+        for edge in (float(np.max(x)), float(np.min(x))):
+            if abs(edge - median) < RAIL_SIGMAS * sigma:
+                continue
+            at = np.flatnonzero(x == edge)
+            held = np.flatnonzero(np.diff(at) == 1)
+            if at.size < RAIL_RUN_SAMPLES or _longest_run(held) + 1 < RAIL_RUN_SAMPLES - 1:
+                continue
+            out.append(Finding("rail", "warn", f"{recording.source}: {axis} sits at {edge:.5g} deg/s for {at.size} "
+                               f"sample(s) (first at row {int(recording.row_numbers[at[0]])}): the sensor's range "
+                               "was exceeded", f"{at.size} sample(s) ({100 * at.size / x.size:.2g} %) wrong by an "
+                               "unknown amount; the unit moved, so the run is no rest either"))
+    return out
+
+
+def _longest_run(held: np.ndarray) -> int:
+    """The longest stretch of consecutive indices in ``held``."""
+    if not held.size:
+        return 0
+    breaks = np.flatnonzero(np.diff(held) != 1)
+    lengths = np.diff(np.concatenate(([0], breaks + 1, [held.size])))
+    return int(lengths.max())
+
+
+def motion_findings(recording: Recording) -> list[Finding]:
+    """Motion: consecutive 10 s means of an axis that differ by more than MOTION_DPS (the bias drifts by hundredths
+    of a deg/s in 10 s, even on a fast chamber ramp; a turning unit by degrees per second); a multi-position
+    session (still poses that turn every accelerometer axis up and down) turns on purpose and is not said."""
+    w = max(1, int(round(MOTION_WINDOW_S * recording.rate_hz)))
+    n_blocks = recording.gyro_dps.shape[0] // w
+    if n_blocks < 2:
+        return []
+    blocks = recording.gyro_dps[:n_blocks * w].reshape(n_blocks, w, -1).mean(axis=1)
+    steps = np.abs(np.diff(blocks, axis=0))
+    jump = np.any(steps > MOTION_DPS, axis=1)
+    if not jump.any() or turned_between_poses(recording):
+        return []
+    moving = np.zeros(n_blocks, dtype=bool)
+    moving[:-1] |= jump
+    moving[1:] |= jump
+    fraction, worst = float(moving.mean()), float(steps.max())
+    return [Finding("motion", "warn", f"{recording.source}: the unit moves in {int(moving.sum())} of {n_blocks} "
+                    f"10 s windows (their means jump by up to {worst:.3g} deg/s)", f"up to {worst * fraction:.2g} "
+                    f"deg/s of bias error where the moving {100 * fraction:.2g} % of the run lies, unless cut out")]
+
+
+def white_noise_density(recording: Recording) -> float:
+    """The gyro's white-noise density [deg/s/sqrt(Hz)] where the unit is stillest: the standard deviation of
+    sample-to-sample differences over windows of UNIT_WINDOW_SAMPLES (at most UNIT_MAX_WINDOWS of them, evenly
+    spread over the run), its UNIT_QUIET_PERCENTILE-th percentile (motion and steps leave the quiet windows alone)
+    over UNIT_QUIET_FACTOR, divided by sqrt(2 rate); the median over the axes."""
+    x = recording.gyro_dps
+    span = UNIT_WINDOW_SAMPLES + 1
+    if x.shape[0] < span:
+        return float(np.median(np.std(np.diff(x, axis=0), axis=0))) / math.sqrt(2.0 * recording.rate_hz)
+    starts = np.unique(np.linspace(0, x.shape[0] - span, min(UNIT_MAX_WINDOWS, x.shape[0] // span)).astype(int))
+    windows = np.diff(x[starts[:, None] + np.arange(span)], axis=1).std(axis=1)  # (windows, axes)
+    quiet = float(np.median(np.percentile(windows, UNIT_QUIET_PERCENTILE, axis=0))) / UNIT_QUIET_FACTOR
+    return quiet / math.sqrt(2.0 * recording.rate_hz)
+
+
+def unit_findings(recording: Recording) -> list[Finding]:
+    """The gyro's unit: its white-noise density (:func:`white_noise_density`) outside NOISE_DENSITY_RANGE, by the
+    factor of 57.3 a rad/s-deg/s mistake makes."""
+    if recording.gyro_dps.shape[0] < 10:
+        return []
+    density = white_noise_density(recording)
+    lo, hi = NOISE_DENSITY_RANGE
+    if lo <= density <= hi or density == 0.0:
+        return []
+    words = ("rad/s read as deg/s? (give the gyro's unit: gyro_unit=rad/s)" if density < lo
+             else "deg/s read as rad/s? (the gyro's unit given is wrong)")
+    return [Finding("unit", "warn", f"{recording.source}: gyro white noise {density:.3g} deg/s/sqrt(Hz), outside any "
+                    f"MEMS gyro's {lo:g}..{hi:g}: {words}", "a model 57.3 times too small or too large")]
+
+
+def time_findings(source: str, notes: Sequence[Warning], rate_hz: float) -> list[Finding]:
+    """Time order from what the reader said (:class:`TimeOrderWarning`): going back far is refused, a logger's
+    reordering or repeated stamps are said."""
+    out = []
+    for note in notes:
+        if not isinstance(note, TimeOrderWarning):
+            continue
+        limit = max(TIME_BACK_PERIODS / rate_hz, TIME_BACK_MIN_S)
+        if note.largest_back_s > limit:
+            out.append(Finding("time", "refuse", f"{source}: the time goes back by {note.largest_back_s:.4g} s (more "
+                               f"than {limit:.3g} s): two logs appended or a clock reset; split it into its parts"))
+        else:
+            out.append(Finding("time", "warn", str(note), "none: the samples were put in order"))
+    return out
+
+
+#: the reader's refusals that are time order (tables refuse any backward or repeated time)
+_TIME_REFUSAL = re.compile(r"time (repeats|goes backwards)")
+
+
+def unreadable(source: str, message: str) -> RunCheck:
+    """The check of a run the reader refused: ``time`` when its time repeats or goes back, else ``unreadable``."""
+    check = "time" if _TIME_REFUSAL.search(message) else "unreadable"
+    return RunCheck(source, (Finding(check, "refuse", message),))
+
+
+# -- the checks of a set of runs ----------------------------------------------------------------------------------
+def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Finding]]:
+    """What only the runs together say, by run: too little span, too short for the curve, no reversal where
+    hysteresis is asked (each said on every run it concerns)."""
+    out: dict[int, list[Finding]] = {}
+    temps = [_temperature(r) for r in recordings]
+    known = [t for t in temps if t is not None]
+    if ask.temperature != "none" and known:
+        samples = sum(t.size for t in known)
+        levels = len(np.unique(np.round(np.concatenate(known), 1)))
+        if samples < SAMPLES_PER_PARAMETER * ask.parameters or levels < LEVELS_PER_PARAMETER * ask.parameters:
+            for i in range(len(recordings)):
+                out.setdefault(i, []).append(Finding(
+                    "too-short", _curve_severity(ask), f"{recordings[i].source}: {samples} sample(s) at {levels} "
+                    f"temperature level(s) for a curve of {ask.parameters} parameters (at least "
+                    f"{SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
+                    _NO_CURVE if ask.temperature == "auto" else ""))
+    present = [t for t in temps if t is not None and np.ptp(t) >= CONSTANT_SPAN_DEGC]
+    if ask.temperature != "none" and present:
+        span = float(max(t.max() for t in present) - min(t.min() for t in present))
+        if span < MIN_SPAN_DEGC:
+            for i, t in enumerate(temps):
+                if t is not None:
+                    out.setdefault(i, []).append(Finding("temperature-span", _curve_severity(ask),
+                                                         f"{recordings[i].source}: the runs span {span:.3g} degC, "
+                                                         f"less than {MIN_SPAN_DEGC:g} degC: no temperature curve "
+                                                         "can be told from noise",
+                                                         _NO_CURVE if ask.temperature == "auto" else ""))
+        if ask.hysteresis and not any(_reverses(t) for t in present):
+            for i in range(len(recordings)):
+                out.setdefault(i, []).append(Finding("reversal", "refuse", f"{recordings[i].source}: the "
+                                                     "temperature never turns back, and turning-point hysteresis "
+                                                     "is asked: record heating and cooling"))
+    return out
+
+
+def _reverses(t: np.ndarray) -> bool:
+    """Whether a temperature heats and cools by at least MIN_SPAN_DEGC each (judged on 1 % of its samples)."""
+    s = moving_average(t, max(1, t.size // 100))
+    rise = s - np.minimum.accumulate(s)
+    fall = np.maximum.accumulate(s) - s
+    return bool(rise.max() >= MIN_SPAN_DEGC and fall.max() >= MIN_SPAN_DEGC
+                and (np.argmax(fall >= MIN_SPAN_DEGC) > np.argmax(rise >= MIN_SPAN_DEGC)
+                     or np.argmax(rise >= MIN_SPAN_DEGC) > np.argmax(fall >= MIN_SPAN_DEGC)))
+
+
+@dataclass(frozen=True)
+class CheckedRun:
+    """A run as read: its recording (None when the reader refused it) and what the reader said."""
+
+    source: str
+    recording: Recording | None
+    notes: tuple[Warning, ...] = ()
+    refusal: str | None = None
+
+
+def check_runs(runs: Sequence[CheckedRun], ask: Ask | None = None, accept: Iterable[str] = (),
+               still_only: Iterable[str] = ()) -> list[RunCheck]:
+    """The data check of each run (see the module), the checks named in ``accept`` reported as accepted.
+    ``still_only``: the sources of field logs fitted on their still segments alone, whose motion is expected (it
+    is not checked)."""
+    ask = ask or Ask()
+    accept, still_only = frozenset(accept), frozenset(still_only)
+    readable = [i for i, r in enumerate(runs) if r.recording is not None]
+    together = set_findings([runs[i].recording for i in readable], ask)
+    position = {i: k for k, i in enumerate(readable)}
+    out = []
+    for i, run in enumerate(runs):
+        if run.recording is None:
+            out.append(_split(unreadable(run.source, run.refusal or "unreadable").findings, run.source, accept))
+            continue
+        rec = run.recording
+        found = (time_findings(run.source, run.notes, rec.rate_hz) + temperature_findings(rec, ask)
+                 + together.get(position[i], []) + gap_findings(rec) + rail_findings(rec)
+                 + (motion_findings(rec) if rec.source not in still_only else []) + unit_findings(rec))
+        out.append(_split(found, run.source, accept))
+    return out
+
+
+def _split(found: Iterable[Finding], source: str, accept: frozenset[str]) -> RunCheck:
+    found = sorted(found, key=lambda f: (DATA_CHECKS.index(f.check) if f.check in DATA_CHECKS else -1))
+    return RunCheck(source, tuple(f for f in found if f.check not in accept),
+                    tuple(f for f in found if f.check in accept))
+
+
+def refusals(checks: Sequence[RunCheck]) -> list[RunCheck]:
+    """The runs refused."""
+    return [c for c in checks if c.verdict == "refused"]
+
+
+__all__ = ["Ask", "DATA_CHECKS", "CheckedRun", "Finding", "RunCheck", "check_runs", "refusals", "set_findings",
+           "unreadable"]
+

@@ -1,0 +1,147 @@
+"""The data check: every injected fault found with its own reason on simulated runs read from files, clean runs
+left alone, refusals and warnings as documented (a named curve refuses what the automatic choice only warns of),
+accepted checks reported and never refusing, the noise-density estimate recovering the simulated truth, and the
+check at the start of ``gyrocomp check``, ``fit`` and ``fleet fit``."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gyrocomp.errors import InputError, TimeOrderWarning
+from gyrocomp.fleet import CalibrationStore
+from gyrocomp.files.check import ask_for, check_files, enforce, read_checked
+from gyrocomp.io.tables import write_recording
+from gyrocomp.measures.data_check import (MIN_SPAN_DEGC, Ask, CheckedRun, check_runs, time_findings,
+                                          white_noise_density)
+from gyrocomp.models.options import FitOptions, Network, Polynomial
+from gyrocomp.simulation import preset_model, simulate
+from gyrocomp.simulation.faults import FAULTS, inject
+
+from ..conftest import run
+
+PRESETS = ("adxrs450", "consumer")
+
+
+@pytest.fixture(scope="module")
+def clean_columns(tmp_path_factory) -> dict[str, dict[str, np.ndarray]]:
+    """A clean 1 Hz chamber run of each preset, as its table's columns."""
+    folder = tmp_path_factory.mktemp("clean")
+    out = {}
+    for preset in PRESETS:
+        path = folder / f"{preset}.parquet"
+        write_recording(simulate(preset, profile="chamber", rate_hz=1.0, seed=5).recording, path)
+        table = pd.read_parquet(path)
+        out[preset] = {c: table[c].to_numpy() for c in table.columns}
+    return out
+
+
+@pytest.mark.parametrize("preset", PRESETS)
+def test_every_fault_is_found_with_its_reason_and_clean_runs_are_left_alone(clean_columns, preset, tmp_path):
+    columns = clean_columns[preset]
+    path = tmp_path / "run.parquet"
+    pd.DataFrame(columns).to_parquet(path)
+    (clean,) = check_files([path])[1]
+    # the consumer part reads its temperature in whole degrees (the preset's temperature_quantization_degc)
+    expected_clean = ("temperature-quantized",) if preset_model(preset).temperature_quantization_degc >= 0.25 else ()
+    assert clean.reasons == expected_clean, clean.line()
+    rng = np.random.default_rng(3)
+    for fault, check in FAULTS.items():
+        pd.DataFrame(inject(columns, fault, rng)).to_parquet(path)
+        ask = Ask(hysteresis=True) if fault == "no-reversal" else Ask()
+        (found,) = check_runs([read_checked(path)], ask)
+        assert check in found.reasons, (fault, found.line())
+        assert found.line().startswith(f"{path}: ") and "\n" not in found.line()
+
+
+def test_refusals_and_warnings_follow_what_is_asked(clean_columns, tmp_path):
+    path = tmp_path / "flat.parquet"
+    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-span", np.random.default_rng(0))).to_parquet(path)
+    run_ = read_checked(path)
+    (auto,) = check_runs([run_], ask_for())
+    assert auto.verdict == "warning" and "the automatic choice fits a constant bias" in auto.line()
+    (named,) = check_runs([run_], ask_for(FitOptions(temperature=Polynomial(3))))
+    # 0.5 degC holds 6 levels of 0.1 degC, fewer than a cubic's 8
+    assert named.verdict == "refused" and named.reasons == ("temperature-span", "too-short")
+    (accepted,) = check_runs([run_], ask_for(FitOptions(temperature=Polynomial(3))),
+                             accept=["temperature-span", "too-short"])
+    assert accepted.verdict == "ok" and [f.check for f in accepted.accepted] == ["temperature-span", "too-short"]
+    assert "accepted: temperature-span, too-short" in accepted.line()
+    (none,) = check_runs([run_], ask_for(FitOptions(temperature=None)))
+    assert none.verdict == "ok"
+    with pytest.raises(InputError, match=r"flat.parquet: the runs span 0.5 degC, less than 1 degC.*refused by the "
+                                         r"data check \(accept=temperature-span fits it anyway\)"):
+        enforce([named])
+    # a run at one temperature beside a chamber run: the set spans enough, the flat run is fine
+    full = tmp_path / "full.parquet"
+    pd.DataFrame(clean_columns["adxrs450"]).to_parquet(full)
+    both = check_runs([run_, read_checked(full)], ask_for(FitOptions(temperature=Polynomial(3))))
+    assert [c.verdict for c in both] == ["ok", "ok"]
+    assert ask_for(FitOptions(temperature=Network())).parameters == 10  # 1-3-1: 3 + 3 weights, 3 + 1 biases
+
+
+def test_the_span_threshold_is_the_documented_one(clean_columns, tmp_path):
+    columns = dict(clean_columns["adxrs450"])
+    t = columns["temperature"]
+    for span, refused in ((0.9 * MIN_SPAN_DEGC, True), (1.1 * MIN_SPAN_DEGC, False)):
+        columns["temperature"] = 20.0 + span * (t - t.min()) / np.ptp(t)
+        path = tmp_path / "run.parquet"
+        pd.DataFrame(columns).to_parquet(path)
+        (c,) = check_runs([read_checked(path)], Ask(temperature="asked", parameters=4))
+        assert ("temperature-span" in c.reasons) == refused
+
+
+def test_time_going_back_far_is_refused_and_a_loggers_reordering_said():
+    far = TimeOrderWarning("x.ulg: 5 sample(s) out of time order", moved=5, dropped=0, largest_back_s=3600.0)
+    near = TimeOrderWarning("x.ulg: 2 sample(s) out of time order", moved=2, dropped=0, largest_back_s=0.004)
+    (refusal,) = time_findings("x.ulg", [far], rate_hz=100.0)
+    (note,) = time_findings("x.ulg", [near], rate_hz=100.0)
+    assert refusal.severity == "refuse" and "goes back by 3600 s" in refusal.message
+    assert note.severity == "warn" and note.cost.startswith("none")
+
+
+def test_the_noise_density_is_recovered_and_the_unit_mistake_is_57_times_off():
+    model = preset_model("adis16488")
+    rec = simulate(model, profile="chamber", rate_hz=10.0, seed=2, duration_s=3600).recording
+    nd = model.noise_density_dps_per_sqrt_hz
+    # 1080 windows of 20 differences: the 10th percentile's own spread is a few percent
+    assert white_noise_density(rec) == pytest.approx(nd, rel=0.1)
+    for factor, words in ((math.pi / 180, "rad/s read as deg/s"), (180 / math.pi, "deg/s read as rad/s")):
+        scaled = CheckedRun("r", rec.with_gyro(rec.gyro_dps * factor))
+        (c,) = check_runs([scaled], Ask(temperature="none"))
+        assert c.reasons == ("unit",) and words in c.line()
+
+
+@pytest.mark.slow
+def test_check_fit_and_fleet_fit_run_the_check(clean_columns, tmp_path):
+    good, flat, bare = tmp_path / "good.csv", tmp_path / "flat.csv", tmp_path / "bare.csv"
+    pd.DataFrame(clean_columns["adxrs450"]).to_csv(good, index=False)
+    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-span", np.random.default_rng(0))).to_csv(flat, index=False)
+    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-missing", np.random.default_rng(0))).to_csv(bare, index=False)
+    checked = run("check", good, flat, bare)  # one unit's runs: together they span enough
+    assert checked.returncode == 1, checked.stderr
+    lines = checked.stdout.splitlines()
+    assert lines[:2] == [f"{good}: ok", f"{flat}: ok"] and len(lines) == 3
+    assert lines[2].startswith(f"{bare}: refused (temperature-missing)")
+    alone = run("check", flat)
+    assert alone.returncode == 0 and alone.stdout.startswith(f"{flat}: warning (temperature-span")
+    as_json = json.loads(run("check", flat, "--temperature", "poly:3", "--json").stdout)
+    assert as_json[0]["verdict"] == "refused" and as_json[0]["findings"][0]["check"] == "temperature-span"
+    refused = run("fit", flat, "--temperature", "poly:3", "-o", tmp_path / "m.json")
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and not (tmp_path / "m.json").exists()
+    assert "--accept temperature-span fits it anyway" in refused.stderr
+    accepted = run("fit", flat, "--temperature", "poly:3", "--accept", "temperature-span", "--accept", "too-short",
+                   "-o", tmp_path / "m.json")
+    assert accepted.returncode == 0, accepted.stderr
+    manifest = tmp_path / "units.csv"
+    manifest.write_text(f"path,serial\n{good},A\n{bare},B\n")
+    fleet = run("fleet", "fit", "--manifest", manifest, "-o", tmp_path / "FLEET", "--scheduler", "serial")
+    assert fleet.returncode == 0, fleet.stderr
+    with CalibrationStore(tmp_path / "FLEET") as db:
+        (b,) = db.history("B")
+        assert b.status == "failed" and "no temperature channel" in b.error and "data check" in b.error
+        assert db.history("A")[0].status == "ok"
