@@ -36,7 +36,7 @@ quick: $(STAMP)
 
 # the linter (ruff: pyflakes, pycodestyle, bugbear; pyproject.toml's [tool.ruff])
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks tools
+	$(BIN)/ruff check src tests benchmarks tools examples
 
 # the documentation site (MkDocs, Material, mkdocstrings) into site/, warnings as errors
 docs: $(STAMP)
