@@ -143,5 +143,5 @@ def test_check_fit_and_fleet_fit_run_the_check(clean_columns, tmp_path):
     assert fleet.returncode == 0, fleet.stderr
     with CalibrationStore(tmp_path / "FLEET") as db:
         (b,) = db.history("B")
-        assert b.status == "failed" and "no temperature channel" in b.error and "data check" in b.error
+        assert b.status == "failed" and "no temperature column" in b.error and "data check" in b.error
         assert db.history("A")[0].status == "ok"

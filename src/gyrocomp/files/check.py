@@ -57,12 +57,22 @@ SAID_ELSEWHERE = frozenset({"gaps", "time", "temperature-span"})
 
 
 def enforce(checks: Sequence[RunCheck]) -> None:
-    """Refuse the first refused run in one line (naming the check to accept); warn once for each finding of the
-    others (:class:`DataQualityWarning`, with its expected cost) that is not said elsewhere."""
+    """Refuse the first refused run in one line (naming the check to accept), then warn of the findings of the
+    others (:func:`refuse`, :func:`warn_findings`)."""
+    refuse(checks)
+    warn_findings(checks)
+
+
+def refuse(checks: Sequence[RunCheck]) -> None:
+    """Raise :class:`InputError` for the first refused run: its first refusal, and the check to accept."""
     for c in checks:
         if c.verdict == "refused":
             first = next(f for f in c.findings if f.severity == "refuse")
             raise InputError(f"{first.message}: refused by the data check (accept={first.check} fits it anyway)")
+
+
+def warn_findings(checks: Sequence[RunCheck]) -> None:
+    """Warn once for each finding (:class:`DataQualityWarning`, with its expected cost) not said elsewhere."""
     for c in checks:
         for f in c.findings:
             if f.check not in SAID_ELSEWHERE:
@@ -87,4 +97,5 @@ def rewarn(runs: Iterable[CheckedRun]) -> None:
             warnings.warn(note, stacklevel=2)
 
 
-__all__ = ["SAID_ELSEWHERE", "ask_for", "check_files", "enforce", "read_checked", "read_noting", "rewarn"]
+__all__ = ["SAID_ELSEWHERE", "ask_for", "check_files", "enforce", "read_checked", "read_noting", "refuse", "rewarn",
+           "warn_findings"]

@@ -41,7 +41,7 @@ from typing import Literal
 
 from .._version import __version__
 from ..errors import DataQualityWarning, GyrocompError, InputError
-from ..files.check import ask_for, enforce, read_checked, rewarn
+from ..files.check import ask_for, read_checked, refuse, rewarn, warn_findings
 from ..io import ReadOptions
 from ..measures.data_check import check_runs
 from ..io.atomic import atomic_path, folder_lock, write_text_atomic
@@ -159,7 +159,8 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
             if unread is not None:
                 raise InputError(unread.refusal or f"{unread.source}: unreadable")
             rewarn(runs)
-            enforce(check_runs(runs, ask_for(), settings.accept))
+            checks = check_runs(runs, ask_for(), settings.accept)
+            refuse(checks)
             recordings = [r.recording for r in runs]
             if settings.prior is not None:
                 calibration = fit_with_prior(recordings, settings.prior)
@@ -167,6 +168,7 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
                 calibration = fit(recordings, channels=settings.channels, pipeline=settings.pipeline)
             figures = unit_figures(calibration, recordings,
                                    reference_temperature_degc=settings.reference_temperature_degc)
+            warn_findings(checks)  # after the fit's own warnings, which say more of this unit's model
         except Exception as exc:  # noqa: BLE001 - one unit's failure, whatever it is, must not stop the fleet
             return UnitOutcome(unit.serial, "failed", digest, inputs, error=_error_text(exc))
     messages = tuple(dict.fromkeys(str(w.message) for w in caught))[:_MAX_WARNINGS]

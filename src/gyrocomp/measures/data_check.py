@@ -3,8 +3,9 @@
 Each check has a name, a documented threshold and a severity. A **refusal** is a run (or a set of runs) that
 cannot give a valid fit of what is asked: no temperature, time that goes back (two logs appended, a clock reset),
 no reversal where turning-point hysteresis is asked, and, when a temperature curve is asked by name (``poly:3``,
-``table``, ``mlp``), a constant temperature, too little span, or too few samples for the curve. Under the default
-automatic choice those three are warnings: the choice then fits no curve (a constant bias, and whatever else the
+``table``, ``mlp``), a constant temperature, too little span, or fewer samples or temperature levels than the
+curve has parameters (fewer than ten samples and two levels per parameter is a warning). Under the default
+automatic choice those are warnings: the choice then fits no curve (a constant bias, and whatever else the
 runs identify, such as g-sensitivity from positions at one temperature), which is a valid fit of what the data
 hold.
 A **warning** is what only degrades a fit, said with its expected cost: temperature quantized in coarse steps,
@@ -185,8 +186,9 @@ def temperature_findings(recording: Recording, ask: Ask) -> list[Finding]:
     src = recording.source
     t = _temperature(recording)
     if t is None:
-        return [Finding("temperature-missing", "refuse", f"{src}: no temperature channel (or no finite sample of "
-                        "it): a temperature curve cannot be fitted (temperature=none fits a bias alone)")]
+        return [Finding("temperature-missing", "refuse", f"{src}: no temperature column (or no finite sample in "
+                        "it): a temperature curve cannot be fitted (map one with columns={'temperature': 'NAME'}, "
+                        "or temperature=none fits a bias alone)")]
     if np.ptp(t) < CONSTANT_SPAN_DEGC:
         return [Finding("temperature-constant", _curve_severity(ask), f"{src}: the temperature is constant "
                         f"({t[0]:.4g} degC throughout): a stuck or absent sensor, or a run at one temperature",
@@ -344,12 +346,16 @@ def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Fi
         samples = sum(t.size for t in known)
         levels = len(np.unique(np.round(np.concatenate(known), 1)))
         if samples < SAMPLES_PER_PARAMETER * ask.parameters or levels < LEVELS_PER_PARAMETER * ask.parameters:
+            # fewer samples or levels than parameters: the curve asked is not determined at all
+            undetermined = ask.temperature == "asked" and min(samples, levels) < ask.parameters
+            cost = (_NO_CURVE if ask.temperature == "auto" else "" if undetermined
+                    else "the curve's parameters poorly determined: its error between the levels is not known")
             for i in range(len(recordings)):
                 out.setdefault(i, []).append(Finding(
-                    "too-short", _curve_severity(ask), f"{recordings[i].source}: {samples} sample(s) at {levels} "
-                    f"temperature level(s) for a curve of {ask.parameters} parameters (at least "
-                    f"{SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
-                    _NO_CURVE if ask.temperature == "auto" else ""))
+                    "too-short", "refuse" if undetermined else "warn", f"{recordings[i].source}: {samples} "
+                    f"sample(s) at {levels} temperature level(s) for a curve of {ask.parameters} parameters (at "
+                    f"least {SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
+                    cost))
     present = [t for t in temps if t is not None and np.ptp(t) >= CONSTANT_SPAN_DEGC]
     if ask.temperature != "none" and present:
         span = float(max(t.max() for t in present) - min(t.min() for t in present))
