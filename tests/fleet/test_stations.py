@@ -19,6 +19,7 @@ import sqlalchemy as sa
 
 from gyrocomp.errors import InputError
 from gyrocomp.fleet import CalibrationRecord, CalibrationStore, InputFile, model_file_name
+from gyrocomp.fleet import stations
 from gyrocomp.fleet.stations import CLAIM_LEASE_S, Station, claim, claims, release, station_status
 from gyrocomp.fleet.store import STORE_SCHEMA_VERSION
 from gyrocomp.io.tables import write_recording
@@ -231,3 +232,17 @@ def test_a_station_killed_at_random_moments_leaves_a_consistent_store_its_rerun_
             assert claims(db) == []
             assert all(sum(r.status == "ok" for r in db.history(s)) >= 1 for s in serials)
             assert all((out / "models" / model_file_name(s)).exists() for s in serials)
+
+
+def test_a_running_station_renews_its_claims_and_releases_them_at_the_end(store_location, monkeypatch):
+    monkeypatch.setattr(stations, "CLAIM_RENEW_S", 0.2)
+    with CalibrationStore(store_location, create=True) as db:
+        me = Station.here("beat")
+        with stations.station(db, me):
+            claim(db, "U1", me)
+            first = claims(db)[0].heartbeat_utc
+            deadline = time.monotonic() + 10
+            while claims(db)[0].heartbeat_utc == first and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert claims(db)[0].heartbeat_utc > first
+        assert claims(db) == []

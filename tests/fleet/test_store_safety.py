@@ -115,16 +115,18 @@ def test_outputs_onto_the_store_are_refused_and_the_store_is_intact(manifest, tm
     assert store.read_bytes() == before
 
 
-def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_path):
+def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_path, store_location):
+    """Two fits creating one new store at once (a fleet folder's SQLite file, or an empty PostgreSQL database)."""
     out = tmp_path / "FLEET"
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
-    args = ["fleet", "fit", "--manifest", str(manifest), "-o", str(out), "--scheduler", "serial"]
+    args = ["fleet", "fit", "--manifest", str(manifest), "-o", str(out), "--scheduler", "serial", "--store",
+            store_location if "://" in store_location else str(out)]
     procs = [subprocess.Popen([*cmd, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for _ in range(2)]
     results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
     for _stdout, stderr, code in results:
         assert code == 0, stderr
-    with CalibrationStore(out) as db:
+    with CalibrationStore(store_location if "://" in store_location else out) as db:
         assert sorted(db.serials()) == sorted(SERIALS)
         assert all(len(db.history(s)) == 1 for s in SERIALS)
 

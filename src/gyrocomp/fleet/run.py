@@ -340,10 +340,11 @@ def _check_units(units: list[UnitRuns]) -> None:
         raise InputError(f"units: serial {repeated[0]!r} is given twice; give each unit once with all its runs")
 
 
-#: units in flight per worker thread of a Dask cluster (each claimed just before it is submitted): one, so that a
-#: unit is never waiting on a worker beside another that outgrows the worker's memory (Dask counts every task of
-#: a killed worker against its retries), and a claim is taken only when a thread is free for it
-IN_FLIGHT_PER_THREAD = 1
+#: units in flight per worker thread of a Dask cluster (each claimed just before it is submitted): enough to hide
+#: the round trip to the workers; the local cluster's scheduler hands a worker one at a time (its
+#: ``worker-saturation`` 1.0), the rest wait in its queue, so that a unit never waits on a worker beside another
+#: that outgrows the worker's memory (Dask counts every task of a killed worker against its retries)
+IN_FLIGHT_PER_THREAD = 4
 
 
 def _outcomes(claimed: Iterator[_Claimed], settings: FleetSettings, scheduler: str, workers: int | None,
@@ -472,7 +473,8 @@ def _client(distributed, scheduler: str, workers: int | None, memory_limit: str 
         config = require("dask.config", "fleet", "fitting a fleet on Dask")
         # Dask's statistical profiler samples every task's stack every 10 ms: 10 % of a fleet's time on 2 cores
         with _quiet_dask():
-            with warnings.catch_warnings(), config.set({"distributed.worker.profile.enabled": False}), \
+            with warnings.catch_warnings(), config.set({"distributed.worker.profile.enabled": False,
+                                                  "distributed.scheduler.worker-saturation": 1.0}), \
                     _workers_deaf_to_the_terminal():
                 warnings.simplefilter("ignore")  # Dask's notes on ports and the dashboard are not the user's concern
                 try:

@@ -42,7 +42,8 @@ from .limits import Failure
 sa = require("sqlalchemy", "fleet", "the calibration store")
 
 STORE_FILE = "calibrations.sqlite"
-#: 2: the station that wrote a row, the row a successful row supersedes (unique per serial), station claims
+#: 2: the station that wrote a row, the row a successful row supersedes (unique per serial), station claims, serials
+#: of any length
 STORE_SCHEMA_VERSION = 2
 _SQLITE_SUFFIXES = (".sqlite", ".sqlite3", ".db")
 
@@ -52,7 +53,7 @@ _INFO = sa.Table("gyrocomp_store", _META, sa.Column("key", sa.String(64), primar
 _ROWS = sa.Table(
     "calibrations", _META,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
-    sa.Column("serial", sa.String(200), nullable=False, index=True),
+    sa.Column("serial", sa.Text, nullable=False, index=True),  # any length: PostgreSQL enforces a VARCHAR's
     sa.Column("calibrated_utc", sa.DateTime, nullable=False, index=True),
     sa.Column("status", sa.String(16), nullable=False),
     sa.Column("verdict", sa.String(8)),
@@ -65,7 +66,7 @@ _ROWS = sa.Table(
     sa.Column("figures", sa.Text),
     sa.Column("error", sa.Text),
     sa.Column("warnings", sa.Text, nullable=False),
-    sa.Column("station", sa.String(200)),
+    sa.Column("station", sa.Text),
     sa.Column("supersedes", sa.Integer),
 )
 #: one successor per successful row of a unit: two writers that read the same history cannot both append
@@ -75,9 +76,9 @@ _READ = [c for c in _ROWS.c if c.name not in ("station", "supersedes")]
 #: which station fits which unit now (:mod:`gyrocomp.fleet.stations`)
 CLAIMS = sa.Table(
     "claims", _META,
-    sa.Column("serial", sa.String(200), primary_key=True),
-    sa.Column("station", sa.String(200), nullable=False),
-    sa.Column("host", sa.String(255), nullable=False),
+    sa.Column("serial", sa.Text, primary_key=True),
+    sa.Column("station", sa.Text, nullable=False),
+    sa.Column("host", sa.Text, nullable=False),
     sa.Column("pid", sa.Integer, nullable=False),
     sa.Column("claimed_utc", sa.DateTime, nullable=False),
     sa.Column("heartbeat_utc", sa.DateTime, nullable=False),
@@ -253,6 +254,8 @@ class CalibrationStore:
             for column in (_ROWS.c.station, _ROWS.c.supersedes):
                 conn.execute(sa.text(f"ALTER TABLE {_ROWS.name} ADD COLUMN {column.name} "
                                      f"{column.type.compile(conn.dialect)}"))
+            if conn.dialect.name == "postgresql":  # schema 1 made the serial a VARCHAR(200), which PostgreSQL enforces
+                conn.execute(sa.text(f"ALTER TABLE {_ROWS.name} ALTER COLUMN serial TYPE TEXT"))
             _CHAIN.create(conn)
             CLAIMS.create(conn, checkfirst=True)
             conn.execute(_INFO.update().where(_INFO.c.key == "schema_version")
