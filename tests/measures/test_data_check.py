@@ -145,3 +145,13 @@ def test_check_fit_and_fleet_fit_run_the_check(clean_columns, tmp_path):
         (b,) = db.history("B")
         assert b.status == "failed" and "no temperature column" in b.error and "data check" in b.error
         assert db.history("A")[0].status == "ok"
+
+
+def test_a_run_at_one_temperature_is_fine_beside_runs_that_span_enough(clean_columns, tmp_path):
+    still, full = tmp_path / "still.parquet", tmp_path / "full.parquet"
+    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-constant", np.random.default_rng(0))).to_parquet(still)
+    pd.DataFrame(clean_columns["adxrs450"]).to_parquet(full)
+    asked = ask_for(FitOptions(temperature=Polynomial(3)))
+    assert [c.verdict for c in check_runs([read_checked(still), read_checked(full)], asked)] == ["ok", "ok"]
+    (alone,) = check_runs([read_checked(still)], asked)
+    assert alone.verdict == "refused" and alone.reasons[0] == "temperature-constant"

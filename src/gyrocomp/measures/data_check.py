@@ -180,7 +180,8 @@ def _slope_dps_per_degc(recording: Recording, t: np.ndarray) -> float:
 
 
 def temperature_findings(recording: Recording, ask: Ask) -> list[Finding]:
-    """Missing, constant and quantized temperature of one run (span is judged over the set of runs)."""
+    """Missing and quantized temperature of one run (a constant one and the span are judged over the set of
+    runs: a run at one temperature beside runs that span enough is fine)."""
     if ask.temperature == "none":
         return []
     src = recording.source
@@ -189,11 +190,7 @@ def temperature_findings(recording: Recording, ask: Ask) -> list[Finding]:
         return [Finding("temperature-missing", "refuse", f"{src}: no temperature column (or no finite sample in "
                         "it): a temperature curve cannot be fitted (map one with columns={'temperature': 'NAME'}, "
                         "or temperature=none fits a bias alone)")]
-    if np.ptp(t) < CONSTANT_SPAN_DEGC:
-        return [Finding("temperature-constant", _curve_severity(ask), f"{src}: the temperature is constant "
-                        f"({t[0]:.4g} degC throughout): a stuck or absent sensor, or a run at one temperature",
-                        _NO_CURVE if ask.temperature == "auto" else "")]
-    q = _quantization_step(t)
+    q = _quantization_step(t) if np.ptp(t) >= CONSTANT_SPAN_DEGC else 0.0
     if q >= QUANTIZED_STEP_DEGC:
         slope = _slope_dps_per_degc(recording, t)
         return [Finding("temperature-quantized", "warn", f"{src}: the temperature is read in steps of {q:.3g} degC",
@@ -337,8 +334,8 @@ def unreadable(source: str, message: str) -> RunCheck:
 
 # -- the checks of a set of runs ----------------------------------------------------------------------------------
 def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Finding]]:
-    """What only the runs together say, by run: too little span, too short for the curve, no reversal where
-    hysteresis is asked (each said on every run it concerns)."""
+    """What only the runs together say, by run: a constant temperature in every run, too little span, too short
+    for the curve, no reversal where hysteresis is asked (each said on every run it concerns)."""
     out: dict[int, list[Finding]] = {}
     temps = [_temperature(r) for r in recordings]
     known = [t for t in temps if t is not None]
@@ -357,6 +354,13 @@ def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Fi
                     f"least {SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
                     cost))
     present = [t for t in temps if t is not None and np.ptp(t) >= CONSTANT_SPAN_DEGC]
+    if ask.temperature != "none" and known and not present:  # every run at one temperature
+        for i, t in enumerate(temps):
+            if t is not None:
+                out.setdefault(i, []).append(Finding(
+                    "temperature-constant", _curve_severity(ask), f"{recordings[i].source}: the temperature is "
+                    f"constant ({t[0]:.4g} degC throughout), as in every run given: a stuck or absent sensor, or "
+                    "runs at one temperature", _NO_CURVE if ask.temperature == "auto" else ""))
     if ask.temperature != "none" and present:
         span = float(max(t.max() for t in present) - min(t.min() for t in present))
         if span < MIN_SPAN_DEGC:
