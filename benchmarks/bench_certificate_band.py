@@ -19,7 +19,8 @@ import warnings
 import numpy as np
 
 from gyrocomp import apply, fit
-from gyrocomp.evaluation.held_out import held_out_residuals, smoothed_about_mean
+from gyrocomp.evaluation.held_out import held_out_residuals
+from gyrocomp.measures.merit import smoothed_about_mean
 from gyrocomp.simulation import PRESETS, simulate
 
 

@@ -24,6 +24,7 @@ from pathlib import Path
 
 #: a Letter page's printable height at Chromium's default margins (0.4 in top and bottom) [CSS px]
 PRINTABLE_HEIGHT_PX, PRINTABLE_WIDTH_PX = (11.0 - 0.8) * 96, (8.5 - 0.8) * 96
+#: the flags the machines here need for a headless Chromium without network (see the env notes)
 FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync")
 #: each figure's natural and drawn size: an image that did not decode has a natural width of 0

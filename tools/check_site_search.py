@@ -8,17 +8,15 @@ finds nothing, 2 when Chromium is missing (``apt-get install chromium``).
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+from browser import FLAGS, chromium as find_chromium  # tools/browser.py, beside this script
+
 #: words every build of the site must find (pages on the fit, the noise, the errors)
 WORDS = ("allan", "hysteresis", "symbolic")
-#: the flags the machines here need for a headless Chromium without network (see the env notes)
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync")
 
 
 def results(site: Path, word: str, chromium: str) -> int:
@@ -35,7 +33,7 @@ def results(site: Path, word: str, chromium: str) -> int:
 
 def main() -> int:
     site = Path(sys.argv[1] if len(sys.argv) > 1 else "site")
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    chromium = find_chromium()
     if chromium is None:
         print("check_site_search: no chromium (apt-get install chromium)", file=sys.stderr)
         return 2

@@ -22,21 +22,19 @@ conformal prediction); the fold scheme of :mod:`gyrocomp.fitting.folds`.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..calibration.compensate import apply
 from ..effects import moving_average
-from ..errors import DataQualityWarning, ModelChoiceWarning, TemperatureRangeWarning
-from ..fitting.folds import drift_window_s
+from ..measures.merit import smoothed_about_mean
 from ..models.options import FitOptions
 from ..recording import Recording
 from ..runs.prepared import prepare
 from ..threads import single_threaded_blas
 from .comparison import Method, fit_method
-from .validation import make_sample_folds, training_runs
+from .validation import fold_window_s, make_sample_folds, quiet_fold_fit, training_runs
 
 #: the coverage the band is made for
 BAND_LEVEL = 0.95
@@ -45,8 +43,8 @@ BAND_LEVEL = 0.95
 @dataclass(frozen=True)
 class AxisResidual:
     """One axis's held-out residual: the samples' temperature [degC] (moving-averaged as the residual is) and
-    residual [deg/s] over every fold, its
-    RMS [deg/s] and the band [deg/s] (|r| below it with probability BAND_LEVEL)."""
+    residual [deg/s] over every fold (:func:`gyrocomp.measures.merit.smoothed_about_mean`), its RMS [deg/s] and
+    the band [deg/s] (|r| below it with probability BAND_LEVEL)."""
 
     temperature_degc: np.ndarray
     residual_dps: np.ndarray
@@ -64,12 +62,6 @@ class HeldOut:
     window_s: float
 
 
-def smoothed_about_mean(x: np.ndarray, window_samples: int) -> np.ndarray:
-    """MA_w[x] - mean(MA_w[x]) [unit of x] (the module's r)."""
-    smooth = moving_average(np.asarray(x, dtype=float), window_samples)
-    return smooth - smooth.mean()
-
-
 @single_threaded_blas
 def held_out_residuals(recordings: list[Recording], method: Method | None = None) -> HeldOut:
     """The held-out residual and its band of the fit ``method`` (default: gyrocomp's default fit) on
@@ -77,16 +69,13 @@ def held_out_residuals(recordings: list[Recording], method: Method | None = None
     method = method or FitOptions()
     recordings = prepare(recordings)
     kind, folds = make_sample_folds(recordings, "auto")
-    lengths = [fold.rows.size / recordings[fold.run].rate_hz for fold in folds]
-    window_s = drift_window_s(lengths, max(1.0 / rec.rate_hz for rec in recordings))
+    window_s = fold_window_s(recordings, folds)
     axes = recordings[0].gyro_axes
     temps: dict[str, list[np.ndarray]] = {a: [] for a in axes}
     residuals: dict[str, list[np.ndarray]] = {a: [] for a in axes}
     for fold in folds:
         held = recordings[fold.run]
-        with warnings.catch_warnings():
-            for category in (TemperatureRangeWarning, DataQualityWarning, ModelChoiceWarning):
-                warnings.simplefilter("ignore", category)
+        with quiet_fold_fit():
             comp = apply(fit_method(method, training_runs(recordings, fold, kind)), held).gyro_dps
         w = max(1, int(round(window_s * held.rate_hz)))
         for j, axis in enumerate(axes):
@@ -100,4 +89,4 @@ def held_out_residuals(recordings: list[Recording], method: Method | None = None
     return HeldOut(out, kind, len(folds), window_s)
 
 
-__all__ = ["BAND_LEVEL", "AxisResidual", "HeldOut", "held_out_residuals", "smoothed_about_mean"]
+__all__ = ["BAND_LEVEL", "AxisResidual", "HeldOut", "held_out_residuals"]

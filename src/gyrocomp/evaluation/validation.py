@@ -16,8 +16,10 @@ plus any candidates named.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -194,6 +196,23 @@ def training_runs(recordings: list[Recording], fold: Fold, kind: str) -> list[Re
     return out
 
 
+def fold_window_s(recordings: list[Recording], folds: list[Fold]) -> float:
+    """The drift window of held-out folds [s], as the model choice takes it
+    (:func:`gyrocomp.fitting.folds.drift_window_s` of the folds' lengths)."""
+    lengths = [fold.rows.size / recordings[fold.run].rate_hz for fold in folds]
+    return drift_window_s(lengths, max(1.0 / rec.rate_hz for rec in recordings))
+
+
+@contextlib.contextmanager
+def quiet_fold_fit() -> Iterator[None]:
+    """The warnings of a fold's fit kept quiet (a range, data-quality or model-choice warning of a fit on part of
+    the runs says nothing the user can act on)."""
+    with warnings.catch_warnings():
+        for category in (TemperatureRangeWarning, DataQualityWarning, ModelChoiceWarning):
+            warnings.simplefilter("ignore", category)
+        yield
+
+
 def _fit(method: Method | None, train: list[Recording]) -> Calibration | None:
     return None if method is None else fit_method(method, train)
 
@@ -225,8 +244,7 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
     require_temperature_span(recordings, "validate")
     kind, fold_list = make_sample_folds(recordings, folds)
     if window_s is None:
-        lengths = [fold.rows.size / recordings[fold.run].rate_hz for fold in fold_list]
-        window_s = drift_window_s(lengths, max(1.0 / rec.rate_hz for rec in recordings))  # as the model choice
+        window_s = fold_window_s(recordings, fold_list)
     if not window_s > 0:
         raise InputError(f"window_s: must be positive, got {window_s}")
     methods = {**BASELINES, **(candidates or {})}
@@ -237,9 +255,7 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
         held = recordings[fold.run]
         w = max(1, int(round(window_s * held.rate_hz)))
         for name, method in methods.items():
-            with warnings.catch_warnings():
-                for category in (TemperatureRangeWarning, DataQualityWarning, ModelChoiceWarning):
-                    warnings.simplefilter("ignore", category)
+            with quiet_fold_fit():
                 cal = _fit(method, train)
                 comp = held.gyro_dps if cal is None else apply(cal, held).gyro_dps
             for j, axis in enumerate(axes):
@@ -248,5 +264,6 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
     return ValidationResult(kind, tuple(f.name for f in fold_list), window_s, tuple(methods), tuple(axes), scores)
 
 
-__all__ = ["BASELINES", "Fold", "MethodScore", "ValidationResult", "fit_plain_cubic", "make_sample_folds", "training_runs",
+__all__ = ["BASELINES", "Fold", "MethodScore", "ValidationResult", "fit_plain_cubic", "fold_window_s", "make_sample_folds",
+           "quiet_fold_fit", "training_runs",
            "validate"]

@@ -29,17 +29,23 @@ def ask_for(options: FitOptions | None = None) -> Ask:
         size = spec.order if isinstance(spec, Polynomial) else spec.size
         parameters = 2 if size == "auto" else int(size) + 1
     automatic = isinstance(spec, Polynomial) and spec.order == "auto"
-    return Ask(temperature="auto" if automatic else "asked", hysteresis=options.hysteresis.startswith("turning-point"), parameters=parameters)
+    return Ask(temperature="auto" if automatic else "asked",
+               hysteresis=options.hysteresis.startswith("turning-point"), parameters=parameters)
 
 
 def read_checked(path: str | os.PathLike, options: ReadOptions | None = None, fmt: str | None = None) -> CheckedRun:
     """Read one run for the check: its recording and the reader's warnings, or the reader's refusal."""
+    try:
+        return _noted(lambda p: read_input(p, options or ReadOptions(), fmt=fmt), path)
+    except InputError as exc:
+        return CheckedRun(os.fspath(path), None, refusal=str(exc))
+
+
+def _noted(read, path: str | os.PathLike) -> CheckedRun:
+    """``read(path)``'s recording with the warnings the reader gave, kept (not shown)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        try:
-            recording = read_input(path, options or ReadOptions(), fmt=fmt).recording
-        except InputError as exc:
-            return CheckedRun(os.fspath(path), None, refusal=str(exc))
+        recording = read(path).recording
     return CheckedRun(os.fspath(path), recording, tuple(w.message for w in caught))
 
 
@@ -52,7 +58,7 @@ def check_files(paths: Sequence[str | os.PathLike], options: ReadOptions | None 
 
 
 #: the checks whose warnings another part already gives (the reader: gaps and time order; the plausibility checks
-#: of a fit: too little span): :func:`enforce` does not say them twice
+#: of a fit: too little span): :func:`warn_findings` does not say them twice
 SAID_ELSEWHERE = frozenset({"gaps", "time", "temperature-span"})
 
 
@@ -82,10 +88,7 @@ def warn_findings(checks: Sequence[RunCheck]) -> None:
 def read_noting(read, path: str | os.PathLike) -> CheckedRun:
     """``read(path)`` (a :class:`gyrocomp.io.InputData`'s maker) kept for the check with what the reader said,
     which is said again as it was."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        recording = read(path).recording
-    run = CheckedRun(os.fspath(path), recording, tuple(w.message for w in caught))
+    run = _noted(read, path)
     rewarn([run])
     return run
 

@@ -304,8 +304,7 @@ def _store_with_model(db: CalibrationStore, record: CalibrationRecord, since, ou
     except _NotStored:
         return None
     except OSError as exc:
-        raise InputError(f"{path}: cannot write unit {record.serial!r}'s model ({exc.strerror or exc}); nothing was "
-                         "stored for it, the next run fits it again") from None
+        raise _model_write_error(path, record.serial, exc) from None
     return row
 
 
@@ -549,8 +548,13 @@ def _write_model(output: Path, serial: str, model_json: str) -> None:
         folder.mkdir(exist_ok=True)
         write_text_atomic(folder / model_file_name(serial), model_json)
     except OSError as exc:
-        raise InputError(f"{folder / model_file_name(serial)}: cannot write unit {serial!r}'s model "
-                         f"({exc.strerror or exc}); nothing was stored for it, the next run fits it again") from None
+        raise _model_write_error(folder / model_file_name(serial), serial, exc) from None
+
+
+def _model_write_error(path: Path, serial: str, exc: OSError) -> InputError:
+    """The one line for a unit's model file that could not be written (nothing is stored for the unit)."""
+    return InputError(f"{path}: cannot write unit {serial!r}'s model ({exc.strerror or exc}); nothing was stored "
+                      "for it, the next run fits it again")
 
 
 def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
+from ..io.atomic import process_alive
 from .store import CLAIMS, CalibrationStore, sa, utc_now
 
 #: a claim whose heartbeat is older than this is another machine's dead station's, and may be taken over [s]
@@ -64,12 +65,8 @@ class Claim:
 
 def _running(pid: int) -> bool:
     """Whether process ``pid`` runs on this machine (a zombie, killed and not yet reaped, does not)."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+    if not process_alive(pid):
         return False
-    except OSError:
-        return True
     try:
         state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
     except (OSError, IndexError):

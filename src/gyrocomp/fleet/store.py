@@ -71,6 +71,8 @@ _ROWS = sa.Table(
 )
 #: one successor per successful row of a unit: two writers that read the same history cannot both append
 _CHAIN = sa.Index("uq_calibrations_chain", _ROWS.c.serial, _ROWS.c.supersedes, unique=True)
+#: the store's schema version, as its info table holds it
+_VERSION = sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")
 #: the columns a row is read back from (a schema 1 store has neither the station nor the chain)
 _READ = [c for c in _ROWS.c if c.name not in ("station", "supersedes")]
 #: which station fits which unit now (:mod:`gyrocomp.fleet.stations`)
@@ -239,7 +241,7 @@ class CalibrationStore:
 
     def _version(self) -> str | None:
         with self.engine.connect() as conn:
-            return conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
+            return conn.execute(_VERSION).scalar()
 
     @staticmethod
     def _create_or_upgrade(conn) -> None:
@@ -249,8 +251,7 @@ class CalibrationStore:
             _META.create_all(conn, checkfirst=True)
             conn.execute(_INFO.insert().values(key="schema_version", value=str(STORE_SCHEMA_VERSION)))
             return
-        version = conn.execute(sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")).scalar()
-        if version == "1":
+        if conn.execute(_VERSION).scalar() == "1":
             for column in (_ROWS.c.station, _ROWS.c.supersedes):
                 conn.execute(sa.text(f"ALTER TABLE {_ROWS.name} ADD COLUMN {column.name} "
                                      f"{column.type.compile(conn.dialect)}"))
@@ -275,18 +276,13 @@ class CalibrationStore:
     def _writing(self, schema: bool = False):
         """A write transaction (SQLite: ``BEGIN IMMEDIATE``, writers take turns; PostgreSQL: concurrent, at
         repeatable read, kept apart by the unique chain, and, for ``schema`` changes, a transaction-wide advisory
-        lock); a full disk or a
-        read-only store is one line naming the store. Conflicts that a retry resolves propagate as
-        :class:`_Retry`."""
+        lock); a full disk or a read-only store is one line naming the store. Conflicts that a retry resolves
+        propagate as :class:`_Retry`."""
         try:
-            with self.engine.connect() as conn:
-                conn.info["immediate"] = True
-                if conn.dialect.name == "postgresql" and not schema:  # every statement of it sees one snapshot
-                    conn.execution_options(isolation_level="REPEATABLE READ")
-                with conn.begin():
-                    if schema and conn.dialect.name == "postgresql":
-                        conn.execute(sa.text("SELECT pg_advisory_xact_lock(:key)"), {"key": _SCHEMA_LOCK_KEY})
-                    yield conn
+            with self.transaction(snapshot=not schema) as conn:
+                if schema and conn.dialect.name == "postgresql":
+                    conn.execute(sa.text("SELECT pg_advisory_xact_lock(:key)"), {"key": _SCHEMA_LOCK_KEY})
+                yield conn
         except sa.exc.IntegrityError as exc:
             raise _Retry(str(exc.orig)) from None
         except sa.exc.OperationalError as exc:
@@ -296,11 +292,14 @@ class CalibrationStore:
                              "full or the store read-only?") from None
 
     @contextlib.contextmanager
-    def transaction(self):
-        """A connection in a write transaction (on SQLite holding the write lock from its start); errors as the
-        database raises them."""
+    def transaction(self, snapshot: bool = False):
+        """A connection in a write transaction (on SQLite holding the write lock from its start); ``snapshot``: on
+        PostgreSQL at repeatable read, every statement of it seeing one snapshot. Errors as the database raises
+        them."""
         with self.engine.connect() as conn:
             conn.info["immediate"] = True
+            if snapshot and conn.dialect.name == "postgresql":
+                conn.execution_options(isolation_level="REPEATABLE READ")
             with conn.begin():
                 yield conn
 
@@ -338,8 +337,7 @@ class CalibrationStore:
                         & (_ROWS.c.input_hash == record.input_hash) & (_ROWS.c.calibrated_utc >= since))
                         .limit(1)).scalar() is not None:
                     return None
-                previous = conn.execute(sa.select(sa.func.max(_ROWS.c.id)).where(
-                    (_ROWS.c.serial == record.serial) & (_ROWS.c.status == "ok"))).scalar() or 0
+                previous = conn.execute(_newest_ok(record.serial)).scalar() or 0
             row = _to_row(record if not stamp else _replace(record, calibrated_utc=utc_now()))
             result = conn.execute(_ROWS.insert().values(**row, supersedes=previous))
             return int(result.inserted_primary_key[0])
@@ -347,8 +345,7 @@ class CalibrationStore:
     def newest_ok_id(self, serial: str) -> int | None:
         """The id of the newest successful row of ``serial`` (None when it has none)."""
         with self.engine.connect() as conn:
-            return conn.execute(sa.select(sa.func.max(_ROWS.c.id)).where(
-                (_ROWS.c.serial == serial) & (_ROWS.c.status == "ok"))).scalar()
+            return conn.execute(_newest_ok(serial)).scalar()
 
     # -- reading -------------------------------------------------------------------------------------------
     def _records(self, query) -> list[CalibrationRecord]:
@@ -422,11 +419,9 @@ class CalibrationStore:
 
     def ok_hash(self, serial: str) -> str | None:
         """The input hash of ``serial``'s newest successful calibration (None when it has none)."""
-        newest = self.newest_ok_id(serial)
-        if newest is None:
-            return None
         with self.engine.connect() as conn:
-            return conn.execute(sa.select(_ROWS.c.input_hash).where(_ROWS.c.id == newest)).scalar()
+            return conn.execute(sa.select(_ROWS.c.input_hash)
+                                .where(_ROWS.c.id == _newest_ok(serial).scalar_subquery())).scalar()
 
     def station_counts(self) -> list[tuple[str | None, str, int, _dt.datetime | None]]:
         """(station, status, rows, newest time) for each station and status (station None: rows that name none)."""
@@ -438,6 +433,11 @@ class CalibrationStore:
     def serials(self) -> list[str]:
         with self.engine.connect() as conn:
             return list(conn.execute(sa.select(_ROWS.c.serial).distinct().order_by(_ROWS.c.serial)).scalars())
+
+
+def _newest_ok(serial: str):
+    """The query of the id of ``serial``'s newest successful row (NULL when it has none)."""
+    return sa.select(sa.func.max(_ROWS.c.id)).where((_ROWS.c.serial == serial) & (_ROWS.c.status == "ok"))
 
 
 def _to_row(record: CalibrationRecord) -> dict:

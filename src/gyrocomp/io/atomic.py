@@ -74,12 +74,13 @@ def _remove_stale(folder: Path, tag: str) -> None:
     whose process is gone. A process still running keeps its own."""
     for stale in folder.glob(f"{TEMP_PREFIX}*-{glob_escape(tag)}.*.tmp"):
         pid = stale.name[len(TEMP_PREFIX):].split("-", 1)[0]
-        if pid.isdigit() and not _alive(int(pid)):
+        if pid.isdigit() and not process_alive(int(pid)):
             with contextlib.suppress(OSError):
                 stale.unlink()
 
 
-def _alive(pid: int) -> bool:
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this machine (another user's counts as alive)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:

@@ -428,11 +428,6 @@ def _split(found: Iterable[Finding], source: str, accept: frozenset[str]) -> Run
                     tuple(f for f in found if f.check in accept))
 
 
-def refusals(checks: Sequence[RunCheck]) -> list[RunCheck]:
-    """The runs refused."""
-    return [c for c in checks if c.verdict == "refused"]
-
-
-__all__ = ["Ask", "DATA_CHECKS", "CheckedRun", "Finding", "RunCheck", "check_runs", "refusals", "set_findings",
+__all__ = ["Ask", "DATA_CHECKS", "CheckedRun", "Finding", "RunCheck", "check_runs", "set_findings",
            "unreadable"]
 

@@ -203,10 +203,15 @@ def window_samples(window_s: float, rate_hz: float, n_samples: int) -> int:
     return w
 
 
+def smoothed_about_mean(x: np.ndarray, window_samples: int) -> np.ndarray:
+    """The moving-averaged series about its mean, MA_w[x] - mean(MA_w[x]) [unit of x]."""
+    smooth = moving_average(np.asarray(x, dtype=float), window_samples)
+    return smooth - smooth.mean()
+
+
 def smoothed_residual_rms(x: np.ndarray, window_samples: int) -> float:
-    """RMS about its mean of the moving-averaged series [unit of x]."""
-    smooth = moving_average(x, window_samples)
-    return float(np.sqrt(np.mean((smooth - smooth.mean()) ** 2)))
+    """RMS about its mean of the moving-averaged series [unit of x] (of :func:`smoothed_about_mean`)."""
+    return float(np.sqrt(np.mean(smoothed_about_mean(x, window_samples) ** 2)))
 
 
 @dataclass(frozen=True)
