@@ -78,6 +78,31 @@ def _weighted_fit(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarr
     return resid, float(np.sum(w * resid ** 2))
 
 
+class _ProjectedFit:
+    """The weighted residual sum of squares of ``y`` fitted on ``[x, extra]`` for many ``extra`` columns beside one
+    fixed ``x``: ``x`` is projected out once (its left singular vectors of non-negligible singular value, the rank
+    rule of ``np.linalg.lstsq``), so each :meth:`rss` fits only the extra columns' residuals (Frisch-Waugh-Lovell:
+    the same minimum as the fit on all the columns)."""
+
+    def __init__(self, x: np.ndarray, y: np.ndarray, w: np.ndarray):
+        self.sw = np.sqrt(w)
+        u, s, _ = np.linalg.svd(x * self.sw[:, None], full_matrices=False)
+        self.basis = u[:, s > s.max() * max(x.shape) * np.finfo(float).eps] if s.size else u[:, :0]
+        self.y = self._residual(y * self.sw)
+
+    def _residual(self, z: np.ndarray) -> np.ndarray:
+        return z - self.basis @ (self.basis.T @ z)
+
+    def rss(self, extra: np.ndarray) -> float:
+        """The weighted residual sum of squares with the columns ``extra`` (n, m) added."""
+        e = self._residual(extra * self.sw[:, None])
+        gram = e.T @ e
+        scale = np.sqrt(np.maximum(np.diag(gram), 1e-300))
+        coef, *_ = np.linalg.lstsq(gram / np.outer(scale, scale), (e.T @ self.y) / scale, rcond=1e-10)
+        resid = self.y - e @ (coef / scale)
+        return float(resid @ resid)
+
+
 def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], t_ref_degc: float,
                   t_scale_degc: float, order: int, block_s: float | None = None) -> tuple[float, float] | None:
     """The band where the branches after a reversal part [degC] (:func:`parting_band_degc`), in the residual of
@@ -134,11 +159,12 @@ def _refined_edges(band, step, temps, x, y, w, thresholds, t_scale_degc) -> tupl
     after = ~np.isnan(turn_degc)
     direction = np.concatenate([tr.direction for tr in turns])
     d = np.where(after, np.abs(t - np.where(after, turn_degc, 0.0)), 0.0) / t_scale_degc
+    projected = _ProjectedFit(x, y, w)
+    powers = [np.where(direction == sign, d ** j, 0.0) for sign in (-1, 1) for j in (1, 2)]
 
     def rss(lo, hi):
         inside = after & (t >= lo) & (t <= hi)
-        cols = [np.where(inside & (direction == sign), d ** j, 0.0) for sign in (-1, 1) for j in (1, 2)]
-        return _weighted_fit(np.hstack([x, np.column_stack(cols)]), y, w)[1]
+        return projected.rss(np.column_stack([np.where(inside, p, 0.0) for p in powers]))
 
     offsets = np.linspace(-step, step, 9)
     lo = min(band[0] + offsets, key=lambda v: rss(v, band[1]))
