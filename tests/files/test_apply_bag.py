@@ -45,15 +45,29 @@ def _digest(path: Path) -> str:
     return hashlib.sha256(b"".join(f.read_bytes() for f in files if f.is_file())).hexdigest()
 
 
+@pytest.fixture(scope="module")
+def model_with_accel():
+    """A gyro and accelerometer model (the consumer part's accelerometer tempco): apply changes both."""
+    from gyrocomp.models.fit import fit_channels
+
+    profile = get_profile("cycle", set_points_degc=(15.0, 45.0), cycles=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit_channels([simulate("consumer", profile=profile, rate_hz=1.0, seed=s).recording for s in (1, 2)],
+                            ("accel", "gyro"))
+
+
 @pytest.mark.parametrize("kind", list(KINDS))
-def test_a_bag_out_is_the_bag_in_with_its_imu_topic_compensated(kind, model, tmp_path):
+@pytest.mark.parametrize("chunk_rows", [None, 7])
+def test_a_bag_out_is_the_bag_in_with_its_imu_topic_compensated(kind, chunk_rows, model, tmp_path):
+    """In one batch and in batches of 7 messages (the compensator's state carried from one to the next)."""
     options, name, out_name = KINDS[kind]
     source, output = tmp_path / name, tmp_path / out_name
     write_bag(source, n=300, **options)
     before = _digest(source)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        done = apply_bag(model, source, output)
+        done = apply_bag(model, source, output, **({"chunk_rows": chunk_rows} if chunk_rows else {}))
         expected = apply(model, read(source)).gyro_dps
         back = read(output)
     assert (done.compensated, done.unchanged, done.accel, done.imu_topic) == (300, 0, False, "/imu/data")
@@ -66,15 +80,17 @@ def test_a_bag_out_is_the_bag_in_with_its_imu_topic_compensated(kind, model, tmp
         assert "mcap" in (output / "metadata.yaml").read_text()
 
 
-def test_a_repeated_stamp_is_corrected_as_its_twin_and_uncovered_messages_are_said(model, tmp_path):
+@pytest.mark.parametrize("chunk_rows", [1000, 151, 40])
+def test_a_repeated_stamp_is_corrected_as_its_twin_and_uncovered_messages_are_said(chunk_rows, model, tmp_path):
+    """In one batch, with the twin the first message of a batch (151), and in batches of 40."""
     source = tmp_path / "in.bag"
     write_bag(source, ros2=False, n=300, repeat=150, temperature_from=100)
     # the first temperature at message 100 (1 s in); reading matches within 5 of its periods (0.5 s): the first
     # 51 messages (the one at 0.5 s too) are outside its span
     with pytest.warns(DataQualityWarning, match=r"in.bag: 51 message\(s\) of /imu/data are not in the recording the "
                                                 r"bag reads as .* copied uncompensated"):
-        done = apply_bag(model, source, tmp_path / "out.bag")
-    assert (done.compensated, done.unchanged) == (250, 51)
+        done = apply_bag(model, source, tmp_path / "out.bag", chunk_rows=chunk_rows)
+    assert (done.compensated, done.unchanged, done.streamed) == (250, 51, True)
     with AnyReader([tmp_path / "out.bag"]) as reader:
         msgs = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages() if c.topic == "/imu/data"]
     first, twin = msgs[150], msgs[151]
@@ -140,3 +156,40 @@ def test_the_covariances_are_written_from_a_noise_model(model, tmp_path):
     noise.write_text('{"format": "something else"}')
     with pytest.raises(InputError, match=r"noise.json: not a gyrocomp noise model"):
         apply_bag(model, source, tmp_path / "again", noise=noise)
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 40, 100])
+def test_stamps_out_of_order_are_compensated_as_a_whole_read_gives_them(chunk_rows, model, tmp_path):
+    """Messages 99 and 100 carry each other's stamps: within a batch they are sorted (40); across two batches
+    (100: the second's first stamp is earlier than the first's last) the bag is compensated from a whole read;
+    either way every message gets what apply gives its sample, in the bag's own order."""
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=300, swap=99)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        done = apply_bag(model, source, tmp_path / "out.bag", **({"chunk_rows": chunk_rows} if chunk_rows else {}))
+        expected = apply(model, read(source))
+    assert (done.compensated, done.unchanged, done.streamed) == (300, 0, chunk_rows != 100)
+    with AnyReader([tmp_path / "out.bag"]) as reader:
+        msgs = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages() if c.topic == "/imu/data"]
+    stamps = np.array([m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in msgs])
+    assert stamps[99] > stamps[100]
+    gyro = np.array([[m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z] for m in msgs])
+    order = np.argsort(stamps, kind="stable")
+    np.testing.assert_allclose(np.degrees(gyro[order]), expected.gyro_dps, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 13])
+def test_a_model_with_accelerometer_terms_compensates_the_accelerations_too(chunk_rows, model_with_accel, tmp_path):
+    source = tmp_path / "in"
+    write_bag(source, ros2=True, n=200)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        done = apply_bag(model_with_accel, source, tmp_path / "out",
+                         **({"chunk_rows": chunk_rows} if chunk_rows else {}))
+        expected = apply(model_with_accel, read(source))
+        back = read(tmp_path / "out")
+    assert done.accel and done.compensated == 200
+    assert np.max(np.abs(expected.accel_g - read(source).accel_g)) > 1e-4  # the model does change them
+    np.testing.assert_allclose(back.accel_g, expected.accel_g, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(back.gyro_dps, expected.gyro_dps, rtol=0, atol=1e-12)

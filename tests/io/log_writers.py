@@ -75,11 +75,11 @@ def write_dataflash(path, messages: dict[str, tuple[int, list[tuple[str, str]], 
 
 
 def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",), mcap=False,
-              repeat: int | None = None, temperature_from: int = 0):
+              repeat: int | None = None, temperature_from: int = 0, swap: int | None = None):
     """A bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or, with ``mcap``, MCAP storage) of ``n`` IMU messages
     per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth
     (from message ``temperature_from`` on); ``repeat``: message i written a second time with the same stamp and
-    gyro y 0.5 rad/s."""
+    gyro y 0.5 rad/s; ``swap``: messages i and i + 1 written in each other's place (their stamps out of order)."""
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
@@ -104,8 +104,9 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
         imus = [writer.add_connection(topic, Imu.__msgtype__, typestore=store) for topic in imu_topics]
         thermo = writer.add_connection("/imu/temperature", Temperature.__msgtype__, typestore=store)
         for i in range(n):
-            t = 100.0 + i / rate_hz
-            msg = Imu(header=header(t), orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
+            t = 100.0 + i / rate_hz  # when the message is logged
+            stamped = 100.0 + (i + 1 if i == swap else i - 1 if swap is not None and i == swap + 1 else i) / rate_hz
+            msg = Imu(header=header(stamped), orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
                       angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01), angular_velocity_covariance=cov,
                       linear_acceleration=Vector3(x=0.0, y=0.0, z=9.80665), linear_acceleration_covariance=cov)
             for conn in imus:
@@ -118,3 +119,41 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
             if temperature and i % 10 == 0 and i >= temperature_from:  # 10 Hz temperature
                 msg = Temperature(header=header(t), temperature=20.0 + i / 10.0, variance=0.0)
                 writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))
+
+
+def write_recording_bag(path, recording, ros2: bool, mcap: bool = False, temperature_every: int = 10):
+    """A recording [s, deg/s, g, degC] as a bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or MCAP storage),
+    serialized by rosbags: ``/imu/data`` (rad/s, m/s^2) and every ``temperature_every``-th sample's temperature on
+    ``/imu/temperature``."""
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
+    types = store.types
+    Imu, Temperature = types["sensor_msgs/msg/Imu"], types["sensor_msgs/msg/Temperature"]
+    Vector3, Quaternion = types["geometry_msgs/msg/Vector3"], types["geometry_msgs/msg/Quaternion"]
+    serialize = store.serialize_cdr if ros2 else store.serialize_ros1
+    if ros2:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+        writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3)
+    else:
+        from rosbags.rosbag1 import Writer
+        writer = Writer(path)
+    gyro = np.radians(recording.gyro_dps)
+    accel = recording.accel_g * 9.80665
+    cov = np.zeros(9)
+    with writer:
+        imu = writer.add_connection("/imu/data", Imu.__msgtype__, typestore=store)
+        thermo = writer.add_connection("/imu/temperature", Temperature.__msgtype__, typestore=store)
+        for i, t in enumerate(recording.time_s):
+            sec = int(t)
+            stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int(round((t - sec) * 1e9)))
+            header = (types["std_msgs/msg/Header"](stamp=stamp, frame_id="imu_link") if ros2 else
+                      types["std_msgs/msg/Header"](seq=i, stamp=stamp, frame_id="imu_link"))
+            msg = Imu(header=header, orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
+                      angular_velocity=Vector3(*gyro[i]), angular_velocity_covariance=cov,
+                      linear_acceleration=Vector3(*accel[i]), linear_acceleration_covariance=cov)
+            writer.write(imu, int(round(t * 1e9)), serialize(msg, Imu.__msgtype__))
+            if i % temperature_every == 0:
+                writer.write(thermo, int(round(t * 1e9)),
+                             serialize(Temperature(header=header, temperature=float(recording.temperature_degc[i]),
+                                                   variance=0.0), Temperature.__msgtype__))

@@ -43,7 +43,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **
                     else "covariances left as they were")
             click.echo(f"wrote {output}: {done.compensated} messages of {done.imu_topic} compensated (angular velocity"
                        f"{' and linear acceleration' if done.accel else ''}), every other message copied as it was; "
-                       f"{said}")
+                       f"{said}" + ("" if done.streamed else " (read whole: its IMU stamps go back across batches)"))
         return
     if noise_path is not None:
         raise click.BadParameter("a noise model is written into a bag's covariances: give a bag out", param_hint="--noise")

@@ -10,7 +10,12 @@ says how many. The covariance fields are written from a noise model when one is 
 A ROS 1 ``.bag`` gives a ``.bag``; a ROS 2 bag folder gives a folder in the same storage (sqlite3 or MCAP). The
 output is written beside its final name and moved there when complete; the input is never touched.
 
-This version reads the IMU topic into memory (as reading does) and copies the bag message by message.
+The bag goes through once, in memory bounded whatever its length: messages are held until ``chunk_rows`` IMU
+messages (or :data:`WINDOW_BYTES` of messages, once :data:`FIRST_SAMPLES` IMU samples have set the rate) have come,
+the IMU messages among them decoded and compensated as a batch (:class:`gyrocomp.io.rosbag.BagStream`'s reading,
+one :class:`~gyrocomp.calibration.compensate.Compensator` carrying its state from batch to batch) and written back
+into their bytes (:mod:`gyrocomp.io.ros_imu`), then everything held written out in its order. A bag whose IMU
+stamps go back further than the batch before is compensated from a whole read instead (the same result).
 """
 
 from __future__ import annotations
@@ -27,24 +32,32 @@ from pathlib import Path
 import numpy as np
 
 from ..calibration import Calibration
-from ..calibration.compensate import apply
+from ..calibration.compensate import accel_xyz, apply, compensator_for
 from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
-from ..io.rosbag import IMU_TYPE, bag_path, read_rosbag
+from ..io.ros_imu import (ANGULAR_VELOCITY, ANGULAR_VELOCITY_COVARIANCE, LINEAR_ACCELERATION,
+                          LINEAR_ACCELERATION_COVARIANCE, imu_batch)
+from ..io.rosbag import IMU_TYPE, BagStream, bag_path, decoded_imu, read_rosbag
+from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
 
 _RAD = unit_factor("gyro", "rad/s")  # deg/s per rad/s
 _MS2 = unit_factor("accel", "m/s2")  # g per m/s^2
+#: messages held before the IMU messages among them are compensated and everything written [bytes]
+WINDOW_BYTES = 64 << 20
+#: IMU samples the first batch holds at least, whatever the bytes held: the compensator's rate is theirs
+FIRST_SAMPLES = 1000
 
 
 @dataclass(frozen=True)
 class AppliedBag:
     """What :func:`apply_bag` wrote: the output, the topic compensated, the messages compensated and copied as
     they were, whether the accelerations were compensated too, and the covariance fields written (none: left as
-    they were)."""
+    they were), and whether it went through the bag once in batches (``streamed``) or from a whole read (stamps
+    that go back across batches)."""
 
     path: Path
     imu_topic: str
@@ -52,6 +65,7 @@ class AppliedBag:
     unchanged: int
     accel: bool
     covariances: tuple[str, ...] = ()
+    streamed: bool = True
 
 
 def _stamp_s(header) -> float:
@@ -79,7 +93,7 @@ def _writer(bag: Path, target: Path, connections):
 
 
 def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | None = None,
-              noise=None) -> AppliedBag:
+              noise=None, chunk_rows: int = CHUNK_ROWS) -> AppliedBag:
     """Compensate the IMU topic of a ROS bag into a bag of the same kind (see the module).
 
     Parameters
@@ -97,6 +111,8 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
         (and ``linear_acceleration_covariance`` when it models the accelerometer) are written from it, the
         variance of one sample at the bag's rate (N^2 rate) [rad^2/s^2, m^2/s^4]; without one they are left as
         they were.
+    chunk_rows : int
+        IMU messages compensated at once [messages].
 
     Returns
     -------
@@ -113,18 +129,147 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
         raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
                          "only a bag)")
     covariance_of = _covariances(noise) if noise is not None else {}
-    recording = read_rosbag(path, options)
-    compensated = apply(calibration, recording)
-    covariances = {field: make(recording.rate_hz) for field, make in covariance_of.items()}
-    with_accel = recording.accel_g is not None and not np.array_equal(compensated.accel_g, recording.accel_g)
-    topic = recording.metadata["imu_topic"]
+    stream = BagStream(path, options, chunk_rows=chunk_rows)
     counts = {"compensated": 0, "unchanged": 0}
-    _write_bag(bag, output, topic, (recording, compensated, with_accel, covariances), counts)
+    streamed = True
+    try:
+        copier = _Copier(calibration, stream, covariance_of, counts)
+        _write_bag(bag, output, copier.copy)
+        stream.warn_summary()
+        accel, covariances = copier.with_accel, tuple(copier.covariances)
+    except NotStreamable:
+        counts, streamed = {"compensated": 0, "unchanged": 0}, False
+        recording = read_rosbag(path, options)
+        compensated = apply(calibration, recording)
+        covariances = {field: make(recording.rate_hz) for field, make in covariance_of.items()}
+        accel = recording.accel_g is not None and not np.array_equal(compensated.accel_g, recording.accel_g)
+        result = (recording, compensated, accel, covariances)
+        _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections,
+                                                                          stream.imu[0].topic, result, counts))
     if counts["unchanged"]:
-        warnings.warn(f"{path}: {counts['unchanged']} message(s) of {topic} are not in the recording the bag reads as "
-                      "(outside the temperature topic's span, or not finite) and were copied uncompensated",
-                      DataQualityWarning, stacklevel=2)
-    return AppliedBag(output, topic, counts["compensated"], counts["unchanged"], with_accel, tuple(covariances))
+        warnings.warn(f"{path}: {counts['unchanged']} message(s) of {stream.imu[0].topic} are not in the recording "
+                      "the bag reads as (outside the temperature topic's span, or not finite) and were copied "
+                      "uncompensated", DataQualityWarning, stacklevel=2)
+    return AppliedBag(output, stream.imu[0].topic, counts["compensated"], counts["unchanged"], accel,
+                      tuple(covariances), streamed)
+
+
+class _Copier:
+    """The one pass of :func:`apply_bag`: every message of the bag into the writer, the IMU topic's compensated a
+    batch at a time (see the module)."""
+
+    def __init__(self, calibration: Calibration, stream: BagStream, covariance_of: dict, counts: dict):
+        self.calibration, self.stream, self.covariance_of, self.counts = calibration, stream, covariance_of, counts
+        self.topic = stream.imu[0].topic
+        self.comp = None
+        self.with_accel = False
+        self.covariances: dict = {}
+        self.twin: tuple | None = None  # the last batch's last stamp and its corrections [rad/s, m/s^2] (or None)
+
+    def copy(self, reader, writer, connections: dict) -> None:
+        held, imu, held_bytes = [], [], 0
+        for connection, timestamp, raw in reader.messages():
+            is_imu = connection.topic == self.topic and connection.msgtype == IMU_TYPE
+            held.append((connections[connection.id], timestamp, len(imu) if is_imu else -1, raw))
+            held_bytes += len(raw)
+            if is_imu:
+                imu.append(raw)
+            if len(imu) >= self.stream.chunk_rows or (held_bytes >= WINDOW_BYTES and len(imu) >= FIRST_SAMPLES):
+                self._write(reader, writer, held, imu)
+                held, imu, held_bytes = [], [], 0
+        self._write(reader, writer, held, imu)
+
+    def _write(self, reader, writer, held: list, imu: list) -> None:
+        out = self._compensated(reader, imu) if imu else []
+        for connection, timestamp, slot, raw in held:
+            writer.write(connection, timestamp, raw if slot < 0 else out[slot])
+
+    def _compensated(self, reader, raws: list) -> list:
+        """The IMU messages ``raws`` compensated (those outside the recording as they were)."""
+        stamp, gyro_rad, accel_ms2 = decoded_imu(reader, IMU_TYPE, raws)
+        stream = self.stream
+        with_twin = self.twin is not None and np.any(stamp == self.twin[0])
+        time_s, gyro, accel = stream.ordered(stamp, gyro_rad * _RAD, accel_ms2 * _MS2)
+        part = stream.matched(time_s, gyro, accel)
+        rec = stream.chunk_of(part).recording if part[0].size else None
+        values, correction, accel_values, accel_correction = self._corrections(rec)
+        # each message: the first of its stamp takes the recording's value, a repeat the same correction
+        new = np.full((len(raws), 3), np.nan)
+        new_accel = np.full((len(raws), 3), np.nan) if self.with_accel else None
+        times = rec.time_s if rec is not None else np.empty(0)
+        k = np.minimum(np.searchsorted(times, stamp), max(times.size - 1, 0))
+        found = (times[k] == stamp) if times.size else np.zeros(len(raws), dtype=bool)
+        _, first_of = np.unique(stamp, return_index=True)
+        first = np.zeros(len(raws), dtype=bool)
+        first[first_of] = True
+        repeat = found & ~first
+        new[found & first] = values[k[found & first]]
+        new[repeat] = gyro_rad[repeat] - correction[k[repeat]]
+        if self.with_accel:
+            new_accel[found & first] = accel_values[k[found & first]]
+            new_accel[repeat] = accel_ms2[repeat] - accel_correction[k[repeat]]
+        if with_twin:  # repeats of the last batch's last sample
+            again = stamp == self.twin[0]
+            if self.twin[1] is not None:
+                new[again] = gyro_rad[again] - self.twin[1]
+                if self.with_accel:
+                    new_accel[again] = accel_ms2[again] - self.twin[2]
+        done = np.flatnonzero(np.all(np.isfinite(new), axis=1))
+        if times.size:
+            last = times.size - 1
+            self.twin = (float(times[-1]), correction[last],
+                         accel_correction[last] if self.with_accel else None)
+        self.counts["compensated"] += done.size
+        self.counts["unchanged"] += len(raws) - done.size
+        return self._encoded(reader, raws, done, new, new_accel)
+
+    def _corrections(self, rec):
+        """(compensated gyro [rad/s], its correction, compensated accel [m/s^2], its correction) of the recording's
+        samples."""
+        if rec is None or rec.n_samples == 0:
+            return np.empty((0, 3)), np.empty((0, 3)), np.empty((0, 3)), np.empty((0, 3))
+        if self.comp is None:
+            self.comp = compensator_for(self.calibration, rec)
+            self.with_accel = self.comp.compensates_accel
+            self.covariances = {field: make(rec.rate_hz) for field, make in self.covariance_of.items()}
+        gyro = self.comp.update(rec.time_s, rec.gyro_dps, rec.temperature_degc, accel_xyz(rec))
+        out = (gyro / _RAD, (rec.gyro_dps - gyro) / _RAD)
+        if not self.with_accel:
+            return (*out, None, None)
+        accel = self.comp.take_accel()
+        return (*out, accel / _MS2, (rec.accel_g - accel) / _MS2)
+
+    def _encoded(self, reader, raws: list, done: np.ndarray, gyro: np.ndarray, accel) -> list:
+        """The messages with the new values in rows ``done``: written into their bytes when they share a layout,
+        else through rosbags message by message."""
+        batch = imu_batch(raws, cdr=reader.is2)
+        if batch is None:
+            return self._reserialized(reader, raws, done, gyro, accel)
+        batch = batch.with_values(ANGULAR_VELOCITY, done, gyro[done])
+        if accel is not None:
+            batch = batch.with_values(LINEAR_ACCELERATION, done, accel[done])
+        for field, start in (("angular_velocity_covariance", ANGULAR_VELOCITY_COVARIANCE),
+                             ("linear_acceleration_covariance", LINEAR_ACCELERATION_COVARIANCE)):
+            if field in self.covariances:
+                batch = batch.with_values(start, done, np.tile(np.asarray(self.covariances[field], dtype=float),
+                                                               (done.size, 1)))
+        return [batch.message(i) for i in range(len(raws))]
+
+    def _reserialized(self, reader, raws: list, done: np.ndarray, gyro: np.ndarray, accel) -> list:
+        store = reader.typestore
+        serialize = store.serialize_cdr if reader.is2 else store.serialize_ros1
+        out = list(raws)
+        for i in done:
+            msg = reader.deserialize(raws[i], IMU_TYPE)
+            changes = {"angular_velocity": dataclasses.replace(msg.angular_velocity, x=float(gyro[i, 0]),
+                                                               y=float(gyro[i, 1]), z=float(gyro[i, 2]))}
+            if accel is not None:
+                changes["linear_acceleration"] = dataclasses.replace(
+                    msg.linear_acceleration, x=float(accel[i, 0]), y=float(accel[i, 1]), z=float(accel[i, 2]))
+            for field, values in self.covariances.items():
+                changes[field] = np.asarray(values, dtype=np.float64)
+            out[i] = serialize(dataclasses.replace(msg, **changes), IMU_TYPE)
+        return out
 
 
 def _covariances(noise) -> dict:
@@ -138,8 +283,9 @@ def _covariances(noise) -> dict:
     return out
 
 
-def _write_bag(bag: Path, output: Path, topic: str, result: tuple, counts: dict) -> None:
-    """The copy written beside ``output`` in a temporary folder, moved into place when complete."""
+def _write_bag(bag: Path, output: Path, copy) -> None:
+    """``copy(reader, writer, connections)`` into a bag written beside ``output`` in a temporary folder, moved into
+    place when complete."""
     highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
     parent = output.parent if str(output.parent) else Path(".")
     tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
@@ -148,7 +294,7 @@ def _write_bag(bag: Path, output: Path, topic: str, result: tuple, counts: dict)
         with highlevel.AnyReader([bag]) as reader:
             writer, connections = _writer(bag, target, reader.connections)
             try:
-                _copy(reader, writer, connections, topic, result, counts)
+                copy(reader, writer, connections)
             finally:
                 writer.close()
         _move_into_place(target, output)

@@ -1,8 +1,9 @@
 """Chunked file work, in one place: whether a file is read in chunks, the chunk settings, and the one pattern
-every file command follows (apply, convert, evaluate, allan): a CSV or Parquet table is read in chunks, in memory
-bounded by the chunk whatever the file's length, and any other file (a log, a table whose rows are selected by
-time, a table that cannot be read in chunks: a time gap, a CSV column whose type changes after its first
-megabyte) is read whole, with the same result.
+every file command follows (apply, convert, evaluate, allan): a CSV or Parquet table, or a file whose reader
+streams (a ROS bag), is read in chunks, in memory bounded by the chunk whatever the file's length, and any other
+file (a log, a table whose rows are selected by time, a file that cannot be read in chunks: a time gap, a CSV
+column whose type changes after its first megabyte, a bag whose stamps go back) is read whole, with the same
+result.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io import ReadOptions, TableData, detect_format, read_input, table_formats
+from ..io.readers import reader_named
 from ..io.common import ProgressCallback
 from ..io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from ..recording import GAP_FACTOR, nominal_rate_hz
@@ -64,9 +66,9 @@ class TimeSteps:
 
 
 def reads_in_chunks(fmt: str, options: ReadOptions) -> bool:
-    """Whether a file of format ``fmt`` is read in chunks with these options: a table whose rows are not selected
-    by time (a time range is cut from the whole file)."""
-    return fmt in table_formats() and options.time_range_s is None
+    """Whether a file of format ``fmt`` is read in chunks with these options: a table, or a format whose reader
+    streams (a ROS bag), whose rows are not selected by time (a time range is cut from the whole file)."""
+    return (fmt in table_formats() or reader_named(fmt).stream is not None) and options.time_range_s is None
 
 
 def chunked_or_whole(path, options: ReadOptions | None, *, fmt: str | None, chunks: ChunkSettings,
@@ -94,8 +96,11 @@ def chunked_or_whole(path, options: ReadOptions | None, *, fmt: str | None, chun
         raise InputError(f"{path}: no such file")
     fmt = detect_format(path, fmt)
     if reads_in_chunks(fmt, options):
-        stream = TableStream(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite,
-                             chunk_rows=chunks.chunk_rows, progress=progress, channels=options.channels)
+        if fmt in table_formats():
+            stream = TableStream(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite,
+                                 chunk_rows=chunks.chunk_rows, progress=progress, channels=options.channels)
+        else:
+            stream = reader_named(fmt).stream(Path(path), options, chunks.chunk_rows, progress)
         try:
             return chunked(stream)
         except NotStreamable:

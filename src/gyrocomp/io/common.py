@@ -170,9 +170,10 @@ def foreign_output(source: str, library: str) -> Iterator[None]:
 
 def log_recording(path, options: ReadOptions, time_s: np.ndarray, gyro_dps: np.ndarray, accel_g: np.ndarray | None,
                   temperature_degc: np.ndarray | None, metadata: dict,
-                  gyro_axes: tuple[str, ...] = GYRO_AXES) -> Recording:
+                  gyro_axes: tuple[str, ...] = GYRO_AXES, first_row: int = 0) -> Recording:
     """The :class:`Recording` a log reader returns [s, deg/s, g, degC]; with ``options.drop_nonfinite`` the rows
-    holding an empty, NaN or infinite value are dropped first (a warning says how many), as for tables."""
+    holding an empty, NaN or infinite value are dropped first (a warning says how many), as for tables. Rows are
+    numbered from ``first_row`` + 1 (a chunk of a longer log: the samples before it)."""
     n = time_s.size
     index = np.arange(n)
     if options.drop_nonfinite:
@@ -180,7 +181,7 @@ def log_recording(path, options: ReadOptions, time_s: np.ndarray, gyro_dps: np.n
             path, time_s, gyro_dps, accel_g, temperature_degc)
     return Recording(time_s=time_s, gyro_dps=gyro_dps, gyro_axes=gyro_axes, temperature_degc=temperature_degc,
                      accel_g=accel_g, accel_axes=ACCEL_AXES if accel_g is not None else (), source=str(path),
-                     row_numbers=index + 1, metadata={**metadata, "rows_dropped": int(n - index.size)})
+                     row_numbers=index + 1 + first_row, metadata={**metadata, "rows_dropped": int(n - index.size)})
 
 
 def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -> tuple:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import stat
 from collections.abc import Callable
+from typing import Any
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -47,6 +48,11 @@ class Reader:
         ``instances(path) -> tuple of int``: the sensor instances a file holds (default: one, ``(0,)``).
     table : bool
         A table of columns (CSV, Parquet): its layout options apply, and it can be read and written in chunks.
+    stream : callable, optional
+        ``stream(path, options, chunk_rows, progress)``: the file read in chunks of about ``chunk_rows`` samples,
+        an object with the interface of :class:`gyrocomp.io.stream.TableStream` that the file commands use
+        (``chunks()``, the axes, ``layout``, ``columns``, ``gaps``, ``warn_summary()``); a format without one
+        is read whole by every command.
     """
 
     name: str
@@ -58,6 +64,7 @@ class Reader:
     folder_marker: str | None = None
     instances: Callable[[Path], tuple[int, ...]] | None = None
     table: bool = False
+    stream: Callable[[Path, ReadOptions, int, ProgressCallback | None], Any] | None = None
 
     def read_table_data(self, path: Path, options: ReadOptions, progress: ProgressCallback | None) -> TableData:
         """What :attr:`read` returns, as :class:`TableData` (a recording becomes a table in the default layout).

@@ -2,7 +2,9 @@
 
 Reads a ``sensor_msgs/Imu`` topic (rad/s, m/s^2, time from each message's header stamp) and a
 ``sensor_msgs/Temperature`` topic (degC) matched to it by time. Messages are read one topic at a
-time, straight into arrays; a ROS 2 bag is its folder (with ``metadata.yaml``) or a file in it.
+time, the IMU's decoded a batch at a time (:mod:`gyrocomp.io.ros_imu`); a ROS 2 bag is its folder (with
+``metadata.yaml``) or a file in it. :class:`BagStream` reads the IMU topic in chunks, in memory bounded by the
+chunk whatever the bag's length (``allan``, ``apply``, ``evaluate`` and ``convert`` read bags so).
 """
 
 from __future__ import annotations
@@ -10,15 +12,21 @@ from __future__ import annotations
 import contextlib
 import re
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
 
-from ..errors import DataQualityWarning, InputError, printable
-from ..recording import Recording
+from ..errors import DataQualityWarning, InputError, TimeOrderWarning, printable
+from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, keep_matched, log_recording, match_by_time, order_by_time, require
+from .layout import TIME_COLUMN, TableLayout
 from .readers import Reader, register_reader
+from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, imu_batch
+from .stream import CHUNK_ROWS, NotStreamable
+from .tables import recording_table
 
 IMU_TYPE = "sensor_msgs/msg/Imu"
 TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
@@ -151,26 +159,58 @@ def _read_all(path: Path, counted: int, read: int, topic: str) -> None:
                       "rest is damaged or missing", DataQualityWarning, stacklevel=3)
 
 
-def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | None, total: int):
-    """(time [s], gyro [deg/s], accel [g]) of every message on the IMU topic, in time order."""
+#: IMU messages decoded at once (about 20 MB of messages)
+DECODE_BATCH = 65536
+
+
+def decoded_imu(reader, msgtype: str, raws: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(stamp [s], angular velocity [rad/s] (n, 3), linear acceleration [m/s^2] (n, 3)) of serialized IMU
+    messages: a batch of one layout at once, any other message by message through rosbags."""
+    batch = imu_batch(raws, cdr=reader.is2)
+    if batch is not None:
+        values = batch.values
+        return (batch.stamp_s(cdr=reader.is2), values[:, ANGULAR_VELOCITY:ANGULAR_VELOCITY + 3],
+                values[:, LINEAR_ACCELERATION:LINEAR_ACCELERATION + 3])
+    time_s, gyro, accel = np.empty(len(raws)), np.empty((len(raws), 3)), np.empty((len(raws), 3))
+    for i, raw in enumerate(raws):
+        msg = reader.deserialize(raw, msgtype)
+        time_s[i] = _stamp_s(msg.header)
+        w, a = msg.angular_velocity, msg.linear_acceleration
+        gyro[i] = (w.x, w.y, w.z)
+        accel[i] = (a.x, a.y, a.z)
+    return time_s, gyro, accel
+
+
+def _imu_batches(path: Path, reader, imu: list, size: int, progress: ProgressCallback | None = None):
+    """The IMU topic's messages as they lie in the bag, ``size`` at a time, decoded (:func:`decoded_imu`) [s, rad/s,
+    m/s^2]; a damaged bag or one holding more messages than its index counts is one line naming the topic."""
     n = sum(c.msgcount for c in imu)
-    time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))
-    i = 0
+    raws, read = [], 0
     with _damaged(path, imu[0].topic):
-        for connection, _, raw in reader.messages(connections=imu):
-            if i == n:
+        for _, _, raw in reader.messages(connections=imu):
+            raws.append(raw)
+            read += 1
+            if read > n:
                 raise InputError(f"{path}: damaged ROS bag: topic {imu[0].topic}: more messages than the bag's "
                                  f"index counts ({n})")
-            msg = reader.deserialize(raw, connection.msgtype)
-            time_s[i] = _stamp_s(msg.header)
-            w, a = msg.angular_velocity, msg.linear_acceleration
-            gyro[i] = (w.x, w.y, w.z)
-            accel[i] = (a.x, a.y, a.z)
-            i += 1
-            if progress and i % 20000 == 0:
-                progress(i / total)
-    _read_all(path, n, i, imu[0].topic)
-    return order_by_time(str(path), time_s[:i], gyro[:i] * _RAD, accel[:i] * _MS2)
+            if len(raws) == size:
+                yield decoded_imu(reader, imu[0].msgtype, raws)
+                raws = []
+                if progress:
+                    progress(read / max(n, 1))
+        if raws:
+            yield decoded_imu(reader, imu[0].msgtype, raws)
+    _read_all(path, n, read, imu[0].topic)
+
+
+def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | None, total: int):
+    """(time [s], gyro [deg/s], accel [g]) of every message on the IMU topic, in time order."""
+    parts = list(_imu_batches(path, reader, imu, DECODE_BATCH,
+                              (lambda f: progress(f * sum(c.msgcount for c in imu) / total)) if progress else None))
+    if not parts:
+        return order_by_time(str(path), np.empty(0), np.empty((0, 3)), np.empty((0, 3)))
+    time_s, gyro, accel = (np.concatenate(p) for p in zip(*parts))
+    return order_by_time(str(path), time_s, gyro * _RAD, accel * _MS2)
 
 
 def _temperature_samples(path: Path, reader, thermo: list):
@@ -183,6 +223,25 @@ def _temperature_samples(path: Path, reader, thermo: list):
             t_value.append(msg.temperature)
     _read_all(path, sum(c.msgcount for c in thermo), len(t_time), thermo[0].topic)
     return order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
+
+
+def chosen_topics(path: Path, connections: list, options: ReadOptions) -> tuple[list, list]:
+    """The connections of the IMU topic the options choose and of its temperature topic (empty: none)."""
+    imu = _topic(path, connections, IMU_TYPE, _imu_topic_asked(path, connections, options), "imu_topic")
+    if not imu:
+        topics = ", ".join(sorted(f"{c.topic} ({c.msgtype})" for c in connections)) or "none"
+        raise InputError(f"{path}: no {IMU_TYPE} topic in the bag; its topics are {topics}")
+    return imu, _topic(path, connections, TEMPERATURE_TYPE, options.temperature_topic, "temperature_topic")
+
+
+def _metadata(path: Path, imu: list, thermo: list) -> dict:
+    return {"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
+            "temperature_topic": thermo[0].topic if thermo else None}
+
+
+def _warn_no_temperature(path: Path, stacklevel: int) -> None:
+    warnings.warn(f"{path}: no {TEMPERATURE_TYPE} topic; the recording has no temperature "
+                  "(only noise analysis works without it)", DataQualityWarning, stacklevel=stacklevel + 1)
 
 
 def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
@@ -201,12 +260,7 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     path = Path(path)
     reader = _open(path)
     try:
-        connections = list(reader.connections)
-        imu = _topic(path, connections, IMU_TYPE, _imu_topic_asked(path, connections, options), "imu_topic")
-        if not imu:
-            topics = ", ".join(sorted(f"{c.topic} ({c.msgtype})" for c in connections)) or "none"
-            raise InputError(f"{path}: no {IMU_TYPE} topic in the bag; its topics are {topics}")
-        thermo = _topic(path, connections, TEMPERATURE_TYPE, options.temperature_topic, "temperature_topic")
+        imu, thermo = chosen_topics(path, list(reader.connections), options)
         total = max(1, sum(c.msgcount for c in imu + thermo))
         time_s, gyro, accel = _imu_samples(path, reader, imu, progress, total)
         temperature = None
@@ -219,15 +273,176 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     finally:
         reader.close()
     if temperature is None:
-        warnings.warn(f"{path}: no {TEMPERATURE_TYPE} topic; the recording has no temperature "
-                      "(only noise analysis works without it)", DataQualityWarning, stacklevel=2)
+        _warn_no_temperature(path, stacklevel=2)
     if progress:
         progress(1.0)
-    return log_recording(path, options, time_s, gyro, accel, temperature,
-                         {"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
-                          "temperature_topic": thermo[0].topic if thermo else None})
+    return log_recording(path, options, time_s, gyro, accel, temperature, _metadata(path, imu, thermo))
+
+
+@dataclass(frozen=True, eq=False)
+class BagChunk:
+    """Consecutive samples of a bag's IMU topic: the recording (``recording``), the same as a table in the
+    default layout (``table``), every row of which is kept (``kept``), and the index of its first sample."""
+
+    table: pa.Table
+    recording: Recording
+    kept: np.ndarray
+    first_row: int
+
+
+class BagStream:
+    """A ROS bag's IMU topic read in chunks of about ``chunk_rows`` samples [s, deg/s, g, degC], each chunk the
+    samples :func:`read_rosbag` gives for those messages, in memory bounded by the chunk whatever the bag's
+    length: the temperature topic (a message a second, say) is read whole first and matched to each chunk, the
+    IMU messages decoded a batch at a time. Repeated stamps are dropped and a batch out of time order sorted, as a
+    whole read does, with its warning once for the bag; a stamp earlier than the last of a batch before cannot be
+    sorted in chunks (:class:`~gyrocomp.io.stream.NotStreamable`: the bag is read whole). The interface of
+    :class:`gyrocomp.io.stream.TableStream` that the file commands use: the chunks, the axes, the default
+    layout, the gaps between chunks, :meth:`warn_summary`.
+
+    Parameters
+    ----------
+    path : path
+        A ROS 1 ``.bag`` file or a ROS 2 bag folder.
+    options : ReadOptions, optional
+        ``imu_topic``, ``instance``, ``temperature_topic``, ``drop_nonfinite``.
+    chunk_rows : int
+        Samples per chunk.
+    progress : callable, optional
+        Called with the fraction of the IMU messages read.
+    """
+
+    def __init__(self, path, options: ReadOptions | None = None, *, chunk_rows: int = CHUNK_ROWS, progress=None):
+        self.path = Path(path)
+        self.options = options or ReadOptions()
+        self.chunk_rows = int(chunk_rows)
+        self.progress = progress
+        reader = _open(self.path)
+        try:
+            self.imu, self.thermo = chosen_topics(self.path, list(reader.connections), self.options)
+            self._temperature = _temperature_samples(self.path, reader, self.thermo) if self.thermo else None
+        finally:
+            reader.close()
+        self.layout = TableLayout()
+        self.text_format = None
+        self.gyro_axes, self.accel_axes = GYRO_AXES, ACCEL_AXES
+        self.columns = {name: name for name in (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES)}
+        self.rows = self.rows_dropped = self.gaps = 0
+        self._period_s: float | None = None  # the first chunk's sample period [s]
+        self._last_s: float | None = None  # the last chunk's last time [s]
+        self._order = {"moved": 0, "dropped": 0, "back": 0.0, "samples": 0, "unmatched": 0, "last": -np.inf}
+
+    def ordered(self, time_s, gyro, accel):
+        """A batch sorted by time, repeated stamps dropped (the first kept), as :func:`order_by_time` does for
+        the whole bag; a stamp not after the batches before: NotStreamable."""
+        again = time_s == self._order["last"]  # the last sample's stamp repeated across the batches: dropped
+        if np.any(again):
+            self._order["dropped"] += int(np.count_nonzero(again))
+            time_s, gyro, accel = time_s[~again], gyro[~again], accel[~again]
+        if time_s.size and time_s.min() < self._order["last"]:
+            raise NotStreamable("IMU stamps earlier than those of a batch before")
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always", TimeOrderWarning)
+            time_s, gyro, accel = order_by_time(str(self.path), time_s, gyro, accel)
+        for warning in said:
+            if isinstance(warning.message, TimeOrderWarning):
+                self._order["moved"] += warning.message.moved
+                self._order["dropped"] += warning.message.dropped
+                self._order["back"] = max(self._order["back"], warning.message.largest_back_s)
+            else:
+                warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+        if time_s.size:
+            self._order["last"] = float(time_s[-1])
+        return time_s, gyro, accel
+
+    def matched(self, time_s, gyro, accel):
+        """The samples within the temperature topic's span, with their temperature [degC] (None: no topic)."""
+        self._order["samples"] += time_s.size
+        if self._temperature is None:
+            return time_s, gyro, accel, None
+        what = f"temperature topic {self.thermo[0].topic}"
+        temperature, ok = match_by_time(str(self.path), what, time_s, *self._temperature)
+        self._order["unmatched"] += int(np.count_nonzero(~ok))
+        return time_s[ok], gyro[ok], accel[ok], temperature[ok]
+
+    def chunks(self):
+        """The IMU topic as :class:`BagChunk` s."""
+        if self._temperature is None:
+            _warn_no_temperature(self.path, stacklevel=2)
+        reader = _open(self.path)
+        held, parts = None, []
+        try:
+            imu = [c for c in reader.connections if c.topic == self.imu[0].topic]  # this reader's connections
+            batch = max(2, min(DECODE_BATCH, self.chunk_rows))
+            for time_s, gyro, accel in _imu_batches(self.path, reader, imu, batch, self.progress):
+                part = self.matched(*self.ordered(time_s, gyro * _RAD, accel * _MS2))
+                if part[0].size:
+                    parts.append(part)
+                if sum(p[0].size for p in parts) >= self.chunk_rows:
+                    if held is not None:
+                        yield self.chunk_of(held)
+                    held, parts = _joined(parts), []
+        finally:
+            reader.close()
+        rest = _joined(parts) if parts else None
+        if held is not None and rest is not None and rest[0].size < 2:
+            held, rest = _joined([held, rest]), None
+        for part in (held, rest):
+            if part is not None:
+                yield self.chunk_of(part)
+        if self._temperature is not None and self._order["unmatched"] == self._order["samples"]:
+            raise InputError(f"{self.path}: no gyro sample lies within the time span of temperature topic "
+                             f"{self.thermo[0].topic}; they cannot be matched")
+        if self.progress:
+            self.progress(1.0)
+
+    def chunk_of(self, part: tuple) -> BagChunk:
+        """The chunk of the samples ``part`` (time, gyro, accel, temperature or None, from :meth:`matched`), the
+        next after those of the chunks before; gaps and dropped rows counted."""
+        time_s, gyro, accel, temperature = part
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DataQualityWarning)  # rows dropped: counted over the bag, said once
+            recording = log_recording(self.path, self.options, time_s, gyro, accel, temperature,
+                                      _metadata(self.path, self.imu, self.thermo), first_row=self.rows)
+        self.rows_dropped += recording.metadata["rows_dropped"]
+        first, self.rows = self.rows, self.rows + time_s.size
+        if recording.n_samples and self._last_s is not None and recording.time_s[0] - self._last_s > 2 * self._period_s:
+            self.gaps += 1
+        self.gaps += len(recording.gaps)
+        if recording.n_samples > 1:
+            self._period_s = self._period_s or 1.0 / recording.rate_hz
+            self._last_s = float(recording.time_s[-1])
+        return BagChunk(recording_table(recording), recording, np.arange(recording.n_samples), first)
+
+    def warn_summary(self) -> None:
+        """The warnings a whole read gives, once for the bag: samples sorted or repeated, samples outside the
+        temperature topic's span, rows dropped."""
+        moved, dropped, back = self._order["moved"], self._order["dropped"], self._order["back"]
+        if moved or dropped:
+            warnings.warn(TimeOrderWarning(
+                f"{self.path}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) "
+                "dropped" + (f" (the time went back by up to {back:.6g} s)" if back > 0 else ""),
+                moved=moved, dropped=dropped, largest_back_s=back), stacklevel=2)
+        if self._order["unmatched"]:
+            warnings.warn(f"{self.path}: {self._order['unmatched']} of {self._order['samples']} gyro samples lie "
+                          f"outside the time span of temperature topic {self.thermo[0].topic} and were left out",
+                          DataQualityWarning, stacklevel=2)
+        if self.rows_dropped:
+            warnings.warn(f"{self.path}: dropped {self.rows_dropped} of {self.rows} rows with empty, NaN or infinite "
+                          "values", DataQualityWarning, stacklevel=2)
+
+
+def _joined(parts: list) -> tuple:
+    """Sample tuples (time, gyro, accel, temperature or None) end to end."""
+    return tuple(None if values[0] is None else np.concatenate(values) for values in zip(*parts))
+
+
+def bag_stream(path: Path, options: ReadOptions, chunk_rows: int, progress) -> BagStream:
+    """The :class:`BagStream` of a bag (the reader's ``stream``)."""
+    return BagStream(path, options, chunk_rows=chunk_rows, progress=progress)
 
 
 register_reader(Reader("rosbag", "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, extra [ros]", read_rosbag,
                        suffixes=(".bag", ".db3", ".mcap"), magic=(b"#ROSBAG", b"\x89MCAP"), aliases=("bag", "ros"),
-                       folder_marker="metadata.yaml", instances=rosbag_instances))
+                       folder_marker="metadata.yaml", instances=rosbag_instances,
+                       stream=bag_stream))
