@@ -37,6 +37,24 @@ def pytest_collection_modifyitems(config, items):
     items.sort(key=lambda item: not item.nodeid.startswith(HEAVY_FIRST))  # stable: each group keeps its order
 
 
+#: test modules that share a session fixture too costly to build twice, sent to one process of ``make test``
+#: together (the fleet fitted once: tests/fleet/conftest.py's ``fleet_run``, about 35 s)
+SAME_PROCESS = {"tests/fleet/test_prior.py": "tests/fleet/test_fleet_fit.py"}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` (each test module in one process), with the modules of :data:`SAME_PROCESS` in one
+    process together."""
+    from xdist.scheduler import LoadFileScheduling
+
+    class SharedFixtureFiles(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            scope = super()._split_scope(nodeid)
+            return SAME_PROCESS.get(scope, scope)
+
+    return SharedFixtureFiles(config, log)
+
+
 def shared_dataset(name: str) -> Path:
     """Path of a folder in ../shared/datasets, or skip the test with a message saying what is missing."""
     path = DATASETS / name
