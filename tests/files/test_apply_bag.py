@@ -24,7 +24,8 @@ pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 from rosbags.highlevel import AnyReader  # noqa: E402
 
 KINDS = {"ros1": ({"ros2": False}, "in.bag", "out.bag"), "ros2": ({"ros2": True}, "in", "out"),
-         "mcap": ({"ros2": True, "mcap": True}, "in", "out")}
+         "mcap": ({"ros2": True, "mcap": True}, "in", "out"),
+         "bare mcap": ({"ros2": True, "mcap": True, "bare": True}, "in.mcap", "out.mcap")}
 
 
 @pytest.fixture(scope="module")
@@ -78,6 +79,13 @@ def test_a_bag_out_is_the_bag_in_with_its_imu_topic_compensated(kind, chunk_rows
     assert _digest(source) == before
     if kind == "mcap":
         assert "mcap" in (output / "metadata.yaml").read_text()
+    if kind == "bare mcap":  # one file, that the MCAP project's own reader reads, with the schemas in it
+        assert output.is_file()
+        reader = pytest.importorskip("mcap.reader", reason="the mcap library reads the file back")
+        with open(output, "rb") as f:
+            read_back = [(channel.topic, schema.name, message.log_time)
+                         for schema, channel, message in reader.make_reader(f).iter_messages()]
+        assert read_back == [(topic, kind_, t) for topic, kind_, t, _ in ins]
 
 
 @pytest.mark.parametrize("chunk_rows", [1000, 151, 40])
@@ -193,3 +201,32 @@ def test_a_model_with_accelerometer_terms_compensates_the_accelerations_too(chun
     assert np.max(np.abs(expected.accel_g - read(source).accel_g)) > 1e-4  # the model does change them
     np.testing.assert_allclose(back.accel_g, expected.accel_g, rtol=0, atol=1e-12)
     np.testing.assert_allclose(back.gyro_dps, expected.gyro_dps, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 30])
+def test_each_imu_topic_with_its_own_model_in_one_pass(chunk_rows, model, model_with_accel, tmp_path):
+    """Two IMU topics (instances in name order: /imu_a 0, /imu_b 1), each with its model; and through the command
+    line with the model files fit --instance all writes, one missing named."""
+    from gyrocomp.files.apply_bag import apply_bag_instances
+
+    source = tmp_path / "two.bag"
+    write_bag(source, ros2=False, n=200, imu_topics=("/imu_b", "/imu_a"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        done = apply_bag_instances({0: model, 1: model_with_accel}, source, tmp_path / "out.bag",
+                                   **({"chunk_rows": chunk_rows} if chunk_rows else {}))
+        for instance, used in ((0, model), (1, model_with_accel)):
+            expected = apply(used, read(source, instance=instance))
+            back = read(tmp_path / "out.bag", instance=instance)
+            np.testing.assert_allclose(back.gyro_dps, expected.gyro_dps, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(back.accel_g, expected.accel_g, rtol=0, atol=1e-12)
+    assert [(d.imu_topic, d.compensated, d.accel) for d in done] == [("/imu_a", 200, False), ("/imu_b", 200, True)]
+    model.save(tmp_path / "m_imu0.json")
+    cli = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "cli.bag", "--instance", "all")
+    assert cli.returncode == 2 and "no model file" in cli.stderr and "m_imu1.json" in cli.stderr
+    assert not (tmp_path / "cli.bag").exists()
+    model_with_accel.save(tmp_path / "m_imu1.json")
+    cli = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "cli.bag", "--instance", "all")
+    assert cli.returncode == 0, cli.stderr
+    assert "200 messages of /imu_a compensated (angular velocity); 200 messages of /imu_b compensated" in cli.stdout
+    assert _messages(tmp_path / "cli.bag") == _messages(tmp_path / "out.bag")

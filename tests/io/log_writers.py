@@ -75,11 +75,24 @@ def write_dataflash(path, messages: dict[str, tuple[int, list[tuple[str, str]], 
 
 
 def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",), mcap=False,
-              repeat: int | None = None, temperature_from: int = 0, swap: int | None = None):
+              repeat: int | None = None, temperature_from: int = 0, swap: int | None = None, bare: bool = False,
+              temperature_gap: tuple[int, int] | None = None):
     """A bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or, with ``mcap``, MCAP storage) of ``n`` IMU messages
     per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth
     (from message ``temperature_from`` on); ``repeat``: message i written a second time with the same stamp and
-    gyro y 0.5 rad/s; ``swap``: messages i and i + 1 written in each other's place (their stamps out of order)."""
+    gyro y 0.5 rad/s; ``swap``: messages i and i + 1 written in each other's place (their stamps out of order);
+    ``bare`` (with ``mcap``): the MCAP file alone at ``path``, without its folder and ``metadata.yaml``;
+    ``temperature_gap`` (i, j): no temperature message from message i to before j."""
+    if bare:
+        import shutil
+        from pathlib import Path
+
+        folder = Path(str(path) + ".folder")
+        write_bag(folder, ros2=True, n=n, rate_hz=rate_hz, temperature=temperature, imu_topics=imu_topics, mcap=True,
+                  repeat=repeat, temperature_from=temperature_from, swap=swap, temperature_gap=temperature_gap)
+        next(folder.glob("*.mcap")).rename(path)
+        shutil.rmtree(folder)
+        return
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
@@ -116,7 +129,8 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
                                angular_velocity=Vector3(x=0.001 * i, y=0.5, z=-0.01), angular_velocity_covariance=cov,
                                linear_acceleration=msg.linear_acceleration, linear_acceleration_covariance=cov)
                     writer.write(conn, int(t * 1e9) + 1, serialize(twin, Imu.__msgtype__))
-            if temperature and i % 10 == 0 and i >= temperature_from:  # 10 Hz temperature
+            in_gap = temperature_gap is not None and temperature_gap[0] <= i < temperature_gap[1]
+            if temperature and i % 10 == 0 and i >= temperature_from and not in_gap:  # 10 Hz temperature
                 msg = Temperature(header=header(t), temperature=20.0 + i / 10.0, variance=0.0)
                 writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))
 

@@ -56,6 +56,26 @@ def test_a_bag_in_chunks_is_what_reading_it_whole_gives(kind, chunk_rows, tmp_pa
     assert chunks[0].metadata == whole.metadata
 
 
+@pytest.mark.parametrize("chunk_rows", [50, 5000])
+def test_a_gap_in_the_temperature_topic_is_said_never_bridged(chunk_rows, tmp_path):
+    """No temperature from message 1000 to 1500 (10 s at 100 Hz): the IMU samples more than 5 temperature periods
+    (0.5 s) from any temperature are left out and counted, in chunks as whole; the rest interpolate exactly."""
+    path = tmp_path / "gap.bag"
+    write_bag(path, ros2=False, n=3000, temperature_gap=(1000, 1500))
+    stream = BagStream(path, ReadOptions(), chunk_rows=chunk_rows)
+    chunks, said = _caught(lambda: [c.recording for c in stream.chunks()] + [stream.warn_summary()])
+    whole, said_whole = _caught(lambda: read_rosbag(path))
+    assert said == said_whole
+    assert any("of 3000 gyro samples lie outside the time span of temperature topic /imu/temperature and were left "
+               "out" in m for m in said)
+    time_s = np.concatenate([c.time_s for c in chunks[:-1]])
+    np.testing.assert_array_equal(time_s, whole.time_s)
+    inside = (time_s > 100.0 + 990 / 100.0 + 0.5) & (time_s < 100.0 + 1500 / 100.0 - 0.5)
+    assert not inside.any()  # nothing matched across the gap
+    np.testing.assert_allclose(whole.temperature_degc, 20.0 + np.minimum(np.round((whole.time_s - 100.0) * 100),
+                                                                           2990) / 10.0, atol=1e-6)
+
+
 @pytest.fixture(scope="module")
 def run_bag(tmp_path_factory):
     """A simulated consumer part's cycle at 20 Hz as a ROS 1 bag, and a model fitted on two other runs."""

@@ -8,9 +8,10 @@ import click
 
 from ..calibration import Calibration
 from ..files.apply import apply_file
-from ..files.apply_bag import apply_bag
-from ..io import detect_format, output_format, refuse_to_overwrite_inputs
-from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
+from ..files.apply_bag import apply_bag, apply_bag_instances
+from ..io import detect_format, instances, output_format, refuse_to_overwrite_inputs
+from .common import (FINITE, OUTPUT_FILE, instance_model_path, pop_read_options, progress_bar, read_options,
+                     read_settings)
 
 
 @click.command()
@@ -18,7 +19,8 @@ from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_op
 @click.argument("input_path", metavar="IN", type=click.Path())
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE,
               help="Compensated output file: a table (.csv, .parquet), or for a ROS bag a bag of the same kind (a "
-                   ".bag file for ROS 1, a new folder for a ROS 2 bag).")
+                   ".bag file for ROS 1, a new folder for a ROS 2 bag, a .mcap file for a bare MCAP file; with "
+                   "--instance all, each IMU topic with MODEL's model of its instance, MODEL_imuN).")
 @click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
               help="Estimate the turn-on bias from the first S seconds of IN [s] (default: the model's mean).")
 @click.option("--axes", "axes", default=None, metavar="AXES",
@@ -33,17 +35,19 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **
     """Compensate IN with MODEL: same columns and rows out, gyro columns compensated (a ROS bag into a bag: every
     message copied, the IMU topic compensated)."""
     opts = pop_read_options(kwargs)
+    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
+    bag_out = in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag", ".mcap")  # a bag of the input's kind
+    if bag_out and str(opts["instance"]).strip().lower() == "all":
+        _apply_instances(ctx, model, input_path, output, opts, noise_path)
+        return
     refuse_to_overwrite_inputs(output, [input_path, model] + ([noise_path] if noise_path else []))
     calibration = Calibration.load(model)
-    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
-    if in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag"):  # a bag out: the same kind as in
+    if bag_out:
         done = apply_bag(calibration, input_path, output, options=read_settings(opts), noise=noise_path)
         if not ctx.obj["quiet"]:
             said = (f"{' and '.join(done.covariances)} written from {noise_path}" if done.covariances
                     else "covariances left as they were")
-            click.echo(f"wrote {output}: {done.compensated} messages of {done.imu_topic} compensated (angular velocity"
-                       f"{' and linear acceleration' if done.accel else ''}), every other message copied as it was; "
-                       f"{said}" + ("" if done.streamed else " (read whole: its IMU stamps go back across batches)"))
+            _said_bag(output, [done], f"every other message copied as it was; {said}")
         return
     if noise_path is not None:
         raise click.BadParameter("a noise model is written into a bag's covariances: give a bag out", param_hint="--noise")
@@ -55,6 +59,33 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **
     rows, done = result.rows, result.axes
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output}: {rows} rows, {', '.join(done)} compensated")
+
+
+def _apply_instances(ctx, model, input_path, output, opts: dict, noise_path) -> None:
+    """``--instance all`` with a bag out: each IMU topic with the model of its instance (MODEL's name with
+    ``_imuN``, as ``fit --instance all`` writes them)."""
+    if noise_path is not None:
+        raise click.BadParameter("one noise model describes one IMU: give --instance N or --imu-topic with it",
+                                 param_hint="--noise")
+    found = instances(input_path, opts["fmt"])
+    paths = {k: instance_model_path(model, k) for k in found}
+    refuse_to_overwrite_inputs(output, [input_path, *paths.values()])
+    missing = [str(p) for p in paths.values() if not p.is_file()]
+    if missing:
+        raise click.BadParameter(f"the bag has {len(found)} IMU topic(s), instances {', '.join(map(str, found))}; "
+                                 f"no model file {', '.join(missing)} (gyrocomp fit -o {model} --instance all writes "
+                                 "one per instance)", param_hint="--instance")
+    done = apply_bag_instances({k: Calibration.load(p) for k, p in paths.items()}, input_path, output,
+                               options=read_settings({**opts, "instance": None}))
+    if not ctx.obj["quiet"]:
+        _said_bag(output, done, "every other message copied as it was; covariances left as they were")
+
+
+def _said_bag(output, done, rest: str) -> None:
+    topics = "; ".join(f"{d.compensated} messages of {d.imu_topic} compensated (angular velocity"
+                       f"{' and linear acceleration' if d.accel else ''})" for d in done)
+    whole = "" if all(d.streamed for d in done) else " (read whole: its IMU stamps go back across batches)"
+    click.echo(f"wrote {output}: {topics}, {rest}{whole}")
 
 
 __all__ = ["apply"]

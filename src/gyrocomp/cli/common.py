@@ -210,3 +210,11 @@ def accept_option(function):
     return click.option("--accept", "accept", multiple=True, type=click.Choice(DATA_CHECKS), metavar="CHECK",
                         help=f"Accept this data check's finding knowingly (repeatable): {', '.join(DATA_CHECKS)}.")(
         function)
+
+
+def instance_model_path(model, instance: int) -> Path:
+    """The model file of one sensor instance beside ``model`` (``fit -o m.json --instance all`` writes
+    ``m_imu0.json``, ``m_imu1.json``, ...; ``apply m.json --instance all`` reads them)."""
+    model = Path(model)
+    return model.parent / f"{model.stem}_imu{instance}{model.suffix}"
+

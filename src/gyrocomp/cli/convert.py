@@ -7,7 +7,9 @@ from pathlib import Path
 import click
 
 from ..files.convert import convert_file
-from ..io import output_format, refuse_to_overwrite_inputs
+from ..files.convert_bag import convert_bag
+from ..io import detect_format, output_format, refuse_to_overwrite_inputs
+from ..io.rosbag import KIND_WORDS
 from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
 
 
@@ -17,12 +19,20 @@ from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, r
 @read_options
 @click.pass_context
 def convert(ctx, input_path, output, **kwargs):
-    """Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.
+    """Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT; a ROS bag IN as another kind
+    of bag OUT (out.bag: ROS 1, out.mcap: a bare MCAP file, a name without suffix: a ROS 2 folder), every message kept.
 
     Columns: time [s], gyro_x/y/z [deg/s], accel_x/y/z [g], temperature [degC].
     """
     opts = pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path], option="OUT")
+    in_fmt = detect_format(input_path, opts["fmt"]) if Path(input_path).exists() else None
+    if in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag", ".mcap"):
+        done = convert_bag(input_path, output)
+        if not ctx.obj["quiet"]:
+            click.echo(f"wrote {output}: {KIND_WORDS[done.kind]}, every message of {input_path} "
+                       f"({KIND_WORDS[done.from_kind]})")
+        return
     out_fmt = output_format(output, option="OUT")
     with progress_bar(f"reading {Path(input_path).name}") as progress:
         result = convert_file(input_path, output, options=read_settings(opts), fmt=opts["fmt"], out_fmt=out_fmt,

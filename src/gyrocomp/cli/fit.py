@@ -21,7 +21,7 @@ from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
 from ..files.check import ask_for, enforce, read_noting
 from ..measures.data_check import check_runs
-from .common import (accept_option, FINITE, OUTPUT_FILE, float_list, parse_channels, parse_temperature_option, pop_read_options,
+from .common import (accept_option, FINITE, OUTPUT_FILE, float_list, instance_model_path, parse_channels, parse_temperature_option, pop_read_options,
                      progress_bar, read_options, read_run, temperature_help)
 from .render import print_contributions, print_fit
 
@@ -116,7 +116,7 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
             fits[instance] = fit_runs(recordings, options, channels=channels, pipeline=pipeline,
                                       scale_factor=scale_factor)
     out = Path(output)
-    names = {instance: f"{out.stem}_imu{instance}{out.suffix}" for instance in fits} if every else {None: out.name}
+    names = {instance: instance_model_path(out, instance).name for instance in fits} if every else {None: out.name}
     written = {i: out.parent / names[i] for i in fits}
     # what the fit found is printed before the files are written: a standard output that fails (a full disk
     # behind > file) fails the command before it leaves a model file, not after

@@ -7,7 +7,8 @@ replaced by the compensated value, exactly what :func:`gyrocomp.apply` gives on 
 repeats an earlier one (which reading leaves out) gets the same correction as that one; a message the recording
 does not hold (outside the temperature topic's span, or dropped as non-finite) is copied as it is, and a warning
 says how many. The covariance fields are written from a noise model when one is given, else left as they were.
-A ROS 1 ``.bag`` gives a ``.bag``; a ROS 2 bag folder gives a folder in the same storage (sqlite3 or MCAP). The
+A ROS 1 ``.bag`` gives a ``.bag``; a ROS 2 bag folder gives a folder in the same storage (sqlite3 or MCAP); a bare
+``.mcap`` file (an MCAP bag without its folder, read with the message definitions it holds) gives a ``.mcap``. The
 output is written beside its final name and moved there when complete; the input is never touched.
 
 The bag goes through once, in memory bounded whatever its length: messages are held until ``chunk_rows`` IMU
@@ -26,6 +27,7 @@ import re
 import shutil
 import tempfile
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,7 +41,7 @@ from ..io.atomic import refuse_link
 from ..io.common import require
 from ..io.ros_imu import (ANGULAR_VELOCITY, ANGULAR_VELOCITY_COVARIANCE, LINEAR_ACCELERATION,
                           LINEAR_ACCELERATION_COVARIANCE, imu_batch)
-from ..io.rosbag import IMU_TYPE, BagStream, bag_path, decoded_imu, read_rosbag
+from ..io.rosbag import IMU_TYPE, KIND_WORDS, BagStream, bag_kind, bag_path, decoded_imu, read_rosbag
 from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
@@ -72,15 +74,24 @@ def _stamp_s(header) -> float:
     return header.stamp.sec + header.stamp.nanosec * 1e-9
 
 
-def _writer(bag: Path, target: Path, connections):
-    """A rosbags writer of the input's kind at ``target``, with every connection of the input, by id."""
-    if bag.is_dir():
+def _storage(folder: Path) -> str | None:
+    """The storage a ROS 2 bag folder's ``metadata.yaml`` names (``sqlite3``, ``mcap``)."""
+    found = re.search(r"storage_identifier:\s*['\"]?(\w+)", (folder / "metadata.yaml").read_text(errors="replace"))
+    return found.group(1) if found else None
+
+
+def _writer(bag: Path, target: Path, connections, typestore):
+    """A rosbags writer of the input's kind at ``target`` (a bare MCAP file: a ROS 2 folder in MCAP storage, whose
+    file is taken out of it), with every connection of the input, by id (a connection of a bare MCAP file has no
+    type hash: ``typestore``'s, from the definition in the file)."""
+    kind = bag_kind(bag)
+    if kind != "ros1":
         rosbag2 = require("rosbags.rosbag2", "ros", "writing ROS 2 bags")
-        storage = re.search(r"storage_identifier:\s*['\"]?(\w+)", (bag / "metadata.yaml").read_text(errors="replace"))
-        plugin = rosbag2.StoragePlugin.MCAP if storage and storage.group(1) == "mcap" else rosbag2.StoragePlugin.SQLITE3
+        plugin = rosbag2.StoragePlugin.MCAP if kind == "mcap" or _storage(bag) == "mcap" else rosbag2.StoragePlugin.SQLITE3
         writer = rosbag2.Writer(target, version=9, storage_plugin=plugin)
         writer.open()
-        out = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, rihs01=c.digest,
+        out = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data,
+                                           rihs01=c.digest or typestore.hash_rihs01(c.msgtype),
                                            serialization_format=c.ext.serialization_format,
                                            offered_qos_profiles=c.ext.offered_qos_profiles) for c in connections}
     else:
@@ -101,11 +112,12 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
     calibration : Calibration
         The model.
     path : path
-        A ROS 1 ``.bag`` file or a ROS 2 bag folder.
+        A ROS 1 ``.bag`` file, a ROS 2 bag folder or a bare ``.mcap`` file.
     output : path
-        The bag to write: a ``.bag`` file for a ROS 1 bag, a folder for a ROS 2 bag (replaced when it exists).
+        The bag to write, of the input's kind: a ``.bag`` file, a folder (replaced when it is a bag) or a
+        ``.mcap`` file.
     options : ReadOptions, optional
-        ``imu_topic`` and ``temperature_topic`` (default: the only topic of each type).
+        ``imu_topic`` or ``instance``, and ``temperature_topic`` (default: the only topic of each type).
     noise : path, optional
         A noise model (``gyrocomp noise --export json``): the compensated messages' ``angular_velocity_covariance``
         (and ``linear_acceleration_covariance`` when it models the accelerometer) are written from it, the
@@ -118,73 +130,126 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
     -------
     AppliedBag
     """
-    options = options or ReadOptions()
+    return _apply_bag({None: calibration}, path, output, options or ReadOptions(), noise, chunk_rows)[0]
+
+
+def apply_bag_instances(calibrations: Mapping[int, Calibration], path, output, *,
+                        options: ReadOptions | None = None, chunk_rows: int = CHUNK_ROWS) -> tuple[AppliedBag, ...]:
+    """Compensate several IMU topics of a ROS bag in one pass, each with its own model, into a bag of the same
+    kind (see the module): instance k is the bag's k-th ``sensor_msgs/Imu`` topic in name order, as reading and
+    ``gyrocomp fit --instance all`` number them.
+
+    Parameters
+    ----------
+    calibrations : mapping of int to Calibration
+        The model of each instance compensated (the other IMU topics are copied as they are).
+    path, output : path
+        As :func:`apply_bag`.
+    options : ReadOptions, optional
+        ``temperature_topic`` (default: the only one).
+    chunk_rows : int
+        IMU messages of a topic compensated at once [messages].
+
+    Returns
+    -------
+    tuple of AppliedBag
+        One per instance, in the order of ``calibrations``.
+    """
+    if not calibrations:
+        raise InputError("calibrations: no model given")
+    return _apply_bag(dict(calibrations), path, output, options or ReadOptions(), None, chunk_rows)
+
+
+def _apply_bag(calibrations: dict, path, output, options: ReadOptions, noise, chunk_rows: int
+               ) -> tuple[AppliedBag, ...]:
+    """Each model of ``calibrations`` (by instance; None: the topic ``options`` choose) on its IMU topic."""
     path, output = Path(path), Path(output)
     bag = bag_path(path)
-    if bag.is_dir() == (output.suffix.lower() == ".bag"):
-        kind = "a folder (a ROS 2 bag)" if bag.is_dir() else "a .bag file (a ROS 1 bag)"
-        raise InputError(f"output: {output}: a compensated bag is written as the input's kind: {kind}")
+    if bag_kind(bag) != bag_kind(output):
+        raise InputError(f"output: {output}: a compensated bag is written as the input's kind: "
+                         f"{KIND_WORDS[bag_kind(bag)]}")
     refuse_link(output)
     if output.is_dir() and not (output / "metadata.yaml").is_file():
         raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
                          "only a bag)")
     covariance_of = _covariances(noise) if noise is not None else {}
-    stream = BagStream(path, options, chunk_rows=chunk_rows)
-    counts = {"compensated": 0, "unchanged": 0}
+    streams = {k: BagStream(path, options if k is None else dataclasses.replace(options, instance=k, imu_topic=None),
+                            chunk_rows=chunk_rows) for k in calibrations}
+    topics = {k: stream.imu[0].topic for k, stream in streams.items()}
+    counts = {topics[k]: {"compensated": 0, "unchanged": 0} for k in calibrations}
     streamed = True
     try:
-        copier = _Copier(calibration, stream, covariance_of, counts)
-        _write_bag(bag, output, copier.copy)
-        stream.warn_summary()
-        accel, covariances = copier.with_accel, tuple(copier.covariances)
+        copiers = {topics[k]: _Copier(calibrations[k], streams[k], covariance_of, counts[topics[k]])
+                   for k in calibrations}
+        _write_bag(bag, output, lambda reader, writer, connections: _copy_in_batches(reader, writer, connections,
+                                                                                     copiers, chunk_rows))
+        for stream in streams.values():
+            stream.warn_summary()
+        done = {topic: (c.with_accel, tuple(c.covariances)) for topic, c in copiers.items()}
     except NotStreamable:
-        counts, streamed = {"compensated": 0, "unchanged": 0}, False
-        recording = read_rosbag(path, options)
-        compensated = apply(calibration, recording)
-        covariances = {field: make(recording.rate_hz) for field, make in covariance_of.items()}
-        accel = recording.accel_g is not None and not np.array_equal(compensated.accel_g, recording.accel_g)
-        result = (recording, compensated, accel, covariances)
-        _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections,
-                                                                          stream.imu[0].topic, result, counts))
-    if counts["unchanged"]:
-        warnings.warn(f"{path}: {counts['unchanged']} message(s) of {stream.imu[0].topic} are not in the recording "
-                      "the bag reads as (outside the temperature topic's span, or not finite) and were copied "
-                      "uncompensated", DataQualityWarning, stacklevel=2)
-    return AppliedBag(output, stream.imu[0].topic, counts["compensated"], counts["unchanged"], accel,
-                      tuple(covariances), streamed)
+        streamed = False
+        counts = {topic: {"compensated": 0, "unchanged": 0} for topic in counts}
+        results = {topics[k]: _whole(calibrations[k], path, streams[k].options, covariance_of) for k in calibrations}
+        _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections, results,
+                                                                          counts))
+        done = {topic: (result[2], tuple(result[3])) for topic, result in results.items()}
+    for topic, count in counts.items():
+        if count["unchanged"]:
+            warnings.warn(f"{path}: {count['unchanged']} message(s) of {topic} are not in the recording the bag "
+                          "reads as (outside the temperature topic's span, or not finite) and were copied "
+                          "uncompensated", DataQualityWarning, stacklevel=3)
+    return tuple(AppliedBag(output, topics[k], counts[topics[k]]["compensated"], counts[topics[k]]["unchanged"],
+                            *done[topics[k]], streamed) for k in calibrations)
+
+
+def _whole(calibration: Calibration, path: Path, options: ReadOptions, covariance_of: dict) -> tuple:
+    """(recording, its compensation, whether the accelerations are compensated, the covariance fields) of a whole
+    read of the topic ``options`` choose."""
+    recording = read_rosbag(path, options)
+    compensated = apply(calibration, recording)
+    covariances = {field: make(recording.rate_hz) for field, make in covariance_of.items()}
+    accel = recording.accel_g is not None and not np.array_equal(compensated.accel_g, recording.accel_g)
+    return recording, compensated, accel, covariances
+
+
+def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_rows: int) -> None:
+    """Every message of the bag into ``writer`` in one pass: held until a topic of ``copiers`` has ``chunk_rows``
+    IMU messages (or :data:`WINDOW_BYTES` are held, each topic with :data:`FIRST_SAMPLES` at least), the IMU
+    messages among them compensated by their topic's copier, then everything held written in its order."""
+    held, raws, held_bytes = [], {topic: [] for topic in copiers}, 0
+
+    def write() -> None:
+        out = {topic: copiers[topic].compensated(reader, messages) for topic, messages in raws.items() if messages}
+        for connection, timestamp, topic, slot, raw in held:
+            writer.write(connection, timestamp, raw if topic is None else out[topic][slot])
+
+    for connection, timestamp, raw in reader.messages():
+        topic = connection.topic if connection.topic in copiers and connection.msgtype == IMU_TYPE else None
+        if topic is None:
+            held.append((connections[connection.id], timestamp, None, -1, raw))
+        else:
+            held.append((connections[connection.id], timestamp, topic, len(raws[topic]), raw))
+            raws[topic].append(raw)
+        held_bytes += len(raw)
+        if (any(len(m) >= chunk_rows for m in raws.values())
+                or (held_bytes >= WINDOW_BYTES and all(len(m) >= FIRST_SAMPLES for m in raws.values()))):
+            write()
+            held, raws, held_bytes = [], {topic: [] for topic in copiers}, 0
+    write()
 
 
 class _Copier:
-    """The one pass of :func:`apply_bag`: every message of the bag into the writer, the IMU topic's compensated a
-    batch at a time (see the module)."""
+    """One IMU topic's part of the pass of :func:`apply_bag`: its messages compensated a batch at a time, the
+    compensator's state carried from one batch to the next (see the module)."""
 
     def __init__(self, calibration: Calibration, stream: BagStream, covariance_of: dict, counts: dict):
         self.calibration, self.stream, self.covariance_of, self.counts = calibration, stream, covariance_of, counts
-        self.topic = stream.imu[0].topic
         self.comp = None
         self.with_accel = False
         self.covariances: dict = {}
         self.twin: tuple | None = None  # the last batch's last stamp and its corrections [rad/s, m/s^2] (or None)
 
-    def copy(self, reader, writer, connections: dict) -> None:
-        held, imu, held_bytes = [], [], 0
-        for connection, timestamp, raw in reader.messages():
-            is_imu = connection.topic == self.topic and connection.msgtype == IMU_TYPE
-            held.append((connections[connection.id], timestamp, len(imu) if is_imu else -1, raw))
-            held_bytes += len(raw)
-            if is_imu:
-                imu.append(raw)
-            if len(imu) >= self.stream.chunk_rows or (held_bytes >= WINDOW_BYTES and len(imu) >= FIRST_SAMPLES):
-                self._write(reader, writer, held, imu)
-                held, imu, held_bytes = [], [], 0
-        self._write(reader, writer, held, imu)
-
-    def _write(self, reader, writer, held: list, imu: list) -> None:
-        out = self._compensated(reader, imu) if imu else []
-        for connection, timestamp, slot, raw in held:
-            writer.write(connection, timestamp, raw if slot < 0 else out[slot])
-
-    def _compensated(self, reader, raws: list) -> list:
+    def compensated(self, reader, raws: list) -> list:
         """The IMU messages ``raws`` compensated (those outside the recording as they were)."""
         stamp, gyro_rad, accel_ms2 = decoded_imu(reader, IMU_TYPE, raws)
         stream = self.stream
@@ -289,61 +354,72 @@ def _write_bag(bag: Path, output: Path, copy) -> None:
     highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
     parent = output.parent if str(output.parent) else Path(".")
     tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
-    target = tmp / (output.name if output.suffix else "bag")
+    target = tmp / (output.name if bag_kind(bag) == "ros1" else "bag")
     try:
         with highlevel.AnyReader([bag]) as reader:
-            writer, connections = _writer(bag, target, reader.connections)
+            writer, connections = _writer(bag, target, reader.connections, reader.typestore)
             try:
                 copy(reader, writer, connections)
             finally:
                 writer.close()
-        _move_into_place(target, output)
+        if bag_kind(bag) == "mcap":  # the storage file alone, without its folder
+            target = next(target.glob("*.mcap"))
+        move_into_place(target, output)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def _copy(reader, writer, connections: dict, topic: str, result: tuple, counts: dict) -> None:
-    """Every message into ``writer``: the IMU topic's compensated (``result``: the recording, its compensation,
-    whether the accelerations are compensated, the covariance fields to write), the rest as its bytes."""
-    recording, compensated, with_accel, covariances = result
-    time_s = recording.time_s
-    gyro_rad = compensated.gyro_dps / _RAD
-    correction = (recording.gyro_dps - compensated.gyro_dps) / _RAD
-    accel_ms2 = compensated.accel_g / _MS2 if with_accel else None
-    accel_correction = (recording.accel_g - compensated.accel_g) / _MS2 if with_accel else None
-    axes = [recording.gyro_axes.index(a) for a in ("gyro_x", "gyro_y", "gyro_z")]
-    seen: set[int] = set()
+def _copy(reader, writer, connections: dict, results: dict, counts: dict) -> None:
+    """Every message into ``writer``: the IMU topics of ``results`` compensated (by topic: the recording, its
+    compensation, whether the accelerations are compensated, the covariance fields to write), the rest as its
+    bytes (a bag compensated from a whole read: message by message through rosbags)."""
+    prepared = {topic: _prepared(result) for topic, result in results.items()}
+    seen: dict[str, set[int]] = {topic: set() for topic in results}
     store = reader.typestore
     serialize = store.serialize_cdr if reader.is2 else store.serialize_ros1
     for connection, timestamp, raw in reader.messages():
         out = connections[connection.id]
-        if connection.topic != topic or connection.msgtype != IMU_TYPE:
+        topic = connection.topic
+        if topic not in results or connection.msgtype != IMU_TYPE:
             writer.write(out, timestamp, raw)
             continue
+        time_s, gyro_rad, correction, accel_ms2, accel_correction, covariances = prepared[topic]
         msg = reader.deserialize(raw, connection.msgtype)
         stamp = _stamp_s(msg.header)
         k = int(np.searchsorted(time_s, stamp))
         if k >= time_s.size or time_s[k] != stamp:
-            counts["unchanged"] += 1
+            counts[topic]["unchanged"] += 1
             writer.write(out, timestamp, raw)
             continue
-        first = k not in seen  # a repeated stamp gets the same correction as the message reading kept
-        seen.add(k)
+        first = k not in seen[topic]  # a repeated stamp gets the same correction as the message reading kept
+        seen[topic].add(k)
         w = msg.angular_velocity
-        values = gyro_rad[k, axes] if first else np.array([w.x, w.y, w.z]) - correction[k, axes]
+        values = gyro_rad[k] if first else np.array([w.x, w.y, w.z]) - correction[k]
         changes = {"angular_velocity": dataclasses.replace(w, x=float(values[0]), y=float(values[1]),
                                                            z=float(values[2]))}
-        if with_accel:
+        if accel_ms2 is not None:
             a = msg.linear_acceleration
             acc = accel_ms2[k] if first else np.array([a.x, a.y, a.z]) - accel_correction[k]
             changes["linear_acceleration"] = dataclasses.replace(a, x=float(acc[0]), y=float(acc[1]), z=float(acc[2]))
         for field, values in covariances.items():
             changes[field] = np.asarray(values, dtype=np.float64)
         writer.write(out, timestamp, serialize(dataclasses.replace(msg, **changes), connection.msgtype))
-        counts["compensated"] += 1
+        counts[topic]["compensated"] += 1
 
 
-def _move_into_place(source: Path, output: Path) -> None:
+def _prepared(result: tuple) -> tuple:
+    """(time [s], compensated gyro [rad/s] (x, y, z), its correction, compensated accel [m/s^2] and its correction
+    or None, covariance fields) of a whole read's ``result``."""
+    recording, compensated, with_accel, covariances = result
+    axes = [recording.gyro_axes.index(a) for a in ("gyro_x", "gyro_y", "gyro_z")]
+    gyro_rad = (compensated.gyro_dps / _RAD)[:, axes]
+    correction = ((recording.gyro_dps - compensated.gyro_dps) / _RAD)[:, axes]
+    accel_ms2 = compensated.accel_g / _MS2 if with_accel else None
+    accel_correction = (recording.accel_g - compensated.accel_g) / _MS2 if with_accel else None
+    return recording.time_s, gyro_rad, correction, accel_ms2, accel_correction, covariances
+
+
+def move_into_place(source: Path, output: Path) -> None:
     """``source`` (a file or a folder) to ``output``: a file replaces it in one step; a folder replaces an older
     folder by moving that aside first, then removing it."""
     if source.is_file() or not output.exists():
@@ -355,4 +431,4 @@ def _move_into_place(source: Path, output: Path) -> None:
     shutil.rmtree(aside, ignore_errors=True)
 
 
-__all__ = ["AppliedBag", "apply_bag"]
+__all__ = ["AppliedBag", "apply_bag", "apply_bag_instances", "move_into_place"]

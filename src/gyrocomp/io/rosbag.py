@@ -44,6 +44,20 @@ def bag_path(path: Path) -> Path:
     return path
 
 
+#: what a bag of each kind is, for messages
+KIND_WORDS = {"ros1": "a .bag file (a ROS 1 bag)", "ros2": "a folder (a ROS 2 bag)",
+              "mcap": "a .mcap file (an MCAP bag without its folder)"}
+
+
+def bag_kind(path: Path) -> str:
+    """``ros1`` (a ``.bag`` file), ``ros2`` (a ROS 2 bag folder) or ``mcap`` (a bare ``.mcap`` file) for the path
+    rosbags opens (:func:`gyrocomp.io.rosbag.bag_path`), or for an output by its name (no suffix: a folder)."""
+    if path.is_dir():
+        return "ros2"
+    suffix = path.suffix.lower()
+    return "mcap" if suffix == ".mcap" else "ros1" if suffix == ".bag" or path.is_file() else "ros2"
+
+
 def _only_its_own_files(path: Path, bag: Path) -> None:
     """Refuse a ROS 2 bag folder holding a link to a file outside it: a bag is read from its own files only."""
     if not bag.is_dir():
