@@ -19,10 +19,11 @@ from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, r
 @read_options
 @click.pass_context
 def convert(ctx, input_path, output, **kwargs):
-    """Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT; a ROS bag IN as another kind
-    of bag OUT (out.bag: ROS 1, out.mcap: a bare MCAP file, a name without suffix: a ROS 2 folder), every message kept.
+    """Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT, or a bag as another bag.
 
-    Columns: time [s], gyro_x/y/z [deg/s], accel_x/y/z [g], temperature [degC].
+    Columns: time [s], gyro_x/y/z [deg/s], accel_x/y/z [g], temperature [degC]. A ROS bag IN with OUT named
+    out.bag (ROS 1), out.mcap (a bare MCAP file) or without a suffix (a ROS 2 folder) is rewritten as that kind of
+    bag, every message kept.
     """
     opts = pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [input_path], option="OUT")

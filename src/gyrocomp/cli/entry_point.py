@@ -45,7 +45,8 @@ COMMANDS = {
                 "ids), and the drift its held-out folds expect."),
     "split": ("split", "Cut LOG into runs, one file each, so that a recording of several "
                        "power-ons, poses or temperature legs becomes the runs a fit takes."),
-    "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT.'),
+    "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT, or a bag '
+                           'as another bag.'),
     "check": ("check", "Check RUNS before a fit, as fit and fleet fit do: one verdict line per run (ok, warning with "
                        "its expected cost, or refused with the reason)."),
     "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
