@@ -41,7 +41,7 @@ from ..io.atomic import refuse_link
 from ..io.common import require
 from ..io.ros_imu import (ANGULAR_VELOCITY, ANGULAR_VELOCITY_COVARIANCE, LINEAR_ACCELERATION,
                           LINEAR_ACCELERATION_COVARIANCE, imu_batch)
-from ..io.rosbag import IMU_TYPE, KIND_WORDS, BagStream, bag_kind, bag_path, decoded_imu, read_rosbag
+from ..io.rosbag import IMU_TYPE, KIND_WORDS, BagStream, any_reader, bag_kind, bag_path, decoded_imu, read_rosbag
 from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
@@ -351,12 +351,11 @@ def _covariances(noise) -> dict:
 def _write_bag(bag: Path, output: Path, copy) -> None:
     """``copy(reader, writer, connections)`` into a bag written beside ``output`` in a temporary folder, moved into
     place when complete."""
-    highlevel = require("rosbags.highlevel", "ros", "reading ROS bags")
     parent = output.parent if str(output.parent) else Path(".")
     tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
     target = tmp / (output.name if bag_kind(bag) == "ros1" else "bag")
     try:
-        with highlevel.AnyReader([bag]) as reader:
+        with any_reader(bag) as reader:
             writer, connections = _writer(bag, target, reader.connections, reader.typestore)
             try:
                 copy(reader, writer, connections)

@@ -25,6 +25,7 @@ from .common import ProgressCallback, ReadOptions, keep_matched, log_recording, 
 from .layout import TIME_COLUMN, TableLayout
 from .readers import Reader, register_reader
 from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, imu_batch
+from .rosbag1_chunks import chunked_reader1
 from .stream import CHUNK_ROWS, NotStreamable
 from .tables import recording_table
 
@@ -85,6 +86,16 @@ def _topics_of(connections: list, msgtype: str) -> list[str]:
     return sorted({c.topic for c in connections if c.msgtype == msgtype and c.msgcount > 0})
 
 
+def any_reader(bag: Path, highlevel=None):
+    """rosbags' :class:`~rosbags.highlevel.AnyReader` of a bag (not opened), a ROS 1 bag read chunk by chunk
+    (:mod:`gyrocomp.io.rosbag1_chunks`: without an index entry of every message in memory)."""
+    highlevel = highlevel or require("rosbags.highlevel", "ros", "reading ROS bags")
+    reader = highlevel.AnyReader([bag])
+    if not reader.is2:
+        reader.readers = [chunked_reader1()(bag)]
+    return reader
+
+
 def _open(path: Path):
     """An open rosbags reader of the bag at ``path`` (its message type names checked first); anything that is not
     a readable bag is refused in one line."""
@@ -94,7 +105,7 @@ def _open(path: Path):
     bag = bag_path(path)
     _only_its_own_files(path, bag)
     try:
-        reader = highlevel.AnyReader([bag])
+        reader = any_reader(bag, highlevel)
         _check_types(path, reader.readers)
         reader.open()
     except InputError:
