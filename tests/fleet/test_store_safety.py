@@ -74,17 +74,19 @@ def test_serials_that_once_shared_a_file_each_keep_their_model(manifest, tmp_pat
 
 
 @pytest.mark.slow
-def test_a_failed_model_write_stores_nothing_and_the_rerun_fits_the_unit(manifest, tmp_path):
-    out = tmp_path / "FLEET"
+def test_a_failed_model_write_stores_nothing_and_the_rerun_fits_the_unit(manifest, tmp_path, store_location):
+    """On each backend (the store a fleet folder's SQLite file, or a PostgreSQL database beside the folder)."""
+    out = tmp_path / "OUT"
     out.mkdir()
     (out / "models").write_text("not a folder")  # every model write fails
-    result = _fit(manifest, out)
+    store = _store_args(store_location, out)
+    result = _fit(manifest, out, *store)
     assert result.returncode == 2 and result.stderr.count("\n") == 1
     assert "cannot write unit" in result.stderr and "the next run fits it again" in result.stderr
-    with CalibrationStore(out) as db:
+    with CalibrationStore(_store(store_location, out)) as db:
         assert db.serials() == []  # no row without its model file
     (out / "models").unlink()
-    result = _fit(manifest, out)
+    result = _fit(manifest, out, *store)
     assert result.returncode == 0, result.stderr
     assert f"{len(SERIALS)} unit(s) fitted, 0 unchanged" in result.stdout
 
@@ -120,13 +122,13 @@ def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_pa
     out = tmp_path / "FLEET"
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
     args = ["fleet", "fit", "--manifest", str(manifest), "-o", str(out), "--scheduler", "serial", "--store",
-            store_location if "://" in store_location else str(out)]
+            str(_store(store_location, out))]
     procs = [subprocess.Popen([*cmd, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for _ in range(2)]
     results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
     for _stdout, stderr, code in results:
         assert code == 0, stderr
-    with CalibrationStore(store_location if "://" in store_location else out) as db:
+    with CalibrationStore(_store(store_location, out)) as db:
         assert sorted(db.serials()) == sorted(SERIALS)
         assert all(len(db.history(s)) == 1 for s in SERIALS)
 
@@ -145,28 +147,42 @@ def _other_inputs(folder, serials):
     return other
 
 
-def _files_agree_with_newest_rows(out, serials):
-    with CalibrationStore(out) as db:
+def _store(store_location: str, out):
+    """The store of a test on either backend: a PostgreSQL URL, else the fleet folder ``out``."""
+    return store_location if "://" in store_location else out
+
+
+def _store_args(store_location: str, out) -> list:
+    """``--store URL`` for a PostgreSQL store (a SQLite store is the fleet folder's own)."""
+    return ["--store", store_location] if "://" in store_location else []
+
+
+def _files_agree_with_newest_rows(out, serials, store=None):
+    with CalibrationStore(store or out) as db:
         for s in serials:
             newest = [r for r in db.history(s) if r.status == "ok"][-1]
             assert (out / "models" / model_file_name(s)).read_text() == newest.model_json, s
 
 
 @pytest.mark.slow
-def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_model(manifest, tmp_path):
+def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_model(manifest, tmp_path,
+                                                                                   store_location, request):
     """Two stations recalibrating the same units from different runs at once: whatever the interleaving, each
-    unit's model file is its newest row's (the file is written holding the store's write lock)."""
+    unit's model file is its newest row's (the file is written holding the store's write lock); on each backend
+    (each repeat a new PostgreSQL database)."""
     other = _other_inputs(tmp_path, SERIALS)
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
     for repeat in range(3):
         out = tmp_path / f"FLEET{repeat}"
+        location = store_location if repeat == 0 or "://" not in store_location else \
+            request.getfixturevalue("postgres_server")()
         procs = [subprocess.Popen([*cmd, "fleet", "fit", "--manifest", str(m), "-o", str(out), "--scheduler",
-                                   "serial"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-                 for m in (manifest, other)]
+                                   "serial", *_store_args(location, out)], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True) for m in (manifest, other)]
         for p in procs:
             _, stderr = p.communicate(timeout=300)
             assert p.returncode == 0, stderr
-        _files_agree_with_newest_rows(out, SERIALS)
+        _files_agree_with_newest_rows(out, SERIALS, _store(location, out))
 
 
 @pytest.mark.slow
