@@ -191,6 +191,8 @@ def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -
     the recording needs strictly increasing time.
     """
     time_s = np.asarray(time_s, dtype=float)
+    if time_s.size < 2 or bool(np.all(time_s[1:] > time_s[:-1])):  # in order, no repeat: nothing to sort or copy
+        return (time_s, *(None if a is None else np.asarray(a) for a in arrays))
     order = np.argsort(time_s, kind="stable")
     sorted_t = time_s[order]
     keep = np.ones(sorted_t.size, dtype=bool)

@@ -230,12 +230,17 @@ def _imu_batches(path: Path, reader, imu: list, size: int, progress: ProgressCal
 
 def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | None, total: int):
     """(time [s], gyro [deg/s], accel [g]) of every message on the IMU topic, in time order."""
-    parts = list(_imu_batches(path, reader, imu, DECODE_BATCH,
-                              (lambda f: progress(f * sum(c.msgcount for c in imu) / total)) if progress else None))
-    if not parts:
-        return order_by_time(str(path), np.empty(0), np.empty((0, 3)), np.empty((0, 3)))
-    time_s, gyro, accel = (np.concatenate(p) for p in zip(*parts))
-    return order_by_time(str(path), time_s, gyro * _RAD, accel * _MS2)
+    n = sum(c.msgcount for c in imu)
+    time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))  # filled batch by batch: no copies
+    done = 0
+    for t, g, a in _imu_batches(path, reader, imu, DECODE_BATCH,
+                                (lambda f: progress(f * n / total)) if progress else None):
+        time_s[done:done + t.size], gyro[done:done + t.size], accel[done:done + t.size] = t, g, a
+        done += t.size
+    gyro, accel = gyro[:done], accel[:done]
+    gyro *= _RAD
+    accel *= _MS2
+    return order_by_time(str(path), time_s[:done], gyro, accel)
 
 
 def _temperature_samples(path: Path, reader, thermo: list):
