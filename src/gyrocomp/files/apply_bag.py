@@ -223,18 +223,21 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
         for connection, timestamp, topic, slot, raw in held:
             writer.write(connection, timestamp, raw if topic is None else out[topic][slot])
 
+    imu = {c.id: c.topic for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE}
+    most = 0  # the most IMU messages held of one topic
     for connection, timestamp, raw in reader.messages():
-        topic = connection.topic if connection.topic in copiers and connection.msgtype == IMU_TYPE else None
+        topic = imu.get(connection.id)
         if topic is None:
             held.append((connections[connection.id], timestamp, None, -1, raw))
         else:
-            held.append((connections[connection.id], timestamp, topic, len(raws[topic]), raw))
-            raws[topic].append(raw)
+            messages = raws[topic]
+            held.append((connections[connection.id], timestamp, topic, len(messages), raw))
+            messages.append(raw)
+            most = max(most, len(messages))
         held_bytes += len(raw)
-        if (any(len(m) >= chunk_rows for m in raws.values())
-                or (held_bytes >= WINDOW_BYTES and all(len(m) >= FIRST_SAMPLES for m in raws.values()))):
+        if most >= chunk_rows or (held_bytes >= WINDOW_BYTES and all(len(m) >= FIRST_SAMPLES for m in raws.values())):
             write()
-            held, raws, held_bytes = [], {topic: [] for topic in copiers}, 0
+            held, raws, held_bytes, most = [], {topic: [] for topic in copiers}, 0, 0
     write()
 
 

@@ -5,8 +5,8 @@ rosbags' :class:`rosbags.rosbag1.Reader` reads an index entry of every message w
 connections merged in time order. A ROS 1 bag's chunks follow each other in time, and within a chunk its messages in
 the order they were recorded: :class:`ChunkedReader1` opens a bag from its connection and chunk-info records only
 (the per-connection message counts come from the chunk infos) and yields the messages chunk by chunk as they lie in
-the file, each chunk decompressed (none, bz2, lz4) when it is reached. The records are parsed by rosbags' own
-functions; everything else (connections, message definitions, the type store of :class:`rosbags.highlevel.AnyReader`)
+the file, each chunk decompressed (none, bz2, lz4) when it is reached. The bag's index is read by rosbags' own
+functions, a chunk's records by :func:`_chunk_messages` (their three header fields in place); everything else (connections, message definitions, the type store of :class:`rosbags.highlevel.AnyReader`)
 is rosbags' as it is.
 
 The ROS 1 bag format (version 2.0): records of a header (``op``, ``conn``, ``time``, ...) and data; chunks hold
@@ -19,7 +19,7 @@ from __future__ import annotations
 import functools
 import os
 import re
-from io import BytesIO
+import struct
 
 from .common import require
 
@@ -92,25 +92,48 @@ def _messages(self, connections=(), start: int | None = None, stop: int | None =
         chunk = self.read_chunk()
         self.bio.seek(chunk.datapos)
         data = chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize))
-        yield from _chunk_messages(rb, BytesIO(data), len(data), connmap, wanted, (start, stop))
+        yield from _chunk_messages(rb, bytes(data), connmap, wanted, (start, stop))
 
 
-def _chunk_messages(rb, chunk: BytesIO, size: int, connmap: dict, wanted: set, span: tuple):
-    """The message-data records of one decompressed chunk, in their order."""
+_UINT32 = struct.Struct("<I")
+_TIME = struct.Struct("<II")
+
+
+def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple):
+    """The message-data records of one decompressed chunk, in their order: each record's header fields (``op``,
+    ``conn``, ``time``) read in place with ``struct`` (rosbags' :class:`Header` makes a dict of every record's; this
+    is the reading of a long bag), a record that runs past the chunk a ReaderError."""
     start, stop = span
-    while chunk.tell() < size:
-        header = rb.Header.read(chunk)
-        length = rb.read_uint32(chunk)
-        if header.get_uint8("op") == rb.RecordType.MSGDATA:
-            conn = header.get_uint32("conn")
-            if conn in wanted:
-                time = header.get_time("time")
-                if (start is None or time >= start) and (stop is None or time < stop):
-                    if conn not in connmap:
-                        raise rb.ReaderError(f"A message of connection {conn}, which the bag's index lacks.")
-                    yield connmap[conn], time, rb.read_bytes(chunk, length)
-                    continue
-        chunk.seek(length, os.SEEK_CUR)
+    size, pos = len(data), 0
+    try:
+        while pos < size:
+            (length,), pos = _UINT32.unpack_from(data, pos), pos + 4
+            end = pos + length
+            if end + 4 > size:
+                raise rb.ReaderError("A record's header runs past the end of its chunk.")
+            op = conn = time = None
+            while pos < end:
+                (field,), pos = _UINT32.unpack_from(data, pos), pos + 4
+                name, _, value = data[pos:pos + field].partition(b"=")
+                pos += field
+                if name == b"op":
+                    op = value[0]
+                elif name == b"conn":
+                    conn = _UINT32.unpack(value)[0]
+                elif name == b"time":
+                    sec, nsec = _TIME.unpack(value)
+                    time = sec * 1_000_000_000 + nsec
+            (length,), pos = _UINT32.unpack_from(data, end), end + 4
+            if pos + length > size:
+                raise rb.ReaderError("A record's data runs past the end of its chunk.")
+            if op == rb.RecordType.MSGDATA and conn in wanted and (start is None or time >= start) and (
+                    stop is None or time < stop):
+                if conn not in connmap:
+                    raise rb.ReaderError(f"A message of connection {conn}, which the bag's index lacks.")
+                yield connmap[conn], time, data[pos:pos + length]
+            pos += length
+    except (struct.error, IndexError, TypeError) as err:
+        raise rb.ReaderError(f"A damaged record in a chunk ({type(err).__name__}: {err}).") from None
 
 
 @functools.cache
