@@ -409,14 +409,6 @@ class CalibrationStore:
                   .subquery())
         return self._records(sa.select(*self._columns).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial))
 
-    def ok_hashes(self) -> dict[str, str]:
-        """The input hash of every unit's newest successful calibration, by serial (one query)."""
-        newest = (sa.select(sa.func.max(_ROWS.c.id).label("id")).where(_ROWS.c.status == "ok")
-                  .group_by(_ROWS.c.serial).subquery())
-        query = sa.select(_ROWS.c.serial, _ROWS.c.input_hash).join(newest, _ROWS.c.id == newest.c.id)
-        with self.engine.connect() as conn:
-            return {serial: digest for serial, digest in conn.execute(query)}
-
     def ok_hash(self, serial: str) -> str | None:
         """The input hash of ``serial``'s newest successful calibration (None when it has none)."""
         with self.engine.connect() as conn:
