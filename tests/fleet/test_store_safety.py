@@ -11,6 +11,7 @@ import subprocess
 import sys
 
 import pytest
+import sqlalchemy as sa
 
 from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, model_file_name
@@ -92,13 +93,14 @@ def test_a_failed_model_write_stores_nothing_and_the_rerun_fits_the_unit(manifes
 
 
 @pytest.mark.slow
-def test_the_rerun_puts_back_a_missing_model_file(manifest, tmp_path):
-    out = tmp_path / "FLEET"
-    assert _fit(manifest, out).returncode == 0
+def test_the_rerun_puts_back_a_missing_model_file(manifest, tmp_path, store_location):
+    out = tmp_path / "OUT"
+    store = _store_args(store_location, out)
+    assert _fit(manifest, out, *store).returncode == 0
     lost = out / "models" / model_file_name("a/b")
     text = lost.read_text()
     lost.unlink()
-    result = _fit(manifest, out)
+    result = _fit(manifest, out, *store)
     assert result.returncode == 0 and f"0 unit(s) fitted, {len(SERIALS)} unchanged" in result.stdout
     assert lost.read_text() == text
 
@@ -186,17 +188,18 @@ def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_mo
 
 
 @pytest.mark.slow
-def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp_path):
-    out = tmp_path / "FLEET"
-    assert _fit(manifest, out).returncode == 0
+def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp_path, store_location):
+    out = tmp_path / "OUT"
+    store = _store_args(store_location, out)
+    assert _fit(manifest, out, *store).returncode == 0
     first, second = (out / "models" / model_file_name(s) for s in ("SN-1", "a_b"))
     first.write_text(second.read_text())  # another unit's model copied over it
     second.write_text(second.read_text()[:100])  # cut short
-    result = _fit(manifest, out)
+    result = _fit(manifest, out, *store)
     assert result.returncode == 0 and f"0 unit(s) fitted, {len(SERIALS)} unchanged" in result.stdout
     said = [line for line in result.stderr.splitlines() if "written again from the store" in line]
     assert len(said) == 2 and any(str(first) in line for line in said) and any(str(second) in line for line in said)
-    _files_agree_with_newest_rows(out, SERIALS)
+    _files_agree_with_newest_rows(out, SERIALS, _store(store_location, out))
 
 
 @pytest.mark.parametrize("column, value, said", [
@@ -224,6 +227,27 @@ def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, 
     assert not (tmp_path / "m.json").exists() and (tmp_path / "r.html").exists() == (column == "model")
     # the rerun never writes a damaged row's model over the unit's good file (it did, with a warning)
     assert model_file.read_bytes() == kept
+
+
+@pytest.mark.slow
+def test_a_damaged_model_row_on_postgresql_is_one_line_naming_it(manifest, tmp_path, postgres_server):
+    """The same on a PostgreSQL store, changed by another program through SQL: every command that reads the row
+    says it in one line, and the rerun leaves the unit's good model file alone."""
+    url, out = postgres_server(), tmp_path / "OUT"
+    assert _fit(manifest, out, "--store", url).returncode == 0
+    engine = sa.create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
+    with engine.begin() as conn:
+        conn.execute(sa.text("UPDATE calibrations SET model = :value WHERE serial = 'SN-1'"),
+                     {"value": '{"schema_version": 6, "axes"'})
+    engine.dispose()
+    kept = (out / "models" / "SN-1.json").read_bytes()
+    for args in (["show", "SN-1", "--store", url], ["export", "SN-1", "--store", url, "--format", "json", "-o",
+                                                     tmp_path / "m.json"],
+                 ["fit", "--manifest", manifest, "-o", out, "--scheduler", "serial", "--store", url]):
+        result = run("fleet", *args)
+        assert result.returncode == 2 and result.stderr.count("\n") == 1, (args, result.stderr)
+        assert re.search(r"store row \d+ \(SN-1\): ", result.stderr), (args, result.stderr)
+    assert not (tmp_path / "m.json").exists() and (out / "models" / "SN-1.json").read_bytes() == kept
 
 
 @pytest.mark.slow
