@@ -280,7 +280,7 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     Parameters
     ----------
     path : path
-        A ROS 1 ``.bag`` file or a ROS 2 bag folder.
+        A ROS 1 ``.bag`` file, a ROS 2 bag folder (or a file in it) or a bare ``.mcap`` file.
     options : ReadOptions, optional
         ``imu_topic`` and ``temperature_topic`` (default: the only topic of each type).
     progress : callable, optional
@@ -333,7 +333,7 @@ class BagStream:
     Parameters
     ----------
     path : path
-        A ROS 1 ``.bag`` file or a ROS 2 bag folder.
+        A ROS 1 ``.bag`` file, a ROS 2 bag folder (or a file in it) or a bare ``.mcap`` file.
     options : ReadOptions, optional
         ``imu_topic``, ``instance``, ``temperature_topic``, ``drop_nonfinite``.
     chunk_rows : int
@@ -472,7 +472,7 @@ def bag_stream(path: Path, options: ReadOptions, chunk_rows: int, progress) -> B
     return BagStream(path, options, chunk_rows=chunk_rows, progress=progress)
 
 
-register_reader(Reader("rosbag", "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, extra [ros]", read_rosbag,
+register_reader(Reader("rosbag", "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, a bare .mcap, extra [ros]", read_rosbag,
                        suffixes=(".bag", ".db3", ".mcap"), magic=(b"#ROSBAG", b"\x89MCAP"), aliases=("bag", "ros"),
                        folder_marker="metadata.yaml", instances=rosbag_instances,
                        stream=bag_stream))
