@@ -39,6 +39,7 @@ from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
+from ..io.rosbag1_chunks import lean_writer1
 from ..io.ros_imu import (ANGULAR_VELOCITY, ANGULAR_VELOCITY_COVARIANCE, LINEAR_ACCELERATION,
                           LINEAR_ACCELERATION_COVARIANCE, imu_batch)
 from ..io.rosbag import IMU_TYPE, KIND_WORDS, BagStream, any_reader, bag_kind, bag_path, decoded_imu, read_rosbag
@@ -95,8 +96,7 @@ def _writer(bag: Path, target: Path, connections, typestore):
                                            serialization_format=c.ext.serialization_format,
                                            offered_qos_profiles=c.ext.offered_qos_profiles) for c in connections}
     else:
-        rosbag1 = require("rosbags.rosbag1", "ros", "writing ROS 1 bags")
-        writer = rosbag1.Writer(target)
+        writer = lean_writer1()(target)
         writer.open()
         out = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, md5sum=c.digest,
                                            callerid=c.ext.callerid, latching=c.ext.latching) for c in connections}
