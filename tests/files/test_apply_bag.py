@@ -230,3 +230,20 @@ def test_each_imu_topic_with_its_own_model_in_one_pass(chunk_rows, model, model_
     assert cli.returncode == 0, cli.stderr
     assert "200 messages of /imu_a compensated (angular velocity); 200 messages of /imu_b compensated" in cli.stdout
     assert _messages(tmp_path / "cli.bag") == _messages(tmp_path / "out.bag")
+
+
+def test_a_bag_heavy_with_other_topics_is_written_in_windows_of_bytes(model, tmp_path, monkeypatch):
+    """Held messages written out once their bytes pass the window (here 3 kB, after 20 IMU samples set the rate):
+    the same bag as in one batch."""
+    import gyrocomp.files.apply_bag as module
+
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=300)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        apply_bag(model, source, tmp_path / "one.bag")
+        monkeypatch.setattr(module, "WINDOW_BYTES", 3000)
+        monkeypatch.setattr(module, "FIRST_SAMPLES", 20)
+        done = apply_bag(model, source, tmp_path / "windows.bag")
+    assert done.compensated == 300
+    assert _messages(tmp_path / "windows.bag") == _messages(tmp_path / "one.bag")

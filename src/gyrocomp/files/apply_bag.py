@@ -214,8 +214,9 @@ def _whole(calibration: Calibration, path: Path, options: ReadOptions, covarianc
 
 def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_rows: int) -> None:
     """Every message of the bag into ``writer`` in one pass: held until a topic of ``copiers`` has ``chunk_rows``
-    IMU messages (or :data:`WINDOW_BYTES` are held, each topic with :data:`FIRST_SAMPLES` at least), the IMU
-    messages among them compensated by their topic's copier, then everything held written in its order."""
+    IMU messages (or :data:`WINDOW_BYTES` are held, each topic's rate set: its compensator made, or
+    :data:`FIRST_SAMPLES` held), the IMU messages among them compensated by their topic's copier, then everything
+    held written in its order."""
     held, raws, held_bytes = [], {topic: [] for topic in copiers}, 0
 
     def write() -> None:
@@ -235,7 +236,8 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
             messages.append(raw)
             most = max(most, len(messages))
         held_bytes += len(raw)
-        if most >= chunk_rows or (held_bytes >= WINDOW_BYTES and all(len(m) >= FIRST_SAMPLES for m in raws.values())):
+        if most >= chunk_rows or (held_bytes >= WINDOW_BYTES and all(
+                copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())):
             write()
             held, raws, held_bytes, most = [], {topic: [] for topic in copiers}, 0, 0
     write()
