@@ -51,6 +51,7 @@ def test_every_suffix_of_a_delimited_table_is_read(tmp_path, suffix):
     assert result.returncode == 0, result.stderr
 
 
+@pytest.mark.slow
 def test_progress_bar_on_a_terminal_only(report_files):
     d = report_files
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]

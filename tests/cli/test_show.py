@@ -36,6 +36,7 @@ def test_show_names_the_axes_the_device_ids_and_the_expected_drift(tmp_path):
     assert missing.returncode == 2 and "no such model file" in missing.stderr
 
 
+@pytest.mark.slow
 def test_quiet_prints_only_errors(tmp_path):
     made = run("simulate", "--profile", "chamber", "--duration", 3000, "--rate", 1, "-o", tmp_path / "c.csv")
     assert made.returncode == 0

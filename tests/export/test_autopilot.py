@@ -268,6 +268,7 @@ def test_a_logs_installed_calibration_is_read_from_its_parameters(tmp_path):
     assert np.max(np.abs(apply(installed, rec).gyro_dps)) < 1e-4  # float32 logging, nothing else left
 
 
+@pytest.mark.slow
 def test_evaluate_installed_judges_the_autopilots_calibration_against_the_model(tmp_path):
     """A ULog whose raw sensor_gyro drifts as a gyrocomp model says, written three times: with that model's PX4
     parameters installed, with a stale calibration (slopes halved), and with the right parameters for another

@@ -203,6 +203,7 @@ def test_a_model_with_accelerometer_terms_compensates_the_accelerations_too(chun
     np.testing.assert_allclose(back.gyro_dps, expected.gyro_dps, rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("chunk_rows", [None, 30])
 def test_each_imu_topic_with_its_own_model_in_one_pass(chunk_rows, model, model_with_accel, tmp_path):
     """Two IMU topics (instances in name order: /imu_a 0, /imu_b 1), each with its model; and through the command

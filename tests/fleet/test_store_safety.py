@@ -62,6 +62,7 @@ def fitted(manifest, tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_serials_that_once_shared_a_file_each_keep_their_model(manifest, tmp_path):
     out = tmp_path / "FLEET"
     result = _fit(manifest, out)
@@ -119,6 +120,7 @@ def test_outputs_onto_the_store_are_refused_and_the_store_is_intact(manifest, tm
     assert store.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_path, store_location):
     """Two fits creating one new store at once (a fleet folder's SQLite file, or an empty PostgreSQL database)."""
     out = tmp_path / "FLEET"

@@ -24,6 +24,7 @@ def adis():
         return adis_sessions()
 
 
+@pytest.mark.slow
 def test_adis16405_matches_its_datasheet(adis):
     """ADIS16405 datasheet: angle random walk 2 deg/sqrt(h), in-run bias stability 25 deg/h (typical)."""
     assert len(adis) == 6
