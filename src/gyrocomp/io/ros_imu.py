@@ -64,6 +64,7 @@ class ImuBatch:
         return ImuBatch(data, self.values_at)
 
     def message(self, i: int) -> bytes:
+        """Message ``i`` serialized."""
         return self.data[i].tobytes()
 
 
@@ -73,7 +74,7 @@ def imu_batch(raws: list, cdr: bool) -> ImuBatch | None:
     if not raws:
         return None
     length = len(raws[0])
-    if any(len(r) != length for r in raws):
+    if length < 16 + 8 * _VALUES or any(len(r) != length for r in raws):
         return None
     data = np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(len(raws), length)
     text = np.ascontiguousarray(data[:, 12:16]).view("<u4")[:, 0]
