@@ -21,6 +21,7 @@ stamps go back further than the batch before is compensated from a whole read in
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import re
@@ -42,7 +43,8 @@ from ..io.common import require
 from ..io.rosbag1_chunks import lean_writer1
 from ..io.ros_imu import (ANGULAR_VELOCITY, ANGULAR_VELOCITY_COVARIANCE, LINEAR_ACCELERATION,
                           LINEAR_ACCELERATION_COVARIANCE, imu_batch)
-from ..io.rosbag import IMU_TYPE, KIND_WORDS, BagStream, any_reader, bag_kind, bag_path, decoded_imu, read_rosbag
+from ..io.rosbag import (IMU_TYPE, KIND_WORDS, BagStream, any_reader, bag_kind, bag_path, decoded_imu,
+                          header_stamp_s, read_rosbag)
 from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
@@ -69,10 +71,6 @@ class AppliedBag:
     accel: bool
     covariances: tuple[str, ...] = ()
     streamed: bool = True
-
-
-def _stamp_s(header) -> float:
-    return header.stamp.sec + header.stamp.nanosec * 1e-9
 
 
 def _storage(folder: Path) -> str | None:
@@ -168,10 +166,7 @@ def _apply_bag(calibrations: dict, path, output, options: ReadOptions, noise, ch
     if bag_kind(bag) != bag_kind(output):
         raise InputError(f"output: {output}: a compensated bag is written as the input's kind: "
                          f"{KIND_WORDS[bag_kind(bag)]}")
-    refuse_link(output)
-    if output.is_dir() and not (output / "metadata.yaml").is_file():
-        raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
-                         "only a bag)")
+    refuse_output(output)
     covariance_of = _covariances(noise) if noise is not None else {}
     streams = {k: BagStream(path, options if k is None else dataclasses.replace(options, instance=k, imu_topic=None),
                             chunk_rows=chunk_rows) for k in calibrations}
@@ -331,15 +326,22 @@ class _Copier:
         out = list(raws)
         for i in done:
             msg = reader.deserialize(raws[i], IMU_TYPE)
-            changes = {"angular_velocity": dataclasses.replace(msg.angular_velocity, x=float(gyro[i, 0]),
-                                                               y=float(gyro[i, 1]), z=float(gyro[i, 2]))}
-            if accel is not None:
-                changes["linear_acceleration"] = dataclasses.replace(
-                    msg.linear_acceleration, x=float(accel[i, 0]), y=float(accel[i, 1]), z=float(accel[i, 2]))
-            for field, values in self.covariances.items():
-                changes[field] = np.asarray(values, dtype=np.float64)
-            out[i] = serialize(dataclasses.replace(msg, **changes), IMU_TYPE)
+            out[i] = serialize(_replaced(msg, gyro[i], None if accel is None else accel[i], self.covariances),
+                               IMU_TYPE)
         return out
+
+
+def _replaced(msg, gyro_rad, accel_ms2, covariances: dict):
+    """An IMU message with its angular velocity (x, y, z) [rad/s], its linear acceleration [m/s^2] (None: as it
+    was) and the covariance fields ``covariances`` replaced."""
+    changes = {"angular_velocity": dataclasses.replace(msg.angular_velocity, x=float(gyro_rad[0]),
+                                                       y=float(gyro_rad[1]), z=float(gyro_rad[2]))}
+    if accel_ms2 is not None:
+        changes["linear_acceleration"] = dataclasses.replace(msg.linear_acceleration, x=float(accel_ms2[0]),
+                                                             y=float(accel_ms2[1]), z=float(accel_ms2[2]))
+    for field, values in covariances.items():
+        changes[field] = np.asarray(values, dtype=np.float64)
+    return dataclasses.replace(msg, **changes)
 
 
 def _covariances(noise) -> dict:
@@ -353,24 +355,39 @@ def _covariances(noise) -> dict:
     return out
 
 
-def _write_bag(bag: Path, output: Path, copy) -> None:
-    """``copy(reader, writer, connections)`` into a bag written beside ``output`` in a temporary folder, moved into
-    place when complete."""
+def refuse_output(output: Path) -> None:
+    """An output bag that is a link, or an existing folder that is not a ROS 2 bag (gyrocomp replaces only a bag),
+    refused in one line."""
+    refuse_link(output)
+    if output.is_dir() and not (output / "metadata.yaml").is_file():
+        raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
+                         "only a bag)")
+
+
+@contextlib.contextmanager
+def staged_bag(output: Path, kind: str):
+    """The path to write a bag of ``kind`` (``ros1``, ``ros2``, ``mcap``) at: beside ``output``, in a temporary
+    folder moved into place when the block ends without an error (a bare MCAP file: its storage file alone, out
+    of the folder rosbags writes it in), removed either way."""
     parent = output.parent if str(output.parent) else Path(".")
     tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
-    target = tmp / (output.name if bag_kind(bag) == "ros1" else "bag")
+    target = tmp / (output.name if kind == "ros1" else "bag")
     try:
-        with any_reader(bag) as reader:
-            writer, connections = _writer(bag, target, reader.connections, reader.typestore)
-            try:
-                copy(reader, writer, connections)
-            finally:
-                writer.close()
-        if bag_kind(bag) == "mcap":  # the storage file alone, without its folder
-            target = next(target.glob("*.mcap"))
-        move_into_place(target, output)
+        yield target
+        move_into_place(next(target.glob("*.mcap")) if kind == "mcap" else target, output)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _write_bag(bag: Path, output: Path, copy) -> None:
+    """``copy(reader, writer, connections)`` into a bag of the input's kind, staged beside ``output``
+    (:func:`staged_bag`)."""
+    with staged_bag(output, bag_kind(bag)) as target, any_reader(bag) as reader:
+        writer, connections = _writer(bag, target, reader.connections, reader.typestore)
+        try:
+            copy(reader, writer, connections)
+        finally:
+            writer.close()
 
 
 def _copy(reader, writer, connections: dict, results: dict, counts: dict) -> None:
@@ -389,7 +406,7 @@ def _copy(reader, writer, connections: dict, results: dict, counts: dict) -> Non
             continue
         time_s, gyro_rad, correction, accel_ms2, accel_correction, covariances = prepared[topic]
         msg = reader.deserialize(raw, connection.msgtype)
-        stamp = _stamp_s(msg.header)
+        stamp = header_stamp_s(msg.header)
         k = int(np.searchsorted(time_s, stamp))
         if k >= time_s.size or time_s[k] != stamp:
             counts[topic]["unchanged"] += 1
@@ -399,15 +416,11 @@ def _copy(reader, writer, connections: dict, results: dict, counts: dict) -> Non
         seen[topic].add(k)
         w = msg.angular_velocity
         values = gyro_rad[k] if first else np.array([w.x, w.y, w.z]) - correction[k]
-        changes = {"angular_velocity": dataclasses.replace(w, x=float(values[0]), y=float(values[1]),
-                                                           z=float(values[2]))}
+        acc = None
         if accel_ms2 is not None:
             a = msg.linear_acceleration
             acc = accel_ms2[k] if first else np.array([a.x, a.y, a.z]) - accel_correction[k]
-            changes["linear_acceleration"] = dataclasses.replace(a, x=float(acc[0]), y=float(acc[1]), z=float(acc[2]))
-        for field, values in covariances.items():
-            changes[field] = np.asarray(values, dtype=np.float64)
-        writer.write(out, timestamp, serialize(dataclasses.replace(msg, **changes), connection.msgtype))
+        writer.write(out, timestamp, serialize(_replaced(msg, values, acc, covariances), connection.msgtype))
         counts[topic]["compensated"] += 1
 
 
@@ -435,4 +448,4 @@ def move_into_place(source: Path, output: Path) -> None:
     shutil.rmtree(aside, ignore_errors=True)
 
 
-__all__ = ["AppliedBag", "apply_bag", "apply_bag_instances", "move_into_place"]
+__all__ = ["AppliedBag", "apply_bag", "apply_bag_instances", "refuse_output", "staged_bag"]

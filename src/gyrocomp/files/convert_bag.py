@@ -5,16 +5,13 @@ dropped as ROS 2 has none). Written beside the output and moved there when compl
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError, printable
-from ..io.atomic import refuse_link
 from ..io.common import require
 from ..io.rosbag import KIND_WORDS, bag_kind, bag_path
-from .apply_bag import move_into_place
+from .apply_bag import refuse_output, staged_bag
 
 
 @dataclass(frozen=True)
@@ -47,14 +44,8 @@ def convert_bag(path, output) -> ConvertedBag:
     if source == target:
         others = " or ".join(words for kind, words in KIND_WORDS.items() if kind != source)
         raise InputError(f"output: {output}: the input is already {KIND_WORDS[source]}; name {others}")
-    refuse_link(output)
-    if output.is_dir() and not (output / "metadata.yaml").is_file():
-        raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
-                         "only a bag)")
-    parent = output.parent if str(output.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
-    written = tmp / (output.name if target == "ros1" else "bag")
-    try:
+    refuse_output(output)
+    with staged_bag(output, target) as written:
         try:
             converter.convert([bag], written, dst_storage="mcap" if target == "mcap" else "sqlite3",
                               dst_version=None if target == "ros1" else 9, compress=None, compress_mode="file",
@@ -63,11 +54,6 @@ def convert_bag(path, output) -> ConvertedBag:
         except converter.ConverterError as exc:
             raise InputError(f"{path}: cannot be converted to {KIND_WORDS[target]}: {printable(str(exc))[:200]}") \
                 from None
-        if target == "mcap":  # the storage file alone, without its folder
-            written = next(written.glob("*.mcap"))
-        move_into_place(written, output)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
     return ConvertedBag(output, target, source)
 
 

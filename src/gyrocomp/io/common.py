@@ -202,11 +202,17 @@ def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -
     dropped = int(sorted_t.size - index.size)
     if moved or dropped:
         back = float(np.max(np.maximum.accumulate(time_s)[:-1] - time_s[1:])) if time_s.size > 1 else 0.0
-        warnings.warn(TimeOrderWarning(
-            f"{source}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) dropped"
-            + (f" (the time went back by up to {back:.6g} s)" if back > 0 else ""),
-            moved=moved, dropped=dropped, largest_back_s=max(back, 0.0)), stacklevel=3)
+        warnings.warn(time_order_warning(source, moved, dropped, back), stacklevel=3)
     return (time_s[index], *(None if a is None else np.asarray(a)[index] for a in arrays))
+
+
+def time_order_warning(source: str, moved: int, dropped: int, back_s: float) -> TimeOrderWarning:
+    """What :func:`order_by_time` says of ``moved`` samples sorted, ``dropped`` repeated stamps and the time going
+    back by up to ``back_s`` [s] (a reader in chunks says it once for the whole file)."""
+    return TimeOrderWarning(
+        f"{source}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) dropped"
+        + (f" (the time went back by up to {back_s:.6g} s)" if back_s > 0 else ""),
+        moved=moved, dropped=dropped, largest_back_s=max(back_s, 0.0))
 
 
 def match_by_time(
@@ -258,11 +264,17 @@ def match_by_time(
 def keep_matched(source: str, what: str, ok: np.ndarray) -> np.ndarray:
     """Index of the samples that could be matched; warns how many were left out, refuses if none."""
     if not ok.any():
-        raise InputError(f"{source}: no gyro sample lies within the time span of {what}; they cannot be matched")
+        raise none_matched(source, what)
     if not ok.all():
-        warnings.warn(
-            f"{source}: {int(np.count_nonzero(~ok))} of {ok.size} gyro samples lie outside the time span of {what} "
-            "and were left out",
-            DataQualityWarning, stacklevel=3,
-        )
+        warnings.warn(left_out(source, what, int(np.count_nonzero(~ok)), ok.size), DataQualityWarning, stacklevel=3)
     return np.flatnonzero(ok)
+
+
+def none_matched(source: str, what: str) -> InputError:
+    """The refusal of gyro samples none of which lies within the time span of ``what``."""
+    return InputError(f"{source}: no gyro sample lies within the time span of {what}; they cannot be matched")
+
+
+def left_out(source: str, what: str, unmatched: int, total: int) -> str:
+    """What :func:`keep_matched` says of ``unmatched`` of ``total`` gyro samples outside the span of ``what``."""
+    return f"{source}: {unmatched} of {total} gyro samples lie outside the time span of {what} and were left out"

@@ -21,13 +21,14 @@ import pyarrow as pa
 from ..errors import DataQualityWarning, InputError, TimeOrderWarning, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, keep_matched, log_recording, match_by_time, order_by_time, require
+from .common import (ProgressCallback, ReadOptions, keep_matched, left_out, log_recording, match_by_time,
+                     none_matched, order_by_time, require, time_order_warning)
 from .layout import TIME_COLUMN, TableLayout
 from .readers import Reader, register_reader
 from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, imu_batch
 from .rosbag1_chunks import chunked_reader1
 from .stream import CHUNK_ROWS, NotStreamable
-from .tables import recording_table
+from .tables import recording_table, rows_dropped
 
 IMU_TYPE = "sensor_msgs/msg/Imu"
 TEMPERATURE_TYPE = "sensor_msgs/msg/Temperature"
@@ -159,7 +160,8 @@ def _topic(path: Path, connections: list, msgtype: str, asked: str | None, optio
     return [c for c in connections if c.topic == of_type[0]]
 
 
-def _stamp_s(header) -> float:
+def header_stamp_s(header) -> float:
+    """A message header's stamp [s]: sec + nanosec 1e-9."""
     stamp = header.stamp
     return stamp.sec + stamp.nanosec * 1e-9
 
@@ -199,7 +201,7 @@ def decoded_imu(reader, msgtype: str, raws: list) -> tuple[np.ndarray, np.ndarra
     time_s, gyro, accel = np.empty(len(raws)), np.empty((len(raws), 3)), np.empty((len(raws), 3))
     for i, raw in enumerate(raws):
         msg = reader.deserialize(raw, msgtype)
-        time_s[i] = _stamp_s(msg.header)
+        time_s[i] = header_stamp_s(msg.header)
         w, a = msg.angular_velocity, msg.linear_acceleration
         gyro[i] = (w.x, w.y, w.z)
         accel[i] = (a.x, a.y, a.z)
@@ -249,7 +251,7 @@ def _temperature_samples(path: Path, reader, thermo: list):
     with _damaged(path, thermo[0].topic):
         for connection, _, raw in reader.messages(connections=thermo):
             msg = reader.deserialize(raw, connection.msgtype)
-            t_time.append(_stamp_s(msg.header))
+            t_time.append(header_stamp_s(msg.header))
             t_value.append(msg.temperature)
     _read_all(path, sum(c.msgcount for c in thermo), len(t_time), thermo[0].topic)
     return order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
@@ -421,8 +423,7 @@ class BagStream:
             if part is not None:
                 yield self.chunk_of(part)
         if self._temperature is not None and self._order["unmatched"] == self._order["samples"]:
-            raise InputError(f"{self.path}: no gyro sample lies within the time span of temperature topic "
-                             f"{self.thermo[0].topic}; they cannot be matched")
+            raise none_matched(str(self.path), f"temperature topic {self.thermo[0].topic}")
         if self.progress:
             self.progress(1.0)
 
@@ -447,19 +448,14 @@ class BagStream:
     def warn_summary(self) -> None:
         """The warnings a whole read gives, once for the bag: samples sorted or repeated, samples outside the
         temperature topic's span, rows dropped."""
-        moved, dropped, back = self._order["moved"], self._order["dropped"], self._order["back"]
+        moved, dropped = self._order["moved"], self._order["dropped"]
         if moved or dropped:
-            warnings.warn(TimeOrderWarning(
-                f"{self.path}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) "
-                "dropped" + (f" (the time went back by up to {back:.6g} s)" if back > 0 else ""),
-                moved=moved, dropped=dropped, largest_back_s=back), stacklevel=2)
+            warnings.warn(time_order_warning(str(self.path), moved, dropped, self._order["back"]), stacklevel=2)
         if self._order["unmatched"]:
-            warnings.warn(f"{self.path}: {self._order['unmatched']} of {self._order['samples']} gyro samples lie "
-                          f"outside the time span of temperature topic {self.thermo[0].topic} and were left out",
-                          DataQualityWarning, stacklevel=2)
+            warnings.warn(left_out(str(self.path), f"temperature topic {self.thermo[0].topic}",
+                                   self._order["unmatched"], self._order["samples"]), DataQualityWarning, stacklevel=2)
         if self.rows_dropped:
-            warnings.warn(f"{self.path}: dropped {self.rows_dropped} of {self.rows} rows with empty, NaN or infinite "
-                          "values", DataQualityWarning, stacklevel=2)
+            warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
 
 
 def _joined(parts: list) -> tuple:

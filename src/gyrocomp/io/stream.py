@@ -29,7 +29,7 @@ from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (CSV_BLOCK_BYTES, DECOMPRESS_ERRORS, HEADER_MAX_BYTES, TableLayout, TextFormat, _channel_selector,
                      _csv_options, _read_arrow, _resolved_columns, check_header, check_parquet_footer, csv_codec,
-                     detect_table_format, open_csv_bytes, output_text_format, read_error, table_recording,
+                     detect_table_format, open_csv_bytes, output_text_format, read_error, rows_dropped, table_recording,
                      with_decimal)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
@@ -232,8 +232,7 @@ class TableStream:
     def warn_summary(self) -> None:
         """The warnings a whole-file read gives: rows dropped, time gaps (once each, for the whole file)."""
         if self.rows_dropped:
-            warnings.warn(f"{self.path}: dropped {self.rows_dropped} of {self.rows} rows with empty, NaN or infinite "
-                          "values", DataQualityWarning, stacklevel=2)
+            warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
         if self.gaps:
             duration, row = self.longest_gap
             warnings.warn(f"{self.path}: {self.gaps} time gap(s) longer than 2 sample periods (longest "

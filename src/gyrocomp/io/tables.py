@@ -359,6 +359,11 @@ def _temperature_columns(cols: dict[str, str], gyro_axes: tuple[str, ...]) -> li
     return [TEMPERATURE_COLUMN] if TEMPERATURE_COLUMN in cols else []
 
 
+def rows_dropped(path, dropped: int, rows: int) -> str:
+    """What :func:`keep_finite_rows` says of ``dropped`` of ``rows`` rows left out (a reader in chunks: once)."""
+    return f"{path}: dropped {dropped} of {rows} rows with empty, NaN or infinite values"
+
+
 def keep_finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | None) -> tuple[np.ndarray, list]:
     """The indices of rows where every channel is finite and the channels cut to them (a warning says how many
     rows went)."""
@@ -370,8 +375,7 @@ def keep_finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | Non
     if ok.all():
         return np.arange(n), [time_s, *channels]
     kept = np.flatnonzero(ok)
-    warnings.warn(f"{path}: dropped {n - kept.size} of {n} rows with empty, NaN or infinite values",
-                  DataQualityWarning, stacklevel=3)
+    warnings.warn(rows_dropped(path, n - kept.size, n), DataQualityWarning, stacklevel=3)
     return kept, [time_s[kept], *(None if v is None else v[kept] for v in channels)]
 
 
