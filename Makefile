@@ -34,9 +34,10 @@ test: $(STAMP)
 quick: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m "not slow"
 
-# the linter (ruff: pyflakes, pycodestyle, bugbear; pyproject.toml's [tool.ruff])
+# the linter and the formatter's check (ruff: pyflakes, pycodestyle, bugbear; pyproject.toml's [tool.ruff])
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks tools examples
+	$(BIN)/ruff format --check src tests benchmarks tools examples
 
 # the documentation site (MkDocs, Material, mkdocstrings) into site/, warnings as errors
 docs: $(STAMP)

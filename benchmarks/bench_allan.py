@@ -56,12 +56,22 @@ def compare(n: int, repeat: int) -> dict:
     t_ours, mem_ours, ours = measure(lambda: allan_deviation(y, rate_hz, taus=taus, confidence=None), repeat)
     t_ci, mem_ci, _ = measure(lambda: allan_deviation(y, rate_hz, taus=taus), repeat)
     t_theirs, mem_theirs, theirs = measure(
-        lambda: allantools.oadev(y, rate=rate_hz, data_type="freq", taus=taus), repeat)
+        lambda: allantools.oadev(y, rate=rate_hz, data_type="freq", taus=taus), repeat
+    )
     agree = float(np.max(np.abs(ours.deviation / theirs[1] - 1.0)))
-    return {"n": n, "taus": len(taus), "gyrocomp_s": t_ours, "allantools_s": t_theirs,
-            "speedup": t_theirs / t_ours, "gyrocomp_extra_memory_x": mem_ours / y.nbytes,
-            "gyrocomp_ci_s": t_ci, "speedup_ci": t_theirs / t_ci, "gyrocomp_ci_extra_memory_x": mem_ci / y.nbytes,
-            "allantools_extra_memory_x": mem_theirs / y.nbytes, "max_relative_difference": agree}
+    return {
+        "n": n,
+        "taus": len(taus),
+        "gyrocomp_s": t_ours,
+        "allantools_s": t_theirs,
+        "speedup": t_theirs / t_ours,
+        "gyrocomp_extra_memory_x": mem_ours / y.nbytes,
+        "gyrocomp_ci_s": t_ci,
+        "speedup_ci": t_theirs / t_ci,
+        "gyrocomp_ci_extra_memory_x": mem_ci / y.nbytes,
+        "allantools_extra_memory_x": mem_theirs / y.nbytes,
+        "max_relative_difference": agree,
+    }
 
 
 def huge(n: int, workdir: Path) -> dict:
@@ -85,12 +95,18 @@ def huge(n: int, workdir: Path) -> dict:
     traced_peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     expected = 0.01 / np.sqrt(result.tau * rate_hz)  # white noise: sigma(tau) = sigma_1 / sqrt(m)
-    return {"n": n, "seconds": elapsed, "samples_per_s": n / elapsed, "taus": len(result.tau),
-            "working_memory_mib": traced_peak / 2 ** 20,
-            "peak_rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20,
-            "input_gib": n * 8 / 2 ** 30,
-            "max_relative_error_vs_white_noise_theory_first_10_taus":
-                float(np.max(np.abs(result.deviation[:10] / expected[:10] - 1)))}
+    return {
+        "n": n,
+        "seconds": elapsed,
+        "samples_per_s": n / elapsed,
+        "taus": len(result.tau),
+        "working_memory_mib": traced_peak / 2**20,
+        "peak_rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20,
+        "input_gib": n * 8 / 2**30,
+        "max_relative_error_vs_white_noise_theory_first_10_taus": float(
+            np.max(np.abs(result.deviation[:10] / expected[:10] - 1))
+        ),
+    }
 
 
 def main() -> None:
@@ -100,32 +116,42 @@ def main() -> None:
     parser.add_argument("--huge", type=float, default=0)
     parser.add_argument("--workdir", type=Path, default=None)
     args = parser.parse_args()
-    print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
-          f"numpy {np.__version__}")
-    print("| samples | taus | allantools.oadev [s] | gyrocomp, deviations only [s] | speed-up | "
-          "gyrocomp with noise ID + CIs [s] | speed-up | extra memory: allantools / gyrocomp / gyrocomp + CIs "
-          "| max rel. difference |")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
+        f"numpy {np.__version__}"
+    )
+    print(
+        "| samples | taus | allantools.oadev [s] | gyrocomp, deviations only [s] | speed-up | "
+        "gyrocomp with noise ID + CIs [s] | speed-up | extra memory: allantools / gyrocomp / gyrocomp + CIs "
+        "| max rel. difference |"
+    )
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for size in args.sizes.split(","):
         r = compare(int(float(size)), args.repeat)
-        print(f"| {r['n']:.0e} | {r['taus']} | {r['allantools_s']:.3f} | {r['gyrocomp_s']:.3f} | "
-              f"{r['speedup']:.1f}x | {r['gyrocomp_ci_s']:.3f} | {r['speedup_ci']:.1f}x | "
-              f"{r['allantools_extra_memory_x']:.2f}x / {r['gyrocomp_extra_memory_x']:.2f}x / "
-              f"{r['gyrocomp_ci_extra_memory_x']:.2f}x input | {r['max_relative_difference']:.1e} |")
+        print(
+            f"| {r['n']:.0e} | {r['taus']} | {r['allantools_s']:.3f} | {r['gyrocomp_s']:.3f} | "
+            f"{r['speedup']:.1f}x | {r['gyrocomp_ci_s']:.3f} | {r['speedup_ci']:.1f}x | "
+            f"{r['allantools_extra_memory_x']:.2f}x / {r['gyrocomp_extra_memory_x']:.2f}x / "
+            f"{r['gyrocomp_ci_extra_memory_x']:.2f}x input | {r['max_relative_difference']:.1e} |"
+        )
     largest = max(int(float(size)) for size in args.sizes.split(","))
     with busy_neighbour():
         r = compare(largest, args.repeat)
-    print(f"\nwith a busy neighbour process on one core, {largest:.0e} samples: allantools {r['allantools_s']:.3f} s, "
-          f"gyrocomp {r['gyrocomp_s']:.3f} s = {r['speedup']:.1f}x; with noise ID + CIs {r['gyrocomp_ci_s']:.3f} s "
-          f"= {r['speedup_ci']:.1f}x")
+    print(
+        f"\nwith a busy neighbour process on one core, {largest:.0e} samples: allantools {r['allantools_s']:.3f} s, "
+        f"gyrocomp {r['gyrocomp_s']:.3f} s = {r['speedup']:.1f}x; with noise ID + CIs {r['gyrocomp_ci_s']:.3f} s "
+        f"= {r['speedup_ci']:.1f}x"
+    )
     if args.huge:
         with tempfile.TemporaryDirectory(dir=args.workdir) as tmp:
             r = huge(int(args.huge), Path(tmp))
-        print(f"\nout of core: {r['n']:.0e} samples ({r['input_gib']:.1f} GiB), {r['taus']} octave taus with CIs "
-              f"in {r['seconds']:.0f} s = {r['samples_per_s'] / 1e6:.1f} M samples/s; working memory (numpy "
-              f"allocations) {r['working_memory_mib']:.1f} MiB; peak RSS {r['peak_rss_gib']:.2f} GiB (reclaimable "
-              f"memory-mapped file pages included); deviation vs theory "
-              f"{r['max_relative_error_vs_white_noise_theory_first_10_taus']:.1e}")
+        print(
+            f"\nout of core: {r['n']:.0e} samples ({r['input_gib']:.1f} GiB), {r['taus']} octave taus with CIs "
+            f"in {r['seconds']:.0f} s = {r['samples_per_s'] / 1e6:.1f} M samples/s; working memory (numpy "
+            f"allocations) {r['working_memory_mib']:.1f} MiB; peak RSS {r['peak_rss_gib']:.2f} GiB (reclaimable "
+            f"memory-mapped file pages included); deviation vs theory "
+            f"{r['max_relative_error_vs_white_noise_theory_first_10_taus']:.1e}"
+        )
 
 
 if __name__ == "__main__":

@@ -65,8 +65,15 @@ def run(rows: int, repeat: int) -> dict:
             t_arrow_busy = best_of(repeat, arrow_io)
             t_apply_busy = best_of(repeat, gyrocomp_apply)
         size_mb = data.stat().st_size / 1e6
-    return {"rows": sim.recording.n_samples, "size_mb": size_mb, "pandas_s": t_pandas, "pyarrow_s": t_arrow,
-            "apply_s": t_apply, "pyarrow_busy_s": t_arrow_busy, "apply_busy_s": t_apply_busy}
+    return {
+        "rows": sim.recording.n_samples,
+        "size_mb": size_mb,
+        "pandas_s": t_pandas,
+        "pyarrow_s": t_arrow,
+        "apply_s": t_apply,
+        "pyarrow_busy_s": t_arrow_busy,
+        "apply_busy_s": t_apply_busy,
+    }
 
 
 def cli() -> None:
@@ -75,17 +82,21 @@ def cli() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     r = run(args.rows, args.repeat)
-    print(f"machine: {platform.machine()}, {platform.python_implementation()} {platform.python_version()}, "
-          f"pandas {pd.__version__}")
+    print(
+        f"machine: {platform.machine()}, {platform.python_implementation()} {platform.python_version()}, "
+        f"pandas {pd.__version__}"
+    )
     print(f"file: {r['rows']} rows, 8 columns, {r['size_mb']:.1f} MB CSV; best of {args.repeat}")
     print(f"pandas read_csv + to_csv : {r['pandas_s']:7.2f} s")
     print(f"pyarrow read + write     : {r['pyarrow_s']:7.2f} s")
     print(f"gyrocomp apply           : {r['apply_s']:7.2f} s")
     print(f"apply / pandas I/O  = {r['apply_s'] / r['pandas_s']:.2f}x (target <= 1.3x)")
     print(f"apply / pyarrow I/O = {r['apply_s'] / r['pyarrow_s']:.2f}x")
-    print(f"with a busy neighbour on one core: pyarrow I/O {r['pyarrow_busy_s']:.2f} s, gyrocomp apply "
-          f"{r['apply_busy_s']:.2f} s ({r['apply_busy_s'] / r['apply_s']:.2f}x idle, "
-          f"{r['apply_busy_s'] / r['pyarrow_busy_s']:.2f}x pyarrow)")
+    print(
+        f"with a busy neighbour on one core: pyarrow I/O {r['pyarrow_busy_s']:.2f} s, gyrocomp apply "
+        f"{r['apply_busy_s']:.2f} s ({r['apply_busy_s'] / r['apply_s']:.2f}x idle, "
+        f"{r['apply_busy_s'] / r['pyarrow_busy_s']:.2f}x pyarrow)"
+    )
 
 
 if __name__ == "__main__":

@@ -39,12 +39,18 @@ from gyrocomp.simulation import simulate
 BLOCK_S = 3600.0
 G = 9.80665
 
-PROGRAMS.update({
-    "gyrocomp apply bag": ("import sys\nfrom gyrocomp.cli import main\n"
-                           "sys.exit(main(['--quiet', 'apply', sys.argv[3], sys.argv[1], '-o', sys.argv[2]]))\n"),
-    "gyrocomp fit": ("import sys\nfrom gyrocomp.cli import main\n"
-                     "sys.exit(main(['--quiet', 'fit', sys.argv[1], '-o', sys.argv[2] + '.json']))\n"),
-})
+PROGRAMS.update(
+    {
+        "gyrocomp apply bag": (
+            "import sys\nfrom gyrocomp.cli import main\n"
+            "sys.exit(main(['--quiet', 'apply', sys.argv[3], sys.argv[1], '-o', sys.argv[2]]))\n"
+        ),
+        "gyrocomp fit": (
+            "import sys\nfrom gyrocomp.cli import main\n"
+            "sys.exit(main(['--quiet', 'fit', sys.argv[1], '-o', sys.argv[2] + '.json']))\n"
+        ),
+    }
+)
 #: each command's program, on the bag and on the table
 COMMANDS = {"allan": "gyrocomp allan", "apply": "gyrocomp apply bag", "fit": "gyrocomp fit"}
 
@@ -69,22 +75,33 @@ def make_files(bag, table, hours: float, rate_hz: float, kind: str) -> int:
     types = store.types
     imu_type, temperature_type = "sensor_msgs/msg/Imu", "sensor_msgs/msg/Temperature"
     stamp0 = types["builtin_interfaces/msg/Time"](sec=0, nanosec=0)
-    header = (types["std_msgs/msg/Header"](stamp=stamp0, frame_id="imu_link") if ros2
-              else types["std_msgs/msg/Header"](seq=0, stamp=stamp0, frame_id="imu_link"))
+    header = (
+        types["std_msgs/msg/Header"](stamp=stamp0, frame_id="imu_link")
+        if ros2
+        else types["std_msgs/msg/Header"](seq=0, stamp=stamp0, frame_id="imu_link")
+    )
     zero, vector = np.zeros(9), types["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
-    template = types[imu_type](header=header, orientation=types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0,
-                                                                                                w=1.0),
-                               orientation_covariance=zero, angular_velocity=vector, angular_velocity_covariance=zero,
-                               linear_acceleration=vector, linear_acceleration_covariance=zero)
+    template = types[imu_type](
+        header=header,
+        orientation=types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+        orientation_covariance=zero,
+        angular_velocity=vector,
+        angular_velocity_covariance=zero,
+        linear_acceleration=vector,
+        linear_acceleration_covariance=zero,
+    )
     serialize = store.serialize_cdr if ros2 else store.serialize_ros1
     raw = bytes(serialize(template, imu_type))
-    block = simulate("consumer", profile="chamber", rate_hz=rate_hz, duration_s=BLOCK_S - 1 / rate_hz, seed=1,
-                     unit=3).recording
+    block = simulate(
+        "consumer", profile="chamber", rate_hz=rate_hz, duration_s=BLOCK_S - 1 / rate_hz, seed=1, unit=3
+    ).recording
     if ros2:
         from rosbags.rosbag2 import StoragePlugin, Writer
+
         writer = Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3)
     else:
         from rosbags.rosbag1 import Writer
+
         writer = Writer(bag)
     blocks = int(np.ceil(hours * 3600.0 / BLOCK_S))
     samples = 0
@@ -107,10 +124,14 @@ def make_files(bag, table, hours: float, rate_hz: float, kind: str) -> int:
                 if i % each == 0:
                     sec = int(time_s[i])
                     stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int(round((time_s[i] - sec) * 1e9)))
-                    head = (types["std_msgs/msg/Header"](stamp=stamp, frame_id="imu_link") if ros2
-                            else types["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id="imu_link"))
-                    message = types[temperature_type](header=head, temperature=float(block.temperature_degc[i]),
-                                                      variance=0.0)
+                    head = (
+                        types["std_msgs/msg/Header"](stamp=stamp, frame_id="imu_link")
+                        if ros2
+                        else types["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id="imu_link")
+                    )
+                    message = types[temperature_type](
+                        header=head, temperature=float(block.temperature_degc[i]), variance=0.0
+                    )
                     writer.write(thermo, int(stamps[i]), bytes(serialize(message, temperature_type)))
             part = recording_table(block.take(np.arange(n)))
             parquet.write_table(part.set_column(0, "time", pa.array(time_s)))
@@ -132,26 +153,49 @@ def main() -> None:
         bag, table = tmp / ("in.bag" if args.kind == "ros1" else "in"), tmp / "in.parquet"
         # written by a process of its own: rosbags' writer holds an index entry of every message until it closes
         # the bag, and a child process started from a large one reports that one's peak as its own ru_maxrss
-        made = subprocess.run([sys.executable, "-c", "import sys; from bench_bag import make_files; "
-                               "print(make_files(*sys.argv[1:3], float(sys.argv[3]), float(sys.argv[4]), sys.argv[5]))",
-                               str(bag), str(table), str(args.hours), str(args.rate_hz), args.kind],
-                              capture_output=True, text=True, check=True, cwd=Path(__file__).parent)
+        made = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "import sys; from bench_bag import make_files; "
+                "print(make_files(*sys.argv[1:3], float(sys.argv[3]), float(sys.argv[4]), sys.argv[5]))",
+                str(bag),
+                str(table),
+                str(args.hours),
+                str(args.rate_hz),
+                args.kind,
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=Path(__file__).parent,
+        )
         samples = int(made.stdout.split()[-1])
         model = tmp / "model.json"
-        fit_channels([simulate("consumer", profile="chamber", rate_hz=5, duration_s=3600, seed=s, unit=3).recording
-                      for s in (2, 3)]).save(model)
-        size = sum(f.stat().st_size for f in ([bag] if bag.is_file() else bag.iterdir())) / 2 ** 20
-        print(f"{samples:,} samples ({args.hours:g} h at {args.rate_hz:g} Hz): {args.kind} bag {size:,.0f} MB, "
-              f"Parquet {table.stat().st_size / 2 ** 20:,.0f} MB")
+        fit_channels(
+            [
+                simulate("consumer", profile="chamber", rate_hz=5, duration_s=3600, seed=s, unit=3).recording
+                for s in (2, 3)
+            ]
+        ).save(model)
+        size = sum(f.stat().st_size for f in ([bag] if bag.is_file() else bag.iterdir())) / 2**20
+        print(
+            f"{samples:,} samples ({args.hours:g} h at {args.rate_hz:g} Hz): {args.kind} bag {size:,.0f} MB, "
+            f"Parquet {table.stat().st_size / 2**20:,.0f} MB"
+        )
         for command in (c.strip() for c in args.commands.split(",")):
             program = COMMANDS[command]
             results = {}
             for name, source in (("bag", bag), ("table", table)):
                 out = tmp / ("out.bag" if args.kind == "ros1" else "out") if name == "bag" else tmp / "out.parquet"
-                results[name] = measure(program if name == "bag" or command != "apply" else "gyrocomp apply",
-                                        source, out, model)
-                print(f"  {command:6s} {name:6s} {results[name][0]:8.1f} s  {results[name][1]:8.0f} MB peak RSS  "
-                      f"{results[name][2]:8.0f} MB peak anonymous", flush=True)
+                results[name] = measure(
+                    program if name == "bag" or command != "apply" else "gyrocomp apply", source, out, model
+                )
+                print(
+                    f"  {command:6s} {name:6s} {results[name][0]:8.1f} s  {results[name][1]:8.0f} MB peak RSS  "
+                    f"{results[name][2]:8.0f} MB peak anonymous",
+                    flush=True,
+                )
                 for leftover in tmp.glob("out*"):
                     if leftover.is_dir():
                         for f in leftover.iterdir():
@@ -160,8 +204,11 @@ def main() -> None:
                     else:
                         leftover.unlink()
             bag_result, table_result = results["bag"], results["table"]
-            print(f"  {command}: the bag {bag_result[0] / table_result[0]:.2f}x the table's time, peak anonymous "
-                  f"{bag_result[2]:.0f} MB (the table's {table_result[2]:.0f} MB)", flush=True)
+            print(
+                f"  {command}: the bag {bag_result[0] / table_result[0]:.2f}x the table's time, peak anonymous "
+                f"{bag_result[2]:.0f} MB (the table's {table_result[2]:.0f} MB)",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -39,8 +39,13 @@ def main() -> None:
         alone = []
         for j in range(len(rec.gyro_axes)):
             noise = sims[2].truth.noise.total_dps[:, j]
-            alone.append(bound_noise(allan_deviation(noise - noise.mean(), rec.rate_hz), markov=False,
-                                     max_tau_s=MAX_TAU_FRACTION * rec.time_s[-1]).random_walk)
+            alone.append(
+                bound_noise(
+                    allan_deviation(noise - noise.mean(), rec.rate_hz),
+                    markov=False,
+                    max_tau_s=MAX_TAU_FRACTION * rec.time_s[-1],
+                ).random_walk
+            )
         raw = max(b.raw.random_walk for b in benefit.values()) * 216000.0  # deg/s/sqrt(s) -> deg/h/sqrt(h)
         compensated = max(b.compensated.random_walk for b in benefit.values()) * 216000.0
         print(f"| {preset} | {raw:.0f} | {compensated:.0f} | {max(alone) * 216000.0:.0f} | {raw / compensated:.1f} |")

@@ -26,15 +26,18 @@ from gyrocomp.simulation import PRESETS, simulate
 
 def unit_coverage(preset: str, unit: int, rate_hz: float) -> list[float]:
     """Per axis, the fraction of a new run's residual within the band of ``unit``."""
-    runs = [simulate(preset, profile="chamber", rate_hz=rate_hz, seed=100 * unit + k, unit=unit).recording
-            for k in range(4)]
+    runs = [
+        simulate(preset, profile="chamber", rate_hz=rate_hz, seed=100 * unit + k, unit=unit).recording for k in range(4)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         held = held_out_residuals(runs[:3])
         comp = apply(fit(runs[:3]), runs[3]).gyro_dps
     w = max(1, int(round(held.window_s * rate_hz)))
-    return [float(np.mean(np.abs(smoothed_about_mean(comp[:, j], w)) <= held.axes[axis].band_dps))
-            for j, axis in enumerate(runs[3].gyro_axes)]
+    return [
+        float(np.mean(np.abs(smoothed_about_mean(comp[:, j], w)) <= held.axes[axis].band_dps))
+        for j, axis in enumerate(runs[3].gyro_axes)
+    ]
 
 
 def main() -> None:
@@ -47,10 +50,15 @@ def main() -> None:
     for preset in PRESETS:
         cover = [c for u in range(args.units) for c in unit_coverage(preset, u, args.rate)]
         every += cover
-        print(f"{preset}: {args.units} units: band covers {100 * np.mean(cover):.1f} % of the new runs' residual "
-              f"(units' axes below 80 %: {sum(c < 0.8 for c in cover)} of {len(cover)})", flush=True)
-    print(f"fleet ({len(PRESETS)} presets x {args.units} units): {100 * np.mean(every):.1f} % "
-          f"({time.perf_counter() - started:.0f} s)")
+        print(
+            f"{preset}: {args.units} units: band covers {100 * np.mean(cover):.1f} % of the new runs' residual "
+            f"(units' axes below 80 %: {sum(c < 0.8 for c in cover)} of {len(cover)})",
+            flush=True,
+        )
+    print(
+        f"fleet ({len(PRESETS)} presets x {args.units} units): {100 * np.mean(every):.1f} % "
+        f"({time.perf_counter() - started:.0f} s)"
+    )
 
 
 if __name__ == "__main__":

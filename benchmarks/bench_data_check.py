@@ -77,8 +77,11 @@ def corpus(runs: int, folder: Path) -> tuple[dict, dict]:
                 (check,) = check_runs([run], ask)
                 found[preset][fault] += expected in check.reasons
         found[preset] = {f: n / runs for f, n in found[preset].items()}
-        clean[preset] = {"any": flagged / runs, "other": other / runs,
-                         **{r: n / runs for r, n in sorted(reasons.items())}}
+        clean[preset] = {
+            "any": flagged / runs,
+            "other": other / runs,
+            **{r: n / runs for r, n in sorted(reasons.items())},
+        }
         print(f"{preset}: clean flagged {100 * flagged / runs:.0f} % {clean[preset]}", file=sys.stderr)
     return found, clean
 
@@ -119,21 +122,38 @@ def main() -> None:
     started = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         found, clean = corpus(args.runs, Path(tmp))
-    lines = [f"Fault-injection corpus: {args.runs} runs per preset and fault, {args.runs} clean runs per preset "
-             f"(chamber profile, {RATE_HZ:g} Hz), {time.perf_counter() - started:.0f} s.", "",
-             "| fault (check) | " + " | ".join(PRESETS) + " |", "|---|" + "---|" * len(PRESETS)]
+    lines = [
+        f"Fault-injection corpus: {args.runs} runs per preset and fault, {args.runs} clean runs per preset "
+        f"(chamber profile, {RATE_HZ:g} Hz), {time.perf_counter() - started:.0f} s.",
+        "",
+        "| fault (check) | " + " | ".join(PRESETS) + " |",
+        "|---|" + "---|" * len(PRESETS),
+    ]
     for fault, check in FAULTS.items():
         lines.append(f"| {fault} ({check}) | " + " | ".join(f"{100 * found[p][fault]:.0f} %" for p in PRESETS) + " |")
     lines.append("| **clean runs flagged** | " + " | ".join(f"{100 * clean[p]['any']:.0f} %" for p in PRESETS) + " |")
-    lines.append("| **clean runs flagged for what the part does not have** | " + " | ".join(
-        f"{100 * clean[p]['other']:.0f} %" for p in PRESETS) + " |")
-    lines += ["", "Reasons on clean runs: " + "; ".join(
-        f"{p}: " + (", ".join(f"{r} {100 * v:.0f} %" for r, v in clean[p].items() if r not in ("any", "other"))
-                    or "none")
-        for p in PRESETS), "", "Real recordings:", "", "| dataset | run | verdict |", "|---|---|---|"]
+    lines.append(
+        "| **clean runs flagged for what the part does not have** | "
+        + " | ".join(f"{100 * clean[p]['other']:.0f} %" for p in PRESETS)
+        + " |"
+    )
+    lines += [
+        "",
+        "Reasons on clean runs: "
+        + "; ".join(
+            f"{p}: "
+            + (", ".join(f"{r} {100 * v:.0f} %" for r, v in clean[p].items() if r not in ("any", "other")) or "none")
+            for p in PRESETS
+        ),
+        "",
+        "Real recordings:",
+        "",
+        "| dataset | run | verdict |",
+        "|---|---|---|",
+    ]
     for name, ask, runs in real_recordings():
         for check in check_runs(runs, ask):
-            line = check.line()[len(check.source) + 2:].replace("|", "\\|")
+            line = check.line()[len(check.source) + 2 :].replace("|", "\\|")
             lines.append(f"| {name} | {Path(check.source).name} | {line} |")
     text = "\n".join(lines) + "\n"
     print(text)

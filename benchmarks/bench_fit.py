@@ -43,11 +43,15 @@ def timed(func):
 def runs(minutes: float, rate_hz: float, count: int = 3):
     """``count`` power-ons of the consumer preset: a heat-cool cycle, a ramp-and-hold, a warm-up, in turn."""
     duration = minutes * 60.0
-    profiles = [get_profile("cycle", set_points_degc=(10.0, 50.0), cycles=1),
-                get_profile("chamber", set_points_degc=(10.0, 50.0)),
-                get_profile("warmup")]
-    return [simulate("consumer", profile=profiles[s % 3], duration_s=duration, rate_hz=rate_hz, seed=s).recording
-            for s in range(count)]
+    profiles = [
+        get_profile("cycle", set_points_degc=(10.0, 50.0), cycles=1),
+        get_profile("chamber", set_points_degc=(10.0, 50.0)),
+        get_profile("warmup"),
+    ]
+    return [
+        simulate("consumer", profile=profiles[s % 3], duration_s=duration, rate_hz=rate_hz, seed=s).recording
+        for s in range(count)
+    ]
 
 
 def main() -> None:
@@ -68,18 +72,28 @@ def main() -> None:
         t_fit_busy, _ = timed(lambda: fit_calibration(recordings))
     scored = sum(len(s["candidates"]) for s in cal.fit_report["selection"].values())
 
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"python {platform.python_version()}, numpy {np.__version__}")
-    print(f"runs: {args.runs} x {args.minutes:g} min at {args.rate:g} Hz, 3 axes = {n:,} samples per axis; "
-          f"chosen {cal.model}; {scored} candidates scored over 3 axes, folds: {result.fold_kind}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"python {platform.python_version()}, numpy {np.__version__}"
+    )
+    print(
+        f"runs: {args.runs} x {args.minutes:g} min at {args.rate:g} Hz, 3 axes = {n:,} samples per axis; "
+        f"chosen {cal.model}; {scored} candidates scored over 3 axes, folds: {result.fold_kind}"
+    )
     print("| step | time [s] | ratio |")
     print("|---|---:|---:|")
     print(f"| plain cubic + run constants, least squares on every sample (baseline) | {t_cubic:.1f} | 1 |")
-    print(f"| `fit_calibration`, defaults (every candidate scored on held-out folds) | {t_fit:.1f} | "
-          f"{t_fit / t_cubic:.1f}x |")
+    print(
+        f"| `fit_calibration`, defaults (every candidate scored on held-out folds) | {t_fit:.1f} | "
+        f"{t_fit / t_cubic:.1f}x |"
+    )
     print(f"| `validate` (5 methods, each refitted on every fold) | {t_validate:.1f} | {t_validate / t_cubic:.1f}x |")
-    print(f"| with a busy neighbour on one core: plain cubic | {t_cubic_busy:.1f} | {t_cubic_busy / t_cubic:.2f}x idle |")
-    print(f"| with a busy neighbour on one core: `fit_calibration` | {t_fit_busy:.1f} | {t_fit_busy / t_fit:.2f}x idle |")
+    print(
+        f"| with a busy neighbour on one core: plain cubic | {t_cubic_busy:.1f} | {t_cubic_busy / t_cubic:.2f}x idle |"
+    )
+    print(
+        f"| with a busy neighbour on one core: `fit_calibration` | {t_fit_busy:.1f} | {t_fit_busy / t_fit:.2f}x idle |"
+    )
 
 
 if __name__ == "__main__":

@@ -46,15 +46,15 @@ def write_runs(folder: Path, n_runs: int, seed: int = 0) -> list[Path]:
     t = np.arange(n) / RATE_HZ
     temp = 25.0 - 35.0 * np.cos(2 * np.pi * t / t[-1])
     u = (temp - 25.0) / 35.0
-    shape = np.column_stack([0.02 * u + 0.01 * u ** 2 - 0.005 * u ** 3, -0.015 * u + 0.004 * u ** 3,
-                             0.01 * u ** 2])
+    shape = np.column_stack([0.02 * u + 0.01 * u**2 - 0.005 * u**3, -0.015 * u + 0.004 * u**3, 0.01 * u**2])
     paths = []
     for r in range(n_runs):
         gyro = shape + rng.normal(0.0, 0.05, 3) + rng.normal(0.0, 0.01, (n, 3))
         path = folder / f"run{r + 1:02d}.csv"
         data = np.column_stack([t, gyro, temp + rng.normal(0.0, 0.02, n)])
-        np.savetxt(path, data, delimiter=",", fmt="%.6f", header="time_s,gyro_x,gyro_y,gyro_z,temperature_degc",
-                   comments="")
+        np.savetxt(
+            path, data, delimiter=",", fmt="%.6f", header="time_s,gyro_x,gyro_y,gyro_z,temperature_degc", comments=""
+        )
         paths.append(path)
     return paths
 
@@ -75,8 +75,11 @@ def timed_process(args: list[str], repeat: int) -> float:
 #: the fit's stages: the functions of ``gyrocomp.models`` (fit, joint) each stage's time is spent in (the rest of
 #: ``gyrocomp.fit`` is the final fit of the chosen models and its report)
 #: each stage's functions, by the module of gyrocomp.models that calls them (the runs are prepared once, by fit)
-STAGES = {"checks": (("joint", "_check_fit_inputs"),), "reduction": (("fit", "prepare"), ("joint", "prepare_axis")),
-          "model choice": (("joint", "share_fold_lags"), ("joint", "select_axes"))}
+STAGES = {
+    "checks": (("joint", "_check_fit_inputs"),),
+    "reduction": (("fit", "prepare"), ("joint", "prepare_axis")),
+    "model choice": (("joint", "share_fold_lags"), ("joint", "select_axes")),
+}
 
 
 def _timed(func, stage: str, spent: dict[str, float]):
@@ -86,6 +89,7 @@ def _timed(func, stage: str, spent: dict[str, float]):
             return func(*args, **kwargs)
         finally:
             spent[stage] += time.perf_counter() - start
+
     return wrapper
 
 
@@ -134,22 +138,28 @@ def main() -> None:
     parser.add_argument("--runs", type=int, nargs="+", default=[3, 10])
     parser.add_argument("--repeat", type=int, default=2)
     args = parser.parse_args()
-    lines = ["| runs | PX4-style pipeline [s] | `gyrocomp fit` [s] | ratio | busy neighbour: PX4-style / gyrocomp [s] "
-             "| ratio | stages in-process: read / checks / reduction / model choice / final fit [s] |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| runs | PX4-style pipeline [s] | `gyrocomp fit` [s] | ratio | busy neighbour: PX4-style / gyrocomp [s] "
+        "| ratio | stages in-process: read / checks / reduction / model choice / final fit [s] |",
+        "|---|---|---|---|---|---|---|",
+    ]
     print("\n".join(lines), flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         all_paths = write_runs(folder, max(args.runs))
         for n in args.runs:
             f = measure(all_paths[:n], folder / "model.json", args.repeat)
-            lines.append(f"| {n} | {f['px4']:.2f} | {f['gyrocomp']:.2f} | **{f['gyrocomp'] / f['px4']:.2f}x** | "
-                         f"{f['px4 busy']:.2f} / {f['gyrocomp busy']:.2f} | "
-                         f"{f['gyrocomp busy'] / f['px4 busy']:.2f}x | "
-                         f"{' / '.join(f'{f[stage]:.2f}' for stage in ('read', *STAGES, 'final fit'))} |")
+            lines.append(
+                f"| {n} | {f['px4']:.2f} | {f['gyrocomp']:.2f} | **{f['gyrocomp'] / f['px4']:.2f}x** | "
+                f"{f['px4 busy']:.2f} / {f['gyrocomp busy']:.2f} | "
+                f"{f['gyrocomp busy'] / f['px4 busy']:.2f}x | "
+                f"{' / '.join(f'{f[stage]:.2f}' for stage in ('read', *STAGES, 'final fit'))} |"
+            )
             print(lines[-1], flush=True)
-    machine = (f"{os.cpu_count()} cores, {platform.machine()}, CPython {platform.python_version()}, "
-               f"{time.strftime('%Y-%m-%d')}")
+    machine = (
+        f"{os.cpu_count()} cores, {platform.machine()}, CPython {platform.python_version()}, "
+        f"{time.strftime('%Y-%m-%d')}"
+    )
     print(machine)
 
 

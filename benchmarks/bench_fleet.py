@@ -40,8 +40,9 @@ def write_fleet(folder: Path, units: int) -> None:
     for unit in range(units):
         (folder / f"U{unit:05d}").mkdir(parents=True)
         for k in range(3):
-            rec = simulate("consumer", profile="chamber", duration_s=900.0, rate_hz=10.0, seed=1000 * unit + k,
-                           unit=unit).recording
+            rec = simulate(
+                "consumer", profile="chamber", duration_s=900.0, rate_hz=10.0, seed=1000 * unit + k, unit=unit
+            ).recording
             write_recording(rec, folder / f"U{unit:05d}" / f"run_{k}.parquet")
 
 
@@ -59,8 +60,10 @@ def main() -> None:
         simulated_s = time.perf_counter() - start
         units = units_from_pattern(expand_inputs([data]), "{serial}/run_{n}.parquet")
         size_mb = sum(p.stat().st_size for p in data.rglob("*.parquet")) / 1e6
-        print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores; {len(units)} units, "
-              f"3 runs each ({size_mb:.0f} MB of Parquet, simulated in {simulated_s:.0f} s)")
+        print(
+            f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores; {len(units)} units, "
+            f"3 runs each ({size_mb:.0f} MB of Parquet, simulated in {simulated_s:.0f} s)"
+        )
         serial_s = None
         if not args.skip_serial:
             start = time.perf_counter()
@@ -68,23 +71,34 @@ def main() -> None:
             serial_s = time.perf_counter() - start
             print(f"serial (baseline)   {serial_s:8.1f} s  {len(units) / serial_s:6.2f} units/s")
         # the local cluster fit_fleet starts (its profiler off), kept here to read the workers' memory after
-        with dask.config.set({"distributed.worker.profile.enabled": False}), \
-                LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                             dashboard_address=None) as cluster, Client(cluster) as client:
+        with (
+            dask.config.set({"distributed.worker.profile.enabled": False}),
+            LocalCluster(
+                n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None
+            ) as cluster,
+            Client(cluster) as client,
+        ):
             start = time.perf_counter()
             summary = fit_fleet(units, Path(tmp) / "dask", scheduler=cluster.scheduler_address)
             dask_s = time.perf_counter() - start
             speedup = f"  {serial_s / dask_s:4.2f}x serial" if serial_s else ""
-            print(f"dask, {args.workers} workers     {dask_s:8.1f} s  {len(units) / dask_s:6.2f} units/s{speedup}  "
-                  f"({len(summary.fitted)} fitted, {len(summary.failed)} failed)")
+            print(
+                f"dask, {args.workers} workers     {dask_s:8.1f} s  {len(units) / dask_s:6.2f} units/s{speedup}  "
+                f"({len(summary.fitted)} fitted, {len(summary.failed)} failed)"
+            )
             start = time.perf_counter()
             again = fit_fleet(units, Path(tmp) / "dask", scheduler=cluster.scheduler_address)
             rerun_s = time.perf_counter() - start
-            print(f"rerun, all unchanged {rerun_s:7.1f} s  {len(units) / rerun_s:6.1f} units/s "
-                  f"({len(again.unchanged)} skipped)")
+            print(
+                f"rerun, all unchanged {rerun_s:7.1f} s  {len(units) / rerun_s:6.1f} units/s "
+                f"({len(again.unchanged)} skipped)"
+            )
             workers = client.run(peak_rss_mb)
-            print("peak memory per worker: " + ", ".join(f"{mb:.0f} MB" for mb in sorted(workers.values()))
-                  + f"; client {peak_rss_mb():.0f} MB")
+            print(
+                "peak memory per worker: "
+                + ", ".join(f"{mb:.0f} MB" for mb in sorted(workers.values()))
+                + f"; client {peak_rss_mb():.0f} MB"
+            )
             store_mb = (Path(tmp) / "dask" / "calibrations.sqlite").stat().st_size / 1e6
             print(f"store {store_mb:.1f} MB ({store_mb * 1e3 / len(units):.1f} kB per calibration)")
 

@@ -36,8 +36,14 @@ LOGS = 10
 
 def drift(calibration, recording) -> float:
     compensated = recording if calibration is None else apply(calibration, recording)
-    return float(np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz))
-                          for j in range(compensated.gyro_dps.shape[1])]))
+    return float(
+        np.mean(
+            [
+                smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz))
+                for j in range(compensated.gyro_dps.shape[1])
+            ]
+        )
+    )
 
 
 def first_staying_within(values: list[float], minutes: list[float], bound: float) -> float | None:
@@ -49,12 +55,20 @@ def first_staying_within(values: list[float], minutes: list[float], bound: float
 
 
 def part(preset: str, unit: int, rate_hz: float) -> None:
-    logs = [simulate(preset, profile=get_profile("field", motion_seed=k), rate_hz=rate_hz, seed=100 + k,
-                     unit=unit).recording for k in range(LOGS)]
+    logs = [
+        simulate(
+            preset, profile=get_profile("field", motion_seed=k), rate_hz=rate_hz, seed=100 + k, unit=unit
+        ).recording
+        for k in range(LOGS)
+    ]
     profile = resolve_profile("chamber", preset, set_points_degc=(20.0, 45.0))
     held = simulate(preset, profile=profile, rate_hz=rate_hz, duration_s=3600, seed=300, unit=unit).recording
-    chamber = fit_channels([simulate(preset, profile=profile, rate_hz=rate_hz, duration_s=3600, seed=200 + k,
-                                     unit=unit).recording for k in range(3)])
+    chamber = fit_channels(
+        [
+            simulate(preset, profile=profile, rate_hz=rate_hz, duration_s=3600, seed=200 + k, unit=unit).recording
+            for k in range(3)
+        ]
+    )
     field = fit_channels(field_recordings(logs)[0])
     reference = {"raw": drift(None, held), "chamber": drift(chamber, held), "field": drift(field, held)}
     learner = OnlineCalibrator(rate_hz)
@@ -66,8 +80,10 @@ def part(preset: str, unit: int, rate_hz: float) -> None:
         status = learner.status
         minutes.append(status.still_s / 60)
         values.append(drift(learner.to_calibration(axes=held.gyro_axes), held) if status.degree > 0 else np.inf)
-    print(f"\n{preset} unit {unit} at {rate_hz:g} Hz: raw {reference['raw']:.4f}, chamber {reference['chamber']:.4f}, "
-          f"batch field fit {reference['field']:.4f} deg/s")
+    print(
+        f"\n{preset} unit {unit} at {rate_hz:g} Hz: raw {reference['raw']:.4f}, chamber {reference['chamber']:.4f}, "
+        f"batch field fit {reference['field']:.4f} deg/s"
+    )
     print("  after log  still [min]  learner [deg/s]  / chamber")
     for k, (m, v) in enumerate(zip(minutes, values), start=1):
         print(f"  {k:9d}  {m:11.1f}  {v:15.4f}  {v / reference['chamber']:9.2f}")
@@ -80,8 +96,9 @@ def part(preset: str, unit: int, rate_hz: float) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--parts", default="consumer:3:25,consumer:7:25,adxrs450:0:10",
-                        help="preset:unit:rate_hz, comma-separated")
+    parser.add_argument(
+        "--parts", default="consumer:3:25,consumer:7:25,adxrs450:0:10", help="preset:unit:rate_hz, comma-separated"
+    )
     args = parser.parse_args()
     warnings.simplefilter("ignore")
     for item in args.parts.split(","):

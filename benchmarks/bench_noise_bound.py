@@ -36,20 +36,33 @@ def main() -> None:
     print("|---|---|---|---|---|---|")
     for preset in PRESETS:
         model = preset_model(preset)
-        draw = lambda seed, model=model: simulate_noise(n, args.rate, model, np.random.default_rng(seed)).total_dps[:, 0]  # noqa: E731
+
+        def draw(seed, model=model):
+            return simulate_noise(n, args.rate, model, np.random.default_rng(seed)).total_dps[:, 0]
+
         measured = allan_deviation(draw(1), args.rate, taus="octave")
         keep = measured.tau <= record_s / 10
         tau = measured.tau[keep]
-        truth = np.sqrt(np.mean([allan_deviation(draw(seed), args.rate, taus="octave").deviation[keep] ** 2
-                                 for seed in range(2, 2 + args.truths)], axis=0))
-        models = {"IEEE 952 fit": noise_terms(measured).model_deviation(tau),
-                  "bound, white + random walk": bound_noise(measured, markov=False, max_tau_s=record_s / 10)
-                  .deviation(tau),
-                  "bound with Gauss-Markov terms": bound_noise(measured, max_tau_s=record_s / 10).deviation(tau)}
+        truth = np.sqrt(
+            np.mean(
+                [
+                    allan_deviation(draw(seed), args.rate, taus="octave").deviation[keep] ** 2
+                    for seed in range(2, 2 + args.truths)
+                ],
+                axis=0,
+            )
+        )
+        models = {
+            "IEEE 952 fit": noise_terms(measured).model_deviation(tau),
+            "bound, white + random walk": bound_noise(measured, markov=False, max_tau_s=record_s / 10).deviation(tau),
+            "bound with Gauss-Markov terms": bound_noise(measured, max_tau_s=record_s / 10).deviation(tau),
+        }
         for name, deviation in models.items():
             ratio = deviation / truth
-            print(f"| {preset} | {name} | {np.mean(ratio >= 1.0):.0%} | {np.median(ratio):.2f} | {ratio.max():.2f} "
-                  f"| {ratio.min():.2f} |")
+            print(
+                f"| {preset} | {name} | {np.mean(ratio >= 1.0):.0%} | {np.median(ratio):.2f} | {ratio.max():.2f} "
+                f"| {ratio.min():.2f} |"
+            )
 
 
 if __name__ == "__main__":

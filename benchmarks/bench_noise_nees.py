@@ -54,22 +54,31 @@ def main() -> None:
         middle = chamber.take(temperature_dwells(chamber)[1])  # the 25 degC dwell: what a user fits at room temperature
         ieee = analyse_noise(middle, [model.axes[0]], motion_check=False).axes[model.axes[0]].terms
         fitted = NoiseBound(ieee.white_noise_density, ieee.random_walk, (), (1.0,), 1.0, 1.0)
-        scaled = dataclasses.replace(fitted, white_noise_density=10 * fitted.white_noise_density,
-                                     random_walk=10 * fitted.random_walk)
+        scaled = dataclasses.replace(
+            fitted, white_noise_density=10 * fitted.white_noise_density, random_walk=10 * fitted.random_walk
+        )
         #: what the filter is told: attitude_nees's keywords
-        told = {"bound, white + random walk": {"noise": axis.bound},
-                "bound with Gauss-Markov terms": {"noise": axis.markov},
-                "bound scheduled by temperature (each dwell's)": {"noise": axis.bound, "schedule": scheduled_bound(axis),
-                                                                  "temperature_degc": ramp},
-                "IEEE 952 fit (N, K)": {"noise": fitted}, "IEEE 952 fit x10": {"noise": scaled}}
+        told = {
+            "bound, white + random walk": {"noise": axis.bound},
+            "bound with Gauss-Markov terms": {"noise": axis.markov},
+            "bound scheduled by temperature (each dwell's)": {
+                "noise": axis.bound,
+                "schedule": scheduled_bound(axis),
+                "temperature_degc": ramp,
+            },
+            "IEEE 952 fit (N, K)": {"noise": fitted},
+            "IEEE 952 fit x10": {"noise": scaled},
+        }
         errors = np.empty((args.runs, n))
         for r in range(args.runs):
             truth = simulate_noise(n, args.rate, model, np.random.default_rng(1000 + r), ramp)
             errors[r] = truth.white_dps[:, 0] + truth.flicker_dps[:, 0] + truth.random_walk_dps[:, 0]
         for name, keywords in told.items():
             result = attitude_nees(errors, args.rate, **keywords)
-            print(f"| {preset} | {name} | {np.median(result.nees):.2f} | {result.inside:.0%} | "
-                  f"{result.band[0]:.2f}..{result.band[1]:.2f} |")
+            print(
+                f"| {preset} | {name} | {np.median(result.nees):.2f} | {result.inside:.0%} | "
+                f"{result.band[0]:.2f}..{result.band[1]:.2f} |"
+            )
 
 
 if __name__ == "__main__":

@@ -39,8 +39,12 @@ from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import preset_model, resolve_profile, simulate
 
 RUN_S, RATE_HZ, RUNS = 900.0, 10.0, 3
-COVERAGES = {"a third (10..40 degC)": (10.0, 40.0), "half (2.5..47.5 degC)": (2.5, 47.5),
-             "two thirds (-5..55 degC)": (-5.0, 55.0), "all (-20..70 degC)": (-20.0, 70.0)}
+COVERAGES = {
+    "a third (10..40 degC)": (10.0, 40.0),
+    "half (2.5..47.5 degC)": (2.5, 47.5),
+    "two thirds (-5..55 degC)": (-5.0, 55.0),
+    "all (-20..70 degC)": (-20.0, 70.0),
+}
 TIME_FRACTIONS = (0.25, 0.5)
 #: how the short run visits its range: the profile's name
 DESIGNS = {"one way": "chamber", "there and back": "cycle"}
@@ -55,8 +59,7 @@ def drift(calibration, recording) -> float:
 def simulation(unit: int, seed: int, profile="chamber", duration_s: float = RUN_S):
     if isinstance(profile, str):
         return simulate("consumer", profile=profile, duration_s=duration_s, rate_hz=RATE_HZ, seed=seed, unit=unit)
-    return simulate(preset_model("consumer", unit), profile=profile, duration_s=duration_s, rate_hz=RATE_HZ,
-                    seed=seed)
+    return simulate(preset_model("consumer", unit), profile=profile, duration_s=duration_s, rate_hz=RATE_HZ, seed=seed)
 
 
 def run(unit: int, seed: int, profile="chamber", duration_s: float = RUN_S):
@@ -92,11 +95,15 @@ def main() -> None:
     warnings.simplefilter("ignore")
     with tempfile.TemporaryDirectory() as tmp:
         prior = fleet_prior(args.fleet, Path(tmp))
-    print(f"prior from {prior.units} of {args.fleet} units; {args.new} new units; full calibration: "
-          f"{RUNS} x {RUN_S / 60:.0f} min over -20..70 degC")
+    print(
+        f"prior from {prior.units} of {args.fleet} units; {args.new} new units; full calibration: "
+        f"{RUNS} x {RUN_S / 60:.0f} min over -20..70 degC"
+    )
     oracle = prior_from_models([preset_model("consumer", unit) for unit in range(50_000, 54_000)], like=prior)
-    print(f"{'short run':15s} {'covers':26s} {'time':>6s}  {'prior: median (worst)':>22s}  "
-          f"{'alone: median (worst)':>22s}  {'oracle: median (worst)':>23s}")
+    print(
+        f"{'short run':15s} {'covers':26s} {'time':>6s}  {'prior: median (worst)':>22s}  "
+        f"{'alone: median (worst)':>22s}  {'oracle: median (worst)':>23s}"
+    )
     new = range(10_000, 10_000 + args.new)
     references = {}
     held_out = {}
@@ -106,8 +113,10 @@ def main() -> None:
         held_out[unit] = held.recording
         references[unit] = drift(fit_channels([run(unit, 1000 * unit + k) for k in range(RUNS)]), held_out[unit])
         floors.append(noise_floor(held) / references[unit])
-    print(f"the held-out runs' noise alone (every deterministic error taken out): {np.median(floors):.2f}x "
-          f"({max(floors):.2f}x) the full calibration's drift")
+    print(
+        f"the held-out runs' noise alone (every deterministic error taken out): {np.median(floors):.2f}x "
+        f"({max(floors):.2f}x) the full calibration's drift"
+    )
     for (design, profile_name), (label, (low, high)) in itertools.product(DESIGNS.items(), COVERAGES.items()):
         profile = resolve_profile(profile_name, "consumer", set_points_degc=(low, high))
         for fraction in TIME_FRACTIONS:
@@ -117,8 +126,10 @@ def main() -> None:
                 with_prior.append(drift(fit_with_prior(short, prior), held_out[unit]) / references[unit])
                 alone.append(drift(fit_channels(short), held_out[unit]) / references[unit])
                 best.append(drift(fit_with_prior(short, oracle), held_out[unit]) / references[unit])
-            print(f"{design:15s} {label:26s} {fraction:5.0%}   {np.median(with_prior):8.2f}x ({max(with_prior):5.2f}x)     "
-                  f"{np.median(alone):8.2f}x ({max(alone):5.2f}x)     {np.median(best):8.2f}x ({max(best):5.2f}x)")
+            print(
+                f"{design:15s} {label:26s} {fraction:5.0%}   {np.median(with_prior):8.2f}x ({max(with_prior):5.2f}x)     "
+                f"{np.median(alone):8.2f}x ({max(alone):5.2f}x)     {np.median(best):8.2f}x ({max(best):5.2f}x)"
+            )
 
 
 if __name__ == "__main__":

@@ -67,21 +67,44 @@ WINDOW_S = 60.0
 RATE_HZ = 2.0
 #: the parts that test the model choice, with their chamber range [degC]
 TEST_PARTS = {
-    "random walk": (GyroErrorModel(axes=("gyro_x",), temperature_coefficients=((0.0,),),
-                                   rate_random_walk_dps_per_sqrt_s=2e-3, noise_density_dps_per_sqrt_hz=0.005),
-                    (-20.0, 70.0)),
-    "branches": (GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01, 5e-5),), t_ref_degc=25.0,
-                                hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
-                                noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0,
-                                turn_on_bias_sigma_dps=0.05), (-20.0, 70.0)),
-    "branches, lag": (GyroErrorModel(axes=("gyro_x", "gyro_y", "gyro_z"),
-                                     temperature_coefficients=((0.004, 2e-5), (-0.003, 1e-5), (0.01, 5e-5)),
-                                     t_ref_degc=25.0, thermal_time_constant_s=40.0,
-                                     hysteresis=Hysteresis(((0.0, 0.0), (0.0, 0.0), (0.03, 0.0008)), transition_degc=5.0),
-                                     noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0,
-                                     turn_on_bias_sigma_dps=0.05), (-20.0, 70.0)),
-    "drifting, dT/dt": (dataclasses.replace(preset_model("drifting"),
-                                            temperature_rate_dps_per_degc_per_min=(0.03, 0.03, -0.03)), (-20.0, 70.0)),
+    "random walk": (
+        GyroErrorModel(
+            axes=("gyro_x",),
+            temperature_coefficients=((0.0,),),
+            rate_random_walk_dps_per_sqrt_s=2e-3,
+            noise_density_dps_per_sqrt_hz=0.005,
+        ),
+        (-20.0, 70.0),
+    ),
+    "branches": (
+        GyroErrorModel(
+            axes=("gyro_z",),
+            temperature_coefficients=((0.01, 5e-5),),
+            t_ref_degc=25.0,
+            hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
+            noise_density_dps_per_sqrt_hz=0.005,
+            bias_instability_deg_per_h=10.0,
+            turn_on_bias_sigma_dps=0.05,
+        ),
+        (-20.0, 70.0),
+    ),
+    "branches, lag": (
+        GyroErrorModel(
+            axes=("gyro_x", "gyro_y", "gyro_z"),
+            temperature_coefficients=((0.004, 2e-5), (-0.003, 1e-5), (0.01, 5e-5)),
+            t_ref_degc=25.0,
+            thermal_time_constant_s=40.0,
+            hysteresis=Hysteresis(((0.0, 0.0), (0.0, 0.0), (0.03, 0.0008)), transition_degc=5.0),
+            noise_density_dps_per_sqrt_hz=0.005,
+            bias_instability_deg_per_h=10.0,
+            turn_on_bias_sigma_dps=0.05,
+        ),
+        (-20.0, 70.0),
+    ),
+    "drifting, dT/dt": (
+        dataclasses.replace(preset_model("drifting"), temperature_rate_dps_per_degc_per_min=(0.03, 0.03, -0.03)),
+        (-20.0, 70.0),
+    ),
 }
 
 
@@ -96,8 +119,9 @@ def judge(fit_runs, held_recording, truth_rate, noise, rate_hz, start: int = 0):
         warnings.simplefilter("ignore")
         default = fit_channels(fit_runs)
         cubic = fit_plain_cubic(fit_runs)
-        out = {name: apply(cal, held_recording).gyro_dps[start:]
-               for name, cal in (("default", default), ("cubic", cubic))}
+        out = {
+            name: apply(cal, held_recording).gyro_dps[start:] for name, cal in (("default", default), ("cubic", cubic))
+        }
     held_recording = held_recording.take(np.arange(start, held_recording.n_samples))
     k = held_recording.gyro_dps.shape[1]
     rows = {name: [drift(v[:, j] - truth_rate[:, j], rate_hz) for j in range(k)] for name, v in out.items()}
@@ -107,22 +131,30 @@ def judge(fit_runs, held_recording, truth_rate, noise, rate_hz, start: int = 0):
 
 
 def one_cycle(model, seed):
-    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
-                       dwell_s=300.0)
+    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0, dwell_s=300.0)
     sim = simulate(model, profile=prof, rate_hz=RATE_HZ, seed=seed)
     rec = sim.recording
     k = int(np.argmax(rec.temperature_degc))
-    return judge([rec.take(np.arange(k))], rec, sim.truth.true_rate_dps[k:], sim.truth.noise.total_dps[k:],
-                 RATE_HZ, start=k)
+    return judge(
+        [rec.take(np.arange(k))], rec, sim.truth.true_rate_dps[k:], sim.truth.noise.total_dps[k:], RATE_HZ, start=k
+    )
 
 
 def cycles(model, seed, span, runs: int, rate_hz: float = RATE_HZ):
     lo, hi = span
     ranges = [(lo, hi), (lo + 10.0, hi - 10.0), (lo + 5.0, hi)][:runs] if runs <= 3 else [(lo, hi)] * runs
-    fit = [simulate(model, profile=get_profile("cycle", set_points_degc=r, cycles=1), rate_hz=rate_hz,
-                    seed=100 * seed + i).recording for i, r in enumerate(ranges)]
-    held = simulate(model, profile=get_profile("cycle", set_points_degc=(lo + 5.0, hi + 5.0), cycles=1),
-                    rate_hz=rate_hz, seed=100 * seed + 99)
+    fit = [
+        simulate(
+            model, profile=get_profile("cycle", set_points_degc=r, cycles=1), rate_hz=rate_hz, seed=100 * seed + i
+        ).recording
+        for i, r in enumerate(ranges)
+    ]
+    held = simulate(
+        model,
+        profile=get_profile("cycle", set_points_degc=(lo + 5.0, hi + 5.0), cycles=1),
+        rate_hz=rate_hz,
+        seed=100 * seed + 99,
+    )
     return judge(fit, held.recording, held.truth.true_rate_dps, held.truth.noise.total_dps, rate_hz)
 
 
@@ -134,16 +166,23 @@ def summarize(results: list[dict]) -> tuple[float, float, int, int, int]:
     p = np.concatenate([r["perfect"] for r in results])
     raw = np.concatenate([r["raw"] for r in results])
     worse = d > 1.01 * raw
-    return (float(np.mean(d / p)), float(np.mean(c / p)), int(np.sum(worse)), int(np.sum(worse & (p > 1.01 * raw))),
-            int(d.size))
+    return (
+        float(np.mean(d / p)),
+        float(np.mean(c / p)),
+        int(np.sum(worse)),
+        int(np.sum(worse & (p > 1.01 * raw))),
+        int(d.size),
+    )
 
 
 def adxrs450_case(hysteresis: Hysteresis | None, lag_s: float = 60.0):
     model = dataclasses.replace(preset_model("adxrs450"), thermal_time_constant_s=lag_s)
     if hysteresis is not None:
         model = dataclasses.replace(model, hysteresis=hysteresis)
-    fit = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=20.0, seed=s).recording
-           for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)))]
+    fit = [
+        simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=20.0, seed=s).recording
+        for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)))
+    ]
     held = simulate(model, profile=get_profile("cycle", set_points_degc=(-25.0, 85.0), cycles=1), rate_hz=20.0, seed=7)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -170,11 +209,16 @@ def real_one_cycle_lines() -> list[str]:
         return ["Real one-cycle log (tofupilot-imu-thermal): dataset absent"]
     result = real_data.tofupilot_one_cycle()
     cubic, raw = result["plain cubic"].mean(), result["raw"]
-    lines = ["| real one-cycle log (tofupilot) | x | y | z | mean | mean / plain cubic | worst axis / raw |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| real one-cycle log (tofupilot) | x | y | z | mean | mean / plain cubic | worst axis / raw |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for name, std in result.items():
-        lines.append(f"| {name} | " + " | ".join(f"{v:.3f}" for v in std)
-                     + f" | {std.mean():.3f} | {std.mean() / cubic:.2f} | {np.max(std / raw):.2f} |")
+        lines.append(
+            f"| {name} | "
+            + " | ".join(f"{v:.3f}" for v in std)
+            + f" | {std.mean():.3f} | {std.mean() / cubic:.2f} | {np.max(std / raw):.2f} |"
+        )
     return lines
 
 
@@ -183,15 +227,20 @@ def real_still_lines() -> list[str]:
     if not all(p.is_dir() for p in (real_data.ADIS, real_data.GALAXY, real_data.DATASETS / "allantools-stable32")):
         return ["Real still noise with a temperature effect: datasets absent"]
     trials = real_data.still_one_cycle_trials()
-    lines = ["| real still noise + one temperature curve, one cycle | windows | memory terms added | lag taken "
-             "| default / perfect | plain cubic / perfect | axes worse than raw |", "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| real still noise + one temperature curve, one cycle | windows | memory terms added | lag taken "
+        "| default / perfect | plain cubic / perfect | axes worse than raw |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for amplitude in sorted({t["amplitude_dps"] for t in trials}):
         group = [t for t in trials if t["amplitude_dps"] == amplitude]
         memory = sum(bool(t["chosen"].branch or t["chosen"].hysteresis_order) for t in group)
         ratio = lambda key, group=group: np.mean([t[key] / t["perfect"] for t in group])  # noqa: E731
         worse = sum(t["default"] > 1.01 * t["raw"] for t in group)
-        lines.append(f"| effect {amplitude:g} deg/s | {len(group)} | {memory} | {sum(t['chosen'].lag for t in group)} "
-                     f"| {ratio('default'):.2f} | {ratio('cubic'):.2f} | {worse} |")
+        lines.append(
+            f"| effect {amplitude:g} deg/s | {len(group)} | {memory} | {sum(t['chosen'].lag for t in group)} "
+            f"| {ratio('default'):.2f} | {ratio('cubic'):.2f} | {worse} |"
+        )
     return lines
 
 
@@ -200,8 +249,9 @@ def drifting_false_positives(seeds: int = 20) -> tuple[int, int]:
     added = total = 0
     model = preset_model("drifting")
     for seed in range(seeds):
-        prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
-                           dwell_s=300.0)
+        prof = get_profile(
+            "chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0, dwell_s=300.0
+        )
         rec = simulate(model, profile=prof, rate_hz=RATE_HZ, seed=seed).recording
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -216,17 +266,24 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seeds", type=int, default=10)
     parser.add_argument("--markdown", type=Path, help="write the tables as Markdown to this file")
-    parser.add_argument("--only", choices=("one cycle", "two cycles", "three runs"),
-                        help="this protocol alone, no cases (a quick look; not for --markdown)")
+    parser.add_argument(
+        "--only",
+        choices=("one cycle", "two cycles", "three runs"),
+        help="this protocol alone, no cases (a quick look; not for --markdown)",
+    )
     args = parser.parse_args()
     start = time.perf_counter()
-    lines = ["| part | protocol | default / perfect | plain cubic / perfect | axes worse than raw | of them, perfect too |",
-             "|---|---|---|---|---|---|"]
+    lines = [
+        "| part | protocol | default / perfect | plain cubic / perfect | axes worse than raw | of them, perfect too |",
+        "|---|---|---|---|---|---|",
+    ]
     parts = {name: (preset_model(name), get_preset(name).set_points_degc) for name in PRESETS} | TEST_PARTS
     for name, (model, span) in parts.items():
-        protocols = {"one cycle": lambda s, model=model: one_cycle(model, s),
-                     "two cycles": lambda s, model=model, span=span: cycles(model, s, span, 2),
-                     "three runs": lambda s, model=model, span=span: cycles(model, s, span, 3)}
+        protocols = {
+            "one cycle": lambda s, model=model: one_cycle(model, s),
+            "two cycles": lambda s, model=model, span=span: cycles(model, s, span, 2),
+            "three runs": lambda s, model=model, span=span: cycles(model, s, span, 3),
+        }
         for protocol, run in protocols.items():
             if args.only and protocol != args.only:
                 continue
@@ -237,9 +294,11 @@ def main() -> None:
         return
     lines += ["", "| case | default / perfect | lag [s] | true lag [s] | model |", "|---|---|---|---|---|"]
     bump = Hysteresis(((0.2,),), direction="descending", fade_degc=25.0)
-    for label, hyst, lag_s in (("adxrs450, the preset's hysteresis", None, 60.0),
-                               ("adxrs450, a bump fading over 25 degC", bump, 60.0),
-                               ("adxrs450, the preset's hysteresis behind a 30 s lag", None, 30.0)):
+    for label, hyst, lag_s in (
+        ("adxrs450, the preset's hysteresis", None, 60.0),
+        ("adxrs450, a bump fading over 25 degC", bump, 60.0),
+        ("adxrs450, the preset's hysteresis behind a 30 s lag", None, 30.0),
+    ):
         ratio, lag, model_name = adxrs450_case(hyst, lag_s)
         lines.append(f"| {label} | {ratio:.2f} | {lag:.1f} | {lag_s:g} | {model_name} |")
         print(lines[-1], flush=True)
@@ -247,19 +306,31 @@ def main() -> None:
         lines += ["", *block]
         print("\n".join(block), flush=True)
     added, total = drifting_false_positives()
-    lines += ["", f"Memory terms on the drifting preset (one curve heating and cooling), one cycle, 20 seeds: "
-                  f"{added} of {total} axes"]
+    lines += [
+        "",
+        f"Memory terms on the drifting preset (one curve heating and cooling), one cycle, 20 seeds: "
+        f"{added} of {total} axes",
+    ]
     print(lines[-1], flush=True)
     cats = cats_case()
-    lines += ["", "CATS (real, fit on two runs, judged on the third): default / plain cubic = "
-              + ("dataset absent" if cats is None else f"{cats:.3f}")]
+    lines += [
+        "",
+        "CATS (real, fit on two runs, judged on the third): default / plain cubic = "
+        + ("dataset absent" if cats is None else f"{cats:.3f}"),
+    ]
     print(lines[-1])
     print(f"({time.perf_counter() - start:.0f} s)")
     if args.markdown:
-        page = ["# Accuracy by calibration protocol", "",
-                f"Generated by `python benchmarks/bench_protocols.py --seeds {args.seeds} --markdown docs/accuracy.md` "
-                f"(gyrocomp {__version__}, {time.strftime('%Y-%m-%d')}); do not edit by hand.", "",
-                *__doc__.split("\n\nUsage:")[0].split("\n")[2:], "", *lines]
+        page = [
+            "# Accuracy by calibration protocol",
+            "",
+            f"Generated by `python benchmarks/bench_protocols.py --seeds {args.seeds} --markdown docs/accuracy.md` "
+            f"(gyrocomp {__version__}, {time.strftime('%Y-%m-%d')}); do not edit by hand.",
+            "",
+            *__doc__.split("\n\nUsage:")[0].split("\n")[2:],
+            "",
+            *lines,
+        ]
         args.markdown.write_text("\n".join(page) + "\n")
 
 

@@ -41,8 +41,9 @@ def main() -> None:
     duration = args.hours * 3600.0
     profile = get_profile("cycle", set_points_degc=(-25.0, 90.0), cycles=1)
     warnings.simplefilter("ignore")
-    calibration_runs = [simulate("mti10", profile=profile, duration_s=duration, rate_hz=1.0, seed=s).recording
-                        for s in (1, 2)]
+    calibration_runs = [
+        simulate("mti10", profile=profile, duration_s=duration, rate_hz=1.0, seed=s).recording for s in (1, 2)
+    ]
     calibration = fit_calibration(calibration_runs, hysteresis="none")
     run = simulate("mti10", profile=profile, duration_s=duration, rate_hz=args.rate, seed=3).recording
 
@@ -51,14 +52,20 @@ def main() -> None:
     t_allan, _ = timed(lambda: [allan_deviation(run.gyro_dps[:, j], run.rate_hz) for j in range(3)])
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
-    print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
-          f"numpy {np.__version__}")
-    print(f"run: {args.hours:g} h at {args.rate:g} Hz, 3 axes = {run.n_samples:,} samples per axis; "
-          f"model {calibration.model}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
+        f"numpy {np.__version__}"
+    )
+    print(
+        f"run: {args.hours:g} h at {args.rate:g} Hz, 3 axes = {run.n_samples:,} samples per axis; "
+        f"model {calibration.model}"
+    )
     print("| step | time [s] | ratio |")
     print("|---|---:|---:|")
-    print(f"| gyrocomp report (HTML, {len(report.sections)} sections, {len(report.html) / 1e6:.1f} MB) | "
-          f"{t_report:.1f} | {t_report / t_apply:.1f}x apply |")
+    print(
+        f"| gyrocomp report (HTML, {len(report.sections)} sections, {len(report.html) / 1e6:.1f} MB) | "
+        f"{t_report:.1f} | {t_report / t_apply:.1f}x apply |"
+    )
     print(f"| gyrocomp apply (baseline) | {t_apply:.1f} | 1 |")
     print(f"| Allan deviation of the 3 raw axes, octave taus | {t_allan:.1f} | {t_allan / t_apply:.1f}x apply |")
     print(f"peak resident memory of the process: {peak_mib:.0f} MiB")

@@ -33,8 +33,9 @@ def main() -> None:
     n = int(duration * args.rate) + 1
     profile = get_profile("cycle", set_points_degc=(-25.0, 90.0), cycles=1)
 
-    t_sim = best_of(args.repeat, lambda: simulate("mti10", profile=profile, duration_s=duration, rate_hz=args.rate,
-                                                  seed=1))
+    t_sim = best_of(
+        args.repeat, lambda: simulate("mti10", profile=profile, duration_s=duration, rate_hz=args.rate, seed=1)
+    )
     rng = np.random.default_rng(0)
     t_white = best_of(args.repeat, lambda: rng.standard_normal((n, 3)))
     t_bank = best_of(args.repeat, lambda: [error_model.flicker_bank(n, args.rate, 18.0, rng) for _ in range(3)])
@@ -46,8 +47,10 @@ def main() -> None:
         error_model.GM_STEPS_PER_TIME_CONSTANT = saved
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
-    print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
-          f"numpy {np.__version__}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}, "
+        f"numpy {np.__version__}"
+    )
     print(f"run: {args.hours:g} h at {args.rate:g} Hz, 3 axes = {n:,} samples per axis")
     print("| step | time [s] | ratio |")
     print("|---|---:|---:|")

@@ -38,23 +38,38 @@ def main() -> None:
         small = Path(tmp) / "small.csv"
         t = np.arange(100) / 10.0
         pd.DataFrame({"time": t, "gyro_x": 0.01 * t, "gyro_y": 0.0, "gyro_z": 0.02, "temperature": 25.0}).to_csv(
-            small, index=False)
+            small, index=False
+        )
         run = Path(tmp) / "run.csv"
         model = Path(tmp) / "model.json"
-        subprocess.run([str(SCRIPT), "-q", "simulate", "--preset", "consumer", "--rate", "1", "--duration", "600",
-                        "-o", str(run)], check=True, capture_output=True)
-        subprocess.run([str(SCRIPT), "-q", "fit", str(run), "-o", str(model), "--hysteresis", "lag"], check=True,
-                       capture_output=True)
-        rows = [("`python -c pass` (baseline)", best([sys.executable, "-c", "pass"])),
-                ("`python -c 'import numpy, pandas'`", best([sys.executable, "-c", "import numpy, pandas"])),
-                ("`python -c 'import numpy, pyarrow.parquet'`",
-                 best([sys.executable, "-c", "import numpy, pyarrow.parquet"])),
-                ("`gyrocomp --help`", best([str(SCRIPT), "--help"])),
-                ("`gyrocomp --version`", best([str(SCRIPT), "--version"])),
-                ("`gyrocomp convert` of a 100-row CSV to Parquet",
-                 best([str(SCRIPT), "-q", "convert", str(small), str(Path(tmp) / "small.parquet")])),
-                ("`gyrocomp apply` of a model with thermal lag to a 600-row CSV",
-                 best([str(SCRIPT), "-q", "apply", str(model), str(run), "-o", str(Path(tmp) / "out.csv")]))]
+        subprocess.run(
+            [str(SCRIPT), "-q", "simulate", "--preset", "consumer", "--rate", "1", "--duration", "600", "-o", str(run)],
+            check=True,
+            capture_output=True,
+        )
+        subprocess.run(
+            [str(SCRIPT), "-q", "fit", str(run), "-o", str(model), "--hysteresis", "lag"],
+            check=True,
+            capture_output=True,
+        )
+        rows = [
+            ("`python -c pass` (baseline)", best([sys.executable, "-c", "pass"])),
+            ("`python -c 'import numpy, pandas'`", best([sys.executable, "-c", "import numpy, pandas"])),
+            (
+                "`python -c 'import numpy, pyarrow.parquet'`",
+                best([sys.executable, "-c", "import numpy, pyarrow.parquet"]),
+            ),
+            ("`gyrocomp --help`", best([str(SCRIPT), "--help"])),
+            ("`gyrocomp --version`", best([str(SCRIPT), "--version"])),
+            (
+                "`gyrocomp convert` of a 100-row CSV to Parquet",
+                best([str(SCRIPT), "-q", "convert", str(small), str(Path(tmp) / "small.parquet")]),
+            ),
+            (
+                "`gyrocomp apply` of a model with thermal lag to a 600-row CSV",
+                best([str(SCRIPT), "-q", "apply", str(model), str(run), "-o", str(Path(tmp) / "out.csv")]),
+            ),
+        ]
     base = rows[0][1]
     print("| command | time [s] | ratio |")
     print("|---|---:|---:|")

@@ -52,9 +52,27 @@ def _manifest(path: Path, runs: dict[str, Path], serials) -> Path:
 
 
 def _station(manifest: Path, out: Path, store: str, name: str) -> subprocess.Popen:
-    return subprocess.Popen([*CMD, "-q", "fleet", "fit", "--manifest", str(manifest), "-o", str(out), "--store",
-                             store, "--scheduler", "serial", "--station", name],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [
+            *CMD,
+            "-q",
+            "fleet",
+            "fit",
+            "--manifest",
+            str(manifest),
+            "-o",
+            str(out),
+            "--store",
+            store,
+            "--scheduler",
+            "serial",
+            "--station",
+            name,
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def _problems(store: str, outputs: list[Path], serials: list[str], complete: bool) -> list[str]:
@@ -92,8 +110,10 @@ def overlapping(store: str, runs: dict[str, Path], folder: Path) -> tuple[float,
     lists = [[serials[(50 * k + i) % UNITS] for i in range(75)] for k in range(STATIONS)]
     outputs = [folder / f"station{k}" for k in range(STATIONS)]
     started = time.perf_counter()
-    procs = [_station(_manifest(folder / f"m{k}.csv", runs, lst), out, store, f"S{k}")
-             for k, (lst, out) in enumerate(zip(lists, outputs))]
+    procs = [
+        _station(_manifest(folder / f"m{k}.csv", runs, lst), out, store, f"S{k}")
+        for k, (lst, out) in enumerate(zip(lists, outputs))
+    ]
     errors = [p.communicate()[1] for p in procs if p.wait() != 0]
     elapsed = time.perf_counter() - started
     return elapsed, errors + _problems(store, outputs, serials, complete=True)
@@ -131,11 +151,15 @@ def main() -> None:
             work = folder / name
             work.mkdir()
             elapsed, problems = overlapping(new_store(work / "fleet.sqlite"), runs, work)
-            print(f"{name}: {STATIONS} stations x 75 units (200 units, overlapping): {elapsed:.1f} s, "
-                  f"{'every unit stored once' if not problems else 'PROBLEMS: ' + '; '.join(problems[:5])}")
+            print(
+                f"{name}: {STATIONS} stations x 75 units (200 units, overlapping): {elapsed:.1f} s, "
+                f"{'every unit stored once' if not problems else 'PROBLEMS: ' + '; '.join(problems[:5])}"
+            )
             problems = killed(new_store, runs, work, args.trials, rng)
-            print(f"{name}: {args.trials} trials of a station killed at a random moment: "
-                  f"{'consistent every time, each rerun completed' if not problems else 'PROBLEMS: ' + '; '.join(problems[:5])}")
+            print(
+                f"{name}: {args.trials} trials of a station killed at a random moment: "
+                f"{'consistent every time, each rerun completed' if not problems else 'PROBLEMS: ' + '; '.join(problems[:5])}"
+            )
 
 
 if __name__ == "__main__":

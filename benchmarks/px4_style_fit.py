@@ -38,7 +38,7 @@ def main(paths: list[str]) -> None:
     x = np.vstack(rows)
     for axis in AXES:
         coef, *_ = np.linalg.lstsq(x, np.concatenate(values[axis]), rcond=None)
-        print(axis, " ".join(f"{c:.6g}" for c in coef[len(frames):]))
+        print(axis, " ".join(f"{c:.6g}" for c in coef[len(frames) :]))
 
 
 if __name__ == "__main__":

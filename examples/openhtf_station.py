@@ -25,8 +25,12 @@ AXES = ("gyro_x", "gyro_y", "gyro_z")
 #: the line's limits [deg/s, deg/s/sqrt(Hz)]: the held-out drift and the white noise of each axis
 MAX_HELD_OUT_DRIFT_DPS = 0.05
 MAX_NOISE_DENSITY_DPS_PER_SQRT_HZ = 0.05
-LIMITS = Limits((Limit("held_out_drift_dps", max=MAX_HELD_OUT_DRIFT_DPS),
-                 Limit("noise_density_dps_per_sqrt_hz", max=MAX_NOISE_DENSITY_DPS_PER_SQRT_HZ)))
+LIMITS = Limits(
+    (
+        Limit("held_out_drift_dps", max=MAX_HELD_OUT_DRIFT_DPS),
+        Limit("noise_density_dps_per_sqrt_hz", max=MAX_NOISE_DENSITY_DPS_PER_SQRT_HZ),
+    )
+)
 
 
 def station_test(runs: list[str], store: str, output: str, station: str = "openhtf") -> htf.Test:
@@ -43,17 +47,27 @@ def station_test(runs: list[str], store: str, output: str, station: str = "openh
         return htf.PhaseResult.STOP if test.measurements.runs_refused else htf.PhaseResult.CONTINUE
 
     # the names carry the units (OpenHTF's unit table has no deg/s)
-    @htf.measures(*[htf.Measurement(f"{a}_held_out_drift_dps").in_range(maximum=MAX_HELD_OUT_DRIFT_DPS)
-                    for a in AXES],
-                  *[htf.Measurement(f"{a}_noise_density_dps_per_sqrt_hz")
-                    .in_range(maximum=MAX_NOISE_DENSITY_DPS_PER_SQRT_HZ) for a in AXES])
+    @htf.measures(
+        *[htf.Measurement(f"{a}_held_out_drift_dps").in_range(maximum=MAX_HELD_OUT_DRIFT_DPS) for a in AXES],
+        *[
+            htf.Measurement(f"{a}_noise_density_dps_per_sqrt_hz").in_range(maximum=MAX_NOISE_DENSITY_DPS_PER_SQRT_HZ)
+            for a in AXES
+        ],
+    )
     def fit(test):
         """gyrocomp fleet fit of this one unit into the line's store (the data check runs there too)."""
         serial = test.test_record.dut_id
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            summary = fit_fleet([UnitRuns(serial, tuple(runs))], output, FleetSettings(), limits=LIMITS,
-                                scheduler="serial", store=store, station=station)
+            summary = fit_fleet(
+                [UnitRuns(serial, tuple(runs))],
+                output,
+                FleetSettings(),
+                limits=LIMITS,
+                scheduler="serial",
+                store=store,
+                station=station,
+            )
         if serial in summary.failed:
             test.logger.error(summary.failed[serial])
             return htf.PhaseResult.STOP
@@ -61,8 +75,9 @@ def station_test(runs: list[str], store: str, output: str, station: str = "openh
             figures = db.latest(serial).figures
         for axis in AXES:
             test.measurements[f"{axis}_held_out_drift_dps"] = figures.axes[axis].held_out_drift_dps
-            test.measurements[f"{axis}_noise_density_dps_per_sqrt_hz"] = \
-                figures.axes[axis].noise_density_dps_per_sqrt_hz
+            test.measurements[f"{axis}_noise_density_dps_per_sqrt_hz"] = figures.axes[
+                axis
+            ].noise_density_dps_per_sqrt_hz
         return htf.PhaseResult.CONTINUE
 
     def certificate(test):

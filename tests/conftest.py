@@ -70,16 +70,23 @@ def xsens_session():
     folder = shared_dataset("imu_tk-xsens")
     acc = np.loadtxt(folder / "xsens_acc.mat")
     gyro = np.loadtxt(folder / "xsens_gyro.mat")
-    return Recording(acc[:, 0], np.degrees((gyro[:, 1:] - 32768) / 6258), GYRO_AXES,
-                     accel_g=(acc[:, 1:] - 32768) / 3700.0, accel_axes=ACCEL_AXES, source="xsens")
+    return Recording(
+        acc[:, 0],
+        np.degrees((gyro[:, 1:] - 32768) / 6258),
+        GYRO_AXES,
+        accel_g=(acc[:, 1:] - 32768) / 3700.0,
+        accel_axes=ACCEL_AXES,
+        source="xsens",
+    )
 
 
 @pytest.fixture(scope="session")
 def consumer_model():
     """A consumer part's default model (thermal lag included), fitted on two 1-hour chamber runs at 2 Hz (unit 3,
     seeds 0 and 1); the model the chunked paths (apply_file, evaluate_file) are checked with."""
-    runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
-            for s in range(2)]
+    runs = [
+        simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return fit_channels(runs)
@@ -106,8 +113,13 @@ def assert_streaming_equals_batch(calibration, recording, cuts: list[int]) -> No
         for c in list(cuts) + [recording.n_samples]:
             stop = min(start + c, recording.n_samples)
             if stop > start:
-                parts.append(comp.update(recording.time_s[start:stop], recording.gyro_dps[start:stop],
-                                         recording.temperature_degc[start:stop]))
+                parts.append(
+                    comp.update(
+                        recording.time_s[start:stop],
+                        recording.gyro_dps[start:stop],
+                        recording.temperature_degc[start:stop],
+                    )
+                )
             start = stop
     np.testing.assert_allclose(np.concatenate(parts), batch, rtol=0, atol=1e-12)
 
@@ -174,8 +186,13 @@ def joined_recordings(pieces, gap_s):
         gyro.append(rec.gyro_dps)
         temps.append(rec.temperature_degc)
         start = t[-1] + gap_s
-    return Recording(np.concatenate(times), np.concatenate(gyro), pieces[0].gyro_axes,
-                     temperature_degc=np.concatenate(temps), source="joined")
+    return Recording(
+        np.concatenate(times),
+        np.concatenate(gyro),
+        pieces[0].gyro_axes,
+        temperature_degc=np.concatenate(temps),
+        source="joined",
+    )
 
 
 def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0) -> Recording:
@@ -186,10 +203,17 @@ def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0) -> Recordin
     if gap_after is not None:
         time_s[gap_after:] += 10.0  # a 10 s hole
     gyro = rng.standard_normal((n, 2)) * 0.01 * math.sqrt(rate_hz)  # N = 0.01 deg/s/sqrt(Hz)
-    accel = np.column_stack([rng.standard_normal(n) * 1e-3, rng.standard_normal(n) * 1e-3,
-                             1.0 + rng.standard_normal(n) * 1e-3])
-    return Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=("gyro_x", "gyro_z"), accel_g=accel,
-                     accel_axes=("accel_x", "accel_y", "accel_z"), source="static.csv")
+    accel = np.column_stack(
+        [rng.standard_normal(n) * 1e-3, rng.standard_normal(n) * 1e-3, 1.0 + rng.standard_normal(n) * 1e-3]
+    )
+    return Recording(
+        time_s=time_s,
+        gyro_dps=gyro,
+        gyro_axes=("gyro_x", "gyro_z"),
+        accel_g=accel,
+        accel_axes=("accel_x", "accel_y", "accel_z"),
+        source="static.csv",
+    )
 
 
 # -- a throwaway PostgreSQL server ------------------------------------------------------------------------------

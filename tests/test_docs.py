@@ -33,8 +33,9 @@ def test_the_sites_home_page_is_the_readme():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert (ROOT / "docs" / "index.md").read_text(encoding="utf-8") == module.site_index(readme), \
+    assert (ROOT / "docs" / "index.md").read_text(encoding="utf-8") == module.site_index(readme), (
         "docs/index.md differs from the README: run python tools/site_index.py"
+    )
     assert "## Measured" in readme and "](docs/" not in module.site_index(readme)
 
 
@@ -62,7 +63,8 @@ def test_the_readmes_python_example_runs(tmp_path, monkeypatch):
         sims[name] = rec = simulate("consumer", profile=prof, rate_hz=2.0, seed=k).recording
         rows = ["Stamp\tGyrX\tGyrY\tGyrZ\tTemp"] + [
             "\t".join([f"{t:.2f}", *(f"{v:.9g}" for v in g), f"{temp:.2f}"])
-            for t, g, temp in zip(rec.time_s, rec.gyro_dps, rec.temperature_degc)]
+            for t, g, temp in zip(rec.time_s, rec.gyro_dps, rec.temperature_degc)
+        ]
         (tmp_path / name).write_text("\n".join(rows) + "\n")
     made = run("init", "chamber_1.csv", cwd=tmp_path)
     assert made.returncode == 0, made.stderr
@@ -98,11 +100,19 @@ def _api_objects():
             obj = getattr(obj, part)
         yield dotted, obj
         if inspect.ismodule(obj):
-            members = [(n, m) for n, m in vars(obj).items() if not n.startswith("_")
-                       and (inspect.isfunction(m) or inspect.isclass(m)) and m.__module__ == obj.__name__]
+            members = [
+                (n, m)
+                for n, m in vars(obj).items()
+                if not n.startswith("_")
+                and (inspect.isfunction(m) or inspect.isclass(m))
+                and m.__module__ == obj.__name__
+            ]
         elif inspect.isclass(obj):
-            members = [(n, m) for n, m in vars(obj).items() if not n.startswith("_")
-                       and (inspect.isfunction(m) or isinstance(m, (classmethod, staticmethod)))]
+            members = [
+                (n, m)
+                for n, m in vars(obj).items()
+                if not n.startswith("_") and (inspect.isfunction(m) or isinstance(m, (classmethod, staticmethod)))
+            ]
         else:
             members = []
         for name, _member in members:

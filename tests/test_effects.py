@@ -47,7 +47,7 @@ def test_lag_coefficients_have_unit_gain_and_no_lag_without_time_constant():
     assert (b0 + b1) / (1 - a) == pytest.approx(1.0, rel=1e-12)
     assert lag_coefficients(0.01, 0.0) == (0.0, 1.0, 0.0)
     t = np.arange(5.0)
-    np.testing.assert_array_equal(thermal_lag(t, t ** 2, 0.0)[0], t ** 2)
+    np.testing.assert_array_equal(thermal_lag(t, t**2, 0.0)[0], t**2)
 
 
 def test_lag_bridges_a_gap_as_if_the_samples_were_there():
@@ -106,13 +106,20 @@ def test_turns_ignore_noise_and_whole_degree_steps():
     # without a threshold the noise makes hundreds of false reversals
     assert len(find_turns(temp).turn_index) > 100
     turns = find_turns(temp, threshold_degc=2.5)
-    assert set(np.unique(turns.turn_degc[~np.isnan(turns.turn_degc)])) <= {-22.0, -21.0, -20.0, -19.0,
-                                                                            69.0, 70.0, 71.0, 72.0}
+    assert set(np.unique(turns.turn_degc[~np.isnan(turns.turn_degc)])) <= {
+        -22.0,
+        -21.0,
+        -20.0,
+        -19.0,
+        69.0,
+        70.0,
+        71.0,
+        72.0,
+    }
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.integers(min_value=1, max_value=3000), min_size=1, max_size=10),
-       st.sampled_from([0.0, 0.5, 2.5]))
+@given(st.lists(st.integers(min_value=1, max_value=3000), min_size=1, max_size=10), st.sampled_from([0.0, 0.5, 2.5]))
 def test_turns_in_chunks_equal_one_call(cuts, threshold):
     rng = np.random.default_rng(7)
     temp = np.round(_cycle(2, 900) + rng.normal(0, 0.3, _cycle(2, 900).size), 1)
@@ -137,7 +144,7 @@ def test_hysteresis_offset_on_the_chosen_branches_and_band():
     off = hysteresis_offset(temp, turns, h, direction="descending", band_degc=(55.0, 80.0))
     falling = (turns.direction == -1) & (temp >= 55)
     d = 70.0 - temp[falling]
-    np.testing.assert_allclose(off[falling], 0.032 * d - 0.00128 * d ** 2, rtol=1e-12)
+    np.testing.assert_allclose(off[falling], 0.032 * d - 0.00128 * d**2, rtol=1e-12)
     assert np.all(off[~falling] == 0)
     both = hysteresis_offset(temp, turns, (1e-3,), direction="both")
     first_turn = turns.turn_index[0]
@@ -158,7 +165,7 @@ def test_hysteresis_offset_is_held_past_the_largest_distance_fitted():
     near, far = falling & (d <= 30.0), falling & (d > 30.0)
     assert near.any() and far.any()
     np.testing.assert_array_equal(held[near], free[near])
-    np.testing.assert_allclose(held[far], 0.01 * 30 + 2e-4 * 30 ** 2, rtol=1e-12)  # the value at d = 30 degC
+    np.testing.assert_allclose(held[far], 0.01 * 30 + 2e-4 * 30**2, rtol=1e-12)  # the value at d = 30 degC
 
 
 def test_g_sensitivity_is_the_matrix_times_the_force():

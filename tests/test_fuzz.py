@@ -32,7 +32,7 @@ FUZZ = settings(max_examples=60, deadline=None, suppress_health_check=[HealthChe
 NAMES = ["time", "gyro_x", "gyro_y", "gyro_z", "accel_z", "temperature", "Time", " gyro_z ", "GyrZ", "t", ""]
 CELLS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True).map(repr),
-    st.integers(-10 ** 30, 10 ** 30).map(str),
+    st.integers(-(10**30), 10**30).map(str),
     st.sampled_from(["", "nan", "NaN", "inf", "-inf", "1e308", "1e999", "abc", '"1"', "1,5", "0x10", " 3 ", "\t"]),
 )
 
@@ -58,9 +58,12 @@ def read_or_refuse(reader, *args, **kwargs):
 
 
 @FUZZ
-@given(header=st.lists(st.sampled_from(NAMES), min_size=1, max_size=7),
-       rows=st.lists(st.lists(CELLS, min_size=0, max_size=8), min_size=0, max_size=6),
-       delimiter=st.sampled_from([",", ";", "\t"]), drop=st.booleans())
+@given(
+    header=st.lists(st.sampled_from(NAMES), min_size=1, max_size=7),
+    rows=st.lists(st.lists(CELLS, min_size=0, max_size=8), min_size=0, max_size=6),
+    delimiter=st.sampled_from([",", ";", "\t"]),
+    drop=st.booleans(),
+)
 def test_malformed_csv_is_read_cleanly_or_refused(tmp_path_factory, header, rows, delimiter, drop):
     path = tmp_path_factory.mktemp("csv") / "f.csv"
     path.write_text("\n".join(delimiter.join(r) for r in [header, *rows]) + "\n", encoding="utf-8")
@@ -70,13 +73,22 @@ def test_malformed_csv_is_read_cleanly_or_refused(tmp_path_factory, header, rows
 
 
 @FUZZ
-@given(columns=st.dictionaries(st.sampled_from(NAMES[:6]), st.sampled_from(["float", "int", "str", "nan", "bool"]),
-                               min_size=1, max_size=6),
-       n=st.integers(0, 5), drop=st.booleans())
+@given(
+    columns=st.dictionaries(
+        st.sampled_from(NAMES[:6]), st.sampled_from(["float", "int", "str", "nan", "bool"]), min_size=1, max_size=6
+    ),
+    n=st.integers(0, 5),
+    drop=st.booleans(),
+)
 def test_malformed_parquet_is_read_cleanly_or_refused(tmp_path_factory, columns, n, drop):
     rng = np.random.default_rng(n)
-    make = {"float": lambda: np.cumsum(rng.random(n)), "int": lambda: np.arange(n), "str": lambda: ["a"] * n,
-            "nan": lambda: np.full(n, np.nan), "bool": lambda: np.ones(n, dtype=bool)}
+    make = {
+        "float": lambda: np.cumsum(rng.random(n)),
+        "int": lambda: np.arange(n),
+        "str": lambda: ["a"] * n,
+        "nan": lambda: np.full(n, np.nan),
+        "bool": lambda: np.ones(n, dtype=bool),
+    }
     path = tmp_path_factory.mktemp("pq") / "f.parquet"
     pd.DataFrame({name: make[kind]() for name, kind in columns.items()}).to_parquet(path)
     data = read_or_refuse(read_table, path, drop_nonfinite=drop)
@@ -104,8 +116,13 @@ def _paths(node, prefix=()):
 
 
 JSON_VALUES = st.recursive(
-    st.one_of(st.none(), st.booleans(), st.integers(-10 ** 40, 10 ** 40),
-              st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=12)),
+    st.one_of(
+        st.none(),
+        st.booleans(),
+        st.integers(-(10**40), 10**40),
+        st.floats(allow_nan=True, allow_infinity=True),
+        st.text(max_size=12),
+    ),
     lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=6), inner, max_size=3)),
     max_leaves=8,
 )
@@ -139,17 +156,17 @@ def _mutations(blob: bytes, seed: int, count: int):
     """``count`` truncations and ``count`` corrupted copies (1-8 random bytes replaced) of ``blob``."""
     rng = np.random.default_rng(seed)
     for _ in range(count):
-        yield "cut", blob[:int(rng.integers(1, len(blob)))]
+        yield "cut", blob[: int(rng.integers(1, len(blob)))]
         damaged = bytearray(blob)
         for at in rng.integers(0, len(blob), size=int(rng.integers(1, 9))):
             damaged[at] = int(rng.integers(0, 256))
         yield "flip", bytes(damaged)
 
 
-@pytest.mark.parametrize("dataset, name, extra", [
-    ("px4-pyulog-samples", "sample_log_small.ulg", "pyulog"),
-    ("ardupilot-pymavlink-sample", "test.BIN", "pymavlink"),
-])
+@pytest.mark.parametrize(
+    "dataset, name, extra",
+    [("px4-pyulog-samples", "sample_log_small.ulg", "pyulog"), ("ardupilot-pymavlink-sample", "test.BIN", "pymavlink")],
+)
 def test_truncated_and_byte_flipped_logs_read_cleanly_or_are_refused(tmp_path, dataset, name, extra):
     pytest.importorskip(extra)
     folder = shared_dataset(dataset)
@@ -171,7 +188,10 @@ def test_layout_fuzz_helpers_see_every_outcome(tmp_path):
     with pytest.raises(AssertionError):
         read_or_refuse(lambda: (_ for _ in ()).throw(InputError("two\nlines")))
     with pytest.raises(AssertionError):
-        assert_clean(types.SimpleNamespace(time_s=np.zeros(2), gyro_dps=np.full((2, 1), np.nan), temperature_degc=None,
-                                           accel_g=None))
+        assert_clean(
+            types.SimpleNamespace(
+                time_s=np.zeros(2), gyro_dps=np.full((2, 1), np.nan), temperature_degc=None, accel_g=None
+            )
+        )
     (tmp_path / "ok.csv").write_text("time,gyro_z\n0,1\n1,2\n")
     assert read_or_refuse(read_table, tmp_path / "ok.csv", TableLayout()).recording.n_samples == 2

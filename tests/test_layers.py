@@ -13,8 +13,22 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gyrocomp"
 #: foundation is one or more folders of its own; the package root holds only the foundation's modules.
 LAYERS = (
     # pure functions and helpers any layer may use: errors, physical units, the effects' equations, spilling
-    ("foundation", ("_version", "errors", "units", "threads", "jsontext", "rounding", "c_literals", "effects",
-                    "spilled_series", "option_spelling", "lazy")),
+    (
+        "foundation",
+        (
+            "_version",
+            "errors",
+            "units",
+            "threads",
+            "jsontext",
+            "rounding",
+            "c_literals",
+            "effects",
+            "spilled_series",
+            "option_spelling",
+            "lazy",
+        ),
+    ),
     # what a recording is and what is measured of it: the recording and its preparation, motion (stillness,
     # static positions), measures (figures of merit, noise terms, plausibility), Allan statistics, simulation
     ("signals", ("recording", "motion", "runs", "measures", "allan", "simulation")),
@@ -73,11 +87,16 @@ def _imports(path: Path) -> tuple[set[str], list[tuple[int, str]]]:
                 targets = [".".join(filter(None, (stem, a.name))) for a in node.names]
         elif isinstance(node, (ast.Import, ast.ImportFrom)):
             names = [node.module] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
-            targets = [n[len("gyrocomp."):] if n != "gyrocomp" else "" for n in names
-                       if n == "gyrocomp" or n.startswith("gyrocomp.")]
+            targets = [
+                n[len("gyrocomp.") :] if n != "gyrocomp" else ""
+                for n in names
+                if n == "gyrocomp" or n.startswith("gyrocomp.")
+            ]
         for target in targets:
-            while target and not ((SRC / target.replace(".", "/")).with_suffix(".py").exists()
-                                  or (SRC / target.replace(".", "/") / "__init__.py").exists()):
+            while target and not (
+                (SRC / target.replace(".", "/")).with_suffix(".py").exists()
+                or (SRC / target.replace(".", "/") / "__init__.py").exists()
+            ):
                 target = target.rpartition(".")[0]  # a name imported from a module, not a module
             found.add(target)
             if id(node) in nested:
@@ -97,8 +116,9 @@ def test_every_module_is_in_a_layer():
 def test_imports_go_down_the_layers(module):
     rank = _layer(module)
     upward = sorted(t for t in GRAPH[module][0] if _layer(t) > rank)
-    assert not upward, (f"{module} ({LAYERS[rank][0]}) imports from a higher layer: "
-                        + ", ".join(f"{t} ({LAYERS[_layer(t)][0]})" for t in upward))
+    assert not upward, f"{module} ({LAYERS[rank][0]}) imports from a higher layer: " + ", ".join(
+        f"{t} ({LAYERS[_layer(t)][0]})" for t in upward
+    )
 
 
 def test_no_function_imports_a_project_module():
@@ -115,7 +135,7 @@ def test_the_import_graph_has_no_cycle():
         state[node] = 1
         for nxt in sorted(graph[node]):
             if state.get(nxt) == 1:
-                cycle = path[path.index(nxt):] + [nxt]
+                cycle = path[path.index(nxt) :] + [nxt]
                 raise AssertionError("import cycle: " + " -> ".join(cycle))
             if nxt not in state:
                 visit(nxt, path + [nxt])
@@ -130,7 +150,9 @@ def test_the_parser_sees_relative_absolute_and_inner_imports(tmp_path):
     # the checks above are not vacuous: known edges of the graph are found
     assert {"calibration.calibration", "effects", "recording"} <= GRAPH["calibration.compensate"][0]
     assert "models.options" in GRAPH["cli.fit"][0] and "io.atomic" in GRAPH["calibration.calibration"][0]
-    assert _layer("measures.merit") < _layer("models.pipelines") and _layer("fitting.selection") == _layer("fitting.thermal")
+    assert _layer("measures.merit") < _layer("models.pipelines") and _layer("fitting.selection") == _layer(
+        "fitting.thermal"
+    )
     with pytest.raises(AssertionError, match="newthing: in no layer"):
         _layer("newthing")
 
@@ -153,8 +175,12 @@ def _folder(module: str) -> str:
 
 def test_no_two_folders_import_each_other():
     """The folders' graph has no two-way edge (the layers allow imports within one layer, not both ways)."""
-    edges = {(_folder(m), _folder(t)) for m, (deps, _) in GRAPH.items() for t in deps
-             if _folder(m) and _folder(t) and _folder(m) != _folder(t)}
+    edges = {
+        (_folder(m), _folder(t))
+        for m, (deps, _) in GRAPH.items()
+        for t in deps
+        if _folder(m) and _folder(t) and _folder(m) != _folder(t)
+    }
     assert sorted((a, b) for a, b in edges if (b, a) in edges and a < b) == []
 
 
@@ -175,9 +201,12 @@ def test_the_init_files_only_export():
             if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant):
                 continue  # the docstring
             if isinstance(node, ast.Assign) and all(
-                    isinstance(t, ast.Name) and t.id in allowed_targets
-                    or isinstance(t, ast.Tuple) and all(isinstance(e, ast.Name) and e.id in allowed_targets
-                                                        for e in t.elts) for t in node.targets):
+                isinstance(t, ast.Name)
+                and t.id in allowed_targets
+                or isinstance(t, ast.Tuple)
+                and all(isinstance(e, ast.Name) and e.id in allowed_targets for e in t.elts)
+                for t in node.targets
+            ):
                 continue
             code.append(f"{path.relative_to(SRC)}:{node.lineno}")
     assert code == []

@@ -40,8 +40,9 @@ def test_the_openhtf_station_checks_fits_and_certifies_one_unit(tmp_path):
     runs = []
     for k in range(3):
         path = tmp_path / f"run{k}.parquet"
-        write_recording(simulate("mti10", profile="chamber", rate_hz=1, duration_s=3600, seed=k, unit=4).recording,
-                        path)
+        write_recording(
+            simulate("mti10", profile="chamber", rate_hz=1, duration_s=3600, seed=k, unit=4).recording, path
+        )
         runs.append(path)
     store, output = tmp_path / "line.sqlite", tmp_path / "out"
     record = _execute(station, "SN-HTF-1", runs, store, output)

@@ -172,31 +172,43 @@ def extended(tmp_path_factory):
         names = target / registry
         lines = names.read_text().splitlines()
         last = max(i for i, x in enumerate(lines) if x.startswith("from . import "))
-        names.write_text("\n".join(lines[:last + 1] + [line] + lines[last + 1:]) + "\n")
-    changed = {p.relative_to(target) for p in target.rglob("*.py")
-               if before.get(p.relative_to(target)) != p.read_bytes()}
+        names.write_text("\n".join(lines[: last + 1] + [line] + lines[last + 1 :]) + "\n")
+    changed = {
+        p.relative_to(target) for p in target.rglob("*.py") if before.get(p.relative_to(target)) != p.read_bytes()
+    }
     assert changed == {Path(m) for m, _, r, _ in RECIPES.values()} | {Path(r) for _, _, r, _ in RECIPES.values()}
 
     def run(*args, cwd=root):
         env = {**os.environ, "PYTHONPATH": str(root), "COLUMNS": "200"}
-        return subprocess.run([sys.executable, "-m", "gyrocomp", *map(str, args)], capture_output=True, text=True,
-                              cwd=cwd, env=env, timeout=300)
+        return subprocess.run(
+            [sys.executable, "-m", "gyrocomp", *map(str, args)],
+            capture_output=True,
+            text=True,
+            cwd=cwd,
+            env=env,
+            timeout=300,
+        )
 
     runs = root / "runs"
     runs.mkdir()
     for seed in range(3):
-        rec = simulate("consumer", profile=get_profile("cycle", set_points_degc=(-10.0, 60.0), cycles=1),
-                       rate_hz=1.0, seed=seed).recording
-        np.savez(runs / f"run{seed}.npz", time_s=rec.time_s, gyro_dps=rec.gyro_dps,
-                 temperature_degc=rec.temperature_degc)
+        rec = simulate(
+            "consumer", profile=get_profile("cycle", set_points_degc=(-10.0, 60.0), cycles=1), rate_hz=1.0, seed=seed
+        ).recording
+        np.savez(
+            runs / f"run{seed}.npz", time_s=rec.time_s, gyro_dps=rec.gyro_dps, temperature_degc=rec.temperature_degc
+        )
     return run, root
 
 
 def test_the_copy_runs_its_own_package(extended):
     _, root = extended
     done = subprocess.run(
-        [sys.executable, "-c", "import gyrocomp; print(gyrocomp.__file__)"], capture_output=True, text=True,
-        env={**os.environ, "PYTHONPATH": str(root)})
+        [sys.executable, "-c", "import gyrocomp; print(gyrocomp.__file__)"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(root)},
+    )
     assert done.stdout.strip() == str(root / "gyrocomp" / "__init__.py")
 
 

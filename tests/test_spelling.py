@@ -13,7 +13,8 @@ from gyrocomp.option_spelling import Spelling, from_values, spelled, spelled_fie
 def test_every_reading_field_is_spelled_once_and_flags_do_not_repeat():
     spelled_names = [field.name for field, _ in spelled_fields(ReadOptions)]
     own = [f.name for f in dataclasses.fields(TableLayout)] + [
-        f.name for f in dataclasses.fields(ReadOptions) if f.name not in ("layout", "channels")]
+        f.name for f in dataclasses.fields(ReadOptions) if f.name not in ("layout", "channels")
+    ]
     assert sorted(spelled_names) == sorted(own)  # layout is spelled through its fields; channels by each command
     flags = [spelling.flag for _, spelling in spelled_fields(ReadOptions)]
     assert len(set(flags)) == len(flags) and all(f.startswith("--") for f in flags)
@@ -21,23 +22,38 @@ def test_every_reading_field_is_spelled_once_and_flags_do_not_repeat():
 
 def test_values_build_the_options_and_nested_layout():
     parsed = {field.name: spelling.parse for field, spelling in spelled_fields(ReadOptions)}
-    options = from_values(ReadOptions, {
-        "columns": parsed["columns"]("gyro_z=GyrZ,temperature=T"), "gyro_unit": "rad/s", "delimiter":
-        parsed["delimiter"]("tab"), "drop_nonfinite": True, "instance": parsed["instance"]("2"),
-        "time_range_s": parsed["time_range_s"]("10:"), "imu_topic": None})
-    assert options == ReadOptions(layout=TableLayout({"gyro_z": "GyrZ", "temperature": "T"}, "rad/s", delimiter="\t"),
-                                  drop_nonfinite=True, instance=2, time_range_s=(10.0, None))
+    options = from_values(
+        ReadOptions,
+        {
+            "columns": parsed["columns"]("gyro_z=GyrZ,temperature=T"),
+            "gyro_unit": "rad/s",
+            "delimiter": parsed["delimiter"]("tab"),
+            "drop_nonfinite": True,
+            "instance": parsed["instance"]("2"),
+            "time_range_s": parsed["time_range_s"]("10:"),
+            "imu_topic": None,
+        },
+    )
+    assert options == ReadOptions(
+        layout=TableLayout({"gyro_z": "GyrZ", "temperature": "T"}, "rad/s", delimiter="\t"),
+        drop_nonfinite=True,
+        instance=2,
+        time_range_s=(10.0, None),
+    )
     assert from_values(ReadOptions, {}) == ReadOptions()
 
 
-@pytest.mark.parametrize("name, text, match", [
-    ("time_range_s", "1:x", r"time_range_s: '1:x': give A:B in seconds"),
-    ("time_range_s", ":", r"time_range_s: ':': give finite seconds on at least one side"),
-    ("time_range_s", "1:inf", r"time_range_s: '1:inf': give finite seconds"),
-    ("instance", "-1", r"instance: -1: give a whole number >= 0"),
-    ("device_id", "abc", r"device_id: 'abc': give a whole number >= 0"),
-    ("columns", "gyro_z", r"columns: 'gyro_z' is not CHANNEL=COLUMN"),
-])
+@pytest.mark.parametrize(
+    "name, text, match",
+    [
+        ("time_range_s", "1:x", r"time_range_s: '1:x': give A:B in seconds"),
+        ("time_range_s", ":", r"time_range_s: ':': give finite seconds on at least one side"),
+        ("time_range_s", "1:inf", r"time_range_s: '1:inf': give finite seconds"),
+        ("instance", "-1", r"instance: -1: give a whole number >= 0"),
+        ("device_id", "abc", r"device_id: 'abc': give a whole number >= 0"),
+        ("columns", "gyro_z", r"columns: 'gyro_z' is not CHANNEL=COLUMN"),
+    ],
+)
 def test_parse_errors_name_the_field(name, text, match):
     parse = {field.name: spelling.parse for field, spelling in spelled_fields(ReadOptions)}[name]
     with pytest.raises(InputError, match=match):

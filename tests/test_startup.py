@@ -18,8 +18,12 @@ from .conftest import run
 
 
 def _modules_after(code: str) -> set[str]:
-    out = subprocess.run([sys.executable, "-c", f"{code}; import sys; print(' '.join(sys.modules))"],
-                         capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-c", f"{code}; import sys; print(' '.join(sys.modules))"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
     return set(out.split())
 
 
@@ -80,10 +84,12 @@ def test_apply_and_convert_of_a_table_do_not_load_pandas(tmp_path):
     cells[1] = ""  # an empty gyro cell: a null in the column
     lines[5] = ",".join(cells)
     (tmp_path / "run.csv").write_text("\n".join(lines) + "\n")
-    code = ("from gyrocomp.cli import main; "
-            f"assert main(['-q', 'apply', r'{tmp_path / 'model.json'}', r'{tmp_path / 'run.csv'}', '--drop-nan', "
-            f"'-o', r'{tmp_path / 'out.parquet'}']) == 0; "
-            f"assert main(['-q', 'convert', r'{tmp_path / 'out.parquet'}', r'{tmp_path / 'back.csv'}']) == 0")
+    code = (
+        "from gyrocomp.cli import main; "
+        f"assert main(['-q', 'apply', r'{tmp_path / 'model.json'}', r'{tmp_path / 'run.csv'}', '--drop-nan', "
+        f"'-o', r'{tmp_path / 'out.parquet'}']) == 0; "
+        f"assert main(['-q', 'convert', r'{tmp_path / 'out.parquet'}', r'{tmp_path / 'back.csv'}']) == 0"
+    )
     assert "pandas" not in _modules_after(code)
     back = gyrocomp.read(tmp_path / "back.csv")
     assert back.n_samples == rec.n_samples - 1

@@ -37,8 +37,16 @@ def test_the_setting_returns_when_the_call_raises():
         assert blas_threads() == before
 
 
-@pytest.mark.parametrize("module, entry", [(fit_module, "fit"), (joint, "fit_calibration"), (pipelines, "fit_pipeline"),
-                                           (fit_module, "fit_channels"), (accelerometer, "fit_accelerometer")])
+@pytest.mark.parametrize(
+    "module, entry",
+    [
+        (fit_module, "fit"),
+        (joint, "fit_calibration"),
+        (pipelines, "fit_pipeline"),
+        (fit_module, "fit_channels"),
+        (accelerometer, "fit_accelerometer"),
+    ],
+)
 def test_every_fit_entry_point_fits_with_blas_on_one_thread(monkeypatch, module, entry):
     """What the fit runs sees one BLAS thread, whichever public entry point it came through."""
     seen = []

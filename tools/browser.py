@@ -25,8 +25,16 @@ from pathlib import Path
 #: a Letter page's printable height at Chromium's default margins (0.4 in top and bottom) [CSS px]
 PRINTABLE_HEIGHT_PX, PRINTABLE_WIDTH_PX = (11.0 - 0.8) * 96, (8.5 - 0.8) * 96
 #: the flags the machines here need for a headless Chromium without network (see the env notes)
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync")
+FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+)
 #: each figure's natural and drawn size: an image that did not decode has a natural width of 0
 _FIGURES_JS = """JSON.stringify(Array.from(document.querySelectorAll('img, svg, canvas')).map(e => {
   const r = e.getBoundingClientRect();
@@ -104,6 +112,7 @@ def open_page(path: str | os.PathLike, timeout_s: float = 60.0) -> PageSeen:
     to_chrome_r, to_chrome_w = os.pipe()
     from_chrome_r, from_chrome_w = os.pipe()
     with tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile:
+
         def onto_3_and_4() -> None:  # in the child: the pipe's ends on 3 and 4, where Chromium looks for them
             read_end, write_end = os.dup(to_chrome_r), os.dup(from_chrome_w)  # clear of 3 and 4 first
             os.dup2(read_end, 3)
@@ -111,8 +120,13 @@ def open_page(path: str | os.PathLike, timeout_s: float = 60.0) -> PageSeen:
 
         process = subprocess.Popen(
             [browser, *FLAGS, f"--user-data-dir={profile}", "--remote-debugging-pipe", "about:blank"],
-            close_fds=False, preexec_fn=onto_3_and_4, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL, start_new_session=True)
+            close_fds=False,
+            preexec_fn=onto_3_and_4,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         os.close(to_chrome_r)
         os.close(from_chrome_w)
         pipe = _Pipe(process, to_chrome_w, from_chrome_r)
@@ -123,16 +137,20 @@ def open_page(path: str | os.PathLike, timeout_s: float = 60.0) -> PageSeen:
                 pipe.send(f"{domain}.enable", session=session)
             pipe.send("Page.navigate", {"url": Path(path).resolve().as_uri()}, session=session)
             pipe.wait_for("Page.loadEventFired", timeout_s)
-            seen = pipe.send("Runtime.evaluate", {"expression": _FIGURES_JS, "returnByValue": True},
-                             session=session)
+            seen = pipe.send("Runtime.evaluate", {"expression": _FIGURES_JS, "returnByValue": True}, session=session)
             figures = tuple(json.loads(seen["result"]["value"]))
             # the height as printed: print media at the printable width of a Letter page (0.4 in margins)
             pipe.send("Emulation.setEmulatedMedia", {"media": "print"}, session=session)
-            pipe.send("Emulation.setDeviceMetricsOverride", {"width": int(PRINTABLE_WIDTH_PX), "height": 1000,
-                                                             "deviceScaleFactor": 1, "mobile": False},
-                      session=session)
-            height = pipe.send("Runtime.evaluate", {"expression": "document.documentElement.scrollHeight",
-                                                    "returnByValue": True}, session=session)["result"]["value"]
+            pipe.send(
+                "Emulation.setDeviceMetricsOverride",
+                {"width": int(PRINTABLE_WIDTH_PX), "height": 1000, "deviceScaleFactor": 1, "mobile": False},
+                session=session,
+            )
+            height = pipe.send(
+                "Runtime.evaluate",
+                {"expression": "document.documentElement.scrollHeight", "returnByValue": True},
+                session=session,
+            )["result"]["value"]
             pipe.send("Emulation.clearDeviceMetricsOverride", session=session)
             printed = pipe.send("Page.printToPDF", {"printBackground": True}, session=session)
             pdf = base64.b64decode(printed["data"])

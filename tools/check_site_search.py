@@ -22,9 +22,19 @@ WORDS = ("allan", "hysteresis", "symbolic")
 def results(site: Path, word: str, chromium: str) -> int:
     """How many documents Material's search says match ``word`` on the site opened from files."""
     with tempfile.TemporaryDirectory() as profile:
-        dom = subprocess.run([chromium, *FLAGS, f"--user-data-dir={profile}", "--virtual-time-budget=15000",
-                              "--dump-dom", f"{(site / 'index.html').resolve().as_uri()}?q={word}"],
-                             capture_output=True, text=True, timeout=120).stdout
+        dom = subprocess.run(
+            [
+                chromium,
+                *FLAGS,
+                f"--user-data-dir={profile}",
+                "--virtual-time-budget=15000",
+                "--dump-dom",
+                f"{(site / 'index.html').resolve().as_uri()}?q={word}",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        ).stdout
     found = re.search(r"md-search-result__meta\">\s*(\d+|One|No) matching document", dom)
     if not found:
         return 0

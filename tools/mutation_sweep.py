@@ -115,7 +115,7 @@ def mutated_logs(source: Path, count: int, rng: np.random.Generator, limit: int 
     blob = source.read_bytes()[:limit]
     for k in range(count):
         if k % 2 == 0:
-            yield "truncated", blob[:int(rng.integers(1, len(blob)))]
+            yield "truncated", blob[: int(rng.integers(1, len(blob)))]
         else:
             damaged = bytearray(blob)
             for at in rng.integers(0, len(blob), size=int(rng.integers(1, 17))):
@@ -125,7 +125,7 @@ def mutated_logs(source: Path, count: int, rng: np.random.Generator, limit: int 
 
 def malformed_csv(rng: np.random.Generator) -> str:
     """A plausible table (time, gyro, temperature; 20 rows) with some header names and cells damaged."""
-    header = ["time", "gyro_x", "gyro_y", "gyro_z", "temperature"][:int(rng.integers(2, 6))]
+    header = ["time", "gyro_x", "gyro_y", "gyro_z", "temperature"][: int(rng.integers(2, 6))]
     header = [str(rng.choice(NAMES)) if rng.random() < 0.15 else name for name in header]
     rows = [[repr(float(k)), *(repr(float(v)) for v in rng.normal(0.1, 0.01, len(header) - 1))] for k in range(20)]
     for row in rows:
@@ -159,7 +159,7 @@ def mutated_model(model: dict, rng: np.random.Generator) -> tuple[str, bool]:
     parent = copy
     for key in path[:-1]:
         parent = parent[key]
-    replacements = [None, True, -5, 10 ** 300, "../../etc/passwd", [], {}, [1.0] * 5000, "NaN", 1e308, -1e308]
+    replacements = [None, True, -5, 10**300, "../../etc/passwd", [], {}, [1.0] * 5000, "NaN", 1e308, -1e308]
     original = parent[path[-1]]
     valid = False
     if rng.random() < 0.3:
@@ -181,18 +181,23 @@ def model_kinds(seed: int, work: Path) -> dict[str, tuple[Path, dict]]:
     default fit of a consumer part (thermal lag, heating/cooling memory, g-sensitivity; chamber runs with static
     positions), the same with the accelerometer (triads), and a network."""
     chamber = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=seed).recording
-    runs = [simulate("consumer", profile="combined", duration_s=3600, rate_hz=2, seed=seed + s, unit=3).recording
-            for s in (0, 1)]
+    runs = [
+        simulate("consumer", profile="combined", duration_s=3600, rate_hz=2, seed=seed + s, unit=3).recording
+        for s in (0, 1)
+    ]
     write(chamber, work / "chamber.csv")
     write(runs[1], work / "combined.csv")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return {"polynomial": (work / "chamber.csv", fit_calibration([chamber], temperature=Polynomial(2)).to_dict()),
-                "default (lag, memory, g-sensitivity)": (work / "combined.csv", fit(runs).to_dict()),
-                "gyro and accelerometer triads": (work / "combined.csv",
-                                                  fit(runs, channels=("gyro", "accel")).to_dict()),
-                "network": (work / "combined.csv",
-                            fit_calibration(runs, temperature=Network(), hysteresis="none").to_dict())}
+        return {
+            "polynomial": (work / "chamber.csv", fit_calibration([chamber], temperature=Polynomial(2)).to_dict()),
+            "default (lag, memory, g-sensitivity)": (work / "combined.csv", fit(runs).to_dict()),
+            "gyro and accelerometer triads": (work / "combined.csv", fit(runs, channels=("gyro", "accel")).to_dict()),
+            "network": (
+                work / "combined.csv",
+                fit_calibration(runs, temperature=Network(), hysteresis="none").to_dict(),
+            ),
+        }
 
 
 def mutated_models(seed: int, work: Path, rng: np.random.Generator, count: int) -> dict[str, collections.Counter]:
@@ -230,8 +235,11 @@ def _bag(path: Path, recording, kind: str) -> Path:
 
     store = get_typestore(Stores.ROS1_NOETIC if kind == "ros1" else Stores.ROS2_HUMBLE)
     types = store.types
-    writer = (Writer1(path) if kind == "ros1" else
-              Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3))
+    writer = (
+        Writer1(path)
+        if kind == "ros1"
+        else Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3)
+    )
     serialize = store.serialize_ros1 if kind == "ros1" else store.serialize_cdr
     zeros, g_mps2 = np.zeros(9), 9.80665
     rad = np.deg2rad(recording.gyro_dps)
@@ -241,16 +249,21 @@ def _bag(path: Path, recording, kind: str) -> Path:
         for k, t in enumerate(recording.time_s + 100.0):
             sec = int(t)
             stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int((t - sec) * 1e9))
-            header = types["std_msgs/msg/Header"](**({"seq": k} if kind == "ros1" else {}), stamp=stamp,
-                                                   frame_id="imu")
+            header = types["std_msgs/msg/Header"](**({"seq": k} if kind == "ros1" else {}), stamp=stamp, frame_id="imu")
             vector, quaternion = types["geometry_msgs/msg/Vector3"], types["geometry_msgs/msg/Quaternion"]
             msg = types["sensor_msgs/msg/Imu"](
-                header=header, orientation=quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=zeros,
-                angular_velocity=vector(*rad[k]), angular_velocity_covariance=zeros,
-                linear_acceleration=vector(*(recording.accel_g[k] * g_mps2)), linear_acceleration_covariance=zeros)
+                header=header,
+                orientation=quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=zeros,
+                angular_velocity=vector(*rad[k]),
+                angular_velocity_covariance=zeros,
+                linear_acceleration=vector(*(recording.accel_g[k] * g_mps2)),
+                linear_acceleration_covariance=zeros,
+            )
             writer.write(imu, int(t * 1e9), serialize(msg, "sensor_msgs/msg/Imu"))
-            msg = types["sensor_msgs/msg/Temperature"](header=header, temperature=float(recording.temperature_degc[k]),
-                                                       variance=0.0)
+            msg = types["sensor_msgs/msg/Temperature"](
+                header=header, temperature=float(recording.temperature_degc[k]), variance=0.0
+            )
             writer.write(thermo, int(t * 1e9), serialize(msg, "sensor_msgs/msg/Temperature"))
     return path if kind == "ros1" else next(p for p in path.iterdir() if p.suffix in (".db3", ".mcap"))
 
@@ -273,18 +286,20 @@ def corrupted_binaries(work: Path, rng: np.random.Generator, count: int) -> dict
     Parquet table, a ROS 1 bag and ROS 2 bags in sqlite3 and MCAP storage, all of one simulated run, converted;
     a copy whose length is kept must not lose rows without a word."""
     recording = simulate("mti10", profile="chamber", duration_s=600, rate_hz=2, seed=7).recording
-    makers = {"HDF5": lambda p: _hdf5(p.with_suffix(".h5"), recording),
-              "Parquet": lambda p: (write(recording, p.with_suffix(".parquet")), p.with_suffix(".parquet"))[1],
-              "ROS 1 bag": lambda p: _bag(p.with_suffix(".bag"), recording, "ros1"),
-              "ROS 2 bag (sqlite3)": lambda p: _bag(p, recording, "sqlite3"),
-              "ROS 2 bag (MCAP)": lambda p: _bag(p, recording, "mcap")}
+    makers = {
+        "HDF5": lambda p: _hdf5(p.with_suffix(".h5"), recording),
+        "Parquet": lambda p: (write(recording, p.with_suffix(".parquet")), p.with_suffix(".parquet"))[1],
+        "ROS 1 bag": lambda p: _bag(p.with_suffix(".bag"), recording, "ros1"),
+        "ROS 2 bag (sqlite3)": lambda p: _bag(p, recording, "sqlite3"),
+        "ROS 2 bag (MCAP)": lambda p: _bag(p, recording, "mcap"),
+    }
     results = {}
     for label, make in makers.items():
         seed_folder = work / f"seed_{len(results)}"
         seed_folder.mkdir()
         damaged_file = make(seed_folder / "intact")
         bag_folder = damaged_file.parent if damaged_file.parent != seed_folder else None
-        intact = (bag_folder or damaged_file)
+        intact = bag_folder or damaged_file
         status, _ = run_command(["convert", intact, work / "intact.csv"])
         intact_rows = len(pd.read_csv(work / "intact.csv")) if status == 0 else None
         counter = results.setdefault(f"{label} ({count} corrupted)", collections.Counter())
@@ -299,8 +314,9 @@ def corrupted_binaries(work: Path, rng: np.random.Generator, count: int) -> dict
                 target.write_bytes(blob)
             out = work / f"damaged_{len(results)}_{k}.csv"
             status, lines = run_command(["convert", target, out])
-            counter[judged(classify(status, lines, out), lines, out,
-                           intact_rows if how == "byte-flipped" else None)] += 1
+            counter[
+                judged(classify(status, lines, out), lines, out, intact_rows if how == "byte-flipped" else None)
+            ] += 1
     return results
 
 
@@ -316,8 +332,10 @@ def simulated_model(seed: int, data: Path) -> tuple[Path, dict]:
 def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counter]:
     rng = np.random.default_rng(seed)
     results: dict[str, collections.Counter] = {}
-    logs = [("PX4 ULog", datasets / "px4-pyulog-samples" / "sample_log_small.ulg"),
-            ("ArduPilot DataFlash", datasets / "ardupilot-pymavlink-sample" / "test.BIN")]
+    logs = [
+        ("PX4 ULog", datasets / "px4-pyulog-samples" / "sample_log_small.ulg"),
+        ("ArduPilot DataFlash", datasets / "ardupilot-pymavlink-sample" / "test.BIN"),
+    ]
     for label, source in logs:
         counter = results.setdefault(f"{label} (250 corrupted)", collections.Counter())
         for k, (_, blob) in enumerate(mutated_logs(source, 250, rng)):
@@ -346,8 +364,16 @@ def sweep(datasets: Path, seed: int, work: Path) -> dict[str, collections.Counte
     return results
 
 
-HOSTILE_TEXT = ['*/ int evil(void) { return system("id"); } /*', "a??/\nb", "\\\n#include <stdlib.h>",
-                "x\nTC_G0_X0_0\t1e9", "\r\x00\x1b[2J", "*" * 300, "\u2028 */ \u00e8", '"; DROP TABLE runs; --']
+HOSTILE_TEXT = [
+    '*/ int evil(void) { return system("id"); } /*',
+    "a??/\nb",
+    "\\\n#include <stdlib.h>",
+    "x\nTC_G0_X0_0\t1e9",
+    "\r\x00\x1b[2J",
+    "*" * 300,
+    "\u2028 */ \u00e8",
+    '"; DROP TABLE runs; --',
+]
 CC = shutil.which("cc") or shutil.which("gcc")
 
 
@@ -364,8 +390,11 @@ def _string_paths(node, prefix=()):
 
 def _compiled(folder: Path) -> bytes | None:
     """The object compiled from an exported C folder, or None when it does not compile."""
-    done = subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-c", "-o", str(folder / "g.o"),
-                           str(folder / "gyrocomp.c")], capture_output=True, cwd=folder)
+    done = subprocess.run(
+        [CC, "-std=c99", "-O2", "-Wall", "-Werror", "-c", "-o", str(folder / "g.o"), str(folder / "gyrocomp.c")],
+        capture_output=True,
+        cwd=folder,
+    )
     return (folder / "g.o").read_bytes() if done.returncode == 0 else None
 
 
@@ -395,8 +424,9 @@ def hostile_exports(model: dict, work: Path, rng: np.random.Generator, count: in
         outcome = classify(status, lines, work / "none.csv")
         if status == 0 and CC and _compiled(work / f"c{k}") != reference:
             outcome = "security hole"
-        status, lines = run_command(["export", source, "--format", "px4", "-o", work / f"p{k}.params",
-                                     "--device-id", 1])
+        status, lines = run_command(
+            ["export", source, "--format", "px4", "-o", work / f"p{k}.params", "--device-id", 1]
+        )
         if status == 0 and _parameter_lines(work / f"p{k}.params") != _parameter_lines(work / "plain.params"):
             outcome = "security hole"
         counter[outcome] += 1
@@ -416,8 +446,7 @@ def hostile_hdf5(work: Path) -> collections.Counter:
     makers = {
         "external storage": lambda fh: fh.create_dataset("gyro_z", (8,), "f8", external=[(str(secret), 0, 64)]),
         "external link": lambda fh: fh.__setitem__("gyro_z", h5py.ExternalLink(str(other), "/gyro_z")),
-        "virtual dataset": lambda fh: fh.create_virtual_dataset(
-            "gyro_z", _virtual_layout(h5py, other)),
+        "virtual dataset": lambda fh: fh.create_virtual_dataset("gyro_z", _virtual_layout(h5py, other)),
     }
     for k, (_kind, make) in enumerate(makers.items()):
         path = work / f"pointing{k}.h5"
@@ -426,8 +455,13 @@ def hostile_hdf5(work: Path) -> collections.Counter:
             fh["temperature"] = np.full(8, 25.0)
             make(fh)
         status, lines = run_command(["convert", path, work / f"pointing{k}.csv"])
-        counter["refused" if status == 2 and len(lines) == 1 else
-                classify(status, lines, work / "none.csv") if status != 0 else "security hole"] += 1
+        counter[
+            "refused"
+            if status == 2 and len(lines) == 1
+            else classify(status, lines, work / "none.csv")
+            if status != 0
+            else "security hole"
+        ] += 1
     return counter
 
 
@@ -476,11 +510,15 @@ def hostile_numbers(data: Path, model: Path, work: Path) -> collections.Counter:
     never an internal error; a non-finite value taken is silently wrong."""
     counter: collections.Counter = collections.Counter()
     simulate_ = ["simulate", "--preset", "mti10", "--profile", "chamber", "-o", work / "sim.csv", "--duration", 60]
-    commands = [(simulate_, "--rate"), (simulate_, "--ramp-rate"), (["evaluate", model, data], "--window"),
-                (["apply", model, data, "-o", work / "applied.csv"], "--turn-on-window"),
-                (["learn", data, "-o", work / "learned.json"], "--rate"),
-                (["learn", data, "-o", work / "learned.json"], "--bin-width"),
-                (["fit", data, "-o", work / "fitted.json"], "--min-static")]
+    commands = [
+        (simulate_, "--rate"),
+        (simulate_, "--ramp-rate"),
+        (["evaluate", model, data], "--window"),
+        (["apply", model, data, "-o", work / "applied.csv"], "--turn-on-window"),
+        (["learn", data, "-o", work / "learned.json"], "--rate"),
+        (["learn", data, "-o", work / "learned.json"], "--bin-width"),
+        (["fit", data, "-o", work / "fitted.json"], "--min-static"),
+    ]
     for command, option in commands:
         for value in BAD_NUMBERS:
             status, lines = run_command([*command, option, value])
@@ -501,7 +539,7 @@ def hostile_states(data: Path, work: Path) -> collections.Counter:
     for k, match in enumerate(numbers[:: max(1, len(numbers) // 20)]):
         for replacement in ("9" * 5000, "1e308", "-1e308"):
             mutated = work / f"state{k}.json"
-            mutated.write_text(text[:match.start()] + replacement + text[match.end():], encoding="utf-8")
+            mutated.write_text(text[: match.start()] + replacement + text[match.end() :], encoding="utf-8")
             status, lines = run_command(["learn", data, "-o", work / f"relearned{k}.json", "--resume", mutated])
             counter[classify(status, lines, work / "none.csv")] += 1
     return counter
@@ -511,12 +549,19 @@ def unlucky_reads(work: Path) -> collections.Counter:
     """Reads that used to be silently wrong: each must be refused or warned."""
     counter: collections.Counter = collections.Counter()
     rows = "".join(f"{k},{0.1 + 1e-3 * k},{0.1},{20 + 0.01 * k}\n" for k in range(400))
-    cases = {"duplicate.csv": ("time,Gyro_Z,GYRO_Z,temperature\n" + rows, ["convert"]),
-             "twice.csv": ("time,gyro_z,temperature,Temperature\n" + rows, ["convert"]),
-             "ns.csv": ("time,gyro_z,temperature\n" + "".join(f"{k * 10_000_000},{0.1},{20.0}\n" for k in range(400)),
-                        ["allan"]),
-             "hot.csv": ("time,gyro_z,temperature\n" + "".join(
-                 f"{k},{0.1 + 1e-4 * k},{1e6 if k == 123 else 20 + 0.05 * k}\n" for k in range(400)), ["fit"])}
+    cases = {
+        "duplicate.csv": ("time,Gyro_Z,GYRO_Z,temperature\n" + rows, ["convert"]),
+        "twice.csv": ("time,gyro_z,temperature,Temperature\n" + rows, ["convert"]),
+        "ns.csv": (
+            "time,gyro_z,temperature\n" + "".join(f"{k * 10_000_000},{0.1},{20.0}\n" for k in range(400)),
+            ["allan"],
+        ),
+        "hot.csv": (
+            "time,gyro_z,temperature\n"
+            + "".join(f"{k},{0.1 + 1e-4 * k},{1e6 if k == 123 else 20 + 0.05 * k}\n" for k in range(400)),
+            ["fit"],
+        ),
+    }
     for name, (text, command) in cases.items():
         path = work / name
         path.write_text(text, encoding="utf-8")
@@ -540,11 +585,14 @@ def planted_links(data: Path, model: Path, work: Path) -> collections.Counter:
     cannot be a file is ``silently wrong``."""
     counter: collections.Counter = collections.Counter()
     victim = work / "victim.txt"
-    outputs = [lambda out: ["apply", model, data, "-o", out], lambda out: ["convert", data, out],
-               lambda out: ["fit", data, "-o", out, "--temperature", "poly:1", "--hysteresis", "none"],
-               lambda out: ["learn", data, "-o", work / "learned_link.json", "--save-state", out],
-               lambda out: ["export", model, "--format", "px4", "-o", out],
-               lambda out: ["simulate", "--profile", "chamber", "--duration", 60, "-o", out]]
+    outputs = [
+        lambda out: ["apply", model, data, "-o", out],
+        lambda out: ["convert", data, out],
+        lambda out: ["fit", data, "-o", out, "--temperature", "poly:1", "--hysteresis", "none"],
+        lambda out: ["learn", data, "-o", work / "learned_link.json", "--save-state", out],
+        lambda out: ["export", model, "--format", "px4", "-o", out],
+        lambda out: ["simulate", "--profile", "chamber", "--duration", 60, "-o", out],
+    ]
     suffixes = [".csv", ".csv", ".json", ".json", ".params", ".csv"]
     for k, (command, suffix) in enumerate(zip(outputs, suffixes)):
         victim.write_text("precious\n", encoding="utf-8")
@@ -579,19 +627,30 @@ def damaged_store_rows(run_path: Path, work: Path) -> collections.Counter:
     pd.DataFrame([{"path": str(run_path), "serial": "SN-1"}]).to_csv(manifest, index=False)
     fitted = work / "store_fitted"
     run_command(["fleet", "fit", "--manifest", manifest, "-o", fitted, "--scheduler", "serial"])
-    damages = [("model", '{"schema_version": 6, "axes"'), ("model", "[]"), ("inputs", "not json"),
-               ("inputs", '{"a": 1}'), ("calibrated_utc", "garbage"), ("calibrated_utc", "9999-99-99"),
-               ("status", "weird"), ("unit_metadata", "{"), ("failures", "[1"), ("figures", "{]"),
-               ("warnings", "7")]
+    damages = [
+        ("model", '{"schema_version": 6, "axes"'),
+        ("model", "[]"),
+        ("inputs", "not json"),
+        ("inputs", '{"a": 1}'),
+        ("calibrated_utc", "garbage"),
+        ("calibrated_utc", "9999-99-99"),
+        ("status", "weird"),
+        ("unit_metadata", "{"),
+        ("failures", "[1"),
+        ("figures", "{]"),
+        ("warnings", "7"),
+    ]
     for k, (column, value) in enumerate(damages):
         store = work / f"store_damaged{k}"
         shutil.copytree(fitted, store)
         with sqlite3.connect(store / "calibrations.sqlite") as conn:
             conn.execute(f"UPDATE calibrations SET {column} = ?", (value,))
-        for command in (["fleet", "show", "SN-1", "--store", store],
-                        ["fleet", "export", "SN-1", "--store", store, "--format", "json", "-o", work / f"e{k}.json"],
-                        ["fleet", "report", store, "-o", work / f"r{k}.html"],
-                        ["fleet", "fit", "--manifest", manifest, "-o", store, "--scheduler", "serial"]):
+        for command in (
+            ["fleet", "show", "SN-1", "--store", store],
+            ["fleet", "export", "SN-1", "--store", store, "--format", "json", "-o", work / f"e{k}.json"],
+            ["fleet", "report", store, "-o", work / f"r{k}.html"],
+            ["fleet", "fit", "--manifest", manifest, "-o", store, "--scheduler", "serial"],
+        ):
             status, lines = run_command(command)
             outcome = classify(status, lines, work / "none.csv")
             if not _loads(store / "models" / "SN-1.json"):  # the unit's good model file replaced: lost
@@ -610,8 +669,13 @@ def _loads(model: Path) -> bool:
 
 
 def _gyrocomp(*args, **popen) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "gyrocomp", *map(str, args)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.PIPE, text=True, **popen)
+    return subprocess.Popen(
+        [sys.executable, "-m", "gyrocomp", *map(str, args)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        **popen,
+    )
 
 
 def concurrent_writers(data: Path, other: Path, work: Path, repeats: int) -> collections.Counter:
@@ -623,13 +687,20 @@ def concurrent_writers(data: Path, other: Path, work: Path, repeats: int) -> col
     run_command(["learn", data, "-o", work / "first.json", "--save-state", state])
     for k in range(repeats):
         target = work / f"next_state{k}.json"
-        learners = [_gyrocomp("learn", log, "--resume", state, "-o", work / f"m{k}_{j}.json", "--save-state", target)
-                    for j, log in enumerate((data, other))]
+        learners = [
+            _gyrocomp("learn", log, "--resume", state, "-o", work / f"m{k}_{j}.json", "--save-state", target)
+            for j, log in enumerate((data, other))
+        ]
         results = [(p.wait(timeout=600), p.stderr.read()) for p in learners]
         codes = sorted(code for code, _ in results)
         refusal = next((err for code, err in results if code == 2), "")
-        counter["refused" if codes == [0, 2] and refusal.count("\n") == 1 else
-                "data loss" if codes == [0, 0] else "internal error"] += 1
+        counter[
+            "refused"
+            if codes == [0, 2] and refusal.count("\n") == 1
+            else "data loss"
+            if codes == [0, 0]
+            else "internal error"
+        ] += 1
     for k in range(repeats):
         store = work / f"race_store{k}"
         manifests = []
@@ -639,8 +710,9 @@ def concurrent_writers(data: Path, other: Path, work: Path, repeats: int) -> col
         fits = [_gyrocomp("fleet", "fit", "--manifest", m, "-o", store, "--scheduler", "serial") for m in manifests]
         codes = [p.wait(timeout=600) for p in fits]
         with sqlite3.connect(store / "calibrations.sqlite") as conn:
-            newest = conn.execute("SELECT model FROM calibrations WHERE serial = 'SN-R' ORDER BY id DESC "
-                                  "LIMIT 1").fetchone()[0]
+            newest = conn.execute(
+                "SELECT model FROM calibrations WHERE serial = 'SN-R' ORDER BY id DESC LIMIT 1"
+            ).fetchone()[0]
         model_file = store / "models" / "SN-R.json"
         agree = model_file.exists() and json.loads(model_file.read_text()) == json.loads(newest)
         counter["clean" if codes == [0, 0] and agree else "silently wrong" if not agree else "internal error"] += 1
@@ -658,7 +730,7 @@ def resource_limits(data: Path, work: Path) -> collections.Counter:
     cut short while ``apply`` streams it (exit 0 is ``silently wrong``)."""
     counter: collections.Counter = collections.Counter()
     wide = work / "wide.csv"
-    wide.write_text(",".join(f"c{i}" for i in range(10 ** 6)) + "\n" + ",".join("1" * 10 ** 6) + "\n")
+    wide.write_text(",".join(f"c{i}" for i in range(10**6)) + "\n" + ",".join("1" * 10**6) + "\n")
     bomb = work / "bomb.csv.gz"
     with gzip.open(bomb, "wb", compresslevel=9) as fh:
         fh.write(b"time,gyro_z,temperature\n0,0.1,25\n")
@@ -666,8 +738,11 @@ def resource_limits(data: Path, work: Path) -> collections.Counter:
             fh.write(b"1" * (1 << 20))
     groups = work / "groups.parquet"
     n = 100_000
-    pq.write_table(pa.table({"time": np.arange(n) / 10.0, "gyro_z": np.full(n, 0.1),
-                             "temperature": np.linspace(20, 30, n)}), groups, row_group_size=1)
+    pq.write_table(
+        pa.table({"time": np.arange(n) / 10.0, "gyro_z": np.full(n, 0.1), "temperature": np.linspace(20, 30, n)}),
+        groups,
+        row_group_size=1,
+    )
     for path in (wide, bomb, groups):
         for command in (["init", path, "-o", work / "p.toml"], ["fit", path, "-o", work / "wide.json"]):
             status, lines = run_command(command)
@@ -677,8 +752,9 @@ def resource_limits(data: Path, work: Path) -> collections.Counter:
     for limit, path in ((3 << 29, big), (300 << 20, data)):
         process = _gyrocomp("fit", path, "-o", work / "limited.json", preexec_fn=_limited(resource.RLIMIT_AS, limit))
         status, stderr = process.wait(timeout=600), process.stderr.read()
-        counter[classify(status, stderr.splitlines(), work / "none.csv") if status in (0, 1, 2) else
-                "internal error"] += 1
+        counter[
+            classify(status, stderr.splitlines(), work / "none.csv") if status in (0, 1, 2) else "internal error"
+        ] += 1
     loop = work / "looped"
     loop.mkdir()
     shutil.copy(data, loop / "r1.csv")
@@ -692,8 +768,20 @@ def resource_limits(data: Path, work: Path) -> collections.Counter:
     fleet = work / "fd_fleet"
     (fleet / "SN1").mkdir(parents=True)
     shutil.copy(data, fleet / "SN1" / "run_1.csv")
-    process = _gyrocomp("fleet", "fit", fleet, "--unit-from", "{serial}/run_{n}.csv", "-o", work / "fd_out",
-                        "--scheduler", "local", "--workers", 2, preexec_fn=_limited(resource.RLIMIT_NOFILE, 40))
+    process = _gyrocomp(
+        "fleet",
+        "fit",
+        fleet,
+        "--unit-from",
+        "{serial}/run_{n}.csv",
+        "-o",
+        work / "fd_out",
+        "--scheduler",
+        "local",
+        "--workers",
+        2,
+        preexec_fn=_limited(resource.RLIMIT_NOFILE, 40),
+    )
     status, stderr = process.wait(timeout=600), process.stderr.read()
     counter[classify(status, stderr.splitlines(), work / "none.csv")] += 1
     growing = work / "cut_short.csv"
@@ -740,8 +828,11 @@ def serial_logs(rng: np.random.Generator, work: Path, count: int) -> collections
             if status == 0:
                 status, errors = run_command(["apply", "m.json", "log.txt", "-o", "out.csv"])
             outcome = judged(classify(status, errors, folder / "out.csv"), errors, folder / "out.csv")
-            if status == 0 and len(pd.read_csv(folder / "out.csv")) < rows and not any(
-                    "skipped" in line for line in errors):
+            if (
+                status == 0
+                and len(pd.read_csv(folder / "out.csv")) < rows
+                and not any("skipped" in line for line in errors)
+            ):
                 outcome = "silently wrong"
         finally:
             os.chdir(cwd)
@@ -755,18 +846,19 @@ def hostile_sweep(seed: int, work: Path) -> dict[str, collections.Counter]:
     other, _ = simulated_model(seed + 7, work / "hostile_other.csv")
     model_path = work / "hostile_model.json"
     model_path.write_text(json.dumps(model), encoding="utf-8")
-    return {"model text fields made hostile, exported (60)": hostile_exports(model, work, rng, 60),
-            "HDF5 pointing at other files (3)": hostile_hdf5(work),
-            "fleet stores: colliding and long serials, -o onto the store (5)": hostile_store(data, work),
-            "number options: inf, nan, 1e999, -1, 0, 25 digits (49)": hostile_numbers(data, model_path, work),
-            "learner states with huge numbers (resumed)": hostile_states(data, work),
-            "ambiguous columns, ns time, 1e6 degC, non-UTF-8 name (5)": unlucky_reads(work),
-            "outputs through planted links, odd names, pipes as inputs (26)": planted_links(data, model_path, work),
-            "store rows changed by another program, read four ways (44)": damaged_store_rows(data, work),
-            "concurrent learners and fleet fits (6)": concurrent_writers(data, other, work, 3),
-            "resource limits: wide, bomb, row groups, memory, link loop, fds, cut short (11)":
-                resource_limits(data, work),
-            "serial-terminal logs with garbled lines (20)": serial_logs(rng, work, 10)}
+    return {
+        "model text fields made hostile, exported (60)": hostile_exports(model, work, rng, 60),
+        "HDF5 pointing at other files (3)": hostile_hdf5(work),
+        "fleet stores: colliding and long serials, -o onto the store (5)": hostile_store(data, work),
+        "number options: inf, nan, 1e999, -1, 0, 25 digits (49)": hostile_numbers(data, model_path, work),
+        "learner states with huge numbers (resumed)": hostile_states(data, work),
+        "ambiguous columns, ns time, 1e6 degC, non-UTF-8 name (5)": unlucky_reads(work),
+        "outputs through planted links, odd names, pipes as inputs (26)": planted_links(data, model_path, work),
+        "store rows changed by another program, read four ways (44)": damaged_store_rows(data, work),
+        "concurrent learners and fleet fits (6)": concurrent_writers(data, other, work, 3),
+        "resource limits: wide, bomb, row groups, memory, link loop, fds, cut short (11)": resource_limits(data, work),
+        "serial-terminal logs with garbled lines (20)": serial_logs(rng, work, 10),
+    }
 
 
 def summary(results: dict[str, collections.Counter], seed: int) -> str:
@@ -776,8 +868,7 @@ def summary(results: dict[str, collections.Counter], seed: int) -> str:
         rows.append(f"| {label} | " + " | ".join(str(counter.get(k, 0)) for k in kinds) + " |")
     total = {k: sum(c.get(k, 0) for c in results.values()) for k in kinds}
     rows.append("| **all** | " + " | ".join(f"**{total[k]}**" for k in kinds) + " |")
-    return (f"Mutation sweep, seed {seed} (`python tools/mutation_sweep.py --seed {seed}`):\n\n" + "\n".join(rows)
-            + "\n")
+    return f"Mutation sweep, seed {seed} (`python tools/mutation_sweep.py --seed {seed}`):\n\n" + "\n".join(rows) + "\n"
 
 
 def main_cli() -> int:

@@ -19,7 +19,8 @@ from pathlib import Path
 def binaries() -> Path | None:
     """The folder of initdb and pg_ctl, or None where the server is not installed."""
     for folder in os.environ.get("PATH", "").split(os.pathsep) + sorted(
-            (str(p) for p in Path("/usr/lib/postgresql").glob("*/bin")), reverse=True):
+        (str(p) for p in Path("/usr/lib/postgresql").glob("*/bin")), reverse=True
+    ):
         if folder and (Path(folder) / "initdb").exists() and (Path(folder) / "pg_ctl").exists():
             return Path(folder)
     return None
@@ -46,13 +47,44 @@ def throwaway_cluster() -> Iterator[Callable[[], str]]:
     data, port = folder / "data", 5432
     pg_ctl = str(folder_of_binaries / "pg_ctl")
     try:
-        subprocess.run(_as_server_user([str(folder_of_binaries / "initdb"), "-D", str(data), "-A", "trust", "-U",
-                                        "postgres", "--no-sync", "-E", "UTF8"]), check=True, capture_output=True)
-        subprocess.run(_as_server_user([pg_ctl, "-D", str(data), "-w", "-l", str(folder / "log"), "-o",
-                                        f"-k {folder} -p {port} -c listen_addresses= -c fsync=off "
-                                        "-c max_connections=200", "start"]), check=True, capture_output=True)
-        admin = sa.create_engine(f"postgresql+psycopg://postgres@/postgres?host={folder}&port={port}",
-                                 isolation_level="AUTOCOMMIT")
+        subprocess.run(
+            _as_server_user(
+                [
+                    str(folder_of_binaries / "initdb"),
+                    "-D",
+                    str(data),
+                    "-A",
+                    "trust",
+                    "-U",
+                    "postgres",
+                    "--no-sync",
+                    "-E",
+                    "UTF8",
+                ]
+            ),
+            check=True,
+            capture_output=True,
+        )
+        subprocess.run(
+            _as_server_user(
+                [
+                    pg_ctl,
+                    "-D",
+                    str(data),
+                    "-w",
+                    "-l",
+                    str(folder / "log"),
+                    "-o",
+                    f"-k {folder} -p {port} -c listen_addresses= -c fsync=off -c max_connections=200",
+                    "start",
+                ]
+            ),
+            check=True,
+            capture_output=True,
+        )
+        admin = sa.create_engine(
+            f"postgresql+psycopg://postgres@/postgres?host={folder}&port={port}", isolation_level="AUTOCOMMIT"
+        )
         made = []
 
         def new_database() -> str:

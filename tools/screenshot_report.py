@@ -20,9 +20,17 @@ from gyrocomp import fit_calibration
 from gyrocomp.report.html import build_report
 from gyrocomp.simulation import simulate
 
-CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  "--hide-scrollbars")
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+)
 
 
 def main() -> None:
@@ -34,8 +42,7 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     warnings.simplefilter("ignore")
-    runs = [simulate("mti10", profile="combined", duration_s=4 * 3600, rate_hz=2, seed=s).recording
-            for s in range(3)]
+    runs = [simulate("mti10", profile="combined", duration_s=4 * 3600, rate_hz=2, seed=s).recording for s in range(3)]
     calibration = fit_calibration(runs[:2])
     report = build_report(calibration, [runs[2]])
     page = out / "report.html"
@@ -43,9 +50,19 @@ def main() -> None:
     shots = {"report-top.png": 1400, "report-full.png": args.height}
     with tempfile.TemporaryDirectory() as profile:
         for name, height in shots.items():
-            subprocess.run([args.chromium, *CHROMIUM_FLAGS, f"--user-data-dir={profile}",
-                            f"--window-size=1280,{height}", f"--screenshot={out / name}", page.resolve().as_uri()],
-                           check=True, capture_output=True, timeout=180)
+            subprocess.run(
+                [
+                    args.chromium,
+                    *CHROMIUM_FLAGS,
+                    f"--user-data-dir={profile}",
+                    f"--window-size=1280,{height}",
+                    f"--screenshot={out / name}",
+                    page.resolve().as_uri(),
+                ],
+                check=True,
+                capture_output=True,
+                timeout=180,
+            )
     print(f"model {calibration.model}; sections {', '.join(report.sections)}")
     print("wrote " + ", ".join(str(out / n) for n in ("report.html", *shots)))
 

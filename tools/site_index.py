@@ -19,8 +19,9 @@ def site_index(readme: str) -> str:
 
 
 def main() -> None:
-    (ROOT / "docs" / "index.md").write_text(site_index((ROOT / "README.md").read_text(encoding="utf-8")),
-                                            encoding="utf-8")
+    (ROOT / "docs" / "index.md").write_text(
+        site_index((ROOT / "README.md").read_text(encoding="utf-8")), encoding="utf-8"
+    )
 
 
 if __name__ == "__main__":

@@ -42,8 +42,14 @@ def lazy_lfilter(b, a, x, zi=None):
     y = x b0 + z, z = x b1 - y a1), so the result is the same to the bit (tested); once it is imported (a fit
     filters thousands of times), scipy's is used, forty times faster."""
     x = np.asarray(x, dtype=float)
-    if (len(a) == 2 and a[0] == 1.0 and len(b) <= 2 and x.ndim == 1 and x.size <= PYTHON_FILTER_SAMPLES
-            and "scipy.signal" not in sys.modules):
+    if (
+        len(a) == 2
+        and a[0] == 1.0
+        and len(b) <= 2
+        and x.ndim == 1
+        and x.size <= PYTHON_FILTER_SAMPLES
+        and "scipy.signal" not in sys.modules
+    ):
         return _first_order(b, a, x, zi)
     from scipy.signal import lfilter
 
@@ -59,6 +65,7 @@ def _first_order(b, a, x: np.ndarray, zi):
         z = value * b1 - y * a1
         out[i] = y
     return out if zi is None else (out, np.array([z]))
+
 
 def lag_coefficients(step_s: float, time_constant_s: float) -> tuple[float, float, float]:
     """Coefficients (a, b0, b1) of the exact first-order lag for an input linear between samples.
@@ -95,8 +102,14 @@ class LagState:
     last_time_s: float
 
 
-def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_s: float, *,
-                period_s: float | None = None, state: LagState | None = None) -> tuple[np.ndarray, LagState]:
+def thermal_lag(
+    time_s: np.ndarray,
+    temperature_degc: np.ndarray,
+    time_constant_s: float,
+    *,
+    period_s: float | None = None,
+    state: LagState | None = None,
+) -> tuple[np.ndarray, LagState]:
     """Temperature of the sensing structure, lagging the reported temperature (first-order) [degC].
 
     Parameters
@@ -130,8 +143,7 @@ def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_
     if time_constant_s == 0:
         return u.copy(), LagState(float(u[-1]), float(u[-1]), float(t[-1]))
     if period_s is None:
-        period_s = float(np.median(np.diff(t))) if t.size > 1 else (
-            t[0] - state.last_time_s if state else 1.0)
+        period_s = float(np.median(np.diff(t))) if t.size > 1 else (t[0] - state.last_time_s if state else 1.0)
     if state is None:
         prev_u, prev_y, prev_t = float(u[0]), float(u[0]), float(t[0])
         start = 1
@@ -145,8 +157,15 @@ def thermal_lag(time_s: np.ndarray, temperature_degc: np.ndarray, time_constant_
     return out, LagState(float(u[-1]), float(out[-1]), float(t[-1]))
 
 
-def _lag_stretches(t: np.ndarray, u: np.ndarray, out: np.ndarray, start: int, previous: tuple[float, float, float],
-                   period_s: float, time_constant_s: float) -> None:
+def _lag_stretches(
+    t: np.ndarray,
+    u: np.ndarray,
+    out: np.ndarray,
+    start: int,
+    previous: tuple[float, float, float],
+    period_s: float,
+    time_constant_s: float,
+) -> None:
     """Fill ``out[start:]`` with the lagged temperature [degC]: each uniform stretch by one IIR filter, each gap
     (a step over 1.5 periods) bridged exactly; ``previous`` is (input, output, time) before ``start``."""
     prev_u, prev_y, prev_t = previous
@@ -214,15 +233,16 @@ def _first_true(mask: np.ndarray) -> int:
 _TURN_BLOCK = 256
 
 
-def _leave_band(x: np.ndarray, start: int, low: float, high: float,
-                threshold: float) -> tuple[int, int, float, float, float]:
+def _leave_band(
+    x: np.ndarray, start: int, low: float, high: float, threshold: float
+) -> tuple[int, int, float, float, float]:
     """Where the series x [degC] leaves the band of its running extremes (from ``low``, ``high`` [degC]) by more
     than ``threshold`` [degC] while the direction is unknown: (index or -1, direction, extreme there, low,
     high), scanning blocks from ``start``; low and high are the extremes up to that index (where the first
     branch started: low when it rises, high when it falls)."""
     block, pos = _TURN_BLOCK, start
     while pos < x.size:
-        seg = x[pos:pos + block]
+        seg = x[pos : pos + block]
         lo = np.minimum.accumulate(np.minimum(seg, low))
         hi = np.maximum.accumulate(np.maximum(seg, high))
         up = _first_true(seg - lo > threshold)
@@ -242,9 +262,12 @@ def _reversal(x: np.ndarray, start: int, d: int, extreme: float, threshold: floa
     running extreme there or at the end [degC])."""
     block, pos = _TURN_BLOCK, start
     while pos < x.size:
-        seg = x[pos:pos + block]
-        running = np.maximum.accumulate(np.maximum(seg, extreme)) if d == 1 else \
-            np.minimum.accumulate(np.minimum(seg, extreme))
+        seg = x[pos : pos + block]
+        running = (
+            np.maximum.accumulate(np.maximum(seg, extreme))
+            if d == 1
+            else np.minimum.accumulate(np.minimum(seg, extreme))
+        )
         back = (running - seg) if d == 1 else (seg - running)
         k = _first_true(back > threshold)
         if k >= 0:
@@ -273,8 +296,7 @@ def _turn_arrays(n: int, changes: list, turns: list[int], state: TurnState) -> t
     return direction, turn
 
 
-def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
-               state: TurnState | None = None) -> Turns:
+def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *, state: TurnState | None = None) -> Turns:
     """Turning points of a temperature series, robust to noise and to whole-degree steps.
 
     A reversal is confirmed when the temperature has come back from the running extreme of the
@@ -327,9 +349,15 @@ def find_turns(temperature_degc: np.ndarray, threshold_degc: float = 0.0, *,
     return Turns(direction, turn, np.asarray(turns, dtype=np.int64), TurnState(int(d), extreme, last_turn, low, high))
 
 
-def hysteresis_offset(temperature_degc: np.ndarray, turns: Turns, coefficients_dps: tuple[float, ...] | np.ndarray,
-                      *, direction: str = "descending", band_degc: tuple[float, float] | None = None,
-                      max_distance_degc: float | None = None) -> np.ndarray:
+def hysteresis_offset(
+    temperature_degc: np.ndarray,
+    turns: Turns,
+    coefficients_dps: tuple[float, ...] | np.ndarray,
+    *,
+    direction: str = "descending",
+    band_degc: tuple[float, float] | None = None,
+    max_distance_degc: float | None = None,
+) -> np.ndarray:
     """Bias offset on the branch after a temperature reversal [deg/s] (thesis section 2.6).
 
         offset = sum_j h_j d^j,   d = |T - T_turn|,   j = 1..p
@@ -404,8 +432,9 @@ def branch_position(temperature_degc: np.ndarray, turns: Turns, transition_degc:
     start = np.where(d > 0, turns.state.low_degc, turns.state.high_degc)  # where the first branch started
     first = np.where(~after & (d != 0), np.abs(t - start), 0.0)
     distance = np.abs(t - np.where(after, turns.turn_degc, t))
-    return np.where(after, d * (1.0 - 2.0 * np.exp(-distance / transition_degc)),
-                    d * (1.0 - np.exp(-first / transition_degc)))
+    return np.where(
+        after, d * (1.0 - 2.0 * np.exp(-distance / transition_degc)), d * (1.0 - np.exp(-first / transition_degc))
+    )
 
 
 # -- acceleration -----------------------------------------------------------------------------------
@@ -416,8 +445,9 @@ def g_squared_products(accel_g: np.ndarray) -> np.ndarray:
     return np.column_stack([x * x, y * y, z * z, x * y, x * z, y * z])
 
 
-def g_sensitivity_offset(accel_g: np.ndarray, matrix_dps_per_g: np.ndarray,
-                         squared_dps_per_g2: np.ndarray | None = None) -> np.ndarray:
+def g_sensitivity_offset(
+    accel_g: np.ndarray, matrix_dps_per_g: np.ndarray, squared_dps_per_g2: np.ndarray | None = None
+) -> np.ndarray:
     """Gyro bias caused by specific force (n, k) [deg/s]: G a (+ the g x g terms).
 
         offset_i = sum_j G_ij a_j + sum_m Q_im p_m(a)
@@ -479,8 +509,8 @@ def moving_average_range(x: np.ndarray, window_samples: int, block: int = 1 << 1
     low, high = math.inf, -math.inf
     for start in range(0, count, block):
         stop = min(start + block, count)
-        out = part[:stop - start]
-        np.subtract(c[start + w:stop + w], c[start:stop], out=out)
+        out = part[: stop - start]
+        np.subtract(c[start + w : stop + w], c[start:stop], out=out)
         out /= w
         out += x[0]
         low, high = min(low, float(out.min())), max(high, float(out.max()))
@@ -495,8 +525,21 @@ def estimate_turn_on_bias(residual_dps: np.ndarray, time_s: np.ndarray, window_s
 
 
 __all__ = [
-    "G_SQUARED_TERMS", "HYSTERESIS_DIRECTIONS", "LagState", "TurnState", "Turns", "branch_position", "estimate_turn_on_bias", "find_turns",
-    "g_sensitivity_offset", "g_squared_products", "hysteresis_offset", "lag_coefficients", "lazy_lfilter",
-    "moving_average", "moving_average_range", "quantize", "thermal_lag",
+    "G_SQUARED_TERMS",
+    "HYSTERESIS_DIRECTIONS",
+    "LagState",
+    "TurnState",
+    "Turns",
+    "branch_position",
+    "estimate_turn_on_bias",
+    "find_turns",
+    "g_sensitivity_offset",
+    "g_squared_products",
+    "hysteresis_offset",
+    "lag_coefficients",
+    "lazy_lfilter",
+    "moving_average",
+    "moving_average_range",
+    "quantize",
+    "thermal_lag",
 ]
-

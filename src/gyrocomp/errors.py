@@ -55,8 +55,17 @@ class PlausibilityWarning(DataQualityWarning):
 
 
 #: the name of a plausibility check (the checks themselves are in :mod:`gyrocomp.measures.plausibility`)
-CheckName = Literal["rate", "kelvin", "time-unit", "offset", "rotation", "temperature-span", "agreement",
-                    "accel-unit", "temperature-range"]
+CheckName = Literal[
+    "rate",
+    "kelvin",
+    "time-unit",
+    "offset",
+    "rotation",
+    "temperature-span",
+    "agreement",
+    "accel-unit",
+    "temperature-range",
+]
 #: every check's name
 CHECKS: tuple[CheckName, ...] = get_args(CheckName)
 
@@ -87,4 +96,3 @@ def printable(text: str) -> str:
     """``text`` with control characters escaped (``\\n``, ``\\x1b``): a newline or a raw byte in a message (a file
     name's, a foreign library's) would otherwise break a one-line message or the terminal."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-

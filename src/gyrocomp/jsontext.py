@@ -27,8 +27,10 @@ def loads(text: str, source: str, what: str = "file", remedy: str = "", non_fini
 
     def integer(digits: str) -> int:
         if len(digits.lstrip("-")) > MAX_INTEGER_DIGITS:
-            raise InputError(f"{source}: an integer of {len(digits.lstrip('-'))} digits; gyrocomp's files hold none "
-                             f"of more than {MAX_INTEGER_DIGITS}")
+            raise InputError(
+                f"{source}: an integer of {len(digits.lstrip('-'))} digits; gyrocomp's files hold none "
+                f"of more than {MAX_INTEGER_DIGITS}"
+            )
         return int(digits)
 
     def constant(name: str):
@@ -40,8 +42,10 @@ def loads(text: str, source: str, what: str = "file", remedy: str = "", non_fini
         out: dict = {}
         for key, value in pairs:
             if key in out:
-                raise InputError(f"{source}: the key {key!r} appears twice in one object; which one is meant is not "
-                                 f"said (a {what} names each once)")
+                raise InputError(
+                    f"{source}: the key {key!r} appears twice in one object; which one is meant is not "
+                    f"said (a {what} names each once)"
+                )
             out[key] = value
         return out
 

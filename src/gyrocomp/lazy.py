@@ -9,8 +9,9 @@ import sys
 from collections.abc import Callable, Mapping
 
 
-def lazy_exports(package: str, exports: Mapping[str, tuple[str, str]]) -> tuple[Callable[[str], object],
-                                                                                 Callable[[], list[str]]]:
+def lazy_exports(
+    package: str, exports: Mapping[str, tuple[str, str]]
+) -> tuple[Callable[[str], object], Callable[[], list[str]]]:
     """The module ``__getattr__`` and ``__dir__`` of ``package`` (its ``__name__``) for ``exports``: public name ->
     (its module relative to the package, its name there). A name is imported when first asked for, then kept in
     the package's namespace (found once)."""

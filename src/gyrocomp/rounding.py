@@ -31,7 +31,7 @@ def with_error(value: float | None, standard_error: float | None, *, sign: bool 
     decimals = 1 - math.floor(math.log10(standard_error))
     if decimals > 8 or abs(value) >= 1e6:
         exponent = math.floor(math.log10(max(abs(value), standard_error)))
-        scale = 10.0 ** exponent
+        scale = 10.0**exponent
         digits = max(0, exponent - math.floor(math.log10(standard_error)) + 1)
         return f"({value / scale:{plus}.{digits}f} +- {standard_error / scale:.{digits}f})e{exponent:+03d}"
     decimals = max(decimals, 0)

@@ -97,11 +97,17 @@ class SpillArray:
             if self._file is not None:
                 self._file.close()
                 self._file = None
-                self._finished = (np.memmap(self._path, dtype=np.float64, mode="r+", shape=(self.size,))
-                                  if self.size else np.empty(0))
+                self._finished = (
+                    np.memmap(self._path, dtype=np.float64, mode="r+", shape=(self.size,)) if self.size else np.empty(0)
+                )
             else:
-                self._finished = (np.concatenate(self._blocks) if len(self._blocks) > 1 else
-                                  self._blocks[0] if self._blocks else np.empty(0))
+                self._finished = (
+                    np.concatenate(self._blocks)
+                    if len(self._blocks) > 1
+                    else self._blocks[0]
+                    if self._blocks
+                    else np.empty(0)
+                )
                 self._blocks = []
         return self._finished
 
@@ -132,7 +138,7 @@ def block_median(values, block: int = _BLOCK, whole: int = _WHOLE) -> float:
         return float(np.median(np.asarray(values[:], dtype=np.float64)))
     low, high = np.inf, -np.inf
     for start in range(0, n, block):
-        chunk = np.asarray(values[start:start + block], dtype=np.float64)
+        chunk = np.asarray(values[start : start + block], dtype=np.float64)
         if np.isnan(chunk).any():
             return float("nan")
         low, high = min(low, float(chunk.min())), max(high, float(chunk.max()))
@@ -179,5 +185,5 @@ def _order_statistic(values, rank: int, low: float, high: float, block: int) -> 
 def _inside(values, low: float, high: float, closed: bool, block: int):
     """The values in [low, high] (``closed``) or [low, high), block by block."""
     for start in range(0, len(values), block):
-        chunk = np.asarray(values[start:start + block], dtype=np.float64)
+        chunk = np.asarray(values[start : start + block], dtype=np.float64)
         yield chunk[(chunk >= low) & ((chunk <= high) if closed else (chunk < high))]

@@ -44,9 +44,11 @@ def require_unit(actual: str, expected: str, name: str, neutral: str) -> None:
 def in_unit(neutral: str, unit: str, name: str) -> property:
     """The attribute ``neutral`` of an object with a ``unit``, read under ``name``, the name that says ``unit``:
     refused (:func:`require_unit`) for an object in the other unit."""
+
     def get(self) -> object:
         require_unit(self.unit, unit, name, neutral)
         return getattr(self, neutral)
+
     return property(get, doc=f"``{neutral}`` of an axis in {unit}.")
 
 
@@ -92,6 +94,4 @@ def unit_factor(kind: str, unit: str, option: str | None = None) -> float:
         return table[unit.strip()]
     except KeyError:
         where = option or f"{kind}_unit"
-        raise InputError(
-            f"{where}: unknown unit {unit!r}; use one of {', '.join(sorted(table))}"
-        ) from None
+        raise InputError(f"{where}: unknown unit {unit!r}; use one of {', '.join(sorted(table))}") from None

@@ -34,8 +34,8 @@ def brute_force_oadev(rate, m):
     y = np.asarray(rate, float)  # averages of rate samples: the deviation does not depend on rate_hz
     terms = []
     for i in range(y.size - 2 * m + 1):
-        a = y[i:i + m].mean()
-        b = y[i + m:i + 2 * m].mean()
+        a = y[i : i + m].mean()
+        b = y[i + m : i + 2 * m].mean()
         terms.append((b - a) ** 2)
     return np.sqrt(0.5 * np.mean(terms)), len(terms)
 
@@ -54,7 +54,7 @@ def test_matches_brute_force_definition():
 def brute_force(kind, y, rate_hz, m):
     """Each estimator term by term from averages of m rate samples (Riley, NIST SP 1065, section 5.2)."""
     tau = m / rate_hz
-    avg = lambda i: y[i:i + m].mean()  # noqa: E731
+    avg = lambda i: y[i : i + m].mean()  # noqa: E731
     if kind in ("adev", "oadev"):
         step = m if kind == "adev" else 1
         terms = [(avg(i + m) - avg(i)) ** 2 / 2 for i in range(0, y.size - 2 * m + 1, step)]
@@ -69,7 +69,7 @@ def brute_force(kind, y, rate_hz, m):
         n = x.size
         star = lambda j: 2 * x[0] - x[-j] if j < 0 else (x[j] if j < n else 2 * x[-1] - x[2 * (n - 1) - j])  # noqa: E731
         terms = [(star(i - m) - 2 * x[i] + star(i + m)) ** 2 for i in range(1, n - 1)]
-        return np.sqrt(np.sum(terms) / (2 * tau ** 2 * (n - 2))), len(terms)
+        return np.sqrt(np.sum(terms) / (2 * tau**2 * (n - 2))), len(terms)
     # modified Allan: the Allan term of averages, itself averaged over m consecutive starts
     terms = [np.mean([avg(i + m) - avg(i) for i in range(j, j + m)]) ** 2 / 2 for j in range(y.size - 3 * m + 2)]
     mdev = np.sqrt(np.mean(terms))
@@ -89,8 +89,11 @@ def test_every_kind_matches_its_definition(kind):
 
 
 def read_columns(path):
-    rows = [line.split() for line in path.read_text(encoding="utf-8").splitlines()
-            if line.strip() and not line.lstrip().startswith("#")]
+    rows = [
+        line.split()
+        for line in path.read_text(encoding="utf-8").splitlines()
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
     return np.array(rows, dtype=float)
 
 
@@ -115,23 +118,44 @@ def load_series(path):
 
 # (data file, data type, rate [Hz], result file, kind, relative tolerance on the deviation)
 STABLE32_FILES = [
-    *[("phasedat/PHASE.DAT", "phase", 1.0, f"phasedat/phase_dat_{k}_octave.txt", k, 1e-4)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
-    *[("phasedat/PHASE.DAT", "phase", 1.0, f"phasedat/phase_dat_{k}.txt", k, 1e-4)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
+    *[
+        ("phasedat/PHASE.DAT", "phase", 1.0, f"phasedat/phase_dat_{k}_octave.txt", k, 1e-4)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
+    *[
+        ("phasedat/PHASE.DAT", "phase", 1.0, f"phasedat/phase_dat_{k}.txt", k, 1e-4)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
     ("gps/gps_1pps_phase_data.txt.gz", "phase", 1.0, "gps/stable32_ADEV_decade.txt", "adev", 1e-4),
-    *[("gps/gps_1pps_phase_data.txt.gz", "phase", 1.0, f"gps/stable32_{k.upper()}_octave.txt", k, 1e-4)
-      for k in ("oadev", "mdev", "tdev", "hdev", "ohdev")],
-    *[("Cs5071A/5071A_phase.txt.gz", "phase", 1.0, f"Cs5071A/{k}_decade.txt", k, 1e-4)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
-    *[("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", 1.0, f"Keysight53230A_ti_noise_floor/tic_{k}.txt", k, 1e-4)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
+    *[
+        ("gps/gps_1pps_phase_data.txt.gz", "phase", 1.0, f"gps/stable32_{k.upper()}_octave.txt", k, 1e-4)
+        for k in ("oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
+    *[
+        ("Cs5071A/5071A_phase.txt.gz", "phase", 1.0, f"Cs5071A/{k}_decade.txt", k, 1e-4)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
+    *[
+        (
+            "Keysight53230A_ti_noise_floor/tic_phase.txt",
+            "phase",
+            1.0,
+            f"Keysight53230A_ti_noise_floor/tic_{k}.txt",
+            k,
+            1e-4,
+        )
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
     # the Stable32 input was normalised slightly differently (README: agreement about 1.2e-3)
-    *[("ocxo/ocxo_frequency.txt", "ocxo", 1.0, f"ocxo/{k}_octave.txt", k, 2e-3)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
+    *[
+        ("ocxo/ocxo_frequency.txt", "ocxo", 1.0, f"ocxo/{k}_octave.txt", k, 2e-3)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
     # Stable32 ran this one with tau0 = 42 s
-    *[("pink_frequency/pink_frequency.txt", "rate", 1.0 / 42, f"pink_frequency/{k}.txt", k, 1e-4)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")],
+    *[
+        ("pink_frequency/pink_frequency.txt", "rate", 1.0 / 42, f"pink_frequency/{k}.txt", k, 1e-4)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev")
+    ],
     ("pink_frequency/pink_frequency.txt", "rate", 1.0 / 42, "pink_frequency/totdev_alpha0.txt", "totdev", 1e-4),
     ("pink_frequency/pink_frequency.txt", "rate", 1.0, "pink_frequency/s32_oadev_octave.txt", "oadev", 1e-4),
     # total deviation
@@ -139,8 +163,14 @@ STABLE32_FILES = [
     ("phasedat/PHASE.DAT", "phase", 1.0, "phasedat/phase_dat_totdev.txt", "totdev", 1e-4),
     ("gps/gps_1pps_phase_data.txt.gz", "phase", 1.0, "gps/stable32_TOTDEV_octave.txt", "totdev", 1e-4),
     ("Cs5071A/5071A_phase.txt.gz", "phase", 1.0, "Cs5071A/totdev_decade.txt", "totdev", 1e-4),
-    ("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", 1.0, "Keysight53230A_ti_noise_floor/tic_totdev.txt",
-     "totdev", 1e-4),
+    (
+        "Keysight53230A_ti_noise_floor/tic_phase.txt",
+        "phase",
+        1.0,
+        "Keysight53230A_ti_noise_floor/tic_totdev.txt",
+        "totdev",
+        1e-4,
+    ),
     # ocxo/totdev_octave.txt came from the differently normalised input (.001); TOTDEV's end reflections
     # make it 1.2e-2 off, so TOTDEV is checked on the all-tau run of the (f - 1e7)/1e7 data instead
     ("ocxo/ocxo_frequency.txt", "ocxo", 1.0, "ocxo/stable32_totdev_alltau.txt", "totdev", 1e-4),
@@ -159,8 +189,9 @@ def stable32_case(data_file, data_type, result_file):
     return data, data_type, read_columns(folder / result_file)
 
 
-@pytest.mark.parametrize("data_file,data_type,rate_hz,result_file,kind,rtol", STABLE32_FILES,
-                         ids=[f[3] for f in STABLE32_FILES])
+@pytest.mark.parametrize(
+    "data_file,data_type,rate_hz,result_file,kind,rtol", STABLE32_FILES, ids=[f[3] for f in STABLE32_FILES]
+)
 def test_matches_stable32_row_by_row(data_file, data_type, rate_hz, result_file, kind, rtol):
     data, data_type, ref = stable32_case(data_file, data_type, result_file)
     res = allan_deviation(data, rate_hz, kind=kind, taus=ref[:, 0] / rate_hz, data_type=data_type, confidence=None)
@@ -171,21 +202,37 @@ def test_matches_stable32_row_by_row(data_file, data_type, rate_hz, result_file,
 
 # every reference file that carries Stable32's confidence intervals and noise types (octave/decade runs)
 CI_FILES = [
-    *[("phasedat/PHASE.DAT", "phase", f"phasedat/phase_dat_{k}_octave.txt", k)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    *[
+        ("phasedat/PHASE.DAT", "phase", f"phasedat/phase_dat_{k}_octave.txt", k)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+    ],
     ("gps/gps_1pps_phase_data.txt.gz", "phase", "gps/stable32_ADEV_decade.txt", "adev"),
-    *[("gps/gps_1pps_phase_data.txt.gz", "phase", f"gps/stable32_{k.upper()}_octave.txt", k)
-      for k in ("oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
-    *[("Cs5071A/5071A_phase.txt.gz", "phase", f"Cs5071A/{k}_decade.txt", k)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
-    *[("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", f"Keysight53230A_ti_noise_floor/tic_{k}.txt", k)
-      for k in ("oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
-    *[("ocxo/ocxo_frequency.txt", "ocxo", f"ocxo/{k}_octave.txt", k)
-      for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")],
+    *[
+        ("gps/gps_1pps_phase_data.txt.gz", "phase", f"gps/stable32_{k.upper()}_octave.txt", k)
+        for k in ("oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+    ],
+    *[
+        ("Cs5071A/5071A_phase.txt.gz", "phase", f"Cs5071A/{k}_decade.txt", k)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+    ],
+    *[
+        ("Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", f"Keysight53230A_ti_noise_floor/tic_{k}.txt", k)
+        for k in ("oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+    ],
+    *[
+        ("ocxo/ocxo_frequency.txt", "ocxo", f"ocxo/{k}_octave.txt", k)
+        for k in ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev")
+    ],
     ("pink_frequency/pink_frequency.txt", "rate", "pink_frequency/s32_oadev_octave.txt", "oadev"),
 ]
-_EDF_ARGS = {"adev": (2, False, False), "oadev": (2, True, False), "mdev": (2, True, True), "tdev": (2, True, True),
-             "hdev": (3, False, False), "ohdev": (3, True, False)}
+_EDF_ARGS = {
+    "adev": (2, False, False),
+    "oadev": (2, True, False),
+    "mdev": (2, True, True),
+    "tdev": (2, True, True),
+    "hdev": (3, False, False),
+    "ohdev": (3, True, False),
+}
 
 
 def stable32_edf(kind, alpha, m, n_phase):
@@ -243,10 +290,13 @@ def test_the_listed_rows_are_where_stable32s_own_runs_disagree_or_came_from_othe
     assert ours == pytest.approx(adev_ref[0, 5], rel=2e-5)
     for series, one, other, taus in [
         ("Cs5071A/5071A_phase.txt.gz", "Cs5071A/adev_decade.txt", "Cs5071A/oadev_decade.txt", {20000, 40000, 100000}),
-        ("gps/gps_1pps_phase_data.txt.gz", "gps/stable32_TOTDEV_octave.txt", "gps/stable32_OADEV_octave.txt",
-         {32768}),
-        ("Keysight53230A_ti_noise_floor/tic_phase.txt", "Keysight53230A_ti_noise_floor/tic_totdev.txt",
-         "Keysight53230A_ti_noise_floor/tic_oadev.txt", {8192}),
+        ("gps/gps_1pps_phase_data.txt.gz", "gps/stable32_TOTDEV_octave.txt", "gps/stable32_OADEV_octave.txt", {32768}),
+        (
+            "Keysight53230A_ti_noise_floor/tic_phase.txt",
+            "Keysight53230A_ti_noise_floor/tic_totdev.txt",
+            "Keysight53230A_ti_noise_floor/tic_oadev.txt",
+            {8192},
+        ),
     ]:
         a, b = (stable32_case(series, "phase", f)[2] for f in (one, other))
         assert a[0, 5] == b[0, 5]
@@ -289,9 +339,11 @@ def test_fewer_than_30_points_use_b1_and_rn():
     names simulated white PM, white FM and random walk FM at the longest taus of OADEV curves in most runs
     (about 80, 75 and 98 % over 100 seeds; B1 from 8 to 16 averages is a coarse statistic)."""
     rng = np.random.default_rng(7)
-    makers = {2: lambda: rng.standard_normal(4001),
-              0: lambda: np.concatenate([[0.0], np.cumsum(rng.standard_normal(4000))]),
-              -2: lambda: np.concatenate([[0.0], np.cumsum(np.cumsum(rng.standard_normal(4000)))])}
+    makers = {
+        2: lambda: rng.standard_normal(4001),
+        0: lambda: np.concatenate([[0.0], np.cumsum(rng.standard_normal(4000))]),
+        -2: lambda: np.concatenate([[0.0], np.cumsum(np.cumsum(rng.standard_normal(4000)))]),
+    }
     for alpha, make in makers.items():
         found = []
         for _ in range(40):
@@ -307,23 +359,31 @@ def test_fewer_than_30_points_use_b1_and_rn():
         allan_deviation(rng.standard_normal(100), 1.0, noise_alpha=3)
     with pytest.raises(InputError, match=r"noise_alpha: one alpha, or one per tau \(5\), got 2"):
         allan_deviation(rng.standard_normal(100), 1.0, noise_alpha=[0, 1])
-    assert b1_expected(20, -2) == pytest.approx((20 ** 2 - 1) / (1.5 * 20 * 19))
+    assert b1_expected(20, -2) == pytest.approx((20**2 - 1) / (1.5 * 20 * 19))
     assert rn_expected(8, 2) == 1 / 8
 
 
 @pytest.mark.parametrize("kind", ["adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev"])
-@pytest.mark.parametrize("dataset,data_file,data_type", [
-    ("nbs14_10", "nbs14_10point_phase.txt", "phase"),
-    ("nbs14_10", "nbs14_10point_freq.txt", "rate"),
-    ("nbs14_1000", "nbs14_1000point_freq.txt", "rate"),
-])
+@pytest.mark.parametrize(
+    "dataset,data_file,data_type",
+    [
+        ("nbs14_10", "nbs14_10point_phase.txt", "phase"),
+        ("nbs14_10", "nbs14_10point_freq.txt", "rate"),
+        ("nbs14_1000", "nbs14_1000point_freq.txt", "rate"),
+    ],
+)
 def test_nbs14_published_values(kind, dataset, data_file, data_type):
     folder = shared_dataset("allantools-stable32") / "nbs14"
     data = read_columns(folder / data_file)[:, 0]
-    ref = {float(t): float(v) for d, stat, t, v, *_ in
-           (line.split() for line in (folder / "nbs14_reference_values.txt").read_text().splitlines()
-            if line.strip() and not line.startswith("#"))
-           if d == dataset and stat == kind.upper()}
+    ref = {
+        float(t): float(v)
+        for d, stat, t, v, *_ in (
+            line.split()
+            for line in (folder / "nbs14_reference_values.txt").read_text().splitlines()
+            if line.strip() and not line.startswith("#")
+        )
+        if d == dataset and stat == kind.upper()
+    }
     assert ref, f"no {kind.upper()} reference for {dataset}"
     res = allan_deviation(data, 1.0, kind=kind, taus=np.array(sorted(ref)), data_type=data_type)
     assert len(res.tau) == len(ref)
@@ -399,26 +459,33 @@ def test_long_taus_from_lag_products_match_second_differences(shape):
     rng = np.random.default_rng(8)
     n = 399_999  # 400 000 phase points: 3125 is the shortest factor with N/m <= 128
     t = np.linspace(0.0, 1.0, n)
-    y = {"ramp": 0.5 + 2.0 * t + 1e-3 * rng.standard_normal(n),
-         "random_walk": np.cumsum(rng.standard_normal(n)),
-         "step": np.where(t > 0.37, 1.0, 0.0) + 1e-6 * rng.standard_normal(n),
-         "cubic": 1e3 * (t - 0.3) ** 3 + 1e-6 * rng.standard_normal(n)}[shape]
+    y = {
+        "ramp": 0.5 + 2.0 * t + 1e-3 * rng.standard_normal(n),
+        "random_walk": np.cumsum(rng.standard_normal(n)),
+        "step": np.where(t > 0.37, 1.0, 0.0) + 1e-6 * rng.standard_normal(n),
+        "cubic": 1e3 * (t - 0.3) ** 3 + 1e-6 * rng.standard_normal(n),
+    }[shape]
     ms = np.array([3125, 4096, 5000, 8192, 16384, 30001, 65536, 100_000, 150_001, 199_000])  # to N/2: cuts cross
     assert (ms * 128 >= n + 1).all() and (2 * ms < n + 1).all()
     res = allan_deviation(y, 1.0, taus=ms.astype(float), confidence=None)
     phase = np.concatenate([[0.0], np.cumsum(y - y.mean())])
     for m, dev in zip(ms, res.deviation):
-        d = phase[2 * m:] - 2.0 * phase[m:-m] + phase[:-2 * m]
-        assert dev == pytest.approx(np.sqrt(np.dot(d, d) / (2.0 * m ** 2 * d.size)), rel=1e-7), m
+        d = phase[2 * m :] - 2.0 * phase[m:-m] + phase[: -2 * m]
+        assert dev == pytest.approx(np.sqrt(np.dot(d, d) / (2.0 * m**2 * d.size)), rel=1e-7), m
 
 
 def _second_difference_sums(phase, ms):
-    return np.array([np.sum((phase[2 * m:] - 2.0 * phase[m:-m] + phase[:-2 * m]) ** 2) for m in ms])
+    return np.array([np.sum((phase[2 * m :] - 2.0 * phase[m:-m] + phase[: -2 * m]) ** 2) for m in ms])
 
 
 @settings(max_examples=60, deadline=None)
-@given(n=st.integers(8, 3000), block_log2=st.integers(2, 12), offset=st.floats(-1e3, 1e3),
-       slope=st.floats(-10.0, 10.0), seed=st.integers(0, 2 ** 16))
+@given(
+    n=st.integers(8, 3000),
+    block_log2=st.integers(2, 12),
+    offset=st.floats(-1e3, 1e3),
+    slope=st.floats(-10.0, 10.0),
+    seed=st.integers(0, 2**16),
+)
 def test_octave_pass_equals_direct_sums_for_any_length_block_and_drift(n, block_log2, offset, slope, seed):
     """The block-wise octave pass gives the direct sums of squared second differences whatever the block
     length (blocks shorter than the top factor's window included), the length and the drift."""
@@ -432,8 +499,13 @@ def test_octave_pass_equals_direct_sums_for_any_length_block_and_drift(n, block_
 
 
 @settings(max_examples=60, deadline=None)
-@given(first=st.integers(1, 40), block_spans=st.integers(1, 128), shape=st.sampled_from(["white", "walk", "drift"]),
-       seed=st.integers(0, 2 ** 16), data=st.data())
+@given(
+    first=st.integers(1, 40),
+    block_spans=st.integers(1, 128),
+    shape=st.sampled_from(["white", "walk", "drift"]),
+    seed=st.integers(0, 2**16),
+    data=st.data(),
+)
 def test_lag_products_of_detrended_windows_equal_direct_sums(first, block_spans, shape, seed, data):
     """The windowed lag products (each block's window detrended first) give the direct sums for any factors of
     a band [m, 8m], any block of up to 128 m starting points (shorter than the factors' windows included), any
@@ -458,13 +530,17 @@ def test_long_octave_levels_from_detrended_windows_are_exact_on_drift_dominated_
     rng = np.random.default_rng(5)
     n = 2_000_000
     t = np.linspace(0.0, 1.0, n)
-    y = {"ramp": 0.5 + 2.0 * t + 1e-3 * rng.standard_normal(n), "random_walk": np.cumsum(rng.standard_normal(n)),
-         "cubic": 1e3 * (t - 0.3) ** 3 + 1e-6 * rng.standard_normal(n),
-         "sine": 10.0 * np.sin(14.0 * np.pi * t) + 1e-4 * rng.standard_normal(n)}[shape]
+    y = {
+        "ramp": 0.5 + 2.0 * t + 1e-3 * rng.standard_normal(n),
+        "random_walk": np.cumsum(rng.standard_normal(n)),
+        "cubic": 1e3 * (t - 0.3) ** 3 + 1e-6 * rng.standard_normal(n),
+        "sine": 10.0 * np.sin(14.0 * np.pi * t) + 1e-4 * rng.standard_normal(n),
+    }[shape]
     phase = np.concatenate([[0.0], np.cumsum(y - y.mean())])
     ms = 1 << np.arange(estimators._OCTAVE_SHORT_MAX_M.bit_length(), 17)
-    np.testing.assert_allclose(estimators._windowed_oadev_sums(phase, ms), _second_difference_sums(phase, ms),
-                               rtol=1e-8)
+    np.testing.assert_allclose(
+        estimators._windowed_oadev_sums(phase, ms), _second_difference_sums(phase, ms), rtol=1e-8
+    )
 
 
 def test_the_default_octave_pass_splits_short_and_long_factors_with_the_same_sums(monkeypatch):
@@ -472,22 +548,22 @@ def test_the_default_octave_pass_splits_short_and_long_factors_with_the_same_sum
     monkeypatch.setattr(estimators, "_OCTAVE_SHORT_BLOCK", 64)
     phase = np.concatenate([[0.0], np.cumsum(np.random.default_rng(1).standard_normal(5000))])
     ms = 2 ** np.arange(10)  # 1 .. 512: 1..8 in 64-sample blocks, 16..512 in the long pass
-    np.testing.assert_allclose(estimators._octave_oadev_sums(phase, 512), _second_difference_sums(phase, ms),
-                               rtol=1e-9)
+    np.testing.assert_allclose(estimators._octave_oadev_sums(phase, 512), _second_difference_sums(phase, ms), rtol=1e-9)
 
 
 @settings(max_examples=60, deadline=None)
-@given(n=st.integers(8, 3000), seed=st.integers(0, 2 ** 16), data=st.data())
+@given(n=st.integers(8, 3000), seed=st.integers(0, 2**16), data=st.data())
 def test_lag_products_equal_direct_sums_for_any_factors(n, seed, data):
     """Lag products of the phase for any set of factors (shared lags, crossing cut points, m up to N/2)."""
     phase = np.concatenate([[0.0], np.cumsum(np.random.default_rng(seed).standard_normal(n))])
     ms = np.unique(data.draw(st.lists(st.integers(1, n // 2), min_size=1, max_size=6)))
-    np.testing.assert_allclose(estimators._lagged_oadev_sums(phase, ms), _second_difference_sums(phase, ms),
-                               rtol=1e-7, atol=1e-9 * n)
+    np.testing.assert_allclose(
+        estimators._lagged_oadev_sums(phase, ms), _second_difference_sums(phase, ms), rtol=1e-7, atol=1e-9 * n
+    )
 
 
 @settings(max_examples=40, deadline=None)
-@given(n=st.integers(2, 5000), cuts=st.lists(st.integers(1, 4999), max_size=8), seed=st.integers(0, 2 ** 16))
+@given(n=st.integers(2, 5000), cuts=st.lists(st.integers(1, 4999), max_size=8), seed=st.integers(0, 2**16))
 def test_phase_from_any_chunking_equals_the_batch_phase(n, cuts, seed):
     y = np.random.default_rng(seed).standard_normal(n) + 3.0
     edges = [0, *sorted({c for c in cuts if c < n}), n]
@@ -524,7 +600,7 @@ def test_memory_mapped_input_and_phase(tmp_path):
     np.testing.assert_allclose(mapped.deviation, plain.deviation, rtol=1e-12)
     np.testing.assert_array_equal(mapped.alpha, plain.alpha)
     np.testing.assert_allclose(np.asarray(phase) / 10.0, to_phase(y, 10.0), rtol=0, atol=1e-9)  # [unit*samples]
-    chunks = lambda: (y[i:i + 70_000] for i in range(0, y.size, 70_000))  # noqa: E731
+    chunks = lambda: (y[i : i + 70_000] for i in range(0, y.size, 70_000))  # noqa: E731
     np.testing.assert_allclose(phase_from_chunks(chunks, 10.0, y.size), to_phase(y, 10.0), atol=1e-9)
     with pytest.raises(InputError, match=r"chunks: delivered 300001 samples, expected 5"):
         phase_from_chunks(chunks, 10.0, 5)
@@ -543,7 +619,7 @@ def test_pooled_stretches_sum_the_terms_of_each(kind):
         for piece in pieces:
             if piece.size >= (3 * m if kind in ("mdev", "hdev", "ohdev") else 2 * m):
                 ref, k = brute_force(kind, piece, 2.0, m)
-                total, count = total + ref ** 2 * k, count + k
+                total, count = total + ref**2 * k, count + k
         assert n == count
         assert dev == pytest.approx(np.sqrt(total / count), rel=1e-9)
     single = allan_deviation_segments([pieces[0]], 2.0, kind=kind)
@@ -560,7 +636,8 @@ def test_interval_identities():
     assert ONE_SIGMA == pytest.approx(0.682689492, abs=1e-9)
     # white FM, overlapping Allan, large N: Greenhall's edf tends to (table 2) r / (a0 - a1/r) ~ 1.5 N/m
     assert edf_greenhall(0, 2, 100, 1_000_001, overlapping=True, modified=False) == pytest.approx(
-        1.5 * 1_000_000 / 100, rel=0.01)
+        1.5 * 1_000_000 / 100, rel=0.01
+    )
     with pytest.raises(InputError, match=r"alpha: -3 is outside the range the difference order 2 can estimate"):
         edf_greenhall(-3, 2, 1, 100, overlapping=True, modified=False)
     with pytest.raises(InputError, match=r"alpha: -3 has no total-deviation degrees of freedom"):
@@ -621,16 +698,19 @@ def test_rn_modified_variance_from_the_running_sum_on_a_grid():
     rng = np.random.default_rng(11)
     for phase in (rng.standard_normal(40001), np.cumsum(rng.standard_normal(40001))):
         for m, tolerance in ((8, 1e-12), (64, 1e-12), (256, 1e-2), (1024, 1e-2), (3000, 1e-2)):
-            exact = allan_deviation(phase, 1.0, kind="mdev", taus=np.array([float(m)]), data_type="phase",
-                                    confidence=None).deviation[0] ** 2
+            exact = (
+                allan_deviation(
+                    phase, 1.0, kind="mdev", taus=np.array([float(m)]), data_type="phase", confidence=None
+                ).deviation[0]
+                ** 2
+            )
             assert modified_variance_on_grid(phase, m) == pytest.approx(exact, rel=tolerance), m
     assert _grid_step(64) == 1 and _grid_step(4096) == 64 and _grid_step(3000) == 3000 // 75
     assert math.isnan(modified_variance_on_grid(np.zeros(100), 40))  # 3m beyond the series: no term
 
 
 @settings(max_examples=40, deadline=None)
-@given(n=st.integers(10, 5000), steps=st.lists(st.integers(1, 300), min_size=1, max_size=6),
-       seed=st.integers(0, 2 ** 16))
+@given(n=st.integers(10, 5000), steps=st.lists(st.integers(1, 300), min_size=1, max_size=6), seed=st.integers(0, 2**16))
 def test_shared_phase_grids_equal_grids_made_alone(n, steps, seed):
     """A grid read from a finer one made before (its step dividing the new one's) is the grid made from the phase
     alone, to rounding, in any order of requests; R(n)'s variance is the same with shared grids or without."""
@@ -645,5 +725,6 @@ def test_shared_phase_grids_equal_grids_made_alone(n, steps, seed):
         assert got.shape == alone.shape == (n // g + 1,)
         np.testing.assert_allclose(got, alone, rtol=1e-9, atol=1e-9 * np.sqrt(n) * n)
     for m in (64, 128, 256, 640):
-        assert modified_variance_on_grid(phase, m, shared) == pytest.approx(modified_variance_on_grid(phase, m),
-                                                                             rel=1e-9, nan_ok=True)
+        assert modified_variance_on_grid(phase, m, shared) == pytest.approx(
+            modified_variance_on_grid(phase, m), rel=1e-9, nan_ok=True
+        )

@@ -25,7 +25,7 @@ def test_the_markov_allan_variance_tends_to_a_random_walk_below_its_time_and_whi
     short = np.array([1e-4, 1e-3, 1e-2])
     np.testing.assert_allclose(markov_allan_variance(short, t), short / 3.0, rtol=1e-3)  # K^2 tau / 3, K = q
     long = np.array([1e4, 1e5])
-    np.testing.assert_allclose(markov_allan_variance(long, t), t ** 2 / long, rtol=2e-3)  # N^2 / tau, N = q T
+    np.testing.assert_allclose(markov_allan_variance(long, t), t**2 / long, rtol=2e-3)  # N^2 / tau, N = q T
     tau = np.geomspace(1e-5, 1e5, 200)
     g = markov_allan_variance(tau, t)
     assert np.all(np.isfinite(g)) and np.all(g > 0)
@@ -35,16 +35,17 @@ def test_the_markov_allan_variance_tends_to_a_random_walk_below_its_time_and_whi
 
 def test_the_markov_allan_variance_is_that_of_a_simulated_process():
     sigma, t = 0.02, 5.0
-    x = _gauss_markov(400_000, 1.0 / RATE_HZ, t, sigma ** 2, np.random.default_rng(4))
+    x = _gauss_markov(400_000, 1.0 / RATE_HZ, t, sigma**2, np.random.default_rng(4))
     r = allan_deviation(x, RATE_HZ, taus=np.array([0.1, 1.0, 5.0, 20.0, 100.0]))
-    model = np.sqrt(2.0 * sigma ** 2 / t * markov_allan_variance(r.tau, t))
+    model = np.sqrt(2.0 * sigma**2 / t * markov_allan_variance(r.tau, t))
     low, high = confidence_interval(r.deviation, r.edf, 0.997)
     assert np.all((model >= low) & (model <= high)), (model, r.deviation)
 
 
 def _record(preset: str, seed: int) -> np.ndarray:
-    return simulate_noise(int(RATE_HZ * RECORD_S), RATE_HZ, preset_model(preset), np.random.default_rng(seed)
-                          ).total_dps[:, 0]
+    return simulate_noise(
+        int(RATE_HZ * RECORD_S), RATE_HZ, preset_model(preset), np.random.default_rng(seed)
+    ).total_dps[:, 0]
 
 
 @pytest.mark.parametrize("preset", ["mti10", "adis16488", "consumer", "adxrs450"])
@@ -54,8 +55,15 @@ def test_the_bound_is_above_the_true_deviation_of_simulated_parts(preset):
     keep = measured.tau <= max_tau
     tau = measured.tau[keep]
     # the truth: the mean Allan variance of independent realizations of the same part
-    truth = np.sqrt(np.mean([allan_deviation(_record(preset, seed), RATE_HZ, taus="octave").deviation[keep] ** 2
-                             for seed in range(2, 10)], axis=0))
+    truth = np.sqrt(
+        np.mean(
+            [
+                allan_deviation(_record(preset, seed), RATE_HZ, taus="octave").deviation[keep] ** 2
+                for seed in range(2, 10)
+            ],
+            axis=0,
+        )
+    )
     full = bound_noise(measured, max_tau_s=max_tau)
     two = bound_noise(measured, markov=False, max_tau_s=max_tau)
     ieee = noise_terms(measured).model_deviation(tau) / truth
@@ -79,8 +87,9 @@ def test_the_bound_meets_every_curves_upper_confidence_bound():
         ok = np.isfinite(high)
         assert np.all(both.deviation(curve.tau[ok]) >= high[ok] * (1 - 1e-5))
     alone = bound_noise(curves[0], markov=False)
-    assert both.white_noise_density >= alone.white_noise_density * (1 - 1e-9) or \
-        both.random_walk >= alone.random_walk * (1 - 1e-9)
+    assert both.white_noise_density >= alone.white_noise_density * (
+        1 - 1e-9
+    ) or both.random_walk >= alone.random_walk * (1 - 1e-9)
     d = both.to_dict()
     assert d["white_noise_density_u_per_sqrt_hz"] == both.white_noise_density and d["gauss_markov"] == []
     assert math.isclose(d["ratio_to_measured_median"], both.ratio_median)

@@ -20,11 +20,19 @@ from gyrocomp.simulation.error_model import flicker_bank
 
 def analytic_curve(q, n, b, k, r, tau, relative_halfwidth=0.02):
     """The five-term model itself, with intervals of a fixed relative width."""
-    dev = np.sqrt(3 * q ** 2 / tau ** 2 + n ** 2 / tau + BIAS_INSTABILITY_FACTOR ** 2 * b ** 2
-                  + k ** 2 * tau / 3 + r ** 2 * tau ** 2 / 2)
+    dev = np.sqrt(
+        3 * q**2 / tau**2 + n**2 / tau + BIAS_INSTABILITY_FACTOR**2 * b**2 + k**2 * tau / 3 + r**2 * tau**2 / 2
+    )
     nan = np.full(tau.size, np.nan)
-    return AllanResult(tau=tau, deviation=dev, n=np.full(tau.size, 1000), ci_low=dev * (1 - relative_halfwidth),
-                       ci_high=dev * (1 + relative_halfwidth), alpha=nan, edf=nan)
+    return AllanResult(
+        tau=tau,
+        deviation=dev,
+        n=np.full(tau.size, 1000),
+        ci_low=dev * (1 - relative_halfwidth),
+        ci_high=dev * (1 + relative_halfwidth),
+        alpha=nan,
+        edf=nan,
+    )
 
 
 def test_fit_recovers_the_five_terms_of_an_exact_curve():
@@ -71,10 +79,16 @@ def test_unit_conversions():
     assert gyro.bias_instability_deg_per_h == pytest.approx(curve.minimum().deviation / 0.6643 * 3600, rel=1e-3)
     assert gyro.integration_time_s == curve.minimum().tau_s
     assert gyro.rrw_deg_per_h_per_sqrt_h == pytest.approx(terms.random_walk * 3600 * 60)
-    assert gyro.rate_ramp_deg_per_h2 == pytest.approx(terms.ramp * 3600 ** 2)
-    assert set(gyro.summary()) == {"noise_density_dps_per_sqrt_hz", "arw_deg_per_sqrt_h", "bias_instability_deg_per_h",
-                                   "integration_time_s", "rrw_deg_per_h_per_sqrt_h", "quantization_deg",
-                                   "rate_ramp_deg_per_h2"}
+    assert gyro.rate_ramp_deg_per_h2 == pytest.approx(terms.ramp * 3600**2)
+    assert set(gyro.summary()) == {
+        "noise_density_dps_per_sqrt_hz",
+        "arw_deg_per_sqrt_h",
+        "bias_instability_deg_per_h",
+        "integration_time_s",
+        "rrw_deg_per_h_per_sqrt_h",
+        "quantization_deg",
+        "rate_ramp_deg_per_h2",
+    }
     accel = noise_parameters(curve, "accel")
     assert isinstance(accel, AccelNoise)
     assert accel.vrw_m_per_s_per_sqrt_h == pytest.approx(terms.white_noise_density * 9.80665 * 60)
@@ -132,7 +146,7 @@ def test_bias_instability_floor_where_simulated():
         rng = np.random.default_rng(seed)
         y = rng.standard_normal(n) * density * math.sqrt(rate_hz) + flicker_bank(n, rate_hz, b_deg_per_h, rng)
         res = allan_deviation(y, rate_hz, confidence=0.95)
-        expected = np.sqrt(density ** 2 / res.tau + floor ** 2)
+        expected = np.sqrt(density**2 / res.tau + floor**2)
         plateau = (res.tau > 20) & (res.tau < 500)
         assert plateau.sum() >= 4
         inside += int(np.sum((expected[plateau] >= res.ci_low[plateau]) & (expected[plateau] <= res.ci_high[plateau])))

@@ -57,7 +57,9 @@ def test_future_schema_is_refused(calibration, tmp_path):
     d = calibration.to_dict()
     d["schema_version"] = SCHEMA_VERSION + 1
     (tmp_path / "f.json").write_text(json.dumps(d))
-    with pytest.raises(InputError, match=rf"f.json: written with model schema {SCHEMA_VERSION + 1}, .*upgrade gyrocomp"):
+    with pytest.raises(
+        InputError, match=rf"f.json: written with model schema {SCHEMA_VERSION + 1}, .*upgrade gyrocomp"
+    ):
         Calibration.load(tmp_path / "f.json")
 
 
@@ -82,14 +84,25 @@ def test_old_schema_is_upgraded(calibration, monkeypatch):
 @pytest.mark.parametrize(
     "text,message",
     [
-        ('{"format": "gyrocomp-calibration", "schema_version": 1, "axes": {"gyro_z": {"temperature": nu', r"not valid JSON \(line 1, column \d+: .*\); the file may be truncated"),
+        (
+            '{"format": "gyrocomp-calibration", "schema_version": 1, "axes": {"gyro_z": {"temperature": nu',
+            r"not valid JSON \(line 1, column \d+: .*\); the file may be truncated",
+        ),
         ("", r"not valid JSON"),
         ('{"a": 1}', r'not a gyrocomp model file \(no "format": "gyrocomp-calibration"\)'),
-        ('{"format": "gyrocomp-calibration", "schema_version": "1"}', r"schema_version '1' is not a positive whole number"),
-        ('{"format": "gyrocomp-calibration", "schema_version": 1, "model": "x"}', r"m\.json: 'axes' is a required property"),
+        (
+            '{"format": "gyrocomp-calibration", "schema_version": "1"}',
+            r"schema_version '1' is not a positive whole number",
+        ),
+        (
+            '{"format": "gyrocomp-calibration", "schema_version": 1, "model": "x"}',
+            r"m\.json: 'axes' is a required property",
+        ),
         ('{"format": "gyrocomp-calibration", "schema_version": 1, "model": "x", "axes": {}}', r"m.json: no axes"),
-        ('{"format": "gyrocomp-calibration", "schema_version": 1, "model": "x", "axes": {"gyro_z": {"temperature": {"type": "spline"}, "turn_on_biases_dps": [0]}}}',
-         r"unknown temperature model type 'spline'"),
+        (
+            '{"format": "gyrocomp-calibration", "schema_version": 1, "model": "x", "axes": {"gyro_z": {"temperature": {"type": "spline"}, "turn_on_biases_dps": [0]}}}',
+            r"unknown temperature model type 'spline'",
+        ),
     ],
 )
 def test_bad_model_files(tmp_path, text, message):
@@ -141,43 +154,73 @@ def _poly(d):
     return d["axes"]["gyro_z"]["temperature"]
 
 
-@pytest.mark.parametrize("change, message", [
-    (lambda d: _poly(d)["coefficients_dps"].__setitem__(0, float("nan")),
-     r"axes\.gyro_z\.temperature\.coefficients_dps\[0\]: nan is not a finite number"),
-    (lambda d: _poly(d)["coefficients_dps"].__setitem__(1, float("inf")),
-     r"axes\.gyro_z\.temperature\.coefficients_dps\[1\]: inf is not a finite number"),
-    (lambda d: _poly(d)["coefficients_dps"].__setitem__(0, 1e300),
-     r"axes\.gyro_z\.temperature\.coefficients_dps\[0\]: 1e\+300 is greater than the maximum of 10000"),
-    (lambda d: _poly(d).__setitem__("coefficients_dps", [0.0] * 5000),
-     r"axes\.gyro_z\.temperature\.coefficients_dps: 5000 values; at most 10$"),
-    (lambda d: _poly(d).update(t_min_degc=90.0, t_max_degc=-20.0),
-     r"axes\.gyro_z\.temperature: t_min_degc 90 is above t_max_degc -20"),
-    (lambda d: d["axes"]["gyro_z"].pop("temperature"), r"axes\.gyro_z: 'temperature' is a required property"),
-    (lambda d: d["axes"]["gyro_z"].__setitem__("lag_time_constant_s", -5.0),
-     r"axes\.gyro_z\.lag_time_constant_s: -5\.0 is less than the minimum of 0\.0"),
-    (lambda d: d["axes"].__setitem__("../../etc/passwd", d["axes"]["gyro_z"]),
-     r"axes: '\.\./\.\./etc/passwd' is not one of \['gyro_x', 'gyro_y', 'gyro_z'\]"),
-    (lambda d: d["axes"]["gyro_z"].__setitem__("temperature_column", "../x"),
-     r"axes\.gyro_z\.temperature_column: '\.\./x' is not one of \['temperature', 'temperature_x'"),
-    (lambda d: d["axes"]["gyro_z"].__setitem__("turn_on_biases_dps", []),
-     r"axes\.gyro_z\.turn_on_biases_dps: 0 values; at least 1"),
-    # text where a number belongs: float() would read "NaN" as a number and apply would write NaN (the sweep found it)
-    (lambda d: d["axes"]["gyro_z"].__setitem__("turn_on_biases_dps", ["NaN"]),
-     r"axes\.gyro_z\.turn_on_biases_dps\[0\]: 'NaN' is not of type 'number'"),
-    (lambda d: _poly(d).__setitem__("t_max_degc", "1e5"),
-     r"axes\.gyro_z\.temperature\.t_max_degc: '1e5' is not of type 'number'"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (
+            lambda d: _poly(d)["coefficients_dps"].__setitem__(0, float("nan")),
+            r"axes\.gyro_z\.temperature\.coefficients_dps\[0\]: nan is not a finite number",
+        ),
+        (
+            lambda d: _poly(d)["coefficients_dps"].__setitem__(1, float("inf")),
+            r"axes\.gyro_z\.temperature\.coefficients_dps\[1\]: inf is not a finite number",
+        ),
+        (
+            lambda d: _poly(d)["coefficients_dps"].__setitem__(0, 1e300),
+            r"axes\.gyro_z\.temperature\.coefficients_dps\[0\]: 1e\+300 is greater than the maximum of 10000",
+        ),
+        (
+            lambda d: _poly(d).__setitem__("coefficients_dps", [0.0] * 5000),
+            r"axes\.gyro_z\.temperature\.coefficients_dps: 5000 values; at most 10$",
+        ),
+        (
+            lambda d: _poly(d).update(t_min_degc=90.0, t_max_degc=-20.0),
+            r"axes\.gyro_z\.temperature: t_min_degc 90 is above t_max_degc -20",
+        ),
+        (lambda d: d["axes"]["gyro_z"].pop("temperature"), r"axes\.gyro_z: 'temperature' is a required property"),
+        (
+            lambda d: d["axes"]["gyro_z"].__setitem__("lag_time_constant_s", -5.0),
+            r"axes\.gyro_z\.lag_time_constant_s: -5\.0 is less than the minimum of 0\.0",
+        ),
+        (
+            lambda d: d["axes"].__setitem__("../../etc/passwd", d["axes"]["gyro_z"]),
+            r"axes: '\.\./\.\./etc/passwd' is not one of \['gyro_x', 'gyro_y', 'gyro_z'\]",
+        ),
+        (
+            lambda d: d["axes"]["gyro_z"].__setitem__("temperature_column", "../x"),
+            r"axes\.gyro_z\.temperature_column: '\.\./x' is not one of \['temperature', 'temperature_x'",
+        ),
+        (
+            lambda d: d["axes"]["gyro_z"].__setitem__("turn_on_biases_dps", []),
+            r"axes\.gyro_z\.turn_on_biases_dps: 0 values; at least 1",
+        ),
+        # text where a number belongs: float() would read "NaN" as a number and apply would write NaN (the sweep found it)
+        (
+            lambda d: d["axes"]["gyro_z"].__setitem__("turn_on_biases_dps", ["NaN"]),
+            r"axes\.gyro_z\.turn_on_biases_dps\[0\]: 'NaN' is not of type 'number'",
+        ),
+        (
+            lambda d: _poly(d).__setitem__("t_max_degc", "1e5"),
+            r"axes\.gyro_z\.temperature\.t_max_degc: '1e5' is not of type 'number'",
+        ),
+    ],
+)
 def test_model_files_are_validated_on_load(calibration, tmp_path, change, message):
     (tmp_path / "m.json").write_text(json.dumps(_mutated(calibration, change)))
     with pytest.raises(InputError, match=r"m\.json: " + message):
         Calibration.load(tmp_path / "m.json")
 
 
-@pytest.mark.parametrize("text, message", [
-    ("[" * 100000 + "]" * 100000, r"not a gyrocomp model file \(nested too deeply\)"),
-    ('{"format": "gyrocomp-calibration", "schema_version": ' + "9" * 5000 + "}",
-     r"an integer of 5000 digits; gyrocomp's files hold none of more than 30"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("[" * 100000 + "]" * 100000, r"not a gyrocomp model file \(nested too deeply\)"),
+        (
+            '{"format": "gyrocomp-calibration", "schema_version": ' + "9" * 5000 + "}",
+            r"an integer of 5000 digits; gyrocomp's files hold none of more than 30",
+        ),
+    ],
+)
 def test_pathological_json_is_refused_in_one_line(tmp_path, text, message):
     (tmp_path / "m.json").write_text(text)
     with pytest.raises(InputError, match=r"m\.json: " + message):
@@ -187,8 +230,10 @@ def test_pathological_json_is_refused_in_one_line(tmp_path, text, message):
 def test_a_valid_file_still_loads_and_applies_identically(calibration, tmp_path):
     calibration.save(tmp_path / "ok.json")
     sim = simulate(duration_s=120, rate_hz=10, seed=8)
-    np.testing.assert_array_equal(apply(Calibration.load(tmp_path / "ok.json"), sim.recording).gyro_dps,
-                                  apply(calibration, sim.recording).gyro_dps)
+    np.testing.assert_array_equal(
+        apply(Calibration.load(tmp_path / "ok.json"), sim.recording).gyro_dps,
+        apply(calibration, sim.recording).gyro_dps,
+    )
 
 
 def test_schema_5_file_written_by_the_previous_release_loads_and_applies_identically():
@@ -218,8 +263,7 @@ def test_schema_6_file_written_before_the_registries_loads_and_applies_identical
     assert loaded.axes["gyro_z"].hysteresis is not None and loaded.axes["gyro_z"].lag_time_constant_s > 0
     data = read_table(folder / "heldout.csv")
     out = apply(loaded, data.recording, turn_on_window_s=60)
-    np.testing.assert_allclose(out.gyro_dps[:, 0], data.table.column("expected_gyro_z").to_numpy(), rtol=0,
-                               atol=1e-12)
+    np.testing.assert_allclose(out.gyro_dps[:, 0], data.table.column("expected_gyro_z").to_numpy(), rtol=0, atol=1e-12)
 
 
 def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other():
@@ -230,7 +274,9 @@ def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other()
     gyro = AxisCalibration(curve, (0.1, 0.3))
     accel = AxisCalibration(curve, (0.02, 0.04), unit="g")
     assert gyro.unit == "deg/s" and gyro.turn_on_biases_dps == (0.1, 0.3) and gyro.mean_turn_on_bias_dps == 0.2
-    assert accel.turn_on_biases_g == accel.turn_on_biases == (0.02, 0.04) and accel.mean_turn_on_bias == pytest.approx(0.03)
+    assert accel.turn_on_biases_g == accel.turn_on_biases == (0.02, 0.04) and accel.mean_turn_on_bias == pytest.approx(
+        0.03
+    )
     with pytest.raises(InputError, match=r"turn_on_biases_dps: the axis's values are in g, not deg/s"):
         _ = accel.turn_on_biases_dps
     with pytest.raises(InputError, match=r"mean_turn_on_bias_dps: the axis's values are in g, not deg/s"):
@@ -254,11 +300,15 @@ def test_each_axis_carries_its_unit_and_the_names_with_a_unit_refuse_the_other()
 def test_integers_beyond_any_count_are_refused_in_one_line(calibration, tmp_path, digits):
     """Python turns a 4,000-digit integer into an int no float holds and refuses 5,000 digits with an error about
     its own limits: a model file or a learner state holding one is refused naming the file."""
-    text = json.dumps(calibration.to_dict()).replace('"schema_version": ', '"schema_version": ' + "9" * digits + ", "
-                                                     '"was": ', 1)
+    text = json.dumps(calibration.to_dict()).replace(
+        '"schema_version": ', '"schema_version": ' + "9" * digits + ', "was": ', 1
+    )
     (tmp_path / "m.json").write_text(text)
-    with pytest.raises(InputError, match=rf"m.json: an integer of {digits} digits; gyrocomp's files hold none of more "
-                                         r"than 30"):
+    with pytest.raises(
+        InputError,
+        match=rf"m.json: an integer of {digits} digits; gyrocomp's files hold none of more "
+        r"than 30",
+    ):
         Calibration.load(tmp_path / "m.json")
     (tmp_path / "s.json").write_text('{"format": "gyrocomp-learner", "schema_version": ' + "9" * digits + "}")
     with pytest.raises(InputError, match=rf"s.json: an integer of {digits} digits"):

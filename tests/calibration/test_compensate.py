@@ -22,22 +22,27 @@ def sim():
 @pytest.fixture(scope="module")
 def cal():
     """A cubic fitted on two 10-minute runs (at first use, not when the module is imported)."""
-    return fit_calibration([simulate(duration_s=600, rate_hz=RATE_HZ, seed=s).recording for s in (1, 2)],
-                           temperature=Polynomial(3))
+    return fit_calibration(
+        [simulate(duration_s=600, rate_hz=RATE_HZ, seed=s).recording for s in (1, 2)], temperature=Polynomial(3)
+    )
 
 
 def stream(cal, rec, cuts, **kw):
     comp = Compensator(cal, rec.gyro_axes, **kw)
     edges = [0, *sorted(cuts), rec.n_samples]
-    blocks = [comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b])
-              for a, b in zip(edges[:-1], edges[1:])]
+    blocks = [
+        comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b])
+        for a, b in zip(edges[:-1], edges[1:])
+    ]
     blocks.append(comp.finish())
     return np.concatenate(blocks)
 
 
 @settings(max_examples=60, deadline=None)
-@given(cuts=st.lists(st.integers(0, DURATION_S * RATE_HZ), max_size=12),
-       window=st.one_of(st.none(), st.floats(0.05, 200.0)))
+@given(
+    cuts=st.lists(st.integers(0, DURATION_S * RATE_HZ), max_size=12),
+    window=st.one_of(st.none(), st.floats(0.05, 200.0)),
+)
 def test_any_chunking_equals_batch(sim, cal, cuts, window):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -73,7 +78,7 @@ def test_warns_once_across_chunks(sim, cal):
     comp = Compensator(cal, rec.gyro_axes)
     with pytest.warns(TemperatureRangeWarning) as record:
         for a in range(0, rec.n_samples, 100):
-            comp.update(rec.time_s[a:a + 100], rec.gyro_dps[a:a + 100], hot[a:a + 100])
+            comp.update(rec.time_s[a : a + 100], rec.gyro_dps[a : a + 100], hot[a : a + 100])
     assert len(record) == 1
 
 
@@ -82,10 +87,18 @@ def test_an_axis_the_model_lacks_is_refused_unless_the_axes_are_named():
     temp = np.linspace(10, 40, t.size)
     z_only = Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)
     cal_z = fit_calibration([z_only], temperature=Polynomial(1))
-    both = Recording(time_s=t, gyro_dps=np.column_stack([np.ones(t.size), 1e-3 * temp]),
-                     gyro_axes=("gyro_x", "gyro_z"), temperature_degc=temp, source="both.csv")
-    with pytest.raises(InputError, match=r"both.csv: the model has no curve for gyro_x \(it covers gyro_z\); "
-                                         r"give axes= with the axes to compensate"):
+    both = Recording(
+        time_s=t,
+        gyro_dps=np.column_stack([np.ones(t.size), 1e-3 * temp]),
+        gyro_axes=("gyro_x", "gyro_z"),
+        temperature_degc=temp,
+        source="both.csv",
+    )
+    with pytest.raises(
+        InputError,
+        match=r"both.csv: the model has no curve for gyro_x \(it covers gyro_z\); "
+        r"give axes= with the axes to compensate",
+    ):
         apply(cal_z, both)
     with pytest.warns(DataQualityWarning, match=r"both.csv: gyro_x left raw \(not among the axes to compensate\)"):
         out = apply(cal_z, both, axes=("gyro_z",))
@@ -100,7 +113,9 @@ def test_an_axis_the_model_lacks_is_refused_unless_the_axes_are_named():
 def test_errors(cal):
     with pytest.raises(InputError, match=r"turn_on_window_s: must be a positive number of seconds, got -1"):
         Compensator(cal, ("gyro_z",), turn_on_window_s=-1)
-    with pytest.raises(InputError, match=r"the model covers gyro_x, gyro_y, gyro_z, the data has gyro_w; no axis in common"):
+    with pytest.raises(
+        InputError, match=r"the model covers gyro_x, gyro_y, gyro_z, the data has gyro_w; no axis in common"
+    ):
         Compensator(cal, ("gyro_w",))
     comp = Compensator(cal, ("gyro_x", "gyro_y", "gyro_z"))
     with pytest.raises(InputError, match="the model needs temperature, the data has none"):

@@ -23,8 +23,10 @@ _CACHE = {}
 def _turning_fit():
     """The default fit of consumer-part runs that heat, cool and turn between positions (memory and G chosen)."""
     if "fit" not in _CACHE:
-        runs = [simulate("consumer", profile="combined", rate_hz=5, duration_s=3 * 3600, seed=s, unit=2).recording
-                for s in range(3)]
+        runs = [
+            simulate("consumer", profile="combined", rate_hz=5, duration_s=3 * 3600, seed=s, unit=2).recording
+            for s in range(3)
+        ]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             _CACHE["fit"] = fit_calibration(runs)
@@ -52,8 +54,9 @@ def test_the_report_of_a_default_fit_is_typed_and_says_what_the_model_holds():
     for axis, written in cal.fit_report["axes"].items():  # each axis's entry was written from its record
         assert report.axes[axis].to_dict() == written and report.axes[axis].unit == "deg/s"
         assert choice.hysteresis_order == (0 if ax.hysteresis is None else ax.hysteresis.order)
-        assert choice.label == (choice.memory + (f" (order {choice.hysteresis_order})"
-                                                 if choice.hysteresis_order else ""))
+        assert choice.label == (
+            choice.memory + (f" (order {choice.hysteresis_order})" if choice.hysteresis_order else "")
+        )
     # the runs turn between positions: G is fitted, and the report's rows are the model's
     assert report.acceleration is not None and report.acceleration.excited_axes
     for axis, row in report.acceleration.axes.items():
@@ -80,16 +83,25 @@ def test_the_selection_report_is_the_selection_as_it_was_made():
 
 
 def test_an_older_file_that_wrote_the_memory_as_text_reads_into_the_same_fields():
-    old = {"chosen": "turning-point+lag (order 2)", "lag_time_constant_s": 31.5, "order": 3,
-           "scores_bic": {"none": -10.0, "turning-point+lag": -14.5}}
+    old = {
+        "chosen": "turning-point+lag (order 2)",
+        "lag_time_constant_s": 31.5,
+        "order": 3,
+        "scores_bic": {"none": -10.0, "turning-point+lag": -14.5},
+    }
     choice = MemoryChoice.from_dict(old)
     assert (choice.memory, choice.hysteresis_order, choice.order) == ("turning-point+lag", 2, 3)
     assert choice.label == old["chosen"] and choice.scores["turning-point+lag"] == -14.5
     assert MemoryChoice.from_dict({"chosen": "lag", "lag_time_constant_s": 12.0}).hysteresis_order == 0
-    report = FitReport.from_dict({"temperature": "polynomial", "order_selection": "bic",
-                                  "axes": {"gyro_x": {"order": 2, "scores": {"1": 3.0, "2": 1.0}, "fit_rms_dps": 0.01}},
-                                  "hysteresis": {"mode": "auto", "selection": "bic", "axes": {"gyro_x": old}},
-                                  "learner": {"points": 12}})
+    report = FitReport.from_dict(
+        {
+            "temperature": "polynomial",
+            "order_selection": "bic",
+            "axes": {"gyro_x": {"order": 2, "scores": {"1": 3.0, "2": 1.0}, "fit_rms_dps": 0.01}},
+            "hysteresis": {"mode": "auto", "selection": "bic", "axes": {"gyro_x": old}},
+            "learner": {"points": 12},
+        }
+    )
     assert report.hysteresis.by_bic and report.hysteresis.memories_scored == ("none", "turning-point+lag")
     assert report.order_selection.scores == {"gyro_x": {1: 3.0, 2: 1.0}} and report.order_selection.orders == (1, 2)
     assert report.axes["gyro_x"].fit_rms == 0.01
@@ -97,8 +109,10 @@ def test_an_older_file_that_wrote_the_memory_as_text_reads_into_the_same_fields(
     # an axis's entry is written from its record, and reads back into it
     entry = {"order": 2, "t_min_degc": 5.0, "t_max_degc": 60.0, "scores": {"1": 3.0, "2": 1.0}, "fit_rms_dps": 0.01}
     assert AxisFit.from_dict(entry).to_dict() == entry
-    assert AxisFit.from_dict(entry, "g").to_dict() == {**{k: v for k, v in entry.items() if k != "fit_rms_dps"},
-                                                       "fit_rms_g": 0.01}
+    assert AxisFit.from_dict(entry, "g").to_dict() == {
+        **{k: v for k, v in entry.items() if k != "fit_rms_dps"},
+        "fit_rms_g": 0.01,
+    }
 
 
 def test_a_model_without_a_fit_report_reads_as_an_empty_one():
@@ -107,8 +121,9 @@ def test_a_model_without_a_fit_report_reads_as_an_empty_one():
     assert report.acceleration is None and report.accel is None and report.stages == ()
 
 
-@pytest.mark.parametrize("how", ["chosen by the selection", "fixed order and memory (the thermal fit's own)",
-                                 "no memory asked for"])
+@pytest.mark.parametrize(
+    "how", ["chosen by the selection", "fixed order and memory (the thermal fit's own)", "no memory asked for"]
+)
 def test_the_hysteresis_section_is_written_from_its_typed_record(how, chamber_runs):
     """The fit builds the typed record and stores its serialization: reading the section back and writing it
     again gives the stored section, key for key, on each of the three ways the section is made."""
@@ -117,8 +132,11 @@ def test_the_hysteresis_section_is_written_from_its_typed_record(how, chamber_ru
     else:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            cal = fit_calibration([sim.recording for sim in chamber_runs[:3]], temperature=Polynomial(2),
-                                  hysteresis="none" if how == "no memory asked for" else "lag")
+            cal = fit_calibration(
+                [sim.recording for sim in chamber_runs[:3]],
+                temperature=Polynomial(2),
+                hysteresis="none" if how == "no memory asked for" else "lag",
+            )
     stored = cal.fit_report["hysteresis"]
     typed = cal.report.hysteresis
     assert typed.to_dict() == stored
@@ -136,8 +154,10 @@ def test_the_acceleration_section_is_written_from_its_typed_record(mode):
     """As for the hysteresis: the section read back and written again is the stored one, for G, G with the g x g
     terms, no G (with why), and the acceleration network (and the temperature network's section before it); and
     the typed rows are the model's."""
-    runs = [simulate("consumer", profile="combined", rate_hz=5, duration_s=3 * 3600, seed=s, unit=2).recording
-            for s in range(3)]
+    runs = [
+        simulate("consumer", profile="combined", rate_hz=5, duration_s=3 * 3600, seed=s, unit=2).recording
+        for s in range(3)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if mode == "network":

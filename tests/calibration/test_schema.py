@@ -30,8 +30,12 @@ def _published() -> dict:
 
 @pytest.fixture(scope="module")
 def runs():
-    return [simulate("consumer", profile=get_profile("combined", set_points_degc=(-10, 50)), rate_hz=0.5,
-                     duration_s=5400, seed=s).recording for s in range(3)]
+    return [
+        simulate(
+            "consumer", profile=get_profile("combined", set_points_degc=(-10, 50)), rate_hz=0.5, duration_s=5400, seed=s
+        ).recording
+        for s in range(3)
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -46,22 +50,29 @@ def default_model(runs):
 def models(runs, default_model):
     """A model of every kind the fitter writes: polynomial and lag, network, gyro and accelerometer, g x g terms,
     an acceleration network, turning-point hysteresis, heating/cooling branches, a rate-table triad."""
-    adx = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1.0,
-                    seed=s).recording for s, sp in ((0, (-30, 85)), (1, (-20, 80)))]
+    adx = [
+        simulate("adxrs450", profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1.0, seed=s).recording
+        for s, sp in ((0, (-30, 85)), (1, (-20, 80)))
+    ]
     table = [simulate("mti10", profile="ratetable", rate_hz=20.0, seed=s).recording for s in range(2)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return {"default": default_model, "network": fit(runs, FitOptions(temperature=Network())),
-                "gyro and accel": fit(runs, channels=("gyro", "accel")),
-                "g x g": fit(runs, FitOptions(acceleration="matrix2")),
-                "acceleration network": fit_pipeline(runs, "mlp>mlp-accel"),
-                "turning-point": fit(adx), "branches": fit(adx, FitOptions(hysteresis="branch")),
-                "triad": fit(table + runs[:1])}
+        return {
+            "default": default_model,
+            "network": fit(runs, FitOptions(temperature=Network())),
+            "gyro and accel": fit(runs, channels=("gyro", "accel")),
+            "g x g": fit(runs, FitOptions(acceleration="matrix2")),
+            "acceleration network": fit_pipeline(runs, "mlp>mlp-accel"),
+            "turning-point": fit(adx),
+            "branches": fit(adx, FitOptions(hysteresis="branch")),
+            "triad": fit(table + runs[:1]),
+        }
 
 
 def test_the_shipped_schema_is_the_builders():
-    assert _published() == json.loads(json.dumps(build_schema(SCHEMA_VERSION))), \
+    assert _published() == json.loads(json.dumps(build_schema(SCHEMA_VERSION))), (
         "the shipped model.schema.json is stale: run python tools/model_schema.py"
+    )
 
 
 @pytest.mark.slow
@@ -90,24 +101,41 @@ def _refusal(cal, change) -> str:
     return str(caught.value)
 
 
-@pytest.mark.parametrize("change, message", [
-    # what the deeper sweep found accepted (issue: nothing silently wrong, at depth)
-    (lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("coefficients_dps", [True, False, True]),
-     "m.json: axes.gyro_x.temperature.coefficients_dps[0]: True is not of type 'number'"),
-    (lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("t_scale_degc", 0),
-     "m.json: axes.gyro_x.temperature.t_scale_degc: 0 is less than the minimum of 0.01"),
-    (lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("t_scale_degc", 1e-300),
-     "m.json: axes.gyro_x.temperature.t_scale_degc: 1e-300 is less than the minimum of 0.01"),
-    (lambda d: d["units"].__setitem__("gyro", "rad/s"), "m.json: units.gyro: 'deg/s' was expected"),
-    (lambda d: d["axes"]["gyro_x"].__setitem__("comment", "hi"),
-     "m.json: axes.gyro_x: Additional properties are not allowed ('comment' was unexpected)"),
-    (lambda d: d.__setitem__("temperature_unit", "degF"),
-     "m.json: Additional properties are not allowed ('temperature_unit' was unexpected)"),
-    (lambda d: d["axes"]["gyro_x"].__setitem__("lag_time_constant_s", "30"),
-     "m.json: axes.gyro_x.lag_time_constant_s: '30' is not of type 'number'"),
-    (lambda d: d["axes"]["gyro_x"].__setitem__("temperature_column", "temp"),
-     "m.json: axes.gyro_x.temperature_column: 'temp' is not one of ['temperature', 'temperature_x'"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        # what the deeper sweep found accepted (issue: nothing silently wrong, at depth)
+        (
+            lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("coefficients_dps", [True, False, True]),
+            "m.json: axes.gyro_x.temperature.coefficients_dps[0]: True is not of type 'number'",
+        ),
+        (
+            lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("t_scale_degc", 0),
+            "m.json: axes.gyro_x.temperature.t_scale_degc: 0 is less than the minimum of 0.01",
+        ),
+        (
+            lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("t_scale_degc", 1e-300),
+            "m.json: axes.gyro_x.temperature.t_scale_degc: 1e-300 is less than the minimum of 0.01",
+        ),
+        (lambda d: d["units"].__setitem__("gyro", "rad/s"), "m.json: units.gyro: 'deg/s' was expected"),
+        (
+            lambda d: d["axes"]["gyro_x"].__setitem__("comment", "hi"),
+            "m.json: axes.gyro_x: Additional properties are not allowed ('comment' was unexpected)",
+        ),
+        (
+            lambda d: d.__setitem__("temperature_unit", "degF"),
+            "m.json: Additional properties are not allowed ('temperature_unit' was unexpected)",
+        ),
+        (
+            lambda d: d["axes"]["gyro_x"].__setitem__("lag_time_constant_s", "30"),
+            "m.json: axes.gyro_x.lag_time_constant_s: '30' is not of type 'number'",
+        ),
+        (
+            lambda d: d["axes"]["gyro_x"].__setitem__("temperature_column", "temp"),
+            "m.json: axes.gyro_x.temperature_column: 'temp' is not one of ['temperature', 'temperature_x'",
+        ),
+    ],
+)
 def test_what_the_schema_refuses_is_refused_naming_the_field(default_model, change, message):
     assert _refusal(default_model, change).startswith(message)
 
@@ -115,17 +143,25 @@ def test_what_the_schema_refuses_is_refused_naming_the_field(default_model, chan
 @pytest.mark.slow
 def test_the_other_kinds_fields_are_checked_too(models):
     network = models["network"]
-    assert _refusal(network, lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("activation", "relu")) == \
-        "m.json: axes.gyro_x.temperature.activation: 'tanh' was expected"
+    assert (
+        _refusal(network, lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__("activation", "relu"))
+        == "m.json: axes.gyro_x.temperature.activation: 'tanh' was expected"
+    )
     triad = models["triad"]
-    assert _refusal(triad, lambda d: d["gyro_triad"]["sensitivity"][0].__setitem__(0, "1.5")) == \
-        "m.json: gyro_triad.sensitivity[0][0]: '1.5' is not of type 'number'"
-    assert _refusal(triad, lambda d: d["gyro_triad"]["sensitivity"][1].__setitem__(1, 1e300)) == \
-        "m.json: gyro_triad.sensitivity[1][1]: 1e+300 is greater than the maximum of 10.0"
+    assert (
+        _refusal(triad, lambda d: d["gyro_triad"]["sensitivity"][0].__setitem__(0, "1.5"))
+        == "m.json: gyro_triad.sensitivity[0][0]: '1.5' is not of type 'number'"
+    )
+    assert (
+        _refusal(triad, lambda d: d["gyro_triad"]["sensitivity"][1].__setitem__(1, 1e300))
+        == "m.json: gyro_triad.sensitivity[1][1]: 1e+300 is greater than the maximum of 10.0"
+    )
     branches = models["branches"]
     axis = next(a for a, ax in branches.axes.items() if ax.hysteresis is not None)
-    assert _refusal(branches, lambda d: d["axes"][axis]["hysteresis"].__setitem__("transition_degc", 0)) == \
-        f"m.json: axes.{axis}.hysteresis.transition_degc: 0 is less than or equal to the minimum of 0.0"
+    assert (
+        _refusal(branches, lambda d: d["axes"][axis]["hysteresis"].__setitem__("transition_degc", 0))
+        == f"m.json: axes.{axis}.hysteresis.transition_degc: 0 is less than or equal to the minimum of 0.0"
+    )
 
 
 def test_duplicate_keys_and_non_json_numbers_are_refused_in_the_file(default_model, tmp_path):
@@ -172,34 +208,63 @@ def test_the_temperature_column_a_model_names_is_the_one_it_reads(models):
     column without a word, nor a shared-temperature model to data with one per axis: the column the model names
     is honoured (before: it was never read, and the data's column was used whatever it was)."""
     cal = models["default"]
-    per_axis = Calibration.from_dict({**cal.to_dict(), "axes": {
-        a: {**ax, "temperature_column": f"temperature_{a[-1]}"} for a, ax in cal.to_dict()["axes"].items()}})
+    per_axis = Calibration.from_dict(
+        {
+            **cal.to_dict(),
+            "axes": {
+                a: {**ax, "temperature_column": f"temperature_{a[-1]}"} for a, ax in cal.to_dict()["axes"].items()
+            },
+        }
+    )
     rec = simulate("consumer", profile="cycle", duration_s=1200, rate_hz=1.0, seed=9).recording
-    with pytest.raises(InputError, match=r"the model of gyro_x reads 'temperature_x' \(one temperature per axis\); "
-                                         r"the data has one temperature column"):
+    with pytest.raises(
+        InputError,
+        match=r"the model of gyro_x reads 'temperature_x' \(one temperature per axis\); "
+        r"the data has one temperature column",
+    ):
         apply(per_axis, rec)
-    three = Recording(time_s=rec.time_s, gyro_dps=rec.gyro_dps, gyro_axes=rec.gyro_axes,
-                      temperature_degc=np.column_stack([rec.temperature_degc + d for d in (0.0, 1.0, 2.0)]),
-                      accel_g=rec.accel_g, accel_axes=rec.accel_axes, source="three")
-    with pytest.raises(InputError, match=r"three: the model of gyro_x reads one temperature column \('temperature'\); "
-                                         r"the data has one per axis"):
+    three = Recording(
+        time_s=rec.time_s,
+        gyro_dps=rec.gyro_dps,
+        gyro_axes=rec.gyro_axes,
+        temperature_degc=np.column_stack([rec.temperature_degc + d for d in (0.0, 1.0, 2.0)]),
+        accel_g=rec.accel_g,
+        accel_axes=rec.accel_axes,
+        source="three",
+    )
+    with pytest.raises(
+        InputError,
+        match=r"three: the model of gyro_x reads one temperature column \('temperature'\); "
+        r"the data has one per axis",
+    ):
         apply(cal, three)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out = apply(per_axis, three).gyro_dps
-        shifted = apply(cal, Recording(time_s=rec.time_s, gyro_dps=rec.gyro_dps, gyro_axes=rec.gyro_axes,
-                                       temperature_degc=rec.temperature_degc + 2.0, accel_g=rec.accel_g,
-                                       accel_axes=rec.accel_axes)).gyro_dps
+        shifted = apply(
+            cal,
+            Recording(
+                time_s=rec.time_s,
+                gyro_dps=rec.gyro_dps,
+                gyro_axes=rec.gyro_axes,
+                temperature_degc=rec.temperature_degc + 2.0,
+                accel_g=rec.accel_g,
+                accel_axes=rec.accel_axes,
+            ),
+        ).gyro_dps
     np.testing.assert_allclose(out[:, 2], shifted[:, 2], rtol=0, atol=1e-12)  # gyro_z read temperature_z
 
 
-@pytest.mark.parametrize("report, refusal", [
-    (None, "fit_report: None is not of type 'object'"),
-    ({"selection": {"gyro_x": None}}, "fit_report: malformed (AttributeError"),
-    ({"axes": {"gyro_x": {"scores": 5}}}, "fit_report: malformed (AttributeError"),
-    ({"selection": {"gyro_x": {"axis": "gyro_x"}}}, "fit_report: malformed (KeyError: 'fold_kind')"),
-    ({}, None),  # an empty report: a model without its account, shown as such
-])
+@pytest.mark.parametrize(
+    "report, refusal",
+    [
+        (None, "fit_report: None is not of type 'object'"),
+        ({"selection": {"gyro_x": None}}, "fit_report: malformed (AttributeError"),
+        ({"axes": {"gyro_x": {"scores": 5}}}, "fit_report: malformed (AttributeError"),
+        ({"selection": {"gyro_x": {"axis": "gyro_x"}}}, "fit_report: malformed (KeyError: 'fold_kind')"),
+        ({}, None),  # an empty report: a model without its account, shown as such
+    ],
+)
 def test_a_damaged_fit_report_is_refused_on_load_and_show_never_meets_it(default_model, tmp_path, report, refusal):
     """Nulls and wrong shapes in the fit report gave show internal errors; now the model file is refused in one
     line (exit 2) naming the report."""

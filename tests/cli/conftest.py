@@ -10,8 +10,21 @@ def workdir(tmp_path_factory):
     """Three simulated chamber runs and a model fitted on two of them, made with the CLI itself."""
     d = tmp_path_factory.mktemp("cli")
     for seed in (1, 2, 3):
-        r = run("simulate", "--profile", "chamber", "--duration", 1200, "--rate", 10, "--seed", seed,
-                "-o", d / f"run{seed}.csv", "--truth", d / f"truth{seed}.json")
+        r = run(
+            "simulate",
+            "--profile",
+            "chamber",
+            "--duration",
+            1200,
+            "--rate",
+            10,
+            "--seed",
+            seed,
+            "-o",
+            d / f"run{seed}.csv",
+            "--truth",
+            d / f"truth{seed}.json",
+        )
         assert r.returncode == 0, r.stderr
     r = run("fit", d / "run1.csv", d / "run2.csv", "-o", d / "model.json", "--temperature", "poly:3")
     assert r.returncode == 0, r.stderr
@@ -31,8 +44,21 @@ def report_files(tmp_path_factory):
     """Two simulated one-hour runs of the mti10 preset and a model fitted on the first, made with the CLI."""
     d = tmp_path_factory.mktemp("report")
     for seed in (1, 2):
-        r = run("simulate", "--preset", "mti10", "--profile", "combined", "--duration", 3600, "--rate", 1,
-                "--seed", seed, "-o", d / f"run{seed}.csv")
+        r = run(
+            "simulate",
+            "--preset",
+            "mti10",
+            "--profile",
+            "combined",
+            "--duration",
+            3600,
+            "--rate",
+            1,
+            "--seed",
+            seed,
+            "-o",
+            d / f"run{seed}.csv",
+        )
         assert r.returncode == 0, r.stderr
     r = run("fit", d / "run1.csv", "-o", d / "model.json", "--hysteresis", "none")
     assert r.returncode == 0, r.stderr

@@ -16,7 +16,9 @@ def test_apply_keeps_columns_rows_and_other_channels(workdir):
     assert list(comp.columns) == list(raw.columns) and len(comp) == len(raw)
     for col in ("time", "accel_x", "accel_y", "accel_z", "temperature"):
         np.testing.assert_array_equal(comp[col], raw[col])
-    assert comp["gyro_z"].rolling(600).mean().dropna().pipe(np.ptp) < raw["gyro_z"].rolling(600).mean().dropna().pipe(np.ptp)
+    assert comp["gyro_z"].rolling(600).mean().dropna().pipe(np.ptp) < raw["gyro_z"].rolling(600).mean().dropna().pipe(
+        np.ptp
+    )
 
 
 def test_apply_parquet_and_turn_on_window(workdir):
@@ -44,9 +46,11 @@ def test_apply_refuses_an_axis_the_model_lacks_unless_axes_are_named(workdir, tm
     (tmp_path / "z.json").write_text(json.dumps(d))
     r = run("apply", tmp_path / "z.json", workdir / "run3.csv", "-o", tmp_path / "out.csv")
     assert r.returncode == 2 and not (tmp_path / "out.csv").exists()
-    assert r.stderr.strip() == (f"gyrocomp: error: {workdir / 'run3.csv'}: the model has no curve for gyro_x, gyro_y "
-                                "(it covers gyro_z); give --axes with the axes to compensate, the others are then "
-                                "left raw")
+    assert r.stderr.strip() == (
+        f"gyrocomp: error: {workdir / 'run3.csv'}: the model has no curve for gyro_x, gyro_y "
+        "(it covers gyro_z); give --axes with the axes to compensate, the others are then "
+        "left raw"
+    )
     r = run("apply", tmp_path / "z.json", workdir / "run3.csv", "-o", tmp_path / "out.csv", "--axes", "gyro_z")
     assert r.returncode == 0, r.stderr
     assert "gyro_x, gyro_y left raw (not among the axes to compensate)" in r.stderr
@@ -76,8 +80,9 @@ def test_apply_keeps_a_decimal_comma_and_its_separator(workdir, tmp_path):
 
     original = (workdir / "run3.csv").read_text().splitlines()
     header, rows = original[0], original[1:]
-    lines = [header.replace(",", ";") + ";note"] + [r.replace(",", ";").replace(".", ",") + (';"a;b"' if i == 1 else ";x")
-                                                   for i, r in enumerate(rows)]
+    lines = [header.replace(",", ";") + ";note"] + [
+        r.replace(",", ";").replace(".", ",") + (';"a;b"' if i == 1 else ";x") for i, r in enumerate(rows)
+    ]
     (tmp_path / "comma.csv").write_text("\n".join(lines) + "\n")
     for extra in ((), ("--time", "0:100000")):  # streamed, and read whole (rows selected by time)
         done = run("apply", workdir / "model.json", tmp_path / "comma.csv", "-o", tmp_path / "out.csv", *extra)
@@ -87,5 +92,6 @@ def test_apply_keeps_a_decimal_comma_and_its_separator(workdir, tmp_path):
         assert '"a;b"' in out[2]  # the one value that holds the separator, quoted
         reference = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "point.csv")
         assert reference.returncode == 0
-        np.testing.assert_allclose(read(tmp_path / "out.csv").gyro_dps, read(tmp_path / "point.csv").gyro_dps,
-                                   rtol=1e-12)
+        np.testing.assert_allclose(
+            read(tmp_path / "out.csv").gyro_dps, read(tmp_path / "point.csv").gyro_dps, rtol=1e-12
+        )

@@ -58,8 +58,12 @@ def test_progress_bar_on_a_terminal_only(report_files):
 
     def stderr_of(*extra):
         master, slave = pty.openpty()
-        done = subprocess.run([*cmd, *extra, "convert", str(d / "run2.csv"), str(d / "tty.parquet")],
-                               stdout=subprocess.PIPE, stderr=slave, timeout=300)
+        done = subprocess.run(
+            [*cmd, *extra, "convert", str(d / "run2.csv"), str(d / "tty.parquet")],
+            stdout=subprocess.PIPE,
+            stderr=slave,
+            timeout=300,
+        )
         os.close(slave)
         chunks = []
         while True:

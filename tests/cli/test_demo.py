@@ -15,8 +15,14 @@ def test_demo(tmp_path):
     r = run("demo", "-o", tmp_path / "demo")
     assert r.returncode == 0, r.stderr
     names = {p.name for p in (tmp_path / "demo").iterdir()}
-    assert {"model.json", "heldout_compensated.csv", "metrics.json", "heldout_run.csv", "effects.json",
-            "heldout_truth.json"} <= names
+    assert {
+        "model.json",
+        "heldout_compensated.csv",
+        "metrics.json",
+        "heldout_run.csv",
+        "effects.json",
+        "heldout_truth.json",
+    } <= names
     metrics = json.loads((tmp_path / "demo" / "metrics.json").read_text())
     assert all(a["offset_improvement"] > 1.0 for a in metrics["runs"][0]["axes"].values())
     assert "held-out run, raw vs compensated" in r.stdout
@@ -40,8 +46,11 @@ def test_demo(tmp_path):
     assert "held-out drift [deg/s]" in r.stdout and "gyrocomp default" in r.stdout and "PX4 cubic" in r.stdout
     by = {(s["method"], s["axis"]): s for s in validation["scores"]}
     axes = ("gyro_x", "gyro_y", "gyro_z")
-    mean = {m: np.mean([by[(m, a)][k] for a in axes]) for m in ("gyrocomp default", "cubic + run constants")
-            for k in ("mean_drift_dps",)}
+    mean = {
+        m: np.mean([by[(m, a)][k] for a in axes])
+        for m in ("gyrocomp default", "cubic + run constants")
+        for k in ("mean_drift_dps",)
+    }
     cubic_se = np.mean([by[("cubic + run constants", a)]["standard_error_dps"] for a in axes])
     assert mean["gyrocomp default"] <= mean["cubic + run constants"] + cubic_se
     assert all(by[("gyrocomp default", a)]["mean_drift_dps"] < by[("raw", a)]["mean_drift_dps"] for a in axes)
@@ -64,11 +73,11 @@ def test_demo(tmp_path):
     assert "report.html (open it in a browser)" in r.stdout
     # the page opens with the case where compensation matters, its factor against PX4's cubic read from the page
     # itself, every ratio written the same way round ("N x less drift than ...")
-    first = report[report.index("<section"):]
+    first = report[report.index("<section") :]
     assert first.startswith('<section id="case"><h2>Where compensation matters</h2>')
     opening = re.search(r"gyrocomp's default leaves <b>([0-9.]+)x less drift than PX4 cubic", first)
     assert opening and float(opening.group(1)) >= 5.0, first[:400]  # measured 12.1x
-    assert not re.search(r"\d\.\d+x (?!less drift than|more drift than)", report[:report.index('id="summary"')])
+    assert not re.search(r"\d\.\d+x (?!less drift than|more drift than)", report[: report.index('id="summary"')])
     # the case where gyrocomp's models matter, against the simulator's truth, and the one where they do not
     cases = json.loads((tmp_path / "demo" / "cases.json").read_text())
     matters, not_matters = cases
@@ -78,8 +87,10 @@ def test_demo(tmp_path):
     for case in cases:
         assert case["drift_dps"]["gyrocomp"] < case["drift_dps"]["raw"]
     assert "Where gyrocomp's models matter" in r.stdout and "Where they do not" in r.stdout
-    assert f"{matters['gyrocomp_factor_vs']['PX4 cubic (process_sensor_caldata.py)']:.1f}x less drift than PX4 cubic" \
+    assert (
+        f"{matters['gyrocomp_factor_vs']['PX4 cubic (process_sensor_caldata.py)']:.1f}x less drift than PX4 cubic"
         in r.stdout
+    )
     assert "case_consumer.png" in names
 
 

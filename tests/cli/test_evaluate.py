@@ -18,8 +18,16 @@ def test_evaluate_json_shape(workdir):
     run0 = data["runs"][0]
     assert set(run0) == {"file", "window_s", "axes"}
     assert run0["window_s"] >= 1.0
-    keys = {"bias_offset_raw_dps", "bias_offset_comp_dps", "offset_improvement", "bias_instability_raw_dph",
-            "bias_instability_comp_dph", "integration_time_raw_s", "integration_time_comp_s", "residual_rms_dps"}
+    keys = {
+        "bias_offset_raw_dps",
+        "bias_offset_comp_dps",
+        "offset_improvement",
+        "bias_instability_raw_dph",
+        "bias_instability_comp_dph",
+        "integration_time_raw_s",
+        "integration_time_comp_s",
+        "residual_rms_dps",
+    }
     for axis in ("gyro_x", "gyro_y", "gyro_z"):
         assert set(run0["axes"][axis]) == keys
         assert run0["axes"][axis]["offset_improvement"] > 1

@@ -33,8 +33,10 @@ def test_lag_needs_the_rate_and_the_cli_writes_a_folder(tmp_path):
 
 
 def test_export_prints_what_the_firmware_leaves_against_the_model(tmp_path):
-    runs = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=1,
-                     seed=s) for s in range(2)]
+    runs = [
+        simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=1, seed=s)
+        for s in range(2)
+    ]
     paths = []
     for k, sim in enumerate(runs):
         paths.append(tmp_path / f"c{k}.csv")

@@ -17,8 +17,16 @@ RAD = np.pi / 180.0
 def _log(path, n=4000, rate_hz=100.0, *, names=None, time_unit="us", si=True, sep="\t", seed=0):
     """A chamber log as another project writes it: time in us, gyro in rad/s, accelerometer in m/s^2, the
     temperature rising through 30 degC; gyro bias 0.1 + 0.01 (T - 25) deg/s on each axis."""
-    names = names or ["timestamp", "imu.gyro.x", "imu.gyro.y", "imu.gyro.z", "imu.acc.x", "imu.acc.y", "imu.acc.z",
-                      "imu.temperature"]
+    names = names or [
+        "timestamp",
+        "imu.gyro.x",
+        "imu.gyro.y",
+        "imu.gyro.z",
+        "imu.acc.x",
+        "imu.acc.y",
+        "imu.acc.z",
+        "imu.temperature",
+    ]
     rng = np.random.default_rng(seed)
     k = np.arange(n)
     temperature = 20.0 + 30.0 * k / n
@@ -27,8 +35,17 @@ def _log(path, n=4000, rate_hz=100.0, *, names=None, time_unit="us", si=True, se
     gyro_dps = 0.1 + 0.01 * (temperature - 25.0)[:, None] + 0.002 * rng.standard_normal((n, 3))
     accel_g = np.array([0.0, 0.0, 1.0]) + 0.001 * rng.standard_normal((n, 3))
     gyro, accel = (gyro_dps * RAD, accel_g * 9.80665) if si else (gyro_dps, accel_g)
-    rows = [sep.join([f"{time[i]:.0f}" if time_unit != "s" else f"{time[i]:.3f}", *(f"{v:.8g}" for v in gyro[i]),
-                      *(f"{v:.6g}" for v in accel[i]), f"{temperature[i]:.3f}"]) for i in range(n)]
+    rows = [
+        sep.join(
+            [
+                f"{time[i]:.0f}" if time_unit != "s" else f"{time[i]:.3f}",
+                *(f"{v:.8g}" for v in gyro[i]),
+                *(f"{v:.6g}" for v in accel[i]),
+                f"{temperature[i]:.3f}",
+            ]
+        )
+        for i in range(n)
+    ]
     path.write_text(sep.join(names) + "\n" + "\n".join(rows) + "\n")
     return path
 
@@ -64,9 +81,14 @@ def test_init_then_every_command_without_flags(tmp_path):
     # its header as one column)
     out = (tmp_path / "out.tsv").read_text().splitlines()
     assert out[0] == (tmp_path / first.name).read_text().splitlines()[0] and "\t" in out[1] and "," not in out[1]
-    for command in (("fit", "out.tsv", "-o", "again.json"), ("evaluate", "m.json", "out.tsv", "--json"),
-                    ("apply", "m.json", "out.tsv", "-o", "twice.tsv"), ("report", "m.json", "out.tsv", "-o", "o.html"),
-                    ("export", "m.json", "-o", "m.parm"), ("export", "m.json", "-o", "c")):  # the format by name
+    for command in (
+        ("fit", "out.tsv", "-o", "again.json"),
+        ("evaluate", "m.json", "out.tsv", "--json"),
+        ("apply", "m.json", "out.tsv", "-o", "twice.tsv"),
+        ("report", "m.json", "out.tsv", "-o", "o.html"),
+        ("export", "m.json", "-o", "m.parm"),
+        ("export", "m.json", "-o", "c"),
+    ):  # the format by name
         done = run(*command, cwd=tmp_path)
         assert done.returncode == 0 or (command[0] == "report" and "matplotlib" in done.stderr), (command, done.stderr)
     again = json.loads(run("evaluate", "m.json", "out.tsv", "--json", cwd=tmp_path).stdout)["runs"][0]["axes"]
@@ -80,10 +102,15 @@ def test_init_then_every_command_without_flags(tmp_path):
 
 
 def test_defaults_and_command_sections_apply_where_the_option_exists(tmp_path):
-    _log(tmp_path / "run.csv", names=["time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
-                                      "temperature"], time_unit="s", si=False, sep=",")
+    _log(
+        tmp_path / "run.csv",
+        names=["time", "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z", "temperature"],
+        time_unit="s",
+        si=False,
+        sep=",",
+    )
     assert run("fit", "run.csv", "-o", "m.json", cwd=tmp_path).returncode == 0
-    (tmp_path / "gyrocomp.toml").write_text('[defaults]\nwindow = 7.5\n\n[evaluate]\nturn-on-window = 20\n')
+    (tmp_path / "gyrocomp.toml").write_text("[defaults]\nwindow = 7.5\n\n[evaluate]\nturn-on-window = 20\n")
     evaluated = run("evaluate", "m.json", "run.csv", "--json", cwd=tmp_path)
     assert evaluated.returncode == 0, evaluated.stderr
     assert json.loads(evaluated.stdout)["runs"][0]["window_s"] == 7.5
@@ -93,13 +120,19 @@ def test_defaults_and_command_sections_apply_where_the_option_exists(tmp_path):
     assert json.loads(evaluated.stdout)["runs"][0]["window_s"] == 12
 
 
-@pytest.mark.parametrize("text, message", [
-    ("[read]\ngyro_units = 'rad/s'\n", r"gyrocomp.toml: \[read\] gyro-units: not a reading option"),
-    ("[fitt]\norder = 3\n", r"gyrocomp.toml: \[fitt\]: no such command"),
-    ("[evaluate]\nwindoww = 3\n", r"gyrocomp.toml: \[evaluate\] windoww: gyrocomp evaluate has no option --windoww"),
-    ("[read\n", r"gyrocomp.toml: not a readable TOML file"),
-    ("window = 3\n", r"gyrocomp.toml: window = ...: options go in \[read\], \[defaults\] or a command's section"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("[read]\ngyro_units = 'rad/s'\n", r"gyrocomp.toml: \[read\] gyro-units: not a reading option"),
+        ("[fitt]\norder = 3\n", r"gyrocomp.toml: \[fitt\]: no such command"),
+        (
+            "[evaluate]\nwindoww = 3\n",
+            r"gyrocomp.toml: \[evaluate\] windoww: gyrocomp evaluate has no option --windoww",
+        ),
+        ("[read\n", r"gyrocomp.toml: not a readable TOML file"),
+        ("window = 3\n", r"gyrocomp.toml: window = ...: options go in \[read\], \[defaults\] or a command's section"),
+    ],
+)
 def test_a_bad_project_file_is_refused_in_one_line(tmp_path, text, message):
     import re
 
@@ -134,16 +167,35 @@ def test_init_keeps_an_existing_file_and_refuses_what_it_cannot_read(tmp_path):
 def test_guessing_from_names_and_magnitudes(tmp_path):
     """Units from the magnitudes when the names do not say: ms time at 50 Hz, accelerometer in g, gyro then in
     deg/s; names like GyrZ, Temp; a name that says its unit wins over the magnitudes."""
-    path = _log(tmp_path / "v.csv", names=["Time", "GyrX", "GyrY", "GyrZ", "AccX", "AccY", "AccZ", "Temp"],
-                time_unit="ms", si=False, sep=";", rate_hz=50.0)
+    path = _log(
+        tmp_path / "v.csv",
+        names=["Time", "GyrX", "GyrY", "GyrZ", "AccX", "AccY", "AccZ", "Temp"],
+        time_unit="ms",
+        si=False,
+        sep=";",
+        rate_hz=50.0,
+    )
     guess = guess_layout(path)
     layout = guess.layout
-    assert layout.columns == {"time": "Time", "gyro_x": "GyrX", "gyro_y": "GyrY", "gyro_z": "GyrZ", "accel_x": "AccX",
-                              "accel_y": "AccY", "accel_z": "AccZ", "temperature": "Temp"}
+    assert layout.columns == {
+        "time": "Time",
+        "gyro_x": "GyrX",
+        "gyro_y": "GyrY",
+        "gyro_z": "GyrZ",
+        "accel_x": "AccX",
+        "accel_y": "AccY",
+        "accel_z": "AccZ",
+        "temperature": "Temp",
+    }
     assert (layout.time_unit, layout.accel_unit, layout.gyro_unit, layout.delimiter) == ("ms", "g", "deg/s", ";")
     assert any("50 Hz in ms" in r for r in guess.reasons)
-    named = _log(tmp_path / "n.csv", names=["time_s", "gyro_x_rad", "gyro_y_rad", "gyro_z_rad", "ax", "ay", "az",
-                                            "temperature"], time_unit="s", si=False, sep=",")
+    named = _log(
+        tmp_path / "n.csv",
+        names=["time_s", "gyro_x_rad", "gyro_y_rad", "gyro_z_rad", "ax", "ay", "az", "temperature"],
+        time_unit="s",
+        si=False,
+        sep=",",
+    )
     guess = guess_layout(named)
     assert guess.layout.gyro_unit == "rad/s" and guess.layout.time_unit == "s"
     assert guess.unused == ("ax", "ay", "az")

@@ -21,15 +21,23 @@ def test_learn_through_the_command_line(tmp_path):
     """gyrocomp learn on two logs; in two steps (--save-state, then --resume) the same model; apply takes it;
     a log without still data exits 2 in one line, writing nothing."""
     paths = []
-    for k, rec in enumerate((simulate("consumer", profile=get_profile("field", motion_seed=k), rate_hz=10.0, seed=80 + k,
-                                     unit=3).recording for k in range(2))):
+    for k, rec in enumerate(
+        (
+            simulate(
+                "consumer", profile=get_profile("field", motion_seed=k), rate_hz=10.0, seed=80 + k, unit=3
+            ).recording
+            for k in range(2)
+        )
+    ):
         paths.append(tmp_path / f"log{k}.csv")
         write_recording(rec, paths[-1])
     done = run("learn", *paths, "-o", tmp_path / "all.json")
     assert done.returncode == 0, done.stderr
     assert "logs replayed" in done.stdout and "learned: curve of degree 3" in done.stdout
-    assert run("-q", "learn", paths[0], "-o", tmp_path / "first.json", "--save-state",
-               tmp_path / "state.json").returncode == 0
+    assert (
+        run("-q", "learn", paths[0], "-o", tmp_path / "first.json", "--save-state", tmp_path / "state.json").returncode
+        == 0
+    )
     done = run("-q", "learn", paths[1], "--resume", tmp_path / "state.json", "-o", tmp_path / "second.json")
     assert done.returncode == 0, done.stderr
     one, two = (Calibration.load(tmp_path / n) for n in ("all.json", "second.json"))
@@ -38,12 +46,31 @@ def test_learn_through_the_command_line(tmp_path):
     assert run("-q", "apply", tmp_path / "all.json", paths[0], "-o", tmp_path / "out.csv").returncode == 0
     # the C export bakes a learner state's settings (here 2.5 degC bins) into gyrocomp_learn.c
     OnlineCalibrator(LearnerSettings(rate_hz=10.0, bin_width_degc=2.5)).save(tmp_path / "coarse.json")
-    done = run("-q", "export", tmp_path / "all.json", "--format", "c", "--rate", 10, "--learner",
-               tmp_path / "coarse.json", "-o", tmp_path / "c")
+    done = run(
+        "-q",
+        "export",
+        tmp_path / "all.json",
+        "--format",
+        "c",
+        "--rate",
+        10,
+        "--learner",
+        tmp_path / "coarse.json",
+        "-o",
+        tmp_path / "c",
+    )
     assert done.returncode == 0, done.stderr
     assert "BIN_WIDTH = 2.5," in (tmp_path / "c" / "gyrocomp_learn.c").read_text()
-    done = run("export", tmp_path / "all.json", "--format", "px4", "--learner", tmp_path / "coarse.json", "-o",
-               tmp_path / "x.params")
+    done = run(
+        "export",
+        tmp_path / "all.json",
+        "--format",
+        "px4",
+        "--learner",
+        tmp_path / "coarse.json",
+        "-o",
+        tmp_path / "x.params",
+    )
     assert done.returncode == 2 and "--learner" in done.stderr and not (tmp_path / "x.params").exists()
     moving = simulate("consumer", profile="tumble", rate_hz=10.0, duration_s=600, seed=1, unit=3).recording
     write_recording(moving, tmp_path / "moving.csv")
@@ -63,8 +90,11 @@ def test_a_state_is_saved_only_over_one_it_goes_on_from(tmp_path):
     resumed.save(tmp_path / "s2.json")
     kept = (tmp_path / "s2.json").read_text()
     for other in (OnlineCalibrator(LearnerSettings(rate_hz=10.0)), OnlineCalibrator.load(tmp_path / "s1.json")):
-        with pytest.raises(InputError, match=r"s2.json: holds another learner's state, one this learner does not go "
-                                             r"on from .* nothing written"):
+        with pytest.raises(
+            InputError,
+            match=r"s2.json: holds another learner's state, one this learner does not go "
+            r"on from .* nothing written",
+        ):
             other.save(tmp_path / "s2.json")
         assert (tmp_path / "s2.json").read_text() == kept
     OnlineCalibrator.load(tmp_path / "s2.json").save(tmp_path / "s1.json")  # s1 is an ancestor: replaced
@@ -81,15 +111,33 @@ def test_two_learners_resuming_one_state_at_once_never_lose_each_others_work(tmp
     overwriting; the state saved is the one that went on from s.json with its own log."""
     paths = []
     for k in range(3):
-        rec = simulate("consumer", profile=get_profile("field", motion_seed=k), rate_hz=10.0, seed=90 + k,
-                       unit=3).recording
+        rec = simulate(
+            "consumer", profile=get_profile("field", motion_seed=k), rate_hz=10.0, seed=90 + k, unit=3
+        ).recording
         paths.append(tmp_path / f"log{k}.csv")
         write_recording(rec, paths[-1])
     assert run("-q", "learn", paths[0], "-o", tmp_path / "m0.json", "--save-state", tmp_path / "s.json").returncode == 0
     command = [SCRIPT if SCRIPT.exists() else sys.executable, *([] if SCRIPT.exists() else ["-m", "gyrocomp"])]
-    learners = [subprocess.Popen([*map(str, command), "-q", "learn", str(paths[k]), "--resume", str(tmp_path / "s.json"),
-                                  "-o", str(tmp_path / f"m{k}.json"), "--save-state", str(tmp_path / "next.json")],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for k in (1, 2)]
+    learners = [
+        subprocess.Popen(
+            [
+                *map(str, command),
+                "-q",
+                "learn",
+                str(paths[k]),
+                "--resume",
+                str(tmp_path / "s.json"),
+                "-o",
+                str(tmp_path / f"m{k}.json"),
+                "--save-state",
+                str(tmp_path / "next.json"),
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for k in (1, 2)
+    ]
     results = [(learner.wait(timeout=300), learner.stderr.read()) for learner in learners]
     assert sorted(code for code, _ in results) == [0, 2], results
     saved = next(k for (code, _), k in zip(results, (1, 2)) if code == 0)

@@ -20,8 +20,9 @@ def test_noise_prints_the_model_and_writes_each_export(static_log, tmp_path):
     assert written.returncode == 0, written.stderr
     model = json.loads((tmp_path / "m.json").read_text())
     assert {"gyro_x", "gyro_z", "accel_x"} <= set(model["axes"]) and model["rate_hz"] == 20.0
-    largest = max(a["bound"]["white_noise_density_u_per_sqrt_hz"] for name, a in model["axes"].items()
-                  if name.startswith("gyro"))
+    largest = max(
+        a["bound"]["white_noise_density_u_per_sqrt_hz"] for name, a in model["axes"].items() if name.startswith("gyro")
+    )
     kalibr = run("noise", log, "--export", "kalibr", "-o", tmp_path / "imu.yaml", "--rostopic", "/imu")
     assert kalibr.returncode == 0, kalibr.stderr
     text = (tmp_path / "imu.yaml").read_text()
@@ -35,8 +36,11 @@ def test_noise_prints_the_model_and_writes_each_export(static_log, tmp_path):
 def test_noise_options_are_checked_and_nothing_is_written(static_log, tmp_path):
     log = static_log / "s.csv"
     alone = run("noise", log, "--export", "kalibr")
-    assert alone.returncode == 2 and alone.stderr.strip().splitlines()[-1].startswith("gyrocomp: error:") \
+    assert (
+        alone.returncode == 2
+        and alone.stderr.strip().splitlines()[-1].startswith("gyrocomp: error:")
         and "give --export and -o together" in alone.stderr
+    )
     vins = run("noise", log, "--axes", "gyro_x", "--export", "vins", "-o", tmp_path / "v.yaml")
     assert vins.returncode == 2 and "export vins: the logs have no accelerometer axes" in vins.stderr
     assert not (tmp_path / "v.yaml").exists()
@@ -45,11 +49,25 @@ def test_noise_options_are_checked_and_nothing_is_written(static_log, tmp_path):
 
 
 def test_noise_of_a_chamber_runs_dwells(tmp_path):
-    made = run("simulate", "--profile", "chamber", "--set-points", "-20,25,70", "--dwell", 1200, "--rate", 10,
-               "--axes", "z", "-o", tmp_path / "ch.csv")
+    made = run(
+        "simulate",
+        "--profile",
+        "chamber",
+        "--set-points",
+        "-20,25,70",
+        "--dwell",
+        1200,
+        "--rate",
+        10,
+        "--axes",
+        "z",
+        "-o",
+        tmp_path / "ch.csv",
+    )
     assert made.returncode == 0, made.stderr
-    done = run("noise", tmp_path / "ch.csv", "--dwells", "--axes", "gyro_z", "--export", "json",
-               "-o", tmp_path / "m.json")
+    done = run(
+        "noise", tmp_path / "ch.csv", "--dwells", "--axes", "gyro_z", "--export", "json", "-o", tmp_path / "m.json"
+    )
     assert done.returncode == 0, done.stderr
     logs = json.loads((tmp_path / "m.json").read_text())["axes"]["gyro_z"]["logs"]
     assert [round(log["temperature_degc"]) for log in logs] == [-20, 25, 70]
@@ -58,13 +76,24 @@ def test_noise_of_a_chamber_runs_dwells(tmp_path):
 
 @pytest.mark.slow
 def test_noise_with_a_model_says_what_compensation_buys(tmp_path):
-    made = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 2, "--runs", 3,
-               "-o", tmp_path / "c.csv")
+    made = run(
+        "simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 2, "--runs", 3, "-o", tmp_path / "c.csv"
+    )
     assert made.returncode == 0, made.stderr
     fitted = run("fit", tmp_path / "c_0.csv", tmp_path / "c_1.csv", "-o", tmp_path / "m.json")
     assert fitted.returncode == 0, fitted.stderr
-    done = run("noise", tmp_path / "c_2.csv", "--model", tmp_path / "m.json", "--axes", "gyro_z",
-               "--export", "json", "-o", tmp_path / "n.json")
+    done = run(
+        "noise",
+        tmp_path / "c_2.csv",
+        "--model",
+        tmp_path / "m.json",
+        "--axes",
+        "gyro_z",
+        "--export",
+        "json",
+        "-o",
+        tmp_path / "n.json",
+    )
     assert done.returncode == 0, done.stderr
     assert "the bias random walk a filter needs" in done.stdout and "raw / compensated" in done.stdout
     ratio = float(done.stdout.split("gyro_z", 2)[2].split("│")[3])

@@ -19,8 +19,19 @@ def test_mapping_and_units_through_cli(workdir, tmp_path):
     df = pd.read_csv(workdir / "run3.csv")
     vendor = pd.DataFrame({"Stamp": df["time"] * 1000, "GyrZ": np.deg2rad(df["gyro_z"]), "T": df["temperature"]})
     vendor.to_csv(tmp_path / "vendor.csv", index=False)
-    r = run("apply", workdir / "model.json", tmp_path / "vendor.csv", "-o", tmp_path / "v_out.csv",
-            "--columns", "time=Stamp,gyro_z=GyrZ,temperature=T", "--gyro-unit", "rad/s", "--time-unit", "ms")
+    r = run(
+        "apply",
+        workdir / "model.json",
+        tmp_path / "vendor.csv",
+        "-o",
+        tmp_path / "v_out.csv",
+        "--columns",
+        "time=Stamp,gyro_z=GyrZ,temperature=T",
+        "--gyro-unit",
+        "rad/s",
+        "--time-unit",
+        "ms",
+    )
     assert r.returncode == 0, r.stderr
     ours = pd.read_csv(tmp_path / "v_out.csv")
     theirs = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "d_out.csv")
@@ -54,24 +65,27 @@ def test_every_command_that_reads_data_has_the_reading_options_of_the_library():
             reading = {o.name: max(o.opts, key=len) for o in options if isinstance(o, ReadingOption)}
             if reading:
                 readers += 1
-                assert reading == {"fmt": "--format",
-                                   **{f.name: s.flag for f, s in spelled_fields(ReadOptions)}}, cmd.name
+                assert reading == {"fmt": "--format", **{f.name: s.flag for f, s in spelled_fields(ReadOptions)}}, (
+                    cmd.name
+                )
     assert readers >= 10
     assert {n: f for n, f in flags_by_name.items() if len(f) > 1} == {}
     assert flags_by_name["drop_nonfinite"] == {"--drop-nan"} and flags_by_name["time_range_s"] == {"--time"}
 
 
 def test_a_bad_reading_option_is_one_line_naming_the_flag(workdir, tmp_path):
-    for flag, value, said in [("--time", "1:x", "--time: '1:x': give A:B"),
-                              ("--instance", "all", "--instance: all is for gyrocomp fit"),
-                              ("--device-id", "-3", "--device-id: -3: give a whole number >= 0")]:
+    for flag, value, said in [
+        ("--time", "1:x", "--time: '1:x': give A:B"),
+        ("--instance", "all", "--instance: all is for gyrocomp fit"),
+        ("--device-id", "-3", "--device-id: -3: give a whole number >= 0"),
+    ]:
         r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv", flag, value)
         assert r.returncode == 2 and r.stderr.strip().startswith(f"gyrocomp: error: {said}"), r.stderr
         assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "o.csv").exists()
 
 
 def test_the_project_file_read_section_takes_the_reading_options_of_the_command(workdir, tmp_path):
-    (tmp_path / "gyrocomp.toml").write_text('[read]\ndrop-nan = true\nwindoww = 3\n')
+    (tmp_path / "gyrocomp.toml").write_text("[read]\ndrop-nan = true\nwindoww = 3\n")
     r = run("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv", cwd=tmp_path)
     assert r.returncode == 2 and "[read] windoww: not a reading option; use accel-unit, columns" in r.stderr
 
@@ -84,9 +98,11 @@ def test_the_project_file_in_use_is_named_once_with_what_it_sets(workdir, tmp_pa
     args = ("apply", workdir / "model.json", workdir / "run3.csv", "-o", tmp_path / "o.csv")
     r = run(*args, cwd=tmp_path)
     notes = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: note:")]
-    assert r.returncode == 0 and notes == ["gyrocomp: note: gyrocomp.toml sets --axes, --drop-nan (an "
-                                           "option on the command line wins; gyrocomp config show prints the "
-                                           "file)"], r.stderr
+    assert r.returncode == 0 and notes == [
+        "gyrocomp: note: gyrocomp.toml sets --axes, --drop-nan (an "
+        "option on the command line wins; gyrocomp config show prints the "
+        "file)"
+    ], r.stderr
     r = run(*args, "--no-drop-nan", "--axes", "gyro_z", cwd=tmp_path)
     assert r.returncode == 0 and "gyrocomp: note" not in r.stderr, r.stderr
     assert "gyrocomp: note" not in run("-q", *args, cwd=tmp_path).stderr
@@ -98,4 +114,5 @@ def test_a_project_file_cannot_switch_on_what_the_command_line_could_not_switch_
     r = run("allan", workdir / "run3.csv", cwd=tmp_path)
     assert r.returncode == 2 and r.stderr.strip() == (
         "gyrocomp: error: gyrocomp.toml: json = true: a switch the command line could not turn off again; give "
-        "--json when running gyrocomp allan"), r.stderr
+        "--json when running gyrocomp allan"
+    ), r.stderr

@@ -14,8 +14,12 @@ from ..conftest import run
 
 @pytest.mark.slow
 def test_show_names_the_axes_the_device_ids_and_the_expected_drift(tmp_path):
-    runs = [simulate("consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 70.0), cycles=1), rate_hz=1,
-                     seed=s).recording for s in range(2)]
+    runs = [
+        simulate(
+            "consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 70.0), cycles=1), rate_hz=1, seed=s
+        ).recording
+        for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs)

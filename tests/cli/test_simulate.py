@@ -23,8 +23,26 @@ def test_simulate_writes_data_and_truth(workdir):
 
 
 def test_simulate_runs_with_truth_columns_that_add_up(tmp_path):
-    r = run("simulate", "--preset", "adxrs450", "--profile", "cycle", "--duration", 3600, "--rate", 2, "--runs", 3,
-            "--seed", 10, "-o", tmp_path / "cyc.csv", "--truth", tmp_path / "truth.json", "--truth-columns")
+    r = run(
+        "simulate",
+        "--preset",
+        "adxrs450",
+        "--profile",
+        "cycle",
+        "--duration",
+        3600,
+        "--rate",
+        2,
+        "--runs",
+        3,
+        "--seed",
+        10,
+        "-o",
+        tmp_path / "cyc.csv",
+        "--truth",
+        tmp_path / "truth.json",
+        "--truth-columns",
+    )
     assert r.returncode == 0, r.stderr
     assert [p.name for p in sorted(tmp_path.glob("cyc_*.csv"))] == ["cyc_0.csv", "cyc_1.csv", "cyc_2.csv"]
     truth = json.loads((tmp_path / "truth.json").read_text())
@@ -34,8 +52,15 @@ def test_simulate_runs_with_truth_columns_that_add_up(tmp_path):
     assert truth["error_model"]["hysteresis"]["band_degc"] == [55.0, 80.0]
     for i in range(3):
         df = pd.read_csv(tmp_path / f"cyc_{i}.csv")
-        assert list(df.columns) == ["time", "gyro_z", "temperature", "true_error_gyro_z", "true_noise_gyro_z",
-                                    "true_rate_gyro_z", "true_structure_temperature"]
+        assert list(df.columns) == [
+            "time",
+            "gyro_z",
+            "temperature",
+            "true_error_gyro_z",
+            "true_noise_gyro_z",
+            "true_rate_gyro_z",
+            "true_structure_temperature",
+        ]
         rebuilt = df["true_rate_gyro_z"] + df["true_error_gyro_z"] + df["true_noise_gyro_z"]
         np.testing.assert_allclose(df["gyro_z"], rebuilt, rtol=0, atol=1e-12)
         # the quantized output: whole multiples of the ADXRS450's 1/80 deg/s LSB

@@ -31,10 +31,12 @@ def test_a_tables_runs_keep_its_columns_units_and_separator(tmp_path):
     joined = joined_recordings(parts, 120.0)
     lines = ["Zeit;GyrX;GyrY;GyrZ;Temp"] + [
         ";".join(f"{v:.6f}".replace(".", ",") for v in (t, *np.radians(g), temp))
-        for t, g, temp in zip(joined.time_s, joined.gyro_dps, joined.temperature_degc)]
+        for t, g, temp in zip(joined.time_s, joined.gyro_dps, joined.temperature_degc)
+    ]
     (tmp_path / "log.txt").write_text("\n".join(lines) + "\n")
-    (tmp_path / "gyrocomp.toml").write_text('[read]\ncolumns = "time=Zeit,gyro_x=GyrX,gyro_y=GyrY,gyro_z=GyrZ,'
-                                            'temperature=Temp"\ngyro-unit = "rad/s"\n')
+    (tmp_path / "gyrocomp.toml").write_text(
+        '[read]\ncolumns = "time=Zeit,gyro_x=GyrX,gyro_y=GyrY,gyro_z=GyrZ,temperature=Temp"\ngyro-unit = "rad/s"\n'
+    )
     done = run("split", "log.txt", "-o", "runs", "--by", "power-on", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     first = (tmp_path / "runs" / "log_run1.csv").read_text().splitlines()
@@ -48,5 +50,7 @@ def test_a_tables_runs_keep_its_columns_units_and_separator(tmp_path):
 def _layout():
     from gyrocomp.io import TableLayout
 
-    return TableLayout(columns={"time": "Zeit", "gyro_x": "GyrX", "gyro_y": "GyrY", "gyro_z": "GyrZ",
-                                "temperature": "Temp"}, gyro_unit="rad/s")
+    return TableLayout(
+        columns={"time": "Zeit", "gyro_x": "GyrX", "gyro_y": "GyrY", "gyro_z": "GyrZ", "temperature": "Temp"},
+        gyro_unit="rad/s",
+    )

@@ -14,8 +14,14 @@ def test_validate_prints_every_method_and_json_holds_the_folds(workdir):
     assert out.returncode == 0, out.stderr
     result = json.loads(out.stdout)
     assert result["fold_kind"] == "runs" and len(result["folds"]) == 3
-    assert result["methods"] == ["raw", "PX4 cubic", "ArduPilot cubic", "cubic + run constants", "gyrocomp default",
-                                 "gyrocomp for firmware"]
+    assert result["methods"] == [
+        "raw",
+        "PX4 cubic",
+        "ArduPilot cubic",
+        "cubic + run constants",
+        "gyrocomp default",
+        "gyrocomp for firmware",
+    ]
     means = result["mean_over_axes_dps"]
     # chamber runs with a strong tempco: every model beats the raw output
     assert all(means[m] < means["raw"] for m in result["methods"] if m != "raw")

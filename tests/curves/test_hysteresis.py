@@ -29,7 +29,7 @@ def test_curve_offset_is_the_branch_polynomial_in_the_distance_from_the_turn():
     assert np.all(first == 0.0)
     confirmed = temperature[601:1201] < 80 - 0.5  # the reversal counts once T is the threshold past the extreme
     d = 80.0 - temperature[601:1201][confirmed]
-    np.testing.assert_allclose(cooling[confirmed], 0.01 * d - 2e-4 * d ** 2, rtol=1e-12)
+    np.testing.assert_allclose(cooling[confirmed], 0.01 * d - 2e-4 * d**2, rtol=1e-12)
     assert np.all(cooling[~confirmed] == 0.0)
     rising = temperature[1201:] > 20 + 0.5
     np.testing.assert_allclose(heating[rising], -0.005 * (temperature[1201:][rising] - 20.0), rtol=1e-12)
@@ -53,8 +53,12 @@ def test_curve_dict_round_trip_and_errors():
 def test_heats_and_cools_needs_both_directions_over_the_runs():
     def run(temperature):
         n = temperature.size
-        return Recording(time_s=np.arange(n, dtype=float), gyro_dps=np.zeros((n, 1)), gyro_axes=("gyro_z",),
-                         temperature_degc=temperature)
+        return Recording(
+            time_s=np.arange(n, dtype=float),
+            gyro_dps=np.zeros((n, 1)),
+            gyro_axes=("gyro_z",),
+            temperature_degc=temperature,
+        )
 
     heating, cooling = run(np.linspace(20, 60, 500)), run(np.linspace(60, 20, 500))
     assert not heats_and_cools([heating], "gyro_z") and not heats_and_cools([cooling], "gyro_z")

@@ -31,20 +31,23 @@ def _run(seed, lo, hi, hours=1.0, rate_hz=1.0):
     t = np.arange(n) / rate_hz
     temp = (lo + hi) / 2 - (hi - lo) / 2 * np.cos(2 * np.pi * t / t[-1])
     gyro = kink(temp) + rng.normal(0.0, 0.05) + rng.normal(0.0, 0.003, n)
-    return Recording(time_s=t, gyro_dps=gyro[:, None], gyro_axes=("gyro_z",), temperature_degc=temp,
-                     source=f"kink{seed}")
+    return Recording(
+        time_s=t, gyro_dps=gyro[:, None], gyro_axes=("gyro_z",), temperature_degc=temp, source=f"kink{seed}"
+    )
 
 
 def test_the_table_interpolates_and_holds_past_its_ends():
     table = LookupTableCurve((0.0, 1.0, 0.5), 0.0, 20.0)
-    np.testing.assert_allclose(table.shape(np.array([-5.0, 0.0, 5.0, 10.0, 15.0, 20.0, 30.0])),
-                               [0.0, 0.0, 0.5, 1.0, 0.75, 0.5, 0.5])
+    np.testing.assert_allclose(
+        table.shape(np.array([-5.0, 0.0, 5.0, 10.0, 15.0, 20.0, 30.0])), [0.0, 0.0, 0.5, 1.0, 0.75, 0.5, 0.5]
+    )
     assert isinstance(table, TemperatureCurve) and table.order == "table:2" and table.label == "table:2"
     assert table.describe() == "lookup table, 3 points 10 degC apart"
     sloped = table.plus_slope(0.01)  # + 0.01 (T - 0)
     np.testing.assert_allclose(sloped.shape(np.array([10.0, 20.0])), [1.1, 0.7])
-    assert table.clamped() is table and table.outside_range(np.array([25.0])) and not table.outside_range(
-        np.array([20.1]))
+    assert (
+        table.clamped() is table and table.outside_range(np.array([25.0])) and not table.outside_range(np.array([20.1]))
+    )
 
 
 def test_the_basis_columns_are_the_table():
@@ -66,7 +69,9 @@ def test_model_files_store_and_check_the_table(tmp_path):
         curve_from_dict({"type": "table", "values_dps": [0.0, "x"], "t_min_degc": 0.0, "t_max_degc": 1.0})
     with pytest.raises(InputError, match="lookup table: at least 2 values"):
         curve_from_dict({"type": "table", "values_dps": [0.0], "t_min_degc": 0.0, "t_max_degc": 1.0})
-    with pytest.raises(InputError, match=rf"unknown temperature model type 'spline'; known: {', '.join(sorted(CURVES))}$"):
+    with pytest.raises(
+        InputError, match=rf"unknown temperature model type 'spline'; known: {', '.join(sorted(CURVES))}$"
+    ):
         curve_from_dict({"type": "spline"})
 
 

@@ -8,7 +8,7 @@ from gyrocomp.curves.polynomial import polynomial_columns, power_columns
 
 
 @settings(max_examples=60, deadline=None)
-@given(first=st.integers(0, 3), count=st.integers(0, 6), seed=st.integers(0, 2 ** 16), n=st.integers(0, 50))
+@given(first=st.integers(0, 3), count=st.integers(0, 6), seed=st.integers(0, 2**16), n=st.integers(0, 50))
 def test_power_columns_are_the_integer_powers(first, count, seed, n):
     u = np.random.default_rng(seed).uniform(-1.5, 1.5, n)
     got = power_columns(u, first, first + count - 1)

@@ -34,8 +34,11 @@ def test_the_raw_gyro_needs_far_more_bias_process_noise_than_the_compensated(con
     rec = held_out.recording
     for j, (name, b) in enumerate(benefit.items()):
         noise = held_out.truth.noise.total_dps[:, j]
-        alone = bound_noise(allan_deviation(noise - noise.mean(), rec.rate_hz), markov=False,
-                            max_tau_s=MAX_TAU_FRACTION * rec.time_s[-1]).random_walk
+        alone = bound_noise(
+            allan_deviation(noise - noise.mean(), rec.rate_hz),
+            markov=False,
+            max_tau_s=MAX_TAU_FRACTION * rec.time_s[-1],
+        ).random_walk
         assert b.random_walk_ratio > 10, name
         assert 0.8 * alone <= b.compensated.random_walk <= 1.5 * alone, name
 

@@ -48,9 +48,11 @@ def test_leave_one_run_out_table_has_every_method_and_hysteresis_helps(cycles):
 
 
 def test_one_run_is_scored_on_itself_and_says_so(cycles):
-    result = compare_methods([cycles[0].recording], methods={"polynomial": FitOptions(temperature=Polynomial(2),
-                                                                                           hysteresis="none")},
-                             window_s=100.0)
+    result = compare_methods(
+        [cycles[0].recording],
+        methods={"polynomial": FitOptions(temperature=Polynomial(2), hysteresis="none")},
+        window_s=100.0,
+    )
     assert "fitted and scored on the same run" in result.how
     assert [r.method for r in result.rows] == ["raw", "polynomial"]
     with pytest.raises(InputError, match="compare: give at least one run"):
@@ -61,8 +63,23 @@ def test_one_run_is_scored_on_itself_and_says_so(cycles):
 
 @pytest.mark.slow
 def test_cli_compare(tmp_path):
-    r = run("simulate", "--preset", "adxrs450", "--profile", "cycle", "--cycles", 1, "--rate", 1, "--runs", 2,
-            "--duration", 6000, "-o", tmp_path / "c.csv")
+    r = run(
+        "simulate",
+        "--preset",
+        "adxrs450",
+        "--profile",
+        "cycle",
+        "--cycles",
+        1,
+        "--rate",
+        1,
+        "--runs",
+        2,
+        "--duration",
+        6000,
+        "-o",
+        tmp_path / "c.csv",
+    )
     assert r.returncode == 0, r.stderr
     r = run("evaluate", "--compare", tmp_path / "c_0.csv", tmp_path / "c_1.csv", "--window", 60, "--json")
     assert r.returncode == 0, r.stderr
@@ -80,15 +97,16 @@ def test_cli_compare(tmp_path):
 def _cubic_run(temperature_degc, rate_hz=10.0):
     """A run whose gyro is exactly 0.02 + 1e-3 d - 2e-5 d^2 + 3e-7 d^3 [deg/s], d = T - 30, no noise."""
     d = temperature_degc - 30.0
-    gyro = 0.02 + 1e-3 * d - 2e-5 * d ** 2 + 3e-7 * d ** 3
+    gyro = 0.02 + 1e-3 * d - 2e-5 * d**2 + 3e-7 * d**3
     n = temperature_degc.size
-    return Recording(time_s=np.arange(n) / rate_hz, gyro_dps=gyro[:, None], gyro_axes=("gyro_z",),
-                     temperature_degc=temperature_degc)
+    return Recording(
+        time_s=np.arange(n) / rate_hz, gyro_dps=gyro[:, None], gyro_axes=("gyro_z",), temperature_degc=temperature_degc
+    )
 
 
 def _expected(temperature_degc):
     d = np.clip(temperature_degc, -20.0, 80.0) - 30.0
-    return 1e-3 * d - 2e-5 * d ** 2 + 3e-7 * d ** 3
+    return 1e-3 * d - 2e-5 * d**2 + 3e-7 * d**3
 
 
 def test_autopilot_cubics_recover_an_exact_cubic_and_clamp_like_the_firmware():

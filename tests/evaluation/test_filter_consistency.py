@@ -48,7 +48,7 @@ def test_a_gauss_markov_term_the_truth_has_is_carried(white_and_walk):
     sigma, tau = 0.01, 60.0
     steps = errors.shape[1]
     phi = np.exp(-1.0 / (RATE_HZ * tau))
-    drive = np.random.default_rng(2).standard_normal((RUNS, steps)) * sigma * np.sqrt(1 - phi ** 2)
+    drive = np.random.default_rng(2).standard_normal((RUNS, steps)) * sigma * np.sqrt(1 - phi**2)
     markov = np.empty_like(drive)
     markov[:, 0] = np.random.default_rng(3).standard_normal(RUNS) * sigma
     for i in range(1, steps):
@@ -72,8 +72,13 @@ def test_a_filter_told_the_noise_at_each_temperature_is_consistent_where_one_con
     temperature = np.linspace(0.0, 60.0, n)
     density = 0.02 * (1.0 + temperature / 60.0)
     errors = np.random.default_rng(4).standard_normal((RUNS, n)) * density * np.sqrt(RATE_HZ)
-    scheduled = attitude_nees(errors, RATE_HZ, _told(0.04, 1e-9), temperature_degc=temperature,
-                              schedule=lambda t: _told(0.02 * (1.0 + t / 60.0), 1e-9))
+    scheduled = attitude_nees(
+        errors,
+        RATE_HZ,
+        _told(0.04, 1e-9),
+        temperature_degc=temperature,
+        schedule=lambda t: _told(0.02 * (1.0 + t / 60.0), 1e-9),
+    )
     assert np.median(scheduled.nees) == pytest.approx(1.0, abs=0.05)
     constant = attitude_nees(errors, RATE_HZ, _told(0.04, 1e-9))
     assert np.median(constant.nees) < constant.band[0]

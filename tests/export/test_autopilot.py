@@ -44,11 +44,13 @@ def px4_offset_rad_s(p, instance, axis, temperature, sensor="G"):
     """PX4: offset = X0 + X1 d + X2 d^2 + X3 d^3, d = clip(T, TMIN, TMAX) - TREF (sensor G gyro, A accel)."""
     g = f"TC_{sensor}{instance}_"
     d = np.clip(temperature, p[g + "TMIN"], p[g + "TMAX"]) - p[g + "TREF"]
-    return sum(p[f"{g}X{k}_{axis}"] * d ** k for k in range(4))
+    return sum(p[f"{g}X{k}_{axis}"] * d**k for k in range(4))
 
 
 def _read_ardupilot(text):
-    return {name: float(value) for name, value in (line.split() for line in text.splitlines() if not line.startswith("#"))}
+    return {
+        name: float(value) for name, value in (line.split() for line in text.splitlines() if not line.startswith("#"))
+    }
 
 
 def ardupilot_correction_rad_s(p, instance, axis, temperature, cal_temp, sensor="GYR"):
@@ -110,7 +112,9 @@ def test_terms_the_autopilots_lack_are_named():
     with pytest.raises(InputError, match=r"instance: PX4 has thermal compensation for gyros 0..3, got 7"):
         px4_params_file(cal, instance=7, device_id=3)
     flat = fit_calibration(runs, temperature=None)
-    with pytest.raises(InputError, match="export: the model has no gyro or accelerometer axis with a temperature curve"):
+    with pytest.raises(
+        InputError, match="export: the model has no gyro or accelerometer axis with a temperature curve"
+    ):
         px4_params_file(flat, device_id=3)
 
 
@@ -139,7 +143,8 @@ def test_cli_export(tmp_path):
     named = ", ".join(f"{s} ({n})" for n in offered for s in EXPORTERS[n].suffixes)
     assert r.returncode == 2 and r.stderr.strip() == (
         f"gyrocomp: error: --format: not given, and 'x.slx' names none; give it ({', '.join(offered)}), or name the "
-        f"file {named}, or a folder without a suffix (c)")
+        f"file {named}, or a folder without a suffix (c)"
+    )
     assert ".params (px4), .parm (ardupilot), .param (ardupilot)" in named
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "m.json")
     assert r.returncode == 2 and "this is an input file" in r.stderr
@@ -149,9 +154,11 @@ def test_px4_export_without_a_device_id_is_refused_naming_where_to_find_it(tmp_p
     _model(3).save(tmp_path / "m.json")
     r = run("export", tmp_path / "m.json", "--format", "px4", "-o", tmp_path / "tc.params")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and not (tmp_path / "tc.params").exists()
-    assert ("no gyro device id (PX4 applies TC_Gn_* only to the sensor whose device id matches, so 0 does nothing); "
-            "give --device-id ID: find it in the ULog's sensor_gyro topic, with 'listener sensor_gyro' on the vehicle, "
-            "or in the CAL_GYRO0_ID parameter") in r.stderr
+    assert (
+        "no gyro device id (PX4 applies TC_Gn_* only to the sensor whose device id matches, so 0 does nothing); "
+        "give --device-id ID: find it in the ULog's sensor_gyro topic, with 'listener sensor_gyro' on the vehicle, "
+        "or in the CAL_GYRO0_ID parameter"
+    ) in r.stderr
     with pytest.raises(InputError, match=r"device_id: a PX4 device id is a positive 32-bit number, got 0"):
         px4_params_file(_model(3), device_id=0)
 
@@ -172,7 +179,10 @@ def test_accelerometer_parameters_reproduce_the_accelerometer_model():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_channels(runs, ("gyro", "accel"), options=FitOptions(temperature=Polynomial(3), hysteresis="none"))
-        px4, ardu = _read_px4(px4_params_file(cal, device_id=5, accel_device_id=6)), _read_ardupilot(ardupilot_params_file(cal))
+        px4, ardu = (
+            _read_px4(px4_params_file(cal, device_id=5, accel_device_id=6)),
+            _read_ardupilot(ardupilot_params_file(cal)),
+        )
     assert px4["TC_A_ENABLE"] == 1 and px4["TC_G_ENABLE"] == 1
     reference = cal.accel_reference_degc
     assert px4["TC_A0_TREF"] == pytest.approx(reference, abs=1e-4)
@@ -201,10 +211,10 @@ def test_accelerometer_offsets_and_scales_from_a_multi_position_calibration(tmp_
         ardu = _read_ardupilot(ardupilot_params_file(cal, instance=2))
     raw = np.array([p.accel_g for p in find_poses(rec)])
     ours = triad.correct(raw) * G0
-    for offsets, scales in ((np.array([px4[f"CAL_ACC0_{a}OFF"] for a in "XYZ"]),
-                             np.array([px4[f"CAL_ACC0_{a}SCALE"] for a in "XYZ"])),
-                            (np.array([ardu[f"INS_ACC2OFFS_{a}"] for a in "XYZ"]),
-                             np.array([ardu[f"INS_ACC2SCAL_{a}"] for a in "XYZ"]))):
+    for offsets, scales in (
+        (np.array([px4[f"CAL_ACC0_{a}OFF"] for a in "XYZ"]), np.array([px4[f"CAL_ACC0_{a}SCALE"] for a in "XYZ"])),
+        (np.array([ardu[f"INS_ACC2OFFS_{a}"] for a in "XYZ"]), np.array([ardu[f"INS_ACC2SCAL_{a}"] for a in "XYZ"])),
+    ):
         theirs = (raw * G0 - offsets) * scales
         assert np.max(np.abs(theirs - ours)) < 2 * off_diagonal * G0 + 1e-5  # float32 in the PX4 file
     # the accelerometer's own id, not the gyro's (separate dies: BMI055, SCHA63T)
@@ -212,7 +222,9 @@ def test_accelerometer_offsets_and_scales_from_a_multi_position_calibration(tmp_
     cal.save(tmp_path / "accel.json")
     r = run("export", tmp_path / "accel.json", "--format", "ardupilot", "-o", tmp_path / "acc.parm")
     assert r.returncode == 0, r.stderr
-    assert _read_ardupilot((tmp_path / "acc.parm").read_text())["INS_ACCOFFS_X"] == pytest.approx(ardu["INS_ACC2OFFS_X"])
+    assert _read_ardupilot((tmp_path / "acc.parm").read_text())["INS_ACCOFFS_X"] == pytest.approx(
+        ardu["INS_ACC2OFFS_X"]
+    )
     assert Calibration.load(tmp_path / "accel.json").accel_triad == triad
 
 
@@ -253,16 +265,25 @@ def test_a_logs_installed_calibration_is_read_from_its_parameters(tmp_path):
     model = _model(3)
     params = px4_parameters(model, instance=0, device_id=5, accel_device_id=6).values
     n = 2000
-    temperature = np.linspace(model.axes["gyro_x"].temperature.t_min_degc,
-                              model.axes["gyro_x"].temperature.t_max_degc, n)
-    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 100_000).astype(np.uint64)),
-              "device_id": ("uint32_t", np.full(n, 5, np.uint32)),
-              "temperature": ("float", temperature.astype(np.float32))}
+    temperature = np.linspace(
+        model.axes["gyro_x"].temperature.t_min_degc, model.axes["gyro_x"].temperature.t_max_degc, n
+    )
+    fields = {
+        "timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 100_000).astype(np.uint64)),
+        "device_id": ("uint32_t", np.full(n, 5, np.uint32)),
+        "temperature": ("float", temperature.astype(np.float32)),
+    }
     for j, axis in enumerate("xyz"):
         fields[axis] = ("float", px4_offset_rad_s(params, 0, j, temperature).astype(np.float32))
-    write_ulog(tmp_path / "tc.ulg", {("sensor_gyro", 0): fields},
-               parameters={k: (int(v) if k.endswith(("ENABLE", "_ID")) else float(v)) for k, v in params.items()
-                           if k.startswith("TC_G")})
+    write_ulog(
+        tmp_path / "tc.ulg",
+        {("sensor_gyro", 0): fields},
+        parameters={
+            k: (int(v) if k.endswith(("ENABLE", "_ID")) else float(v))
+            for k, v in params.items()
+            if k.startswith("TC_G")
+        },
+    )
     rec = read(tmp_path / "tc.ulg")
     installed = installed_calibration(rec.metadata["autopilot_parameters"], "px4")
     assert np.max(np.abs(apply(installed, rec).gyro_dps)) < 1e-4  # float32 logging, nothing else left
@@ -287,14 +308,17 @@ def test_evaluate_installed_judges_the_autopilots_calibration_against_the_model(
     curve = model.axes["gyro_x"].temperature
     temperature = np.linspace(curve.t_min_degc, curve.t_max_degc, n)
     rng = np.random.default_rng(3)
-    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 200_000).astype(np.uint64)),
-              "device_id": ("uint32_t", np.full(n, 5, np.uint32)),
-              "temperature": ("float", temperature.astype(np.float32))}
+    fields = {
+        "timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 200_000).astype(np.uint64)),
+        "device_id": ("uint32_t", np.full(n, 5, np.uint32)),
+        "temperature": ("float", temperature.astype(np.float32)),
+    }
     for j, axis in enumerate("xyz"):
         drift = px4_offset_rad_s(params, 0, j, temperature) + 2e-5 * rng.standard_normal(n)
         fields[axis] = ("float", drift.astype(np.float32))
-    installed = {k: (int(v) if k.endswith(("ENABLE", "_ID")) else float(v)) for k, v in params.items()
-                 if k.startswith("TC_G")}
+    installed = {
+        k: (int(v) if k.endswith(("ENABLE", "_ID")) else float(v)) for k, v in params.items() if k.startswith("TC_G")
+    }
     stale = {k: (0.5 * v if "_X1_" in k or "_X2_" in k or "_X3_" in k else v) for k, v in installed.items()}
     write_ulog(tmp_path / "good.ulg", {("sensor_gyro", 0): fields}, parameters=installed)
     write_ulog(tmp_path / "stale.ulg", {("sensor_gyro", 0): fields}, parameters=stale)
@@ -342,9 +366,11 @@ def test_a_hostile_model_name_stays_in_its_comment_line():
 def test_a_model_fitted_on_a_ulog_exports_its_sensor_s_device_id(tmp_path):
     n = 3000
     temperature = np.linspace(10.0, 50.0, n)
-    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 500_000).astype(np.uint64)),
-              "device_id": ("uint32_t", np.full(n, 2293768, np.uint32)),
-              "temperature": ("float", temperature.astype(np.float32))}
+    fields = {
+        "timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 500_000).astype(np.uint64)),
+        "device_id": ("uint32_t", np.full(n, 2293768, np.uint32)),
+        "temperature": ("float", temperature.astype(np.float32)),
+    }
     for j, axis in enumerate("xyz"):
         fields[axis] = ("float", (1e-4 * (j + 1) * (temperature - 30.0)).astype(np.float32))
     write_ulog(tmp_path / "chamber.ulg", {("sensor_gyro", 0): fields})
@@ -357,8 +383,16 @@ def test_a_model_fitted_on_a_ulog_exports_its_sensor_s_device_id(tmp_path):
 
 
 def test_the_firmware_files_say_they_cannot_carry_heating_and_cooling_branches():
-    runs = [simulate(GyroErrorModel(hysteresis=Hysteresis(((0.02, 0.0005),) * 3, transition_degc=5.0)),
-                     profile="cycle", duration_s=6000, rate_hz=1, seed=s).recording for s in range(2)]
+    runs = [
+        simulate(
+            GyroErrorModel(hysteresis=Hysteresis(((0.02, 0.0005),) * 3, transition_degc=5.0)),
+            profile="cycle",
+            duration_s=6000,
+            rate_hz=1,
+            seed=s,
+        ).recording
+        for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, hysteresis="branch")
@@ -373,10 +407,15 @@ def test_terms_that_are_rounding_are_written_as_zero(tmp_path):
     from gyrocomp.models.options import Polynomial
     from gyrocomp.simulation import get_profile
 
-    part = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01,),), t_ref_degc=25.0,
-                          noise_density_dps_per_sqrt_hz=0.002)
-    runs = [simulate(part, profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=0.5,
-                     seed=s).recording for s in range(2)]
+    part = GyroErrorModel(
+        axes=("gyro_z",), temperature_coefficients=((0.01,),), t_ref_degc=25.0, noise_density_dps_per_sqrt_hz=0.002
+    )
+    runs = [
+        simulate(
+            part, profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=0.5, seed=s
+        ).recording
+        for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, temperature=Polynomial(1), hysteresis="none")

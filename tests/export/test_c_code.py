@@ -41,8 +41,23 @@ def _run_c(calibration, recording, tmp_path):
         (tmp_path / name).write_text(text)
     (tmp_path / "driver.c").write_text(DRIVER)
     exe = tmp_path / "driver"
-    subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-o", str(exe), str(tmp_path / "driver.c"),
-                    str(tmp_path / "gyrocomp.c"), "-lm"], check=True, capture_output=True, text=True)
+    subprocess.run(
+        [
+            CC,
+            "-std=c99",
+            "-O2",
+            "-Wall",
+            "-Werror",
+            "-o",
+            str(exe),
+            str(tmp_path / "driver.c"),
+            str(tmp_path / "gyrocomp.c"),
+            "-lm",
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     gyro = np.zeros((recording.n_samples, 3))
     cols = {"gyro_x": 0, "gyro_y": 1, "gyro_z": 2}
     for j, axis in enumerate(recording.gyro_axes):
@@ -71,8 +86,12 @@ def test_polynomial_lag_and_hysteresis(tmp_path):
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, hysteresis="turning-point+lag", hysteresis_band_degc=(55.0, 80.0))
     assert cal.axes["gyro_z"].lag_time_constant_s > 0 and cal.axes["gyro_z"].hysteresis is not None
-    held = simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
-                                                     ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
+    held = simulate(
+        "adxrs450",
+        profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2, ramp_rate_degc_per_min=3.0),
+        rate_hz=1,
+        seed=9,
+    ).recording
     _compare(cal, held, tmp_path)
 
 
@@ -118,23 +137,34 @@ def test_temperature_network_then_acceleration_network(tmp_path):
     _compare(cal, held, tmp_path)
 
 
-DRIVER_ACCEL = DRIVER.replace('printf("%.17g %.17g %.17g\\n", out[0], out[1], out[2]);',
-                              'printf("%.17g %.17g %.17g %.17g %.17g %.17g\\n", out[0], out[1], out[2], '
-                              's.accel_out[0], s.accel_out[1], s.accel_out[2]);')
+DRIVER_ACCEL = DRIVER.replace(
+    'printf("%.17g %.17g %.17g\\n", out[0], out[1], out[2]);',
+    'printf("%.17g %.17g %.17g %.17g %.17g %.17g\\n", out[0], out[1], out[2], '
+    "s.accel_out[0], s.accel_out[1], s.accel_out[2]);",
+)
 
 
 def _triad(k0, unit, bias=(0.0, 0.0, 0.0), k1=None):
     zeros = ((0.0,) * 3,) * 3
     k0 = tuple(map(tuple, np.eye(3) + np.asarray(k0)))
     per_degc = () if k1 is None else (tuple(map(tuple, k1)),)
-    return TriadCalibration(k0, bias, "rate-table" if unit == "deg/s" else "norm", zeros, (0.0, 0.0, 0.0), unit,
-                            reference_degc=None if k1 is None else 25.0, sensitivity_per_degc=per_degc,
-                            sensitivity_per_degc_stderr=() if k1 is None else (zeros,))
+    return TriadCalibration(
+        k0,
+        bias,
+        "rate-table" if unit == "deg/s" else "norm",
+        zeros,
+        (0.0, 0.0, 0.0),
+        unit,
+        reference_degc=None if k1 is None else 25.0,
+        sensitivity_per_degc=per_degc,
+        sensitivity_per_degc_stderr=() if k1 is None else (zeros,),
+    )
 
 
 #: a gyro K(T) linear in temperature (0.5 % scale, 1 mrad misalignment, 50 ppm/degC) and an accelerometer triad
-GYRO_TRIAD = _triad([[5e-3, 1e-3, -1e-3], [-1e-3, -4e-3, 2e-3], [1e-3, -2e-3, 3e-3]], "deg/s",
-                    k1=np.diag([5e-5, -3e-5, 4e-5]) + 1e-6)
+GYRO_TRIAD = _triad(
+    [[5e-3, 1e-3, -1e-3], [-1e-3, -4e-3, 2e-3], [1e-3, -2e-3, 3e-3]], "deg/s", k1=np.diag([5e-5, -3e-5, 4e-5]) + 1e-6
+)
 ACCEL_TRIAD = _triad([[2e-3, 1e-3, -2e-3], [0.0, -3e-3, 1.5e-3], [0.0, 0.0, 4e-3]], "g", bias=(0.02, -0.015, 0.03))
 
 
@@ -159,12 +189,29 @@ def test_accelerometer_temperature_models_g_sensitivity_and_both_triads(tmp_path
         (tmp_path / name).write_text(text)
     (tmp_path / "driver.c").write_text(DRIVER_ACCEL)
     exe = tmp_path / "driver"
-    subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-o", str(exe), str(tmp_path / "driver.c"),
-                    str(tmp_path / "gyrocomp.c"), "-lm"], check=True, capture_output=True, text=True)
+    subprocess.run(
+        [
+            CC,
+            "-std=c99",
+            "-O2",
+            "-Wall",
+            "-Werror",
+            "-o",
+            str(exe),
+            str(tmp_path / "driver.c"),
+            str(tmp_path / "gyrocomp.c"),
+            "-lm",
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     rec = runs[1]
     table = np.column_stack([rec.time_s, rec.gyro_dps, rec.accel_g, rec.temperature_degc])
     text = "\n".join(" ".join(repr(float(v)) for v in row) for row in table) + "\n"
-    out = np.loadtxt(subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True).stdout.splitlines())
+    out = np.loadtxt(
+        subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True).stdout.splitlines()
+    )
     for theirs, mine in ((out[:, :3], ours.gyro_dps), (out[:, 3:], ours.accel_g)):
         assert np.max(np.abs(theirs - mine) / np.maximum(np.abs(mine), 1.0)) < 1e-9
     assert np.max(np.abs(ours.accel_g - rec.accel_g)) > 1e-3  # the accelerometer really was compensated
@@ -184,12 +231,20 @@ def test_the_two_files_are_written_both_or_neither(tmp_path):
     written = write_c_sources(cal, tmp_path / "new")
     assert [p.name for p in written] == ["gyrocomp.h", "gyrocomp.c", "gyrocomp_learn.h", "gyrocomp_learn.c"]
     assert "#ifndef" in written[0].read_text() and "gyrocomp_learn_step" in written[3].read_text()
-    assert [p.name for p in write_c_sources(cal, tmp_path / "alone", with_learner=False)] == ["gyrocomp.h",
-                                                                                               "gyrocomp.c"]
+    assert [p.name for p in write_c_sources(cal, tmp_path / "alone", with_learner=False)] == [
+        "gyrocomp.h",
+        "gyrocomp.c",
+    ]
 
 
-HOSTILE_NAMES = ['*/ int gyrocomp_evil(void) { return system("id"); } /*', "a??/\nb", "\\\n#include <stdlib.h>",
-                 "*" * 300, "mod\u00e8le \u2028 */", "\x00\x1b[2J"]
+HOSTILE_NAMES = [
+    '*/ int gyrocomp_evil(void) { return system("id"); } /*',
+    "a??/\nb",
+    "\\\n#include <stdlib.h>",
+    "*" * 300,
+    "mod\u00e8le \u2028 */",
+    "\x00\x1b[2J",
+]
 
 
 @pytest.mark.parametrize("hostile", HOSTILE_NAMES)
@@ -207,45 +262,83 @@ def test_a_hostile_model_name_compiles_to_the_same_code_as_a_plain_one(tmp_path,
         folder.mkdir()
         for file, text in c_sources(dataclasses.replace(cal, model=name)).items():
             (folder / file).write_text(text)
-        subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-c", "-o", str(folder / "gyrocomp.o"),
-                        str(folder / "gyrocomp.c")], check=True, capture_output=True, text=True, cwd=folder)
+        subprocess.run(
+            [
+                CC,
+                "-std=c99",
+                "-O2",
+                "-Wall",
+                "-Werror",
+                "-c",
+                "-o",
+                str(folder / "gyrocomp.o"),
+                str(folder / "gyrocomp.c"),
+            ],
+            check=True,
+            capture_output=True,
+            text=True,
+            cwd=folder,
+        )
         objects.append((folder / "gyrocomp.o").read_bytes())
     assert objects[0] == objects[1]
 
 
 def test_heating_and_cooling_branches(tmp_path):
-    part = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01, 5e-5),), t_ref_degc=25.0,
-                          hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
-                          noise_density_dps_per_sqrt_hz=0.005, turn_on_bias_sigma_dps=0.05)
-    runs = [simulate(part, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1, seed=s).recording
-            for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))]
+    part = GyroErrorModel(
+        axes=("gyro_z",),
+        temperature_coefficients=((0.01, 5e-5),),
+        t_ref_degc=25.0,
+        hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
+        noise_density_dps_per_sqrt_hz=0.005,
+        turn_on_bias_sigma_dps=0.05,
+    )
+    runs = [
+        simulate(part, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1, seed=s).recording
+        for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, hysteresis="branch+lag")
     assert type(cal.axes["gyro_z"].hysteresis).__name__ == "BranchCurve" and cal.axes["gyro_z"].lag_time_constant_s > 0
     # past the calibrated range on both sides, two turns
-    held = simulate(part, profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
-                                              ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
+    held = simulate(
+        part,
+        profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2, ramp_rate_degc_per_min=3.0),
+        rate_hz=1,
+        seed=9,
+    ).recording
     _compare(cal, held, tmp_path)
 
 
 def test_lookup_table_with_lag_and_branches_past_its_grid(tmp_path):
     """A table curve (every axis: 3, 8 and 16 intervals) under the lag and heating/cooling branches, on a run
     that goes past the table's grid at both ends: the C is apply's to 1e-9."""
-    part = GyroErrorModel(axes=("gyro_x", "gyro_y", "gyro_z"), temperature_coefficients=((0.01,), (0.02,), (0.03,)),
-                          t_ref_degc=25.0, hysteresis=Hysteresis(((0.03,), (0.02,), (0.01,)), transition_degc=5.0),
-                          noise_density_dps_per_sqrt_hz=0.005)
-    runs = [simulate(part, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1, seed=s).recording
-            for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))]
+    part = GyroErrorModel(
+        axes=("gyro_x", "gyro_y", "gyro_z"),
+        temperature_coefficients=((0.01,), (0.02,), (0.03,)),
+        t_ref_degc=25.0,
+        hysteresis=Hysteresis(((0.03,), (0.02,), (0.01,)), transition_degc=5.0),
+        noise_density_dps_per_sqrt_hz=0.005,
+    )
+    runs = [
+        simulate(part, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1, seed=s).recording
+        for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration(runs, hysteresis="branch+lag")
-    tables = {"gyro_x": LookupTableCurve((0.0, 0.4, -0.1, 0.2), -20.0, 70.0),
-              "gyro_y": LookupTableCurve(tuple(np.sin(np.arange(9.0))), -20.0, 70.0),
-              "gyro_z": LookupTableCurve(tuple(np.cos(np.arange(17.0))), -20.0, 70.0)}
-    cal = dataclasses.replace(cal, axes={a: dataclasses.replace(ax, temperature=tables[a])
-                                         for a, ax in cal.axes.items()})
-    held = simulate(part, profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2,
-                                              ramp_rate_degc_per_min=3.0), rate_hz=1, seed=9).recording
+    tables = {
+        "gyro_x": LookupTableCurve((0.0, 0.4, -0.1, 0.2), -20.0, 70.0),
+        "gyro_y": LookupTableCurve(tuple(np.sin(np.arange(9.0))), -20.0, 70.0),
+        "gyro_z": LookupTableCurve(tuple(np.cos(np.arange(17.0))), -20.0, 70.0),
+    }
+    cal = dataclasses.replace(
+        cal, axes={a: dataclasses.replace(ax, temperature=tables[a]) for a, ax in cal.axes.items()}
+    )
+    held = simulate(
+        part,
+        profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=2, ramp_rate_degc_per_min=3.0),
+        rate_hz=1,
+        seed=9,
+    ).recording
     _compare(cal, held, tmp_path)
-

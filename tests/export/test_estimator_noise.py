@@ -13,8 +13,15 @@ import pytest
 
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.export.estimator_noise import (NOISE_EXPORTS, continuous_noise, kalibr_yaml, openvins_yaml,
-                                             ros_covariances, vins_values, vins_yaml)
+from gyrocomp.export.estimator_noise import (
+    NOISE_EXPORTS,
+    continuous_noise,
+    kalibr_yaml,
+    openvins_yaml,
+    ros_covariances,
+    vins_values,
+    vins_yaml,
+)
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.measures.noise_model import noise_model
 from gyrocomp.simulation import simulate
@@ -50,8 +57,9 @@ def test_every_export_writes_and_reads_back_the_bound_in_si_units(model):
         v = _values(text)
         assert float(v["gyroscope_noise_density"]) == pytest.approx(c.gyro_noise_density_rad_per_s_per_sqrt_hz, 1e-6)
         assert float(v["gyroscope_random_walk"]) == pytest.approx(c.gyro_random_walk_rad_per_s2_per_sqrt_hz, 1e-6)
-        assert float(v["accelerometer_noise_density"]) == pytest.approx(c.accel_noise_density_m_per_s2_per_sqrt_hz,
-                                                                       1e-6)
+        assert float(v["accelerometer_noise_density"]) == pytest.approx(
+            c.accel_noise_density_m_per_s2_per_sqrt_hz, 1e-6
+        )
         assert float(v["update_rate"]) == RATE_HZ and json.loads(v["rostopic"]) == "/imu"
     assert openvins_yaml(model).startswith("%YAML:1.0") and "\nimu0:\n" in openvins_yaml(model)
     v = _values(vins_yaml(model))
@@ -59,17 +67,19 @@ def test_every_export_writes_and_reads_back_the_bound_in_si_units(model):
         assert float(v[key]) == pytest.approx(value, rel=1e-6)
     back = json.loads(NOISE_EXPORTS["json"](model, "/imu0"))
     assert back["format"] == "gyrocomp-noise-model" and set(back["axes"]) == set(model.axes)
-    assert back["axes"]["gyro_x"]["bound"]["white_noise_density_u_per_sqrt_hz"] == \
-        model.axes["gyro_x"].bound.white_noise_density
+    assert (
+        back["axes"]["gyro_x"]["bound"]["white_noise_density_u_per_sqrt_hz"]
+        == model.axes["gyro_x"].bound.white_noise_density
+    )
 
 
 def test_vins_numbers_give_its_mid_point_step_the_continuous_models_variance(model):
     """integration_base.h: the angle gets (0.5 dt)^2 GYR_N^2 from each of the step's two samples and the bias dt^2
     GYR_W^2; the continuous model gives N^2 dt and K^2 dt per step."""
     c, v, dt = continuous_noise(model), vins_values(model), 1.0 / RATE_HZ
-    assert 2 * (0.5 * dt) ** 2 * v["gyr_n"] ** 2 == pytest.approx(c.gyro_noise_density_rad_per_s_per_sqrt_hz ** 2 * dt)
-    assert dt ** 2 * v["gyr_w"] ** 2 == pytest.approx(c.gyro_random_walk_rad_per_s2_per_sqrt_hz ** 2 * dt)
-    assert 2 * (0.5 * dt) ** 2 * v["acc_n"] ** 2 == pytest.approx(c.accel_noise_density_m_per_s2_per_sqrt_hz ** 2 * dt)
+    assert 2 * (0.5 * dt) ** 2 * v["gyr_n"] ** 2 == pytest.approx(c.gyro_noise_density_rad_per_s_per_sqrt_hz**2 * dt)
+    assert dt**2 * v["gyr_w"] ** 2 == pytest.approx(c.gyro_random_walk_rad_per_s2_per_sqrt_hz**2 * dt)
+    assert 2 * (0.5 * dt) ** 2 * v["acc_n"] ** 2 == pytest.approx(c.accel_noise_density_m_per_s2_per_sqrt_hz**2 * dt)
 
 
 def test_the_ros_covariance_is_the_variance_of_one_sample_of_white_noise_of_that_density(model):
@@ -80,15 +90,19 @@ def test_the_ros_covariance_is_the_variance_of_one_sample_of_white_noise_of_that
     r = allan_deviation(white, RATE_HZ, taus=np.array([1.0 / RATE_HZ]))
     assert r.deviation[0] == pytest.approx(density * math.sqrt(RATE_HZ), rel=0.01)
     assert cov["angular_velocity_covariance"][0] == pytest.approx(np.var(white), rel=0.02)
-    assert cov["angular_velocity_covariance"][1] == 0.0 and cov["angular_velocity_covariance"][4] == cov[
-        "angular_velocity_covariance"][8]
+    assert (
+        cov["angular_velocity_covariance"][1] == 0.0
+        and cov["angular_velocity_covariance"][4] == cov["angular_velocity_covariance"][8]
+    )
     slower = ros_covariances(model, rate_hz=RATE_HZ / 2)
     assert slower["angular_velocity_covariance"][0] == pytest.approx(cov["angular_velocity_covariance"][0] / 2)
     from gyrocomp.export.estimator_noise import ros_yaml
 
     written = ros_yaml(model, "/imu\nangular_velocity_covariance: [0]")  # a topic cannot add a key
     assert [line.split(":")[0] for line in written.splitlines() if not line.startswith("#")] == [
-        "angular_velocity_covariance", "linear_acceleration_covariance"]
+        "angular_velocity_covariance",
+        "linear_acceleration_covariance",
+    ]
     with pytest.raises(InputError, match=r"rate_hz: a positive number of Hz, got -1"):
         ros_covariances(model, rate_hz=-1)
 
@@ -104,8 +118,11 @@ def test_a_consumer_that_needs_the_accelerometer_says_so():
 def test_the_autopilot_parameters_give_each_prediction_step_the_continuous_variance(model):
     """PX4 and ArduPilot add (dt sigma)^2 to the angle and (dt sigma_b)^2 to the rate bias per step: at their
     filter period that is N^2 dt and K^2 dt; the files read back to the values."""
-    from gyrocomp.export.estimator_noise import (ARDUPILOT_FILTER_PERIOD_S, PX4_PREDICT_PERIOD_S,
-                                                 autopilot_noise_parameters)
+    from gyrocomp.export.estimator_noise import (
+        ARDUPILOT_FILTER_PERIOD_S,
+        PX4_PREDICT_PERIOD_S,
+        autopilot_noise_parameters,
+    )
 
     c = continuous_noise(model)
     with warnings.catch_warnings():
@@ -114,10 +131,12 @@ def test_the_autopilot_parameters_give_each_prediction_step_the_continuous_varia
         ardupilot = autopilot_noise_parameters(model, "ardupilot")
         px4_text = NOISE_EXPORTS["px4"](model, "/imu0")
         ardupilot_text = NOISE_EXPORTS["ardupilot"](model, "/imu0")
-    for values, dt, gyro, bias in ((px4, PX4_PREDICT_PERIOD_S, "EKF2_GYR_NOISE", "EKF2_GYR_B_NOISE"),
-                                   (ardupilot, ARDUPILOT_FILTER_PERIOD_S, "EK3_GYRO_P_NSE", "EK3_GBIAS_P_NSE")):
-        assert (dt * values[gyro]) ** 2 == pytest.approx(c.gyro_noise_density_rad_per_s_per_sqrt_hz ** 2 * dt)
-        assert (dt * values[bias]) ** 2 == pytest.approx(c.gyro_random_walk_rad_per_s2_per_sqrt_hz ** 2 * dt)
+    for values, dt, gyro, bias in (
+        (px4, PX4_PREDICT_PERIOD_S, "EKF2_GYR_NOISE", "EKF2_GYR_B_NOISE"),
+        (ardupilot, ARDUPILOT_FILTER_PERIOD_S, "EK3_GYRO_P_NSE", "EK3_GBIAS_P_NSE"),
+    ):
+        assert (dt * values[gyro]) ** 2 == pytest.approx(c.gyro_noise_density_rad_per_s_per_sqrt_hz**2 * dt)
+        assert (dt * values[bias]) ** 2 == pytest.approx(c.gyro_random_walk_rad_per_s2_per_sqrt_hz**2 * dt)
     rows = [line.split("\t") for line in px4_text.splitlines() if not line.startswith("#")]
     assert {name: float(value) for _, _, name, value, _ in rows} == pytest.approx(px4, rel=1e-5)
     pairs = [line.split() for line in ardupilot_text.splitlines() if not line.startswith("#")]
@@ -127,8 +146,11 @@ def test_the_autopilot_parameters_give_each_prediction_step_the_continuous_varia
 def test_a_value_outside_what_the_autopilot_accepts_is_clamped_and_said(model):
     from gyrocomp.export.estimator_noise import NOISE_PARAMETER_RANGES, autopilot_noise_parameters
 
-    with pytest.warns(DataQualityWarning, match=r"export px4: EKF2_GYR_NOISE would be [0-9.e-]+, outside the "
-                                                r"0.0001..0.1 the autopilot accepts; written as 0.1"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"export px4: EKF2_GYR_NOISE would be [0-9.e-]+, outside the "
+        r"0.0001..0.1 the autopilot accepts; written as 0.1",
+    ):
         values = autopilot_noise_parameters(model, "px4", filter_period_s=1e-9)
     assert values["EKF2_GYR_NOISE"] == NOISE_PARAMETER_RANGES["EKF2_GYR_NOISE"][1]
     with pytest.raises(InputError, match=r"target: 'inav'; use px4 or ardupilot"):

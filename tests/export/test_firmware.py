@@ -13,14 +13,25 @@ from gyrocomp.simulation import get_profile, simulate
 
 
 DEG = 180.0 / math.pi
-PX4 = {"TC_G0_TMIN": 10.0, "TC_G0_TMAX": 50.0, "TC_G0_TREF": 30.0,
-       **{f"TC_G0_X{k}_{j}": c for j, coefs in enumerate(((1e-3, 2e-5, -3e-7, 4e-9), (0.0, 1e-4, 0.0, 0.0),
-                                                          (-2e-3, 0.0, 5e-7, 0.0)))
-          for k, c in enumerate(coefs)}}
-ARDU = {"INS_TCAL1_TMIN": 0.0, "INS_TCAL1_TMAX": 60.0,
-        **{f"INS_TCAL1_GYR{k}_{a}": c for a, coefs in zip("XYZ", ((100.0, -2.0, 0.03), (50.0, 0.0, 0.0),
-                                                                   (0.0, 1.0, 0.0)))
-           for k, c in zip((1, 2, 3), coefs)}}
+PX4 = {
+    "TC_G0_TMIN": 10.0,
+    "TC_G0_TMAX": 50.0,
+    "TC_G0_TREF": 30.0,
+    **{
+        f"TC_G0_X{k}_{j}": c
+        for j, coefs in enumerate(((1e-3, 2e-5, -3e-7, 4e-9), (0.0, 1e-4, 0.0, 0.0), (-2e-3, 0.0, 5e-7, 0.0)))
+        for k, c in enumerate(coefs)
+    },
+}
+ARDU = {
+    "INS_TCAL1_TMIN": 0.0,
+    "INS_TCAL1_TMAX": 60.0,
+    **{
+        f"INS_TCAL1_GYR{k}_{a}": c
+        for a, coefs in zip("XYZ", ((100.0, -2.0, 0.03), (50.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
+        for k, c in zip((1, 2, 3), coefs)
+    },
+}
 
 
 def test_px4_offsets_by_hand_inside_and_clamped_outside():
@@ -56,8 +67,10 @@ def test_ardupilot_correction_by_hand_relative_to_the_calibration_temperature():
     assert out[0, 2] == pytest.approx((p(10.0, (0, 1, 0)) - p(-10.0, (0, 1, 0))) * DEG, rel=1e-5)
     assert out[1, 0] == pytest.approx((p(25.0, x) - p(-10.0, x)) * DEG, rel=1e-5)  # 80 clamped to TMAX 60
     # the calibration temperature is clamped too
-    np.testing.assert_allclose(ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), -20.0),
-                               ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), 0.0))
+    np.testing.assert_allclose(
+        ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), -20.0),
+        ardupilot_gyro_correction_dps(ARDU, np.array([30.0]), 0.0),
+    )
 
 
 def test_a_parameter_left_out_has_the_firmwares_default():
@@ -89,10 +102,14 @@ def test_ardupilot_as_installed_takes_its_calibration_temperature_from_the_param
     assert ardupilot_cal_temp_degc(params, 1) == 22.0 and ardupilot_cal_temp_degc(params, 2) == 31.0
     assert ardupilot_cal_temp_degc(ARDU, 1) == -300.0  # never calibrated: the firmware clamps it to TMIN
     temps = np.array([10.0, 40.0])
-    np.testing.assert_array_equal(installed_correction_dps(params, "ardupilot", np.arange(2.0), temps, 1),
-                                  ardupilot_gyro_correction_dps(ARDU, temps, 22.0))
-    np.testing.assert_array_equal(installed_correction_dps(ARDU, "ardupilot", np.arange(2.0), temps, 1),
-                                  ardupilot_gyro_correction_dps(ARDU, temps, 0.0))
+    np.testing.assert_array_equal(
+        installed_correction_dps(params, "ardupilot", np.arange(2.0), temps, 1),
+        ardupilot_gyro_correction_dps(ARDU, temps, 22.0),
+    )
+    np.testing.assert_array_equal(
+        installed_correction_dps(ARDU, "ardupilot", np.arange(2.0), temps, 1),
+        ardupilot_gyro_correction_dps(ARDU, temps, 0.0),
+    )
     with pytest.raises(InputError, match=r"autopilot: 'betaflight'; use px4 or ardupilot"):
         installed_correction_dps(ARDU, "betaflight", np.arange(2.0), temps, 1)
 
@@ -105,11 +122,17 @@ def test_the_firmwares_cost_is_measured_for_a_model_with_g_sensitivity():
     from gyrocomp.export.firmware import firmware_costs
     from gyrocomp.models.joint import fit_calibration
 
-    sims = [simulate("adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=0.2,
-                     seed=s).recording for s in range(2)]
+    sims = [
+        simulate(
+            "adxrs450", profile=get_profile("cycle", set_points_degc=(-30.0, 80.0), cycles=1), rate_hz=0.2, seed=s
+        ).recording
+        for s in range(2)
+    ]
     plain = fit_calibration(sims, hysteresis="none")
     axis = plain.axes["gyro_z"]
-    with_g = dataclasses.replace(plain, axes={"gyro_z": dataclasses.replace(axis, g_sensitivity_dps_per_g=(0.1, 0.2, 0.3))})
+    with_g = dataclasses.replace(
+        plain, axes={"gyro_z": dataclasses.replace(axis, g_sensitivity_dps_per_g=(0.1, 0.2, 0.3))}
+    )
     costs, costs_plain = firmware_costs(with_g), firmware_costs(plain)
     assert set(costs) == {"px4", "ardupilot"}
     for target in costs:  # the g-term is not the temperature correction's: the same figures

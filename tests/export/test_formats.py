@@ -16,8 +16,12 @@ from gyrocomp.simulation import get_profile, simulate
 
 @pytest.fixture(scope="module")
 def model():
-    runs = [simulate("consumer", profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=0.5,
-                     seed=s).recording for s in range(2)]
+    runs = [
+        simulate(
+            "consumer", profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=0.5, seed=s
+        ).recording
+        for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return fit_calibration(runs, temperature=Polynomial(2), hysteresis="none")
@@ -43,8 +47,9 @@ def test_an_unknown_format_is_refused_and_a_new_one_is_one_registration(tmp_path
         export_to(model, "betaflight", tmp_path / "x")
 
     def axes_csv(calibration, path, options):
-        path.write_text("axis,constant\n" + "".join(f"{a},{ax.mean_turn_on_bias}\n"
-                                                    for a, ax in calibration.axes.items()))
+        path.write_text(
+            "axis,constant\n" + "".join(f"{a},{ax.mean_turn_on_bias}\n" for a, ax in calibration.axes.items())
+        )
         return Exported("axes-csv", (path,))
 
     register(Exporter("axes-csv", "each axis's mean turn-on constant", "everything else", axes_csv))

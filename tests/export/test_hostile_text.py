@@ -81,8 +81,13 @@ def _compile(folder, sources: dict[str, str]) -> bytes:
     folder.mkdir()
     for name, text in sources.items():
         (folder / name).write_text(text)
-    subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Werror", "-c", "-o", str(folder / "gyrocomp.o"),
-                    str(folder / "gyrocomp.c")], check=True, capture_output=True, text=True, cwd=folder)
+    subprocess.run(
+        [CC, "-std=c99", "-O2", "-Wall", "-Werror", "-c", "-o", str(folder / "gyrocomp.o"), str(folder / "gyrocomp.c")],
+        check=True,
+        capture_output=True,
+        text=True,
+        cwd=folder,
+    )
     return (folder / "gyrocomp.o").read_bytes()
 
 
@@ -103,7 +108,9 @@ def test_every_text_field_of_a_model_hostile_compiles_to_the_same_code(tmp_path,
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         hostile = Calibration.from_dict(hostile_dict)
-    assert _compile(tmp_path / "plain", c_sources(model, rate_hz=0.5)) == _compile(tmp_path / "hostile", c_sources(hostile, rate_hz=0.5))
+    assert _compile(tmp_path / "plain", c_sources(model, rate_hz=0.5)) == _compile(
+        tmp_path / "hostile", c_sources(hostile, rate_hz=0.5)
+    )
     for write in (lambda c: px4_params_file(c, device_id=7), ardupilot_params_file):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -128,30 +135,32 @@ def test_a_hostile_serial_and_header_reach_no_generated_code(tmp_path):
 
     from ..conftest import run
 
-    rec = simulate("consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 60.0), cycles=1), rate_hz=0.5,
-                   seed=1).recording
+    rec = simulate(
+        "consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 60.0), cycles=1), rate_hz=0.5, seed=1
+    ).recording
     plain_csv = tmp_path / "plain.csv"
     write_recording(rec, plain_csv)
-    header = 'g*/ system(0); /* ??/'
+    header = "g*/ system(0); /* ??/"
     text = plain_csv.read_text().splitlines()
     hostile_csv = tmp_path / "hostile.csv"
     hostile_csv.write_text("\n".join([text[0].replace("gyro_x", f'"{header}"')] + text[1:]) + "\n")
     objects, parameters = [], []
-    for name, (serial, source, extra) in {"plain": ("U1", plain_csv, []),
-                                          "hostile": ('*/ int x; /* ??/', hostile_csv,
-                                                      ["--columns", f"gyro_x={header}"])}.items():
+    for name, (serial, source, extra) in {
+        "plain": ("U1", plain_csv, []),
+        "hostile": ("*/ int x; /* ??/", hostile_csv, ["--columns", f"gyro_x={header}"]),
+    }.items():
         manifest = tmp_path / f"manifest_{name}.csv"
         manifest.write_text(f'path,serial\n{source},"{serial}"\n')
-        fitted = run("fleet", "fit", "--manifest", manifest, "-o", tmp_path / name, "--scheduler", "serial",
-                     *extra)
+        fitted = run("fleet", "fit", "--manifest", manifest, "-o", tmp_path / name, "--scheduler", "serial", *extra)
         assert fitted.returncode == 0, fitted.stderr
         out = tmp_path / f"{name}_c"
         exported = run("fleet", "export", serial, "--store", tmp_path / name, "--format", "c", "-o", out, "--rate", 0.5)
         assert exported.returncode == 0, exported.stderr
         objects.append(_compile(tmp_path / f"{name}_o", {f.name: f.read_text() for f in out.iterdir()}))
         params = tmp_path / f"{name}.params"
-        exported = run("fleet", "export", serial, "--store", tmp_path / name, "--format", "px4", "-o", params,
-                       "--device-id", 7)
+        exported = run(
+            "fleet", "export", serial, "--store", tmp_path / name, "--format", "px4", "-o", params, "--device-id", 7
+        )
         assert exported.returncode == 0, exported.stderr
         parameters.append(_parameters(params.read_text()))
     assert objects[0] == objects[1] and parameters[0] == parameters[1]

@@ -35,8 +35,14 @@ def test_values_are_the_continuous_time_densities_in_si_units():
     accel_n = max(analysis.axes[a].noise.noise_density_g_per_sqrt_hz for a in ("accel_x", "accel_y", "accel_z"))
     assert imu.accelerometer_noise_density_m_per_s2_per_sqrt_hz == pytest.approx(accel_n * 9.80665)
     values = parse(kalibr_imu_yaml(imu))
-    assert set(values) == {"accelerometer_noise_density", "accelerometer_random_walk", "gyroscope_noise_density",
-                           "gyroscope_random_walk", "rostopic", "update_rate"}
+    assert set(values) == {
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+        "gyroscope_noise_density",
+        "gyroscope_random_walk",
+        "rostopic",
+        "update_rate",
+    }
     assert float(values["gyroscope_noise_density"]) == pytest.approx(0.01 * math.pi / 180, rel=0.03)
     assert float(values["update_rate"]) == 50.0 and json.loads(values["rostopic"]) == "/imu/data"
 

@@ -21,10 +21,15 @@ from ..conftest import run
 
 @pytest.fixture(scope="module")
 def runs_and_held_out():
-    fit = [simulate("consumer", profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=1,
-                    seed=s).recording for s in range(2)]
-    held = simulate("consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 70.0), cycles=1), rate_hz=1,
-                    seed=9).recording  # 20 degC past the calibrated range on both sides
+    fit = [
+        simulate(
+            "consumer", profile=get_profile("cycle", set_points_degc=(0.0, 50.0), cycles=1), rate_hz=1, seed=s
+        ).recording
+        for s in range(2)
+    ]
+    held = simulate(
+        "consumer", profile=get_profile("cycle", set_points_degc=(-20.0, 70.0), cycles=1), rate_hz=1, seed=9
+    ).recording  # 20 degC past the calibrated range on both sides
     return fit, held
 
 

@@ -29,6 +29,7 @@ from gyrocomp.io.tables import TableLayout, read_table, write_gyro_back, write_r
 from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import simulate
 
+
 def _whole(calibration, source, target, **kwargs):
     """The whole-file path: read_table, apply, write_gyro_back."""
     layout = kwargs.pop("layout", None)
@@ -64,14 +65,20 @@ def held_out(tmp_path_factory):
 
 @hsettings(max_examples=6, deadline=None)
 @given(st.integers(2, 4000), st.sampled_from(["csv", "parquet"]), st.sampled_from([None, 120.0]))
-def test_any_chunk_size_writes_what_the_whole_file_gives(consumer_model, held_out, tmp_path_factory, chunk_rows, suffix,
-                                                         window):
+def test_any_chunk_size_writes_what_the_whole_file_gives(
+    consumer_model, held_out, tmp_path_factory, chunk_rows, suffix, window
+):
     out = tmp_path_factory.mktemp("out")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         _whole(consumer_model, held_out[suffix], out / f"whole.{suffix}", turn_on_window_s=window)
-        result = apply_file(consumer_model, held_out[suffix], out / f"chunks.{suffix}", chunks=ChunkSettings(chunk_rows=chunk_rows),
-                            turn_on_window_s=window)
+        result = apply_file(
+            consumer_model,
+            held_out[suffix],
+            out / f"chunks.{suffix}",
+            chunks=ChunkSettings(chunk_rows=chunk_rows),
+            turn_on_window_s=window,
+        )
     assert result.streamed and result.rows == _read(held_out[suffix]).num_rows
     assert _read(out / f"chunks.{suffix}").equals(_read(out / f"whole.{suffix}"))
     if suffix == "csv":  # the same bytes
@@ -80,7 +87,13 @@ def test_any_chunk_size_writes_what_the_whole_file_gives(consumer_model, held_ou
 
 def test_dropped_rows_and_gaps_are_said_once_for_the_whole_file(consumer_model, held_out, tmp_path):
     with pytest.warns(DataQualityWarning) as caught:
-        result = apply_file(consumer_model, held_out["holes"], tmp_path / "out.csv", options=ReadOptions(drop_nonfinite=True), chunks=ChunkSettings(chunk_rows=700))
+        result = apply_file(
+            consumer_model,
+            held_out["holes"],
+            tmp_path / "out.csv",
+            options=ReadOptions(drop_nonfinite=True),
+            chunks=ChunkSettings(chunk_rows=700),
+        )
     said = [str(w.message) for w in caught if issubclass(w.category, DataQualityWarning)]
     assert sum("dropped 2 of 3541 rows" in m for m in said) == 1
     assert sum("1 time gap(s)" in m and "longest 30.5 s after row 1000" in m for m in said) == 1
@@ -117,7 +130,9 @@ def test_a_csv_whose_column_type_changes_is_read_whole(consumer_model, held_out,
     monkeypatch.setattr(stream_module, "CSV_BLOCK_BYTES", 4096)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = apply_file(consumer_model, tmp_path / "mixed.csv", tmp_path / "out.csv", chunks=ChunkSettings(chunk_rows=500))
+        result = apply_file(
+            consumer_model, tmp_path / "mixed.csv", tmp_path / "out.csv", chunks=ChunkSettings(chunk_rows=500)
+        )
         _whole(consumer_model, tmp_path / "mixed.csv", tmp_path / "whole.csv")
     assert not result.streamed
     assert (tmp_path / "out.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
@@ -126,18 +141,28 @@ def test_a_csv_whose_column_type_changes_is_read_whole(consumer_model, held_out,
 def test_units_and_mapped_columns_stream_too(consumer_model, held_out, tmp_path):
     """A file in rad/s and milliseconds with its own column names: the output keeps them, in its units."""
     table = pacsv.read_csv(held_out["csv"])
-    table = table.rename_columns(["t_ms" if n == "time" else n.upper() if n.startswith("gyro") else n
-                                  for n in table.column_names])
+    table = table.rename_columns(
+        ["t_ms" if n == "time" else n.upper() if n.startswith("gyro") else n for n in table.column_names]
+    )
     table = table.set_column(0, "t_ms", pa.array(table.column("t_ms").to_numpy() * 1000.0))
     for axis in ("GYRO_X", "GYRO_Y", "GYRO_Z"):
         i = table.column_names.index(axis)
         table = table.set_column(i, axis, pa.array(table.column(axis).to_numpy() * np.pi / 180))
     pq.write_table(table, tmp_path / "own.parquet")
-    layout = TableLayout(columns={"time": "t_ms", "gyro_x": "GYRO_X", "gyro_y": "GYRO_Y", "gyro_z": "GYRO_Z"},
-                         gyro_unit="rad/s", time_unit="ms")
+    layout = TableLayout(
+        columns={"time": "t_ms", "gyro_x": "GYRO_X", "gyro_y": "GYRO_Y", "gyro_z": "GYRO_Z"},
+        gyro_unit="rad/s",
+        time_unit="ms",
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        apply_file(consumer_model, tmp_path / "own.parquet", tmp_path / "out.parquet", options=ReadOptions(layout=layout), chunks=ChunkSettings(chunk_rows=333))
+        apply_file(
+            consumer_model,
+            tmp_path / "own.parquet",
+            tmp_path / "out.parquet",
+            options=ReadOptions(layout=layout),
+            chunks=ChunkSettings(chunk_rows=333),
+        )
         _whole(consumer_model, tmp_path / "own.parquet", tmp_path / "whole.parquet", layout=layout)
     out = pq.read_table(tmp_path / "out.parquet")
     assert out.column_names == table.column_names
@@ -147,15 +172,21 @@ def test_units_and_mapped_columns_stream_too(consumer_model, held_out, tmp_path)
 def test_a_model_with_the_accelerometer_streams_its_columns_too(held_out, tmp_path):
     """Accelerometer temperature models: the accel columns are replaced chunk by chunk as in the whole-file path;
     with a turn-on window (which holds the gyro back, not the accelerometer) the file is read whole."""
-    runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
-            for s in range(2)]
+    runs = [
+        simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = fit_channels(runs, ("gyro", "accel"))
         assert model.accel_axes
         for window in (None, 60.0):
-            result = apply_file(model, held_out["parquet"], tmp_path / "out.parquet", chunks=ChunkSettings(chunk_rows=250),
-                                turn_on_window_s=window)
+            result = apply_file(
+                model,
+                held_out["parquet"],
+                tmp_path / "out.parquet",
+                chunks=ChunkSettings(chunk_rows=250),
+                turn_on_window_s=window,
+            )
             data = read_table(held_out["parquet"])
             done = apply(model, data.recording, turn_on_window_s=window)
             write_gyro_back(data, done.gyro_dps, tmp_path / "whole.parquet", accel_g=done.accel_g)
@@ -168,8 +199,12 @@ def test_a_model_with_the_accelerometer_streams_its_columns_too(held_out, tmp_pa
 def test_convert_in_chunks_writes_what_the_whole_file_gives(held_out, tmp_path, suffix, out_suffix):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = convert_file(held_out[suffix], tmp_path / f"chunks.{out_suffix}", options=ReadOptions(drop_nonfinite=True),
-                               chunks=ChunkSettings(chunk_rows=777))
+        result = convert_file(
+            held_out[suffix],
+            tmp_path / f"chunks.{out_suffix}",
+            options=ReadOptions(drop_nonfinite=True),
+            chunks=ChunkSettings(chunk_rows=777),
+        )
         write_recording(read_table(held_out[suffix], drop_nonfinite=True).recording, tmp_path / f"whole.{out_suffix}")
     assert _read(tmp_path / f"chunks.{out_suffix}").equals(_read(tmp_path / f"whole.{out_suffix}"))
     assert result.gaps == 1 and result.rate_hz == 2.0 and result.channels[:3] == ("gyro_x", "gyro_y", "gyro_z")
@@ -195,12 +230,17 @@ def test_any_file_name_the_os_allows(tmp_path):
     writes through every table path: whole, in chunks, Parquet and CSV."""
     name = os.fsdecode(b"run\xff")
     csv = tmp_path / f"{name}.csv"
-    write_text_atomic(csv, "time,gyro_z,temperature\n" + "".join(f"{t},{0.01 * t},{20 + 0.01 * t}\n"
-                                                                 for t in range(2000)))
-    for args, out in ((("convert", csv, tmp_path / f"{name}.parquet"), f"{name}.parquet"),
-                      (("fit", csv, "-o", tmp_path / f"{name}.json", "--temperature", "poly:1"), f"{name}.json"),
-                      (("apply", tmp_path / f"{name}.json", tmp_path / f"{name}.parquet", "-o",
-                        tmp_path / f"{name}-comp.csv"), f"{name}-comp.csv")):
+    write_text_atomic(
+        csv, "time,gyro_z,temperature\n" + "".join(f"{t},{0.01 * t},{20 + 0.01 * t}\n" for t in range(2000))
+    )
+    for args, out in (
+        (("convert", csv, tmp_path / f"{name}.parquet"), f"{name}.parquet"),
+        (("fit", csv, "-o", tmp_path / f"{name}.json", "--temperature", "poly:1"), f"{name}.json"),
+        (
+            ("apply", tmp_path / f"{name}.json", tmp_path / f"{name}.parquet", "-o", tmp_path / f"{name}-comp.csv"),
+            f"{name}-comp.csv",
+        ),
+    ):
         result = _run_bytes(*args)  # the names come back as the bytes they are
         assert result.returncode == 0, result.stderr
         assert (tmp_path / out).exists()

@@ -23,9 +23,12 @@ from tests.io.log_writers import write_bag
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 from rosbags.highlevel import AnyReader  # noqa: E402
 
-KINDS = {"ros1": ({"ros2": False}, "in.bag", "out.bag"), "ros2": ({"ros2": True}, "in", "out"),
-         "mcap": ({"ros2": True, "mcap": True}, "in", "out"),
-         "bare mcap": ({"ros2": True, "mcap": True, "bare": True}, "in.mcap", "out.mcap")}
+KINDS = {
+    "ros1": ({"ros2": False}, "in.bag", "out.bag"),
+    "ros2": ({"ros2": True}, "in", "out"),
+    "mcap": ({"ros2": True, "mcap": True}, "in", "out"),
+    "bare mcap": ({"ros2": True, "mcap": True, "bare": True}, "in.mcap", "out.mcap"),
+}
 
 
 @pytest.fixture(scope="module")
@@ -54,8 +57,9 @@ def model_with_accel():
     profile = get_profile("cycle", set_points_degc=(15.0, 45.0), cycles=1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return fit_channels([simulate("consumer", profile=profile, rate_hz=1.0, seed=s).recording for s in (1, 2)],
-                            ("accel", "gyro"))
+        return fit_channels(
+            [simulate("consumer", profile=profile, rate_hz=1.0, seed=s).recording for s in (1, 2)], ("accel", "gyro")
+        )
 
 
 @pytest.mark.parametrize("kind", list(KINDS))
@@ -83,8 +87,10 @@ def test_a_bag_out_is_the_bag_in_with_its_imu_topic_compensated(kind, chunk_rows
         assert output.is_file() == (kind == "bare mcap")
         reader = pytest.importorskip("mcap.reader", reason="the mcap library reads the file back")
         with open(output if output.is_file() else next(output.glob("*.mcap")), "rb") as f:
-            read_back = [(channel.topic, schema.name, message.log_time)
-                         for schema, channel, message in reader.make_reader(f).iter_messages()]
+            read_back = [
+                (channel.topic, schema.name, message.log_time)
+                for schema, channel, message in reader.make_reader(f).iter_messages()
+            ]
         assert read_back == [(topic, kind_, t) for topic, kind_, t, _ in ins]
 
 
@@ -95,8 +101,11 @@ def test_a_repeated_stamp_is_corrected_as_its_twin_and_uncovered_messages_are_sa
     write_bag(source, ros2=False, n=300, repeat=150, temperature_from=100)
     # the first temperature at message 100 (1 s in); reading matches within 5 of its periods (0.5 s): the first
     # 51 messages (the one at 0.5 s too) are outside its span
-    with pytest.warns(DataQualityWarning, match=r"in.bag: 51 message\(s\) of /imu/data are not in the recording the "
-                                                r"bag reads as .* copied uncompensated"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"in.bag: 51 message\(s\) of /imu/data are not in the recording the "
+        r"bag reads as .* copied uncompensated",
+    ):
         done = apply_bag(model, source, tmp_path / "out.bag", chunk_rows=chunk_rows)
     assert (done.compensated, done.unchanged, done.streamed) == (250, 51, True)
     with AnyReader([tmp_path / "out.bag"]) as reader:
@@ -117,7 +126,8 @@ def test_the_command_line_writes_a_bag_of_the_inputs_kind_and_refuses_another(mo
     assert "wrote" in done.stdout and "200 messages of /imu/data compensated" in done.stdout
     folder = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "outdir")
     assert folder.returncode == 2 and folder.stderr.strip().endswith(
-        "a compensated bag is written as the input's kind: a .bag file (a ROS 1 bag)")
+        "a compensated bag is written as the input's kind: a .bag file (a ROS 1 bag)"
+    )
     assert not (tmp_path / "outdir").exists()
     table = run("apply", tmp_path / "m.json", source, "-o", tmp_path / "out.csv")
     assert table.returncode == 0 and (tmp_path / "out.csv").exists()  # a table out, as before
@@ -151,9 +161,18 @@ def test_the_covariances_are_written_from_a_noise_model(model, tmp_path):
     source = tmp_path / "in"
     write_bag(source, ros2=True, n=200)
     noise = tmp_path / "noise.json"
-    noise.write_text(json.dumps({"format": "gyrocomp-noise-model", "rate_hz": 100.0, "axes": {
-        "gyro_x": {"bound": {"white_noise_density_u_per_sqrt_hz": 0.01}},
-        "gyro_z": {"bound": {"white_noise_density_u_per_sqrt_hz": 0.02}}}}))
+    noise.write_text(
+        json.dumps(
+            {
+                "format": "gyrocomp-noise-model",
+                "rate_hz": 100.0,
+                "axes": {
+                    "gyro_x": {"bound": {"white_noise_density_u_per_sqrt_hz": 0.01}},
+                    "gyro_z": {"bound": {"white_noise_density_u_per_sqrt_hz": 0.02}},
+                },
+            }
+        )
+    )
     done = apply_bag(model, source, tmp_path / "out", noise=noise)
     assert done.covariances == ("angular_velocity_covariance",)
     with AnyReader([tmp_path / "out"]) as reader:
@@ -193,8 +212,9 @@ def test_a_model_with_accelerometer_terms_compensates_the_accelerations_too(chun
     write_bag(source, ros2=True, n=200)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        done = apply_bag(model_with_accel, source, tmp_path / "out",
-                         **({"chunk_rows": chunk_rows} if chunk_rows else {}))
+        done = apply_bag(
+            model_with_accel, source, tmp_path / "out", **({"chunk_rows": chunk_rows} if chunk_rows else {})
+        )
         expected = apply(model_with_accel, read(source))
         back = read(tmp_path / "out")
     assert done.accel and done.compensated == 200
@@ -214,8 +234,12 @@ def test_each_imu_topic_with_its_own_model_in_one_pass(chunk_rows, model, model_
     write_bag(source, ros2=False, n=200, imu_topics=("/imu_b", "/imu_a"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        done = apply_bag_instances({0: model, 1: model_with_accel}, source, tmp_path / "out.bag",
-                                   **({"chunk_rows": chunk_rows} if chunk_rows else {}))
+        done = apply_bag_instances(
+            {0: model, 1: model_with_accel},
+            source,
+            tmp_path / "out.bag",
+            **({"chunk_rows": chunk_rows} if chunk_rows else {}),
+        )
         for instance, used in ((0, model), (1, model_with_accel)):
             expected = apply(used, read(source, instance=instance))
             back = read(tmp_path / "out.bag", instance=instance)

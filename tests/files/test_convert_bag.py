@@ -54,8 +54,11 @@ def test_ros1_to_a_ros2_folder_reads_as_the_same_recording(tmp_path):
 def test_the_same_kind_a_damaged_bag_and_a_folder_that_is_no_bag_are_refused(tmp_path):
     source = tmp_path / "in.bag"
     write_bag(source, ros2=False, n=300)
-    with pytest.raises(InputError, match=r"output: .*again\.bag: the input is already a \.bag file \(a ROS 1 bag\); "
-                                         r"name a folder \(a ROS 2 bag\) or a \.mcap file"):
+    with pytest.raises(
+        InputError,
+        match=r"output: .*again\.bag: the input is already a \.bag file \(a ROS 1 bag\); "
+        r"name a folder \(a ROS 2 bag\) or a \.mcap file",
+    ):
         convert_bag(source, tmp_path / "again.bag")
     notes = tmp_path / "notes"
     notes.mkdir()

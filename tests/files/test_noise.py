@@ -24,6 +24,7 @@ from gyrocomp.spilled_series import SpillArray, block_median
 
 from ..conftest import run
 
+
 @pytest.fixture(scope="module")
 def run_files(tmp_path_factory):
     """A held-out chamber run (temperature drift, 3 gyro and 3 accelerometer axes) as CSV and Parquet, and the
@@ -42,6 +43,7 @@ def run_files(tmp_path_factory):
 
 
 # --- spilled series -----------------------------------------------------------------------------------------
+
 
 def test_a_spilled_series_holds_what_was_appended_and_its_file_goes_on_close(tmp_path):
     rng = np.random.default_rng(0)
@@ -65,8 +67,12 @@ def test_a_spilled_series_refuses_a_negative_memory_limit():
 
 
 @hsettings(max_examples=60, deadline=None)
-@given(st.integers(1, 3000), st.integers(1, 64), st.sampled_from(["normal", "rounded", "mostly equal", "ulps"]),
-       st.integers(0, 2 ** 31))
+@given(
+    st.integers(1, 3000),
+    st.integers(1, 64),
+    st.sampled_from(["normal", "rounded", "mostly equal", "ulps"]),
+    st.integers(0, 2**31),
+)
 def test_block_median_is_numpys_median_exactly(n, block, kind, seed):
     rng = np.random.default_rng(seed)
     values = {
@@ -87,9 +93,9 @@ def test_block_median_of_nothing_is_refused():
 
 # --- phases in one pass -------------------------------------------------------------------------------------
 
+
 @hsettings(max_examples=25, deadline=None)
-@given(st.lists(st.integers(0, 700), min_size=1, max_size=8), st.sampled_from([0, 1 << 20]),
-       st.integers(0, 2 ** 31))
+@given(st.lists(st.integers(0, 700), min_size=1, max_size=8), st.sampled_from([0, 1 << 20]), st.integers(0, 2**31))
 def test_any_chunking_gives_the_phase_to_phase_gives(sizes, memory_bytes, seed):
     rng = np.random.default_rng(seed)
     rate = rng.standard_normal((sum(sizes) + 2, 2)) * 0.01 + [1.5, -40.0] + np.linspace(0, 3, sum(sizes) + 2)[:, None]
@@ -102,7 +108,7 @@ def test_any_chunking_gives_the_phase_to_phase_gives(sizes, memory_bytes, seed):
         for j in range(2):
             expected = to_phase(rate[:, j], 50.0)
             # the sums are about the first chunk's mean: equal to rounding of the largest partial sum
-            scale = np.abs(np.cumsum(rate[:, j] - rate[:cuts[1] or 1, j].mean())).max() / 50.0 + 1e-300
+            scale = np.abs(np.cumsum(rate[:, j] - rate[: cuts[1] or 1, j].mean())).max() / 50.0 + 1e-300
             assert np.max(np.abs(phases[j] - expected)) <= 1e-12 * max(scale, np.abs(expected).max())
 
 
@@ -132,7 +138,7 @@ def test_the_allan_deviation_of_the_accumulated_phase_is_the_rates(tmp_path):
     exact = np.concatenate([[0], np.cumsum((rate - rate.mean()).astype(np.longdouble))]) / 100
     np.testing.assert_array_equal(np.round(from_phase.tau * 100).astype(int), factors)
     for j, m in enumerate(factors):
-        d = exact[2 * m:] - 2 * exact[m:-m] + exact[:-2 * m]
+        d = exact[2 * m :] - 2 * exact[m:-m] + exact[: -2 * m]
         reference = float(np.sqrt(np.sum(d * d) / (2 * (m / 100) ** 2 * d.size)))
         assert from_phase.deviation[j] == pytest.approx(reference, rel=1e-7), m
         assert direct.deviation[j] == pytest.approx(reference, rel=1e-7), m
@@ -140,6 +146,7 @@ def test_the_allan_deviation_of_the_accumulated_phase_is_the_rates(tmp_path):
 
 
 # --- a file's noise -----------------------------------------------------------------------------------------
+
 
 def _same_noise(chunked, whole):
     assert chunked.rate_hz == whole.rate_hz and list(chunked.axes) == list(whole.axes)
@@ -158,8 +165,10 @@ def _same_noise(chunked, whole):
 @pytest.mark.parametrize("chunk_rows, memory_bytes", [(777, 0), (5000, 1 << 25)])
 def test_a_files_noise_in_chunks_is_the_whole_files(run_files, tmp_path, suffix, chunk_rows, memory_bytes):
     chunks = ChunkSettings(chunk_rows=chunk_rows, memory_bytes=memory_bytes, scratch_dir=str(tmp_path))
-    for kind, axes, accel, names in (("oadev", None, False, ["gyro_x", "gyro_y", "gyro_z"]),
-                                     ("mdev", ["gyro_z", "accel_x"], True, ["gyro_z", "accel_x", "accel_y", "accel_z"])):
+    for kind, axes, accel, names in (
+        ("oadev", None, False, ["gyro_x", "gyro_y", "gyro_z"]),
+        ("mdev", ["gyro_z", "accel_x"], True, ["gyro_z", "accel_x", "accel_y", "accel_z"]),
+    ):
         chunked = analyse_noise_file(run_files[suffix], axes, with_accel=accel, kind=kind, chunks=chunks)
         whole = analyse_noise(read_table(run_files[suffix]).recording, names, kind=kind)
         _same_noise(chunked, whole)
@@ -186,13 +195,15 @@ def test_an_axis_the_file_lacks_is_named(run_files):
 
 # --- a file's evaluation ------------------------------------------------------------------------------------
 
+
 def _same_evaluation(chunked, whole):
     assert len(chunked.runs) == len(whole.runs) == 1
     a, b = chunked.runs[0], whole.runs[0]
     assert a.file == b.file and a.window_s == pytest.approx(b.window_s, rel=1e-12)
     assert list(a.axes) == list(b.axes) and list(a.accel_axes) == list(b.accel_axes)
-    for mine, theirs in [(a.axes[k], b.axes[k]) for k in a.axes] + [(a.accel_axes[k], b.accel_axes[k])
-                                                                     for k in a.accel_axes]:
+    for mine, theirs in [(a.axes[k], b.axes[k]) for k in a.axes] + [
+        (a.accel_axes[k], b.accel_axes[k]) for k in a.accel_axes
+    ]:
         assert mine.unit == theirs.unit
         for key, value in mine.to_dict().items():
             assert value == pytest.approx(theirs.to_dict()[key], rel=1e-8), key
@@ -246,14 +257,16 @@ def test_a_bad_row_half_way_leaves_no_temporary_file(consumer_model, run_files, 
 
 
 def test_a_model_with_the_accelerometer_is_judged_on_both_sensors_in_chunks(run_files, tmp_path):
-    runs = [simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording
-            for s in range(2)]
+    runs = [
+        simulate("consumer", profile="chamber", rate_hz=2, duration_s=3600, seed=s, unit=3).recording for s in range(2)
+    ]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = fit_channels(runs, ("gyro", "accel"))
         whole = evaluate(model, read_table(run_files["parquet"]).recording)
-        chunked = evaluate_file(model, run_files["parquet"], chunks=ChunkSettings(chunk_rows=450, memory_bytes=0,
-                                                                                   scratch_dir=str(tmp_path)))
+        chunked = evaluate_file(
+            model, run_files["parquet"], chunks=ChunkSettings(chunk_rows=450, memory_bytes=0, scratch_dir=str(tmp_path))
+        )
     assert model.accel_axes and list(chunked.runs[0].accel_axes) == ["accel_x", "accel_y", "accel_z"]
     _same_evaluation(chunked, whole)
     assert not list(tmp_path.iterdir())
@@ -273,7 +286,7 @@ def test_a_compensation_beyond_any_sensors_range_is_refused_naming_its_row(consu
     message = r"hot\.csv: row 3001, column 'temperature': 1e\+308 degC is beyond what any sensor gives"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for chunk_rows in (700, 10 ** 6):
+        for chunk_rows in (700, 10**6):
             with pytest.raises(InputError, match=message):
                 evaluate_file(consumer_model, bad, chunks=ChunkSettings(chunk_rows=chunk_rows))
         with pytest.raises(InputError, match=message):

@@ -26,9 +26,14 @@ def consumer():
     model = preset_model("consumer")
     prof = get_profile("combined", set_points_degc=(-20.0, 70.0), ramp_rate_degc_per_min=1.0, dwell_s=900.0)
     runs = [simulate(model, profile=prof, rate_hz=RATE_HZ, seed=s) for s in range(3)]
-    held = simulate(model, profile=get_profile("combined", set_points_degc=(-10.0, 60.0),
-                                               positions_g=tumble_positions((0.5, -0.5)), position_s=600.0),
-                    rate_hz=RATE_HZ, seed=77)
+    held = simulate(
+        model,
+        profile=get_profile(
+            "combined", set_points_degc=(-10.0, 60.0), positions_g=tumble_positions((0.5, -0.5)), position_s=600.0
+        ),
+        rate_hz=RATE_HZ,
+        seed=77,
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration([r.recording for r in runs])
@@ -41,8 +46,12 @@ def test_default_is_within_15_percent_of_perfect_on_every_axis(consumer):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         comp = apply(cal, held.recording).gyro_dps
-        cubic = apply(fit_calibration([r.recording for r in runs], temperature=Polynomial(3), hysteresis="none",
-                                      acceleration="none"), held.recording).gyro_dps
+        cubic = apply(
+            fit_calibration(
+                [r.recording for r in runs], temperature=Polynomial(3), hysteresis="none", acceleration="none"
+            ),
+            held.recording,
+        ).gyro_dps
     w = int(60 * RATE_HZ)
     for j in range(3):
         perfect = smoothed_residual_rms(held.truth.noise.total_dps[:, j], w)
@@ -88,12 +97,15 @@ def test_streaming_with_accelerations_equals_batch(consumer):
         warnings.simplefilter("ignore")
         batch = apply(cal, rec).gyro_dps
         comp = Compensator(cal, rec.gyro_axes, rate_hz=rec.rate_hz)
-        parts = [comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b], rec.accel_g[a:b])
-                 for a, b in [(0, 777), (777, 5000), (5000, rec.n_samples)]]
+        parts = [
+            comp.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.temperature_degc[a:b], rec.accel_g[a:b])
+            for a, b in [(0, 777), (777, 5000), (5000, rec.n_samples)]
+        ]
     np.testing.assert_allclose(np.concatenate(parts), batch, rtol=0, atol=1e-12)
     with pytest.raises(InputError, match="the model has g-sensitivity; the data needs accel_x, accel_y and accel_z"):
-        Compensator(cal, rec.gyro_axes, rate_hz=rec.rate_hz).update(rec.time_s[:10], rec.gyro_dps[:10],
-                                                                     rec.temperature_degc[:10])
+        Compensator(cal, rec.gyro_axes, rate_hz=rec.rate_hz).update(
+            rec.time_s[:10], rec.gyro_dps[:10], rec.temperature_degc[:10]
+        )
 
 
 def test_model_file_keeps_g_and_old_files_upgrade(consumer, tmp_path):
@@ -114,8 +126,9 @@ def test_model_file_keeps_g_and_old_files_upgrade(consumer, tmp_path):
 def test_g_x_g_terms_recovered_with_matrix2():
     base = preset_model("consumer").without("hysteresis", "lag", "temperature")
     q = ((0.02, 0.0, 0.0, 0.01, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0, 0.0, 0.03))
-    model = dataclasses.replace(base, g_squared_dps_per_g2=q, bias_instability_deg_per_h=2.0,
-                                rate_random_walk_dps_per_sqrt_s=0.0)
+    model = dataclasses.replace(
+        base, g_squared_dps_per_g2=q, bias_instability_deg_per_h=2.0, rate_random_walk_dps_per_sqrt_s=0.0
+    )
     runs = [simulate(model, profile="tumble", rate_hz=2, seed=s).recording for s in range(2)]
     cal = fit_calibration(runs, acceleration="matrix2")
     acc = cal.fit_report["acceleration"]["axes"]
@@ -125,7 +138,9 @@ def test_g_x_g_terms_recovered_with_matrix2():
     a = f + np.asarray(model.accelerometer.bias_g)
     p, pa = g_squared_products(f), g_squared_products(a)
     for i, axis in enumerate(("gyro_x", "gyro_y", "gyro_z")):
-        fitted = pa @ np.asarray(acc[axis]["g_squared_dps_per_g2"]) + a @ np.asarray(acc[axis]["g_sensitivity_dps_per_g"])
+        fitted = pa @ np.asarray(acc[axis]["g_squared_dps_per_g2"]) + a @ np.asarray(
+            acc[axis]["g_sensitivity_dps_per_g"]
+        )
         true = p @ np.asarray(q[i]) + f @ np.asarray(model.g_sensitivity_dps_per_g[i])
         # 13 coefficients from 2 x 27 five-minute positions, each mean good to ~5e-4 deg/s: within 2e-3
         # of an effect of up to 0.1 deg/s
@@ -138,7 +153,10 @@ def test_rank_deficient_positions_warn_and_leave_the_columns_unfitted():
     positions = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.7071, 0.7071, 0.0))
     prof = get_profile("tumble", positions_g=positions, position_s=600.0)
     runs = [simulate("consumer", profile=prof, rate_hz=2, seed=s).recording for s in range(2)]
-    with pytest.warns(DataQualityWarning, match=r"the positions do not excite accel_z \(\d[.\de-]* g\): within-run spread below 0.1 g; .*not fitted"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"the positions do not excite accel_z \(\d[.\de-]* g\): within-run spread below 0.1 g; .*not fitted",
+    ):
         cal = fit_calibration(runs, acceleration="matrix")
     for _axis, info in cal.fit_report["acceleration"]["axes"].items():
         assert info["g_sensitivity_dps_per_g"][2] == 0.0 and info["standard_error_dps_per_g"][2] is None
@@ -167,8 +185,11 @@ def pipelines(consumer):
         for name in PIPELINES:
             cal = joint if name == "joint" else fit_pipeline([r.recording for r in runs], name)
             comp = apply(cal, held.recording).gyro_dps
-            ratio = [smoothed_residual_rms(comp[:, j] - held.truth.true_rate_dps[:, j], 60)
-                     / smoothed_residual_rms(held.truth.noise.total_dps[:, j], 60) for j in range(3)]
+            ratio = [
+                smoothed_residual_rms(comp[:, j] - held.truth.true_rate_dps[:, j], 60)
+                / smoothed_residual_rms(held.truth.noise.total_dps[:, j], 60)
+                for j in range(3)
+            ]
             out[name] = (cal, float(np.mean(ratio)))
     return out
 
@@ -217,7 +238,8 @@ def test_joint_network_reads_the_accelerations(consumer, pipelines, tmp_path):
         np.testing.assert_array_equal(apply(loaded, held.recording).gyro_dps, apply(cal, held.recording).gyro_dps)
     with pytest.raises(InputError, match="the data needs accel_x, accel_y and accel_z"):
         Compensator(cal, ("gyro_x", "gyro_y", "gyro_z"), rate_hz=1.0).update(
-            held.recording.time_s[:5], held.recording.gyro_dps[:5], held.recording.temperature_degc[:5])
+            held.recording.time_s[:5], held.recording.gyro_dps[:5], held.recording.temperature_degc[:5]
+        )
 
 
 def test_unknown_pipeline():
@@ -231,11 +253,15 @@ def test_excited_columns_from_the_spread_of_the_positions():
     """Positions that tilt x and y but leave z near 1 g excite two columns; with all three excited the zz
     term is left out of the g x g set (xx + yy + zz = 1 g^2 at rest makes it the run constant)."""
     rng = np.random.default_rng(4)
-    tilted = np.column_stack([rng.choice([-0.5, 0.0, 0.5], 200), rng.choice([-0.5, 0.5], 200),
-                              0.95 + 0.01 * rng.standard_normal(200)])
+    tilted = np.column_stack(
+        [rng.choice([-0.5, 0.0, 0.5], 200), rng.choice([-0.5, 0.5], 200), 0.95 + 0.01 * rng.standard_normal(200)]
+    )
     weights = [np.ones(200), np.ones(200)]
-    with pytest.warns(DataQualityWarning, match=r"the positions do not excite accel_z \(0\.01 g\): within-run spread "
-                                                r"below 0\.1 g"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"the positions do not excite accel_z \(0\.01 g\): within-run spread "
+        r"below 0\.1 g",
+    ):
         excited, squares, names = excited_columns([tilted, tilted[::-1]], weights, squares=True)
     assert excited == (0, 1) and names == ("accel_x", "accel_y")
     assert [G_SQUARED_TERMS[m] for m in squares] == ["xx", "yy", "xy"]

@@ -23,10 +23,15 @@ from ..conftest import assert_streaming_equals_batch
 RATE_HZ = 2.0
 #: the half difference between the heating and the cooling curve: 0.03 deg/s at 25 degC, 0.0008 deg/s/degC more
 #: per degree; the branches cross over within about 5 degC after each turn
-PART = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.01, 5e-5),), t_ref_degc=25.0,
-                      hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
-                      noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=10.0,
-                      turn_on_bias_sigma_dps=0.05)
+PART = GyroErrorModel(
+    axes=("gyro_z",),
+    temperature_coefficients=((0.01, 5e-5),),
+    t_ref_degc=25.0,
+    hysteresis=Hysteresis(((0.03, 0.0008),), transition_degc=5.0),
+    noise_density_dps_per_sqrt_hz=0.005,
+    bias_instability_deg_per_h=10.0,
+    turn_on_bias_sigma_dps=0.05,
+)
 
 
 def test_branch_position_crosses_over_after_each_turn():
@@ -47,10 +52,13 @@ def test_branch_position_crosses_over_after_each_turn():
 @pytest.fixture(scope="module")
 def two_runs():
     """Two heat-cool runs (four legs) to fit on, a third to judge on."""
-    fit = [simulate(PART, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=RATE_HZ,
-                    seed=s).recording for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))]
-    held = simulate(PART, profile=get_profile("cycle", set_points_degc=(-15.0, 65.0), cycles=1), rate_hz=RATE_HZ,
-                    seed=7)
+    fit = [
+        simulate(PART, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=RATE_HZ, seed=s).recording
+        for s, sp in ((0, (-20.0, 70.0)), (1, (-10.0, 60.0)))
+    ]
+    held = simulate(
+        PART, profile=get_profile("cycle", set_points_degc=(-15.0, 65.0), cycles=1), rate_hz=RATE_HZ, seed=7
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return fit_channels(fit), fit_plain_cubic(fit), held
@@ -90,8 +98,9 @@ def test_model_file_round_trip_and_validation(two_runs, tmp_path):
     assert loaded.axes == cal.axes
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        np.testing.assert_array_equal(apply(loaded, two_runs[2].recording).gyro_dps,
-                                      apply(cal, two_runs[2].recording).gyro_dps)
+        np.testing.assert_array_equal(
+            apply(loaded, two_runs[2].recording).gyro_dps, apply(cal, two_runs[2].recording).gyro_dps
+        )
     entry = cal.axes["gyro_z"].hysteresis.to_dict()
     with pytest.raises(InputError, match=r"a branch model needs t_scale_degc and transition_degc above 0"):
         memory_curve_from_dict({**entry, "transition_degc": 0.0})

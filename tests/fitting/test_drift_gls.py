@@ -3,12 +3,19 @@
 import numpy as np
 import pytest
 
-from gyrocomp.fitting.drift_gls import (DriftNoise, chi2_threshold, coarsen, covariance, fit_drift_noise,
-                                       wald_statistic, whitened)
+from gyrocomp.fitting.drift_gls import (
+    DriftNoise,
+    chi2_threshold,
+    coarsen,
+    covariance,
+    fit_drift_noise,
+    wald_statistic,
+    whitened,
+)
 from gyrocomp.fitting.thermal import plausible_middle
 
-K = 2e-3       # random walk [unit/sqrt(s)]
-SIGMA = 0.01   # white noise per point [unit]
+K = 2e-3  # random walk [unit/sqrt(s)]
+SIGMA = 0.01  # white noise per point [unit]
 DT_S = 5.0
 
 
@@ -23,8 +30,8 @@ def test_the_walk_model_recovers_the_white_noise_and_the_walk():
     runs = [_walk(rng, 4000) for _ in range(3)]
     noise = fit_drift_noise([r for _, r in runs], [t for t, _ in runs], exponents=(1.0,))
     # 12000 points, the shortest lags carry thousands of increments: a few per cent, 15 % allowed
-    assert noise.walk_var_per_s == pytest.approx(K ** 2, rel=0.15)
-    assert noise.white_var == pytest.approx(SIGMA ** 2, rel=0.15)
+    assert noise.walk_var_per_s == pytest.approx(K**2, rel=0.15)
+    assert noise.white_var == pytest.approx(SIGMA**2, rel=0.15)
     assert noise.exponent == 1.0
 
 
@@ -47,8 +54,8 @@ def test_the_drift_exponent_and_the_variogram_are_recovered(alpha):
 def test_the_covariance_of_exponent_one_is_the_walks():
     t = np.arange(40) * DT_S + 7.0
     tau = t - t[0]
-    expected = K ** 2 * np.minimum.outer(tau, tau) + SIGMA ** 2 * np.eye(t.size)
-    np.testing.assert_allclose(covariance(t, DriftNoise(SIGMA ** 2, K ** 2)), expected, rtol=1e-12, atol=1e-15)
+    expected = K**2 * np.minimum.outer(tau, tau) + SIGMA**2 * np.eye(t.size)
+    np.testing.assert_allclose(covariance(t, DriftNoise(SIGMA**2, K**2)), expected, rtol=1e-12, atol=1e-15)
 
 
 def test_a_step_between_two_halves_is_weighed_against_the_walk():
@@ -59,12 +66,12 @@ def test_a_step_between_two_halves_is_weighed_against_the_walk():
     n = 200
     step = (np.arange(n) >= n // 2).astype(float)
     x = np.column_stack([np.ones(n), step])
-    noise = DriftNoise(SIGMA ** 2, K ** 2)
+    noise = DriftNoise(SIGMA**2, K**2)
     null, ols = [], []
     for _ in range(200):
         t, y = _walk(rng, n)
         null.append(wald_statistic([x], [y], [t], noise, np.array([1])))
-        ols.append(wald_statistic([x], [y], [t], DriftNoise(SIGMA ** 2, 0.0), np.array([1])))
+        ols.append(wald_statistic([x], [y], [t], DriftNoise(SIGMA**2, 0.0), np.array([1])))
     threshold = chi2_threshold(1)
     assert np.mean(np.asarray(ols) > threshold) > 0.5
     # chi-square(1): mean 1, and at 3 sigma a pass in 200 runs is rare (binomial: 4 or more has p < 0.1 %)
@@ -77,8 +84,8 @@ def test_a_step_between_two_halves_is_weighed_against_the_walk():
 
 def test_whitening_makes_the_covariance_the_identity():
     t = np.arange(50) * DT_S
-    noise = DriftNoise(SIGMA ** 2, K ** 2)
-    cov = K ** 2 * np.minimum.outer(t - t[0], t - t[0]) + SIGMA ** 2 * np.eye(t.size)
+    noise = DriftNoise(SIGMA**2, K**2)
+    cov = K**2 * np.minimum.outer(t - t[0], t - t[0]) + SIGMA**2 * np.eye(t.size)
     # whitened(x) = L^-1 x, so whitened(L) = I for the Cholesky factor L of the covariance
     chol = np.linalg.cholesky(cov)
     xw, yw = whitened(chol, chol[:, 0], t, noise)

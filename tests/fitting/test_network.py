@@ -24,8 +24,12 @@ def test_jacobian_matches_finite_differences(hidden):
     _, acts = forward(theta, shapes, x)
     jac = jacobian(theta, shapes, acts)
     h = 1e-6
-    numeric = np.column_stack([(forward(theta + h * e, shapes, x)[0] - forward(theta - h * e, shapes, x)[0]) / (2 * h)
-                               for e in np.eye(theta.size)])
+    numeric = np.column_stack(
+        [
+            (forward(theta + h * e, shapes, x)[0] - forward(theta - h * e, shapes, x)[0]) / (2 * h)
+            for e in np.eye(theta.size)
+        ]
+    )
     np.testing.assert_allclose(jac, numeric, atol=1e-8)
 
 
@@ -36,8 +40,10 @@ def test_lm_recovers_a_network_it_could_represent():
     x = np.linspace(-1, 1, 400)[:, None]
     y, _ = forward(truth, shapes, x)
     run = np.zeros(400, dtype=int)
-    fits = [train_lm(x, y, np.ones(400), run, 1, np.ones(400, dtype=bool), shapes, np.random.default_rng([0, k]))
-            for k in range(5)]
+    fits = [
+        train_lm(x, y, np.ones(400), run, 1, np.ones(400, dtype=bool), shapes, np.random.default_rng([0, k]))
+        for k in range(5)
+    ]
     best = min(fits, key=lambda r: r.train_rmse)
     assert best.train_rmse < 1e-6 * np.std(y)
 
@@ -53,8 +59,12 @@ def test_validation_segments_are_spread_and_the_same_every_time():
 @pytest.fixture(scope="module")
 def chamber():
     """A cubic truth: four 1-hour chamber runs to fit on, one cycle held out (10 Hz)."""
-    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((2e-3, 3e-5, -4e-7),),
-                           bias_instability_deg_per_h=2.0, accelerometer=None)
+    model = GyroErrorModel(
+        axes=("gyro_z",),
+        temperature_coefficients=((2e-3, 3e-5, -4e-7),),
+        bias_instability_deg_per_h=2.0,
+        accelerometer=None,
+    )
     runs = [simulate(model, profile="chamber", duration_s=3600, rate_hz=10, seed=s).recording for s in range(4)]
     held = simulate(model, profile="cycle", duration_s=3600, rate_hz=10, seed=40)
     return runs, held
@@ -95,10 +105,16 @@ def test_network_is_deterministic_for_a_seed_and_saved_as_json(chamber, tmp_path
 def test_network_with_lag_and_hysteresis_generalizes_to_a_faster_ramp():
     rng_c = (-30.0, 80.0)
     model = preset_model("adxrs450")
-    runs = [simulate(model, profile=get_profile("cycle", set_points_degc=rng_c, cycles=1), rate_hz=1.0, seed=s)
-            for s in range(3)]
-    held = simulate(model, profile=get_profile("cycle", set_points_degc=rng_c, cycles=1, ramp_rate_degc_per_min=3.0),
-                    rate_hz=1.0, seed=50)
+    runs = [
+        simulate(model, profile=get_profile("cycle", set_points_degc=rng_c, cycles=1), rate_hz=1.0, seed=s)
+        for s in range(3)
+    ]
+    held = simulate(
+        model,
+        profile=get_profile("cycle", set_points_degc=rng_c, cycles=1, ramp_rate_degc_per_min=3.0),
+        rate_hz=1.0,
+        seed=50,
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         cal = fit_calibration([r.recording for r in runs], temperature=Network(), hysteresis_band_degc=(55.0, 80.0))
@@ -117,11 +133,24 @@ def test_network_options_and_errors():
     with pytest.raises(InputError, match=r"--temperature: 'net': use auto, poly, poly:N, .*mlp, mlp:H or none"):
         parse_temperature_option("net")
     with pytest.raises(InputError, match="mlp weights do not fit a 1-3-1 network"):
-        NetworkCurve.from_dict({"type": "mlp", "hidden": [3], "weights": [[0.0] * 6, [0.0] * 3], "output_mean_dps": 0,
-                           "output_scale_dps": 1, "t_ref_degc": 25, "t_min_degc": 0, "t_max_degc": 50})
+        NetworkCurve.from_dict(
+            {
+                "type": "mlp",
+                "hidden": [3],
+                "weights": [[0.0] * 6, [0.0] * 3],
+                "output_mean_dps": 0,
+                "output_scale_dps": 1,
+                "t_ref_degc": 25,
+                "t_min_degc": 0,
+                "t_max_degc": 50,
+            }
+        )
     model = NetworkTemperatureModel()
-    with pytest.raises(NotFittedError, match=r"NetworkTemperatureModel is not fitted yet; call fit_blocks\(axis, ...\) "
-                                             r"first \(curves_ is learned by the fit\)"):
+    with pytest.raises(
+        NotFittedError,
+        match=r"NetworkTemperatureModel is not fitted yet; call fit_blocks\(axis, ...\) "
+        r"first \(curves_ is learned by the fit\)",
+    ):
         _ = model.curves_
     assert not hasattr(model, "epochs_")  # hasattr reads a NotFittedError as absent
     flat = [np.full(100, 25.0)]

@@ -34,13 +34,23 @@ CC = shutil.which("cc") or shutil.which("gcc")
 def _drift(calibration, recording) -> float:
     """Mean over the axes of the RMS of the 60 s moving average about its mean (at rest the truth is 0)."""
     compensated = recording if calibration is None else apply(calibration, recording)
-    return float(np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz))
-                          for j in range(compensated.gyro_dps.shape[1])]))
+    return float(
+        np.mean(
+            [
+                smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz))
+                for j in range(compensated.gyro_dps.shape[1])
+            ]
+        )
+    )
 
 
 def _field_logs(count: int, rate_hz: float, first_seed: int = 100):
-    return [simulate(PRESET, profile=get_profile("field", motion_seed=k), rate_hz=rate_hz, seed=first_seed + k,
-                     unit=UNIT).recording for k in range(count)]
+    return [
+        simulate(
+            PRESET, profile=get_profile("field", motion_seed=k), rate_hz=rate_hz, seed=first_seed + k, unit=UNIT
+        ).recording
+        for k in range(count)
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -51,8 +61,12 @@ def study():
     profile = resolve_profile("chamber", PRESET, set_points_degc=(20.0, 45.0))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        chamber = fit_channels([simulate(PRESET, profile=profile, rate_hz=25.0, duration_s=3600, seed=200 + k,
-                                         unit=UNIT).recording for k in range(3)])
+        chamber = fit_channels(
+            [
+                simulate(PRESET, profile=profile, rate_hz=25.0, duration_s=3600, seed=200 + k, unit=UNIT).recording
+                for k in range(3)
+            ]
+        )
     held_out = simulate(PRESET, profile=profile, rate_hz=25.0, duration_s=3600, seed=300, unit=UNIT).recording
     return logs, chamber, held_out
 
@@ -96,10 +110,10 @@ def _inject(rec, turn_dps: float):
     gyro, accel = rec.gyro_dps.copy(), rec.accel_g.copy()
     turn, bump = segments[2], segments[1]
     mid, n = (turn.start + turn.stop) // 2, int(40 * rec.rate_hz)
-    gyro[mid - n:mid + n, 2] += turn_dps
+    gyro[mid - n : mid + n, 2] += turn_dps
     mid, n = (bump.start + bump.stop) // 2, int(0.3 * rec.rate_hz)
-    gyro[mid:mid + n] += 3.0
-    accel[mid:mid + n] += 0.3
+    gyro[mid : mid + n] += 3.0
+    accel[mid : mid + n] += 0.3
     return dataclasses.replace(rec, gyro_dps=gyro, accel_g=accel)
 
 
@@ -115,8 +129,7 @@ def test_injected_outliers_are_rejected(study, learned):
     replay(guarded, dirty)
     replay(unguarded, dirty)
     assert guarded.status.rejected_outliers >= clean_learner.status.rejected_outliers + 5
-    clean, with_test, without_test = (_drift(x.to_calibration(), held_out)
-                                      for x in (clean_learner, guarded, unguarded))
+    clean, with_test, without_test = (_drift(x.to_calibration(), held_out) for x in (clean_learner, guarded, unguarded))
     assert with_test < 1.1 * clean
     assert without_test > 2 * clean
 
@@ -148,8 +161,9 @@ _SHORT = {}
 
 def _short_log():
     if "log" not in _SHORT:
-        _SHORT["log"] = simulate(PRESET, profile=get_profile("field", motion_seed=1), rate_hz=10.0, seed=3,
-                                 unit=UNIT).recording
+        _SHORT["log"] = simulate(
+            PRESET, profile=get_profile("field", motion_seed=1), rate_hz=10.0, seed=3, unit=UNIT
+        ).recording
     return _SHORT["log"]
 
 
@@ -188,9 +202,14 @@ def test_should_save_turns_on_when_the_model_moves():
     before = learner.to_calibration()
     replay(learner, logs[1:])
     after = learner.to_calibration()
-    moved = max(float(np.max(np.abs(before.axes[a].shape_dps(np.arange(22.0, 44.0))
-                                    - after.axes[a].shape_dps(np.arange(22.0, 44.0)))))
-                for a in before.axes)
+    moved = max(
+        float(
+            np.max(
+                np.abs(before.axes[a].shape_dps(np.arange(22.0, 44.0)) - after.axes[a].shape_dps(np.arange(22.0, 44.0)))
+            )
+        )
+        for a in before.axes
+    )
     assert (moved > learner.settings.save_change_dps) == learner.should_save
 
 
@@ -247,8 +266,10 @@ def test_the_c_learner_matches_python(tmp_path):
     slow turn at the start of another, which exercises the outlier pool) against the Python learner fed each log
     at once: the same decisions, and the model to 1e-9; the C code allocates nothing (no malloc/calloc/realloc/free,
     no variable-length array)."""
-    tables = [np.column_stack([rec.time_s, rec.gyro_dps, rec.accel_g, rec.temperature_degc])
-              for rec in _field_logs(3, 10.0, first_seed=60)]
+    tables = [
+        np.column_stack([rec.time_s, rec.gyro_dps, rec.accel_g, rec.temperature_degc])
+        for rec in _field_logs(3, 10.0, first_seed=60)
+    ]
     tables[1][9000, 2] = np.nan  # a bad sample
     tables[1] = np.delete(tables[1], np.s_[20000:20100], axis=0)  # a 10 s gap
     tables[2][300:1150, 3] += 0.1  # the third power-on begins with a slow turn: its first points are replaced
@@ -258,9 +279,25 @@ def test_the_c_learner_matches_python(tmp_path):
         (tmp_path / name).write_text(text)
     (tmp_path / "driver.c").write_text(DRIVER)
     exe = tmp_path / "driver"
-    subprocess.run([CC, "-std=c99", "-O2", "-Wall", "-Wextra", "-Wvla", "-Werror", "-o", str(exe),
-                    str(tmp_path / "driver.c"), str(tmp_path / "gyrocomp_learn.c"), "-lm"],
-                   check=True, capture_output=True, text=True)
+    subprocess.run(
+        [
+            CC,
+            "-std=c99",
+            "-O2",
+            "-Wall",
+            "-Wextra",
+            "-Wvla",
+            "-Werror",
+            "-o",
+            str(exe),
+            str(tmp_path / "driver.c"),
+            str(tmp_path / "gyrocomp_learn.c"),
+            "-lm",
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     lines = ["10.0"]
     learner = OnlineCalibrator(10.0)
     for table in tables:
@@ -268,13 +305,19 @@ def test_the_c_learner_matches_python(tmp_path):
         learner.start_session()
         learner.update(table[:, 0], table[:, 1:4], table[:, 4:7], table[:, 7])
         learner.end_session()
-    out = subprocess.run([str(exe)], input="\n".join(lines) + "\n", capture_output=True, text=True,
-                         check=True).stdout.splitlines()
+    out = subprocess.run(
+        [str(exe)], input="\n".join(lines) + "\n", capture_output=True, text=True, check=True
+    ).stdout.splitlines()
     status = learner.status
     assert status.rejected_outliers >= 2  # the slow turn: its pieces went to the pool, which replaced the points
     head = out[0].split()
-    assert [int(v) for v in head[:5]] == [status.degree, learner._lag_index, learner._sessions.size,
-                                          status.rejected_outliers, status.rejected_bound]
+    assert [int(v) for v in head[:5]] == [
+        status.degree,
+        learner._lag_index,
+        learner._sessions.size,
+        status.rejected_outliers,
+        status.rejected_bound,
+    ]
     assert float(head[5]) == pytest.approx(status.still_s, rel=1e-12)
     t_min, t_max, temperature, size = (float(v) for v in out[1].split())
     assert (t_min, t_max) == pytest.approx((status.t_min_degc, status.t_max_degc), rel=1e-12)
@@ -321,11 +364,14 @@ def test_bad_input_is_refused_with_a_clear_message():
         learner.to_calibration()
     with pytest.raises(NotFittedError, match="no model yet"):
         learner.bias_dps(25.0)
-    for kwargs, message in (({"rate_hz": 0.0}, "rate_hz: must be positive"), ({"degree": 4}, "degree: 1, 2 or 3"),
-                            ({"lag_candidates_s": (30.0,)}, "lag_candidates_s: 1 to 8 time constants"),
-                            ({"max_points": 3}, "max_points: a whole number in 8..4096"),
-                            ({"t_high_degc": -50.0}, "t_high_degc: must exceed t_low_degc"),
-                            ({"alpha": 0.7}, r"alpha: must lie in \(0, 0.5\)")):
+    for kwargs, message in (
+        ({"rate_hz": 0.0}, "rate_hz: must be positive"),
+        ({"degree": 4}, "degree: 1, 2 or 3"),
+        ({"lag_candidates_s": (30.0,)}, "lag_candidates_s: 1 to 8 time constants"),
+        ({"max_points": 3}, "max_points: a whole number in 8..4096"),
+        ({"t_high_degc": -50.0}, "t_high_degc: must exceed t_low_degc"),
+        ({"alpha": 0.7}, r"alpha: must lie in \(0, 0.5\)"),
+    ):
         with pytest.raises(InputError, match=message):
             LearnerSettings(**{"rate_hz": 10.0, **kwargs})
     good = learner.to_dict()
@@ -343,10 +389,11 @@ def test_bad_input_is_refused_with_a_clear_message():
         OnlineCalibrator.from_dict(broken, "state.json")
     # finite but forged: numbers that would overflow the refit, integers beyond numpy's, a temperature no sensor has
     for section, field, value, message in (
-            ("points", "bias_dps", 1e308, r"points.bias_dps: holds 1e\+308, beyond the 1e\+12 a learner state holds"),
-            ("points", "temperature_degc", 5000.0, r"points.temperature_degc: holds 5e\+03, beyond the 200"),
-            ("noise", "var_count", 10 ** 29, r"noise.var_count: whole numbers in 0..\d+ expected"),
-            ("stream", "t0", -1e300, r"stream.t0: holds -1e\+300, beyond")):
+        ("points", "bias_dps", 1e308, r"points.bias_dps: holds 1e\+308, beyond the 1e\+12 a learner state holds"),
+        ("points", "temperature_degc", 5000.0, r"points.temperature_degc: holds 5e\+03, beyond the 200"),
+        ("noise", "var_count", 10**29, r"noise.var_count: whole numbers in 0..\d+ expected"),
+        ("stream", "t0", -1e300, r"stream.t0: holds -1e\+300, beyond"),
+    ):
         forged = json.loads(json.dumps(good))
         target = forged[section][field]
         while isinstance(target, list) and isinstance(target[0], list):
@@ -379,10 +426,17 @@ def test_a_narrow_range_gives_no_temperature_model():
 def test_a_single_axis_gyro_learns_its_axis():
     """The thesis's ADXRS450 (gyro_z only): the missing axes read nothing and are never tested; the model file
     holds gyro_z alone and removes most of its drift on a held-out chamber run (measured: 0.143 -> 0.013 deg/s)."""
-    logs = [simulate("adxrs450", profile=get_profile("field", motion_seed=k), rate_hz=5.0, seed=10 + k).recording
-            for k in range(4)]
-    held_out = simulate("adxrs450", profile=resolve_profile("chamber", "adxrs450", set_points_degc=(20.0, 45.0)),
-                        rate_hz=5.0, duration_s=3600, seed=30).recording
+    logs = [
+        simulate("adxrs450", profile=get_profile("field", motion_seed=k), rate_hz=5.0, seed=10 + k).recording
+        for k in range(4)
+    ]
+    held_out = simulate(
+        "adxrs450",
+        profile=resolve_profile("chamber", "adxrs450", set_points_degc=(20.0, 45.0)),
+        rate_hz=5.0,
+        duration_s=3600,
+        seed=30,
+    ).recording
     learner = OnlineCalibrator(5.0)
     contributions = replay(learner, logs)
     assert {c.gyro_axes for c in contributions} == {("gyro_z",)}
@@ -399,8 +453,10 @@ def test_a_power_on_that_begins_with_a_slow_turn_is_recovered():
     """The third of three power-ons turns slowly (0.1 deg/s about z) for its first 85 s: its first points set a wrong
     constant, the pieces after them are rejected into the pool until they outvote those points, which are
     replaced. Its constant ends within 1 mdeg/s of the clean run's, keeping nearly all its still time."""
-    tables = [np.column_stack([rec.time_s, rec.gyro_dps, rec.accel_g, rec.temperature_degc])
-              for rec in _field_logs(3, 10.0, first_seed=60)]
+    tables = [
+        np.column_stack([rec.time_s, rec.gyro_dps, rec.accel_g, rec.temperature_degc])
+        for rec in _field_logs(3, 10.0, first_seed=60)
+    ]
     turned = [t.copy() for t in tables]
     turned[2][300:1150, 3] += 0.1
     learners = []
@@ -417,11 +473,14 @@ def test_a_power_on_that_begins_with_a_slow_turn_is_recovered():
     assert recovered.status.still_s > 0.95 * clean.status.still_s
 
 
-@pytest.mark.parametrize("field, value, message", [
-    ("block_s", 1e7, r"block_s: at most 60, got 1e\+07"),
-    ("rate_hz", 1e9, r"rate_hz: at most 40000, got 1e\+09"),
-    ("piece_s", 1e5, r"piece_s: at most 3600, got 100000"),
-])
+@pytest.mark.parametrize(
+    "field, value, message",
+    [
+        ("block_s", 1e7, r"block_s: at most 60, got 1e\+07"),
+        ("rate_hz", 1e9, r"rate_hz: at most 40000, got 1e\+09"),
+        ("piece_s", 1e5, r"piece_s: at most 3600, got 100000"),
+    ],
+)
 def test_settings_that_would_ask_for_gigabytes_are_refused(field, value, message):
     with pytest.raises(InputError, match=message):
         LearnerSettings(**{"rate_hz": 100.0, field: value})

@@ -19,8 +19,13 @@ from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.io.tables import write_recording
 from gyrocomp.models.fit import fit_channels
 from gyrocomp.report.html import _pose_residuals, build_report
-from gyrocomp.fitting.pose_rotation import (fit_gyro_between_poses, ordered_product, quaternion_from_rotvec,
-                                           rotation_errors, rotation_matrix)
+from gyrocomp.fitting.pose_rotation import (
+    fit_gyro_between_poses,
+    ordered_product,
+    quaternion_from_rotvec,
+    rotation_errors,
+    rotation_matrix,
+)
 from gyrocomp.simulation import AccelErrorModel, get_profile, preset_model, simulate
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
@@ -29,14 +34,35 @@ from ..conftest import run, xsens_session
 
 #: a hand-turned session: the six faces in turn (90 deg turns about every axis, both ways), then three poses
 #: tilted between the axes; 1 s per turn, 10 s per pose
-FACES = ((0, 0, 1), (1, 0, 0), (0, 0, -1), (-1, 0, 0), (0, 0, 1), (0, 1, 0), (0, 0, -1), (0, -1, 0), (0, 0, 1),
-         (1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0), (1, 0, 0), (0.7071, 0, 0.7071), (0, 0.7071, -0.7071),
-         (-0.7071, 0.7071, 0))
+FACES = (
+    (0, 0, 1),
+    (1, 0, 0),
+    (0, 0, -1),
+    (-1, 0, 0),
+    (0, 0, 1),
+    (0, 1, 0),
+    (0, 0, -1),
+    (0, -1, 0),
+    (0, 0, 1),
+    (1, 0, 0),
+    (0, 1, 0),
+    (-1, 0, 0),
+    (0, -1, 0),
+    (1, 0, 0),
+    (0.7071, 0, 0.7071),
+    (0, 0.7071, -0.7071),
+    (-0.7071, 0.7071, 0),
+)
 #: the MTi-10 preset (500 ppm scale, 0.05 deg misalignment, its noise and g-sensitivity) with an accelerometer
 #: that is misaligned too: the gyro's K is found in the accelerometer's corrected frame, here the body frame
-PART = dataclasses.replace(preset_model("mti10"), accelerometer=AccelErrorModel(
-    bias_g=(0.005, -0.003, 0.004), noise_density_g_per_sqrt_hz=80e-6,
-    scale_misalignment=((2e-3, 1e-3, -2e-3), (0.5e-3, -3e-3, 1.5e-3), (-1e-3, 2e-3, 4e-3))))
+PART = dataclasses.replace(
+    preset_model("mti10"),
+    accelerometer=AccelErrorModel(
+        bias_g=(0.005, -0.003, 0.004),
+        noise_density_g_per_sqrt_hz=80e-6,
+        scale_misalignment=((2e-3, 1e-3, -2e-3), (0.5e-3, -3e-3, 1.5e-3), (-1e-3, 2e-3, 4e-3)),
+    ),
+)
 TRUTH = np.eye(3) + np.diag(np.array(PART.scale_factor_error_ppm) * 1e-6) + np.array(PART.misalignment_rad)
 IDENTITY = TriadCalibration.identity()
 
@@ -73,7 +99,9 @@ def test_turns_between_poses_recover_the_gyro_scale_within_0_1_percent():
 
 
 def _session_at(temperature_degc, seed):
-    prof = get_profile("tumble", positions_g=FACES * 2, position_s=10.0, move_s=1.0, set_points_degc=(temperature_degc,))
+    prof = get_profile(
+        "tumble", positions_g=FACES * 2, position_s=10.0, move_s=1.0, set_points_degc=(temperature_degc,)
+    )
     return simulate(PART, profile=prof, rate_hz=100, seed=seed).recording
 
 
@@ -94,7 +122,7 @@ def test_sessions_at_three_temperatures_give_k_and_its_temperature_coefficients(
     assert np.all(np.abs(z) < 3.0), z
     held = _session_at(40.0, 9)
     constant = dataclasses.replace(cal, sensitivity_per_degc=(), sensitivity_per_degc_stderr=(), reference_degc=None)
-    rms = lambda moves: np.sqrt(np.mean([m.error_after_deg ** 2 for m in moves]))  # noqa: E731
+    rms = lambda moves: np.sqrt(np.mean([m.error_after_deg**2 for m in moves]))  # noqa: E731
     assert rms(rotation_errors(held, cal)) < rms(rotation_errors(held, constant))
     with pytest.raises(InputError, match="temperature_order: 1 needs turning sessions at temperatures at least 5 degC"):
         fit_gyro_between_poses(_session(1), temperature_order=1)
@@ -109,8 +137,11 @@ def test_bad_sessions_are_refused_naming_what_is_missing():
         fit_gyro_between_poses(_session(2, no_z))
     # the tumble profile turns about z once only (90 deg, from -x to +y): K's z column stays undetermined
     tumble = simulate(PART, profile=get_profile("tumble", position_s=10.0, move_s=2.0), rate_hz=50, seed=3).recording
-    with pytest.raises(InputError, match=r"turns leave the gyro's K undetermined \(the [xy] output's response to "
-                                         r"turns about z\); turn the unit about its z axis more"):
+    with pytest.raises(
+        InputError,
+        match=r"turns leave the gyro's K undetermined \(the [xy] output's response to "
+        r"turns about z\); turn the unit about its z axis more",
+    ):
         fit_gyro_between_poses(tumble)
     with pytest.raises(InputError, match="needs all three gyro axes"):
         fit_gyro_between_poses(dataclasses.replace(still, gyro_dps=still.gyro_dps[:, 2:], gyro_axes=("gyro_z",)))
@@ -124,10 +155,11 @@ def test_xsens_session_turns_predict_gravity_to_0_2_deg_on_held_out_turns():
     half = int(np.searchsorted(rec.time_s, 280.0))
     first = fit_gyro_between_poses(rec.take(slice(0, half)))
     assert len(first.moves) >= 18 and first.error_rms_after_deg < 0.2
-    later = rotation_errors(rec.take(slice(half, rec.n_samples)), first.calibration,
-                            accel_calibration=first.accel_calibrations[0])
-    after = np.sqrt(np.mean([m.error_after_deg ** 2 for m in later]))
-    before = np.sqrt(np.mean([m.error_before_deg ** 2 for m in later]))
+    later = rotation_errors(
+        rec.take(slice(half, rec.n_samples)), first.calibration, accel_calibration=first.accel_calibrations[0]
+    )
+    after = np.sqrt(np.mean([m.error_after_deg**2 for m in later]))
+    before = np.sqrt(np.mean([m.error_before_deg**2 for m in later]))
     assert len(later) >= 15 and after < 0.3 and before > 20
     assert np.all(np.abs(np.diag(first.calibration.sensitivity) - 0.76) < 0.02)
 
@@ -143,7 +175,7 @@ def test_fit_and_apply_correct_the_turns_of_another_session(tmp_path):
     other = _session(5, part=consumer)
     raw = rotation_errors(other, IDENTITY)
     out = rotation_errors(apply(loaded, other), IDENTITY)
-    rms = lambda moves: np.sqrt(np.mean([m.error_after_deg ** 2 for m in moves]))  # noqa: E731
+    rms = lambda moves: np.sqrt(np.mean([m.error_after_deg**2 for m in moves]))  # noqa: E731
     assert rms(out) < 0.1 and rms(raw) > 0.5  # 1 % of 90 deg turns before, the noise after
     # the plain tumble cannot determine K: auto says so and fits the bias alone
     tumble = simulate(PART, profile=get_profile("tumble", position_s=10.0, move_s=2.0), rate_hz=20, seed=3).recording
@@ -153,8 +185,16 @@ def test_fit_and_apply_correct_the_turns_of_another_session(tmp_path):
 
 def test_cli_fits_the_scale_factor_from_a_turned_session(tmp_path):
     write_recording(_session(6), tmp_path / "session.csv")
-    result = run("fit", tmp_path / "session.csv", "-o", tmp_path / "model.json", "--hysteresis", "none",
-                 "--scale-factor", "matrix")
+    result = run(
+        "fit",
+        tmp_path / "session.csv",
+        "-o",
+        tmp_path / "model.json",
+        "--hysteresis",
+        "none",
+        "--scale-factor",
+        "matrix",
+    )
     assert result.returncode == 0, result.stderr
     assert "gyro scale factor and misalignment (rotation" in result.stdout
     assert Calibration.load(tmp_path / "model.json").gyro_triad.method == "rotation"
@@ -163,13 +203,15 @@ def test_cli_fits_the_scale_factor_from_a_turned_session(tmp_path):
 def test_report_draws_the_scale_factor_and_the_residual_of_each_pose_and_turn():
     part = dataclasses.replace(PART, scale_factor_error_ppm=(10000.0, -8000.0, 6000.0))
     rec = _session(7, part=part)
-    cal = fit_channels([rec], ("gyro", "accel"), options=FitOptions(hysteresis="none"))  # one temperature: the triads alone
+    cal = fit_channels(
+        [rec], ("gyro", "accel"), options=FitOptions(hysteresis="none")
+    )  # one temperature: the triads alone
     assert cal.gyro_triad.method == "rotation" and cal.accel_triad.method == "six-position" and not cal.accel_axes
     residuals = _pose_residuals(cal, [rec], [apply(cal, rec)])
     before, after = residuals["accelerometer |a| - 1 g [mg]"]
     assert len(before) == 34 and np.max(np.abs(before)) > 5 and np.max(np.abs(after)) < 0.5  # 3-5 mg bias, 0.4 % scale
     before, after = residuals["gyro: gravity direction after each turn [deg]"]
-    assert len(before) == 33 and np.sqrt(np.mean(after ** 2)) < 0.1 < np.sqrt(np.mean(before ** 2))
+    assert len(before) == 33 and np.sqrt(np.mean(after**2)) < 0.1 < np.sqrt(np.mean(before**2))
     report = build_report(cal, [rec])
     assert "scale-factor" in report.sections and "+10000" not in report.html  # the fitted error, not the truth
     assert re.search(r"gyro x</td><td[^>]*>rotation</td><td[^>]*>\+1\.0(09|10|11)", report.html)

@@ -94,8 +94,8 @@ def test_tangent_extension_past_the_range():
     # analytic: at the edge u=1 the value is 0.07 and the slope d/du is 0.1 - 0.1 + 0.06 = 0.06 per u
     expected_hi = 0.07 + 0.06 * (40 - 30) / 10
     lo_u = -1.0
-    value_lo = 0.1 * lo_u - 0.05 * lo_u ** 2 + 0.02 * lo_u ** 3
-    slope_lo = 0.1 - 0.1 * lo_u + 0.06 * lo_u ** 2
+    value_lo = 0.1 * lo_u - 0.05 * lo_u**2 + 0.02 * lo_u**3
+    slope_lo = 0.1 - 0.1 * lo_u + 0.06 * lo_u**2
     np.testing.assert_allclose(curve.shape(t), [expected_hi, value_lo + slope_lo * (5 - 10) / 10], rtol=1e-12)
     held = PolynomialCurve((0.1, -0.05, 0.02), 20.0, 10.0, 10.0, 30.0)
     np.testing.assert_allclose(held.shape(t), [0.07, value_lo], rtol=1e-12)
@@ -106,8 +106,7 @@ def test_tangent_extension_past_the_range():
 
 def _single_cycle(seed):
     """One chamber run cooled, heated, cooled again (the way PX4 and most vendors calibrate), 2 Hz."""
-    prof = get_profile("chamber", set_points_degc=(25.0, -20.0, 70.0, -20.0), ramp_rate_degc_per_min=1.0,
-                       dwell_s=600.0)
+    prof = get_profile("chamber", set_points_degc=(25.0, -20.0, 70.0, -20.0), ramp_rate_degc_per_min=1.0, dwell_s=600.0)
     return simulate("adxrs450", profile=prof, rate_hz=2.0, seed=seed)
 
 
@@ -143,10 +142,18 @@ def _consumer_runs(seed):
     different range and rate."""
     model = dataclasses.replace(preset_model("consumer"), thermal_time_constant_s=20.0)
     kw = dict(positions_g=SIX_POSITIONS_G, position_s=300.0, move_s=10.0)
-    profiles = [Profile("warmup", set_points_degc=(20.0,), warmup_rise_degc=25.0, warmup_time_constant_s=600.0,
-                        duration_s=2400.0, **kw),
-                Profile("chamber", set_points_degc=(10.0, 50.0), ramp_rate_degc_per_min=2.0, dwell_s=600.0, **kw),
-                Profile("cycle", set_points_degc=(10.0, 50.0), ramp_rate_degc_per_min=2.0, dwell_s=300.0, **kw)]
+    profiles = [
+        Profile(
+            "warmup",
+            set_points_degc=(20.0,),
+            warmup_rise_degc=25.0,
+            warmup_time_constant_s=600.0,
+            duration_s=2400.0,
+            **kw,
+        ),
+        Profile("chamber", set_points_degc=(10.0, 50.0), ramp_rate_degc_per_min=2.0, dwell_s=600.0, **kw),
+        Profile("cycle", set_points_degc=(10.0, 50.0), ramp_rate_degc_per_min=2.0, dwell_s=300.0, **kw),
+    ]
     held = Profile("cycle", set_points_degc=(15.0, 45.0), ramp_rate_degc_per_min=1.5, dwell_s=200.0, **kw)
     runs = [simulate(model, profile=p, rate_hz=10.0, seed=10 * seed + k).recording for k, p in enumerate(profiles)]
     return runs, simulate(model, profile=held, rate_hz=10.0, seed=10 * seed + 9)
@@ -175,11 +182,19 @@ def test_lag_residuals_from_the_shape_columns_equal_those_of_the_full_normal_mat
     columns alone; they equal the same candidates' residuals in the matrices with every hysteresis and branch
     column, at every lag of the grid and for every fold."""
     model = preset_model("adxrs450")
-    runs = [simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=2.0, seed=s).recording
-            for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)), (2, (-25.0, 85.0)))]
-    problem = prepare_axis(runs, "gyro_z", groups=(0, 1, 2), max_order=3, hysteresis_orders=(1, 2),
-                           branch_orders=(1, 2),
-                           other_curves=curve_candidates(Polynomial()).others)
+    runs = [
+        simulate(model, profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=2.0, seed=s).recording
+        for s, sp in ((0, (-30.0, 85.0)), (1, (-20.0, 80.0)), (2, (-25.0, 85.0)))
+    ]
+    problem = prepare_axis(
+        runs,
+        "gyro_z",
+        groups=(0, 1, 2),
+        max_order=3,
+        hysteresis_orders=(1, 2),
+        branch_orders=(1, 2),
+        other_curves=curve_candidates(Polynomial()).others,
+    )
     assert problem.columns(0, problem.runs[0].temperature_degc).shape[1] > 3 + 2 * 2  # hysteresis, branch columns
     if accel:  # the triad as if the part had been turned between blocks (at rest it would add nothing)
         rng = np.random.default_rng(3)
@@ -189,8 +204,12 @@ def test_lag_residuals_from_the_shape_columns_equal_those_of_the_full_normal_mat
     for order in (1, 3):
         got = problem.lag_rss(order, "time", grid)
         idx = problem.column_index(Candidate(order, True, 0, "time"))
-        full = np.array([[problem.solve(problem.training_matrices(float(tau), "time")[0][f], idx)[1]
-                          for tau in grid] for f in range(problem.folds.count)])
+        full = np.array(
+            [
+                [problem.solve(problem.training_matrices(float(tau), "time")[0][f], idx)[1] for tau in grid]
+                for f in range(problem.folds.count)
+            ]
+        )
         np.testing.assert_allclose(got, full / full.min(axis=1, keepdims=True), rtol=1e-9)
 
 
@@ -205,8 +224,16 @@ def test_a_lag_some_fold_puts_at_the_top_of_the_search_is_not_identified():
 def test_the_lag_search_stops_at_half_the_longest_run_on_the_grid_it_had():
     """The fold lags are the points of the grid from two blocks to the longest run (at most 4 h) that lie within
     half the longest run; the final fit searches up to the same half."""
-    runs = [simulate("consumer", profile=get_profile("cycle", set_points_degc=(-10.0, 40.0), cycles=1), rate_hz=1.0,
-                     duration_s=d, seed=1).recording for d in (3000.0, 7200.0)]
+    runs = [
+        simulate(
+            "consumer",
+            profile=get_profile("cycle", set_points_degc=(-10.0, 40.0), cycles=1),
+            rate_hz=1.0,
+            duration_s=d,
+            seed=1,
+        ).recording
+        for d in (3000.0, 7200.0)
+    ]
     problem = prepare_axis(runs, "gyro_x")
     lo = 2.0 * problem.block_s
     longest = max(float(r.time_s[-1] - r.time_s[0]) for r in problem.runs)  # of the blocks' times
@@ -215,6 +242,8 @@ def test_the_lag_search_stops_at_half_the_longest_run_on_the_grid_it_had():
     grid = problem.lag_grid_s()
     np.testing.assert_allclose(grid, full[full <= longest / 2])
     assert lag_search_top_s(problem.runs, lo) == pytest.approx(longest / 2)
-    assert lag_search_top_s([dataclasses.replace(problem.runs[0], time_s=np.array([0.0, 3.0 * LAG_MAX_S]))], lo) \
+    assert (
+        lag_search_top_s([dataclasses.replace(problem.runs[0], time_s=np.array([0.0, 3.0 * LAG_MAX_S]))], lo)
         == LAG_MAX_S
+    )
     assert lag_search_top_s([dataclasses.replace(problem.runs[0], time_s=np.array([0.0, 1.0]))], lo) == 2 * lo

@@ -57,7 +57,7 @@ def test_both_effects_recovered_and_generalize_to_a_faster_ramp(both_effects):
     assert ax.lag_time_constant_s == pytest.approx(60.0, rel=0.2)
     d = np.linspace(0, 25, 26)  # the preset: 0.032 d - 0.00128 d^2 below an 80 degC turn
     fitted = sum(h * d ** (j + 1) for j, h in enumerate(ax.hysteresis.descending))
-    np.testing.assert_allclose(fitted, 0.032 * d - 0.00128 * d ** 2, atol=0.02)
+    np.testing.assert_allclose(fitted, 0.032 * d - 0.00128 * d**2, atol=0.02)
     assert ax.hysteresis.band_degc == (55.0, 80.0)
     # the bar where both effects are present: within 35 % of perfect, 2x better than a cubic
     assert vs_perfect < 1.35
@@ -73,8 +73,9 @@ def test_lag_alone_generalizes_to_a_faster_ramp():
 
 
 def test_turning_point_hysteresis_alone():
-    model = dataclasses.replace(preset_model("adxrs450").without("lag"),
-                                hysteresis=Hysteresis(((0.0, 3e-5),), direction="descending"))
+    model = dataclasses.replace(
+        preset_model("adxrs450").without("lag"), hysteresis=Hysteresis(((0.0, 3e-5),), direction="descending")
+    )
     cal, _, vs_perfect, cubic_over_chosen = _experiment(model)
     assert cal.fit_report["hysteresis"]["axes"]["gyro_z"]["chosen"].startswith("turning-point")
     assert vs_perfect < 1.2 and cubic_over_chosen > 2.0
@@ -147,8 +148,9 @@ def test_one_temperature_column_gives_every_lagged_axis_one_time_constant():
         shared = ThermalHysteresisModel(order=2, hysteresis="lag", hysteresis_order=0).fit(runs)
         own = ThermalHysteresisModel(order=2, hysteresis="lag", hysteresis_order=0, shared_lag=False).fit(runs)
         # one temperature column per axis: each axis may sit on its own die, so each keeps its own lag
-        per_axis = [dataclasses.replace(r, temperature_degc=np.repeat(r.temperature_degc[:, None], 3, axis=1))
-                    for r in runs]
+        per_axis = [
+            dataclasses.replace(r, temperature_degc=np.repeat(r.temperature_degc[:, None], 3, axis=1)) for r in runs
+        ]
         separate = ThermalHysteresisModel(order=2, hysteresis="lag", hysteresis_order=0).fit(per_axis)
     taus = list(shared.lag_time_constants_s_.values())
     assert len(set(taus)) == 1 and taus[0] == pytest.approx(30.0, rel=0.25)  # the preset's 30 s

@@ -32,8 +32,9 @@ def unit_model(unit: int):
     if unit == NOISY_UNIT:
         model = dataclasses.replace(model, noise_density_dps_per_sqrt_hz=3 * model.noise_density_dps_per_sqrt_hz)
     if unit == HOT_UNIT:
-        model = dataclasses.replace(model, temperature_coefficients=tuple(tuple(5 * c for c in row)
-                                                                          for row in model.temperature_coefficients))
+        model = dataclasses.replace(
+            model, temperature_coefficients=tuple(tuple(5 * c for c in row) for row in model.temperature_coefficients)
+        )
     return model
 
 
@@ -46,8 +47,13 @@ def write_unit(folder: Path, unit: int, session: int = 0) -> list[Path]:
     paths = []
     (folder / serial(unit)).mkdir(parents=True, exist_ok=True)
     for k in range(RUNS_PER_UNIT):
-        sim = simulate(unit_model(unit), profile=resolve_profile("chamber", PRESET), duration_s=RUN_DURATION_S,
-                       rate_hz=RATE_HZ, seed=1000 * unit + 10 * session + k)
+        sim = simulate(
+            unit_model(unit),
+            profile=resolve_profile("chamber", PRESET),
+            duration_s=RUN_DURATION_S,
+            rate_hz=RATE_HZ,
+            seed=1000 * unit + 10 * session + k,
+        )
         path = folder / serial(unit) / f"run_{k}.parquet"
         write_recording(sim.recording, path)
         paths.append(path)
@@ -69,8 +75,10 @@ def _limits_text() -> str:
     largest temperature sensitivity."""
     nominal = preset_model(PRESET)
     sensitivity = max(abs(row[0]) for row in nominal.temperature_coefficients)
-    return (f"[noise_density_dps_per_sqrt_hz]\nmax = {2 * nominal.noise_density_dps_per_sqrt_hz}\n\n"
-            f"[temperature_sensitivity_dps_per_degc]\nabs_max = {2 * sensitivity}\n")
+    return (
+        f"[noise_density_dps_per_sqrt_hz]\nmax = {2 * nominal.noise_density_dps_per_sqrt_hz}\n\n"
+        f"[temperature_sensitivity_dps_per_degc]\nabs_max = {2 * sensitivity}\n"
+    )
 
 
 @pytest.fixture(scope="session")

@@ -18,8 +18,20 @@ from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import resolve_profile, simulate
 
 from ..conftest import run
-from .conftest import (CORRUPT_UNIT, FLEET_UNITS, HOT_UNIT, NOISY_UNIT, PATTERN, PRESET, RATE_HZ, RUN_DURATION_S,
-                       RUNS_PER_UNIT, serial, unit_model, write_unit)
+from .conftest import (
+    CORRUPT_UNIT,
+    FLEET_UNITS,
+    HOT_UNIT,
+    NOISY_UNIT,
+    PATTERN,
+    PRESET,
+    RATE_HZ,
+    RUN_DURATION_S,
+    RUNS_PER_UNIT,
+    serial,
+    unit_model,
+    write_unit,
+)
 
 pytestmark = pytest.mark.slow
 
@@ -78,8 +90,9 @@ def test_a_fleet_model_equals_gyrocomp_fit_on_the_command_line(fleet_run, fleet_
     runs = sorted((fleet_data / serial(5)).glob("run_*.parquet"))
     result = run("fit", *runs, "-o", tmp_path / "alone.json")
     assert result.returncode == 0, result.stderr
-    assert (_model_document(Calibration.load(out / "models" / f"{serial(5)}.json"))
-            == _model_document(Calibration.load(tmp_path / "alone.json")))
+    assert _model_document(Calibration.load(out / "models" / f"{serial(5)}.json")) == _model_document(
+        Calibration.load(tmp_path / "alone.json")
+    )
 
 
 def test_figures_recover_the_true_temperature_sensitivity(fleet_run):
@@ -91,12 +104,21 @@ def test_figures_recover_the_true_temperature_sensitivity(fleet_run):
     with CalibrationStore(out) as db:
         for unit in (0, 7, 64, HOT_UNIT):
             figures = db.valid_at(serial(unit)).figures
-            truths = [simulate(unit_model(unit), profile=resolve_profile("chamber", PRESET), duration_s=RUN_DURATION_S,
-                               rate_hz=RATE_HZ, seed=1000 * unit + k).truth for k in range(RUNS_PER_UNIT)]
+            truths = [
+                simulate(
+                    unit_model(unit),
+                    profile=resolve_profile("chamber", PRESET),
+                    duration_s=RUN_DURATION_S,
+                    rate_hz=RATE_HZ,
+                    seed=1000 * unit + k,
+                ).truth
+                for k in range(RUNS_PER_UNIT)
+            ]
             # at rest, upright: the turn-on bias plus the g-sensitivity's 1 g term, which a run at one orientation
             # cannot tell apart
-            turn_on = np.mean([t.turn_on_bias_dps + t.components_dps["acceleration"].mean(axis=0) for t in truths],
-                              axis=0)
+            turn_on = np.mean(
+                [t.turn_on_bias_dps + t.components_dps["acceleration"].mean(axis=0) for t in truths], axis=0
+            )
             for j, f in enumerate(figures.axes.values()):
                 assert f.turn_on_bias_dps == pytest.approx(turn_on[j], abs=3 * f.held_out_drift_dps), (unit, j)
             span = figures.temperature_max_degc - figures.temperature_min_degc
@@ -104,15 +126,17 @@ def test_figures_recover_the_true_temperature_sensitivity(fleet_run):
                 f = figures.axes[axis]
                 tolerance = 3 * f.held_out_drift_dps / (span / 2)
                 assert f.temperature_sensitivity_dps_per_degc == pytest.approx(row[0], abs=tolerance), (unit, axis)
-                assert f.noise_density_dps_per_sqrt_hz == pytest.approx(unit_model(unit).noise_density_dps_per_sqrt_hz,
-                                                                        rel=0.15)
+                assert f.noise_density_dps_per_sqrt_hz == pytest.approx(
+                    unit_model(unit).noise_density_dps_per_sqrt_hz, rel=0.15
+                )
 
 
 def test_a_rerun_skips_every_unchanged_unit_and_refits_a_changed_one(fleet_run, fleet_data, tmp_path):
     out, limits, _ = fleet_run
     # (without Dask: what is skipped is decided from the store before anything is sent to a worker)
-    again = run("fleet", "fit", fleet_data, "--unit-from", PATTERN, "-o", out, "--limits", limits, "--scheduler",
-                "serial")
+    again = run(
+        "fleet", "fit", fleet_data, "--unit-from", PATTERN, "-o", out, "--limits", limits, "--scheduler", "serial"
+    )
     assert again.returncode == 0, again.stderr
     # the corrupt unit has no successful calibration to compare with: it is tried again (and fails again)
     assert f"0 unit(s) fitted, {FLEET_UNITS - 1} unchanged (skipped), 1 failed" in again.stdout
@@ -137,8 +161,9 @@ def test_serial_scheduler_gives_the_dask_models(fleet_run, fleet_data):
     unit = UnitRuns(serial(11), tuple(str(p) for p in sorted((fleet_data / serial(11)).glob("run_*.parquet"))))
     outcome = fit_unit(unit, FleetSettings())
     assert outcome.status == "ok"
-    assert (_model_document(Calibration.from_dict(json.loads(outcome.model_json)))
-            == _model_document(Calibration.load(out / "models" / f"{serial(11)}.json")))
+    assert _model_document(Calibration.from_dict(json.loads(outcome.model_json))) == _model_document(
+        Calibration.load(out / "models" / f"{serial(11)}.json")
+    )
     assert fit_unit(unit, FleetSettings(), known_hash=outcome.input_hash).status == "unchanged"
     assert np.isfinite(outcome.figures.axes["gyro_x"].bias_instability_deg_per_h)
 

@@ -33,9 +33,26 @@ def fleet(tmp_path_factory):
 
 
 def _start(fleet, out, **popen):
-    return subprocess.Popen([str(SCRIPT), "fleet", "fit", str(fleet), "--unit-from", "{serial}/run_{n}.csv",
-                             "-o", str(out), "--scheduler", "local", "--workers", "2"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, **popen)
+    return subprocess.Popen(
+        [
+            str(SCRIPT),
+            "fleet",
+            "fit",
+            str(fleet),
+            "--unit-from",
+            "{serial}/run_{n}.csv",
+            "-o",
+            str(out),
+            "--scheduler",
+            "local",
+            "--workers",
+            "2",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        **popen,
+    )
 
 
 def _only_line(stderr: str, message: str) -> None:
@@ -46,15 +63,19 @@ def _only_line(stderr: str, message: str) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("stop, message, status", [
-    ("group SIGINT", "gyrocomp: interrupted (Ctrl-C); outputs not finished were removed", 130),
-    ("SIGTERM", "gyrocomp: stopped by SIGTERM; outputs not finished were removed", 143),
-])
+@pytest.mark.parametrize(
+    "stop, message, status",
+    [
+        ("group SIGINT", "gyrocomp: interrupted (Ctrl-C); outputs not finished were removed", 130),
+        ("SIGTERM", "gyrocomp: stopped by SIGTERM; outputs not finished were removed", 143),
+    ],
+)
 def test_a_fleet_stopped_says_so_in_one_line_and_the_rerun_finishes(fleet, tmp_path, stop, message, status):
     out = tmp_path / "out"
     # a terminal's Ctrl-C reaches every process of the command: its own session, SIGINT to the whole group
-    process = _start(fleet, out, start_new_session=True,
-                     preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    process = _start(
+        fleet, out, start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)
+    )
     time.sleep(1.0)
     # as a user would, again every half second until it stops: while the workers start (a second or two), the
     # command ignores the terminal's signals, so that the workers it spawns ignore them too
@@ -79,19 +100,35 @@ def test_a_fleet_stopped_says_so_in_one_line_and_the_rerun_finishes(fleet, tmp_p
 
 @pytest.mark.slow
 def test_too_few_file_descriptors_for_the_workers_is_one_line(fleet, tmp_path):
-    process = _start(fleet, tmp_path / "out",
-                     preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_NOFILE, (40, 40)))
+    process = _start(fleet, tmp_path / "out", preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_NOFILE, (40, 40)))
     stderr = process.communicate(timeout=120)[1]
     assert process.returncode == 2, stderr
-    _only_line(stderr, "--scheduler: local: this process may open 40 files at once (ulimit -n), and a local Dask "
-                       "cluster of 2 worker(s) needs about 192: raise the limit")
+    _only_line(
+        stderr,
+        "--scheduler: local: this process may open 40 files at once (ulimit -n), and a local Dask "
+        "cluster of 2 worker(s) needs about 192: raise the limit",
+    )
 
 
 def test_a_command_stopped_by_sighup_says_so_in_one_line(tmp_path):
     """A closed terminal (SIGHUP) on a long simulation: one line, no output left behind."""
-    process = subprocess.Popen([str(SCRIPT), "simulate", "--profile", "chamber", "--duration", "4e6", "--rate", "10",
-                                "-o", str(tmp_path / "long.csv")], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                               text=True)
+    process = subprocess.Popen(
+        [
+            str(SCRIPT),
+            "simulate",
+            "--profile",
+            "chamber",
+            "--duration",
+            "4e6",
+            "--rate",
+            "10",
+            "-o",
+            str(tmp_path / "long.csv"),
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     time.sleep(1.5)
     process.send_signal(signal.SIGHUP)
     stderr = process.communicate(timeout=60)[1]

@@ -15,8 +15,14 @@ import pytest
 from gyrocomp.calibration import Calibration
 from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.fleet import (CalibrationStore, block_covariance, comes_back, fit_with_prior, population_prior,
-                            prior_from_models)
+from gyrocomp.fleet import (
+    CalibrationStore,
+    block_covariance,
+    comes_back,
+    fit_with_prior,
+    population_prior,
+    prior_from_models,
+)
 from gyrocomp.io import read
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
@@ -58,8 +64,11 @@ def _held_out_drift(calibration: Calibration, recording) -> float:
     """Mean over the axes of the RMS of the 60 s moving average of the compensated rate (at rest: 0) about its mean."""
     compensated = apply(calibration, recording)
     window = int(DRIFT_WINDOW_S * recording.rate_hz)
-    return float(np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], window)
-                          for j in range(compensated.gyro_dps.shape[1])]))
+    return float(
+        np.mean(
+            [smoothed_residual_rms(compensated.gyro_dps[:, j], window) for j in range(compensated.gyro_dps.shape[1])]
+        )
+    )
 
 
 @pytest.fixture(scope="module")
@@ -73,8 +82,9 @@ def _short_run(unit: int, seed: int, profile_name: str = "cycle"):
     """The short run of ``unit``: ``cycle`` goes there and back (twice), ``chamber`` one way (held cold, up, held
     hot)."""
     profile = resolve_profile(profile_name, PRESET, set_points_degc=SHORT_SET_POINTS_DEGC)
-    return simulate(preset_model(PRESET, unit), profile=profile, duration_s=SHORT_DURATION_S, rate_hz=RATE_HZ,
-                    seed=seed).recording
+    return simulate(
+        preset_model(PRESET, unit), profile=profile, duration_s=SHORT_DURATION_S, rate_hz=RATE_HZ, seed=seed
+    ).recording
 
 
 def test_the_prior_leaves_out_outliers_and_spans_the_fleet(prior, fleet_run):
@@ -88,7 +98,9 @@ def test_the_prior_leaves_out_outliers_and_spans_the_fleet(prior, fleet_run):
         # the population mean of the linear coefficient is the nominal part's, within its 20 % spread / sqrt(n)
         slope = p.mean_dps[0] / prior.temperature_scale_degc
         assert slope == pytest.approx(row[0], rel=3 * 0.2 / math.sqrt(prior.units))
-        assert math.sqrt(p.covariance_dps2[0][0]) / prior.temperature_scale_degc == pytest.approx(0.2 * abs(row[0]), rel=0.2)
+        assert math.sqrt(p.covariance_dps2[0][0]) / prior.temperature_scale_degc == pytest.approx(
+            0.2 * abs(row[0]), rel=0.2
+        )
         assert p.lag_time_constant_s == pytest.approx(nominal.thermal_time_constant_s, rel=0.2)
 
 
@@ -106,10 +118,15 @@ def test_a_short_run_with_the_prior_comes_as_close_as_the_true_population_allows
     even the true population gives on this part)."""
     with_prior, with_truth, alone = [], [], []
     for unit in NEW_UNITS:
-        full = [simulate(PRESET, profile="chamber", duration_s=RUN_DURATION_S, rate_hz=RATE_HZ, seed=1000 * unit + k,
-                         unit=unit).recording for k in range(RUNS_PER_UNIT)]
-        held_out = simulate(PRESET, profile="chamber", duration_s=RUN_DURATION_S, rate_hz=RATE_HZ,
-                            seed=1000 * unit + 7, unit=unit).recording
+        full = [
+            simulate(
+                PRESET, profile="chamber", duration_s=RUN_DURATION_S, rate_hz=RATE_HZ, seed=1000 * unit + k, unit=unit
+            ).recording
+            for k in range(RUNS_PER_UNIT)
+        ]
+        held_out = simulate(
+            PRESET, profile="chamber", duration_s=RUN_DURATION_S, rate_hz=RATE_HZ, seed=1000 * unit + 7, unit=unit
+        ).recording
         short = _short_run(unit, 1000 * unit + 9)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the short run alone: its narrow span is warned about
@@ -131,8 +148,12 @@ def test_prior_from_models_recovers_the_parts_coefficients(prior):
     assert oracle.units == 50 and prior.reference_temperature_degc == parts[0].t_ref_degc
     scale = prior.temperature_scale_degc
     for j, axis in enumerate(parts[0].axes):
-        theta = np.array([[m.temperature_coefficients[j][0] * scale, m.temperature_coefficients[j][1] * scale ** 2, 0.0]
-                          for m in parts])
+        theta = np.array(
+            [
+                [m.temperature_coefficients[j][0] * scale, m.temperature_coefficients[j][1] * scale**2, 0.0]
+                for m in parts
+            ]
+        )
         assert np.allclose(oracle.axes[axis].mean_dps, theta.mean(axis=0), rtol=1e-9, atol=1e-12)
         assert np.allclose(oracle.axes[axis].covariance_dps2, np.cov(theta, rowvar=False), rtol=1e-7, atol=1e-15)
         assert oracle.axes[axis].lag_time_constant_s == parts[0].thermal_time_constant_s
@@ -144,23 +165,29 @@ def test_a_run_that_only_rises_is_warned_about(prior):
     """One way (held cold, one ramp up, held hot), temperature is a function of time and slow drift looks like the
     bias curve: the fit says so."""
     one_way = _short_run(NEW_UNITS[0], 1, "chamber")
-    with pytest.warns(DataQualityWarning, match=r"recordings: the temperature only rises or only falls in every "
-                                                r"run \(.*\): slow drift cannot be told from the temperature curve"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"recordings: the temperature only rises or only falls in every "
+        r"run \(.*\): slow drift cannot be told from the temperature curve",
+    ):
         fit_with_prior(one_way, prior)
     with warnings.catch_warnings():
         warnings.simplefilter("error", DataQualityWarning)
         fit_with_prior([one_way, _short_run(NEW_UNITS[0], 2)], prior)  # one run that comes back is enough
 
 
-@pytest.mark.parametrize(("temperature", "expected"), [
-    (np.linspace(10, 40, 500), False),  # up
-    (np.linspace(40, 10, 500), False),  # down
-    (np.r_[np.linspace(10, 40, 250), np.linspace(40, 10, 250)], True),  # up and down again
-    (np.r_[np.linspace(10, 40, 250), np.linspace(40, 30, 100)], False),  # back by a third of the span only
-    (np.r_[np.linspace(10, 40, 250), np.linspace(40, 24, 100)], True),  # back by more than half
-    (np.full(100, 25.0), False),  # no span
-    (np.array([25.0]), False),
-])
+@pytest.mark.parametrize(
+    ("temperature", "expected"),
+    [
+        (np.linspace(10, 40, 500), False),  # up
+        (np.linspace(40, 10, 500), False),  # down
+        (np.r_[np.linspace(10, 40, 250), np.linspace(40, 10, 250)], True),  # up and down again
+        (np.r_[np.linspace(10, 40, 250), np.linspace(40, 30, 100)], False),  # back by a third of the span only
+        (np.r_[np.linspace(10, 40, 250), np.linspace(40, 24, 100)], True),  # back by more than half
+        (np.full(100, 25.0), False),  # no span
+        (np.array([25.0]), False),
+    ],
+)
 def test_comes_back_needs_a_return_of_half_the_span(temperature, expected):
     assert comes_back(temperature) is expected
 
@@ -194,10 +221,22 @@ def test_fleet_fit_with_the_prior_on_the_command_line(fleet_run, prior, tmp_path
     out, _, _ = fleet_run
     for unit, profile_name in zip(NEW_UNITS[:2], ("cycle", "chamber")):  # the second unit's run goes one way
         (tmp_path / "new" / f"SN{unit}").mkdir(parents=True)
-        write_recording(_short_run(unit, 1000 * unit + 9, profile_name),
-                        tmp_path / "new" / f"SN{unit}" / "short.parquet")
-    result = run("fleet", "fit", tmp_path / "new", "--unit-from", "{serial}/short.parquet", "-o", tmp_path / "NEW",
-                 "--prior", out, "--scheduler", "serial")
+        write_recording(
+            _short_run(unit, 1000 * unit + 9, profile_name), tmp_path / "new" / f"SN{unit}" / "short.parquet"
+        )
+    result = run(
+        "fleet",
+        "fit",
+        tmp_path / "new",
+        "--unit-from",
+        "{serial}/short.parquet",
+        "-o",
+        tmp_path / "NEW",
+        "--prior",
+        out,
+        "--scheduler",
+        "serial",
+    )
     assert result.returncode == 0, result.stderr
     assert "2 unit(s) fitted" in result.stdout
     # the one-way unit is named in the summary with its warning, the other is not
@@ -216,8 +255,19 @@ def test_fleet_fit_with_the_prior_on_the_command_line(fleet_run, prior, tmp_path
         one_way = db.valid_at(f"SN{NEW_UNITS[1]}")
     assert any("the temperature only rises or only falls in every run" in w for w in one_way.warnings), one_way.warnings
     # a fleet of prior fits does not make a prior
-    few = run("fleet", "fit", tmp_path / "new", "--unit-from", "{serial}/short.parquet", "-o", tmp_path / "N2",
-              "--prior", tmp_path / "NEW", "--scheduler", "serial")
+    few = run(
+        "fleet",
+        "fit",
+        tmp_path / "new",
+        "--unit-from",
+        "{serial}/short.parquet",
+        "-o",
+        tmp_path / "N2",
+        "--prior",
+        tmp_path / "NEW",
+        "--scheduler",
+        "serial",
+    )
     assert few.returncode == 2 and "--prior: 0 calibrated unit(s) that are not outliers" in few.stderr
 
 

@@ -31,15 +31,27 @@ CMD = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
 
 
 def _record(serial: str, digest: str = "ab" * 32, when: dt.datetime | None = None) -> CalibrationRecord:
-    return CalibrationRecord(serial=serial, calibrated_utc=when or dt.datetime(2026, 1, 1), status="ok",
-                             input_hash=digest, gyrocomp_version="0.1.0", inputs=(InputFile("/a.csv", "cd" * 32),),
-                             model_json='{"not": "read here"}', station="T")
+    return CalibrationRecord(
+        serial=serial,
+        calibrated_utc=when or dt.datetime(2026, 1, 1),
+        status="ok",
+        input_hash=digest,
+        gyrocomp_version="0.1.0",
+        inputs=(InputFile("/a.csv", "cd" * 32),),
+        model_json='{"not": "read here"}',
+        station="T",
+    )
 
 
 def _chain(db: CalibrationStore, serial: str) -> list[tuple[int, int | None]]:
     with db.engine.connect() as conn:
-        return [tuple(r) for r in conn.execute(sa.text(
-            "select id, supersedes from calibrations where serial = :s and status = 'ok' order by id"), {"s": serial})]
+        return [
+            tuple(r)
+            for r in conn.execute(
+                sa.text("select id, supersedes from calibrations where serial = :s and status = 'ok' order by id"),
+                {"s": serial},
+            )
+        ]
 
 
 def _in_threads(work, n: int) -> list:
@@ -105,16 +117,19 @@ def test_claims_are_exclusive_and_taken_over_from_a_dead_or_silent_station(store
         assert claim(db, "U1", other) is None
         # B on another machine, silent past the lease: taken over
         with db.engine.begin() as conn:
-            conn.execute(sa.text("update claims set heartbeat_utc = :t"),
-                         {"t": dt.datetime.now(dt.timezone.utc).replace(tzinfo=None)
-                          - dt.timedelta(seconds=CLAIM_LEASE_S + 5)})
+            conn.execute(
+                sa.text("update claims set heartbeat_utc = :t"),
+                {"t": dt.datetime.now(dt.timezone.utc).replace(tzinfo=None) - dt.timedelta(seconds=CLAIM_LEASE_S + 5)},
+            )
         assert claim(db, "U1", me) is None and claims(db)[0].station == "A"
         # a station of this machine whose process is gone: taken over at once
         dead = subprocess.Popen([sys.executable, "-c", "pass"])
         dead.wait()
         here = Station("C", me.host, dead.pid)
         with db.engine.begin() as conn:
-            conn.execute(sa.text("update claims set host = :h, pid = :p, station = 'C'"), {"h": here.host, "p": dead.pid})
+            conn.execute(
+                sa.text("update claims set host = :h, pid = :p, station = 'C'"), {"h": here.host, "p": dead.pid}
+            )
         live = Station("D", me.host, os.getpid() + 0)
         assert claim(db, "U1", live) is None
         assert [(s.station, s.fitting) for s in station_status(db)] == [("D", ("U1",))]
@@ -162,9 +177,26 @@ def _manifest(folder, runs, serials) -> str:
 
 
 def _station(manifest, out, store, name) -> subprocess.Popen:
-    return subprocess.Popen([*CMD, "fleet", "fit", "--manifest", manifest, "-o", str(out), "--store", str(store),
-                             "--scheduler", "serial", "--station", name],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [
+            *CMD,
+            "fleet",
+            "fit",
+            "--manifest",
+            manifest,
+            "-o",
+            str(out),
+            "--store",
+            str(store),
+            "--scheduler",
+            "serial",
+            "--station",
+            name,
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def _consistent(store, outputs, serials) -> None:
@@ -191,17 +223,23 @@ def _consistent(store, outputs, serials) -> None:
 @pytest.mark.slow
 def test_four_stations_with_overlapping_units_store_each_once(store_location, runs, tmp_path):
     serials = sorted(runs)
-    lists = [sorted(set(serials[k * 3:k * 3 + 6] + serials[:2])) for k in range(4)]  # each overlaps the others
+    lists = [sorted(set(serials[k * 3 : k * 3 + 6] + serials[:2])) for k in range(4)]  # each overlaps the others
     outputs = [tmp_path / f"station{k}" for k in range(4)]
-    procs = [_station(_manifest(tmp_path, runs, lst), out, store_location, f"S{k}")
-             for k, (lst, out) in enumerate(zip(lists, outputs))]
+    procs = [
+        _station(_manifest(tmp_path, runs, lst), out, store_location, f"S{k}")
+        for k, (lst, out) in enumerate(zip(lists, outputs))
+    ]
     for p in procs:
         _, stderr = p.communicate(timeout=300)
         assert p.returncode == 0, stderr
     wanted = sorted(set().union(*lists))
     with CalibrationStore(store_location) as db:
         assert db.serials() == wanted
-        assert {s: [(r.station, r.status, r.input_hash[:8]) for r in db.history(s)] for s in wanted if len(db.history(s)) != 1} == {}
+        assert {
+            s: [(r.station, r.status, r.input_hash[:8]) for r in db.history(s)]
+            for s in wanted
+            if len(db.history(s)) != 1
+        } == {}
         assert claims(db) == []
     _consistent(store_location, outputs, wanted)
     status = json.loads(run("fleet", "status", "--store", store_location, "--json").stdout)
@@ -210,15 +248,19 @@ def test_four_stations_with_overlapping_units_store_each_once(store_location, ru
 
 
 @pytest.mark.slow
-def test_a_station_killed_at_random_moments_leaves_a_consistent_store_its_rerun_completes(store_location, runs,
-                                                                                          tmp_path):
+def test_a_station_killed_at_random_moments_leaves_a_consistent_store_its_rerun_completes(
+    store_location, runs, tmp_path
+):
     serials = sorted(runs)
     manifest = _manifest(tmp_path, runs, serials)
     rng = random.Random(7)
     for trial in range(1):  # 20 trials per backend: benchmarks/bench_stations.py
         out = tmp_path / f"trial{trial}"
-        store = store_location if trial == 0 else (
-            str(out / "calibrations.sqlite") if "://" not in store_location else store_location)
+        store = (
+            store_location
+            if trial == 0
+            else (str(out / "calibrations.sqlite") if "://" not in store_location else store_location)
+        )
         station = _station(manifest, out, store, "K")
         time.sleep(rng.uniform(0.5, 3.0))
         station.send_signal(signal.SIGKILL)

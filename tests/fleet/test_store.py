@@ -13,8 +13,16 @@ import sqlalchemy as sa
 from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError, ModelError
 from gyrocomp.fleet.store import STORE_SCHEMA_VERSION
-from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Failure, InputFile, UnitFigures,
-                            parse_time, store_url)
+from gyrocomp.fleet import (
+    AxisFigures,
+    CalibrationRecord,
+    CalibrationStore,
+    Failure,
+    InputFile,
+    UnitFigures,
+    parse_time,
+    store_url,
+)
 from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import simulate
 
@@ -24,8 +32,15 @@ from ..conftest import run
 @pytest.fixture(scope="module")
 def models() -> list[Calibration]:
     """Two different models of one part (two sessions of 20-minute chamber runs)."""
-    return [fit_channels([simulate("consumer", profile="chamber", duration_s=1200, rate_hz=5, seed=10 * s + k, unit=1)
-                          .recording for k in range(2)]) for s in range(2)]
+    return [
+        fit_channels(
+            [
+                simulate("consumer", profile="chamber", duration_s=1200, rate_hz=5, seed=10 * s + k, unit=1).recording
+                for k in range(2)
+            ]
+        )
+        for s in range(2)
+    ]
 
 
 def _figures(value: float) -> UnitFigures:
@@ -35,11 +50,20 @@ def _figures(value: float) -> UnitFigures:
 
 def _record(serial: str, when: dt.datetime, model: Calibration | None, drift: float = 0.004) -> CalibrationRecord:
     return CalibrationRecord(
-        serial=serial, calibrated_utc=when, status="ok" if model else "failed", input_hash="ab" * 32,
-        gyrocomp_version="0.1.0", inputs=(InputFile("/data/a.csv", "cd" * 32),), metadata={"lot": "L7"},
-        verdict="fail" if model else None, failures=(Failure("gyro_x_held_out_drift_dps", drift, "> max"),),
-        model_json=model.to_json() if model else None, figures=_figures(drift) if model else None,
-        error=None if model else "run.csv: row 3: not a number", warnings=("one warning",))
+        serial=serial,
+        calibrated_utc=when,
+        status="ok" if model else "failed",
+        input_hash="ab" * 32,
+        gyrocomp_version="0.1.0",
+        inputs=(InputFile("/data/a.csv", "cd" * 32),),
+        metadata={"lot": "L7"},
+        verdict="fail" if model else None,
+        failures=(Failure("gyro_x_held_out_drift_dps", drift, "> max"),),
+        model_json=model.to_json() if model else None,
+        figures=_figures(drift) if model else None,
+        error=None if model else "run.csv: row 3: not a number",
+        warnings=("one warning",),
+    )
 
 
 JAN, MAR, JUN = dt.datetime(2026, 1, 5, 12), dt.datetime(2026, 3, 1, 8, 30), dt.datetime(2026, 6, 1)
@@ -61,8 +85,20 @@ def test_a_row_round_trips_field_by_field(store, models):
     back = store.history("U1")[0]
     original = _record("U1", JAN, models[0], 0.004)
     assert back.id is not None
-    for name in ("serial", "calibrated_utc", "status", "input_hash", "gyrocomp_version", "inputs", "metadata",
-                 "verdict", "failures", "model_json", "error", "warnings"):
+    for name in (
+        "serial",
+        "calibrated_utc",
+        "status",
+        "input_hash",
+        "gyrocomp_version",
+        "inputs",
+        "metadata",
+        "verdict",
+        "failures",
+        "model_json",
+        "error",
+        "warnings",
+    ):
         assert getattr(back, name) == getattr(original, name), name
     assert back.figures.axes["gyro_x"].held_out_drift_dps == 0.004
     assert math.isnan(back.figures.axes["gyro_x"].tempco_3_dps_per_degc3)  # NaN survives (stored as null)
@@ -138,8 +174,19 @@ def test_fleet_show_and_export_through_the_command_line(store, models, tmp_path)
     exported = run("fleet", "export", "U1", "--store", folder, "--format", "json", "--at", "2026-02-01", "-o", out)
     assert exported.returncode == 0, exported.stderr
     assert Calibration.load(out).to_dict() == models[0].to_dict()
-    px4 = run("fleet", "export", "U2", "--store", store.file or folder, "--format", "px4", "-o",
-              tmp_path / "u2.params", "--device-id", 7)
+    px4 = run(
+        "fleet",
+        "export",
+        "U2",
+        "--store",
+        store.file or folder,
+        "--format",
+        "px4",
+        "-o",
+        tmp_path / "u2.params",
+        "--device-id",
+        7,
+    )
     models[1].save(tmp_path / "u2.json")
     direct = run("export", tmp_path / "u2.json", "--format", "px4", "-o", tmp_path / "direct.params", "--device-id", 7)
     assert px4.returncode == 0 and direct.returncode == 0

@@ -112,8 +112,11 @@ def test_outputs_onto_the_store_are_refused_and_the_store_is_intact(manifest, tm
     assert _fit(manifest, out).returncode == 0
     store = out / "calibrations.sqlite"
     before = store.read_bytes()
-    for args in (("report", out, "-o", store), ("export", "SN-1", "--store", out, "--format", "json", "-o", store),
-                 ("show", "SN-1", "--store", out, "-o", store)):
+    for args in (
+        ("report", out, "-o", store),
+        ("export", "SN-1", "--store", out, "--format", "json", "-o", store),
+        ("show", "SN-1", "--store", out, "-o", store),
+    ):
         result = run("fleet", *args)
         assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
         assert "this is an input file; choose another output path" in result.stderr
@@ -125,10 +128,21 @@ def test_two_fits_of_one_new_store_at_once_store_each_unit_once(manifest, tmp_pa
     """Two fits creating one new store at once (a fleet folder's SQLite file, or an empty PostgreSQL database)."""
     out = tmp_path / "FLEET"
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
-    args = ["fleet", "fit", "--manifest", str(manifest), "-o", str(out), "--scheduler", "serial", "--store",
-            str(_store(store_location, out))]
-    procs = [subprocess.Popen([*cmd, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for _ in range(2)]
+    args = [
+        "fleet",
+        "fit",
+        "--manifest",
+        str(manifest),
+        "-o",
+        str(out),
+        "--scheduler",
+        "serial",
+        "--store",
+        str(_store(store_location, out)),
+    ]
+    procs = [
+        subprocess.Popen([*cmd, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)
+    ]
     results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
     for _stdout, stderr, code in results:
         assert code == 0, stderr
@@ -143,8 +157,7 @@ def _other_inputs(folder, serials):
     for k, s in enumerate(serials):
         (folder / f"v{k}").mkdir(parents=True)
         path = folder / f"v{k}" / "run.csv"
-        write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=2, seed=50 + k).recording,
-                        path)
+        write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=2, seed=50 + k).recording, path)
         rows.append(f'{path},"{s}"')
     other = folder / "other.csv"
     other.write_text("\n".join(rows) + "\n")
@@ -169,8 +182,9 @@ def _files_agree_with_newest_rows(out, serials, store=None):
 
 
 @pytest.mark.slow
-def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_model(manifest, tmp_path,
-                                                                                   store_location, request):
+def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_model(
+    manifest, tmp_path, store_location, request
+):
     """Two stations recalibrating the same units from different runs at once: whatever the interleaving, each
     unit's model file is its newest row's (the file is written holding the store's write lock); on each backend
     (each repeat a new PostgreSQL database)."""
@@ -178,11 +192,31 @@ def test_two_fits_of_one_unit_from_other_inputs_at_once_leave_the_newest_rows_mo
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
     for repeat in range(3):
         out = tmp_path / f"FLEET{repeat}"
-        location = store_location if repeat == 0 or "://" not in store_location else \
-            request.getfixturevalue("postgres_server")()
-        procs = [subprocess.Popen([*cmd, "fleet", "fit", "--manifest", str(m), "-o", str(out), "--scheduler",
-                                   "serial", *_store_args(location, out)], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True) for m in (manifest, other)]
+        location = (
+            store_location
+            if repeat == 0 or "://" not in store_location
+            else request.getfixturevalue("postgres_server")()
+        )
+        procs = [
+            subprocess.Popen(
+                [
+                    *cmd,
+                    "fleet",
+                    "fit",
+                    "--manifest",
+                    str(m),
+                    "-o",
+                    str(out),
+                    "--scheduler",
+                    "serial",
+                    *_store_args(location, out),
+                ],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for m in (manifest, other)
+        ]
         for p in procs:
             _, stderr = p.communicate(timeout=300)
             assert p.returncode == 0, stderr
@@ -204,23 +238,28 @@ def test_the_rerun_puts_back_a_model_file_copied_over_or_cut_short(manifest, tmp
     _files_agree_with_newest_rows(out, SERIALS, _store(store_location, out))
 
 
-@pytest.mark.parametrize("column, value, said", [
-    ("model", '{"schema_version": 6, "axes"', r"store row \d+ \(SN-1\): .*"),
-    ("inputs", "not json", r"row \d+ \(unit 'SN-1'\) is damaged \(JSONDecodeError"),
-    ("calibrated_utc", "garbage", r"row \d+ \(unit 'SN-1'\) holds no time gyrocomp wrote"),
-])
+@pytest.mark.parametrize(
+    "column, value, said",
+    [
+        ("model", '{"schema_version": 6, "axes"', r"store row \d+ \(SN-1\): .*"),
+        ("inputs", "not json", r"row \d+ \(unit 'SN-1'\) is damaged \(JSONDecodeError"),
+        ("calibrated_utc", "garbage", r"row \d+ \(unit 'SN-1'\) holds no time gyrocomp wrote"),
+    ],
+)
 @pytest.mark.slow
-def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, fitted, tmp_path, column, value,
-                                                                     said):
+def test_a_store_row_changed_by_another_program_is_one_line_naming_it(manifest, fitted, tmp_path, column, value, said):
     out = tmp_path / "FLEET"
     shutil.copytree(fitted, out)
     with sqlite3.connect(out / "calibrations.sqlite") as conn:
         conn.execute(f"UPDATE calibrations SET {column} = ? WHERE serial = 'SN-1'", (value,))
     model_file = out / "models" / "SN-1.json"
     kept = model_file.read_bytes()
-    for args in (["show", "SN-1", "--store", out], ["export", "SN-1", "--store", out, "--format", "json", "-o",
-                                                     tmp_path / "m.json"], ["report", out, "-o", tmp_path / "r.html"],
-                 ["fit", "--manifest", manifest, "-o", out, "--scheduler", "serial"]):
+    for args in (
+        ["show", "SN-1", "--store", out],
+        ["export", "SN-1", "--store", out, "--format", "json", "-o", tmp_path / "m.json"],
+        ["report", out, "-o", tmp_path / "r.html"],
+        ["fit", "--manifest", manifest, "-o", out, "--scheduler", "serial"],
+    ):
         result = run("fleet", *args)
         if column == "model" and args[0] == "report":
             continue  # the report reads figures, not models
@@ -239,13 +278,17 @@ def test_a_damaged_model_row_on_postgresql_is_one_line_naming_it(manifest, tmp_p
     assert _fit(manifest, out, "--store", url).returncode == 0
     engine = sa.create_engine(url.replace("postgresql://", "postgresql+psycopg://", 1))
     with engine.begin() as conn:
-        conn.execute(sa.text("UPDATE calibrations SET model = :value WHERE serial = 'SN-1'"),
-                     {"value": '{"schema_version": 6, "axes"'})
+        conn.execute(
+            sa.text("UPDATE calibrations SET model = :value WHERE serial = 'SN-1'"),
+            {"value": '{"schema_version": 6, "axes"'},
+        )
     engine.dispose()
     kept = (out / "models" / "SN-1.json").read_bytes()
-    for args in (["show", "SN-1", "--store", url], ["export", "SN-1", "--store", url, "--format", "json", "-o",
-                                                     tmp_path / "m.json"],
-                 ["fit", "--manifest", manifest, "-o", out, "--scheduler", "serial", "--store", url]):
+    for args in (
+        ["show", "SN-1", "--store", url],
+        ["export", "SN-1", "--store", url, "--format", "json", "-o", tmp_path / "m.json"],
+        ["fit", "--manifest", manifest, "-o", out, "--scheduler", "serial", "--store", url],
+    ):
         result = run("fleet", *args)
         assert result.returncode == 2 and result.stderr.count("\n") == 1, (args, result.stderr)
         assert re.search(r"store row \d+ \(SN-1\): ", result.stderr), (args, result.stderr)

@@ -13,11 +13,23 @@ import pytest
 from scipy.stats import norm
 
 from gyrocomp.errors import DataQualityWarning, InputError
-from gyrocomp.fleet import (AxisFigures, CalibrationRecord, CalibrationStore, Limits, UnitFigures, UnitRuns, expand_inputs,
-                            fleet_table, fleet_yield, input_hash, robust_z, units_from_manifest,
-                            units_from_pattern, utc_now)
+from gyrocomp.fleet import (
+    AxisFigures,
+    CalibrationRecord,
+    CalibrationStore,
+    Limits,
+    UnitFigures,
+    UnitRuns,
+    expand_inputs,
+    fleet_table,
+    fleet_yield,
+    input_hash,
+    robust_z,
+    units_from_manifest,
+    units_from_pattern,
+    utc_now,
+)
 from gyrocomp.fleet.population import MIN_UNITS_FOR_OUTLIERS
-
 
 
 def _touch(root, *names):
@@ -34,8 +46,10 @@ def test_units_from_a_path_pattern(tmp_path):
     assert len(files) == 4  # notes.txt is a possible table too; the pattern leaves it out
     with pytest.warns(DataQualityWarning, match=r"1 file\(s\) do not match '\{lot\}/\{serial\}/run_\{n\}.csv'"):
         units = units_from_pattern(files, "{lot}/{serial}/run_{n}.csv")
-    assert [(u.serial, len(u.paths), dict(u.metadata)) for u in units] == [("SN1", 2, {"lot": "lotA"}),
-                                                                          ("SN2", 1, {"lot": "lotB"})]
+    assert [(u.serial, len(u.paths), dict(u.metadata)) for u in units] == [
+        ("SN1", 2, {"lot": "lotA"}),
+        ("SN2", 1, {"lot": "lotB"}),
+    ]
     with pytest.raises(InputError, match=r"unit_pattern: 'run_\{n\}.csv' names no \{serial\} field"):
         units_from_pattern(files, "run_{n}.csv")
     with pytest.raises(InputError, match=r"names \{serial\} twice"):
@@ -63,7 +77,9 @@ def test_units_from_a_manifest(tmp_path):
     manifest.write_text("path,serial,lot\nr1.csv,A7,L1\nr2.csv,A7,L1\nr3.csv,B2,L2\n")
     units = units_from_manifest(manifest)
     assert [(u.serial, [p.rsplit("/", 1)[1] for p in u.paths], u.metadata) for u in units] == [
-        ("A7", ["r1.csv", "r2.csv"], {"lot": "L1"}), ("B2", ["r3.csv"], {"lot": "L2"})]
+        ("A7", ["r1.csv", "r2.csv"], {"lot": "L1"}),
+        ("B2", ["r3.csv"], {"lot": "L2"}),
+    ]
     pd.read_csv(manifest).to_parquet(tmp_path / "manifest.parquet")
     assert units_from_manifest(tmp_path / "manifest.parquet") == units
     manifest.write_text("file,serial\nr1.csv,A7\n")
@@ -94,10 +110,20 @@ def test_input_hash_follows_content_and_settings_not_names(tmp_path):
 
 
 def _axis(**values) -> AxisFigures:
-    base = dict(held_out_drift_dps=0.005, raw_drift_dps=0.9, temperature_sensitivity_dps_per_degc=0.03,
-                tempco_1_dps_per_degc=0.03, tempco_2_dps_per_degc2=1e-4, tempco_3_dps_per_degc3=0.0,
-                bias_span_dps=2.8, turn_on_bias_dps=0.01, turn_on_repeatability_dps=0.05,
-                g_sensitivity_dps_per_g=math.nan, noise_density_dps_per_sqrt_hz=0.005, bias_instability_deg_per_h=15.0)
+    base = dict(
+        held_out_drift_dps=0.005,
+        raw_drift_dps=0.9,
+        temperature_sensitivity_dps_per_degc=0.03,
+        tempco_1_dps_per_degc=0.03,
+        tempco_2_dps_per_degc2=1e-4,
+        tempco_3_dps_per_degc3=0.0,
+        bias_span_dps=2.8,
+        turn_on_bias_dps=0.01,
+        turn_on_repeatability_dps=0.05,
+        g_sensitivity_dps_per_g=math.nan,
+        noise_density_dps_per_sqrt_hz=0.005,
+        bias_instability_deg_per_h=15.0,
+    )
     return AxisFigures(**{**base, **values})
 
 
@@ -125,8 +151,10 @@ def test_limits_give_verdicts_naming_the_failing_figures():
     assert limits.check(_unit()).passed
     verdict = limits.check(_unit(temperature_sensitivity_dps_per_degc=-0.06, held_out_drift_dps=0.03))
     assert verdict.label == "fail"
-    assert [f.figure for f in verdict.failures] == ["gyro_z_temperature_sensitivity_dps_per_degc",
-                                                     "gyro_z_held_out_drift_dps"]
+    assert [f.figure for f in verdict.failures] == [
+        "gyro_z_temperature_sensitivity_dps_per_degc",
+        "gyro_z_held_out_drift_dps",
+    ]
     assert "|-0.06| > abs_max 0.05" in verdict.summary()
     hot_range = UnitFigures(_unit().axes, -20.0, 45.0, 3)
     assert limits.check(hot_range).failures[0].reason == "45 < min 60"
@@ -134,14 +162,17 @@ def test_limits_give_verdicts_naming_the_failing_figures():
     assert {f.reason for f in unmeasured.check(_unit()).failures} == {"not measured"}
 
 
-@pytest.mark.parametrize("text, message", [
-    ("[noise]\nmax = 1", r"limits.toml: \[noise\]: unknown figure; use one of held_out_drift_dps"),
-    ("[noise_density_dps_per_sqrt_hz]\nbelow = 1", r"\[noise_density_dps_per_sqrt_hz\]: unknown bound 'below'"),
-    ("[bias_span_dps]\nmin = 2\nmax = 1", r"\[bias_span_dps\]: min 2 is above max 1"),
-    ("[bias_span_dps]\nmax = 'big'", r"\[bias_span_dps\]: max = 'big' is not a finite number"),
-    ("bias_span_dps = 3", r"\[bias_span_dps\]: give bounds as a table"),
-    ("[bias_span_dps\nmax = 1", r"limits.toml: not a TOML file"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("[noise]\nmax = 1", r"limits.toml: \[noise\]: unknown figure; use one of held_out_drift_dps"),
+        ("[noise_density_dps_per_sqrt_hz]\nbelow = 1", r"\[noise_density_dps_per_sqrt_hz\]: unknown bound 'below'"),
+        ("[bias_span_dps]\nmin = 2\nmax = 1", r"\[bias_span_dps\]: min 2 is above max 1"),
+        ("[bias_span_dps]\nmax = 'big'", r"\[bias_span_dps\]: max = 'big' is not a finite number"),
+        ("bias_span_dps = 3", r"\[bias_span_dps\]: give bounds as a table"),
+        ("[bias_span_dps\nmax = 1", r"limits.toml: not a TOML file"),
+    ],
+)
 def test_bad_limits_files_are_refused_in_one_line(tmp_path, text, message):
     path = tmp_path / "limits.toml"
     path.write_text(text)
@@ -161,8 +192,7 @@ def test_robust_z_identities():
 
 
 def _records(units: list[UnitFigures]) -> list[CalibrationRecord]:
-    return [CalibrationRecord(f"U{i:03d}", utc_now(), "ok", "0" * 64, "0.1.0", figures=f)
-            for i, f in enumerate(units)]
+    return [CalibrationRecord(f"U{i:03d}", utc_now(), "ok", "0" * 64, "0.1.0", figures=f) for i, f in enumerate(units)]
 
 
 def test_fleet_table_scores_only_a_population():
@@ -181,10 +211,14 @@ def test_fleet_table_scores_only_a_population():
 
 def test_units_given_twice_are_refused(tmp_path):
     from gyrocomp.fleet import fit_fleet
+
     _touch(tmp_path, "a.csv")
     with pytest.raises(InputError, match=r"units: serial 'X' is given twice"):
-        fit_fleet([UnitRuns("X", (str(tmp_path / "a.csv"),)), UnitRuns("X", (str(tmp_path / "a.csv"),))],
-                  tmp_path / "out", scheduler="serial")
+        fit_fleet(
+            [UnitRuns("X", (str(tmp_path / "a.csv"),)), UnitRuns("X", (str(tmp_path / "a.csv"),))],
+            tmp_path / "out",
+            scheduler="serial",
+        )
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(InputError, match=r"units: no unit to fit"):
@@ -203,8 +237,9 @@ def test_a_running_dask_cluster_is_used_by_its_address(tmp_path):
     units = []
     for k in range(3):
         path = tmp_path / f"u{k}.parquet"
-        write_recording(simulate("consumer", profile="chamber", duration_s=600, rate_hz=5, seed=k, unit=k).recording,
-                        path)
+        write_recording(
+            simulate("consumer", profile="chamber", duration_s=600, rate_hz=5, seed=k, unit=k).recording, path
+        )
         units.append(UnitRuns(f"U{k}", (str(path),)))
     with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=":0") as cluster, Client(cluster) as client:
         summary = fit_fleet(units, tmp_path / "FLEET", scheduler=cluster.scheduler_address)

@@ -23,8 +23,12 @@ def test_a_unit_past_the_worker_memory_limit_fails_and_the_fleet_goes_on(tmp_pat
         paths = []
         for k in range(2):
             path = tmp_path / f"{serial}_{k}.parquet"
-            write_recording(simulate("consumer", profile="chamber", rate_hz=rate_hz, duration_s=hours * 3600,
-                                     seed=k, unit=len(units)).recording, path)
+            write_recording(
+                simulate(
+                    "consumer", profile="chamber", rate_hz=rate_hz, duration_s=hours * 3600, seed=k, unit=len(units)
+                ).recording,
+                path,
+            )
             paths.append(str(path))
         units.append(UnitRuns(serial, tuple(paths)))
     with warnings.catch_warnings():
@@ -35,8 +39,9 @@ def test_a_unit_past_the_worker_memory_limit_fails_and_the_fleet_goes_on(tmp_pat
         summary = fit_fleet(units, tmp_path / "fleet", workers=1, memory_limit="650MB")
     assert sorted(summary.fitted) == ["SMALL-1", "SMALL-2"], (summary.failed, summary.busy)
     assert list(summary.failed) == ["BIG"]
-    assert summary.failed["BIG"].startswith("its worker was killed on every try (past its memory limit, or a crash): "
-                                            "KilledWorker")
+    assert summary.failed["BIG"].startswith(
+        "its worker was killed on every try (past its memory limit, or a crash): KilledWorker"
+    )
     table = pd.read_parquet(tmp_path / "fleet" / "fleet.parquet").set_index("serial")
     assert table.loc["BIG", "status"] == "failed" and (table.loc[["SMALL-1", "SMALL-2"], "status"] == "ok").all()
     with CalibrationStore(tmp_path / "fleet") as store:

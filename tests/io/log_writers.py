@@ -10,8 +10,11 @@ import numpy as np
 _ULOG_TYPES = {"uint64_t": "Q", "uint32_t": "I", "float": "f", "uint8_t": "B", "int32_t": "i"}
 
 
-def write_ulog(path, topics: dict[tuple[str, int], dict[str, tuple[str, np.ndarray]]],
-               parameters: dict[str, int | float] | None = None) -> None:
+def write_ulog(
+    path,
+    topics: dict[tuple[str, int], dict[str, tuple[str, np.ndarray]]],
+    parameters: dict[str, int | float] | None = None,
+) -> None:
     """Write a ULog with one data series per ``(topic, multi_id)``: ``{field: (c_type, values)}``, and
     ``parameters`` (an int is written as int32_t, a float as float) in the definitions section.
 
@@ -61,9 +64,13 @@ def write_dataflash(path, messages: dict[str, tuple[int, list[tuple[str, str]], 
     for name, (type_id, columns, _) in messages.items():
         body = struct.Struct("<" + "".join(_DF_TYPES[c] for _, c in columns))
         structs[name] = body
-        out += b"\xa3\x95\x80" + fmt_struct.pack(type_id, body.size + 3, name.encode(),
-                                                 "".join(c for _, c in columns).encode(),
-                                                 ",".join(n for n, _ in columns).encode())
+        out += b"\xa3\x95\x80" + fmt_struct.pack(
+            type_id,
+            body.size + 3,
+            name.encode(),
+            "".join(c for _, c in columns).encode(),
+            ",".join(n for n, _ in columns).encode(),
+        )
     records = []
     for name, (type_id, _, rows) in messages.items():
         for row in rows:
@@ -74,9 +81,20 @@ def write_dataflash(path, messages: dict[str, tuple[int, list[tuple[str, str]], 
         fh.write(bytes(out[: len(out) - cut]))
 
 
-def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topics=("/imu/data",), mcap=False,
-              repeat: int | None = None, temperature_from: int = 0, swap: int | None = None, bare: bool = False,
-              temperature_gap: tuple[int, int] | None = None):
+def write_bag(
+    path,
+    ros2: bool,
+    n=100,
+    rate_hz=100.0,
+    temperature=True,
+    imu_topics=("/imu/data",),
+    mcap=False,
+    repeat: int | None = None,
+    temperature_from: int = 0,
+    swap: int | None = None,
+    bare: bool = False,
+    temperature_gap: tuple[int, int] | None = None,
+):
     """A bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or, with ``mcap``, MCAP storage) of ``n`` IMU messages
     per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth
     (from message ``temperature_from`` on); ``repeat``: message i written a second time with the same stamp and
@@ -88,8 +106,19 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
         from pathlib import Path
 
         folder = Path(str(path) + ".folder")
-        write_bag(folder, ros2=True, n=n, rate_hz=rate_hz, temperature=temperature, imu_topics=imu_topics, mcap=True,
-                  repeat=repeat, temperature_from=temperature_from, swap=swap, temperature_gap=temperature_gap)
+        write_bag(
+            folder,
+            ros2=True,
+            n=n,
+            rate_hz=rate_hz,
+            temperature=temperature,
+            imu_topics=imu_topics,
+            mcap=True,
+            repeat=repeat,
+            temperature_from=temperature_from,
+            swap=swap,
+            temperature_gap=temperature_gap,
+        )
         next(folder.glob("*.mcap")).rename(path)
         shutil.rmtree(folder)
         return
@@ -102,9 +131,11 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
     serialize = store.serialize_cdr if ros2 else store.serialize_ros1
     if ros2:
         from rosbags.rosbag2 import StoragePlugin, Writer
+
         writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3)
     else:
         from rosbags.rosbag1 import Writer
+
         writer = Writer(path)
 
     def header(t):
@@ -119,15 +150,27 @@ def write_bag(path, ros2: bool, n=100, rate_hz=100.0, temperature=True, imu_topi
         for i in range(n):
             t = 100.0 + i / rate_hz  # when the message is logged
             stamped = 100.0 + (i + 1 if i == swap else i - 1 if swap is not None and i == swap + 1 else i) / rate_hz
-            msg = Imu(header=header(stamped), orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
-                      angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01), angular_velocity_covariance=cov,
-                      linear_acceleration=Vector3(x=0.0, y=0.0, z=9.80665), linear_acceleration_covariance=cov)
+            msg = Imu(
+                header=header(stamped),
+                orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=cov,
+                angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01),
+                angular_velocity_covariance=cov,
+                linear_acceleration=Vector3(x=0.0, y=0.0, z=9.80665),
+                linear_acceleration_covariance=cov,
+            )
             for conn in imus:
                 writer.write(conn, int(t * 1e9), serialize(msg, Imu.__msgtype__))
                 if i == repeat:
-                    twin = Imu(header=msg.header, orientation=msg.orientation, orientation_covariance=cov,
-                               angular_velocity=Vector3(x=0.001 * i, y=0.5, z=-0.01), angular_velocity_covariance=cov,
-                               linear_acceleration=msg.linear_acceleration, linear_acceleration_covariance=cov)
+                    twin = Imu(
+                        header=msg.header,
+                        orientation=msg.orientation,
+                        orientation_covariance=cov,
+                        angular_velocity=Vector3(x=0.001 * i, y=0.5, z=-0.01),
+                        angular_velocity_covariance=cov,
+                        linear_acceleration=msg.linear_acceleration,
+                        linear_acceleration_covariance=cov,
+                    )
                     writer.write(conn, int(t * 1e9) + 1, serialize(twin, Imu.__msgtype__))
             in_gap = temperature_gap is not None and temperature_gap[0] <= i < temperature_gap[1]
             if temperature and i % 10 == 0 and i >= temperature_from and not in_gap:  # 10 Hz temperature
@@ -148,9 +191,11 @@ def write_recording_bag(path, recording, ros2: bool, mcap: bool = False, tempera
     serialize = store.serialize_cdr if ros2 else store.serialize_ros1
     if ros2:
         from rosbags.rosbag2 import StoragePlugin, Writer
+
         writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3)
     else:
         from rosbags.rosbag1 import Writer
+
         writer = Writer(path)
     gyro = np.radians(recording.gyro_dps)
     accel = recording.accel_g * 9.80665
@@ -161,13 +206,27 @@ def write_recording_bag(path, recording, ros2: bool, mcap: bool = False, tempera
         for i, t in enumerate(recording.time_s):
             sec = int(t)
             stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int(round((t - sec) * 1e9)))
-            header = (types["std_msgs/msg/Header"](stamp=stamp, frame_id="imu_link") if ros2 else
-                      types["std_msgs/msg/Header"](seq=i, stamp=stamp, frame_id="imu_link"))
-            msg = Imu(header=header, orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
-                      angular_velocity=Vector3(*gyro[i]), angular_velocity_covariance=cov,
-                      linear_acceleration=Vector3(*accel[i]), linear_acceleration_covariance=cov)
+            header = (
+                types["std_msgs/msg/Header"](stamp=stamp, frame_id="imu_link")
+                if ros2
+                else types["std_msgs/msg/Header"](seq=i, stamp=stamp, frame_id="imu_link")
+            )
+            msg = Imu(
+                header=header,
+                orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=cov,
+                angular_velocity=Vector3(*gyro[i]),
+                angular_velocity_covariance=cov,
+                linear_acceleration=Vector3(*accel[i]),
+                linear_acceleration_covariance=cov,
+            )
             writer.write(imu, int(round(t * 1e9)), serialize(msg, Imu.__msgtype__))
             if i % temperature_every == 0:
-                writer.write(thermo, int(round(t * 1e9)),
-                             serialize(Temperature(header=header, temperature=float(recording.temperature_degc[i]),
-                                                   variance=0.0), Temperature.__msgtype__))
+                writer.write(
+                    thermo,
+                    int(round(t * 1e9)),
+                    serialize(
+                        Temperature(header=header, temperature=float(recording.temperature_degc[i]), variance=0.0),
+                        Temperature.__msgtype__,
+                    ),
+                )

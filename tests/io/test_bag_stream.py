@@ -27,8 +27,11 @@ from tests.io.log_writers import write_bag, write_recording_bag
 
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 
-KINDS = {"ros1": ({"ros2": False}, "in.bag"), "ros2": ({"ros2": True}, "in"),
-         "mcap": ({"ros2": True, "mcap": True}, "in")}
+KINDS = {
+    "ros1": ({"ros2": False}, "in.bag"),
+    "ros2": ({"ros2": True}, "in"),
+    "mcap": ({"ros2": True, "mcap": True}, "in"),
+}
 
 
 def _caught(func):
@@ -66,14 +69,17 @@ def test_a_gap_in_the_temperature_topic_is_said_never_bridged(chunk_rows, tmp_pa
     chunks, said = _caught(lambda: [c.recording for c in stream.chunks()] + [stream.warn_summary()])
     whole, said_whole = _caught(lambda: read_rosbag(path))
     assert said == said_whole
-    assert any("of 3000 gyro samples lie outside the time span of temperature topic /imu/temperature and were left "
-               "out" in m for m in said)
+    assert any(
+        "of 3000 gyro samples lie outside the time span of temperature topic /imu/temperature and were left out" in m
+        for m in said
+    )
     time_s = np.concatenate([c.time_s for c in chunks[:-1]])
     np.testing.assert_array_equal(time_s, whole.time_s)
     inside = (time_s > 100.0 + 990 / 100.0 + 0.5) & (time_s < 100.0 + 1500 / 100.0 - 0.5)
     assert not inside.any()  # nothing matched across the gap
-    np.testing.assert_allclose(whole.temperature_degc, 20.0 + np.minimum(np.round((whole.time_s - 100.0) * 100),
-                                                                           2990) / 10.0, atol=1e-6)
+    np.testing.assert_allclose(
+        whole.temperature_degc, 20.0 + np.minimum(np.round((whole.time_s - 100.0) * 100), 2990) / 10.0, atol=1e-6
+    )
 
 
 @pytest.fixture(scope="module")
@@ -83,8 +89,7 @@ def run_bag(tmp_path_factory):
     profile = get_profile("cycle", set_points_degc=(15.0, 45.0), cycles=1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model = fit_calibration([simulate("consumer", profile=profile, rate_hz=1.0, seed=s).recording
-                                 for s in (1, 2)])
+        model = fit_calibration([simulate("consumer", profile=profile, rate_hz=1.0, seed=s).recording for s in (1, 2)])
         run = simulate("consumer", profile=profile, duration_s=900.0, rate_hz=20.0, seed=3).recording
     write_recording_bag(folder / "run.bag", run, ros2=False)
     return folder / "run.bag", model
@@ -143,5 +148,4 @@ def test_stamps_that_go_back_across_chunks_are_read_whole(run_bag, tmp_path):
         result = apply_file(model, path, tmp_path / "out.parquet", chunks=ChunkSettings(chunk_rows=100))
         expected = apply(model, read(path))
     assert not result.streamed
-    np.testing.assert_array_equal(pq.read_table(tmp_path / "out.parquet")["gyro_x"].to_numpy(),
-                                  expected.gyro_dps[:, 0])
+    np.testing.assert_array_equal(pq.read_table(tmp_path / "out.parquet")["gyro_x"].to_numpy(), expected.gyro_dps[:, 0])

@@ -49,6 +49,7 @@ def _bag(kind):
             return path, path
         write_bag(folder / "bag", ros2=True, n=300, mcap=kind == "mcap")
         return folder / "bag", next(p for p in (folder / "bag").iterdir() if p.suffix in (".db3", ".mcap"))
+
     return make
 
 
@@ -58,17 +59,24 @@ def _shared(dataset, name):
         copy = folder / name
         shutil.copyfile(path, copy)
         return copy, copy
+
     return make
 
 
-MAKERS = {"hdf5": _hdf5, "parquet": _parquet, "ros1": _bag("ros1"), "ros2-sqlite3": _bag("sqlite3"),
-          "ros2-mcap": _bag("mcap"), "ulog": _shared("px4-pyulog-samples", "sample_log_small.ulg"),
-          "dataflash": _shared("ardupilot-pymavlink-sample", "test.BIN")}
+MAKERS = {
+    "hdf5": _hdf5,
+    "parquet": _parquet,
+    "ros1": _bag("ros1"),
+    "ros2-sqlite3": _bag("sqlite3"),
+    "ros2-mcap": _bag("mcap"),
+    "ulog": _shared("px4-pyulog-samples", "sample_log_small.ulg"),
+    "dataflash": _shared("ardupilot-pymavlink-sample", "test.BIN"),
+}
 
 
 def _damaged(blob: bytes, rng: np.random.Generator, k: int) -> bytes:
     if k % 2 == 0:
-        return blob[:int(rng.integers(1, len(blob)))]
+        return blob[: int(rng.integers(1, len(blob)))]
     damaged = bytearray(blob)
     for at in rng.integers(0, len(blob), size=int(rng.integers(1, 17))):
         damaged[at] = int(rng.integers(0, 256))

@@ -40,10 +40,13 @@ def _one_line(result, message):
     assert "Traceback" not in result.stderr and "internal error" not in result.stderr
 
 
-@pytest.mark.parametrize("columns, message", [
-    (MAX_COLUMNS + 1, f"the header names {MAX_COLUMNS + 1} columns; gyrocomp reads tables of up to {MAX_COLUMNS}"),
-    (200_000, "its first line is over 1 MB long, which no table's header is"),
-])
+@pytest.mark.parametrize(
+    "columns, message",
+    [
+        (MAX_COLUMNS + 1, f"the header names {MAX_COLUMNS + 1} columns; gyrocomp reads tables of up to {MAX_COLUMNS}"),
+        (200_000, "its first line is over 1 MB long, which no table's header is"),
+    ],
+)
 def test_a_header_of_too_many_columns_is_refused_naming_the_limit(tmp_path, columns, message):
     path = tmp_path / "wide.csv"
     path.write_text(",".join(f"column{i}" for i in range(columns)) + "\n" + ",".join("1" * columns) + "\n")
@@ -71,8 +74,9 @@ def test_a_gzip_that_expands_to_a_gigabyte_on_one_line_is_refused_in_bounded_mem
             fh.write(block)
     assert bomb.stat().st_size < 5 << 20
     for args in (("fit", bomb, "-o", tmp_path / "m.json"), ("init", bomb, "-o", tmp_path / "p.toml")):
-        result = subprocess.run([str(SCRIPT), *map(str, args)], capture_output=True, text=True, timeout=120,
-                                preexec_fn=_limited(3 << 29))
+        result = subprocess.run(
+            [str(SCRIPT), *map(str, args)], capture_output=True, text=True, timeout=120, preexec_fn=_limited(3 << 29)
+        )
         _one_line(result, "bomb.csv.gz: a line over 1 MB long, which no row of a table is")
     assert not (tmp_path / "m.json").exists()
 
@@ -80,13 +84,19 @@ def test_a_gzip_that_expands_to_a_gigabyte_on_one_line_is_refused_in_bounded_mem
 def test_a_parquet_file_of_very_many_row_groups_is_refused_before_its_metadata_is_read(tmp_path, monkeypatch):
     path = tmp_path / "groups.parquet"
     n = 300
-    pq.write_table(pa.table({"time": np.arange(n) / 10.0, "gyro_z": np.full(n, 0.1),
-                             "temperature": np.linspace(20, 30, n)}), path, row_group_size=1)
+    pq.write_table(
+        pa.table({"time": np.arange(n) / 10.0, "gyro_z": np.full(n, 0.1), "temperature": np.linspace(20, 30, n)}),
+        path,
+        row_group_size=1,
+    )
     assert read_table(path).recording.n_samples == n
     footer = int.from_bytes(path.read_bytes()[-8:-4], "little")
     monkeypatch.setattr(tables_module, "PARQUET_FOOTER_MAX_BYTES", footer // 2)  # as a file 2x past the limit
-    with pytest.raises(InputError, match=r"groups.parquet: its metadata takes .* very many small row groups\), "
-                                         r"which would take gigabytes to read; rewrite it with larger row groups"):
+    with pytest.raises(
+        InputError,
+        match=r"groups.parquet: its metadata takes .* very many small row groups\), "
+        r"which would take gigabytes to read; rewrite it with larger row groups",
+    ):
         read_table(path)
     with pytest.raises(InputError, match="groups.parquet: its metadata takes"):
         TableStream(path)
@@ -100,8 +110,11 @@ def test_a_file_larger_than_the_memory_left_is_refused_naming_both(tmp_path, mon
     monkeypatch.setattr(limits, "address_space_left", lambda: int(need * 2))
     assert read_table(path).recording.n_samples == 2000
     monkeypatch.setattr(limits, "address_space_left", lambda: int(need / 2))
-    with pytest.raises(InputError, match=r"run.csv: reading it whole takes about .* GB of memory, and this process "
-                                         r"may map .* GB more under its limit \(ulimit -v\)"):
+    with pytest.raises(
+        InputError,
+        match=r"run.csv: reading it whole takes about .* GB of memory, and this process "
+        r"may map .* GB more under its limit \(ulimit -v\)",
+    ):
         read_table(path)
 
 
@@ -109,8 +122,13 @@ def test_too_small_an_address_space_is_one_line_not_a_hang(tmp_path):
     """Under 300 MB of address space, OpenBLAS retried its buffers for ever while loading (a hang at 100 % CPU);
     refused at once, naming the limit."""
     path = _table(tmp_path / "run.csv")
-    result = subprocess.run([str(SCRIPT), "fit", str(path), "-o", str(tmp_path / "m.json")], capture_output=True,
-                            text=True, timeout=60, preexec_fn=_limited(300 << 20))
+    result = subprocess.run(
+        [str(SCRIPT), "fit", str(path), "-o", str(tmp_path / "m.json")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=_limited(300 << 20),
+    )
     _one_line(result, "this process may map 315 MB (ulimit -v); gyrocomp needs at least 1 GB")
 
 
@@ -122,8 +140,17 @@ def test_a_glob_through_a_link_loop_names_each_file_once(tmp_path):
     with pytest.warns(DataQualityWarning, match=r"name\(s\) matched are files already named by another path"):
         found = expand_inputs([str(tmp_path / "a" / "**" / "*.csv")])
     assert found == [tmp_path / "a" / "r1.csv", tmp_path / "a" / "r2.csv"]
-    result = run("fit", str(tmp_path / "a" / "**" / "*.csv"), "-o", tmp_path / "m.json", "--temperature", "poly:1",
-                 "--hysteresis", "none", cwd=tmp_path)
+    result = run(
+        "fit",
+        str(tmp_path / "a" / "**" / "*.csv"),
+        "-o",
+        tmp_path / "m.json",
+        "--temperature",
+        "poly:1",
+        "--hysteresis",
+        "none",
+        cwd=tmp_path,
+    )
     assert result.returncode == 0, result.stderr
     assert "files already named by another path" in result.stderr
     inputs = json.loads((tmp_path / "m.json").read_text())["provenance"]["inputs"]
@@ -137,6 +164,9 @@ def test_a_table_cut_short_while_it_is_read_is_refused_not_read_shorter(tmp_path
     next(chunks)
     with open(path, "r+b") as fh:  # another program cuts the file while the first chunk is used
         fh.truncate(path.stat().st_size // 2)
-    with pytest.raises(InputError, match=r"run.csv: changed while it was read \(\d+ bytes when the reading began, "
-                                         r"\d+ at its end: still being written, or cut short\); nothing written"):
+    with pytest.raises(
+        InputError,
+        match=r"run.csv: changed while it was read \(\d+ bytes when the reading began, "
+        r"\d+ at its end: still being written, or cut short\); nothing written",
+    ):
         list(chunks)

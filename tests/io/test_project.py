@@ -18,14 +18,16 @@ def log(tmp_path):
     """A semicolon-separated log with a decimal comma, time in ms, gyro in rad/s, other names."""
     t = np.arange(ROWS) * 10.0
     gyro = np.column_stack([np.full(ROWS, 0.01), np.linspace(0, 0.02, ROWS), np.full(ROWS, -0.01)])
-    lines = ["Zeit;GX;GY;GZ;Temp"] + [";".join(f"{v:.6f}".replace(".", ",") for v in (t[i], *gyro[i], 25.0 + i))
-                                     for i in range(ROWS)]
+    lines = ["Zeit;GX;GY;GZ;Temp"] + [
+        ";".join(f"{v:.6f}".replace(".", ",") for v in (t[i], *gyro[i], 25.0 + i)) for i in range(ROWS)
+    ]
     path = tmp_path / "log.txt"
     path.write_text("\n".join(lines) + "\n")
     (tmp_path / "gyrocomp.toml").write_text(
         '[read]\ngyro-unit = "rad/s"\ntime-unit = "ms"\ndelimiter = ";"\ndecimal = ","\nformat = "csv"\n'
         '[read.columns]\ntime = "Zeit"\ngyro_x = "GX"\ngyro_y = "GY"\ngyro_z = "GZ"\ntemperature = "Temp"\n'
-        '[fit]\nhysteresis = "none"\n')
+        '[fit]\nhysteresis = "none"\n'
+    )
     return path, gyro
 
 

@@ -16,15 +16,25 @@ MAGIC = b"GYRTEST\x00"
 
 def _read(path, options, progress=None):
     t = np.arange(50.0)
-    return Recording(time_s=t, gyro_dps=np.full((50, 1), 0.25), gyro_axes=("gyro_z",), temperature_degc=20 + 0 * t,
-                     source=str(path))
+    return Recording(
+        time_s=t, gyro_dps=np.full((50, 1), 0.25), gyro_axes=("gyro_z",), temperature_degc=20 + 0 * t, source=str(path)
+    )
 
 
 @pytest.fixture
 def probe():
-    reader = register_reader(Reader("probe", "a test format", _read, suffixes=(".prb", ".prb.gz"), magic=(MAGIC,),
-                                    aliases=("prb",), folder_marker="probe.marker",
-                                    instances=lambda path: (0, 2)))
+    reader = register_reader(
+        Reader(
+            "probe",
+            "a test format",
+            _read,
+            suffixes=(".prb", ".prb.gz"),
+            magic=(MAGIC,),
+            aliases=("prb",),
+            folder_marker="probe.marker",
+            instances=lambda path: (0, 2),
+        )
+    )
     yield reader
     READERS.pop("probe")
 

@@ -28,8 +28,11 @@ pytest.importorskip("rosbags", reason="the [ros] extra (rosbags) is not installe
 # -- PX4 ULog -----------------------------------------------------------------------------------------
 def test_ulog_real_sample_instances_units_and_times():
     path = shared_dataset("px4-pyulog-samples") / "sample_log_small.ulg"
-    raw = {d.multi_id: d.data for d in pyulog.ULog(str(path), ["sensor_gyro", "sensor_accel"]).data_list
-           if d.name == "sensor_gyro"}
+    raw = {
+        d.multi_id: d.data
+        for d in pyulog.ULog(str(path), ["sensor_gyro", "sensor_accel"]).data_list
+        if d.name == "sensor_gyro"
+    }
     with pytest.warns(DataQualityWarning, match=r"3 sensor_gyro instances \(0, 1, 2\); read instance 0"):
         first = read(path)
     for instance, (low, high) in {0: (40.0, 40.4), 1: (28.2, 28.4), 2: (29.4, 29.7)}.items():
@@ -70,9 +73,13 @@ def test_ulog_written_here_converts_units_and_matches_accel_by_time(tmp_path):
     key, gyro = _gyro_topic()
     n = 100  # accelerometer at half the rate, offset by 3 ms
     t_acc = (1_003_000 + np.arange(n) * 40_000).astype(np.uint64)
-    accel = {"timestamp": ("uint64_t", t_acc), "device_id": ("uint32_t", np.full(n, 9, dtype=np.uint32)),
-             "x": ("float", np.zeros(n, np.float32)), "y": ("float", np.linspace(0, 1, n).astype(np.float32)),
-             "z": ("float", np.full(n, -G, np.float32))}
+    accel = {
+        "timestamp": ("uint64_t", t_acc),
+        "device_id": ("uint32_t", np.full(n, 9, dtype=np.uint32)),
+        "x": ("float", np.zeros(n, np.float32)),
+        "y": ("float", np.linspace(0, 1, n).astype(np.float32)),
+        "z": ("float", np.full(n, -G, np.float32)),
+    }
     path = tmp_path / "log.ulg"
     write_ulog(path, {key: gyro, ("sensor_accel", 0): accel})
     with warnings.catch_warnings():
@@ -84,8 +91,9 @@ def test_ulog_written_here_converts_units_and_matches_accel_by_time(tmp_path):
     np.testing.assert_allclose(rec.accel_g[:, 2], -1.0, rtol=1e-6)
     expected_y = np.interp(rec.time_s, t_acc * 1e-6, np.linspace(0, 1, n).astype(np.float32)) / G
     np.testing.assert_allclose(rec.accel_g[:, 1], expected_y, rtol=1e-6, atol=1e-9)
-    np.testing.assert_allclose(rec.temperature_degc[[0, -1]], [20, np.linspace(20, 40, 200)[rec.n_samples - 1]],
-                               rtol=1e-6)
+    np.testing.assert_allclose(
+        rec.temperature_degc[[0, -1]], [20, np.linspace(20, 40, 200)[rec.n_samples - 1]], rtol=1e-6
+    )
 
 
 def test_ulog_cut_inside_a_message_is_said_and_a_whole_one_is_not(tmp_path):
@@ -97,8 +105,11 @@ def test_ulog_cut_inside_a_message_is_said_and_a_whole_one_is_not(tmp_path):
         full = read(whole)
     cut = tmp_path / "cut.ulg"
     cut.write_bytes(whole.read_bytes()[:-5])
-    with pytest.warns(DataQualityWarning, match=r"cut.ulg: the file ends \d+ byte\(s\) short inside its last "
-                                                r"message \(at byte \d+\): a truncated or damaged log"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"cut.ulg: the file ends \d+ byte\(s\) short inside its last "
+        r"message \(at byte \d+\): a truncated or damaged log",
+    ):
         short = read(cut)
     assert short.n_samples == full.n_samples - 1
 
@@ -110,8 +121,11 @@ def test_ulog_drop_nonfinite_drops_the_row_the_refusal_names(tmp_path):
     values[5] = np.nan
     path = tmp_path / "hole.ulg"
     write_ulog(path, {key: {**gyro, "x": ("float", values)}})
-    with pytest.raises(InputError, match=r"hole.ulg: row 6, column 'gyro_x': nan is not a finite number; .* "
-                                         r"\(drop_nonfinite=True\)"):
+    with pytest.raises(
+        InputError,
+        match=r"hole.ulg: row 6, column 'gyro_x': nan is not a finite number; .* "
+        r"\(drop_nonfinite=True\)",
+    ):
         read(path)
     with pytest.warns(DataQualityWarning, match=r"hole.ulg: dropped 1 of 200 rows with empty, NaN or infinite"):
         rec = read(path, drop_nonfinite=True)
@@ -122,8 +136,11 @@ def test_ulog_without_gyro_topics_names_what_it_has(tmp_path):
     path = tmp_path / "baro.ulg"
     t = (np.arange(10) * 1000).astype(np.uint64)
     write_ulog(path, {("sensor_baro", 0): {"timestamp": ("uint64_t", t), "temperature": ("float", np.ones(10))}})
-    with pytest.raises(InputError, match=r"baro.ulg: no gyro topic \(sensor_gyro, vehicle_imu, sensor_combined\) "
-                                         r"in this ULog; it has sensor_baro"):
+    with pytest.raises(
+        InputError,
+        match=r"baro.ulg: no gyro topic \(sensor_gyro, vehicle_imu, sensor_combined\) "
+        r"in this ULog; it has sensor_baro",
+    ):
         read(path)
 
 
@@ -137,10 +154,27 @@ def test_ulog_instance_and_device_id_that_are_not_there(tmp_path):
 
 
 # -- ArduPilot DataFlash ------------------------------------------------------------------------------
-_IMU_COLUMNS = [("TimeUS", "Q"), ("I", "B"), ("GyrX", "f"), ("GyrY", "f"), ("GyrZ", "f"),
-                ("AccX", "f"), ("AccY", "f"), ("AccZ", "f"), ("T", "f")]
-_TCLR_COLUMNS = [("TimeUS", "Q"), ("I", "B"), ("SType", "B"), ("Temp", "f"), ("X", "f"), ("Y", "f"), ("Z", "f"),
-                 ("NDone", "I")]
+_IMU_COLUMNS = [
+    ("TimeUS", "Q"),
+    ("I", "B"),
+    ("GyrX", "f"),
+    ("GyrY", "f"),
+    ("GyrZ", "f"),
+    ("AccX", "f"),
+    ("AccY", "f"),
+    ("AccZ", "f"),
+    ("T", "f"),
+]
+_TCLR_COLUMNS = [
+    ("TimeUS", "Q"),
+    ("I", "B"),
+    ("SType", "B"),
+    ("Temp", "f"),
+    ("X", "f"),
+    ("Y", "f"),
+    ("Z", "f"),
+    ("NDone", "I"),
+]
 
 
 def test_dataflash_real_sample_is_read_up_to_its_cut_end():
@@ -171,8 +205,11 @@ def test_dataflash_real_sample_is_read_up_to_its_cut_end():
 
 def test_dataflash_instance_field_and_tclr_records(tmp_path):
     n = 60
-    imu = [(1_000_000 + i * 10_000 + k, k, 0.001 * i, 0.0, -0.002, 0.0, 0.1, -G, 25.0 + 10 * k + 0.01 * i)
-           for i in range(n) for k in (0, 1)]
+    imu = [
+        (1_000_000 + i * 10_000 + k, k, 0.001 * i, 0.0, -0.002, 0.0, 0.1, -G, 25.0 + 10 * k + 0.01 * i)
+        for i in range(n)
+        for k in (0, 1)
+    ]
     tclr = [(2_000_000 + i * 100_000 + s, 0, s, 20.0 + i, 0.01 * i, 0.0, 0.0, i) for i in range(n) for s in (0, 1)]
     path = tmp_path / "tcal.bin"
     write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, imu), "TCLR": (131, _TCLR_COLUMNS, tclr)})
@@ -185,8 +222,12 @@ def test_dataflash_instance_field_and_tclr_records(tmp_path):
     # SType 1 is the gyro (rad/s), SType 0 the accelerometer (m/s^2), as ArduPilot's tempcal_IMU.py reads them
     np.testing.assert_allclose(learned.temperature_degc, 20.0 + np.arange(n))
     np.testing.assert_allclose(learned.gyro_dps[:, 0], 0.01 * np.arange(n) * RAD_TO_DEG, rtol=1e-6)
-    np.testing.assert_allclose(learned.accel_g[:, 0], np.interp(learned.time_s, 2.0 + 0.1 * np.arange(n),
-                                                                0.01 * np.arange(n)) / G, rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(
+        learned.accel_g[:, 0],
+        np.interp(learned.time_s, 2.0 + 0.1 * np.arange(n), 0.01 * np.arange(n)) / G,
+        rtol=1e-5,
+        atol=1e-9,
+    )
     with pytest.raises(InputError, match=r"instance=2: no IMU instance 2; the log has 0, 1"):
         read(path, instance=2)
     with pytest.raises(InputError, match=r"record: unknown DataFlash record 'GPS'; use IMU or TCLR"):
@@ -208,11 +249,14 @@ def test_dataflash_garbage_chatter_of_pymavlink_is_one_warning(tmp_path, capfd):
     path = tmp_path / "noisy.bin"
     write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, rows)})
     data = bytearray(path.read_bytes())
-    data[len(data) // 2:len(data) // 2] = bytes(range(40))  # 40 bytes of garbage between two messages
+    data[len(data) // 2 : len(data) // 2] = bytes(range(40))  # 40 bytes of garbage between two messages
     path.write_bytes(bytes(data))
     capfd.readouterr()
-    with pytest.warns(DataQualityWarning, match=r"noisy.bin: pymavlink reported \d+ line\(s\) while reading, the "
-                                                r"first: .*; the log is probably damaged in places") as record:
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"noisy.bin: pymavlink reported \d+ line\(s\) while reading, the "
+        r"first: .*; the log is probably damaged in places",
+    ) as record:
         rec = read(path)
     assert rec.n_samples == 50 and len(record) == 1
     assert capfd.readouterr() == ("", "")  # nothing printed past gyrocomp
@@ -238,8 +282,7 @@ def test_rosbag_imu_and_temperature_matched_by_time(tmp_path, ros2):
     np.testing.assert_allclose(rec.accel_g[:, 2], 1.0, rtol=1e-12)
     # temperature rises 1 degC per 10 samples: linear interpolation is exact; the last 9 IMU samples,
     # within 5 temperature periods of the last temperature, hold its value
-    np.testing.assert_allclose(rec.temperature_degc, 20.0 + np.minimum(np.arange(rec.n_samples), 90) / 10.0,
-                               atol=1e-9)
+    np.testing.assert_allclose(rec.temperature_degc, 20.0 + np.minimum(np.arange(rec.n_samples), 90) / 10.0, atol=1e-9)
     assert rec.n_samples == 100
     assert detect_format(path) == "rosbag"
 
@@ -264,8 +307,11 @@ def test_a_bag_is_read_from_its_own_files_and_type_names_only(tmp_path):
     elsewhere.parent.mkdir()
     storage.rename(elsewhere)
     storage.symlink_to(elsewhere)
-    with pytest.raises(InputError, match=rf"bag: {re.escape(storage.name)} links to .*elsewhere.*, outside the bag "
-                                         r"folder; gyrocomp reads only the bag's own files"):
+    with pytest.raises(
+        InputError,
+        match=rf"bag: {re.escape(storage.name)} links to .*elsewhere.*, outside the bag "
+        r"folder; gyrocomp reads only the bag's own files",
+    ):
         read(folder)
     result = run("convert", folder, tmp_path / "out.csv")
     assert result.returncode == 2 and "outside the bag folder" in result.stderr and not (tmp_path / "out.csv").exists()
@@ -275,14 +321,16 @@ def _ulog_with_appended_offset(tmp_path, name: str, offset_of):
     import struct
 
     n = 200
-    fields = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 10_000).astype(np.uint64)),
-              **{a: ("float", np.zeros(n, np.float32)) for a in "xyz"},
-              "temperature": ("float", np.full(n, 30.0, np.float32))}
+    fields = {
+        "timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 10_000).astype(np.uint64)),
+        **{a: ("float", np.zeros(n, np.float32)) for a in "xyz"},
+        "temperature": ("float", np.full(n, 30.0, np.float32)),
+    }
     write_ulog(tmp_path / "plain.ulg", {("sensor_gyro", 0): fields})
     data = bytearray((tmp_path / "plain.ulg").read_bytes())
     payload = 16 + 3  # the flag-bits message is the first: incompat flags at +8, appended offsets at +16
     data[payload + 8] = 1  # DATA_APPENDED
-    data[payload + 16:payload + 24] = struct.pack("<Q", offset_of(len(data)))
+    data[payload + 16 : payload + 24] = struct.pack("<Q", offset_of(len(data)))
     (tmp_path / name).write_bytes(bytes(data))
     return tmp_path / name
 
@@ -291,12 +339,18 @@ def test_ulog_appended_data_offsets_are_checked(tmp_path):
     """The flag bits' appended-data offset inside a message (pyulog would stop there and drop the rest without a
     word) is refused naming the byte; one past the end is a warning, and the log is read whole."""
     inside = _ulog_with_appended_offset(tmp_path, "inside.ulg", lambda size: size // 2 + 1)
-    with pytest.raises(InputError, match=r"inside.ulg: the flag bits say data were appended at byte \d+, where no "
-                                         r"message starts: a damaged log"):
+    with pytest.raises(
+        InputError,
+        match=r"inside.ulg: the flag bits say data were appended at byte \d+, where no "
+        r"message starts: a damaged log",
+    ):
         read(inside)
-    past = _ulog_with_appended_offset(tmp_path, "past.ulg", lambda size: 10 ** 12)
-    with pytest.warns(DataQualityWarning, match=r"past.ulg: the flag bits say data were appended at byte "
-                                                r"1000000000000, past the end of the file \(\d+ bytes\): none read"):
+    past = _ulog_with_appended_offset(tmp_path, "past.ulg", lambda size: 10**12)
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"past.ulg: the flag bits say data were appended at byte "
+        r"1000000000000, past the end of the file \(\d+ bytes\): none read",
+    ):
         rec = read(past)
     assert rec.n_samples == 200
 
@@ -332,14 +386,20 @@ def test_rosbag_topic_choices_and_missing_topics(tmp_path):
     write_bag(path, ros2=False, temperature=False, imu_topics=("/imu0", "/imu1"))
     with pytest.raises(InputError, match=r"2 sensor_msgs/msg/Imu topics \(/imu0, /imu1\); choose one with imu_topic="):
         read(path)
-    with pytest.raises(InputError, match=r"imu_topic=/imu9: no such topic in the bag; its sensor_msgs/msg/Imu "
-                                         r"topics are /imu0, /imu1; its sensor_msgs/msg/Temperature topics are none$"):
+    with pytest.raises(
+        InputError,
+        match=r"imu_topic=/imu9: no such topic in the bag; its sensor_msgs/msg/Imu "
+        r"topics are /imu0, /imu1; its sensor_msgs/msg/Temperature topics are none$",
+    ):
         read(path, imu_topic="/imu9")
     with_temperature = tmp_path / "one.bag"
     write_bag(with_temperature, ros2=False)
-    with pytest.raises(InputError, match=r"temperature_topic=/t: no such topic in the bag; its sensor_msgs/msg/Imu "
-                                         r"topics are /imu/data; its sensor_msgs/msg/Temperature topics are "
-                                         r"/imu/temperature$"):
+    with pytest.raises(
+        InputError,
+        match=r"temperature_topic=/t: no such topic in the bag; its sensor_msgs/msg/Imu "
+        r"topics are /imu/data; its sensor_msgs/msg/Temperature topics are "
+        r"/imu/temperature$",
+    ):
         read(with_temperature, temperature_topic="/t")
     with pytest.raises(InputError, match=r"temperature_topic=/imu1: the topic has type sensor_msgs/msg/Imu"):
         read(path, imu_topic="/imu0", temperature_topic="/imu1")
@@ -372,7 +432,7 @@ def test_hdf5_of_strings_and_damaged_hdf5_are_refused_in_one_line(tmp_path):
     with h5py.File(whole, "w") as f:
         f["time"], f["gyro_z"] = np.arange(100.0), np.zeros(100)
     cut = tmp_path / "cut.h5"
-    cut.write_bytes(whole.read_bytes()[:whole.stat().st_size // 2])
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
     with pytest.raises(InputError, match=r"cut.h5: not a readable HDF5 file \(.*truncated file.*\); is it damaged"):
         read(cut)
     result = run("allan", cut)
@@ -403,8 +463,10 @@ def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
         f["imu/acc"].attrs["units"] = "m/s^2"
         f["imu/temp_k"] = np.full(n, 300.0)
         f["imu/temp_k"].attrs["units"] = "K"
-    layout = TableLayout(columns={"time": "imu/t_ms", "gyro_z": "imu/wz", "accel": "imu/acc",
-                                  "temperature": "imu/temp_k"}, time_unit="ms")
+    layout = TableLayout(
+        columns={"time": "imu/t_ms", "gyro_z": "imu/wz", "accel": "imu/acc", "temperature": "imu/temp_k"},
+        time_unit="ms",
+    )
     rec = read(path, layout)
     assert rec.gyro_axes == ("gyro_z",) and rec.rate_hz == pytest.approx(100.0)
     np.testing.assert_allclose(rec.gyro_dps[:, 0], 2.0 * RAD_TO_DEG)
@@ -417,8 +479,11 @@ def test_hdf5_with_a_column_mapping_and_units_attributes(tmp_path):
     # a units attribute gyrocomp does not know is said, not read silently as deg/s
     with h5py.File(path, "a") as f:
         f["imu/wz"].attrs["units"] = "furlongs/fortnight"
-    with pytest.warns(DataQualityWarning, match=r"dataset /imu/wz has units 'furlongs/fortnight', which gyrocomp "
-                                                r"does not know; read as deg/s \(set gyro_unit= if that is wrong\)"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"dataset /imu/wz has units 'furlongs/fortnight', which gyrocomp "
+        r"does not know; read as deg/s \(set gyro_unit= if that is wrong\)",
+    ):
         read(path, TableLayout(columns={"time": "imu/t_ms", "gyro_z": "imu/wz"}, time_unit="ms"))
 
 
@@ -490,9 +555,12 @@ def test_missing_extra_is_named_in_one_line(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "pyulog", None)  # makes "import pyulog" fail as if it were not installed
     path = tmp_path / "x.ulg"
     write_ulog(path, dict([_gyro_topic()]))
-    with pytest.raises(MissingDependencyError, match=r"^reading PX4 ULog files needs the optional package pyulog; "
-                                                     r"install it with: pip install 'gyrocomp\[ulog\]' \(from a clone of the "
-                                                     r"repository: pip install -e '\.\[ulog\]'\)$"):
+    with pytest.raises(
+        MissingDependencyError,
+        match=r"^reading PX4 ULog files needs the optional package pyulog; "
+        r"install it with: pip install 'gyrocomp\[ulog\]' \(from a clone of the "
+        r"repository: pip install -e '\.\[ulog\]'\)$",
+    ):
         read(path)
 
 
@@ -555,11 +623,17 @@ def test_cli_bad_logs_give_one_line_and_status_2(tmp_path, case):
     elif case == "no-such-bag-topic":
         path = tmp_path / "imu.bag"
         write_bag(path, ros2=False)
-        args, expected = ["convert", path, tmp_path / "o.csv", "--imu-topic", "/gyro"], "--imu-topic /gyro: no such topic"
+        args, expected = (
+            ["convert", path, tmp_path / "o.csv", "--imu-topic", "/gyro"],
+            "--imu-topic /gyro: no such topic",
+        )
     else:
         path = tmp_path / "x.ulg"
         write_ulog(path, dict([_gyro_topic()]))
-        args, expected = ["convert", path, tmp_path / "o.ulg"], "OUT " + str(tmp_path / "o.ulg") + ": gyrocomp writes CSV"
+        args, expected = (
+            ["convert", path, tmp_path / "o.ulg"],
+            "OUT " + str(tmp_path / "o.ulg") + ": gyrocomp writes CSV",
+        )
     r = run(*args)
     assert r.returncode == 2
     errors = [line for line in r.stderr.splitlines() if line.startswith("gyrocomp: error")]
@@ -572,8 +646,11 @@ def _drifting_gyro(multi_id: int, slope_rad_s_per_degc: float, n: int = 3000, ra
     temperature = np.linspace(10, 50, n)
     t_us = (1_000_000 + np.arange(n) * 1e6 / rate_hz).astype(np.uint64)
     rng = np.random.default_rng(multi_id)
-    fields = {"timestamp": ("uint64_t", t_us), "device_id": ("uint32_t", np.full(n, 7 + multi_id, np.uint32)),
-              "temperature": ("float", temperature.astype(np.float32))}
+    fields = {
+        "timestamp": ("uint64_t", t_us),
+        "device_id": ("uint32_t", np.full(n, 7 + multi_id, np.uint32)),
+        "temperature": ("float", temperature.astype(np.float32)),
+    }
     for axis in "xyz":
         rate = slope_rad_s_per_degc * (temperature - 30) + 1e-5 * rng.standard_normal(n)
         fields[axis] = ("float", rate.astype(np.float32))
@@ -598,8 +675,21 @@ def test_fit_every_instance_of_a_px4_and_an_ardupilot_log(tmp_path):
     assert not (tmp_path / "px4.json").exists()
     n = 3000
     temperature = np.linspace(10, 50, n)
-    rows = [(1_000_000 + i * 100_000, k, s * (temperature[i] - 30), s * (temperature[i] - 30), s * (temperature[i] - 30),
-             0.0, 0.0, -G, temperature[i]) for i in range(n) for k, s in ((0, 5e-4), (1, 1.5e-3))]
+    rows = [
+        (
+            1_000_000 + i * 100_000,
+            k,
+            s * (temperature[i] - 30),
+            s * (temperature[i] - 30),
+            s * (temperature[i] - 30),
+            0.0,
+            0.0,
+            -G,
+            temperature[i],
+        )
+        for i in range(n)
+        for k, s in ((0, 5e-4), (1, 1.5e-3))
+    ]
     dataflash = tmp_path / "two.bin"
     write_dataflash(dataflash, {"IMU": (130, _IMU_COLUMNS, rows)})
     r = run("fit", dataflash, "-o", tmp_path / "ap.json", "--instance", "all", "--hysteresis", "none")
@@ -627,15 +717,19 @@ def test_a_px4_log_already_corrected_onboard_is_recognized(tmp_path):
         raw = read(raw_log)
     assert raw.metadata["px4_thermal_compensation"] and not raw.metadata["corrected_onboard"]
     n = 100
-    combined = {"timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 20_000).astype(np.uint64)),
-                **{f"gyro_rad[{i}]": ("float", np.zeros(n, np.float32)) for i in range(3)},
-                **{f"accelerometer_m_s2[{i}]": ("float", np.full(n, -G if i == 2 else 0.0, np.float32))
-                   for i in range(3)}}
+    combined = {
+        "timestamp": ("uint64_t", (1_000_000 + np.arange(n) * 20_000).astype(np.uint64)),
+        **{f"gyro_rad[{i}]": ("float", np.zeros(n, np.float32)) for i in range(3)},
+        **{f"accelerometer_m_s2[{i}]": ("float", np.full(n, -G if i == 2 else 0.0, np.float32)) for i in range(3)},
+    }
     corrected_log = tmp_path / "corrected.ulg"
     write_ulog(corrected_log, {("sensor_combined", 0): combined}, parameters={"TC_G_ENABLE": 1})
-    with pytest.warns(DataQualityWarning, match=r"TC_G_ENABLE = 1: sensor_combined is already corrected by PX4's "
-                                                r"thermal compensation; a model fitted or applied on it would correct "
-                                                r"twice"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"TC_G_ENABLE = 1: sensor_combined is already corrected by PX4's "
+        r"thermal compensation; a model fitted or applied on it would correct "
+        r"twice",
+    ):
         corrected = read(corrected_log)
     assert corrected.metadata["corrected_onboard"]
     write_ulog(tmp_path / "off.ulg", {("sensor_combined", 0): combined}, parameters={"TC_G_ENABLE": 0})
@@ -652,8 +746,11 @@ def test_a_bags_imu_topics_are_its_instances(tmp_path):
     assert instances(path) == (0, 1)
     assert read(path, instance=0).metadata["imu_topic"] == "/imu_a"
     assert read(path, instance=1).metadata["imu_topic"] == "/imu_b"
-    with pytest.raises(InputError, match=r"instance=2: the bag has 2 sensor_msgs/msg/Imu topic\(s\) \(/imu_a, /imu_b\), "
-                                         r"instances 0 to 1"):
+    with pytest.raises(
+        InputError,
+        match=r"instance=2: the bag has 2 sensor_msgs/msg/Imu topic\(s\) \(/imu_a, /imu_b\), "
+        r"instances 0 to 1",
+    ):
         read(path, instance=2)
     with pytest.raises(InputError, match=r"choose one with imu_topic= or instance= \(their index"):
         read(path)
@@ -670,5 +767,6 @@ def test_the_command_line_reads_a_bags_instance(tmp_path):
     assert read(tmp_path / "b.csv").n_samples == 100
     wrong = run("convert", path, tmp_path / "c.csv", "--instance", 5)
     assert wrong.returncode == 2 and wrong.stderr.strip().endswith(
-        "two.bag: --instance 5: the bag has 2 sensor_msgs/msg/Imu topic(s) (/imu_a, /imu_b), instances 0 to 1")
+        "two.bag: --instance 5: the bag has 2 sensor_msgs/msg/Imu topic(s) (/imu_a, /imu_b), instances 0 to 1"
+    )
     assert not (tmp_path / "c.csv").exists()

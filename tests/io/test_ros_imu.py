@@ -21,16 +21,27 @@ def _messages(ros2: bool, frame_id: str, n: int, seed: int):
     rng = np.random.default_rng(seed)
     out = []
     for i in range(n):
-        stamp = types["builtin_interfaces/msg/Time"](sec=int(rng.integers(0, 2**31 - 1)),
-                                                     nanosec=int(rng.integers(0, 10**9)))
-        header = (types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame_id) if ros2 else
-                  types["std_msgs/msg/Header"](seq=i, stamp=stamp, frame_id=frame_id))
+        stamp = types["builtin_interfaces/msg/Time"](
+            sec=int(rng.integers(0, 2**31 - 1)), nanosec=int(rng.integers(0, 10**9))
+        )
+        header = (
+            types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame_id)
+            if ros2
+            else types["std_msgs/msg/Header"](seq=i, stamp=stamp, frame_id=frame_id)
+        )
         v = rng.normal(size=37)
         vector = types["geometry_msgs/msg/Vector3"]
-        out.append(types[IMU](header=header, orientation=types["geometry_msgs/msg/Quaternion"](*v[:4]),
-                              orientation_covariance=v[4:13], angular_velocity=vector(*v[13:16]),
-                              angular_velocity_covariance=v[16:25], linear_acceleration=vector(*v[25:28]),
-                              linear_acceleration_covariance=v[28:37]))
+        out.append(
+            types[IMU](
+                header=header,
+                orientation=types["geometry_msgs/msg/Quaternion"](*v[:4]),
+                orientation_covariance=v[4:13],
+                angular_velocity=vector(*v[13:16]),
+                angular_velocity_covariance=v[16:25],
+                linear_acceleration=vector(*v[25:28]),
+                linear_acceleration_covariance=v[28:37],
+            )
+        )
     serialize = store.serialize_cdr if ros2 else store.serialize_ros1
     deserialize = store.deserialize_cdr if ros2 else store.deserialize_ros1
     return out, [bytes(serialize(m, IMU)) for m in out], (lambda raw: deserialize(raw, IMU))
@@ -50,8 +61,8 @@ def test_a_batch_reads_what_rosbags_reads(ros2, frame_id):
     stamps = batch.stamp_s(cdr=ros2)
     for k, msg in enumerate(messages):
         assert stamps[k] == msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-        assert tuple(values[k, ANGULAR_VELOCITY:ANGULAR_VELOCITY + 3]) == _vector(msg.angular_velocity)
-        assert tuple(values[k, LINEAR_ACCELERATION:LINEAR_ACCELERATION + 3]) == _vector(msg.linear_acceleration)
+        assert tuple(values[k, ANGULAR_VELOCITY : ANGULAR_VELOCITY + 3]) == _vector(msg.angular_velocity)
+        assert tuple(values[k, LINEAR_ACCELERATION : LINEAR_ACCELERATION + 3]) == _vector(msg.linear_acceleration)
         assert np.array_equal(values[k, LINEAR_ACCELERATION_COVARIANCE:], msg.linear_acceleration_covariance)
 
 

@@ -26,11 +26,17 @@ def _bag(path, compression=None, n=600, writer_class=Writer):
         a = writer.add_connection("/a", "std_msgs/msg/String", typestore=STORE)
         b = writer.add_connection("/b", "std_msgs/msg/String", typestore=STORE)
         for i in range(n):
-            writer.write(a, 1_000_000_000 + 10_000_000 * i, STORE.serialize_ros1(string(data="x" * (40 + i % 60)),
-                                                                                  "std_msgs/msg/String"))
+            writer.write(
+                a,
+                1_000_000_000 + 10_000_000 * i,
+                STORE.serialize_ros1(string(data="x" * (40 + i % 60)), "std_msgs/msg/String"),
+            )
             if i % 3 == 0:
-                writer.write(b, 1_000_000_000 + 10_000_000 * i + 5, STORE.serialize_ros1(string(data=str(i)),
-                                                                                          "std_msgs/msg/String"))
+                writer.write(
+                    b,
+                    1_000_000_000 + 10_000_000 * i + 5,
+                    STORE.serialize_ros1(string(data=str(i)), "std_msgs/msg/String"),
+                )
     return path, writer
 
 
@@ -42,8 +48,9 @@ def _read(reader_class, path, **kwargs):
     return connections, messages
 
 
-@pytest.mark.parametrize("compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4],
-                         ids=["none", "bz2", "lz4"])
+@pytest.mark.parametrize(
+    "compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["none", "bz2", "lz4"]
+)
 def test_the_chunked_reader_reads_what_rosbags_reads(compression, tmp_path):
     path, _ = _bag(tmp_path / "in.bag", compression)
     ours, theirs = _read(chunked_reader1(), path), _read(Reader, path)
@@ -60,8 +67,10 @@ def test_a_damaged_or_foreign_file_is_a_reader_error(tmp_path):
     data = path.read_bytes()
     (tmp_path / "cut.bag").write_bytes(data[: len(data) // 2])
     (tmp_path / "other.bag").write_bytes(b"#ROSBAG V1.2\n" + data[13:])
-    for name, message in (("cut.bag", r"index position .* lies past the end|damaged"),
-                          ("other.bag", r"magic is invalid or the bag version is not 2\.0")):
+    for name, message in (
+        ("cut.bag", r"index position .* lies past the end|damaged"),
+        ("other.bag", r"magic is invalid or the bag version is not 2\.0"),
+    ):
         with pytest.raises(ReaderError, match=message), chunked_reader1()(tmp_path / name) as reader:
             list(reader.messages())
 

@@ -29,8 +29,9 @@ def _samples(n=3000, seed=0):
     rng = np.random.default_rng(seed)
     k = np.arange(n)
     temperature = 25.0 + 15.0 * np.sin(np.pi * k / n)
-    bias = np.column_stack([0.1 + 0.01 * (temperature - 25), -0.2 + 0.02 * (temperature - 25),
-                            0.05 - 0.015 * (temperature - 25)])
+    bias = np.column_stack(
+        [0.1 + 0.01 * (temperature - 25), -0.2 + 0.02 * (temperature - 25), 0.05 - 0.015 * (temperature - 25)]
+    )
     return np.column_stack([np.round(bias + 0.01 * rng.standard_normal((n, 3)), 5), np.round(temperature, 3)])
 
 
@@ -52,8 +53,12 @@ def _timed_table(path, samples, garbled=()):
     slots = np.arange(len(samples)) + np.searchsorted(sorted(garbled), np.arange(len(samples)), side="right")
     time_s = slots / RATE_HZ
     header = "time," + ",".join(NAMES)
-    path.write_text(header + "\n" + "\n".join(
-        f"{float(t)!r}," + ",".join(f"{v:.6g}" for v in row) for t, row in zip(time_s, samples)) + "\n")
+    path.write_text(
+        header
+        + "\n"
+        + "\n".join(f"{float(t)!r}," + ",".join(f"{v:.6g}" for v in row) for t, row in zip(time_s, samples))
+        + "\n"
+    )
     return path
 
 
@@ -112,16 +117,25 @@ def test_a_table_with_a_header_and_no_time_takes_a_nominal_rate(tmp_path):
 
 def test_what_cannot_be_read_so_is_refused_naming_it(tmp_path):
     serial = _serial_log(tmp_path / "serial.txt", _samples(50))
-    with pytest.raises(InputError, match=r"serial.txt: not a readable CSV table \(CSV parse error: Expected 2 "
-                                         r"columns, got 4.*\); if it has no header line .* names=gyro_x"):
+    with pytest.raises(
+        InputError,
+        match=r"serial.txt: not a readable CSV table \(CSV parse error: Expected 2 "
+        r"columns, got 4.*\); if it has no header line .* names=gyro_x",
+    ):
         read_table(serial)  # the banner taken for a header of one column
     bare = tmp_path / "bare.txt"
     bare.write_bytes(serial.read_bytes().split(b"\r\n", 1)[1])
-    with pytest.raises(InputError, match=r"bare.txt: the first line is numbers \(.*\), not the columns' names: a "
-                                         r"table without a header line; give the names in order"):
+    with pytest.raises(
+        InputError,
+        match=r"bare.txt: the first line is numbers \(.*\), not the columns' names: a "
+        r"table without a header line; give the names in order",
+    ):
         read_table(bare)
-    with pytest.raises(InputError, match=r"serial.txt: no line holds 3 numbers, one per name given \(a, b, c\); its "
-                                         r"first line: 'MPU6050 ready, 50 Hz'"):
+    with pytest.raises(
+        InputError,
+        match=r"serial.txt: no line holds 3 numbers, one per name given \(a, b, c\); its "
+        r"first line: 'MPU6050 ready, 50 Hz'",
+    ):
         read_table(serial, TableLayout(names=("a", "b", "c")))
     with pytest.raises(InputError, match="names: 'gyro_x' given twice"):
         TableLayout(names=("gyro_x", "gyro_x"))
@@ -169,8 +183,10 @@ def test_init_fit_apply_with_the_names_given_once(tmp_path):
     r = run("apply", "m.json", "serial.txt", "-o", "out.csv", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     (tmp_path / "gyrocomp.toml").unlink()
-    for args in (("fit", "timed.csv", "-o", "m_timed.json", "--temperature", "poly:2", "--hysteresis", "none"),
-                 ("apply", "m_timed.json", "timed.csv", "-o", "out_timed.csv")):
+    for args in (
+        ("fit", "timed.csv", "-o", "m_timed.json", "--temperature", "poly:2", "--hysteresis", "none"),
+        ("apply", "m_timed.json", "timed.csv", "-o", "out_timed.csv"),
+    ):
         r = run(*args, cwd=tmp_path)
         assert r.returncode == 0, r.stderr
     model, timed_model = (json.loads((tmp_path / name).read_text()) for name in ("m.json", "m_timed.json"))

@@ -57,11 +57,16 @@ def test_per_axis_temperatures(tmp_path):
 
 
 def test_mapping_and_unit_conversions(tmp_path):
-    p = write_csv(tmp_path / "vendor.csv", "Stamp,GyrZ,AccX,AccY,AccZ,T\n"
-                  "0,3.141592653589793,0,0,9.80665,25\n1000,0,0,9.80665,0,26\n2000,0,0,0,0,27\n")
-    layout = TableLayout(parse_column_mapping(
-        "time=Stamp,gyro_z=GyrZ,accel_x=AccX,accel_y=AccY,accel_z=AccZ,temperature=T"),
-        gyro_unit="rad/s", accel_unit="m/s2", time_unit="ms")
+    p = write_csv(
+        tmp_path / "vendor.csv",
+        "Stamp,GyrZ,AccX,AccY,AccZ,T\n0,3.141592653589793,0,0,9.80665,25\n1000,0,0,9.80665,0,26\n2000,0,0,0,0,27\n",
+    )
+    layout = TableLayout(
+        parse_column_mapping("time=Stamp,gyro_z=GyrZ,accel_x=AccX,accel_y=AccY,accel_z=AccZ,temperature=T"),
+        gyro_unit="rad/s",
+        accel_unit="m/s2",
+        time_unit="ms",
+    )
     rec = read(p, layout)
     np.testing.assert_allclose(rec.time_s, [0, 1, 2])
     assert rec.gyro_dps[0, 0] == pytest.approx(180.0)
@@ -89,11 +94,23 @@ def test_time_units(tmp_path, unit, factor):
         ("", r"e.csv: the file is empty; expected a header"),
         ("\n\n", r"e.csv: the file is empty"),
         ("time,gyro_z,temperature\n", r"e.csv: a header but no data rows"),
-        ("time,gyro_z,temperature\n0,1,20\n1,abc,21\n2,1,22\n", r"e.csv: row 2 \(line 3\), column 'gyro_z': 'abc' is not a number"),
-        ("time,gyro_z,temperature\n0,1,20\n1,,21\n2,1,22\n", r"e.csv: row 2, column 'gyro_z': nan is not a finite number"),
-        ("time,gyro_z,temperature\n0,1,20\n1,nan,21\n2,1,22\n", r"e.csv: row 2, column 'gyro_z': nan is not a finite number"),
+        (
+            "time,gyro_z,temperature\n0,1,20\n1,abc,21\n2,1,22\n",
+            r"e.csv: row 2 \(line 3\), column 'gyro_z': 'abc' is not a number",
+        ),
+        (
+            "time,gyro_z,temperature\n0,1,20\n1,,21\n2,1,22\n",
+            r"e.csv: row 2, column 'gyro_z': nan is not a finite number",
+        ),
+        (
+            "time,gyro_z,temperature\n0,1,20\n1,nan,21\n2,1,22\n",
+            r"e.csv: row 2, column 'gyro_z': nan is not a finite number",
+        ),
         ("time,gyro_z,temperature\n0,1,20\n2,1,21\n1,1,22\n", r"e.csv: row 3: time goes backwards"),
-        ("t,gyro_z\n0,1\n1,2\n", r"e.csv: no 'time' column \(the file has t, gyro_z\); map one with columns=\{'time': 'NAME'\}"),
+        (
+            "t,gyro_z\n0,1\n1,2\n",
+            r"e.csv: no 'time' column \(the file has t, gyro_z\); map one with columns=\{'time': 'NAME'\}",
+        ),
         ("time,temperature\n0,1\n1,2\n", r"e.csv: no gyro column .*columns=\{'gyro_z': 'NAME'\}"),
     ],
 )
@@ -119,7 +136,9 @@ def test_missing_file_and_unknown_suffix(tmp_path):
     with pytest.raises(InputError, match=r"nothere.csv: no such file"):
         read(tmp_path / "nothere.csv")
     (tmp_path / "x.log").write_text("time,gyro_z\n0,1\n1,2\n")
-    with pytest.raises(InputError, match=r"x.log: cannot tell the format from the file or its suffix '.log'; name it with fmt="):
+    with pytest.raises(
+        InputError, match=r"x.log: cannot tell the format from the file or its suffix '.log'; name it with fmt="
+    ):
         read(tmp_path / "x.log")
     assert read(tmp_path / "x.log", fmt="csv").n_samples == 2
 
@@ -131,7 +150,9 @@ def test_not_a_parquet_file(tmp_path):
 
 
 def test_drop_nan_reports_count_and_write_back_leaves_the_dropped_rows_out(tmp_path):
-    p = write_csv(tmp_path / "n.csv", "time,gyro_z,temperature,note\n0,1,20,a\n1,,21,b\n2,3,22,c\n3,4,inf,d\n4,5,23,e\n")
+    p = write_csv(
+        tmp_path / "n.csv", "time,gyro_z,temperature,note\n0,1,20,a\n1,,21,b\n2,3,22,c\n3,4,inf,d\n4,5,23,e\n"
+    )
     with pytest.warns(DataQualityWarning, match=r"n.csv: dropped 2 of 5 rows"):
         data = read_table(p, drop_nonfinite=True)
     assert list(data.recording.row_numbers) == [1, 3, 5]
@@ -208,8 +229,11 @@ def test_single_axis_simulation_writes_default_layout(tmp_path):
 def test_gaps_are_reported_and_kept(tmp_path):
     rows = [f"{t:.2f},0.1,20" for t in [0, 0.01, 0.02, 0.03, 3.0, 3.01, 3.02, 9.0, 9.01]]
     p = write_csv(tmp_path / "g.csv", "time,gyro_z,temperature\n" + "\n".join(rows) + "\n")
-    with pytest.warns(DataQualityWarning, match=r"g.csv: 2 time gap\(s\) longer than 2 sample periods "
-                                                 r"\(longest 5.98 s after row 7\); kept as they are, nothing interpolated"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"g.csv: 2 time gap\(s\) longer than 2 sample periods "
+        r"\(longest 5.98 s after row 7\); kept as they are, nothing interpolated",
+    ):
         rec = read(p)
     assert rec.n_samples == 9
     assert [g.after_row for g in rec.gaps] == [4, 7]
@@ -248,8 +272,11 @@ THREE_AXES = "time,gyro_x,gyro_y,gyro_z,temperature\n0,1,2,3,20\n1,1,2,3,21\n"
 
 def test_a_column_read_as_two_channels_is_refused_and_a_swap_is_read(tmp_path):
     p = write_csv(tmp_path / "three.csv", THREE_AXES)
-    with pytest.raises(InputError, match=r"three.csv: column 'gyro_x' would be read as gyro_x and gyro_z "
-                                         r"\(columns=\{'gyro_z': 'gyro_x'\}\); one column feeds one channel"):
+    with pytest.raises(
+        InputError,
+        match=r"three.csv: column 'gyro_x' would be read as gyro_x and gyro_z "
+        r"\(columns=\{'gyro_z': 'gyro_x'\}\); one column feeds one channel",
+    ):
         read_table(p, TableLayout(columns={"gyro_z": "gyro_x"}))
     swapped = read_table(p, TableLayout(columns={"gyro_x": "gyro_z", "gyro_z": "gyro_x"})).recording
     np.testing.assert_array_equal(swapped.gyro_dps[0], [3.0, 2.0, 1.0])
@@ -257,8 +284,11 @@ def test_a_column_read_as_two_channels_is_refused_and_a_swap_is_read(tmp_path):
 
 def test_a_channels_own_column_left_unread_by_a_mapping_is_said(tmp_path):
     p = write_csv(tmp_path / "alt.csv", "time,gyro_z,gyro_z_filtered,temperature\n0,1,5,20\n1,1,6,21\n")
-    with pytest.warns(DataQualityWarning, match=r"alt.csv: column 'gyro_z' is not read: "
-                                                r"columns=\{'gyro_z': 'gyro_z_filtered'\} reads gyro_z from"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"alt.csv: column 'gyro_z' is not read: "
+        r"columns=\{'gyro_z': 'gyro_z_filtered'\} reads gyro_z from",
+    ):
         data = read_table(p, TableLayout(columns={"gyro_z": "gyro_z_filtered"}))
     np.testing.assert_array_equal(data.recording.gyro_dps[:, 0], [5.0, 6.0])
 
@@ -274,12 +304,15 @@ def test_cli_refuses_a_mapping_that_reads_one_column_twice(tmp_path):
 SEMICOLON = "time;gyro_z;temperature\n0;1,5;20,25\n1;2,5;21,5\n2;-0,5;22\n"
 
 
-@pytest.mark.parametrize("text, layout", [
-    (SEMICOLON, TableLayout()),                                     # a spreadsheet in a decimal-comma locale
-    (SEMICOLON.replace(";", "\t"), TableLayout()),                  # tab-separated
-    (SEMICOLON, TableLayout(delimiter=";", decimal=",")),           # said explicitly
-    (" Time , GYRO_Z , Temperature\n0,1.5,20.25\n1,2.5,21.5\n2,-0.5,22\n", TableLayout()),  # spaced, capitalized
-])
+@pytest.mark.parametrize(
+    "text, layout",
+    [
+        (SEMICOLON, TableLayout()),  # a spreadsheet in a decimal-comma locale
+        (SEMICOLON.replace(";", "\t"), TableLayout()),  # tab-separated
+        (SEMICOLON, TableLayout(delimiter=";", decimal=",")),  # said explicitly
+        (" Time , GYRO_Z , Temperature\n0,1.5,20.25\n1,2.5,21.5\n2,-0.5,22\n", TableLayout()),  # spaced, capitalized
+    ],
+)
 def test_delimiters_decimal_commas_and_loose_standard_names(tmp_path, text, layout):
     data = read_table(write_csv(tmp_path / "v.csv", text), layout)
     np.testing.assert_array_equal(data.recording.gyro_dps[:, 0], [1.5, 2.5, -0.5])
@@ -334,14 +367,19 @@ def test_reading_only_some_channels(tmp_path, suffix):
         read_table(path, channels=("accel_x",))
 
 
-@pytest.mark.parametrize("header, name", [("time,Gyro_Z,GYRO_Z,temperature", "gyro_z"),
-                                          ("time,gyro_z,temperature,Temperature", "temperature")])
+@pytest.mark.parametrize(
+    "header, name",
+    [("time,Gyro_Z,GYRO_Z,temperature", "gyro_z"), ("time,gyro_z,temperature,Temperature", "temperature")],
+)
 def test_two_columns_that_match_one_channel_are_refused_naming_both(tmp_path, header, name):
     path = tmp_path / "amb.csv"
     path.write_text(header + "\n" + "\n".join(f"{t},1,2,{20 + t}" for t in range(5)) + "\n")
     first, second = [c for c in header.split(",") if c.strip().lower() == name]
-    with pytest.raises(InputError, match=rf"amb.csv: columns '{first}' and '{second}' would both be read as {name}; "
-                                         rf"say which with columns="):
+    with pytest.raises(
+        InputError,
+        match=rf"amb.csv: columns '{first}' and '{second}' would both be read as {name}; "
+        rf"say which with columns=",
+    ):
         read(path)
     result = run("convert", path, tmp_path / "out.csv")
     assert result.returncode == 2 and result.stderr.count("\n") == 1 and f"--columns {name}={first}" in result.stderr
@@ -353,8 +391,10 @@ def test_two_columns_that_match_one_channel_are_refused_naming_both(tmp_path, he
 def test_names_that_say_the_project_units_are_read_without_a_mapping(tmp_path):
     """time_s, gyro_x_dps, accel_x_g, temperature_degc: the names the project itself gives things."""
     path = tmp_path / "units.csv"
-    path.write_text("time_s,gyro_x_dps,gyro_z_dps,accel_z_g,temperature_degc\n"
-                    + "".join(f"{t / 10},0.5,-0.25,1.0,{20 + t / 100}\n" for t in range(50)))
+    path.write_text(
+        "time_s,gyro_x_dps,gyro_z_dps,accel_z_g,temperature_degc\n"
+        + "".join(f"{t / 10},0.5,-0.25,1.0,{20 + t / 100}\n" for t in range(50))
+    )
     rec = read(path)
     assert rec.gyro_axes == ("gyro_x", "gyro_z") and rec.accel_axes == ("accel_z",)
     np.testing.assert_allclose(rec.time_s[:3], [0.0, 0.1, 0.2])
@@ -364,5 +404,3 @@ def test_names_that_say_the_project_units_are_read_without_a_mapping(tmp_path):
     both = tmp_path / "both.csv"
     both.write_text("time,gyro_x,gyro_x_dps\n" + "".join(f"{t},1.0,2.0\n" for t in range(5)))
     np.testing.assert_allclose(read(both).gyro_dps[:, 0], 1.0)
-
-

@@ -16,8 +16,7 @@ from gyrocomp.errors import InputError, TimeOrderWarning
 from gyrocomp.fleet import CalibrationStore
 from gyrocomp.files.check import ask_for, check_files, enforce, read_checked
 from gyrocomp.io.tables import write_recording
-from gyrocomp.measures.data_check import (MIN_SPAN_DEGC, Ask, CheckedRun, check_runs, time_findings,
-                                          white_noise_density)
+from gyrocomp.measures.data_check import MIN_SPAN_DEGC, Ask, CheckedRun, check_runs, time_findings, white_noise_density
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.simulation import preset_model, simulate
 from gyrocomp.simulation.faults import FAULTS, inject
@@ -67,14 +66,18 @@ def test_refusals_and_warnings_follow_what_is_asked(clean_columns, tmp_path):
     (named,) = check_runs([run_], ask_for(FitOptions(temperature=Polynomial(3))))
     # 0.5 degC holds 6 levels of 0.1 degC, fewer than a cubic's 8
     assert named.verdict == "refused" and named.reasons == ("temperature-span", "too-short")
-    (accepted,) = check_runs([run_], ask_for(FitOptions(temperature=Polynomial(3))),
-                             accept=["temperature-span", "too-short"])
+    (accepted,) = check_runs(
+        [run_], ask_for(FitOptions(temperature=Polynomial(3))), accept=["temperature-span", "too-short"]
+    )
     assert accepted.verdict == "ok" and [f.check for f in accepted.accepted] == ["temperature-span", "too-short"]
     assert "accepted: temperature-span, too-short" in accepted.line()
     (none,) = check_runs([run_], ask_for(FitOptions(temperature=None)))
     assert none.verdict == "ok"
-    with pytest.raises(InputError, match=r"flat.parquet: the runs span 0.5 degC, less than 1 degC.*refused by the "
-                                         r"data check \(accept=temperature-span fits it anyway\)"):
+    with pytest.raises(
+        InputError,
+        match=r"flat.parquet: the runs span 0.5 degC, less than 1 degC.*refused by the "
+        r"data check \(accept=temperature-span fits it anyway\)",
+    ):
         enforce([named])
     # a run at one temperature beside a chamber run: the set spans enough, the flat run is fine
     full = tmp_path / "full.parquet"
@@ -120,8 +123,12 @@ def test_the_noise_density_is_recovered_and_the_unit_mistake_is_57_times_off():
 def test_check_fit_and_fleet_fit_run_the_check(clean_columns, tmp_path):
     good, flat, bare = tmp_path / "good.csv", tmp_path / "flat.csv", tmp_path / "bare.csv"
     pd.DataFrame(clean_columns["adxrs450"]).to_csv(good, index=False)
-    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-span", np.random.default_rng(0))).to_csv(flat, index=False)
-    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-missing", np.random.default_rng(0))).to_csv(bare, index=False)
+    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-span", np.random.default_rng(0))).to_csv(
+        flat, index=False
+    )
+    pd.DataFrame(inject(clean_columns["adxrs450"], "temperature-missing", np.random.default_rng(0))).to_csv(
+        bare, index=False
+    )
     checked = run("check", good, flat, bare)  # one unit's runs: together they span enough
     assert checked.returncode == 1, checked.stderr
     lines = checked.stdout.splitlines()
@@ -134,8 +141,18 @@ def test_check_fit_and_fleet_fit_run_the_check(clean_columns, tmp_path):
     refused = run("fit", flat, "--temperature", "poly:3", "-o", tmp_path / "m.json")
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1 and not (tmp_path / "m.json").exists()
     assert "--accept temperature-span fits it anyway" in refused.stderr
-    accepted = run("fit", flat, "--temperature", "poly:3", "--accept", "temperature-span", "--accept", "too-short",
-                   "-o", tmp_path / "m.json")
+    accepted = run(
+        "fit",
+        flat,
+        "--temperature",
+        "poly:3",
+        "--accept",
+        "temperature-span",
+        "--accept",
+        "too-short",
+        "-o",
+        tmp_path / "m.json",
+    )
     assert accepted.returncode == 0, accepted.stderr
     manifest = tmp_path / "units.csv"
     manifest.write_text(f"path,serial\n{good},A\n{bare},B\n")

@@ -84,13 +84,15 @@ def test_runs_with_gaps_pool_the_allan_sums_over_their_stretches():
     stretches = rec.contiguous_stretches()
     pooled = allan_deviation_segments([rec.gyro_dps[s, 0] for s in stretches], rec.rate_hz).minimum()
     assert ev.axes["gyro_x"].bias_instability_raw_dph == pytest.approx(
-        pooled.deviation / BIAS_INSTABILITY_FACTOR * 3600, rel=1e-12)
+        pooled.deviation / BIAS_INSTABILITY_FACTOR * 3600, rel=1e-12
+    )
     # no tau longer than a stretch: the curve stops where the positions do
     assert ev.axes["gyro_x"].integration_time_raw_s <= max(s.stop - s.start for s in stretches) / rec.rate_hz
 
 
-@pytest.mark.parametrize(("unit", "bi_unit", "suffix", "bi", "other"), [("deg/s", "deg/h", "dps", "dph", "g"),
-                                                                    ("g", "ug", "g", "ug", "dps")])
+@pytest.mark.parametrize(
+    ("unit", "bi_unit", "suffix", "bi", "other"), [("deg/s", "deg/h", "dps", "dph", "g"), ("g", "ug", "g", "ug", "dps")]
+)
 def test_one_figures_class_reads_each_figure_under_its_units_name(unit, bi_unit, suffix, bi, other):
     """Gyro and accelerometer figures are one class with a unit: the names that carry a unit read the axis's own
     figures (distinct values, so a swap would show) and refuse the other unit's; the JSON writes those names."""
@@ -103,13 +105,21 @@ def test_one_figures_class_reads_each_figure_under_its_units_name(unit, bi_unit,
     assert getattr(figures, f"bias_instability_raw_{bi}") == value["bias_instability_raw"]
     assert getattr(figures, f"bias_instability_comp_{bi}") == value["bias_instability_comp"]
     assert getattr(figures, f"residual_rms_{suffix}") == value["residual_rms"]
-    with pytest.raises(InputError, match=rf"bias_offset_raw_{other}: the axis's values are in {unit}, not .*; "
-                                         r"read offset_raw"):
+    with pytest.raises(
+        InputError,
+        match=rf"bias_offset_raw_{other}: the axis's values are in {unit}, not .*; "
+        r"read offset_raw",
+    ):
         getattr(figures, f"bias_offset_raw_{other}")
     assert figures.to_dict() == {
-        f"bias_offset_raw_{suffix}": 1.0, f"bias_offset_comp_{suffix}": 2.0, "offset_improvement": 3.0,
-        f"bias_instability_raw_{bi}": 4.0, f"bias_instability_comp_{bi}": 5.0, "integration_time_raw_s": 6.0,
-        "integration_time_comp_s": 7.0, f"residual_rms_{suffix}": 8.0}
+        f"bias_offset_raw_{suffix}": 1.0,
+        f"bias_offset_comp_{suffix}": 2.0,
+        "offset_improvement": 3.0,
+        f"bias_instability_raw_{bi}": 4.0,
+        f"bias_instability_comp_{bi}": 5.0,
+        "integration_time_raw_s": 6.0,
+        "integration_time_comp_s": 7.0,
+        f"residual_rms_{suffix}": 8.0,
+    }
     with pytest.raises(InputError, match=r"unit: 'rad/s'; an axis is in one of deg/s, g"):
         AxisMetrics("rad/s", *[1.0] * len(names))
-

@@ -29,7 +29,11 @@ def test_every_gyro_axis_by_default_and_accelerometers_on_request():
         analyse_noise(rec, ["gyro_y"])
     # with_accel (Kalibr's file): the named axes, then every accelerometer axis not named already
     assert list(analyse_noise(rec, ["accel_y", "gyro_z"], with_accel=True).axes) == [
-        "accel_y", "gyro_z", "accel_x", "accel_z"]
+        "accel_y",
+        "gyro_z",
+        "accel_x",
+        "accel_z",
+    ]
 
 
 def test_other_kinds_keep_noise_terms_from_the_overlapping_curve():
@@ -42,8 +46,11 @@ def test_other_kinds_keep_noise_terms_from_the_overlapping_curve():
 
 def test_gaps_are_refused_unless_split():
     rec = static_recording(gap_after=40_000)
-    with pytest.raises(InputError, match=r"static.csv: time gap of 10.02 s after row 40000 \(t = 799.98 s\); "
-                                         r"Allan deviations need evenly spaced samples: use split_gaps=True"):
+    with pytest.raises(
+        InputError,
+        match=r"static.csv: time gap of 10.02 s after row 40000 \(t = 799.98 s\); "
+        r"Allan deviations need evenly spaced samples: use split_gaps=True",
+    ):
         analyse_noise(rec)
     assert [(s.start, s.stop) for s in rec.contiguous_stretches()] == [(0, 40_000), (40_000, 60_000)]
     analysis = analyse_noise(rec, split_gaps=True)
@@ -63,9 +70,15 @@ def test_json_document_has_the_documented_shape_and_no_nan():
     assert set(doc) == {"rate_hz", "axes"}
     z = doc["axes"]["gyro_z"]
     assert set(z) == {"tau_s", "adev", "n", "ci_low", "ci_high", "noise"}
-    assert set(z["noise"]) == {"noise_density_dps_per_sqrt_hz", "arw_deg_per_sqrt_h", "bias_instability_deg_per_h",
-                               "integration_time_s", "rrw_deg_per_h_per_sqrt_h", "quantization_deg",
-                               "rate_ramp_deg_per_h2"}
+    assert set(z["noise"]) == {
+        "noise_density_dps_per_sqrt_hz",
+        "arw_deg_per_sqrt_h",
+        "bias_instability_deg_per_h",
+        "integration_time_s",
+        "rrw_deg_per_h_per_sqrt_h",
+        "quantization_deg",
+        "rate_ramp_deg_per_h2",
+    }
     assert "noise_density_g_per_sqrt_hz" in doc["axes"]["accel_x"]["noise"]
     flat = [v for axis in doc["axes"].values() for key in ("adev", "ci_low", "ci_high") for v in axis[key]]
     assert all(v is None or math.isfinite(v) for v in flat)
@@ -81,6 +94,9 @@ def test_a_noise_model_that_misses_the_curve_is_warned_about_in_the_library():
         warnings.simplefilter("error", DataQualityWarning)
         analyse_noise(white)
     periodic = Recording(t, (rng.normal(0, 0.01, t.size) + 0.5 * np.sin(2 * np.pi * t / 50.0))[:, None], ("gyro_z",))
-    with pytest.warns(DataQualityWarning, match=r"gyro_z: the five-term noise model misses the curve by \d+% RMS.*"
-                                                r"fit_taus_s: \(low, high\) \[s\]"):
+    with pytest.warns(
+        DataQualityWarning,
+        match=r"gyro_z: the five-term noise model misses the curve by \d+% RMS.*"
+        r"fit_taus_s: \(low, high\) \[s\]",
+    ):
         analyse_noise(periodic)

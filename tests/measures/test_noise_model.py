@@ -112,4 +112,5 @@ def test_the_scheduled_bound_is_each_dwells_at_its_temperature_and_held_past_the
     assert at(120.0).random_walk == pytest.approx(hot.bound.random_walk)
     halfway = 0.5 * (middle.temperature_degc + hot.temperature_degc)
     assert at(halfway).white_noise_density == pytest.approx(
-        0.5 * (middle.bound.white_noise_density + hot.bound.white_noise_density))
+        0.5 * (middle.bound.white_noise_density + hot.bound.white_noise_density)
+    )

@@ -12,8 +12,13 @@ from hypothesis import strategies as st
 from gyrocomp import Polynomial, apply, fit_calibration, write
 from gyrocomp.evaluation import comparison, validation
 from gyrocomp.calibration.compensate import Compensator
-from gyrocomp.errors import (DataQualityWarning, InputError, ModelChoiceWarning, PlausibilityWarning,
-                             TemperatureRangeWarning)
+from gyrocomp.errors import (
+    DataQualityWarning,
+    InputError,
+    ModelChoiceWarning,
+    PlausibilityWarning,
+    TemperatureRangeWarning,
+)
 from gyrocomp.io import read
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.measures.plausibility import (
@@ -56,14 +61,22 @@ def test_kelvin_looking_temperatures():
 
 def _still(rate_hz, n, time_factor=1.0):
     t = np.arange(n) / rate_hz
-    return Recording(time_s=t * time_factor, gyro_dps=np.zeros((n, 1)), gyro_axes=("gyro_z",),
-                     temperature_degc=np.linspace(20.0, 30.0, n), source="t.csv")
+    return Recording(
+        time_s=t * time_factor,
+        gyro_dps=np.zeros((n, 1)),
+        gyro_axes=("gyro_z",),
+        temperature_degc=np.linspace(20.0, 30.0, n),
+        source="t.csv",
+    )
 
 
 def test_time_in_another_unit():
     # 10 Hz with the time in ms read as s: 0.01 Hz for 116 days
     (concern,) = recording_concerns(_still(10.0, 100_000, time_factor=1000.0))
-    assert concern.check == "time-unit" and concern.message == "t.csv: 116 days at 0.01 Hz: is the time column in ms read as s?"
+    assert (
+        concern.check == "time-unit"
+        and concern.message == "t.csv: 116 days at 0.01 Hz: is the time column in ms read as s?"
+    )
     # 100 Hz with the time in s read as ms: 100 kHz
     (concern,) = recording_concerns(_still(100.0, 1000, time_factor=1e-3))
     assert concern.message.startswith("t.csv: 1e+05 Hz is no IMU's sample rate")
@@ -77,8 +90,11 @@ def test_values_beyond_any_mems_range():
     assert concern.check == "rate" and "6e+04 deg/s, beyond any MEMS gyro's range" in concern.message
     # what no output can be (a damaged binary file gives 1e36..1e302) is refused where the recording is made
     gyro[10, 0] = 6e31
-    with pytest.raises(InputError, match=r"row 11, column 'gyro_x': 6e\+31 deg/s is beyond what any sensor gives "
-                                         r"\(-1e\+06\.\.1e\+06 deg/s\): a damaged file, or a column in another unit"):
+    with pytest.raises(
+        InputError,
+        match=r"row 11, column 'gyro_x': 6e\+31 deg/s is beyond what any sensor gives "
+        r"\(-1e\+06\.\.1e\+06 deg/s\): a damaged file, or a column in another unit",
+    ):
         dataclasses.replace(RUN, gyro_dps=gyro)
 
 
@@ -116,11 +132,15 @@ def test_fit_and_apply_warn_and_the_warning_can_be_silenced():
 
 @pytest.mark.parametrize("what, call", [("compare", "compare_methods"), ("validate", "validate")])
 def test_comparing_temperature_models_on_flat_runs_is_refused_in_one_line(what, call):
-    flat = [dataclasses.replace(RUN, temperature_degc=np.full(RUN.n_samples, 25.0), source=f"flat{k}.csv")
-            for k in range(3)]
+    flat = [
+        dataclasses.replace(RUN, temperature_degc=np.full(RUN.n_samples, 25.0), source=f"flat{k}.csv") for k in range(3)
+    ]
     function = getattr(comparison if call == "compare_methods" else validation, call)
-    with pytest.raises(InputError, match=rf"flat0.csv: the temperature of every run spans at most 0 degC; {what} "
-                                         "compares temperature models"):
+    with pytest.raises(
+        InputError,
+        match=rf"flat0.csv: the temperature of every run spans at most 0 degC; {what} "
+        "compares temperature models",
+    ):
         function(flat)
 
 
@@ -165,6 +185,7 @@ def test_a_hand_turned_multi_position_session_is_not_taken_for_a_rotating_run():
 
 # -- the model against the data it is applied to ------------------------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def chamber_model():
     """A consumer part's default model from two chamber runs, and a third run of the same part held out."""
@@ -178,8 +199,9 @@ def _agreement_warnings(calibration, recording):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         apply(calibration, recording)
-    return [str(w.message) for w in caught
-            if issubclass(w.category, PlausibilityWarning) and w.message.check == "agreement"]
+    return [
+        str(w.message) for w in caught if issubclass(w.category, PlausibilityWarning) and w.message.check == "agreement"
+    ]
 
 
 def test_a_model_applied_to_its_own_part_agrees_and_says_nothing(chamber_model):
@@ -220,8 +242,9 @@ def test_the_agreement_check_is_silenced_by_name_and_on_the_command_line(chamber
     write(radians, tmp_path / "rad.csv")
     said = run("apply", tmp_path / "model.json", tmp_path / "rad.csv", "-o", tmp_path / "out.csv")
     assert said.returncode == 0 and said.stderr.count("(check 'agreement')") == 3
-    quiet = run("--allow", "agreement", "apply", tmp_path / "model.json", tmp_path / "rad.csv", "-o",
-                tmp_path / "out2.csv")
+    quiet = run(
+        "--allow", "agreement", "apply", tmp_path / "model.json", tmp_path / "rad.csv", "-o", tmp_path / "out2.csv"
+    )
     assert quiet.returncode == 0 and "agreement" not in quiet.stderr
 
 
@@ -241,7 +264,7 @@ def test_block_means_are_the_same_for_any_chunking(cuts):
     # the blocks are 60 s from the first sample, the partial last one left out
     blocks = np.floor((time_s - time_s[0]) / 60.0)
     expected = [values[blocks == k].mean(axis=0) for k in range(int(blocks.max()))]
-    np.testing.assert_allclose(whole.means()[:len(expected)], expected, atol=1e-12)
+    np.testing.assert_allclose(whole.means()[: len(expected)], expected, atol=1e-12)
 
 
 def test_block_means_keep_only_the_blocks_with_data():
@@ -272,15 +295,18 @@ def test_the_slope_and_when_there_is_none():
     assert not ScaleAgreement(0.3, 0.06, 40).disagrees  # 0.3 + 4 x 0.06 > 0.5: not sure enough
 
 
-@pytest.mark.parametrize("factor, words", [(9.80665, "m/s^2 read as g"), (1000.0, "mg read as g"),
-                                           (1 / 9.80665, "g read as m/s^2")])
+@pytest.mark.parametrize(
+    "factor, words", [(9.80665, "m/s^2 read as g"), (1000.0, "mg read as g"), (1 / 9.80665, "g read as m/s^2")]
+)
 def test_an_accelerometer_in_the_wrong_unit_is_said(factor, words):
     assert RUN.accel_g is not None and "accel-unit" not in _checks(recording_concerns(RUN))
     wrong = dataclasses.replace(RUN, accel_g=RUN.accel_g * factor)
     (concern,) = [c for c in recording_concerns(wrong) if c.check == "accel-unit"]
     norm = np.median(np.linalg.norm(wrong.accel_g, axis=1))
-    assert concern.message == (f"{RUN.source}: the accelerometer's median norm is {norm:.3g} g where gravity is 1 g: "
-                               f"{words}? (give its unit with accel_unit=)")
+    assert concern.message == (
+        f"{RUN.source}: the accelerometer's median norm is {norm:.3g} g where gravity is 1 g: "
+        f"{words}? (give its unit with accel_unit=)"
+    )
     # in motion too: a field log's median norm is gravity's (turns, vibration and accelerations average out)
     field = simulate("consumer", profile="field", rate_hz=20, seed=4, duration_s=600).recording
     assert accel_unit_concern(field) is None
@@ -308,7 +334,9 @@ def test_an_output_that_parts_with_the_direction_of_temperature_change_is_named_
     # the plain slope's residual is the step between the branches, one long correlated stretch: that slope alone
     # is not trusted (few effective blocks), the fit with the direction is
     assert fit.follows_direction and not fit.disagrees
-    assert fit.direction_offset == pytest.approx(0.3, rel=0.02) and fit.slope_with_direction == pytest.approx(1, rel=0.05)
+    assert fit.direction_offset == pytest.approx(0.3, rel=0.02) and fit.slope_with_direction == pytest.approx(
+        1, rel=0.05
+    )
     message = agreement_concern("f.csv", "gyro_z", fit).message
     assert "parts between heating and cooling by 0.3 deg/s beyond the model" in message
     assert "slope of" not in message  # the slope agrees: no "slope of 1 +- 0.06, not 1"
@@ -332,25 +360,29 @@ def test_a_drift_of_the_part_is_not_read_as_a_unit_or_another_part():
     said = 0
     for _ in range(40):
         drift = np.cumsum(0.016 * rng.standard_normal(temperature.size))
-        fit = scale_agreement(predicted + drift + 0.001 * rng.standard_normal(temperature.size), predicted,
-                              temperature)
+        fit = scale_agreement(predicted + drift + 0.001 * rng.standard_normal(temperature.size), predicted, temperature)
         said += agreement_concern("f.csv", "gyro_z", fit) is not None
     assert said <= 5
-    wrong = scale_agreement(np.degrees(predicted) + 1e-4 * rng.standard_normal(temperature.size), predicted,
-                            temperature)
-    assert agreement_concern("f.csv", "gyro_z", wrong).message.endswith(
-        "not 1: deg/s data for a model fitted on rad/s?") and "slope of 57.3 +-" in agreement_concern(
-        "f.csv", "gyro_z", wrong).message
+    wrong = scale_agreement(
+        np.degrees(predicted) + 1e-4 * rng.standard_normal(temperature.size), predicted, temperature
+    )
+    assert (
+        agreement_concern("f.csv", "gyro_z", wrong).message.endswith("not 1: deg/s data for a model fitted on rad/s?")
+        and "slope of 57.3 +-" in agreement_concern("f.csv", "gyro_z", wrong).message
+    )
 
 
 def test_an_impossible_temperature_is_named_with_its_row():
     rec = simulate("consumer", profile="cycle", duration_s=3000, rate_hz=1, seed=1).recording
     t = rec.temperature_degc.copy()
     t[[500, 900]] = [900.0, -150.0]
-    (concern,) = [c for c in recording_concerns(dataclasses.replace(rec, temperature_degc=t))
-                  if c.check == "temperature-range"]
-    assert concern.message.endswith("row 501: temperature 900 degC, beyond any sensor's range (-100..200 degC), "
-                                    "and 1 row(s) more: a corrupt sample, or another unit?")
+    (concern,) = [
+        c for c in recording_concerns(dataclasses.replace(rec, temperature_degc=t)) if c.check == "temperature-range"
+    ]
+    assert concern.message.endswith(
+        "row 501: temperature 900 degC, beyond any sensor's range (-100..200 degC), "
+        "and 1 row(s) more: a corrupt sample, or another unit?"
+    )
     assert not [c for c in recording_concerns(rec) if c.check == "temperature-range"]
     with pytest.warns(PlausibilityWarning, match=r"row 501: temperature 900 degC"):
         with warnings.catch_warnings():
@@ -361,11 +393,17 @@ def test_an_impossible_temperature_is_named_with_its_row():
 def test_allan_says_a_time_column_in_another_unit(tmp_path):
     path = tmp_path / "ns.csv"
     rng = np.random.default_rng(0)
-    pd.DataFrame({"time": (np.arange(5000) * 10_000_000).astype(np.int64),  # 100 Hz in ns, read as s
-                  "gyro_z": rng.standard_normal(5000)}).to_csv(path, index=False)
+    pd.DataFrame(
+        {
+            "time": (np.arange(5000) * 10_000_000).astype(np.int64),  # 100 Hz in ns, read as s
+            "gyro_z": rng.standard_normal(5000),
+        }
+    ).to_csv(path, index=False)
     result = run("allan", path)
     assert result.returncode == 0
-    assert "ns.csv: 1e-07 Hz is no IMU's sample rate: is the time column in another unit than the one given? " \
-           "(check 'time-unit')" in result.stderr
+    assert (
+        "ns.csv: 1e-07 Hz is no IMU's sample rate: is the time column in another unit than the one given? "
+        "(check 'time-unit')" in result.stderr
+    )
     with pytest.warns(PlausibilityWarning, match=r"1e-07 Hz is no IMU's sample rate"):
         analyse_noise(read(path))

@@ -79,8 +79,12 @@ def test_gyro_and_accel_together_fit_g_on_compensated_accelerations():
 
 
 def test_round_trip_names_accelerometer_values_in_g(cycles, tmp_path):
-    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("gyro", "accel"),
-                 options=FitOptions(temperature=Polynomial(2), hysteresis="none"))
+    cal = _quiet(
+        fit_channels,
+        [s.recording for s in cycles[:2]],
+        ("gyro", "accel"),
+        options=FitOptions(temperature=Polynomial(2), hysteresis="none"),
+    )
     path = tmp_path / "model.json"
     cal.save(path)
     text = path.read_text()
@@ -103,7 +107,7 @@ def _keys(d) -> list[str]:
 def _renamed(d, old: str, new: str):
     """``d`` with every key ending in ``old`` ending in ``new`` instead."""
     if isinstance(d, dict):
-        return {(k[:-len(old)] + new if k.endswith(old) else k): _renamed(v, old, new) for k, v in d.items()}
+        return {(k[: -len(old)] + new if k.endswith(old) else k): _renamed(v, old, new) for k, v in d.items()}
     return [_renamed(v, old, new) for v in d] if isinstance(d, list) else d
 
 
@@ -112,13 +116,17 @@ def test_the_accelerometer_fit_report_names_its_figures_in_g(cycles, temperature
     """The accelerometer's held-out drifts, thermal-memory scores, fit and network residuals are in g: the model
     file says so (``_g``, never ``_dps``), the typed report carries the unit and refuses the deg/s names, and a file
     written before (the same values under ``_dps``) reads into the same records."""
-    cal = _quiet(fit_channels, [s.recording for s in cycles[:3]], ("accel",),
-                 options=FitOptions(temperature=temperature))
+    cal = _quiet(
+        fit_channels, [s.recording for s in cycles[:3]], ("accel",), options=FitOptions(temperature=temperature)
+    )
     section = cal.fit_report["accel"]
     keys = _keys(section)
     assert not [k for k in keys if k.endswith("_dps")]
-    expected = {"fit_rms_g", "validation_rmse_g"} if isinstance(temperature, Network) else {
-        "raw_drift_g", "chosen_drift_g", "mean_drift_g", "fold_drift_g"}
+    expected = (
+        {"fit_rms_g", "validation_rmse_g"}
+        if isinstance(temperature, Network)
+        else {"raw_drift_g", "chosen_drift_g", "mean_drift_g", "fold_drift_g"}
+    )
     assert expected <= set(keys)
     report = cal.report.accel
     if isinstance(temperature, Network):
@@ -152,18 +160,28 @@ def test_bad_channels_and_missing_accelerometer(cycles):
     assert parse_channels(" ACCEL, gyro") == ("gyro", "accel")
     with pytest.raises(InputError, match=r"channels: 'mag': use 'gyro', 'accel' or both"):
         fit_channels([cycles[0].recording], ("gyro", "mag"))
-    with pytest.raises(InputError, match=r"channels: a tuple of 'gyro' and/or 'accel', e.g. \('gyro', 'accel'\); "
-                                         r"got 'gyro,accel'"):
+    with pytest.raises(
+        InputError,
+        match=r"channels: a tuple of 'gyro' and/or 'accel', e.g. \('gyro', 'accel'\); "
+        r"got 'gyro,accel'",
+    ):
         fit_channels([cycles[0].recording], "gyro,accel")
     bare = dataclasses.replace(cycles[0].recording, accel_g=None, accel_axes=())
     with pytest.raises(InputError, match=r"channels=accel needs accel_x, accel_y and accel_z columns"):
         fit_accelerometer([bare])
-    cal = _quiet(fit_channels, [s.recording for s in cycles[:2]], ("accel",),
-                 options=FitOptions(temperature=Polynomial(1), hysteresis="none"))
+    cal = _quiet(
+        fit_channels,
+        [s.recording for s in cycles[:2]],
+        ("accel",),
+        options=FitOptions(temperature=Polynomial(1), hysteresis="none"),
+    )
     with pytest.raises(InputError, match=r"the model compensates the accelerometer; the data needs accel_x"):
         apply(cal, bare)
-    with pytest.raises(InputError, match=r"channels=accel: the accelerometer model is a temperature model; "
-                                         r"temperature=None leaves nothing to fit"):
+    with pytest.raises(
+        InputError,
+        match=r"channels=accel: the accelerometer model is a temperature model; "
+        r"temperature=None leaves nothing to fit",
+    ):
         fit_accelerometer([cycles[0].recording], FitOptions(temperature=None))
 
 
@@ -172,19 +190,42 @@ def test_the_gyro_only_options_do_not_change_the_accelerometer_model(cycles):
     same options to both, and the accelerometer's model does not read them."""
     runs = [s.recording for s in cycles[:2]]
     plain = _quiet(fit_accelerometer, runs, FitOptions(temperature=Polynomial(2), hysteresis="none"))
-    gyro_only = _quiet(fit_accelerometer, runs, FitOptions(temperature=Polynomial(2), hysteresis="none",
-                                                           acceleration="matrix", folds="blocks"))
+    gyro_only = _quiet(
+        fit_accelerometer,
+        runs,
+        FitOptions(temperature=Polynomial(2), hysteresis="none", acceleration="matrix", folds="blocks"),
+    )
     assert gyro_only.accel_axes == plain.accel_axes
 
 
 @pytest.mark.slow
 def test_cli_accelerometer_channel_end_to_end(tmp_path):
     for seed in (1, 2, 3):
-        r = run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 0.5, "--seed", seed,
-                "-o", tmp_path / f"run{seed}.csv")
+        r = run(
+            "simulate",
+            "--preset",
+            "consumer",
+            "--profile",
+            "cycle",
+            "--rate",
+            0.5,
+            "--seed",
+            seed,
+            "-o",
+            tmp_path / f"run{seed}.csv",
+        )
         assert r.returncode == 0, r.stderr
-    r = run("fit", tmp_path / "run1.csv", tmp_path / "run2.csv", "--channels", "accel", "--hysteresis", "none",
-            "-o", tmp_path / "acc.json")
+    r = run(
+        "fit",
+        tmp_path / "run1.csv",
+        tmp_path / "run2.csv",
+        "--channels",
+        "accel",
+        "--hysteresis",
+        "none",
+        "-o",
+        tmp_path / "acc.json",
+    )
     assert r.returncode == 0, r.stderr
     assert "accelerometer (correction relative to" in r.stdout and "constants [g]" in r.stdout
     r = run("evaluate", tmp_path / "acc.json", tmp_path / "run3.csv", "--json")

@@ -22,17 +22,27 @@ from gyrocomp.simulation import get_profile, simulate
 from ..conftest import run
 
 
-@pytest.mark.parametrize("make, message", [
-    (lambda: Curve("spline"), r"Curve.family: 'spline'; the registered curves are .*\btable\b"),
-    (lambda: Curve("table", 0), rf"Curve.size: table takes a whole number from 1 to {MAX_CURVE_SIZE}, or 'auto'; "
-                                r"got 0"),
-    (lambda: Curve("table", MAX_CURVE_SIZE + 1), r"Curve.size: table takes a whole number"),
-    (lambda: Curve("poly", 6), r"Curve.size: poly takes a whole number from 0 to 5"),
-    (lambda: FitOptions(temperature=Curve("table", 8), hysteresis="lag"),
-     r"FitOptions.hysteresis: table is fitted without lag or hysteresis; leave hysteresis='auto' or 'none'"),
-    (lambda: FitOptions(temperature=Curve("table"), target="px4"),
-     r"FitOptions.target: px4 carries a polynomial of order 3 at most"),
-])
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: Curve("spline"), r"Curve.family: 'spline'; the registered curves are .*\btable\b"),
+        (
+            lambda: Curve("table", 0),
+            rf"Curve.size: table takes a whole number from 1 to {MAX_CURVE_SIZE}, or 'auto'; "
+            r"got 0",
+        ),
+        (lambda: Curve("table", MAX_CURVE_SIZE + 1), r"Curve.size: table takes a whole number"),
+        (lambda: Curve("poly", 6), r"Curve.size: poly takes a whole number from 0 to 5"),
+        (
+            lambda: FitOptions(temperature=Curve("table", 8), hysteresis="lag"),
+            r"FitOptions.hysteresis: table is fitted without lag or hysteresis; leave hysteresis='auto' or 'none'",
+        ),
+        (
+            lambda: FitOptions(temperature=Curve("table"), target="px4"),
+            r"FitOptions.target: px4 carries a polynomial of order 3 at most",
+        ),
+    ],
+)
 def test_a_curve_not_registered_or_of_a_size_it_has_not_is_refused(make, message):
     with pytest.raises(InputError, match=message):
         make()
@@ -55,12 +65,17 @@ def test_what_each_temperature_option_offers_the_model_choice():
     try:
         automatic = curve_candidates(Polynomial())
         assert automatic.orders == (0, 1, 2, 3, 4, 5) and automatic.do_no_harm
-        assert set(automatic.others) == {(name, size) for name, basis in BASES.items() if name != "poly"
-                                         for size in basis.sizes}
+        assert set(automatic.others) == {
+            (name, size) for name, basis in BASES.items() if name != "poly" for size in basis.sizes
+        }
         assert ("probe", 2) in automatic.others and ("probe", 5) in automatic.others
         assert curve_candidates(Curve("probe")).others == (("probe", 2), ("probe", 5))
         assert curve_candidates(Polynomial(), "px4").others == () and curve_candidates(Polynomial(), "px4").orders == (
-            0, 1, 2, 3)
+            0,
+            1,
+            2,
+            3,
+        )
     finally:
         BASES.pop("probe")
     asked = curve_candidates(Curve("table", 16))
@@ -80,13 +95,15 @@ def test_a_lookup_table_asked_for_is_fitted_stored_and_applied(cycles, tmp_path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = fit_calibration([c.recording for c in cycles[:2]], temperature=Curve("table", 16))
-    assert all(isinstance(ax.temperature, LookupTableCurve) and len(ax.temperature.values) == 17
-               for ax in model.axes.values())
+    assert all(
+        isinstance(ax.temperature, LookupTableCurve) and len(ax.temperature.values) == 17 for ax in model.axes.values()
+    )
     model.save(tmp_path / "m.json")
     back = Calibration.load(tmp_path / "m.json")
     held_out = cycles[2]
-    np.testing.assert_allclose(apply(back, held_out.recording).gyro_dps, apply(model, held_out.recording).gyro_dps,
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        apply(back, held_out.recording).gyro_dps, apply(model, held_out.recording).gyro_dps, rtol=0, atol=1e-12
+    )
     raw = held_out.recording.gyro_dps - held_out.truth.true_rate_dps
     left = apply(model, held_out.recording).gyro_dps - held_out.truth.true_rate_dps
     # the held-out run's drift about its own constant: the table takes most of it out
@@ -102,10 +119,25 @@ def test_the_command_line_fits_a_table_asked_for_and_lists_every_registered_fami
 
     assert all(said(f"{name} or {name}:N") and said(BASES[name].description) for name in BASES)
     for k in range(3):
-        assert run("simulate", "--preset", "consumer", "--profile", "cycle", "--rate", 1, "--seed", k,
-                   "-o", tmp_path / f"run{k}.csv").returncode == 0
-    fitted = run("fit", tmp_path / "run0.csv", tmp_path / "run1.csv", "-o", tmp_path / "m.json",
-                 "--temperature", "table:16")
+        assert (
+            run(
+                "simulate",
+                "--preset",
+                "consumer",
+                "--profile",
+                "cycle",
+                "--rate",
+                1,
+                "--seed",
+                k,
+                "-o",
+                tmp_path / f"run{k}.csv",
+            ).returncode
+            == 0
+        )
+    fitted = run(
+        "fit", tmp_path / "run0.csv", tmp_path / "run1.csv", "-o", tmp_path / "m.json", "--temperature", "table:16"
+    )
     assert fitted.returncode == 0, fitted.stderr
     assert "table:16" in fitted.stdout
     shown = run("show", tmp_path / "m.json").stdout
@@ -118,5 +150,6 @@ def test_the_command_line_fits_a_table_asked_for_and_lists_every_registered_fami
     refused = run("fit", tmp_path / "run0.csv", "-o", tmp_path / "x.json", "--temperature", "table:99")
     assert refused.returncode == 2 and refused.stderr.strip() == (
         f"gyrocomp: error: --temperature: 'table:99': the size of table must be a whole number from 1 to "
-        f"{MAX_CURVE_SIZE}")
+        f"{MAX_CURVE_SIZE}"
+    )
     assert not (tmp_path / "x.json").exists()

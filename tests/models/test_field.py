@@ -25,13 +25,18 @@ PRESET, UNIT, RATE_HZ = "consumer", 3, 25.0
 def _drift(calibration, recording) -> float:
     """Mean over the axes of the RMS of the 60 s moving average about its mean (at rest the truth is 0)."""
     compensated = recording if calibration is None else apply(calibration, recording)
-    return float(np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz))
-                          for j in range(3)]))
+    return float(
+        np.mean([smoothed_residual_rms(compensated.gyro_dps[:, j], int(60 * recording.rate_hz)) for j in range(3)])
+    )
 
 
 def _field_logs(count: int, **overrides):
-    return [simulate(PRESET, profile=get_profile("field", motion_seed=k, **overrides), rate_hz=RATE_HZ,
-                     seed=100 + k, unit=UNIT).recording for k in range(count)]
+    return [
+        simulate(
+            PRESET, profile=get_profile("field", motion_seed=k, **overrides), rate_hz=RATE_HZ, seed=100 + k, unit=UNIT
+        ).recording
+        for k in range(count)
+    ]
 
 
 @pytest.mark.slow
@@ -47,10 +52,17 @@ def test_ten_field_logs_calibrate_as_well_as_the_chamber():
         warnings.simplefilter("ignore")
         field = fit_channels(runs)
         chamber_profile = resolve_profile("chamber", PRESET, set_points_degc=(20.0, 45.0))
-        chamber = fit_channels([simulate(PRESET, profile=chamber_profile, rate_hz=RATE_HZ, duration_s=3600,
-                                         seed=200 + k, unit=UNIT).recording for k in range(3)])
-    held_out = simulate(PRESET, profile=chamber_profile, rate_hz=RATE_HZ, duration_s=3600, seed=300,
-                        unit=UNIT).recording
+        chamber = fit_channels(
+            [
+                simulate(
+                    PRESET, profile=chamber_profile, rate_hz=RATE_HZ, duration_s=3600, seed=200 + k, unit=UNIT
+                ).recording
+                for k in range(3)
+            ]
+        )
+    held_out = simulate(
+        PRESET, profile=chamber_profile, rate_hz=RATE_HZ, duration_s=3600, seed=300, unit=UNIT
+    ).recording
     raw, with_chamber, with_field = (_drift(c, held_out) for c in (None, chamber, field))
     assert with_field <= 1.5 * with_chamber
     assert with_field < raw / 20
@@ -68,8 +80,11 @@ def test_field_data_that_cannot_make_a_model_is_refused():
     with pytest.raises(InputError, match=r"no still segment of at least the minimum length in any log \(2 log"):
         field_recordings(never_still)
     lukewarm = _field_logs(2, warmup_rise_degc=2.0, duration_s=1200.0)
-    with pytest.raises(InputError, match=r"the still data of 2 log\(s\) cover 20\.\d..2\d\.\d degC \(\d\.\d degC\); "
-                                         r"a temperature model needs at least 5 degC"):
+    with pytest.raises(
+        InputError,
+        match=r"the still data of 2 log\(s\) cover 20\.\d..2\d\.\d degC \(\d\.\d degC\); "
+        r"a temperature model needs at least 5 degC",
+    ):
         field_recordings(lukewarm)
     no_temperature = [dataclasses.replace(lukewarm[0], temperature_degc=None)]
     with pytest.raises(InputError, match=r"no temperature; a field calibration learns the bias against temperature"):

@@ -32,8 +32,11 @@ def test_the_entry_point_is_the_keyword_call_with_its_options_typed(runs):
         _same(gyrocomp.fit(runs), fit_calibration(runs))
         _same(gyrocomp.fit(runs, FitOptions(hysteresis="none")), fit_calibration(runs, hysteresis="none"))
         both = gyrocomp.fit(runs, FitOptions(hysteresis="none"), channels=("gyro", "accel"))
-    assert set(both.axes) == {"gyro_x", "gyro_y", "gyro_z"} and set(both.accel_axes) == {"accel_x", "accel_y",
-                                                                                            "accel_z"}
+    assert set(both.axes) == {"gyro_x", "gyro_y", "gyro_z"} and set(both.accel_axes) == {
+        "accel_x",
+        "accel_y",
+        "accel_z",
+    }
 
 
 def test_the_channel_is_said_not_guessed(runs):
@@ -61,12 +64,14 @@ def test_the_runs_are_prepared_once_per_fit_whatever_the_entry_point(runs, monke
         monkeypatch.setattr(module, "prepare", counting)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for call, expected in ((lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none")), 1),
-                               (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none"), channels=("gyro", "accel")), 1),
-                               (lambda: gyrocomp.fit_channels(runs, ("gyro",)), 1),
-                               (lambda: gyrocomp.fit_pipeline(runs, "joint", FitOptions(hysteresis="none")), 1),
-                               (lambda: fit_calibration(runs, hysteresis="none"), 1),
-                               (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none"), pipeline="poly>matrix"), 2)):
+        for call, expected in (
+            (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none")), 1),
+            (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none"), channels=("gyro", "accel")), 1),
+            (lambda: gyrocomp.fit_channels(runs, ("gyro",)), 1),
+            (lambda: gyrocomp.fit_pipeline(runs, "joint", FitOptions(hysteresis="none")), 1),
+            (lambda: fit_calibration(runs, hysteresis="none"), 1),
+            (lambda: gyrocomp.fit(runs, FitOptions(hysteresis="none"), pipeline="poly>matrix"), 2),
+        ):
             calls.clear()
             call()
             assert calls == [len(runs)] * expected

@@ -26,24 +26,30 @@ def test_the_literal_choices_are_the_fittings_own():
     assert set(get_args(FoldChoice)) == set(FOLD_KINDS)
 
 
-@pytest.mark.parametrize("make, message", [
-    (lambda: Polynomial(6), r"Polynomial.order: a whole number from 0 to 5, or 'auto'; got 6"),
-    (lambda: Polynomial(True), r"Polynomial.order: .* got True"),
-    (lambda: Network(hidden=(0,)), r"Network.hidden: 1 to 3 layers of 1..50 neurons, e.g. \(3,\); got \(0,\)"),
-    (lambda: Network(hidden=(3, 3, 3, 3)), r"Network.hidden: 1 to 3 layers"),
-    (lambda: Network(seed=1.5), r"Network.seed: a whole number, got 1.5"),
-    (lambda: FitOptions(temperature=3), r"FitOptions.temperature: Polynomial\(order=...\), Curve\(family, size\), Network\(hidden=...\) or "
-                                        r"None; got 3"),
-    (lambda: FitOptions(hysteresis="lagg"), r"FitOptions.hysteresis: 'lagg'; use one of auto, none, turning-point"),
-    (lambda: FitOptions(hysteresis_order=4), r"FitOptions.hysteresis_order: 4; use one of auto, 1, 2, 3"),
-    (lambda: FitOptions(acceleration="network"), r"FitOptions.acceleration: 'network'; use one of auto, none"),
-    (lambda: FitOptions(folds="weeks"), r"FitOptions.folds: 'weeks'; use one of auto, runs, legs, blocks"),
-    (lambda: FitOptions(bin_width_degc=0), r"FitOptions.bin_width_degc: a positive number of degC, got 0"),
-    (lambda: FitOptions(static_min_duration_s=-1), r"FitOptions.static_min_duration_s: a positive number"),
-    (lambda: FitOptions(hysteresis_band_degc=(80, 55)), r"FitOptions.hysteresis_band_degc: \(lo, hi\) in degC"),
-    (lambda: FitOptions(hysteresis_band_degc="55,80"), r"FitOptions.hysteresis_band_degc: .* got '55,80'"),
-    (lambda: FitOptions(hysteresis_band_degc=(55, None)), r"FitOptions.hysteresis_band_degc: .* got \(55, None\)"),
-])
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: Polynomial(6), r"Polynomial.order: a whole number from 0 to 5, or 'auto'; got 6"),
+        (lambda: Polynomial(True), r"Polynomial.order: .* got True"),
+        (lambda: Network(hidden=(0,)), r"Network.hidden: 1 to 3 layers of 1..50 neurons, e.g. \(3,\); got \(0,\)"),
+        (lambda: Network(hidden=(3, 3, 3, 3)), r"Network.hidden: 1 to 3 layers"),
+        (lambda: Network(seed=1.5), r"Network.seed: a whole number, got 1.5"),
+        (
+            lambda: FitOptions(temperature=3),
+            r"FitOptions.temperature: Polynomial\(order=...\), Curve\(family, size\), Network\(hidden=...\) or "
+            r"None; got 3",
+        ),
+        (lambda: FitOptions(hysteresis="lagg"), r"FitOptions.hysteresis: 'lagg'; use one of auto, none, turning-point"),
+        (lambda: FitOptions(hysteresis_order=4), r"FitOptions.hysteresis_order: 4; use one of auto, 1, 2, 3"),
+        (lambda: FitOptions(acceleration="network"), r"FitOptions.acceleration: 'network'; use one of auto, none"),
+        (lambda: FitOptions(folds="weeks"), r"FitOptions.folds: 'weeks'; use one of auto, runs, legs, blocks"),
+        (lambda: FitOptions(bin_width_degc=0), r"FitOptions.bin_width_degc: a positive number of degC, got 0"),
+        (lambda: FitOptions(static_min_duration_s=-1), r"FitOptions.static_min_duration_s: a positive number"),
+        (lambda: FitOptions(hysteresis_band_degc=(80, 55)), r"FitOptions.hysteresis_band_degc: \(lo, hi\) in degC"),
+        (lambda: FitOptions(hysteresis_band_degc="55,80"), r"FitOptions.hysteresis_band_degc: .* got '55,80'"),
+        (lambda: FitOptions(hysteresis_band_degc=(55, None)), r"FitOptions.hysteresis_band_degc: .* got \(55, None\)"),
+    ],
+)
 def test_a_bad_option_is_refused_naming_its_field(make, message):
     with pytest.raises(InputError, match=message):
         make()
@@ -52,19 +58,25 @@ def test_a_bad_option_is_refused_naming_its_field(make, message):
 @pytest.mark.parametrize("plain", ["auto", 3, "mlp", ("mlp", (5, 2))])
 def test_fit_calibration_refuses_the_plain_temperature_forms_naming_the_typed_ones(plain):
     run = simulate("mti10", profile="chamber", rate_hz=1, duration_s=600, seed=1).recording
-    with pytest.raises(InputError, match=r"temperature: Polynomial\(order=...\), Curve\(family, size\), Network\(hidden=...\) or None; got "
-                                         r".*\(an order N is Polynomial\(N\), 'auto' is Polynomial\(\), 'mlp' is "
-                                         r"Network\(\)\)"):
+    with pytest.raises(
+        InputError,
+        match=r"temperature: Polynomial\(order=...\), Curve\(family, size\), Network\(hidden=...\) or None; got "
+        r".*\(an order N is Polynomial\(N\), 'auto' is Polynomial\(\), 'mlp' is "
+        r"Network\(\)\)",
+    ):
         fit_calibration([run], temperature=plain)
 
 
-@pytest.mark.parametrize("keywords, message", [
-    (dict(hysteresis="magic"), r"hysteresis: 'magic'; use one of auto, none"),
-    (dict(acceleration="cube"), r"acceleration: 'cube'; use one of auto, none, matrix, matrix2"),
-    (dict(static_min_duration_s=0), r"static_min_duration_s: a positive number of seconds, got 0"),
-    (dict(hysteresis_band_degc=(80.0, 55.0)), r"hysteresis_band_degc: \(lo, hi\) in degC with lo < hi"),
-    (dict(mlp_seed=3), r"unexpected keyword argument 'mlp_seed'"),
-])
+@pytest.mark.parametrize(
+    "keywords, message",
+    [
+        (dict(hysteresis="magic"), r"hysteresis: 'magic'; use one of auto, none"),
+        (dict(acceleration="cube"), r"acceleration: 'cube'; use one of auto, none, matrix, matrix2"),
+        (dict(static_min_duration_s=0), r"static_min_duration_s: a positive number of seconds, got 0"),
+        (dict(hysteresis_band_degc=(80.0, 55.0)), r"hysteresis_band_degc: \(lo, hi\) in degC with lo < hi"),
+        (dict(mlp_seed=3), r"unexpected keyword argument 'mlp_seed'"),
+    ],
+)
 def test_fit_calibration_checks_its_keywords_as_the_options_do(keywords, message):
     run = simulate("mti10", profile="chamber", rate_hz=1, duration_s=600, seed=1).recording
     with pytest.raises((InputError, TypeError), match=message):

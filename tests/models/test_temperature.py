@@ -24,8 +24,9 @@ def noise_scale(sims, axis_index, rate_hz, n_bins=100):
     """Allan deviation of the simulated noise at the time one temperature bin takes to cross [deg/s]."""
     ramp_s = 0.8 * sims[0].truth.duration_s
     tau = np.array([ramp_s / n_bins])
-    return float(np.mean([allan_deviation(s.truth.noise.total_dps[:, axis_index], rate_hz, taus=tau).deviation[0]
-                          for s in sims]))
+    return float(
+        np.mean([allan_deviation(s.truth.noise.total_dps[:, axis_index], rate_hz, taus=tau).deviation[0] for s in sims])
+    )
 
 
 @pytest.mark.parametrize("held_out", [4, 5, 6])
@@ -89,8 +90,9 @@ def held_out_drift(chamber_runs, temperature):
     achieved, perfect, raw = [], [], []
     for held_out in (4, 5, 6):
         held = chamber_runs[held_out]
-        cal = fit_calibration([s.recording for i, s in enumerate(chamber_runs) if i != held_out],
-                              temperature=temperature)
+        cal = fit_calibration(
+            [s.recording for i, s in enumerate(chamber_runs) if i != held_out], temperature=temperature
+        )
         comp = apply(cal, held.recording)
         w = int(default_window_s(held.recording) * held.recording.rate_hz)
         achieved.append([smoothed_residual_rms(comp.gyro_dps[:, j], w) for j in range(3)])
@@ -166,15 +168,19 @@ def test_clamps_outside_range_and_warns_once():
 def test_noise_level_overshoot_of_the_range_is_not_outside_it():
     t = np.arange(0, 600.0)
     temp = np.linspace(10, 40, t.size)
-    cal = fit_calibration([Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)],
-                          temperature=Polynomial(1))
+    cal = fit_calibration(
+        [Recording(time_s=t, gyro_dps=1e-3 * temp, gyro_axes=("gyro_z",), temperature_degc=temp)],
+        temperature=Polynomial(1),
+    )
     curve = cal.axes["gyro_z"].temperature
     assert curve.range_tolerance_degc == 0.5  # 1 % of a 30 degC span is less
     assert not curve.outside_range(np.array([9.6, 40.4]))
     assert curve.outside_range(np.array([40.6]))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        apply(cal, Recording(time_s=t, gyro_dps=1e-3 * (temp + 0.3), gyro_axes=("gyro_z",), temperature_degc=temp + 0.3))
+        apply(
+            cal, Recording(time_s=t, gyro_dps=1e-3 * (temp + 0.3), gyro_axes=("gyro_z",), temperature_degc=temp + 0.3)
+        )
 
 
 def test_errors():
@@ -193,9 +199,19 @@ def test_errors():
         PolynomialTemperatureModel().fit([])
 
 
-@pytest.mark.parametrize("text,expected", [("auto", Polynomial()), ("poly", Curve("poly")), ("POLY:3", Polynomial(3)),
-                                           ("none", None), ("poly:0", Polynomial(0)), ("mlp:4x2", Network((4, 2))),
-                                           ("table", Curve("table")), ("table:16", Curve("table", 16))])
+@pytest.mark.parametrize(
+    "text,expected",
+    [
+        ("auto", Polynomial()),
+        ("poly", Curve("poly")),
+        ("POLY:3", Polynomial(3)),
+        ("none", None),
+        ("poly:0", Polynomial(0)),
+        ("mlp:4x2", Network((4, 2))),
+        ("table", Curve("table")),
+        ("table:16", Curve("table", 16)),
+    ],
+)
 def test_parse_temperature_option(text, expected):
     assert parse_temperature_option(text) == expected
 

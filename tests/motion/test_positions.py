@@ -34,9 +34,9 @@ def test_combined_segments_never_span_a_pause():
     segs = static_segments(rec)
     gap_rows = {g.after_row for g in rec.gaps}
     for s in segs:
-        rows = rec.row_numbers[s.start: s.stop]
+        rows = rec.row_numbers[s.start : s.stop]
         assert not any(r in gap_rows for r in rows[:-1])
-        assert np.max(np.diff(rec.time_s[s.start: s.stop])) < 2.0
+        assert np.max(np.diff(rec.time_s[s.start : s.stop])) < 2.0
     assert len(orientations(segs)) == 6  # +-1 g on each axis
 
 

@@ -67,7 +67,7 @@ def test_a_smooth_slow_turn_and_a_knock_are_not_still():
     # beside a move: the block next to it (its mean differs from the move's) and the trimmed edge are left out
     assert [round(s.start_s) for s in found.segments] == [1, 262, 403]
     assert [round(s.stop_s) for s in found.segments] == [198, 398, 599]
-    assert found.gyro_noise_dps2 == pytest.approx(np.full(3, 0.05 ** 2), rel=0.1)
+    assert found.gyro_noise_dps2 == pytest.approx(np.full(3, 0.05**2), rel=0.1)
 
 
 def test_a_gap_ends_a_segment_and_no_block_spans_it():
@@ -92,8 +92,19 @@ def test_any_chunking_gives_the_batch_blocks_and_segments(chunks):
         state.update(rec.time_s[a:b], rec.gyro_dps[a:b], rec.accel_g[a:b], rec.temperature_degc[a:b])
     streamed = detection(state.blocks())
     batch = detect_still(rec)
-    for name in ("start_s", "stop_s", "first", "count", "whole", "after_gap", "gyro_mean_dps", "gyro_var_dps2",
-                 "accel_mean_g", "accel_var_g2", "temperature_degc"):
+    for name in (
+        "start_s",
+        "stop_s",
+        "first",
+        "count",
+        "whole",
+        "after_gap",
+        "gyro_mean_dps",
+        "gyro_var_dps2",
+        "accel_mean_g",
+        "accel_var_g2",
+        "temperature_degc",
+    ):
         assert np.allclose(getattr(streamed.blocks, name), getattr(batch.blocks, name), rtol=1e-12, atol=0), name
     assert np.array_equal(streamed.still_blocks, batch.still_blocks)
     assert [(s.start, s.stop) for s in streamed.segments] == [(s.start, s.stop) for s in batch.segments]

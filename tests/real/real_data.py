@@ -18,10 +18,12 @@ CATS = DATASETS / "skdivemove-cats-tempcal"
 #: the three static periods of the CATS experiment [s since the file's start] (its README, from the package)
 CATS_PERIODS_S = ((480, 92460), (92880, 183780), (184920, 268020))
 #: the fit choices compared on the CATS runs: name -> fit_calibration options
-CATS_CHOICES = {"gyrocomp poly:3, no hysteresis": dict(temperature=Polynomial(3), hysteresis="none",
-                                                      acceleration="none"),
-                "default (auto)": {}, "polynomial, order by CV, no hysteresis": dict(hysteresis="none"),
-                "network 1-3-1": dict(temperature=Network())}
+CATS_CHOICES = {
+    "gyrocomp poly:3, no hysteresis": dict(temperature=Polynomial(3), hysteresis="none", acceleration="none"),
+    "default (auto)": {},
+    "polynomial, order by CV, no hysteresis": dict(hysteresis="none"),
+    "network 1-3-1": dict(temperature=Network()),
+}
 #: moving-average window of the held-out drift on the CATS runs [s]
 CATS_WINDOW_S = 600
 GALAXY = DATASETS / "skdivemove-galaxy-s5-static"
@@ -48,11 +50,17 @@ def cats_runs() -> list:
     runs = []
     for k, (lo, hi) in enumerate(CATS_PERIODS_S):
         m = (t >= lo) & (t < hi)
-        runs.append(Recording(time_s=t[m], gyro_dps=np.degrees(d["gyro_mrad_s"][m].astype(np.float64) / 1000.0),
-                              gyro_axes=("gyro_x", "gyro_y", "gyro_z"),
-                              temperature_degc=d["temperature_c"][m].astype(np.float64),
-                              accel_g=d["acc_m_s2"][m].astype(np.float64) / 9.80665,
-                              accel_axes=("accel_x", "accel_y", "accel_z"), source=f"CATS period {k + 1}"))
+        runs.append(
+            Recording(
+                time_s=t[m],
+                gyro_dps=np.degrees(d["gyro_mrad_s"][m].astype(np.float64) / 1000.0),
+                gyro_axes=("gyro_x", "gyro_y", "gyro_z"),
+                temperature_degc=d["temperature_c"][m].astype(np.float64),
+                accel_g=d["acc_m_s2"][m].astype(np.float64) / 9.80665,
+                accel_axes=("accel_x", "accel_y", "accel_z"),
+                source=f"CATS period {k + 1}",
+            )
+        )
     return runs
 
 
@@ -88,8 +96,12 @@ def cats_numpy_cubic_drift() -> np.ndarray:
     out = np.zeros((3, 3))
     for held in range(3):
         train = [r for i, r in enumerate(runs) if i != held]
-        x = np.vstack([np.hstack([np.eye(2)[np.full(r.n_samples, k)], (r.temperature_degc - 15.0)[:, None] ** [1, 2, 3]])
-                       for k, r in enumerate(train)])
+        x = np.vstack(
+            [
+                np.hstack([np.eye(2)[np.full(r.n_samples, k)], (r.temperature_degc - 15.0)[:, None] ** [1, 2, 3]])
+                for k, r in enumerate(train)
+            ]
+        )
         coef, *_ = np.linalg.lstsq(x, np.vstack([r.gyro_dps for r in train]), rcond=None)
         u = (runs[held].temperature_degc - 15.0)[:, None] ** [1, 2, 3]
         comp = runs[held].gyro_dps - u @ coef[2:]
@@ -106,10 +118,16 @@ def tofupilot_run():
     from gyrocomp import read
     from gyrocomp.io import TableLayout
 
-    columns = {"time": "timestamp", "temperature": "imu.temperature",
-               **{f"gyro_{a}": f"imu.gyro.{a}" for a in AXES}, **{f"accel_{a}": f"imu.acc.{a}" for a in AXES}}
-    return read(TOFUPILOT / "imu_raw_data.tsv",
-                TableLayout(columns=columns, gyro_unit="rad/s", accel_unit="m/s2", time_unit="us"))
+    columns = {
+        "time": "timestamp",
+        "temperature": "imu.temperature",
+        **{f"gyro_{a}": f"imu.gyro.{a}" for a in AXES},
+        **{f"accel_{a}": f"imu.acc.{a}" for a in AXES},
+    }
+    return read(
+        TOFUPILOT / "imu_raw_data.tsv",
+        TableLayout(columns=columns, gyro_unit="rad/s", accel_unit="m/s2", time_unit="us"),
+    )
 
 
 #: the methods of the one-cycle protocol: name -> a function of the fit rows giving a Calibration (None: raw)
@@ -118,8 +136,13 @@ def one_cycle_methods() -> dict:
     from gyrocomp.evaluation.comparison import fit_ardupilot_style, fit_px4_style
     from gyrocomp.evaluation.validation import fit_plain_cubic
 
-    return {"raw": None, "plain cubic": lambda r: fit_plain_cubic([r]), "PX4 cubic": lambda r: fit_px4_style([r]),
-            "ArduPilot cubic": lambda r: fit_ardupilot_style([r]), "gyrocomp default": lambda r: fit([r])}
+    return {
+        "raw": None,
+        "plain cubic": lambda r: fit_plain_cubic([r]),
+        "PX4 cubic": lambda r: fit_px4_style([r]),
+        "ArduPilot cubic": lambda r: fit_ardupilot_style([r]),
+        "gyrocomp default": lambda r: fit([r]),
+    }
 
 
 def tofupilot_one_cycle(methods: dict | None = None) -> dict[str, np.ndarray]:
@@ -138,7 +161,7 @@ def tofupilot_one_cycle(methods: dict | None = None) -> dict[str, np.ndarray]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             gyro = run.gyro_dps if method is None else apply(method(train), run).gyro_dps
-        out[name] = gyro[hot + 1:].std(axis=0)
+        out[name] = gyro[hot + 1 :].std(axis=0)
     return out
 
 
@@ -190,9 +213,14 @@ def still_with_temperature_effect(noise: np.ndarray, amplitude_dps: float, rng: 
     temperature = one_cycle_profile_degc(noise.size)
     u = (temperature - 25.0) / 45.0
     c = rng.normal(size=3)
-    effect = amplitude_dps * (c[0] * u + c[1] * u ** 2 + c[2] * u ** 3) / np.abs(c).sum()
-    run = Recording(time_s=np.arange(noise.size) / STILL_RATE_HZ, gyro_dps=(noise - noise.mean() + effect)[:, None],
-                    gyro_axes=("gyro_x",), temperature_degc=temperature, source="still + temperature effect")
+    effect = amplitude_dps * (c[0] * u + c[1] * u**2 + c[2] * u**3) / np.abs(c).sum()
+    run = Recording(
+        time_s=np.arange(noise.size) / STILL_RATE_HZ,
+        gyro_dps=(noise - noise.mean() + effect)[:, None],
+        gyro_axes=("gyro_x",),
+        temperature_degc=temperature,
+        source="still + temperature effect",
+    )
     return run.take(np.arange(int(np.argmax(temperature)))), run
 
 
@@ -215,19 +243,27 @@ def still_one_cycle_trials(amplitudes_dps=(0.05, 0.5), minutes: float = 80.0, se
     out = []
     for name, series in still_series().items():
         for start in range(0, series.size - window + 1, window):
-            noise = series[start:start + window]
+            noise = series[start : start + window]
             for amplitude in amplitudes_dps:
                 train, run = still_with_temperature_effect(noise, amplitude, rng)
                 hot = train.n_samples
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     default, cubic = fit([train]), fit_plain_cubic([train])
-                    drift = {label: smoothed_residual_rms(apply(cal, run).gyro_dps[hot:, 0], smooth)
-                             for label, cal in (("default", default), ("cubic", cubic))}
-                out.append({"name": name, "amplitude_dps": amplitude,
-                            "chosen": default.report.selection["gyro_x"].chosen, **drift,
-                            "perfect": smoothed_residual_rms(noise[hot:], smooth),
-                            "raw": smoothed_residual_rms(run.gyro_dps[hot:, 0], smooth)})
+                    drift = {
+                        label: smoothed_residual_rms(apply(cal, run).gyro_dps[hot:, 0], smooth)
+                        for label, cal in (("default", default), ("cubic", cubic))
+                    }
+                out.append(
+                    {
+                        "name": name,
+                        "amplitude_dps": amplitude,
+                        "chosen": default.report.selection["gyro_x"].chosen,
+                        **drift,
+                        "perfect": smoothed_residual_rms(noise[hot:], smooth),
+                        "raw": smoothed_residual_rms(run.gyro_dps[hot:, 0], smooth),
+                    }
+                )
     return out
 
 
@@ -245,11 +281,11 @@ def _unit_sphere(accel: np.ndarray, rec_for_segments) -> np.ndarray:
     means = np.array([s.gravity_g for s in static_segments(rec_for_segments, min_duration_s=3.0)])
     mid, spread = means.mean(axis=0), np.abs(means - means.mean(axis=0)).max()
     x = (means - mid) / spread  # conditioning
-    design = np.column_stack([x ** 2, x, np.ones(len(x))])
+    design = np.column_stack([x**2, x, np.ones(len(x))])
     coef, *_ = np.linalg.lstsq(design, np.ones(len(x)), rcond=None)
     p, q, r = coef[:3], coef[3:6], coef[6]
     centre = -q / (2 * p)
-    k = 1 - r + np.sum(p * centre ** 2)
+    k = 1 - r + np.sum(p * centre**2)
     return np.sqrt(p / k) * ((accel - mid) / spread - centre)
 
 
@@ -263,18 +299,32 @@ def multi_position_recordings() -> dict:
     a = np.loadtxt(XSENS / "xsens_acc.mat")
     gyro = np.degrees(g[:, 1:] / 6258.0)  # imu_tk's scale: 1/6258 (rad/s)/count; the offset is a bias
     raw = Recording(time_s=g[:, 0], gyro_dps=gyro, gyro_axes=gyro_axes, accel_g=a[:, 1:], accel_axes=accel_axes)
-    out["Xsens (imu_tk)"] = Recording(time_s=g[:, 0], gyro_dps=gyro, gyro_axes=gyro_axes,
-                                      accel_g=_unit_sphere(a[:, 1:], raw), accel_axes=accel_axes,
-                                      source="imu_tk-xsens")
+    out["Xsens (imu_tk)"] = Recording(
+        time_s=g[:, 0],
+        gyro_dps=gyro,
+        gyro_axes=gyro_axes,
+        accel_g=_unit_sphere(a[:, 1:], raw),
+        accel_axes=accel_axes,
+        source="imu_tk-xsens",
+    )
     f = np.genfromtxt(FERRARIS / "example_ferraris_session.csv", delimiter=",", names=True)
     out["imucal Ferraris session"] = Recording(
-        time_s=f["n_samples"] / 102.4, gyro_dps=np.column_stack([f["gyr_x"], f["gyr_y"], f["gyr_z"]]),
-        gyro_axes=gyro_axes, accel_g=np.column_stack([f["acc_x"], f["acc_y"], f["acc_z"]]) / 9.80665,
-        accel_axes=accel_axes, source="imucal-ferraris")
+        time_s=f["n_samples"] / 102.4,
+        gyro_dps=np.column_stack([f["gyr_x"], f["gyr_y"], f["gyr_z"]]),
+        gyro_axes=gyro_axes,
+        accel_g=np.column_stack([f["acc_x"], f["acc_y"], f["acc_z"]]) / 9.80665,
+        accel_axes=accel_axes,
+        source="imucal-ferraris",
+    )
     m = np.loadtxt(MPU / "example_data_calibration.csv", delimiter=",", skiprows=5)
     out["MPU-6050 (tomisuarez2)"] = Recording(
-        time_s=np.arange(len(m)) / 100.0, gyro_dps=m[:, 3:] / 131.0, gyro_axes=gyro_axes, accel_g=m[:, :3] / 16384.0,
-        accel_axes=accel_axes, source="tomisuarez2-mpu6050")
+        time_s=np.arange(len(m)) / 100.0,
+        gyro_dps=m[:, 3:] / 131.0,
+        gyro_axes=gyro_axes,
+        accel_g=m[:, :3] / 16384.0,
+        accel_axes=accel_axes,
+        source="tomisuarez2-mpu6050",
+    )
     return out
 
 
@@ -288,8 +338,9 @@ def g_sensitivity_fits() -> dict:
     for name, rec in multi_position_recordings().items():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            fits[name] = fit_calibration([rec], temperature=None, acceleration="matrix",
-                                         static_min_duration_s=POSE_MIN_S[name])
+            fits[name] = fit_calibration(
+                [rec], temperature=None, acceleration="matrix", static_min_duration_s=POSE_MIN_S[name]
+            )
     return fits
 
 
@@ -299,10 +350,15 @@ def main_g_sensitivity() -> None:
     for name, cal in g_sensitivity_fits().items():
         acc = cal.fit_report["acceleration"]
         for k, (axis, info) in enumerate(acc["axes"].items()):
-            cells = [f"{g:+.4f} +- {e:.4f}" if e is not None else "not excited"
-                     for g, e in zip(info["g_sensitivity_dps_per_g"], info["standard_error_dps_per_g"])]
-            print(f"| {name if k == 0 else ''} | {acc['static_segments'][0] if k == 0 else ''} | {axis} | "
-                  + " | ".join(cells) + " | |")
+            cells = [
+                f"{g:+.4f} +- {e:.4f}" if e is not None else "not excited"
+                for g, e in zip(info["g_sensitivity_dps_per_g"], info["standard_error_dps_per_g"])
+            ]
+            print(
+                f"| {name if k == 0 else ''} | {acc['static_segments'][0] if k == 0 else ''} | {axis} | "
+                + " | ".join(cells)
+                + " | |"
+            )
 
 
 def galaxy_gyro_dps() -> np.ndarray:
@@ -318,30 +374,38 @@ GALAXY_FIT_TAUS_S = (3.0, 1000.0)
 
 
 def noise_table(gyro_dps: np.ndarray, rate_hz: float, fit_taus_s=None) -> list:
-    return [noise_parameters(allan_deviation(gyro_dps[:, j], rate_hz), fit_taus_s=fit_taus_s)
-            for j in range(gyro_dps.shape[1])]
+    return [
+        noise_parameters(allan_deviation(gyro_dps[:, j], rate_hz), fit_taus_s=fit_taus_s)
+        for j in range(gyro_dps.shape[1])
+    ]
 
 
 def main() -> None:
-    print("| recording | axis | ARW fit [deg/sqrt(h)] | ARW read-off [deg/sqrt(h)] | B [deg/h] | at tau [s] "
-          "| K [deg/h/sqrt(h)] | fit misfit |")
+    print(
+        "| recording | axis | ARW fit [deg/sqrt(h)] | ARW read-off [deg/sqrt(h)] | B [deg/h] | at tau [s] "
+        "| K [deg/h/sqrt(h)] | fit misfit |"
+    )
     print("|---|---|---:|---:|---:|---:|---:|---:|")
     rows = [(f"ADIS16405 {name}", gyro, 100.0, None) for name, gyro in adis_sessions().items()]
     rows.append(("Galaxy S5 (fit 3-1000 s)", galaxy_gyro_dps(), 10.0, GALAXY_FIT_TAUS_S))
     for label, gyro, rate_hz, fit_taus_s in rows:
         for axis, n in zip(AXES, noise_table(gyro, rate_hz, fit_taus_s)):
             readoff = n.noise_density_readoff_dps_per_sqrt_hz
-            print(f"| {label} | {axis} | {n.arw_deg_per_sqrt_h:.2f} | "
-                  f"{'-' if readoff is None else f'{60 * readoff:.2f}'} | {n.bias_instability_deg_per_h:.1f} | "
-                  f"{n.integration_time_s:.0f} | {n.rrw_deg_per_h_per_sqrt_h:.0f} | {n.fit_rms_log_residual:.0%} |")
+            print(
+                f"| {label} | {axis} | {n.arw_deg_per_sqrt_h:.2f} | "
+                f"{'-' if readoff is None else f'{60 * readoff:.2f}'} | {n.bias_instability_deg_per_h:.1f} | "
+                f"{n.integration_time_s:.0f} | {n.rrw_deg_per_h_per_sqrt_h:.0f} | {n.fit_rms_log_residual:.0%} |"
+            )
 
 
 def main_bound() -> None:
     """The noise bounds of the real static recordings beside the IEEE 952 fit and, where stated, the datasheet."""
     from gyrocomp.allan.bound import bound_noise
 
-    print("| recording | axis | ARW fit [deg/sqrt(h)] | ARW bound | K bound [deg/h/sqrt(h)] | with Gauss-Markov: "
-          "median / largest ratio to the curve | datasheet ARW |")
+    print(
+        "| recording | axis | ARW fit [deg/sqrt(h)] | ARW bound | K bound [deg/h/sqrt(h)] | with Gauss-Markov: "
+        "median / largest ratio to the curve | datasheet ARW |"
+    )
     print("|---|---|---:|---:|---:|---:|---:|")
     rows = [(f"ADIS16405 {name}", gyro, 100.0, "2") for name, gyro in adis_sessions().items()]
     rows.append(("Galaxy S5", galaxy_gyro_dps(), 10.0, "-"))
@@ -352,8 +416,10 @@ def main_bound() -> None:
             fitted = noise_parameters(curve)
             two = bound_noise(curve, markov=False, max_tau_s=record_s / 10)
             full = bound_noise(curve, max_tau_s=record_s / 10)
-            print(f"| {label} | {axis} | {fitted.arw_deg_per_sqrt_h:.2f} | {60 * two.white_noise_density:.2f} | "
-                  f"{two.random_walk * 216000.0:.1f} | {full.ratio_median:.2f} / {full.ratio_max:.2f} | {datasheet} |")
+            print(
+                f"| {label} | {axis} | {fitted.arw_deg_per_sqrt_h:.2f} | {60 * two.white_noise_density:.2f} | "
+                f"{two.random_walk * 216000.0:.1f} | {full.ratio_median:.2f} / {full.ratio_max:.2f} | {datasheet} |"
+            )
 
 
 def main_temperature() -> None:
@@ -362,16 +428,23 @@ def main_temperature() -> None:
 
     for k, run in enumerate(cats_runs()):
         raw[k] = [smoothed_residual_rms(run.gyro_dps[:, j], CATS_WINDOW_S) for j in range(3)]
-    drift = {"cubic in T - 15 degC + run constants, numpy, every sample (the baseline)": cats_numpy_cubic_drift(),
-             **cats_held_out_drift()}
+    drift = {
+        "cubic in T - 15 degC + run constants, numpy, every sample (the baseline)": cats_numpy_cubic_drift(),
+        **cats_held_out_drift(),
+    }
     cubic = next(iter(drift.values())).mean()
     print("| fit (on two runs, scored on the third) | drift x | drift y | drift z | mean [deg/s] | vs cubic |")
     print("|---|---:|---:|---:|---:|---:|")
-    print("| raw (no compensation) | " + " | ".join(f"{v:.4f}" for v in raw.mean(axis=0)) +
-          f" | {raw.mean():.4f} | {raw.mean() / cubic - 1:+.0%} |")
+    print(
+        "| raw (no compensation) | "
+        + " | ".join(f"{v:.4f}" for v in raw.mean(axis=0))
+        + f" | {raw.mean():.4f} | {raw.mean() / cubic - 1:+.0%} |"
+    )
     for name, d in drift.items():
-        print(f"| {name} | " + " | ".join(f"{v:.4f}" for v in d.mean(axis=0)) + f" | {d.mean():.4f} | "
-              f"{d.mean() / cubic - 1:+.0%} |")
+        print(
+            f"| {name} | " + " | ".join(f"{v:.4f}" for v in d.mean(axis=0)) + f" | {d.mean():.4f} | "
+            f"{d.mean() / cubic - 1:+.0%} |"
+        )
 
 
 if __name__ == "__main__":

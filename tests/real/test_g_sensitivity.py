@@ -20,8 +20,12 @@ def fits():
 def _g(cal):
     axes = cal.fit_report["acceleration"]["axes"]
     g = np.array([axes[a]["g_sensitivity_dps_per_g"] for a in ("gyro_x", "gyro_y", "gyro_z")])
-    se = np.array([[np.nan if e is None else e for e in axes[a]["standard_error_dps_per_g"]]
-                   for a in ("gyro_x", "gyro_y", "gyro_z")])
+    se = np.array(
+        [
+            [np.nan if e is None else e for e in axes[a]["standard_error_dps_per_g"]]
+            for a in ("gyro_x", "gyro_y", "gyro_z")
+        ]
+    )
     return g, se
 
 

@@ -62,8 +62,9 @@ def test_galaxy_s5_phone_gyro():
         assert full.noise_density_dps_per_sqrt_hz < 0.2 * full.noise_density_readoff_dps_per_sqrt_hz
         # ... past the filter it fits to 10 % and agrees with the read-off to 25 %
         assert fitted.fit_rms_log_residual < 0.1
-        assert fitted.noise_density_dps_per_sqrt_hz == pytest.approx(fitted.noise_density_readoff_dps_per_sqrt_hz,
-                                                                     rel=0.25)
+        assert fitted.noise_density_dps_per_sqrt_hz == pytest.approx(
+            fitted.noise_density_readoff_dps_per_sqrt_hz, rel=0.25
+        )
         assert 10.0 < fitted.bias_instability_deg_per_h < 50.0
 
 

@@ -26,7 +26,11 @@ def drift():
 def test_runs_are_the_three_documented_static_periods():
     shared_dataset("skdivemove-cats-tempcal")
     runs = cats_runs()
-    assert [r.n_samples for r in runs] == [91980, 90900, 83100]  # the README's counts less one: our intervals are half-open
+    assert [r.n_samples for r in runs] == [
+        91980,
+        90900,
+        83100,
+    ]  # the README's counts less one: our intervals are half-open
     gravity = [np.argmax(np.abs(r.accel_g.mean(axis=0))) for r in runs]
     assert gravity == [2, 0, 1]  # -z, -x, -y down, as documented
     assert all(not r.gaps for r in runs)

@@ -7,8 +7,14 @@ from gyrocomp.recording import Recording
 
 def make(time, gyro=None, temp=None, **kw):
     n = len(time)
-    return Recording(time_s=np.asarray(time, float), gyro_dps=np.zeros(n) if gyro is None else gyro,
-                     gyro_axes=("gyro_z",), temperature_degc=temp, source="r.csv", **kw)
+    return Recording(
+        time_s=np.asarray(time, float),
+        gyro_dps=np.zeros(n) if gyro is None else gyro,
+        gyro_axes=("gyro_z",),
+        temperature_degc=temp,
+        source="r.csv",
+        **kw,
+    )
 
 
 def test_rate_and_duration():
@@ -29,7 +35,9 @@ def test_time_repeat_names_row_number_from_source():
 
 
 def test_nan_names_row_and_channel():
-    with pytest.raises(InputError, match=r"row 2, column 'temperature': nan is not a finite number.*drop_nonfinite=True"):
+    with pytest.raises(
+        InputError, match=r"row 2, column 'temperature': nan is not a finite number.*drop_nonfinite=True"
+    ):
         make([0.0, 1.0, 2.0], temp=np.array([20.0, np.nan, 21.0]))
 
 
@@ -76,15 +84,17 @@ def test_temperature_column_for_axis():
     t = np.arange(5.0)
     one = Recording(time_s=t, gyro_dps=np.zeros((5, 2)), gyro_axes=("gyro_x", "gyro_z"), temperature_degc=t)
     assert one.temperature_column_for("gyro_z") == "temperature"
-    per_axis = Recording(time_s=t, gyro_dps=np.zeros((5, 2)), gyro_axes=("gyro_x", "gyro_z"),
-                         temperature_degc=np.column_stack([t, t]))
+    per_axis = Recording(
+        time_s=t, gyro_dps=np.zeros((5, 2)), gyro_axes=("gyro_x", "gyro_z"), temperature_degc=np.column_stack([t, t])
+    )
     assert per_axis.temperature_column_for("gyro_z") == "temperature_z"
 
 
 def test_with_gyro_checks_only_the_new_data_and_keeps_the_rest():
     time_s = np.r_[np.arange(100) * 0.1, 30.0 + np.arange(50) * 0.1]  # one gap
-    rec = Recording(time_s, np.zeros((150, 2)), ("gyro_x", "gyro_z"), temperature_degc=np.full(150, 20.0),
-                    source="run.csv")
+    rec = Recording(
+        time_s, np.zeros((150, 2)), ("gyro_x", "gyro_z"), temperature_degc=np.full(150, 20.0), source="run.csv"
+    )
     new = rec.with_gyro(np.ones((150, 2)))
     assert new.gyro_dps.sum() == 300 and rec.gyro_dps.sum() == 0
     assert new.time_s is rec.time_s and new.gaps == rec.gaps and new.rate_hz == rec.rate_hz

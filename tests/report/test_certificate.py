@@ -21,8 +21,9 @@ from gyrocomp.simulation import simulate
 
 from ..conftest import browser, check_report_page, run
 
-needs_chromium = pytest.mark.skipif(browser.chromium() is None,
-                                    reason="no Chromium to open the pages in (apt-get install chromium)")
+needs_chromium = pytest.mark.skipif(
+    browser.chromium() is None, reason="no Chromium to open the pages in (apt-get install chromium)"
+)
 SERIAL = 'SN<1>&"x"'
 
 
@@ -34,16 +35,31 @@ def fleet(tmp_path_factory):
     rows = ["path,serial"]
     for k in range(3):
         path = folder / f"run{k}.parquet"
-        write_recording(simulate("mti10", profile="chamber", rate_hz=1, duration_s=3600, seed=k, unit=2).recording,
-                        path)
+        write_recording(
+            simulate("mti10", profile="chamber", rate_hz=1, duration_s=3600, seed=k, unit=2).recording, path
+        )
         rows.append(f'{path},"{SERIAL.replace(chr(34), 2 * chr(34))}"')
     (folder / "m.csv").write_text("\n".join(rows) + "\n")
-    (folder / "limits.toml").write_text("[held_out_drift_dps]\nmax = 0.05\n\n[noise_density_dps_per_sqrt_hz]\n"
-                                        "max = 1e-6\n")
+    (folder / "limits.toml").write_text(
+        "[held_out_drift_dps]\nmax = 0.05\n\n[noise_density_dps_per_sqrt_hz]\nmax = 1e-6\n"
+    )
     out = folder / "FLEET"
-    result = run("fleet", "fit", "--manifest", folder / "m.csv", "-o", out, "--scheduler", "serial", "--limits",
-                 folder / "limits.toml", "--station", "bay <3>", "--certificates",
-                 "pdf" if browser.chromium() else "html")
+    result = run(
+        "fleet",
+        "fit",
+        "--manifest",
+        folder / "m.csv",
+        "-o",
+        out,
+        "--scheduler",
+        "serial",
+        "--limits",
+        folder / "limits.toml",
+        "--station",
+        "bay <3>",
+        "--certificates",
+        "pdf" if browser.chromium() else "html",
+    )
     assert result.returncode == 0, result.stderr
     return folder, out
 

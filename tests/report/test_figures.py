@@ -22,8 +22,11 @@ def test_allan_figure_is_a_png_with_both_sensor_panels(tmp_path):
 
 def test_missing_matplotlib_names_the_extra(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)
-    with pytest.raises(MissingDependencyError, match=r"^plots need the optional package matplotlib; install it with: "
-                                                     r"pip install 'gyrocomp\[plot\]' \(from a clone of the repository: "
-                                                     r"pip install -e '\.\[plot\]'\)$"):
+    with pytest.raises(
+        MissingDependencyError,
+        match=r"^plots need the optional package matplotlib; install it with: "
+        r"pip install 'gyrocomp\[plot\]' \(from a clone of the repository: "
+        r"pip install -e '\.\[plot\]'\)$",
+    ):
         allan_figure(analyse_noise(static_recording(n=2000)), tmp_path / "a.png")
     assert not (tmp_path / "a.png").exists()

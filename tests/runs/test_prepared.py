@@ -22,18 +22,26 @@ def session():
     return simulate("mti10", profile="combined", duration_s=6000, rate_hz=5, seed=4).recording
 
 
-@pytest.mark.parametrize(("window_s", "min_duration_s", "factor"), [(1.0, 10.0, 4.0), (2.0, 30.0, 3.0), (0.5, 5.0, 8.0)])
+@pytest.mark.parametrize(
+    ("window_s", "min_duration_s", "factor"), [(1.0, 10.0, 4.0), (2.0, 30.0, 3.0), (0.5, 5.0, 8.0)]
+)
 def test_kept_segments_equal_those_found_afresh(session, window_s, min_duration_s, factor):
     run = PreparedRun.of(session)
     kept = run.static_segments(window_s=window_s, min_duration_s=min_duration_s, factor=factor)
     fresh = static_segments(session, window_s=window_s, min_duration_s=min_duration_s, factor=factor)
     assert len(kept) == len(fresh) > 0
     for a, b in zip(kept, fresh):
-        assert (a.start, a.stop, a.start_s, a.duration_s, a.temperature_degc) == (b.start, b.stop, b.start_s,
-                                                                                  b.duration_s, b.temperature_degc)
+        assert (a.start, a.stop, a.start_s, a.duration_s, a.temperature_degc) == (
+            b.start,
+            b.stop,
+            b.start_s,
+            b.duration_s,
+            b.temperature_degc,
+        )
         assert np.array_equal(a.gravity_g, b.gravity_g)
-    assert np.array_equal(run.still_mask(window_s=window_s, factor=factor),
-                          still_mask(session, window_s=window_s, factor=factor))
+    assert np.array_equal(
+        run.still_mask(window_s=window_s, factor=factor), still_mask(session, window_s=window_s, factor=factor)
+    )
 
 
 def test_block_means_equal_those_computed_afresh_and_are_kept_read_only(session):
@@ -75,8 +83,11 @@ def test_a_copy_with_other_data_keeps_nothing(session):
 
 
 def test_prepare_refuses_what_is_not_a_recording(session):
-    with pytest.raises(InputError, match=r"recordings\[1\]: expected a Recording \(from gyrocomp.read or simulate\), "
-                                         r"got str"):
+    with pytest.raises(
+        InputError,
+        match=r"recordings\[1\]: expected a Recording \(from gyrocomp.read or simulate\), "
+        r"got str",
+    ):
         prepare([session, "run.csv"])
 
 
@@ -116,10 +127,15 @@ def test_a_run_prepared_for_its_accelerometer_models_the_accelerometer_axes_in_g
     blocks = accel.block_means("accel_z", 5.0, 1.0)
     assert abs(float(np.average(blocks.value, weights=blocks.samples)) - float(session.accel_g[:, 2].mean())) < 1e-9
     assert accel.take(slice(0, 100)).channel == "accel"
-    per_axis = dataclasses.replace(session, temperature_degc=np.column_stack(
-        [session.temperature_degc, session.temperature_degc + 1.0, session.temperature_degc + 2.0]))
-    np.testing.assert_allclose(PreparedRun.of(per_axis, "accel").temperature_for("accel_x"),
-                               session.temperature_degc + 1.0)
+    per_axis = dataclasses.replace(
+        session,
+        temperature_degc=np.column_stack(
+            [session.temperature_degc, session.temperature_degc + 1.0, session.temperature_degc + 2.0]
+        ),
+    )
+    np.testing.assert_allclose(
+        PreparedRun.of(per_axis, "accel").temperature_for("accel_x"), session.temperature_degc + 1.0
+    )
     assert per_axis.temperature_column_for("accel_y") == "temperature"  # the mean, as the compensation reads it
 
 

@@ -24,14 +24,15 @@ def test_power_on_and_gap_cut_where_the_logger_stopped():
 
 
 def test_temperature_turn_cuts_at_each_extreme():
-    rec = simulate("consumer", profile=get_profile("cycle", set_points_degc=(0.0, 60.0), cycles=2), rate_hz=1,
-                   seed=1).recording
+    rec = simulate(
+        "consumer", profile=get_profile("cycle", set_points_degc=(0.0, 60.0), cycles=2), rate_hz=1, seed=1
+    ).recording
     pieces = split_runs(rec, "temperature-turn")
     temperature = rec.temperature_degc
     assert len(pieces) >= 4  # two cycles: up, down, up, down (and the start)
     for piece in pieces[1:]:  # each cut lies on an extreme of the temperature around it
         k = piece.start
-        window = temperature[max(k - 60, 0):k + 60]
+        window = temperature[max(k - 60, 0) : k + 60]
         assert temperature[k] in (window.max(), window.min())
     assert sum(p.recording.n_samples for p in pieces) == rec.n_samples
 

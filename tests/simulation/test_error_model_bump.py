@@ -20,8 +20,11 @@ def test_bump_starts_at_the_turn_peaks_and_fades_to_zero():
 def test_polynomial_shape_unchanged_and_bump_only_on_the_branch_after_a_cooling_turn():
     h = Hysteresis(((0.01, -0.001),), direction="descending")
     assert h.offset_dps(np.array([3.0]), (0.01, -0.001))[0] == pytest.approx(0.01 * 3 - 0.001 * 9, rel=1e-12)
-    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.0,),),
-                           hysteresis=Hysteresis(((0.2,),), direction="descending", fade_degc=25.0))
+    model = GyroErrorModel(
+        axes=("gyro_z",),
+        temperature_coefficients=((0.0,),),
+        hysteresis=Hysteresis(((0.2,),), direction="descending", fade_degc=25.0),
+    )
     temp = np.concatenate([np.linspace(20, 80, 601), np.linspace(80, 20, 601)[1:]])
     out = model.hysteresis_error_dps(temp)[:, 0]
     assert np.all(out[:601] == 0.0)  # heating: no turn yet

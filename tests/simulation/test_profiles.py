@@ -114,8 +114,11 @@ def test_profile_errors():
     with pytest.raises(InputError, match="duration_s: must be positive, got -5"):
         get_profile("static").with_duration(-5)
     # a parameter the profile does not have is named (it was a TypeError from dataclasses.replace)
-    with pytest.raises(InputError, match=r"ramp_rate: not a parameter of a profile; use any of set_points_degc, "
-                                         r"ramp_rate_degc_per_min, dwell_s"):
+    with pytest.raises(
+        InputError,
+        match=r"ramp_rate: not a parameter of a profile; use any of set_points_degc, "
+        r"ramp_rate_degc_per_min, dwell_s",
+    ):
         get_profile("chamber", ramp_rate=3.0)
     with pytest.raises(InputError, match=r"dwell: not a parameter of a profile"):
         resolve_profile(get_profile("chamber"), dwell=10.0)

@@ -13,8 +13,14 @@ from gyrocomp.simulation import GyroErrorModel, get_profile, simulate
 from gyrocomp.simulation.error_model import smooth_process
 
 RATE_HZ = 2.0
-QUIET = GyroErrorModel(axes=("gyro_x",), temperature_coefficients=((0.0,),), noise_density_dps_per_sqrt_hz=0.0,
-                       bias_instability_deg_per_h=0.0, turn_on_bias_sigma_dps=0.0, accelerometer=None)
+QUIET = GyroErrorModel(
+    axes=("gyro_x",),
+    temperature_coefficients=((0.0,),),
+    noise_density_dps_per_sqrt_hz=0.0,
+    bias_instability_deg_per_h=0.0,
+    turn_on_bias_sigma_dps=0.0,
+    accelerometer=None,
+)
 
 
 def test_the_smooth_process_has_unit_variance_and_grows_as_dt_squared_below_its_time_constant():
@@ -24,7 +30,7 @@ def test_the_smooth_process_has_unit_variance_and_grows_as_dt_squared_below_its_
     rng = np.random.default_rng(0)
     t_c = 100.0
     draws = np.array([smooth_process(600, 2.0, t_c, rng) for _ in range(400)])
-    assert np.mean(draws ** 2) == pytest.approx(1.0, rel=0.1)  # 400 x ~3 independent stretches: ~5 %
+    assert np.mean(draws**2) == pytest.approx(1.0, rel=0.1)  # 400 x ~3 independent stretches: ~5 %
     for lag_s in (5.0, 10.0, 50.0):
         lag = int(lag_s * 2.0)
         measured = np.mean((draws[:, lag:] - draws[:, :-lag]) ** 2)
@@ -66,8 +72,7 @@ def test_a_bias_from_the_temperature_rate_parts_heating_from_cooling_by_twice_k_
 def test_the_non_repeatable_drift_follows_the_temperature_partly_and_differs_by_run():
     """With the temperature part alone, drift / (T_s - T_ref) is a smooth process of standard deviation sigma_c;
     with the smooth part alone it does not depend on the temperature; both differ from run to run."""
-    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0,
-                       dwell_s=300.0)
+    prof = get_profile("chamber", set_points_degc=(40.0, -20.0, 70.0, 30.0), ramp_rate_degc_per_min=2.0, dwell_s=300.0)
     tempco = dataclasses.replace(QUIET, run_tempco_sigma_dps_per_degc=0.002, run_drift_time_s=600.0)
     runs = [simulate(tempco, profile=prof, rate_hz=RATE_HZ, seed=s) for s in range(12)]
     ratios = []
@@ -85,8 +90,9 @@ def test_the_non_repeatable_drift_follows_the_temperature_partly_and_differs_by_
 
 
 def test_the_new_terms_can_be_switched_off_and_are_checked():
-    part = dataclasses.replace(QUIET, run_drift_dps=0.05, warm_up_sigma_dps=0.1,
-                               temperature_rate_dps_per_degc_per_min=(0.01,))
+    part = dataclasses.replace(
+        QUIET, run_drift_dps=0.05, warm_up_sigma_dps=0.1, temperature_rate_dps_per_degc_per_min=(0.01,)
+    )
     off = part.without("drift", "warm-up", "temperature-rate")
     assert off.run_drift_dps == 0 and off.warm_up_sigma_dps == 0 and off.temperature_rate_dps_per_degc_per_min is None
     with pytest.raises(InputError, match="run_drift_dps: must not be negative"):

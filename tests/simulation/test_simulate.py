@@ -37,15 +37,20 @@ def test_same_seed_same_run_other_seed_other_turn_on():
 
 def _expected_adev(model: GyroErrorModel, tau, rate_hz):
     """sigma^2 = (N^2 + q^2 / (12 f)) / tau + (0.664 B)^2 + K^2 tau / 3; the output rounding is white."""
-    white = model.noise_density_dps_per_sqrt_hz ** 2 + model.quantization_dps ** 2 / (12 * rate_hz)
+    white = model.noise_density_dps_per_sqrt_hz**2 + model.quantization_dps**2 / (12 * rate_hz)
     floor = BIAS_INSTABILITY_FACTOR * model.bias_instability_deg_per_h / DEG_PER_S_TO_DEG_PER_H
-    return np.sqrt(white / tau + floor ** 2 + model.rate_random_walk_dps_per_sqrt_s ** 2 * tau / 3)
+    return np.sqrt(white / tau + floor**2 + model.rate_random_walk_dps_per_sqrt_s**2 * tau / 3)
 
 
-@pytest.mark.parametrize("preset, duration_s, rate_hz", [
-    ("adxrs450", 4 * 3600, 20.0), ("mti10", 4 * 3600, 20.0), ("adis16488", 4 * 3600, 20.0),
-    ("consumer", 4 * 3600, 20.0),
-])
+@pytest.mark.parametrize(
+    "preset, duration_s, rate_hz",
+    [
+        ("adxrs450", 4 * 3600, 20.0),
+        ("mti10", 4 * 3600, 20.0),
+        ("adis16488", 4 * 3600, 20.0),
+        ("consumer", 4 * 3600, 20.0),
+    ],
+)
 def test_static_run_has_the_presets_allan_curve(preset, duration_s, rate_hz):
     model = preset_model(preset)
     inside, total = 0, 0
@@ -58,7 +63,7 @@ def test_static_run_has_the_presets_allan_curve(preset, duration_s, rate_hz):
         inside += int(np.sum((expected >= res.ci_low[use]) & (expected <= res.ci_high[use])))
         total += int(use.sum())
         terms = noise_parameters(res)
-        white = math.sqrt(model.noise_density_dps_per_sqrt_hz ** 2 + model.quantization_dps ** 2 / (12 * rate_hz))
+        white = math.sqrt(model.noise_density_dps_per_sqrt_hz**2 + model.quantization_dps**2 / (12 * rate_hz))
         assert terms.noise_density_dps_per_sqrt_hz == pytest.approx(white, rel=0.1)
     # 95 % intervals: with correlated neighbouring taus, allow a few misses over three seeds
     assert inside >= 0.9 * total
@@ -78,8 +83,12 @@ def test_consumer_rate_random_walk_recovered():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_white_noise_density_recovered(seed):
-    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.0,),), bias_instability_deg_per_h=0.0,
-                           noise_density_dps_per_sqrt_hz=0.005)
+    model = GyroErrorModel(
+        axes=("gyro_z",),
+        temperature_coefficients=((0.0,),),
+        bias_instability_deg_per_h=0.0,
+        noise_density_dps_per_sqrt_hz=0.005,
+    )
     sim = simulate(model, profile="static", duration_s=2000, rate_hz=100, seed=seed)
     res = allan_deviation(sim.recording.gyro_dps[:, 0], 100.0, taus=np.array([1.0]))
     # a 1-s overlapping estimate over 2000 s has about sqrt(2000/1.5) equivalent degrees of freedom
@@ -100,16 +109,29 @@ def test_flicker_bank_drawn_coarse_for_slow_processes_has_the_same_floor():
     """The slow Gauss-Markov processes are drawn on coarse grids; over seeds the floor stays 0.664 B."""
     rate_hz, b, n = 20.0, 10.0, 216_000
     taus = np.array([1.0, 5.0, 20.0, 100.0])
-    var = np.mean([allan_deviation(flicker_bank(n, rate_hz, b, np.random.default_rng(s)), rate_hz, taus=taus,
-                                   confidence=None).deviation ** 2 for s in range(8)], axis=0)
+    var = np.mean(
+        [
+            allan_deviation(
+                flicker_bank(n, rate_hz, b, np.random.default_rng(s)), rate_hz, taus=taus, confidence=None
+            ).deviation
+            ** 2
+            for s in range(8)
+        ],
+        axis=0,
+    )
     floor = BIAS_INSTABILITY_FACTOR * b / DEG_PER_S_TO_DEG_PER_H
     np.testing.assert_allclose(np.sqrt(var), floor, rtol=0.08)
 
 
 def test_rate_random_walk_recovered():
     k = 2e-4  # [deg/s/sqrt(s)]
-    model = GyroErrorModel(axes=("gyro_z",), temperature_coefficients=((0.0,),), bias_instability_deg_per_h=0.0,
-                           noise_density_dps_per_sqrt_hz=1e-5, rate_random_walk_dps_per_sqrt_s=k)
+    model = GyroErrorModel(
+        axes=("gyro_z",),
+        temperature_coefficients=((0.0,),),
+        bias_instability_deg_per_h=0.0,
+        noise_density_dps_per_sqrt_hz=1e-5,
+        rate_random_walk_dps_per_sqrt_s=k,
+    )
     devs = []
     for seed in range(6):
         sim = simulate(model, profile="static", duration_s=20000, rate_hz=5, seed=seed)
@@ -136,7 +158,7 @@ def test_cycle_shows_the_presets_hysteresis_between_branches():
     centres = np.arange(40.0, 78.0, 2.5)
     gap = _branch_means(temp, gyro, falling, centres) - _branch_means(temp, gyro, rising, centres)
     d = 80.0 - centres
-    expected = np.where(centres >= 55, 0.032 * d - 0.00128 * d ** 2, 0.0)
+    expected = np.where(centres >= 55, 0.032 * d - 0.00128 * d**2, 0.0)
     # each branch mean averages ~300 samples of 0.015 deg/s/sqrt(Hz) noise plus the 25 deg/h floor
     np.testing.assert_allclose(gap, expected, atol=0.03)
     assert gap[centres == 67.5][0] == pytest.approx(0.2, abs=0.03)
@@ -146,9 +168,15 @@ def test_cycle_shows_the_presets_hysteresis_between_branches():
 def test_thermal_lag_opens_a_branch_gap_in_proportion_to_the_ramp_rate(ramp):
     base = preset_model("consumer")
     # a strong tempco and little noise, so that the gap stands out from the drift between branches
-    model = dataclasses.replace(base, hysteresis=None, temperature_coefficients=((0.1,), (0.0,), (0.0,)),
-                                temperature_quantization_degc=0.0, temperature_noise_degc=0.0,
-                                bias_instability_deg_per_h=1.0, rate_random_walk_dps_per_sqrt_s=0.0)
+    model = dataclasses.replace(
+        base,
+        hysteresis=None,
+        temperature_coefficients=((0.1,), (0.0,), (0.0,)),
+        temperature_quantization_degc=0.0,
+        temperature_noise_degc=0.0,
+        bias_instability_deg_per_h=1.0,
+        rate_random_walk_dps_per_sqrt_s=0.0,
+    )
     prof = get_profile("cycle", set_points_degc=(-20.0, 70.0), cycles=1, ramp_rate_degc_per_min=ramp, dwell_s=600.0)
     sim = simulate(model, profile=prof, rate_hz=2, seed=5)
     temp, gyro = sim.recording.temperature_degc, sim.recording.gyro_dps[:, 0]
@@ -189,7 +217,8 @@ def test_ratetable_shows_scale_factor_and_misalignment():
     spin_x = t.true_rate_dps[:, 0] == 100.0
     err = t.components_dps["scale_misalignment"][spin_x]
     sf = model.scale_factor_error_ppm[0] * 1e-6 + model.scale_factor_tempco_ppm_per_degc[0] * 1e-6 * (
-        t.structure_temperature_degc[spin_x] - model.t_ref_degc)
+        t.structure_temperature_degc[spin_x] - model.t_ref_degc
+    )
     np.testing.assert_allclose(err[:, 0], 100.0 * sf, rtol=1e-12)
     np.testing.assert_allclose(err[:, 1], 100.0 * model.misalignment_rad[1][0], rtol=1e-12)
     measured = sim.recording.gyro_dps[spin_x, 0].mean() - t.turn_on_bias_dps[0]
@@ -231,8 +260,13 @@ def test_truth_dict_names_every_parameter():
     assert d["preset"] == "adxrs450" and d["seed"] == 7 and d["samples"] == 1201
     assert list(d["error_model"]["hysteresis"]["band_degc"]) == [55.0, 80.0]
     assert list(d["profile"]["set_points_degc"]) == [-30.0, 80.0]
-    assert set(d["deterministic_error_range_dps"]) == {"temperature", "hysteresis", "acceleration",
-                                                       "scale_misalignment", "temperature_rate"}
+    assert set(d["deterministic_error_range_dps"]) == {
+        "temperature",
+        "hysteresis",
+        "acceleration",
+        "scale_misalignment",
+        "temperature_rate",
+    }
 
 
 def test_parameter_errors():
@@ -259,8 +293,9 @@ def test_terms_switch_off_one_by_one():
     np.testing.assert_allclose(sim.recording.gyro_dps, t.components_dps["temperature"], atol=1e-15)
     no_lag = simulate(quiet.without("lag"), profile="cycle", duration_s=4000, rate_hz=1)
     np.testing.assert_array_equal(no_lag.truth.structure_temperature_degc, no_lag.truth.reported_temperature_degc)
-    flat = simulate(quiet.without("temperature", "hysteresis", "g-sensitivity"), profile="cycle", duration_s=4000,
-                    rate_hz=1)
+    flat = simulate(
+        quiet.without("temperature", "hysteresis", "g-sensitivity"), profile="cycle", duration_s=4000, rate_hz=1
+    )
     assert not np.any(flat.recording.gyro_dps)
     with pytest.raises(InputError, match="disable: unknown term 'wind'; use any of temperature, lag"):
         base.without("wind")
@@ -269,6 +304,9 @@ def test_terms_switch_off_one_by_one():
 def test_a_simulation_larger_than_memory_is_refused_up_front():
     """1e9 s at 100 Hz (1e11 samples) would end in a MemoryError after minutes; it is refused at once, naming
     the two settings (the command line's exit 2)."""
-    with pytest.raises(InputError, match=r"duration_s: 1e\+09 s at rate_hz=100 is 1e\+11 samples, about .* GB to "
-                                         r"simulate, more than this machine's .* GB; shorten duration_s= or lower"):
+    with pytest.raises(
+        InputError,
+        match=r"duration_s: 1e\+09 s at rate_hz=100 is 1e\+11 samples, about .* GB to "
+        r"simulate, more than this machine's .* GB; shorten duration_s= or lower",
+    ):
         simulate("mti10", duration_s=1e9, rate_hz=100.0)

@@ -62,8 +62,9 @@ def markov_allan_variance(tau_s, time_constant_s: float) -> np.ndarray:
     tau = np.asarray(tau_s, dtype=float)
     x = tau / time_constant_s
     small = x < 1e-3  # the series tau / 3 (1 - x/4 + ...) where the closed form cancels
-    closed = time_constant_s ** 2 / tau * (1.0 - (3.0 - 4.0 * np.exp(-x) + np.exp(-2.0 * x)) / (2.0 * np.where(
-        small, 1.0, x)))
+    closed = (
+        time_constant_s**2 / tau * (1.0 - (3.0 - 4.0 * np.exp(-x) + np.exp(-2.0 * x)) / (2.0 * np.where(small, 1.0, x)))
+    )
     return np.where(small, tau / 3.0 * (1.0 - x / 4.0), closed)
 
 
@@ -96,22 +97,26 @@ class NoiseBound:
     def deviation(self, tau_s) -> np.ndarray:
         """The model's Allan deviation [u] at ``tau_s`` [s]."""
         tau = np.asarray(tau_s, dtype=float)
-        variance = self.white_noise_density ** 2 / tau + self.random_walk ** 2 * tau / 3.0
+        variance = self.white_noise_density**2 / tau + self.random_walk**2 * tau / 3.0
         for sigma, time_constant in self.markov:
-            variance = variance + 2.0 * sigma ** 2 / time_constant * markov_allan_variance(tau, time_constant)
+            variance = variance + 2.0 * sigma**2 / time_constant * markov_allan_variance(tau, time_constant)
         return np.sqrt(variance)
 
     def to_dict(self) -> dict:
         """The model as JSON: each term with its unit's name (``u`` is the data's)."""
-        return {"white_noise_density_u_per_sqrt_hz": self.white_noise_density,
-                "random_walk_u_per_sqrt_s": self.random_walk,
-                "gauss_markov": [{"sigma_u": s, "time_constant_s": t} for s, t in self.markov],
-                "bounded_taus_s": [self.taus_s[0], self.taus_s[-1]] if self.taus_s else [],
-                "ratio_to_measured_median": self.ratio_median, "ratio_to_measured_max": self.ratio_max}
+        return {
+            "white_noise_density_u_per_sqrt_hz": self.white_noise_density,
+            "random_walk_u_per_sqrt_s": self.random_walk,
+            "gauss_markov": [{"sigma_u": s, "time_constant_s": t} for s, t in self.markov],
+            "bounded_taus_s": [self.taus_s[0], self.taus_s[-1]] if self.taus_s else [],
+            "ratio_to_measured_median": self.ratio_median,
+            "ratio_to_measured_max": self.ratio_max,
+        }
 
 
-def _targets(curves: list[AllanResult], max_tau_s: float | None, confidence: float
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _targets(
+    curves: list[AllanResult], max_tau_s: float | None, confidence: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(tau, measured deviation, one-sided upper confidence bound) of every point bounded, all curves together:
     the chi-squared bound of each point's equivalent degrees of freedom (NIST SP 1065 eq. 45), or, where no
     noise type gave them, the deviation times 1 + 2 / sqrt(n)."""
@@ -138,8 +143,13 @@ def _columns(tau: np.ndarray, times: np.ndarray) -> np.ndarray:
     return np.column_stack([1.0 / tau, tau / 3.0, *(markov_allan_variance(tau, t) for t in times)])
 
 
-def bound_noise(curves: AllanResult | list[AllanResult], *, markov: bool = True,
-                max_tau_s: float | None = None, confidence: float = BOUND_CONFIDENCE) -> NoiseBound:
+def bound_noise(
+    curves: AllanResult | list[AllanResult],
+    *,
+    markov: bool = True,
+    max_tau_s: float | None = None,
+    confidence: float = BOUND_CONFIDENCE,
+) -> NoiseBound:
     """The tightest noise model a filter can carry whose Allan deviation is at or above the upper confidence
     bound of every curve at every averaging time (see the module).
 
@@ -170,23 +180,41 @@ def bound_noise(curves: AllanResult | list[AllanResult], *, markov: bool = True,
     lo, hi = float(tau.min()), float(tau.max())
     count = int(math.ceil(MARKOV_PER_DECADE * math.log10(hi / lo))) + 1 if markov and hi > lo else 0
     times = np.geomspace(lo, hi, count) if count else np.empty(0)
-    target = high ** 2
+    target = high**2
     basis = _columns(tau, times) / target[:, None]  # each row: the model's variance over the bound's
     scale = basis.max(axis=0)
     scale[scale <= 0] = 1.0
     a = basis / scale
     from scipy.optimize import linprog  # scipy.optimize is slow to import: only the bound needs it here
 
-    solution = linprog(a.sum(axis=0), A_ub=-a, b_ub=-np.ones(tau.size) * (1 + BOUND_TOLERANCE),
-                       bounds=[(0, None)] * a.shape[1], method="highs")
+    solution = linprog(
+        a.sum(axis=0),
+        A_ub=-a,
+        b_ub=-np.ones(tau.size) * (1 + BOUND_TOLERANCE),
+        bounds=[(0, None)] * a.shape[1],
+        method="highs",
+    )
     if not solution.success:
         raise InputError(f"data: no noise bound found ({solution.message})")
     x = solution.x / scale
     model = np.sqrt(_columns(tau, times) @ x)
     ratio = model / dev
     terms = tuple((math.sqrt(q2 * t / 2.0), float(t)) for q2, t in zip(x[2:], times) if q2 > 0)
-    return NoiseBound(math.sqrt(x[0]), math.sqrt(x[1]), terms, tuple(float(t) for t in np.unique(tau)),
-                      float(np.median(ratio)), float(ratio.max()))
+    return NoiseBound(
+        math.sqrt(x[0]),
+        math.sqrt(x[1]),
+        terms,
+        tuple(float(t) for t in np.unique(tau)),
+        float(np.median(ratio)),
+        float(ratio.max()),
+    )
 
 
-__all__ = ["BOUND_CONFIDENCE", "BOUND_TOLERANCE", "MARKOV_PER_DECADE", "NoiseBound", "bound_noise", "markov_allan_variance"]
+__all__ = [
+    "BOUND_CONFIDENCE",
+    "BOUND_TOLERANCE",
+    "MARKOV_PER_DECADE",
+    "NoiseBound",
+    "bound_noise",
+    "markov_allan_variance",
+]

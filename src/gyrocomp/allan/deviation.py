@@ -59,12 +59,41 @@ from .terms import (
 )
 
 __all__ = [
-    "AccelNoise", "AllanKind", "AllanMinimum", "AllanResult", "DataType", "TauGrid", "BIAS_INSTABILITY_FACTOR", "DEFAULT_STOP_RATIO", "GyroNoise",
-    "KINDS", "MODEL_UNCERTAINTY", "NOISE_ID_MAX_POINTS", "NOISE_ID_MIN_POINTS", "NoiseIdentification",
-    "NoiseTerms", "ONE_SIGMA", "PhaseAccumulator", "READOFF_SLOPE_TOLERANCE", "STOP_RATIO", "allan_deviation",
-    "allan_deviation_segments", "averaging_factors", "b1_expected", "confidence_interval",
-    "degrees_of_freedom", "edf_greenhall", "edf_totdev", "identify_noise", "identify_noise_b1",
-    "noise_parameters", "noise_terms", "noise_types", "phase_from_chunks", "rn_expected", "term_count",
+    "AccelNoise",
+    "AllanKind",
+    "AllanMinimum",
+    "AllanResult",
+    "DataType",
+    "TauGrid",
+    "BIAS_INSTABILITY_FACTOR",
+    "DEFAULT_STOP_RATIO",
+    "GyroNoise",
+    "KINDS",
+    "MODEL_UNCERTAINTY",
+    "NOISE_ID_MAX_POINTS",
+    "NOISE_ID_MIN_POINTS",
+    "NoiseIdentification",
+    "NoiseTerms",
+    "ONE_SIGMA",
+    "PhaseAccumulator",
+    "READOFF_SLOPE_TOLERANCE",
+    "STOP_RATIO",
+    "allan_deviation",
+    "allan_deviation_segments",
+    "averaging_factors",
+    "b1_expected",
+    "confidence_interval",
+    "degrees_of_freedom",
+    "edf_greenhall",
+    "edf_totdev",
+    "identify_noise",
+    "identify_noise_b1",
+    "noise_parameters",
+    "noise_terms",
+    "noise_types",
+    "phase_from_chunks",
+    "rn_expected",
+    "term_count",
     "to_phase",
 ]
 
@@ -93,10 +122,17 @@ def _as_phase(data, rate_hz: float, data_type: str, phase_out) -> tuple[np.ndarr
 
 
 @single_threaded_blas
-def allan_deviation(data, rate_hz: float, *, kind: AllanKind = "oadev", taus: TauGrid | np.ndarray = "octave",
-                    data_type: DataType = "rate",
-                    confidence: float | None = ONE_SIGMA, phase_out: np.ndarray | None = None,
-                    noise_alpha=None) -> AllanResult:
+def allan_deviation(
+    data,
+    rate_hz: float,
+    *,
+    kind: AllanKind = "oadev",
+    taus: TauGrid | np.ndarray = "octave",
+    data_type: DataType = "rate",
+    confidence: float | None = ONE_SIGMA,
+    phase_out: np.ndarray | None = None,
+    noise_alpha=None,
+) -> AllanResult:
     """Allan deviation of ``data`` sampled at ``rate_hz``, with confidence intervals.
 
     Parameters
@@ -143,9 +179,18 @@ def allan_deviation(data, rate_hz: float, *, kind: AllanKind = "oadev", taus: Ta
             alphas, methods = forced, ("given",) * len(ms)
         edf = degrees_of_freedom(kind, alphas, ms, phase.size)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
-    return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
-                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence,
-                       noise_method=methods)
+    return AllanResult(
+        tau=tau,
+        deviation=deviation,
+        n=counts,
+        ci_low=low,
+        ci_high=high,
+        alpha=alphas,
+        edf=edf,
+        kind=kind,
+        confidence=math.nan if confidence is None else confidence,
+        noise_method=methods,
+    )
 
 
 def _noise_alpha(value, count: int) -> np.ndarray | None:
@@ -159,15 +204,22 @@ def _noise_alpha(value, count: int) -> np.ndarray | None:
     if values.ndim != 1 or values.size not in (1, count):
         raise InputError(f"noise_alpha: one alpha, or one per tau ({count}), got {values.size}")
     if not np.all(np.isin(values, (-2, -1, 0, 1, 2))):
-        raise InputError(f"noise_alpha: each one of 2, 1, 0, -1, -2 (white PM .. random walk FM), got "
-                         f"{values.tolist()}")
+        raise InputError(
+            f"noise_alpha: each one of 2, 1, 0, -1, -2 (white PM .. random walk FM), got {values.tolist()}"
+        )
     return np.broadcast_to(values, (count,)).astype(float)
 
 
 @single_threaded_blas
-def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: AllanKind = "oadev",
-                             taus: TauGrid | np.ndarray = "octave", data_type: DataType = "rate",
-                             confidence: float | None = ONE_SIGMA) -> AllanResult:
+def allan_deviation_segments(
+    segments: Iterable,
+    rate_hz: float,
+    *,
+    kind: AllanKind = "oadev",
+    taus: TauGrid | np.ndarray = "octave",
+    data_type: DataType = "rate",
+    confidence: float | None = ONE_SIGMA,
+) -> AllanResult:
     """One deviation curve from several contiguous stretches of data separated by gaps.
 
     The sums of squared differences and their term counts are pooled over the stretches, so no term
@@ -199,7 +251,15 @@ def allan_deviation_segments(segments: Iterable, rate_hz: float, *, kind: AllanK
     edf = np.where(np.isnan(alphas), np.nan, edf)
     deviation = _normalize(kind, sums, ms, tau, counts, scale)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
-    return AllanResult(tau=tau, deviation=deviation, n=counts, ci_low=low, ci_high=high, alpha=alphas,
-                       edf=edf, kind=kind, confidence=math.nan if confidence is None else confidence,
-                       noise_method=found.method if found is not None else ("",) * len(ms))
-
+    return AllanResult(
+        tau=tau,
+        deviation=deviation,
+        n=counts,
+        ci_low=low,
+        ci_high=high,
+        alpha=alphas,
+        edf=edf,
+        kind=kind,
+        confidence=math.nan if confidence is None else confidence,
+        noise_method=found.method if found is not None else ("",) * len(ms),
+    )

@@ -130,7 +130,7 @@ def _running_sum(chunks, mean: float, out: np.ndarray, divisor: float = 1.0) -> 
         size = len(chunk)
         if not size:
             continue
-        target = out[position + 1:position + 1 + size]
+        target = out[position + 1 : position + 1 + size]
         np.subtract(chunk, mean, out=target, dtype=np.float64)
         np.cumsum(target, out=target)
         if carry:
@@ -171,7 +171,9 @@ def phase_from_chunks(chunks, rate_hz: float, n_samples: int, out: np.ndarray | 
     return _running_sum(chunks(), total / count, phase, rate_hz)
 
 
-def averaging_factors(n_phase: int, taus: TauGrid | np.ndarray, rate_hz: float, kind: AllanKind = "oadev") -> np.ndarray:
+def averaging_factors(
+    n_phase: int, taus: TauGrid | np.ndarray, rate_hz: float, kind: AllanKind = "oadev"
+) -> np.ndarray:
     """Averaging factors m for a tau specification; the named grids stop at n_phase / stop ratio (as Stable32)."""
     m_max = max(1, n_phase // STOP_RATIO.get(kind, DEFAULT_STOP_RATIO))
     if isinstance(taus, str):
@@ -210,6 +212,7 @@ def term_count(kind: str, n_phase: int, m):
 
 # --- sums of squared differences, in blocks -------------------------------------------------------------
 
+
 def _second_difference_sum(x, m: int, stride: int, count: int, buffer: np.ndarray) -> float:
     """sum over i = 0, stride, ..., of (x[i+2m] - 2 x[i+m] + x[i])^2."""
     total = 0.0
@@ -217,9 +220,9 @@ def _second_difference_sum(x, m: int, stride: int, count: int, buffer: np.ndarra
     step = len(buffer) * stride
     for start in range(0, last, step):
         stop = min(start + step, last)
-        d = buffer[:len(range(start, stop, stride))]
-        np.add(x[start:stop:stride], x[start + 2 * m:stop + 2 * m:stride], out=d)
-        middle = x[start + m:stop + m:stride]
+        d = buffer[: len(range(start, stop, stride))]
+        np.add(x[start:stop:stride], x[start + 2 * m : stop + 2 * m : stride], out=d)
+        middle = x[start + m : stop + m : stride]
         d -= middle
         d -= middle
         total += float(np.dot(d, d))
@@ -235,8 +238,8 @@ def _third_difference_sum(x, m: int, stride: int, count: int, buffer: np.ndarray
         stop = min(start + step, last)
         size = len(range(start, stop, stride))
         d, inner = buffer[:size], spare[:size]
-        np.subtract(x[start + 3 * m:stop + 3 * m:stride], x[start:stop:stride], out=d)
-        np.subtract(x[start + m:stop + m:stride], x[start + 2 * m:stop + 2 * m:stride], out=inner)
+        np.subtract(x[start + 3 * m : stop + 3 * m : stride], x[start:stop:stride], out=d)
+        np.subtract(x[start + m : stop + m : stride], x[start + 2 * m : stop + 2 * m : stride], out=inner)
         inner *= 3.0
         d += inner
         total += float(np.dot(d, d))
@@ -247,16 +250,16 @@ def _reflected(x, lo: int, hi: int, out: np.ndarray) -> np.ndarray:
     """x*[lo:hi] of the series reflected about both ends (NIST SP 1065 eq. 25): x*[-j] = 2x[0] - x[j],
     x*[n-1+j] = 2x[n-1] - x[n-1-j]."""
     n = len(x)
-    out = out[:hi - lo]
+    out = out[: hi - lo]
     k = 0
     if lo < 0:
         top = min(hi, 0)
         piece = 2.0 * x[0] - np.asarray(x[-lo:-top:-1] if top < 0 else x[-lo:0:-1])
-        out[:piece.size] = piece
+        out[: piece.size] = piece
         k = piece.size
     middle_lo, middle_hi = max(lo, 0), min(hi, n)
     if middle_hi > middle_lo:
-        out[k:k + middle_hi - middle_lo] = x[middle_lo:middle_hi]
+        out[k : k + middle_hi - middle_lo] = x[middle_lo:middle_hi]
         k += middle_hi - middle_lo
     if hi > n:
         first = max(lo, n)
@@ -324,11 +327,11 @@ def _octave_level_sums(x, top: int, block: int) -> np.ndarray:
     buffers = np.empty(min(window, n)), np.empty(min(window, n))  # short series: no 3 MiB buffers
     for start in range(0, n - 2, block):
         current, spare = buffers
-        w = np.asarray(x[start:min(start + window, n)], dtype=np.float64)
+        w = np.asarray(x[start : min(start + window, n)], dtype=np.float64)
         length = w.size - 1
         u = current[:length]
         np.subtract(w[1:], w[:-1], out=u)
-        u -= u[:min(block, length)].mean()
+        u -= u[: min(block, length)].mean()
         known_sum, known_len = 0.0, 0  # sum of u[:known_len]^2, carried from the level before
         m = 1
         for level in range(levels):
@@ -345,7 +348,7 @@ def _octave_level_sums(x, top: int, block: int) -> np.ndarray:
                 sums[level] += 2.0 * squares - edges - 2.0 * float(np.dot(u[:count], u[m:need]))
                 break
             length -= m
-            np.add(u[:length], u[m:m + length], out=spare[:length])
+            np.add(u[:length], u[m : m + length], out=spare[:length])
             current, spare = spare, current
             u = current[:length]
             doubled = float(np.dot(u[:count], u[:count]))
@@ -375,11 +378,11 @@ def _prefix_dots(x, cuts: dict[int, set[int]], block: int = _BLOCK) -> dict[int,
                     prefix[k][cs[i]] = totals[k]
                     i += 1
                 stop = min(end, cs[i]) if i < len(cs) else end
-                totals[k] += float(np.dot(x[start:stop], x[start + k:stop + k]))
+                totals[k] += float(np.dot(x[start:stop], x[start + k : stop + k]))
                 start = stop
             next_cut[k] = i
     for k, cs in ordered.items():
-        for c in cs[next_cut[k]:]:
+        for c in cs[next_cut[k] :]:
             prefix[k][c] = totals[k]
     return prefix
 
@@ -402,8 +405,14 @@ def _lag_combination_sums(x, ms: list[int], counts: list[int]) -> np.ndarray:
     for j, (m, c) in enumerate(zip(ms, counts)):
         if c > 0:
             q, lm, l2m = lagged[0], lagged[m], lagged[2 * m]
-            sums[j] = ((q[c + 2 * m] - q[2 * m]) + 4.0 * (q[c + m] - q[m]) + q[c]
-                       - 4.0 * (lm[c + m] - lm[m]) - 4.0 * lm[c] + 2.0 * l2m[c])
+            sums[j] = (
+                (q[c + 2 * m] - q[2 * m])
+                + 4.0 * (q[c + m] - q[m])
+                + q[c]
+                - 4.0 * (lm[c + m] - lm[m])
+                - 4.0 * lm[c]
+                + 2.0 * l2m[c]
+            )
     return sums
 
 
@@ -440,7 +449,7 @@ def _windowed_oadev_sums(x, ms: np.ndarray, block: int = _WINDOW_BLOCK) -> np.nd
     ramp, detrended = np.arange(size, dtype=np.float64), np.empty(size)
     sums = np.zeros(len(ms))
     for start in range(0, n - 2 * min(ms), block):
-        window = np.asarray(x[start:min(start + size, n)], dtype=np.float64)
+        window = np.asarray(x[start : min(start + size, n)], dtype=np.float64)
         length = window.size
         w = detrended[:length]
         np.multiply(ramp[:length], (window[-1] - window[0]) / (length - 1), out=w)
@@ -479,7 +488,7 @@ class PhaseGrids:
         """X at 0, g, 2g, ... (n // g + 1 points) [phase unit x samples]."""
         if g not in self._grids:
             finer = [h for h in self._grids if g % h == 0]
-            self._grids[g] = self._grids[max(finer)][::g // max(finer)] if finer else self._from_phase(g)
+            self._grids[g] = self._grids[max(finer)][:: g // max(finer)] if finer else self._from_phase(g)
         return self._grids[g]
 
     def _from_phase(self, g: int) -> np.ndarray:
@@ -490,7 +499,7 @@ class PhaseGrids:
         for start in range(0, blocks * g, step):
             stop = min(start + step, blocks * g)
             chunk = np.asarray(phase[start:stop], dtype=np.float64) - mean
-            sums[start // g: stop // g] = chunk.reshape(-1, g).sum(axis=1)
+            sums[start // g : stop // g] = chunk.reshape(-1, g).sum(axis=1)
         return np.concatenate([[0.0], np.cumsum(sums)])
 
 
@@ -529,10 +538,10 @@ class _LazyCumulated:
         out = np.empty(stop - base)
         out[0] = self.checkpoints[base // _CHECKPOINT]
         if stop - base > 1:
-            np.subtract(self.x[base:stop - 1], self.mean, out=out[1:], dtype=np.float64)
+            np.subtract(self.x[base : stop - 1], self.mean, out=out[1:], dtype=np.float64)
             np.cumsum(out[1:], out=out[1:])
             out[1:] += out[0]
-        return out[start - base:]
+        return out[start - base :]
 
 
 def _one_sum(kind: str, phase, cumulated, m: int, count: int) -> float:
@@ -552,8 +561,12 @@ def _octave_chain(ms: np.ndarray, n_phase: int) -> int:
     """How many of ms (sorted) are 1, 2, 4, ... in a row, up to the in-cache limit and short of the
     factors the lag products take."""
     length = 0
-    while (length < len(ms) and ms[length] == 1 << length and ms[length] <= _OCTAVE_IN_CACHE_MAX_M
-           and ms[length] * _LAGGED_MAX_SPANS < n_phase):
+    while (
+        length < len(ms)
+        and ms[length] == 1 << length
+        and ms[length] <= _OCTAVE_IN_CACHE_MAX_M
+        and ms[length] * _LAGGED_MAX_SPANS < n_phase
+    ):
         length += 1
     return length
 
@@ -581,20 +594,20 @@ def _variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.n
     return sums
 
 
-def _normalize(kind: str, sums: np.ndarray, ms: np.ndarray, tau: np.ndarray, counts: np.ndarray,
-               phase_scale: float) -> np.ndarray:
+def _normalize(
+    kind: str, sums: np.ndarray, ms: np.ndarray, tau: np.ndarray, counts: np.ndarray, phase_scale: float
+) -> np.ndarray:
     """Deviations from the sums; ``phase_scale`` is what the phase was multiplied by (rate_hz for rate
     data integrated in samples, see _as_phase)."""
     scaled_tau = tau * phase_scale
     with np.errstate(invalid="ignore", divide="ignore"):
         if kind in ("oadev", "adev", "totdev"):
-            var = sums / (2.0 * scaled_tau ** 2 * counts)
+            var = sums / (2.0 * scaled_tau**2 * counts)
         elif kind in ("hdev", "ohdev"):
-            var = sums / (6.0 * scaled_tau ** 2 * counts)
+            var = sums / (6.0 * scaled_tau**2 * counts)
         else:
-            var = sums / (2.0 * ms.astype(float) ** 2 * scaled_tau ** 2 * counts)
+            var = sums / (2.0 * ms.astype(float) ** 2 * scaled_tau**2 * counts)
         dev = np.sqrt(np.where(counts > 0, var, np.nan))
     if kind == "tdev":
         dev = tau * dev / np.sqrt(3.0)  # time deviation [unit*s]: tau / sqrt(3) * MDEV
     return dev
-

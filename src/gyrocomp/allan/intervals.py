@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import InputError
 from .estimators import _ESTIMATORS, ONE_SIGMA
 
+
 def _sw(t: np.ndarray, alpha: int) -> np.ndarray:
     """Greenhall's generalized autocovariance sw(t) of the power-law noise (Greenhall 2004, eq. 7)."""
     t = np.abs(np.asarray(t, dtype=float))
@@ -48,20 +49,24 @@ def _basic_sum(j_terms: float, m_terms: float, stride: float, filter_factor: flo
 
 
 # Greenhall 2004, tables 1-3: (a0, a1) by alpha = 2, 1, 0, -1, -2, -3, -4 (rows) and d = 1, 2, 3 (columns)
-_TABLE1 = [[(2 / 3, 1 / 3), (7 / 9, 1 / 2), (22 / 25, 2 / 3)],
-           [(0.840, 0.345), (0.997, 0.616), (1.141, 0.843)],
-           [(1.079, 0.368), (1.033, 0.607), (1.184, 0.848)],
-           [None, (1.048, 0.534), (1.180, 0.816)],
-           [None, (1.302, 0.535), (1.175, 0.777)],
-           [None, None, (1.194, 0.703)],
-           [None, None, (1.489, 0.702)]]
-_TABLE2 = [[(3 / 2, 1 / 2), (35 / 18, 1.0), (231 / 100, 3 / 2)],
-           [(78.6, 25.2), (790.0, 410.0), (9950.0, 6520.0)],
-           [(2 / 3, 1 / 6), (2 / 3, 1 / 3), (7 / 9, 1 / 2)],
-           [None, (0.852, 0.375), (0.997, 0.617)],
-           [None, (1.079, 0.368), (1.033, 0.607)],
-           [None, None, (1.053, 0.553)],
-           [None, None, (1.302, 0.535)]]
+_TABLE1 = [
+    [(2 / 3, 1 / 3), (7 / 9, 1 / 2), (22 / 25, 2 / 3)],
+    [(0.840, 0.345), (0.997, 0.616), (1.141, 0.843)],
+    [(1.079, 0.368), (1.033, 0.607), (1.184, 0.848)],
+    [None, (1.048, 0.534), (1.180, 0.816)],
+    [None, (1.302, 0.535), (1.175, 0.777)],
+    [None, None, (1.194, 0.703)],
+    [None, None, (1.489, 0.702)],
+]
+_TABLE2 = [
+    [(3 / 2, 1 / 2), (35 / 18, 1.0), (231 / 100, 3 / 2)],
+    [(78.6, 25.2), (790.0, 410.0), (9950.0, 6520.0)],
+    [(2 / 3, 1 / 6), (2 / 3, 1 / 3), (7 / 9, 1 / 2)],
+    [None, (0.852, 0.375), (0.997, 0.617)],
+    [None, (1.079, 0.368), (1.033, 0.607)],
+    [None, None, (1.053, 0.553)],
+    [None, None, (1.302, 0.535)],
+]
 _TABLE3 = {1: (6.0, 4.0), 2: (15.23, 12.0), 3: (47.8, 40.0)}
 _J_MAX = 100
 
@@ -174,12 +179,9 @@ def _edf(kind: str, alpha: int, m: int, n_phase: int) -> float:
     if kind == "totdev":
         return edf_totdev(alpha, m, n_phase)
     spec = _ESTIMATORS[kind]
-    return edf_greenhall(alpha, spec.difference_order, m, n_phase,
-                         overlapping=spec.overlapping, modified=spec.modified)
-
+    return edf_greenhall(alpha, spec.difference_order, m, n_phase, overlapping=spec.overlapping, modified=spec.modified)
 
 
 def degrees_of_freedom(kind: str, alphas: np.ndarray, ms: np.ndarray, n_phase: int) -> np.ndarray:
     """Equivalent degrees of freedom of estimator ``kind`` at each averaging factor (NaN where alpha is)."""
-    return np.array([math.nan if math.isnan(a) else _edf(kind, int(a), int(m), n_phase)
-                     for a, m in zip(alphas, ms)])
+    return np.array([math.nan if math.isnan(a) else _edf(kind, int(a), int(m), n_phase) for a, m in zip(alphas, ms)])

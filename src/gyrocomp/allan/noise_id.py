@@ -45,11 +45,17 @@ class NoiseIdentification:
 def _trend_gram(length: int) -> np.ndarray:
     """sum_k u^(p+q), p, q = 0..2, for u = 2k/(L-1) - 1, k = 0..L-1 (exact power sums of k, then rescaled)."""
     n = length
-    power_sums = [n, n * (n - 1) // 2, (n - 1) * n * (2 * n - 1) // 6, (n * (n - 1) // 2) ** 2,
-                  (n - 1) * n * (2 * n - 1) * (3 * (n - 1) ** 2 + 3 * (n - 1) - 1) // 30]
+    power_sums = [
+        n,
+        n * (n - 1) // 2,
+        (n - 1) * n * (2 * n - 1) // 6,
+        (n * (n - 1) // 2) ** 2,
+        (n - 1) * n * (2 * n - 1) * (3 * (n - 1) ** 2 + 3 * (n - 1) - 1) // 30,
+    ]
     scale = 2.0 / (n - 1)
-    u_sums = [sum(math.comb(p, j) * scale ** j * (-1.0) ** (p - j) * power_sums[j]
-                  for j in range(p + 1)) for p in range(5)]
+    u_sums = [
+        sum(math.comb(p, j) * scale**j * (-1.0) ** (p - j) * power_sums[j] for j in range(p + 1)) for p in range(5)
+    ]
     return np.array([[u_sums[p + q] for q in range(3)] for p in range(3)])
 
 
@@ -80,8 +86,9 @@ def _lag1_autocorrelations(x: np.ndarray, max_differences: int) -> list[float]:
         total = float(z.sum())
         mean = total / size
         denominator = float(np.dot(z, z)) - size * mean * mean
-        numerator = (float(np.dot(z[:-1], z[1:])) - mean * (2.0 * total - float(z[0]) - float(z[-1]))
-                     + (size - 1) * mean * mean)
+        numerator = (
+            float(np.dot(z[:-1], z[1:])) - mean * (2.0 * total - float(z[0]) - float(z[-1])) + (size - 1) * mean * mean
+        )
         result.append(numerator / denominator if denominator > 0 else math.nan)
     return result
 
@@ -97,7 +104,7 @@ def identify_noise(phase, m: int, *, max_differences: int = 2) -> NoiseIdentific
     Stable32 reference file agrees as with 2^20, and it keeps the identification a fraction of the deviations'
     cost on long series.
     """
-    x = np.asarray(phase[:NOISE_ID_MAX_POINTS * m:m], dtype=np.float64)  # at most 2 MiB, whatever the phase
+    x = np.asarray(phase[: NOISE_ID_MAX_POINTS * m : m], dtype=np.float64)  # at most 2 MiB, whatever the phase
     if len(x) < NOISE_ID_MIN_POINTS:
         return None
     correlations = _lag1_autocorrelations(x, max_differences)
@@ -108,12 +115,13 @@ def identify_noise(phase, m: int, *, max_differences: int = 2) -> NoiseIdentific
         if rho < 0.25 or d == max_differences:
             break
     estimate = 2.0 - 2.0 * (rho + d)
-    return NoiseIdentification(alpha=int(2 - np.round(2.0 * rho) - 2 * d), alpha_estimate=estimate,
-                               differences=d, rho=rho)
-
+    return NoiseIdentification(
+        alpha=int(2 - np.round(2.0 * rho) - 2 * d), alpha_estimate=estimate, differences=d, rho=rho
+    )
 
 
 # --- fewer than 30 points: the B1 ratio and R(n) ------------------------------------------------------------
+
 
 def b1_expected(n_points: int, mu: int) -> float:
     """Expected B1 ratio (standard over Allan variance) of ``n_points`` frequency averages of a noise whose
@@ -124,7 +132,7 @@ def b1_expected(n_points: int, mu: int) -> float:
         return n * math.log(n) / (2.0 * (n - 1.0) * math.log(2.0))
     if mu == -1:
         return 1.0
-    return n * (1.0 - n ** mu) / (2.0 * (n - 1.0) * (1.0 - 2.0 ** mu))
+    return n * (1.0 - n**mu) / (2.0 * (n - 1.0) * (1.0 - 2.0**mu))
 
 
 def rn_expected(m: int, alpha: Literal[1, 2]) -> float:
@@ -162,8 +170,8 @@ def modified_variance_on_grid(phase, m: int, grids: PhaseGrids | None = None) ->
     grid = (PhaseGrids(phase) if grids is None else grids).running_sum(g)
     d = m // g
     starts = (n - 3 * m) // g + 1  # grid starts i = 0, g, ... with i + 3m <= n
-    x = grid[:starts + 3 * d]
-    terms = x[3 * d:3 * d + starts] - 3.0 * x[2 * d:2 * d + starts] + 3.0 * x[d:d + starts] - x[:starts]
+    x = grid[: starts + 3 * d]
+    terms = x[3 * d : 3 * d + starts] - 3.0 * x[2 * d : 2 * d + starts] + 3.0 * x[d : d + starts] - x[:starts]
     return float(np.dot(terms, terms) / (2.0 * float(m) ** 4 * starts))
 
 
@@ -181,7 +189,7 @@ def identify_noise_b1(phase, m: int, grids: PhaseGrids | None = None) -> NoiseId
     n_points = (len(phase) - 1) // m
     if n_points < 3:
         return None
-    x = np.asarray(phase[:n_points * m + 1:m], dtype=np.float64)
+    x = np.asarray(phase[: n_points * m + 1 : m], dtype=np.float64)
     averages = np.diff(x) / m
     k = np.arange(n_points, dtype=np.float64)
     residual = averages - np.polyval(np.polyfit(k, averages, 1), k)
@@ -195,14 +203,16 @@ def identify_noise_b1(phase, m: int, grids: PhaseGrids | None = None) -> NoiseId
             mu = candidate
             break
     if mu > -2:
-        return NoiseIdentification(alpha=-mu - 1, alpha_estimate=math.nan, differences=-1, rho=math.nan,
-                                   method="b1", ratio=ratio)
+        return NoiseIdentification(
+            alpha=-mu - 1, alpha_estimate=math.nan, differences=-1, rho=math.nan, method="b1", ratio=ratio
+        )
     rn = modified_variance_on_grid(phase, m, grids) / allan  # the ADEV at m is the Allan variance of these averages
     if not math.isfinite(rn):
         return None
     alpha = 1 if rn > math.sqrt(rn_expected(m, 1) * rn_expected(m, 2)) else 2
-    return NoiseIdentification(alpha=alpha, alpha_estimate=math.nan, differences=-1, rho=math.nan,
-                               method="rn", ratio=rn)
+    return NoiseIdentification(
+        alpha=alpha, alpha_estimate=math.nan, differences=-1, rho=math.nan, method="rn", ratio=rn
+    )
 
 
 #: a lag-1 identification from fewer decimated points than this is cross-checked with R(n) of the whole series
@@ -222,8 +232,9 @@ def overlapping_allan_variance(phase, m: int) -> float:
     return _second_difference_sum(phase, m, 1, count, np.empty(_BLOCK)) / (2.0 * float(m) ** 2 * count)
 
 
-def _rn_checked(alphas: np.ndarray, methods: list[str], points: list, phase, ms: np.ndarray,
-                lowest: int, grids: PhaseGrids) -> np.ndarray:
+def _rn_checked(
+    alphas: np.ndarray, methods: list[str], points: list, phase, ms: np.ndarray, lowest: int, grids: PhaseGrids
+) -> np.ndarray:
     """Where a lag-1 phase-noise type (white or flicker PM) rests on few decimated points (< RN_CHECK_MAX_POINTS),
     R(n) = MVAR/AVAR of the whole series at that m (every term, not the few points) decides between the phase
     noises and frequency noise: the type whose expected R(n) lies nearest on a log scale (``methods`` then says
@@ -237,8 +248,11 @@ def _rn_checked(alphas: np.ndarray, methods: list[str], points: list, phase, ms:
         rn = modified_variance_on_grid(phase, m, grids) / allan if allan > 0 else math.nan
         if not math.isfinite(rn) or not rn > 0:
             continue
-        expected = {2: rn_expected(m, 2), 1: rn_expected(m, 1),
-                    **{a: r for a, r in RN_FREQUENCY_NOISE.items() if a >= lowest}}
+        expected = {
+            2: rn_expected(m, 2),
+            1: rn_expected(m, 1),
+            **{a: r for a, r in RN_FREQUENCY_NOISE.items() if a >= lowest},
+        }
         nearest = min(expected, key=lambda a: abs(math.log(rn / expected[a])))
         if nearest != alphas[j]:
             out[j] = float(nearest)

@@ -95,7 +95,7 @@ class PhaseAccumulator:
         for j, sums in enumerate(self._sums):
             phase = sums.finish()
             for start in range(0, phase.size, _BLOCK):
-                piece = phase[start:start + _BLOCK]
+                piece = phase[start : start + _BLOCK]
                 piece -= np.arange(start, start + piece.size, dtype=np.float64) * slopes[j]
                 piece /= rate_hz
             self._phases.append(phase)

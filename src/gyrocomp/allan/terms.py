@@ -64,8 +64,12 @@ class NoiseTerms:
 
     def model_deviation(self, tau_s) -> np.ndarray:
         """The fitted five-term model's deviation at ``tau_s`` [s], in the data's unit."""
-        coefficients = np.array([self.quantization, self.white_noise_density, self.bias_instability_fit,
-                                 self.random_walk, self.ramp]) ** 2
+        coefficients = (
+            np.array(
+                [self.quantization, self.white_noise_density, self.bias_instability_fit, self.random_walk, self.ramp]
+            )
+            ** 2
+        )
         return np.sqrt(_model_basis(np.asarray(tau_s, dtype=float)) @ coefficients)
 
 
@@ -88,8 +92,15 @@ class GyroNoise:
     fit_rms_log_residual: float
 
     #: the keys of ``gyrocomp allan --json``
-    SUMMARY_KEYS = ("noise_density_dps_per_sqrt_hz", "arw_deg_per_sqrt_h", "bias_instability_deg_per_h",
-                    "integration_time_s", "rrw_deg_per_h_per_sqrt_h", "quantization_deg", "rate_ramp_deg_per_h2")
+    SUMMARY_KEYS = (
+        "noise_density_dps_per_sqrt_hz",
+        "arw_deg_per_sqrt_h",
+        "bias_instability_deg_per_h",
+        "integration_time_s",
+        "rrw_deg_per_h_per_sqrt_h",
+        "quantization_deg",
+        "rate_ramp_deg_per_h2",
+    )
 
     @classmethod
     def from_terms(cls, t: NoiseTerms) -> "GyroNoise":
@@ -103,7 +114,7 @@ class GyroNoise:
             rrw_deg_per_h_per_sqrt_h=t.random_walk * 216000.0,  # 3600 [deg/h per deg/s] * 60 [sqrt(s/h)]
             rrw_dps_sqrt_hz=t.random_walk,
             quantization_deg=t.quantization,
-            rate_ramp_deg_per_h2=t.ramp * 3600.0 ** 2,
+            rate_ramp_deg_per_h2=t.ramp * 3600.0**2,
             bias_instability_fit_deg_per_h=t.bias_instability_fit * 3600.0,
             noise_density_readoff_dps_per_sqrt_hz=t.white_noise_readoff,
             rrw_readoff_deg_per_h_per_sqrt_h=readoff_k,
@@ -132,9 +143,15 @@ class AccelNoise:
     floor_reached: bool
     fit_rms_log_residual: float
 
-    SUMMARY_KEYS = ("noise_density_g_per_sqrt_hz", "vrw_m_per_s_per_sqrt_h", "bias_instability_micro_g",
-                    "integration_time_s", "random_walk_m_per_s3_per_sqrt_hz", "quantization_m_per_s",
-                    "ramp_m_per_s3")
+    SUMMARY_KEYS = (
+        "noise_density_g_per_sqrt_hz",
+        "vrw_m_per_s_per_sqrt_h",
+        "bias_instability_micro_g",
+        "integration_time_s",
+        "random_walk_m_per_s3_per_sqrt_hz",
+        "quantization_m_per_s",
+        "ramp_m_per_s3",
+    )
 
     @classmethod
     def from_terms(cls, t: NoiseTerms) -> "AccelNoise":
@@ -150,7 +167,8 @@ class AccelNoise:
             ramp_m_per_s3=t.ramp * g,
             bias_instability_fit_micro_g=t.bias_instability_fit * 1e6,
             noise_density_readoff_g_per_sqrt_hz=t.white_noise_readoff,
-            random_walk_readoff_m_per_s3_per_sqrt_hz=None if t.random_walk_readoff is None
+            random_walk_readoff_m_per_s3_per_sqrt_hz=None
+            if t.random_walk_readoff is None
             else t.random_walk_readoff * g,
             floor_reached=t.floor_reached,
             fit_rms_log_residual=t.fit_rms_log_residual,
@@ -162,8 +180,9 @@ class AccelNoise:
 
 def _model_basis(tau: np.ndarray) -> np.ndarray:
     """Columns of sigma^2(tau) = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2."""
-    return np.stack([3.0 / tau ** 2, 1.0 / tau, np.full_like(tau, BIAS_INSTABILITY_FACTOR ** 2),
-                     tau / 3.0, tau ** 2 / 2.0], axis=1)
+    return np.stack(
+        [3.0 / tau**2, 1.0 / tau, np.full_like(tau, BIAS_INSTABILITY_FACTOR**2), tau / 3.0, tau**2 / 2.0], axis=1
+    )
 
 
 def _readoff(tau: np.ndarray, dev: np.ndarray, slope: float) -> tuple[float, float] | None:
@@ -203,7 +222,7 @@ def noise_terms(result: AllanResult, fit_taus_s: tuple[float, float] | None = No
         if fitted.sum() < 2:
             raise InputError(f"fit_taus_s: fewer than two taus between {fit_taus_s[0]:g} and {fit_taus_s[1]:g} s")
     tau, dev = result.tau[fitted], result.deviation[fitted]
-    variance = dev ** 2
+    variance = dev**2
     half_width = (result.ci_high[fitted] ** 2 - result.ci_low[fitted] ** 2) / 2.0
     fallback = variance * np.sqrt(2.0 / np.maximum(result.n[fitted], 1))
     half_width = np.where(np.isfinite(half_width) & (half_width > 0), half_width, fallback)
@@ -238,8 +257,9 @@ def noise_terms(result: AllanResult, fit_taus_s: tuple[float, float] | None = No
     )
 
 
-def noise_parameters(result: AllanResult, sensor: Literal["gyro", "accel"] = "gyro",
-                     fit_taus_s: tuple[float, float] | None = None) -> GyroNoise | AccelNoise:
+def noise_parameters(
+    result: AllanResult, sensor: Literal["gyro", "accel"] = "gyro", fit_taus_s: tuple[float, float] | None = None
+) -> GyroNoise | AccelNoise:
     """Noise parameters of a gyro curve in [deg/s] (``sensor="gyro"``) or an accelerometer curve in [g]."""
     terms = noise_terms(result, fit_taus_s)
     if sensor == "gyro":

@@ -3,10 +3,6 @@ application (:mod:`.compensate`)."""
 
 from __future__ import annotations
 
-from .calibration import (
-    AxisCalibration, AxisSummary, Calibration, FORMAT_NAME, SCHEMA_VERSION
-)
+from .calibration import AxisCalibration, AxisSummary, Calibration, FORMAT_NAME, SCHEMA_VERSION
 
-__all__ = [
-    "AxisCalibration", "AxisSummary", "Calibration", "FORMAT_NAME", "SCHEMA_VERSION"
-]
+__all__ = ["AxisCalibration", "AxisSummary", "Calibration", "FORMAT_NAME", "SCHEMA_VERSION"]

@@ -41,10 +41,14 @@ def _refuse_later_fields(d: dict, version: int, top: tuple[str, ...] = (), per_a
     copied from another file) is refused: upgrading it would overwrite those values with the defaults."""
     found = [key for key in top if key in d]
     axes = d.get("axes") if isinstance(d.get("axes"), dict) else {}
-    found += [f"axes.{name}.{key}" for name, ax in axes.items() if isinstance(ax, dict) for key in per_axis if key in ax]
+    found += [
+        f"axes.{name}.{key}" for name, ax in axes.items() if isinstance(ax, dict) for key in per_axis if key in ax
+    ]
     if found:
-        raise InputError(f"schema_version {version}: the file holds {found[0]}, which schema {version + 1} added; "
-                         "its schema_version was changed by hand? (write it again with gyrocomp fit)")
+        raise InputError(
+            f"schema_version {version}: the file holds {found[0]}, which schema {version + 1} added; "
+            "its schema_version was changed by hand? (write it again with gyrocomp fit)"
+        )
 
 
 def _upgrade_1_to_2(d: dict) -> dict:
@@ -52,8 +56,10 @@ def _upgrade_1_to_2(d: dict) -> dict:
     _refuse_later_fields(d, 1, (), ("lag_time_constant_s", "hysteresis"))
     d = dict(d)
     if isinstance(d.get("axes"), dict):
-        d["axes"] = {name: {**ax, "lag_time_constant_s": 0.0, "hysteresis": None} if isinstance(ax, dict) else ax
-                     for name, ax in d["axes"].items()}
+        d["axes"] = {
+            name: {**ax, "lag_time_constant_s": 0.0, "hysteresis": None} if isinstance(ax, dict) else ax
+            for name, ax in d["axes"].items()
+        }
     d["schema_version"] = 2
     return d
 
@@ -63,8 +69,10 @@ def _upgrade_2_to_3(d: dict) -> dict:
     _refuse_later_fields(d, 2, (), ("g_sensitivity_dps_per_g", "g_squared_dps_per_g2"))
     d = dict(d)
     if isinstance(d.get("axes"), dict):
-        d["axes"] = {name: {**ax, "g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None}
-                     if isinstance(ax, dict) else ax for name, ax in d["axes"].items()}
+        d["axes"] = {
+            name: {**ax, "g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None} if isinstance(ax, dict) else ax
+            for name, ax in d["axes"].items()
+        }
     d["schema_version"] = 3
     return d
 
@@ -74,8 +82,9 @@ def _upgrade_3_to_4(d: dict) -> dict:
     _refuse_later_fields(d, 3, (), ("acceleration_network",))
     d = dict(d)
     if isinstance(d.get("axes"), dict):
-        d["axes"] = {name: {**ax, "acceleration_network": None} if isinstance(ax, dict) else ax
-                     for name, ax in d["axes"].items()}
+        d["axes"] = {
+            name: {**ax, "acceleration_network": None} if isinstance(ax, dict) else ax for name, ax in d["axes"].items()
+        }
     d["schema_version"] = 4
     return d
 
@@ -101,8 +110,15 @@ def _upgrade_5_to_6(d: dict) -> dict:
 
 
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
-UPGRADES: dict[int, Callable[[dict], dict]] = {1: _upgrade_1_to_2, 2: _upgrade_2_to_3, 3: _upgrade_3_to_4,
-                                               4: _upgrade_4_to_5, 5: _upgrade_5_to_6}
+UPGRADES: dict[int, Callable[[dict], dict]] = {
+    1: _upgrade_1_to_2,
+    2: _upgrade_2_to_3,
+    3: _upgrade_3_to_4,
+    4: _upgrade_4_to_5,
+    5: _upgrade_5_to_6,
+}
+
+
 def _require_finite(value: Any, where: str = "") -> None:
     """Every number under ``value`` finite (a NaN passes any bound a schema sets: it compares false), the error
     naming the field (``axes.gyro_z.temperature.coefficients_dps[0]``), in the fit report too (show formats it)."""
@@ -122,11 +138,16 @@ def _check_ranges(d: dict) -> None:
         for name, ax in d[section].items():
             for key in ("temperature", "hysteresis", "acceleration_network"):
                 curve = ax.get(key)
-                if isinstance(curve, dict) and isinstance(curve.get("t_min_degc"), (int, float)) \
-                        and isinstance(curve.get("t_max_degc"), (int, float)) \
-                        and curve["t_min_degc"] > curve["t_max_degc"]:
-                    raise InputError(f"{section}.{name}.{key}: t_min_degc {curve['t_min_degc']:g} is above "
-                                     f"t_max_degc {curve['t_max_degc']:g}")
+                if (
+                    isinstance(curve, dict)
+                    and isinstance(curve.get("t_min_degc"), (int, float))
+                    and isinstance(curve.get("t_max_degc"), (int, float))
+                    and curve["t_min_degc"] > curve["t_max_degc"]
+                ):
+                    raise InputError(
+                        f"{section}.{name}.{key}: t_min_degc {curve['t_min_degc']:g} is above "
+                        f"t_max_degc {curve['t_max_degc']:g}"
+                    )
 
 
 def _check_triads(triads: dict[str, TriadCalibration | None], axes: dict) -> None:
@@ -210,8 +231,11 @@ class AxisCalibration:
     @property
     def has_acceleration_stage(self) -> bool:
         """Whether the axis has a g-sensitivity stage: G, g x g terms or an acceleration network."""
-        return (self.g_sensitivity_dps_per_g is not None or self.g_squared_dps_per_g2 is not None
-                or self.acceleration_network is not None)
+        return (
+            self.g_sensitivity_dps_per_g is not None
+            or self.g_squared_dps_per_g2 is not None
+            or self.acceleration_network is not None
+        )
 
     @property
     def needs_accel(self) -> bool:
@@ -245,7 +269,9 @@ class AxisCalibration:
             "temperature_column": self.temperature_column,
             "lag_time_constant_s": self.lag_time_constant_s,
             "hysteresis": None if self.hysteresis is None else self.hysteresis.to_dict(),
-            "g_sensitivity_dps_per_g": None if self.g_sensitivity_dps_per_g is None else list(self.g_sensitivity_dps_per_g),
+            "g_sensitivity_dps_per_g": None
+            if self.g_sensitivity_dps_per_g is None
+            else list(self.g_sensitivity_dps_per_g),
             "g_squared_dps_per_g2": None if self.g_squared_dps_per_g2 is None else list(self.g_squared_dps_per_g2),
             "acceleration_network": None if self.acceleration_network is None else self.acceleration_network.to_dict(),
         }
@@ -260,7 +286,9 @@ class AxisCalibration:
             hysteresis=None if d["hysteresis"] is None else memory_curve_from_dict(d["hysteresis"]),
             g_sensitivity_dps_per_g=_floats(d["g_sensitivity_dps_per_g"], 3, "g_sensitivity_dps_per_g"),
             g_squared_dps_per_g2=_floats(d["g_squared_dps_per_g2"], 6, "g_squared_dps_per_g2"),
-            acceleration_network=None if d["acceleration_network"] is None else NetworkCurve.from_dict(d["acceleration_network"]),
+            acceleration_network=None
+            if d["acceleration_network"] is None
+            else NetworkCurve.from_dict(d["acceleration_network"]),
             unit=unit,
         )
 
@@ -286,15 +314,26 @@ class AxisSummary:
             words += f", {ax.hysteresis.describe()}"
         if ax.has_acceleration_stage:
             words += ", g-sensitivity"
-        return cls(name, ax.unit, words, None if curve is None else (curve.t_min_degc, curve.t_max_degc),
-                   ax.lag_time_constant_s, ax.g_sensitivity_dps_per_g, tuple(ax.turn_on_biases))
+        return cls(
+            name,
+            ax.unit,
+            words,
+            None if curve is None else (curve.t_min_degc, curve.t_max_degc),
+            ax.lag_time_constant_s,
+            ax.g_sensitivity_dps_per_g,
+            tuple(ax.turn_on_biases),
+        )
 
     def to_dict(self) -> dict:
-        return {"axis": self.axis, "unit": self.unit, "model": self.model,
-                "range_degc": None if self.range_degc is None else list(self.range_degc),
-                "lag_time_constant_s": self.lag_time_constant_s,
-                "g_row": None if self.g_row is None else list(self.g_row),
-                "turn_on_biases": list(self.turn_on_biases)}
+        return {
+            "axis": self.axis,
+            "unit": self.unit,
+            "model": self.model,
+            "range_degc": None if self.range_degc is None else list(self.range_degc),
+            "lag_time_constant_s": self.lag_time_constant_s,
+            "g_row": None if self.g_row is None else list(self.g_row),
+            "turn_on_biases": list(self.turn_on_biases),
+        }
 
 
 @dataclass(frozen=True)
@@ -339,7 +378,6 @@ class Calibration:
     #: accelerometer's temperature models
     accel_triad: TriadCalibration | None = None
 
-
     def __post_init__(self) -> None:
         for section, unit, axes in (("axes", "deg/s", self.axes), ("accel_axes", "g", self.accel_axes)):
             for name, ax in axes.items():
@@ -379,7 +417,9 @@ class Calibration:
             changes["lag_time_constant_s"] = 0.0
         axes = {name: dataclasses.replace(ax, **changes) for name, ax in self.axes.items()}
         triad = None if "scale-factor" in parts else self.gyro_triad
-        return dataclasses.replace(self, axes=axes, gyro_triad=triad, model=f"{self.model} without {', '.join(parts)}" if parts else self.model)
+        return dataclasses.replace(
+            self, axes=axes, gyro_triad=triad, model=f"{self.model} without {', '.join(parts)}" if parts else self.model
+        )
 
     def without_accel_triad(self) -> "Calibration":
         """The same calibration without the accelerometer's bias, scale and misalignment (its temperature models
@@ -429,8 +469,11 @@ class Calibration:
         """
         if path is None or not Path(path).is_file():
             return False
-        named = [entry for entry in self.provenance.get("inputs", ())
-                 if isinstance(entry, dict) and entry.get("file") == Path(path).name and entry.get("sha256")]
+        named = [
+            entry
+            for entry in self.provenance.get("inputs", ())
+            if isinstance(entry, dict) and entry.get("file") == Path(path).name and entry.get("sha256")
+        ]
         return bool(named) and file_sha256(path) in {entry["sha256"] for entry in named}
 
     def save(self, path: str | os.PathLike) -> None:
@@ -455,7 +498,7 @@ class Calibration:
             Where it came from (a file name), for messages.
         """
         if not isinstance(d, dict) or d.get("format") != FORMAT_NAME:
-            raise InputError(f"{source}: not a gyrocomp model file (no \"format\": \"{FORMAT_NAME}\")")
+            raise InputError(f'{source}: not a gyrocomp model file (no "format": "{FORMAT_NAME}")')
         version = d.get("schema_version")
         if not isinstance(version, int) or isinstance(version, bool) or version < 1:
             raise InputError(f"{source}: schema_version {version!r} is not a positive whole number")
@@ -472,10 +515,13 @@ class Calibration:
             validate_model(d)  # the published schema: every field typed, bounded, known (schema.py)
             _check_ranges(d)
             axes = {str(name): AxisCalibration.from_dict(ax) for name, ax in d["axes"].items()}
-            accel_axes = {str(name): AxisCalibration.from_dict(_in_g(ax, False), unit="g")
-                          for name, ax in d["accel_axes"].items()}
-            triads = {key: None if d[key] is None else TriadCalibration.from_dict(d[key], key)
-                      for key in ("gyro_triad", "accel_triad")}
+            accel_axes = {
+                str(name): AxisCalibration.from_dict(_in_g(ax, False), unit="g") for name, ax in d["accel_axes"].items()
+            }
+            triads = {
+                key: None if d[key] is None else TriadCalibration.from_dict(d[key], key)
+                for key in ("gyro_triad", "accel_triad")
+            }
             _check_triads(triads, axes)
             if not axes and not accel_axes and triads["accel_triad"] is None:
                 raise InputError("no axes")
@@ -487,10 +533,16 @@ class Calibration:
                 FitReport.from_dict(report)
             except (KeyError, TypeError, ValueError, AttributeError, IndexError) as exc:
                 raise InputError(f"fit_report: malformed ({type(exc).__name__}: {exc})") from None
-            return cls(axes=axes, model=str(d["model"]), provenance=dict(d.get("provenance", {})),
-                       fit_report=report, schema_version=SCHEMA_VERSION,
-                       accel_axes=accel_axes, accel_reference_degc=None if reference is None else float(reference),
-                       **triads)
+            return cls(
+                axes=axes,
+                model=str(d["model"]),
+                provenance=dict(d.get("provenance", {})),
+                fit_report=report,
+                schema_version=SCHEMA_VERSION,
+                accel_axes=accel_axes,
+                accel_reference_degc=None if reference is None else float(reference),
+                **triads,
+            )
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
@@ -520,9 +572,16 @@ class Calibration:
         except (UnicodeDecodeError, IsADirectoryError):
             raise InputError(f"{path}: not a gyrocomp model file (not UTF-8 JSON text)") from None
         except OSError as exc:  # permissions, a symbolic link loop, a device that fails
-            raise InputError(f"{path}: cannot read the model file ({(exc.strerror or type(exc).__name__).lower()})") from None
-        data = jsontext.loads(text, str(path), "model file",
-                              "the file may be truncated, write it again with gyrocomp fit", non_finite=True)
+            raise InputError(
+                f"{path}: cannot read the model file ({(exc.strerror or type(exc).__name__).lower()})"
+            ) from None
+        data = jsontext.loads(
+            text,
+            str(path),
+            "model file",
+            "the file may be truncated, write it again with gyrocomp fit",
+            non_finite=True,
+        )
         return cls.from_dict(data, source=str(path))
 
 

@@ -40,11 +40,20 @@ class Compensator:
     reads the compensated ones.
     """
 
-    def __init__(self, calibration: Calibration, gyro_axes: tuple[str, ...], *,
-                 turn_on_window_s: float | None = None, rate_hz: float | None = None, source: str = "<stream>"):
+    def __init__(
+        self,
+        calibration: Calibration,
+        gyro_axes: tuple[str, ...],
+        *,
+        turn_on_window_s: float | None = None,
+        rate_hz: float | None = None,
+        source: str = "<stream>",
+    ):
         if not isinstance(calibration, Calibration):
-            raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
-                             f"got {type(calibration).__name__}")
+            raise InputError(
+                f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+                f"got {type(calibration).__name__}"
+            )
         if turn_on_window_s is not None and not turn_on_window_s > 0:
             raise InputError(f"turn_on_window_s: must be a positive number of seconds, got {turn_on_window_s}")
         self.calibration = calibration
@@ -55,15 +64,19 @@ class Compensator:
         # each accelerometer axis with its error at the reference temperature, which the correction keeps; an axis
         # the fit left without a temperature model (none beat its constant) is not corrected
         reference = np.array([calibration.accel_reference_degc])
-        self._accel_modelled = [(j, a, ax, float(np.asarray(ax.temperature.shape(reference), dtype=float)[0]))
-                                for j, a in enumerate(ACCEL_AXES)
-                                if (ax := calibration.accel_axes.get(a)) is not None and ax.temperature is not None]
+        self._accel_modelled = [
+            (j, a, ax, float(np.asarray(ax.temperature.shape(reference), dtype=float)[0]))
+            for j, a in enumerate(ACCEL_AXES)
+            if (ax := calibration.accel_axes.get(a)) is not None and ax.temperature is not None
+        ]
         self._triad_columns = None
         if calibration.gyro_triad is not None:
             missing = [a for a in GYRO_AXES if a not in self.gyro_axes]
             if missing:
-                raise InputError(f"{source}: the model corrects scale factor and misalignment across gyro_x, gyro_y "
-                                 f"and gyro_z; the data has no {', '.join(missing)}")
+                raise InputError(
+                    f"{source}: the model corrects scale factor and misalignment across gyro_x, gyro_y "
+                    f"and gyro_z; the data has no {', '.join(missing)}"
+                )
             self._triad_columns = [self.gyro_axes.index(a) for a in GYRO_AXES]
         if not self._modelled and not self._accel_modelled and calibration.accel_triad is None:
             raise InputError(
@@ -85,7 +98,7 @@ class Compensator:
         if turn_on_window_s is None:
             self._constants = np.array([ax.mean_turn_on_bias_dps for _, ax in self._modelled])
         self._last_time_s: float | None = None
-        self._pending: list[np.ndarray] = []   # residuals (gyro - shape) held during the turn-on window
+        self._pending: list[np.ndarray] = []  # residuals (gyro - shape) held during the turn-on window
         self._pending_time: list[np.ndarray] = []
         self._pending_temp: list[np.ndarray | None] = []
         # the block means of each modelled axis's output and of the error the model predicts for it
@@ -96,12 +109,18 @@ class Compensator:
         """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""
         if ax.lag_time_constant_s <= 0:
             return temperature_degc
-        lagged, self._lag_states[key] = thermal_lag(time_s, temperature_degc, ax.lag_time_constant_s,
-                                                    period_s=1.0 / self.rate_hz, state=self._lag_states.get(key))
+        lagged, self._lag_states[key] = thermal_lag(
+            time_s,
+            temperature_degc,
+            ax.lag_time_constant_s,
+            period_s=1.0 / self.rate_hz,
+            state=self._lag_states.get(key),
+        )
         return lagged
 
-    def _temperature_error(self, key: str, ax, time_s: np.ndarray, t: np.ndarray,
-                           accel_g: np.ndarray | None) -> np.ndarray:
+    def _temperature_error(
+        self, key: str, ax, time_s: np.ndarray, t: np.ndarray, accel_g: np.ndarray | None
+    ) -> np.ndarray:
         """The axis's temperature-driven error (shape and hysteresis) [deg/s, or g for an accelerometer]."""
         t_model = self._model_temperature(key, ax, time_s, t)
         if not self._warned and ax.temperature.outside_range(t_model):
@@ -110,33 +129,36 @@ class Compensator:
                 f"{self.source}: temperature{lagged} outside the model's range "
                 f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
                 f"the model is {ax.temperature.beyond_range} there",
-                TemperatureRangeWarning, stacklevel=4,
+                TemperatureRangeWarning,
+                stacklevel=4,
             )
             self._warned = True
-        error = np.asarray(ax.temperature.shape(t_model, accel_g if ax.temperature.needs_accel else None),
-                           dtype=float)
+        error = np.asarray(ax.temperature.shape(t_model, accel_g if ax.temperature.needs_accel else None), dtype=float)
         if ax.hysteresis is not None:
             turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states.get(key))
             self._turn_states[key] = turns.state
             error = error + ax.hysteresis.offset(t_model, turns)
         return error
 
-    def _compensate_accel(self, time_s: np.ndarray, temperature_degc: np.ndarray | None,
-                          accel_g: np.ndarray | None) -> np.ndarray | None:
+    def _compensate_accel(
+        self, time_s: np.ndarray, temperature_degc: np.ndarray | None, accel_g: np.ndarray | None
+    ) -> np.ndarray | None:
         """Accelerometer axes with their temperature error removed, relative to the model's reference [g]."""
         if not self._accel_modelled or accel_g is None or time_s.size == 0:
             return accel_g
         if temperature_degc is None:
-            raise InputError(f"{self.source}: the model compensates the accelerometer for temperature; "
-                             "the data has no temperature")
+            raise InputError(
+                f"{self.source}: the model compensates the accelerometer for temperature; the data has no temperature"
+            )
         t = temperature_degc if temperature_degc.ndim == 1 else temperature_degc.mean(axis=1)
         out = np.array(accel_g, dtype=float, copy=True)
         for j, name, ax, at_reference in self._accel_modelled:
             out[:, j] -= self._temperature_error(name, ax, time_s, t, None) - at_reference
         return out
 
-    def _accel_output(self, time_s: np.ndarray, temperature_degc: np.ndarray | None,
-                      accel_g: np.ndarray | None) -> np.ndarray | None:
+    def _accel_output(
+        self, time_s: np.ndarray, temperature_degc: np.ndarray | None, accel_g: np.ndarray | None
+    ) -> np.ndarray | None:
         """The accelerations the gyro's g-sensitivity reads (temperature-compensated, as it was fitted), and the
         accelerometer output queued for :meth:`take_accel` (also bias, scale and misalignment corrected)."""
         accel_g = self._compensate_accel(time_s, temperature_degc, accel_g)
@@ -170,15 +192,22 @@ class Compensator:
         self._accel_out = []
         return rows
 
-    def _residual(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None,
-                  accel_g: np.ndarray | None = None) -> np.ndarray:
+    def _residual(
+        self,
+        time_s: np.ndarray,
+        gyro_dps: np.ndarray,
+        temperature_degc: np.ndarray | None,
+        accel_g: np.ndarray | None = None,
+    ) -> np.ndarray:
         out = np.array(gyro_dps, dtype=float, copy=True)
         accel_g = self._accel_output(time_s, temperature_degc, accel_g)
         for j, ax in self._modelled:
             if ax.needs_accel and time_s.size:
                 if accel_g is None:
-                    raise InputError(f"{self.source}: the model has g-sensitivity; the data needs accel_x, accel_y "
-                                     "and accel_z columns [g] (map them with columns=)")
+                    raise InputError(
+                        f"{self.source}: the model has g-sensitivity; the data needs accel_x, accel_y "
+                        "and accel_z columns [g] (map them with columns=)"
+                    )
                 if ax.g_sensitivity_dps_per_g is not None or ax.g_squared_dps_per_g2 is not None:
                     g = np.zeros(3) if ax.g_sensitivity_dps_per_g is None else np.asarray(ax.g_sensitivity_dps_per_g)
                     q = None if ax.g_squared_dps_per_g2 is None else np.asarray(ax.g_squared_dps_per_g2)[None, :]
@@ -201,12 +230,16 @@ class Compensator:
         shared = ax.temperature_column == TEMPERATURE_COLUMN
         if temperature_degc.ndim == 1:
             if not shared:
-                raise InputError(f"{self.source}: the model of {axis} reads {ax.temperature_column!r} (one temperature "
-                                 "per axis); the data has one temperature column (map its columns with columns=)")
+                raise InputError(
+                    f"{self.source}: the model of {axis} reads {ax.temperature_column!r} (one temperature "
+                    "per axis); the data has one temperature column (map its columns with columns=)"
+                )
             return temperature_degc
         if shared:
-            raise InputError(f"{self.source}: the model of {axis} reads one temperature column ('temperature'); the "
-                             "data has one per axis (map the one to read with columns={'temperature': 'NAME'})")
+            raise InputError(
+                f"{self.source}: the model of {axis} reads one temperature column ('temperature'); the "
+                "data has one per axis (map the one to read with columns={'temperature': 'NAME'})"
+            )
         return temperature_degc[:, j]
 
     def _subtract_constants(self, residual: np.ndarray, temperature_degc: np.ndarray | None) -> np.ndarray:
@@ -219,8 +252,13 @@ class Compensator:
             residual[:, cols] = triad.correct(residual[:, cols], self._triad_temperature(triad, temperature_degc))
         return residual
 
-    def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, temperature_degc: np.ndarray | None = None,
-               accel_g: np.ndarray | None = None) -> np.ndarray:
+    def update(
+        self,
+        time_s: np.ndarray,
+        gyro_dps: np.ndarray,
+        temperature_degc: np.ndarray | None = None,
+        accel_g: np.ndarray | None = None,
+    ) -> np.ndarray:
         """Compensate one chunk: time [s] (m,), gyro [deg/s] (m, k), temperature [degC] (m,) or (m, k),
         specific force [g] (m, 3) on accel_x, accel_y, accel_z (needed by a model with g-sensitivity).
 
@@ -232,7 +270,9 @@ class Compensator:
         if self._modelled:
             columns = [j for j, _ in self._modelled]
             output = gyro_dps[:, columns]
-            temp = np.full(time_s.size, np.nan) if temperature_degc is None else np.asarray(temperature_degc, dtype=float)
+            temp = (
+                np.full(time_s.size, np.nan) if temperature_degc is None else np.asarray(temperature_degc, dtype=float)
+            )
             if temp.ndim == 2:  # one temperature per axis: their mean tells the direction of change as well
                 temp = temp.mean(axis=1)
             self._agreement_blocks.add(time_s, [output, output - residual[:, columns], temp])
@@ -253,8 +293,10 @@ class Compensator:
         prediction that does not vary): the slope is 1 when the model describes the data."""
         means = self._agreement_blocks.means()
         k = len(self._modelled)
-        return {self.gyro_axes[j]: scale_agreement(means[:, i], means[:, k + i], means[:, 2 * k])
-                for i, (j, _) in enumerate(self._modelled)}
+        return {
+            self.gyro_axes[j]: scale_agreement(means[:, i], means[:, k + i], means[:, 2 * k])
+            for i, (j, _) in enumerate(self._modelled)
+        }
 
     def _checked(self, time_s, gyro_dps, temperature_degc, accel_g):
         """The chunk as float arrays of the documented shapes, its time increasing from the previous chunk's and
@@ -271,24 +313,31 @@ class Compensator:
                 want = shapes[name]
                 if name == "temperature_degc":
                     if value.shape not in ((n,), (n, k)) and not (value.ndim == 2 and value.shape[0] == n):
-                        raise InputError(f"temperature_degc: shape {value.shape}; give ({n},) or ({n}, {k}) for "
-                                         f"{n} time stamps")
+                        raise InputError(
+                            f"temperature_degc: shape {value.shape}; give ({n},) or ({n}, {k}) for {n} time stamps"
+                        )
                 elif value.size != n * want[1]:
                     raise InputError(f"{name}: shape {value.shape}; give {want} for {n} time stamps")
                 arrays[name] = value.reshape(want) if want else value
         except (TypeError, ValueError) as exc:
             raise InputError(f"{self.source}: a chunk that is not numbers ({exc})") from None
         if n and self._last_time_s is not None and time_s[0] <= self._last_time_s:
-            raise InputError(f"{self.source}: time_s goes back from {self._last_time_s:.9g} s to {time_s[0]:.9g} s "
-                             "between chunks; give the chunks in time order")
+            raise InputError(
+                f"{self.source}: time_s goes back from {self._last_time_s:.9g} s to {time_s[0]:.9g} s "
+                "between chunks; give the chunks in time order"
+            )
         if n > 1 and np.any(np.diff(time_s) <= 0):
-            raise InputError(f"{self.source}: time_s does not increase within the chunk "
-                             f"(row {int(np.argmax(np.diff(time_s) <= 0)) + 1})")
+            raise InputError(
+                f"{self.source}: time_s does not increase within the chunk "
+                f"(row {int(np.argmax(np.diff(time_s) <= 0)) + 1})"
+            )
         temp = arrays["temperature_degc"]
         if temp is not None and temp.size and not np.all(np.isfinite(temp)):
             row = int(np.argmax(~np.isfinite(temp.reshape(n, -1)).any(axis=1)))
-            raise InputError(f"{self.source}: temperature_degc is not finite at row {row} of this chunk; the "
-                             "compensation would be NaN (drop such rows or fill them before compensating)")
+            raise InputError(
+                f"{self.source}: temperature_degc is not finite at row {row} of this chunk; the "
+                "compensation would be NaN (drop such rows or fill them before compensating)"
+            )
         if n:
             self._last_time_s = float(time_s[-1])
         return time_s, arrays["gyro_dps"], temp, arrays["accel_g"]
@@ -298,9 +347,9 @@ class Compensator:
         time_s = np.concatenate(self._pending_time)
         temps = None if any(t is None for t in self._pending_temp) else np.concatenate(self._pending_temp)
         self._pending, self._pending_time, self._pending_temp = [], [], []
-        self._constants = np.array([
-            estimate_turn_on_bias(residual[:, j], time_s, self.turn_on_window_s) for j, _ in self._modelled
-        ])
+        self._constants = np.array(
+            [estimate_turn_on_bias(residual[:, j], time_s, self.turn_on_window_s) for j, _ in self._modelled]
+        )
         return self._subtract_constants(residual, temps)
 
     def finish(self) -> np.ndarray:
@@ -311,13 +360,19 @@ class Compensator:
         warnings.warn(
             f"{self.source}: the data lasts {held_s:.3g} s, shorter than the turn-on window of "
             f"{self.turn_on_window_s:g} s; the constant was estimated from all of it",
-            UserWarning, stacklevel=2,
+            UserWarning,
+            stacklevel=2,
         )
         return self._release()
 
 
-def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: float | None = None,
-          axes: tuple[str, ...] | None = None) -> Recording:
+def apply(
+    calibration: Calibration,
+    recording: Recording,
+    *,
+    turn_on_window_s: float | None = None,
+    axes: tuple[str, ...] | None = None,
+) -> Recording:
     """Compensate a whole recording; the result has the same rows, axes and other channels.
 
     The gyro axes the model covers are compensated [deg/s] (with a gyro triad, scale factor and misalignment
@@ -339,10 +394,14 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
         with a warning saying which.
     """
     if not isinstance(recording, Recording):
-        raise InputError(f"recording: expected a Recording (from gyrocomp.read or simulate), got {type(recording).__name__}")
+        raise InputError(
+            f"recording: expected a Recording (from gyrocomp.read or simulate), got {type(recording).__name__}"
+        )
     if not isinstance(calibration, Calibration):
-        raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
-                         f"got {type(calibration).__name__}")
+        raise InputError(
+            f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+            f"got {type(calibration).__name__}"
+        )
     comp = compensator_for(calibration, recording, axes=axes, turn_on_window_s=turn_on_window_s)
     accel, temperature = accel_xyz(recording), recording.temperature_degc
     parts = []
@@ -350,9 +409,14 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     # arrays a few MiB (a day at 100 Hz in one chunk allocates, and page-faults, several of 200 MiB)
     for start in range(0, recording.n_samples, CHUNK_ROWS):
         rows = slice(start, start + CHUNK_ROWS)
-        parts.append(comp.update(recording.time_s[rows], recording.gyro_dps[rows],
-                                 None if temperature is None else temperature[rows],
-                                 None if accel is None else accel[rows]))
+        parts.append(
+            comp.update(
+                recording.time_s[rows],
+                recording.gyro_dps[rows],
+                None if temperature is None else temperature[rows],
+                None if accel is None else accel[rows],
+            )
+        )
     parts.append(comp.finish())
     warn_disagreement(comp)
     result = recording.with_gyro(np.concatenate(parts))
@@ -362,19 +426,31 @@ def apply(calibration: Calibration, recording: Recording, *, turn_on_window_s: f
     return result
 
 
-def compensator_for(calibration: Calibration, recording: Recording, *, axes: tuple[str, ...] | None = None,
-                    turn_on_window_s: float | None = None) -> Compensator:
+def compensator_for(
+    calibration: Calibration,
+    recording: Recording,
+    *,
+    axes: tuple[str, ...] | None = None,
+    turn_on_window_s: float | None = None,
+) -> Compensator:
     """The :class:`Compensator` that :func:`apply` runs on ``recording`` (or on a file whose first chunk it is):
     the model limited to ``axes`` after checking the recording's axes against it, the recording's plausibility
     concerns warned about, the accelerometer's three axes required when the model compensates them."""
     calibration = _restricted(calibration, recording, axes)
     for concern in recording_concerns(recording):
         warnings.warn(concern.warning(), stacklevel=3)
-    comp = Compensator(calibration, recording.gyro_axes, turn_on_window_s=turn_on_window_s,
-                       rate_hz=recording.rate_hz, source=recording.source)
+    comp = Compensator(
+        calibration,
+        recording.gyro_axes,
+        turn_on_window_s=turn_on_window_s,
+        rate_hz=recording.rate_hz,
+        source=recording.source,
+    )
     if comp.compensates_accel and not set(ACCEL_AXES) <= set(recording.accel_axes):
-        raise InputError(f"{recording.source}: the model compensates the accelerometer; the data needs accel_x, "
-                         "accel_y and accel_z columns [g]")
+        raise InputError(
+            f"{recording.source}: the model compensates the accelerometer; the data needs accel_x, "
+            "accel_y and accel_z columns [g]"
+        )
     return comp
 
 
@@ -404,24 +480,33 @@ def _restricted(calibration: Calibration, recording: Recording, axes: tuple[str,
     if axes is None:
         missing = [a for a in recording.gyro_axes if a not in calibration.axes]
         if missing:
-            raise InputError(f"{recording.source}: the model has no curve for {', '.join(missing)} (it covers "
-                             f"{', '.join(calibration.axes)}); give axes= with the axes to compensate, the "
-                             "others are then left raw")
+            raise InputError(
+                f"{recording.source}: the model has no curve for {', '.join(missing)} (it covers "
+                f"{', '.join(calibration.axes)}); give axes= with the axes to compensate, the "
+                "others are then left raw"
+            )
         return calibration
     axes = tuple(axes)
     if calibration.gyro_triad is not None and set(axes) != set(GYRO_AXES):
-        raise InputError(f"axes: {', '.join(axes)}; the model's scale-factor and misalignment correction couples "
-                         "gyro_x, gyro_y and gyro_z, compensate all three (or use calibration.without('scale-factor'))")
+        raise InputError(
+            f"axes: {', '.join(axes)}; the model's scale-factor and misalignment correction couples "
+            "gyro_x, gyro_y and gyro_z, compensate all three (or use calibration.without('scale-factor'))"
+        )
     for axis in axes:
         where = [] if axis in calibration.axes else ["the model"]
         where += [] if axis in recording.gyro_axes else [recording.source]
         if where:
-            raise InputError(f"axes: {axis!r} is not in {' or '.join(where)} (the model covers "
-                             f"{', '.join(calibration.axes)}; the data has {', '.join(recording.gyro_axes)})")
+            raise InputError(
+                f"axes: {axis!r} is not in {' or '.join(where)} (the model covers "
+                f"{', '.join(calibration.axes)}; the data has {', '.join(recording.gyro_axes)})"
+            )
     raw = [a for a in recording.gyro_axes if a not in axes]
     if raw:
-        warnings.warn(f"{recording.source}: {', '.join(raw)} left raw (not among the axes to compensate)",
-                      DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{recording.source}: {', '.join(raw)} left raw (not among the axes to compensate)",
+            DataQualityWarning,
+            stacklevel=3,
+        )
     return dataclasses.replace(calibration, axes={a: calibration.axes[a] for a in axes})
 
 
@@ -431,8 +516,9 @@ def predict_error(calibration: Calibration, recording: Recording) -> np.ndarray:
     return recording.gyro_dps - apply(calibration, recording).gyro_dps
 
 
-def compensated_axes(calibration: Calibration, recording: Recording, axes: tuple[str, ...] | None,
-                     with_accel: bool) -> tuple[str, ...]:
+def compensated_axes(
+    calibration: Calibration, recording: Recording, axes: tuple[str, ...] | None, with_accel: bool
+) -> tuple[str, ...]:
     """The axes :func:`apply` compensates in ``recording``: the gyro axes the model covers (those of ``axes``
     when given), and the accelerometer's when ``with_accel``."""
     done = [a for a in recording.gyro_axes if a in calibration.axes and (axes is None or a in axes)]

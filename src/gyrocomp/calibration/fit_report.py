@@ -25,8 +25,18 @@ from ..units import AxisUnit, in_unit, unit_suffix
 
 #: the thermal memories a gyro axis's model may carry
 MEMORIES = ("none", "lag", "turning-point", "turning-point+lag", "branch", "branch+lag")
-_TYPED = ("temperature", "axes", "order_selection", "selection", "hysteresis", "network", "acceleration", "stages",
-          "accel", "pipeline")
+_TYPED = (
+    "temperature",
+    "axes",
+    "order_selection",
+    "selection",
+    "hysteresis",
+    "network",
+    "acceleration",
+    "stages",
+    "accel",
+    "pipeline",
+)
 
 
 def memory_name(lag: bool, hysteresis_order: int, branch: int = 0) -> str:
@@ -82,8 +92,13 @@ class Candidate:
     def complexity(self) -> int:
         """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band, the
         branch difference's terms and its crossover width."""
-        return (self.order + int(self.lag) + 2 * self.hysteresis_order + int(self.band)
-                + (self.branch + 1 if self.branch else 0))
+        return (
+            self.order
+            + int(self.lag)
+            + 2 * self.hysteresis_order
+            + int(self.band)
+            + (self.branch + 1 if self.branch else 0)
+        )
 
     @property
     def has_temperature_model(self) -> bool:
@@ -103,8 +118,14 @@ class Candidate:
         return " + ".join(parts) + f" ({self.weighting})"
 
     def to_dict(self) -> dict:
-        d = {"order": self.order, "lag": self.lag, "hysteresis_order": self.hysteresis_order,
-             "weighting": self.weighting, "band": self.band, "label": self.label}
+        d = {
+            "order": self.order,
+            "lag": self.lag,
+            "hysteresis_order": self.hysteresis_order,
+            "weighting": self.weighting,
+            "band": self.band,
+            "label": self.label,
+        }
         if self.branch:  # written only when set: files without it read as before
             d["branch"] = self.branch
         if self.curve != POLY_FAMILY:
@@ -114,9 +135,15 @@ class Candidate:
     @classmethod
     def from_dict(cls, d: dict) -> "Candidate":
         """A stored candidate (its ``label`` is derived from the fields)."""
-        return cls(int(d["order"]), bool(d.get("lag", False)), int(d.get("hysteresis_order", 0)),
-                   d.get("weighting", "time"), bool(d.get("band", False)), int(d.get("branch", 0)),
-                   str(d.get("curve", POLY_FAMILY)))
+        return cls(
+            int(d["order"]),
+            bool(d.get("lag", False)),
+            int(d.get("hysteresis_order", 0)),
+            d.get("weighting", "time"),
+            bool(d.get("band", False)),
+            int(d.get("branch", 0)),
+            str(d.get("curve", POLY_FAMILY)),
+        )
 
 
 def _entry_in_unit(d: dict, name: str, unit: str, default=None):
@@ -140,10 +167,13 @@ class CandidateResult:
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "CandidateResult":
-        return cls(Candidate.from_dict(d), _number(_entry_in_unit(d, "mean_drift", unit)),
-                   _number(_entry_in_unit(d, "standard_error", unit)),
-                   tuple(_number(v) for v in _entry_in_unit(d, "fold_drift", unit, ())),
-                   tuple(float(v) for v in d.get("fold_lag_s", ())))
+        return cls(
+            Candidate.from_dict(d),
+            _number(_entry_in_unit(d, "mean_drift", unit)),
+            _number(_entry_in_unit(d, "standard_error", unit)),
+            tuple(_number(v) for v in _entry_in_unit(d, "fold_drift", unit, ())),
+            tuple(float(v) for v in d.get("fold_lag_s", ())),
+        )
 
 
 @dataclass(frozen=True)
@@ -167,22 +197,35 @@ class BranchTest:
     drift_exponent: float = 1.0
 
     def to_dict(self) -> dict:
-        return {"order": self.order, "statistic": self.statistic, "threshold": self.threshold,
-                "width_degc": self.width_degc, "walk_per_sqrt_s": self.walk_per_sqrt_s,
-                "drift_exponent": self.drift_exponent}
+        return {
+            "order": self.order,
+            "statistic": self.statistic,
+            "threshold": self.threshold,
+            "width_degc": self.width_degc,
+            "walk_per_sqrt_s": self.walk_per_sqrt_s,
+            "drift_exponent": self.drift_exponent,
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> "BranchTest":
-        return cls(int(d["order"]), float(d["statistic"]), float(d["threshold"]), float(d["width_degc"]),
-                   float(d["walk_per_sqrt_s"]), float(d.get("drift_exponent", 1.0)))
+        return cls(
+            int(d["order"]),
+            float(d["statistic"]),
+            float(d["threshold"]),
+            float(d["width_degc"]),
+            float(d["walk_per_sqrt_s"]),
+            float(d.get("drift_exponent", 1.0)),
+        )
 
     def sentence(self, axis: str) -> str:
         """One line for the user: what the test found and did."""
         found = "differ" if self.order else "do not differ"
         done = "branch terms added" if self.order else "no branch terms"
-        return (f"{axis}: one heating and one cooling leg cannot test a branch model on held-out legs; its heating "
-                f"and cooling curves {found} beyond the drift the data shows (Wald {self.statistic:.3g} against "
-                f"{self.threshold:.3g}): {done}")
+        return (
+            f"{axis}: one heating and one cooling leg cannot test a branch model on held-out legs; its heating "
+            f"and cooling curves {found} beyond the drift the data shows (Wald {self.statistic:.3g} against "
+            f"{self.threshold:.3g}): {done}"
+        )
 
 
 @dataclass(frozen=True)
@@ -201,13 +244,21 @@ class OrderTest:
     drift_exponents: tuple[float, ...]
 
     def to_dict(self) -> dict:
-        return {"order": self.order, "statistics": list(self.statistics), "threshold": self.threshold,
-                "drift_exponents": list(self.drift_exponents)}
+        return {
+            "order": self.order,
+            "statistics": list(self.statistics),
+            "threshold": self.threshold,
+            "drift_exponents": list(self.drift_exponents),
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> "OrderTest":
-        return cls(int(d["order"]), tuple(float(v) for v in d["statistics"]), float(d["threshold"]),
-                   tuple(float(v) for v in d["drift_exponents"]))
+        return cls(
+            int(d["order"]),
+            tuple(float(v) for v in d["statistics"]),
+            float(d["threshold"]),
+            tuple(float(v) for v in d["drift_exponents"]),
+        )
 
 
 @dataclass(frozen=True)
@@ -258,16 +309,28 @@ class SelectionReport:
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "SelectionReport":
         band = d.get("band_degc")
-        return cls(str(d["axis"]), str(d["fold_kind"]), tuple(d.get("folds", ())), float(d["window_s"]),
-                   float(d.get("temperature_step_degc", 0.0)), None if band is None else (float(band[0]), float(band[1])),
-                   Candidate.from_dict(d["best"]), Candidate.from_dict(d["chosen"]),
-                   _number(_entry_in_unit(d, "raw_drift", unit)), _number(_entry_in_unit(d, "chosen_drift", unit)),
-                   bool(d.get("validated", True)), bool(d.get("generalizes", True)),
-                   tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())), unit,
-                   _number(_entry_in_unit(d, "chosen_standard_error", unit)), str(d.get("fold_note", "")),
-                   BranchTest.from_dict(d["branch_test"]) if d.get("branch_test") else None,
-                   bool(d.get("lag_from_unit", False)), str(d.get("decided_by", "")),
-                   OrderTest.from_dict(d["order_test"]) if d.get("order_test") else None)
+        return cls(
+            str(d["axis"]),
+            str(d["fold_kind"]),
+            tuple(d.get("folds", ())),
+            float(d["window_s"]),
+            float(d.get("temperature_step_degc", 0.0)),
+            None if band is None else (float(band[0]), float(band[1])),
+            Candidate.from_dict(d["best"]),
+            Candidate.from_dict(d["chosen"]),
+            _number(_entry_in_unit(d, "raw_drift", unit)),
+            _number(_entry_in_unit(d, "chosen_drift", unit)),
+            bool(d.get("validated", True)),
+            bool(d.get("generalizes", True)),
+            tuple(CandidateResult.from_dict(c, unit) for c in d.get("candidates", ())),
+            unit,
+            _number(_entry_in_unit(d, "chosen_standard_error", unit)),
+            str(d.get("fold_note", "")),
+            BranchTest.from_dict(d["branch_test"]) if d.get("branch_test") else None,
+            bool(d.get("lag_from_unit", False)),
+            str(d.get("decided_by", "")),
+            OrderTest.from_dict(d["order_test"]) if d.get("order_test") else None,
+        )
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
@@ -296,8 +359,13 @@ class MemoryChoice:
     def to_dict(self, by_bic: bool = False, unit: AxisUnit = "deg/s") -> dict:
         """As the model file stores it (``scores_bic`` when the scores are BIC, else ``scores_dps`` or
         ``scores_g`` by the axis's ``unit``)."""
-        out = {"chosen": self.label, "memory": self.memory, "hysteresis_order": self.hysteresis_order,
-               "lag_time_constant_s": self.lag_time_constant_s, "order": self.order}
+        out = {
+            "chosen": self.label,
+            "memory": self.memory,
+            "hysteresis_order": self.hysteresis_order,
+            "lag_time_constant_s": self.lag_time_constant_s,
+            "order": self.order,
+        }
         if self.weighting is not None:
             out["weighting"] = self.weighting
         if self.order_scores:
@@ -313,10 +381,15 @@ class MemoryChoice:
             match = _CHOSEN.match(str(d.get("chosen", "none")))
             memory, order = (match["memory"], int(match["order"] or 0)) if match else (str(d.get("chosen")), 0)
         scores = _entry_in_unit(d, "scores", unit, d.get("scores_bic", {})) or {}
-        return cls(memory, order, float(d.get("lag_time_constant_s", 0.0)),
-                   None if d.get("order") is None else int(d["order"]), d.get("weighting"),
-                   {str(k): _number(v) for k, v in scores.items()},
-                   {int(o): float(v) for o, v in (d.get("order_scores") or {}).items()})
+        return cls(
+            memory,
+            order,
+            float(d.get("lag_time_constant_s", 0.0)),
+            None if d.get("order") is None else int(d["order"]),
+            d.get("weighting"),
+            {str(k): _number(v) for k, v in scores.items()},
+            {int(o): float(v) for o, v in (d.get("order_scores") or {}).items()},
+        )
 
 
 @dataclass(frozen=True)
@@ -348,8 +421,12 @@ class HysteresisReport:
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "HysteresisReport":
-        return cls(str(d.get("mode", "auto")), str(d.get("selection", "none")),
-                   {str(a): MemoryChoice.from_dict(v, unit) for a, v in (d.get("axes") or {}).items()}, unit)
+        return cls(
+            str(d.get("mode", "auto")),
+            str(d.get("selection", "none")),
+            {str(a): MemoryChoice.from_dict(v, unit) for a, v in (d.get("axes") or {}).items()},
+            unit,
+        )
 
 
 @dataclass(frozen=True)
@@ -381,17 +458,28 @@ class NetworkReport:
     def to_dict(self) -> dict:
         """As the model file stores it (``validation_rmse_dps`` or ``validation_rmse_g``)."""
         name = "validation_rmse" + unit_suffix(self.unit)
-        return {"hidden": list(self.hidden), "restarts": self.restarts, "seed": self.seed, "training": self.training,
-                "axes": {a: {name: list(self.validation_rmse[a]), "epochs": self.epochs.get(a)}
-                         for a in self.validation_rmse}}
+        return {
+            "hidden": list(self.hidden),
+            "restarts": self.restarts,
+            "seed": self.seed,
+            "training": self.training,
+            "axes": {
+                a: {name: list(self.validation_rmse[a]), "epochs": self.epochs.get(a)} for a in self.validation_rmse
+            },
+        }
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "NetworkReport":
         axes = d.get("axes", {})
-        return cls(tuple(int(h) for h in d["hidden"]), int(d.get("restarts", 1)), int(d.get("seed", 0)),
-                   str(d.get("training", "")),
-                   {a: tuple(float(v) for v in _entry_in_unit(i, "validation_rmse", unit, ())) for a, i in axes.items()},
-                   {a: i.get("epochs") for a, i in axes.items()}, unit)
+        return cls(
+            tuple(int(h) for h in d["hidden"]),
+            int(d.get("restarts", 1)),
+            int(d.get("seed", 0)),
+            str(d.get("training", "")),
+            {a: tuple(float(v) for v in _entry_in_unit(i, "validation_rmse", unit, ())) for a, i in axes.items()},
+            {a: i.get("epochs") for a, i in axes.items()},
+            unit,
+        )
 
 
 @dataclass(frozen=True)
@@ -405,8 +493,10 @@ class GSensitivityRow:
     g_squared_standard_error_dps_per_g2: tuple[float | None, ...] | None = None
 
     def to_dict(self) -> dict:
-        out = {"g_sensitivity_dps_per_g": list(self.g_sensitivity_dps_per_g),
-               "standard_error_dps_per_g": list(self.standard_error_dps_per_g)}
+        out = {
+            "g_sensitivity_dps_per_g": list(self.g_sensitivity_dps_per_g),
+            "standard_error_dps_per_g": list(self.standard_error_dps_per_g),
+        }
         if self.g_squared_dps_per_g2 is not None:
             out["g_squared_dps_per_g2"] = list(self.g_squared_dps_per_g2)
             out["g_squared_standard_error_dps_per_g2"] = list(self.g_squared_standard_error_dps_per_g2 or ())
@@ -416,10 +506,12 @@ class GSensitivityRow:
     def from_dict(cls, d: dict) -> "GSensitivityRow":
         squared = d.get("g_squared_dps_per_g2")
         errors = d.get("g_squared_standard_error_dps_per_g2")
-        return cls(tuple(float(v) for v in d["g_sensitivity_dps_per_g"]),
-                   tuple(_number(v) for v in d.get("standard_error_dps_per_g", (None,) * 3)),
-                   None if squared is None else tuple(_number(v) for v in squared),
-                   None if errors is None else tuple(_number(v) for v in errors))
+        return cls(
+            tuple(float(v) for v in d["g_sensitivity_dps_per_g"]),
+            tuple(_number(v) for v in d.get("standard_error_dps_per_g", (None,) * 3)),
+            None if squared is None else tuple(_number(v) for v in squared),
+            None if errors is None else tuple(_number(v) for v in errors),
+        )
 
 
 @dataclass(frozen=True)
@@ -451,11 +543,18 @@ class GSensitivityReport:
 
     @classmethod
     def from_dict(cls, d: dict) -> "GSensitivityReport":
-        return cls(str(d.get("mode", "none")), d.get("why"), tuple(int(s) for s in d.get("static_segments", ())),
-                   tuple(d.get("excited_axes", ())),
-                   {a: GSensitivityRow.from_dict(i) for a, i in (d.get("axes") or {}).items()
-                    if "g_sensitivity_dps_per_g" in i},
-                   None if d.get("hidden") is None else tuple(int(h) for h in d["hidden"]))
+        return cls(
+            str(d.get("mode", "none")),
+            d.get("why"),
+            tuple(int(s) for s in d.get("static_segments", ())),
+            tuple(d.get("excited_axes", ())),
+            {
+                a: GSensitivityRow.from_dict(i)
+                for a, i in (d.get("axes") or {}).items()
+                if "g_sensitivity_dps_per_g" in i
+            },
+            None if d.get("hidden") is None else tuple(int(h) for h in d["hidden"]),
+        )
 
 
 @dataclass(frozen=True)
@@ -483,9 +582,14 @@ class AxisFit:
 
     @classmethod
     def from_dict(cls, d: dict, unit: AxisUnit = "deg/s") -> "AxisFit":
-        return cls(d.get("order"), _number(d.get("t_min_degc")), _number(d.get("t_max_degc")),
-                   _number(_entry_in_unit(d, "fit_rms", unit)), unit,
-                   {int(p): float(v) for p, v in (d.get("scores") or {}).items()})
+        return cls(
+            d.get("order"),
+            _number(d.get("t_min_degc")),
+            _number(d.get("t_max_degc")),
+            _number(_entry_in_unit(d, "fit_rms", unit)),
+            unit,
+            {int(p): float(v) for p, v in (d.get("scores") or {}).items()},
+        )
 
 
 #: fewer held-out folds than this: the evidence for a model choice (and for the drift it expects) is thin
@@ -515,9 +619,17 @@ class ExpectedDrift:
 
     def to_dict(self) -> dict:
         u = unit_suffix(self.unit)
-        return {"axis": self.axis, "model": self.model, f"drift{u}": self.drift,
-                f"standard_error{u}": self.standard_error, f"constant_drift{u}": self.constant_drift,
-                "window_s": self.window_s, "fold_kind": self.fold_kind, "folds": self.folds, "thin": self.thin}
+        return {
+            "axis": self.axis,
+            "model": self.model,
+            f"drift{u}": self.drift,
+            f"standard_error{u}": self.standard_error,
+            f"constant_drift{u}": self.constant_drift,
+            "window_s": self.window_s,
+            "fold_kind": self.fold_kind,
+            "folds": self.folds,
+            "thin": self.thin,
+        }
 
 
 @dataclass(frozen=True)
@@ -573,12 +685,15 @@ class FitReport:
         d = d or {}
         axes = {a: AxisFit.from_dict(i, unit) for a, i in (d.get("axes") or {}).items()}
         scores = {a: fit.scores for a, fit in axes.items() if fit.scores}
-        order_selection = (OrderSelection(str(d.get("order_selection", "")), scores)
-                           if scores and "network" not in d else None)
+        order_selection = (
+            OrderSelection(str(d.get("order_selection", "")), scores) if scores and "network" not in d else None
+        )
         hysteresis = d.get("hysteresis")
         acceleration = d.get("acceleration")
         return cls(
-            method=d.get("temperature"), axes=axes, order_selection=order_selection,
+            method=d.get("temperature"),
+            axes=axes,
+            order_selection=order_selection,
             selection={a: SelectionReport.from_dict(s, unit) for a, s in (d.get("selection") or {}).items()},
             hysteresis=HysteresisReport.from_dict(hysteresis, unit) if isinstance(hysteresis, dict) else None,
             network=NetworkReport.from_dict(d["network"], unit) if d.get("network") else None,
@@ -586,7 +701,8 @@ class FitReport:
             pipeline=d.get("pipeline"),
             stages=tuple(cls.from_dict(s, unit) for s in d.get("stages") or ()),
             accel=cls.from_dict(d["accel"], "g") if isinstance(d.get("accel"), dict) else None,
-            sections={k: v for k, v in d.items() if k not in _TYPED})
+            sections={k: v for k, v in d.items() if k not in _TYPED},
+        )
 
     def expected_drift(self) -> dict[str, ExpectedDrift]:
         """Per axis chosen by held-out drift, the drift to expect on unseen data of the same kind (empty when the
@@ -595,11 +711,38 @@ class FitReport:
         for axis, sel in self.selection.items():
             if sel.chosen_drift is None:
                 continue
-            out[axis] = ExpectedDrift(axis, sel.chosen.label, sel.chosen_drift, sel.chosen_standard_error,
-                                      sel.raw_drift, sel.unit, sel.window_s, sel.fold_kind, len(sel.folds))
+            out[axis] = ExpectedDrift(
+                axis,
+                sel.chosen.label,
+                sel.chosen_drift,
+                sel.chosen_standard_error,
+                sel.raw_drift,
+                sel.unit,
+                sel.window_s,
+                sel.fold_kind,
+                len(sel.folds),
+            )
         return out
 
 
-__all__ = ["AxisFit", "BranchTest", "Candidate", "CandidateResult", "ExpectedDrift", "FitReport", "GSensitivityReport", "GSensitivityRow",
-           "HysteresisReport", "MEMORIES", "MemoryChoice", "NetworkReport", "OrderSelection", "SelectionReport",
-           "OrderTest", "THIN_FOLDS", "Weighting", "memory_label", "memory_name"]
+__all__ = [
+    "AxisFit",
+    "BranchTest",
+    "Candidate",
+    "CandidateResult",
+    "ExpectedDrift",
+    "FitReport",
+    "GSensitivityReport",
+    "GSensitivityRow",
+    "HysteresisReport",
+    "MEMORIES",
+    "MemoryChoice",
+    "NetworkReport",
+    "OrderSelection",
+    "SelectionReport",
+    "OrderTest",
+    "THIN_FOLDS",
+    "Weighting",
+    "memory_label",
+    "memory_name",
+]

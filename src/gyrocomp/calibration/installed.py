@@ -42,8 +42,10 @@ RAD_TO_DEG = 180.0 / math.pi
 Autopilot = Literal["px4", "ardupilot"]
 #: what each firmware uses for a thermal-calibration parameter it was not given (PX4 ``temp_comp_params_gyro``,
 #: ArduPilot ``AP_InertialSensor_TCal::var_info``) [degC]
-FIRMWARE_DEFAULTS: dict[str, dict[str, float]] = {"px4": {"TMIN": 0.0, "TMAX": 100.0, "TREF": 25.0},
-                                                  "ardupilot": {"TMIN": 0.0, "TMAX": 70.0}}
+FIRMWARE_DEFAULTS: dict[str, dict[str, float]] = {
+    "px4": {"TMIN": 0.0, "TMAX": 100.0, "TREF": 25.0},
+    "ardupilot": {"TMIN": 0.0, "TMAX": 70.0},
+}
 #: the gyro slots PX4's temperature compensation holds (``TC_G0`` to ``TC_G3``)
 PX4_GYRO_SLOTS = 4
 #: PX4's TemperatureCompensationModule: poll period [s] and the temperature change that republishes [degC]
@@ -121,8 +123,9 @@ def px4_as_run(params: dict, time_s: np.ndarray, temperature_degc: np.ndarray, i
     return np.concatenate([np.zeros((index[0], 3)), held]) if index[0] else held
 
 
-def ardupilot_gyro_correction_dps(params: dict, temperature_degc: np.ndarray, cal_temp_degc: float,
-                                  instance: int = 1) -> np.ndarray:
+def ardupilot_gyro_correction_dps(
+    params: dict, temperature_degc: np.ndarray, cal_temp_degc: float, instance: int = 1
+) -> np.ndarray:
     """(n, 3) what ArduPilot subtracts from gyro x, y, z [deg/s] at ``temperature_degc`` [degC], its gyro offsets
     taken at ``cal_temp_degc`` [degC], from the ``INS_TCAL{instance}_*`` parameters (``TCal::correct_sensor``).
 
@@ -194,8 +197,9 @@ def ardupilot_cal_temp_degc(params: dict, instance: int = 1) -> float:
     return float(params.get("INS_GYR_CALTEMP" if instance == 1 else f"INS_GYR{instance}_CALTEMP", -300.0))
 
 
-def installed_correction_dps(params: dict, autopilot: Autopilot, time_s: np.ndarray, temperature_degc: np.ndarray,
-                             instance: int) -> np.ndarray:
+def installed_correction_dps(
+    params: dict, autopilot: Autopilot, time_s: np.ndarray, temperature_degc: np.ndarray, instance: int
+) -> np.ndarray:
     """(n, 3) what the firmware subtracts from gyro x, y, z [deg/s] at each sample as it runs: PX4's slot
     ``TC_G{instance}`` with its 1 Hz / 1 degC republish (:func:`px4_as_run`), ArduPilot's ``INS_TCAL{instance}``
     relative to its gyro calibration temperature (:func:`ardupilot_cal_temp_degc`).
@@ -215,8 +219,9 @@ def installed_correction_dps(params: dict, autopilot: Autopilot, time_s: np.ndar
     if autopilot == "px4":
         return px4_as_run(params, time_s, temperature_degc, instance)
     if autopilot == "ardupilot":
-        return ardupilot_gyro_correction_dps(params, temperature_degc, ardupilot_cal_temp_degc(params, instance),
-                                             instance)
+        return ardupilot_gyro_correction_dps(
+            params, temperature_degc, ardupilot_cal_temp_degc(params, instance), instance
+        )
     raise InputError(f"autopilot: {autopilot!r}; use px4 or ardupilot")
 
 
@@ -247,15 +252,17 @@ def installed_calibration(parameters: dict[str, float], autopilot: str, instance
         coefficients = [[parameters.get(f"{p}X{k}_{j}", 0.0) for k in range(4)] for j in range(3)]
         scales = [parameters.get(f"{p}SCL_{j}", 1.0) for j in range(3)]
         if any(abs(sc - 1.0) > 1e-6 for sc in scales):
-            warnings.warn(f"{p}SCL_*: scale factors {scales} are not modelled; the offsets are", DataQualityWarning,
-                          stacklevel=2)
+            warnings.warn(
+                f"{p}SCL_*: scale factors {scales} are not modelled; the offsets are", DataQualityWarning, stacklevel=2
+            )
     elif autopilot == "ardupilot":
         p = f"INS_TCAL{instance + 1}_"
         if int(parameters.get(f"{p}ENABLE", 0)) != 1:
             return None
         reference = ARDUPILOT_TEMP_REFERENCE_DEGC
-        coefficients = [[0.0, *(parameters.get(f"{p}GYR{k}_{a}", 0.0) / ARDUPILOT_SCALE for k in (1, 2, 3))]
-                        for a in "XYZ"]
+        coefficients = [
+            [0.0, *(parameters.get(f"{p}GYR{k}_{a}", 0.0) / ARDUPILOT_SCALE for k in (1, 2, 3))] for a in "XYZ"
+        ]
     else:
         raise InputError(f"autopilot: {autopilot!r}; use px4 or ardupilot")
     defaults = FIRMWARE_DEFAULTS[autopilot]
@@ -267,11 +274,30 @@ def installed_calibration(parameters: dict[str, float], autopilot: str, instance
         c = [v / DEG_TO_RAD for v in coefficients[j]]  # rad/s -> deg/s
         curve = PolynomialCurve((c[1], c[2], c[3]), reference, 1.0, t_min, t_max)
         axes[name] = AxisCalibration(curve, (c[0],))
-    return Calibration(axes=axes, model=f"installed {autopilot} cubic ({p}*)",
-                       provenance={"source": f"{autopilot} parameters {p}*"}, fit_report={"temperature": "installed"})
+    return Calibration(
+        axes=axes,
+        model=f"installed {autopilot} cubic ({p}*)",
+        provenance={"source": f"{autopilot} parameters {p}*"},
+        fit_report={"temperature": "installed"},
+    )
 
 
-__all__ = ["ARDUPILOT_SCALE", "ARDUPILOT_TEMP_REFERENCE_DEGC", "AXIS_INDEX", "Autopilot", "DEG_TO_RAD",
-           "FIRMWARE_DEFAULTS", "PX4_GYRO_SLOTS", "PX4_POLL_S", "PX4_REPUBLISH_DEGC", "RAD_TO_DEG",
-           "ardupilot_cal_temp_degc", "ardupilot_gyro_correction_dps", "installed_calibration",
-           "installed_correction_dps", "px4_as_run", "px4_gyro_correction_dps", "px4_slot"]
+__all__ = [
+    "ARDUPILOT_SCALE",
+    "ARDUPILOT_TEMP_REFERENCE_DEGC",
+    "AXIS_INDEX",
+    "Autopilot",
+    "DEG_TO_RAD",
+    "FIRMWARE_DEFAULTS",
+    "PX4_GYRO_SLOTS",
+    "PX4_POLL_S",
+    "PX4_REPUBLISH_DEGC",
+    "RAD_TO_DEG",
+    "ardupilot_cal_temp_degc",
+    "ardupilot_gyro_correction_dps",
+    "installed_calibration",
+    "installed_correction_dps",
+    "px4_as_run",
+    "px4_gyro_correction_dps",
+    "px4_slot",
+]

@@ -64,8 +64,12 @@ def _array(item: dict, n: int | None = None, lo: int = 0, hi: int | None = None)
 
 
 def _object(properties: dict, required: list[str] | None = None) -> dict:
-    return {"type": "object", "properties": properties, "required": list(properties) if required is None else required,
-            "additionalProperties": False}
+    return {
+        "type": "object",
+        "properties": properties,
+        "required": list(properties) if required is None else required,
+        "additionalProperties": False,
+    }
 
 
 def _nullable(schema: dict) -> dict:
@@ -78,27 +82,54 @@ def _curves(u: str, value: dict) -> dict:
     temperature = {"$ref": "#/$defs/temperature_degc"}
     scale = _number(0.01, 1000.0)
     return {
-        "polynomial": _object({"type": {"const": "polynomial"}, f"coefficients{u}": _array(value, hi=MAX_COEFFICIENTS),
-                               "t_ref_degc": temperature, "t_scale_degc": scale, "t_min_degc": temperature,
-                               "t_max_degc": temperature, "extrapolation": {"enum": list(EXTRAPOLATIONS)}},
-                              ["type", f"coefficients{u}", "t_ref_degc", "t_scale_degc", "t_min_degc", "t_max_degc"]),
-        "mlp": _object({"type": {"const": "mlp"},
-                        "hidden": _array({"type": "integer", "minimum": 1, "maximum": MAX_HIDDEN}, lo=1,
-                                         hi=MAX_LAYERS),
-                        "activation": {"const": "tanh"}, "output": {"const": "linear"},
-                        "inputs": {**_array({"enum": list(NETWORK_INPUTS)}, lo=1, hi=len(NETWORK_INPUTS)),
-                                   "uniqueItems": True},
-                        "input_min": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
-                        "input_max": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
-                        "reference": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
-                        "weights": _array(_array(_number(-WEIGHT, WEIGHT), lo=1, hi=10000), lo=2,
-                                          hi=MAX_LAYERS + 1),
-                        f"output_mean{u}": value, f"output_scale{u}": {**value, "exclusiveMinimum": 0},
-                        "t_ref_degc": temperature, "t_min_degc": temperature, "t_max_degc": temperature},
-                       ["type", "hidden", "weights", f"output_mean{u}", f"output_scale{u}", "t_ref_degc",
-                        "t_min_degc", "t_max_degc"]),
-        "table": _object({"type": {"const": "table"}, f"values{u}": _array(value, lo=2, hi=MAX_TABLE),
-                          "t_min_degc": temperature, "t_max_degc": temperature}),
+        "polynomial": _object(
+            {
+                "type": {"const": "polynomial"},
+                f"coefficients{u}": _array(value, hi=MAX_COEFFICIENTS),
+                "t_ref_degc": temperature,
+                "t_scale_degc": scale,
+                "t_min_degc": temperature,
+                "t_max_degc": temperature,
+                "extrapolation": {"enum": list(EXTRAPOLATIONS)},
+            },
+            ["type", f"coefficients{u}", "t_ref_degc", "t_scale_degc", "t_min_degc", "t_max_degc"],
+        ),
+        "mlp": _object(
+            {
+                "type": {"const": "mlp"},
+                "hidden": _array({"type": "integer", "minimum": 1, "maximum": MAX_HIDDEN}, lo=1, hi=MAX_LAYERS),
+                "activation": {"const": "tanh"},
+                "output": {"const": "linear"},
+                "inputs": {**_array({"enum": list(NETWORK_INPUTS)}, lo=1, hi=len(NETWORK_INPUTS)), "uniqueItems": True},
+                "input_min": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
+                "input_max": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
+                "reference": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
+                "weights": _array(_array(_number(-WEIGHT, WEIGHT), lo=1, hi=10000), lo=2, hi=MAX_LAYERS + 1),
+                f"output_mean{u}": value,
+                f"output_scale{u}": {**value, "exclusiveMinimum": 0},
+                "t_ref_degc": temperature,
+                "t_min_degc": temperature,
+                "t_max_degc": temperature,
+            },
+            [
+                "type",
+                "hidden",
+                "weights",
+                f"output_mean{u}",
+                f"output_scale{u}",
+                "t_ref_degc",
+                "t_min_degc",
+                "t_max_degc",
+            ],
+        ),
+        "table": _object(
+            {
+                "type": {"const": "table"},
+                f"values{u}": _array(value, lo=2, hi=MAX_TABLE),
+                "t_min_degc": temperature,
+                "t_max_degc": temperature,
+            }
+        ),
     }
 
 
@@ -106,55 +137,90 @@ def _memory(u: str, value: dict) -> dict:
     temperature = {"$ref": "#/$defs/temperature_degc"}
     threshold = _number(0.0, 100.0)
     return {
-        "turning-point": _object({"type": {"const": "turning-point"},
-                                  f"descending{u}": _array(value, hi=MAX_COEFFICIENTS),
-                                  f"ascending{u}": _array(value, hi=MAX_COEFFICIENTS), "threshold_degc": threshold,
-                                  "band_degc": _nullable(_array(temperature, 2)),
-                                  "max_distance_degc": _nullable(_array(_number(0.0, 300.0), 2))},
-                                 ["type", f"descending{u}", f"ascending{u}", "threshold_degc", "band_degc"]),
-        "branch": _object({"type": {"const": "branch"}, f"coefficients{u}": _array(value, lo=1, hi=MAX_COEFFICIENTS),
-                           "t_ref_degc": temperature, "t_scale_degc": _number(0.01, 1000.0),
-                           "transition_degc": _number(0.0, 1000.0, exclusive_lo=True), "threshold_degc": threshold,
-                           "t_min_degc": temperature, "t_max_degc": temperature}),
+        "turning-point": _object(
+            {
+                "type": {"const": "turning-point"},
+                f"descending{u}": _array(value, hi=MAX_COEFFICIENTS),
+                f"ascending{u}": _array(value, hi=MAX_COEFFICIENTS),
+                "threshold_degc": threshold,
+                "band_degc": _nullable(_array(temperature, 2)),
+                "max_distance_degc": _nullable(_array(_number(0.0, 300.0), 2)),
+            },
+            ["type", f"descending{u}", f"ascending{u}", "threshold_degc", "band_degc"],
+        ),
+        "branch": _object(
+            {
+                "type": {"const": "branch"},
+                f"coefficients{u}": _array(value, lo=1, hi=MAX_COEFFICIENTS),
+                "t_ref_degc": temperature,
+                "t_scale_degc": _number(0.01, 1000.0),
+                "transition_degc": _number(0.0, 1000.0, exclusive_lo=True),
+                "threshold_degc": threshold,
+                "t_min_degc": temperature,
+                "t_max_degc": temperature,
+            }
+        ),
     }
 
 
 def _by_type(defs: dict[str, dict], prefix: str, what: str) -> dict:
     """One of ``defs`` chosen by the object's ``type`` (so that an error is about that kind's fields, not a list
     of every kind that did not match); another type is left to the registry's reader (``what`` names the kind)."""
-    return {"type": "object", "required": ["type"],
-            "properties": {"type": {"type": "string", "description": f"the {what}'s kind"}},
-            "allOf": [{"if": {"properties": {"type": {"const": kind}}},
-                       "then": {"$ref": f"#/$defs/{prefix}{kind}"}} for kind in defs]}
+    return {
+        "type": "object",
+        "required": ["type"],
+        "properties": {"type": {"type": "string", "description": f"the {what}'s kind"}},
+        "allOf": [
+            {"if": {"properties": {"type": {"const": kind}}}, "then": {"$ref": f"#/$defs/{prefix}{kind}"}}
+            for kind in defs
+        ],
+    }
 
 
 def _axis(u: str, value: dict, per_g: bool) -> dict:
     """An axis of unit suffix ``u`` (``_dps`` for a gyro axis, ``_g`` for an accelerometer axis)."""
     sensitivity = _number(-1e3, 1e3)
-    return _object({
-        "temperature": _nullable({"$ref": f"#/$defs/curve{u}"}),
-        f"turn_on_biases{u}": _array(value, lo=0 if per_g else 1, hi=10000),
-        "temperature_column": {"enum": list(TEMPERATURE_CHANNELS)},
-        "lag_time_constant_s": _number(0.0, LAG_S),
-        "hysteresis": _nullable({"$ref": f"#/$defs/memory{u}"}),
-        "g_sensitivity_dps_per_g": _nullable(_array(sensitivity, 3)),
-        "g_squared_dps_per_g2": _nullable(_array(sensitivity, 6)),
-        "acceleration_network": _nullable({"$ref": f"#/$defs/curve{u}_mlp"}),
-    }, ["temperature", f"turn_on_biases{u}", "lag_time_constant_s", "hysteresis", "g_sensitivity_dps_per_g",
-        "g_squared_dps_per_g2", "acceleration_network"])
+    return _object(
+        {
+            "temperature": _nullable({"$ref": f"#/$defs/curve{u}"}),
+            f"turn_on_biases{u}": _array(value, lo=0 if per_g else 1, hi=10000),
+            "temperature_column": {"enum": list(TEMPERATURE_CHANNELS)},
+            "lag_time_constant_s": _number(0.0, LAG_S),
+            "hysteresis": _nullable({"$ref": f"#/$defs/memory{u}"}),
+            "g_sensitivity_dps_per_g": _nullable(_array(sensitivity, 3)),
+            "g_squared_dps_per_g2": _nullable(_array(sensitivity, 6)),
+            "acceleration_network": _nullable({"$ref": f"#/$defs/curve{u}_mlp"}),
+        },
+        [
+            "temperature",
+            f"turn_on_biases{u}",
+            "lag_time_constant_s",
+            "hysteresis",
+            "g_sensitivity_dps_per_g",
+            "g_squared_dps_per_g2",
+            "acceleration_network",
+        ],
+    )
 
 
 def _triad(u: str, unit: str, value: dict) -> dict:
     matrix = _array(_array(_number(-10.0, 10.0), 3), 3)
     error = _array(_array(_number(0.0, 10.0), 3), 3)
     per_degc = _array(_array(_number(-1.0, 1.0), 3), 3)
-    return _object({"method": {"enum": list(TRIAD_METHODS)}, "unit": {"const": unit}, "sensitivity": matrix,
-                    "sensitivity_stderr": error, f"bias{u}": _array(value, 3),
-                    f"bias_stderr{u}": _array({**value, "minimum": 0}, 3),
-                    "reference_degc": _nullable({"$ref": "#/$defs/temperature_degc"}),
-                    "sensitivity_per_degc": _array(per_degc, hi=4),
-                    "sensitivity_per_degc_stderr": _array(_array(_array(_number(0.0, 1.0), 3), 3), hi=4)},
-                   ["method", "unit", "sensitivity", "sensitivity_stderr", f"bias{u}", f"bias_stderr{u}"])
+    return _object(
+        {
+            "method": {"enum": list(TRIAD_METHODS)},
+            "unit": {"const": unit},
+            "sensitivity": matrix,
+            "sensitivity_stderr": error,
+            f"bias{u}": _array(value, 3),
+            f"bias_stderr{u}": _array({**value, "minimum": 0}, 3),
+            "reference_degc": _nullable({"$ref": "#/$defs/temperature_degc"}),
+            "sensitivity_per_degc": _array(per_degc, hi=4),
+            "sensitivity_per_degc_stderr": _array(_array(_array(_number(0.0, 1.0), 3), 3), hi=4),
+        },
+        ["method", "unit", "sensitivity", "sensitivity_stderr", f"bias{u}", f"bias_stderr{u}"],
+    )
 
 
 def build_schema(version: int) -> dict:
@@ -168,28 +234,44 @@ def build_schema(version: int) -> dict:
         defs[f"curve{u}"] = _by_type(curves, f"curve{u}_", "temperature curve")
         defs[f"memory{u}"] = _by_type(memories, f"memory{u}_", "thermal memory")
     return {
-        "$schema": "https://json-schema.org/draft/2020-12/schema", "$id": SCHEMA_ID,
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": SCHEMA_ID,
         "title": f"gyrocomp model file, schema {version}",
         "description": "A calibration gyrocomp fitted: per gyro (and accelerometer) axis its temperature curve, "
-                       "turn-on constants, thermal lag and memory, g-sensitivity; the triads' scale factor and "
-                       "misalignment; how it was fitted and from what. Units: deg/s, g, degC, s.",
+        "turn-on constants, thermal lag and memory, g-sensitivity; the triads' scale factor and "
+        "misalignment; how it was fitted and from what. Units: deg/s, g, degC, s.",
         "type": "object",
         "properties": {
-            "format": {"const": "gyrocomp-calibration"}, "schema_version": {"type": "integer", "minimum": 1},
+            "format": {"const": "gyrocomp-calibration"},
+            "schema_version": {"type": "integer", "minimum": 1},
             "model": {"type": "string", "maxLength": 1000},
             "units": _object({name: {"const": unit} for name, unit in UNITS.items()}),
-            "axes": {"type": "object", "propertyNames": {"enum": list(GYRO_AXES)},
-                     "additionalProperties": _axis("_dps", rate, False)},
-            "accel_axes": {"type": "object", "propertyNames": {"enum": list(ACCEL_AXES)},
-                           "additionalProperties": _axis("_g", accel, True)},
+            "axes": {
+                "type": "object",
+                "propertyNames": {"enum": list(GYRO_AXES)},
+                "additionalProperties": _axis("_dps", rate, False),
+            },
+            "accel_axes": {
+                "type": "object",
+                "propertyNames": {"enum": list(ACCEL_AXES)},
+                "additionalProperties": _axis("_g", accel, True),
+            },
             "accel_reference_degc": _nullable({"$ref": "#/$defs/temperature_degc"}),
             "gyro_triad": _nullable(_triad("_dps", "deg/s", rate)),
             "accel_triad": _nullable(_triad("_g", "g", accel)),
             "fit_report": {"type": "object"},
             "provenance": {"type": "object"},
         },
-        "required": ["format", "schema_version", "model", "axes", "accel_axes", "accel_reference_degc",
-                     "gyro_triad", "accel_triad"],
+        "required": [
+            "format",
+            "schema_version",
+            "model",
+            "axes",
+            "accel_axes",
+            "accel_reference_degc",
+            "gyro_triad",
+            "accel_triad",
+        ],
         "additionalProperties": False,
         "$defs": defs,
     }

@@ -114,7 +114,7 @@ class TriadCalibration:
         d = np.asarray(temperature_degc, dtype=float) - float(self.reference_degc)
         out = np.broadcast_to(k0, d.shape + (3, 3)).copy()
         for p, coef in enumerate(self.sensitivity_per_degc, start=1):
-            out = out + np.multiply.outer(d ** p, np.asarray(coef, dtype=float))
+            out = out + np.multiply.outer(d**p, np.asarray(coef, dtype=float))
         return out
 
     def correct(self, raw: np.ndarray, temperature_degc: np.ndarray | None = None) -> np.ndarray:
@@ -146,8 +146,14 @@ class TriadCalibration:
         """K = I and no bias (zero standard errors): a triad that passes the data through as given, e.g. to measure
         raw data with the tools that take a calibration (``rotation_errors``)."""
         zeros = ((0.0, 0.0, 0.0),) * 3
-        return cls(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0),
-                   "norm" if unit == "g" else "rotation", zeros, (0.0, 0.0, 0.0), unit)
+        return cls(
+            ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+            (0.0, 0.0, 0.0),
+            "norm" if unit == "g" else "rotation",
+            zeros,
+            (0.0, 0.0, 0.0),
+            unit,
+        )
 
     # -- serialization ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -189,10 +195,12 @@ class TriadCalibration:
                 bias_stderr=tuple(_vector(d[f"bias_stderr{suffix}"], f"{where}.bias_stderr{suffix}")),
                 unit=unit,
                 reference_degc=None if reference is None else float(reference),
-                sensitivity_per_degc=tuple(rows_of(_matrix(m, f"{where}.sensitivity_per_degc[{p}]"))
-                                           for p, m in enumerate(per_degc)),
-                sensitivity_per_degc_stderr=tuple(rows_of(_matrix(m, f"{where}.sensitivity_per_degc_stderr[{p}]"))
-                                                  for p, m in enumerate(per_degc_se)),
+                sensitivity_per_degc=tuple(
+                    rows_of(_matrix(m, f"{where}.sensitivity_per_degc[{p}]")) for p, m in enumerate(per_degc)
+                ),
+                sensitivity_per_degc_stderr=tuple(
+                    rows_of(_matrix(m, f"{where}.sensitivity_per_degc_stderr[{p}]")) for p, m in enumerate(per_degc_se)
+                ),
             )
         except InputError as exc:
             message = str(exc)

@@ -2,10 +2,6 @@
 
 from __future__ import annotations
 
-from .entry_point import (
-    cli, COMMANDS, in_cli_words, LazyGroup, main
-)
+from .entry_point import cli, COMMANDS, in_cli_words, LazyGroup, main
 
-__all__ = [
-    "COMMANDS", "LazyGroup", "cli", "in_cli_words", "main"
-]
+__all__ = ["COMMANDS", "LazyGroup", "cli", "in_cli_words", "main"]

@@ -24,8 +24,9 @@ def _parse_taus(text: str):
     except ValueError:
         values = []
     if not values or min(values) <= 0:
-        raise click.BadParameter("use octave, decade, all or a comma-separated list of taus [s], e.g. 1,10,100",
-                                 param_hint="--taus")
+        raise click.BadParameter(
+            "use octave, decade, all or a comma-separated list of taus [s], e.g. 1,10,100", param_hint="--taus"
+        )
     return values
 
 
@@ -43,20 +44,32 @@ def _parse_fit_taus(text: str | None):
 
 @click.command()
 @click.argument("input_path", metavar="FILE", type=click.Path())
-@click.option("--axes", "axes", default=None, help="Columns to analyse, e.g. gyro_x,gyro_z,accel_z (default: every gyro axis).")
-@click.option("--kind", type=click.Choice(KINDS), default="oadev", show_default=True, help="Estimator of the printed curve.")
+@click.option(
+    "--axes", "axes", default=None, help="Columns to analyse, e.g. gyro_x,gyro_z,accel_z (default: every gyro axis)."
+)
+@click.option(
+    "--kind", type=click.Choice(KINDS), default="oadev", show_default=True, help="Estimator of the printed curve."
+)
 @click.option("--taus", default="octave", show_default=True, help="octave, decade, all, or taus [s] such as 1,10,100.")
 @click.option("--json", "as_json", is_flag=True, help="Print curves and noise terms as JSON on stdout.")
 @click.option("--plot", "plot_path", type=OUTPUT_FILE, help="Write the Allan plot here (.png, .svg, .pdf).")
 @click.option("--kalibr", "kalibr", type=OUTPUT_FILE, help="Write Kalibr's imu.yaml here.")
 @click.option("--rostopic", default="/imu0", show_default=True, help="rostopic written into the Kalibr file.")
-@click.option("--split-gaps/--no-split-gaps", default=False, help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
-@click.option("--fit-taus", "fit_taus_s", default=None, metavar="MIN,MAX",
-              help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.")
+@click.option(
+    "--split-gaps/--no-split-gaps",
+    default=False,
+    help="Pool the contiguous stretches of a log with time gaps instead of refusing it.",
+)
+@click.option(
+    "--fit-taus",
+    "fit_taus_s",
+    default=None,
+    metavar="MIN,MAX",
+    help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.",
+)
 @read_options
 @click.pass_context
-def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopic, split_gaps, fit_taus_s,
-          **kwargs):
+def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopic, split_gaps, fit_taus_s, **kwargs):
     """Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of FILE."""
     opts = pop_read_options(kwargs)
     tau_spec = _parse_taus(taus)
@@ -68,9 +81,18 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopi
         check_figure_path(plot_path)
     named = [a.strip() for a in axes.split(",") if a.strip()] if axes else None
     with progress_bar(f"reading {Path(input_path).name}") as progress:
-        analysis = analyse_noise_file(input_path, named, options=read_settings(opts), fmt=opts["fmt"],
-                                      with_accel=bool(kalibr), kind=kind, taus=tau_spec, split_gaps=split_gaps,
-                                      fit_taus_s=fit_range, progress=progress)
+        analysis = analyse_noise_file(
+            input_path,
+            named,
+            options=read_settings(opts),
+            fmt=opts["fmt"],
+            with_accel=bool(kalibr),
+            kind=kind,
+            taus=tau_spec,
+            split_gaps=split_gaps,
+            fit_taus_s=fit_range,
+            progress=progress,
+        )
     if analysis.how and not ctx.obj["quiet"]:
         click.echo(f"gyrocomp: note: {analysis.how}", err=True)
     if kalibr:

@@ -11,7 +11,14 @@ from ..fitting.thermal import HYSTERESIS_CHOICES
 from ..io.inputs import expand_runs
 from ..models.options import FitOptions
 from .entry_point import in_cli_words
-from .common import accept_option, parse_temperature_option, pop_read_options, read_options, read_settings, temperature_help
+from .common import (
+    accept_option,
+    parse_temperature_option,
+    pop_read_options,
+    read_options,
+    read_settings,
+    temperature_help,
+)
 
 #: the exit status when a run is refused (0: every run may be fitted; 2 stays bad input)
 REFUSED_EXIT = 1
@@ -19,10 +26,19 @@ REFUSED_EXIT = 1
 
 @click.command()
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
-@click.option("--temperature", default="auto", show_default=True, help="The fit's temperature curve, as fit takes it: "
-              + temperature_help())
-@click.option("--hysteresis", type=click.Choice(HYSTERESIS_CHOICES), default="auto", show_default=True,
-              help="The fit's hysteresis, as fit takes it (turning-point: the runs must heat and cool).")
+@click.option(
+    "--temperature",
+    default="auto",
+    show_default=True,
+    help="The fit's temperature curve, as fit takes it: " + temperature_help(),
+)
+@click.option(
+    "--hysteresis",
+    type=click.Choice(HYSTERESIS_CHOICES),
+    default="auto",
+    show_default=True,
+    help="The fit's hysteresis, as fit takes it (turning-point: the runs must heat and cool).",
+)
 @accept_option
 @click.option("--json", "as_json", is_flag=True, help="Print every finding as JSON.")
 @read_options

@@ -60,18 +60,28 @@ def click_option(name: str, spelling: Spelling, default=None):
     and shown in the help, any other default (None, an empty mapping) applies when the option is not given."""
     if spelling.switch:
         # with its off form: a project file that switches it on is undone on the command line
-        return click.option(f"{spelling.flag}/--no-{spelling.flag[2:]}", name, default=False, help=spelling.help,
-                            cls=ReadingOption)
+        return click.option(
+            f"{spelling.flag}/--no-{spelling.flag[2:]}", name, default=False, help=spelling.help, cls=ReadingOption
+        )
     shown = isinstance(default, str)
-    return click.option(spelling.flag, name, default=default if shown else None, show_default=shown,
-                        metavar=spelling.metavar, help=spelling.help,
-                        callback=_parsed(spelling.parse) if spelling.parse else None, cls=ReadingOption)
+    return click.option(
+        spelling.flag,
+        name,
+        default=default if shown else None,
+        show_default=shown,
+        metavar=spelling.metavar,
+        help=spelling.help,
+        callback=_parsed(spelling.parse) if spelling.parse else None,
+        cls=ReadingOption,
+    )
 
 
 #: the reading options of every command that reads data: the input's format, then the fields of ReadOptions
 #: (and of its TableLayout), each defined once, where the library defines it, with its default
-READ_FIELDS = (("fmt", format_spelling(), None),
-               *((field.name, spelling, field.default) for field, spelling in spelled_fields(ReadOptions)))
+READ_FIELDS = (
+    ("fmt", format_spelling(), None),
+    *((field.name, spelling, field.default) for field, spelling in spelled_fields(ReadOptions)),
+)
 READ_OPTIONS = tuple(name for name, _, _ in READ_FIELDS)
 
 
@@ -91,8 +101,14 @@ def progress_bar(description: str, indeterminate: bool = False):
     if quiet or not sys.stderr.isatty():
         yield None
         return
-    with Progress(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(), TimeElapsedColumn(),
-                  console=Console(stderr=True), transient=True) as bar:
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TaskProgressColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    ) as bar:
         task = bar.add_task(description, total=None if indeterminate else 1.0)
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
@@ -145,17 +161,21 @@ def parse_temperature_option(text: str, seed: int = 0) -> Polynomial | Curve | N
             return Polynomial(int(size)) if family == POLY_FAMILY else Curve(family, int(size))
         except (ValueError, InputError):
             low, top = curve_size_range(family)
-            raise InputError(f"--temperature: {text!r}: the size of {family} must be a whole number from {low} to "
-                             f"{top}") from None
-    raise InputError(f"--temperature: {text!r}: use auto, {', '.join(f'{n}, {n}:N' for n in BASES)}, mlp, mlp:H "
-                     "or none")
+            raise InputError(
+                f"--temperature: {text!r}: the size of {family} must be a whole number from {low} to {top}"
+            ) from None
+    raise InputError(
+        f"--temperature: {text!r}: use auto, {', '.join(f'{n}, {n}:N' for n in BASES)}, mlp, mlp:H or none"
+    )
 
 
 def temperature_help() -> str:
     """``--temperature``'s help, its curve families read from the registry."""
-    return ("auto (the default: every polynomial order and each other curve family at its sizes, chosen by held-out "
-            f"drift); {family_help()}; mlp (the thesis's 1-3-1 network, Levenberg-Marquardt), mlp:H (H hidden "
-            "neurons); none.")
+    return (
+        "auto (the default: every polynomial order and each other curve family at its sizes, chosen by held-out "
+        f"drift); {family_help()}; mlp (the thesis's 1-3-1 network, Levenberg-Marquardt), mlp:H (H hidden "
+        "neurons); none."
+    )
 
 
 def parse_channels(text: str) -> tuple[str, ...]:
@@ -202,14 +222,34 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
-__all__ = ["FINITE", "FiniteFloat", "READ_OPTIONS", "make_console", "float_list", "parse_channels", "parse_hidden", "parse_temperature_option", "temperature_help", "pop_read_options", "progress_bar", "read_options", "read_run", "read_settings"]
+__all__ = [
+    "FINITE",
+    "FiniteFloat",
+    "READ_OPTIONS",
+    "make_console",
+    "float_list",
+    "parse_channels",
+    "parse_hidden",
+    "parse_temperature_option",
+    "temperature_help",
+    "pop_read_options",
+    "progress_bar",
+    "read_options",
+    "read_run",
+    "read_settings",
+]
 
 
 def accept_option(function):
     """``--accept CHECK`` (repeatable): a data check's finding accepted knowingly (check, fit, fleet fit)."""
-    return click.option("--accept", "accept", multiple=True, type=click.Choice(DATA_CHECKS), metavar="CHECK",
-                        help=f"Accept this data check's finding knowingly (repeatable): {', '.join(DATA_CHECKS)}.")(
-        function)
+    return click.option(
+        "--accept",
+        "accept",
+        multiple=True,
+        type=click.Choice(DATA_CHECKS),
+        metavar="CHECK",
+        help=f"Accept this data check's finding knowingly (repeatable): {', '.join(DATA_CHECKS)}.",
+    )(function)
 
 
 def instance_model_path(model, instance: int) -> Path:
@@ -217,4 +257,3 @@ def instance_model_path(model, instance: int) -> Path:
     ``m_imu0.json``, ``m_imu1.json``, ...; ``apply m.json --instance all`` reads them)."""
     model = Path(model)
     return model.parent / f"{model.stem}_imu{instance}{model.suffix}"
-

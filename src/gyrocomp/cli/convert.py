@@ -31,15 +31,22 @@ def convert(ctx, input_path, output, **kwargs):
     if in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag", ".mcap"):
         done = convert_bag(input_path, output)
         if not ctx.obj["quiet"]:
-            click.echo(f"wrote {output}: {KIND_WORDS[done.kind]}, every message of {input_path} "
-                       f"({KIND_WORDS[done.from_kind]})")
+            click.echo(
+                f"wrote {output}: {KIND_WORDS[done.kind]}, every message of {input_path} ({KIND_WORDS[done.from_kind]})"
+            )
         return
     out_fmt = output_format(output, option="OUT")
     with progress_bar(f"reading {Path(input_path).name}") as progress:
-        result = convert_file(input_path, output, options=read_settings(opts), fmt=opts["fmt"], out_fmt=out_fmt,
-                              progress=progress)
-    rows, duration_s, rate_hz, gaps, channels = (result.rows, result.duration_s, result.rate_hz, result.gaps,
-                                                 result.channels)
+        result = convert_file(
+            input_path, output, options=read_settings(opts), fmt=opts["fmt"], out_fmt=out_fmt, progress=progress
+        )
+    rows, duration_s, rate_hz, gaps, channels = (
+        result.rows,
+        result.duration_s,
+        result.rate_hz,
+        result.gaps,
+        result.channels,
+    )
     if not ctx.obj["quiet"]:
         said = f", {gaps} time gap(s)" if gaps else ""
         click.echo(f"wrote {output}: {rows} rows, {duration_s:.6g} s at {rate_hz:.6g} Hz{said}; {', '.join(channels)}")

@@ -12,8 +12,15 @@ from .render import print_evaluation, print_validation
 
 
 @click.command()
-@click.option("-o", "--output", "out_dir", default="gyrocomp-demo", show_default=True,
-              type=click.Path(file_okay=False), help="Folder for the demo's files.")
+@click.option(
+    "-o",
+    "--output",
+    "out_dir",
+    default="gyrocomp-demo",
+    show_default=True,
+    type=click.Path(file_okay=False),
+    help="Folder for the demo's files.",
+)
 @click.pass_context
 def demo(ctx, out_dir):
     """The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score it,

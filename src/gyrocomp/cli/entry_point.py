@@ -34,42 +34,90 @@ EXIT_FAILURE = 1
 #: every command: its name, its module in gyrocomp.cli (the command is the function of the same name there), and
 #: its one-line help (``gyrocomp --help`` shows it shortened to the terminal)
 COMMANDS = {
-    "simulate": ("simulate", 'Simulate calibration runs of a sensor preset through a test profile, with the exact truth.'),
-    "fit": ("fit", 'Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still '
-                   'moments of field logs.'),
-    "learn": ("learn", 'Learn a temperature model from the still moments of LOGS, as the online learner would on the '
-                       'vehicle: each log one power-on, replayed in the order given.'),
-    "apply": ("apply", 'Compensate IN with MODEL: same columns and rows out, gyro columns compensated (a ROS bag into a '
-                       'bag: every message copied, the IMU topic compensated).'),
-    "show": ("show", 'What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device '
-                "ids), and the drift its held-out folds expect."),
-    "split": ("split", "Cut LOG into runs, one file each, so that a recording of several "
-                       "power-ons, poses or temperature legs becomes the runs a fit takes."),
-    "convert": ("convert", 'Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT, or a bag '
-                           'as another bag.'),
-    "check": ("check", "Check RUNS before a fit, as fit and fleet fit do: one verdict line per run (ok, warning with "
-                       "its expected cost, or refused with the reason)."),
-    "validate": ("validate", "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
-                    'default and the best model a firmware carries.'),
-    "evaluate": ("evaluate", 'Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.'),
-    "allan": ("allan", 'Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of '
-                 'FILE.'),
-    "noise": ("noise", "Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov "
-                       "terms) whose Allan deviation is at or above the upper end of every log's 95 % interval at "
-                       "every averaging time, beside the IEEE 952 fit."),
-    "export": ("export", 'Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as '
-                  'C code.'),
-    "report": ("report", 'One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias '
-                  'against temperature, raw and compensated series, Allan deviations, g-sensitivity; with '
-                  '--validate-on, the held-out drift of each method on those calibration runs.'),
-    "plot": ("plot", 'Single figures as PNG, SVG or PDF (from the suffix of -o).'),
-    "fleet": ("fleet", 'Production calibration of many units: fit them on Dask into a calibration store, judge them '
-                  "against limits, look a unit's calibration up and export it."),
-    "init": ("project", "Write a project file for LOG's kind of table: its columns and units guessed from their "
-                        "names and magnitudes, said one by one, read by every command run in this folder."),
+    "simulate": (
+        "simulate",
+        "Simulate calibration runs of a sensor preset through a test profile, with the exact truth.",
+    ),
+    "fit": (
+        "fit",
+        "Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still "
+        "moments of field logs.",
+    ),
+    "learn": (
+        "learn",
+        "Learn a temperature model from the still moments of LOGS, as the online learner would on the "
+        "vehicle: each log one power-on, replayed in the order given.",
+    ),
+    "apply": (
+        "apply",
+        "Compensate IN with MODEL: same columns and rows out, gyro columns compensated (a ROS bag into a "
+        "bag: every message copied, the IMU topic compensated).",
+    ),
+    "show": (
+        "show",
+        "What MODEL is: its axes (curve, range, lag, memory, G), the runs it came from (with their device "
+        "ids), and the drift its held-out folds expect.",
+    ),
+    "split": (
+        "split",
+        "Cut LOG into runs, one file each, so that a recording of several "
+        "power-ons, poses or temperature legs becomes the runs a fit takes.",
+    ),
+    "convert": (
+        "convert",
+        "Write IN (any format gyrocomp reads) as the canonical CSV or Parquet table OUT, or a bag as another bag.",
+    ),
+    "check": (
+        "check",
+        "Check RUNS before a fit, as fit and fleet fit do: one verdict line per run (ok, warning with "
+        "its expected cost, or refused with the reason).",
+    ),
+    "validate": (
+        "validate",
+        "Held-out drift on RUNS of raw, PX4's cubic, ArduPilot's cubic, a plain cubic, gyrocomp's "
+        "default and the best model a firmware carries.",
+    ),
+    "evaluate": (
+        "evaluate",
+        "Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.",
+    ),
+    "allan": (
+        "allan",
+        "Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of FILE.",
+    ),
+    "noise": (
+        "noise",
+        "Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov "
+        "terms) whose Allan deviation is at or above the upper end of every log's 95 % interval at "
+        "every averaging time, beside the IEEE 952 fit.",
+    ),
+    "export": (
+        "export",
+        "Write MODEL as autopilot parameters (temperature cubic, accelerometer offsets and scales) or as C code.",
+    ),
+    "report": (
+        "report",
+        "One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias "
+        "against temperature, raw and compensated series, Allan deviations, g-sensitivity; with "
+        "--validate-on, the held-out drift of each method on those calibration runs.",
+    ),
+    "plot": ("plot", "Single figures as PNG, SVG or PDF (from the suffix of -o)."),
+    "fleet": (
+        "fleet",
+        "Production calibration of many units: fit them on Dask into a calibration store, judge them "
+        "against limits, look a unit's calibration up and export it.",
+    ),
+    "init": (
+        "project",
+        "Write a project file for LOG's kind of table: its columns and units guessed from their "
+        "names and magnitudes, said one by one, read by every command run in this folder.",
+    ),
     "config": ("project", "The project file in use (gyrocomp.toml in this folder, or --config)."),
-    "demo": ("demo", 'The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score '
-                'it, and write the HTML report.'),
+    "demo": (
+        "demo",
+        "The main job on built-in simulated data: fit on chamber runs, compensate a held-out run, score "
+        "it, and write the HTML report.",
+    ),
 }
 
 
@@ -109,18 +157,28 @@ class LazyGroup(click.Group):
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         limit = formatter.width - 6 - max(len(name) for name in COMMANDS)
         with formatter.section("Commands"):
-            formatter.write_dl([(name, short_help(text, limit))
-                                for name, (_, text) in sorted(COMMANDS.items())])
+            formatter.write_dl([(name, short_help(text, limit)) for name, (_, text) in sorted(COMMANDS.items())])
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="gyrocomp")
 @click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
 @click.option("--quiet", "-q", is_flag=True, help="Print only errors (no tables, no warnings).")
-@click.option("--allow", "allowed", multiple=True, type=click.Choice(CHECKS), metavar="CHECK",
-              help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.")
-@click.option("--config", "config", default=None, metavar="FILE",
-              help="Project file of default options (default: gyrocomp.toml in this folder, when there is one).")
+@click.option(
+    "--allow",
+    "allowed",
+    multiple=True,
+    type=click.Choice(CHECKS),
+    metavar="CHECK",
+    help=f"Silence one plausibility check (repeatable): {', '.join(CHECKS)}.",
+)
+@click.option(
+    "--config",
+    "config",
+    default=None,
+    metavar="FILE",
+    help="Project file of default options (default: gyrocomp.toml in this folder, when there is one).",
+)
 @click.pass_context
 def cli(ctx, debug, quiet, allowed, config):
     """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
@@ -178,12 +236,19 @@ def _name_the_project(ctx: click.Context) -> None:
     project = root.meta.get(PROJECT_KEY)
     if project is None or (root.obj or {}).get("quiet"):
         return
-    used = [next((o for o in param.opts if o.startswith("--")), param.opts[0]) for param in ctx.command.params
-            if isinstance(param, click.Option) and param.name
-            and ctx.get_parameter_source(param.name) is click.core.ParameterSource.DEFAULT_MAP]
+    used = [
+        next((o for o in param.opts if o.startswith("--")), param.opts[0])
+        for param in ctx.command.params
+        if isinstance(param, click.Option)
+        and param.name
+        and ctx.get_parameter_source(param.name) is click.core.ParameterSource.DEFAULT_MAP
+    ]
     if used:
-        click.echo(f"gyrocomp: note: {printable(project.path)} sets {', '.join(used)} (an option on the command "
-                   "line wins; gyrocomp config show prints the file)", err=True)
+        click.echo(
+            f"gyrocomp: note: {printable(project.path)} sets {', '.join(used)} (an option on the command "
+            "line wins; gyrocomp config show prints the file)",
+            err=True,
+        )
 
 
 def _options(command: click.Command) -> list[click.Option]:
@@ -211,7 +276,7 @@ def in_cli_words(message: str, commands: list[click.Command] | None = None) -> s
     names = "|".join(map(re.escape, sorted(flags, key=len, reverse=True)))
 
     def flag(m: re.Match) -> str:
-        name, sep, after = m.group(1), m.group(2), m.string[m.end():m.end() + 1]
+        name, sep, after = m.group(1), m.group(2), m.string[m.end() : m.end() + 1]
         if sep == ":":
             return flags[name] + ":"
         return flags[name] + (" " if after and not after.isspace() and after not in ",;)" else "")
@@ -226,30 +291,42 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 
 #: what a library says when the machine runs out of memory, threads or file descriptors (pyarrow's thread pool,
 #: Python's threads), each an error of the environment, not of gyrocomp
-_EXHAUSTED = re.compile(r"failed to launch worker thread|can't start new thread|cannot allocate memory|"
-                        r"out of memory|resource temporarily unavailable|too many open files|failed to map segment", re.IGNORECASE)
-_OUT_OF_MEMORY = ("not enough memory (or threads) for this size of data under this machine's limits; read less at "
-                  "once (--columns for the channels needed, --time A:B for a stretch, apply streams tables) or "
-                  "run it where more memory is allowed (ulimit -v)")
+_EXHAUSTED = re.compile(
+    r"failed to launch worker thread|can't start new thread|cannot allocate memory|"
+    r"out of memory|resource temporarily unavailable|too many open files|failed to map segment",
+    re.IGNORECASE,
+)
+_OUT_OF_MEMORY = (
+    "not enough memory (or threads) for this size of data under this machine's limits; read less at "
+    "once (--columns for the channels needed, --time A:B for a stretch, apply streams tables) or "
+    "run it where more memory is allowed (ulimit -v)"
+)
 
 
 def _resource_exhausted(exc: BaseException) -> bool:
     """Whether ``exc`` says the machine ran out of memory, threads or file descriptors."""
-    return isinstance(exc, MemoryError) or bool(_EXHAUSTED.search(str(exc))) and (
-        type(exc).__name__.startswith("Arrow") or isinstance(exc, (RuntimeError, OSError, ImportError)))
+    return (
+        isinstance(exc, MemoryError)
+        or bool(_EXHAUSTED.search(str(exc)))
+        and (type(exc).__name__.startswith("Arrow") or isinstance(exc, (RuntimeError, OSError, ImportError)))
+    )
 
 
 def _environment_message(exc: BaseException) -> str:
     """One line for an error of the machine rather than of gyrocomp: the file and what to do."""
     if isinstance(exc, OSError) and exc.errno in (errno.EMFILE, errno.ENFILE):
-        return ("too many files open at once for this machine's limit (ulimit -n); raise it, or give fewer files at "
-                "once")
+        return "too many files open at once for this machine's limit (ulimit -n); raise it, or give fewer files at once"
     if _resource_exhausted(exc):
         return _OUT_OF_MEMORY
     where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-    hint = {errno.EACCES: "check its permissions", errno.EPERM: "check its permissions",
-            errno.ENOSPC: "the disk is full; free space and run again", errno.EFBIG: "the file is too large here",
-            errno.ELOOP: "a symbolic link loops", errno.EROFS: "the file system is read-only"}
+    hint = {
+        errno.EACCES: "check its permissions",
+        errno.EPERM: "check its permissions",
+        errno.ENOSPC: "the disk is full; free space and run again",
+        errno.EFBIG: "the file is too large here",
+        errno.ELOOP: "a symbolic link loops",
+        errno.EROFS: "the file system is read-only",
+    }
     reason = exc.strerror or str(exc) or type(exc).__name__
     return f"{where}{reason.lower()}" + (f"; {hint[exc.errno]}" if getattr(exc, "errno", None) in hint else "")
 
@@ -270,6 +347,7 @@ def _exit_on_termination() -> None:
     """SIGTERM, SIGHUP and SIGINT (Ctrl-C) end the command as an exception would: every temporary output is
     removed on the way out (the atomic writers clean up on any exception) and nothing half-written is left at a
     target."""
+
     def stop(signum, frame):
         for sig in caught:  # a second Ctrl-C must not break the cleanup on the way out
             signal.signal(sig, signal.SIG_IGN)
@@ -299,8 +377,10 @@ def _within_address_limit() -> None:
     if soft == resource.RLIM_INFINITY:
         return
     if soft < MIN_ADDRESS_SPACE_BYTES:  # OpenBLAS would retry its buffers for ever while loading
-        raise InputError(f"this process may map {soft / 1e6:.0f} MB (ulimit -v); gyrocomp needs at least "
-                         f"{MIN_ADDRESS_SPACE_BYTES / 1e9:.0f} GB to load its numeric libraries: raise the limit")
+        raise InputError(
+            f"this process may map {soft / 1e6:.0f} MB (ulimit -v); gyrocomp needs at least "
+            f"{MIN_ADDRESS_SPACE_BYTES / 1e9:.0f} GB to load its numeric libraries: raise the limit"
+        )
     for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(name, "1")
     os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
@@ -312,8 +392,10 @@ def _unexpected(exc: Exception) -> int:
     if _resource_exhausted(exc):
         click.echo(f"gyrocomp: error: {_environment_message(exc)}", err=True)
         return EXIT_INPUT
-    click.echo(f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} "
-               "(run with --debug for the traceback)", err=True)
+    click.echo(
+        f"gyrocomp: internal error: {type(exc).__name__}: {printable(str(exc))} (run with --debug for the traceback)",
+        err=True,
+    )
     return EXIT_FAILURE
 
 
@@ -338,7 +420,9 @@ def main(argv: list[str] | None = None) -> int:
         click.echo(f"gyrocomp: interrupted; {_NOTHING_HALF_WRITTEN}", err=True)
         status = EXIT_FAILURE
     except _Terminated as exc:
-        what = "interrupted (Ctrl-C)" if exc.signum == signal.SIGINT else f"stopped by {signal.Signals(exc.signum).name}"
+        what = (
+            "interrupted (Ctrl-C)" if exc.signum == signal.SIGINT else f"stopped by {signal.Signals(exc.signum).name}"
+        )
         click.echo(f"gyrocomp: {what}; {_NOTHING_HALF_WRITTEN}", err=True)
         status = exc.code
     except click.ClickException as exc:  # usage errors: bad option, missing argument

@@ -27,29 +27,69 @@ def _nan_none(value):
 
 @click.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path(), metavar="MODEL RUNS... | --compare RUNS...")
-@click.option("--window", "window_s", type=FINITE, default=None,
-              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
-@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
-              help="Estimate each run's turn-on bias from its first S seconds [s].")
-@click.option("--compare", is_flag=True,
-              help="The thesis's comparison on RUNS: raw, polynomial, network, each with and without hysteresis "
-                   "(leave one run out with two runs or more).")
-@click.option("--hysteresis-band", "hysteresis_band", default=None, metavar="LO,HI",
-              help="With --compare: limit the hysteresis to this band [degC].")
-@click.option("--stages", is_flag=True,
-              help="Report each stage of MODEL (the thesis's Table 4.4): raw, temperature only, + acceleration, "
-                   "+ hysteresis.")
-@click.option("--installed", is_flag=True,
-              help="RUNS are PX4/ArduPilot logs: judge the thermal calibration installed on the vehicle (TC_G*, "
-                   "INS_TCAL* parameters in the log) against MODEL on the same data (the still segments of a log "
-                   "that moves).")
+@click.option(
+    "--window",
+    "window_s",
+    type=FINITE,
+    default=None,
+    help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
+)
+@click.option(
+    "--turn-on-window",
+    "turn_on_window_s",
+    type=FINITE,
+    default=None,
+    help="Estimate each run's turn-on bias from its first S seconds [s].",
+)
+@click.option(
+    "--compare",
+    is_flag=True,
+    help="The thesis's comparison on RUNS: raw, polynomial, network, each with and without hysteresis "
+    "(leave one run out with two runs or more).",
+)
+@click.option(
+    "--hysteresis-band",
+    "hysteresis_band",
+    default=None,
+    metavar="LO,HI",
+    help="With --compare: limit the hysteresis to this band [degC].",
+)
+@click.option(
+    "--stages",
+    is_flag=True,
+    help="Report each stage of MODEL (the thesis's Table 4.4): raw, temperature only, + acceleration, + hysteresis.",
+)
+@click.option(
+    "--installed",
+    is_flag=True,
+    help="RUNS are PX4/ArduPilot logs: judge the thermal calibration installed on the vehicle (TC_G*, "
+    "INS_TCAL* parameters in the log) against MODEL on the same data (the still segments of a log "
+    "that moves).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON on stdout.")
-@click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
-              help="A rate table's schedule for the RUNS it names (as for fit): adds their rate error.")
+@click.option(
+    "--rate-schedule",
+    "rate_schedule",
+    type=click.Path(),
+    default=None,
+    metavar="FILE",
+    help="A rate table's schedule for the RUNS it names (as for fit): adds their rate error.",
+)
 @read_options
 @click.pass_context
-def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, stages, installed, as_json, rate_schedule,
-             **kwargs):
+def evaluate(
+    ctx,
+    paths,
+    window_s,
+    turn_on_window_s,
+    compare,
+    hysteresis_band,
+    stages,
+    installed,
+    as_json,
+    rate_schedule,
+    **kwargs,
+):
     """Bias offset, bias instability and integration time of RUNS, raw and compensated with MODEL.
 
     With --compare, no model is given: the methods of the reference thesis are fitted on the runs and compared.
@@ -58,7 +98,6 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     if window_s is not None and not window_s > 0:
         raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
     if compare:
-
         band = float_list(hysteresis_band, "--hysteresis-band")
         if band is not None and (len(band) != 2 or not band[0] < band[1]):
             raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
@@ -75,10 +114,16 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     calibration = Calibration.load(model)
     if stages:
         if not calibration.axes:
-            raise InputError(f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
-                             "evaluate it without --stages")
-        staged = [evaluate_stages(calibration, read_run(path, opts).recording, window_s=window_s,
-                                  turn_on_window_s=turn_on_window_s) for path in runs]
+            raise InputError(
+                f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
+                "evaluate it without --stages"
+            )
+        staged = [
+            evaluate_stages(
+                calibration, read_run(path, opts).recording, window_s=window_s, turn_on_window_s=turn_on_window_s
+            )
+            for path in runs
+        ]
         if as_json:
             click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
         elif not ctx.obj["quiet"]:
@@ -95,18 +140,32 @@ def evaluate(ctx, paths, window_s, turn_on_window_s, compare, hysteresis_band, s
     expected = calibration.report.expected_drift()
     in_sample = [str(path) for path in runs if calibration.fitted_on(path)]
     for path in in_sample:
-        click.echo(f"gyrocomp: note: {path}: the model was fitted on this file, so its figures are in-sample; on new "
-                   "data expect the held-out drift the model file states (gyrocomp show)", err=True)
+        click.echo(
+            f"gyrocomp: note: {path}: the model was fitted on this file, so its figures are in-sample; on new "
+            "data expect the held-out drift the model file states (gyrocomp show)",
+            err=True,
+        )
     if as_json:
-        click.echo(json.dumps({**evaluation.to_dict(), "in_sample_files": in_sample,
-                               "expected_held_out_drift": [e.to_dict() for e in expected.values()]}, indent=2))
+        click.echo(
+            json.dumps(
+                {
+                    **evaluation.to_dict(),
+                    "in_sample_files": in_sample,
+                    "expected_held_out_drift": [e.to_dict() for e in expected.values()],
+                },
+                indent=2,
+            )
+        )
     else:
         print_evaluation(evaluation)
         print_expected_drift(expected)
         if turn_on_window_s is not None and not ctx.obj["quiet"]:
-            click.echo(f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
-                       "its first seconds; bias offset, bias instability and integration time do not depend on a "
-                       "constant, so only the compensated output (gyrocomp apply) shows it", err=True)
+            click.echo(
+                f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
+                "its first seconds; bias offset, bias instability and integration time do not depend on a "
+                "constant, so only the compensated output (gyrocomp apply) shows it",
+                err=True,
+            )
 
 
 def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, rate_schedule) -> Evaluation:
@@ -116,8 +175,17 @@ def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, ra
         parts = []
         for path in runs:
             with progress_bar(f"reading {Path(path).name}") as progress:
-                parts.append(evaluate_file(calibration, path, options=read_settings(opts), fmt=opts["fmt"],
-                                           window_s=window_s, turn_on_window_s=turn_on_window_s, progress=progress))
+                parts.append(
+                    evaluate_file(
+                        calibration,
+                        path,
+                        options=read_settings(opts),
+                        fmt=opts["fmt"],
+                        window_s=window_s,
+                        turn_on_window_s=turn_on_window_s,
+                        progress=progress,
+                    )
+                )
         return Evaluation([r for p in parts for r in p.runs], [t for p in parts for t in p.triads])
     recordings = [read_run(path, opts).recording for path in runs]
     if rate_schedule is not None:

@@ -21,8 +21,20 @@ from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
 from ..files.check import ask_for, enforce, read_noting
 from ..measures.data_check import check_runs
-from .common import (accept_option, FINITE, OUTPUT_FILE, float_list, instance_model_path, parse_channels, parse_temperature_option, pop_read_options,
-                     progress_bar, read_options, read_run, temperature_help)
+from .common import (
+    accept_option,
+    FINITE,
+    OUTPUT_FILE,
+    float_list,
+    instance_model_path,
+    parse_channels,
+    parse_temperature_option,
+    pop_read_options,
+    progress_bar,
+    read_options,
+    read_run,
+    temperature_help,
+)
 from .render import print_contributions, print_fit
 
 
@@ -30,54 +42,140 @@ from .render import print_contributions, print_fit
 @click.argument("runs", nargs=-1, required=True, type=click.Path())  # files, folders of runs, or quoted globs
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="Model file to write (JSON).")
 @click.option("--temperature", default="auto", show_default=True, help=temperature_help())
-@click.option("--seed", "mlp_seed", type=int, default=0, show_default=True,
-              help="Seed of the network's initializations (mlp); the same seed gives the same model.")
-@click.option("--bin-width", "bin_width_degc", type=FINITE, default=None, help="Temperature bin width [degC] (default: span/100).")
-@click.option("--hysteresis", type=click.Choice(HYSTERESIS_CHOICES), default="auto", show_default=True,
-              help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
-                   "when the runs both heat and cool.")
-@click.option("--hysteresis-order", default="auto", show_default=True,
-              help="Order of the turning-point polynomial in |T - T_turn|: auto (validated) or 1..3.")
-@click.option("--hysteresis-band", "hysteresis_band_degc", default=None, metavar="LO,HI",
-              help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.")
-@click.option("--acceleration", type=click.Choice(["auto", *ACCELERATION_CHOICES]), default="auto", show_default=True,
-              help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
-                   "none; auto: matrix when the runs turn the unit between positions.")
-@click.option("--pipeline", default="joint", show_default=True,
-              help="joint (temperature, lag/hysteresis, G and run constants in one fit), or a cascade fitted stage by "
-                   "stage: 'poly>matrix', 'matrix>poly', 'mlp>matrix', or 'joint-mlp' (one network reading the "
-                   "temperature and the three accelerations). Quote the > in a shell.")
-@click.option("--min-static", "static_min_duration_s", type=FINITE, default=10.0, show_default=True,
-              help="Shortest still stretch used as a static position [s].")
-@click.option("--channels", default="gyro", show_default=True,
-              help="What to model: gyro, accel (the accelerometer's bias against temperature, in g) or gyro,accel "
-                   "(then G reads the temperature-compensated accelerations).")
-@click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
-              help="What the model choice holds out: each run, each heating or cooling leg, or time blocks; "
-                   "auto: runs with three runs or more, else legs.")
-@click.option("--target", type=click.Choice(["model", "px4", "ardupilot"]), default="model", show_default=True,
-              help="px4 or ardupilot: the best model that firmware carries (a cubic at most, chosen by the same "
-                   "held-out validation, held at the range's edges as the firmware clamps, no lag or hysteresis), so "
-                   "that apply computes what the exported file will.")
-@click.option("--scale-factor", "scale_factor", type=click.Choice(SCALE_FACTOR_CHOICES), default="auto",
-              show_default=True,
-              help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table) or, "
-                   "without them, from the turns between the still poses of multi-position runs: matrix (constant), "
-                   "matrix-temperature (linear in temperature), none; auto: when such runs are given, the order by "
-                   "leave-one-run-out.")
-@click.option("--rate-schedule", "rate_schedule", type=click.Path(), default=None, metavar="FILE",
-              help="A rate table's schedule (CSV: file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z [deg/s]) "
-                   "giving the reference rates of the runs it names, instead of ref_rate_x/y/z columns.")
-@click.option("--still-only", "still_only", type=click.Choice(["auto", "yes", "no"]), default="auto",
-              show_default=True,
-              help="Fit on the still segments of field logs (flights, drives: each one power-on) found from their "
-                   "own noise: yes for every run, auto for the runs still less than half the time, no for none.")
+@click.option(
+    "--seed",
+    "mlp_seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="Seed of the network's initializations (mlp); the same seed gives the same model.",
+)
+@click.option(
+    "--bin-width", "bin_width_degc", type=FINITE, default=None, help="Temperature bin width [degC] (default: span/100)."
+)
+@click.option(
+    "--hysteresis",
+    type=click.Choice(HYSTERESIS_CHOICES),
+    default="auto",
+    show_default=True,
+    help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
+    "when the runs both heat and cool.",
+)
+@click.option(
+    "--hysteresis-order",
+    default="auto",
+    show_default=True,
+    help="Order of the turning-point polynomial in |T - T_turn|: auto (validated) or 1..3.",
+)
+@click.option(
+    "--hysteresis-band",
+    "hysteresis_band_degc",
+    default=None,
+    metavar="LO,HI",
+    help="Limit the hysteresis to this temperature band [degC], e.g. 55,80.",
+)
+@click.option(
+    "--acceleration",
+    type=click.Choice(["auto", *ACCELERATION_CHOICES]),
+    default="auto",
+    show_default=True,
+    help="g-sensitivity fitted jointly on the static segments: matrix (3x3), matrix2 (+ g x g terms), "
+    "none; auto: matrix when the runs turn the unit between positions.",
+)
+@click.option(
+    "--pipeline",
+    default="joint",
+    show_default=True,
+    help="joint (temperature, lag/hysteresis, G and run constants in one fit), or a cascade fitted stage by "
+    "stage: 'poly>matrix', 'matrix>poly', 'mlp>matrix', or 'joint-mlp' (one network reading the "
+    "temperature and the three accelerations). Quote the > in a shell.",
+)
+@click.option(
+    "--min-static",
+    "static_min_duration_s",
+    type=FINITE,
+    default=10.0,
+    show_default=True,
+    help="Shortest still stretch used as a static position [s].",
+)
+@click.option(
+    "--channels",
+    default="gyro",
+    show_default=True,
+    help="What to model: gyro, accel (the accelerometer's bias against temperature, in g) or gyro,accel "
+    "(then G reads the temperature-compensated accelerations).",
+)
+@click.option(
+    "--folds",
+    type=click.Choice(FOLD_KINDS),
+    default="auto",
+    show_default=True,
+    help="What the model choice holds out: each run, each heating or cooling leg, or time blocks; "
+    "auto: runs with three runs or more, else legs.",
+)
+@click.option(
+    "--target",
+    type=click.Choice(["model", "px4", "ardupilot"]),
+    default="model",
+    show_default=True,
+    help="px4 or ardupilot: the best model that firmware carries (a cubic at most, chosen by the same "
+    "held-out validation, held at the range's edges as the firmware clamps, no lag or hysteresis), so "
+    "that apply computes what the exported file will.",
+)
+@click.option(
+    "--scale-factor",
+    "scale_factor",
+    type=click.Choice(SCALE_FACTOR_CHOICES),
+    default="auto",
+    show_default=True,
+    help="Gyro scale factor and misalignment from the runs with ref_rate_x/y/z columns (rate table) or, "
+    "without them, from the turns between the still poses of multi-position runs: matrix (constant), "
+    "matrix-temperature (linear in temperature), none; auto: when such runs are given, the order by "
+    "leave-one-run-out.",
+)
+@click.option(
+    "--rate-schedule",
+    "rate_schedule",
+    type=click.Path(),
+    default=None,
+    metavar="FILE",
+    help="A rate table's schedule (CSV: file,start_s,end_s,ref_rate_x,ref_rate_y,ref_rate_z [deg/s]) "
+    "giving the reference rates of the runs it names, instead of ref_rate_x/y/z columns.",
+)
+@click.option(
+    "--still-only",
+    "still_only",
+    type=click.Choice(["auto", "yes", "no"]),
+    default="auto",
+    show_default=True,
+    help="Fit on the still segments of field logs (flights, drives: each one power-on) found from their "
+    "own noise: yes for every run, auto for the runs still less than half the time, no for none.",
+)
 @accept_option
 @read_options
 @click.pass_context
-def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hysteresis_order, hysteresis_band_degc,
-        acceleration, pipeline, static_min_duration_s, channels, folds, target, scale_factor, rate_schedule,
-        still_only, accept, **kwargs):
+def fit(
+    ctx,
+    runs,
+    output,
+    temperature,
+    mlp_seed,
+    bin_width_degc,
+    hysteresis,
+    hysteresis_order,
+    hysteresis_band_degc,
+    acceleration,
+    pipeline,
+    static_min_duration_s,
+    channels,
+    folds,
+    target,
+    scale_factor,
+    rate_schedule,
+    still_only,
+    accept,
+    **kwargs,
+):
     """Fit a compensation model on calibration RUNS (each one power-on, the gyro at rest), or on the still
     moments of field logs. The runs are checked first (as gyrocomp check does): a run that cannot give a valid
     fit is refused in one line, one that only degrades it is said with its expected cost.
@@ -92,10 +190,17 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
     if band is not None and (len(band) != 2 or not band[0] < band[1]):
         raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     channels = parse_channels(channels)
-    options = FitOptions(temperature=parse_temperature_option(temperature, mlp_seed),
-                         bin_width_degc=bin_width_degc, hysteresis=hysteresis, hysteresis_order=hysteresis_order,
-                         hysteresis_band_degc=None if band is None else tuple(band), acceleration=acceleration,
-                         static_min_duration_s=static_min_duration_s, folds=folds, target=target)
+    options = FitOptions(
+        temperature=parse_temperature_option(temperature, mlp_seed),
+        bin_width_degc=bin_width_degc,
+        hysteresis=hysteresis,
+        hysteresis_order=hysteresis_order,
+        hysteresis_band_degc=None if band is None else tuple(band),
+        acceleration=acceleration,
+        static_min_duration_s=static_min_duration_s,
+        folds=folds,
+        target=target,
+    )
     runs = expand_runs(runs)
     refuse_to_overwrite_inputs(output, runs)
     every = str(opts["instance"]).strip().lower() == "all"
@@ -108,13 +213,15 @@ def fit(ctx, runs, output, temperature, mlp_seed, bin_width_degc, hysteresis, hy
         if rate_schedule is not None:
             recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
         recordings, contributions = field_recordings(recordings, still_only)
-        enforce(check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions
-                                                                        if c.still_only]))
+        enforce(
+            check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions if c.still_only])
+        )
         if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
             print_contributions(contributions)
         with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):
-            fits[instance] = fit_runs(recordings, options, channels=channels, pipeline=pipeline,
-                                      scale_factor=scale_factor)
+            fits[instance] = fit_runs(
+                recordings, options, channels=channels, pipeline=pipeline, scale_factor=scale_factor
+            )
     out = Path(output)
     names = {instance: instance_model_path(out, instance).name for instance in fits} if every else {None: out.name}
     written = {i: out.parent / names[i] for i in fits}
@@ -137,8 +244,10 @@ def _common_instances(runs: list[str], fmt: str | None) -> list[int]:
     for path, have in found.items():
         lacking = [i for i in every if i not in have]
         if lacking:
-            raise InputError(f"{path}: no instance {lacking[0]} (it has {', '.join(map(str, have))}); --instance all "
-                             "fits each instance on every run, so every run must hold the same instances")
+            raise InputError(
+                f"{path}: no instance {lacking[0]} (it has {', '.join(map(str, have))}); --instance all "
+                "fits each instance on every run, so every run must hold the same instances"
+            )
     return every
 
 

@@ -18,16 +18,42 @@ from .render import print_learner
 
 @click.command()
 @click.argument("logs", nargs=-1, required=True, type=click.Path())  # files, folders of logs, or quoted globs
-@click.option("-o", "--output", required=True, type=OUTPUT_FILE,
-              help="Model file to write (JSON; gyrocomp apply and export take it).")
-@click.option("--resume", "resume", type=click.Path(dir_okay=False), default=None,
-              help="A learner state saved by --save-state: go on from it (the logs are later power-ons).")
-@click.option("--save-state", "save_state", type=OUTPUT_FILE, default=None,
-              help="Write the learner's whole state here (JSON), to go on later with --resume.")
-@click.option("--degree", type=click.Choice(["1", "2", "3"]), default="3", show_default=True,
-              help="Highest degree of the temperature curve (used once the still data span enough).")
-@click.option("--bin-width", "bin_width_degc", type=FINITE, default=1.0, show_default=True,
-              help="Temperature bin of the learner's points [degC].")
+@click.option(
+    "-o",
+    "--output",
+    required=True,
+    type=OUTPUT_FILE,
+    help="Model file to write (JSON; gyrocomp apply and export take it).",
+)
+@click.option(
+    "--resume",
+    "resume",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="A learner state saved by --save-state: go on from it (the logs are later power-ons).",
+)
+@click.option(
+    "--save-state",
+    "save_state",
+    type=OUTPUT_FILE,
+    default=None,
+    help="Write the learner's whole state here (JSON), to go on later with --resume.",
+)
+@click.option(
+    "--degree",
+    type=click.Choice(["1", "2", "3"]),
+    default="3",
+    show_default=True,
+    help="Highest degree of the temperature curve (used once the still data span enough).",
+)
+@click.option(
+    "--bin-width",
+    "bin_width_degc",
+    type=FINITE,
+    default=1.0,
+    show_default=True,
+    help="Temperature bin of the learner's points [degC].",
+)
 @read_options
 @click.pass_context
 def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, **kwargs):
@@ -39,8 +65,7 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, **kwarg
     paths = expand_runs(logs)
     outputs = [p for p in (output, save_state) if p is not None]
     for out in outputs:
-        refuse_to_overwrite_inputs(out, paths + ([resume] if resume else []),
-                                   "-o" if out == output else "--save-state")
+        refuse_to_overwrite_inputs(out, paths + ([resume] if resume else []), "-o" if out == output else "--save-state")
     if save_state is not None and save_state == output:
         raise click.BadParameter("give the state a file of its own, not the model's", param_hint="--save-state")
     recordings = (read_run(path, opts).recording for path in paths)
@@ -51,16 +76,16 @@ def learn(ctx, logs, output, resume, save_state, degree, bin_width_degc, **kwarg
             raise InputError(f"--rate {rate_hz:g}: the resumed learner runs at {learner.settings.rate_hz:g} Hz")
     else:
         first = next(recordings)
-        settings = LearnerSettings(rate_hz=first.rate_hz, degree=int(degree),
-                                   bin_width_degc=bin_width_degc)
+        settings = LearnerSettings(rate_hz=first.rate_hz, degree=int(degree), bin_width_degc=bin_width_degc)
         learner = OnlineCalibrator(settings)
         recordings = itertools.chain([first], recordings)
     if save_state is not None:
         learner.check_state_target(save_state)  # before the logs are replayed; again under the lock below
     contributions = replay(learner, recordings)
     try:
-        model = learner.to_calibration(axes=[a for a in GYRO_AXES if any(a in c.gyro_axes for c in contributions)],
-                                       contributions=contributions)
+        model = learner.to_calibration(
+            axes=[a for a in GYRO_AXES if any(a in c.gyro_axes for c in contributions)], contributions=contributions
+        )
     except NotFittedError as exc:  # no still piece in any log: bad input, not a failure
         raise InputError(str(exc)) from None
     texts = {output: model.to_json()}

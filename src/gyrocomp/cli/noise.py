@@ -18,23 +18,43 @@ from .render import print_bias_process_noise, print_noise_model
 
 @click.command()
 @click.argument("logs", nargs=-1, required=True, type=click.Path())
-@click.option("--export", "export_format", type=click.Choice(tuple(NOISE_EXPORTS)), default=None,
-              help="Write the model for an estimator: kalibr (imu.yaml), openvins (kalibr_imu_chain.yaml), vins "
-                   "(acc_n, gyr_n, acc_w, gyr_w), ros (sensor_msgs/Imu covariances), px4 (EKF2_*_NOISE, .params), "
-                   "ardupilot (EK3_*_P_NSE, .parm) or json (the whole model).")
+@click.option(
+    "--export",
+    "export_format",
+    type=click.Choice(tuple(NOISE_EXPORTS)),
+    default=None,
+    help="Write the model for an estimator: kalibr (imu.yaml), openvins (kalibr_imu_chain.yaml), vins "
+    "(acc_n, gyr_n, acc_w, gyr_w), ros (sensor_msgs/Imu covariances), px4 (EKF2_*_NOISE, .params), "
+    "ardupilot (EK3_*_P_NSE, .parm) or json (the whole model).",
+)
 @click.option("-o", "--output", type=OUTPUT_FILE, default=None, help="The file --export writes.")
 @click.option("--rostopic", default="/imu0", show_default=True, help="The IMU topic written into the export.")
-@click.option("--axes", "axes", default=None,
-              help="Columns to model, e.g. gyro_x,gyro_z,accel_z (default: every gyro and accelerometer axis).")
-@click.option("--split-gaps/--no-split-gaps", default=False,
-              help="Pool the contiguous stretches of a log with time gaps instead of refusing it.")
-@click.option("--model", "model_path", type=click.Path(dir_okay=False), default=None,
-              help="A model file: the logs are static runs through a temperature profile, held out from its fit; "
-                   "say the bias random walk a filter needs with the raw and the compensated gyro, and model (and "
-                   "export) the compensated gyro's noise.")
-@click.option("--dwells", is_flag=True,
-              help="Each log is a chamber run: model the noise of each of its temperature dwells (the first 300 s "
-                   "of each left out, at least 600 s kept) and bound them all, with the per-temperature table.")
+@click.option(
+    "--axes",
+    "axes",
+    default=None,
+    help="Columns to model, e.g. gyro_x,gyro_z,accel_z (default: every gyro and accelerometer axis).",
+)
+@click.option(
+    "--split-gaps/--no-split-gaps",
+    default=False,
+    help="Pool the contiguous stretches of a log with time gaps instead of refusing it.",
+)
+@click.option(
+    "--model",
+    "model_path",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="A model file: the logs are static runs through a temperature profile, held out from its fit; "
+    "say the bias random walk a filter needs with the raw and the compensated gyro, and model (and "
+    "export) the compensated gyro's noise.",
+)
+@click.option(
+    "--dwells",
+    is_flag=True,
+    help="Each log is a chamber run: model the noise of each of its temperature dwells (the first 300 s "
+    "of each left out, at least 600 s kept) and bound them all, with the per-temperature table.",
+)
 @read_options
 @click.pass_context
 def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_path, dwells, **kwargs):
@@ -43,8 +63,9 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
     952 fit."""
     opts = pop_read_options(kwargs)
     if (export_format is None) != (output is None):
-        raise click.BadParameter("give --export and -o together",
-                                 param_hint="--export" if export_format is None else "-o")
+        raise click.BadParameter(
+            "give --export and -o together", param_hint="--export" if export_format is None else "-o"
+        )
     paths = expand_runs(logs)
     if output is not None:
         refuse_to_overwrite_inputs(output, paths + ([model_path] if model_path else []), option="-o")
@@ -53,19 +74,32 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
     if model_path is not None:
         if dwells:
             raise click.BadParameter("give --model or --dwells, not both", param_hint="--model")
-        model, benefit = compensated_noise(Calibration.load(model_path), [read_run(path, opts).recording
-                                                                          for path in paths],
-                                           named, with_accel=named is None, split_gaps=split_gaps)
+        model, benefit = compensated_noise(
+            Calibration.load(model_path),
+            [read_run(path, opts).recording for path in paths],
+            named,
+            with_accel=named is None,
+            split_gaps=split_gaps,
+        )
     elif dwells:
-        model = noise_over_temperature([read_run(path, opts).recording for path in paths], named,
-                                       with_accel=named is None)
+        model = noise_over_temperature(
+            [read_run(path, opts).recording for path in paths], named, with_accel=named is None
+        )
     else:
         analyses = []
         for path in paths:
             with progress_bar(f"reading {Path(path).name}") as progress:
-                analyses.append(analyse_noise_file(path, named, options=read_settings(opts), fmt=opts["fmt"],
-                                                   with_accel=named is None, split_gaps=split_gaps,
-                                                   progress=progress))
+                analyses.append(
+                    analyse_noise_file(
+                        path,
+                        named,
+                        options=read_settings(opts),
+                        fmt=opts["fmt"],
+                        with_accel=named is None,
+                        split_gaps=split_gaps,
+                        progress=progress,
+                    )
+                )
         model = noise_model(analyses)
     if export_format is not None:
         write_text_atomic(output, NOISE_EXPORTS[export_format](model, rostopic))

@@ -47,8 +47,9 @@ def _axis_option(axis, calibration, recording) -> str:
             raise InputError(f"{recording.source}: no axis of the model in the data")
         return known[0]
     if axis not in known:
-        raise click.BadParameter(f"{axis!r}: the model and the data share {', '.join(known) or 'no axis'}",
-                                 param_hint="--axis")
+        raise click.BadParameter(
+            f"{axis!r}: the model and the data share {', '.join(known) or 'no axis'}", param_hint="--axis"
+        )
     return axis
 
 
@@ -104,10 +105,20 @@ def plot_temperature(ctx, model, runs, axis, output, **kwargs):
 @click.argument("model", type=click.Path())
 @click.argument("run", type=click.Path())
 @click.option("--axis", default=None, help="The axis to draw (default: the model's first).")
-@click.option("--window", "window_s", type=FINITE, default=None,
-              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
-@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
-              help="Estimate the run's turn-on bias from its first S seconds [s].")
+@click.option(
+    "--window",
+    "window_s",
+    type=FINITE,
+    default=None,
+    help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
+)
+@click.option(
+    "--turn-on-window",
+    "turn_on_window_s",
+    type=FINITE,
+    default=None,
+    help="Estimate the run's turn-on bias from its first S seconds [s].",
+)
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE)
 @read_options
 @click.pass_context
@@ -119,8 +130,17 @@ def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, *
     calibration, (recording,), (comp,) = _compensated(model, [run], opts, turn_on_window_s)
     axis = _axis_option(axis, calibration, recording)
     window = window_s or default_window_s(recording)
-    save_figure(timeseries_plot(recording, comp, axis, window, "g" if axis.startswith("accel") else "deg/s",
-                                title=f"{axis}: {Path(run).name}"), output)
+    save_figure(
+        timeseries_plot(
+            recording,
+            comp,
+            axis,
+            window,
+            "g" if axis.startswith("accel") else "deg/s",
+            title=f"{axis}: {Path(run).name}",
+        ),
+        output,
+    )
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output}")
 

@@ -24,14 +24,24 @@ def _toml_text(value) -> str:
 
 @click.command()
 @click.argument("log", type=click.Path())
-@click.option("-o", "--output", default=PROJECT_FILE, show_default=True, type=OUTPUT_FILE,
-              help="The project file to write.")
+@click.option(
+    "-o", "--output", default=PROJECT_FILE, show_default=True, type=OUTPUT_FILE, help="The project file to write."
+)
 @click.option("--force", is_flag=True, help="Replace an existing project file.")
-@click.option("--names", default=None, metavar="NAME,...",
-              help="A table without a header line (a serial terminal's log): its columns' names in order, e.g. "
-                   "gyro_x,gyro_y,gyro_z,temperature (asked for in a terminal).")
-@click.option("--rate", "rate_hz", default=None, metavar="HZ",
-              help="The rows' sample rate [Hz], for a table without a time column.")
+@click.option(
+    "--names",
+    default=None,
+    metavar="NAME,...",
+    help="A table without a header line (a serial terminal's log): its columns' names in order, e.g. "
+    "gyro_x,gyro_y,gyro_z,temperature (asked for in a terminal).",
+)
+@click.option(
+    "--rate",
+    "rate_hz",
+    default=None,
+    metavar="HZ",
+    help="The rows' sample rate [Hz], for a table without a time column.",
+)
 @click.pass_context
 def init(ctx, log, output, force, names, rate_hz):
     """Write a project file for LOG's kind of table: its columns and units guessed from their names and
@@ -45,21 +55,30 @@ def init(ctx, log, output, force, names, rate_hz):
         guess = guess_layout(log, None if names is None else parse_names(names), rate_hz)
     except HeaderlessTable as exc:
         if not sys.stdin.isatty():
-            raise InputError(f"{log}: a table without a header line, rows of {exc.count} numbers (e.g. "
-                             f"{exc.example!r}); give their names in order with --names (e.g. --names "
-                             "gyro_x,gyro_y,gyro_z,temperature), and --rate HZ if it has no time column") from None
+            raise InputError(
+                f"{log}: a table without a header line, rows of {exc.count} numbers (e.g. "
+                f"{exc.example!r}); give their names in order with --names (e.g. --names "
+                "gyro_x,gyro_y,gyro_z,temperature), and --rate HZ if it has no time column"
+            ) from None
         click.echo(f"{log} has no header line; its rows hold {exc.count} numbers, e.g. {exc.example}")
-        names = click.prompt(f"their {exc.count} names in order (time, gyro_x..z, accel_x..z, temperature; "
-                             "any other name leaves a column unused)")
+        names = click.prompt(
+            f"their {exc.count} names in order (time, gyro_x..z, accel_x..z, temperature; "
+            "any other name leaves a column unused)"
+        )
         if rate_hz is None and "time" not in parse_names(names):
             rate_hz = parse_rate(click.prompt("no time column: the rows' sample rate [Hz]"))
         guess = guess_layout(log, parse_names(names), rate_hz)
     layout = guess.layout
-    lines = [f"# gyrocomp project file: written by `gyrocomp init {Path(log).name}` on "
-             f"{_dt.date.today().isoformat()}; every gyrocomp command run in this folder reads it",
-             "# (an option on the command line wins; `gyrocomp config show` prints what is in use)",
-             *(f"# {reason}" for reason in guess.reasons), "", "[read]", "# channel = the file's column",
-             "[read.columns]"]
+    lines = [
+        f"# gyrocomp project file: written by `gyrocomp init {Path(log).name}` on "
+        f"{_dt.date.today().isoformat()}; every gyrocomp command run in this folder reads it",
+        "# (an option on the command line wins; `gyrocomp config show` prints what is in use)",
+        *(f"# {reason}" for reason in guess.reasons),
+        "",
+        "[read]",
+        "# channel = the file's column",
+        "[read.columns]",
+    ]
     lines += [f"{channel} = {_toml_text(column)}" for channel, column in layout.columns.items()]
     read = {"gyro-unit": layout.gyro_unit, "accel-unit": layout.accel_unit, "time-unit": layout.time_unit}
     if layout.delimiter is not None:
@@ -70,7 +89,7 @@ def init(ctx, log, output, force, names, rate_hz):
         read["rate"] = layout.rate_hz
     # TOML: a table's keys come before its sub-tables, so the units go in a [read] written before [read.columns]
     head = lines.index("[read]")
-    lines[head + 1:head + 1] = [f"{k} = {_toml_text(v)}" for k, v in read.items()]
+    lines[head + 1 : head + 1] = [f"{k} = {_toml_text(v)}" for k, v in read.items()]
     write_text_atomic(output, "\n".join(lines) + "\n")
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output} from {log}:")

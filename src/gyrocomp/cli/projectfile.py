@@ -70,8 +70,9 @@ def load_project(given: str | None, commands: tuple[str, ...]) -> Project | None
             if not isinstance(value, dict):
                 raise InputError(f"{path}: {name} = ...: options go in [read], [defaults] or a command's section")
             if prefix == "" and name not in commands:
-                raise InputError(f"{path}: [{name}]: no such command; sections are read, defaults and "
-                                 f"{', '.join(commands)}")
+                raise InputError(
+                    f"{path}: [{name}]: no such command; sections are read, defaults and {', '.join(commands)}"
+                )
             options = {_key(k): v for k, v in value.items() if not isinstance(v, dict)}
             sections[full] = options
             walk(full, {k: v for k, v in value.items() if isinstance(v, dict)})
@@ -84,26 +85,40 @@ def defaults_for(project: Project, command: click.Command, name: str) -> dict:
     """Click's ``default_map`` for ``command`` (named ``name``, dotted for a group's command) from ``project``:
     the [read] and [defaults] options it has, then its own section's (refused when it has no such option); a
     group's commands nested."""
-    flags = {opt.lstrip("-"): param.name for param in command.params if isinstance(param, click.Option)
-             for opt in param.opts if opt.startswith("--")}
-    reading = sorted(opt.lstrip("-") for param in command.params if isinstance(param, ReadingOption)
-                     for opt in param.opts if opt.startswith("--"))
+    flags = {
+        opt.lstrip("-"): param.name
+        for param in command.params
+        if isinstance(param, click.Option)
+        for opt in param.opts
+        if opt.startswith("--")
+    }
+    reading = sorted(
+        opt.lstrip("-")
+        for param in command.params
+        if isinstance(param, ReadingOption)
+        for opt in param.opts
+        if opt.startswith("--")
+    )
     for key in project.read if reading else ():
         if key not in reading:
             raise InputError(f"{project.path}: [read] {key}: not a reading option; use {', '.join(reading)}")
     out = {flags[k]: v for k, v in {**project.read, **project.defaults}.items() if k in flags}
     for key, value in project.commands.get(name, {}).items():
         if key not in flags:
-            raise InputError(f"{project.path}: [{name}] {key}: gyrocomp {name.replace('.', ' ')} has no option "
-                             f"--{key}")
+            raise InputError(f"{project.path}: [{name}] {key}: gyrocomp {name.replace('.', ' ')} has no option --{key}")
         out[flags[key]] = value
-    switches = {param.name: param for param in command.params if isinstance(param, click.Option)
-                and param.is_flag and not param.secondary_opts}
+    switches = {
+        param.name: param
+        for param in command.params
+        if isinstance(param, click.Option) and param.is_flag and not param.secondary_opts
+    }
     for key, value in out.items():
         if key in switches and value is True:
             flag = next(o for o in switches[key].opts if o.startswith("--"))
-            raise InputError(f"{project.path}: {flag[2:]} = true: a switch the command line could not turn off "
-                             f"again; give {flag} when running gyrocomp {name.replace('.', ' ')}")
+            raise InputError(
+                f"{project.path}: {flag[2:]} = true: a switch the command line could not turn off "
+                f"again; give {flag} when running gyrocomp {name.replace('.', ' ')}"
+            )
     for sub_name, sub in getattr(command, "commands", {}).items():
         out[sub_name] = defaults_for(project, sub, f"{name}.{sub_name}")
     return out

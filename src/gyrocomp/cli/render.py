@@ -26,13 +26,16 @@ def print_fit(calibration: Calibration, output) -> None:
         console.print(f"gyrocomp fit: {calibration.model}  ->  {output}")
     report = calibration.report
     if calibration.axes:
-        _print_axis_fits(console, calibration.axes, report, f"gyrocomp fit: {calibration.model}  ->  "
-                         f"{output}", "deg/s")
+        _print_axis_fits(console, calibration.axes, report, f"gyrocomp fit: {calibration.model}  ->  {output}", "deg/s")
     if calibration.accel_axes and report.accel is not None:
-        _print_axis_fits(console, calibration.accel_axes, report.accel,
-                         f"accelerometer (correction relative to {calibration.accel_reference_degc:.2f} degC; "
-                         "constants per run or per static position)" + ("" if calibration.axes else f"  ->  {output}"),
-                         "g")
+        _print_axis_fits(
+            console,
+            calibration.accel_axes,
+            report.accel,
+            f"accelerometer (correction relative to {calibration.accel_reference_degc:.2f} degC; "
+            "constants per run or per static position)" + ("" if calibration.axes else f"  ->  {output}"),
+            "g",
+        )
     for name, triad in (("gyro", calibration.gyro_triad), ("accelerometer", calibration.accel_triad)):
         if triad is not None:
             _print_triad(console, name, triad)
@@ -42,9 +45,11 @@ def print_installed(results) -> None:
     """The installed autopilot calibration against the model, per log and axis (residual RMS)."""
     console = make_console()
     for r in results:
-        where = (f"{r.data_s / 60:.1f} min of still segments" if r.still_only else f"all {r.data_s / 60:.1f} min")
-        console.print(f"{Path(r.file).name}: {r.installed or f'no {r.autopilot} thermal calibration installed'} vs "
-                      f"the model, on {where} (residual RMS of the {r.window_s:.3g} s moving average, deg/s)")
+        where = f"{r.data_s / 60:.1f} min of still segments" if r.still_only else f"all {r.data_s / 60:.1f} min"
+        console.print(
+            f"{Path(r.file).name}: {r.installed or f'no {r.autopilot} thermal calibration installed'} vs "
+            f"the model, on {where} (residual RMS of the {r.window_s:.3g} s moving average, deg/s)"
+        )
         table = Table()
         for col in ("axis", "raw" + (" (corrected onboard)" if r.corrected_onboard else ""), "installed", "model"):
             table.add_column(col, justify="right")
@@ -54,8 +59,10 @@ def print_installed(results) -> None:
         if r.note:
             console.print(r.note)
         if r.corrected_onboard:
-            console.print("the logged data are already corrected onboard: the model would correct them twice "
-                          "(log the raw sensor, or disable the onboard calibration)")
+            console.print(
+                "the logged data are already corrected onboard: the model would correct them twice "
+                "(log the raw sensor, or disable the onboard calibration)"
+            )
 
 
 def _number(value: float) -> str:
@@ -68,11 +75,18 @@ def print_contributions(contributions) -> None:
     for col in ("log", "length [min]", "still [min]", "still %", "segments", "temperature [degC]", "used"):
         table.add_column(col)
     for c in contributions:
-        span = ("-" if c.temperature_min_degc is None else
-                f"{c.temperature_min_degc:.1f} .. {c.temperature_max_degc:.1f}")
-        table.add_row(Path(c.source).name, f"{c.duration_s / 60:.1f}", f"{c.still_s / 60:.1f}",
-                      f"{100 * c.still_fraction:.0f}", str(c.segments), span,
-                      "still segments" if c.still_only else "whole run")
+        span = (
+            "-" if c.temperature_min_degc is None else f"{c.temperature_min_degc:.1f} .. {c.temperature_max_degc:.1f}"
+        )
+        table.add_row(
+            Path(c.source).name,
+            f"{c.duration_s / 60:.1f}",
+            f"{c.still_s / 60:.1f}",
+            f"{100 * c.still_fraction:.0f}",
+            str(c.segments),
+            span,
+            "still segments" if c.still_only else "whole run",
+        )
     make_console().print(table)
 
 
@@ -82,26 +96,38 @@ def print_learner(learner, contributions, output) -> None:
     for col in ("log", "length [min]", "still used [min]", "rejected pieces", "temperature [degC]"):
         table.add_column(col)
     for c in contributions:
-        table.add_row(Path(c.source).name, f"{c.duration_s / 60:.1f}", f"{c.still_s / 60:.1f}", str(c.rejected),
-                      f"{c.temperature_min_degc:.1f} .. {c.temperature_max_degc:.1f}")
+        table.add_row(
+            Path(c.source).name,
+            f"{c.duration_s / 60:.1f}",
+            f"{c.still_s / 60:.1f}",
+            str(c.rejected),
+            f"{c.temperature_min_degc:.1f} .. {c.temperature_max_degc:.1f}",
+        )
     console = make_console()
     console.print(table)
     st = learner.status
-    console.print(f"learned: curve of degree {st.degree} in the temperature through a {st.lag_time_constant_s:g} s lag, "
-                  f"{st.t_min_degc:.1f}..{st.t_max_degc:.1f} degC, from {st.still_s / 60:.1f} still minutes of "
-                  f"{st.sessions} power-on(s) ({st.points} points, {st.rejected_outliers} outliers and "
-                  f"{st.rejected_bound} out-of-bound pieces rejected)")
-    console.print("residual RMS [deg/s]: " + ", ".join(f"{a} {v:.4f}" for a, v in zip("xyz", st.rms_dps))
-                  + "; standard error of the model [deg/s]: "
-                  + ", ".join(f"{a} {v:.4f}" for a, v in zip("xyz", st.uncertainty_dps)))
+    console.print(
+        f"learned: curve of degree {st.degree} in the temperature through a {st.lag_time_constant_s:g} s lag, "
+        f"{st.t_min_degc:.1f}..{st.t_max_degc:.1f} degC, from {st.still_s / 60:.1f} still minutes of "
+        f"{st.sessions} power-on(s) ({st.points} points, {st.rejected_outliers} outliers and "
+        f"{st.rejected_bound} out-of-bound pieces rejected)"
+    )
+    console.print(
+        "residual RMS [deg/s]: "
+        + ", ".join(f"{a} {v:.4f}" for a, v in zip("xyz", st.rms_dps))
+        + "; standard error of the model [deg/s]: "
+        + ", ".join(f"{a} {v:.4f}" for a, v in zip("xyz", st.uncertainty_dps))
+    )
     console.print(f"wrote {output}")
 
 
 def _print_triad(console, name: str, triad) -> None:
     """K (and its standard errors) of a triad, with its scale-factor errors in ppm."""
-    table = Table(title=f"{name} scale factor and misalignment ({triad.method}"
-                  + (f", K linear in temperature about {triad.reference_degc:.1f} degC" if triad.temperature_order else "")
-                  + ")")
+    table = Table(
+        title=f"{name} scale factor and misalignment ({triad.method}"
+        + (f", K linear in temperature about {triad.reference_degc:.1f} degC" if triad.temperature_order else "")
+        + ")"
+    )
     for col in ("axis", "K row (+- standard error)", "scale error [ppm]", f"bias [{triad.unit}]"):
         table.add_column(col)
     for i, axis in enumerate("xyz"):
@@ -132,14 +158,18 @@ def _print_axis_fits(console, axes: dict, report: FitReport, title: str, unit: s
         rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
         rms = ["-" if fit is None or fit.fit_rms is None else f"{fit.fit_rms:.3g}"] if with_rms else []
         constants = ax.turn_on_biases
-        shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (f" ... ({len(constants)})" if len(constants) > 6 else "")
+        shown = ", ".join(f"{c:+.4g}" for c in constants[:6]) + (
+            f" ... ({len(constants)})" if len(constants) > 6 else ""
+        )
         table.add_row(axis, model, rng, *rms, shown)
     console.print(table)
     net = report.network
     if net:
-        console.print(f"network: 1-{'-'.join(map(str, net.hidden))}-1 tanh/linear, {net.restarts} restarts "
-                      f"(seed {net.seed}), {net.training}; validation RMS of the restarts [{unit}]: " + "; ".join(
-                          f"{a} " + ", ".join(f"{v:.4g}" for v in rmse) for a, rmse in net.validation_rmse.items()))
+        console.print(
+            f"network: 1-{'-'.join(map(str, net.hidden))}-1 tanh/linear, {net.restarts} restarts "
+            f"(seed {net.seed}), {net.training}; validation RMS of the restarts [{unit}]: "
+            + "; ".join(f"{a} " + ", ".join(f"{v:.4g}" for v in rmse) for a, rmse in net.validation_rmse.items())
+        )
     if report.order_selection is not None:
         _print_order_selection(console, axes, report.order_selection, unit)
     if report.selection:
@@ -147,16 +177,30 @@ def _print_axis_fits(console, axes: dict, report: FitReport, title: str, unit: s
         return _print_g_sensitivity(console, report.acceleration)
     hyst = report.hysteresis
     if hyst is not None and any(len(choice.scores) > 1 for choice in hyst.axes.values()):
-        ht = Table(title="hysteresis / thermal lag by " + ("BIC (lower is better)" if hyst.by_bic else
-                   f"leave-one-run-out residual drift RMS [{unit}] (60 s moving average; lower is better)"))
+        ht = Table(
+            title="hysteresis / thermal lag by "
+            + (
+                "BIC (lower is better)"
+                if hyst.by_bic
+                else f"leave-one-run-out residual drift RMS [{unit}] (60 s moving average; lower is better)"
+            )
+        )
         ht.add_column("axis")
         candidates = hyst.memories_scored
         for name in candidates:
             ht.add_column(name, justify="right")
         ht.add_column("chosen")
         for axis, choice in hyst.axes.items():
-            cells = [("-" if choice.scores.get(c) is None else f"{choice.scores[c]:.4g}"
-                      + ("*" if c == choice.memory else "")) if c in choice.scores else "-" for c in candidates]
+            cells = [
+                (
+                    "-"
+                    if choice.scores.get(c) is None
+                    else f"{choice.scores[c]:.4g}" + ("*" if c == choice.memory else "")
+                )
+                if c in choice.scores
+                else "-"
+                for c in candidates
+            ]
             ht.add_row(axis, *cells, choice.label)
         console.print(ht)
     _print_g_sensitivity(console, report.acceleration)
@@ -185,19 +229,27 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
     """The model choice: per axis the chosen and best candidates against the run constant alone, then the fold
     scores of those three (every candidate's are in the model file)."""
     first = next(iter(selection.values()))
-    table = Table(title=f"model choice by held-out drift ({first.fold_kind}: {len(first.folds)} folds, "
-                        f"{first.window_s:g} s moving average, simplest within one standard error) [{unit}]")
+    table = Table(
+        title=f"model choice by held-out drift ({first.fold_kind}: {len(first.folds)} folds, "
+        f"{first.window_s:g} s moving average, simplest within one standard error) [{unit}]"
+    )
     decided = any(sel.decided_by for sel in selection.values())  # files written before it was stored have none
     columns = ("axis", "chosen", "held-out drift", "best", "best drift", "constant only") + (
-        ("decided by",) if decided else ())
+        ("decided by",) if decided else ()
+    )
     for col in columns:
         table.add_column(col, justify="left" if col in ("axis", "chosen", "best", "decided by") else "right")
     for axis, sel in selection.items():
         chosen, best = sel.result(sel.chosen.label), sel.result(sel.best.label)
-        table.add_row(axis, sel.chosen.label + (" (the die's lag)" if sel.lag_from_unit else ""),
-                      with_error(chosen.mean_drift, chosen.standard_error),
-                      sel.best.label, _score(best.mean_drift), _score(sel.raw_drift),
-                      *((sel.decided_by,) if decided else ()))
+        table.add_row(
+            axis,
+            sel.chosen.label + (" (the die's lag)" if sel.lag_from_unit else ""),
+            with_error(chosen.mean_drift, chosen.standard_error),
+            sel.best.label,
+            _score(best.mean_drift),
+            _score(sel.raw_drift),
+            *((sel.decided_by,) if decided else ()),
+        )
     console.print(table)
     # one row per fold, one column per axis and model: as narrow for twelve legs as for three runs
     folds = Table(title=f"held-out drift per fold [{unit}]: each axis's chosen model, the best, the constant")
@@ -211,25 +263,34 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
         for role in named.values():
             folds.add_column(f"{axis} {role}", justify="right")
     for f, name in enumerate(first.folds):
-        folds.add_row(name, *[_score(selection[axis].result(label).fold_drift[f])
-                              for axis, named in roles.items() for label in named])
+        folds.add_row(
+            name,
+            *[_score(selection[axis].result(label).fold_drift[f]) for axis, named in roles.items() for label in named],
+        )
     console.print(folds)
 
 
 def _print_g_sensitivity(console, acc: GSensitivityReport | None) -> None:
     """The G table, for the gyro axes where some column was fitted (a chamber run in one orientation fits none:
     no table of "not fitted" cells then)."""
-    fitted = {} if acc is None else {axis: row for axis, row in acc.axes.items()
-                                     if any(e is not None for e in row.standard_error_dps_per_g)}
+    fitted = (
+        {}
+        if acc is None
+        else {axis: row for axis, row in acc.axes.items() if any(e is not None for e in row.standard_error_dps_per_g)}
+    )
     if fitted:
-        gt = Table(title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc.static_segments)} "
-                         f"static segments; excited: {', '.join(acc.excited_axes) or 'none'})")
+        gt = Table(
+            title=f"g-sensitivity G [deg/s/g] +- standard error (cluster-robust over {sum(acc.static_segments)} "
+            f"static segments; excited: {', '.join(acc.excited_axes) or 'none'})"
+        )
         gt.add_column("gyro axis")
         for name in ("accel_x", "accel_y", "accel_z"):
             gt.add_column(name, justify="right")
         for axis, row in fitted.items():
-            cells = [with_error(g, e, sign=True) if e is not None else "not fitted"
-                     for g, e in zip(row.g_sensitivity_dps_per_g, row.standard_error_dps_per_g)]
+            cells = [
+                with_error(g, e, sign=True) if e is not None else "not fitted"
+                for g, e in zip(row.g_sensitivity_dps_per_g, row.standard_error_dps_per_g)
+            ]
             gt.add_row(axis, *cells)
         console.print(gt)
 
@@ -252,8 +313,12 @@ def _figures_table(title: str, what: str) -> Table:
     table = Table(title=title)
     for col in ("axis", what):
         table.add_column(col, no_wrap=True)
-    for col in ("bias offset\n[deg/s]", f"improvement\n(raw/{what})", "bias instability\n[deg/h]",
-                "integration time\n[s]"):
+    for col in (
+        "bias offset\n[deg/s]",
+        f"improvement\n(raw/{what})",
+        "bias instability\n[deg/h]",
+        "integration time\n[s]",
+    ):
         table.add_column(col, justify="right")
     return table
 
@@ -261,17 +326,30 @@ def _figures_table(title: str, what: str) -> Table:
 def print_stages(staged) -> None:
     console = make_console()
     for run in staged:
-        table = _figures_table(f"{Path(run.file).name}: stages of the compensation (window {run.window_s:.4g} s)",
-                               "stage")
+        table = _figures_table(
+            f"{Path(run.file).name}: stages of the compensation (window {run.window_s:.4g} s)", "stage"
+        )
         first = next(iter(run.stages.values()))
         for axis in first:
             m0 = first[axis]
-            table.add_row(axis, "raw", f"{m0.bias_offset_raw_dps:.4g}", "1x", f"{m0.bias_instability_raw_dph:.4g}",
-                          f"{m0.integration_time_raw_s:.4g}")
+            table.add_row(
+                axis,
+                "raw",
+                f"{m0.bias_offset_raw_dps:.4g}",
+                "1x",
+                f"{m0.bias_instability_raw_dph:.4g}",
+                f"{m0.integration_time_raw_s:.4g}",
+            )
             for name, axes in run.stages.items():
                 m = axes[axis]
-                table.add_row("", name, f"{m.bias_offset_comp_dps:.4g}", f"{m.offset_improvement:.3g}x",
-                              f"{m.bias_instability_comp_dph:.4g}", f"{m.integration_time_comp_s:.4g}")
+                table.add_row(
+                    "",
+                    name,
+                    f"{m.bias_offset_comp_dps:.4g}",
+                    f"{m.offset_improvement:.3g}x",
+                    f"{m.bias_instability_comp_dph:.4g}",
+                    f"{m.integration_time_comp_s:.4g}",
+                )
         console.print(table)
 
 
@@ -279,8 +357,14 @@ def print_comparison(result) -> None:
     console = make_console()
     table = _figures_table(f"methods compared ({result.how})", "method")
     for row in result.rows:
-        table.add_row(row.axis, row.method, f"{row.bias_offset_dps:.4g}", f"{row.improvement:.3g}x",
-                      f"{row.bias_instability_deg_per_h:.4g}", f"{row.integration_time_s:.4g}")
+        table.add_row(
+            row.axis,
+            row.method,
+            f"{row.bias_offset_dps:.4g}",
+            f"{row.improvement:.3g}x",
+            f"{row.bias_instability_deg_per_h:.4g}",
+            f"{row.integration_time_s:.4g}",
+        )
     console.print(table)
 
 
@@ -294,14 +378,32 @@ def _metrics_table(title: str, evaluation: Evaluation, rows_of) -> Table | None:
     table = Table(title=title)
     table.add_column("run", no_wrap=True)
     table.add_column("axis", no_wrap=True)
-    for col in ("window\n[s]", f"offset raw\n[{unit}]", f"offset comp\n[{unit}]", "improvement\n(raw/comp)",
-                f"BI raw\n[{bi_unit}]", f"BI comp\n[{bi_unit}]", "int. time raw\n[s]", "int. time comp\n[s]",
-                f"residual RMS\n[{unit}]"):
+    for col in (
+        "window\n[s]",
+        f"offset raw\n[{unit}]",
+        f"offset comp\n[{unit}]",
+        "improvement\n(raw/comp)",
+        f"BI raw\n[{bi_unit}]",
+        f"BI comp\n[{bi_unit}]",
+        "int. time raw\n[s]",
+        "int. time comp\n[s]",
+        f"residual RMS\n[{unit}]",
+    ):
         table.add_column(col, justify="right")
     for run, axis, m in rows:
-        table.add_row(Path(run.file).name, axis, f"{run.window_s:.4g}", f"{m.offset_raw:.4g}", f"{m.offset_comp:.4g}",
-                      f"{m.offset_improvement:.3g}x", f"{m.bias_instability_raw:.4g}", f"{m.bias_instability_comp:.4g}",
-                      f"{m.integration_time_raw_s:.4g}", f"{m.integration_time_comp_s:.4g}", f"{m.residual_rms:.3g}")
+        table.add_row(
+            Path(run.file).name,
+            axis,
+            f"{run.window_s:.4g}",
+            f"{m.offset_raw:.4g}",
+            f"{m.offset_comp:.4g}",
+            f"{m.offset_improvement:.3g}x",
+            f"{m.bias_instability_raw:.4g}",
+            f"{m.bias_instability_comp:.4g}",
+            f"{m.integration_time_raw_s:.4g}",
+            f"{m.integration_time_comp_s:.4g}",
+            f"{m.residual_rms:.3g}",
+        )
     return table
 
 
@@ -310,20 +412,25 @@ def print_expected_drift(expected: dict) -> None:
     if not expected:
         return
     first = next(iter(expected.values()))
-    table = Table(title=f"drift to expect on unseen data (the model file's {first.folds} held-out {first.fold_kind}, "
-                        f"{first.window_s:g} s moving average" + ("; thin evidence" if first.thin else "") + ")")
+    table = Table(
+        title=f"drift to expect on unseen data (the model file's {first.folds} held-out {first.fold_kind}, "
+        f"{first.window_s:g} s moving average" + ("; thin evidence" if first.thin else "") + ")"
+    )
     for col in ("axis", "model", "expected drift", "run constant alone"):
         table.add_column(col, justify="left" if col in ("axis", "model") else "right")
     for e in expected.values():
-        table.add_row(e.axis, e.model, f"{with_error(e.drift, e.standard_error)} {e.unit}",
-                      f"{_score(e.constant_drift)} {e.unit}")
+        table.add_row(
+            e.axis, e.model, f"{with_error(e.drift, e.standard_error)} {e.unit}", f"{_score(e.constant_drift)} {e.unit}"
+        )
     make_console().print(table)
 
 
 def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -> None:
     console = make_console()
-    for table in (_metrics_table(title, evaluation, lambda run: run.axes.items()),
-                  _metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items())):
+    for table in (
+        _metrics_table(title, evaluation, lambda run: run.axes.items()),
+        _metrics_table(f"{title}: accelerometer", evaluation, lambda run: run.accel_axes.items()),
+    ):
         if table is not None:
             console.print(table)
     if evaluation.triads:
@@ -332,16 +439,23 @@ def print_evaluation(evaluation: Evaluation, title: str = "gyrocomp evaluate") -
             table.add_column(col, justify="left" if col in ("run", "figure") else "right")
         for t in evaluation.triads:
             label, scale, unit = _TRIAD_FIGURES[t.figure]
-            table.add_row(Path(t.file).name, label, str(t.raw.size), f"{t.rms_raw * scale:.3g} {unit}",
-                          f"{t.rms_compensated * scale:.3g} {unit}",
-                          f"{t.rms_raw / t.rms_compensated:.3g}x" if t.rms_compensated > 0 else "-")
+            table.add_row(
+                Path(t.file).name,
+                label,
+                str(t.raw.size),
+                f"{t.rms_raw * scale:.3g} {unit}",
+                f"{t.rms_compensated * scale:.3g} {unit}",
+                f"{t.rms_raw / t.rms_compensated:.3g}x" if t.rms_compensated > 0 else "-",
+            )
         console.print(table)
 
 
 #: how ``evaluate`` prints each scale-factor figure: label, factor to the printed unit, unit
-_TRIAD_FIGURES = {"pose_norm_g": ("|a| - 1 g at each still pose", 1e3, "mg"),
-                  "turn_direction_deg": ("gravity direction after each turn", 1.0, "deg"),
-                  "rate_error_dps": ("rate error on each rate-table stretch", 1.0, "deg/s")}
+_TRIAD_FIGURES = {
+    "pose_norm_g": ("|a| - 1 g at each still pose", 1e3, "mg"),
+    "turn_direction_deg": ("gravity direction after each turn", 1.0, "deg"),
+    "rate_error_dps": ("rate error on each rate-table stretch", 1.0, "deg/s"),
+}
 
 
 def print_noise(analysis: NoiseAnalysis) -> None:
@@ -353,8 +467,15 @@ def print_noise(analysis: NoiseAnalysis) -> None:
             table.add_column(col, justify="left" if col == "noise type by" else "right")
         methods = c.noise_method or ("",) * len(c.tau)
         for row in zip(c.tau, c.deviation, c.ci_low, c.ci_high, c.n, c.alpha, methods):
-            table.add_row(f"{row[0]:.6g}", f"{row[1]:.5g}", f"{row[2]:.5g}", f"{row[3]:.5g}", f"{row[4]:d}",
-                          "-" if np.isnan(row[5]) else f"{row[5]:+.0f}", row[6] or "-")
+            table.add_row(
+                f"{row[0]:.6g}",
+                f"{row[1]:.5g}",
+                f"{row[2]:.5g}",
+                f"{row[3]:.5g}",
+                f"{row[4]:d}",
+                "-" if np.isnan(row[5]) else f"{row[5]:+.0f}",
+                row[6] or "-",
+            )
         console.print(table)
     table = Table(title="noise terms (IEEE Std 952 fit; B = Allan minimum / 0.664)")
     table.add_column("axis", no_wrap=True)
@@ -364,21 +485,25 @@ def print_noise(analysis: NoiseAnalysis) -> None:
     for name, a in analysis.axes.items():
         n = a.noise
         if a.sensor == "gyro":
-            rows = [("N [deg/s/sqrt(Hz)]", n.noise_density_dps_per_sqrt_hz, n.noise_density_readoff_dps_per_sqrt_hz),
-                    ("ARW [deg/sqrt(h)]", n.arw_deg_per_sqrt_h, None),
-                    ("B [deg/h]", n.bias_instability_deg_per_h, None),
-                    ("integration time [s]", n.integration_time_s, None),
-                    ("K [deg/h/sqrt(h)]", n.rrw_deg_per_h_per_sqrt_h, n.rrw_readoff_deg_per_h_per_sqrt_h),
-                    ("Q [deg]", n.quantization_deg, None),
-                    ("R [deg/h^2]", n.rate_ramp_deg_per_h2, None)]
+            rows = [
+                ("N [deg/s/sqrt(Hz)]", n.noise_density_dps_per_sqrt_hz, n.noise_density_readoff_dps_per_sqrt_hz),
+                ("ARW [deg/sqrt(h)]", n.arw_deg_per_sqrt_h, None),
+                ("B [deg/h]", n.bias_instability_deg_per_h, None),
+                ("integration time [s]", n.integration_time_s, None),
+                ("K [deg/h/sqrt(h)]", n.rrw_deg_per_h_per_sqrt_h, n.rrw_readoff_deg_per_h_per_sqrt_h),
+                ("Q [deg]", n.quantization_deg, None),
+                ("R [deg/h^2]", n.rate_ramp_deg_per_h2, None),
+            ]
         else:
-            rows = [("N [g/sqrt(Hz)]", n.noise_density_g_per_sqrt_hz, n.noise_density_readoff_g_per_sqrt_hz),
-                    ("VRW [m/s/sqrt(h)]", n.vrw_m_per_s_per_sqrt_h, None),
-                    ("B [micro-g]", n.bias_instability_micro_g, None),
-                    ("integration time [s]", n.integration_time_s, None),
-                    ("K [m/s^3/sqrt(Hz)]", n.random_walk_m_per_s3_per_sqrt_hz, n.random_walk_readoff_m_per_s3_per_sqrt_hz),
-                    ("Q [m/s]", n.quantization_m_per_s, None),
-                    ("R [m/s^3]", n.ramp_m_per_s3, None)]
+            rows = [
+                ("N [g/sqrt(Hz)]", n.noise_density_g_per_sqrt_hz, n.noise_density_readoff_g_per_sqrt_hz),
+                ("VRW [m/s/sqrt(h)]", n.vrw_m_per_s_per_sqrt_h, None),
+                ("B [micro-g]", n.bias_instability_micro_g, None),
+                ("integration time [s]", n.integration_time_s, None),
+                ("K [m/s^3/sqrt(Hz)]", n.random_walk_m_per_s3_per_sqrt_hz, n.random_walk_readoff_m_per_s3_per_sqrt_hz),
+                ("Q [m/s]", n.quantization_m_per_s, None),
+                ("R [m/s^3]", n.ramp_m_per_s3, None),
+            ]
         for i, (term, value, readoff) in enumerate(rows):
             table.add_row(name if i == 0 else "", term, f"{value:.4g}", "" if readoff is None else f"{readoff:.4g}")
         if not n.floor_reached:
@@ -389,48 +514,88 @@ def print_noise(analysis: NoiseAnalysis) -> None:
 def print_noise_model(model: NoiseModel) -> None:
     """Per axis: the IEEE 952 fit beside the two bounds, and each log's own bound."""
     console = make_console()
-    table = Table(title=f"noise model at {model.rate_hz:g} Hz: at or above the measured Allan deviation's upper "
-                        "95 % interval (ratio: model / measured over the bounded taus)")
-    for col in ("axis", "unit u", "IEEE 952 N [u/sqrt(Hz)]", "IEEE 952 K [u/sqrt(s)]", "bound N", "bound K",
-                "ratio median / max", "with Gauss-Markov: terms", "ratio median / max ", "taus bounded [s]"):
+    table = Table(
+        title=f"noise model at {model.rate_hz:g} Hz: at or above the measured Allan deviation's upper "
+        "95 % interval (ratio: model / measured over the bounded taus)"
+    )
+    for col in (
+        "axis",
+        "unit u",
+        "IEEE 952 N [u/sqrt(Hz)]",
+        "IEEE 952 K [u/sqrt(s)]",
+        "bound N",
+        "bound K",
+        "ratio median / max",
+        "with Gauss-Markov: terms",
+        "ratio median / max ",
+        "taus bounded [s]",
+    ):
         table.add_column(col, justify="left" if col in ("axis", "unit u") else "right")
     for name, a in model.axes.items():
-        table.add_row(name, a.unit, f"{a.ieee.white_noise_density:.4g}",
-                      f"{a.ieee.random_walk:.4g}", f"{a.bound.white_noise_density:.4g}",
-                      f"{a.bound.random_walk:.4g}", f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}",
-                      str(len(a.markov.markov)), f"{a.markov.ratio_median:.2f} / {a.markov.ratio_max:.2f}",
-                      f"{a.bound.taus_s[0]:.3g} .. {a.max_tau_s:.3g}")
+        table.add_row(
+            name,
+            a.unit,
+            f"{a.ieee.white_noise_density:.4g}",
+            f"{a.ieee.random_walk:.4g}",
+            f"{a.bound.white_noise_density:.4g}",
+            f"{a.bound.random_walk:.4g}",
+            f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}",
+            str(len(a.markov.markov)),
+            f"{a.markov.ratio_median:.2f} / {a.markov.ratio_max:.2f}",
+            f"{a.bound.taus_s[0]:.3g} .. {a.max_tau_s:.3g}",
+        )
     console.print(table)
     if any(len(a.logs) > 1 for a in model.axes.values()):
-        logs = Table(title="each log's own bound (white noise N, random walk K) and N read at one sample with its "
-                           "95 % interval")
+        logs = Table(
+            title="each log's own bound (white noise N, random walk K) and N read at one sample with its 95 % interval"
+        )
         for col in ("axis", "log", "temperature [degC]", "bound N", "bound K", "N at one sample [95 %]"):
             logs.add_column(col, justify="left" if col in ("axis", "log") else "right")
         for name, a in model.axes.items():
             for log in a.logs:
                 low, value, high = log.white_noise_interval
-                logs.add_row(name, Path(log.source).name,
-                             "-" if log.temperature_degc is None else f"{log.temperature_degc:.1f}",
-                             f"{log.bound.white_noise_density:.4g}", f"{log.bound.random_walk:.4g}",
-                             f"{value:.4g} [{low:.4g}, {high:.4g}]")
+                logs.add_row(
+                    name,
+                    Path(log.source).name,
+                    "-" if log.temperature_degc is None else f"{log.temperature_degc:.1f}",
+                    f"{log.bound.white_noise_density:.4g}",
+                    f"{log.bound.random_walk:.4g}",
+                    f"{value:.4g} [{low:.4g}, {high:.4g}]",
+                )
         console.print(logs)
 
 
 def print_bias_process_noise(benefit: dict) -> None:
     """Per gyro axis: the bias random walk a filter needs with the raw and with the compensated gyro."""
-    table = Table(title="the bias random walk a filter needs on these runs (white noise and random walk at or above "
-                        "the Allan curve up to a quarter of the run) [deg/s/sqrt(s)]")
+    table = Table(
+        title="the bias random walk a filter needs on these runs (white noise and random walk at or above "
+        "the Allan curve up to a quarter of the run) [deg/s/sqrt(s)]"
+    )
     for col in ("axis", "raw K", "compensated K", "raw / compensated", "raw N", "compensated N"):
         table.add_column(col, justify="left" if col == "axis" else "right")
     for name, b in benefit.items():
-        table.add_row(name, f"{b.raw.random_walk:.4g}", f"{b.compensated.random_walk:.4g}",
-                      f"{b.random_walk_ratio:.1f}", f"{b.raw.white_noise_density:.4g}",
-                      f"{b.compensated.white_noise_density:.4g}")
+        table.add_row(
+            name,
+            f"{b.raw.random_walk:.4g}",
+            f"{b.compensated.random_walk:.4g}",
+            f"{b.random_walk_ratio:.1f}",
+            f"{b.raw.white_noise_density:.4g}",
+            f"{b.compensated.white_noise_density:.4g}",
+        )
     make_console().print(table)
 
 
-__all__ = ["print_bias_process_noise", "print_comparison", "print_evaluation", "print_expected_drift", "print_fit",
-           "print_noise", "print_noise_model", "print_stages", "print_validation"]
+__all__ = [
+    "print_bias_process_noise",
+    "print_comparison",
+    "print_evaluation",
+    "print_expected_drift",
+    "print_fit",
+    "print_noise",
+    "print_noise_model",
+    "print_stages",
+    "print_validation",
+]
 
 
 def print_station_status(stations, store) -> None:
@@ -444,7 +609,12 @@ def print_station_status(stations, store) -> None:
         table.add_column(column, overflow="fold")
     for s in stations:
         fitting = ", ".join(s.fitting[:5]) + (f" (+{len(s.fitting) - 5})" if len(s.fitting) > 5 else "")
-        table.add_row(s.station, str(s.ok), str(s.failed),
-                      "" if s.last_utc is None else f"{s.last_utc:%Y-%m-%d %H:%M:%S}", fitting or "-",
-                      f"{s.stale} (rerun the station)" if s.stale else "0")
+        table.add_row(
+            s.station,
+            str(s.ok),
+            str(s.failed),
+            "" if s.last_utc is None else f"{s.last_utc:%Y-%m-%d %H:%M:%S}",
+            fitting or "-",
+            f"{s.stale} (rerun the station)" if s.stale else "0",
+        )
     console.print(table)

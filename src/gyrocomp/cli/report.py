@@ -16,21 +16,41 @@ from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_op
 @click.argument("model", type=click.Path())
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="The HTML file to write.")
-@click.option("--window", "window_s", type=FINITE, default=None,
-              help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).")
-@click.option("--turn-on-window", "turn_on_window_s", type=FINITE, default=None,
-              help="Estimate each run's turn-on bias from its first S seconds [s].")
-@click.option("--min-static", "static_min_duration_s", type=FINITE, default=10.0, show_default=True,
-              help="Shortest still stretch drawn as a static position [s].")
-@click.option("--validate-on", "validate_on", multiple=True, type=click.Path(),
-              help="A calibration run to validate on (repeat it for each run): adds the table of gyrocomp validate.")
+@click.option(
+    "--window",
+    "window_s",
+    type=FINITE,
+    default=None,
+    help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
+)
+@click.option(
+    "--turn-on-window",
+    "turn_on_window_s",
+    type=FINITE,
+    default=None,
+    help="Estimate each run's turn-on bias from its first S seconds [s].",
+)
+@click.option(
+    "--min-static",
+    "static_min_duration_s",
+    type=FINITE,
+    default=10.0,
+    show_default=True,
+    help="Shortest still stretch drawn as a static position [s].",
+)
+@click.option(
+    "--validate-on",
+    "validate_on",
+    multiple=True,
+    type=click.Path(),
+    help="A calibration run to validate on (repeat it for each run): adds the table of gyrocomp validate.",
+)
 @read_options
 @click.pass_context
 def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_duration_s, validate_on, **kwargs):
     """One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias against
     temperature, raw and compensated series, Allan deviations, g-sensitivity; with --validate-on, the held-out
     drift of each method on those calibration runs."""
-
 
     opts = pop_read_options(kwargs)
     refuse_to_overwrite_inputs(output, [model, *runs, *validate_on])
@@ -46,8 +66,15 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
         with progress_bar("validating", indeterminate=True):
             validation = validate_runs([read_run(path, opts).recording for path in validate_on])
     with progress_bar("report") as progress:
-        result = build_report(calibration, recordings, window_s=window_s, turn_on_window_s=turn_on_window_s,
-                              min_static_s=static_min_duration_s, progress=progress, validation=validation)
+        result = build_report(
+            calibration,
+            recordings,
+            window_s=window_s,
+            turn_on_window_s=turn_on_window_s,
+            min_static_s=static_min_duration_s,
+            progress=progress,
+            validation=validation,
+        )
     write_text_atomic(output, result.html)
     if not ctx.obj["quiet"]:
         click.echo(f"wrote {output}: {len(result.html) / 1e6:.2f} MB, sections {', '.join(result.sections)}")

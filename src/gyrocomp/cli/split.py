@@ -15,19 +15,52 @@ from .common import FINITE, pop_read_options, read_options, read_run
 
 @click.command()
 @click.argument("log", type=click.Path())
-@click.option("-o", "--output", "folder", required=True, type=click.Path(file_okay=False),
-              help="Folder to write the runs to (made when missing): LOG_run1.csv, LOG_run2.csv, ...")
-@click.option("--by", "by", required=True, type=click.Choice(SPLITS),
-              help="Where to cut: power-on (gaps of --min-gap or more), gap (every time gap), still (still "
-                   "segments of --min-still or more), temperature-turn (each heating or cooling leg).")
-@click.option("--min-gap", "min_gap_s", type=FINITE, default=60.0, show_default=True,
-              help="power-on: the shortest gap between two power-ons [s].")
-@click.option("--min-still", "min_still_s", type=FINITE, default=600.0, show_default=True,
-              help="still: the shortest still segment kept [s].")
-@click.option("--min-leg", "min_leg_degc", type=FINITE, default=2.0, show_default=True,
-              help="temperature-turn: how far the temperature must come back for a turn to count [degC].")
-@click.option("--suffix", type=click.Choice(("csv", "tsv", "parquet")), default=None,
-              help="Format of the runs written (default: the log's, for a table; csv for any other log).")
+@click.option(
+    "-o",
+    "--output",
+    "folder",
+    required=True,
+    type=click.Path(file_okay=False),
+    help="Folder to write the runs to (made when missing): LOG_run1.csv, LOG_run2.csv, ...",
+)
+@click.option(
+    "--by",
+    "by",
+    required=True,
+    type=click.Choice(SPLITS),
+    help="Where to cut: power-on (gaps of --min-gap or more), gap (every time gap), still (still "
+    "segments of --min-still or more), temperature-turn (each heating or cooling leg).",
+)
+@click.option(
+    "--min-gap",
+    "min_gap_s",
+    type=FINITE,
+    default=60.0,
+    show_default=True,
+    help="power-on: the shortest gap between two power-ons [s].",
+)
+@click.option(
+    "--min-still",
+    "min_still_s",
+    type=FINITE,
+    default=600.0,
+    show_default=True,
+    help="still: the shortest still segment kept [s].",
+)
+@click.option(
+    "--min-leg",
+    "min_leg_degc",
+    type=FINITE,
+    default=2.0,
+    show_default=True,
+    help="temperature-turn: how far the temperature must come back for a turn to count [degC].",
+)
+@click.option(
+    "--suffix",
+    type=click.Choice(("csv", "tsv", "parquet")),
+    default=None,
+    help="Format of the runs written (default: the log's, for a table; csv for any other log).",
+)
 @read_options
 @click.pass_context
 def split(ctx, log, folder, by, min_gap_s, min_still_s, min_leg_degc, suffix, **kwargs):
@@ -54,9 +87,14 @@ def split(ctx, log, folder, by, min_gap_s, min_still_s, min_leg_degc, suffix, **
         click.echo(f"wrote {len(pieces)} run(s) of {log} to {folder} (by {by}):")
         for piece, path in zip(pieces, names):
             rec = piece.recording
-            click.echo(f"  {path.name}: {rec.n_samples} rows, {rec.time_s[0] - t0:.6g} .. {rec.time_s[-1] - t0:.6g} s"
-                       + ("" if rec.temperature_degc is None else
-                          f", {rec.temperature_degc.min():.2f} .. {rec.temperature_degc.max():.2f} degC"))
+            click.echo(
+                f"  {path.name}: {rec.n_samples} rows, {rec.time_s[0] - t0:.6g} .. {rec.time_s[-1] - t0:.6g} s"
+                + (
+                    ""
+                    if rec.temperature_degc is None
+                    else f", {rec.temperature_degc.min():.2f} .. {rec.temperature_degc.max():.2f} degC"
+                )
+            )
 
 
 def _table_suffix(log: str, data) -> str:

@@ -15,13 +15,28 @@ from .render import print_validation
 
 @click.command()
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
-@click.option("--folds", type=click.Choice(FOLD_KINDS), default="auto", show_default=True,
-              help="Hold out each run, each heating or cooling leg, or time blocks; auto: runs with three runs "
-                   "or more, else legs.")
-@click.option("--window", "window_s", type=FINITE, default=None,
-              help="Moving-average window of the drift [s] (default: as fit's model choice: a tenth of the median fold, 60..600 s, at most a quarter of the shortest).")
-@click.option("--candidate", "candidates", multiple=True, metavar="SPEC",
-              help="Also validate gyrocomp fitted with --temperature SPEC (poly:N, poly, mlp); repeatable.")
+@click.option(
+    "--folds",
+    type=click.Choice(FOLD_KINDS),
+    default="auto",
+    show_default=True,
+    help="Hold out each run, each heating or cooling leg, or time blocks; auto: runs with three runs "
+    "or more, else legs.",
+)
+@click.option(
+    "--window",
+    "window_s",
+    type=FINITE,
+    default=None,
+    help="Moving-average window of the drift [s] (default: as fit's model choice: a tenth of the median fold, 60..600 s, at most a quarter of the shortest).",
+)
+@click.option(
+    "--candidate",
+    "candidates",
+    multiple=True,
+    metavar="SPEC",
+    help="Also validate gyrocomp fitted with --temperature SPEC (poly:N, poly, mlp); repeatable.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON on stdout.")
 @read_options
 @click.pass_context
@@ -39,8 +54,9 @@ def validate(ctx, runs, folds, window_s, candidates, as_json, **kwargs):
     for spec in candidates:
         model = parse_temperature_option(spec)
         if model is None:
-            raise click.BadParameter("a candidate needs a temperature model (poly, poly:N or mlp)",
-                                     param_hint="--candidate")
+            raise click.BadParameter(
+                "a candidate needs a temperature model (poly, poly:N or mlp)", param_hint="--candidate"
+            )
         named[f"gyrocomp {spec}"] = FitOptions(temperature=model)
     recordings = [read_run(path, opts).recording for path in runs]
     with progress_bar("validating", indeterminate=True):

@@ -87,16 +87,32 @@ class HysteresisCurve:
 
     def offset(self, temperature_degc: np.ndarray, turns) -> np.ndarray:
         reach = self.max_distance_degc or (None, None)
-        down = hysteresis_offset(temperature_degc, turns, self.descending, direction="descending",
-                                 band_degc=self.band_degc, max_distance_degc=reach[0])
-        up = hysteresis_offset(temperature_degc, turns, self.ascending, direction="ascending",
-                               band_degc=self.band_degc, max_distance_degc=reach[1])
+        down = hysteresis_offset(
+            temperature_degc,
+            turns,
+            self.descending,
+            direction="descending",
+            band_degc=self.band_degc,
+            max_distance_degc=reach[0],
+        )
+        up = hysteresis_offset(
+            temperature_degc,
+            turns,
+            self.ascending,
+            direction="ascending",
+            band_degc=self.band_degc,
+            max_distance_degc=reach[1],
+        )
         return down + up
 
     def to_dict(self) -> dict[str, Any]:
-        d = {"type": self.kind, "descending_dps": list(self.descending),
-             "ascending_dps": list(self.ascending), "threshold_degc": self.threshold_degc,
-             "band_degc": None if self.band_degc is None else list(self.band_degc)}
+        d = {
+            "type": self.kind,
+            "descending_dps": list(self.descending),
+            "ascending_dps": list(self.ascending),
+            "threshold_degc": self.threshold_degc,
+            "band_degc": None if self.band_degc is None else list(self.band_degc),
+        }
         if self.max_distance_degc is not None:  # written only when set: earlier readers see an earlier file
             d["max_distance_degc"] = list(self.max_distance_degc)
         return d
@@ -104,10 +120,15 @@ class HysteresisCurve:
     def c_code(self, slot: int) -> CCode:
         """The offset on the branch after the last confirmed turn: sum_j h_j d^j, d = |tm - turn| (held at the
         largest distance the fit saw), inside the band."""
-        lines = [f"turn_update(&s->turn[{slot}], tm, {c_number(self.threshold_degc)});",
-                 f"if (s->turn[{slot}].has_turn) {{"]
-        band = ("" if self.band_degc is None
-                else f" && tm >= {c_number(self.band_degc[0])} && tm <= {c_number(self.band_degc[1])}")
+        lines = [
+            f"turn_update(&s->turn[{slot}], tm, {c_number(self.threshold_degc)});",
+            f"if (s->turn[{slot}].has_turn) {{",
+        ]
+        band = (
+            ""
+            if self.band_degc is None
+            else f" && tm >= {c_number(self.band_degc[0])} && tm <= {c_number(self.band_degc[1])}"
+        )
         reach = self.max_distance_degc or (None, None)
         for sign, coefs, d_max in ((-1, self.descending, reach[0]), (1, self.ascending, reach[1])):
             lines.append(f"    if (s->turn[{slot}].direction == {sign}{band}) {{")
@@ -127,9 +148,13 @@ class HysteresisCurve:
             raise InputError(f"unknown hysteresis model type {d.get('type')!r}")
         band = d.get("band_degc")
         reach = d.get("max_distance_degc")
-        return cls(tuple(float(v) for v in d["descending_dps"]), tuple(float(v) for v in d["ascending_dps"]),
-                   float(d["threshold_degc"]), None if band is None else (float(band[0]), float(band[1])),
-                   None if reach is None else (float(reach[0]), float(reach[1])))
+        return cls(
+            tuple(float(v) for v in d["descending_dps"]),
+            tuple(float(v) for v in d["ascending_dps"]),
+            float(d["threshold_degc"]),
+            None if band is None else (float(band[0]), float(band[1])),
+            None if reach is None else (float(reach[0]), float(reach[1])),
+        )
 
 
 @register_memory_curve
@@ -167,13 +192,16 @@ class BranchCurve:
 
     def describe(self) -> str:
         """In words for tables: ``heating/cooling branches (2 terms, crossover 6 degC)``."""
-        return f"heating/cooling branches ({self.order} term{'s' if self.order > 1 else ''}, crossover " \
-               f"{self.transition_degc:.3g} degC)"
+        return (
+            f"heating/cooling branches ({self.order} term{'s' if self.order > 1 else ''}, crossover "
+            f"{self.transition_degc:.3g} degC)"
+        )
 
     def half_difference(self, temperature_degc: np.ndarray) -> np.ndarray:
         """(heating curve - cooling curve) / 2 at ``temperature_degc`` [the axis's unit], held past the range."""
-        u = (np.clip(np.asarray(temperature_degc, dtype=float), self.t_min_degc, self.t_max_degc)
-             - self.t_ref_degc) / self.t_scale_degc
+        u = (
+            np.clip(np.asarray(temperature_degc, dtype=float), self.t_min_degc, self.t_max_degc) - self.t_ref_degc
+        ) / self.t_scale_degc
         out = np.zeros_like(u)
         for c in reversed(self.coefficients):
             out = out * u + c
@@ -183,41 +211,66 @@ class BranchCurve:
         return branch_position(temperature_degc, turns, self.transition_degc) * self.half_difference(temperature_degc)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": self.kind, "coefficients_dps": list(self.coefficients), "t_ref_degc": self.t_ref_degc,
-                "t_scale_degc": self.t_scale_degc, "transition_degc": self.transition_degc,
-                "threshold_degc": self.threshold_degc, "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
+        return {
+            "type": self.kind,
+            "coefficients_dps": list(self.coefficients),
+            "t_ref_degc": self.t_ref_degc,
+            "t_scale_degc": self.t_scale_degc,
+            "transition_degc": self.transition_degc,
+            "threshold_degc": self.threshold_degc,
+            "t_min_degc": self.t_min_degc,
+            "t_max_degc": self.t_max_degc,
+        }
 
     def c_code(self, slot: int) -> CCode:
         """The heating and cooling branches: s * sum c_k u^k (:func:`gyrocomp.effects.branch_position` for s)."""
         w = c_number(self.transition_degc)
-        return CCode((f"turn_update(&s->turn[{slot}], tm, {c_number(self.threshold_degc)});",
-                      "{",
-                      f"    const double c[] = {c_array(self.coefficients)};",
-                      f"    double tc = tm < {c_number(self.t_min_degc)} ? {c_number(self.t_min_degc)} : "
-                      f"(tm > {c_number(self.t_max_degc)} ? {c_number(self.t_max_degc)} : tm);",
-                      f"    double u = (tc - {c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)}, half = 0.0;",
-                      f"    for (int k = {self.order - 1}; k >= 0; --k) half = half * u + c[k];",
-                      f"    const gyrocomp_turn *tp = &s->turn[{slot}];",
-                      "    double position = (double)tp->direction;",
-                      f"    if (tp->has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - tp->turn) / {w});",
-                      "    else position *= 1.0 - exp(-fabs(tm - (tp->direction > 0 ? tp->low : tp->high)) / "
-                      f"{w});",
-                      "    shape += position * half;",
-                      "}"))
+        return CCode(
+            (
+                f"turn_update(&s->turn[{slot}], tm, {c_number(self.threshold_degc)});",
+                "{",
+                f"    const double c[] = {c_array(self.coefficients)};",
+                f"    double tc = tm < {c_number(self.t_min_degc)} ? {c_number(self.t_min_degc)} : "
+                f"(tm > {c_number(self.t_max_degc)} ? {c_number(self.t_max_degc)} : tm);",
+                f"    double u = (tc - {c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)}, half = 0.0;",
+                f"    for (int k = {self.order - 1}; k >= 0; --k) half = half * u + c[k];",
+                f"    const gyrocomp_turn *tp = &s->turn[{slot}];",
+                "    double position = (double)tp->direction;",
+                f"    if (tp->has_turn) position *= 1.0 - 2.0 * exp(-fabs(tm - tp->turn) / {w});",
+                f"    else position *= 1.0 - exp(-fabs(tm - (tp->direction > 0 ? tp->low : tp->high)) / {w});",
+                "    shape += position * half;",
+                "}",
+            )
+        )
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "BranchCurve":
-        curve = cls(tuple(float(v) for v in d["coefficients_dps"]), float(d["t_ref_degc"]),
-                    float(d["t_scale_degc"]), float(d["transition_degc"]), float(d["threshold_degc"]),
-                    float(d["t_min_degc"]), float(d["t_max_degc"]))
+        curve = cls(
+            tuple(float(v) for v in d["coefficients_dps"]),
+            float(d["t_ref_degc"]),
+            float(d["t_scale_degc"]),
+            float(d["transition_degc"]),
+            float(d["threshold_degc"]),
+            float(d["t_min_degc"]),
+            float(d["t_max_degc"]),
+        )
         if not (curve.t_scale_degc > 0 and curve.transition_degc > 0 and curve.threshold_degc >= 0):
-            raise InputError("hysteresis: a branch model needs t_scale_degc and transition_degc above 0 and "
-                             "threshold_degc of 0 or more")
+            raise InputError(
+                "hysteresis: a branch model needs t_scale_degc and transition_degc above 0 and "
+                "threshold_degc of 0 or more"
+            )
         return curve
 
 
-__all__ = ["BranchCurve", "HysteresisCurve", "MEMORY_CURVES", "heats_and_cools", "memory_curve_from_dict",
-           "parting_band_degc", "turn_threshold_degc"]
+__all__ = [
+    "BranchCurve",
+    "HysteresisCurve",
+    "MEMORY_CURVES",
+    "heats_and_cools",
+    "memory_curve_from_dict",
+    "parting_band_degc",
+    "turn_threshold_degc",
+]
 
 
 def _grow(core: np.ndarray, tail: np.ndarray, start: int, step: int) -> int:
@@ -228,8 +281,13 @@ def _grow(core: np.ndarray, tail: np.ndarray, start: int, step: int) -> int:
     return k
 
 
-def parting_band_degc(temperature_degc: np.ndarray, residual_dps: np.ndarray, after_turn: np.ndarray,
-                      direction: np.ndarray, tail: bool = False) -> tuple[float, float] | None:
+def parting_band_degc(
+    temperature_degc: np.ndarray,
+    residual_dps: np.ndarray,
+    after_turn: np.ndarray,
+    direction: np.ndarray,
+    tail: bool = False,
+) -> tuple[float, float] | None:
     """The temperature band where the branches after a reversal part from the opposite branches [degC], or None
     when no band stands out or it spans most of the range.
 

@@ -45,8 +45,10 @@ class LookupTableCurve:
 
     def __post_init__(self) -> None:
         if len(self.values) < 2 or not self.t_max_degc > self.t_min_degc:
-            raise InputError(f"lookup table: at least 2 values on a range with t_max_degc > t_min_degc, got "
-                             f"{len(self.values)} on {self.t_min_degc}..{self.t_max_degc}")
+            raise InputError(
+                f"lookup table: at least 2 values on a range with t_max_degc > t_min_degc, got "
+                f"{len(self.values)} on {self.t_min_degc}..{self.t_max_degc}"
+            )
 
     @property
     def order(self) -> str:
@@ -87,16 +89,24 @@ class LookupTableCurve:
         """The segment of the clipped temperature, then linear interpolation in it."""
         n = len(self.values) - 1
         step = (self.t_max_degc - self.t_min_degc) / n
-        return CCode((f"{{ static const double v[{n + 1}] = {c_array(self.values)};",
-                      f"  double x = (clip(tm, {c_number(self.t_min_degc)}, {c_number(self.t_max_degc)}) - "
-                      f"{c_number(self.t_min_degc)}) / {c_number(step)};",
-                      f"  int k = (int)x; if (k > {n - 1}) k = {n - 1}; if (k < 0) k = 0;",
-                      "  shape = v[k] + (v[k + 1] - v[k]) * (x - k);",
-                      "}"))
+        return CCode(
+            (
+                f"{{ static const double v[{n + 1}] = {c_array(self.values)};",
+                f"  double x = (clip(tm, {c_number(self.t_min_degc)}, {c_number(self.t_max_degc)}) - "
+                f"{c_number(self.t_min_degc)}) / {c_number(step)};",
+                f"  int k = (int)x; if (k > {n - 1}) k = {n - 1}; if (k < 0) k = 0;",
+                "  shape = v[k] + (v[k + 1] - v[k]) * (x - k);",
+                "}",
+            )
+        )
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": self.kind, "values_dps": list(self.values), "t_min_degc": self.t_min_degc,
-                "t_max_degc": self.t_max_degc}
+        return {
+            "type": self.kind,
+            "values_dps": list(self.values),
+            "t_min_degc": self.t_min_degc,
+            "t_max_degc": self.t_max_degc,
+        }
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "LookupTableCurve":
@@ -116,8 +126,10 @@ class LookupTableBasis:
     paired difference (:mod:`gyrocomp.fitting.scores`)."""
 
     name: ClassVar[str] = "table"
-    description: ClassVar[str] = ("a lookup table of N intervals over the calibrated range, linear between its points, "
-                                  "held past its ends (what sensor vendors flash)")
+    description: ClassVar[str] = (
+        "a lookup table of N intervals over the calibrated range, linear between its points, "
+        "held past its ends (what sensor vendors flash)"
+    )
     sizes: ClassVar[tuple[int, ...]] = (8, 16)
 
     lo_degc: float
@@ -127,8 +139,9 @@ class LookupTableBasis:
     def over(cls, lo_degc: float, hi_degc: float, extended: bool = True) -> "LookupTableBasis":
         return cls(lo_degc, hi_degc if hi_degc > lo_degc else lo_degc + 1.0)
 
-    def columns(self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None,
-                hi_degc: float | None = None) -> np.ndarray:
+    def columns(
+        self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None, hi_degc: float | None = None
+    ) -> np.ndarray:
         t = np.asarray(temperature_degc, dtype=float)
         if lo_degc is not None:
             t = np.clip(t, lo_degc, hi_degc)

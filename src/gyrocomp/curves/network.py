@@ -32,9 +32,9 @@ def unpack(theta: np.ndarray, shapes: list[tuple[int, int]]) -> list[tuple[np.nd
     """Weights and biases of each layer from the flat parameter vector."""
     out, i = [], 0
     for rows, cols in shapes:
-        w = theta[i: i + rows * cols].reshape(rows, cols)
+        w = theta[i : i + rows * cols].reshape(rows, cols)
         i += rows * cols
-        b = theta[i: i + rows]
+        b = theta[i : i + rows]
         i += rows
         out.append((w, b))
     return out
@@ -123,30 +123,46 @@ class NetworkCurve:
         """``name(tm, accel)``: the network, inputs scaled to [-1, 1] as fitted, tanh layers, a linear output;
         ``name_ref`` its value at the reference inputs, set by ``gyrocomp_init``."""
         shapes = layer_shapes(len(self.inputs), self.hidden)
-        lines = [f"static double {name}(double tm, const double accel[3])", "{", "    (void)tm; (void)accel;",
-                 f"    double a0[{len(self.inputs)}];"]
+        lines = [
+            f"static double {name}(double tm, const double accel[3])",
+            "{",
+            "    (void)tm; (void)accel;",
+            f"    double a0[{len(self.inputs)}];",
+        ]
         values = ["tm" if i == "temperature" else f"accel[{ACCEL_INPUTS.index(i)}]" for i in self.inputs]
         for i, (v, lo, hi) in enumerate(zip(values, self.input_min, self.input_max)):
-            lines.append(f"    a0[{i}] = 2.0 * (clip({v}, {c_number(lo)}, {c_number(hi)}) - {c_number(lo)}) / "
-                         f"{c_number(hi - lo)} - 1.0;" if hi > lo else f"    a0[{i}] = 0.0;")
+            lines.append(
+                f"    a0[{i}] = 2.0 * (clip({v}, {c_number(lo)}, {c_number(hi)}) - {c_number(lo)}) / "
+                f"{c_number(hi - lo)} - 1.0;"
+                if hi > lo
+                else f"    a0[{i}] = 0.0;"
+            )
         prev = "a0"
         for k, ((rows, cols), flat) in enumerate(zip(shapes, self.weights)):
             activation = f"z + b{k}[r]" if k == len(shapes) - 1 else f"tanh(z + b{k}[r])"
-            lines += [f"    static const double w{k}[{rows * cols}] = {c_array(flat[: rows * cols])};",
-                      f"    static const double b{k}[{rows}] = {c_array(flat[rows * cols:])};",
-                      f"    double a{k + 1}[{rows}];",
-                      f"    for (int r = 0; r < {rows}; ++r) {{",
-                      "        double z = 0.0;",
-                      f"        for (int c = 0; c < {cols}; ++c) z += {prev}[c] * w{k}[r * {cols} + c];",
-                      f"        a{k + 1}[r] = {activation};",
-                      "    }"]
+            lines += [
+                f"    static const double w{k}[{rows * cols}] = {c_array(flat[: rows * cols])};",
+                f"    static const double b{k}[{rows}] = {c_array(flat[rows * cols :])};",
+                f"    double a{k + 1}[{rows}];",
+                f"    for (int r = 0; r < {rows}; ++r) {{",
+                "        double z = 0.0;",
+                f"        for (int c = 0; c < {cols}; ++c) z += {prev}[c] * w{k}[r * {cols} + c];",
+                f"        a{k + 1}[r] = {activation};",
+                "    }",
+            ]
             prev = f"a{k + 1}"
-        lines += [f"    return {prev}[0] * {c_number(self.output_scale)} + {c_number(self.output_mean)};", "}",
-                  f"static double {name}_ref;", ""]
+        lines += [
+            f"    return {prev}[0] * {c_number(self.output_scale)} + {c_number(self.output_mean)};",
+            "}",
+            f"static double {name}_ref;",
+            "",
+        ]
         ref = list(self.reference)
         t_ref = ref[self.inputs.index("temperature")] if "temperature" in self.inputs else 0.0
         acc = [ref[self.inputs.index(a)] if a in self.inputs else 0.0 for a in ACCEL_INPUTS]
-        init = f"    {{ const double ref_accel[3] = {c_array(acc)}; {name}_ref = {name}({c_number(t_ref)}, ref_accel); }}"
+        init = (
+            f"    {{ const double ref_accel[3] = {c_array(acc)}; {name}_ref = {name}({c_number(t_ref)}, ref_accel); }}"
+        )
         return CCode((f"shape = {name}(tm, acc) - {name}_ref;",), tuple(lines), (init,))
 
     @property
@@ -179,24 +195,36 @@ class NetworkCurve:
                 cols.append(t)
             else:
                 if accel_g is None:
-                    raise InputError("the network reads the accelerations; the data needs accel_x, accel_y and "
-                                     "accel_z columns [g]")
+                    raise InputError(
+                        "the network reads the accelerations; the data needs accel_x, accel_y and accel_z columns [g]"
+                    )
                 cols.append(np.asarray(accel_g, dtype=float)[:, ACCEL_INPUTS.index(name)])
         return np.column_stack(cols)
 
     def shape(self, temperature_degc: np.ndarray, accel_g: np.ndarray | None = None) -> np.ndarray:
         """Bias shape [the axis's unit], zero at the reference inputs, held at the edges of the fitted ranges."""
         shape = self.net_dps(self.input_values(temperature_degc, accel_g)) - float(
-            self.net_dps(np.asarray(self.reference)[None, :])[0])
+            self.net_dps(np.asarray(self.reference)[None, :])[0]
+        )
         return shape.reshape(np.shape(temperature_degc))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": "mlp", "hidden": list(self.hidden), "activation": "tanh", "output": "linear",
-                "inputs": list(self.inputs), "input_min": list(self.input_min), "input_max": list(self.input_max),
-                "reference": list(self.reference),
-                "weights": [list(layer) for layer in self.weights], "output_mean_dps": self.output_mean,
-                "output_scale_dps": self.output_scale, "t_ref_degc": self.t_ref_degc,
-                "t_min_degc": self.t_min_degc, "t_max_degc": self.t_max_degc}
+        return {
+            "type": "mlp",
+            "hidden": list(self.hidden),
+            "activation": "tanh",
+            "output": "linear",
+            "inputs": list(self.inputs),
+            "input_min": list(self.input_min),
+            "input_max": list(self.input_max),
+            "reference": list(self.reference),
+            "weights": [list(layer) for layer in self.weights],
+            "output_mean_dps": self.output_mean,
+            "output_scale_dps": self.output_scale,
+            "t_ref_degc": self.t_ref_degc,
+            "t_min_degc": self.t_min_degc,
+            "t_max_degc": self.t_max_degc,
+        }
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "NetworkCurve":
@@ -209,11 +237,29 @@ class NetworkCurve:
         if [len(layer) for layer in weights] != [r * c + r for r, c in shapes]:
             raise InputError(f"mlp weights do not fit a {len(inputs)}-{'-'.join(map(str, hidden))}-1 network")
         floats = lambda key: tuple(float(v) for v in d.get(key, ()))  # noqa: E731
-        return cls(hidden, weights, float(d["output_mean_dps"]), float(d["output_scale_dps"]), float(d["t_ref_degc"]),
-                   float(d["t_min_degc"]), float(d["t_max_degc"]), inputs, floats("input_min"), floats("input_max"),
-                   floats("reference"))
+        return cls(
+            hidden,
+            weights,
+            float(d["output_mean_dps"]),
+            float(d["output_scale_dps"]),
+            float(d["t_ref_degc"]),
+            float(d["t_min_degc"]),
+            float(d["t_max_degc"]),
+            inputs,
+            floats("input_min"),
+            floats("input_max"),
+            floats("reference"),
+        )
 
 
-
-__all__ = ["ACCEL_INPUTS", "DEFAULT_HIDDEN", "NETWORK_BLOCK_S", "NETWORK_INPUTS", "NetworkCurve", "forward", "layer_shapes",
-           "n_parameters", "unpack"]
+__all__ = [
+    "ACCEL_INPUTS",
+    "DEFAULT_HIDDEN",
+    "NETWORK_BLOCK_S",
+    "NETWORK_INPUTS",
+    "NetworkCurve",
+    "forward",
+    "layer_shapes",
+    "n_parameters",
+    "unpack",
+]

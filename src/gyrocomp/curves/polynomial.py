@@ -83,16 +83,20 @@ class PolynomialCurve:
         """Horner's rule on u = (clip(tm) - T_ref) / T_scale, continued along the tangent past the range when the
         curve is."""
         c = self.coefficients
-        lines = [f"{{ const double c[] = {c_array(c)};" if c else "{",
-                 f"  double u = (clip(tm, {c_number(self.t_min_degc)}, {c_number(self.t_max_degc)}) - "
-                 f"{c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)};",
-                 "  shape = 0.0;"]
+        lines = [
+            f"{{ const double c[] = {c_array(c)};" if c else "{",
+            f"  double u = (clip(tm, {c_number(self.t_min_degc)}, {c_number(self.t_max_degc)}) - "
+            f"{c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)};",
+            "  shape = 0.0;",
+        ]
         if c:
             lines.append(f"  for (int k = {len(c) - 1}; k >= 0; --k) shape = (shape + c[k]) * u;")
             if self.extrapolation == "linear":  # continued along the tangent past the range
-                lines += ["  double slope = 0.0;",
-                          f"  for (int k = {len(c) - 1}; k >= 0; --k) slope = slope * u + (k + 1) * c[k];",
-                          f"  shape += slope * ((tm - {c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)} - u);"]
+                lines += [
+                    "  double slope = 0.0;",
+                    f"  for (int k = {len(c) - 1}; k >= 0; --k) slope = slope * u + (k + 1) * c[k];",
+                    f"  shape += slope * ((tm - {c_number(self.t_ref_degc)}) / {c_number(self.t_scale_degc)} - u);",
+                ]
         lines.append("}")
         return CCode(tuple(lines))
 
@@ -142,14 +146,21 @@ class PolynomialCurve:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "PolynomialCurve":
-        return cls(tuple(float(c) for c in d["coefficients_dps"]), float(d["t_ref_degc"]),
-                   float(d["t_scale_degc"]), float(d["t_min_degc"]), float(d["t_max_degc"]),
-                   str(d.get("extrapolation", "hold")))
+        return cls(
+            tuple(float(c) for c in d["coefficients_dps"]),
+            float(d["t_ref_degc"]),
+            float(d["t_scale_degc"]),
+            float(d["t_min_degc"]),
+            float(d["t_max_degc"]),
+            str(d.get("extrapolation", "hold")),
+        )
 
 
 def horner(u: np.ndarray, coefficients: list[float]) -> np.ndarray:
     """sum_k coefficients[k] u^k by Horner's rule, one pass over u per coefficient."""
-    value = np.full(np.shape(u), coefficients[-1]) if len(coefficients) == 1 else coefficients[-1] * u + coefficients[-2]
+    value = (
+        np.full(np.shape(u), coefficients[-1]) if len(coefficients) == 1 else coefficients[-1] * u + coefficients[-2]
+    )
     for c in reversed(coefficients[:-2]):
         value *= u
         value += c
@@ -176,8 +187,9 @@ class PolynomialBasis:
     def over(cls, lo_degc: float, hi_degc: float, extended: bool = True) -> "PolynomialBasis":
         return cls((lo_degc + hi_degc) / 2, (hi_degc - lo_degc) / 2 if hi_degc > lo_degc else 1.0, extended)
 
-    def columns(self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None,
-                hi_degc: float | None = None) -> np.ndarray:
+    def columns(
+        self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None, hi_degc: float | None = None
+    ) -> np.ndarray:
         t = np.asarray(temperature_degc, dtype=float)
         u = (t - self.t_ref_degc) / self.t_scale_degc
         if lo_degc is None:
@@ -186,8 +198,14 @@ class PolynomialBasis:
         return polynomial_columns(clipped, size, u - clipped if self.extended else None)
 
     def curve(self, coefficients: np.ndarray, lo_degc: float, hi_degc: float) -> PolynomialCurve:
-        return PolynomialCurve(tuple(float(a) for a in coefficients), self.t_ref_degc, self.t_scale_degc, lo_degc,
-                              hi_degc, "linear" if self.extended else "hold")
+        return PolynomialCurve(
+            tuple(float(a) for a in coefficients),
+            self.t_ref_degc,
+            self.t_scale_degc,
+            lo_degc,
+            hi_degc,
+            "linear" if self.extended else "hold",
+        )
 
 
 def power_columns(u: np.ndarray, first: int, last: int) -> np.ndarray:
@@ -200,7 +218,7 @@ def power_columns(u: np.ndarray, first: int, last: int) -> np.ndarray:
         if j:
             np.multiply(out[j - 1], u, out=out[j])
         else:
-            out[0] = 1.0 if first == 0 else u if first == 1 else u ** first
+            out[0] = 1.0 if first == 0 else u if first == 1 else u**first
     return out.T
 
 
@@ -211,5 +229,3 @@ def polynomial_columns(clipped_u: np.ndarray, order: int, beyond_u: np.ndarray |
     if beyond_u is not None and order:
         cols = cols + np.arange(1, order + 1) * power_columns(clipped_u, 0, order - 1) * beyond_u[:, None]
     return cols
-
-

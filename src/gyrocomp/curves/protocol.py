@@ -138,8 +138,9 @@ class CurveBasis(Protocol):
     @classmethod
     def over(cls, lo_degc: float, hi_degc: float, extended: bool = True) -> "CurveBasis": ...
 
-    def columns(self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None,
-                hi_degc: float | None = None) -> np.ndarray:
+    def columns(
+        self, temperature_degc: np.ndarray, size: int, lo_degc: float | None = None, hi_degc: float | None = None
+    ) -> np.ndarray:
         """(n, size) columns at ``temperature_degc`` [degC], applied as a curve of range [lo, hi] would be
         (default: this basis's range)."""
 
@@ -200,10 +201,24 @@ def memory_curve_from_dict(d: dict[str, Any]) -> MemoryCurve:
     """The memory curve a model file's ``hysteresis`` entry describes (its ``type`` one of :data:`MEMORY_CURVES`)."""
     kind = MEMORY_CURVES.get(d.get("type")) if isinstance(d, dict) else None
     if kind is None:
-        raise InputError(f"hysteresis: unknown model type {d.get('type') if isinstance(d, dict) else d!r}; "
-                         f"use one of {', '.join(MEMORY_CURVES)}")
+        raise InputError(
+            f"hysteresis: unknown model type {d.get('type') if isinstance(d, dict) else d!r}; "
+            f"use one of {', '.join(MEMORY_CURVES)}"
+        )
     return kind.from_dict(d)
 
 
-__all__ = ["BASES", "CCode", "CURVES", "CurveBasis", "MEMORY_CURVES", "MemoryCurve", "TemperatureCurve",
-           "curve_from_dict", "memory_curve_from_dict", "register_basis", "register_curve", "register_memory_curve"]
+__all__ = [
+    "BASES",
+    "CCode",
+    "CURVES",
+    "CurveBasis",
+    "MEMORY_CURVES",
+    "MemoryCurve",
+    "TemperatureCurve",
+    "curve_from_dict",
+    "memory_curve_from_dict",
+    "register_basis",
+    "register_curve",
+    "register_memory_curve",
+]

@@ -5,11 +5,21 @@
 from __future__ import annotations
 
 from .evaluate_model import (
-    compare_installed, evaluate, evaluate_stages, InstalledComparison, stage_calibrations, StageEvaluation,
-    triad_residuals
+    compare_installed,
+    evaluate,
+    evaluate_stages,
+    InstalledComparison,
+    stage_calibrations,
+    StageEvaluation,
+    triad_residuals,
 )
 
 __all__ = [
-    "InstalledComparison", "StageEvaluation", "compare_installed", "evaluate", "evaluate_stages",
-    "stage_calibrations", "triad_residuals"
+    "InstalledComparison",
+    "StageEvaluation",
+    "compare_installed",
+    "evaluate",
+    "evaluate_stages",
+    "stage_calibrations",
+    "triad_residuals",
 ]

@@ -53,8 +53,9 @@ class BiasProcessNoise:
         return self.raw.random_walk / c if c > 0 else np.inf
 
 
-def bias_process_noise(calibration: Calibration, recordings: Recording | list[Recording],
-                       axes: list[str] | None = None) -> dict[str, BiasProcessNoise]:
+def bias_process_noise(
+    calibration: Calibration, recordings: Recording | list[Recording], axes: list[str] | None = None
+) -> dict[str, BiasProcessNoise]:
     """The bias process noise a filter needs, raw and compensated, on static runs through a temperature profile.
 
     Parameters
@@ -83,8 +84,9 @@ def _gyro_axes(calibration: Calibration, runs: list[Recording], axes: list[str] 
     names = shared if axes is None else list(axes)
     unknown = [a for a in names if a not in shared]
     if unknown or not names:
-        raise InputError(f"axes: {', '.join(unknown) or 'none'}: the model and the runs share "
-                         f"{', '.join(shared) or 'no gyro axis'}")
+        raise InputError(
+            f"axes: {', '.join(unknown) or 'none'}: the model and the runs share {', '.join(shared) or 'no gyro axis'}"
+        )
     return names
 
 
@@ -94,8 +96,7 @@ def _compensated(calibration: Calibration, runs: list[Recording]) -> list[Record
     return [apply(calibration, r) for r in runs]
 
 
-def _bias_bounds(runs: list[Recording], compensated: list[Recording], names: list[str]
-                 ) -> dict[str, BiasProcessNoise]:
+def _bias_bounds(runs: list[Recording], compensated: list[Recording], names: list[str]) -> dict[str, BiasProcessNoise]:
     """Each axis's two-term bound of the raw and of the compensated runs about their means."""
     max_tau = MAX_TAU_FRACTION * min(float(r.time_s[-1] - r.time_s[0]) for r in runs)
     out = {}
@@ -111,9 +112,14 @@ def _bias_bounds(runs: list[Recording], compensated: list[Recording], names: lis
     return out
 
 
-def compensated_noise(calibration: Calibration, recordings: list[Recording], axes: list[str] | None = None, *,
-                      with_accel: bool = False, split_gaps: bool = False
-                      ) -> tuple[NoiseModel, dict[str, BiasProcessNoise]]:
+def compensated_noise(
+    calibration: Calibration,
+    recordings: list[Recording],
+    axes: list[str] | None = None,
+    *,
+    with_accel: bool = False,
+    split_gaps: bool = False,
+) -> tuple[NoiseModel, dict[str, BiasProcessNoise]]:
     """The noise model of the compensated gyro (what an estimator on the vehicle receives) and what the calibration
     buys its bias process noise (:func:`bias_process_noise`), on the same static runs.
 
@@ -134,8 +140,9 @@ def compensated_noise(calibration: Calibration, recordings: list[Recording], axe
     names = _gyro_axes(calibration, runs, [a for a in axes if a.startswith("gyro")] if axes else None)
     compensated = _compensated(calibration, runs)  # once, for both
     benefit = _bias_bounds(runs, compensated, names)
-    model = noise_model([analyse_noise(r, axes, with_accel=with_accel, split_gaps=split_gaps, motion_check=False)
-                         for r in compensated])
+    model = noise_model(
+        [analyse_noise(r, axes, with_accel=with_accel, split_gaps=split_gaps, motion_check=False) for r in compensated]
+    )
     return model, benefit
 
 

@@ -45,10 +45,11 @@ def _cubic_calibration(recordings: list[Recording], name: str, fit_axis) -> Cali
     for axis in recordings[0].gyro_axes:
         coef, t_ref, t_min, t_max = fit_axis(recordings, axis)
         shape = tuple(float(c) for c in coef[::-1][1:])  # np.polyfit: highest power first; X0 is the constant
-        axes[axis] = AxisCalibration(PolynomialCurve(shape, float(t_ref), 1.0, float(t_min), float(t_max)),
-                                     tuple(float(coef[-1]) for _ in recordings))
-    return Calibration(axes=axes, model=name, provenance=provenance(recordings),
-                       fit_report={"temperature": name})
+        axes[axis] = AxisCalibration(
+            PolynomialCurve(shape, float(t_ref), 1.0, float(t_min), float(t_max)),
+            tuple(float(coef[-1]) for _ in recordings),
+        )
+    return Calibration(axes=axes, model=name, provenance=provenance(recordings), fit_report={"temperature": name})
 
 
 def fit_px4_style(recordings: list[Recording]) -> Calibration:
@@ -66,8 +67,13 @@ def fit_px4_style(recordings: list[Recording]) -> Calibration:
         t_min, t_max = float(temperature.min()), float(temperature.max())
         t_ref = 0.5 * (t_min + t_max)
         span = t_max - t_min
-        index = np.clip(((temperature - t_min) / (span / PX4_BINS)).astype(np.int64) if span > 0 else
-                        np.zeros(temperature.size, dtype=np.int64), 0, PX4_BINS - 1)
+        index = np.clip(
+            ((temperature - t_min) / (span / PX4_BINS)).astype(np.int64)
+            if span > 0
+            else np.zeros(temperature.size, dtype=np.int64),
+            0,
+            PX4_BINS - 1,
+        )
         count = np.bincount(index, minlength=PX4_BINS)
         full = count > 0
         t_mean = np.bincount(index, weights=temperature - t_ref, minlength=PX4_BINS)[full] / count[full]
@@ -83,6 +89,7 @@ def fit_ardupilot_style(recordings: list[Recording]) -> Calibration:
     over every sample, unweighted, in T - 35 degC; applied clamped to [TMIN, TMAX] of the log. Several runs
     are pooled as one log.
     """
+
     def fit_axis(recs, axis):
         temps, gyros = [], []
         for r in recs:
@@ -95,6 +102,7 @@ def fit_ardupilot_style(recordings: list[Recording]) -> Calibration:
         return coef, ARDUPILOT_TEMP_REF_DEGC, float(temperature.min()), float(temperature.max())
 
     return _cubic_calibration(recordings, "ArduPilot cubic (tempcal_IMU.py)", fit_axis)
+
 
 #: a method compared: the options of gyrocomp's fit, or a function of the training runs returning a Calibration
 Method = FitOptions | Callable[[list[Recording]], Calibration]
@@ -115,8 +123,13 @@ AUTOPILOT_METHODS: dict[str, Callable[[list[Recording]], Calibration]] = {
 DEFAULT_METHODS: dict[str, Method] = {**AUTOPILOT_METHODS, **THESIS_METHODS, "gyrocomp default (auto)": FitOptions()}
 
 
-def fit_method(method: Method, train: list[Recording], *, hysteresis_band_degc: tuple[float, float] | None = None,
-               seed: int | None = None) -> Calibration:
+def fit_method(
+    method: Method,
+    train: list[Recording],
+    *,
+    hysteresis_band_degc: tuple[float, float] | None = None,
+    seed: int | None = None,
+) -> Calibration:
     """Fit one compared method on the training runs.
 
     Parameters
@@ -178,16 +191,33 @@ def _method_row(name: str, axis: str, metrics: list) -> MethodRow:
     """One method's figures on one axis, averaged over the held-out runs (``raw``: the runs' raw figures)."""
     mean = lambda field: float(np.mean([getattr(m, field) for m in metrics]))  # noqa: E731
     if name == "raw":
-        return MethodRow(name, axis, mean("bias_offset_raw_dps"), 1.0, mean("bias_instability_raw_dph"),
-                         mean("integration_time_raw_s"))
+        return MethodRow(
+            name,
+            axis,
+            mean("bias_offset_raw_dps"),
+            1.0,
+            mean("bias_instability_raw_dph"),
+            mean("integration_time_raw_s"),
+        )
     offset, raw = mean("bias_offset_comp_dps"), mean("bias_offset_raw_dps")
-    return MethodRow(name, axis, offset, raw / offset if offset > 0 else float("inf"),
-                     mean("bias_instability_comp_dph"), mean("integration_time_comp_s"))
+    return MethodRow(
+        name,
+        axis,
+        offset,
+        raw / offset if offset > 0 else float("inf"),
+        mean("bias_instability_comp_dph"),
+        mean("integration_time_comp_s"),
+    )
 
 
-def compare_methods(recordings: list[Recording], *, methods: dict[str, Method] | None = None,
-                    window_s: float | None = None, hysteresis_band_degc: tuple[float, float] | None = None,
-                    seed: int | None = None) -> MethodComparison:
+def compare_methods(
+    recordings: list[Recording],
+    *,
+    methods: dict[str, Method] | None = None,
+    window_s: float | None = None,
+    hysteresis_band_degc: tuple[float, float] | None = None,
+    seed: int | None = None,
+) -> MethodComparison:
     """Score each method on the runs (see the module doc); the raw output is the first row of each axis.
 
     Parameters
@@ -227,12 +257,28 @@ def compare_methods(recordings: list[Recording], *, methods: dict[str, Method] |
             scored[name].append(result)
             if name == next(iter(methods)):
                 scored["raw"].append(result)
-    rows = [_method_row(name, axis, [r.axes[axis] for r in results])
-            for axis in recordings[0].gyro_axes for name, results in scored.items()]
-    how = ("leave one run out: each run compensated by models fitted on the other runs" if n > 1 else
-           "one run: the models are fitted and scored on the same run, as in the thesis (optimistic)")
+    rows = [
+        _method_row(name, axis, [r.axes[axis] for r in results])
+        for axis in recordings[0].gyro_axes
+        for name, results in scored.items()
+    ]
+    how = (
+        "leave one run out: each run compensated by models fitted on the other runs"
+        if n > 1
+        else "one run: the models are fitted and scored on the same run, as in the thesis (optimistic)"
+    )
     return MethodComparison(rows, how, windows)
 
 
-__all__ = ["AUTOPILOT_METHODS", "DEFAULT_METHODS", "Method", "MethodComparison", "MethodRow", "THESIS_METHODS", "compare_methods",
-           "fit_ardupilot_style", "fit_method", "fit_px4_style"]
+__all__ = [
+    "AUTOPILOT_METHODS",
+    "DEFAULT_METHODS",
+    "Method",
+    "MethodComparison",
+    "MethodRow",
+    "THESIS_METHODS",
+    "compare_methods",
+    "fit_ardupilot_style",
+    "fit_method",
+    "fit_px4_style",
+]

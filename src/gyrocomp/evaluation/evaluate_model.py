@@ -25,8 +25,13 @@ from ..calibration.installed import installed_calibration, installed_correction_
 from ..models.field import field_recordings
 
 
-def evaluate(calibration: Calibration, recordings: list[Recording] | Recording, *, window_s: float | None = None,
-             turn_on_window_s: float | None = None) -> Evaluation:
+def evaluate(
+    calibration: Calibration,
+    recordings: list[Recording] | Recording,
+    *,
+    window_s: float | None = None,
+    turn_on_window_s: float | None = None,
+) -> Evaluation:
     """Apply ``calibration`` to each recording and compare raw with compensated (:func:`evaluate_run`).
 
     Parameters
@@ -41,10 +46,13 @@ def evaluate(calibration: Calibration, recordings: list[Recording] | Recording, 
     """
     recordings = [recordings] if isinstance(recordings, Recording) else list(recordings)
     compensated = [apply(calibration, rec, turn_on_window_s=turn_on_window_s) for rec in recordings]
-    runs = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
-            for rec, comp in zip(recordings, compensated)]
-    return Evaluation(runs, [r for rec, comp in zip(recordings, compensated)
-                             for r in triad_residuals(calibration, rec, comp)])
+    runs = [
+        evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes))
+        for rec, comp in zip(recordings, compensated)
+    ]
+    return Evaluation(
+        runs, [r for rec, comp in zip(recordings, compensated) for r in triad_residuals(calibration, rec, comp)]
+    )
 
 
 def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recording) -> list[TriadResiduals]:
@@ -63,8 +71,10 @@ def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recor
         moving = np.linalg.norm(ref, axis=1) >= MIN_REFERENCE_RATE_DPS
         if np.any(still) and np.any(moving):
             bias = np.mean([s.gyro_dps for s, k in zip(before, still) if k], axis=0)
-            err = lambda segs, b: np.array([np.linalg.norm(s.gyro_dps - b - s.reference_dps)  # noqa: E731
-                                            for s, k in zip(segs, moving) if k])
+
+            def err(segs, b):
+                return np.array([np.linalg.norm(s.gyro_dps - b - s.reference_dps) for s, k in zip(segs, moving) if k])
+
             out.append(TriadResiduals(name, "rate_error_dps", err(before, bias), err(after, 0.0)))
     if raw.accel_g is None or raw.accel_g.shape[1] != 3 or raw.reference_rate_dps is not None:
         return out
@@ -73,17 +83,30 @@ def triad_residuals(calibration: Calibration, raw: Recording, compensated: Recor
         return out
     if calibration.accel_triad is not None and compensated.accel_g is not None:
         norm = lambda a: np.linalg.norm(a) - 1.0  # noqa: E731
-        out.append(TriadResiduals(name, "pose_norm_g", np.array([norm(p.accel_g) for p in poses]),
-                                  np.array([norm(compensated.accel_g[p.start_index:p.stop_index].mean(axis=0))
-                                            for p in poses])))
+        out.append(
+            TriadResiduals(
+                name,
+                "pose_norm_g",
+                np.array([norm(p.accel_g) for p in poses]),
+                np.array([norm(compensated.accel_g[p.start_index : p.stop_index].mean(axis=0)) for p in poses]),
+            )
+        )
     if calibration.gyro_triad is not None and raw.gyro_axes == GYRO_AXES:
         try:
-            before, after = (rotation_errors(r, TriadCalibration.identity(), accel_calibration=calibration.accel_triad)
-                             for r in (raw, dataclasses.replace(raw, gyro_dps=compensated.gyro_dps)))
+            before, after = (
+                rotation_errors(r, TriadCalibration.identity(), accel_calibration=calibration.accel_triad)
+                for r in (raw, dataclasses.replace(raw, gyro_dps=compensated.gyro_dps))
+            )
         except InputError:
             return out
-        out.append(TriadResiduals(name, "turn_direction_deg", np.array([m.error_after_deg for m in before]),
-                                  np.array([m.error_after_deg for m in after])))
+        out.append(
+            TriadResiduals(
+                name,
+                "turn_direction_deg",
+                np.array([m.error_after_deg for m in before]),
+                np.array([m.error_after_deg for m in after]),
+            )
+        )
     return out
 
 
@@ -97,15 +120,21 @@ class StageEvaluation:
     stages: dict[str, dict[str, AxisMetrics]]
 
     def to_dict(self) -> dict:
-        return {"file": self.file, "window_s": self.window_s,
-                "stages": {name: {a: m.to_dict() for a, m in axes.items()} for name, axes in self.stages.items()}}
+        return {
+            "file": self.file,
+            "window_s": self.window_s,
+            "stages": {name: {a: m.to_dict() for a, m in axes.items()} for name, axes in self.stages.items()},
+        }
 
 
 def stage_calibrations(calibration) -> dict:
     """The stages a calibration has, in the thesis's order, each as a calibration with the later parts off."""
     stages = {}
-    later = [p for p, on in (("acceleration", calibration.has_acceleration), ("hysteresis", calibration.has_hysteresis))
-             if on]
+    later = [
+        p
+        for p, on in (("acceleration", calibration.has_acceleration), ("hysteresis", calibration.has_hysteresis))
+        if on
+    ]
     stages["temperature only"] = calibration.without(*later)
     if calibration.has_acceleration:
         stages["temperature + acceleration"] = calibration.without(*[p for p in later if p != "acceleration"])
@@ -115,8 +144,13 @@ def stage_calibrations(calibration) -> dict:
     return stages
 
 
-def evaluate_stages(calibration: Calibration, recording: Recording, *, window_s: float | None = None,
-                    turn_on_window_s: float | None = None) -> StageEvaluation:
+def evaluate_stages(
+    calibration: Calibration,
+    recording: Recording,
+    *,
+    window_s: float | None = None,
+    turn_on_window_s: float | None = None,
+) -> StageEvaluation:
     """Bias offset, improvement, bias instability and integration time of a run at each stage of the calibration."""
     if window_s is None:
         window_s = default_window_s(recording)
@@ -124,7 +158,9 @@ def evaluate_stages(calibration: Calibration, recording: Recording, *, window_s:
     for name, cal in stage_calibrations(calibration).items():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DataQualityWarning)
-            result = evaluate_run(recording, apply(cal, recording, turn_on_window_s=turn_on_window_s), window_s=window_s)
+            result = evaluate_run(
+                recording, apply(cal, recording, turn_on_window_s=turn_on_window_s), window_s=window_s
+            )
         stages[name] = {axis: m for axis, m in result.axes.items() if axis in calibration.axes}
     return StageEvaluation(recording.source, float(window_s), stages)
 
@@ -164,13 +200,16 @@ def _installed_slot(recording: Recording, autopilot: str) -> tuple[int | None, s
         return instance, ""
     slot = px4_slot(params, device_id)
     if slot is None and int(params.get("TC_G_ENABLE", 0)) == 1:
-        return None, (f"no TC_G*_ID is the gyro's device id {device_id}: PX4 applies no thermal correction to it "
-                      "(export with device_id= that id)")
+        return None, (
+            f"no TC_G*_ID is the gyro's device id {device_id}: PX4 applies no thermal correction to it "
+            "(export with device_id= that id)"
+        )
     return slot, ""
 
 
-def compare_installed(calibration: Calibration, recording: Recording, *, window_s: float | None = None
-                      ) -> InstalledComparison:
+def compare_installed(
+    calibration: Calibration, recording: Recording, *, window_s: float | None = None
+) -> InstalledComparison:
     """Judge the thermal calibration installed on the vehicle that wrote ``recording`` (a PX4 ULog's ``TC_G*`` or
     an ArduPilot log's ``INS_TCAL*`` parameters) against ``calibration`` on the same data: the log's still segments
     when it moves most of the time (:func:`gyrocomp.models.field.field_recordings`), else all of it. The installed
@@ -189,12 +228,15 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
     """
     autopilot = recording.metadata.get("autopilot")
     if autopilot not in ("px4", "ardupilot") or "autopilot_parameters" not in recording.metadata:
-        raise InputError(f"{recording.source}: not a PX4 ULog or ArduPilot DataFlash log; the installed calibration "
-                         "is read from a log's parameters")
+        raise InputError(
+            f"{recording.source}: not a PX4 ULog or ArduPilot DataFlash log; the installed calibration "
+            "is read from a log's parameters"
+        )
     params = recording.metadata["autopilot_parameters"]
     slot, note = _installed_slot(recording, autopilot)
-    installed = None if slot is None else installed_calibration(params, autopilot,
-                                                                slot if autopilot == "px4" else slot - 1)
+    installed = (
+        None if slot is None else installed_calibration(params, autopilot, slot if autopilot == "px4" else slot - 1)
+    )
     onboard = bool(recording.metadata.get("corrected_onboard"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)
@@ -214,18 +256,35 @@ def compare_installed(calibration: Calibration, recording: Recording, *, window_
         if installed is None:
             return {a: float("nan") for a in data.gyro_axes}
         # the firmware runs over the whole log (PX4's republish follows its time), then the same samples are judged
-        correction = installed_correction_dps(params, autopilot, recording.time_s, recording.temperature_degc,
-                                              slot)[rows]
+        correction = installed_correction_dps(params, autopilot, recording.time_s, recording.temperature_degc, slot)[
+            rows
+        ]
         cols = [GYRO_AXES.index(a) for a in data.gyro_axes]
         corrected = data.with_gyro(data.gyro_dps - correction[:, cols])
         return {a: m.residual_rms_dps for a, m in evaluate_run(data, corrected, window_s=window).axes.items()}
 
     raw = {a: m.residual_rms_dps for a, m in evaluate_run(data, data, window_s=window).axes.items()}
-    return InstalledComparison(recording.source, autopilot, None if installed is None else installed.model, onboard,
-                               still_only, data.duration_s if not still_only else contributions[0].still_s, window,
-                               raw, raw if onboard else residual_installed(),
-                               residual(None) if onboard else residual(calibration), note)
+    return InstalledComparison(
+        recording.source,
+        autopilot,
+        None if installed is None else installed.model,
+        onboard,
+        still_only,
+        data.duration_s if not still_only else contributions[0].still_s,
+        window,
+        raw,
+        raw if onboard else residual_installed(),
+        residual(None) if onboard else residual(calibration),
+        note,
+    )
 
 
-__all__ = ["InstalledComparison", "StageEvaluation", "compare_installed", "evaluate", "evaluate_stages", "stage_calibrations",
-           "triad_residuals"]
+__all__ = [
+    "InstalledComparison",
+    "StageEvaluation",
+    "compare_installed",
+    "evaluate",
+    "evaluate_stages",
+    "stage_calibrations",
+    "triad_residuals",
+]

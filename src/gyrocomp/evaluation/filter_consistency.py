@@ -80,11 +80,11 @@ def _model(noise: NoiseBound, period_s: float) -> tuple[np.ndarray, np.ndarray]:
     f = np.zeros((size, size))
     f[0, 1:] = -1.0  # theta' = measured rate - bias - sum of the Gauss-Markov terms
     q = np.zeros(size)
-    q[0] = noise.white_noise_density ** 2
-    q[1] = noise.random_walk ** 2
+    q[0] = noise.white_noise_density**2
+    q[1] = noise.random_walk**2
     for j, (sigma, time_constant) in enumerate(noise.markov):
         f[2 + j, 2 + j] = -1.0 / time_constant
-        q[2 + j] = 2.0 * sigma ** 2 / time_constant
+        q[2 + j] = 2.0 * sigma**2 / time_constant
     block = np.zeros((2 * size, 2 * size))
     block[:size, :size] = -f
     block[:size, size:] = np.diag(q)
@@ -94,10 +94,17 @@ def _model(noise: NoiseBound, period_s: float) -> tuple[np.ndarray, np.ndarray]:
     return phi, phi @ e[:size, size:]
 
 
-def attitude_nees(errors_dps: np.ndarray, rate_hz: float, noise: NoiseBound, *, update_period_s: float = 2.0,
-                  update_sigma_deg: float = 0.01, burn_in_fraction: float = 0.2,
-                  schedule: Callable[[float], NoiseBound] | None = None,
-                  temperature_degc: np.ndarray | None = None) -> NeesResult:
+def attitude_nees(
+    errors_dps: np.ndarray,
+    rate_hz: float,
+    noise: NoiseBound,
+    *,
+    update_period_s: float = 2.0,
+    update_sigma_deg: float = 0.01,
+    burn_in_fraction: float = 0.2,
+    schedule: Callable[[float], NoiseBound] | None = None,
+    temperature_degc: np.ndarray | None = None,
+) -> NeesResult:
     """The time-averaged NEES of the attitude filter (see the module) told ``noise``, on gyro errors of known
     truth.
 
@@ -131,21 +138,28 @@ def attitude_nees(errors_dps: np.ndarray, rate_hz: float, noise: NoiseBound, *, 
     epochs = errors.shape[1] // per
     first = int(math.ceil(burn_in_fraction * epochs))
     if per < 1 or epochs - first < 2:
-        raise InputError(f"update_period_s: {update_period_s:g} s leaves fewer than two updates after the burn-in in "
-                         f"{errors.shape[1] / rate_hz:g} s")
+        raise InputError(
+            f"update_period_s: {update_period_s:g} s leaves fewer than two updates after the burn-in in "
+            f"{errors.shape[1] / rate_hz:g} s"
+        )
     if schedule is not None and (temperature_degc is None or noise.markov):
         raise InputError("schedule: needs temperature_degc, and a noise model of white noise and random walk only")
     # the measured angle of each update period: the rate integrated over it [deg]
-    integrated = errors[:, :epochs * per].reshape(errors.shape[0], epochs, per).sum(axis=2) / rate_hz
-    models = [_model(noise, per / rate_hz)] * epochs if schedule is None else [
-        _model(schedule(float(np.mean(t))), per / rate_hz)
-        for t in np.asarray(temperature_degc, dtype=float)[:epochs * per].reshape(epochs, per)]
+    integrated = errors[:, : epochs * per].reshape(errors.shape[0], epochs, per).sum(axis=2) / rate_hz
+    models = (
+        [_model(noise, per / rate_hz)] * epochs
+        if schedule is None
+        else [
+            _model(schedule(float(np.mean(t))), per / rate_hz)
+            for t in np.asarray(temperature_degc, dtype=float)[: epochs * per].reshape(epochs, per)
+        ]
+    )
     size = models[0][0].shape[0]
     p = np.zeros((size, size))
-    p[0, 0] = update_sigma_deg ** 2
+    p[0, 0] = update_sigma_deg**2
     p[1, 1] = (errors[:, : max(per, 1)].mean(axis=1).std() + noise.deviation(1.0)) ** 2  # the turn-on bias
     for j, (sigma, _) in enumerate(noise.markov):
-        p[2 + j, 2 + j] = sigma ** 2
+        p[2 + j, 2 + j] = sigma**2
     samples = _filter(integrated, models, p, first, update_sigma_deg)
     return NeesResult(np.mean(samples, axis=0), nees_band(len(samples)), len(samples))
 
@@ -163,7 +177,7 @@ def _filter(integrated: np.ndarray, models: list, p: np.ndarray, first: int, upd
         if k >= first:
             samples.append(x[:, 0] ** 2 / p[0, 0])
         z = rng.standard_normal(integrated.shape[0]) * update_sigma_deg
-        gain = p[:, 0] / (p[0, 0] + update_sigma_deg ** 2)
+        gain = p[:, 0] / (p[0, 0] + update_sigma_deg**2)
         x = x + np.outer(z - x[:, 0], gain)
         p = p - np.outer(gain, p[0, :])
     return samples

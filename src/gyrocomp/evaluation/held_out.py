@@ -84,8 +84,9 @@ def held_out_residuals(recordings: list[Recording], method: Method | None = None
     out = {}
     for axis in axes:
         r = np.concatenate(residuals[axis])
-        out[axis] = AxisResidual(np.concatenate(temps[axis]), r, float(np.sqrt(np.mean(r ** 2))),
-                                 float(np.quantile(np.abs(r), BAND_LEVEL)))
+        out[axis] = AxisResidual(
+            np.concatenate(temps[axis]), r, float(np.sqrt(np.mean(r**2))), float(np.quantile(np.abs(r), BAND_LEVEL))
+        )
     return HeldOut(out, kind, len(folds), window_s)
 
 

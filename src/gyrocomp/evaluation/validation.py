@@ -60,10 +60,16 @@ def fit_plain_cubic(recordings: list[Recording]) -> Calibration:
         y = np.concatenate([r.gyro(axis) for r in recordings])
         coef, *_ = np.linalg.lstsq(np.vstack(rows), y, rcond=None)
         n = len(recordings)
-        axes[axis] = AxisCalibration(PolynomialCurve(tuple(float(c) for c in coef[n:]), mid, 1.0, -math.inf, math.inf),
-                                     tuple(float(c) for c in coef[:n]))
-    return Calibration(axes=axes, model="cubic + run constants", provenance=provenance(recordings),
-                       fit_report={"temperature": "cubic + run constants"})
+        axes[axis] = AxisCalibration(
+            PolynomialCurve(tuple(float(c) for c in coef[n:]), mid, 1.0, -math.inf, math.inf),
+            tuple(float(c) for c in coef[:n]),
+        )
+    return Calibration(
+        axes=axes,
+        model="cubic + run constants",
+        provenance=provenance(recordings),
+        fit_report={"temperature": "cubic + run constants"},
+    )
 
 
 #: the methods every validation compares: name -> fit_calibration options, or a function of the training runs
@@ -105,8 +111,13 @@ class MethodScore:
         return fold_standard_error(self.fold_drift_dps)
 
     def to_dict(self) -> dict:
-        return {"method": self.method, "axis": self.axis, "mean_drift_dps": self.mean_drift_dps,
-                "standard_error_dps": self.standard_error_dps, "fold_drift_dps": list(self.fold_drift_dps)}
+        return {
+            "method": self.method,
+            "axis": self.axis,
+            "mean_drift_dps": self.mean_drift_dps,
+            "standard_error_dps": self.standard_error_dps,
+            "fold_drift_dps": list(self.fold_drift_dps),
+        }
 
 
 @dataclass(frozen=True)
@@ -130,8 +141,10 @@ class ValidationResult:
     @property
     def title(self) -> str:
         """What the table shows: the quantity, window, statistic and folds."""
-        return (f"held-out drift [deg/s], {self.window_s:g} s moving average, mean +- standard error over "
-                f"{len(self.folds)} folds ({self.fold_kind})")
+        return (
+            f"held-out drift [deg/s], {self.window_s:g} s moving average, mean +- standard error over "
+            f"{len(self.folds)} folds ({self.fold_kind})"
+        )
 
     def table_rows(self) -> tuple[list[str], list[list[str]]]:
         """(header, rows) of the table ``gyrocomp validate`` prints and the report shows: per method, each axis's
@@ -139,17 +152,24 @@ class ValidationResult:
         cubic = self.mean_over_axes("cubic + run constants") if "cubic + run constants" in self.methods else 0.0
         rows = []
         for method in self.methods:
-            cells = [with_error(self.score(method, a).mean_drift_dps, self.score(method, a).standard_error_dps)
-                     for a in self.axes]
+            cells = [
+                with_error(self.score(method, a).mean_drift_dps, self.score(method, a).standard_error_dps)
+                for a in self.axes
+            ]
             mean = self.mean_over_axes(method)
             rows.append([method, *cells, f"{mean:.4g}", f"{mean / cubic:.2f}x" if cubic > 0 else "-"])
         return ["method", *self.axes, "mean", "vs cubic"], rows
 
     def to_dict(self) -> dict:
-        return {"fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
-                "methods": list(self.methods), "axes": list(self.axes),
-                "mean_over_axes_dps": {m: self.mean_over_axes(m) for m in self.methods},
-                "scores": [s.to_dict() for s in self.scores]}
+        return {
+            "fold_kind": self.fold_kind,
+            "folds": list(self.folds),
+            "window_s": self.window_s,
+            "methods": list(self.methods),
+            "axes": list(self.axes),
+            "mean_over_axes_dps": {m: self.mean_over_axes(m) for m in self.methods},
+            "scores": [s.to_dict() for s in self.scores],
+        }
 
 
 def make_sample_folds(recordings: list[Recording], kind: str = "auto") -> tuple[str, list[Fold]]:
@@ -169,8 +189,13 @@ def make_sample_folds(recordings: list[Recording], kind: str = "auto") -> tuple[
             t = rec.temperature_for(rec.gyro_axes[0])
             labels, directions = leg_labels(t, turn_threshold_degc(t), max(10, int(rec.rate_hz * WINDOW_MIN_S)))
             for j, d in enumerate(directions):
-                folds.append(Fold(f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, ""), k,
-                                  np.flatnonzero(labels == j)))
+                folds.append(
+                    Fold(
+                        f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, ""),
+                        k,
+                        np.flatnonzero(labels == j),
+                    )
+                )
         if len(folds) >= MIN_FOLDS:
             return "legs", folds
     per_run = max(BLOCKS_PER_RUN, math.ceil(MIN_FOLDS / len(recordings)))
@@ -218,8 +243,13 @@ def _fit(method: Method | None, train: list[Recording]) -> Calibration | None:
 
 
 @single_threaded_blas
-def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_s: float | None = None,
-             candidates: dict[str, Method] | None = None) -> ValidationResult:
+def validate(
+    recordings: list[Recording],
+    *,
+    folds: FoldChoice = "auto",
+    window_s: float | None = None,
+    candidates: dict[str, Method] | None = None,
+) -> ValidationResult:
     """Held-out drift of the baselines, gyrocomp's default and ``candidates`` on folds of ``recordings``.
 
     Parameters
@@ -264,6 +294,15 @@ def validate(recordings: list[Recording], *, folds: FoldChoice = "auto", window_
     return ValidationResult(kind, tuple(f.name for f in fold_list), window_s, tuple(methods), tuple(axes), scores)
 
 
-__all__ = ["BASELINES", "Fold", "MethodScore", "ValidationResult", "fit_plain_cubic", "fold_window_s", "make_sample_folds",
-           "quiet_fold_fit", "training_runs",
-           "validate"]
+__all__ = [
+    "BASELINES",
+    "Fold",
+    "MethodScore",
+    "ValidationResult",
+    "fit_plain_cubic",
+    "fold_window_s",
+    "make_sample_folds",
+    "quiet_fold_fit",
+    "training_runs",
+    "validate",
+]

@@ -31,7 +31,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..calibration.installed import ARDUPILOT_SCALE, ARDUPILOT_TEMP_REFERENCE_DEGC, AXIS_INDEX, DEG_TO_RAD, installed_calibration
+from ..calibration.installed import (
+    ARDUPILOT_SCALE,
+    ARDUPILOT_TEMP_REFERENCE_DEGC,
+    AXIS_INDEX,
+    DEG_TO_RAD,
+    installed_calibration,
+)
 from ..errors import DataQualityWarning, InputError
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment
@@ -56,8 +62,7 @@ class CubicFit:
     max_error_dps: float  # [g] for an accelerometer axis
 
 
-def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool,
-             to_si: float = DEG_TO_RAD) -> CubicFit:
+def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool, to_si: float = DEG_TO_RAD) -> CubicFit:
     """Least-squares cubic of an axis's bias (shape plus mean turn-on constant) in d = T - reference;
     ``to_si`` converts the model's unit to the autopilot's (deg/s -> rad/s, or g -> m/s^2)."""
     curve = axis.temperature
@@ -66,14 +71,14 @@ def cubic_of(axis: AxisCalibration, reference_degc: float, with_constant: bool,
     t = np.linspace(curve.t_min_degc, curve.t_max_degc, GRID_POINTS)
     bias_dps = np.asarray(curve.shape(t), dtype=float) + (axis.mean_turn_on_bias if with_constant else 0.0)
     d = t - reference_degc
-    powers = np.column_stack([d ** k for k in (range(4) if with_constant else range(1, 4))])
+    powers = np.column_stack([d**k for k in (range(4) if with_constant else range(1, 4))])
     target = bias_dps if with_constant else bias_dps - np.asarray(curve.shape(np.array([reference_degc]))[0])
     coef, *_ = np.linalg.lstsq(powers, target, rcond=None)
     # a term that moves the correction by less than NEGLIGIBLE_SI over the range is rounding (a 1e-20 cubic of a
     # curve that is a line): written as 0
     reach = np.max(np.abs(d))
     orders = np.arange(4) if with_constant else np.arange(1, 4)
-    coef = np.where(np.abs(coef * to_si) * reach ** orders < NEGLIGIBLE_SI, 0.0, coef)
+    coef = np.where(np.abs(coef * to_si) * reach**orders < NEGLIGIBLE_SI, 0.0, coef)
     error = float(np.max(np.abs(powers @ coef - target)))
     full = tuple(float(c) for c in coef) if with_constant else (0.0, *map(float, coef))
     return CubicFit(tuple(c * to_si for c in full), reference_degc, curve.t_min_degc, curve.t_max_degc, error)
@@ -97,9 +102,13 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
         if triad.sensitivity_per_degc:
             parts.append("accelerometer scale-factor temperature dependence")
     if parts:
-        warnings.warn(f"{target} has no {' or '.join(parts)} term: left out of the export, only the temperature cubic "
-                      "and the accelerometer's offsets and scales are written (compare the stages of the evaluation "
-                      "to see what that costs)", DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{target} has no {' or '.join(parts)} term: left out of the export, only the temperature cubic "
+            "and the accelerometer's offsets and scales are written (compare the stages of the evaluation "
+            "to see what that costs)",
+            DataQualityWarning,
+            stacklevel=3,
+        )
 
 
 def accel_offsets_and_scales(calibration: Calibration) -> tuple[np.ndarray, np.ndarray] | None:
@@ -108,15 +117,19 @@ def accel_offsets_and_scales(calibration: Calibration) -> tuple[np.ndarray, np.n
     triad = calibration.accel_triad
     if triad is None:
         return None
-    return np.asarray(triad.bias, dtype=float) * G_TO_M_PER_S2, 1.0 / np.diag(np.asarray(triad.sensitivity, dtype=float))
+    return np.asarray(triad.bias, dtype=float) * G_TO_M_PER_S2, 1.0 / np.diag(
+        np.asarray(triad.sensitivity, dtype=float)
+    )
 
 
 def _gyro_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
     """The gyro axes with a temperature curve (refused when neither they nor accelerometer axes exist)."""
     axes = {name: ax for name, ax in calibration.axes.items() if name in AXIS_INDEX and ax.temperature is not None}
     if not axes and not _accel_axes(calibration) and calibration.accel_triad is None:
-        raise InputError("export: the model has no gyro or accelerometer axis with a temperature curve and no "
-                         "accelerometer calibration; nothing to export")
+        raise InputError(
+            "export: the model has no gyro or accelerometer axis with a temperature curve and no "
+            "accelerometer calibration; nothing to export"
+        )
     return axes
 
 
@@ -129,47 +142,61 @@ class AutopilotParameters:
 
 
 def _accel_axes(calibration: Calibration) -> dict[str, AxisCalibration]:
-    return {name: ax for name, ax in calibration.accel_axes.items() if name in ACCEL_INDEX and ax.temperature is not None}
+    return {
+        name: ax for name, ax in calibration.accel_axes.items() if name in ACCEL_INDEX and ax.temperature is not None
+    }
 
 
 def _range(axes: dict[str, AxisCalibration]) -> tuple[float, float]:
-    return (min(ax.temperature.t_min_degc for ax in axes.values()), max(ax.temperature.t_max_degc for ax in axes.values()))
+    return (
+        min(ax.temperature.t_min_degc for ax in axes.values()),
+        max(ax.temperature.t_max_degc for ax in axes.values()),
+    )
 
 
 #: where a user finds a PX4 sensor's device id, per sensor, for the refusal's message
-_WHERE_ID = {"G": ("device_id", "sensor_gyro", "CAL_GYRO0_ID"), "A": ("accel_device_id", "sensor_accel",
-                                                                      "CAL_ACC0_ID")}
+_WHERE_ID = {"G": ("device_id", "sensor_gyro", "CAL_GYRO0_ID"), "A": ("accel_device_id", "sensor_accel", "CAL_ACC0_ID")}
 
 
 def model_device_id(calibration: Calibration, key: str = "device_id") -> int | None:
     """The device id the model's runs name (``device_id`` of the gyro, ``accel_device_id`` of the accelerometer,
     recorded from a ULog's ``sensor_gyro``/``sensor_accel``), or None when no run names one; runs of different
     sensors are refused, naming their ids."""
-    ids = sorted({int(i[key]) for i in (calibration.provenance or {}).get("inputs", ())
-                  if isinstance(i, dict) and isinstance(i.get(key), int) and i[key] != 0})
+    ids = sorted(
+        {
+            int(i[key])
+            for i in (calibration.provenance or {}).get("inputs", ())
+            if isinstance(i, dict) and isinstance(i.get(key), int) and i[key] != 0
+        }
+    )
     if len(ids) > 1:
-        raise InputError(f"export: the model's runs come from sensors with {key} {', '.join(map(str, ids))}; "
-                         "a PX4 slot applies to one (give it with device_id= / accel_device_id=)")
+        raise InputError(
+            f"export: the model's runs come from sensors with {key} {', '.join(map(str, ids))}; "
+            "a PX4 slot applies to one (give it with device_id= / accel_device_id=)"
+        )
     return ids[0] if ids else None
 
 
 def _device_id(calibration: Calibration, sensor: str, given: int | None) -> int:
     if given is not None:
-        if not 0 < given < 2 ** 32:
+        if not 0 < given < 2**32:
             raise InputError(f"{_WHERE_ID[sensor][0]}: a PX4 device id is a positive 32-bit number, got {given}")
         return given
     found = model_device_id(calibration, "device_id" if sensor == "G" else "accel_device_id")
     if found is None:
         option, topic, param = _WHERE_ID[sensor]
-        raise InputError(f"PX4 export: no {'gyro' if sensor == 'G' else 'accelerometer'} device id (PX4 applies "
-                         f"TC_{sensor}n_* only to the sensor whose device id matches, so 0 does nothing); give "
-                         f"{option}=ID: find it in the ULog's {topic} topic, with 'listener {topic}' on the vehicle, or "
-                         f"in the {param} parameter")
+        raise InputError(
+            f"PX4 export: no {'gyro' if sensor == 'G' else 'accelerometer'} device id (PX4 applies "
+            f"TC_{sensor}n_* only to the sensor whose device id matches, so 0 does nothing); give "
+            f"{option}=ID: find it in the ULog's {topic} topic, with 'listener {topic}' on the vehicle, or "
+            f"in the {param} parameter"
+        )
     return found
 
 
-def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: int | None = None,
-                   accel_device_id: int | None = None) -> AutopilotParameters:
+def px4_parameters(
+    calibration: Calibration, *, instance: int = 0, device_id: int | None = None, accel_device_id: int | None = None
+) -> AutopilotParameters:
     """``TC_G{instance}_*`` (and ``TC_A{instance}_*``) for PX4: TREF is the middle of the model's range, axes not in
     the model 0. ``TC_Gn_ID``/``TC_An_ID``: ``device_id``/``accel_device_id``, else the ids the model's runs
     recorded (:func:`model_device_id`); without one the export is refused (PX4 would apply nothing). No
@@ -183,15 +210,23 @@ def px4_parameters(calibration: Calibration, *, instance: int = 0, device_id: in
     values: dict[str, float] = {}
     fits = {}
     for sensor, axes, index, to_si, with_constant, given in (
-            ("G", _gyro_axes(calibration), AXIS_INDEX, DEG_TO_RAD, True, device_id),
-            ("A", _accel_axes(calibration), ACCEL_INDEX, G_TO_M_PER_S2, False, accel_device_id)):
+        ("G", _gyro_axes(calibration), AXIS_INDEX, DEG_TO_RAD, True, device_id),
+        ("A", _accel_axes(calibration), ACCEL_INDEX, G_TO_M_PER_S2, False, accel_device_id),
+    ):
         if not axes:
             continue
         t_min, t_max = _range(axes)
         t_ref = 0.5 * (t_min + t_max)
         p = f"TC_{sensor}{instance}_"
-        values.update({f"TC_{sensor}_ENABLE": 1, f"{p}ID": _device_id(calibration, sensor, given), f"{p}TMIN": t_min,
-                       f"{p}TMAX": t_max, f"{p}TREF": t_ref})
+        values.update(
+            {
+                f"TC_{sensor}_ENABLE": 1,
+                f"{p}ID": _device_id(calibration, sensor, given),
+                f"{p}TMIN": t_min,
+                f"{p}TMAX": t_max,
+                f"{p}TREF": t_ref,
+            }
+        )
         for name, j in index.items():
             fit = cubic_of(axes[name], t_ref, with_constant=with_constant, to_si=to_si) if name in axes else None
             coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
@@ -227,10 +262,16 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
     t_min, t_max = _range({**gyro, **accel})
     p = f"INS_TCAL{instance}_"
     values.update({f"{p}ENABLE": 1, f"{p}TMIN": t_min, f"{p}TMAX": t_max})
-    for sensor, axes, index, to_si in (("ACC", accel, ACCEL_INDEX, G_TO_M_PER_S2), ("GYR", gyro, AXIS_INDEX, DEG_TO_RAD)):
+    for sensor, axes, index, to_si in (
+        ("ACC", accel, ACCEL_INDEX, G_TO_M_PER_S2),
+        ("GYR", gyro, AXIS_INDEX, DEG_TO_RAD),
+    ):
         for name, j in index.items():
-            fit = cubic_of(axes[name], ARDUPILOT_TEMP_REFERENCE_DEGC, with_constant=False, to_si=to_si) \
-                if name in axes else None
+            fit = (
+                cubic_of(axes[name], ARDUPILOT_TEMP_REFERENCE_DEGC, with_constant=False, to_si=to_si)
+                if name in axes
+                else None
+            )
             coef = fit.coefficients_rad_per_s if fit else (0.0, 0.0, 0.0, 0.0)
             for k in (1, 2, 3):
                 values[f"{p}{sensor}{k}_{'XYZ'[j]}"] = coef[k] * ARDUPILOT_SCALE
@@ -242,40 +283,50 @@ def ardupilot_parameters(calibration: Calibration, *, instance: int = 1) -> Auto
 #: what to do with the file on the vehicle, in order (PX4: TemperatureCompensationModule.cpp and
 #: sensor_calibration/Gyroscope.hpp; ArduPilot: AP_InertialSensor_tempcal.cpp and AP_InertialSensor.cpp)
 _STEPS = {
-    "PX4": ("load it in QGroundControl (Vehicle Setup > Parameters > Tools > Load from file)",
-            "reboot: TC_G_ENABLE / TC_A_ENABLE take effect at start-up",
-            "PX4 subtracts CAL_GYRO*_XOFF/YOFF/ZOFF after these offsets: calibrate the gyro again (or zero them), "
-            "and calibrate the accelerometer again after loading TC_A*",
-            "outside TMIN..TMAX PX4 holds the correction at its edge; it updates it at 1 Hz when the temperature "
-            "moved by more than 1 degC"),
-    "ArduPilot": ("set INS_TCAL<n>_ENABLE = 1 first (the INS_TCAL<n>_* group is hidden until then): load the file, "
-                  "refresh the parameters, load it again",
-                  "reboot",
-                  "INS_GYR<n>_CALTEMP must hold a valid temperature (calibrate the gyro once at start-up); the "
-                  "boot-time gyro offset is taken without this correction: keep the vehicle still at boot",
-                  "outside TMIN..TMAX ArduPilot holds the correction at its edge"),
+    "PX4": (
+        "load it in QGroundControl (Vehicle Setup > Parameters > Tools > Load from file)",
+        "reboot: TC_G_ENABLE / TC_A_ENABLE take effect at start-up",
+        "PX4 subtracts CAL_GYRO*_XOFF/YOFF/ZOFF after these offsets: calibrate the gyro again (or zero them), "
+        "and calibrate the accelerometer again after loading TC_A*",
+        "outside TMIN..TMAX PX4 holds the correction at its edge; it updates it at 1 Hz when the temperature "
+        "moved by more than 1 degC",
+    ),
+    "ArduPilot": (
+        "set INS_TCAL<n>_ENABLE = 1 first (the INS_TCAL<n>_* group is hidden until then): load the file, "
+        "refresh the parameters, load it again",
+        "reboot",
+        "INS_GYR<n>_CALTEMP must hold a valid temperature (calibrate the gyro once at start-up); the "
+        "boot-time gyro offset is taken without this correction: keep the vehicle still at boot",
+        "outside TMIN..TMAX ArduPilot holds the correction at its edge",
+    ),
 }
 
 
 def _header(calibration: Calibration, params: AutopilotParameters, target: str, comment: str) -> list[str]:
-    lines = [f"{comment} {target} thermal calibration written by gyrocomp from model "
-             f"'{line_comment(calibration.model)}'",
-             f"{comment} bias as a cubic in temperature [rad/s, accelerometer m/s^2]; largest difference from the "
-             "gyrocomp model over its range:"]
+    lines = [
+        f"{comment} {target} thermal calibration written by gyrocomp from model '{line_comment(calibration.model)}'",
+        f"{comment} bias as a cubic in temperature [rad/s, accelerometer m/s^2]; largest difference from the "
+        "gyrocomp model over its range:",
+    ]
     for name, fit in params.fits.items():
         unit = "g" if name in ACCEL_INDEX else "deg/s"
-        lines.append(f"{comment}   {name}: {fit.max_error_dps:.3g} {unit} over {fit.t_min_degc:.2f}..{fit.t_max_degc:.2f} degC")
+        lines.append(
+            f"{comment}   {name}: {fit.max_error_dps:.3g} {unit} over {fit.t_min_degc:.2f}..{fit.t_max_degc:.2f} degC"
+        )
     lines.append(f"{comment} on the vehicle, in this order:")
     lines += [f"{comment}   {k}. {step}" for k, step in enumerate(_STEPS[target], 1)]
     return lines
 
 
-def px4_params_file(calibration: Calibration, *, instance: int = 0, device_id: int | None = None,
-                    accel_device_id: int | None = None) -> str:
+def px4_params_file(
+    calibration: Calibration, *, instance: int = 0, device_id: int | None = None, accel_device_id: int | None = None
+) -> str:
     """A QGroundControl parameter file (vehicle 1, component 1; type 6 = int32, 9 = float32) of
     :func:`px4_parameters` (``instance`` 0..3 of the sensor, its device ids)."""
-    return px4_params_text(calibration, px4_parameters(calibration, instance=instance, device_id=device_id,
-                                                       accel_device_id=accel_device_id))
+    return px4_params_text(
+        calibration,
+        px4_parameters(calibration, instance=instance, device_id=device_id, accel_device_id=accel_device_id),
+    )
 
 
 def px4_params_text(calibration: Calibration, params: AutopilotParameters) -> str:
@@ -284,7 +335,9 @@ def px4_params_text(calibration: Calibration, params: AutopilotParameters) -> st
     lines.append("# Vehicle-Id Component-Id Name Value Type")
     for name, value in params.values.items():
         integer = name in ("TC_G_ENABLE", "TC_A_ENABLE") or name.endswith("_ID")
-        lines.append(f"1\t1\t{name}\t{int(value) if integer else format(np.float32(value), '.9g')}\t{6 if integer else 9}")
+        lines.append(
+            f"1\t1\t{name}\t{int(value) if integer else format(np.float32(value), '.9g')}\t{6 if integer else 9}"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -297,13 +350,26 @@ def ardupilot_params_file(calibration: Calibration, *, instance: int = 1) -> str
 def ardupilot_params_text(calibration: Calibration, params: AutopilotParameters) -> str:
     """The ArduPilot file of parameters already computed (:func:`ardupilot_parameters` of ``calibration``)."""
     lines = _header(calibration, params, "ArduPilot", "#")
-    lines.append("# the correction is relative to INS_GYRn_CALTEMP (INS_ACCn_CALTEMP for the accelerometer): the offsets "
-                 "taken there remove the bias at that temperature")
+    lines.append(
+        "# the correction is relative to INS_GYRn_CALTEMP (INS_ACCn_CALTEMP for the accelerometer): the offsets "
+        "taken there remove the bias at that temperature"
+    )
     for name, value in params.values.items():
         lines.append(f"{name} {int(value)}" if name.endswith("ENABLE") else f"{name} {float(value):.9g}")
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["AutopilotParameters", "CubicFit", "accel_offsets_and_scales", "ardupilot_parameters", "ardupilot_params_file",
-           "ardupilot_params_text", "px4_params_text", "cubic_of",
-           "installed_calibration", "model_device_id", "px4_parameters", "px4_params_file"]
+__all__ = [
+    "AutopilotParameters",
+    "CubicFit",
+    "accel_offsets_and_scales",
+    "ardupilot_parameters",
+    "ardupilot_params_file",
+    "ardupilot_params_text",
+    "px4_params_text",
+    "cubic_of",
+    "installed_calibration",
+    "model_device_id",
+    "px4_parameters",
+    "px4_params_file",
+]

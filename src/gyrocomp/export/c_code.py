@@ -100,7 +100,8 @@ _HELPERS = [
     "    double g = -expm1(-h) / h;",
     "    *b0 = 1.0 - g;",
     "    *b1 = g - *a;",
-    "}", "",
+    "}",
+    "",
     "static inline double lag_update(gyrocomp_lag *l, double step, double u, double tau)",
     "{",
     "    if (!l->started) { l->started = 1; l->last_input = u; l->last_output = u; return u; }",
@@ -111,7 +112,8 @@ _HELPERS = [
     "    l->last_input = u;",
     "    l->last_output = y;",
     "    return y;",
-    "}", "",
+    "}",
+    "",
     "static inline void turn_update(gyrocomp_turn *s, double x, double thr)",
     "{",
     "    if (s->direction == 0) {",
@@ -126,7 +128,9 @@ _HELPERS = [
     "    double back = s->direction == 1 ? running - x : x - running;",
     "    if (back > thr) { s->turn = running; s->has_turn = 1; s->direction = -s->direction; s->extreme = x; }",
     "    else s->extreme = running;",
-    "}", ""]
+    "}",
+    "",
+]
 
 
 def _shape_code(k: int, ax: AxisCalibration) -> list[str]:
@@ -148,31 +152,41 @@ _SOLVE3 = [
     "    double y = (c1 * v[0] + (k[0] * k[8] - k[2] * k[6]) * v[1] + (k[2] * k[3] - k[0] * k[5]) * v[2]) / det;",
     "    double z = (c2 * v[0] + (k[1] * k[6] - k[0] * k[7]) * v[1] + (k[0] * k[4] - k[1] * k[3]) * v[2]) / det;",
     "    v[0] = x; v[1] = y; v[2] = z;",
-    "}", ""]
+    "}",
+    "",
+]
 
 
 def _triad_code(triad: TriadCalibration, vector: str, label: str) -> list[str]:
     """C statements correcting ``vector`` (a double[3]) by a triad: v = K(T)^-1 (v - bias), K(T) from the raw
     temperature, as :meth:`TriadCalibration.correct` does."""
-    lines = [f"    {{   /* {label}: scale factor and misalignment ({triad.method}) */",
-             f"        double k[9] = {c_array(np.ravel(triad.sensitivity))};"]
+    lines = [
+        f"    {{   /* {label}: scale factor and misalignment ({triad.method}) */",
+        f"        double k[9] = {c_array(np.ravel(triad.sensitivity))};",
+    ]
     for p, block in enumerate(triad.sensitivity_per_degc, start=1):
-        lines += [f"        const double k{p}[9] = {c_array(np.ravel(block))};",
-                  f"        double d{p} = pow(temperature - {c_number(triad.reference_degc)}, {p});",
-                  f"        for (int i = 0; i < 9; ++i) k[i] += k{p}[i] * d{p};"]
+        lines += [
+            f"        const double k{p}[9] = {c_array(np.ravel(block))};",
+            f"        double d{p} = pow(temperature - {c_number(triad.reference_degc)}, {p});",
+            f"        for (int i = 0; i < 9; ++i) k[i] += k{p}[i] * d{p};",
+        ]
     lines += [f"        {vector}[{i}] -= {c_number(b)};" for i, b in enumerate(triad.bias) if b != 0.0]
     return lines + [f"        solve3(k, {vector});", "    }"]
 
 
 def _init_code(codes: dict) -> list[str]:
-    body = ["void gyrocomp_init(gyrocomp_state *s)", "{",
-            "    s->started = 0;", "    s->last_t = 0.0;",
-            "    for (int j = 0; j < 3; ++j) s->accel_out[j] = 0.0;",
-            "    for (int j = 0; j < 6; ++j) {",
-            "        s->lag[j].started = 0; s->lag[j].last_input = 0.0; s->lag[j].last_output = 0.0;",
-            "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
-            "        s->turn[j].turn = 0.0; s->turn[j].low = INFINITY; s->turn[j].high = -INFINITY;",
-            "    }"]
+    body = [
+        "void gyrocomp_init(gyrocomp_state *s)",
+        "{",
+        "    s->started = 0;",
+        "    s->last_t = 0.0;",
+        "    for (int j = 0; j < 3; ++j) s->accel_out[j] = 0.0;",
+        "    for (int j = 0; j < 6; ++j) {",
+        "        s->lag[j].started = 0; s->lag[j].last_input = 0.0; s->lag[j].last_output = 0.0;",
+        "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
+        "        s->turn[j].turn = 0.0; s->turn[j].low = INFINITY; s->turn[j].high = -INFINITY;",
+        "    }",
+    ]
     for code in codes.values():
         body += list(code.init)
     return body + ["}", ""]
@@ -209,8 +223,14 @@ def _gyro_step_code(calibration: Calibration, axes: dict) -> list[str]:
             g = g or (0.0, 0.0, 0.0)
             expr = f"acc[0] * {c_number(g[0])} + acc[1] * {c_number(g[1])} + acc[2] * {c_number(g[2])}"
             if q is not None:
-                products = ("acc[0] * acc[0]", "acc[1] * acc[1]", "acc[2] * acc[2]",
-                            "acc[0] * acc[1]", "acc[0] * acc[2]", "acc[1] * acc[2]")
+                products = (
+                    "acc[0] * acc[0]",
+                    "acc[1] * acc[1]",
+                    "acc[2] * acc[2]",
+                    "acc[0] * acc[1]",
+                    "acc[0] * acc[2]",
+                    "acc[1] * acc[2]",
+                )
                 expr = f"({expr}) + (" + " + ".join(f"{p} * {c_number(c)}" for p, c in zip(products, q)) + ")"
             body.append(f"    out[{j}] -= {expr};")
         if ax.acceleration_network is not None:
@@ -236,10 +256,20 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
     if any(ax.lag_time_constant_s > 0 for ax in every) and not (rate_hz and rate_hz > 0):
         raise InputError("C export: the model has thermal lag; give the data's sample rate with rate_hz=")
     period = 1.0 / rate_hz if rate_hz else 0.0
-    body = [f"/* gyrocomp model '{c_comment(calibration.model)}', generated by gyrocomp. */",
-            "#include <math.h>", "#include \"gyrocomp.h\"", "",
-            "static inline double clip(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }", "",
-            f"static const double PERIOD_S = {c_number(period)};", ""] + _HELPERS + _SOLVE3
+    body = (
+        [
+            f"/* gyrocomp model '{c_comment(calibration.model)}', generated by gyrocomp. */",
+            "#include <math.h>",
+            '#include "gyrocomp.h"',
+            "",
+            "static inline double clip(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }",
+            "",
+            f"static const double PERIOD_S = {c_number(period)};",
+            "",
+        ]
+        + _HELPERS
+        + _SOLVE3
+    )
     codes = {}  # C name -> the curve's code (functions and init statements; the step's come per axis)
     for j, name in enumerate(AXES + ACCEL):
         ax = axes.get(name) or accel_axes.get(name)
@@ -250,20 +280,33 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
     for code in codes.values():
         body += list(code.functions)
     body += _init_code(codes)
-    body += ["void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],",
-             "                   double temperature, double out[3])", "{",
-             "    double step = s->started ? t - s->last_t : 0.0;",
-             "    s->started = 1;", "    s->last_t = t;",
-             "    for (int j = 0; j < 3; ++j) out[j] = gyro[j];",
-             "    double acc[3] = {accel[0], accel[1], accel[2]};",
-             "    double tm, shape;", "    (void)step; (void)tm; (void)shape;"]
+    body += [
+        "void gyrocomp_step(gyrocomp_state *s, double t, const double gyro[3], const double accel[3],",
+        "                   double temperature, double out[3])",
+        "{",
+        "    double step = s->started ? t - s->last_t : 0.0;",
+        "    s->started = 1;",
+        "    s->last_t = t;",
+        "    for (int j = 0; j < 3; ++j) out[j] = gyro[j];",
+        "    double acc[3] = {accel[0], accel[1], accel[2]};",
+        "    double tm, shape;",
+        "    (void)step; (void)tm; (void)shape;",
+    ]
     body += _accel_step_code(calibration, accel_axes) + _gyro_step_code(calibration, axes) + ["}", ""]
-    return {"gyrocomp.h": _HEADER.replace("{model}", f"'{c_comment(calibration.model)}'"),
-            "gyrocomp.c": "\n".join(body)}
+    return {
+        "gyrocomp.h": _HEADER.replace("{model}", f"'{c_comment(calibration.model)}'"),
+        "gyrocomp.c": "\n".join(body),
+    }
 
 
-def write_c_sources(calibration: Calibration, folder: str | os.PathLike, *, rate_hz: float | None = None,
-                    learner: LearnerSettings | None = None, with_learner: bool = True) -> list[Path]:
+def write_c_sources(
+    calibration: Calibration,
+    folder: str | os.PathLike,
+    *,
+    rate_hz: float | None = None,
+    learner: LearnerSettings | None = None,
+    with_learner: bool = True,
+) -> list[Path]:
     """Write gyrocomp.h and gyrocomp.c (:func:`c_sources`) into ``folder`` (created if needed), with the online
     learner beside them (gyrocomp_learn.h and gyrocomp_learn.c, :func:`learner_c_sources` with ``learner``'s
     settings, the defaults when None) unless ``with_learner`` is false; all or none: a write that fails leaves the
@@ -289,7 +332,14 @@ def _write_c(calibration: Calibration, path: Path, options: ExportOptions) -> Ex
     return Exported("c", tuple(write_c_sources(calibration, path, rate_hz=options.rate_hz, learner=options.learner)))
 
 
-register(Exporter("c", "the whole model as C99: gyrocomp.h, gyrocomp.c, with the online learner beside them",
-                  "a temperature from each axis's own sensor (the C interface takes one)", _write_c, folder=True))
+register(
+    Exporter(
+        "c",
+        "the whole model as C99: gyrocomp.h, gyrocomp.c, with the online learner beside them",
+        "a temperature from each axis's own sensor (the C interface takes one)",
+        _write_c,
+        folder=True,
+    )
+)
 
 __all__ = ["c_sources", "write_c_sources"]

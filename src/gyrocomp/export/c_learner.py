@@ -28,9 +28,20 @@ from __future__ import annotations
 from importlib.resources import files
 
 from ..c_literals import c_number
-from ..fitting.online import (GAP_PERIODS, LEVEL_GROWTH, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G,
-                             PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC,
-                             LearnerSettings)
+from ..fitting.online import (
+    GAP_PERIODS,
+    LEVEL_GROWTH,
+    MIN_OUTLIER_DOF,
+    MIN_SESSION_POINTS,
+    MIN_STEPS,
+    MIN_TILT_G,
+    PIECE_SPREAD_WEIGHT,
+    POINTS_PER_TILT,
+    POOL_PIECES,
+    T_REF_DEGC,
+    T_SCALE_DEGC,
+    LearnerSettings,
+)
 from ..fitting.online.settings import _MAD_TO_SIGMA, _RIDGE
 from ..motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY, MIN_BLOCK_SAMPLES
 
@@ -46,23 +57,50 @@ def template_values(settings: LearnerSettings | None = None) -> dict[str, str]:
     s = settings or LearnerSettings(rate_hz=100.0)
     z = s.z_values()
     return {
-        "LAGS": str(len(s.lag_candidates_s)), "HISTORY": str(s.history_blocks), "POINTS": str(s.max_points),
-        "SESSIONS": str(s.max_sessions), "POOL": str(POOL_PIECES),
+        "LAGS": str(len(s.lag_candidates_s)),
+        "HISTORY": str(s.history_blocks),
+        "POINTS": str(s.max_points),
+        "SESSIONS": str(s.max_sessions),
+        "POOL": str(POOL_PIECES),
         "LAG_VALUES": "{" + ", ".join(c_number(v) for v in s.lag_candidates_s) + "}",
-        "BLOCK_S": c_number(s.block_s), "MIN_STILL_S": c_number(s.min_still_s), "PIECE_S": c_number(s.piece_s),
-        "NOISE_QUANTILE": c_number(s.noise_quantile), "Z_NOISE": c_number(z["noise"]), "Z_VAR3": c_number(z["variance3"]),
-        "Z_VAR6": c_number(z["variance6"]), "Z_STEP3": c_number(z["step3"]), "Z_STEP6": c_number(z["step6"]),
-        "BIN_WIDTH": c_number(s.bin_width_degc), "T_LOW": c_number(s.t_low_degc), "BINS": str(s.bins),
-        "DEGREE": str(s.degree), "MIN_BLOCK": str(MIN_BLOCK_SAMPLES), "MIN_STEPS": str(MIN_STEPS),
-        "PER_TILT": str(POINTS_PER_TILT), "MIN_DOF": str(MIN_OUTLIER_DOF), "MIN_POINTS": str(MIN_SESSION_POINTS),
-        "CUBIC_SPAN": c_number(s.cubic_span_degc), "MIN_SPAN": c_number(s.min_span_degc), "HALF_LIFE_H": c_number(s.half_life_h),
-        "STALE_H": c_number(s.stale_h), "MAX_BIAS": c_number(s.max_bias_dps), "OUTLIER_DPS": c_number(s.outlier_dps),
-        "OUTLIER_SIGMAS": c_number(s.outlier_sigmas), "MAX_TEMPCO": c_number(s.max_tempco_dps_per_degc),
-        "SAVE_CHANGE": c_number(s.save_change_dps), "GAP_PERIODS": c_number(GAP_PERIODS), "LEVEL_GROWTH": c_number(LEVEL_GROWTH),
-        "MAD": c_number(_MAD_TO_SIGMA), "MIN_TILT": c_number(MIN_TILT_G), "PIECE_WEIGHT": c_number(PIECE_SPREAD_WEIGHT), "RIDGE": c_number(_RIDGE), "T_REF": c_number(T_REF_DEGC),
+        "BLOCK_S": c_number(s.block_s),
+        "MIN_STILL_S": c_number(s.min_still_s),
+        "PIECE_S": c_number(s.piece_s),
+        "NOISE_QUANTILE": c_number(s.noise_quantile),
+        "Z_NOISE": c_number(z["noise"]),
+        "Z_VAR3": c_number(z["variance3"]),
+        "Z_VAR6": c_number(z["variance6"]),
+        "Z_STEP3": c_number(z["step3"]),
+        "Z_STEP6": c_number(z["step6"]),
+        "BIN_WIDTH": c_number(s.bin_width_degc),
+        "T_LOW": c_number(s.t_low_degc),
+        "BINS": str(s.bins),
+        "DEGREE": str(s.degree),
+        "MIN_BLOCK": str(MIN_BLOCK_SAMPLES),
+        "MIN_STEPS": str(MIN_STEPS),
+        "PER_TILT": str(POINTS_PER_TILT),
+        "MIN_DOF": str(MIN_OUTLIER_DOF),
+        "MIN_POINTS": str(MIN_SESSION_POINTS),
+        "CUBIC_SPAN": c_number(s.cubic_span_degc),
+        "MIN_SPAN": c_number(s.min_span_degc),
+        "HALF_LIFE_H": c_number(s.half_life_h),
+        "STALE_H": c_number(s.stale_h),
+        "MAX_BIAS": c_number(s.max_bias_dps),
+        "OUTLIER_DPS": c_number(s.outlier_dps),
+        "OUTLIER_SIGMAS": c_number(s.outlier_sigmas),
+        "MAX_TEMPCO": c_number(s.max_tempco_dps_per_degc),
+        "SAVE_CHANGE": c_number(s.save_change_dps),
+        "GAP_PERIODS": c_number(GAP_PERIODS),
+        "LEVEL_GROWTH": c_number(LEVEL_GROWTH),
+        "MAD": c_number(_MAD_TO_SIGMA),
+        "MIN_TILT": c_number(MIN_TILT_G),
+        "PIECE_WEIGHT": c_number(PIECE_SPREAD_WEIGHT),
+        "RIDGE": c_number(_RIDGE),
+        "T_REF": c_number(T_REF_DEGC),
         "T_SCALE": c_number(T_SCALE_DEGC),
-        "CEILING": "{" + ", ".join([c_number(MAX_GYRO_NOISE_DENSITY ** 2)] * 3 + [c_number(MAX_ACCEL_NOISE_DENSITY ** 2)] * 3)
-                   + "}",
+        "CEILING": "{"
+        + ", ".join([c_number(MAX_GYRO_NOISE_DENSITY**2)] * 3 + [c_number(MAX_ACCEL_NOISE_DENSITY**2)] * 3)
+        + "}",
     }
 
 

@@ -124,8 +124,10 @@ def format_of(path, offered: tuple[str, ...] | None = None) -> str:
             return name
     named = ", ".join(f"{s} ({n})" for n in offered for s in EXPORTERS[n].suffixes)
     folders = [n for n in offered if EXPORTERS[n].folder]
-    raise InputError(f"fmt: not given, and {Path(path).name!r} names none; give it ({', '.join(offered)}), or "
-                     f"name the file {named}" + (f", or a folder without a suffix ({folders[0]})" if folders else ""))
+    raise InputError(
+        f"fmt: not given, and {Path(path).name!r} names none; give it ({', '.join(offered)}), or "
+        f"name the file {named}" + (f", or a folder without a suffix ({folders[0]})" if folders else "")
+    )
 
 
 def export_to(calibration: Calibration, fmt: str, path, options: ExportOptions = ExportOptions()) -> Exported:

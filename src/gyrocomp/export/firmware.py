@@ -59,15 +59,18 @@ class FirmwareDifference:
 
     def lines(self) -> list[str]:
         """The figures in words, one line per axis."""
-        return [f"{axis}: firmware vs model, largest (RMS) [deg/s]: {self.in_range_max_dps[j]:.2g} "
-                f"({self.in_range_rms_dps[j]:.2g}) in range, {self.beyond_max_dps[j]:.2g} ({self.beyond_rms_dps[j]:.2g}) "
-                f"up to {BEYOND_DEGC:g} degC beyond it, {self.as_run_max_dps[j]:.2g} ({self.as_run_rms_dps[j]:.2g}) "
-                f"through a 1 degC/min heat-cool cycle as it runs" for j, axis in enumerate(self.axes)]
+        return [
+            f"{axis}: firmware vs model, largest (RMS) [deg/s]: {self.in_range_max_dps[j]:.2g} "
+            f"({self.in_range_rms_dps[j]:.2g}) in range, {self.beyond_max_dps[j]:.2g} ({self.beyond_rms_dps[j]:.2g}) "
+            f"up to {BEYOND_DEGC:g} degC beyond it, {self.as_run_max_dps[j]:.2g} ({self.as_run_rms_dps[j]:.2g}) "
+            f"through a 1 degC/min heat-cool cycle as it runs"
+            for j, axis in enumerate(self.axes)
+        ]
 
 
 def _stats(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     a = a - a.mean(axis=0)
-    return np.max(np.abs(a), axis=0), np.sqrt(np.mean(a ** 2, axis=0))
+    return np.max(np.abs(a), axis=0), np.sqrt(np.mean(a**2, axis=0))
 
 
 def firmware_difference(calibration: Calibration, params: dict, target: str, instance: int) -> FirmwareDifference:
@@ -87,8 +90,11 @@ def firmware_difference(calibration: Calibration, params: dict, target: str, ins
     """
     # the gyro's temperature correction is compared: neither firmware has a g-term, and the accelerometer's
     # calibration is the accelerometer's
-    calibration = dataclasses.replace(calibration.without("acceleration") if calibration.has_acceleration
-                                      else calibration, accel_axes={}, accel_triad=None)
+    calibration = dataclasses.replace(
+        calibration.without("acceleration") if calibration.has_acceleration else calibration,
+        accel_axes={},
+        accel_triad=None,
+    )
     axes = _gyro_axes_with_curve(calibration)
     curves = [calibration.axes[a].temperature for a in axes]
     lo, hi = min(c.t_min_degc for c in curves), max(c.t_max_degc for c in curves)
@@ -106,25 +112,35 @@ def firmware_difference(calibration: Calibration, params: dict, target: str, ins
 
     def firmware(temperature: np.ndarray, time: np.ndarray | None = None) -> np.ndarray:
         if target == "px4":
-            out = px4_as_run(params, time, temperature, instance) if time is not None else \
-                px4_gyro_correction_dps(params, temperature, instance)
+            out = (
+                px4_as_run(params, time, temperature, instance)
+                if time is not None
+                else px4_gyro_correction_dps(params, temperature, instance)
+            )
         else:
             out = ardupilot_gyro_correction_dps(params, temperature, 0.5 * (lo + hi), instance)
         return out[:, cols]
 
     # static points of the curve (no history): the model without its memory there; the cycle with it
-    static = calibration.without("hysteresis", "lag") if any(
-        calibration.axes[a].has_memory for a in axes) else calibration
+    static = (
+        calibration.without("hysteresis", "lag") if any(calibration.axes[a].has_memory for a in axes) else calibration
+    )
     diffs = []
     for temps in (inside, beyond):
-        rec = Recording(np.arange(temps.size, dtype=float), np.zeros((temps.size, len(axes))), axes,
-                        temperature_degc=temps, source="<firmware>")
+        rec = Recording(
+            np.arange(temps.size, dtype=float),
+            np.zeros((temps.size, len(axes))),
+            axes,
+            temperature_degc=temps,
+            source="<firmware>",
+        )
         diffs.append(firmware(temps) - predict_error(static, rec))
     diffs.append(firmware(ramp, time_s) - model(ramp, time_s))
     (a, b), (c, d), (e, f) = (_stats(x) for x in diffs)
     as_tuple = lambda x: tuple(float(v) for v in x)  # noqa: E731
-    return FirmwareDifference(target, axes, as_tuple(a), as_tuple(b), as_tuple(c), as_tuple(d), as_tuple(e),
-                              as_tuple(f))
+    return FirmwareDifference(
+        target, axes, as_tuple(a), as_tuple(b), as_tuple(c), as_tuple(d), as_tuple(e), as_tuple(f)
+    )
 
 
 #: the firmwares judged, and the slot each exports by default (PX4 TC_G0, ArduPilot INS_TCAL1)
@@ -151,8 +167,9 @@ def firmware_parameters(calibration: Calibration, target: Autopilot) -> dict[str
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)
         if target == "px4":
-            return px4_parameters(calibration, instance=TARGETS["px4"], device_id=_ANY_DEVICE_ID,
-                                  accel_device_id=_ANY_DEVICE_ID).values
+            return px4_parameters(
+                calibration, instance=TARGETS["px4"], device_id=_ANY_DEVICE_ID, accel_device_id=_ANY_DEVICE_ID
+            ).values
         return ardupilot_parameters(calibration, instance=TARGETS["ardupilot"]).values
 
 
@@ -177,8 +194,9 @@ def firmware_correction(calibration: Calibration, recording: Recording, target: 
     return ardupilot_gyro_correction_dps(params, temperature, float(temperature[0]), TARGETS["ardupilot"])
 
 
-def firmware_corrected_axes(calibration: Calibration, recording: Recording, target: Autopilot
-                            ) -> Iterator[tuple[str, np.ndarray]]:
+def firmware_corrected_axes(
+    calibration: Calibration, recording: Recording, target: Autopilot
+) -> Iterator[tuple[str, np.ndarray]]:
     """(axis, output [deg/s]) of each gyro axis of ``recording`` as the autopilot outputs it with the file
     exported from ``calibration`` (:func:`firmware_correction`; an axis without a temperature curve in the model
     is not corrected). Each output is written into one buffer, valid until the next axis is yielded: a day at
@@ -237,9 +255,23 @@ def firmware_costs(calibration: Calibration) -> dict[str, FirmwareDifference]:
         return {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TemperatureRangeWarning)  # the model continues past its range: the point
-        return {target: firmware_difference(calibration, firmware_parameters(calibration, target), target, slot)
-                for target, slot in TARGETS.items()}
+        return {
+            target: firmware_difference(calibration, firmware_parameters(calibration, target), target, slot)
+            for target, slot in TARGETS.items()
+        }
 
 
-__all__ = ["BEYOND_DEGC", "FirmwareDifference", "TARGETS", "ardupilot_gyro_correction_dps", "firmware_correction", "firmware_corrected", "firmware_corrected_axes",
-           "firmware_costs", "firmware_difference", "firmware_parameters", "px4_as_run", "px4_gyro_correction_dps"]
+__all__ = [
+    "BEYOND_DEGC",
+    "FirmwareDifference",
+    "TARGETS",
+    "ardupilot_gyro_correction_dps",
+    "firmware_correction",
+    "firmware_corrected",
+    "firmware_corrected_axes",
+    "firmware_costs",
+    "firmware_difference",
+    "firmware_parameters",
+    "px4_as_run",
+    "px4_gyro_correction_dps",
+]

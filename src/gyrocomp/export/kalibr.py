@@ -39,8 +39,12 @@ def warn_zero_walks(source: str, gyro_walk: float | None, accel_walk: float | No
     walk [any unit] is 0 (None: no such sensor)."""
     for label, walk in (("gyroscope", gyro_walk), ("accelerometer", accel_walk)):
         if walk is not None and walk == 0.0:
-            warnings.warn(f"{source}: no {label} random walk is visible in this log (K = 0); {consumer} needs a "
-                          "non-zero value: record a longer static log (hours)", DataQualityWarning, stacklevel=3)
+            warnings.warn(
+                f"{source}: no {label} random walk is visible in this log (K = 0); {consumer} needs a "
+                "non-zero value: record a longer static log (hours)",
+                DataQualityWarning,
+                stacklevel=3,
+            )
 
 
 def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
@@ -52,15 +56,19 @@ def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
     gyro_walk = max(g.rrw_dps_sqrt_hz for g in gyros) * DEG_TO_RAD
     accel_walk = max(a.random_walk_m_per_s3_per_sqrt_hz for a in accels) if accels else None
     if not accels:
-        warnings.warn(f"{analysis.source}: no accelerometer axes, so imu.yaml has gyroscope values only; "
-                      "Kalibr needs both (name the accelerometer columns with columns=)", DataQualityWarning,
-                      stacklevel=2)
+        warnings.warn(
+            f"{analysis.source}: no accelerometer axes, so imu.yaml has gyroscope values only; "
+            "Kalibr needs both (name the accelerometer columns with columns=)",
+            DataQualityWarning,
+            stacklevel=2,
+        )
     warn_zero_walks(analysis.source, gyro_walk, accel_walk)
     return KalibrImu(
         gyroscope_noise_density_rad_per_s_per_sqrt_hz=max(g.noise_density_dps_per_sqrt_hz for g in gyros) * DEG_TO_RAD,
         gyroscope_random_walk_rad_per_s2_per_sqrt_hz=gyro_walk,
         accelerometer_noise_density_m_per_s2_per_sqrt_hz=(
-            max(a.noise_density_g_per_sqrt_hz for a in accels) * STANDARD_GRAVITY_M_PER_S2 if accels else None),
+            max(a.noise_density_g_per_sqrt_hz for a in accels) * STANDARD_GRAVITY_M_PER_S2 if accels else None
+        ),
         accelerometer_random_walk_m_per_s3_per_sqrt_hz=accel_walk,
         update_rate_hz=analysis.rate_hz,
         rostopic=rostopic,
@@ -84,8 +92,10 @@ def kalibr_imu_yaml(imu: KalibrImu, source: str = ALLAN_FIT) -> str:
             "#Bias random walk [m/s^3/sqrt(Hz)]",
         ]
     else:
-        lines.append("# no accelerometer columns in the log: add accelerometer_noise_density and "
-                     "accelerometer_random_walk before running Kalibr")
+        lines.append(
+            "# no accelerometer columns in the log: add accelerometer_noise_density and "
+            "accelerometer_random_walk before running Kalibr"
+        )
     lines += [
         "#Gyroscopes",
         f"gyroscope_noise_density:     {imu.gyroscope_noise_density_rad_per_s_per_sqrt_hz:.6e}  "

@@ -20,8 +20,9 @@ def _autopilot(target: str) -> Callable[[Calibration, Path, ExportOptions], Expo
     def write(calibration: Calibration, path: Path, options: ExportOptions) -> Exported:
         slot = (0 if target == "px4" else 1) if options.instance is None else options.instance
         if target == "px4":
-            params = px4_parameters(calibration, instance=slot, device_id=options.device_id,
-                                    accel_device_id=options.accel_device_id)
+            params = px4_parameters(
+                calibration, instance=slot, device_id=options.device_id, accel_device_id=options.accel_device_id
+            )
             text = px4_params_text(calibration, params)
         else:
             params = ardupilot_parameters(calibration, instance=slot)
@@ -33,8 +34,9 @@ def _autopilot(target: str) -> Callable[[Calibration, Path, ExportOptions], Expo
                 break
             notes.append(line.lstrip("# "))
         difference = None
-        if options.judge_firmware and any(a in calibration.axes and calibration.axes[a].temperature is not None
-                                          for a in GYRO_AXES):
+        if options.judge_firmware and any(
+            a in calibration.axes and calibration.axes[a].temperature is not None for a in GYRO_AXES
+        ):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # the model continued past its range: that is the point here
                 difference = firmware_difference(calibration, params.values, target, slot)
@@ -43,11 +45,23 @@ def _autopilot(target: str) -> Callable[[Calibration, Path, ExportOptions], Expo
     return write
 
 
-register(Exporter("px4", "PX4 TC_G*/TC_A* parameters for QGroundControl",
-                  "lag, hysteresis, g-sensitivity, gyro scale factor; a cubic held at TMIN/TMAX", _autopilot("px4"),
-                  suffixes=(".params",)))
-register(Exporter("ardupilot", "ArduPilot INS_TCAL* parameters",
-                  "lag, hysteresis, g-sensitivity, gyro scale factor, the constant; a cubic about 35 degC held at "
-                  "TMIN/TMAX", _autopilot("ardupilot"), suffixes=(".parm", ".param")))
+register(
+    Exporter(
+        "px4",
+        "PX4 TC_G*/TC_A* parameters for QGroundControl",
+        "lag, hysteresis, g-sensitivity, gyro scale factor; a cubic held at TMIN/TMAX",
+        _autopilot("px4"),
+        suffixes=(".params",),
+    )
+)
+register(
+    Exporter(
+        "ardupilot",
+        "ArduPilot INS_TCAL* parameters",
+        "lag, hysteresis, g-sensitivity, gyro scale factor, the constant; a cubic about 35 degC held at TMIN/TMAX",
+        _autopilot("ardupilot"),
+        suffixes=(".parm", ".param"),
+    )
+)
 
 __all__: list[str] = []

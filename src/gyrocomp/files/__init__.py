@@ -10,10 +10,17 @@ from __future__ import annotations
 from ..lazy import lazy_exports
 
 #: public name -> (its module in this package, its name there)
-_EXPORTS = {name: (module, name) for module, names in (
-    ("apply", ("FileResult", "apply_file")), ("chunks", ("ChunkSettings", "reads_in_chunks")),
-    ("convert", ("ConvertResult", "convert_file")), ("evaluate", ("evaluate_file",)),
-    ("noise_file", ("analyse_noise_file",))) for name in names}
+_EXPORTS = {
+    name: (module, name)
+    for module, names in (
+        ("apply", ("FileResult", "apply_file")),
+        ("chunks", ("ChunkSettings", "reads_in_chunks")),
+        ("convert", ("ConvertResult", "convert_file")),
+        ("evaluate", ("evaluate_file",)),
+        ("noise_file", ("analyse_noise_file",)),
+    )
+    for name in names
+}
 
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 

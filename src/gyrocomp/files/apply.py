@@ -29,10 +29,19 @@ class FileResult:
     streamed: bool
 
 
-def apply_file(calibration: Calibration, input_path, output_path, *, options: ReadOptions | None = None,
-               fmt: str | None = None, out_fmt: str | None = None, axes: tuple[str, ...] | None = None,
-               turn_on_window_s: float | None = None, chunks: ChunkSettings = ChunkSettings(),
-               progress=None) -> FileResult:
+def apply_file(
+    calibration: Calibration,
+    input_path,
+    output_path,
+    *,
+    options: ReadOptions | None = None,
+    fmt: str | None = None,
+    out_fmt: str | None = None,
+    axes: tuple[str, ...] | None = None,
+    turn_on_window_s: float | None = None,
+    chunks: ChunkSettings = ChunkSettings(),
+    progress=None,
+) -> FileResult:
     """Compensate a file into ``output_path`` (CSV or Parquet): the same rows and columns, the gyro columns (and
     the accelerometer's when the model compensates them) replaced in the file's units.
 
@@ -61,29 +70,40 @@ def apply_file(calibration: Calibration, input_path, output_path, *, options: Re
         Called with the fraction of the file read.
     """
     if not isinstance(calibration, Calibration):
-        raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
-                         f"got {type(calibration).__name__}")
+        raise InputError(
+            f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+            f"got {type(calibration).__name__}"
+        )
 
     def whole(read) -> FileResult:
         data = read()
         compensated = apply(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=axes)
         accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
         write_gyro_back(data, compensated.gyro_dps, output_path, fmt=out_fmt, accel_g=accel)
-        return FileResult(data.recording.n_samples,
-                          compensated_axes(calibration, data.recording, axes, accel is not None), False)
+        return FileResult(
+            data.recording.n_samples, compensated_axes(calibration, data.recording, axes, accel is not None), False
+        )
 
     return chunked_or_whole(
-        input_path, options, fmt=fmt, chunks=chunks, progress=progress, whole=whole,
-        chunked=lambda stream: _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s))
+        input_path,
+        options,
+        fmt=fmt,
+        chunks=chunks,
+        progress=progress,
+        whole=whole,
+        chunked=lambda stream: _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s),
+    )
 
 
-def _apply_stream(calibration: Calibration, stream: TableStream, output_path, out_fmt, axes,
-                  turn_on_window_s) -> FileResult:
+def _apply_stream(
+    calibration: Calibration, stream: TableStream, output_path, out_fmt, axes, turn_on_window_s
+) -> FileResult:
     gyro_factor = unit_factor("gyro", stream.layout.gyro_unit)
     accel_factor = unit_factor("accel", stream.layout.accel_unit)
     comp, accel_order, pending, written, first = None, None, [], 0, None
     computed = tuple(stream.columns[a] for a in stream.gyro_axes + stream.accel_axes)
     with TableWriter(output_path, out_fmt, computed=computed, text_format=stream.text_format) as writer:
+
         def flush(gyro: np.ndarray, accel: np.ndarray | None) -> None:
             nonlocal pending, written
             if not len(gyro):
@@ -97,8 +117,7 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
             for names, values, factor in replaced:
                 for j, axis in enumerate(names):
                     column = stream.columns[axis]
-                    out = out.set_column(out.column_names.index(column), column,
-                                         arrow_floats(values[:, j] / factor))
+                    out = out.set_column(out.column_names.index(column), column, arrow_floats(values[:, j] / factor))
             writer.write(out)
             written += out.num_rows
 
@@ -110,7 +129,9 @@ def _apply_stream(calibration: Calibration, stream: TableStream, output_path, ou
                 if comp.compensates_accel and turn_on_window_s is not None:
                     raise NotStreamable("the accelerometer is not held back with the turn-on window")
             accel = accel_xyz(rec)
-            rows = chunk.table if chunk.kept.size == chunk.table.num_rows else chunk.table.take(arrow_indices(chunk.kept))
+            rows = (
+                chunk.table if chunk.kept.size == chunk.table.num_rows else chunk.table.take(arrow_indices(chunk.kept))
+            )
             pending.append(rows)
             gyro = comp.update(rec.time_s, rec.gyro_dps, rec.temperature_degc, accel)
             accel_out = None

@@ -41,10 +41,24 @@ from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
 from ..io.rosbag1_chunks import lean_writer1
-from ..io.ros_imu import (ANGULAR_VELOCITY, ANGULAR_VELOCITY_COVARIANCE, LINEAR_ACCELERATION,
-                          LINEAR_ACCELERATION_COVARIANCE, imu_batch)
-from ..io.rosbag import (IMU_TYPE, KIND_WORDS, BagStream, any_reader, bag_kind, bag_path, decoded_imu,
-                          header_stamp_s, read_rosbag)
+from ..io.ros_imu import (
+    ANGULAR_VELOCITY,
+    ANGULAR_VELOCITY_COVARIANCE,
+    LINEAR_ACCELERATION,
+    LINEAR_ACCELERATION_COVARIANCE,
+    imu_batch,
+)
+from ..io.rosbag import (
+    IMU_TYPE,
+    KIND_WORDS,
+    BagStream,
+    any_reader,
+    bag_kind,
+    bag_path,
+    decoded_imu,
+    header_stamp_s,
+    read_rosbag,
+)
 from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
@@ -86,23 +100,48 @@ def _writer(bag: Path, target: Path, connections, typestore):
     kind = bag_kind(bag)
     if kind != "ros1":
         rosbag2 = require("rosbags.rosbag2", "ros", "writing ROS 2 bags")
-        plugin = rosbag2.StoragePlugin.MCAP if kind == "mcap" or _storage(bag) == "mcap" else rosbag2.StoragePlugin.SQLITE3
+        plugin = (
+            rosbag2.StoragePlugin.MCAP if kind == "mcap" or _storage(bag) == "mcap" else rosbag2.StoragePlugin.SQLITE3
+        )
         writer = rosbag2.Writer(target, version=9, storage_plugin=plugin)
         writer.open()
-        out = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data,
-                                           rihs01=c.digest or typestore.hash_rihs01(c.msgtype),
-                                           serialization_format=c.ext.serialization_format,
-                                           offered_qos_profiles=c.ext.offered_qos_profiles) for c in connections}
+        out = {
+            c.id: writer.add_connection(
+                c.topic,
+                c.msgtype,
+                msgdef=c.msgdef.data,
+                rihs01=c.digest or typestore.hash_rihs01(c.msgtype),
+                serialization_format=c.ext.serialization_format,
+                offered_qos_profiles=c.ext.offered_qos_profiles,
+            )
+            for c in connections
+        }
     else:
         writer = lean_writer1()(target)
         writer.open()
-        out = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, md5sum=c.digest,
-                                           callerid=c.ext.callerid, latching=c.ext.latching) for c in connections}
+        out = {
+            c.id: writer.add_connection(
+                c.topic,
+                c.msgtype,
+                msgdef=c.msgdef.data,
+                md5sum=c.digest,
+                callerid=c.ext.callerid,
+                latching=c.ext.latching,
+            )
+            for c in connections
+        }
     return writer, out
 
 
-def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | None = None,
-              noise=None, chunk_rows: int = CHUNK_ROWS) -> AppliedBag:
+def apply_bag(
+    calibration: Calibration,
+    path,
+    output,
+    *,
+    options: ReadOptions | None = None,
+    noise=None,
+    chunk_rows: int = CHUNK_ROWS,
+) -> AppliedBag:
     """Compensate the IMU topic of a ROS bag into a bag of the same kind (see the module).
 
     Parameters
@@ -131,8 +170,14 @@ def apply_bag(calibration: Calibration, path, output, *, options: ReadOptions | 
     return _apply_bag({None: calibration}, path, output, options or ReadOptions(), noise, chunk_rows)[0]
 
 
-def apply_bag_instances(calibrations: Mapping[int, Calibration], path, output, *,
-                        options: ReadOptions | None = None, chunk_rows: int = CHUNK_ROWS) -> tuple[AppliedBag, ...]:
+def apply_bag_instances(
+    calibrations: Mapping[int, Calibration],
+    path,
+    output,
+    *,
+    options: ReadOptions | None = None,
+    chunk_rows: int = CHUNK_ROWS,
+) -> tuple[AppliedBag, ...]:
     """Compensate several IMU topics of a ROS bag in one pass, each with its own model, into a bag of the same
     kind (see the module): instance k is the bag's k-th ``sensor_msgs/Imu`` topic in name order, as reading and
     ``gyrocomp fit --instance all`` number them.
@@ -158,26 +203,38 @@ def apply_bag_instances(calibrations: Mapping[int, Calibration], path, output, *
     return _apply_bag(dict(calibrations), path, output, options or ReadOptions(), None, chunk_rows)
 
 
-def _apply_bag(calibrations: dict, path, output, options: ReadOptions, noise, chunk_rows: int
-               ) -> tuple[AppliedBag, ...]:
+def _apply_bag(
+    calibrations: dict, path, output, options: ReadOptions, noise, chunk_rows: int
+) -> tuple[AppliedBag, ...]:
     """Each model of ``calibrations`` (by instance; None: the topic ``options`` choose) on its IMU topic."""
     path, output = Path(path), Path(output)
     bag = bag_path(path)
     if bag_kind(bag) != bag_kind(output):
-        raise InputError(f"output: {output}: a compensated bag is written as the input's kind: "
-                         f"{KIND_WORDS[bag_kind(bag)]}")
+        raise InputError(
+            f"output: {output}: a compensated bag is written as the input's kind: {KIND_WORDS[bag_kind(bag)]}"
+        )
     refuse_output(output)
     covariance_of = _covariances(noise) if noise is not None else {}
-    streams = {k: BagStream(path, options if k is None else dataclasses.replace(options, instance=k, imu_topic=None),
-                            chunk_rows=chunk_rows) for k in calibrations}
+    streams = {
+        k: BagStream(
+            path,
+            options if k is None else dataclasses.replace(options, instance=k, imu_topic=None),
+            chunk_rows=chunk_rows,
+        )
+        for k in calibrations
+    }
     topics = {k: stream.imu[0].topic for k, stream in streams.items()}
     counts = {topics[k]: {"compensated": 0, "unchanged": 0} for k in calibrations}
     streamed = True
     try:
-        copiers = {topics[k]: _Copier(calibrations[k], streams[k], covariance_of, counts[topics[k]])
-                   for k in calibrations}
-        _write_bag(bag, output, lambda reader, writer, connections: _copy_in_batches(reader, writer, connections,
-                                                                                     copiers, chunk_rows))
+        copiers = {
+            topics[k]: _Copier(calibrations[k], streams[k], covariance_of, counts[topics[k]]) for k in calibrations
+        }
+        _write_bag(
+            bag,
+            output,
+            lambda reader, writer, connections: _copy_in_batches(reader, writer, connections, copiers, chunk_rows),
+        )
         for stream in streams.values():
             stream.warn_summary()
         done = {topic: (c.with_accel, tuple(c.covariances)) for topic, c in copiers.items()}
@@ -185,16 +242,28 @@ def _apply_bag(calibrations: dict, path, output, options: ReadOptions, noise, ch
         streamed = False
         counts = {topic: {"compensated": 0, "unchanged": 0} for topic in counts}
         results = {topics[k]: _whole(calibrations[k], path, streams[k].options, covariance_of) for k in calibrations}
-        _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections, results,
-                                                                          counts))
+        _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections, results, counts))
         done = {topic: (result[2], tuple(result[3])) for topic, result in results.items()}
     for topic, count in counts.items():
         if count["unchanged"]:
-            warnings.warn(f"{path}: {count['unchanged']} message(s) of {topic} are not in the recording the bag "
-                          "reads as (outside the temperature topic's span, or not finite) and were copied "
-                          "uncompensated", DataQualityWarning, stacklevel=3)
-    return tuple(AppliedBag(output, topics[k], counts[topics[k]]["compensated"], counts[topics[k]]["unchanged"],
-                            *done[topics[k]], streamed) for k in calibrations)
+            warnings.warn(
+                f"{path}: {count['unchanged']} message(s) of {topic} are not in the recording the bag "
+                "reads as (outside the temperature topic's span, or not finite) and were copied "
+                "uncompensated",
+                DataQualityWarning,
+                stacklevel=3,
+            )
+    return tuple(
+        AppliedBag(
+            output,
+            topics[k],
+            counts[topics[k]]["compensated"],
+            counts[topics[k]]["unchanged"],
+            *done[topics[k]],
+            streamed,
+        )
+        for k in calibrations
+    )
 
 
 def _whole(calibration: Calibration, path: Path, options: ReadOptions, covariance_of: dict) -> tuple:
@@ -231,8 +300,10 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
             messages.append(raw)
             most = max(most, len(messages))
         held_bytes += len(raw)
-        if most >= chunk_rows or (held_bytes >= WINDOW_BYTES and all(
-                copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())):
+        if most >= chunk_rows or (
+            held_bytes >= WINDOW_BYTES
+            and all(copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())
+        ):
             write()
             held, raws, held_bytes, most = [], {topic: [] for topic in copiers}, 0, 0
     write()
@@ -282,8 +353,7 @@ class _Copier:
         done = np.flatnonzero(np.all(np.isfinite(new), axis=1))
         if times.size:
             last = times.size - 1
-            self.twin = (float(times[-1]), correction[last],
-                         accel_correction[last] if self.with_accel else None)
+            self.twin = (float(times[-1]), correction[last], accel_correction[last] if self.with_accel else None)
         self.counts["compensated"] += done.size
         self.counts["unchanged"] += len(raws) - done.size
         return self._encoded(reader, raws, done, new, new_accel)
@@ -313,11 +383,14 @@ class _Copier:
         batch = batch.with_values(ANGULAR_VELOCITY, done, gyro[done])
         if accel is not None:
             batch = batch.with_values(LINEAR_ACCELERATION, done, accel[done])
-        for field, start in (("angular_velocity_covariance", ANGULAR_VELOCITY_COVARIANCE),
-                             ("linear_acceleration_covariance", LINEAR_ACCELERATION_COVARIANCE)):
+        for field, start in (
+            ("angular_velocity_covariance", ANGULAR_VELOCITY_COVARIANCE),
+            ("linear_acceleration_covariance", LINEAR_ACCELERATION_COVARIANCE),
+        ):
             if field in self.covariances:
-                batch = batch.with_values(start, done, np.tile(np.asarray(self.covariances[field], dtype=float),
-                                                               (done.size, 1)))
+                batch = batch.with_values(
+                    start, done, np.tile(np.asarray(self.covariances[field], dtype=float), (done.size, 1))
+                )
         return [batch.message(i) for i in range(len(raws))]
 
     def _reserialized(self, reader, raws: list, done: np.ndarray, gyro: np.ndarray, accel) -> list:
@@ -326,19 +399,22 @@ class _Copier:
         out = list(raws)
         for i in done:
             msg = reader.deserialize(raws[i], IMU_TYPE)
-            out[i] = serialize(_replaced(msg, gyro[i], None if accel is None else accel[i], self.covariances),
-                               IMU_TYPE)
+            out[i] = serialize(_replaced(msg, gyro[i], None if accel is None else accel[i], self.covariances), IMU_TYPE)
         return out
 
 
 def _replaced(msg, gyro_rad, accel_ms2, covariances: dict):
     """An IMU message with its angular velocity (x, y, z) [rad/s], its linear acceleration [m/s^2] (None: as it
     was) and the covariance fields ``covariances`` replaced."""
-    changes = {"angular_velocity": dataclasses.replace(msg.angular_velocity, x=float(gyro_rad[0]),
-                                                       y=float(gyro_rad[1]), z=float(gyro_rad[2]))}
+    changes = {
+        "angular_velocity": dataclasses.replace(
+            msg.angular_velocity, x=float(gyro_rad[0]), y=float(gyro_rad[1]), z=float(gyro_rad[2])
+        )
+    }
     if accel_ms2 is not None:
-        changes["linear_acceleration"] = dataclasses.replace(msg.linear_acceleration, x=float(accel_ms2[0]),
-                                                             y=float(accel_ms2[1]), z=float(accel_ms2[2]))
+        changes["linear_acceleration"] = dataclasses.replace(
+            msg.linear_acceleration, x=float(accel_ms2[0]), y=float(accel_ms2[1]), z=float(accel_ms2[2])
+        )
     for field, values in covariances.items():
         changes[field] = np.asarray(values, dtype=np.float64)
     return dataclasses.replace(msg, **changes)
@@ -360,8 +436,9 @@ def refuse_output(output: Path) -> None:
     refused in one line."""
     refuse_link(output)
     if output.is_dir() and not (output / "metadata.yaml").is_file():
-        raise InputError(f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces "
-                         "only a bag)")
+        raise InputError(
+            f"output: {output}: is a folder that is not a ROS 2 bag; name a new path (gyrocomp replaces only a bag)"
+        )
 
 
 @contextlib.contextmanager

@@ -29,8 +29,11 @@ def ask_for(options: FitOptions | None = None) -> Ask:
         size = spec.order if isinstance(spec, Polynomial) else spec.size
         parameters = 2 if size == "auto" else int(size) + 1
     automatic = isinstance(spec, Polynomial) and spec.order == "auto"
-    return Ask(temperature="auto" if automatic else "asked",
-               hysteresis=options.hysteresis.startswith("turning-point"), parameters=parameters)
+    return Ask(
+        temperature="auto" if automatic else "asked",
+        hysteresis=options.hysteresis.startswith("turning-point"),
+        parameters=parameters,
+    )
 
 
 def read_checked(path: str | os.PathLike, options: ReadOptions | None = None, fmt: str | None = None) -> CheckedRun:
@@ -49,8 +52,13 @@ def _noted(read, path: str | os.PathLike) -> CheckedRun:
     return CheckedRun(os.fspath(path), recording, tuple(w.message for w in caught))
 
 
-def check_files(paths: Sequence[str | os.PathLike], options: ReadOptions | None = None, fmt: str | None = None,
-                ask: Ask | None = None, accept: Iterable[str] = ()) -> tuple[list[CheckedRun], list[RunCheck]]:
+def check_files(
+    paths: Sequence[str | os.PathLike],
+    options: ReadOptions | None = None,
+    fmt: str | None = None,
+    ask: Ask | None = None,
+    accept: Iterable[str] = (),
+) -> tuple[list[CheckedRun], list[RunCheck]]:
     """Read and check ``paths`` as one set of runs (one unit's): the runs as read and their checks (``ask``:
     default, ``gyrocomp fit``'s defaults)."""
     runs = [read_checked(p, options, fmt) for p in paths]
@@ -100,5 +108,14 @@ def rewarn(runs: Iterable[CheckedRun]) -> None:
             warnings.warn(note, stacklevel=2)
 
 
-__all__ = ["SAID_ELSEWHERE", "ask_for", "check_files", "enforce", "read_checked", "read_noting", "refuse", "rewarn",
-           "warn_findings"]
+__all__ = [
+    "SAID_ELSEWHERE",
+    "ask_for",
+    "check_files",
+    "enforce",
+    "read_checked",
+    "read_noting",
+    "refuse",
+    "rewarn",
+    "warn_findings",
+]

@@ -71,9 +71,16 @@ def reads_in_chunks(fmt: str, options: ReadOptions) -> bool:
     return (fmt in table_formats() or reader_named(fmt).stream is not None) and options.time_range_s is None
 
 
-def chunked_or_whole(path, options: ReadOptions | None, *, fmt: str | None, chunks: ChunkSettings,
-                     progress: ProgressCallback | None, chunked: Callable[[TableStream], T],
-                     whole: Callable[[Callable[[], TableData]], T]) -> T:
+def chunked_or_whole(
+    path,
+    options: ReadOptions | None,
+    *,
+    fmt: str | None,
+    chunks: ChunkSettings,
+    progress: ProgressCallback | None,
+    chunked: Callable[[TableStream], T],
+    whole: Callable[[Callable[[], TableData]], T],
+) -> T:
     """``chunked(stream)`` of the file read in chunks when it can be (:func:`reads_in_chunks`), else (and when the
     stream raises :class:`~gyrocomp.io.stream.NotStreamable`) ``whole(read)``, ``read()`` reading the whole file
     with the same options (:func:`gyrocomp.io.read_input`).
@@ -97,8 +104,15 @@ def chunked_or_whole(path, options: ReadOptions | None, *, fmt: str | None, chun
     fmt = detect_format(path, fmt)
     if reads_in_chunks(fmt, options):
         if fmt in table_formats():
-            stream = TableStream(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite,
-                                 chunk_rows=chunks.chunk_rows, progress=progress, channels=options.channels)
+            stream = TableStream(
+                path,
+                options.layout,
+                fmt=fmt,
+                drop_nonfinite=options.drop_nonfinite,
+                chunk_rows=chunks.chunk_rows,
+                progress=progress,
+                channels=options.channels,
+            )
         else:
             stream = reader_named(fmt).stream(Path(path), options, chunks.chunk_rows, progress)
         try:

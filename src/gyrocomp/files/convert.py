@@ -24,9 +24,16 @@ class ConvertResult:
     channels: tuple[str, ...]
 
 
-def convert_file(input_path, output_path, *, options: ReadOptions | None = None, fmt: str | None = None,
-                 out_fmt: str | None = None, chunks: ChunkSettings = ChunkSettings(),
-                 progress=None) -> ConvertResult:
+def convert_file(
+    input_path,
+    output_path,
+    *,
+    options: ReadOptions | None = None,
+    fmt: str | None = None,
+    out_fmt: str | None = None,
+    chunks: ChunkSettings = ChunkSettings(),
+    progress=None,
+) -> ConvertResult:
     """Any file gyrocomp reads written as the canonical table (time [s], gyro [deg/s], accel [g], temperature
     [degC]) in CSV or Parquet (a text table with the input's separator and decimal point; a ``.tsv`` name means
     tabs): the same bytes as reading it whole and writing the recording
@@ -45,17 +52,26 @@ def convert_file(input_path, output_path, *, options: ReadOptions | None = None,
     progress : callable, optional
         Called with the fraction read.
     """
+
     def whole(read) -> ConvertResult:
         data = read()
         recording = data.recording
         _warn_once(recording_concerns(recording))
         write_recording(recording, output_path, fmt=out_fmt, text_format=data.text_format)
         channels = (*recording.gyro_axes, *recording.accel_axes, *recording.temperature_columns)
-        return ConvertResult(recording.n_samples, recording.duration_s, recording.rate_hz, len(recording.gaps),
-                             channels)
+        return ConvertResult(
+            recording.n_samples, recording.duration_s, recording.rate_hz, len(recording.gaps), channels
+        )
 
-    return chunked_or_whole(input_path, options, fmt=fmt, chunks=chunks, progress=progress, whole=whole,
-                            chunked=lambda stream: _convert_stream(stream, output_path, out_fmt))
+    return chunked_or_whole(
+        input_path,
+        options,
+        fmt=fmt,
+        chunks=chunks,
+        progress=progress,
+        whole=whole,
+        chunked=lambda stream: _convert_stream(stream, output_path, out_fmt),
+    )
 
 
 def _convert_stream(stream: TableStream, output_path, out_fmt) -> ConvertResult:

@@ -47,13 +47,24 @@ def convert_bag(path, output) -> ConvertedBag:
     refuse_output(output)
     with staged_bag(output, target) as written:
         try:
-            converter.convert([bag], written, dst_storage="mcap" if target == "mcap" else "sqlite3",
-                              dst_version=None if target == "ros1" else 9, compress=None, compress_mode="file",
-                              default_typestore=None, typestore=None, exclude_topics=[], include_topics=[],
-                              exclude_msgtypes=[], include_msgtypes=[])
+            converter.convert(
+                [bag],
+                written,
+                dst_storage="mcap" if target == "mcap" else "sqlite3",
+                dst_version=None if target == "ros1" else 9,
+                compress=None,
+                compress_mode="file",
+                default_typestore=None,
+                typestore=None,
+                exclude_topics=[],
+                include_topics=[],
+                exclude_msgtypes=[],
+                include_msgtypes=[],
+            )
         except converter.ConverterError as exc:
-            raise InputError(f"{path}: cannot be converted to {KIND_WORDS[target]}: {printable(str(exc))[:200]}") \
-                from None
+            raise InputError(
+                f"{path}: cannot be converted to {KIND_WORDS[target]}: {printable(str(exc))[:200]}"
+            ) from None
     return ConvertedBag(output, target, source)
 
 

@@ -16,9 +16,17 @@ from ..recording import ACCEL_AXES, Recording
 from .chunks import ChunkSettings, TimeSteps, chunked_or_whole
 
 
-def evaluate_file(calibration: Calibration, path, *, options: ReadOptions | None = None, fmt: str | None = None,
-                  window_s: float | None = None, turn_on_window_s: float | None = None,
-                  chunks: ChunkSettings = ChunkSettings(), progress=None) -> Evaluation:
+def evaluate_file(
+    calibration: Calibration,
+    path,
+    *,
+    options: ReadOptions | None = None,
+    fmt: str | None = None,
+    window_s: float | None = None,
+    turn_on_window_s: float | None = None,
+    chunks: ChunkSettings = ChunkSettings(),
+    progress=None,
+) -> Evaluation:
     """:func:`gyrocomp.evaluation.evaluate` of ``calibration`` on a file: a CSV or Parquet table read in chunks
     (each chunk compensated by one :class:`gyrocomp.Compensator`, both the raw and the compensated rates
     integrated into phases as they come, the figures read from the phases; equal to the whole file's to
@@ -39,21 +47,30 @@ def evaluate_file(calibration: Calibration, path, *, options: ReadOptions | None
         Called with the fraction of the file read.
     """
     if not isinstance(calibration, Calibration):
-        raise InputError(f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
-                         f"got {type(calibration).__name__}")
+        raise InputError(
+            f"calibration: expected a Calibration (from fit_calibration or Calibration.load), "
+            f"got {type(calibration).__name__}"
+        )
 
     def chunked(stream: TableStream) -> Evaluation:
         if calibration.gyro_triad is not None or calibration.accel_triad is not None:
             raise NotStreamable("a triad is judged on whole still poses")
         return Evaluation([_evaluate_stream(calibration, stream, window_s, turn_on_window_s, chunks)])
 
-    return chunked_or_whole(path, options, fmt=fmt, chunks=chunks, progress=progress, chunked=chunked,
-                            whole=lambda read: evaluate(calibration, read().recording, window_s=window_s,
-                                                        turn_on_window_s=turn_on_window_s))
+    return chunked_or_whole(
+        path,
+        options,
+        fmt=fmt,
+        chunks=chunks,
+        progress=progress,
+        chunked=chunked,
+        whole=lambda read: evaluate(
+            calibration, read().recording, window_s=window_s, turn_on_window_s=turn_on_window_s
+        ),
+    )
 
 
-def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, turn_on_window_s,
-                     chunks: ChunkSettings):
+def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, turn_on_window_s, chunks: ChunkSettings):
     comp: Compensator | None = None
     accel_axes: tuple[str, ...] = ()
     steps, raw, compensated = TimeSteps(chunks), None, None
@@ -70,25 +87,34 @@ def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, tu
                 if calibration.accel_axes and comp.compensates_accel:
                     accel_axes = recording.accel_axes
                 columns = len(recording.gyro_axes) + len(accel_axes)
-                raw, compensated = (PhaseAccumulator(columns, memory_bytes=chunks.memory_bytes,
-                                                     directory=chunks.scratch_dir) for _ in range(2))
+                raw, compensated = (
+                    PhaseAccumulator(columns, memory_bytes=chunks.memory_bytes, directory=chunks.scratch_dir)
+                    for _ in range(2)
+                )
                 first = recording
             steps.add(recording.time_s)
             raw.update(np.column_stack([recording.gyro_dps] + ([recording.accel_g] if accel_axes else [])))
             out = comp.update(recording.time_s, recording.gyro_dps, recording.temperature_degc, accel_xyz(recording))
             pending_rows = np.concatenate([pending_rows, recording.row_numbers])
             block = _compensated(comp, out, accel_axes)
-            _check_block(first, block, accel_axes, pending_rows[:len(block)])
+            _check_block(first, block, accel_axes, pending_rows[: len(block)])
             compensated.update(block)
-            pending_rows = pending_rows[len(block):]
+            pending_rows = pending_rows[len(block) :]
         block = _compensated(comp, comp.finish(), accel_axes)
-        _check_block(first, block, accel_axes, pending_rows[:len(block)])
+        _check_block(first, block, accel_axes, pending_rows[: len(block)])
         compensated.update(block)
         warn_disagreement(comp, stacklevel=4)
         rate_hz = steps.rate_hz()
         stream.warn_summary()
-        return evaluate_phases(first.source, raw.finish(rate_hz), compensated.finish(rate_hz), rate_hz,
-                               gyro_axes=first.gyro_axes, accel_axes=accel_axes, window_s=window_s)
+        return evaluate_phases(
+            first.source,
+            raw.finish(rate_hz),
+            compensated.finish(rate_hz),
+            rate_hz,
+            gyro_axes=first.gyro_axes,
+            accel_axes=accel_axes,
+            window_s=window_s,
+        )
     finally:
         steps.close()
         for accumulator in (raw, compensated):

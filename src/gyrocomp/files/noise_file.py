@@ -21,19 +21,27 @@ from ..allan.streaming import PhaseAccumulator
 from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
 from ..io.stream import NotStreamable, TableStream
-from ..measures.noise import (NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes,
-                              warn_if_moving)
+from ..measures.noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes, warn_if_moving
 from ..measures.plausibility import temperature_range_concerns, time_unit_concern
 from ..motion.stillness import StillnessState, detection
 from ..recording import ACCEL_AXES, GYRO_AXES
 from .chunks import ChunkSettings, TimeSteps, chunked_or_whole, with_channels
 
 
-def analyse_noise_file(path, axes: list[str] | None = None, *, options: ReadOptions | None = None,
-                       fmt: str | None = None, with_accel: bool = False, kind: AllanKind = "oadev",
-                       taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
-                       fit_taus_s: tuple[float, float] | None = None, chunks: ChunkSettings = ChunkSettings(),
-                       progress=None) -> NoiseAnalysis:
+def analyse_noise_file(
+    path,
+    axes: list[str] | None = None,
+    *,
+    options: ReadOptions | None = None,
+    fmt: str | None = None,
+    with_accel: bool = False,
+    kind: AllanKind = "oadev",
+    taus: TauGrid | np.ndarray = "octave",
+    split_gaps: bool = False,
+    fit_taus_s: tuple[float, float] | None = None,
+    chunks: ChunkSettings = ChunkSettings(),
+    progress=None,
+) -> NoiseAnalysis:
     """:func:`gyrocomp.measures.noise.analyse_noise` of a file: a CSV or Parquet table read in chunks (see the
     module), any other file whole; only time and the analysed columns are read.
 
@@ -67,16 +75,24 @@ def analyse_noise_file(path, axes: list[str] | None = None, *, options: ReadOpti
             # the gaps are refused by analyse_noise in one line of their own, or split and said in the result's how
             warnings.filterwarnings("ignore", message=r".*time gap\(s\) longer than", category=DataQualityWarning)
             recording = read().recording
-        return analyse_noise(recording, named, kind=kind, taus=taus, split_gaps=split_gaps, fit_taus_s=fit_taus_s,
-                             with_accel=with_accel)
+        return analyse_noise(
+            recording, named, kind=kind, taus=taus, split_gaps=split_gaps, fit_taus_s=fit_taus_s, with_accel=with_accel
+        )
 
     return chunked_or_whole(
-        path, with_channels(options, wanted), fmt=fmt, chunks=chunks, progress=progress, whole=whole,
-        chunked=lambda stream: _noise_stream(stream, named, with_accel, kind, taus, fit_taus_s, chunks))
+        path,
+        with_channels(options, wanted),
+        fmt=fmt,
+        chunks=chunks,
+        progress=progress,
+        whole=whole,
+        chunked=lambda stream: _noise_stream(stream, named, with_accel, kind, taus, fit_taus_s, chunks),
+    )
 
 
-def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_taus_s,
-                  chunks: ChunkSettings) -> NoiseAnalysis:
+def _noise_stream(
+    stream: TableStream, named, with_accel: bool, kind, taus, fit_taus_s, chunks: ChunkSettings
+) -> NoiseAnalysis:
     names = noise_axes(named, stream.gyro_axes, stream.accel_axes, with_accel)
     have = (*stream.gyro_axes, *stream.accel_axes)
     for name in names:
@@ -109,8 +125,9 @@ def _noise_stream(stream: TableStream, named, with_accel: bool, kind, taus, fit_
             if concern is not None:  # the same words as a whole recording's check (allan on ns read as s)
                 warnings.warn(concern.warning(), stacklevel=3)
             integrated = dict(zip(names, phases.finish(rate_hz)))
-            return analyse_noise_phases(integrated, rate_hz, source=str(stream.path), kind=kind, taus=taus,
-                                        fit_taus_s=fit_taus_s)
+            return analyse_noise_phases(
+                integrated, rate_hz, source=str(stream.path), kind=kind, taus=taus, fit_taus_s=fit_taus_s
+            )
     finally:
         steps.close()
 

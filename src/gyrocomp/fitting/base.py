@@ -26,8 +26,9 @@ class LearnedAttributes:
 
     def __getattr__(self, name: str):
         if name.endswith("_") and not name.startswith("_"):
-            raise NotFittedError(f"{type(self).__name__} is not fitted yet; call {self.FIT_CALL} first ({name} is "
-                                 "learned by the fit)")
+            raise NotFittedError(
+                f"{type(self).__name__} is not fitted yet; call {self.FIT_CALL} first ({name} is learned by the fit)"
+            )
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
 
@@ -78,8 +79,9 @@ def bin_width_for(temperatures: list[np.ndarray], bin_width_degc: float | None) 
     return max((hi - lo) / DEFAULT_BINS_PER_SPAN, 1e-3)
 
 
-def bin_by_temperature(temperatures: list[np.ndarray], values: list[np.ndarray], width_degc: float,
-                       origin_degc: float = 0.0) -> TemperatureBins:
+def bin_by_temperature(
+    temperatures: list[np.ndarray], values: list[np.ndarray], width_degc: float, origin_degc: float = 0.0
+) -> TemperatureBins:
     """Average ``values`` in temperature bins of ``width_degc``, separately for each run."""
     temps, vals, counts, runs = [], [], [], []
     for r, (t, v) in enumerate(zip(temperatures, values)):
@@ -89,15 +91,16 @@ def bin_by_temperature(temperatures: list[np.ndarray], values: list[np.ndarray],
         vals.append(np.bincount(inverse, weights=v) / count)
         counts.append(count)
         runs.append(np.full(uniq.size, r))
-    return TemperatureBins(np.concatenate(temps), np.concatenate(vals), np.concatenate(counts),
-                           np.concatenate(runs))
+    return TemperatureBins(np.concatenate(temps), np.concatenate(vals), np.concatenate(counts), np.concatenate(runs))
 
 
 def one_temperature_column(recordings: list[Recording]) -> bool:
     """Whether every recording reads one temperature for all the axes a fit models (one sensor, so one die and one
     lag): one column, or the accelerometer's axes (which all read the mean of the gyro's columns)."""
-    return all(rec.temperature_degc is None or len({rec.temperature_column_for(a) for a in fit_axes([rec])}) == 1
-               for rec in recordings)
+    return all(
+        rec.temperature_degc is None or len({rec.temperature_column_for(a) for a in fit_axes([rec])}) == 1
+        for rec in recordings
+    )
 
 
 def provenance(recordings) -> dict:
@@ -106,8 +109,12 @@ def provenance(recordings) -> dict:
     them)."""
     inputs = []
     for rec in recordings:
-        entry = {"file": Path(rec.source).name, "rows": rec.n_samples, "duration_s": rec.duration_s,
-                 "rate_hz": rec.rate_hz}
+        entry = {
+            "file": Path(rec.source).name,
+            "rows": rec.n_samples,
+            "duration_s": rec.duration_s,
+            "rate_hz": rec.rate_hz,
+        }
         path = rec.metadata.get("path")
         if path and Path(path).is_file():
             entry["sha256"] = file_sha256(path)

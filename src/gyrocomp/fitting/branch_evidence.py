@@ -75,7 +75,7 @@ def _weighted_fit(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarr
     sw = np.sqrt(w)
     coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
     resid = y - x @ coef
-    return resid, float(np.sum(w * resid ** 2))
+    return resid, float(np.sum(w * resid**2))
 
 
 class _ProjectedFit:
@@ -103,8 +103,15 @@ class _ProjectedFit:
         return float(resid @ resid)
 
 
-def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], t_ref_degc: float,
-                  t_scale_degc: float, order: int, block_s: float | None = None) -> tuple[float, float] | None:
+def observed_band(
+    runs: list[RunBlocks],
+    groups: tuple[int, ...],
+    thresholds: list[float],
+    t_ref_degc: float,
+    t_scale_degc: float,
+    order: int,
+    block_s: float | None = None,
+) -> tuple[float, float] | None:
     """The band where the branches after a reversal part [degC] (:func:`parting_band_degc`), in the residual of
     a polynomial of ``order`` with one constant per run, fitted by time-weighted least squares on the blocks.
 
@@ -119,16 +126,24 @@ def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: li
     onehot = np.zeros((sum(r.value.size for r in runs), len(group_ids)))
     start = 0
     for r, g in zip(runs, groups):
-        onehot[start:start + r.value.size, group_ids.index(g)] = 1.0
+        onehot[start : start + r.value.size, group_ids.index(g)] = 1.0
         start += r.value.size
     y = np.concatenate([r.value for r in runs])
     w = np.concatenate([r.samples.astype(float) for r in runs])
-    taus = [0.0] if block_s is None else [0.0, *np.geomspace(2 * block_s, min(LAG_MAX_S, max(
-        float(r.time_s[-1] - r.time_s[0]) for r in runs)) / 4, 8)]
+    taus = (
+        [0.0]
+        if block_s is None
+        else [
+            0.0,
+            *np.geomspace(2 * block_s, min(LAG_MAX_S, max(float(r.time_s[-1] - r.time_s[0]) for r in runs)) / 4, 8),
+        ]
+    )
     fits = []
     for tau in taus:
-        temps = [thermal_lag(r.time_s, r.temperature_degc, tau, period_s=block_s)[0] if tau > 0
-                 else r.temperature_degc for r in runs]
+        temps = [
+            thermal_lag(r.time_s, r.temperature_degc, tau, period_s=block_s)[0] if tau > 0 else r.temperature_degc
+            for r in runs
+        ]
         u = (np.concatenate(temps) - t_ref_degc) / t_scale_degc
         x = np.hstack([onehot, power_columns(u, 1, order)])
         resid, rss = _weighted_fit(x, y, w)
@@ -145,8 +160,9 @@ def observed_band(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: li
     # the edges at every lag of the grid: an edge a little off is a jump at the wrong temperature, which a longer
     # or shorter lag moves back in time, so the lag that fits the polynomial best need not be the band's (measured
     # on the ADXRS450-like part with a 30 s lag: upper edge 80.7 degC at 61 s, 80.0 degC at the truth)
-    return min((_refined_edges(band, step, f[1], f[3], y, w, thresholds, t_scale_degc) for f in fits),
-               key=lambda e: e[0])[1]
+    return min(
+        (_refined_edges(band, step, f[1], f[3], y, w, thresholds, t_scale_degc) for f in fits), key=lambda e: e[0]
+    )[1]
 
 
 def _refined_edges(band, step, temps, x, y, w, thresholds, t_scale_degc) -> tuple[float, tuple[float, float]]:
@@ -160,7 +176,7 @@ def _refined_edges(band, step, temps, x, y, w, thresholds, t_scale_degc) -> tupl
     direction = np.concatenate([tr.direction for tr in turns])
     d = np.where(after, np.abs(t - np.where(after, turn_degc, 0.0)), 0.0) / t_scale_degc
     projected = _ProjectedFit(x, y, w)
-    powers = [np.where(direction == sign, d ** j, 0.0) for sign in (-1, 1) for j in (1, 2)]
+    powers = [np.where(direction == sign, d**j, 0.0) for sign in (-1, 1) for j in (1, 2)]
 
     def rss(lo, hi):
         inside = after & (t >= lo) & (t <= hi)
@@ -172,8 +188,17 @@ def _refined_edges(band, step, temps, x, y, w, thresholds, t_scale_degc) -> tupl
     return rss(lo, hi), (float(lo), float(hi))
 
 
-def band_offer(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[float], folds, t_ref: float,
-               t_scale: float, order: int, block_s: float, both_directions: bool):
+def band_offer(
+    runs: list[RunBlocks],
+    groups: tuple[int, ...],
+    thresholds: list[float],
+    folds,
+    t_ref: float,
+    t_scale: float,
+    order: int,
+    block_s: float,
+    both_directions: bool,
+):
     """(band, band only) with the folds ``folds`` (a :class:`gyrocomp.fitting.folds.Folds`): the band where the
     branches part [degC] or None, and whether turning-point candidates are offered only inside it.
 
@@ -184,8 +209,7 @@ def band_offer(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[
     it must stand out by three standard errors per bin (:func:`parting_band_degc`). It is found through a fitted
     lag only with one or two runs, where that is what finds it (the ADXRS450 case); with whole runs held out, it
     moved the choice of the demo's MTi-10-class part to a worse gyro_y (measured: 0.0067 against 0.0019 deg/s)."""
-    band_only = both_directions and folds.kind != "runs" and not branches_identified(runs, thresholds,
-                                                                                     one_sided=False)
+    band_only = both_directions and folds.kind != "runs" and not branches_identified(runs, thresholds, one_sided=False)
     band = observed_band(runs, groups, thresholds, t_ref, t_scale, order, block_s if folds.kind != "runs" else None)
     return band, band_only
 
@@ -194,9 +218,17 @@ def band_offer(runs: list[RunBlocks], groups: tuple[int, ...], thresholds: list[
 BRANCH_TEST_SIGMAS = 3.0
 
 
-def branch_test(runs: list[RunBlocks], groups: tuple[int, ...], threshold_degc: float, t_ref_degc: float,
-                t_scale_degc: float, order: int, tau_s: float, block_s: float,
-                extra: list[np.ndarray] | None = None) -> BranchTest:
+def branch_test(
+    runs: list[RunBlocks],
+    groups: tuple[int, ...],
+    threshold_degc: float,
+    t_ref_degc: float,
+    t_scale_degc: float,
+    order: int,
+    tau_s: float,
+    block_s: float,
+    extra: list[np.ndarray] | None = None,
+) -> BranchTest:
     """Do the heating and cooling curves differ by more than the drift explains?
 
     For data where every held-out leg leaves one direction of travel only in training (one cooling and one
@@ -223,9 +255,14 @@ def branch_test(runs: list[RunBlocks], groups: tuple[int, ...], threshold_degc: 
     order = max(order, 1)
     coarse = CoarseRuns.of(runs, tau_s, block_s)
     y, t = coarse.value, coarse.time_s
-    designs = [coarse.coarse(_branch_design(runs, coarse.temperature_degc, groups, threshold_degc, t_ref_degc,
-                                            t_scale_degc, order, w, extra))
-               for w in BRANCH_WIDTHS_DEGC]
+    designs = [
+        coarse.coarse(
+            _branch_design(
+                runs, coarse.temperature_degc, groups, threshold_degc, t_ref_degc, t_scale_degc, order, w, extra
+            )
+        )
+        for w in BRANCH_WIDTHS_DEGC
+    ]
     ys = np.concatenate(y)
     fits = [_weighted_fit(np.vstack(x), ys, np.ones(ys.size)) for x in designs]  # (residual, rss) per width
     duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in runs)
@@ -239,7 +276,7 @@ def branch_test(runs: list[RunBlocks], groups: tuple[int, ...], threshold_degc: 
     null = _weighted_fit(np.vstack([xk[:, :first] for xk in x]), ys, np.ones(ys.size))[0]
     noise = fit_drift_noise(np.split(null, np.cumsum([v.size for v in y])[:-1]), t)
     walk = math.sqrt(noise.walk_var_per_s)
-    one = wald_statistic([xk[:, :first + 1] for xk in x], y, t, noise, np.array([first]))
+    one = wald_statistic([xk[:, : first + 1] for xk in x], y, t, noise, np.array([first]))
     both = wald_statistic(x, y, t, noise, np.array([first, first + 1]))
     alone = wald_statistic(x, y, t, noise, np.array([first + 1]))
     c1, c2 = chi2_threshold(1, BRANCH_TEST_SIGMAS), chi2_threshold(2, BRANCH_TEST_SIGMAS)
@@ -265,4 +302,13 @@ def _branch_design(runs, temps, groups, threshold_degc, t_ref_degc, t_scale_degc
     return out
 
 
-__all__ = ["BRANCH_OVERLAP", "BRANCH_TEST_SIGMAS", "band_offer", "branch_test", "branches_identified", "branches_present", "heats_and_cools_blocks", "observed_band"]
+__all__ = [
+    "BRANCH_OVERLAP",
+    "BRANCH_TEST_SIGMAS",
+    "band_offer",
+    "branch_test",
+    "branches_identified",
+    "branches_present",
+    "heats_and_cools_blocks",
+    "observed_band",
+]

@@ -28,8 +28,9 @@ from .selection import WEIGHTINGS, AxisSelection, SelectionProblem
 from .thermal import MAX_BRANCH_ORDER
 
 
-def share_fold_lags(problems: list[SelectionProblem], orders: tuple[int, ...],
-                    weightings: tuple[Weighting, ...] = WEIGHTINGS) -> None:
+def share_fold_lags(
+    problems: list[SelectionProblem], orders: tuple[int, ...], weightings: tuple[Weighting, ...] = WEIGHTINGS
+) -> None:
     """Give the axes one lag per fold and per (order, weighting): the lag is the die's, behind one temperature
     sensor, and the axes together pin it down better than any one of them (as the final fit does, see
     :class:`gyrocomp.fitting.thermal.ThermalHysteresisModel`'s ``shared_lag``). Each fold's lag minimizes the
@@ -66,13 +67,20 @@ class AxisScores:
     eligible: frozenset[Candidate]
 
 
-def score_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],
-               weightings: tuple[Weighting, ...] = WEIGHTINGS) -> AxisScores:
+def score_axis(
+    axis: str,
+    problem: SelectionProblem,
+    orders: tuple[int, ...],
+    memories: tuple[str, ...],
+    weightings: tuple[Weighting, ...] = WEIGHTINGS,
+) -> AxisScores:
     """Score every candidate of one axis on the held-out folds (:meth:`SelectionProblem.score`)."""
     cands = problem.candidates(orders, memories, weightings)
     if not cands:
-        raise InputError(f"hysteresis={'/'.join(memories)!r}: the temperature of {axis} never reverses in these "
-                         "runs, so there is no branch to fit; use hysteresis='none' or 'lag'")
+        raise InputError(
+            f"hysteresis={'/'.join(memories)!r}: the temperature of {axis} never reverses in these "
+            "runs, so there is no branch to fit; use hysteresis='none' or 'lag'"
+        )
     eligible = set(cands)
     if Candidate(0) not in cands:  # the reference every score is read against; chosen only when asked for
         cands.insert(0, Candidate(0))
@@ -84,8 +92,9 @@ def score_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], me
 TWO_FOLDS = 2
 
 
-def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_harm: bool = True,
-                unit_lag: bool = False) -> AxisSelection:
+def choose_axis(
+    axis: str, problem: SelectionProblem, scored: AxisScores, do_no_harm: bool = True, unit_lag: bool = False
+) -> AxisSelection:
     """Choose among the scores of one axis (see the module doc); with ``do_no_harm``, a temperature model only
     where it beats the run constant (:func:`gyrocomp.fitting.scores.beats_constant`; with two folds,
     :func:`_choose_on_two_folds`), and whatever rule or test chose, never a model that leaves more held-out drift
@@ -110,15 +119,22 @@ def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_
         best, chosen, decided_by, evidence = _choose_on_two_folds(problem, offered, complexity, constant)
     else:
         best, chosen = choose(offered, complexity, constant if do_no_harm else None)
-        decided_by = (f"held-out drift ({problem.window_s:.3g} s window): the simplest within one standard error "
-                      "of the best" if do_no_harm else
-                      f"held-out drift ({problem.window_s:.3g} s window) among the candidates asked for")
+        decided_by = (
+            f"held-out drift ({problem.window_s:.3g} s window): the simplest within one standard error of the best"
+            if do_no_harm
+            else f"held-out drift ({problem.window_s:.3g} s window) among the candidates asked for"
+        )
         if do_no_harm and not chosen.has_temperature_model and best.has_temperature_model:
             decided_by = "do no harm: no temperature model beats the constant on the held-out folds"
     chosen, decided_by = _lag_at_the_short_window(problem, scored, chosen, decided_by)
     test = None
-    if problem.branch_orders and chosen.has_temperature_model and not chosen.branch \
-            and not chosen.hysteresis_order and not np.any(problem.fold_has_both_directions()):
+    if (
+        problem.branch_orders
+        and chosen.has_temperature_model
+        and not chosen.branch
+        and not chosen.hysteresis_order
+        and not np.any(problem.fold_has_both_directions())
+    ):
         twin = dataclasses.replace(chosen, lag=True)
         if unit_lag and twin in scored.eligible:
             chosen = twin  # a lag also parts the heating and cooling legs: the branch terms are tested beyond it
@@ -126,16 +142,35 @@ def choose_axis(axis: str, problem: SelectionProblem, scored: AxisScores, do_no_
         if test is not None and test.order:
             decided_by += f"; branch terms by their test (Wald {test.statistic:.3g} against {test.threshold:.3g})"
     if do_no_harm and chosen.has_temperature_model and harms(_score(scored, chosen), constant):
-        chosen, decided_by = constant.candidate, (f"do no harm: {chosen.label} leaves more held-out drift than the "
-                                                  "constant by more than its standard error")
-    return AxisSelection(axis, problem.folds.kind, problem.folds.names, problem.window_s,
-                         problem.temperature_step_degc, scored.scores, best, chosen, problem.band_degc, problem.unit,
-                         problem.folds.note, test, lag_from_unit=unit_lag and chosen.lag, decided_by=decided_by,
-                         order_test=evidence)
+        chosen, decided_by = (
+            constant.candidate,
+            (
+                f"do no harm: {chosen.label} leaves more held-out drift than the "
+                "constant by more than its standard error"
+            ),
+        )
+    return AxisSelection(
+        axis,
+        problem.folds.kind,
+        problem.folds.names,
+        problem.window_s,
+        problem.temperature_step_degc,
+        scored.scores,
+        best,
+        chosen,
+        problem.band_degc,
+        problem.unit,
+        problem.folds.note,
+        test,
+        lag_from_unit=unit_lag and chosen.lag,
+        decided_by=decided_by,
+        order_test=evidence,
+    )
 
 
-def _lag_at_the_short_window(problem: SelectionProblem, scored: AxisScores, chosen: Candidate,
-                             decided_by: str) -> tuple[Candidate, str]:
+def _lag_at_the_short_window(
+    problem: SelectionProblem, scored: AxisScores, chosen: Candidate, decided_by: str
+) -> tuple[Candidate, str]:
     """``chosen`` with a thermal lag where the lag leaves less held-out drift at the short window (the thesis's
     timescale, :attr:`SelectionProblem.short_window_s`, where that is half the score's window or less) by more than
     the standard error of the paired difference over the folds (with two folds, on both), and no more at the
@@ -143,15 +178,20 @@ def _lag_at_the_short_window(problem: SelectionProblem, scored: AxisScores, chos
     at the long window the other candidates are told apart by (held-out legs remove each leg's mean, and a lag
     shifts a steady ramp by a constant)."""
     twin = dataclasses.replace(chosen, lag=True)
-    if chosen.lag or not chosen.has_temperature_model or twin not in scored.eligible \
-            or not 2.0 * problem.short_window_s <= problem.window_s:
+    if (
+        chosen.lag
+        or not chosen.has_temperature_model
+        or twin not in scored.eligible
+        or not 2.0 * problem.short_window_s <= problem.window_s
+    ):
         return chosen, decided_by
     mine, theirs = problem.score(chosen, short_window=True), problem.score(twin, short_window=True)
     gain, se = paired_difference(mine.at_short_window(), theirs.at_short_window())
     loss, se_long = paired_difference(theirs, mine)
     # with two folds the standard error rests on one degree of freedom: the lag must then be better on both
-    consistent = len(mine.fold_drift) > TWO_FOLDS or helps_on_every_fold(theirs.at_short_window(),
-                                                                        mine.at_short_window())
+    consistent = len(mine.fold_drift) > TWO_FOLDS or helps_on_every_fold(
+        theirs.at_short_window(), mine.at_short_window()
+    )
     if np.isfinite(gain) and np.isfinite(se) and gain > se and consistent and not loss > se_long:
         window = f"{problem.short_window_s:.3g} s"
         return twin, decided_by + f"; the lag by the {window} window (its drift there {gain:.3g} less, +- {se:.3g})"
@@ -162,8 +202,9 @@ def _score(scored: AxisScores, candidate: Candidate) -> CandidateScore:
     return next(s for s in scored.scores if s.candidate == candidate)
 
 
-def _choose_on_two_folds(problem: SelectionProblem, offered: list[CandidateScore], complexity,
-                         constant: CandidateScore) -> tuple[Candidate, Candidate, str, OrderTest]:
+def _choose_on_two_folds(
+    problem: SelectionProblem, offered: list[CandidateScore], complexity, constant: CandidateScore
+) -> tuple[Candidate, Candidate, str, OrderTest]:
     """(best, chosen, the rule that decided, the order test) where one heating and one cooling leg are the only
     folds.
 
@@ -184,20 +225,41 @@ def _choose_on_two_folds(problem: SelectionProblem, offered: list[CandidateScore
     best = min(finite or offered, key=lambda s: s.mean_drift).candidate
     pool = [s for s in finite if s.candidate.has_temperature_model and not harms(s, constant)]
     if not pool:
-        return best, constant.candidate, "do no harm: every temperature model leaves more held-out drift than the " \
-            "constant by more than its standard error", order_test(problem.runs, problem.groups, problem.t_ref_degc,
-                                                                   problem.t_scale_degc, 0, 0.0, problem.block_s)
+        return (
+            best,
+            constant.candidate,
+            "do no harm: every temperature model leaves more held-out drift than the "
+            "constant by more than its standard error",
+            order_test(problem.runs, problem.groups, problem.t_ref_degc, problem.t_scale_degc, 0, 0.0, problem.block_s),
+        )
     _, held_out = choose(pool, complexity)
     tau = float(np.median(_of(pool, held_out).fold_lag_s)) if held_out.lag else 0.0
     accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
-    test = order_test(problem.runs, problem.groups, problem.t_ref_degc, problem.t_scale_degc, problem.max_order,
-                      tau, problem.block_s, accel if accel[0].shape[1] else None)
+    test = order_test(
+        problem.runs,
+        problem.groups,
+        problem.t_ref_degc,
+        problem.t_scale_degc,
+        problem.max_order,
+        tau,
+        problem.block_s,
+        accel if accel[0].shape[1] else None,
+    )
     if not any(helps_on_every_fold(s, constant) for s in finite if s.candidate.has_temperature_model):
-        return best, constant.candidate, "do no harm: no temperature model leaves less drift than the constant on " \
-            "both held-out legs", test
+        return (
+            best,
+            constant.candidate,
+            "do no harm: no temperature model leaves less drift than the constant on both held-out legs",
+            test,
+        )
     if test.order == 0:
-        return best, constant.candidate, "do no harm: no term of the temperature curve stands out of the drift " \
-            f"(order test, largest Wald {max(test.statistics, default=0.0):.3g} against {test.threshold:.3g})", test
+        return (
+            best,
+            constant.candidate,
+            "do no harm: no term of the temperature curve stands out of the drift "
+            f"(order test, largest Wald {max(test.statistics, default=0.0):.3g} against {test.threshold:.3g})",
+            test,
+        )
     rule = f"two held-out legs ({problem.window_s:.3g} s window): the simplest within one standard error of the best"
     if held_out.curve == POLY_FAMILY and held_out.order < test.order:
         in_pool = {s.candidate for s in pool}
@@ -205,10 +267,17 @@ def _choose_on_two_folds(problem: SelectionProblem, offered: list[CandidateScore
             raised = dataclasses.replace(held_out, order=order)
             if raised in in_pool:
                 statistic = test.statistics[order - 1]
-                return best, raised, (f"two held-out legs ({problem.window_s:.3g} s window), the order raised from "
-                                      f"{held_out.order} by the order test "
-                                      f"(the u^{order} term stands out of the drift: Wald {statistic:.3g} against "
-                                      f"{test.threshold:.3g})"), test
+                return (
+                    best,
+                    raised,
+                    (
+                        f"two held-out legs ({problem.window_s:.3g} s window), the order raised from "
+                        f"{held_out.order} by the order test "
+                        f"(the u^{order} term stands out of the drift: Wald {statistic:.3g} against "
+                        f"{test.threshold:.3g})"
+                    ),
+                    test,
+                )
     return best, held_out, rule, test
 
 
@@ -221,35 +290,50 @@ def _with_free_lag(c: Candidate) -> tuple[int, bool]:
     return c.complexity - int(c.lag), c.has_temperature_model and not c.lag
 
 
-def select_axis(axis: str, problem: SelectionProblem, orders: tuple[int, ...], memories: tuple[str, ...],
-                weightings: tuple[Weighting, ...] = WEIGHTINGS, do_no_harm: bool = True) -> AxisSelection:
+def select_axis(
+    axis: str,
+    problem: SelectionProblem,
+    orders: tuple[int, ...],
+    memories: tuple[str, ...],
+    weightings: tuple[Weighting, ...] = WEIGHTINGS,
+    do_no_harm: bool = True,
+) -> AxisSelection:
     """Score every candidate of one axis and choose (:func:`score_axis`, :func:`choose_axis`)."""
     return choose_axis(axis, problem, score_axis(axis, problem, orders, memories, weightings), do_no_harm)
 
 
-def select_axes(problems: dict[str, SelectionProblem], orders: tuple[int, ...], memories: tuple[str, ...],
-                do_no_harm: bool = True, one_die: bool = True) -> dict[str, AxisSelection]:
+def select_axes(
+    problems: dict[str, SelectionProblem],
+    orders: tuple[int, ...],
+    memories: tuple[str, ...],
+    do_no_harm: bool = True,
+    one_die: bool = True,
+) -> dict[str, AxisSelection]:
     """Choose every axis's model (:func:`select_axis`). With ``one_die`` (one temperature column for every
     axis), when some axis chooses a thermal lag, the others choose again with the die's lag free
     (``unit_lag`` of :func:`choose_axis`); their scores are not computed again."""
     scored = {axis: score_axis(axis, p, orders, memories) for axis, p in problems.items()}
     out = {axis: choose_axis(axis, problems[axis], scored[axis], do_no_harm) for axis in problems}
     if one_die and any(sel.chosen.lag for sel in out.values()):
-        out = {axis: sel if sel.chosen.lag else _with_the_dies_lag(problems[axis], scored[axis], sel, do_no_harm)
-               for axis, sel in out.items()}
+        out = {
+            axis: sel if sel.chosen.lag else _with_the_dies_lag(problems[axis], scored[axis], sel, do_no_harm)
+            for axis, sel in out.items()
+        }
     return out
 
 
-def _with_the_dies_lag(problem: SelectionProblem, scored: AxisScores, alone: AxisSelection,
-                       do_no_harm: bool) -> AxisSelection:
+def _with_the_dies_lag(
+    problem: SelectionProblem, scored: AxisScores, alone: AxisSelection, do_no_harm: bool
+) -> AxisSelection:
     """``alone``'s axis chosen again with the die's lag free (:func:`choose_axis`), keeping ``alone`` to fall back
     on."""
     again = choose_axis(alone.axis, problem, scored, do_no_harm, unit_lag=True)
     return dataclasses.replace(again, alone=alone) if again.lag_from_unit else alone
 
 
-def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[CandidateScore],
-                    eligible: set[Candidate]) -> tuple[Candidate, BranchTest | None]:
+def _branch_by_test(
+    problem: SelectionProblem, chosen: Candidate, scores: list[CandidateScore], eligible: set[Candidate]
+) -> tuple[Candidate, BranchTest | None]:
     """Where no fold can judge a branch model (every fold's training holds one direction of travel only), the
     chosen candidate with the branch terms :func:`branch_test` finds beyond the drift (and no change where it
     finds none, or where that candidate is not among the ones offered)."""
@@ -258,13 +342,30 @@ def _branch_by_test(problem: SelectionProblem, chosen: Candidate, scores: list[C
         return chosen, None
     tau = float(np.median(next(s for s in scores if s.candidate == chosen).fold_lag_s)) if chosen.lag else 0.0
     accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
-    test = branch_test(problem.runs, problem.groups, problem.threshold_degc, problem.t_ref_degc,
-                       problem.t_scale_degc, chosen.order, tau, problem.block_s, accel)
+    test = branch_test(
+        problem.runs,
+        problem.groups,
+        problem.threshold_degc,
+        problem.t_ref_degc,
+        problem.t_scale_degc,
+        chosen.order,
+        tau,
+        problem.block_s,
+        accel,
+    )
     if not test.order:
         return chosen, test
     kept = dataclasses.replace(with_branch, branch=test.order)
     return (kept, test) if kept in eligible else (chosen, test)
 
 
-__all__ = ["AxisScores", "TWO_FOLDS", "choose_axis", "score_axis", "select_axes", "select_axis", "share_fold_lags",
-           "unidentified_lags"]
+__all__ = [
+    "AxisScores",
+    "TWO_FOLDS",
+    "choose_axis",
+    "score_axis",
+    "select_axes",
+    "select_axis",
+    "share_fold_lags",
+    "unidentified_lags",
+]

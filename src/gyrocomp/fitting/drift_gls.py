@@ -70,8 +70,9 @@ def coarsen(values: np.ndarray, factor: int) -> np.ndarray:
     return sums / counts
 
 
-def empirical_variogram(residuals: list[np.ndarray], times_s: list[np.ndarray], reach: int = VARIOGRAM_REACH,
-                        lags: int = VARIOGRAM_LAGS) -> tuple[np.ndarray, np.ndarray]:
+def empirical_variogram(
+    residuals: list[np.ndarray], times_s: list[np.ndarray], reach: int = VARIOGRAM_REACH, lags: int = VARIOGRAM_LAGS
+) -> tuple[np.ndarray, np.ndarray]:
     """(dt [s], V [unit^2]): ``V(L) = mean_i (r_{i+L} - r_i)^2`` of each residual (one array per recording, at
     times ``times_s`` [s]) at ``lags`` log-spaced lags L up to 1/``reach`` of the recording, dt(L) the mean time
     they span."""
@@ -83,25 +84,26 @@ def empirical_variogram(residuals: list[np.ndarray], times_s: list[np.ndarray], 
         for lag in np.unique(np.round(np.geomspace(1, max(1, n // reach), lags)).astype(int)):
             d = r[lag:] - r[:-lag]
             rows.append(float(np.mean(t[lag:] - t[:-lag])))
-            values.append(float(np.mean(d ** 2)))
+            values.append(float(np.mean(d**2)))
     return np.asarray(rows), np.asarray(values)
 
 
 def _fit_at(dt: np.ndarray, v: np.ndarray, w: np.ndarray, exponent: float) -> tuple[float, float, float]:
     """(a, c, weighted squared misfit) of ``V = 2 a + c dt^exponent``, a and c non-negative, weights ``w``."""
-    x = np.column_stack([np.full(dt.size, 2.0), dt ** exponent]) * w[:, None]
+    x = np.column_stack([np.full(dt.size, 2.0), dt**exponent]) * w[:, None]
     (a, c), *_ = np.linalg.lstsq(x, v * w, rcond=None)
     if c < 0:
         a, c = float(np.sum(w * w * v) / np.sum(w * w * 2.0)), 0.0
     elif a < 0:
-        p = dt ** exponent
+        p = dt**exponent
         a, c = 0.0, float(np.sum(w * w * v * p) / np.sum(w * w * p * p))
     a, c = max(float(a), 0.0), max(float(c), 0.0)
-    return a, c, float(np.sum((w * (2.0 * a + c * dt ** exponent - v)) ** 2))
+    return a, c, float(np.sum((w * (2.0 * a + c * dt**exponent - v)) ** 2))
 
 
-def fit_drift_noise(residuals: list[np.ndarray], times_s: list[np.ndarray],
-                    exponents: tuple[float, ...] = DRIFT_EXPONENTS) -> DriftNoise:
+def fit_drift_noise(
+    residuals: list[np.ndarray], times_s: list[np.ndarray], exponents: tuple[float, ...] = DRIFT_EXPONENTS
+) -> DriftNoise:
     """The white variance ``a`` [unit^2], drift coefficient ``c`` [unit^2/s^alpha] and exponent ``alpha`` of
     residuals (one array per recording, at times ``times_s`` [s]), from a non-negative least-squares fit of
 
@@ -127,10 +129,10 @@ def covariance(t_s: np.ndarray, noise: DriftNoise) -> np.ndarray:
     exactly)."""
     tau = t_s - t_s[0]
     e = noise.exponent
-    powered = tau ** e
+    powered = tau**e
     cov = 0.5 * noise.walk_var_per_s * (powered[:, None] + powered[None, :] - np.abs(np.subtract.outer(tau, tau)) ** e)
     spacing = float(np.median(np.diff(t_s))) if t_s.size > 1 else 0.0
-    floor = max(noise.walk_var_per_s * spacing ** e / 3.0, 1e-12 * max(float(np.max(np.diag(cov))), 1e-300))
+    floor = max(noise.walk_var_per_s * spacing**e / 3.0, 1e-12 * max(float(np.max(np.diag(cov))), 1e-300))
     cov[np.diag_indices_from(cov)] += max(noise.white_var, floor)
     return cov
 
@@ -143,8 +145,9 @@ def whitened(x: np.ndarray, y: np.ndarray, t_s: np.ndarray, noise: DriftNoise) -
     return from_left[:, :-1], from_left[:, -1]
 
 
-def wald_statistic(x: list[np.ndarray], y: list[np.ndarray], t_s: list[np.ndarray], noise: DriftNoise,
-                   tested: np.ndarray) -> float:
+def wald_statistic(
+    x: list[np.ndarray], y: list[np.ndarray], t_s: list[np.ndarray], noise: DriftNoise, tested: np.ndarray
+) -> float:
     """The Wald statistic ``b' cov(b)^-1 b`` of the coefficients ``b`` of columns ``tested`` (indices) in the
     generalized least-squares fit of ``y`` on ``x`` (one pair per recording, at times ``t_s`` [s]) under
     ``noise``. Under the hypothesis that those terms are zero it follows a chi-square law with
@@ -152,7 +155,7 @@ def wald_statistic(x: list[np.ndarray], y: list[np.ndarray], t_s: list[np.ndarra
     recording is dense.)"""
     pairs = [whitened(xk, yk, tk, noise) for xk, yk, tk in zip(x, y, t_s)]
     xw, yw = np.vstack([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs])
-    scale = np.sqrt(np.maximum(np.sum(xw ** 2, axis=0), 1e-300))
+    scale = np.sqrt(np.maximum(np.sum(xw**2, axis=0), 1e-300))
     coef, *_ = np.linalg.lstsq(xw / scale, yw, rcond=1e-10)
     cov = np.linalg.pinv((xw / scale).T @ (xw / scale), rcond=1e-10)
     b = coef[tested]
@@ -164,11 +167,22 @@ def chi2_threshold(dof: int, sigmas: float = 3.0) -> float:
     probability of ``sigmas`` standard deviations of a normal law (3: 0.27 %)."""
     p = math.erfc(sigmas / math.sqrt(2.0))
     if dof == 1:
-        return sigmas ** 2
+        return sigmas**2
     if dof == 2:
         return -2.0 * math.log(p)
     raise ValueError(f"dof: 1 or 2, got {dof}")
 
 
-__all__ = ["DRIFT_EXPONENTS", "DriftNoise", "MAX_POINTS", "VARIOGRAM_REACH", "chi2_threshold", "coarsen", "covariance",
-           "empirical_variogram", "fit_drift_noise", "wald_statistic", "whitened"]
+__all__ = [
+    "DRIFT_EXPONENTS",
+    "DriftNoise",
+    "MAX_POINTS",
+    "VARIOGRAM_REACH",
+    "chi2_threshold",
+    "coarsen",
+    "covariance",
+    "empirical_variogram",
+    "fit_drift_noise",
+    "wald_statistic",
+    "whitened",
+]

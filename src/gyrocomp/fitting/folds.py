@@ -65,8 +65,13 @@ def leg_labels(temperature_degc: np.ndarray, threshold_degc: float, min_length: 
     return labels, directions
 
 
-def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: list[float], kind: str = "auto",
-               min_leg_blocks: int = 10) -> Folds:
+def make_folds(
+    runs: list[RunBlocks],
+    groups: tuple[int, ...],
+    thresholds_degc: list[float],
+    kind: str = "auto",
+    min_leg_blocks: int = 10,
+) -> Folds:
     """The folds of a selection.
 
     Parameters
@@ -93,23 +98,33 @@ def make_folds(runs: list[RunBlocks], groups: tuple[int, ...], thresholds_degc: 
         kind = "legs"
     if kind == "runs":
         ids = sorted(set(groups))
-        return Folds("runs", tuple(np.full(r.value.size, ids.index(g)) for r, g in zip(runs, groups)),
-                     tuple(f"run {g + 1}" for g in ids))
+        return Folds(
+            "runs",
+            tuple(np.full(r.value.size, ids.index(g)) for r, g in zip(runs, groups)),
+            tuple(f"run {g + 1}" for g in ids),
+        )
     legs, names = [], []
     for k, (run, threshold) in enumerate(zip(runs, thresholds_degc)):
         leg, directions = leg_labels(run.temperature_degc, threshold, min_leg_blocks)
         legs.append(leg)
-        names += [f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, "")
-                  for j, d in enumerate(directions)]
+        names += [
+            f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, "")
+            for j, d in enumerate(directions)
+        ]
     note = "" if asked in ("auto", kind) else f"folds={asked!r}: one run cannot be held out against others; "
     if kind == "legs" and len(names) >= 2:
         offsets = np.cumsum([0] + [int(leg.max()) + 1 for leg in legs[:-1]])
-        return Folds("legs", tuple(leg + o for leg, o in zip(legs, offsets)), tuple(names),
-                     note + "held out each heating and cooling leg" if note else "")
+        return Folds(
+            "legs",
+            tuple(leg + o for leg, o in zip(legs, offsets)),
+            tuple(names),
+            note + "held out each heating and cooling leg" if note else "",
+        )
     if kind == "legs":
         note = (f"folds={asked!r}: " if asked != "auto" else "") + (
             "the temperature never reverses, so there are no heating and cooling legs to hold out; held out "
-            f"{BLOCKS_PER_RUN} contiguous time blocks per run instead (neighbouring blocks share slow drift)")
+            f"{BLOCKS_PER_RUN} contiguous time blocks per run instead (neighbouring blocks share slow drift)"
+        )
     per_run = max(BLOCKS_PER_RUN, math.ceil(MIN_FOLDS / len(runs)))
     of_block, names = [], []
     for k, run in enumerate(runs):
@@ -137,5 +152,16 @@ def window_for(folds: Folds, runs: list[RunBlocks], block_s: float) -> float:
     return drift_window_s(lengths, block_s)
 
 
-__all__ = ["BLOCKS_PER_RUN", "FOLD_KINDS", "FoldKind", "Folds", "MIN_FOLDS", "WINDOW_MAX_S", "WINDOW_MIN_S",
-           "drift_window_s", "leg_labels", "make_folds", "window_for"]
+__all__ = [
+    "BLOCKS_PER_RUN",
+    "FOLD_KINDS",
+    "FoldKind",
+    "Folds",
+    "MIN_FOLDS",
+    "WINDOW_MAX_S",
+    "WINDOW_MIN_S",
+    "drift_window_s",
+    "leg_labels",
+    "make_folds",
+    "window_for",
+]

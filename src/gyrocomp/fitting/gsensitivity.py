@@ -19,8 +19,9 @@ ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
 EXCITATION_G = 0.1
 
 
-def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squares: bool = False,
-                    warn: bool = True) -> tuple[tuple[int, ...], tuple[int, ...], tuple[str, ...]]:
+def excited_columns(
+    accel_g: list[np.ndarray], weights: list[np.ndarray], *, squares: bool = False, warn: bool = True
+) -> tuple[tuple[int, ...], tuple[int, ...], tuple[str, ...]]:
     """The accelerometer axes the positions excite, the g x g terms a fit can tell apart, and the names.
 
     Parameters
@@ -35,8 +36,10 @@ def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squ
     warn : bool
         Warn (``DataQualityWarning``) about axes below ``EXCITATION_G`` of within-run spread.
     """
-    spread = np.sqrt(sum(np.sum(w[:, None] * (a - np.average(a, axis=0, weights=w)) ** 2, axis=0)
-                         for a, w in zip(accel_g, weights)) / sum(float(np.sum(w)) for w in weights))
+    spread = np.sqrt(
+        sum(np.sum(w[:, None] * (a - np.average(a, axis=0, weights=w)) ** 2, axis=0) for a, w in zip(accel_g, weights))
+        / sum(float(np.sum(w)) for w in weights)
+    )
     excited = tuple(j for j in range(3) if spread[j] > EXCITATION_G)
     missing = [f"{ACCEL_AXES[j]} ({spread[j]:.2g} g)" for j in range(3) if j not in excited]
     if missing and warn:
@@ -44,12 +47,17 @@ def excited_columns(accel_g: list[np.ndarray], weights: list[np.ndarray], *, squ
             f"the positions do not excite {', '.join(missing)}: within-run spread below {EXCITATION_G} g; "
             "those columns of the g-sensitivity matrix are not fitted (reported as 0 with no standard error). "
             "Record positions that tilt every axis (a tumble: +1, 0 and -1 g on each)",
-            DataQualityWarning, stacklevel=4)
+            DataQualityWarning,
+            stacklevel=4,
+        )
     chosen: tuple[int, ...] = ()
     if squares:
         pairs = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
-        chosen = tuple(m for m, term in enumerate(G_SQUARED_TERMS)
-                       if set(pairs[term]) <= set(excited) and not (len(excited) == 3 and term == "zz"))
+        chosen = tuple(
+            m
+            for m, term in enumerate(G_SQUARED_TERMS)
+            if set(pairs[term]) <= set(excited) and not (len(excited) == 3 and term == "zz")
+        )
     return excited, chosen, tuple(ACCEL_AXES[j] for j in excited)
 
 

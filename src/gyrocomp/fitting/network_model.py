@@ -78,9 +78,18 @@ class TrainResult:
 
 # Over 60 lines on purpose: one Levenberg-Marquardt loop (damping, step, acceptance, early stop) whose state
 # is shared by every branch; split, its pieces would pass that state back and forth.
-def train_lm(x: np.ndarray, y: np.ndarray, w: np.ndarray, run: np.ndarray, n_runs: int, train: np.ndarray,
-             shapes, rng: np.random.Generator | None, max_epochs: int = MAX_EPOCHS,
-             start: np.ndarray | None = None) -> TrainResult:
+def train_lm(
+    x: np.ndarray,
+    y: np.ndarray,
+    w: np.ndarray,
+    run: np.ndarray,
+    n_runs: int,
+    train: np.ndarray,
+    shapes,
+    rng: np.random.Generator | None,
+    max_epochs: int = MAX_EPOCHS,
+    start: np.ndarray | None = None,
+) -> TrainResult:
     """Levenberg-Marquardt on weighted squared error of y ~ net(x) + c_run (c_0 = 0), scaled units.
 
     ``train`` marks the training points; the rest validate and stop the training early (with no
@@ -152,8 +161,9 @@ def train_lm(x: np.ndarray, y: np.ndarray, w: np.ndarray, run: np.ndarray, n_run
     return TrainResult(best_theta[:p], np.concatenate([[0.0], best_theta[p:]]), sse_best, val_rmse(e_best), epoch)
 
 
-def validation_mask(run: np.ndarray, n_runs: int, share: float = VALIDATION_SHARE,
-                    segments: int = VALIDATION_SEGMENTS) -> np.ndarray:
+def validation_mask(
+    run: np.ndarray, n_runs: int, share: float = VALIDATION_SHARE, segments: int = VALIDATION_SEGMENTS
+) -> np.ndarray:
     """True for training points: each run cut into ``segments`` contiguous pieces in time, of which a
     ``share`` spread evenly across the run (never the first) is held out."""
     train = np.ones(run.size, dtype=bool)
@@ -200,9 +210,16 @@ class NetworkTemperatureModel(LearnedAttributes):
     seed: int = 0
     max_epochs: int = MAX_EPOCHS
 
-    def fit_blocks(self, axis: str, temperature_degc: list[np.ndarray], value: list[np.ndarray],
-                   weight: list[np.ndarray], t_ref_degc: float, accel_g: list[np.ndarray] | None = None,
-                   inputs: tuple[str, ...] = ("temperature",)) -> "NetworkTemperatureModel":
+    def fit_blocks(
+        self,
+        axis: str,
+        temperature_degc: list[np.ndarray],
+        value: list[np.ndarray],
+        weight: list[np.ndarray],
+        t_ref_degc: float,
+        accel_g: list[np.ndarray] | None = None,
+        inputs: tuple[str, ...] = ("temperature",),
+    ) -> "NetworkTemperatureModel":
         """Fit one axis on per-run arrays of temperature [degC], value [deg/s], weight and, for a network that
         reads them, specific force (n, 3) [g]."""
         if self.restarts < 1:
@@ -216,8 +233,19 @@ class NetworkTemperatureModel(LearnedAttributes):
         run = np.concatenate([np.full(a.size, r) for r, a in enumerate(temperature_degc)])
         n_runs = len(temperature_degc)
         accel = None if accel_g is None else np.vstack(accel_g)
-        probe = NetworkCurve(self.hidden, (), 0.0, 1.0, t_ref_degc, 0.0, 0.0, inputs, (0.0,) * len(inputs),
-                        (0.0,) * len(inputs), (0.0,) * len(inputs))
+        probe = NetworkCurve(
+            self.hidden,
+            (),
+            0.0,
+            1.0,
+            t_ref_degc,
+            0.0,
+            0.0,
+            inputs,
+            (0.0,) * len(inputs),
+            (0.0,) * len(inputs),
+            (0.0,) * len(inputs),
+        )
         values = probe.input_values(t, accel)
         lo, hi = values.min(axis=0), values.max(axis=0)
         t_min, t_max = float(t.min()), float(t.max())
@@ -225,12 +253,16 @@ class NetworkTemperatureModel(LearnedAttributes):
             raise ModelError(f"{axis}: the temperature does not vary; a network needs a temperature range")
         n_params = n_parameters(layer_shapes(len(inputs), self.hidden)) + n_runs - 1
         if y.size < 2 * n_params:
-            raise ModelError(f"{axis}: {y.size} training points for {n_params} parameters; record longer runs "
-                             "or choose fewer hidden neurons")
+            raise ModelError(
+                f"{axis}: {y.size} training points for {n_params} parameters; record longer runs "
+                "or choose fewer hidden neurons"
+            )
         span = np.where(hi > lo, hi - lo, 1.0)
         x = np.where(hi > lo, 2.0 * (values - lo) / span - 1.0, 0.0)
-        mean, scale = float(np.average(y, weights=w)), float(np.sqrt(np.average((y - np.average(y, weights=w)) ** 2,
-                                                                                  weights=w))) or 1.0
+        mean, scale = (
+            float(np.average(y, weights=w)),
+            float(np.sqrt(np.average((y - np.average(y, weights=w)) ** 2, weights=w))) or 1.0,
+        )
         target = (y - mean) / scale
         train = validation_mask(run, n_runs)
         shapes = layer_shapes(len(inputs), self.hidden)
@@ -244,14 +276,27 @@ class NetworkTemperatureModel(LearnedAttributes):
         start = np.concatenate([best.theta, best.run_constants[1:]])
         every = np.ones(y.size, dtype=bool)
         final = train_lm(x, target, w, run, n_runs, every, shapes, None, self.max_epochs, start=start)
-        best = TrainResult(final.theta, final.run_constants, final.train_rmse, best.validation_rmse,
-                           best.epochs + final.epochs)
+        best = TrainResult(
+            final.theta, final.run_constants, final.train_rmse, best.validation_rmse, best.epochs + final.epochs
+        )
         layers = unpack(best.theta, shapes)
         weights = tuple(tuple(float(v) for v in np.concatenate([wt.ravel(), b])) for wt, b in layers)
-        reference = tuple(t_ref_degc if name == "temperature" else (1.0 if name == "accel_z" else 0.0)
-                          for name in inputs)
-        curve = NetworkCurve(self.hidden, weights, mean, scale, t_ref_degc, t_min, t_max, tuple(inputs),
-                        tuple(map(float, lo)), tuple(map(float, hi)), reference)
+        reference = tuple(
+            t_ref_degc if name == "temperature" else (1.0 if name == "accel_z" else 0.0) for name in inputs
+        )
+        curve = NetworkCurve(
+            self.hidden,
+            weights,
+            mean,
+            scale,
+            t_ref_degc,
+            t_min,
+            t_max,
+            tuple(inputs),
+            tuple(map(float, lo)),
+            tuple(map(float, hi)),
+            reference,
+        )
         at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
         self.curves_[axis] = curve
         self.turn_on_biases_[axis] = best.run_constants * scale + at_ref

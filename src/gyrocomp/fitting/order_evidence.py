@@ -58,10 +58,11 @@ class CoarseRuns:
         """``runs`` averaged over groups of blocks, the temperature through a thermal lag of ``tau_s`` [s] first
         (0: none)."""
         factor = max(1, math.ceil(sum(r.value.size for r in runs) / MAX_POINTS))
-        temps = [thermal_lag(r.time_s, r.temperature_degc, tau_s, period_s=block_s)[0] if tau_s > 0
-                 else r.temperature_degc for r in runs]
-        return cls([coarsen(r.value, factor) for r in runs], [coarsen(r.time_s, factor) for r in runs],
-                   temps, factor)
+        temps = [
+            thermal_lag(r.time_s, r.temperature_degc, tau_s, period_s=block_s)[0] if tau_s > 0 else r.temperature_degc
+            for r in runs
+        ]
+        return cls([coarsen(r.value, factor) for r in runs], [coarsen(r.time_s, factor) for r in runs], temps, factor)
 
     def coarse(self, columns: list[np.ndarray]) -> list[np.ndarray]:
         """Per-block ``columns`` (one (n_k, p) array per recording) averaged as the values are."""
@@ -79,8 +80,16 @@ def run_constants(sizes: list[int], groups: tuple[int, ...]) -> list[np.ndarray]
     return out
 
 
-def order_test(runs: list[RunBlocks], groups: tuple[int, ...], t_ref_degc: float, t_scale_degc: float,
-               max_order: int, tau_s: float, block_s: float, extra: list[np.ndarray] | None = None) -> OrderTest:
+def order_test(
+    runs: list[RunBlocks],
+    groups: tuple[int, ...],
+    t_ref_degc: float,
+    t_scale_degc: float,
+    max_order: int,
+    tau_s: float,
+    block_s: float,
+    extra: list[np.ndarray] | None = None,
+) -> OrderTest:
     """The temperature polynomial's order that all the data support beyond the drift.
 
     For each order p = N..1 (N = ``max_order``), the Wald statistic of the coefficient of ``u^p``

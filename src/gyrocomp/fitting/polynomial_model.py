@@ -36,7 +36,6 @@ def simplest_within(scores: dict, simplest_first, *, by_bic: bool = False, toler
     return next(k for k in simplest_first if k in finite and finite[k] <= limit)
 
 
-
 @dataclass(frozen=True)
 class _Design:
     bins: TemperatureBins
@@ -66,7 +65,7 @@ def _solve(design: _Design, order: int, runs: np.ndarray) -> tuple[np.ndarray, n
     sw = np.sqrt(w)
     coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
     resid = y - x @ coef
-    return coef[runs.size:], coef[:runs.size], float(np.sum(w * resid**2))
+    return coef[runs.size :], coef[: runs.size], float(np.sum(w * resid**2))
 
 
 def _leave_one_run_out(design: _Design, order: int) -> float:
@@ -164,13 +163,15 @@ class PolynomialTemperatureModel(LearnedAttributes):
             folds = np.arange(len(recordings)) if self.folds is None else np.asarray(self.folds)
             if folds.shape != (len(recordings),):
                 raise InputError(f"folds: {folds.size} given for {len(recordings)} recordings; give one per recording")
-            design = _Design(bins, len(recordings), (t_min + t_max) / 2, span / 2 if span > 0 else 1.0, t_min, t_max,
-                             folds)
+            design = _Design(
+                bins, len(recordings), (t_min + t_max) / 2, span / 2 if span > 0 else 1.0, t_min, t_max, folds
+            )
             distinct = np.unique(bins.temperature_degc).size
             order = self._choose_order(axis, design, distinct)
             shape, consts, rss = _solve(design, order, np.arange(len(recordings)))
-            self.curves_[axis] = PolynomialCurve(tuple(float(a) for a in shape), design.t_ref, design.t_scale,
-                                                t_min, t_max)
+            self.curves_[axis] = PolynomialCurve(
+                tuple(float(a) for a in shape), design.t_ref, design.t_scale, t_min, t_max
+            )
             self.turn_on_biases_[axis] = consts
             self.fit_rms_[axis] = math.sqrt(rss / float(np.sum(bins.weight)))
         return self

@@ -109,12 +109,12 @@ class RotationFit:
     @property
     def error_rms_before_deg(self) -> float:
         """RMS over the moves of the predicted gravity direction's error with K = I [deg]."""
-        return float(np.sqrt(np.mean([m.error_before_deg ** 2 for m in self.moves])))
+        return float(np.sqrt(np.mean([m.error_before_deg**2 for m in self.moves])))
 
     @property
     def error_rms_after_deg(self) -> float:
         """RMS over the moves of the predicted gravity direction's error with the fitted K [deg]."""
-        return float(np.sqrt(np.mean([m.error_after_deg ** 2 for m in self.moves])))
+        return float(np.sqrt(np.mean([m.error_after_deg**2 for m in self.moves])))
 
 
 # -- rotations as unit quaternions (w, x, y, z), Hamilton convention: R(p q) = R(p) R(q) ---------------------
@@ -123,7 +123,7 @@ def quaternion_from_rotvec(phi: np.ndarray) -> np.ndarray:
     phi = np.asarray(phi, dtype=float)
     angle = np.linalg.norm(phi, axis=-1)
     small = angle < 1e-6
-    scale = np.where(small, 0.5 - angle ** 2 / 48.0, np.sin(0.5 * angle) / np.where(small, 1.0, angle))
+    scale = np.where(small, 0.5 - angle**2 / 48.0, np.sin(0.5 * angle) / np.where(small, 1.0, angle))
     return np.concatenate([np.cos(0.5 * angle)[..., None], phi * scale[..., None]], axis=-1)
 
 
@@ -131,10 +131,15 @@ def quaternion_multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Hamilton product p q of quaternions (..., 4)."""
     pw, px, py, pz = np.moveaxis(p, -1, 0)
     qw, qx, qy, qz = np.moveaxis(q, -1, 0)
-    return np.stack([pw * qw - px * qx - py * qy - pz * qz,
-                     pw * qx + px * qw + py * qz - pz * qy,
-                     pw * qy - px * qz + py * qw + pz * qx,
-                     pw * qz + px * qy - py * qx + pz * qw], axis=-1)
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        axis=-1,
+    )
 
 
 def ordered_product(q: np.ndarray) -> np.ndarray:
@@ -151,9 +156,14 @@ def ordered_product(q: np.ndarray) -> np.ndarray:
 def rotation_matrix(q: np.ndarray) -> np.ndarray:
     """Rotation matrices (..., 3, 3) of unit quaternions (..., 4)."""
     w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-                     np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-                     np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
 
 
 # -- the fit ----------------------------------------------------------------------------------------------
@@ -173,8 +183,15 @@ class _Moves:
 
     def take(self, which: np.ndarray) -> "_Moves":
         """The moves selected by the boolean mask ``which``."""
-        return _Moves(self.rates_dps[which], self.dt_s[which], self.temperature_degc[which], self.before[which],
-                      self.after[which], self.session[which], [m for m, w in zip(self.meta, which) if w])
+        return _Moves(
+            self.rates_dps[which],
+            self.dt_s[which],
+            self.temperature_degc[which],
+            self.before[which],
+            self.after[which],
+            self.session[which],
+            [m for m, w in zip(self.meta, which) if w],
+        )
 
     def predicted(self, triad: tuple[np.ndarray, ...], reference_degc: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """(predicted gravity direction after each move (m, 3), rotation angle of each move (m,) [deg]) for
@@ -183,7 +200,7 @@ class _Moves:
             rates = self.rates_dps @ np.linalg.inv(triad[0]).T
         else:
             d = np.nan_to_num(self.temperature_degc - reference_degc)
-            k = triad[0] + sum(np.multiply.outer(d ** p, triad[p]) for p in range(1, len(triad)))
+            k = triad[0] + sum(np.multiply.outer(d**p, triad[p]) for p in range(1, len(triad)))
             rates = np.linalg.solve(k, self.rates_dps[..., None])[..., 0]
         phi = np.radians(rates) * self.dt_s[..., None]
         q = ordered_product(quaternion_from_rotvec(phi))
@@ -204,20 +221,27 @@ def _bias_at_rest(poses: list[Pose]) -> tuple[np.ndarray, float | None]:
         columns.append(np.asarray(temps) - t_mean)
     x = np.column_stack(columns)
     if x.shape[0] <= x.shape[1]:
-        raise InputError(f"poses: {len(poses)} still poses for the gyro's bias at rest ({x.shape[1]} unknowns per "
-                         "axis: bias, g-sensitivity, temperature); record more poses")
+        raise InputError(
+            f"poses: {len(poses)} still poses for the gyro's bias at rest ({x.shape[1]} unknowns per "
+            "axis: bias, g-sensitivity, temperature); record more poses"
+        )
     return np.linalg.lstsq(x, gyro, rcond=None)[0], t_mean
 
 
-def _session_moves(recording: Recording, poses: list[Pose], coef: np.ndarray, t_mean: float | None,
-                   directions: np.ndarray) -> list[tuple]:
+def _session_moves(
+    recording: Recording, poses: list[Pose], coef: np.ndarray, t_mean: float | None, directions: np.ndarray
+) -> list[tuple]:
     """(rates freed of the bias at rest [deg/s], dt [s], temperature [degC], before, after, meta) of each move
     between consecutive poses of one recording that was recorded without a pause and lasts at most MAX_TURN_S
     (longer stretches between still poses are motion, not a turn: their bias drift would dominate)."""
     out = []
     time = recording.time_s
     gap = GAP_FACTOR * float(np.median(np.diff(time)))
-    temp = None if recording.temperature_degc is None else recording.temperature_degc.reshape(recording.n_samples, -1).mean(axis=1)
+    temp = (
+        None
+        if recording.temperature_degc is None
+        else recording.temperature_degc.reshape(recording.n_samples, -1).mean(axis=1)
+    )
     for k in range(len(poses) - 1):
         a, b = poses[k].stop_index, poses[k + 1].start_index
         if b <= a:
@@ -225,12 +249,20 @@ def _session_moves(recording: Recording, poses: list[Pose], coef: np.ndarray, t_
         bias = coef[0] + recording.accel_g[a:b] @ coef[1:4]
         if t_mean is not None:
             bias = bias + np.outer(temp[a:b] - t_mean, coef[4])
-        dt = time[a + 1:b + 1] - time[a:b]
+        dt = time[a + 1 : b + 1] - time[a:b]
         if np.any(dt > gap) or time[b] - time[a] > MAX_TURN_S:  # a pause, or not a turn between two poses
             continue
         t = np.full(b - a, np.nan) if temp is None else temp[a:b]
-        out.append((recording.gyro_dps[a:b] - bias, dt, t, directions[k], directions[k + 1],
-                    (recording.source, float(time[a]), float(time[b] - time[a]))))
+        out.append(
+            (
+                recording.gyro_dps[a:b] - bias,
+                dt,
+                t,
+                directions[k],
+                directions[k + 1],
+                (recording.source, float(time[a]), float(time[b] - time[a])),
+            )
+        )
     return out
 
 
@@ -240,11 +272,18 @@ def _pad(moves: list[tuple], sessions: list[int]) -> _Moves:
     dt = np.zeros((len(moves), length))
     temp = np.full((len(moves), length), np.nan)
     for i, m in enumerate(moves):
-        rates[i, :len(m[1])] = m[0]
-        dt[i, :len(m[1])] = m[1]
-        temp[i, :len(m[1])] = m[2]
-    return _Moves(rates, dt, temp, np.array([m[3] for m in moves]), np.array([m[4] for m in moves]),
-                  np.asarray(sessions), [m[5] for m in moves])
+        rates[i, : len(m[1])] = m[0]
+        dt[i, : len(m[1])] = m[1]
+        temp[i, : len(m[1])] = m[2]
+    return _Moves(
+        rates,
+        dt,
+        temp,
+        np.array([m[3] for m in moves]),
+        np.array([m[4] for m in moves]),
+        np.asarray(sessions),
+        [m[5] for m in moves],
+    )
 
 
 def _require_turns(moves: _Moves) -> None:
@@ -254,8 +293,10 @@ def _require_turns(moves: _Moves) -> None:
     across = turn - np.sum(turn * moves.before, axis=1)[:, None] * moves.before
     for j, name in enumerate("xyz"):
         if not np.any(np.abs(across[:, j]) >= MIN_TURN_DEG):
-            raise InputError(f"moves between poses: none turns about the {name} axis by {MIN_TURN_DEG:g} deg or more "
-                             f"(other than about gravity); the gyro's scale factor needs a turn about every axis")
+            raise InputError(
+                f"moves between poses: none turns about the {name} axis by {MIN_TURN_DEG:g} deg or more "
+                f"(other than about gravity); the gyro's scale factor needs a turn about every axis"
+            )
 
 
 def _require_determined(jacobian: np.ndarray, moves: int) -> None:
@@ -267,9 +308,11 @@ def _require_determined(jacobian: np.ndarray, moves: int) -> None:
     block, element = divmod(int(np.argmax(np.abs(vt[-1]))), 9)
     row, col = divmod(element, 3)
     what = "" if block == 0 else ", its change with temperature"
-    raise InputError(f"moves between poses: the turns leave the gyro's K undetermined (the {'xyz'[row]} output's "
-                     f"response to turns about {'xyz'[col]}{what}); turn the unit about its {'xyz'[col]} axis more, from "
-                     f"poses with gravity off that axis")
+    raise InputError(
+        f"moves between poses: the turns leave the gyro's K undetermined (the {'xyz'[row]} output's "
+        f"response to turns about {'xyz'[col]}{what}); turn the unit about its {'xyz'[col]} axis more, from "
+        f"poses with gravity off that axis"
+    )
 
 
 def _angle_deg(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -302,8 +345,12 @@ def _session_accels(sessions: list[tuple[Recording, list[Pose]]]) -> list[TriadC
             try:
                 joint.append(fit_accel_multiposition([p for _, ps in sessions for p in ps]).calibration)
             except InputError as exc:
-                warnings.warn(f"accelerometer not calibrated from the poses ({exc}); the gravity directions carry its "
-                              "bias and scale errors, and so does the gyro's K", DataQualityWarning, stacklevel=4)
+                warnings.warn(
+                    f"accelerometer not calibrated from the poses ({exc}); the gravity directions carry its "
+                    "bias and scale errors, and so does the gyro's K",
+                    DataQualityWarning,
+                    stacklevel=4,
+                )
                 joint.append(None)
         out.append(joint[0])
     return out
@@ -340,16 +387,22 @@ def _prepare(recordings: list[Recording] | Recording, accel_calibration: TriadCa
         moves += found
         index += [k] * len(found)
     if len(moves) < 5:
-        raise TooFewTurns(f"moves between poses: {len(moves)} found; the gyro's scale factor and misalignment (nine "
-                         "unknowns, two equations per move) need at least 5 turns between still poses")
+        raise TooFewTurns(
+            f"moves between poses: {len(moves)} found; the gyro's scale factor and misalignment (nine "
+            "unknowns, two equations per move) need at least 5 turns between still poses"
+        )
     return _Session(all_poses, tuple(accels), coefs, _pad(moves, index))
 
 
 def _move_table(moves: _Moves, triad: tuple[np.ndarray, ...], reference_degc: float = 0.0) -> tuple[PoseMove, ...]:
     before, _ = moves.predicted((np.eye(3),))
     after, turn = moves.predicted(triad, reference_degc)
-    return tuple(PoseMove(src, start, length, float(t), float(e0), float(e1)) for (src, start, length), t, e0, e1
-                 in zip(moves.meta, turn, _angle_deg(before, moves.after), _angle_deg(after, moves.after)))
+    return tuple(
+        PoseMove(src, start, length, float(t), float(e0), float(e1))
+        for (src, start, length), t, e0, e1 in zip(
+            moves.meta, turn, _angle_deg(before, moves.after), _angle_deg(after, moves.after)
+        )
+    )
 
 
 def _solve(moves: _Moves, order: int, reference_degc: float):
@@ -368,9 +421,14 @@ def _solve(moves: _Moves, order: int, reference_degc: float):
 def _session_temperatures(moves: _Moves) -> np.ndarray:
     """Mean temperature of each session's turns [degC] (NaN without temperature)."""
     with np.errstate(invalid="ignore"):
-        return np.array([np.nanmean(moves.temperature_degc[moves.session == k]) if np.any(moves.session == k)
-                         and np.any(np.isfinite(moves.temperature_degc[moves.session == k])) else np.nan
-                         for k in np.unique(moves.session)])
+        return np.array(
+            [
+                np.nanmean(moves.temperature_degc[moves.session == k])
+                if np.any(moves.session == k) and np.any(np.isfinite(moves.temperature_degc[moves.session == k]))
+                else np.nan
+                for k in np.unique(moves.session)
+            ]
+        )
 
 
 def _held_out_error(moves: _Moves, order: int, reference_degc: float) -> float:
@@ -396,14 +454,19 @@ def _rotation_order(moves: _Moves, reference_degc: float, temperature_order: int
     if temperature_order not in (0, 1):
         raise InputError(f"temperature_order: {temperature_order!r}; use 'auto', 0 or 1")
     if temperature_order == 1 and (distinct < 2 or span < MIN_TRIAD_SPAN_DEGC):
-        raise InputError(f"temperature_order: 1 needs turning sessions at temperatures at least {MIN_TRIAD_SPAN_DEGC:g} "
-                         f"degC apart; these span {span:.1f} degC")
+        raise InputError(
+            f"temperature_order: 1 needs turning sessions at temperatures at least {MIN_TRIAD_SPAN_DEGC:g} "
+            f"degC apart; these span {span:.1f} degC"
+        )
     return temperature_order
 
 
-def fit_gyro_between_poses(recordings: list[Recording] | Recording, *,
-                           accel_calibration: TriadCalibration | None = None,
-                           temperature_order: int | Literal["auto"] = "auto") -> RotationFit:
+def fit_gyro_between_poses(
+    recordings: list[Recording] | Recording,
+    *,
+    accel_calibration: TriadCalibration | None = None,
+    temperature_order: int | Literal["auto"] = "auto",
+) -> RotationFit:
     """Scale factor and misalignment of a gyro triad from the rotations between still poses (no rate table).
 
     Parameters
@@ -435,32 +498,61 @@ def fit_gyro_between_poses(recordings: list[Recording] | Recording, *,
     sol, triad = _solve(moves, order, reference)
     _require_determined(sol.jac, len(moves.meta))
     if np.max(np.abs(triad[0] - np.eye(3))) > MAX_SENSITIVITY_ERROR:
-        raise InputError(f"moves between poses: the fit found no plausible gyro triad (scale or misalignment beyond "
-                         f"{MAX_SENSITIVITY_ERROR:.0%}); the turns do not determine it")
+        raise InputError(
+            f"moves between poses: the fit found no plausible gyro triad (scale or misalignment beyond "
+            f"{MAX_SENSITIVITY_ERROR:.0%}); the turns do not determine it"
+        )
     dof = 2 * len(moves.meta) - sol.x.size
-    variance = float(np.sum(sol.fun ** 2) / max(dof, 1))
+    variance = float(np.sum(sol.fun**2) / max(dof, 1))
     se = np.sqrt(np.diag(np.linalg.pinv(sol.jac.T @ sol.jac)) * variance).reshape(-1, 3, 3)
-    cal = TriadCalibration(sensitivity=rows_of(triad[0]), bias=(0.0, 0.0, 0.0), method="rotation",
-                           sensitivity_stderr=rows_of(se[0]), bias_stderr=(0.0, 0.0, 0.0), unit="deg/s",
-                           reference_degc=reference if order else None,
-                           sensitivity_per_degc=tuple(rows_of(k) for k in triad[1:]),
-                           sensitivity_per_degc_stderr=tuple(rows_of(k) for k in se[1:]))
+    cal = TriadCalibration(
+        sensitivity=rows_of(triad[0]),
+        bias=(0.0, 0.0, 0.0),
+        method="rotation",
+        sensitivity_stderr=rows_of(se[0]),
+        bias_stderr=(0.0, 0.0, 0.0),
+        unit="deg/s",
+        reference_degc=reference if order else None,
+        sensitivity_per_degc=tuple(rows_of(k) for k in triad[1:]),
+        sensitivity_per_degc_stderr=tuple(rows_of(k) for k in se[1:]),
+    )
     coefs = session.coefficients
-    return RotationFit(cal, tuple(session.poses), _move_table(moves, triad, reference), np.array([c[0] for c in coefs]),
-                       np.array([c[1:4].T for c in coefs]), session.accels)
+    return RotationFit(
+        cal,
+        tuple(session.poses),
+        _move_table(moves, triad, reference),
+        np.array([c[0] for c in coefs]),
+        np.array([c[1:4].T for c in coefs]),
+        session.accels,
+    )
 
 
-def rotation_errors(recordings: list[Recording] | Recording, gyro_calibration: TriadCalibration, *,
-                    accel_calibration: TriadCalibration | None = None) -> tuple[PoseMove, ...]:
+def rotation_errors(
+    recordings: list[Recording] | Recording,
+    gyro_calibration: TriadCalibration,
+    *,
+    accel_calibration: TriadCalibration | None = None,
+) -> tuple[PoseMove, ...]:
     """The turns between the still poses of ``recordings`` and how well ``gyro_calibration`` (its K(T) at each
     sample's temperature) predicts each one's gravity direction: a held-out check of a calibration on another
     session. ``accel_calibration`` as in :func:`fit_gyro_between_poses`."""
     session = _prepare(recordings, accel_calibration)
-    triad = tuple(np.asarray(k, dtype=float) for k in (gyro_calibration.sensitivity, *gyro_calibration.sensitivity_per_degc))
+    triad = tuple(
+        np.asarray(k, dtype=float) for k in (gyro_calibration.sensitivity, *gyro_calibration.sensitivity_per_degc)
+    )
     if len(triad) > 1 and not np.all(np.isfinite(session.moves.temperature_degc[session.moves.dt_s > 0])):
         raise InputError("recordings: the calibration's K depends on temperature; the sessions have no temperature")
     return _move_table(session.moves, triad, gyro_calibration.reference_degc or 0.0)
 
 
-__all__ = ["PoseMove", "RotationFit", "TooFewTurns", "fit_gyro_between_poses", "ordered_product", "quaternion_from_rotvec",
-           "quaternion_multiply", "rotation_errors", "rotation_matrix"]
+__all__ = [
+    "PoseMove",
+    "RotationFit",
+    "TooFewTurns",
+    "fit_gyro_between_poses",
+    "ordered_product",
+    "quaternion_from_rotvec",
+    "quaternion_multiply",
+    "rotation_errors",
+    "rotation_matrix",
+]

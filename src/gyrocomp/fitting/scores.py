@@ -66,9 +66,13 @@ class CandidateScore:
     def to_dict(self, unit: AxisUnit = "deg/s") -> dict:
         """As the model file stores it: the drifts under names that say ``unit``."""
         u = unit_suffix(unit)
-        return {**self.candidate.to_dict(), f"mean_drift{u}": json_number(self.mean_drift),
-                f"standard_error{u}": json_number(self.standard_error),
-                f"fold_drift{u}": [json_number(v) for v in self.fold_drift], "fold_lag_s": list(self.fold_lag_s)}
+        return {
+            **self.candidate.to_dict(),
+            f"mean_drift{u}": json_number(self.mean_drift),
+            f"standard_error{u}": json_number(self.standard_error),
+            f"fold_drift{u}": [json_number(v) for v in self.fold_drift],
+            "fold_lag_s": list(self.fold_lag_s),
+        }
 
 
 def paired_difference(worse: CandidateScore, better: CandidateScore) -> tuple[float, float]:
@@ -119,8 +123,9 @@ def helps_on_every_fold(score: CandidateScore, constant: CandidateScore) -> bool
     return bool(np.all(np.isfinite(mine)) and np.all(mine < theirs))
 
 
-def choose(scores: list[CandidateScore], complexity, constant: CandidateScore | None = None
-           ) -> tuple[Candidate, Candidate]:
+def choose(
+    scores: list[CandidateScore], complexity, constant: CandidateScore | None = None
+) -> tuple[Candidate, Candidate]:
     """(best, chosen).
 
     ``best`` has the lowest mean held-out drift. ``chosen`` is the least complex candidate whose mean lies within
@@ -159,5 +164,15 @@ def _other_families_that_earn_it(finite: list[CandidateScore]) -> list[Candidate
     return [s for s in finite if s.candidate.curve == POLY_FAMILY or beats_constant(s, best_poly)]
 
 
-__all__ = ["CandidateScore", "TWO_FOLD_RATIO", "beats_constant", "choose", "fold_mean", "fold_standard_error",
-           "harms", "helps_on_every_fold", "json_number", "paired_difference"]
+__all__ = [
+    "CandidateScore",
+    "TWO_FOLD_RATIO",
+    "beats_constant",
+    "choose",
+    "fold_mean",
+    "fold_standard_error",
+    "harms",
+    "helps_on_every_fold",
+    "json_number",
+    "paired_difference",
+]

@@ -158,18 +158,27 @@ class AxisSelection:
     def to_dict(self) -> dict:
         """As the model file stores it: the drifts under names that say the axis's unit."""
         u = unit_suffix(self.unit)
-        return {"axis": self.axis, "fold_kind": self.fold_kind, "folds": list(self.folds), "window_s": self.window_s,
-                "temperature_step_degc": self.temperature_step_degc,
-                "band_degc": list(self.band_degc) if self.band_degc is not None else None, "best": self.best.to_dict(),
-                "chosen": self.chosen.to_dict(), f"raw_drift{u}": json_number(self.raw_drift),
-                f"chosen_drift{u}": json_number(self.chosen_drift),
-                f"chosen_standard_error{u}": json_number(self.chosen_standard_error), "fold_note": self.fold_note,
-                "validated": self.validated,
-                "generalizes": self.generalizes,
-                "branch_test": self.branch_test.to_dict() if self.branch_test is not None else None,
-                "lag_from_unit": self.lag_from_unit, "decided_by": self.decided_by,
-                "order_test": self.order_test.to_dict() if self.order_test is not None else None,
-                "candidates": [s.to_dict(self.unit) for s in self.scores]}
+        return {
+            "axis": self.axis,
+            "fold_kind": self.fold_kind,
+            "folds": list(self.folds),
+            "window_s": self.window_s,
+            "temperature_step_degc": self.temperature_step_degc,
+            "band_degc": list(self.band_degc) if self.band_degc is not None else None,
+            "best": self.best.to_dict(),
+            "chosen": self.chosen.to_dict(),
+            f"raw_drift{u}": json_number(self.raw_drift),
+            f"chosen_drift{u}": json_number(self.chosen_drift),
+            f"chosen_standard_error{u}": json_number(self.chosen_standard_error),
+            "fold_note": self.fold_note,
+            "validated": self.validated,
+            "generalizes": self.generalizes,
+            "branch_test": self.branch_test.to_dict() if self.branch_test is not None else None,
+            "lag_from_unit": self.lag_from_unit,
+            "decided_by": self.decided_by,
+            "order_test": self.order_test.to_dict() if self.order_test is not None else None,
+            "candidates": [s.to_dict(self.unit) for s in self.scores],
+        }
 
 
 def temperature_step_degc(temperature_degc: np.ndarray) -> float:
@@ -217,7 +226,7 @@ def drift_rms(residual: np.ndarray, weights: DriftWeights) -> tuple[float, float
     smooth = moving_average(e, weights.window)
     w = weights.smoothed
     smooth = smooth - np.sum(w * smooth) / weights.smoothed_total
-    return float(np.sum(w * smooth ** 2)), weights.smoothed_total
+    return float(np.sum(w * smooth**2)), weights.smoothed_total
 
 
 @dataclass
@@ -321,7 +330,7 @@ class SelectionProblem:
                 inside = (temp >= self.band_degc[0]) & (temp <= self.band_degc[1])
                 for sign in (-1, 1):
                     cols.append(np.where((active & inside & (turns.direction == sign))[:, None], powers, 0.0))
-        for width in (BRANCH_WIDTHS_DEGC if self.branch_orders else ()):
+        for width in BRANCH_WIDTHS_DEGC if self.branch_orders else ():
             position = branch_position(temp, turns, width)
             cols.append(position[:, None] * power_columns(u, 0, self.max_branch - 1))
         cols.append(self.accel_columns(k))
@@ -407,12 +416,15 @@ class SelectionProblem:
         key = ("prep", tau_s, shape_only)
         if key not in self._cache:
             temps = self._model_temperatures(tau_s)
-            self._cache[key] = [(temp, self.shape_columns(k, temp) if shape_only
-                                 else self.columns(k, temp, lagged=tau_s > 0)) for k, temp in enumerate(temps)]
+            self._cache[key] = [
+                (temp, self.shape_columns(k, temp) if shape_only else self.columns(k, temp, lagged=tau_s > 0))
+                for k, temp in enumerate(temps)
+            ]
         return self._cache[key]
 
-    def training_matrices(self, tau_s: float, weighting: Weighting, shape_only: bool = False
-                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def training_matrices(
+        self, tau_s: float, weighting: Weighting, shape_only: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(F, P+1, P+1) centred normal matrices of [columns, y] over each fold's training data (each run's
         constant profiled out), and the (F,) lowest and highest training model temperature. The columns are
         :meth:`columns`, or with ``shape_only`` :meth:`shape_columns`."""
@@ -471,8 +483,17 @@ class SelectionProblem:
         coef = coef / scale
         return coef, float(matrix[-1, -1] - b @ coef)
 
-    def _held_out(self, f: int, c: Candidate, tau_s: float, coef: np.ndarray, lo: float, hi: float,
-                  idx: np.ndarray, windows_s: tuple[float, ...]) -> tuple[float, ...]:
+    def _held_out(
+        self,
+        f: int,
+        c: Candidate,
+        tau_s: float,
+        coef: np.ndarray,
+        lo: float,
+        hi: float,
+        idx: np.ndarray,
+        windows_s: tuple[float, ...],
+    ) -> tuple[float, ...]:
         """The held-out drift of fold ``f`` at each of ``windows_s`` [s] [the axis's unit]."""
         if not (math.isfinite(lo) and math.isfinite(hi) and np.all(np.isfinite(coef))):
             return (math.nan,) * len(windows_s)  # nothing left to train on without this fold
@@ -510,8 +531,10 @@ class SelectionProblem:
         key = ("fold weights", window_s)
         if key not in self._cache:
             window = max(1, int(round(window_s / self.block_s)))
-            self._cache[key] = [[DriftWeights.of(self.runs[k].samples[sel].astype(float), window)
-                                 for k, sel in members] for members in self.fold_members()]
+            self._cache[key] = [
+                [DriftWeights.of(self.runs[k].samples[sel].astype(float), window) for k, sel in members]
+                for members in self.fold_members()
+            ]
         return self._cache[key]
 
     @property
@@ -533,7 +556,7 @@ class SelectionProblem:
             fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False)
             widths = range(len(BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
             best = None
-            for tau in (taus if shared is None else shared[f:f + 1]):
+            for tau in taus if shared is None else shared[f : f + 1]:
                 matrices, lo, hi = self.training_matrices(float(tau), c.weighting)
                 for w in widths:
                     idx = self.column_index(fc, w)
@@ -544,8 +567,9 @@ class SelectionProblem:
             windows = (self.window_s, self.short_window_s) if short_window else (self.window_s,)
             drifts.append(self._held_out(f, c, tau, coef, lo_f, hi_f, idx, windows))
             lags.append(tau)
-        return CandidateScore(c, tuple(d[0] for d in drifts), tuple(lags),
-                              tuple(d[1] for d in drifts) if short_window else ())
+        return CandidateScore(
+            c, tuple(d[0] for d in drifts), tuple(lags), tuple(d[1] for d in drifts) if short_window else ()
+        )
 
     def fold_has_both_directions(self) -> np.ndarray:
         """(F,) whether each fold's training data holds both heating and cooling blocks."""
@@ -576,8 +600,9 @@ class SelectionProblem:
             out[:, g] = [self.solve(matrices[f], idx)[1] for f in range(self.folds.count)]
         return out / np.maximum(out.min(axis=1, keepdims=True), 1e-300)
 
-    def candidates(self, orders: tuple[int, ...], memories: tuple[str, ...],
-                   weightings: tuple[Weighting, ...] = WEIGHTINGS) -> list[Candidate]:
+    def candidates(
+        self, orders: tuple[int, ...], memories: tuple[str, ...], weightings: tuple[Weighting, ...] = WEIGHTINGS
+    ) -> list[Candidate]:
         out = []
         for w in weightings:
             if "none" in memories:  # the other families: no lag, no hysteresis
@@ -586,7 +611,7 @@ class SelectionProblem:
                 for mem in memories:
                     lag = "lag" in mem
                     if "branch" in mem:
-                        for b in (self.branch_orders if p > 0 else ()):
+                        for b in self.branch_orders if p > 0 else ():
                             c = Candidate(p, lag, 0, w, False, b)
                             if c not in out:
                                 out.append(c)
@@ -612,12 +637,23 @@ class SelectionProblem:
         return c.complexity - (1 if c.lag and self.temperature_step_degc > 0 else 0)
 
 
-def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, groups: tuple[int, ...] | None = None,
-                 block_s: float = 2.0, bin_width_degc: float | None = None, fold_kind: str = "auto",
-                 max_order: int = 5, hysteresis_orders: tuple[int, ...] = (1, 2, 3), accel_cols: tuple[int, ...] = (),
-                 square_cols: tuple[int, ...] = (), both_directions: bool = True,
-                 branch_orders: tuple[int, ...] = (), other_curves: tuple[tuple[str, int], ...] = ()
-                 ) -> SelectionProblem:
+def prepare_axis(
+    recordings: list,
+    axis: str,
+    *,
+    pieces: list | None = None,
+    groups: tuple[int, ...] | None = None,
+    block_s: float = 2.0,
+    bin_width_degc: float | None = None,
+    fold_kind: str = "auto",
+    max_order: int = 5,
+    hysteresis_orders: tuple[int, ...] = (1, 2, 3),
+    accel_cols: tuple[int, ...] = (),
+    square_cols: tuple[int, ...] = (),
+    both_directions: bool = True,
+    branch_orders: tuple[int, ...] = (),
+    other_curves: tuple[tuple[str, int], ...] = (),
+) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
     Parameters
@@ -661,16 +697,43 @@ def prepare_axis(recordings: list, axis: str, *, pieces: list | None = None, gro
     groups = tuple(range(len(recordings))) if groups is None else tuple(int(g) for g in groups)
     folds = make_folds(runs, groups, thresholds, fold_kind)
     step = max(p.of_temperature(axis, "step", temperature_step_degc) for p in prepared)
-    reverses = (branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds))
+    reverses = branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds)
     t_ref, t_scale = (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0
-    band, band_only = band_offer(runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order),
-                                  block_s, both_directions) if reverses and hysteresis_orders else (None, False)
-    return SelectionProblem(runs, groups, folds, t_ref, t_scale, max(thresholds), block_s,
-                            window_for(folds, runs, block_s), max_order, hysteresis_orders if reverses else (),
-                            accel_cols, square_cols, step, band, unit=recordings[0].unit_of(axis), band_only=band_only,
-                            branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
-                            other_curves=tuple(other_curves))
+    band, band_only = (
+        band_offer(
+            runs, groups, thresholds, folds, t_ref, t_scale, min(BAND_ORDER, max_order), block_s, both_directions
+        )
+        if reverses and hysteresis_orders
+        else (None, False)
+    )
+    return SelectionProblem(
+        runs,
+        groups,
+        folds,
+        t_ref,
+        t_scale,
+        max(thresholds),
+        block_s,
+        window_for(folds, runs, block_s),
+        max_order,
+        hysteresis_orders if reverses else (),
+        accel_cols,
+        square_cols,
+        step,
+        band,
+        unit=recordings[0].unit_of(axis),
+        band_only=band_only,
+        branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
+        other_curves=tuple(other_curves),
+    )
 
 
-__all__ = ["AxisSelection", "BRANCH_WIDTHS_DEGC", "Candidate", "SelectionProblem", "Weighting", "prepare_axis",
-           "temperature_step_degc"]
+__all__ = [
+    "AxisSelection",
+    "BRANCH_WIDTHS_DEGC",
+    "Candidate",
+    "SelectionProblem",
+    "Weighting",
+    "prepare_axis",
+    "temperature_step_degc",
+]

@@ -163,10 +163,10 @@ class _Problem:
             d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0)
             for sign in (-1, 1):
                 on = active & (turns.direction == sign)
-                cols += [np.where(on, d ** j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
+                cols += [np.where(on, d**j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
         if spec.branch:
             position = branch_position(temp, find_turns(temp, self.threshold), spec.width_degc)
-            cols += [position * u ** k for k in range(spec.branch)]
+            cols += [position * u**k for k in range(spec.branch)]
         if self.accel_cols:
             cols += [run.accel_g[:, j] for j in self.accel_cols]
         if self.square_cols:
@@ -214,7 +214,7 @@ class _Problem:
         sw = np.sqrt(w)
         coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
         rss = float(np.sum(w * (y - x @ coef) ** 2))
-        return coef[len(which):], coef[: len(which)], rss, t_range
+        return coef[len(which) :], coef[: len(which)], rss, t_range
 
     def best_width(self, spec: _Spec, tau: float, which: list[int]) -> _Spec:
         """``spec`` with the branch crossover width [degC] of :data:`BRANCH_WIDTHS_DEGC` at lag ``tau`` [s]
@@ -238,8 +238,11 @@ class _Problem:
             return 0.0, self.solve(spec, 0.0, which), spec
         if tau_s is None:
             lo_s = LAG_MIN_BLOCKS * self.block_s
-            tau_s = best_lag_s(lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2],
-                               lo_s, lag_search_top_s(self.runs, lo_s))
+            tau_s = best_lag_s(
+                lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2],
+                lo_s,
+                lag_search_top_s(self.runs, lo_s),
+            )
         spec = self.best_width(spec, tau_s, which)
         return tau_s, self.solve(spec, tau_s, which), spec
 
@@ -316,7 +319,7 @@ class _Problem:
             kernel = np.ones(w) / w
             smooth_e = np.convolve(e, kernel, mode="valid")
             smooth_w = np.convolve(run.weight, kernel, mode="valid")
-            sse += float(np.sum(smooth_w * smooth_e ** 2))
+            sse += float(np.sum(smooth_w * smooth_e**2))
             wsum += float(np.sum(smooth_w))
         return math.sqrt(sse / wsum)
 
@@ -346,8 +349,12 @@ class _Problem:
         segment is correlated (flicker) while different positions are close to independent."""
         n = len(self.runs)
         x, y, w, _ = self.design(spec, tau, list(range(n)))
-        clusters = np.concatenate([run.cluster * n + k if run.cluster is not None else np.full(run.value.size, k)
-                                   for k, run in enumerate(self.runs)])
+        clusters = np.concatenate(
+            [
+                run.cluster * n + k if run.cluster is not None else np.full(run.value.size, k)
+                for k, run in enumerate(self.runs)
+            ]
+        )
         xtw = x.T * w
         bread = np.linalg.pinv(xtw @ x)
         coef = bread @ (xtw @ y)
@@ -509,8 +516,11 @@ class ThermalHysteresisModel(LearnedAttributes):
         self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
         axes = fit_axes(recordings)
         pieces = self._pieces(recordings)
-        self.selection_ = "fixed" if self.hysteresis != "auto" and self.hysteresis_order != "auto" else (
-            "leave-one-run-out" if len(recordings) >= 2 else "bic")
+        self.selection_ = (
+            "fixed"
+            if self.hysteresis != "auto" and self.hysteresis_order != "auto"
+            else ("leave-one-run-out" if len(recordings) >= 2 else "bic")
+        )
         choices = {axis: self._choose(axis, recordings, pieces, first=axis == axes[0]) for axis in axes}
         taus = self._shared_lag(choices) if self.shared_lag and one_temperature_column(recordings) else {}
         self.lag_evidence_ = {}
@@ -519,17 +529,16 @@ class ThermalHysteresisModel(LearnedAttributes):
         return self
 
     def _check_settings(self) -> None:
-        for mode in (self.hysteresis.values() if isinstance(self.hysteresis, dict) else [self.hysteresis]):
+        for mode in self.hysteresis.values() if isinstance(self.hysteresis, dict) else [self.hysteresis]:
             if mode not in HYSTERESIS_CHOICES:
                 raise InputError(f"hysteresis: {mode!r}; use one of {', '.join(HYSTERESIS_CHOICES)}")
-        for h in (self.hysteresis_order.values() if isinstance(self.hysteresis_order, dict)
-                  else [self.hysteresis_order]):
+        for h in self.hysteresis_order.values() if isinstance(self.hysteresis_order, dict) else [self.hysteresis_order]:
             if h != "auto" and not (isinstance(h, int) and 0 <= h <= MAX_HYSTERESIS_ORDER):
                 raise InputError(f"hysteresis_order: {h!r}; use 'auto' or 1..{MAX_HYSTERESIS_ORDER}")
-        for w in (self.weighting.values() if isinstance(self.weighting, dict) else [self.weighting]):
+        for w in self.weighting.values() if isinstance(self.weighting, dict) else [self.weighting]:
             if w not in ("time", "temperature-balanced"):
                 raise InputError(f"weighting: {w!r}; use 'time' or 'temperature-balanced'")
-        for band in (self.band_degc.values() if isinstance(self.band_degc, dict) else [self.band_degc]):
+        for band in self.band_degc.values() if isinstance(self.band_degc, dict) else [self.band_degc]:
             if band is not None and not band[0] < band[1]:
                 raise InputError(f"band_degc: {band}; give (low, high) with low < high [degC]")
         if not self.block_s > 0:
@@ -548,11 +557,21 @@ class ThermalHysteresisModel(LearnedAttributes):
         runs = [PreparedRun.of(rec).block_means(axis, block_s, width, piece) for rec, piece in zip(recordings, pieces)]
         if self._of(self.weighting, axis) == "time":  # every second counts equally, as in the drift judged
             runs = [dataclasses.replace(r, weight=r.samples / r.samples.max()) for r in runs]
-        threshold = max(PreparedRun.of(rec).of_temperature(axis, "turn threshold", turn_threshold_degc)
-                        for rec in recordings)
+        threshold = max(
+            PreparedRun.of(rec).of_temperature(axis, "turn threshold", turn_threshold_degc) for rec in recordings
+        )
         accel_cols, square_cols = self._accel_columns(runs, first)
-        return _Problem(runs, (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0, threshold,
-                        self._of(self.band_degc, axis), block_s, accel_cols, square_cols, self.extended)
+        return _Problem(
+            runs,
+            (lo + hi) / 2,
+            (hi - lo) / 2 if hi > lo else 1.0,
+            threshold,
+            self._of(self.band_degc, axis),
+            block_s,
+            accel_cols,
+            square_cols,
+            self.extended,
+        )
 
     def _choose(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _AxisChoice:
         """The candidate of one axis: given, or the best by leave-one-run-out error (BIC with one run)."""
@@ -581,8 +600,10 @@ class ThermalHysteresisModel(LearnedAttributes):
                     scores[name], bands[name] = with_band, found
         chosen = self._pick(axis, scores, n_runs)
         if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
-            tried = {p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
-                     for p in range(1, MAX_HYSTERESIS_ORDER + 1)}
+            tried = {
+                p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
+                for p in range(1, MAX_HYSTERESIS_ORDER + 1)
+            }
             pick = _simplest(tried, n_runs)
             best_spec[chosen] = self._spec(chosen, order, pick, axis)
             scores[chosen] = tried[pick]
@@ -635,15 +656,28 @@ class ThermalHysteresisModel(LearnedAttributes):
         self.curves_[axis] = problem.basis(spec).curve(coef[: spec.order], t_lo, t_hi)
         self.lag_time_constants_s_[axis] = float(tau)
         p = spec.hysteresis_order
-        self.hysteresis_[axis] = None if not p else HysteresisCurve(
-            tuple(float(v) for v in coef[spec.order: spec.order + p]),
-            tuple(float(v) for v in coef[spec.order + p: spec.order + 2 * p]), problem.threshold, problem.band,
-            problem.branch_reach(spec, tau))
+        self.hysteresis_[axis] = (
+            None
+            if not p
+            else HysteresisCurve(
+                tuple(float(v) for v in coef[spec.order : spec.order + p]),
+                tuple(float(v) for v in coef[spec.order + p : spec.order + 2 * p]),
+                problem.threshold,
+                problem.band,
+                problem.branch_reach(spec, tau),
+            )
+        )
         if spec.branch:
             start = spec.order + 2 * p
-            self.hysteresis_[axis] = BranchCurve(tuple(float(v) for v in coef[start: start + spec.branch]),
-                                                 problem.t_ref, problem.t_scale, spec.width_degc, problem.threshold,
-                                                 t_lo, t_hi)
+            self.hysteresis_[axis] = BranchCurve(
+                tuple(float(v) for v in coef[start : start + spec.branch]),
+                problem.t_ref,
+                problem.t_scale,
+                spec.width_degc,
+                problem.threshold,
+                t_lo,
+                t_hi,
+            )
         self.bands_[axis] = problem.band
         self.turn_on_biases_[axis] = consts
         self.memories_[axis] = (choice.name, spec.branch or p)
@@ -659,14 +693,18 @@ class ThermalHysteresisModel(LearnedAttributes):
         if self.acceleration == "none":
             return (), ()
         if any(r.accel_g is None for r in runs):
-            raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
-                             "fit; map them with columns= or fit with acceleration='none'")
-        excited, squares, self.excited_axes_ = excited_columns([r.accel_g for r in runs], [r.weight for r in runs],
-                                                               squares=self.acceleration == "matrix2", warn=warn)
+            raise InputError(
+                "acceleration: the runs need accel_x, accel_y and accel_z columns for a g-sensitivity "
+                "fit; map them with columns= or fit with acceleration='none'"
+            )
+        excited, squares, self.excited_axes_ = excited_columns(
+            [r.accel_g for r in runs], [r.weight for r in runs], squares=self.acceleration == "matrix2", warn=warn
+        )
         return excited, squares
 
-    def _store_acceleration(self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray,
-                            n_runs: int) -> None:
+    def _store_acceleration(
+        self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray, n_runs: int
+    ) -> None:
         start = spec.order + 2 * spec.hysteresis_order + spec.branch
         full, cov = problem.covariance(spec, tau)
         se_all = np.sqrt(np.maximum(np.diag(cov), 0.0))[n_runs:]
@@ -684,8 +722,9 @@ class ThermalHysteresisModel(LearnedAttributes):
             self.g_squared_se_dps_per_g2_[axis] = q_se
 
 
-def static_pieces(recordings: list[Recording], min_duration_s: float,
-                  warn: bool = True) -> tuple[list, list[list[slice] | None]]:
+def static_pieces(
+    recordings: list[Recording], min_duration_s: float, warn: bool = True
+) -> tuple[list, list[list[slice] | None]]:
     """Per run, its static segments and the stretches a fit uses: the static segments where the unit moves
     between positions (runs with an accelerometer), else None (every stretch between time gaps); with ``warn``,
     a run with an accelerometer but no static segment is said (once per fit: the model choice asks without)."""
@@ -696,8 +735,9 @@ def static_pieces(recordings: list[Recording], min_duration_s: float,
         segs = PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if moves else []
         segments.append(segs)
         if moves and not segs and warn:
-            warnings.warn(f"{rec.source}: no static segment found; fitting on every sample",
-                          DataQualityWarning, stacklevel=3)
+            warnings.warn(
+                f"{rec.source}: no static segment found; fitting on every sample", DataQualityWarning, stacklevel=3
+            )
         out.append([slice(g.start, g.stop) for g in segs] if segs else None)
     return segments, out
 

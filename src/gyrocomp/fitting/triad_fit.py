@@ -95,15 +95,28 @@ def _pose(recording: Recording, start: int, stop: int) -> Pose:
     acc = recording.accel_g[start:stop]
     n = stop - start
     temp = recording.temperature_degc
-    return Pose(recording.source, float(recording.time_s[start]), float(recording.time_s[stop - 1] - recording.time_s[start]),
-                int(n), acc.mean(axis=0), acc.std(axis=0, ddof=1) / np.sqrt(n),
-                recording.gyro_dps[start:stop].mean(axis=0),
-                None if temp is None else float(np.mean(temp[start:stop])), start, stop)
+    return Pose(
+        recording.source,
+        float(recording.time_s[start]),
+        float(recording.time_s[stop - 1] - recording.time_s[start]),
+        int(n),
+        acc.mean(axis=0),
+        acc.std(axis=0, ddof=1) / np.sqrt(n),
+        recording.gyro_dps[start:stop].mean(axis=0),
+        None if temp is None else float(np.mean(temp[start:stop])),
+        start,
+        stop,
+    )
 
 
-def find_poses(recording: Recording, *, ranges: list[tuple[int, int]] | None = None,
-               min_duration_s: float = DEFAULT_POSE_MIN_S, window_s: float = DEFAULT_POSE_WINDOW_S,
-               factor: float = DEFAULT_POSE_FACTOR) -> list[Pose]:
+def find_poses(
+    recording: Recording,
+    *,
+    ranges: list[tuple[int, int]] | None = None,
+    min_duration_s: float = DEFAULT_POSE_MIN_S,
+    window_s: float = DEFAULT_POSE_WINDOW_S,
+    factor: float = DEFAULT_POSE_FACTOR,
+) -> list[Pose]:
     """The still poses of a multi-position recording.
 
     Parameters
@@ -117,17 +130,22 @@ def find_poses(recording: Recording, *, ranges: list[tuple[int, int]] | None = N
         variance is at most ``factor`` times its median over the recording.
     """
     if recording.accel_g is None or recording.accel_g.shape[1] != 3:
-        raise InputError(f"{recording.source}: a multi-position calibration needs the three accelerometer axes "
-                         "(accel_x, accel_y, accel_z)")
+        raise InputError(
+            f"{recording.source}: a multi-position calibration needs the three accelerometer axes "
+            "(accel_x, accel_y, accel_z)"
+        )
     if ranges is None:
-        segs = PreparedRun.of(recording).static_segments(window_s=window_s, min_duration_s=min_duration_s,
-                                                         factor=factor)
+        segs = PreparedRun.of(recording).static_segments(
+            window_s=window_s, min_duration_s=min_duration_s, factor=factor
+        )
         ranges = [(s.start, s.stop) for s in segs]
     out = []
     for start, stop in ranges:
         if not 0 <= start < stop <= recording.n_samples or stop - start < 2:
-            raise InputError(f"{recording.source}: pose range [{start}, {stop}) is not inside the "
-                             f"{recording.n_samples} samples or holds fewer than 2")
+            raise InputError(
+                f"{recording.source}: pose range [{start}, {stop}) is not inside the "
+                f"{recording.n_samples} samples or holds fewer than 2"
+            )
         out.append(_pose(recording, int(start), int(stop)))
     return out
 
@@ -184,8 +202,10 @@ def _directions(means: np.ndarray) -> np.ndarray:
     norms = np.linalg.norm(means, axis=1)
     if np.any(norms < 0.1):
         k = int(np.flatnonzero(norms < 0.1)[0])
-        raise InputError(f"pose {k + 1}: mean specific force {norms[k]:.3g} g; a pose at rest reads about 1 g "
-                         "(are the accelerations in g?)")
+        raise InputError(
+            f"pose {k + 1}: mean specific force {norms[k]:.3g} g; a pose at rest reads about 1 g "
+            "(are the accelerations in g?)"
+        )
     return means / norms[:, None]
 
 
@@ -213,8 +233,10 @@ def _require_span(units: np.ndarray) -> None:
     if missing is not None:
         axis, sign = missing
         name, word = "xyz"[axis], "up" if sign > 0 else "down"
-        raise InputError(f"poses: no pose has the {name} axis pointing {word} (gravity within 60 deg of "
-                         f"{'+' if sign > 0 else '-'}{name}); the poses must turn every axis both up and down")
+        raise InputError(
+            f"poses: no pose has the {name} axis pointing {word} (gravity within 60 deg of "
+            f"{'+' if sign > 0 else '-'}{name}); the poses must turn every axis both up and down"
+        )
 
 
 def distinct_orientations(units: np.ndarray) -> int:
@@ -261,14 +283,20 @@ def _fixed_couplings(poses: list[Pose], units: np.ndarray) -> tuple[str, ...]:
     fixed: tuple[str, ...] = ()
     while (term := undetermined_norm_term(units, fixed)) is not None:
         if term not in _COUPLING_INDEX:
-            raise InputError(f"poses: the {len(poses)} orientations leave the norm method's {term} term undetermined "
-                             f"(the poses do not vary the {term[0]} axis's share of gravity enough); add poses tilted "
-                             "between the axes, or use method='six-position'")
+            raise InputError(
+                f"poses: the {len(poses)} orientations leave the norm method's {term} term undetermined "
+                f"(the poses do not vary the {term[0]} axis's share of gravity enough); add poses tilted "
+                "between the axes, or use method='six-position'"
+            )
         fixed += (term,)
     if fixed:
         pairs = ", ".join(f"{t[0]} and {t[2]}" for t in fixed)
-        warnings.warn(f"poses: no pose has gravity between the {pairs} axes; that misalignment is not determined and "
-                      "is taken as zero (add poses tilted between the axes to fit it)", DataQualityWarning, stacklevel=4)
+        warnings.warn(
+            f"poses: no pose has gravity between the {pairs} axes; that misalignment is not determined and "
+            "is taken as zero (add poses tilted between the axes to fit it)",
+            DataQualityWarning,
+            stacklevel=4,
+        )
     return fixed
 
 
@@ -312,7 +340,7 @@ def _norm_jacobian(theta: np.ndarray, means: np.ndarray, gravity_g: float) -> np
 def _sphere_start(means: np.ndarray, gravity_g: float) -> np.ndarray:
     """Start of the norm fit: the centre and radius of the sphere through the poses."""
     x = np.column_stack([2.0 * means, np.ones(len(means))])
-    sol = np.linalg.lstsq(x, np.sum(means ** 2, axis=1), rcond=None)[0]
+    sol = np.linalg.lstsq(x, np.sum(means**2, axis=1), rcond=None)[0]
     centre = sol[:3]
     radius = np.sqrt(max(sol[3] + centre @ centre, 1e-12))
     return np.concatenate([centre, (gravity_g / radius) * np.eye(3)[np.triu_indices(3)]])
@@ -347,8 +375,10 @@ def _residual_variance(ssr: float, dof: int, noise_variance: float) -> tuple[flo
 def _fit_norm(poses: list[Pose], means: np.ndarray, units: np.ndarray, gravity_g: float):
     distinct = distinct_orientations(units)
     if distinct < MIN_POSES_NORM:
-        raise InputError(f"poses: {distinct} distinct orientations (of {len(poses)} still poses); the norm method "
-                         f"needs at least {MIN_POSES_NORM} (nine unknowns: bias, scale and misalignment)")
+        raise InputError(
+            f"poses: {distinct} distinct orientations (of {len(poses)} still poses); the norm method "
+            f"needs at least {MIN_POSES_NORM} (nine unknowns: bias, scale and misalignment)"
+        )
     fixed = _fixed_couplings(poses, units)
     free = np.array([k for k in range(9) if k not in [_COUPLING_INDEX[t] for t in fixed]])
     start = _sphere_start(means, gravity_g)
@@ -360,25 +390,43 @@ def _fit_norm(poses: list[Pose], means: np.ndarray, units: np.ndarray, gravity_g
 
     from scipy import optimize  # slow to import; only the multi-position fit needs it
 
-    sol = optimize.least_squares(lambda t: _norm_residuals(full(t), means, gravity_g), start[free],
-                                 jac=lambda t: _norm_jacobian(full(t), means, gravity_g)[:, free],
-                                 method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    sol = optimize.least_squares(
+        lambda t: _norm_residuals(full(t), means, gravity_g),
+        start[free],
+        jac=lambda t: _norm_jacobian(full(t), means, gravity_g)[:, free],
+        method="lm",
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+    )
     theta = full(sol.x)
     sens = np.linalg.inv(_upper(theta)) if abs(np.linalg.det(_upper(theta))) > 1e-9 else np.full((3, 3), np.inf)
     if np.any(np.diag(_upper(theta)) <= 0) or np.max(np.abs(sens - np.eye(3))) > MAX_SENSITIVITY_ERROR:
-        raise InputError(f"poses: the norm fit over {len(poses)} poses found no plausible triad (scale or "
-                         f"misalignment beyond {MAX_SENSITIVITY_ERROR:.0%}); the orientations do not determine it")
+        raise InputError(
+            f"poses: the norm fit over {len(poses)} poses found no plausible triad (scale or "
+            f"misalignment beyond {MAX_SENSITIVITY_ERROR:.0%}); the orientations do not determine it"
+        )
     dof = len(poses) - free.size
-    red, variance = _residual_variance(float(np.sum(sol.fun ** 2)), dof,
-                                       float(np.mean(_sigma_of_norm(poses, units) ** 2)))
+    red, variance = _residual_variance(
+        float(np.sum(sol.fun**2)), dof, float(np.mean(_sigma_of_norm(poses, units) ** 2))
+    )
     cov = np.zeros((9, 9))
     cov[np.ix_(free, free)] = np.linalg.pinv(sol.jac.T @ sol.jac) * variance
     sens = lambda t: np.linalg.inv(_upper(t))  # noqa: E731
-    return theta[:3], sens(theta), np.sqrt(np.diag(cov))[:3], propagate_stderr(sens, theta, cov).reshape(3, 3), red, dof, 0
+    return (
+        theta[:3],
+        sens(theta),
+        np.sqrt(np.diag(cov))[:3],
+        propagate_stderr(sens, theta, cov).reshape(3, 3),
+        red,
+        dof,
+        0,
+    )
 
 
-def _six_position_design(d: np.ndarray, temperatures: np.ndarray | None, order: int, t_ref: float,
-                         bias_order: int = 0) -> np.ndarray:
+def _six_position_design(
+    d: np.ndarray, temperatures: np.ndarray | None, order: int, t_ref: float, bias_order: int = 0
+) -> np.ndarray:
     """Columns: the direction (3), then (T - t_ref)^p times it for p = 1..order, then 1 (the bias), then
     (T - t_ref)^p for p = 1..bias_order (a bias still drifting with temperature)."""
     blocks = [d] + [d * ((temperatures - t_ref) ** p)[:, None] for p in range(1, order + 1)]
@@ -395,8 +443,14 @@ def _press(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.sum(((y - x @ coef) / (1.0 - hat)[:, None]) ** 2))
 
 
-def _six_position_order(d: np.ndarray, y: np.ndarray, temperatures: np.ndarray | None, t_ref: float,
-                        temperature_order: int | Literal["auto"], bias_order: int) -> int:
+def _six_position_order(
+    d: np.ndarray,
+    y: np.ndarray,
+    temperatures: np.ndarray | None,
+    t_ref: float,
+    temperature_order: int | Literal["auto"],
+    bias_order: int,
+) -> int:
     """0 (K constant) or 1 (K linear in temperature): as asked, or by leave-one-pose-out error when the poses
     span MIN_TRIAD_SPAN_DEGC (the lowest order within 5 % of the best)."""
     span = 0.0 if temperatures is None else float(np.ptp(temperatures))
@@ -408,18 +462,26 @@ def _six_position_order(d: np.ndarray, y: np.ndarray, temperatures: np.ndarray |
     if temperature_order not in (0, 1):
         raise InputError(f"temperature_order: {temperature_order!r}; use 'auto', 0 or 1")
     if temperature_order == 1 and span < MIN_TRIAD_SPAN_DEGC:
-        raise InputError(f"temperature_order: 1 needs poses over at least {MIN_TRIAD_SPAN_DEGC:g} degC; these span "
-                         f"{span:.1f} degC")
+        raise InputError(
+            f"temperature_order: 1 needs poses over at least {MIN_TRIAD_SPAN_DEGC:g} degC; these span {span:.1f} degC"
+        )
     return temperature_order
 
 
-def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray,
-                      temperature_order: int | Literal["auto"] = 0, bias_order: int = 0):
+def _fit_six_position(
+    poses: list[Pose],
+    means: np.ndarray,
+    units: np.ndarray,
+    temperature_order: int | Literal["auto"] = 0,
+    bias_order: int = 0,
+):
     which = _axis_assignment(units)
     missing = [_DIRECTION_NAMES[k] for k in range(6) if not np.any(which == k)]
     if missing:
-        raise InputError(f"poses: no pose along {', '.join(missing)}; the six-position method needs the unit "
-                         f"resting on each of its six faces (or give {MIN_POSES_NORM} or more poses for the norm method)")
+        raise InputError(
+            f"poses: no pose along {', '.join(missing)}; the six-position method needs the unit "
+            f"resting on each of its six faces (or give {MIN_POSES_NORM} or more poses for the norm method)"
+        )
     keep = which >= 0
     d = np.zeros((int(keep.sum()), 3))
     d[np.arange(d.shape[0]), which[keep] // 2] = np.where(which[keep] % 2, -1.0, 1.0)
@@ -428,8 +490,10 @@ def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray,
     temperatures = None if any(t is None for t in temps) else np.asarray(temps, dtype=float)
     t_ref = 0.0 if temperatures is None else float(np.round(0.5 * (temperatures.min() + temperatures.max()), 1))
     if bias_order and (temperatures is None or np.ptp(temperatures) < MIN_TRIAD_SPAN_DEGC):
-        raise InputError(f"bias_temperature_order: {bias_order} needs poses with temperatures over at least "
-                         f"{MIN_TRIAD_SPAN_DEGC:g} degC")
+        raise InputError(
+            f"bias_temperature_order: {bias_order} needs poses with temperatures over at least "
+            f"{MIN_TRIAD_SPAN_DEGC:g} degC"
+        )
     order = _six_position_order(d, y, temperatures, t_ref, temperature_order, bias_order)
     x = _six_position_design(d, temperatures, order, t_ref, bias_order)
     sem = np.array([p.accel_sem_g for p in poses])[keep]
@@ -438,14 +502,23 @@ def _fit_six_position(poses: list[Pose], means: np.ndarray, units: np.ndarray,
     coef = np.linalg.lstsq(x, y, rcond=None)[0]
     ssr = float(np.sum((y - x @ coef) ** 2))
     dof = 3 * (d.shape[0] - x.shape[1])
-    red, variance = _residual_variance(ssr, dof, float(np.mean(sem ** 2)))
+    red, variance = _residual_variance(ssr, dof, float(np.mean(sem**2)))
     unscaled = np.diag(np.linalg.pinv(x.T @ x))
     se = np.sqrt(np.outer(np.ones(3), unscaled) * variance)
-    blocks = [coef[3 * p: 3 * p + 3].T for p in range(order + 1)]
-    block_se = [se[:, 3 * p: 3 * p + 3] for p in range(order + 1)]
+    blocks = [coef[3 * p : 3 * p + 3].T for p in range(order + 1)]
+    block_se = [se[:, 3 * p : 3 * p + 3] for p in range(order + 1)]
     constant = 3 * (order + 1)
-    return SixPosition(coef[constant], blocks, se[:, constant], block_se, red, dof, int((~keep).sum()),
-                       t_ref if order or bias_order else None, coef[constant + 1:])
+    return SixPosition(
+        coef[constant],
+        blocks,
+        se[:, constant],
+        block_se,
+        red,
+        dof,
+        int((~keep).sum()),
+        t_ref if order or bias_order else None,
+        coef[constant + 1 :],
+    )
 
 
 @dataclass(frozen=True)
@@ -464,8 +537,14 @@ class SixPosition:
     bias_drift: np.ndarray  # (bias_order, 3): coefficients of (T - reference)^p, p = 1.. [g/degC^p]
 
 
-def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", gravity_g: float = 1.0,
-                            temperature_order: int | Literal["auto"] = "auto", bias_temperature_order: int = 0) -> PoseFit:
+def fit_accel_multiposition(
+    poses: list[Pose],
+    *,
+    method: PoseMethod = "auto",
+    gravity_g: float = 1.0,
+    temperature_order: int | Literal["auto"] = "auto",
+    bias_temperature_order: int = 0,
+) -> PoseFit:
     """Bias, scale factor and misalignment of an accelerometer from still poses (see the module doc).
 
     Parameters
@@ -495,31 +574,60 @@ def fit_accel_multiposition(poses: list[Pose], *, method: PoseMethod = "auto", g
     method = _auto_method(units) if method == "auto" else method
     if method == "norm":
         if temperature_order not in ("auto", 0) or bias_temperature_order:
-            raise InputError("temperature_order: the norm method fits K constant; K(T) needs the six-position method "
-                             "(the unit on its six faces across the temperatures)")
+            raise InputError(
+                "temperature_order: the norm method fits K constant; K(T) needs the six-position method "
+                "(the unit on its six faces across the temperatures)"
+            )
         bias, sens, bias_se, sens_se, red, dof, left = _fit_norm(poses, means, units, gravity_g)
-        cal = TriadCalibration(sensitivity=rows_of(sens), bias=tuple(float(b) for b in bias), method=method,
-                               sensitivity_stderr=rows_of(sens_se), bias_stderr=tuple(float(b) for b in bias_se),
-                               unit="g")
-        return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1),
-                       np.linalg.norm(cal.correct(means), axis=1), red, dof, left, float(gravity_g))
+        cal = TriadCalibration(
+            sensitivity=rows_of(sens),
+            bias=tuple(float(b) for b in bias),
+            method=method,
+            sensitivity_stderr=rows_of(sens_se),
+            bias_stderr=tuple(float(b) for b in bias_se),
+            unit="g",
+        )
+        return PoseFit(
+            cal,
+            tuple(poses),
+            np.linalg.norm(means, axis=1),
+            np.linalg.norm(cal.correct(means), axis=1),
+            red,
+            dof,
+            left,
+            float(gravity_g),
+        )
     fit = _fit_six_position(poses, means / gravity_g, units, temperature_order, bias_temperature_order)
     drift = fit.bias_drift * gravity_g
     blocks = fit.blocks[1:]
-    cal = TriadCalibration(sensitivity=rows_of(fit.blocks[0]), bias=tuple(float(b) * gravity_g for b in fit.bias),
-                           method=method, sensitivity_stderr=rows_of(fit.blocks_se[0]),
-                           bias_stderr=tuple(float(b) * gravity_g for b in fit.bias_se), unit="g",
-                           reference_degc=fit.reference_degc if blocks else None,
-                           sensitivity_per_degc=tuple(rows_of(b) for b in blocks),
-                           sensitivity_per_degc_stderr=tuple(rows_of(b) for b in fit.blocks_se[1:]))
+    cal = TriadCalibration(
+        sensitivity=rows_of(fit.blocks[0]),
+        bias=tuple(float(b) * gravity_g for b in fit.bias),
+        method=method,
+        sensitivity_stderr=rows_of(fit.blocks_se[0]),
+        bias_stderr=tuple(float(b) * gravity_g for b in fit.bias_se),
+        unit="g",
+        reference_degc=fit.reference_degc if blocks else None,
+        sensitivity_per_degc=tuple(rows_of(b) for b in blocks),
+        sensitivity_per_degc_stderr=tuple(rows_of(b) for b in fit.blocks_se[1:]),
+    )
     seen, temperatures = means, None
     if fit.reference_degc is not None:
         temperatures = np.array([p.temperature_degc for p in poses], dtype=float)
         d = temperatures - fit.reference_degc  # the pose means less the fitted drift: what the calibration sees
         seen = means - sum((np.outer(d ** (p + 1), drift[p]) for p in range(drift.shape[0])), np.zeros_like(means))
     after = cal.correct(seen, temperatures if cal.temperature_order else None)
-    return PoseFit(cal, tuple(poses), np.linalg.norm(means, axis=1), np.linalg.norm(after, axis=1),
-                   fit.reduced_chi_square, fit.dof, fit.left_out, float(gravity_g), drift)
+    return PoseFit(
+        cal,
+        tuple(poses),
+        np.linalg.norm(means, axis=1),
+        np.linalg.norm(after, axis=1),
+        fit.reduced_chi_square,
+        fit.dof,
+        fit.left_out,
+        float(gravity_g),
+        drift,
+    )
 
 
 def _checked_poses(poses: list[Pose], method: str, gravity_g: float) -> tuple[np.ndarray, np.ndarray]:
@@ -530,8 +638,10 @@ def _checked_poses(poses: list[Pose], method: str, gravity_g: float) -> tuple[np
     if not gravity_g > 0:
         raise InputError(f"gravity_g: {gravity_g}; must be positive")
     if len(poses) < 6:
-        raise InputError(f"poses: {len(poses)} still poses found; a multi-position calibration needs at least 6 "
-                         "(each axis up and down), better 10 or more")
+        raise InputError(
+            f"poses: {len(poses)} still poses found; a multi-position calibration needs at least 6 "
+            "(each axis up and down), better 10 or more"
+        )
     means = np.array([p.accel_g for p in poses], dtype=float)
     units = _directions(means)
     _require_span(units)
@@ -587,8 +697,10 @@ def rate_segments(recordings: list[Recording], *, settle_s: float = 1.0) -> list
     out = []
     for run, rec in enumerate(recordings):
         if rec.reference_rate_dps is None:
-            raise InputError(f"{rec.source}: no reference rates (ref_rate_x, ref_rate_y, ref_rate_z); a rate-table "
-                             "calibration needs the rate the table applied in each row")
+            raise InputError(
+                f"{rec.source}: no reference rates (ref_rate_x, ref_rate_y, ref_rate_z); a rate-table "
+                "calibration needs the rate the table applied in each row"
+            )
         if rec.gyro_axes != ("gyro_x", "gyro_y", "gyro_z"):
             raise InputError(f"{rec.source}: a scale-factor and misalignment calibration needs all three gyro axes")
         if rec.temperature_degc is None:
@@ -613,7 +725,7 @@ def _rate_design(segments: list[RateSegment], runs: int, order: int, t_ref: floa
         x[i, seg.run] = 1.0
         d = seg.temperature_degc - t_ref
         for p in range(order + 1):
-            x[i, runs + 3 * p: runs + 3 * p + 3] = seg.reference_dps * d ** p
+            x[i, runs + 3 * p : runs + 3 * p + 3] = seg.reference_dps * d**p
     return x
 
 
@@ -659,18 +771,27 @@ class RateTableFit:
     residual_rms_dps: float
 
 
-def _choose_order(segments: list[RateSegment], runs: int, temperatures: np.ndarray, t_ref: float,
-                  temperature_order: int | Literal["auto"]) -> tuple[int, dict[int, float]]:
+def _choose_order(
+    segments: list[RateSegment],
+    runs: int,
+    temperatures: np.ndarray,
+    t_ref: float,
+    temperature_order: int | Literal["auto"],
+) -> tuple[int, dict[int, float]]:
     distinct = len(np.unique(np.round(temperatures, 1)))
     possible = min(MAX_TRIAD_TEMPERATURE_ORDER, distinct - 1)
     if temperature_order == "auto":  # leaving a run out must leave enough temperatures for the order
         possible = min(possible, distinct - 2)
     else:
         if not isinstance(temperature_order, int) or not 0 <= temperature_order <= MAX_TRIAD_TEMPERATURE_ORDER:
-            raise InputError(f"temperature_order: {temperature_order!r}; use 'auto' or 0..{MAX_TRIAD_TEMPERATURE_ORDER}")
+            raise InputError(
+                f"temperature_order: {temperature_order!r}; use 'auto' or 0..{MAX_TRIAD_TEMPERATURE_ORDER}"
+            )
         if temperature_order > possible:
-            raise InputError(f"temperature_order: {temperature_order} needs runs at {temperature_order + 1} or more "
-                             f"temperatures; these runs have {distinct}")
+            raise InputError(
+                f"temperature_order: {temperature_order} needs runs at {temperature_order + 1} or more "
+                f"temperatures; these runs have {distinct}"
+            )
         return temperature_order, {}
     if runs < 3 or possible < 1:
         return 0, {}
@@ -679,8 +800,9 @@ def _choose_order(segments: list[RateSegment], runs: int, temperatures: np.ndarr
     return min(q for q, v in scores.items() if v <= ORDER_TOLERANCE * best), scores
 
 
-def fit_gyro_rate_table(recordings: list[Recording], *, temperature_order: int | Literal["auto"] = "auto",
-                        settle_s: float = 1.0) -> RateTableFit:
+def fit_gyro_rate_table(
+    recordings: list[Recording], *, temperature_order: int | Literal["auto"] = "auto", settle_s: float = 1.0
+) -> RateTableFit:
     """Scale factor and misalignment of a gyro triad, K(T), from rate-table runs.
 
     Each run holds constant rates about each axis (both directions) with the table's rate in the sensor
@@ -704,8 +826,10 @@ def fit_gyro_rate_table(recordings: list[Recording], *, temperature_order: int |
     moving = np.abs(ref) >= MIN_REFERENCE_RATE_DPS
     for j, name in enumerate("xyz"):
         if not (np.any(moving[:, j] & (ref[:, j] > 0)) and np.any(moving[:, j] & (ref[:, j] < 0))):
-            raise InputError(f"rate table: no constant-rate stretch turning about {name} in both directions "
-                             f"(at least {MIN_REFERENCE_RATE_DPS:g} deg/s each way); K needs every axis turned")
+            raise InputError(
+                f"rate table: no constant-rate stretch turning about {name} in both directions "
+                f"(at least {MIN_REFERENCE_RATE_DPS:g} deg/s each way); K needs every axis turned"
+            )
     runs = len(recordings)
     temperatures = np.array([s.temperature_degc for s in segments])
     t_ref = float(np.round(np.mean(temperatures), 1))
@@ -716,18 +840,25 @@ def fit_gyro_rate_table(recordings: list[Recording], *, temperature_order: int |
     resid = y - x @ coef
     dof = x.shape[0] - x.shape[1]
     if dof <= 0:
-        raise InputError(f"rate table: {x.shape[0]} constant-rate stretches for {x.shape[1]} unknowns; "
-                         "record more rates or runs")
-    variance = float(np.sum(resid ** 2) / (3 * dof))
+        raise InputError(
+            f"rate table: {x.shape[0]} constant-rate stretches for {x.shape[1]} unknowns; record more rates or runs"
+        )
+    variance = float(np.sum(resid**2) / (3 * dof))
     se = np.sqrt(np.outer(np.diag(np.linalg.pinv(x.T @ x)), np.ones(3)) * variance)
-    blocks = [coef[runs + 3 * p: runs + 3 * p + 3].T for p in range(order + 1)]  # K row i = output axis i
-    block_se = [se[runs + 3 * p: runs + 3 * p + 3].T for p in range(order + 1)]
-    cal = TriadCalibration(sensitivity=rows_of(blocks[0]), bias=(0.0, 0.0, 0.0), method="rate-table",
-                           sensitivity_stderr=rows_of(block_se[0]), bias_stderr=(0.0, 0.0, 0.0), unit="deg/s",
-                           reference_degc=t_ref if order else None,
-                           sensitivity_per_degc=tuple(rows_of(b) for b in blocks[1:]),
-                           sensitivity_per_degc_stderr=tuple(rows_of(b) for b in block_se[1:]))
-    return RateTableFit(cal, tuple(segments), coef[:runs], scores, float(np.sqrt(np.mean(resid ** 2))))
+    blocks = [coef[runs + 3 * p : runs + 3 * p + 3].T for p in range(order + 1)]  # K row i = output axis i
+    block_se = [se[runs + 3 * p : runs + 3 * p + 3].T for p in range(order + 1)]
+    cal = TriadCalibration(
+        sensitivity=rows_of(blocks[0]),
+        bias=(0.0, 0.0, 0.0),
+        method="rate-table",
+        sensitivity_stderr=rows_of(block_se[0]),
+        bias_stderr=(0.0, 0.0, 0.0),
+        unit="deg/s",
+        reference_degc=t_ref if order else None,
+        sensitivity_per_degc=tuple(rows_of(b) for b in blocks[1:]),
+        sensitivity_per_degc_stderr=tuple(rows_of(b) for b in block_se[1:]),
+    )
+    return RateTableFit(cal, tuple(segments), coef[:runs], scores, float(np.sqrt(np.mean(resid**2))))
 
 
 def rq_upper(sensitivity: np.ndarray) -> np.ndarray:
@@ -740,6 +871,21 @@ def rq_upper(sensitivity: np.ndarray) -> np.ndarray:
     return r * signs[None, :]
 
 
-__all__ = ["AUTO_NORM_POSES", "MIN_POSES_NORM", "Pose", "PoseFit", "PoseMethod", "RateSegment", "RateTableFit",
-           "distinct_orientations", "find_poses", "spans_axes", "fit_accel_multiposition", "fit_gyro_rate_table", "propagate_stderr", "rate_segments",
-           "rq_upper", "undetermined_norm_term"]
+__all__ = [
+    "AUTO_NORM_POSES",
+    "MIN_POSES_NORM",
+    "Pose",
+    "PoseFit",
+    "PoseMethod",
+    "RateSegment",
+    "RateTableFit",
+    "distinct_orientations",
+    "find_poses",
+    "spans_axes",
+    "fit_accel_multiposition",
+    "fit_gyro_rate_table",
+    "propagate_stderr",
+    "rate_segments",
+    "rq_upper",
+    "undetermined_norm_term",
+]

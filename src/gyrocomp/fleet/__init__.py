@@ -18,15 +18,66 @@ the ``postgresql`` extra: psycopg).
 from .unit_figures import FIGURE_NAMES, REFERENCE_TEMPERATURE_DEGC, AxisFigures, UnitFigures, unit_figures
 from .limits import Failure, Limit, Limits, Verdict
 from .population import FleetYield, fleet_table, fleet_yield, robust_z
-from .prior import (AxisPrior, PopulationPrior, block_covariance, comes_back, fit_with_prior, population_prior,
-                    prior_from_models)
-from .run import (FLEET_TABLE, MODELS_FOLDER, FleetSettings, FleetSummary, UnitOutcome, fit_fleet, fit_unit,
-                  model_file_name)
+from .prior import (
+    AxisPrior,
+    PopulationPrior,
+    block_covariance,
+    comes_back,
+    fit_with_prior,
+    population_prior,
+    prior_from_models,
+)
+from .run import (
+    FLEET_TABLE,
+    MODELS_FOLDER,
+    FleetSettings,
+    FleetSummary,
+    UnitOutcome,
+    fit_fleet,
+    fit_unit,
+    model_file_name,
+)
 from .store import CalibrationRecord, CalibrationStore, InputFile, parse_time, store_url, utc_now
 from .devices import UnitRuns, expand_inputs, input_hash, units_from_manifest, units_from_pattern
 
-__all__ = ["AxisPrior", "PopulationPrior", "block_covariance", "comes_back", "fit_with_prior", "population_prior", "prior_from_models", "AxisFigures", "CalibrationRecord", "CalibrationStore", "FIGURE_NAMES", "FLEET_TABLE", "Failure",
-           "FleetSettings", "FleetSummary", "FleetYield", "InputFile", "Limit", "Limits", "MODELS_FOLDER",
-           "REFERENCE_TEMPERATURE_DEGC", "UnitFigures", "UnitOutcome", "UnitRuns", "Verdict", "expand_inputs",
-           "fit_fleet", "fit_unit", "fleet_table", "fleet_yield", "input_hash", "model_file_name", "parse_time", "robust_z", "store_url",
-           "units_from_manifest", "units_from_pattern", "unit_figures", "utc_now"]
+__all__ = [
+    "AxisPrior",
+    "PopulationPrior",
+    "block_covariance",
+    "comes_back",
+    "fit_with_prior",
+    "population_prior",
+    "prior_from_models",
+    "AxisFigures",
+    "CalibrationRecord",
+    "CalibrationStore",
+    "FIGURE_NAMES",
+    "FLEET_TABLE",
+    "Failure",
+    "FleetSettings",
+    "FleetSummary",
+    "FleetYield",
+    "InputFile",
+    "Limit",
+    "Limits",
+    "MODELS_FOLDER",
+    "REFERENCE_TEMPERATURE_DEGC",
+    "UnitFigures",
+    "UnitOutcome",
+    "UnitRuns",
+    "Verdict",
+    "expand_inputs",
+    "fit_fleet",
+    "fit_unit",
+    "fleet_table",
+    "fleet_yield",
+    "input_hash",
+    "model_file_name",
+    "parse_time",
+    "robust_z",
+    "store_url",
+    "units_from_manifest",
+    "units_from_pattern",
+    "unit_figures",
+    "utc_now",
+]

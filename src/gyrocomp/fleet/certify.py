@@ -17,11 +17,15 @@ def held_out_of(record: CalibrationRecord, read: ReadOptions | None = None, fmt:
         try:
             digest = content_hash(run.path)
         except OSError as exc:
-            raise InputError(f"{run.path}: a run of unit {record.serial!r} cannot be read ({exc.strerror or exc}); "
-                             "the certificate's residual needs the unit's runs") from None
+            raise InputError(
+                f"{run.path}: a run of unit {record.serial!r} cannot be read ({exc.strerror or exc}); "
+                "the certificate's residual needs the unit's runs"
+            ) from None
         if digest != run.sha256:
-            raise InputError(f"{run.path}: changed since unit {record.serial!r} was calibrated (SHA-256 "
-                             f"{digest[:12]}..., the store has {run.sha256[:12]}...)")
+            raise InputError(
+                f"{run.path}: changed since unit {record.serial!r} was calibrated (SHA-256 "
+                f"{digest[:12]}..., the store has {run.sha256[:12]}...)"
+            )
     recordings = [read_input(run.path, read or ReadOptions(), fmt=fmt).recording for run in record.inputs]
     return held_out_residuals(recordings)
 

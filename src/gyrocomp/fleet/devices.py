@@ -47,7 +47,7 @@ def pattern_regex(pattern: str) -> re.Pattern:
         raise InputError(f"unit_pattern: {pattern!r} names {{{repeated[0]}}} twice")
     parts, last = [], 0
     for m in _FIELD.finditer(pattern):
-        parts.append(re.escape(pattern[last:m.start()]))
+        parts.append(re.escape(pattern[last : m.start()]))
         parts.append(f"(?P<{m.group(1)}>[^/]+?)")
         last = m.end()
     parts.append(re.escape(pattern[last:]))
@@ -71,15 +71,20 @@ def units_from_pattern(paths: Iterable[str | os.PathLike], pattern: str) -> list
         groups.setdefault(fields.pop("serial"), []).append((os.fspath(path), fields))
     if unmatched:
         if not groups:
-            raise InputError(f"unit_pattern: {pattern!r} matches none of the {len(unmatched)} files "
-                             f"(e.g. {unmatched[0]})")
-        warnings.warn(f"unit_pattern: {len(unmatched)} file(s) do not match {pattern!r} and are left out "
-                      f"(e.g. {unmatched[0]})", DataQualityWarning, stacklevel=2)
+            raise InputError(
+                f"unit_pattern: {pattern!r} matches none of the {len(unmatched)} files (e.g. {unmatched[0]})"
+            )
+        warnings.warn(
+            f"unit_pattern: {len(unmatched)} file(s) do not match {pattern!r} and are left out (e.g. {unmatched[0]})",
+            DataQualityWarning,
+            stacklevel=2,
+        )
     # a field that differs between the runs of any unit names runs (``{n}``); the others describe units
     per_run = {k for runs in groups.values() for k in runs[0][1] if len({f[k] for _, f in runs}) > 1}
-    return [UnitRuns(serial, tuple(sorted(p for p, _ in runs)),
-                     {k: v for k, v in runs[0][1].items() if k not in per_run})
-            for serial, runs in sorted(groups.items())]
+    return [
+        UnitRuns(serial, tuple(sorted(p for p, _ in runs)), {k: v for k, v in runs[0][1].items() if k not in per_run})
+        for serial, runs in sorted(groups.items())
+    ]
 
 
 def units_from_manifest(path: str | os.PathLike) -> list[UnitRuns]:
@@ -94,8 +99,10 @@ def units_from_manifest(path: str | os.PathLike) -> list[UnitRuns]:
     table = pd.read_parquet(path) if fmt == "parquet" else pd.read_csv(path, dtype=str, keep_default_na=False)
     missing = [c for c in ("path", "serial") if c not in table.columns]
     if missing:
-        raise InputError(f"{path}: the manifest has no {missing[0]!r} column (it needs path and serial; "
-                         f"found {', '.join(map(str, table.columns))})")
+        raise InputError(
+            f"{path}: the manifest has no {missing[0]!r} column (it needs path and serial; "
+            f"found {', '.join(map(str, table.columns))})"
+        )
     groups: dict[str, list[tuple[str, dict[str, str]]]] = {}
     for i, row in enumerate(table.astype(str).to_dict("records")):
         where = f"{path}: row {i + 2 if fmt == 'csv' else i + 1}"
@@ -112,9 +119,13 @@ def units_from_manifest(path: str | os.PathLike) -> list[UnitRuns]:
         for key in runs[0][1]:
             values = {f[key] for _, f in runs}
             if len(values) > 1:
-                raise InputError(f"{path}: unit {serial}: column {key!r} differs between its runs "
-                                 f"({', '.join(sorted(values)[:3])}); metadata is per unit")
-    return [UnitRuns(serial, tuple(sorted(p for p, _ in runs)), dict(runs[0][1])) for serial, runs in sorted(groups.items())]
+                raise InputError(
+                    f"{path}: unit {serial}: column {key!r} differs between its runs "
+                    f"({', '.join(sorted(values)[:3])}); metadata is per unit"
+                )
+    return [
+        UnitRuns(serial, tuple(sorted(p for p, _ in runs)), dict(runs[0][1])) for serial, runs in sorted(groups.items())
+    ]
 
 
 def content_hash(path: str | os.PathLike) -> str:
@@ -142,5 +153,12 @@ def _folder_sha256(folder: Path) -> str:
     return digest.hexdigest()
 
 
-__all__ = ["UnitRuns", "content_hash", "expand_inputs", "input_hash", "pattern_regex", "units_from_manifest",
-           "units_from_pattern"]
+__all__ = [
+    "UnitRuns",
+    "content_hash",
+    "expand_inputs",
+    "input_hash",
+    "pattern_regex",
+    "units_from_manifest",
+    "units_from_pattern",
+]

@@ -148,8 +148,10 @@ def _figure_of(key: str, where: str) -> tuple[str, str | None]:
     for figure in FIGURE_NAMES:
         if key.endswith("_" + figure):
             return figure, key[: -len(figure) - 1]
-    raise InputError(f"{where}: unknown figure; use one of {', '.join(FIGURE_NAMES + UNIT_FIGURES)}, optionally "
-                     f"after an axis (gyro_z_...)")
+    raise InputError(
+        f"{where}: unknown figure; use one of {', '.join(FIGURE_NAMES + UNIT_FIGURES)}, optionally "
+        f"after an axis (gyro_z_...)"
+    )
 
 
 __all__ = ["BOUNDS", "Failure", "Limit", "Limits", "UNIT_FIGURES", "Verdict"]

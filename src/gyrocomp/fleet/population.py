@@ -34,16 +34,32 @@ from .store import CalibrationRecord
 OUTLIER_THRESHOLD = 3.5
 MIN_UNITS_FOR_OUTLIERS = 10
 #: figures a unit is scored on (see the module), by axis; the positive ones on their logarithm
-SCORED_FIGURES = ("held_out_drift_dps", "temperature_sensitivity_dps_per_degc", "bias_span_dps", "turn_on_bias_dps",
-                  "turn_on_repeatability_dps", "g_sensitivity_dps_per_g", "noise_density_dps_per_sqrt_hz",
-                  "bias_instability_deg_per_h")
+SCORED_FIGURES = (
+    "held_out_drift_dps",
+    "temperature_sensitivity_dps_per_degc",
+    "bias_span_dps",
+    "turn_on_bias_dps",
+    "turn_on_repeatability_dps",
+    "g_sensitivity_dps_per_g",
+    "noise_density_dps_per_sqrt_hz",
+    "bias_instability_deg_per_h",
+)
 _SIGNED = ("temperature_sensitivity_dps_per_degc", "turn_on_bias_dps")
 _UNIT_SCORED = ("temperature_min_degc", "temperature_max_degc")
 _MAD_SCALE = 0.6745
 _MEAN_AD_SCALE = 1.253314
 #: columns of the table that are not figures
-INFO_COLUMNS = ("serial", "status", "verdict", "failing", "calibrated_utc", "error", "outlier_score", "outlier",
-                "outlier_figures")
+INFO_COLUMNS = (
+    "serial",
+    "status",
+    "verdict",
+    "failing",
+    "calibrated_utc",
+    "error",
+    "outlier_score",
+    "outlier",
+    "outlier_figures",
+)
 
 
 def robust_z(values: np.ndarray) -> np.ndarray:
@@ -76,8 +92,9 @@ class FleetYield:
         return self.passed / self.units if self.units else math.nan
 
 
-def fleet_table(records: Sequence[CalibrationRecord], limits: Limits | None = None, *,
-                threshold: float = OUTLIER_THRESHOLD) -> pd.DataFrame:
+def fleet_table(
+    records: Sequence[CalibrationRecord], limits: Limits | None = None, *, threshold: float = OUTLIER_THRESHOLD
+) -> pd.DataFrame:
     """One row per unit: ``serial``, ``status`` (ok/failed), ``verdict`` (pass/fail by ``limits``, or the verdict
     stored with the calibration when no limits are given; empty for a failed fit), ``failing`` (the failing figures),
     ``calibrated_utc``, ``error``, ``outlier_score``, ``outlier``, ``outlier_figures`` and every figure
@@ -85,11 +102,16 @@ def fleet_table(records: Sequence[CalibrationRecord], limits: Limits | None = No
     rows = []
     for r in records:
         verdict = limits.check(r.figures) if (limits is not None and r.figures is not None) else None
-        row = {"serial": r.serial, "status": r.status,
-               "verdict": verdict.label if verdict is not None else (r.verdict or ""),
-               "failing": verdict.summary() if verdict is not None else "; ".join(f"{f.figure} {f.reason}"
-                                                                                 for f in r.failures),
-               "calibrated_utc": r.calibrated_utc, "error": r.error or ""}
+        row = {
+            "serial": r.serial,
+            "status": r.status,
+            "verdict": verdict.label if verdict is not None else (r.verdict or ""),
+            "failing": verdict.summary()
+            if verdict is not None
+            else "; ".join(f"{f.figure} {f.reason}" for f in r.failures),
+            "calibrated_utc": r.calibrated_utc,
+            "error": r.error or "",
+        }
         row.update(r.figures.as_row() if r.figures is not None else {})
         rows.append(row)
     table = pd.DataFrame(rows, columns=None if rows else list(INFO_COLUMNS[:6]))
@@ -98,14 +120,16 @@ def fleet_table(records: Sequence[CalibrationRecord], limits: Limits | None = No
     scored = [c for c in figures if c in _UNIT_SCORED or any(c.endswith("_" + f) for f in SCORED_FIGURES)]
     if int(ok.sum()) < MIN_UNITS_FOR_OUTLIERS:
         scored = []
-    scores = pd.DataFrame({c: _score(c, table[c].where(ok).to_numpy(dtype=float)) for c in scored},
-                          index=table.index)
+    scores = pd.DataFrame({c: _score(c, table[c].where(ok).to_numpy(dtype=float)) for c in scored}, index=table.index)
     magnitude = scores.abs()
     table["outlier_score"] = magnitude.max(axis=1, skipna=True).where(ok) if scored else np.nan
     table["outlier"] = (table["outlier_score"] > threshold).fillna(False).astype(bool)
     table["outlier_figures"] = [
         ", ".join(magnitude.loc[i][magnitude.loc[i] > threshold].sort_values(ascending=False).index)
-        if scored and ok[i] else "" for i in table.index]
+        if scored and ok[i]
+        else ""
+        for i in table.index
+    ]
     return table[[*INFO_COLUMNS, *figures]]
 
 
@@ -126,4 +150,13 @@ def fleet_yield(table: pd.DataFrame) -> FleetYield:
     return FleetYield(len(table), int(fitted.sum()), int(passed.sum()))
 
 
-__all__ = ["FleetYield", "INFO_COLUMNS", "MIN_UNITS_FOR_OUTLIERS", "OUTLIER_THRESHOLD", "SCORED_FIGURES", "fleet_table", "fleet_yield", "robust_z"]
+__all__ = [
+    "FleetYield",
+    "INFO_COLUMNS",
+    "MIN_UNITS_FOR_OUTLIERS",
+    "OUTLIER_THRESHOLD",
+    "SCORED_FIGURES",
+    "fleet_table",
+    "fleet_yield",
+    "robust_z",
+]

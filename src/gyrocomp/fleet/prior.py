@@ -106,26 +106,38 @@ class PopulationPrior:
     units: int
 
     def to_dict(self) -> dict:
-        return {"schema_version": PRIOR_SCHEMA_VERSION,
-                "axes": {a: {"mean_dps": list(p.mean_dps), "covariance_dps2": [list(r) for r in p.covariance_dps2],
-                             "lag_time_constant_s": p.lag_time_constant_s,
-                             "residual_drift_dps": p.residual_drift_dps,
-                             "noise_density_dps_per_sqrt_hz": p.noise_density_dps_per_sqrt_hz,
-                             "bias_instability_deg_per_h": p.bias_instability_deg_per_h,
-                             "rate_random_walk_dps_per_sqrt_s": p.rate_random_walk_dps_per_sqrt_s}
-                         for a, p in self.axes.items()},
-                "reference_temperature_degc": self.reference_temperature_degc,
-                "temperature_scale_degc": self.temperature_scale_degc,
-                "temperature_min_degc": self.temperature_min_degc,
-                "temperature_max_degc": self.temperature_max_degc, "units": self.units}
+        return {
+            "schema_version": PRIOR_SCHEMA_VERSION,
+            "axes": {
+                a: {
+                    "mean_dps": list(p.mean_dps),
+                    "covariance_dps2": [list(r) for r in p.covariance_dps2],
+                    "lag_time_constant_s": p.lag_time_constant_s,
+                    "residual_drift_dps": p.residual_drift_dps,
+                    "noise_density_dps_per_sqrt_hz": p.noise_density_dps_per_sqrt_hz,
+                    "bias_instability_deg_per_h": p.bias_instability_deg_per_h,
+                    "rate_random_walk_dps_per_sqrt_s": p.rate_random_walk_dps_per_sqrt_s,
+                }
+                for a, p in self.axes.items()
+            },
+            "reference_temperature_degc": self.reference_temperature_degc,
+            "temperature_scale_degc": self.temperature_scale_degc,
+            "temperature_min_degc": self.temperature_min_degc,
+            "temperature_max_degc": self.temperature_max_degc,
+            "units": self.units,
+        }
 
     def digest(self) -> str:
         """SHA-256 of the prior (part of the input hash of units fitted with it)."""
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()
 
 
-def population_prior(records: Sequence[CalibrationRecord], *, threshold: float = OUTLIER_THRESHOLD,
-                     reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC) -> PopulationPrior:
+def population_prior(
+    records: Sequence[CalibrationRecord],
+    *,
+    threshold: float = OUTLIER_THRESHOLD,
+    reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC,
+) -> PopulationPrior:
     """The prior of a calibrated fleet: its units' newest successful calibrations, outliers (robust score above
     ``threshold``) and units themselves fitted with a prior left out.
 
@@ -139,14 +151,17 @@ def population_prior(records: Sequence[CalibrationRecord], *, threshold: float =
         T_ref of the basis [degC].
     """
     # units fitted with a prior are shrunk towards it: they would narrow the next prior without new evidence
-    records = [r for r in records if r.figures is None
-               or all(math.isnan(f.curve_sd_dps) for f in r.figures.axes.values())]
+    records = [
+        r for r in records if r.figures is None or all(math.isnan(f.curve_sd_dps) for f in r.figures.axes.values())
+    ]
     table = fleet_table(records)
     keep = set(table.loc[(table["status"] == "ok") & ~table["outlier"], "serial"])
     good = [r for r in records if r.serial in keep and r.figures is not None and r.model_json is not None]
     if len(good) < MIN_UNITS_FOR_PRIOR:
-        raise InputError(f"prior: {len(good)} calibrated unit(s) that are not outliers; a population prior needs at "
-                         f"least {MIN_UNITS_FOR_PRIOR}")
+        raise InputError(
+            f"prior: {len(good)} calibrated unit(s) that are not outliers; a population prior needs at "
+            f"least {MIN_UNITS_FOR_PRIOR}"
+        )
     t_min = float(np.median([r.figures.temperature_min_degc for r in good]))
     t_max = float(np.median([r.figures.temperature_max_degc for r in good]))
     scale = max(abs(t_max - reference_temperature_degc), abs(t_min - reference_temperature_degc), 1.0)
@@ -154,8 +169,16 @@ def population_prior(records: Sequence[CalibrationRecord], *, threshold: float =
     axes = {}
     for axis in good[0].figures.axes:
         figures = [r.figures.axes[axis] for r in good if axis in r.figures.axes]
-        theta = np.array([[f.tempco_1_dps_per_degc * scale, f.tempco_2_dps_per_degc2 * scale ** 2,
-                           f.tempco_3_dps_per_degc3 * scale ** 3] for f in figures])
+        theta = np.array(
+            [
+                [
+                    f.tempco_1_dps_per_degc * scale,
+                    f.tempco_2_dps_per_degc2 * scale**2,
+                    f.tempco_3_dps_per_degc3 * scale**3,
+                ]
+                for f in figures
+            ]
+        )
         theta = theta[np.all(np.isfinite(theta), axis=1)]
         if theta.shape[0] < MIN_UNITS_FOR_PRIOR:
             continue
@@ -167,7 +190,8 @@ def population_prior(records: Sequence[CalibrationRecord], *, threshold: float =
             residual_drift_dps=float(np.nanmedian([f.held_out_drift_dps for f in figures])),
             noise_density_dps_per_sqrt_hz=float(np.nanmedian([f.noise_density_dps_per_sqrt_hz for f in figures])),
             bias_instability_deg_per_h=_median_or_zero([f.flicker_deg_per_h for f in figures]),
-            rate_random_walk_dps_per_sqrt_s=_median_or_zero([f.rate_random_walk_dps_per_sqrt_s for f in figures]))
+            rate_random_walk_dps_per_sqrt_s=_median_or_zero([f.rate_random_walk_dps_per_sqrt_s for f in figures]),
+        )
     if not axes:
         raise InputError("prior: no axis has a temperature curve in enough units")
     return PopulationPrior(axes, reference_temperature_degc, scale, t_min, t_max, len(good))
@@ -202,13 +226,23 @@ def prior_from_models(models: Sequence, like: PopulationPrior) -> PopulationPrio
         if axis not in like.axes:
             continue
         theta = np.linalg.lstsq(basis, curves[:, :, j].T, rcond=None)[0][1:].T  # the constant is each run's
-        axes[axis] = AxisPrior(tuple(map(float, theta.mean(axis=0))),
-                               tuple(tuple(map(float, row)) for row in np.cov(theta, rowvar=False)),
-                               float(first.thermal_time_constant_s), like.axes[axis].residual_drift_dps,
-                               float(first.noise_density_dps_per_sqrt_hz), float(first.bias_instability_deg_per_h),
-                               float(first.rate_random_walk_dps_per_sqrt_s))
-    return PopulationPrior(axes, like.reference_temperature_degc, like.temperature_scale_degc,
-                           like.temperature_min_degc, like.temperature_max_degc, len(models))
+        axes[axis] = AxisPrior(
+            tuple(map(float, theta.mean(axis=0))),
+            tuple(tuple(map(float, row)) for row in np.cov(theta, rowvar=False)),
+            float(first.thermal_time_constant_s),
+            like.axes[axis].residual_drift_dps,
+            float(first.noise_density_dps_per_sqrt_hz),
+            float(first.bias_instability_deg_per_h),
+            float(first.rate_random_walk_dps_per_sqrt_s),
+        )
+    return PopulationPrior(
+        axes,
+        like.reference_temperature_degc,
+        like.temperature_scale_degc,
+        like.temperature_min_degc,
+        like.temperature_max_degc,
+        len(models),
+    )
 
 
 def _median_or_zero(values: list[float]) -> float:
@@ -231,8 +265,9 @@ def _blocks(recording: Recording, axis: str, lag_s: float, block_s: float):
     return mean_rate, mean_temperature, counts[used] / recording.rate_hz
 
 
-def fit_with_prior(recordings: Sequence[Recording] | Recording, prior: PopulationPrior, *,
-                   block_s: float = PRIOR_BLOCK_S) -> Calibration:
+def fit_with_prior(
+    recordings: Sequence[Recording] | Recording, prior: PopulationPrior, *, block_s: float = PRIOR_BLOCK_S
+) -> Calibration:
     """A unit's calibration from (short) runs and its population's prior (see the module).
 
     Parameters
@@ -257,9 +292,13 @@ def fit_with_prior(recordings: Sequence[Recording] | Recording, prior: Populatio
         raise InputError(f"block_s: must be positive, got {block_s}")
     if not any(comes_back(rec.temperature_degc) for rec in recordings):
         names = ", ".join(str(rec.source) for rec in recordings)
-        warnings.warn(f"recordings: the temperature only rises or only falls in every run ({names}): slow drift "
-                      "cannot be told from the temperature curve; a run that comes back (cold, hot, cold) tells "
-                      "them apart", DataQualityWarning, stacklevel=2)
+        warnings.warn(
+            f"recordings: the temperature only rises or only falls in every run ({names}): slow drift "
+            "cannot be told from the temperature curve; a run that comes back (cold, hot, cold) tells "
+            "them apart",
+            DataQualityWarning,
+            stacklevel=2,
+        )
     axes, report = {}, {}
     for axis, p in prior.axes.items():
         if not all(axis in rec.gyro_axes for rec in recordings):
@@ -268,8 +307,12 @@ def fit_with_prior(recordings: Sequence[Recording] | Recording, prior: Populatio
     if not axes:
         raise InputError(f"recordings: none of the prior's axes ({', '.join(prior.axes)}) is in every run")
     name = f"population prior ({prior.units} units): cubic in the lagged temperature, constant per run"
-    return Calibration(axes=axes, model=name, provenance=provenance(recordings),
-                       fit_report={"temperature": "population prior", "prior": report})
+    return Calibration(
+        axes=axes,
+        model=name,
+        provenance=provenance(recordings),
+        fit_report={"temperature": "population prior", "prior": report},
+    )
 
 
 def comes_back(temperature_degc: np.ndarray) -> bool:
@@ -283,41 +326,46 @@ def comes_back(temperature_degc: np.ndarray) -> bool:
     return span > 0 and find_turns(t, span / 2).turn_index.size > 0
 
 
-def block_covariance(duration_s: np.ndarray, noise_density_dps_per_sqrt_hz: float,
-                     bias_instability_deg_per_h: float, rate_random_walk_dps_per_sqrt_s: float = 0.0) -> np.ndarray:
+def block_covariance(
+    duration_s: np.ndarray,
+    noise_density_dps_per_sqrt_hz: float,
+    bias_instability_deg_per_h: float,
+    rate_random_walk_dps_per_sqrt_s: float = 0.0,
+) -> np.ndarray:
     """Covariance [(deg/s)^2] of the means of consecutive blocks of ``duration_s`` [s] from the start of a run,
     under white noise of density N [deg/s/sqrt(Hz)], flicker of bias instability B [deg/h] and a rate random walk
     K [deg/s/sqrt(s)] from the run's start (see the module)."""
     length = np.asarray(duration_s, dtype=float)
     centre = np.cumsum(length) - length / 2
-    cov = np.diag(noise_density_dps_per_sqrt_hz ** 2 / length)
+    cov = np.diag(noise_density_dps_per_sqrt_hz**2 / length)
     if rate_random_walk_dps_per_sqrt_s > 0:
         # W(t) of variance K^2 t: cov(W(s), W(t)) = K^2 min(s, t); averaged over two disjoint blocks, K^2 times the
         # earlier block's centre; over one block [a, a + L], K^2 (a + L / 3)
         walk = np.minimum(centre[:, None], centre[None, :])
         np.fill_diagonal(walk, centre - length / 2 + length / 3)
-        cov = cov + rate_random_walk_dps_per_sqrt_s ** 2 * walk
+        cov = cov + rate_random_walk_dps_per_sqrt_s**2 * walk
     b_dps = bias_instability_deg_per_h / DEG_PER_S_TO_DEG_PER_H
     if b_dps <= 0:
         return cov
-    variance = b_dps ** 2 * math.log(_FLICKER_RATIO) / math.pi
+    variance = b_dps**2 * math.log(_FLICKER_RATIO) / math.pi
     shortest, longest = float(length.min()) / 20, 20 * float(length.sum())
     count = int(math.ceil(math.log(longest / shortest) / math.log(_FLICKER_RATIO))) + 1
     gap = np.abs(centre[:, None] - centre[None, :])
     for k in range(count):
-        tc = shortest * _FLICKER_RATIO ** k
+        tc = shortest * _FLICKER_RATIO**k
         x = length / (2 * tc)
         # log((2T/L) sinh(L/2T)), computed without overflow
         log_shape = x + np.log1p(-np.exp(-2 * x)) - np.log(2 * x)
         off = variance * np.exp(log_shape[:, None] + log_shape[None, :] - gap / tc)
         r = length / tc
-        np.fill_diagonal(off, variance * 2 * (r - 1 + np.exp(-r)) / r ** 2)
+        np.fill_diagonal(off, variance * 2 * (r - 1 + np.exp(-r)) / r**2)
         cov = cov + off
     return cov
 
 
-def _map(design: np.ndarray, y: np.ndarray, noise: np.ndarray, precision: np.ndarray,
-         prior_mean: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+def _map(
+    design: np.ndarray, y: np.ndarray, noise: np.ndarray, precision: np.ndarray, prior_mean: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, float]:
     """MAP coefficients, their posterior covariance and the noise inflation: when the residuals scatter more than
     the noise model says (Birge ratio r' C^-1 r / (n - p) above 1), C is scaled up by it and the fit repeated, so
     that a unit noisier than its population gets wider uncertainties rather than false confidence."""
@@ -335,8 +383,9 @@ def _map(design: np.ndarray, y: np.ndarray, noise: np.ndarray, precision: np.nda
     return beta, np.linalg.inv(normal), inflation
 
 
-def _fit_axis(recordings: list[Recording], axis: str, p: AxisPrior, prior: PopulationPrior,
-              block_s: float) -> tuple[AxisCalibration, dict]:
+def _fit_axis(
+    recordings: list[Recording], axis: str, p: AxisPrior, prior: PopulationPrior, block_s: float
+) -> tuple[AxisCalibration, dict]:
     runs = len(recordings)
     ys, us, columns, covariances = [], [], [], []
     for r, rec in enumerate(recordings):
@@ -344,14 +393,20 @@ def _fit_axis(recordings: list[Recording], axis: str, p: AxisPrior, prior: Popul
         ys.append(rate)
         us.append((temperature - prior.reference_temperature_degc) / prior.temperature_scale_degc)
         columns.append(np.full(rate.size, r))
-        covariances.append(block_covariance(duration_s, p.noise_density_dps_per_sqrt_hz, p.bias_instability_deg_per_h,
-                                            p.rate_random_walk_dps_per_sqrt_s))
+        covariances.append(
+            block_covariance(
+                duration_s,
+                p.noise_density_dps_per_sqrt_hz,
+                p.bias_instability_deg_per_h,
+                p.rate_random_walk_dps_per_sqrt_s,
+            )
+        )
     y, u, run = (np.concatenate(v) for v in (ys, us, columns))
-    design = np.column_stack([(run[:, None] == np.arange(runs)).astype(float), *(u ** k for k in range(1, _ORDER + 1))])
+    design = np.column_stack([(run[:, None] == np.arange(runs)).astype(float), *(u**k for k in range(1, _ORDER + 1))])
     noise = np.zeros((y.size, y.size))
     start = 0
     for c in covariances:
-        noise[start:start + c.shape[0], start:start + c.shape[0]] = c
+        noise[start : start + c.shape[0], start : start + c.shape[0]] = c
         start += c.shape[0]
     covariance = np.asarray(p.covariance_dps2, dtype=float)
     covariance = covariance + np.eye(_ORDER) * _JITTER * max(float(np.max(np.diag(covariance))), 1e-30)
@@ -362,16 +417,37 @@ def _fit_axis(recordings: list[Recording], axis: str, p: AxisPrior, prior: Popul
     posterior = posterior[runs:, runs:]
     grid = np.linspace(prior.temperature_min_degc, prior.temperature_max_degc, 91)
     g = (grid - prior.reference_temperature_degc) / prior.temperature_scale_degc
-    basis = np.column_stack([g ** k for k in range(1, _ORDER + 1)])
+    basis = np.column_stack([g**k for k in range(1, _ORDER + 1)])
     curve_sd = np.sqrt(np.einsum("ij,jk,ik->i", basis, posterior, basis))
-    curve = PolynomialCurve(tuple(map(float, beta[runs:])), prior.reference_temperature_degc,
-                           prior.temperature_scale_degc, prior.temperature_min_degc, prior.temperature_max_degc)
+    curve = PolynomialCurve(
+        tuple(map(float, beta[runs:])),
+        prior.reference_temperature_degc,
+        prior.temperature_scale_degc,
+        prior.temperature_min_degc,
+        prior.temperature_max_degc,
+    )
     calibrated = AxisCalibration(curve, tuple(map(float, beta[:runs])), lag_time_constant_s=p.lag_time_constant_s)
-    seen = (float(np.min(u)) * prior.temperature_scale_degc + prior.reference_temperature_degc,
-            float(np.max(u)) * prior.temperature_scale_degc + prior.reference_temperature_degc)
-    return calibrated, {"curve_sd_max_dps": float(curve_sd.max()), "blocks": int(y.size),
-                        "seen_degc": list(seen), "noise_inflation": inflation, "posterior_sd_dps": [math.sqrt(v) for v in np.diag(posterior)]}
+    seen = (
+        float(np.min(u)) * prior.temperature_scale_degc + prior.reference_temperature_degc,
+        float(np.max(u)) * prior.temperature_scale_degc + prior.reference_temperature_degc,
+    )
+    return calibrated, {
+        "curve_sd_max_dps": float(curve_sd.max()),
+        "blocks": int(y.size),
+        "seen_degc": list(seen),
+        "noise_inflation": inflation,
+        "posterior_sd_dps": [math.sqrt(v) for v in np.diag(posterior)],
+    }
 
 
-__all__ = ["MIN_UNITS_FOR_PRIOR", "PRIOR_BLOCK_S", "AxisPrior", "PopulationPrior", "block_covariance", "comes_back",
-           "fit_with_prior", "population_prior", "prior_from_models"]
+__all__ = [
+    "MIN_UNITS_FOR_PRIOR",
+    "PRIOR_BLOCK_S",
+    "AxisPrior",
+    "PopulationPrior",
+    "block_covariance",
+    "comes_back",
+    "fit_with_prior",
+    "population_prior",
+    "prior_from_models",
+]

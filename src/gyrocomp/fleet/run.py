@@ -102,10 +102,15 @@ class FleetSettings:
 
     def fingerprint(self) -> dict:
         """What of the settings changes a unit's model (part of its input hash)."""
-        return {"channels": list(self.channels), "pipeline": self.pipeline, "read": repr(self.read),
-                "fmt": self.fmt, "reference_temperature_degc": self.reference_temperature_degc,
-                "prior": None if self.prior is None else self.prior.digest(),
-                **({"accept": sorted(self.accept)} if self.accept else {})}
+        return {
+            "channels": list(self.channels),
+            "pipeline": self.pipeline,
+            "read": repr(self.read),
+            "fmt": self.fmt,
+            "reference_temperature_degc": self.reference_temperature_degc,
+            "prior": None if self.prior is None else self.prior.digest(),
+            **({"accept": sorted(self.accept)} if self.accept else {}),
+        }
 
 
 @dataclass(frozen=True)
@@ -166,8 +171,9 @@ def fit_unit(unit: UnitRuns, settings: FleetSettings, known_hash: str | None = N
                 calibration = fit_with_prior(recordings, settings.prior)
             else:
                 calibration = fit(recordings, channels=settings.channels, pipeline=settings.pipeline)
-            figures = unit_figures(calibration, recordings,
-                                   reference_temperature_degc=settings.reference_temperature_degc)
+            figures = unit_figures(
+                calibration, recordings, reference_temperature_degc=settings.reference_temperature_degc
+            )
             warn_findings(checks)  # after the fit's own warnings, which say more of this unit's model
         except Exception as exc:  # noqa: BLE001 - one unit's failure, whatever it is, must not stop the fleet
             return UnitOutcome(unit.serial, "failed", digest, inputs, error=_error_text(exc))
@@ -181,10 +187,19 @@ def _error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}"
 
 
-def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: FleetSettings | None = None, *,
-              limits: Limits | None = None, scheduler: str = "local", workers: int | None = None,
-              memory_limit: str | int = "auto", store: str | os.PathLike | None = None,
-              progress: Callable[[int, int], None] | None = None, station: str | None = None) -> FleetSummary:
+def fit_fleet(
+    units: Iterable[UnitRuns],
+    output: str | os.PathLike,
+    settings: FleetSettings | None = None,
+    *,
+    limits: Limits | None = None,
+    scheduler: str = "local",
+    workers: int | None = None,
+    memory_limit: str | int = "auto",
+    store: str | os.PathLike | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    station: str | None = None,
+) -> FleetSummary:
     """Fit every unit (see the module) and write the fleet's outputs into the folder ``output``.
 
     Parameters
@@ -225,19 +240,30 @@ def fit_fleet(units: Iterable[UnitRuns], output: str | os.PathLike, settings: Fl
     units = [replace(u, paths=tuple(os.path.abspath(p) for p in u.paths)) for u in units]
     tally = _Tally()
     started = utc_now()
-    with CalibrationStore(store if store is not None else output, create=True) as db, \
-            running_as(db, Station.here(station)) as me:
+    with (
+        CalibrationStore(store if store is not None else output, create=True) as db,
+        running_as(db, Station.here(station)) as me,
+    ):
         by_serial = {u.serial: u for u in units}
-        for done, outcome in enumerate(_outcomes(_claimed(units, db, me), settings, scheduler, workers,
-                                                 memory_limit), 1):
+        for done, outcome in enumerate(
+            _outcomes(_claimed(units, db, me), settings, scheduler, workers, memory_limit), 1
+        ):
             _keep(outcome, by_serial[outcome.serial], limits, output, db, started, tally, me)
             release(db, outcome.serial, me)
             if progress is not None:
                 progress(done, len(units))
         table = write_fleet_table(db, output / FLEET_TABLE, limits)
-    return FleetSummary(tuple(tally.fitted), tuple(tally.unchanged), tally.failed, tuple(tally.passed),
-                        tuple(tally.rejected), store=os.fspath(store if store is not None else output), table=table,
-                        warned=tally.warned, busy=tally.busy)
+    return FleetSummary(
+        tuple(tally.fitted),
+        tuple(tally.unchanged),
+        tally.failed,
+        tuple(tally.passed),
+        tuple(tally.rejected),
+        store=os.fspath(store if store is not None else output),
+        table=table,
+        warned=tally.warned,
+        busy=tally.busy,
+    )
 
 
 @dataclass(frozen=True)
@@ -258,13 +284,30 @@ def _claimed(units: list[UnitRuns], db: CalibrationStore, me: Station) -> Iterat
         if holder is None:
             yield _Claimed(unit, db.ok_hash(unit.serial))
         else:
-            yield _Claimed(unit, busy=UnitOutcome(unit.serial, "busy", "", error=(
-                f"station {holder.station} ({holder.host}, process {holder.pid}) has been fitting it since "
-                f"{holder.claimed_utc:%Y-%m-%d %H:%M:%S} UTC")))
+            yield _Claimed(
+                unit,
+                busy=UnitOutcome(
+                    unit.serial,
+                    "busy",
+                    "",
+                    error=(
+                        f"station {holder.station} ({holder.host}, process {holder.pid}) has been fitting it since "
+                        f"{holder.claimed_utc:%Y-%m-%d %H:%M:%S} UTC"
+                    ),
+                ),
+            )
 
 
-def _keep(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, output: Path, db: CalibrationStore,
-          started, tally: "_Tally", me: Station) -> None:
+def _keep(
+    outcome: UnitOutcome,
+    unit: UnitRuns,
+    limits: Limits | None,
+    output: Path,
+    db: CalibrationStore,
+    started,
+    tally: "_Tally",
+    me: Station,
+) -> None:
     """Store one unit's outcome with its model file (:func:`_store_with_model`); a unit another fit stored from
     the same inputs since ``started`` counts as unchanged; an unchanged unit's missing model file is put back."""
     if outcome.status == "busy":
@@ -275,8 +318,11 @@ def _keep(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, output: P
         _repair_model(output, db, outcome.serial)
         return
     record = _record(outcome, unit, limits, me.name)
-    stored = (_store_with_model(db, record, started, output) if record.status == "ok"
-              else db.add_new(record, since=started, stamp=True))
+    stored = (
+        _store_with_model(db, record, started, output)
+        if record.status == "ok"
+        else db.add_new(record, since=started, stamp=True)
+    )
     if stored is None:
         tally.unchanged.append(outcome.serial)
     else:
@@ -346,8 +392,9 @@ def _check_units(units: list[UnitRuns]) -> None:
 IN_FLIGHT_PER_THREAD = 4
 
 
-def _outcomes(claimed: Iterator[_Claimed], settings: FleetSettings, scheduler: str, workers: int | None,
-              memory_limit: str | int) -> Iterator[UnitOutcome]:
+def _outcomes(
+    claimed: Iterator[_Claimed], settings: FleetSettings, scheduler: str, workers: int | None, memory_limit: str | int
+) -> Iterator[UnitOutcome]:
     """Each unit's outcome as it finishes (a busy unit's at once)."""
     if scheduler == "serial":
         for item in claimed:
@@ -368,8 +415,14 @@ def _outcomes(claimed: Iterator[_Claimed], settings: FleetSettings, scheduler: s
                 if item.busy is not None:
                     busy.append(item.busy)
                     continue
-                future = client.submit(fit_unit, item.unit, settings, item.known_hash, pure=False,
-                                       key=f"gyrocomp-fit-{_safe_name(item.unit.serial)}-{os.getpid()}-{id(item)}")
+                future = client.submit(
+                    fit_unit,
+                    item.unit,
+                    settings,
+                    item.known_hash,
+                    pure=False,
+                    key=f"gyrocomp-fit-{_safe_name(item.unit.serial)}-{os.getpid()}-{id(item)}",
+                )
                 futures[future] = item.unit
                 running.add(future)
             return busy
@@ -381,8 +434,11 @@ def _outcomes(claimed: Iterator[_Claimed], settings: FleetSettings, scheduler: s
                 yield future.result()
             else:  # the worker died (memory limit, a crash): the unit fails, the fleet goes on
                 exc = future.exception()
-                why = ("its worker was killed on every try (past its memory limit, or a crash): "
-                       if type(exc).__name__ == "KilledWorker" else "")
+                why = (
+                    "its worker was killed on every try (past its memory limit, or a crash): "
+                    if type(exc).__name__ == "KilledWorker"
+                    else ""
+                )
                 yield UnitOutcome(unit.serial, "failed", "", error=why + _error_text(exc))
             future.release()
             yield from top_up()
@@ -420,9 +476,11 @@ def _require_descriptors(workers: int) -> None:
     soft, _ = resource.getrlimit(resource.RLIMIT_NOFILE)
     needed = DESCRIPTORS_BASE + DESCRIPTORS_PER_WORKER * workers
     if soft != resource.RLIM_INFINITY and soft < needed:
-        raise InputError(f"scheduler: local: this process may open {soft} files at once (ulimit -n), and a local "
-                         f"Dask cluster of {workers} worker(s) needs about {needed}: raise the limit, use fewer "
-                         "workers, or the serial scheduler, which fits without Dask")
+        raise InputError(
+            f"scheduler: local: this process may open {soft} files at once (ulimit -n), and a local "
+            f"Dask cluster of {workers} worker(s) needs about {needed}: raise the limit, use fewer "
+            "workers, or the serial scheduler, which fits without Dask"
+        )
 
 
 def _cluster_error(exc: BaseException) -> InputError:
@@ -439,8 +497,9 @@ def _cluster_error(exc: BaseException) -> InputError:
         why = "not enough memory or threads for the workers; run with fewer workers or a lower memory limit"
     else:
         why = f"{causes[0][:160]}"
-    return InputError(f"scheduler: local: the Dask workers did not start ({why}); the serial scheduler fits "
-                      "without Dask")
+    return InputError(
+        f"scheduler: local: the Dask workers did not start ({why}); the serial scheduler fits without Dask"
+    )
 
 
 def _quiet_worker() -> None:
@@ -472,14 +531,22 @@ def _client(distributed, scheduler: str, workers: int | None, memory_limit: str 
         config = require("dask.config", "fleet", "fitting a fleet on Dask")
         # Dask's statistical profiler samples every task's stack every 10 ms: 10 % of a fleet's time on 2 cores
         with _quiet_dask():
-            with warnings.catch_warnings(), config.set({"distributed.worker.profile.enabled": False,
-                                                  "distributed.scheduler.worker-saturation": 1.0}), \
-                    _workers_deaf_to_the_terminal():
+            with (
+                warnings.catch_warnings(),
+                config.set(
+                    {"distributed.worker.profile.enabled": False, "distributed.scheduler.worker-saturation": 1.0}
+                ),
+                _workers_deaf_to_the_terminal(),
+            ):
                 warnings.simplefilter("ignore")  # Dask's notes on ports and the dashboard are not the user's concern
                 try:
-                    cluster = distributed.LocalCluster(n_workers=workers or os.cpu_count() or 1,
-                                                       threads_per_worker=1, processes=True,
-                                                       memory_limit=memory_limit, dashboard_address=None)
+                    cluster = distributed.LocalCluster(
+                        n_workers=workers or os.cpu_count() or 1,
+                        threads_per_worker=1,
+                        processes=True,
+                        memory_limit=memory_limit,
+                        dashboard_address=None,
+                    )
                 except Exception as exc:  # noqa: BLE001 - Dask wraps the cause (files, memory) in its own errors
                     raise _cluster_error(exc) from None
             with cluster, distributed.Client(cluster) as client:
@@ -499,8 +566,7 @@ def _check_reachable(address: str) -> None:
     m = re.fullmatch(r"(?:tcp://)?\[?([^\]\s]+?)\]?:(\d+)", address.strip())
     if m is None:
         if "://" not in address:
-            raise InputError(f"scheduler: {address!r}; use local, serial or a Dask scheduler address "
-                             f"(tcp://host:8786)")
+            raise InputError(f"scheduler: {address!r}; use local, serial or a Dask scheduler address (tcp://host:8786)")
         return  # another protocol (tls://, ucx://, inproc://): Dask connects and reports
     try:
         socket.create_connection((m.group(1), int(m.group(2))), timeout=10).close()
@@ -513,11 +579,21 @@ def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, station
     if outcome.status == "ok" and limits is not None:
         verdict = limits.check(outcome.figures)
     return CalibrationRecord(
-        serial=outcome.serial, calibrated_utc=utc_now(), status="ok" if outcome.status == "ok" else "failed",
-        input_hash=outcome.input_hash, gyrocomp_version=__version__, inputs=outcome.inputs,
-        metadata=dict(unit.metadata), verdict=None if verdict is None else verdict.label,
-        failures=() if verdict is None else verdict.failures, model_json=outcome.model_json,
-        figures=outcome.figures, error=outcome.error, warnings=outcome.warnings, station=station)
+        serial=outcome.serial,
+        calibrated_utc=utc_now(),
+        status="ok" if outcome.status == "ok" else "failed",
+        input_hash=outcome.input_hash,
+        gyrocomp_version=__version__,
+        inputs=outcome.inputs,
+        metadata=dict(unit.metadata),
+        verdict=None if verdict is None else verdict.label,
+        failures=() if verdict is None else verdict.failures,
+        model_json=outcome.model_json,
+        figures=outcome.figures,
+        error=outcome.error,
+        warnings=outcome.warnings,
+        station=station,
+    )
 
 
 #: the longest serial kept whole in a model file's name [characters]
@@ -537,7 +613,7 @@ def model_file_name(serial: str) -> str:
 
 def _safe_name(serial: str) -> str:
     """A Dask key part for a serial (file names: :func:`model_file_name`)."""
-    return model_file_name(serial)[:-len(".json")]
+    return model_file_name(serial)[: -len(".json")]
 
 
 def _write_model(output: Path, serial: str, model_json: str) -> None:
@@ -553,8 +629,10 @@ def _write_model(output: Path, serial: str, model_json: str) -> None:
 
 def _model_write_error(path: Path, serial: str, exc: OSError) -> InputError:
     """The one line for a unit's model file that could not be written (nothing is stored for the unit)."""
-    return InputError(f"{path}: cannot write unit {serial!r}'s model ({exc.strerror or exc}); nothing was stored "
-                      "for it, the next run fits it again")
+    return InputError(
+        f"{path}: cannot write unit {serial!r}'s model ({exc.strerror or exc}); nothing was stored "
+        "for it, the next run fits it again"
+    )
 
 
 def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
@@ -575,12 +653,18 @@ def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
         try:  # a row another program damaged is no model to write back: said, the file left as it is
             ok[-1].calibration()
         except GyrocompError as exc:
-            raise InputError(f"{db.location}: {exc}; {path} is left as it is (refit the unit into a new store, or "
-                             "restore the store from a copy)") from None
+            raise InputError(
+                f"{db.location}: {exc}; {path} is left as it is (refit the unit into a new store, or "
+                "restore the store from a copy)"
+            ) from None
         _write_model(output, serial, ok[-1].model_json)
         if present is not None:
-            warnings.warn(f"{path}: differed from unit {serial!r}'s newest calibration in the store (row "
-                          f"{ok[-1].id}); written again from the store", DataQualityWarning, stacklevel=2)
+            warnings.warn(
+                f"{path}: differed from unit {serial!r}'s newest calibration in the store (row "
+                f"{ok[-1].id}); written again from the store",
+                DataQualityWarning,
+                stacklevel=2,
+            )
 
 
 def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None) -> Path:
@@ -591,4 +675,13 @@ def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None
     return path
 
 
-__all__ = ["FLEET_TABLE", "MODELS_FOLDER", "FleetSettings", "model_file_name", "FleetSummary", "UnitOutcome", "fit_fleet", "fit_unit"]
+__all__ = [
+    "FLEET_TABLE",
+    "MODELS_FOLDER",
+    "FleetSettings",
+    "model_file_name",
+    "FleetSummary",
+    "UnitOutcome",
+    "fit_fleet",
+    "fit_unit",
+]

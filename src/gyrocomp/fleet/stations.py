@@ -88,9 +88,16 @@ def claim(db: CalibrationStore, serial: str, me: Station) -> Claim | None:
                 holder = Claim(**held)
                 if (holder.host, holder.pid) != (me.host, me.pid) and not holder.stale(now, me.host):
                     return holder
-                taken = conn.execute(CLAIMS.update().where(  # take it over, unless another station did since
-                    (CLAIMS.c.serial == serial) & (CLAIMS.c.host == holder.host) & (CLAIMS.c.pid == holder.pid)
-                    & (CLAIMS.c.heartbeat_utc == holder.heartbeat_utc)).values(**mine)).rowcount
+                taken = conn.execute(
+                    CLAIMS.update()
+                    .where(  # take it over, unless another station did since
+                        (CLAIMS.c.serial == serial)
+                        & (CLAIMS.c.host == holder.host)
+                        & (CLAIMS.c.pid == holder.pid)
+                        & (CLAIMS.c.heartbeat_utc == holder.heartbeat_utc)
+                    )
+                    .values(**mine)
+                ).rowcount
                 if taken == 1:
                     return None
         except sa.exc.IntegrityError:
@@ -105,15 +112,17 @@ def claim(db: CalibrationStore, serial: str, me: Station) -> Claim | None:
 def release(db: CalibrationStore, serial: str, me: Station) -> None:
     """Release ``me``'s claim of ``serial`` (nothing when it holds none)."""
     with db.transaction() as conn:
-        conn.execute(CLAIMS.delete().where((CLAIMS.c.serial == serial) & (CLAIMS.c.host == me.host)
-                                           & (CLAIMS.c.pid == me.pid)))
+        conn.execute(
+            CLAIMS.delete().where((CLAIMS.c.serial == serial) & (CLAIMS.c.host == me.host) & (CLAIMS.c.pid == me.pid))
+        )
 
 
 def renew(db: CalibrationStore, me: Station) -> None:
     """Renew the heartbeat of every claim of ``me``."""
     with db.transaction() as conn:
-        conn.execute(CLAIMS.update().where((CLAIMS.c.host == me.host) & (CLAIMS.c.pid == me.pid))
-                     .values(heartbeat_utc=utc_now()))
+        conn.execute(
+            CLAIMS.update().where((CLAIMS.c.host == me.host) & (CLAIMS.c.pid == me.pid)).values(heartbeat_utc=utc_now())
+        )
 
 
 def claims(db: CalibrationStore) -> list[Claim]:
@@ -172,11 +181,29 @@ def station_status(db: CalibrationStore) -> list[StationStatus]:
         counts = {status: (n, last) for station_name, status, n, last in rows if station_name == name}
         mine = [c for c in held if c.station == name]
         lasts = [last for _n, last in counts.values() if last is not None]
-        out.append(StationStatus(name if name is not None else "(none)", counts.get("ok", (0, None))[0],
-                                 counts.get("failed", (0, None))[0], max(lasts) if lasts else None,
-                                 tuple(c.serial for c in mine), sum(c.stale(now, host) for c in mine)))
+        out.append(
+            StationStatus(
+                name if name is not None else "(none)",
+                counts.get("ok", (0, None))[0],
+                counts.get("failed", (0, None))[0],
+                max(lasts) if lasts else None,
+                tuple(c.serial for c in mine),
+                sum(c.stale(now, host) for c in mine),
+            )
+        )
     return out
 
 
-__all__ = ["CLAIM_LEASE_S", "CLAIM_RENEW_S", "Claim", "Station", "StationStatus", "claim", "claims", "release",
-           "renew", "station", "station_status"]
+__all__ = [
+    "CLAIM_LEASE_S",
+    "CLAIM_RENEW_S",
+    "Claim",
+    "Station",
+    "StationStatus",
+    "claim",
+    "claims",
+    "release",
+    "renew",
+    "station",
+    "station_status",
+]

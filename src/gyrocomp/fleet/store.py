@@ -48,10 +48,15 @@ STORE_SCHEMA_VERSION = 2
 _SQLITE_SUFFIXES = (".sqlite", ".sqlite3", ".db")
 
 _META = sa.MetaData()
-_INFO = sa.Table("gyrocomp_store", _META, sa.Column("key", sa.String(64), primary_key=True),
-                 sa.Column("value", sa.String(256), nullable=False))
+_INFO = sa.Table(
+    "gyrocomp_store",
+    _META,
+    sa.Column("key", sa.String(64), primary_key=True),
+    sa.Column("value", sa.String(256), nullable=False),
+)
 _ROWS = sa.Table(
-    "calibrations", _META,
+    "calibrations",
+    _META,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("serial", sa.Text, nullable=False, index=True),  # any length: PostgreSQL enforces a VARCHAR's
     sa.Column("calibrated_utc", sa.DateTime, nullable=False, index=True),
@@ -77,7 +82,8 @@ _VERSION = sa.select(_INFO.c.value).where(_INFO.c.key == "schema_version")
 _READ = [c for c in _ROWS.c if c.name not in ("station", "supersedes")]
 #: which station fits which unit now (:mod:`gyrocomp.fleet.stations`)
 CLAIMS = sa.Table(
-    "claims", _META,
+    "claims",
+    _META,
     sa.Column("serial", sa.Text, primary_key=True),
     sa.Column("station", sa.Text, nullable=False),
     sa.Column("host", sa.Text, nullable=False),
@@ -120,8 +126,10 @@ class CalibrationRecord:
     def calibration(self) -> Calibration:
         """The model, validated (and upgraded) as a model file is on load."""
         if self.model_json is None:
-            raise ModelError(f"unit {self.serial}: the calibration of {self.calibrated_utc:%Y-%m-%d %H:%M:%S} "
-                             f"failed ({self.error}); it has no model")
+            raise ModelError(
+                f"unit {self.serial}: the calibration of {self.calibrated_utc:%Y-%m-%d %H:%M:%S} "
+                f"failed ({self.error}); it has no model"
+            )
         source = f"store row {self.id} ({self.serial})"
         return Calibration.from_dict(loads(self.model_json, source, "model", non_finite=True), source=source)
 
@@ -137,10 +145,11 @@ def parse_time(text: str, name: str = "at") -> _dt.datetime:
     try:
         value = _dt.datetime.fromisoformat(text.strip())
     except ValueError:
-        raise InputError(f"{name}: {text!r} is not an ISO 8601 date or time (e.g. 2026-11-24 or "
-                         f"2026-11-24T10:30:00Z)") from None
+        raise InputError(
+            f"{name}: {text!r} is not an ISO 8601 date or time (e.g. 2026-11-24 or 2026-11-24T10:30:00Z)"
+        ) from None
     if len(text.strip()) <= 10:  # the end of that day (the last day there is: its last microsecond)
-        value = (_dt.datetime.combine(value.date(), _dt.time.max, value.tzinfo))
+        value = _dt.datetime.combine(value.date(), _dt.time.max, value.tzinfo)
     if value.tzinfo is not None:
         value = value.astimezone(_dt.timezone.utc).replace(tzinfo=None)
     return value
@@ -151,7 +160,7 @@ def store_url(location: str | os.PathLike) -> str:
     text = os.fspath(location)
     if "://" in text:
         if text.startswith("postgresql://") and find_spec("psycopg2") is None and find_spec("psycopg") is not None:
-            return "postgresql+psycopg://" + text[len("postgresql://"):]  # SQLAlchemy's default driver is psycopg2
+            return "postgresql+psycopg://" + text[len("postgresql://") :]  # SQLAlchemy's default driver is psycopg2
         return text
     path = sqlite_file(text)
     return f"sqlite:///{path.resolve()}"
@@ -204,15 +213,18 @@ class CalibrationStore:
         self.file: Path | None = None
         if url.startswith("sqlite:///"):
             refuse_link(sqlite_file(location), "calibration stores are")
-            self.file = file = Path(url[len("sqlite:///"):])
+            self.file = file = Path(url[len("sqlite:///") :])
             if not file.exists():
                 if not create:
-                    raise InputError(f"{self.location}: no calibration store there (no {file.name}); give the folder "
-                                     f"a fleet fit wrote, an SQLite file or a database URL")
+                    raise InputError(
+                        f"{self.location}: no calibration store there (no {file.name}); give the folder "
+                        f"a fleet fit wrote, an SQLite file or a database URL"
+                    )
                 file.parent.mkdir(parents=True, exist_ok=True)
         try:
-            self.engine = sa.create_engine(url, **({"connect_args": {"timeout": SQLITE_BUSY_TIMEOUT_S}}
-                                                   if self.file is not None else {}))
+            self.engine = sa.create_engine(
+                url, **({"connect_args": {"timeout": SQLITE_BUSY_TIMEOUT_S}} if self.file is not None else {})
+            )
         except (sa.exc.ArgumentError, sa.exc.NoSuchModuleError, ModuleNotFoundError) as exc:
             raise InputError(f"{self.location}: not a database URL SQLAlchemy can open ({exc})") from None
         if self.file is not None:
@@ -229,8 +241,10 @@ class CalibrationStore:
             raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
         version = self._version() if present else None
         if present and (version is None or not version.isdigit() or int(version) > STORE_SCHEMA_VERSION):
-            raise InputError(f"{self.location}: store schema version {version}; this gyrocomp reads up to "
-                             f"{STORE_SCHEMA_VERSION} (upgrade gyrocomp)")
+            raise InputError(
+                f"{self.location}: store schema version {version}; this gyrocomp reads up to "
+                f"{STORE_SCHEMA_VERSION} (upgrade gyrocomp)"
+            )
         if create and version != str(STORE_SCHEMA_VERSION):
             with self._writing(schema=True) as conn:  # one transaction: a second creator waits, then finds it done
                 self._create_or_upgrade(conn)
@@ -253,14 +267,14 @@ class CalibrationStore:
             return
         if conn.execute(_VERSION).scalar() == "1":
             for column in (_ROWS.c.station, _ROWS.c.supersedes):
-                conn.execute(sa.text(f"ALTER TABLE {_ROWS.name} ADD COLUMN {column.name} "
-                                     f"{column.type.compile(conn.dialect)}"))
+                conn.execute(
+                    sa.text(f"ALTER TABLE {_ROWS.name} ADD COLUMN {column.name} {column.type.compile(conn.dialect)}")
+                )
             if conn.dialect.name == "postgresql":  # schema 1 made the serial a VARCHAR(200), which PostgreSQL enforces
                 conn.execute(sa.text(f"ALTER TABLE {_ROWS.name} ALTER COLUMN serial TYPE TEXT"))
             _CHAIN.create(conn)
             CLAIMS.create(conn, checkfirst=True)
-            conn.execute(_INFO.update().where(_INFO.c.key == "schema_version")
-                         .values(value=str(STORE_SCHEMA_VERSION)))
+            conn.execute(_INFO.update().where(_INFO.c.key == "schema_version").values(value=str(STORE_SCHEMA_VERSION)))
 
     def close(self) -> None:
         self.engine.dispose()
@@ -288,8 +302,10 @@ class CalibrationStore:
         except sa.exc.OperationalError as exc:
             if getattr(exc.orig, "sqlstate", None) in _RETRIED_SQLSTATES:
                 raise _Retry(str(exc.orig)) from None
-            raise InputError(f"{self.location}: cannot write to the calibration store ({exc.orig}); is the disk "
-                             "full or the store read-only?") from None
+            raise InputError(
+                f"{self.location}: cannot write to the calibration store ({exc.orig}); is the disk "
+                "full or the store read-only?"
+            ) from None
 
     @contextlib.contextmanager
     def transaction(self, snapshot: bool = False):
@@ -311,8 +327,10 @@ class CalibrationStore:
                 return write()
             except _Retry as conflict:
                 if attempt == WRITE_TRIES - 1:
-                    raise InputError(f"{self.location}: another writer conflicted with this one {WRITE_TRIES} times "
-                                     f"in a row ({str(conflict)[:160]}); try again") from None
+                    raise InputError(
+                        f"{self.location}: another writer conflicted with this one {WRITE_TRIES} times "
+                        f"in a row ({str(conflict)[:160]}); try again"
+                    ) from None
                 time.sleep(random.uniform(0.0, 0.05 * 2 ** min(attempt, 6)))
         raise AssertionError("unreachable")
 
@@ -332,10 +350,20 @@ class CalibrationStore:
         with self._writing() as conn:
             previous = None
             if record.status == "ok":
-                if since is not None and conn.execute(sa.select(_ROWS.c.id).where(
-                        (_ROWS.c.serial == record.serial) & (_ROWS.c.status == "ok")
-                        & (_ROWS.c.input_hash == record.input_hash) & (_ROWS.c.calibrated_utc >= since))
-                        .limit(1)).scalar() is not None:
+                if (
+                    since is not None
+                    and conn.execute(
+                        sa.select(_ROWS.c.id)
+                        .where(
+                            (_ROWS.c.serial == record.serial)
+                            & (_ROWS.c.status == "ok")
+                            & (_ROWS.c.input_hash == record.input_hash)
+                            & (_ROWS.c.calibrated_utc >= since)
+                        )
+                        .limit(1)
+                    ).scalar()
+                    is not None
+                ):
                     return None
                 previous = conn.execute(_newest_ok(record.serial)).scalar() or 0
             row = _to_row(record if not stamp else _replace(record, calibrated_utc=utc_now()))
@@ -355,16 +383,20 @@ class CalibrationStore:
             try:
                 rows = list(conn.execute(query).mappings())
             except (ValueError, TypeError, OverflowError) as exc:  # the time column, parsed as rows are fetched
-                raise InputError(f"{self.location}: {self._bad_time(conn) or 'a row'} holds no time gyrocomp wrote "
-                                 f"({exc}); the store was changed by another program") from None
+                raise InputError(
+                    f"{self.location}: {self._bad_time(conn) or 'a row'} holds no time gyrocomp wrote "
+                    f"({exc}); the store was changed by another program"
+                ) from None
         out = []
         for row in rows:
             try:
                 out.append(_from_row(row))
             except (ValueError, TypeError, KeyError, AttributeError) as exc:
-                raise InputError(f"{self.location}: row {row['id']} (unit {str(row['serial'])[:80]!r}) is damaged "
-                                 f"({type(exc).__name__}: {str(exc)[:120]}); the store was changed by another "
-                                 "program") from None
+                raise InputError(
+                    f"{self.location}: row {row['id']} (unit {str(row['serial'])[:80]!r}) is damaged "
+                    f"({type(exc).__name__}: {str(exc)[:120]}); the store was changed by another "
+                    "program"
+                ) from None
         return out
 
     @staticmethod
@@ -380,8 +412,9 @@ class CalibrationStore:
 
     def history(self, serial: str) -> list[CalibrationRecord]:
         """Every row of ``serial``, oldest first."""
-        return self._records(sa.select(*self._columns).where(_ROWS.c.serial == serial)
-                             .order_by(_ROWS.c.calibrated_utc, _ROWS.c.id))
+        return self._records(
+            sa.select(*self._columns).where(_ROWS.c.serial == serial).order_by(_ROWS.c.calibrated_utc, _ROWS.c.id)
+        )
 
     def latest(self, serial: str) -> CalibrationRecord | None:
         """The newest row of ``serial`` (ok or failed), or None."""
@@ -398,22 +431,25 @@ class CalibrationStore:
         if not ok:
             first = next((r for r in rows if r.status == "ok"), None)
             when = f" at {at:%Y-%m-%d %H:%M:%S}" if at is not None else ""
-            hint = (f"; its first calibration is of {first.calibrated_utc:%Y-%m-%d %H:%M:%S} UTC" if first is not None
-                    else f"; every calibration of it failed (last: {rows[-1].error})")
+            hint = (
+                f"; its first calibration is of {first.calibrated_utc:%Y-%m-%d %H:%M:%S} UTC"
+                if first is not None
+                else f"; every calibration of it failed (last: {rows[-1].error})"
+            )
             raise InputError(f"serial: unit {serial!r} had no valid calibration{when}{hint}")
         return ok[-1]
 
     def latest_rows(self) -> list[CalibrationRecord]:
         """The newest row of every unit, by serial."""
-        newest = (sa.select(_ROWS.c.serial, sa.func.max(_ROWS.c.id).label("id")).group_by(_ROWS.c.serial)
-                  .subquery())
+        newest = sa.select(_ROWS.c.serial, sa.func.max(_ROWS.c.id).label("id")).group_by(_ROWS.c.serial).subquery()
         return self._records(sa.select(*self._columns).join(newest, _ROWS.c.id == newest.c.id).order_by(_ROWS.c.serial))
 
     def ok_hash(self, serial: str) -> str | None:
         """The input hash of ``serial``'s newest successful calibration (None when it has none)."""
         with self.engine.connect() as conn:
-            return conn.execute(sa.select(_ROWS.c.input_hash)
-                                .where(_ROWS.c.id == _newest_ok(serial).scalar_subquery())).scalar()
+            return conn.execute(
+                sa.select(_ROWS.c.input_hash).where(_ROWS.c.id == _newest_ok(serial).scalar_subquery())
+            ).scalar()
 
     def station_counts(self) -> list[tuple[str | None, str, int, _dt.datetime | None]]:
         """(station, status, rows, newest time) for each station and status (station None: rows that name none)."""
@@ -434,15 +470,20 @@ def _newest_ok(serial: str):
 
 def _to_row(record: CalibrationRecord) -> dict:
     return {
-        "serial": record.serial, "calibrated_utc": record.calibrated_utc, "status": record.status,
+        "serial": record.serial,
+        "calibrated_utc": record.calibrated_utc,
+        "status": record.status,
         "verdict": record.verdict,
         "failures": json.dumps([[f.figure, _json_float(f.value), f.reason] for f in record.failures]),
         "input_hash": record.input_hash,
         "inputs": json.dumps([[i.path, i.sha256] for i in record.inputs]),
-        "unit_metadata": json.dumps(dict(record.metadata)), "gyrocomp_version": record.gyrocomp_version,
+        "unit_metadata": json.dumps(dict(record.metadata)),
+        "gyrocomp_version": record.gyrocomp_version,
         "model": record.model_json,
         "figures": None if record.figures is None else json.dumps(record.figures.to_dict()),
-        "error": record.error, "warnings": json.dumps(list(record.warnings)), "station": record.station,
+        "error": record.error,
+        "warnings": json.dumps(list(record.warnings)),
+        "station": record.station,
     }
 
 
@@ -462,15 +503,33 @@ def _from_row(row) -> CalibrationRecord:
     if not isinstance(metadata, dict):
         raise TypeError("unit_metadata is no JSON object")
     return CalibrationRecord(
-        serial=row["serial"], calibrated_utc=row["calibrated_utc"], status=row["status"],
-        input_hash=row["input_hash"], gyrocomp_version=row["gyrocomp_version"],
+        serial=row["serial"],
+        calibrated_utc=row["calibrated_utc"],
+        status=row["status"],
+        input_hash=row["input_hash"],
+        gyrocomp_version=row["gyrocomp_version"],
         inputs=tuple(InputFile(str(p), str(h)) for p, h in json.loads(row["inputs"])),
-        metadata={str(k): str(v) for k, v in metadata.items()}, verdict=row["verdict"],
-        failures=tuple(Failure(str(f), math.nan if v is None else float(v), str(r))
-                       for f, v, r in json.loads(row["failures"])),
-        model_json=row["model"], figures=figures, error=row["error"],
-        warnings=tuple(str(w) for w in json.loads(row["warnings"])), station=row.get("station"), id=row["id"])
+        metadata={str(k): str(v) for k, v in metadata.items()},
+        verdict=row["verdict"],
+        failures=tuple(
+            Failure(str(f), math.nan if v is None else float(v), str(r)) for f, v, r in json.loads(row["failures"])
+        ),
+        model_json=row["model"],
+        figures=figures,
+        error=row["error"],
+        warnings=tuple(str(w) for w in json.loads(row["warnings"])),
+        station=row.get("station"),
+        id=row["id"],
+    )
 
 
-__all__ = ["STORE_FILE", "STORE_SCHEMA_VERSION", "CalibrationRecord", "CalibrationStore", "InputFile", "parse_time",
-           "store_url", "utc_now"]
+__all__ = [
+    "STORE_FILE",
+    "STORE_SCHEMA_VERSION",
+    "CalibrationRecord",
+    "CalibrationStore",
+    "InputFile",
+    "parse_time",
+    "store_url",
+    "utc_now",
+]

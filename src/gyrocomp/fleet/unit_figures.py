@@ -80,30 +80,47 @@ class UnitFigures:
 
     def as_row(self) -> dict[str, float]:
         """Flat ``{axis_figure: value}`` (``gyro_x_noise_density_dps_per_sqrt_hz``, ...) for a table."""
-        row = {"runs": float(self.runs), "temperature_min_degc": self.temperature_min_degc,
-               "temperature_max_degc": self.temperature_max_degc}
+        row = {
+            "runs": float(self.runs),
+            "temperature_min_degc": self.temperature_min_degc,
+            "temperature_max_degc": self.temperature_max_degc,
+        }
         for axis, figures in self.axes.items():
             row.update({f"{axis}_{name}": value for name, value in asdict(figures).items()})
         return row
 
     def to_dict(self) -> dict:
         """The figures as a JSON document (a figure not measured, NaN, as null)."""
+
         def number(v):
             return None if isinstance(v, float) and math.isnan(v) else v
-        return {"axes": {a: {k: number(v) for k, v in asdict(f).items()} for a, f in self.axes.items()},
-                "temperature_min_degc": number(self.temperature_min_degc),
-                "temperature_max_degc": number(self.temperature_max_degc), "runs": self.runs}
+
+        return {
+            "axes": {a: {k: number(v) for k, v in asdict(f).items()} for a, f in self.axes.items()},
+            "temperature_min_degc": number(self.temperature_min_degc),
+            "temperature_max_degc": number(self.temperature_max_degc),
+            "runs": self.runs,
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> "UnitFigures":
         def number(v):
             return math.nan if v is None else float(v)
-        return cls({a: AxisFigures(**{k: number(v) for k, v in f.items()}) for a, f in d["axes"].items()},
-                   number(d["temperature_min_degc"]), number(d["temperature_max_degc"]), int(d["runs"]))
+
+        return cls(
+            {a: AxisFigures(**{k: number(v) for k, v in f.items()}) for a, f in d["axes"].items()},
+            number(d["temperature_min_degc"]),
+            number(d["temperature_max_degc"]),
+            int(d["runs"]),
+        )
 
 
-def unit_figures(calibration: Calibration, recordings: list[Recording], *,
-                 reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC) -> UnitFigures:
+def unit_figures(
+    calibration: Calibration,
+    recordings: list[Recording],
+    *,
+    reference_temperature_degc: float = REFERENCE_TEMPERATURE_DEGC,
+) -> UnitFigures:
     """The figures of merit of ``calibration`` fitted on ``recordings`` (see the module).
 
     Parameters
@@ -129,10 +146,20 @@ def unit_figures(calibration: Calibration, recordings: list[Recording], *,
             raw_drift_dps=_number(None if chosen is None else chosen.raw_drift_dps),
             **_curve_figures(axis, t_lo, t_hi, reference_temperature_degc),
             **_constants(axis, reference_temperature_degc),
-            g_sensitivity_dps_per_g=(float(np.linalg.norm(axis.g_sensitivity_dps_per_g))
-                                     if axis.g_sensitivity_dps_per_g is not None else math.nan),
-            **noise.get(name, {"noise_density_dps_per_sqrt_hz": math.nan, "bias_instability_deg_per_h": math.nan,
-                               "rate_random_walk_dps_per_sqrt_s": math.nan, "flicker_deg_per_h": math.nan}),
+            g_sensitivity_dps_per_g=(
+                float(np.linalg.norm(axis.g_sensitivity_dps_per_g))
+                if axis.g_sensitivity_dps_per_g is not None
+                else math.nan
+            ),
+            **noise.get(
+                name,
+                {
+                    "noise_density_dps_per_sqrt_hz": math.nan,
+                    "bias_instability_deg_per_h": math.nan,
+                    "rate_random_walk_dps_per_sqrt_s": math.nan,
+                    "flicker_deg_per_h": math.nan,
+                },
+            ),
             curve_sd_dps=_number(prior_fit.get(name, {}).get("curve_sd_max_dps")),
         )
     return UnitFigures(axes, t_lo, t_hi, len(recordings))
@@ -144,8 +171,13 @@ def _number(value) -> float:
 
 def _curve_figures(axis: AxisCalibration, t_lo: float, t_hi: float, t_ref: float) -> dict[str, float]:
     """Temperature sensitivity at ``t_ref``, the cubic in (T - t_ref) and the span over [t_lo, t_hi]."""
-    nan = {"temperature_sensitivity_dps_per_degc": math.nan, "tempco_1_dps_per_degc": math.nan,
-           "tempco_2_dps_per_degc2": math.nan, "tempco_3_dps_per_degc3": math.nan, "bias_span_dps": math.nan}
+    nan = {
+        "temperature_sensitivity_dps_per_degc": math.nan,
+        "tempco_1_dps_per_degc": math.nan,
+        "tempco_2_dps_per_degc2": math.nan,
+        "tempco_3_dps_per_degc3": math.nan,
+        "bias_span_dps": math.nan,
+    }
     if axis.temperature is None or not t_hi > t_lo:
         return {**nan, "bias_span_dps": 0.0} if axis.temperature is None else nan
     grid = np.linspace(t_lo, t_hi, _GRID_POINTS)
@@ -157,18 +189,24 @@ def _curve_figures(axis: AxisCalibration, t_lo: float, t_hi: float, t_ref: float
         ends = np.asarray(axis.shape_dps(np.array([t_ref - h, t_ref + h])), dtype=float)
         slope = float(ends[1] - ends[0]) / (2 * h)
     d = grid - t_ref
-    basis = np.column_stack([np.ones_like(d), d, d ** 2, d ** 3])
+    basis = np.column_stack([np.ones_like(d), d, d**2, d**3])
     coefficients = np.linalg.lstsq(basis, curve, rcond=None)[0]
-    return {"temperature_sensitivity_dps_per_degc": slope, "tempco_1_dps_per_degc": float(coefficients[1]),
-            "tempco_2_dps_per_degc2": float(coefficients[2]), "tempco_3_dps_per_degc3": float(coefficients[3]),
-            "bias_span_dps": float(np.ptp(curve))}
+    return {
+        "temperature_sensitivity_dps_per_degc": slope,
+        "tempco_1_dps_per_degc": float(coefficients[1]),
+        "tempco_2_dps_per_degc2": float(coefficients[2]),
+        "tempco_3_dps_per_degc3": float(coefficients[3]),
+        "bias_span_dps": float(np.ptp(curve)),
+    }
 
 
 def _constants(axis: AxisCalibration, t_ref: float) -> dict[str, float]:
     c = np.asarray(axis.turn_on_biases_dps, dtype=float)
     at_reference = float(np.asarray(axis.shape_dps(np.array([t_ref])), dtype=float).reshape(-1)[0])
-    return {"turn_on_bias_dps": float(c.mean()) + at_reference if c.size else math.nan,
-            "turn_on_repeatability_dps": float(c.std(ddof=1)) if c.size > 1 else math.nan}
+    return {
+        "turn_on_bias_dps": float(c.mean()) + at_reference if c.size else math.nan,
+        "turn_on_repeatability_dps": float(c.std(ddof=1)) if c.size > 1 else math.nan,
+    }
 
 
 def _noise(calibration: Calibration, recording: Recording) -> dict[str, dict[str, float]]:
@@ -185,11 +223,15 @@ def _noise(calibration: Calibration, recording: Recording) -> dict[str, dict[str
             analysis = analyse_noise(compensated, axes, split_gaps=True, motion_check=False)
     except GyrocompError:
         return {}
-    return {name: {"noise_density_dps_per_sqrt_hz": float(a.noise.noise_density_dps_per_sqrt_hz),
-                   "bias_instability_deg_per_h": float(a.noise.bias_instability_deg_per_h),
-                   "rate_random_walk_dps_per_sqrt_s": float(a.noise.rrw_dps_sqrt_hz),
-                   "flicker_deg_per_h": float(a.noise.bias_instability_fit_deg_per_h)}
-            for name, a in analysis.axes.items()}
+    return {
+        name: {
+            "noise_density_dps_per_sqrt_hz": float(a.noise.noise_density_dps_per_sqrt_hz),
+            "bias_instability_deg_per_h": float(a.noise.bias_instability_deg_per_h),
+            "rate_random_walk_dps_per_sqrt_s": float(a.noise.rrw_dps_sqrt_hz),
+            "flicker_deg_per_h": float(a.noise.bias_instability_fit_deg_per_h),
+        }
+        for name, a in analysis.axes.items()
+    }
 
 
 __all__ = ["FIGURE_NAMES", "REFERENCE_TEMPERATURE_DEGC", "AxisFigures", "UnitFigures", "unit_figures"]

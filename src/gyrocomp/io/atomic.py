@@ -73,7 +73,7 @@ def _remove_stale(folder: Path, tag: str) -> None:
     """Remove the temporary outputs for the same target that a killed process (SIGKILL, a power cut) left: those
     whose process is gone. A process still running keeps its own."""
     for stale in folder.glob(f"{TEMP_PREFIX}*-{glob_escape(tag)}.*.tmp"):
-        pid = stale.name[len(TEMP_PREFIX):].split("-", 1)[0]
+        pid = stale.name[len(TEMP_PREFIX) :].split("-", 1)[0]
         if pid.isdigit() and not process_alive(int(pid)):
             with contextlib.suppress(OSError):
                 stale.unlink()
@@ -108,9 +108,17 @@ def check_output_file(path: str | os.PathLike) -> Path:
     except FileNotFoundError:
         return target
     if not stat.S_ISREG(mode):
-        kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
-                "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode)
-                else "not a regular file")
+        kind = (
+            "a folder"
+            if stat.S_ISDIR(mode)
+            else "a FIFO"
+            if stat.S_ISFIFO(mode)
+            else "a device"
+            if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else "a socket"
+            if stat.S_ISSOCK(mode)
+            else "not a regular file"
+        )
         raise InputError(f"{path}: is {kind}; outputs are written to regular files (name a new path)")
     return target
 
@@ -124,8 +132,10 @@ def refuse_link(path: str | os.PathLike, what: str = "outputs are") -> None:
             points_to = f" (to {os.readlink(target)})"
         except OSError:
             points_to = ""
-        raise InputError(f"{path}: is a symbolic link{points_to}; {what} never written through a link, which could "
-                         "replace a file elsewhere: name the file itself, or remove the link")
+        raise InputError(
+            f"{path}: is a symbolic link{points_to}; {what} never written through a link, which could "
+            "replace a file elsewhere: name the file itself, or remove the link"
+        )
 
 
 def _mode_for(target: Path) -> int:
@@ -148,10 +158,15 @@ def require_unchanged(path: str | os.PathLike, before: os.stat_result) -> None:
     except OSError:
         raise InputError(f"{path}: removed or replaced while it was read; nothing written from it") from None
     if (after.st_size, after.st_mtime_ns, after.st_ino) != (before.st_size, before.st_mtime_ns, before.st_ino):
-        change = (f"{before.st_size} bytes when the reading began, {after.st_size} at its end"
-                  if after.st_size != before.st_size else "modified or replaced during the reading")
-        raise InputError(f"{path}: changed while it was read ({change}: still being written, or cut short); "
-                         "nothing written from it: read it again once it is complete")
+        change = (
+            f"{before.st_size} bytes when the reading began, {after.st_size} at its end"
+            if after.st_size != before.st_size
+            else "modified or replaced during the reading"
+        )
+        raise InputError(
+            f"{path}: changed while it was read ({change}: still being written, or cut short); "
+            "nothing written from it: read it again once it is complete"
+        )
 
 
 @contextlib.contextmanager
@@ -191,7 +206,9 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
         tmp.write_text(text, encoding="utf-8")
 
 
-def refuse_to_overwrite_inputs(output: str | os.PathLike, inputs: Iterable[str | os.PathLike], option: str = "-o") -> None:
+def refuse_to_overwrite_inputs(
+    output: str | os.PathLike, inputs: Iterable[str | os.PathLike], option: str = "-o"
+) -> None:
     """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs``, or a symbolic link
     (:func:`refuse_link`): the checks a command makes on its output (a file or a folder) before it does the work;
     an output file is checked besides by :func:`check_output_file` (the command line's type of output files)."""

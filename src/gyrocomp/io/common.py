@@ -51,8 +51,9 @@ def parse_time_range(text: str) -> tuple[float | None, float | None]:
             raise ValueError
         bounds = tuple(None if p.strip() == "" else float(p) for p in parts)
     except ValueError:
-        raise InputError(f"time_range_s: {text!r}: give A:B in seconds from the file's start (A: or :B for an "
-                         "open end)") from None
+        raise InputError(
+            f"time_range_s: {text!r}: give A:B in seconds from the file's start (A: or :B for an open end)"
+        ) from None
     if any(b is not None and not math.isfinite(b) for b in bounds) or bounds == (None, None):
         raise InputError(f"time_range_s: {text!r}: give finite seconds on at least one side")
     return bounds
@@ -88,26 +89,51 @@ class ReadOptions:
     """
 
     layout: TableLayout = field(default_factory=TableLayout)
-    drop_nonfinite: bool = spelled(Spelling(
-        "--drop-nan", "Drop rows with empty/NaN values (says how many) instead of refusing the file.", switch=True),
-        default=False)
-    instance: int | None = spelled(Spelling(
-        "--instance", "Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0) or ROS "
-        "bags (the IMU topic's index in name order); fit: all fits every instance, one model file each.",
-        metavar="N", parse=parse_instance), default=None)
-    device_id: int | None = spelled(Spelling(
-        "--device-id", "PX4 device id of the gyro to read.", metavar="ID",
-        parse=lambda text: _whole_number(text, "device_id")), default=None)
-    imu_topic: str | None = spelled(Spelling(
-        "--imu-topic", "ROS bag: the sensor_msgs/Imu topic (default: the only one)."), default=None)
-    temperature_topic: str | None = spelled(Spelling(
-        "--temperature-topic", "ROS bag: the sensor_msgs/Temperature topic (default: the only one)."), default=None)
-    record: str | None = spelled(Spelling(
-        "--record", "ArduPilot log: IMU (default) or TCLR (onboard learning records)."), default=None)
+    drop_nonfinite: bool = spelled(
+        Spelling(
+            "--drop-nan", "Drop rows with empty/NaN values (says how many) instead of refusing the file.", switch=True
+        ),
+        default=False,
+    )
+    instance: int | None = spelled(
+        Spelling(
+            "--instance",
+            "Sensor instance in PX4/ArduPilot logs (uORB multi_id, IMU number from 0; default 0) or ROS "
+            "bags (the IMU topic's index in name order); fit: all fits every instance, one model file each.",
+            metavar="N",
+            parse=parse_instance,
+        ),
+        default=None,
+    )
+    device_id: int | None = spelled(
+        Spelling(
+            "--device-id",
+            "PX4 device id of the gyro to read.",
+            metavar="ID",
+            parse=lambda text: _whole_number(text, "device_id"),
+        ),
+        default=None,
+    )
+    imu_topic: str | None = spelled(
+        Spelling("--imu-topic", "ROS bag: the sensor_msgs/Imu topic (default: the only one)."), default=None
+    )
+    temperature_topic: str | None = spelled(
+        Spelling("--temperature-topic", "ROS bag: the sensor_msgs/Temperature topic (default: the only one)."),
+        default=None,
+    )
+    record: str | None = spelled(
+        Spelling("--record", "ArduPilot log: IMU (default) or TCLR (onboard learning records)."), default=None
+    )
     channels: tuple[str, ...] | None = None
-    time_range_s: tuple[float | None, float | None] | None = spelled(Spelling(
-        "--time", "Only the samples from A to B seconds after the file's first ([A, B); A: or :B open).",
-        metavar="A:B", parse=parse_time_range), default=None)
+    time_range_s: tuple[float | None, float | None] | None = spelled(
+        Spelling(
+            "--time",
+            "Only the samples from A to B seconds after the file's first ([A, B); A: or :B open).",
+            metavar="A:B",
+            parse=parse_time_range,
+        ),
+        default=None,
+    )
 
     def __post_init__(self) -> None:
         if self.instance == "all":
@@ -124,8 +150,7 @@ def require(module: str, extra: str, what: str) -> ModuleType:
         return importlib.import_module(module)
     except ImportError:
         raise MissingDependencyError(
-            f"{what} needs the optional package {module.split('.')[0]}; "
-            f"install it with: {install_hint(extra)}"
+            f"{what} needs the optional package {module.split('.')[0]}; install it with: {install_hint(extra)}"
         ) from None
 
 
@@ -156,21 +181,37 @@ def foreign_output(source: str, library: str) -> Iterator[None]:
         for stream in (sys.stdout, sys.stderr):
             with contextlib.suppress(Exception):
                 stream.flush()
-        with _descriptor_into(1, sink), _descriptor_into(2, sink), \
-                contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
+        with (
+            _descriptor_into(1, sink),
+            _descriptor_into(2, sink),
+            contextlib.redirect_stdout(captured),
+            contextlib.redirect_stderr(captured),
+        ):
             yield
         sink.seek(0)
         text = captured.getvalue() + sink.read().decode("utf-8", "replace")
     lines = [line for line in text.splitlines() if line.strip()]
     if lines:
         first = printable(lines[0].strip())[:120]
-        warnings.warn(f"{source}: {library} reported {len(lines)} line(s) while reading, the first: {first!r}; "
-                      "the log is probably damaged in places", DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{source}: {library} reported {len(lines)} line(s) while reading, the first: {first!r}; "
+            "the log is probably damaged in places",
+            DataQualityWarning,
+            stacklevel=3,
+        )
 
 
-def log_recording(path, options: ReadOptions, time_s: np.ndarray, gyro_dps: np.ndarray, accel_g: np.ndarray | None,
-                  temperature_degc: np.ndarray | None, metadata: dict,
-                  gyro_axes: tuple[str, ...] = GYRO_AXES, first_row: int = 0) -> Recording:
+def log_recording(
+    path,
+    options: ReadOptions,
+    time_s: np.ndarray,
+    gyro_dps: np.ndarray,
+    accel_g: np.ndarray | None,
+    temperature_degc: np.ndarray | None,
+    metadata: dict,
+    gyro_axes: tuple[str, ...] = GYRO_AXES,
+    first_row: int = 0,
+) -> Recording:
     """The :class:`Recording` a log reader returns [s, deg/s, g, degC]; with ``options.drop_nonfinite`` the rows
     holding an empty, NaN or infinite value are dropped first (a warning says how many), as for tables. Rows are
     numbered from ``first_row`` + 1 (a chunk of a longer log: the samples before it)."""
@@ -178,10 +219,19 @@ def log_recording(path, options: ReadOptions, time_s: np.ndarray, gyro_dps: np.n
     index = np.arange(n)
     if options.drop_nonfinite:
         index, (time_s, gyro_dps, accel_g, temperature_degc) = keep_finite_rows(
-            path, time_s, gyro_dps, accel_g, temperature_degc)
-    return Recording(time_s=time_s, gyro_dps=gyro_dps, gyro_axes=gyro_axes, temperature_degc=temperature_degc,
-                     accel_g=accel_g, accel_axes=ACCEL_AXES if accel_g is not None else (), source=str(path),
-                     row_numbers=index + 1 + first_row, metadata={**metadata, "rows_dropped": int(n - index.size)})
+            path, time_s, gyro_dps, accel_g, temperature_degc
+        )
+    return Recording(
+        time_s=time_s,
+        gyro_dps=gyro_dps,
+        gyro_axes=gyro_axes,
+        temperature_degc=temperature_degc,
+        accel_g=accel_g,
+        accel_axes=ACCEL_AXES if accel_g is not None else (),
+        source=str(path),
+        row_numbers=index + 1 + first_row,
+        metadata={**metadata, "rows_dropped": int(n - index.size)},
+    )
 
 
 def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -> tuple:
@@ -212,7 +262,10 @@ def time_order_warning(source: str, moved: int, dropped: int, back_s: float) -> 
     return TimeOrderWarning(
         f"{source}: {moved} sample(s) out of time order were sorted and {dropped} repeated time stamp(s) dropped"
         + (f" (the time went back by up to {back_s:.6g} s)" if back_s > 0 else ""),
-        moved=moved, dropped=dropped, largest_back_s=max(back_s, 0.0))
+        moved=moved,
+        dropped=dropped,
+        largest_back_s=max(back_s, 0.0),
+    )
 
 
 def match_by_time(

@@ -39,8 +39,18 @@ RECORDS = ("IMU", "TCLR")
 _US = unit_factor("time", "us")
 _RAD = unit_factor("gyro", "rad/s")
 _MS2 = unit_factor("accel", "m/s2")
-_STRUCT_TO_NUMPY = {"b": "i1", "B": "u1", "h": "<i2", "H": "<u2", "i": "<i4", "I": "<u4",
-                    "q": "<i8", "Q": "<u8", "f": "<f4", "d": "<f8"}
+_STRUCT_TO_NUMPY = {
+    "b": "i1",
+    "B": "u1",
+    "h": "<i2",
+    "H": "<u2",
+    "i": "<i4",
+    "I": "<u4",
+    "q": "<i8",
+    "Q": "<u8",
+    "f": "<f4",
+    "d": "<f8",
+}
 _TCLR_ACCEL, _TCLR_GYRO = 0, 1
 
 
@@ -68,7 +78,8 @@ class _Log:
         try:
             with foreign_output(str(path), "pymavlink"):
                 self.reader = DFReader.DFReader_binary(
-                    str(path), zero_time_base=False,
+                    str(path),
+                    zero_time_base=False,
                     progress_callback=(lambda pct: progress(0.8 * pct / 100.0)) if progress else None,
                 )
         except Exception as exc:  # pymavlink raises assorted errors on corrupt files
@@ -113,8 +124,10 @@ class _Log:
         if not self.has("PARM"):
             return {}
         parm = self.records("PARM")
-        return {name.split(b"\0")[0].decode("ascii", "replace"): float(value)
-                for name, value in zip(parm["Name"], parm["Value"])}
+        return {
+            name.split(b"\0")[0].decode("ascii", "replace"): float(value)
+            for name, value in zip(parm["Name"], parm["Value"])
+        }
 
 
 def _instances(log: _Log) -> list[int]:
@@ -140,14 +153,17 @@ def _instance_records(log: _Log, instance: int) -> np.ndarray:
         imu = log.records("IMU")
         found = _instances(log)
         if instance not in found:
-            raise InputError(f"{log.path}: instance={instance}: no IMU instance {instance}; "
-                             f"the log has {', '.join(map(str, found))}")
+            raise InputError(
+                f"{log.path}: instance={instance}: no IMU instance {instance}; the log has {', '.join(map(str, found))}"
+            )
         return imu[imu["I"] == instance], found
     names = ["IMU", "IMU2", "IMU3"]
     found = _instances(log)
     if instance not in found:
-        raise InputError(f"{log.path}: instance={instance}: no {names[instance] if instance < 3 else 'IMU'} "
-                         f"records; the log has instance(s) {', '.join(map(str, found))}")
+        raise InputError(
+            f"{log.path}: instance={instance}: no {names[instance] if instance < 3 else 'IMU'} "
+            f"records; the log has instance(s) {', '.join(map(str, found))}"
+        )
     return log.records(names[instance]), found
 
 
@@ -157,8 +173,12 @@ def _from_imu(log: _Log, instance: int, explicit: bool):
         raise InputError(f"{log.path}: no IMU records in this log; it has {', '.join(present) or 'none'}")
     imu, found = _instance_records(log, instance)
     if not explicit and len(found) > 1:
-        warnings.warn(f"{log.path}: {len(found)} IMU instances ({', '.join(map(str, found))}); read instance "
-                      f"{instance}, choose another with instance=", DataQualityWarning, stacklevel=4)
+        warnings.warn(
+            f"{log.path}: {len(found)} IMU instances ({', '.join(map(str, found))}); read instance "
+            f"{instance}, choose another with instance=",
+            DataQualityWarning,
+            stacklevel=4,
+        )
     time_s = imu["TimeUS"].astype(float) * _US
     gyro = np.column_stack([imu[f"Gyr{a}"] for a in "XYZ"]).astype(float) * _RAD
     accel = np.column_stack([imu[f"Acc{a}"] for a in "XYZ"]).astype(float) * _MS2
@@ -168,21 +188,30 @@ def _from_imu(log: _Log, instance: int, explicit: bool):
 
 def _from_tclr(log: _Log, instance: int):
     if not log.has("TCLR"):
-        raise InputError(f"{log.path}: record=TCLR: no TCLR records in this log "
-                         "(the onboard learner writes them while INS_TCALn_ENABLE = 2)")
+        raise InputError(
+            f"{log.path}: record=TCLR: no TCLR records in this log "
+            "(the onboard learner writes them while INS_TCALn_ENABLE = 2)"
+        )
     tclr = log.records("TCLR")
     tclr = tclr[tclr["I"] == instance]
     gyro_rows, accel_rows = tclr[tclr["SType"] == _TCLR_GYRO], tclr[tclr["SType"] == _TCLR_ACCEL]
     if gyro_rows.size < 2:
-        raise InputError(f"{log.path}: record=TCLR: {gyro_rows.size} gyro record(s) for instance {instance}; "
-                         "at least 2 are needed")
+        raise InputError(
+            f"{log.path}: record=TCLR: {gyro_rows.size} gyro record(s) for instance {instance}; at least 2 are needed"
+        )
     time_s, gyro, temperature = order_by_time(
-        str(log.path), gyro_rows["TimeUS"].astype(float) * _US,
-        np.column_stack([gyro_rows[a] for a in "XYZ"]).astype(float) * _RAD, gyro_rows["Temp"].astype(float))
+        str(log.path),
+        gyro_rows["TimeUS"].astype(float) * _US,
+        np.column_stack([gyro_rows[a] for a in "XYZ"]).astype(float) * _RAD,
+        gyro_rows["Temp"].astype(float),
+    )
     accel = None
     if accel_rows.size >= 2:
-        a_time, a_values = order_by_time(str(log.path), accel_rows["TimeUS"].astype(float) * _US,
-                                         np.column_stack([accel_rows[a] for a in "XYZ"]).astype(float) * _MS2)
+        a_time, a_values = order_by_time(
+            str(log.path),
+            accel_rows["TimeUS"].astype(float) * _US,
+            np.column_stack([accel_rows[a] for a in "XYZ"]).astype(float) * _MS2,
+        )
         accel, ok = match_by_time(str(log.path), "the TCLR accelerometer records", time_s, a_time, a_values)
         keep = keep_matched(str(log.path), "the TCLR accelerometer records", ok)
         time_s, gyro, accel, temperature = time_s[keep], gyro[keep], accel[keep], temperature[keep]
@@ -203,15 +232,24 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
     """
     options = options or ReadOptions()
     path = Path(path)
-    check_magic(path, DATAFLASH_MAGIC, "ArduPilot DataFlash", "name its real format with fmt=, or leave fmt= out to have it told from the file")
+    check_magic(
+        path,
+        DATAFLASH_MAGIC,
+        "ArduPilot DataFlash",
+        "name its real format with fmt=, or leave fmt= out to have it told from the file",
+    )
     record = (options.record or "IMU").upper()
     if record not in RECORDS:
         raise InputError(f"record: unknown DataFlash record {options.record!r}; use IMU or TCLR")
     log = _Log(path, progress)
     try:
         if log.cut_bytes >= 3:
-            warnings.warn(f"{path}: the log ends mid-message ({log.cut_bytes} bytes after the last whole message, "
-                          "a truncated download?); read up to there", DataQualityWarning, stacklevel=2)
+            warnings.warn(
+                f"{path}: the log ends mid-message ({log.cut_bytes} bytes after the last whole message, "
+                "a truncated download?); read up to there",
+                DataQualityWarning,
+                stacklevel=2,
+            )
         instance = 0 if options.instance is None else options.instance
         if record == "TCLR":
             time_s, gyro, accel, temperature = _from_tclr(log, instance)
@@ -222,23 +260,52 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
         log.close()
     orientation = params.get("AHRS_ORIENTATION", 0.0)
     if orientation:
-        warnings.warn(f"{path}: AHRS_ORIENTATION = {orientation:g}: the logged IMU axes are the board's, rotated "
-                      "from the sensor's; INS_TCAL parameters apply in the sensor frame", DataQualityWarning,
-                      stacklevel=2)
+        warnings.warn(
+            f"{path}: AHRS_ORIENTATION = {orientation:g}: the logged IMU axes are the board's, rotated "
+            "from the sensor's; INS_TCAL parameters apply in the sensor frame",
+            DataQualityWarning,
+            stacklevel=2,
+        )
     if params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU":
-        warnings.warn(f"{path}: INS_TCAL{instance + 1}_ENABLE = 1: the logged IMU data are already corrected by "
-                      "the onboard temperature calibration", DataQualityWarning, stacklevel=2)
+        warnings.warn(
+            f"{path}: INS_TCAL{instance + 1}_ENABLE = 1: the logged IMU data are already corrected by "
+            "the onboard temperature calibration",
+            DataQualityWarning,
+            stacklevel=2,
+        )
     if progress:
         progress(1.0)
-    return log_recording(path, options, time_s, gyro, accel, temperature,
-                         {"path": str(path), "format": "dataflash", "autopilot": "ardupilot", "record": record,
-                          "instance": instance,
-                          "corrected_onboard": params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU",
-                          # the installed thermal calibration and the temperatures its gyro offsets were taken at
-                          "autopilot_parameters": {k: v for k, v in params.items()
-                                                   if k.startswith("INS_TCAL") or k.endswith("_CALTEMP")},
-                          "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0})
+    return log_recording(
+        path,
+        options,
+        time_s,
+        gyro,
+        accel,
+        temperature,
+        {
+            "path": str(path),
+            "format": "dataflash",
+            "autopilot": "ardupilot",
+            "record": record,
+            "instance": instance,
+            "corrected_onboard": params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU",
+            # the installed thermal calibration and the temperatures its gyro offsets were taken at
+            "autopilot_parameters": {
+                k: v for k, v in params.items() if k.startswith("INS_TCAL") or k.endswith("_CALTEMP")
+            },
+            "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0,
+        },
+    )
 
 
-register_reader(Reader("dataflash", "ArduPilot DataFlash, extra [dataflash]", read_dataflash, suffixes=(".bin",),
-                       magic=(DATAFLASH_MAGIC,), aliases=("bin", "ardupilot"), instances=dataflash_instances))
+register_reader(
+    Reader(
+        "dataflash",
+        "ArduPilot DataFlash, extra [dataflash]",
+        read_dataflash,
+        suffixes=(".bin",),
+        magic=(DATAFLASH_MAGIC,),
+        aliases=("bin", "ardupilot"),
+        instances=dataflash_instances,
+    )
+)

@@ -22,14 +22,30 @@ import pyarrow.parquet as pq
 
 from ..errors import InputError
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
-from .tables import (DECOMPRESS_ERRORS, TableLayout, _csv_bytes, check_parquet_footer, detect_table_format, read_error,
-                     sniff_csv)
+from .tables import (
+    DECOMPRESS_ERRORS,
+    TableLayout,
+    _csv_bytes,
+    check_parquet_footer,
+    detect_table_format,
+    read_error,
+    sniff_csv,
+)
 
 #: rows read to guess from
 GUESS_ROWS = 20_000
 _TIME_WORDS = {"time", "timestamp", "stamp", "t", "ts", "timeus", "timems", "sec", "seconds"}
-_TIME_UNIT_WORDS = {"us": "us", "usec": "us", "micros": "us", "timeus": "us", "ms": "ms", "msec": "ms",
-                    "timems": "ms", "ns": "ns", "nsec": "ns"}
+_TIME_UNIT_WORDS = {
+    "us": "us",
+    "usec": "us",
+    "micros": "us",
+    "timeus": "us",
+    "ms": "ms",
+    "msec": "ms",
+    "timems": "ms",
+    "ns": "ns",
+    "nsec": "ns",
+}
 #: sample periods a log plausibly has [s]: 10 kHz to 1 Hz
 _PERIOD_RANGE_S = (1e-4, 1.0)
 _TIME_FACTORS = (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9))
@@ -81,8 +97,10 @@ class HeaderlessTable(InputError):
     the caller asks for their names."""
 
     def __init__(self, path: Path, count: int, example: str):
-        super().__init__(f"{path}: a table without a header line, rows of {count} numbers (e.g. {example!r}); give "
-                         f"their names in order (names=gyro_x,gyro_y,gyro_z,temperature)")
+        super().__init__(
+            f"{path}: a table without a header line, rows of {count} numbers (e.g. {example!r}); give "
+            f"their names in order (names=gyro_x,gyro_y,gyro_z,temperature)"
+        )
         self.count = count
         self.example = example
 
@@ -118,8 +136,11 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
     delimiter, decimal = sniff_csv(head[:4096])
     batches, rows = [], 0
     try:
-        reader = pacsv.open_csv(source, parse_options=pacsv.ParseOptions(delimiter=delimiter),
-                                convert_options=pacsv.ConvertOptions(decimal_point=decimal))
+        reader = pacsv.open_csv(
+            source,
+            parse_options=pacsv.ParseOptions(delimiter=delimiter),
+            convert_options=pacsv.ConvertOptions(decimal_point=decimal),
+        )
         for batch in reader:
             batches.append(batch)
             rows += batch.num_rows
@@ -166,8 +187,10 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
             columns[channel] = name
             reasons.append(f"{channel} = {name!r}: its name")
     if not any(c.startswith("gyro_") for c in columns):
-        raise InputError(f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
-                         f"its columns are {', '.join(names)}")
+        raise InputError(
+            f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
+            f"its columns are {', '.join(names)}"
+        )
     if rate_hz is not None:
         reasons.insert(0, f"time: row n at n / {rate_hz:g} s (the rate given; the table has no time column)")
         return columns, reasons
@@ -182,8 +205,10 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
     else:
         reasons.append(f"time = {time_name!r}: its name")
     if time_name is None:
-        raise InputError(f"{path}: no column looks like the time (named time or timestamp, or only increasing); "
-                         "name it with columns= time=NAME, or give the rows' sample rate (rate_hz=50)")
+        raise InputError(
+            f"{path}: no column looks like the time (named time or timestamp, or only increasing); "
+            "name it with columns= time=NAME, or give the rows' sample rate (rate_hz=50)"
+        )
     return {"time": time_name, **columns}, reasons
 
 
@@ -197,8 +222,11 @@ def _accel_unit(table: pa.Table, columns: dict[str, str]) -> tuple[str, str]:
     if not accel or not all(a is not None and a.size for a in accel):
         return "g", "accelerometer in g: the default"
     n = min(a.size for a in accel)
-    norm = float(np.median(np.sqrt(sum(a[:n] ** 2 for a in accel)))) if len(accel) == 3 else \
-        float(np.max(np.abs(np.concatenate(accel))))
+    norm = (
+        float(np.median(np.sqrt(sum(a[:n] ** 2 for a in accel))))
+        if len(accel) == 3
+        else float(np.max(np.abs(np.concatenate(accel))))
+    )
     unit = min(_ACCEL_NORMS, key=lambda u: abs(np.log(max(norm, 1e-12) / u[1])))[0]
     return unit, f"accelerometer in {unit}: its {'norm' if len(accel) == 3 else 'largest value'} at rest is {norm:.3g}"
 
@@ -219,11 +247,15 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
     gyro = [_numbers(table, columns[c]) for c in columns if c.startswith("gyro_")]
     typical = float(np.median(np.abs(np.concatenate(gyro)))) if all(g is not None and g.size for g in gyro) else 0.0
     if typical > _MAX_REST_DPS:
-        return "mdps", (f"gyro in mdps: its typical size, {typical:.4g}, is no rate in deg/s while still (check: raw "
-                        "counts need the part's scale)")
+        return "mdps", (
+            f"gyro in mdps: its typical size, {typical:.4g}, is no rate in deg/s while still (check: raw "
+            "counts need the part's scale)"
+        )
     if accel_unit == "m/s2":
-        return "rad/s", ("gyro in rad/s: the accelerometer is in m/s2, and a logger that writes SI does so throughout "
-                         "(check: a bias at rest cannot tell rad/s from deg/s)")
+        return "rad/s", (
+            "gyro in rad/s: the accelerometer is in m/s2, and a logger that writes SI does so throughout "
+            "(check: a bias at rest cannot tell rad/s from deg/s)"
+        )
     return "deg/s", "gyro in deg/s: the default (check: a bias at rest cannot tell rad/s from deg/s)"
 
 
@@ -259,8 +291,15 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
         time_unit, why_time = "s", "time unit s: the nominal time"
     accel_unit, why_accel = _accel_unit(table, columns)
     gyro_unit, why_gyro = _gyro_unit(table, columns, accel_unit)
-    layout = TableLayout(columns, gyro_unit=gyro_unit, accel_unit=accel_unit, time_unit=time_unit,
-                         delimiter=delimiter, names=check.names, rate_hz=check.rate_hz)
+    layout = TableLayout(
+        columns,
+        gyro_unit=gyro_unit,
+        accel_unit=accel_unit,
+        time_unit=time_unit,
+        delimiter=delimiter,
+        names=check.names,
+        rate_hz=check.rate_hz,
+    )
     unused = tuple(n for n in table.column_names if n not in columns.values() and not (rate_hz and n == "time"))
     return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
 

@@ -54,8 +54,12 @@ def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> floa
         try:
             return unit_factor(kind, unit)
         except InputError:
-            warnings.warn(f"{source}: dataset {dataset.name} has units {units!r}, which gyrocomp does not know; "
-                          f"read as {fallback} (set {option}= if that is wrong)", DataQualityWarning, stacklevel=4)
+            warnings.warn(
+                f"{source}: dataset {dataset.name} has units {units!r}, which gyrocomp does not know; "
+                f"read as {fallback} (set {option}= if that is wrong)",
+                DataQualityWarning,
+                stacklevel=4,
+            )
     return unit_factor(kind, fallback, option)
 
 
@@ -69,21 +73,29 @@ def _opened(h5py, path: Path):
     except (PermissionError, FileNotFoundError, IsADirectoryError, GyrocompError):
         raise
     except (OSError, KeyError, RuntimeError) as exc:  # h5py's KeyError: an object of a damaged file that won't open
-        raise InputError(f"{path}: not a readable HDF5 file ({printable(str(exc))[:200]}); is it damaged or cut "
-                         "short?") from None
+        raise InputError(
+            f"{path}: not a readable HDF5 file ({printable(str(exc))[:200]}); is it damaged or cut short?"
+        ) from None
 
 
 def _in_this_file(dataset, source: str) -> None:
     """Refuse, naming the dataset, one whose values would come from another file: HDF5 external storage (raw
     bytes of any file named in the dataset's layout), a virtual dataset (a map onto other files) or an external
     link (the dataset itself in another file). A reader reads the file it was given, nothing beside it."""
-    how = ("is stored in external files" if dataset.external else
-           "is a virtual dataset mapped onto other files" if dataset.is_virtual else
-           f"lies in another file, {dataset.file.filename!r} (an external link)"
-           if Path(dataset.file.filename).resolve() != Path(source).resolve() else None)
+    how = (
+        "is stored in external files"
+        if dataset.external
+        else "is a virtual dataset mapped onto other files"
+        if dataset.is_virtual
+        else f"lies in another file, {dataset.file.filename!r} (an external link)"
+        if Path(dataset.file.filename).resolve() != Path(source).resolve()
+        else None
+    )
     if how is not None:
-        raise InputError(f"{source}: dataset {dataset.name!r} {how}; gyrocomp reads only the file it is given "
-                         "(copy the data into the file, e.g. with h5repack)")
+        raise InputError(
+            f"{source}: dataset {dataset.name!r} {how}; gyrocomp reads only the file it is given "
+            "(copy the data into the file, e.g. with h5repack)"
+        )
 
 
 #: ``NAME[:, k]``: column k of a two-dimensional dataset, given as a channel's column
@@ -95,8 +107,10 @@ class _Column:
 
     def __init__(self, dataset, k: int, source: str):
         if dataset.ndim != 2 or not 0 <= k < dataset.shape[1]:
-            raise InputError(f"{source}: columns= {dataset.name}[:, {k}]: the dataset has shape {dataset.shape}; "
-                             f"[:, k] needs two dimensions and k below {dataset.shape[-1] if dataset.ndim else 0}")
+            raise InputError(
+                f"{source}: columns= {dataset.name}[:, {k}]: the dataset has shape {dataset.shape}; "
+                f"[:, k] needs two dimensions and k below {dataset.shape[-1] if dataset.ndim else 0}"
+            )
         self.dataset, self.k = dataset, k
         self.name, self.attrs, self.shape = f"{dataset.name}[:, {k}]", dataset.attrs, (dataset.shape[0],)
 
@@ -108,8 +122,10 @@ def _numbers(dataset, source: str) -> np.ndarray:
         return _numbers(dataset.dataset, source)[:, dataset.k]
     _in_this_file(dataset, source)
     if dataset.dtype.kind not in "biuf":
-        raise InputError(f"{source}: dataset {dataset.name!r} holds {dataset.dtype} values, not numbers; "
-                         "store numbers, or map another dataset with columns=")
+        raise InputError(
+            f"{source}: dataset {dataset.name!r} holds {dataset.dtype} values, not numbers; "
+            "store numbers, or map another dataset with columns="
+        )
     return np.asarray(dataset[()], dtype=float)
 
 
@@ -130,8 +146,10 @@ def _find(handle, source: str, channel: str, mapping: dict[str, str]):
         if column and column["name"] in handle and name not in handle:
             return _Column(handle[column["name"]], int(column["k"]), source)
         if name not in handle:
-            raise InputError(f"{source}: columns={{{channel!r}: {name!r}}}: no dataset {name!r}; "
-                             f"the file has {', '.join(_datasets(handle))}")
+            raise InputError(
+                f"{source}: columns={{{channel!r}: {name!r}}}: no dataset {name!r}; "
+                f"the file has {', '.join(_datasets(handle))}"
+            )
         return handle[name]
     for name in COMMON_NAMES.get(channel, (channel,)):
         if name in handle and hasattr(handle[name], "shape"):
@@ -173,13 +191,17 @@ def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
     source, mapping = str(path), dict(layout.columns)
     time_ds = _find(handle, source, TIME_COLUMN, mapping)
     if time_ds is None:
-        raise InputError(f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
-                         "map one with columns={'time': 'NAME'}")
+        raise InputError(
+            f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
+            "map one with columns={'time': 'NAME'}"
+        )
     time_s = _numbers(time_ds, source).reshape(-1) * _factor("time", time_ds, layout.time_unit, "time_unit", source)
     gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
     if gyro is None:
-        raise InputError(f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
-                         "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}")
+        raise InputError(
+            f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
+            "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}"
+        )
     gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "gyro_unit", source)
     if progress:
         progress(0.5)
@@ -212,23 +234,40 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
     with open(path, "rb") as fh:
         head = fh.read(8)
     if head.startswith(NETCDF3_MAGIC):
-        raise InputError(f"{path}: a NetCDF-3 (classic) file; gyrocomp reads NetCDF-4, convert it with "
-                         "'nccopy -k nc4 IN OUT'")
+        raise InputError(
+            f"{path}: a NetCDF-3 (classic) file; gyrocomp reads NetCDF-4, convert it with 'nccopy -k nc4 IN OUT'"
+        )
     if not head.startswith(HDF5_MAGIC):
-        check_magic(path, HDF5_MAGIC, "HDF5/NetCDF-4", "name its real format with fmt=, or leave fmt= out to have it told from the file")
+        check_magic(
+            path,
+            HDF5_MAGIC,
+            "HDF5/NetCDF-4",
+            "name its real format with fmt=, or leave fmt= out to have it told from the file",
+        )
     h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
     with _opened(h5py, path) as handle:
         time_s, gyro, gyro_axes, accel, accel_axes, temperature = _channels(handle, options.layout, path, progress)
     n = time_s.size
     for name, values in (("gyro", gyro), ("accel", accel), ("temperature", temperature)):
         if values is not None and values.shape[0] != n:
-            raise InputError(f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
-                             "map datasets of the same length with columns=")
+            raise InputError(
+                f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
+                "map datasets of the same length with columns="
+            )
     if progress:
         progress(1.0)
-    return log_recording(path, options, time_s, gyro, accel, temperature, {"path": source, "format": "hdf5"},
-                         gyro_axes=gyro_axes)
+    return log_recording(
+        path, options, time_s, gyro, accel, temperature, {"path": source, "format": "hdf5"}, gyro_axes=gyro_axes
+    )
 
 
-register_reader(Reader("hdf5", "HDF5 or NetCDF-4, extra [hdf5]", read_hdf5, suffixes=(".h5", ".hdf5", ".nc", ".nc4"),
-                       magic=(HDF5_MAGIC,), aliases=("h5", "netcdf", "nc")))
+register_reader(
+    Reader(
+        "hdf5",
+        "HDF5 or NetCDF-4, extra [hdf5]",
+        read_hdf5,
+        suffixes=(".h5", ".hdf5", ".nc", ".nc4"),
+        magic=(HDF5_MAGIC,),
+        aliases=("h5", "netcdf", "nc"),
+    )
+)

@@ -19,8 +19,9 @@ def expand_inputs(data: Iterable[str | os.PathLike]) -> list[Path]:
     name, and a warning says how many were dropped."""
     found = _each_once(_named_files(data))
     if not found:
-        raise InputError(f"{', '.join(map(os.fspath, data))}: no run file found (looked for "
-                         f"{', '.join(run_suffixes())})")
+        raise InputError(
+            f"{', '.join(map(os.fspath, data))}: no run file found (looked for {', '.join(run_suffixes())})"
+        )
     return sorted(found)
 
 
@@ -31,8 +32,12 @@ def _each_once(paths: set[Path]) -> set[Path]:
         by_file.setdefault(os.path.realpath(path), path)
     dropped = len(paths) - len(by_file)
     if dropped:
-        warnings.warn(f"{dropped} name(s) matched are files already named by another path (through symbolic "
-                      "links, or a link loop); each file is read once", DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{dropped} name(s) matched are files already named by another path (through symbolic "
+            "links, or a link loop); each file is read once",
+            DataQualityWarning,
+            stacklevel=3,
+        )
     return set(by_file.values())
 
 
@@ -65,11 +70,8 @@ def _runs_in_folder(folder: Path) -> list[Path]:
             dirs.clear()
             continue
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-        runs += [Path(root) / f for f in sorted(files)
-                 if not f.startswith(".") and format_of_name(f) is not None]
+        runs += [Path(root) / f for f in sorted(files) if not f.startswith(".") and format_of_name(f) is not None]
     return runs + bags
-
-
 
 
 def expand_runs(items: Iterable[str | os.PathLike]) -> list[str]:

@@ -19,8 +19,14 @@ NOMINAL_TIME = "\x00row / rate"
 #: the most columns a table without a header line may name (a row is at most 1 kB of text)
 MAX_NAMES = 40
 PER_AXIS_TEMPERATURES = tuple(f"{TEMPERATURE_COLUMN}_{a[-1]}" for a in GYRO_AXES)
-CANONICAL_COLUMNS = (TIME_COLUMN, *GYRO_AXES, *ACCEL_AXES, TEMPERATURE_COLUMN, *PER_AXIS_TEMPERATURES,
-                     *REFERENCE_RATE_AXES)
+CANONICAL_COLUMNS = (
+    TIME_COLUMN,
+    *GYRO_AXES,
+    *ACCEL_AXES,
+    TEMPERATURE_COLUMN,
+    *PER_AXIS_TEMPERATURES,
+    *REFERENCE_RATE_AXES,
+)
 #: channels a mapping may name as one (n, 3) array, in formats that hold arrays (HDF5/NetCDF)
 ARRAY_CHANNELS = ("gyro", "accel")
 
@@ -83,24 +89,48 @@ class TableLayout:
         after the first row) is at n / rate_hz [s]. Refused for a table that has a time column.
     """
 
-    columns: dict[str, str] = spelled(Spelling(
-        "--columns", "Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T.", metavar="CH=COL,...",
-        parse=parse_column_mapping), default_factory=dict)
+    columns: dict[str, str] = spelled(
+        Spelling(
+            "--columns",
+            "Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T.",
+            metavar="CH=COL,...",
+            parse=parse_column_mapping,
+        ),
+        default_factory=dict,
+    )
     gyro_unit: str = spelled(Spelling("--gyro-unit", "deg/s, rad/s or mdps."), default="deg/s")
     accel_unit: str = spelled(Spelling("--accel-unit", "g, mg or m/s2."), default="g")
     time_unit: str = spelled(Spelling("--time-unit", "s, ms, us or ns."), default="s")
-    delimiter: str | None = spelled(Spelling(
-        "--delimiter", "CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a "
-        "tab).", parse=_delimiter), default=None)
-    decimal: str | None = spelled(Spelling("--decimal", "CSV decimal point, . or , (default: told from the first row)."),
-                                  default=None)
-    names: tuple[str, ...] | None = spelled(Spelling(
-        "--names", "A text table without a header line (a serial terminal's log): its columns' names in order, e.g. "
-        "gyro_x,gyro_y,gyro_z,temperature; lines that are not that many numbers are skipped and counted.",
-        metavar="NAME,...", parse=parse_names), default=None)
-    rate_hz: float | None = spelled(Spelling(
-        "--rate", "Nominal sample rate [Hz] of a table without a time column: the n-th row is at n / rate s.",
-        metavar="HZ", parse=parse_rate), default=None)
+    delimiter: str | None = spelled(
+        Spelling(
+            "--delimiter",
+            "CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a tab).",
+            parse=_delimiter,
+        ),
+        default=None,
+    )
+    decimal: str | None = spelled(
+        Spelling("--decimal", "CSV decimal point, . or , (default: told from the first row)."), default=None
+    )
+    names: tuple[str, ...] | None = spelled(
+        Spelling(
+            "--names",
+            "A text table without a header line (a serial terminal's log): its columns' names in order, e.g. "
+            "gyro_x,gyro_y,gyro_z,temperature; lines that are not that many numbers are skipped and counted.",
+            metavar="NAME,...",
+            parse=parse_names,
+        ),
+        default=None,
+    )
+    rate_hz: float | None = spelled(
+        Spelling(
+            "--rate",
+            "Nominal sample rate [Hz] of a table without a time column: the n-th row is at n / rate s.",
+            metavar="HZ",
+            parse=parse_rate,
+        ),
+        default=None,
+    )
 
     def __post_init__(self) -> None:
         if self.names is not None:
@@ -113,14 +143,16 @@ class TableLayout:
             if repeated:
                 raise InputError(f"names: {repeated[0]!r} given twice; give each column its own name")
             if len(names) > MAX_NAMES:
-                raise InputError(f"names: {len(names)} names; a row of a table without a header holds at most "
-                                 f"{MAX_NAMES}")
+                raise InputError(
+                    f"names: {len(names)} names; a row of a table without a header holds at most {MAX_NAMES}"
+                )
             object.__setattr__(self, "names", tuple(names))
         if self.rate_hz is not None:
             object.__setattr__(self, "rate_hz", check_rate(self.rate_hz))
             if self.names is not None and TIME_COLUMN in self.names:
-                raise InputError(f"rate_hz: the names include {TIME_COLUMN}; a nominal rate is for tables without "
-                                 "a time column")
+                raise InputError(
+                    f"rate_hz: the names include {TIME_COLUMN}; a nominal rate is for tables without a time column"
+                )
         for canonical in self.columns:
             if canonical not in CANONICAL_COLUMNS + ARRAY_CHANNELS:
                 raise InputError(
@@ -159,8 +191,10 @@ class TableLayout:
             if not matches:  # the name with its unit: time_s, gyro_x_dps, temperature_degc
                 matches = [column for column in header if column.strip().lower() == unit_named(name)]
             if len(matches) > 1 and name not in self.columns:
-                raise InputError(f"{source}: columns {' and '.join(map(repr, matches))} would both be read as "
-                                 f"{name}; say which with columns={{{name!r}: {matches[0]!r}}} (or rename one)")
+                raise InputError(
+                    f"{source}: columns {' and '.join(map(repr, matches))} would both be read as "
+                    f"{name}; say which with columns={{{name!r}: {matches[0]!r}}} (or rename one)"
+                )
             if name not in resolved and matches and matches[0] not in resolved.values():
                 resolved[name] = matches[0]
         for canonical, column in self.columns.items():
@@ -197,5 +231,6 @@ class TableLayout:
                 f"{source}: column {canonical!r} is not read: columns={{{canonical!r}: {self.columns[canonical]!r}}} "
                 f"reads {canonical} from {self.columns[canonical]!r}; where the output keeps the table, "
                 f"{canonical!r} stays as it was",
-                DataQualityWarning, stacklevel=4,
+                DataQualityWarning,
+                stacklevel=4,
             )

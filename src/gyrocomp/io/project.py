@@ -67,8 +67,9 @@ def project_read_options(path: str | os.PathLike) -> tuple[ReadOptions, str | No
     values: dict[str, dict] = {"layout": {}, "options": {}}
     for key, value in section.items():
         if key not in fields:
-            raise InputError(f"{path}: [read] {key}: not a reading option; use "
-                             f"{', '.join(sorted([*fields, FORMAT_KEY]))}")
+            raise InputError(
+                f"{path}: [read] {key}: not a reading option; use {', '.join(sorted([*fields, FORMAT_KEY]))}"
+            )
         field, spelling = fields[key]
         if spelling.switch:
             if not isinstance(value, bool):

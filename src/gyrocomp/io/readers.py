@@ -203,8 +203,10 @@ def _require_a_file(path: str | os.PathLike) -> None:
         return  # a missing file is said where it is opened, with the same words everywhere
     if stat.S_ISFIFO(mode) or stat.S_ISCHR(mode) or stat.S_ISBLK(mode) or stat.S_ISSOCK(mode):
         kind = "a pipe" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
-        raise InputError(f"{path}: is {kind}, not a file; gyrocomp reads an input more than once (its first bytes "
-                         "tell the format, then its rows): save it to a file first")
+        raise InputError(
+            f"{path}: is {kind}, not a file; gyrocomp reads an input more than once (its first bytes "
+            "tell the format, then its rows): save it to a file first"
+        )
 
 
 def instances(path: str | os.PathLike, fmt: str | None = None) -> tuple[int, ...]:
@@ -233,6 +235,20 @@ def _describe_head(head: bytes) -> str:
     return f"it starts with {head[:8]!r}"
 
 
-__all__ = ["READERS", "Reader", "check_magic", "detect_format", "folder_format", "folder_markers", "format_help",
-           "format_names", "format_of_name", "instances", "reader_named", "register_reader", "run_suffixes",
-           "sniff_format", "table_formats"]
+__all__ = [
+    "READERS",
+    "Reader",
+    "check_magic",
+    "detect_format",
+    "folder_format",
+    "folder_markers",
+    "format_help",
+    "format_names",
+    "format_of_name",
+    "instances",
+    "reader_named",
+    "register_reader",
+    "run_suffixes",
+    "sniff_format",
+    "table_formats",
+]

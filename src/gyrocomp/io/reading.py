@@ -21,8 +21,18 @@ from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
 from .common import ProgressCallback, ReadOptions
 from .project import project_read_options
 from . import read_formats  # noqa: F401  registers every reader
-from .readers import (READERS, Reader, detect_format, format_help, format_names, instances, reader_named,
-                      register_reader, sniff_format, table_formats)
+from .readers import (
+    READERS,
+    Reader,
+    detect_format,
+    format_help,
+    format_names,
+    instances,
+    reader_named,
+    register_reader,
+    sniff_format,
+    table_formats,
+)
 from .tables import (
     TableData,
     TableLayout,
@@ -86,9 +96,11 @@ def select_time(data: TableData, time_range_s: tuple[float | None, float | None]
     if stop is not None:
         keep &= since < stop
     if not keep.any():
-        raise InputError(f"{rec.source}: time_range_s={'' if start is None else f'{start:g}'}:"
-                         f"{'' if stop is None else f'{stop:g}'} holds no sample; the file lasts {since[-1]:.6g} s "
-                         "from its first sample")
+        raise InputError(
+            f"{rec.source}: time_range_s={'' if start is None else f'{start:g}'}:"
+            f"{'' if stop is None else f'{stop:g}'} holds no sample; the file lasts {since[-1]:.6g} s "
+            "from its first sample"
+        )
     return dataclasses.replace(data, recording=rec.take(keep), kept_rows=data.kept_rows[keep])
 
 
@@ -154,17 +166,31 @@ def read(
     -----
     The same options as :class:`ReadOptions` (its doc says more of each).
     """
-    layout_fields = {"columns": columns, "gyro_unit": gyro_unit, "accel_unit": accel_unit, "time_unit": time_unit,
-                     "delimiter": delimiter, "decimal": decimal}
-    others = {"drop_nonfinite": drop_nonfinite, "instance": instance, "device_id": device_id, "imu_topic": imu_topic,
-              "temperature_topic": temperature_topic, "record": record, "channels": channels,
-              "time_range_s": time_range_s}
+    layout_fields = {
+        "columns": columns,
+        "gyro_unit": gyro_unit,
+        "accel_unit": accel_unit,
+        "time_unit": time_unit,
+        "delimiter": delimiter,
+        "decimal": decimal,
+    }
+    others = {
+        "drop_nonfinite": drop_nonfinite,
+        "instance": instance,
+        "device_id": device_id,
+        "imu_topic": imu_topic,
+        "temperature_topic": temperature_topic,
+        "record": record,
+        "channels": channels,
+        "time_range_s": time_range_s,
+    }
     options, project_fmt = _merged_options(config, layout, layout_fields, others)
     return read_input(path, options, fmt=fmt or project_fmt, progress=progress).recording
 
 
-def _merged_options(config, layout: TableLayout | None, layout_fields: dict, others: dict
-                    ) -> tuple[ReadOptions, str | None]:
+def _merged_options(
+    config, layout: TableLayout | None, layout_fields: dict, others: dict
+) -> tuple[ReadOptions, str | None]:
     """The reading options of :func:`read`: the project file's (``config``), then what was given (not None)."""
     base, fmt = project_read_options(config) if config is not None else (ReadOptions(), None)
     given_layout = {k: v for k, v in layout_fields.items() if v is not None}

@@ -44,9 +44,11 @@ def require_memory(path: str | os.PathLike, needed_bytes: float, what: str = "re
     """Refuse (one line naming ``path``) when ``needed_bytes`` [bytes] exceed the address space left."""
     left = address_space_left()
     if left is not None and needed_bytes > left:
-        raise InputError(f"{Path(path)}: {what} takes about {needed_bytes / 1e9:.2g} GB of memory, and this process "
-                         f"may map {left / 1e9:.2g} GB more under its limit (ulimit -v); read less at once (the "
-                         "channels needed, a stretch of time; apply streams tables) or raise the limit")
+        raise InputError(
+            f"{Path(path)}: {what} takes about {needed_bytes / 1e9:.2g} GB of memory, and this process "
+            f"may map {left / 1e9:.2g} GB more under its limit (ulimit -v); read less at once (the "
+            "channels needed, a stretch of time; apply streams tables) or raise the limit"
+        )
 
 
 def estimated_table_bytes(path: str | os.PathLike, compressed: bool) -> float:

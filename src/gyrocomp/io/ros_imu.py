@@ -44,7 +44,7 @@ class ImuBatch:
     @property
     def values(self) -> np.ndarray:
         """The 37 float64 values of each message (n, 37), a copy."""
-        raw = np.ascontiguousarray(self.data[:, self.values_at:self.values_at + 8 * _VALUES])
+        raw = np.ascontiguousarray(self.data[:, self.values_at : self.values_at + 8 * _VALUES])
         return raw.view("<f8").reshape(-1, _VALUES)
 
     def stamp_s(self, cdr: bool) -> np.ndarray:
@@ -60,7 +60,7 @@ class ImuBatch:
         data = self.data.copy()
         at = self.values_at + 8 * start
         width = 8 * values.shape[1]
-        data[rows, at:at + width] = np.ascontiguousarray(values, dtype="<f8").view(np.uint8).reshape(-1, width)
+        data[rows, at : at + width] = np.ascontiguousarray(values, dtype="<f8").view(np.uint8).reshape(-1, width)
         return ImuBatch(data, self.values_at)
 
     def message(self, i: int) -> bytes:
@@ -92,5 +92,11 @@ def imu_batch(raws: list, cdr: bool) -> ImuBatch | None:
     return ImuBatch(data, values_at)
 
 
-__all__ = ["ANGULAR_VELOCITY", "ANGULAR_VELOCITY_COVARIANCE", "ImuBatch", "LINEAR_ACCELERATION",
-           "LINEAR_ACCELERATION_COVARIANCE", "imu_batch"]
+__all__ = [
+    "ANGULAR_VELOCITY",
+    "ANGULAR_VELOCITY_COVARIANCE",
+    "ImuBatch",
+    "LINEAR_ACCELERATION",
+    "LINEAR_ACCELERATION_COVARIANCE",
+    "imu_batch",
+]

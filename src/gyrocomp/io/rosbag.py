@@ -21,8 +21,18 @@ import pyarrow as pa
 from ..errors import DataQualityWarning, InputError, TimeOrderWarning, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
-from .common import (ProgressCallback, ReadOptions, keep_matched, left_out, log_recording, match_by_time,
-                     none_matched, order_by_time, require, time_order_warning)
+from .common import (
+    ProgressCallback,
+    ReadOptions,
+    keep_matched,
+    left_out,
+    log_recording,
+    match_by_time,
+    none_matched,
+    order_by_time,
+    require,
+    time_order_warning,
+)
 from .layout import TIME_COLUMN, TableLayout
 from .readers import Reader, register_reader
 from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, imu_batch
@@ -47,8 +57,11 @@ def bag_path(path: Path) -> Path:
 
 
 #: what a bag of each kind is, for messages
-KIND_WORDS = {"ros1": "a .bag file (a ROS 1 bag)", "ros2": "a folder (a ROS 2 bag)",
-              "mcap": "a .mcap file (an MCAP bag without its folder)"}
+KIND_WORDS = {
+    "ros1": "a .bag file (a ROS 1 bag)",
+    "ros2": "a folder (a ROS 2 bag)",
+    "mcap": "a .mcap file (an MCAP bag without its folder)",
+}
 
 
 def bag_kind(path: Path) -> str:
@@ -67,8 +80,10 @@ def _only_its_own_files(path: Path, bag: Path) -> None:
     root = bag.resolve()
     for entry in sorted(bag.iterdir()):
         if entry.is_symlink() and root not in entry.resolve().parents:
-            raise InputError(f"{path}: {entry.name} links to {entry.resolve()}, outside the bag folder; gyrocomp reads "
-                             "only the bag's own files (copy the file into the folder)")
+            raise InputError(
+                f"{path}: {entry.name} links to {entry.resolve()}, outside the bag folder; gyrocomp reads "
+                "only the bag's own files (copy the file into the folder)"
+            )
 
 
 def _check_types(path: Path, readers: list) -> None:
@@ -78,8 +93,10 @@ def _check_types(path: Path, readers: list) -> None:
         with reader:
             for connection in reader.connections:
                 if not _MSGTYPE.fullmatch(str(connection.msgtype)):
-                    raise InputError(f"{path}: topic {connection.topic!r} has the message type "
-                                     f"{str(connection.msgtype)[:80]!r}, not a ROS type name; refused")
+                    raise InputError(
+                        f"{path}: topic {connection.topic!r} has the message type "
+                        f"{str(connection.msgtype)[:80]!r}, not a ROS type name; refused"
+                    )
 
 
 def _topics_of(connections: list, msgtype: str) -> list[str]:
@@ -123,8 +140,10 @@ def _imu_topic_asked(path: Path, connections: list, options: ReadOptions) -> str
         return options.imu_topic
     topics = _topics_of(connections, IMU_TYPE)
     if not 0 <= options.instance < len(topics):
-        raise InputError(f"{path}: instance={options.instance}: the bag has {len(topics)} {IMU_TYPE} topic(s) "
-                         f"({', '.join(topics) or 'none'}), instances 0 to {len(topics) - 1}")
+        raise InputError(
+            f"{path}: instance={options.instance}: the bag has {len(topics)} {IMU_TYPE} topic(s) "
+            f"({', '.join(topics) or 'none'}), instances 0 to {len(topics) - 1}"
+        )
     return topics[options.instance]
 
 
@@ -143,8 +162,10 @@ def _topic(path: Path, connections: list, msgtype: str, asked: str | None, optio
     if asked is not None:
         chosen = [c for c in connections if c.topic == asked]
         if not chosen:
-            present = "; ".join(f"its {kind} topics are {', '.join(_topics_of(connections, kind)) or 'none'}"
-                                for kind in (IMU_TYPE, TEMPERATURE_TYPE))
+            present = "; ".join(
+                f"its {kind} topics are {', '.join(_topics_of(connections, kind)) or 'none'}"
+                for kind in (IMU_TYPE, TEMPERATURE_TYPE)
+            )
             raise InputError(f"{path}: {option}={asked}: no such topic in the bag; {present}")
         if chosen[0].msgtype != msgtype:
             raise InputError(f"{path}: {option}={asked}: the topic has type {chosen[0].msgtype}, not {msgtype}")
@@ -155,8 +176,9 @@ def _topic(path: Path, connections: list, msgtype: str, asked: str | None, optio
         return []
     if len(of_type) > 1:
         also = " or instance= (their index, from 0, in this order)" if msgtype == IMU_TYPE else ""
-        raise InputError(f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with "
-                         f"{option}={also}")
+        raise InputError(
+            f"{path}: {len(of_type)} {msgtype} topics ({', '.join(of_type)}); choose one with {option}={also}"
+        )
     return [c for c in connections if c.topic == of_type[0]]
 
 
@@ -175,15 +197,20 @@ def _damaged(path: Path, topic: str):
     except InputError:
         raise
     except Exception as exc:  # rosbags' own errors, and what a damaged record makes its parsers raise
-        raise InputError(f"{path}: damaged ROS bag: topic {topic}: {type(exc).__name__}: "
-                         f"{printable(str(exc))[:160]}") from None
+        raise InputError(
+            f"{path}: damaged ROS bag: topic {topic}: {type(exc).__name__}: {printable(str(exc))[:160]}"
+        ) from None
 
 
 def _read_all(path: Path, counted: int, read: int, topic: str) -> None:
     """Warn when fewer messages were read than the bag's index counts (a damaged or cut-short bag)."""
     if read < counted:
-        warnings.warn(f"{path}: topic {topic}: the bag's index counts {counted} messages, {read} were read; the "
-                      "rest is damaged or missing", DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{path}: topic {topic}: the bag's index counts {counted} messages, {read} were read; the "
+            "rest is damaged or missing",
+            DataQualityWarning,
+            stacklevel=3,
+        )
 
 
 #: IMU messages decoded at once (about 20 MB of messages)
@@ -196,8 +223,11 @@ def decoded_imu(reader, msgtype: str, raws: list) -> tuple[np.ndarray, np.ndarra
     batch = imu_batch(raws, cdr=reader.is2)
     if batch is not None:
         values = batch.values
-        return (batch.stamp_s(cdr=reader.is2), values[:, ANGULAR_VELOCITY:ANGULAR_VELOCITY + 3],
-                values[:, LINEAR_ACCELERATION:LINEAR_ACCELERATION + 3])
+        return (
+            batch.stamp_s(cdr=reader.is2),
+            values[:, ANGULAR_VELOCITY : ANGULAR_VELOCITY + 3],
+            values[:, LINEAR_ACCELERATION : LINEAR_ACCELERATION + 3],
+        )
     time_s, gyro, accel = np.empty(len(raws)), np.empty((len(raws), 3)), np.empty((len(raws), 3))
     for i, raw in enumerate(raws):
         msg = reader.deserialize(raw, msgtype)
@@ -218,8 +248,9 @@ def _imu_batches(path: Path, reader, imu: list, size: int, progress: ProgressCal
             raws.append(raw)
             read += 1
             if read > n:
-                raise InputError(f"{path}: damaged ROS bag: topic {imu[0].topic}: more messages than the bag's "
-                                 f"index counts ({n})")
+                raise InputError(
+                    f"{path}: damaged ROS bag: topic {imu[0].topic}: more messages than the bag's index counts ({n})"
+                )
             if len(raws) == size:
                 yield decoded_imu(reader, imu[0].msgtype, raws)
                 raws = []
@@ -235,9 +266,10 @@ def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | Non
     n = sum(c.msgcount for c in imu)
     time_s, gyro, accel = np.empty(n), np.empty((n, 3)), np.empty((n, 3))  # filled batch by batch: no copies
     done = 0
-    for t, g, a in _imu_batches(path, reader, imu, DECODE_BATCH,
-                                (lambda f: progress(f * n / total)) if progress else None):
-        time_s[done:done + t.size], gyro[done:done + t.size], accel[done:done + t.size] = t, g, a
+    for t, g, a in _imu_batches(
+        path, reader, imu, DECODE_BATCH, (lambda f: progress(f * n / total)) if progress else None
+    ):
+        time_s[done : done + t.size], gyro[done : done + t.size], accel[done : done + t.size] = t, g, a
         done += t.size
     gyro, accel = gyro[:done], accel[:done]
     gyro *= _RAD
@@ -267,13 +299,20 @@ def chosen_topics(path: Path, connections: list, options: ReadOptions) -> tuple[
 
 
 def _metadata(path: Path, imu: list, thermo: list) -> dict:
-    return {"path": str(path), "format": "rosbag", "imu_topic": imu[0].topic,
-            "temperature_topic": thermo[0].topic if thermo else None}
+    return {
+        "path": str(path),
+        "format": "rosbag",
+        "imu_topic": imu[0].topic,
+        "temperature_topic": thermo[0].topic if thermo else None,
+    }
 
 
 def _warn_no_temperature(path: Path, stacklevel: int) -> None:
-    warnings.warn(f"{path}: no {TEMPERATURE_TYPE} topic; the recording has no temperature "
-                  "(only noise analysis works without it)", DataQualityWarning, stacklevel=stacklevel + 1)
+    warnings.warn(
+        f"{path}: no {TEMPERATURE_TYPE} topic; the recording has no temperature (only noise analysis works without it)",
+        DataQualityWarning,
+        stacklevel=stacklevel + 1,
+    )
 
 
 def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
@@ -433,8 +472,16 @@ class BagStream:
         time_s, gyro, accel, temperature = part
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DataQualityWarning)  # rows dropped: counted over the bag, said once
-            recording = log_recording(self.path, self.options, time_s, gyro, accel, temperature,
-                                      _metadata(self.path, self.imu, self.thermo), first_row=self.rows)
+            recording = log_recording(
+                self.path,
+                self.options,
+                time_s,
+                gyro,
+                accel,
+                temperature,
+                _metadata(self.path, self.imu, self.thermo),
+                first_row=self.rows,
+            )
         self.rows_dropped += recording.metadata["rows_dropped"]
         first, self.rows = self.rows, self.rows + time_s.size
         if recording.n_samples and self._last_s is not None and recording.time_s[0] - self._last_s > 2 * self._period_s:
@@ -452,8 +499,16 @@ class BagStream:
         if moved or dropped:
             warnings.warn(time_order_warning(str(self.path), moved, dropped, self._order["back"]), stacklevel=2)
         if self._order["unmatched"]:
-            warnings.warn(left_out(str(self.path), f"temperature topic {self.thermo[0].topic}",
-                                   self._order["unmatched"], self._order["samples"]), DataQualityWarning, stacklevel=2)
+            warnings.warn(
+                left_out(
+                    str(self.path),
+                    f"temperature topic {self.thermo[0].topic}",
+                    self._order["unmatched"],
+                    self._order["samples"],
+                ),
+                DataQualityWarning,
+                stacklevel=2,
+            )
         if self.rows_dropped:
             warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
 
@@ -468,7 +523,16 @@ def bag_stream(path: Path, options: ReadOptions, chunk_rows: int, progress) -> B
     return BagStream(path, options, chunk_rows=chunk_rows, progress=progress)
 
 
-register_reader(Reader("rosbag", "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, a bare .mcap, extra [ros]", read_rosbag,
-                       suffixes=(".bag", ".db3", ".mcap"), magic=(b"#ROSBAG", b"\x89MCAP"), aliases=("bag", "ros"),
-                       folder_marker="metadata.yaml", instances=rosbag_instances,
-                       stream=bag_stream))
+register_reader(
+    Reader(
+        "rosbag",
+        "ROS 1 bag, ROS 2 bag folder or its .db3/.mcap, a bare .mcap, extra [ros]",
+        read_rosbag,
+        suffixes=(".bag", ".db3", ".mcap"),
+        magic=(b"#ROSBAG", b"\x89MCAP"),
+        aliases=("bag", "ros"),
+        folder_marker="metadata.yaml",
+        instances=rosbag_instances,
+        stream=bag_stream,
+    )
+)

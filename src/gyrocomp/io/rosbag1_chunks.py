@@ -117,7 +117,7 @@ def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple):
             op = conn = time = None
             while pos < end:
                 (field,), pos = _UINT32.unpack_from(data, pos), pos + 4
-                name, _, value = data[pos:pos + field].partition(b"=")
+                name, _, value = data[pos : pos + field].partition(b"=")
                 pos += field
                 if name == b"op":
                     op = value[0]
@@ -129,11 +129,15 @@ def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple):
             (length,), pos = _UINT32.unpack_from(data, end), end + 4
             if pos + length > size:
                 raise rb.ReaderError("A record's data runs past the end of its chunk.")
-            if op == rb.RecordType.MSGDATA and conn in wanted and (start is None or time >= start) and (
-                    stop is None or time < stop):
+            if (
+                op == rb.RecordType.MSGDATA
+                and conn in wanted
+                and (start is None or time >= start)
+                and (stop is None or time < stop)
+            ):
                 if conn not in connmap:
                     raise rb.ReaderError(f"A message of connection {conn}, which the bag's index lacks.")
-                yield connmap[conn], time, data[pos:pos + length]
+                yield connmap[conn], time, data[pos : pos + length]
             pos += length
     except (struct.error, IndexError, TypeError) as err:
         raise rb.ReaderError(f"A damaged record in a chunk ({type(err).__name__}: {err}).") from None
@@ -144,8 +148,11 @@ def chunked_reader1() -> type:
     """``ChunkedReader1``: a :class:`rosbags.rosbag1.Reader` without the per-message index (see the module), the
     same connections (with their message counts), messages yielded chunk by chunk in file order; made on first
     use (rosbags is an optional extra)."""
-    return type("ChunkedReader1", (_rosbag1().Reader,), {"open": _open, "messages": _messages,
-                                                          "__doc__": chunked_reader1.__doc__})
+    return type(
+        "ChunkedReader1",
+        (_rosbag1().Reader,),
+        {"open": _open, "messages": _messages, "__doc__": chunked_reader1.__doc__},
+    )
 
 
 def _write_chunk(self, chunk) -> None:
@@ -165,8 +172,9 @@ def lean_writer1() -> type:
     """``LeanWriter1``: a :class:`rosbags.rosbag1.Writer` that keeps of each written chunk only its message counts
     (rosbags' keeps an index entry of every message until it closes the bag: 5.6 GB for ten hours of IMU messages at
     1 kHz); the bag it writes is rosbags' byte for byte."""
-    return type("LeanWriter1", (_rosbag1_writer().Writer,), {"write_chunk": _write_chunk,
-                                                              "__doc__": lean_writer1.__doc__})
+    return type(
+        "LeanWriter1", (_rosbag1_writer().Writer,), {"write_chunk": _write_chunk, "__doc__": lean_writer1.__doc__}
+    )
 
 
 __all__ = ["chunked_reader1", "lean_writer1"]

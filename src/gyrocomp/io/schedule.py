@@ -61,22 +61,27 @@ class RateSchedule:
     def apply(self, recording: Recording, name: str) -> Recording:
         """``recording`` with the reference rates of the run the schedule calls ``name`` [deg/s]."""
         if recording.reference_rate_dps is not None:
-            raise InputError(f"{recording.source}: has ref_rate_x/_y/_z columns and the schedule {self.source} names "
-                             "it too; give the rates once")
+            raise InputError(
+                f"{recording.source}: has ref_rate_x/_y/_z columns and the schedule {self.source} names "
+                "it too; give the rates once"
+            )
         t = recording.time_s - recording.time_s[0]
         reference = np.zeros((recording.n_samples, 3))
         for s in self.stretches:
             if s.file != name:
                 continue
             if s.start_s >= t[-1]:
-                raise InputError(f"{self.source}, row {s.row}: start_s {s.start_s:g} s is after the end of "
-                                 f"{recording.source} ({t[-1]:g} s)")
+                raise InputError(
+                    f"{self.source}, row {s.row}: start_s {s.start_s:g} s is after the end of "
+                    f"{recording.source} ({t[-1]:g} s)"
+                )
             reference[(t >= s.start_s) & (t < s.end_s)] = s.rate_dps
         return replace(recording, reference_rate_dps=reference)
 
 
-def apply_schedule(schedule: RateSchedule, recordings: list[Recording],
-                   paths: list[str | os.PathLike]) -> list[Recording]:
+def apply_schedule(
+    schedule: RateSchedule, recordings: list[Recording], paths: list[str | os.PathLike]
+) -> list[Recording]:
     """Each recording (read from the matching path) with its reference rates when the schedule names it; refuses
     a schedule that names a run not among them."""
     out, used = [], set()
@@ -105,8 +110,9 @@ def read_rate_schedule(path: str | os.PathLike) -> RateSchedule:
         raise InputError(f"{path}: not a readable CSV schedule ({str(exc).splitlines()[0]})") from None
     missing = [c for c in SCHEDULE_COLUMNS if c not in table.columns]
     if missing:
-        raise InputError(f"{path}: schedule column(s) {', '.join(missing)} missing; it needs "
-                         f"{', '.join(SCHEDULE_COLUMNS)}")
+        raise InputError(
+            f"{path}: schedule column(s) {', '.join(missing)} missing; it needs {', '.join(SCHEDULE_COLUMNS)}"
+        )
     stretches = []
     for i, row in enumerate(table.itertuples(index=False), start=2):
         values = {}
@@ -118,10 +124,19 @@ def read_rate_schedule(path: str | os.PathLike) -> RateSchedule:
         if not str(row.file).strip():
             raise InputError(f"{path}, row {i}: file is empty; name the run the stretch belongs to")
         if not 0 <= values["start_s"] < values["end_s"]:
-            raise InputError(f"{path}, row {i}: start_s {values['start_s']:g}, end_s {values['end_s']:g}; need "
-                             "0 <= start_s < end_s [s from the run's first sample]")
-        stretches.append(RateStretch(str(row.file).strip(), values["start_s"], values["end_s"],
-                                     tuple(values[c] for c in REFERENCE_RATE_AXES), i))
+            raise InputError(
+                f"{path}, row {i}: start_s {values['start_s']:g}, end_s {values['end_s']:g}; need "
+                "0 <= start_s < end_s [s from the run's first sample]"
+            )
+        stretches.append(
+            RateStretch(
+                str(row.file).strip(),
+                values["start_s"],
+                values["end_s"],
+                tuple(values[c] for c in REFERENCE_RATE_AXES),
+                i,
+            )
+        )
     if not stretches:
         raise InputError(f"{path}: the schedule has no stretches")
     for name in dict.fromkeys(s.file for s in stretches):

@@ -54,8 +54,12 @@ def parse_rate(text: str) -> float:
 
 def check_rate(value) -> float:
     """A nominal sample rate [Hz]: a finite number > 0 (and at most 1 MHz), else one line naming it."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or not 0 < value <= 1e6:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not math.isfinite(value)
+        or not 0 < value <= 1e6
+    ):
         raise InputError(f"rate_hz: must be a positive number of Hz up to 1e6, got {value!r}")
     return float(value)
 
@@ -71,6 +75,7 @@ def _lines(path: Path) -> Iterator[Iterator[bytes]]:
     else:
         stream = opener(path, "rb")
     with stream as fh:
+
         def lines() -> Iterator[bytes]:
             while True:
                 line = fh.readline(MAX_LINE_BYTES + 1)
@@ -82,6 +87,7 @@ def _lines(path: Path) -> Iterator[Iterator[bytes]]:
                     yield b"\x00"  # a placeholder that is no row
                     continue
                 yield line
+
         yield lines()
 
 
@@ -135,15 +141,25 @@ def read_headerless(path, names: tuple[str, ...], rate_hz: float | None = None) 
     except (OSError, EOFError, lzma.LZMAError) as exc:
         raise InputError(f"{path}: a compressed file that does not decompress ({exc})") from None
     if not rows:
-        shown = f"; its first line: {printable(first_skipped[1].decode('utf-8', 'replace').strip())[:80]!r}" \
-            if first_skipped else ""
+        shown = (
+            f"; its first line: {printable(first_skipped[1].decode('utf-8', 'replace').strip())[:80]!r}"
+            if first_skipped
+            else ""
+        )
         raise InputError(f"{path}: no line holds {count} numbers, one per name given ({', '.join(names)}){shown}")
     if skipped:
         line_number, text = first_skipped
-        quoted = "(longer than a row can be)" if text == b"\x00" else \
-            repr(printable(text.decode("utf-8", "replace").strip())[:60])
-        warnings.warn(f"{path}: skipped {skipped} line(s) that are not {count} numbers (a banner, a header or "
-                      f"a garbled line), the first: line {line_number} {quoted}", DataQualityWarning, stacklevel=3)
+        quoted = (
+            "(longer than a row can be)"
+            if text == b"\x00"
+            else repr(printable(text.decode("utf-8", "replace").strip())[:60])
+        )
+        warnings.warn(
+            f"{path}: skipped {skipped} line(s) that are not {count} numbers (a banner, a header or "
+            f"a garbled line), the first: line {line_number} {quoted}",
+            DataQualityWarning,
+            stacklevel=3,
+        )
     values = np.asarray(rows, dtype=float)
     columns = {name: _floats(values[:, i]) for i, name in enumerate(names)}
     if rate_hz is not None and "time" not in names:
@@ -174,5 +190,12 @@ def looks_headerless(first_line: str) -> bool:
     return True
 
 
-__all__ = ["MAX_LINE_BYTES", "check_rate", "looks_headerless", "parse_names", "parse_rate", "read_headerless",
-           "split_fields"]
+__all__ = [
+    "MAX_LINE_BYTES",
+    "check_rate",
+    "looks_headerless",
+    "parse_names",
+    "parse_rate",
+    "read_headerless",
+    "split_fields",
+]

@@ -27,10 +27,27 @@ import pyarrow.parquet as pq
 from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
-from .tables import (CSV_BLOCK_BYTES, DECOMPRESS_ERRORS, HEADER_MAX_BYTES, TableLayout, TextFormat, _channel_selector,
-                     _csv_options, _read_arrow, _resolved_columns, check_header, check_parquet_footer, csv_codec,
-                     detect_table_format, open_csv_bytes, output_text_format, read_error, rows_dropped, table_recording,
-                     with_decimal)
+from .tables import (
+    CSV_BLOCK_BYTES,
+    DECOMPRESS_ERRORS,
+    HEADER_MAX_BYTES,
+    TableLayout,
+    TextFormat,
+    _channel_selector,
+    _csv_options,
+    _read_arrow,
+    _resolved_columns,
+    check_header,
+    check_parquet_footer,
+    csv_codec,
+    detect_table_format,
+    open_csv_bytes,
+    output_text_format,
+    read_error,
+    rows_dropped,
+    table_recording,
+    with_decimal,
+)
 
 #: rows per chunk (about 100 MB of numbers for an 8-column table)
 CHUNK_ROWS = 262144
@@ -58,9 +75,17 @@ class TableStream:
     """A CSV or Parquet table read in chunks of about ``chunk_rows`` rows (see the module); with ``channels``, only
     those channels' columns (and time) are read, as :func:`gyrocomp.io.read_table` reads them."""
 
-    def __init__(self, path, layout: TableLayout | None = None, *, fmt: str | None = None,
-                 drop_nonfinite: bool = False, chunk_rows: int = CHUNK_ROWS, progress=None,
-                 channels: tuple[str, ...] | None = None):
+    def __init__(
+        self,
+        path,
+        layout: TableLayout | None = None,
+        *,
+        fmt: str | None = None,
+        drop_nonfinite: bool = False,
+        chunk_rows: int = CHUNK_ROWS,
+        progress=None,
+        channels: tuple[str, ...] | None = None,
+    ):
         self.path = Path(path)
         self.layout = layout or TableLayout()
         self.fmt = fmt or detect_table_format(self.path) or "csv"
@@ -120,14 +145,20 @@ class TableStream:
                 source = stack.enter_context(open_csv_bytes(self.path, codec))
                 self._source = source if codec is None else None
                 if not head.strip():
-                    raise InputError(f"{self.path}: the file is empty; expected a header such as "
-                                     "time,gyro_z,temperature")
+                    raise InputError(
+                        f"{self.path}: the file is empty; expected a header such as time,gyro_z,temperature"
+                    )
                 self.text_format = TextFormat.found(head[:4096], self.layout)
                 parse = pacsv.ParseOptions(delimiter=self.text_format.delimiter)
-                convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=self.text_format.decimal,
-                                               include_columns=self._read or [])
-                reader = pacsv.open_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
-                                        parse_options=parse, convert_options=convert)
+                convert = pacsv.ConvertOptions(
+                    strings_can_be_null=True, decimal_point=self.text_format.decimal, include_columns=self._read or []
+                )
+                reader = pacsv.open_csv(
+                    source,
+                    read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
+                    parse_options=parse,
+                    convert_options=convert,
+                )
             except DECOMPRESS_ERRORS as exc:
                 raise read_error(self.path, exc, head) from None
             yield reader
@@ -140,8 +171,9 @@ class TableStream:
         if self.fmt == "parquet":
             # without pre-buffering: pyarrow would keep every row group's read-ahead until the file is closed
             # (memory growing with the file, about 12 bytes a row)
-            yield from pq.ParquetFile(arrow_source(self.path), pre_buffer=False).iter_batches(batch_size=self.chunk_rows,
-                                                                                 columns=self._read)
+            yield from pq.ParquetFile(arrow_source(self.path), pre_buffer=False).iter_batches(
+                batch_size=self.chunk_rows, columns=self._read
+            )
             return
         with self._csv_reader() as reader:
             while True:
@@ -188,15 +220,24 @@ class TableStream:
         for table in self._tables():
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", DataQualityWarning)  # rows dropped: counted over the file, said once
-                recording, kept = table_recording(table, self.columns, self.layout, self.path, self.fmt,
-                                                  drop_nonfinite=self.drop_nonfinite, first_row=first)
+                recording, kept = table_recording(
+                    table,
+                    self.columns,
+                    self.layout,
+                    self.path,
+                    self.fmt,
+                    drop_nonfinite=self.drop_nonfinite,
+                    first_row=first,
+                )
             self.rows_dropped += table.num_rows - kept.size
             time_s = recording.time_s
             if last is not None:
                 step = float(time_s[0] - last[0])
                 if not step > 0:
-                    raise InputError(f"{self.path}: row {first + kept[0] + 1}: time {time_s[0]!r} s does not "
-                                     f"increase (row {last[1]}: {last[0]!r} s); sort the file by time")
+                    raise InputError(
+                        f"{self.path}: row {first + kept[0] + 1}: time {time_s[0]!r} s does not "
+                        f"increase (row {last[1]}: {last[0]!r} s); sort the file by time"
+                    )
                 if step > 2.0 * period:
                     self._gap(step, last[1])
             period = period or 1.0 / recording.rate_hz
@@ -235,9 +276,12 @@ class TableStream:
             warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
         if self.gaps:
             duration, row = self.longest_gap
-            warnings.warn(f"{self.path}: {self.gaps} time gap(s) longer than 2 sample periods (longest "
-                          f"{duration:.6g} s after row {row}); kept as they are, nothing interpolated",
-                          DataQualityWarning, stacklevel=2)
+            warnings.warn(
+                f"{self.path}: {self.gaps} time gap(s) longer than 2 sample periods (longest "
+                f"{duration:.6g} s after row {row}); kept as they are, nothing interpolated",
+                DataQualityWarning,
+                stacklevel=2,
+            )
 
 
 class TableWriter:
@@ -246,8 +290,9 @@ class TableWriter:
     the columns whose values were computed (compensated rates): Parquet stores them without a dictionary, which
     only costs time on continuous values (twice the writing time in row groups of 2^18 rows)."""
 
-    def __init__(self, path, fmt: str | None = None, *, computed: tuple[str, ...] = (),
-                 text_format: TextFormat | None = None):
+    def __init__(
+        self, path, fmt: str | None = None, *, computed: tuple[str, ...] = (), text_format: TextFormat | None = None
+    ):
         self.path = Path(path)
         self.fmt = fmt or detect_table_format(self.path) or "csv"
         self.computed = tuple(computed)
@@ -268,8 +313,11 @@ class TableWriter:
                 dictionary = [n for n in table.column_names if n not in self.computed] if self.computed else True
                 self._writer = pq.ParquetWriter(self._tmp, table.schema, use_dictionary=dictionary)
             else:
-                self._writer = pacsv.CSVWriter(self._tmp, with_decimal(table, self.text_format).schema,
-                                               write_options=_csv_options(table.column_names, self.text_format))
+                self._writer = pacsv.CSVWriter(
+                    self._tmp,
+                    with_decimal(table, self.text_format).schema,
+                    write_options=_csv_options(table.column_names, self.text_format),
+                )
         elif table.schema != self._schema:
             try:
                 table = table.cast(self._schema)

@@ -7,14 +7,14 @@ from pathlib import Path
 
 from .common import ProgressCallback, ReadOptions
 from .readers import Reader, register_reader
-from .tables import (COMPRESSED_SUFFIXES, PARQUET_MAGIC, PARQUET_SUFFIXES, TEXT_TABLE_SUFFIXES, TableData,
-                     read_table)
+from .tables import COMPRESSED_SUFFIXES, PARQUET_MAGIC, PARQUET_SUFFIXES, TEXT_TABLE_SUFFIXES, TableData, read_table
 
 
 def _table_reader(fmt: str):
     def read(path: Path, options: ReadOptions, progress: ProgressCallback | None) -> TableData:
-        data = read_table(path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite,
-                          channels=options.channels)
+        data = read_table(
+            path, options.layout, fmt=fmt, drop_nonfinite=options.drop_nonfinite, channels=options.channels
+        )
         if progress:
             progress(1.0)
         return data
@@ -22,11 +22,26 @@ def _table_reader(fmt: str):
     return read
 
 
-register_reader(Reader("csv", "a delimited text table, gzip/bz2/xz/zstd compressed too", _table_reader("csv"),
-                       suffixes=TEXT_TABLE_SUFFIXES + tuple(s + c for s in TEXT_TABLE_SUFFIXES
-                                                            for c in COMPRESSED_SUFFIXES),
-                       aliases=("tsv", "txt"), table=True))
-register_reader(Reader("parquet", "an Apache Parquet table", _table_reader("parquet"), suffixes=PARQUET_SUFFIXES,
-                       magic=(PARQUET_MAGIC,), aliases=("pq",), table=True))
+register_reader(
+    Reader(
+        "csv",
+        "a delimited text table, gzip/bz2/xz/zstd compressed too",
+        _table_reader("csv"),
+        suffixes=TEXT_TABLE_SUFFIXES + tuple(s + c for s in TEXT_TABLE_SUFFIXES for c in COMPRESSED_SUFFIXES),
+        aliases=("tsv", "txt"),
+        table=True,
+    )
+)
+register_reader(
+    Reader(
+        "parquet",
+        "an Apache Parquet table",
+        _table_reader("parquet"),
+        suffixes=PARQUET_SUFFIXES,
+        magic=(PARQUET_MAGIC,),
+        aliases=("pq",),
+        table=True,
+    )
+)
 
 __all__: list[str] = []

@@ -67,8 +67,7 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
 
 
 #: compressed CSV, told by its first bytes: the codec's name for pyarrow (xz through Python's lzma)
-_COMPRESSED = ((b"\x1f\x8b", "gzip"), (b"BZh", "bz2"), (b"\x28\xb5\x2f\xfd", "zstd"),
-               (b"\xfd7zXZ\x00", "xz"))
+_COMPRESSED = ((b"\x1f\x8b", "gzip"), (b"BZh", "bz2"), (b"\x28\xb5\x2f\xfd", "zstd"), (b"\xfd7zXZ\x00", "xz"))
 #: CSV bytes parsed at once (the longest line a table may have)
 CSV_BLOCK_BYTES = 1 << 20
 #: field separators a CSV may use (vendor exports, spreadsheets in locales with a decimal comma)
@@ -106,14 +105,18 @@ def check_header(path: Path, head: bytes) -> None:
     and time of a million empty columns)."""
     first = head.split(b"\n", 1)[0]
     if b"\n" not in head and len(head) >= HEADER_MAX_BYTES:
-        raise InputError(f"{path}: its first line is over {HEADER_MAX_BYTES >> 20} MB long, which no table's header "
-                         f"is (more than {MAX_COLUMNS} columns, or a damaged or binary file); keep the columns "
-                         "gyrocomp reads (time, gyro, accelerometer, temperature) in a file of their own")
+        raise InputError(
+            f"{path}: its first line is over {HEADER_MAX_BYTES >> 20} MB long, which no table's header "
+            f"is (more than {MAX_COLUMNS} columns, or a damaged or binary file); keep the columns "
+            "gyrocomp reads (time, gyro, accelerometer, temperature) in a file of their own"
+        )
     columns = max(first.count(d.encode()) for d in DELIMITERS) + 1
     if columns > MAX_COLUMNS:
-        raise InputError(f"{path}: the header names {columns} columns; gyrocomp reads tables of up to "
-                         f"{MAX_COLUMNS}: keep the columns it reads (time, gyro, accelerometer, temperature) in a "
-                         "file of their own")
+        raise InputError(
+            f"{path}: the header names {columns} columns; gyrocomp reads tables of up to "
+            f"{MAX_COLUMNS}: keep the columns it reads (time, gyro, accelerometer, temperature) in a "
+            "file of their own"
+        )
 
 
 def _csv_bytes(path: Path) -> tuple[pa.NativeFile | str, bytes]:
@@ -148,9 +151,11 @@ def check_parquet_footer(path: Path) -> None:
         return
     footer = int.from_bytes(tail[:4], "little")
     if tail[4:] == PARQUET_MAGIC and footer > PARQUET_FOOTER_MAX_BYTES:
-        raise InputError(f"{path}: its metadata takes {footer / 1e6:.0f} MB (over {PARQUET_FOOTER_MAX_BYTES >> 20} MB: "
-                         "very many small row groups), which would take gigabytes to read; rewrite it with larger "
-                         "row groups, e.g. pyarrow.parquet.write_table(table, path, row_group_size=1_000_000)")
+        raise InputError(
+            f"{path}: its metadata takes {footer / 1e6:.0f} MB (over {PARQUET_FOOTER_MAX_BYTES >> 20} MB: "
+            "very many small row groups), which would take gigabytes to read; rewrite it with larger "
+            "row groups, e.g. pyarrow.parquet.write_table(table, path, row_group_size=1_000_000)"
+        )
 
 
 def read_error(path: Path, exc: Exception, head: bytes) -> InputError:
@@ -158,8 +163,10 @@ def read_error(path: Path, exc: Exception, head: bytes) -> InputError:
     does not decompress, or a parse error with a hint for a log without a header line."""
     text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     if "straddl" in text:
-        return InputError(f"{path}: a line over {CSV_BLOCK_BYTES >> 20} MB long, which no row of a table is (a "
-                          "damaged file, or text that is no table)")
+        return InputError(
+            f"{path}: a line over {CSV_BLOCK_BYTES >> 20} MB long, which no row of a table is (a "
+            "damaged file, or text that is no table)"
+        )
     if not isinstance(exc, pa.ArrowInvalid):
         return InputError(f"{path}: cannot be read to its end ({text}); a damaged or cut-short compressed file?")
     return InputError(f"{path}: not a readable CSV table ({text}){_headerless_hint(head)}")
@@ -191,8 +198,7 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
     delimiter, decimal = layout.delimiter, layout.decimal
     if layout.names is not None:
         if fmt != "csv":
-            raise InputError(f"{path}: names: for a text table without a header line; a {fmt} file names its "
-                             "columns")
+            raise InputError(f"{path}: names: for a text table without a header line; a {fmt} file names its columns")
         table = read_headerless(path, layout.names, layout.rate_hz)
         return (table if select is None else table.select(select(table.column_names))), TextFormat()
     if fmt == "csv":
@@ -209,16 +215,21 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
             if select is not None:  # the header's names, from its first line
                 header = pacsv.read_csv(pa.py_buffer(head.splitlines()[0] + b"\n"), parse_options=parse)
                 convert.include_columns = select(header.column_names)
-            return pacsv.read_csv(source, read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
-                                  parse_options=parse, convert_options=convert), text
+            return pacsv.read_csv(
+                source,
+                read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
+                parse_options=parse,
+                convert_options=convert,
+            ), text
         except DECOMPRESS_ERRORS as exc:
             raise read_error(path, exc, head) from None
     check_parquet_footer(path)
     try:
         if address_space_left() is not None:  # the columns' uncompressed size, from the metadata
             meta = pq.read_metadata(arrow_source(path))
-            require_memory(path, PARQUET_MEMORY_FACTOR * sum(meta.row_group(i).total_byte_size
-                                                             for i in range(meta.num_row_groups)))
+            require_memory(
+                path, PARQUET_MEMORY_FACTOR * sum(meta.row_group(i).total_byte_size for i in range(meta.num_row_groups))
+            )
         columns = None if select is None else select(pq.read_schema(arrow_source(path)).names)
         return pq.read_table(arrow_source(path), columns=columns), None
     except (pa.ArrowInvalid, OSError) as exc:
@@ -230,8 +241,10 @@ def _headerless_hint(head: bytes) -> str:
     banner where the header should be."""
     lines = [line for line in head[:4096].decode("utf-8", "replace").splitlines()[1:-1] if line.strip()]
     if lines and sum(map(looks_headerless, lines)) > len(lines) / 2:
-        return ("; if it has no header line (a serial terminal's log), give its columns' names in order: "
-                "names=gyro_x,gyro_y,gyro_z,temperature")
+        return (
+            "; if it has no header line (a serial terminal's log), give its columns' names in order: "
+            "names=gyro_x,gyro_y,gyro_z,temperature"
+        )
     return ""
 
 
@@ -262,13 +275,14 @@ def _chunk_numbers(chunk: pa.Array) -> np.ndarray:
     if not (pa.types.is_integer(kind) or pa.types.is_float32(kind) or pa.types.is_float64(kind)):
         return chunk.to_numpy(zero_copy_only=False).astype(float, copy=False)
     validity, data = chunk.buffers()[:2]
-    dtype = np.dtype(np.float32 if pa.types.is_float32(kind) else np.float64 if pa.types.is_float64(kind)
-                     else kind.to_pandas_dtype())
+    dtype = np.dtype(
+        np.float32 if pa.types.is_float32(kind) else np.float64 if pa.types.is_float64(kind) else kind.to_pandas_dtype()
+    )
     values = np.frombuffer(data, dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize)
     values = values.astype(float, copy=False)
     if chunk.null_count:
         bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
-        valid = bits[chunk.offset:chunk.offset + len(chunk)].astype(bool)
+        valid = bits[chunk.offset : chunk.offset + len(chunk)].astype(bool)
         values = np.where(valid, values, np.nan)
     return values
 
@@ -325,17 +339,23 @@ def _resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dic
     """Canonical name to column, refusing a repeated column name, a missing time column or no gyro column."""
     repeated = sorted({name for name in header if header.count(name) > 1})
     if repeated:
-        raise InputError(f"{path}: column {repeated[0]!r} appears {header.count(repeated[0])} times in the header; "
-                         "give each column its own name")
+        raise InputError(
+            f"{path}: column {repeated[0]!r} appears {header.count(repeated[0])} times in the header; "
+            "give each column its own name"
+        )
     cols = layout.resolve(header, str(path))
     if layout.names is None and looks_headerless(",".join(header)):
-        raise InputError(f"{path}: the first line is numbers ({','.join(header)[:60]}), not the columns' names: a "
-                         "table without a header line; give the names in order (names=gyro_x,gyro_y,gyro_z,"
-                         "temperature), and the sample rate if it has no time column (rate_hz=50)")
+        raise InputError(
+            f"{path}: the first line is numbers ({','.join(header)[:60]}), not the columns' names: a "
+            "table without a header line; give the names in order (names=gyro_x,gyro_y,gyro_z,"
+            "temperature), and the sample rate if it has no time column (rate_hz=50)"
+        )
     timed_by_rate = layout.names is not None and layout.rate_hz is not None and TIME_COLUMN not in layout.names
     if layout.rate_hz is not None and TIME_COLUMN in cols and not timed_by_rate:
-        raise InputError(f"{path}: rate_hz={layout.rate_hz:g}: the file has a time column ({cols[TIME_COLUMN]!r}); "
-                         "a nominal rate is for tables without one")
+        raise InputError(
+            f"{path}: rate_hz={layout.rate_hz:g}: the file has a time column ({cols[TIME_COLUMN]!r}); "
+            "a nominal rate is for tables without one"
+        )
     if layout.rate_hz is not None and TIME_COLUMN not in cols:
         cols[TIME_COLUMN] = NOMINAL_TIME
     if TIME_COLUMN not in cols:
@@ -386,8 +406,10 @@ def _reference_rates(cols: dict[str, str], num, path: Path, factor: float) -> np
         return None
     if len(present) < 3:
         missing = [a for a in REFERENCE_RATE_AXES if a not in cols]
-        raise InputError(f"{path}: reference rate column(s) {', '.join(missing)} missing; give all three "
-                         f"({', '.join(REFERENCE_RATE_AXES)}, 0 about the axes the table does not turn)")
+        raise InputError(
+            f"{path}: reference rate column(s) {', '.join(missing)} missing; give all three "
+            f"({', '.join(REFERENCE_RATE_AXES)}, 0 about the axes the table does not turn)"
+        )
     return np.column_stack([num(a) for a in REFERENCE_RATE_AXES]) * factor
 
 
@@ -400,8 +422,10 @@ def _channel_selector(channels: tuple[str, ...], layout: TableLayout, path: Path
         found = _resolved_columns(names, layout, path)
         chosen.update({channel: column for channel, column in found.items() if channel in wanted})
         if not any(a in chosen for a in GYRO_AXES):
-            raise InputError(f"{path}: none of the channels read ({', '.join(channels)}) is a gyro axis of the "
-                             f"file ({', '.join(a for a in GYRO_AXES if a in found)})")
+            raise InputError(
+                f"{path}: none of the channels read ({', '.join(channels)}) is a gyro axis of the "
+                f"file ({', '.join(a for a in GYRO_AXES if a in found)})"
+            )
         return [column for column in dict.fromkeys(chosen.values()) if column != NOMINAL_TIME]
 
     return select
@@ -451,13 +475,22 @@ def read_table(
         warnings.warn(
             f"{path}: {len(recording.gaps)} time gap(s) longer than 2 sample periods (longest {longest.duration_s:.6g} s "
             f"after row {longest.after_row}); kept as they are, nothing interpolated",
-            DataQualityWarning, stacklevel=2,
+            DataQualityWarning,
+            stacklevel=2,
         )
     return TableData(recording, table, layout, cols, kept, path, text_format)
 
 
-def table_recording(table: pa.Table, cols: dict[str, str], layout: TableLayout, path: Path, fmt: str, *,
-                    drop_nonfinite: bool = False, first_row: int = 0) -> tuple[Recording, np.ndarray]:
+def table_recording(
+    table: pa.Table,
+    cols: dict[str, str],
+    layout: TableLayout,
+    path: Path,
+    fmt: str,
+    *,
+    drop_nonfinite: bool = False,
+    first_row: int = 0,
+) -> tuple[Recording, np.ndarray]:
     """The recording [s, deg/s, g, degC] of a table's rows (``cols``: channel -> column) and the indices of the
     rows kept in it (all, or those with every used value finite when ``drop_nonfinite``; a warning says how many
     went). ``first_row``: the table's first row in its file (0-based), for the row numbers in messages. Used by
@@ -473,20 +506,32 @@ def table_recording(table: pa.Table, cols: dict[str, str], layout: TableLayout, 
         time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
     gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
-    accel = (np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
-             if accel_axes else None)
+    accel = (
+        np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
+        if accel_axes
+        else None
+    )
     reference = _reference_rates(cols, num, path, gyro_factor)
     n = table.num_rows
     kept = np.arange(n)
     if drop_nonfinite:
         kept, (time_s, gyro, temp, accel, reference) = keep_finite_rows(path, time_s, gyro, temp, accel, reference)
         if kept.size < 2:
-            raise InputError(f"{path}: rows {first_row + 1}..{first_row + n}: fewer than 2 rows with values in "
-                             "every used column")
-    recording = Recording(time_s=time_s, gyro_dps=gyro, gyro_axes=gyro_axes, temperature_degc=temp, accel_g=accel,
-                          accel_axes=accel_axes, reference_rate_dps=reference, source=str(path),
-                          row_numbers=first_row + kept + 1,
-                          metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)})
+            raise InputError(
+                f"{path}: rows {first_row + 1}..{first_row + n}: fewer than 2 rows with values in every used column"
+            )
+    recording = Recording(
+        time_s=time_s,
+        gyro_dps=gyro,
+        gyro_axes=gyro_axes,
+        temperature_degc=temp,
+        accel_g=accel,
+        accel_axes=accel_axes,
+        reference_rate_dps=reference,
+        source=str(path),
+        row_numbers=first_row + kept + 1,
+        metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)},
+    )
     return recording, kept
 
 
@@ -503,8 +548,9 @@ def _write_arrow(table: pa.Table, path: Path, fmt: str, text_format: TextFormat 
                 pacsv.write_csv(decimal, tmp, _csv_options(table.column_names, text_format, quote_text=True))
 
 
-def _csv_options(names: list[str], text_format: TextFormat | None = None,
-                 quote_text: bool = False) -> pacsv.WriteOptions:
+def _csv_options(
+    names: list[str], text_format: TextFormat | None = None, quote_text: bool = False
+) -> pacsv.WriteOptions:
     """A header as other tools write and expect it: names unquoted unless one needs quotes; fields separated
     by ``text_format``'s delimiter (default a comma)."""
     text_format = text_format or TextFormat()
@@ -533,8 +579,14 @@ def with_decimal(table: pa.Table, text_format: TextFormat) -> pa.Table:
     return table
 
 
-def write_gyro_back(data: TableData, gyro_dps: np.ndarray, path: str | os.PathLike, *, fmt: str | None = None,
-                    accel_g: np.ndarray | None = None) -> None:
+def write_gyro_back(
+    data: TableData,
+    gyro_dps: np.ndarray,
+    path: str | os.PathLike,
+    *,
+    fmt: str | None = None,
+    accel_g: np.ndarray | None = None,
+) -> None:
     """Write the table as read with its gyro columns replaced by ``gyro_dps`` [deg/s] (and its accelerometer
     columns by ``accel_g`` [g], when given).
 
@@ -566,8 +618,12 @@ def write_rows(data: TableData, samples: slice, path: str | os.PathLike, *, fmt:
     log that reads as the log does."""
     path = Path(path)
     rows = data.kept_rows[samples]
-    _write_arrow(data.table.take(arrow_indices(rows)), path, fmt or detect_table_format(path) or "csv",
-                 output_text_format(path, data.text_format))
+    _write_arrow(
+        data.table.take(arrow_indices(rows)),
+        path,
+        fmt or detect_table_format(path) or "csv",
+        output_text_format(path, data.text_format),
+    )
 
 
 def recording_table(recording: Recording, extra_columns: dict[str, np.ndarray] | None = None) -> pa.Table:
@@ -592,19 +648,34 @@ def recording_table(recording: Recording, extra_columns: dict[str, np.ndarray] |
 def table_data(recording: Recording) -> TableData:
     """A recording read from a log, as table data in the default layout, so results can be written back."""
     table = recording_table(recording)
-    return TableData(recording, table, TableLayout(), {name: name for name in table.column_names},
-                     np.arange(recording.n_samples), Path(recording.source))
+    return TableData(
+        recording,
+        table,
+        TableLayout(),
+        {name: name for name in table.column_names},
+        np.arange(recording.n_samples),
+        Path(recording.source),
+    )
 
 
-def write_recording(recording: Recording, path: str | os.PathLike, *, fmt: str | None = None,
-                    extra_columns: dict[str, np.ndarray] | None = None,
-                    text_format: TextFormat | None = None) -> None:
+def write_recording(
+    recording: Recording,
+    path: str | os.PathLike,
+    *,
+    fmt: str | None = None,
+    extra_columns: dict[str, np.ndarray] | None = None,
+    text_format: TextFormat | None = None,
+) -> None:
     """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically; a text table with the
     separator and decimal point of ``text_format`` (the input's, say), a ``.tsv`` name meaning tabs
     (:func:`output_text_format`)."""
     path = Path(path)
-    _write_arrow(recording_table(recording, extra_columns), path, fmt or detect_table_format(path) or "csv",
-                 output_text_format(path, text_format))
+    _write_arrow(
+        recording_table(recording, extra_columns),
+        path,
+        fmt or detect_table_format(path) or "csv",
+        output_text_format(path, text_format),
+    )
 
 
 __all__ = [

@@ -92,14 +92,24 @@ def _check_framing(path: Path) -> None:
     size = path.stat().st_size
     for offset in offsets:
         if offset >= size:
-            warnings.warn(f"{path}: the flag bits say data were appended at byte {offset}, past the end of the file "
-                          f"({size} bytes): none read", DataQualityWarning, stacklevel=3)
+            warnings.warn(
+                f"{path}: the flag bits say data were appended at byte {offset}, past the end of the file "
+                f"({size} bytes): none read",
+                DataQualityWarning,
+                stacklevel=3,
+            )
         elif offset not in starts:
-            raise InputError(f"{path}: the flag bits say data were appended at byte {offset}, where no message "
-                             "starts: a damaged log (read on, the data after that byte would be dropped)")
+            raise InputError(
+                f"{path}: the flag bits say data were appended at byte {offset}, where no message "
+                "starts: a damaged log (read on, the data after that byte would be dropped)"
+            )
     if cut is not None:
-        warnings.warn(f"{path}: the file ends {cut[1]} byte(s) short inside its last message (at byte {cut[0]}): "
-                      "a truncated or damaged log; read up to there", DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{path}: the file ends {cut[1]} byte(s) short inside its last message (at byte {cut[0]}): "
+            "a truncated or damaged log; read up to there",
+            DataQualityWarning,
+            stacklevel=3,
+        )
 
 
 def _time_s(data: dict) -> np.ndarray:
@@ -130,7 +140,8 @@ def _choose(path: Path, topic: str, datasets: list, options: ReadOptions, id_fie
         warnings.warn(
             f"{path}: {len(found)} {topic} instances ({', '.join(map(str, sorted(found)))}); read instance 0, "
             "choose another with instance= or device_id=",
-            DataQualityWarning, stacklevel=4,
+            DataQualityWarning,
+            stacklevel=4,
         )
     return found[instance]
 
@@ -144,8 +155,11 @@ def _from_sensor_gyro(path: Path, datasets: list, options: ReadOptions, metadata
     temperature = np.asarray(data["temperature"], dtype=float) if "temperature" in data else None
     if temperature is not None and not np.isfinite(temperature).any():
         temperature = None
-    metadata.update(topic="sensor_gyro", instance=int(gyro_set.multi_id),
-                    device_id=int(data["device_id"][0]) if "device_id" in data else None)
+    metadata.update(
+        topic="sensor_gyro",
+        instance=int(gyro_set.multi_id),
+        device_id=int(data["device_id"][0]) if "device_id" in data else None,
+    )
     accel = None
     time_s, gyro, temperature = order_by_time(str(path), time_s, gyro, temperature)
     accel_sets = [d for d in datasets if d.name == "sensor_accel" and d.multi_id == gyro_set.multi_id]
@@ -154,8 +168,9 @@ def _from_sensor_gyro(path: Path, datasets: list, options: ReadOptions, metadata
         if "device_id" in adata:  # a separate die (BMI055, SCHA63T) has an id of its own
             metadata["accel_device_id"] = int(adata["device_id"][0])
         what = f"sensor_accel instance {gyro_set.multi_id}"
-        a_time, a_values = order_by_time(str(path), _time_s(adata),
-                                         np.column_stack([adata[a] for a in "xyz"]).astype(float) * _MS2)
+        a_time, a_values = order_by_time(
+            str(path), _time_s(adata), np.column_stack([adata[a] for a in "xyz"]).astype(float) * _MS2
+        )
         accel, ok = match_by_time(str(path), what, time_s, a_time, a_values)
         keep = keep_matched(str(path), what, ok)
         time_s, gyro, accel = time_s[keep], gyro[keep], accel[keep]
@@ -187,8 +202,11 @@ def _from_sensor_combined(path: Path, datasets: list, options: ReadOptions, meta
 
 
 #: the gyro topics in order of preference, each with the function that reads it
-_TOPIC_READERS = {"sensor_gyro": _from_sensor_gyro, "vehicle_imu": _from_vehicle_imu,
-                  "sensor_combined": _from_sensor_combined}
+_TOPIC_READERS = {
+    "sensor_gyro": _from_sensor_gyro,
+    "vehicle_imu": _from_vehicle_imu,
+    "sensor_combined": _from_sensor_combined,
+}
 
 
 def _warn_if_corrected(path: Path, topic: str, parameters: dict, metadata: dict) -> None:
@@ -201,9 +219,13 @@ def _warn_if_corrected(path: Path, topic: str, parameters: dict, metadata: dict)
     metadata["autopilot_parameters"] = {k: float(v) for k, v in parameters.items() if k.startswith("TC_G")}
     metadata["corrected_onboard"] = enabled and topic != "sensor_gyro"
     if metadata["corrected_onboard"]:
-        warnings.warn(f"{path}: TC_G_ENABLE = 1: {topic} is already corrected by PX4's thermal compensation; a "
-                      "model fitted or applied on it would correct twice (log sensor_gyro, the raw topic, or "
-                      "disable TC_G_ENABLE)", DataQualityWarning, stacklevel=4)
+        warnings.warn(
+            f"{path}: TC_G_ENABLE = 1: {topic} is already corrected by PX4's thermal compensation; a "
+            "model fitted or applied on it would correct twice (log sensor_gyro, the raw topic, or "
+            "disable TC_G_ENABLE)",
+            DataQualityWarning,
+            stacklevel=4,
+        )
 
 
 def ulog_instances(path) -> tuple[int, ...]:
@@ -237,7 +259,9 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
     """
     options = options or ReadOptions()
     path = Path(path)
-    check_magic(path, ULOG_MAGIC, "PX4 ULog", "name its real format with fmt=, or leave fmt= out to have it told from the file")
+    check_magic(
+        path, ULOG_MAGIC, "PX4 ULog", "name its real format with fmt=, or leave fmt= out to have it told from the file"
+    )
     pyulog = require("pyulog", "ulog", "reading PX4 ULog files")
     if progress:
         progress(0.0)
@@ -264,12 +288,22 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
         warnings.warn(
             f"{path}: {metadata['topic']} carries no temperature; log sensor_gyro for temperature calibration "
             "(only noise analysis works without it)",
-            DataQualityWarning, stacklevel=3,
+            DataQualityWarning,
+            stacklevel=3,
         )
     if progress:
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature, metadata)
 
 
-register_reader(Reader("ulog", "PX4 ULog, extra [ulog]", read_ulog, suffixes=(".ulg",), magic=(ULOG_MAGIC,),
-                       aliases=("ulg", "px4"), instances=ulog_instances))
+register_reader(
+    Reader(
+        "ulog",
+        "PX4 ULog, extra [ulog]",
+        read_ulog,
+        suffixes=(".ulg",),
+        magic=(ULOG_MAGIC,),
+        aliases=("ulg", "px4"),
+        instances=ulog_instances,
+    )
+)

@@ -36,8 +36,19 @@ from .plausibility import turned_between_poses
 
 Severity = Literal["refuse", "warn"]
 #: every check, in the order a verdict line lists them
-DATA_CHECKS = ("time", "temperature-missing", "temperature-constant", "temperature-span", "too-short", "reversal",
-          "temperature-quantized", "gaps", "rail", "motion", "unit")
+DATA_CHECKS = (
+    "time",
+    "temperature-missing",
+    "temperature-constant",
+    "temperature-span",
+    "too-short",
+    "reversal",
+    "temperature-quantized",
+    "gaps",
+    "rail",
+    "motion",
+    "unit",
+)
 
 #: a temperature that varies less than this over a run is constant (a stuck or absent sensor) [degC]
 CONSTANT_SPAN_DEGC = 0.01
@@ -127,16 +138,20 @@ class RunCheck:
         if not self.findings:
             extra = f" (accepted: {', '.join(f.check for f in self.accepted)})" if self.accepted else ""
             return f"{self.source}: ok{extra}"
-        first = next(f for f in self.findings if f.severity == "refuse") if self.verdict == "refused" \
-            else self.findings[0]
+        first = (
+            next(f for f in self.findings if f.severity == "refuse") if self.verdict == "refused" else self.findings[0]
+        )
         text = first.text()
-        text = text[len(self.source) + 2:] if text.startswith(self.source + ": ") else text
+        text = text[len(self.source) + 2 :] if text.startswith(self.source + ": ") else text
         return f"{self.source}: {self.verdict} ({', '.join(self.reasons)}): {text}"
 
     def to_dict(self) -> dict:
-        return {"source": self.source, "verdict": self.verdict,
-                "findings": [_finding_dict(f) for f in self.findings],
-                "accepted": [_finding_dict(f) for f in self.accepted]}
+        return {
+            "source": self.source,
+            "verdict": self.verdict,
+            "findings": [_finding_dict(f) for f in self.findings],
+            "accepted": [_finding_dict(f) for f in self.accepted],
+        }
 
 
 def _finding_dict(f: Finding) -> dict:
@@ -187,15 +202,27 @@ def temperature_findings(recording: Recording, ask: Ask) -> list[Finding]:
     src = recording.source
     t = _temperature(recording)
     if t is None:
-        return [Finding("temperature-missing", "refuse", f"{src}: no temperature column (or no finite sample in "
-                        "it): a temperature curve cannot be fitted (map one with columns={'temperature': 'NAME'}, "
-                        "or temperature=none fits a bias alone)")]
+        return [
+            Finding(
+                "temperature-missing",
+                "refuse",
+                f"{src}: no temperature column (or no finite sample in "
+                "it): a temperature curve cannot be fitted (map one with columns={'temperature': 'NAME'}, "
+                "or temperature=none fits a bias alone)",
+            )
+        ]
     q = _quantization_step(t) if np.ptp(t) >= CONSTANT_SPAN_DEGC else 0.0
     if q >= QUANTIZED_STEP_DEGC:
         slope = _slope_dps_per_degc(recording, t)
-        return [Finding("temperature-quantized", "warn", f"{src}: the temperature is read in steps of {q:.3g} degC",
-                        f"about {slope * q / math.sqrt(12):.2g} deg/s RMS of bias error (the slope "
-                        f"{slope:.2g} deg/s/degC times the step's {q / math.sqrt(12):.2g} degC RMS)")]
+        return [
+            Finding(
+                "temperature-quantized",
+                "warn",
+                f"{src}: the temperature is read in steps of {q:.3g} degC",
+                f"about {slope * q / math.sqrt(12):.2g} deg/s RMS of bias error (the slope "
+                f"{slope:.2g} deg/s/degC times the step's {q / math.sqrt(12):.2g} degC RMS)",
+            )
+        ]
     return []
 
 
@@ -218,10 +245,16 @@ def gap_findings(recording: Recording) -> list[Finding]:
     fraction = missing / max(recording.duration_s, period)
     if longest.duration_s < max(GAP_PERIODS * period, GAP_MIN_S) and fraction < GAP_MISSING_FRACTION:
         return []
-    return [Finding("gaps", "warn", f"{recording.source}: {len(recording.gaps)} gap(s), {missing:.4g} s in all "
-                    f"({100 * fraction:.2g} % of the run; longest {longest.duration_s:.4g} s after row "
-                    f"{longest.after_row})", f"{100 * fraction:.2g} % fewer samples; the drift over the gaps is "
-                    "not seen, nothing is interpolated")]
+    return [
+        Finding(
+            "gaps",
+            "warn",
+            f"{recording.source}: {len(recording.gaps)} gap(s), {missing:.4g} s in all "
+            f"({100 * fraction:.2g} % of the run; longest {longest.duration_s:.4g} s after row "
+            f"{longest.after_row})",
+            f"{100 * fraction:.2g} % fewer samples; the drift over the gaps is not seen, nothing is interpolated",
+        )
+    ]
 
 
 def rail_findings(recording: Recording) -> list[Finding]:
@@ -238,10 +271,17 @@ def rail_findings(recording: Recording) -> list[Finding]:
             held = np.flatnonzero(np.diff(at) == 1)
             if at.size < RAIL_RUN_SAMPLES or _longest_run(held) + 1 < RAIL_RUN_SAMPLES - 1:
                 continue
-            out.append(Finding("rail", "warn", f"{recording.source}: {axis} sits at {edge:.5g} deg/s for {at.size} "
-                               f"sample(s) (first at row {int(recording.row_numbers[at[0]])}): the sensor's range "
-                               "was exceeded", f"{at.size} sample(s) ({100 * at.size / x.size:.2g} %) wrong by an "
-                               "unknown amount; the unit moved, so the run is no rest either"))
+            out.append(
+                Finding(
+                    "rail",
+                    "warn",
+                    f"{recording.source}: {axis} sits at {edge:.5g} deg/s for {at.size} "
+                    f"sample(s) (first at row {int(recording.row_numbers[at[0]])}): the sensor's range "
+                    "was exceeded",
+                    f"{at.size} sample(s) ({100 * at.size / x.size:.2g} %) wrong by an "
+                    "unknown amount; the unit moved, so the run is no rest either",
+                )
+            )
     return out
 
 
@@ -262,7 +302,7 @@ def motion_findings(recording: Recording) -> list[Finding]:
     n_blocks = recording.gyro_dps.shape[0] // w
     if n_blocks < 2:
         return []
-    blocks = recording.gyro_dps[:n_blocks * w].reshape(n_blocks, w, -1).mean(axis=1)
+    blocks = recording.gyro_dps[: n_blocks * w].reshape(n_blocks, w, -1).mean(axis=1)
     steps = np.abs(np.diff(blocks, axis=0))
     jump = np.any(steps > MOTION_DPS, axis=1)
     if not jump.any() or turned_between_poses(recording):
@@ -271,9 +311,16 @@ def motion_findings(recording: Recording) -> list[Finding]:
     moving[:-1] |= jump
     moving[1:] |= jump
     fraction, worst = float(moving.mean()), float(steps.max())
-    return [Finding("motion", "warn", f"{recording.source}: the unit moves in {int(moving.sum())} of {n_blocks} "
-                    f"10 s windows (their means jump by up to {worst:.3g} deg/s)", f"up to {worst * fraction:.2g} "
-                    f"deg/s of bias error where the moving {100 * fraction:.2g} % of the run lies, unless cut out")]
+    return [
+        Finding(
+            "motion",
+            "warn",
+            f"{recording.source}: the unit moves in {int(moving.sum())} of {n_blocks} "
+            f"10 s windows (their means jump by up to {worst:.3g} deg/s)",
+            f"up to {worst * fraction:.2g} "
+            f"deg/s of bias error where the moving {100 * fraction:.2g} % of the run lies, unless cut out",
+        )
+    ]
 
 
 def white_noise_density(recording: Recording) -> float:
@@ -300,10 +347,20 @@ def unit_findings(recording: Recording) -> list[Finding]:
     lo, hi = NOISE_DENSITY_RANGE
     if lo <= density <= hi or density == 0.0:
         return []
-    words = ("rad/s read as deg/s? (give the gyro's unit: gyro_unit=rad/s)" if density < lo
-             else "deg/s read as rad/s? (the gyro's unit given is wrong)")
-    return [Finding("unit", "warn", f"{recording.source}: gyro white noise {density:.3g} deg/s/sqrt(Hz), outside any "
-                    f"MEMS gyro's {lo:g}..{hi:g}: {words}", "a model 57.3 times too small or too large")]
+    words = (
+        "rad/s read as deg/s? (give the gyro's unit: gyro_unit=rad/s)"
+        if density < lo
+        else "deg/s read as rad/s? (the gyro's unit given is wrong)"
+    )
+    return [
+        Finding(
+            "unit",
+            "warn",
+            f"{recording.source}: gyro white noise {density:.3g} deg/s/sqrt(Hz), outside any "
+            f"MEMS gyro's {lo:g}..{hi:g}: {words}",
+            "a model 57.3 times too small or too large",
+        )
+    ]
 
 
 def time_findings(source: str, notes: Sequence[Warning], rate_hz: float) -> list[Finding]:
@@ -315,8 +372,14 @@ def time_findings(source: str, notes: Sequence[Warning], rate_hz: float) -> list
             continue
         limit = max(TIME_BACK_PERIODS / rate_hz, TIME_BACK_MIN_S)
         if note.largest_back_s > limit:
-            out.append(Finding("time", "refuse", f"{source}: the time goes back by {note.largest_back_s:.4g} s (more "
-                               f"than {limit:.3g} s): two logs appended or a clock reset; split it into its parts"))
+            out.append(
+                Finding(
+                    "time",
+                    "refuse",
+                    f"{source}: the time goes back by {note.largest_back_s:.4g} s (more "
+                    f"than {limit:.3g} s): two logs appended or a clock reset; split it into its parts",
+                )
+            )
         else:
             out.append(Finding("time", "warn", str(note), "none: the samples were put in order"))
     return out
@@ -345,37 +408,64 @@ def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Fi
         if samples < SAMPLES_PER_PARAMETER * ask.parameters or levels < LEVELS_PER_PARAMETER * ask.parameters:
             # fewer samples or levels than parameters: the curve asked is not determined at all
             undetermined = ask.temperature == "asked" and min(samples, levels) < ask.parameters
-            cost = (_NO_CURVE if ask.temperature == "auto" else "" if undetermined
-                    else "the curve's parameters poorly determined: its error between the levels is not known")
+            cost = (
+                _NO_CURVE
+                if ask.temperature == "auto"
+                else ""
+                if undetermined
+                else "the curve's parameters poorly determined: its error between the levels is not known"
+            )
             for i in range(len(recordings)):
-                out.setdefault(i, []).append(Finding(
-                    "too-short", "refuse" if undetermined else "warn", f"{recordings[i].source}: {samples} "
-                    f"sample(s) at {levels} temperature level(s) for a curve of {ask.parameters} parameters (at "
-                    f"least {SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
-                    cost))
+                out.setdefault(i, []).append(
+                    Finding(
+                        "too-short",
+                        "refuse" if undetermined else "warn",
+                        f"{recordings[i].source}: {samples} "
+                        f"sample(s) at {levels} temperature level(s) for a curve of {ask.parameters} parameters (at "
+                        f"least {SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
+                        cost,
+                    )
+                )
     present = [t for t in temps if t is not None and np.ptp(t) >= CONSTANT_SPAN_DEGC]
     if ask.temperature != "none" and known and not present:  # every run at one temperature
         for i, t in enumerate(temps):
             if t is not None:
-                out.setdefault(i, []).append(Finding(
-                    "temperature-constant", _curve_severity(ask), f"{recordings[i].source}: the temperature is "
-                    f"constant ({t[0]:.4g} degC throughout), as in every run given: a stuck or absent sensor, or "
-                    "runs at one temperature", _NO_CURVE if ask.temperature == "auto" else ""))
+                out.setdefault(i, []).append(
+                    Finding(
+                        "temperature-constant",
+                        _curve_severity(ask),
+                        f"{recordings[i].source}: the temperature is "
+                        f"constant ({t[0]:.4g} degC throughout), as in every run given: a stuck or absent sensor, or "
+                        "runs at one temperature",
+                        _NO_CURVE if ask.temperature == "auto" else "",
+                    )
+                )
     if ask.temperature != "none" and present:
         span = float(max(t.max() for t in present) - min(t.min() for t in present))
         if span < MIN_SPAN_DEGC:
             for i, t in enumerate(temps):
                 if t is not None:
-                    out.setdefault(i, []).append(Finding("temperature-span", _curve_severity(ask),
-                                                         f"{recordings[i].source}: the runs span {span:.3g} degC, "
-                                                         f"less than {MIN_SPAN_DEGC:g} degC: no temperature curve "
-                                                         "can be told from noise",
-                                                         _NO_CURVE if ask.temperature == "auto" else ""))
+                    out.setdefault(i, []).append(
+                        Finding(
+                            "temperature-span",
+                            _curve_severity(ask),
+                            f"{recordings[i].source}: the runs span {span:.3g} degC, "
+                            f"less than {MIN_SPAN_DEGC:g} degC: no temperature curve "
+                            "can be told from noise",
+                            _NO_CURVE if ask.temperature == "auto" else "",
+                        )
+                    )
         if ask.hysteresis and not any(_reverses(t) for t in present):
             for i in range(len(recordings)):
-                out.setdefault(i, []).append(Finding("reversal", "refuse", f"{recordings[i].source}: the "
-                                                     "temperature never turns back, and turning-point hysteresis "
-                                                     "is asked: record heating and cooling"))
+                out.setdefault(i, []).append(
+                    Finding(
+                        "reversal",
+                        "refuse",
+                        f"{recordings[i].source}: the "
+                        "temperature never turns back, and turning-point hysteresis "
+                        "is asked: record heating and cooling",
+                    )
+                )
     return out
 
 
@@ -384,9 +474,14 @@ def _reverses(t: np.ndarray) -> bool:
     s = moving_average(t, max(1, t.size // 100))
     rise = s - np.minimum.accumulate(s)
     fall = np.maximum.accumulate(s) - s
-    return bool(rise.max() >= MIN_SPAN_DEGC and fall.max() >= MIN_SPAN_DEGC
-                and (np.argmax(fall >= MIN_SPAN_DEGC) > np.argmax(rise >= MIN_SPAN_DEGC)
-                     or np.argmax(rise >= MIN_SPAN_DEGC) > np.argmax(fall >= MIN_SPAN_DEGC)))
+    return bool(
+        rise.max() >= MIN_SPAN_DEGC
+        and fall.max() >= MIN_SPAN_DEGC
+        and (
+            np.argmax(fall >= MIN_SPAN_DEGC) > np.argmax(rise >= MIN_SPAN_DEGC)
+            or np.argmax(rise >= MIN_SPAN_DEGC) > np.argmax(fall >= MIN_SPAN_DEGC)
+        )
+    )
 
 
 @dataclass(frozen=True)
@@ -399,8 +494,9 @@ class CheckedRun:
     refusal: str | None = None
 
 
-def check_runs(runs: Sequence[CheckedRun], ask: Ask | None = None, accept: Iterable[str] = (),
-               still_only: Iterable[str] = ()) -> list[RunCheck]:
+def check_runs(
+    runs: Sequence[CheckedRun], ask: Ask | None = None, accept: Iterable[str] = (), still_only: Iterable[str] = ()
+) -> list[RunCheck]:
     """The data check of each run (see the module), the checks named in ``accept`` reported as accepted.
     ``still_only``: the sources of field logs fitted on their still segments alone, whose motion is expected (it
     is not checked)."""
@@ -415,19 +511,24 @@ def check_runs(runs: Sequence[CheckedRun], ask: Ask | None = None, accept: Itera
             out.append(_split(unreadable(run.source, run.refusal or "unreadable").findings, run.source, accept))
             continue
         rec = run.recording
-        found = (time_findings(run.source, run.notes, rec.rate_hz) + temperature_findings(rec, ask)
-                 + together.get(position[i], []) + gap_findings(rec) + rail_findings(rec)
-                 + (motion_findings(rec) if rec.source not in still_only else []) + unit_findings(rec))
+        found = (
+            time_findings(run.source, run.notes, rec.rate_hz)
+            + temperature_findings(rec, ask)
+            + together.get(position[i], [])
+            + gap_findings(rec)
+            + rail_findings(rec)
+            + (motion_findings(rec) if rec.source not in still_only else [])
+            + unit_findings(rec)
+        )
         out.append(_split(found, run.source, accept))
     return out
 
 
 def _split(found: Iterable[Finding], source: str, accept: frozenset[str]) -> RunCheck:
-    found = sorted(found, key=lambda f: (DATA_CHECKS.index(f.check) if f.check in DATA_CHECKS else -1))
-    return RunCheck(source, tuple(f for f in found if f.check not in accept),
-                    tuple(f for f in found if f.check in accept))
+    found = sorted(found, key=lambda f: DATA_CHECKS.index(f.check) if f.check in DATA_CHECKS else -1)
+    return RunCheck(
+        source, tuple(f for f in found if f.check not in accept), tuple(f for f in found if f.check in accept)
+    )
 
 
-__all__ = ["Ask", "DATA_CHECKS", "CheckedRun", "Finding", "RunCheck", "check_runs", "set_findings",
-           "unreadable"]
-
+__all__ = ["Ask", "DATA_CHECKS", "CheckedRun", "Finding", "RunCheck", "check_runs", "set_findings", "unreadable"]

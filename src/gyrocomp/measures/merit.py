@@ -67,19 +67,23 @@ def default_window_s(recording: Recording) -> float:
     With several axes, the longest of their Allan-minimum taus.
     """
     stretches = recording.contiguous_stretches()
-    taus = [bias_instability(recording.gyro_dps[:, j], recording.rate_hz, stretches).integration_time_s
-            for j in range(len(recording.gyro_axes))]
+    taus = [
+        bias_instability(recording.gyro_dps[:, j], recording.rate_hz, stretches).integration_time_s
+        for j in range(len(recording.gyro_axes))
+    ]
     return max(MIN_WINDOW_S, max(taus))
 
 
 #: the unit of an axis's bias instability, by the unit of its values (:data:`gyrocomp.units.AXIS_UNITS`)
 BIAS_INSTABILITY_UNITS = {"deg/s": "deg/h", "g": "ug"}
 #: each figure under the name that says its unit, for a gyro axis and for an accelerometer axis
-_NAMED = {"offset_raw": ("bias_offset_raw_dps", "bias_offset_raw_g"),
-          "offset_comp": ("bias_offset_comp_dps", "bias_offset_comp_g"),
-          "bias_instability_raw": ("bias_instability_raw_dph", "bias_instability_raw_ug"),
-          "bias_instability_comp": ("bias_instability_comp_dph", "bias_instability_comp_ug"),
-          "residual_rms": ("residual_rms_dps", "residual_rms_g")}
+_NAMED = {
+    "offset_raw": ("bias_offset_raw_dps", "bias_offset_raw_g"),
+    "offset_comp": ("bias_offset_comp_dps", "bias_offset_comp_g"),
+    "bias_instability_raw": ("bias_instability_raw_dph", "bias_instability_raw_ug"),
+    "bias_instability_comp": ("bias_instability_comp_dph", "bias_instability_comp_ug"),
+    "residual_rms": ("residual_rms_dps", "residual_rms_g"),
+}
 
 
 def _in_unit(name: str, unit: str) -> property:
@@ -115,8 +119,11 @@ class AxisMetrics:
     def to_dict(self) -> dict[str, float]:
         """The figures under the names that say their units (``bias_offset_raw_dps`` ..., or ``..._g``)."""
         column = AXIS_UNITS.index(self.unit)
-        return {(_NAMED[f.name][column] if f.name in _NAMED else f.name): getattr(self, f.name)
-                for f in fields(self) if f.name != "unit"}
+        return {
+            (_NAMED[f.name][column] if f.name in _NAMED else f.name): getattr(self, f.name)
+            for f in fields(self)
+            if f.name != "unit"
+        }
 
     bias_offset_raw_dps = _in_unit("offset_raw", "deg/s")
     bias_offset_comp_dps = _in_unit("offset_comp", "deg/s")
@@ -141,8 +148,11 @@ class RunEvaluation:
     accel_axes: dict[str, AxisMetrics] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        out = {"file": self.file, "window_s": self.window_s,
-               "axes": {name: m.to_dict() for name, m in self.axes.items()}}
+        out = {
+            "file": self.file,
+            "window_s": self.window_s,
+            "axes": {name: m.to_dict() for name, m in self.axes.items()},
+        }
         if self.accel_axes:
             out["accel_axes"] = {name: m.to_dict() for name, m in self.accel_axes.items()}
         return out
@@ -166,15 +176,20 @@ class TriadResiduals:
 
     @property
     def rms_raw(self) -> float:
-        return float(np.sqrt(np.mean(self.raw ** 2)))
+        return float(np.sqrt(np.mean(self.raw**2)))
 
     @property
     def rms_compensated(self) -> float:
-        return float(np.sqrt(np.mean(self.compensated ** 2)))
+        return float(np.sqrt(np.mean(self.compensated**2)))
 
     def to_dict(self) -> dict:
-        return {"file": self.file, "figure": self.figure, "count": int(self.raw.size), "rms_raw": self.rms_raw,
-                "rms_compensated": self.rms_compensated}
+        return {
+            "file": self.file,
+            "figure": self.figure,
+            "count": int(self.raw.size),
+            "rms_raw": self.rms_raw,
+            "rms_compensated": self.rms_compensated,
+        }
 
 
 @dataclass(frozen=True)
@@ -228,14 +243,22 @@ class _Figures:
     residual_rms: float
 
 
-def _figures(raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretches: list[slice],
-             lows: tuple | None = None) -> _Figures:
+def _figures(
+    raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretches: list[slice], lows: tuple | None = None
+) -> _Figures:
     """``lows``: the raw and compensated Allan minima when already computed."""
     off_raw, off_comp = bias_offset(raw, w), bias_offset(comp, w)
     low_raw, low_comp = lows or (_allan_minimum(raw, rate_hz, stretches), _allan_minimum(comp, rate_hz, stretches))
-    return _Figures(off_raw, off_comp, off_raw / off_comp if off_comp > 0 else math.inf,
-                    low_raw.deviation, low_comp.deviation, low_raw.tau_s, low_comp.tau_s,
-                    smoothed_residual_rms(comp, w))
+    return _Figures(
+        off_raw,
+        off_comp,
+        off_raw / off_comp if off_comp > 0 else math.inf,
+        low_raw.deviation,
+        low_comp.deviation,
+        low_raw.tau_s,
+        low_comp.tau_s,
+        smoothed_residual_rms(comp, w),
+    )
 
 
 def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarray | None = None) -> None:
@@ -250,14 +273,21 @@ def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarr
         return
     k = int(np.flatnonzero(bad)[0])
     where = "" if rows is None else f" at row {int(rows[k])}"
-    raise InputError(f"{source}: {axis} compensated is {values[k]:.3g} {unit}{where}, beyond any MEMS sensor's "
-                     f"range ({limit:g} {unit}): the model was applied far outside its temperature range (a "
-                     "corrupt temperature value?); nothing to judge")
+    raise InputError(
+        f"{source}: {axis} compensated is {values[k]:.3g} {unit}{where}, beyond any MEMS sensor's "
+        f"range ({limit:g} {unit}): the model was applied far outside its temperature range (a "
+        "corrupt temperature value?); nothing to judge"
+    )
 
 
-def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | None = None,
-                 accel: bool = False, allan: tuple[Mapping[str, AllanResult], Mapping[str, AllanResult]] | None = None
-                 ) -> RunEvaluation:
+def evaluate_run(
+    raw: Recording,
+    compensated: Recording,
+    *,
+    window_s: float | None = None,
+    accel: bool = False,
+    allan: tuple[Mapping[str, AllanResult], Mapping[str, AllanResult]] | None = None,
+) -> RunEvaluation:
     """Compare one run before and after compensation, axis by axis.
 
     Parameters
@@ -283,37 +313,55 @@ def evaluate_run(raw: Recording, compensated: Recording, *, window_s: float | No
         warnings.warn(
             f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation pools the {len(stretches)} stretches "
             "between them, the moving average runs across them",
-            DataQualityWarning, stacklevel=2,
+            DataQualityWarning,
+            stacklevel=2,
         )
     # the Allan minima do not depend on the window; the default window is the raw minima's longest tau
     if allan is not None:
         lows = [(allan[0][axis].minimum(), allan[1][axis].minimum()) for axis in raw.gyro_axes]
     else:
-        lows = [(_allan_minimum(raw.gyro_dps[:, j], raw.rate_hz, stretches),
-                 _allan_minimum(compensated.gyro_dps[:, j], raw.rate_hz, stretches))
-                for j in range(len(raw.gyro_axes))]
+        lows = [
+            (
+                _allan_minimum(raw.gyro_dps[:, j], raw.rate_hz, stretches),
+                _allan_minimum(compensated.gyro_dps[:, j], raw.rate_hz, stretches),
+            )
+            for j in range(len(raw.gyro_axes))
+        ]
     if window_s is None:
         window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows))  # as default_window_s(raw)
     w = window_samples(window_s, raw.rate_hz, raw.n_samples)
-    gyro = {axis: _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches, lows[j])
-            for j, axis in enumerate(raw.gyro_axes)}
+    gyro = {
+        axis: _figures(raw.gyro_dps[:, j], compensated.gyro_dps[:, j], raw.rate_hz, w, stretches, lows[j])
+        for j, axis in enumerate(raw.gyro_axes)
+    }
     accel_figures = {}
     if accel and raw.accel_g is not None and compensated.accel_g is not None:
-        accel_figures = {axis: _figures(raw.accel_g[:, j], compensated.accel_g[:, j], raw.rate_hz, w, stretches)
-                         for j, axis in enumerate(raw.accel_axes)}
+        accel_figures = {
+            axis: _figures(raw.accel_g[:, j], compensated.accel_g[:, j], raw.rate_hz, w, stretches)
+            for j, axis in enumerate(raw.accel_axes)
+        }
     return _run_evaluation(raw.source, window_s, gyro, accel_figures)
 
 
 def _axis_metrics(f: _Figures, unit: str, to_bias_instability: float) -> AxisMetrics:
     """One axis's figures in its unit; ``to_bias_instability`` turns the Allan minimum into the bias instability
     in its unit (deg/h or ug)."""
-    return AxisMetrics(unit, f.offset_raw, f.offset_comp, f.improvement, f.allan_min_raw * to_bias_instability,
-                       f.allan_min_comp * to_bias_instability, f.integration_time_raw_s, f.integration_time_comp_s,
-                       f.residual_rms)
+    return AxisMetrics(
+        unit,
+        f.offset_raw,
+        f.offset_comp,
+        f.improvement,
+        f.allan_min_raw * to_bias_instability,
+        f.allan_min_comp * to_bias_instability,
+        f.integration_time_raw_s,
+        f.integration_time_comp_s,
+        f.residual_rms,
+    )
 
 
-def _run_evaluation(source: str, window_s: float, gyro: dict[str, _Figures],
-                    accel: dict[str, _Figures]) -> RunEvaluation:
+def _run_evaluation(
+    source: str, window_s: float, gyro: dict[str, _Figures], accel: dict[str, _Figures]
+) -> RunEvaluation:
     """The figures of each axis in their quoted units: gyro [deg/s, deg/h], accelerometer [g, ug]."""
     to_dph = DEG_PER_S_TO_DEG_PER_H / BIAS_INSTABILITY_FACTOR
     to_ug = 1e6 / BIAS_INSTABILITY_FACTOR
@@ -322,9 +370,16 @@ def _run_evaluation(source: str, window_s: float, gyro: dict[str, _Figures],
     return RunEvaluation(file=source, window_s=float(window_s), axes=axes, accel_axes=accel_axes)
 
 
-def evaluate_phases(source: str, raw: list[np.ndarray], compensated: list[np.ndarray], rate_hz: float, *,
-                    gyro_axes: tuple[str, ...], accel_axes: tuple[str, ...] = (),
-                    window_s: float | None = None) -> RunEvaluation:
+def evaluate_phases(
+    source: str,
+    raw: list[np.ndarray],
+    compensated: list[np.ndarray],
+    rate_hz: float,
+    *,
+    gyro_axes: tuple[str, ...],
+    accel_axes: tuple[str, ...] = (),
+    window_s: float | None = None,
+) -> RunEvaluation:
     """:func:`evaluate_run` of one contiguous run given as phases, e.g. integrated chunk by chunk from a file
     (:class:`gyrocomp.allan.PhaseAccumulator`, possibly memory-mapped): the moving average of a series is a
     difference of its phase, (x[k + w] - x[k]) rate_hz / w, and the Allan deviation reads the phase itself.
@@ -343,21 +398,29 @@ def evaluate_phases(source: str, raw: list[np.ndarray], compensated: list[np.nda
     """
     names = (*gyro_axes, *accel_axes)
     if not (len(raw) == len(compensated) == len(names)):
-        raise InputError(f"raw, compensated: one phase per axis ({', '.join(names)}); got {len(raw)} and "
-                         f"{len(compensated)}")
+        raise InputError(
+            f"raw, compensated: one phase per axis ({', '.join(names)}); got {len(raw)} and {len(compensated)}"
+        )
     n_samples = len(raw[0]) - 1
     lows = [(_phase_allan_minimum(r, rate_hz), _phase_allan_minimum(c, rate_hz)) for r, c in zip(raw, compensated)]
     if window_s is None:
-        window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows[:len(gyro_axes)]))
+        window_s = max(MIN_WINDOW_S, max(low.tau_s for low, _ in lows[: len(gyro_axes)]))
     w = window_samples(window_s, rate_hz, n_samples)
     figures = {}
     for name, r, c, (low_raw, low_comp) in zip(names, raw, compensated, lows):
         off_raw, _ = _smoothed_spread(r, rate_hz, w)
         off_comp, rms = _smoothed_spread(c, rate_hz, w)
-        figures[name] = _Figures(off_raw, off_comp, off_raw / off_comp if off_comp > 0 else math.inf,
-                                 low_raw.deviation, low_comp.deviation, low_raw.tau_s, low_comp.tau_s, rms)
-    return _run_evaluation(source, window_s, {a: figures[a] for a in gyro_axes},
-                           {a: figures[a] for a in accel_axes})
+        figures[name] = _Figures(
+            off_raw,
+            off_comp,
+            off_raw / off_comp if off_comp > 0 else math.inf,
+            low_raw.deviation,
+            low_comp.deviation,
+            low_raw.tau_s,
+            low_comp.tau_s,
+            rms,
+        )
+    return _run_evaluation(source, window_s, {a: figures[a] for a in gyro_axes}, {a: figures[a] for a in accel_axes})
 
 
 def _phase_allan_minimum(phase: np.ndarray, rate_hz: float):
@@ -377,7 +440,7 @@ def _smoothed_spread(phase: np.ndarray, rate_hz: float, w: int) -> tuple[float, 
     def averages():
         for start in range(0, count, _PHASE_BLOCK):
             stop = min(start + _PHASE_BLOCK, count)
-            yield (np.asarray(phase[start + w:stop + w]) - np.asarray(phase[start:stop])) * scale
+            yield (np.asarray(phase[start + w : stop + w]) - np.asarray(phase[start:stop])) * scale
 
     low, high, total = math.inf, -math.inf, 0.0
     for smooth in averages():

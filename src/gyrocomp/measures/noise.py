@@ -100,9 +100,11 @@ def axis_values(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
 def _describe_gap(recording: Recording) -> str:
     gap = recording.gaps[0]
     more = f" (and {len(recording.gaps) - 1} more)" if len(recording.gaps) > 1 else ""
-    return (f"{recording.source}: time gap of {gap.duration_s:.6g} s after row {gap.after_row} "
-            f"(t = {gap.start_s:.6g} s){more}; Allan deviations need evenly spaced samples: "
-            f"use split_gaps=True to pool the contiguous stretches")
+    return (
+        f"{recording.source}: time gap of {gap.duration_s:.6g} s after row {gap.after_row} "
+        f"(t = {gap.start_s:.6g} s){more}; Allan deviations need evenly spaced samples: "
+        f"use split_gaps=True to pool the contiguous stretches"
+    )
 
 
 #: RMS misfit (in ln deviation) of the noise model beyond which :func:`analyse_noise` warns
@@ -124,16 +126,27 @@ def warn_if_moving(source: str, found: StillDetection) -> None:
     with no still block at all is not judged (pure noise above any MEMS part's, or a test signal)."""
     if found.still_blocks.any() and moves_most_of_the_time(found):
         whole = found.blocks.whole
-        warnings.warn(f"{source}: the log moves most of the time ({found.still_blocks[whole].mean():.0%} of it "
-                      "still): its Allan deviation and noise terms describe the motion, not the sensor's noise; "
-                      "analyse a still stretch (time_range_s=) or the still poses (by=still)", DataQualityWarning,
-                      stacklevel=3)
+        warnings.warn(
+            f"{source}: the log moves most of the time ({found.still_blocks[whole].mean():.0%} of it "
+            "still): its Allan deviation and noise terms describe the motion, not the sensor's noise; "
+            "analyse a still stretch (time_range_s=) or the still poses (by=still)",
+            DataQualityWarning,
+            stacklevel=3,
+        )
 
 
-def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: AllanKind = "oadev",
-                  taus: TauGrid | np.ndarray = "octave", split_gaps: bool = False,
-                  fit_taus_s: tuple[float, float] | None = None, with_accel: bool = False,
-                  motion_check: bool = True, plausibility_check: bool = True) -> NoiseAnalysis:
+def analyse_noise(
+    recording: Recording,
+    axes: list[str] | None = None,
+    *,
+    kind: AllanKind = "oadev",
+    taus: TauGrid | np.ndarray = "octave",
+    split_gaps: bool = False,
+    fit_taus_s: tuple[float, float] | None = None,
+    with_accel: bool = False,
+    motion_check: bool = True,
+    plausibility_check: bool = True,
+) -> NoiseAnalysis:
     """Allan curve (``kind``) and noise terms (from the overlapping Allan deviation) for each axis.
 
     Parameters
@@ -166,12 +179,16 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
     if len(stretches) > 1:
         longest = max(stretches, key=lambda s: s.stop - s.start)
         length_s = (longest.stop - longest.start) / recording.rate_hz
-        how = (f"{recording.source}: pooled {len(stretches)} contiguous stretches split at "
-               f"{len(recording.gaps)} gap(s); no difference spans a gap (longest stretch {length_s:.6g} s)")
+        how = (
+            f"{recording.source}: pooled {len(stretches)} contiguous stretches split at "
+            f"{len(recording.gaps)} gap(s); no difference spans a gap (longest stretch {length_s:.6g} s)"
+        )
         if kind == "totdev":
-            how = (f"{recording.source}: TOTDEV on the longest of {len(stretches)} contiguous stretches "
-                   f"({length_s:.6g} s, rows {recording.row_numbers[longest.start]}-"
-                   f"{recording.row_numbers[longest.stop - 1]}); the noise terms pool all stretches")
+            how = (
+                f"{recording.source}: TOTDEV on the longest of {len(stretches)} contiguous stretches "
+                f"({length_s:.6g} s, rows {recording.row_numbers[longest.start]}-"
+                f"{recording.row_numbers[longest.stop - 1]}); the noise terms pool all stretches"
+            )
     results = {}
     for name in names:
         values, sensor, unit = axis_values(recording, name)
@@ -188,13 +205,20 @@ def analyse_noise(recording: Recording, axes: list[str] | None = None, *, kind: 
             else:
                 curve = allan_deviation_segments(pieces, recording.rate_hz, kind=kind, taus=taus)
         results[name] = _axis_noise(name, sensor, unit, curve, allan, fit_taus_s)
-    return NoiseAnalysis(source=recording.source, rate_hz=recording.rate_hz, axes=results,
-                         stretches=len(stretches), how=how)
+    return NoiseAnalysis(
+        source=recording.source, rate_hz=recording.rate_hz, axes=results, stretches=len(stretches), how=how
+    )
 
 
-def analyse_noise_phases(phases: dict[str, np.ndarray], rate_hz: float, *, source: str = "<phases>",
-                         kind: str = "oadev", taus="octave",
-                         fit_taus_s: tuple[float, float] | None = None) -> NoiseAnalysis:
+def analyse_noise_phases(
+    phases: dict[str, np.ndarray],
+    rate_hz: float,
+    *,
+    source: str = "<phases>",
+    kind: str = "oadev",
+    taus="octave",
+    fit_taus_s: tuple[float, float] | None = None,
+) -> NoiseAnalysis:
     """:func:`analyse_noise` of one contiguous stretch given as the phase of each axis, e.g. integrated chunk by
     chunk from a file (:class:`gyrocomp.allan.PhaseAccumulator`), possibly memory-mapped.
 
@@ -217,13 +241,18 @@ def analyse_noise_phases(phases: dict[str, np.ndarray], rate_hz: float, *, sourc
     return NoiseAnalysis(source=source, rate_hz=rate_hz, axes=results)
 
 
-def _axis_noise(name: str, sensor: str, unit: str, curve: AllanResult, allan: AllanResult,
-                fit_taus_s: tuple[float, float] | None) -> AxisNoise:
+def _axis_noise(
+    name: str, sensor: str, unit: str, curve: AllanResult, allan: AllanResult, fit_taus_s: tuple[float, float] | None
+) -> AxisNoise:
     """One axis's noise terms read from its overlapping Allan curve (a warning when the model misses it)."""
     terms = noise_terms(allan, fit_taus_s)
     if terms.fit_rms_log_residual > POOR_FIT_LOG_RESIDUAL:
-        warnings.warn(f"{name}: the five-term noise model misses the curve by {terms.fit_rms_log_residual:.0%} "
-                      "RMS; compare the read-offs, or restrict the fit to the taus where a term holds "
-                      "(fit_taus_s: (low, high) [s])", DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{name}: the five-term noise model misses the curve by {terms.fit_rms_log_residual:.0%} "
+            "RMS; compare the read-offs, or restrict the fit to the taus where a term holds "
+            "(fit_taus_s: (low, high) [s])",
+            DataQualityWarning,
+            stacklevel=3,
+        )
     quoted = GyroNoise.from_terms(terms) if sensor == "gyro" else AccelNoise.from_terms(terms)
     return AxisNoise(name, sensor, unit, curve, allan, terms, quoted)

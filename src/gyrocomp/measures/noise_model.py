@@ -95,16 +95,34 @@ class NoiseModel:
 
     def to_dict(self) -> dict:
         """The model as JSON (``gyrocomp noise --export json``): each axis's bounds and IEEE terms, in its unit."""
-        return {"format": NOISE_MODEL_FORMAT, "rate_hz": self.rate_hz, "axes": {
-            name: {"sensor": a.sensor, "unit": a.unit, "bound": a.bound.to_dict(), "bound_with_markov":
-                   a.markov.to_dict(), "ieee_952": {"white_noise_density": a.ieee.white_noise_density,
-                                                   "bias_instability": a.ieee.bias_instability,
-                                                   "random_walk": a.ieee.random_walk},
-                   "logs": [{"source": log.source, "temperature_degc": log.temperature_degc,
-                             "white_noise_density": log.bound.white_noise_density,
-                             "random_walk": log.bound.random_walk,
-                             "white_noise_at_one_sample_95": list(log.white_noise_interval)} for log in a.logs]}
-            for name, a in self.axes.items()}}
+        return {
+            "format": NOISE_MODEL_FORMAT,
+            "rate_hz": self.rate_hz,
+            "axes": {
+                name: {
+                    "sensor": a.sensor,
+                    "unit": a.unit,
+                    "bound": a.bound.to_dict(),
+                    "bound_with_markov": a.markov.to_dict(),
+                    "ieee_952": {
+                        "white_noise_density": a.ieee.white_noise_density,
+                        "bias_instability": a.ieee.bias_instability,
+                        "random_walk": a.ieee.random_walk,
+                    },
+                    "logs": [
+                        {
+                            "source": log.source,
+                            "temperature_degc": log.temperature_degc,
+                            "white_noise_density": log.bound.white_noise_density,
+                            "random_walk": log.bound.random_walk,
+                            "white_noise_at_one_sample_95": list(log.white_noise_interval),
+                        }
+                        for log in a.logs
+                    ],
+                }
+                for name, a in self.axes.items()
+            },
+        }
 
 
 def _white_at_one_sample(curve: AllanResult) -> tuple[float, float, float]:
@@ -114,8 +132,9 @@ def _white_at_one_sample(curve: AllanResult) -> tuple[float, float, float]:
     return float(low[0]) * root, float(curve.deviation[0]) * root, float(high[0]) * root
 
 
-def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
-                temperatures_degc: list[float | None] | None = None) -> NoiseModel:
+def noise_model(
+    analyses: NoiseAnalysis | list[NoiseAnalysis], temperatures_degc: list[float | None] | None = None
+) -> NoiseModel:
     """The noise model of the axes the analyses share, bounding every analysis's overlapping Allan curve.
 
     Parameters
@@ -134,8 +153,10 @@ def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
         raise InputError("noise: give at least one static log")
     rates = {round(a.rate_hz, 9) for a in analyses}
     if len(rates) > 1:
-        raise InputError(f"noise: the logs have different sample rates ({', '.join(f'{r:g}' for r in sorted(rates))} "
-                         "Hz); a model is for one rate: analyse each rate on its own")
+        raise InputError(
+            f"noise: the logs have different sample rates ({', '.join(f'{r:g}' for r in sorted(rates))} "
+            "Hz); a model is for one rate: analyse each rate on its own"
+        )
     temperatures = list(temperatures_degc) if temperatures_degc is not None else [None] * len(analyses)
     shared = [name for name in analyses[0].axes if all(name in a.axes for a in analyses)]
     if not shared:
@@ -145,12 +166,21 @@ def noise_model(analyses: NoiseAnalysis | list[NoiseAnalysis],
     for name in shared:
         curves = [a.axes[name].allan for a in analyses]
         max_tau = MAX_TAU_FRACTION * min(record_length_s(c, rate) for c in curves)
-        logs = tuple(LogNoise(a.source, t, bound_noise(c, markov=False, max_tau_s=max_tau), _white_at_one_sample(c))
-                     for a, c, t in zip(analyses, curves, temperatures))
+        logs = tuple(
+            LogNoise(a.source, t, bound_noise(c, markov=False, max_tau_s=max_tau), _white_at_one_sample(c))
+            for a, c, t in zip(analyses, curves, temperatures)
+        )
         first = analyses[0].axes[name]
-        axes[name] = AxisNoiseModel(name, first.sensor, first.unit, first.terms,
-                                    bound_noise(curves, markov=False, max_tau_s=max_tau),
-                                    bound_noise(curves, markov=True, max_tau_s=max_tau), logs, max_tau)
+        axes[name] = AxisNoiseModel(
+            name,
+            first.sensor,
+            first.unit,
+            first.terms,
+            bound_noise(curves, markov=False, max_tau_s=max_tau),
+            bound_noise(curves, markov=True, max_tau_s=max_tau),
+            logs,
+            max_tau,
+        )
     return NoiseModel(rate, axes)
 
 
@@ -172,8 +202,14 @@ def scheduled_bound(axis: AxisNoiseModel) -> Callable[[float], NoiseBound]:
     k = np.array([log.bound.random_walk for log in logs])
 
     def at(temperature_degc: float) -> NoiseBound:
-        return NoiseBound(float(np.interp(temperature_degc, t, n)), float(np.interp(temperature_degc, t, k)), (),
-                          axis.bound.taus_s, math.nan, math.nan)
+        return NoiseBound(
+            float(np.interp(temperature_degc, t, n)),
+            float(np.interp(temperature_degc, t, k)),
+            (),
+            axis.bound.taus_s,
+            math.nan,
+            math.nan,
+        )
 
     return at
 
@@ -187,7 +223,7 @@ def per_sample_covariance(density: float, rate_hz: float) -> list[float]:
     N^2 rate on the diagonal [u^2] (``sensor_msgs/Imu``'s covariance fields)."""
     if not (isinstance(rate_hz, (int, float)) and rate_hz > 0 and math.isfinite(rate_hz)):
         raise InputError(f"rate_hz: a positive number of Hz, got {rate_hz!r}")
-    v = density ** 2 * rate_hz
+    v = density**2 * rate_hz
     return [v, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0.0, v]
 
 
@@ -203,20 +239,24 @@ def noise_file_densities(path) -> tuple[float | None, float | None]:
     try:
         d = json.loads(Path(path).read_text())
     except (OSError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable noise model ({type(exc).__name__}); gyrocomp's json noise export "
-                         "writes one") from None
+        raise InputError(
+            f"{path}: not a readable noise model ({type(exc).__name__}); gyrocomp's json noise export writes one"
+        ) from None
     if not isinstance(d, dict) or d.get("format") != NOISE_MODEL_FORMAT or not isinstance(d.get("axes"), dict):
-        raise InputError(f"{path}: not a gyrocomp noise model (no \"format\": \"{NOISE_MODEL_FORMAT}\"); gyrocomp's "
-                         "json noise export writes one")
+        raise InputError(
+            f'{path}: not a gyrocomp noise model (no "format": "{NOISE_MODEL_FORMAT}"); gyrocomp\'s '
+            "json noise export writes one"
+        )
     found: dict[str, list[float]] = {"gyro": [], "accel": []}
     for name, axis in d["axes"].items():
         try:
             value = float(axis["bound"]["white_noise_density_u_per_sqrt_hz"])
         except (KeyError, TypeError, ValueError):
-            raise InputError(f"{path}: axes.{name}.bound.white_noise_density_u_per_sqrt_hz: missing or not a number") from None
+            raise InputError(
+                f"{path}: axes.{name}.bound.white_noise_density_u_per_sqrt_hz: missing or not a number"
+            ) from None
         if not (math.isfinite(value) and value >= 0):
-            raise InputError(f"{path}: axes.{name}.bound.white_noise_density_u_per_sqrt_hz: {value!r} is not a "
-                             "density")
+            raise InputError(f"{path}: axes.{name}.bound.white_noise_density_u_per_sqrt_hz: {value!r} is not a density")
         found["accel" if str(name).startswith("accel") else "gyro"].append(value)
     return (max(found["gyro"]) if found["gyro"] else None, max(found["accel"]) if found["accel"] else None)
 
@@ -231,8 +271,13 @@ def mean_temperature_degc(recording) -> float | None:
 DWELL_RATE_DEGC_PER_MIN = 0.05
 
 
-def temperature_dwells(recording: Recording, *, settle_s: float = 300.0, min_duration_s: float = 600.0,
-                       max_rate_degc_per_min: float = DWELL_RATE_DEGC_PER_MIN) -> list[slice]:
+def temperature_dwells(
+    recording: Recording,
+    *,
+    settle_s: float = 300.0,
+    min_duration_s: float = 600.0,
+    max_rate_degc_per_min: float = DWELL_RATE_DEGC_PER_MIN,
+) -> list[slice]:
     """The stretches of a chamber run where the temperature holds, each without its first ``settle_s``.
 
     Parameters
@@ -270,9 +315,14 @@ def temperature_dwells(recording: Recording, *, settle_s: float = 300.0, min_dur
     return out
 
 
-def noise_over_temperature(recordings: Recording | list[Recording], axes: list[str] | None = None, *,
-                           with_accel: bool = False, settle_s: float = 300.0,
-                           min_duration_s: float = 600.0) -> NoiseModel:
+def noise_over_temperature(
+    recordings: Recording | list[Recording],
+    axes: list[str] | None = None,
+    *,
+    with_accel: bool = False,
+    settle_s: float = 300.0,
+    min_duration_s: float = 600.0,
+) -> NoiseModel:
     """The noise model of chamber runs' dwells (:func:`temperature_dwells`), each dwell a log at its mean
     temperature: the bound covers every dwell, and each dwell's own bound makes the per-temperature table.
 
@@ -291,17 +341,35 @@ def noise_over_temperature(recordings: Recording | list[Recording], axes: list[s
     for recording in [recordings] if isinstance(recordings, Recording) else recordings:
         dwells = temperature_dwells(recording, settle_s=settle_s, min_duration_s=min_duration_s)
         if not dwells:
-            raise InputError(f"{recording.source}: no dwell of {min_duration_s:g} s after {settle_s:g} s of settling "
-                             f"(the temperature held within {DWELL_RATE_DEGC_PER_MIN:g} degC/min); give static logs, "
-                             "or a chamber run with longer dwells")
+            raise InputError(
+                f"{recording.source}: no dwell of {min_duration_s:g} s after {settle_s:g} s of settling "
+                f"(the temperature held within {DWELL_RATE_DEGC_PER_MIN:g} degC/min); give static logs, "
+                "or a chamber run with longer dwells"
+            )
         pieces += [recording.take(d) for d in dwells]
-    analyses = [analyse_noise(p, axes, with_accel=with_accel, motion_check=False, plausibility_check=False)
-                for p in pieces]
-    named = [dataclasses.replace(a, source=f"{p.source} at {mean_temperature_degc(p):.1f} degC")
-             for a, p in zip(analyses, pieces)]
+    analyses = [
+        analyse_noise(p, axes, with_accel=with_accel, motion_check=False, plausibility_check=False) for p in pieces
+    ]
+    named = [
+        dataclasses.replace(a, source=f"{p.source} at {mean_temperature_degc(p):.1f} degC")
+        for a, p in zip(analyses, pieces)
+    ]
     return noise_model(named, [mean_temperature_degc(p) for p in pieces])
 
 
-__all__ = ["AxisNoiseModel", "DWELL_RATE_DEGC_PER_MIN", "LogNoise", "MAX_TAU_FRACTION", "NOISE_MODEL_FORMAT",
-           "NoiseModel", "noise_file_densities", "per_sample_covariance", "scheduled_bound",
-           "mean_temperature_degc", "noise_model", "noise_over_temperature", "record_length_s", "temperature_dwells"]
+__all__ = [
+    "AxisNoiseModel",
+    "DWELL_RATE_DEGC_PER_MIN",
+    "LogNoise",
+    "MAX_TAU_FRACTION",
+    "NOISE_MODEL_FORMAT",
+    "NoiseModel",
+    "noise_file_densities",
+    "per_sample_covariance",
+    "scheduled_bound",
+    "mean_temperature_degc",
+    "noise_model",
+    "noise_over_temperature",
+    "record_length_s",
+    "temperature_dwells",
+]

@@ -57,15 +57,22 @@ RATE_RANGE_HZ = (1e-3, 4e4)
 LONG_SLOW_S = 7 * 86400.0
 #: the median norm of three accelerometer axes [g] that a unit mistake gives (gravity is 1 g, at rest and on
 #: average in ordinary motion), and the mistake; said within 20 % of one
-ACCEL_NORM_MISTAKES = ((STANDARD_GRAVITY_M_PER_S2, "m/s^2 read as g"), (1000.0, "mg read as g"),
-                       (1.0 / STANDARD_GRAVITY_M_PER_S2, "g read as m/s^2"))
+ACCEL_NORM_MISTAKES = (
+    (STANDARD_GRAVITY_M_PER_S2, "m/s^2 read as g"),
+    (1000.0, "mg read as g"),
+    (1.0 / STANDARD_GRAVITY_M_PER_S2, "g read as m/s^2"),
+)
 #: the agreement check: block length [s], fewest complete blocks, the factor either way the data's slope on the
 #: model's prediction may differ from 1 unsaid, and by how many standard errors it must lie beyond it
 AGREEMENT_BLOCK_S, AGREEMENT_MIN_BLOCKS, AGREEMENT_FACTOR, AGREEMENT_SIGMAS = 60.0, 10, 2.0, 4.0
 #: slopes that mean a known mistake, and the words for it (named when the slope is within 25 % of one)
-KNOWN_SLOPES = ((math.pi / 180.0, "rad/s read as deg/s?"), (180.0 / math.pi, "deg/s data for a model fitted on rad/s?"),
-                (1e-3, "a factor of 1/1000: the wrong unit prefix?"), (1e3, "a factor of 1000: the wrong unit prefix?"),
-                (-1.0, "the opposite sign: an axis mapped with the wrong sign?"))
+KNOWN_SLOPES = (
+    (math.pi / 180.0, "rad/s read as deg/s?"),
+    (180.0 / math.pi, "deg/s data for a model fitted on rad/s?"),
+    (1e-3, "a factor of 1/1000: the wrong unit prefix?"),
+    (1e3, "a factor of 1000: the wrong unit prefix?"),
+    (-1.0, "the opposite sign: an axis mapped with the wrong sign?"),
+)
 
 
 @dataclass(frozen=True)
@@ -93,7 +100,7 @@ def _stride(n: int) -> int:
 
 def _median(values: np.ndarray) -> float:
     """The median of ``values`` (all of them, or every k-th past MEDIAN_SAMPLES)."""
-    return float(np.median(values[::_stride(len(values))]))
+    return float(np.median(values[:: _stride(len(values))]))
 
 
 def recording_concerns(recording: Recording) -> list[Concern]:
@@ -104,13 +111,23 @@ def recording_concerns(recording: Recording) -> list[Concern]:
     src = recording.source
     peak = float(np.max(np.abs(recording.gyro_dps))) if recording.gyro_dps.size else 0.0
     if peak > MAX_RATE_DPS:
-        out.append(Concern("rate", f"{src}: gyro values up to {peak:.4g} deg/s, beyond any MEMS gyro's range "
-                                   f"({MAX_RATE_DPS:g} deg/s): a unit mistake or a corrupt file?"))
+        out.append(
+            Concern(
+                "rate",
+                f"{src}: gyro values up to {peak:.4g} deg/s, beyond any MEMS gyro's range "
+                f"({MAX_RATE_DPS:g} deg/s): a unit mistake or a corrupt file?",
+            )
+        )
     if recording.temperature_degc is not None:
         median = _median(recording.temperature_degc)
         if median > KELVIN_LOOKING_DEGC:
-            out.append(Concern("kelvin", f"{src}: median temperature {median:.4g} degC looks like kelvin; "
-                                         "gyrocomp reads degC (subtract 273.15)"))
+            out.append(
+                Concern(
+                    "kelvin",
+                    f"{src}: median temperature {median:.4g} degC looks like kelvin; "
+                    "gyrocomp reads degC (subtract 273.15)",
+                )
+            )
         else:
             out += temperature_range_concerns(recording)
     concern = accel_unit_concern(recording)
@@ -127,11 +144,16 @@ def time_unit_concern(source: str, rate_hz: float, duration_s: float) -> Concern
     milliseconds read as seconds, or the reverse)."""
     lo, hi = RATE_RANGE_HZ
     if not lo <= rate_hz <= hi:
-        return Concern("time-unit", f"{source}: {rate_hz:.3g} Hz is no IMU's sample rate: is the time column in "
-                                    "another unit than the one given?")
+        return Concern(
+            "time-unit",
+            f"{source}: {rate_hz:.3g} Hz is no IMU's sample rate: is the time column in "
+            "another unit than the one given?",
+        )
     if duration_s > LONG_SLOW_S and rate_hz <= 1.0:
-        return Concern("time-unit", f"{source}: {duration_s / 86400:.3g} days at {rate_hz:.3g} Hz: is the time "
-                                    "column in ms read as s?")
+        return Concern(
+            "time-unit",
+            f"{source}: {duration_s / 86400:.3g} days at {rate_hz:.3g} Hz: is the time column in ms read as s?",
+        )
     return None
 
 
@@ -145,10 +167,15 @@ def temperature_range_concerns(recording: Recording) -> list[Concern]:
         return []
     first = int(bad[0])
     value = float(np.ravel(t[first])[np.argmax(np.abs(np.ravel(t[first]) - 25.0))])
-    return [Concern("temperature-range", f"{recording.source}: row {int(recording.row_numbers[first])}: temperature "
-                                         f"{value:.4g} degC, beyond any sensor's range ({lo:g}..{hi:g} degC)"
-                                         + (f", and {bad.size - 1} row(s) more" if bad.size > 1 else "")
-                                         + ": a corrupt sample, or another unit?")]
+    return [
+        Concern(
+            "temperature-range",
+            f"{recording.source}: row {int(recording.row_numbers[first])}: temperature "
+            f"{value:.4g} degC, beyond any sensor's range ({lo:g}..{hi:g} degC)"
+            + (f", and {bad.size - 1} row(s) more" if bad.size > 1 else "")
+            + ": a corrupt sample, or another unit?",
+        )
+    ]
 
 
 def accel_unit_concern(recording: Recording) -> Concern | None:
@@ -157,12 +184,15 @@ def accel_unit_concern(recording: Recording) -> Concern | None:
     read as m/s^2 (``ACCEL_NORM_MISTAKES``)."""
     if recording.accel_g is None or recording.accel_g.shape[1] != 3 or not recording.accel_g.size:
         return None
-    accel = recording.accel_g[::_stride(len(recording.accel_g))]
+    accel = recording.accel_g[:: _stride(len(recording.accel_g))]
     norm = _median(np.sqrt(np.einsum("ij,ij->i", accel, accel)))
     for value, words in ACCEL_NORM_MISTAKES:
         if abs(norm / value - 1.0) < 0.2:
-            return Concern("accel-unit", f"{recording.source}: the accelerometer's median norm is {norm:.3g} g where "
-                                         f"gravity is 1 g: {words}? (give its unit with accel_unit=)")
+            return Concern(
+                "accel-unit",
+                f"{recording.source}: the accelerometer's median norm is {norm:.3g} g where "
+                f"gravity is 1 g: {words}? (give its unit with accel_unit=)",
+            )
     return None
 
 
@@ -178,14 +208,24 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
         x = recording.gyro_dps[:, j]
         median = _median(x)
         if abs(median) > MAX_OFFSET_DPS:
-            out.append(Concern("offset", f"{src}: {axis} reads {median:.3g} deg/s at the median, more than any "
-                                         "zero-rate offset: does the unit turn, or is the unit of the data wrong?"))
+            out.append(
+                Concern(
+                    "offset",
+                    f"{src}: {axis} reads {median:.3g} deg/s at the median, more than any "
+                    "zero-rate offset: does the unit turn, or is the unit of the data wrong?",
+                )
+            )
         if x.size >= w:
             swing = float(np.ptp(moving_average(x, w)))
             if swing > MAX_SWING_DPS and not turned_between_poses(recording):
-                out.append(Concern("rotation", f"{src}: {axis} swings by {swing:.3g} deg/s over {SWING_WINDOW_S:g} s "
-                                               "means: the unit turns, and a calibration run must be at rest "
-                                               "(record still positions, or cut the run to them)"))
+                out.append(
+                    Concern(
+                        "rotation",
+                        f"{src}: {axis} swings by {swing:.3g} deg/s over {SWING_WINDOW_S:g} s "
+                        "means: the unit turns, and a calibration run must be at rest "
+                        "(record still positions, or cut the run to them)",
+                    )
+                )
     return out
 
 
@@ -196,11 +236,12 @@ def turned_between_poses(recording: Recording) -> bool:
     rest."""
     if recording.accel_g is None or recording.accel_g.shape[1] != 3:
         return False
-    segments = PreparedRun.of(recording).static_segments(window_s=POSE_WINDOW_S, min_duration_s=POSE_MIN_S,
-                                                        factor=POSE_FACTOR)
+    segments = PreparedRun.of(recording).static_segments(
+        window_s=POSE_WINDOW_S, min_duration_s=POSE_MIN_S, factor=POSE_FACTOR
+    )
     if len(segments) < 6:
         return False
-    means = np.array([recording.accel_g[s.start:s.stop].mean(axis=0) for s in segments])
+    means = np.array([recording.accel_g[s.start : s.stop].mean(axis=0) for s in segments])
     units = means / np.maximum(np.linalg.norm(means, axis=1), 1e-12)[:, None]
     return bool(np.all(np.any(units > 0.5, axis=0)) and np.all(np.any(units < -0.5, axis=0)))
 
@@ -241,8 +282,9 @@ class BlockMeans:
         else:
             numbers, which = np.unique(index, return_inverse=True)
             rows = np.column_stack([np.ones(len(index)), *parts])
-            sums = np.stack([np.bincount(which, weights=rows[:, j], minlength=numbers.size)
-                             for j in range(rows.shape[1])], axis=1)
+            sums = np.stack(
+                [np.bincount(which, weights=rows[:, j], minlength=numbers.size) for j in range(rows.shape[1])], axis=1
+            )
         for number, row in zip(numbers.tolist(), sums):
             if number in self._blocks:
                 self._blocks[number] += row
@@ -279,8 +321,10 @@ class ScaleAgreement:
         """Whether the output parts between heating and cooling blocks by ``AGREEMENT_SIGMAS`` standard errors
         beyond what the model predicts, and with that part taken out the slope is within ``AGREEMENT_FACTOR``
         either way of 1: a branch (hysteresis) or a lag the model does not carry, rather than a unit or a part."""
-        return bool(abs(self.direction_offset) > AGREEMENT_SIGMAS * self.direction_standard_error
-                    and 1.0 / AGREEMENT_FACTOR <= self.slope_with_direction <= AGREEMENT_FACTOR)
+        return bool(
+            abs(self.direction_offset) > AGREEMENT_SIGMAS * self.direction_standard_error
+            and 1.0 / AGREEMENT_FACTOR <= self.slope_with_direction <= AGREEMENT_FACTOR
+        )
 
     @property
     def disagrees(self) -> bool:
@@ -309,8 +353,9 @@ def _direction_fit(x: np.ndarray, y: np.ndarray, temperature_means: np.ndarray |
     return 2.0 * float(coef[1]), 2.0 * math.sqrt(max(float(cov[1, 1]), 0.0)), float(coef[0])
 
 
-def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray,
-                    temperature_means: np.ndarray | None = None) -> ScaleAgreement | None:
+def scale_agreement(
+    output_means: np.ndarray, predicted_means: np.ndarray, temperature_means: np.ndarray | None = None
+) -> ScaleAgreement | None:
     """The slope of an axis's block-mean output on its predicted error's (both [deg/s]), with its standard error
     from the scatter about the line (each about its mean: the turn-on constant does not enter). With the blocks'
     mean temperatures [degC], also the fit with the direction of temperature change as a second regressor
@@ -344,8 +389,14 @@ def scale_agreement(output_means: np.ndarray, predicted_means: np.ndarray,
     effective = max(x.size * (1.0 - r) / (1.0 + r), 3.0)
     standard_error = math.sqrt(float(residual @ residual) / (x.size - 2) / sxx * (x.size - 2) / (effective - 2))
     offset, offset_se, slope_d = _direction_fit(x, y, temperature_means)
-    return ScaleAgreement(slope * y_scale / scale, standard_error * y_scale / scale, int(x.size),
-                          offset * y_scale, offset_se * y_scale, slope_d * y_scale / scale)
+    return ScaleAgreement(
+        slope * y_scale / scale,
+        standard_error * y_scale / scale,
+        int(x.size),
+        offset * y_scale,
+        offset_se * y_scale,
+        slope_d * y_scale / scale,
+    )
 
 
 def _lag_one_correlation(residual: np.ndarray) -> float:
@@ -366,17 +417,23 @@ def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) 
     slope = agreement.slope
     known = next((words for ratio, words in KNOWN_SLOPES if abs(slope / ratio - 1.0) < 0.25), None)
     if known is None and agreement.follows_direction:
-        said = (f"with a slope of {slope:.3g} +- {agreement.standard_error:.2g}, not 1, and " if agreement.disagrees
-                else "")
-        return Concern("agreement", f"{source}: {axis} follows the error the model predicts for it {said}parts "
-                                    f"between heating and cooling by {agreement.direction_offset:.2g} deg/s beyond "
-                                    f"the model (slope {agreement.slope_with_direction:.3g} with that taken out): "
-                                    "hysteresis or a thermal lag the model does not carry? (fit on runs that both "
-                                    "heat and cool)")
-    return Concern("agreement", f"{source}: {axis} follows the error the model predicts for it with a slope of "
-                                f"{slope:.3g} +- {agreement.standard_error:.2g}, not 1: "
-                                + (known or "is the data in another unit than the model's, or the model of another "
-                                   "part?"))
+        said = (
+            f"with a slope of {slope:.3g} +- {agreement.standard_error:.2g}, not 1, and " if agreement.disagrees else ""
+        )
+        return Concern(
+            "agreement",
+            f"{source}: {axis} follows the error the model predicts for it {said}parts "
+            f"between heating and cooling by {agreement.direction_offset:.2g} deg/s beyond "
+            f"the model (slope {agreement.slope_with_direction:.3g} with that taken out): "
+            "hysteresis or a thermal lag the model does not carry? (fit on runs that both "
+            "heat and cool)",
+        )
+    return Concern(
+        "agreement",
+        f"{source}: {axis} follows the error the model predicts for it with a slope of "
+        f"{slope:.3g} +- {agreement.standard_error:.2g}, not 1: "
+        + (known or "is the data in another unit than the model's, or the model of another part?"),
+    )
 
 
 def _largest_span_degc(recordings: list[Recording]) -> float | None:
@@ -390,8 +447,10 @@ def require_temperature_span(recordings: list[Recording], what: str) -> None:
     is then undetermined (``what`` names the operation in the message)."""
     span = _largest_span_degc(recordings)
     if span is not None and span < MIN_TEMPERATURE_SPAN_DEGC:
-        raise InputError(f"{recordings[0].source}: the temperature of every run spans at most {span:.3g} degC; "
-                         f"{what} compares temperature models, which need runs over a temperature range")
+        raise InputError(
+            f"{recordings[0].source}: the temperature of every run spans at most {span:.3g} degC; "
+            f"{what} compares temperature models, which need runs over a temperature range"
+        )
 
 
 def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
@@ -400,12 +459,30 @@ def temperature_span_concern(recordings: list[Recording]) -> Concern | None:
     span = _largest_span_degc(recordings)
     if span is None or span >= MIN_TEMPERATURE_SPAN_DEGC:
         return None
-    return Concern("temperature-span", f"{recordings[0].source}: the temperature of every run spans at most "
-                                       f"{span:.3g} degC; a temperature curve needs runs over a temperature "
-                                       "range (or fit with temperature=None)")
+    return Concern(
+        "temperature-span",
+        f"{recordings[0].source}: the temperature of every run spans at most "
+        f"{span:.3g} degC; a temperature curve needs runs over a temperature "
+        "range (or fit with temperature=None)",
+    )
 
 
-__all__ = ["AGREEMENT_BLOCK_S", "BlockMeans", "CHECKS", "CheckName", "Concern", "ScaleAgreement", "accel_unit_concern",
-           "agreement_concern", "temperature_range_concerns", "time_unit_concern",
-           "calibration_concerns", "recording_concerns", "require_temperature_span", "scale_agreement", "silence_pattern",
-           "temperature_span_concern", "turned_between_poses"]
+__all__ = [
+    "AGREEMENT_BLOCK_S",
+    "BlockMeans",
+    "CHECKS",
+    "CheckName",
+    "Concern",
+    "ScaleAgreement",
+    "accel_unit_concern",
+    "agreement_concern",
+    "temperature_range_concerns",
+    "time_unit_concern",
+    "calibration_concerns",
+    "recording_concerns",
+    "require_temperature_span",
+    "scale_agreement",
+    "silence_pattern",
+    "temperature_span_concern",
+    "turned_between_poses",
+]

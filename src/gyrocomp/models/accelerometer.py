@@ -59,17 +59,32 @@ def fit_accelerometer(recordings: list[Recording], options: FitOptions | None = 
 def accelerometer_models(recordings: list[PreparedRun], options: FitOptions) -> Calibration:
     """:func:`fit_accelerometer` on runs prepared once, with checked options."""
     if options.temperature is None:
-        raise InputError("channels=accel: the accelerometer model is a temperature model; "
-                         "temperature=None leaves nothing to fit (use a polynomial or a network)")
+        raise InputError(
+            "channels=accel: the accelerometer model is a temperature model; "
+            "temperature=None leaves nothing to fit (use a polynomial or a network)"
+        )
     pieces, folds, split = _accelerometer_pieces(recordings, options.static_min_duration_s)
-    fitted = fit_joint(pieces, dataclasses.replace(
-        options, hysteresis="none" if split and options.hysteresis == "auto" else options.hysteresis,
-        acceleration="none", run_folds=folds, folds="auto"))
+    fitted = fit_joint(
+        pieces,
+        dataclasses.replace(
+            options,
+            hysteresis="none" if split and options.hysteresis == "auto" else options.hysteresis,
+            acceleration="none",
+            run_folds=folds,
+            folds="auto",
+        ),
+    )
     if fitted.accel_reference_degc is None:
-        raise InputError("channels=accel: no temperature model of the accelerometer generalizes across these runs "
-                         "(every axis is left a constant); their temperatures do not span enough to fit one")
-    return dataclasses.replace(fitted, model=f"accel {fitted.model}", provenance=provenance(recordings),
-                               fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}})
+        raise InputError(
+            "channels=accel: no temperature model of the accelerometer generalizes across these runs "
+            "(every axis is left a constant); their temperatures do not span enough to fit one"
+        )
+    return dataclasses.replace(
+        fitted,
+        model=f"accel {fitted.model}",
+        provenance=provenance(recordings),
+        fit_report={"accel": {**fitted.fit_report, "pieces": len(pieces)}},
+    )
 
 
 def fit_accel_channel(recordings: list[PreparedRun], options: FitOptions) -> Calibration:
@@ -89,19 +104,36 @@ def fit_accel_channel(recordings: list[PreparedRun], options: FitOptions) -> Cal
     poses = _spanning_poses(recordings)
     if poses is None:
         if accel_cal is None:
-            raise InputError("channels=accel: the runs have no temperature (for a temperature model) and do not turn "
-                             "every accelerometer axis up and down (for a multi-position calibration)")
+            raise InputError(
+                "channels=accel: the runs have no temperature (for a temperature model) and do not turn "
+                "every accelerometer axis up and down (for a multi-position calibration)"
+            )
         return accel_cal
     fit, accel_cal = _accel_triad(poses, accel_cal)
-    report = {"accel_triad": {"method": fit.calibration.method, "poses": len(poses),
-                              "norm_rms_before_g": fit.norm_rms_error_before_g, "norm_rms_after_g": fit.norm_rms_error_g,
-                              "degrees_of_freedom": fit.degrees_of_freedom,
-                              "temperature_order": fit.calibration.temperature_order}}
+    report = {
+        "accel_triad": {
+            "method": fit.calibration.method,
+            "poses": len(poses),
+            "norm_rms_before_g": fit.norm_rms_error_before_g,
+            "norm_rms_after_g": fit.norm_rms_error_g,
+            "degrees_of_freedom": fit.degrees_of_freedom,
+            "temperature_order": fit.calibration.temperature_order,
+        }
+    }
     if accel_cal is None:
-        return Calibration(axes={}, model=f"accel {fit.calibration.method}", provenance=provenance(recordings),
-                           fit_report=report, accel_triad=fit.calibration)
-    return dataclasses.replace(accel_cal, model=f"{accel_cal.model} + {fit.calibration.method}",
-                               fit_report={**accel_cal.fit_report, **report}, accel_triad=fit.calibration)
+        return Calibration(
+            axes={},
+            model=f"accel {fit.calibration.method}",
+            provenance=provenance(recordings),
+            fit_report=report,
+            accel_triad=fit.calibration,
+        )
+    return dataclasses.replace(
+        accel_cal,
+        model=f"{accel_cal.model} + {fit.calibration.method}",
+        fit_report={**accel_cal.fit_report, **report},
+        accel_triad=fit.calibration,
+    )
 
 
 __all__ = ["accelerometer_models", "fit_accel_channel", "fit_accelerometer"]

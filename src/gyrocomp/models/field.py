@@ -23,8 +23,14 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..motion.stillness import (AUTO_MIN_BLOCKS, AUTO_STILL_FRACTION, MIN_DURATION_S, StillDetection, detect_still,
-                         moves_most_of_the_time)
+from ..motion.stillness import (
+    AUTO_MIN_BLOCKS,
+    AUTO_STILL_FRACTION,
+    MIN_DURATION_S,
+    StillDetection,
+    detect_still,
+    moves_most_of_the_time,
+)
 
 #: the still data of all logs together must span at least this [degC]
 MIN_FIELD_SPAN_DEGC = 5.0
@@ -50,8 +56,9 @@ class LogContribution:
         return self.still_s / self.duration_s if self.duration_s > 0 else 0.0
 
 
-def field_recordings(recordings: list[Recording], still_only: StillOnly = "auto", *,
-                     min_still_s: float = MIN_DURATION_S) -> tuple[list[Recording], list[LogContribution]]:
+def field_recordings(
+    recordings: list[Recording], still_only: StillOnly = "auto", *, min_still_s: float = MIN_DURATION_S
+) -> tuple[list[Recording], list[LogContribution]]:
     """The runs to fit from ``recordings`` (see the module), and what each log contributed.
 
     Parameters
@@ -76,8 +83,9 @@ def field_recordings(recordings: list[Recording], still_only: StillOnly = "auto"
     for rec in recordings:
         if rec.temperature_degc is None or rec.reference_rate_dps is not None:
             if still_only == "yes" and rec.temperature_degc is None:
-                raise InputError(f"{rec.source}: no temperature; a field calibration learns the bias against "
-                                 "temperature")
+                raise InputError(
+                    f"{rec.source}: no temperature; a field calibration learns the bias against temperature"
+                )
             runs.append(rec)  # auto: a run for the accelerometer, G or a rate table, used as given
             continue
         found = detect_still(rec, min_duration_s=min_still_s)
@@ -93,27 +101,45 @@ def field_recordings(recordings: list[Recording], still_only: StillOnly = "auto"
 
 
 def _contribution(rec: Recording, found: StillDetection, keep: bool) -> LogContribution:
-    temps = [(s.temperature_min_degc, s.temperature_max_degc) for s in found.segments
-             if s.temperature_min_degc is not None]
+    temps = [
+        (s.temperature_min_degc, s.temperature_max_degc) for s in found.segments if s.temperature_min_degc is not None
+    ]
     if not keep:  # the whole log is used
         temps = [(float(np.min(rec.temperature_degc)), float(np.max(rec.temperature_degc)))]
-    return LogContribution(rec.source, rec.duration_s, found.still_s, len(found.segments),
-                           min(t[0] for t in temps) if temps else None, max(t[1] for t in temps) if temps else None,
-                           keep)
+    return LogContribution(
+        rec.source,
+        rec.duration_s,
+        found.still_s,
+        len(found.segments),
+        min(t[0] for t in temps) if temps else None,
+        max(t[1] for t in temps) if temps else None,
+        keep,
+    )
 
 
 def _require_still_data(contributions: list[LogContribution]) -> None:
     used = [c for c in contributions if c.temperature_min_degc is not None]
     if not used:
-        raise InputError(f"{contributions[0].source}: no still segment of at least the minimum length in any log "
-                         f"({len(contributions)} log(s)); a field calibration needs the vehicle still for a while")
+        raise InputError(
+            f"{contributions[0].source}: no still segment of at least the minimum length in any log "
+            f"({len(contributions)} log(s)); a field calibration needs the vehicle still for a while"
+        )
     low = min(c.temperature_min_degc for c in used)
     high = max(c.temperature_max_degc for c in used)
     if high - low < MIN_FIELD_SPAN_DEGC:
-        raise InputError(f"{used[0].source}: the still data of {len(used)} log(s) cover {low:.1f}..{high:.1f} degC "
-                         f"({high - low:.1f} degC); a temperature model needs at least {MIN_FIELD_SPAN_DEGC:g} degC "
-                         "(log cold starts and warm-ups, still now and then)")
+        raise InputError(
+            f"{used[0].source}: the still data of {len(used)} log(s) cover {low:.1f}..{high:.1f} degC "
+            f"({high - low:.1f} degC); a temperature model needs at least {MIN_FIELD_SPAN_DEGC:g} degC "
+            "(log cold starts and warm-ups, still now and then)"
+        )
 
 
-__all__ = ["AUTO_MIN_BLOCKS", "AUTO_STILL_FRACTION", "LogContribution", "MIN_FIELD_SPAN_DEGC", "StillOnly", "field_recordings",
-           "moves_most_of_the_time"]
+__all__ = [
+    "AUTO_MIN_BLOCKS",
+    "AUTO_STILL_FRACTION",
+    "LogContribution",
+    "MIN_FIELD_SPAN_DEGC",
+    "StillOnly",
+    "field_recordings",
+    "moves_most_of_the_time",
+]

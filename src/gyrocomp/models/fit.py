@@ -37,9 +37,14 @@ def check_channels(channels: tuple[Channel, ...]) -> tuple[Channel, ...]:
 
 
 @single_threaded_blas
-def fit(runs: list[Recording] | Recording, options: FitOptions | None = None, *,
-        channels: tuple[Channel, ...] = ("gyro",), pipeline: Pipeline = "joint",
-        scale_factor: ScaleFactor = "auto") -> Calibration:
+def fit(
+    runs: list[Recording] | Recording,
+    options: FitOptions | None = None,
+    *,
+    channels: tuple[Channel, ...] = ("gyro",),
+    pipeline: Pipeline = "joint",
+    scale_factor: ScaleFactor = "auto",
+) -> Calibration:
     """Fit a compensation on calibration runs.
 
     Parameters
@@ -80,8 +85,11 @@ def fit(runs: list[Recording] | Recording, options: FitOptions | None = None, *,
     recordings = prepare([runs] if isinstance(runs, Recording) else runs)
     channels = check_channels(channels)
     options = checked_options(options)
-    gyro_triad, recordings = (_gyro_triad(recordings, scale_factor, options.temperature is not None)
-                              if "gyro" in channels else (None, recordings))
+    gyro_triad, recordings = (
+        _gyro_triad(recordings, scale_factor, options.temperature is not None)
+        if "gyro" in channels
+        else (None, recordings)
+    )
     if "accel" not in channels:
         return dataclasses.replace(run_pipeline(recordings, pipeline, options), gyro_triad=gyro_triad)
     accel_cal = fit_accel_channel(recordings, options)
@@ -89,18 +97,29 @@ def fit(runs: list[Recording] | Recording, options: FitOptions | None = None, *,
         return accel_cal
     compensated = recordings
     if accel_cal.accel_axes:
-        compensated = [dataclasses.replace(rec, accel_g=apply(accel_cal.without_accel_triad(), rec).accel_g)
-                       for rec in recordings]
+        compensated = [
+            dataclasses.replace(rec, accel_g=apply(accel_cal.without_accel_triad(), rec).accel_g) for rec in recordings
+        ]
     gyro_cal = run_pipeline(compensated, pipeline, options)
-    return dataclasses.replace(gyro_cal, model=f"{gyro_cal.model}; {accel_cal.model}",
-                               fit_report={**gyro_cal.fit_report, **accel_cal.fit_report},
-                               accel_axes=accel_cal.accel_axes, accel_reference_degc=accel_cal.accel_reference_degc,
-                               gyro_triad=gyro_triad, accel_triad=accel_cal.accel_triad)
+    return dataclasses.replace(
+        gyro_cal,
+        model=f"{gyro_cal.model}; {accel_cal.model}",
+        fit_report={**gyro_cal.fit_report, **accel_cal.fit_report},
+        accel_axes=accel_cal.accel_axes,
+        accel_reference_degc=accel_cal.accel_reference_degc,
+        gyro_triad=gyro_triad,
+        accel_triad=accel_cal.accel_triad,
+    )
 
 
-def fit_channels(recordings: list[Recording] | Recording, channels: tuple[Channel, ...] = ("gyro",),
-                 pipeline: Pipeline = "joint", *, scale_factor: ScaleFactor = "auto",
-                 options: FitOptions | None = None) -> Calibration:
+def fit_channels(
+    recordings: list[Recording] | Recording,
+    channels: tuple[Channel, ...] = ("gyro",),
+    pipeline: Pipeline = "joint",
+    *,
+    scale_factor: ScaleFactor = "auto",
+    options: FitOptions | None = None,
+) -> Calibration:
     """:func:`fit` with its arguments in another order (release 0.1's form)."""
     return fit(recordings, options, channels=channels, pipeline=pipeline, scale_factor=scale_factor)
 

@@ -14,16 +14,18 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
 from ..errors import InputError, ModelChoiceWarning
-from ..calibration.fit_report import THIN_FOLDS, AxisFit, GSensitivityReport, HysteresisReport, MemoryChoice, NetworkReport
+from ..calibration.fit_report import (
+    THIN_FOLDS,
+    AxisFit,
+    GSensitivityReport,
+    HysteresisReport,
+    MemoryChoice,
+    NetworkReport,
+)
 from ..measures.plausibility import calibration_concerns, temperature_span_concern
 from ..runs.prepared import PreparedRun, fit_axes, prepare
 from ..recording import Recording
-from ..fitting.acceleration import (
-    acceleration_report,
-    excited_columns,
-    fit_g_sensitivity,
-    turned_between_positions,
-)
+from ..fitting.acceleration import acceleration_report, excited_columns, fit_g_sensitivity, turned_between_positions
 from ..fitting.base import bin_width_for, one_temperature_column, provenance
 from ..curves.hysteresis import heats_and_cools
 from ..curves.network import NETWORK_BLOCK_S
@@ -33,10 +35,15 @@ from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
 from ..fitting.selection import AxisSelection, prepare_axis
 from ..fitting.polynomial_model import PolynomialTemperatureModel
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, _accel_triad, _gyro_triad, _spanning_poses  # noqa: F401
-from .options import (Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target,
-                      curve_candidates)
-from ..fitting.thermal import (CANDIDATES, LAG_EVIDENCE_CHI2, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER,
-                               ThermalHysteresisModel, static_pieces)
+from .options import Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target, curve_candidates
+from ..fitting.thermal import (
+    CANDIDATES,
+    LAG_EVIDENCE_CHI2,
+    MAX_BRANCH_ORDER,
+    MAX_HYSTERESIS_ORDER,
+    ThermalHysteresisModel,
+    static_pieces,
+)
 from ..threads import single_threaded_blas
 
 #: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
@@ -47,9 +54,19 @@ BRANCH_ORDERS = tuple(range(1, MAX_BRANCH_ORDER + 1))
 FOLD_SELECTION = {"runs": "leave-one-run-out", "legs": "leave-one-leg-out", "blocks": "leave-one-block-out"}
 
 
-def _fit_network(network: NetworkTemperatureModel, recordings: list[Recording], axis: str, lag_s: float,
-                 hysteresis, scaffold, bin_width_degc: float | None, g_row=None, g_squared=None,
-                 segments=None, inputs: tuple[str, ...] = ("temperature",)):
+def _fit_network(
+    network: NetworkTemperatureModel,
+    recordings: list[Recording],
+    axis: str,
+    lag_s: float,
+    hysteresis,
+    scaffold,
+    bin_width_degc: float | None,
+    g_row=None,
+    g_squared=None,
+    segments=None,
+    inputs: tuple[str, ...] = ("temperature",),
+):
     """Train the network on the block means of the runs, through the lag and without the hysteresis
     that the least-squares stage found (a cascade: the network replaces its curve, ``scaffold``, and takes the
     middle of its range as the reference temperature)."""
@@ -76,17 +93,27 @@ def _fit_network(network: NetworkTemperatureModel, recordings: list[Recording], 
     if needs_accel and any(a is None for a in a_in):
         raise InputError("pipeline=joint-mlp: the runs need accel_x, accel_y and accel_z columns")
     t_ref_degc = 0.5 * (scaffold.t_min_degc + scaffold.t_max_degc)
-    network.fit_blocks(axis, t_in, y_in, w_in, t_ref_degc=t_ref_degc, accel_g=a_in if needs_accel else None,
-                       inputs=inputs)
+    network.fit_blocks(
+        axis, t_in, y_in, w_in, t_ref_degc=t_ref_degc, accel_g=a_in if needs_accel else None, inputs=inputs
+    )
     return network.curves_[axis], network.turn_on_biases_[axis]
 
 
-def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memories: tuple[str, ...],
-                  hysteresis_orders: tuple[int, ...] = (1, 2, 3), acceleration: str = "none",
-                  static_min_duration_s: float = 10.0, bin_width_degc: float | None = None,
-                  run_folds: tuple[int, ...] | None = None, folds: str = "auto",
-                  shared_lag: bool = True, do_no_harm: bool = True,
-                  other_curves: tuple[tuple[str, int], ...] = ()) -> dict[str, AxisSelection]:
+def select_models(
+    recordings: list[Recording],
+    *,
+    orders: tuple[int, ...],
+    memories: tuple[str, ...],
+    hysteresis_orders: tuple[int, ...] = (1, 2, 3),
+    acceleration: str = "none",
+    static_min_duration_s: float = 10.0,
+    bin_width_degc: float | None = None,
+    run_folds: tuple[int, ...] | None = None,
+    folds: str = "auto",
+    shared_lag: bool = True,
+    do_no_harm: bool = True,
+    other_curves: tuple[tuple[str, int], ...] = (),
+) -> dict[str, AxisSelection]:
     """Choose each gyro axis's model by held-out drift (:mod:`gyrocomp.fitting.selection`).
 
     Parameters
@@ -120,19 +147,32 @@ def select_models(recordings: list[Recording], *, orders: tuple[int, ...], memor
     square_cols: tuple[int, ...] = ()
     problems = {}
     for k, axis in enumerate(fit_axes(recordings)):
-        problem = prepare_axis(recordings, axis, pieces=pieces, groups=run_folds, bin_width_degc=bin_width_degc,
-                               fold_kind=folds, max_order=max(orders, default=0), hysteresis_orders=hysteresis_orders,
-                               both_directions="none" in memories,
-                               branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
-                               other_curves=other_curves)
+        problem = prepare_axis(
+            recordings,
+            axis,
+            pieces=pieces,
+            groups=run_folds,
+            bin_width_degc=bin_width_degc,
+            fold_kind=folds,
+            max_order=max(orders, default=0),
+            hysteresis_orders=hysteresis_orders,
+            both_directions="none" in memories,
+            branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
+            other_curves=other_curves,
+        )
         if acceleration != "none":
             if any(r.accel_g is None for r in problem.runs):
-                raise InputError("acceleration: the runs need accel_x, accel_y and accel_z columns for a "
-                                 "g-sensitivity fit; map them with columns= or fit with acceleration='none'")
+                raise InputError(
+                    "acceleration: the runs need accel_x, accel_y and accel_z columns for a "
+                    "g-sensitivity fit; map them with columns= or fit with acceleration='none'"
+                )
             if k == 0:
-                accel_cols, square_cols, _ = excited_columns([r.accel_g for r in problem.runs],
-                                                             [r.weight for r in problem.runs],
-                                                             squares=acceleration == "matrix2", warn=False)
+                accel_cols, square_cols, _ = excited_columns(
+                    [r.accel_g for r in problem.runs],
+                    [r.weight for r in problem.runs],
+                    squares=acceleration == "matrix2",
+                    warn=False,
+                )
             problem.accel_cols, problem.square_cols = accel_cols, square_cols
         problems[axis] = problem
     one_die = shared_lag and one_temperature_column(recordings)
@@ -147,28 +187,44 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
     if first.fold_note:
         warnings.warn(f"model choice: {first.fold_note}", ModelChoiceWarning, stacklevel=3)
     if first.validated and len(first.folds) < THIN_FOLDS:
-        warnings.warn(f"model choice: only {len(first.folds)} {across} to hold out; the evidence for each axis's "
-                      f"choice is thin (more runs, or runs that heat and cool more than once, make it firmer)",
-                      ModelChoiceWarning, stacklevel=3)
+        warnings.warn(
+            f"model choice: only {len(first.folds)} {across} to hold out; the evidence for each axis's "
+            f"choice is thin (more runs, or runs that heat and cool more than once, make it firmer)",
+            ModelChoiceWarning,
+            stacklevel=3,
+        )
     for axis, sel in selections.items():
         unit = sel.unit
         if sel.lag_from_unit:
-            warnings.warn(f"{axis}: the held-out {across} cannot tell {sel.chosen.label} from the same without the lag "
-                          "the other axes found; the die's lag is kept", ModelChoiceWarning, stacklevel=3)
+            warnings.warn(
+                f"{axis}: the held-out {across} cannot tell {sel.chosen.label} from the same without the lag "
+                "the other axes found; the die's lag is kept",
+                ModelChoiceWarning,
+                stacklevel=3,
+            )
         if sel.branch_test is not None:
             warnings.warn(sel.branch_test.sentence(axis), ModelChoiceWarning, stacklevel=3)
         if not sel.validated:
-            warnings.warn(f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without "
-                          "validation", ModelChoiceWarning, stacklevel=3)
+            warnings.warn(
+                f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without validation",
+                ModelChoiceWarning,
+                stacklevel=3,
+            )
         elif not sel.generalizes:
-            warnings.warn(f"{axis}: left with its constant only; {sel.decided_by or 'do no harm'} "
-                          f"(best: {sel.best.label})", ModelChoiceWarning, stacklevel=3)
+            warnings.warn(
+                f"{axis}: left with its constant only; {sel.decided_by or 'do no harm'} (best: {sel.best.label})",
+                ModelChoiceWarning,
+                stacklevel=3,
+            )
         elif len(sel.folds) == TWO_FOLDS:  # thin evidence: which rule chose, in one line
             warnings.warn(f"{axis}: {sel.chosen.label}; {sel.decided_by}", ModelChoiceWarning, stacklevel=3)
         elif sel.chosen_drift > sel.raw_drift:
-            warnings.warn(f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift:.3g} {unit} of "
-                          f"held-out drift, more than the raw output's {sel.raw_drift:.3g} {unit}",
-                          ModelChoiceWarning, stacklevel=3)
+            warnings.warn(
+                f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift:.3g} {unit} of "
+                f"held-out drift, more than the raw output's {sel.raw_drift:.3g} {unit}",
+                ModelChoiceWarning,
+                stacklevel=3,
+            )
 
 
 def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHysteresisModel, mode: str) -> dict:
@@ -185,17 +241,26 @@ def _selection_report(selections: dict[str, AxisSelection], thermal: ThermalHyst
                 m = s.candidate.memory
                 if math.isfinite(s.mean_drift):
                     by_memory[m] = min(by_memory.get(m, s.mean_drift), s.mean_drift)
-        axes[axis] = MemoryChoice(c.memory, c.hysteresis_order, thermal.lag_time_constants_s_[axis], c.order,
-                                  c.weighting, by_memory)
+        axes[axis] = MemoryChoice(
+            c.memory, c.hysteresis_order, thermal.lag_time_constants_s_[axis], c.order, c.weighting, by_memory
+        )
     return HysteresisReport(mode, kind, axes, next(iter(selections.values())).unit).to_dict()
 
 
 def _thermal_report(thermal: ThermalHysteresisModel, mode: str, unit: str) -> dict:
     """The hysteresis part of the fit report from the thermal model's own choice (a fixed order or memory)."""
-    axes = {axis: MemoryChoice(memory, order, thermal.lag_time_constants_s_[axis], thermal.curves_[axis].order, None,
-                               {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()},
-                               {int(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()})
-            for axis, (memory, order) in thermal.memories_.items()}
+    axes = {
+        axis: MemoryChoice(
+            memory,
+            order,
+            thermal.lag_time_constants_s_[axis],
+            thermal.curves_[axis].order,
+            None,
+            {k: (None if math.isnan(v) else float(v)) for k, v in thermal.scores_[axis].items()},
+            {int(o): float(v) for o, v in thermal.order_scores_.get(axis, {}).items()},
+        )
+        for axis, (memory, order) in thermal.memories_.items()
+    }
     return HysteresisReport(mode, thermal.selection_, axes, unit).to_dict()
 
 
@@ -205,16 +270,31 @@ def _fit_selected(recordings: list[Recording], options: FitOptions, accel_mode: 
     chosen model on all runs."""
     offered = curve_candidates(options.temperature, options.target)
     memories = tuple(CANDIDATES) if options.hysteresis == "auto" else (options.hysteresis,)
-    h_orders = (tuple(range(1, MAX_HYSTERESIS_ORDER + 1)) if options.hysteresis_order == "auto"
-                else (int(options.hysteresis_order),))
-    selections = select_models(recordings, orders=offered.orders, memories=memories, hysteresis_orders=h_orders,
-                               acceleration=accel_mode, static_min_duration_s=options.static_min_duration_s,
-                               bin_width_degc=options.bin_width_degc, run_folds=options.run_folds,
-                               folds=options.folds, do_no_harm=offered.do_no_harm, other_curves=offered.others)
+    h_orders = (
+        tuple(range(1, MAX_HYSTERESIS_ORDER + 1))
+        if options.hysteresis_order == "auto"
+        else (int(options.hysteresis_order),)
+    )
+    selections = select_models(
+        recordings,
+        orders=offered.orders,
+        memories=memories,
+        hysteresis_orders=h_orders,
+        acceleration=accel_mode,
+        static_min_duration_s=options.static_min_duration_s,
+        bin_width_degc=options.bin_width_degc,
+        run_folds=options.run_folds,
+        folds=options.folds,
+        do_no_harm=offered.do_no_harm,
+        other_curves=offered.others,
+    )
     _refuse_what_cannot_be_judged(recordings, selections)
     thermal = _fit_chosen(recordings, selections, options, accel_mode)
-    unseen = {axis for axis, sel in selections.items()
-              if sel.lag_from_unit and not thermal.lag_evidence_[axis] > LAG_EVIDENCE_CHI2}
+    unseen = {
+        axis
+        for axis, sel in selections.items()
+        if sel.lag_from_unit and not thermal.lag_evidence_[axis] > LAG_EVIDENCE_CHI2
+    }
     if unseen:
         # an axis that took the die's lag keeps it where its own data, all runs together, see it (a fit at the
         # die's lag apart from one at the bottom of the search); elsewhere it goes back to its own choice
@@ -232,36 +312,50 @@ def _refuse_what_cannot_be_judged(recordings: list[Recording], selections: dict[
         return
     rows = sum(rec.n_samples for rec in recordings)
     span = max(float(np.ptp(rec.temperature_degc)) for rec in recordings)
-    raise InputError(f"{recordings[0].source}: {rows} samples over {span:.3g} degC: too little to hold any of it "
-                     "out, and no temperature range to fit a curve over; a calibration needs runs over a temperature "
-                     "range (for the turn-on constants alone, fit with temperature=None)")
+    raise InputError(
+        f"{recordings[0].source}: {rows} samples over {span:.3g} degC: too little to hold any of it "
+        "out, and no temperature range to fit a curve over; a calibration needs runs over a temperature "
+        "range (for the turn-on constants alone, fit with temperature=None)"
+    )
 
 
-def _fit_chosen(recordings: list[Recording], selections: dict[str, AxisSelection], options: FitOptions,
-                accel_mode: str) -> ThermalHysteresisModel:
+def _fit_chosen(
+    recordings: list[Recording], selections: dict[str, AxisSelection], options: FitOptions, accel_mode: str
+) -> ThermalHysteresisModel:
     """Each axis's chosen model (``selections``) fitted on all the runs."""
     chosen = {axis: sel.chosen for axis, sel in selections.items()}
-    return ThermalHysteresisModel(order={a: c.order for a, c in chosen.items()},
-                                  hysteresis={a: c.memory for a, c in chosen.items()},
-                                  hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
-                                  weighting={a: c.weighting for a, c in chosen.items()},
-                                  band_degc={a: selections[a].band_degc if c.band else None
-                                             for a, c in chosen.items()},
-                                  branch_order={a: c.branch for a, c in chosen.items()},
-                                  curve={a: c.curve for a, c in chosen.items()},
-                                  bin_width_degc=options.bin_width_degc, acceleration=accel_mode,
-                                  static_min_duration_s=options.static_min_duration_s,
-                                  refine_band=True, extended=True).fit(recordings)
+    return ThermalHysteresisModel(
+        order={a: c.order for a, c in chosen.items()},
+        hysteresis={a: c.memory for a, c in chosen.items()},
+        hysteresis_order={a: c.hysteresis_order for a, c in chosen.items()},
+        weighting={a: c.weighting for a, c in chosen.items()},
+        band_degc={a: selections[a].band_degc if c.band else None for a, c in chosen.items()},
+        branch_order={a: c.branch for a, c in chosen.items()},
+        curve={a: c.curve for a, c in chosen.items()},
+        bin_width_degc=options.bin_width_degc,
+        acceleration=accel_mode,
+        static_min_duration_s=options.static_min_duration_s,
+        refine_band=True,
+        extended=True,
+    ).fit(recordings)
 
 
 @single_threaded_blas
-def fit_calibration(recordings: list[Recording] | Recording, *,
-                    temperature: Polynomial | Curve | Network | None = Polynomial(), bin_width_degc: float | None = None,
-                    hysteresis: Memory = "auto", hysteresis_order: int | Literal["auto"] = "auto",
-                    hysteresis_band_degc: tuple[float, float] | None = None, acceleration: Acceleration = "auto",
-                    static_min_duration_s: float = 10.0, network_inputs: tuple[str, ...] = ("temperature",),
-                    run_folds: tuple[int, ...] | None = None, folds: FoldChoice = "auto",
-                    target: Target = "model") -> Calibration:
+def fit_calibration(
+    recordings: list[Recording] | Recording,
+    *,
+    temperature: Polynomial | Curve | Network | None = Polynomial(),
+    bin_width_degc: float | None = None,
+    hysteresis: Memory = "auto",
+    hysteresis_order: int | Literal["auto"] = "auto",
+    hysteresis_band_degc: tuple[float, float] | None = None,
+    acceleration: Acceleration = "auto",
+    static_min_duration_s: float = 10.0,
+    network_inputs: tuple[str, ...] = ("temperature",),
+    run_folds: tuple[int, ...] | None = None,
+    folds: FoldChoice = "auto",
+    target: Target = "model",
+) -> Calibration:
     """Fit a compensation on calibration runs (each one power-on, the gyro at rest), the options as keyword
     arguments: the gyro's ``joint`` fit of :func:`gyrocomp.fit` (``gyrocomp.models.fit.fit``) with those options
     as a :class:`~gyrocomp.models.options.FitOptions`, which documents each one (``temperature``, the curve and its
@@ -277,16 +371,26 @@ def fit_calibration(recordings: list[Recording] | Recording, *,
     standard error of the best); an axis no temperature model helps gets none, with a
     :class:`~gyrocomp.errors.ModelChoiceWarning`.
     """
-    options = FitOptions(temperature=temperature, bin_width_degc=bin_width_degc, hysteresis=hysteresis,
-                         hysteresis_order=hysteresis_order, hysteresis_band_degc=hysteresis_band_degc,
-                         acceleration=acceleration, static_min_duration_s=static_min_duration_s, run_folds=run_folds,
-                         folds=folds, target=target)
-    return fit_joint(prepare([recordings] if isinstance(recordings, Recording) else recordings or ()), options,
-                     network_inputs)
+    options = FitOptions(
+        temperature=temperature,
+        bin_width_degc=bin_width_degc,
+        hysteresis=hysteresis,
+        hysteresis_order=hysteresis_order,
+        hysteresis_band_degc=hysteresis_band_degc,
+        acceleration=acceleration,
+        static_min_duration_s=static_min_duration_s,
+        run_folds=run_folds,
+        folds=folds,
+        target=target,
+    )
+    return fit_joint(
+        prepare([recordings] if isinstance(recordings, Recording) else recordings or ()), options, network_inputs
+    )
 
 
-def fit_joint(recordings: list[PreparedRun], options: FitOptions,
-              network_inputs: tuple[str, ...] = ("temperature",)) -> Calibration:
+def fit_joint(
+    recordings: list[PreparedRun], options: FitOptions, network_inputs: tuple[str, ...] = ("temperature",)
+) -> Calibration:
     """The joint fit of prepared runs (:func:`gyrocomp.runs.prepared.prepare`) with checked options: the route (no
     temperature model, a selection by held-out drift, one binned fit), then each axis's frozen result, the network
     trained on top where asked for.
@@ -320,20 +424,27 @@ def fit_joint(recordings: list[PreparedRun], options: FitOptions,
     axes = {}
     for axis in fit_axes(recordings):
         axes[axis], report["axes"][axis] = _axis_calibration(
-            axis, recordings, selections, model, thermal, network, accel_mode, options.bin_width_degc,
-            network_inputs)
+            axis, recordings, selections, model, thermal, network, accel_mode, options.bin_width_degc, network_inputs
+        )
     if network is not None:
         report["temperature"] = "mlp"
         report["network"] = NetworkReport(
-            tuple(network.hidden), network.restarts, network.seed,
+            tuple(network.hidden),
+            network.restarts,
+            network.seed,
             "Levenberg-Marquardt, early stopping on 20 % held-out segments",
             {a: tuple(network.validation_rmse_[a]) for a in network.curves_},
-            {a: network.epochs_[a] for a in network.curves_}, unit).to_dict()
-    name = _model_name(axes, network, network_inputs, spec.size if isinstance(spec, Curve) else order, thermal,
-                       accel_mode)
+            {a: network.epochs_[a] for a in network.curves_},
+            unit,
+        ).to_dict()
+    name = _model_name(
+        axes, network, network_inputs, spec.size if isinstance(spec, Curve) else order, thermal, accel_mode
+    )
     if options.target != "model":  # what the firmware computes: the curve held at its range's edges (it clamps)
-        axes = {a: dataclasses.replace(ax, temperature=ax.temperature.clamped()) if ax.temperature is not None
-                else ax for a, ax in axes.items()}
+        axes = {
+            a: dataclasses.replace(ax, temperature=ax.temperature.clamped()) if ax.temperature is not None else ax
+            for a, ax in axes.items()
+        }
         report["target"] = options.target
         name += f" for {options.target}"
     if PreparedRun.of(recordings[0]).channel == "accel":
@@ -355,8 +466,9 @@ def _accelerometer_calibration(axes: dict[str, AxisCalibration], name: str, sour
     (``accel_reference_degc``), since at rest the accelerometer's constant cannot be told from gravity."""
     curves = [ax.temperature for ax in axes.values() if ax.temperature is not None]
     reference = 0.5 * (min(c.t_min_degc for c in curves) + max(c.t_max_degc for c in curves)) if curves else None
-    return Calibration(axes={}, model=name, provenance=source, fit_report=report, accel_axes=axes,
-                       accel_reference_degc=reference)
+    return Calibration(
+        axes={}, model=name, provenance=source, fit_report=report, accel_axes=axes, accel_reference_degc=reference
+    )
 
 
 def _check_fit_inputs(recordings: list[Recording], spec: Polynomial | Curve | Network | None) -> None:
@@ -380,59 +492,94 @@ def _check_fit_inputs(recordings: list[Recording], spec: Polynomial | Curve | Ne
 def _fit_without_temperature(recordings: list[Recording], acceleration: str, static_min_duration_s: float):
     """G alone (when the runs turn between positions or it is asked for), else the run constants alone."""
     if acceleration != "none" and (
-            acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)):
-        return fit_g_sensitivity(recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s)
-    axes = {axis: AxisCalibration(None, tuple(float(rec.signal(axis).mean()) for rec in recordings))
-            for axis in fit_axes(recordings)}
+        acceleration != "auto" or turned_between_positions(recordings, static_min_duration_s)
+    ):
+        return fit_g_sensitivity(
+            recordings, "matrix" if acceleration == "auto" else acceleration, static_min_duration_s
+        )
+    axes = {
+        axis: AxisCalibration(None, tuple(float(rec.signal(axis).mean()) for rec in recordings))
+        for axis in fit_axes(recordings)
+    }
     return Calibration(axes=axes, model="none", provenance=provenance(recordings), fit_report={"temperature": None})
 
 
 def _fit_binned(recordings: list[Recording], order: int | str, options: FitOptions, accel_mode: str):
     """The earlier path (a fixed band, or a fixed order and memory): the binned polynomial of ``order`` (or
     "auto"), then lag, hysteresis and G on top where asked for or where the runs heat and cool."""
-    model = PolynomialTemperatureModel(order=order, bin_width_degc=options.bin_width_degc,
-                                       folds=options.run_folds).fit(recordings)
+    model = PolynomialTemperatureModel(order=order, bin_width_degc=options.bin_width_degc, folds=options.run_folds).fit(
+        recordings
+    )
     mode = options.hysteresis
     if mode == "auto" and not any(heats_and_cools(recordings, a) for a in fit_axes(recordings)):
         mode = "none"
     thermal = None
     if mode != "none" or accel_mode != "none":
         orders = {axis: curve.order for axis, curve in model.curves_.items()}
-        thermal = ThermalHysteresisModel(order=orders, hysteresis=mode, hysteresis_order=options.hysteresis_order,
-                                         band_degc=options.hysteresis_band_degc, bin_width_degc=options.bin_width_degc,
-                                         reselect_order=order == "auto", acceleration=accel_mode,
-                                         static_min_duration_s=options.static_min_duration_s).fit(recordings)
+        thermal = ThermalHysteresisModel(
+            order=orders,
+            hysteresis=mode,
+            hysteresis_order=options.hysteresis_order,
+            band_degc=options.hysteresis_band_degc,
+            bin_width_degc=options.bin_width_degc,
+            reselect_order=order == "auto",
+            acceleration=accel_mode,
+            static_min_duration_s=options.static_min_duration_s,
+        ).fit(recordings)
     return model, thermal
 
 
-def _report_of_choice(selections, model, thermal, hysteresis: str, acceleration: str, accel_mode: str,
-                      unit: str) -> dict:
+def _report_of_choice(
+    selections, model, thermal, hysteresis: str, acceleration: str, accel_mode: str, unit: str
+) -> dict:
     """The fit report's account of what was chosen and how (the axes are filled in after)."""
-    report = {"temperature": "polynomial", "axes": {},
-              "order_selection": FOLD_SELECTION[next(iter(selections.values())).fold_kind] if selections
-              else model.selection_}
+    report = {
+        "temperature": "polynomial",
+        "axes": {},
+        "order_selection": FOLD_SELECTION[next(iter(selections.values())).fold_kind]
+        if selections
+        else model.selection_,
+    }
     if selections is not None:
         report["selection"] = {axis: sel.to_dict() for axis, sel in selections.items()}
         report["hysteresis"] = _selection_report(selections, thermal, hysteresis)
     elif thermal is not None:
         report["hysteresis"] = _thermal_report(thermal, hysteresis, unit)
     else:
-        report["hysteresis"] = HysteresisReport(hysteresis, "none: the runs do not both heat and cool"
-                                                if hysteresis == "auto" else "none", {}).to_dict()
+        report["hysteresis"] = HysteresisReport(
+            hysteresis, "none: the runs do not both heat and cool" if hysteresis == "auto" else "none", {}
+        ).to_dict()
     if accel_mode != "none":
         report["acceleration"] = acceleration_report(thermal, accel_mode)
     else:
-        report["acceleration"] = GSensitivityReport("none", "the runs do not turn the unit between positions"
-                                                    if acceleration == "auto" else "not asked for", (), (), {}).to_dict()
+        report["acceleration"] = GSensitivityReport(
+            "none",
+            "the runs do not turn the unit between positions" if acceleration == "auto" else "not asked for",
+            (),
+            (),
+            {},
+        ).to_dict()
     return report
 
 
-def _axis_calibration(axis: str, recordings: list[Recording], selections, model, thermal, network, accel_mode: str,
-                      bin_width_degc, network_inputs: tuple[str, ...]) -> tuple[AxisCalibration, dict]:
+def _axis_calibration(
+    axis: str,
+    recordings: list[Recording],
+    selections,
+    model,
+    thermal,
+    network,
+    accel_mode: str,
+    bin_width_degc,
+    network_inputs: tuple[str, ...],
+) -> tuple[AxisCalibration, dict]:
     """One axis's frozen result from the fitted models (the network trained on top when asked for), and its
     entry in the fit report."""
-    curve, consts = (thermal.curves_[axis], thermal.turn_on_biases_[axis]) if thermal is not None else (
-        model.curves_[axis], model.turn_on_biases_[axis])
+    curve, consts = (
+        (thermal.curves_[axis], thermal.turn_on_biases_[axis])
+        if thermal is not None
+        else (model.curves_[axis], model.turn_on_biases_[axis])
+    )
     lag, hyst, g_row, g_sq = 0.0, None, None, None
     if thermal is not None:
         lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
@@ -442,23 +589,53 @@ def _axis_calibration(axis: str, recordings: list[Recording], selections, model,
                 g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
     if network is not None:
         joint = network_inputs != ("temperature",)
-        curve, consts = _fit_network(network, recordings, axis, lag, hyst, curve, bin_width_degc,
-                                     None if joint else g_row, None if joint else g_sq,
-                                     thermal.segments_ if thermal is not None else None, network_inputs)
+        curve, consts = _fit_network(
+            network,
+            recordings,
+            axis,
+            lag,
+            hyst,
+            curve,
+            bin_width_degc,
+            None if joint else g_row,
+            None if joint else g_sq,
+            thermal.segments_ if thermal is not None else None,
+            network_inputs,
+        )
         if joint:  # the network reads the accelerations itself: the least-squares G was only a scaffold
             g_row = g_sq = None
     keep_curve = curve if selections is None or selections[axis].generalizes or network is not None else None
-    result = AxisCalibration(keep_curve, tuple(float(c) for c in consts), recordings[0].temperature_column_for(axis),
-                             lag, hyst, g_row, g_sq, unit=recordings[0].unit_of(axis))
-    fit_rms = (network.train_rmse_[axis] if network is not None
-               else model.fit_rms_[axis] if model is not None and thermal is None else None)
-    entry = AxisFit(curve.order, curve.t_min_degc, curve.t_max_degc, fit_rms, result.unit,
-                    {} if model is None else dict(model.scores_[axis]))
+    result = AxisCalibration(
+        keep_curve,
+        tuple(float(c) for c in consts),
+        recordings[0].temperature_column_for(axis),
+        lag,
+        hyst,
+        g_row,
+        g_sq,
+        unit=recordings[0].unit_of(axis),
+    )
+    fit_rms = (
+        network.train_rmse_[axis]
+        if network is not None
+        else model.fit_rms_[axis]
+        if model is not None and thermal is None
+        else None
+    )
+    entry = AxisFit(
+        curve.order,
+        curve.t_min_degc,
+        curve.t_max_degc,
+        fit_rms,
+        result.unit,
+        {} if model is None else dict(model.scores_[axis]),
+    )
     return result, entry.to_dict()
 
 
-def _model_name(axes: dict[str, AxisCalibration], network, network_inputs, order: int | str, thermal,
-                accel_mode: str) -> str:
+def _model_name(
+    axes: dict[str, AxisCalibration], network, network_inputs, order: int | str, thermal, accel_mode: str
+) -> str:
     """The short name of the fitted model, e.g. ``poly:2/3 (auto) + lag + g-sensitivity``."""
     if network is not None:
         name = f"mlp:{len(network_inputs)}-" + "-".join(map(str, network.hidden)) + "-1"

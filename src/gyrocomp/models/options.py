@@ -41,8 +41,9 @@ class Polynomial:
     order: int | Literal["auto"] = "auto"
 
     def __post_init__(self):
-        if self.order != "auto" and not (isinstance(self.order, int) and not isinstance(self.order, bool)
-                                         and 0 <= self.order <= MAX_ORDER):
+        if self.order != "auto" and not (
+            isinstance(self.order, int) and not isinstance(self.order, bool) and 0 <= self.order <= MAX_ORDER
+        ):
             raise InputError(f"Polynomial.order: a whole number from 0 to {MAX_ORDER}, or 'auto'; got {self.order!r}")
 
 
@@ -56,10 +57,14 @@ class Network:
 
     def __post_init__(self):
         hidden = tuple(self.hidden) if isinstance(self.hidden, (tuple, list)) else None
-        if (not hidden or len(hidden) > MAX_LAYERS
-                or not all(isinstance(h, int) and not isinstance(h, bool) and 1 <= h <= MAX_HIDDEN for h in hidden)):
-            raise InputError(f"Network.hidden: 1 to {MAX_LAYERS} layers of 1..{MAX_HIDDEN} neurons, e.g. (3,); "
-                             f"got {self.hidden!r}")
+        if (
+            not hidden
+            or len(hidden) > MAX_LAYERS
+            or not all(isinstance(h, int) and not isinstance(h, bool) and 1 <= h <= MAX_HIDDEN for h in hidden)
+        ):
+            raise InputError(
+                f"Network.hidden: 1 to {MAX_LAYERS} layers of 1..{MAX_HIDDEN} neurons, e.g. (3,); got {self.hidden!r}"
+            )
         object.__setattr__(self, "hidden", hidden)
         if not isinstance(self.seed, int) or isinstance(self.seed, bool):
             raise InputError(f"Network.seed: a whole number, got {self.seed!r}")
@@ -98,10 +103,12 @@ class Curve:
         if self.family not in BASES:
             raise InputError(f"Curve.family: {self.family!r}; the registered curves are {', '.join(BASES)}")
         low, top = curve_size_range(self.family)
-        if self.size != "auto" and not (isinstance(self.size, int) and not isinstance(self.size, bool)
-                                        and low <= self.size <= top):
-            raise InputError(f"Curve.size: {self.family} takes a whole number from {low} to {top}, or 'auto'; "
-                             f"got {self.size!r}")
+        if self.size != "auto" and not (
+            isinstance(self.size, int) and not isinstance(self.size, bool) and low <= self.size <= top
+        ):
+            raise InputError(
+                f"Curve.size: {self.family} takes a whole number from {low} to {top}, or 'auto'; got {self.size!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -212,13 +219,18 @@ class FitOptions:
     target: Target = "model"
 
     def __post_init__(self):
-        if isinstance(self.temperature, Curve) and self.temperature.family == POLY_FAMILY and self.temperature.size != "auto":
+        if (
+            isinstance(self.temperature, Curve)
+            and self.temperature.family == POLY_FAMILY
+            and self.temperature.size != "auto"
+        ):
             object.__setattr__(self, "temperature", Polynomial(self.temperature.size))
         if self.temperature is not None and not isinstance(self.temperature, (Polynomial, Curve, Network)):
-            raise InputError(f"FitOptions.temperature: Polynomial(order=...), Curve(family, size), Network(hidden=...) "
-                             f"or None; got "
-                             f"{self.temperature!r}" + (PLAIN_FORMS if isinstance(self.temperature, (int, str, tuple))
-                                                         else ""))
+            raise InputError(
+                f"FitOptions.temperature: Polynomial(order=...), Curve(family, size), Network(hidden=...) "
+                f"or None; got "
+                f"{self.temperature!r}" + (PLAIN_FORMS if isinstance(self.temperature, (int, str, tuple)) else "")
+            )
         _choice("FitOptions.hysteresis", self.hysteresis, get_args(Memory))
         _choice("FitOptions.hysteresis_order", self.hysteresis_order, ("auto", *range(1, MAX_HYSTERESIS_ORDER + 1)))
         _choice("FitOptions.acceleration", self.acceleration, get_args(Acceleration))
@@ -228,30 +240,37 @@ class FitOptions:
             self._check_firmware_target()
         if isinstance(self.temperature, Curve) and self.temperature.family != POLY_FAMILY:
             self._check_other_family()
-        if self.bin_width_degc is not None and not (isinstance(self.bin_width_degc, (int, float))
-                                                    and self.bin_width_degc > 0):
+        if self.bin_width_degc is not None and not (
+            isinstance(self.bin_width_degc, (int, float)) and self.bin_width_degc > 0
+        ):
             raise InputError(f"FitOptions.bin_width_degc: a positive number of degC, got {self.bin_width_degc!r}")
         if not (isinstance(self.static_min_duration_s, (int, float)) and self.static_min_duration_s > 0):
-            raise InputError(f"FitOptions.static_min_duration_s: a positive number of seconds, got "
-                             f"{self.static_min_duration_s!r}")
+            raise InputError(
+                f"FitOptions.static_min_duration_s: a positive number of seconds, got {self.static_min_duration_s!r}"
+            )
         band = self.hysteresis_band_degc
         if band is not None:
-            if not (isinstance(band, (tuple, list)) and len(band) == 2
-                    and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in band)
-                    and band[0] < band[1]):
+            if not (
+                isinstance(band, (tuple, list))
+                and len(band) == 2
+                and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in band)
+                and band[0] < band[1]
+            ):
                 raise InputError(f"FitOptions.hysteresis_band_degc: (lo, hi) in degC with lo < hi, got {band!r}")
             object.__setattr__(self, "hysteresis_band_degc", (float(band[0]), float(band[1])))
-
 
     def _check_firmware_target(self) -> None:
         """A firmware target carries a cubic at most and nothing else: other asks are refused naming the field."""
         t = self.target
         poly_only = isinstance(self.temperature, Curve) and self.temperature.family == POLY_FAMILY
         if not (isinstance(self.temperature, Polynomial) or poly_only) or (
-                not poly_only and self.temperature.order != "auto" and self.temperature.order > FIRMWARE_MAX_ORDER):
-            raise InputError(f"FitOptions.target: {t} carries a polynomial of order {FIRMWARE_MAX_ORDER} at most; "
-                             f"use temperature=Polynomial() or Polynomial(0..{FIRMWARE_MAX_ORDER}), got "
-                             f"{self.temperature!r}")
+            not poly_only and self.temperature.order != "auto" and self.temperature.order > FIRMWARE_MAX_ORDER
+        ):
+            raise InputError(
+                f"FitOptions.target: {t} carries a polynomial of order {FIRMWARE_MAX_ORDER} at most; "
+                f"use temperature=Polynomial() or Polynomial(0..{FIRMWARE_MAX_ORDER}), got "
+                f"{self.temperature!r}"
+            )
         if self.hysteresis not in ("auto", "none") or self.hysteresis_band_degc is not None:
             raise InputError(f"FitOptions.target: {t} has no lag or hysteresis term; leave hysteresis='auto' or 'none'")
         if self.acceleration not in ("auto", "none"):
@@ -262,10 +281,26 @@ class FitOptions:
     def _check_other_family(self) -> None:
         """A family other than the polynomial is fitted without thermal memory: asking for one is refused."""
         if self.hysteresis not in ("auto", "none") or self.hysteresis_band_degc is not None:
-            raise InputError(f"FitOptions.hysteresis: {self.temperature.family} is fitted without lag or hysteresis; "
-                             "leave hysteresis='auto' or 'none', or use a polynomial")
+            raise InputError(
+                f"FitOptions.hysteresis: {self.temperature.family} is fitted without lag or hysteresis; "
+                "leave hysteresis='auto' or 'none', or use a polynomial"
+            )
         object.__setattr__(self, "hysteresis", "none")
 
 
-__all__ = ["Acceleration", "Curve", "CurveCandidates", "FIRMWARE_MAX_ORDER", "FitOptions", "FoldChoice", "MAX_CURVE_SIZE", "curve_size_range",
-           "Memory", "Network", "Polynomial", "Target", "curve_candidates", "family_help"]
+__all__ = [
+    "Acceleration",
+    "Curve",
+    "CurveCandidates",
+    "FIRMWARE_MAX_ORDER",
+    "FitOptions",
+    "FoldChoice",
+    "MAX_CURVE_SIZE",
+    "curve_size_range",
+    "Memory",
+    "Network",
+    "Polynomial",
+    "Target",
+    "curve_candidates",
+    "family_help",
+]

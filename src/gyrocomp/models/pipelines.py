@@ -13,14 +13,12 @@ from ..calibration.compensate import apply
 from ..errors import InputError, TemperatureRangeWarning
 from ..runs.prepared import PreparedRun, prepare
 from ..recording import Recording
-from ..fitting.acceleration import (
-    fit_acceleration_network,
-)
+from ..fitting.acceleration import fit_acceleration_network
 from ..fitting.base import provenance
 from ..curves.network import NETWORK_INPUTS
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, _accel_triad, _gyro_triad, _spanning_poses  # noqa: F401
 from .joint import checked_options, fit_joint
-from .options import (FitOptions, Network)
+from .options import FitOptions, Network
 from ..threads import single_threaded_blas
 
 
@@ -46,19 +44,30 @@ def _chain(first: Calibration, second: Calibration, recordings: list[Recording],
         temp_stage = a if a.temperature is not None or a.has_memory else b
         g_stage = a if a.needs_accel else b
         consts = tuple(a.mean_turn_on_bias_dps + cb for cb in b.turn_on_biases_dps)
-        axes[axis] = AxisCalibration(temp_stage.temperature, consts, temp_stage.temperature_column,
-                                     temp_stage.lag_time_constant_s, temp_stage.hysteresis,
-                                     g_stage.g_sensitivity_dps_per_g, g_stage.g_squared_dps_per_g2,
-                                     g_stage.acceleration_network)
-    report = {"pipeline": name, "stages": [first.fit_report, second.fit_report],
-              "acceleration": (first.fit_report if first.has_acceleration else second.fit_report).get("acceleration", {})}
-    return Calibration(axes=axes, model=f"{name}: {first.model} > {second.model}", provenance=provenance(recordings),
-                       fit_report=report)
+        axes[axis] = AxisCalibration(
+            temp_stage.temperature,
+            consts,
+            temp_stage.temperature_column,
+            temp_stage.lag_time_constant_s,
+            temp_stage.hysteresis,
+            g_stage.g_sensitivity_dps_per_g,
+            g_stage.g_squared_dps_per_g2,
+            g_stage.acceleration_network,
+        )
+    report = {
+        "pipeline": name,
+        "stages": [first.fit_report, second.fit_report],
+        "acceleration": (first.fit_report if first.has_acceleration else second.fit_report).get("acceleration", {}),
+    }
+    return Calibration(
+        axes=axes, model=f"{name}: {first.model} > {second.model}", provenance=provenance(recordings), fit_report=report
+    )
 
 
 @single_threaded_blas
-def fit_pipeline(recordings: list[Recording] | Recording, pipeline: Pipeline = "joint",
-                 options: FitOptions | None = None) -> Calibration:
+def fit_pipeline(
+    recordings: list[Recording] | Recording, pipeline: Pipeline = "joint", options: FitOptions | None = None
+) -> Calibration:
     """Fit a named pipeline (``PIPELINES``); ``options`` (:class:`gyrocomp.models.options.FitOptions`, default
     ``FitOptions()``) are :func:`fit_calibration`'s for the temperature stage.
 
@@ -70,8 +79,9 @@ def fit_pipeline(recordings: list[Recording] | Recording, pipeline: Pipeline = "
       output (thesis 2.7.2);
     - ``joint-mlp``: one network with the (lagged) temperature and the three accelerations as inputs.
     """
-    return run_pipeline(prepare([recordings] if isinstance(recordings, Recording) else recordings), pipeline,
-                        checked_options(options))
+    return run_pipeline(
+        prepare([recordings] if isinstance(recordings, Recording) else recordings), pipeline, checked_options(options)
+    )
 
 
 def run_pipeline(recordings: list[PreparedRun], pipeline: Pipeline, options: FitOptions) -> Calibration:
@@ -86,24 +96,31 @@ def run_pipeline(recordings: list[PreparedRun], pipeline: Pipeline, options: Fit
     # the network pipelines use the network asked for, else the thesis's 1-3-1
     network = options.temperature if isinstance(options.temperature, Network) else Network()
     if pipeline == "joint-mlp":
-        cal = fit_joint(recordings, dataclasses.replace(options, temperature=network, acceleration=accel_mode),
-                        NETWORK_INPUTS)
-        return dataclasses.replace(cal, model=f"joint-mlp: {cal.model}", fit_report={**cal.fit_report,
-                                                                                      "pipeline": pipeline})
-    temperature_first = dataclasses.replace(options, acceleration="none",
-                                            temperature=network if pipeline.startswith("mlp") else options.temperature)
+        cal = fit_joint(
+            recordings, dataclasses.replace(options, temperature=network, acceleration=accel_mode), NETWORK_INPUTS
+        )
+        return dataclasses.replace(
+            cal, model=f"joint-mlp: {cal.model}", fit_report={**cal.fit_report, "pipeline": pipeline}
+        )
+    temperature_first = dataclasses.replace(
+        options, acceleration="none", temperature=network if pipeline.startswith("mlp") else options.temperature
+    )
     if pipeline == "mlp>mlp-accel":
         first = fit_joint(recordings, temperature_first)
-        second = fit_acceleration_network(_residual_runs(first, recordings), hidden=network.hidden, seed=network.seed,
-                                          min_static=min_static)
+        second = fit_acceleration_network(
+            _residual_runs(first, recordings), hidden=network.hidden, seed=network.seed, min_static=min_static
+        )
         return _chain(first, second, recordings, pipeline)
     if pipeline in ("poly>matrix", "mlp>matrix"):
         first = fit_joint(recordings, temperature_first)
-        second = fit_joint(prepare(_residual_runs(first, recordings)),
-                           FitOptions(temperature=None, acceleration=accel_mode, static_min_duration_s=min_static))
+        second = fit_joint(
+            prepare(_residual_runs(first, recordings)),
+            FitOptions(temperature=None, acceleration=accel_mode, static_min_duration_s=min_static),
+        )
         return _chain(first, second, recordings, pipeline)
-    first = fit_joint(recordings, FitOptions(temperature=None, acceleration=accel_mode,
-                                             static_min_duration_s=min_static))
+    first = fit_joint(
+        recordings, FitOptions(temperature=None, acceleration=accel_mode, static_min_duration_s=min_static)
+    )
     second = fit_joint(prepare(_residual_runs(first, recordings)), temperature_first)
     return _chain(first, second, recordings, pipeline)
 

@@ -14,8 +14,16 @@ from ..calibration import Calibration
 from ..calibration.triad import TriadCalibration
 from ..errors import DataQualityWarning, InputError
 from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
-from ..fitting.triad_fit import (MIN_REFERENCE_RATE_DPS, MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses,
-                             fit_accel_multiposition, fit_gyro_rate_table, spans_axes)
+from ..fitting.triad_fit import (
+    MIN_REFERENCE_RATE_DPS,
+    MIN_TRIAD_SPAN_DEGC,
+    Pose,
+    PoseFit,
+    find_poses,
+    fit_accel_multiposition,
+    fit_gyro_rate_table,
+    spans_axes,
+)
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 
 #: how ``fit_channels`` treats the gyro's scale factor and misalignment
@@ -28,14 +36,20 @@ def _turning_sessions(recordings: list[Recording]) -> list[Recording]:
     three accelerometer axes, still poses turning every accelerometer axis up and down)."""
     out = []
     for rec in recordings:
-        if rec.reference_rate_dps is None and rec.gyro_axes == GYRO_AXES and rec.accel_g is not None \
-                and set(ACCEL_AXES) <= set(rec.accel_axes) and _spanning_poses([rec]) is not None:
+        if (
+            rec.reference_rate_dps is None
+            and rec.gyro_axes == GYRO_AXES
+            and rec.accel_g is not None
+            and set(ACCEL_AXES) <= set(rec.accel_axes)
+            and _spanning_poses([rec]) is not None
+        ):
             out.append(rec)
     return out
 
 
-def _gyro_triad(recordings: list[Recording], scale_factor: str,
-                wants_temperature: bool = True) -> tuple[TriadCalibration | None, list[Recording]]:
+def _gyro_triad(
+    recordings: list[Recording], scale_factor: str, wants_temperature: bool = True
+) -> tuple[TriadCalibration | None, list[Recording]]:
     """The gyro's K(T) from the runs that carry reference rates (those runs then leave the bias model) or, without
     them, K from the turns between the still poses of multi-position sessions; and the runs for the bias model."""
     if scale_factor not in SCALE_FACTOR_CHOICES:
@@ -46,9 +60,11 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str,
     if not rate_runs:
         sessions = _turning_sessions(recordings)
         if scale_factor != "auto" and not sessions:
-            raise InputError(f"scale_factor={scale_factor!r}: no run carries reference rates (ref_rate_x, ref_rate_y, "
-                             "ref_rate_z [deg/s]) or turns between still poses; a scale-factor calibration needs "
-                             "rate-table runs or a multi-position session with the turns recorded")
+            raise InputError(
+                f"scale_factor={scale_factor!r}: no run carries reference rates (ref_rate_x, ref_rate_y, "
+                "ref_rate_z [deg/s]) or turns between still poses; a scale-factor calibration needs "
+                "rate-table runs or a multi-position session with the turns recorded"
+            )
         if not sessions:
             return None, recordings
         order = {"auto": "auto", "matrix": 0, "matrix-temperature": 1}[scale_factor]
@@ -59,7 +75,9 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str,
                 raise
             if isinstance(exc, TooFewTurns):  # the turns were not recorded: nothing to say
                 return None, recordings
-            warnings.warn(f"scale factor not fitted from the multi-position runs: {exc}", DataQualityWarning, stacklevel=3)
+            warnings.warn(
+                f"scale factor not fitted from the multi-position runs: {exc}", DataQualityWarning, stacklevel=3
+            )
             return None, recordings
     rest = [r for r in recordings if r.reference_rate_dps is None]
     order = {"auto": "auto", "matrix": 0, "matrix-temperature": 1}[scale_factor]
@@ -67,13 +85,18 @@ def _gyro_triad(recordings: list[Recording], scale_factor: str,
     if not rest:  # rate-table runs alone: their still stretches carry the bias (one constant per run at least)
         rest = _still_stretches(rate_runs)
         if not rest:
-            raise InputError("scale_factor: every run is a rate-table run and none holds still between its rates; "
-                             "the bias needs still stretches or runs at rest")
+            raise InputError(
+                "scale_factor: every run is a rate-table run and none holds still between its rates; "
+                "the bias needs still stretches or runs at rest"
+            )
         if wants_temperature and any(r.temperature_degc is not None and np.ptp(r.temperature_degc) < 5.0 for r in rest):
-            warnings.warn("the bias comes from the rate-table runs' still stretches, each held near a single "
-                          "temperature, so their drift with temperature cannot be told from their turn-on biases (one "
-                          "constant per run); fit no temperature model, or add runs at rest through a range",
-                          DataQualityWarning, stacklevel=3)
+            warnings.warn(
+                "the bias comes from the rate-table runs' still stretches, each held near a single "
+                "temperature, so their drift with temperature cannot be told from their turn-on biases (one "
+                "constant per run); fit no temperature model, or add runs at rest through a range",
+                DataQualityWarning,
+                stacklevel=3,
+            )
     return triad, rest
 
 
@@ -91,8 +114,11 @@ def _still_stretches(rate_runs: list[Recording]) -> list[Recording]:
 def _spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
     """The still poses of runs that turn the accelerometer's every axis up and down (a multi-position test), or
     None when they do not."""
-    turned = [rec for rec in recordings if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes)
-              and _reaches_both_ways(rec)]
+    turned = [
+        rec
+        for rec in recordings
+        if rec.accel_g is not None and set(ACCEL_AXES) <= set(rec.accel_axes) and _reaches_both_ways(rec)
+    ]
     poses = [p for rec in turned for p in find_poses(rec)]
     return poses if len(poses) >= 6 and spans_axes(poses) else None
 

@@ -64,7 +64,9 @@ def _moving_variance(x: np.ndarray, w: int) -> np.ndarray:
     return var[idx]
 
 
-def still_mask(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S, factor: float = DEFAULT_FACTOR) -> np.ndarray:
+def still_mask(
+    recording: Recording, *, window_s: float = DEFAULT_WINDOW_S, factor: float = DEFAULT_FACTOR
+) -> np.ndarray:
     """True where the unit is still (see the module doc)."""
     if not window_s > 0 or not factor > 1:
         raise InputError(f"static detection: window {window_s} s must be positive and factor {factor} above 1")
@@ -81,15 +83,29 @@ def still_mask(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S, fact
     return still
 
 
-def static_segments(recording: Recording, *, window_s: float = DEFAULT_WINDOW_S,
-                    min_duration_s: float = DEFAULT_MIN_DURATION_S, factor: float = DEFAULT_FACTOR) -> list[StaticSegment]:
+def static_segments(
+    recording: Recording,
+    *,
+    window_s: float = DEFAULT_WINDOW_S,
+    min_duration_s: float = DEFAULT_MIN_DURATION_S,
+    factor: float = DEFAULT_FACTOR,
+) -> list[StaticSegment]:
     """The still stretches of a recording, in time order (see the module doc)."""
-    return segments_from_mask(recording, still_mask(recording, window_s=window_s, factor=factor),
-                              window_s=window_s, min_duration_s=min_duration_s)
+    return segments_from_mask(
+        recording,
+        still_mask(recording, window_s=window_s, factor=factor),
+        window_s=window_s,
+        min_duration_s=min_duration_s,
+    )
 
 
-def segments_from_mask(recording: Recording, still: np.ndarray, *, window_s: float = DEFAULT_WINDOW_S,
-                       min_duration_s: float = DEFAULT_MIN_DURATION_S) -> list[StaticSegment]:
+def segments_from_mask(
+    recording: Recording,
+    still: np.ndarray,
+    *,
+    window_s: float = DEFAULT_WINDOW_S,
+    min_duration_s: float = DEFAULT_MIN_DURATION_S,
+) -> list[StaticSegment]:
     """The static segments of ``recording`` from its still mask (:func:`still_mask` with the same ``window_s``
     [s]): runs of still samples, trimmed by half a window where they border motion, of at least
     ``min_duration_s`` [s]."""
@@ -108,8 +124,16 @@ def segments_from_mask(recording: Recording, still: np.ndarray, *, window_s: flo
                 continue
             grav = None if recording.accel_g is None else recording.accel_g[a:b].mean(axis=0)
             temp = None if recording.temperature_degc is None else float(np.mean(recording.temperature_degc[a:b]))
-            out.append(StaticSegment(int(a), int(b), float(recording.time_s[a]),
-                                     float(recording.time_s[b - 1] - recording.time_s[a]), grav, temp))
+            out.append(
+                StaticSegment(
+                    int(a),
+                    int(b),
+                    float(recording.time_s[a]),
+                    float(recording.time_s[b - 1] - recording.time_s[a]),
+                    grav,
+                    temp,
+                )
+            )
     return out
 
 
@@ -117,7 +141,7 @@ def segment_mask(n_samples: int, segments: list[StaticSegment]) -> np.ndarray:
     """Boolean mask of the samples inside the segments."""
     mask = np.zeros(n_samples, dtype=bool)
     for seg in segments:
-        mask[seg.start: seg.stop] = True
+        mask[seg.start : seg.stop] = True
     return mask
 
 

@@ -128,7 +128,7 @@ class StillDetection:
         """Boolean mask of the samples inside a still segment."""
         out = np.zeros(n_samples, dtype=bool)
         for s in self.segments:
-            out[s.start:s.stop] = True
+            out[s.start : s.stop] = True
         return out
 
 
@@ -153,8 +153,13 @@ class StillnessState:
             raise InputError(f"block_s: must be positive, got {self.block_s}")
         self.block_samples = max(MIN_BLOCK_SAMPLES, int(round(self.block_s * self.rate_hz)))
 
-    def update(self, time_s: np.ndarray, gyro_dps: np.ndarray, accel_g: np.ndarray | None = None,
-               temperature_degc: np.ndarray | None = None) -> None:
+    def update(
+        self,
+        time_s: np.ndarray,
+        gyro_dps: np.ndarray,
+        accel_g: np.ndarray | None = None,
+        temperature_degc: np.ndarray | None = None,
+    ) -> None:
         time_s = np.asarray(time_s, dtype=float)
         columns = [np.asarray(gyro_dps, dtype=float).reshape(time_s.size, -1)]
         columns.append(None if accel_g is None else np.asarray(accel_g, dtype=float).reshape(time_s.size, 3))
@@ -174,7 +179,8 @@ class StillnessState:
             return
         time_s, gyro, accel, temperature, gaps = (  # one chunk pending (a whole log): used as it is, not copied
             None if part[0] is None else part[0] if len(part) == 1 else np.concatenate(part)
-            for part in zip(*self._pending))
+            for part in zip(*self._pending)
+        )
         w = self.block_samples
         n = time_s.size
         # a block ends every w samples from the last block's start, or early, before a gap
@@ -190,13 +196,23 @@ class StillnessState:
             if start < end:  # a short block: closed by the gap, or the log's end when final
                 if end == n and not final:
                     break
-                self._done.append(_blocks(time_s, gyro, accel, temperature, start, 1, end - start, self._seen, gaps,
-                                          w))
+                self._done.append(_blocks(time_s, gyro, accel, temperature, start, 1, end - start, self._seen, gaps, w))
                 start = end
         self._seen += start
         rest = slice(start, None)
-        self._pending = [] if start >= n else [(time_s[rest], gyro[rest], None if accel is None else accel[rest],
-                                                None if temperature is None else temperature[rest], gaps[rest])]
+        self._pending = (
+            []
+            if start >= n
+            else [
+                (
+                    time_s[rest],
+                    gyro[rest],
+                    None if accel is None else accel[rest],
+                    None if temperature is None else temperature[rest],
+                    gaps[rest],
+                )
+            ]
+        )
 
     def blocks(self, final: bool = True) -> BlockStats:
         if final:
@@ -225,15 +241,16 @@ def _detrended_variance(x: np.ndarray) -> np.ndarray:
     out = np.empty((x.shape[0], x.shape[2]))
     group = max(1, _GROUP_SAMPLES // m)  # blocks at a time: the centred copy stays small (no day-long temporary)
     for start in range(0, x.shape[0], group):
-        part = x[start:start + group]
+        part = x[start : start + group]
         e = part - _block_means(part)[:, None, :]
         slope = np.einsum("j,bjk->bk", i, e) / (i @ i)
-        out[start:start + group] = np.maximum(np.einsum("bjk,bjk->bk", e, e) - slope ** 2 * (i @ i), 0.0) / (m - 2)
+        out[start : start + group] = np.maximum(np.einsum("bjk,bjk->bk", e, e) - slope**2 * (i @ i), 0.0) / (m - 2)
     return out
 
 
-def _blocks(time_s, gyro, accel, temperature, start: int, count: int, length: int, seen: int, gaps: np.ndarray,
-            w: int) -> dict:
+def _blocks(
+    time_s, gyro, accel, temperature, start: int, count: int, length: int, seen: int, gaps: np.ndarray, w: int
+) -> dict:
     """Statistics of ``count`` consecutive blocks of ``length`` samples from ``start`` (``w``: a full block's
     length; ``seen``: samples before this buffer)."""
     sl = slice(start, start + count * length)
@@ -244,29 +261,57 @@ def _blocks(time_s, gyro, accel, temperature, start: int, count: int, length: in
     firsts = np.arange(count) * length + start
     temps = None if temperature is None else blocked(temperature).reshape(count, -1)
     return {
-        "start_s": time_s[firsts], "stop_s": time_s[firsts + length - 1], "first": seen + firsts,
-        "count": np.full(count, length), "whole": np.full(count, length == w),
+        "start_s": time_s[firsts],
+        "stop_s": time_s[firsts + length - 1],
+        "first": seen + firsts,
+        "count": np.full(count, length),
+        "whole": np.full(count, length == w),
         "after_gap": gaps[firsts] & (seen + firsts > 0),
-        "gyro_mean": _block_means(blocked(gyro)), "gyro_var": _detrended_variance(blocked(gyro)),
+        "gyro_mean": _block_means(blocked(gyro)),
+        "gyro_var": _detrended_variance(blocked(gyro)),
         "accel_mean": None if accel is None else _block_means(blocked(accel)),
         "accel_var": None if accel is None else _detrended_variance(blocked(accel)),
-        "temperature": None if temps is None else np.column_stack([temps.mean(axis=1), temps.min(axis=1),
-                                                                   temps.max(axis=1)]),
+        "temperature": None
+        if temps is None
+        else np.column_stack([temps.mean(axis=1), temps.min(axis=1), temps.max(axis=1)]),
     }
 
 
 def _stack(done: list[dict], w: int) -> BlockStats:
     if not done:
         empty = np.zeros(0)
-        return BlockStats(empty, empty, empty.astype(int), empty.astype(int), empty.astype(bool), empty.astype(bool),
-                          np.zeros((0, 1)), np.zeros((0, 1)), None, None, None, w)
+        return BlockStats(
+            empty,
+            empty,
+            empty.astype(int),
+            empty.astype(int),
+            empty.astype(bool),
+            empty.astype(bool),
+            np.zeros((0, 1)),
+            np.zeros((0, 1)),
+            None,
+            None,
+            None,
+            w,
+        )
 
     def joined(key):
         return None if done[0][key] is None else np.concatenate([d[key] for d in done])
 
-    return BlockStats(joined("start_s"), joined("stop_s"), joined("first"), joined("count"), joined("whole"),
-                      joined("after_gap"), joined("gyro_mean"), joined("gyro_var"), joined("accel_mean"),
-                      joined("accel_var"), joined("temperature"), w)
+    return BlockStats(
+        joined("start_s"),
+        joined("stop_s"),
+        joined("first"),
+        joined("count"),
+        joined("whole"),
+        joined("after_gap"),
+        joined("gyro_mean"),
+        joined("gyro_var"),
+        joined("accel_mean"),
+        joined("accel_var"),
+        joined("temperature"),
+        w,
+    )
 
 
 def _noise_level(variance: np.ndarray, usable: np.ndarray, w: int, quantile: float) -> np.ndarray:
@@ -277,8 +322,9 @@ def _noise_level(variance: np.ndarray, usable: np.ndarray, w: int, quantile: flo
     return low * (w - 2) / chdtri(w - 2, 1.0 - quantile)
 
 
-def classify_blocks(blocks: BlockStats, *, quantile: float = QUANTILE, alpha: float = ALPHA
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+def classify_blocks(
+    blocks: BlockStats, *, quantile: float = QUANTILE, alpha: float = ALPHA
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Which blocks are still (see the module), and the noise levels: (still (n,), gyro s^2 (k,), accel s^2 (3,)
     or None)."""
     if not 0 < quantile < 0.5:
@@ -289,8 +335,11 @@ def classify_blocks(blocks: BlockStats, *, quantile: float = QUANTILE, alpha: fl
     usable = blocks.whole
     if usable.sum() < 2:
         return np.zeros(blocks.whole.size, dtype=bool), np.full(blocks.gyro_var_dps2.shape[1], np.nan), None
-    channels = [(m, v) for m, v in ((blocks.gyro_mean_dps, blocks.gyro_var_dps2),
-                                    (blocks.accel_mean_g, blocks.accel_var_g2)) if m is not None]
+    channels = [
+        (m, v)
+        for m, v in ((blocks.gyro_mean_dps, blocks.gyro_var_dps2), (blocks.accel_mean_g, blocks.accel_var_g2))
+        if m is not None
+    ]
     tests = sum(m.shape[1] for m, _ in channels)
     per_test = alpha / tests  # Bonferroni: about ``alpha`` false alarms per still block in all
     from scipy.special import chdtri, ndtri  # the chi-square and normal quantiles, without scipy.stats' import
@@ -305,7 +354,7 @@ def classify_blocks(blocks: BlockStats, *, quantile: float = QUANTILE, alpha: fl
         # an axis without noise (synthetic data, a coarse LSB at rest) tells nothing: it is not tested
         informative = levels[-1] > 0
         quiet &= np.all((var <= levels[-1] * bound) | ~informative, axis=1)
-        if np.any(levels[-1] > ceiling ** 2 * rate_hz):  # the quietest blocks are not a sensor at rest
+        if np.any(levels[-1] > ceiling**2 * rate_hz):  # the quietest blocks are not a sensor at rest
             quiet[:] = False
     still = quiet.copy()
     joined = ~blocks.after_gap[1:]  # neighbours with no gap between them
@@ -323,8 +372,9 @@ def classify_blocks(blocks: BlockStats, *, quantile: float = QUANTILE, alpha: fl
     return still, levels[0], levels[1]
 
 
-def still_segments(blocks: BlockStats, still: np.ndarray, *, min_duration_s: float = MIN_DURATION_S
-                   ) -> list[StillSegment]:
+def still_segments(
+    blocks: BlockStats, still: np.ndarray, *, min_duration_s: float = MIN_DURATION_S
+) -> list[StillSegment]:
     """Runs of still blocks (no gap inside), one block trimmed at each end, at least ``min_duration_s`` [s] long."""
     segments = []
     n = still.size
@@ -356,14 +406,18 @@ def _segment(blocks: BlockStats, first: int, last: int) -> StillSegment:
     weights = blocks.count[sel].astype(float)
     temps = blocks.temperature_degc
     return StillSegment(
-        start=int(blocks.first[first]), stop=int(blocks.first[last] + blocks.count[last]),
-        start_s=float(blocks.start_s[first]), stop_s=float(blocks.stop_s[last] + 1.0 / _rate(blocks)),
+        start=int(blocks.first[first]),
+        stop=int(blocks.first[last] + blocks.count[last]),
+        start_s=float(blocks.start_s[first]),
+        stop_s=float(blocks.stop_s[last] + 1.0 / _rate(blocks)),
         gyro_mean_dps=np.average(blocks.gyro_mean_dps[sel], axis=0, weights=weights),
-        accel_mean_g=None if blocks.accel_mean_g is None else np.average(blocks.accel_mean_g[sel], axis=0,
-                                                                           weights=weights),
+        accel_mean_g=None
+        if blocks.accel_mean_g is None
+        else np.average(blocks.accel_mean_g[sel], axis=0, weights=weights),
         temperature_degc=None if temps is None else float(np.average(temps[sel, 0], weights=weights)),
         temperature_min_degc=None if temps is None else float(temps[sel, 1].min()),
-        temperature_max_degc=None if temps is None else float(temps[sel, 2].max()))
+        temperature_max_degc=None if temps is None else float(temps[sel, 2].max()),
+    )
 
 
 def moves_most_of_the_time(found: StillDetection) -> bool:
@@ -373,8 +427,14 @@ def moves_most_of_the_time(found: StillDetection) -> bool:
     return int(whole.sum()) >= AUTO_MIN_BLOCKS and found.still_blocks[whole].mean() < AUTO_STILL_FRACTION
 
 
-def detect_still(recording: Recording, *, block_s: float = BLOCK_S, min_duration_s: float = MIN_DURATION_S,
-                 quantile: float = QUANTILE, alpha: float = ALPHA) -> StillDetection:
+def detect_still(
+    recording: Recording,
+    *,
+    block_s: float = BLOCK_S,
+    min_duration_s: float = MIN_DURATION_S,
+    quantile: float = QUANTILE,
+    alpha: float = ALPHA,
+) -> StillDetection:
     """The still segments of a log (see the module).
 
     Parameters
@@ -395,13 +455,32 @@ def detect_still(recording: Recording, *, block_s: float = BLOCK_S, min_duration
     return detection(state.blocks(), min_duration_s=min_duration_s, quantile=quantile, alpha=alpha)
 
 
-def detection(blocks: BlockStats, *, min_duration_s: float = MIN_DURATION_S, quantile: float = QUANTILE,
-              alpha: float = ALPHA) -> StillDetection:
+def detection(
+    blocks: BlockStats, *, min_duration_s: float = MIN_DURATION_S, quantile: float = QUANTILE, alpha: float = ALPHA
+) -> StillDetection:
     """The still segments of blocks a :class:`StillnessState` gathered (streaming) or :func:`detect_still` made."""
     still, gyro_level, accel_level = classify_blocks(blocks, quantile=quantile, alpha=alpha)
-    return StillDetection(still_segments(blocks, still, min_duration_s=min_duration_s), still, blocks, gyro_level,
-                          accel_level)
+    return StillDetection(
+        still_segments(blocks, still, min_duration_s=min_duration_s), still, blocks, gyro_level, accel_level
+    )
 
 
-__all__ = ["ALPHA", "AUTO_MIN_BLOCKS", "AUTO_STILL_FRACTION", "BLOCK_S", "BlockStats", "MAX_ACCEL_NOISE_DENSITY", "MAX_GYRO_NOISE_DENSITY", "MIN_DURATION_S", "QUANTILE", "StillDetection", "StillSegment",
-           "StillnessState", "classify_blocks", "detect_still", "detection", "moves_most_of_the_time", "still_segments"]
+__all__ = [
+    "ALPHA",
+    "AUTO_MIN_BLOCKS",
+    "AUTO_STILL_FRACTION",
+    "BLOCK_S",
+    "BlockStats",
+    "MAX_ACCEL_NOISE_DENSITY",
+    "MAX_GYRO_NOISE_DENSITY",
+    "MIN_DURATION_S",
+    "QUANTILE",
+    "StillDetection",
+    "StillSegment",
+    "StillnessState",
+    "classify_blocks",
+    "detect_still",
+    "detection",
+    "moves_most_of_the_time",
+    "still_segments",
+]

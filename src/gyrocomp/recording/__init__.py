@@ -4,11 +4,25 @@ deg/s, g, degC]."""
 from __future__ import annotations
 
 from .recording import (
-    ACCEL_AXES, Gap, GAP_FACTOR, GYRO_AXES, nominal_rate_hz, POSSIBLE, Recording, REFERENCE_RATE_AXES,
-    TEMPERATURE_COLUMN
+    ACCEL_AXES,
+    Gap,
+    GAP_FACTOR,
+    GYRO_AXES,
+    nominal_rate_hz,
+    POSSIBLE,
+    Recording,
+    REFERENCE_RATE_AXES,
+    TEMPERATURE_COLUMN,
 )
 
 __all__ = [
-    "ACCEL_AXES", "GAP_FACTOR", "GYRO_AXES", "Gap", "POSSIBLE", "REFERENCE_RATE_AXES", "Recording",
-    "TEMPERATURE_COLUMN", "nominal_rate_hz"
+    "ACCEL_AXES",
+    "GAP_FACTOR",
+    "GYRO_AXES",
+    "Gap",
+    "POSSIBLE",
+    "REFERENCE_RATE_AXES",
+    "Recording",
+    "TEMPERATURE_COLUMN",
+    "nominal_rate_hz",
 ]

@@ -80,9 +80,11 @@ def _require_possible(src: str, rows: np.ndarray, channels) -> None:
             first = int(np.flatnonzero(bad.any(axis=1))[0])
             column = names[int(np.flatnonzero(bad[first])[0])]
             value = table[first][bad[first]][0]
-            raise InputError(f"{src}: row {rows[first]}, column {column!r}: {value:.6g} {unit} is beyond what any "
-                             f"sensor gives ({lo:g}..{hi:g} {unit}): a damaged file, or a column in another unit "
-                             "than the one given?")
+            raise InputError(
+                f"{src}: row {rows[first]}, column {column!r}: {value:.6g} {unit} is beyond what any "
+                f"sensor gives ({lo:g}..{hi:g} {unit}): a damaged file, or a column in another unit "
+                "than the one given?"
+            )
 
 
 def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray, dt: np.ndarray) -> None:
@@ -159,9 +161,7 @@ class Recording:
             raise InputError(f"{src}: {n} sample(s); a recording needs at least 2 rows of data")
         axes = tuple(self.gyro_axes)
         if gyro.shape != (n, len(axes)) or not axes:
-            raise InputError(
-                f"{src}: gyro data has shape {gyro.shape}, expected ({n}, {len(axes)}) for axes {axes}"
-            )
+            raise InputError(f"{src}: gyro data has shape {gyro.shape}, expected ({n}, {len(axes)}) for axes {axes}")
         rows = np.arange(1, n + 1) if self.row_numbers is None else np.asarray(self.row_numbers)
         temp = None
         if self.temperature_degc is not None:
@@ -169,9 +169,7 @@ class Recording:
             if temp.ndim == 2 and temp.shape[1] == 1:
                 temp = temp[:, 0]
             if temp.shape not in ((n,), (n, len(axes))):
-                raise InputError(
-                    f"{src}: temperature has shape {temp.shape}; expected ({n},) or ({n}, {len(axes)})"
-                )
+                raise InputError(f"{src}: temperature has shape {temp.shape}; expected ({n},) or ({n}, {len(axes)})")
         accel = None
         if self.accel_g is not None:
             accel = np.asarray(self.accel_g, dtype=float)
@@ -185,13 +183,27 @@ class Recording:
         if self.reference_rate_dps is not None:
             reference = np.asarray(self.reference_rate_dps, dtype=float)
             if reference.shape != (n, 3):
-                raise InputError(f"{src}: reference rates have shape {reference.shape}, expected ({n}, 3) "
-                                 f"for {', '.join(REFERENCE_RATE_AXES)}")
+                raise InputError(
+                    f"{src}: reference rates have shape {reference.shape}, expected ({n}, 3) "
+                    f"for {', '.join(REFERENCE_RATE_AXES)}"
+                )
         temp_names = _temperature_names(axes, temp is not None and temp.ndim == 2)
-        _require_finite(src, rows, ((("time",), time_s), (axes, gyro), (temp_names, temp),
-                                    (tuple(self.accel_axes), accel), (REFERENCE_RATE_AXES, reference)))
-        _require_possible(src, rows, (("gyro", axes, gyro), ("temperature", temp_names, temp),
-                                      ("accel", tuple(self.accel_axes), accel)))
+        _require_finite(
+            src,
+            rows,
+            (
+                (("time",), time_s),
+                (axes, gyro),
+                (temp_names, temp),
+                (tuple(self.accel_axes), accel),
+                (REFERENCE_RATE_AXES, reference),
+            ),
+        )
+        _require_possible(
+            src,
+            rows,
+            (("gyro", axes, gyro), ("temperature", temp_names, temp), ("accel", tuple(self.accel_axes), accel)),
+        )
         dt = np.diff(time_s)
         _require_increasing(src, rows, time_s, dt)
         period = float(np.median(dt))
@@ -283,8 +295,10 @@ class Recording:
         if gyro.ndim == 1:
             gyro = gyro[:, None]
         if gyro.shape != self.gyro_dps.shape:
-            raise InputError(f"{self.source}: gyro data has shape {gyro.shape}, expected {self.gyro_dps.shape} for "
-                             f"axes {self.gyro_axes}")
+            raise InputError(
+                f"{self.source}: gyro data has shape {gyro.shape}, expected {self.gyro_dps.shape} for "
+                f"axes {self.gyro_axes}"
+            )
         _require_finite(self.source, self.row_numbers, ((self.gyro_axes, gyro),))
         copied = copy.copy(self)
         object.__setattr__(copied, "gyro_dps", gyro)
@@ -307,5 +321,14 @@ class Recording:
         )
 
 
-__all__ = ["ACCEL_AXES", "GAP_FACTOR", "GYRO_AXES", "Gap", "POSSIBLE", "REFERENCE_RATE_AXES", "Recording", "TEMPERATURE_COLUMN",
-           "nominal_rate_hz"]
+__all__ = [
+    "ACCEL_AXES",
+    "GAP_FACTOR",
+    "GYRO_AXES",
+    "Gap",
+    "POSSIBLE",
+    "REFERENCE_RATE_AXES",
+    "Recording",
+    "TEMPERATURE_COLUMN",
+    "nominal_rate_hz",
+]

@@ -38,8 +38,9 @@ PRINT_CSS = """
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome")
 
 
-def build_certificate(record: CalibrationRecord, *, held_out: HeldOut | None = None,
-                      limits: Limits | None = None) -> Report:
+def build_certificate(
+    record: CalibrationRecord, *, held_out: HeldOut | None = None, limits: Limits | None = None
+) -> Report:
     """The certificate of the calibration ``record`` (a successful row of the store); ``held_out``: its residual
     and band (from the unit's runs); ``limits``: the line's limits (default: the verdict stored with the row)."""
     calibration = record.calibration()
@@ -55,20 +56,28 @@ def build_certificate(record: CalibrationRecord, *, held_out: HeldOut | None = N
         "merit": ("Figures of merit against the limits", _merit(record, limits, failures)),
     }
     title = f"Calibration certificate: {record.serial}"
-    page = html_page(title, title, f"calibrated {record.calibrated_utc:%Y-%m-%d %H:%M:%S} UTC", sections,
-                     css=PRINT_CSS)
+    page = html_page(title, title, f"calibrated {record.calibrated_utc:%Y-%m-%d %H:%M:%S} UTC", sections, css=PRINT_CSS)
     return Report(page, SECTIONS)
 
 
 def _unit(record: CalibrationRecord, verdict: str | None) -> str:
-    words = {"pass": "PASS: within every limit", "fail": "FAIL: outside a limit"}.get(verdict or "", "not judged "
-                                                                                    "(no limits given)")
-    rows = [["serial", record.serial], ["station", record.station or "-"],
-            ["calibrated (UTC)", f"{record.calibrated_utc:%Y-%m-%d %H:%M:%S}"],
-            ["calibrated by", f"gyrocomp {record.gyrocomp_version}"], ["store row", str(record.id)],
-            ["input hash (runs and settings)", record.input_hash], ["verdict", words]]
-    return (f'<p class="lead"><strong>{html.escape(words)}</strong></p>' + table_html(["", ""], rows)
-            + ("".join(f"<p class=note>{html.escape(w)}</p>" for w in record.warnings[:5])))
+    words = {"pass": "PASS: within every limit", "fail": "FAIL: outside a limit"}.get(
+        verdict or "", "not judged (no limits given)"
+    )
+    rows = [
+        ["serial", record.serial],
+        ["station", record.station or "-"],
+        ["calibrated (UTC)", f"{record.calibrated_utc:%Y-%m-%d %H:%M:%S}"],
+        ["calibrated by", f"gyrocomp {record.gyrocomp_version}"],
+        ["store row", str(record.id)],
+        ["input hash (runs and settings)", record.input_hash],
+        ["verdict", words],
+    ]
+    return (
+        f'<p class="lead"><strong>{html.escape(words)}</strong></p>'
+        + table_html(["", ""], rows)
+        + ("".join(f"<p class=note>{html.escape(w)}</p>" for w in record.warnings[:5]))
+    )
 
 
 def _model(calibration: Calibration, record: CalibrationRecord) -> str:
@@ -78,9 +87,11 @@ def _model(calibration: Calibration, record: CalibrationRecord) -> str:
         rows.append([s.axis, s.unit, s.model, valid])
     seen = ""
     if record.figures is not None:
-        seen = (f"<p class=note>The runs covered {record.figures.temperature_min_degc:.4g} .. "
-                f"{record.figures.temperature_max_degc:.4g} degC in {record.figures.runs} run(s); outside the valid "
-                "range the model is held at its edge.</p>")
+        seen = (
+            f"<p class=note>The runs covered {record.figures.temperature_min_degc:.4g} .. "
+            f"{record.figures.temperature_max_degc:.4g} degC in {record.figures.runs} run(s); outside the valid "
+            "range the model is held at its edge.</p>"
+        )
     return table_html(["axis", "unit", "model", "valid temperature range [degC]"], rows) + seen
 
 
@@ -88,12 +99,17 @@ def _residual(held_out: HeldOut | None) -> str:
     if held_out is None:
         return "<p class=note>Not computed (the unit's runs were not at hand).</p>"
     rows = [[axis, a.rms_dps, a.band_dps] for axis, a in held_out.axes.items()]
-    text = (f"<p>Each {held_out.folds[:-1] if held_out.folds.endswith('s') else held_out.folds} of the "
-            f"{held_out.fold_count} held out in turn, fitted on the rest and compensated; the residual is the "
-            f"compensated output moving-averaged over {held_out.window_s:.4g} s, about its mean. On a new run of "
-            f"this unit the residual is expected within +-band {100 * BAND_LEVEL:.0f} % of the time.</p>")
-    return text + table_html(["axis", "held-out residual RMS [deg/s]", f"{100 * BAND_LEVEL:.0f} % band [deg/s]"],
-                             rows) + figure_html(_residual_figure(held_out), "held-out residual against temperature")
+    text = (
+        f"<p>Each {held_out.folds[:-1] if held_out.folds.endswith('s') else held_out.folds} of the "
+        f"{held_out.fold_count} held out in turn, fitted on the rest and compensated; the residual is the "
+        f"compensated output moving-averaged over {held_out.window_s:.4g} s, about its mean. On a new run of "
+        f"this unit the residual is expected within +-band {100 * BAND_LEVEL:.0f} % of the time.</p>"
+    )
+    return (
+        text
+        + table_html(["axis", "held-out residual RMS [deg/s]", f"{100 * BAND_LEVEL:.0f} % band [deg/s]"], rows)
+        + figure_html(_residual_figure(held_out), "held-out residual against temperature")
+    )
 
 
 def _residual_figure(held_out: HeldOut):
@@ -105,8 +121,9 @@ def _residual_figure(held_out: HeldOut):
         step = max(1, a.residual_dps.size // 4000)
         ax.plot(a.temperature_degc[::step], a.residual_dps[::step], ".", ms=2, color="#1f77b4", label="held out")
         for sign in (1, -1):
-            ax.axhline(sign * a.band_dps, color="#d62728", lw=1, label=f"{100 * BAND_LEVEL:.0f} % band"
-                       if sign > 0 else None)
+            ax.axhline(
+                sign * a.band_dps, color="#d62728", lw=1, label=f"{100 * BAND_LEVEL:.0f} % band" if sign > 0 else None
+            )
         ax.set_ylabel(f"{name} [deg/s]")
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("temperature [degC]")
@@ -121,21 +138,32 @@ def _merit(record: CalibrationRecord, limits: Limits | None, failures) -> str:
     row = record.figures.as_row()
     failing = {f.figure: f.reason for f in failures}
     bounds = _bounds(limits, row) if limits is not None else {}
-    names = [n for n in row if np.isfinite(row[n]) and (n in bounds or n in failing or n.endswith("drift_dps")
-                                                         or "noise_density" in n or "bias_instability" in n)]
-    rows = [[n, row[n], bounds.get(n, "-"), "fail" if n in failing else ("pass" if n in bounds else "-")]
-            for n in names]
+    names = [
+        n
+        for n in row
+        if np.isfinite(row[n])
+        and (n in bounds or n in failing or n.endswith("drift_dps") or "noise_density" in n or "bias_instability" in n)
+    ]
+    rows = [
+        [n, row[n], bounds.get(n, "-"), "fail" if n in failing else ("pass" if n in bounds else "-")] for n in names
+    ]
     return table_html(["figure", "value", "limit", "result"], rows)
 
 
 def _bounds(limits: Limits, row: dict) -> dict[str, str]:
     out = {}
     for limit in limits.limits:
-        words = ", ".join(f"{k} {v:.4g}" for k, v in (("min", limit.min), ("max", limit.max),
-                                                     ("abs_max", limit.abs_max)) if v is not None)
+        words = ", ".join(
+            f"{k} {v:.4g}"
+            for k, v in (("min", limit.min), ("max", limit.max), ("abs_max", limit.abs_max))
+            if v is not None
+        )
         for name in row:
-            if name == limit.figure or name == f"{limit.axis}_{limit.figure}" or (
-                    limit.axis is None and name.endswith("_" + limit.figure)):
+            if (
+                name == limit.figure
+                or name == f"{limit.axis}_{limit.figure}"
+                or (limit.axis is None and name.endswith("_" + limit.figure))
+            ):
                 out[name] = words
     return out
 
@@ -145,16 +173,33 @@ def print_pdf(page: str | os.PathLike, pdf: str | os.PathLike) -> Path:
     installed (Debian's package ``chromium``)."""
     browser = next((shutil.which(n) for n in CHROMIUM_NAMES if shutil.which(n)), None)
     if browser is None:
-        raise InputError(f"{pdf}: printing the PDF needs Chromium, and none is installed (apt-get install "
-                         "chromium); the HTML certificate was written")
+        raise InputError(
+            f"{pdf}: printing the PDF needs Chromium, and none is installed (apt-get install "
+            "chromium); the HTML certificate was written"
+        )
     with atomic_path(pdf) as tmp, tempfile.TemporaryDirectory() as profile:
-        done = subprocess.run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-                               "--disable-background-networking", f"--user-data-dir={profile}",
-                               "--no-pdf-header-footer", f"--print-to-pdf={tmp}", Path(page).resolve().as_uri()],
-                              capture_output=True, text=True, timeout=120)
+        done = subprocess.run(
+            [
+                browser,
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--no-first-run",
+                "--disable-background-networking",
+                f"--user-data-dir={profile}",
+                "--no-pdf-header-footer",
+                f"--print-to-pdf={tmp}",
+                Path(page).resolve().as_uri(),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         if done.returncode != 0 or not tmp.stat().st_size:
-            raise InputError(f"{pdf}: Chromium could not print {page} (exit {done.returncode}: "
-                             f"{done.stderr.strip().splitlines()[-1:] or ''})")
+            raise InputError(
+                f"{pdf}: Chromium could not print {page} (exit {done.returncode}: "
+                f"{done.stderr.strip().splitlines()[-1:] or ''})"
+            )
     return Path(pdf)
 
 

@@ -83,9 +83,12 @@ class AllanComparison:
     noise_alone_deg_per_h: tuple[float, ...]
 
     def to_dict(self) -> dict:
-        return {"tau_s": list(self.tau_s), "raw_deg_per_h": list(self.raw_deg_per_h),
-                "compensated_deg_per_h": list(self.compensated_deg_per_h),
-                "noise_alone_deg_per_h": list(self.noise_alone_deg_per_h)}
+        return {
+            "tau_s": list(self.tau_s),
+            "raw_deg_per_h": list(self.raw_deg_per_h),
+            "compensated_deg_per_h": list(self.compensated_deg_per_h),
+            "noise_alone_deg_per_h": list(self.noise_alone_deg_per_h),
+        }
 
 
 @dataclass(frozen=True)
@@ -101,8 +104,12 @@ class CaseResult:
     factor_vs: dict[str, float]
 
     def to_dict(self) -> dict:
-        return {"part": self.part, "window_s": self.window_s, "drift_dps": self.drift_dps,
-                "gyrocomp_factor_vs": self.factor_vs}
+        return {
+            "part": self.part,
+            "window_s": self.window_s,
+            "drift_dps": self.drift_dps,
+            "gyrocomp_factor_vs": self.factor_vs,
+        }
 
 
 @dataclass(frozen=True)
@@ -162,41 +169,72 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     allan = _allan_table(held, compensated)
     write_text_atomic(out_dir / "allan.json", json.dumps({a: c.to_dict() for a, c in allan.items()}, indent=2) + "\n")
     effects, residual, methods_rms = _effects(held, calibration, by_method, rate_hz)
-    write_text_atomic(out_dir / "effects.json", json.dumps(
-        {"window_s": EFFECT_WINDOW_S, "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
-         "residual_peak_to_peak_dps": residual,
-         "deterministic_error_left_rms_dps_by_method": methods_rms}, indent=2) + "\n")
+    write_text_atomic(
+        out_dir / "effects.json",
+        json.dumps(
+            {
+                "window_s": EFFECT_WINDOW_S,
+                "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
+                "residual_peak_to_peak_dps": residual,
+                "deterministic_error_left_rms_dps_by_method": methods_rms,
+            },
+            indent=2,
+        )
+        + "\n",
+    )
     w = window_samples(run_eval.window_s, rate_hz, held.recording.n_samples)
-    perfect = {axis: smoothed_residual_rms(held.truth.noise.total_dps[:, j], w)
-               for j, axis in enumerate(held.recording.gyro_axes)}
-    lines = _summary(len(cal_paths), rate_hz, calibration, held, effects, residual, allan, run_eval, perfect,
-                     methods_rms)
+    perfect = {
+        axis: smoothed_residual_rms(held.truth.noise.total_dps[:, j], w)
+        for j, axis in enumerate(held.recording.gyro_axes)
+    }
+    lines = _summary(
+        len(cal_paths), rate_hz, calibration, held, effects, residual, allan, run_eval, perfect, methods_rms
+    )
     mti10 = _case_from_methods(f"{PRESET} (the run above)", held, by_method, calibration.model, rate_hz)
     consumer, series = _consumer_case(rate_hz)
     cases = (consumer, mti10)
     write_text_atomic(out_dir / "cases.json", json.dumps([c.to_dict() for c in cases], indent=2) + "\n")
-    skipped = _write_report(calibration, held_data.recording, out_dir / "report.html", validation,
-                            (consumer, mti10, series)) if report else "not asked for"
+    skipped = (
+        _write_report(calibration, held_data.recording, out_dir / "report.html", validation, (consumer, mti10, series))
+        if report
+        else "not asked for"
+    )
     drawn = _draw_case(series, out_dir / "case_consumer.png") if report and skipped is None else None
     lines += _case_lines(consumer, mti10, drawn)
     if skipped is None:
-        lines.append(f"Report: {out_dir / 'report.html'} (open it in a browser): the case where compensation matters "
-                     "first, then the MTi-10 model on its held-out run.")
+        lines.append(
+            f"Report: {out_dir / 'report.html'} (open it in a browser): the case where compensation matters "
+            "first, then the MTi-10 model on its held-out run."
+        )
     files = sorted(out_dir.iterdir())
-    return DemoResult(calibration, evaluation, perfect, effects, residual, methods_rms, validation, allan,
-                      "\n".join(lines), files, skipped, cases)
+    return DemoResult(
+        calibration,
+        evaluation,
+        perfect,
+        effects,
+        residual,
+        methods_rms,
+        validation,
+        allan,
+        "\n".join(lines),
+        files,
+        skipped,
+        cases,
+    )
 
 
-def _case_from_methods(part: str, held, by_method: dict, gyrocomp_name: str, rate_hz: float,
-                       window_s: float = CASE_WINDOW_S) -> CaseResult:
+def _case_from_methods(
+    part: str, held, by_method: dict, gyrocomp_name: str, rate_hz: float, window_s: float = CASE_WINDOW_S
+) -> CaseResult:
     """The :class:`CaseResult` of compensated recordings (``by_method``, gyrocomp's under ``gyrocomp: NAME``)."""
     w = window_samples(window_s, rate_hz, held.recording.n_samples)
     truth = held.truth
     drift = {}
     for name, rec in {"raw": held.recording, **by_method}.items():
         left = rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
-        drift["gyrocomp" if name == f"gyrocomp: {gyrocomp_name}" else name] = float(np.mean(
-            [smoothed_residual_rms(left[:, j], w) for j in range(left.shape[1])]))
+        drift["gyrocomp" if name == f"gyrocomp: {gyrocomp_name}" else name] = float(
+            np.mean([smoothed_residual_rms(left[:, j], w) for j in range(left.shape[1])])
+        )
     factors = {name: drift[name] / drift["gyrocomp"] for name in AUTOPILOT_METHODS}
     return CaseResult(part, window_s, drift, factors)
 
@@ -204,10 +242,18 @@ def _case_from_methods(part: str, held, by_method: dict, gyrocomp_name: str, rat
 def _consumer_case(rate_hz: float):
     """Where gyrocomp's models matter: the consumer part, fitted on two heat-cool runs, judged on a third."""
     lo, hi = get_preset(CASE_PRESET).set_points_degc
-    fit_runs = [simulate(CASE_PRESET, profile=get_profile("cycle", set_points_degc=span, cycles=1), rate_hz=rate_hz,
-                         seed=seed).recording for seed, span in zip(CASE_SEEDS, ((lo, hi), (lo + 10.0, hi - 10.0)))]
-    held = simulate(CASE_PRESET, profile=get_profile("cycle", set_points_degc=(lo + 5.0, hi + 5.0), cycles=1),
-                    rate_hz=rate_hz, seed=CASE_HELDOUT_SEED)
+    fit_runs = [
+        simulate(
+            CASE_PRESET, profile=get_profile("cycle", set_points_degc=span, cycles=1), rate_hz=rate_hz, seed=seed
+        ).recording
+        for seed, span in zip(CASE_SEEDS, ((lo, hi), (lo + 10.0, hi - 10.0)))
+    ]
+    held = simulate(
+        CASE_PRESET,
+        profile=get_profile("cycle", set_points_degc=(lo + 5.0, hi + 5.0), cycles=1),
+        rate_hz=rate_hz,
+        seed=CASE_HELDOUT_SEED,
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # two runs: thin evidence, said in the validation of the main case
         calibration = fit_calibration(fit_runs)
@@ -215,16 +261,19 @@ def _consumer_case(rate_hz: float):
         by_method.update({name: apply(fit(fit_runs), held.recording) for name, fit in AUTOPILOT_METHODS.items()})
     result = _case_from_methods(f"{CASE_PRESET} ({calibration.model})", held, by_method, calibration.model, rate_hz)
     truth = held.truth
-    series = {name.split(":")[0]: (rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps)[:, 2]
-              for name, rec in {"raw": held.recording, **by_method}.items()}
+    series = {
+        name.split(":")[0]: (rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps)[:, 2]
+        for name, rec in {"raw": held.recording, **by_method}.items()
+    }
     return result, (held.recording.time_s, series)
 
 
 def _draw_case(series, path: Path) -> str | None:
     """The deterministic error each method leaves on gyro_z of the consumer case, over time, one panel each."""
     time_s, lefts = series
-    fig = figures.drift_panels(time_s, lefts, window_s=CASE_WINDOW_S,
-                               title=f"{CASE_PRESET}: error left on gyro_z (output - true rate - noise)")
+    fig = figures.drift_panels(
+        time_s, lefts, window_s=CASE_WINDOW_S, title=f"{CASE_PRESET}: error left on gyro_z (output - true rate - noise)"
+    )
     figures.save_figure(fig, path)
     return str(path)
 
@@ -232,25 +281,28 @@ def _draw_case(series, path: Path) -> str | None:
 def versus(factor: float, name: str) -> str:
     """gyrocomp against another method, always the same way round: ``factor`` is the other's drift over
     gyrocomp's, written "N x less drift than NAME" (or "N x more drift than NAME" where gyrocomp leaves more)."""
-    return (f"{factor:.1f}x less drift than {name}" if factor >= 1 else f"{1 / factor:.1f}x more drift than {name}")
+    return f"{factor:.1f}x less drift than {name}" if factor >= 1 else f"{1 / factor:.1f}x more drift than {name}"
 
 
 def _case_lines(matters: CaseResult, not_matters: CaseResult, drawn: str | None) -> list[str]:
     def row(case: CaseResult) -> str:
         return "  ".join(f"{name} {value:.2g}" for name, value in case.drift_dps.items())
 
-    lines = [f"Where gyrocomp's models matter: a {CASE_PRESET} part (large tempco, 30 s thermal lag, whole-degree "
-             "temperature) fitted on two heat-cool runs and judged on a third over a wider range; the "
-             f"deterministic drift each leaves (RMS of a {matters.window_s:g} s moving average, mean over the axes) "
-             f"[deg/s]: {row(matters)}",
-             "  gyrocomp leaves " + " and ".join(versus(f, name.split(" (")[0]) for name, f in matters.factor_vs.items())
-             + ": inside the calibrated range by following the thermal lag, and most where the held-out run goes "
-             "5 degC hotter than the calibration, where the autopilots hold their cubic's edge value.",
-             f"Where they do not: the {not_matters.part}, the same drift [deg/s]: {row(not_matters)}",
-             "  gyrocomp leaves " + " and ".join(versus(f, name.split(" (")[0])
-                                                 for name, f in not_matters.factor_vs.items())
-             + ": no better than a cubic there (a drift that is a smooth curve within the calibrated range leaves "
-             "nothing more to model)."]
+    lines = [
+        f"Where gyrocomp's models matter: a {CASE_PRESET} part (large tempco, 30 s thermal lag, whole-degree "
+        "temperature) fitted on two heat-cool runs and judged on a third over a wider range; the "
+        f"deterministic drift each leaves (RMS of a {matters.window_s:g} s moving average, mean over the axes) "
+        f"[deg/s]: {row(matters)}",
+        "  gyrocomp leaves "
+        + " and ".join(versus(f, name.split(" (")[0]) for name, f in matters.factor_vs.items())
+        + ": inside the calibrated range by following the thermal lag, and most where the held-out run goes "
+        "5 degC hotter than the calibration, where the autopilots hold their cubic's edge value.",
+        f"Where they do not: the {not_matters.part}, the same drift [deg/s]: {row(not_matters)}",
+        "  gyrocomp leaves "
+        + " and ".join(versus(f, name.split(" (")[0]) for name, f in not_matters.factor_vs.items())
+        + ": no better than a cubic there (a drift that is a smooth curve within the calibrated range leaves "
+        "nothing more to model).",
+    ]
     if drawn:
         lines.append(f"The consumer case drawn, one panel per method: {drawn}")
     return lines
@@ -261,22 +313,36 @@ def _case_section(matters: CaseResult, not_matters: CaseResult, series) -> tuple
     and the case where it does not (every ratio the same way round, :func:`versus`)."""
     time_s, lefts = series
     against = " and ".join(versus(f, name.split(" (")[0]) for name, f in matters.factor_vs.items())
-    rows = [[case.part, *(case.drift_dps[name] for name in ("raw", "gyrocomp", *AUTOPILOT_METHODS))]
-            for case in (matters, not_matters)]
-    body = "\n".join([
-        f"<p class=lead>On a {html.escape(CASE_PRESET)} part (large tempco, 30 s thermal lag, whole-degree "
-        f"temperature), fitted on two heat-cool runs and judged on a third that goes 5 degC hotter, gyrocomp's "
-        f"default leaves <b>{html.escape(against)}</b>.</p>",
-        figure_html(figures.drift_panels(time_s, lefts, window_s=CASE_WINDOW_S,
-                                         title=f"{CASE_PRESET}: error left on gyro_z (output - true rate - noise)"),
-                    "the error each method leaves on the consumer part's held-out run"),
-        table_html(["part", "raw", "gyrocomp", *AUTOPILOT_METHODS], rows,
-                   f"deterministic drift each leaves on the held-out run (RMS of a {matters.window_s:g} s moving "
-                   "average of output - true rate - noise, mean over the axes) [deg/s]"),
-        f"<p class=note>Where compensation does not matter: the {html.escape(not_matters.part)}, whose drift is a "
-        "smooth curve inside the calibrated range; gyrocomp leaves "
-        + html.escape(" and ".join(versus(f, name.split(' (')[0]) for name, f in not_matters.factor_vs.items()))
-        + ". Its model and held-out run are the rest of this page.</p>"])
+    rows = [
+        [case.part, *(case.drift_dps[name] for name in ("raw", "gyrocomp", *AUTOPILOT_METHODS))]
+        for case in (matters, not_matters)
+    ]
+    body = "\n".join(
+        [
+            f"<p class=lead>On a {html.escape(CASE_PRESET)} part (large tempco, 30 s thermal lag, whole-degree "
+            f"temperature), fitted on two heat-cool runs and judged on a third that goes 5 degC hotter, gyrocomp's "
+            f"default leaves <b>{html.escape(against)}</b>.</p>",
+            figure_html(
+                figures.drift_panels(
+                    time_s,
+                    lefts,
+                    window_s=CASE_WINDOW_S,
+                    title=f"{CASE_PRESET}: error left on gyro_z (output - true rate - noise)",
+                ),
+                "the error each method leaves on the consumer part's held-out run",
+            ),
+            table_html(
+                ["part", "raw", "gyrocomp", *AUTOPILOT_METHODS],
+                rows,
+                f"deterministic drift each leaves on the held-out run (RMS of a {matters.window_s:g} s moving "
+                "average of output - true rate - noise, mean over the axes) [deg/s]",
+            ),
+            f"<p class=note>Where compensation does not matter: the {html.escape(not_matters.part)}, whose drift is a "
+            "smooth curve inside the calibrated range; gyrocomp leaves "
+            + html.escape(" and ".join(versus(f, name.split(" (")[0]) for name, f in not_matters.factor_vs.items()))
+            + ". Its model and held-out run are the rest of this page.</p>",
+        ]
+    )
     return "Where compensation matters", body
 
 
@@ -289,8 +355,14 @@ def _simulate_inputs(out_dir: Path, rate_hz: float):
         path = out_dir / f"calibration_run_{seed}.csv"
         write_recording(sim.recording, path)
         cal_paths.append(path)
-    held_profile = get_profile("cycle", set_points_degc=HELDOUT_RANGE_DEGC, cycles=3, dwell_s=600.0,
-                               ramp_rate_degc_per_min=HELDOUT_RAMP_DEGC_PER_MIN, positions_g=(HELDOUT_TILT_G,))
+    held_profile = get_profile(
+        "cycle",
+        set_points_degc=HELDOUT_RANGE_DEGC,
+        cycles=3,
+        dwell_s=600.0,
+        ramp_rate_degc_per_min=HELDOUT_RAMP_DEGC_PER_MIN,
+        positions_g=(HELDOUT_TILT_G,),
+    )
     held = simulate(PRESET, profile=held_profile, rate_hz=rate_hz, seed=HELDOUT_SEED)
     held_path = out_dir / "heldout_run.csv"
     write_recording(held.recording, held_path)
@@ -305,7 +377,8 @@ def _status(calibration: Calibration) -> dict[str, str]:
     with_hysteresis = [a for a, ax in axes.items() if ax.hysteresis]
     return {
         "temperature": "compensated" + (f" (with fitted thermal lag on {', '.join(lagged)})" if lagged else ""),
-        "hysteresis": f"compensated on {', '.join(with_hysteresis)}" if with_hysteresis
+        "hysteresis": f"compensated on {', '.join(with_hysteresis)}"
+        if with_hysteresis
         else "not modelled: the data chose no hysteresis",
         "acceleration": "compensated: 3x3 G fitted jointly" if calibration.has_acceleration else "not modelled",
     }
@@ -320,24 +393,49 @@ def _effects(held, calibration: Calibration, by_method: dict, rate_hz: float):
     status = _status(calibration)
     # the tilt is held all run, so its g-sensitivity is a constant: its size is the mean, not a swing
     effects = [
-        EffectSize(name, {a: float(np.ptp(moving_average(truth.components_dps[key][:, j], w_eff)) if swing
-                                   else abs(np.mean(truth.components_dps[key][:, j])))
-                          for j, a in enumerate(axes)}, compensated=status[key])
-        for name, key, swing in (("temperature (with thermal lag)", "temperature", True),
-                                 ("hysteresis", "hysteresis", True), ("g-sensitivity", "acceleration", False))
+        EffectSize(
+            name,
+            {
+                a: float(
+                    np.ptp(moving_average(truth.components_dps[key][:, j], w_eff))
+                    if swing
+                    else abs(np.mean(truth.components_dps[key][:, j]))
+                )
+                for j, a in enumerate(axes)
+            },
+            compensated=status[key],
+        )
+        for name, key, swing in (
+            ("temperature (with thermal lag)", "temperature", True),
+            ("hysteresis", "hysteresis", True),
+            ("g-sensitivity", "acceleration", False),
+        )
     ]
     # what each compensation left: output minus what it should be (true rate + noise) [deg/s]
-    lefts = {name: rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
-             for name, rec in {"raw (no compensation)": held.recording, **by_method}.items()}
+    lefts = {
+        name: rec.gyro_dps - truth.true_rate_dps - truth.noise.total_dps
+        for name, rec in {"raw (no compensation)": held.recording, **by_method}.items()
+    }
     left = lefts[f"gyrocomp: {calibration.model}"]
     residual = {a: float(np.ptp(moving_average(left[:, j] - left[:, j].mean(), w_eff))) for j, a in enumerate(axes)}
-    methods_rms = {name: {axis: smoothed_residual_rms(d[:, j], w_eff) for j, axis in enumerate(axes)}
-                   for name, d in lefts.items()}
+    methods_rms = {
+        name: {axis: smoothed_residual_rms(d[:, j], w_eff) for j, axis in enumerate(axes)} for name, d in lefts.items()
+    }
     return effects, residual, methods_rms
 
 
-def _summary(n_runs: int, rate_hz: float, calibration: Calibration, held, effects, residual, allan, run_eval, perfect,
-             methods_rms) -> list[str]:
+def _summary(
+    n_runs: int,
+    rate_hz: float,
+    calibration: Calibration,
+    held,
+    effects,
+    residual,
+    allan,
+    run_eval,
+    perfect,
+    methods_rms,
+) -> list[str]:
     """The lines the demo prints."""
     lo, hi = HELDOUT_RANGE_DEGC
     lines = [
@@ -354,25 +452,35 @@ def _summary(n_runs: int, rate_hz: float, calibration: Calibration, held, effect
         "g-sensitivity at the fixed tilt is a constant: its mean) [deg/s]:",
     ]
     for e in effects:
-        lines.append(f"  {e.effect:32s} " + "  ".join(f"{a} {v:.2g}" for a, v in e.size_dps.items())
-                     + f"   ({e.compensated})")
+        lines.append(
+            f"  {e.effect:32s} " + "  ".join(f"{a} {v:.2g}" for a, v in e.size_dps.items()) + f"   ({e.compensated})"
+        )
     lines.append(f"  {'left after compensation':32s} " + "  ".join(f"{a} {v:.2g}" for a, v in residual.items()))
-    lines.append("Allan deviation of the held-out run [deg/h]: raw / compensated / the sensor's noise alone (what "
-                 "perfect compensation leaves). Temperature drift makes the raw curve rise at long averaging times:")
+    lines.append(
+        "Allan deviation of the held-out run [deg/h]: raw / compensated / the sensor's noise alone (what "
+        "perfect compensation leaves). Temperature drift makes the raw curve rise at long averaging times:"
+    )
     lines.append("  " + " " * 8 + "".join(f"{f'tau {t:g} s':>22s}" for t in next(iter(allan.values())).tau_s))
     for axis, c in allan.items():
-        cells = [f"{r:.3g} / {k:.3g} / {n:.3g}" for r, k, n in
-                 zip(c.raw_deg_per_h, c.compensated_deg_per_h, c.noise_alone_deg_per_h)]
+        cells = [
+            f"{r:.3g} / {k:.3g} / {n:.3g}"
+            for r, k, n in zip(c.raw_deg_per_h, c.compensated_deg_per_h, c.noise_alone_deg_per_h)
+        ]
         lines.append(f"  {axis:8s}" + "".join(f"{cell:>22s}" for cell in cells))
-    lines.append("Residual drift of the held-out run (RMS of the moving average) against what perfect "
-                 "compensation leaves:")
+    lines.append(
+        "Residual drift of the held-out run (RMS of the moving average) against what perfect compensation leaves:"
+    )
     for axis, m in run_eval.axes.items():
-        lines.append(f"  {axis}: {m.residual_rms_dps:.3g} deg/s compensated, {perfect[axis]:.3g} deg/s noise alone "
-                     f"(ratio {m.residual_rms_dps / perfect[axis]:.2f}); raw bias offset {m.bias_offset_raw_dps:.3g} "
-                     f"-> {m.bias_offset_comp_dps:.3g} deg/s")
-    lines.append("Against the cubics the autopilots' own tools fit on the same three runs: the deterministic error each "
-                 f"leaves in the held-out run (output - true rate - noise; RMS of a {EFFECT_WINDOW_S:g} s moving "
-                 "average) [deg/s]:")
+        lines.append(
+            f"  {axis}: {m.residual_rms_dps:.3g} deg/s compensated, {perfect[axis]:.3g} deg/s noise alone "
+            f"(ratio {m.residual_rms_dps / perfect[axis]:.2f}); raw bias offset {m.bias_offset_raw_dps:.3g} "
+            f"-> {m.bias_offset_comp_dps:.3g} deg/s"
+        )
+    lines.append(
+        "Against the cubics the autopilots' own tools fit on the same three runs: the deterministic error each "
+        f"leaves in the held-out run (output - true rate - noise; RMS of a {EFFECT_WINDOW_S:g} s moving "
+        "average) [deg/s]:"
+    )
     for name, rms in methods_rms.items():
         lines.append(f"  {name:60.60s} " + "  ".join(f"{a} {v:.2g}" for a, v in rms.items()))
     return lines
@@ -384,16 +492,18 @@ def _allan_table(held, compensated) -> dict[str, AllanComparison]:
     stretches = held.recording.contiguous_stretches()
     out = {}
     for j, axis in enumerate(held.recording.gyro_axes):
-        curves = [allan_deviation_segments([x[s] for s in stretches], rate_hz, taus=np.array(ALLAN_TABLE_TAUS_S))
-                  for x in (held.recording.gyro_dps[:, j], compensated.gyro_dps[:, j],
-                            held.truth.noise.total_dps[:, j])]
+        curves = [
+            allan_deviation_segments([x[s] for s in stretches], rate_hz, taus=np.array(ALLAN_TABLE_TAUS_S))
+            for x in (held.recording.gyro_dps[:, j], compensated.gyro_dps[:, j], held.truth.noise.total_dps[:, j])
+        ]
         to_dph = [tuple(float(v) * DEG_PER_S_TO_DEG_PER_H for v in c.deviation) for c in curves]
         out[axis] = AllanComparison(tuple(float(t) for t in curves[0].tau), *to_dph)
     return out
 
 
-def _write_report(calibration: Calibration, run, path: Path, validation: ValidationResult | None = None,
-                  cases=None) -> str | None:
+def _write_report(
+    calibration: Calibration, run, path: Path, validation: ValidationResult | None = None, cases=None
+) -> str | None:
     """Write the HTML report, opening with the cases (:func:`_case_section`) when given; return why not (the
     missing [plot] extra), or None."""
     try:

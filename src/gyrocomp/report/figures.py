@@ -43,8 +43,9 @@ def _pyplot():
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise MissingDependencyError("plots need the optional package matplotlib; install it with: "
-                                     + install_hint("plot")) from None
+        raise MissingDependencyError(
+            "plots need the optional package matplotlib; install it with: " + install_hint("plot")
+        ) from None
     return plt
 
 
@@ -77,8 +78,9 @@ def envelope(time_s: np.ndarray, values: np.ndarray, columns: int = DRAW_POINTS)
     return t, v
 
 
-def envelope_band(time_s: np.ndarray, values: np.ndarray, columns: int = DRAW_POINTS
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def envelope_band(
+    time_s: np.ndarray, values: np.ndarray, columns: int = DRAW_POINTS
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The band a series fills, cut to at most ``columns`` columns: each column's middle time, minimum and
     maximum (for drawing only: one polygon renders in a fraction of the time of the zigzag line through the same
     extremes)."""
@@ -126,20 +128,28 @@ def allan_figure(analysis: NoiseAnalysis, path: str | os.PathLike) -> None:
                 continue
             c = a.curve
             errors = np.vstack([c.deviation - c.ci_low, c.ci_high - c.deviation])
-            line = panel.errorbar(c.tau, c.deviation, yerr=np.nan_to_num(errors), fmt="o-", ms=3, capsize=2,
-                                  label=f"{name} ({c.kind})")[0]
+            line = panel.errorbar(
+                c.tau, c.deviation, yerr=np.nan_to_num(errors), fmt="o-", ms=3, capsize=2, label=f"{name} ({c.kind})"
+            )[0]
             terms = a.terms
             panel.plot(a.allan.tau, terms.model_deviation(a.allan.tau), "--", color=line.get_color(), lw=1)
-            panel.plot([terms.integration_time_s], [terms.bias_instability * BIAS_INSTABILITY_FACTOR], "v",
-                       color=line.get_color())
+            panel.plot(
+                [terms.integration_time_s],
+                [terms.bias_instability * BIAS_INSTABILITY_FACTOR],
+                "v",
+                color=line.get_color(),
+            )
         panel.set_xscale("log")
         panel.set_yscale("log")
         panel.set_xlabel("averaging time tau [s]")
         panel.set_ylabel(f"deviation [{unit}]")
         panel.grid(True, which="both", alpha=0.3)
         panel.legend(fontsize="small")
-    fig.suptitle(f"Allan deviation: {os.path.basename(analysis.source)}  "
-                 "(dashed: IEEE 952 fit; triangle: bias-instability floor)", fontsize="medium")
+    fig.suptitle(
+        f"Allan deviation: {os.path.basename(analysis.source)}  "
+        "(dashed: IEEE 952 fit; triangle: bias-instability floor)",
+        fontsize="medium",
+    )
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=suffix[1:], dpi=120)
@@ -164,13 +174,32 @@ def allan_plot(analyses: dict, title: str = "Allan deviation"):
             c, colour = a.curve, colours.get(label, f"C{i + 2}")
             errors = np.vstack([c.deviation - c.ci_low, c.ci_high - c.deviation])
             b = a.terms.bias_instability
-            b_text = f"{b * 3600.0:.3g} deg/h" if unit == "deg/s" else f"{b * 1e6:.3g} ug" if unit == "g" else \
-                f"{b:.3g} {unit}"
-            panel.errorbar(c.tau, c.deviation, yerr=np.nan_to_num(errors), fmt="o-", ms=3, capsize=2, color=colour,
-                           label=f"{label}: B = {b_text} at {a.terms.integration_time_s:.3g} s")
+            b_text = (
+                f"{b * 3600.0:.3g} deg/h"
+                if unit == "deg/s"
+                else f"{b * 1e6:.3g} ug"
+                if unit == "g"
+                else f"{b:.3g} {unit}"
+            )
+            panel.errorbar(
+                c.tau,
+                c.deviation,
+                yerr=np.nan_to_num(errors),
+                fmt="o-",
+                ms=3,
+                capsize=2,
+                color=colour,
+                label=f"{label}: B = {b_text} at {a.terms.integration_time_s:.3g} s",
+            )
             _slope_lines(panel, a.terms, c.tau, colour)
-            panel.plot([a.terms.integration_time_s], [a.terms.bias_instability * BIAS_INSTABILITY_FACTOR], "v",
-                       color=colour, ms=9, mec="black")
+            panel.plot(
+                [a.terms.integration_time_s],
+                [a.terms.bias_instability * BIAS_INSTABILITY_FACTOR],
+                "v",
+                color=colour,
+                ms=9,
+                mec="black",
+            )
         panel.set_xscale("log")
         panel.set_yscale("log")
         panel.set_title(axis)
@@ -178,8 +207,10 @@ def allan_plot(analyses: dict, title: str = "Allan deviation"):
         panel.set_ylabel(f"Allan deviation [{unit}]")
         panel.grid(True, which="both", alpha=0.3)
         panel.legend(fontsize="small", loc="best")
-    fig.suptitle(f"{title} (dotted: -1/2, 0, +1/2 slope lines of the identified terms; triangle: bias "
-                 "instability)", fontsize="medium")
+    fig.suptitle(
+        f"{title} (dotted: -1/2, 0, +1/2 slope lines of the identified terms; triangle: bias instability)",
+        fontsize="medium",
+    )
     fig.tight_layout()
     return fig
 
@@ -232,8 +263,7 @@ def _binned_by_branch(t: np.ndarray, width: float, *series: np.ndarray) -> dict:
         bins = int(index.max()) + 1
         key = (_branches(t).astype(np.intp) + 1) * bins + index
         counts = np.bincount(key, minlength=3 * bins)
-        found.update(width=width, bins=bins, key=key, counts=counts,
-                     t_sums=np.bincount(key, t, minlength=3 * bins))
+        found.update(width=width, bins=bins, key=key, counts=counts, t_sums=np.bincount(key, t, minlength=3 * bins))
     bins, key, counts = found["bins"], found["key"], found["counts"]
     sums = [found["t_sums"]] + [np.bincount(key, y, minlength=3 * bins) for y in series]
     out = {}
@@ -260,29 +290,41 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
         j = (rec.accel_axes if accel else rec.gyro_axes).index(axis)
         y_raw = (rec.accel_g if accel else rec.gyro_dps)[:, j]
         y_comp = (comp.accel_g if accel else comp.gyro_dps)[:, j]
-        t = rec.temperature_degc if rec.temperature_degc.ndim == 1 else (
-            rec.temperature_degc.mean(axis=1) if accel else rec.temperature_for(axis))
+        t = (
+            rec.temperature_degc
+            if rec.temperature_degc.ndim == 1
+            else (rec.temperature_degc.mean(axis=1) if accel else rec.temperature_for(axis))
+        )
         offset = float(np.mean(y_comp))
         width = max(float(np.ptp(t)) / 400.0, 1e-3)
         direction = _branches(t)
         binned = _binned_by_branch(t, width, y_raw, y_comp)
-        for sign, colour, name in ((1, HEATING_COLOUR, "heating"), (-1, COOLING_COLOUR, "cooling"),
-                                   (0, "tab:gray", "before the first move")):
+        for sign, colour, name in (
+            (1, HEATING_COLOUR, "heating"),
+            (-1, COOLING_COLOUR, "cooling"),
+            (0, "tab:gray", "before the first move"),
+        ):
             if sign not in binned:
                 continue
             tb, raw_mean, comp_mean = binned[sign]  # the correction's bin mean is their difference
             yb, yc, yr = raw_mean - offset, raw_mean - comp_mean, comp_mean - offset
             top.plot(tb, yb, ".", ms=3, color=colour, alpha=0.7, label=None if name in labelled else f"raw, {name}")
             labelled.add(name)
-            top.plot(tb, yc, "-", color="black", lw=1.2,
-                     label=None if "model" in labelled else "model correction")
+            top.plot(tb, yc, "-", color="black", lw=1.2, label=None if "model" in labelled else "model correction")
             labelled.add("model")
             bottom.plot(tb, yr, ".", ms=3, color=colour, alpha=0.7)
         turns = np.flatnonzero(np.diff(direction) != 0) + 1
         turns = turns[direction[turns - 1] != 0]
         if turns.size:
-            top.plot(t[turns], y_raw[turns] - y_comp[turns], "D", color="black", ms=6, mfc="gold",
-                     label=None if "turn" in labelled else "turning points")
+            top.plot(
+                t[turns],
+                y_raw[turns] - y_comp[turns],
+                "D",
+                color="black",
+                ms=6,
+                mfc="gold",
+                label=None if "turn" in labelled else "turning points",
+            )
             labelled.add("turn")
     top.set_ylabel(f"bias [{unit}]")
     top.set_title(title or f"{axis}: bias against temperature")
@@ -303,8 +345,10 @@ def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "d
     plt = _pyplot()
     accel = axis.startswith("accel")
     j = (raw.accel_axes if accel else raw.gyro_axes).index(axis)
-    series = {"raw": (raw.accel_g if accel else raw.gyro_dps)[:, j],
-              "compensated": (compensated.accel_g if accel else compensated.gyro_dps)[:, j]}
+    series = {
+        "raw": (raw.accel_g if accel else raw.gyro_dps)[:, j],
+        "compensated": (compensated.accel_g if accel else compensated.gyro_dps)[:, j],
+    }
     hours = raw.duration_s > 3 * 3600
     scale, t_unit = (1 / 3600.0, "h") if hours else (1.0, "s")
     t = (raw.time_s - raw.time_s[0]) * scale
@@ -314,7 +358,7 @@ def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "d
         te, low, high = envelope_band(t, y)
         top.fill_between(te, low, high, color=colour, lw=0.5, alpha=0.35)
         smooth = moving_average(y, w)
-        ts = t[w // 2: w // 2 + smooth.size]
+        ts = t[w // 2 : w // 2 + smooth.size]
         ts, smooth = envelope(ts, smooth)
         top.plot(ts, smooth, "-", color=colour, lw=1.6, label=f"{label}, {window_s:.3g} s moving average")
     top.set_ylabel(f"{axis} [{unit}]")
@@ -331,8 +375,7 @@ def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "d
     return fig
 
 
-def drift_panels(time_s: np.ndarray, errors: dict[str, np.ndarray], window_s: float, title: str,
-                 unit: str = "deg/s"):
+def drift_panels(time_s: np.ndarray, errors: dict[str, np.ndarray], window_s: float, title: str, unit: str = "deg/s"):
     """The error each method leaves [unit] against time, one panel per method (``errors``: name to its series,
     about its mean), each its ``window_s`` [s] moving average; the panels after the first (raw) share one vertical
     scale, so that what compensation leaves is compared at its own size, not flattened by raw's."""
@@ -347,9 +390,9 @@ def drift_panels(time_s: np.ndarray, errors: dict[str, np.ndarray], window_s: fl
     smooth = {name: moving_average(np.asarray(y, float) - np.mean(y), w) for name, y in errors.items()}
     shared = max((np.max(np.abs(v)) for name, v in list(smooth.items())[1:]), default=0.0) * 1.1 or 1.0
     for k, (panel, (name, y)) in enumerate(zip(panels[:, 0], smooth.items())):
-        ts = t[w // 2: w // 2 + y.size]
+        ts = t[w // 2 : w // 2 + y.size]
         panel.plot(*envelope(ts, y), "-", color=RAW_COLOUR if k == 0 else COMP_COLOUR, lw=1.2)
-        rms = float(np.sqrt(np.mean(y ** 2)))
+        rms = float(np.sqrt(np.mean(y**2)))
         panel.set_title(f"{name}: RMS {rms:.2g} {unit}", fontsize="small", loc="left")
         if k > 0:
             panel.set_ylim(-shared, shared)
@@ -389,8 +432,12 @@ def g_sensitivity_plot(positions: dict, g_matrix: dict, title: str = "g-sensitiv
     return fig
 
 
-def triad_plot(triads: dict, temperature_range_degc: tuple[float, float] | None, poses: dict,
-               title: str = "Scale factor and misalignment"):
+def triad_plot(
+    triads: dict,
+    temperature_range_degc: tuple[float, float] | None,
+    poses: dict,
+    title: str = "Scale factor and misalignment",
+):
     """Left: each triad's scale-factor error (diagonal of K(T) - I) [ppm] against temperature over
     ``temperature_range_degc`` [degC] (a constant K: flat lines), with its standard error band at the reference.
     Right: the residual of each still pose or turn before and after the calibration: ``poses`` maps a label
@@ -403,8 +450,11 @@ def triad_plot(triads: dict, temperature_range_degc: tuple[float, float] | None,
     grid = np.linspace(lo, hi, 50)
     styles = {"gyro": "-", "accelerometer": "--"}
     for name, triad in triads.items():
-        k = triad.sensitivity_at(grid) if triad.sensitivity_per_degc else np.broadcast_to(
-            np.asarray(triad.sensitivity, dtype=float), (grid.size, 3, 3))
+        k = (
+            triad.sensitivity_at(grid)
+            if triad.sensitivity_per_degc
+            else np.broadcast_to(np.asarray(triad.sensitivity, dtype=float), (grid.size, 3, 3))
+        )
         se = np.diag(np.asarray(triad.sensitivity_stderr, dtype=float))
         for j, colour in enumerate(("tab:red", "tab:green", "tab:blue")):
             error_ppm = (k[:, j, j] - 1.0) * 1e6
@@ -430,8 +480,13 @@ def triad_plot(triads: dict, temperature_range_degc: tuple[float, float] | None,
     return fig
 
 
-def fleet_distributions(table, figure_names: tuple[str, ...], axes: tuple[str, ...], limits=None,
-                        title: str = "fleet: distribution of each figure"):
+def fleet_distributions(
+    table,
+    figure_names: tuple[str, ...],
+    axes: tuple[str, ...],
+    limits=None,
+    title: str = "fleet: distribution of each figure",
+):
     """One histogram per figure of a fleet table (every axis overlaid), the limits as dashed lines.
 
     Parameters
@@ -460,7 +515,7 @@ def fleet_distributions(table, figure_names: tuple[str, ...], axes: tuple[str, .
             bins = np.histogram_bin_edges(values, bins=min(40, max(5, int(np.sqrt(values.size)))))
             for axis, v in series:
                 panel.hist(v[np.isfinite(v)], bins=bins, histtype="step", label=axis.replace("gyro_", ""))
-        for limit in (limits.limits if limits is not None else ()):
+        for limit in limits.limits if limits is not None else ():
             if limit.figure != name:
                 continue
             for bound in (limit.min, limit.max, limit.abs_max, -limit.abs_max if limit.abs_max is not None else None):
@@ -468,7 +523,7 @@ def fleet_distributions(table, figure_names: tuple[str, ...], axes: tuple[str, .
                     panel.axvline(bound, color="k", ls="--", lw=0.9)
         panel.set_title(name, fontsize=8)
         panel.tick_params(labelsize=7)
-    for panel in list(panels.flat)[len(names):]:
+    for panel in list(panels.flat)[len(names) :]:
         panel.set_visible(False)
     if names:
         panels.flat[0].legend(fontsize=7)
@@ -486,14 +541,21 @@ def stillness_plot(recording, detection, title: str | None = None):
     for j, axis in enumerate(recording.gyro_axes):
         panel.plot(*envelope(t, recording.gyro_dps[:, j]), lw=0.6, label=axis)
     for k, segment in enumerate(detection.segments):
-        panel.axvspan(segment.start_s - recording.time_s[0], segment.stop_s - recording.time_s[0], color="tab:green",
-                      alpha=0.18, lw=0, label="still" if k == 0 else None)
+        panel.axvspan(
+            segment.start_s - recording.time_s[0],
+            segment.stop_s - recording.time_s[0],
+            color="tab:green",
+            alpha=0.18,
+            lw=0,
+            label="still" if k == 0 else None,
+        )
     panel.set_xlabel("time [s]")
     panel.set_ylabel("rate [deg/s]")
     if recording.temperature_degc is not None:
         right = panel.twinx()
-        right.plot(*_binned(t, max(float(t[-1]) / DRAW_POINTS, 1e-9), recording.temperature_degc), color="k", lw=0.9,
-                   ls="--")  # means over short time bins: a whole-degree sensor's steps and noise averaged
+        right.plot(
+            *_binned(t, max(float(t[-1]) / DRAW_POINTS, 1e-9), recording.temperature_degc), color="k", lw=0.9, ls="--"
+        )  # means over short time bins: a whole-degree sensor's steps and noise averaged
         right.set_ylabel("temperature [degC] (dashed)")
     panel.legend(loc="upper left", fontsize=8, ncol=4)
     panel.set_title(title or f"still segments: {recording.source.rsplit('/', 1)[-1]}")

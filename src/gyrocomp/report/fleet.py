@@ -28,39 +28,61 @@ def build_fleet_report(table: pd.DataFrame, *, limits: Limits | None = None, tit
     counts = fleet_yield(table)
     sections = {"summary": ("Summary", _summary(table, counts, limits))}
     if counts.fitted:
-        sections["distributions"] = ("Distributions", _img(
-            figures.fleet_distributions(table, FIGURE_NAMES, axes, limits), "histograms of every figure"))
+        sections["distributions"] = (
+            "Distributions",
+            _img(figures.fleet_distributions(table, FIGURE_NAMES, axes, limits), "histograms of every figure"),
+        )
     outliers = table[table["outlier"]].sort_values("outlier_score", ascending=False)
-    sections["outliers"] = ("Outliers", _table(
-        ["serial", "score", "figures", "verdict"],
-        [[s, float(z), f, v or "-"] for s, z, f, v in zip(outliers["serial"], outliers["outlier_score"],
-                                                          outliers["outlier_figures"], outliers["verdict"])],
-        f"units whose robust z-score passes {OUTLIER_THRESHOLD} on some figure: {len(outliers)}")
-        if len(outliers) else "<p>No unit stands out of its population.</p>")
+    sections["outliers"] = (
+        "Outliers",
+        _table(
+            ["serial", "score", "figures", "verdict"],
+            [
+                [s, float(z), f, v or "-"]
+                for s, z, f, v in zip(
+                    outliers["serial"], outliers["outlier_score"], outliers["outlier_figures"], outliers["verdict"]
+                )
+            ],
+            f"units whose robust z-score passes {OUTLIER_THRESHOLD} on some figure: {len(outliers)}",
+        )
+        if len(outliers)
+        else "<p>No unit stands out of its population.</p>",
+    )
     sections["worst"] = ("Worst units", _worst(table, axes))
     rejected = table[table["verdict"] == "fail"]
     if len(rejected):
-        sections["rejected"] = ("Outside the limits", _table(
-            ["serial", "failing figures"], [[s, f] for s, f in zip(rejected["serial"], rejected["failing"])]))
+        sections["rejected"] = (
+            "Outside the limits",
+            _table(["serial", "failing figures"], [[s, f] for s, f in zip(rejected["serial"], rejected["failing"])]),
+        )
     failed = table[table["status"] == "failed"]
     if len(failed):
-        sections["failed"] = ("Failed fits", _table(["serial", "error"],
-                                                    [[s, e] for s, e in zip(failed["serial"], failed["error"])]))
-    return Report(html_page(f"gyrocomp fleet report: {title}", f"gyrocomp fleet report: {title}", "", sections),
-                  tuple(sections))
+        sections["failed"] = (
+            "Failed fits",
+            _table(["serial", "error"], [[s, e] for s, e in zip(failed["serial"], failed["error"])]),
+        )
+    return Report(
+        html_page(f"gyrocomp fleet report: {title}", f"gyrocomp fleet report: {title}", "", sections), tuple(sections)
+    )
 
 
 def _summary(table: pd.DataFrame, counts, limits: Limits | None) -> str:
-    rows = [["units", counts.units], ["fitted", counts.fitted], ["failed", counts.units - counts.fitted],
-            ["outliers", int(table["outlier"].sum())]]
+    rows = [
+        ["units", counts.units],
+        ["fitted", counts.fitted],
+        ["failed", counts.units - counts.fitted],
+        ["outliers", int(table["outlier"].sum())],
+    ]
     if limits is not None or (table["verdict"] != "").any():
         rows.append(["pass", counts.passed])
         rows.append(["yield", f"{100 * counts.yield_fraction:.1f} %"])
     text = _table(["", "count"], rows)
     if limits is not None:
-        text += _table(["figure", "axis", "min", "max", "abs_max"],
-                       [[lim.figure, lim.axis or "every", lim.min, lim.max, lim.abs_max] for lim in limits.limits],
-                       f"limits ({limits.source})")
+        text += _table(
+            ["figure", "axis", "min", "max", "abs_max"],
+            [[lim.figure, lim.axis or "every", lim.min, lim.max, lim.abs_max] for lim in limits.limits],
+            f"limits ({limits.source})",
+        )
     return text
 
 

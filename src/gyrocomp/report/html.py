@@ -130,54 +130,83 @@ def _expected(drift: float, standard_error: float | None, unit: str) -> str:
 
 def _summary(calibration: Calibration) -> str:
     report = calibration.report
-    parts = [f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
-             f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>"]
+    parts = [
+        f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
+        f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>"
+    ]
     rows = []
     for group, axes, unit in (("gyro", calibration.axes, "deg/s"), ("accelerometer", calibration.accel_axes, "g")):
         fits = (report.accel.axes if report.accel is not None else {}) if group == "accelerometer" else report.axes
         for name, ax in axes.items():
             inputs = ", ".join(ax.temperature.inputs) if ax.temperature else "-"
-            rng = "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
+            rng = (
+                "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
+            )
             rms = fits[name].fit_rms if name in fits else None
-            rows.append([name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}",
-                         len(ax.turn_on_biases)])
+            rows.append(
+                [name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}", len(ax.turn_on_biases)]
+            )
     header = ["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"]
     if all(row[4] == "-" for row in rows):  # no fit recorded one: no empty column
         header, rows = header[:4] + header[5:], [row[:4] + row[5:] for row in rows]
     parts.append(_table(header, rows))
     if calibration.accel_axes:
-        parts.append(f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
-                     "degC (its constant cannot be told from gravity at rest).</p>")
+        parts.append(
+            f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
+            "degC (its constant cannot be told from gravity at rest).</p>"
+        )
     expected = report.expected_drift()
     if expected:
         first = next(iter(expected.values()))
-        parts.append(_table(["axis", "model", "expected held-out drift", "run constant alone"],
-                            [[e.axis, e.model, _expected(e.drift, e.standard_error, e.unit),
-                              "-" if e.constant_drift is None else f"{e.constant_drift:.3g} {e.unit}"]
-                             for e in expected.values()],
-                            f"drift to expect on unseen data: mean +- standard error over {first.folds} held-out "
-                            f"{first.fold_kind} ({first.window_s:g} s moving average)"))
+        parts.append(
+            _table(
+                ["axis", "model", "expected held-out drift", "run constant alone"],
+                [
+                    [
+                        e.axis,
+                        e.model,
+                        _expected(e.drift, e.standard_error, e.unit),
+                        "-" if e.constant_drift is None else f"{e.constant_drift:.3g} {e.unit}",
+                    ]
+                    for e in expected.values()
+                ],
+                f"drift to expect on unseen data: mean +- standard error over {first.folds} held-out "
+                f"{first.fold_kind} ({first.window_s:g} s moving average)",
+            )
+        )
         if first.thin:
-            parts.append(f"<p class=note>Only {first.folds} folds: thin evidence; more runs, or runs that heat and "
-                         "cool more than once, make these figures firmer.</p>")
+            parts.append(
+                f"<p class=note>Only {first.folds} folds: thin evidence; more runs, or runs that heat and "
+                "cool more than once, make these figures firmer.</p>"
+            )
     selection = report.order_selection
     if selection is not None:
         orders = selection.orders
-        parts.append(_table(["axis"] + [f"order {p}" for p in orders],
-                            [[a] + [s.get(p) for p in orders] for a, s in selection.scores.items()],
-                            f"polynomial order by {selection.method} (lower is better)"))
+        parts.append(
+            _table(
+                ["axis"] + [f"order {p}" for p in orders],
+                [[a] + [s.get(p) for p in orders] for a, s in selection.scores.items()],
+                f"polynomial order by {selection.method} (lower is better)",
+            )
+        )
     hyst = report.hysteresis
     scored = {a: c for a, c in hyst.axes.items() if c.scores} if hyst is not None else {}
     if scored:
         names = hyst.memories_scored
-        parts.append(_table(["axis"] + list(names) + ["chosen"],
-                            [[a] + [c.scores.get(m) for m in names] + [c.label] for a, c in scored.items()],
-                            f"hysteresis / thermal lag candidates by {hyst.selection} (lower is better)"))
+        parts.append(
+            _table(
+                ["axis"] + list(names) + ["chosen"],
+                [[a] + [c.scores.get(m) for m in names] + [c.label] for a, c in scored.items()],
+                f"hysteresis / thermal lag candidates by {hyst.selection} (lower is better)",
+            )
+        )
     prov = calibration.provenance
     if prov:
         files = ", ".join(str(f.get("file", f)) if isinstance(f, dict) else str(f) for f in prov.get("inputs", []))
-        parts.append(f"<p class=note>Fitted {html.escape(str(prov.get('created_utc', '')))} by gyrocomp "
-                     f"{html.escape(str(prov.get('gyrocomp_version', '')))} on {html.escape(files)}.</p>")
+        parts.append(
+            f"<p class=note>Fitted {html.escape(str(prov.get('created_utc', '')))} by gyrocomp "
+            f"{html.escape(str(prov.get('gyrocomp_version', '')))} on {html.escape(files)}.</p>"
+        )
     return "\n".join(parts)
 
 
@@ -189,8 +218,9 @@ def _validation(result: ValidationResult) -> str:
     return _table(header, rows, caption) + folds
 
 
-def _evaluation(calibration: Calibration, runs: list[Recording], evaluations: list,
-                turn_on_window_s: float | None) -> str:
+def _evaluation(
+    calibration: Calibration, runs: list[Recording], evaluations: list, turn_on_window_s: float | None
+) -> str:
     """The evaluation table: ``evaluations`` (:func:`evaluate_run` of each run), or the stages of a staged model
     over the same windows."""
     staged = len(stage_calibrations(calibration)) > 1
@@ -204,37 +234,114 @@ def _evaluation(calibration: Calibration, runs: list[Recording], evaluations: li
             first = next(iter(st.stages.values()))
             for axis in first:
                 m0 = first[axis]
-                rows.append([name, axis, f"{window_s:.3g}", "raw", m0.bias_offset_raw_dps, "1x",
-                             m0.bias_instability_raw_dph, m0.integration_time_raw_s])
+                rows.append(
+                    [
+                        name,
+                        axis,
+                        f"{window_s:.3g}",
+                        "raw",
+                        m0.bias_offset_raw_dps,
+                        "1x",
+                        m0.bias_instability_raw_dph,
+                        m0.integration_time_raw_s,
+                    ]
+                )
                 for stage, axes in st.stages.items():
                     m = axes[axis]
-                    rows.append(["", "", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x",
-                                 m.bias_instability_comp_dph, m.integration_time_comp_s])
+                    rows.append(
+                        [
+                            "",
+                            "",
+                            "",
+                            stage,
+                            m.bias_offset_comp_dps,
+                            f"{m.offset_improvement:.3g}x",
+                            m.bias_instability_comp_dph,
+                            m.integration_time_comp_s,
+                        ]
+                    )
         if not staged:
             for axis, m in ev.axes.items():
-                rows.append([name, axis, f"{window_s:.3g}", m.bias_offset_raw_dps, m.bias_offset_comp_dps,
-                             f"{m.offset_improvement:.3g}x", m.bias_instability_raw_dph, m.bias_instability_comp_dph,
-                             m.integration_time_raw_s, m.integration_time_comp_s])
+                rows.append(
+                    [
+                        name,
+                        axis,
+                        f"{window_s:.3g}",
+                        m.bias_offset_raw_dps,
+                        m.bias_offset_comp_dps,
+                        f"{m.offset_improvement:.3g}x",
+                        m.bias_instability_raw_dph,
+                        m.bias_instability_comp_dph,
+                        m.integration_time_raw_s,
+                        m.integration_time_comp_s,
+                    ]
+                )
         for axis, m in ev.accel_axes.items():
-            accel_rows.append([name, axis, m.bias_offset_raw_g, m.bias_offset_comp_g, f"{m.offset_improvement:.3g}x",
-                               m.bias_instability_raw_ug, m.bias_instability_comp_ug])
+            accel_rows.append(
+                [
+                    name,
+                    axis,
+                    m.bias_offset_raw_g,
+                    m.bias_offset_comp_g,
+                    f"{m.offset_improvement:.3g}x",
+                    m.bias_instability_raw_ug,
+                    m.bias_instability_comp_ug,
+                ]
+            )
     if staged:
-        parts.append(_table(["run", "axis", "window [s]", "stage", "bias offset [deg/s]", "improvement (raw/stage)",
-                             "bias instability [deg/h]", "integration time [s]"], rows,
-                            "stages of the compensation (the thesis's Table 4.4)"))
+        parts.append(
+            _table(
+                [
+                    "run",
+                    "axis",
+                    "window [s]",
+                    "stage",
+                    "bias offset [deg/s]",
+                    "improvement (raw/stage)",
+                    "bias instability [deg/h]",
+                    "integration time [s]",
+                ],
+                rows,
+                "stages of the compensation (the thesis's Table 4.4)",
+            )
+        )
     else:
-        parts.append(_table(["run", "axis", "window [s]", "offset raw [deg/s]", "offset comp [deg/s]", "improvement",
-                             "BI raw [deg/h]", "BI comp [deg/h]", "int. time raw [s]", "int. time comp [s]"], rows))
+        parts.append(
+            _table(
+                [
+                    "run",
+                    "axis",
+                    "window [s]",
+                    "offset raw [deg/s]",
+                    "offset comp [deg/s]",
+                    "improvement",
+                    "BI raw [deg/h]",
+                    "BI comp [deg/h]",
+                    "int. time raw [s]",
+                    "int. time comp [s]",
+                ],
+                rows,
+            )
+        )
     if accel_rows:
-        parts.append(_table(["run", "axis", "offset raw [g]", "offset comp [g]", "improvement", "BI raw [ug]",
-                             "BI comp [ug]"], accel_rows, "accelerometer"))
-    parts.append("<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
-                 "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>")
+        parts.append(
+            _table(
+                ["run", "axis", "offset raw [g]", "offset comp [g]", "improvement", "BI raw [ug]", "BI comp [ug]"],
+                accel_rows,
+                "accelerometer",
+            )
+        )
+    parts.append(
+        "<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
+        "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>"
+    )
     fitted_on = [rec.source.rsplit("/", 1)[-1] for rec in runs if calibration.fitted_on(rec.metadata.get("path"))]
     if fitted_on:
-        parts.append(f"<p class=note><b>In-sample</b>: the model was fitted on {html.escape(', '.join(fitted_on))}; "
-                     "its figures there are not the drift to expect on new data (the held-out drift in the model "
-                     "section is).</p>")
+        parts.append(
+            f"<p class=note><b>In-sample</b>: the model was fitted on {html.escape(', '.join(fitted_on))}; "
+            "its figures there are not the drift to expect on new data (the held-out drift in the model "
+            "section is).</p>"
+        )
     return "\n".join(parts)
 
 
@@ -250,8 +357,8 @@ def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: 
             continue
         out = apply(no_g, rec)
         accel = out.accel_g[:, [rec.accel_axes.index(a) for a in ACCEL_AXES]]
-        g = np.array([accel[s.start:s.stop].mean(axis=0) for s in segments])
-        y = np.array([out.gyro_dps[s.start:s.stop].mean(axis=0) for s in segments])
+        g = np.array([accel[s.start : s.stop].mean(axis=0) for s in segments])
+        y = np.array([out.gyro_dps[s.start : s.stop].mean(axis=0) for s in segments])
         gravity.append(g)
         offsets.append(y)
     result = {}
@@ -266,9 +373,11 @@ def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: 
 
 
 #: how the report labels each scale-factor residual, and the factor to its unit
-_RESIDUAL_LABELS = {"pose_norm_g": ("accelerometer |a| - 1 g [mg]", 1e3),
-                    "turn_direction_deg": ("gyro: gravity direction after each turn [deg]", 1.0),
-                    "rate_error_dps": ("gyro: rate error on each rate-table stretch [deg/s]", 1.0)}
+_RESIDUAL_LABELS = {
+    "pose_norm_g": ("accelerometer |a| - 1 g [mg]", 1e3),
+    "turn_direction_deg": ("gyro: gravity direction after each turn [deg]", 1.0),
+    "rate_error_dps": ("gyro: rate error on each rate-table stretch [deg/s]", 1.0),
+}
 
 
 def _pose_residuals(calibration: Calibration, runs: list[Recording], compensated: list[Recording]) -> dict:
@@ -287,26 +396,38 @@ def _pose_residuals(calibration: Calibration, runs: list[Recording], compensated
 def _triads(calibration: Calibration, runs: list[Recording], compensated: list[Recording]) -> str:
     """The scale-factor section: each triad's K with standard errors, its scale-factor error against
     temperature and the residual per pose or turn."""
-    triads = {name: t for name, t in (("gyro", calibration.gyro_triad), ("accelerometer", calibration.accel_triad))
-              if t is not None}
+    triads = {
+        name: t
+        for name, t in (("gyro", calibration.gyro_triad), ("accelerometer", calibration.accel_triad))
+        if t is not None
+    }
     rows = []
     for name, triad in triads.items():
         for i, axis in enumerate("xyz"):
-            rows.append([f"{name} {axis}", triad.method]
-                        + [with_error(k, e, sign=True) for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i])]
-                        + [f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g} {triad.unit}"])
+            rows.append(
+                [f"{name} {axis}", triad.method]
+                + [with_error(k, e, sign=True) for k, e in zip(triad.sensitivity[i], triad.sensitivity_stderr[i])]
+                + [f"{triad.scale_factor_error[i] * 1e6:+.0f}", f"{triad.bias[i]:+.5g} {triad.unit}"]
+            )
     temps = [rec.temperature_degc for rec in runs if rec.temperature_degc is not None]
     span = (float(min(np.min(t) for t in temps)), float(max(np.max(t) for t in temps))) if temps else None
-    body = [_table(["triad", "method", "K column x", "K column y", "K column z", "scale error [ppm]", "bias"], rows,
-                   "raw = K(T) v + bias, corrected v = K(T)^-1 (raw - bias); K at the reference temperature "
-                   "+- standard error"),
-            _img(figures.triad_plot(triads, span, _pose_residuals(calibration, runs, compensated)),
-                 "scale-factor error against temperature, residual per pose")]
+    body = [
+        _table(
+            ["triad", "method", "K column x", "K column y", "K column z", "scale error [ppm]", "bias"],
+            rows,
+            "raw = K(T) v + bias, corrected v = K(T)^-1 (raw - bias); K at the reference temperature +- standard error",
+        ),
+        _img(
+            figures.triad_plot(triads, span, _pose_residuals(calibration, runs, compensated)),
+            "scale-factor error against temperature, residual per pose",
+        ),
+    ]
     return "\n".join(body)
 
 
-def _axis_sections(calibration: Calibration, runs: list[Recording], compensated: list[Recording],
-                   windows: list[float]) -> dict:
+def _axis_sections(
+    calibration: Calibration, runs: list[Recording], compensated: list[Recording], windows: list[float]
+) -> dict:
     """One section per modelled axis: bias against temperature, raw and compensated output of each run."""
     modelled = [a for a in runs[0].gyro_axes if a in calibration.axes]
     modelled += [a for a in calibration.accel_axes if runs[0].accel_g is not None]
@@ -315,12 +436,16 @@ def _axis_sections(calibration: Calibration, runs: list[Recording], compensated:
         unit = "g" if axis.startswith("accel") else "deg/s"
         body = []
         if runs[0].temperature_degc is not None:
-            body.append(_img(figures.temperature_plot(runs, compensated, axis, unit),
-                             f"{axis}: bias against temperature"))
+            body.append(
+                _img(figures.temperature_plot(runs, compensated, axis, unit), f"{axis}: bias against temperature")
+            )
         for rec, comp, w in zip(runs, compensated, windows):
-            body.append(_img(figures.timeseries_plot(rec, comp, axis, w, unit,
-                                                     title=f"{axis}: {rec.source.rsplit('/', 1)[-1]}"),
-                             f"{axis}: raw and compensated output"))
+            body.append(
+                _img(
+                    figures.timeseries_plot(rec, comp, axis, w, unit, title=f"{axis}: {rec.source.rsplit('/', 1)[-1]}"),
+                    f"{axis}: raw and compensated output",
+                )
+            )
         sections[f"axis-{axis}"] = (f"Axis {axis}", "\n".join(body))
     return sections
 
@@ -337,8 +462,11 @@ def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s
         errors = acc[axis].standard_error_dps_per_g if axis in acc else (None, None, None)
         g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
         rows.append([axis] + [with_error(g, e, sign=True) for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
-    body = [_table(["gyro axis", "accel_x", "accel_y", "accel_z"], rows,
-                   "g-sensitivity matrix G [deg/s/g] +- standard error")]
+    body = [
+        _table(
+            ["gyro axis", "accel_x", "accel_y", "accel_z"], rows, "g-sensitivity matrix G [deg/s/g] +- standard error"
+        )
+    ]
     if positions:
         body.append(_img(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
     else:
@@ -346,11 +474,17 @@ def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s
     return "\n".join(body)
 
 
-def build_report(calibration: Calibration, runs: list[Recording], *, window_s: float | None = None,
-                 turn_on_window_s: float | None = None, min_static_s: float = 10.0,
-                 progress: Callable[[float], None] | None = None,
-                 validation: ValidationResult | None = None,
-                 lead: dict[str, tuple[str, str]] | None = None) -> Report:
+def build_report(
+    calibration: Calibration,
+    runs: list[Recording],
+    *,
+    window_s: float | None = None,
+    turn_on_window_s: float | None = None,
+    min_static_s: float = 10.0,
+    progress: Callable[[float], None] | None = None,
+    validation: ValidationResult | None = None,
+    lead: dict[str, tuple[str, str]] | None = None,
+) -> Report:
     """The report of ``calibration`` judged on ``runs`` (see the module doc for what it holds).
 
     Parameters
@@ -386,9 +520,16 @@ def build_report(calibration: Calibration, runs: list[Recording], *, window_s: f
             sections["validation"] = ("Validation", _validation(validation))
         # the Allan curves drawn below, raw and compensated: their minima are the bias instabilities (once)
         noise = [_noise(rec, comp) for rec, comp in zip(runs, compensated)]
-        evaluations = [evaluate_run(rec, comp, window_s=window_s, accel=bool(calibration.accel_axes),
-                                    allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair))
-                       for rec, comp, pair in zip(runs, compensated, noise)]
+        evaluations = [
+            evaluate_run(
+                rec,
+                comp,
+                window_s=window_s,
+                accel=bool(calibration.accel_axes),
+                allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair),
+            )
+            for rec, comp, pair in zip(runs, compensated, noise)
+        ]
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
         sections.update(_axis_sections(calibration, runs, compensated, [ev.window_s for ev in evaluations]))
@@ -412,14 +553,38 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
     """What the PX4 and ArduPilot files exported from the model do, as each firmware computes them
     (:mod:`gyrocomp.export.firmware`): their correction against the model's, and the bias offset each leaves on
     the runs."""
-    rows = [[target, axis, d.in_range_max_dps[j], d.in_range_rms_dps[j], d.beyond_max_dps[j], d.beyond_rms_dps[j],
-             d.as_run_max_dps[j], d.as_run_rms_dps[j]] for target, d in costs.items() for j, axis in enumerate(d.axes)]
-    parts = [_table(["firmware", "axis", "in range, largest", "in range, RMS", f"{BEYOND_DEGC:g} degC beyond, largest",
-                     f"{BEYOND_DEGC:g} degC beyond, RMS", "heat-cool cycle as run, largest",
-                     "heat-cool cycle as run, RMS"], rows,
-                    "the firmware's correction against the model's [deg/s] (about its mean): the firmware clamps at "
-                    "the calibrated range, carries a cubic without lag or hysteresis, and PX4 republishes at 1 Hz "
-                    "when the temperature moved by more than 1 degC")]
+    rows = [
+        [
+            target,
+            axis,
+            d.in_range_max_dps[j],
+            d.in_range_rms_dps[j],
+            d.beyond_max_dps[j],
+            d.beyond_rms_dps[j],
+            d.as_run_max_dps[j],
+            d.as_run_rms_dps[j],
+        ]
+        for target, d in costs.items()
+        for j, axis in enumerate(d.axes)
+    ]
+    parts = [
+        _table(
+            [
+                "firmware",
+                "axis",
+                "in range, largest",
+                "in range, RMS",
+                f"{BEYOND_DEGC:g} degC beyond, largest",
+                f"{BEYOND_DEGC:g} degC beyond, RMS",
+                "heat-cool cycle as run, largest",
+                "heat-cool cycle as run, RMS",
+            ],
+            rows,
+            "the firmware's correction against the model's [deg/s] (about its mean): the firmware clamps at "
+            "the calibrated range, carries a cubic without lag or hysteresis, and PX4 republishes at 1 Hz "
+            "when the temperature moved by more than 1 degC",
+        )
+    ]
     run_rows = []
     for rec, ev in zip(runs, evaluations):
         if rec.temperature_degc is None:
@@ -427,17 +592,30 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
         # the bias offset of each firmware's output, over the evaluation's window (the other figures are not
         # shown here: their Allan minima would cost a report on a long run some seconds per firmware)
         w = window_samples(ev.window_s, rec.rate_hz, rec.n_samples)
-        on_vehicle = {target: {axis: bias_offset(output, w)
-                               for axis, output in firmware_corrected_axes(calibration, rec, target)}
-                      for target in costs}
+        on_vehicle = {
+            target: {axis: bias_offset(output, w) for axis, output in firmware_corrected_axes(calibration, rec, target)}
+            for target in costs
+        }
         for axis, m in ev.axes.items():
             if all(axis in offsets for offsets in on_vehicle.values()):
-                run_rows.append([rec.source.rsplit("/", 1)[-1], axis, m.bias_offset_raw_dps, m.bias_offset_comp_dps,
-                                 *(on_vehicle[t][axis] for t in costs)])
+                run_rows.append(
+                    [
+                        rec.source.rsplit("/", 1)[-1],
+                        axis,
+                        m.bias_offset_raw_dps,
+                        m.bias_offset_comp_dps,
+                        *(on_vehicle[t][axis] for t in costs),
+                    ]
+                )
     if run_rows:
-        parts.append(_table(["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"], run_rows,
-                            "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
-                            "files as each firmware applies them"))
+        parts.append(
+            _table(
+                ["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"],
+                run_rows,
+                "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
+                "files as each firmware applies them",
+            )
+        )
     return "\n".join(parts)
 
 
@@ -446,8 +624,9 @@ def _noise(rec: Recording, comp: Recording) -> tuple:
     moving runs itself (the stillness section), and the raw run's plausibility was checked by apply: neither is
     judged again per curve."""
     names, split = list(rec.gyro_axes), bool(rec.gaps)
-    return tuple(analyse_noise(r, names, split_gaps=split, motion_check=False, plausibility_check=False)
-                 for r in (rec, comp))
+    return tuple(
+        analyse_noise(r, names, split_gaps=split, motion_check=False, plausibility_check=False) for r in (rec, comp)
+    )
 
 
 def _allan(runs: list[Recording], noise: list[tuple], tick: Callable[[], None]) -> str:
@@ -456,8 +635,12 @@ def _allan(runs: list[Recording], noise: list[tuple], tick: Callable[[], None]) 
     parts = []
     for rec, (raw, compensated) in zip(runs, noise):
         analyses = {"raw": raw, "compensated": compensated}
-        parts.append(_img(figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
-                          "Allan deviation, raw and compensated"))
+        parts.append(
+            _img(
+                figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
+                "Allan deviation, raw and compensated",
+            )
+        )
         parts.append(_noise_model_table(compensated))
         tick()
     return "\n".join(parts)
@@ -471,12 +654,24 @@ def _noise_model_table(compensated) -> str:
         model = noise_model(compensated)
     except InputError as exc:  # too short a run for two averaging times
         return f"<p class=note>No noise model: {html.escape(str(exc))}</p>"
-    rows = [[name, a.ieee.white_noise_density, a.ieee.random_walk, a.bound.white_noise_density, a.bound.random_walk,
-             f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}"] for name, a in model.axes.items()]
-    return _table(["axis", "IEEE 952 N", "IEEE 952 K", "bound N", "bound K", "bound / curve: median / largest"], rows,
-                  caption="noise model of the compensated gyro for an estimator (gyrocomp noise): N "
-                          "[deg/s/sqrt(Hz)] and K [deg/s/sqrt(s)] at or above the upper end of the curve's 95 % "
-                          "interval at every averaging time up to a tenth of the run")
+    rows = [
+        [
+            name,
+            a.ieee.white_noise_density,
+            a.ieee.random_walk,
+            a.bound.white_noise_density,
+            a.bound.random_walk,
+            f"{a.bound.ratio_median:.2f} / {a.bound.ratio_max:.2f}",
+        ]
+        for name, a in model.axes.items()
+    ]
+    return _table(
+        ["axis", "IEEE 952 N", "IEEE 952 K", "bound N", "bound K", "bound / curve: median / largest"],
+        rows,
+        caption="noise model of the compensated gyro for an estimator (gyrocomp noise): N "
+        "[deg/s/sqrt(Hz)] and K [deg/s/sqrt(s)] at or above the upper end of the curve's 95 % "
+        "interval at every averaging time up to a tenth of the run",
+    )
 
 
 def _stillness(moving: list) -> str:
@@ -485,14 +680,24 @@ def _stillness(moving: list) -> str:
     parts = []
     for rec, found in moving:
         parts.append(_img(figures.stillness_plot(rec, found), "rate and temperature with the still segments shaded"))
-        rows = [[f"{s.start_s - rec.time_s[0]:.0f}", f"{s.duration_s:.0f}",
-                 "-" if s.temperature_degc is None else f"{s.temperature_degc:.2f}",
-                 *(float(v) for v in s.gyro_mean_dps)] for s in found.segments]
+        rows = [
+            [
+                f"{s.start_s - rec.time_s[0]:.0f}",
+                f"{s.duration_s:.0f}",
+                "-" if s.temperature_degc is None else f"{s.temperature_degc:.2f}",
+                *(float(v) for v in s.gyro_mean_dps),
+            ]
+            for s in found.segments
+        ]
         total = rec.duration_s
-        parts.append(_table(["start [s]", "length [s]", "temperature [degC]",
-                             *(f"{a} mean [deg/s]" for a in rec.gyro_axes)], rows,
-                            f"{rec.source.rsplit('/', 1)[-1]}: {len(found.segments)} still segment(s), "
-                            f"{found.still_s / 60:.1f} of {total / 60:.1f} min"))
+        parts.append(
+            _table(
+                ["start [s]", "length [s]", "temperature [degC]", *(f"{a} mean [deg/s]" for a in rec.gyro_axes)],
+                rows,
+                f"{rec.source.rsplit('/', 1)[-1]}: {len(found.segments)} still segment(s), "
+                f"{found.still_s / 60:.1f} of {total / 60:.1f} min",
+            )
+        )
     return "\n".join(parts)
 
 
@@ -507,10 +712,16 @@ def html_page(title: str, heading: str, note: str, sections: dict[str, tuple[str
     navigation bar, and ``sections`` (id -> (title, HTML body)) in order; ``css``: more style (the page's own)."""
     created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     nav = " ".join(f'<a href="#{sid}">{html.escape(name)}</a>' for sid, (name, _) in sections.items())
-    page = ["<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
-            f"<title>{html.escape(title)}</title>", f"<style>{_CSS}{css}</style></head><body>",
-            f"<h1>{html.escape(heading)}</h1><p class=note>{created}, gyrocomp {__version__}"
-            + (f"; {note}" if note else "") + "</p>", f"<nav>{nav}</nav>"]
+    page = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f"<title>{html.escape(title)}</title>",
+        f"<style>{_CSS}{css}</style></head><body>",
+        f"<h1>{html.escape(heading)}</h1><p class=note>{created}, gyrocomp {__version__}"
+        + (f"; {note}" if note else "")
+        + "</p>",
+        f"<nav>{nav}</nav>",
+    ]
     for sid, (name, body) in sections.items():
         page.append(f'<section id="{sid}"><h2>{html.escape(name)}</h2>\n{body}\n</section>')
     page.append("</body></html>")

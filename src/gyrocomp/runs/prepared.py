@@ -29,8 +29,14 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import ACCEL_AXES, Recording
-from ..motion.positions import (DEFAULT_FACTOR, DEFAULT_MIN_DURATION_S, DEFAULT_WINDOW_S, StaticSegment, segments_from_mask,
-                     still_mask)
+from ..motion.positions import (
+    DEFAULT_FACTOR,
+    DEFAULT_MIN_DURATION_S,
+    DEFAULT_WINDOW_S,
+    StaticSegment,
+    segments_from_mask,
+    still_mask,
+)
 
 
 #: what a fit models: the gyro's axes or the accelerometer's
@@ -54,8 +60,9 @@ class RunBlocks:
     samples: np.ndarray | None = None
 
 
-def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float,
-                pieces: Sequence[slice] | None = None) -> RunBlocks:
+def block_means(
+    rec: Recording, axis: str, block_s: float, bin_width_degc: float, pieces: Sequence[slice] | None = None
+) -> RunBlocks:
     """Means over consecutive blocks of ``block_s`` inside each of ``pieces`` (default: the stretches
     between time gaps; for multi-position runs, the static segments), with bin-balancing weights.
     ``cluster`` numbers the piece each block comes from."""
@@ -84,7 +91,6 @@ def block_means(rec: Recording, axis: str, block_s: float, bin_width_degc: float
     _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
     weight = (counts / counts.max()) / per_bin[inverse]
     return RunBlocks(bt, btemp, by, weight, accel, cluster, counts)
-
 
 
 def _read_only(blocks: RunBlocks) -> RunBlocks:
@@ -143,25 +149,40 @@ class PreparedRun(Recording):
 
     def still_mask(self, *, window_s: float = DEFAULT_WINDOW_S, factor: float = DEFAULT_FACTOR) -> np.ndarray:
         """:func:`gyrocomp.motion.positions.still_mask` (window [s], factor over the median variance), read-only."""
+
         def compute():
             mask = still_mask(self, window_s=window_s, factor=factor)
             mask.flags.writeable = False
             return mask
+
         return self._once(("still", float(window_s), float(factor)), compute)
 
-    def static_segments(self, *, window_s: float = DEFAULT_WINDOW_S, min_duration_s: float = DEFAULT_MIN_DURATION_S,
-                        factor: float = DEFAULT_FACTOR) -> list[StaticSegment]:
+    def static_segments(
+        self,
+        *,
+        window_s: float = DEFAULT_WINDOW_S,
+        min_duration_s: float = DEFAULT_MIN_DURATION_S,
+        factor: float = DEFAULT_FACTOR,
+    ) -> list[StaticSegment]:
         """:func:`gyrocomp.motion.positions.static_segments` (window and shortest segment [s]), from the kept still mask."""
+
         def compute():
             mask = self.still_mask(window_s=window_s, factor=factor)
             return tuple(segments_from_mask(self, mask, window_s=window_s, min_duration_s=min_duration_s))
+
         return list(self._once(("segments", float(window_s), float(min_duration_s), float(factor)), compute))
 
-    def block_means(self, axis: str, block_s: float, bin_width_degc: float,
-                    pieces: Sequence[slice] | None = None) -> RunBlocks:
+    def block_means(
+        self, axis: str, block_s: float, bin_width_degc: float, pieces: Sequence[slice] | None = None
+    ) -> RunBlocks:
         """:func:`block_means` of one axis (block [s], bin width [degC], the stretches to use), read-only."""
-        key = ("blocks", axis, float(block_s), float(bin_width_degc),
-               None if pieces is None else tuple((p.start, p.stop, p.step) for p in pieces))
+        key = (
+            "blocks",
+            axis,
+            float(block_s),
+            float(bin_width_degc),
+            None if pieces is None else tuple((p.start, p.stop, p.step) for p in pieces),
+        )
         return self._once(key, lambda: _read_only(block_means(self, axis, block_s, bin_width_degc, pieces)))
 
 
@@ -177,8 +198,9 @@ def prepare(recordings: Iterable[Recording]) -> list[PreparedRun]:
     out = []
     for k, rec in enumerate(recordings):
         if not isinstance(rec, Recording):
-            raise InputError(f"recordings[{k}]: expected a Recording (from gyrocomp.read or simulate), "
-                             f"got {type(rec).__name__}")
+            raise InputError(
+                f"recordings[{k}]: expected a Recording (from gyrocomp.read or simulate), got {type(rec).__name__}"
+            )
         out.append(PreparedRun.of(rec))
     return out
 

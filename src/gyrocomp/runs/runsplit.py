@@ -76,7 +76,7 @@ def _bounds(rec: Recording, by: str, min_gap_s: float, min_still_s: float, min_l
     turns = find_turns(temperature, min_leg_degc)
     cuts, previous = [], 0
     for confirmed in turns.turn_index:
-        piece = temperature[previous:confirmed + 1]
+        piece = temperature[previous : confirmed + 1]
         rising = turns.direction[max(confirmed - 1, 0)] > 0
         cut = previous + int(np.argmax(piece) if rising else np.argmin(piece))
         if cut > previous:
@@ -85,8 +85,15 @@ def _bounds(rec: Recording, by: str, min_gap_s: float, min_still_s: float, min_l
     return list(zip([0, *cuts], [*cuts, n]))
 
 
-def split_runs(rec: Recording, by: SplitBy, *, min_gap_s: float = 60.0, min_still_s: float = 600.0,
-               min_leg_degc: float = 2.0, min_samples: int = 10) -> list[RunPiece]:
+def split_runs(
+    rec: Recording,
+    by: SplitBy,
+    *,
+    min_gap_s: float = 60.0,
+    min_still_s: float = 600.0,
+    min_leg_degc: float = 2.0,
+    min_samples: int = 10,
+) -> list[RunPiece]:
     """Cut ``rec`` into runs (see the module), in time order, each of at least ``min_samples`` samples.
 
     Parameters
@@ -110,8 +117,11 @@ def split_runs(rec: Recording, by: SplitBy, *, min_gap_s: float = 60.0, min_stil
     for name, value in (("min_gap_s", min_gap_s), ("min_still_s", min_still_s), ("min_leg_degc", min_leg_degc)):
         if not (np.isfinite(value) and value > 0):
             raise InputError(f"{name}: must be a positive number, got {value:g}")
-    pieces = [RunPiece(a, b, rec.take(slice(a, b))) for a, b in _bounds(rec, by, min_gap_s, min_still_s,
-                                                                          min_leg_degc) if b - a >= min_samples]
+    pieces = [
+        RunPiece(a, b, rec.take(slice(a, b)))
+        for a, b in _bounds(rec, by, min_gap_s, min_still_s, min_leg_degc)
+        if b - a >= min_samples
+    ]
     if not pieces:
         raise InputError(f"{rec.source}: by={by}: no run of {min_samples} samples or more found")
     return pieces

@@ -46,7 +46,14 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..effects import HYSTERESIS_DIRECTIONS, branch_position, find_turns, g_sensitivity_offset, hysteresis_offset, thermal_lag
+from ..effects import (
+    HYSTERESIS_DIRECTIONS,
+    branch_position,
+    find_turns,
+    g_sensitivity_offset,
+    hysteresis_offset,
+    thermal_lag,
+)
 from ..errors import InputError
 from ..recording import GYRO_AXES
 from ..units import DEG_PER_S_TO_DEG_PER_H
@@ -229,7 +236,11 @@ class GyroErrorModel:
     """
 
     axes: tuple[str, ...] = GYRO_AXES
-    temperature_coefficients: tuple[tuple[float, ...], ...] = ((4e-4, 6e-6, -8e-8), (-3e-4, 4e-6, 5e-8), (5e-4, -5e-6, 6e-8))
+    temperature_coefficients: tuple[tuple[float, ...], ...] = (
+        (4e-4, 6e-6, -8e-8),
+        (-3e-4, 4e-6, 5e-8),
+        (5e-4, -5e-6, 6e-8),
+    )
     t_ref_degc: float = 25.0
     thermal_time_constant_s: float = 0.0
     hysteresis: Hysteresis | None = None
@@ -264,13 +275,20 @@ class GyroErrorModel:
         if not k or any(a not in GYRO_AXES for a in self.axes) or len(set(self.axes)) != k:
             raise InputError(f"axes: {self.axes}; use distinct names from {', '.join(GYRO_AXES)}")
         if len(self.temperature_coefficients) != k:
-            raise InputError(
-                f"temperature_coefficients: {len(self.temperature_coefficients)} sets for {k} axes"
-            )
-        for name in ("turn_on_bias_sigma_dps", "noise_density_dps_per_sqrt_hz", "bias_instability_deg_per_h",
-                     "rate_random_walk_dps_per_sqrt_s", "quantization_dps", "temperature_noise_degc",
-                     "temperature_quantization_degc", "thermal_time_constant_s", "run_drift_dps",
-                     "run_tempco_sigma_dps_per_degc", "warm_up_sigma_dps"):
+            raise InputError(f"temperature_coefficients: {len(self.temperature_coefficients)} sets for {k} axes")
+        for name in (
+            "turn_on_bias_sigma_dps",
+            "noise_density_dps_per_sqrt_hz",
+            "bias_instability_deg_per_h",
+            "rate_random_walk_dps_per_sqrt_s",
+            "quantization_dps",
+            "temperature_noise_degc",
+            "temperature_quantization_degc",
+            "thermal_time_constant_s",
+            "run_drift_dps",
+            "run_tempco_sigma_dps_per_degc",
+            "warm_up_sigma_dps",
+        ):
             if getattr(self, name) < 0:
                 raise InputError(f"{name}: must not be negative")
         if not math.isfinite(self.noise_tempco_per_degc):
@@ -314,8 +332,9 @@ class GyroErrorModel:
         if h.transition_degc is not None:  # heating and cooling branches
             position = branch_position(structure_degc, turns, h.transition_degc)
             dt = structure_degc - self.t_ref_degc
-            return np.column_stack([position * sum(c * dt ** k for k, c in enumerate(coefs))
-                                    for coefs in h.coefficients_dps])
+            return np.column_stack(
+                [position * sum(c * dt**k for k, c in enumerate(coefs)) for coefs in h.coefficients_dps]
+            )
         # the distance from the turning point on the branches that carry the offset (zero elsewhere), then its shape
         d = hysteresis_offset(structure_degc, turns, (1.0,), direction=h.direction, band_degc=h.band_degc)
         return np.column_stack([np.where(d > 0, h.offset_dps(d, c), 0.0) for c in h.coefficients_dps])
@@ -348,8 +367,11 @@ class GyroErrorModel:
         if self.scale_factor_error_ppm is not None:
             out += own * np.asarray(self.scale_factor_error_ppm) * 1e-6
         if self.scale_factor_tempco_ppm_per_degc is not None:
-            out += own * np.outer(structure_degc - self.t_ref_degc,
-                                  np.asarray(self.scale_factor_tempco_ppm_per_degc)) * 1e-6
+            out += (
+                own
+                * np.outer(structure_degc - self.t_ref_degc, np.asarray(self.scale_factor_tempco_ppm_per_degc))
+                * 1e-6
+            )
         if self.misalignment_rad is not None:
             m = np.array(self.misalignment_rad, dtype=float)
             m[np.arange(k), self.body_index] = 0.0
@@ -377,11 +399,16 @@ class GyroErrorModel:
         if hyst is not None:
             hyst = dataclasses.replace(hyst, coefficients_dps=pick(hyst.coefficients_dps))
         return dataclasses.replace(
-            self, axes=tuple(axes), temperature_coefficients=pick(self.temperature_coefficients), hysteresis=hyst,
-            g_sensitivity_dps_per_g=pick(self.g_sensitivity_dps_per_g), g_squared_dps_per_g2=pick(self.g_squared_dps_per_g2),
+            self,
+            axes=tuple(axes),
+            temperature_coefficients=pick(self.temperature_coefficients),
+            hysteresis=hyst,
+            g_sensitivity_dps_per_g=pick(self.g_sensitivity_dps_per_g),
+            g_squared_dps_per_g2=pick(self.g_squared_dps_per_g2),
             scale_factor_error_ppm=pick(self.scale_factor_error_ppm),
             scale_factor_tempco_ppm_per_degc=pick(self.scale_factor_tempco_ppm_per_degc),
-            misalignment_rad=pick(self.misalignment_rad))
+            misalignment_rad=pick(self.misalignment_rad),
+        )
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -389,16 +416,21 @@ class GyroErrorModel:
 
 #: what ``GyroErrorModel.without`` (and ``gyrocomp simulate --disable``) can switch off
 SWITCHABLE_TERMS = {
-    "temperature": lambda m: {"temperature_coefficients": tuple((0.0,) for _ in m.axes),
-                              "temperature_rate_dps_per_degc_per_min": None},
+    "temperature": lambda m: {
+        "temperature_coefficients": tuple((0.0,) for _ in m.axes),
+        "temperature_rate_dps_per_degc_per_min": None,
+    },
     "lag": lambda m: {"thermal_time_constant_s": 0.0},
     "hysteresis": lambda m: {"hysteresis": None},
     "g-sensitivity": lambda m: {"g_sensitivity_dps_per_g": None, "g_squared_dps_per_g2": None},
     "scale-factor": lambda m: {"scale_factor_error_ppm": None, "scale_factor_tempco_ppm_per_degc": None},
     "misalignment": lambda m: {"misalignment_rad": None},
     "turn-on": lambda m: {"turn_on_bias_sigma_dps": 0.0},
-    "noise": lambda m: {"noise_density_dps_per_sqrt_hz": 0.0, "bias_instability_deg_per_h": 0.0,
-                        "rate_random_walk_dps_per_sqrt_s": 0.0},
+    "noise": lambda m: {
+        "noise_density_dps_per_sqrt_hz": 0.0,
+        "bias_instability_deg_per_h": 0.0,
+        "rate_random_walk_dps_per_sqrt_s": 0.0,
+    },
     "quantization": lambda m: {"quantization_dps": 0.0, "temperature_quantization_degc": 0.0},
     "temperature-noise": lambda m: {"temperature_noise_degc": 0.0},
     "drift": lambda m: {"run_drift_dps": 0.0, "run_tempco_sigma_dps_per_degc": 0.0},
@@ -430,12 +462,19 @@ class NoiseTruth:
 
     def take(self, index) -> "NoiseTruth":
         pick = lambda a: None if a is None else a[index]  # noqa: E731
-        return NoiseTruth(self.white_dps[index], self.flicker_dps[index], self.random_walk_dps[index],
-                          pick(self.quantization_dps), pick(self.drift_dps), pick(self.warm_up_dps))
+        return NoiseTruth(
+            self.white_dps[index],
+            self.flicker_dps[index],
+            self.random_walk_dps[index],
+            pick(self.quantization_dps),
+            pick(self.drift_dps),
+            pick(self.warm_up_dps),
+        )
 
 
-def _gauss_markov(m: int, step_s: float, time_constant_s: float, variance: float,
-                  rng: np.random.Generator) -> np.ndarray:
+def _gauss_markov(
+    m: int, step_s: float, time_constant_s: float, variance: float, rng: np.random.Generator
+) -> np.ndarray:
     """A stationary first-order Gauss-Markov process of ``m`` samples ``step_s`` apart."""
     phi = math.exp(-step_s / time_constant_s)
     drive = rng.standard_normal(m) * math.sqrt(variance * -math.expm1(-2.0 * step_s / time_constant_s))
@@ -445,8 +484,14 @@ def _gauss_markov(m: int, step_s: float, time_constant_s: float, variance: float
     return lfilter([1.0], [1.0, -phi], drive)
 
 
-def flicker_bank(n: int, rate_hz: float, bias_instability_deg_per_h: float, rng: np.random.Generator,
-                 shortest_s: float | None = None, longest_s: float | None = None) -> np.ndarray:
+def flicker_bank(
+    n: int,
+    rate_hz: float,
+    bias_instability_deg_per_h: float,
+    rng: np.random.Generator,
+    shortest_s: float | None = None,
+    longest_s: float | None = None,
+) -> np.ndarray:
     """Flicker (bias instability) noise [deg/s] from a bank of Gauss-Markov processes (see module doc).
 
     Processes whose correlation time spans more than ``GM_STEPS_PER_TIME_CONSTANT`` samples are
@@ -504,13 +549,14 @@ def smooth_process(n: int, rate_hz: float, time_constant_s: float, rng: np.rando
     burn = int(math.ceil(10 * time_constant_s / step))
     m = int(math.ceil((n - 1) * dt / step)) + 1
     phi = math.exp(-step / time_constant_s)
-    drive = rng.standard_normal(burn + m) * math.sqrt((1 - phi ** 2) ** 3 / (1 + phi ** 2))
+    drive = rng.standard_normal(burn + m) * math.sqrt((1 - phi**2) ** 3 / (1 + phi**2))
     coarse = lfilter([1.0], [1.0, -phi], lfilter([1.0], [1.0, -phi], drive))[burn:]
     return np.interp(np.arange(n) * dt, np.arange(m) * step, coarse)
 
 
-def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random.Generator,
-                   structure_degc: np.ndarray | None = None) -> NoiseTruth:
+def simulate_noise(
+    n: int, rate_hz: float, model: GyroErrorModel, rng: np.random.Generator, structure_degc: np.ndarray | None = None
+) -> NoiseTruth:
     """Draw the random errors of every axis (without quantization, which depends on the output); the
     non-repeatable drift's temperature part reads ``structure_degc`` [degC] (the reference temperature where it is
     not given)."""
@@ -528,18 +574,22 @@ def simulate_noise(n: int, rate_hz: float, model: GyroErrorModel, rng: np.random
     drift = warm_up = None
     if model.run_drift_dps > 0 or model.run_tempco_sigma_dps_per_degc > 0:
         above = np.zeros(n) if structure_degc is None else np.asarray(structure_degc, dtype=float) - model.t_ref_degc
-        drift = np.column_stack([
-            model.run_drift_dps * smooth_process(n, rate_hz, model.run_drift_time_s, rng)
-            + model.run_tempco_sigma_dps_per_degc * smooth_process(n, rate_hz, model.run_drift_time_s, rng) * above
-            for _ in range(k)])
+        drift = np.column_stack(
+            [
+                model.run_drift_dps * smooth_process(n, rate_hz, model.run_drift_time_s, rng)
+                + model.run_tempco_sigma_dps_per_degc * smooth_process(n, rate_hz, model.run_drift_time_s, rng) * above
+                for _ in range(k)
+            ]
+        )
     if model.warm_up_sigma_dps > 0:
         amplitude = rng.standard_normal(k) * model.warm_up_sigma_dps
         warm_up = np.outer(np.exp(-np.arange(n) / rate_hz / model.warm_up_time_s), amplitude)
     return NoiseTruth(white, flicker, walk, None, drift, warm_up)
 
 
-def structure_temperature(model: GyroErrorModel, time_s: np.ndarray, temperature_degc: np.ndarray,
-                          rate_hz: float) -> np.ndarray:
+def structure_temperature(
+    model: GyroErrorModel, time_s: np.ndarray, temperature_degc: np.ndarray, rate_hz: float
+) -> np.ndarray:
     """Temperature of the MEMS structure [degC]: the reported temperature through the thermal lag."""
     lagged, _ = thermal_lag(time_s, temperature_degc, model.thermal_time_constant_s, period_s=1.0 / rate_hz)
     return lagged

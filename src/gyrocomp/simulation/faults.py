@@ -53,14 +53,14 @@ def inject(columns: dict[str, np.ndarray], fault: str, rng: np.random.Generator)
     elif fault == "gaps":
         keep = np.ones(n, dtype=bool)
         for start in rng.choice(np.arange(n // 10, n - n // 10), 4, replace=False):
-            keep[start:start + n // 80] = False
+            keep[start : start + n // 80] = False
         out = {k: v[keep] for k, v in out.items()}
     elif fault == "rail":
         rate_hz = 1.0 / float(np.median(np.diff(out["time"])))
         width = max(3, int(2 * rate_hz))
         for start in rng.choice(np.arange(n // 10, n - n // 10), 3, replace=False):
             axis = gyro[int(rng.integers(len(gyro)))]
-            out[axis][start:start + width] += rng.choice([-1.0, 1.0]) * 400.0
+            out[axis][start : start + width] += rng.choice([-1.0, 1.0]) * 400.0
         for axis in gyro:
             np.clip(out[axis], -RAIL_DPS, RAIL_DPS, out=out[axis])
     elif fault == "motion":
@@ -69,7 +69,7 @@ def inject(columns: dict[str, np.ndarray], fault: str, rng: np.random.Generator)
         start = int(rng.integers(n // 10, max(n // 10 + 1, n - width - n // 10)))
         axis = gyro[int(rng.integers(len(gyro)))]
         phase = np.arange(min(width, n - start)) / max(width, 1)
-        out[axis][start:start + width] += rng.uniform(20.0, 60.0) * np.sin(2 * math.pi * 3 * phase)
+        out[axis][start : start + width] += rng.uniform(20.0, 60.0) * np.sin(2 * math.pi * 3 * phase)
     elif fault == "time-back":
         half = n // 2
         out["time"][half:] -= out["time"][half] - out["time"][0]

@@ -61,8 +61,13 @@ def _adxrs450() -> Preset:
         temperature_quantization_degc=0.2,
         accelerometer=None,
     )
-    return Preset("adxrs450", "Analog Devices ADXRS450: single-axis, strong linear tempco, "
-                  "hysteresis on cooling between 55 and 80 degC, 25 deg/h class", model, (-30.0, 80.0))
+    return Preset(
+        "adxrs450",
+        "Analog Devices ADXRS450: single-axis, strong linear tempco, "
+        "hysteresis on cooling between 55 and 80 degC, 25 deg/h class",
+        model,
+        (-30.0, 80.0),
+    )
 
 
 def _mti10() -> Preset:
@@ -92,11 +97,19 @@ def _mti10() -> Preset:
         quantization_dps=450.0 / 32768.0,
         temperature_noise_degc=0.05,
         temperature_quantization_degc=0.0625,
-        accelerometer=AccelErrorModel(bias_g=(0.005, -0.003, 0.004), bias_tempco_g_per_degc=(1e-4, -1e-4, 1.5e-4),
-                                      noise_density_g_per_sqrt_hz=80e-6, quantization_g=1.6e-4),
+        accelerometer=AccelErrorModel(
+            bias_g=(0.005, -0.003, 0.004),
+            bias_tempco_g_per_degc=(1e-4, -1e-4, 1.5e-4),
+            noise_density_g_per_sqrt_hz=80e-6,
+            quantization_g=1.6e-4,
+        ),
     )
-    return Preset("mti10", "Xsens MTi-10 raw output: 3-axis, ~0.05 deg/s drift over -25..90 degC, "
-                  "g-sensitivity ~0.005 deg/s/g, 18 deg/h", model, (-25.0, 90.0))
+    return Preset(
+        "mti10",
+        "Xsens MTi-10 raw output: 3-axis, ~0.05 deg/s drift over -25..90 degC, g-sensitivity ~0.005 deg/s/g, 18 deg/h",
+        model,
+        (-25.0, 90.0),
+    )
 
 
 def _adis16488() -> Preset:
@@ -123,8 +136,12 @@ def _adis16488() -> Preset:
         temperature_quantization_degc=0.00565,
         accelerometer=AccelErrorModel(bias_g=(0.001, -0.001, 0.0005), noise_density_g_per_sqrt_hz=63e-6),
     )
-    return Preset("adis16488", "Analog Devices ADIS16488A: 0.26 deg/sqrt(h), 5.1 deg/h, small residual "
-                  "tempco, g-sensitivity ~0.01 deg/s/g", model, (-20.0, 50.0))
+    return Preset(
+        "adis16488",
+        "Analog Devices ADIS16488A: 0.26 deg/sqrt(h), 5.1 deg/h, small residual tempco, g-sensitivity ~0.01 deg/s/g",
+        model,
+        (-20.0, 50.0),
+    )
 
 
 def _consumer() -> Preset:
@@ -152,11 +169,19 @@ def _consumer() -> Preset:
         quantization_dps=1.0 / 131.0,
         temperature_noise_degc=0.1,
         temperature_quantization_degc=1.0,
-        accelerometer=AccelErrorModel(bias_g=(0.02, -0.015, 0.03), bias_tempco_g_per_degc=(3.5e-4, -3.5e-4, 7.5e-4),
-                                      noise_density_g_per_sqrt_hz=400e-6, quantization_g=1.0 / 16384.0),
+        accelerometer=AccelErrorModel(
+            bias_g=(0.02, -0.015, 0.03),
+            bias_tempco_g_per_degc=(3.5e-4, -3.5e-4, 7.5e-4),
+            noise_density_g_per_sqrt_hz=400e-6,
+            quantization_g=1.0 / 16384.0,
+        ),
     )
-    return Preset("consumer", "MPU-6050/BMI-class consumer part: large tempco, whole-degree temperature, "
-                  "0.1 deg/s/g", model, (-20.0, 70.0))
+    return Preset(
+        "consumer",
+        "MPU-6050/BMI-class consumer part: large tempco, whole-degree temperature, 0.1 deg/s/g",
+        model,
+        (-20.0, 70.0),
+    )
 
 
 def _drifting() -> Preset:
@@ -183,8 +208,13 @@ def _drifting() -> Preset:
         warm_up_time_s=300.0,
         accelerometer=None,
     )
-    return Preset("drifting", "consumer-class triad with the non-repeatable drift and warm-up of a real chamber log, "
-                  "one curve heating and cooling", model, (-20.0, 70.0))
+    return Preset(
+        "drifting",
+        "consumer-class triad with the non-repeatable drift and warm-up of a real chamber log, "
+        "one curve heating and cooling",
+        model,
+        (-20.0, 70.0),
+    )
 
 
 PRESETS: dict[str, Preset] = {p.name: p for p in (_adxrs450(), _mti10(), _adis16488(), _consumer(), _drifting())}

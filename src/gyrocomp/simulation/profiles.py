@@ -82,9 +82,11 @@ def _check_memory(n_samples: int, duration_s: float, rate_hz: float) -> None:
     need = n_samples * SIMULATION_BYTES_PER_SAMPLE
     have = _memory_bytes()
     if have is not None and need > have:
-        raise InputError(f"duration_s: {duration_s:g} s at rate_hz={rate_hz:g} is {n_samples:.3g} samples, about "
-                         f"{need / 1e9:.3g} GB to simulate, more than this machine's {have / 1e9:.3g} GB; "
-                         "shorten duration_s= or lower rate_hz=")
+        raise InputError(
+            f"duration_s: {duration_s:g} s at rate_hz={rate_hz:g} is {n_samples:.3g} samples, about "
+            f"{need / 1e9:.3g} GB to simulate, more than this machine's {have / 1e9:.3g} GB; "
+            "shorten duration_s= or lower rate_hz="
+        )
 
 
 @dataclass(frozen=True)
@@ -231,7 +233,8 @@ class Profile:
             temperature = np.full(n, float(self.set_points_degc[0]))
         elif self.name in ("warmup", "field"):
             temperature = self.set_points_degc[0] + self.warmup_rise_degc * -np.expm1(
-                -time_s / self.warmup_time_constant_s)
+                -time_s / self.warmup_time_constant_s
+            )
         else:
             knots_t, knots_T = self._temperature_knots()
             temperature = np.interp(time_s * stretch, knots_t, knots_T)
@@ -239,16 +242,24 @@ class Profile:
         rate = np.zeros((n, 3))
         recorded = np.ones(n, dtype=bool)
         if self.name == "field":
-            field_motion(time_s, self.position_s / stretch, self.move_s / stretch, self.positions_g[0],
-                         np.random.default_rng(self.motion_seed), force, rate)
+            field_motion(
+                time_s,
+                self.position_s / stretch,
+                self.move_s / stretch,
+                self.positions_g[0],
+                np.random.default_rng(self.motion_seed),
+                force,
+                rate,
+            )
         elif self.name in ("static", "warmup", "chamber", "cycle") and len(self.positions_g) == 1:
             force[:] = self.positions_g[0]
         else:
             self._fill_motion(time_s * stretch, stretch, force, rate, recorded)
         return Trajectory(time_s, temperature, force, rate, recorded)
 
-    def _fill_motion(self, profile_t: np.ndarray, stretch: float, force: np.ndarray, rate: np.ndarray,
-                     recorded: np.ndarray) -> None:
+    def _fill_motion(
+        self, profile_t: np.ndarray, stretch: float, force: np.ndarray, rate: np.ndarray, recorded: np.ndarray
+    ) -> None:
         start = 0.0
         segs = self._segments()
         for k, (length, f0, f1, rec) in enumerate(segs):
@@ -287,8 +298,15 @@ FIELD_ACCELERATION_G = 0.3
 FIELD_TURN_S = 20.0
 
 
-def field_motion(time_s: np.ndarray, still_s: float, move_s: float, start_g: tuple[float, float, float],
-                 rng: np.random.Generator, force: np.ndarray, rate: np.ndarray) -> np.ndarray:
+def field_motion(
+    time_s: np.ndarray,
+    still_s: float,
+    move_s: float,
+    start_g: tuple[float, float, float],
+    rng: np.random.Generator,
+    force: np.ndarray,
+    rate: np.ndarray,
+) -> np.ndarray:
     """Fill ``force`` [g] and ``rate`` [deg/s] with a field log's motion: still for ``still_s``, then moving for
     ``move_s``, in turn, from ``start_g``. A move is a series of turns of at most FIELD_TURN_S seconds, each about
     a random axis by up to FIELD_TURN_DEG with a smooth start and stop (angle Phi (tau - sin(2 pi tau) / (2 pi)),
@@ -312,8 +330,16 @@ def field_motion(time_s: np.ndarray, still_s: float, move_s: float, start_g: tup
     return still
 
 
-def _turn(t: np.ndarray, start: float, length: float, gravity: np.ndarray, rng: np.random.Generator,
-          force: np.ndarray, rate: np.ndarray, where: np.ndarray) -> np.ndarray:
+def _turn(
+    t: np.ndarray,
+    start: float,
+    length: float,
+    gravity: np.ndarray,
+    rng: np.random.Generator,
+    force: np.ndarray,
+    rate: np.ndarray,
+    where: np.ndarray,
+) -> np.ndarray:
     """One smooth turn of a field move (see :func:`field_motion`); returns the gravity direction after it."""
     tau = (t - start) / length
     axis = rng.standard_normal(3)
@@ -323,11 +349,16 @@ def _turn(t: np.ndarray, start: float, length: float, gravity: np.ndarray, rng: 
     push = rng.standard_normal(3)
     push *= rng.uniform(0, FIELD_ACCELERATION_G) / np.linalg.norm(push)
     m = t.size
-    force[where] = (_rotate(gravity, axis, angle) + np.outer(np.sin(np.pi * tau), push)
-                    + rng.standard_normal((m, 3)) * FIELD_VIBRATION_G)
+    force[where] = (
+        _rotate(gravity, axis, angle)
+        + np.outer(np.sin(np.pi * tau), push)
+        + rng.standard_normal((m, 3)) * FIELD_VIBRATION_G
+    )
     # df/dt = -omega x f, as in _fill_motion: omega = -(d angle / dt) axis
-    rate[where] = (-np.degrees(turn * (1 - np.cos(2 * np.pi * tau)) / length)[:, None] * axis
-                   + rng.standard_normal((m, 3)) * FIELD_VIBRATION_DPS)
+    rate[where] = (
+        -np.degrees(turn * (1 - np.cos(2 * np.pi * tau)) / length)[:, None] * axis
+        + rng.standard_normal((m, 3)) * FIELD_VIBRATION_DPS
+    )
     return _rotate(gravity, axis, np.array([turn]))[0]
 
 
@@ -357,13 +388,28 @@ def _profiles() -> dict[str, Profile]:
         "chamber": Profile("chamber", set_points_degc=cold_hot),
         "cycle": Profile("cycle", set_points_degc=cold_hot, cycles=2),
         "tumble": Profile("tumble", set_points_degc=(25.0,), positions_g=tumble_positions()),
-        "combined": Profile("combined", set_points_degc=cold_hot, cycles=1, ramp_rate_degc_per_min=0.5,
-                            dwell_s=1800.0, position_s=240.0, move_s=60.0, positions_g=tumble_positions((1.0, 0.0, -1.0))),
-        "ratetable": Profile("ratetable", set_points_degc=(25.0,), position_s=60.0,
-                             rates_dps=(10.0, -10.0, 100.0, -100.0)),
+        "combined": Profile(
+            "combined",
+            set_points_degc=cold_hot,
+            cycles=1,
+            ramp_rate_degc_per_min=0.5,
+            dwell_s=1800.0,
+            position_s=240.0,
+            move_s=60.0,
+            positions_g=tumble_positions((1.0, 0.0, -1.0)),
+        ),
+        "ratetable": Profile(
+            "ratetable", set_points_degc=(25.0,), position_s=60.0, rates_dps=(10.0, -10.0, 100.0, -100.0)
+        ),
         # a field log: powered on at room temperature, warming by self-heating, still 2 minutes then moving 4
-        "field": Profile("field", set_points_degc=(20.0,), warmup_rise_degc=25.0, warmup_time_constant_s=900.0,
-                         position_s=120.0, move_s=240.0),
+        "field": Profile(
+            "field",
+            set_points_degc=(20.0,),
+            warmup_rise_degc=25.0,
+            warmup_time_constant_s=900.0,
+            position_s=120.0,
+            move_s=240.0,
+        ),
     }
 
 

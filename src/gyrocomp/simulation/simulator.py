@@ -51,6 +51,8 @@ def run_profiles(profile: Profile, runs: int) -> list[Profile]:
         return [profile] * runs
     points = profile.set_points_degc
     return [dataclasses.replace(profile, set_points_degc=(points[i % len(points)],)) for i in range(runs)]
+
+
 #: the parts of the deterministic error, in the order they are listed in the truth
 COMPONENTS = ("temperature", "hysteresis", "acceleration", "scale_misalignment", "temperature_rate")
 
@@ -162,9 +164,19 @@ def resolve_profile(profile: str | Profile, preset: str | None = None, **overrid
     return get_profile(profile, **overrides)
 
 
-def _accelerometer(acc: AccelErrorModel, force: np.ndarray, structure: np.ndarray, t_ref: float, rate_hz: float,
-                   rng: np.random.Generator) -> np.ndarray:
-    out = force @ acc.sensitivity.T + np.asarray(acc.bias_g) + np.outer(structure - t_ref, np.asarray(acc.bias_tempco_g_per_degc))
+def _accelerometer(
+    acc: AccelErrorModel,
+    force: np.ndarray,
+    structure: np.ndarray,
+    t_ref: float,
+    rate_hz: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    out = (
+        force @ acc.sensitivity.T
+        + np.asarray(acc.bias_g)
+        + np.outer(structure - t_ref, np.asarray(acc.bias_tempco_g_per_degc))
+    )
     if acc.scale_misalignment_per_degc is not None:
         out = out + (structure - t_ref)[:, None] * (force @ acc.sensitivity_per_degc.T)
     if acc.noise_density_g_per_sqrt_hz > 0:
@@ -178,18 +190,31 @@ def truth_document(runs: list[tuple[str, "Simulation"]]) -> dict:
     per_run = ("seed", "turn_on_bias_dps", "samples", "deterministic_error_range_dps")
     first = runs[0][1].truth.to_dict()
     doc = {k: v for k, v in first.items() if k not in per_run}
-    doc["runs"] = [{"file": name, "seed": sim.truth.seed, "samples": sim.recording.n_samples,
-                    "turn_on_bias_dps": sim.truth.to_dict()["turn_on_bias_dps"],
-                    "deterministic_error_range_dps": sim.truth.to_dict()["deterministic_error_range_dps"]}
-                   for name, sim in runs]
+    doc["runs"] = [
+        {
+            "file": name,
+            "seed": sim.truth.seed,
+            "samples": sim.recording.n_samples,
+            "turn_on_bias_dps": sim.truth.to_dict()["turn_on_bias_dps"],
+            "deterministic_error_range_dps": sim.truth.to_dict()["deterministic_error_range_dps"],
+        }
+        for name, sim in runs
+    ]
     return doc
 
 
 # Over 60 lines on purpose: the simulation in the order the physics happens (trajectory, temperatures, each
 # error term, sensor output, truth), each step a call; the docstring is a third of it.
-def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profile = "chamber",
-             duration_s: float | None = None, rate_hz: float = 100.0, seed: int = 0, unit: int | None = None,
-             source: str | None = None) -> Simulation:
+def simulate(
+    model: GyroErrorModel | str | None = None,
+    *,
+    profile: str | Profile = "chamber",
+    duration_s: float | None = None,
+    rate_hz: float = 100.0,
+    seed: int = 0,
+    unit: int | None = None,
+    source: str | None = None,
+) -> Simulation:
     """Simulate one power-on of a gyro through a test profile.
 
     Parameters
@@ -247,20 +272,60 @@ def simulate(model: GyroErrorModel | str | None = None, *, profile: str | Profil
 
     keep = traj.recorded if not traj.recorded.all() else slice(None)
     src = source or f"simulated:{preset_name or 'model'}:{prof.name}:seed{seed}"
-    rec = Recording(time_s=traj.time_s[keep], gyro_dps=gyro[keep], gyro_axes=model.axes,
-                    temperature_degc=temperature[keep], accel_g=None if accel is None else accel[keep],
-                    accel_axes=ACCEL_AXES if accel is not None else (), source=src,
-                    reference_rate_dps=traj.angular_rate_dps[keep] if prof.name == "ratetable" else None,
-                    metadata={"simulated": True, "preset": preset_name, "seed": seed, "unit": unit})
-    truth = Truth(model, prof, seed, float(rate_hz), prof.total_duration_s, turn_on,
-                  {name: c[keep] for name, c in components.items()}, noise.take(keep), true_rate[keep],
-                  traj.temperature_degc[keep], structure[keep], traj.specific_force_g[keep],
-                  preset=preset_name, unit=unit)
+    rec = Recording(
+        time_s=traj.time_s[keep],
+        gyro_dps=gyro[keep],
+        gyro_axes=model.axes,
+        temperature_degc=temperature[keep],
+        accel_g=None if accel is None else accel[keep],
+        accel_axes=ACCEL_AXES if accel is not None else (),
+        source=src,
+        reference_rate_dps=traj.angular_rate_dps[keep] if prof.name == "ratetable" else None,
+        metadata={"simulated": True, "preset": preset_name, "seed": seed, "unit": unit},
+    )
+    truth = Truth(
+        model,
+        prof,
+        seed,
+        float(rate_hz),
+        prof.total_duration_s,
+        turn_on,
+        {name: c[keep] for name, c in components.items()},
+        noise.take(keep),
+        true_rate[keep],
+        traj.temperature_degc[keep],
+        structure[keep],
+        traj.specific_force_g[keep],
+        preset=preset_name,
+        unit=unit,
+    )
     return Simulation(rec, truth)
 
 
-__all__ = ["AccelErrorModel", "COMPONENTS", "ONE_TEMPERATURE_PROFILES", "GyroErrorModel", "Hysteresis", "NoiseTruth", "PRESETS", "PROFILES",
-           "PROFILE_PARAMETERS", "Preset", "Profile", "Simulation", "Trajectory", "Truth", "changed_profile", "flicker_bank",
-           "get_preset", "get_profile",
-           "preset_model", "resolve_profile", "run_profiles", "simulate", "simulate_noise", "truth_document",
-           "tumble_positions"]
+__all__ = [
+    "AccelErrorModel",
+    "COMPONENTS",
+    "ONE_TEMPERATURE_PROFILES",
+    "GyroErrorModel",
+    "Hysteresis",
+    "NoiseTruth",
+    "PRESETS",
+    "PROFILES",
+    "PROFILE_PARAMETERS",
+    "Preset",
+    "Profile",
+    "Simulation",
+    "Trajectory",
+    "Truth",
+    "changed_profile",
+    "flicker_bank",
+    "get_preset",
+    "get_profile",
+    "preset_model",
+    "resolve_profile",
+    "run_profiles",
+    "simulate",
+    "simulate_noise",
+    "truth_document",
+    "tumble_positions",
+]

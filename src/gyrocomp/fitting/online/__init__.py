@@ -71,16 +71,54 @@ Limits: a steady rotation about gravity looks still to any detector, and only th
 catches it, so a power-on whose first still piece turns slowly keeps a wrong constant; the lag is one of the
 candidates (no finer); hysteresis is not modelled.
 """
+
 from __future__ import annotations
 
 from .blocks import block_statistics
 from .calibrator import OnlineCalibrator
 from .replay import RATE_TOLERANCE, replay
-from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, MIN_OUTLIER_DOF,
-                       MIN_SESSION_POINTS, MIN_STEPS, MIN_TILT_G, PIECE_SPREAD_WEIGHT, POINTS_PER_TILT, POOL_PIECES,
-                       T_REF_DEGC, T_SCALE_DEGC, LearnerSettings, LearnerStatus, ReplayedLog, chi2_quantile)
+from .settings import (
+    GAP_PERIODS,
+    GYRO_AXES,
+    LEARNER_FORMAT,
+    LEARNER_SCHEMA_VERSION,
+    LEVEL_GROWTH,
+    MIN_OUTLIER_DOF,
+    MIN_SESSION_POINTS,
+    MIN_STEPS,
+    MIN_TILT_G,
+    PIECE_SPREAD_WEIGHT,
+    POINTS_PER_TILT,
+    POOL_PIECES,
+    T_REF_DEGC,
+    T_SCALE_DEGC,
+    LearnerSettings,
+    LearnerStatus,
+    ReplayedLog,
+    chi2_quantile,
+)
 
-__all__ = ["GAP_PERIODS", "GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LEVEL_GROWTH", "MIN_OUTLIER_DOF",
-           "MIN_SESSION_POINTS", "MIN_STEPS", "MIN_TILT_G", "PIECE_SPREAD_WEIGHT", "POINTS_PER_TILT", "POOL_PIECES",
-           "RATE_TOLERANCE", "T_REF_DEGC", "T_SCALE_DEGC", "LearnerSettings", "LearnerStatus", "ReplayedLog",
-           "OnlineCalibrator", "block_statistics", "chi2_quantile", "replay"]
+__all__ = [
+    "GAP_PERIODS",
+    "GYRO_AXES",
+    "LEARNER_FORMAT",
+    "LEARNER_SCHEMA_VERSION",
+    "LEVEL_GROWTH",
+    "MIN_OUTLIER_DOF",
+    "MIN_SESSION_POINTS",
+    "MIN_STEPS",
+    "MIN_TILT_G",
+    "PIECE_SPREAD_WEIGHT",
+    "POINTS_PER_TILT",
+    "POOL_PIECES",
+    "RATE_TOLERANCE",
+    "T_REF_DEGC",
+    "T_SCALE_DEGC",
+    "LearnerSettings",
+    "LearnerStatus",
+    "ReplayedLog",
+    "OnlineCalibrator",
+    "block_statistics",
+    "chi2_quantile",
+    "replay",
+]

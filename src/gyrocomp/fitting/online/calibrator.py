@@ -22,9 +22,26 @@ from ...motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY
 from ..base import provenance
 from ...curves.polynomial import PolynomialCurve
 from .state import _record_to_dict, _restore, check_state_target
-from .settings import (GAP_PERIODS, GYRO_AXES, LEARNER_FORMAT, LEARNER_SCHEMA_VERSION, LEVEL_GROWTH, LINEAGE_KEPT,
-                       LearnerSettings, LearnerStatus, ReplayedLog, MIN_OUTLIER_DOF, MIN_SESSION_POINTS, MIN_STEPS,
-                       PIECE_SPREAD_WEIGHT, POOL_PIECES, T_REF_DEGC, T_SCALE_DEGC, _MAD_TO_SIGMA, chi2_quantile)
+from .settings import (
+    GAP_PERIODS,
+    GYRO_AXES,
+    LEARNER_FORMAT,
+    LEARNER_SCHEMA_VERSION,
+    LEVEL_GROWTH,
+    LINEAGE_KEPT,
+    LearnerSettings,
+    LearnerStatus,
+    ReplayedLog,
+    MIN_OUTLIER_DOF,
+    MIN_SESSION_POINTS,
+    MIN_STEPS,
+    PIECE_SPREAD_WEIGHT,
+    POOL_PIECES,
+    T_REF_DEGC,
+    T_SCALE_DEGC,
+    _MAD_TO_SIGMA,
+    chi2_quantile,
+)
 from .refit import _curve, _design, _forward, _matrix, _tilted, _weighted_fit
 from .blocks import _fresh_dequantizer, _quantile, block_statistics
 
@@ -52,7 +69,7 @@ class OnlineCalibrator:
         self._z = s.z_values()
         self._noise_factor = (self._w - 2) / chi2_quantile(self._z["noise"], self._w - 2)
         self._bounds = {c: chi2_quantile(self._z[f"variance{c}"], self._w - 2) / (self._w - 2) for c in (3, 6)}
-        self._ceiling = np.array([MAX_GYRO_NOISE_DENSITY ** 2] * 3 + [MAX_ACCEL_NOISE_DENSITY ** 2] * 3) * s.rate_hz
+        self._ceiling = np.array([MAX_GYRO_NOISE_DENSITY**2] * 3 + [MAX_ACCEL_NOISE_DENSITY**2] * 3) * s.rate_hz
         self._lags = len(s.lag_candidates_s)
         self._init_stream()
         self._init_points(s.max_points)
@@ -166,8 +183,10 @@ class OnlineCalibrator:
         previous = self._last_t if self._last_t is not None else t[0] - 1.0 / self.settings.rate_hz
         steps = np.diff(np.concatenate([[previous], t]))
         if np.any(steps <= 0):
-            raise InputError(f"time_s: does not increase at sample {int(np.flatnonzero(steps <= 0)[0])} of this "
-                             f"chunk ({t[np.flatnonzero(steps <= 0)[0]]!r} s after {previous!r} s)")
+            raise InputError(
+                f"time_s: does not increase at sample {int(np.flatnonzero(steps <= 0)[0])} of this "
+                f"chunk ({t[np.flatnonzero(steps <= 0)[0]]!r} s after {previous!r} s)"
+            )
         self._accel = has_accel
         if self._last_t is None:
             self._t0 = float(t[0])
@@ -221,10 +240,11 @@ class OnlineCalibrator:
                 if end > first + 1:
                     a = nominal[k]
                     if tau > 0:
-                        y[first + 1:end, k] = lazy_lfilter([a], [1.0, -(1.0 - a)], x[first + 1:end],
-                                                           zi=[(1.0 - a) * state[k]])[0]
+                        y[first + 1 : end, k] = lazy_lfilter(
+                            [a], [1.0, -(1.0 - a)], x[first + 1 : end], zi=[(1.0 - a) * state[k]]
+                        )[0]
                     else:
-                        y[first + 1:end, k] = x[first + 1:end]
+                        y[first + 1 : end, k] = x[first + 1 : end]
                     state[k] = y[end - 1, k]
         self._lag_state = state
         self._lag_t = float(t[good[-1]])
@@ -242,8 +262,8 @@ class OnlineCalibrator:
         where = np.flatnonzero(x != previous)
         crossing = (x[where] + previous[where]) / 2.0
         half = np.abs(x[where] - previous[where]) / 2.0
-        prior_c = np.concatenate([[state_c], crossing])[:where.size]
-        prior_t = np.concatenate([[dq["time"]], t[where]])[:where.size]
+        prior_c = np.concatenate([[state_c], crossing])[: where.size]
+        prior_t = np.concatenate([[dq["time"]], t[where]])[: where.size]
         known = ~np.isnan(prior_c)
         rates = np.zeros(where.size)
         rates[known] = (crossing[known] - prior_c[known]) / (t[where][known] - prior_t[known])
@@ -257,8 +277,9 @@ class OnlineCalibrator:
             out = np.where(np.isnan(c_k), x, np.minimum(np.maximum(c_k + r_k * (t - t_k), x - h_k), x + h_k))
         out[where] = crossing
         if where.size:
-            dq.update(crossing=float(crossing[-1]), time=float(t[where[-1]]), rate=float(rates[-1]),
-                      half=float(half[-1]))
+            dq.update(
+                crossing=float(crossing[-1]), time=float(t[where[-1]]), rate=float(rates[-1]), half=float(half[-1])
+            )
         dq["previous"] = float(x[-1])
         return out
 
@@ -268,16 +289,18 @@ class OnlineCalibrator:
         i = 0
         if self._fill:
             take = min(w - self._fill, rows.shape[0])
-            self._buffer[self._fill:self._fill + take] = rows[:take]
+            self._buffer[self._fill : self._fill + take] = rows[:take]
             self._fill += take
             i = take
             if self._fill < w:
                 return
-            self._blocks(self._buffer[None], clocks[i - 1:i])
+            self._blocks(self._buffer[None], clocks[i - 1 : i])
             self._fill = 0
         whole = (rows.shape[0] - i) // w
         if whole:
-            self._blocks(rows[i:i + whole * w].reshape(whole, w, rows.shape[1]), clocks[i + w - 1:i + whole * w:w])
+            self._blocks(
+                rows[i : i + whole * w].reshape(whole, w, rows.shape[1]), clocks[i + w - 1 : i + whole * w : w]
+            )
             i += whole * w
         rest = rows.shape[0] - i
         if rest:
@@ -312,8 +335,14 @@ class OnlineCalibrator:
                 quiet = False
             elif self._level[c] > 0 and var[c] > self._level[c] * self._bounds[channels]:
                 quiet = False
-        record = {"mean": mean, "temperature": temperature, "quiet": quiet, "linked": linked, "agree": True,
-                  "still": False}
+        record = {
+            "mean": mean,
+            "temperature": temperature,
+            "quiet": quiet,
+            "linked": linked,
+            "agree": True,
+            "still": False,
+        }
         previous = self._recent[-1] if self._recent and linked else None
         if previous is not None:
             record["agree"] = self._agree(previous, record, channels)
@@ -358,7 +387,7 @@ class OnlineCalibrator:
         first = int(counts[0])
         if first and np.all(counts[:channels] == first):
             return _quantile(ring[:first, :channels], q)
-        return np.array([_quantile(ring[:int(counts[c]), c], q) if counts[c] else np.nan for c in range(channels)])
+        return np.array([_quantile(ring[: int(counts[c]), c], q) if counts[c] else np.nan for c in range(channels)])
 
     def _interior(self, block: dict, interior: bool, now: float) -> None:
         s = self.settings
@@ -380,15 +409,21 @@ class OnlineCalibrator:
     def _close_piece(self, now: float | None = None) -> None:
         if self._piece_bin >= 0 and self._run_s >= self.settings.min_still_s:
             samples = self._piece[-1]
-            self._commit(self._piece_bin, self._piece[:3] / samples, self._piece[3:6] / samples,
-                         self._piece[6:-1] / samples,
-                         samples / self.settings.rate_hz, self._clock if now is None else now)
+            self._commit(
+                self._piece_bin,
+                self._piece[:3] / samples,
+                self._piece[3:6] / samples,
+                self._piece[6:-1] / samples,
+                samples / self.settings.rate_hz,
+                self._clock if now is None else now,
+            )
         self._piece[:] = 0.0
         self._piece_bin = -1
 
     # ---------------------------------------------------------------- pieces, bins, the model
-    def _commit(self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float,
-                now: float) -> None:
+    def _commit(
+        self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float, now: float
+    ) -> None:
         s = self.settings
         if np.any(np.abs(bias) > s.max_bias_dps):
             self._counts["rejected_bound"] += 1
@@ -399,8 +434,11 @@ class OnlineCalibrator:
             return
         if self._residual is not None:  # the scatter of accepted pieces about the model, a running mean square
             square = self._residual * self._residual
-            self._piece_var = square if np.isnan(self._piece_var[0]) else \
-                (1.0 - PIECE_SPREAD_WEIGHT) * self._piece_var + PIECE_SPREAD_WEIGHT * square
+            self._piece_var = (
+                square
+                if np.isnan(self._piece_var[0])
+                else (1.0 - PIECE_SPREAD_WEIGHT) * self._piece_var + PIECE_SPREAD_WEIGHT * square
+            )
         self._store(bin_index, bias, accel, temperature, seconds, now)
         self._refit(now)
         # the session's points judged again by the model they made: a bad first piece, accepted while its
@@ -408,8 +446,16 @@ class OnlineCalibrator:
         mine = np.flatnonzero(self._pt_session == self._session)
         bad = [i for i in mine if self._is_outlier(self._pt_bias[i], self._pt_accel[i], self._pt_t[i])]
         if bad:
-            dropped = [(int(self._pt_bin[i]), self._pt_bias[i].copy(), self._pt_accel[i].copy(), self._pt_t[i].copy(),
-                        float(self._pt_s[i])) for i in bad]
+            dropped = [
+                (
+                    int(self._pt_bin[i]),
+                    self._pt_bias[i].copy(),
+                    self._pt_accel[i].copy(),
+                    self._pt_t[i].copy(),
+                    float(self._pt_s[i]),
+                )
+                for i in bad
+            ]
             self._counts["rejected_outliers"] += len(bad)
             self._counts["still_s"] -= float(self._pt_s[bad].sum())
             self._pt_session[bad] = 0
@@ -417,8 +463,9 @@ class OnlineCalibrator:
             for piece in dropped:
                 self._to_pool(*piece, now)
 
-    def _to_pool(self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float,
-                 now: float) -> None:
+    def _to_pool(
+        self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float, now: float
+    ) -> None:
         """A rejected piece (or a dropped point) into the session's pool; the pool replaces the session's points
         when it outvotes them."""
         self._pool = (self._pool + [(bin_index, bias, accel, temperature, seconds)])[-POOL_PIECES:]
@@ -431,8 +478,9 @@ class OnlineCalibrator:
         points, not the pieces, were wrong (the power-on began with a slow turn)."""
         if len(self._pool) < MIN_SESSION_POINTS or self._degree < 0:
             return False
-        offsets = np.array([bias - self._shape(temps[self._lag_index]) - self._g @ accel
-                            for _, bias, accel, temps, _ in self._pool])
+        offsets = np.array(
+            [bias - self._shape(temps[self._lag_index]) - self._g @ accel for _, bias, accel, temps, _ in self._pool]
+        )
         limit = np.maximum(self.settings.outlier_dps, self.settings.outlier_sigmas * self._rms)
         if np.any(np.abs(offsets - np.median(offsets, axis=0)) > limit):
             return False
@@ -449,8 +497,9 @@ class OnlineCalibrator:
         self._pool = []
         self._refit(now)
 
-    def _store(self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float,
-               now: float) -> None:
+    def _store(
+        self, bin_index: int, bias: np.ndarray, accel: np.ndarray, temperature: np.ndarray, seconds: float, now: float
+    ) -> None:
         """A piece into its bin's point of this session, or a new point."""
         self._counts["still_s"] += seconds
         same = np.flatnonzero((self._pt_session == self._session) & (self._pt_bin == bin_index))
@@ -477,8 +526,9 @@ class OnlineCalibrator:
     def _decay(self, age_s: float) -> float:
         return 2.0 ** (-age_s / (self.settings.half_life_h * 3600.0))
 
-    def _is_outlier(self, bias: np.ndarray, accel: np.ndarray, temperatures: np.ndarray, *,
-                    piece: bool = False) -> bool:
+    def _is_outlier(
+        self, bias: np.ndarray, accel: np.ndarray, temperatures: np.ndarray, *, piece: bool = False
+    ) -> bool:
         """Whether a piece (``piece``: judged with the pieces' own scatter, which a point's averaging hides) or a
         point lies beyond the outlier limit (see the module, step 6); a judged piece's residual is kept in
         ``self._residual``."""
@@ -492,14 +542,14 @@ class OnlineCalibrator:
         points = np.flatnonzero(self._pt_session == self._session)
         if points.size < MIN_SESSION_POINTS or mine.size == 0 or self._dof < MIN_OUTLIER_DOF:
             return False  # the session's constant is not known robustly yet, or the model is too young to judge
-        predicted, spread2 = shape + self._session_offset(points), self._rms ** 2
+        predicted, spread2 = shape + self._session_offset(points), self._rms**2
         if piece and not np.isnan(self._piece_var[0]):
             spread2 = np.maximum(spread2, self._piece_var)
         sessions = np.zeros(self._sessions.size)
         sessions[mine[0]] = 1.0
         # the model's own uncertainty there: s^2 x' (X'WX)^-1 x, s^2 = rms^2 sum(w) / n
         u = (min(max(temperature, self._t_range[0]), self._t_range[1]) - T_REF_DEGC) / T_SCALE_DEGC
-        x = np.concatenate([[u ** k for k in range(1, self._degree + 1)], accel[self._tilted], sessions])
+        x = np.concatenate([[u**k for k in range(1, self._degree + 1)], accel[self._tilted], sessions])
         z = _forward(self._lower, x)
         spread2 = spread2 + self._scale2 * float(z @ z)
         # past the temperatures the model has seen it cannot judge a piece closely: the bias may move by up to
@@ -514,8 +564,11 @@ class OnlineCalibrator:
         """This session's constant, robustly: the median of its points' offsets from the curve (kept until the
         model or the points change: every change is followed by a refit, which forgets it)."""
         if self._offset_cache is None or self._offset_cache[0] != self._session:
-            offsets = self._pt_bias[points] - self._shape(self._pt_t[points, self._lag_index]) \
+            offsets = (
+                self._pt_bias[points]
+                - self._shape(self._pt_t[points, self._lag_index])
                 - self._pt_accel[points] @ self._g.T
+            )
             self._offset_cache = (self._session, np.median(offsets, axis=0))
         return self._offset_cache[1]
 
@@ -549,8 +602,16 @@ class OnlineCalibrator:
             # every candidate lag, the one leaving the smallest weighted residual kept (the first of equals)
             solution, chosen = None, -1
             for k in range(self._lags):
-                fit = _weighted_fit(self._pt_t[used, k], accel, tilted, self._pt_session[used], sessions,
-                                    self._pt_bias[used], weights, degree)
+                fit = _weighted_fit(
+                    self._pt_t[used, k],
+                    accel,
+                    tilted,
+                    self._pt_session[used],
+                    sessions,
+                    self._pt_bias[used],
+                    weights,
+                    degree,
+                )
                 if fit is not None and (solution is None or fit[-1] < solution[-1]):
                     solution, chosen = fit, k
             if solution is not None or degree == 0:
@@ -590,13 +651,18 @@ class OnlineCalibrator:
     def mark_saved(self) -> None:
         """The current model was saved: ``should_save`` turns false until it changes enough again."""
         if self._degree >= 0:
-            self._saved = {"degree": self._degree, "coef": self._coef.copy(), "t_range": self._t_range,
-                           "constant": self._constants.mean(axis=0)}
+            self._saved = {
+                "degree": self._degree,
+                "coef": self._coef.copy(),
+                "t_range": self._t_range,
+                "constant": self._constants.mean(axis=0),
+            }
         self._should_save = False
 
     # ---------------------------------------------------------------- results
-    def bias_dps(self, temperature_degc, accel_g=None, *, session: Literal["current", "mean"] = "current"
-                 ) -> np.ndarray:
+    def bias_dps(
+        self, temperature_degc, accel_g=None, *, session: Literal["current", "mean"] = "current"
+    ) -> np.ndarray:
         """The learned bias [deg/s] (..., 3) at ``temperature_degc`` [degC] (the temperature the model reads:
         through its lag, :attr:`lag_time_constant_s`) and specific force ``accel_g`` (..., 3) [g] (None: no
         g-sensitivity term): the curve plus this session's constant (``"current"``, when it has one; else the
@@ -633,20 +699,33 @@ class OnlineCalibrator:
         filled = self._pt_session > 0
         has = self._degree >= 0
         return LearnerStatus(
-            sessions=self._session, points=int(filled.sum()), still_s=float(self._counts["still_s"]),
-            rejected_bound=self._counts["rejected_bound"], rejected_outliers=self._counts["rejected_outliers"],
-            stale_dropped=self._counts["stale_dropped"], degree=self._degree,
+            sessions=self._session,
+            points=int(filled.sum()),
+            still_s=float(self._counts["still_s"]),
+            rejected_bound=self._counts["rejected_bound"],
+            rejected_outliers=self._counts["rejected_outliers"],
+            stale_dropped=self._counts["stale_dropped"],
+            degree=self._degree,
             lag_time_constant_s=self.lag_time_constant_s,
-            t_min_degc=self._t_range[0] if has else None, t_max_degc=self._t_range[1] if has else None,
-            rms_dps=tuple(float(v) for v in self._rms), uncertainty_dps=self._uncertainty(),
-            should_save=self.should_save)
+            t_min_degc=self._t_range[0] if has else None,
+            t_max_degc=self._t_range[1] if has else None,
+            rms_dps=tuple(float(v) for v in self._rms),
+            uncertainty_dps=self._uncertainty(),
+            should_save=self.should_save,
+        )
 
     def _uncertainty(self) -> tuple[float, float, float]:
         used = np.flatnonzero(self._pt_session > 0)
         if self._degree < 0:
             return (math.inf,) * 3
-        design = _design(self._pt_t[used, self._lag_index], self._pt_accel[used], self._tilted, self._pt_session[used],
-                         self._sessions, self._degree)
+        design = _design(
+            self._pt_t[used, self._lag_index],
+            self._pt_accel[used],
+            self._tilted,
+            self._pt_session[used],
+            self._sessions,
+            self._degree,
+        )
         sessions = self._sessions.size
         if used.size <= design.shape[1]:
             return (math.inf,) * 3
@@ -658,9 +737,14 @@ class OnlineCalibrator:
         leverage = np.einsum("ij,ij->i", at, np.linalg.solve(normal, at.T).T) * weights.sum() / used.size
         return tuple(float(r * math.sqrt(leverage.max())) for r in self._rms)
 
-    def to_calibration(self, *, model: str = "online", require_curve: bool = True,
-                       axes: Iterable[str] = GYRO_AXES, contributions: Iterable[ReplayedLog] = ()
-                       ) -> Calibration:
+    def to_calibration(
+        self,
+        *,
+        model: str = "online",
+        require_curve: bool = True,
+        axes: Iterable[str] = GYRO_AXES,
+        contributions: Iterable[ReplayedLog] = (),
+    ) -> Calibration:
         """The learned model as a model file's :class:`Calibration` (the curve continued along its tangent past
         the range seen, its lag, the g-sensitivity, the sessions' constants as turn-on biases); ``gyrocomp apply``
         takes it, for ``axes`` (those the logs had); ``contributions`` (from :func:`replay`) are listed in its
@@ -670,13 +754,17 @@ class OnlineCalibrator:
         if not axes or any(a not in GYRO_AXES for a in axes):
             raise InputError(f"axes: some of {', '.join(GYRO_AXES)}, got {axes!r}")
         if self._degree < 0:
-            raise NotFittedError("the learner has no model yet: it has seen no still piece long enough "
-                                 f"({self.settings.min_still_s:g} s) in {self._session} log(s)")
+            raise NotFittedError(
+                "the learner has no model yet: it has seen no still piece long enough "
+                f"({self.settings.min_still_s:g} s) in {self._session} log(s)"
+            )
         if require_curve and self._degree == 0:
             used = self._pt_session > 0
             low, high = float(self._pt_t[used, 0].min()), float(self._pt_t[used, 0].max())
-            raise InputError(f"the still data of {self._session} log(s) cover {low:.1f}..{high:.1f} degC; a "
-                             f"temperature model needs at least {self.settings.min_span_degc:g} degC (min_span_degc)")
+            raise InputError(
+                f"the still data of {self._session} log(s) cover {low:.1f}..{high:.1f} degC; a "
+                f"temperature model needs at least {self.settings.min_span_degc:g} degC (min_span_degc)"
+            )
         low, high = self._t_range
         out = {}
         for j, name in enumerate(GYRO_AXES):
@@ -684,55 +772,121 @@ class OnlineCalibrator:
                 continue
             curve = None
             if self._degree > 0:
-                curve = PolynomialCurve(tuple(float(c) for c in self._coef[j, :self._degree]), T_REF_DEGC,
-                                       T_SCALE_DEGC, low, high, extrapolation="linear")
+                curve = PolynomialCurve(
+                    tuple(float(c) for c in self._coef[j, : self._degree]),
+                    T_REF_DEGC,
+                    T_SCALE_DEGC,
+                    low,
+                    high,
+                    extrapolation="linear",
+                )
             g = tuple(float(v) for v in self._g[j]) if self._tilted.any() else None
-            out[name] = AxisCalibration(temperature=curve, g_sensitivity_dps_per_g=g,
-                                         lag_time_constant_s=self.lag_time_constant_s,
-                                         turn_on_biases=tuple(float(c) for c in self._constants[:, j]))
+            out[name] = AxisCalibration(
+                temperature=curve,
+                g_sensitivity_dps_per_g=g,
+                lag_time_constant_s=self.lag_time_constant_s,
+                turn_on_biases=tuple(float(c) for c in self._constants[:, j]),
+            )
         status = self.status
-        report = {"method": "online learner", "sessions": status.sessions, "points": status.points,
-                  "still_s": status.still_s, "degree": self._degree,
-                  "rejected": status.rejected_bound + status.rejected_outliers,
-                  "settings": self.settings.to_dict()}
+        report = {
+            "method": "online learner",
+            "sessions": status.sessions,
+            "points": status.points,
+            "still_s": status.still_s,
+            "degree": self._degree,
+            "rejected": status.rejected_bound + status.rejected_outliers,
+            "settings": self.settings.to_dict(),
+        }
         origin = provenance([])
-        origin["inputs"] = [{"file": Path(c.source).name, "duration_s": c.duration_s, "still_s": c.still_s,
-                             "rejected_pieces": c.rejected} for c in contributions]
+        origin["inputs"] = [
+            {
+                "file": Path(c.source).name,
+                "duration_s": c.duration_s,
+                "still_s": c.still_s,
+                "rejected_pieces": c.rejected,
+            }
+            for c in contributions
+        ]
         return Calibration(axes=out, model=model, provenance=origin, fit_report=report)
 
     # ---------------------------------------------------------------- state as JSON
     def to_dict(self) -> dict[str, Any]:
         """The whole state (a learner loaded from it continues exactly where this one is)."""
         return {
-            "format": LEARNER_FORMAT, "schema_version": LEARNER_SCHEMA_VERSION,
+            "format": LEARNER_FORMAT,
+            "schema_version": LEARNER_SCHEMA_VERSION,
             "settings": self.settings.to_dict(),
-            "stream": {"session": self._session, "accel": self._accel, "buffer": self._buffer[:self._fill].tolist(),
-                       "last_t": self._last_t, "t0": self._t0, "base_clock": self._base_clock,
-                       "clock": self._clock, "broken": self._broken, "lag_state_degc": self._lag_state.tolist(),
-                       "lag_t": self._lag_t, "dequantizer": dict(self._dq),
-                       "recent": [_record_to_dict(r) for r in self._recent]},
-            "noise": {"var_ring": self._var_ring.tolist(), "var_count": self._var_count.tolist(),
-                      "ring_pos": self._ring_pos.tolist(), "step_ring": self._step_ring.tolist(),
-                      "step_count": self._step_count.tolist(), "step_pos": self._step_pos.tolist(),
-                      "level": [None if math.isnan(v) else float(v) for v in self._level]},
-            "piece": {"run_s": self._run_s, "sums": self._piece.tolist(), "bin": self._piece_bin,
-                      "pool": [{"bin": b, "bias_dps": list(map(float, bias)), "accel_g": list(map(float, accel)),
-                                "temperature_degc": list(map(float, temps)), "still_s": float(sec)}
-                               for b, bias, accel, temps, sec in self._pool]},
-            "points": {"bias_dps": self._pt_bias.tolist(), "temperature_degc": self._pt_t.tolist(),
-                     "accel_g": self._pt_accel.tolist(),
-                     "still_s": self._pt_s.tolist(), "clock_s": self._pt_clock.tolist(),
-                     "session": self._pt_session.tolist(), "bin": self._pt_bin.tolist()},
-            "model": {"degree": self._degree, "coef": self._coef.tolist(), "g_dps_per_g": self._g.tolist(),
-                      "tilted": self._tilted.tolist(), "sessions": self._sessions.tolist(),
-                      "constants_dps": self._constants.tolist(), "rms_dps": self._rms.tolist(),
-                      "t_range_degc": list(self._t_range), "should_save": self._should_save,
-                      "lag_index": self._lag_index, "dof": self._dof, "lower": self._lower.tolist(),
-                      "piece_var": [None if math.isnan(v) else float(v) for v in self._piece_var],
-                      "scale2": self._scale2.tolist(),
-                      "saved": None if self._saved is None else {
-                          "degree": self._saved["degree"], "coef": self._saved["coef"].tolist(),
-                          "t_range": list(self._saved["t_range"]), "constant": self._saved["constant"].tolist()}},
+            "stream": {
+                "session": self._session,
+                "accel": self._accel,
+                "buffer": self._buffer[: self._fill].tolist(),
+                "last_t": self._last_t,
+                "t0": self._t0,
+                "base_clock": self._base_clock,
+                "clock": self._clock,
+                "broken": self._broken,
+                "lag_state_degc": self._lag_state.tolist(),
+                "lag_t": self._lag_t,
+                "dequantizer": dict(self._dq),
+                "recent": [_record_to_dict(r) for r in self._recent],
+            },
+            "noise": {
+                "var_ring": self._var_ring.tolist(),
+                "var_count": self._var_count.tolist(),
+                "ring_pos": self._ring_pos.tolist(),
+                "step_ring": self._step_ring.tolist(),
+                "step_count": self._step_count.tolist(),
+                "step_pos": self._step_pos.tolist(),
+                "level": [None if math.isnan(v) else float(v) for v in self._level],
+            },
+            "piece": {
+                "run_s": self._run_s,
+                "sums": self._piece.tolist(),
+                "bin": self._piece_bin,
+                "pool": [
+                    {
+                        "bin": b,
+                        "bias_dps": list(map(float, bias)),
+                        "accel_g": list(map(float, accel)),
+                        "temperature_degc": list(map(float, temps)),
+                        "still_s": float(sec),
+                    }
+                    for b, bias, accel, temps, sec in self._pool
+                ],
+            },
+            "points": {
+                "bias_dps": self._pt_bias.tolist(),
+                "temperature_degc": self._pt_t.tolist(),
+                "accel_g": self._pt_accel.tolist(),
+                "still_s": self._pt_s.tolist(),
+                "clock_s": self._pt_clock.tolist(),
+                "session": self._pt_session.tolist(),
+                "bin": self._pt_bin.tolist(),
+            },
+            "model": {
+                "degree": self._degree,
+                "coef": self._coef.tolist(),
+                "g_dps_per_g": self._g.tolist(),
+                "tilted": self._tilted.tolist(),
+                "sessions": self._sessions.tolist(),
+                "constants_dps": self._constants.tolist(),
+                "rms_dps": self._rms.tolist(),
+                "t_range_degc": list(self._t_range),
+                "should_save": self._should_save,
+                "lag_index": self._lag_index,
+                "dof": self._dof,
+                "lower": self._lower.tolist(),
+                "piece_var": [None if math.isnan(v) else float(v) for v in self._piece_var],
+                "scale2": self._scale2.tolist(),
+                "saved": None
+                if self._saved is None
+                else {
+                    "degree": self._saved["degree"],
+                    "coef": self._saved["coef"].tolist(),
+                    "t_range": list(self._saved["t_range"]),
+                    "constant": self._saved["constant"].tolist(),
+                },
+            },
             "counts": dict(self._counts),
             "lineage": list(self._lineage),
         }
@@ -741,10 +895,12 @@ class OnlineCalibrator:
     def from_dict(cls, d: Any, source: str = "<dict>") -> "OnlineCalibrator":
         """A learner from :meth:`to_dict`'s output, every field checked."""
         if not isinstance(d, dict) or d.get("format") != LEARNER_FORMAT:
-            raise InputError(f"{source}: not a gyrocomp learner state (no \"format\": \"{LEARNER_FORMAT}\")")
+            raise InputError(f'{source}: not a gyrocomp learner state (no "format": "{LEARNER_FORMAT}")')
         if d.get("schema_version") != LEARNER_SCHEMA_VERSION:
-            raise InputError(f"{source}: learner state schema {d.get('schema_version')!r}; this gyrocomp reads "
-                             f"{LEARNER_SCHEMA_VERSION}")
+            raise InputError(
+                f"{source}: learner state schema {d.get('schema_version')!r}; this gyrocomp reads "
+                f"{LEARNER_SCHEMA_VERSION}"
+            )
         try:
             return _restore(cls, d)
         except InputError as exc:

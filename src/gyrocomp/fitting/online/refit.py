@@ -10,6 +10,7 @@ import numpy as np
 from ...errors import InputError
 from .settings import MIN_TILT_G, POINTS_PER_TILT, T_REF_DEGC, T_SCALE_DEGC, _RIDGE
 
+
 def _matrix(values, rows: int, name: str) -> np.ndarray:
     try:
         out = np.asarray(values, dtype=float)
@@ -50,10 +51,16 @@ def _tilted(accel: np.ndarray, point_sessions: np.ndarray, sessions: np.ndarray,
     return out
 
 
-def _design(temps: np.ndarray, accel: np.ndarray, tilted: np.ndarray, bin_sessions: np.ndarray, sessions: np.ndarray,
-            degree: int) -> np.ndarray:
+def _design(
+    temps: np.ndarray,
+    accel: np.ndarray,
+    tilted: np.ndarray,
+    bin_sessions: np.ndarray,
+    sessions: np.ndarray,
+    degree: int,
+) -> np.ndarray:
     u = (temps - T_REF_DEGC) / T_SCALE_DEGC
-    columns = [u ** k for k in range(1, degree + 1)]
+    columns = [u**k for k in range(1, degree + 1)]
     columns += [accel[:, k] for k in range(3) if tilted[k]]
     columns += [(bin_sessions == s).astype(float) for s in sessions]
     return np.column_stack(columns)

@@ -89,10 +89,15 @@ class LearnerSettings:
         if isinstance(lags, (str, bytes)) or not hasattr(lags, "__len__"):
             raise InputError(f"lag_candidates_s: expected a list of time constants [s], got {lags!r}")
         lags = tuple(lags)
-        if not 1 <= len(lags) <= 8 or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in lags) \
-                or lags[0] != 0 or any(not (math.isfinite(v) and v > 0) for v in lags[1:]):
-            raise InputError(f"lag_candidates_s: 1 to 8 time constants [s], the first 0 and the rest positive, got "
-                             f"{list(lags)!r}")
+        if (
+            not 1 <= len(lags) <= 8
+            or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in lags)
+            or lags[0] != 0
+            or any(not (math.isfinite(v) and v > 0) for v in lags[1:])
+        ):
+            raise InputError(
+                f"lag_candidates_s: 1 to 8 time constants [s], the first 0 and the rest positive, got {list(lags)!r}"
+            )
         object.__setattr__(self, "lag_candidates_s", tuple(float(v) for v in lags))
         for f in fields(self):
             if f.name == "lag_candidates_s":
@@ -100,19 +105,38 @@ class LearnerSettings:
             value = getattr(self, f.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise InputError(f"{f.name}: expected a finite number, got {value!r}")
-        positive = ("rate_hz", "block_s", "min_still_s", "piece_s", "bin_width_degc", "half_life_h", "stale_h",
-                    "max_bias_dps", "outlier_dps", "outlier_sigmas", "max_tempco_dps_per_degc", "save_change_dps")
+        positive = (
+            "rate_hz",
+            "block_s",
+            "min_still_s",
+            "piece_s",
+            "bin_width_degc",
+            "half_life_h",
+            "stale_h",
+            "max_bias_dps",
+            "outlier_dps",
+            "outlier_sigmas",
+            "max_tempco_dps_per_degc",
+            "save_change_dps",
+        )
         for name in positive:
             if not getattr(self, name) > 0:
                 raise InputError(f"{name}: must be positive, got {getattr(self, name):.6g}")
         # what the learner holds in memory grows with these: bounded, so a state file cannot ask for gigabytes
-        for name, high in (("rate_hz", 4e4), ("block_s", 60.0), ("min_still_s", 3600.0), ("piece_s", 3600.0),
-                           ("bin_width_degc", 50.0)):
+        for name, high in (
+            ("rate_hz", 4e4),
+            ("block_s", 60.0),
+            ("min_still_s", 3600.0),
+            ("piece_s", 3600.0),
+            ("bin_width_degc", 50.0),
+        ):
             if getattr(self, name) > high:
                 raise InputError(f"{name}: at most {high:g}, got {getattr(self, name):.6g}")
         if self.rate_hz * self.block_s > 1e6:
-            raise InputError(f"block_s: {self.block_s:.6g} s at rate_hz={self.rate_hz:.6g} is "
-                             f"{self.rate_hz * self.block_s:.3g} samples a block; at most 1e6")
+            raise InputError(
+                f"block_s: {self.block_s:.6g} s at rate_hz={self.rate_hz:.6g} is "
+                f"{self.rate_hz * self.block_s:.3g} samples a block; at most 1e6"
+            )
         if not 0 < self.alpha < 0.5:
             raise InputError(f"alpha: must lie in (0, 0.5), got {self.alpha}")
         if not 0 < self.noise_quantile < 0.5:
@@ -128,8 +152,10 @@ class LearnerSettings:
         if self.bins > 1000:
             raise InputError(f"bin_width_degc: {self.bins} bins from t_low_degc to t_high_degc; at most 1000")
         if not self.cubic_span_degc >= self.min_span_degc >= 0:
-            raise InputError("cubic_span_degc and min_span_degc: need cubic_span_degc >= min_span_degc >= 0, got "
-                             f"{self.cubic_span_degc} and {self.min_span_degc}")
+            raise InputError(
+                "cubic_span_degc and min_span_degc: need cubic_span_degc >= min_span_degc >= 0, got "
+                f"{self.cubic_span_degc} and {self.min_span_degc}"
+            )
 
     @property
     def block_samples(self) -> int:
@@ -196,4 +222,23 @@ class ReplayedLog:
     temperature_max_degc: float
 
 
-__all__ = ["GAP_PERIODS", "GYRO_AXES", "LEARNER_FORMAT", "LEARNER_SCHEMA_VERSION", "LEVEL_GROWTH", "LearnerSettings", "LearnerStatus", "ReplayedLog", "MIN_OUTLIER_DOF", "MIN_SESSION_POINTS", "MIN_STEPS", "MIN_TILT_G", "PIECE_SPREAD_WEIGHT", "POINTS_PER_TILT", "POOL_PIECES", "T_REF_DEGC", "T_SCALE_DEGC", "chi2_quantile"]
+__all__ = [
+    "GAP_PERIODS",
+    "GYRO_AXES",
+    "LEARNER_FORMAT",
+    "LEARNER_SCHEMA_VERSION",
+    "LEVEL_GROWTH",
+    "LearnerSettings",
+    "LearnerStatus",
+    "ReplayedLog",
+    "MIN_OUTLIER_DOF",
+    "MIN_SESSION_POINTS",
+    "MIN_STEPS",
+    "MIN_TILT_G",
+    "PIECE_SPREAD_WEIGHT",
+    "POINTS_PER_TILT",
+    "POOL_PIECES",
+    "T_REF_DEGC",
+    "T_SCALE_DEGC",
+    "chi2_quantile",
+]

@@ -16,6 +16,7 @@ from ...errors import InputError
 from ...measures.plausibility import TEMPERATURE_RANGE_DEGC
 from .settings import LEARNER_FORMAT, LINEAGE_KEPT, POOL_PIECES, LearnerSettings
 
+
 def check_state_target(path: str | os.PathLike, lineage: tuple[str, ...]) -> None:
     """Refuse to save a learner whose lineage (the ids of the saved states it goes on from, its own last) is
     ``lineage`` over ``path`` when that file holds a learner state not among them: another learner resumed the same
@@ -32,10 +33,12 @@ def check_state_target(path: str | os.PathLike, lineage: tuple[str, ...]) -> Non
     theirs = other.get("lineage")
     theirs = theirs[-1] if isinstance(theirs, list) and theirs and isinstance(theirs[-1], str) else None
     if theirs is None or theirs not in lineage:
-        raise InputError(f"{path}: holds another learner's state, one this learner does not go on from (another "
-                         "learner resumed the same state and saved here first, or it started afresh); nothing "
-                         "written, so that neither loses what it learned: resume from that state, or save to "
-                         "another file")
+        raise InputError(
+            f"{path}: holds another learner's state, one this learner does not go on from (another "
+            "learner resumed the same state and saved here first, or it started afresh); nothing "
+            "written, so that neither loses what it learned: resume from that state, or save to "
+            "another file"
+        )
 
 
 def _record_to_dict(record: dict) -> dict:
@@ -53,8 +56,9 @@ STATE_MAGNITUDE_MAX = 1e12
 STATE_TEMPERATURE_MAX_DEGC = max(abs(t) for t in TEMPERATURE_RANGE_DEGC)
 
 
-def _finite_array(values, shape: tuple | None, name: str, *, allow_nan: bool = False,
-                  bound: float = STATE_MAGNITUDE_MAX) -> np.ndarray:
+def _finite_array(
+    values, shape: tuple | None, name: str, *, allow_nan: bool = False, bound: float = STATE_MAGNITUDE_MAX
+) -> np.ndarray:
     try:
         out = np.array(values, dtype=float)
     except (TypeError, ValueError, OverflowError):
@@ -65,8 +69,9 @@ def _finite_array(values, shape: tuple | None, name: str, *, allow_nan: bool = F
         raise InputError(f"{name}: holds a non-finite number")
     finite = out[np.isfinite(out)]
     if finite.size and np.max(np.abs(finite)) > bound:
-        raise InputError(f"{name}: holds {float(finite[np.argmax(np.abs(finite))]):.3g}, beyond the {bound:g} a "
-                         "learner state holds")
+        raise InputError(
+            f"{name}: holds {float(finite[np.argmax(np.abs(finite))]):.3g}, beyond the {bound:g} a learner state holds"
+        )
     return out
 
 
@@ -91,11 +96,16 @@ def _restore(cls, d: dict) -> Any:
     _restore_points(self, d["points"])
     _restore_model(self, d["model"])
     counts = d["counts"]
-    self._counts = {"still_s": float(counts["still_s"]),
-                    **{k: int(counts[k]) for k in ("rejected_bound", "rejected_outliers", "stale_dropped")}}
+    self._counts = {
+        "still_s": float(counts["still_s"]),
+        **{k: int(counts[k]) for k in ("rejected_bound", "rejected_outliers", "stale_dropped")},
+    }
     lineage = d.get("lineage", [])  # absent in states written before 0.2: no ancestors known
-    if not isinstance(lineage, list) or len(lineage) > LINEAGE_KEPT or \
-            not all(isinstance(i, str) and re.fullmatch(r"[0-9a-f]{32}", i) for i in lineage):
+    if (
+        not isinstance(lineage, list)
+        or len(lineage) > LINEAGE_KEPT
+        or not all(isinstance(i, str) and re.fullmatch(r"[0-9a-f]{32}", i) for i in lineage)
+    ):
         raise InputError(f"lineage: up to {LINEAGE_KEPT} state ids (32 hexadecimal digits) expected")
     self._lineage = tuple(lineage)
     return self
@@ -103,7 +113,7 @@ def _restore(cls, d: dict) -> Any:
 
 def _restore_stream(self, stream: dict, piece: dict) -> None:
     w = self._w
-    self._session = int(_whole_array(stream["session"], "stream.session", 0, 10 ** 9)[0])
+    self._session = int(_whole_array(stream["session"], "stream.session", 0, 10**9)[0])
     self._accel = None if stream["accel"] is None else bool(stream["accel"])
     buffer = _finite_array(stream["buffer"], None, "stream.buffer", allow_nan=True)
     if buffer.size % (6 + self._lags):
@@ -112,36 +122,49 @@ def _restore_stream(self, stream: dict, piece: dict) -> None:
     if buffer.shape[0] >= w:
         raise InputError(f"stream.buffer: {buffer.shape[0]} samples; a block holds {w}")
     self._fill = buffer.shape[0]
-    self._buffer[:self._fill] = buffer
+    self._buffer[: self._fill] = buffer
     self._last_t = None if stream["last_t"] is None else _scalar(stream["last_t"], "stream.last_t")
     self._t0, self._base_clock, self._clock = (_scalar(stream[k], f"stream.{k}") for k in ("t0", "base_clock", "clock"))
     self._broken = bool(stream["broken"])
-    self._lag_state = _finite_array(stream["lag_state_degc"], (self._lags,), "stream.lag_state_degc",
-                                    bound=STATE_TEMPERATURE_MAX_DEGC)
+    self._lag_state = _finite_array(
+        stream["lag_state_degc"], (self._lags,), "stream.lag_state_degc", bound=STATE_TEMPERATURE_MAX_DEGC
+    )
     self._lag_t = None if stream["lag_t"] is None else _scalar(stream["lag_t"], "stream.lag_t")
     dq = stream["dequantizer"]
-    self._dq = {"previous": None if dq["previous"] is None else _scalar(dq["previous"], "stream.dequantizer"),
-                "crossing": None if dq["crossing"] is None else _scalar(dq["crossing"], "stream.dequantizer"),
-                **{k: _scalar(dq[k], "stream.dequantizer") for k in ("time", "rate", "half")}}
+    self._dq = {
+        "previous": None if dq["previous"] is None else _scalar(dq["previous"], "stream.dequantizer"),
+        "crossing": None if dq["crossing"] is None else _scalar(dq["crossing"], "stream.dequantizer"),
+        **{k: _scalar(dq[k], "stream.dequantizer") for k in ("time", "rate", "half")},
+    }
     self._recent = []
     for rec in stream["recent"][-3:]:
         restored = {k: bool(rec[k]) for k in ("still", "linked")}
         if "mean" in rec:
-            restored.update(mean=_finite_array(rec["mean"], (6,), "stream.recent.mean"),
-                            temperature=_finite_array(rec["temperature"], (self._lags,), "stream.recent.temperature",
-                                                      bound=STATE_TEMPERATURE_MAX_DEGC),
-                            quiet=bool(rec["quiet"]), agree=bool(rec["agree"]))
+            restored.update(
+                mean=_finite_array(rec["mean"], (6,), "stream.recent.mean"),
+                temperature=_finite_array(
+                    rec["temperature"], (self._lags,), "stream.recent.temperature", bound=STATE_TEMPERATURE_MAX_DEGC
+                ),
+                quiet=bool(rec["quiet"]),
+                agree=bool(rec["agree"]),
+            )
         self._recent.append(restored)
     self._run_s = _scalar(piece["run_s"], "piece.run_s")
     self._piece = _finite_array(piece["sums"], (7 + self._lags,), "piece.sums")
     bins = int(2 * STATE_TEMPERATURE_MAX_DEGC / self.settings.bin_width_degc) + 1
     self._piece_bin = int(_whole_array(piece["bin"], "piece.bin", -bins, bins)[0])
-    self._pool = [(int(_whole_array(p["bin"], "piece.pool.bin", -bins, bins)[0]),
-                   _finite_array(p["bias_dps"], (3,), "piece.pool.bias_dps"),
-                   _finite_array(p["accel_g"], (3,), "piece.pool.accel_g"),
-                   _finite_array(p["temperature_degc"], (self._lags,), "piece.pool.temperature_degc",
-                                 bound=STATE_TEMPERATURE_MAX_DEGC),
-                   _scalar(p["still_s"], "piece.pool.still_s")) for p in piece["pool"][-POOL_PIECES:]]
+    self._pool = [
+        (
+            int(_whole_array(p["bin"], "piece.pool.bin", -bins, bins)[0]),
+            _finite_array(p["bias_dps"], (3,), "piece.pool.bias_dps"),
+            _finite_array(p["accel_g"], (3,), "piece.pool.accel_g"),
+            _finite_array(
+                p["temperature_degc"], (self._lags,), "piece.pool.temperature_degc", bound=STATE_TEMPERATURE_MAX_DEGC
+            ),
+            _scalar(p["still_s"], "piece.pool.still_s"),
+        )
+        for p in piece["pool"][-POOL_PIECES:]
+    ]
 
 
 def _restore_noise(self, noise: dict) -> None:
@@ -153,15 +176,17 @@ def _restore_noise(self, noise: dict) -> None:
         if values.shape != (6,):
             raise InputError(f"noise.{name}: six whole numbers in 0..{r}")
         setattr(self, f"_{name}", values)
-    self._level = _finite_array([np.nan if v is None else v for v in noise["level"]], (len(noise["level"]),),
-                                "noise.level", allow_nan=True)
+    self._level = _finite_array(
+        [np.nan if v is None else v for v in noise["level"]], (len(noise["level"]),), "noise.level", allow_nan=True
+    )
 
 
 def _restore_points(self, points: dict) -> None:
     n = self.settings.max_points
     self._pt_bias = _finite_array(points["bias_dps"], (n, 3), "points.bias_dps")
-    self._pt_t = _finite_array(points["temperature_degc"], (n, self._lags), "points.temperature_degc",
-                               bound=STATE_TEMPERATURE_MAX_DEGC)
+    self._pt_t = _finite_array(
+        points["temperature_degc"], (n, self._lags), "points.temperature_degc", bound=STATE_TEMPERATURE_MAX_DEGC
+    )
     self._pt_accel = _finite_array(points["accel_g"], (n, 3), "points.accel_g")
     self._pt_s = _finite_array(points["still_s"], (n,), "points.still_s")
     self._pt_clock = _finite_array(points["clock_s"], (n,), "points.clock_s")
@@ -181,26 +206,35 @@ def _restore_model(self, model: dict) -> None:
     self._tilted = np.array([bool(v) for v in model["tilted"]], dtype=bool).reshape(3)
     self._sessions = _whole_array(model["sessions"], "model.sessions", 0, self._session).reshape(-1)
     constants = model["constants_dps"]
-    self._constants = _finite_array(constants if constants else np.zeros((0, 3)), (self._sessions.size, 3),
-                                    "model.constants_dps")
+    self._constants = _finite_array(
+        constants if constants else np.zeros((0, 3)), (self._sessions.size, 3), "model.constants_dps"
+    )
     self._rms = _finite_array(model["rms_dps"], (3,), "model.rms_dps")
-    self._t_range = tuple(_finite_array(model["t_range_degc"], (2,), "model.t_range_degc",
-                                        bound=STATE_TEMPERATURE_MAX_DEGC))
+    self._t_range = tuple(
+        _finite_array(model["t_range_degc"], (2,), "model.t_range_degc", bound=STATE_TEMPERATURE_MAX_DEGC)
+    )
     self._should_save = bool(model["should_save"])
     self._lag_index = int(model["lag_index"])
     self._dof = int(model["dof"])
-    self._piece_var = _finite_array([np.nan if v is None else v for v in model["piece_var"]], (3,), "model.piece_var",
-                                    allow_nan=True)
+    self._piece_var = _finite_array(
+        [np.nan if v is None else v for v in model["piece_var"]], (3,), "model.piece_var", allow_nan=True
+    )
     if not 0 <= self._lag_index < self._lags:
         raise InputError(f"model.lag_index: {self._lag_index} outside 0..{self._lags - 1}")
     p = 0 if self._degree < 0 else self._degree + int(self._tilted.sum()) + self._sessions.size
     self._lower = _finite_array(model["lower"], (p, p), "model.lower") if p else np.zeros((0, 0))
     self._scale2 = _finite_array(model["scale2"], (3,), "model.scale2")
     saved = model["saved"]
-    self._saved = None if saved is None else {
-        "degree": int(saved["degree"]), "coef": _finite_array(saved["coef"], (3, 3), "model.saved.coef"),
-        "t_range": tuple(float(v) for v in saved["t_range"]),
-        "constant": _finite_array(saved["constant"], (3,), "model.saved.constant")}
+    self._saved = (
+        None
+        if saved is None
+        else {
+            "degree": int(saved["degree"]),
+            "coef": _finite_array(saved["coef"], (3, 3), "model.saved.coef"),
+            "t_range": tuple(float(v) for v in saved["t_range"]),
+            "constant": _finite_array(saved["constant"], (3,), "model.saved.constant"),
+        }
+    )
 
 
 __all__ = ["STATE_MAGNITUDE_MAX", "STATE_TEMPERATURE_MAX_DEGC", "check_state_target"]
