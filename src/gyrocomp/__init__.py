@@ -57,7 +57,7 @@ _EXPORTS = {
     "rotation_errors": ("fitting.pose_rotation", "rotation_errors"),
     "find_poses": ("fitting.triad_fit", "find_poses"),
     "fit_accel_multiposition": ("fitting.triad_fit", "fit_accel_multiposition"),
-    "fit_gyro_rate_table": ("fitting.triad_fit", "fit_gyro_rate_table"),
+    "fit_gyro_rate_table": ("fitting.rate_table", "fit_gyro_rate_table"),
     "analyse_noise": ("measures.noise", "analyse_noise"),
     "Recording": ("recording", "Recording"),
     "simulate": ("simulation", "simulate"),

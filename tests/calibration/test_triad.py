@@ -20,14 +20,8 @@ from gyrocomp.export.c_code import c_sources
 from gyrocomp.io.schedule import apply_schedule, read_rate_schedule
 from gyrocomp.io.tables import read_table, write_recording
 from gyrocomp.models.fit import fit_channels
-from gyrocomp.fitting.triad_fit import (
-    Pose,
-    find_poses,
-    fit_accel_multiposition,
-    fit_gyro_rate_table,
-    rate_segments,
-    rq_upper,
-)
+from gyrocomp.fitting.rate_table import fit_gyro_rate_table, rate_segments
+from gyrocomp.fitting.triad_fit import Pose, find_poses, fit_accel_multiposition, rq_upper
 from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
 from gyrocomp.simulation import AccelErrorModel, GyroErrorModel, get_profile, preset_model, simulate, tumble_positions
 from gyrocomp.calibration.triad import TriadCalibration

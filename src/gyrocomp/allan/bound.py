@@ -143,6 +143,26 @@ def _columns(tau: np.ndarray, times: np.ndarray) -> np.ndarray:
     return np.column_stack([1.0 / tau, tau / 3.0, *(markov_allan_variance(tau, t) for t in times)])
 
 
+def _least_strengths(basis: np.ndarray) -> np.ndarray:
+    """The non-negative strengths of the model's terms that keep every row of ``basis`` @ x (the model's variance
+    over the bound's at each tau) at or above one, with the least sum of those ratios (a linear program)."""
+    scale = basis.max(axis=0)
+    scale[scale <= 0] = 1.0
+    a = basis / scale
+    from scipy.optimize import linprog  # scipy.optimize is slow to import: only the bound needs it here
+
+    solution = linprog(
+        a.sum(axis=0),
+        A_ub=-a,
+        b_ub=-np.ones(a.shape[0]) * (1 + BOUND_TOLERANCE),
+        bounds=[(0, None)] * a.shape[1],
+        method="highs",
+    )
+    if not solution.success:
+        raise InputError(f"data: no noise bound found ({solution.message})")
+    return solution.x / scale
+
+
 def bound_noise(
     curves: AllanResult | list[AllanResult],
     *,
@@ -180,23 +200,7 @@ def bound_noise(
     lo, hi = float(tau.min()), float(tau.max())
     count = int(math.ceil(MARKOV_PER_DECADE * math.log10(hi / lo))) + 1 if markov and hi > lo else 0
     times = np.geomspace(lo, hi, count) if count else np.empty(0)
-    target = high**2
-    basis = _columns(tau, times) / target[:, None]  # each row: the model's variance over the bound's
-    scale = basis.max(axis=0)
-    scale[scale <= 0] = 1.0
-    a = basis / scale
-    from scipy.optimize import linprog  # scipy.optimize is slow to import: only the bound needs it here
-
-    solution = linprog(
-        a.sum(axis=0),
-        A_ub=-a,
-        b_ub=-np.ones(tau.size) * (1 + BOUND_TOLERANCE),
-        bounds=[(0, None)] * a.shape[1],
-        method="highs",
-    )
-    if not solution.success:
-        raise InputError(f"data: no noise bound found ({solution.message})")
-    x = solution.x / scale
+    x = _least_strengths(_columns(tau, times) / (high**2)[:, None])
     model = np.sqrt(_columns(tau, times) @ x)
     ratio = model / dev
     terms = tuple((math.sqrt(q2 * t / 2.0), float(t)) for q2, t in zip(x[2:], times) if q2 > 0)

@@ -167,17 +167,7 @@ def allan_deviation(
     tau = ms / rate_hz
     counts = term_count(kind, phase.size, ms)
     deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
-    methods = ("",) * len(ms)
-    if confidence is None:
-        alphas = np.full(len(ms), np.nan)
-        edf = alphas.copy()
-    else:
-        if forced is None:
-            found = noise_types(kind, phase, ms)
-            alphas, methods = found.alpha, found.method
-        else:
-            alphas, methods = forced, ("given",) * len(ms)
-        edf = degrees_of_freedom(kind, alphas, ms, phase.size)
+    alphas, methods, edf = _noise_and_edf(kind, phase, ms, confidence, forced)
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(
         tau=tau,
@@ -191,6 +181,19 @@ def allan_deviation(
         confidence=math.nan if confidence is None else confidence,
         noise_method=methods,
     )
+
+
+def _noise_and_edf(kind: str, phase: np.ndarray, ms: np.ndarray, confidence: float | None, forced) -> tuple:
+    """Per averaging factor: the noise type's alpha (``forced``, or identified from ``phase``), how it was found,
+    and the equivalent degrees of freedom (NaN and empty without ``confidence``)."""
+    if confidence is None:
+        return np.full(len(ms), np.nan), ("",) * len(ms), np.full(len(ms), np.nan)
+    if forced is None:
+        found = noise_types(kind, phase, ms)
+        alphas, methods = found.alpha, found.method
+    else:
+        alphas, methods = forced, ("given",) * len(ms)
+    return alphas, methods, degrees_of_freedom(kind, alphas, ms, phase.size)
 
 
 def _noise_alpha(value, count: int) -> np.ndarray | None:

@@ -69,15 +69,7 @@ class Compensator:
             for j, a in enumerate(ACCEL_AXES)
             if (ax := calibration.accel_axes.get(a)) is not None and ax.temperature is not None
         ]
-        self._triad_columns = None
-        if calibration.gyro_triad is not None:
-            missing = [a for a in GYRO_AXES if a not in self.gyro_axes]
-            if missing:
-                raise InputError(
-                    f"{source}: the model corrects scale factor and misalignment across gyro_x, gyro_y "
-                    f"and gyro_z; the data has no {', '.join(missing)}"
-                )
-            self._triad_columns = [self.gyro_axes.index(a) for a in GYRO_AXES]
+        self._triad_columns = self._gyro_triad_columns()
         if not self._modelled and not self._accel_modelled and calibration.accel_triad is None:
             raise InputError(
                 f"{source}: the model covers {', '.join(calibration.axes)}, the data has "
@@ -104,6 +96,18 @@ class Compensator:
         # the block means of each modelled axis's output and of the error the model predicts for it
         # (and of the temperature: the direction of its change tells a branch the model lacks from a unit mistake)
         self._agreement_blocks = BlockMeans(2 * len(self._modelled) + 1)
+
+    def _gyro_triad_columns(self) -> list[int] | None:
+        """The data's columns of gyro_x, gyro_y and gyro_z when the model has a gyro triad (None otherwise)."""
+        if self.calibration.gyro_triad is None:
+            return None
+        missing = [a for a in GYRO_AXES if a not in self.gyro_axes]
+        if missing:
+            raise InputError(
+                f"{self.source}: the model corrects scale factor and misalignment across gyro_x, gyro_y "
+                f"and gyro_z; the data has no {', '.join(missing)}"
+            )
+        return [self.gyro_axes.index(a) for a in GYRO_AXES]
 
     def _model_temperature(self, key: str, ax, time_s: np.ndarray, temperature_degc: np.ndarray) -> np.ndarray:
         """The temperature the axis model reads: reported, or through the thermal lag (state carried)."""

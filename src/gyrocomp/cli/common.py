@@ -222,6 +222,14 @@ def float_list(text: str | None, option: str) -> tuple[float, ...] | None:
     return values
 
 
+def hysteresis_band(text: str | None) -> tuple[float, float] | None:
+    """--hysteresis-band: LO,HI [degC], LO < HI (None when not given)."""
+    band = float_list(text, "--hysteresis-band")
+    if band is not None and (len(band) != 2 or not band[0] < band[1]):
+        raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
+    return None if band is None else (band[0], band[1])
+
+
 __all__ = [
     "FINITE",
     "FiniteFloat",

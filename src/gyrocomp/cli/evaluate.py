@@ -17,7 +17,7 @@ from ..measures.merit import Evaluation
 from ..evaluation.comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
-from .common import FINITE, float_list, pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import FINITE, hysteresis_band, pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
 
 
@@ -49,7 +49,7 @@ def _nan_none(value):
 )
 @click.option(
     "--hysteresis-band",
-    "hysteresis_band",
+    "hysteresis_band_text",
     default=None,
     metavar="LO,HI",
     help="With --compare: limit the hysteresis to this band [degC].",
@@ -83,7 +83,7 @@ def evaluate(
     window_s,
     turn_on_window_s,
     compare,
-    hysteresis_band,
+    hysteresis_band_text,
     stages,
     installed,
     as_json,
@@ -97,45 +97,17 @@ def evaluate(
     opts = pop_read_options(kwargs)
     if window_s is not None and not window_s > 0:
         raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
+    quiet = ctx.obj["quiet"]
     if compare:
-        band = float_list(hysteresis_band, "--hysteresis-band")
-        if band is not None and (len(band) != 2 or not band[0] < band[1]):
-            raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
-        recordings = [read_run(path, opts).recording for path in paths]
-        result = compare_methods(recordings, window_s=window_s, hysteresis_band_degc=band)
-        if as_json:
-            click.echo(json.dumps(result.to_dict(), indent=2))
-        elif not ctx.obj["quiet"]:
-            print_comparison(result)
-        return
+        return _compare(paths, opts, window_s, hysteresis_band(hysteresis_band_text), as_json, quiet)
     if len(paths) < 2:
         raise click.UsageError("give MODEL and at least one run, or --compare RUNS...")
     model, runs = paths[0], paths[1:]
     calibration = Calibration.load(model)
     if stages:
-        if not calibration.axes:
-            raise InputError(
-                f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
-                "evaluate it without --stages"
-            )
-        staged = [
-            evaluate_stages(
-                calibration, read_run(path, opts).recording, window_s=window_s, turn_on_window_s=turn_on_window_s
-            )
-            for path in runs
-        ]
-        if as_json:
-            click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
-        elif not ctx.obj["quiet"]:
-            print_stages(staged)
-        return
+        return _stages(calibration, model, runs, opts, window_s, turn_on_window_s, as_json, quiet)
     if installed:
-        results = [compare_installed(calibration, read_run(path, opts).recording, window_s=window_s) for path in runs]
-        if as_json:
-            click.echo(json.dumps({"runs": [dataclasses.asdict(r) for r in results]}, indent=2, default=_nan_none))
-        elif not ctx.obj["quiet"]:
-            print_installed(results)
-        return
+        return _installed(calibration, runs, opts, window_s, as_json, quiet)
     evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
     expected = calibration.report.expected_drift()
     in_sample = [str(path) for path in runs if calibration.fitted_on(path)]
@@ -146,26 +118,57 @@ def evaluate(
             err=True,
         )
     if as_json:
-        click.echo(
-            json.dumps(
-                {
-                    **evaluation.to_dict(),
-                    "in_sample_files": in_sample,
-                    "expected_held_out_drift": [e.to_dict() for e in expected.values()],
-                },
-                indent=2,
-            )
-        )
+        document = {**evaluation.to_dict(), "in_sample_files": in_sample}
+        document["expected_held_out_drift"] = [e.to_dict() for e in expected.values()]
+        click.echo(json.dumps(document, indent=2))
     else:
         print_evaluation(evaluation)
         print_expected_drift(expected)
-        if turn_on_window_s is not None and not ctx.obj["quiet"]:
+        if turn_on_window_s is not None and not quiet:
             click.echo(
                 f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
                 "its first seconds; bias offset, bias instability and integration time do not depend on a "
                 "constant, so only the compensated output (gyrocomp apply) shows it",
                 err=True,
             )
+
+
+def _installed(calibration: Calibration, runs, opts: dict, window_s, as_json: bool, quiet: bool) -> None:
+    """--installed: the thermal calibration installed on the vehicle against the model, on its logs."""
+    results = [compare_installed(calibration, read_run(path, opts).recording, window_s=window_s) for path in runs]
+    if as_json:
+        click.echo(json.dumps({"runs": [dataclasses.asdict(r) for r in results]}, indent=2, default=_nan_none))
+    elif not quiet:
+        print_installed(results)
+
+
+def _compare(paths, opts: dict, window_s, band, as_json: bool, quiet: bool) -> None:
+    """--compare: the thesis's methods fitted on the runs and compared."""
+    recordings = [read_run(path, opts).recording for path in paths]
+    result = compare_methods(recordings, window_s=window_s, hysteresis_band_degc=band)
+    if as_json:
+        click.echo(json.dumps(result.to_dict(), indent=2))
+    elif not quiet:
+        print_comparison(result)
+
+
+def _stages(calibration: Calibration, model, runs, opts: dict, window_s, turn_on_window_s, as_json, quiet) -> None:
+    """--stages: the figures after each stage of the model."""
+    if not calibration.axes:
+        raise InputError(
+            f"--stages: {model} has no gyro axes (an accelerometer-only model has one stage); "
+            "evaluate it without --stages"
+        )
+    staged = [
+        evaluate_stages(
+            calibration, read_run(path, opts).recording, window_s=window_s, turn_on_window_s=turn_on_window_s
+        )
+        for path in runs
+    ]
+    if as_json:
+        click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
+    elif not quiet:
+        print_stages(staged)
 
 
 def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, rate_schedule) -> Evaluation:

@@ -25,7 +25,7 @@ from .common import (
     accept_option,
     FINITE,
     OUTPUT_FILE,
-    float_list,
+    hysteresis_band,
     instance_model_path,
     parse_channels,
     parse_temperature_option,
@@ -182,20 +182,13 @@ def fit(
 
     RUNS are files, folders (every run file in them) or quoted glob patterns ('logs/**/*.ulg')."""
     opts = pop_read_options(kwargs)
-    if hysteresis_order != "auto":
-        if hysteresis_order not in ("1", "2", "3"):
-            raise click.BadParameter("use auto, 1, 2 or 3", param_hint="--hysteresis-order")
-        hysteresis_order = int(hysteresis_order)
-    band = float_list(hysteresis_band_degc, "--hysteresis-band")
-    if band is not None and (len(band) != 2 or not band[0] < band[1]):
-        raise click.BadParameter("give LO,HI in degC with LO < HI, e.g. 55,80", param_hint="--hysteresis-band")
     channels = parse_channels(channels)
     options = FitOptions(
         temperature=parse_temperature_option(temperature, mlp_seed),
         bin_width_degc=bin_width_degc,
         hysteresis=hysteresis,
-        hysteresis_order=hysteresis_order,
-        hysteresis_band_degc=None if band is None else tuple(band),
+        hysteresis_order=_hysteresis_order(hysteresis_order),
+        hysteresis_band_degc=hysteresis_band(hysteresis_band_degc),
         acceleration=acceleration,
         static_min_duration_s=static_min_duration_s,
         folds=folds,
@@ -208,26 +201,45 @@ def fit(
     fits = {}
     for instance in chosen:
         read_opts = {**opts, "instance": instance if every else opts["instance"]}
-        read = [read_noting(lambda p, o=read_opts: read_run(p, o), path) for path in runs]
-        recordings = [r.recording for r in read]
-        if rate_schedule is not None:
-            recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
-        recordings, contributions = field_recordings(recordings, still_only)
-        enforce(
-            check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions if c.still_only])
-        )
-        if not ctx.obj["quiet"] and any(c.still_only for c in contributions):
-            print_contributions(contributions)
+        recordings = _checked_runs(runs, read_opts, rate_schedule, still_only, options, accept, ctx.obj["quiet"])
         with progress_bar("fitting" + (f" instance {instance}" if every else ""), indeterminate=True):
             fits[instance] = fit_runs(
                 recordings, options, channels=channels, pipeline=pipeline, scale_factor=scale_factor
             )
+    _print_and_write(fits, output, every, ctx.obj["quiet"])
+
+
+def _checked_runs(runs, read_opts: dict, rate_schedule, still_only, options: FitOptions, accept, quiet: bool):
+    """The runs read (through the rate schedule, field logs reduced to their still moments) and checked as
+    gyrocomp check does (a run that cannot give a valid fit refused)."""
+    read = [read_noting(lambda p, o=read_opts: read_run(p, o), path) for path in runs]
+    recordings = [r.recording for r in read]
+    if rate_schedule is not None:
+        recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
+    recordings, contributions = field_recordings(recordings, still_only)
+    enforce(check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions if c.still_only]))
+    if not quiet and any(c.still_only for c in contributions):
+        print_contributions(contributions)
+    return recordings
+
+
+def _hysteresis_order(value: str) -> int | str:
+    """--hysteresis-order: auto, or 1, 2 or 3."""
+    if value == "auto":
+        return value
+    if value not in ("1", "2", "3"):
+        raise click.BadParameter("use auto, 1, 2 or 3", param_hint="--hysteresis-order")
+    return int(value)
+
+
+def _print_and_write(fits: dict, output: str, every: bool, quiet: bool) -> None:
+    """Say what each fit found, then write its model file (with every instance, one file each, all or none)."""
     out = Path(output)
     names = {instance: instance_model_path(out, instance).name for instance in fits} if every else {None: out.name}
     written = {i: out.parent / names[i] for i in fits}
     # what the fit found is printed before the files are written: a standard output that fails (a full disk
     # behind > file) fails the command before it leaves a model file, not after
-    if not ctx.obj["quiet"]:
+    if not quiet:
         for instance, calibration in fits.items():
             print_fit(calibration, written[instance])
         sys.stdout.flush()

@@ -154,21 +154,8 @@ def fit(
     parallel; rerun to fit only the units whose runs changed. Several stations may fit into one store at once
     (--store URL): each unit is fitted by one of them, the others skip it."""
     opts = pop_read_options(kwargs)
-    if (unit_pattern is None) == (manifest is None):
-        raise click.UsageError(
-            "say which unit each run belongs to: give --unit-from PATTERN or --manifest FILE (one of them)"
-        )
-    if manifest is not None:
-        if data:
-            raise click.UsageError("--manifest names the runs: give no DATA with it")
-        units = units_from_manifest(manifest)
-    else:
-        if not data:
-            raise click.UsageError("give DATA: the folders, globs or files of the runs (or --manifest FILE)")
-        units = units_from_pattern(expand_inputs(data), unit_pattern)
+    units = _units(data, unit_pattern, manifest, output)
     limits = Limits.load(limits_file) if limits_file else None
-    for unit in units:
-        refuse_to_overwrite_inputs(output, unit.paths)
     population = None
     if prior is not None:
         with CalibrationStore(prior) as db:
@@ -202,6 +189,25 @@ def fit(
         _write_certificates(summary, output, store, limits, certificates, settings)
     if not ctx.obj["quiet"]:
         _print_summary(summary, output, limits is not None)
+
+
+def _units(data, unit_pattern, manifest, output) -> list:
+    """The units to fit, from DATA and --unit-from or from --manifest (none of their runs the output)."""
+    if (unit_pattern is None) == (manifest is None):
+        raise click.UsageError(
+            "say which unit each run belongs to: give --unit-from PATTERN or --manifest FILE (one of them)"
+        )
+    if manifest is not None:
+        if data:
+            raise click.UsageError("--manifest names the runs: give no DATA with it")
+        units = units_from_manifest(manifest)
+    else:
+        if not data:
+            raise click.UsageError("give DATA: the folders, globs or files of the runs (or --manifest FILE)")
+        units = units_from_pattern(expand_inputs(data), unit_pattern)
+    for unit in units:
+        refuse_to_overwrite_inputs(output, unit.paths)
+    return units
 
 
 def _write_certificates(summary, output, store, limits, kind: str, settings) -> None:

@@ -120,12 +120,7 @@ def simulate(
     truth_columns,
 ):
     """Simulate calibration runs of a sensor preset through a test profile, with the exact truth."""
-
-    model = preset_model(preset, unit)
-    if axes:
-        model = model.subset(tuple(f"gyro_{a.strip()}" for a in axes.split(",") if a.strip()))
-    if disable:
-        model = model.without(*(t.strip() for t in disable.split(",") if t.strip()))
+    model = _preset_model(preset, unit, axes, disable)
     if runs < 1:
         raise click.BadParameter("must be at least 1", param_hint="--runs")
     prof = resolve_profile(
@@ -141,11 +136,7 @@ def simulate(
     if runs == 1 and prof.name in ONE_TEMPERATURE_PROFILES and len(prof.set_points_degc) > 1:
         runs = len(prof.set_points_degc)  # one run per temperature
     profiles = run_profiles(prof, runs)
-    output_format(output)
-    out = Path(output)
-    paths = [out] if runs == 1 else [out.with_name(f"{out.stem}_{i}{out.suffix}") for i in range(runs)]
-    if truth and any(Path(truth).resolve() == p.resolve() for p in paths):
-        raise InputError(f"--truth {truth}: the same file as a data output; choose another path")
+    paths = _output_paths(output, runs, truth)
     records = []
     for i, path in enumerate(paths):
         sim = run_simulation(
@@ -164,3 +155,23 @@ def simulate(
 
 
 __all__ = ["simulate"]
+
+
+def _preset_model(preset: str, unit: str, axes: str | None, disable: str | None):
+    """The preset's sensor model in ``unit``, with the axes of ``--axes`` and without the terms of ``--disable``."""
+    model = preset_model(preset, unit)
+    if axes:
+        model = model.subset(tuple(f"gyro_{a.strip()}" for a in axes.split(",") if a.strip()))
+    if disable:
+        model = model.without(*(t.strip() for t in disable.split(",") if t.strip()))
+    return model
+
+
+def _output_paths(output: str, runs: int, truth: str | None) -> list[Path]:
+    """The file of each run (``output`` itself for one run, numbered beside it for several)."""
+    output_format(output)
+    out = Path(output)
+    paths = [out] if runs == 1 else [out.with_name(f"{out.stem}_{i}{out.suffix}") for i in range(runs)]
+    if truth and any(Path(truth).resolve() == p.resolve() for p in paths):
+        raise InputError(f"--truth {truth}: the same file as a data output; choose another path")
+    return paths

@@ -281,6 +281,21 @@ def _grow(core: np.ndarray, tail: np.ndarray, start: int, step: int) -> int:
     return k
 
 
+def _bin_differences(
+    t: np.ndarray, e: np.ndarray, hit: np.ndarray, ref: np.ndarray, edges: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per temperature bin (``edges`` [degC]), the mean of ``e`` where ``hit`` minus its mean where ``ref``, and
+    that difference's standard error (NaN and infinity where either side has fewer than three points)."""
+    diff, se = np.full(edges.size - 1, np.nan), np.full(edges.size - 1, np.inf)
+    for b in range(edges.size - 1):
+        inside = (t >= edges[b]) & (t < edges[b + 1])
+        h, r = e[inside & hit], e[inside & ref]
+        if h.size >= 3 and r.size >= 3:
+            diff[b] = h.mean() - r.mean()
+            se[b] = math.sqrt(h.var() / h.size + r.var() / r.size)
+    return diff, se
+
+
 def parting_band_degc(
     temperature_degc: np.ndarray,
     residual_dps: np.ndarray,
@@ -318,15 +333,7 @@ def parting_band_degc(
     edges = np.arange(t.min(), t.max() + width, width)
     best = None
     for sign in (-1, 1):
-        hit = after & (d == sign)
-        ref = d == -sign
-        diff, se = np.full(edges.size - 1, np.nan), np.full(edges.size - 1, np.inf)
-        for b in range(edges.size - 1):
-            inside = (t >= edges[b]) & (t < edges[b + 1])
-            h, r = e[inside & hit], e[inside & ref]
-            if h.size >= 3 and r.size >= 3:
-                diff[b] = h.mean() - r.mean()
-                se[b] = math.sqrt(h.var() / h.size + r.var() / r.size)
+        diff, se = _bin_differences(t, e, after & (d == sign), d == -sign, edges)
         if np.all(np.isnan(diff)):
             continue
         peak = int(np.nanargmax(np.abs(diff)))

@@ -18,7 +18,8 @@ from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, InputError
 from ..measures.merit import AxisMetrics, Evaluation, TriadResiduals, default_window_s, evaluate_run
 from ..fitting.pose_rotation import rotation_errors
-from ..fitting.triad_fit import MIN_REFERENCE_RATE_DPS, find_poses, rate_segments, spans_axes
+from ..fitting.rate_table import MIN_REFERENCE_RATE_DPS, rate_segments
+from ..fitting.triad_fit import find_poses, spans_axes
 from ..recording import GYRO_AXES, Recording
 from ..calibration.triad import TriadCalibration
 from ..calibration.installed import installed_calibration, installed_correction_dps, px4_slot
@@ -244,26 +245,13 @@ def compare_installed(
     data = runs[0]
     still_only = bool(contributions and contributions[0].still_only)
     window = window_s if window_s is not None else default_window_s(data)
-    rows = np.searchsorted(recording.time_s, data.time_s)  # the samples kept, in the whole log
-
-    def residual(model: Calibration | None) -> dict[str, float]:
-        if model is None:
-            return {a: float("nan") for a in data.gyro_axes}
-        evaluation = evaluate_run(data, apply(model, data), window_s=window)
-        return {a: m.residual_rms_dps for a, m in evaluation.axes.items()}
-
-    def residual_installed() -> dict[str, float]:
-        if installed is None:
-            return {a: float("nan") for a in data.gyro_axes}
-        # the firmware runs over the whole log (PX4's republish follows its time), then the same samples are judged
-        correction = installed_correction_dps(params, autopilot, recording.time_s, recording.temperature_degc, slot)[
-            rows
-        ]
-        cols = [GYRO_AXES.index(a) for a in data.gyro_axes]
-        corrected = data.with_gyro(data.gyro_dps - correction[:, cols])
-        return {a: m.residual_rms_dps for a, m in evaluate_run(data, corrected, window_s=window).axes.items()}
-
-    raw = {a: m.residual_rms_dps for a, m in evaluate_run(data, data, window_s=window).axes.items()}
+    raw = _residual_rms(data, data, window)
+    nothing = {a: float("nan") for a in data.gyro_axes}
+    if onboard or installed is None:
+        by_installed = raw if onboard else nothing
+    else:
+        by_installed = _residual_rms(data, _installed_output(data, recording, params, autopilot, slot), window)
+    by_model = nothing if onboard else _residual_rms(data, apply(calibration, data), window)
     return InstalledComparison(
         recording.source,
         autopilot,
@@ -273,10 +261,24 @@ def compare_installed(
         data.duration_s if not still_only else contributions[0].still_s,
         window,
         raw,
-        raw if onboard else residual_installed(),
-        residual(None) if onboard else residual(calibration),
+        by_installed,
+        by_model,
         note,
     )
+
+
+def _residual_rms(data: Recording, output: Recording, window_s: float) -> dict[str, float]:
+    """Each gyro axis's residual RMS [deg/s] of ``output`` (``data`` compensated), over ``window_s`` [s]."""
+    return {a: m.residual_rms_dps for a, m in evaluate_run(data, output, window_s=window_s).axes.items()}
+
+
+def _installed_output(data: Recording, recording: Recording, params: dict, autopilot: str, slot: int) -> Recording:
+    """``data`` (samples of ``recording``) corrected by the installed calibration: the firmware runs over the whole
+    log (PX4's republish follows its time), then the same samples are judged."""
+    rows = np.searchsorted(recording.time_s, data.time_s)  # the samples kept, in the whole log
+    correction = installed_correction_dps(params, autopilot, recording.time_s, recording.temperature_degc, slot)
+    cols = [GYRO_AXES.index(a) for a in data.gyro_axes]
+    return data.with_gyro(data.gyro_dps - correction[rows][:, cols])
 
 
 __all__ = [

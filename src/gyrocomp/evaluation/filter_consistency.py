@@ -146,22 +146,30 @@ def attitude_nees(
         raise InputError("schedule: needs temperature_degc, and a noise model of white noise and random walk only")
     # the measured angle of each update period: the rate integrated over it [deg]
     integrated = errors[:, : epochs * per].reshape(errors.shape[0], epochs, per).sum(axis=2) / rate_hz
-    models = (
-        [_model(noise, per / rate_hz)] * epochs
-        if schedule is None
-        else [
-            _model(schedule(float(np.mean(t))), per / rate_hz)
-            for t in np.asarray(temperature_degc, dtype=float)[: epochs * per].reshape(epochs, per)
-        ]
-    )
-    size = models[0][0].shape[0]
-    p = np.zeros((size, size))
-    p[0, 0] = update_sigma_deg**2
-    p[1, 1] = (errors[:, : max(per, 1)].mean(axis=1).std() + noise.deviation(1.0)) ** 2  # the turn-on bias
-    for j, (sigma, _) in enumerate(noise.markov):
-        p[2 + j, 2 + j] = sigma**2
+    models = _models(noise, schedule, temperature_degc, epochs, per, rate_hz)
+    p = _initial_covariance(models[0][0].shape[0], errors[:, : max(per, 1)], noise, update_sigma_deg)
     samples = _filter(integrated, models, p, first, update_sigma_deg)
     return NeesResult(np.mean(samples, axis=0), nees_band(len(samples)), len(samples))
+
+
+def _models(noise: NoiseBound, schedule, temperature_degc, epochs: int, per: int, rate_hz: float) -> list:
+    """The filter's model of each update period of ``per`` samples: ``noise``'s, or the schedule's at the
+    period's mean temperature [degC]."""
+    if schedule is None:
+        return [_model(noise, per / rate_hz)] * epochs
+    periods = np.asarray(temperature_degc, dtype=float)[: epochs * per].reshape(epochs, per)
+    return [_model(schedule(float(np.mean(t))), per / rate_hz) for t in periods]
+
+
+def _initial_covariance(size: int, first_errors_dps: np.ndarray, noise: NoiseBound, update_sigma_deg: float):
+    """The filter's initial covariance: the attitude's [deg^2] from an update, the bias's [(deg/s)^2] from the
+    spread of the runs' first update period, each Gauss-Markov state's [(deg/s)^2] its stationary variance."""
+    p = np.zeros((size, size))
+    p[0, 0] = update_sigma_deg**2
+    p[1, 1] = (first_errors_dps.mean(axis=1).std() + noise.deviation(1.0)) ** 2  # the turn-on bias
+    for j, (sigma, _) in enumerate(noise.markov):
+        p[2 + j, 2 + j] = sigma**2
+    return p
 
 
 def _filter(integrated: np.ndarray, models: list, p: np.ndarray, first: int, update_sigma_deg: float) -> list:

@@ -105,11 +105,6 @@ def firmware_difference(calibration: Calibration, params: dict, target: str, ins
     ramp = np.concatenate([np.linspace(lo, hi, int(60 * (hi - lo)) + 2), np.linspace(hi, lo, int(60 * (hi - lo)) + 2)])
     time_s = np.arange(ramp.size, dtype=float)
 
-    def model(temperature: np.ndarray, time: np.ndarray | None = None) -> np.ndarray:
-        t = np.arange(temperature.size, dtype=float) if time is None else time
-        rec = Recording(t, np.zeros((t.size, len(axes))), axes, temperature_degc=temperature, source="<firmware>")
-        return predict_error(calibration, rec)
-
     def firmware(temperature: np.ndarray, time: np.ndarray | None = None) -> np.ndarray:
         if target == "px4":
             out = (
@@ -125,22 +120,16 @@ def firmware_difference(calibration: Calibration, params: dict, target: str, ins
     static = (
         calibration.without("hysteresis", "lag") if any(calibration.axes[a].has_memory for a in axes) else calibration
     )
-    diffs = []
-    for temps in (inside, beyond):
-        rec = Recording(
-            np.arange(temps.size, dtype=float),
-            np.zeros((temps.size, len(axes))),
-            axes,
-            temperature_degc=temps,
-            source="<firmware>",
-        )
-        diffs.append(firmware(temps) - predict_error(static, rec))
-    diffs.append(firmware(ramp, time_s) - model(ramp, time_s))
-    (a, b), (c, d), (e, f) = (_stats(x) for x in diffs)
-    as_tuple = lambda x: tuple(float(v) for v in x)  # noqa: E731
-    return FirmwareDifference(
-        target, axes, as_tuple(a), as_tuple(b), as_tuple(c), as_tuple(d), as_tuple(e), as_tuple(f)
-    )
+    diffs = [firmware(temps) - predict_error(static, _probe(temps, axes)) for temps in (inside, beyond)]
+    diffs.append(firmware(ramp, time_s) - predict_error(calibration, _probe(ramp, axes, time_s)))
+    figures = [tuple(float(v) for v in x) for d in diffs for x in _stats(d)]
+    return FirmwareDifference(target, axes, *figures)
+
+
+def _probe(temperature_degc: np.ndarray, axes: tuple, time_s: np.ndarray | None = None) -> Recording:
+    """A recording of zero rate on ``axes`` at ``temperature_degc`` [degC] (one sample a second by default) [s]."""
+    t = np.arange(temperature_degc.size, dtype=float) if time_s is None else time_s
+    return Recording(t, np.zeros((t.size, len(axes))), axes, temperature_degc=temperature_degc, source="<firmware>")
 
 
 #: the firmwares judged, and the slot each exports by default (PX4 TC_G0, ArduPilot INS_TCAL1)

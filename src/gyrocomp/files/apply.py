@@ -80,18 +80,14 @@ def apply_file(
         compensated = apply(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=axes)
         accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
         write_gyro_back(data, compensated.gyro_dps, output_path, fmt=out_fmt, accel_g=accel)
-        return FileResult(
-            data.recording.n_samples, compensated_axes(calibration, data.recording, axes, accel is not None), False
-        )
+        done = compensated_axes(calibration, data.recording, axes, accel is not None)
+        return FileResult(data.recording.n_samples, done, False)
+
+    def chunked(stream) -> FileResult:
+        return _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s)
 
     return chunked_or_whole(
-        input_path,
-        options,
-        fmt=fmt,
-        chunks=chunks,
-        progress=progress,
-        whole=whole,
-        chunked=lambda stream: _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s),
+        input_path, options, fmt=fmt, chunks=chunks, progress=progress, whole=whole, chunked=chunked
     )
 
 

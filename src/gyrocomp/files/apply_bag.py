@@ -203,6 +203,19 @@ def apply_bag_instances(
     return _apply_bag(dict(calibrations), path, output, options or ReadOptions(), None, chunk_rows)
 
 
+def _warn_unchanged(path: Path, counts: dict) -> None:
+    """Warn of each topic's IMU messages copied uncompensated (``counts``: by topic, ``compensated``/``unchanged``)."""
+    for topic, count in counts.items():
+        if count["unchanged"]:
+            warnings.warn(
+                f"{path}: {count['unchanged']} message(s) of {topic} are not in the recording the bag "
+                "reads as (outside the temperature topic's span, or not finite) and were copied "
+                "uncompensated",
+                DataQualityWarning,
+                stacklevel=4,
+            )
+
+
 def _apply_bag(
     calibrations: dict, path, output, options: ReadOptions, noise, chunk_rows: int
 ) -> tuple[AppliedBag, ...]:
@@ -244,15 +257,7 @@ def _apply_bag(
         results = {topics[k]: _whole(calibrations[k], path, streams[k].options, covariance_of) for k in calibrations}
         _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections, results, counts))
         done = {topic: (result[2], tuple(result[3])) for topic, result in results.items()}
-    for topic, count in counts.items():
-        if count["unchanged"]:
-            warnings.warn(
-                f"{path}: {count['unchanged']} message(s) of {topic} are not in the recording the bag "
-                "reads as (outside the temperature topic's span, or not finite) and were copied "
-                "uncompensated",
-                DataQualityWarning,
-                stacklevel=3,
-            )
+    _warn_unchanged(path, counts)
     return tuple(
         AppliedBag(
             output,

@@ -264,9 +264,7 @@ def branch_test(
         for w in BRANCH_WIDTHS_DEGC
     ]
     ys = np.concatenate(y)
-    fits = [_weighted_fit(np.vstack(x), ys, np.ones(ys.size)) for x in designs]  # (residual, rss) per width
-    duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in runs)
-    pick = plausible_middle(np.array([rss for _, rss in fits]), duration_s / SCORE_WINDOW_S)
+    pick = _middle_width(runs, designs, ys)
     x, width = designs[pick], BRANCH_WIDTHS_DEGC[pick]
     first = x[0].shape[1] - MAX_BRANCH_ORDER  # the branch columns come last: s, then s u
     # the drift model from the residual of the model without branch terms (the null hypothesis): a difference
@@ -275,6 +273,20 @@ def branch_test(
     # statistic was 53 against a threshold of 11.8; from the null's, 9.2)
     null = _weighted_fit(np.vstack([xk[:, :first] for xk in x]), ys, np.ones(ys.size))[0]
     noise = fit_drift_noise(np.split(null, np.cumsum([v.size for v in y])[:-1]), t)
+    return _kept_terms(x, y, t, noise, first, width)
+
+
+def _middle_width(runs: list[RunBlocks], designs: list, ys: np.ndarray) -> int:
+    """The index of the crossover width (of ``BRANCH_WIDTHS_DEGC``) in the middle of those the fits of
+    ``designs`` cannot tell apart (:func:`gyrocomp.fitting.thermal.plausible_middle`)."""
+    fits = [_weighted_fit(np.vstack(x), ys, np.ones(ys.size)) for x in designs]  # (residual, rss) per width
+    duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in runs)
+    return plausible_middle(np.array([rss for _, rss in fits]), duration_s / SCORE_WINDOW_S)
+
+
+def _kept_terms(x: list, y: list, t: list, noise, first: int, width: float) -> BranchTest:
+    """The branch terms kept, from the lowest, by their Wald statistics under the drift model ``noise``
+    (``first``: the column of the constant branch term in each design of ``x``)."""
     walk = math.sqrt(noise.walk_var_per_s)
     one = wald_statistic([xk[:, : first + 1] for xk in x], y, t, noise, np.array([first]))
     both = wald_statistic(x, y, t, noise, np.array([first, first + 1]))

@@ -127,28 +127,12 @@ def choose_axis(
         if do_no_harm and not chosen.has_temperature_model and best.has_temperature_model:
             decided_by = "do no harm: no temperature model beats the constant on the held-out folds"
     chosen, decided_by = _lag_at_the_short_window(problem, scored, chosen, decided_by)
-    test = None
-    if (
-        problem.branch_orders
-        and chosen.has_temperature_model
-        and not chosen.branch
-        and not chosen.hysteresis_order
-        and not np.any(problem.fold_has_both_directions())
-    ):
-        twin = dataclasses.replace(chosen, lag=True)
-        if unit_lag and twin in scored.eligible:
-            chosen = twin  # a lag also parts the heating and cooling legs: the branch terms are tested beyond it
-        chosen, test = _branch_by_test(problem, chosen, list(scored.scores), set(scored.eligible))
-        if test is not None and test.order:
-            decided_by += f"; branch terms by their test (Wald {test.statistic:.3g} against {test.threshold:.3g})"
+    chosen, test, decided_by = _branch_step(problem, scored, chosen, decided_by, unit_lag)
     if do_no_harm and chosen.has_temperature_model and harms(_score(scored, chosen), constant):
-        chosen, decided_by = (
-            constant.candidate,
-            (
-                f"do no harm: {chosen.label} leaves more held-out drift than the "
-                "constant by more than its standard error"
-            ),
+        decided_by = (
+            f"do no harm: {chosen.label} leaves more held-out drift than the constant by more than its standard error"
         )
+        chosen = constant.candidate
     return AxisSelection(
         axis,
         problem.folds.kind,
@@ -166,6 +150,26 @@ def choose_axis(
         decided_by=decided_by,
         order_test=evidence,
     )
+
+
+def _branch_step(problem: SelectionProblem, scored: AxisScores, chosen: Candidate, decided_by: str, unit_lag: bool):
+    """Where the branch terms are decided by their test (no fold holds both directions), the chosen candidate with
+    the terms the test keeps (beyond the die's lag where ``unit_lag``), the test, and what decided."""
+    if (
+        not problem.branch_orders
+        or not chosen.has_temperature_model
+        or chosen.branch
+        or chosen.hysteresis_order
+        or np.any(problem.fold_has_both_directions())
+    ):
+        return chosen, None, decided_by
+    twin = dataclasses.replace(chosen, lag=True)
+    if unit_lag and twin in scored.eligible:
+        chosen = twin  # a lag also parts the heating and cooling legs: the branch terms are tested beyond it
+    chosen, test = _branch_by_test(problem, chosen, list(scored.scores), set(scored.eligible))
+    if test is not None and test.order:
+        decided_by += f"; branch terms by their test (Wald {test.statistic:.3g} against {test.threshold:.3g})"
+    return chosen, test, decided_by
 
 
 def _lag_at_the_short_window(
@@ -234,17 +238,7 @@ def _choose_on_two_folds(
         )
     _, held_out = choose(pool, complexity)
     tau = float(np.median(_of(pool, held_out).fold_lag_s)) if held_out.lag else 0.0
-    accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
-    test = order_test(
-        problem.runs,
-        problem.groups,
-        problem.t_ref_degc,
-        problem.t_scale_degc,
-        problem.max_order,
-        tau,
-        problem.block_s,
-        accel if accel[0].shape[1] else None,
-    )
+    test = _order_test(problem, tau)
     if not any(helps_on_every_fold(s, constant) for s in finite if s.candidate.has_temperature_model):
         return (
             best,
@@ -260,25 +254,43 @@ def _choose_on_two_folds(
             f"(order test, largest Wald {max(test.statistics, default=0.0):.3g} against {test.threshold:.3g})",
             test,
         )
-    rule = f"two held-out legs ({problem.window_s:.3g} s window): the simplest within one standard error of the best"
+    chosen, rule = _raised_order(problem, held_out, test, {s.candidate for s in pool})
+    return best, chosen, rule, test
+
+
+def _order_test(problem: SelectionProblem, tau_s: float) -> OrderTest:
+    """The order test (:func:`gyrocomp.fitting.order_evidence.order_test`) on all of an axis's data, its lag
+    ``tau_s`` [s], the acceleration columns fitted with it."""
+    accel = [problem.accel_columns(k) for k in range(len(problem.runs))]
+    return order_test(
+        problem.runs,
+        problem.groups,
+        problem.t_ref_degc,
+        problem.t_scale_degc,
+        problem.max_order,
+        tau_s,
+        problem.block_s,
+        accel if accel[0].shape[1] else None,
+    )
+
+
+def _raised_order(problem: SelectionProblem, held_out: Candidate, test: OrderTest, in_pool: set) -> tuple:
+    """The held-out legs' choice with its polynomial raised to the highest order the test supports that is in
+    ``in_pool`` (offered, doing no harm), and the rule that decided."""
     if held_out.curve == POLY_FAMILY and held_out.order < test.order:
-        in_pool = {s.candidate for s in pool}
         for order in range(test.order, held_out.order, -1):
             raised = dataclasses.replace(held_out, order=order)
             if raised in in_pool:
                 statistic = test.statistics[order - 1]
-                return (
-                    best,
-                    raised,
-                    (
-                        f"two held-out legs ({problem.window_s:.3g} s window), the order raised from "
-                        f"{held_out.order} by the order test "
-                        f"(the u^{order} term stands out of the drift: Wald {statistic:.3g} against "
-                        f"{test.threshold:.3g})"
-                    ),
-                    test,
+                return raised, (
+                    f"two held-out legs ({problem.window_s:.3g} s window), the order raised from "
+                    f"{held_out.order} by the order test "
+                    f"(the u^{order} term stands out of the drift: Wald {statistic:.3g} against "
+                    f"{test.threshold:.3g})"
                 )
-    return best, held_out, rule, test
+    return held_out, (
+        f"two held-out legs ({problem.window_s:.3g} s window): the simplest within one standard error of the best"
+    )
 
 
 def _of(scores: list[CandidateScore], candidate: Candidate) -> CandidateScore:

@@ -103,14 +103,7 @@ def make_folds(
             tuple(np.full(r.value.size, ids.index(g)) for r, g in zip(runs, groups)),
             tuple(f"run {g + 1}" for g in ids),
         )
-    legs, names = [], []
-    for k, (run, threshold) in enumerate(zip(runs, thresholds_degc)):
-        leg, directions = leg_labels(run.temperature_degc, threshold, min_leg_blocks)
-        legs.append(leg)
-        names += [
-            f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, "")
-            for j, d in enumerate(directions)
-        ]
+    legs, names = _legs(runs, thresholds_degc, min_leg_blocks)
     note = "" if asked in ("auto", kind) else f"folds={asked!r}: one run cannot be held out against others; "
     if kind == "legs" and len(names) >= 2:
         offsets = np.cumsum([0] + [int(leg.max()) + 1 for leg in legs[:-1]])
@@ -125,6 +118,24 @@ def make_folds(
             "the temperature never reverses, so there are no heating and cooling legs to hold out; held out "
             f"{BLOCKS_PER_RUN} contiguous time blocks per run instead (neighbouring blocks share slow drift)"
         )
+    return _time_blocks(runs, note)
+
+
+def _legs(runs: list[RunBlocks], thresholds_degc: list[float], min_leg_blocks: int) -> tuple[list, list[str]]:
+    """Each run's leg of each block (numbered within the run) and every leg's name, in order."""
+    legs, names = [], []
+    for k, (run, threshold) in enumerate(zip(runs, thresholds_degc)):
+        leg, directions = leg_labels(run.temperature_degc, threshold, min_leg_blocks)
+        legs.append(leg)
+        names += [
+            f"run {k + 1} leg {j + 1}" + {1: " (heating)", -1: " (cooling)"}.get(d, "")
+            for j, d in enumerate(directions)
+        ]
+    return legs, names
+
+
+def _time_blocks(runs: list[RunBlocks], note: str) -> Folds:
+    """Folds of contiguous time blocks, ``BLOCKS_PER_RUN`` per run (more when there are few runs)."""
     per_run = max(BLOCKS_PER_RUN, math.ceil(MIN_FOLDS / len(runs)))
     of_block, names = [], []
     for k, run in enumerate(runs):

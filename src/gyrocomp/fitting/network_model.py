@@ -233,19 +233,8 @@ class NetworkTemperatureModel(LearnedAttributes):
         run = np.concatenate([np.full(a.size, r) for r, a in enumerate(temperature_degc)])
         n_runs = len(temperature_degc)
         accel = None if accel_g is None else np.vstack(accel_g)
-        probe = NetworkCurve(
-            self.hidden,
-            (),
-            0.0,
-            1.0,
-            t_ref_degc,
-            0.0,
-            0.0,
-            inputs,
-            (0.0,) * len(inputs),
-            (0.0,) * len(inputs),
-            (0.0,) * len(inputs),
-        )
+        zeros = (0.0,) * len(inputs)
+        probe = NetworkCurve(self.hidden, (), 0.0, 1.0, t_ref_degc, 0.0, 0.0, inputs, zeros, zeros, zeros)
         values = probe.input_values(t, accel)
         lo, hi = values.min(axis=0), values.max(axis=0)
         t_min, t_max = float(t.min()), float(t.max())
@@ -259,13 +248,29 @@ class NetworkTemperatureModel(LearnedAttributes):
             )
         span = np.where(hi > lo, hi - lo, 1.0)
         x = np.where(hi > lo, 2.0 * (values - lo) / span - 1.0, 0.0)
-        mean, scale = (
-            float(np.average(y, weights=w)),
-            float(np.sqrt(np.average((y - np.average(y, weights=w)) ** 2, weights=w))) or 1.0,
-        )
-        target = (y - mean) / scale
-        train = validation_mask(run, n_runs)
+        mean = float(np.average(y, weights=w))
+        scale = float(np.sqrt(np.average((y - mean) ** 2, weights=w))) or 1.0
         shapes = layer_shapes(len(inputs), self.hidden)
+        best, results = self._train(x, (y - mean) / scale, w, run, n_runs, shapes)
+        weights = tuple(
+            tuple(float(v) for v in np.concatenate([wt.ravel(), b])) for wt, b in unpack(best.theta, shapes)
+        )
+        reference = tuple(
+            t_ref_degc if name == "temperature" else (1.0 if name == "accel_z" else 0.0) for name in inputs
+        )
+        ranges = (t_min, t_max, tuple(inputs), tuple(map(float, lo)), tuple(map(float, hi)))
+        curve = NetworkCurve(self.hidden, weights, mean, scale, t_ref_degc, *ranges, reference)
+        at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
+        self.curves_[axis] = curve
+        self.turn_on_biases_[axis] = best.run_constants * scale + at_ref
+        self.validation_rmse_[axis] = [r.validation_rmse * scale for r in results]
+        self.epochs_[axis] = best.epochs
+        self.train_rmse_[axis] = best.train_rmse * scale
+        return self
+
+    def _train(self, x, target, w, run, n_runs: int, shapes) -> tuple[TrainResult, list[TrainResult]]:
+        """The best of the restarts by held-out error, converged on all the data, and every restart's result."""
+        train = validation_mask(run, n_runs)
         results = []
         for k in range(self.restarts):
             rng = np.random.default_rng([self.seed, k])
@@ -274,36 +279,12 @@ class NetworkTemperatureModel(LearnedAttributes):
         # the restart is chosen on held-out segments; it then converges on all the data (a 1-3-1 network
         # has ten weights for thousands of points, and block noise makes the early stop premature)
         start = np.concatenate([best.theta, best.run_constants[1:]])
-        every = np.ones(y.size, dtype=bool)
+        every = np.ones(target.size, dtype=bool)
         final = train_lm(x, target, w, run, n_runs, every, shapes, None, self.max_epochs, start=start)
         best = TrainResult(
             final.theta, final.run_constants, final.train_rmse, best.validation_rmse, best.epochs + final.epochs
         )
-        layers = unpack(best.theta, shapes)
-        weights = tuple(tuple(float(v) for v in np.concatenate([wt.ravel(), b])) for wt, b in layers)
-        reference = tuple(
-            t_ref_degc if name == "temperature" else (1.0 if name == "accel_z" else 0.0) for name in inputs
-        )
-        curve = NetworkCurve(
-            self.hidden,
-            weights,
-            mean,
-            scale,
-            t_ref_degc,
-            t_min,
-            t_max,
-            tuple(inputs),
-            tuple(map(float, lo)),
-            tuple(map(float, hi)),
-            reference,
-        )
-        at_ref = float(curve.net_dps(np.asarray(reference)[None, :])[0])
-        self.curves_[axis] = curve
-        self.turn_on_biases_[axis] = best.run_constants * scale + at_ref
-        self.validation_rmse_[axis] = [r.validation_rmse * scale for r in results]
-        self.epochs_[axis] = best.epochs
-        self.train_rmse_[axis] = best.train_rmse * scale
-        return self
+        return best, results
 
 
 __all__ = ["NetworkTemperatureModel", "TrainResult", "jacobian", "train_lm", "validation_mask"]

@@ -461,6 +461,22 @@ def _rotation_order(moves: _Moves, reference_degc: float, temperature_order: int
     return temperature_order
 
 
+def _require_plausible(sensitivity: np.ndarray) -> None:
+    """Refuse a fitted sensitivity matrix [1] further from the identity than :data:`MAX_SENSITIVITY_ERROR`."""
+    if np.max(np.abs(sensitivity - np.eye(3))) > MAX_SENSITIVITY_ERROR:
+        raise InputError(
+            f"moves between poses: the fit found no plausible gyro triad (scale or misalignment beyond "
+            f"{MAX_SENSITIVITY_ERROR:.0%}); the turns do not determine it"
+        )
+
+
+def _standard_errors(sol, n_moves: int) -> np.ndarray:
+    """The standard errors of the least-squares solution ``sol`` (two residuals per move), one 3x3 per term."""
+    dof = 2 * n_moves - sol.x.size
+    variance = float(np.sum(sol.fun**2) / max(dof, 1))
+    return np.sqrt(np.diag(np.linalg.pinv(sol.jac.T @ sol.jac)) * variance).reshape(-1, 3, 3)
+
+
 def fit_gyro_between_poses(
     recordings: list[Recording] | Recording,
     *,
@@ -497,14 +513,8 @@ def fit_gyro_between_poses(
     order = _rotation_order(moves, reference, temperature_order)
     sol, triad = _solve(moves, order, reference)
     _require_determined(sol.jac, len(moves.meta))
-    if np.max(np.abs(triad[0] - np.eye(3))) > MAX_SENSITIVITY_ERROR:
-        raise InputError(
-            f"moves between poses: the fit found no plausible gyro triad (scale or misalignment beyond "
-            f"{MAX_SENSITIVITY_ERROR:.0%}); the turns do not determine it"
-        )
-    dof = 2 * len(moves.meta) - sol.x.size
-    variance = float(np.sum(sol.fun**2) / max(dof, 1))
-    se = np.sqrt(np.diag(np.linalg.pinv(sol.jac.T @ sol.jac)) * variance).reshape(-1, 3, 3)
+    _require_plausible(triad[0])
+    se = _standard_errors(sol, len(moves.meta))
     cal = TriadCalibration(
         sensitivity=rows_of(triad[0]),
         bias=(0.0, 0.0, 0.0),

@@ -132,6 +132,18 @@ class PopulationPrior:
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()
 
 
+def _scaled_tempcos(figures: list, scale: float) -> np.ndarray:
+    """The units' temperature coefficients times ``scale`` [degC] to their power (one row per unit with all three
+    finite) [deg/s]."""
+    theta = np.array(
+        [
+            [f.tempco_1_dps_per_degc * scale, f.tempco_2_dps_per_degc2 * scale**2, f.tempco_3_dps_per_degc3 * scale**3]
+            for f in figures
+        ]
+    )
+    return theta[np.all(np.isfinite(theta), axis=1)]
+
+
 def population_prior(
     records: Sequence[CalibrationRecord],
     *,
@@ -169,17 +181,7 @@ def population_prior(
     axes = {}
     for axis in good[0].figures.axes:
         figures = [r.figures.axes[axis] for r in good if axis in r.figures.axes]
-        theta = np.array(
-            [
-                [
-                    f.tempco_1_dps_per_degc * scale,
-                    f.tempco_2_dps_per_degc2 * scale**2,
-                    f.tempco_3_dps_per_degc3 * scale**3,
-                ]
-                for f in figures
-            ]
-        )
-        theta = theta[np.all(np.isfinite(theta), axis=1)]
+        theta = _scaled_tempcos(figures, scale)
         if theta.shape[0] < MIN_UNITS_FOR_PRIOR:
             continue
         lags = [m.axes[axis].lag_time_constant_s for m in models if axis in m.axes]

@@ -228,16 +228,8 @@ def fit_fleet(
     station : str, optional
         This station's name, stored with each row it writes (default: the machine's name).
     """
-    units = list(units)
-    _check_units(units)
+    units, output = _checked(units, output, scheduler)
     settings = settings or FleetSettings()
-    if scheduler not in ("local", "serial"):
-        _check_reachable(scheduler)
-    output = Path(output)
-    if output.exists() and not output.is_dir():
-        raise InputError(f"output: {output} is a file; a fleet is written into a folder")
-    output.mkdir(parents=True, exist_ok=True)
-    units = [replace(u, paths=tuple(os.path.abspath(p) for p in u.paths)) for u in units]
     tally = _Tally()
     started = utc_now()
     with (
@@ -253,17 +245,21 @@ def fit_fleet(
             if progress is not None:
                 progress(done, len(units))
         table = write_fleet_table(db, output / FLEET_TABLE, limits)
-    return FleetSummary(
-        tuple(tally.fitted),
-        tuple(tally.unchanged),
-        tally.failed,
-        tuple(tally.passed),
-        tuple(tally.rejected),
-        store=os.fspath(store if store is not None else output),
-        table=table,
-        warned=tally.warned,
-        busy=tally.busy,
-    )
+    return tally.summary(os.fspath(store if store is not None else output), table)
+
+
+def _checked(units: Iterable[UnitRuns], output, scheduler: str) -> tuple[list[UnitRuns], Path]:
+    """The units (their paths made absolute) and the output folder (made), after checking them and that a
+    scheduler's address is reachable."""
+    units = list(units)
+    _check_units(units)
+    if scheduler not in ("local", "serial"):
+        _check_reachable(scheduler)
+    output = Path(output)
+    if output.exists() and not output.is_dir():
+        raise InputError(f"output: {output} is a file; a fleet is written into a folder")
+    output.mkdir(parents=True, exist_ok=True)
+    return [replace(u, paths=tuple(os.path.abspath(p) for p in u.paths)) for u in units], output
 
 
 @dataclass(frozen=True)
@@ -365,6 +361,20 @@ class _Tally:
     rejected: list[str] = field(default_factory=list)
     warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
     busy: dict[str, str] = field(default_factory=dict)
+
+    def summary(self, store: str, table) -> FleetSummary:
+        """The fleet fit's summary: what this tally counted, the store's location and the fleet table."""
+        return FleetSummary(
+            tuple(self.fitted),
+            tuple(self.unchanged),
+            self.failed,
+            tuple(self.passed),
+            tuple(self.rejected),
+            store=store,
+            table=table,
+            warned=self.warned,
+            busy=self.busy,
+        )
 
     def count(self, record: CalibrationRecord) -> None:
         if record.status == "ok":

@@ -218,6 +218,25 @@ def _from_tclr(log: _Log, instance: int):
     return time_s, gyro, accel, temperature
 
 
+def _warn_of_parameters(path: Path, params: dict, instance: int, corrected: bool) -> None:
+    """Warn where the log's parameters say its IMU axes are rotated, or its data already corrected onboard."""
+    orientation = params.get("AHRS_ORIENTATION", 0.0)
+    if orientation:
+        warnings.warn(
+            f"{path}: AHRS_ORIENTATION = {orientation:g}: the logged IMU axes are the board's, rotated "
+            "from the sensor's; INS_TCAL parameters apply in the sensor frame",
+            DataQualityWarning,
+            stacklevel=3,
+        )
+    if corrected:
+        warnings.warn(
+            f"{path}: INS_TCAL{instance + 1}_ENABLE = 1: the logged IMU data are already corrected by "
+            "the onboard temperature calibration",
+            DataQualityWarning,
+            stacklevel=3,
+        )
+
+
 def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read an ArduPilot DataFlash log into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -258,44 +277,18 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
         params = log.parameters()
     finally:
         log.close()
-    orientation = params.get("AHRS_ORIENTATION", 0.0)
-    if orientation:
-        warnings.warn(
-            f"{path}: AHRS_ORIENTATION = {orientation:g}: the logged IMU axes are the board's, rotated "
-            "from the sensor's; INS_TCAL parameters apply in the sensor frame",
-            DataQualityWarning,
-            stacklevel=2,
-        )
-    if params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU":
-        warnings.warn(
-            f"{path}: INS_TCAL{instance + 1}_ENABLE = 1: the logged IMU data are already corrected by "
-            "the onboard temperature calibration",
-            DataQualityWarning,
-            stacklevel=2,
-        )
+    corrected = params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU"
+    _warn_of_parameters(path, params, instance, corrected)
     if progress:
         progress(1.0)
-    return log_recording(
-        path,
-        options,
-        time_s,
-        gyro,
-        accel,
-        temperature,
-        {
-            "path": str(path),
-            "format": "dataflash",
-            "autopilot": "ardupilot",
-            "record": record,
-            "instance": instance,
-            "corrected_onboard": params.get(f"INS_TCAL{instance + 1}_ENABLE") == 1.0 and record == "IMU",
-            # the installed thermal calibration and the temperatures its gyro offsets were taken at
-            "autopilot_parameters": {
-                k: v for k, v in params.items() if k.startswith("INS_TCAL") or k.endswith("_CALTEMP")
-            },
-            "truncated_bytes": log.cut_bytes if log.cut_bytes >= 3 else 0,
-        },
-    )
+    metadata = {"path": str(path), "format": "dataflash", "autopilot": "ardupilot", "record": record}
+    metadata.update(instance=instance, corrected_onboard=corrected)
+    # the installed thermal calibration and the temperatures its gyro offsets were taken at
+    metadata["autopilot_parameters"] = {
+        k: v for k, v in params.items() if k.startswith("INS_TCAL") or k.endswith("_CALTEMP")
+    }
+    metadata["truncated_bytes"] = log.cut_bytes if log.cut_bytes >= 3 else 0
+    return log_recording(path, options, time_s, gyro, accel, temperature, metadata)
 
 
 register_reader(

@@ -396,6 +396,36 @@ def unreadable(source: str, message: str) -> RunCheck:
 
 
 # -- the checks of a set of runs ----------------------------------------------------------------------------------
+def _too_few_levels(recordings: Sequence[Recording], known: list, ask: Ask, out: dict) -> None:
+    """Add to ``out`` (by run) the finding that the runs' temperatures ``known`` [degC] have fewer samples or
+    levels than the curve asked needs."""
+    samples = sum(t.size for t in known)
+    levels = len(np.unique(np.round(np.concatenate(known), 1)))
+    if samples >= SAMPLES_PER_PARAMETER * ask.parameters and levels >= LEVELS_PER_PARAMETER * ask.parameters:
+        return
+    # fewer samples or levels than parameters: the curve asked is not determined at all
+    undetermined = ask.temperature == "asked" and min(samples, levels) < ask.parameters
+    if ask.temperature == "auto":
+        cost = _NO_CURVE
+    else:
+        cost = (
+            ""
+            if undetermined
+            else "the curve's parameters poorly determined: its error between the levels is not known"
+        )
+    for i in range(len(recordings)):
+        out.setdefault(i, []).append(
+            Finding(
+                "too-short",
+                "refuse" if undetermined else "warn",
+                f"{recordings[i].source}: {samples} "
+                f"sample(s) at {levels} temperature level(s) for a curve of {ask.parameters} parameters (at "
+                f"least {SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
+                cost,
+            )
+        )
+
+
 def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Finding]]:
     """What only the runs together say, by run: a constant temperature in every run, too little span, too short
     for the curve, no reversal where hysteresis is asked (each said on every run it concerns)."""
@@ -403,29 +433,7 @@ def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Fi
     temps = [_temperature(r) for r in recordings]
     known = [t for t in temps if t is not None]
     if ask.temperature != "none" and known:
-        samples = sum(t.size for t in known)
-        levels = len(np.unique(np.round(np.concatenate(known), 1)))
-        if samples < SAMPLES_PER_PARAMETER * ask.parameters or levels < LEVELS_PER_PARAMETER * ask.parameters:
-            # fewer samples or levels than parameters: the curve asked is not determined at all
-            undetermined = ask.temperature == "asked" and min(samples, levels) < ask.parameters
-            cost = (
-                _NO_CURVE
-                if ask.temperature == "auto"
-                else ""
-                if undetermined
-                else "the curve's parameters poorly determined: its error between the levels is not known"
-            )
-            for i in range(len(recordings)):
-                out.setdefault(i, []).append(
-                    Finding(
-                        "too-short",
-                        "refuse" if undetermined else "warn",
-                        f"{recordings[i].source}: {samples} "
-                        f"sample(s) at {levels} temperature level(s) for a curve of {ask.parameters} parameters (at "
-                        f"least {SAMPLES_PER_PARAMETER * ask.parameters} and {LEVELS_PER_PARAMETER * ask.parameters})",
-                        cost,
-                    )
-                )
+        _too_few_levels(recordings, known, ask, out)
     present = [t for t in temps if t is not None and np.ptp(t) >= CONSTANT_SPAN_DEGC]
     if ask.temperature != "none" and known and not present:  # every run at one temperature
         for i, t in enumerate(temps):

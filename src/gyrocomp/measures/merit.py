@@ -280,6 +280,24 @@ def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarr
     )
 
 
+def _checked_stretches(raw: Recording, compensated: Recording, accel: bool) -> list[slice]:
+    """The raw run's stretches between time gaps, after checking the compensated values (warns of the gaps)."""
+    for j, axis in enumerate(compensated.gyro_axes):
+        check_compensated(raw.source, axis, compensated.gyro_dps[:, j], raw.row_numbers)
+    if accel and compensated.accel_g is not None:
+        for j, axis in enumerate(compensated.accel_axes):
+            check_compensated(raw.source, axis, compensated.accel_g[:, j], raw.row_numbers)
+    stretches = raw.contiguous_stretches()
+    if raw.gaps:
+        warnings.warn(
+            f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation pools the {len(stretches)} stretches "
+            "between them, the moving average runs across them",
+            DataQualityWarning,
+            stacklevel=3,
+        )
+    return stretches
+
+
 def evaluate_run(
     raw: Recording,
     compensated: Recording,
@@ -303,19 +321,7 @@ def evaluate_run(
         the stretches between time gaps), by axis, when the caller has them already (the report draws them):
         their minima are the bias instabilities, instead of computing the curves again.
     """
-    for j, axis in enumerate(compensated.gyro_axes):
-        check_compensated(raw.source, axis, compensated.gyro_dps[:, j], raw.row_numbers)
-    if accel and compensated.accel_g is not None:
-        for j, axis in enumerate(compensated.accel_axes):
-            check_compensated(raw.source, axis, compensated.accel_g[:, j], raw.row_numbers)
-    stretches = raw.contiguous_stretches()
-    if raw.gaps:
-        warnings.warn(
-            f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation pools the {len(stretches)} stretches "
-            "between them, the moving average runs across them",
-            DataQualityWarning,
-            stacklevel=2,
-        )
+    stretches = _checked_stretches(raw, compensated, accel)
     # the Allan minima do not depend on the window; the default window is the raw minima's longest tau
     if allan is not None:
         lows = [(allan[0][axis].minimum(), allan[1][axis].minimum()) for axis in raw.gyro_axes]

@@ -175,38 +175,47 @@ def analyse_noise(
     if motion_check:
         warn_if_moving(recording.source, detect_still(recording))
     stretches = recording.contiguous_stretches()
-    how = None
-    if len(stretches) > 1:
-        longest = max(stretches, key=lambda s: s.stop - s.start)
-        length_s = (longest.stop - longest.start) / recording.rate_hz
-        how = (
-            f"{recording.source}: pooled {len(stretches)} contiguous stretches split at "
-            f"{len(recording.gaps)} gap(s); no difference spans a gap (longest stretch {length_s:.6g} s)"
-        )
-        if kind == "totdev":
-            how = (
-                f"{recording.source}: TOTDEV on the longest of {len(stretches)} contiguous stretches "
-                f"({length_s:.6g} s, rows {recording.row_numbers[longest.start]}-"
-                f"{recording.row_numbers[longest.stop - 1]}); the noise terms pool all stretches"
-            )
     results = {}
     for name in names:
         values, sensor, unit = axis_values(recording, name)
-        pieces = [values[s] for s in stretches]
-        if len(pieces) == 1:
-            curve = allan_deviation(values, recording.rate_hz, kind=kind, taus=taus)
-            allan = curve if kind == "oadev" else allan_deviation(values, recording.rate_hz, taus="octave")
-        else:
-            allan = allan_deviation_segments(pieces, recording.rate_hz, taus="octave")
-            if kind == "totdev":
-                curve = allan_deviation(max(pieces, key=len), recording.rate_hz, kind=kind, taus=taus)
-            elif kind == "oadev" and isinstance(taus, str) and taus == "octave":
-                curve = allan
-            else:
-                curve = allan_deviation_segments(pieces, recording.rate_hz, kind=kind, taus=taus)
+        curve, allan = _curves([values[s] for s in stretches], recording.rate_hz, kind, taus)
         results[name] = _axis_noise(name, sensor, unit, curve, allan, fit_taus_s)
+    how = _pooling_note(recording, stretches, kind)
     return NoiseAnalysis(
         source=recording.source, rate_hz=recording.rate_hz, axes=results, stretches=len(stretches), how=how
+    )
+
+
+def _curves(pieces: list[np.ndarray], rate_hz: float, kind: str, taus) -> tuple[AllanResult, AllanResult]:
+    """The curve of ``kind`` and the octave overlapping Allan deviation of an axis's contiguous ``pieces``."""
+    if len(pieces) == 1:
+        curve = allan_deviation(pieces[0], rate_hz, kind=kind, taus=taus)
+        return curve, curve if kind == "oadev" else allan_deviation(pieces[0], rate_hz, taus="octave")
+    allan = allan_deviation_segments(pieces, rate_hz, taus="octave")
+    if kind == "totdev":
+        curve = allan_deviation(max(pieces, key=len), rate_hz, kind=kind, taus=taus)
+    elif kind == "oadev" and isinstance(taus, str) and taus == "octave":
+        curve = allan
+    else:
+        curve = allan_deviation_segments(pieces, rate_hz, kind=kind, taus=taus)
+    return curve, allan
+
+
+def _pooling_note(recording: Recording, stretches: list[slice], kind: str) -> str | None:
+    """How the stretches between the recording's gaps were pooled (None: one stretch)."""
+    if len(stretches) <= 1:
+        return None
+    longest = max(stretches, key=lambda s: s.stop - s.start)
+    length_s = (longest.stop - longest.start) / recording.rate_hz
+    if kind == "totdev":
+        return (
+            f"{recording.source}: TOTDEV on the longest of {len(stretches)} contiguous stretches "
+            f"({length_s:.6g} s, rows {recording.row_numbers[longest.start]}-"
+            f"{recording.row_numbers[longest.stop - 1]}); the noise terms pool all stretches"
+        )
+    return (
+        f"{recording.source}: pooled {len(stretches)} contiguous stretches split at "
+        f"{len(recording.gaps)} gap(s); no difference spans a gap (longest stretch {length_s:.6g} s)"
     )
 
 

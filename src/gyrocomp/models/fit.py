@@ -95,12 +95,20 @@ def fit(
     accel_cal = fit_accel_channel(recordings, options)
     if "gyro" not in channels:
         return accel_cal
-    compensated = recordings
-    if accel_cal.accel_axes:
-        compensated = [
-            dataclasses.replace(rec, accel_g=apply(accel_cal.without_accel_triad(), rec).accel_g) for rec in recordings
-        ]
-    gyro_cal = run_pipeline(compensated, pipeline, options)
+    gyro_cal = run_pipeline(_accel_compensated(recordings, accel_cal), pipeline, options)
+    return _combined(gyro_cal, accel_cal, gyro_triad)
+
+
+def _accel_compensated(recordings: list[Recording], accel_cal: Calibration) -> list[Recording]:
+    """The runs with their accelerations [g] temperature-compensated (as the compensation will feed the gyro's
+    g-sensitivity stage)."""
+    if not accel_cal.accel_axes:
+        return recordings
+    return [dataclasses.replace(rec, accel_g=apply(accel_cal.without_accel_triad(), rec).accel_g) for rec in recordings]
+
+
+def _combined(gyro_cal: Calibration, accel_cal: Calibration, gyro_triad) -> Calibration:
+    """The gyro's calibration with the accelerometer's models and the gyro's triad."""
     return dataclasses.replace(
         gyro_cal,
         model=f"{gyro_cal.model}; {accel_cal.model}",

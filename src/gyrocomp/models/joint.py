@@ -99,6 +99,40 @@ def _fit_network(
     return network.curves_[axis], network.turn_on_biases_[axis]
 
 
+def _set_accel_columns(problem, acceleration: str, columns: tuple | None) -> tuple:
+    """Give an axis's problem the excited acceleration columns (and squared columns for ``matrix2``): ``columns``
+    as the first axis found them, or found from this axis's runs when None; returns them."""
+    if any(r.accel_g is None for r in problem.runs):
+        raise InputError(
+            "acceleration: the runs need accel_x, accel_y and accel_z columns for a "
+            "g-sensitivity fit; map them with columns= or fit with acceleration='none'"
+        )
+    if columns is None:
+        accel_cols, square_cols, _ = excited_columns(
+            [r.accel_g for r in problem.runs],
+            [r.weight for r in problem.runs],
+            squares=acceleration == "matrix2",
+            warn=False,
+        )
+        columns = (accel_cols, square_cols)
+    problem.accel_cols, problem.square_cols = columns
+    return columns
+
+
+def _axis_problems(recordings: list[Recording], acceleration: str, static_min_duration_s: float, **settings) -> dict:
+    """Each gyro axis's selection problem (:func:`gyrocomp.fitting.selection.prepare_axis` with ``settings``), with
+    the acceleration columns of ``acceleration`` and the static pieces of at least ``static_min_duration_s`` [s]."""
+    _, pieces = static_pieces(recordings, static_min_duration_s, warn=False)  # the final fit says it
+    columns = None
+    problems = {}
+    for axis in fit_axes(recordings):
+        problem = prepare_axis(recordings, axis, pieces=pieces, **settings)
+        if acceleration != "none":
+            columns = _set_accel_columns(problem, acceleration, columns)
+        problems[axis] = problem
+    return problems
+
+
 def select_models(
     recordings: list[Recording],
     *,
@@ -142,39 +176,19 @@ def select_models(
     """
     if folds not in FOLD_KINDS:
         raise InputError(f"folds: {folds!r}; use one of {', '.join(FOLD_KINDS)}")
-    _, pieces = static_pieces(recordings, static_min_duration_s, warn=False)  # the final fit says it
-    accel_cols: tuple[int, ...] = ()
-    square_cols: tuple[int, ...] = ()
-    problems = {}
-    for k, axis in enumerate(fit_axes(recordings)):
-        problem = prepare_axis(
-            recordings,
-            axis,
-            pieces=pieces,
-            groups=run_folds,
-            bin_width_degc=bin_width_degc,
-            fold_kind=folds,
-            max_order=max(orders, default=0),
-            hysteresis_orders=hysteresis_orders,
-            both_directions="none" in memories,
-            branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
-            other_curves=other_curves,
-        )
-        if acceleration != "none":
-            if any(r.accel_g is None for r in problem.runs):
-                raise InputError(
-                    "acceleration: the runs need accel_x, accel_y and accel_z columns for a "
-                    "g-sensitivity fit; map them with columns= or fit with acceleration='none'"
-                )
-            if k == 0:
-                accel_cols, square_cols, _ = excited_columns(
-                    [r.accel_g for r in problem.runs],
-                    [r.weight for r in problem.runs],
-                    squares=acceleration == "matrix2",
-                    warn=False,
-                )
-            problem.accel_cols, problem.square_cols = accel_cols, square_cols
-        problems[axis] = problem
+    problems = _axis_problems(
+        recordings,
+        acceleration,
+        static_min_duration_s,
+        groups=run_folds,
+        bin_width_degc=bin_width_degc,
+        fold_kind=folds,
+        max_order=max(orders, default=0),
+        hysteresis_orders=hysteresis_orders,
+        both_directions="none" in memories,
+        branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
+        other_curves=other_curves,
+    )
     one_die = shared_lag and one_temperature_column(recordings)
     if one_die and any("lag" in m for m in memories):
         share_fold_lags(list(problems.values()), orders)
@@ -388,6 +402,19 @@ def fit_calibration(
     )
 
 
+def _network_report(network: NetworkTemperatureModel, unit: str) -> dict:
+    """The fit report's entry for a trained network (its validation errors in ``unit``)."""
+    return NetworkReport(
+        tuple(network.hidden),
+        network.restarts,
+        network.seed,
+        "Levenberg-Marquardt, early stopping on 20 % held-out segments",
+        {a: tuple(network.validation_rmse_[a]) for a in network.curves_},
+        {a: network.epochs_[a] for a in network.curves_},
+        unit,
+    ).to_dict()
+
+
 def fit_joint(
     recordings: list[PreparedRun], options: FitOptions, network_inputs: tuple[str, ...] = ("temperature",)
 ) -> Calibration:
@@ -428,15 +455,7 @@ def fit_joint(
         )
     if network is not None:
         report["temperature"] = "mlp"
-        report["network"] = NetworkReport(
-            tuple(network.hidden),
-            network.restarts,
-            network.seed,
-            "Levenberg-Marquardt, early stopping on 20 % held-out segments",
-            {a: tuple(network.validation_rmse_[a]) for a in network.curves_},
-            {a: network.epochs_[a] for a in network.curves_},
-            unit,
-        ).to_dict()
+        report["network"] = _network_report(network, unit)
     name = _model_name(
         axes, network, network_inputs, spec.size if isinstance(spec, Curve) else order, thermal, accel_mode
     )
@@ -562,6 +581,19 @@ def _report_of_choice(
     return report
 
 
+def _thermal_terms(thermal, axis: str, accel_mode: str) -> tuple:
+    """An axis's lag [s], hysteresis, g-sensitivity row [deg/s/g] and squared row [deg/s/g^2] from the thermal
+    fit (``None``: lag 0 and no other term)."""
+    lag, hyst, g_row, g_sq = 0.0, None, None, None
+    if thermal is not None:
+        lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
+        if accel_mode != "none" and thermal.excited_axes_:
+            g_row = tuple(float(v) for v in thermal.g_sensitivity_dps_per_g_[axis])
+            if accel_mode == "matrix2":
+                g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
+    return lag, hyst, g_row, g_sq
+
+
 def _axis_calibration(
     axis: str,
     recordings: list[Recording],
@@ -580,13 +612,7 @@ def _axis_calibration(
         if thermal is not None
         else (model.curves_[axis], model.turn_on_biases_[axis])
     )
-    lag, hyst, g_row, g_sq = 0.0, None, None, None
-    if thermal is not None:
-        lag, hyst = thermal.lag_time_constants_s_[axis], thermal.hysteresis_[axis]
-        if accel_mode != "none" and thermal.excited_axes_:
-            g_row = tuple(float(v) for v in thermal.g_sensitivity_dps_per_g_[axis])
-            if accel_mode == "matrix2":
-                g_sq = tuple(float(v) for v in thermal.g_squared_dps_per_g2_[axis])
+    lag, hyst, g_row, g_sq = _thermal_terms(thermal, axis, accel_mode)
     if network is not None:
         joint = network_inputs != ("temperature",)
         curve, consts = _fit_network(
@@ -615,21 +641,13 @@ def _axis_calibration(
         g_sq,
         unit=recordings[0].unit_of(axis),
     )
-    fit_rms = (
-        network.train_rmse_[axis]
-        if network is not None
-        else model.fit_rms_[axis]
-        if model is not None and thermal is None
-        else None
-    )
-    entry = AxisFit(
-        curve.order,
-        curve.t_min_degc,
-        curve.t_max_degc,
-        fit_rms,
-        result.unit,
-        {} if model is None else dict(model.scores_[axis]),
-    )
+    fit_rms = None
+    if network is not None:
+        fit_rms = network.train_rmse_[axis]
+    elif model is not None and thermal is None:
+        fit_rms = model.fit_rms_[axis]
+    scores = {} if model is None else dict(model.scores_[axis])
+    entry = AxisFit(curve.order, curve.t_min_degc, curve.t_max_degc, fit_rms, result.unit, scores)
     return result, entry.to_dict()
 
 

@@ -14,16 +14,8 @@ from ..calibration import Calibration
 from ..calibration.triad import TriadCalibration
 from ..errors import DataQualityWarning, InputError
 from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
-from ..fitting.triad_fit import (
-    MIN_REFERENCE_RATE_DPS,
-    MIN_TRIAD_SPAN_DEGC,
-    Pose,
-    PoseFit,
-    find_poses,
-    fit_accel_multiposition,
-    fit_gyro_rate_table,
-    spans_axes,
-)
+from ..fitting.rate_table import MIN_REFERENCE_RATE_DPS, fit_gyro_rate_table
+from ..fitting.triad_fit import MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, spans_axes
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 
 #: how ``fit_channels`` treats the gyro's scale factor and misalignment

@@ -20,6 +20,43 @@ TEMPERATURE_COLUMN = "temperature"
 GAP_FACTOR = 2.0
 
 
+def _temperature_array(src: str, value, n: int, axes: tuple[str, ...]) -> np.ndarray | None:
+    """The temperature [degC] as one column (n,) or one per gyro axis (n, axes), shape checked."""
+    if value is None:
+        return None
+    temp = np.asarray(value, dtype=float)
+    if temp.ndim == 2 and temp.shape[1] == 1:
+        temp = temp[:, 0]
+    if temp.shape not in ((n,), (n, len(axes))):
+        raise InputError(f"{src}: temperature has shape {temp.shape}; expected ({n},) or ({n}, {len(axes)})")
+    return temp
+
+
+def _accel_array(src: str, value, n: int, accel_axes: tuple[str, ...]) -> np.ndarray | None:
+    """The accelerations [g] as (n, accel axes), shape checked."""
+    if value is None:
+        return None
+    accel = np.asarray(value, dtype=float)
+    if accel.ndim == 1:
+        accel = accel[:, None]
+    if accel.shape != (n, len(accel_axes)):
+        raise InputError(f"{src}: accelerometer data has shape {accel.shape}, expected ({n}, {len(accel_axes)})")
+    return accel
+
+
+def _reference_array(src: str, value, n: int) -> np.ndarray | None:
+    """The rate table's reference rates [deg/s] as (n, 3), shape checked."""
+    if value is None:
+        return None
+    reference = np.asarray(value, dtype=float)
+    if reference.shape != (n, 3):
+        raise InputError(
+            f"{src}: reference rates have shape {reference.shape}, expected ({n}, 3) "
+            f"for {', '.join(REFERENCE_RATE_AXES)}"
+        )
+    return reference
+
+
 def _temperature_names(gyro_axes: tuple[str, ...], per_axis: bool) -> tuple[str, ...]:
     """Temperature channel names: one shared column, or ``temperature_x`` ... one per gyro axis."""
     if not per_axis:
@@ -163,30 +200,9 @@ class Recording:
         if gyro.shape != (n, len(axes)) or not axes:
             raise InputError(f"{src}: gyro data has shape {gyro.shape}, expected ({n}, {len(axes)}) for axes {axes}")
         rows = np.arange(1, n + 1) if self.row_numbers is None else np.asarray(self.row_numbers)
-        temp = None
-        if self.temperature_degc is not None:
-            temp = np.asarray(self.temperature_degc, dtype=float)
-            if temp.ndim == 2 and temp.shape[1] == 1:
-                temp = temp[:, 0]
-            if temp.shape not in ((n,), (n, len(axes))):
-                raise InputError(f"{src}: temperature has shape {temp.shape}; expected ({n},) or ({n}, {len(axes)})")
-        accel = None
-        if self.accel_g is not None:
-            accel = np.asarray(self.accel_g, dtype=float)
-            if accel.ndim == 1:
-                accel = accel[:, None]
-            if accel.shape != (n, len(self.accel_axes)):
-                raise InputError(
-                    f"{src}: accelerometer data has shape {accel.shape}, expected ({n}, {len(self.accel_axes)})"
-                )
-        reference = None
-        if self.reference_rate_dps is not None:
-            reference = np.asarray(self.reference_rate_dps, dtype=float)
-            if reference.shape != (n, 3):
-                raise InputError(
-                    f"{src}: reference rates have shape {reference.shape}, expected ({n}, 3) "
-                    f"for {', '.join(REFERENCE_RATE_AXES)}"
-                )
+        temp = _temperature_array(src, self.temperature_degc, n, axes)
+        accel = _accel_array(src, self.accel_g, n, tuple(self.accel_axes))
+        reference = _reference_array(src, self.reference_rate_dps, n)
         temp_names = _temperature_names(axes, temp is not None and temp.ndim == 2)
         _require_finite(
             src,

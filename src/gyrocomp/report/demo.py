@@ -146,14 +146,7 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
     """
     out_dir.mkdir(parents=True, exist_ok=True)
     cal_paths, held, held_path = _simulate_inputs(out_dir, rate_hz)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DataQualityWarning)  # the pauses while turning the unit are the profile's
-        # three runs are three folds, fewer than the four a firm choice wants: the validation table shows them
-        warnings.simplefilter("ignore", ModelChoiceWarning)
-        cal_runs = [read_table(p).recording for p in cal_paths]
-        calibration = fit_calibration(cal_runs)
-        validation = validate(cal_runs)
-        autopilots = {name: fit(cal_runs) for name, fit in AUTOPILOT_METHODS.items()}
+    calibration, validation, autopilots = _fitted(cal_paths)
     calibration.save(out_dir / "model.json")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)  # the pauses are the profile's; said in the summary
@@ -164,36 +157,28 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
         by_method.update({name: apply(cal, held_data.recording) for name, cal in autopilots.items()})
     write_gyro_back(held_data, compensated.gyro_dps, out_dir / "heldout_compensated.csv")
     evaluation = Evaluation([run_eval])
-    write_text_atomic(out_dir / "metrics.json", json.dumps(evaluation.to_dict(), indent=2) + "\n")
-    write_text_atomic(out_dir / "validation.json", json.dumps(validation.to_dict(), indent=2) + "\n")
     allan = _allan_table(held, compensated)
-    write_text_atomic(out_dir / "allan.json", json.dumps({a: c.to_dict() for a, c in allan.items()}, indent=2) + "\n")
     effects, residual, methods_rms = _effects(held, calibration, by_method, rate_hz)
-    write_text_atomic(
+    _write_json(out_dir / "metrics.json", evaluation.to_dict())
+    _write_json(out_dir / "validation.json", validation.to_dict())
+    _write_json(out_dir / "allan.json", {a: c.to_dict() for a, c in allan.items()})
+    _write_json(
         out_dir / "effects.json",
-        json.dumps(
-            {
-                "window_s": EFFECT_WINDOW_S,
-                "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
-                "residual_peak_to_peak_dps": residual,
-                "deterministic_error_left_rms_dps_by_method": methods_rms,
-            },
-            indent=2,
-        )
-        + "\n",
+        {
+            "window_s": EFFECT_WINDOW_S,
+            "effects_peak_to_peak_dps": {e.effect: e.size_dps for e in effects},
+            "residual_peak_to_peak_dps": residual,
+            "deterministic_error_left_rms_dps_by_method": methods_rms,
+        },
     )
-    w = window_samples(run_eval.window_s, rate_hz, held.recording.n_samples)
-    perfect = {
-        axis: smoothed_residual_rms(held.truth.noise.total_dps[:, j], w)
-        for j, axis in enumerate(held.recording.gyro_axes)
-    }
+    perfect = _perfect(held, window_samples(run_eval.window_s, rate_hz, held.recording.n_samples))
     lines = _summary(
         len(cal_paths), rate_hz, calibration, held, effects, residual, allan, run_eval, perfect, methods_rms
     )
     mti10 = _case_from_methods(f"{PRESET} (the run above)", held, by_method, calibration.model, rate_hz)
     consumer, series = _consumer_case(rate_hz)
     cases = (consumer, mti10)
-    write_text_atomic(out_dir / "cases.json", json.dumps([c.to_dict() for c in cases], indent=2) + "\n")
+    _write_json(out_dir / "cases.json", [c.to_dict() for c in cases])
     skipped = (
         _write_report(calibration, held_data.recording, out_dir / "report.html", validation, (consumer, mti10, series))
         if report
@@ -206,21 +191,36 @@ def run_demo(out_dir: Path, *, rate_hz: float = RATE_HZ, report: bool = True) ->
             f"Report: {out_dir / 'report.html'} (open it in a browser): the case where compensation matters "
             "first, then the MTi-10 model on its held-out run."
         )
-    files = sorted(out_dir.iterdir())
-    return DemoResult(
-        calibration,
-        evaluation,
-        perfect,
-        effects,
-        residual,
-        methods_rms,
-        validation,
-        allan,
-        "\n".join(lines),
-        files,
-        skipped,
-        cases,
-    )
+    text, files = "\n".join(lines), sorted(out_dir.iterdir())
+    figures = (effects, residual, methods_rms, validation, allan)
+    return DemoResult(calibration, evaluation, perfect, *figures, text, files, skipped, cases)
+
+
+def _fitted(cal_paths: list[Path]) -> tuple:
+    """gyrocomp's model of the calibration runs, its validation, and each autopilot method's model."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)  # the pauses while turning the unit are the profile's
+        # three runs are three folds, fewer than the four a firm choice wants: the validation table shows them
+        warnings.simplefilter("ignore", ModelChoiceWarning)
+        cal_runs = [read_table(p).recording for p in cal_paths]
+        calibration = fit_calibration(cal_runs)
+        validation = validate(cal_runs)
+        autopilots = {name: fit(cal_runs) for name, fit in AUTOPILOT_METHODS.items()}
+    return calibration, validation, autopilots
+
+
+def _perfect(held, window: int) -> dict[str, float]:
+    """Per axis, the residual RMS [deg/s] a perfect compensation leaves on the held-out run: its noise alone,
+    smoothed over ``window`` samples."""
+    return {
+        axis: smoothed_residual_rms(held.truth.noise.total_dps[:, j], window)
+        for j, axis in enumerate(held.recording.gyro_axes)
+    }
+
+
+def _write_json(path: Path, document) -> None:
+    """``document`` as indented JSON, atomically."""
+    write_text_atomic(path, json.dumps(document, indent=2) + "\n")
 
 
 def _case_from_methods(

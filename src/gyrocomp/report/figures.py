@@ -275,6 +275,23 @@ def _binned_by_branch(t: np.ndarray, width: float, *series: np.ndarray) -> dict:
     return out
 
 
+def _axis_temperature(rec, axis: str, accel: bool) -> np.ndarray:
+    """The temperature [degC] an axis of ``rec`` is drawn against (an accelerometer's: the mean of the sensors')."""
+    if rec.temperature_degc.ndim == 1:
+        return rec.temperature_degc
+    return rec.temperature_degc.mean(axis=1) if accel else rec.temperature_for(axis)
+
+
+def _plot_turns(ax, direction: np.ndarray, t: np.ndarray, correction: np.ndarray, labelled: set) -> None:
+    """Diamonds at the turning points of the temperature ``t`` [degC], at the model's ``correction``."""
+    turns = np.flatnonzero(np.diff(direction) != 0) + 1
+    turns = turns[direction[turns - 1] != 0]
+    if turns.size:
+        label = None if "turn" in labelled else "turning points"
+        ax.plot(t[turns], correction[turns], "D", color="black", ms=6, mfc="gold", label=label)
+        labelled.add("turn")
+
+
 def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: str | None = None):
     """Bias against temperature of one axis of one or more runs: the raw output (binned by 0.25 % of the
     range on each branch, heating red, cooling blue), the model's correction (black), the turning points
@@ -290,11 +307,7 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
         j = (rec.accel_axes if accel else rec.gyro_axes).index(axis)
         y_raw = (rec.accel_g if accel else rec.gyro_dps)[:, j]
         y_comp = (comp.accel_g if accel else comp.gyro_dps)[:, j]
-        t = (
-            rec.temperature_degc
-            if rec.temperature_degc.ndim == 1
-            else (rec.temperature_degc.mean(axis=1) if accel else rec.temperature_for(axis))
-        )
+        t = _axis_temperature(rec, axis, accel)
         offset = float(np.mean(y_comp))
         width = max(float(np.ptp(t)) / 400.0, 1e-3)
         direction = _branches(t)
@@ -313,19 +326,7 @@ def temperature_plot(raw, compensated, axis: str, unit: str = "deg/s", title: st
             top.plot(tb, yc, "-", color="black", lw=1.2, label=None if "model" in labelled else "model correction")
             labelled.add("model")
             bottom.plot(tb, yr, ".", ms=3, color=colour, alpha=0.7)
-        turns = np.flatnonzero(np.diff(direction) != 0) + 1
-        turns = turns[direction[turns - 1] != 0]
-        if turns.size:
-            top.plot(
-                t[turns],
-                y_raw[turns] - y_comp[turns],
-                "D",
-                color="black",
-                ms=6,
-                mfc="gold",
-                label=None if "turn" in labelled else "turning points",
-            )
-            labelled.add("turn")
+        _plot_turns(top, direction, t, y_raw - y_comp, labelled)
     top.set_ylabel(f"bias [{unit}]")
     top.set_title(title or f"{axis}: bias against temperature")
     top.grid(True, alpha=0.3)

@@ -132,53 +132,15 @@ def _summary(calibration: Calibration) -> str:
     report = calibration.report
     parts = [
         f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
-        f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>"
+        f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>",
+        _axis_table(calibration),
     ]
-    rows = []
-    for group, axes, unit in (("gyro", calibration.axes, "deg/s"), ("accelerometer", calibration.accel_axes, "g")):
-        fits = (report.accel.axes if report.accel is not None else {}) if group == "accelerometer" else report.axes
-        for name, ax in axes.items():
-            inputs = ", ".join(ax.temperature.inputs) if ax.temperature else "-"
-            rng = (
-                "-" if ax.temperature is None else f"{ax.temperature.t_min_degc:.2f} .. {ax.temperature.t_max_degc:.2f}"
-            )
-            rms = fits[name].fit_rms if name in fits else None
-            rows.append(
-                [name, _describe(ax), inputs, rng, "-" if rms is None else f"{rms:.3g} {unit}", len(ax.turn_on_biases)]
-            )
-    header = ["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"]
-    if all(row[4] == "-" for row in rows):  # no fit recorded one: no empty column
-        header, rows = header[:4] + header[5:], [row[:4] + row[5:] for row in rows]
-    parts.append(_table(header, rows))
     if calibration.accel_axes:
         parts.append(
             f"<p class=note>Accelerometer corrections are relative to {calibration.accel_reference_degc:.2f} "
             "degC (its constant cannot be told from gravity at rest).</p>"
         )
-    expected = report.expected_drift()
-    if expected:
-        first = next(iter(expected.values()))
-        parts.append(
-            _table(
-                ["axis", "model", "expected held-out drift", "run constant alone"],
-                [
-                    [
-                        e.axis,
-                        e.model,
-                        _expected(e.drift, e.standard_error, e.unit),
-                        "-" if e.constant_drift is None else f"{e.constant_drift:.3g} {e.unit}",
-                    ]
-                    for e in expected.values()
-                ],
-                f"drift to expect on unseen data: mean +- standard error over {first.folds} held-out "
-                f"{first.fold_kind} ({first.window_s:g} s moving average)",
-            )
-        )
-        if first.thin:
-            parts.append(
-                f"<p class=note>Only {first.folds} folds: thin evidence; more runs, or runs that heat and "
-                "cool more than once, make these figures firmer.</p>"
-            )
+    parts += _expected_drift(report.expected_drift())
     selection = report.order_selection
     if selection is not None:
         orders = selection.orders
@@ -210,6 +172,55 @@ def _summary(calibration: Calibration) -> str:
     return "\n".join(parts)
 
 
+def _axis_table(calibration: Calibration) -> str:
+    """The table of the model's axes: model, inputs, valid range [degC], fit RMS, run constants."""
+    report = calibration.report
+    rows = []
+    for group, axes, unit in (("gyro", calibration.axes, "deg/s"), ("accelerometer", calibration.accel_axes, "g")):
+        fits = (report.accel.axes if report.accel is not None else {}) if group == "accelerometer" else report.axes
+        for name, ax in axes.items():
+            inputs = ", ".join(ax.temperature.inputs) if ax.temperature else "-"
+            t = ax.temperature
+            rng = "-" if t is None else f"{t.t_min_degc:.2f} .. {t.t_max_degc:.2f}"
+            rms = fits[name].fit_rms if name in fits else None
+            rms_text = "-" if rms is None else f"{rms:.3g} {unit}"
+            rows.append([name, _describe(ax), inputs, rng, rms_text, len(ax.turn_on_biases)])
+    header = ["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"]
+    if all(row[4] == "-" for row in rows):  # no fit recorded one: no empty column
+        header, rows = header[:4] + header[5:], [row[:4] + row[5:] for row in rows]
+    return _table(header, rows)
+
+
+def _expected_drift(expected: dict) -> list[str]:
+    """The table of the held-out drift to expect per axis, and a note when the folds are few."""
+    if not expected:
+        return []
+    first = next(iter(expected.values()))
+    rows = [
+        [
+            e.axis,
+            e.model,
+            _expected(e.drift, e.standard_error, e.unit),
+            "-" if e.constant_drift is None else f"{e.constant_drift:.3g} {e.unit}",
+        ]
+        for e in expected.values()
+    ]
+    parts = [
+        _table(
+            ["axis", "model", "expected held-out drift", "run constant alone"],
+            rows,
+            f"drift to expect on unseen data: mean +- standard error over {first.folds} held-out "
+            f"{first.fold_kind} ({first.window_s:g} s moving average)",
+        )
+    ]
+    if first.thin:
+        parts.append(
+            f"<p class=note>Only {first.folds} folds: thin evidence; more runs, or runs that heat and "
+            "cool more than once, make these figures firmer.</p>"
+        )
+    return parts
+
+
 def _validation(result: ValidationResult) -> str:
     """The held-out drift table: mean +- standard error per method and axis [deg/s], and against the cubic."""
     header, rows = result.table_rows()
@@ -218,119 +229,54 @@ def _validation(result: ValidationResult) -> str:
     return _table(header, rows, caption) + folds
 
 
+_STAGE_HEADERS = [
+    "run",
+    "axis",
+    "window [s]",
+    "stage",
+    "bias offset [deg/s]",
+    "improvement (raw/stage)",
+    "bias instability [deg/h]",
+    "integration time [s]",
+]
+_EVALUATION_HEADERS = [
+    "run",
+    "axis",
+    "window [s]",
+    "offset raw [deg/s]",
+    "offset comp [deg/s]",
+    "improvement",
+    "BI raw [deg/h]",
+    "BI comp [deg/h]",
+    "int. time raw [s]",
+    "int. time comp [s]",
+]
+_ACCEL_HEADERS = ["run", "axis", "offset raw [g]", "offset comp [g]", "improvement", "BI raw [ug]", "BI comp [ug]"]
+
+
 def _evaluation(
     calibration: Calibration, runs: list[Recording], evaluations: list, turn_on_window_s: float | None
 ) -> str:
     """The evaluation table: ``evaluations`` (:func:`evaluate_run` of each run), or the stages of a staged model
     over the same windows."""
     staged = len(stage_calibrations(calibration)) > 1
-    parts = []
     rows, accel_rows = [], []
     for rec, ev in zip(runs, evaluations):
-        window_s = ev.window_s
         name = rec.source.rsplit("/", 1)[-1]  # a table cell: escaped once, by _table
         if staged:
-            st = evaluate_stages(calibration, rec, window_s=window_s, turn_on_window_s=turn_on_window_s)
-            first = next(iter(st.stages.values()))
-            for axis in first:
-                m0 = first[axis]
-                rows.append(
-                    [
-                        name,
-                        axis,
-                        f"{window_s:.3g}",
-                        "raw",
-                        m0.bias_offset_raw_dps,
-                        "1x",
-                        m0.bias_instability_raw_dph,
-                        m0.integration_time_raw_s,
-                    ]
-                )
-                for stage, axes in st.stages.items():
-                    m = axes[axis]
-                    rows.append(
-                        [
-                            "",
-                            "",
-                            "",
-                            stage,
-                            m.bias_offset_comp_dps,
-                            f"{m.offset_improvement:.3g}x",
-                            m.bias_instability_comp_dph,
-                            m.integration_time_comp_s,
-                        ]
-                    )
-        if not staged:
-            for axis, m in ev.axes.items():
-                rows.append(
-                    [
-                        name,
-                        axis,
-                        f"{window_s:.3g}",
-                        m.bias_offset_raw_dps,
-                        m.bias_offset_comp_dps,
-                        f"{m.offset_improvement:.3g}x",
-                        m.bias_instability_raw_dph,
-                        m.bias_instability_comp_dph,
-                        m.integration_time_raw_s,
-                        m.integration_time_comp_s,
-                    ]
-                )
+            rows += _stage_rows(calibration, rec, name, ev.window_s, turn_on_window_s)
+        else:
+            rows += _evaluation_rows(ev, name)
         for axis, m in ev.accel_axes.items():
-            accel_rows.append(
-                [
-                    name,
-                    axis,
-                    m.bias_offset_raw_g,
-                    m.bias_offset_comp_g,
-                    f"{m.offset_improvement:.3g}x",
-                    m.bias_instability_raw_ug,
-                    m.bias_instability_comp_ug,
-                ]
-            )
+            improvement = f"{m.offset_improvement:.3g}x"
+            accel_rows.append([name, axis, m.bias_offset_raw_g, m.bias_offset_comp_g, improvement])
+            accel_rows[-1] += [m.bias_instability_raw_ug, m.bias_instability_comp_ug]
     if staged:
-        parts.append(
-            _table(
-                [
-                    "run",
-                    "axis",
-                    "window [s]",
-                    "stage",
-                    "bias offset [deg/s]",
-                    "improvement (raw/stage)",
-                    "bias instability [deg/h]",
-                    "integration time [s]",
-                ],
-                rows,
-                "stages of the compensation (the thesis's Table 4.4)",
-            )
-        )
+        parts = [_table(_STAGE_HEADERS, rows, "stages of the compensation (the thesis's Table 4.4)")]
     else:
-        parts.append(
-            _table(
-                [
-                    "run",
-                    "axis",
-                    "window [s]",
-                    "offset raw [deg/s]",
-                    "offset comp [deg/s]",
-                    "improvement",
-                    "BI raw [deg/h]",
-                    "BI comp [deg/h]",
-                    "int. time raw [s]",
-                    "int. time comp [s]",
-                ],
-                rows,
-            )
-        )
+        parts = [_table(_EVALUATION_HEADERS, rows)]
     if accel_rows:
-        parts.append(
-            _table(
-                ["run", "axis", "offset raw [g]", "offset comp [g]", "improvement", "BI raw [ug]", "BI comp [ug]"],
-                accel_rows,
-                "accelerometer",
-            )
-        )
+        parts.append(_table(_ACCEL_HEADERS, accel_rows, "accelerometer"))
     parts.append(
         "<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
         "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>"
@@ -343,6 +289,33 @@ def _evaluation(
             "section is).</p>"
         )
     return "\n".join(parts)
+
+
+def _evaluation_rows(ev, name: str) -> list:
+    """One row per gyro axis of a run's evaluation: window [s], bias offsets [deg/s], improvement, bias
+    instabilities [deg/h], integration times [s]."""
+    rows = []
+    for axis, m in ev.axes.items():
+        row = [name, axis, f"{ev.window_s:.3g}", m.bias_offset_raw_dps, m.bias_offset_comp_dps]
+        row += [f"{m.offset_improvement:.3g}x", m.bias_instability_raw_dph, m.bias_instability_comp_dph]
+        rows.append(row + [m.integration_time_raw_s, m.integration_time_comp_s])
+    return rows
+
+
+def _stage_rows(calibration: Calibration, rec: Recording, name: str, window_s: float, turn_on_window_s) -> list:
+    """Per gyro axis of a run, its raw figures then each stage's (:func:`evaluate_stages`) over ``window_s`` [s]."""
+    st = evaluate_stages(calibration, rec, window_s=window_s, turn_on_window_s=turn_on_window_s)
+    first = next(iter(st.stages.values()))
+    rows = []
+    for axis in first:
+        m0 = first[axis]
+        rows.append([name, axis, f"{window_s:.3g}", "raw", m0.bias_offset_raw_dps, "1x"])
+        rows[-1] += [m0.bias_instability_raw_dph, m0.integration_time_raw_s]
+        for stage, axes in st.stages.items():
+            m = axes[axis]
+            rows.append(["", "", "", stage, m.bias_offset_comp_dps, f"{m.offset_improvement:.3g}x"])
+            rows[-1] += [m.bias_instability_comp_dph, m.integration_time_comp_s]
+    return rows
 
 
 def _g_positions(calibration: Calibration, runs: list[Recording], min_static_s: float):
@@ -520,16 +493,7 @@ def build_report(
             sections["validation"] = ("Validation", _validation(validation))
         # the Allan curves drawn below, raw and compensated: their minima are the bias instabilities (once)
         noise = [_noise(rec, comp) for rec, comp in zip(runs, compensated)]
-        evaluations = [
-            evaluate_run(
-                rec,
-                comp,
-                window_s=window_s,
-                accel=bool(calibration.accel_axes),
-                allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair),
-            )
-            for rec, comp, pair in zip(runs, compensated, noise)
-        ]
+        evaluations = _evaluations(calibration, runs, compensated, noise, window_s)
         sections["evaluation"] = ("Evaluation", _evaluation(calibration, runs, evaluations, turn_on_window_s))
         tick()
         sections.update(_axis_sections(calibration, runs, compensated, [ev.window_s for ev in evaluations]))
@@ -538,15 +502,47 @@ def build_report(
             sections["firmware"] = ("On the autopilot", _firmware(calibration, runs, evaluations, costs))
         tick()
         sections["allan"] = ("Allan deviation", _allan(runs, noise, tick))
-        if calibration.has_acceleration:
-            sections["g-sensitivity"] = ("g-sensitivity", _g_sensitivity(calibration, runs, min_static_s))
-        if calibration.gyro_triad is not None or calibration.accel_triad is not None:
-            sections["scale-factor"] = ("Scale factor and misalignment", _triads(calibration, runs, compensated))
-        moving = [(rec, found) for rec in runs for found in [detect_still(rec)] if moves_most_of_the_time(found)]
-        if moving:
-            sections["stillness"] = ("Still moments of the field logs", _stillness(moving))
+        sections.update(_closing_sections(calibration, runs, compensated, min_static_s))
         tick()
     return Report(_page(calibration, runs, sections), tuple(sections))
+
+
+def _evaluations(calibration: Calibration, runs: list, compensated: list, noise: list, window_s) -> list:
+    """:func:`evaluate_run` of each run, its bias instabilities from the Allan curves already drawn."""
+    return [
+        evaluate_run(
+            rec,
+            comp,
+            window_s=window_s,
+            accel=bool(calibration.accel_axes),
+            allan=tuple({a: n.axes[a].allan for a in rec.gyro_axes} for n in pair),
+        )
+        for rec, comp, pair in zip(runs, compensated, noise)
+    ]
+
+
+def _closing_sections(calibration: Calibration, runs: list, compensated: list, min_static_s: float) -> dict:
+    """The sections that only some models or runs have: g-sensitivity, scale factor, still moments."""
+    sections = {}
+    if calibration.has_acceleration:
+        sections["g-sensitivity"] = ("g-sensitivity", _g_sensitivity(calibration, runs, min_static_s))
+    if calibration.gyro_triad is not None or calibration.accel_triad is not None:
+        sections["scale-factor"] = ("Scale factor and misalignment", _triads(calibration, runs, compensated))
+    moving = [(rec, found) for rec in runs for found in [detect_still(rec)] if moves_most_of_the_time(found)]
+    if moving:
+        sections["stillness"] = ("Still moments of the field logs", _stillness(moving))
+    return sections
+
+
+#: the columns of the firmware table: the differences of :class:`gyrocomp.export.firmware.FirmwareDifference`
+_FIRMWARE_FIELDS = (
+    "in_range_max_dps",
+    "in_range_rms_dps",
+    "beyond_max_dps",
+    "beyond_rms_dps",
+    "as_run_max_dps",
+    "as_run_rms_dps",
+)
 
 
 def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list, costs: dict) -> str:
@@ -554,16 +550,7 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
     (:mod:`gyrocomp.export.firmware`): their correction against the model's, and the bias offset each leaves on
     the runs."""
     rows = [
-        [
-            target,
-            axis,
-            d.in_range_max_dps[j],
-            d.in_range_rms_dps[j],
-            d.beyond_max_dps[j],
-            d.beyond_rms_dps[j],
-            d.as_run_max_dps[j],
-            d.as_run_rms_dps[j],
-        ]
+        [target, axis, *(getattr(d, field)[j] for field in _FIRMWARE_FIELDS)]
         for target, d in costs.items()
         for j, axis in enumerate(d.axes)
     ]
@@ -585,6 +572,21 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
             "when the temperature moved by more than 1 degC",
         )
     ]
+    run_rows = _firmware_run_rows(calibration, runs, evaluations, costs)
+    if run_rows:
+        parts.append(
+            _table(
+                ["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"],
+                run_rows,
+                "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
+                "files as each firmware applies them",
+            )
+        )
+    return "\n".join(parts)
+
+
+def _firmware_run_rows(calibration: Calibration, runs: list[Recording], evaluations: list, costs: dict) -> list:
+    """Per run with a temperature and axis: the bias offset [deg/s] raw, after the model and after each firmware."""
     run_rows = []
     for rec, ev in zip(runs, evaluations):
         if rec.temperature_degc is None:
@@ -596,27 +598,12 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
             target: {axis: bias_offset(output, w) for axis, output in firmware_corrected_axes(calibration, rec, target)}
             for target in costs
         }
+        name = rec.source.rsplit("/", 1)[-1]
         for axis, m in ev.axes.items():
             if all(axis in offsets for offsets in on_vehicle.values()):
-                run_rows.append(
-                    [
-                        rec.source.rsplit("/", 1)[-1],
-                        axis,
-                        m.bias_offset_raw_dps,
-                        m.bias_offset_comp_dps,
-                        *(on_vehicle[t][axis] for t in costs),
-                    ]
-                )
-    if run_rows:
-        parts.append(
-            _table(
-                ["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"],
-                run_rows,
-                "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
-                "files as each firmware applies them",
-            )
-        )
-    return "\n".join(parts)
+                offsets = (on_vehicle[t][axis] for t in costs)
+                run_rows.append([name, axis, m.bias_offset_raw_dps, m.bias_offset_comp_dps, *offsets])
+    return run_rows
 
 
 def _noise(rec: Recording, comp: Recording) -> tuple:

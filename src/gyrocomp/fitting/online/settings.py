@@ -49,6 +49,48 @@ def chi2_quantile(z: float, dof: float) -> float:
     return dof * (1.0 - h + z * math.sqrt(h)) ** 3
 
 
+#: settings that must be positive
+_POSITIVE = (
+    "rate_hz",
+    "block_s",
+    "min_still_s",
+    "piece_s",
+    "bin_width_degc",
+    "half_life_h",
+    "stale_h",
+    "max_bias_dps",
+    "outlier_dps",
+    "outlier_sigmas",
+    "max_tempco_dps_per_degc",
+    "save_change_dps",
+)
+#: what the learner holds in memory grows with these: bounded, so a state file cannot ask for gigabytes
+_MEMORY_BOUNDS = (
+    ("rate_hz", 4e4),
+    ("block_s", 60.0),
+    ("min_still_s", 3600.0),
+    ("piece_s", 3600.0),
+    ("bin_width_degc", 50.0),
+)
+
+
+def _checked_lags(lags) -> tuple[float, ...]:
+    """``lag_candidates_s`` checked: 1 to 8 time constants [s], the first 0 and the rest positive."""
+    if isinstance(lags, (str, bytes)) or not hasattr(lags, "__len__"):
+        raise InputError(f"lag_candidates_s: expected a list of time constants [s], got {lags!r}")
+    lags = tuple(lags)
+    if (
+        not 1 <= len(lags) <= 8
+        or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in lags)
+        or lags[0] != 0
+        or any(not (math.isfinite(v) and v > 0) for v in lags[1:])
+    ):
+        raise InputError(
+            f"lag_candidates_s: 1 to 8 time constants [s], the first 0 and the rest positive, got {list(lags)!r}"
+        )
+    return tuple(float(v) for v in lags)
+
+
 @dataclass(frozen=True)
 class LearnerSettings:
     """What the learner is told (see the module): the stream's nominal rate ``rate_hz`` [Hz], blocks ``block_s``
@@ -85,51 +127,17 @@ class LearnerSettings:
     lag_candidates_s: tuple[float, ...] = (0.0, 15.0, 30.0, 60.0, 120.0, 240.0)
 
     def __post_init__(self) -> None:
-        lags = self.lag_candidates_s
-        if isinstance(lags, (str, bytes)) or not hasattr(lags, "__len__"):
-            raise InputError(f"lag_candidates_s: expected a list of time constants [s], got {lags!r}")
-        lags = tuple(lags)
-        if (
-            not 1 <= len(lags) <= 8
-            or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in lags)
-            or lags[0] != 0
-            or any(not (math.isfinite(v) and v > 0) for v in lags[1:])
-        ):
-            raise InputError(
-                f"lag_candidates_s: 1 to 8 time constants [s], the first 0 and the rest positive, got {list(lags)!r}"
-            )
-        object.__setattr__(self, "lag_candidates_s", tuple(float(v) for v in lags))
+        object.__setattr__(self, "lag_candidates_s", _checked_lags(self.lag_candidates_s))
         for f in fields(self):
             if f.name == "lag_candidates_s":
                 continue
             value = getattr(self, f.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise InputError(f"{f.name}: expected a finite number, got {value!r}")
-        positive = (
-            "rate_hz",
-            "block_s",
-            "min_still_s",
-            "piece_s",
-            "bin_width_degc",
-            "half_life_h",
-            "stale_h",
-            "max_bias_dps",
-            "outlier_dps",
-            "outlier_sigmas",
-            "max_tempco_dps_per_degc",
-            "save_change_dps",
-        )
-        for name in positive:
+        for name in _POSITIVE:
             if not getattr(self, name) > 0:
                 raise InputError(f"{name}: must be positive, got {getattr(self, name):.6g}")
-        # what the learner holds in memory grows with these: bounded, so a state file cannot ask for gigabytes
-        for name, high in (
-            ("rate_hz", 4e4),
-            ("block_s", 60.0),
-            ("min_still_s", 3600.0),
-            ("piece_s", 3600.0),
-            ("bin_width_degc", 50.0),
-        ):
+        for name, high in _MEMORY_BOUNDS:
             if getattr(self, name) > high:
                 raise InputError(f"{name}: at most {high:g}, got {getattr(self, name):.6g}")
         if self.rate_hz * self.block_s > 1e6:
