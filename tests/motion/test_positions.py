@@ -2,12 +2,14 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gyrocomp.errors import InputError
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import simulate
 from gyrocomp.simulation.profiles import TUMBLE_LEVELS_G
-from gyrocomp.motion.positions import orientations, segment_mask, static_segments, still_mask
+from gyrocomp.motion.positions import _moving_variance, orientations, segment_mask, static_segments, still_mask
 
 
 @pytest.mark.parametrize("preset, rate_hz", [("mti10", 10.0), ("consumer", 10.0), ("mti10", 1.0)])
@@ -49,3 +51,27 @@ def test_a_still_gyro_only_log_is_one_segment():
     assert sum(s.stop - s.start for s in segs) > 0.95 * t.size
     with pytest.raises(InputError, match="static detection: window -1 s must be positive and factor 4.0 above 1"):
         still_mask(rec, window_s=-1)
+
+
+@given(
+    n=st.integers(2, 400),
+    columns=st.integers(1, 6),
+    w=st.integers(5, 60),
+    seed=st.integers(0, 2**32 - 1),
+    scale=st.floats(1e-6, 1e3),
+)
+@settings(max_examples=60, deadline=None)
+def test_the_moving_variance_column_by_column_is_the_whole_arrays_to_the_bit(n, columns, w, seed, scale):
+    """The still mask's moving variance is taken a column at a time (its working memory a few columns); the
+    result is the one of the running sums over the whole array (the formula it replaced), bit for bit."""
+    x = np.random.default_rng(seed).normal(size=(n, columns)) * scale + 3.0 * scale
+    if n < w:
+        expected = np.full(n, np.var(x, axis=0).sum())
+    else:
+        centred = x - x.mean(axis=0)
+        c1 = np.vstack([np.zeros((1, columns)), np.cumsum(centred, axis=0)])
+        c2 = np.vstack([np.zeros((1, columns)), np.cumsum(centred * centred, axis=0)])
+        s1, s2 = (c1[w:] - c1[:-w]) / w, (c2[w:] - c2[:-w]) / w
+        var = np.maximum(s2 - s1 * s1, 0.0).sum(axis=1)
+        expected = var[np.clip(np.arange(n) - w // 2, 0, var.size - 1)]
+    np.testing.assert_array_equal(_moving_variance(x, w), expected)

@@ -9,6 +9,7 @@ from collections.abc import Iterable, Sequence
 
 from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions, read_input
+from ..io.tables import release_table_memory
 from ..measures.data_check import Ask, CheckedRun, RunCheck, check_runs
 from ..models.options import FitOptions, Network, Polynomial
 
@@ -49,6 +50,7 @@ def _noted(read, path: str | os.PathLike) -> CheckedRun:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         recording = read(path).recording
+    release_table_memory()
     return CheckedRun(os.fspath(path), recording, tuple(w.message for w in caught))
 
 

@@ -248,6 +248,13 @@ def _headerless_hint(head: bytes) -> str:
     return ""
 
 
+def release_table_memory() -> None:
+    """Give the memory of the tables no longer held back to the system: Arrow's default pool (jemalloc or mimalloc)
+    keeps what a table freed for the next one, and a fit's working memory would come on top of it (measured: a fit
+    of an hour at 1 kHz read from Parquet, 1.10 GB peak resident without this, 0.82 GB with it)."""
+    pa.default_memory_pool().release_unused()
+
+
 def arrow_floats(values: np.ndarray) -> pa.Array:
     """A float64 Arrow array of ``values`` (zero-copy when they are contiguous float64). Unlike ``pa.array``, it
     does not make pyarrow import pandas (a third of a second at start-up)."""
@@ -504,13 +511,13 @@ def table_recording(
         time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
     else:
         time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
-    gyro = np.column_stack([num(a) for a in gyro_axes]) * gyro_factor
+    gyro = np.column_stack([num(a) for a in gyro_axes])
+    gyro *= gyro_factor  # in place: a long table's columns are not copied twice
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
-    accel = (
-        np.column_stack([num(a) for a in accel_axes]) * unit_factor("accel", layout.accel_unit, "accel_unit")
-        if accel_axes
-        else None
-    )
+    accel = None
+    if accel_axes:
+        accel = np.column_stack([num(a) for a in accel_axes])
+        accel *= unit_factor("accel", layout.accel_unit, "accel_unit")
     reference = _reference_rates(cols, num, path, gyro_factor)
     n = table.num_rows
     kept = np.arange(n)

@@ -50,18 +50,28 @@ class StaticSegment:
 
 
 def _moving_variance(x: np.ndarray, w: int) -> np.ndarray:
-    """Variance over a centred window of w samples (edges: the nearest full window), summed over columns."""
+    """Variance over a centred window of w samples (edges: the nearest full window), summed over columns.
+
+    Column by column (each column's running sums, then the next's), so that the working memory is a few columns'
+    worth, not a few copies of ``x``: the sums are those of the whole array's, to the bit."""
     n = x.shape[0]
     if n < w:
         return np.full(n, np.var(x, axis=0).sum())
-    x = x - x.mean(axis=0)
-    c1 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x, axis=0)])
-    c2 = np.vstack([np.zeros((1, x.shape[1])), np.cumsum(x * x, axis=0)])
-    s1 = (c1[w:] - c1[:-w]) / w
-    s2 = (c2[w:] - c2[:-w]) / w
-    var = np.maximum(s2 - s1 * s1, 0.0).sum(axis=1)  # window k covers [k, k + w)
-    idx = np.clip(np.arange(n) - w // 2, 0, var.size - 1)
-    return var[idx]
+    means = x.mean(axis=0)
+    total = None
+    for j in range(x.shape[1]):
+        column = x[:, j] - means[j]
+        c1 = np.concatenate([[0.0], np.cumsum(column)])
+        c2 = np.concatenate([[0.0], np.cumsum(column * column)])
+        del column
+        s1 = (c1[w:] - c1[:-w]) / w
+        del c1
+        s2 = (c2[w:] - c2[:-w]) / w
+        del c2
+        var = np.maximum(s2 - s1 * s1, 0.0)  # window k covers [k, k + w)
+        total = var if total is None else np.add(total, var, out=total)
+    idx = np.clip(np.arange(n) - w // 2, 0, total.size - 1)
+    return total[idx]
 
 
 def still_mask(
