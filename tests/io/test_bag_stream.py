@@ -149,3 +149,58 @@ def test_stamps_that_go_back_across_chunks_are_read_whole(run_bag, tmp_path):
         expected = apply(model, read(path))
     assert not result.streamed
     np.testing.assert_array_equal(pq.read_table(tmp_path / "out.parquet")["gyro_x"].to_numpy(), expected.gyro_dps[:, 0])
+
+
+def test_a_ros1_bag_whose_imu_messages_change_layout_within_a_chunk_reads_as_rosbags_decodes_them(tmp_path):
+    """IMU messages whose frame_id changes length every few messages (no one byte layout in a chunk: decoded
+    message by message), in chunks of one layout too: read whole and in chunks, the values rosbags' deserializer
+    gives for each message."""
+    from rosbags.rosbag1 import Reader, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    types = store.types
+    imu_type = "sensor_msgs/msg/Imu"
+    path = tmp_path / "mixed.bag"
+    writer = Writer(path)
+    writer.chunk_threshold = 8192  # many chunks: those of one frame_id and those of both
+    rng = np.random.default_rng(5)
+    cov = np.zeros(9)
+    with writer:
+        connection = writer.add_connection("/imu/data", imu_type, typestore=store)
+        for i in range(600):
+            t = 100.0 + i * 0.01
+            stamp = types["builtin_interfaces/msg/Time"](sec=int(t), nanosec=int(round((t - int(t)) * 1e9)))
+            frame = "base_link/imu0" if 200 <= i < 400 and i % 5 == 0 else "imu"
+            msg = types[imu_type](
+                header=types["std_msgs/msg/Header"](seq=i, stamp=stamp, frame_id=frame),
+                orientation=types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=cov,
+                angular_velocity=types["geometry_msgs/msg/Vector3"](*rng.normal(size=3)),
+                angular_velocity_covariance=cov,
+                linear_acceleration=types["geometry_msgs/msg/Vector3"](*rng.normal(size=3)),
+                linear_acceleration_covariance=cov,
+            )
+            writer.write(connection, int(round(t * 1e9)), store.serialize_ros1(msg, imu_type))
+    expected = []
+    with Reader(path) as reader:
+        for _, _, raw in reader.messages():
+            msg = store.deserialize_ros1(raw, imu_type)
+            w, a = msg.angular_velocity, msg.linear_acceleration
+            stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+            expected.append([stamp, w.x, w.y, w.z, a.x, a.y, a.z])
+    expected = np.array(expected)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # no temperature topic: said, not the point here
+        whole = read_rosbag(path)
+        chunks = [c.recording for c in BagStream(path, ReadOptions(), chunk_rows=77).chunks()]
+    for recording in (whole, *chunks):
+        assert recording.n_samples >= 2
+    for got in (whole, chunks):
+        recordings = got if isinstance(got, list) else [got]
+        time_s = np.concatenate([r.time_s for r in recordings])
+        gyro = np.concatenate([r.gyro_dps for r in recordings])
+        accel = np.concatenate([r.accel_g for r in recordings])
+        np.testing.assert_array_equal(time_s, expected[:, 0])
+        np.testing.assert_allclose(gyro, np.degrees(expected[:, 1:4]), rtol=1e-14, atol=0)
+        np.testing.assert_allclose(accel, expected[:, 4:7] / 9.80665, rtol=1e-14, atol=0)

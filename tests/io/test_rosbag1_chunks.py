@@ -4,9 +4,15 @@ does not hold an index entry per message."""
 
 from __future__ import annotations
 
-import pytest
+import io
+import struct
 
-from gyrocomp.io.rosbag1_chunks import chunked_reader1, lean_writer1
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gyrocomp.io import rosbag1_chunks as chunks_module
+from gyrocomp.io.rosbag1_chunks import _chunk_messages, chunked_reader1, lean_writer1
 
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 from rosbags.rosbag1 import Reader, ReaderError, Writer  # noqa: E402
@@ -82,3 +88,100 @@ def test_the_lean_writer_writes_rosbags_bytes_and_keeps_counts_only(compression,
     assert ours.read_bytes() == theirs.read_bytes()
     written = [c for c in writer.chunks if c.pos != -1]
     assert len(written) > 20 and all(isinstance(entries, range) for c in written for entries in c.connections.values())
+
+
+def _record(fields: list[tuple[bytes, bytes]], payload: bytes) -> bytes:
+    """One ROS 1 record: its header's fields (``name=value``, each after its length), then its data."""
+    header = b"".join(struct.pack("<I", len(name) + 1 + len(value)) + name + b"=" + value for name, value in fields)
+    return struct.pack("<I", len(header)) + header + struct.pack("<I", len(payload)) + payload
+
+
+def _message(conn: int, sec: int, nsec: int, payload: bytes, order=(0, 1, 2), extra=()) -> bytes:
+    fields = [(b"op", b"\x02"), (b"conn", struct.pack("<I", conn)), (b"time", struct.pack("<II", sec, nsec))]
+    return _record([fields[k] for k in order] + list(extra), payload)
+
+
+@given(
+    layouts=st.lists(
+        st.tuples(
+            st.integers(0, 3),  # connection
+            st.integers(0, 2**31),  # seconds
+            st.integers(0, 999_999_999),  # nanoseconds
+            st.sampled_from([(0, 1, 2), (2, 0, 1), (1, 2, 0)]),  # field order: one header length, other layouts
+            st.sampled_from([(), ((b"x", b"ab"),), ((b"x", b"cd"),), ((b"conn", b"\x03\x00\x00\x00"),)]),
+            st.binary(max_size=12),
+        ),
+        max_size=40,
+    ),
+    wanted=st.sets(st.integers(0, 3)),
+)
+@settings(max_examples=80, deadline=None)
+def test_a_chunks_records_are_read_as_field_by_field_whatever_their_header_layouts(layouts, wanted):
+    """Records whose headers share one length but not one layout (fields in another order, an extra field whose
+    value changes, a field given twice) are read as rosbags' own header parser reads each record (the last value of a
+    field given twice); connection records between them are passed over."""
+    reader = pytest.importorskip("rosbags.rosbag1.reader")
+    chunk = _record([(b"op", b"\x07"), (b"conn", b"\x00\x00\x00\x00"), (b"topic", b"/t")], b"definition")
+    for conn, sec, nsec, order, extra, payload in layouts:
+        chunk += _message(conn, sec, nsec, payload, order, extra)
+    connmap = {c: f"connection {c}" for c in range(4)}
+    ours = [(c, t, bytes(raw)) for c, t, raw in _chunk_messages(reader, chunk, connmap, wanted, (None, None))]
+    theirs, source = [], io.BytesIO(chunk)
+    while source.tell() < len(chunk):
+        header = reader.Header.read(source)
+        raw = reader.read_bytes(source, reader.read_uint32(source))
+        if header.get_uint8("op") == reader.RecordType.MSGDATA and header.get_uint32("conn") in wanted:
+            sec, nsec = struct.unpack("<II", header["time"])
+            theirs.append((connmap[header.get_uint32("conn")], sec * 1_000_000_000 + nsec, raw))
+    assert ours == theirs
+
+
+@pytest.mark.parametrize(
+    "compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["none", "bz2", "lz4"]
+)
+def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compression, tmp_path, monkeypatch):
+    """A topic of one message in fifty (a temperature at 1 Hz beside an IMU at 50 Hz): an uncompressed chunk's
+    messages of it are read where the chunk's index data say (each checked against its entry), the same messages
+    as rosbags' reader, with a time filter too; a chunk whose index entry points at another record is walked."""
+    path = tmp_path / "sparse.bag"
+    writer = Writer(path)
+    if compression:
+        writer.set_compression(compression)
+    writer.chunk_threshold = 16384
+    string = STORE.types["std_msgs/msg/String"]
+    with writer:
+        dense = writer.add_connection("/imu", "std_msgs/msg/String", typestore=STORE)
+        sparse = writer.add_connection("/temperature", "std_msgs/msg/String", typestore=STORE)
+        for i in range(3000):
+            writer.write(dense, 10**9 + 20_000_000 * i, STORE.serialize_ros1(string(data="i" * 60), string.__msgtype__))
+            if i % 50 == 7:
+                message = STORE.serialize_ros1(string(data=f"t{i}"), string.__msgtype__)
+                writer.write(sparse, 10**9 + 20_000_000 * i + 1, message)
+    indexed = []  # what each indexed read of a chunk gave: its messages, or None (the chunk then walked)
+    original = chunks_module._indexed_messages
+    monkeypatch.setattr(chunks_module, "_indexed_messages", lambda *a: indexed.append(original(*a)) or indexed[-1])
+    topic = {"topics": ("/temperature",)}
+    for kwargs in (topic, {**topic, "start": 2 * 10**10, "stop": 4 * 10**10}):
+        ours = _read(chunked_reader1(), path, **dict(kwargs))[1]
+        assert ours == _read(Reader, path, **dict(kwargs))[1] and ours
+    # uncompressed: every chunk read by its index; compressed: none (a chunk is decompressed whole)
+    assert (len(indexed) > 10 and all(m is not None for m in indexed)) if compression is None else not indexed
+    if compression is None:  # the second chunk's first index entry of the topic given another time
+        rosbag1 = pytest.importorskip("rosbags.rosbag1.reader")
+        data = bytearray(path.read_bytes())
+        with chunked_reader1()(path) as reader:
+            info = reader.chunk_infos[1]
+            reader.bio.seek(info.pos)
+            chunk = reader.read_chunk()
+            reader.bio.seek(chunk.datapos + chunk.datasize)
+            for _ in info.connection_counts:  # the chunk's index data records, one per connection in it
+                header = rosbag1.Header.read(reader.bio, rosbag1.RecordType.IDXDATA)
+                size, entries = rosbag1.read_uint32(reader.bio), reader.bio.tell()
+                if header.get_uint32("conn") == sparse.id:
+                    (sec,) = struct.unpack_from("<I", data, entries)
+                    data[entries : entries + 4] = struct.pack("<I", sec + 1)
+                reader.bio.seek(entries + size)
+        (tmp_path / "moved.bag").write_bytes(bytes(data))
+        indexed.clear()
+        assert _read(chunked_reader1(), tmp_path / "moved.bag", **topic)[1] == _read(Reader, path, **topic)[1]
+        assert sum(m is None for m in indexed) == 1  # that chunk walked, its messages as the records say

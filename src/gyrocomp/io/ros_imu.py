@@ -76,7 +76,15 @@ def imu_batch(raws: list, cdr: bool) -> ImuBatch | None:
     length = len(raws[0])
     if length < 16 + 8 * _VALUES or any(len(r) != length for r in raws):
         return None
-    data = np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(len(raws), length)
+    return imu_batch_of(np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(len(raws), length), cdr)
+
+
+def imu_batch_of(data: np.ndarray, cdr: bool) -> ImuBatch | None:
+    """Messages of one length as a byte array (n, length) as one :class:`ImuBatch`, or None when they do not share
+    one layout (see the module)."""
+    if data.shape[0] == 0 or data.shape[1] < 16 + 8 * _VALUES:
+        return None
+    length = data.shape[1]
     text = np.ascontiguousarray(data[:, 12:16]).view("<u4")[:, 0]
     if np.any(text != text[0]):
         return None
@@ -99,4 +107,5 @@ __all__ = [
     "LINEAR_ACCELERATION",
     "LINEAR_ACCELERATION_COVARIANCE",
     "imu_batch",
+    "imu_batch_of",
 ]

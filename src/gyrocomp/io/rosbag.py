@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 import pyarrow as pa
 
 from ..errors import DataQualityWarning, InputError, TimeOrderWarning, printable
@@ -35,7 +36,7 @@ from .common import (
 )
 from .layout import TIME_COLUMN, TableLayout
 from .readers import Reader, register_reader
-from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, imu_batch
+from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_batch_of
 from .rosbag1_chunks import chunked_reader1
 from .stream import CHUNK_ROWS, NotStreamable
 from .tables import recording_table, rows_dropped
@@ -222,12 +223,7 @@ def decoded_imu(reader, msgtype: str, raws: list) -> tuple[np.ndarray, np.ndarra
     messages: a batch of one layout at once, any other message by message through rosbags."""
     batch = imu_batch(raws, cdr=reader.is2)
     if batch is not None:
-        values = batch.values
-        return (
-            batch.stamp_s(cdr=reader.is2),
-            values[:, ANGULAR_VELOCITY : ANGULAR_VELOCITY + 3],
-            values[:, LINEAR_ACCELERATION : LINEAR_ACCELERATION + 3],
-        )
+        return _batch_values(batch, reader.is2)
     time_s, gyro, accel = np.empty(len(raws)), np.empty((len(raws), 3)), np.empty((len(raws), 3))
     for i, raw in enumerate(raws):
         msg = reader.deserialize(raw, msgtype)
@@ -238,26 +234,65 @@ def decoded_imu(reader, msgtype: str, raws: list) -> tuple[np.ndarray, np.ndarra
     return time_s, gyro, accel
 
 
+def _batch_values(batch: ImuBatch, cdr: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A batch's stamps [s], angular velocities [rad/s] and linear accelerations [m/s^2]."""
+    values = batch.values
+    return (
+        batch.stamp_s(cdr=cdr),
+        values[:, ANGULAR_VELOCITY : ANGULAR_VELOCITY + 3],
+        values[:, LINEAR_ACCELERATION : LINEAR_ACCELERATION + 3],
+    )
+
+
+def _decoded_groups(reader, imu: list, size: int):
+    """The IMU topic's messages as they lie in the bag, decoded a group at a time [s, rad/s, m/s^2]: a ROS 1 bag's
+    a chunk at a time from the chunk's bytes (:meth:`ChunkedReader1.message_arrays`, no Python object per message),
+    any other bag's ``size`` messages at a time as rosbags yields them."""
+    readers = getattr(reader, "readers", ())
+    arrays = getattr(readers[0], "message_arrays", None) if len(readers) == 1 else None
+    if arrays is None:
+        raws = []
+        for _, _, raw in reader.messages(connections=imu):
+            raws.append(raw)
+            if len(raws) == size:
+                yield decoded_imu(reader, imu[0].msgtype, raws)
+                raws = []
+        if raws:
+            yield decoded_imu(reader, imu[0].msgtype, raws)
+        return
+    for chunk, _, _, data_at, data_length in arrays(connections=imu):
+        if data_length.size and np.all(data_length == data_length[0]):
+            batch = imu_batch_of(sliding_window_view(chunk, int(data_length[0]))[data_at], cdr=False)
+            if batch is not None:
+                yield _batch_values(batch, False)
+                continue
+        if data_length.size:
+            raws = [chunk[at : at + length].tobytes() for at, length in zip(data_at.tolist(), data_length.tolist())]
+            yield decoded_imu(reader, imu[0].msgtype, raws)
+
+
 def _imu_batches(path: Path, reader, imu: list, size: int, progress: ProgressCallback | None = None):
     """The IMU topic's messages as they lie in the bag, ``size`` at a time, decoded (:func:`decoded_imu`) [s, rad/s,
     m/s^2]; a damaged bag or one holding more messages than its index counts is one line naming the topic."""
     n = sum(c.msgcount for c in imu)
-    raws, read = [], 0
+    pending, held, read = [], 0, 0
     with _damaged(path, imu[0].topic):
-        for _, _, raw in reader.messages(connections=imu):
-            raws.append(raw)
-            read += 1
+        for group in _decoded_groups(reader, imu, size):
+            read += group[0].size
             if read > n:
                 raise InputError(
                     f"{path}: damaged ROS bag: topic {imu[0].topic}: more messages than the bag's index counts ({n})"
                 )
-            if len(raws) == size:
-                yield decoded_imu(reader, imu[0].msgtype, raws)
-                raws = []
+            pending.append(group)
+            held += group[0].size
+            while held >= size:  # batches of ``size`` whatever the groups' sizes: as a message-by-message reading
+                joined = pending[0] if len(pending) == 1 else _joined(pending)
+                pending, held = [tuple(values[size:] for values in joined)], held - size
+                yield tuple(values[:size] for values in joined)
                 if progress:
-                    progress(read / max(n, 1))
-        if raws:
-            yield decoded_imu(reader, imu[0].msgtype, raws)
+                    progress((read - held) / max(n, 1))
+        if held:
+            yield _joined(pending)
     _read_all(path, n, read, imu[0].topic)
 
 

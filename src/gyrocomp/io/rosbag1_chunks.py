@@ -6,7 +6,8 @@ connections merged in time order. A ROS 1 bag's chunks follow each other in time
 the order they were recorded: :class:`ChunkedReader1` opens a bag from its connection and chunk-info records only
 (the per-connection message counts come from the chunk infos) and yields the messages chunk by chunk as they lie in
 the file, each chunk decompressed (none, bz2, lz4) when it is reached. The bag's index is read by rosbags' own
-functions, a chunk's records by :func:`_chunk_messages` (their three header fields in place); everything else (connections, message definitions, the type store of :class:`rosbags.highlevel.AnyReader`)
+functions, a chunk's records by :func:`_chunk_messages` (walked by their lengths, their three header fields read
+for all records of one layout at once); everything else (connections, message definitions, the type store of :class:`rosbags.highlevel.AnyReader`)
 is rosbags' as it is.
 
 :func:`lean_writer1`'s writer is rosbags' writer that, once a chunk and its index records are in the file, keeps
@@ -23,6 +24,9 @@ import functools
 import os
 import re
 import struct
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from .common import require
 
@@ -87,60 +91,246 @@ def _messages(self, connections=(), start: int | None = None, stop: int | None =
     connmap = {c.id: c for c in self.connections}
     wanted = {c.id for c in connections} if connections else set(connmap)
     for info in self.chunk_infos:
-        if not wanted.intersection(info.connection_counts):
+        hits = sum(info.connection_counts.get(c, 0) for c in wanted)
+        if not hits:
             continue
         if (start is not None and info.end_time <= start) or (stop is not None and info.start_time >= stop):
             continue
         self.bio.seek(info.pos)
         chunk = self.read_chunk()
+        if chunk.decompressor is rb.decompressors["none"] and hits * _SPARSE <= sum(info.connection_counts.values()):
+            found = _indexed_messages(self, rb, chunk, len(info.connection_counts), connmap, wanted, (start, stop))
+            if found is not None:
+                yield from found
+                continue
         self.bio.seek(chunk.datapos)
         data = chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize))
         yield from _chunk_messages(rb, bytes(data), connmap, wanted, (start, stop))
 
 
+#: a chunk whose messages of the connections read are at most one in this many is read by its index (uncompressed)
+_SPARSE = 16
+_INDEX_ENTRY = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("offset", "<u4")])
+
+
+def _indexed_messages(self, rb, chunk, connections: int, connmap: dict, wanted: set, span: tuple) -> list | None:
+    """The messages of ``wanted`` in an uncompressed chunk read where the chunk's index data records (which follow
+    it, one per connection in it: a time and an offset per message) say they lie, instead of walking every record
+    of the chunk (a temperature topic at 1 Hz among IMU messages at 1 kHz); each record read is checked against its
+    index entry. None where the index does not hold or does not match: the chunk is then walked."""
+    start, stop = span
+    found = []
+    try:
+        self.bio.seek(chunk.datapos + chunk.datasize)
+        for _ in range(connections):
+            header = rb.Header.read(self.bio, rb.RecordType.IDXDATA)
+            conn, count = header.get_uint32("conn"), header.get_uint32("count")
+            entries = np.frombuffer(rb.read_bytes(self.bio, rb.read_uint32(self.bio)), dtype=_INDEX_ENTRY)
+            if header.get_uint32("ver") != 1 or entries.size != count:
+                return None
+            if conn in wanted:
+                times = entries["sec"].astype(np.int64) * 1_000_000_000 + entries["nsec"]
+                found += [(int(o), conn, int(t)) for o, t in zip(entries["offset"].tolist(), times.tolist())]
+        messages = []
+        for offset, conn, time in sorted(found):  # the chunk's order
+            if (start is not None and time < start) or (stop is not None and time >= stop):
+                continue
+            if not 0 <= offset <= chunk.datasize - 8:
+                return None
+            self.bio.seek(chunk.datapos + offset)
+            length = rb.read_uint32(self.bio)
+            head = rb.read_bytes(self.bio, length)
+            raw = rb.read_bytes(self.bio, rb.read_uint32(self.bio))
+            if offset + 8 + length + len(raw) > chunk.datasize or conn not in connmap:
+                return None
+            if _fields_of(head, 0, length) != (rb.RecordType.MSGDATA, conn, time):
+                return None
+            messages.append((connmap[conn], time, raw))
+    except (rb.ReaderError, struct.error, IndexError, TypeError, ValueError):
+        return None
+    return messages
+
+
 _UINT32 = struct.Struct("<I")
 _TIME = struct.Struct("<II")
+#: the header fields a chunk's records are read by
+_FIELDS = (b"op", b"conn", b"time")
 
 
 def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple):
-    """The message-data records of one decompressed chunk, in their order: each record's header fields (``op``,
-    ``conn``, ``time``) read in place with ``struct`` (rosbags' :class:`Header` makes a dict of every record's; this
-    is the reading of a long bag), a record that runs past the chunk a ReaderError."""
+    """The message-data records of one decompressed chunk, in their order, as (connection, time [ns], raw bytes).
+
+    The records are walked by their two lengths (:func:`_records`); their header fields (``op``, ``conn``,
+    ``time``) are then read for all records of one header layout at once (:func:`_header_fields`; rosbags'
+    :class:`Header` makes a dict of every record's, the reading of a long bag). A record that runs past the chunk is a
+    ReaderError."""
+    conn, time, data_at, data_length = _chunk_arrays(rb, data, connmap, wanted, span)
+    for k in range(conn.size):
+        yield connmap[int(conn[k])], int(time[k]), data[data_at[k] : data_at[k] + data_length[k]]
+
+
+def _chunk_arrays(rb, data: bytes, connmap: dict, wanted: set, span: tuple) -> tuple[np.ndarray, ...]:
+    """The message-data records of one decompressed chunk that :func:`_chunk_messages` yields, as arrays: their
+    connection ids, times [ns], and where each one's data starts in ``data`` and its length [bytes]."""
     start, stop = span
-    size, pos = len(data), 0
     try:
-        while pos < size:
-            (length,), pos = _UINT32.unpack_from(data, pos), pos + 4
-            end = pos + length
-            if end + 4 > size:
-                raise rb.ReaderError("A record's header runs past the end of its chunk.")
-            op = conn = time = None
-            while pos < end:
-                (field,), pos = _UINT32.unpack_from(data, pos), pos + 4
-                name, _, value = data[pos : pos + field].partition(b"=")
-                pos += field
-                if name == b"op":
-                    op = value[0]
-                elif name == b"conn":
-                    conn = _UINT32.unpack(value)[0]
-                elif name == b"time":
-                    sec, nsec = _TIME.unpack(value)
-                    time = sec * 1_000_000_000 + nsec
-            (length,), pos = _UINT32.unpack_from(data, end), end + 4
-            if pos + length > size:
-                raise rb.ReaderError("A record's data runs past the end of its chunk.")
-            if (
-                op == rb.RecordType.MSGDATA
-                and conn in wanted
-                and (start is None or time >= start)
-                and (stop is None or time < stop)
-            ):
-                if conn not in connmap:
-                    raise rb.ReaderError(f"A message of connection {conn}, which the bag's index lacks.")
-                yield connmap[conn], time, data[pos : pos + length]
-            pos += length
-    except (struct.error, IndexError, TypeError) as err:
+        records = _records(rb, data)
+        op, conn, time = _header_fields(np.frombuffer(data, dtype=np.uint8), data, *records[:2])
+    except (struct.error, IndexError, TypeError, ValueError) as err:
         raise rb.ReaderError(f"A damaged record in a chunk ({type(err).__name__}: {err}).") from None
+    keep = (op == rb.RecordType.MSGDATA) & np.isin(conn, np.fromiter(wanted, dtype=np.int64, count=len(wanted)))
+    if start is not None:
+        keep &= time >= start
+    if stop is not None:
+        keep &= time < stop
+    chosen = np.flatnonzero(keep)
+    unknown = np.setdiff1d(conn[chosen], np.fromiter(connmap, dtype=np.int64, count=len(connmap)))
+    if unknown.size:
+        raise rb.ReaderError(f"A message of connection {int(unknown[0])}, which the bag's index lacks.")
+    return conn[chosen], time[chosen], records[2][chosen], records[3][chosen]
+
+
+def _message_arrays(self, connections=()):
+    """The messages of ``connections`` (all when empty) chunk by chunk in file order, each chunk as arrays: its
+    decompressed bytes (uint8), and of its messages the connection ids, times [ns], where each one's data starts and
+    its length [bytes] (:func:`_chunk_arrays`): a caller that decodes many messages at once reads them without a
+    Python object per message."""
+    rb = _rosbag1()
+    self._check_open()
+    connmap = {c.id: c for c in self.connections}
+    wanted = {c.id for c in connections} if connections else set(connmap)
+    for info in self.chunk_infos:
+        if not wanted.intersection(info.connection_counts):
+            continue
+        self.bio.seek(info.pos)
+        chunk = self.read_chunk()
+        self.bio.seek(chunk.datapos)
+        data = bytes(chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize)))
+        yield (np.frombuffer(data, dtype=np.uint8), *_chunk_arrays(rb, data, connmap, wanted, (None, None)))
+
+
+#: records walked one by one after a run of fewer than this many of one shape, before trying runs again
+_WALK = 32
+
+
+def _records(rb, data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each record of a chunk: where its header starts and its length, where its data starts and its length
+    [bytes].
+
+    A record's lengths say where the next one starts. A chunk of IMU messages is mostly records of one shape (one
+    header length, one data length) one after the other: from each record, the records of its shape that follow
+    are found at once (:func:`_same_shape`, each checked at its place), the others walked one by one."""
+    array = np.frombuffer(data, dtype=np.uint8)
+    size, pos, walk = len(data), 0, 0
+    parts, single = [], []
+    while pos < size:
+        (length,) = _UINT32.unpack_from(data, pos)
+        end = pos + 4 + length
+        if end + 4 > size:
+            raise rb.ReaderError("A record's header runs past the end of its chunk.")
+        (count,) = _UINT32.unpack_from(data, end)
+        if end + 4 + count > size:
+            raise rb.ReaderError("A record's data runs past the end of its chunk.")
+        run = 1 if walk else _same_shape(array, pos, length, count)
+        if run == 1:
+            single.append((pos, length, count))
+            walk = walk - 1 if walk else _WALK
+        else:
+            if single:
+                parts.append(np.array(single, dtype=np.int64).reshape(-1, 3))
+                single = []
+            starts = pos + (8 + length + count) * np.arange(run, dtype=np.int64)
+            parts.append(np.column_stack([starts, np.full(run, length), np.full(run, count)]))
+        pos += run * (8 + length + count)
+    if single:
+        parts.append(np.array(single, dtype=np.int64).reshape(-1, 3))
+    table = np.concatenate(parts) if parts else np.empty((0, 3), dtype=np.int64)
+    header_at = table[:, 0] + 4
+    return header_at, table[:, 1], header_at + table[:, 1] + 4, table[:, 2]
+
+
+def _same_shape(array: np.ndarray, pos: int, length: int, count: int) -> int:
+    """How many records from ``pos`` on, one after the other, have the header length ``length`` and the data length
+    ``count`` of the record at ``pos`` (at least that one): each candidate's two lengths read at its place, the run
+    ending at the first that differs or at the end of the chunk (looked at in windows that double, so that a short
+    run costs little whatever the chunk's size)."""
+    total = 8 + length + count
+    fits = (array.size - pos) // total
+    checked, window = 1, 1024
+    while checked < fits:
+        starts = pos + total * np.arange(checked, min(fits, checked + window), dtype=np.int64)
+        words = sliding_window_view(array, 4)  # the four bytes from each offset, read where asked
+        lengths = words[starts].view("<u4")[:, 0]
+        counts = words[starts + 4 + length].view("<u4")[:, 0]
+        same = (lengths == length) & (counts == count)
+        if not same.all():
+            return checked + int(np.argmin(same))
+        checked, window = checked + starts.size, window * 2
+    return max(fits, 1)
+
+
+def _header_fields(array: np.ndarray, data: bytes, header_at: list, header_length: list) -> tuple:
+    """Each record's ``op`` (-1 where absent), ``conn`` (-1) and ``time`` [ns] (-1): the records whose headers have
+    one length and the same bytes as the first of them but for these three values are read as one array; any other
+    record field by field (:func:`_fields_of`)."""
+    n = len(header_at)
+    op, conn, time = np.full(n, -1, np.int64), np.full(n, -1, np.int64), np.full(n, -1, np.int64)
+    starts, lengths = np.asarray(header_at, dtype=np.int64), np.asarray(header_length, dtype=np.int64)
+    for length in np.unique(lengths).tolist():
+        group = np.flatnonzero(lengths == length)
+        first = int(starts[group[0]])
+        places = _field_places(data, first, first + length)
+        headers = sliding_window_view(array, length)[starts[group]] if length else np.empty((group.size, 0), np.uint8)
+        fixed = np.ones(length, dtype=bool)
+        for at, width in places.values():
+            fixed[at : at + width] = False
+        same = np.all(headers[:, fixed] == headers[0, fixed], axis=1)
+        if any(places.get(name, (0, width))[1] != width for name, width in zip(_FIELDS, (1, 4, 8))):
+            same[:] = False  # a value of another width: read as it is (and refused as a field-by-field reading does)
+        if b"op" in places:
+            op[group[same]] = headers[same, places[b"op"][0]]
+        if b"conn" in places:
+            at = places[b"conn"][0]
+            conn[group[same]] = np.ascontiguousarray(headers[same, at : at + 4]).view("<u4")[:, 0]
+        if b"time" in places:
+            at = places[b"time"][0]
+            sec_nsec = np.ascontiguousarray(headers[same, at : at + 8]).view("<u4").astype(np.int64)
+            time[group[same]] = sec_nsec[:, 0] * 1_000_000_000 + sec_nsec[:, 1]
+        for k in group[~same].tolist():  # another layout: read as it is
+            op[k], conn[k], time[k] = _fields_of(data, int(header_at[k]), int(header_at[k] + header_length[k]))
+    return op, conn, time
+
+
+def _field_places(data: bytes, pos: int, end: int) -> dict[bytes, tuple[int, int]]:
+    """Where in a header (from ``pos`` to ``end``) the values of ``op``, ``conn`` and ``time`` lie: their offset from
+    the header's start and their length [bytes]."""
+    places, start = {}, pos
+    while pos < end:
+        (field,) = _UINT32.unpack_from(data, pos)
+        name, sign, _ = data[pos + 4 : pos + 4 + field].partition(b"=")
+        if name in _FIELDS and sign:  # a field given twice: its last value, as a field-by-field reading takes
+            places[name] = (pos + 4 + len(name) + 1 - start, field - len(name) - 1)
+        pos += 4 + field
+    if pos != end:
+        raise ValueError("a header field runs past its header")
+    return places
+
+
+def _fields_of(data: bytes, pos: int, end: int) -> tuple[int, int, int]:
+    """One header's ``op``, ``conn`` and ``time`` [ns] read field by field (-1 where absent)."""
+    op = conn = time = -1
+    while pos < end:
+        (field,), pos = _UINT32.unpack_from(data, pos), pos + 4
+        name, _, value = data[pos : pos + field].partition(b"=")
+        pos += field
+        if name == b"op":
+            op = value[0]
+        elif name == b"conn":
+            conn = _UINT32.unpack(value)[0]
+        elif name == b"time":
+            sec, nsec = _TIME.unpack(value)
+            time = sec * 1_000_000_000 + nsec
+    return op, conn, time
 
 
 @functools.cache
@@ -151,7 +341,7 @@ def chunked_reader1() -> type:
     return type(
         "ChunkedReader1",
         (_rosbag1().Reader,),
-        {"open": _open, "messages": _messages, "__doc__": chunked_reader1.__doc__},
+        {"open": _open, "messages": _messages, "message_arrays": _message_arrays, "__doc__": chunked_reader1.__doc__},
     )
 
 
