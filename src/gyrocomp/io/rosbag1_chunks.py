@@ -6,16 +6,19 @@ connections merged in time order. A ROS 1 bag's chunks follow each other in time
 the order they were recorded: :class:`ChunkedReader1` opens a bag from its connection and chunk-info records only
 (the per-connection message counts come from the chunk infos) and yields the messages chunk by chunk as they lie in
 the file, each chunk decompressed (none, bz2, lz4) when it is reached. The bag's index is read by rosbags' own
-functions, a chunk's records by :func:`_chunk_messages` (walked by their lengths, their three header fields read
-for all records of one layout at once); everything else (connections, message definitions, the type store of :class:`rosbags.highlevel.AnyReader`)
-is rosbags' as it is.
+functions, a chunk's records by :func:`_chunk_messages` (walked by runs of records of one shape, their three header
+fields read for all records of one layout at once), a topic that is a small part of an uncompressed chunk (a
+temperature beside an IMU) where the chunk's index data records say (:func:`_indexed_messages`), and a chunk's
+messages as arrays for a caller that decodes them together (:func:`_message_arrays`); everything else
+(connections, message definitions, the type store of :class:`rosbags.highlevel.AnyReader`) is rosbags' as it is.
 
 :func:`lean_writer1`'s writer is rosbags' writer that, once a chunk and its index records are in the file, keeps
 only the chunk's message count per connection (what closing the bag writes) instead of an entry per message.
 
 The ROS 1 bag format (version 2.0): records of a header (``op``, ``conn``, ``time``, ...) and data; chunks hold
 connection and message-data records; after the chunks, at the bag header's ``index_pos``, the connection records and
-one chunk-info record per chunk (its position and its message count per connection).
+one chunk-info record per chunk (its position and its message count per connection); each chunk is followed by one
+index data record per connection in it (each message's time and offset in the uncompressed chunk).
 """
 
 from __future__ import annotations
