@@ -15,6 +15,7 @@ import pytest
 from gyrocomp import apply, fit_calibration, read
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.files.apply_bag import apply_bag
+from gyrocomp.io.rosbag1_chunks import chunked_reader1
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
@@ -272,3 +273,56 @@ def test_a_bag_heavy_with_other_topics_is_written_in_windows_of_bytes(model, tmp
         done = apply_bag(model, source, tmp_path / "windows.bag")
     assert done.compensated == 300
     assert _messages(tmp_path / "windows.bag") == _messages(tmp_path / "one.bag")
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 7])
+@pytest.mark.parametrize("window_bytes", [None, 3000])
+def test_an_uncompressed_ros1_bag_is_compensated_in_place_as_the_writer_would(
+    chunk_rows, window_bytes, model_with_accel, tmp_path, monkeypatch
+):
+    """An uncompressed ROS 1 bag is copied with each IMU message's values written in place: the output has the
+    input's bytes but for those values (every record, offset and index as it was), and the messages rosbags reads
+    from it are those of the bag written message by message through rosbags' writer, in batches of 7 messages and
+    in windows of bytes too (a batch holding a single IMU message among them), and those of one batch."""
+    import gyrocomp.files.apply_bag as module
+
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=400, repeat=11)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        apply_bag(model_with_accel, source, tmp_path / "one.bag")
+        if window_bytes:
+            monkeypatch.setattr(module, "WINDOW_BYTES", window_bytes)
+            monkeypatch.setattr(module, "FIRST_SAMPLES", 20)
+        patched = apply_bag(model_with_accel, source, tmp_path / "patched.bag", chunk_rows=chunk_rows or 100_000)
+        monkeypatch.setattr(module, "_patched_bag", lambda *args: False)
+        written = apply_bag(model_with_accel, source, tmp_path / "written.bag", chunk_rows=chunk_rows or 100_000)
+    assert patched.compensated == written.compensated == 401 and patched.accel  # 400 and a repeat
+    assert _messages(tmp_path / "patched.bag") == _messages(tmp_path / "written.bag") == _messages(tmp_path / "one.bag")
+    before, after = source.read_bytes(), (tmp_path / "patched.bag").read_bytes()
+    assert len(after) == len(before)
+    changed = np.flatnonzero(np.frombuffer(before, np.uint8) != np.frombuffer(after, np.uint8))
+    assert changed.size and _messages(source) != _messages(tmp_path / "patched.bag")
+    # only IMU messages changed: each changed byte lies in the data of a message on the IMU topic
+    inside = np.zeros(len(before), dtype=bool)
+    with chunked_reader1()(source) as reader:
+        imu = [c for c in reader.connections if c.topic == "/imu/data"]
+        for chunk in reader.message_arrays(connections=imu):
+            for at, length in zip(chunk.data_at.tolist(), chunk.data_length.tolist()):
+                inside[chunk.data_pos + at : chunk.data_pos + at + length] = True
+    assert np.all(inside[changed])
+
+
+@pytest.mark.parametrize("kind", ["ros1", "ros2"])
+def test_a_last_batch_of_one_imu_message_is_compensated_as_the_next_sample(kind, model, tmp_path):
+    """400 IMU messages in batches of 7: the last batch holds one (a recording needs two rows); it is compensated
+    as the next sample of the stream, the bag the same as compensated in one batch."""
+    options, name, _ = KINDS[kind]
+    source = tmp_path / name
+    write_bag(source, n=400, **options)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one = apply_bag(model, source, tmp_path / ("one.bag" if kind == "ros1" else "one"))
+        sevens = apply_bag(model, source, tmp_path / ("sevens.bag" if kind == "ros1" else "sevens"), chunk_rows=7)
+    assert 400 % 7 == 1 and one.compensated == sevens.compensated == 400
+    assert _messages(Path(sevens.path)) == _messages(Path(one.path))

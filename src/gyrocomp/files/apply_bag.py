@@ -15,8 +15,14 @@ The bag goes through once, in memory bounded whatever its length: messages are h
 messages (or :data:`WINDOW_BYTES` of messages, once :data:`FIRST_SAMPLES` IMU samples have set the rate) have come,
 the IMU messages among them decoded and compensated as a batch (:class:`gyrocomp.io.rosbag.BagStream`'s reading,
 one :class:`~gyrocomp.calibration.compensate.Compensator` carrying its state from batch to batch) and written back
-into their bytes (:mod:`gyrocomp.io.ros_imu`), then everything held written out in its order. A bag whose IMU
+into their bytes (:mod:`gyrocomp.io.ros_imu`), then everything held written out in its order. A batch holding a
+single IMU sample (the last of a bag, say) is compensated as the next sample of the stream. A bag whose IMU
 stamps go back further than the batch before is compensated from a whole read instead (the same result).
+
+An uncompressed ROS 1 bag (what ``rosbag record`` writes by default) is not rewritten message by message: its bytes
+are copied with each IMU message's values written in place (:func:`_patched_bag`; a compensated message keeps its
+length, so every record, offset and index stays valid), the messages batched as above. Any other bag goes through
+rosbags' writer.
 """
 
 from __future__ import annotations
@@ -243,11 +249,12 @@ def _apply_bag(
         copiers = {
             topics[k]: _Copier(calibrations[k], streams[k], covariance_of, counts[topics[k]]) for k in calibrations
         }
-        _write_bag(
-            bag,
-            output,
-            lambda reader, writer, connections: _copy_in_batches(reader, writer, connections, copiers, chunk_rows),
-        )
+        if not _patched_bag(bag, output, copiers, chunk_rows):
+            _write_bag(
+                bag,
+                output,
+                lambda reader, writer, connections: _copy_in_batches(reader, writer, connections, copiers, chunk_rows),
+            )
         for stream in streams.values():
             stream.warn_summary()
         done = {topic: (c.with_accel, tuple(c.covariances)) for topic, c in copiers.items()}
@@ -314,6 +321,97 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
     write()
 
 
+def _patched_bag(bag: Path, output: Path, copiers: dict, chunk_rows: int) -> bool:
+    """An uncompressed ROS 1 bag compensated in one pass by copying its bytes with each IMU message's values written
+    in place (a compensated message keeps its length, so every record, offset and index stays as it was): the
+    input's chunks, connections and index byte for byte, the IMU messages batched as :func:`_copy_in_batches` does.
+    False (nothing written) for any other bag."""
+    if bag_kind(bag) != "ros1":
+        return False
+    with any_reader(bag) as reader:
+        inner = reader.readers[0]
+        if not hasattr(inner, "message_arrays") or not _uncompressed(inner):
+            return False
+        with staged_bag(output, "ros1") as target, open(bag, "rb") as source, open(target, "wb") as sink:
+            _patch_in_batches(reader, inner, _BagCopy(source, sink), copiers, chunk_rows)
+    return True
+
+
+def _uncompressed(reader) -> bool:
+    """Whether every chunk of a ROS 1 bag is stored uncompressed."""
+    rb = require("rosbags.rosbag1.reader", "ros", "reading ROS 1 bags")
+    for info in reader.chunk_infos:
+        reader.bio.seek(info.pos)
+        if reader.read_chunk().decompressor is not rb.decompressors["none"]:
+            return False
+    return True
+
+
+class _BagCopy:
+    """The output of :func:`_patched_bag`: the input's bytes copied through, each chunk's data from its patched copy."""
+
+    def __init__(self, source, sink):
+        self.source, self.sink, self.copied = source, sink, 0
+
+    def chunk(self, data_pos: int, data: bytearray) -> None:
+        """The input up to a chunk's data as it is, then the chunk's data (patched)."""
+        self.through(data_pos)
+        self.sink.write(data)
+        self.copied = data_pos + len(data)
+
+    def through(self, end: int | None = None) -> None:
+        """The input's bytes from where the copy is to ``end`` (None: the end of the file)."""
+        self.source.seek(self.copied)
+        left = None if end is None else end - self.copied
+        while left is None or left > 0:
+            block = self.source.read(1 << 20 if left is None else min(1 << 20, left))
+            if not block:
+                break
+            self.sink.write(block)
+            if left is not None:
+                left -= len(block)
+        self.copied = self.source.tell()
+
+
+def _patch_in_batches(reader, inner, copy: _BagCopy, copiers: dict, chunk_rows: int) -> None:
+    """Every message of the bag in its order, held as :func:`_copy_in_batches` holds them; at each batch the IMU
+    messages are compensated by their topic's copier and written into their chunk's copy, and every chunk whose
+    messages are all done goes out."""
+    imu = {c.id: c.topic for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE}
+    chunks: list = []  # [data_pos, patched copy] of the chunks not yet written, in order
+    raws, places, held_bytes, most = {t: [] for t in copiers}, {t: [] for t in copiers}, 0, 0
+
+    def write(done: int) -> None:
+        for topic, messages in raws.items():
+            if messages:
+                for (data, at), new in zip(places[topic], copiers[topic].compensated(reader, messages)):
+                    if len(new) != at[1]:  # values replaced in a fixed layout: never; the offsets would not hold
+                        raise InputError(f"topic {topic}: a compensated IMU message changed its length")
+                    data[at[0] : at[0] + at[1]] = new
+        for data_pos, data in chunks[:done]:
+            copy.chunk(data_pos, data)
+        del chunks[:done]
+
+    for found in inner.message_arrays():
+        chunks.append((found.data_pos, bytearray(found.data)))
+        data = chunks[-1][1]
+        for conn, at, length in zip(found.conn.tolist(), found.data_at.tolist(), found.data_length.tolist()):
+            topic = imu.get(conn)
+            if topic is not None:
+                raws[topic].append(bytes(data[at : at + length]))
+                places[topic].append((data, (at, length)))
+                most = max(most, len(raws[topic]))
+            held_bytes += length
+            if most >= chunk_rows or (
+                held_bytes >= WINDOW_BYTES
+                and all(copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())
+            ):
+                write(len(chunks) - 1)  # the chunks before this one are done
+                raws, places, held_bytes, most = {t: [] for t in copiers}, {t: [] for t in copiers}, 0, 0
+    write(len(chunks))
+    copy.through()
+
+
 class _Copier:
     """One IMU topic's part of the pass of :func:`apply_bag`: its messages compensated a batch at a time, the
     compensator's state carried from one batch to the next (see the module)."""
@@ -332,7 +430,11 @@ class _Copier:
         with_twin = self.twin is not None and np.any(stamp == self.twin[0])
         time_s, gyro, accel = stream.ordered(stamp, gyro_rad * _RAD, accel_ms2 * _MS2)
         part = stream.matched(time_s, gyro, accel)
-        rec = stream.chunk_of(part).recording if part[0].size else None
+        rec = None
+        if part[0].size >= 2 or (part[0].size and self.comp is None):
+            rec = stream.chunk_of(part).recording
+        elif part[0].size:  # one sample (the last of a bag, say): compensated as the next of the stream
+            rec = stream.lone_sample(part)
         values, correction, accel_values, accel_correction = self._corrections(rec)
         # each message: the first of its stamp takes the recording's value, a repeat the same correction
         new = np.full((len(raws), 3), np.nan)

@@ -14,6 +14,7 @@ import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -260,7 +261,8 @@ def _decoded_groups(reader, imu: list, size: int):
         if raws:
             yield decoded_imu(reader, imu[0].msgtype, raws)
         return
-    for chunk, _, _, data_at, data_length in arrays(connections=imu):
+    for found in arrays(connections=imu):
+        chunk, data_at, data_length = found.data, found.data_at, found.data_length
         if data_length.size and np.all(data_length == data_length[0]):
             batch = imu_batch_of(sliding_window_view(chunk, int(data_length[0]))[data_at], cdr=False)
             if batch is not None:
@@ -527,6 +529,21 @@ class BagStream:
             self._last_s = float(recording.time_s[-1])
         return BagChunk(recording_table(recording), recording, np.arange(recording.n_samples), first)
 
+    def lone_sample(self, part: tuple):
+        """One sample (``part`` as :meth:`chunk_of` takes it) as the next after those before, where a chunk of one
+        sample cannot be a :class:`Recording` (at least two rows): its arrays [s, deg/s, g, degC] with the chunk's
+        bookkeeping (rows, a gap before it, a non-finite sample dropped: None)."""
+        time_s, gyro, accel, temperature = part
+        values = [v for v in (gyro, accel, temperature) if v is not None]
+        if self.options.drop_nonfinite and not all(np.all(np.isfinite(v)) for v in (time_s, *values)):
+            self.rows_dropped += 1
+            return None
+        if self._last_s is not None and time_s[0] - self._last_s > 2 * self._period_s:
+            self.gaps += 1
+        self.rows += 1
+        self._last_s = float(time_s[0])
+        return LoneSample(time_s, gyro, self.gyro_axes, temperature, accel, self.accel_axes)
+
     def warn_summary(self) -> None:
         """The warnings a whole read gives, once for the bag: samples sorted or repeated, samples outside the
         temperature topic's span, rows dropped."""
@@ -546,6 +563,22 @@ class BagStream:
             )
         if self.rows_dropped:
             warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
+
+
+class LoneSample(NamedTuple):
+    """One sample of a stream [s, deg/s, g, degC], what a compensator reads of a recording
+    (:meth:`BagStream.lone_sample`)."""
+
+    time_s: np.ndarray
+    gyro_dps: np.ndarray
+    gyro_axes: tuple
+    temperature_degc: np.ndarray | None
+    accel_g: np.ndarray | None
+    accel_axes: tuple
+
+    @property
+    def n_samples(self) -> int:
+        return 1
 
 
 def _joined(parts: list) -> tuple:

@@ -27,6 +27,7 @@ import functools
 import os
 import re
 import struct
+from typing import NamedTuple
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -196,8 +197,8 @@ def _chunk_arrays(rb, data: bytes, connmap: dict, wanted: set, span: tuple) -> t
 def _message_arrays(self, connections=()):
     """The messages of ``connections`` (all when empty) chunk by chunk in file order, each chunk as arrays: its
     decompressed bytes (uint8), and of its messages the connection ids, times [ns], where each one's data starts and
-    its length [bytes] (:func:`_chunk_arrays`): a caller that decodes many messages at once reads them without a
-    Python object per message."""
+    its length [bytes] (:func:`_chunk_arrays`), as :class:`ChunkArrays`: a caller that decodes many messages at once
+    reads them without a Python object per message."""
     rb = _rosbag1()
     self._check_open()
     connmap = {c.id: c for c in self.connections}
@@ -209,7 +210,26 @@ def _message_arrays(self, connections=()):
         chunk = self.read_chunk()
         self.bio.seek(chunk.datapos)
         data = bytes(chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize)))
-        yield (np.frombuffer(data, dtype=np.uint8), *_chunk_arrays(rb, data, connmap, wanted, (None, None)))
+        yield ChunkArrays(
+            np.frombuffer(data, dtype=np.uint8),
+            chunk.datapos,
+            chunk.datasize,
+            chunk.decompressor is rb.decompressors["none"],
+            *_chunk_arrays(rb, data, connmap, wanted, (None, None)),
+        )
+
+
+class ChunkArrays(NamedTuple):
+    """One chunk's messages as arrays (:meth:`ChunkedReader1.message_arrays`)."""
+
+    data: np.ndarray  # the decompressed chunk's bytes (uint8)
+    data_pos: int  # where the chunk's data lie in the file [bytes]
+    data_size: int  # their size in the file [bytes]
+    uncompressed: bool  # stored as they are (the file's bytes are ``data``)
+    conn: np.ndarray  # each message's connection id
+    time: np.ndarray  # each message's time [ns]
+    data_at: np.ndarray  # where each message's data start in ``data`` [bytes]
+    data_length: np.ndarray  # and their length [bytes]
 
 
 #: records walked one by one after a run of fewer than this many of one shape, before trying runs again
@@ -370,4 +390,4 @@ def lean_writer1() -> type:
     )
 
 
-__all__ = ["chunked_reader1", "lean_writer1"]
+__all__ = ["ChunkArrays", "chunked_reader1", "lean_writer1"]
