@@ -21,12 +21,13 @@ from rosbags.typesys import Stores, get_typestore  # noqa: E402
 STORE = get_typestore(Stores.ROS1_NOETIC)
 
 
-def _bag(path, compression=None, n=600, writer_class=Writer):
-    """Two topics of strings, messages of 40 to 100 bytes, chunks of about 4 kB (many chunks)."""
+def _bag(path, compression=None, n=600, writer_class=Writer, every=3, threshold=4096):
+    """Two topics of strings, messages of 40 to 100 bytes on /a and one in ``every`` on /b, chunks of about
+    ``threshold`` bytes (many chunks)."""
     writer = writer_class(path)
     if compression:
         writer.set_compression(compression)
-    writer.chunk_threshold = 4096
+    writer.chunk_threshold = threshold
     string = STORE.types["std_msgs/msg/String"]
     with writer:
         a = writer.add_connection("/a", "std_msgs/msg/String", typestore=STORE)
@@ -37,7 +38,7 @@ def _bag(path, compression=None, n=600, writer_class=Writer):
                 1_000_000_000 + 10_000_000 * i,
                 STORE.serialize_ros1(string(data="x" * (40 + i % 60)), "std_msgs/msg/String"),
             )
-            if i % 3 == 0:
+            if i % every == 0:
                 writer.write(
                     b,
                     1_000_000_000 + 10_000_000 * i + 5,
@@ -140,27 +141,14 @@ def test_a_chunks_records_are_read_as_field_by_field_whatever_their_header_layou
     "compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["none", "bz2", "lz4"]
 )
 def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compression, tmp_path, monkeypatch):
-    """A topic of one message in fifty (a temperature at 1 Hz beside an IMU at 50 Hz): an uncompressed chunk's
+    """A topic of one message in fifty (a temperature at 1 Hz beside an IMU at 50 Hz, say): an uncompressed chunk's
     messages of it are read where the chunk's index data say (each checked against its entry), the same messages
     as rosbags' reader, with a time filter too; a chunk whose index entry points at another record is walked."""
-    path = tmp_path / "sparse.bag"
-    writer = Writer(path)
-    if compression:
-        writer.set_compression(compression)
-    writer.chunk_threshold = 16384
-    string = STORE.types["std_msgs/msg/String"]
-    with writer:
-        dense = writer.add_connection("/imu", "std_msgs/msg/String", typestore=STORE)
-        sparse = writer.add_connection("/temperature", "std_msgs/msg/String", typestore=STORE)
-        for i in range(3000):
-            writer.write(dense, 10**9 + 20_000_000 * i, STORE.serialize_ros1(string(data="i" * 60), string.__msgtype__))
-            if i % 50 == 7:
-                message = STORE.serialize_ros1(string(data=f"t{i}"), string.__msgtype__)
-                writer.write(sparse, 10**9 + 20_000_000 * i + 1, message)
+    path, _ = _bag(tmp_path / "sparse.bag", compression, n=3000, every=50, threshold=16384)
     indexed = []  # what each indexed read of a chunk gave: its messages, or None (the chunk then walked)
     original = chunks_module._indexed_messages
     monkeypatch.setattr(chunks_module, "_indexed_messages", lambda *a: indexed.append(original(*a)) or indexed[-1])
-    topic = {"topics": ("/temperature",)}
+    topic = {"topics": ("/b",)}
     for kwargs in (topic, {**topic, "start": 2 * 10**10, "stop": 4 * 10**10}):
         ours = _read(chunked_reader1(), path, **dict(kwargs))[1]
         assert ours == _read(Reader, path, **dict(kwargs))[1] and ours
@@ -170,6 +158,7 @@ def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compress
         rosbag1 = pytest.importorskip("rosbags.rosbag1.reader")
         data = bytearray(path.read_bytes())
         with chunked_reader1()(path) as reader:
+            (sparse,) = [c.id for c in reader.connections if c.topic == "/b"]
             info = reader.chunk_infos[1]
             reader.bio.seek(info.pos)
             chunk = reader.read_chunk()
@@ -177,7 +166,7 @@ def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compress
             for _ in info.connection_counts:  # the chunk's index data records, one per connection in it
                 header = rosbag1.Header.read(reader.bio, rosbag1.RecordType.IDXDATA)
                 size, entries = rosbag1.read_uint32(reader.bio), reader.bio.tell()
-                if header.get_uint32("conn") == sparse.id:
+                if header.get_uint32("conn") == sparse:
                     (sec,) = struct.unpack_from("<I", data, entries)
                     data[entries : entries + 4] = struct.pack("<I", sec + 1)
                 reader.bio.seek(entries + size)
