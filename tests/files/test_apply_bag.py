@@ -19,7 +19,7 @@ from gyrocomp.io.rosbag1_chunks import chunked_reader1
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
-from tests.io.log_writers import write_bag
+from tests.io.log_writers import write_bag, write_recording_bag
 
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 from rosbags.highlevel import AnyReader  # noqa: E402
@@ -326,3 +326,28 @@ def test_a_last_batch_of_one_imu_message_is_compensated_as_the_next_sample(kind,
         sevens = apply_bag(model, source, tmp_path / ("sevens.bag" if kind == "ros1" else "sevens"), chunk_rows=7)
     assert 400 % 7 == 1 and one.compensated == sevens.compensated == 400
     assert _messages(Path(sevens.path)) == _messages(Path(one.path))
+
+
+def test_a_damaged_imu_record_the_reading_passed_over_is_refused_in_one_line(model, tmp_path):
+    """The temperature topic is read by the chunks' index (one message in fifty), so a damaged IMU record is first
+    met while compensating: one line naming the bag and the topic, exit 2, nothing written."""
+    from gyrocomp.io.rosbag1_chunks import chunked_reader1 as reader_class
+
+    profile = get_profile("cycle", set_points_degc=(15.0, 45.0), cycles=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        recording = simulate("consumer", profile=profile, rate_hz=10.0, duration_s=600.0, seed=3).recording
+    source = tmp_path / "in.bag"
+    write_recording_bag(source, recording, ros2=False, temperature_every=50)
+    data = bytearray(source.read_bytes())
+    with reader_class()(source) as reader:
+        imu = [c for c in reader.connections if c.topic == "/imu/data"]
+        chunk = list(reader.message_arrays(connections=imu))[-1]
+    at = chunk.data_pos + int(chunk.data_at[5]) - 4  # the data length of an IMU message in the last chunk
+    data[at : at + 4] = (10**8).to_bytes(4, "little")
+    (tmp_path / "bad.bag").write_bytes(bytes(data))
+    model.save(tmp_path / "m.json")
+    cli = run("apply", str(tmp_path / "m.json"), str(tmp_path / "bad.bag"), "-o", str(tmp_path / "out.bag"))
+    assert cli.returncode == 2 and "Traceback" not in cli.stderr, cli.stderr
+    assert "bad.bag: damaged ROS bag: topic /imu/data" in cli.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.bag", "in.bag", "m.json"]

@@ -61,6 +61,7 @@ from ..io.rosbag import (
     any_reader,
     bag_kind,
     bag_path,
+    damaged_bag,
     decoded_imu,
     header_stamp_s,
     read_rosbag,
@@ -249,12 +250,15 @@ def _apply_bag(
         copiers = {
             topics[k]: _Copier(calibrations[k], streams[k], covariance_of, counts[topics[k]]) for k in calibrations
         }
-        if not _patched_bag(bag, output, copiers, chunk_rows):
-            _write_bag(
-                bag,
-                output,
-                lambda reader, writer, connections: _copy_in_batches(reader, writer, connections, copiers, chunk_rows),
-            )
+        with damaged_bag(path, ", ".join(copiers)):  # a damaged IMU record: found here when reading skipped it
+            if not _patched_bag(bag, output, copiers, chunk_rows):
+                _write_bag(
+                    bag,
+                    output,
+                    lambda reader, writer, connections: _copy_in_batches(
+                        reader, writer, connections, copiers, chunk_rows
+                    ),
+                )
         for stream in streams.values():
             stream.warn_summary()
         done = {topic: (c.with_accel, tuple(c.covariances)) for topic, c in copiers.items()}
@@ -262,7 +266,10 @@ def _apply_bag(
         streamed = False
         counts = {topic: {"compensated": 0, "unchanged": 0} for topic in counts}
         results = {topics[k]: _whole(calibrations[k], path, streams[k].options, covariance_of) for k in calibrations}
-        _write_bag(bag, output, lambda reader, writer, connections: _copy(reader, writer, connections, results, counts))
+        with damaged_bag(path, ", ".join(results)):
+            _write_bag(
+                bag, output, lambda reader, writer, connections: _copy(reader, writer, connections, results, counts)
+            )
         done = {topic: (result[2], tuple(result[3])) for topic, result in results.items()}
     _warn_unchanged(path, counts)
     return tuple(

@@ -191,12 +191,13 @@ def header_stamp_s(header) -> float:
 
 
 @contextlib.contextmanager
-def _damaged(path: Path, topic: str):
+def damaged_bag(path: Path, topic: str):
     """Any error rosbags raises on the messages of ``topic`` (a damaged record, a length past the file, a message
-    that does not deserialize) as one line naming the bag and the topic."""
+    that does not deserialize) as one line naming the bag and the topic (:class:`NotStreamable` passes: the caller
+    reads the bag whole; so does an OSError, the system's: a full disk writing an output, say)."""
     try:
         yield
-    except InputError:
+    except (InputError, NotStreamable, OSError):
         raise
     except Exception as exc:  # rosbags' own errors, and what a damaged record makes its parsers raise
         raise InputError(
@@ -278,7 +279,7 @@ def _imu_batches(path: Path, reader, imu: list, size: int, progress: ProgressCal
     m/s^2]; a damaged bag or one holding more messages than its index counts is one line naming the topic."""
     n = sum(c.msgcount for c in imu)
     pending, held, read = [], 0, 0
-    with _damaged(path, imu[0].topic):
+    with damaged_bag(path, imu[0].topic):
         for group in _decoded_groups(reader, imu, size):
             read += group[0].size
             if read > n:
@@ -317,7 +318,7 @@ def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | Non
 def _temperature_samples(path: Path, reader, thermo: list):
     """(time [s], temperature [degC]) of every message on the temperature topic, in time order."""
     t_time, t_value = [], []
-    with _damaged(path, thermo[0].topic):
+    with damaged_bag(path, thermo[0].topic):
         for connection, _, raw in reader.messages(connections=thermo):
             msg = reader.deserialize(raw, connection.msgtype)
             t_time.append(header_stamp_s(msg.header))
