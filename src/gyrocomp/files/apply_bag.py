@@ -295,6 +295,16 @@ def _whole(calibration: Calibration, path: Path, options: ReadOptions, covarianc
     return recording, compensated, accel, covariances
 
 
+def _batch_due(copiers: dict, raws: dict, most: int, held_bytes: int, chunk_rows: int) -> bool:
+    """Whether the messages held are compensated and written now: a topic of ``copiers`` holds ``chunk_rows`` IMU
+    messages (``most``), or :data:`WINDOW_BYTES` are held and each topic's rate is set (its compensator made, or
+    :data:`FIRST_SAMPLES` of its messages held in ``raws``)."""
+    return most >= chunk_rows or (
+        held_bytes >= WINDOW_BYTES
+        and all(copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())
+    )
+
+
 def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_rows: int) -> None:
     """Every message of the bag into ``writer`` in one pass: held until a topic of ``copiers`` has ``chunk_rows``
     IMU messages (or :data:`WINDOW_BYTES` are held, each topic's rate set: its compensator made, or
@@ -319,10 +329,7 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
             messages.append(raw)
             most = max(most, len(messages))
         held_bytes += len(raw)
-        if most >= chunk_rows or (
-            held_bytes >= WINDOW_BYTES
-            and all(copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())
-        ):
+        if _batch_due(copiers, raws, most, held_bytes, chunk_rows):
             write()
             held, raws, held_bytes, most = [], {topic: [] for topic in copiers}, 0, 0
     write()
@@ -381,7 +388,7 @@ class _BagCopy:
 
 
 def _patch_in_batches(reader, inner, copy: _BagCopy, copiers: dict, chunk_rows: int) -> None:
-    """Every message of the bag in its order, held as :func:`_copy_in_batches` holds them; at each batch the IMU
+    """Every message of the bag in its order, held until :func:`_batch_due`; at each batch the IMU
     messages are compensated by their topic's copier and written into their chunk's copy, and every chunk whose
     messages are all done goes out."""
     imu = {c.id: c.topic for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE}
@@ -409,10 +416,7 @@ def _patch_in_batches(reader, inner, copy: _BagCopy, copiers: dict, chunk_rows: 
                 places[topic].append((data, (at, length)))
                 most = max(most, len(raws[topic]))
             held_bytes += length
-            if most >= chunk_rows or (
-                held_bytes >= WINDOW_BYTES
-                and all(copiers[t].comp is not None or len(m) >= FIRST_SAMPLES for t, m in raws.items())
-            ):
+            if _batch_due(copiers, raws, most, held_bytes, chunk_rows):
                 write(len(chunks) - 1)  # the chunks before this one are done
                 raws, places, held_bytes, most = {t: [] for t in copiers}, {t: [] for t in copiers}, 0, 0
     write(len(chunks))

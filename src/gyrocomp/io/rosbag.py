@@ -522,13 +522,18 @@ class BagStream:
             )
         self.rows_dropped += recording.metadata["rows_dropped"]
         first, self.rows = self.rows, self.rows + time_s.size
-        if recording.n_samples and self._last_s is not None and recording.time_s[0] - self._last_s > 2 * self._period_s:
-            self.gaps += 1
+        if recording.n_samples:
+            self._count_gap_before(recording.time_s[0])
         self.gaps += len(recording.gaps)
         if recording.n_samples > 1:
             self._period_s = self._period_s or 1.0 / recording.rate_hz
             self._last_s = float(recording.time_s[-1])
         return BagChunk(recording_table(recording), recording, np.arange(recording.n_samples), first)
+
+    def _count_gap_before(self, first_s: float) -> None:
+        """Count a gap between the chunks before and one starting at ``first_s`` [s] (more than two periods)."""
+        if self._last_s is not None and first_s - self._last_s > 2 * self._period_s:
+            self.gaps += 1
 
     def lone_sample(self, part: tuple):
         """One sample (``part`` as :meth:`chunk_of` takes it) as the next after those before, where a chunk of one
@@ -539,8 +544,7 @@ class BagStream:
         if self.options.drop_nonfinite and not all(np.all(np.isfinite(v)) for v in (time_s, *values)):
             self.rows_dropped += 1
             return None
-        if self._last_s is not None and time_s[0] - self._last_s > 2 * self._period_s:
-            self.gaps += 1
+        self._count_gap_before(time_s[0])
         self.rows += 1
         self._last_s = float(time_s[0])
         return LoneSample(time_s, gyro, self.gyro_axes, temperature, accel, self.accel_axes)

@@ -211,11 +211,7 @@ def _message_arrays(self, connections=()):
         self.bio.seek(chunk.datapos)
         data = bytes(chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize)))
         yield ChunkArrays(
-            np.frombuffer(data, dtype=np.uint8),
-            chunk.datapos,
-            chunk.datasize,
-            chunk.decompressor is rb.decompressors["none"],
-            *_chunk_arrays(rb, data, connmap, wanted, (None, None)),
+            np.frombuffer(data, dtype=np.uint8), chunk.datapos, *_chunk_arrays(rb, data, connmap, wanted, (None, None))
         )
 
 
@@ -224,8 +220,6 @@ class ChunkArrays(NamedTuple):
 
     data: np.ndarray  # the decompressed chunk's bytes (uint8)
     data_pos: int  # where the chunk's data lie in the file [bytes]
-    data_size: int  # their size in the file [bytes]
-    uncompressed: bool  # stored as they are (the file's bytes are ``data``)
     conn: np.ndarray  # each message's connection id
     time: np.ndarray  # each message's time [ns]
     data_at: np.ndarray  # where each message's data start in ``data`` [bytes]
@@ -292,7 +286,7 @@ def _same_shape(array: np.ndarray, pos: int, length: int, count: int) -> int:
     return max(fits, 1)
 
 
-def _header_fields(array: np.ndarray, data: bytes, header_at: list, header_length: list) -> tuple:
+def _header_fields(array: np.ndarray, data: bytes, header_at: np.ndarray, header_length: np.ndarray) -> tuple:
     """Each record's ``op`` (-1 where absent), ``conn`` (-1) and ``time`` [ns] (-1): the records whose headers have
     one length and the same bytes as the first of them but for these three values are read as one array; any other
     record field by field (:func:`_fields_of`)."""
