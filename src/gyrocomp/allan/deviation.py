@@ -168,6 +168,12 @@ def allan_deviation(
     counts = term_count(kind, phase.size, ms)
     deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
     alphas, methods, edf = _noise_and_edf(kind, phase, ms, confidence, forced)
+    return _result(kind, tau, deviation, counts, alphas, edf, methods, confidence)
+
+
+def _result(kind: str, tau, deviation, counts, alphas, edf, methods: tuple, confidence: float | None) -> AllanResult:
+    """The :class:`AllanResult` of the deviations [u] at ``tau`` [s], with their intervals at ``confidence`` (the
+    interval arrays of one sigma, and a NaN confidence, where it is None)."""
     low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
     return AllanResult(
         tau=tau,
@@ -253,16 +259,5 @@ def allan_deviation_segments(
             edf += np.where((own > 0) & np.isfinite(own_edf), own_edf, 0.0)
     edf = np.where(np.isnan(alphas), np.nan, edf)
     deviation = _normalize(kind, sums, ms, tau, counts, scale)
-    low, high = confidence_interval(deviation, edf, ONE_SIGMA if confidence is None else confidence)
-    return AllanResult(
-        tau=tau,
-        deviation=deviation,
-        n=counts,
-        ci_low=low,
-        ci_high=high,
-        alpha=alphas,
-        edf=edf,
-        kind=kind,
-        confidence=math.nan if confidence is None else confidence,
-        noise_method=found.method if found is not None else ("",) * len(ms),
-    )
+    methods = found.method if found is not None else ("",) * len(ms)
+    return _result(kind, tau, deviation, counts, alphas, edf, methods, confidence)

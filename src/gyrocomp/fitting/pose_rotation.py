@@ -29,8 +29,8 @@ import numpy as np
 
 from ..errors import DataQualityWarning, InputError
 from ..recording import Recording
-from ..calibration.triad import TriadCalibration, rows_of
-from .triad_fit import MIN_TRIAD_SPAN_DEGC, ORDER_TOLERANCE, Pose, find_poses, fit_accel_multiposition
+from ..calibration.triad import TriadCalibration
+from .triad_fit import MIN_TRIAD_SPAN_DEGC, ORDER_TOLERANCE, Pose, find_poses, fit_accel_multiposition, gyro_triad
 
 #: every axis must be turned at least this far [deg] in some move, about an axis other than gravity
 MIN_TURN_DEG = 20.0
@@ -515,17 +515,7 @@ def fit_gyro_between_poses(
     _require_determined(sol.jac, len(moves.meta))
     _require_plausible(triad[0])
     se = _standard_errors(sol, len(moves.meta))
-    cal = TriadCalibration(
-        sensitivity=rows_of(triad[0]),
-        bias=(0.0, 0.0, 0.0),
-        method="rotation",
-        sensitivity_stderr=rows_of(se[0]),
-        bias_stderr=(0.0, 0.0, 0.0),
-        unit="deg/s",
-        reference_degc=reference if order else None,
-        sensitivity_per_degc=tuple(rows_of(k) for k in triad[1:]),
-        sensitivity_per_degc_stderr=tuple(rows_of(k) for k in se[1:]),
-    )
+    cal = gyro_triad(triad, se, "rotation", reference)
     coefs = session.coefficients
     return RotationFit(
         cal,

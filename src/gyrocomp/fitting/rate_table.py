@@ -12,8 +12,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..calibration.triad import TriadCalibration, rows_of
-from .triad_fit import ORDER_TOLERANCE
+from ..calibration.triad import TriadCalibration
+from .triad_fit import ORDER_TOLERANCE, gyro_triad
 
 #: the highest order of K(T) in temperature the rate-table fit considers
 MAX_TRIAD_TEMPERATURE_ORDER = 2
@@ -202,17 +202,7 @@ def fit_gyro_rate_table(
     se = np.sqrt(np.outer(np.diag(np.linalg.pinv(x.T @ x)), np.ones(3)) * variance)
     blocks = [coef[runs + 3 * p : runs + 3 * p + 3].T for p in range(order + 1)]  # K row i = output axis i
     block_se = [se[runs + 3 * p : runs + 3 * p + 3].T for p in range(order + 1)]
-    cal = TriadCalibration(
-        sensitivity=rows_of(blocks[0]),
-        bias=(0.0, 0.0, 0.0),
-        method="rate-table",
-        sensitivity_stderr=rows_of(block_se[0]),
-        bias_stderr=(0.0, 0.0, 0.0),
-        unit="deg/s",
-        reference_degc=t_ref if order else None,
-        sensitivity_per_degc=tuple(rows_of(b) for b in blocks[1:]),
-        sensitivity_per_degc_stderr=tuple(rows_of(b) for b in block_se[1:]),
-    )
+    cal = gyro_triad(blocks, block_se, "rate-table", t_ref)
     return RateTableFit(cal, tuple(segments), coef[:runs], scores, float(np.sqrt(np.mean(resid**2))))
 
 

@@ -669,6 +669,23 @@ def _auto_method(units: np.ndarray) -> str:
     return "six-position"
 
 
+def gyro_triad(blocks, stderr, method: str, reference_degc: float) -> TriadCalibration:
+    """A gyro triad's scale factor and misalignment K(T) [1, 1/degC^p] from its fitted blocks (K at the reference
+    temperature, then each power of (T - ``reference_degc``)) and their standard errors; no bias (each run keeps its
+    own)."""
+    return TriadCalibration(
+        sensitivity=rows_of(blocks[0]),
+        bias=(0.0, 0.0, 0.0),
+        method=method,
+        sensitivity_stderr=rows_of(stderr[0]),
+        bias_stderr=(0.0, 0.0, 0.0),
+        unit="deg/s",
+        reference_degc=reference_degc if len(blocks) > 1 else None,
+        sensitivity_per_degc=tuple(rows_of(b) for b in blocks[1:]),
+        sensitivity_per_degc_stderr=tuple(rows_of(b) for b in stderr[1:]),
+    )
+
+
 def rq_upper(sensitivity: np.ndarray) -> np.ndarray:
     """The upper-triangular factor R (positive diagonal) of K = R Q: the K the norm method can see of a
     triad whose true K is ``sensitivity`` (the rest is a rotation of the reference frame)."""
@@ -689,6 +706,7 @@ __all__ = [
     "find_poses",
     "spans_axes",
     "fit_accel_multiposition",
+    "gyro_triad",
     "propagate_stderr",
     "rq_upper",
     "undetermined_norm_term",
