@@ -85,6 +85,28 @@ READ_FIELDS = (
 READ_OPTIONS = tuple(name for name, _, _ in READ_FIELDS)
 
 
+def window_option():
+    """``--window`` [s]: the moving average of the figures of merit (evaluate, report, plot)."""
+    return click.option(
+        "--window",
+        "window_s",
+        type=FINITE,
+        default=None,
+        help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
+    )
+
+
+def turn_on_window_option(whose: str = "each run's"):
+    """``--turn-on-window`` [s]: a run's turn-on bias from its first seconds (``whose``: the help's words)."""
+    return click.option(
+        "--turn-on-window",
+        "turn_on_window_s",
+        type=FINITE,
+        default=None,
+        help=f"Estimate {whose} turn-on bias from its first S seconds [s].",
+    )
+
+
 def read_options(func):
     """Options every command that reads data files shares."""
     for name, spelling, default in reversed(READ_FIELDS):

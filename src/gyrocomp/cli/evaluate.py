@@ -17,7 +17,16 @@ from ..measures.merit import Evaluation
 from ..evaluation.comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
-from .common import FINITE, hysteresis_band, pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import (
+    hysteresis_band,
+    pop_read_options,
+    progress_bar,
+    read_options,
+    read_run,
+    read_settings,
+    turn_on_window_option,
+    window_option,
+)
 from .render import print_comparison, print_evaluation, print_expected_drift, print_installed, print_stages
 
 
@@ -27,20 +36,8 @@ def _nan_none(value):
 
 @click.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path(), metavar="MODEL RUNS... | --compare RUNS...")
-@click.option(
-    "--window",
-    "window_s",
-    type=FINITE,
-    default=None,
-    help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
-)
-@click.option(
-    "--turn-on-window",
-    "turn_on_window_s",
-    type=FINITE,
-    default=None,
-    help="Estimate each run's turn-on bias from its first S seconds [s].",
-)
+@window_option()
+@turn_on_window_option()
 @click.option(
     "--compare",
     is_flag=True,

@@ -15,7 +15,7 @@ from ..measures.merit import default_window_s
 from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
 from ..measures.noise import analyse_noise
 from ..report.figures import check_figure_path
-from .common import FINITE, OUTPUT_FILE, pop_read_options, read_options, read_run
+from .common import OUTPUT_FILE, pop_read_options, read_options, read_run, turn_on_window_option, window_option
 
 
 @click.group()
@@ -105,20 +105,8 @@ def plot_temperature(ctx, model, runs, axis, output, **kwargs):
 @click.argument("model", type=click.Path())
 @click.argument("run", type=click.Path())
 @click.option("--axis", default=None, help="The axis to draw (default: the model's first).")
-@click.option(
-    "--window",
-    "window_s",
-    type=FINITE,
-    default=None,
-    help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
-)
-@click.option(
-    "--turn-on-window",
-    "turn_on_window_s",
-    type=FINITE,
-    default=None,
-    help="Estimate the run's turn-on bias from its first S seconds [s].",
-)
+@window_option()
+@turn_on_window_option("the run's")
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE)
 @read_options
 @click.pass_context

@@ -9,27 +9,24 @@ from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.figures import require_matplotlib
 from ..report.html import build_report
 from ..evaluation.validation import validate as validate_runs
-from .common import FINITE, OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_run
+from .common import (
+    FINITE,
+    OUTPUT_FILE,
+    pop_read_options,
+    progress_bar,
+    read_options,
+    read_run,
+    turn_on_window_option,
+    window_option,
+)
 
 
 @click.command()
 @click.argument("model", type=click.Path())
 @click.argument("runs", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", required=True, type=OUTPUT_FILE, help="The HTML file to write.")
-@click.option(
-    "--window",
-    "window_s",
-    type=FINITE,
-    default=None,
-    help="Moving-average window [s] (default: tau at the raw Allan minimum, at least 1 s).",
-)
-@click.option(
-    "--turn-on-window",
-    "turn_on_window_s",
-    type=FINITE,
-    default=None,
-    help="Estimate each run's turn-on bias from its first S seconds [s].",
-)
+@window_option()
+@turn_on_window_option()
 @click.option(
     "--min-static",
     "static_min_duration_s",
