@@ -84,3 +84,46 @@ def test_a_filter_told_the_noise_at_each_temperature_is_consistent_where_one_con
     assert np.median(constant.nees) < constant.band[0]
     with pytest.raises(InputError, match=r"schedule: needs temperature_degc"):
         attitude_nees(errors, RATE_HZ, _told(0.04, 1e-9), schedule=lambda t: _told(0.04, 1e-9))
+
+
+def test_the_band_widens_by_what_the_filter_says_its_errors_share():
+    """A precise gyro (white noise 0.002 deg/s/sqrt(Hz)) against 0.01 deg updates: an update leaves much of the
+    prior error, so successive NEES samples are correlated and the time average spreads wider than K independent
+    samples would. The spread across runs of a filter told the truth is the one its own correlations predict
+    (sqrt(2 / nu)), not sqrt(2 / K), and it is inside its band in about 95 % of runs."""
+    runs, n = 600, int(RATE_HZ * 600)
+    rng = np.random.default_rng(7)
+    errors = rng.standard_normal((runs, n)) * 0.002 * np.sqrt(RATE_HZ) + rng.standard_normal((runs, 1)) * 0.01
+    truth = attitude_nees(errors, RATE_HZ, _told(0.002, 0.0))
+    assert truth.effective_epochs < 0.6 * truth.epochs
+    predicted, independent = np.sqrt(2.0 / truth.effective_epochs), np.sqrt(2.0 / truth.epochs)
+    assert np.std(truth.nees) == pytest.approx(predicted, rel=0.12)
+    assert abs(np.std(truth.nees) - independent) > 0.25 * independent
+    assert truth.inside >= 0.9
+    assert truth.band == nees_band(truth.effective_epochs)
+
+
+def test_white_noise_alone_gives_nearly_independent_samples(white_and_walk):
+    errors, n, k = white_and_walk
+    result = attitude_nees(errors, RATE_HZ, _told(n, k))
+    assert result.epochs * 0.98 <= result.effective_epochs <= result.epochs
+
+
+def test_a_scheduled_model_with_markov_terms_keeps_its_states():
+    """Told the same model at every temperature the schedule is the constant filter, to the bit; a schedule whose
+    Gauss-Markov correlation times change with temperature is refused (a filter cannot change its states)."""
+    n = int(RATE_HZ * 600)
+    errors = np.random.default_rng(5).standard_normal((20, n)) * 0.03 * np.sqrt(RATE_HZ)
+    temperature = np.linspace(0.0, 60.0, n)
+    model = _told(0.03, 1e-5, ((0.004, 30.0), (0.002, 300.0)))
+    constant = attitude_nees(errors, RATE_HZ, model)
+    scheduled = attitude_nees(errors, RATE_HZ, model, schedule=lambda t: model, temperature_degc=temperature)
+    assert np.array_equal(constant.nees, scheduled.nees)
+    with pytest.raises(InputError, match=r"schedule: the Gauss-Markov terms' correlation times change"):
+        attitude_nees(
+            errors,
+            RATE_HZ,
+            model,
+            schedule=lambda t: _told(0.03, 1e-5, ((0.004, 30.0 if t < 30 else 60.0),)),
+            temperature_degc=temperature,
+        )

@@ -71,6 +71,9 @@ def test_every_export_writes_and_reads_back_the_bound_in_si_units(model):
         back["axes"]["gyro_x"]["bound"]["white_noise_density_u_per_sqrt_hz"]
         == model.axes["gyro_x"].bound.white_noise_density
     )
+    log, written = model.axes["gyro_x"].logs[0], back["axes"]["gyro_x"]["logs"][0]["bound_with_markov"]
+    assert [(t["sigma_u"], t["time_constant_s"]) for t in written["gauss_markov"]] == list(log.markov.markov)
+    assert written["white_noise_density_u_per_sqrt_hz"] == log.markov.white_noise_density
 
 
 def test_vins_numbers_give_its_mid_point_step_the_continuous_models_variance(model):

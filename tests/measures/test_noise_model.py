@@ -111,6 +111,33 @@ def test_the_scheduled_bound_is_each_dwells_at_its_temperature_and_held_past_the
     assert at(-60.0).white_noise_density == pytest.approx(cold.bound.white_noise_density)
     assert at(120.0).random_walk == pytest.approx(hot.bound.random_walk)
     halfway = 0.5 * (middle.temperature_degc + hot.temperature_degc)
-    assert at(halfway).white_noise_density == pytest.approx(
-        0.5 * (middle.bound.white_noise_density + hot.bound.white_noise_density)
+    assert at(halfway).white_noise_density ** 2 == pytest.approx(
+        0.5 * (middle.bound.white_noise_density**2 + hot.bound.white_noise_density**2)
     )
+
+
+def test_the_scheduled_markov_bound_keeps_one_grid_and_mixes_the_dwells_variances(warming_part):
+    """With Gauss-Markov terms: each dwell's own bound (on the axis's grid, at or above its curve) at its
+    temperature, the same correlation times at every temperature (a filter's states), and between two dwells
+    the mean of their Allan variances at every tau (so never below both)."""
+    from gyrocomp.measures.noise_model import noise_over_temperature, scheduled_bound
+
+    _, rec = warming_part
+    axis = noise_over_temperature(rec).axes["gyro_x"]
+    at = scheduled_bound(axis, markov=True)
+    from gyrocomp.allan.bound import markov_grid
+
+    taus = np.array(axis.markov.taus_s)
+    grid = set(markov_grid(taus[0], taus[-1]).tolist())
+    times = {tuple(t for _, t in at(temperature).markov) for temperature in (-40.0, -20.0, 0.0, 25.0, 47.0, 90.0)}
+    assert len(times) == 1 and set(next(iter(times))) <= grid
+    assert {t for _, t in axis.markov.markov} <= grid
+    for log in axis.logs:
+        assert {t for _, t in log.markov.markov} <= set(next(iter(times)))
+        assert np.allclose(at(log.temperature_degc).deviation(taus), log.markov.deviation(taus), rtol=1e-12)
+        assert log.markov.ratio_median >= 1.0  # at or above its own curve
+    cold, middle, hot = axis.logs
+    halfway = 0.5 * (cold.temperature_degc + middle.temperature_degc)
+    mixed = 0.5 * (cold.markov.deviation(taus) ** 2 + middle.markov.deviation(taus) ** 2)
+    assert np.allclose(at(halfway).deviation(taus) ** 2, mixed, rtol=1e-12)
+    assert np.allclose(at(200.0).deviation(taus), hot.markov.deviation(taus), rtol=1e-12)

@@ -114,6 +114,16 @@ class NoiseBound:
         }
 
 
+def markov_grid(shortest_tau_s: float, longest_tau_s: float) -> np.ndarray:
+    """The Gauss-Markov correlation times [s] a bound chooses from over averaging times from ``shortest_tau_s``
+    to ``longest_tau_s`` [s]: ``MARKOV_PER_DECADE`` per decade, log-spaced, both ends included (none when the
+    span is a single tau)."""
+    if not longest_tau_s > shortest_tau_s:
+        return np.empty(0)
+    count = int(math.ceil(MARKOV_PER_DECADE * math.log10(longest_tau_s / shortest_tau_s))) + 1
+    return np.geomspace(shortest_tau_s, longest_tau_s, count)
+
+
 def _targets(
     curves: list[AllanResult], max_tau_s: float | None, confidence: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -169,6 +179,7 @@ def bound_noise(
     markov: bool = True,
     max_tau_s: float | None = None,
     confidence: float = BOUND_CONFIDENCE,
+    time_constants_s=None,
 ) -> NoiseBound:
     """The tightest noise model a filter can carry whose Allan deviation is at or above the upper confidence
     bound of every curve at every averaging time (see the module).
@@ -188,6 +199,9 @@ def bound_noise(
         One-sided confidence of the upper bound of each measured point that the model stays above (default
         0.975, the upper end of the two-sided 95 % interval: a point's true deviation lies below it 39 times in
         40).
+    time_constants_s : array, optional
+        The Gauss-Markov terms' correlation times [s] to choose from (default: the grid over the bounded taus), e.g.
+        one grid for the logs of several temperatures so that their terms match (:func:`markov_grid`).
 
     Returns
     -------
@@ -197,9 +211,14 @@ def bound_noise(
     if not 0.5 < confidence < 1.0:
         raise InputError(f"confidence: a one-sided confidence between 0.5 and 1, got {confidence!r}")
     tau, dev, high = _targets(curves, max_tau_s, confidence)
-    lo, hi = float(tau.min()), float(tau.max())
-    count = int(math.ceil(MARKOV_PER_DECADE * math.log10(hi / lo))) + 1 if markov and hi > lo else 0
-    times = np.geomspace(lo, hi, count) if count else np.empty(0)
+    if not markov:
+        times = np.empty(0)
+    elif time_constants_s is None:
+        times = markov_grid(float(tau.min()), float(tau.max()))
+    else:
+        times = np.asarray(time_constants_s, dtype=float)
+        if times.ndim != 1 or not np.all(np.isfinite(times) & (times > 0)):
+            raise InputError("time_constants_s: positive correlation times [s], one list")
     x = _least_strengths(_columns(tau, times) / (high**2)[:, None])
     model = np.sqrt(_columns(tau, times) @ x)
     ratio = model / dev
@@ -221,4 +240,5 @@ __all__ = [
     "NoiseBound",
     "bound_noise",
     "markov_allan_variance",
+    "markov_grid",
 ]

@@ -9,10 +9,16 @@ measured rate is the gyro's error itself. Between updates the state and its cova
 matrix exponential), so the filter's covariance is the same for every run and only its estimates differ.
 
 At each update the prior attitude error squared over its variance is one NEES sample of one degree of freedom;
-a run's time-averaged NEES over K updates (after a burn-in) has, when the filter is consistent, mean 1 and lies in
-[chi2(0.025, K) / K, chi2(0.975, K) / K] 95 times in 100 (Bar-Shalom, Li and Kirubarajan, *Estimation with
-Applications to Tracking and Navigation*, 2001, section 5.4). Below the band the filter is over-cautious (its
-noise too large), above it over-confident.
+a run's time-averaged NEES over K updates (after a burn-in) has, when the filter is consistent, mean 1 (Bar-Shalom,
+Li and Kirubarajan, *Estimation with Applications to Tracking and Navigation*, 2001, section 5.4). Its 95 % band
+is [chi2(0.025, nu) / nu, chi2(0.975, nu) / nu]: for independent samples nu = K, but successive prior errors share
+the bias estimate's error, so their squares are correlated and the mean spreads wider. Under consistency the
+filter itself says how: the prior error of update k + j is A_{k+j-1} ... A_k times that of update k plus noise
+independent of it, A_i = Phi_{i+1} (I - G_i H) (the transition after the update with gain G_i), so the normalized
+errors z_k have correlations rho_kl = (A_{l-1} ... A_k P_k)[0, 0] / sqrt(P_k[0, 0] P_l[0, 0]), and for
+Gaussian errors cov(z_k^2, z_l^2) = 2 rho_kl^2. The band takes the chi-square of the same mean and variance
+(Satterthwaite, *Biometrics Bulletin* 2, 1946): nu = K^2 / sum_kl rho_kl^2, equal to K when the errors are
+independent. Below the band the filter is over-cautious (its noise too large), above it over-confident.
 """
 
 from __future__ import annotations
@@ -36,14 +42,17 @@ class NeesResult:
     nees : array (runs,)
         Each run's time-averaged NEES over the updates after the burn-in.
     band : (float, float)
-        Its 95 % chi-square band.
+        Its 95 % chi-square band (on ``effective_epochs`` degrees of freedom).
     epochs : int
         The updates averaged per run.
+    effective_epochs : float
+        The independent samples their correlation is worth (nu in the module's text; ``epochs`` when independent).
     """
 
     nees: np.ndarray
     band: tuple[float, float]
     epochs: int
+    effective_epochs: float
 
     @property
     def inside(self) -> float:
@@ -51,13 +60,13 @@ class NeesResult:
         return float(np.mean((self.nees >= self.band[0]) & (self.nees <= self.band[1])))
 
 
-def nees_band(epochs: int, dof: int = 1, confidence: float = 0.95) -> tuple[float, float]:
-    """The two-sided band of the mean of ``epochs`` NEES samples of ``dof`` degrees of freedom each.
+def nees_band(epochs: float, dof: int = 1, confidence: float = 0.95) -> tuple[float, float]:
+    """The two-sided band of the mean of ``epochs`` independent NEES samples of ``dof`` degrees of freedom each.
 
     Parameters
     ----------
-    epochs : int
-        The samples averaged.
+    epochs : float
+        The samples averaged (or the independent samples correlated ones are worth).
     dof : int
         The degrees of freedom of each.
     confidence : float
@@ -125,7 +134,8 @@ def attitude_nees(
         The share of the updates left out at the start (the bias estimate converging).
     schedule : callable, optional
         ``schedule(temperature_degc) -> NoiseBound``: the noise the filter is told at each update period's mean
-        temperature instead of ``noise`` (white noise and random walk only), with ``temperature_degc``.
+        temperature instead of ``noise``, with ``temperature_degc`` (its Gauss-Markov terms, if any, of the same
+        correlation times at every temperature).
     temperature_degc : array (n,), optional
         The temperature along the runs [degC], for ``schedule``.
 
@@ -142,23 +152,33 @@ def attitude_nees(
             f"update_period_s: {update_period_s:g} s leaves fewer than two updates after the burn-in in "
             f"{errors.shape[1] / rate_hz:g} s"
         )
-    if schedule is not None and (temperature_degc is None or noise.markov):
-        raise InputError("schedule: needs temperature_degc, and a noise model of white noise and random walk only")
+    if schedule is not None and temperature_degc is None:
+        raise InputError("schedule: needs temperature_degc, the temperature along the runs")
     # the measured angle of each update period: the rate integrated over it [deg]
     integrated = errors[:, : epochs * per].reshape(errors.shape[0], epochs, per).sum(axis=2) / rate_hz
-    models = _models(noise, schedule, temperature_degc, epochs, per, rate_hz)
-    p = _initial_covariance(models[0][0].shape[0], errors[:, : max(per, 1)], noise, update_sigma_deg)
-    samples = _filter(integrated, models, p, first, update_sigma_deg)
-    return NeesResult(np.mean(samples, axis=0), nees_band(len(samples)), len(samples))
+    told = _told(noise, schedule, temperature_degc, epochs, per)
+    models = (
+        [_model(t, per / rate_hz) for t in told] if schedule is not None else [_model(noise, per / rate_hz)] * epochs
+    )
+    p = _initial_covariance(models[0][0].shape[0], errors[:, : max(per, 1)], told[0], update_sigma_deg)
+    samples, effective = _filter(integrated, models, p, first, update_sigma_deg)
+    return NeesResult(np.mean(samples, axis=0), nees_band(effective), len(samples), effective)
 
 
-def _models(noise: NoiseBound, schedule, temperature_degc, epochs: int, per: int, rate_hz: float) -> list:
-    """The filter's model of each update period of ``per`` samples: ``noise``'s, or the schedule's at the
-    period's mean temperature [degC]."""
+def _told(noise: NoiseBound, schedule, temperature_degc, epochs: int, per: int) -> list[NoiseBound]:
+    """The noise model the filter is told for each update period of ``per`` samples: ``noise``, or the
+    schedule's at the period's mean temperature [degC] (the same Gauss-Markov correlation times at every one)."""
     if schedule is None:
-        return [_model(noise, per / rate_hz)] * epochs
+        return [noise] * epochs
     periods = np.asarray(temperature_degc, dtype=float)[: epochs * per].reshape(epochs, per)
-    return [_model(schedule(float(np.mean(t))), per / rate_hz) for t in periods]
+    told = [schedule(float(np.mean(t))) for t in periods]
+    times = {tuple(tc for _, tc in b.markov) for b in told}
+    if len(times) > 1:
+        raise InputError(
+            "schedule: the Gauss-Markov terms' correlation times change with temperature; a filter's "
+            "states cannot: give each temperature the same grid (scheduled_bound does)"
+        )
+    return told
 
 
 def _initial_covariance(size: int, first_errors_dps: np.ndarray, noise: NoiseBound, update_sigma_deg: float):
@@ -172,23 +192,50 @@ def _initial_covariance(size: int, first_errors_dps: np.ndarray, noise: NoiseBou
     return p
 
 
-def _filter(integrated: np.ndarray, models: list, p: np.ndarray, first: int, update_sigma_deg: float) -> list:
+def _filter(
+    integrated: np.ndarray, models: list, p: np.ndarray, first: int, update_sigma_deg: float
+) -> tuple[list, float]:
     """Each update's prior NEES of the attitude (from ``first`` on), every run at once: propagate with each
-    period's (transition, process noise), then update with an absolute attitude of the true value 0."""
+    period's (transition, process noise), then update with an absolute attitude of the true value 0. Also the
+    independent samples they are worth under consistency (:func:`_effective_samples`)."""
     x = np.zeros((integrated.shape[0], p.shape[0]))
     rng = np.random.default_rng(0)
-    samples = []
+    samples, priors, after = [], [], []
     for k, (phi, q) in enumerate(models):
         x = x @ phi.T
         x[:, 0] += integrated[:, k]
         p = phi @ p @ phi.T + q
         if k >= first:
             samples.append(x[:, 0] ** 2 / p[0, 0])
+            priors.append(p[:, 0].copy())
         z = rng.standard_normal(integrated.shape[0]) * update_sigma_deg
         gain = p[:, 0] / (p[0, 0] + update_sigma_deg**2)
         x = x + np.outer(z - x[:, 0], gain)
         p = p - np.outer(gain, p[0, :])
-    return samples
+        if k >= first and k + 1 < len(models):
+            update = np.eye(p.shape[0])
+            update[:, 0] -= gain
+            after.append(models[k + 1][0] @ update)  # A_k: the prior error of update k on to that of k + 1
+    return samples, _effective_samples(np.array(priors), np.array(after))
+
+
+def _effective_samples(priors: np.ndarray, after: np.ndarray) -> float:
+    """nu = K^2 / sum_kl rho_kl^2 (the module's text) of K prior errors whose covariances with the attitude's,
+    P_k[:, 0], are ``priors`` (K, size), ``after`` (K - 1, size, size) carrying each on to the next update.
+
+    Lag by lag, every k at once: c_k <- A_{k+j-1} c_k is the covariance of update k + j's prior error with the
+    attitude error of update k; the lags stop when every correlation is below 1e-6."""
+    variance = priors[:, 0]
+    count = len(variance)
+    total = float(count)  # rho_kk = 1
+    c = priors.copy()
+    for lag in range(1, count):
+        c = np.einsum("kij,kj->ki", after[lag - 1 :], c[: count - lag])
+        rho = c[:, 0] / np.sqrt(variance[: count - lag] * variance[lag:])
+        total += 2.0 * float(np.sum(rho**2))
+        if np.max(np.abs(rho)) < 1e-6:
+            break
+    return count**2 / total
 
 
 __all__ = ["NeesResult", "attitude_nees", "nees_band"]

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..allan import AllanResult, NoiseTerms
-from ..allan.bound import NoiseBound, bound_noise
+from ..allan.bound import NoiseBound, bound_noise, markov_grid
 from ..allan.intervals import confidence_interval
 from ..errors import InputError
 from ..recording import Recording
@@ -47,13 +47,16 @@ def record_length_s(curve: AllanResult, rate_hz: float) -> float:
 @dataclass(frozen=True)
 class LogNoise:
     """One log's part of an axis's model: its source, mean temperature [degC] (None without one), the two-term
-    bound of its own curve, and the white noise read at one sample with its 95 % interval [u/sqrt(Hz)] (the
-    deviation at the shortest tau times sqrt(tau), where white noise rules)."""
+    bound of its own curve, the white noise read at one sample with its 95 % interval [u/sqrt(Hz)] (the
+    deviation at the shortest tau times sqrt(tau), where white noise rules), and the bound of its own curve with
+    Gauss-Markov terms on the axis's grid of correlation times (the same for every log, so that a filter
+    scheduling its noise by temperature interpolates term by term)."""
 
     source: str
     temperature_degc: float | None
     bound: NoiseBound
     white_noise_interval: tuple[float, float, float]
+    markov: NoiseBound
 
 
 @dataclass(frozen=True)
@@ -71,7 +74,7 @@ class AxisNoiseModel:
     markov : NoiseBound
         The same with Gauss-Markov terms: tighter, for a filter that carries them [u].
     logs : tuple of LogNoise
-        Each log's own two-term bound.
+        Each log's own bounds.
     max_tau_s : float
         The longest averaging time bounded [s].
     """
@@ -116,6 +119,7 @@ class NoiseModel:
                             "white_noise_density": log.bound.white_noise_density,
                             "random_walk": log.bound.random_walk,
                             "white_noise_at_one_sample_95": list(log.white_noise_interval),
+                            "bound_with_markov": log.markov.to_dict(),
                         }
                         for log in a.logs
                     ],
@@ -166,8 +170,16 @@ def noise_model(
     for name in shared:
         curves = [a.axes[name].allan for a in analyses]
         max_tau = MAX_TAU_FRACTION * min(record_length_s(c, rate) for c in curves)
+        markov = bound_noise(curves, markov=True, max_tau_s=max_tau)
+        grid = markov_grid(markov.taus_s[0], markov.taus_s[-1])
         logs = tuple(
-            LogNoise(a.source, t, bound_noise(c, markov=False, max_tau_s=max_tau), _white_at_one_sample(c))
+            LogNoise(
+                a.source,
+                t,
+                bound_noise(c, markov=False, max_tau_s=max_tau),
+                _white_at_one_sample(c),
+                bound_noise(c, markov=True, max_tau_s=max_tau, time_constants_s=grid),
+            )
             for a, c, t in zip(analyses, curves, temperatures)
         )
         first = analyses[0].axes[name]
@@ -177,35 +189,57 @@ def noise_model(
             first.unit,
             first.terms,
             bound_noise(curves, markov=False, max_tau_s=max_tau),
-            bound_noise(curves, markov=True, max_tau_s=max_tau),
+            markov,
             logs,
             max_tau,
         )
     return NoiseModel(rate, axes)
 
 
-def scheduled_bound(axis: AxisNoiseModel) -> Callable[[float], NoiseBound]:
-    """The noise an axis needs at a temperature: each log's own two-term bound at its temperature, interpolated
-    linearly between them and held past the coldest and the hottest (what a filter scheduling its noise by
-    temperature is told).
+def scheduled_bound(axis: AxisNoiseModel, *, markov: bool = False) -> Callable[[float], NoiseBound]:
+    """The noise an axis needs at a temperature: each log's own bound at its temperature, its variances (N^2, K^2,
+    sigma^2 of each Gauss-Markov term) interpolated linearly between them and held past the coldest and the
+    hottest (what a filter scheduling its noise by temperature is told).
 
     Parameters
     ----------
     axis : AxisNoiseModel
         An axis modelled from logs at known temperatures (:func:`noise_over_temperature`).
+    markov : bool
+        The logs' bounds with Gauss-Markov terms (every term any log uses at every temperature, zero where a log
+        needs none); False: white noise and random walk only.
+
+    Returns
+    -------
+    callable
+        ``at(temperature_degc [degC]) -> NoiseBound`` [u].
     """
     logs = sorted((log for log in axis.logs if log.temperature_degc is not None), key=lambda log: log.temperature_degc)
     if not logs:
         raise InputError(f"{axis.axis}: no log with a temperature to schedule by")
+    bounds = [log.markov if markov else log.bound for log in logs]
     t = np.array([log.temperature_degc for log in logs])
-    n = np.array([log.bound.white_noise_density for log in logs])
-    k = np.array([log.bound.random_walk for log in logs])
+    times = sorted({time_constant for b in bounds for _, time_constant in b.markov})
+    # each log's variance coefficients [N^2, K^2, sigma_j^2...], interpolated as variances: between two logs the
+    # model is then the mix of their two models, never below both (as interpolated sigmas would be where the two
+    # logs' programmes chose neighbouring correlation times)
+    variances = np.array(
+        [
+            [
+                b.white_noise_density**2,
+                b.random_walk**2,
+                *(dict((tc, s) for s, tc in b.markov).get(tc, 0.0) ** 2 for tc in times),
+            ]
+            for b in bounds
+        ]
+    )
 
     def at(temperature_degc: float) -> NoiseBound:
+        v = [float(np.interp(temperature_degc, t, variances[:, j])) for j in range(variances.shape[1])]
         return NoiseBound(
-            float(np.interp(temperature_degc, t, n)),
-            float(np.interp(temperature_degc, t, k)),
-            (),
+            math.sqrt(v[0]),
+            math.sqrt(v[1]),
+            tuple((math.sqrt(s2), tc) for s2, tc in zip(v[2:], times)),
             axis.bound.taus_s,
             math.nan,
             math.nan,
