@@ -47,6 +47,25 @@ def _bag(path, compression=None, n=600, writer_class=Writer, every=3, threshold=
     return path, writer
 
 
+def _index_entries_at(path, chunk: int, topic: str) -> int:
+    """Where in the file the index entries (time sec, nsec, offset: 12 bytes each) of ``topic`` in chunk number
+    ``chunk`` start (the chunk's index data records follow it, one per connection in it)."""
+    rosbag1 = pytest.importorskip("rosbags.rosbag1.reader")
+    with chunked_reader1()(path) as reader:
+        (conn,) = [c.id for c in reader.connections if c.topic == topic]
+        info = reader.chunk_infos[chunk]
+        reader.bio.seek(info.pos)
+        found = reader.read_chunk()
+        reader.bio.seek(found.datapos + found.datasize)
+        for _ in info.connection_counts:
+            header = rosbag1.Header.read(reader.bio, rosbag1.RecordType.IDXDATA)
+            size, entries = rosbag1.read_uint32(reader.bio), reader.bio.tell()
+            if header.get_uint32("conn") == conn:
+                return entries
+            reader.bio.seek(entries + size)
+    raise AssertionError(f"no index entries of {topic} in chunk {chunk}")
+
+
 def _read(reader_class, path, **kwargs):
     with reader_class(path) as reader:
         connections = [(c.id, c.topic, c.msgtype, c.digest, c.msgcount) for c in reader.connections]
@@ -137,6 +156,51 @@ def test_a_chunks_records_are_read_as_field_by_field_whatever_their_header_layou
     assert ours == theirs
 
 
+@given(
+    layouts=st.lists(
+        st.tuples(
+            st.integers(0, 3),
+            st.integers(0, 2**31),
+            st.integers(0, 999_999_999),
+            st.sampled_from([(0, 1, 2), (2, 0, 1), (1, 2, 0)]),
+            st.sampled_from([(), ((b"x", b"ab"),), ((b"conn", b"\x03\x00\x00\x00"),)]),
+            st.binary(max_size=12),
+            st.booleans(),  # a connection record before the message
+        ),
+        min_size=1,
+        max_size=30,
+    )
+)
+@settings(max_examples=60, deadline=None)
+def test_records_found_by_the_index_are_those_a_walk_finds(layouts):
+    """A chunk of messages of several header layouts with connection records between them, and its index data
+    (each message's connection, time and offset): the records found where the index says, the connection records
+    walked, are the walk's, field for field."""
+    import numpy as np
+
+    reader = pytest.importorskip("rosbags.rosbag1.reader")
+    chunk, entries = b"", {}
+    for conn, sec, nsec, order, extra, payload, connection_first in layouts:
+        if connection_first:
+            chunk += _record([(b"op", b"\x07"), (b"conn", struct.pack("<I", conn)), (b"topic", b"/t")], b"def")
+        effective = 3 if extra and extra[0][0] == b"conn" else conn  # a field given twice: its last value
+        entries.setdefault(effective, []).append((sec, nsec, len(chunk)))
+        chunk += _message(conn, sec, nsec, payload, order, extra)
+    index = [(c, np.array(e, dtype=chunks_module._INDEX_ENTRY)) for c, e in entries.items()]
+    located = chunks_module._located(reader, chunk, index)
+    records = chunks_module._records(reader, chunk)
+    walked = (*records, *chunks_module._header_fields(np.frombuffer(chunk, np.uint8), chunk, *records[:2]))
+    assert located is not None
+    assert all(np.array_equal(a, b) for a, b in zip(located, walked))
+
+
+def test_a_message_of_a_connection_the_index_lacks_is_a_reader_error():
+    reader = pytest.importorskip("rosbags.rosbag1.reader")
+    chunk = _message(0, 1, 0, b"a") + _message(5, 2, 0, b"b")
+    with pytest.raises(reader.ReaderError, match=r"A message of connection 5, which the bag's index lacks"):
+        list(_chunk_messages(reader, chunk, {0: "connection 0"}, {0}, (None, None)))
+
+
 @pytest.mark.parametrize(
     "compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["none", "bz2", "lz4"]
 )
@@ -155,22 +219,48 @@ def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compress
     # uncompressed: every chunk read by its index; compressed: none (a chunk is decompressed whole)
     assert (len(indexed) > 10 and all(m is not None for m in indexed)) if compression is None else not indexed
     if compression is None:  # the second chunk's first index entry of the topic given another time
-        rosbag1 = pytest.importorskip("rosbags.rosbag1.reader")
         data = bytearray(path.read_bytes())
-        with chunked_reader1()(path) as reader:
-            (sparse,) = [c.id for c in reader.connections if c.topic == "/b"]
-            info = reader.chunk_infos[1]
-            reader.bio.seek(info.pos)
-            chunk = reader.read_chunk()
-            reader.bio.seek(chunk.datapos + chunk.datasize)
-            for _ in info.connection_counts:  # the chunk's index data records, one per connection in it
-                header = rosbag1.Header.read(reader.bio, rosbag1.RecordType.IDXDATA)
-                size, entries = rosbag1.read_uint32(reader.bio), reader.bio.tell()
-                if header.get_uint32("conn") == sparse:
-                    (sec,) = struct.unpack_from("<I", data, entries)
-                    data[entries : entries + 4] = struct.pack("<I", sec + 1)
-                reader.bio.seek(entries + size)
+        entries = _index_entries_at(path, 1, "/b")
+        (sec,) = struct.unpack_from("<I", data, entries)
+        data[entries : entries + 4] = struct.pack("<I", sec + 1)
         (tmp_path / "moved.bag").write_bytes(bytes(data))
         indexed.clear()
         assert _read(chunked_reader1(), tmp_path / "moved.bag", **topic)[1] == _read(Reader, path, **topic)[1]
         assert sum(m is None for m in indexed) == 1  # that chunk walked, its messages as the records say
+
+
+def _arrays(path) -> list:
+    """Each chunk's message arrays (connection, time, data start, data length) as lists."""
+    with chunked_reader1()(path) as reader:
+        return [tuple(a.tolist() for a in (c.conn, c.time, c.data_at, c.data_length)) for c in reader.message_arrays()]
+
+
+@pytest.mark.parametrize(
+    "compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["none", "bz2", "lz4"]
+)
+def test_a_chunks_messages_are_found_where_its_index_says_as_walking_finds_them(compression, tmp_path, monkeypatch):
+    """Each chunk's records found by its index data (the connection records between them walked): the same arrays
+    as walking every record, compressed or not; a chunk whose index gives a message another time, or two
+    messages one offset, is walked, and reads as before."""
+    path, _ = _bag(tmp_path / "in.bag", compression, n=1200, every=7)
+    located = []
+    original = chunks_module._located
+    monkeypatch.setattr(chunks_module, "_located", lambda *a: located.append(original(*a)) or located[-1])
+    by_index = _arrays(path)
+    assert len(located) > 20 and all(found is not None for found in located)
+    with monkeypatch.context() as m:
+        m.setattr(chunks_module, "_index_entries", lambda *a: None)
+        walked = _arrays(path)
+    assert by_index == walked and sum(len(chunk[0]) for chunk in walked) == 1200 + 1200 // 7 + 1
+    data = bytes(path.read_bytes())
+    entries = _index_entries_at(path, 2, "/a")
+    for name, at, value in (("time", entries, 1), ("offset", entries + 12 + 8, -1)):
+        bent = bytearray(data)
+        (field,) = struct.unpack_from("<I", bent, at)
+        # a later time; or the second entry's offset that of the first
+        new = field + value if value > 0 else struct.unpack_from("<I", bent, entries + 8)[0]
+        bent[at : at + 4] = struct.pack("<I", new)
+        (tmp_path / f"{name}.bag").write_bytes(bytes(bent))
+        located.clear()
+        assert _arrays(tmp_path / f"{name}.bag") == walked, name
+        assert sum(found is None for found in located) == 1, name

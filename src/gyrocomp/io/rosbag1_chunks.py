@@ -173,24 +173,32 @@ def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple):
         yield connmap[int(conn[k])], int(time[k]), data[data_at[k] : data_at[k] + data_length[k]]
 
 
-def _chunk_arrays(rb, data: bytes, connmap: dict, wanted: set, span: tuple) -> tuple[np.ndarray, ...]:
+def _chunk_arrays(
+    rb, data: bytes, connmap: dict, wanted: set, span: tuple, index: list | None = None
+) -> tuple[np.ndarray, ...]:
     """The message-data records of one decompressed chunk that :func:`_chunk_messages` yields, as arrays: their
-    connection ids, times [ns], and where each one's data starts in ``data`` and its length [bytes]."""
+    connection ids, times [ns], and where each one's data starts in ``data`` and its length [bytes]. With the
+    chunk's ``index`` (:func:`_index_entries`) the records are found where it says (:func:`_located`), else
+    walked."""
     start, stop = span
+    located = _located(rb, data, index) if index is not None else None
     try:
-        records = _records(rb, data)
-        op, conn, time = _header_fields(np.frombuffer(data, dtype=np.uint8), data, *records[:2])
+        if located is None:
+            records = _records(rb, data)
+            located = (*records, *_header_fields(np.frombuffer(data, dtype=np.uint8), data, *records[:2]))
     except (struct.error, IndexError, TypeError, ValueError) as err:
         raise rb.ReaderError(f"A damaged record in a chunk ({type(err).__name__}: {err}).") from None
-    keep = (op == rb.RecordType.MSGDATA) & np.isin(conn, np.fromiter(wanted, dtype=np.int64, count=len(wanted)))
+    records, (op, conn, time) = located[:4], located[4:]
+    message = op == rb.RecordType.MSGDATA
+    unknown = message & ~np.isin(conn, np.fromiter(connmap, dtype=np.int64, count=len(connmap)), kind="table")
+    if np.any(unknown):
+        raise rb.ReaderError(f"A message of connection {int(conn[np.argmax(unknown)])}, which the bag's index lacks.")
+    keep = message & np.isin(conn, np.fromiter(wanted, dtype=np.int64, count=len(wanted)), kind="table")
     if start is not None:
         keep &= time >= start
     if stop is not None:
         keep &= time < stop
     chosen = np.flatnonzero(keep)
-    unknown = np.setdiff1d(conn[chosen], np.fromiter(connmap, dtype=np.int64, count=len(connmap)))
-    if unknown.size:
-        raise rb.ReaderError(f"A message of connection {int(unknown[0])}, which the bag's index lacks.")
     return conn[chosen], time[chosen], records[2][chosen], records[3][chosen]
 
 
@@ -210,9 +218,105 @@ def _message_arrays(self, connections=()):
         chunk = self.read_chunk()
         self.bio.seek(chunk.datapos)
         data = bytes(chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize)))
+        index = _index_entries(self, rb, len(info.connection_counts))  # they follow the chunk's data
         yield ChunkArrays(
-            np.frombuffer(data, dtype=np.uint8), chunk.datapos, *_chunk_arrays(rb, data, connmap, wanted, (None, None))
+            np.frombuffer(data, dtype=np.uint8),
+            chunk.datapos,
+            *_chunk_arrays(rb, data, connmap, wanted, (None, None), index),
         )
+
+
+def _index_entries(self, rb, connections: int) -> list | None:
+    """The index data records at the reader's place (those that follow a chunk, one per connection in it): each
+    connection's (id, entries: time sec, nsec, offset in the uncompressed chunk); None where they do not read."""
+    out = []
+    try:
+        for _ in range(connections):
+            header = rb.Header.read(self.bio, rb.RecordType.IDXDATA)
+            conn, count = header.get_uint32("conn"), header.get_uint32("count")
+            entries = np.frombuffer(rb.read_bytes(self.bio, rb.read_uint32(self.bio)), dtype=_INDEX_ENTRY)
+            if header.get_uint32("ver") != 1 or entries.size != count:
+                return None
+            out.append((conn, entries))
+    except (rb.ReaderError, struct.error, IndexError, TypeError, ValueError):
+        return None
+    return out
+
+
+def _located(rb, data: bytes, index: list) -> tuple | None:
+    """A chunk's records found where its index data say the messages lie instead of walked: (header start, header
+    length, data start, data length, op, conn, time [ns]) of each record in the chunk's order, as :func:`_records`
+    and :func:`_header_fields` give them. The records between the messages (a connection record) are walked;
+    every message must lie where its entry says with its entry's connection and time, the records must tile the
+    chunk, and no message may be missing from the index: else None (the chunk is then walked)."""
+    try:
+        offsets = np.concatenate([e["offset"] for _, e in index]).astype(np.int64)
+        conns = np.concatenate([np.full(e.size, c, dtype=np.int64) for c, e in index])
+        times = np.concatenate([e["sec"].astype(np.int64) * 1_000_000_000 + e["nsec"] for _, e in index])
+        order = np.argsort(offsets, kind="stable")
+        offsets, conns, times = offsets[order], conns[order], times[order]
+        size, array = len(data), np.frombuffer(data, dtype=np.uint8)
+        if offsets.size == 0 or offsets[-1] + 8 > size:
+            return None
+        words = sliding_window_view(array, 4)
+        header_length = words[offsets].view("<u4")[:, 0].astype(np.int64)
+        if np.any(offsets + 8 + header_length > size):
+            return None
+        data_length = words[offsets + 4 + header_length].view("<u4")[:, 0].astype(np.int64)
+        ends = offsets + 8 + header_length + data_length
+        if ends[-1] > size or np.any(ends[:-1] > offsets[1:]):
+            return None
+        # (header start, header length, data start, data length, listed in the index)
+        listed = np.ones(offsets.size, dtype=np.int64)
+        parts = [np.column_stack([offsets + 4, header_length, offsets + 8 + header_length, data_length, listed])]
+        gap_starts, gap_stops = np.r_[0, ends], np.r_[offsets, size]
+        between = gap_starts < gap_stops
+        for a, b in zip(gap_starts[between].tolist(), gap_stops[between].tolist()):
+            walked = np.column_stack(_records(rb, data[a:b]))
+            parts.append(np.column_stack([walked + np.array([a, 0, a, 0]), np.zeros(len(walked), np.int64)]))
+        table = np.concatenate(parts)
+        if len(parts) > 1:
+            table = table[np.argsort(table[:, 0], kind="stable")]
+        listed = table[:, 4].astype(bool)
+        op, conn, time = (np.full(len(table), -1, dtype=np.int64) for _ in range(3))
+        rest = ~listed
+        if _as_indexed(rb, array, data, offsets, header_length, conns, times):
+            op[listed], conn[listed], time[listed] = rb.RecordType.MSGDATA, conns, times
+        else:
+            rest[:] = True
+        if rest.any():
+            op[rest], conn[rest], time[rest] = _header_fields(array, data, table[rest, 0], table[rest, 1])
+    except (rb.ReaderError, struct.error, IndexError, TypeError, ValueError):
+        return None
+    if np.any(op[~listed] == rb.RecordType.MSGDATA):
+        return None  # a message the index does not list
+    if not (np.all(op[listed] == rb.RecordType.MSGDATA) and np.array_equal(conn[listed], conns)):
+        return None
+    if not np.array_equal(time[listed], times):
+        return None
+    return table[:, 0], table[:, 1], table[:, 2], table[:, 3], op, conn, time
+
+
+def _as_indexed(rb, array, data: bytes, offsets, header_length, conns, times) -> bool:
+    """Whether the records at ``offsets`` share one header length and their ``op``, ``conn`` and ``time`` values,
+    read at the places the first record's header gives them (:func:`_field_places`), are a message's with the
+    index entries' connections ``conns`` and times ``times`` [ns]: three small reads per record instead of its
+    whole header (:func:`_header_fields`). A header of another layout of the same length would put other bytes
+    there and not match."""
+    if np.any(header_length != header_length[0]):
+        return False
+    first = int(offsets[0]) + 4
+    places = _field_places(data, first, first + int(header_length[0]))
+    if [places.get(name, (0, -1))[1] for name in _FIELDS] != [1, 4, 8]:
+        return False
+    at = offsets + 4
+    if np.any(array[at + places[b"op"][0]] != rb.RecordType.MSGDATA):
+        return False
+    conn = sliding_window_view(array, 4)[at + places[b"conn"][0]].view("<u4")[:, 0]
+    if not np.array_equal(conn, conns):
+        return False
+    sec_nsec = sliding_window_view(array, 8)[at + places[b"time"][0]].view("<u4").astype(np.int64)
+    return bool(np.array_equal(sec_nsec[:, 0] * 1_000_000_000 + sec_nsec[:, 1], times))
 
 
 class ChunkArrays(NamedTuple):
