@@ -313,6 +313,26 @@ def test_an_uncompressed_ros1_bag_is_compensated_in_place_as_the_writer_would(
     assert np.all(inside[changed])
 
 
+@pytest.mark.parametrize("chunk_rows", [None, 7])
+def test_imu_messages_of_several_layouts_are_compensated_in_place_one_by_one(chunk_rows, model, tmp_path):
+    """Every ninth IMU message with a longer frame_id (another length): the batches holding them are compensated
+    message by message, still in place; the bag's messages are those of the writer's pass."""
+    import gyrocomp.files.apply_bag as module
+
+    source = tmp_path / "in.bag"
+    write_bag(source, ros2=False, n=200, long_frame_every=9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        patched = apply_bag(model, source, tmp_path / "patched.bag", chunk_rows=chunk_rows or 100_000)
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(module, "_patched_bag", lambda *args: False)
+            written = apply_bag(model, source, tmp_path / "written.bag", chunk_rows=chunk_rows or 100_000)
+    assert patched.compensated == written.compensated == 200
+    assert _messages(tmp_path / "patched.bag") == _messages(tmp_path / "written.bag")
+    assert (tmp_path / "patched.bag").stat().st_size == source.stat().st_size
+    assert _messages(tmp_path / "patched.bag") != _messages(source)
+
+
 @pytest.mark.parametrize("kind", ["ros1", "ros2"])
 def test_a_last_batch_of_one_imu_message_is_compensated_as_the_next_sample(kind, model, tmp_path):
     """400 IMU messages in batches of 7: the last batch holds one (a recording needs two rows); it is compensated

@@ -94,13 +94,15 @@ def write_bag(
     swap: int | None = None,
     bare: bool = False,
     temperature_gap: tuple[int, int] | None = None,
+    long_frame_every: int | None = None,
 ):
     """A bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or, with ``mcap``, MCAP storage) of ``n`` IMU messages
     per topic at ``rate_hz`` (gyro x ramping, z -0.01 rad/s, 1 g on z) and a temperature message every tenth
     (from message ``temperature_from`` on); ``repeat``: message i written a second time with the same stamp and
     gyro y 0.5 rad/s; ``swap``: messages i and i + 1 written in each other's place (their stamps out of order);
     ``bare`` (with ``mcap``): the MCAP file alone at ``path``, without its folder and ``metadata.yaml``;
-    ``temperature_gap`` (i, j): no temperature message from message i to before j."""
+    ``temperature_gap`` (i, j): no temperature message from message i to before j; ``long_frame_every`` k: every
+    k-th IMU message's ``frame_id`` longer (a message of another length and layout)."""
     if bare:
         import shutil
         from pathlib import Path
@@ -138,10 +140,10 @@ def write_bag(
 
         writer = Writer(path)
 
-    def header(t):
+    def header(t, frame="imu"):
         sec = int(t)
         stamp = Time(sec=sec, nanosec=int(round((t - sec) * 1e9)))
-        return Header(stamp=stamp, frame_id="imu") if ros2 else Header(seq=0, stamp=stamp, frame_id="imu")
+        return Header(stamp=stamp, frame_id=frame) if ros2 else Header(seq=0, stamp=stamp, frame_id=frame)
 
     cov = np.zeros(9)
     with writer:
@@ -150,8 +152,9 @@ def write_bag(
         for i in range(n):
             t = 100.0 + i / rate_hz  # when the message is logged
             stamped = 100.0 + (i + 1 if i == swap else i - 1 if swap is not None and i == swap + 1 else i) / rate_hz
+            long = long_frame_every is not None and i % long_frame_every == 0
             msg = Imu(
-                header=header(stamped),
+                header=header(stamped, "imu_link_long" if long else "imu"),
                 orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
                 orientation_covariance=cov,
                 angular_velocity=Vector3(x=0.001 * i, y=0.0, z=-0.01),

@@ -7,7 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gyrocomp.io.ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, LINEAR_ACCELERATION_COVARIANCE, imu_batch
+from gyrocomp.io.ros_imu import (
+    ANGULAR_VELOCITY,
+    LINEAR_ACCELERATION,
+    LINEAR_ACCELERATION_COVARIANCE,
+    imu_batch,
+    imu_fields,
+)
 
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
@@ -98,3 +104,35 @@ def test_batches_not_of_one_layout_are_left_to_rosbags():
     bent = bytearray(raws[1])
     bent[12] = 3
     assert imu_batch([raws[0], bytes(bent)], cdr=False) is None
+
+
+@pytest.mark.parametrize("ros2", [False, True], ids=["ros1", "ros2"])
+@pytest.mark.parametrize("frame_id", ["", "imu", "base_link/imu0"])
+def test_fields_read_where_the_messages_lie_are_what_rosbags_reads(ros2, frame_id):
+    """Messages at irregular offsets of one byte array (other bytes between them, as in a bag's chunk): the
+    stamps and vectors read in place are rosbags' to the bit, and where the float64 values start is the batch's."""
+    messages, raws, _ = _messages(ros2, frame_id, 15, seed=7 + len(frame_id))
+    gaps = np.random.default_rng(8).integers(0, 40, size=len(raws))
+    data, at = bytearray(), []
+    for gap, raw in zip(gaps, raws):
+        data += bytes(range(int(gap)))
+        at.append(len(data))
+        data += raw
+    fields = imu_fields(np.frombuffer(bytes(data), np.uint8), np.array(at), len(raws[0]), cdr=ros2)
+    assert fields is not None and fields.values_at == imu_batch(raws, cdr=ros2).values_at
+    for k, msg in enumerate(messages):
+        assert fields.stamp_s[k] == msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        assert tuple(fields.angular_velocity[k]) == _vector(msg.angular_velocity)
+        assert tuple(fields.linear_acceleration[k]) == _vector(msg.linear_acceleration)
+
+
+def test_fields_of_messages_not_of_one_layout_or_past_the_bytes_are_not_read():
+    _, raws, _ = _messages(False, "abcd", 2, seed=6)
+    data = np.frombuffer(raws[0] + raws[1], np.uint8)
+    length = len(raws[0])
+    assert imu_fields(data, np.array([0, length]), length, cdr=False) is not None
+    assert imu_fields(data, np.array([0, length + 1]), length, cdr=False) is None  # past the end
+    assert imu_fields(data, np.array([], dtype=np.int64), length, cdr=False) is None
+    bent = bytearray(raws[1])
+    bent[12] = 3  # the frame_id's length field differs
+    assert imu_fields(np.frombuffer(raws[0] + bytes(bent), np.uint8), np.array([0, length]), length, False) is None

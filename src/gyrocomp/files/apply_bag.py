@@ -67,6 +67,7 @@ from ..io.rosbag import (
     read_rosbag,
 )
 from ..io.stream import CHUNK_ROWS, NotStreamable
+from .bag_patch import BagCopy, patch_in_batches, uncompressed
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
 
@@ -344,83 +345,13 @@ def _patched_bag(bag: Path, output: Path, copiers: dict, chunk_rows: int) -> boo
         return False
     with any_reader(bag) as reader:
         inner = reader.readers[0]
-        if not hasattr(inner, "message_arrays") or not _uncompressed(inner):
+        if not hasattr(inner, "message_arrays") or not uncompressed(inner):
             return False
+        imu = {c.id: c.topic for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE}
         with staged_bag(output, "ros1") as target, open(bag, "rb") as source, open(target, "wb") as sink:
-            _patch_in_batches(reader, inner, _BagCopy(source, sink), copiers, chunk_rows)
+            limits = (chunk_rows, WINDOW_BYTES, FIRST_SAMPLES)  # read now: the tests make windows smaller
+            patch_in_batches(reader, inner, BagCopy(source, sink), copiers, imu, limits)
     return True
-
-
-def _uncompressed(reader) -> bool:
-    """Whether every chunk of a ROS 1 bag is stored uncompressed."""
-    rb = require("rosbags.rosbag1.reader", "ros", "reading ROS 1 bags")
-    for info in reader.chunk_infos:
-        reader.bio.seek(info.pos)
-        if reader.read_chunk().decompressor is not rb.decompressors["none"]:
-            return False
-    return True
-
-
-class _BagCopy:
-    """The output of :func:`_patched_bag`: the input's bytes copied through, each chunk's data from its patched copy."""
-
-    def __init__(self, source, sink):
-        self.source, self.sink, self.copied = source, sink, 0
-
-    def chunk(self, data_pos: int, data: bytearray) -> None:
-        """The input up to a chunk's data as it is, then the chunk's data (patched)."""
-        self.through(data_pos)
-        self.sink.write(data)
-        self.copied = data_pos + len(data)
-
-    def through(self, end: int | None = None) -> None:
-        """The input's bytes from where the copy is to ``end`` (None: the end of the file)."""
-        self.source.seek(self.copied)
-        left = None if end is None else end - self.copied
-        while left is None or left > 0:
-            block = self.source.read(1 << 20 if left is None else min(1 << 20, left))
-            if not block:
-                break
-            self.sink.write(block)
-            if left is not None:
-                left -= len(block)
-        self.copied = self.source.tell()
-
-
-def _patch_in_batches(reader, inner, copy: _BagCopy, copiers: dict, chunk_rows: int) -> None:
-    """Every message of the bag in its order, held until :func:`_batch_due`; at each batch the IMU
-    messages are compensated by their topic's copier and written into their chunk's copy, and every chunk whose
-    messages are all done goes out."""
-    imu = {c.id: c.topic for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE}
-    chunks: list = []  # [data_pos, patched copy] of the chunks not yet written, in order
-    raws, places, held_bytes, most = {t: [] for t in copiers}, {t: [] for t in copiers}, 0, 0
-
-    def write(done: int) -> None:
-        for topic, messages in raws.items():
-            if messages:
-                for (data, at), new in zip(places[topic], copiers[topic].compensated(reader, messages)):
-                    if len(new) != at[1]:  # values replaced in a fixed layout: never; the offsets would not hold
-                        raise InputError(f"topic {topic}: a compensated IMU message changed its length")
-                    data[at[0] : at[0] + at[1]] = new
-        for data_pos, data in chunks[:done]:
-            copy.chunk(data_pos, data)
-        del chunks[:done]
-
-    for found in inner.message_arrays():
-        chunks.append((found.data_pos, bytearray(found.data)))
-        data = chunks[-1][1]
-        for conn, at, length in zip(found.conn.tolist(), found.data_at.tolist(), found.data_length.tolist()):
-            topic = imu.get(conn)
-            if topic is not None:
-                raws[topic].append(bytes(data[at : at + length]))
-                places[topic].append((data, (at, length)))
-                most = max(most, len(raws[topic]))
-            held_bytes += length
-            if _batch_due(copiers, raws, most, held_bytes, chunk_rows):
-                write(len(chunks) - 1)  # the chunks before this one are done
-                raws, places, held_bytes, most = {t: [] for t in copiers}, {t: [] for t in copiers}, 0, 0
-    write(len(chunks))
-    copy.through()
 
 
 class _Copier:
@@ -437,6 +368,20 @@ class _Copier:
     def compensated(self, reader, raws: list) -> list:
         """The IMU messages ``raws`` compensated (those outside the recording as they were)."""
         stamp, gyro_rad, accel_ms2 = decoded_imu(reader, IMU_TYPE, raws)
+        done, new, new_accel = self._corrected(stamp, gyro_rad, accel_ms2)
+        return self._encoded(reader, raws, done, new, new_accel)
+
+    def compensated_fields(self, stamp_s: np.ndarray, gyro_rad: np.ndarray, accel_ms2: np.ndarray) -> tuple:
+        """IMU messages of stamps ``stamp_s`` [s], angular velocities [rad/s] and linear accelerations [m/s^2]
+        (n, 3) compensated, as what to write into them: the rows changed (in order) and, for each field written,
+        (its first value's index among the message's float64 values, the rows' values (len(rows), m)) (those
+        outside the recording as they were)."""
+        done, new, new_accel = self._corrected(stamp_s, gyro_rad, accel_ms2)
+        return done, self._fields(done, new, new_accel)
+
+    def _corrected(self, stamp: np.ndarray, gyro_rad: np.ndarray, accel_ms2: np.ndarray) -> tuple:
+        """(the rows compensated, their new angular velocity [rad/s] (n, 3), new linear acceleration [m/s^2] or
+        None) of IMU messages of stamps ``stamp`` [s] as the stream's next; NaN in the rows left as they were."""
         stream = self.stream
         with_twin = self.twin is not None and np.any(stamp == self.twin[0])
         time_s, gyro, accel = stream.ordered(stamp, gyro_rad * _RAD, accel_ms2 * _MS2)
@@ -448,13 +393,14 @@ class _Copier:
             rec = stream.lone_sample(part)
         values, correction, accel_values, accel_correction = self._corrections(rec)
         # each message: the first of its stamp takes the recording's value, a repeat the same correction
-        new = np.full((len(raws), 3), np.nan)
-        new_accel = np.full((len(raws), 3), np.nan) if self.with_accel else None
+        count = stamp.size
+        new = np.full((count, 3), np.nan)
+        new_accel = np.full((count, 3), np.nan) if self.with_accel else None
         times = rec.time_s if rec is not None else np.empty(0)
         k = np.minimum(np.searchsorted(times, stamp), max(times.size - 1, 0))
-        found = (times[k] == stamp) if times.size else np.zeros(len(raws), dtype=bool)
+        found = (times[k] == stamp) if times.size else np.zeros(count, dtype=bool)
         _, first_of = np.unique(stamp, return_index=True)
-        first = np.zeros(len(raws), dtype=bool)
+        first = np.zeros(count, dtype=bool)
         first[first_of] = True
         repeat = found & ~first
         new[found & first] = values[k[found & first]]
@@ -473,8 +419,8 @@ class _Copier:
             last = times.size - 1
             self.twin = (float(times[-1]), correction[last], accel_correction[last] if self.with_accel else None)
         self.counts["compensated"] += done.size
-        self.counts["unchanged"] += len(raws) - done.size
-        return self._encoded(reader, raws, done, new, new_accel)
+        self.counts["unchanged"] += count - done.size
+        return done, new, new_accel
 
     def _corrections(self, rec):
         """(compensated gyro [rad/s], its correction, compensated accel [m/s^2], its correction) of the recording's
@@ -498,18 +444,23 @@ class _Copier:
         batch = imu_batch(raws, cdr=reader.is2)
         if batch is None:
             return self._reserialized(reader, raws, done, gyro, accel)
-        batch = batch.with_values(ANGULAR_VELOCITY, done, gyro[done])
+        for start, values in self._fields(done, gyro, accel):
+            batch = batch.with_values(start, done, values)
+        return [batch.message(i) for i in range(len(raws))]
+
+    def _fields(self, done: np.ndarray, gyro: np.ndarray, accel) -> list:
+        """(first value's index, values of the rows ``done``) of each field a compensated message gets: the angular
+        velocity [rad/s], the linear acceleration [m/s^2] when compensated, the covariances when given."""
+        fields = [(ANGULAR_VELOCITY, gyro[done])]
         if accel is not None:
-            batch = batch.with_values(LINEAR_ACCELERATION, done, accel[done])
+            fields.append((LINEAR_ACCELERATION, accel[done]))
         for field, start in (
             ("angular_velocity_covariance", ANGULAR_VELOCITY_COVARIANCE),
             ("linear_acceleration_covariance", LINEAR_ACCELERATION_COVARIANCE),
         ):
             if field in self.covariances:
-                batch = batch.with_values(
-                    start, done, np.tile(np.asarray(self.covariances[field], dtype=float), (done.size, 1))
-                )
-        return [batch.message(i) for i in range(len(raws))]
+                fields.append((start, np.tile(np.asarray(self.covariances[field], dtype=float), (done.size, 1))))
+        return fields
 
     def _reserialized(self, reader, raws: list, done: np.ndarray, gyro: np.ndarray, accel) -> list:
         store = reader.typestore

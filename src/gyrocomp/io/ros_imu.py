@@ -23,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 #: float64 values after the header: orientation (4), its covariance (9), angular velocity (3), its covariance (9),
 #: linear acceleration (3), its covariance (9)
@@ -82,30 +83,84 @@ def imu_batch(raws: list, cdr: bool) -> ImuBatch | None:
 def imu_batch_of(data: np.ndarray, cdr: bool) -> ImuBatch | None:
     """Messages of one length as a byte array (n, length) as one :class:`ImuBatch`, or None when they do not share
     one layout (see the module)."""
-    if data.shape[0] == 0 or data.shape[1] < 16 + 8 * _VALUES:
+    if data.shape[0] == 0 or data.shape[1] < 16:
         return None
-    length = data.shape[1]
     text = np.ascontiguousarray(data[:, 12:16]).view("<u4")[:, 0]
-    if np.any(text != text[0]):
+    values_at = _values_at(text, data[:, :2] if cdr else None, data.shape[1])
+    return None if values_at is None else ImuBatch(data, values_at)
+
+
+def _values_at(text: np.ndarray, encapsulation: np.ndarray | None, length: int) -> int | None:
+    """Where the float64 values of messages of ``length`` bytes start [bytes], from each one's ``frame_id`` length
+    ``text`` and, for CDR, its first two bytes ``encapsulation`` (n, 2) (None: ROS 1); None when the messages do
+    not share one layout (see the module)."""
+    if length < 16 + 8 * _VALUES or text.size == 0 or np.any(text != text[0]):
         return None
-    if cdr:
-        if np.any(data[:, 0] != 0) or np.any(data[:, 1] != 1):  # little-endian plain CDR only
+    if encapsulation is not None:
+        if np.any(encapsulation[:, 0] != 0) or np.any(encapsulation[:, 1] != 1):  # little-endian plain CDR only
             return None
         end = 16 + int(text[0])
         values_at = end + (-(end - 4)) % 8
     else:
         values_at = 16 + int(text[0])
-    if values_at + 8 * _VALUES != length:
+    return values_at if values_at + 8 * _VALUES == length else None
+
+
+@dataclass(frozen=True)
+class ImuFields:
+    """What a reader and a compensator take of IMU messages of one layout lying in a byte array: where their float64
+    values start in each [bytes], their header stamps [s], angular velocities [rad/s] (n, 3) and linear
+    accelerations [m/s^2] (n, 3)."""
+
+    values_at: int
+    stamp_s: np.ndarray
+    angular_velocity: np.ndarray
+    linear_acceleration: np.ndarray
+
+
+def imu_fields(data: np.ndarray, at: np.ndarray, length: int, cdr: bool) -> ImuFields | None:
+    """The fields of the IMU messages of ``length`` bytes that start at offsets ``at`` of ``data`` (uint8, 1-D),
+    read where they lie (only the bytes used are copied, not whole messages); None when they do not share one
+    layout (see the module).
+
+    Parameters
+    ----------
+    data : array of uint8
+        Bytes holding the messages (a bag's chunk, say).
+    at : array of int
+        Where each message starts in ``data`` [bytes].
+    length : int
+        Their length [bytes].
+    cdr : bool
+        ROS 2 CDR (else ROS 1 serialization).
+    """
+    at = np.asarray(at, dtype=np.int64)
+    if at.size == 0 or length < 16 + 8 * _VALUES or at.max() + length > data.size or at.min() < 0:
         return None
-    return ImuBatch(data, values_at)
+    text = sliding_window_view(data, 4)[at + 12].view("<u4")[:, 0]
+    values_at = _values_at(text, sliding_window_view(data, 2)[at] if cdr else None, length)
+    if values_at is None:
+        return None
+    stamps = sliding_window_view(data, 8)[at + 4]  # sec, nanosec: a copy, contiguous
+    sec = stamps.view("<i4" if cdr else "<u4")[:, 0]
+    nsec = stamps.view("<u4")[:, 1]
+    vectors = sliding_window_view(data, 24)
+    return ImuFields(
+        values_at,
+        sec.astype(float) + nsec.astype(float) * 1e-9,
+        vectors[at + values_at + 8 * ANGULAR_VELOCITY].view("<f8"),
+        vectors[at + values_at + 8 * LINEAR_ACCELERATION].view("<f8"),
+    )
 
 
 __all__ = [
     "ANGULAR_VELOCITY",
     "ANGULAR_VELOCITY_COVARIANCE",
     "ImuBatch",
+    "ImuFields",
     "LINEAR_ACCELERATION",
     "LINEAR_ACCELERATION_COVARIANCE",
     "imu_batch",
     "imu_batch_of",
+    "imu_fields",
 ]

@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 import pyarrow as pa
 
 from ..errors import DataQualityWarning, InputError, TimeOrderWarning, printable
@@ -37,7 +36,7 @@ from .common import (
 )
 from .layout import TIME_COLUMN, TableLayout
 from .readers import Reader, register_reader
-from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_batch_of
+from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_fields
 from .rosbag1_chunks import chunked_reader1
 from .stream import CHUNK_ROWS, NotStreamable
 from .tables import recording_table, rows_dropped
@@ -265,9 +264,9 @@ def _decoded_groups(reader, imu: list, size: int):
     for found in arrays(connections=imu):
         chunk, data_at, data_length = found.data, found.data_at, found.data_length
         if data_length.size and np.all(data_length == data_length[0]):
-            batch = imu_batch_of(sliding_window_view(chunk, int(data_length[0]))[data_at], cdr=False)
-            if batch is not None:
-                yield _batch_values(batch, False)
+            fields = imu_fields(chunk, data_at, int(data_length[0]), cdr=False)
+            if fields is not None:
+                yield fields.stamp_s, fields.angular_velocity, fields.linear_acceleration
                 continue
         if data_length.size:
             raws = [chunk[at : at + length].tobytes() for at, length in zip(data_at.tolist(), data_length.tolist())]

@@ -1,0 +1,168 @@
+"""An uncompressed ROS 1 bag compensated in place: its bytes copied through, each IMU message's values written
+where they lie (:func:`gyrocomp.files.apply_bag.apply_bag`'s way for the bag ``rosbag record`` writes by default).
+
+A compensated message keeps its length, so every record, offset and index of the input stays valid. The messages
+are taken a chunk at a time as arrays (:meth:`ChunkedReader1.message_arrays`), held until a batch is due by the same
+rule as a message-by-message pass (a topic holds ``chunk_rows`` IMU messages, or ``window_bytes`` are held and every
+topic's rate is set: its compensator made or ``first_samples`` of its messages held), found for a whole chunk at
+once; a batch's IMU messages of one layout are decoded and written back field by field as arrays, without a Python
+object per message (messages of other layouts go through the copier message by message).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from ..errors import InputError
+from ..io.common import require
+from ..io.ros_imu import imu_fields
+
+
+def uncompressed(reader) -> bool:
+    """Whether every chunk of a ROS 1 bag (rosbags' reader) is stored uncompressed."""
+    rb = require("rosbags.rosbag1.reader", "ros", "reading ROS 1 bags")
+    for info in reader.chunk_infos:
+        reader.bio.seek(info.pos)
+        if reader.read_chunk().decompressor is not rb.decompressors["none"]:
+            return False
+    return True
+
+
+class BagCopy:
+    """The output of an in-place compensation: the input's bytes copied through, each chunk's data from its patched
+    copy."""
+
+    def __init__(self, source, sink):
+        self.source, self.sink, self.copied = source, sink, 0
+
+    def chunk(self, data_pos: int, data) -> None:
+        """The input up to a chunk's data as it is, then the chunk's data (patched; any buffer)."""
+        self.through(data_pos)
+        self.sink.write(data)
+        self.copied = data_pos + len(data)
+
+    def through(self, end: int | None = None) -> None:
+        """The input's bytes from where the copy is to ``end`` (None: the end of the file)."""
+        self.source.seek(self.copied)
+        left = None if end is None else end - self.copied
+        while left is None or left > 0:
+            block = self.source.read(1 << 20 if left is None else min(1 << 20, left))
+            if not block:
+                break
+            self.sink.write(block)
+            if left is not None:
+                left -= len(block)
+        self.copied = self.source.tell()
+
+
+def due_at(
+    topic_of: np.ndarray,
+    lengths: np.ndarray,
+    held: np.ndarray,
+    held_bytes: int,
+    ready: np.ndarray,
+    limits: tuple[int, int, int],
+) -> int | None:
+    """The first message after which a batch is due, or None: messages of topics ``topic_of`` (index, -1: not
+    compensated) and data ``lengths`` [bytes] in order, after ``held`` messages of each topic and ``held_bytes``
+    already held, ``ready`` the topics whose compensator is made; ``limits`` = (chunk_rows, window_bytes,
+    first_samples). Due when a topic holds chunk_rows messages, or window_bytes are held and every topic is ready
+    or holds first_samples."""
+    chunk_rows, window_bytes, first_samples = limits
+    counts = held[None, :] + np.cumsum(topic_of[:, None] == np.arange(held.size)[None, :], axis=0)
+    full = counts.max(axis=1, initial=0) >= chunk_rows
+    window = (held_bytes + np.cumsum(lengths) >= window_bytes) & np.all(ready | (counts >= first_samples), axis=1)
+    due = full | window
+    return int(np.argmax(due)) if due.any() else None
+
+
+def patch_in_batches(reader, inner, copy: BagCopy, copiers: dict, imu: dict, limits: tuple[int, int, int]) -> None:
+    """Every message of the bag in its order, a chunk at a time, held until a batch is due (:func:`due_at`); at
+    each batch each topic's IMU messages are compensated by its copier and written into their chunk's copy, and
+    every chunk whose messages are all done goes out.
+
+    Parameters
+    ----------
+    reader, inner
+        rosbags' reader of the bag and its ROS 1 reader with ``message_arrays``.
+    copy : BagCopy
+        Where the bag goes.
+    copiers : dict
+        Each compensated topic's copier (``comp``, ``compensated(reader, raws)``, ``compensated_fields(batch)``).
+    imu : dict
+        Connection id -> topic of the IMU connections compensated.
+    limits : (int, int, int)
+        chunk_rows, window_bytes [bytes], first_samples: the batching rule.
+    """
+    topics = list(copiers)
+    ids = {conn: topics.index(topic) for conn, topic in imu.items()}
+    chunks: list = []  # (data_pos, patched copy) of the chunks not yet written, in order
+    held: list = [[] for _ in topics]  # each topic's messages held: (chunk copy, data_at, data_length) pieces
+    counts, held_bytes = np.zeros(len(topics), dtype=np.int64), 0
+
+    def write(done: int) -> None:
+        for topic, pieces in zip(topics, held):
+            if pieces:
+                _write_topic(reader, topic, copiers[topic], pieces)
+        for data_pos, data in chunks[:done]:
+            copy.chunk(data_pos, data)
+        del chunks[:done]
+
+    for found in inner.message_arrays():
+        data = found.data.copy()
+        chunks.append((found.data_pos, data))
+        topic_of = np.full(found.conn.size, -1, dtype=np.int64)
+        for conn, index in ids.items():
+            topic_of[found.conn == conn] = index
+        start = 0
+        while start < topic_of.size:
+            ready = np.array([copiers[t].comp is not None for t in topics], dtype=bool)
+            hit = due_at(topic_of[start:], found.data_length[start:], counts, held_bytes, ready, limits)
+            stop = topic_of.size if hit is None else start + hit + 1
+            for index in range(len(topics)):
+                rows = start + np.flatnonzero(topic_of[start:stop] == index)
+                if rows.size:
+                    held[index].append((data, found.data_at[rows], found.data_length[rows]))
+                    counts[index] += rows.size
+            held_bytes += int(found.data_length[start:stop].sum())
+            if hit is not None:
+                write(len(chunks) - 1)  # the chunks before this one are done
+                held, counts, held_bytes = [[] for _ in topics], np.zeros(len(topics), dtype=np.int64), 0
+            start = stop
+    write(len(chunks))
+    copy.through()
+
+
+def _write_topic(reader, topic: str, copier, pieces: list) -> None:
+    """One topic's held IMU messages compensated and written into their chunks' copies: when they share one layout
+    as arrays, field by field; else message by message."""
+    lengths = np.concatenate([p[2] for p in pieces])
+    if lengths.size and np.all(lengths == lengths[0]):
+        width = int(lengths[0])
+        read = [imu_fields(p[0], p[1], width, cdr=False) for p in pieces]
+        if all(f is not None and f.values_at == read[0].values_at for f in read):
+            done, fields = copier.compensated_fields(
+                np.concatenate([f.stamp_s for f in read]),
+                np.concatenate([f.angular_velocity for f in read]),
+                np.concatenate([f.linear_acceleration for f in read]),
+            )  # rows in order
+            cuts = np.searchsorted(done, np.cumsum([0] + [p[1].size for p in pieces]))
+            at = np.concatenate([p[1] for p in pieces]) + read[0].values_at
+            for start, values in fields:
+                values = np.ascontiguousarray(values, dtype="<f8")
+                raw = values.view(np.uint8).reshape(done.size, 8 * values.shape[1])
+                for k, (data, _, _) in enumerate(pieces):
+                    rows = slice(cuts[k], cuts[k + 1])
+                    sliding_window_view(data, raw.shape[1], writeable=True)[at[done[rows]] + 8 * start] = raw[rows]
+            return
+    places = [(p[0], a, n) for p in pieces for a, n in zip(p[1].tolist(), p[2].tolist())]
+    for (data, a, n), new in zip(
+        places, copier.compensated(reader, [data[a : a + n].tobytes() for data, a, n in places])
+    ):
+        if len(new) != n:  # values replaced in a fixed layout: never; the offsets would not hold
+            raise InputError(f"topic {topic}: a compensated IMU message changed its length")
+        data[a : a + n] = np.frombuffer(new, dtype=np.uint8)
+
+
+__all__ = ["BagCopy", "due_at", "patch_in_batches", "uncompressed"]
