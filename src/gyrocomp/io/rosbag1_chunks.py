@@ -124,17 +124,15 @@ def _indexed_messages(self, rb, chunk, connections: int, connmap: dict, wanted: 
     index entry. None where the index does not hold or does not match: the chunk is then walked."""
     start, stop = span
     found = []
+    self.bio.seek(chunk.datapos + chunk.datasize)
+    index = _index_entries(self, rb, connections)
+    if index is None:
+        return None
+    for conn, entries in index:
+        if conn in wanted:
+            times = entries["sec"].astype(np.int64) * 1_000_000_000 + entries["nsec"]
+            found += [(int(o), conn, int(t)) for o, t in zip(entries["offset"].tolist(), times.tolist())]
     try:
-        self.bio.seek(chunk.datapos + chunk.datasize)
-        for _ in range(connections):
-            header = rb.Header.read(self.bio, rb.RecordType.IDXDATA)
-            conn, count = header.get_uint32("conn"), header.get_uint32("count")
-            entries = np.frombuffer(rb.read_bytes(self.bio, rb.read_uint32(self.bio)), dtype=_INDEX_ENTRY)
-            if header.get_uint32("ver") != 1 or entries.size != count:
-                return None
-            if conn in wanted:
-                times = entries["sec"].astype(np.int64) * 1_000_000_000 + entries["nsec"]
-                found += [(int(o), conn, int(t)) for o, t in zip(entries["offset"].tolist(), times.tolist())]
         messages = []
         for offset, conn, time in sorted(found):  # the chunk's order
             if (start is not None and time < start) or (stop is not None and time >= stop):
