@@ -72,6 +72,10 @@ def test_noise_of_a_chamber_runs_dwells(tmp_path):
     logs = json.loads((tmp_path / "m.json").read_text())["axes"]["gyro_z"]["logs"]
     assert [round(log["temperature_degc"]) for log in logs] == [-20, 25, 70]
     assert "N at one sample [95 %]" in done.stdout and "at 70.0 degC" in done.stdout
+    for log in logs:  # each dwell's bound with Gauss-Markov terms, said in the table as in the file
+        markov = log["bound_with_markov"]
+        said = f"{len(markov['gauss_markov'])}: {markov['ratio_to_measured_median']:.2f} / "
+        assert said in done.stdout
 
 
 @pytest.mark.slow

@@ -547,9 +547,11 @@ def print_noise_model(model: NoiseModel) -> None:
     console.print(table)
     if any(len(a.logs) > 1 for a in model.axes.values()):
         logs = Table(
-            title="each log's own bound (white noise N, random walk K) and N read at one sample with its 95 % interval"
+            title="each log's own bound (white noise N, random walk K; with Gauss-Markov terms: how many, its "
+            "median / largest ratio to the log's curve) and N read at one sample with its 95 % interval"
         )
-        for col in ("axis", "log", "temperature [degC]", "bound N", "bound K", "N at one sample [95 %]"):
+        columns = ("axis", "log", "temperature [degC]", "bound N", "bound K", "Gauss-Markov", "N at one sample [95 %]")
+        for col in columns:
             logs.add_column(col, justify="left" if col in ("axis", "log") else "right")
         for name, a in model.axes.items():
             for log in a.logs:
@@ -560,6 +562,7 @@ def print_noise_model(model: NoiseModel) -> None:
                     "-" if log.temperature_degc is None else f"{log.temperature_degc:.1f}",
                     f"{log.bound.white_noise_density:.4g}",
                     f"{log.bound.random_walk:.4g}",
+                    f"{len(log.markov.markov)}: {log.markov.ratio_median:.2f} / {log.markov.ratio_max:.2f}",
                     f"{value:.4g} [{low:.4g}, {high:.4g}]",
                 )
         console.print(logs)
