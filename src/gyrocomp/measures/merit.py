@@ -242,6 +242,22 @@ class _Figures:
     integration_time_comp_s: float
     residual_rms: float
 
+    @classmethod
+    def of(cls, off_raw: float, off_comp: float, low_raw, low_comp, residual_rms: float) -> "_Figures":
+        """From the bias offsets before and after, the Allan minima before and after (``deviation``, ``tau_s``)
+        and the residual's RMS."""
+        improvement = off_raw / off_comp if off_comp > 0 else math.inf
+        return cls(
+            off_raw,
+            off_comp,
+            improvement,
+            low_raw.deviation,
+            low_comp.deviation,
+            low_raw.tau_s,
+            low_comp.tau_s,
+            residual_rms,
+        )
+
 
 def _figures(
     raw: np.ndarray, comp: np.ndarray, rate_hz: float, w: int, stretches: list[slice], lows: tuple | None = None
@@ -249,16 +265,7 @@ def _figures(
     """``lows``: the raw and compensated Allan minima when already computed."""
     off_raw, off_comp = bias_offset(raw, w), bias_offset(comp, w)
     low_raw, low_comp = lows or (_allan_minimum(raw, rate_hz, stretches), _allan_minimum(comp, rate_hz, stretches))
-    return _Figures(
-        off_raw,
-        off_comp,
-        off_raw / off_comp if off_comp > 0 else math.inf,
-        low_raw.deviation,
-        low_comp.deviation,
-        low_raw.tau_s,
-        low_comp.tau_s,
-        smoothed_residual_rms(comp, w),
-    )
+    return _Figures.of(off_raw, off_comp, low_raw, low_comp, smoothed_residual_rms(comp, w))
 
 
 def check_compensated(source: str, axis: str, values: np.ndarray, rows: np.ndarray | None = None) -> None:
@@ -416,16 +423,7 @@ def evaluate_phases(
     for name, r, c, (low_raw, low_comp) in zip(names, raw, compensated, lows):
         off_raw, _ = _smoothed_spread(r, rate_hz, w)
         off_comp, rms = _smoothed_spread(c, rate_hz, w)
-        figures[name] = _Figures(
-            off_raw,
-            off_comp,
-            off_raw / off_comp if off_comp > 0 else math.inf,
-            low_raw.deviation,
-            low_comp.deviation,
-            low_raw.tau_s,
-            low_comp.tau_s,
-            rms,
-        )
+        figures[name] = _Figures.of(off_raw, off_comp, low_raw, low_comp, rms)
     return _run_evaluation(source, window_s, {a: figures[a] for a in gyro_axes}, {a: figures[a] for a in accel_axes})
 
 
