@@ -67,9 +67,9 @@ from ..io.rosbag import (
     read_rosbag,
 )
 from ..io.stream import CHUNK_ROWS, NotStreamable
-from .bag_patch import BagCopy, patch_in_batches, uncompressed
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
+from .bag_patch import BagCopy, patch_in_batches, uncompressed
 
 _RAD = unit_factor("gyro", "rad/s")  # deg/s per rad/s
 _MS2 = unit_factor("accel", "m/s2")  # g per m/s^2

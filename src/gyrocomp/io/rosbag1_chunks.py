@@ -188,10 +188,10 @@ def _chunk_arrays(
         raise rb.ReaderError(f"A damaged record in a chunk ({type(err).__name__}: {err}).") from None
     records, (op, conn, time) = located[:4], located[4:]
     message = op == rb.RecordType.MSGDATA
-    unknown = message & ~np.isin(conn, np.fromiter(connmap, dtype=np.int64, count=len(connmap)), kind="table")
+    unknown = message & ~np.isin(conn, np.fromiter(connmap, dtype=np.int64, count=len(connmap)))
     if np.any(unknown):
         raise rb.ReaderError(f"A message of connection {int(conn[np.argmax(unknown)])}, which the bag's index lacks.")
-    keep = message & np.isin(conn, np.fromiter(wanted, dtype=np.int64, count=len(wanted)), kind="table")
+    keep = message & np.isin(conn, np.fromiter(wanted, dtype=np.int64, count=len(wanted)))
     if start is not None:
         keep &= time >= start
     if stop is not None:
