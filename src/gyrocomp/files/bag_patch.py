@@ -89,7 +89,8 @@ def patch_in_batches(reader, inner, copy: BagCopy, copiers: dict, imu: dict, lim
     copy : BagCopy
         Where the bag goes.
     copiers : dict
-        Each compensated topic's copier (``comp``, ``compensated(reader, raws)``, ``compensated_fields(batch)``).
+        Each compensated topic's copier (``comp``, ``compensated(reader, raws)``, ``compensated_fields(stamp_s,
+        gyro_rad, accel_ms2)``).
     imu : dict
         Connection id -> topic of the IMU connections compensated.
     limits : (int, int, int)
