@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from gyrocomp.allan import allan_deviation, noise_terms
-from gyrocomp.allan.bound import bound_noise, markov_allan_variance
+from gyrocomp.allan.bound import bound_noise, markov_allan_variance, markov_grid
 from gyrocomp.allan.intervals import confidence_interval
 from gyrocomp.errors import InputError
 from gyrocomp.simulation import preset_model
@@ -103,3 +103,17 @@ def test_what_cannot_be_bounded_is_refused():
         bound_noise(curve, max_tau_s=0.02)
     with pytest.raises(InputError, match=r"confidence: a one-sided confidence between 0.5 and 1, got 1.5"):
         bound_noise(curve, confidence=1.5)
+    with pytest.raises(InputError, match=r"time_constants_s: positive correlation times \[s\], one list"):
+        bound_noise(curve, time_constants_s=[1.0, -2.0])
+
+
+def test_a_given_grid_of_correlation_times_is_the_one_chosen_from():
+    """The grid a bound chooses its Gauss-Markov terms from by default, given explicitly, gives the same bound;
+    any other grid gives terms from it only, and the bound still lies above the curve."""
+    curve = allan_deviation(_record("consumer", 1)[:40_000], RATE_HZ, taus="octave")
+    default = bound_noise(curve)
+    grid = markov_grid(default.taus_s[0], default.taus_s[-1])
+    assert bound_noise(curve, time_constants_s=grid) == default
+    other = bound_noise(curve, time_constants_s=[0.5, 5.0, 50.0])
+    assert {t for _, t in other.markov} <= {0.5, 5.0, 50.0} and other.ratio_median >= 1.0
+    assert markov_grid(1.0, 1.0).size == 0 and markov_grid(0.1, 100.0).size == 7  # two per decade, both ends
