@@ -8,7 +8,6 @@ import math
 from pathlib import Path
 
 import click
-import pandas as pd
 from rich.table import Table
 
 from ..errors import InputError
@@ -234,7 +233,7 @@ def _write_certificates(summary, output, store, limits, kind: str, settings) -> 
 
 def _print_summary(summary, output, judged: bool) -> None:
     console = make_console()
-    table = pd.read_parquet(summary.table)
+    table = summary.units
     counts = fleet_yield(table)
     console.print(
         f"gyrocomp fleet fit -> {output}: {len(summary.fitted)} unit(s) fitted, {len(summary.unchanged)} "

@@ -37,7 +37,7 @@ import warnings
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from .._version import __version__
 from ..errors import DataQualityWarning, GyrocompError, InputError
@@ -54,6 +54,9 @@ from ..threads import single_threaded_blas
 from .unit_figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
 from .limits import Limits
 from .population import fleet_table
+
+if TYPE_CHECKING:
+    import pandas as pd
 from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
 from .stations import Station, claim, release, station as running_as
@@ -143,6 +146,9 @@ class FleetSummary:
     table: Path | None
     warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
     busy: dict[str, str] = field(default_factory=dict)
+    #: the fleet table as written (one row per unit): what a caller shows, without reading back a file another
+    #: fit of the same folder may be replacing at that moment
+    units: pd.DataFrame | None = None
 
 
 @single_threaded_blas
@@ -244,8 +250,9 @@ def fit_fleet(
             release(db, outcome.serial, me)
             if progress is not None:
                 progress(done, len(units))
-        table = write_fleet_table(db, output / FLEET_TABLE, limits)
-    return tally.summary(os.fspath(store if store is not None else output), table)
+        table = fleet_table(db.latest_rows(), limits)
+        write_fleet_table(table, output / FLEET_TABLE)
+    return tally.summary(os.fspath(store if store is not None else output), output / FLEET_TABLE, table)
 
 
 def _checked(units: Iterable[UnitRuns], output, scheduler: str) -> tuple[list[UnitRuns], Path]:
@@ -362,8 +369,9 @@ class _Tally:
     warned: dict[str, tuple[str, ...]] = field(default_factory=dict)
     busy: dict[str, str] = field(default_factory=dict)
 
-    def summary(self, store: str, table) -> FleetSummary:
-        """The fleet fit's summary: what this tally counted, the store's location and the fleet table."""
+    def summary(self, store: str, table, units=None) -> FleetSummary:
+        """The fleet fit's summary: what this tally counted, the store's location and the fleet table (its path
+        and its rows)."""
         return FleetSummary(
             tuple(self.fitted),
             tuple(self.unchanged),
@@ -374,6 +382,7 @@ class _Tally:
             table=table,
             warned=self.warned,
             busy=self.busy,
+            units=units,
         )
 
     def count(self, record: CalibrationRecord) -> None:
@@ -677,9 +686,8 @@ def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
             )
 
 
-def write_fleet_table(store: CalibrationStore, path: Path, limits: Limits | None) -> Path:
+def write_fleet_table(table: pd.DataFrame, path: Path) -> Path:
     """Write the fleet table (one row per unit, its newest calibration; see :func:`fleet_table`) atomically."""
-    table = fleet_table(store.latest_rows(), limits)
     with atomic_path(path) as tmp:
         table.to_parquet(tmp, index=False)
     return path
