@@ -107,9 +107,8 @@ def _messages(self, connections=(), start: int | None = None, stop: int | None =
             if found is not None:
                 yield from found
                 continue
-        self.bio.seek(chunk.datapos)
-        data = chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize))
-        yield from _chunk_messages(rb, bytes(data), connmap, wanted, (start, stop))
+        data, index = _chunk_data(self, rb, chunk, len(info.connection_counts))
+        yield from _chunk_messages(rb, data, connmap, wanted, (start, stop), index)
 
 
 #: a chunk whose messages of the connections read are at most one in this many is read by its index (uncompressed)
@@ -159,14 +158,14 @@ _TIME = struct.Struct("<II")
 _FIELDS = (b"op", b"conn", b"time")
 
 
-def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple):
+def _chunk_messages(rb, data: bytes, connmap: dict, wanted: set, span: tuple, index: list | None = None):
     """The message-data records of one decompressed chunk, in their order, as (connection, time [ns], raw bytes).
 
     The records are walked by their two lengths (:func:`_records`); their header fields (``op``, ``conn``,
     ``time``) are then read for all records of one header layout at once (:func:`_header_fields`; rosbags'
-    :class:`Header` makes a dict of every record's, the reading of a long bag). A record that runs past the chunk is a
-    ReaderError."""
-    conn, time, data_at, data_length = _chunk_arrays(rb, data, connmap, wanted, span)
+    :class:`Header` makes a dict of every record's, the reading of a long bag), or found where the chunk's
+    ``index`` says (:func:`_chunk_arrays`). A record that runs past the chunk is a ReaderError."""
+    conn, time, data_at, data_length = _chunk_arrays(rb, data, connmap, wanted, span, index)
     for k in range(conn.size):
         yield connmap[int(conn[k])], int(time[k]), data[data_at[k] : data_at[k] + data_length[k]]
 
@@ -214,14 +213,20 @@ def _message_arrays(self, connections=()):
             continue
         self.bio.seek(info.pos)
         chunk = self.read_chunk()
-        self.bio.seek(chunk.datapos)
-        data = bytes(chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize)))
-        index = _index_entries(self, rb, len(info.connection_counts))  # they follow the chunk's data
+        data, index = _chunk_data(self, rb, chunk, len(info.connection_counts))
         yield ChunkArrays(
             np.frombuffer(data, dtype=np.uint8),
             chunk.datapos,
             *_chunk_arrays(rb, data, connmap, wanted, (None, None), index),
         )
+
+
+def _chunk_data(self, rb, chunk, connections: int) -> tuple[bytes, list | None]:
+    """A chunk's decompressed bytes and the index data records that follow it (:func:`_index_entries`, one per
+    connection in it; None where they do not read)."""
+    self.bio.seek(chunk.datapos)
+    data = bytes(chunk.decompressor(rb.read_bytes(self.bio, chunk.datasize)))
+    return data, _index_entries(self, rb, connections)
 
 
 def _index_entries(self, rb, connections: int) -> list | None:
