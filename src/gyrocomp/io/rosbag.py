@@ -2,7 +2,9 @@
 
 Reads a ``sensor_msgs/Imu`` topic (rad/s, m/s^2, time from each message's header stamp) and a
 ``sensor_msgs/Temperature`` topic (degC) matched to it by time. Messages are read one topic at a
-time, the IMU's decoded a batch at a time (:mod:`gyrocomp.io.ros_imu`); a ROS 2 bag is its folder (with
+time, the IMU's decoded a batch at a time (:mod:`gyrocomp.io.ros_imu`); a ROS 1 bag's and an MCAP file's chunk by
+chunk as arrays (:mod:`gyrocomp.io.rosbag1_chunks`, :mod:`gyrocomp.io.mcap_chunks`), a ROS 2 sqlite3 bag's message
+by message through rosbags; a ROS 2 bag is its folder (with
 ``metadata.yaml``) or a file in it. :class:`BagStream` reads the IMU topic in chunks, in memory bounded by the
 chunk whatever the bag's length (``allan``, ``apply``, ``evaluate`` and ``convert`` read bags so).
 """
@@ -35,6 +37,7 @@ from .common import (
     time_order_warning,
 )
 from .layout import TIME_COLUMN, TableLayout
+from .mcap_chunks import mcap_arrays
 from .readers import Reader, register_reader
 from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_fields
 from .rosbag1_chunks import chunked_reader1
@@ -245,13 +248,22 @@ def _batch_values(batch: ImuBatch, cdr: bool) -> tuple[np.ndarray, np.ndarray, n
     )
 
 
-def _decoded_groups(reader, imu: list, size: int):
-    """The IMU topic's messages as they lie in the bag, decoded a group at a time [s, rad/s, m/s^2]: a ROS 1 bag's
-    a chunk at a time from the chunk's bytes (:meth:`ChunkedReader1.message_arrays`, no Python object per message),
-    any other bag's ``size`` messages at a time as rosbags yields them."""
+def message_arrays(reader, connections: list):
+    """The messages of ``connections`` chunk by chunk as arrays (:class:`~gyrocomp.io.rosbag1_chunks.ChunkArrays`,
+    no Python object per message), in the order rosbags yields them: a ROS 1 bag's
+    (:meth:`ChunkedReader1.message_arrays`) or one MCAP file's (:func:`~gyrocomp.io.mcap_chunks.mcap_arrays`); None
+    for any other bag (read message by message through rosbags)."""
     readers = getattr(reader, "readers", ())
     arrays = getattr(readers[0], "message_arrays", None) if len(readers) == 1 else None
-    if arrays is None:
+    return arrays(connections=connections) if arrays is not None else mcap_arrays(reader, connections)
+
+
+def _decoded_groups(reader, imu: list, size: int):
+    """The IMU topic's messages as they lie in the bag, decoded a group at a time [s, rad/s, m/s^2]: a ROS 1 bag's
+    or an MCAP file's a chunk at a time from the chunk's bytes (:func:`message_arrays`), any other bag's ``size``
+    messages at a time as rosbags yields them."""
+    chunks = message_arrays(reader, imu)
+    if chunks is None:
         raws = []
         for _, _, raw in reader.messages(connections=imu):
             raws.append(raw)
@@ -261,16 +273,20 @@ def _decoded_groups(reader, imu: list, size: int):
         if raws:
             yield decoded_imu(reader, imu[0].msgtype, raws)
         return
-    for found in arrays(connections=imu):
+    for found in chunks:
         chunk, data_at, data_length = found.data, found.data_at, found.data_length
         if data_length.size and np.all(data_length == data_length[0]):
-            fields = imu_fields(chunk, data_at, int(data_length[0]), cdr=False)
+            fields = imu_fields(chunk, data_at, int(data_length[0]), cdr=reader.is2)
             if fields is not None:
                 yield fields.stamp_s, fields.angular_velocity, fields.linear_acceleration
                 continue
         if data_length.size:
-            raws = [chunk[at : at + length].tobytes() for at, length in zip(data_at.tolist(), data_length.tolist())]
-            yield decoded_imu(reader, imu[0].msgtype, raws)
+            yield decoded_imu(reader, imu[0].msgtype, _raws(found))
+
+
+def _raws(found) -> list[bytes]:
+    """The serialized messages of a chunk's arrays."""
+    return [found.data[at : at + n].tobytes() for at, n in zip(found.data_at.tolist(), found.data_length.tolist())]
 
 
 def _imu_batches(path: Path, reader, imu: list, size: int, progress: ProgressCallback | None = None):
@@ -315,11 +331,18 @@ def _imu_samples(path: Path, reader, imu: list, progress: ProgressCallback | Non
 
 
 def _temperature_samples(path: Path, reader, thermo: list):
-    """(time [s], temperature [degC]) of every message on the temperature topic, in time order."""
+    """(time [s], temperature [degC]) of every message on the temperature topic, in time order (an MCAP file's
+    found by its chunks' indexes, :func:`~gyrocomp.io.mcap_chunks.mcap_arrays`; a ROS 1 bag's by rosbags' interface
+    to :class:`ChunkedReader1`, which reads a sparse topic where the index says)."""
     t_time, t_value = [], []
     with damaged_bag(path, thermo[0].topic):
-        for connection, _, raw in reader.messages(connections=thermo):
-            msg = reader.deserialize(raw, connection.msgtype)
+        chunks = mcap_arrays(reader, thermo)
+        if chunks is None:
+            raws = (raw for _, _, raw in reader.messages(connections=thermo))
+        else:
+            raws = (raw for found in chunks for raw in _raws(found))
+        for raw in raws:
+            msg = reader.deserialize(raw, thermo[0].msgtype)
             t_time.append(header_stamp_s(msg.header))
             t_value.append(msg.temperature)
     _read_all(path, sum(c.msgcount for c in thermo), len(t_time), thermo[0].topic)

@@ -323,11 +323,12 @@ def _as_indexed(rb, array, data: bytes, offsets, header_length, conns, times) ->
 
 
 class ChunkArrays(NamedTuple):
-    """One chunk's messages as arrays (:meth:`ChunkedReader1.message_arrays`)."""
+    """One chunk's messages as arrays (:meth:`ChunkedReader1.message_arrays`, and an MCAP file's:
+    :func:`gyrocomp.io.mcap_chunks.mcap_arrays`)."""
 
     data: np.ndarray  # the decompressed chunk's bytes (uint8)
-    data_pos: int  # where the chunk's data lie in the file [bytes]
-    conn: np.ndarray  # each message's connection id
+    data_pos: int  # where the chunk's data lie in the file [bytes] (their place, when uncompressed)
+    conn: np.ndarray  # each message's connection id (an MCAP file's channel id)
     time: np.ndarray  # each message's time [ns]
     data_at: np.ndarray  # where each message's data start in ``data`` [bytes]
     data_length: np.ndarray  # and their length [bytes]
