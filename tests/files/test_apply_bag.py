@@ -15,7 +15,7 @@ import pytest
 from gyrocomp import apply, fit_calibration, read
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.files.apply_bag import apply_bag
-from gyrocomp.io.rosbag1_chunks import chunked_reader1
+from gyrocomp.io.rosbag import any_reader, message_arrays
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
@@ -275,42 +275,117 @@ def test_a_bag_heavy_with_other_topics_is_written_in_windows_of_bytes(model, tmp
     assert _messages(tmp_path / "windows.bag") == _messages(tmp_path / "one.bag")
 
 
+def _imu_bytes(bag: Path) -> tuple[Path, np.ndarray]:
+    """The file holding a bag's messages, and where the data of its IMU messages lie in it (a mask of its bytes)."""
+    file = next(bag.glob("*.mcap")) if bag.is_dir() else bag
+    inside = np.zeros(file.stat().st_size, dtype=bool)
+    with any_reader(bag) as reader:
+        imu = [c for c in reader.connections if c.topic == "/imu/data"]
+        for chunk in message_arrays(reader, imu):
+            for at, length in zip(chunk.data_at.tolist(), chunk.data_length.tolist()):
+                inside[chunk.data_pos + at : chunk.data_pos + at + length] = True
+    return file, inside
+
+
+@pytest.mark.parametrize("kind", ["ros1", "mcap", "bare mcap"])
 @pytest.mark.parametrize("chunk_rows", [None, 7])
 @pytest.mark.parametrize("window_bytes", [None, 3000])
-def test_an_uncompressed_ros1_bag_is_compensated_in_place_as_the_writer_would(
-    chunk_rows, window_bytes, model_with_accel, tmp_path, monkeypatch
+def test_a_bag_of_uncompressed_chunks_is_compensated_in_place_as_the_writer_would(
+    kind, chunk_rows, window_bytes, model_with_accel, tmp_path, monkeypatch
 ):
-    """An uncompressed ROS 1 bag is copied with each IMU message's values written in place: the output has the
-    input's bytes but for those values (every record, offset and index as it was), and the messages rosbags reads
-    from it are those of the bag written message by message through rosbags' writer, in batches of 7 messages and
-    in windows of bytes too (a batch holding a single IMU message among them), and those of one batch."""
+    """An uncompressed ROS 1 bag and an MCAP file (a bag folder's, and bare) are copied with each IMU message's
+    values written in place: the output has the input's bytes but for those values (every record, offset and index
+    as it was), and the messages rosbags reads from it are those of the bag written message by message through
+    rosbags' writer, in batches of 7 messages and in windows of bytes too (a batch holding a single IMU message
+    among them), and those of one batch."""
     import gyrocomp.files.apply_bag as module
 
-    source = tmp_path / "in.bag"
-    write_bag(source, ros2=False, n=400, repeat=11)
+    options, name, out_name = KINDS[kind]
+    source = tmp_path / name
+    outputs = {label: tmp_path / f"{label}{Path(out_name).suffix}" for label in ("one", "patched", "written")}
+    write_bag(source, n=400, repeat=11, **options)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        apply_bag(model_with_accel, source, tmp_path / "one.bag")
+        apply_bag(model_with_accel, source, outputs["one"])
         if window_bytes:
             monkeypatch.setattr(module, "WINDOW_BYTES", window_bytes)
             monkeypatch.setattr(module, "FIRST_SAMPLES", 20)
-        patched = apply_bag(model_with_accel, source, tmp_path / "patched.bag", chunk_rows=chunk_rows or 100_000)
+        patched = apply_bag(model_with_accel, source, outputs["patched"], chunk_rows=chunk_rows or 100_000)
         monkeypatch.setattr(module, "_patched_bag", lambda *args: False)
-        written = apply_bag(model_with_accel, source, tmp_path / "written.bag", chunk_rows=chunk_rows or 100_000)
+        written = apply_bag(model_with_accel, source, outputs["written"], chunk_rows=chunk_rows or 100_000)
     assert patched.compensated == written.compensated == 401 and patched.accel  # 400 and a repeat
-    assert _messages(tmp_path / "patched.bag") == _messages(tmp_path / "written.bag") == _messages(tmp_path / "one.bag")
-    before, after = source.read_bytes(), (tmp_path / "patched.bag").read_bytes()
+    assert _messages(outputs["patched"]) == _messages(outputs["written"]) == _messages(outputs["one"])
+    file, inside = _imu_bytes(source)
+    before = file.read_bytes()
+    after = (
+        next(outputs["patched"].glob("*.mcap")) if outputs["patched"].is_dir() else outputs["patched"]
+    ).read_bytes()
     assert len(after) == len(before)
     changed = np.flatnonzero(np.frombuffer(before, np.uint8) != np.frombuffer(after, np.uint8))
-    assert changed.size and _messages(source) != _messages(tmp_path / "patched.bag")
-    # only IMU messages changed: each changed byte lies in the data of a message on the IMU topic
-    inside = np.zeros(len(before), dtype=bool)
-    with chunked_reader1()(source) as reader:
-        imu = [c for c in reader.connections if c.topic == "/imu/data"]
-        for chunk in reader.message_arrays(connections=imu):
-            for at, length in zip(chunk.data_at.tolist(), chunk.data_length.tolist()):
-                inside[chunk.data_pos + at : chunk.data_pos + at + length] = True
-    assert np.all(inside[changed])
+    assert changed.size and _messages(source) != _messages(outputs["patched"])
+    assert np.all(inside[changed])  # only IMU messages changed: each changed byte lies in an IMU message's data
+    if kind == "mcap":
+        assert (outputs["patched"] / "metadata.yaml").read_bytes() == (source / "metadata.yaml").read_bytes()
+
+
+def _rewritten_with_crcs(source: Path, target: Path) -> Path:
+    """An MCAP file's schemas, channels and messages written again by the mcap library with the CRC-32 of each
+    chunk and of the data section (rosbags writes none)."""
+    mcap_reader = pytest.importorskip("mcap.reader")
+    mcap_writer = pytest.importorskip("mcap.writer")
+    with open(source, "rb") as f_in, open(target, "wb") as f_out:
+        reader = mcap_reader.make_reader(f_in)
+        writer = mcap_writer.Writer(
+            f_out,
+            chunk_size=4096,
+            compression=mcap_writer.CompressionType.NONE,
+            enable_crcs=True,
+            enable_data_crcs=True,
+        )
+        writer.start(profile="ros2", library="gyrocomp tests")
+        schemas, channels = {}, {}
+        for schema, channel, message in reader.iter_messages():
+            if schema.id not in schemas:
+                schemas[schema.id] = writer.register_schema(schema.name, schema.encoding, schema.data)
+            if channel.id not in channels:
+                channels[channel.id] = writer.register_channel(
+                    channel.topic, channel.message_encoding, schemas[schema.id], channel.metadata
+                )
+            writer.add_message(channels[channel.id], message.log_time, message.data, message.publish_time)
+        writer.finish()
+    return target
+
+
+def test_an_mcap_files_crcs_are_written_anew_when_compensated_in_place(model, tmp_path):
+    """A patched chunk's CRC-32 and the data section's, where the input has them: the mcap library's reader
+    checks both, and the messages are those of the writer's pass."""
+    import gyrocomp.files.apply_bag as module
+
+    stream_reader = pytest.importorskip("mcap.stream_reader")
+    write_bag(tmp_path / "plain.mcap", n=300, **KINDS["bare mcap"][0])
+    source = _rewritten_with_crcs(tmp_path / "plain.mcap", tmp_path / "in.mcap")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        patched = apply_bag(model, source, tmp_path / "patched.mcap")
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(module, "_patched_bag", lambda *args: False)
+            apply_bag(model, source, tmp_path / "written.mcap")
+    assert patched.compensated == 300
+    assert (tmp_path / "patched.mcap").stat().st_size == source.stat().st_size
+    assert _messages(tmp_path / "patched.mcap") == _messages(tmp_path / "written.mcap") != _messages(source)
+    for path in (source, tmp_path / "patched.mcap"):
+        with open(path, "rb") as f:
+            records = list(stream_reader.StreamReader(f, validate_crcs=True).records)  # every CRC checked
+        with open(path, "rb") as f:
+            chunks = [r for r in stream_reader.StreamReader(f, emit_chunks=True).records if type(r).__name__ == "Chunk"]
+        assert len(chunks) > 3 and all(chunk.uncompressed_crc != 0 for chunk in chunks)
+        assert [r.data_section_crc != 0 for r in records if type(r).__name__ == "DataEnd"] == [True]
+    data = bytearray((tmp_path / "patched.mcap").read_bytes())
+    _, inside = _imu_bytes(tmp_path / "patched.mcap")
+    data[int(np.flatnonzero(inside)[-1])] ^= 1  # a bit of a message flipped: the check fails
+    (tmp_path / "bent.mcap").write_bytes(bytes(data))
+    with open(tmp_path / "bent.mcap", "rb") as f, pytest.raises(Exception, match="(?i)crc"):
+        list(stream_reader.StreamReader(f, validate_crcs=True).records)
 
 
 @pytest.mark.parametrize("chunk_rows", [None, 7])

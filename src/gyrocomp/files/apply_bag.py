@@ -19,10 +19,11 @@ into their bytes (:mod:`gyrocomp.io.ros_imu`), then everything held written out 
 single IMU sample (the last of a bag, say) is compensated as the next sample of the stream. A bag whose IMU
 stamps go back further than the batch before is compensated from a whole read instead (the same result).
 
-An uncompressed ROS 1 bag (what ``rosbag record`` writes by default) is not rewritten message by message: its bytes
-are copied with each IMU message's values written in place (:func:`_patched_bag`; a compensated message keeps its
-length, so every record, offset and index stays valid), the messages batched as above. Any other bag goes through
-rosbags' writer.
+A ROS 1 bag or an MCAP file (bare, or a bag folder's one file) of uncompressed chunks (what ``rosbag record`` and
+``ros2 bag record`` in MCAP storage write by default) is not rewritten message by message: its bytes are copied with
+each IMU message's values written in place (:func:`_patched_bag`; a compensated message keeps its length, so every
+record, offset and index stays valid; an MCAP file's CRC-32s are computed anew), the messages batched as above. Any
+other bag goes through rosbags' writer.
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
+from ..io.mcap_chunks import channel_ids, mcap_arrays, mcap_storage
 from ..io.rosbag1_chunks import lean_writer1
 from ..io.ros_imu import (
     ANGULAR_VELOCITY,
@@ -69,7 +71,7 @@ from ..io.rosbag import (
 from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
-from .bag_patch import BagCopy, patch_in_batches, uncompressed
+from .bag_patch import BagCopy, McapCopy, patch_in_batches, uncompressed
 
 _RAD = unit_factor("gyro", "rad/s")  # deg/s per rad/s
 _MS2 = unit_factor("accel", "m/s2")  # g per m/s^2
@@ -337,21 +339,59 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
 
 
 def _patched_bag(bag: Path, output: Path, copiers: dict, chunk_rows: int) -> bool:
-    """An uncompressed ROS 1 bag compensated in one pass by copying its bytes with each IMU message's values written
-    in place (a compensated message keeps its length, so every record, offset and index stays as it was): the
-    input's chunks, connections and index byte for byte, the IMU messages batched as :func:`_copy_in_batches` does.
+    """A bag of uncompressed chunks (a ROS 1 bag, or one MCAP file: bare or the storage of a bag folder) compensated
+    in one pass by copying its bytes with each IMU message's values written in place (a compensated message keeps
+    its length, so every record, offset and index stays as it was): the input's chunks, connections and index byte
+    for byte (an MCAP file's CRC-32s computed anew), the IMU messages batched as :func:`_copy_in_batches` does.
     False (nothing written) for any other bag."""
-    if bag_kind(bag) != "ros1":
-        return False
+    kind = bag_kind(bag)
     with any_reader(bag) as reader:
-        inner = reader.readers[0]
-        if not hasattr(inner, "message_arrays") or not uncompressed(inner):
+        imu = [c for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE]
+        place = _ros1_in_place(reader, imu) if kind == "ros1" else _mcap_in_place(bag, reader, imu)
+        if place is None:
             return False
-        imu = {c.id: c.topic for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE}
-        with staged_bag(output, "ros1") as target, open(bag, "rb") as source, open(target, "wb") as sink:
-            limits = (chunk_rows, WINDOW_BYTES, FIRST_SAMPLES)  # read now: the tests make windows smaller
-            patch_in_batches(reader, inner, BagCopy(source, sink), copiers, imu, limits)
+        file, arrays, ids, copy_of = place
+        limits = (chunk_rows, WINDOW_BYTES, FIRST_SAMPLES)  # read now: the tests make windows smaller
+        with staged_bag(output, kind) as target:
+            if kind != "ros1":  # a folder: the bag's metadata.yaml as it is, beside its file
+                target.mkdir()
+                if bag.is_dir():
+                    shutil.copyfile(bag / "metadata.yaml", target / "metadata.yaml")
+                target = target / file.name
+            with open(file, "rb") as source, open(target, "wb") as sink:
+                patch_in_batches(reader, arrays, copy_of(source, sink), copiers, ids, limits)
     return True
+
+
+def _ros1_in_place(reader, imu: list):
+    """(the file, its messages as chunk arrays, IMU connection id -> topic, the copy's maker) of a ROS 1 bag
+    whose chunks are uncompressed, else None."""
+    inner = reader.readers[0]
+    if not hasattr(inner, "message_arrays") or not uncompressed(inner):
+        return None
+    return inner.path, inner.message_arrays(), {c.id: c.topic for c in imu}, BagCopy
+
+
+def _mcap_in_place(bag: Path, reader, imu: list):
+    """What :func:`_ros1_in_place` gives, of a bag that is one MCAP file (bare, or a bag folder's only file as it
+    lies there) with a summary, whose chunks are uncompressed and in time order (:func:`mcap_arrays`), else None."""
+    storage = mcap_storage(reader)
+    if storage is None or any(c.compression for c in storage.chunks):
+        return None
+    file = Path(storage.path)
+    if (file.parent if bag.is_dir() else file).resolve() != bag.resolve():  # a bag folder's file decompressed
+        return None
+    data_end = storage.data_end - McapCopy.DATA_END.size  # the data end record, just before the summary
+    storage.bio.seek(data_end)
+    record = storage.bio.read(McapCopy.DATA_END.size)
+    if len(record) != McapCopy.DATA_END.size or McapCopy.DATA_END.unpack(record)[:2] != (0x0F, 4):
+        return None
+    arrays = mcap_arrays(reader, list(reader.connections))
+    if arrays is None:
+        return None
+    ids = {i: c.topic for c in imu for i in channel_ids(storage, [c])}
+    data_crc = McapCopy.DATA_END.unpack(record)[2] != 0
+    return file, arrays, ids, lambda source, sink: McapCopy(source, sink, data_end, data_crc)
 
 
 class _Copier:

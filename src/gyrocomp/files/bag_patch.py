@@ -1,8 +1,11 @@
-"""An uncompressed ROS 1 bag compensated in place: its bytes copied through, each IMU message's values written
-where they lie (:func:`gyrocomp.files.apply_bag.apply_bag`'s way for the bag ``rosbag record`` writes by default).
+"""A bag of uncompressed chunks compensated in place: its bytes copied through, each IMU message's values written
+where they lie (:func:`gyrocomp.files.apply_bag.apply_bag`'s way for the bags ``rosbag record`` and ``ros2 bag
+record`` with MCAP storage write by default: a ROS 1 bag, and an MCAP file).
 
-A compensated message keeps its length, so every record, offset and index of the input stays valid. The messages
-are taken a chunk at a time as arrays (:meth:`ChunkedReader1.message_arrays`), held until a batch is due by the same
+A compensated message keeps its length, so every record, offset and index of the input stays valid (an MCAP file's
+CRC-32s of a patched chunk and of the data section are written anew where the input has them, :class:`McapCopy`).
+The messages are taken a chunk at a time as arrays (:meth:`ChunkedReader1.message_arrays`,
+:func:`gyrocomp.io.mcap_chunks.mcap_arrays`), held until a batch is due by the same
 rule as a message-by-message pass (a topic holds ``chunk_rows`` IMU messages, or ``window_bytes`` are held and every
 topic's rate is set: its compensator made or ``first_samples`` of its messages held), found for a whole chunk at
 once; a batch's IMU messages of one layout are decoded and written back field by field as arrays, without a Python
@@ -10,6 +13,9 @@ object per message (messages of other layouts go through the copier message by m
 """
 
 from __future__ import annotations
+
+import struct
+import zlib
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -36,11 +42,19 @@ class BagCopy:
     def __init__(self, source, sink):
         self.source, self.sink, self.copied = source, sink, 0
 
+    def write(self, block) -> None:
+        """Bytes out (any buffer)."""
+        self.sink.write(block)
+
     def chunk(self, data_pos: int, data) -> None:
         """The input up to a chunk's data as it is, then the chunk's data (patched; any buffer)."""
         self.through(data_pos)
-        self.sink.write(data)
+        self.write(data)
         self.copied = data_pos + len(data)
+
+    def finish(self) -> None:
+        """The rest of the input as it is."""
+        self.through()
 
     def through(self, end: int | None = None) -> None:
         """The input's bytes from where the copy is to ``end`` (None: the end of the file)."""
@@ -50,10 +64,49 @@ class BagCopy:
             block = self.source.read(1 << 20 if left is None else min(1 << 20, left))
             if not block:
                 break
-            self.sink.write(block)
+            self.write(block)
             if left is not None:
                 left -= len(block)
         self.copied = self.source.tell()
+
+
+class McapCopy(BagCopy):
+    """:class:`BagCopy` of an MCAP file of uncompressed chunks: a patched chunk's CRC-32 (in its record, before its
+    records: CRC uint32, compression "" as its length uint32, the records' length uint64) and the data section's
+    (in the data end record at ``data_end``, of every byte before it; ``data_crc``: the input has one) computed anew
+    where the input has them (zero: none)."""
+
+    #: a chunk record's bytes from its CRC to its records, uncompressed
+    HEAD = 16
+    DATA_END = struct.Struct("<BQI")  # opcode 0x0F, length 4, CRC-32
+
+    def __init__(self, source, sink, data_end: int, data_crc: bool):
+        super().__init__(source, sink)
+        self.data_end, self.data_crc, self.written, self.crc = data_end, data_crc, 0, 0
+
+    def write(self, block) -> None:
+        if self.data_crc and self.written < self.data_end:
+            self.crc = zlib.crc32(memoryview(block)[: self.data_end - self.written], self.crc)
+        self.written += len(block)
+        self.sink.write(block)
+
+    def chunk(self, data_pos: int, data) -> None:
+        self.through(data_pos - self.HEAD)
+        head = bytearray(self.source.read(self.HEAD))
+        if head[:4] != bytes(4):
+            head[:4] = struct.pack("<I", zlib.crc32(data))
+        self.write(head)
+        self.write(data)
+        self.copied = data_pos + len(data)
+
+    def finish(self) -> None:
+        self.through(self.data_end)
+        op, length, crc = self.DATA_END.unpack(self.source.read(self.DATA_END.size))
+        if (op, length) != (0x0F, 4):
+            raise InputError(f"no MCAP data end record at byte {self.data_end}")
+        self.write(self.DATA_END.pack(op, length, self.crc if crc else 0))
+        self.copied = self.data_end + self.DATA_END.size
+        self.through()
 
 
 def due_at(
@@ -77,22 +130,24 @@ def due_at(
     return int(np.argmax(due)) if due.any() else None
 
 
-def patch_in_batches(reader, inner, copy: BagCopy, copiers: dict, imu: dict, limits: tuple[int, int, int]) -> None:
+def patch_in_batches(reader, arrays, copy: BagCopy, copiers: dict, imu: dict, limits: tuple[int, int, int]) -> None:
     """Every message of the bag in its order, a chunk at a time, held until a batch is due (:func:`due_at`); at
     each batch each topic's IMU messages are compensated by its copier and written into their chunk's copy, and
     every chunk whose messages are all done goes out.
 
     Parameters
     ----------
-    reader, inner
-        rosbags' reader of the bag and its ROS 1 reader with ``message_arrays``.
+    reader
+        rosbags' reader of the bag.
+    arrays : iterable of ChunkArrays
+        Every message of the bag, chunk by chunk as arrays, in the order of ``reader.messages()``.
     copy : BagCopy
         Where the bag goes.
     copiers : dict
         Each compensated topic's copier (``comp``, ``compensated(reader, raws)``, ``compensated_fields(stamp_s,
         gyro_rad, accel_ms2)``).
     imu : dict
-        Connection id -> topic of the IMU connections compensated.
+        Connection id (an MCAP file's channel id) -> topic of the IMU connections compensated.
     limits : (int, int, int)
         chunk_rows, window_bytes [bytes], first_samples: the batching rule.
     """
@@ -110,7 +165,7 @@ def patch_in_batches(reader, inner, copy: BagCopy, copiers: dict, imu: dict, lim
             copy.chunk(data_pos, data)
         del chunks[:done]
 
-    for found in inner.message_arrays():
+    for found in arrays:
         data = found.data.copy()
         chunks.append((found.data_pos, data))
         topic_of = np.full(found.conn.size, -1, dtype=np.int64)
@@ -132,7 +187,7 @@ def patch_in_batches(reader, inner, copy: BagCopy, copiers: dict, imu: dict, lim
                 held, counts, held_bytes = [[] for _ in topics], np.zeros(len(topics), dtype=np.int64), 0
             start = stop
     write(len(chunks))
-    copy.through()
+    copy.finish()
 
 
 def _write_topic(reader, topic: str, copier, pieces: list) -> None:
@@ -141,7 +196,7 @@ def _write_topic(reader, topic: str, copier, pieces: list) -> None:
     lengths = np.concatenate([p[2] for p in pieces])
     if lengths.size and np.all(lengths == lengths[0]):
         width = int(lengths[0])
-        read = [imu_fields(p[0], p[1], width, cdr=False) for p in pieces]
+        read = [imu_fields(p[0], p[1], width, cdr=reader.is2) for p in pieces]
         if all(f is not None and f.values_at == read[0].values_at for f in read):
             done, fields = copier.compensated_fields(
                 np.concatenate([f.stamp_s for f in read]),
@@ -166,4 +221,4 @@ def _write_topic(reader, topic: str, copier, pieces: list) -> None:
         data[a : a + n] = np.frombuffer(new, dtype=np.uint8)
 
 
-__all__ = ["BagCopy", "due_at", "patch_in_batches", "uncompressed"]
+__all__ = ["BagCopy", "McapCopy", "due_at", "patch_in_batches", "uncompressed"]
