@@ -133,6 +133,27 @@ def test_a_chunk_whose_index_does_not_hold_is_walked(bend, tmp_path, monkeypatch
     assert walked == [1]
 
 
+@pytest.mark.parametrize("bend", [None, "offset", "time"])
+def test_a_sparse_topic_is_read_where_the_index_says(bend, tmp_path, monkeypatch):
+    """/b, one message in 40, in uncompressed chunks: its records alone are read (the chunks not read whole), the
+    same messages as rosbags reads; an index entry that does not hold: that chunk read whole."""
+    path = _mcap(tmp_path / "x.mcap", _messages(n=1200, every=40), chunk_size=2048)
+    if bend:
+        entry = _index_entry_at(path, "/b")
+        with open(path, "r+b") as stream:
+            stream.seek(entry)
+            log_time, offset = struct.unpack("<QQ", stream.read(16))
+            stream.seek(entry)
+            stream.write(struct.pack("<QQ", log_time + (bend == "time"), offset + (bend == "offset")))
+    expected = _read(path, "/b", fast=False)
+    assert len(expected) == 30
+    whole = []
+    records = mcap_chunks._chunk_records
+    monkeypatch.setattr(mcap_chunks, "_chunk_records", lambda *a: whole.append(1) or records(*a))
+    assert _read(path, "/b", fast=True) == expected
+    assert len(whole) == (1 if bend else 0)
+
+
 def test_a_chunk_record_that_disagrees_with_the_chunk_index_is_a_reader_error(tmp_path):
     path = _mcap(tmp_path / "x.mcap", _messages(), chunk_size=2048)
     with AnyReader([path]) as reader:

@@ -12,11 +12,14 @@ together.
 A chunk's messages are found where its message index records say (one per channel in the chunk, after it: each
 message's log time and offset). Each entry is checked at its place (a message record of that channel and log time),
 and the records between consecutive messages are walked (a schema or channel record may lie there; a message record
-there means the index is incomplete). A chunk whose index does not hold is walked record by record. The order is
-rosbags': in a chunk by log time (a stable sort of the records' order), chunk after chunk in file order, which is
-rosbags' merge by log time when no chunk's time range starts before the previous one's ends; where they overlap,
-:func:`mcap_arrays` gives None and the caller reads through rosbags. As rosbags does, only the chunks whose index
-names the channel are read, and only the messages within their chunk's time range.
+there means the index is incomplete). A chunk whose index does not hold is walked record by record. A topic that is
+a small part of an uncompressed chunk (a temperature at 1 Hz beside an IMU at 1 kHz) is read where the index says,
+its records alone, each checked at its place.
+
+The order is rosbags': in a chunk by log time (a stable sort of the records' order), chunk after chunk in file
+order, which is rosbags' merge by log time when no chunk's time range starts before the previous one's ends; where
+they overlap, :func:`mcap_arrays` gives None and the caller reads through rosbags. As rosbags does, only the chunks
+whose index names the channel are read, and only the messages within their chunk's time range.
 
 The MCAP format: records of an opcode (1 byte), a length (uint64) and content. A chunk record (0x06) holds its
 messages' start and end log time, the records' uncompressed size and CRC-32, the compression and the records:
@@ -105,22 +108,30 @@ def mcap_arrays(reader, connections) -> Iterator[ChunkArrays] | None:
 
 def _chunk_arrays(bio, size: int, info, ids: set[int]) -> ChunkArrays:
     """One chunk's messages of the channels ``ids`` within its time range, sorted by log time (stably), from a file
-    of ``size`` bytes."""
+    of ``size`` bytes: read where the index says when they are a small part of an uncompressed chunk
+    (:func:`_sparse`), else from the whole chunk."""
+    sparse = _sparse(bio, size, info, ids)
+    if sparse is not None:
+        return _chosen(*sparse, info, ids)
     data, records_at = _chunk_records(bio, size, info)
     found = _indexed(bio, size, info, data)
-    at, channel, time, length = found if found is not None else _walked(data)
+    return _chosen(data, records_at, *(found if found is not None else _walked(data)), info, ids)
+
+
+def _chosen(data, data_pos: int, at, channel, time, length, info, ids: set[int]) -> ChunkArrays:
+    """The messages of ``ids`` among records at ``at`` of ``data`` (their channel ids, log times [ns], lengths
+    [bytes]) within the chunk's time range, sorted by log time (stably), as :class:`ChunkArrays`."""
     keep = np.isin(channel, np.fromiter(ids, dtype=np.int64)) & (time >= info.message_start_time)
     keep &= time <= info.message_end_time
     order = np.flatnonzero(keep)[np.argsort(time[keep], kind="stable")]
     return ChunkArrays(
-        data, records_at, channel[order], time[order], at[order] + _MESSAGE_HEAD, length[order] - _MESSAGE_FIELDS
+        data, data_pos, channel[order], time[order], at[order] + _MESSAGE_HEAD, length[order] - _MESSAGE_FIELDS
     )
 
 
-def _chunk_records(bio, file_size: int, info) -> tuple[np.ndarray, int]:
-    """A chunk's records, decompressed and checked (size and CRC-32, by rosbags), as uint8, and where they lie in the
-    file [bytes] (their place when uncompressed); a chunk record that disagrees with the chunk index, or runs past
-    the end of the file (nothing read past it), is an error."""
+def _chunk_head(bio, file_size: int, info) -> tuple[int, int]:
+    """(where a chunk's records lie in the file [bytes], their CRC-32) from its record's head, checked against the
+    chunk index; a chunk record that disagrees with it, or runs past the end of the file, is an error."""
     mcap = _storage_mcap()
     bio.seek(info.chunk_start_offset)
     op, length, _, _, size, crc = _CHUNK_HEAD.unpack(mcap.read_exact(bio, _CHUNK_HEAD.size))
@@ -137,8 +148,86 @@ def _chunk_records(bio, file_size: int, info) -> tuple[np.ndarray, int]:
         info.uncompressed_size,
     ) or records_at + compressed > end:
         raise mcap.ReaderError(f"The chunk at byte {info.chunk_start_offset} does not match the file's chunk index.")
-    raw = mcap.decompress(mcap.read_exact(bio, compressed), compression, size, crc)
+    return records_at, crc
+
+
+def _chunk_records(bio, file_size: int, info) -> tuple[np.ndarray, int]:
+    """A chunk's records, decompressed and checked (size and CRC-32, by rosbags), as uint8, and where they lie in the
+    file [bytes] (their place when uncompressed)."""
+    records_at, crc = _chunk_head(bio, file_size, info)
+    mcap = _storage_mcap()
+    raw = mcap.decompress(mcap.read_exact(bio, info.compressed_size), info.compression, info.uncompressed_size, crc)
     return np.frombuffer(raw, dtype=np.uint8), records_at
+
+
+def _index_entries(bio, file_size: int, offset: int, cid: int) -> np.ndarray | None:
+    """The entries (log time [ns], offset in the chunk's records [bytes]) (n, 2) of channel ``cid``'s message index
+    record at ``offset`` of the file; None where it does not read as one."""
+    bio.seek(offset)
+    head = bio.read(_INDEX_HEAD.size)
+    if len(head) < _INDEX_HEAD.size:
+        return None
+    op, length, index_channel, size = _INDEX_HEAD.unpack(head)
+    if op != _MESSAGE_INDEX or index_channel != cid or size % 16 or size + 6 > length:
+        return None
+    if offset + _INDEX_HEAD.size + size > file_size:
+        return None
+    raw = bio.read(size)
+    return np.frombuffer(raw, dtype="<u8").reshape(-1, 2) if len(raw) == size else None
+
+
+#: a chunk whose messages of the channels read are at most one in this many is read where its index says
+#: (uncompressed)
+_SPARSE = 16
+
+
+def _sparse(bio, file_size: int, info, ids: set[int]):
+    """What :func:`_chosen` takes, of the messages of ``ids`` in an uncompressed chunk where they are at most one in
+    :data:`_SPARSE` of its messages (a temperature topic at 1 Hz beside an IMU at 1 kHz), each message record read
+    where the chunk's message index says and checked there (a message of its channel and log time, inside the
+    chunk) instead of reading the whole chunk; None where that does not apply or does not hold (the chunk is then
+    read whole). Those records alone are read (their bytes end to end, ``data_pos`` -1: not the chunk's place), and
+    the chunk's CRC-32 is not checked."""
+    hits = sum(info.channel_count.get(i, 0) for i in ids)
+    if info.compression or hits * _SPARSE > sum(info.channel_count.values()):
+        return None
+    records_at, _ = _chunk_head(bio, file_size, info)
+    found = []
+    for cid in sorted(ids & info.message_index_offsets.keys()):
+        entries = _index_entries(bio, file_size, info.message_index_offsets[cid], cid)
+        if entries is None:
+            return None
+        found += [(int(o), cid, int(t)) for t, o in entries.tolist()]
+    records, at, channel, time, lengths = [], [], [], [], []
+    held = 0
+    for offset, cid, log_time in sorted(found):  # the records' order
+        if offset + _MESSAGE_HEAD > info.uncompressed_size:
+            return None
+        bio.seek(records_at + offset)
+        record = bio.read(_MESSAGE_HEAD)
+        if len(record) < _MESSAGE_HEAD:
+            return None
+        op, length = _RECORD.unpack_from(record)
+        channel_id, _, record_time = _MESSAGE_ID.unpack_from(record, 9)
+        if (op, channel_id, record_time) != (_MESSAGE, cid, log_time) or length < _MESSAGE_FIELDS:
+            return None
+        if offset + 9 + length > info.uncompressed_size:
+            return None
+        record += bio.read(length - _MESSAGE_FIELDS)
+        records.append(record)
+        at.append(held)
+        channel.append(cid)
+        time.append(log_time)
+        lengths.append(length)
+        held += len(record)
+    return (
+        np.frombuffer(b"".join(records), dtype=np.uint8),
+        -1,
+        np.array(at, dtype=np.int64),
+        np.array(channel, dtype=np.int64),
+        np.array(time, dtype=np.int64),
+        np.array(lengths, dtype=np.int64),
+    )
 
 
 def _indexed(bio, file_size: int, info, data: np.ndarray):
@@ -148,19 +237,9 @@ def _indexed(bio, file_size: int, info, data: np.ndarray):
     records that do not tile the chunk)."""
     at, channel, time = [], [], []
     for cid, offset in info.message_index_offsets.items():
-        bio.seek(offset)
-        head = bio.read(_INDEX_HEAD.size)
-        if len(head) < _INDEX_HEAD.size:
+        entries = _index_entries(bio, file_size, offset, cid)
+        if entries is None:
             return None
-        op, length, index_channel, size = _INDEX_HEAD.unpack(head)
-        if op != _MESSAGE_INDEX or index_channel != cid or size % 16 or size + 6 > length:
-            return None
-        if offset + _INDEX_HEAD.size + size > file_size:
-            return None
-        raw = bio.read(size)
-        if len(raw) < size:
-            return None
-        entries = np.frombuffer(raw, dtype="<u8").reshape(-1, 2)
         time.append(entries[:, 0])
         at.append(entries[:, 1])
         channel.append(np.full(entries.shape[0], cid, dtype=np.int64))
