@@ -317,6 +317,33 @@ def test_a_bag_is_read_from_its_own_files_and_type_names_only(tmp_path):
     assert result.returncode == 2 and "outside the bag folder" in result.stderr and not (tmp_path / "out.csv").exists()
 
 
+@pytest.mark.parametrize("mcap", [False, True], ids=["sqlite3", "mcap"])
+def test_a_ros2_folders_type_names_are_checked_from_its_metadata_before_its_storage_is_opened(
+    mcap, tmp_path, monkeypatch
+):
+    """A ROS 2 bag folder's topic types (rosbags takes its connections from ``metadata.yaml``) are checked there,
+    without opening the storage (rosbags' sqlite3 storage counts every topic's messages when it opens): a hostile
+    type name is refused before rosbags makes code of it, and a bag that reads is opened once."""
+    from rosbags.rosbag2.reader import DirectoryReader
+
+    folder = tmp_path / "bag"
+    write_bag(folder, ros2=True, mcap=mcap)
+    opened = []
+    open_folder = DirectoryReader.open
+    monkeypatch.setattr(DirectoryReader, "open", lambda self: opened.append(1) or open_folder(self))
+    assert read(folder).n_samples == 100
+    assert len(opened) == 1
+    marker = tmp_path / "ran"
+    hostile = f"x/msg/A': (), **__import__('os').system('touch {marker}') and {{}}, 'b"
+    yaml = (folder / "metadata.yaml").read_text()
+    assert "type: sensor_msgs/msg/Temperature" in yaml
+    (folder / "metadata.yaml").write_text(yaml.replace("type: sensor_msgs/msg/Temperature", f'type: "{hostile}"'))
+    opened.clear()
+    with pytest.raises(InputError, match=r"bag: topic '/imu/temperature' has the message type .*, not a ROS type name"):
+        read(folder)
+    assert not marker.exists() and not opened
+
+
 def _ulog_with_appended_offset(tmp_path, name: str, offset_of):
     import struct
 

@@ -91,16 +91,35 @@ def _only_its_own_files(path: Path, bag: Path) -> None:
 
 
 def _check_types(path: Path, readers: list) -> None:
-    """Open each underlying reader once to refuse message type names that are not ROS names, before rosbags
-    makes Python code of them."""
+    """Refuse message type names that are not ROS names, before rosbags makes Python code of them: the topics of a
+    ROS 2 bag folder's ``metadata.yaml`` (where rosbags' reader of a folder takes its connections from), read
+    without opening its storage (rosbags' sqlite3 storage counts every topic's messages when it opens: seconds
+    for an hour at 1 kHz); any other reader's connections, opening it once."""
     for reader in readers:
-        with reader:
-            for connection in reader.connections:
-                if not _MSGTYPE.fullmatch(str(connection.msgtype)):
-                    raise InputError(
-                        f"{path}: topic {connection.topic!r} has the message type "
-                        f"{str(connection.msgtype)[:80]!r}, not a ROS type name; refused"
-                    )
+        named = _folder_topics(reader)
+        if named is None:
+            with reader:
+                named = [(connection.topic, connection.msgtype) for connection in reader.connections]
+        for topic, msgtype in named:
+            if not _MSGTYPE.fullmatch(str(msgtype)):
+                raise InputError(
+                    f"{path}: topic {topic!r} has the message type {str(msgtype)[:80]!r}, not a ROS type name; refused"
+                )
+
+
+def _folder_topics(reader) -> list[tuple] | None:
+    """(topic, message type) of each topic the ``metadata.yaml`` of the ROS 2 bag folder ``reader`` (rosbags'
+    reader, not open) reads names, as rosbags' reader of a folder reads them; None for any other reader, or a
+    metadata file that does not read so (rosbags' reader then says what is wrong when it opens)."""
+    directory = require("rosbags.rosbag2.reader", "ros", "reading ROS 2 bags").DirectoryReader
+    if not isinstance(getattr(reader, "storage", None), directory):
+        return None
+    yaml = require("ruamel.yaml", "ros", "reading ROS 2 bags")
+    try:
+        info = yaml.YAML(typ="safe").load((reader.path / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+        return [(t["topic_metadata"]["name"], t["topic_metadata"]["type"]) for t in info["topics_with_message_count"]]
+    except Exception:  # noqa: BLE001 - any metadata rosbags cannot read: its reader says so
+        return None
 
 
 def _topics_of(connections: list, msgtype: str) -> list[str]:
