@@ -6,7 +6,8 @@ the time running on (three axes on ``/imu/data``, ``sensor_msgs/Imu``, and its t
 ``/imu/temperature``), in ROS 1 (``.bag``), ROS 2 sqlite3 or MCAP storage (``--kind``). Its IMU messages are
 serialized from one template message whose stamp and values are written in place (:mod:`gyrocomp.io.ros_imu`,
 whose tests check that against rosbags' serializer), so that writing 3.6e7 messages takes minutes, not hours. The
-Parquet table holds the same samples (the temperature of every sample, as reading the bag matches it).
+Parquet table holds the samples reading the bag gives (:class:`gyrocomp.io.rosbag.BagStream`'s chunks: the header
+stamps, the temperature interpolated from the 1 Hz topic), so that each command reads the same recording from both.
 
 Each command runs in a fresh process (the wrapper of ``bench_apply_stream.py``): wall time, peak resident memory
 (``ru_maxrss``, which counts the pages of memory-mapped temporary files too) and peak anonymous memory (sampled
@@ -27,12 +28,11 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-import pyarrow as pa
 import pyarrow.parquet as pq
 
 from bench_apply_stream import PROGRAMS, measure
 from gyrocomp.io.ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch
-from gyrocomp.io.tables import recording_table
+from gyrocomp.io.rosbag import BagStream
 from gyrocomp.models.fit import fit_channels
 from gyrocomp.simulation import simulate
 
@@ -105,7 +105,7 @@ def make_files(bag, table, hours: float, rate_hz: float, kind: str) -> int:
         writer = Writer(bag)
     blocks = int(np.ceil(hours * 3600.0 / BLOCK_S))
     samples = 0
-    with writer, pq.ParquetWriter(table, recording_table(block).schema) as parquet:
+    with writer:
         imu = writer.add_connection("/imu/data", imu_type, typestore=store)
         thermo = writer.add_connection("/imu/temperature", temperature_type, typestore=store)
         for k in range(blocks):
@@ -133,9 +133,17 @@ def make_files(bag, table, hours: float, rate_hz: float, kind: str) -> int:
                         header=head, temperature=float(block.temperature_degc[i]), variance=0.0
                     )
                     writer.write(thermo, int(stamps[i]), bytes(serialize(message, temperature_type)))
-            part = recording_table(block.take(np.arange(n)))
-            parquet.write_table(part.set_column(0, "time", pa.array(time_s)))
             samples += n
+    # the table: the samples reading the bag gives (its stamps, the temperature interpolated from the 1 Hz topic), a
+    # chunk at a time, so that every command reads the same recording from both
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chunks = BagStream(bag).chunks()
+        first = next(chunks)
+        with pq.ParquetWriter(table, first.table.schema) as parquet:
+            parquet.write_table(first.table)
+            for chunk in chunks:
+                parquet.write_table(chunk.table)
     return samples
 
 
