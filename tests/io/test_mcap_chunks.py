@@ -107,24 +107,25 @@ def test_chunks_whose_time_ranges_overlap_are_left_to_rosbags(tmp_path):
         assert mcap_arrays(reader, list(reader.connections)) is None
 
 
-def _index_entry_at(path, topic: str) -> int:
-    """Where in the file the first message index entry (log time, offset) of ``topic`` lies [bytes]."""
+def _bend_index_entry(path, topic: str, bend: str) -> None:
+    """The first message index entry (log time, offset) of ``topic`` in the first chunk made wrong by one: its
+    ``time`` or its ``offset``."""
     with AnyReader([path]) as reader:
         storage = mcap_chunks.mcap_storage(reader)
         (cid,) = mcap_chunks.channel_ids(storage, [c for c in reader.connections if c.topic == topic])
         chunk = min(storage.chunks, key=lambda c: c.chunk_start_offset)
-        return chunk.message_index_offsets[cid] + 15
-
-
-@pytest.mark.parametrize("bend", ["offset", "time"])
-def test_a_chunk_whose_index_does_not_hold_is_walked(bend, tmp_path, monkeypatch):
-    path = _mcap(tmp_path / "x.mcap", _messages(), chunk_size=2048)
-    entry = _index_entry_at(path, "/a")
+        entry = chunk.message_index_offsets[cid] + 15
     with open(path, "r+b") as stream:
         stream.seek(entry)
         log_time, offset = struct.unpack("<QQ", stream.read(16))
         stream.seek(entry)
         stream.write(struct.pack("<QQ", log_time + (bend == "time"), offset + (bend == "offset")))
+
+
+@pytest.mark.parametrize("bend", ["offset", "time"])
+def test_a_chunk_whose_index_does_not_hold_is_walked(bend, tmp_path, monkeypatch):
+    path = _mcap(tmp_path / "x.mcap", _messages(), chunk_size=2048)
+    _bend_index_entry(path, "/a", bend)
     expected = _read(path, "/a", fast=False)
     walked = []
     walk = mcap_chunks._walked
@@ -139,12 +140,7 @@ def test_a_sparse_topic_is_read_where_the_index_says(bend, tmp_path, monkeypatch
     same messages as rosbags reads; an index entry that does not hold: that chunk read whole."""
     path = _mcap(tmp_path / "x.mcap", _messages(n=1200, every=40), chunk_size=2048)
     if bend:
-        entry = _index_entry_at(path, "/b")
-        with open(path, "r+b") as stream:
-            stream.seek(entry)
-            log_time, offset = struct.unpack("<QQ", stream.read(16))
-            stream.seek(entry)
-            stream.write(struct.pack("<QQ", log_time + (bend == "time"), offset + (bend == "offset")))
+        _bend_index_entry(path, "/b", bend)
     expected = _read(path, "/b", fast=False)
     assert len(expected) == 30
     whole = []
