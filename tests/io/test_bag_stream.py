@@ -204,3 +204,30 @@ def test_a_ros1_bag_whose_imu_messages_change_layout_within_a_chunk_reads_as_ros
         np.testing.assert_array_equal(time_s, expected[:, 0])
         np.testing.assert_allclose(gyro, np.degrees(expected[:, 1:4]), rtol=1e-14, atol=0)
         np.testing.assert_allclose(accel, expected[:, 4:7] / 9.80665, rtol=1e-14, atol=0)
+
+
+@pytest.mark.parametrize("read_chunks", [True, False])
+def test_a_bag_stream_opens_its_bag_once_and_closes_it_read_or_not(read_chunks, tmp_path, monkeypatch):
+    """The reader that found the topics and read the temperature reads the chunks too (rosbags' sqlite3 storage
+    counts every topic's messages when it opens: seconds an hour at 1 kHz); closed when the chunks are read, or
+    when a stream is dropped unread."""
+    import gc
+
+    from rosbags.rosbag2.reader import DirectoryReader
+
+    write_bag(tmp_path / "in", n=300, ros2=True)
+    opened = []
+    open_folder = DirectoryReader.open
+    monkeypatch.setattr(DirectoryReader, "open", lambda self: opened.append(1) or open_folder(self))
+    stream = BagStream(tmp_path / "in", chunk_rows=50)
+    reader = stream._reader
+    if read_chunks:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert sum(chunk.recording.n_samples for chunk in stream.chunks()) == 300
+    else:
+        del stream
+        gc.collect()
+    assert len(opened) == 1
+    with pytest.raises(Exception, match="not open"):
+        next(reader.messages())

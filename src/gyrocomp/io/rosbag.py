@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import re
 import warnings
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
@@ -471,8 +472,12 @@ class BagStream:
         try:
             self.imu, self.thermo = chosen_topics(self.path, list(reader.connections), self.options)
             self._temperature = _temperature_samples(self.path, reader, self.thermo) if self.thermo else None
-        finally:
+        except BaseException:
             reader.close()
+            raise
+        # kept open for the first reading of the chunks (an opening can take seconds: rosbags' sqlite3 storage
+        # counts every topic's messages), closed then or when the stream is dropped unread
+        self._reader, self._close_unread = reader, weakref.finalize(self, reader.close)
         self.layout = TableLayout()
         self.text_format = None
         self.gyro_axes, self.accel_axes = GYRO_AXES, ACCEL_AXES
@@ -519,7 +524,11 @@ class BagStream:
         """The IMU topic as :class:`BagChunk` s."""
         if self._temperature is None:
             _warn_no_temperature(self.path, stacklevel=2)
-        reader = _open(self.path)
+        reader, self._reader = self._reader, None
+        if reader is None:
+            reader = _open(self.path)
+        else:
+            self._close_unread.detach()
         held, parts = None, []
         try:
             imu = [c for c in reader.connections if c.topic == self.imu[0].topic]  # this reader's connections
