@@ -287,17 +287,18 @@ def _imu_bytes(bag: Path) -> tuple[Path, np.ndarray]:
     return file, inside
 
 
-@pytest.mark.parametrize("kind", ["ros1", "mcap", "bare mcap"])
+@pytest.mark.parametrize("kind", ["ros1", "mcap", "bare mcap", "ros2"])
 @pytest.mark.parametrize("chunk_rows", [None, 7])
 @pytest.mark.parametrize("window_bytes", [None, 3000])
-def test_a_bag_of_uncompressed_chunks_is_compensated_in_place_as_the_writer_would(
+def test_a_bag_is_compensated_in_place_as_the_writer_would(
     kind, chunk_rows, window_bytes, model_with_accel, tmp_path, monkeypatch
 ):
-    """An uncompressed ROS 1 bag and an MCAP file (a bag folder's, and bare) are copied with each IMU message's
-    values written in place: the output has the input's bytes but for those values (every record, offset and index
-    as it was), and the messages rosbags reads from it are those of the bag written message by message through
-    rosbags' writer, in batches of 7 messages and in windows of bytes too (a batch holding a single IMU message
-    among them), and those of one batch."""
+    """An uncompressed ROS 1 bag, an MCAP file (a bag folder's, and bare) and a bag folder's sqlite3 file are copied
+    with each IMU message's values written in place: a file of chunks has the input's bytes but for those values
+    (every record, offset and index as it was), the sqlite3 file its rows but the IMU messages', and the messages
+    rosbags reads from it are those of the bag written message by message through rosbags' writer, in batches of 7
+    messages and in windows of bytes too (a batch holding a single IMU message among them), and those of one
+    batch; a folder keeps its file's name and its metadata.yaml as they were."""
     import gyrocomp.files.apply_bag as module
 
     options, name, out_name = KINDS[kind]
@@ -315,6 +316,12 @@ def test_a_bag_of_uncompressed_chunks_is_compensated_in_place_as_the_writer_woul
         written = apply_bag(model_with_accel, source, outputs["written"], chunk_rows=chunk_rows or 100_000)
     assert patched.compensated == written.compensated == 401 and patched.accel  # 400 and a repeat
     assert _messages(outputs["patched"]) == _messages(outputs["written"]) == _messages(outputs["one"])
+    assert _messages(source) != _messages(outputs["patched"])
+    if source.is_dir():
+        assert (outputs["patched"] / "metadata.yaml").read_bytes() == (source / "metadata.yaml").read_bytes()
+        assert sorted(p.name for p in outputs["patched"].iterdir()) == sorted(p.name for p in source.iterdir())
+    if kind == "ros2":
+        return
     file, inside = _imu_bytes(source)
     before = file.read_bytes()
     after = (
@@ -322,10 +329,8 @@ def test_a_bag_of_uncompressed_chunks_is_compensated_in_place_as_the_writer_woul
     ).read_bytes()
     assert len(after) == len(before)
     changed = np.flatnonzero(np.frombuffer(before, np.uint8) != np.frombuffer(after, np.uint8))
-    assert changed.size and _messages(source) != _messages(outputs["patched"])
+    assert changed.size
     assert np.all(inside[changed])  # only IMU messages changed: each changed byte lies in an IMU message's data
-    if kind == "mcap":
-        assert (outputs["patched"] / "metadata.yaml").read_bytes() == (source / "metadata.yaml").read_bytes()
 
 
 def _rewritten_with_crcs(source: Path, target: Path) -> Path:

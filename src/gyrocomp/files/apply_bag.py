@@ -22,14 +22,15 @@ stamps go back further than the batch before is compensated from a whole read in
 A ROS 1 bag or an MCAP file (bare, or a bag folder's one file) of uncompressed chunks (what ``rosbag record`` and
 ``ros2 bag record`` in MCAP storage write by default) is not rewritten message by message: its bytes are copied with
 each IMU message's values written in place (:func:`_patched_bag`; a compensated message keeps its length, so every
-record, offset and index stays valid; an MCAP file's CRC-32s are computed anew), the messages batched as above. Any
-other bag goes through rosbags' writer.
+record, offset and index stays valid; an MCAP file's CRC-32s are computed anew), the messages batched as above; a
+bag folder's one sqlite3 file is copied and its IMU rows updated. Any other bag goes through rosbags' writer.
 """
 
 from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import os
 import re
 import shutil
@@ -48,6 +49,7 @@ from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
 from ..io.mcap_chunks import channel_ids, mcap_arrays, mcap_storage
+from ..io.rosbag2_sqlite import sqlite_arrays, sqlite_storage
 from ..io.rosbag1_chunks import lean_writer1
 from ..io.ros_imu import (
     ANGULAR_VELOCITY,
@@ -71,7 +73,7 @@ from ..io.rosbag import (
 from ..io.stream import CHUNK_ROWS, NotStreamable
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
-from .bag_patch import BagCopy, McapCopy, patch_in_batches, uncompressed
+from .bag_patch import BagCopy, McapCopy, SqliteCopy, patch_in_batches, uncompressed
 
 _RAD = unit_factor("gyro", "rad/s")  # deg/s per rad/s
 _MS2 = unit_factor("accel", "m/s2")  # g per m/s^2
@@ -339,18 +341,21 @@ def _copy_in_batches(reader, writer, connections: dict, copiers: dict, chunk_row
 
 
 def _patched_bag(bag: Path, output: Path, copiers: dict, chunk_rows: int) -> bool:
-    """A bag of uncompressed chunks (a ROS 1 bag, or one MCAP file: bare or the storage of a bag folder) compensated
-    in one pass by copying its bytes with each IMU message's values written in place (a compensated message keeps
-    its length, so every record, offset and index stays as it was): the input's chunks, connections and index byte
-    for byte (an MCAP file's CRC-32s computed anew), the IMU messages batched as :func:`_copy_in_batches` does.
-    False (nothing written) for any other bag."""
+    """A bag compensated in one pass by copying it with each IMU message's values written in place (a compensated
+    message keeps its length, so every record, offset and index stays as it was): a ROS 1 bag or one MCAP file (bare
+    or the storage of a bag folder) of uncompressed chunks, the input's chunks, connections and index byte for byte
+    (an MCAP file's CRC-32s computed anew); a bag folder's one sqlite3 file, its rows but the IMU messages' as they
+    were. The IMU messages are batched as :func:`_copy_in_batches` does. False (nothing written) for any other bag."""
     kind = bag_kind(bag)
     with any_reader(bag) as reader:
         imu = [c for c in reader.connections if c.topic in copiers and c.msgtype == IMU_TYPE]
-        place = _ros1_in_place(reader, imu) if kind == "ros1" else _mcap_in_place(bag, reader, imu)
+        if kind == "ros1":
+            place = _ros1_in_place(reader, imu)
+        else:
+            place = _mcap_in_place(bag, reader, imu) or _sqlite_in_place(reader, imu)
         if place is None:
             return False
-        file, arrays, ids, copy_of = place
+        file, arrays, ids, copy_to = place
         limits = (chunk_rows, WINDOW_BYTES, FIRST_SAMPLES)  # read now: the tests make windows smaller
         with staged_bag(output, kind) as target:
             if kind != "ros1":  # a folder: the bag's metadata.yaml as it is, beside its file
@@ -358,18 +363,36 @@ def _patched_bag(bag: Path, output: Path, copiers: dict, chunk_rows: int) -> boo
                 if bag.is_dir():
                     shutil.copyfile(bag / "metadata.yaml", target / "metadata.yaml")
                 target = target / file.name
-            with open(file, "rb") as source, open(target, "wb") as sink:
-                patch_in_batches(reader, arrays, copy_of(source, sink), copiers, ids, limits)
+            with copy_to(file, target) as copy:
+                patch_in_batches(reader, arrays, copy, copiers, ids, limits)
     return True
 
 
+@contextlib.contextmanager
+def _file_copy(make, source_path: Path, target_path: Path):
+    """A :class:`BagCopy` (``make`` with the open source and sink) from ``source_path`` to ``target_path``."""
+    with open(source_path, "rb") as source, open(target_path, "wb") as sink:
+        yield make(source, sink)
+
+
+@contextlib.contextmanager
+def _sqlite_copy(imu, source_path: Path, target_path: Path):
+    """A :class:`SqliteCopy` from ``source_path`` to ``target_path``, rolled back on an error."""
+    copy = SqliteCopy(source_path, target_path, imu)
+    try:
+        yield copy
+    except BaseException:
+        copy.abandon()
+        raise
+
+
 def _ros1_in_place(reader, imu: list):
-    """(the file, its messages as chunk arrays, IMU connection id -> topic, the copy's maker) of a ROS 1 bag
-    whose chunks are uncompressed, else None."""
+    """(the file, its messages as chunk arrays, IMU connection id -> topic, the copy's maker: source and target
+    paths to a context of the copy) of a ROS 1 bag whose chunks are uncompressed, else None."""
     inner = reader.readers[0]
     if not hasattr(inner, "message_arrays") or not uncompressed(inner):
         return None
-    return inner.path, inner.message_arrays(), {c.id: c.topic for c in imu}, BagCopy
+    return inner.path, inner.message_arrays(), {c.id: c.topic for c in imu}, functools.partial(_file_copy, BagCopy)
 
 
 def _mcap_in_place(bag: Path, reader, imu: list):
@@ -391,7 +414,23 @@ def _mcap_in_place(bag: Path, reader, imu: list):
         return None
     ids = {i: c.topic for c in imu for i in channel_ids(storage, [c])}
     data_crc = McapCopy.DATA_END.unpack(record)[2] != 0
-    return file, arrays, ids, lambda source, sink: McapCopy(source, sink, data_end, data_crc)
+    make = functools.partial(_file_copy, lambda source, sink: McapCopy(source, sink, data_end, data_crc))
+    return file, arrays, ids, make
+
+
+def _sqlite_in_place(reader, imu: list):
+    """What :func:`_ros1_in_place` gives, of a ROS 2 bag folder whose one storage file is sqlite3 (messages not
+    compressed): its rows in batches with their row ids (:func:`sqlite_arrays`), else None."""
+    storage = sqlite_storage(reader)
+    if storage is None:
+        return None
+    ids = {i: c.topic for c in imu for i in channel_ids(storage, [c])}
+    return (
+        Path(storage.path),
+        sqlite_arrays(storage, list(reader.connections)),
+        ids,
+        functools.partial(_sqlite_copy, ids),
+    )
 
 
 class _Copier:

@@ -1,11 +1,13 @@
-"""A bag of uncompressed chunks compensated in place: its bytes copied through, each IMU message's values written
-where they lie (:func:`gyrocomp.files.apply_bag.apply_bag`'s way for the bags ``rosbag record`` and ``ros2 bag
-record`` with MCAP storage write by default: a ROS 1 bag, and an MCAP file).
+"""A bag compensated in place: its bytes copied through, each IMU message's values written where they lie
+(:func:`gyrocomp.files.apply_bag.apply_bag`'s way for the bags ``rosbag record`` and ``ros2 bag record`` write by
+default: a ROS 1 bag and an MCAP file of uncompressed chunks, and a ROS 2 sqlite3 file, whose IMU rows are
+updated, :class:`SqliteCopy`).
 
 A compensated message keeps its length, so every record, offset and index of the input stays valid (an MCAP file's
 CRC-32s of a patched chunk and of the data section are written anew where the input has them, :class:`McapCopy`).
 The messages are taken a chunk at a time as arrays (:meth:`ChunkedReader1.message_arrays`,
-:func:`gyrocomp.io.mcap_chunks.mcap_arrays`), held until a batch is due by the same
+:func:`gyrocomp.io.mcap_chunks.mcap_arrays`; a sqlite3 file's rows in batches,
+:func:`gyrocomp.io.rosbag2_sqlite.sqlite_arrays`), held until a batch is due by the same
 rule as a message-by-message pass (a topic holds ``chunk_rows`` IMU messages, or ``window_bytes`` are held and every
 topic's rate is set: its compensator made or ``first_samples`` of its messages held), found for a whole chunk at
 once; a batch's IMU messages of one layout are decoded and written back field by field as arrays, without a Python
@@ -14,6 +16,9 @@ object per message (messages of other layouts go through the copier message by m
 
 from __future__ import annotations
 
+import contextlib
+import shutil
+import sqlite3
 import struct
 import zlib
 
@@ -46,11 +51,12 @@ class BagCopy:
         """Bytes out (any buffer)."""
         self.sink.write(block)
 
-    def chunk(self, data_pos: int, data) -> None:
-        """The input up to a chunk's data as it is, then the chunk's data (patched; any buffer)."""
-        self.through(data_pos)
+    def chunk(self, found, data) -> None:
+        """The input up to a chunk's data as it is (``found``: the chunk's arrays, where its data lie in the file),
+        then the chunk's data (patched; any buffer)."""
+        self.through(found.data_pos)
         self.write(data)
-        self.copied = data_pos + len(data)
+        self.copied = found.data_pos + len(data)
 
     def finish(self) -> None:
         """The rest of the input as it is."""
@@ -90,14 +96,14 @@ class McapCopy(BagCopy):
         self.written += len(block)
         self.sink.write(block)
 
-    def chunk(self, data_pos: int, data) -> None:
-        self.through(data_pos - self.HEAD)
+    def chunk(self, found, data) -> None:
+        self.through(found.data_pos - self.HEAD)
         head = bytearray(self.source.read(self.HEAD))
         if head[:4] != bytes(4):
             head[:4] = struct.pack("<I", zlib.crc32(data))
         self.write(head)
         self.write(data)
-        self.copied = data_pos + len(data)
+        self.copied = found.data_pos + len(data)
 
     def finish(self) -> None:
         self.through(self.data_end)
@@ -107,6 +113,41 @@ class McapCopy(BagCopy):
         self.write(self.DATA_END.pack(op, length, self.crc if crc else 0))
         self.copied = self.data_end + self.DATA_END.size
         self.through()
+
+
+class SqliteCopy:
+    """The output of an in-place compensation of a ROS 2 sqlite3 bag's storage file: the file copied as it is,
+    then each batch's IMU messages (the rows of the topic ids ``imu``) written over their rows by row id, in one
+    transaction without a journal (a compensated message keeps its length; every other row, table and index stays as
+    it was)."""
+
+    def __init__(self, source, target, imu):
+        shutil.copyfile(source, target)
+        self.db = sqlite3.connect(target, isolation_level=None)
+        # no rollback journal and no syncs: the copy is a staged file, moved into place only when complete
+        self.db.execute("PRAGMA journal_mode = OFF")
+        self.db.execute("PRAGMA synchronous = OFF")
+        self.db.execute("BEGIN")
+        self.imu = np.fromiter(imu, dtype=np.int64)
+
+    def chunk(self, found, data) -> None:
+        """A batch's IMU messages from their patched bytes ``data`` (``found``: the batch's arrays with row ids)."""
+        rows = np.flatnonzero(np.isin(found.conn, self.imu))
+        starts, lengths, ids = found.data_at[rows].tolist(), found.data_length[rows].tolist(), found.ids[rows].tolist()
+        self.db.executemany(
+            "UPDATE messages SET data = ? WHERE id = ?",
+            ((data[a : a + n].tobytes(), i) for a, n, i in zip(starts, lengths, ids)),
+        )
+
+    def finish(self) -> None:
+        """Commit and close."""
+        self.db.execute("COMMIT")
+        self.db.close()
+
+    def abandon(self) -> None:
+        """Close after an error part way (the staged copy is then removed, never moved into place)."""
+        with contextlib.suppress(sqlite3.Error):
+            self.db.close()
 
 
 def due_at(
@@ -153,7 +194,7 @@ def patch_in_batches(reader, arrays, copy: BagCopy, copiers: dict, imu: dict, li
     """
     topics = list(copiers)
     ids = {conn: topics.index(topic) for conn, topic in imu.items()}
-    chunks: list = []  # (data_pos, patched copy) of the chunks not yet written, in order
+    chunks: list = []  # (arrays, patched copy) of the chunks not yet written, in order
     held: list = [[] for _ in topics]  # each topic's messages held: (chunk copy, data_at, data_length) pieces
     counts, held_bytes = np.zeros(len(topics), dtype=np.int64), 0
 
@@ -161,13 +202,13 @@ def patch_in_batches(reader, arrays, copy: BagCopy, copiers: dict, imu: dict, li
         for topic, pieces in zip(topics, held):
             if pieces:
                 _write_topic(reader, topic, copiers[topic], pieces)
-        for data_pos, data in chunks[:done]:
-            copy.chunk(data_pos, data)
+        for found, data in chunks[:done]:
+            copy.chunk(found, data)
         del chunks[:done]
 
     for found in arrays:
         data = found.data.copy()
-        chunks.append((found.data_pos, data))
+        chunks.append((found, data))
         topic_of = np.full(found.conn.size, -1, dtype=np.int64)
         for conn, index in ids.items():
             topic_of[found.conn == conn] = index
@@ -221,4 +262,4 @@ def _write_topic(reader, topic: str, copier, pieces: list) -> None:
         data[a : a + n] = np.frombuffer(new, dtype=np.uint8)
 
 
-__all__ = ["BagCopy", "McapCopy", "due_at", "patch_in_batches", "uncompressed"]
+__all__ = ["BagCopy", "McapCopy", "SqliteCopy", "due_at", "patch_in_batches", "uncompressed"]

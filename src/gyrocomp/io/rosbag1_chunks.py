@@ -324,7 +324,8 @@ def _as_indexed(rb, array, data: bytes, offsets, header_length, conns, times) ->
 
 class ChunkArrays(NamedTuple):
     """One chunk's messages as arrays (:meth:`ChunkedReader1.message_arrays`, and an MCAP file's:
-    :func:`gyrocomp.io.mcap_chunks.mcap_arrays`)."""
+    :func:`gyrocomp.io.mcap_chunks.mcap_arrays`; a batch of a sqlite3 bag's rows:
+    :func:`gyrocomp.io.rosbag2_sqlite.sqlite_arrays`)."""
 
     data: np.ndarray  # the decompressed chunk's bytes (uint8)
     data_pos: int  # where the chunk's data lie in the file [bytes] (their place, when uncompressed)
@@ -332,6 +333,7 @@ class ChunkArrays(NamedTuple):
     time: np.ndarray  # each message's time [ns]
     data_at: np.ndarray  # where each message's data start in ``data`` [bytes]
     data_length: np.ndarray  # and their length [bytes]
+    ids: np.ndarray | None = None  # each message's row id (a sqlite3 bag's: :mod:`gyrocomp.io.rosbag2_sqlite`)
 
 
 #: records walked one by one after a run of fewer than this many of one shape, before trying runs again
