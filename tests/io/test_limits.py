@@ -170,3 +170,22 @@ def test_a_table_cut_short_while_it_is_read_is_refused_not_read_shorter(tmp_path
         r"\d+ at its end: still being written, or cut short\); nothing written",
     ):
         list(chunks)
+
+
+def test_a_parquet_file_replaced_while_it_is_read_is_said_to_have_changed_not_to_be_damaged(tmp_path, monkeypatch):
+    """pyarrow opens a Parquet file by path more than once (its metadata, its schema, its table): another program
+    replacing it in between makes the read fail part way ("couldn't deserialize thrift"); the refusal says the file
+    changed, not that it is unreadable."""
+    path = tmp_path / "run.parquet"
+    pq.write_table(pa.table({"time": np.arange(100.0), "gyro_z": np.zeros(100)}), path)
+    read_arrow = tables_module._read_arrow
+
+    def replaced_part_way(*args):
+        other = tmp_path / "other.parquet"
+        pq.write_table(pa.table({"time": np.arange(50.0), "gyro_z": np.ones(50)}), other)
+        os.replace(other, path)  # another program's atomic write lands while the file is read
+        read_arrow(tmp_path / "missing.parquet", *args[1:])  # and the read fails part way
+
+    monkeypatch.setattr(tables_module, "_read_arrow", replaced_part_way)
+    with pytest.raises(InputError, match=r"run.parquet: changed while it was read \(.*\); nothing written from it"):
+        read_table(path)

@@ -470,7 +470,12 @@ def read_table(
     chosen: dict[str, str] = {}
     select = None if channels is None else _channel_selector(tuple(channels), layout, path, chosen)
     opened = os.stat(path) if path.is_file() else None
-    table, text_format = _read_arrow(path, fmt, layout, select)
+    try:
+        table, text_format = _read_arrow(path, fmt, layout, select)
+    except InputError:
+        if opened is not None:  # a file replaced while it was read (opened by path more than once): said so
+            require_unchanged(path, opened)
+        raise
     if opened is not None:
         require_unchanged(path, opened)
     if table.num_rows == 0:
