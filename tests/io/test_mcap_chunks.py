@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from gyrocomp.io import mcap_chunks, rosbag
 from gyrocomp.io.common import ReadOptions
 from gyrocomp.io.mcap_chunks import mcap_arrays
+from gyrocomp.io.rosbag2_storage import channel_ids
 
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
 mcap_writer = pytest.importorskip("mcap.writer", reason="MCAP files need the mcap library")
@@ -112,7 +113,7 @@ def _bend_index_entry(path, topic: str, bend: str) -> None:
     ``time`` or its ``offset``."""
     with AnyReader([path]) as reader:
         storage = mcap_chunks.mcap_storage(reader)
-        (cid,) = mcap_chunks.channel_ids(storage, [c for c in reader.connections if c.topic == topic])
+        (cid,) = channel_ids(storage, [c for c in reader.connections if c.topic == topic])
         chunk = min(storage.chunks, key=lambda c: c.chunk_start_offset)
         entry = chunk.message_index_offsets[cid] + 15
     with open(path, "r+b") as stream:

@@ -48,8 +48,9 @@ from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
 from ..io.atomic import refuse_link
 from ..io.common import require
-from ..io.mcap_chunks import channel_ids, mcap_arrays, mcap_storage
+from ..io.mcap_chunks import mcap_arrays, mcap_storage
 from ..io.rosbag2_sqlite import sqlite_arrays, sqlite_storage
+from ..io.rosbag2_storage import topic_ids
 from ..io.rosbag1_chunks import lean_writer1
 from ..io.ros_imu import (
     ANGULAR_VELOCITY,
@@ -377,7 +378,8 @@ def _file_copy(make, source_path: Path, target_path: Path):
 
 @contextlib.contextmanager
 def _sqlite_copy(imu, source_path: Path, target_path: Path):
-    """A :class:`SqliteCopy` from ``source_path`` to ``target_path``, rolled back on an error."""
+    """A :class:`SqliteCopy` from ``source_path`` to ``target_path``, closed on an error (the staged copy is then
+    removed)."""
     copy = SqliteCopy(source_path, target_path, imu)
     try:
         yield copy
@@ -412,7 +414,7 @@ def _mcap_in_place(bag: Path, reader, imu: list):
     arrays = mcap_arrays(reader, list(reader.connections))
     if arrays is None:
         return None
-    ids = {i: c.topic for c in imu for i in channel_ids(storage, [c])}
+    ids = topic_ids(storage, imu)
     data_crc = McapCopy.DATA_END.unpack(record)[2] != 0
     make = functools.partial(_file_copy, lambda source, sink: McapCopy(source, sink, data_end, data_crc))
     return file, arrays, ids, make
@@ -424,7 +426,7 @@ def _sqlite_in_place(reader, imu: list):
     storage = sqlite_storage(reader)
     if storage is None:
         return None
-    ids = {i: c.topic for c in imu for i in channel_ids(storage, [c])}
+    ids = topic_ids(storage, imu)
     return (
         Path(storage.path),
         sqlite_arrays(storage, list(reader.connections)),

@@ -21,6 +21,7 @@ import shutil
 import sqlite3
 import struct
 import zlib
+from typing import Protocol
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -38,6 +39,17 @@ def uncompressed(reader) -> bool:
         if reader.read_chunk().decompressor is not rb.decompressors["none"]:
             return False
     return True
+
+
+class BagOutput(Protocol):
+    """Where :func:`patch_in_batches` writes a bag: each chunk (or batch of rows) once its IMU messages are
+    compensated, in order, then the rest of the bag (:class:`BagCopy`, :class:`McapCopy`, :class:`SqliteCopy`)."""
+
+    def chunk(self, found, data) -> None:
+        """A chunk's arrays ``found`` with its bytes ``data``, its IMU messages compensated."""
+
+    def finish(self) -> None:
+        """The rest of the bag, after the last chunk."""
 
 
 class BagCopy:
@@ -171,7 +183,7 @@ def due_at(
     return int(np.argmax(due)) if due.any() else None
 
 
-def patch_in_batches(reader, arrays, copy: BagCopy, copiers: dict, imu: dict, limits: tuple[int, int, int]) -> None:
+def patch_in_batches(reader, arrays, copy: BagOutput, copiers: dict, imu: dict, limits: tuple[int, int, int]) -> None:
     """Every message of the bag in its order, a chunk at a time, held until a batch is due (:func:`due_at`); at
     each batch each topic's IMU messages are compensated by its copier and written into their chunk's copy, and
     every chunk whose messages are all done goes out.
@@ -182,7 +194,7 @@ def patch_in_batches(reader, arrays, copy: BagCopy, copiers: dict, imu: dict, li
         rosbags' reader of the bag.
     arrays : iterable of ChunkArrays
         Every message of the bag, chunk by chunk as arrays, in the order of ``reader.messages()``.
-    copy : BagCopy
+    copy : BagOutput
         Where the bag goes.
     copiers : dict
         Each compensated topic's copier (``comp``, ``compensated(reader, raws)``, ``compensated_fields(stamp_s,
@@ -262,4 +274,4 @@ def _write_topic(reader, topic: str, copier, pieces: list) -> None:
         data[a : a + n] = np.frombuffer(new, dtype=np.uint8)
 
 
-__all__ = ["BagCopy", "McapCopy", "SqliteCopy", "due_at", "patch_in_batches", "uncompressed"]
+__all__ = ["BagCopy", "BagOutput", "McapCopy", "SqliteCopy", "due_at", "patch_in_batches", "uncompressed"]

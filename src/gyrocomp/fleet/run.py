@@ -54,13 +54,13 @@ from ..threads import single_threaded_blas
 from .unit_figures import REFERENCE_TEMPERATURE_DEGC, UnitFigures, unit_figures
 from .limits import Limits
 from .population import fleet_table
-
-if TYPE_CHECKING:
-    import pandas as pd
 from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
 from .stations import Station, claim, release, station as running_as
 from .devices import UnitRuns, content_hash, input_hash
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 MODELS_FOLDER = "models"
 FLEET_TABLE = "fleet.parquet"

@@ -39,6 +39,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from .common import require
 from .rosbag1_chunks import ChunkArrays
+from .rosbag2_storage import channel_ids, one_storage
 
 _MESSAGE, _CHUNK, _MESSAGE_INDEX = 0x05, 0x06, 0x07
 #: a message record's bytes before its data: opcode, length, channel id, sequence, log time, publish time
@@ -61,32 +62,13 @@ def mcap_storage(reader):
     """The rosbags MCAP reader of the one MCAP file under an open :class:`rosbags.highlevel.AnyReader` (a ROS 2 bag
     folder holding one MCAP file, or a bare ``.mcap``) whose summary indexes its chunks; None for any other bag
     (ROS 1, sqlite3, several files, messages compressed one by one, no chunk index)."""
-    readers = getattr(reader, "readers", ())
-    if not getattr(reader, "is2", False) or len(readers) != 1:
+    found = one_storage(reader)
+    if found is None or (found[1] is not None and found[1].compression_mode == "message"):
         return None
-    storage = readers[0].storage
-    directory = require("rosbags.rosbag2.reader", "ros", "reading ROS 2 bags").DirectoryReader
-    if isinstance(storage, directory):
-        if len(storage.storages) != 1 or storage.metadata.compression_mode == "message":
-            return None
-        storage = storage.storages[0]
+    storage = found[0]
     if not isinstance(storage, _storage_mcap().McapReader) or storage.bio is None or not storage.chunks:
         return None
     return storage
-
-
-def channel_ids(storage, connections) -> set[int]:
-    """The file's channel ids of ``connections`` (a bag folder's connections come from its ``metadata.yaml``: they
-    are matched to the file's channels as rosbags matches them, by topic, type, serialization and digest)."""
-    return {
-        x.id
-        for x in storage.connections
-        for y in connections
-        if y.topic == x.topic
-        and y.msgtype == x.msgtype
-        and y.ext == x.ext
-        and (not x.digest or not y.digest or y.digest == x.digest)
-    }
 
 
 def mcap_arrays(reader, connections) -> Iterator[ChunkArrays] | None:
@@ -309,4 +291,4 @@ def _walked(data: np.ndarray):
     )
 
 
-__all__ = ["channel_ids", "mcap_arrays", "mcap_storage"]
+__all__ = ["mcap_arrays", "mcap_storage"]

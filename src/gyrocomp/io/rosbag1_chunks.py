@@ -129,8 +129,7 @@ def _indexed_messages(self, rb, chunk, connections: int, connmap: dict, wanted: 
         return None
     for conn, entries in index:
         if conn in wanted:
-            times = entries["sec"].astype(np.int64) * 1_000_000_000 + entries["nsec"]
-            found += [(int(o), conn, int(t)) for o, t in zip(entries["offset"].tolist(), times.tolist())]
+            found += [(int(o), conn, int(t)) for o, t in zip(entries["offset"].tolist(), _times(entries).tolist())]
     try:
         messages = []
         for offset, conn, time in sorted(found):  # the chunk's order
@@ -246,6 +245,11 @@ def _index_entries(self, rb, connections: int) -> list | None:
     return out
 
 
+def _times(entries: np.ndarray) -> np.ndarray:
+    """Index entries' times [ns] from their sec and nsec."""
+    return entries["sec"].astype(np.int64) * 1_000_000_000 + entries["nsec"]
+
+
 def _located(rb, data: bytes, index: list) -> tuple | None:
     """A chunk's records found where its index data say the messages lie instead of walked: (header start, header
     length, data start, data length, op, conn, time [ns]) of each record in the chunk's order, as :func:`_records`
@@ -255,7 +259,7 @@ def _located(rb, data: bytes, index: list) -> tuple | None:
     try:
         offsets = np.concatenate([e["offset"] for _, e in index]).astype(np.int64)
         conns = np.concatenate([np.full(e.size, c, dtype=np.int64) for c, e in index])
-        times = np.concatenate([e["sec"].astype(np.int64) * 1_000_000_000 + e["nsec"] for _, e in index])
+        times = np.concatenate([_times(e) for _, e in index])
         order = np.argsort(offsets, kind="stable")
         offsets, conns, times = offsets[order], conns[order], times[order]
         size, array = len(data), np.frombuffer(data, dtype=np.uint8)

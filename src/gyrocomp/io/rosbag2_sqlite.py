@@ -15,8 +15,8 @@ from itertools import islice
 import numpy as np
 
 from .common import require
-from .mcap_chunks import channel_ids
 from .rosbag1_chunks import ChunkArrays
+from .rosbag2_storage import channel_ids, one_storage
 
 #: messages of a sqlite3 bag taken at once (about 20 MB of IMU messages)
 SQLITE_ROWS = 65536
@@ -24,18 +24,13 @@ SQLITE_ROWS = 65536
 
 def sqlite_storage(reader):
     """The rosbags sqlite3 reader (open) of the one storage file of the ROS 2 bag folder an open
-    :class:`~rosbags.highlevel.AnyReader` reads, with the path of that file as it lies in the folder; None for any
-    other bag (ROS 1, MCAP, several files, messages compressed one by one or the file compressed whole)."""
-    readers = getattr(reader, "readers", ())
-    if not getattr(reader, "is2", False) or len(readers) != 1:
+    :class:`~rosbags.highlevel.AnyReader` reads; None for any other bag (ROS 1, MCAP, several files, messages
+    compressed one by one or the file compressed whole)."""
+    found = one_storage(reader)
+    if found is None or found[1] is None or found[1].compression_mode:
         return None
-    storage = readers[0].storage
-    directory = require("rosbags.rosbag2.reader", "ros", "reading ROS 2 bags").DirectoryReader
     sqlite = require("rosbags.rosbag2.storage_sqlite3", "ros", "reading ROS 2 bags").Sqlite3Reader
-    if not isinstance(storage, directory) or storage.metadata.compression_mode or len(storage.storages) != 1:
-        return None
-    found = storage.storages[0]
-    return found if isinstance(found, sqlite) and found.dbconn is not None else None
+    return found[0] if isinstance(found[0], sqlite) and found[0].dbconn is not None else None
 
 
 def sqlite_arrays(storage, connections, rows: int = SQLITE_ROWS) -> Iterator[ChunkArrays]:
