@@ -36,6 +36,23 @@ def test_import_and_help_do_not_load_numpy_scipy_or_pandas():
     assert run("--version").stdout.startswith("gyrocomp, version")
 
 
+def test_each_command_starts_without_scipy_pandas_or_matplotlib():
+    """A command's module (what ``gyrocomp CMD --help`` or a run imports before any work) loads none of them:
+    scipy alone took 0.15 s of every command's start (its array API layer imports numpy.testing and f2py), so it
+    is imported where it is used. The fleet's commands open a store (SQLAlchemy) and build tables (pandas)."""
+    code = (
+        "import click, sys; from gyrocomp.cli import cli, COMMANDS; ctx = click.Context(cli)\n"
+        "for name in COMMANDS:\n"
+        "    seen = set(sys.modules); cli.get_command(ctx, name)\n"
+        "    heavy = {m.split('.')[0] for m in set(sys.modules) - seen} & {'scipy', 'pandas', 'matplotlib'}\n"
+        "    print(name, *sorted(heavy))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    loaded = {name: rest for name, *rest in map(str.split, out.splitlines())}
+    assert set(loaded) == set(COMMANDS)
+    assert {name: heavy for name, heavy in loaded.items() if heavy} == {"fleet": ["pandas"]}
+
+
 def test_every_public_name_resolves_and_simulate_stays_the_function():
     for name in gyrocomp.__all__:
         assert getattr(gyrocomp, name) is not None, name

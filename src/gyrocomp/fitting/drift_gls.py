@@ -29,7 +29,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 #: the most points a test should be computed on (each recording's covariance is dense): average longer
 #: series over consecutive blocks first (:func:`coarsen`)
@@ -140,6 +139,8 @@ def covariance(t_s: np.ndarray, noise: DriftNoise) -> np.ndarray:
 def whitened(x: np.ndarray, y: np.ndarray, t_s: np.ndarray, noise: DriftNoise) -> tuple[np.ndarray, np.ndarray]:
     """``x`` (n, p) and ``y`` (n,) of one recording multiplied by the inverse Cholesky factor of its
     :func:`covariance`: ordinary least squares on the result is GLS."""
+    import scipy.linalg  # slow to import (0.1 s with scipy's array API layer): not at every command's start
+
     chol = scipy.linalg.cholesky(covariance(t_s, noise), lower=True, overwrite_a=True, check_finite=False)
     from_left = scipy.linalg.solve_triangular(chol, np.column_stack([x, y]), lower=True, check_finite=False)
     return from_left[:, :-1], from_left[:, -1]

@@ -6,8 +6,6 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any, Literal
 
-from scipy.special import ndtri
-
 from ...errors import InputError
 from ...motion.stillness import MIN_BLOCK_SAMPLES
 
@@ -176,6 +174,8 @@ class LearnerSettings:
     def z_values(self) -> dict[str, float]:
         """The normal quantiles of the tests: the noise quantile's, and the variance and step tests' with three
         channels (gyro only) and six (gyro and accelerometer)."""
+        from scipy.special import ndtri  # scipy.special takes 0.1 s to import: not at every command's start
+
         out = {"noise": float(ndtri(self.noise_quantile))}
         for channels in (3, 6):
             per_test = self.alpha / channels
