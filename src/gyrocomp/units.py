@@ -7,6 +7,7 @@ Readers and CLI options convert to these with the factors below; writers convert
 from __future__ import annotations
 
 import math
+import re
 from typing import Literal, get_args
 
 from .errors import InputError
@@ -77,21 +78,44 @@ DEG_PER_S_TO_DEG_PER_H = 3600.0
 DEG_PER_S_PER_SQRT_S_TO_DEG_PER_H_PER_SQRT_H = 3600.0 * 60.0
 
 
+#: an example of a scaled unit per kind, for messages
+_EXAMPLE_SCALED = {"gyro": "1/131 deg/s", "accel": "1/16384 g", "time": "10 ms"}
+#: a scaled unit: one file unit is a number (or a fraction) of a named unit, "1/131 deg/s", "0.061 mg", "10 ms"
+_SCALED_UNIT = re.compile(
+    r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)(?:\s*/\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?))?\s+(\S+)\s*$"
+)
+
+
 def unit_factor(kind: str, unit: str, option: str | None = None) -> float:
     """Factor that converts a value in ``unit`` to gyrocomp's internal unit for ``kind``.
+
+    A unit is a name (``"rad/s"``) or a scaled name: a number or a fraction, a space, a name, meaning that one unit
+    of the file is that much of the named unit. Raw counts are read so: an MPU-6050 at +-250 deg/s gives 131 counts
+    per deg/s, ``"1/131 deg/s"``; its accelerometer at +-2 g 16384 counts per g, ``"1/16384 g"``; a sample counter
+    at 100 Hz is a time in ``"10 ms"``.
 
     Parameters
     ----------
     kind : {"gyro", "accel", "time"}
     unit : str
-        Unit name as a user writes it, e.g. ``"rad/s"``.
+        Unit as a user writes it, e.g. ``"rad/s"`` or ``"1/131 deg/s"``.
     option : str, optional
         The parameter the unit came from (``gyro_unit`` ...), named in the error message.
     """
     tables = {"gyro": GYRO_UNITS_TO_DPS, "accel": ACCEL_UNITS_TO_G, "time": TIME_UNITS_TO_S}
     table = tables[kind]
-    try:
-        return table[unit.strip()]
-    except KeyError:
-        where = option or f"{kind}_unit"
-        raise InputError(f"{where}: unknown unit {unit!r}; use one of {', '.join(sorted(table))}") from None
+    where = option or f"{kind}_unit"
+    name, scale = unit.strip(), 1.0
+    scaled = _SCALED_UNIT.match(unit)
+    if scaled is not None:
+        numerator, denominator, name = scaled.groups()
+        bottom = float(denominator or 1.0)
+        scale = float(numerator) / bottom if bottom > 0 else math.inf
+        if not (math.isfinite(scale) and scale > 0):
+            raise InputError(f"{where}: {unit!r} scales its unit by {scale:g}; a scale is a positive number")
+    if name not in table:
+        raise InputError(
+            f"{where}: unknown unit {unit!r}; use one of {', '.join(sorted(table))}, or one scaled, "
+            f"such as {_EXAMPLE_SCALED[kind]!r} (raw counts)"
+        )
+    return scale * table[name]

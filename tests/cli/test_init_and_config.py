@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError
 from gyrocomp.io.guess import guess_layout
 
@@ -198,7 +199,45 @@ def test_guessing_from_names_and_magnitudes(tmp_path):
     )
     guess = guess_layout(named)
     assert guess.layout.gyro_unit == "rad/s" and guess.layout.time_unit == "s"
-    assert guess.unused == ("ax", "ay", "az")
+    assert guess.unused == () and guess.layout.columns["accel_y"] == "ay"  # a two-letter name: channel and axis
+    assert guess.layout.accel_unit == "g"
     (tmp_path / "bad.csv").write_text("a,b\n1,2\n2,1\n3,5\n")
     with pytest.raises(InputError, match=r"bad.csv: no column looks like a gyro axis"):
         guess_layout(tmp_path / "bad.csv")
+
+
+def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
+    """An Arduino sketch's MPU-6050 log: metadata lines, then ax..gz in raw counts without time. The
+    accelerometer's norm at rest (16384 counts) is near 1 g in no unit: raw counts, 1/16384 g, an InvenSense part's
+    power-on range, whose gyro then counts 131 per deg/s; a norm of no power of two leaves the gyro's scale to the
+    user, in deg/s with a reason that says so."""
+    rng = np.random.default_rng(1)
+    n = 500
+    accel = np.array([300.0, -200.0, 16300.0]) + rng.normal(0, 30, (n, 3))
+    gyro = np.array([-430.0, 146.0, -66.0]) + rng.normal(0, 12, (n, 3))
+    body = "\n".join(",".join(str(int(round(v))) for v in row) for row in np.column_stack([accel, gyro]))
+    preamble = "Fs,100\nLogging Type,1\nInitialization time,-1\nWaiting time,-1\n"
+    (tmp_path / "mpu.csv").write_text(preamble + "ax,ay,az,gx,gy,gz\n" + body + "\n")
+    with pytest.raises(InputError, match=r"no column looks like the time .*\(rate_hz=50\)"):
+        guess_layout(tmp_path / "mpu.csv")
+    guess = guess_layout(tmp_path / "mpu.csv", rate_hz=100.0)
+    assert (guess.layout.accel_unit, guess.layout.gyro_unit) == ("1/16384 g", "1/131 deg/s")
+    assert guess.layout.columns == {
+        "accel_x": "ax",
+        "accel_y": "ay",
+        "accel_z": "az",
+        "gyro_x": "gx",
+        "gyro_y": "gy",
+        "gyro_z": "gz",
+    }
+    assert any("raw counts, 1/16384 g" in r and "check the part's range" in r for r in guess.reasons)
+    assert run("init", "mpu.csv", "--rate", "100", cwd=tmp_path).returncode == 0
+    allan = run("allan", "mpu.csv", "--json", cwd=tmp_path)
+    assert allan.returncode == 0, allan.stderr
+    expected = allan_deviation(np.round(gyro[:, 0]) / 131.0, 100.0).deviation
+    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_x"]["adev"], expected, rtol=1e-9)
+    odd_body = "\n".join(",".join(str(int(round(v))) for v in row) for row in np.column_stack([0.75 * accel, gyro]))
+    (tmp_path / "odd.csv").write_text(preamble + "ax,ay,az,gx,gy,gz\n" + odd_body + "\n")  # 12,200 per g
+    odd = guess_layout(tmp_path / "odd.csv", rate_hz=100.0)
+    assert odd.layout.accel_unit == "1/12200 g" and odd.layout.gyro_unit == "deg/s"
+    assert any("the gyro's scale cannot be told at rest" in r for r in odd.reasons)

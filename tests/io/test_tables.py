@@ -3,6 +3,7 @@ import lzma
 import math
 import os
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -20,9 +21,13 @@ from gyrocomp.io import (
     write_gyro_back,
     write_recording,
 )
+from gyrocomp.io.guess import guess_layout
+from gyrocomp.io.stream import TableStream
+from gyrocomp.io.tables import TextFormat, preamble_lines
 from gyrocomp.simulation import GyroErrorModel, simulate
+from gyrocomp.units import unit_factor
 
-from ..conftest import run
+from ..conftest import run, shared_dataset
 
 
 def write_csv(path, text):
@@ -404,3 +409,112 @@ def test_names_that_say_the_project_units_are_read_without_a_mapping(tmp_path):
     both = tmp_path / "both.csv"
     both.write_text("time,gyro_x,gyro_x_dps\n" + "".join(f"{t},1.0,2.0\n" for t in range(5)))
     np.testing.assert_allclose(read(both).gyro_dps[:, 0], 1.0)
+
+
+def _mpu_log(path, counts: np.ndarray, preamble: str = "Fs,100\nLogging Type,1\n\nInitialization time,-1\n") -> Path:
+    """A raw MPU-6050 log as an Arduino sketch writes it: metadata lines, then ax..gz in counts, no time."""
+    body = "\n".join(",".join(str(int(v)) for v in row) for row in counts)
+    path.write_text(preamble + "ax,ay,az,gx,gy,gz\n" + body + "\n")
+    return path
+
+
+def test_a_preamble_before_the_header_is_skipped_whole_and_in_chunks_with_raw_counts_scaled(tmp_path):
+    """A logger's metadata lines before the header (a different number of fields than the table's) are skipped,
+    whole and streamed; raw counts are read in a scaled unit (131 counts per deg/s, 16384 per g); a value that is
+    no number names its row and its line in the file; an output written back has no preamble."""
+    rng = np.random.default_rng(3)
+    counts = np.column_stack(
+        [rng.integers(-300, 300, (40, 2)), 16384 + rng.integers(-50, 50, 40), rng.integers(-500, 500, (40, 3))]
+    )
+    path = _mpu_log(tmp_path / "mpu.csv", counts)
+    layout = TableLayout(
+        parse_column_mapping("accel_x=ax,accel_y=ay,accel_z=az,gyro_x=gx,gyro_y=gy,gyro_z=gz"),
+        gyro_unit="1/131 deg/s",
+        accel_unit="1/16384 g",
+        rate_hz=100.0,
+    )
+    data = read_table(path, layout)
+    assert data.text_format.preamble_lines == 4  # the header on line 5
+    np.testing.assert_array_equal(data.recording.gyro_dps, counts[:, 3:] * (1.0 / 131.0))
+    np.testing.assert_array_equal(data.recording.accel_g, counts[:, :3] * (1.0 / 16384.0))
+    np.testing.assert_array_equal(data.recording.time_s, np.arange(40) / 100.0)
+    chunks = list(TableStream(path, layout, chunk_rows=7).chunks())
+    np.testing.assert_array_equal(np.concatenate([c.recording.gyro_dps for c in chunks]), data.recording.gyro_dps)
+    np.testing.assert_array_equal(np.concatenate([c.recording.accel_g for c in chunks]), data.recording.accel_g)
+    write_gyro_back(data, data.recording.gyro_dps + 1.0, tmp_path / "out.csv")
+    assert (tmp_path / "out.csv").read_text().startswith("ax,ay,az,gx,gy,gz\n")
+    back = read_table(tmp_path / "out.csv", layout)
+    assert back.text_format.preamble_lines == 0
+    np.testing.assert_allclose(back.recording.gyro_dps, data.recording.gyro_dps + 1.0, rtol=1e-12)
+    # the values quoted, the 30th row's gx not a number: row 30, on line 5 + 30 (whole; streamed, in the fifth chunk)
+    lines = path.read_text().splitlines()
+    for i in range(5, len(lines)):
+        lines[i] = '"' + lines[i].replace(",", '","') + '"'
+    lines[4 + 30] = lines[4 + 30].replace(lines[4 + 30].split(",")[3], '"x"', 1)
+    path.write_text("\n".join(lines) + "\n")
+    for reading in (lambda: read_table(path, layout), lambda: list(TableStream(path, layout, chunk_rows=7).chunks())):
+        with pytest.raises(InputError, match=r"mpu.csv: row 30 \(line 35\), column 'gx': 'x' is not a number"):
+            reading()
+
+
+@pytest.mark.parametrize(
+    "text,skipped",
+    [
+        ("time,gyro_z\n0,1\n1,2\n2,3\n", 0),  # no preamble
+        ("# logger v2\n# started 12:00\ntime,gyro_z\n0,1\n1,2\n2,3\n", 2),  # comment lines, one field each
+        ("Fs;100\n\ntime;gyro_x;gyro_z\n0;1,5;2\n1;2,5;3\n2;3,5;4\n", 2),  # semicolons, a decimal comma
+        ("Fs,100\n0,1,2\n1,2,3\n2,3,4\n", 0),  # numbers after the preamble: a log without a header line
+        ("device,X\ntime,gyro_z\n0,1\n", 0),  # too few rows to tell: the first line is the header
+    ],
+)
+def test_preamble_lines_are_those_before_the_first_line_that_splits_as_the_table(tmp_path, text, skipped):
+    found = TextFormat.found(text.encode(), TableLayout())
+    assert preamble_lines(text.encode(), found.delimiter) == skipped == found.preamble_lines
+    if skipped and ";" in text:
+        assert found.decimal == ","
+        rec = read(write_csv(tmp_path / "p.csv", text))
+        np.testing.assert_array_equal(rec.gyro_dps, [[1.5, 2], [2.5, 3], [3.5, 4]])
+
+
+@pytest.mark.parametrize(
+    "kind,unit,factor",
+    [
+        ("gyro", "1/131 deg/s", 1 / 131),
+        ("gyro", "0.00875 deg/s", 0.00875),
+        ("gyro", "2.5e-2 rad/s", 2.5e-2 * 180 / math.pi),
+        ("accel", "1/16384 g", 1 / 16384),
+        ("accel", "0.061 mg", 0.061e-3),
+        ("time", "10 ms", 0.01),
+    ],
+)
+def test_scaled_units_read_raw_counts(kind, unit, factor):
+    assert unit_factor(kind, unit) == pytest.approx(factor, rel=1e-15)
+
+
+@pytest.mark.parametrize(
+    "unit,message",
+    [
+        ("0 deg/s", r"gyro_unit: '0 deg/s' scales its unit by 0; a scale is a positive number"),
+        ("1/0 deg/s", r"gyro_unit: '1/0 deg/s' scales its unit by inf"),
+        ("1/131 furlong", r"gyro_unit: unknown unit '1/131 furlong'; use one of .*'1/131 deg/s' \(raw counts\)"),
+        ("131", r"gyro_unit: unknown unit '131'"),
+    ],
+)
+def test_a_bad_scaled_unit_is_one_line(tmp_path, unit, message):
+    p = write_csv(tmp_path / "u.csv", "time,gyro_z\n0,2\n1,4\n")
+    with pytest.raises(InputError, match=message):
+        read(p, TableLayout(gyro_unit=unit))
+
+
+def test_a_real_mpu6050_log_with_its_preamble_is_read_as_its_counts_scaled():
+    """../shared/datasets/tomisuarez2-mpu6050 (its README: four metadata lines, the header ax..gz, raw counts at
+    100 Hz, 131 counts per deg/s and 16384 per g): the layout gyrocomp init guesses reads the values numpy.loadtxt
+    reads with the README's skiprows, times the README's scales."""
+    path = shared_dataset("tomisuarez2-mpu6050") / "imu_static_test.csv"
+    guess = guess_layout(path, rate_hz=100.0)
+    assert (guess.layout.gyro_unit, guess.layout.accel_unit) == ("1/131 deg/s", "1/16384 g")
+    recording = read_table(path, guess.layout).recording
+    counts = np.loadtxt(path, delimiter=",", skiprows=5)
+    np.testing.assert_array_equal(recording.gyro_dps, counts[:, 3:] * (1.0 / 131.0))
+    np.testing.assert_array_equal(recording.accel_g, counts[:, :3] * (1.0 / 16384.0))
+    np.testing.assert_array_equal(recording.time_s, np.arange(len(counts)) / 100.0)

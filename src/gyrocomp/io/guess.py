@@ -29,7 +29,7 @@ from .tables import (
     check_parquet_footer,
     detect_table_format,
     read_error,
-    sniff_csv,
+    TextFormat,
 )
 
 #: rows read to guess from
@@ -80,9 +80,15 @@ def _axis(name: str) -> str | None:
     return words[-1][-1] if words and len(words[-1]) > 1 and words[-1][-1] in "xyz" else None
 
 
+#: a name of two letters, a channel's and an axis's (``gx``, ``wz``, ``ay``: an Arduino sketch's), its kind
+_SHORT_KINDS = {"g": "gyro", "w": "gyro", "a": "accel"}
+
+
 def _kind(name: str) -> str | None:
     words = _words(name)
     joined = "".join(words)
+    if len(joined) == 2 and joined[0] in _SHORT_KINDS and joined[1] in "xyz":
+        return _SHORT_KINDS[joined[0]]
     if any(w.startswith("temp") or w == "tmp" for w in words) or joined.startswith("temp"):
         return "temperature"
     if any(w.startswith("gyr") or w in ("omega", "rate", "angular", "gyro") for w in words):
@@ -133,13 +139,14 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
     headerless = _headerless_rows(head[:4096])
     if headerless is not None:
         raise HeaderlessTable(path, *headerless)
-    delimiter, decimal = sniff_csv(head[:4096])
+    text = TextFormat.found(head[:4096], TableLayout())
     batches, rows = [], 0
     try:
         reader = pacsv.open_csv(
             source,
-            parse_options=pacsv.ParseOptions(delimiter=delimiter),
-            convert_options=pacsv.ConvertOptions(decimal_point=decimal),
+            read_options=text.read_options(),
+            parse_options=pacsv.ParseOptions(delimiter=text.delimiter),
+            convert_options=pacsv.ConvertOptions(decimal_point=text.decimal),
         )
         for batch in reader:
             batches.append(batch)
@@ -148,7 +155,7 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
                 break
     except DECOMPRESS_ERRORS as exc:
         raise read_error(path, exc, head) from None
-    return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), delimiter
+    return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), text.delimiter
 
 
 def _numbers(table: pa.Table, column: str) -> np.ndarray | None:
@@ -207,7 +214,8 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
     if time_name is None:
         raise InputError(
             f"{path}: no column looks like the time (named time or timestamp, or only increasing); "
-            "name it with columns= time=NAME, or give the rows' sample rate (rate_hz=50)"
+            "give the rows' sample rate (rate_hz=50), or map the time column in a project file's [read.columns] "
+            '(time = "NAME")'
         )
     return {"time": time_name, **columns}, reasons
 
@@ -227,8 +235,31 @@ def _accel_unit(table: pa.Table, columns: dict[str, str]) -> tuple[str, str]:
         if len(accel) == 3
         else float(np.max(np.abs(np.concatenate(accel))))
     )
-    unit = min(_ACCEL_NORMS, key=lambda u: abs(np.log(max(norm, 1e-12) / u[1])))[0]
-    return unit, f"accelerometer in {unit}: its {'norm' if len(accel) == 3 else 'largest value'} at rest is {norm:.3g}"
+    what = "norm" if len(accel) == 3 else "largest value"
+    unit, size = min(_ACCEL_NORMS, key=lambda u: abs(np.log(max(norm, 1e-12) / u[1])))
+    if norm > _COUNTS_MIN and abs(np.log(norm / size)) > np.log(_COUNTS_RATIO):
+        per_g = _counts_per_g(norm)
+        return f"1/{per_g:g} g", (
+            f"accelerometer in raw counts, 1/{per_g:g} g: its {what} at rest is {norm:.5g}, near 1 g in no unit "
+            "(check the part's range)"
+        )
+    return unit, f"accelerometer in {unit}: its {what} at rest is {norm:.3g}"
+
+
+#: an accelerometer's norm at rest farther than this factor from 1 g in every unit, and above _COUNTS_MIN (a 10-bit
+#: part over +-16 g counts 32 per g; a norm of a few g is a log that moves, not counts), is in raw counts
+_COUNTS_RATIO = 1.5
+_COUNTS_MIN = 20.0
+#: the counts per g of an InvenSense part at its power-on range (+-2 g), whose gyro then counts 131 per deg/s
+#: (+-250 deg/s): MPU-6050, MPU-9250, ICM-20600 family
+_INVENSENSE_DEFAULT_PER_G, _INVENSENSE_DEFAULT_PER_DPS = 16384, 131
+
+
+def _counts_per_g(norm: float) -> float:
+    """The counts per g of a raw accelerometer whose norm at rest is ``norm``: the nearest power of two (the full
+    scale of an ADC over a range of 2, 4, 8 or 16 g) when within 10 %, else the norm rounded to 3 digits."""
+    power = 2.0 ** round(np.log2(norm))
+    return power if abs(norm / power - 1.0) < 0.1 else float(f"{norm:.3g}")
 
 
 #: the largest median |gyro| over all axes [deg/s] a gyro in deg/s gives while still or turning about one axis (the
@@ -244,6 +275,17 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
         return "mdps", "gyro in mdps: the column's name says so"
     if words & {"dps", "deg", "degs"}:
         return "deg/s", "gyro in deg/s: the column's name says so"
+    if accel_unit == f"1/{_INVENSENSE_DEFAULT_PER_G} g":
+        return f"1/{_INVENSENSE_DEFAULT_PER_DPS} deg/s", (
+            f"gyro in raw counts, 1/{_INVENSENSE_DEFAULT_PER_DPS} deg/s: the accelerometer counts "
+            f"{_INVENSENSE_DEFAULT_PER_G} per g, an InvenSense part's power-on range (+-2 g), where its gyro "
+            f"counts {_INVENSENSE_DEFAULT_PER_DPS} per deg/s (+-250 deg/s; check the part's range)"
+        )
+    if accel_unit.startswith("1/"):
+        return "deg/s", (
+            "gyro in deg/s: the default, but the accelerometer is in raw counts: the gyro's scale cannot be told at "
+            f"rest; give the part's (gyro-unit = '1/{_INVENSENSE_DEFAULT_PER_DPS} deg/s' for 131 counts per deg/s)"
+        )
     gyro = [_numbers(table, columns[c]) for c in columns if c.startswith("gyro_")]
     typical = float(np.median(np.abs(np.concatenate(gyro)))) if all(g is not None and g.size for g in gyro) else 0.0
     if typical > _MAX_REST_DPS:

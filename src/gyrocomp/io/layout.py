@@ -98,9 +98,11 @@ class TableLayout:
         ),
         default_factory=dict,
     )
-    gyro_unit: str = spelled(Spelling("--gyro-unit", "deg/s, rad/s or mdps."), default="deg/s")
-    accel_unit: str = spelled(Spelling("--accel-unit", "g, mg or m/s2."), default="g")
-    time_unit: str = spelled(Spelling("--time-unit", "s, ms, us or ns."), default="s")
+    gyro_unit: str = spelled(
+        Spelling("--gyro-unit", "deg/s, rad/s or mdps; raw counts scaled: '1/131 deg/s'."), default="deg/s"
+    )
+    accel_unit: str = spelled(Spelling("--accel-unit", "g, mg or m/s2; raw counts scaled: '1/16384 g'."), default="g")
+    time_unit: str = spelled(Spelling("--time-unit", "s, ms, us or ns; a counter scaled: '10 ms'."), default="s")
     delimiter: str | None = spelled(
         Spelling(
             "--delimiter",

@@ -28,11 +28,11 @@ from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (
-    CSV_BLOCK_BYTES,
     DECOMPRESS_ERRORS,
     HEADER_MAX_BYTES,
     TableLayout,
     TextFormat,
+    header_line,
     _channel_selector,
     _csv_options,
     _read_arrow,
@@ -154,10 +154,7 @@ class TableStream:
                     strings_can_be_null=True, decimal_point=self.text_format.decimal, include_columns=self._read or []
                 )
                 reader = pacsv.open_csv(
-                    source,
-                    read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
-                    parse_options=parse,
-                    convert_options=convert,
+                    source, read_options=self.text_format.read_options(), parse_options=parse, convert_options=convert
                 )
             except DECOMPRESS_ERRORS as exc:
                 raise read_error(self.path, exc, head) from None
@@ -228,6 +225,7 @@ class TableStream:
                     self.fmt,
                     drop_nonfinite=self.drop_nonfinite,
                     first_row=first,
+                    header_line=header_line(self.text_format),
                 )
             self.rows_dropped += table.num_rows - kept.size
             time_s = recording.time_s

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import csv
+import dataclasses
 import lzma
 import os
 import warnings
@@ -41,16 +43,32 @@ class TableData:
 @dataclass(frozen=True)
 class TextFormat:
     """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;`` or a
-    tab; ``decimal`` ``.`` or ``,``)."""
+    tab; ``decimal`` ``.`` or ``,``), and how many lines before its header are a preamble that is skipped
+    (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`)."""
 
     delimiter: str = ","
     decimal: str = "."
+    preamble_lines: int = 0
 
     @classmethod
     def found(cls, head: bytes, layout: "TableLayout") -> "TextFormat":
-        """A table's format from its first bytes (:func:`sniff_csv`), where ``layout`` does not name it."""
+        """A table's format from its first bytes (:func:`sniff_csv`, :func:`preamble_lines`), where ``layout``
+        does not name it."""
         delimiter, decimal = sniff_csv(head)
-        return cls(layout.delimiter or delimiter, layout.decimal or decimal)
+        delimiter = layout.delimiter or delimiter
+        skipped = preamble_lines(head, delimiter)
+        if skipped:  # the decimal point told from the first row after the header, not the preamble's
+            decimal = sniff_csv(b"\n".join(head.split(b"\n")[skipped:]))[1]
+        return cls(delimiter, layout.decimal or decimal, skipped)
+
+    def read_options(self) -> pacsv.ReadOptions:
+        """pyarrow's reading options for this format: its blocks of :data:`CSV_BLOCK_BYTES`, the preamble skipped."""
+        return pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES, skip_rows=self.preamble_lines)
+
+
+def header_line(text_format: TextFormat | None) -> int:
+    """The line of a table's header (1-based): after a text table's preamble; 1 for Parquet (no lines)."""
+    return 1 + (text_format.preamble_lines if text_format is not None else 0)
 
 
 def output_text_format(path: str | os.PathLike, source: TextFormat | None = None) -> TextFormat:
@@ -60,7 +78,7 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
     name = Path(path).name.lower()
     for compressed in COMPRESSED_SUFFIXES:
         name = name.removesuffix(compressed)
-    base = source or TextFormat()
+    base = dataclasses.replace(source, preamble_lines=0) if source is not None else TextFormat()
     if name.endswith(".tsv"):
         return TextFormat("\t", base.decimal)
     return base if base.delimiter != "," or base.decimal == "." else TextFormat()
@@ -187,6 +205,29 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
     return delimiter, decimal
 
 
+#: the most lines before a text table's header skipped as its preamble
+MAX_PREAMBLE_LINES = 50
+
+
+def preamble_lines(head: bytes, delimiter: str) -> int:
+    """The lines before a text table's header that are a preamble (a logger's metadata: ``Fs,100``, ``Logging
+    Type,1``), from its first bytes ``head``: the header is the first line from which every complete line of
+    ``head`` splits into the same number of fields (at least two) by ``delimiter``, and is not a row of numbers.
+    0 when that is the first line, when the lines after it are too few to tell (fewer than two), when the header
+    would lie past :data:`MAX_PREAMBLE_LINES`, or when it is a row of numbers (a log without a header line after
+    its preamble, which the table's names read)."""
+    lines = head.decode("utf-8", "replace").split("\n")[:-1]  # the last piece: a line not complete, or nothing
+    counts = [len(next(csv.reader([line.rstrip("\r")], delimiter=delimiter), [])) for line in lines]
+    if len(counts) < 3 or counts[-1] < 2:
+        return 0
+    first = len(counts) - 1
+    while first > 0 and counts[first - 1] == counts[-1]:
+        first -= 1
+    if first == 0 or first > MAX_PREAMBLE_LINES or len(counts) - first < 3 or looks_headerless(lines[first]):
+        return 0
+    return first
+
+
 def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple[pa.Table, TextFormat | None]:
     """The table, and a text table's format (None for Parquet); ``select`` (a function of the header's names
     giving the names to read, or None for all) reads only some columns. A table without a header line
@@ -195,7 +236,6 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         raise InputError(f"{path}: no such file")
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a file")
-    delimiter, decimal = layout.delimiter, layout.decimal
     if layout.names is not None:
         if fmt != "csv":
             raise InputError(f"{path}: names: for a text table without a header line; a {fmt} file names its columns")
@@ -207,19 +247,16 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         source, head = _csv_bytes(path)
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
-        found_delimiter, found_decimal = sniff_csv(head[:4096])
-        text = TextFormat(delimiter or found_delimiter, decimal or found_decimal)
+        text = TextFormat.found(head[:4096], layout)
         parse = pacsv.ParseOptions(delimiter=text.delimiter)
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
         try:
-            if select is not None:  # the header's names, from its first line
-                header = pacsv.read_csv(pa.py_buffer(head.splitlines()[0] + b"\n"), parse_options=parse)
+            if select is not None:  # the header's names, from its line
+                header_line = head.splitlines()[text.preamble_lines]
+                header = pacsv.read_csv(pa.py_buffer(header_line + b"\n"), parse_options=parse)
                 convert.include_columns = select(header.column_names)
             return pacsv.read_csv(
-                source,
-                read_options=pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES),
-                parse_options=parse,
-                convert_options=convert,
+                source, read_options=text.read_options(), parse_options=parse, convert_options=convert
             ), text
         except DECOMPRESS_ERRORS as exc:
             raise read_error(path, exc, head) from None
@@ -294,7 +331,9 @@ def _chunk_numbers(chunk: pa.Array) -> np.ndarray:
     return values
 
 
-def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
+def _numeric_column(table: pa.Table, column: str, source: Path, first_row: int = 0, header_line: int = 1) -> np.ndarray:
+    """A column as float64; a value that is no number is one line naming its row in the file (the table's rows
+    after ``first_row`` of them) and its line (the header on ``header_line``, 1-based)."""
     array = table.column(column)
     if pa.types.is_floating(array.type) or pa.types.is_integer(array.type):
         return _to_numpy(array).astype(float, copy=False)
@@ -315,8 +354,9 @@ def _numeric_column(table: pa.Table, column: str, source: Path) -> np.ndarray:
         try:
             out[i] = float(value)
         except (TypeError, ValueError):
+            row = first_row + i + 1
             raise InputError(
-                f"{source}: row {i + 1} (line {i + 2}), column {column!r}: {value!r} is not a number"
+                f"{source}: row {row} (line {header_line + row}), column {column!r}: {value!r} is not a number"
             ) from None
     return out
 
@@ -481,7 +521,9 @@ def read_table(
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
     cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
-    recording, kept = table_recording(table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite)
+    recording, kept = table_recording(
+        table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite, header_line=header_line(text_format)
+    )
     if recording.gaps:
         longest = max(recording.gaps, key=lambda g: g.duration_s)
         warnings.warn(
@@ -502,16 +544,18 @@ def table_recording(
     *,
     drop_nonfinite: bool = False,
     first_row: int = 0,
+    header_line: int = 1,
 ) -> tuple[Recording, np.ndarray]:
     """The recording [s, deg/s, g, degC] of a table's rows (``cols``: channel -> column) and the indices of the
     rows kept in it (all, or those with every used value finite when ``drop_nonfinite``; a warning says how many
-    went). ``first_row``: the table's first row in its file (0-based), for the row numbers in messages. Used by
+    went). ``first_row``: the table's first row in its file (0-based), and ``header_line`` the line of a text
+    table's header (1-based: after its preamble), for the row and line numbers in messages. Used by
     :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for each chunk."""
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
     accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
     temp_names = _temperature_columns(cols, gyro_axes)
     gyro_factor = unit_factor("gyro", layout.gyro_unit, "gyro_unit")
-    num = lambda name: _numeric_column(table, cols[name], path)  # noqa: E731
+    num = lambda name: _numeric_column(table, cols[name], path, first_row, header_line)  # noqa: E731
     if cols[TIME_COLUMN] == NOMINAL_TIME:  # a table without time, at a nominal rate
         time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
     else:
@@ -694,7 +738,9 @@ __all__ = [
     "TableLayout",
     "TableData",
     "TextFormat",
+    "header_line",
     "output_text_format",
+    "preamble_lines",
     "parse_column_mapping",
     "read_table",
     "write_gyro_back",
