@@ -2,8 +2,8 @@
 through the real command line.
 
 Makes 500 corrupted logs (truncations and byte flips of the shared PX4 ULog and ArduPilot DataFlash samples,
-250 each), 250 corrupted binaries written here (an HDF5 file, a Parquet table, a ROS 1 bag, ROS 2 bags in sqlite3
-and MCAP storage, 50 each), 150 malformed CSV tables and 240 mutated model files (60 each of four kinds: a
+250 each), 350 corrupted binaries written here (an HDF5 file, a MATLAB MAT-file, a NumPy .npz, a Parquet table, a
+ROS 1 bag, ROS 2 bags in sqlite3 and MCAP storage, 50 each), 150 malformed CSV tables and 240 mutated model files (60 each of four kinds: a
 polynomial, the default fit with lag, memory and g-sensitivity, gyro and accelerometer triads, a network), runs
 each through ``gyrocomp convert`` (logs, binaries, tables; every other table with ``--drop-nan``) or ``gyrocomp
 apply`` (models) in this process, and classifies the outcome:
@@ -58,6 +58,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import scipy.io
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -281,13 +282,30 @@ def _hdf5(path: Path, recording) -> Path:
     return path
 
 
+def _arrays(path: Path, recording) -> Path:
+    """The run as named arrays: a MATLAB v5 MAT-file (scipy) or a NumPy .npz, by ``path``'s suffix."""
+    arrays = {
+        "time": recording.time_s,
+        "gyro": recording.gyro_dps,
+        "accel": recording.accel_g,
+        "temperature": recording.temperature_degc,
+    }
+    if path.suffix == ".mat":
+        scipy.io.savemat(path, arrays)
+    else:
+        np.savez(path, **arrays)
+    return path
+
+
 def corrupted_binaries(work: Path, rng: np.random.Generator, count: int) -> dict[str, collections.Counter]:
     """``count`` damaged copies each (half cut short, half with 1..16 bytes overwritten) of an HDF5 file, a
-    Parquet table, a ROS 1 bag and ROS 2 bags in sqlite3 and MCAP storage, all of one simulated run, converted;
-    a copy whose length is kept must not lose rows without a word."""
+    MATLAB MAT-file, a NumPy .npz, a Parquet table, a ROS 1 bag and ROS 2 bags in sqlite3 and MCAP storage, all of
+    one simulated run, converted; a copy whose length is kept must not lose rows without a word."""
     recording = simulate("mti10", profile="chamber", duration_s=600, rate_hz=2, seed=7).recording
     makers = {
         "HDF5": lambda p: _hdf5(p.with_suffix(".h5"), recording),
+        "MATLAB MAT-file": lambda p: _arrays(p.with_suffix(".mat"), recording),
+        "NumPy .npz": lambda p: _arrays(p.with_suffix(".npz"), recording),
         "Parquet": lambda p: (write(recording, p.with_suffix(".parquet")), p.with_suffix(".parquet"))[1],
         "ROS 1 bag": lambda p: _bag(p.with_suffix(".bag"), recording, "ros1"),
         "ROS 2 bag (sqlite3)": lambda p: _bag(p, recording, "sqlite3"),

@@ -64,7 +64,7 @@ def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> floa
 
 
 @contextlib.contextmanager
-def _opened(h5py, path: Path):
+def opened_hdf5(h5py, path: Path):
     """The open file; what HDF5 reports about a damaged one (a truncated file, a bad signature or B-tree, a
     failed read) becomes an InputError naming the file. Permission and missing-file errors stay as they are."""
     try:
@@ -190,18 +190,26 @@ def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
     """(time [s], gyro [deg/s], gyro axes, accel [g] or None, accel axes, temperature [degC] or None)."""
     source, mapping = str(path), dict(layout.columns)
     time_ds = _find(handle, source, TIME_COLUMN, mapping)
-    if time_ds is None:
+    if time_ds is None and layout.rate_hz is None:
         raise InputError(
             f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
-            "map one with columns={'time': 'NAME'}"
+            "map one with columns={'time': 'NAME'}, or give the samples' rate (rate_hz=100)"
         )
-    time_s = _numbers(time_ds, source).reshape(-1) * _factor("time", time_ds, layout.time_unit, "time_unit", source)
+    if time_ds is not None and layout.rate_hz is not None:
+        raise InputError(
+            f"{path}: rate_hz={layout.rate_hz:g} is for a file without time, and this one has {time_ds.name!r}"
+        )
+    time_s = None
+    if time_ds is not None:
+        time_s = _numbers(time_ds, source).reshape(-1) * _factor("time", time_ds, layout.time_unit, "time_unit", source)
     gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
     if gyro is None:
         raise InputError(
             f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
             "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}"
         )
+    if time_s is None:  # no time in the file: sample n at n / rate
+        time_s = np.arange(gyro.shape[0]) / layout.rate_hz
     gyro = gyro * _factor("gyro", gyro_ds, layout.gyro_unit, "gyro_unit", source)
     if progress:
         progress(0.5)
@@ -213,6 +221,57 @@ def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
     return time_s, gyro, gyro_axes, accel, accel_axes, temperature
 
 
+def named_arrays_recording(
+    handle, path: Path, options: ReadOptions, progress: ProgressCallback | None, fmt: str
+) -> Recording:
+    """The recording [s, deg/s, g, degC] of a file of named arrays: an open HDF5 file, or an :class:`ArrayStore`
+    (another format's arrays, in memory). Channels are found as the module says; ``fmt`` names the format in the
+    recording's metadata."""
+    time_s, gyro, gyro_axes, accel, accel_axes, temperature = _channels(handle, options.layout, path, progress)
+    n = time_s.size
+    for name, values in (("gyro", gyro), ("accel", accel), ("temperature", temperature)):
+        if values is not None and values.shape[0] != n:
+            raise InputError(
+                f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
+                "map datasets of the same length with columns="
+            )
+    if progress:
+        progress(1.0)
+    return log_recording(
+        path, options, time_s, gyro, accel, temperature, {"path": str(path), "format": fmt}, gyro_axes=gyro_axes
+    )
+
+
+class StoredArray:
+    """An array in memory with what the reading of named arrays asks of an HDF5 dataset (its name, shape, dtype,
+    ``units`` in ``attrs``, its values by ``[()]``), for formats read whole (NumPy's ``.npz``, MATLAB files)."""
+
+    external = None
+    is_virtual = False
+
+    def __init__(self, name: str, values: np.ndarray, source: str, units: str | None = None):
+        self.name, self._values = name, values
+        self.shape, self.ndim, self.dtype = values.shape, values.ndim, values.dtype
+        self.attrs = {} if units is None else {"units": units}
+        self.file = _StoreFile(source)
+
+    def __getitem__(self, key):
+        return self._values[key]
+
+
+class _StoreFile:
+    def __init__(self, filename: str):
+        self.filename = filename
+
+
+class ArrayStore(dict):
+    """Named :class:`StoredArray` s (name -> array), read as an HDF5 file's datasets are."""
+
+    def visititems(self, func) -> None:
+        for name, value in self.items():
+            func(name, value)
+
+
 def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read an HDF5 or NetCDF-4 file into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -222,13 +281,13 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
         The ``.h5`` / ``.hdf5`` / ``.nc`` file.
     options : ReadOptions, optional
         ``layout.columns`` maps channels to dataset paths (``time=timestamp_utc,gyro=angular_velocity``);
-        ``layout``'s units apply where a dataset has no ``units`` attribute.
+        ``layout``'s units apply where a dataset has no ``units`` attribute; ``layout.rate_hz`` times the samples
+        of a file without a time dataset.
     progress : callable, optional
         Called with the fraction done.
     """
     options = options or ReadOptions()
     path = Path(path)
-    source = str(path)
     if not path.exists():
         raise InputError(f"{path}: no such file")
     with open(path, "rb") as fh:
@@ -245,20 +304,8 @@ def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallba
             "name its real format with fmt=, or leave fmt= out to have it told from the file",
         )
     h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
-    with _opened(h5py, path) as handle:
-        time_s, gyro, gyro_axes, accel, accel_axes, temperature = _channels(handle, options.layout, path, progress)
-    n = time_s.size
-    for name, values in (("gyro", gyro), ("accel", accel), ("temperature", temperature)):
-        if values is not None and values.shape[0] != n:
-            raise InputError(
-                f"{path}: {name} has {values.shape[0]} samples but time has {n}; "
-                "map datasets of the same length with columns="
-            )
-    if progress:
-        progress(1.0)
-    return log_recording(
-        path, options, time_s, gyro, accel, temperature, {"path": source, "format": "hdf5"}, gyro_axes=gyro_axes
-    )
+    with opened_hdf5(h5py, path) as handle:
+        return named_arrays_recording(handle, path, options, progress, "hdf5")
 
 
 register_reader(

@@ -8,6 +8,7 @@ from . import ulog  # noqa: F401
 from . import dataflash  # noqa: F401
 from . import rosbag  # noqa: F401
 from . import hdf5  # noqa: F401
+from . import matlab  # noqa: F401
 from .readers import READERS
 
 __all__ = ["READERS"]
