@@ -5,7 +5,10 @@ A channel is a one-dimensional dataset (``time``, ``gyro_z``, ``temperature`` ..
 Without a mapping, datasets are looked up under gyrocomp's names and common ones
 (``angular_velocity``, ``acceleration``, ``timestamp`` ...). Units come from each dataset's
 ``units`` attribute when it names a unit gyrocomp knows (CF conventions: ``"mrad/s"``,
-``"m/s2"``, ``"seconds since 2021-09-20 08:52:00"``, ``"C"``), else from the options.
+``"m/s2"``, ``"seconds since 2021-09-20 08:52:00"``, ``"C"``), else from the options. A file without a time
+dataset is timed by the layout's ``rate_hz`` (sample n at n / rate). The same reading of named arrays serves the
+formats read whole into memory (MATLAB files, NumPy ``.npz``: :mod:`gyrocomp.io.matlab`) through
+:class:`ArrayStore` (:func:`named_arrays_recording`).
 """
 
 from __future__ import annotations
@@ -318,3 +321,5 @@ register_reader(
         aliases=("h5", "netcdf", "nc"),
     )
 )
+
+__all__ = ["ArrayStore", "StoredArray", "named_arrays_recording", "opened_hdf5", "read_hdf5"]

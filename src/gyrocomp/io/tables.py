@@ -252,8 +252,8 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
         try:
             if select is not None:  # the header's names, from its line
-                header_line = head.splitlines()[text.preamble_lines]
-                header = pacsv.read_csv(pa.py_buffer(header_line + b"\n"), parse_options=parse)
+                names_line = head.split(b"\n")[text.preamble_lines].rstrip(b"\r")
+                header = pacsv.read_csv(pa.py_buffer(names_line + b"\n"), parse_options=parse)
                 convert.include_columns = select(header.column_names)
             return pacsv.read_csv(
                 source, read_options=text.read_options(), parse_options=parse, convert_options=convert
