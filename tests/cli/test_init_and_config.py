@@ -241,3 +241,36 @@ def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
     odd = guess_layout(tmp_path / "odd.csv", rate_hz=100.0)
     assert odd.layout.accel_unit == "1/12200 g" and odd.layout.gyro_unit == "deg/s"
     assert any("the gyro's scale cannot be told at rest" in r for r in odd.reasons)
+
+
+def test_an_xsens_export_with_its_comment_lines_and_sample_time_fine(tmp_path):
+    """MT Manager's text export: lines of '// ...' (no separator) before a tab-separated header, a 16-bit
+    PacketCounter and SampleTimeFine (ticks of a 10 kHz clock). The preamble is skipped, the tab told from the
+    header, SampleTimeFine taken as the time in 100 us, the counter left unused; with only a counter, the counter is
+    the time and the reason asks for its period."""
+    n, rate_hz = 300, 100.0
+    rng = np.random.default_rng(2)
+    gyro = 0.002 + 0.001 * rng.standard_normal((n, 3))
+    rows = [
+        "\t".join(
+            [f"{k % 65536:05d}", str(16011 + 100 * k), "0.1", "-0.2", "9.81", *(f"{v:.6f}" for v in gyro[k]), "30"]
+        )
+        for k in range(n)
+    ]
+    preamble = "// Start Time: Unknown\n// Update Rate: 100.0Hz\n// Firmware Version: 4.3.0\n"
+    header = "PacketCounter\tSampleTimeFine\tAcc_X\tAcc_Y\tAcc_Z\tGyr_X\tGyr_Y\tGyr_Z\tTemperature\n"
+    (tmp_path / "MT_0001.txt").write_text(preamble + header + "\n".join(rows) + "\n")
+    guess = guess_layout(tmp_path / "MT_0001.txt")
+    assert guess.layout.columns["time"] == "SampleTimeFine" and guess.layout.time_unit == "100 us"
+    assert guess.layout.delimiter == "\t" and guess.unused == ("PacketCounter",)
+    assert run("init", "MT_0001.txt", cwd=tmp_path).returncode == 0
+    allan = run("allan", "MT_0001.txt", "--json", cwd=tmp_path)
+    assert allan.returncode == 0, allan.stderr
+    expected = allan_deviation(np.round(gyro[:, 0], 6) * 180.0 / np.pi, rate_hz).deviation  # as written: 6 decimals
+    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_x"]["adev"], expected, rtol=1e-9)
+    counted = "\n".join(r.split("\t", 2)[0] + "\t" + r.split("\t", 2)[2] for r in rows)
+    header = header.replace("SampleTimeFine\t", "")
+    (tmp_path / "counted.txt").write_text(preamble + header + counted + "\n")
+    counter = guess_layout(tmp_path / "counted.txt")
+    assert counter.layout.columns["time"] == "PacketCounter"
+    assert any("a counter, the only column that only increases" in r for r in counter.reasons)

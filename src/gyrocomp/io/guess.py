@@ -34,7 +34,10 @@ from .tables import (
 
 #: rows read to guess from
 GUESS_ROWS = 20_000
-_TIME_WORDS = {"time", "timestamp", "stamp", "t", "ts", "timeus", "timems", "sec", "seconds"}
+_TIME_WORDS = {"time", "timestamp", "stamp", "t", "ts", "timeus", "timems", "sec", "seconds", "sampletimefine"}
+#: words of a column that counts packets or samples: increasing, but no time unless nothing else is (its period is
+#: not in the file)
+_COUNTER_WORDS = {"counter", "packetcounter", "packet", "count", "seq", "sequence", "index", "idx", "frame", "n"}
 _TIME_UNIT_WORDS = {
     "us": "us",
     "usec": "us",
@@ -45,6 +48,7 @@ _TIME_UNIT_WORDS = {
     "timems": "ms",
     "ns": "ns",
     "nsec": "ns",
+    "sampletimefine": "100 us",  # Xsens (MT Manager, the SDK): ticks of a 10 kHz clock
 }
 #: sample periods a log plausibly has [s]: 10 kHz to 1 Hz
 _PERIOD_RANGE_S = (1e-4, 1.0)
@@ -178,6 +182,10 @@ def _time_unit(name: str, values: np.ndarray) -> tuple[str, str]:
     return "s", f"time unit s: the median step {period:.4g} fits no usual rate; check it"
 
 
+def _only_increases(values: np.ndarray | None) -> bool:
+    return values is not None and values.size > 2 and bool(np.all(np.diff(values) > 0))
+
+
 def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> tuple[dict[str, str], list[str]]:
     """Channel to column, time first, and why (see the module); refuses a table without time or gyro columns.
     With a nominal rate [Hz], the table has no time column and none is looked for."""
@@ -203,12 +211,18 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
         return columns, reasons
     time_name = next((n for n in names if set(_words(n)) & _TIME_WORDS and n not in columns.values()), None)
     if time_name is None:
-        for name in names:
-            values = _numbers(table, name)
-            if name not in columns.values() and values is not None and values.size > 2 and np.all(np.diff(values) > 0):
-                time_name = name
-                reasons.append(f"time = {name!r}: the first column that only increases")
-                break
+        rising = [n for n in names if n not in columns.values() and _only_increases(_numbers(table, n))]
+        counters = [n for n in rising if set(_words(n)) & _COUNTER_WORDS]
+        others = [n for n in rising if n not in counters]
+        if others:
+            time_name = others[0]
+            reasons.append(f"time = {time_name!r}: the first column that only increases")
+        elif counters:
+            time_name = counters[0]
+            reasons.append(
+                f"time = {time_name!r}: a counter, the only column that only increases; its period is not in the "
+                "file: give it as the time unit (time-unit = '10 ms' at 100 Hz)"
+            )
     else:
         reasons.append(f"time = {time_name!r}: its name")
     if time_name is None:

@@ -192,10 +192,13 @@ def read_error(path: Path, exc: Exception, head: bytes) -> InputError:
 
 def sniff_csv(head: bytes) -> tuple[str, str]:
     """(delimiter, decimal point) of a CSV from its first bytes: the separator that splits the header into the
-    most fields (comma on a tie), and a decimal comma when the separator is not a comma and a number in the first
+    most fields (comma on a tie; the first line that holds one where the first line holds none, a preamble's),
+    and a decimal comma when the separator is not a comma and a number in the first
     data row has one."""
     lines = head.decode("utf-8", errors="replace").splitlines()
     header = lines[0] if lines else ""
+    if not any(d in header for d in DELIMITERS):  # a preamble's first line (// Start Time: ...): the first with one
+        header = next((line for line in lines[1:] if any(d in line for d in DELIMITERS)), header)
     delimiter = max(DELIMITERS, key=lambda d: (header.count(d), d == ","))
     decimal = "."
     if delimiter != "," and len(lines) > 1:
