@@ -207,8 +207,8 @@ def test_guessing_from_names_and_magnitudes(tmp_path):
 
 
 def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
-    """An Arduino sketch's MPU-6050 log: metadata lines, then ax..gz in raw counts without time. The
-    accelerometer's norm at rest (16384 counts) is near 1 g in no unit: raw counts, 1/16384 g, an InvenSense part's
+    """An Arduino sketch's MPU-6050 log: metadata lines (the rate among them), then ax..gz in raw counts without
+    time. The rate is taken from the preamble's Fs line, else asked for. The accelerometer's norm at rest (16384 counts) is near 1 g in no unit: raw counts, 1/16384 g, an InvenSense part's
     power-on range, whose gyro then counts 131 per deg/s; a norm of no power of two leaves the gyro's scale to the
     user, in deg/s with a reason that says so."""
     rng = np.random.default_rng(1)
@@ -218,9 +218,12 @@ def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
     body = "\n".join(",".join(str(int(round(v))) for v in row) for row in np.column_stack([accel, gyro]))
     preamble = "Fs,100\nLogging Type,1\nInitialization time,-1\nWaiting time,-1\n"
     (tmp_path / "mpu.csv").write_text(preamble + "ax,ay,az,gx,gy,gz\n" + body + "\n")
+    guess = guess_layout(tmp_path / "mpu.csv")  # the rate the preamble states: Fs,100
+    assert guess.layout.rate_hz == 100.0 and "the rate the preamble states, 'Fs,100'" in guess.reasons[0]
+    (tmp_path / "unstated.csv").write_text(preamble.replace("Fs,100", "Fs,fast") + "ax,ay,az,gx,gy,gz\n" + body + "\n")
     with pytest.raises(InputError, match=r"no column looks like the time .*\(rate_hz=50\)"):
-        guess_layout(tmp_path / "mpu.csv")
-    guess = guess_layout(tmp_path / "mpu.csv", rate_hz=100.0)
+        guess_layout(tmp_path / "unstated.csv")
+    assert guess_layout(tmp_path / "unstated.csv", rate_hz=100.0).layout.rate_hz == 100.0
     assert (guess.layout.accel_unit, guess.layout.gyro_unit) == ("1/16384 g", "1/131 deg/s")
     assert guess.layout.columns == {
         "accel_x": "ax",
@@ -231,7 +234,7 @@ def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
         "gyro_z": "gz",
     }
     assert any("raw counts, 1/16384 g" in r and "check the part's range" in r for r in guess.reasons)
-    assert run("init", "mpu.csv", "--rate", "100", cwd=tmp_path).returncode == 0
+    assert run("init", "mpu.csv", cwd=tmp_path).returncode == 0
     allan = run("allan", "mpu.csv", "--json", cwd=tmp_path)
     assert allan.returncode == 0, allan.stderr
     expected = allan_deviation(np.round(gyro[:, 0]) / 131.0, 100.0).deviation

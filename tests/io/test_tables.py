@@ -511,8 +511,12 @@ def test_a_real_mpu6050_log_with_its_preamble_is_read_as_its_counts_scaled():
     100 Hz, 131 counts per deg/s and 16384 per g): the layout gyrocomp init guesses reads the values numpy.loadtxt
     reads with the README's skiprows, times the README's scales."""
     path = shared_dataset("tomisuarez2-mpu6050") / "imu_static_test.csv"
-    guess = guess_layout(path, rate_hz=100.0)
-    assert (guess.layout.gyro_unit, guess.layout.accel_unit) == ("1/131 deg/s", "1/16384 g")
+    guess = guess_layout(path)  # the rate from its preamble's Fs,100
+    assert (guess.layout.gyro_unit, guess.layout.accel_unit, guess.layout.rate_hz) == (
+        "1/131 deg/s",
+        "1/16384 g",
+        100.0,
+    )
     recording = read_table(path, guess.layout).recording
     counts = np.loadtxt(path, delimiter=",", skiprows=5)
     np.testing.assert_array_equal(recording.gyro_dps, counts[:, 3:] * (1.0 / 131.0))

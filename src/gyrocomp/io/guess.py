@@ -102,6 +102,10 @@ def _kind(name: str) -> str | None:
     return None
 
 
+class NoTimeColumn(InputError):
+    """No column of the table looks like its time, and no rate was given."""
+
+
 class HeaderlessTable(InputError):
     """The table has no header line (a serial terminal's log): its rows hold ``count`` numbers, like ``example``;
     the caller asks for their names."""
@@ -132,11 +136,13 @@ def _headerless_rows(head: bytes) -> tuple[int, str] | None:
     return count, lines[first][:MAX_LINE_BYTES]
 
 
-def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
+def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None, list[str]]:
+    """The first rows, the field separator (None for Parquet) and the preamble's lines (before the header)."""
     if fmt == "parquet":
         check_parquet_footer(path)
         parquet = pq.ParquetFile(path)
-        return (parquet.read_row_group(0) if parquet.num_row_groups else parquet.read()).slice(0, GUESS_ROWS), None
+        first = parquet.read_row_group(0) if parquet.num_row_groups else parquet.read()
+        return first.slice(0, GUESS_ROWS), None, []
     source, head = _csv_bytes(path)
     if not head.strip():
         raise InputError(f"{path}: the file is empty; nothing to guess from")
@@ -159,7 +165,28 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None]:
                 break
     except DECOMPRESS_ERRORS as exc:
         raise read_error(path, exc, head) from None
-    return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), text.delimiter
+    preamble = head.decode("utf-8", "replace").split("\n")[: text.preamble_lines]
+    return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), text.delimiter, preamble
+
+
+#: a preamble's line that states the sample rate: a key (Fs, rate, sample rate, update rate, ODR, frequency), a
+#: separator, a number, an optional Hz (``Fs,100``, ``// Update Rate: 100.0Hz``)
+_STATED_RATE = re.compile(
+    r"^[\s/#;%*]*(?:fs|odr|freq(?:uency)?|(?:sample|sampling|update|output data|data)?[ _-]?rate)"
+    r"(?:[ _-]?\[?hz\]?)?\s*[:=,;\t ]\s*([0-9]+(?:\.[0-9]+)?)\s*(?:hz)?\s*$",
+    re.IGNORECASE,
+)
+#: the rates a stated rate may be [Hz]
+_STATED_RATE_RANGE_HZ = (0.01, 100_000.0)
+
+
+def _stated_rate(preamble: list[str]) -> tuple[float, str] | None:
+    """(rate [Hz], the line) of the first preamble line that states a sample rate, within the plausible range."""
+    for line in preamble:
+        found = _STATED_RATE.match(line.strip())
+        if found and _STATED_RATE_RANGE_HZ[0] <= float(found[1]) <= _STATED_RATE_RANGE_HZ[1]:
+            return float(found[1]), line.strip()
+    return None
 
 
 def _numbers(table: pa.Table, column: str) -> np.ndarray | None:
@@ -226,7 +253,7 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
     else:
         reasons.append(f"time = {time_name!r}: its name")
     if time_name is None:
-        raise InputError(
+        raise NoTimeColumn(
             f"{path}: no column looks like the time (named time or timestamp, or only increasing); "
             "give the rows' sample rate (rate_hz=50), or map the time column in a project file's [read.columns] "
             '(time = "NAME")'
@@ -337,10 +364,21 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
         raise InputError(f"{path}: not a CSV/TSV or Parquet table; logs (ULog, DataFlash, ROS bags) need no layout")
     check = TableLayout(names=names, rate_hz=rate_hz)  # names and rate checked as every reader checks them
     if names is not None:
-        table, delimiter = read_headerless(path, check.names, check.rate_hz).slice(0, GUESS_ROWS), None
+        table, delimiter, preamble = read_headerless(path, check.names, check.rate_hz).slice(0, GUESS_ROWS), None, []
     else:
-        table, delimiter = _sample(path, fmt)
-    columns, reasons = _find_columns(path, table, check.rate_hz)
+        table, delimiter, preamble = _sample(path, fmt)
+    try:
+        columns, reasons = _find_columns(path, table, check.rate_hz)
+    except NoTimeColumn:
+        stated = _stated_rate(preamble)
+        if stated is None:
+            raise
+        check = TableLayout(names=names, rate_hz=stated[0])
+        columns, reasons = _find_columns(path, table, check.rate_hz)
+        reasons[0] = (
+            f"time: row n at n / {stated[0]:g} s (the rate the preamble states, {stated[1]!r}; the table has no time "
+            "column)"
+        )
     if "time" in columns:
         time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
     else:
@@ -356,8 +394,8 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
         names=check.names,
         rate_hz=check.rate_hz,
     )
-    unused = tuple(n for n in table.column_names if n not in columns.values() and not (rate_hz and n == "time"))
+    unused = tuple(n for n in table.column_names if n not in columns.values() and not (check.rate_hz and n == "time"))
     return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
 
 
-__all__ = ["GUESS_ROWS", "HeaderlessTable", "LayoutGuess", "guess_layout"]
+__all__ = ["GUESS_ROWS", "HeaderlessTable", "LayoutGuess", "NoTimeColumn", "guess_layout"]
