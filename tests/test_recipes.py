@@ -20,7 +20,8 @@ pytestmark = pytest.mark.slow
 
 PACKAGE = Path(gyrocomp.__file__).parent
 
-READER = '''"""NumPy ``.npz`` archives of ``time_s``, ``gyro_dps`` (n, 3) and ``temperature_degc`` arrays."""
+READER = '''"""``.imuz`` files (a made-up format: NumPy's npz archive) of ``time_s``, ``gyro_dps`` (n, 3) and
+``temperature_degc`` arrays."""
 
 from __future__ import annotations
 
@@ -30,14 +31,14 @@ from .common import log_recording
 from .readers import Reader, register_reader
 
 
-def read_npz(path, options, progress=None):
-    with np.load(path) as archive:
+def read_imuz(path, options, progress=None):
+    with np.load(path, allow_pickle=False) as archive:
         return log_recording(path, options, archive["time_s"], archive["gyro_dps"], None,
-                             archive["temperature_degc"], {"path": str(path), "format": "npz"})
+                             archive["temperature_degc"], {"path": str(path), "format": "imuz"})
 
 
-register_reader(Reader("npz", "a NumPy archive of time_s, gyro_dps, temperature_degc", read_npz,
-                       suffixes=(".npz",), aliases=("numpy",)))
+register_reader(Reader("imuz", "arrays time_s, gyro_dps, temperature_degc", read_imuz,
+                       suffixes=(".imuz",), aliases=("imuzip",)))
 '''
 
 EXPORT = '''"""Each gyro axis's mean turn-on constant, one line each."""
@@ -154,7 +155,7 @@ class StepBasis:
 
 #: the recipe of each kind: (its module's path in the package, its text, the file that names it, the line)
 RECIPES = {
-    "reader": ("io/npz.py", READER, "io/read_formats.py", "from . import npz  # noqa: F401"),
+    "reader": ("io/imuz.py", READER, "io/read_formats.py", "from . import imuz  # noqa: F401"),
     "export": ("export/offsets.py", EXPORT, "export/formats.py", "from . import offsets  # noqa: F401"),
     "curve": ("curves/step.py", CURVE, "curves/kinds.py", "from . import step  # noqa: F401"),
 }
@@ -195,9 +196,8 @@ def extended(tmp_path_factory):
         rec = simulate(
             "consumer", profile=get_profile("cycle", set_points_degc=(-10.0, 60.0), cycles=1), rate_hz=1.0, seed=seed
         ).recording
-        np.savez(
-            runs / f"run{seed}.npz", time_s=rec.time_s, gyro_dps=rec.gyro_dps, temperature_degc=rec.temperature_degc
-        )
+        with open(runs / f"run{seed}.imuz", "wb") as fh:  # a file object: numpy adds no .npz
+            np.savez(fh, time_s=rec.time_s, gyro_dps=rec.gyro_dps, temperature_degc=rec.temperature_degc)
     return run, root
 
 
@@ -215,16 +215,16 @@ def test_the_copy_runs_its_own_package(extended):
 def test_a_reader_is_its_module_and_one_line(extended, tmp_path):
     run, root = extended
     help_text = " ".join(run("fit", "--help").stdout.split())
-    assert "npz (a NumPy archive of time_s, gyro_dps, temperature_degc)" in help_text
+    assert "imuz (arrays time_s, gyro_dps, temperature_degc)" in help_text
     fitted = run("fit", root / "runs", "-o", tmp_path / "m.json", "--temperature", "poly:2", "--hysteresis", "none")
     assert fitted.returncode == 0, fitted.stderr
     inputs = json.loads((tmp_path / "m.json").read_text())["provenance"]["inputs"]
-    assert len(inputs) == 3 and all(".npz" in json.dumps(i) for i in inputs)  # the folder's three .npz files
+    assert len(inputs) == 3 and all(".imuz" in json.dumps(i) for i in inputs)  # the folder's three .imuz files
     renamed = tmp_path / "run0.data"
-    shutil.copy(root / "runs" / "run0.npz", renamed)
+    shutil.copy(root / "runs" / "run0.imuz", renamed)
     refused = run("apply", tmp_path / "m.json", renamed, "-o", tmp_path / "c.csv")
     assert refused.returncode == 2 and "cannot tell the format" in refused.stderr
-    for name in ("npz", "numpy"):
+    for name in ("imuz", "imuzip"):
         done = run("apply", tmp_path / "m.json", renamed, "-o", tmp_path / f"{name}.csv", "--format", name)
         assert done.returncode == 0, done.stderr
         assert "rows" in done.stdout
@@ -250,7 +250,7 @@ def test_a_curve_is_its_module_and_one_line(extended, tmp_path):
     assert fitted.returncode == 0, fitted.stderr
     shown = run("show", tmp_path / "m.json")
     assert shown.stdout.count("step function, 7 levels") == 3, shown.stdout
-    applied = run("apply", tmp_path / "m.json", root / "runs" / "run1.npz", "-o", tmp_path / "c.csv")
+    applied = run("apply", tmp_path / "m.json", root / "runs" / "run1.imuz", "-o", tmp_path / "c.csv")
     assert applied.returncode == 0, applied.stderr
     exported = run("export", tmp_path / "m.json", "-o", tmp_path / "c")
     assert exported.returncode == 0, exported.stderr

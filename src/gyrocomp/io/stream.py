@@ -28,6 +28,7 @@ from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (
+    CSV_BLOCK_BYTES,
     DECOMPRESS_ERRORS,
     HEADER_MAX_BYTES,
     TableLayout,
@@ -154,7 +155,10 @@ class TableStream:
                     strings_can_be_null=True, decimal_point=self.text_format.decimal, include_columns=self._read or []
                 )
                 reader = pacsv.open_csv(
-                    source, read_options=self.text_format.read_options(), parse_options=parse, convert_options=convert
+                    source,
+                    read_options=self.text_format.read_options(CSV_BLOCK_BYTES),
+                    parse_options=parse,
+                    convert_options=convert,
                 )
             except DECOMPRESS_ERRORS as exc:
                 raise read_error(self.path, exc, head) from None

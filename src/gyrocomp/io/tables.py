@@ -61,9 +61,10 @@ class TextFormat:
             decimal = sniff_csv(b"\n".join(head.split(b"\n")[skipped:]))[1]
         return cls(delimiter, layout.decimal or decimal, skipped)
 
-    def read_options(self) -> pacsv.ReadOptions:
-        """pyarrow's reading options for this format: its blocks of :data:`CSV_BLOCK_BYTES`, the preamble skipped."""
-        return pacsv.ReadOptions(block_size=CSV_BLOCK_BYTES, skip_rows=self.preamble_lines)
+    def read_options(self, block_bytes: int | None = None) -> pacsv.ReadOptions:
+        """pyarrow's reading options for this format: blocks of ``block_bytes`` [bytes] (default
+        :data:`CSV_BLOCK_BYTES`), the preamble skipped."""
+        return pacsv.ReadOptions(block_size=block_bytes or CSV_BLOCK_BYTES, skip_rows=self.preamble_lines)
 
 
 def header_line(text_format: TextFormat | None) -> int:
