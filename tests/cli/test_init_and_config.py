@@ -3,6 +3,7 @@ reads the file, the command line wins, and a bad file is refused in one line; th
 
 import json
 
+import h5py
 import numpy as np
 import pytest
 
@@ -277,3 +278,46 @@ def test_an_xsens_export_with_its_comment_lines_and_sample_time_fine(tmp_path):
     counter = guess_layout(tmp_path / "counted.txt")
     assert counter.layout.columns["time"] == "PacketCounter"
     assert any("a counter, the only column that only increases" in r for r in counter.reasons)
+
+
+def test_files_of_named_arrays_get_their_layout_guessed_from_the_names(tmp_path):
+    """An .npz as a script saves one (t_s, gyro_mrad_s (n, 3), acc_m_s2 (n, 3), temperature_c): each array named
+    as a channel, the units from the names; init writes it, and allan then reads the file as mapped. An HDF5 file of
+    one array per axis; a file whose arrays name no gyro lists them with their shapes."""
+    rng = np.random.default_rng(4)
+    n = 2000
+    gyro_mrad_s = 0.5 + 0.05 * rng.standard_normal((n, 3))
+    arrays = {
+        "t_s": np.arange(n) / 50.0,
+        "gyro_mrad_s": gyro_mrad_s,
+        "acc_m_s2": np.array([0.0, 0.0, 9.81]) + 0.01 * rng.standard_normal((n, 3)),
+        "temperature_c": np.linspace(20, 30, n),
+    }
+    np.savez(tmp_path / "log.npz", **arrays)
+    guess = guess_layout(tmp_path / "log.npz")
+    assert guess.layout.columns == {
+        "time": "t_s",
+        "gyro": "gyro_mrad_s",
+        "accel": "acc_m_s2",
+        "temperature": "temperature_c",
+    }
+    assert (guess.layout.gyro_unit, guess.layout.accel_unit, guess.layout.time_unit) == ("mrad/s", "m/s2", "s")
+    assert run("init", "log.npz", cwd=tmp_path).returncode == 0
+    allan = run("allan", "log.npz", "--json", cwd=tmp_path)
+    assert allan.returncode == 0, allan.stderr
+    expected = allan_deviation(gyro_mrad_s[:, 1] * 0.18 / np.pi, 50.0).deviation
+    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_y"]["adev"], expected, rtol=1e-9)
+    with h5py.File(tmp_path / "axes.h5", "w") as f:
+        f["imu/time"] = arrays["t_s"]
+        for k, axis in enumerate("xyz"):
+            f[f"imu/gyr_{axis}"] = gyro_mrad_s[:, k] * 0.18 / np.pi
+    per_axis = guess_layout(tmp_path / "axes.h5")
+    assert per_axis.layout.columns == {
+        "time": "imu/time",
+        "gyro_x": "imu/gyr_x",
+        "gyro_y": "imu/gyr_y",
+        "gyro_z": "imu/gyr_z",
+    }
+    np.savez(tmp_path / "data.npz", data=np.zeros((10, 6)))
+    with pytest.raises(InputError, match=r"data.npz: no array looks like the gyro .*its arrays are data \(10, 6\)"):
+        guess_layout(tmp_path / "data.npz")

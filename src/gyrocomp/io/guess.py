@@ -7,6 +7,10 @@ Names: a column is a gyro, accelerometer or temperature channel when one of its 
 period lies within 0.1 ms..1 s, the accelerometer unit in which the norm at rest is near 1 (g, m/s2, mg), the gyro
 in rad/s when the accelerometer is in m/s2 (a logger that writes SI writes it throughout), else deg/s. Each guess
 comes with the reason, to be checked by the user: nothing here is certain.
+
+Files of named arrays (HDF5/NetCDF, MAT-files, ``.npz``) are guessed the same way from their arrays' names: an
+(n, 3) array whose name says gyro or accelerometer is that channel whole, one-dimensional arrays per axis, the time
+and the temperature; the units from the names and the magnitudes of the first ``GUESS_ROWS`` samples.
 """
 
 from __future__ import annotations
@@ -21,6 +25,9 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import InputError
+from .hdf5 import ArrayStore, sample_hdf5
+from .matlab import load_arrays
+from .readers import detect_format
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
 from .tables import (
     DECOMPRESS_ERRORS,
@@ -312,6 +319,8 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
     words = {w for c in columns if c.startswith("gyro") for w in _words(columns[c])}
     if words & {"rad", "rads", "radps"}:
         return "rad/s", "gyro in rad/s: the column's name says so"
+    if words & {"mrad", "mrads"}:
+        return "mrad/s", "gyro in mrad/s: the column's name says so"
     if "mdps" in words:
         return "mdps", "gyro in mdps: the column's name says so"
     if words & {"dps", "deg", "degs"}:
@@ -342,9 +351,30 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
     return "deg/s", "gyro in deg/s: the default (check: a bias at rest cannot tell rad/s from deg/s)"
 
 
+def _columns_timed(
+    path: Path, table: pa.Table, check: TableLayout, preamble: list[str]
+) -> tuple[dict[str, str], list[str], TableLayout]:
+    """:func:`_find_columns`, and where the table has no time and no rate was given, the rate its preamble states
+    (:func:`_stated_rate`; else :class:`NoTimeColumn`); the layout ``check`` with that rate."""
+    try:
+        columns, reasons = _find_columns(path, table, check.rate_hz)
+    except NoTimeColumn:
+        stated = _stated_rate(preamble)
+        if stated is None:
+            raise
+        check = TableLayout(names=check.names, rate_hz=stated[0])
+        columns, reasons = _find_columns(path, table, check.rate_hz)
+        reasons[0] = (
+            f"time: row n at n / {stated[0]:g} s (the rate the preamble states, {stated[1]!r}; the table has no time "
+            "column)"
+        )
+    return columns, reasons, check
+
+
 def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | None = None) -> LayoutGuess:
     """Guess the column mapping and units of a CSV/TSV or Parquet table from its first ``GUESS_ROWS`` rows (see
-    the module); refuses a file of another format, or one whose time or gyro columns cannot be told.
+    the module), or of a file of named arrays (HDF5/NetCDF, MAT-file, ``.npz``) from its arrays' names; refuses a
+    file of another format, or one whose time or gyro columns cannot be told.
 
     Parameters
     ----------
@@ -360,25 +390,21 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     fmt = detect_table_format(path)
+    if fmt is None and names is None:
+        named = detect_format(path)
+        if named in _NAMED_ARRAYS:
+            return _guess_arrays(path, _NAMED_ARRAYS[named](path), rate_hz)
     if fmt not in ("csv", "parquet"):
-        raise InputError(f"{path}: not a CSV/TSV or Parquet table; logs (ULog, DataFlash, ROS bags) need no layout")
+        raise InputError(
+            f"{path}: not a CSV/TSV or Parquet table, nor a file of named arrays (HDF5, MAT, .npz); logs (ULog, "
+            "DataFlash, ROS bags) need no layout"
+        )
     check = TableLayout(names=names, rate_hz=rate_hz)  # names and rate checked as every reader checks them
     if names is not None:
         table, delimiter, preamble = read_headerless(path, check.names, check.rate_hz).slice(0, GUESS_ROWS), None, []
     else:
         table, delimiter, preamble = _sample(path, fmt)
-    try:
-        columns, reasons = _find_columns(path, table, check.rate_hz)
-    except NoTimeColumn:
-        stated = _stated_rate(preamble)
-        if stated is None:
-            raise
-        check = TableLayout(names=names, rate_hz=stated[0])
-        columns, reasons = _find_columns(path, table, check.rate_hz)
-        reasons[0] = (
-            f"time: row n at n / {stated[0]:g} s (the rate the preamble states, {stated[1]!r}; the table has no time "
-            "column)"
-        )
+    columns, reasons, check = _columns_timed(path, table, check, preamble)
     if "time" in columns:
         time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
     else:
@@ -395,6 +421,69 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
         rate_hz=check.rate_hz,
     )
     unused = tuple(n for n in table.column_names if n not in columns.values() and not (check.rate_hz and n == "time"))
+    return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
+
+
+#: the formats of named arrays a layout is guessed for, and how their first rows are sampled
+_NAMED_ARRAYS = {"hdf5": lambda path: sample_hdf5(path, GUESS_ROWS), "mat": lambda path: load_arrays(path)[0]}
+
+
+def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[str, tuple[str, np.ndarray]]]:
+    """Channel -> array of each array named as a channel (an (n, 3) gyro or accelerometer array whole, one of one
+    dimension per axis, the temperature, the time), why, and the per-axis columns (``NAME[:, k]`` -> values)."""
+    columns: dict[str, str] = {}
+    reasons: list[str] = []
+    flat: dict[str, tuple[str, np.ndarray]] = {}
+    for name, array in store.items():
+        base = name.rsplit("/", 1)[-1]
+        kind = "time" if set(_words(base)) & _TIME_WORDS else _kind(base)
+        if kind in ("gyro", "accel") and array.ndim == 2 and array.shape[1] == 3 and kind not in columns:
+            columns[kind] = name
+            reasons.append(f"{kind} = {name!r}: its name, an (n, 3) array")
+            for k, axis in enumerate("xyz"):
+                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", array[()][:, k])
+        elif kind in ("time", "temperature") and array.ndim == 1 and kind not in columns:
+            columns[kind] = name
+            reasons.append(f"{kind} = {name!r}: its name")
+            flat[kind] = (name, array[()])
+        elif kind in ("gyro", "accel") and array.ndim == 1 and _axis(base) and f"{kind}_{_axis(base)}" not in columns:
+            channel = f"{kind}_{_axis(base)}"
+            columns[channel] = name
+            reasons.append(f"{channel} = {name!r}: its name")
+            flat[channel] = (name, array[()])
+    return columns, reasons, flat
+
+
+def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> LayoutGuess:
+    """The layout of a file of named arrays: the channels from the arrays' names (:func:`_array_channels`), the
+    units from the names and the magnitudes as for a table's columns (a column k of an array is ``NAME[:, k]``)."""
+    columns, reasons, flat = _array_channels(store)
+    if not any(c == "gyro" or c.startswith("gyro_") for c in columns):
+        shapes = ", ".join(f"{n} {tuple(a.shape)}" for n, a in store.items())
+        raise InputError(
+            f"{path}: no array looks like the gyro (a name with gyr, omega or rate: an (n, 3) array, or one per axis "
+            f"named with x, y or z); its arrays are {shapes}: map them in a project file's [read.columns] "
+            '(gyro_x = "NAME[:, k]" for column k of an array)'
+        )
+    if "time" not in columns and rate_hz is None:
+        raise NoTimeColumn(
+            f"{path}: no array looks like the time (named time, t or timestamp); give the samples' rate "
+            '(rate_hz=50), or map the time array in a project file\'s [read.columns] (time = "NAME")'
+        )
+    n = min(len(values) for _, values in flat.values())
+    table = pa.table({column: np.asarray(values[:n], dtype=float) for column, values in flat.values()})
+    named = {channel: column for channel, (column, _) in flat.items()}
+    if "time" in columns:
+        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+    else:
+        time_unit, why_time = "s", f"time: sample n at n / {rate_hz:g} s (the rate given; no time array)"
+    accel_unit, why_accel = _accel_unit(table, named)
+    gyro_unit, why_gyro = _gyro_unit(table, named, accel_unit)
+    units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
+    if units:
+        reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")
+    layout = TableLayout(columns, gyro_unit=gyro_unit, accel_unit=accel_unit, time_unit=time_unit, rate_hz=rate_hz)
+    unused = tuple(name for name in store if name not in columns.values())
     return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
 
 

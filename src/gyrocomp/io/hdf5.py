@@ -275,6 +275,23 @@ class ArrayStore(dict):
             func(name, value)
 
 
+def sample_hdf5(path, rows: int) -> ArrayStore:
+    """The first ``rows`` samples of each numeric dataset of one or two dimensions in an HDF5 file, with its
+    ``units`` attribute (for guessing a layout: nothing else is read)."""
+    path = Path(path)
+    h5py = require("h5py", "hdf5", "reading HDF5/NetCDF files")
+    store = ArrayStore()
+
+    def visit(name, obj) -> None:
+        if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "iuf" and obj.ndim in (1, 2) and obj.shape[0] > 1:
+            _in_this_file(obj, str(path))
+            store[name] = StoredArray(name, np.asarray(obj[:rows]), str(path), _units(obj))
+
+    with opened_hdf5(h5py, path) as handle:
+        handle.visititems(visit)
+    return store
+
+
 def read_hdf5(path, options: ReadOptions | None = None, progress: ProgressCallback | None = None) -> Recording:
     """Read an HDF5 or NetCDF-4 file into a :class:`Recording` [s, deg/s, g, degC].
 
@@ -322,4 +339,4 @@ register_reader(
     )
 )
 
-__all__ = ["ArrayStore", "StoredArray", "named_arrays_recording", "opened_hdf5", "read_hdf5"]
+__all__ = ["ArrayStore", "StoredArray", "named_arrays_recording", "opened_hdf5", "read_hdf5", "sample_hdf5"]

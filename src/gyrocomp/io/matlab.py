@@ -156,6 +156,13 @@ def read_arrays(path, options: ReadOptions | None = None, progress: ProgressCall
         Called with the fraction done.
     """
     options = options or ReadOptions()
+    store, fmt = load_arrays(path)
+    return named_arrays_recording(store, Path(path), options, progress, fmt)
+
+
+def load_arrays(path) -> tuple[ArrayStore, str]:
+    """The numeric arrays of a MAT-file or an ``.npz`` (see the module) and the format's name (``mat`` or ``npz``);
+    a file that holds none, or is a text matrix, is refused in one line."""
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file" if not path.exists() else f"{path}: is a folder, not a file")
@@ -174,7 +181,7 @@ def read_arrays(path, options: ReadOptions | None = None, progress: ProgressCall
         store, fmt = _mat5(path), "mat"
     if not store:
         raise InputError(f"{path}: no numeric array of one or two dimensions in the file")
-    return named_arrays_recording(store, path, options, progress, fmt)
+    return store, fmt
 
 
 register_reader(
@@ -188,4 +195,4 @@ register_reader(
     )
 )
 
-__all__ = ["MAT5_MAGIC", "MAT73_MAGIC", "read_arrays"]
+__all__ = ["MAT5_MAGIC", "MAT73_MAGIC", "load_arrays", "read_arrays"]
