@@ -110,7 +110,8 @@ COMMANDS = {
     "init": (
         "project",
         "Write a project file for LOG's kind of table: its columns and units guessed from their "
-        "names and magnitudes, said one by one, read by every command run in this folder.",
+        "names and magnitudes, said one by one, read by every command run in this folder (a file of named "
+        "arrays, HDF5, MAT or .npz: the same from its arrays).",
     ),
     "config": ("project", "The project file in use (gyrocomp.toml in this folder, or --config)."),
     "demo": (

@@ -45,8 +45,9 @@ def _toml_text(value) -> str:
 @click.pass_context
 def init(ctx, log, output, force, names, rate_hz):
     """Write a project file for LOG's kind of table: its columns and units guessed from their names and
-    magnitudes, said one by one, read by every command run in this folder. A table without a header line (a
-    serial terminal's log) needs its columns' names, in order, once: --names, or asked for in a terminal."""
+    magnitudes, said one by one, read by every command run in this folder (a file of named arrays, HDF5, MAT or
+    .npz: the same from its arrays). A table without a header line (a serial terminal's log) needs its columns'
+    names, in order, once: --names, or asked for in a terminal."""
     refuse_to_overwrite_inputs(output, [log], option="-o")
     if Path(output).exists() and not force:
         raise InputError(f"{output}: exists; give --force to replace it, or -o another file")
