@@ -62,6 +62,21 @@ def test_named_arrays_are_read_as_written(tmp_path, imu, kind):
     assert rec.gyro_axes == ("gyro_x", "gyro_y", "gyro_z")
 
 
+@pytest.mark.parametrize("kind", ["mat5", "mat73"])
+def test_a_structures_fields_are_arrays_named_by_their_path(tmp_path, imu, kind):
+    """MATLAB's save of a struct imu with fields t and gyro (and a text field, left out): imu/t and imu/gyro, as a
+    v7.3 file's HDF5 groups name them."""
+    t, gyro, _ = imu
+    path = tmp_path / "struct.mat"
+    if kind == "mat5":
+        scipy.io.savemat(path, {"imu": {"t": t, "gyro": gyro, "label": "chamber"}})
+    else:
+        _mat73(path, {"imu/t": t[None, :], "imu/gyro": gyro})
+    rec = read(path, TableLayout(columns={"time": "imu/t", "gyro": "imu/gyro"}))
+    np.testing.assert_array_equal(rec.time_s, t)
+    np.testing.assert_array_equal(rec.gyro_dps, gyro)
+
+
 def test_columns_of_one_matrix_and_a_rate_for_a_file_without_time(tmp_path, imu):
     """A MATLAB habit: one (n, 4) matrix [t x y z] mapped column by column (NAME[:, k]); a file with no time
     array is timed by the rate given, and a rate given for a file with time is refused."""

@@ -12,7 +12,8 @@ the layout's units, these formats having no units of their own).
   with how to read it so.
 
 Only numeric arrays of one or two dimensions are channels; a vector stored as one row or one column (MATLAB has no
-other kind) is one-dimensional.
+other kind) is one-dimensional. A structure's fields are arrays named by their path, ``imu/gyro`` (a v7.3 file's
+groups are named so by HDF5 already).
 """
 
 from __future__ import annotations
@@ -72,18 +73,27 @@ def _array(name: str, values, source: str) -> StoredArray | None:
 
 
 #: the program that reads a MAT-file of versions 4 to 7 in a process of its own: scipy's reader is compiled code that
-#: a damaged file can crash (a flipped byte in a matrix's header made it read past its buffer); its numeric arrays
-#: are handed back as an .npz, its error as the last line of its stderr
+#: a damaged file can crash (a flipped byte in a matrix's header made it read past its buffer); its numeric arrays,
+#: those in structures named by their path (``imu/gyro``, as in a v7.3 file), are handed back as an .npz, its error
+#: as the last line of its stderr
 _LOADMAT = """
 import sys
 import numpy as np
 from scipy.io import loadmat
 try:
-    contents = loadmat(sys.argv[1])
+    contents = loadmat(sys.argv[1], simplify_cells=True)
 except Exception as exc:
     sys.stderr.write(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     sys.exit(3)
-arrays = {k: v for k, v in contents.items() if not k.startswith("__") and isinstance(v, np.ndarray) and v.dtype.kind in "iuf"}
+arrays = {}
+def walk(prefix, value):
+    if isinstance(value, dict):
+        for key, inner in value.items():
+            if not key.startswith("__"):
+                walk(prefix + key if not prefix else prefix + "/" + key, inner)
+    elif isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+        arrays[prefix] = value
+walk("", contents)
 np.savez(sys.argv[2], **arrays)
 """
 
