@@ -321,3 +321,33 @@ def test_files_of_named_arrays_get_their_layout_guessed_from_the_names(tmp_path)
     np.savez(tmp_path / "data.npz", data=np.zeros((10, 6)))
     with pytest.raises(InputError, match=r"data.npz: no array looks like the gyro .*its arrays are data \(10, 6\)"):
         guess_layout(tmp_path / "data.npz")
+
+
+def test_phone_app_exports_phyphox_quoted_names_and_sensor_loggers_bare_axes(tmp_path):
+    """phyphox writes quoted names with spaces and units ("Gyroscope x (rad/s)"): a header, not a headerless log.
+    Sensor Logger writes one file per sensor, its axes named x, y, z alone and its time in ns: in a file named for
+    the gyroscope, they are the gyro's."""
+    rng = np.random.default_rng(5)
+    n = 500
+    t, gyro = np.arange(n) / 100.0, 0.01 + 0.001 * rng.standard_normal((n, 3))
+    header = '"Time (s)","Gyroscope x (rad/s)","Gyroscope y (rad/s)","Gyroscope z (rad/s)","Absolute (rad/s)"\n'
+    rows = [",".join(f"{v:.9E}" for v in (t[k], *gyro[k], np.linalg.norm(gyro[k]))) for k in range(n)]
+    (tmp_path / "Gyroscope.csv").write_text(header + "\n".join(rows) + "\n")
+    phyphox = guess_layout(tmp_path / "Gyroscope.csv")
+    assert phyphox.layout.columns["gyro_x"] == "Gyroscope x (rad/s)" and phyphox.layout.gyro_unit == "rad/s"
+    assert phyphox.layout.columns["time"] == "Time (s)" and phyphox.unused == ("Absolute (rad/s)",)
+    rows = [
+        ",".join([str(1_700_000_000_000_000_000 + 10_000_000 * k), f"{t[k]:.3f}", *map(str, gyro[k][::-1])])
+        for k in range(n)
+    ]
+    (tmp_path / "Gyroscope_logger.csv").write_text("time,seconds_elapsed,z,y,x\n" + "\n".join(rows) + "\n")
+    logger = guess_layout(tmp_path / "Gyroscope_logger.csv")
+    assert {c: logger.layout.columns[c] for c in ("gyro_x", "gyro_y", "gyro_z")} == {
+        "gyro_x": "x",
+        "gyro_y": "y",
+        "gyro_z": "z",
+    }
+    assert logger.layout.columns["time"] == "time" and logger.layout.time_unit == "ns"
+    (tmp_path / "Accelerometer.csv").write_text("time,seconds_elapsed,z,y,x\n" + "\n".join(rows) + "\n")
+    with pytest.raises(InputError, match=r"Accelerometer.csv: no column looks like a gyro axis"):
+        guess_layout(tmp_path / "Accelerometer.csv")

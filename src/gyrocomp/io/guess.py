@@ -15,6 +15,7 @@ and the temperature; the units from the names and the magnitudes of the first ``
 
 from __future__ import annotations
 
+import csv
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +31,7 @@ from .matlab import load_arrays
 from .readers import detect_format
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
 from .tables import (
+    DELIMITERS,
     DECOMPRESS_ERRORS,
     TableLayout,
     _csv_bytes,
@@ -136,9 +138,11 @@ def _headerless_rows(head: bytes) -> tuple[int, str] | None:
     counts = [len(split_fields(row)) for row in rows]
     count = max(set(counts), key=counts.count)
     first = next(i for i, line in enumerate(lines) if len(split_fields(line)) == count and looks_headerless(line))
-    # a header: the line just before the first row, as many fields, none of them a number
-    before = split_fields(lines[first - 1]) if first > 0 else []
-    if len(before) == count and not any(looks_headerless(f) for f in before):
+    # a header: the line just before the first row, as many fields, none of them a number (split as the rows are,
+    # or as a CSV's quoted names with spaces are: "Time (s)","Gyroscope x (rad/s)")
+    before = lines[first - 1] if first > 0 else ""
+    splits = [split_fields(before), *(next(csv.reader([before], delimiter=d), []) for d in DELIMITERS)]
+    if before and any(len(f) == count and not any(looks_headerless(x) for x in f) for f in splits):
         return None
     return count, lines[first][:MAX_LINE_BYTES]
 
@@ -235,6 +239,11 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
         if channel and channel not in columns:
             columns[channel] = name
             reasons.append(f"{channel} = {name!r}: its name")
+    if not any(c.startswith("gyro_") for c in columns) and _kind(path.stem) == "gyro":
+        for name in names:  # columns named x, y and z alone in a file named for the gyro (Sensor Logger's)
+            if name.strip().lower() in ("x", "y", "z") and f"gyro_{name.strip().lower()}" not in columns:
+                columns[f"gyro_{name.strip().lower()}"] = name
+                reasons.append(f"gyro_{name.strip().lower()} = {name!r}: its name, in a file named {path.name!r}")
     if not any(c.startswith("gyro_") for c in columns):
         raise InputError(
             f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
