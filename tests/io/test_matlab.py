@@ -13,6 +13,7 @@ import scipy.io
 
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout, detect_format, read
+from gyrocomp.io.guess import guess_layout
 from gyrocomp.io.matlab import MAT73_MAGIC
 
 from ..conftest import run, shared_dataset
@@ -157,3 +158,16 @@ def test_real_matlab_v73_and_npz_files_read_as_h5py_and_numpy_read_them():
     rec = read(npz, TableLayout(columns=columns, rate_hz=rate_hz))
     np.testing.assert_array_equal(rec.gyro_dps, data[:, :3].astype(float))
     assert rec.n_samples == 1_000_000 and rec.rate_hz == pytest.approx(100.0)
+
+
+def test_the_layout_guessed_for_a_real_npz_reads_what_its_netcdf_original_holds():
+    """../shared's CATS tag: its .npz copy (t_s, gyro_mrad_s, acc_m_s2, temperature_c; float32, its README) read
+    with the layout init guesses from those names equals the NetCDF original, whose units are attributes."""
+    folder = shared_dataset("skdivemove-cats-tempcal")
+    guess = guess_layout(folder / "cats_temperature_calib_1hz.npz")
+    assert (guess.layout.gyro_unit, guess.layout.accel_unit) == ("mrad/s", "m/s2")
+    copy = read(folder / "cats_temperature_calib_1hz.npz", guess.layout)
+    original = read(folder / "cats_temperature_calib.nc")
+    np.testing.assert_allclose(copy.gyro_dps, original.gyro_dps, atol=5e-4 * 0.18 / math.pi)
+    np.testing.assert_allclose(copy.accel_g, original.accel_g, atol=1e-5)
+    np.testing.assert_allclose(copy.temperature_degc, original.temperature_degc, atol=2e-6)
