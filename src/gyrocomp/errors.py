@@ -18,6 +18,15 @@ class InputError(GyrocompError, ValueError):
     """Bad data, a bad file or a bad option value (CLI exit status 2)."""
 
 
+class LayoutError(InputError):
+    """A table's (or a file of named arrays') time or gyro is not where gyrocomp looks, and no mapping says where
+    (``path``: the file); its layout can be guessed from the names (``gyrocomp init``)."""
+
+    def __init__(self, message: str, path):
+        super().__init__(message)
+        self.path = path
+
+
 class ModelError(GyrocompError):
     """A model could not be fitted, loaded or applied (CLI exit status 1)."""
 

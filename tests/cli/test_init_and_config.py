@@ -351,3 +351,16 @@ def test_phone_app_exports_phyphox_quoted_names_and_sensor_loggers_bare_axes(tmp
     (tmp_path / "Accelerometer.csv").write_text("time,seconds_elapsed,z,y,x\n" + "\n".join(rows) + "\n")
     with pytest.raises(InputError, match=r"Accelerometer.csv: no column looks like a gyro axis"):
         guess_layout(tmp_path / "Accelerometer.csv")
+
+
+def test_a_command_that_cannot_find_the_columns_points_to_init(tmp_path):
+    """Without a mapping, fit on a table whose time and gyro have other names says what it lacks and that init
+    guesses the layout; after init, the same command runs."""
+    path = _log(tmp_path / "vendor.tsv", n=400)
+    refused = run("fit", "vendor.tsv", "-o", "m.json", "--hysteresis", "none", cwd=tmp_path)
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1
+    assert "no 'time' column" in refused.stderr
+    assert "or let `gyrocomp init vendor.tsv` guess them from the names into a project file" in refused.stderr
+    assert run("init", path, cwd=tmp_path).returncode == 0
+    fitted = run("fit", "vendor.tsv", "-o", "m.json", "--hysteresis", "none", cwd=tmp_path)
+    assert fitted.returncode == 0, fitted.stderr

@@ -17,6 +17,7 @@ import importlib
 import os
 import re
 import resource
+import shlex
 import signal
 import sys
 import traceback
@@ -25,7 +26,7 @@ import warnings
 import click
 
 from .._version import __version__
-from ..errors import CHECKS, GyrocompError, InputError, PlausibilityWarning, printable, silence_pattern
+from ..errors import CHECKS, GyrocompError, InputError, LayoutError, PlausibilityWarning, printable, silence_pattern
 from .projectfile import PROJECT_KEY, defaults_for, load_project
 
 EXIT_INPUT = 2
@@ -286,6 +287,13 @@ def in_cli_words(message: str, commands: list[click.Command] | None = None) -> s
     return _MAPPING.sub(lambda m: f"--columns {m.group(1)}={m.group(2)}", message)
 
 
+def _init_hint(exc: InputError) -> str:
+    """For a file whose time or gyro is not where gyrocomp looks (outside ``init``): that ``init`` guesses them."""
+    if not isinstance(exc, LayoutError) or any(c.name == "init" for c in _LOOKED_UP):
+        return ""
+    return f"; or let `gyrocomp init {shlex.quote(str(exc.path))}` guess them from the names into a project file"
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     click.echo(f"gyrocomp: warning: {printable(in_cli_words(str(message)))}", err=True)
 
@@ -436,7 +444,7 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         if debug:
             traceback.print_exc()
-        click.echo(f"gyrocomp: error: {printable(in_cli_words(str(exc)))}", err=True)
+        click.echo(f"gyrocomp: error: {printable(in_cli_words(str(exc)) + _init_hint(exc))}", err=True)
         status = EXIT_INPUT
     except GyrocompError as exc:
         if debug:

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, GyrocompError, InputError, printable
+from ..errors import DataQualityWarning, GyrocompError, InputError, LayoutError, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, log_recording, require
@@ -194,9 +194,10 @@ def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
     source, mapping = str(path), dict(layout.columns)
     time_ds = _find(handle, source, TIME_COLUMN, mapping)
     if time_ds is None and layout.rate_hz is None:
-        raise InputError(
+        raise LayoutError(
             f"{path}: no time dataset (the file has {', '.join(_datasets(handle))}); "
-            "map one with columns={'time': 'NAME'}, or give the samples' rate (rate_hz=100)"
+            "map one with columns={'time': 'NAME'}, or give the samples' rate (rate_hz=100)",
+            path,
         )
     if time_ds is not None and layout.rate_hz is not None:
         raise InputError(
@@ -207,9 +208,10 @@ def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
         time_s = _numbers(time_ds, source).reshape(-1) * _factor("time", time_ds, layout.time_unit, "time_unit", source)
     gyro, gyro_axes, gyro_ds = _vector(handle, source, "gyro", GYRO_AXES, mapping)
     if gyro is None:
-        raise InputError(
+        raise LayoutError(
             f"{path}: no gyro dataset (the file has {', '.join(_datasets(handle))}); "
-            "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}"
+            "map one with columns={'gyro': 'NAME'} (an (n, 3) array) or columns={'gyro_z': 'NAME'}",
+            path,
         )
     if time_s is None:  # no time in the file: sample n at n / rate
         time_s = np.arange(gyro.shape[0]) / layout.rate_hz

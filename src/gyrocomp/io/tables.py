@@ -15,7 +15,7 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, LayoutError
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .digest import file_sha256
@@ -410,14 +410,16 @@ def _resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dic
     if layout.rate_hz is not None and TIME_COLUMN not in cols:
         cols[TIME_COLUMN] = NOMINAL_TIME
     if TIME_COLUMN not in cols:
-        raise InputError(
+        raise LayoutError(
             f"{path}: no 'time' column (the file has {', '.join(header)}); map one with columns={{'time': 'NAME'}}, "
-            "or give the rows' sample rate (rate_hz=50) where the file has no time"
+            "or give the rows' sample rate (rate_hz=50) where the file has no time",
+            path,
         )
     if not any(a in cols for a in GYRO_AXES):
-        raise InputError(
+        raise LayoutError(
             f"{path}: no gyro column (expected gyro_x, gyro_y or gyro_z; the file has {', '.join(header)}); "
-            "map one with columns={'gyro_z': 'NAME'}"
+            "map one with columns={'gyro_z': 'NAME'}",
+            path,
         )
     return cols
 
