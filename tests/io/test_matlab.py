@@ -171,3 +171,42 @@ def test_the_layout_guessed_for_a_real_npz_reads_what_its_netcdf_original_holds(
     np.testing.assert_allclose(copy.gyro_dps, original.gyro_dps, atol=5e-4 * 0.18 / math.pi)
     np.testing.assert_allclose(copy.accel_g, original.accel_g, atol=1e-5)
     np.testing.assert_allclose(copy.temperature_degc, original.temperature_degc, atol=2e-6)
+
+
+def test_a_matrix_named_by_a_list_of_column_names_is_mapped_column_by_column(tmp_path, imu):
+    """MATLAB importdata's struct (data and colheaders) and numpy's data beside columns: each column is a channel by
+    its label (data[:, k]), its unit from the label; a single number named for the rate times a file without time."""
+    t, gyro, temperature = imu
+    path = tmp_path / "imported.mat"
+    data = np.column_stack([t, gyro, temperature])
+    scipy.io.savemat(path, {"imp": {"data": data, "colheaders": ["Time", "GyrX", "GyrY", "GyrZ", "Temp"]}})
+    guess = guess_layout(path)
+    assert guess.layout.columns == {
+        "time": "imp/data[:, 0]",
+        "gyro_x": "imp/data[:, 1]",
+        "gyro_y": "imp/data[:, 2]",
+        "gyro_z": "imp/data[:, 3]",
+        "temperature": "imp/data[:, 4]",
+    }
+    rec = read(path, guess.layout)
+    np.testing.assert_array_equal(rec.gyro_dps, gyro)
+    np.testing.assert_array_equal(rec.temperature_degc, temperature)
+    archive = tmp_path / "untimed.npz"
+    np.savez(archive, data=gyro, columns=np.array(["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s"]), fs_hz=50.0)
+    untimed = guess_layout(archive)
+    assert untimed.layout.rate_hz == 50.0 and untimed.layout.gyro_unit == "rad/s"
+    assert untimed.reasons[0] == "time: sample n at n / 50 s (the file's fs_hz = 50; no time array)"
+    np.testing.assert_allclose(read(archive, untimed.layout).gyro_dps, gyro * RAD_TO_DEG, rtol=1e-15)
+
+
+def test_the_layout_guessed_for_smacs_npz_reads_its_columns_at_its_rate():
+    """../shared's SMAC ADIS16405 copy: data (1e6, 6) with columns gyro_x_dps .. acc_z_g and fs_hz = 100 (its
+    README); init needs no option."""
+    path = shared_dataset("smac-imudata-adis16405") / "adis_16405_imu1.npz"
+    guess = guess_layout(path)
+    assert guess.layout.rate_hz == 100.0 and (guess.layout.gyro_unit, guess.layout.accel_unit) == ("deg/s", "g")
+    with np.load(path) as archive:
+        data = archive["data"].astype(float)
+    rec = read(path, guess.layout)
+    np.testing.assert_array_equal(rec.gyro_dps, data[:, :3])
+    np.testing.assert_array_equal(rec.accel_g, data[:, 3:])

@@ -437,30 +437,73 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
 _NAMED_ARRAYS = {"hdf5": lambda path: sample_hdf5(path, GUESS_ROWS), "mat": lambda path: load_arrays(path)[0]}
 
 
+#: names of a list that names a matrix's columns (numpy's and pandas' ``columns``, MATLAB importdata's
+#: ``colheaders``), alone or after the matrix's name (``data_columns``, ``data/colheaders``)
+_COLUMN_LABELS = ("columns", "colheaders", "column_names", "names", "labels", "header")
+
+
+def _entries(store: ArrayStore) -> list[tuple[str, str, np.ndarray]]:
+    """(name to map, name to read the channel from, values) of each array, and of each column of a matrix that a list
+    of names of its width names (``data[:, 0]`` read as ``gyro_x_dps``, its label): a list beside it or in the same
+    structure (MATLAB importdata's ``data`` and ``colheaders``)."""
+    entries = [(name, name.rsplit("/", 1)[-1], array[()]) for name, array in store.items()]
+    for name, array in store.items():
+        if array.ndim != 2:
+            continue
+        for key, labels in store.labels.items():
+            owner, _, last = key.rpartition("/") if "/" in key else ("", "", key)
+            last = last.removeprefix(f"{name}_")
+            if (
+                len(labels) == array.shape[1]
+                and last in _COLUMN_LABELS
+                and owner in ("", name, name.rpartition("/")[0])
+            ):
+                values = array[()]
+                entries += [(f"{name}[:, {k}]", label, values[:, k]) for k, label in enumerate(labels)]
+                break
+    return entries
+
+
 def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[str, tuple[str, np.ndarray]]]:
     """Channel -> array of each array named as a channel (an (n, 3) gyro or accelerometer array whole, one of one
-    dimension per axis, the temperature, the time), why, and the per-axis columns (``NAME[:, k]`` -> values)."""
+    dimension per axis, the temperature, the time; a matrix's column by its label), why, and the per-axis columns
+    (``NAME[:, k]`` -> values)."""
     columns: dict[str, str] = {}
     reasons: list[str] = []
     flat: dict[str, tuple[str, np.ndarray]] = {}
-    for name, array in store.items():
-        base = name.rsplit("/", 1)[-1]
+    for name, base, values in _entries(store):
         kind = "time" if set(_words(base)) & _TIME_WORDS else _kind(base)
-        if kind in ("gyro", "accel") and array.ndim == 2 and array.shape[1] == 3 and kind not in columns:
+        said = "its name" if base == name.rsplit("/", 1)[-1] else f"its label, {base!r}"
+        if kind in ("gyro", "accel") and values.ndim == 2 and values.shape[1] == 3 and kind not in columns:
             columns[kind] = name
-            reasons.append(f"{kind} = {name!r}: its name, an (n, 3) array")
+            reasons.append(f"{kind} = {name!r}: {said}, an (n, 3) array")
             for k, axis in enumerate("xyz"):
-                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", array[()][:, k])
-        elif kind in ("time", "temperature") and array.ndim == 1 and kind not in columns:
+                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+        elif kind in ("time", "temperature") and values.ndim == 1 and kind not in columns:
             columns[kind] = name
-            reasons.append(f"{kind} = {name!r}: its name")
-            flat[kind] = (name, array[()])
-        elif kind in ("gyro", "accel") and array.ndim == 1 and _axis(base) and f"{kind}_{_axis(base)}" not in columns:
+            reasons.append(f"{kind} = {name!r}: {said}")
+            flat[kind] = (name, values)
+        elif kind in ("gyro", "accel") and values.ndim == 1 and _axis(base) and f"{kind}_{_axis(base)}" not in columns:
             channel = f"{kind}_{_axis(base)}"
             columns[channel] = name
-            reasons.append(f"{channel} = {name!r}: its name")
-            flat[channel] = (name, array[()])
+            reasons.append(f"{channel} = {name!r}: {said}")
+            flat[channel] = (base if base != name.rsplit("/", 1)[-1] else name, values)
     return columns, reasons, flat
+
+
+#: words of a number in a file of arrays that states its sample rate [Hz] (``fs_hz``, ``rate_hz``, ``sample_rate``)
+_RATE_WORDS = {"fs", "rate", "hz", "freq", "frequency", "odr", "samplerate"}
+
+
+def _stated_array_rate(store: ArrayStore) -> tuple[float, str] | None:
+    """(rate [Hz], its name) of the first single number whose name says it is the sample rate, within the
+    plausible range."""
+    for name, value in store.scalars.items():
+        if set(_words(name.rsplit("/", 1)[-1])) & _RATE_WORDS and (
+            _STATED_RATE_RANGE_HZ[0] <= value <= _STATED_RATE_RANGE_HZ[1]
+        ):
+            return value, name
+    return None
 
 
 def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> LayoutGuess:
@@ -474,6 +517,12 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
             f"named with x, y or z); its arrays are {shapes}: map them in a project file's [read.columns] "
             '(gyro_x = "NAME[:, k]" for column k of an array)'
         )
+    stated = _stated_array_rate(store) if "time" not in columns and rate_hz is None else None
+    if stated is not None:
+        rate_hz = stated[0]
+        reasons.insert(0, f"time: sample n at n / {rate_hz:g} s (the file's {stated[1]} = {rate_hz:g}; no time array)")
+    elif "time" not in columns and rate_hz is not None:
+        reasons.insert(0, f"time: sample n at n / {rate_hz:g} s (the rate given; no time array)")
     if "time" not in columns and rate_hz is None:
         raise NoTimeColumn(
             f"{path}: no array looks like the time (named time, t or timestamp); give the samples' rate "
@@ -483,16 +532,17 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     table = pa.table({column: np.asarray(values[:n], dtype=float) for column, values in flat.values()})
     named = {channel: column for channel, (column, _) in flat.items()}
     if "time" in columns:
-        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+        time_unit, why_time = _time_unit(named["time"], _numbers(table, named["time"]))
     else:
-        time_unit, why_time = "s", f"time: sample n at n / {rate_hz:g} s (the rate given; no time array)"
+        time_unit, why_time = "s", "time unit s: the nominal time"
     accel_unit, why_accel = _accel_unit(table, named)
     gyro_unit, why_gyro = _gyro_unit(table, named, accel_unit)
     units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
     if units:
         reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")
     layout = TableLayout(columns, gyro_unit=gyro_unit, accel_unit=accel_unit, time_unit=time_unit, rate_hz=rate_hz)
-    unused = tuple(name for name in store if name not in columns.values())
+    used = [value.split("[", 1)[0] for value in columns.values()]  # a matrix read by its columns is used
+    unused = tuple(name for name in store if name not in used)
     return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
 
 

@@ -270,7 +270,14 @@ class _StoreFile:
 
 
 class ArrayStore(dict):
-    """Named :class:`StoredArray` s (name -> array), read as an HDF5 file's datasets are."""
+    """Named :class:`StoredArray` s (name -> array), read as an HDF5 file's datasets are; beside them, what a file
+    may say of them for guessing a layout: lists of names (``labels``, e.g. a matrix's column names) and numbers
+    (``scalars``, e.g. its sample rate)."""
+
+    def __init__(self):
+        super().__init__()
+        self.labels: dict[str, tuple[str, ...]] = {}
+        self.scalars: dict[str, float] = {}
 
     def visititems(self, func) -> None:
         for name, value in self.items():

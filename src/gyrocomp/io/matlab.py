@@ -74,8 +74,8 @@ def _array(name: str, values, source: str) -> StoredArray | None:
 
 #: the program that reads a MAT-file of versions 4 to 7 in a process of its own: scipy's reader is compiled code that
 #: a damaged file can crash (a flipped byte in a matrix's header made it read past its buffer); its numeric arrays,
-#: those in structures named by their path (``imu/gyro``, as in a v7.3 file), are handed back as an .npz, its error
-#: as the last line of its stderr
+#: those in structures named by their path (``imu/gyro``, as in a v7.3 file), with lists of names and single numbers
+#: (for guessing a layout), are handed back as an .npz, its error as the last line of its stderr
 _LOADMAT = """
 import sys
 import numpy as np
@@ -91,8 +91,12 @@ def walk(prefix, value):
         for key, inner in value.items():
             if not key.startswith("__"):
                 walk(prefix + key if not prefix else prefix + "/" + key, inner)
-    elif isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+    elif isinstance(value, np.ndarray) and value.dtype.kind in "iufU":
         arrays[prefix] = value
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        arrays[prefix] = np.asarray(value, dtype=float)
+    elif isinstance(value, list) and value and all(isinstance(v, str) for v in value):
+        arrays[prefix] = np.array(value, dtype=str)
 walk("", contents)
 np.savez(sys.argv[2], **arrays)
 """
@@ -146,6 +150,10 @@ def _npz(path: Path, source: str | None = None) -> ArrayStore:
                 array = _array(name, values, source)
                 if array is not None:
                     store[name] = array
+                elif values.dtype.kind in "US" and values.ndim == 1:  # names, of a matrix's columns say
+                    store.labels[name] = tuple(str(v) for v in values)
+                elif values.dtype.kind in "iuf" and values.size == 1:  # a number, a sample rate say
+                    store.scalars[name] = float(values.reshape(-1)[0])
     except _DAMAGED as exc:
         raise InputError(f"{path}: not a readable .npz archive ({printable(str(exc))[:200]})") from None
     return store
