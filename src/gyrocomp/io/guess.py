@@ -360,6 +360,17 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
     return "deg/s", "gyro in deg/s: the default (check: a bias at rest cannot tell rad/s from deg/s)"
 
 
+def _guessed_units(table: pa.Table, columns: dict[str, str]) -> tuple[str, str, str, tuple[str, str, str]]:
+    """The time, accelerometer and gyro units of the channels ``columns`` (channel -> column of ``table``), and why."""
+    if "time" in columns:
+        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+    else:
+        time_unit, why_time = "s", "time unit s: the nominal time"
+    accel_unit, why_accel = _accel_unit(table, columns)
+    gyro_unit, why_gyro = _gyro_unit(table, columns, accel_unit)
+    return time_unit, accel_unit, gyro_unit, (why_time, why_accel, why_gyro)
+
+
 def _columns_timed(
     path: Path, table: pa.Table, check: TableLayout, preamble: list[str]
 ) -> tuple[dict[str, str], list[str], TableLayout]:
@@ -414,12 +425,7 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
     else:
         table, delimiter, preamble = _sample(path, fmt)
     columns, reasons, check = _columns_timed(path, table, check, preamble)
-    if "time" in columns:
-        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
-    else:
-        time_unit, why_time = "s", "time unit s: the nominal time"
-    accel_unit, why_accel = _accel_unit(table, columns)
-    gyro_unit, why_gyro = _gyro_unit(table, columns, accel_unit)
+    time_unit, accel_unit, gyro_unit, why = _guessed_units(table, columns)
     layout = TableLayout(
         columns,
         gyro_unit=gyro_unit,
@@ -430,7 +436,7 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
         rate_hz=check.rate_hz,
     )
     unused = tuple(n for n in table.column_names if n not in columns.values() and not (check.rate_hz and n == "time"))
-    return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
+    return LayoutGuess(str(path), layout, (*reasons, *why), unused)
 
 
 #: the formats of named arrays a layout is guessed for, and how their first rows are sampled
@@ -531,19 +537,14 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     n = min(len(values) for _, values in flat.values())
     table = pa.table({column: np.asarray(values[:n], dtype=float) for column, values in flat.values()})
     named = {channel: column for channel, (column, _) in flat.items()}
-    if "time" in columns:
-        time_unit, why_time = _time_unit(named["time"], _numbers(table, named["time"]))
-    else:
-        time_unit, why_time = "s", "time unit s: the nominal time"
-    accel_unit, why_accel = _accel_unit(table, named)
-    gyro_unit, why_gyro = _gyro_unit(table, named, accel_unit)
+    time_unit, accel_unit, gyro_unit, why = _guessed_units(table, named)
     units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
     if units:
         reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")
     layout = TableLayout(columns, gyro_unit=gyro_unit, accel_unit=accel_unit, time_unit=time_unit, rate_hz=rate_hz)
     used = [value.split("[", 1)[0] for value in columns.values()]  # a matrix read by its columns is used
     unused = tuple(name for name in store if name not in used)
-    return LayoutGuess(str(path), layout, (*reasons, why_time, why_accel, why_gyro), unused)
+    return LayoutGuess(str(path), layout, (*reasons, *why), unused)
 
 
 __all__ = ["GUESS_ROWS", "HeaderlessTable", "LayoutGuess", "NoTimeColumn", "guess_layout"]
