@@ -16,6 +16,17 @@ from ..conftest import run
 RAD = np.pi / 180.0
 
 
+def _init_then_allan_reads(folder, name: str, axis: str, gyro_dps: np.ndarray, rate_hz: float) -> None:
+    """``gyrocomp init NAME`` in ``folder``, then ``allan NAME --json`` with the project file it wrote: the curve
+    of ``axis`` equals the library's Allan deviation of ``gyro_dps`` [deg/s] at ``rate_hz`` [Hz], the file read as
+    mapped."""
+    assert run("init", name, cwd=folder).returncode == 0
+    allan = run("allan", name, "--json", cwd=folder)
+    assert allan.returncode == 0, allan.stderr
+    expected = allan_deviation(gyro_dps, rate_hz).deviation
+    np.testing.assert_allclose(json.loads(allan.stdout)["axes"][axis]["adev"], expected, rtol=1e-9)
+
+
 def _log(path, n=4000, rate_hz=100.0, *, names=None, time_unit="us", si=True, sep="\t", seed=0):
     """A chamber log as another project writes it: time in us, gyro in rad/s, accelerometer in m/s^2, the
     temperature rising through 30 degC; gyro bias 0.1 + 0.01 (T - 25) deg/s on each axis."""
@@ -235,11 +246,7 @@ def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
         "gyro_z": "gz",
     }
     assert any("raw counts, 1/16384 g" in r and "check the part's range" in r for r in guess.reasons)
-    assert run("init", "mpu.csv", cwd=tmp_path).returncode == 0
-    allan = run("allan", "mpu.csv", "--json", cwd=tmp_path)
-    assert allan.returncode == 0, allan.stderr
-    expected = allan_deviation(np.round(gyro[:, 0]) / 131.0, 100.0).deviation
-    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_x"]["adev"], expected, rtol=1e-9)
+    _init_then_allan_reads(tmp_path, "mpu.csv", "gyro_x", np.round(gyro[:, 0]) / 131.0, 100.0)
     odd_body = "\n".join(",".join(str(int(round(v))) for v in row) for row in np.column_stack([0.75 * accel, gyro]))
     (tmp_path / "odd.csv").write_text(preamble + "ax,ay,az,gx,gy,gz\n" + odd_body + "\n")  # 12,200 per g
     odd = guess_layout(tmp_path / "odd.csv", rate_hz=100.0)
@@ -267,11 +274,8 @@ def test_an_xsens_export_with_its_comment_lines_and_sample_time_fine(tmp_path):
     guess = guess_layout(tmp_path / "MT_0001.txt")
     assert guess.layout.columns["time"] == "SampleTimeFine" and guess.layout.time_unit == "100 us"
     assert guess.layout.delimiter == "\t" and guess.unused == ("PacketCounter",)
-    assert run("init", "MT_0001.txt", cwd=tmp_path).returncode == 0
-    allan = run("allan", "MT_0001.txt", "--json", cwd=tmp_path)
-    assert allan.returncode == 0, allan.stderr
-    expected = allan_deviation(np.round(gyro[:, 0], 6) * 180.0 / np.pi, rate_hz).deviation  # as written: 6 decimals
-    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_x"]["adev"], expected, rtol=1e-9)
+    as_written = np.round(gyro[:, 0], 6) * 180.0 / np.pi  # 6 decimals
+    _init_then_allan_reads(tmp_path, "MT_0001.txt", "gyro_x", as_written, rate_hz)
     counted = "\n".join(r.split("\t", 2)[0] + "\t" + r.split("\t", 2)[2] for r in rows)
     header = header.replace("SampleTimeFine\t", "")
     (tmp_path / "counted.txt").write_text(preamble + header + counted + "\n")
@@ -302,11 +306,7 @@ def test_files_of_named_arrays_get_their_layout_guessed_from_the_names(tmp_path)
         "temperature": "temperature_c",
     }
     assert (guess.layout.gyro_unit, guess.layout.accel_unit, guess.layout.time_unit) == ("mrad/s", "m/s2", "s")
-    assert run("init", "log.npz", cwd=tmp_path).returncode == 0
-    allan = run("allan", "log.npz", "--json", cwd=tmp_path)
-    assert allan.returncode == 0, allan.stderr
-    expected = allan_deviation(gyro_mrad_s[:, 1] * 0.18 / np.pi, 50.0).deviation
-    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_y"]["adev"], expected, rtol=1e-9)
+    _init_then_allan_reads(tmp_path, "log.npz", "gyro_y", gyro_mrad_s[:, 1] * 0.18 / np.pi, 50.0)
     with h5py.File(tmp_path / "axes.h5", "w") as f:
         f["imu/time"] = arrays["t_s"]
         for k, axis in enumerate("xyz"):

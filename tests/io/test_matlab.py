@@ -29,6 +29,11 @@ def imu():
     return t, 0.01 + 0.001 * rng.standard_normal((400, 3)), 20.0 + 0.01 * t
 
 
+def _gyro_columns(matrix: str, first: int = 0) -> dict[str, str]:
+    """gyro_x, gyro_y, gyro_z mapped to columns ``first``, ``first`` + 1, ``first`` + 2 of ``matrix``."""
+    return {f"gyro_{a}": f"{matrix}[:, {first + k}]" for k, a in enumerate("xyz")}
+
+
 def _mat73(path, arrays: dict) -> None:
     """A MATLAB v7.3 file as MATLAB writes one: the 512-byte header, then HDF5 holding each array by columns (a
     MATLAB (n, 3) array is an HDF5 (3, n) dataset) with its MATLAB_class."""
@@ -84,7 +89,7 @@ def test_columns_of_one_matrix_and_a_rate_for_a_file_without_time(tmp_path, imu)
     t, gyro, _ = imu
     path = tmp_path / "buffer.mat"
     scipy.io.savemat(path, {"gyroBuffer": np.column_stack([t, gyro])})
-    mapping = {"time": "gyroBuffer[:, 0]", **{f"gyro_{a}": f"gyroBuffer[:, {k + 1}]" for k, a in enumerate("xyz")}}
+    mapping = {"time": "gyroBuffer[:, 0]", **_gyro_columns("gyroBuffer", first=1)}
     rec = read(path, TableLayout(columns=mapping))
     np.testing.assert_array_equal(rec.gyro_dps, gyro)
     np.testing.assert_array_equal(rec.time_s, t)
@@ -94,7 +99,7 @@ def test_columns_of_one_matrix_and_a_rate_for_a_file_without_time(tmp_path, imu)
     np.savez(untimed, data=np.column_stack([gyro, gyro]))
     with pytest.raises(InputError, match=r"untimed.npz: no time dataset \(the file has data\); .*rate_hz=100"):
         read(untimed)
-    columns = {f"gyro_{a}": f"data[:, {k}]" for k, a in enumerate("xyz")}
+    columns = _gyro_columns("data")
     rec = read(untimed, TableLayout(columns=columns, rate_hz=50.0))
     np.testing.assert_array_equal(rec.time_s, np.arange(400) / 50.0)
     np.testing.assert_array_equal(rec.gyro_dps, gyro)
@@ -145,7 +150,7 @@ def test_real_matlab_v73_and_npz_files_read_as_h5py_and_numpy_read_them():
     (fs_hz)."""
     folder = shared_dataset("sunsided-mpu6050-static") / "unmoved-with-x-pointing-forward"
     path = folder / "mpu6050_gyroscope.mat"
-    mapping = {"time": "gyroBuffer[:, 0]", **{f"gyro_{a}": f"gyroBuffer[:, {k + 1}]" for k, a in enumerate("xyz")}}
+    mapping = {"time": "gyroBuffer[:, 0]", **_gyro_columns("gyroBuffer", first=1)}
     with h5py.File(path, "r") as f:
         expected = f["gyroBuffer"][:].T
     rec = read(path, TableLayout(columns=mapping))
@@ -154,7 +159,7 @@ def test_real_matlab_v73_and_npz_files_read_as_h5py_and_numpy_read_them():
     npz = shared_dataset("smac-imudata-adis16405") / "adis_16405_imu1.npz"
     with np.load(npz) as archive:
         data, rate_hz = archive["data"], float(archive["fs_hz"])
-    columns = {f"gyro_{a}": f"data[:, {k}]" for k, a in enumerate("xyz")}
+    columns = _gyro_columns("data")
     rec = read(npz, TableLayout(columns=columns, rate_hz=rate_hz))
     np.testing.assert_array_equal(rec.gyro_dps, data[:, :3].astype(float))
     assert rec.n_samples == 1_000_000 and rec.rate_hz == pytest.approx(100.0)
