@@ -20,6 +20,7 @@ from gyrocomp.models.fit import fit_channels
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.files import ChunkSettings, analyse_noise_file, evaluate_file
 from gyrocomp.simulation import simulate
+import gyrocomp.spilled_series as spilled_series
 from gyrocomp.spilled_series import SpillArray, block_median
 
 from ..conftest import run
@@ -66,14 +67,30 @@ def test_a_spilled_series_refuses_a_negative_memory_limit():
         SpillArray(memory_bytes=-1)
 
 
+@pytest.fixture(scope="module")
+def monkeypatch_passes():
+    """The passes :func:`block_median` makes over a series (each a walk of :func:`_inside`), listed as made."""
+    passes = []
+    inside = spilled_series._inside
+
+    def counted(*args):
+        passes.append(args[1:3])
+        return inside(*args)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(spilled_series, "_inside", counted)
+        yield passes
+
+
 @hsettings(max_examples=60, deadline=None)
 @given(
     st.integers(1, 3000),
     st.integers(1, 64),
-    st.sampled_from(["normal", "rounded", "mostly equal", "ulps"]),
+    st.sampled_from(["normal", "rounded", "mostly equal", "ulps", "every exponent"]),
     st.integers(0, 2**31),
 )
-def test_block_median_is_numpys_median_exactly(n, block, kind, seed):
+def test_block_median_is_numpys_median_exactly(monkeypatch_passes, n, block, kind, seed):
+    """Whatever the values' spread, in at most six passes over the series after the one for its extremes."""
     rng = np.random.default_rng(seed)
     values = {
         "normal": lambda: rng.standard_normal(n),
@@ -81,9 +98,13 @@ def test_block_median_is_numpys_median_exactly(n, block, kind, seed):
         "mostly equal": lambda: np.where(rng.random(n) < 0.01, rng.standard_normal(n), 0.01),
         # time steps of k / rate_hz stamps: a few distinct values float64 steps apart
         "ulps": lambda: 0.01 + rng.integers(-2, 3, n) * np.spacing(0.01),
+        # second differences of an interpolated temperature: zeros and rounding errors of every size, both signs
+        "every exponent": lambda: rng.choice([-1.0, 0.0, 1.0], n) * 10.0 ** rng.uniform(-310, -3, n),
     }[kind]()
     block = max(block, n // 40 + 1)  # up to 40 blocks: several, without a Python loop over thousands
+    monkeypatch_passes.clear()
     assert block_median(values, block=block, whole=0) == np.median(values)
+    assert len(monkeypatch_passes) <= 2 * 6 + 2  # each order statistic: six counting passes and its gathering
 
 
 def test_block_median_of_nothing_is_refused():
