@@ -59,11 +59,13 @@ def test_a_still_gyro_only_log_is_one_segment():
     w=st.integers(5, 60),
     seed=st.integers(0, 2**32 - 1),
     scale=st.floats(1e-6, 1e3),
+    rows=st.integers(1, 500),
 )
-@settings(max_examples=60, deadline=None)
-def test_the_moving_variance_column_by_column_is_the_whole_arrays_to_the_bit(n, columns, w, seed, scale):
-    """The still mask's moving variance is taken a column at a time (its working memory a few columns); the
-    result is the one of the running sums over the whole array (the formula it replaced), bit for bit."""
+@settings(max_examples=100, deadline=None)
+def test_the_moving_variance_column_by_column_is_the_whole_arrays_to_the_bit(n, columns, w, seed, scale, rows):
+    """The still mask's moving variance is taken a column at a time and ``rows`` rows at a time (its working
+    memory a few columns of a part); the result is the one of the running sums over the whole array (the formula
+    it replaced), bit for bit, however the rows are parted."""
     x = np.random.default_rng(seed).normal(size=(n, columns)) * scale + 3.0 * scale
     if n < w:
         expected = np.full(n, np.var(x, axis=0).sum())
@@ -74,4 +76,4 @@ def test_the_moving_variance_column_by_column_is_the_whole_arrays_to_the_bit(n, 
         s1, s2 = (c1[w:] - c1[:-w]) / w, (c2[w:] - c2[:-w]) / w
         var = np.maximum(s2 - s1 * s1, 0.0).sum(axis=1)
         expected = var[np.clip(np.arange(n) - w // 2, 0, var.size - 1)]
-    np.testing.assert_array_equal(_moving_variance(x, w), expected)
+    np.testing.assert_array_equal(_moving_variance(x, w, rows), expected)

@@ -6,11 +6,13 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import gyrocomp.runs.prepared as prepared_module
 from gyrocomp.errors import InputError
 from gyrocomp.models.fit import fit_channels
-from gyrocomp.runs.prepared import PreparedRun, block_means, fit_axes, prepare
+from gyrocomp.runs.prepared import PreparedRun, block_means, fit_axes, prefix_sums_at, prepare
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import simulate
 from gyrocomp.motion.positions import static_segments, still_mask
@@ -147,3 +149,26 @@ def test_a_channel_is_refused_where_the_run_cannot_give_it(session):
         PreparedRun.of(bare, "accel")
     with pytest.raises(InputError, match=r"no gyro axis 'accel_x'"):
         bare.signal("accel_x")
+
+
+@given(
+    n=st.integers(0, 300),
+    columns=st.integers(1, 4),
+    rows=st.integers(1, 400),
+    seed=st.integers(0, 2**32 - 1),
+    offset=st.sampled_from([0.0, 3.7]),
+)
+@settings(max_examples=80, deadline=None)
+def test_running_sums_in_parts_are_the_whole_columns_to_the_bit(n, columns, rows, seed, offset):
+    """The block means' running sums, taken ``rows`` rows at a time at indices anywhere in 0..n (in any order,
+    repeated), are ``np.cumsum`` over the whole column, bit for bit."""
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(n, columns)) * 1e3 + 5.0
+    at = rng.integers(0, n + 1, size=50)
+    whole = np.vstack([np.zeros((1, columns)), np.cumsum(x - offset if offset else x, axis=0)])
+    np.testing.assert_array_equal(prefix_sums_at(x, at, offset=offset, rows=rows), whole[at])
+    picked = [columns - 1, 0]
+    np.testing.assert_array_equal(
+        prefix_sums_at(x, at, columns=picked, rows=rows),
+        np.vstack([np.zeros((1, 2)), np.cumsum(x[:, picked], axis=0)])[at],
+    )

@@ -159,6 +159,10 @@ def _finding_dict(f: Finding) -> dict:
 
 
 # -- the checks of one run ------------------------------------------------------------------------------------
+#: samples read at once by the checks that walk a run (a few MB, whatever the run's length)
+CHUNK_ROWS = 1 << 18
+
+
 def _temperature(recording: Recording) -> np.ndarray | None:
     """The run's temperature [degC] (the mean of several sensors), finite samples only; None when absent."""
     t = recording.temperature_degc
@@ -166,32 +170,41 @@ def _temperature(recording: Recording) -> np.ndarray | None:
         return None
     t = np.asarray(t, dtype=float)
     t = t.mean(axis=1) if t.ndim == 2 else t
-    t = t[np.isfinite(t)]
+    if not np.isfinite(t).all():  # a recording's values are finite; a copy only for one that is not
+        t = t[np.isfinite(t)]
     return t if t.size else None
 
 
 def _quantization_step(t: np.ndarray) -> float:
     """The step of a temperature read on a grid [degC] (0 when it is not): the smallest change, when every value
-    lies on multiples of it from the first."""
-    steps = np.abs(np.diff(t))
-    steps = steps[steps > 1e-9]
-    if steps.size < 3:
+    lies on multiples of it from the first. Read :data:`CHUNK_ROWS` samples at a time."""
+    smallest, changes = np.inf, 0
+    for start in range(0, t.size - 1, CHUNK_ROWS):
+        steps = np.abs(np.diff(t[start : start + CHUNK_ROWS + 1]))
+        steps = steps[steps > 1e-9]
+        changes += steps.size
+        smallest = min(smallest, float(np.min(steps))) if steps.size else smallest
+    if changes < 3:
         return 0.0
-    q = float(np.min(steps))
-    on_grid = np.abs((t - t[0]) / q - np.round((t - t[0]) / q)) < 1e-3
-    return q if np.mean(on_grid) > 0.99 else 0.0
+    q, on_grid = smallest, 0
+    for start in range(0, t.size, CHUNK_ROWS):
+        scaled = (t[start : start + CHUNK_ROWS] - t[0]) / q
+        on_grid += int(np.count_nonzero(np.abs(scaled - np.round(scaled)) < 1e-3))
+    return q if on_grid / t.size > 0.99 else 0.0
 
 
 def _slope_dps_per_degc(recording: Recording, t: np.ndarray) -> float:
-    """The largest least-squares slope of an axis on the temperature [deg/s/degC] (for costs)."""
-    temp = np.asarray(recording.temperature_degc, dtype=float)
-    temp = temp.mean(axis=1) if temp.ndim == 2 else temp
-    ok = np.isfinite(temp)
-    if np.ptp(temp[ok]) <= 0:
+    """The largest least-squares slope of an axis on the temperature ``t`` [degC] (for costs) [deg/s/degC],
+    summed :data:`CHUNK_ROWS` samples at a time."""
+    if np.ptp(t) <= 0 or t.size != recording.n_samples:
         return 0.0
-    x = temp[ok] - temp[ok].mean()
-    g = recording.gyro_dps[ok] - recording.gyro_dps[ok].mean(axis=0)
-    return float(np.max(np.abs(x @ g / (x @ x))))
+    t_mean, g_mean = t.mean(), recording.gyro_dps.mean(axis=0)
+    cross, power = np.zeros(recording.gyro_dps.shape[1]), 0.0
+    for start in range(0, t.size, CHUNK_ROWS):
+        x = t[start : start + CHUNK_ROWS] - t_mean
+        cross += x @ (recording.gyro_dps[start : start + CHUNK_ROWS] - g_mean)
+        power += float(x @ x)
+    return float(np.max(np.abs(cross / power)))
 
 
 def temperature_findings(recording: Recording, ask: Ask) -> list[Finding]:
@@ -396,11 +409,21 @@ def unreadable(source: str, message: str) -> RunCheck:
 
 
 # -- the checks of a set of runs ----------------------------------------------------------------------------------
+def _levels(known: list) -> int:
+    """How many distinct temperatures to 0.1 degC the runs' temperatures ``known`` [degC] hold, read
+    :data:`CHUNK_ROWS` samples at a time (as many values held as there are levels)."""
+    levels = np.empty(0)
+    for t in known:
+        for start in range(0, t.size, CHUNK_ROWS):
+            levels = np.union1d(levels, np.round(t[start : start + CHUNK_ROWS], 1))
+    return int(levels.size)
+
+
 def _too_few_levels(recordings: Sequence[Recording], known: list, ask: Ask, out: dict) -> None:
     """Add to ``out`` (by run) the finding that the runs' temperatures ``known`` [degC] have fewer samples or
     levels than the curve asked needs."""
     samples = sum(t.size for t in known)
-    levels = len(np.unique(np.round(np.concatenate(known), 1)))
+    levels = _levels(known)
     if samples >= SAMPLES_PER_PARAMETER * ask.parameters and levels >= LEVELS_PER_PARAMETER * ask.parameters:
         return
     # fewer samples or levels than parameters: the curve asked is not determined at all

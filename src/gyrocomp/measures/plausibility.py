@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
-from ..effects import moving_average
+from ..effects import moving_average_range
 from ..recording import Recording
 from ..runs.prepared import PreparedRun
 from ..units import STANDARD_GRAVITY_M_PER_S2
@@ -109,7 +109,8 @@ def recording_concerns(recording: Recording) -> list[Concern]:
     in ms read as s, or the reverse)."""
     out = []
     src = recording.source
-    peak = float(np.max(np.abs(recording.gyro_dps))) if recording.gyro_dps.size else 0.0
+    gyro = recording.gyro_dps  # its largest magnitude from its extremes: no copy of the samples
+    peak = max(float(np.max(gyro)), -float(np.min(gyro))) if gyro.size else 0.0
     if peak > MAX_RATE_DPS:
         out.append(
             Concern(
@@ -216,7 +217,7 @@ def calibration_concerns(recording: Recording) -> list[Concern]:
                 )
             )
         if x.size >= w:
-            swing = float(np.ptp(moving_average(x, w)))
+            swing = moving_average_range(x, w)
             if swing > MAX_SWING_DPS and not turned_between_poses(recording):
                 out.append(
                     Concern(

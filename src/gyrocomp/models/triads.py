@@ -119,8 +119,9 @@ def _reaches_both_ways(recording: Recording) -> bool:
     """Whether some sample has each accelerometer axis beyond +-0.4 g: without it no pose can turn that axis
     within 60 deg of up and of down (half of gravity; 0.4 leaves room for a scale error), and the still-pose
     search (on every run of every fit) is not worth doing."""
-    accel = recording.accel_g[:, [recording.accel_axes.index(a) for a in ACCEL_AXES]]
-    return bool(np.all(accel.max(axis=0) > 0.4) and np.all(accel.min(axis=0) < -0.4))
+    order = [recording.accel_axes.index(a) for a in ACCEL_AXES]  # the columns' extremes: no copy of the samples
+    accel = recording.accel_g
+    return bool(np.all(accel.max(axis=0)[order] > 0.4) and np.all(accel.min(axis=0)[order] < -0.4))
 
 
 def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[PoseFit, Calibration | None]:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
+from ..spilled_series import SpillArray, block_median
 
 DEFAULT_WINDOW_S = 1.0
 DEFAULT_MIN_DURATION_S = 10.0
@@ -49,47 +50,89 @@ class StaticSegment:
     temperature_degc: float | None
 
 
-def _moving_variance(x: np.ndarray, w: int) -> np.ndarray:
+#: rows of a recording read at once by the still mask (a few MB of each column, whatever the recording's length)
+CHUNK_ROWS = 1 << 18
+
+
+def _moving_variance_parts(x: np.ndarray, w: int, rows: int = CHUNK_ROWS):
+    """The summed moving variance of :func:`_moving_variance`, in consecutive parts, ``rows`` rows of ``x`` read
+    at a time (``x`` may be a memory-mapped file): each column's running sums are carried from one part to the
+    next, in the same order of additions as over the whole column, so the parts joined are its result to the bit."""
+    n, k = x.shape
+    if n < w:
+        yield np.full(n, np.var(x, axis=0).sum())
+        return
+    means = x.mean(axis=0)
+    # each column's running sums of the centred values and of their squares, from window ``base`` on
+    sums = [(np.zeros(1), np.zeros(1)) for _ in range(k)]
+    base = 0
+    for start in range(0, n, rows):
+        stop = min(n, start + rows)
+        windows = stop - w + 1 - base  # windows [k, k + w) that end in this part
+        total = None
+        for j in range(k):
+            column = x[start:stop, j] - means[j]
+            c1, c2 = sums[j]
+            c1 = np.concatenate([c1, np.cumsum(np.concatenate([c1[-1:], column]))[1:]])
+            c2 = np.concatenate([c2, np.cumsum(np.concatenate([c2[-1:], column * column]))[1:]])
+            if windows > 0:
+                s1 = (c1[w : w + windows] - c1[:windows]) / w
+                s2 = (c2[w : w + windows] - c2[:windows]) / w
+                var = np.maximum(s2 - s1 * s1, 0.0)  # window k covers [k, k + w)
+                total = var if total is None else np.add(total, var, out=total)
+                c1, c2 = c1[windows:], c2[windows:]
+            sums[j] = (c1, c2)
+        if total is None:
+            continue
+        if base == 0:  # the first samples take the first full window's
+            yield np.full(w // 2, total[0])
+        yield total
+        base += windows
+        last = total[-1]
+    yield np.full(w - 1 - w // 2, last)  # and the last samples the last one's
+
+
+def _moving_variance(x: np.ndarray, w: int, rows: int = CHUNK_ROWS) -> np.ndarray:
     """Variance over a centred window of w samples (edges: the nearest full window), summed over columns.
 
-    Column by column (each column's running sums, then the next's), so that the working memory is a few columns'
-    worth, not a few copies of ``x``: the sums are those of the whole array's, to the bit."""
-    n = x.shape[0]
-    if n < w:
-        return np.full(n, np.var(x, axis=0).sum())
-    means = x.mean(axis=0)
-    total = None
-    for j in range(x.shape[1]):
-        column = x[:, j] - means[j]
-        c1 = np.concatenate([[0.0], np.cumsum(column)])
-        c2 = np.concatenate([[0.0], np.cumsum(column * column)])
-        del column
-        s1 = (c1[w:] - c1[:-w]) / w
-        del c1
-        s2 = (c2[w:] - c2[:-w]) / w
-        del c2
-        var = np.maximum(s2 - s1 * s1, 0.0)  # window k covers [k, k + w)
-        total = var if total is None else np.add(total, var, out=total)
-    idx = np.clip(np.arange(n) - w // 2, 0, total.size - 1)
-    return total[idx]
+    Column by column and ``rows`` rows at a time (:func:`_moving_variance_parts`), so that the working memory is a
+    few columns of a part, not copies of ``x``: the sums are those of the whole array's, to the bit."""
+    return np.concatenate(list(_moving_variance_parts(x, w, rows)))
+
+
+def _variance_series(recording: Recording, data: np.ndarray, w: int) -> SpillArray:
+    """The moving variance of ``data`` (:func:`_moving_variance`) inside each stretch between time gaps, in a
+    series held in memory while small and in a temporary file beyond (:class:`gyrocomp.spilled_series.SpillArray`)."""
+    series = SpillArray()
+    for piece in recording.contiguous_stretches():
+        for part in _moving_variance_parts(data[piece], w):
+            series.append(part)
+    return series
 
 
 def still_mask(
     recording: Recording, *, window_s: float = DEFAULT_WINDOW_S, factor: float = DEFAULT_FACTOR
 ) -> np.ndarray:
-    """True where the unit is still (see the module doc)."""
+    """True where the unit is still (see the module doc).
+
+    The moving variances are read in parts and kept in a series that goes to a temporary file when long, their
+    medians taken block by block (:func:`gyrocomp.spilled_series.block_median`): the working memory is the mask
+    and a few parts, whatever the recording's length."""
     if not window_s > 0 or not factor > 1:
         raise InputError(f"static detection: window {window_s} s must be positive and factor {factor} above 1")
     w = max(5, int(round(window_s * recording.rate_hz)))
-    gyro_var = np.empty(recording.n_samples)
-    accel_var = np.zeros(recording.n_samples) if recording.accel_g is not None else None
-    for piece in recording.contiguous_stretches():
-        gyro_var[piece] = _moving_variance(recording.gyro_dps[piece], w)
-        if accel_var is not None:
-            accel_var[piece] = _moving_variance(recording.accel_g[piece], w)
-    still = gyro_var <= factor * np.median(gyro_var)
-    if accel_var is not None:
-        still &= accel_var <= factor * max(np.median(accel_var), 1e-30)
+    with _variance_series(recording, recording.gyro_dps, w) as gyro:
+        gyro_var = gyro.finish()
+        gyro_limit = factor * block_median(gyro_var)
+        still = np.empty(recording.n_samples, dtype=bool)
+        for start in range(0, still.size, CHUNK_ROWS):
+            np.less_equal(gyro_var[start : start + CHUNK_ROWS], gyro_limit, out=still[start : start + CHUNK_ROWS])
+    if recording.accel_g is not None:
+        with _variance_series(recording, recording.accel_g, w) as accel:
+            accel_var = accel.finish()
+            accel_limit = factor * max(block_median(accel_var), 1e-30)
+            for start in range(0, still.size, CHUNK_ROWS):
+                still[start : start + CHUNK_ROWS] &= accel_var[start : start + CHUNK_ROWS] <= accel_limit
     return still
 
 

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..spilled_series import streamed_median
 
 GYRO_AXES = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL_AXES = ("accel_x", "accel_y", "accel_z")
@@ -18,6 +19,9 @@ REFERENCE_RATE_AXES = ("ref_rate_x", "ref_rate_y", "ref_rate_z")
 TEMPERATURE_COLUMN = "temperature"
 #: a gap is a time step longer than this many median sample periods
 GAP_FACTOR = 2.0
+#: rows checked at once (a few MB of each column): a recording's checks need no copy of its columns, which may be
+#: memory-mapped files
+CHUNK_ROWS = 1 << 18
 
 
 def _temperature_array(src: str, value, n: int, axes: tuple[str, ...]) -> np.ndarray | None:
@@ -86,15 +90,15 @@ def _require_finite(src: str, rows: np.ndarray, channels) -> None:
     for names, arr in channels:
         if arr is None:
             continue
-        table = arr.reshape(arr.shape[0], -1)
-        bad = ~np.isfinite(table)
-        if bad.any():
-            first = int(np.flatnonzero(bad.any(axis=1))[0])
-            column = names[int(np.flatnonzero(bad[first])[0])]
-            raise InputError(
-                f"{src}: row {rows[first]}, column {column!r}: {table[first][bad[first]][0]} "
-                "is not a finite number; fix the file or drop such rows explicitly (drop_nonfinite=True)"
-            )
+        for start, table in _row_chunks(arr):
+            bad = ~np.isfinite(table)
+            if bad.any():
+                at = int(np.flatnonzero(bad.any(axis=1))[0])
+                column = names[int(np.flatnonzero(bad[at])[0])]
+                raise InputError(
+                    f"{src}: row {rows[start + at]}, column {column!r}: {table[at][bad[at]][0]} "
+                    "is not a finite number; fix the file or drop such rows explicitly (drop_nonfinite=True)"
+                )
 
 
 #: values no sensor's output can be, in any unit it was taken in (raw 16-bit counts stay within 65536): a gyro or an
@@ -111,29 +115,54 @@ def _require_possible(src: str, rows: np.ndarray, channels) -> None:
         if arr is None:
             continue
         lo, hi, unit = POSSIBLE[kind]
-        table = arr.reshape(arr.shape[0], -1)
-        bad = (table < lo) | (table > hi)
-        if bad.any():
-            first = int(np.flatnonzero(bad.any(axis=1))[0])
-            column = names[int(np.flatnonzero(bad[first])[0])]
-            value = table[first][bad[first]][0]
+        for start, table in _row_chunks(arr):
+            bad = (table < lo) | (table > hi)
+            if bad.any():
+                at = int(np.flatnonzero(bad.any(axis=1))[0])
+                column = names[int(np.flatnonzero(bad[at])[0])]
+                value = table[at][bad[at]][0]
+                raise InputError(
+                    f"{src}: row {rows[start + at]}, column {column!r}: {value:.6g} {unit} is beyond what any "
+                    f"sensor gives ({lo:g}..{hi:g} {unit}): a damaged file, or a column in another unit "
+                    "than the one given?"
+                )
+
+
+def _row_chunks(arr: np.ndarray):
+    """(first row, rows as a 2-D table) of ``arr``, :data:`CHUNK_ROWS` rows at a time."""
+    table = arr.reshape(arr.shape[0], -1)
+    for start in range(0, table.shape[0], CHUNK_ROWS):
+        yield start, table[start : start + CHUNK_ROWS]
+
+
+def _time_steps(time_s: np.ndarray):
+    """(index of the first step, the steps [s]) of ``time_s``, :data:`CHUNK_ROWS` steps at a time."""
+    for start in range(0, time_s.size - 1, CHUNK_ROWS):
+        yield start, np.diff(time_s[start : start + CHUNK_ROWS + 1])
+
+
+def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray) -> None:
+    """Refuse the first row whose time repeats or goes backwards."""
+    for start, dt in _time_steps(time_s):
+        bad_steps = np.flatnonzero(dt <= 0)
+        if bad_steps.size:
+            i = start + int(bad_steps[0]) + 1
+            what = "repeats" if dt[bad_steps[0]] == 0 else "goes backwards"
             raise InputError(
-                f"{src}: row {rows[first]}, column {column!r}: {value:.6g} {unit} is beyond what any "
-                f"sensor gives ({lo:g}..{hi:g} {unit}): a damaged file, or a column in another unit "
-                "than the one given?"
+                f"{src}: row {rows[i]}: time {what} ({time_s[i]:.9g} s after {time_s[i - 1]:.9g} s); "
+                "time must strictly increase"
             )
 
 
-def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray, dt: np.ndarray) -> None:
-    """Refuse the first row whose time repeats or goes backwards."""
-    bad_steps = np.flatnonzero(dt <= 0)
-    if bad_steps.size:
-        i = int(bad_steps[0]) + 1
-        what = "repeats" if dt[i - 1] == 0 else "goes backwards"
-        raise InputError(
-            f"{src}: row {rows[i]}: time {what} ({time_s[i]:.9g} s after {time_s[i - 1]:.9g} s); "
-            "time must strictly increase"
-        )
+def _gaps(rows: np.ndarray, time_s: np.ndarray) -> tuple[float, tuple[Gap, ...]]:
+    """(the median sample period [s], the gaps: steps longer than ``GAP_FACTOR`` of it), the steps read a part at a
+    time, their median exact (:func:`gyrocomp.spilled_series.streamed_median`)."""
+    period = streamed_median(dt for _, dt in _time_steps(time_s))
+    gaps = []
+    for start, dt in _time_steps(time_s):
+        for i in np.flatnonzero(dt > GAP_FACTOR * period):
+            gaps.append(Gap(int(rows[start + i]), float(time_s[start + i]), float(dt[i])))
+    return period, tuple(gaps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -220,11 +249,8 @@ class Recording:
             rows,
             (("gyro", axes, gyro), ("temperature", temp_names, temp), ("accel", tuple(self.accel_axes), accel)),
         )
-        dt = np.diff(time_s)
-        _require_increasing(src, rows, time_s, dt)
-        period = float(np.median(dt))
-        gap_steps = np.flatnonzero(dt > GAP_FACTOR * period)
-        gaps = tuple(Gap(int(rows[i]), float(time_s[i]), float(dt[i])) for i in gap_steps)
+        _require_increasing(src, rows, time_s)
+        period, gaps = _gaps(rows, time_s)
         set_ = object.__setattr__
         set_(self, "time_s", time_s)
         set_(self, "gyro_dps", gyro)

@@ -60,6 +60,35 @@ class RunBlocks:
     samples: np.ndarray | None = None
 
 
+#: rows summed at once by :func:`prefix_sums_at` (a few MB of each column, whatever the recording's length)
+PREFIX_CHUNK_ROWS = 1 << 18
+
+
+def prefix_sums_at(
+    x: np.ndarray, at: np.ndarray, *, offset: float = 0.0, columns=None, rows: int = PREFIX_CHUNK_ROWS
+) -> np.ndarray:
+    """The running sums ``c[i] = sum(x[:i] - offset)`` at the indices ``at`` (each in 0..n), of the ``columns`` of
+    ``x`` (default: all), walked in chunks of ``rows`` rows, so that the working memory does not
+    grow with the recording (its columns may be memory-mapped files). The sums are ``np.cumsum``'s over the whole
+    column, to the bit: each chunk's sum starts from the sum before it, in the same order of additions."""
+    at = np.asarray(at, dtype=np.int64)
+    n = x.shape[0]
+    shape = x.shape[1:] if columns is None else (len(columns),)
+    out = np.zeros((at.size, *shape))
+    order = np.argsort(at, kind="stable")
+    ordered = at[order]
+    carry = np.zeros((1, *shape))
+    first = 0  # the first of ``ordered`` not yet given a value
+    for start in range(0, n, rows):
+        stop = min(n, start + rows)
+        chunk = x[start:stop] if columns is None else x[start:stop][:, columns]
+        c = np.cumsum(np.concatenate([carry, chunk - offset if offset else chunk]), axis=0)
+        last = int(np.searchsorted(ordered, stop, side="right"))
+        out[order[first:last]] = c[ordered[first:last] - start]
+        first, carry = last, c[-1:]
+    return out
+
+
 def block_means(
     rec: Recording, axis: str, block_s: float, bin_width_degc: float, pieces: Sequence[slice] | None = None
 ) -> RunBlocks:
@@ -78,15 +107,14 @@ def block_means(
     starts, ends, cluster = np.concatenate(starts), np.concatenate(ends), np.concatenate(cluster)
     counts = ends - starts
 
-    def mean(x):
-        c = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)])
-        return (c[ends] - c[starts]) / (counts if x.ndim == 1 else counts[:, None])
+    def mean(x, offset=0.0, columns=None):
+        c = prefix_sums_at(x, np.concatenate([starts, ends]), offset=offset, columns=columns)
+        return (c[starts.size :] - c[: starts.size]) / (counts if c.ndim == 1 else counts[:, None])
 
-    bt, btemp, by = mean(t - t[0]) + t[0], mean(temp), mean(y)
+    bt, btemp, by = mean(t, offset=t[0]) + t[0], mean(temp), mean(y)
     accel = None
     if rec.accel_g is not None and set(("accel_x", "accel_y", "accel_z")) <= set(rec.accel_axes):
-        order = [rec.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")]
-        accel = mean(rec.accel_g[:, order])
+        accel = mean(rec.accel_g, columns=[rec.accel_axes.index(a) for a in ("accel_x", "accel_y", "accel_z")])
     idx = np.floor(btemp / bin_width_degc).astype(np.int64)
     _, inverse, per_bin = np.unique(idx, return_inverse=True, return_counts=True)
     weight = (counts / counts.max()) / per_bin[inverse]
