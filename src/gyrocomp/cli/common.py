@@ -17,6 +17,7 @@ from ..option_spelling import Spelling, from_values, spelled_fields
 from .projectfile import ReadingOption
 from ..io import ReadOptions, format_spelling, read_input
 from ..io.atomic import check_output_file
+from ..files.chunks import read_whole
 from ..curves.network import DEFAULT_HIDDEN
 from ..curves.kinds import BASES
 from ..models.options import Curve, Network, Polynomial, curve_size_range, family_help
@@ -144,6 +145,13 @@ def read_settings(opts: dict, channels: tuple[str, ...] | None = None) -> ReadOp
 def read_run(path, opts: dict, channels: tuple[str, ...] | None = None):
     with progress_bar(f"reading {Path(path).name}") as progress:
         return read_input(path, read_settings(opts, channels), fmt=opts["fmt"], progress=progress)
+
+
+def read_whole_run(path, opts: dict):
+    """A run for a command that needs its whole recording (``.recording``; a fit): a large file gathered from its
+    chunks into temporary files (:func:`gyrocomp.files.chunks.read_whole`), so its size is not the memory's."""
+    with progress_bar(f"reading {Path(path).name}") as progress:
+        return read_whole(path, read_settings(opts), fmt=opts["fmt"], progress=progress)
 
 
 def pop_read_options(kwargs: dict) -> dict:

@@ -32,7 +32,7 @@ from .common import (
     pop_read_options,
     progress_bar,
     read_options,
-    read_run,
+    read_whole_run,
     temperature_help,
 )
 from .render import print_contributions, print_fit
@@ -212,7 +212,7 @@ def fit(
 def _checked_runs(runs, read_opts: dict, rate_schedule, still_only, options: FitOptions, accept, quiet: bool):
     """The runs read (through the rate schedule, field logs reduced to their still moments) and checked as
     gyrocomp check does (a run that cannot give a valid fit refused)."""
-    read = [read_noting(lambda p, o=read_opts: read_run(p, o), path) for path in runs]
+    read = [read_noting(lambda p, o=read_opts: read_whole_run(p, o), path) for path in runs]
     recordings = [r.recording for r in read]
     if rate_schedule is not None:
         recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))

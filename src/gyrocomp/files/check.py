@@ -8,8 +8,9 @@ import warnings
 from collections.abc import Iterable, Sequence
 
 from ..errors import DataQualityWarning, InputError
-from ..io import ReadOptions, read_input
+from ..io import ReadOptions
 from ..io.tables import release_table_memory
+from .chunks import read_whole
 from ..measures.data_check import Ask, CheckedRun, RunCheck, check_runs
 from ..models.options import FitOptions, Network, Polynomial
 
@@ -38,9 +39,10 @@ def ask_for(options: FitOptions | None = None) -> Ask:
 
 
 def read_checked(path: str | os.PathLike, options: ReadOptions | None = None, fmt: str | None = None) -> CheckedRun:
-    """Read one run for the check: its recording and the reader's warnings, or the reader's refusal."""
+    """Read one run for the check: its recording and the reader's warnings, or the reader's refusal (a large file
+    gathered from its chunks, as a fit reads it: :func:`gyrocomp.files.chunks.read_whole`)."""
     try:
-        return _noted(lambda p: read_input(p, options or ReadOptions(), fmt=fmt), path)
+        return _noted(lambda p: read_whole(p, options or ReadOptions(), fmt=fmt), path)
     except InputError as exc:
         return CheckedRun(os.fspath(path), None, refusal=str(exc))
 
