@@ -20,12 +20,24 @@ from .errors import InputError
 
 #: bytes a :class:`SpillArray` holds in memory before it moves to a file (8 MiB: 1 M samples)
 DEFAULT_MEMORY_BYTES = 1 << 23
+#: samples a part of a long series holds where a function walks it a part at a time (:func:`parts`: a few MB a
+#: column, whatever the series' length)
+PART_ROWS = 1 << 18
 #: values read at once by :func:`block_median`
 _BLOCK = 1 << 20
 #: series up to this length are read whole (128 MiB) and handed to np.median
 _WHOLE = 1 << 24
 #: bins of each histogram :func:`block_median` narrows the median with
 _BINS = 4096
+
+
+def parts(n: int, overlap: int = 0, rows: int | None = None):
+    """(start, stop) of the consecutive parts of a series of ``n`` values, ``rows`` each (default
+    :data:`PART_ROWS`, read when called), each part reaching ``overlap`` values into the next (1 for first
+    differences, 2 for second), the parts' starts covering 0..n - overlap."""
+    rows = PART_ROWS if rows is None else int(rows)
+    for start in range(0, max(n - overlap, 0), rows):
+        yield start, min(n, start + rows + overlap)
 
 
 class SpillArray:

@@ -15,9 +15,7 @@ import pytest
 import gyrocomp.curves.hysteresis as hysteresis_module
 import gyrocomp.fitting.selection as selection_module
 import gyrocomp.measures.data_check as data_check_module
-import gyrocomp.motion.positions as positions_module
-import gyrocomp.recording.recording as recording_module
-import gyrocomp.runs.prepared as prepared_module
+import gyrocomp.spilled_series as spilled_series
 from gyrocomp.errors import InputError
 from gyrocomp.files.chunks import ChunkSettings, GatheredRun, read_whole
 from gyrocomp.io import read_input, write_recording
@@ -139,15 +137,7 @@ def test_a_fit_of_a_gathered_file_is_the_fit_of_it_read_whole(chamber_with_gap, 
 @pytest.fixture
 def small_parts(monkeypatch):
     """Every check a fit makes of a run taken 333 samples at a time (the parts fall anywhere)."""
-    for module, name in (
-        (prepared_module, "PREFIX_CHUNK_ROWS"),
-        (positions_module, "CHUNK_ROWS"),
-        (data_check_module, "CHUNK_ROWS"),
-        (hysteresis_module, "CHUNK_ROWS"),
-        (selection_module, "CHUNK_ROWS"),
-        (recording_module, "CHUNK_ROWS"),
-    ):
-        monkeypatch.setattr(module, name, 333)
+    monkeypatch.setattr(spilled_series, "PART_ROWS", 333)
 
 
 def test_the_fits_checks_in_small_parts_give_the_model_of_the_whole_run(chamber_with_gap, small_parts, tmp_path):

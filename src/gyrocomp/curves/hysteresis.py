@@ -18,12 +18,8 @@ from ..effects import branch_position, find_turns, hysteresis_offset
 from ..errors import InputError
 from ..c_literals import c_array, c_number
 from ..recording import Recording
-from ..spilled_series import streamed_median
+from ..spilled_series import parts, streamed_median
 from .protocol import MEMORY_CURVES, CCode, memory_curve_from_dict, register_memory_curve
-
-
-#: samples read at once by :func:`turn_threshold_degc` (a few MB, whatever the series' length)
-CHUNK_ROWS = 1 << 18
 
 
 def turn_threshold_degc(temperature_degc: np.ndarray) -> float:
@@ -32,29 +28,22 @@ def turn_threshold_degc(temperature_degc: np.ndarray) -> float:
     Ten times the sample noise (robust, from the median absolute second difference, which a ramp
     does not inflate: the running extreme of a long dwell wanders several sigma), 1.5 times the
     quantization step when the values sit on a grid, and at least 0.1 degC. The series (which may be a
-    memory-mapped file) is read :data:`CHUNK_ROWS` samples at a time, the median taken exactly from a series that
-    goes to a temporary file when long (:func:`gyrocomp.spilled_series.streamed_median`).
+    memory-mapped file) is read a part at a time (:func:`gyrocomp.spilled_series.parts`), the median taken exactly
+    from a series that goes to a temporary file when long (:func:`gyrocomp.spilled_series.streamed_median`).
     """
     t = np.asarray(temperature_degc, dtype=float)
     n = t.size
-    ranges = range(0, max(n - 1, 0), CHUNK_ROWS)
-    noise = (
-        1.4826
-        * streamed_median(np.abs(np.diff(t[a : a + CHUNK_ROWS + 2], 2)) for a in range(0, n - 2, CHUNK_ROWS))
-        / math.sqrt(6.0)
-        if n > 2
-        else 0.0
-    )
+    second = (np.abs(np.diff(t[a:b], 2)) for a, b in parts(n, overlap=2))
+    noise = 1.4826 * streamed_median(second) / math.sqrt(6.0) if n > 2 else 0.0
 
-    def steps(a: int) -> np.ndarray:
-        step = np.abs(np.diff(t[a : a + CHUNK_ROWS + 1]))
-        return step[step > 0]
+    def steps():
+        for a, b in parts(n, overlap=1):
+            step = np.abs(np.diff(t[a:b]))
+            yield step[step > 0]
 
-    smallest = min((float(s.min()) for s in map(steps, ranges) if s.size), default=None)
+    smallest = min((float(s.min()) for s in steps() if s.size), default=None)
     lsb = 0.0
-    if smallest is not None and all(
-        np.allclose(s / smallest, np.round(s / smallest), atol=1e-6) for s in map(steps, ranges)
-    ):
+    if smallest is not None and all(np.allclose(s / smallest, np.round(s / smallest), atol=1e-6) for s in steps()):
         lsb = smallest
     return max(10.0 * noise, 1.5 * lsb, 0.1)
 

@@ -48,7 +48,7 @@ from ..effects import branch_position, find_turns, g_squared_products, thermal_l
 from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..measures.merit import moving_average
 from ..runs.prepared import PreparedRun, RunBlocks
-from ..spilled_series import streamed_median
+from ..spilled_series import parts, streamed_median
 from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
 from .folds import FoldKind, Folds, make_folds, window_for
@@ -182,23 +182,19 @@ class AxisSelection:
         }
 
 
-#: samples read at once by :func:`temperature_step_degc` (a few MB, whatever the series' length)
-CHUNK_ROWS = 1 << 18
-
-
 def temperature_step_degc(temperature_degc: np.ndarray) -> float:
     """The step of a quantized temperature register [degC], or 0 when the values are not on a coarse grid.
 
     The step is the most common non-zero difference between consecutive samples; the series counts as
     quantized when that step is at least ``COARSE_STEP_DEGC`` and almost every value (99 %) lies on its grid.
-    The series (which may be a memory-mapped file) is read :data:`CHUNK_ROWS` samples at a time: the steps are
+    The series (which may be a memory-mapped file) is read a part at a time: the steps are
     counted by their value (to 1e-6 degC, as many as there are distinct ones), the median offset from the grid
     taken exactly (:func:`gyrocomp.spilled_series.streamed_median`).
     """
     t = np.asarray(temperature_degc, dtype=float)
     values, counts = np.empty(0), np.empty(0, dtype=np.int64)
-    for a in range(0, max(t.size - 1, 0), CHUNK_ROWS):
-        steps = np.abs(np.diff(t[a : a + CHUNK_ROWS + 1]))
+    for a, b in parts(t.size, overlap=1):
+        steps = np.abs(np.diff(t[a:b]))
         here, many = np.unique(np.round(steps[steps > 1e-9], 6), return_counts=True)
         values, where = np.unique(np.concatenate([values, here]), return_inverse=True)
         counts = np.bincount(where, weights=np.concatenate([counts, many]), minlength=values.size).astype(np.int64)
@@ -209,9 +205,8 @@ def temperature_step_degc(temperature_degc: np.ndarray) -> float:
         return 0.0
 
     def offsets():
-        for a in range(0, t.size, CHUNK_ROWS):
-            part = t[a : a + CHUNK_ROWS]
-            yield part - np.round(part / step) * step
+        for a, b in parts(t.size):
+            yield t[a:b] - np.round(t[a:b] / step) * step
 
     phase = streamed_median(offsets())
     on_grid = sum(int(np.count_nonzero(np.abs(offset - phase) < 0.01 * step)) for offset in offsets())

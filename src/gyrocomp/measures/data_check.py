@@ -32,6 +32,7 @@ import numpy as np
 from ..effects import moving_average
 from ..errors import TimeOrderWarning
 from ..recording import Recording
+from ..spilled_series import parts
 from .plausibility import turned_between_poses
 
 Severity = Literal["refuse", "warn"]
@@ -159,10 +160,6 @@ def _finding_dict(f: Finding) -> dict:
 
 
 # -- the checks of one run ------------------------------------------------------------------------------------
-#: samples read at once by the checks that walk a run (a few MB, whatever the run's length)
-CHUNK_ROWS = 1 << 18
-
-
 def _temperature(recording: Recording) -> np.ndarray | None:
     """The run's temperature [degC] (the mean of several sensors), finite samples only; None when absent."""
     t = recording.temperature_degc
@@ -177,32 +174,32 @@ def _temperature(recording: Recording) -> np.ndarray | None:
 
 def _quantization_step(t: np.ndarray) -> float:
     """The step of a temperature read on a grid [degC] (0 when it is not): the smallest change, when every value
-    lies on multiples of it from the first. Read :data:`CHUNK_ROWS` samples at a time."""
+    lies on multiples of it from the first. Read a part at a time (:func:`gyrocomp.spilled_series.parts`)."""
     smallest, changes = np.inf, 0
-    for start in range(0, t.size - 1, CHUNK_ROWS):
-        steps = np.abs(np.diff(t[start : start + CHUNK_ROWS + 1]))
+    for start, stop in parts(t.size, overlap=1):
+        steps = np.abs(np.diff(t[start:stop]))
         steps = steps[steps > 1e-9]
         changes += steps.size
         smallest = min(smallest, float(np.min(steps))) if steps.size else smallest
     if changes < 3:
         return 0.0
     q, on_grid = smallest, 0
-    for start in range(0, t.size, CHUNK_ROWS):
-        scaled = (t[start : start + CHUNK_ROWS] - t[0]) / q
+    for start, stop in parts(t.size):
+        scaled = (t[start:stop] - t[0]) / q
         on_grid += int(np.count_nonzero(np.abs(scaled - np.round(scaled)) < 1e-3))
     return q if on_grid / t.size > 0.99 else 0.0
 
 
 def _slope_dps_per_degc(recording: Recording, t: np.ndarray) -> float:
     """The largest least-squares slope of an axis on the temperature ``t`` [degC] (for costs) [deg/s/degC],
-    summed :data:`CHUNK_ROWS` samples at a time."""
+    summed a part at a time."""
     if np.ptp(t) <= 0 or t.size != recording.n_samples:
         return 0.0
     t_mean, g_mean = t.mean(), recording.gyro_dps.mean(axis=0)
     cross, power = np.zeros(recording.gyro_dps.shape[1]), 0.0
-    for start in range(0, t.size, CHUNK_ROWS):
-        x = t[start : start + CHUNK_ROWS] - t_mean
-        cross += x @ (recording.gyro_dps[start : start + CHUNK_ROWS] - g_mean)
+    for start, stop in parts(t.size):
+        x = t[start:stop] - t_mean
+        cross += x @ (recording.gyro_dps[start:stop] - g_mean)
         power += float(x @ x)
     return float(np.max(np.abs(cross / power)))
 
@@ -411,11 +408,11 @@ def unreadable(source: str, message: str) -> RunCheck:
 # -- the checks of a set of runs ----------------------------------------------------------------------------------
 def _levels(known: list) -> int:
     """How many distinct temperatures to 0.1 degC the runs' temperatures ``known`` [degC] hold, read
-    :data:`CHUNK_ROWS` samples at a time (as many values held as there are levels)."""
+    a part at a time (as many values held as there are levels)."""
     levels = np.empty(0)
     for t in known:
-        for start in range(0, t.size, CHUNK_ROWS):
-            levels = np.union1d(levels, np.round(t[start : start + CHUNK_ROWS], 1))
+        for start, stop in parts(t.size):
+            levels = np.union1d(levels, np.round(t[start:stop], 1))
     return int(levels.size)
 
 

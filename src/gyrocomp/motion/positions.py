@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..spilled_series import SpillArray, block_median
+from ..spilled_series import SpillArray, block_median, parts
 
 DEFAULT_WINDOW_S = 1.0
 DEFAULT_MIN_DURATION_S = 10.0
@@ -50,13 +50,9 @@ class StaticSegment:
     temperature_degc: float | None
 
 
-#: rows of a recording read at once by the still mask (a few MB of each column, whatever the recording's length)
-CHUNK_ROWS = 1 << 18
-
-
-def _moving_variance_parts(x: np.ndarray, w: int, rows: int = CHUNK_ROWS):
+def _moving_variance_parts(x: np.ndarray, w: int, rows: int | None = None):
     """The summed moving variance of :func:`_moving_variance`, in consecutive parts, ``rows`` rows of ``x`` read
-    at a time (``x`` may be a memory-mapped file): each column's running sums are carried from one part to the
+    at a time (default: :data:`gyrocomp.spilled_series.PART_ROWS`; ``x`` may be a memory-mapped file): each column's running sums are carried from one part to the
     next, in the same order of additions as over the whole column, so the parts joined are its result to the bit."""
     n, k = x.shape
     if n < w:
@@ -66,8 +62,7 @@ def _moving_variance_parts(x: np.ndarray, w: int, rows: int = CHUNK_ROWS):
     # each column's running sums of the centred values and of their squares, from window ``base`` on
     sums = [(np.zeros(1), np.zeros(1)) for _ in range(k)]
     base = 0
-    for start in range(0, n, rows):
-        stop = min(n, start + rows)
+    for start, stop in parts(n, rows=rows):
         windows = stop - w + 1 - base  # windows [k, k + w) that end in this part
         total = None
         for j in range(k):
@@ -92,7 +87,7 @@ def _moving_variance_parts(x: np.ndarray, w: int, rows: int = CHUNK_ROWS):
     yield np.full(w - 1 - w // 2, last)  # and the last samples the last one's
 
 
-def _moving_variance(x: np.ndarray, w: int, rows: int = CHUNK_ROWS) -> np.ndarray:
+def _moving_variance(x: np.ndarray, w: int, rows: int | None = None) -> np.ndarray:
     """Variance over a centred window of w samples (edges: the nearest full window), summed over columns.
 
     Column by column and ``rows`` rows at a time (:func:`_moving_variance_parts`), so that the working memory is a
@@ -125,14 +120,14 @@ def still_mask(
         gyro_var = gyro.finish()
         gyro_limit = factor * block_median(gyro_var)
         still = np.empty(recording.n_samples, dtype=bool)
-        for start in range(0, still.size, CHUNK_ROWS):
-            np.less_equal(gyro_var[start : start + CHUNK_ROWS], gyro_limit, out=still[start : start + CHUNK_ROWS])
+        for start, stop in parts(still.size):
+            np.less_equal(gyro_var[start:stop], gyro_limit, out=still[start:stop])
     if recording.accel_g is not None:
         with _variance_series(recording, recording.accel_g, w) as accel:
             accel_var = accel.finish()
             accel_limit = factor * max(block_median(accel_var), 1e-30)
-            for start in range(0, still.size, CHUNK_ROWS):
-                still[start : start + CHUNK_ROWS] &= accel_var[start : start + CHUNK_ROWS] <= accel_limit
+            for start, stop in parts(still.size):
+                still[start:stop] &= accel_var[start:stop] <= accel_limit
     return still
 
 

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..spilled_series import streamed_median
+from ..spilled_series import parts, streamed_median
 
 GYRO_AXES = ("gyro_x", "gyro_y", "gyro_z")
 ACCEL_AXES = ("accel_x", "accel_y", "accel_z")
@@ -19,9 +19,6 @@ REFERENCE_RATE_AXES = ("ref_rate_x", "ref_rate_y", "ref_rate_z")
 TEMPERATURE_COLUMN = "temperature"
 #: a gap is a time step longer than this many median sample periods
 GAP_FACTOR = 2.0
-#: rows checked at once (a few MB of each column): a recording's checks need no copy of its columns, which may be
-#: memory-mapped files
-CHUNK_ROWS = 1 << 18
 
 
 def _temperature_array(src: str, value, n: int, axes: tuple[str, ...]) -> np.ndarray | None:
@@ -129,16 +126,17 @@ def _require_possible(src: str, rows: np.ndarray, channels) -> None:
 
 
 def _row_chunks(arr: np.ndarray):
-    """(first row, rows as a 2-D table) of ``arr``, :data:`CHUNK_ROWS` rows at a time."""
+    """(first row, rows as a 2-D table) of ``arr``, a part at a time (:func:`gyrocomp.spilled_series.parts`): a
+    recording's checks need no copy of its columns, which may be memory-mapped files."""
     table = arr.reshape(arr.shape[0], -1)
-    for start in range(0, table.shape[0], CHUNK_ROWS):
-        yield start, table[start : start + CHUNK_ROWS]
+    for start, stop in parts(table.shape[0]):
+        yield start, table[start:stop]
 
 
 def _time_steps(time_s: np.ndarray):
-    """(index of the first step, the steps [s]) of ``time_s``, :data:`CHUNK_ROWS` steps at a time."""
-    for start in range(0, time_s.size - 1, CHUNK_ROWS):
-        yield start, np.diff(time_s[start : start + CHUNK_ROWS + 1])
+    """(index of the first step, the steps [s]) of ``time_s``, a part at a time."""
+    for start, stop in parts(time_s.size, overlap=1):
+        yield start, np.diff(time_s[start:stop])
 
 
 def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray) -> None:

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import ACCEL_AXES, Recording
+from ..spilled_series import parts
 from ..motion.positions import (
     DEFAULT_FACTOR,
     DEFAULT_MIN_DURATION_S,
@@ -60,17 +61,14 @@ class RunBlocks:
     samples: np.ndarray | None = None
 
 
-#: rows summed at once by :func:`prefix_sums_at` (a few MB of each column, whatever the recording's length)
-PREFIX_CHUNK_ROWS = 1 << 18
-
-
 def prefix_sums_at(
-    x: np.ndarray, at: np.ndarray, *, offset: float = 0.0, columns=None, rows: int = PREFIX_CHUNK_ROWS
+    x: np.ndarray, at: np.ndarray, *, offset: float = 0.0, columns=None, rows: int | None = None
 ) -> np.ndarray:
     """The running sums ``c[i] = sum(x[:i] - offset)`` at the indices ``at`` (each in 0..n), of the ``columns`` of
-    ``x`` (default: all), walked in chunks of ``rows`` rows, so that the working memory does not
-    grow with the recording (its columns may be memory-mapped files). The sums are ``np.cumsum``'s over the whole
-    column, to the bit: each chunk's sum starts from the sum before it, in the same order of additions."""
+    ``x`` (default: all), walked in parts of ``rows`` rows (default: :data:`gyrocomp.spilled_series.PART_ROWS`), so
+    that the working memory does not grow with the recording (its columns may be memory-mapped files). The sums are
+    ``np.cumsum``'s over the whole column, to the bit: each part's sum starts from the sum before it, in the same
+    order of additions."""
     at = np.asarray(at, dtype=np.int64)
     n = x.shape[0]
     shape = x.shape[1:] if columns is None else (len(columns),)
@@ -79,8 +77,7 @@ def prefix_sums_at(
     ordered = at[order]
     carry = np.zeros((1, *shape))
     first = 0  # the first of ``ordered`` not yet given a value
-    for start in range(0, n, rows):
-        stop = min(n, start + rows)
+    for start, stop in parts(n, rows=rows):
         chunk = x[start:stop] if columns is None else x[start:stop][:, columns]
         c = np.cumsum(np.concatenate([carry, chunk - offset if offset else chunk]), axis=0)
         last = int(np.searchsorted(ordered, stop, side="right"))
