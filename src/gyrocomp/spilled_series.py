@@ -9,6 +9,7 @@ blocks (:mod:`gyrocomp.allan`), or as an ordinary array when it stayed in memory
 
 from __future__ import annotations
 
+import contextlib
 import shutil
 import tempfile
 import weakref
@@ -95,7 +96,7 @@ class SpillArray:
         if self._file is None and self._held + block.nbytes > self.memory_bytes:
             self._spill()
         if self._file is not None:
-            self._file.write(block.tobytes())
+            self._write(block)
         else:
             self._blocks.append(block.copy() if block.base is not None else block)
             self._held += block.nbytes
@@ -105,15 +106,29 @@ class SpillArray:
         self._path = Path(self._folder) / "series.f64"
         self._file = open(self._path, "wb")
         for block in self._blocks:
-            self._file.write(block.tobytes())
+            self._write(block)
         self._blocks, self._held = [], 0
+
+    def _write(self, block: np.ndarray) -> None:
+        """``block`` onto the file; a failure (a full disk) names the file, so that a message says where the
+        temporary series went (the system's temporary folder, ``TMPDIR``, unless a ``directory`` was given)."""
+        try:
+            self._file.write(block.tobytes())
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, str(self._path)) from exc
+
+    def _close_file(self) -> None:
+        file, self._file = self._file, None
+        try:
+            file.close()  # what was still buffered is written here
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, str(self._path)) from exc
 
     def finish(self) -> np.ndarray:
         """The whole series, writable: an array, or a ``np.memmap`` of the file (valid until :meth:`close`)."""
         if self._finished is None:
             if self._file is not None:
-                self._file.close()
-                self._file = None
+                self._close_file()
                 self._finished = (
                     np.memmap(self._path, dtype=self.dtype, mode="r+", shape=(self.size,))
                     if self.size
@@ -143,7 +158,8 @@ class SpillArray:
     def close(self) -> None:
         """Forget the series and remove its file."""
         if self._file is not None:
-            self._file.close()
+            with contextlib.suppress(OSError):  # what the file could not take is dropped with it
+                self._file.close()
             self._file = None
         self._finished, self._blocks = None, []
         if self._folder is not None:

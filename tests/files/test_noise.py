@@ -6,7 +6,9 @@ gaps and triads."""
 from __future__ import annotations
 
 import dataclasses
+import errno
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -60,6 +62,24 @@ def test_a_spilled_series_holds_what_was_appended_and_its_file_goes_on_close(tmp
         with pytest.raises(InputError, match="values: the series is finished"):
             spilled.append([1.0])
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full, a device that is always full")
+@pytest.mark.parametrize("values", [2_000_000, 10], ids=["written at once", "buffered until finished"])
+def test_a_full_disk_under_a_spilled_series_names_its_file_and_leaves_nothing(values, tmp_path, monkeypatch):
+    """The series' file put on a full disk (a link to /dev/full): the error names the file, in one line through
+    the command line's mapping, and closing the series removes its folder."""
+    folder = tmp_path / "gyrocomp-full"
+    folder.mkdir()
+    (folder / "series.f64").symlink_to("/dev/full")
+    monkeypatch.setattr(spilled_series.tempfile, "mkdtemp", lambda **kwargs: str(folder))
+    series = SpillArray(memory_bytes=0)
+    with pytest.raises(OSError, match="No space left on device") as full:
+        series.append(np.ones(values))
+        series.finish()
+    assert full.value.errno == errno.ENOSPC and full.value.filename == str(folder / "series.f64")
+    series.close()
+    assert not folder.exists()
 
 
 def test_a_spilled_series_refuses_a_negative_memory_limit():
