@@ -247,6 +247,8 @@ def test_the_short_first_order_filter_is_scipys_to_the_bit(n):
 @settings(max_examples=25, deadline=None)
 @given(st.integers(1, 5000), st.integers(1, 70_000), st.integers(0, 2**31 - 1))
 def test_moving_average_range_is_the_peak_to_peak_of_the_moving_average(w, n, seed):
-    """Block by block (blocks of 4096 here), the same extremes as the whole moving average, to the bit."""
+    """A part at a time (4096 samples, and parts shorter than the window), the same extremes as the whole moving
+    average, to the bit."""
     x = np.cumsum(np.random.default_rng(seed).standard_normal(max(n, w))) * 0.01 + 3.0
-    assert moving_average_range(x, w, block=4096) == float(np.ptp(moving_average(x, w)))
+    assert moving_average_range(x, w, rows=4096) == float(np.ptp(moving_average(x, w)))
+    assert moving_average_range(x, w, rows=w // 2 + 1) == float(np.ptp(moving_average(x, w)))

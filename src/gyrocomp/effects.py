@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
+from .spilled_series import parts
 
 HYSTERESIS_DIRECTIONS = ("descending", "ascending", "both")
 #: order of the g x g terms: products of specific-force components [g^2]
@@ -500,20 +501,28 @@ def moving_average(x: np.ndarray, window_samples: int) -> np.ndarray:
     return out
 
 
-def moving_average_range(x: np.ndarray, window_samples: int, block: int = 1 << 16) -> float:
-    """Peak-to-peak of :func:`moving_average` [unit of x], the same values, its extremes found block by block
-    (no array of the average's length)."""
-    x, c, w = _window_sums(x, window_samples)
-    count = x.size - w + 1
-    part = np.empty(min(block, count))
+def moving_average_range(x: np.ndarray, window_samples: int, rows: int | None = None) -> float:
+    """Peak-to-peak of :func:`moving_average` [unit of x], the same values, found a part of ``rows`` samples at a
+    time (default :data:`gyrocomp.spilled_series.PART_ROWS`): the running sum is carried from part to part in the
+    same order of additions, so no array of the data's length is made (``x`` may be a memory-mapped file)."""
+    x = np.asarray(x, dtype=float)
+    w = int(window_samples)
+    if w < 1:
+        raise InputError(f"window: must be at least one sample, got {w}")
+    if w > x.size:
+        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
+    first = x[0]
+    held, base = np.zeros(1), 0  # the running sums about the first value from sample ``base`` on
     low, high = math.inf, -math.inf
-    for start in range(0, count, block):
-        stop = min(start + block, count)
-        out = part[: stop - start]
-        np.subtract(c[start + w : stop + w], c[start:stop], out=out)
-        out /= w
-        out += x[0]
-        low, high = min(low, float(out.min())), max(high, float(out.max()))
+    for start, stop in parts(x.size, rows=rows):
+        held = np.concatenate([held, np.cumsum(np.concatenate([held[-1:], x[start:stop] - first]))[1:]])
+        windows = stop - w + 1 - base  # the windows [k, k + w) that end in this part
+        if windows > 0:
+            out = held[w : w + windows] - held[:windows]
+            out /= w
+            out += first
+            low, high = min(low, float(out.min())), max(high, float(out.max()))
+            held, base = held[windows:], base + windows
     return high - low
 
 

@@ -32,7 +32,7 @@ import numpy as np
 from ..effects import moving_average
 from ..errors import TimeOrderWarning
 from ..recording import Recording
-from ..spilled_series import parts
+from ..spilled_series import parts, streamed_median
 from .plausibility import turned_between_poses
 
 Severity = Literal["refuse", "warn"]
@@ -268,12 +268,13 @@ def gap_findings(recording: Recording) -> list[Finding]:
 
 
 def rail_findings(recording: Recording) -> list[Finding]:
-    """A rail: an axis's extreme value held RAIL_RUN_SAMPLES times in a row, RAIL_SIGMAS from its median."""
+    """A rail: an axis's extreme value held RAIL_RUN_SAMPLES times in a row, RAIL_SIGMAS from its median (the
+    medians exact, a part at a time: :func:`gyrocomp.spilled_series.streamed_median`)."""
     out = []
     for j, axis in enumerate(recording.gyro_axes):
         x = recording.gyro_dps[:, j]
-        median = float(np.median(x))
-        sigma = 1.4826 * float(np.median(np.abs(x - median))) or 1e-12
+        median = streamed_median(x[a:b] for a, b in parts(x.size))
+        sigma = 1.4826 * streamed_median(np.abs(x[a:b] - median) for a, b in parts(x.size)) or 1e-12
         for edge in (float(np.max(x)), float(np.min(x))):
             if abs(edge - median) < RAIL_SIGMAS * sigma:
                 continue

@@ -42,6 +42,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
+from ..spilled_series import parts
 
 BLOCK_S = 1.0
 MIN_DURATION_S = 20.0
@@ -451,7 +452,14 @@ def detect_still(
         False-alarm probability of each block test.
     """
     state = StillnessState(recording.rate_hz, block_s)
-    state.update(recording.time_s, recording.gyro_dps, recording.accel_g, recording.temperature_degc)
+    accel, temperature = recording.accel_g, recording.temperature_degc
+    for a, b in parts(recording.n_samples):  # a part at a time: no temporary as long as the log
+        state.update(
+            recording.time_s[a:b],
+            recording.gyro_dps[a:b],
+            None if accel is None else accel[a:b],
+            None if temperature is None else temperature[a:b],
+        )
     return detection(state.blocks(), min_duration_s=min_duration_s, quantile=quantile, alpha=alpha)
 
 
