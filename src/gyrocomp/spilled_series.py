@@ -230,16 +230,18 @@ def _order_statistic(values, rank: int, low: float, high: float, block: int) -> 
     below = 0  # values whose key is less than lo
     while lo < hi:
         span = hi - lo + 1
-        bins = min(_BINS, span)
-        edges = [lo + span * k // bins for k in range(bins + 1)]  # bin k holds keys in [edges[k], edges[k + 1])
-        inner = np.array(edges[1:-1], dtype=np.int64)
+        width = -(-span // _BINS)  # bin k holds keys in [lo + k width, lo + (k + 1) width)
+        bins = -(-span // width)
         counts = np.zeros(bins, dtype=np.int64)
+        start = np.uint64(lo % (1 << 64))
         for keys in _inside(values, lo, hi, block):
-            counts += np.bincount(np.searchsorted(inner, keys, side="right"), minlength=bins)
+            # the distance from lo in unsigned 64-bit arithmetic (it can exceed the int64 range), divided
+            offsets = (keys.view(np.uint64) - start) // np.uint64(width)
+            counts += np.bincount(offsets.astype(np.intp), minlength=bins)
         cumulated = below + np.cumsum(counts)
         j = int(np.searchsorted(cumulated, rank, side="right"))
         below = int(cumulated[j - 1]) if j else below
-        lo, hi = edges[j], edges[j + 1] - 1
+        lo, hi = lo + j * width, min(hi, lo + (j + 1) * width - 1)
         if counts[j] <= block:
             keys = np.concatenate(list(_inside(values, lo, hi, block)))
             return _value(int(np.partition(keys, rank - below)[rank - below]))
