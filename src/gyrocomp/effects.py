@@ -476,15 +476,21 @@ def quantize(x: np.ndarray, lsb: float) -> np.ndarray:
     return np.round(np.asarray(x, dtype=float) / lsb) * lsb
 
 
-def _window_sums(x: np.ndarray, window_samples: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """(x as floats, its running sum about its first value with a leading 0, the window [samples]), the window
-    checked: in place, no temporary of the data's size."""
+def _checked_window(x: np.ndarray, window_samples: int) -> tuple[np.ndarray, int]:
+    """(x as floats, the window [samples]), the window at least one sample and no longer than the data."""
     x = np.asarray(x, dtype=float)
     w = int(window_samples)
     if w < 1:
         raise InputError(f"window: must be at least one sample, got {w}")
     if w > x.size:
         raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
+    return x, w
+
+
+def _window_sums(x: np.ndarray, window_samples: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """(x as floats, its running sum about its first value with a leading 0, the window [samples]), the window
+    checked: in place, no temporary of the data's size."""
+    x, w = _checked_window(x, window_samples)
     c = np.empty(x.size + 1)
     c[0] = 0.0
     np.subtract(x, x[0], out=c[1:])
@@ -505,12 +511,7 @@ def moving_average_range(x: np.ndarray, window_samples: int, rows: int | None = 
     """Peak-to-peak of :func:`moving_average` [unit of x], the same values, found a part of ``rows`` samples at a
     time (default :data:`gyrocomp.spilled_series.PART_ROWS`): the running sum is carried from part to part in the
     same order of additions, so no array of the data's length is made (``x`` may be a memory-mapped file)."""
-    x = np.asarray(x, dtype=float)
-    w = int(window_samples)
-    if w < 1:
-        raise InputError(f"window: must be at least one sample, got {w}")
-    if w > x.size:
-        raise InputError(f"window: {w} samples is longer than the data ({x.size} samples)")
+    x, w = _checked_window(x, window_samples)
     first = x[0]
     held, base = np.zeros(1), 0  # the running sums about the first value from sample ``base`` on
     low, high = math.inf, -math.inf

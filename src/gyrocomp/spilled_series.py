@@ -2,9 +2,11 @@
 file beyond a limit, so a command that reads a file in chunks keeps a bounded working memory whatever the file's
 length (issue #21); and the exact median of such a series, read block by block.
 
-The file is a raw float64 array (or of the series' ``dtype``; native byte order) in a temporary folder removed on :meth:`SpillArray.close`;
-:meth:`SpillArray.finish` gives it back as a ``np.memmap`` that the Allan engine and the moving averages read in
-blocks (:mod:`gyrocomp.allan`), or as an ordinary array when it stayed in memory.
+The file is a raw float64 array (or of the series' ``dtype``; native byte order) in a temporary folder removed on
+:meth:`SpillArray.close`; :meth:`SpillArray.finish` gives it back as a ``np.memmap`` that the Allan engine and the
+moving averages read in blocks (:mod:`gyrocomp.allan`), or as an ordinary array when it stayed in memory, and
+:meth:`SpillArray.detach` hands it over (a recording gathered from a file's chunks, :mod:`gyrocomp.files.chunks`).
+Functions that walk such a series a part at a time take their parts from :func:`parts`.
 """
 
 from __future__ import annotations
@@ -193,13 +195,13 @@ def block_median(values, block: int = _BLOCK, whole: int = _WHOLE) -> float:
     return float(np.mean([lower, upper]))
 
 
-def streamed_median(parts) -> float:
-    """The median of the values of ``parts`` (an iterable of 1-D arrays, taken in turn), exactly as ``np.median``
+def streamed_median(pieces) -> float:
+    """The median of the values of ``pieces`` (an iterable of 1-D arrays, taken in turn), exactly as ``np.median``
     of them joined gives it: kept in a :class:`SpillArray` (a temporary file when long), then
     :func:`block_median`."""
     with SpillArray() as series:
-        for part in parts:
-            series.append(part)
+        for piece in pieces:
+            series.append(piece)
         return block_median(series.finish())
 
 

@@ -52,8 +52,9 @@ class StaticSegment:
 
 def _moving_variance_parts(x: np.ndarray, w: int, rows: int | None = None):
     """The summed moving variance of :func:`_moving_variance`, in consecutive parts, ``rows`` rows of ``x`` read
-    at a time (default: :data:`gyrocomp.spilled_series.PART_ROWS`; ``x`` may be a memory-mapped file): each column's running sums are carried from one part to the
-    next, in the same order of additions as over the whole column, so the parts joined are its result to the bit."""
+    at a time (default: :data:`gyrocomp.spilled_series.PART_ROWS`; ``x`` may be a memory-mapped file): each
+    column's running sums are carried from one part to the next, in the same order of additions as over the whole
+    column, so the parts joined are its result to the bit."""
     n, k = x.shape
     if n < w:
         yield np.full(n, np.var(x, axis=0).sum())
