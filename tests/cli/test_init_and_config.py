@@ -220,9 +220,10 @@ def test_guessing_from_names_and_magnitudes(tmp_path):
 
 def test_raw_counts_after_a_preamble_are_guessed_scaled(tmp_path):
     """An Arduino sketch's MPU-6050 log: metadata lines (the rate among them), then ax..gz in raw counts without
-    time. The rate is taken from the preamble's Fs line, else asked for. The accelerometer's norm at rest (16384 counts) is near 1 g in no unit: raw counts, 1/16384 g, an InvenSense part's
-    power-on range, whose gyro then counts 131 per deg/s; a norm of no power of two leaves the gyro's scale to the
-    user, in deg/s with a reason that says so."""
+    time. The rate is taken from the preamble's Fs line, else asked for. The accelerometer's norm at rest (16384
+    counts) is near 1 g in no unit: raw counts, 1/16384 g, an InvenSense part's power-on range, whose gyro then
+    counts 131 per deg/s; a norm of no power of two leaves the gyro's scale to the user, in deg/s with a reason that
+    says so."""
     rng = np.random.default_rng(1)
     n = 500
     accel = np.array([300.0, -200.0, 16300.0]) + rng.normal(0, 30, (n, 3))

@@ -158,8 +158,8 @@ def read_whole(
     :data:`LARGE_FILE_BYTES`) that can be read in chunks (:func:`reads_in_chunks`) is, each chunk's columns
     appended to series held in memory up to ``settings.memory_bytes`` and in temporary files beyond
     (:class:`gyrocomp.spilled_series.SpillArray`), and the recording reads those files mapped in memory (pages the
-    system can drop and read again); any other file is read whole (:func:`gyrocomp.io.read_input`). Either way the recording is the same, and so are the warnings
-    (the stream's, :meth:`warn_summary`, once for the file)."""
+    system can drop and read again); any other file is read whole (:func:`gyrocomp.io.read_input`). Either way the
+    recording is the same, and so are the warnings (the stream's, :meth:`warn_summary`, once for the file)."""
     options = options or ReadOptions()
     if not Path(path).exists():
         raise InputError(f"{path}: no such file")
