@@ -13,6 +13,7 @@ from gyrocomp.io.ros_imu import (
     LINEAR_ACCELERATION_COVARIANCE,
     imu_batch,
     imu_fields,
+    temperature_fields,
 )
 
 pytest.importorskip("rosbags", reason="bags need the [ros] extra (rosbags)")
@@ -136,3 +137,53 @@ def test_fields_of_messages_not_of_one_layout_or_past_the_bytes_are_not_read():
     bent = bytearray(raws[1])
     bent[12] = 3  # the frame_id's length field differs
     assert imu_fields(np.frombuffer(raws[0] + bytes(bent), np.uint8), np.array([0, length]), length, False) is None
+
+
+def _temperatures(ros2: bool, frame_id: str, n: int, seed: int):
+    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
+    types, rng = store.types, np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        stamp = types["builtin_interfaces/msg/Time"](
+            sec=int(rng.integers(0, 2**31 - 1)), nanosec=int(rng.integers(0, 10**9))
+        )
+        fields = {"stamp": stamp, "frame_id": frame_id} | ({} if ros2 else {"seq": i})
+        out.append(
+            types[TEMPERATURE](
+                header=types["std_msgs/msg/Header"](**fields),
+                temperature=float(rng.normal(30, 20)),
+                variance=float(rng.random()),
+            )
+        )
+    serialize = store.serialize_cdr if ros2 else store.serialize_ros1
+    return out, [bytes(serialize(m, TEMPERATURE)) for m in out]
+
+
+TEMPERATURE = "sensor_msgs/msg/Temperature"
+
+
+@pytest.mark.parametrize("ros2", [False, True], ids=["ros1", "ros2"])
+@pytest.mark.parametrize("frame_id", ["", "i", "im", "imu", "imu_", "imu_link", "base_link/imu0"])
+def test_temperatures_read_at_once_are_what_rosbags_reads(ros2, frame_id):
+    messages, raws = _temperatures(ros2, frame_id, 9, seed=len(frame_id))
+    stamps, values = temperature_fields(raws, cdr=ros2)
+    assert stamps.tolist() == [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in messages]
+    assert values.tolist() == [m.temperature for m in messages]
+
+
+def test_temperatures_not_of_one_layout_are_left_to_rosbags():
+    _, short = _temperatures(True, "t", 2, seed=1)
+    _, long = _temperatures(True, "thermo", 2, seed=2)
+    assert temperature_fields(short + long, cdr=True) is None  # two lengths
+    assert temperature_fields([], cdr=False) is None
+    assert temperature_fields([b"\x00" * 20], cdr=False) is None  # too short for a header and two values
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    messages, _ = _temperatures(True, "t", 2, seed=3)
+    big_endian = [bytes(store.serialize_cdr(m, TEMPERATURE, little_endian=False)) for m in messages]
+    assert temperature_fields(big_endian, cdr=True) is None
+    _, raws = _temperatures(False, "abcd", 2, seed=4)
+    bent = bytearray(raws[1])
+    bent[12] = 3  # the frame_id's length field differs
+    assert temperature_fields([raws[0], bytes(bent)], cdr=False) is None
+    # an IMU message is no temperature message: its length does not fit a header and two values
+    assert temperature_fields(_messages(False, "abcd", 2, seed=5)[1], cdr=False) is None

@@ -24,9 +24,9 @@ import zlib
 from typing import Protocol
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
 from ..errors import InputError
+from ..io.byte_fields import Places
 from ..io.common import require
 from ..io.ros_imu import imu_fields
 
@@ -256,14 +256,15 @@ def _write_topic(reader, topic: str, copier, pieces: list) -> None:
                 np.concatenate([f.angular_velocity for f in read]),
                 np.concatenate([f.linear_acceleration for f in read]),
             )  # rows in order
-            cuts = np.searchsorted(done, np.cumsum([0] + [p[1].size for p in pieces]))
-            at = np.concatenate([p[1] for p in pieces]) + read[0].values_at
+            firsts = np.cumsum([0] + [p[1].size for p in pieces])
+            cuts = np.searchsorted(done, firsts)
+            places = [Places(data, at) for data, at, _ in pieces]
             for start, values in fields:
                 values = np.ascontiguousarray(values, dtype="<f8")
-                raw = values.view(np.uint8).reshape(done.size, 8 * values.shape[1])
-                for k, (data, _, _) in enumerate(pieces):
-                    rows = slice(cuts[k], cuts[k + 1])
-                    sliding_window_view(data, raw.shape[1], writeable=True)[at[done[rows]] + 8 * start] = raw[rows]
+                for k, place in enumerate(places):
+                    rows = done[cuts[k] : cuts[k + 1]] - firsts[k]  # this chunk's rows compensated, in order
+                    every = rows.size == place.at.size
+                    place.write(read[0].values_at + 8 * start, values[cuts[k] : cuts[k + 1]], None if every else rows)
             return
     places = [(p[0], a, n) for p in pieces for a, n in zip(p[1].tolist(), p[2].tolist())]
     for (data, a, n), new in zip(

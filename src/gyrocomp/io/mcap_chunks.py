@@ -35,8 +35,8 @@ import struct
 from collections.abc import Iterator
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
+from .byte_fields import Places, among
 from .common import require
 from .rosbag1_chunks import ChunkArrays
 from .rosbag2_storage import channel_ids, one_storage
@@ -103,7 +103,7 @@ def _chunk_arrays(bio, size: int, info, ids: set[int]) -> ChunkArrays:
 def _chosen(data, data_pos: int, at, channel, time, length, info, ids: set[int]) -> ChunkArrays:
     """The messages of ``ids`` among records at ``at`` of ``data`` (their channel ids, log times [ns], lengths
     [bytes]) within the chunk's time range, sorted by log time (stably), as :class:`ChunkArrays`."""
-    keep = np.isin(channel, np.fromiter(ids, dtype=np.int64)) & (time >= info.message_start_time)
+    keep = among(channel, ids) & (time >= info.message_start_time)
     keep &= time <= info.message_end_time
     order = np.flatnonzero(keep)[np.argsort(time[keep], kind="stable")]
     return ChunkArrays(
@@ -232,16 +232,15 @@ def _indexed(bio, file_size: int, info, data: np.ndarray):
         return None
     order = np.argsort(at, kind="stable")
     at, channel, time = at[order].astype(np.int64), channel[order], time[order]
-    length = sliding_window_view(data, 8)[at + 1].view("<u8")[:, 0]
-    if np.any(data[at] != _MESSAGE) or np.any(length < _MESSAGE_FIELDS) or np.any(length > data.size):
+    places = Places(data, at)
+    length = places.read(1, "<u8")
+    if np.any(places.read(0, np.uint8) != _MESSAGE) or np.any(length < _MESSAGE_FIELDS) or np.any(length > data.size):
         return None
     length = length.astype(np.int64)
     ends = at + 9 + length
     if ends[-1] > data.size:
         return None
-    if not np.array_equal(sliding_window_view(data, 2)[at + 9].view("<u2")[:, 0], channel) or not np.array_equal(
-        sliding_window_view(data, 8)[at + 15].view("<u8")[:, 0], time
-    ):
+    if not np.array_equal(places.read(9, "<u2"), channel) or not np.array_equal(places.read(15, "<u8"), time):
         return None
     between = np.flatnonzero(at[1:] != ends[:-1])
     spans = [(0, int(at[0])), *((int(ends[i]), int(at[i + 1])) for i in between), (int(ends[-1]), data.size)]

@@ -1,4 +1,5 @@
-"""``sensor_msgs/Imu`` messages decoded and re-encoded a batch at a time, without a ROS installation.
+"""``sensor_msgs/Imu`` messages decoded and re-encoded a batch at a time, without a ROS installation (and
+``sensor_msgs/Temperature`` messages decoded, the same way: a header, then the temperature and its variance).
 
 A bag holds its IMU messages serialized one by one (ROS 1: the ROS serialization; ROS 2: CDR). rosbags decodes one
 message in about 20 us, which is most of the time of reading a long bag (3.6e7 messages in ten hours at 1 kHz).
@@ -23,7 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
+
+from .byte_fields import Places
 
 #: float64 values after the header: orientation (4), its covariance (9), angular velocity (3), its covariance (9),
 #: linear acceleration (3), its covariance (9)
@@ -33,6 +35,8 @@ ANGULAR_VELOCITY = 13
 ANGULAR_VELOCITY_COVARIANCE = 16
 LINEAR_ACCELERATION = 25
 LINEAR_ACCELERATION_COVARIANCE = 28
+#: float64 values after a ``sensor_msgs/Temperature`` header: temperature, variance
+_TEMPERATURE_VALUES = 2
 
 
 @dataclass(frozen=True)
@@ -90,11 +94,11 @@ def imu_batch_of(data: np.ndarray, cdr: bool) -> ImuBatch | None:
     return None if values_at is None else ImuBatch(data, values_at)
 
 
-def _values_at(text: np.ndarray, encapsulation: np.ndarray | None, length: int) -> int | None:
-    """Where the float64 values of messages of ``length`` bytes start [bytes], from each one's ``frame_id`` length
-    ``text`` and, for CDR, its first two bytes ``encapsulation`` (n, 2) (None: ROS 1); None when the messages do
-    not share one layout (see the module)."""
-    if length < 16 + 8 * _VALUES or text.size == 0 or np.any(text != text[0]):
+def _values_at(text: np.ndarray, encapsulation: np.ndarray | None, length: int, values: int = _VALUES) -> int | None:
+    """Where the ``values`` float64 values of messages of ``length`` bytes start [bytes], from each one's
+    ``frame_id`` length ``text`` and, for CDR, its first two bytes ``encapsulation`` (n, 2) (None: ROS 1); None when
+    the messages do not share one layout (see the module)."""
+    if length < 16 + 8 * values or text.size == 0 or np.any(text != text[0]):
         return None
     if encapsulation is not None:
         if np.any(encapsulation[:, 0] != 0) or np.any(encapsulation[:, 1] != 1):  # little-endian plain CDR only
@@ -103,7 +107,31 @@ def _values_at(text: np.ndarray, encapsulation: np.ndarray | None, length: int) 
         values_at = end + (-(end - 4)) % 8
     else:
         values_at = 16 + int(text[0])
-    return values_at if values_at + 8 * _VALUES == length else None
+    return values_at if values_at + 8 * values == length else None
+
+
+def _stamps_s(places: Places, cdr: bool) -> np.ndarray:
+    """The header stamps [s] of messages at ``places`` as :func:`gyrocomp.io.rosbag.header_stamp_s` computes them
+    (sec + nanosec 1e-9); the stamp follows the first four bytes in both layouts."""
+    sec = places.read(4, "<i4" if cdr else "<u4")
+    return sec.astype(float) + places.read(8, "<u4").astype(float) * 1e-9
+
+
+def temperature_fields(raws: list, cdr: bool) -> tuple[np.ndarray, np.ndarray] | None:
+    """The header stamps [s] and temperatures [degC] of serialized ``sensor_msgs/Temperature`` messages ``raws``
+    (a header, then ``temperature`` and ``variance``, float64), read at once; None when they do not share one
+    layout (the caller then decodes them one by one)."""
+    if not raws or any(len(r) != len(raws[0]) for r in raws):
+        return None
+    length = len(raws[0])
+    if length < 16 + 8 * _TEMPERATURE_VALUES:
+        return None
+    places = Places(np.frombuffer(b"".join(raws), dtype=np.uint8), length * np.arange(len(raws)))
+    encapsulation = places.read(0, np.uint8, 2) if cdr else None
+    values_at = _values_at(places.read(12, "<u4"), encapsulation, length, _TEMPERATURE_VALUES)
+    if values_at is None:
+        return None
+    return _stamps_s(places, cdr), places.read(values_at, "<f8")
 
 
 @dataclass(frozen=True)
@@ -137,19 +165,15 @@ def imu_fields(data: np.ndarray, at: np.ndarray, length: int, cdr: bool) -> ImuF
     at = np.asarray(at, dtype=np.int64)
     if at.size == 0 or length < 16 + 8 * _VALUES or at.max() + length > data.size or at.min() < 0:
         return None
-    text = sliding_window_view(data, 4)[at + 12].view("<u4")[:, 0]
-    values_at = _values_at(text, sliding_window_view(data, 2)[at] if cdr else None, length)
+    places = Places(data, at)
+    values_at = _values_at(places.read(12, "<u4"), places.read(0, np.uint8, 2) if cdr else None, length)
     if values_at is None:
         return None
-    stamps = sliding_window_view(data, 8)[at + 4]  # sec, nanosec: a copy, contiguous
-    sec = stamps.view("<i4" if cdr else "<u4")[:, 0]
-    nsec = stamps.view("<u4")[:, 1]
-    vectors = sliding_window_view(data, 24)
     return ImuFields(
         values_at,
-        sec.astype(float) + nsec.astype(float) * 1e-9,
-        vectors[at + values_at + 8 * ANGULAR_VELOCITY].view("<f8"),
-        vectors[at + values_at + 8 * LINEAR_ACCELERATION].view("<f8"),
+        _stamps_s(places, cdr),
+        places.read(values_at + 8 * ANGULAR_VELOCITY, "<f8", 3),
+        places.read(values_at + 8 * LINEAR_ACCELERATION, "<f8", 3),
     )
 
 
@@ -163,4 +187,5 @@ __all__ = [
     "imu_batch",
     "imu_batch_of",
     "imu_fields",
+    "temperature_fields",
 ]

@@ -12,6 +12,7 @@ chunk whatever the bag's length (``allan``, ``apply``, ``evaluate`` and ``conver
 from __future__ import annotations
 
 import contextlib
+import itertools
 import re
 import warnings
 import weakref
@@ -40,7 +41,7 @@ from .common import (
 from .layout import TIME_COLUMN, TableLayout
 from .mcap_chunks import mcap_arrays
 from .readers import Reader, register_reader
-from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_fields
+from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_fields, temperature_fields
 from .rosbag1_chunks import chunked_reader1
 from .stream import CHUNK_ROWS, NotStreamable
 from .tables import recording_table, rows_dropped
@@ -354,19 +355,33 @@ def _temperature_samples(path: Path, reader, thermo: list):
     """(time [s], temperature [degC]) of every message on the temperature topic, in time order (an MCAP file's
     found by its chunks' indexes, :func:`~gyrocomp.io.mcap_chunks.mcap_arrays`; a ROS 1 bag's by rosbags' interface
     to :class:`ChunkedReader1`, which reads a sparse topic where the index says)."""
-    t_time, t_value = [], []
+    times, values = [], []
     with damaged_bag(path, thermo[0].topic):
         chunks = mcap_arrays(reader, thermo)
         if chunks is None:
             raws = (raw for _, _, raw in reader.messages(connections=thermo))
         else:
             raws = (raw for found in chunks for raw in _raws(found))
-        for raw in raws:
-            msg = reader.deserialize(raw, thermo[0].msgtype)
-            t_time.append(header_stamp_s(msg.header))
-            t_value.append(msg.temperature)
-    _read_all(path, sum(c.msgcount for c in thermo), len(t_time), thermo[0].topic)
-    return order_by_time(str(path), np.array(t_time), np.array(t_value, dtype=float))
+        while batch := list(itertools.islice(raws, DECODE_BATCH)):
+            time_s, temperature = _decoded_temperatures(reader, thermo[0].msgtype, batch)
+            times.append(time_s)
+            values.append(temperature)
+    time_s, temperature = (np.concatenate(v) if v else np.empty(0) for v in (times, values))
+    _read_all(path, sum(c.msgcount for c in thermo), time_s.size, thermo[0].topic)
+    return order_by_time(str(path), time_s, temperature)
+
+
+def _decoded_temperatures(reader, msgtype: str, raws: list) -> tuple[np.ndarray, np.ndarray]:
+    """(stamp [s], temperature [degC]) of serialized temperature messages: a batch of one layout at once
+    (:func:`~gyrocomp.io.ros_imu.temperature_fields`), any other message by message through rosbags."""
+    fields = temperature_fields(raws, cdr=reader.is2)
+    if fields is not None:
+        return fields
+    messages = [reader.deserialize(raw, msgtype) for raw in raws]
+    return (
+        np.array([header_stamp_s(m.header) for m in messages], dtype=float),
+        np.array([m.temperature for m in messages], dtype=float),
+    )
 
 
 def chosen_topics(path: Path, connections: list, options: ReadOptions) -> tuple[list, list]:

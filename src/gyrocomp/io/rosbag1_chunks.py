@@ -32,6 +32,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from .byte_fields import Places, among
 from .common import require
 
 
@@ -186,10 +187,10 @@ def _chunk_arrays(
         raise rb.ReaderError(f"A damaged record in a chunk ({type(err).__name__}: {err}).") from None
     records, (op, conn, time) = located[:4], located[4:]
     message = op == rb.RecordType.MSGDATA
-    unknown = message & ~np.isin(conn, np.fromiter(connmap, dtype=np.int64, count=len(connmap)))
+    unknown = message & ~among(conn, connmap)
     if np.any(unknown):
         raise rb.ReaderError(f"A message of connection {int(conn[np.argmax(unknown)])}, which the bag's index lacks.")
-    keep = message & np.isin(conn, np.fromiter(wanted, dtype=np.int64, count=len(wanted)))
+    keep = message & among(conn, wanted)
     if start is not None:
         keep &= time >= start
     if stop is not None:
@@ -265,11 +266,14 @@ def _located(rb, data: bytes, index: list) -> tuple | None:
         size, array = len(data), np.frombuffer(data, dtype=np.uint8)
         if offsets.size == 0 or offsets[-1] + 8 > size:
             return None
-        words = sliding_window_view(array, 4)
-        header_length = words[offsets].view("<u4")[:, 0].astype(np.int64)
+        places = Places(array, offsets)
+        header_length = places.read(0, "<u4").astype(np.int64)
         if np.any(offsets + 8 + header_length > size):
             return None
-        data_length = words[offsets + 4 + header_length].view("<u4")[:, 0].astype(np.int64)
+        if np.all(header_length == header_length[0]):
+            data_length = places.read(4 + int(header_length[0]), "<u4").astype(np.int64)
+        else:
+            data_length = sliding_window_view(array, 4)[offsets + 4 + header_length].view("<u4")[:, 0].astype(np.int64)
         ends = offsets + 8 + header_length + data_length
         if ends[-1] > size or np.any(ends[:-1] > offsets[1:]):
             return None
@@ -287,7 +291,7 @@ def _located(rb, data: bytes, index: list) -> tuple | None:
         listed = table[:, 4].astype(bool)
         op, conn, time = (np.full(len(table), -1, dtype=np.int64) for _ in range(3))
         rest = ~listed
-        if _as_indexed(rb, array, data, offsets, header_length, conns, times):
+        if _as_indexed(rb, places, data, header_length, conns, times):
             op[listed], conn[listed], time[listed] = rb.RecordType.MSGDATA, conns, times
         else:
             rest[:] = True
@@ -304,25 +308,23 @@ def _located(rb, data: bytes, index: list) -> tuple | None:
     return table[:, 0], table[:, 1], table[:, 2], table[:, 3], op, conn, time
 
 
-def _as_indexed(rb, array, data: bytes, offsets, header_length, conns, times) -> bool:
-    """Whether the records at ``offsets`` share one header length and their ``op``, ``conn`` and ``time`` values,
-    read at the places the first record's header gives them (:func:`_field_places`), are a message's with the
-    index entries' connections ``conns`` and times ``times`` [ns]: three small reads per record instead of its
-    whole header (:func:`_header_fields`). A header of another layout of the same length would put other bytes
-    there and not match."""
+def _as_indexed(rb, places: Places, data: bytes, header_length, conns, times) -> bool:
+    """Whether the records at ``places`` (:class:`~gyrocomp.io.byte_fields.Places` of the chunk) share one header
+    length and their ``op``, ``conn`` and ``time`` values, read at the places the first record's header gives them
+    (:func:`_field_places`), are a message's with the index entries' connections ``conns`` and times ``times``
+    [ns]: three small reads per record instead of its whole header (:func:`_header_fields`). A header of another
+    layout of the same length would put other bytes there and not match."""
     if np.any(header_length != header_length[0]):
         return False
-    first = int(offsets[0]) + 4
-    places = _field_places(data, first, first + int(header_length[0]))
-    if [places.get(name, (0, -1))[1] for name in _FIELDS] != [1, 4, 8]:
+    first = int(places.at[0]) + 4
+    found = _field_places(data, first, first + int(header_length[0]))
+    if [found.get(name, (0, -1))[1] for name in _FIELDS] != [1, 4, 8]:
         return False
-    at = offsets + 4
-    if np.any(array[at + places[b"op"][0]] != rb.RecordType.MSGDATA):
+    if np.any(places.read(4 + found[b"op"][0], np.uint8) != rb.RecordType.MSGDATA):
         return False
-    conn = sliding_window_view(array, 4)[at + places[b"conn"][0]].view("<u4")[:, 0]
-    if not np.array_equal(conn, conns):
+    if not np.array_equal(places.read(4 + found[b"conn"][0], "<u4"), conns):
         return False
-    sec_nsec = sliding_window_view(array, 8)[at + places[b"time"][0]].view("<u4").astype(np.int64)
+    sec_nsec = places.read(4 + found[b"time"][0], "<u4", 2).astype(np.int64)
     return bool(np.array_equal(sec_nsec[:, 0] * 1_000_000_000 + sec_nsec[:, 1], times))
 
 
