@@ -72,6 +72,7 @@ from ..io.rosbag import (
     read_rosbag,
 )
 from ..io.stream import CHUNK_ROWS, NotStreamable
+from ..io.write_behind import write_behind
 from ..measures.noise_model import noise_file_densities, per_sample_covariance
 from ..units import unit_factor
 from .bag_patch import BagCopy, McapCopy, SqliteCopy, patch_in_batches, uncompressed
@@ -371,9 +372,10 @@ def _patched_bag(bag: Path, output: Path, copiers: dict, chunk_rows: int) -> boo
 
 @contextlib.contextmanager
 def _file_copy(make, source_path: Path, target_path: Path):
-    """A :class:`BagCopy` (``make`` with the open source and sink) from ``source_path`` to ``target_path``."""
-    with open(source_path, "rb") as source, open(target_path, "wb") as sink:
-        yield make(source, sink)
+    """A :class:`BagCopy` (``make`` with the open source and sink) from ``source_path`` to ``target_path``, written
+    by a thread of its own while the next chunks are compensated (:func:`~gyrocomp.io.write_behind.write_behind`)."""
+    with open(source_path, "rb") as source, open(target_path, "wb") as sink, write_behind(sink) as behind:
+        yield make(source, behind)
 
 
 @contextlib.contextmanager
