@@ -532,7 +532,10 @@ class BagStream:
             return time_s, gyro, accel, None
         what = f"temperature topic {self.thermo[0].topic}"
         temperature, ok = match_by_time(str(self.path), what, time_s, *self._temperature)
-        self._order["unmatched"] += int(np.count_nonzero(~ok))
+        missed = int(np.count_nonzero(~ok))
+        self._order["unmatched"] += missed
+        if not missed:  # the usual case: no copies
+            return time_s, gyro, accel, temperature
         return time_s[ok], gyro[ok], accel[ok], temperature[ok]
 
     def chunks(self):
