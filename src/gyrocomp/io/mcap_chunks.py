@@ -38,6 +38,7 @@ import numpy as np
 
 from .byte_fields import Places, among
 from .common import require
+from .read_ahead import ReadAhead
 from .rosbag1_chunks import ChunkArrays
 from .rosbag2_storage import channel_ids, one_storage
 
@@ -85,7 +86,19 @@ def mcap_arrays(reader, connections) -> Iterator[ChunkArrays] | None:
     if any(a.message_end_time > b.message_start_time for a, b in zip(chunks, chunks[1:])):
         return None
     size = os.fstat(storage.bio.fileno()).st_size
-    return (_chunk_arrays(storage.bio, size, info, ids) for info in chunks)
+    wanted = sum(c.channel_count.get(i, 0) for c in chunks for i in ids)
+    if wanted * _SPARSE <= sum(sum(c.channel_count.values()) for c in chunks):  # read where the indexes say
+        return (_chunk_arrays(storage.bio, size, info, ids) for info in chunks)
+    return _read_ahead(storage.bio, size, chunks, ids)
+
+
+def _read_ahead(bio, size: int, chunks: list, ids: set[int]) -> Iterator[ChunkArrays]:
+    """:func:`_chunk_arrays` of each of ``chunks``, the file read ahead by a thread of its own (the disk reads on
+    while a chunk is decoded: :class:`~gyrocomp.io.read_ahead.ReadAhead`)."""
+    with ReadAhead(getattr(bio, "name", None)) as ahead:
+        for info in chunks:
+            ahead.at(info.chunk_start_offset)
+            yield _chunk_arrays(bio, size, info, ids)
 
 
 def _chunk_arrays(bio, size: int, info, ids: set[int]) -> ChunkArrays:

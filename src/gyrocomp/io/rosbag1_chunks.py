@@ -34,6 +34,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from .byte_fields import Places, among
 from .common import require
+from .read_ahead import ReadAhead
 
 
 def _rosbag1():
@@ -203,22 +204,25 @@ def _message_arrays(self, connections=()):
     """The messages of ``connections`` (all when empty) chunk by chunk in file order, each chunk as arrays: its
     decompressed bytes (uint8), and of its messages the connection ids, times [ns], where each one's data starts and
     its length [bytes] (:func:`_chunk_arrays`), as :class:`ChunkArrays`: a caller that decodes many messages at once
-    reads them without a Python object per message."""
+    reads them without a Python object per message. The file is read ahead by a thread of its own
+    (:class:`~gyrocomp.io.read_ahead.ReadAhead`)."""
     rb = _rosbag1()
     self._check_open()
     connmap = {c.id: c for c in self.connections}
     wanted = {c.id for c in connections} if connections else set(connmap)
-    for info in self.chunk_infos:
-        if not wanted.intersection(info.connection_counts):
-            continue
-        self.bio.seek(info.pos)
-        chunk = self.read_chunk()
-        data, index = _chunk_data(self, rb, chunk, len(info.connection_counts))
-        yield ChunkArrays(
-            np.frombuffer(data, dtype=np.uint8),
-            chunk.datapos,
-            *_chunk_arrays(rb, data, connmap, wanted, (None, None), index),
-        )
+    with ReadAhead(self.path) as ahead:  # the disk reads on while a chunk is decoded
+        for info in self.chunk_infos:
+            if not wanted.intersection(info.connection_counts):
+                continue
+            ahead.at(info.pos)
+            self.bio.seek(info.pos)
+            chunk = self.read_chunk()
+            data, index = _chunk_data(self, rb, chunk, len(info.connection_counts))
+            yield ChunkArrays(
+                np.frombuffer(data, dtype=np.uint8),
+                chunk.datapos,
+                *_chunk_arrays(rb, data, connmap, wanted, (None, None), index),
+            )
 
 
 def _chunk_data(self, rb, chunk, connections: int) -> tuple[bytes, list | None]:
