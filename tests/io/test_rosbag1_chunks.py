@@ -201,28 +201,17 @@ def test_a_message_of_a_connection_the_index_lacks_is_a_reader_error():
         list(_chunk_messages(reader, chunk, {0: "connection 0"}, {0}, (None, None)))
 
 
-@pytest.mark.parametrize("threads", [False, True], ids=["one-thread", "threads"])
 @pytest.mark.parametrize(
     "compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["none", "bz2", "lz4"]
 )
-def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compression, threads, tmp_path, monkeypatch):
+def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compression, tmp_path, monkeypatch):
     """A topic of one message in fifty (a temperature at 1 Hz beside an IMU at 50 Hz, say): an uncompressed chunk's
     messages of it are read where the chunk's index data say (each checked against its entry), the same messages
-    as rosbags' reader, with a time filter too; a chunk whose index entry points at another record is walked. With
-    many chunks (here: threads of two chunks each), stretches of chunks are read by threads: the same messages in
-    the same order."""
+    as rosbags' reader, with a time filter too; a chunk whose index entry points at another record is walked."""
     path, _ = _bag(tmp_path / "sparse.bag", compression, n=3000, every=50, threshold=16384)
     indexed = []  # what each indexed read of a chunk gave: its messages, or None (the chunk then walked)
     original = chunks_module._indexed_messages
     monkeypatch.setattr(chunks_module, "_indexed_messages", lambda *a: indexed.append(original(*a)) or indexed[-1])
-    stretches = []
-    if threads:
-        monkeypatch.setattr(chunks_module, "_READERS", 2)
-        monkeypatch.setattr(chunks_module, "_STRETCH", 2)
-        read_stretch = chunks_module._stretch_messages
-        monkeypatch.setattr(
-            chunks_module, "_stretch_messages", lambda *a, **k: stretches.append(a[2]) or read_stretch(*a, **k)
-        )
     topic = {"topics": ("/b",)}
     for kwargs in (topic, {**topic, "start": 2 * 10**10, "stop": 4 * 10**10}):
         ours = _read(chunked_reader1(), path, **dict(kwargs))[1]
@@ -238,8 +227,6 @@ def test_a_sparse_topic_is_read_by_the_chunks_index_as_rosbags_reads_it(compress
         indexed.clear()
         assert _read(chunked_reader1(), tmp_path / "moved.bag", **topic)[1] == _read(Reader, path, **topic)[1]
         assert sum(m is None for m in indexed) == 1  # that chunk walked, its messages as the records say
-    if threads:
-        assert len(stretches) > 4 and all(1 <= len(stretch) <= 2 for stretch in stretches)
 
 
 def _arrays(path) -> list:

@@ -23,8 +23,6 @@ index data record per connection in it (each message's time and offset in the un
 
 from __future__ import annotations
 
-import collections
-import concurrent.futures
 import functools
 import os
 import re
@@ -93,88 +91,26 @@ def _read_metadata(self, rb) -> None:
 
 def _messages(self, connections=(), start: int | None = None, stop: int | None = None):
     """The messages of ``connections`` (all when empty), chunk by chunk in file order: (connection, time [ns],
-    raw bytes); ``start`` and ``stop`` [ns] keep those from ``start`` to before ``stop``.
-
-    A topic that is a small part of every chunk (a temperature beside an IMU) is read where each chunk's index says,
-    a few small reads a chunk: read cold from a disk, their waits are most of the time (a ten-hour bag's 12,566
-    chunks: 10 s to 16 s). Many such chunks are read by threads of their own, each with its own file handle (told
-    not to read ahead) and a stretch of chunks, :data:`_READERS` stretches at a time, the messages in the same
-    order: 4.6 s cold, and 1.8 s from the system's cache, against 1.3 s in one thread (the reading is Python's
-    work, which threads share)."""
+    raw bytes); ``start`` and ``stop`` [ns] keep those from ``start`` to before ``stop``."""
     rb = _rosbag1()
     self._check_open()
     connmap = {c.id: c for c in self.connections}
     wanted = {c.id for c in connections} if connections else set(connmap)
-    span = (start, stop)
-    infos = [
-        info
-        for info in self.chunk_infos
-        if any(info.connection_counts.get(c, 0) for c in wanted)
-        and not (start is not None and info.end_time <= start)
-        and not (stop is not None and info.start_time >= stop)
-    ]
-    sparse = all(_hits(info, wanted) * _SPARSE <= sum(info.connection_counts.values()) for info in infos)
-    if not sparse or len(infos) < _READERS * _STRETCH:
-        for info in infos:
-            yield from _messages_of(self, rb, info, connmap, wanted, span)
-        return
-    stretches = [infos[k : k + _STRETCH] for k in range(0, len(infos), _STRETCH)]
-    with concurrent.futures.ThreadPoolExecutor(_READERS, thread_name_prefix="gyrocomp-bag-index") as pool:
-        read = functools.partial(_stretch_messages, self, rb, connmap=connmap, wanted=wanted, span=span)
-        pending = collections.deque(pool.submit(read, stretch) for stretch in stretches[: 2 * _READERS])
-        for stretch in stretches[2 * _READERS :] + [None] * len(pending):
-            found = pending.popleft().result()
-            if stretch is not None:  # a stretch more read while these are used: at most 2 x _READERS held
-                pending.append(pool.submit(read, stretch))
-            yield from found
-
-
-#: threads reading the chunks of a sparse topic, and chunks in each one's stretch (a bag of fewer chunks than the
-#: two multiplied: one thread)
-_READERS, _STRETCH = 3, 64
-
-
-def _hits(info, wanted: set) -> int:
-    """How many messages of ``wanted`` a chunk holds (its chunk info's counts)."""
-    return sum(info.connection_counts.get(c, 0) for c in wanted)
-
-
-def _messages_of(self, rb, info, connmap: dict, wanted: set, span: tuple) -> list:
-    """One chunk's messages of ``wanted`` within ``span`` (as :func:`_messages` yields them), read through
-    ``self.bio``: where its index says when they are a small part of an uncompressed chunk, else from its data."""
-    self.bio.seek(info.pos)
-    chunk = self.read_chunk()
-    if chunk.decompressor is rb.decompressors["none"] and _hits(info, wanted) * _SPARSE <= sum(
-        info.connection_counts.values()
-    ):
-        found = _indexed_messages(self, rb, chunk, len(info.connection_counts), connmap, wanted, span)
-        if found is not None:
-            return found
-    data, index = _chunk_data(self, rb, chunk, len(info.connection_counts))
-    return list(_chunk_messages(rb, data, connmap, wanted, span, index))
-
-
-class _Handle:
-    """A file handle of its own on an open bag, for a thread reading some of its chunks: rosbags' record readers
-    (``read_chunk``) and :func:`_messages_of` use only the reader's ``bio``."""
-
-    def __init__(self, reader):
-        self.bio = open(reader.path, "rb")  # noqa: SIM115 (closed by the thread that made it)
-        self._reader_type = type(reader)
-        if hasattr(os, "posix_fadvise"):  # a few small reads a chunk: no reading ahead of each
-            os.posix_fadvise(self.bio.fileno(), 0, 0, os.POSIX_FADV_RANDOM)
-
-    def read_chunk(self):
-        return self._reader_type.read_chunk(self)
-
-
-def _stretch_messages(self, rb, infos: list, *, connmap: dict, wanted: set, span: tuple) -> list:
-    """The messages of a stretch of chunks, read through a file handle of its own."""
-    handle = _Handle(self)
-    try:
-        return [message for info in infos for message in _messages_of(handle, rb, info, connmap, wanted, span)]
-    finally:
-        handle.bio.close()
+    for info in self.chunk_infos:
+        hits = sum(info.connection_counts.get(c, 0) for c in wanted)
+        if not hits:
+            continue
+        if (start is not None and info.end_time <= start) or (stop is not None and info.start_time >= stop):
+            continue
+        self.bio.seek(info.pos)
+        chunk = self.read_chunk()
+        if chunk.decompressor is rb.decompressors["none"] and hits * _SPARSE <= sum(info.connection_counts.values()):
+            found = _indexed_messages(self, rb, chunk, len(info.connection_counts), connmap, wanted, (start, stop))
+            if found is not None:
+                yield from found
+                continue
+        data, index = _chunk_data(self, rb, chunk, len(info.connection_counts))
+        yield from _chunk_messages(rb, data, connmap, wanted, (start, stop), index)
 
 
 #: a chunk whose messages of the connections read are at most one in this many is read by its index (uncompressed)
