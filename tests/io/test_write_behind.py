@@ -44,3 +44,30 @@ def test_the_callers_error_goes_on_and_the_writer_ends(tmp_path):
         assert behind.file is file
         assert not any(t.name == "gyrocomp-write-behind" for t in threading.enumerate())
     assert (tmp_path / "out").read_bytes() == b"abc"
+
+
+def test_work_runs_in_the_writer_thread_in_order_with_the_writes(tmp_path):
+    ran_in = []
+
+    def stamp(file, text):
+        ran_in.append(threading.current_thread().name)
+        file.write(text)
+
+    with open(tmp_path / "out", "wb") as file, write_behind(file, most_blocks=1) as behind:
+        for k in range(50):
+            behind.write(b"%d," % k)
+            behind.call(stamp, file, b"[%d]" % k)
+    assert (tmp_path / "out").read_bytes() == b"".join(b"%d,[%d]" % (k, k) for k in range(50))
+    assert set(ran_in) == {"gyrocomp-write-behind"}
+
+
+def test_an_error_of_the_work_is_raised_as_a_writes(tmp_path):
+    def fails():
+        raise ValueError("a checksum that could not be computed")
+
+    with open(tmp_path / "out", "wb") as file:
+        with pytest.raises(ValueError, match="a checksum that could not be computed"):
+            with write_behind(file) as behind:
+                behind.call(fails)
+                behind.write(b"never")
+        assert (tmp_path / "out").read_bytes() == b""

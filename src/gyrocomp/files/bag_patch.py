@@ -92,7 +92,8 @@ class McapCopy(BagCopy):
     """:class:`BagCopy` of an MCAP file of uncompressed chunks: a patched chunk's CRC-32 (in its record, before its
     records: CRC uint32, compression "" as its length uint32, the records' length uint64) and the data section's
     (in the data end record at ``data_end``, of every byte before it; ``data_crc``: the input has one) computed anew
-    where the input has them (zero: none)."""
+    where the input has them (zero: none). ``sink`` is a :class:`~gyrocomp.io.write_behind.WriteBehind`: the
+    checksums (two passes over every byte of the bag) are computed in its thread, in order with the writes."""
 
     #: a chunk record's bytes from its CRC to its records, uncompressed
     HEAD = 16
@@ -103,26 +104,33 @@ class McapCopy(BagCopy):
         self.data_end, self.data_crc, self.written, self.crc = data_end, data_crc, 0, 0
 
     def write(self, block) -> None:
+        self.sink.call(self._out, block)
+
+    def _out(self, block) -> None:
+        """Bytes out, in the writer's thread, added to the data section's CRC while within it."""
         if self.data_crc and self.written < self.data_end:
             self.crc = zlib.crc32(memoryview(block)[: self.data_end - self.written], self.crc)
         self.written += len(block)
-        self.sink.write(block)
+        self.sink.file.write(block)
 
     def chunk(self, found, data) -> None:
         self.through(found.data_pos - self.HEAD)
-        head = bytearray(self.source.read(self.HEAD))
+        self.sink.call(self._chunk_out, bytearray(self.source.read(self.HEAD)), data)
+        self.copied = found.data_pos + len(data)
+
+    def _chunk_out(self, head: bytearray, data) -> None:
+        """A patched chunk's head (its CRC computed anew where it has one) and records, in the writer's thread."""
         if head[:4] != bytes(4):
             head[:4] = struct.pack("<I", zlib.crc32(data))
-        self.write(head)
-        self.write(data)
-        self.copied = found.data_pos + len(data)
+        self._out(head)
+        self._out(data)
 
     def finish(self) -> None:
         self.through(self.data_end)
         op, length, crc = self.DATA_END.unpack(self.source.read(self.DATA_END.size))
         if (op, length) != (0x0F, 4):
             raise InputError(f"no MCAP data end record at byte {self.data_end}")
-        self.write(self.DATA_END.pack(op, length, self.crc if crc else 0))
+        self.sink.call(lambda: self._out(self.DATA_END.pack(op, length, self.crc if crc else 0)))  # the CRC so far
         self.copied = self.data_end + self.DATA_END.size
         self.through()
 

@@ -5,7 +5,9 @@ Copying a ten-hour bag writes 13 GB: once the system's dirty pages are full, eac
 a caller that decodes and compensates between its writes adds the two times. :class:`WriteBehind` hands each block
 to a writer thread through a bounded queue (the blocks waiting are at most ``most_blocks``, so memory stays bounded)
 and returns at once; the file's bytes are the same, in the same order. An error of the writing (a full disk) is
-raised to the caller at its next write or when the writing ends, as the same exception.
+raised to the caller at its next write or when the writing ends, as the same exception. Work that belongs with the
+writing (a checksum of the bytes written) can run in the same thread, in order with the writes
+(:meth:`WriteBehind.call`).
 """
 
 from __future__ import annotations
@@ -34,19 +36,24 @@ class WriteBehind:
         self._thread.start()
 
     def _run(self) -> None:
-        while (block := self._blocks.get()) is not None:
+        while (item := self._blocks.get()) is not None:
             if self._error is None:  # after an error the rest is taken and dropped: the caller never waits for room
                 try:
-                    self.file.write(block)
+                    item[0](*item[1])
                 except BaseException as err:  # raised to the caller (a full disk: OSError)
                     self._error = err
 
     def write(self, block) -> None:
         """Hand ``block`` (bytes, or a buffer nobody changes after) over to be written; the error of an earlier
         write, if any, raised here."""
+        self.call(self.file.write, block)
+
+    def call(self, work, *args) -> None:
+        """Run ``work(*args)`` in the writer thread, in order with the writes (work that belongs with the writing,
+        a checksum of what is written, say); its error raised as a write's."""
         if self._error is not None:
             raise self._error
-        self._blocks.put(block)
+        self._blocks.put((work, args))
 
     def close(self) -> None:
         """Wait until every block is written; the writing's error, if any, raised here."""
