@@ -35,10 +35,10 @@ class ReadAhead:
         self.read_to = 0  # how far the thread has read [bytes]
         self._thread = None
         try:
-            self._fd = os.open(os.fspath(path), os.O_RDONLY)
+            self._file = open(os.fspath(path), "rb", buffering=0)  # noqa: SIM115 (closed by close())
         except (OSError, TypeError):  # a hint only: the reader opens the file and says what is wrong
             return
-        self._size = os.fstat(self._fd).st_size
+        self._size = os.fstat(self._file.fileno()).st_size
         self._thread = threading.Thread(target=self._run, name="gyrocomp-read-ahead", daemon=True)
         self._thread.start()
 
@@ -57,7 +57,7 @@ class ReadAhead:
             self._wake.notify()
         self._thread.join()
         self._thread = None
-        os.close(self._fd)
+        self._file.close()
 
     def _run(self) -> None:
         buffer = bytearray(self.block_bytes)
@@ -71,11 +71,12 @@ class ReadAhead:
                 offset = max(offset, self._place)
             if offset >= self._size:
                 return
-            try:
-                done = os.preadv(self._fd, [buffer], offset)
+            try:  # the thread's own file: a seek and a read, wherever Python runs
+                self._file.seek(offset)
+                done = self._file.readinto(buffer)
             except OSError:
                 return
-            if done <= 0:
+            if not done:  # the end of the file
                 return
             offset += done
             self.read_to = offset
