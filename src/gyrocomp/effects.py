@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
-from .spilled_series import parts
+from .spilled_series import WindowSums, parts
 
 HYSTERESIS_DIRECTIONS = ("descending", "ascending", "both")
 #: order of the g x g terms: products of specific-force components [g^2]
@@ -513,17 +513,14 @@ def moving_average_range(x: np.ndarray, window_samples: int, rows: int | None = 
     same order of additions, so no array of the data's length is made (``x`` may be a memory-mapped file)."""
     x, w = _checked_window(x, window_samples)
     first = x[0]
-    held, base = np.zeros(1), 0  # the running sums about the first value from sample ``base`` on
+    sums = WindowSums(w)  # of the values about the first one, as moving_average sums them
     low, high = math.inf, -math.inf
     for start, stop in parts(x.size, rows=rows):
-        held = np.concatenate([held, np.cumsum(np.concatenate([held[-1:], x[start:stop] - first]))[1:]])
-        windows = stop - w + 1 - base  # the windows [k, k + w) that end in this part
-        if windows > 0:
-            out = held[w : w + windows] - held[:windows]
+        out = sums.add(x[start:stop] - first)
+        if out.size:
             out /= w
             out += first
             low, high = min(low, float(out.min())), max(high, float(out.max()))
-            held, base = held[windows:], base + windows
     return high - low
 
 

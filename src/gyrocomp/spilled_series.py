@@ -43,6 +43,33 @@ def parts(n: int, overlap: int = 0, rows: int | None = None):
         yield start, min(n, start + rows + overlap)
 
 
+class WindowSums:
+    """Sums over windows of ``w`` consecutive values of a series given a part at a time (:meth:`add`): the running
+    sum is carried from part to part in the same order of additions as ``np.cumsum`` over the whole series, so each
+    window's sum is that series' ``c[k + w] - c[k]`` to the bit, and only the last ``w`` running sums are held.
+
+    Parameters
+    ----------
+    w : int
+        Values in a window (at least 1).
+    """
+
+    def __init__(self, w: int):
+        self.w = int(w)
+        self._held: np.ndarray | None = None  # the running sums from the first window not yet summed on
+
+    def add(self, values: np.ndarray) -> np.ndarray:
+        """The sums of the windows that end within ``values`` (the series' next values, 1-D or one row per value),
+        in order; empty until the first window is complete."""
+        values = np.asarray(values, dtype=float)
+        if self._held is None:
+            self._held = np.zeros((1, *values.shape[1:]))
+        held = np.concatenate([self._held, np.cumsum(np.concatenate([self._held[-1:], values]), axis=0)[1:]])
+        windows = max(held.shape[0] - self.w, 0)
+        self._held = held[windows:]
+        return held[self.w : self.w + windows] - held[:windows]
+
+
 class SpillArray:
     """An append-only float64 series (or of another ``dtype``): in memory up to ``memory_bytes`` [bytes], then in a
     temporary file.

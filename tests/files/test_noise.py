@@ -23,7 +23,7 @@ from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.files import ChunkSettings, analyse_noise_file, evaluate_file
 from gyrocomp.simulation import simulate
 import gyrocomp.spilled_series as spilled_series
-from gyrocomp.spilled_series import SpillArray, block_median
+from gyrocomp.spilled_series import SpillArray, WindowSums, block_median
 
 from ..conftest import run
 
@@ -125,6 +125,25 @@ def test_block_median_is_numpys_median_exactly(monkeypatch_passes, n, block, kin
     monkeypatch_passes.clear()
     assert block_median(values, block=block, whole=0) == np.median(values)
     assert len(monkeypatch_passes) <= 2 * 6 + 2  # each order statistic: six counting passes and its gathering
+
+
+@hsettings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 40),
+    st.lists(st.integers(0, 50), min_size=1, max_size=12),
+    st.integers(1, 3),
+    st.integers(0, 2**32 - 1),
+)
+def test_window_sums_given_in_any_parts_are_the_whole_series_cumsums_to_the_bit(w, lengths, columns, seed):
+    """A window's sum is c[k + w] - c[k] of one np.cumsum over the whole series, however the series is parted."""
+    x = np.random.default_rng(seed).normal(size=(sum(lengths), columns)) * 1e3
+    c = np.cumsum(np.concatenate([np.zeros((1, columns)), x]), axis=0)
+    expected = c[w:] - c[:-w] if x.shape[0] >= w else np.empty((0, columns))
+    sums, got, start = WindowSums(w), [], 0
+    for length in lengths:
+        got.append(sums.add(x[start : start + length]))
+        start += length
+    np.testing.assert_array_equal(np.concatenate(got), expected)
 
 
 def test_block_median_of_nothing_is_refused():

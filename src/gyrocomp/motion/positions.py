@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..recording import Recording
-from ..spilled_series import SpillArray, block_median, parts
+from ..spilled_series import SpillArray, WindowSums, block_median, parts
 
 DEFAULT_WINDOW_S = 1.0
 DEFAULT_MIN_DURATION_S = 10.0
@@ -60,30 +60,24 @@ def _moving_variance_parts(x: np.ndarray, w: int, rows: int | None = None):
         yield np.full(n, np.var(x, axis=0).sum())
         return
     means = x.mean(axis=0)
-    # each column's running sums of the centred values and of their squares, from window ``base`` on
-    sums = [(np.zeros(1), np.zeros(1)) for _ in range(k)]
-    base = 0
+    # each column's window sums of the centred values and of their squares
+    sums = [(WindowSums(w), WindowSums(w)) for _ in range(k)]
+    started = False
     for start, stop in parts(n, rows=rows):
-        windows = stop - w + 1 - base  # windows [k, k + w) that end in this part
         total = None
-        for j in range(k):
+        for j, (values, squares) in enumerate(sums):
             column = x[start:stop, j] - means[j]
-            c1, c2 = sums[j]
-            c1 = np.concatenate([c1, np.cumsum(np.concatenate([c1[-1:], column]))[1:]])
-            c2 = np.concatenate([c2, np.cumsum(np.concatenate([c2[-1:], column * column]))[1:]])
-            if windows > 0:
-                s1 = (c1[w : w + windows] - c1[:windows]) / w
-                s2 = (c2[w : w + windows] - c2[:windows]) / w
+            s1 = values.add(column) / w
+            s2 = squares.add(column * column) / w
+            if s1.size:
                 var = np.maximum(s2 - s1 * s1, 0.0)  # window k covers [k, k + w)
                 total = var if total is None else np.add(total, var, out=total)
-                c1, c2 = c1[windows:], c2[windows:]
-            sums[j] = (c1, c2)
         if total is None:
             continue
-        if base == 0:  # the first samples take the first full window's
+        if not started:  # the first samples take the first full window's
             yield np.full(w // 2, total[0])
+            started = True
         yield total
-        base += windows
         last = total[-1]
     yield np.full(w - 1 - w // 2, last)  # and the last samples the last one's
 
