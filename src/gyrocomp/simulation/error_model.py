@@ -52,6 +52,7 @@ from ..effects import (
     find_turns,
     g_sensitivity_offset,
     hysteresis_offset,
+    lazy_lfilter,
     thermal_lag,
 )
 from ..errors import InputError
@@ -479,9 +480,7 @@ def _gauss_markov(
     phi = math.exp(-step_s / time_constant_s)
     drive = rng.standard_normal(m) * math.sqrt(variance * -math.expm1(-2.0 * step_s / time_constant_s))
     drive[0] = rng.standard_normal() * math.sqrt(variance)  # start in the stationary distribution
-    from scipy.signal import lfilter  # scipy.signal is slow to import; only simulation needs it here
-
-    return lfilter([1.0], [1.0, -phi], drive)
+    return lazy_lfilter([1.0], [1.0, -phi], drive)
 
 
 def flicker_bank(
@@ -541,8 +540,6 @@ def smooth_process(n: int, rate_hz: float, time_constant_s: float, rng: np.rando
     (1 + phi^2) / (1 - phi^2)^3: the drive is scaled by the inverse of its square root."""
     if n == 0:
         return np.zeros(0)
-    from scipy.signal import lfilter  # scipy.signal is slow to import; only simulation needs it here
-
     dt = 1.0 / rate_hz
     step = min(time_constant_s / GM_STEPS_PER_TIME_CONSTANT, max(dt * (n - 1), dt))
     step = max(step, dt)
@@ -550,7 +547,7 @@ def smooth_process(n: int, rate_hz: float, time_constant_s: float, rng: np.rando
     m = int(math.ceil((n - 1) * dt / step)) + 1
     phi = math.exp(-step / time_constant_s)
     drive = rng.standard_normal(burn + m) * math.sqrt((1 - phi**2) ** 3 / (1 + phi**2))
-    coarse = lfilter([1.0], [1.0, -phi], lfilter([1.0], [1.0, -phi], drive))[burn:]
+    coarse = lazy_lfilter([1.0], [1.0, -phi], lazy_lfilter([1.0], [1.0, -phi], drive))[burn:]
     return np.interp(np.arange(n) * dt, np.arange(m) * step, coarse)
 
 
