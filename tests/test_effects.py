@@ -1,6 +1,8 @@
 """The deterministic effects: thermal lag, turning points, hysteresis, g-sensitivity, quantization."""
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -232,16 +234,38 @@ def test_find_turns_equals_its_sample_by_sample_definition(seed, threshold, n):
 @pytest.mark.parametrize("n", [1, 2, 57, 5000])
 def test_the_short_first_order_filter_is_scipys_to_the_bit(n):
     """lazy_lfilter runs short first-order filters in Python until scipy.signal is imported: the same numbers as
-    scipy.signal.lfilter, bit for bit, with and without an initial state, for the lag's and the learner's forms."""
+    scipy.signal.lfilter, bit for bit, with and without an initial state, for the lag's, the learner's and the
+    simulator's forms."""
     rng = np.random.default_rng(n)
     x = rng.normal(25.0, 3.0, n)
     a = 0.9973
-    for b, den in (([0.0015, 0.0012], [1.0, -a]), ([1 - a], [1.0, -a])):
+    for b, den in (([0.0015, 0.0012], [1.0, -a]), ([1 - a], [1.0, -a]), ([1.0], [1.0, -a])):
         zi = [rng.normal()]
         ours, state = _first_order(b, den, x, zi)
         theirs, their_state = scipy_lfilter(b, den, x, zi=zi)
         assert np.array_equal(ours, theirs) and np.array_equal(state, their_state)
         assert np.array_equal(_first_order(b, den, x, None), scipy_lfilter(b, den, x))
+
+
+def test_a_process_that_filters_much_imports_scipy_after_its_python_budget():
+    """In a new interpreter (this one has scipy.signal already): short filters run in Python, without importing
+    scipy.signal, until PYTHON_FILTER_BUDGET samples; the next one imports it. Every result is scipy's."""
+    code = """
+import sys
+import numpy as np
+from gyrocomp.effects import PYTHON_FILTER_BUDGET, PYTHON_FILTER_SAMPLES, lazy_lfilter
+x = np.random.default_rng(0).normal(size=PYTHON_FILTER_SAMPLES)
+calls = PYTHON_FILTER_BUDGET // x.size
+got = [lazy_lfilter([0.5, 0.25], [1.0, -0.75], x) for _ in range(calls)]
+before = "scipy.signal" in sys.modules
+got.append(lazy_lfilter([0.5, 0.25], [1.0, -0.75], x))
+after = "scipy.signal" in sys.modules
+from scipy.signal import lfilter
+same = all(np.array_equal(g, lfilter([0.5, 0.25], [1.0, -0.75], x)) for g in got)
+print(calls, before, after, same)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert int(out[0]) >= 2 and out[1:] == ["False", "True", "True"], out
 
 
 @settings(max_examples=25, deadline=None)

@@ -34,14 +34,21 @@ G_SQUARED_TERMS = ("xx", "yy", "zz", "xy", "xz", "yz")
 #: a first-order filter of at most this many samples runs in Python (about 0.1 us a sample) rather than import
 #: scipy.signal (0.6 s) for it
 PYTHON_FILTER_SAMPLES = 100_000
+#: the samples filtered in Python in one process before scipy.signal is imported after all (about 0.2-0.3 s of
+#: Python filtering, under half the import's cost): a command that filters little never imports it, one that
+#: filters a lot (a fit's lag search on hours of blocks) pays at most that much before scipy's faster filter
+PYTHON_FILTER_BUDGET = 2_000_000
+#: samples filtered in Python so far in this process (a running total; a lost update between threads only moves
+#: the switch to scipy a little)
+_python_filtered = [0]
 
 
 def lazy_lfilter(b, a, x, zi=None):
     """``scipy.signal.lfilter``, imported on first use: scipy.signal costs most of a second at start-up and
-    most commands never filter. Until something else has imported it, a first-order filter (``a = [1, a1]``) of
-    a short input runs in Python with scipy's operations in scipy's order (its direct form II transposed:
-    y = x b0 + z, z = x b1 - y a1), so the result is the same to the bit (tested); once it is imported (a fit
-    filters thousands of times), scipy's is used, forty times faster."""
+    most commands never filter. Until something else has imported it, or :data:`PYTHON_FILTER_BUDGET` samples
+    have been filtered in Python, a first-order filter (``a = [1, a1]``) of a short input runs in Python with
+    scipy's operations in scipy's order (its direct form II transposed: y = x b0 + z, z = x b1 - y a1), so the
+    result is the same to the bit (tested); after that, scipy's is used, forty times faster on long inputs."""
     x = np.asarray(x, dtype=float)
     if (
         len(a) == 2
@@ -49,8 +56,10 @@ def lazy_lfilter(b, a, x, zi=None):
         and len(b) <= 2
         and x.ndim == 1
         and x.size <= PYTHON_FILTER_SAMPLES
+        and _python_filtered[0] + x.size <= PYTHON_FILTER_BUDGET
         and "scipy.signal" not in sys.modules
     ):
+        _python_filtered[0] += x.size
         return _first_order(b, a, x, zi)
     from scipy.signal import lfilter
 
