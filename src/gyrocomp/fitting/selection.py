@@ -510,21 +510,30 @@ class SelectionProblem:
             return (math.nan,) * len(windows_s)  # nothing left to train on without this fold
         sums = np.zeros(len(windows_s))
         wsum = np.zeros(len(windows_s))
-        prepared = self._prepared(tau_s)
         weights_of = [self._fold_weights(w)[f] for w in windows_s]
-        for j, (k, sel) in enumerate(self.fold_members()[f]):
-            temp, cols = prepared[k]
-            x = cols[np.ix_(sel, idx)]
-            t = temp[sel]
+        for j, (t, rows, value) in enumerate(self._held_out_rows(tau_s, f)):
+            x = rows[:, idx]
             past = (t < lo) | (t > hi)
             if c.order and np.any(past):  # past the training range the curve goes on as applied (tangent, or held)
                 x[past, : c.order] = self.basis(c.curve).columns(t[past], c.order, lo, hi)
-            residual = self.runs[k].value[sel] - (x @ coef if idx.size else 0.0)
+            residual = value - (x @ coef if idx.size else 0.0)
             for i, weights in enumerate(weights_of):
                 sse, total = drift_rms(residual, weights[j])
                 sums[i] += sse
                 wsum[i] += total
         return tuple(float(math.sqrt(a / b)) if b > 0 else math.nan for a, b in zip(sums, wsum))
+
+    def _held_out_rows(self, tau_s: float, f: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Per run with blocks in fold ``f`` (in the order of :meth:`fold_members`): the model temperature
+        [degC], every column (:meth:`columns`) and the value [the axis's unit] of those blocks at lag ``tau_s``
+        [s]; the same for every candidate scored on the fold."""
+        key = ("held out", tau_s, f)
+        if key not in self._cache:
+            prepared = self._prepared(tau_s)
+            self._cache[key] = [
+                (prepared[k][0][sel], prepared[k][1][sel], self.runs[k].value[sel]) for k, sel in self.fold_members()[f]
+            ]
+        return self._cache[key]
 
     def fold_members(self) -> list[list[tuple[int, np.ndarray]]]:
         """Per fold, (run, indices of its blocks in the fold) for every run with blocks in it."""
