@@ -5,7 +5,8 @@ interpreter (``python -c pass``) and the interpreter importing numpy and pandas,
 
 - ``gyrocomp --help`` and ``gyrocomp --version`` (only click is loaded: the commands are imported when one runs);
 - ``gyrocomp convert`` of a 100-row CSV to Parquet and ``gyrocomp apply`` of a model with thermal lag to a
-  600-row CSV (whole commands on small files: numpy and pyarrow, not pandas or scipy.signal).
+  600-row CSV (whole commands on small files: numpy and pyarrow, not pandas or scipy.signal);
+- ``gyrocomp simulate`` of 600 s at 1 Hz (its noise processes filtered without importing scipy.signal).
 
 Usage: python benchmarks/bench_startup.py
 """
@@ -68,6 +69,12 @@ def main() -> None:
             (
                 "`gyrocomp apply` of a model with thermal lag to a 600-row CSV",
                 best([str(SCRIPT), "-q", "apply", str(model), str(run), "-o", str(Path(tmp) / "out.csv")]),
+            ),
+            (
+                "`gyrocomp simulate` of 600 s at 1 Hz to CSV",
+                best(
+                    [str(SCRIPT), "-q", "simulate", "--rate", "1", "--duration", "600", "-o", str(Path(tmp) / "s.csv")]
+                ),
             ),
         ]
     base = rows[0][1]
