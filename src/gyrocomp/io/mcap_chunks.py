@@ -39,7 +39,7 @@ import numpy as np
 from .byte_fields import Places, among
 from .common import require
 from .read_ahead import ReadAhead
-from .rosbag1_chunks import ChunkArrays
+from .rosbag1_chunks import SPARSE, ChunkArrays
 from .rosbag2_storage import channel_ids, one_storage
 
 _MESSAGE, _CHUNK, _MESSAGE_INDEX = 0x05, 0x06, 0x07
@@ -87,7 +87,7 @@ def mcap_arrays(reader, connections) -> Iterator[ChunkArrays] | None:
         return None
     size = os.fstat(storage.bio.fileno()).st_size
     wanted = sum(c.channel_count.get(i, 0) for c in chunks for i in ids)
-    if wanted * _SPARSE <= sum(sum(c.channel_count.values()) for c in chunks):  # read where the indexes say
+    if wanted * SPARSE <= sum(sum(c.channel_count.values()) for c in chunks):  # read where the indexes say
         return (_chunk_arrays(storage.bio, size, info, ids) for info in chunks)
     return _read_ahead(storage.bio, size, chunks, ids)
 
@@ -171,20 +171,15 @@ def _index_entries(bio, file_size: int, offset: int, cid: int) -> np.ndarray | N
     return np.frombuffer(raw, dtype="<u8").reshape(-1, 2) if len(raw) == size else None
 
 
-#: a chunk whose messages of the channels read are at most one in this many is read where its index says
-#: (uncompressed)
-_SPARSE = 16
-
-
 def _sparse(bio, file_size: int, info, ids: set[int]):
     """What :func:`_chosen` takes, of the messages of ``ids`` in an uncompressed chunk where they are at most one in
-    :data:`_SPARSE` of its messages (a temperature topic at 1 Hz beside an IMU at 1 kHz), each message record read
-    where the chunk's message index says and checked there (a message of its channel and log time, inside the
-    chunk) instead of reading the whole chunk; None where that does not apply or does not hold (the chunk is then
+    :data:`~gyrocomp.io.rosbag1_chunks.SPARSE` of its messages (a temperature topic at 1 Hz beside an IMU at 1
+    kHz), each message record read where the chunk's message index says and checked there (a message of its
+    channel and log time, inside the chunk) instead of reading the whole chunk; None where that does not apply or does not hold (the chunk is then
     read whole). Those records alone are read (their bytes end to end, ``data_pos`` -1: not the chunk's place), and
     the chunk's CRC-32 is not checked."""
     hits = sum(info.channel_count.get(i, 0) for i in ids)
-    if info.compression or hits * _SPARSE > sum(info.channel_count.values()):
+    if info.compression or hits * SPARSE > sum(info.channel_count.values()):
         return None
     records_at, _ = _chunk_head(bio, file_size, info)
     found = []

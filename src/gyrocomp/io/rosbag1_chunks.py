@@ -104,7 +104,7 @@ def _messages(self, connections=(), start: int | None = None, stop: int | None =
             continue
         self.bio.seek(info.pos)
         chunk = self.read_chunk()
-        if chunk.decompressor is rb.decompressors["none"] and hits * _SPARSE <= sum(info.connection_counts.values()):
+        if chunk.decompressor is rb.decompressors["none"] and hits * SPARSE <= sum(info.connection_counts.values()):
             found = _indexed_messages(self, rb, chunk, len(info.connection_counts), connmap, wanted, (start, stop))
             if found is not None:
                 yield from found
@@ -113,8 +113,9 @@ def _messages(self, connections=(), start: int | None = None, stop: int | None =
         yield from _chunk_messages(rb, data, connmap, wanted, (start, stop), index)
 
 
-#: a chunk whose messages of the connections read are at most one in this many is read by its index (uncompressed)
-_SPARSE = 16
+#: a chunk whose messages of the topics read are at most one in this many is read where its index says
+#: (uncompressed), in a ROS 1 bag and in an MCAP file (:mod:`gyrocomp.io.mcap_chunks`) alike
+SPARSE = 16
 _INDEX_ENTRY = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("offset", "<u4")])
 
 
@@ -504,4 +505,4 @@ def lean_writer1() -> type:
     )
 
 
-__all__ = ["ChunkArrays", "chunked_reader1", "lean_writer1"]
+__all__ = ["SPARSE", "ChunkArrays", "chunked_reader1", "lean_writer1"]
