@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
@@ -27,6 +32,34 @@ def test_blas_runs_on_one_thread_inside_and_the_callers_setting_returns():
         before = blas_threads()
         np.testing.assert_allclose(work(), np.ones(3))
         assert seen == [1] and blas_threads() == before
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="one core: BLAS runs one thread anyway")
+def test_scipys_blas_loaded_late_is_held_to_one_thread_too():
+    """In a new interpreter that has not imported scipy: scipy.linalg brings its own BLAS, and a fit imports it
+    late, inside the limit. Every BLAS library loaded (numpy's and scipy's) runs on one thread in the call, and
+    keeps the caller's setting after."""
+    code = """
+import json
+from threadpoolctl import threadpool_info
+import numpy
+from gyrocomp.threads import single_threaded_blas
+
+def threads():
+    return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+@single_threaded_blas
+def work():
+    import scipy.linalg
+    return threads()
+
+inside = work()
+print(json.dumps([inside, threads()]))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    inside, after = json.loads(out)
+    assert inside and set(inside) == {1}, out
+    assert len(after) == len(inside) and max(after) > 1, out
 
 
 def test_the_setting_returns_when_the_call_raises():

@@ -23,8 +23,16 @@ _CONTROLLER: list[ThreadpoolController] = []
 
 
 def _controller() -> ThreadpoolController:
-    """The process's view of its thread pools, found once (the scan of loaded libraries costs milliseconds)."""
+    """The process's view of its thread pools, found once (the scan of loaded libraries costs milliseconds).
+
+    scipy brings a BLAS of its own beside numpy's (scipy.linalg's OpenBLAS), and the fits import scipy.linalg
+    late, inside the limit: a library loaded after the scan, or while the limit holds, keeps every thread, so the
+    same fit's last bits depended on what the process had imported before it (a fit in a process that had not
+    imported scipy against the same fit through the command line). scipy.linalg is loaded before the scan, so
+    both BLAS libraries are held to one thread."""
     if not _CONTROLLER:
+        import scipy.linalg  # noqa: F401 (its BLAS loaded, to be found; 0.1 s, which every fit pays anyway)
+
         _CONTROLLER.append(ThreadpoolController())
     return _CONTROLLER[0]
 
