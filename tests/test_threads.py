@@ -56,7 +56,8 @@ def work():
 inside = work()
 print(json.dumps([inside, threads()]))
 """
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "2"}  # the caller's setting, for libraries not loaded yet too
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env).stdout
     inside, after = json.loads(out)
     assert inside and set(inside) == {1}, out
     assert len(after) == len(inside) and max(after) > 1, out
