@@ -3,14 +3,23 @@
 from __future__ import annotations
 
 import base64
+import gc
+import importlib
 import importlib.util
 import io
+import locale
 import math
 import os
+import pkgutil
 import re
+import select
+import signal
 import subprocess
 import sys
+import tempfile
+import traceback
 import warnings
+import weakref
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -128,11 +137,139 @@ def assert_streaming_equals_batch(calibration, recording, cuts: list[int]) -> No
 SCRIPT = Path(sys.executable).parent / "gyrocomp"
 
 
-def run(*args, cwd=None) -> subprocess.CompletedProcess:
-    """Run the ``gyrocomp`` command through its real entry point in a subprocess (wide terminal, 300 s limit)."""
-    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
-    env = {**os.environ, "COLUMNS": "200"}
-    return subprocess.run([*cmd, *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+def run(*args, cwd=None, fresh: bool = False) -> subprocess.CompletedProcess:
+    """Run the ``gyrocomp`` command through its real entry point (:func:`gyrocomp.cli.main`, the console script's)
+    in a child process: stdout, stderr and the exit status as :func:`subprocess.run` gives them (wide terminal,
+    300 s limit).
+
+    The child is forked from this test process, whose numeric libraries are already loaded (the suite runs the
+    command some 440 times, and a new interpreter's imports took most of each short run); it starts as a new one
+    would: stdin empty, stdout and stderr files, Python's default warning filters, numpy's default error handling,
+    ``sys.argv`` as the script sees it, and it ends with ``os._exit``, after the finalizers its command registered
+    (a spilled series' folder) have run. ``fresh`` (and ``fleet fit`` on Dask, whose thread pools and event loops
+    must not be inherited) runs the console script in a new interpreter instead; tests/cli/test_entry.py checks the two
+    give the same output, byte for byte."""
+    argv = [os.fspath(a) if isinstance(a, os.PathLike) else str(a) for a in args]
+    if fresh or not hasattr(os, "fork") or _on_dask(argv):
+        cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
+        env = {**os.environ, "COLUMNS": "200"}
+        return subprocess.run([*cmd, *argv], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+    return _run_forked(argv, cwd, timeout_s=300.0)
+
+
+def _on_dask(argv: list[str]) -> bool:
+    """Whether the command is a ``fleet fit`` on Dask (any scheduler but ``serial``)."""
+    if argv[:2] != ["fleet", "fit"]:
+        return False
+    scheduler = [b for a, b in zip(argv, argv[1:]) if a == "--scheduler"]
+    scheduler += [a.split("=", 1)[1] for a in argv if a.startswith("--scheduler=")]
+    return scheduler[-1:] != ["serial"]
+
+
+#: the warning filters a new interpreter starts with (``python -c "import warnings; print(warnings.filters)"``,
+#: no -W and no PYTHONWARNINGS), applied in the forked command in place of pytest's
+_DEFAULT_WARNING_FILTERS = (
+    ("default", DeprecationWarning, "__main__"),
+    ("ignore", DeprecationWarning, ""),
+    ("ignore", PendingDeprecationWarning, ""),
+    ("ignore", ImportWarning, ""),
+    ("ignore", ResourceWarning, ""),
+)
+_prewarmed = False
+
+
+def _prewarm() -> None:
+    """Import every module of gyrocomp (and with them the libraries each command loads) once in this process,
+    before the first fork, so that no forked command imports them again."""
+    global _prewarmed
+    if _prewarmed:
+        return
+    import gyrocomp
+
+    for module in pkgutil.walk_packages(gyrocomp.__path__, "gyrocomp."):
+        if module.name != "gyrocomp.__main__":
+            try:
+                importlib.import_module(module.name)
+            except ImportError:  # an optional extra not installed: the command that needs it says so itself
+                pass
+    _prewarmed = True
+
+
+def _run_forked(argv: list[str], cwd, timeout_s: float) -> subprocess.CompletedProcess:
+    _prewarm()
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        for stream in (sys.stdout, sys.stderr, sys.__stdout__, sys.__stderr__):
+            if stream is not None:
+                stream.flush()
+        pid = os.fork()
+        if pid == 0:  # the child: never back into pytest
+            status = 1
+            try:
+                status = _forked_command(argv, cwd, out.fileno(), err.fileno())
+            except BaseException:  # noqa: BLE001 - said on the command's stderr, status 1
+                traceback.print_exc()
+            finally:
+                os._exit(status)
+        status = _wait(pid, timeout_s, argv)
+        out.seek(0)
+        err.seek(0)
+        return subprocess.CompletedProcess(["gyrocomp", *argv], status, _as_text(out.read()), _as_text(err.read()))
+
+
+def _forked_command(argv: list[str], cwd, out_fd: int, err_fd: int) -> int:
+    """In the forked child: the command run as the console script would run it; its exit status."""
+    stdin = os.open(os.devnull, os.O_RDONLY)
+    os.dup2(stdin, 0)
+    os.dup2(out_fd, 1)
+    os.dup2(err_fd, 2)
+    sys.stdin = open(0, closefd=False)  # noqa: SIM115 - the process's streams, as a new interpreter opens them
+    sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115
+    sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)  # noqa: SIM115
+    if cwd is not None:
+        os.chdir(cwd)
+    os.environ["COLUMNS"] = "200"
+    sys.argv = [str(SCRIPT), *argv]
+    warnings.resetwarnings()
+    for action, category, module in reversed(_DEFAULT_WARNING_FILTERS):
+        warnings.filterwarnings(action, category=category, module=module)
+    np.seterr(all="warn", under="ignore")
+    entry_point = importlib.import_module("gyrocomp.cli.entry_point")
+    entry_point._LOOKED_UP.clear()  # what earlier in-process commands looked up is not this command's
+    inherited = set(weakref.finalize._registry)
+    try:
+        entry_point.main()
+        status = 0
+    except SystemExit as exc:
+        status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if not isinstance(exc.code, (int, type(None))):
+            print(exc.code, file=sys.stderr)
+    gc.collect()
+    for finalizer in [f for f in list(weakref.finalize._registry) if f not in inherited]:
+        if finalizer.atexit:
+            finalizer()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    return status
+
+
+def _wait(pid: int, timeout_s: float, argv: list[str]) -> int:
+    """The forked command's exit status (as subprocess gives it: -N when killed by signal N), killing it after
+    ``timeout_s`` [s] as subprocess.run's timeout does."""
+    handle = os.pidfd_open(pid)
+    try:
+        if not select.select([handle], [], [], timeout_s)[0]:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            raise subprocess.TimeoutExpired(["gyrocomp", *argv], timeout_s)
+    finally:
+        os.close(handle)
+    return os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1])
+
+
+def _as_text(data: bytes) -> str:
+    """Bytes decoded as subprocess.run(text=True) decodes them (the locale's encoding, universal newlines)."""
+    text = data.decode(locale.getpreferredencoding(False))
+    return text.replace("\r\n", "\n").replace("\r", "\n")
 
 
 class ReportPage(HTMLParser):
