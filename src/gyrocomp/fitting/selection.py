@@ -511,12 +511,12 @@ class SelectionProblem:
         sums = np.zeros(len(windows_s))
         wsum = np.zeros(len(windows_s))
         weights_of = [self._fold_weights(w)[f] for w in windows_s]
-        for j, (t, rows, value) in enumerate(self._held_out_rows(tau_s, f)):
-            x = rows[:, idx]
+        for j, (t, columns, value) in enumerate(self._held_out_rows(tau_s, f)):
+            x = columns[idx]
             past = (t < lo) | (t > hi)
             if c.order and np.any(past):  # past the training range the curve goes on as applied (tangent, or held)
-                x[past, : c.order] = self.basis(c.curve).columns(t[past], c.order, lo, hi)
-            residual = value - (x @ coef if idx.size else 0.0)
+                x[: c.order, past] = self.basis(c.curve).columns(t[past], c.order, lo, hi).T
+            residual = value - (coef @ x if idx.size else 0.0)
             for i, weights in enumerate(weights_of):
                 sse, total = drift_rms(residual, weights[j])
                 sums[i] += sse
@@ -525,13 +525,15 @@ class SelectionProblem:
 
     def _held_out_rows(self, tau_s: float, f: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """Per run with blocks in fold ``f`` (in the order of :meth:`fold_members`): the model temperature
-        [degC], every column (:meth:`columns`) and the value [the axis's unit] of those blocks at lag ``tau_s``
-        [s]; the same for every candidate scored on the fold."""
+        [degC], every column (:meth:`columns`, one row each: a candidate's columns are then whole rows, gathered
+        four times faster than columns of a row-major table) and the value [the axis's unit] of those blocks at
+        lag ``tau_s`` [s]; the same for every candidate scored on the fold."""
         key = ("held out", tau_s, f)
         if key not in self._cache:
             prepared = self._prepared(tau_s)
             self._cache[key] = [
-                (prepared[k][0][sel], prepared[k][1][sel], self.runs[k].value[sel]) for k, sel in self.fold_members()[f]
+                (prepared[k][0][sel], np.ascontiguousarray(prepared[k][1][sel].T), self.runs[k].value[sel])
+                for k, sel in self.fold_members()[f]
             ]
         return self._cache[key]
 
