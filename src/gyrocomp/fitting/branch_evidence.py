@@ -176,11 +176,15 @@ def _refined_edges(band, step, temps, x, y, w, thresholds, t_scale_degc) -> tupl
     direction = np.concatenate([tr.direction for tr in turns])
     d = np.where(after, np.abs(t - np.where(after, turn_degc, 0.0)), 0.0) / t_scale_degc
     projected = _ProjectedFit(x, y, w)
-    powers = [np.where(direction == sign, d**j, 0.0) for sign in (-1, 1) for j in (1, 2)]
+    powers = np.column_stack([np.where(direction == sign, d**j, 0.0) for sign in (-1, 1) for j in (1, 2)])
+
+    tried: dict[tuple[float, float], float] = {}  # the unmoved lower edge and the final band come up twice
 
     def rss(lo, hi):
-        inside = after & (t >= lo) & (t <= hi)
-        return projected.rss(np.column_stack([np.where(inside, p, 0.0) for p in powers]))
+        if (lo, hi) not in tried:
+            inside = after & (t >= lo) & (t <= hi)
+            tried[lo, hi] = projected.rss(np.where(inside[:, None], powers, 0.0))
+        return tried[lo, hi]
 
     offsets = np.linspace(-step, step, 9)
     lo = min(band[0] + offsets, key=lambda v: rss(v, band[1]))

@@ -324,8 +324,10 @@ class SelectionProblem:
     def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
         """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order, the other
         families' blocks (none at a lag: ``lagged``), the cooling then heating hysteresis terms (d / t_scale)^j,
-        the branch terms s_w u^j for each crossover width w, then the accelerometer columns. (A fold's training
-        range is applied where its held-out blocks are scored, :meth:`_held_out`.)"""
+        the branch terms s_w u^j for each crossover width w, then the accelerometer columns, and last the value
+        fitted (the run's block means [the axis's unit]: the normal matrices' last row, without a copy of the
+        columns to join it). (A fold's training range is applied where its held-out blocks are scored,
+        :meth:`_held_out`.)"""
         u = (temp - self.t_ref_degc) / self.t_scale_degc
         cols = [power_columns(u, 1, self.max_order)]
         cols += [self.basis(name).columns(temp, size) for name, size, _ in self.other_blocks(lagged)]
@@ -344,7 +346,7 @@ class SelectionProblem:
         for width in BRANCH_WIDTHS_DEGC if self.branch_orders else ():
             position = branch_position(temp, turns, width)
             cols.append(position[:, None] * power_columns(u, 0, self.max_branch - 1))
-        cols.append(self.accel_columns(k))
+        cols += [self.accel_columns(k), self.runs[k].value[:, None]]
         return np.hstack(cols)
 
     def accel_columns(self, k: int) -> np.ndarray:
@@ -410,9 +412,9 @@ class SelectionProblem:
     def shape_columns(self, k: int, temp: np.ndarray) -> np.ndarray:
         """The polynomial's columns u^1..u^max_order at model temperature ``temp`` [degC], then the accelerometer
         columns: what a ``poly + lag`` candidate uses (:meth:`lag_rss`), without the hysteresis and branch terms
-        that :meth:`columns` also makes."""
+        that :meth:`columns` also makes; the value last, as there."""
         u = (temp - self.t_ref_degc) / self.t_scale_degc
-        return np.hstack([power_columns(u, 1, self.max_order), self.accel_columns(k)])
+        return np.hstack([power_columns(u, 1, self.max_order), self.accel_columns(k), self.runs[k].value[:, None]])
 
     # -- normal equations, per fold --------------------------------------------------------------------
     def _model_temperatures(self, tau_s: float) -> list[np.ndarray]:
@@ -422,8 +424,8 @@ class SelectionProblem:
         return self._cache[key]
 
     def _prepared(self, tau_s: float, shape_only: bool = False):
-        """Per run at lag ``tau_s``: model temperature and columns (:meth:`columns`, or with ``shape_only``
-        :meth:`shape_columns`)."""
+        """Per run at lag ``tau_s``: model temperature and columns, the value last (:meth:`columns`, or with
+        ``shape_only`` :meth:`shape_columns`)."""
         key = ("prep", tau_s, shape_only)
         if key not in self._cache:
             temps = self._model_temperatures(tau_s)
@@ -444,7 +446,7 @@ class SelectionProblem:
             return self._cache[key]
         n_folds = self.folds.count
         prepared = self._prepared(tau_s, shape_only)
-        p = prepared[0][1].shape[1]
+        p = prepared[0][1].shape[1] - 1  # the columns; the value is last
         # per group (run) and fold: raw sums
         group_ids = sorted(set(self.groups))
         gram = np.zeros((len(group_ids), n_folds, p + 1, p + 1))
@@ -454,17 +456,15 @@ class SelectionProblem:
         hi = np.full(n_folds, -np.inf)
         t_lo = np.full((len(self.runs), n_folds), np.inf)
         t_hi = np.full((len(self.runs), n_folds), -np.inf)
-        for k, (temp, cols) in enumerate(prepared):
+        for k, (temp, z) in enumerate(prepared):
             g = group_ids.index(self.groups[k])
-            z = np.hstack([cols, self.runs[k].value[:, None]])
             w = self.weights(k, weighting)
-            fold = self.folds.of_block[k]
-            for f in np.unique(fold):
-                sel = fold == f
-                zw = z[sel] * w[sel, None]
-                gram[g, f] += zw.T @ z[sel]
+            for f, sel in self._run_folds()[k]:
+                zs, ws = z[sel], w[sel]
+                zw = zs * ws[:, None]
+                gram[g, f] += zw.T @ zs
                 first[g, f] += zw.sum(axis=0)
-                total[g, f] += w[sel].sum()
+                total[g, f] += ws.sum()
                 t_lo[k, f], t_hi[k, f] = temp[sel].min(), temp[sel].max()
         matrices = np.zeros((n_folds, p + 1, p + 1))
         g_all, m_all, s_all = gram.sum(axis=1), first.sum(axis=1), total.sum(axis=1)
@@ -532,20 +532,33 @@ class SelectionProblem:
         if key not in self._cache:
             prepared = self._prepared(tau_s)
             self._cache[key] = [
-                (prepared[k][0][sel], np.ascontiguousarray(prepared[k][1][sel].T), self.runs[k].value[sel])
+                (prepared[k][0][sel], np.ascontiguousarray(prepared[k][1][sel, :-1].T), self.runs[k].value[sel])
                 for k, sel in self.fold_members()[f]
             ]
         return self._cache[key]
 
-    def fold_members(self) -> list[list[tuple[int, np.ndarray]]]:
-        """Per fold, (run, indices of its blocks in the fold) for every run with blocks in it."""
+    def fold_members(self) -> list[list[tuple[int, np.ndarray | slice]]]:
+        """Per fold, (run, its blocks in the fold) for every run with blocks in it: a slice where they follow one
+        another (a leg, a run: then read in place), their indices otherwise."""
         if "members" not in self._cache:
             members = [[] for _ in range(self.folds.count)]
             for k, fold in enumerate(self.folds.of_block):
                 for f in np.unique(fold):
-                    members[int(f)].append((k, np.flatnonzero(fold == f)))
+                    rows = np.flatnonzero(fold == f)
+                    whole = rows[-1] - rows[0] + 1 == rows.size
+                    members[int(f)].append((k, slice(int(rows[0]), int(rows[-1]) + 1) if whole else rows))
             self._cache["members"] = members
         return self._cache["members"]
+
+    def _run_folds(self) -> list[list[tuple[int, np.ndarray | slice]]]:
+        """Per run, (fold, its blocks in the fold) for every fold it has blocks in (:meth:`fold_members`)."""
+        if "run folds" not in self._cache:
+            by_run = [[] for _ in self.runs]
+            for f, members in enumerate(self.fold_members()):
+                for k, sel in members:
+                    by_run[k].append((f, sel))
+            self._cache["run folds"] = by_run
+        return self._cache["run folds"]
 
     def _fold_weights(self, window_s: float) -> list[list[DriftWeights]]:
         """Per fold, the :class:`DriftWeights` (block durations, a moving average of ``window_s`` [s]) of each of its
