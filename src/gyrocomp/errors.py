@@ -68,6 +68,7 @@ CheckName = Literal[
     "rate",
     "kelvin",
     "time-unit",
+    "time-bursts",
     "offset",
     "rotation",
     "temperature-span",

@@ -1,6 +1,7 @@
 """Plausibility checks: unit mistakes and the wrong kind of data are said, never silently fitted."""
 
 import dataclasses
+import re
 import warnings
 
 import numpy as np
@@ -19,7 +20,7 @@ from gyrocomp.errors import (
     PlausibilityWarning,
     TemperatureRangeWarning,
 )
-from gyrocomp.io import read
+from gyrocomp.io import TableLayout, read
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.measures.plausibility import (
     CHECKS,
@@ -37,7 +38,7 @@ from gyrocomp.measures.plausibility import (
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import simulate
 
-from ..conftest import run, xsens_session
+from ..conftest import run, shared_dataset, xsens_session
 
 RUN = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=1).recording
 
@@ -81,6 +82,59 @@ def test_time_in_another_unit():
     (concern,) = recording_concerns(_still(100.0, 1000, time_factor=1e-3))
     assert concern.message.startswith("t.csv: 1e+05 Hz is no IMU's sample rate")
     assert recording_concerns(_still(100.0, 1000)) == []
+
+
+def _burst_stamped(rate_hz: float, n: int, burst: int, arrival_step_s: float) -> Recording:
+    """A sensor sampling evenly at ``rate_hz`` [Hz] whose samples reach the logger ``burst`` at a time (when the
+    last of them is taken), stamped on arrival ``arrival_step_s`` [s] apart (a serial link's buffer)."""
+    arrival = np.repeat(np.arange(burst - 1, n + burst, burst) / rate_hz, burst)[:n]
+    within = np.tile(np.arange(burst) * arrival_step_s, n // burst + 1)[:n]
+    return Recording(time_s=arrival + within, gyro_dps=np.zeros((n, 1)), gyro_axes=("gyro_z",), source="b.csv")
+
+
+def test_time_stamps_that_come_in_bursts_are_said_with_the_samples_mean_rate():
+    """100 Hz delivered five samples at a time, stamped 2 ms apart on arrival: the median step says 500 Hz; the
+    check says so and gives the samples' mean rate (100 Hz), as on sunsided's real MPU-6050 logs (below)."""
+    (concern,) = recording_concerns(_burst_stamped(100.0, 10_000, 5, 2e-3))
+    assert concern.check == "time-bursts"
+    assert concern.message.startswith(
+        "b.csv: the time stamps come in bursts: 1999 of 9999 steps (20%) are gaps over 2 times the median step "
+        "(2 ms, 500 Hz), and the samples average 100 Hz: "
+    ), concern.message
+    assert concern.message.endswith(
+        "would be 5 times off; if the sensor samples evenly, read the samples at that rate without their stamps (rate_hz=100)"
+    )
+
+
+def test_dropouts_and_pauses_are_not_bursts():
+    """Samples lost at random (three in ten: steps of two periods or more, gaps when the stamps' jitter makes them
+    longer than two median steps, here about one step in nine) or long pauses between runs lengthen the mean step a
+    little: not bursts."""
+    rng = np.random.default_rng(3)
+    kept = np.sort(rng.choice(20_000, 14_000, replace=False))
+    jitter = 1e-4 * rng.standard_normal(kept.size)
+    lossy = Recording(time_s=kept / 100.0 + jitter, gyro_dps=np.zeros((kept.size, 1)), gyro_axes=("gyro_z",))
+    assert len(lossy.gaps) > 0.05 * kept.size and "time-bursts" not in _checks(recording_concerns(lossy))
+    paused = np.concatenate([np.arange(1000) / 100.0 + 60.0 * k for k in range(5)])
+    runs = Recording(time_s=paused, gyro_dps=np.zeros((paused.size, 1)), gyro_axes=("gyro_z",))
+    assert len(runs.gaps) == 4 and recording_concerns(runs) == []
+
+
+def test_the_burst_stamped_real_mpu6050_logs_are_said_and_the_others_are_not():
+    """../shared's sunsided MPU-6050 logs: 'nominal 100 Hz (mean about 99.3 Hz, timestamps irregular/bursty;
+    median dt about 2 ms)' (its README): each said, with the README's mean rate; the shared logs with regular
+    stamps (CATS, tofupilot) are not."""
+    from ..real.real_data import cats_runs, tofupilot_run
+
+    folder = shared_dataset("sunsided-mpu6050-static")
+    for path in sorted(folder.glob("*/mpu6050_gyroscope.mat")):
+        columns = {"time": "gyroBuffer[:, 0]", "gyro_x": "gyroBuffer[:, 1]"}
+        (concern,) = [c for c in recording_concerns(read(path, TableLayout(columns=columns)))]
+        mean_hz = float(re.search(r"the samples average ([\d.]+) Hz", concern.message).group(1))
+        assert concern.check == "time-bursts" and 98.5 < mean_hz < 100.0, concern.message
+    shared_dataset("skdivemove-cats-tempcal")
+    shared_dataset("tofupilot-imu-thermal")
+    assert all("time-bursts" not in _checks(recording_concerns(r)) for r in [*cats_runs(), tofupilot_run()])
 
 
 def test_values_beyond_any_mems_range():

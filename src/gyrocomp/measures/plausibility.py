@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import CHECKS, CheckName, InputError, PlausibilityWarning, silence_pattern
 from ..effects import moving_average_range
-from ..recording import Recording
+from ..recording import GAP_FACTOR, Recording
 from ..runs.prepared import PreparedRun
 from ..units import STANDARD_GRAVITY_M_PER_S2
 
@@ -55,6 +55,11 @@ POSE_WINDOW_S, POSE_MIN_S, POSE_FACTOR = 0.5, 1.0, 10.0
 RATE_RANGE_HZ = (1e-3, 4e4)
 #: a recording this long at 1 Hz or slower is more likely a time column in ms read as s [s]
 LONG_SLOW_S = 7 * 86400.0
+#: time stamps in bursts: more than this share of the time steps are gaps (a dropout is a rare event) ...
+BURST_GAP_SHARE = 0.05
+#: ... and the samples' mean step is more than this many median steps (dropouts, even many, lengthen the mean
+#: step a little; stamps taken when buffered samples arrive make the median step that of the transfer)
+BURST_MEAN_STEPS = 2.0
 #: the median norm of three accelerometer axes [g] that a unit mistake gives (gravity is 1 g, at rest and on
 #: average in ordinary motion), and the mistake; said within 20 % of one
 ACCEL_NORM_MISTAKES = (
@@ -78,7 +83,7 @@ KNOWN_SLOPES = (
 @dataclass(frozen=True)
 class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
-    ``temperature-span``, ``agreement``, ``accel-unit``, ``temperature-range``) and the one-line message, which
+    ``time-bursts``, ``temperature-span``, ``agreement``, ``accel-unit``, ``temperature-range``) and the one-line message, which
     starts with the recording's source."""
 
     check: CheckName
@@ -137,7 +142,34 @@ def recording_concerns(recording: Recording) -> list[Concern]:
     concern = time_unit_concern(src, recording.rate_hz, recording.duration_s)
     if concern is not None:
         out.append(concern)
+    concern = time_bursts_concern(recording)
+    if concern is not None:
+        out.append(concern)
     return out
+
+
+def time_bursts_concern(recording: Recording) -> Concern | None:
+    """Time stamps that came in bursts: more than :data:`BURST_GAP_SHARE` of the time steps are gaps (longer than
+    :data:`gyrocomp.recording.GAP_FACTOR` median steps) and the mean step is over :data:`BURST_MEAN_STEPS` median
+    steps. Stamps taken when a buffer of samples arrives (a serial or USB link, a phone's sensor events) look so:
+    the rate read from them (the median step's) is that of the transfer, not the sensor's, and figures that use
+    it (Allan deviation, noise densities) are off by the ratio of the two."""
+    steps = recording.n_samples - 1
+    if steps < 2 or len(recording.gaps) <= BURST_GAP_SHARE * steps:
+        return None
+    mean_rate_hz = steps / recording.duration_s
+    if recording.rate_hz <= BURST_MEAN_STEPS * mean_rate_hz:
+        return None
+    return Concern(
+        "time-bursts",
+        f"{recording.source}: the time stamps come in bursts: {len(recording.gaps)} of {steps} steps "
+        f"({len(recording.gaps) / steps:.0%}) are gaps over {GAP_FACTOR:g} times the median step "
+        f"({1e3 / recording.rate_hz:.3g} ms, {recording.rate_hz:.4g} Hz), and the samples average "
+        f"{mean_rate_hz:.4g} Hz: the stamps look like when buffered samples arrived, not when they were taken, "
+        f"and what uses the rate (Allan deviation, noise densities) would be {recording.rate_hz / mean_rate_hz:.2g} "
+        f"times off; if the sensor samples evenly, read the samples at that rate without their stamps "
+        f"(rate_hz={mean_rate_hz:.4g})",
+    )
 
 
 def time_unit_concern(source: str, rate_hz: float, duration_s: float) -> Concern | None:
@@ -481,6 +513,7 @@ __all__ = [
     "time_unit_concern",
     "calibration_concerns",
     "recording_concerns",
+    "time_bursts_concern",
     "require_temperature_span",
     "scale_agreement",
     "silence_pattern",
