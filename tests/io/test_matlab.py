@@ -4,7 +4,9 @@ the libraries that write them, read back to the values written; the real MATLAB 
 
 from __future__ import annotations
 
+import json
 import math
+import re
 
 import h5py
 import numpy as np
@@ -215,3 +217,52 @@ def test_the_layout_guessed_for_smacs_npz_reads_its_columns_at_its_rate():
     rec = read(path, guess.layout)
     np.testing.assert_array_equal(rec.gyro_dps, data[:, :3])
     np.testing.assert_array_equal(rec.accel_g, data[:, 3:])
+
+
+def test_a_time_then_axes_array_is_guessed_by_its_columns_and_its_time_can_be_left_unread(tmp_path, imu):
+    """An (n, 4) gyro array of [t x y z] (MATLAB logs keep a sensor's buffer so): init maps its columns, the first
+    the time; an (n, 4) array whose first column falls is not taken for one. With the time left unread
+    (``columns={'time': ''}``) and a rate, the samples are at n / rate."""
+    t, gyro, _ = imu
+    path = tmp_path / "buffer.npz"
+    np.savez(path, gyroBuffer=np.column_stack([t, gyro]))
+    guess = guess_layout(path)
+    assert guess.layout.columns == {"time": "gyroBuffer[:, 0]", **_gyro_columns("gyroBuffer", first=1)}
+    rec = read(path, guess.layout)
+    np.testing.assert_array_equal(rec.time_s, t)
+    np.testing.assert_array_equal(rec.gyro_dps, gyro)
+    untimed = read(path, TableLayout({**_gyro_columns("gyroBuffer", first=1), "time": ""}, rate_hz=25.0))
+    np.testing.assert_array_equal(untimed.time_s, np.arange(t.size) / 25.0)
+    np.testing.assert_array_equal(untimed.gyro_dps, gyro)
+    with pytest.raises(
+        InputError,
+        match=r"buffer.npz: rate_hz=25 is for a file without time, and this one has 'gyroBuffer\[:, 0\]'; to read "
+        r"the samples at it instead, leave the time unread \(columns=\{'time': ''\}\)",
+    ):
+        read(path, TableLayout({"time": "gyroBuffer[:, 0]", **_gyro_columns("gyroBuffer", first=1)}, rate_hz=25.0))
+    np.savez(path, gyroBuffer=np.column_stack([t[::-1], gyro]))
+    with pytest.raises(InputError, match=r"no array looks like the gyro .*an \(n, 4\) one of the time then x, y, z"):
+        guess_layout(path)
+
+
+def test_sunsideds_burst_stamped_mpu6050_log_from_init_to_its_allan_deviation(tmp_path):
+    """../shared's sunsided MPU-6050 log (gyroBuffer, [t x y z], its README; stamps in bursts, 99.3 Hz on
+    average): init guesses its columns; allan then says the stamps come in bursts and refuses the gaps; with the
+    time left unread at the mean rate it says, the first Allan deviation of each axis is within 10 % of the
+    standard deviation the dataset's README gives (0.126, 0.091, 0.113 deg/s: white noise, whose deviation at
+    one sample is the standard deviation)."""
+    source = shared_dataset("sunsided-mpu6050-static") / "unmoved-with-x-pointing-forward-10min"
+    path = source / "mpu6050_gyroscope.mat"
+    made = run("init", path, cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    assert 'time = "gyroBuffer[:, 0]"' in (tmp_path / "gyrocomp.toml").read_text()
+    said = run("allan", path, cwd=tmp_path)
+    assert said.returncode == 2 and "(check 'time-bursts')" in said.stderr, said.stderr
+    rate = re.search(r"\(--columns time= and --rate ([\d.]+)\)", said.stderr).group(1)
+    assert 99.0 < float(rate) < 99.6  # the README's 99.3 Hz on average
+    columns = ",".join(f"{k}={v}" for k, v in _gyro_columns("gyroBuffer", first=1).items()) + ",time="
+    done = run("allan", path, "--columns", columns, "--rate", rate, "--json", cwd=tmp_path)
+    assert done.returncode == 0 and "time-bursts" not in done.stderr, done.stderr
+    axes = json.loads(done.stdout)["axes"]
+    for axis, std_dps in zip(("gyro_x", "gyro_y", "gyro_z"), (0.126, 0.091, 0.113)):
+        assert axes[axis]["adev"][0] == pytest.approx(std_dps, rel=0.1)

@@ -522,3 +522,32 @@ def test_a_real_mpu6050_log_with_its_preamble_is_read_as_its_counts_scaled():
     np.testing.assert_array_equal(recording.gyro_dps, counts[:, 3:] * (1.0 / 131.0))
     np.testing.assert_array_equal(recording.accel_g, counts[:, :3] * (1.0 / 16384.0))
     np.testing.assert_array_equal(recording.time_s, np.arange(len(counts)) / 100.0)
+
+
+def test_a_time_column_left_unread_times_the_rows_at_the_rate_given(tmp_path):
+    """``columns={'time': ''}`` (``--columns time=``): the file's time column is not read and the n-th row is at
+    n / rate_hz, for stamps that are not the samples' (taken as buffered samples arrived); the other channels read
+    as before. Without a rate, or for another channel, it is refused; a rate beside a read time column says how."""
+    rows = ["time,gyro_z,temperature"] + [f"{0.05 * (k // 5) + 0.002 * (k % 5):.3f},{k},25" for k in range(50)]
+    path = tmp_path / "burst.csv"
+    path.write_text("\n".join(rows) + "\n")
+    rec = read(path, TableLayout(parse_column_mapping("time="), rate_hz=100.0))
+    np.testing.assert_array_equal(rec.time_s, np.arange(50) / 100.0)
+    np.testing.assert_array_equal(rec.gyro_dps[:, 0], np.arange(50.0))
+    np.testing.assert_array_equal(rec.temperature_degc, np.full(50, 25.0))
+    assert parse_column_mapping("gyro_z=G,time=") == {"gyro_z": "G", "time": ""}
+    with pytest.raises(
+        InputError,
+        match=r"^columns: time is left unread \(columns=\{'time': ''\}\): give the samples' rate \(rate_hz=100\)",
+    ):
+        TableLayout({"time": ""})
+    with pytest.raises(InputError, match=r"^columns: gyro_z= names no column; only the time may be left unread"):
+        TableLayout({"gyro_z": ""}, rate_hz=100.0)
+    with pytest.raises(InputError, match=r"^columns: 'gyro_z=' is not CHANNEL=COLUMN"):
+        parse_column_mapping("gyro_z=")
+    with pytest.raises(
+        InputError,
+        match=r"burst.csv: rate_hz=100: the file has a time column \('time'\); a nominal rate is for tables without "
+        r"one, or to read the rows at it instead of the file's time leave the time unread \(columns=\{'time': ''\}\)",
+    ):
+        read(path, TableLayout(rate_hz=100.0))

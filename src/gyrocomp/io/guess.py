@@ -470,10 +470,20 @@ def _entries(store: ArrayStore) -> list[tuple[str, str, np.ndarray]]:
     return entries
 
 
+def _time_then_axes(values: np.ndarray) -> bool:
+    """Whether ``values`` is an (n, 4) array of the time then three axes (``[t x y z]``, as MATLAB logs keep a
+    sensor's buffer): its first column never falls and rises overall, and no other column does so."""
+    if values.ndim != 2 or values.shape[1] != 4 or values.shape[0] < 2 or not np.issubdtype(values.dtype, np.number):
+        return False
+    steps = np.diff(values, axis=0)
+    rising = np.all(steps >= 0, axis=0) & (values[-1] > values[0])
+    return bool(rising[0] and not rising[1:].any())
+
+
 def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[str, tuple[str, np.ndarray]]]:
-    """Channel -> array of each array named as a channel (an (n, 3) gyro or accelerometer array whole, one of one
-    dimension per axis, the temperature, the time; a matrix's column by its label), why, and the per-axis columns
-    (``NAME[:, k]`` -> values)."""
+    """Channel -> array of each array named as a channel (an (n, 3) gyro or accelerometer array whole, an (n, 4)
+    one of the time then the axes by its columns, one of one dimension per axis, the temperature, the time; a
+    matrix's column by its label), why, and the per-axis columns (``NAME[:, k]`` -> values)."""
     columns: dict[str, str] = {}
     reasons: list[str] = []
     flat: dict[str, tuple[str, np.ndarray]] = {}
@@ -485,6 +495,18 @@ def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[
             reasons.append(f"{kind} = {name!r}: {said}, an (n, 3) array")
             for k, axis in enumerate("xyz"):
                 flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+        elif kind in ("gyro", "accel") and _time_then_axes(values) and not {kind, f"{kind}_x"} & set(columns):
+            for k, axis in enumerate("xyz", start=1):
+                columns[f"{kind}_{axis}"] = f"{name}[:, {k}]"
+                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+            reasons.append(
+                f"{kind}_x, _y, _z = {name!r} columns 1 to 3: {said}, an (n, 4) array whose first column never "
+                "falls (the time)"
+            )
+            if "time" not in columns:
+                columns["time"] = f"{name}[:, 0]"
+                flat["time"] = (f"{name}[:, 0]", values[:, 0])
+                reasons.append(f"time = '{name}[:, 0]': the first column of {name!r}")
         elif kind in ("time", "temperature") and values.ndim == 1 and kind not in columns:
             columns[kind] = name
             reasons.append(f"{kind} = {name!r}: {said}")
@@ -519,8 +541,8 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     if not any(c == "gyro" or c.startswith("gyro_") for c in columns):
         shapes = ", ".join(f"{n} {tuple(a.shape)}" for n, a in store.items())
         raise InputError(
-            f"{path}: no array looks like the gyro (a name with gyr, omega or rate: an (n, 3) array, or one per axis "
-            f"named with x, y or z); its arrays are {shapes}: map them in a project file's [read.columns] "
+            f"{path}: no array looks like the gyro (a name with gyr, omega or rate: an (n, 3) array, an (n, 4) one "
+            f"of the time then x, y, z, or one per axis named with x, y or z); its arrays are {shapes}: map them in a project file's [read.columns] "
             '(gyro_x = "NAME[:, k]" for column k of an array)'
         )
     stated = _stated_array_rate(store) if "time" not in columns and rate_hz is None else None

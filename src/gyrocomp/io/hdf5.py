@@ -25,7 +25,7 @@ from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .common import ProgressCallback, ReadOptions, log_recording, require
 from .readers import Reader, check_magic, register_reader
-from .layout import TIME_COLUMN
+from .layout import TIME_COLUMN, UNMAPPED
 
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
 NETCDF3_MAGIC = b"CDF"
@@ -143,6 +143,8 @@ def _temperature(dataset, source: str) -> np.ndarray:
 
 
 def _find(handle, source: str, channel: str, mapping: dict[str, str]):
+    if mapping.get(channel) == UNMAPPED:  # the time left unread: the samples at the layout's rate
+        return None
     if channel in mapping:
         name = mapping[channel]
         column = _COLUMN_OF.match(name)
@@ -201,7 +203,8 @@ def _channels(handle, layout, path: Path, progress: ProgressCallback | None):
         )
     if time_ds is not None and layout.rate_hz is not None:
         raise InputError(
-            f"{path}: rate_hz={layout.rate_hz:g} is for a file without time, and this one has {time_ds.name!r}"
+            f"{path}: rate_hz={layout.rate_hz:g} is for a file without time, and this one has {time_ds.name!r}; "
+            "to read the samples at it instead, leave the time unread (columns={'time': ''})"
         )
     time_s = None
     if time_ds is not None:

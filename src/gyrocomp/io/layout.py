@@ -42,9 +42,15 @@ def unit_named(name: str) -> str:
     return name + ("_g" if name in ACCEL_AXES else "_dps")
 
 
+#: a channel mapped to this is not read (``columns={"time": ""}``, ``--columns time=``): the time only, for a file
+#: whose time stamps are not the samples' (taken as buffered samples arrived), read at ``rate_hz`` instead
+UNMAPPED = ""
+
+
 def parse_column_mapping(text: str | None) -> dict[str, str]:
     """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``; a comma inside
-    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array)."""
+    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array); ``time=`` leaves the time
+    unread (:data:`UNMAPPED`)."""
     if not text:
         return {}
     mapping = {}
@@ -54,7 +60,7 @@ def parse_column_mapping(text: str | None) -> dict[str, str]:
         if "=" not in item:
             raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
         key, value = (part.strip() for part in item.split("=", 1))
-        if not key or not value:
+        if not key or not value and key != TIME_COLUMN:  # time= (nothing): the time left unread, UNMAPPED
             raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
         mapping[key] = value
     return mapping
@@ -155,6 +161,14 @@ class TableLayout:
                 raise InputError(
                     f"rate_hz: the names include {TIME_COLUMN}; a nominal rate is for tables without a time column"
                 )
+        elif self.columns.get(TIME_COLUMN) == UNMAPPED:
+            raise InputError(
+                "columns: time is left unread (columns={'time': ''}): give the samples' rate (rate_hz=100), the n-th "
+                "row then at n / rate s"
+            )
+        for canonical, column in self.columns.items():
+            if column == UNMAPPED and canonical != TIME_COLUMN:
+                raise InputError(f"columns: {canonical}= names no column; only the time may be left unread (time=)")
         for canonical in self.columns:
             if canonical not in CANONICAL_COLUMNS + ARRAY_CHANNELS:
                 raise InputError(
@@ -185,6 +199,7 @@ class TableLayout:
             Canonical channel (``time``, ``gyro_z``, ``temperature`` ...) to the column that holds it.
         """
         resolved = {name: name for name in CANONICAL_COLUMNS if name in header}
+        unread = {name for name, column in self.columns.items() if column == UNMAPPED}  # the time= of a mapping
         # the standard names (or with their unit: gyro_z_dps) also match whatever their case and surrounding spaces
         # (" Gyro_Z" is gyro_z); two columns that both match one name (Gyro_Z and GYRO_Z) are refused, naming both,
         # unless a mapping says
@@ -199,7 +214,11 @@ class TableLayout:
                 )
             if name not in resolved and matches and matches[0] not in resolved.values():
                 resolved[name] = matches[0]
+        for name in unread:
+            resolved.pop(name, None)
         for canonical, column in self.columns.items():
+            if column == UNMAPPED:
+                continue
             if canonical in ARRAY_CHANNELS:
                 raise InputError(
                     f"{source}: columns={{{canonical!r}: {column!r}}}: a table has one column per axis; "
@@ -227,7 +246,7 @@ class TableLayout:
                     f"(columns={mapped}); one column feeds one channel. To swap axes map both, "
                     "e.g. columns={'gyro_x': 'gyro_z', 'gyro_z': 'gyro_x'}"
                 )
-        unread = [c for c in self.columns if c in header and c not in readers and self.columns[c] != c]
+        unread = [c for c in self.columns if c in header and c not in readers and self.columns[c] not in (c, UNMAPPED)]
         for canonical in unread:
             warnings.warn(
                 f"{source}: column {canonical!r} is not read: columns={{{canonical!r}: {self.columns[canonical]!r}}} "

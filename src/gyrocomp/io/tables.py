@@ -405,7 +405,8 @@ def _resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dic
     if layout.rate_hz is not None and TIME_COLUMN in cols and not timed_by_rate:
         raise InputError(
             f"{path}: rate_hz={layout.rate_hz:g}: the file has a time column ({cols[TIME_COLUMN]!r}); "
-            "a nominal rate is for tables without one"
+            "a nominal rate is for tables without one, or to read the rows at it instead of the file's time "
+            "leave the time unread (columns={'time': ''})"
         )
     if layout.rate_hz is not None and TIME_COLUMN not in cols:
         cols[TIME_COLUMN] = NOMINAL_TIME

@@ -167,8 +167,8 @@ def time_bursts_concern(recording: Recording) -> Concern | None:
         f"({1e3 / recording.rate_hz:.3g} ms, {recording.rate_hz:.4g} Hz), and the samples average "
         f"{mean_rate_hz:.4g} Hz: the stamps look like when buffered samples arrived, not when they were taken, "
         f"and what uses the rate (Allan deviation, noise densities) would be {recording.rate_hz / mean_rate_hz:.2g} "
-        f"times off; if the sensor samples evenly, read the samples at that rate without their stamps "
-        f"(rate_hz={mean_rate_hz:.4g})",
+        f"times off; if the sensor samples evenly, read the samples at that rate, their stamps left unread "
+        f"(columns={{'time': ''}} and rate_hz={mean_rate_hz:.4g})",
     )
 
 
