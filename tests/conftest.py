@@ -255,14 +255,18 @@ def _forked_command(argv: list[str], cwd, out_fd: int, err_fd: int) -> int:
 def _wait(pid: int, timeout_s: float, argv: list[str]) -> int:
     """The forked command's exit status (as subprocess gives it: -N when killed by signal N), killing it after
     ``timeout_s`` [s] as subprocess.run's timeout does."""
-    handle = os.pidfd_open(pid)
     try:
-        if not select.select([handle], [], [], timeout_s)[0]:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
-            raise subprocess.TimeoutExpired(["gyrocomp", *argv], timeout_s)
-    finally:
-        os.close(handle)
+        handle = os.pidfd_open(pid)
+    except (AttributeError, OSError):  # before Linux 5.3: waited for without a limit
+        handle = None
+    if handle is not None:
+        try:
+            if not select.select([handle], [], [], timeout_s)[0]:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                raise subprocess.TimeoutExpired(["gyrocomp", *argv], timeout_s)
+        finally:
+            os.close(handle)
     return os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1])
 
 
