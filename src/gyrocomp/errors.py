@@ -39,6 +39,11 @@ class TemperatureRangeWarning(UserWarning):
     """Data lies outside the temperature range a model was fitted on; the model was clamped to its edge."""
 
 
+class UnusedOptionWarning(UserWarning):
+    """An option was given that the input does not read (a table's column mapping or units for a log whose
+    fields and time stamps are its own): it changed nothing."""
+
+
 class DataQualityWarning(UserWarning):
     """Data was accepted but something about it deserves attention (rows dropped, gaps found)."""
 

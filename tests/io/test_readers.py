@@ -15,7 +15,7 @@ from gyrocomp.io import READERS, TableLayout, detect_format, read, sniff_format
 from gyrocomp.io.common import match_by_time, order_by_time
 
 from ..conftest import run, shared_dataset
-from tests.io.log_writers import write_bag, write_dataflash, write_ulog
+from tests.io.log_writers import write_bag, write_dataflash, write_recording_bag, write_ulog
 
 RAD_TO_DEG = 180.0 / math.pi
 G = 9.80665
@@ -797,3 +797,30 @@ def test_the_command_line_reads_a_bags_instance(tmp_path):
         "two.bag: --instance 5: the bag has 2 sensor_msgs/msg/Imu topic(s) (/imu_a, /imu_b), instances 0 to 1"
     )
     assert not (tmp_path / "c.csv").exists()
+
+
+def test_layout_options_a_log_does_not_read_are_said_not_used(tmp_path):
+    """A ROS bag's fields, units and time stamps are its own: a column mapping or a rate given for it (on the
+    command line, or by a project file written for the folder's tables) changes nothing, and is said so, once, on
+    the whole read and on the chunked one; without them nothing is said, and a table reads them as ever."""
+    from gyrocomp.errors import UnusedOptionWarning
+
+    from gyrocomp.simulation import simulate
+
+    rec = simulate("consumer", profile="static", duration_s=60.0, rate_hz=50.0, seed=1).recording
+    bag = tmp_path / "still.bag"
+    write_recording_bag(bag, rec, ros2=False)
+    with pytest.warns(
+        UnusedOptionWarning,
+        match=r"still.bag: columns=, rate_hz= not used: they are for tables and files of named arrays, and a "
+        r"rosbag file's fields, units and time stamps are its own$",
+    ):
+        read(bag, TableLayout({"time": ""}, rate_hz=100.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnusedOptionWarning)
+        plain = read(bag)
+    with pytest.warns(UnusedOptionWarning, match=r"still.bag: gyro_unit= not used"):
+        np.testing.assert_array_equal(read(bag, gyro_unit="rad/s").gyro_dps, plain.gyro_dps)
+    said = run("allan", bag, "--gyro-unit", "rad/s")
+    assert said.returncode == 0 and said.stderr.count("--gyro-unit not used") == 1, said.stderr
+    assert "not used" not in run("allan", bag).stderr

@@ -114,7 +114,9 @@ def chunked_or_whole(
                 channels=options.channels,
             )
         else:
-            stream = reader_named(fmt).stream(Path(path), options, chunks.chunk_rows, progress)
+            reader = reader_named(fmt)
+            reader.warn_unused_layout(Path(path), options)
+            stream = reader.stream(Path(path), options, chunks.chunk_rows, progress)
         try:
             return chunked(stream)
         except NotStreamable:

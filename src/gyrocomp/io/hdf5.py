@@ -348,6 +348,7 @@ register_reader(
         suffixes=(".h5", ".hdf5", ".nc", ".nc4"),
         magic=(HDF5_MAGIC,),
         aliases=("h5", "netcdf", "nc"),
+        layout=True,
     )
 )
 

@@ -210,6 +210,7 @@ register_reader(
         suffixes=(".mat", ".npz"),
         magic=(MAT5_MAGIC, MAT73_MAGIC),
         aliases=("matlab", "npz"),
+        layout=True,
     )
 )
 

@@ -9,16 +9,19 @@ format.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import stat
+import warnings
 from collections.abc import Callable
 from typing import Any
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, UnusedOptionWarning
 from ..recording import Recording
 from .common import ProgressCallback, ReadOptions
+from .layout import TableLayout
 from .tables import TableData, table_data
 
 
@@ -48,6 +51,8 @@ class Reader:
         ``instances(path) -> tuple of int``: the sensor instances a file holds (default: one, ``(0,)``).
     table : bool
         A table of columns (CSV, Parquet): its layout options apply, and it can be read and written in chunks.
+    layout : bool
+        Not a table, but read by the layout options too (a file of named arrays: their mapping, units, rate).
     stream : callable, optional
         ``stream(path, options, chunk_rows, progress)``: the file read in chunks of about ``chunk_rows`` samples,
         an object with the interface of :class:`gyrocomp.io.stream.TableStream` that the file commands use
@@ -65,6 +70,35 @@ class Reader:
     instances: Callable[[Path], tuple[int, ...]] | None = None
     table: bool = False
     stream: Callable[[Path, ReadOptions, int, ProgressCallback | None], Any] | None = None
+    layout: bool = False
+
+    def warn_unused_layout(self, path: Path, options: ReadOptions) -> None:
+        """Warn (:class:`UnusedOptionWarning`) when ``options`` set layout options (a column mapping, units, a
+        rate, a text table's syntax) for a format that does not read them: a log's fields, units and time stamps
+        are its own, so they change nothing (a project file written for the folder's tables sets them too).
+
+        Parameters
+        ----------
+        path : Path
+            The input.
+        options : ReadOptions
+            The reading options.
+        """
+        if self.table or self.layout:
+            return
+        default = TableLayout()
+        given = [
+            f.name
+            for f in dataclasses.fields(TableLayout)
+            if getattr(options.layout, f.name) != getattr(default, f.name)
+        ]
+        if given:
+            warnings.warn(
+                f"{path}: {', '.join(f'{name}=' for name in given)} not used: they are for tables and files of "
+                f"named arrays, and a {self.name} file's fields, units and time stamps are its own",
+                UnusedOptionWarning,
+                stacklevel=3,
+            )
 
     def read_table_data(self, path: Path, options: ReadOptions, progress: ProgressCallback | None) -> TableData:
         """What :attr:`read` returns, as :class:`TableData` (a recording becomes a table in the default layout).
@@ -78,6 +112,7 @@ class Reader:
         progress : callable, optional
             Called with the fraction done.
         """
+        self.warn_unused_layout(path, options)
         data = self.read(path, options, progress)
         return data if isinstance(data, TableData) else table_data(data)
 
