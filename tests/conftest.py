@@ -357,6 +357,14 @@ def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0) -> Recordin
     )
 
 
+def burst_stamped_recording(rate_hz: float, n: int, burst: int, arrival_step_s: float) -> Recording:
+    """A sensor sampling evenly at ``rate_hz`` [Hz] whose samples reach the logger ``burst`` at a time (when the
+    last of them is taken), stamped on arrival ``arrival_step_s`` [s] apart (a serial link's buffer)."""
+    arrival = np.repeat(np.arange(burst - 1, n + burst, burst) / rate_hz, burst)[:n]
+    within = np.tile(np.arange(burst) * arrival_step_s, n // burst + 1)[:n]
+    return Recording(time_s=arrival + within, gyro_dps=np.zeros((n, 1)), gyro_axes=("gyro_z",), source="b.csv")
+
+
 # -- a throwaway PostgreSQL server ------------------------------------------------------------------------------
 def _tool(name: str):
     """The module tools/NAME.py (the project's scripts beside the package), loaded once."""

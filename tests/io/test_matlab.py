@@ -258,6 +258,8 @@ def test_sunsideds_burst_stamped_mpu6050_log_from_init_to_its_allan_deviation(tm
     assert 'time = "gyroBuffer[:, 0]"' in (tmp_path / "gyrocomp.toml").read_text()
     said = run("allan", path, cwd=tmp_path)
     assert said.returncode == 2 and "(check 'time-bursts')" in said.stderr, said.stderr
+    assert "the stamps come in bursts, so the stretches between them hold 3.9 samples" in said.stderr
+    assert "--split-gaps" not in said.stderr  # pooling stretches of four samples would be no Allan deviation
     rate = re.search(r"\(--columns time= and --rate ([\d.]+)\)", said.stderr).group(1)
     assert 99.0 < float(rate) < 99.6  # the README's 99.3 Hz on average
     columns = ",".join(f"{k}={v}" for k, v in _gyro_columns("gyroBuffer", first=1).items()) + ",time="

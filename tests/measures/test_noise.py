@@ -11,7 +11,7 @@ from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.measures.noise import analyse_noise
 from gyrocomp.recording import Recording
 
-from ..conftest import static_recording
+from ..conftest import burst_stamped_recording, static_recording
 
 
 def test_every_gyro_axis_by_default_and_accelerometers_on_request():
@@ -62,6 +62,23 @@ def test_gaps_are_refused_unless_split():
     assert analysis.axes["gyro_x"].curve.n[0] == (40_000 - 1) + (20_000 - 1)
     total = analyse_noise(rec, ["gyro_x"], kind="totdev", split_gaps=True)
     assert "TOTDEV on the longest of 2 contiguous stretches (800 s, rows 1-40000)" in total.how
+
+
+def test_gaps_of_burst_stamped_samples_are_refused_with_the_samples_mean_rate_not_the_pooling():
+    """Stamps taken as buffered samples arrived (100 Hz, five at a time, 2 ms apart): the gaps are between bursts,
+    and pooling the stretches between them (five samples each) would leave no Allan deviation to speak of; the
+    refusal gives the samples' mean rate and the way to read them at it instead."""
+    rec = burst_stamped_recording(100.0, 10_000, 5, 2e-3)
+    with pytest.raises(
+        InputError,
+        match=r"^b.csv: time gap of 0.042 s after row 5 \(t = 0.048 s\) \(and 1998 more\); Allan deviations need "
+        r"evenly spaced samples: the stamps come in bursts, so the stretches between them hold 5 samples on average; "
+        r"if the sensor samples evenly, read the samples at their mean rate, the stamps left unread "
+        r"\(columns=\{'time': ''\} and rate_hz=100\)$",
+    ):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DataQualityWarning)  # the time-bursts check says it first
+            analyse_noise(rec)
 
 
 def test_json_document_has_the_documented_shape_and_no_nan():

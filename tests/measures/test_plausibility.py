@@ -38,7 +38,7 @@ from gyrocomp.measures.plausibility import (
 from gyrocomp.recording import Recording
 from gyrocomp.simulation import simulate
 
-from ..conftest import run, shared_dataset, xsens_session
+from ..conftest import burst_stamped_recording, run, shared_dataset, xsens_session
 
 RUN = simulate("mti10", profile="chamber", duration_s=1800, rate_hz=2, seed=1).recording
 
@@ -84,18 +84,10 @@ def test_time_in_another_unit():
     assert recording_concerns(_still(100.0, 1000)) == []
 
 
-def _burst_stamped(rate_hz: float, n: int, burst: int, arrival_step_s: float) -> Recording:
-    """A sensor sampling evenly at ``rate_hz`` [Hz] whose samples reach the logger ``burst`` at a time (when the
-    last of them is taken), stamped on arrival ``arrival_step_s`` [s] apart (a serial link's buffer)."""
-    arrival = np.repeat(np.arange(burst - 1, n + burst, burst) / rate_hz, burst)[:n]
-    within = np.tile(np.arange(burst) * arrival_step_s, n // burst + 1)[:n]
-    return Recording(time_s=arrival + within, gyro_dps=np.zeros((n, 1)), gyro_axes=("gyro_z",), source="b.csv")
-
-
 def test_time_stamps_that_come_in_bursts_are_said_with_the_samples_mean_rate():
     """100 Hz delivered five samples at a time, stamped 2 ms apart on arrival: the median step says 500 Hz; the
     check says so and gives the samples' mean rate (100 Hz), as on sunsided's real MPU-6050 logs (below)."""
-    (concern,) = recording_concerns(_burst_stamped(100.0, 10_000, 5, 2e-3))
+    (concern,) = recording_concerns(burst_stamped_recording(100.0, 10_000, 5, 2e-3))
     assert concern.check == "time-bursts"
     assert concern.message.startswith(
         "b.csv: the time stamps come in bursts: 1999 of 9999 steps (20%) are gaps over 2 times the median step "

@@ -25,7 +25,7 @@ from ..allan import (
     noise_terms,
 )
 from ..errors import DataQualityWarning, InputError
-from .plausibility import recording_concerns
+from .plausibility import recording_concerns, time_bursts_concern
 from ..recording import Recording
 from ..motion.stillness import StillDetection, detect_still, moves_most_of_the_time
 
@@ -100,11 +100,18 @@ def axis_values(recording: Recording, axis: str) -> tuple[np.ndarray, str, str]:
 def _describe_gap(recording: Recording) -> str:
     gap = recording.gaps[0]
     more = f" (and {len(recording.gaps) - 1} more)" if len(recording.gaps) > 1 else ""
-    return (
+    said = (
         f"{recording.source}: time gap of {gap.duration_s:.6g} s after row {gap.after_row} "
         f"(t = {gap.start_s:.6g} s){more}; Allan deviations need evenly spaced samples: "
-        f"use split_gaps=True to pool the contiguous stretches"
     )
+    if time_bursts_concern(recording) is not None:  # pooling stretches of a burst or two would be wrong
+        mean_rate_hz = (recording.n_samples - 1) / recording.duration_s
+        return said + (
+            f"the stamps come in bursts, so the stretches between them hold {recording.n_samples / (len(recording.gaps) + 1):.3g} "
+            f"samples on average; if the sensor samples evenly, read the samples at their mean rate, the stamps left "
+            f"unread (columns={{'time': ''}} and rate_hz={mean_rate_hz:.4g})"
+        )
+    return said + "use split_gaps=True to pool the contiguous stretches"
 
 
 #: RMS misfit (in ln deviation) of the noise model beyond which :func:`analyse_noise` warns
