@@ -94,7 +94,8 @@ def test_time_stamps_that_come_in_bursts_are_said_with_the_samples_mean_rate():
         "(2 ms, 500 Hz), and the samples average 100 Hz: "
     ), concern.message
     assert concern.message.endswith(
-        "would be 5 times off; if the sensor samples evenly, read the samples at that rate, their stamps left unread (columns={'time': ''} and rate_hz=100)"
+        "would be 5 times off; if the sensor samples evenly, read the samples at that rate, their stamps left "
+        "unread (columns={'time': ''} and rate_hz=100)"
     )
 
 

@@ -542,8 +542,8 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
         shapes = ", ".join(f"{n} {tuple(a.shape)}" for n, a in store.items())
         raise InputError(
             f"{path}: no array looks like the gyro (a name with gyr, omega or rate: an (n, 3) array, an (n, 4) one "
-            f"of the time then x, y, z, or one per axis named with x, y or z); its arrays are {shapes}: map them in a project file's [read.columns] "
-            '(gyro_x = "NAME[:, k]" for column k of an array)'
+            f"of the time then x, y, z, or one per axis named with x, y or z); its arrays are {shapes}: map them "
+            'in a project file\'s [read.columns] (gyro_x = "NAME[:, k]" for column k of an array)'
         )
     stated = _stated_array_rate(store) if "time" not in columns and rate_hz is None else None
     if stated is not None:

@@ -83,8 +83,8 @@ KNOWN_SLOPES = (
 @dataclass(frozen=True)
 class Concern:
     """One finding: the check that found it (``rate``, ``offset``, ``rotation``, ``kelvin``, ``time-unit``,
-    ``time-bursts``, ``temperature-span``, ``agreement``, ``accel-unit``, ``temperature-range``) and the one-line message, which
-    starts with the recording's source."""
+    ``time-bursts``, ``temperature-span``, ``agreement``, ``accel-unit``, ``temperature-range``) and the one-line
+    message, which starts with the recording's source."""
 
     check: CheckName
     message: str
