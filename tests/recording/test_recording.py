@@ -1,8 +1,14 @@
+import pickle
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gyrocomp.errors import InputError
-from gyrocomp.recording import Recording
+from gyrocomp.recording import GAP_FACTOR, Gap, Recording
+
+from ..conftest import burst_stamped_recording
 
 
 def make(time, gyro=None, temp=None, **kw):
@@ -49,6 +55,35 @@ def test_gaps_are_found_and_kept():
     gap = rec.gaps[0]
     assert gap.after_row == 100
     assert gap.duration_s == pytest.approx(5.0 - 0.99)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(0.005, 0.2), min_size=2, max_size=300))
+def test_the_gaps_are_every_step_over_twice_the_median_in_order(steps):
+    """The gaps (kept as arrays) are, in order, each step longer than GAP_FACTOR median steps: the row before it
+    (1-based), its time and length, as a list of Gap made here one by one; a sequence equal to that list."""
+    t = np.concatenate([[0.0], np.cumsum(steps)])
+    rec = make(t)
+    dt = np.diff(t)
+    expected = [Gap(k + 1, float(t[k]), float(dt[k])) for k in range(dt.size) if dt[k] > GAP_FACTOR * np.median(dt)]
+    assert rec.gaps == expected and rec.gaps == tuple(expected) and list(rec.gaps) == expected
+    assert len(rec.gaps) == len(expected) and bool(rec.gaps) == bool(expected)
+    assert rec.gaps[1:] == expected[1:] and pickle.loads(pickle.dumps(rec.gaps)) == rec.gaps
+    longest = max(expected, key=lambda g: g.duration_s) if expected else None
+    assert rec.gaps.longest() == longest
+    assert rec.gaps != expected[:-1] if expected else rec.gaps == ()
+
+
+def test_the_gaps_of_a_day_of_burst_stamped_samples_are_arrays_not_millions_of_objects():
+    """A day at 100 Hz stamped on arrival five samples at a time: 1.7 million gaps, kept as three arrays (one
+    Gap each cost about 700 MB and 19 s); the stretches between them and the first and longest gap read from them."""
+    rec = burst_stamped_recording(100.0, 8_640_000, 5, 2e-3)
+    assert len(rec.gaps) == 8_640_000 // 5 - 1
+    first = rec.gaps[0]
+    assert first.after_row == 5 and first.start_s == pytest.approx(0.048) and first.duration_s == pytest.approx(0.042)
+    assert rec.gaps.after_rows.nbytes + rec.gaps.starts_s.nbytes + rec.gaps.durations_s.nbytes < 50e6
+    stretches = rec.contiguous_stretches()
+    assert len(stretches) == len(rec.gaps) + 1 and {s.stop - s.start for s in stretches} == {5}
 
 
 def test_step_of_two_periods_is_not_a_gap():

@@ -243,8 +243,10 @@ class TableStream:
                 if step > 2.0 * period:
                     self._gap(step, last[1])
             period = period or 1.0 / recording.rate_hz
-            for gap in recording.gaps:
-                self._gap(gap.duration_s, gap.after_row)
+            longest = recording.gaps.longest()
+            if longest is not None:  # the chunk's gaps: counted, the longest kept (as one by one)
+                self.gaps += len(recording.gaps) - 1
+                self._gap(longest.duration_s, longest.after_row)
             last = (float(time_s[-1]), int(first + kept[-1] + 1))
             self.rows += table.num_rows
             self._report()

@@ -532,7 +532,7 @@ def read_table(
         table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite, header_line=header_line(text_format)
     )
     if recording.gaps:
-        longest = max(recording.gaps, key=lambda g: g.duration_s)
+        longest = recording.gaps.longest()
         warnings.warn(
             f"{path}: {len(recording.gaps)} time gap(s) longer than 2 sample periods (longest {longest.duration_s:.6g} s "
             f"after row {longest.after_row}); kept as they are, nothing interpolated",

@@ -250,8 +250,8 @@ def gap_findings(recording: Recording) -> list[Finding]:
     if not recording.gaps:
         return []
     period = 1.0 / recording.rate_hz
-    longest = max(recording.gaps, key=lambda g: g.duration_s)
-    missing = sum(g.duration_s - period for g in recording.gaps)
+    longest = recording.gaps.longest()
+    missing = float(np.sum(recording.gaps.durations_s - period))
     fraction = missing / max(recording.duration_s, period)
     if longest.duration_s < max(GAP_PERIODS * period, GAP_MIN_S) and fraction < GAP_MISSING_FRACTION:
         return []

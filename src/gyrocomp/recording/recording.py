@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -81,6 +82,61 @@ class Gap:
     duration_s: float
 
 
+class Gaps(Sequence):
+    """A recording's gaps, a sequence of :class:`Gap` kept as three arrays: a log whose stamps come in bursts has
+    a gap every few samples (millions in a day), and one object each would cost hundreds of MB and seconds.
+    Equal to any sequence of the same gaps (``recording.gaps == ()`` when there is none).
+
+    Parameters
+    ----------
+    after_rows : ndarray of int
+        The row after which each gap falls.
+    starts_s : ndarray of float
+        The time of that row [s].
+    durations_s : ndarray of float
+        The step from that row to the next [s].
+    """
+
+    __slots__ = ("after_rows", "starts_s", "durations_s")
+
+    def __init__(self, after_rows=(), starts_s=(), durations_s=()):
+        self.after_rows = np.asarray(after_rows, dtype=np.int64)
+        self.starts_s = np.asarray(starts_s, dtype=float)
+        self.durations_s = np.asarray(durations_s, dtype=float)
+
+    def __len__(self) -> int:
+        return self.after_rows.size
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return Gaps(self.after_rows[index], self.starts_s[index], self.durations_s[index])
+        return Gap(int(self.after_rows[index]), float(self.starts_s[index]), float(self.durations_s[index]))
+
+    def __eq__(self, other) -> bool:
+        if isinstance(other, Gaps):
+            return bool(
+                np.array_equal(self.after_rows, other.after_rows)
+                and np.array_equal(self.starts_s, other.starts_s)
+                and np.array_equal(self.durations_s, other.durations_s)
+            )
+        if isinstance(other, Sequence) and not isinstance(other, str):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment] - equal to tuples, which hash otherwise
+
+    def __repr__(self) -> str:
+        shown = ", ".join(map(repr, self[:3]))
+        return f"Gaps({shown}{', ...' if len(self) > 3 else ''}; {len(self)} in all)"
+
+    def __reduce__(self):
+        return Gaps, (self.after_rows, self.starts_s, self.durations_s)
+
+    def longest(self) -> Gap | None:
+        """The longest gap (the first of equals), None when there is none."""
+        return self[int(np.argmax(self.durations_s))] if len(self) else None
+
+
 def _require_finite(src: str, rows: np.ndarray, channels) -> None:
     """Refuse the first non-finite value of any channel, naming its row and column; ``channels`` holds
     (column names, (n,) or (n, k) array or None) pairs."""
@@ -152,15 +208,19 @@ def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray) -> None:
             )
 
 
-def _gaps(rows: np.ndarray, time_s: np.ndarray) -> tuple[float, tuple[Gap, ...]]:
+def _gaps(rows: np.ndarray, time_s: np.ndarray) -> tuple[float, Gaps]:
     """(the median sample period [s], the gaps: steps longer than ``GAP_FACTOR`` of it), the steps read a part at a
     time, their median exact (:func:`gyrocomp.spilled_series.streamed_median`)."""
     period = streamed_median(dt for _, dt in _time_steps(time_s))
-    gaps = []
+    after, starts, durations = [], [], []
     for start, dt in _time_steps(time_s):
-        for i in np.flatnonzero(dt > GAP_FACTOR * period):
-            gaps.append(Gap(int(rows[start + i]), float(time_s[start + i]), float(dt[i])))
-    return period, tuple(gaps)
+        at = np.flatnonzero(dt > GAP_FACTOR * period)
+        after.append(rows[start + at])
+        starts.append(time_s[start + at])
+        durations.append(dt[at])
+    if not after:
+        return period, Gaps()
+    return period, Gaps(np.concatenate(after), np.concatenate(starts), np.concatenate(durations))
 
 
 @dataclass(frozen=True, eq=False)
@@ -195,7 +255,7 @@ class Recording:
     Validation happens once, here: shapes agree, values are finite (readers drop
     non-finite rows only when asked to) and within what a sensor can give (:data:`POSSIBLE`), time strictly
     increases. Gaps longer than
-    ``GAP_FACTOR`` median sample periods are found and kept in ``gaps``; nothing is
+    ``GAP_FACTOR`` median sample periods are found and kept in ``gaps`` (:class:`Gaps`); nothing is
     interpolated.
     """
 
@@ -210,7 +270,7 @@ class Recording:
     metadata: dict[str, Any] = field(default_factory=dict)
     reference_rate_dps: np.ndarray | None = None
     rate_hz: float = field(init=False)
-    gaps: tuple[Gap, ...] = field(init=False)
+    gaps: Gaps = field(init=False)
 
     def __post_init__(self) -> None:
         src = self.source
@@ -323,7 +383,7 @@ class Recording:
 
     def contiguous_stretches(self) -> list[slice]:
         """Sample ranges between the recording's time gaps, in order (one slice when there is no gap)."""
-        starts = [0] + [int(np.searchsorted(self.row_numbers, gap.after_row)) + 1 for gap in self.gaps]
+        starts = [0] + (np.searchsorted(self.row_numbers, self.gaps.after_rows) + 1).tolist()
         bounds = starts + [self.n_samples]
         return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
 
@@ -366,6 +426,7 @@ __all__ = [
     "GAP_FACTOR",
     "GYRO_AXES",
     "Gap",
+    "Gaps",
     "POSSIBLE",
     "REFERENCE_RATE_AXES",
     "Recording",
