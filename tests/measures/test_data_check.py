@@ -21,7 +21,7 @@ from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.simulation import preset_model, simulate
 from gyrocomp.simulation.faults import FAULTS, inject
 
-from ..conftest import run
+from ..conftest import burst_stamped_recording, run
 
 PRESETS = ("adxrs450", "consumer")
 
@@ -172,3 +172,18 @@ def test_a_run_at_one_temperature_is_fine_beside_runs_that_span_enough(clean_col
     assert [c.verdict for c in check_runs([read_checked(still), read_checked(full)], asked)] == ["ok", "ok"]
     (alone,) = check_runs([read_checked(still)], asked)
     assert alone.verdict == "refused" and alone.reasons[0] == "temperature-constant"
+
+
+def test_gaps_between_bursts_of_stamps_are_not_called_missing_samples():
+    """Stamps taken as buffered samples arrived (100 Hz, five at a time, 2 ms apart) leave a gap every five
+    samples: the check says the stamps come in bursts and that no sample is missing, not that 80 % are; real
+    gaps (a pause) are still counted as missing time."""
+    from gyrocomp.measures.data_check import gap_findings
+
+    (finding,) = gap_findings(burst_stamped_recording(100.0, 10_000, 5, 2e-3))
+    assert finding.check == "gaps" and finding.message.startswith("b.csv: the time stamps come in bursts")
+    assert finding.cost == "no sample missing; what uses the rate (500 Hz from the median step) is 5 times off"
+    paused = simulate("consumer", profile="static", duration_s=600.0, rate_hz=10.0, seed=3).recording
+    cut = paused.take(np.r_[0:2000, 4000:6001])
+    (finding,) = gap_findings(cut)
+    assert "1 gap(s), 200 s in all (33 % of the run" in finding.message and finding.cost.startswith("33 % fewer")

@@ -73,10 +73,17 @@ class Reader:
     layout: bool = False
 
     def warn_unused_layout(self, path: Path, options: ReadOptions) -> None:
-        """Warn (:class:`UnusedOptionWarning`) when the reading ``options`` of ``path`` set layout options (a
-        column mapping, units, a rate, a text table's syntax) for a format that does not read them: a log's fields,
-        units and time stamps are its own, so they change nothing (a project file written for the folder's tables
-        sets them too)."""
+        """Warn (:class:`UnusedOptionWarning`) when ``options`` set layout options (a column mapping, units, a
+        rate, a text table's syntax) for a format that does not read them: a log's fields, units and time stamps
+        are its own, so they change nothing (a project file written for the folder's tables sets them too).
+
+        Parameters
+        ----------
+        path : Path
+            The file named in the warning.
+        options : ReadOptions
+            What was asked of the reading (command line, project file or call).
+        """
         if self.table or self.layout:
             return
         default = TableLayout()

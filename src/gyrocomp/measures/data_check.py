@@ -33,7 +33,7 @@ from ..effects import moving_average
 from ..errors import TimeOrderWarning
 from ..recording import Recording
 from ..spilled_series import parts, streamed_median
-from .plausibility import turned_between_poses
+from .plausibility import time_bursts_concern, turned_between_poses
 
 Severity = Literal["refuse", "warn"]
 #: every check, in the order a verdict line lists them
@@ -249,6 +249,18 @@ def gap_findings(recording: Recording) -> list[Finding]:
     """Gaps: the longest at least GAP_PERIODS sample periods and GAP_MIN_S, or GAP_MISSING_FRACTION missing."""
     if not recording.gaps:
         return []
+    bursts = time_bursts_concern(recording)
+    if bursts is not None:  # the steps are between bursts of stamps, no sample is missing
+        mean_rate_hz = (recording.n_samples - 1) / recording.duration_s
+        return [
+            Finding(
+                "gaps",
+                "warn",
+                bursts.message,
+                f"no sample missing; what uses the rate ({recording.rate_hz:.4g} Hz from the median step) is "
+                f"{recording.rate_hz / mean_rate_hz:.2g} times off",
+            )
+        ]
     period = 1.0 / recording.rate_hz
     longest = recording.gaps.longest()
     missing = float(np.sum(recording.gaps.durations_s - period))
