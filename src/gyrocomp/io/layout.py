@@ -98,7 +98,8 @@ class TableLayout:
     columns: dict[str, str] = spelled(
         Spelling(
             "--columns",
-            "Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T.",
+            "Map channels to the file's columns, e.g. gyro_z=GyrZ,temperature=T; time= leaves the time unread "
+            "(the rows then at the rate given).",
             metavar="CH=COL,...",
             parse=parse_column_mapping,
         ),
@@ -133,7 +134,8 @@ class TableLayout:
     rate_hz: float | None = spelled(
         Spelling(
             "--rate",
-            "Nominal sample rate [Hz] of a table without a time column: the n-th row is at n / rate s.",
+            "Nominal sample rate [Hz] of a file without a time column, or whose time is left unread (time= in "
+            "the column mapping: stamps taken as buffered samples arrived): the n-th row is at n / rate s.",
             metavar="HZ",
             parse=parse_rate,
         ),
