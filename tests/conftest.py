@@ -158,8 +158,9 @@ def run(*args, cwd=None, fresh: bool = False) -> subprocess.CompletedProcess:
 
 
 def _on_dask(argv: list[str]) -> bool:
-    """Whether the command is a ``fleet fit`` on Dask (any scheduler but ``serial``)."""
-    if argv[:2] != ["fleet", "fit"]:
+    """Whether the command is a ``fleet fit`` on Dask (any scheduler but ``serial``), after the group's options
+    or not."""
+    if ["fleet", "fit"] not in [argv[k : k + 2] for k in range(len(argv) - 1)]:
         return False
     scheduler = [b for a, b in zip(argv, argv[1:]) if a == "--scheduler"]
     scheduler += [a.split("=", 1)[1] for a in argv if a.startswith("--scheduler=")]
