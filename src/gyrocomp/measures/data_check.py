@@ -251,14 +251,13 @@ def gap_findings(recording: Recording) -> list[Finding]:
         return []
     bursts = time_bursts_concern(recording)
     if bursts is not None:  # the steps are between bursts of stamps, no sample is missing
-        mean_rate_hz = (recording.n_samples - 1) / recording.duration_s
         return [
             Finding(
                 "gaps",
                 "warn",
                 bursts.message,
                 f"no sample missing; what uses the rate ({recording.rate_hz:.4g} Hz from the median step) is "
-                f"{recording.rate_hz / mean_rate_hz:.2g} times off",
+                f"{recording.rate_hz / recording.mean_rate_hz:.2g} times off",
             )
         ]
     period = 1.0 / recording.rate_hz

@@ -105,12 +105,11 @@ def _describe_gap(recording: Recording) -> str:
         f"(t = {gap.start_s:.6g} s){more}; Allan deviations need evenly spaced samples: "
     )
     if time_bursts_concern(recording) is not None:  # pooling stretches of a burst or two would be wrong
-        mean_rate_hz = (recording.n_samples - 1) / recording.duration_s
         stretch = recording.n_samples / (len(recording.gaps) + 1)
         return said + (
             f"the stamps come in bursts, so the stretches between them hold {stretch:.3g} samples on average; if the "
             "sensor samples evenly, read the samples at their mean rate, the stamps left unread "
-            f"(columns={{'time': ''}} and rate_hz={mean_rate_hz:.4g})"
+            f"(columns={{'time': ''}} and rate_hz={recording.mean_rate_hz:.4g})"
         )
     return said + "use split_gaps=True to pool the contiguous stretches"
 

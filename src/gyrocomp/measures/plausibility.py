@@ -157,7 +157,7 @@ def time_bursts_concern(recording: Recording) -> Concern | None:
     steps = recording.n_samples - 1
     if steps < 2 or len(recording.gaps) <= BURST_GAP_SHARE * steps:
         return None
-    mean_rate_hz = steps / recording.duration_s
+    mean_rate_hz = recording.mean_rate_hz
     if recording.rate_hz <= BURST_MEAN_STEPS * mean_rate_hz:
         return None
     return Concern(

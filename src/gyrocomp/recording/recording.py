@@ -332,6 +332,12 @@ class Recording:
         return float(self.time_s[-1] - self.time_s[0])
 
     @property
+    def mean_rate_hz(self) -> float:
+        """The samples' mean rate, steps over the time they span [Hz] (gaps included; :attr:`rate_hz` is the
+        median step's)."""
+        return (self.n_samples - 1) / self.duration_s
+
+    @property
     def temperature_columns(self) -> tuple[str, ...]:
         if self.temperature_degc is None:
             return ()
