@@ -23,6 +23,7 @@ from gyrocomp import Polynomial, apply, fit_calibration
 from gyrocomp.calibration import Calibration
 from gyrocomp.errors import InputError
 from gyrocomp.io import TableLayout, read, read_table
+from gyrocomp.io.stream import TableStream
 from gyrocomp.simulation import simulate
 
 from .conftest import shared_dataset
@@ -70,6 +71,22 @@ def test_malformed_csv_is_read_cleanly_or_refused(tmp_path_factory, header, rows
     data = read_or_refuse(read_table, path, drop_nonfinite=drop)
     if data is not None:
         assert_clean(data.recording)
+
+
+@FUZZ
+@given(
+    header=st.sampled_from([b"time,gyro_x,gyro_y,gyro_z\n", b"time;gyro_z\r", b"Fs,100\r\n", b""]),
+    body=st.binary(max_size=400),
+)
+def test_any_bytes_named_as_a_table_are_read_cleanly_or_refused_whole_and_streamed(tmp_path_factory, header, body):
+    """Bytes of any kind after a header (a lone CR among them, a NUL, no UTF-8): a clean read or one line."""
+    path = tmp_path_factory.mktemp("bytes") / "f.csv"
+    path.write_bytes(header + body)
+    data = read_or_refuse(read_table, path)
+    if data is not None:
+        assert_clean(data.recording)
+    for chunk in read_or_refuse(lambda: list(TableStream(path).chunks())) or []:
+        assert_clean(chunk.recording)
 
 
 @FUZZ

@@ -365,3 +365,37 @@ def test_a_command_that_cannot_find_the_columns_points_to_init(tmp_path):
     assert run("init", path, cwd=tmp_path).returncode == 0
     fitted = run("fit", "vendor.tsv", "-o", "m.json", "--hysteresis", "none", cwd=tmp_path)
     assert fitted.returncode == 0, fitted.stderr
+
+
+def test_a_spreadsheet_export_of_a_decimal_comma_locale_in_windows_1252_is_guessed_and_read(tmp_path):
+    """A spreadsheet's CSV in a decimal-comma locale (semicolons between fields, commas in the numbers) with names
+    holding a degree sign in Windows-1252 (one byte, 0xB0): init takes its first line as the header (a row of
+    decimal commas split at every comma looked like ten numbers, and the file like a log without a header), the
+    names are read as meant, every command reads it as the same table in UTF-8, and apply writes UTF-8."""
+    rng = np.random.default_rng(8)
+    n, rate_hz = 3000, 100.0
+    gyro = 0.1 + 0.003 * rng.standard_normal((n, 3))
+    names = ["time [s]", "gyro x [°/s]", "gyro y [°/s]", "gyro z [°/s]", "temperature [°C]"]
+    rows = [
+        ";".join(f"{v:.6f}".replace(".", ",") for v in (k / rate_hz, *gyro[k], 20.0 + 10.0 * k / n)) for k in range(n)
+    ]
+    text = ";".join(names) + "\r\n" + "\r\n".join(rows) + "\r\n"
+    (tmp_path / "cp1252.csv").write_bytes(text.encode("cp1252"))
+    (tmp_path / "utf8").mkdir()
+    (tmp_path / "utf8" / "cp1252.csv").write_bytes(text.encode("utf-8"))
+    guessed = guess_layout(tmp_path / "cp1252.csv")
+    assert (
+        guessed.layout.columns["gyro_z"] == "gyro z [°/s]"
+        and guessed.layout.columns["temperature"] == "temperature [°C]"
+    )
+    for folder in (tmp_path, tmp_path / "utf8"):
+        _init_then_allan_reads(folder, "cp1252.csv", "gyro_y", np.round(gyro[:, 1], 6), rate_hz)
+    fitted = run("fit", "cp1252.csv", "-o", "m.json", "--temperature", "poly:1", cwd=tmp_path)
+    assert fitted.returncode == 0, fitted.stderr
+    for folder in (tmp_path, tmp_path / "utf8"):
+        applied = run("apply", tmp_path / "m.json", "cp1252.csv", "-o", "out.csv", cwd=folder)
+        assert applied.returncode == 0, applied.stderr
+    out = (tmp_path / "out.csv").read_bytes()
+    assert (
+        out.decode("utf-8").startswith("time [s];gyro x [°/s]") and out == (tmp_path / "utf8" / "out.csv").read_bytes()
+    )

@@ -23,7 +23,7 @@ from gyrocomp.io import (
 )
 from gyrocomp.io.guess import guess_layout
 from gyrocomp.io.stream import TableStream
-from gyrocomp.io.tables import TextFormat, preamble_lines
+from gyrocomp.io.tables import TextFormat, preamble_lines, text_encoding
 from gyrocomp.simulation import GyroErrorModel, simulate
 from gyrocomp.units import unit_factor
 
@@ -551,3 +551,74 @@ def test_a_time_column_left_unread_times_the_rows_at_the_rate_given(tmp_path):
         r"one, or to read the rows at it instead of the file's time leave the time unread \(columns=\{'time': ''\}\)",
     ):
         read(path, TableLayout(rate_hz=100.0))
+
+
+@pytest.mark.parametrize("line_end", ["\r\n", "\r"], ids=["crlf", "cr"])
+def test_a_table_whose_lines_end_otherwise_reads_as_with_newlines_whole_and_in_chunks(tmp_path, line_end):
+    """Lines ended by CR LF (Windows) or a lone CR (a Macintosh CSV export, which pyarrow reads as line ends) read as
+    the same table as with LF: the preamble found, the header, the values, whole and streamed; a bad value's line
+    is counted the same."""
+    rng = np.random.default_rng(5)
+    counts = np.column_stack(
+        [rng.integers(-300, 300, (40, 2)), 16384 + rng.integers(-50, 50, 40), rng.integers(-500, 500, (40, 3))]
+    )
+    layout = TableLayout(
+        parse_column_mapping("accel_x=ax,accel_y=ay,accel_z=az,gyro_x=gx,gyro_y=gy,gyro_z=gz"),
+        gyro_unit="1/131 deg/s",
+        rate_hz=100.0,
+    )
+    newline = _mpu_log(tmp_path / "lf.csv", counts)
+    other = tmp_path / "other.csv"
+    other.write_bytes(newline.read_bytes().replace(b"\n", line_end.encode()))
+    expected = read_table(newline, layout)
+    data = read_table(other, layout)
+    assert data.text_format == expected.text_format and data.text_format.preamble_lines == 4
+    np.testing.assert_array_equal(data.recording.gyro_dps, expected.recording.gyro_dps)
+    np.testing.assert_array_equal(data.recording.accel_g, expected.recording.accel_g)
+    chunks = list(TableStream(other, layout, chunk_rows=7).chunks())
+    np.testing.assert_array_equal(np.concatenate([c.recording.gyro_dps for c in chunks]), expected.recording.gyro_dps)
+    np.testing.assert_array_equal(np.concatenate([c.recording.accel_g for c in chunks]), expected.recording.accel_g)
+    lines = other.read_bytes().split(line_end.encode())
+    lines[4 + 30] = b"x" + lines[4 + 30][lines[4 + 30].index(b",") :]  # the 30th row's ax
+    other.write_bytes(line_end.encode().join(lines))
+    for reading in (lambda: read_table(other, layout), lambda: list(TableStream(other, layout, chunk_rows=7).chunks())):
+        with pytest.raises(InputError, match=r"other.csv: row 30 \(line 35\), column 'ax': 'x' is not a number"):
+            reading()
+
+
+@pytest.mark.parametrize(
+    "content,said",
+    [
+        ("time,gyro_z\n0,1\n1,2\n".encode("utf-16"), r"UTF-16 text \(it starts with a UTF-16 byte-order mark\)"),
+        ("time,gyro_z\n0,1\n1,2\n".encode("utf-32"), r"UTF-32 text"),
+        (b"time,gy\x00ro_z\r0,1\r1,2\r", r"not a text table: byte 7 is a NUL"),
+        (b"\x93\x1c\r\xfa\x00\x00\x12" * 50, r"not a text table: byte 4 is a NUL"),
+    ],
+    ids=["utf-16", "utf-32", "nul", "binary"],
+)
+def test_text_in_another_encoding_or_bytes_that_are_no_text_are_refused_in_one_line(tmp_path, content, said):
+    """A table in UTF-16 or UTF-32 (a spreadsheet's "Unicode text") and a binary file named .csv are refused in
+    one line naming the file, whole, streamed and through the command (exit 2, nothing written); random bytes
+    with a lone CR used to reach Python's csv module and end in an internal error."""
+    path = tmp_path / "in.csv"
+    path.write_bytes(content)
+    for reading in (lambda: read_table(path), lambda: list(TableStream(path).chunks())):
+        with pytest.raises(InputError, match=r"in.csv: " + said):
+            reading()
+    result = run("fit", path, "-o", tmp_path / "m.json")
+    assert result.returncode == 2 and not (tmp_path / "m.json").exists()
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.stderr and "in.csv: " in lines[0], result.stderr
+
+
+@pytest.mark.parametrize(
+    "head,encoding",
+    [
+        (b"time,gyro_z\n0,1\n", "utf-8"),
+        ("temperature [°C]\n".encode("utf-8")[:-3], "utf-8"),  # the head cut inside the degree sign's two bytes
+        ("temperature [°C] – ‰\n".encode("cp1252"), "cp1252"),
+        (b"temperature [\xb0C] \x81\n", "latin-1"),  # 0x81 is none of Windows-1252's characters
+    ],
+)
+def test_a_text_tables_encoding_is_told_from_its_first_bytes(head, encoding):
+    assert text_encoding(head) == encoding

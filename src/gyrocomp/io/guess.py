@@ -138,11 +138,16 @@ def _headerless_rows(head: bytes) -> tuple[int, str] | None:
     counts = [len(split_fields(row)) for row in rows]
     count = max(set(counts), key=counts.count)
     first = next(i for i, line in enumerate(lines) if len(split_fields(line)) == count and looks_headerless(line))
-    # a header: the line just before the first row, as many fields, none of them a number (split as the rows are,
-    # or as a CSV's quoted names with spaces are: "Time (s)","Gyroscope x (rad/s)")
-    before = lines[first - 1] if first > 0 else ""
-    splits = [split_fields(before), *(next(csv.reader([before], delimiter=d), []) for d in DELIMITERS)]
-    if before and any(len(f) == count and not any(looks_headerless(x) for x in f) for f in splits):
+    # a header: the line just before the first row, as many fields as the row split the same way, none of them a
+    # number (split as the rows are; or by one separator, as a CSV's quoted names with spaces are, "Time (s)",
+    # "Gyroscope x (rad/s)", or a table of semicolons and decimal commas is: Zeit [s];Drehrate X, 0,01;0,25)
+    before, row = (lines[first - 1] if first > 0 else ""), lines[first]
+    splits = [(split_fields(before), count)]  # a separator that splits neither line is no evidence: n > 1
+    splits += [
+        (next(csv.reader([before], delimiter=d), []), len(next(csv.reader([row], delimiter=d), []))) for d in DELIMITERS
+    ]
+    splits = [(f, n) for k, (f, n) in enumerate(splits) if k == 0 or n > 1]
+    if before and any(len(f) == n and not any(looks_headerless(x) for x in f) for f, n in splits):
         return None
     return count, lines[first][:MAX_LINE_BYTES]
 

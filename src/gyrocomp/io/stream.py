@@ -30,7 +30,6 @@ from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (
     CSV_BLOCK_BYTES,
     DECOMPRESS_ERRORS,
-    HEADER_MAX_BYTES,
     TableLayout,
     TextFormat,
     header_line,
@@ -38,7 +37,6 @@ from .tables import (
     _csv_options,
     _read_arrow,
     _resolved_columns,
-    check_header,
     check_parquet_footer,
     csv_codec,
     detect_table_format,
@@ -46,6 +44,7 @@ from .tables import (
     output_text_format,
     read_error,
     rows_dropped,
+    text_head,
     table_recording,
     with_decimal,
 )
@@ -140,9 +139,7 @@ class TableStream:
         head = b""
         with contextlib.ExitStack() as stack:
             try:
-                with open_csv_bytes(self.path, codec) as peek:
-                    head = peek.read(HEADER_MAX_BYTES)
-                check_header(self.path, head)
+                head = text_head(self.path, codec)
                 source = stack.enter_context(open_csv_bytes(self.path, codec))
                 self._source = source if codec is None else None
                 if not head.strip():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import codecs
 import csv
 import dataclasses
 import lzma
@@ -43,12 +44,14 @@ class TableData:
 @dataclass(frozen=True)
 class TextFormat:
     """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;`` or a
-    tab; ``decimal`` ``.`` or ``,``), and how many lines before its header are a preamble that is skipped
-    (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`)."""
+    tab; ``decimal`` ``.`` or ``,``), how many lines before its header are a preamble that is skipped
+    (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`), and its text's encoding
+    (:func:`text_encoding`)."""
 
     delimiter: str = ","
     decimal: str = "."
     preamble_lines: int = 0
+    encoding: str = "utf-8"
 
     @classmethod
     def found(cls, head: bytes, layout: "TableLayout") -> "TextFormat":
@@ -59,12 +62,31 @@ class TextFormat:
         skipped = preamble_lines(head, delimiter)
         if skipped:  # the decimal point told from the first row after the header, not the preamble's
             decimal = sniff_csv(b"\n".join(head.split(b"\n")[skipped:]))[1]
-        return cls(delimiter, layout.decimal or decimal, skipped)
+        return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head))
 
     def read_options(self, block_bytes: int | None = None) -> pacsv.ReadOptions:
         """pyarrow's reading options for this format: blocks of ``block_bytes`` [bytes] (default
-        :data:`CSV_BLOCK_BYTES`), the preamble skipped."""
-        return pacsv.ReadOptions(block_size=block_bytes or CSV_BLOCK_BYTES, skip_rows=self.preamble_lines)
+        :data:`CSV_BLOCK_BYTES`), the preamble skipped, the text decoded."""
+        return pacsv.ReadOptions(
+            block_size=block_bytes or CSV_BLOCK_BYTES, skip_rows=self.preamble_lines, encoding=self.encoding
+        )
+
+
+def text_encoding(head: bytes) -> str:
+    """The encoding of a text table from its first bytes: UTF-8 (ASCII too) where they decode as UTF-8 (a character
+    cut at their end allowed), else Windows-1252, which a spreadsheet on Windows in Western Europe writes
+    (``Temperatur [\u00b0C]`` with the degree sign as the one byte 0xB0), or ISO 8859-1 where a byte is none of
+    Windows-1252's. The names are read as such files mean them; what gyrocomp writes is UTF-8."""
+    try:
+        codecs.getincrementaldecoder("utf-8")().decode(head, final=False)
+        return "utf-8"
+    except UnicodeDecodeError:
+        pass
+    try:
+        head.decode("cp1252")
+        return "cp1252"
+    except UnicodeDecodeError:
+        return "latin-1"
 
 
 def header_line(text_format: TextFormat | None) -> int:
@@ -75,11 +97,12 @@ def header_line(text_format: TextFormat | None) -> int:
 def output_text_format(path: str | os.PathLike, source: TextFormat | None = None) -> TextFormat:
     """The format an output text table is written in: a ``.tsv`` name means tabs; otherwise the input's format
     (``source``), so that the next command reading the output with the same project file reads it; a comma and a
-    decimal point where there is no input table. A decimal comma is kept only beside another separator."""
+    decimal point where there is no input table. A decimal comma is kept only beside another separator. What gyrocomp
+    writes is UTF-8, whatever the input's encoding."""
     name = Path(path).name.lower()
     for compressed in COMPRESSED_SUFFIXES:
         name = name.removesuffix(compressed)
-    base = dataclasses.replace(source, preamble_lines=0) if source is not None else TextFormat()
+    base = dataclasses.replace(source, preamble_lines=0, encoding="utf-8") if source is not None else TextFormat()
     if name.endswith(".tsv"):
         return TextFormat("\t", base.decimal)
     return base if base.delimiter != "," or base.decimal == "." else TextFormat()
@@ -118,6 +141,43 @@ def open_csv_bytes(path: Path, codec: str | None) -> pa.NativeFile:
     return pa.input_stream(source, compression=codec)
 
 
+#: the byte-order marks of UTF-16 and UTF-32 text (a spreadsheet's "Unicode text" export), which pyarrow does not read
+_WIDE_TEXT_MARKS = (
+    (b"\xff\xfe\x00\x00", "UTF-32"),
+    (b"\x00\x00\xfe\xff", "UTF-32"),
+    (b"\xff\xfe", "UTF-16"),
+    (b"\xfe\xff", "UTF-16"),
+)
+
+
+def text_head(path: Path, codec: str | None) -> bytes:
+    """A text table's first bytes (up to :data:`HEADER_MAX_BYTES`, decompressed), its lines ended by ``\\n`` whatever
+    ends them in the file (``\\r\\n``; a lone ``\\r``, as a Macintosh CSV export writes them, which pyarrow reads
+    as line ends too), for the sniffing of its format and header; the header checked (:func:`check_header`). Text in
+    UTF-16 or UTF-32, and bytes that are no text (a NUL byte: a file of another format named ``.csv``), are refused
+    in one line."""
+    try:
+        with open_csv_bytes(path, codec) as peek:
+            head = peek.read(HEADER_MAX_BYTES)
+    except DECOMPRESS_ERRORS as exc:
+        raise InputError(f"{path}: a {codec} file that does not decompress ({str(exc).splitlines()[0]})") from None
+    wide = next((name for mark, name in _WIDE_TEXT_MARKS if head.startswith(mark)), None)
+    if wide is not None:
+        raise InputError(
+            f"{path}: {wide} text (it starts with a {wide} byte-order mark); gyrocomp reads tables in UTF-8 or ASCII: "
+            'save it as UTF-8 (a spreadsheet\'s "CSV UTF-8")'
+        )
+    nul = head.find(b"\x00", 0, 1 << 16)
+    if nul >= 0:
+        raise InputError(
+            f"{path}: not a text table: byte {nul} is a NUL, which no text holds (a binary file, or a file of "
+            "another format named as a table?)"
+        )
+    head = head.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    check_header(path, head)
+    return head
+
+
 def check_header(path: Path, head: bytes) -> None:
     """Refuse, in one line saying what is too big, a text table whose first line is longer than
     :data:`HEADER_MAX_BYTES` or names more than :data:`MAX_COLUMNS` columns (reading it would take the memory
@@ -140,14 +200,9 @@ def check_header(path: Path, head: bytes) -> None:
 
 def _csv_bytes(path: Path) -> tuple[pa.NativeFile | str, bytes]:
     """The CSV's source for pyarrow (gzip, bz2, zstd or xz decompressed as they are read, by their magic bytes)
-    and its first bytes (up to :data:`HEADER_MAX_BYTES`), the header checked (:func:`check_header`)."""
+    and its first bytes as :func:`text_head` gives them."""
     codec = csv_codec(path)
-    try:
-        with open_csv_bytes(path, codec) as peek:
-            head = peek.read(HEADER_MAX_BYTES)
-    except DECOMPRESS_ERRORS as exc:
-        raise InputError(f"{path}: a {codec} file that does not decompress ({str(exc).splitlines()[0]})") from None
-    check_header(path, head)
+    head = text_head(path, codec)
     return (arrow_source(path) if codec is None else open_csv_bytes(path, codec)), head
 
 
@@ -256,8 +311,12 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
         try:
             if select is not None:  # the header's names, from its line
-                names_line = head.split(b"\n")[text.preamble_lines].rstrip(b"\r")
-                header = pacsv.read_csv(pa.py_buffer(names_line + b"\n"), parse_options=parse)
+                names_line = head.split(b"\n")[text.preamble_lines]
+                header = pacsv.read_csv(
+                    pa.py_buffer(names_line + b"\n"),
+                    read_options=pacsv.ReadOptions(encoding=text.encoding),
+                    parse_options=parse,
+                )
                 convert.include_columns = select(header.column_names)
             return pacsv.read_csv(
                 source, read_options=text.read_options(), parse_options=parse, convert_options=convert
