@@ -5,6 +5,7 @@ import json
 
 import h5py
 import numpy as np
+import pandas as pd
 import pytest
 
 from gyrocomp.allan import allan_deviation
@@ -399,3 +400,25 @@ def test_a_spreadsheet_export_of_a_decimal_comma_locale_in_windows_1252_is_guess
     assert (
         out.decode("utf-8").startswith("time [s];gyro x [°/s]") and out == (tmp_path / "utf8" / "out.csv").read_bytes()
     )
+
+
+def test_a_log_timed_by_dates_and_times_is_guessed_in_seconds_and_compensated_by_its_project(tmp_path):
+    """A logger's time column of dates and times (2024-05-01 12:00:00.010): init says it is read as seconds (not
+    ns, as the numbers Arrow keeps would suggest), and with the project file every command reads it: allan's curve
+    is that of the samples at 100 Hz, apply writes the rows back with their time as it was read."""
+    rng = np.random.default_rng(9)
+    n, rate_hz = 2000, 100.0
+    gyro = 0.05 + 0.002 * rng.standard_normal((n, 3))
+    stamps = pd.Timestamp("2024-05-01 12:00:00") + pd.to_timedelta(np.arange(n) * 10, unit="ms")
+    frame = pd.DataFrame({"timestamp": stamps, "gyr_x": gyro[:, 0], "gyr_y": gyro[:, 1], "gyr_z": gyro[:, 2]})
+    frame.to_csv(tmp_path / "log.csv", index=False)
+    guessed = guess_layout(tmp_path / "log.csv")
+    assert guessed.layout.time_unit == "s" and guessed.layout.columns["time"] == "timestamp"
+    assert "time unit s: the column holds dates and times, read as seconds" in guessed.reasons
+    _init_then_allan_reads(tmp_path, "log.csv", "gyro_z", gyro[:, 2], rate_hz)
+    model = tmp_path / "m.json"
+    assert run("fit", "log.csv", "-o", model, "--temperature", "none", cwd=tmp_path).returncode == 0
+    applied = run("apply", model, "log.csv", "-o", "out.csv", cwd=tmp_path)
+    assert applied.returncode == 0, applied.stderr
+    out = pd.read_csv(tmp_path / "out.csv", parse_dates=["timestamp"])
+    assert (out["timestamp"] == stamps).all() and len(out) == n

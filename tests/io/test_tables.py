@@ -622,3 +622,37 @@ def test_text_in_another_encoding_or_bytes_that_are_no_text_are_refused_in_one_l
 )
 def test_a_text_tables_encoding_is_told_from_its_first_bytes(head, encoding):
     assert text_encoding(head) == encoding
+
+
+def test_a_time_column_of_dates_and_times_or_times_of_day_is_read_as_seconds_whole_and_in_chunks(tmp_path):
+    """Loggers (and pandas' to_csv of a DatetimeIndex) write the time as a date and time: ISO 8601 with a space
+    or a T and Z, read as seconds since 1970-01-01 UTC; or as a time of day, read as seconds since midnight; a
+    Parquet timestamp column too. The same seconds whole and streamed; a time unit for such a column and a row
+    that is no time of day are refused in one line."""
+    n, rate_hz = 50, 100.0
+    t0 = pd.Timestamp("2024-05-01 12:00:00")
+    stamps = t0 + pd.to_timedelta(np.arange(n) * 10, unit="ms")
+    epoch_s = (stamps - pd.Timestamp("1970-01-01")).total_seconds().to_numpy()
+    gyro = np.arange(n * 3, dtype=float).reshape(n, 3) / 1000.0
+    frame = pd.DataFrame({"gyro_x": gyro[:, 0], "gyro_y": gyro[:, 1], "gyro_z": gyro[:, 2]})
+    cases = {
+        "space.csv": (stamps.strftime("%Y-%m-%d %H:%M:%S.%f"), epoch_s),
+        "iso_z.csv": (stamps.strftime("%Y-%m-%dT%H:%M:%S.%fZ"), epoch_s),
+        "clock.csv": (stamps.strftime("%H:%M:%S.%f").str[:-3], 43_200.0 + np.arange(n) / rate_hz),
+    }
+    for name, (texts, expected_s) in cases.items():
+        frame.assign(time=texts).to_csv(tmp_path / name, index=False)
+        whole = read_table(tmp_path / name).recording
+        np.testing.assert_allclose(whole.time_s, expected_s, rtol=0, atol=1e-6)
+        np.testing.assert_array_equal(whole.gyro_dps, gyro)
+        chunks = list(TableStream(tmp_path / name, chunk_rows=7).chunks())
+        np.testing.assert_array_equal(np.concatenate([c.recording.time_s for c in chunks]), whole.time_s)
+    frame.assign(time=stamps).to_parquet(tmp_path / "stamps.parquet")
+    np.testing.assert_allclose(read_table(tmp_path / "stamps.parquet").recording.time_s, epoch_s, rtol=0, atol=1e-6)
+    with pytest.raises(InputError, match=r"space.csv: column 'time' holds dates or times of day, whose unit is"):
+        read_table(tmp_path / "space.csv", TableLayout(time_unit="ms"))
+    lines = (tmp_path / "clock.csv").read_text().splitlines()
+    lines[5] = lines[5].replace(lines[5].split(",")[-1], "12:00")
+    (tmp_path / "clock.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"clock.csv: row 5 \(line 6\), column 'time': '12:00' is not a time of"):
+        read_table(tmp_path / "clock.csv")

@@ -31,6 +31,7 @@ from .matlab import load_arrays
 from .readers import detect_format
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
 from .tables import (
+    holds_clock,
     DELIMITERS,
     DECOMPRESS_ERRORS,
     TableLayout,
@@ -367,7 +368,9 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
 
 def _guessed_units(table: pa.Table, columns: dict[str, str]) -> tuple[str, str, str, tuple[str, str, str]]:
     """The time, accelerometer and gyro units of the channels ``columns`` (channel -> column of ``table``), and why."""
-    if "time" in columns:
+    if "time" in columns and holds_clock(table.column(columns["time"])):
+        time_unit, why_time = "s", "time unit s: the column holds dates and times, read as seconds"
+    elif "time" in columns:
         time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
     else:
         time_unit, why_time = "s", "time unit s: the nominal time"

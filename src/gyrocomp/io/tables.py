@@ -7,6 +7,7 @@ import csv
 import dataclasses
 import lzma
 import os
+import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -424,6 +425,71 @@ def _numeric_column(table: pa.Table, column: str, source: Path, first_row: int =
     return out
 
 
+#: seconds per unit of Arrow's timestamps and times of day
+_CLOCK_UNIT_S = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+#: a time of day as text: hours, minutes, seconds and a fraction (12:00:01.250)
+_TIME_OF_DAY = re.compile(r"\s*\d{1,2}:\d{2}:\d{2}(\.\d+)?\s*")
+
+
+def time_column_s(
+    table: pa.Table, column: str, time_unit: str, source: Path, first_row: int = 0, header_line: int = 1
+) -> np.ndarray:
+    """The time column [s]: numbers in ``time_unit``; dates with times (ISO 8601 such as ``2024-05-01
+    12:00:00.010`` or ``...T12:00:00.010Z``, which pyarrow reads as timestamps; Parquet's timestamps) as seconds
+    since 1970-01-01 UTC; times of day (``12:00:00.010``) as seconds since midnight (a log that runs past midnight
+    then goes back in time, and is refused as such). A column of dates and times has its unit in it: a
+    ``time_unit`` other than s is refused for it. Messages name the row and line as :func:`_numeric_column`'s."""
+    array = table.column(column)
+    clock = _clock_s(array, source, column, first_row, header_line)
+    if clock is None:
+        return _numeric_column(table, column, source, first_row, header_line) * unit_factor(
+            "time", time_unit, "time_unit"
+        )
+    if unit_factor("time", time_unit, "time_unit") != 1.0:
+        raise InputError(
+            f"{source}: column {column!r} holds dates or times of day, whose unit is their own; time_unit="
+            f"{time_unit!r} is for a column of numbers"
+        )
+    return clock
+
+
+def holds_clock(array: pa.ChunkedArray | pa.Array) -> bool:
+    """Whether a column holds dates with times or times of day (:func:`time_column_s`), not numbers: an Arrow
+    timestamp or time, or text whose first value is a time of day."""
+    kind = array.type
+    if pa.types.is_timestamp(kind) or pa.types.is_time(kind):
+        return True
+    if not (pa.types.is_string(kind) or pa.types.is_large_string(kind)):
+        return False
+    chunks = array.chunks if isinstance(array, pa.ChunkedArray) else [array]
+    first = next((v for chunk in chunks for v in chunk.drop_null().slice(0, 1).to_pylist()), None)
+    return first is not None and _TIME_OF_DAY.fullmatch(first) is not None
+
+
+def _clock_s(array: pa.ChunkedArray, source: Path, column: str, first_row: int, header_line: int) -> np.ndarray | None:
+    """A column of timestamps [s since 1970-01-01 UTC] or times of day [s since midnight]; None for any other."""
+    kind = array.type
+    if pa.types.is_timestamp(kind) or pa.types.is_time(kind):
+        whole = pa.int64() if kind.bit_width == 64 else pa.int32()
+        return _to_numpy(array.cast(whole)) * _CLOCK_UNIT_S[kind.unit]
+    if not holds_clock(array):
+        return None
+    texts = array.to_pylist()
+    out = np.full(len(texts), np.nan)
+    for i, text in enumerate(texts):
+        if text is None:
+            continue
+        if not _TIME_OF_DAY.fullmatch(text):
+            row = first_row + i + 1
+            raise InputError(
+                f"{source}: row {row} (line {header_line + row}), column {column!r}: {text!r} is not a time of day "
+                "(hh:mm:ss.fff, as the first row's)"
+            )
+        hours, minutes, seconds = text.split(":")
+        out[i] = 3600.0 * int(hours) + 60.0 * int(minutes) + float(seconds)
+    return out
+
+
 #: suffixes of delimited text tables (the delimiter is told from the header: comma, semicolon, tab, space)
 TEXT_TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
 #: suffixes of compressed text tables after their own (``run.csv.gz``), read as they stream
@@ -625,7 +691,7 @@ def table_recording(
     if cols[TIME_COLUMN] == NOMINAL_TIME:  # a table without time, at a nominal rate
         time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
     else:
-        time_s = num(TIME_COLUMN) * unit_factor("time", layout.time_unit, "time_unit")
+        time_s = time_column_s(table, cols[TIME_COLUMN], layout.time_unit, path, first_row, header_line)
     gyro = np.column_stack([num(a) for a in gyro_axes])
     gyro *= gyro_factor  # in place: a long table's columns are not copied twice
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
