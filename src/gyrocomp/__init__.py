@@ -33,6 +33,7 @@ _EXPORTS = {
             "NotFittedError",
             "PlausibilityWarning",
             "TemperatureRangeWarning",
+            "TimeOrderError",
             "UnusedOptionWarning",
         )
     },

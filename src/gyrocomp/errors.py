@@ -27,6 +27,14 @@ class LayoutError(InputError):
         self.path = path
 
 
+class TimeOrderError(InputError):
+    """A recording's time repeats or goes back (``repeated``: it repeats) at row ``row`` (1-based, of its file)."""
+
+    def __init__(self, message: str, row: int, repeated: bool):
+        super().__init__(message)
+        self.row, self.repeated = row, repeated
+
+
 class ModelError(GyrocompError):
     """A model could not be fitted, loaded or applied (CLI exit status 1)."""
 

@@ -10,7 +10,7 @@ import pandas as pd
 import pyarrow as pa
 import pytest
 
-from gyrocomp.errors import DataQualityWarning, InputError
+from gyrocomp.errors import DataQualityWarning, InputError, TimeOrderError
 from gyrocomp.io import (
     TableLayout,
     atomic_path,
@@ -656,3 +656,31 @@ def test_a_time_column_of_dates_and_times_or_times_of_day_is_read_as_seconds_who
     (tmp_path / "clock.csv").write_text("\n".join(lines) + "\n")
     with pytest.raises(InputError, match=r"clock.csv: row 5 \(line 6\), column 'time': '12:00' is not a time of"):
         read_table(tmp_path / "clock.csv")
+
+
+def test_stamps_coarser_than_the_samples_are_refused_with_the_way_to_read_the_rows_at_their_mean_rate(tmp_path):
+    """A 1 kHz log stamped by a clock in ms with jitter repeats some stamps: refused at the first repeat (row and
+    line), with the rows' mean rate to read them at instead; read so, the n-th row is at n / rate. The command
+    line spells the advice as its flags. A time going back gets no such advice."""
+    rng = np.random.default_rng(2)
+    n = 3000
+    stamps = np.round(np.arange(n) * 1e-3 + 3e-4 * rng.standard_normal(n), 3)
+    stamps = np.maximum.accumulate(stamps)  # never back: only repeats
+    first = int(np.flatnonzero(np.diff(stamps) == 0)[0]) + 2  # the 1-based row of the first repeat
+    rate_hz = (n - 1) / (stamps[-1] - stamps[0])
+    rows = "".join(f"{t:.3f},0.1,0.2,0.3\n" for t in stamps)
+    (tmp_path / "ms.csv").write_text("time,gyro_x,gyro_y,gyro_z\n" + rows)
+    with pytest.raises(TimeOrderError, match=rf"ms.csv: row {first}: time repeats .*mean rate instead") as refused:
+        read_table(tmp_path / "ms.csv")
+    assert refused.value.row == first and refused.value.repeated
+    assert f"(columns={{'time': ''}}, rate_hz={rate_hz:.6g})" in str(refused.value)
+    data = read_table(tmp_path / "ms.csv", TableLayout({"time": ""}, rate_hz=float(f"{rate_hz:.6g}")))
+    np.testing.assert_allclose(data.recording.time_s, np.arange(n) / float(f"{rate_hz:.6g}"), rtol=1e-12)
+    said = run("check", tmp_path / "ms.csv").stdout
+    assert f"(--columns time=, --rate {rate_hz:.6g})" in said, said
+    (tmp_path / "back.csv").write_text("time,gyro_z\n0,1\n0.002,1\n0.001,1\n0.003,1\n")
+    with pytest.raises(
+        TimeOrderError,
+        match=r"back.csv: row 3: time goes backwards \(0.001 s after 0.002 s\); time must strictly increase$",
+    ):
+        read_table(tmp_path / "back.csv")

@@ -17,7 +17,7 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from ..errors import DataQualityWarning, InputError, LayoutError
+from ..errors import DataQualityWarning, InputError, LayoutError, TimeOrderError
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .digest import file_sha256
@@ -708,19 +708,37 @@ def table_recording(
             raise InputError(
                 f"{path}: rows {first_row + 1}..{first_row + n}: fewer than 2 rows with values in every used column"
             )
-    recording = Recording(
-        time_s=time_s,
-        gyro_dps=gyro,
-        gyro_axes=gyro_axes,
-        temperature_degc=temp,
-        accel_g=accel,
-        accel_axes=accel_axes,
-        reference_rate_dps=reference,
-        source=str(path),
-        row_numbers=first_row + kept + 1,
-        metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)},
-    )
+    try:
+        recording = Recording(
+            time_s=time_s,
+            gyro_dps=gyro,
+            gyro_axes=gyro_axes,
+            temperature_degc=temp,
+            accel_g=accel,
+            accel_axes=accel_axes,
+            reference_rate_dps=reference,
+            source=str(path),
+            row_numbers=first_row + kept + 1,
+            metadata={"path": str(path), "format": fmt, "rows_dropped": int(n - kept.size)},
+        )
+    except TimeOrderError as exc:
+        raise _coarse_stamps_hint(exc, time_s) from None
     return recording, kept
+
+
+def _coarse_stamps_hint(exc: TimeOrderError, time_s: np.ndarray) -> TimeOrderError:
+    """``exc`` with, where the time repeats and runs on overall, the way to read the rows at their mean rate: a
+    clock coarser than the samples (stamps in ms at 1 kHz with jitter) repeats some of them."""
+    span_s = float(time_s[-1] - time_s[0]) if time_s.size > 1 else 0.0
+    if not exc.repeated or not np.isfinite(span_s) or span_s <= 0:
+        return exc
+    rate_hz = (time_s.size - 1) / span_s
+    return TimeOrderError(
+        f"{exc}; if the stamps are coarser than the samples, read the rows at their mean rate instead "
+        f"(columns={{'time': ''}}, rate_hz={rate_hz:.6g})",
+        exc.row,
+        exc.repeated,
+    )
 
 
 def _write_arrow(table: pa.Table, path: Path, fmt: str, text_format: TextFormat | None = None) -> None:

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, TimeOrderError
 from ..spilled_series import parts, streamed_median
 
 GYRO_AXES = ("gyro_x", "gyro_y", "gyro_z")
@@ -201,10 +201,12 @@ def _require_increasing(src: str, rows: np.ndarray, time_s: np.ndarray) -> None:
         bad_steps = np.flatnonzero(dt <= 0)
         if bad_steps.size:
             i = start + int(bad_steps[0]) + 1
-            what = "repeats" if dt[bad_steps[0]] == 0 else "goes backwards"
-            raise InputError(
-                f"{src}: row {rows[i]}: time {what} ({time_s[i]:.9g} s after {time_s[i - 1]:.9g} s); "
-                "time must strictly increase"
+            repeated = bool(dt[bad_steps[0]] == 0)
+            raise TimeOrderError(
+                f"{src}: row {rows[i]}: time {'repeats' if repeated else 'goes backwards'} ({time_s[i]:.9g} s after "
+                f"{time_s[i - 1]:.9g} s); time must strictly increase",
+                int(rows[i]),
+                repeated,
             )
 
 
