@@ -422,3 +422,21 @@ def test_a_log_timed_by_dates_and_times_is_guessed_in_seconds_and_compensated_by
     assert applied.returncode == 0, applied.stderr
     out = pd.read_csv(tmp_path / "out.csv", parse_dates=["timestamp"])
     assert (out["timestamp"] == stamps).all() and len(out) == n
+
+
+def test_init_refuses_a_chosen_column_of_text_in_one_line_naming_it(tmp_path):
+    """A line of units under the header makes the chosen columns text: init said so as an internal error (the
+    time's steps taken of no numbers); now one line naming the column and its first value, exit 2, no file."""
+    rows = "".join(f"{k / 100:.2f},0.1,0.2,0.3\n" for k in range(100))
+    (tmp_path / "units.csv").write_text("time,gyro_x,gyro_y,gyro_z\n[s],[deg/s],[deg/s],[deg/s]\n" + rows)
+    result = run("init", "units.csv", cwd=tmp_path)
+    assert result.returncode == 2 and not (tmp_path / "gyrocomp.toml").exists()
+    assert result.stderr.strip().splitlines() == [
+        "gyrocomp: error: units.csv: column 'time' (time) holds text, not numbers (its first value '[s]'): a line "
+        "of units under the header, or a column of another kind? Remove the line, or map the channel to another column"
+    ]
+    (tmp_path / "units.csv").write_text("t,gyro_z\n" + "".join(f"{k},off\n" for k in range(50)))
+    with pytest.raises(
+        InputError, match=r"units.csv: column 'gyro_z' \(gyro_z\) holds text, not numbers \(its first value 'off'\)"
+    ):
+        guess_layout(tmp_path / "units.csv")

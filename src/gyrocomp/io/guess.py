@@ -214,6 +214,21 @@ def _numbers(table: pa.Table, column: str) -> np.ndarray | None:
     return values[np.isfinite(values)]
 
 
+def _require_numbers(path: Path, table: pa.Table, columns: dict[str, str]) -> None:
+    """Refuse in one line a chosen column (channel -> column of ``table``) that holds text where numbers (or, for
+    the time, dates and times) belong, naming its first value: a line of units under the header, say."""
+    for channel, name in columns.items():
+        column = table.column(name)
+        if (channel == "time" and holds_clock(column)) or _numbers(table, name) is not None:
+            continue
+        first = next((v for v in column.to_pylist() if v is not None), None)
+        raise InputError(
+            f"{path}: column {name!r} ({channel}) holds text, not numbers (its first value {first!r}): a line of "
+            "units under the header, or a column of another kind? Remove the line, or map the channel to another "
+            "column"
+        )
+
+
 def _time_unit(name: str, values: np.ndarray) -> tuple[str, str]:
     for word in _words(name):
         if word in _TIME_UNIT_WORDS:
@@ -433,6 +448,7 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
     else:
         table, delimiter, preamble = _sample(path, fmt)
     columns, reasons, check = _columns_timed(path, table, check, preamble)
+    _require_numbers(path, table, columns)
     time_unit, accel_unit, gyro_unit, why = _guessed_units(table, columns)
     layout = TableLayout(
         columns,
