@@ -440,3 +440,35 @@ def test_init_refuses_a_chosen_column_of_text_in_one_line_naming_it(tmp_path):
         InputError, match=r"units.csv: column 'gyro_z' \(gyro_z\) holds text, not numbers \(its first value 'off'\)"
     ):
         guess_layout(tmp_path / "units.csv")
+
+
+def test_a_table_of_aligned_columns_goes_through_init_fit_and_apply(tmp_path):
+    """A text table whose columns are aligned by runs of spaces (Fortran's, MATLAB's save -ascii with a header
+    line added, many instruments'): init writes its separator, the commands read it, `--delimiter space` names
+    it, and apply writes the rows back separated by spaces, its values those of the same rows as a CSV."""
+    rng = np.random.default_rng(12)
+    n = 1500
+    temperature = np.linspace(20.0, 40.0, n)
+    gyro = 0.2 + 0.01 * (temperature - 30.0)[:, None] + 0.002 * rng.standard_normal((n, 3))
+    rows = np.column_stack([np.arange(n) / 10.0, gyro, temperature]).tolist()
+    names = ["time", "gyro_x", "gyro_y", "gyro_z", "temperature"]
+    (tmp_path / "run.dat").write_text(
+        "".join(f"{name:>24}" for name in names) + "\n" + "".join("".join(f"{v!r:>24}" for v in r) + "\n" for r in rows)
+    )
+    (tmp_path / "csv").mkdir()
+    (tmp_path / "csv" / "run.csv").write_text(
+        ",".join(names) + "\n" + "".join(",".join(map(repr, r)) + "\n" for r in rows)
+    )
+    assert run("init", "run.dat", cwd=tmp_path).returncode == 0
+    assert 'delimiter = " "' in (tmp_path / "gyrocomp.toml").read_text()
+    fitted = run("fit", "run.dat", "-o", "m.json", "--temperature", "poly:1", cwd=tmp_path)
+    assert fitted.returncode == 0, fitted.stderr
+    applied = run("apply", "m.json", "run.dat", "-o", "out.dat", cwd=tmp_path)
+    assert applied.returncode == 0, applied.stderr
+    again = run("apply", tmp_path / "m.json", "run.csv", "-o", "out.csv", cwd=tmp_path / "csv")
+    assert again.returncode == 0, again.stderr
+    spaced = (tmp_path / "out.dat").read_text()
+    assert spaced.startswith("time gyro_x gyro_y gyro_z temperature\n")
+    assert spaced.replace(" ", ",") == (tmp_path / "csv" / "out.csv").read_text()
+    named = run("check", tmp_path / "run.dat", "--delimiter", "space", cwd=tmp_path / "csv")  # no project file there
+    assert named.returncode == 0, named.stderr

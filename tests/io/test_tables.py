@@ -1,7 +1,9 @@
 import gzip
+import io
 import lzma
 import math
 import os
+import re
 import warnings
 from pathlib import Path
 
@@ -9,6 +11,8 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gyrocomp.errors import DataQualityWarning, InputError, TimeOrderError
 from gyrocomp.io import (
@@ -23,7 +27,7 @@ from gyrocomp.io import (
 )
 from gyrocomp.io.guess import guess_layout
 from gyrocomp.io.stream import TableStream
-from gyrocomp.io.tables import TextFormat, preamble_lines, text_encoding
+from gyrocomp.io.tables import SpacedText, TextFormat, preamble_lines, spaced_as_commas, text_encoding
 from gyrocomp.simulation import GyroErrorModel, simulate
 from gyrocomp.units import unit_factor
 
@@ -684,3 +688,65 @@ def test_stamps_coarser_than_the_samples_are_refused_with_the_way_to_read_the_ro
         match=r"back.csv: row 3: time goes backwards \(0.001 s after 0.002 s\); time must strictly increase$",
     ):
         read_table(tmp_path / "back.csv")
+
+
+def test_a_table_of_spaces_reads_as_the_same_table_with_commas_whole_and_in_chunks(tmp_path):
+    """Columns aligned by runs of spaces and tabs (leading and trailing ones too; Fortran's and MATLAB's text
+    output, many instruments'): told from the header, read as the comma table of the same values, whole and
+    streamed; a value that is no number names its row and line; apply writes it back separated by spaces."""
+    rng = np.random.default_rng(4)
+    n = 60
+    values = np.column_stack([np.arange(n) / 100.0, rng.normal(0, 0.1, (n, 3)), 25 + rng.random(n)])
+    names = ["time", "gyro_x", "gyro_y", "gyro_z", "temperature"]
+    (tmp_path / "commas.csv").write_text(
+        ",".join(names) + "\n" + "".join(",".join(repr(v) for v in row) + "\n" for row in values.tolist())
+    )
+    padded = ["  " + "\t ".join(f"{name:>14}" for name in names) + "   \r\n"]
+    padded += [" " + "   ".join(f"{v!r:>22}" for v in row) + " \t\r\n" for row in values.tolist()]
+    (tmp_path / "spaces.txt").write_text("".join(padded), newline="")
+    expected = read_table(tmp_path / "commas.csv").recording
+    data = read_table(tmp_path / "spaces.txt")
+    assert data.text_format.delimiter == " " and data.table.column_names == names
+    chunks = [c.recording for c in TableStream(tmp_path / "spaces.txt", chunk_rows=7).chunks()]
+    for got in (data.recording, chunks):
+        gyro = got.gyro_dps if not isinstance(got, list) else np.concatenate([c.gyro_dps for c in got])
+        time_s = got.time_s if not isinstance(got, list) else np.concatenate([c.time_s for c in got])
+        np.testing.assert_array_equal(gyro, expected.gyro_dps)
+        np.testing.assert_array_equal(time_s, expected.time_s)
+    write_gyro_back(data, data.recording.gyro_dps + 1.0, tmp_path / "out.txt")
+    back = read_table(tmp_path / "out.txt")
+    assert back.text_format.delimiter == " " and (tmp_path / "out.txt").read_text().startswith("time gyro_x gyro_y")
+    np.testing.assert_allclose(back.recording.gyro_dps, expected.gyro_dps + 1.0, rtol=1e-12)
+    padded[11] = padded[11].replace(repr(float(values[10, 2])), "bad", 1)
+    (tmp_path / "spaces.txt").write_text("".join(padded), newline="")
+    for reading in (
+        lambda: read_table(tmp_path / "spaces.txt"),
+        lambda: list(TableStream(tmp_path / "spaces.txt", chunk_rows=7).chunks()),
+    ):
+        with pytest.raises(InputError, match=r"spaces.txt: row 11 \(line 12\), column 'gyro_y': 'bad' is not a number"):
+            reading()
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    lines=st.lists(
+        st.lists(st.sampled_from(["1.5", "-2", "a_b", "x", "3e-4"]), min_size=1, max_size=5).flatmap(
+            lambda fields: st.tuples(
+                st.just(fields),
+                st.lists(
+                    st.sampled_from([" ", "\t", "  ", " \t "]), min_size=len(fields) + 1, max_size=len(fields) + 1
+                ),
+            )
+        ),
+        max_size=12,
+    ),
+    end=st.sampled_from(["\n", "\r\n", "\r"]),
+    block_bytes=st.integers(1, 40),
+)
+def test_a_table_of_spaces_gives_the_same_commas_whatever_the_blocks_it_is_read_in(lines, end, block_bytes):
+    """Runs of spaces cut by the blocks the file is read in, and line ends of any kind, give the commas of the
+    whole text read at once; each line's fields joined by single commas."""
+    text = "".join(gaps[0] + "".join(f + g for f, g in zip(fields, gaps[1:])) + end for fields, gaps in lines).encode()
+    read = SpacedText(io.BytesIO(text), block_bytes=block_bytes).read()
+    assert read == spaced_as_commas(text)
+    assert [line for line in re.split(rb"\r\n|\r|\n", read)[:-1]] == [",".join(f).encode() for f, _ in lines]

@@ -170,9 +170,9 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None, list[str]]:
     batches, rows = [], 0
     try:
         reader = pacsv.open_csv(
-            source,
+            text.source(path, source),
             read_options=text.read_options(),
-            parse_options=pacsv.ParseOptions(delimiter=text.delimiter),
+            parse_options=text.parse_options(),
             convert_options=pacsv.ConvertOptions(decimal_point=text.decimal),
         )
         for batch in reader:

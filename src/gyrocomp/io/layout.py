@@ -67,8 +67,10 @@ def parse_column_mapping(text: str | None) -> dict[str, str]:
 
 
 def _delimiter(text: str) -> str:
-    """``--delimiter``'s text: ``tab`` (or ``\\t``) for a tab, else the character."""
-    return "\t" if text.strip().lower() in ("tab", "\\t") else text
+    """``--delimiter``'s text: ``tab`` (or ``\\t``) for a tab, ``space`` for runs of spaces and tabs, else the
+    character."""
+    word = text.strip().lower()
+    return "\t" if word in ("tab", "\\t") else " " if word == "space" else text
 
 
 @dataclass(frozen=True)
@@ -113,7 +115,8 @@ class TableLayout:
     delimiter: str | None = spelled(
         Spelling(
             "--delimiter",
-            "CSV field separator (default: told from the header: comma, semicolon or tab; 'tab' for a tab).",
+            "CSV field separator (default: told from the header: comma, semicolon, tab, or runs of spaces; 'tab' "
+            "for a tab, 'space' for runs of spaces and tabs).",
             parse=_delimiter,
         ),
         default=None,

@@ -140,14 +140,14 @@ class TableStream:
         with contextlib.ExitStack() as stack:
             try:
                 head = text_head(self.path, codec)
-                source = stack.enter_context(open_csv_bytes(self.path, codec))
-                self._source = source if codec is None else None
                 if not head.strip():
                     raise InputError(
                         f"{self.path}: the file is empty; expected a header such as time,gyro_z,temperature"
                     )
                 self.text_format = TextFormat.found(head[:4096], self.layout)
-                parse = pacsv.ParseOptions(delimiter=self.text_format.delimiter)
+                source = stack.enter_context(self.text_format.source(self.path, open_csv_bytes(self.path, codec)))
+                self._source = source if codec is None and not self.text_format.spaced else None
+                parse = self.text_format.parse_options()
                 convert = pacsv.ConvertOptions(
                     strings_can_be_null=True, decimal_point=self.text_format.decimal, include_columns=self._read or []
                 )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import codecs
 import csv
 import dataclasses
+import io
 import lzma
 import os
 import re
@@ -65,12 +66,83 @@ class TextFormat:
             decimal = sniff_csv(b"\n".join(head.split(b"\n")[skipped:]))[1]
         return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head))
 
+    @property
+    def spaced(self) -> bool:
+        """Whether fields are separated by runs of spaces and tabs (:data:`SPACE`), read through
+        :class:`SpacedText` as commas."""
+        return self.delimiter == SPACE
+
+    def parse_options(self) -> pacsv.ParseOptions:
+        """pyarrow's parsing options for this format (a comma for a table of spaces, which :func:`text_source`
+        gives it as commas)."""
+        return pacsv.ParseOptions(delimiter="," if self.spaced else self.delimiter)
+
+    def source(self, path: Path, source):
+        """What pyarrow reads of the table at ``path``: ``source`` (its bytes, decompressed), or for a table of
+        spaces the same bytes with each run of spaces and tabs between fields made one comma (:class:`SpacedText`)."""
+        if not self.spaced:
+            return source
+        return pa.PythonFile(SpacedText(open_csv_bytes(path, csv_codec(path))), mode="r")
+
     def read_options(self, block_bytes: int | None = None) -> pacsv.ReadOptions:
         """pyarrow's reading options for this format: blocks of ``block_bytes`` [bytes] (default
         :data:`CSV_BLOCK_BYTES`), the preamble skipped, the text decoded."""
         return pacsv.ReadOptions(
             block_size=block_bytes or CSV_BLOCK_BYTES, skip_rows=self.preamble_lines, encoding=self.encoding
         )
+
+
+#: the delimiter of a table whose fields are separated by runs of spaces and tabs (columns aligned by padding, as
+#: Fortran, MATLAB's ``save -ascii`` and many instruments write them)
+SPACE = " "
+#: runs of spaces and tabs at a line's start or end, and between fields
+_EDGE_SPACES = re.compile(rb"(?:^|(?<=[\r\n]))[ \t]+|[ \t]+(?=[\r\n]|\Z)")
+_INNER_SPACES = re.compile(rb"[ \t]+")
+
+
+def spaced_as_commas(text: bytes) -> bytes:
+    """Complete lines of a table of spaces with each run of spaces and tabs between fields made one comma, those at
+    a line's start and end removed."""
+    return _INNER_SPACES.sub(b",", _EDGE_SPACES.sub(b"", text))
+
+
+class SpacedText(io.RawIOBase):
+    """A table of spaces read as one of commas (:func:`spaced_as_commas`), a block of lines at a time: the bytes
+    after a block's last line end wait for the next block, so that a run of spaces is never cut in two.
+
+    Parameters
+    ----------
+    raw : file-like
+        The table's bytes (``read(n)``), decompressed; closed with this.
+    block_bytes : int
+        Bytes read at once [bytes].
+    """
+
+    def __init__(self, raw, block_bytes: int = 1 << 20):
+        self._raw, self._block = raw, int(block_bytes)
+        self._out, self._rest, self._ended = b"", b"", False
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer) -> int:
+        while not self._out and not self._ended:
+            block = self._raw.read(self._block)
+            if not block:
+                self._out, self._rest, self._ended = spaced_as_commas(self._rest), b"", True
+                break
+            text = self._rest + block
+            end = max(text.rfind(b"\n"), text.rfind(b"\r")) + 1
+            self._out, self._rest = spaced_as_commas(text[:end]), text[end:]
+        n = min(len(buffer), len(self._out))
+        buffer[:n] = self._out[:n]
+        self._out = self._out[n:]
+        return n
+
+    def close(self) -> None:
+        if not self.closed:
+            self._raw.close()
+        super().close()
 
 
 def text_encoding(head: bytes) -> str:
@@ -257,12 +329,36 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
     if not any(d in header for d in DELIMITERS):  # a preamble's first line (// Start Time: ...): the first with one
         header = next((line for line in lines[1:] if any(d in line for d in DELIMITERS)), header)
     delimiter = max(DELIMITERS, key=lambda d: (header.count(d), d == ","))
+    at = lines.index(header) if header in lines else 0
+    if _spaced(lines[at : at + 2]) and (
+        not any(d in header for d in DELIMITERS) or not _same_fields(lines[at : at + 2], delimiter)
+    ):
+        delimiter = SPACE  # fields aligned by spaces (and tabs among them, which do not split the rows alike)
     decimal = "."
     if delimiter != "," and len(lines) > 1:
-        cells = [c.strip().strip('"') for c in lines[1].split(delimiter)]
+        cells = [c.strip().strip('"') for c in fields_of(lines[1], delimiter)]
         if any(c.replace("-", "", 1).replace(",", "", 1).isdigit() and "," in c for c in cells):
             decimal = ","
     return delimiter, decimal
+
+
+def _spaced(lines: list[str]) -> bool:
+    """Whether a table's header and first row (``lines``) are fields separated by runs of spaces and tabs: they
+    split so into the same number of fields, at least two."""
+    return _same_fields(lines, SPACE) and len(fields_of(lines[0], SPACE)) >= 2
+
+
+def _same_fields(lines: list[str], delimiter: str) -> bool:
+    """Whether a header and the row after it (``lines``) split by ``delimiter`` into as many fields."""
+    return len(lines) == 2 and len(fields_of(lines[0], delimiter)) == len(fields_of(lines[1], delimiter))
+
+
+def fields_of(line: str, delimiter: str) -> list[str]:
+    """A line's fields by ``delimiter`` as a CSV reads them (quotes kept together); by runs of spaces and tabs for
+    a table of spaces (:data:`SPACE`)."""
+    if delimiter == SPACE:
+        return line.split()
+    return next(csv.reader([line.rstrip("\r")], delimiter=delimiter), [])
 
 
 #: the most lines before a text table's header skipped as its preamble
@@ -277,7 +373,7 @@ def preamble_lines(head: bytes, delimiter: str) -> int:
     would lie past :data:`MAX_PREAMBLE_LINES`, or when it is a row of numbers (a log without a header line after
     its preamble, which the table's names read)."""
     lines = head.decode("utf-8", "replace").split("\n")[:-1]  # the last piece: a line not complete, or nothing
-    counts = [len(next(csv.reader([line.rstrip("\r")], delimiter=delimiter), [])) for line in lines]
+    counts = [len(fields_of(line, delimiter)) for line in lines]
     if len(counts) < 3 or counts[-1] < 2:
         return 0
     first = len(counts) - 1
@@ -308,11 +404,13 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
         text = TextFormat.found(head[:4096], layout)
-        parse = pacsv.ParseOptions(delimiter=text.delimiter)
+        source = text.source(path, source)
+        parse = text.parse_options()
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
         try:
             if select is not None:  # the header's names, from its line
                 names_line = head.split(b"\n")[text.preamble_lines]
+                names_line = spaced_as_commas(names_line) if text.spaced else names_line
                 header = pacsv.read_csv(
                     pa.py_buffer(names_line + b"\n"),
                     read_options=pacsv.ReadOptions(encoding=text.encoding),
