@@ -31,13 +31,13 @@ from .matlab import load_arrays
 from .readers import detect_format
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
 from .tables import (
-    holds_clock,
     DELIMITERS,
     DECOMPRESS_ERRORS,
     TableLayout,
     _csv_bytes,
     check_parquet_footer,
     detect_table_format,
+    holds_clock,
     read_error,
     TextFormat,
 )

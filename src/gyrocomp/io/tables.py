@@ -45,8 +45,8 @@ class TableData:
 
 @dataclass(frozen=True)
 class TextFormat:
-    """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;`` or a
-    tab; ``decimal`` ``.`` or ``,``), how many lines before its header are a preamble that is skipped
+    """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;``, a
+    tab, or :data:`SPACE` for runs of spaces and tabs; ``decimal`` ``.`` or ``,``), how many lines before its header are a preamble that is skipped
     (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`), and its text's encoding
     (:func:`text_encoding`)."""
 
@@ -73,8 +73,8 @@ class TextFormat:
         return self.delimiter == SPACE
 
     def parse_options(self) -> pacsv.ParseOptions:
-        """pyarrow's parsing options for this format (a comma for a table of spaces, which :func:`text_source`
-        gives it as commas)."""
+        """pyarrow's parsing options for this format (a comma for a table of spaces, which :meth:`source` gives it
+        as commas)."""
         return pacsv.ParseOptions(delimiter="," if self.spaced else self.delimiter)
 
     def source(self, path: Path, source):
