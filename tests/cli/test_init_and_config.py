@@ -472,3 +472,28 @@ def test_a_table_of_aligned_columns_goes_through_init_fit_and_apply(tmp_path):
     assert spaced.replace(" ", ",") == (tmp_path / "csv" / "out.csv").read_text()
     named = run("check", tmp_path / "run.dat", "--delimiter", "space", cwd=tmp_path / "csv")  # no project file there
     assert named.returncode == 0, named.stderr
+
+
+def test_init_reads_a_text_matrix_named_mat_with_the_format_given_and_the_project_keeps_it(tmp_path):
+    """imu_tk's logs are text matrices named .mat: init refuses them with the way (the format and the names, in
+    the command line's words), takes them with --format csv --names, and writes the format into the project file,
+    so that every command then reads the file as that table."""
+    rng = np.random.default_rng(13)
+    n, rate_hz = 3000, 100.0
+    gyro = 0.1 + 0.002 * rng.standard_normal((n, 3))
+    (tmp_path / "gyro.mat").write_text(
+        "".join(f"{k / rate_hz:.4f}   " + "   ".join(f"{v:.8f}" for v in gyro[k]) + "\n" for k in range(n))
+    )
+    refused = run("init", "gyro.mat", cwd=tmp_path)
+    assert refused.returncode == 2 and not (tmp_path / "gyrocomp.toml").exists()
+    assert (
+        "not a binary MAT-file: read it as a table without a header line, --format csv with the columns' names in order (--names time,gyro_x,gyro_y,gyro_z)"
+        in refused.stderr
+    )
+    made = run("init", "gyro.mat", "--format", "csv", "--names", "time,gyro_x,gyro_y,gyro_z", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    assert 'format = "csv"' in (tmp_path / "gyrocomp.toml").read_text()
+    allan = run("allan", "gyro.mat", "--json", cwd=tmp_path)
+    assert allan.returncode == 0, allan.stderr
+    expected = allan_deviation(np.round(gyro[:, 0], 8), rate_hz).deviation
+    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_x"]["adev"], expected, rtol=1e-9)

@@ -11,10 +11,11 @@ from pathlib import Path
 import click
 
 from ..errors import InputError
-from ..io import refuse_to_overwrite_inputs, write_text_atomic
+from ..io import format_spelling, refuse_to_overwrite_inputs, write_text_atomic
+from ..io.project import FORMAT_KEY
 from ..io.guess import HeaderlessTable, guess_layout
 from ..io.serial import parse_names, parse_rate
-from .common import OUTPUT_FILE, make_console
+from .common import OUTPUT_FILE, click_option, make_console
 from .projectfile import PROJECT_FILE, PROJECT_KEY
 
 
@@ -42,8 +43,9 @@ def _toml_text(value) -> str:
     metavar="HZ",
     help="The rows' sample rate [Hz], for a table without a time column.",
 )
+@click_option("fmt", format_spelling())
 @click.pass_context
-def init(ctx, log, output, force, names, rate_hz):
+def init(ctx, log, output, force, names, rate_hz, fmt):
     """Write a project file for LOG's kind of table: its columns and units guessed from their names and
     magnitudes, said one by one, read by every command run in this folder (a file of named arrays, HDF5, MAT or
     .npz: the same from its arrays). A table without a header line (a serial terminal's log) needs its columns'
@@ -53,7 +55,7 @@ def init(ctx, log, output, force, names, rate_hz):
         raise InputError(f"{output}: exists; give --force to replace it, or -o another file")
     rate_hz = None if rate_hz is None else parse_rate(rate_hz)
     try:
-        guess = guess_layout(log, None if names is None else parse_names(names), rate_hz)
+        guess = guess_layout(log, None if names is None else parse_names(names), rate_hz, fmt)
     except HeaderlessTable as exc:
         if not sys.stdin.isatty():
             raise InputError(
@@ -68,7 +70,7 @@ def init(ctx, log, output, force, names, rate_hz):
         )
         if rate_hz is None and "time" not in parse_names(names):
             rate_hz = parse_rate(click.prompt("no time column: the rows' sample rate [Hz]"))
-        guess = guess_layout(log, parse_names(names), rate_hz)
+        guess = guess_layout(log, parse_names(names), rate_hz, fmt)
     layout = guess.layout
     lines = [
         f"# gyrocomp project file: written by `gyrocomp init {Path(log).name}` on "
@@ -82,6 +84,8 @@ def init(ctx, log, output, force, names, rate_hz):
     ]
     lines += [f"{channel} = {_toml_text(column)}" for channel, column in layout.columns.items()]
     read = {"gyro-unit": layout.gyro_unit, "accel-unit": layout.accel_unit, "time-unit": layout.time_unit}
+    if fmt is not None:  # a format the file's name does not tell (a text matrix named .mat): every command reads so
+        read[FORMAT_KEY] = fmt
     if layout.delimiter is not None:
         read["delimiter"] = "tab" if layout.delimiter == "\t" else layout.delimiter
     if layout.names is not None:

@@ -414,7 +414,9 @@ def _columns_timed(
     return columns, reasons, check
 
 
-def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | None = None) -> LayoutGuess:
+def guess_layout(
+    path, names: tuple[str, ...] | None = None, rate_hz: float | None = None, fmt: str | None = None
+) -> LayoutGuess:
     """Guess the column mapping and units of a CSV/TSV or Parquet table from its first ``GUESS_ROWS`` rows (see
     the module), or of a file of named arrays (HDF5/NetCDF, MAT-file, ``.npz``) from its arrays' names; refuses a
     file of another format, or one whose time or gyro columns cannot be told.
@@ -428,15 +430,17 @@ def guess_layout(path, names: tuple[str, ...] | None = None, rate_hz: float | No
         a table raises :class:`HeaderlessTable`, saying how many numbers its rows hold.
     rate_hz : float, optional
         The rows' nominal sample rate [Hz], for a table without a time column.
+    fmt : str, optional
+        The file's format (default: told from its name, then its first bytes): ``csv`` for a text table of
+        another name (MATLAB's ``save -ascii`` output named ``.mat``), ``parquet``, ``hdf5`` or ``mat``.
     """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
-    fmt = detect_table_format(path)
-    if fmt is None and names is None:
-        named = detect_format(path)
-        if named in _NAMED_ARRAYS:
-            return _guess_arrays(path, _NAMED_ARRAYS[named](path), rate_hz)
+    named = fmt if fmt is not None else None if names is not None else detect_table_format(path) or detect_format(path)
+    if named in _NAMED_ARRAYS and names is None:
+        return _guess_arrays(path, _NAMED_ARRAYS[named](path), rate_hz)
+    fmt = named if fmt is not None else detect_table_format(path)
     if fmt not in ("csv", "parquet"):
         raise InputError(
             f"{path}: not a CSV/TSV or Parquet table, nor a file of named arrays (HDF5, MAT, .npz); logs (ULog, "
