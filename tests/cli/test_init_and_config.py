@@ -497,3 +497,31 @@ def test_init_reads_a_text_matrix_named_mat_with_the_format_given_and_the_projec
     assert allan.returncode == 0, allan.stderr
     expected = allan_deviation(np.round(gyro[:, 0], 8), rate_hz).deviation
     np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_x"]["adev"], expected, rtol=1e-9)
+
+
+def test_an_array_of_two_triads_gives_its_first_and_an_index_for_a_time_is_pointed_out(tmp_path):
+    """Android keeps the calibrated and the uncalibrated gyro side by side ((n, 6), as scikit-diveMove's Galaxy S5
+    recording does): init maps the first triad by its columns and says so; an HDF5 reader then reads those columns
+    even though the whole array's name is one it would take for the gyro. A time of 0, 1, 2, ... is pointed out as
+    a sample index as often; with its period as the unit the curve is the samples' at 10 Hz."""
+    rng = np.random.default_rng(14)
+    n = 3000
+    calibrated, raw = 0.001 * rng.standard_normal((n, 3)), 0.02 + 0.001 * rng.standard_normal((n, 3))
+    with h5py.File(tmp_path / "phone.nc", "w") as f:
+        f["timestamp"] = np.arange(n, dtype=float)
+        f["angular_velocity"] = np.hstack([calibrated, raw])
+        f["acceleration"] = np.array([0.0, 0.2, 9.8]) + 0.01 * rng.standard_normal((n, 3))
+    guess = guess_layout(tmp_path / "phone.nc")
+    assert {c: guess.layout.columns[c] for c in ("gyro_x", "gyro_y", "gyro_z")} == {
+        f"gyro_{a}": f"angular_velocity[:, {k}]" for k, a in enumerate("xyz")
+    }
+    assert any("an (n, 6) array of 2 triads, the first taken" in r for r in guess.reasons), guess.reasons
+    assert any("whole numbers counting by one are a sample index as often" in r for r in guess.reasons)
+    assert run("init", "phone.nc", cwd=tmp_path).returncode == 0
+    project = tmp_path / "gyrocomp.toml"
+    project.write_text(project.read_text().replace('time-unit = "s"', 'time-unit = "100 ms"'))
+    allan = run("allan", "phone.nc", "--json", cwd=tmp_path)
+    assert allan.returncode == 0, allan.stderr
+    assert json.loads(allan.stdout)["rate_hz"] == pytest.approx(10.0)
+    expected = allan_deviation(np.degrees(calibrated[:, 2]), 10.0).deviation
+    np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_z"]["adev"], expected, rtol=1e-9)

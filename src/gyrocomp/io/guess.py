@@ -235,9 +235,13 @@ def _time_unit(name: str, values: np.ndarray) -> tuple[str, str]:
             return _TIME_UNIT_WORDS[word], f"time unit {_TIME_UNIT_WORDS[word]}: the column's name says so"
     steps = np.diff(values)
     period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else float("nan")
+    counted = steps.size > 0 and bool(np.all(steps == 1))
     for unit, factor in _TIME_FACTORS:
         if _PERIOD_RANGE_S[0] <= period * factor <= _PERIOD_RANGE_S[1]:
-            return unit, f"time unit {unit}: the median step {period:.4g} is {1 / (period * factor):.4g} Hz in {unit}"
+            why = f"time unit {unit}: the median step {period:.4g} is {1 / (period * factor):.4g} Hz in {unit}"
+            if counted:  # 0, 1, 2, ...: the samples' index as often as a time in s
+                why += " (check: whole numbers counting by one are a sample index as often; its period is then the unit, '100 ms' at 10 Hz)"
+            return unit, why
     return "s", f"time unit s: the median step {period:.4g} fits no usual rate; check it"
 
 
@@ -508,6 +512,13 @@ def _time_then_axes(values: np.ndarray) -> bool:
     return bool(rising[0] and not rising[1:].any())
 
 
+def _triads(values: np.ndarray) -> int:
+    """How many x, y, z triads an (n, 3k) array of numbers holds (0 for any other shape)."""
+    if values.ndim != 2 or values.shape[1] % 3 or not np.issubdtype(values.dtype, np.number):
+        return 0
+    return values.shape[1] // 3
+
+
 def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[str, tuple[str, np.ndarray]]]:
     """Channel -> array of each array named as a channel (an (n, 3) gyro or accelerometer array whole, an (n, 4)
     one of the time then the axes by its columns, one of one dimension per axis, the temperature, the time; a
@@ -523,6 +534,15 @@ def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[
             reasons.append(f"{kind} = {name!r}: {said}, an (n, 3) array")
             for k, axis in enumerate("xyz"):
                 flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+        elif kind in ("gyro", "accel") and _triads(values) > 1 and not {kind, f"{kind}_x"} & set(columns):
+            for k, axis in enumerate("xyz"):
+                columns[f"{kind}_{axis}"] = f"{name}[:, {k}]"
+                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+            reasons.append(
+                f"{kind}_x, _y, _z = {name!r} columns 0 to 2: {said}, an (n, {values.shape[1]}) array of "
+                f"{_triads(values)} triads, the first taken (check: Android keeps the calibrated one first, the "
+                "uncalibrated after it)"
+            )
         elif kind in ("gyro", "accel") and _time_then_axes(values) and not {kind, f"{kind}_x"} & set(columns):
             for k, axis in enumerate("xyz", start=1):
                 columns[f"{kind}_{axis}"] = f"{name}[:, {k}]"

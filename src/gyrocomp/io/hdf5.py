@@ -169,8 +169,9 @@ def _datasets(handle) -> list[str]:
 
 
 def _vector(handle, source: str, kind: str, axes: tuple[str, ...], mapping: dict[str, str]):
-    """The (n, k) channels of ``kind`` (gyro or accel) and their axis names, from one 2-D or several 1-D datasets."""
-    whole = _find(handle, source, kind, mapping)
+    """The (n, k) channels of ``kind`` (gyro or accel) and their axis names, from one 2-D or several 1-D datasets
+    (an axis mapped alone, ``gyro_x = "NAME[:, 0]"``, wins over a dataset found by its name for the whole)."""
+    whole = None if any(axis in mapping for axis in axes) else _find(handle, source, kind, mapping)
     if whole is not None:
         values = _numbers(whole, source)
         if values.ndim == 1:
