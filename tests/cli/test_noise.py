@@ -104,3 +104,32 @@ def test_noise_with_a_model_says_what_compensation_buys(tmp_path):
     assert ratio > 10
     both = run("noise", tmp_path / "c_2.csv", "--model", tmp_path / "m.json", "--dwells")
     assert both.returncode == 2 and "give --model or --dwells, not both" in both.stderr
+
+
+def test_noise_fits_the_ieee_952_model_on_the_taus_given_as_allan_does(static_log, tmp_path):
+    """noise's warnings advise --fit-taus (the taus where a term holds, past an anti-alias filter): the option is
+    noise's too, and its IEEE 952 figures are then allan's on the same taus; the bound does not change."""
+    log = static_log / "s.csv"
+    figures = {}
+    for fit in (None, "1,100"):
+        extra = ["--fit-taus", fit] if fit else []
+        done = run("noise", log, "--axes", "gyro_z", "--export", "json", "-o", tmp_path / "m.json", *extra)
+        assert done.returncode == 0, done.stderr
+        model = json.loads((tmp_path / "m.json").read_text())["axes"]["gyro_z"]
+        allan = run("allan", log, "--axes", "gyro_z", "--json", *extra)
+        assert allan.returncode == 0, allan.stderr
+        terms = json.loads(allan.stdout)["axes"]["gyro_z"]["noise"]
+        assert model["ieee_952"]["white_noise_density"] == pytest.approx(
+            terms["noise_density_dps_per_sqrt_hz"], rel=1e-12
+        )
+        assert model["ieee_952"]["bias_instability"] * 3600 == pytest.approx(
+            terms["bias_instability_deg_per_h"], rel=1e-12
+        )
+        figures[fit] = model
+    assert figures[None]["ieee_952"] != figures["1,100"]["ieee_952"]
+    assert figures[None]["bound"] == figures["1,100"]["bound"]
+    wrong = run("noise", log, "--fit-taus", "5,1")
+    assert (
+        wrong.returncode == 2
+        and "Invalid value for --fit-taus: use MIN,MAX in seconds with 0 < MIN < MAX" in wrong.stderr
+    )

@@ -12,7 +12,7 @@ from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..report.figures import allan_figure, check_figure_path
-from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
+from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, read_settings
 from .render import print_noise
 
 
@@ -28,18 +28,6 @@ def _parse_taus(text: str):
             "use octave, decade, all or a comma-separated list of taus [s], e.g. 1,10,100", param_hint="--taus"
         )
     return values
-
-
-def _parse_fit_taus(text: str | None):
-    if text is None:
-        return None
-    try:
-        low, high = (float(v) for v in text.split(","))
-    except ValueError:
-        low = high = -1.0
-    if not 0 < low < high:
-        raise click.BadParameter("use MIN,MAX in seconds with 0 < MIN < MAX, e.g. 3,1000", param_hint="--fit-taus")
-    return low, high
 
 
 @click.command()
@@ -60,20 +48,13 @@ def _parse_fit_taus(text: str | None):
     default=False,
     help="Pool the contiguous stretches of a log with time gaps instead of refusing it.",
 )
-@click.option(
-    "--fit-taus",
-    "fit_taus_s",
-    default=None,
-    metavar="MIN,MAX",
-    help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.",
-)
+@fit_taus_option()
 @read_options
 @click.pass_context
 def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopic, split_gaps, fit_taus_s, **kwargs):
     """Allan deviation with 68 % intervals and IEEE 952 noise terms (N, B, K, Q, R) of each axis of FILE."""
     opts = pop_read_options(kwargs)
     tau_spec = _parse_taus(taus)
-    fit_range = _parse_fit_taus(fit_taus_s)
     for option, path in (("--plot", plot_path), ("--kalibr", kalibr)):
         if path:
             refuse_to_overwrite_inputs(path, [input_path], option=option)
@@ -90,7 +71,7 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopi
             kind=kind,
             taus=tau_spec,
             split_gaps=split_gaps,
-            fit_taus_s=fit_range,
+            fit_taus_s=fit_taus_s,
             progress=progress,
         )
     if analysis.how and not ctx.obj["quiet"]:

@@ -86,6 +86,30 @@ READ_FIELDS = (
 READ_OPTIONS = tuple(name for name, _, _ in READ_FIELDS)
 
 
+def _fit_taus(ctx, param, text: str | None) -> tuple[float, float] | None:
+    if text is None:
+        return None
+    try:
+        low, high = (float(v) for v in text.split(","))
+    except ValueError:
+        low = high = -1.0
+    if not 0 < low < high:
+        raise click.BadParameter("use MIN,MAX in seconds with 0 < MIN < MAX, e.g. 3,1000", param_hint="--fit-taus")
+    return low, high
+
+
+def fit_taus_option():
+    """``--fit-taus MIN,MAX`` [s]: the taus the descriptive IEEE 952 noise fit uses (allan, noise)."""
+    return click.option(
+        "--fit-taus",
+        "fit_taus_s",
+        default=None,
+        metavar="MIN,MAX",
+        callback=_fit_taus,
+        help="Fit the noise model on taus in [MIN, MAX] s only, e.g. 3,1000 past an anti-alias filter.",
+    )
+
+
 def window_option():
     """``--window`` [s]: the moving average of the figures of merit (evaluate, report, plot)."""
     return click.option(

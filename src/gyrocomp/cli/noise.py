@@ -12,7 +12,7 @@ from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.inputs import expand_runs
 from ..measures.noise_model import noise_model, noise_over_temperature
-from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, read_run, read_settings
 from .render import print_bias_process_noise, print_noise_model
 
 
@@ -55,9 +55,10 @@ from .render import print_bias_process_noise, print_noise_model
     help="Each log is a chamber run: model the noise of each of its temperature dwells (the first 300 s "
     "of each left out, at least 600 s kept) and bound them all, with the per-temperature table.",
 )
+@fit_taus_option()
 @read_options
 @click.pass_context
-def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_path, dwells, **kwargs):
+def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_path, dwells, fit_taus_s, **kwargs):
     """Noise model of static LOGS for an estimator: white noise and random walk (and Gauss-Markov terms) whose Allan
     deviation is at or above the upper end of every log's 95 % interval at every averaging time, beside the IEEE
     952 fit."""
@@ -80,10 +81,11 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
             named,
             with_accel=named is None,
             split_gaps=split_gaps,
+            fit_taus_s=fit_taus_s,
         )
     elif dwells:
         model = noise_over_temperature(
-            [read_run(path, opts).recording for path in paths], named, with_accel=named is None
+            [read_run(path, opts).recording for path in paths], named, with_accel=named is None, fit_taus_s=fit_taus_s
         )
     else:
         analyses = []
@@ -97,6 +99,7 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
                         fmt=opts["fmt"],
                         with_accel=named is None,
                         split_gaps=split_gaps,
+                        fit_taus_s=fit_taus_s,
                         progress=progress,
                     )
                 )

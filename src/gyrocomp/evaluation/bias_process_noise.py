@@ -119,6 +119,7 @@ def compensated_noise(
     *,
     with_accel: bool = False,
     split_gaps: bool = False,
+    fit_taus_s: tuple[float, float] | None = None,
 ) -> tuple[NoiseModel, dict[str, BiasProcessNoise]]:
     """The noise model of the compensated gyro (what an estimator on the vehicle receives) and what the calibration
     buys its bias process noise (:func:`bias_process_noise`), on the same static runs.
@@ -135,13 +136,20 @@ def compensated_noise(
         Also model the accelerometer axes.
     split_gaps : bool
         Pool the contiguous stretches of runs with time gaps.
+    fit_taus_s : (float, float), optional
+        The taus the descriptive IEEE 952 fit uses [s] (:func:`gyrocomp.measures.noise.analyse_noise`).
     """
     runs = list(recordings)
     names = _gyro_axes(calibration, runs, [a for a in axes if a.startswith("gyro")] if axes else None)
     compensated = _compensated(calibration, runs)  # once, for both
     benefit = _bias_bounds(runs, compensated, names)
     model = noise_model(
-        [analyse_noise(r, axes, with_accel=with_accel, split_gaps=split_gaps, motion_check=False) for r in compensated]
+        [
+            analyse_noise(
+                r, axes, with_accel=with_accel, split_gaps=split_gaps, motion_check=False, fit_taus_s=fit_taus_s
+            )
+            for r in compensated
+        ]
     )
     return model, benefit
 

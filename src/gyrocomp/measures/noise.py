@@ -136,7 +136,7 @@ def warn_if_moving(source: str, found: StillDetection) -> None:
         warnings.warn(
             f"{source}: the log moves most of the time ({found.still_blocks[whole].mean():.0%} of it "
             "still): its Allan deviation and noise terms describe the motion, not the sensor's noise; "
-            "analyse a still stretch (time_range_s=) or the still poses (by=still)",
+            "analyse a still stretch (time_range_s=) or the still poses, split into runs of their own (split by still)",
             DataQualityWarning,
             stacklevel=3,
         )

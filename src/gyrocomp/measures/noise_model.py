@@ -356,6 +356,7 @@ def noise_over_temperature(
     with_accel: bool = False,
     settle_s: float = 300.0,
     min_duration_s: float = 600.0,
+    fit_taus_s: tuple[float, float] | None = None,
 ) -> NoiseModel:
     """The noise model of chamber runs' dwells (:func:`temperature_dwells`), each dwell a log at its mean
     temperature: the bound covers every dwell, and each dwell's own bound makes the per-temperature table.
@@ -370,6 +371,8 @@ def noise_over_temperature(
         Also model the accelerometer axes.
     settle_s, min_duration_s : float
         As :func:`temperature_dwells` [s].
+    fit_taus_s : (float, float), optional
+        The taus the descriptive IEEE 952 fit of each dwell uses [s] (:func:`gyrocomp.measures.noise.analyse_noise`).
     """
     pieces = []
     for recording in [recordings] if isinstance(recordings, Recording) else recordings:
@@ -382,7 +385,10 @@ def noise_over_temperature(
             )
         pieces += [recording.take(d) for d in dwells]
     analyses = [
-        analyse_noise(p, axes, with_accel=with_accel, motion_check=False, plausibility_check=False) for p in pieces
+        analyse_noise(
+            p, axes, with_accel=with_accel, motion_check=False, plausibility_check=False, fit_taus_s=fit_taus_s
+        )
+        for p in pieces
     ]
     named = [
         dataclasses.replace(a, source=f"{p.source} at {mean_temperature_degc(p):.1f} degC")
