@@ -424,22 +424,29 @@ def test_a_log_timed_by_dates_and_times_is_guessed_in_seconds_and_compensated_by
     assert (out["timestamp"] == stamps).all() and len(out) == n
 
 
-def test_init_refuses_a_chosen_column_of_text_in_one_line_naming_it(tmp_path):
-    """A line of units under the header makes the chosen columns text: init said so as an internal error (the
-    time's steps taken of no numbers); now one line naming the column and its first value, exit 2, no file."""
-    rows = "".join(f"{k / 100:.2f},0.1,0.2,0.3\n" for k in range(100))
-    (tmp_path / "units.csv").write_text("time,gyro_x,gyro_y,gyro_z\n[s],[deg/s],[deg/s],[deg/s]\n" + rows)
-    result = run("init", "units.csv", cwd=tmp_path)
-    assert result.returncode == 2 and not (tmp_path / "gyrocomp.toml").exists()
+def test_init_reads_a_line_of_units_under_the_header_and_refuses_a_chosen_column_of_text(tmp_path):
+    """Data acquisition tools write a line of units under the header: init reads the units from it (ms, rad/s,
+    m/s^2 here) and every command skips it, counting lines past it; a chosen column that holds text (not a line of
+    units: the same in every row) is one line naming it and its first value (it was an internal error), exit 2."""
+    rng = np.random.default_rng(15)
+    n = 2000
+    gyro_rad_s = np.radians(0.2 + 0.01 * rng.standard_normal((n, 3)))
+    rows = "".join(
+        f"{10 * k},{g[0]!r},{g[1]!r},{g[2]!r},0.01,-0.02,9.81,25.0\n" for k, g in enumerate(gyro_rad_s.tolist())
+    )
+    header = "time,gyro_x,gyro_y,gyro_z,accel_x,accel_y,accel_z,temperature\n"
+    (tmp_path / "daq.csv").write_text(header + "ms,rad/s,rad/s,rad/s,m/s^2,m/s^2,m/s^2,degC\n" + rows)
+    guess = guess_layout(tmp_path / "daq.csv")
+    assert (guess.layout.time_unit, guess.layout.gyro_unit, guess.layout.accel_unit) == ("ms", "rad/s", "m/s2")
+    assert any(r.startswith("a line of units under the header (ms, rad/s") for r in guess.reasons), guess.reasons
+    _init_then_allan_reads(tmp_path, "daq.csv", "gyro_y", np.degrees(gyro_rad_s[:, 1]), 100.0)
+    (tmp_path / "text.csv").write_text("t,gyro_z\n" + "".join(f"{k},off\n" for k in range(50)))
+    result = run("init", "text.csv", "-o", "text.toml", cwd=tmp_path)
+    assert result.returncode == 2 and not (tmp_path / "text.toml").exists()
     assert result.stderr.strip().splitlines() == [
-        "gyrocomp: error: units.csv: column 'time' (time) holds text, not numbers (its first value '[s]'): a line "
+        "gyrocomp: error: text.csv: column 'gyro_z' (gyro_z) holds text, not numbers (its first value 'off'): a line "
         "of units under the header, or a column of another kind? Remove the line, or map the channel to another column"
     ]
-    (tmp_path / "units.csv").write_text("t,gyro_z\n" + "".join(f"{k},off\n" for k in range(50)))
-    with pytest.raises(
-        InputError, match=r"units.csv: column 'gyro_z' \(gyro_z\) holds text, not numbers \(its first value 'off'\)"
-    ):
-        guess_layout(tmp_path / "units.csv")
 
 
 def test_a_table_of_aligned_columns_goes_through_init_fit_and_apply(tmp_path):

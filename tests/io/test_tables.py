@@ -27,7 +27,7 @@ from gyrocomp.io import (
 )
 from gyrocomp.io.guess import guess_layout
 from gyrocomp.io.stream import TableStream
-from gyrocomp.io.tables import SpacedText, TextFormat, preamble_lines, spaced_as_commas, text_encoding
+from gyrocomp.io.tables import SpacedText, TextFormat, preamble_lines, spaced_as_commas, text_encoding, units_line
 from gyrocomp.simulation import GyroErrorModel, simulate
 from gyrocomp.units import unit_factor
 
@@ -750,3 +750,60 @@ def test_a_table_of_spaces_gives_the_same_commas_whatever_the_blocks_it_is_read_
     read = SpacedText(io.BytesIO(text), block_bytes=block_bytes).read()
     assert read == spaced_as_commas(text)
     assert [line for line in re.split(rb"\r\n|\r|\n", read)[:-1]] == [",".join(f).encode() for f, _ in lines]
+
+
+@pytest.mark.parametrize(
+    "separator,units",
+    [(",", "s,deg/s,deg/s,degC"), (";", "[s];[°/s];[°/s];[°C]"), (" ", "  s    deg/s   deg/s   degC")],
+    ids=["commas", "semicolons-decimal-comma", "spaces"],
+)
+def test_a_line_of_units_under_the_header_is_skipped_whole_and_in_chunks_and_lines_counted_past_it(
+    tmp_path, separator, units
+):
+    """A line of units under the header (data acquisition tools write one) is told from its fields, none a number,
+    and skipped: the rows are the table's without it, whole and streamed, with a decimal comma and in a table of
+    spaces too; a bad value's line counts it; an output is written without it, as a preamble is."""
+    rng = np.random.default_rng(6)
+    n = 40
+    values = np.column_stack([np.arange(n) / 100.0, rng.normal(0, 0.1, (n, 2)), 25 + rng.random(n)]).tolist()
+    decimal = "," if separator == ";" else "."
+    rows = [separator.join(repr(v).replace(".", decimal) for v in row) for row in values]
+    names = separator.join(["time", "gyro_x", "gyro_z", "temperature"])
+    (tmp_path / "plain.csv").write_text(
+        "time,gyro_x,gyro_z,temperature\n" + "".join(f"{r}\n" for r in (",".join(map(repr, v)) for v in values))
+    )
+    (tmp_path / "units.csv").write_text("\n".join([names, units, *rows]) + "\n")
+    expected = read_table(tmp_path / "plain.csv").recording
+    data = read_table(tmp_path / "units.csv")
+    assert data.text_format.units is not None and len(data.text_format.units) == 4
+    assert data.recording.n_samples == n and data.text_format.decimal == decimal
+    chunks = list(TableStream(tmp_path / "units.csv", chunk_rows=7).chunks())
+    for gyro in (data.recording.gyro_dps, np.concatenate([c.recording.gyro_dps for c in chunks])):
+        np.testing.assert_array_equal(gyro, expected.gyro_dps)
+    write_gyro_back(data, data.recording.gyro_dps, tmp_path / "out.csv")
+    written = (tmp_path / "out.csv").read_text().splitlines()
+    assert len(written) == n + 1 and read_table(tmp_path / "out.csv").text_format.units is None
+    rows[9] = rows[9].replace(rows[9].split(separator)[1], "bad", 1)
+    (tmp_path / "units.csv").write_text("\n".join([names, units, *rows]) + "\n")
+    for reading in (
+        lambda: read_table(tmp_path / "units.csv"),
+        lambda: list(TableStream(tmp_path / "units.csv", chunk_rows=7).chunks()),
+    ):
+        with pytest.raises(InputError, match=r"units.csv: row 10 \(line 12\), column 'gyro_x': 'bad' is not a number"):
+            reading()
+    assert units_line(b"time,gyro_z\n0.0,1.5\n0.1,1.6\n", ",") is None  # the first row is numbers: no units
+    assert units_line(b"time,gyro_z,status\n0.0,1.5,OK\n0.1,1.6,OK\n", ",") is None  # text beside a number
+
+
+def test_a_bad_value_in_a_table_of_decimal_commas_is_named_not_the_first_number(tmp_path):
+    """One value that is no number makes its column text; the numbers around it keep their decimal commas, and the
+    message names the bad value's row (it named the first row's number, 0,5, as no number)."""
+    rows = [f"{k};{k / 2:.1f}".replace(".", ",") for k in range(20)]
+    rows[13] = "13;n.v."
+    (tmp_path / "de.csv").write_text("time;gyro_z\n" + "\n".join(rows) + "\n")
+    for reading in (
+        lambda: read_table(tmp_path / "de.csv"),
+        lambda: list(TableStream(tmp_path / "de.csv", chunk_rows=5).chunks()),
+    ):
+        with pytest.raises(InputError, match=r"de.csv: row 14 \(line 15\), column 'gyro_z': 'n.v.' is not a number"):
+            reading()

@@ -153,13 +153,14 @@ def _headerless_rows(head: bytes) -> tuple[int, str] | None:
     return count, lines[first][:MAX_LINE_BYTES]
 
 
-def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None, list[str]]:
-    """The first rows, the field separator (None for Parquet) and the preamble's lines (before the header)."""
+def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None, list[str], tuple[str, ...] | None]:
+    """The first rows, the field separator (None for Parquet), the preamble's lines (before the header) and the
+    fields of a line of units under the header (None without one)."""
     if fmt == "parquet":
         check_parquet_footer(path)
         parquet = pq.ParquetFile(path)
         first = parquet.read_row_group(0) if parquet.num_row_groups else parquet.read()
-        return first.slice(0, GUESS_ROWS), None, []
+        return first.slice(0, GUESS_ROWS), None, [], None
     source, head = _csv_bytes(path)
     if not head.strip():
         raise InputError(f"{path}: the file is empty; nothing to guess from")
@@ -183,7 +184,8 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None, list[str]]:
     except DECOMPRESS_ERRORS as exc:
         raise read_error(path, exc, head) from None
     preamble = head.decode("utf-8", "replace").split("\n")[: text.preamble_lines]
-    return pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS), text.delimiter, preamble
+    table = pa.Table.from_batches(batches, schema=reader.schema).slice(0, GUESS_ROWS)
+    return table, text.delimiter, preamble, text.units
 
 
 #: a preamble's line that states the sample rate: a key (Fs, rate, sample rate, update rate, ODR, frequency), a
@@ -212,6 +214,18 @@ def _numbers(table: pa.Table, column: str) -> np.ndarray | None:
     except (pa.ArrowInvalid, TypeError, ValueError):
         return None
     return values[np.isfinite(values)]
+
+
+def _with_units(
+    table: pa.Table, columns: dict[str, str], units: tuple[str, ...] | None
+) -> tuple[pa.Table, dict[str, str]]:
+    """The table and the channels' columns with each column's unit from a line of units appended to its name
+    (``gyro_x [rad/s]``), so that the units are guessed from them as from a name that says its unit."""
+    if units is None:
+        return table, columns
+    names = [f"{name} [{unit}]" if unit else name for name, unit in zip(table.column_names, units)]
+    renamed = dict(zip(table.column_names, names))
+    return table.rename_columns(names), {channel: renamed[column] for channel, column in columns.items()}
 
 
 def _require_numbers(path: Path, table: pa.Table, columns: dict[str, str]) -> None:
@@ -451,13 +465,16 @@ def guess_layout(
             "DataFlash, ROS bags) need no layout"
         )
     check = TableLayout(names=names, rate_hz=rate_hz)  # names and rate checked as every reader checks them
+    units = None
     if names is not None:
         table, delimiter, preamble = read_headerless(path, check.names, check.rate_hz).slice(0, GUESS_ROWS), None, []
     else:
-        table, delimiter, preamble = _sample(path, fmt)
+        table, delimiter, preamble, units = _sample(path, fmt)
     columns, reasons, check = _columns_timed(path, table, check, preamble)
     _require_numbers(path, table, columns)
-    time_unit, accel_unit, gyro_unit, why = _guessed_units(table, columns)
+    time_unit, accel_unit, gyro_unit, why = _guessed_units(*_with_units(table, columns, units))
+    if units is not None:
+        reasons.append(f"a line of units under the header ({', '.join(units)}): read for the units, not as a row")
     layout = TableLayout(
         columns,
         gyro_unit=gyro_unit,

@@ -32,7 +32,6 @@ from .tables import (
     DECOMPRESS_ERRORS,
     TableLayout,
     TextFormat,
-    header_line,
     _channel_selector,
     _csv_options,
     _read_arrow,
@@ -226,7 +225,7 @@ class TableStream:
                     self.fmt,
                     drop_nonfinite=self.drop_nonfinite,
                     first_row=first,
-                    header_line=header_line(self.text_format),
+                    text_format=self.text_format,
                 )
             self.rows_dropped += table.num_rows - kept.size
             time_s = recording.time_s

@@ -47,13 +47,15 @@ class TableData:
 class TextFormat:
     """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;``, a
     tab, or :data:`SPACE` for runs of spaces and tabs; ``decimal`` ``.`` or ``,``), how many lines before its header are a preamble that is skipped
-    (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`), and its text's encoding
-    (:func:`text_encoding`)."""
+    (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`), its text's encoding
+    (:func:`text_encoding`), and the fields of a line of units under its header, skipped (``units``:
+    :func:`units_line`; None without one)."""
 
     delimiter: str = ","
     decimal: str = "."
     preamble_lines: int = 0
     encoding: str = "utf-8"
+    units: tuple[str, ...] | None = None
 
     @classmethod
     def found(cls, head: bytes, layout: "TableLayout") -> "TextFormat":
@@ -64,7 +66,12 @@ class TextFormat:
         skipped = preamble_lines(head, delimiter)
         if skipped:  # the decimal point told from the first row after the header, not the preamble's
             decimal = sniff_csv(b"\n".join(head.split(b"\n")[skipped:]))[1]
-        return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head))
+        units = units_line(head, delimiter, skipped)
+        if units is not None:  # the decimal point told from the first row, not the units'
+            decimal = sniff_csv(
+                b"\n".join(head.split(b"\n")[skipped : skipped + 1] + head.split(b"\n")[skipped + 2 :])
+            )[1]
+        return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head), units)
 
     @property
     def spaced(self) -> bool:
@@ -88,7 +95,10 @@ class TextFormat:
         """pyarrow's reading options for this format: blocks of ``block_bytes`` [bytes] (default
         :data:`CSV_BLOCK_BYTES`), the preamble skipped, the text decoded."""
         return pacsv.ReadOptions(
-            block_size=block_bytes or CSV_BLOCK_BYTES, skip_rows=self.preamble_lines, encoding=self.encoding
+            block_size=block_bytes or CSV_BLOCK_BYTES,
+            skip_rows=self.preamble_lines,
+            skip_rows_after_names=0 if self.units is None else 1,
+            encoding=self.encoding,
         )
 
 
@@ -163,8 +173,11 @@ def text_encoding(head: bytes) -> str:
 
 
 def header_line(text_format: TextFormat | None) -> int:
-    """The line of a table's header (1-based): after a text table's preamble; 1 for Parquet (no lines)."""
-    return 1 + (text_format.preamble_lines if text_format is not None else 0)
+    """The line just before a table's first row (1-based): its header's, after a text table's preamble, or the line
+    of units under it; 1 for Parquet (no lines)."""
+    if text_format is None:
+        return 1
+    return 1 + text_format.preamble_lines + (text_format.units is not None)
 
 
 def output_text_format(path: str | os.PathLike, source: TextFormat | None = None) -> TextFormat:
@@ -175,7 +188,11 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
     name = Path(path).name.lower()
     for compressed in COMPRESSED_SUFFIXES:
         name = name.removesuffix(compressed)
-    base = dataclasses.replace(source, preamble_lines=0, encoding="utf-8") if source is not None else TextFormat()
+    base = (
+        dataclasses.replace(source, preamble_lines=0, encoding="utf-8", units=None)
+        if source is not None
+        else TextFormat()
+    )
     if name.endswith(".tsv"):
         return TextFormat("\t", base.decimal)
     return base if base.delimiter != "," or base.decimal == "." else TextFormat()
@@ -361,6 +378,29 @@ def fields_of(line: str, delimiter: str) -> list[str]:
     return next(csv.reader([line.rstrip("\r")], delimiter=delimiter), [])
 
 
+def _is_number(text: str) -> bool:
+    """Whether a field is a number (a decimal comma too)."""
+    try:
+        float(text.strip().strip('"').replace(",", ".", 1))
+    except ValueError:
+        return False
+    return True
+
+
+def units_line(head: bytes, delimiter: str, preamble: int = 0) -> tuple[str, ...] | None:
+    """The fields of a line of units right under a text table's header (``s;deg/s;deg/s;degC``, as data
+    acquisition tools write one), from the table's first bytes ``head`` (lines ended by ``\\n``) after ``preamble``
+    lines; None where there is none: the line splits into as many fields as the header, none of them a number and
+    one at least not empty, and the line after it holds a number."""
+    lines = head.decode("utf-8", "replace").split("\n")[:-1]
+    if len(lines) < preamble + 3:
+        return None
+    names, units, row = (fields_of(lines[preamble + k], delimiter) for k in range(3))
+    if len(units) != len(names) or not any(u.strip() for u in units) or any(_is_number(u) for u in units if u.strip()):
+        return None
+    return tuple(u.strip() for u in units) if any(_is_number(x) for x in row) else None
+
+
 #: the most lines before a text table's header skipped as its preamble
 MAX_PREAMBLE_LINES = 50
 
@@ -493,9 +533,13 @@ def _chunk_numbers(chunk: pa.Array) -> np.ndarray:
     return values
 
 
-def _numeric_column(table: pa.Table, column: str, source: Path, first_row: int = 0, header_line: int = 1) -> np.ndarray:
+def _numeric_column(
+    table: pa.Table, column: str, source: Path, first_row: int = 0, header_line: int = 1, decimal: str = "."
+) -> np.ndarray:
     """A column as float64; a value that is no number is one line naming its row in the file (the table's rows
-    after ``first_row`` of them) and its line (the header on ``header_line``, 1-based)."""
+    after ``first_row`` of them) and its line (the line before the first row is ``header_line``, 1-based). A
+    column read as text because one value is no number keeps its numbers' ``decimal`` point (a comma), so that
+    the message names that value, not the first number."""
     array = table.column(column)
     if pa.types.is_floating(array.type) or pa.types.is_integer(array.type):
         return _to_numpy(array).astype(float, copy=False)
@@ -514,7 +558,7 @@ def _numeric_column(table: pa.Table, column: str, source: Path, first_row: int =
             out[i] = np.nan
             continue
         try:
-            out[i] = float(value)
+            out[i] = float(value.replace(",", ".", 1) if decimal == "," and isinstance(value, str) else value)
         except (TypeError, ValueError):
             row = first_row + i + 1
             raise InputError(
@@ -530,7 +574,13 @@ _TIME_OF_DAY = re.compile(r"\s*\d{1,2}:\d{2}:\d{2}(\.\d+)?\s*")
 
 
 def time_column_s(
-    table: pa.Table, column: str, time_unit: str, source: Path, first_row: int = 0, header_line: int = 1
+    table: pa.Table,
+    column: str,
+    time_unit: str,
+    source: Path,
+    first_row: int = 0,
+    header_line: int = 1,
+    decimal: str = ".",
 ) -> np.ndarray:
     """The time column [s]: numbers in ``time_unit``; dates with times (ISO 8601 such as ``2024-05-01
     12:00:00.010`` or ``...T12:00:00.010Z``, which pyarrow reads as timestamps; Parquet's timestamps) as seconds
@@ -540,7 +590,7 @@ def time_column_s(
     array = table.column(column)
     clock = _clock_s(array, source, column, first_row, header_line)
     if clock is None:
-        return _numeric_column(table, column, source, first_row, header_line) * unit_factor(
+        return _numeric_column(table, column, source, first_row, header_line, decimal) * unit_factor(
             "time", time_unit, "time_unit"
         )
     if unit_factor("time", time_unit, "time_unit") != 1.0:
@@ -752,7 +802,7 @@ def read_table(
         raise InputError(f"{path}: a header but no data rows")
     cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
     recording, kept = table_recording(
-        table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite, header_line=header_line(text_format)
+        table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite, text_format=text_format
     )
     if recording.gaps:
         longest = recording.gaps.longest()
@@ -774,22 +824,25 @@ def table_recording(
     *,
     drop_nonfinite: bool = False,
     first_row: int = 0,
-    header_line: int = 1,
+    text_format: TextFormat | None = None,
 ) -> tuple[Recording, np.ndarray]:
     """The recording [s, deg/s, g, degC] of a table's rows (``cols``: channel -> column) and the indices of the
     rows kept in it (all, or those with every used value finite when ``drop_nonfinite``; a warning says how many
-    went). ``first_row``: the table's first row in its file (0-based), and ``header_line`` the line of a text
-    table's header (1-based: after its preamble), for the row and line numbers in messages. Used by
-    :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for each chunk."""
+    went). ``first_row``: the table's first row in its file (0-based), and ``text_format`` a text table's (None for
+    Parquet): the line before its rows (:func:`header_line`) for the row and line numbers in messages, and its
+    decimal point. Used by :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for
+    each chunk."""
+    line = header_line(text_format)
+    decimal = text_format.decimal if text_format is not None else "."
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
     accel_axes = tuple(a for a in ACCEL_AXES if a in cols)
     temp_names = _temperature_columns(cols, gyro_axes)
     gyro_factor = unit_factor("gyro", layout.gyro_unit, "gyro_unit")
-    num = lambda name: _numeric_column(table, cols[name], path, first_row, header_line)  # noqa: E731
+    num = lambda name: _numeric_column(table, cols[name], path, first_row, line, decimal)  # noqa: E731
     if cols[TIME_COLUMN] == NOMINAL_TIME:  # a table without time, at a nominal rate
         time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
     else:
-        time_s = time_column_s(table, cols[TIME_COLUMN], layout.time_unit, path, first_row, header_line)
+        time_s = time_column_s(table, cols[TIME_COLUMN], layout.time_unit, path, first_row, line, decimal)
     gyro = np.column_stack([num(a) for a in gyro_axes])
     gyro *= gyro_factor  # in place: a long table's columns are not copied twice
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
