@@ -532,3 +532,21 @@ def test_an_array_of_two_triads_gives_its_first_and_an_index_for_a_time_is_point
     assert json.loads(allan.stdout)["rate_hz"] == pytest.approx(10.0)
     expected = allan_deviation(np.degrees(calibrated[:, 2]), 10.0).deviation
     np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_z"]["adev"], expected, rtol=1e-9)
+
+
+def test_pandas_index_column_is_left_unused_and_said_so(tmp_path):
+    """pandas' to_csv writes its index as a first column with an empty name: init leaves it unused and says so
+    visibly, and apply writes it back as it was."""
+    n = 300
+    frame = pd.DataFrame(
+        {"time": np.arange(n) / 100.0, "gyro_z": np.full(n, 0.1), "temperature": np.linspace(20, 30, n)}
+    )
+    frame.to_csv(tmp_path / "df.csv")
+    made = run("init", "df.csv", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    assert "  columns not used: '' (unnamed)" in made.stdout.splitlines()
+    assert run("fit", "df.csv", "-o", "m.json", "--temperature", "poly:1", cwd=tmp_path).returncode == 0
+    applied = run("apply", "m.json", "df.csv", "-o", "out.csv", cwd=tmp_path)
+    assert applied.returncode == 0, applied.stderr
+    assert (tmp_path / "out.csv").read_text().splitlines()[:2][0] == ",time,gyro_z,temperature"
+    assert pd.read_csv(tmp_path / "out.csv", index_col=0).index.tolist() == list(range(n))

@@ -15,7 +15,7 @@ from ..io import format_spelling, refuse_to_overwrite_inputs, write_text_atomic
 from ..io.project import FORMAT_KEY
 from ..io.guess import HeaderlessTable, guess_layout
 from ..io.serial import parse_names, parse_rate
-from .common import OUTPUT_FILE, click_option, make_console
+from .common import OUTPUT_FILE, make_console
 from .projectfile import PROJECT_FILE, PROJECT_KEY
 
 
@@ -43,7 +43,7 @@ def _toml_text(value) -> str:
     metavar="HZ",
     help="The rows' sample rate [Hz], for a table without a time column.",
 )
-@click_option("fmt", format_spelling())
+@click.option("--format", "fmt", default=None, help=format_spelling().help)
 @click.pass_context
 def init(ctx, log, output, force, names, rate_hz, fmt):
     """Write a project file for LOG's kind of table: its columns and units guessed from their names and
@@ -101,7 +101,9 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
         for reason in guess.reasons:
             click.echo(f"  {reason}")
         if guess.unused:
-            click.echo(f"  columns not used: {', '.join(guess.unused)}")
+            click.echo(
+                f"  columns not used: {', '.join(n if n.strip() else repr(n) + ' (unnamed)' for n in guess.unused)}"
+            )
         click.echo("check the units above; then e.g. gyrocomp fit " + Path(log).name + " -o model.json")
 
 
