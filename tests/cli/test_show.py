@@ -50,3 +50,8 @@ def test_quiet_prints_only_errors(tmp_path):
     assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
     failed = run("-q", "fit", tmp_path / "nope.csv", "-o", tmp_path / "m3.json")
     assert failed.returncode == 2 and failed.stderr.startswith("gyrocomp: error:")
+    # evaluate printed its tables, and its note that the file was fitted on, under -q
+    for args in (["evaluate", tmp_path / "m.json", tmp_path / "c.csv"], ["allan", tmp_path / "c.csv"]):
+        quiet = run("-q", *args)
+        assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == "", args
+        assert run(*args).stdout  # without -q: the tables

@@ -108,7 +108,7 @@ def evaluate(
     evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
     expected = calibration.report.expected_drift()
     in_sample = [str(path) for path in runs if calibration.fitted_on(path)]
-    for path in in_sample:
+    for path in in_sample if not quiet else ():
         click.echo(
             f"gyrocomp: note: {path}: the model was fitted on this file, so its figures are in-sample; on new "
             "data expect the held-out drift the model file states (gyrocomp show)",
@@ -118,10 +118,10 @@ def evaluate(
         document = {**evaluation.to_dict(), "in_sample_files": in_sample}
         document["expected_held_out_drift"] = [e.to_dict() for e in expected.values()]
         click.echo(json.dumps(document, indent=2))
-    else:
+    elif not quiet:
         print_evaluation(evaluation)
         print_expected_drift(expected)
-        if turn_on_window_s is not None and not quiet:
+        if turn_on_window_s is not None:
             click.echo(
                 f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
                 "its first seconds; bias offset, bias instability and integration time do not depend on a "
