@@ -351,8 +351,17 @@ def test_phone_app_exports_phyphox_quoted_names_and_sensor_loggers_bare_axes(tmp
     }
     assert logger.layout.columns["time"] == "time" and logger.layout.time_unit == "ns"
     (tmp_path / "Accelerometer.csv").write_text("time,seconds_elapsed,z,y,x\n" + "\n".join(rows) + "\n")
-    with pytest.raises(InputError, match=r"Accelerometer.csv: no column looks like a gyro axis"):
+    with pytest.raises(
+        InputError,
+        match=r"Accelerometer.csv: no column looks like a gyro axis.*; it holds the accelerometer without the gyro "
+        r"\(a logger's file per sensor\): gyrocomp reads a log's channels from one file",
+    ):
         guess_layout(tmp_path / "Accelerometer.csv")
+    np.savez(tmp_path / "sensors.npz", accelBuffer=np.zeros((10, 4)), temperatureBuffer=np.zeros((10, 2)))
+    with pytest.raises(
+        InputError, match=r"sensors.npz: no array .*; it holds the accelerometer and the temperature without"
+    ):
+        guess_layout(tmp_path / "sensors.npz")
 
 
 def test_a_command_that_cannot_find_the_columns_points_to_init(tmp_path):

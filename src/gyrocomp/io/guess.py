@@ -286,7 +286,7 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
     if not any(c.startswith("gyro_") for c in columns):
         raise InputError(
             f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
-            f"its columns are {', '.join(names)}"
+            f"its columns are {', '.join(names)}{_one_sensor_hint([*names, path.stem])}"
         )
     if rate_hz is not None:
         reasons.insert(0, f"time: row n at n / {rate_hz:g} s (the rate given; the table has no time column)")
@@ -599,16 +599,30 @@ def _stated_array_rate(store: ArrayStore) -> tuple[float, str] | None:
     return None
 
 
+def _one_sensor_hint(names: list[str]) -> str:
+    """For a file without a gyro whose names (its columns' or arrays', its own) say the accelerometer or the
+    temperature: that a log's channels are read from one file (a logger that writes a file per sensor)."""
+    kinds = [k for k in ("accel", "temperature") if k in {_kind(n) for n in names}]
+    if not kinds:
+        return ""
+    held = " and the ".join("accelerometer" if k == "accel" else k for k in kinds)
+    return (
+        f"; it holds the {held} without the gyro (a logger's file per sensor): gyrocomp reads a log's channels from "
+        "one file, so join the sensors' files into one table first"
+    )
+
+
 def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> LayoutGuess:
     """The layout of a file of named arrays: the channels from the arrays' names (:func:`_array_channels`), the
     units from the names and the magnitudes as for a table's columns (a column k of an array is ``NAME[:, k]``)."""
     columns, reasons, flat = _array_channels(store)
     if not any(c == "gyro" or c.startswith("gyro_") for c in columns):
         shapes = ", ".join(f"{n} {tuple(a.shape)}" for n, a in store.items())
+        alone = _one_sensor_hint([n.rsplit("/", 1)[-1] for n in store] + [path.stem])
         raise InputError(
             f"{path}: no array looks like the gyro (a name with gyr, omega or rate: an (n, 3) array, an (n, 4) one "
             f"of the time then x, y, z, or one per axis named with x, y or z); its arrays are {shapes}: map them "
-            'in a project file\'s [read.columns] (gyro_x = "NAME[:, k]" for column k of an array)'
+            f'in a project file\'s [read.columns] (gyro_x = "NAME[:, k]" for column k of an array){alone}'
         )
     stated = _stated_array_rate(store) if "time" not in columns and rate_hz is None else None
     if stated is not None:
