@@ -27,7 +27,7 @@ from gyrocomp.io import (
 )
 from gyrocomp.io.guess import guess_layout
 from gyrocomp.io.stream import TableStream
-from gyrocomp.io.tables import SpacedText, TextFormat, preamble_lines, spaced_as_commas, text_encoding, units_line
+from gyrocomp.io.tables import SpacedText, TextFormat, preamble_lines, spaced_as_fields, text_encoding, units_line
 from gyrocomp.simulation import GyroErrorModel, simulate
 from gyrocomp.units import unit_factor
 
@@ -748,8 +748,8 @@ def test_a_table_of_spaces_gives_the_same_commas_whatever_the_blocks_it_is_read_
     whole text read at once; each line's fields joined by single commas."""
     text = "".join(gaps[0] + "".join(f + g for f, g in zip(fields, gaps[1:])) + end for fields, gaps in lines).encode()
     read = SpacedText(io.BytesIO(text), block_bytes=block_bytes).read()
-    assert read == spaced_as_commas(text)
-    assert [line for line in re.split(rb"\r\n|\r|\n", read)[:-1]] == [",".join(f).encode() for f, _ in lines]
+    assert read == spaced_as_fields(text)
+    assert [line for line in re.split(rb"\r\n|\r|\n", read)[:-1]] == [";".join(f).encode() for f, _ in lines]
 
 
 @pytest.mark.parametrize(
@@ -807,3 +807,20 @@ def test_a_bad_value_in_a_table_of_decimal_commas_is_named_not_the_first_number(
     ):
         with pytest.raises(InputError, match=r"de.csv: row 14 \(line 15\), column 'gyro_z': 'n.v.' is not a number"):
             reading()
+
+
+def test_a_table_of_spaces_with_decimal_commas_reads_its_numbers(tmp_path):
+    """Columns aligned by spaces with decimal commas (a locale's text export): told from the first lines, which
+    all split by spaces alike (the commas are no separator), and read with the comma as the decimal point."""
+    rows = [f"  {k / 100:8.2f}   {0.5 + k / 1000:9.4f}   {25 + k / 10:7.2f}".replace(".", ",") for k in range(30)]
+    (tmp_path / "de.txt").write_text("    time     gyro_z   temperature\n" + "\n".join(rows) + "\n")
+    data = read_table(tmp_path / "de.txt")
+    assert (data.text_format.delimiter, data.text_format.decimal) == (" ", ",")
+    np.testing.assert_allclose(data.recording.gyro_dps[:, 0], 0.5 + np.arange(30) / 1000, rtol=1e-12)
+    chunks = list(TableStream(tmp_path / "de.txt", chunk_rows=7).chunks())
+    np.testing.assert_array_equal(np.concatenate([c.recording.time_s for c in chunks]), data.recording.time_s)
+    # a preamble of spaced words before a tab-separated header is no table of spaces
+    preamble = "// Start Time: 2024 05 01\n// Update Rate: 100.0Hz\n// Filter Profile: human (46.1)\n"
+    body = "time\tgyro_z\n" + "".join(f"{k / 100}\t0.5\n" for k in range(30))
+    (tmp_path / "mt.txt").write_text(preamble + body)
+    assert read_table(tmp_path / "mt.txt").text_format.delimiter == "\t"

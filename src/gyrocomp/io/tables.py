@@ -76,17 +76,18 @@ class TextFormat:
     @property
     def spaced(self) -> bool:
         """Whether fields are separated by runs of spaces and tabs (:data:`SPACE`), read through
-        :class:`SpacedText` as commas."""
+        :class:`SpacedText` as separated by :data:`SPACED_AS` (a decimal comma stays a decimal comma)."""
         return self.delimiter == SPACE
 
     def parse_options(self) -> pacsv.ParseOptions:
-        """pyarrow's parsing options for this format (a comma for a table of spaces, which :meth:`source` gives it
-        as commas)."""
-        return pacsv.ParseOptions(delimiter="," if self.spaced else self.delimiter)
+        """pyarrow's parsing options for this format (:data:`SPACED_AS` for a table of spaces, which :meth:`source`
+        gives it so)."""
+        return pacsv.ParseOptions(delimiter=SPACED_AS if self.spaced else self.delimiter)
 
     def source(self, path: Path, source):
         """What pyarrow reads of the table at ``path``: ``source`` (its bytes, decompressed), or for a table of
-        spaces the same bytes with each run of spaces and tabs between fields made one comma (:class:`SpacedText`)."""
+        spaces the same bytes with each run of spaces and tabs between fields made one :data:`SPACED_AS`
+        (:class:`SpacedText`)."""
         if not self.spaced:
             return source
         return pa.PythonFile(SpacedText(open_csv_bytes(path, csv_codec(path))), mode="r")
@@ -105,19 +106,21 @@ class TextFormat:
 #: the delimiter of a table whose fields are separated by runs of spaces and tabs (columns aligned by padding, as
 #: Fortran, MATLAB's ``save -ascii`` and many instruments write them)
 SPACE = " "
+#: what a run of spaces between fields is read as: a semicolon, so that a decimal comma (``0,25   1,5``) stays one
+SPACED_AS = ";"
 #: runs of spaces and tabs at a line's start or end, and between fields
 _EDGE_SPACES = re.compile(rb"(?:^|(?<=[\r\n]))[ \t]+|[ \t]+(?=[\r\n]|\Z)")
 _INNER_SPACES = re.compile(rb"[ \t]+")
 
 
-def spaced_as_commas(text: bytes) -> bytes:
-    """Complete lines of a table of spaces with each run of spaces and tabs between fields made one comma, those at
-    a line's start and end removed."""
-    return _INNER_SPACES.sub(b",", _EDGE_SPACES.sub(b"", text))
+def spaced_as_fields(text: bytes) -> bytes:
+    """Complete lines of a table of spaces with each run of spaces and tabs between fields made one
+    :data:`SPACED_AS`, those at a line's start and end removed."""
+    return _INNER_SPACES.sub(SPACED_AS.encode(), _EDGE_SPACES.sub(b"", text))
 
 
 class SpacedText(io.RawIOBase):
-    """A table of spaces read as one of commas (:func:`spaced_as_commas`), a block of lines at a time: the bytes
+    """A table of spaces read as one of :data:`SPACED_AS` (:func:`spaced_as_fields`), a block of lines at a time: the bytes
     after a block's last line end wait for the next block, so that a run of spaces is never cut in two.
 
     Parameters
@@ -139,11 +142,11 @@ class SpacedText(io.RawIOBase):
         while not self._out and not self._ended:
             block = self._raw.read(self._block)
             if not block:
-                self._out, self._rest, self._ended = spaced_as_commas(self._rest), b"", True
+                self._out, self._rest, self._ended = spaced_as_fields(self._rest), b"", True
                 break
             text = self._rest + block
             end = max(text.rfind(b"\n"), text.rfind(b"\r")) + 1
-            self._out, self._rest = spaced_as_commas(text[:end]), text[end:]
+            self._out, self._rest = spaced_as_fields(text[:end]), text[end:]
         n = min(len(buffer), len(self._out))
         buffer[:n] = self._out[:n]
         self._out = self._out[n:]
@@ -343,13 +346,12 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
     data row has one."""
     lines = head.decode("utf-8", errors="replace").splitlines()
     header = lines[0] if lines else ""
-    if not any(d in header for d in DELIMITERS):  # a preamble's first line (// Start Time: ...): the first with one
+    aligned = not any(d in header for d in DELIMITERS) and _aligned(lines[:-1][:5])
+    if not aligned and not any(d in header for d in DELIMITERS):  # a preamble's first line (// Start Time: ...)
         header = next((line for line in lines[1:] if any(d in line for d in DELIMITERS)), header)
     delimiter = max(DELIMITERS, key=lambda d: (header.count(d), d == ","))
     at = lines.index(header) if header in lines else 0
-    if _spaced(lines[at : at + 2]) and (
-        not any(d in header for d in DELIMITERS) or not _same_fields(lines[at : at + 2], delimiter)
-    ):
+    if aligned or (_spaced(lines[at : at + 2]) and not _same_fields(lines[at : at + 2], delimiter)):
         delimiter = SPACE  # fields aligned by spaces (and tabs among them, which do not split the rows alike)
     decimal = "."
     if delimiter != "," and len(lines) > 1:
@@ -357,6 +359,14 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
         if any(c.replace("-", "", 1).replace(",", "", 1).isdigit() and "," in c for c in cells):
             decimal = ","
     return delimiter, decimal
+
+
+def _aligned(lines: list[str]) -> bool:
+    """Whether a table's first lines (a header with no comma, semicolon or tab, and rows: a decimal comma is no
+    separator there) split by runs of spaces into the same number of fields, at least two: a table of spaces, not
+    a preamble before another table's header (``// Start Time: ...``, whose lines split otherwise)."""
+    counts = {len(fields_of(line, SPACE)) for line in lines}
+    return len(lines) >= 2 and len(counts) == 1 and counts.pop() >= 2
 
 
 def _spaced(lines: list[str]) -> bool:
@@ -450,7 +460,7 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
         try:
             if select is not None:  # the header's names, from its line
                 names_line = head.split(b"\n")[text.preamble_lines]
-                names_line = spaced_as_commas(names_line) if text.spaced else names_line
+                names_line = spaced_as_fields(names_line) if text.spaced else names_line
                 header = pacsv.read_csv(
                     pa.py_buffer(names_line + b"\n"),
                     read_options=pacsv.ReadOptions(encoding=text.encoding),
