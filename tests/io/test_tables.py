@@ -824,3 +824,18 @@ def test_a_table_of_spaces_with_decimal_commas_reads_its_numbers(tmp_path):
     body = "time\tgyro_z\n" + "".join(f"{k / 100}\t0.5\n" for k in range(30))
     (tmp_path / "mt.txt").write_text(preamble + body)
     assert read_table(tmp_path / "mt.txt").text_format.delimiter == "\t"
+
+
+@pytest.mark.parametrize("chunk_rows", [7, 10, 1000])
+def test_times_of_day_run_on_past_midnight_whole_and_in_chunks(tmp_path, chunk_rows):
+    """An overnight chamber run stamped with the time of day: after 23:59:59.99 comes 00:00:00.00, read as the next
+    day's (the samples run on by 10 ms), whole and streamed, midnight inside a chunk or between two."""
+    n = 60
+    seconds = 86_400.0 - 0.3 + np.arange(n) / 100.0
+    texts = [f"{int(t // 3600) % 24:02d}:{int(t % 3600 // 60):02d}:{t % 60:06.3f}" for t in seconds]
+    (tmp_path / "night.csv").write_text("time,gyro_z\n" + "".join(f"{t},0.1\n" for t in texts))
+    whole = read_table(tmp_path / "night.csv").recording
+    np.testing.assert_allclose(whole.time_s, seconds, rtol=0, atol=1e-9)
+    chunks = list(TableStream(tmp_path / "night.csv", chunk_rows=chunk_rows).chunks())
+    np.testing.assert_array_equal(np.concatenate([c.recording.time_s for c in chunks]), whole.time_s)
+    assert texts[29:32] == ["23:59:59.990", "00:00:00.000", "00:00:00.010"]

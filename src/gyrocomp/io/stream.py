@@ -226,6 +226,7 @@ class TableStream:
                     drop_nonfinite=self.drop_nonfinite,
                     first_row=first,
                     text_format=self.text_format,
+                    time_after_s=None if last is None else last[0],
                 )
             self.rows_dropped += table.num_rows - kept.size
             time_s = recording.time_s

@@ -591,14 +591,16 @@ def time_column_s(
     first_row: int = 0,
     header_line: int = 1,
     decimal: str = ".",
+    after_s: float | None = None,
 ) -> np.ndarray:
     """The time column [s]: numbers in ``time_unit``; dates with times (ISO 8601 such as ``2024-05-01
     12:00:00.010`` or ``...T12:00:00.010Z``, which pyarrow reads as timestamps; Parquet's timestamps) as seconds
-    since 1970-01-01 UTC; times of day (``12:00:00.010``) as seconds since midnight (a log that runs past midnight
-    then goes back in time, and is refused as such). A column of dates and times has its unit in it: a
-    ``time_unit`` other than s is refused for it. Messages name the row and line as :func:`_numeric_column`'s."""
+    since 1970-01-01 UTC; times of day (``12:00:00.010``) as seconds since the first day's midnight, running on
+    past midnight (``after_s``: the time of the row before, for a chunk after another [s]). A column of dates and
+    times has its unit in it: a ``time_unit`` other than s is refused for it. Messages name the row and line as
+    :func:`_numeric_column`'s."""
     array = table.column(column)
-    clock = _clock_s(array, source, column, first_row, header_line)
+    clock = _clock_s(array, source, column, first_row, header_line, after_s)
     if clock is None:
         return _numeric_column(table, column, source, first_row, header_line, decimal) * unit_factor(
             "time", time_unit, "time_unit"
@@ -624,14 +626,37 @@ def holds_clock(array: pa.ChunkedArray | pa.Array) -> bool:
     return first is not None and _TIME_OF_DAY.fullmatch(first) is not None
 
 
-def _clock_s(array: pa.ChunkedArray, source: Path, column: str, first_row: int, header_line: int) -> np.ndarray | None:
-    """A column of timestamps [s since 1970-01-01 UTC] or times of day [s since midnight]; None for any other."""
+def _clock_s(
+    array: pa.ChunkedArray, source: Path, column: str, first_row: int, header_line: int, after_s: float | None = None
+) -> np.ndarray | None:
+    """A column of timestamps [s since 1970-01-01 UTC] or times of day [s since midnight, run on past it:
+    :func:`_past_midnight`]; None for any other."""
     kind = array.type
-    if pa.types.is_timestamp(kind) or pa.types.is_time(kind):
+    if pa.types.is_timestamp(kind):
+        return _to_numpy(array.cast(pa.int64())) * _CLOCK_UNIT_S[kind.unit]
+    if pa.types.is_time(kind):
         whole = pa.int64() if kind.bit_width == 64 else pa.int32()
-        return _to_numpy(array.cast(whole)) * _CLOCK_UNIT_S[kind.unit]
+        return _past_midnight(_to_numpy(array.cast(whole)) * _CLOCK_UNIT_S[kind.unit], after_s)
     if not holds_clock(array):
         return None
+    return _past_midnight(_times_of_day(array, source, column, first_row, header_line), after_s)
+
+
+def _times_of_day(array: pa.ChunkedArray, source: Path, column: str, first_row: int, header_line: int) -> np.ndarray:
+    """Text times of day (``hh:mm:ss.fff``) as seconds since midnight [s] (nulls NaN): split and converted by Arrow
+    at once, value by value only where that fails, to name the row that is no time of day."""
+    import pyarrow.compute as pc  # loaded only for a column of times of day (70 ms)
+
+    parts = pc.split_pattern(array, ":")
+    if pc.all(pc.equal(pc.list_value_length(parts), 3)).as_py() is not False:
+        try:
+            hms = _to_numpy(pc.list_flatten(parts).cast(pa.float64())).reshape(-1, 3)
+        except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+            hms = None
+        if hms is not None and np.all(hms[:, :2] == np.round(hms[:, :2])):
+            out = np.full(len(array), np.nan)
+            out[_to_numpy(pc.is_valid(array).cast(pa.int8())).astype(bool)] = hms @ np.array([3600.0, 60.0, 1.0])
+            return out
     texts = array.to_pylist()
     out = np.full(len(texts), np.nan)
     for i, text in enumerate(texts):
@@ -646,6 +671,22 @@ def _clock_s(array: pa.ChunkedArray, source: Path, column: str, first_row: int, 
         hours, minutes, seconds = text.split(":")
         out[i] = 3600.0 * int(hours) + 60.0 * int(minutes) + float(seconds)
     return out
+
+
+#: seconds in a day [s]
+DAY_S = 86_400.0
+
+
+def _past_midnight(time_of_day_s: np.ndarray, after_s: float | None = None) -> np.ndarray:
+    """Times of day [s] run on past midnight: a step back of more than half a day is the next day's (a log across
+    midnight, or longer than a day). ``after_s``: the time of the row before them [s], already run on (a chunk's
+    rows after the chunk before)."""
+    if time_of_day_s.size == 0:
+        return time_of_day_s
+    start = 0.0 if after_s is None else DAY_S * np.floor(after_s / DAY_S)
+    before = time_of_day_s[0] if after_s is None else after_s - start
+    days = np.cumsum(np.diff(time_of_day_s, prepend=before) < -DAY_S / 2)
+    return start + time_of_day_s + DAY_S * days
 
 
 #: suffixes of delimited text tables (the delimiter is told from the header: comma, semicolon, tab, space)
@@ -835,13 +876,15 @@ def table_recording(
     drop_nonfinite: bool = False,
     first_row: int = 0,
     text_format: TextFormat | None = None,
+    time_after_s: float | None = None,
 ) -> tuple[Recording, np.ndarray]:
     """The recording [s, deg/s, g, degC] of a table's rows (``cols``: channel -> column) and the indices of the
     rows kept in it (all, or those with every used value finite when ``drop_nonfinite``; a warning says how many
     went). ``first_row``: the table's first row in its file (0-based), and ``text_format`` a text table's (None for
     Parquet): the line before its rows (:func:`header_line`) for the row and line numbers in messages, and its
-    decimal point. Used by :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for
-    each chunk."""
+    decimal point; ``time_after_s`` the time of the row before [s] (the chunk before's last; times of day run on
+    from it). Used by :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for each
+    chunk."""
     line = header_line(text_format)
     decimal = text_format.decimal if text_format is not None else "."
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
@@ -852,7 +895,9 @@ def table_recording(
     if cols[TIME_COLUMN] == NOMINAL_TIME:  # a table without time, at a nominal rate
         time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
     else:
-        time_s = time_column_s(table, cols[TIME_COLUMN], layout.time_unit, path, first_row, line, decimal)
+        time_s = time_column_s(
+            table, cols[TIME_COLUMN], layout.time_unit, path, first_row, line, decimal, after_s=time_after_s
+        )
     gyro = np.column_stack([num(a) for a in gyro_axes])
     gyro *= gyro_factor  # in place: a long table's columns are not copied twice
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
