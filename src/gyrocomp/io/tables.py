@@ -880,11 +880,10 @@ def table_recording(
 ) -> tuple[Recording, np.ndarray]:
     """The recording [s, deg/s, g, degC] of a table's rows (``cols``: channel -> column) and the indices of the
     rows kept in it (all, or those with every used value finite when ``drop_nonfinite``; a warning says how many
-    went). ``first_row``: the table's first row in its file (0-based), and ``text_format`` a text table's (None for
-    Parquet): the line before its rows (:func:`header_line`) for the row and line numbers in messages, and its
-    decimal point; ``time_after_s`` the time of the row before [s] (the chunk before's last; times of day run on
-    from it). Used by :func:`read_table` for a whole file and by :class:`gyrocomp.io.stream.TableStream` for each
-    chunk."""
+    went). ``first_row``: the table's first row in its file (0-based); ``text_format``: a text table's (None for
+    Parquet), for its decimal point and the row and line numbers in messages; ``time_after_s``: the time of the
+    row before [s] (times of day run on from it). Used by :func:`read_table` and, a chunk at a time, by
+    :class:`gyrocomp.io.stream.TableStream`."""
     line = header_line(text_format)
     decimal = text_format.decimal if text_format is not None else "."
     gyro_axes = tuple(a for a in GYRO_AXES if a in cols)
@@ -895,15 +894,12 @@ def table_recording(
     if cols[TIME_COLUMN] == NOMINAL_TIME:  # a table without time, at a nominal rate
         time_s = (first_row + np.arange(table.num_rows)) / layout.rate_hz
     else:
-        time_s = time_column_s(
-            table, cols[TIME_COLUMN], layout.time_unit, path, first_row, line, decimal, after_s=time_after_s
-        )
+        time_s = time_column_s(table, cols[TIME_COLUMN], layout.time_unit, path, first_row, line, decimal, time_after_s)
     gyro = np.column_stack([num(a) for a in gyro_axes])
     gyro *= gyro_factor  # in place: a long table's columns are not copied twice
     temp = np.column_stack([num(t) for t in temp_names]) if temp_names else None
-    accel = None
-    if accel_axes:
-        accel = np.column_stack([num(a) for a in accel_axes])
+    accel = np.column_stack([num(a) for a in accel_axes]) if accel_axes else None
+    if accel is not None:
         accel *= unit_factor("accel", layout.accel_unit, "accel_unit")
     reference = _reference_rates(cols, num, path, gyro_factor)
     n = table.num_rows
