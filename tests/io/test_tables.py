@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -839,3 +840,33 @@ def test_times_of_day_run_on_past_midnight_whole_and_in_chunks(tmp_path, chunk_r
     chunks = list(TableStream(tmp_path / "night.csv", chunk_rows=chunk_rows).chunks())
     np.testing.assert_array_equal(np.concatenate([c.recording.time_s for c in chunks]), whole.time_s)
     assert texts[29:32] == ["23:59:59.990", "00:00:00.000", "00:00:00.010"]
+
+
+def test_a_column_of_vectors_is_refused_saying_so_and_init_points_to_it(tmp_path):
+    """A Parquet table whose gyro is one column of 3-number lists (or of x, y, z structs), as array columns and ROS
+    conversions write it: mapped, it is refused saying it holds vectors and that a column per axis is read;
+    init names it beside the columns (and does not take its temperature for a file of another sensor)."""
+    n = 50
+    rates = np.arange(n * 3, dtype=float).reshape(n, 3) / 1000
+    listed = pa.table(
+        {
+            "time": np.arange(n) / 100,
+            "gyro": pa.FixedSizeListArray.from_arrays(pa.array(rates.ravel()), 3),
+            "temperature": np.linspace(20, 30, n),
+        }
+    )
+    pq.write_table(listed, tmp_path / "list.parquet")
+    fields = pa.StructArray.from_arrays([pa.array(rates[:, k]) for k in range(3)], ["x", "y", "z"])
+    pq.write_table(pa.table({"time": np.arange(n) / 100, "imu": fields}), tmp_path / "struct.parquet")
+    with pytest.raises(
+        InputError,
+        match=r"list.parquet: column 'gyro' holds a list of 3 numbers in each row \(a vector\); gyrocomp reads one column per axis",
+    ):
+        read_table(tmp_path / "list.parquet", TableLayout({"gyro_z": "gyro"}))
+    with pytest.raises(InputError, match=r"struct.parquet: column 'imu' holds fields x, y, z in each row \(a vector\)"):
+        list(TableStream(tmp_path / "struct.parquet", TableLayout({"gyro_z": "imu"})).chunks())
+    with pytest.raises(
+        InputError,
+        match=r"its columns are time, gyro, temperature; column 'gyro' holds a list of 3 numbers in each row \(a vector\); gyrocomp reads one column per axis: split it into x, y and z first$",
+    ):
+        guess_layout(tmp_path / "list.parquet")

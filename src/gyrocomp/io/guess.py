@@ -39,6 +39,7 @@ from .tables import (
     detect_table_format,
     holds_clock,
     read_error,
+    vector_column,
     TextFormat,
 )
 
@@ -286,7 +287,7 @@ def _find_columns(path: Path, table: pa.Table, rate_hz: float | None = None) -> 
     if not any(c.startswith("gyro_") for c in columns):
         raise InputError(
             f"{path}: no column looks like a gyro axis (a name with gyr, omega or rate and x, y or z); "
-            f"its columns are {', '.join(names)}{_one_sensor_hint([*names, path.stem])}"
+            f"its columns are {', '.join(names)}{_vectors_hint(table)}{_one_sensor_hint([*names, path.stem])}"
         )
     if rate_hz is not None:
         reasons.insert(0, f"time: row n at n / {rate_hz:g} s (the rate given; the table has no time column)")
@@ -599,11 +600,18 @@ def _stated_array_rate(store: ArrayStore) -> tuple[float, str] | None:
     return None
 
 
+def _vectors_hint(table: pa.Table) -> str:
+    """For a table without a gyro column per axis: its columns of vectors (lists or structs per row), if any."""
+    vectors = [f for f in table.schema if pa.types.is_nested(f.type)]
+    return "".join(f"; column {f.name!r} {vector_column(f.type)}" for f in vectors)
+
+
 def _one_sensor_hint(names: list[str]) -> str:
     """For a file without a gyro whose names (its columns' or arrays', its own) say the accelerometer or the
     temperature: that a log's channels are read from one file (a logger that writes a file per sensor)."""
-    kinds = [k for k in ("accel", "temperature") if k in {_kind(n) for n in names}]
-    if not kinds:
+    found = {_kind(n) for n in names}
+    kinds = [k for k in ("accel", "temperature") if k in found]
+    if not kinds or "gyro" in found:  # a gyro named without its axes is no file of another sensor
         return ""
     held = " and the ".join("accelerometer" if k == "accel" else k for k in kinds)
     return (

@@ -557,6 +557,8 @@ def _numeric_column(
         return np.full(len(array), np.nan)
     if pa.types.is_boolean(array.type) or pa.types.is_timestamp(array.type):
         raise InputError(f"{source}: column {column!r} has type {array.type}; expected numbers")
+    if pa.types.is_nested(array.type):
+        raise InputError(f"{source}: column {column!r} {vector_column(array.type)}")
     try:  # numbers stored as text (quoted, say): one vectorized cast; only on failure find the bad row
         return _to_numpy(array.cast(pa.float64()))  # pyarrow.compute, loaded only here (70 ms)
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
@@ -581,6 +583,14 @@ def _numeric_column(
 _CLOCK_UNIT_S = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 #: a time of day as text: hours, minutes, seconds and a fraction (12:00:01.250)
 _TIME_OF_DAY = re.compile(r"\s*\d{1,2}:\d{2}:\d{2}(\.\d+)?\s*")
+
+
+def vector_column(kind: pa.DataType) -> str:
+    """What a column of vectors (an Arrow list or struct per row, as pandas' arrays and ROS conversions write a
+    3-axis rate) holds, and that gyrocomp reads a column per axis."""
+    width = f"{kind.list_size} numbers" if pa.types.is_fixed_size_list(kind) else "numbers"
+    held = f"fields {', '.join(f.name for f in kind)}" if pa.types.is_struct(kind) else f"a list of {width}"
+    return f"holds {held} in each row (a vector); gyrocomp reads one column per axis: split it into x, y and z first"
 
 
 def time_column_s(
