@@ -64,13 +64,10 @@ class TextFormat:
         delimiter, decimal = sniff_csv(head)
         delimiter = layout.delimiter or delimiter
         skipped = preamble_lines(head, delimiter)
-        if skipped:  # the decimal point told from the first row after the header, not the preamble's
-            decimal = sniff_csv(b"\n".join(head.split(b"\n")[skipped:]))[1]
         units = units_line(head, delimiter, skipped)
-        if units is not None:  # the decimal point told from the first row, not the units'
-            decimal = sniff_csv(
-                b"\n".join(head.split(b"\n")[skipped : skipped + 1] + head.split(b"\n")[skipped + 2 :])
-            )[1]
+        if skipped or units is not None:  # the decimal point told from the first row, not a preamble's or the units'
+            lines = head.split(b"\n")
+            decimal = sniff_csv(b"\n".join([lines[skipped], *lines[skipped + 1 + (units is not None) :]]))[1]
         return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head), units)
 
     @property
@@ -351,7 +348,7 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
         header = next((line for line in lines[1:] if any(d in line for d in DELIMITERS)), header)
     delimiter = max(DELIMITERS, key=lambda d: (header.count(d), d == ","))
     at = lines.index(header) if header in lines else 0
-    if aligned or (_spaced(lines[at : at + 2]) and not _same_fields(lines[at : at + 2], delimiter)):
+    if aligned or (_aligned(lines[at : at + 2]) and not _same_fields(lines[at : at + 2], delimiter)):
         delimiter = SPACE  # fields aligned by spaces (and tabs among them, which do not split the rows alike)
     decimal = "."
     if delimiter != "," and len(lines) > 1:
@@ -362,17 +359,11 @@ def sniff_csv(head: bytes) -> tuple[str, str]:
 
 
 def _aligned(lines: list[str]) -> bool:
-    """Whether a table's first lines (a header with no comma, semicolon or tab, and rows: a decimal comma is no
-    separator there) split by runs of spaces into the same number of fields, at least two: a table of spaces, not
-    a preamble before another table's header (``// Start Time: ...``, whose lines split otherwise)."""
+    """Whether ``lines`` (two at least: a header and rows) split by runs of spaces and tabs into the same number of
+    fields, at least two: a table of spaces (a decimal comma is no separator there; tabs among the spaces align),
+    not a preamble before another table's header (``// Start Time: ...``, whose lines split otherwise)."""
     counts = {len(fields_of(line, SPACE)) for line in lines}
     return len(lines) >= 2 and len(counts) == 1 and counts.pop() >= 2
-
-
-def _spaced(lines: list[str]) -> bool:
-    """Whether a table's header and first row (``lines``) are fields separated by runs of spaces and tabs: they
-    split so into the same number of fields, at least two."""
-    return _same_fields(lines, SPACE) and len(fields_of(lines[0], SPACE)) >= 2
 
 
 def _same_fields(lines: list[str], delimiter: str) -> bool:
