@@ -21,7 +21,8 @@ from gyrocomp.io import resource_limits as limits
 from gyrocomp.io import tables as tables_module
 from gyrocomp.io.inputs import expand_inputs
 from gyrocomp.io.stream import TableStream
-from gyrocomp.io.tables import MAX_COLUMNS, read_table
+from gyrocomp.io.tables import read_table
+from gyrocomp.io.text_format import MAX_COLUMNS
 
 from ..conftest import SCRIPT, run
 

@@ -28,7 +28,7 @@ from gyrocomp.io import (
 )
 from gyrocomp.io.guess import guess_layout
 from gyrocomp.io.stream import TableStream
-from gyrocomp.io.tables import SpacedText, TextFormat, preamble_lines, spaced_as_fields, text_encoding, units_line
+from gyrocomp.io.text_format import SpacedText, TextFormat, preamble_lines, spaced_as_fields, text_encoding, units_line
 from gyrocomp.simulation import GyroErrorModel, simulate
 from gyrocomp.units import unit_factor
 

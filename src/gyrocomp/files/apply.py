@@ -13,7 +13,8 @@ from ..calibration.compensate import accel_xyz, apply, compensated_axes, compens
 from ..errors import InputError
 from ..io import ReadOptions
 from ..io.stream import NotStreamable, TableStream, TableWriter
-from ..io.tables import arrow_floats, arrow_indices, write_gyro_back
+from ..io.columns import arrow_floats, arrow_indices
+from ..io.tables import write_gyro_back
 from ..recording import ACCEL_AXES
 from ..units import unit_factor
 from .chunks import ChunkSettings, chunked_or_whole

@@ -30,18 +30,9 @@ from .hdf5 import ArrayStore, sample_hdf5
 from .matlab import load_arrays
 from .readers import detect_format
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
-from .tables import (
-    DELIMITERS,
-    DECOMPRESS_ERRORS,
-    TableLayout,
-    _csv_bytes,
-    check_parquet_footer,
-    detect_table_format,
-    holds_clock,
-    read_error,
-    vector_column,
-    TextFormat,
-)
+from .columns import holds_clock, vector_column
+from .tables import TableLayout, check_parquet_footer, detect_table_format
+from .text_format import DECOMPRESS_ERRORS, DELIMITERS, TextFormat, _csv_bytes, read_error
 
 #: rows read to guess from
 GUESS_ROWS = 20_000

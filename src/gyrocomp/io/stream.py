@@ -28,23 +28,25 @@ from ..errors import DataQualityWarning, InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (
-    CSV_BLOCK_BYTES,
-    DECOMPRESS_ERRORS,
     TableLayout,
-    TextFormat,
     _channel_selector,
-    _csv_options,
     _read_arrow,
     _resolved_columns,
     check_parquet_footer,
-    csv_codec,
     detect_table_format,
+    rows_dropped,
+    table_recording,
+)
+from .text_format import (
+    CSV_BLOCK_BYTES,
+    DECOMPRESS_ERRORS,
+    TextFormat,
+    _csv_options,
+    csv_codec,
     open_csv_bytes,
     output_text_format,
     read_error,
-    rows_dropped,
     text_head,
-    table_recording,
     with_decimal,
 )
 
@@ -297,7 +299,7 @@ class TableWriter:
         self.path = Path(path)
         self.fmt = fmt or detect_table_format(self.path) or "csv"
         self.computed = tuple(computed)
-        #: a text table's separator and decimal point (:func:`gyrocomp.io.tables.output_text_format` of the input's)
+        #: a text table's separator and decimal point (:func:`gyrocomp.io.text_format.output_text_format` of the input's)
         self.text_format = output_text_format(self.path, text_format)
         self._writer = None
         self._schema: pa.Schema | None = None

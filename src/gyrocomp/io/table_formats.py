@@ -7,7 +7,8 @@ from pathlib import Path
 
 from .common import ProgressCallback, ReadOptions
 from .readers import Reader, register_reader
-from .tables import COMPRESSED_SUFFIXES, PARQUET_MAGIC, PARQUET_SUFFIXES, TEXT_TABLE_SUFFIXES, TableData, read_table
+from .tables import PARQUET_MAGIC, PARQUET_SUFFIXES, TableData, read_table
+from .text_format import COMPRESSED_SUFFIXES, TEXT_TABLE_SUFFIXES
 
 
 def _table_reader(fmt: str):
