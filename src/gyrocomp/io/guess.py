@@ -447,10 +447,10 @@ def guess_layout(
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
-    named = fmt if fmt is not None else None if names is not None else detect_table_format(path) or detect_format(path)
-    if named in _NAMED_ARRAYS and names is None:
-        return _guess_arrays(path, _NAMED_ARRAYS[named](path), rate_hz)
-    fmt = named if fmt is not None else detect_table_format(path)
+    if fmt is None:  # a table by its name; without names given, a file of named arrays by its first bytes too
+        fmt = detect_table_format(path) or (detect_format(path) if names is None else None)
+    if fmt in _NAMED_ARRAYS and names is None:
+        return _guess_arrays(path, _NAMED_ARRAYS[fmt](path), rate_hz)
     if fmt not in ("csv", "parquet"):
         raise InputError(
             f"{path}: not a CSV/TSV or Parquet table, nor a file of named arrays (HDF5, MAT, .npz); logs (ULog, "
@@ -528,6 +528,12 @@ def _triads(values: np.ndarray) -> int:
     return values.shape[1] // 3
 
 
+def _axes_by_column(kind: str, name: str, values: np.ndarray, first: int) -> dict[str, tuple[str, np.ndarray]]:
+    """The x, y and z axes of ``kind`` as columns ``first`` to ``first + 2`` of the array ``name``: channel ->
+    (``NAME[:, k]``, its values)."""
+    return {f"{kind}_{axis}": (f"{name}[:, {k}]", values[:, k]) for k, axis in enumerate("xyz", start=first)}
+
+
 def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[str, tuple[str, np.ndarray]]]:
     """Channel -> array of each array named as a channel (an (n, 3) gyro or accelerometer array whole, an (n, 4)
     one of the time then the axes by its columns, one of one dimension per axis, the temperature, the time; a
@@ -541,21 +547,20 @@ def _array_channels(store: ArrayStore) -> tuple[dict[str, str], list[str], dict[
         if kind in ("gyro", "accel") and values.ndim == 2 and values.shape[1] == 3 and kind not in columns:
             columns[kind] = name
             reasons.append(f"{kind} = {name!r}: {said}, an (n, 3) array")
-            for k, axis in enumerate("xyz"):
-                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+            flat.update(_axes_by_column(kind, name, values, 0))
         elif kind in ("gyro", "accel") and _triads(values) > 1 and not {kind, f"{kind}_x"} & set(columns):
-            for k, axis in enumerate("xyz"):
-                columns[f"{kind}_{axis}"] = f"{name}[:, {k}]"
-                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+            axes = _axes_by_column(kind, name, values, 0)
+            flat.update(axes)
+            columns.update({channel: column for channel, (column, _) in axes.items()})
             reasons.append(
                 f"{kind}_x, _y, _z = {name!r} columns 0 to 2: {said}, an (n, {values.shape[1]}) array of "
                 f"{_triads(values)} triads, the first taken (check: Android keeps the calibrated one first, the "
                 "uncalibrated after it)"
             )
         elif kind in ("gyro", "accel") and _time_then_axes(values) and not {kind, f"{kind}_x"} & set(columns):
-            for k, axis in enumerate("xyz", start=1):
-                columns[f"{kind}_{axis}"] = f"{name}[:, {k}]"
-                flat[f"{kind}_{axis}"] = (f"{name}[:, {k}]", values[:, k])
+            axes = _axes_by_column(kind, name, values, 1)
+            flat.update(axes)
+            columns.update({channel: column for channel, (column, _) in axes.items()})
             reasons.append(
                 f"{kind}_x, _y, _z = {name!r} columns 1 to 3: {said}, an (n, 4) array whose first column never "
                 "falls (the time)"
