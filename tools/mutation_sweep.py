@@ -1,7 +1,7 @@
 """Reliability sweep (#20, #35): corrupted logs, malformed CSV and model files, and hostile or unlucky inputs
 through the real command line.
 
-Makes 500 corrupted logs (truncations and byte flips of the shared PX4 ULog and ArduPilot DataFlash samples,
+Makes 500 corrupted logs (truncations, byte flips and zeroed stretches of the shared PX4 ULog and ArduPilot DataFlash samples,
 250 each), 350 corrupted binaries written here (an HDF5 file, a MATLAB MAT-file, a NumPy .npz, a Parquet table, a
 ROS 1 bag, ROS 2 bags in sqlite3 and MCAP storage, 50 each), 150 malformed CSV tables and 240 mutated model files
 (60 each of four kinds: a polynomial, the default fit with lag, memory and g-sensitivity, gyro and accelerometer
@@ -16,7 +16,7 @@ triads, a network), runs each through ``gyrocomp convert`` (logs, binaries, tabl
 - ``non-finite written``: a NaN or infinity in the output without a warning;
 - ``silently wrong``: without a word, a converted log holding values no sensor gives (beyond 5000 deg/s, outside
   -100..200 degC) or, with its length kept, fewer rows than the intact file; a model file that is no valid model
-  (only -5 for a number keeps it one) applied to other numbers than the intact model's.
+  (one the published schema refuses) applied to other numbers than the intact model's.
 
 The hostile part (``--hostile-only`` runs it alone) adds, each with what it must not do:
 
@@ -63,7 +63,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from gyrocomp import Calibration, Network, Polynomial, fit, fit_calibration, write
+from gyrocomp.calibration.schema import validate_model
 from gyrocomp.cli import main
+from gyrocomp.errors import InputError
 from gyrocomp.simulation import simulate
 
 BAD = ("internal error", "multi-line error", "non-finite written", "security hole", "silently wrong", "data loss")
@@ -115,13 +117,18 @@ def judged(outcome: str, lines: list[str], output: Path, intact_rows: int | None
 def mutated_logs(source: Path, count: int, rng: np.random.Generator, limit: int | None = 400_000):
     blob = source.read_bytes()[:limit]
     for k in range(count):
-        if k % 2 == 0:
+        if k % 3 == 0:
             yield "truncated", blob[: int(rng.integers(1, len(blob)))]
-        else:
+        elif k % 3 == 1:
             damaged = bytearray(blob)
             for at in rng.integers(0, len(blob), size=int(rng.integers(1, 17))):
                 damaged[at] = int(rng.integers(0, 256))
             yield "byte-flipped", bytes(damaged)
+        else:  # a lost flash page or card sector
+            at, length = int(rng.integers(0, len(blob))), int(rng.integers(1, 4097))
+            damaged = bytearray(blob)
+            damaged[at : at + length] = bytes(len(damaged[at : at + length]))
+            yield "zeroed", bytes(damaged)
 
 
 def malformed_csv(rng: np.random.Generator) -> str:
@@ -152,8 +159,11 @@ def _leaves(node, prefix=()):
 
 def mutated_model(model: dict, rng: np.random.Generator) -> tuple[str, bool]:
     """One field of ``model`` deleted or replaced (None, true, -5, 1e300, a path, [], {}, 5000 ones, "NaN",
-    +-1e308), sometimes the text damaged besides; and whether the file is still a valid model (-5 for a number:
-    another model, which may apply without a word)."""
+    +-1e308), sometimes the text damaged besides; and whether the file is still a valid model: another model, which
+    may apply without a word. Valid is what the published schema (``model.schema.json``, checked by jsonschema)
+    allows: -5 for a number, and also an optional field deleted (a polynomial's ``extrapolation``: held at the
+    edge, as files without it always were), a polynomial's coefficient deleted (one order lower; order 0 is a bias
+    alone) or its curve null (no temperature term), other turn-on biases."""
     paths = list(_leaves(model))
     path = paths[int(rng.integers(len(paths)))]
     copy = json.loads(json.dumps(model))
@@ -161,20 +171,27 @@ def mutated_model(model: dict, rng: np.random.Generator) -> tuple[str, bool]:
     for key in path[:-1]:
         parent = parent[key]
     replacements = [None, True, -5, 10**300, "../../etc/passwd", [], {}, [1.0] * 5000, "NaN", 1e308, -1e308]
-    original = parent[path[-1]]
-    valid = False
     if rng.random() < 0.3:
         del parent[path[-1]]
     else:
         replacement = replacements[int(rng.integers(len(replacements)))]
-        valid = replacement == -5 and isinstance(original, (int, float)) and not isinstance(original, bool)
         parent[path[-1]] = replacement
+    valid = _follows_schema(copy)
     text = json.dumps(copy, allow_nan=True)
     if rng.random() < 0.2:  # a damaged file besides: cut short or a stray byte
         cut = int(rng.integers(1, len(text)))
         text = text[:cut] if rng.random() < 0.5 else text[:cut] + "\x00" + text[cut:]
         valid = False
     return text, valid
+
+
+def _follows_schema(model: dict) -> bool:
+    """Whether ``model`` (a model file's content at the current version) follows the published schema."""
+    try:
+        validate_model(model)
+    except InputError:
+        return False
+    return True
 
 
 def model_kinds(seed: int, work: Path) -> dict[str, tuple[Path, dict]]:
@@ -298,9 +315,10 @@ def _arrays(path: Path, recording) -> Path:
 
 
 def corrupted_binaries(work: Path, rng: np.random.Generator, count: int) -> dict[str, collections.Counter]:
-    """``count`` damaged copies each (half cut short, half with 1..16 bytes overwritten) of an HDF5 file, a
-    MATLAB MAT-file, a NumPy .npz, a Parquet table, a ROS 1 bag and ROS 2 bags in sqlite3 and MCAP storage, all of
-    one simulated run, converted; a copy whose length is kept must not lose rows without a word."""
+    """``count`` damaged copies each (a third each cut short, with 1..16 bytes overwritten, with up to 4 KiB
+    zeroed) of an HDF5 file, a MATLAB MAT-file, a NumPy .npz, a Parquet table, a ROS 1 bag and ROS 2 bags in sqlite3
+    and MCAP storage, all of one simulated run, converted; a copy whose length is kept must not lose rows without a
+    word."""
     recording = simulate("mti10", profile="chamber", duration_s=600, rate_hz=2, seed=7).recording
     makers = {
         "HDF5": lambda p: _hdf5(p.with_suffix(".h5"), recording),
@@ -332,9 +350,7 @@ def corrupted_binaries(work: Path, rng: np.random.Generator, count: int) -> dict
                 target.write_bytes(blob)
             out = work / f"damaged_{len(results)}_{k}.csv"
             status, lines = run_command(["convert", target, out])
-            counter[
-                judged(classify(status, lines, out), lines, out, intact_rows if how == "byte-flipped" else None)
-            ] += 1
+            counter[judged(classify(status, lines, out), lines, out, intact_rows if how != "truncated" else None)] += 1
     return results
 
 

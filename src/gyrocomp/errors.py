@@ -119,3 +119,14 @@ def printable(text: str) -> str:
     """``text`` with control characters escaped (``\\n``, ``\\x1b``): a newline or a raw byte in a message (a file
     name's, a foreign library's) would otherwise break a one-line message or the terminal."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+#: the characters of a foreign library's message kept in one of gyrocomp's
+FOREIGN_MESSAGE_CHARS = 160
+
+
+def foreign_message(exc: BaseException) -> str:
+    """What a foreign library's exception says, for one of gyrocomp's one-line messages: its type, then its text
+    with control characters escaped (:func:`printable`) and cut to ``FOREIGN_MESSAGE_CHARS`` (a parser's error can
+    quote a whole schema, newlines and all)."""
+    return f"{type(exc).__name__}: {printable(str(exc))[:FOREIGN_MESSAGE_CHARS]}"

@@ -1,4 +1,4 @@
-"""Damaged binary files (seeded cuts and overwritten bytes of every binary format gyrocomp reads): each is read
+"""Damaged binary files (seeded cuts, overwritten bytes and zeroed stretches of every binary format gyrocomp reads): each is read
 as a recording every sensor could give, or refused with one error naming the file; never another exception. A
 bag that lost messages its index counts says so."""
 
@@ -75,9 +75,15 @@ MAKERS = {
 
 
 def _damaged(blob: bytes, rng: np.random.Generator, k: int) -> bytes:
-    if k % 2 == 0:
+    """Damage k of three kinds: cut short, 1..16 bytes overwritten, or a stretch of up to 4 KiB zeroed (a flash
+    page or card sector lost; in a DataFlash log it made pymavlink loop for ever on a format of length 0)."""
+    if k % 3 == 0:
         return blob[: int(rng.integers(1, len(blob)))]
     damaged = bytearray(blob)
+    if k % 3 == 2:
+        at, length = int(rng.integers(0, len(blob))), int(rng.integers(1, 4097))
+        damaged[at : at + length] = bytes(len(damaged[at : at + length]))
+        return bytes(damaged)
     for at in rng.integers(0, len(blob), size=int(rng.integers(1, 17))):
         damaged[at] = int(rng.integers(0, 256))
     return bytes(damaged)
@@ -116,6 +122,6 @@ def test_a_damaged_binary_is_read_as_possible_values_or_refused_naming_it(fmt, t
             if values is not None:
                 lo, hi, _ = POSSIBLE[kind]
                 assert np.all((values >= lo) & (values <= hi)), (kind, k)
-        if k % 2 and fmt.startswith("ros") and rec.n_samples < whole:  # bytes overwritten, the length kept
+        if k % 3 and fmt.startswith("ros") and rec.n_samples < whole:  # bytes overwritten or zeroed, the length kept
             assert any(issubclass(w.category, DataQualityWarning) for w in said), (k, rec.n_samples, whole)
     assert outcomes["refused"] > 0, outcomes  # the damage is real: some copies cannot be read

@@ -262,6 +262,45 @@ def test_dataflash_garbage_chatter_of_pymavlink_is_one_warning(tmp_path, capfd):
     assert capfd.readouterr() == ("", "")  # nothing printed past gyrocomp
 
 
+@pytest.mark.parametrize("fast_index", ["0", "1"])
+def test_dataflash_fmt_record_shorter_than_a_header_is_refused_not_parsed_for_ever(tmp_path, monkeypatch, fast_index):
+    """A FMT record of length 0 (a zeroed stretch of a damaged card) made pymavlink read one message for ever, with
+    its C indexer and without: refused in one line now."""
+    monkeypatch.setenv("PYMAVLINK_FAST_INDEX", fast_index)
+    rows = [(1_000_000 + i * 10_000, 0, 0.0, 0.0, 0.0, 0.0, 0.0, -G, 30.0) for i in range(50)]
+    path = tmp_path / "zeroed.bin"
+    write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, rows)})
+    data = bytearray(path.read_bytes())
+    boundary = 89 + 40 * 25  # after the FMT record and 25 IMU records of 40 bytes
+    data[boundary:boundary] = b"\xa3\x95\x80" + bytes([200, 0]) + bytes(84) + b"\xa3\x95\xc8"
+    path.write_bytes(bytes(data))
+    with pytest.raises(
+        InputError,
+        match=r"zeroed.bin: not a readable DataFlash log: a FMT record defines message type 200 \(''\) with a "
+        r"length of 0 bytes, under its 3-byte header \(a corrupt log\)",
+    ):
+        read(path)
+
+
+def test_dataflash_imu_format_without_its_fields_or_of_another_length_is_refused(tmp_path):
+    rows = [(1_000_000 + i * 10_000, 0, 0.0, 0.0, 0.0, 0.0, 0.0, -G, 30.0) for i in range(20)]
+    renamed = [("GyrQ", c) if n == "GyrY" else (n, c) for n, c in _IMU_COLUMNS]
+    path = tmp_path / "renamed.bin"
+    write_dataflash(path, {"IMU": (130, renamed, rows)})
+    with pytest.raises(
+        InputError,
+        match=r"renamed.bin: the log's format of IMU messages has no field GyrY \(fields TimeUS, I, GyrX, GyrQ,",
+    ):
+        read(path)
+    path = tmp_path / "longer.bin"
+    write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, rows)})
+    data = bytearray(path.read_bytes())
+    data[4] = 44  # the FMT record's Length: 44 bytes for a message of 40
+    path.write_bytes(bytes(data))
+    with pytest.raises(InputError, match=r"longer.bin: the log's format of IMU messages has 44 bytes for fields of 40"):
+        read(path)
+
+
 def test_dataflash_tclr_asked_for_but_absent(tmp_path):
     path = tmp_path / "imu.bin"
     write_dataflash(path, {"IMU": (130, _IMU_COLUMNS, [(1000 * i, 0, 0, 0, 0, 0, 0, -G, 30.0) for i in range(5)])})
@@ -824,3 +863,16 @@ def test_layout_options_a_log_does_not_read_are_said_not_used(tmp_path):
     said = run("allan", bag, "--gyro-unit", "rad/s")
     assert said.returncode == 0 and said.stderr.count("--gyro-unit not used") == 1, said.stderr
     assert "not used" not in run("allan", bag).stderr
+
+
+def test_a_bag_whose_schema_text_is_damaged_is_refused_in_one_line(tmp_path):
+    """rosbags' parse error quotes the whole damaged message definition, newlines and all: cut and escaped."""
+    write_bag(tmp_path / "bag", ros2=True, n=50, mcap=True)
+    inner = next((tmp_path / "bag").glob("*.mcap"))
+    rule = b"\n" + b"=" * 80 + b"\nMSG: geometry_msgs/Quaternion"
+    inner.write_bytes(inner.read_bytes().replace(rule, rule[:16] + b"U" + rule[17:]))  # the schema and its copy
+    with pytest.raises(
+        InputError, match=r"bag: not a readable ROS bag \(AnyReaderError: Could not parse:\\n.MSG: sensor_msgs"
+    ) as caught:
+        read(tmp_path / "bag")
+    assert "\n" not in str(caught.value) and len(str(caught.value)) < len(str(tmp_path)) + 260

@@ -13,13 +13,14 @@ download) is read up to its last whole message, with a warning.
 
 from __future__ import annotations
 
+import functools
 import re
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, foreign_message
 from ..recording import Recording
 from ..units import unit_factor
 from .common import (
@@ -52,6 +53,8 @@ _STRUCT_TO_NUMPY = {
     "d": "<f8",
 }
 _TCLR_ACCEL, _TCLR_GYRO = 0, 1
+#: the fields of an IMU record that are read (``T``, the temperature, where it has one)
+_IMU_FIELDS = ("TimeUS", "GyrX", "GyrY", "GyrZ", "AccX", "AccY", "AccZ")
 
 
 def _dtype(fmt) -> np.dtype:
@@ -69,6 +72,40 @@ def _dtype(fmt) -> np.dtype:
     return np.dtype({"names": names, "formats": formats})
 
 
+class _CheckedFormats(dict):
+    """pymavlink's table of message formats, keeping out one whose length is under the 3 bytes of a message's
+    header: pymavlink steps to the next message by that length, so a corrupt FMT record of length 0 to 2 (a zeroed
+    or flipped byte) would have it read the same message again and again, never returning. The first one left out
+    is in :attr:`corrupt` (pymavlink catches what its parsing raises, so it is not raised here)."""
+
+    corrupt: str | None = None
+
+    def __setitem__(self, type_id, fmt) -> None:
+        if fmt.len < 3:
+            self.corrupt = self.corrupt or (
+                f"a FMT record defines message type {type_id} ({fmt.name!r}) with a length of {fmt.len} bytes, under "
+                "its 3-byte header"
+            )
+            return
+        super().__setitem__(type_id, fmt)
+
+
+@functools.cache
+def _checked_reader(DFReader):
+    """pymavlink's binary reader whose format table is :class:`_CheckedFormats` before it indexes the log."""
+
+    class CheckedReader(DFReader.DFReader_binary):
+        def init_arrays(self, *args, **kwargs):
+            self.formats = _CheckedFormats(self.formats)
+            return super().init_arrays(*args, **kwargs)
+
+        def init_arrays_fast(self, *args, **kwargs):
+            self.formats = _CheckedFormats(self.formats)
+            return super().init_arrays_fast(*args, **kwargs)
+
+    return CheckedReader
+
+
 class _Log:
     """The indexed log: message types by name and a reader of all records of one type."""
 
@@ -77,13 +114,17 @@ class _Log:
         self.path = path
         try:
             with foreign_output(str(path), "pymavlink"):
-                self.reader = DFReader.DFReader_binary(
+                self.reader = _checked_reader(DFReader)(
                     str(path),
                     zero_time_base=False,
                     progress_callback=(lambda pct: progress(0.8 * pct / 100.0)) if progress else None,
                 )
         except Exception as exc:  # pymavlink raises assorted errors on corrupt files
-            raise InputError(f"{path}: not a readable DataFlash log ({type(exc).__name__}: {exc})") from None
+            raise InputError(f"{path}: not a readable DataFlash log ({foreign_message(exc)})") from None
+        corrupt = getattr(self.reader.formats, "corrupt", None)
+        if corrupt is not None:
+            self.reader.close()
+            raise InputError(f"{path}: not a readable DataFlash log: {corrupt} (a corrupt log)")
         self.bytes = np.frombuffer(self.reader.data_map, dtype=np.uint8)
         self.types = {fmt.name: type_id for type_id, fmt in self.reader.formats.items()}
         self.cut_bytes = self._truncation()
@@ -111,19 +152,30 @@ class _Log:
         """The field names of a message type, from its format (no record is read)."""
         return _dtype(self.reader.formats[self.types[name]]).names
 
-    def records(self, name: str) -> np.ndarray:
-        """Every whole ``name`` message as a numpy record array (multipliers applied by the caller)."""
+    def records(self, name: str, needed: tuple[str, ...] = ()) -> np.ndarray:
+        """Every whole ``name`` message as a numpy record array (multipliers applied by the caller); refused when
+        its format (a FMT record, corrupt in a damaged log) lacks a ``needed`` field or disagrees with its length."""
         type_id = self.types[name]
         fmt = self.reader.formats[type_id]
+        dtype = _dtype(fmt)
+        missing = [f for f in needed if f not in dtype.names]
+        if missing or dtype.itemsize != fmt.len - 3:
+            said = (
+                f"no field {', '.join(missing)}" if missing else f"{fmt.len} bytes for fields of {dtype.itemsize + 3}"
+            )
+            raise InputError(
+                f"{self.path}: the log's format of {name} messages has {said} (fields {', '.join(dtype.names)}): "
+                "its FMT record is corrupt, or the log is no ArduPilot one"
+            )
         offsets = np.asarray(self.reader.offsets[type_id], dtype=np.int64)
         offsets = offsets[offsets + fmt.len <= self.bytes.size]
         body = self.bytes[offsets[:, None] + 3 + np.arange(fmt.len - 3)]
-        return np.ascontiguousarray(body).view(_dtype(fmt)).reshape(-1)
+        return np.ascontiguousarray(body).view(dtype).reshape(-1)
 
     def parameters(self) -> dict[str, float]:
         if not self.has("PARM"):
             return {}
-        parm = self.records("PARM")
+        parm = self.records("PARM", ("Name", "Value"))
         return {
             name.split(b"\0")[0].decode("ascii", "replace"): float(value)
             for name, value in zip(parm["Name"], parm["Value"])
@@ -133,7 +185,7 @@ class _Log:
 def _instances(log: _Log) -> list[int]:
     """The IMU instances of a log: the ``I`` field's values, or which of IMU, IMU2, IMU3 it has (older firmware)."""
     if log.has("IMU") and "I" in log.fields("IMU"):
-        return sorted(set(int(i) for i in np.unique(log.records("IMU")["I"])))
+        return sorted(set(int(i) for i in np.unique(log.records("IMU", ("I",))["I"])))
     return [i for i, name in enumerate(("IMU", "IMU2", "IMU3")) if log.has(name)]
 
 
@@ -150,7 +202,7 @@ def dataflash_instances(path) -> tuple[int, ...]:
 
 def _instance_records(log: _Log, instance: int) -> np.ndarray:
     if log.has("IMU") and "I" in log.fields("IMU"):
-        imu = log.records("IMU")
+        imu = log.records("IMU", _IMU_FIELDS)
         found = _instances(log)
         if instance not in found:
             raise InputError(
@@ -164,7 +216,7 @@ def _instance_records(log: _Log, instance: int) -> np.ndarray:
             f"{log.path}: instance={instance}: no {names[instance] if instance < 3 else 'IMU'} "
             f"records; the log has instance(s) {', '.join(map(str, found))}"
         )
-    return log.records(names[instance]), found
+    return log.records(names[instance], _IMU_FIELDS), found
 
 
 def _from_imu(log: _Log, instance: int, explicit: bool):
@@ -192,7 +244,7 @@ def _from_tclr(log: _Log, instance: int):
             f"{log.path}: record=TCLR: no TCLR records in this log "
             "(the onboard learner writes them while INS_TCALn_ENABLE = 2)"
         )
-    tclr = log.records("TCLR")
+    tclr = log.records("TCLR", ("TimeUS", "I", "SType", "X", "Y", "Z", "Temp"))
     tclr = tclr[tclr["I"] == instance]
     gyro_rows, accel_rows = tclr[tclr["SType"] == _TCLR_GYRO], tclr[tclr["SType"] == _TCLR_ACCEL]
     if gyro_rows.size < 2:

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 import pyarrow as pa
 
-from ..errors import DataQualityWarning, InputError, TimeOrderWarning, printable
+from ..errors import DataQualityWarning, InputError, TimeOrderWarning, foreign_message
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
 from .common import (
@@ -154,7 +154,7 @@ def _open(path: Path):
     except InputError:
         raise
     except Exception as exc:  # rosbags raises its own error types for files that are not bags
-        raise InputError(f"{path}: not a readable ROS bag ({type(exc).__name__}: {exc})") from None
+        raise InputError(f"{path}: not a readable ROS bag ({foreign_message(exc)})") from None
     return reader
 
 
@@ -223,9 +223,7 @@ def damaged_bag(path: Path, topic: str):
     except (InputError, NotStreamable, OSError):
         raise
     except Exception as exc:  # rosbags' own errors, and what a damaged record makes its parsers raise
-        raise InputError(
-            f"{path}: damaged ROS bag: topic {topic}: {type(exc).__name__}: {printable(str(exc))[:160]}"
-        ) from None
+        raise InputError(f"{path}: damaged ROS bag: topic {topic}: {foreign_message(exc)}") from None
 
 
 def _read_all(path: Path, counted: int, read: int, topic: str) -> None:

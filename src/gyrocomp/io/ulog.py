@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, foreign_message
 from ..recording import Recording
 from ..units import unit_factor
 from .common import (
@@ -237,7 +237,7 @@ def ulog_instances(path) -> tuple[int, ...]:
         with foreign_output(str(path), "pyulog"):
             ulog = pyulog.ULog(str(path), list(GYRO_TOPICS), parse_header_only=False)
     except Exception as exc:  # pyulog raises bare Exceptions on corrupt files
-        raise InputError(f"{path}: not a readable ULog ({type(exc).__name__}: {exc})") from None
+        raise InputError(f"{path}: not a readable ULog ({foreign_message(exc)})") from None
     names = {d.name for d in ulog.data_list}
     topic = next((t for t in GYRO_TOPICS if t in names), None)
     if topic is None:
@@ -269,7 +269,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
         with foreign_output(str(path), "pyulog"):
             ulog = pyulog.ULog(str(path), list(GYRO_TOPICS) + ["sensor_accel"], parse_header_only=False)
     except Exception as exc:  # pyulog raises bare Exceptions on corrupt files
-        raise InputError(f"{path}: not a readable ULog ({type(exc).__name__}: {exc})") from None
+        raise InputError(f"{path}: not a readable ULog ({foreign_message(exc)})") from None
     _check_framing(path)
     if progress:
         progress(0.8)
