@@ -15,7 +15,7 @@ time-averaged NEES and the share of runs inside its 95 % chi-square band (below 
 over-confident).
 
 Usage: python benchmarks/bench_noise_nees.py [--runs R] [--minutes M] [--rate HZ] [--tempco C] [--dwell-hours H]
-       [--draws D]
+       [--draws D] [--seed S] [--presets P,...]
 """
 
 from __future__ import annotations
@@ -45,17 +45,19 @@ def main() -> None:
     parser.add_argument("--tempco", type=float, default=0.005)
     parser.add_argument("--dwell-hours", type=float, default=10.0)
     parser.add_argument("--draws", type=int, default=8)
+    parser.add_argument("--seed", type=int, default=1, help="seed of the chamber run the models are made from")
+    parser.add_argument("--presets", default=",".join(PRESETS), help="the parts, comma-separated")
     args = parser.parse_args()
     n = int(args.minutes * 60 * args.rate)
     ramp = np.interp(np.linspace(0.0, 1.0, n), [0.0, 0.5, 1.0], [-20.0, 70.0, -20.0])
     print("| part | model told to the filter | median NEES | runs inside the 95 % band | band |")
     print("|---|---|---|---|---|")
-    for preset in PRESETS:
+    for preset in args.presets.split(","):
         model = dataclasses.replace(preset_model(preset), noise_tempco_per_degc=args.tempco)
         profile = get_profile("chamber", set_points_degc=(-20.0, 25.0, 70.0), dwell_s=args.dwell_hours * 3600.0 + 300.0)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            chamber = simulate(model, profile=profile, rate_hz=args.rate, seed=1).recording
+            chamber = simulate(model, profile=profile, rate_hz=args.rate, seed=args.seed).recording
             made = noise_over_temperature(chamber, [model.axes[0]])
         axis = made.axes[model.axes[0]]
         middle = chamber.take(temperature_dwells(chamber)[1])  # the 25 degC dwell: what a user fits at room temperature
