@@ -1,6 +1,6 @@
-"""Damaged binary files (seeded cuts, overwritten bytes and zeroed stretches of every binary format gyrocomp reads): each is read
-as a recording every sensor could give, or refused with one error naming the file; never another exception. A
-bag that lost messages its index counts says so."""
+"""Damaged binary files (seeded cuts, overwritten bytes and zeroed stretches of every binary format gyrocomp
+reads): each is read as a recording every sensor could give, or refused with one error naming the file; never
+another exception. A bag that lost messages its index counts says so."""
 
 from __future__ import annotations
 
