@@ -2,11 +2,11 @@
 through the real command line.
 
 Makes 500 corrupted logs (truncations, byte flips and zeroed stretches of the shared PX4 ULog and ArduPilot
-DataFlash samples, 250 each), 350 corrupted binaries written here (an HDF5 file, a MATLAB MAT-file, a NumPy .npz,
-a Parquet table, a ROS 1 bag, ROS 2 bags in sqlite3 and MCAP storage, 50 each), 150 malformed CSV tables and 240
+DataFlash samples, 250 each), 350 corrupted binaries written here (an HDF5 file, a MATLAB MAT-file, a NumPy .npz, a
+Parquet table, a ROS 1 bag, ROS 2 bags in sqlite3 and MCAP storage, 50 each), 150 malformed CSV tables and 240
 mutated model files (60 each of four kinds: a polynomial, the default fit with lag, memory and g-sensitivity, gyro
-and accelerometer triads, a network), runs each through ``gyrocomp convert`` (logs, binaries, tables; every other table with
-``--drop-nan``) or ``gyrocomp apply`` (models) in this process, and classifies the outcome:
+and accelerometer triads, a network), runs each through ``gyrocomp convert`` (logs, binaries, tables; every other
+table with ``--drop-nan``) or ``gyrocomp apply`` (models) in this process, and classifies the outcome:
 
 - ``clean``: exit 0, every number written finite, no warning (for a model: none beyond the intact model's);
 - ``warned``: exit 0 with a warning, every number written finite;
