@@ -187,3 +187,29 @@ def test_gaps_between_bursts_of_stamps_are_not_called_missing_samples():
     cut = paused.take(np.r_[0:2000, 4000:6001])
     (finding,) = gap_findings(cut)
     assert "1 gap(s), 200 s in all (33 % of the run" in finding.message and finding.cost.startswith("33 % fewer")
+
+
+def test_a_run_given_twice_or_copied_is_refused_naming_the_first(clean_columns, tmp_path):
+    """The same file twice (a glob that names it again) or a copy would hold a run out against itself."""
+    one, copy, other = tmp_path / "one.csv", tmp_path / "copy.csv", tmp_path / "other.csv"
+    pd.DataFrame(clean_columns["adxrs450"]).to_csv(one, index=False)
+    pd.DataFrame(clean_columns["adxrs450"]).to_csv(copy, index=False)
+    pd.DataFrame(clean_columns["consumer"]).to_csv(other, index=False)
+    _, checks = check_files([one, other, copy, one])
+    assert [c.verdict for c in checks[:2]] == ["ok", "warning"]  # the consumer part's whole degrees
+    for check, path in zip(checks[2:], (copy, one)):
+        assert check.verdict == "refused" and check.reasons == ("repeated",), check.line()
+        assert check.line().startswith(f"{path}: refused (repeated): the same samples as {one} (a run given twice)")
+    with pytest.raises(InputError, match=r"copy.csv: the same samples as .*one.csv .*accept=repeated fits it anyway"):
+        enforce(checks)
+    (_, accepted) = check_files([one, copy], accept=["repeated"])[1]
+    assert accepted.verdict == "ok" and [f.check for f in accepted.accepted] == ["repeated"]
+    shifted = dict(clean_columns["adxrs450"])
+    axis = next(c for c in shifted if c.startswith("gyro_"))
+    shifted[axis] = shifted[axis].copy()
+    shifted[axis][len(shifted[axis]) // 2] += 1e-6  # one sample apart: another run
+    pd.DataFrame(shifted).to_csv(copy, index=False)
+    assert [c.verdict for c in check_files([one, copy])[1]] == ["ok", "ok"]
+    fitted = run("fit", one, one, "-o", tmp_path / "m.json")
+    assert fitted.returncode == 2 and fitted.stderr.count("\n") == 1 and not (tmp_path / "m.json").exists()
+    assert "the same samples as" in fitted.stderr and "--accept repeated fits it anyway" in fitted.stderr

@@ -1,8 +1,9 @@
 """The data check before a fit: is each run fit to calibrate from, and if only partly, what does it cost?
 
 Each check has a name, a documented threshold and a severity. A **refusal** is a run (or a set of runs) that
-cannot give a valid fit of what is asked: no temperature, time that goes back (two logs appended, a clock reset),
-no reversal where turning-point hysteresis is asked, and, when a temperature curve is asked by name (``poly:3``,
+cannot give a valid fit of what is asked: a run given twice (the same samples as another), no temperature, time
+that goes back (two logs appended, a clock reset), no reversal where turning-point hysteresis is asked, and, when a
+temperature curve is asked by name (``poly:3``,
 ``table``, ``mlp``), a constant temperature, too little span, or fewer samples or temperature levels than the
 curve has parameters (fewer than ten samples and two levels per parameter is a warning). Under the default
 automatic choice those are warnings: the choice then fits no curve (a constant bias, and whatever else the
@@ -38,6 +39,7 @@ from .plausibility import time_bursts_concern, turned_between_poses
 Severity = Literal["refuse", "warn"]
 #: every check, in the order a verdict line lists them
 DATA_CHECKS = (
+    "repeated",
     "time",
     "temperature-missing",
     "temperature-constant",
@@ -458,10 +460,51 @@ def _too_few_levels(recordings: Sequence[Recording], known: list, ask: Ask, out:
         )
 
 
-def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Finding]]:
-    """What only the runs together say, by run: a constant temperature in every run, too little span, too short
-    for the curve, no reversal where hysteresis is asked (each said on every run it concerns)."""
+def _same_samples(a: Recording, b: Recording) -> bool:
+    """Whether two recordings hold the same samples: times, gyro and temperature equal, compared a part at a time
+    after their lengths and end samples."""
+    if a.n_samples != b.n_samples or a.n_samples == 0:
+        return False
+    series = [(a.time_s, b.time_s), (a.gyro_dps, b.gyro_dps)]
+    if (a.temperature_degc is None) != (b.temperature_degc is None):
+        return False
+    if a.temperature_degc is not None:
+        series.append((a.temperature_degc, b.temperature_degc))
+    ends = [0, a.n_samples - 1]
+    if not all(np.array_equal(x[ends], y[ends], equal_nan=True) for x, y in series):
+        return False
+    return all(
+        np.array_equal(x[start:stop], y[start:stop], equal_nan=True)
+        for start, stop in parts(a.n_samples)
+        for x, y in series
+    )
+
+
+def repeated_findings(recordings: Sequence[Recording]) -> dict[int, list[Finding]]:
+    """Each run whose samples are an earlier run's, sample for sample (one file given twice, a glob that names it
+    again, a copy): refused, since a run held out against itself would judge the model choice, and the drift it
+    says to expect, on the data it was fitted to."""
     out: dict[int, list[Finding]] = {}
+    for j in range(len(recordings)):
+        earlier = next((i for i in range(j) if _same_samples(recordings[i], recordings[j])), None)
+        if earlier is not None:
+            out[j] = [
+                Finding(
+                    "repeated",
+                    "refuse",
+                    f"{recordings[j].source}: the same samples as {recordings[earlier].source} (a run given twice): "
+                    "held out against itself, it would judge the model and the drift to expect on the data fitted; "
+                    "give each run once",
+                )
+            ]
+    return out
+
+
+def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Finding]]:
+    """What only the runs together say, by run: a run repeated (:func:`repeated_findings`), a constant temperature
+    in every run, too little span, too short for the curve, no reversal where hysteresis is asked (each said on
+    every run it concerns)."""
+    out: dict[int, list[Finding]] = repeated_findings(recordings)
     temps = [_temperature(r) for r in recordings]
     known = [t for t in temps if t is not None]
     if ask.temperature != "none" and known:
