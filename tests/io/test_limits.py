@@ -27,9 +27,9 @@ from gyrocomp.io.text_format import MAX_COLUMNS
 from ..conftest import SCRIPT, run
 
 
-def _table(path, n=2000):
+def _table(path, n=2000, bias_dps=0.1):
     k = np.arange(n)
-    rows = "\n".join(f"{t / 10:.1f},{0.1 + 0.001 * t:.6f},{25 + 10 * t / n:.4f}" for t in k)
+    rows = "\n".join(f"{t / 10:.1f},{bias_dps + 0.001 * t:.6f},{25 + 10 * t / n:.4f}" for t in k)
     path.write_text("time,gyro_z,temperature\n" + rows + "\n")
     return path
 
@@ -135,8 +135,8 @@ def test_too_small_an_address_space_is_one_line_not_a_hang(tmp_path):
 
 def test_a_glob_through_a_link_loop_names_each_file_once(tmp_path):
     (tmp_path / "a").mkdir()
-    for name in ("r1.csv", "r2.csv"):
-        _table(tmp_path / "a" / name)
+    for name, bias_dps in (("r1.csv", 0.1), ("r2.csv", 0.2)):  # two runs (the same one twice is refused)
+        _table(tmp_path / "a" / name, bias_dps=bias_dps)
     os.symlink("..", tmp_path / "a" / "loop")
     with pytest.warns(DataQualityWarning, match=r"name\(s\) matched are files already named by another path"):
         found = expand_inputs([str(tmp_path / "a" / "**" / "*.csv")])
