@@ -1,14 +1,13 @@
 """The data check before a fit: is each run fit to calibrate from, and if only partly, what does it cost?
 
-Each check has a name, a documented threshold and a severity. A **refusal** is a run (or a set of runs) that
-cannot give a valid fit of what is asked: a run given twice (the same samples as another), no temperature, time
-that goes back (two logs appended, a clock reset), no reversal where turning-point hysteresis is asked, and, when a
-temperature curve is asked by name (``poly:3``,
-``table``, ``mlp``), a constant temperature, too little span, or fewer samples or temperature levels than the
-curve has parameters (fewer than ten samples and two levels per parameter is a warning). Under the default
-automatic choice those are warnings: the choice then fits no curve (a constant bias, and whatever else the
-runs identify, such as g-sensitivity from positions at one temperature), which is a valid fit of what the data
-hold.
+Each check has a name, a documented threshold and a severity. A **refusal** is a run (or a set of runs) that cannot
+give a valid fit of what is asked: a run given twice (the same samples as another), no temperature, time that goes
+back (two logs appended, a clock reset), no reversal where turning-point hysteresis is asked, and, when a
+temperature curve is asked by name (``poly:3``, ``table``, ``mlp``), a constant temperature, too little span, or
+fewer samples or temperature levels than the curve has parameters (fewer than ten samples and two levels per
+parameter is a warning). Under the default automatic choice those are warnings: the choice then fits no curve (a
+constant bias, and whatever else the runs identify, such as g-sensitivity from positions at one temperature), which
+is a valid fit of what the data hold.
 A **warning** is what only degrades a fit, said with its expected cost: temperature quantized in coarse steps,
 gaps, a rail (saturated samples), motion, a unit probably read wrongly, time stamps reordered or repeated by a
 logger. Any check is accepted knowingly by its name (``accept``; ``accept=NAME``): it is
@@ -463,11 +462,9 @@ def _too_few_levels(recordings: Sequence[Recording], known: list, ask: Ask, out:
 def _same_samples(a: Recording, b: Recording) -> bool:
     """Whether two recordings hold the same samples: times, gyro and temperature equal, compared a part at a time
     after their lengths and end samples."""
-    if a.n_samples != b.n_samples or a.n_samples == 0:
+    if a.n_samples != b.n_samples or a.n_samples == 0 or (a.temperature_degc is None) != (b.temperature_degc is None):
         return False
     series = [(a.time_s, b.time_s), (a.gyro_dps, b.gyro_dps)]
-    if (a.temperature_degc is None) != (b.temperature_degc is None):
-        return False
     if a.temperature_degc is not None:
         series.append((a.temperature_degc, b.temperature_degc))
     ends = [0, a.n_samples - 1]
