@@ -189,8 +189,9 @@ def test_gaps_between_bursts_of_stamps_are_not_called_missing_samples():
     assert "1 gap(s), 200 s in all (33 % of the run" in finding.message and finding.cost.startswith("33 % fewer")
 
 
-def test_a_run_given_twice_or_copied_is_refused_naming_the_first(clean_columns, tmp_path):
-    """The same file twice (a glob that names it again) or a copy would hold a run out against itself."""
+def test_a_run_given_twice_copied_or_beside_its_log_is_refused_naming_the_first(clean_columns, tmp_path):
+    """The same file twice (a glob that names it again), a copy, or a run split from a log given with the log
+    would hold samples out against themselves."""
     one, copy, other = tmp_path / "one.csv", tmp_path / "copy.csv", tmp_path / "other.csv"
     pd.DataFrame(clean_columns["adxrs450"]).to_csv(one, index=False)
     pd.DataFrame(clean_columns["adxrs450"]).to_csv(copy, index=False)
@@ -210,6 +211,16 @@ def test_a_run_given_twice_or_copied_is_refused_naming_the_first(clean_columns, 
     shifted[axis][len(shifted[axis]) // 2] += 1e-6  # one sample apart: another run
     pd.DataFrame(shifted).to_csv(copy, index=False)
     assert [c.verdict for c in check_files([one, copy])[1]] == ["ok", "ok"]
+    log, part = tmp_path / "log.csv", tmp_path / "part.csv"  # a run split from a log, given beside the log
+    pd.DataFrame(clean_columns["adxrs450"]).to_csv(log, index=False)
+    pd.DataFrame(clean_columns["adxrs450"]).iloc[100:600].to_csv(part, index=False)
+    for first, second, said in (
+        (log, part, f"its rows 0..499 are rows 100..599 of {log}, the same samples (a run given twice in part"),
+        (part, log, f"its rows 100..599 are rows 0..499 of {part}, the same samples"),
+    ):
+        checks = check_files([first, second])[1]
+        assert checks[0].verdict == "ok" and checks[1].reasons == ("repeated",), checks[1].line()
+        assert checks[1].line().startswith(f"{second}: refused (repeated): {said}"), checks[1].line()
     fitted = run("fit", one, one, "-o", tmp_path / "m.json")
     assert fitted.returncode == 2 and fitted.stderr.count("\n") == 1 and not (tmp_path / "m.json").exists()
     assert "the same samples as" in fitted.stderr and "--accept repeated fits it anyway" in fitted.stderr

@@ -1,7 +1,7 @@
 """The data check before a fit: is each run fit to calibrate from, and if only partly, what does it cost?
 
 Each check has a name, a documented threshold and a severity. A **refusal** is a run (or a set of runs) that cannot
-give a valid fit of what is asked: a run given twice (the same samples as another), no temperature, time that goes
+give a valid fit of what is asked: a run given twice (samples another run holds too), no temperature, time that goes
 back (two logs appended, a clock reset), no reversal where turning-point hysteresis is asked, and, when a
 temperature curve is asked by name (``poly:3``, ``table``, ``mlp``), a constant temperature, too little span, or
 fewer samples or temperature levels than the curve has parameters (fewer than ten samples and two levels per
@@ -459,41 +459,66 @@ def _too_few_levels(recordings: Sequence[Recording], known: list, ask: Ask, out:
         )
 
 
-def _same_samples(a: Recording, b: Recording) -> bool:
-    """Whether two recordings hold the same samples: times, gyro and temperature equal, compared a part at a time
-    after their lengths and end samples."""
-    if a.n_samples != b.n_samples or a.n_samples == 0 or (a.temperature_degc is None) != (b.temperature_degc is None):
-        return False
-    series = [(a.time_s, b.time_s), (a.gyro_dps, b.gyro_dps)]
-    if a.temperature_degc is not None:
-        series.append((a.temperature_degc, b.temperature_degc))
-    ends = [0, a.n_samples - 1]
-    if not all(np.array_equal(x[ends], y[ends], equal_nan=True) for x, y in series):
-        return False
-    return all(
-        np.array_equal(x[start:stop], y[start:stop], equal_nan=True)
-        for start, stop in parts(a.n_samples)
-        for x, y in series
-    )
+def _series(rec: Recording) -> list[np.ndarray]:
+    return [rec.time_s, rec.gyro_dps] + ([] if rec.temperature_degc is None else [rec.temperature_degc])
+
+
+def _shared_rows(a: Recording, b: Recording) -> tuple[int, int, int] | None:
+    """Where ``b`` holds ``a``'s samples: (first row in a, first row in b, rows) when, over the time the two share,
+    b's samples are a's at the same stamps, times, gyro and temperature equal (compared at the ends first, then a
+    part at a time); None otherwise."""
+    if min(a.n_samples, b.n_samples) == 0 or (a.temperature_degc is None) != (b.temperature_degc is None):
+        return None
+    lo, hi = max(a.time_s[0], b.time_s[0]), min(a.time_s[-1], b.time_s[-1])
+    if lo > hi:
+        return None
+    first_b = int(np.searchsorted(b.time_s, lo))
+    first_a = int(np.searchsorted(a.time_s, b.time_s[first_b]))
+    if first_a >= a.n_samples or a.time_s[first_a] != b.time_s[first_b]:
+        return None
+    rows = min(a.n_samples - first_a, int(np.searchsorted(b.time_s, hi, side="right")) - first_b)
+    pairs = list(zip(_series(a), _series(b)))
+    ends = np.array([0, rows - 1])
+    if not all(np.array_equal(x[first_a + ends], y[first_b + ends], equal_nan=True) for x, y in pairs):
+        return None
+    for start, stop in parts(rows):
+        if not all(
+            np.array_equal(x[first_a + start : first_a + stop], y[first_b + start : first_b + stop], equal_nan=True)
+            for x, y in pairs
+        ):
+            return None
+    return first_a, first_b, rows
 
 
 def repeated_findings(recordings: Sequence[Recording]) -> dict[int, list[Finding]]:
-    """Each run whose samples are an earlier run's, sample for sample (one file given twice, a glob that names it
-    again, a copy): refused, since a run held out against itself would judge the model choice, and the drift it
-    says to expect, on the data it was fitted to."""
+    """Each run that holds samples an earlier run holds too, at the same time stamps with the same values (one file
+    given twice, a glob that names it again, a copy, a run split from a log given beside the log): refused, since a
+    run held out against itself would judge the model choice, and the drift it says to expect, on the data it was
+    fitted to."""
     out: dict[int, list[Finding]] = {}
-    for j in range(len(recordings)):
-        earlier = next((i for i in range(j) if _same_samples(recordings[i], recordings[j])), None)
-        if earlier is not None:
+    for j, later in enumerate(recordings):
+        for earlier in recordings[:j]:
+            shared = _shared_rows(earlier, later)
+            if shared is None:
+                continue
+            first_a, first_b, rows = shared
+            if rows == earlier.n_samples == later.n_samples:
+                what = f"the same samples as {earlier.source} (a run given twice)"
+            else:
+                what = (
+                    f"its rows {first_b}..{first_b + rows - 1} are rows {first_a}..{first_a + rows - 1} of "
+                    f"{earlier.source}, the same samples (a run given twice in part: a run split from a log given "
+                    "beside the log)"
+                )
             out[j] = [
                 Finding(
                     "repeated",
                     "refuse",
-                    f"{recordings[j].source}: the same samples as {recordings[earlier].source} (a run given twice): "
-                    "held out against itself, it would judge the model and the drift to expect on the data fitted; "
-                    "give each run once",
+                    f"{later.source}: {what}: held out against itself, it would judge the model and the drift to "
+                    "expect on the data fitted; give each run once",
                 )
             ]
+            break
     return out
 
 
