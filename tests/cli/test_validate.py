@@ -30,3 +30,12 @@ def test_validate_prints_every_method_and_json_holds_the_folds(workdir):
     assert "gyrocomp poly:1" in table.stdout and "vs cubic" in table.stdout
     bad = run("validate", *runs, "--folds", "sideways")
     assert bad.returncode == 2 and "--folds" in bad.stderr
+
+
+def test_validate_refuses_a_run_given_twice(workdir):
+    """Leave-one-run-out with a run given twice would hold it out against its own copy."""
+    first, second = sorted(Path(workdir).glob("run*.csv"))[:2]
+    out = run("validate", first, second, first)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1, out.stderr
+    assert f"{first}: the same samples as {first} (a run given twice)" in out.stderr
+    assert "give each run once" in out.stderr

@@ -35,6 +35,7 @@ from ..models.options import FitOptions, FoldChoice
 from ..fitting.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MIN_S, drift_window_s, leg_labels
 from ..fitting.scores import fold_mean, fold_standard_error
 from ..curves.polynomial import PolynomialCurve
+from ..measures.data_check import repeated_findings
 from ..measures.plausibility import require_temperature_span
 from ..runs.prepared import prepare
 from ..threads import single_threaded_blas
@@ -272,6 +273,8 @@ def validate(
         if rec.temperature_degc is None:
             raise InputError(f"{rec.source}: no temperature column; validation compares temperature models")
     require_temperature_span(recordings, "validate")
+    for findings in repeated_findings(recordings).values():  # a run held out against itself
+        raise InputError(findings[0].message)
     kind, fold_list = make_sample_folds(recordings, folds)
     if window_s is None:
         window_s = fold_window_s(recordings, fold_list)

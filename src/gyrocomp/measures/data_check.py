@@ -636,4 +636,14 @@ def _split(found: Iterable[Finding], source: str, accept: frozenset[str]) -> Run
     )
 
 
-__all__ = ["Ask", "DATA_CHECKS", "CheckedRun", "Finding", "RunCheck", "check_runs", "set_findings", "unreadable"]
+__all__ = [
+    "Ask",
+    "DATA_CHECKS",
+    "CheckedRun",
+    "Finding",
+    "RunCheck",
+    "check_runs",
+    "repeated_findings",
+    "set_findings",
+    "unreadable",
+]
