@@ -224,3 +224,14 @@ def test_a_run_given_twice_copied_or_beside_its_log_is_refused_naming_the_first(
     fitted = run("fit", one, one, "-o", tmp_path / "m.json")
     assert fitted.returncode == 2 and fitted.stderr.count("\n") == 1 and not (tmp_path / "m.json").exists()
     assert "the same samples as" in fitted.stderr and "--accept repeated fits it anyway" in fitted.stderr
+
+
+def test_runs_that_share_one_boundary_sample_are_two_runs(clean_columns, tmp_path):
+    """Windows cut at inclusive ends (MATLAB's data(1:1000), data(1000:2000)) share one sample: no repeat."""
+    table = pd.DataFrame(clean_columns["adxrs450"])
+    first, second = tmp_path / "first.csv", tmp_path / "second.csv"
+    table.iloc[:1000].to_csv(first, index=False)
+    table.iloc[999:2000].to_csv(second, index=False)
+    assert all("repeated" not in c.reasons for c in check_files([first, second])[1])
+    table.iloc[998:2000].to_csv(second, index=False)  # two samples: a run given twice in part
+    assert check_files([first, second])[1][1].reasons == ("repeated",)

@@ -78,6 +78,9 @@ UNIT_WINDOW_SAMPLES, UNIT_QUIET_PERCENTILE, UNIT_MAX_WINDOWS = 20, 10.0, 20_000
 #: that percentile of the spread of 20 differences of white noise, over sqrt(2) sigma (by simulation of 1e5
 #: windows; its own error below 1 %): the estimate is divided by it
 UNIT_QUIET_FACTOR = 0.7455
+#: two runs holding this many of the same samples or more are one run given twice, in whole or in part (one shared
+#: sample is a boundary: a window cut by hand at an inclusive end, as MATLAB's ``data(1:1000)``, ``data(1000:2000)``)
+MIN_SHARED_ROWS = 2
 #: samples per parameter of the temperature curve below which a run set is too short, and distinct temperature
 #: levels (at 0.1 degC) per parameter
 SAMPLES_PER_PARAMETER, LEVELS_PER_PARAMETER = 10, 2
@@ -477,6 +480,8 @@ def _shared_rows(a: Recording, b: Recording) -> tuple[int, int, int] | None:
     if first_a >= a.n_samples or a.time_s[first_a] != b.time_s[first_b]:
         return None
     rows = min(a.n_samples - first_a, int(np.searchsorted(b.time_s, hi, side="right")) - first_b)
+    if rows < MIN_SHARED_ROWS:
+        return None
     pairs = list(zip(_series(a), _series(b)))
     ends = np.array([0, rows - 1])
     if not all(np.array_equal(x[first_a + ends], y[first_b + ends], equal_nan=True) for x, y in pairs):
