@@ -8,11 +8,11 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import Calibration, Compensator, Polynomial, apply, fit_calibration
+from gyrocomp import Calibration, Compensator, Polynomial, apply, fit, fit_calibration
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.evaluation import evaluate_stages
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.fitting.acceleration import excited_columns
+from gyrocomp.fitting.acceleration import excited_columns, turned_between_positions
 from gyrocomp.effects import G_SQUARED_TERMS, g_squared_products
 from gyrocomp.simulation import get_profile, preset_model, simulate, tumble_positions
 
@@ -270,3 +270,29 @@ def test_excited_columns_from_the_spread_of_the_positions():
         warnings.simplefilter("error")  # every axis excited: no warning
         excited, squares, _ = excited_columns([tumble], [np.ones(len(tumble))], squares=True)
     assert excited == (0, 1, 2) and "zz" not in [G_SQUARED_TERMS[m] for m in squares] and len(squares) == 5
+
+
+def test_an_accelerometer_drifting_with_temperature_at_one_orientation_is_no_turn():
+    """A real one-cycle log's accelerometer moved 0.05 g with the chamber's temperature at one orientation: its still
+    segments, split by moments of motion, read as several orientations, and the default fit warned that the
+    positions excite no axis. A turn now needs what the g-sensitivity fit needs, a spread beyond 0.1 g."""
+    rec = simulate("consumer", profile="chamber", rate_hz=5.0, seed=4).recording
+    t = rec.temperature_degc
+    accel = rec.accel_g.copy()
+    accel[:, 2] += 0.08 * (t - t.min()) / np.ptp(t)
+    gyro = rec.gyro_dps.copy()
+    every = int(1200 * rec.rate_hz)
+    for start in range(every, rec.n_samples, every):  # a moment of motion every 20 min splits the still stretches
+        gyro[start : start + 10] += 30.0
+    drifting = dataclasses.replace(rec.with_gyro(gyro), accel_g=accel)
+    assert not turned_between_positions([drifting], 20.0)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        calibration = fit([drifting])
+    assert not [w for w in said if "do not excite" in str(w.message)]
+    assert calibration.fit_report["acceleration"] == {
+        "mode": "none",
+        "why": "the runs do not turn the unit between positions",
+    }
+    tumbled = simulate("consumer", profile="tumble", rate_hz=5.0, seed=4).recording
+    assert turned_between_positions([tumbled], 20.0)

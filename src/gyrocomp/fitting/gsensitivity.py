@@ -12,7 +12,6 @@ from ..effects import G_SQUARED_TERMS
 from ..errors import DataQualityWarning
 from ..recording import ACCEL_AXES, Recording
 from ..runs.prepared import PreparedRun
-from ..motion.positions import orientations
 
 ACCELERATION_CHOICES = ("none", "matrix", "matrix2")
 #: an accelerometer axis is excited when its within-run spread over the positions exceeds this [g]
@@ -62,13 +61,30 @@ def excited_columns(
 
 
 def turned_between_positions(recordings: list[Recording], min_duration_s: float) -> bool:
-    """Whether some run has an accelerometer triad and more than one orientation among its static segments."""
+    """Whether the runs turn the unit between positions far enough for a g-sensitivity fit to see: some
+    accelerometer axis whose static segments' mean specific force spreads within the runs (weighted by their
+    durations) beyond ``EXCITATION_G``, as :func:`excited_columns` asks of the fit's own points. Segments at one
+    orientation whose specific force moves with the accelerometer's own bias over a chamber's temperatures (0.05 g on
+    a real one-cycle log) are no turn.
+
+    Parameters
+    ----------
+    recordings : list of Recording
+        The runs; those without a whole accelerometer triad, or with one static segment, say nothing.
+    min_duration_s : float
+        The shortest static segment [s].
+    """
+    gravity_g, weights = [], []
     for rec in recordings:
         if rec.accel_g is None or not set(ACCEL_AXES) <= set(rec.accel_axes):
             continue
-        if len(orientations(PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s))) > 1:
-            return True
-    return False
+        segments = [
+            s for s in PreparedRun.of(rec).static_segments(min_duration_s=min_duration_s) if s.gravity_g is not None
+        ]
+        if len(segments) > 1:
+            gravity_g.append(np.array([s.gravity_g for s in segments]))
+            weights.append(np.array([s.duration_s for s in segments]))
+    return bool(gravity_g) and bool(excited_columns(gravity_g, weights, warn=False)[0])
 
 
 __all__ = ["ACCELERATION_CHOICES", "EXCITATION_G", "excited_columns", "turned_between_positions"]
