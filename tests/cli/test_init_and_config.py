@@ -543,6 +543,35 @@ def test_an_array_of_two_triads_gives_its_first_and_an_index_for_a_time_is_point
     np.testing.assert_allclose(json.loads(allan.stdout)["axes"]["gyro_z"]["adev"], expected, rtol=1e-9)
 
 
+def test_a_sample_index_for_a_time_is_timed_by_the_rate_the_file_states(tmp_path):
+    """scikit-diveMove's NetCDF states each array's rate (``sampling_rate = 10``, ``sampling_rate_units = "Hz"``)
+    beside a time of 0, 1, 2, ...: init reads that index in periods of the stated rate; a rate attribute in
+    another unit is not taken."""
+    rng = np.random.default_rng(15)
+    n = 3000
+    gyro = 0.001 * rng.standard_normal((n, 3))
+    for units, expected in (("Hz", "1/10 s"), ("kHz", "s")):
+        path = tmp_path / f"stated_{units}.nc"
+        with h5py.File(path, "w") as f:
+            f["timestamp"] = np.arange(n, dtype=float)
+            f["angular_velocity"] = gyro
+            f["angular_velocity"].attrs["sampling_rate"] = np.array([10])
+            f["angular_velocity"].attrs["sampling_rate_units"] = np.bytes_(units)
+        guess = guess_layout(path)
+        assert guess.layout.time_unit == expected, guess.reasons
+    assert any(
+        r.startswith(
+            "time unit 1/10 s: the time steps by one (a sample index as often as seconds) and the file's "
+            "angular_velocity@sampling_rate says 10 Hz"
+        )
+        for r in guess_layout(tmp_path / "stated_Hz.nc").reasons
+    )
+    assert run("init", "stated_Hz.nc", cwd=tmp_path).returncode == 0
+    allan = run("allan", "stated_Hz.nc", "--json", cwd=tmp_path)
+    assert allan.returncode == 0, allan.stderr
+    assert json.loads(allan.stdout)["rate_hz"] == pytest.approx(10.0)
+
+
 def test_pandas_index_column_is_left_unused_and_said_so(tmp_path):
     """pandas' to_csv writes its index as a first column with an empty name: init leaves it unused and says so
     visibly, and apply writes it back as it was."""

@@ -643,6 +643,15 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     table = pa.table({column: np.asarray(values[:n], dtype=float) for column, values in flat.values()})
     named = {channel: column for channel, (column, _) in flat.items()}
     time_unit, accel_unit, gyro_unit, why = _guessed_units(table, named)
+    stated = _stated_array_rate(store) if "time" in named else None
+    steps = np.diff(table.column(named["time"]).to_numpy()) if "time" in named else np.empty(0)
+    if stated is not None and steps.size and np.all(steps == 1):  # a sample index, and the file says its rate
+        time_unit = "s" if stated[0] == 1 else f"1/{stated[0]:g} s"
+        why = (
+            f"time unit {time_unit}: the time steps by one (a sample index as often as seconds) and the file's "
+            f"{stated[1]} says {stated[0]:g} Hz",
+            *why[1:],
+        )
     units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
     if units:
         reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")

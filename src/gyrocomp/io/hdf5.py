@@ -48,6 +48,26 @@ def _units(dataset) -> str | None:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
 
 
+def _stated_rates(name: str, dataset) -> dict[str, float]:
+    """A dataset's attributes that state its sample rate as one number (NetCDF files of loggers write
+    ``sampling_rate = 10`` with ``sampling_rate_units = "Hz"``), keyed ``NAME@ATTRIBUTE``; one whose units
+    attribute says anything but Hz is left out."""
+    out = {}
+    for key, value in dataset.attrs.items():
+        words = set(re.split(r"[^a-z]+", key.lower()))
+        if not words & {"rate", "fs", "frequency"} or "units" in words:
+            continue
+        number = np.asarray(value).reshape(-1)
+        if number.size != 1 or number.dtype.kind not in "iuf" or not np.isfinite(number[0]):
+            continue
+        units = dataset.attrs.get(f"{key}_units", b"Hz")
+        units = np.asarray(units).reshape(-1)[0]
+        if (units.decode("utf-8", "replace") if isinstance(units, bytes) else str(units)).strip().lower() != "hz":
+            continue
+        out[f"{name}@{key}"] = float(number[0])
+    return out
+
+
 def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> float:
     """Factor to gyrocomp's units: from the dataset's ``units`` attribute when known, else the option's unit."""
     units = _units(dataset)
@@ -299,6 +319,7 @@ def sample_hdf5(path, rows: int) -> ArrayStore:
         if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "iuf" and obj.ndim in (1, 2) and obj.shape[0] > 1:
             _in_this_file(obj, str(path))
             store[name] = StoredArray(name, np.asarray(obj[:rows]), str(path), _units(obj))
+            store.scalars.update(_stated_rates(name, obj))
 
     with opened_hdf5(h5py, path) as handle:
         handle.visititems(visit)
