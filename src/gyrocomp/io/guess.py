@@ -235,13 +235,21 @@ def _require_numbers(path: Path, table: pa.Table, columns: dict[str, str]) -> No
         )
 
 
-def _time_unit(name: str, values: np.ndarray) -> tuple[str, str]:
+def _time_unit(name: str, values: np.ndarray, stated: tuple[float, str] | None = None) -> tuple[str, str]:
+    """The time unit of the column ``name`` from its name, else its values' median step, and why; ``stated``, the
+    (rate [Hz], name) a file of arrays states, times a time that steps by one (a sample index) first."""
+    steps = np.diff(values)
+    counted = steps.size > 0 and bool(np.all(steps == 1))
+    if counted and stated is not None:
+        unit = "s" if stated[0] == 1 else f"1/{stated[0]:g} s"
+        return unit, (
+            f"time unit {unit}: the time steps by one (a sample index as often as seconds) and the file's "
+            f"{stated[1]} says {stated[0]:g} Hz"
+        )
     for word in _words(name):
         if word in _TIME_UNIT_WORDS:
             return _TIME_UNIT_WORDS[word], f"time unit {_TIME_UNIT_WORDS[word]}: the column's name says so"
-    steps = np.diff(values)
     period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else float("nan")
-    counted = steps.size > 0 and bool(np.all(steps == 1))
     for unit, factor in _TIME_FACTORS:
         if _PERIOD_RANGE_S[0] <= period * factor <= _PERIOD_RANGE_S[1]:
             why = f"time unit {unit}: the median step {period:.4g} is {1 / (period * factor):.4g} Hz in {unit}"
@@ -391,12 +399,15 @@ def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tup
     return "deg/s", "gyro in deg/s: the default (check: a bias at rest cannot tell rad/s from deg/s)"
 
 
-def _guessed_units(table: pa.Table, columns: dict[str, str]) -> tuple[str, str, str, tuple[str, str, str]]:
-    """The time, accelerometer and gyro units of the channels ``columns`` (channel -> column of ``table``), and why."""
+def _guessed_units(
+    table: pa.Table, columns: dict[str, str], stated: tuple[float, str] | None = None
+) -> tuple[str, str, str, tuple[str, str, str]]:
+    """The time, accelerometer and gyro units of the channels ``columns`` (channel -> column of ``table``), and why
+    (``stated``: the sample rate a file of arrays states, :func:`_time_unit`)."""
     if "time" in columns and holds_clock(table.column(columns["time"])):
         time_unit, why_time = "s", "time unit s: the column holds dates and times, read as seconds"
     elif "time" in columns:
-        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]))
+        time_unit, why_time = _time_unit(columns["time"], _numbers(table, columns["time"]), stated)
     else:
         time_unit, why_time = "s", "time unit s: the nominal time"
     accel_unit, why_accel = _accel_unit(table, columns)
@@ -628,8 +639,8 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
             f"of the time then x, y, z, or one per axis named with x, y or z); its arrays are {shapes}: map them "
             f'in a project file\'s [read.columns] (gyro_x = "NAME[:, k]" for column k of an array){alone}'
         )
-    stated = _stated_array_rate(store) if "time" not in columns and rate_hz is None else None
-    if stated is not None:
+    stated = _stated_array_rate(store)
+    if stated is not None and "time" not in columns and rate_hz is None:
         rate_hz = stated[0]
         reasons.insert(0, f"time: sample n at n / {rate_hz:g} s (the file's {stated[1]} = {rate_hz:g}; no time array)")
     elif "time" not in columns and rate_hz is not None:
@@ -642,16 +653,7 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     n = min(len(values) for _, values in flat.values())
     table = pa.table({column: np.asarray(values[:n], dtype=float) for column, values in flat.values()})
     named = {channel: column for channel, (column, _) in flat.items()}
-    time_unit, accel_unit, gyro_unit, why = _guessed_units(table, named)
-    stated = _stated_array_rate(store) if "time" in named else None
-    steps = np.diff(table.column(named["time"]).to_numpy()) if "time" in named else np.empty(0)
-    if stated is not None and steps.size and np.all(steps == 1):  # a sample index, and the file says its rate
-        time_unit = "s" if stated[0] == 1 else f"1/{stated[0]:g} s"
-        why = (
-            f"time unit {time_unit}: the time steps by one (a sample index as often as seconds) and the file's "
-            f"{stated[1]} says {stated[0]:g} Hz",
-            *why[1:],
-        )
+    time_unit, accel_unit, gyro_unit, why = _guessed_units(table, named, stated)
     units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
     if units:
         reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")

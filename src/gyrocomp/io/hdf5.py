@@ -39,13 +39,18 @@ COMMON_NAMES = {
 _CELSIUS = {"c", "degc", "deg_c", "celsius", "degree_celsius", "degrees_celsius", "°c"}
 
 
-def _units(dataset) -> str | None:
-    value = dataset.attrs.get("units")
+def _attribute_text(dataset, key: str) -> str | None:
+    """A dataset's text attribute ``key`` (bytes, a string, or an array holding one), None where it has none."""
+    value = dataset.attrs.get(key)
     if value is None:
         return None
     if isinstance(value, np.ndarray):
         value = value.reshape(-1)[0]
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+
+
+def _units(dataset) -> str | None:
+    return _attribute_text(dataset, "units")
 
 
 def _stated_rates(name: str, dataset) -> dict[str, float]:
@@ -60,9 +65,7 @@ def _stated_rates(name: str, dataset) -> dict[str, float]:
         number = np.asarray(value).reshape(-1)
         if number.size != 1 or number.dtype.kind not in "iuf" or not np.isfinite(number[0]):
             continue
-        units = dataset.attrs.get(f"{key}_units", b"Hz")
-        units = np.asarray(units).reshape(-1)[0]
-        if (units.decode("utf-8", "replace") if isinstance(units, bytes) else str(units)).strip().lower() != "hz":
+        if (_attribute_text(dataset, f"{key}_units") or "Hz").strip().lower() != "hz":
             continue
         out[f"{name}@{key}"] = float(number[0])
     return out
