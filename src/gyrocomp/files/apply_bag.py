@@ -34,7 +34,6 @@ import functools
 import os
 import re
 import shutil
-import tempfile
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -46,7 +45,7 @@ from ..calibration import Calibration
 from ..calibration.compensate import accel_xyz, apply, compensator_for
 from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
-from ..io.atomic import refuse_link
+from ..io.atomic import atomic_folder, refuse_link
 from ..io.common import require
 from ..io.mcap_chunks import mcap_arrays, mcap_storage
 from ..io.rosbag2_sqlite import sqlite_arrays, sqlite_storage
@@ -596,16 +595,13 @@ def refuse_output(output: Path) -> None:
 @contextlib.contextmanager
 def staged_bag(output: Path, kind: str):
     """The path to write a bag of ``kind`` (``ros1``, ``ros2``, ``mcap``) at: beside ``output``, in a temporary
-    folder moved into place when the block ends without an error (a bare MCAP file: its storage file alone, out
-    of the folder rosbags writes it in), removed either way."""
-    parent = output.parent if str(output.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{output.name}.", dir=parent))
-    target = tmp / (output.name if kind == "ros1" else "bag")
-    try:
+    folder (:func:`gyrocomp.io.atomic.atomic_folder`: one a killed process left is removed by the next run) moved
+    into place when the block ends without an error (a bare MCAP file: its storage file alone, out of the folder
+    rosbags writes it in), removed either way."""
+    with atomic_folder(output) as tmp:
+        target = tmp / (output.name if kind == "ros1" else "bag")
         yield target
-        move_into_place(next(target.glob("*.mcap")) if kind == "mcap" else target, output)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        move_into_place(next(target.glob("*.mcap")) if kind == "mcap" else target, output, tmp / "replaced")
 
 
 def _write_bag(bag: Path, output: Path, copy) -> None:
@@ -665,16 +661,14 @@ def _prepared(result: tuple) -> tuple:
     return recording.time_s, gyro_rad, correction, accel_ms2, accel_correction, covariances
 
 
-def move_into_place(source: Path, output: Path) -> None:
+def move_into_place(source: Path, output: Path, aside: Path) -> None:
     """``source`` (a file or a folder) to ``output``: a file replaces it in one step; a folder replaces an older
-    folder by moving that aside first, then removing it."""
+    folder by moving that to ``aside`` first (a new path in the staging folder, removed with it)."""
     if source.is_file() or not output.exists():
         os.replace(source, output)
         return
-    aside = output.with_name(f".{output.name}.old")
     os.replace(output, aside)
     os.replace(source, output)
-    shutil.rmtree(aside, ignore_errors=True)
 
 
 __all__ = ["AppliedBag", "apply_bag", "apply_bag_instances", "refuse_output", "staged_bag"]

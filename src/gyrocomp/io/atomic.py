@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
+import shutil
 import stat
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -30,14 +31,7 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise InputError(f"{target}: folder {folder} does not exist; create it first")
-    tag = _tag(target.name)
-    _remove_stale(folder, tag)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f"{TEMP_PREFIX}{os.getpid()}-{tag}.", suffix=".tmp", dir=folder)
-    except OSError as exc:  # name the output the user gave, not the temporary file
-        raise InputError(f"{target}: cannot write there ({exc.strerror or exc})") from None
-    os.close(fd)
-    tmp_path = Path(tmp)
+    tmp_path = _staged(target, folder, tempfile.mkstemp)
     try:
         yield tmp_path
         os.chmod(tmp_path, _mode_for(target))
@@ -64,6 +58,35 @@ def arrow_source(path: str | os.PathLike):
 TEMP_PREFIX = ".gyrocomp-"
 
 
+@contextlib.contextmanager
+def atomic_folder(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a new temporary folder beside ``path`` (named as :func:`atomic_path`'s temporary files, so that the
+    next writer of the same output removes one a killed process left); it is removed when the block ends, and
+    whatever the block moved out of it into place stays."""
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    staged = _staged(target, folder, tempfile.mkdtemp)
+    try:
+        yield staged
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
+
+
+def _staged(target: Path, folder: Path, make) -> Path:
+    """A new temporary file (``make`` :func:`tempfile.mkstemp`) or folder (:func:`tempfile.mkdtemp`) for
+    ``target`` in ``folder``, after removing those a killed writer of the same target left."""
+    tag = _tag(target.name)
+    _remove_stale(folder, tag)
+    try:
+        made = make(prefix=f"{TEMP_PREFIX}{os.getpid()}-{tag}.", suffix=".tmp", dir=folder)
+    except OSError as exc:  # name the output the user gave, not the temporary file
+        raise InputError(f"{target}: cannot write there ({exc.strerror or exc})") from None
+    if isinstance(made, tuple):
+        os.close(made[0])
+        made = made[1]
+    return Path(made)
+
+
 def _tag(name: str) -> str:
     """A short ASCII tag of a file name for its temporary files (any name the OS allows, long or not UTF-8)."""
     return "".join(c if c.isascii() and (c.isalnum() or c in "._-") else "_" for c in name)[:40]
@@ -75,8 +98,11 @@ def _remove_stale(folder: Path, tag: str) -> None:
     for stale in folder.glob(f"{TEMP_PREFIX}*-{glob_escape(tag)}.*.tmp"):
         pid = stale.name[len(TEMP_PREFIX) :].split("-", 1)[0]
         if pid.isdigit() and not process_alive(int(pid)):
-            with contextlib.suppress(OSError):
-                stale.unlink()
+            if stale.is_dir() and not stale.is_symlink():
+                shutil.rmtree(stale, ignore_errors=True)
+            else:
+                with contextlib.suppress(OSError):
+                    stale.unlink()
 
 
 def process_alive(pid: int) -> bool:
@@ -139,14 +165,18 @@ def refuse_link(path: str | os.PathLike, what: str = "outputs are") -> None:
 
 
 def _mode_for(target: Path) -> int:
-    """The permissions a plain ``open(target, "w")`` would give: the existing file's, else 0o666 less the
-    umask (mkstemp's temporary files are private, 0o600)."""
+    """The permissions of the new file: the read and write bits of the file it replaces where this process's user
+    owns that file, else 0o666 less the umask (mkstemp's temporary files are private, 0o600). A file another user
+    planted (in a shared folder) lends nothing, and no new file is setuid, setgid, sticky or executable."""
     try:
-        return target.stat().st_mode & 0o7777
+        old = target.stat()
     except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
+        old = None
+    if old is not None and old.st_uid == os.geteuid():
+        return old.st_mode & 0o666
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
 
 
 def require_unchanged(path: str | os.PathLike, before: os.stat_result) -> None:
@@ -207,11 +237,15 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
 
 
 def refuse_to_overwrite_inputs(
-    output: str | os.PathLike, inputs: Iterable[str | os.PathLike], option: str = "-o"
+    output: str | os.PathLike,
+    inputs: Iterable[str | os.PathLike],
+    option: str = "-o",
+    what: str = "an input file",
 ) -> None:
-    """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs``, or a symbolic link
-    (:func:`refuse_link`): the checks a command makes on its output (a file or a folder) before it does the work;
-    an output file is checked besides by :func:`check_output_file` (the command line's type of output files)."""
+    """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs`` (by name, through links, or a
+    hard link to it), or a symbolic link (:func:`refuse_link`): the checks a command makes on its output (a file or
+    a folder) before it does the work; ``what`` says in the message what ``inputs`` are. An output file is checked
+    besides by :func:`check_output_file` (the command line's type of output files)."""
     refuse_link(output)
     out = Path(output)
     for item in inputs:
@@ -220,4 +254,4 @@ def refuse_to_overwrite_inputs(
         if not same and out.exists() and src.exists():
             same = os.path.samefile(out, src)
         if same:
-            raise InputError(f"{option} {output}: this is an input file; choose another output path")
+            raise InputError(f"{option} {output}: this is {what}; choose another output path")
