@@ -188,7 +188,7 @@ def make_sample_folds(recordings: list[Recording], kind: str = "auto") -> tuple[
         folds = []
         for k, rec in enumerate(recordings):
             t = rec.temperature_for(rec.gyro_axes[0])
-            labels, directions = leg_labels(t, turn_threshold_degc(t), max(10, int(rec.rate_hz * WINDOW_MIN_S)))
+            labels, directions = leg_labels(t, turn_threshold_degc(t), _shortest_leg(rec))
             for j, d in enumerate(directions):
                 folds.append(
                     Fold(
@@ -209,7 +209,8 @@ def make_sample_folds(recordings: list[Recording], kind: str = "auto") -> tuple[
 
 def training_runs(recordings: list[Recording], fold: Fold, kind: str) -> list[Recording]:
     """The runs a fit without ``fold`` is made on: the other runs (``runs``), or every run with the fold's rows
-    taken out (``legs``, ``blocks``)."""
+    taken out (``legs``, ``blocks``); a run the fold holds whole or all but a sliver of (a run of one leg: less
+    than a leg's shortest length left) is left out."""
     if kind == "runs":
         return [r for k, r in enumerate(recordings) if k != fold.run]
     out = []
@@ -217,9 +218,16 @@ def training_runs(recordings: list[Recording], fold: Fold, kind: str) -> list[Re
         if k == fold.run:
             keep = np.ones(rec.n_samples, dtype=bool)
             keep[fold.rows] = False
+            if np.count_nonzero(keep) < _shortest_leg(rec):
+                continue
             rec = rec.take(keep)
         out.append(rec)
     return out
+
+
+def _shortest_leg(rec: Recording) -> int:
+    """The fewest samples a leg of ``rec`` holds (as :func:`make_sample_folds` cuts them)."""
+    return max(10, int(rec.rate_hz * WINDOW_MIN_S))
 
 
 def fold_window_s(recordings: list[Recording], folds: list[Fold]) -> float:
