@@ -166,6 +166,18 @@ def store_url(location: str | os.PathLike) -> str:
     return f"sqlite:///{path.resolve()}"
 
 
+def shown_location(location: str | os.PathLike) -> str:
+    """A store location as gyrocomp prints and writes it: a URL with its password masked (``***``, as SQLAlchemy
+    renders one), a path as given."""
+    text = os.fspath(location)
+    if "://" not in text:
+        return text
+    try:
+        return sa.engine.make_url(text).render_as_string(hide_password=True)
+    except (sa.exc.ArgumentError, ValueError):  # not a URL SQLAlchemy parses: nothing after the scheme is shown
+        return text.split("://", 1)[0] + "://***"
+
+
 def sqlite_file(location: str | os.PathLike) -> Path:
     """The SQLite file a store location that is not a URL names (the file, or ``calibrations.sqlite`` in the
     folder), as given: not resolved."""
@@ -207,7 +219,8 @@ class CalibrationStore:
     processes creating one store at once both end with it made once."""
 
     def __init__(self, location: str | os.PathLike, *, create: bool = False) -> None:
-        self.location = os.fspath(location)
+        #: the store as messages name it (a URL's password masked: :func:`shown_location`)
+        self.location = shown_location(location)
         url = store_url(location)
         #: the SQLite file of the store (None for a server database)
         self.file: Path | None = None
@@ -225,8 +238,10 @@ class CalibrationStore:
             self.engine = sa.create_engine(
                 url, **({"connect_args": {"timeout": SQLITE_BUSY_TIMEOUT_S}} if self.file is not None else {})
             )
-        except (sa.exc.ArgumentError, sa.exc.NoSuchModuleError, ModuleNotFoundError) as exc:
-            raise InputError(f"{self.location}: not a database URL SQLAlchemy can open ({exc})") from None
+        except (sa.exc.ArgumentError, sa.exc.NoSuchModuleError, ModuleNotFoundError, ValueError) as exc:
+            # a URL's parse errors quote the URL, password and all: named by their kind alone
+            why = exc if isinstance(exc, (sa.exc.NoSuchModuleError, ModuleNotFoundError)) else type(exc).__name__
+            raise InputError(f"{self.location}: not a database URL SQLAlchemy can open ({why})") from None
         if self.file is not None:
             _serialize_sqlite_writes(self.engine)
         self._prepare(create)
@@ -239,6 +254,12 @@ class CalibrationStore:
             raise InputError(f"{self.location}: not a database ({exc.orig})") from None
         if not present and not create:
             raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
+        if present and not inspector.has_table(_INFO.name):
+            raise InputError(
+                f"{self.location}: its calibrations table was not written by gyrocomp (the database has no "
+                f"{_INFO.name} table); gyrocomp neither reads nor writes it: give a store of its own (a new "
+                "database, SQLite file or folder)"
+            )
         version = self._version() if present else None
         if present and (version is None or not version.isdigit() or int(version) > STORE_SCHEMA_VERSION):
             raise InputError(
@@ -530,6 +551,7 @@ __all__ = [
     "CalibrationStore",
     "InputFile",
     "parse_time",
+    "shown_location",
     "store_url",
     "utc_now",
 ]
