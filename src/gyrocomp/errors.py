@@ -115,10 +115,13 @@ class ModelChoiceWarning(UserWarning):
     the chosen one leaves more drift there than the raw output)."""
 
 
-def printable(text: str) -> str:
-    """``text`` with control characters escaped (``\\n``, ``\\x1b``): a newline or a raw byte in a message (a file
-    name's, a foreign library's) would otherwise break a one-line message or the terminal."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+def printable(text: str, lines: bool = False) -> str:
+    """``text`` with control characters escaped (``\\n``, ``\\x1b``), and the other characters that are not
+    printable (bidirectional overrides such as ``\\u202e``, zero-width characters): a newline, a terminal's escape
+    sequence or a reversal in a message (a file name's, a serial's, a foreign library's) would otherwise break a
+    one-line message, take over the terminal or show other text than there is. ``lines``: keep newlines (text of
+    several lines, each made printable)."""
+    return "".join(c if c.isprintable() or (lines and c == "\n") else repr(c)[1:-1] for c in text)
 
 
 #: the characters of a foreign library's message kept in one of gyrocomp's

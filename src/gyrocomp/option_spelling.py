@@ -15,6 +15,8 @@ Nothing here imports more than the standard library (and the package's errors), 
 
 from __future__ import annotations
 
+import json
+
 import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import MISSING, dataclass
@@ -89,13 +91,20 @@ def from_values(cls: type[T], values: Mapping[str, Any]) -> T:
     return cls(**kwargs)
 
 
+def _column_text(column: str) -> str:
+    """A column's name in a mapping's text: as it is, or in double quotes (a JSON string) where a comma, an equals
+    sign, a bracket, a quote or an outer space would otherwise change how the text splits."""
+    plain = column == column.strip() and not any(c in column for c in ',="[]') and not column.startswith('"')
+    return column if plain or not column else json.dumps(column, ensure_ascii=False)
+
+
 def mapping_text(value: Any, where: str) -> str:
     """A mapping option as its command-line text ``KEY=VALUE,...``, from that text or a table of key = value
     (a project file's ``columns``); ``where`` names it in the message of a value that is neither."""
     if isinstance(value, dict):
         if not all(isinstance(v, str) for v in value.values()):
             raise InputError(f"{where}: each channel names a column (a string)")
-        return ",".join(f"{k}={v}" for k, v in value.items())
+        return ",".join(f"{k}={_column_text(v)}" for k, v in value.items())
     if not isinstance(value, str):
         raise InputError(f"{where}: a string CH=COL,... or a table of channel = column")
     return value

@@ -12,7 +12,7 @@ from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..report.figures import allan_figure, check_figure_path
-from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, read_settings
+from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, read_settings, echo
 from .render import print_noise
 
 
@@ -75,13 +75,13 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopi
             progress=progress,
         )
     if analysis.how and not ctx.obj["quiet"]:
-        click.echo(f"gyrocomp: note: {analysis.how}", err=True)
+        echo(f"gyrocomp: note: {analysis.how}", err=True)
     if kalibr:
         write_text_atomic(kalibr, kalibr_imu_yaml(kalibr_imu(analysis, rostopic)))
     if plot_path:
         allan_figure(analysis, plot_path)
     if as_json:
-        click.echo(json.dumps(analysis.to_dict(), indent=2))
+        echo(json.dumps(analysis.to_dict(), indent=2), lines=True)
     elif not ctx.obj["quiet"]:
         print_noise(analysis)
 

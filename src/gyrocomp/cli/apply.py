@@ -11,6 +11,7 @@ from ..files.apply import apply_file
 from ..files.apply_bag import apply_bag, apply_bag_instances
 from ..io import detect_format, instances, output_format, refuse_to_overwrite_inputs
 from .common import (
+    echo,
     FINITE,
     OUTPUT_FILE,
     instance_model_path,
@@ -99,7 +100,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **
         )
     rows, done = result.rows, result.axes
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}: {rows} rows, {', '.join(done)} compensated")
+        echo(f"wrote {output}: {rows} rows, {', '.join(done)} compensated")
 
 
 def _apply_instances(ctx, model, input_path, output, opts: dict, noise_path) -> None:
@@ -137,7 +138,7 @@ def _said_bag(output, done, rest: str) -> None:
         for d in done
     )
     whole = "" if all(d.streamed for d in done) else " (read whole: its IMU stamps go back across batches)"
-    click.echo(f"wrote {output}: {topics}, {rest}{whole}")
+    echo(f"wrote {output}: {topics}, {rest}{whole}")
 
 
 __all__ = ["apply"]

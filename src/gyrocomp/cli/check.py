@@ -12,6 +12,7 @@ from ..io.inputs import expand_runs
 from ..models.options import FitOptions
 from .entry_point import in_cli_words
 from .common import (
+    echo,
     accept_option,
     parse_temperature_option,
     pop_read_options,
@@ -50,9 +51,9 @@ def check(ctx, runs, temperature, hysteresis, accept, as_json, **kwargs):
     ask = ask_for(FitOptions(temperature=parse_temperature_option(temperature), hysteresis=hysteresis))
     _, checks = check_files(expand_runs(runs), read_settings(opts), opts["fmt"], ask, accept)
     if as_json:
-        click.echo(json.dumps([c.to_dict() for c in checks], indent=2))
+        echo(json.dumps([c.to_dict() for c in checks], indent=2), lines=True)
     elif not ctx.obj["quiet"]:
         for c in checks:
-            click.echo(in_cli_words(c.line()))
+            echo(in_cli_words(c.line()))
     if any(c.verdict == "refused" for c in checks):
         ctx.exit(REFUSED_EXIT)

@@ -12,7 +12,7 @@ import click
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 
-from ..errors import InputError
+from ..errors import InputError, printable
 from ..option_spelling import Spelling, from_values, spelled_fields
 from .projectfile import ReadingOption
 from ..io import ReadOptions, format_spelling, read_input
@@ -45,8 +45,23 @@ class OutputFile(click.Path):
 OUTPUT_FILE = OutputFile()
 
 
+class _InertConsole(Console):
+    """A console that shows text as it is: no markup, and control and bidirectional characters escaped
+    (:func:`gyrocomp.errors.printable`) in every text it renders, a table's cells and titles too (a serial, a
+    station's or a file's name holding a terminal's escape sequence cannot reach the terminal)."""
+
+    def render_str(self, text: str, **kwargs):
+        return super().render_str(printable(text, lines=True), **kwargs)
+
+
 def make_console() -> Console:
-    return Console(width=None if sys.stdout.isatty() else 160, highlight=False, markup=False)
+    return _InertConsole(width=None if sys.stdout.isatty() else 160, highlight=False, markup=False)
+
+
+def echo(message: str, err: bool = False, lines: bool = False) -> None:
+    """``click.echo`` of a one-line message with control and bidirectional characters escaped, a newline too (a
+    file's name cannot break the line); ``lines``: a text of several lines (JSON), its newlines kept."""
+    click.echo(printable(str(message), lines=lines), err=err)
 
 
 def _parsed(parse):

@@ -10,7 +10,7 @@ from ..files.convert import convert_file
 from ..files.convert_bag import convert_bag
 from ..io import detect_format, output_format, refuse_to_overwrite_inputs
 from ..io.rosbag import KIND_WORDS
-from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings
+from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings, echo
 
 
 @click.command()
@@ -31,7 +31,7 @@ def convert(ctx, input_path, output, **kwargs):
     if in_fmt == "rosbag" and Path(output).suffix.lower() in ("", ".bag", ".mcap"):
         done = convert_bag(input_path, output)
         if not ctx.obj["quiet"]:
-            click.echo(
+            echo(
                 f"wrote {output}: {KIND_WORDS[done.kind]}, every message of {input_path} ({KIND_WORDS[done.from_kind]})"
             )
         return
@@ -49,7 +49,7 @@ def convert(ctx, input_path, output, **kwargs):
     )
     if not ctx.obj["quiet"]:
         said = f", {gaps} time gap(s)" if gaps else ""
-        click.echo(f"wrote {output}: {rows} rows, {duration_s:.6g} s at {rate_hz:.6g} Hz{said}; {', '.join(channels)}")
+        echo(f"wrote {output}: {rows} rows, {duration_s:.6g} s at {rate_hz:.6g} Hz{said}; {', '.join(channels)}")
 
 
 __all__ = ["convert"]

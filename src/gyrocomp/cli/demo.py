@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from ..report.demo import run_demo
-from .common import make_console
+from .common import make_console, echo
 from .render import print_evaluation, print_validation
 
 
@@ -28,7 +28,7 @@ def demo(ctx, out_dir):
 
     result = run_demo(Path(out_dir))
     if result.report_skipped:
-        click.echo(f"gyrocomp: note: no report.html: {result.report_skipped}", err=True)
+        echo(f"gyrocomp: note: no report.html: {result.report_skipped}", err=True)
     if not ctx.obj["quiet"]:
         console = make_console()
         console.print(result.summary)

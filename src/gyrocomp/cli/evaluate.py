@@ -18,6 +18,7 @@ from ..evaluation.comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
 from .common import (
+    echo,
     hysteresis_band,
     pop_read_options,
     progress_bar,
@@ -109,7 +110,7 @@ def evaluate(
     expected = calibration.report.expected_drift()
     in_sample = [str(path) for path in runs if calibration.fitted_on(path)]
     for path in in_sample if not quiet else ():
-        click.echo(
+        echo(
             f"gyrocomp: note: {path}: the model was fitted on this file, so its figures are in-sample; on new "
             "data expect the held-out drift the model file states (gyrocomp show)",
             err=True,
@@ -117,12 +118,12 @@ def evaluate(
     if as_json:
         document = {**evaluation.to_dict(), "in_sample_files": in_sample}
         document["expected_held_out_drift"] = [e.to_dict() for e in expected.values()]
-        click.echo(json.dumps(document, indent=2))
+        echo(json.dumps(document, indent=2), lines=True)
     elif not quiet:
         print_evaluation(evaluation)
         print_expected_drift(expected)
         if turn_on_window_s is not None:
-            click.echo(
+            echo(
                 f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
                 "its first seconds; bias offset, bias instability and integration time do not depend on a "
                 "constant, so only the compensated output (gyrocomp apply) shows it",
@@ -134,7 +135,7 @@ def _installed(calibration: Calibration, runs, opts: dict, window_s, as_json: bo
     """--installed: the thermal calibration installed on the vehicle against the model, on its logs."""
     results = [compare_installed(calibration, read_run(path, opts).recording, window_s=window_s) for path in runs]
     if as_json:
-        click.echo(json.dumps({"runs": [dataclasses.asdict(r) for r in results]}, indent=2, default=_nan_none))
+        echo(json.dumps({"runs": [dataclasses.asdict(r) for r in results]}, indent=2, default=_nan_none), lines=True)
     elif not quiet:
         print_installed(results)
 
@@ -144,7 +145,7 @@ def _compare(paths, opts: dict, window_s, band, as_json: bool, quiet: bool) -> N
     recordings = [read_run(path, opts).recording for path in paths]
     result = compare_methods(recordings, window_s=window_s, hysteresis_band_degc=band)
     if as_json:
-        click.echo(json.dumps(result.to_dict(), indent=2))
+        echo(json.dumps(result.to_dict(), indent=2), lines=True)
     elif not quiet:
         print_comparison(result)
 
@@ -163,7 +164,7 @@ def _stages(calibration: Calibration, model, runs, opts: dict, window_s, turn_on
         for path in runs
     ]
     if as_json:
-        click.echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2))
+        echo(json.dumps({"runs": [s.to_dict() for s in staged]}, indent=2), lines=True)
     elif not quiet:
         print_stages(staged)
 

@@ -8,7 +8,7 @@ from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs
 from ..export import EXPORTERS, ExportOptions, export_to, format_of
 from ..fitting.online import LearnerSettings, OnlineCalibrator
-from .common import FINITE
+from .common import FINITE, echo
 
 
 #: the formats gyrocomp export offers (the model file itself is already a file: fleet export offers json too)
@@ -108,12 +108,12 @@ def write_export(
     )
     if quiet:
         return
-    click.echo("wrote " + " and ".join(str(p) for p in done.written))
+    echo("wrote " + " and ".join(str(p) for p in done.written))
     for line in done.notes:
-        click.echo(line)
+        echo(line)
     if done.firmware is not None:
         for line in done.firmware.lines():
-            click.echo(line)
+            echo(line)
 
 
 __all__ = ["EXPORT_FORMATS", "export", "write_export"]

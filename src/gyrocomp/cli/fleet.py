@@ -32,6 +32,7 @@ from ..report.certificate import build_certificate, print_pdf
 from ..fleet.certify import held_out_of
 from .entry_point import in_cli_words
 from .common import (
+    echo,
     FINITE,
     accept_option,
     OUTPUT_FILE,
@@ -301,7 +302,7 @@ def status(store, as_json):
     with CalibrationStore(store) as db:
         stations = station_status(db)
     if as_json:
-        click.echo(
+        echo(
             json.dumps(
                 [
                     {
@@ -312,10 +313,11 @@ def status(store, as_json):
                     for s in stations
                 ],
                 indent=2,
-            )
+            ),
+            lines=True,
         )
         return
-    print_station_status(stations, store)
+    print_station_status(stations, db.location)
 
 
 @fleet.command("show")
@@ -342,7 +344,7 @@ def show(ctx, serial, store, at, history, as_json, output):
         if history:
             rows = db.history(serial)
             if not rows:
-                raise InputError(f"serial: no unit {serial!r} in {store}")
+                raise InputError(f"serial: no unit {serial!r} in {db.location}")
             _print_history(rows)
             return
         record = db.valid_at(serial, when)
@@ -350,7 +352,7 @@ def show(ctx, serial, store, at, history, as_json, output):
     if output is not None:
         calibration.save(output)
     if as_json:
-        click.echo(json.dumps(_record_document(record), indent=2))
+        echo(json.dumps(_record_document(record), indent=2), lines=True)
     elif not ctx.obj["quiet"]:
         _print_record(record, calibration)
 
@@ -437,10 +439,11 @@ def report(ctx, store, output, limits_file):
     with CalibrationStore(store) as db:
         _refuse_output_over_store(output, db)
         table = fleet_table(db.latest_rows(), limits)
-    page = build_fleet_report(table, limits=limits, title=str(store))
+        title = db.location
+    page = build_fleet_report(table, limits=limits, title=title)
     write_text_atomic(output, page.html)
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output} ({len(table)} units; sections: {', '.join(page.sections)})")
+        echo(f"wrote {output} ({len(table)} units; sections: {', '.join(page.sections)})")
 
 
 @fleet.command("certificate")
@@ -483,11 +486,17 @@ def certificate(ctx, serial, store, output, pdf, limits_file, at, **kwargs):
         record = db.valid_at(serial, parse_time(at) if at else None)
     write_certificate(record, output, pdf, limits, read_settings(opts), opts["fmt"])
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}" + (f" and {pdf}" if pdf else "") + f" (unit {serial}, row {record.id})")
+        echo(f"wrote {output}" + (f" and {pdf}" if pdf else "") + f" (unit {serial}, row {record.id})")
 
 
 def write_certificate(record, output, pdf, limits, read=None, fmt=None) -> None:
-    """Build the certificate of ``record`` and write it (and its PDF) atomically."""
+    """Build the certificate of ``record`` and write it (and its PDF) atomically; neither output may be one of the
+    unit's runs (read again for the residual), nor the PDF the HTML page it prints."""
+    runs = [i.path for i in record.inputs]
+    refuse_to_overwrite_inputs(output, runs, "-o", f"one of unit {record.serial}'s runs")
+    if pdf is not None:
+        refuse_to_overwrite_inputs(pdf, runs, "--pdf", f"one of unit {record.serial}'s runs")
+        refuse_to_overwrite_inputs(pdf, [output], "--pdf", "the HTML page (-o) it is printed from")
     page = build_certificate(record, held_out=held_out_of(record, read, fmt), limits=limits)
     write_text_atomic(output, page.html)
     if pdf is not None:

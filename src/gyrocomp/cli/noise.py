@@ -12,7 +12,16 @@ from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.inputs import expand_runs
 from ..measures.noise_model import noise_model, noise_over_temperature
-from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, read_run, read_settings
+from .common import (
+    OUTPUT_FILE,
+    fit_taus_option,
+    pop_read_options,
+    progress_bar,
+    read_options,
+    read_run,
+    read_settings,
+    echo,
+)
 from .render import print_bias_process_noise, print_noise_model
 
 
@@ -111,7 +120,7 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
         if benefit is not None:
             print_bias_process_noise(benefit)
         if export_format is not None:
-            click.echo(f"wrote {output} ({export_format})")
+            echo(f"wrote {output} ({export_format})")
 
 
 __all__ = ["noise"]

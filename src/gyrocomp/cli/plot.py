@@ -15,7 +15,7 @@ from ..measures.merit import default_window_s
 from ..report.figures import allan_plot, require_matplotlib, save_figure, temperature_plot, timeseries_plot
 from ..measures.noise import analyse_noise
 from ..report.figures import check_figure_path
-from .common import OUTPUT_FILE, pop_read_options, read_options, read_run, turn_on_window_option, window_option
+from .common import OUTPUT_FILE, pop_read_options, read_options, read_run, turn_on_window_option, window_option, echo
 
 
 @click.group()
@@ -77,7 +77,7 @@ def plot_allan(ctx, input_path, model, axes, split_gaps, output, **kwargs):
         analyses["compensated"] = analyse_noise(comp, names, split_gaps=split_gaps, motion_check=False)  # said raw
     save_figure(allan_plot(analyses, title=f"Allan deviation: {Path(input_path).name}"), output)
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}")
+        echo(f"wrote {output}")
 
 
 @plot.command("temperature")
@@ -98,7 +98,7 @@ def plot_temperature(ctx, model, runs, axis, output, **kwargs):
     axis = _axis_option(axis, calibration, recordings[0])
     save_figure(temperature_plot(recordings, comps, axis, "g" if axis.startswith("accel") else "deg/s"), output)
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}")
+        echo(f"wrote {output}")
 
 
 @plot.command("timeseries")
@@ -130,7 +130,7 @@ def plot_timeseries(ctx, model, run, axis, window_s, turn_on_window_s, output, *
         output,
     )
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}")
+        echo(f"wrote {output}")
 
 
 __all__ = ["plot", "plot_allan", "plot_temperature", "plot_timeseries"]

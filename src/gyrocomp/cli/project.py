@@ -5,22 +5,39 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import shlex
 import sys
 from pathlib import Path
 
 import click
 
-from ..errors import InputError
+from ..errors import InputError, printable
 from ..io import format_spelling, refuse_to_overwrite_inputs, write_text_atomic
 from ..io.project import FORMAT_KEY
 from ..io.guess import HeaderlessTable, guess_layout
 from ..io.serial import parse_names, parse_rate
-from .common import OUTPUT_FILE, make_console
+from .common import OUTPUT_FILE, make_console, echo
 from .projectfile import PROJECT_FILE, PROJECT_KEY
 
 
+#: TOML's short escapes in a basic string
+_TOML_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
+
+
 def _toml_text(value) -> str:
-    return json.dumps(value, ensure_ascii=True) if isinstance(value, str) else json.dumps(value)
+    """A value as TOML: a string quoted (a basic string: quotes, backslashes and control characters escaped, so a
+    name cannot end the value or add a line), a number or a boolean as it is."""
+    if not isinstance(value, str):
+        return json.dumps(value)
+    return '"' + "".join(_TOML_ESCAPES.get(c) or _toml_char(c) for c in value) + '"'
+
+
+def _toml_char(c: str) -> str:
+    if ord(c) < 0x20 or ord(c) == 0x7F:
+        return f"\\u{ord(c):04X}"
+    if 0xD800 <= ord(c) < 0xE000:  # a byte of a name that is not UTF-8 (a surrogate escape): TOML has no spelling
+        raise InputError(f"{c!r}: a name that is not UTF-8 cannot be written into the project file; rename it")
+    return c
 
 
 @click.command()
@@ -63,7 +80,7 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
                 f"{exc.example!r}); give their names in order with --names (e.g. --names "
                 "gyro_x,gyro_y,gyro_z,temperature), and --rate HZ if it has no time column"
             ) from None
-        click.echo(f"{log} has no header line; its rows hold {exc.count} numbers, e.g. {exc.example}")
+        echo(f"{log} has no header line; its rows hold {exc.count} numbers, e.g. {exc.example}")
         names = click.prompt(
             f"their {exc.count} names in order (time, gyro_x..z, accel_x..z, temperature; "
             "any other name leaves a column unused)"
@@ -73,10 +90,10 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
         guess = guess_layout(log, parse_names(names), rate_hz, fmt)
     layout = guess.layout
     lines = [
-        f"# gyrocomp project file: written by `gyrocomp init {Path(log).name}` on "
+        f"# gyrocomp project file: written by `gyrocomp init {printable(Path(log).name)}` on "
         f"{_dt.date.today().isoformat()}; every gyrocomp command run in this folder reads it",
         "# (an option on the command line wins; `gyrocomp config show` prints what is in use)",
-        *(f"# {reason}" for reason in guess.reasons),
+        *(f"# {printable(reason)}" for reason in guess.reasons),
         "",
         "[read]",
         "# channel = the file's column",
@@ -92,19 +109,19 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
         read["names"] = ",".join(layout.names)
     if layout.rate_hz is not None:
         read["rate"] = layout.rate_hz
+        if "time" not in layout.columns:  # rows read at the rate: a time column the file may have is left unread
+            lines.append('time = ""')
     # TOML: a table's keys come before its sub-tables, so the units go in a [read] written before [read.columns]
     head = lines.index("[read]")
     lines[head + 1 : head + 1] = [f"{k} = {_toml_text(v)}" for k, v in read.items()]
     write_text_atomic(output, "\n".join(lines) + "\n")
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output} from {log}:")
+        echo(f"wrote {output} from {log}:")
         for reason in guess.reasons:
-            click.echo(f"  {reason}")
+            echo(f"  {reason}")
         if guess.unused:
-            click.echo(
-                f"  columns not used: {', '.join(n if n.strip() else repr(n) + ' (unnamed)' for n in guess.unused)}"
-            )
-        click.echo("check the units above; then e.g. gyrocomp fit " + Path(log).name + " -o model.json")
+            echo(f"  columns not used: {', '.join(n if n.strip() else repr(n) + ' (unnamed)' for n in guess.unused)}")
+        echo("check the units above; then e.g. gyrocomp fit " + shlex.quote(Path(log).name) + " -o model.json")
 
 
 @click.group()
@@ -119,11 +136,11 @@ def show(ctx, as_json):
     """Print the project file in use and the options it gives each command."""
     project = ctx.meta.get(PROJECT_KEY)  # loaded by the command group, before any command runs
     if project is None:
-        click.echo(f"no project file: no {PROJECT_FILE} in {Path.cwd()} and no --config")
+        echo(f"no project file: no {PROJECT_FILE} in {Path.cwd()} and no --config")
         return
     data = {"path": project.path, "read": project.read, "defaults": project.defaults, "commands": project.commands}
     if as_json:
-        click.echo(json.dumps(data, indent=2))
+        echo(json.dumps(data, indent=2), lines=True)
         return
     console = make_console()
     console.print(f"project file: {project.path}")

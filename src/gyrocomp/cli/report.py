@@ -10,6 +10,7 @@ from ..report.figures import require_matplotlib
 from ..report.html import build_report
 from ..evaluation.validation import validate as validate_runs
 from .common import (
+    echo,
     FINITE,
     OUTPUT_FILE,
     pop_read_options,
@@ -74,7 +75,7 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
         )
     write_text_atomic(output, result.html)
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {output}: {len(result.html) / 1e6:.2f} MB, sections {', '.join(result.sections)}")
+        echo(f"wrote {output}: {len(result.html) / 1e6:.2f} MB, sections {', '.join(result.sections)}")
 
 
 __all__ = ["report"]

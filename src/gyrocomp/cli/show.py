@@ -8,7 +8,7 @@ import click
 from rich.table import Table
 
 from ..calibration import Calibration
-from .common import make_console
+from .common import make_console, echo
 from .render import print_expected_drift
 
 
@@ -24,7 +24,7 @@ def show(ctx, model, as_json):
     expected = calibration.report.expected_drift()
     inputs = [i for i in (calibration.provenance or {}).get("inputs", ()) if isinstance(i, dict)]
     if as_json:
-        click.echo(
+        echo(
             json.dumps(
                 {
                     "model": calibration.model,
@@ -35,7 +35,8 @@ def show(ctx, model, as_json):
                     "provenance": calibration.provenance,
                 },
                 indent=2,
-            )
+            ),
+            lines=True,
         )
         return
     if ctx.obj["quiet"]:

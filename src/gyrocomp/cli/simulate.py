@@ -19,7 +19,7 @@ from ..simulation import (
     truth_document,
 )
 from ..simulation import simulate as run_simulation
-from .common import FINITE, OUTPUT_FILE, float_list
+from .common import FINITE, OUTPUT_FILE, float_list, echo
 
 
 @click.command()
@@ -148,7 +148,7 @@ def simulate(
         if not ctx.obj["quiet"]:
             rec = sim.recording
             gaps = f", {len(rec.gaps)} gaps" if rec.gaps else ""
-            click.echo(f"wrote {path}: {rec.n_samples} rows, {rec.duration_s:g} s at {rate_hz:g} Hz{gaps}")
+            echo(f"wrote {path}: {rec.n_samples} rows, {rec.duration_s:g} s at {rate_hz:g} Hz{gaps}")
     if truth:
         doc = truth_document([(path.name, sim) for path, sim in records])
         write_text_atomic(truth, json.dumps(doc, indent=2) + "\n")

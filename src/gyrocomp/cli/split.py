@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..io import refuse_to_overwrite_inputs, write_rows
 from ..io.tables import PARQUET_SUFFIXES
 from ..runs.runsplit import SPLITS, split_runs
-from .common import FINITE, pop_read_options, read_options, read_run
+from .common import FINITE, pop_read_options, read_options, read_run, echo
 
 
 @click.command()
@@ -84,10 +84,10 @@ def split(ctx, log, folder, by, min_gap_s, min_still_s, min_leg_degc, suffix, **
     for piece, path in zip(pieces, names):
         write_rows(data, slice(piece.start, piece.stop), path)
     if not ctx.obj["quiet"]:
-        click.echo(f"wrote {len(pieces)} run(s) of {log} to {folder} (by {by}):")
+        echo(f"wrote {len(pieces)} run(s) of {log} to {folder} (by {by}):")
         for piece, path in zip(pieces, names):
             rec = piece.recording
-            click.echo(
+            echo(
                 f"  {path.name}: {rec.n_samples} rows, {rec.time_s[0] - t0:.6g} .. {rec.time_s[-1] - t0:.6g} s"
                 + (
                     ""

@@ -9,7 +9,7 @@ import click
 from ..models.options import FitOptions
 from ..fitting.folds import FOLD_KINDS
 from ..evaluation.validation import validate as validate_runs
-from .common import FINITE, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options
+from .common import FINITE, pop_read_options, read_run, parse_temperature_option, progress_bar, read_options, echo
 from .render import print_validation
 
 
@@ -62,7 +62,7 @@ def validate(ctx, runs, folds, window_s, candidates, as_json, **kwargs):
     with progress_bar("validating", indeterminate=True):
         result = validate_runs(recordings, folds=folds, window_s=window_s, candidates=named)
     if as_json:
-        click.echo(json.dumps(result.to_dict(), indent=2))
+        echo(json.dumps(result.to_dict(), indent=2), lines=True)
     elif not ctx.obj["quiet"]:
         print_validation(result)
 

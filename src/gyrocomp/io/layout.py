@@ -3,7 +3,7 @@ line (the names and a nominal rate); each field a reading option (:mod:`gyrocomp
 
 from __future__ import annotations
 
-import re
+import json
 import warnings
 from dataclasses import dataclass
 
@@ -49,21 +49,56 @@ UNMAPPED = ""
 
 def parse_column_mapping(text: str | None) -> dict[str, str]:
     """Parse ``"gyro_z=GyrZ,temperature=T"`` into ``{"gyro_z": "GyrZ", "temperature": "T"}``; a comma inside
-    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array); ``time=`` leaves the time
-    unread (:data:`UNMAPPED`)."""
+    brackets belongs to the column (``gyro_x=imu[:, 0]``, a column of an HDF5 array); a column in double quotes is
+    taken as written, commas, equals signs and spaces included (``gyro_z="g=z, 2"``; a JSON string, ``\\"`` for a
+    quote: :func:`gyrocomp.option_spelling.mapping_text` quotes so); ``time=`` leaves the time unread
+    (:data:`UNMAPPED`)."""
     if not text:
         return {}
     mapping = {}
-    for item in re.split(r",(?![^\[]*\])", text):
+    for item in _mapping_items(text):
         if not item.strip():
             continue
         if "=" not in item:
             raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
         key, value = (part.strip() for part in item.split("=", 1))
+        if value.startswith('"'):
+            try:
+                value = json.loads(value)
+            except json.JSONDecodeError:
+                raise InputError(
+                    f"columns: {item.strip()!r}: a quoted column is one JSON string (\\\" for a quote inside it)"
+                ) from None
         if not key or not value and key != TIME_COLUMN:  # time= (nothing): the time left unread, UNMAPPED
             raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
         mapping[key] = value
     return mapping
+
+
+def _mapping_items(text: str) -> list[str]:
+    """The ``CHANNEL=COLUMN`` items of a mapping's text: split at the commas outside brackets and quotes."""
+    items, start, depth, quoted, escaped = [], 0, 0, False, False
+    for k, c in enumerate(text):
+        if quoted:
+            if escaped:
+                escaped = False
+            elif c == "\\":
+                escaped = True
+            elif c == '"':
+                quoted = False
+        elif c == '"':
+            quoted = True
+        elif c == "[":
+            depth += 1
+        elif c == "]":
+            depth = max(0, depth - 1)
+        elif c == "," and depth == 0:
+            items.append(text[start:k])
+            start = k + 1
+    if quoted:
+        raise InputError(f"columns: {text!r}: a quoted column is not closed (a double quote is missing)")
+    items.append(text[start:])
+    return items
 
 
 def _delimiter(text: str) -> str:

@@ -8,7 +8,6 @@ figures of merit against the line's limits, and the verdict. Every text from the
 
 from __future__ import annotations
 
-import html
 import os
 import shutil
 import subprocess
@@ -18,13 +17,13 @@ from pathlib import Path
 import numpy as np
 
 from ..calibration import Calibration
-from ..errors import InputError
+from ..errors import FOREIGN_MESSAGE_CHARS, InputError, printable
 from ..evaluation.held_out import BAND_LEVEL, HeldOut
 from ..fleet.limits import Limits
 from ..fleet.store import CalibrationRecord
 from ..io.atomic import atomic_path
 from . import figures
-from .html import Report, figure_html, html_page, table_html
+from .html import Report, escape_text, figure_html, html_page, table_html
 
 SECTIONS = ("unit", "inputs", "model", "residual", "merit")
 #: printed: A4, small type, no navigation, the figure a third of a page: two pages for a three-axis unit
@@ -74,9 +73,9 @@ def _unit(record: CalibrationRecord, verdict: str | None) -> str:
         ["verdict", words],
     ]
     return (
-        f'<p class="lead"><strong>{html.escape(words)}</strong></p>'
+        f'<p class="lead"><strong>{escape_text(words)}</strong></p>'
         + table_html(["", ""], rows)
-        + ("".join(f"<p class=note>{html.escape(w)}</p>" for w in record.warnings[:5]))
+        + ("".join(f"<p class=note>{escape_text(w)}</p>" for w in record.warnings[:5]))
     )
 
 
@@ -168,9 +167,14 @@ def _bounds(limits: Limits, row: dict) -> dict[str, str]:
     return out
 
 
-def print_pdf(page: str | os.PathLike, pdf: str | os.PathLike) -> Path:
-    """Print the HTML file ``page`` to ``pdf`` with headless Chromium (atomically); one line when no Chromium is
-    installed (Debian's package ``chromium``)."""
+#: how long Chromium may take to print a certificate [s] (a few seconds on a 2-core machine; one that hangs is stopped)
+PDF_TIMEOUT_S = 60.0
+
+
+def print_pdf(page: str | os.PathLike, pdf: str | os.PathLike, timeout_s: float = PDF_TIMEOUT_S) -> Path:
+    """Print the HTML file ``page`` to ``pdf`` with headless Chromium (atomically), within ``timeout_s`` [s]; one
+    line when no Chromium is installed (Debian's package ``chromium``), when it hangs, fails or writes something
+    that is not a PDF (nothing is then written at ``pdf``)."""
     browser = next((shutil.which(n) for n in CHROMIUM_NAMES if shutil.which(n)), None)
     if browser is None:
         raise InputError(
@@ -178,29 +182,43 @@ def print_pdf(page: str | os.PathLike, pdf: str | os.PathLike) -> Path:
             "chromium); the HTML certificate was written"
         )
     with atomic_path(pdf) as tmp, tempfile.TemporaryDirectory() as profile:
-        done = subprocess.run(
-            [
-                browser,
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--no-first-run",
-                "--disable-background-networking",
-                f"--user-data-dir={profile}",
-                "--no-pdf-header-footer",
-                f"--print-to-pdf={tmp}",
-                Path(page).resolve().as_uri(),
-            ],
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
-        if done.returncode != 0 or not tmp.stat().st_size:
+        command = [
+            browser,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            f"--user-data-dir={profile}",
+            "--no-pdf-header-footer",
+            f"--print-to-pdf={tmp}",
+            Path(page).resolve().as_uri(),
+        ]
+        try:
+            done = subprocess.run(command, capture_output=True, timeout=timeout_s)
+        except subprocess.TimeoutExpired:
             raise InputError(
-                f"{pdf}: Chromium could not print {page} (exit {done.returncode}: "
-                f"{done.stderr.strip().splitlines()[-1:] or ''})"
+                f"{pdf}: Chromium ({browser}) did not print {page} within {timeout_s:g} s and was stopped; "
+                "the HTML certificate was written"
+            ) from None
+        if done.returncode != 0 or not _is_pdf(tmp):
+            said = done.stderr.decode("utf-8", "replace").strip().splitlines()[-1:]
+            why = f"exit {done.returncode}" if done.returncode != 0 else "what it wrote is not a PDF"
+            raise InputError(
+                f"{pdf}: Chromium ({browser}) could not print {page} ({why}"
+                + (f": {printable(said[0])[:FOREIGN_MESSAGE_CHARS]}" if said else "")
+                + "); the HTML certificate was written"
             )
     return Path(pdf)
+
+
+def _is_pdf(path: Path) -> bool:
+    """Whether ``path`` holds a PDF: its header, and an end-of-file marker in its last KiB."""
+    with open(path, "rb") as f:
+        head = f.read(5)
+        f.seek(max(0, path.stat().st_size - 1024))
+        tail = f.read()
+    return head == b"%PDF-" and b"%%EOF" in tail
 
 
 __all__ = ["SECTIONS", "build_certificate", "print_pdf"]

@@ -18,7 +18,6 @@ averaging times and which compensation should bring back to the sensor's own noi
 
 from __future__ import annotations
 
-import html
 import json
 import warnings
 from dataclasses import dataclass
@@ -34,7 +33,7 @@ from ..io import read_table, write_gyro_back, write_recording, write_text_atomic
 from ..allan import allan_deviation_segments
 from ..measures.merit import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
 from ..models.joint import fit_calibration
-from .html import build_report, figure_html, table_html
+from .html import build_report, escape_text, figure_html, table_html
 from . import figures
 from ..simulation import get_preset, get_profile, simulate
 from ..units import DEG_PER_S_TO_DEG_PER_H
@@ -319,9 +318,9 @@ def _case_section(matters: CaseResult, not_matters: CaseResult, series) -> tuple
     ]
     body = "\n".join(
         [
-            f"<p class=lead>On a {html.escape(CASE_PRESET)} part (large tempco, 30 s thermal lag, whole-degree "
+            f"<p class=lead>On a {escape_text(CASE_PRESET)} part (large tempco, 30 s thermal lag, whole-degree "
             f"temperature), fitted on two heat-cool runs and judged on a third that goes 5 degC hotter, gyrocomp's "
-            f"default leaves <b>{html.escape(against)}</b>.</p>",
+            f"default leaves <b>{escape_text(against)}</b>.</p>",
             figure_html(
                 figures.drift_panels(
                     time_s,
@@ -337,9 +336,9 @@ def _case_section(matters: CaseResult, not_matters: CaseResult, series) -> tuple
                 f"deterministic drift each leaves on the held-out run (RMS of a {matters.window_s:g} s moving "
                 "average of output - true rate - noise, mean over the axes) [deg/s]",
             ),
-            f"<p class=note>Where compensation does not matter: the {html.escape(not_matters.part)}, whose drift is a "
+            f"<p class=note>Where compensation does not matter: the {escape_text(not_matters.part)}, whose drift is a "
             "smooth curve inside the calibrated range; gyrocomp leaves "
-            + html.escape(" and ".join(versus(f, name.split(" (")[0]) for name, f in not_matters.factor_vs.items()))
+            + escape_text(" and ".join(versus(f, name.split(" (")[0]) for name, f in not_matters.factor_vs.items()))
             + ". Its model and held-out run are the rest of this page.</p>",
         ]
     )

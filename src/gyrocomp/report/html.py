@@ -31,7 +31,7 @@ import numpy as np
 from .._version import __version__
 from ..calibration import Calibration
 from ..calibration.compensate import apply
-from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
+from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning, printable
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
 from ..export.firmware import BEYOND_DEGC, firmware_corrected_axes, firmware_costs
 from ..measures.merit import bias_offset, evaluate_run, window_samples
@@ -58,6 +58,12 @@ img { max-width: 100%; display: block; margin: 0.6em 0; border: 1px solid #ddd; 
 """
 
 
+def escape_text(text: str) -> str:
+    """``text`` for a page: HTML-escaped (quotes too), with control and bidirectional characters shown as escapes
+    (:func:`gyrocomp.errors.printable`; a serial holding a right-to-left override is shown as it is, not reversed)."""
+    return html.escape(printable(str(text), lines=True))
+
+
 @dataclass(frozen=True)
 class Report:
     """The report's HTML text and the ids of its sections, in order."""
@@ -74,7 +80,7 @@ def _png(fig) -> str:
 
 
 def _img(fig, alt: str) -> str:
-    return f'<img src="{_png(fig)}" alt="{html.escape(alt)}">'
+    return f'<img src="{_png(fig)}" alt="{escape_text(alt)}">'
 
 
 def figure_html(fig, alt: str) -> str:
@@ -90,10 +96,10 @@ def table_html(header: list[str], rows: list[list], caption: str | None = None) 
 def _table(header: list[str], rows: list[list], caption: str | None = None) -> str:
     out = ["<table>"]
     if caption:
-        out.append(f"<caption>{html.escape(caption)}</caption>")
-    out.append("<tr>" + "".join(f"<th>{html.escape(str(h))}</th>" for h in header) + "</tr>")
+        out.append(f"<caption>{escape_text(caption)}</caption>")
+    out.append("<tr>" + "".join(f"<th>{escape_text(str(h))}</th>" for h in header) + "</tr>")
     for row in rows:
-        out.append("<tr>" + "".join(f"<td{_cell_class(v)}>{html.escape(_fmt(v))}</td>" for v in row) + "</tr>")
+        out.append("<tr>" + "".join(f"<td{_cell_class(v)}>{escape_text(_fmt(v))}</td>" for v in row) + "</tr>")
     out.append("</table>")
     return "\n".join(out)
 
@@ -131,7 +137,7 @@ def _expected(drift: float, standard_error: float | None, unit: str) -> str:
 def _summary(calibration: Calibration) -> str:
     report = calibration.report
     parts = [
-        f"<p>Model <b>{html.escape(calibration.model)}</b> (schema {calibration.schema_version}). "
+        f"<p>Model <b>{escape_text(calibration.model)}</b> (schema {calibration.schema_version}). "
         f"Units: rate deg/s, acceleration g, temperature degC, time s.</p>",
         _axis_table(calibration),
     ]
@@ -166,8 +172,8 @@ def _summary(calibration: Calibration) -> str:
     if prov:
         files = ", ".join(str(f.get("file", f)) if isinstance(f, dict) else str(f) for f in prov.get("inputs", []))
         parts.append(
-            f"<p class=note>Fitted {html.escape(str(prov.get('created_utc', '')))} by gyrocomp "
-            f"{html.escape(str(prov.get('gyrocomp_version', '')))} on {html.escape(files)}.</p>"
+            f"<p class=note>Fitted {escape_text(str(prov.get('created_utc', '')))} by gyrocomp "
+            f"{escape_text(str(prov.get('gyrocomp_version', '')))} on {escape_text(files)}.</p>"
         )
     return "\n".join(parts)
 
@@ -225,7 +231,7 @@ def _validation(result: ValidationResult) -> str:
     """The held-out drift table: mean +- standard error per method and axis [deg/s], and against the cubic."""
     header, rows = result.table_rows()
     caption = f"{result.title}: each method fitted without the fold it is scored on"
-    folds = f"<p class=note>folds: {html.escape(', '.join(result.folds))}</p>"
+    folds = f"<p class=note>folds: {escape_text(', '.join(result.folds))}</p>"
     return _table(header, rows, caption) + folds
 
 
@@ -284,7 +290,7 @@ def _evaluation(
     fitted_on = [rec.source.rsplit("/", 1)[-1] for rec in runs if calibration.fitted_on(rec.metadata.get("path"))]
     if fitted_on:
         parts.append(
-            f"<p class=note><b>In-sample</b>: the model was fitted on {html.escape(', '.join(fitted_on))}; "
+            f"<p class=note><b>In-sample</b>: the model was fitted on {escape_text(', '.join(fitted_on))}; "
             "its figures there are not the drift to expect on new data (the held-out drift in the model "
             "section is).</p>"
         )
@@ -640,7 +646,7 @@ def _noise_model_table(compensated) -> str:
     try:
         model = noise_model(compensated)
     except InputError as exc:  # too short a run for two averaging times
-        return f"<p class=note>No noise model: {html.escape(str(exc))}</p>"
+        return f"<p class=note>No noise model: {escape_text(str(exc))}</p>"
     rows = [
         [
             name,
@@ -690,7 +696,7 @@ def _stillness(moving: list) -> str:
 
 def _page(calibration: Calibration, runs: list[Recording], sections: dict) -> str:
     """The self-contained HTML page: title, navigation, the sections in order."""
-    files = ", ".join(html.escape(rec.source.rsplit("/", 1)[-1]) for rec in runs)
+    files = ", ".join(escape_text(rec.source.rsplit("/", 1)[-1]) for rec in runs)
     return html_page(f"gyrocomp report: {calibration.model}", "gyrocomp report", f"runs: {files}", sections)
 
 
@@ -698,19 +704,19 @@ def html_page(title: str, heading: str, note: str, sections: dict[str, tuple[str
     """A self-contained page: ``title``, the ``heading``, the time and version with ``note`` (HTML) beside them, a
     navigation bar, and ``sections`` (id -> (title, HTML body)) in order; ``css``: more style (the page's own)."""
     created = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    nav = " ".join(f'<a href="#{sid}">{html.escape(name)}</a>' for sid, (name, _) in sections.items())
+    nav = " ".join(f'<a href="#{sid}">{escape_text(name)}</a>' for sid, (name, _) in sections.items())
     page = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>{html.escape(title)}</title>",
+        f"<title>{escape_text(title)}</title>",
         f"<style>{_CSS}{css}</style></head><body>",
-        f"<h1>{html.escape(heading)}</h1><p class=note>{created}, gyrocomp {__version__}"
+        f"<h1>{escape_text(heading)}</h1><p class=note>{created}, gyrocomp {__version__}"
         + (f"; {note}" if note else "")
         + "</p>",
         f"<nav>{nav}</nav>",
     ]
     for sid, (name, body) in sections.items():
-        page.append(f'<section id="{sid}"><h2>{html.escape(name)}</h2>\n{body}\n</section>')
+        page.append(f'<section id="{sid}"><h2>{escape_text(name)}</h2>\n{body}\n</section>')
     page.append("</body></html>")
     return "\n".join(page) + "\n"
 
