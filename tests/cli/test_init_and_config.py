@@ -2,6 +2,8 @@
 reads the file, the command line wins, and a bad file is refused in one line; through the real entry point."""
 
 import json
+import os
+import subprocess
 
 import h5py
 import numpy as np
@@ -12,7 +14,7 @@ from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError
 from gyrocomp.io.guess import guess_layout
 
-from ..conftest import run
+from ..conftest import SCRIPT, run
 
 RAD = np.pi / 180.0
 
@@ -144,7 +146,26 @@ def test_defaults_and_command_sections_apply_where_the_option_exists(tmp_path):
             r"gyrocomp.toml: \[evaluate\] windoww: gyrocomp evaluate has no option --windoww",
         ),
         ("[read\n", r"gyrocomp.toml: not a readable TOML file"),
-        ("window = 3\n", r"gyrocomp.toml: window = ...: options go in \[read\], \[defaults\] or a command's section"),
+        ("window = 3\n", r"gyrocomp.toml: window = 3: options go in \[read\], \[defaults\] or a command's section"),
+        ("read = 5\n", r"gyrocomp.toml: read = 5: \[read\] is a table of options"),
+        ('defaults = "x"\n', r"gyrocomp.toml: defaults = 'x': \[defaults\] is a table of options"),
+        ("[defaults]\nwindow = 1e999\n", r"gyrocomp.toml: \[defaults\] window = inf: not a finite number"),
+        ("[defaults]\nwindow = nan\n", r"gyrocomp.toml: \[defaults\] window = nan: not a finite number"),
+        ("[evaluate]\nwindow = 'long'\n", r"gyrocomp.toml: \[evaluate\] window = 'long': 'long' is not a"),
+        ("[evaluate]\nwindow = [1, 2]\n", r"gyrocomp.toml: \[evaluate\] window = \[1, 2\]: --window takes one value"),
+        (
+            "[defaults]\nrate-schedule = 5\n",
+            r"gyrocomp.toml: \[defaults\] rate-schedule = 5: --rate-schedule takes a path, written as a",
+        ),
+        (
+            "[defaults]\ngyro-units = 'rad/s'\n",
+            r"gyrocomp.toml: \[defaults\] gyro-units: no command has such an option",
+        ),
+        ("[read]\ncolumns = 5\n", r"gyrocomp.toml: \[read\] columns = 5: a string CH=COL"),
+        ("[defaults]\nwindow = {a = 1}\n", r"gyrocomp.toml: \[defaults\] window: a table; each option is one value"),
+        ("[fleet.fit.x]\nseed = 1\n", r"gyrocomp.toml: \[fleet.fit.x\]: no such command"),
+        ("x = " + "[" * 3000 + "]" * 3000 + "\n", r"gyrocomp.toml: not a project file: its tables or arrays nest"),
+        ("x = " + "{a = " * 500 + "1" + "}" * 500 + "\n", r"gyrocomp.toml: not a project file: its tables or arrays"),
     ],
 )
 def test_a_bad_project_file_is_refused_in_one_line(tmp_path, text, message):
@@ -156,6 +177,33 @@ def test_a_bad_project_file_is_refused_in_one_line(tmp_path, text, message):
     assert re.search(message, result.stderr), result.stderr
     missing = run("--config", "nothere.toml", "show", "m.json", cwd=tmp_path)
     assert missing.returncode == 2 and "--config nothere.toml: no such file" in missing.stderr
+
+
+def test_the_project_file_is_switched_off_by_no_config_and_its_variable(tmp_path):
+    (tmp_path / "run.csv").write_text(
+        "time,gyro_z,temperature\n" + "".join(f"{k},{0.1 + 0.01 * (k % 5)},{25 + k / 20}\n" for k in range(200))
+    )
+    (tmp_path / "gyrocomp.toml").write_text("[read]\ncolumns = 'gyro_z=GyrZ'\n")  # wrong for run.csv
+    assert (
+        "no column 'GyrZ'"
+        in run("check", "run.csv", cwd=tmp_path).stderr + run("check", "run.csv", cwd=tmp_path).stdout
+    )
+    for args, env in ((["--no-config"], {}), ([], {"GYROCOMP_NO_CONFIG": "1"})):
+        result = subprocess.run(
+            [str(SCRIPT), *args, "check", "run.csv"], capture_output=True, text=True, cwd=tmp_path,
+            env={**os.environ, **env}, timeout=120,
+        )  # fmt: skip
+        assert result.returncode == 0 and "gyrocomp.toml" not in result.stderr, result.stderr
+    both = run("--config", "gyrocomp.toml", "--no-config", "check", "run.csv", cwd=tmp_path)
+    assert both.returncode == 2 and "--config and --no-config: give one of them" in both.stderr
+    empty = run("--config", "", "check", "run.csv", cwd=tmp_path)
+    assert empty.returncode == 2 and "give --no-config" in empty.stderr
+
+
+def test_an_option_of_gyrocomp_itself_after_the_command_is_told_where_it_goes(tmp_path):
+    result = run("check", "run.csv", "--config", "x.toml", cwd=tmp_path)
+    assert result.returncode == 2
+    assert "--config is an option of gyrocomp itself: give it before the command" in result.stderr
 
 
 @pytest.mark.slow
@@ -577,7 +625,11 @@ def test_pandas_index_column_is_left_unused_and_said_so(tmp_path):
     visibly, and apply writes it back as it was."""
     n = 300
     frame = pd.DataFrame(
-        {"time": np.arange(n) / 100.0, "gyro_z": np.full(n, 0.1), "temperature": np.linspace(20, 30, n)}
+        {
+            "time": np.arange(n) / 100.0,
+            "gyro_z": 0.1 + 0.01 * np.sin(np.arange(n) / 7.0),
+            "temperature": np.linspace(20, 30, n),
+        }
     )
     frame.to_csv(tmp_path / "df.csv")
     made = run("init", "df.csv", cwd=tmp_path)
@@ -588,3 +640,10 @@ def test_pandas_index_column_is_left_unused_and_said_so(tmp_path):
     assert applied.returncode == 0, applied.stderr
     assert (tmp_path / "out.csv").read_text().splitlines()[:2][0] == ",time,gyro_z,temperature"
     assert pd.read_csv(tmp_path / "out.csv", index_col=0).index.tolist() == list(range(n))
+
+
+def test_init_on_a_log_without_a_temperature_points_to_noise_not_fit(tmp_path):
+    (tmp_path / "still.csv").write_text("time,gyro_z\n" + "".join(f"{k / 10},{0.01 * (k % 7)}\n" for k in range(100)))
+    result = run("init", "still.csv", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "gyrocomp fit" not in result.stdout and "gyrocomp noise still.csv" in result.stdout

@@ -27,7 +27,7 @@ import click
 
 from .._version import __version__
 from ..errors import CHECKS, GyrocompError, InputError, LayoutError, PlausibilityWarning, printable, silence_pattern
-from .projectfile import PROJECT_KEY, defaults_for, load_project
+from .projectfile import PROJECT_KEY, defaults_for, load_project, unknown_defaults
 
 EXIT_INPUT = 2
 EXIT_FAILURE = 1
@@ -150,10 +150,12 @@ class LazyGroup(click.Group):
         if name == "init":  # init writes the project file: one that does not load must not stop it
             return command
         if PROJECT_KEY not in ctx.meta:
-            ctx.meta[PROJECT_KEY] = load_project(ctx.params.get("config"), tuple(COMMANDS))
+            ctx.meta[PROJECT_KEY] = None if _no_config(ctx) else load_project(ctx.params.get("config"), tuple(COMMANDS))
         project = ctx.meta[PROJECT_KEY]
         if project is not None:
             ctx.default_map = {**(ctx.default_map or {}), name: defaults_for(project, command, name)}
+            if set(project.defaults) - {o[2:] for p in _options(command) for o in p.opts}:  # another command's?
+                _refuse_unknown_defaults(project)
         return command
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
@@ -181,8 +183,14 @@ class LazyGroup(click.Group):
     metavar="FILE",
     help="Project file of default options (default: gyrocomp.toml in this folder, when there is one).",
 )
+@click.option(
+    "--no-config",
+    "no_config",
+    is_flag=True,
+    help="Read no project file, not even gyrocomp.toml in this folder (as GYROCOMP_NO_CONFIG=1 does).",
+)
 @click.pass_context
-def cli(ctx, debug, quiet, allowed, config):
+def cli(ctx, debug, quiet, allowed, config, no_config):
     """Remove the deterministic errors of MEMS gyros (temperature drift, thermal lag, hysteresis,
     g-sensitivity) from logs, and measure what is left.
 
@@ -207,6 +215,31 @@ _LOOKED_UP: list[click.Command] = []
 #: the option objects whose fields messages name (``FitOptions.hysteresis: ...``): the field is the flag's
 _OPTION_OBJECT = re.compile(r"\b(?:FitOptions|Polynomial|Network)\.(?=\w)")
 _MAPPING = re.compile(r"--columns \{'(\w+)': '([^']*)'\}")  # the API's mapping, as --columns writes it
+
+
+#: the environment variable that, set to anything but empty or 0, reads no project file (as --no-config)
+NO_CONFIG_VARIABLE = "GYROCOMP_NO_CONFIG"
+
+
+def _no_config(ctx: click.Context) -> bool:
+    """Whether this run reads no project file: --no-config, or GYROCOMP_NO_CONFIG set (a --config FILE wins over
+    the variable, not over the flag)."""
+    if ctx.params.get("no_config"):
+        if ctx.params.get("config") is not None:
+            raise click.UsageError("--config and --no-config: give one of them")
+        return True
+    return ctx.params.get("config") is None and os.environ.get(NO_CONFIG_VARIABLE, "") not in ("", "0")
+
+
+def _refuse_unknown_defaults(project) -> None:
+    """Refuse a project file whose [defaults] holds a key that no command has (every command imported to tell)."""
+    everyone = [getattr(importlib.import_module(f"gyrocomp.cli.{m}"), n) for n, (m, _) in COMMANDS.items()]
+    unknown = unknown_defaults(project, everyone)
+    if unknown:
+        raise InputError(
+            f"{project.path}: [defaults] {', '.join(unknown)}: no command has such an option (misspelt? each key "
+            "is a command's long option without its dashes, e.g. gyro-unit, window)"
+        )
 
 
 def _name_the_project_first(command: click.Command) -> None:
@@ -408,6 +441,16 @@ def _unexpected(exc: Exception) -> int:
     return EXIT_FAILURE
 
 
+def _before_the_command(exc: click.ClickException) -> str:
+    """For an option of gyrocomp itself given after the command (``fit --config F``): where it goes."""
+    if not isinstance(exc, click.NoSuchOption):
+        return ""
+    own = {o for p in cli.params for o in (*p.opts, *getattr(p, "secondary_opts", ()))}
+    if exc.option_name not in own:
+        return ""
+    return f"; {exc.option_name} is an option of gyrocomp itself: give it before the command (gyrocomp {exc.option_name} ... COMMAND)"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Console entry point: runs the command and returns (and, as a script, exits with) its status."""
     if argv is None:
@@ -439,6 +482,8 @@ def main(argv: list[str] | None = None) -> int:
             traceback.print_exc()
         # click lists choices on indented lines ("Choose from:\n\ta,\n\tb"): one line here
         message = re.sub(r"\s*\n\s*", " ", exc.format_message())
+        hint = _before_the_command(exc)
+        message = message.rstrip(".") + hint if hint else message
         click.echo(f"gyrocomp: error: {printable(message)}", err=True)
         status = EXIT_INPUT if isinstance(exc, click.UsageError) else exc.exit_code
     except InputError as exc:
