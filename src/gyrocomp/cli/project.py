@@ -121,7 +121,14 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
             echo(f"  {reason}")
         if guess.unused:
             echo(f"  columns not used: {', '.join(n if n.strip() else repr(n) + ' (unnamed)' for n in guess.unused)}")
-        echo("check the units above; then e.g. gyrocomp fit " + shlex.quote(Path(log).name) + " -o model.json")
+        name = shlex.quote(Path(log).name)
+        if any(channel.startswith("temperature") for channel in layout.columns):
+            echo(f"check the units above; then e.g. gyrocomp fit {name} -o model.json")
+        else:  # a fit needs a temperature; a log without one still gives its noise
+            echo(
+                f"check the units above; the file has no temperature, so no temperature model can be fitted "
+                f"from it: its noise is measured by gyrocomp noise {name} (or gyrocomp allan {name})"
+            )
 
 
 @click.group()
