@@ -458,23 +458,51 @@ class Calibration:
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n"
 
-    def fitted_on(self, path: str | os.PathLike | None) -> bool:
-        """Whether the file at ``path`` is one the model was fitted on (its name and SHA-256 those of an input in
-        the provenance): figures judged on it are in-sample, not the drift to expect on new data.
+    def fitted_on(
+        self, path: str | os.PathLike | None, time_range_s: tuple[float | None, float | None] | None = None
+    ) -> bool:
+        """Whether the rows of the file at ``path`` (those within ``time_range_s``) are all rows the model was
+        fitted on: figures judged on them are in-sample, not the drift to expect on new data
+        (:meth:`fitted_share`).
 
         Parameters
         ----------
         path : path or None
             The file (None: False).
+        time_range_s : (float or None, float or None), optional
+            The window of the file judged, [A, B) in seconds from its first sample (None: an open end); default:
+            the whole file.
+        """
+        return self.fitted_share(path, time_range_s) == "all"
+
+    def fitted_share(
+        self, path: str | os.PathLike | None, time_range_s: tuple[float | None, float | None] | None = None
+    ) -> str:
+        """How much of the window ``time_range_s`` [s from the file's first sample] of the file at ``path`` the
+        model was fitted on: ``"all"``, ``"part"`` or ``"none"``. The file is an input when its name and SHA-256
+        are an input's in the provenance; the rows fitted are the window that input was read with (``--time``),
+        else the whole file (as model files written before the window was kept say).
+
+        Parameters
+        ----------
+        path : path or None
+            The file (None: ``"none"``).
+        time_range_s : (float or None, float or None), optional
+            The window judged (None: the whole file).
         """
         if path is None or not Path(path).is_file():
-            return False
+            return "none"
         named = [
             entry
             for entry in self.provenance.get("inputs", ())
             if isinstance(entry, dict) and entry.get("file") == Path(path).name and entry.get("sha256")
         ]
-        return bool(named) and file_sha256(path) in {entry["sha256"] for entry in named}
+        if not named:
+            return "none"
+        digest = file_sha256(path)
+        judged = _window(time_range_s)
+        shares = {_overlap(_window(entry.get("time_range_s")), judged) for entry in named if entry["sha256"] == digest}
+        return "all" if "all" in shares else "part" if "part" in shares else "none"
 
     def save(self, path: str | os.PathLike) -> None:
         """Write the model file atomically.
@@ -583,6 +611,24 @@ class Calibration:
             non_finite=True,
         )
         return cls.from_dict(data, source=str(path))
+
+
+def _window(value) -> tuple[float, float]:
+    """A time window [A, B) [s] with open ends as infinities (None or a malformed value: the whole file)."""
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        return (-math.inf, math.inf)
+    lo, hi = (v if isinstance(v, (int, float)) and not isinstance(v, bool) else None for v in value)
+    return (-math.inf if lo is None else float(lo), math.inf if hi is None else float(hi))
+
+
+def _overlap(fitted: tuple[float, float], judged: tuple[float, float]) -> str:
+    """``"all"`` when the window ``judged`` lies within ``fitted``, ``"none"`` when they share no time, else
+    ``"part"``."""
+    if judged[0] >= fitted[0] and judged[1] <= fitted[1]:
+        return "all"
+    if judged[1] <= fitted[0] or judged[0] >= fitted[1]:
+        return "none"
+    return "part"
 
 
 __all__ = ["AxisCalibration", "AxisSummary", "Calibration", "FORMAT_NAME", "SCHEMA_VERSION"]

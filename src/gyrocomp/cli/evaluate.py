@@ -108,15 +108,24 @@ def evaluate(
         return _installed(calibration, runs, opts, window_s, as_json, quiet)
     evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
     expected = calibration.report.expected_drift()
-    in_sample = [str(path) for path in runs if calibration.fitted_on(path)]
+    shares = {str(path): calibration.fitted_share(path, opts["time_range_s"]) for path in runs}
+    in_sample = [path for path, share in shares.items() if share == "all"]
+    partly = [path for path, share in shares.items() if share == "part"]
     for path in in_sample if not quiet else ():
         echo(
-            f"gyrocomp: note: {path}: the model was fitted on this file, so its figures are in-sample; on new "
-            "data expect the held-out drift the model file states (gyrocomp show)",
+            f"gyrocomp: note: {path}: the model was fitted on these rows of the file, so its figures are "
+            "in-sample; on new data expect the held-out drift the model file states (gyrocomp show)",
+            err=True,
+        )
+    for path in partly if not quiet else ():
+        echo(
+            f"gyrocomp: note: {path}: the model was fitted on part of the rows judged (the window its fit read "
+            "with --time overlaps this one), so its figures are partly in-sample; judge the rows outside that "
+            "window alone for the drift to expect on new data",
             err=True,
         )
     if as_json:
-        document = {**evaluation.to_dict(), "in_sample_files": in_sample}
+        document = {**evaluation.to_dict(), "in_sample_files": in_sample, "partly_in_sample_files": partly}
         document["expected_held_out_drift"] = [e.to_dict() for e in expected.values()]
         echo(json.dumps(document, indent=2), lines=True)
     elif not quiet:

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError, NotFittedError
-from ..io import file_sha256
+from ..io import TIME_RANGE_KEY, file_sha256
 from ..runs.prepared import fit_axes
 from ..recording import Recording
 
@@ -118,6 +118,9 @@ def provenance(recordings) -> dict:
         path = rec.metadata.get("path")
         if path and Path(path).is_file():
             entry["sha256"] = file_sha256(path)
+        window = rec.metadata.get(TIME_RANGE_KEY)
+        if window is not None:  # the rows fitted: only this window of the file (--time), [A, B) s from its start
+            entry["time_range_s"] = [None if v is None else float(v) for v in window]
         for key in ("device_id", "accel_device_id"):  # the sensor's id in its autopilot (a ULog's sensor_gyro)
             if isinstance(rec.metadata.get(key), int):
                 entry[key] = rec.metadata[key]

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from .reading import (
+    TIME_RANGE_KEY,
     atomic_path,
     detect_format,
     detect_table_format,
@@ -36,6 +37,7 @@ from .reading import (
 
 __all__ = [
     "READERS",
+    "TIME_RANGE_KEY",
     "ReadOptions",
     "Reader",
     "TableData",

@@ -82,6 +82,11 @@ def read_input(
     return data if options.time_range_s is None else select_time(data, options.time_range_s)
 
 
+#: the recording's metadata key of the window ``--time`` read from its file ((A, B) [s from the file's start], None
+#: for an open end): a model's provenance keeps it, so that only those rows of the file are called in-sample
+TIME_RANGE_KEY = "time_range_s"
+
+
 def select_time(data: TableData, time_range_s: tuple[float | None, float | None]) -> TableData:
     """The rows of ``data`` from A to B seconds after its first sample, [A, B) [s] (None: an open end); refuses a
     range that holds no sample, naming the file's length."""
@@ -101,7 +106,9 @@ def select_time(data: TableData, time_range_s: tuple[float | None, float | None]
             f"{'' if stop is None else f'{stop:g}'} holds no sample; the file lasts {since[-1]:.6g} s "
             "from its first sample"
         )
-    return dataclasses.replace(data, recording=rec.take(keep), kept_rows=data.kept_rows[keep])
+    kept = rec.take(keep)
+    kept = dataclasses.replace(kept, metadata={**kept.metadata, TIME_RANGE_KEY: (start, stop)})
+    return dataclasses.replace(data, recording=kept, kept_rows=data.kept_rows[keep])
 
 
 def read(
@@ -201,6 +208,7 @@ def _merged_options(
 
 
 __all__ = [
+    "TIME_RANGE_KEY",
     "READERS",
     "ReadOptions",
     "Reader",

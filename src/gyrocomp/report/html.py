@@ -34,6 +34,7 @@ from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning, printable
 from ..evaluation import evaluate_stages, stage_calibrations, triad_residuals
 from ..export.firmware import BEYOND_DEGC, firmware_corrected_axes, firmware_costs
+from ..io import TIME_RANGE_KEY
 from ..measures.merit import bias_offset, evaluate_run, window_samples
 from ..measures.noise import analyse_noise
 from ..measures.noise_model import noise_model
@@ -287,12 +288,24 @@ def _evaluation(
         "<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
         "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>"
     )
-    fitted_on = [rec.source.rsplit("/", 1)[-1] for rec in runs if calibration.fitted_on(rec.metadata.get("path"))]
+    shares = {
+        rec.source.rsplit("/", 1)[-1]: calibration.fitted_share(
+            rec.metadata.get("path"), rec.metadata.get(TIME_RANGE_KEY)
+        )
+        for rec in runs
+    }
+    fitted_on = [name for name, share in shares.items() if share == "all"]
+    partly = [name for name, share in shares.items() if share == "part"]
     if fitted_on:
         parts.append(
-            f"<p class=note><b>In-sample</b>: the model was fitted on {escape_text(', '.join(fitted_on))}; "
+            f"<p class=note><b>In-sample</b>: the model was fitted on these rows of {escape_text(', '.join(fitted_on))}; "
             "its figures there are not the drift to expect on new data (the held-out drift in the model "
             "section is).</p>"
+        )
+    if partly:
+        parts.append(
+            f"<p class=note><b>Partly in-sample</b>: the model was fitted on part of the rows judged of "
+            f"{escape_text(', '.join(partly))} (the window its fit read overlaps this one).</p>"
         )
     return "\n".join(parts)
 
