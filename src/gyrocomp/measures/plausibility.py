@@ -451,15 +451,17 @@ def agreement_concern(source: str, axis: str, agreement: ScaleAgreement | None) 
     known = next((words for ratio, words in KNOWN_SLOPES if abs(slope / ratio - 1.0) < 0.25), None)
     if known is None and agreement.follows_direction:
         said = (
-            f"with a slope of {slope:.3g} +- {agreement.standard_error:.2g}, not 1, and " if agreement.disagrees else ""
+            f" (and follows the error the model predicts with a slope of {slope:.3g} +- "
+            f"{agreement.standard_error:.2g}, not 1)"
+            if agreement.disagrees
+            else ""
         )
         return Concern(
             "agreement",
-            f"{source}: {axis} follows the error the model predicts for it {said}parts "
-            f"between heating and cooling by {agreement.direction_offset:.2g} deg/s beyond "
-            f"the model (slope {agreement.slope_with_direction:.3g} with that taken out): "
-            "hysteresis or a thermal lag the model does not carry? (fit on runs that both "
-            "heat and cool)",
+            f"{source}: {axis}'s output differs between heating and cooling by "
+            f"{agreement.direction_offset:.2g} deg/s more than the model predicts{said}; with that difference "
+            f"taken out, its slope on the prediction is {agreement.slope_with_direction:.3g}: a hysteresis or "
+            "a thermal lag the model does not carry, or one unlike the fit runs' (another ramp rate)?",
         )
     return Concern(
         "agreement",
