@@ -277,3 +277,38 @@ def test_a_damaged_fit_report_is_refused_on_load_and_show_never_meets_it(default
         return
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert done.stderr.startswith(f"gyrocomp: error: {tmp_path / 'm.json'}: {refusal}")
+
+
+@pytest.mark.slow
+def test_a_networks_ranges_and_the_provenance_are_what_the_loader_needs(models):
+    """An MLP's input_min, input_max and reference hold one value per input, refused by the schema otherwise
+    (apply met them with matmul and index errors); a temperature range that is no range is refused on load (the
+    network would read no temperature); provenance.inputs is a list of files (show met null with a TypeError)."""
+    accel = models["acceleration network"]
+    axis, key = next(
+        (a, k)
+        for a, ax in accel.to_dict()["axes"].items()
+        for k in ("temperature", "acceleration_network")
+        if isinstance(ax.get(k), dict) and len(ax[k].get("inputs", ())) > 1
+    )
+    inputs = len(accel.to_dict()["axes"][axis][key]["inputs"])
+    for field in ("input_min", "input_max", "reference"):
+        for edit in (lambda v: v[:-1], lambda v: v + [0.0], lambda v: []):
+            value = edit(accel.to_dict()["axes"][axis][key][field])
+
+            def change(d, field=field, value=value):
+                d["axes"][axis][key][field] = value
+
+            message = _refusal(accel, change)
+            assert message.startswith(f"m.json: axes.{axis}.{key}.{field}: "), message
+    assert inputs > 1
+    network = models["network"]
+    assert _refusal(
+        network,
+        lambda d: d["axes"]["gyro_x"]["temperature"].__setitem__(
+            "input_max", list(d["axes"]["gyro_x"]["temperature"]["input_min"])
+        ),
+    ).endswith("is no range; the network would read no temperature")
+    assert _refusal(models["default"], lambda d: d["provenance"].__setitem__("inputs", None)).startswith(
+        "m.json: provenance.inputs: None is not of type 'array'"
+    )

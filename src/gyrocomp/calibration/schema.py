@@ -63,6 +63,25 @@ def _array(item: dict, n: int | None = None, lo: int = 0, hi: int | None = None)
     return out
 
 
+def _with_input_ranges(network: dict) -> dict:
+    """An MLP curve's schema with its input ranges and reference one value per input (as many as ``inputs``, which
+    defaults to the temperature alone): one ``if``/``then`` per count of inputs."""
+    ranges = ("input_min", "input_max", "reference")
+    network["allOf"] = [
+        {
+            "if": {"required": ["inputs"], "properties": {"inputs": {"minItems": k, "maxItems": k}}},
+            "then": {"required": list(ranges), "properties": {key: {"minItems": k, "maxItems": k} for key in ranges}},
+        }
+        for k in range(2, len(NETWORK_INPUTS) + 1)
+    ] + [
+        {
+            "if": {"anyOf": [{"not": {"required": ["inputs"]}}, {"properties": {"inputs": {"maxItems": 1}}}]},
+            "then": {"properties": {key: {"maxItems": 1} for key in ranges}},
+        }
+    ]
+    return network
+
+
 def _object(properties: dict, required: list[str] | None = None) -> dict:
     return {
         "type": "object",
@@ -94,33 +113,38 @@ def _curves(u: str, value: dict) -> dict:
             },
             ["type", f"coefficients{u}", "t_ref_degc", "t_scale_degc", "t_min_degc", "t_max_degc"],
         ),
-        "mlp": _object(
-            {
-                "type": {"const": "mlp"},
-                "hidden": _array({"type": "integer", "minimum": 1, "maximum": MAX_HIDDEN}, lo=1, hi=MAX_LAYERS),
-                "activation": {"const": "tanh"},
-                "output": {"const": "linear"},
-                "inputs": {**_array({"enum": list(NETWORK_INPUTS)}, lo=1, hi=len(NETWORK_INPUTS)), "uniqueItems": True},
-                "input_min": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
-                "input_max": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
-                "reference": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
-                "weights": _array(_array(_number(-WEIGHT, WEIGHT), lo=1, hi=10000), lo=2, hi=MAX_LAYERS + 1),
-                f"output_mean{u}": value,
-                f"output_scale{u}": {**value, "exclusiveMinimum": 0},
-                "t_ref_degc": temperature,
-                "t_min_degc": temperature,
-                "t_max_degc": temperature,
-            },
-            [
-                "type",
-                "hidden",
-                "weights",
-                f"output_mean{u}",
-                f"output_scale{u}",
-                "t_ref_degc",
-                "t_min_degc",
-                "t_max_degc",
-            ],
+        "mlp": _with_input_ranges(
+            _object(
+                {
+                    "type": {"const": "mlp"},
+                    "hidden": _array({"type": "integer", "minimum": 1, "maximum": MAX_HIDDEN}, lo=1, hi=MAX_LAYERS),
+                    "activation": {"const": "tanh"},
+                    "output": {"const": "linear"},
+                    "inputs": {
+                        **_array({"enum": list(NETWORK_INPUTS)}, lo=1, hi=len(NETWORK_INPUTS)),
+                        "uniqueItems": True,
+                    },
+                    "input_min": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
+                    "input_max": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
+                    "reference": _array(_number(-1e3, 1e3), hi=len(NETWORK_INPUTS)),
+                    "weights": _array(_array(_number(-WEIGHT, WEIGHT), lo=1, hi=10000), lo=2, hi=MAX_LAYERS + 1),
+                    f"output_mean{u}": value,
+                    f"output_scale{u}": {**value, "exclusiveMinimum": 0},
+                    "t_ref_degc": temperature,
+                    "t_min_degc": temperature,
+                    "t_max_degc": temperature,
+                },
+                [
+                    "type",
+                    "hidden",
+                    "weights",
+                    f"output_mean{u}",
+                    f"output_scale{u}",
+                    "t_ref_degc",
+                    "t_min_degc",
+                    "t_max_degc",
+                ],
+            )
         ),
         "table": _object(
             {
@@ -260,7 +284,16 @@ def build_schema(version: int) -> dict:
             "gyro_triad": _nullable(_triad("_dps", "deg/s", rate)),
             "accel_triad": _nullable(_triad("_g", "g", accel)),
             "fit_report": {"type": "object"},
-            "provenance": {"type": "object"},
+            # what the model came from; its inputs (when given) a list of files, each named (show and fitted_share
+            # read them)
+            "provenance": {
+                "type": "object",
+                "properties": {
+                    "inputs": _array({"type": "object", "properties": {"file": {"type": "string"}}}),
+                    "gyrocomp_version": {"type": "string"},
+                    "created_utc": {"type": "string"},
+                },
+            },
         },
         "required": [
             "format",

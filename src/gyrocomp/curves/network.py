@@ -237,6 +237,22 @@ class NetworkCurve:
         if [len(layer) for layer in weights] != [r * c + r for r, c in shapes]:
             raise InputError(f"mlp weights do not fit a {len(inputs)}-{'-'.join(map(str, hidden))}-1 network")
         floats = lambda key: tuple(float(v) for v in d.get(key, ()))  # noqa: E731
+        ranges = {key: floats(key) for key in ("input_min", "input_max", "reference")}
+        given = {key: len(values) for key, values in ranges.items() if values}
+        if given and (len(given) < 3 or set(given.values()) != {len(inputs)}):
+            raise InputError(
+                f"mlp input_min, input_max and reference: one value per input ({len(inputs)}: "
+                f"{', '.join(inputs)}), not {', '.join(f'{len(v)}' for v in ranges.values())}"
+            )
+        if not given and inputs != ("temperature",):
+            raise InputError(f"mlp inputs {list(inputs)}: input_min, input_max and reference are needed for each")
+        if "temperature" in inputs and given:
+            k = inputs.index("temperature")
+            if not ranges["input_max"][k] > ranges["input_min"][k]:
+                raise InputError(
+                    f"mlp input_min/input_max of the temperature: {ranges['input_min'][k]:g}..."
+                    f"{ranges['input_max'][k]:g} degC is no range; the network would read no temperature"
+                )
         return cls(
             hidden,
             weights,
