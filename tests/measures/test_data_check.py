@@ -21,7 +21,7 @@ from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.simulation import preset_model, simulate
 from gyrocomp.simulation.faults import FAULTS, inject
 
-from ..conftest import burst_stamped_recording, run
+from ..conftest import burst_stamped_recording, chamber_run, run
 
 PRESETS = ("adxrs450", "consumer")
 
@@ -235,3 +235,77 @@ def test_runs_that_share_one_boundary_sample_are_two_runs(clean_columns, tmp_pat
     assert all("repeated" not in c.reasons for c in check_files([first, second])[1])
     table.iloc[998:2000].to_csv(second, index=False)  # two samples: a run given twice in part
     assert check_files([first, second])[1][1].reasons == ("repeated",)
+
+
+def _physics_run(tmp_path, edit, name="run.csv"):
+    """A chamber run written from the physics (conftest.chamber_run, 2 Hz), its columns changed by ``edit``."""
+    rec = chamber_run([20, 50, 20], ramp_degc_per_min=2, hold_s=300, rate_hz=2, seed=4)
+    table = pd.DataFrame({"time": rec.time_s, "temperature": rec.temperature_degc})
+    for j, axis in enumerate(rec.gyro_axes):
+        table[axis] = rec.gyro_dps[:, j]
+    edit(table)
+    path = tmp_path / name
+    table.to_csv(path, index=False)
+    return path
+
+
+def _dead(table):
+    for axis in ("gyro_x", "gyro_y", "gyro_z"):
+        table[axis] = 0.0
+
+
+def _one_dead(table):
+    table["gyro_y"] = 0.0
+
+
+def _same_column(table):
+    table["gyro_y"] = table["gyro_x"]
+
+
+def _spikes(table):
+    table.loc[::100, "temperature"] = -40.0
+
+
+def _saturated(table):
+    table["gyro_z"] = np.clip(table["gyro_z"] + 300.0 * np.sign(np.sin(np.arange(len(table)) / 300.0)), -250, 250)
+
+
+def _counts(table):
+    for axis in ("gyro_x", "gyro_y", "gyro_z"):
+        table[axis] = np.round(table[axis] * 131.0 + 40.0)
+
+
+@pytest.mark.parametrize(
+    "edit, check, severity, words",
+    [
+        (_dead, "gyro-constant", "refused", r"gyro_x \(0 deg/s\), gyro_y \(0 deg/s\), gyro_z \(0 deg/s\): every"),
+        (_one_dead, "gyro-constant", "warning", r"gyro_y \(0 deg/s\): every sample the same value"),
+        (_same_column, "axes-identical", "refused", r"gyro_x and gyro_y hold the same samples"),
+        (_spikes, "temperature-spikes", "warning", r"temperature sample\(s\) jump 2 degC or more .*rows 1, 101, 201"),
+        (_saturated, "rail", "warning", r"gyro_z sits at 250 deg/s"),
+        (_counts, "counts", "warning", r"every gyro sample is a whole number"),
+    ],
+)
+def test_a_gyro_that_says_nothing_spikes_a_rail_or_counts_is_named_by_check_and_fit(
+    tmp_path, edit, check, severity, words
+):
+    import re
+
+    path = _physics_run(tmp_path, edit)
+    checked = run("check", path)
+    line = checked.stdout.strip()
+    assert line.startswith(f"{path}: {severity} (") and check in line.split(":", 2)[1], line
+    (verdict,) = json.loads(run("check", path, "--json").stdout)
+    found = next(f for f in verdict["findings"] if f["check"] == check)
+    assert re.search(words, found["message"]) and found["message"].startswith(f"{path}: "), found
+    fitted = run("fit", path, "-o", tmp_path / "m.json")
+    said = fitted.stderr
+    if severity == "refused" or check == "counts":  # counts: read as deg/s they move, and nothing is still
+        assert fitted.returncode == 2 and re.search(words, said) and not (tmp_path / "m.json").exists(), said
+    else:
+        assert fitted.returncode == 0 and re.search(words, said), said
+
+
+def test_a_clean_physics_run_raises_none_of_these_checks(tmp_path):
+    checked = run("check", _physics_run(tmp_path, lambda table: None))
+    assert checked.returncode == 0 and ": ok" in checked.stdout, checked.stdout

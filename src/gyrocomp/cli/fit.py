@@ -19,7 +19,7 @@ from ..models.fit import fit as fit_runs
 from ..models.triads import SCALE_FACTOR_CHOICES
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.thermal import HYSTERESIS_CHOICES
-from ..files.check import ask_for, enforce, read_noting
+from ..files.check import ask_for, enforce, read_noting, refuse
 from ..measures.data_check import check_runs
 from .common import (
     accept_option,
@@ -216,7 +216,16 @@ def _checked_runs(runs, read_opts: dict, rate_schedule, still_only, options: Fit
     recordings = [r.recording for r in read]
     if rate_schedule is not None:
         recordings = apply_schedule(read_rate_schedule(rate_schedule), recordings, list(runs))
-    recordings, contributions = field_recordings(recordings, still_only)
+    try:
+        recordings, contributions = field_recordings(recordings, still_only)
+    except InputError as exc:  # no still data: a run refused by the data check, or read in the wrong unit, says why
+        moving = [r.recording.source for r in read if r.recording is not None]  # motion is not the question here
+        checks = check_runs(read, ask_for(options), accept, still_only=moving)
+        refuse(checks)
+        why = sorted((f for c in checks for f in c.findings if f.check in ("counts", "unit")), key=lambda f: f.check)
+        if why:  # raw counts before a unit: the first explains the second
+            raise InputError(f"{exc}; it may be read wrongly: {why[0].message}") from None
+        raise
     enforce(check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions if c.still_only]))
     if not quiet and any(c.still_only for c in contributions):
         print_contributions(contributions)

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from ..effects import moving_average
 from ..errors import TimeOrderWarning
@@ -39,6 +40,8 @@ Severity = Literal["refuse", "warn"]
 #: every check, in the order a verdict line lists them
 DATA_CHECKS = (
     "repeated",
+    "gyro-constant",
+    "axes-identical",
     "time",
     "temperature-missing",
     "temperature-constant",
@@ -46,16 +49,24 @@ DATA_CHECKS = (
     "too-short",
     "reversal",
     "temperature-quantized",
+    "temperature-spikes",
     "gaps",
     "rail",
     "motion",
     "unit",
+    "counts",
 )
 
 #: a temperature that varies less than this over a run is constant (a stuck or absent sensor) [degC]
 CONSTANT_SPAN_DEGC = 0.01
 #: a set of runs spanning less than this cannot identify a temperature curve [degC] (the plausibility check's)
 MIN_SPAN_DEGC = 1.0
+#: a temperature sample this far from the median of its TEMPERATURE_SPIKE_SAMPLES neighbours is a spike [degC]: a
+#: die changes temperature by well under a degree in a few samples, even on a 10 degC/min chamber ramp logged at 1 Hz
+TEMPERATURE_SPIKE_DEGC, TEMPERATURE_SPIKE_SAMPLES = 2.0, 9
+#: gyro samples that are whole numbers, on every axis, spread over at least this many of them: raw counts of the
+#: sensor's converter read as deg/s (a MEMS gyro's rate in deg/s is never whole in every sample)
+COUNTS_MIN_LEVELS = 8
 #: temperature steps at least this coarse are said (whole or half degrees); finer LSBs are no concern [degC]
 QUANTIZED_STEP_DEGC = 0.25
 #: time that goes back by more than this many sample periods, and at least TIME_BACK_MIN_S, is two logs or a
@@ -282,6 +293,94 @@ def gap_findings(recording: Recording) -> list[Finding]:
     ]
 
 
+def gyro_findings(recording: Recording) -> list[Finding]:
+    """A gyro that says nothing: an axis whose every sample is the same value (a dead or absent axis; every axis:
+    refused, one of several: a warning), and two axes that hold the same samples (one column mapped twice:
+    refused)."""
+    out = []
+    x = recording.gyro_dps
+    axes = recording.gyro_axes
+    constant = [j for j in range(x.shape[1]) if x.shape[0] and np.all(x[:, j] == x[0, j])]
+    if constant:
+        every = len(constant) == x.shape[1]
+        named = ", ".join(f"{axes[j]} ({x[0, j]:.6g} deg/s)" for j in constant)
+        out.append(
+            Finding(
+                "gyro-constant",
+                "refuse" if every else "warn",
+                f"{recording.source}: {named}: every sample the same value: a dead, absent or unconnected "
+                + ("gyro, or the wrong columns mapped; nothing to calibrate" if every else "axis"),
+                "" if every else "that axis is fitted as the constant it holds",
+            )
+        )
+    for j in range(x.shape[1]):
+        for k in range(j + 1, x.shape[1]):
+            if j not in constant and np.array_equal(x[:, j], x[:, k]):
+                out.append(
+                    Finding(
+                        "axes-identical",
+                        "refuse",
+                        f"{recording.source}: {axes[j]} and {axes[k]} hold the same samples in every row: one "
+                        "column mapped to two axes? (map each axis to its own column)",
+                    )
+                )
+    return out
+
+
+def temperature_spike_findings(recording: Recording) -> list[Finding]:
+    """Temperature spikes: samples TEMPERATURE_SPIKE_DEGC or more from the median of the TEMPERATURE_SPIKE_SAMPLES
+    around them (a sensor's read errors, -40 degC or a bit flip), said with their count and first rows."""
+    t = _temperature(recording)
+    if t is None or t.size != recording.n_samples or t.size < TEMPERATURE_SPIKE_SAMPLES:
+        return []
+    half = TEMPERATURE_SPIKE_SAMPLES // 2
+    rows = []
+    for start, stop in parts(t.size, overlap=2 * half):
+        piece = t[start:stop]
+        padded = np.pad(piece, half, mode="reflect")  # the median of the samples around each, the ends mirrored
+        local = np.median(sliding_window_view(padded, TEMPERATURE_SPIKE_SAMPLES), axis=1)
+        far = np.flatnonzero(np.abs(piece - local) >= TEMPERATURE_SPIKE_DEGC)
+        lo = 0 if start == 0 else half
+        rows.append(start + far[(far >= lo) & (far < piece.size - (half if stop < t.size else 0))])
+    spikes = np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=int)
+    if not spikes.size:
+        return []
+    first = ", ".join(str(int(recording.row_numbers[k])) for k in spikes[:3])
+    worst = float(np.max(np.abs(t[spikes] - np.median(t))))
+    return [
+        Finding(
+            "temperature-spikes",
+            "warn",
+            f"{recording.source}: {spikes.size} temperature sample(s) jump {TEMPERATURE_SPIKE_DEGC:g} degC or more "
+            f"from their neighbours and back (rows {first}{', ...' if spikes.size > 3 else ''}; up to "
+            f"{worst:.3g} degC from the run's median): read errors of the sensor",
+            f"{100 * spikes.size / t.size:.2g} % of the samples fitted at temperatures the die never had: the "
+            "curve is bent toward them or left out; cut or mend those rows",
+        )
+    ]
+
+
+def counts_findings(recording: Recording) -> list[Finding]:
+    """Raw counts: every gyro sample a whole number, on every axis, over COUNTS_MIN_LEVELS values or more (a
+    converter's output read as deg/s)."""
+    x = recording.gyro_dps
+    if x.shape[0] < COUNTS_MIN_LEVELS or not all(np.all(x[a:b] == np.round(x[a:b])) for a, b in parts(x.shape[0])):
+        return []
+    spread = float(np.max(np.ptp(x, axis=0)))
+    if spread < COUNTS_MIN_LEVELS:
+        return []
+    return [
+        Finding(
+            "counts",
+            "warn",
+            f"{recording.source}: every gyro sample is a whole number (spread over {spread:.0f} of them): raw "
+            "counts of the sensor's converter read as deg/s? give their scale as the gyro's unit (gyro_unit="
+            "'1/131 deg/s' for 131 counts per deg/s, as its data sheet states)",
+            "a model in counts, wrong by the sensor's scale factor wherever deg/s are expected",
+        )
+    ]
+
+
 def rail_findings(recording: Recording) -> list[Finding]:
     """A rail: an axis's extreme value held RAIL_RUN_SAMPLES times in a row, RAIL_SIGMAS from its median (the
     medians exact, a part at a time: :func:`gyrocomp.spilled_series.streamed_median`)."""
@@ -291,11 +390,16 @@ def rail_findings(recording: Recording) -> list[Finding]:
         median = streamed_median(x[a:b] for a, b in parts(x.size))
         sigma = 1.4826 * streamed_median(np.abs(x[a:b] - median) for a, b in parts(x.size)) or 1e-12
         for edge in (float(np.max(x)), float(np.min(x))):
-            if abs(edge - median) < RAIL_SIGMAS * sigma:
-                continue
             at = np.flatnonzero(x == edge)
             held = np.flatnonzero(np.diff(at) == 1)
             if at.size < RAIL_RUN_SAMPLES or _longest_run(held) + 1 < RAIL_RUN_SAMPLES - 1:
+                continue
+            centre, spread = median, sigma
+            if x.size // 10 < at.size < x.size:  # plateaus hold much of the run: judged against the rest
+                rest = x[x != edge]
+                centre = float(np.median(rest))
+                spread = 1.4826 * float(np.median(np.abs(rest - centre))) or 1e-12
+            if abs(edge - centre) < RAIL_SIGMAS * spread:
                 continue
             out.append(
                 Finding(
@@ -625,10 +729,13 @@ def check_runs(
             time_findings(run.source, run.notes, rec.rate_hz)
             + temperature_findings(rec, ask)
             + together.get(position[i], [])
+            + gyro_findings(rec)
+            + temperature_spike_findings(rec)
             + gap_findings(rec)
             + rail_findings(rec)
             + (motion_findings(rec) if rec.source not in still_only else [])
             + unit_findings(rec)
+            + counts_findings(rec)
         )
         out.append(_split(found, run.source, accept))
     return out
