@@ -237,10 +237,7 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
 
 
 def refuse_to_overwrite_inputs(
-    output: str | os.PathLike,
-    inputs: Iterable[str | os.PathLike],
-    option: str = "-o",
-    what: str = "an input file",
+    output: str | os.PathLike, inputs: Iterable[str | os.PathLike], option: str = "-o", what: str = "an input file"
 ) -> None:
     """Raise :class:`InputError` if ``output`` is the same file as any of ``inputs`` (by name, through links, or a
     hard link to it), or a symbolic link (:func:`refuse_link`): the checks a command makes on its output (a file or

@@ -67,7 +67,7 @@ def parse_column_mapping(text: str | None) -> dict[str, str]:
                 value = json.loads(value)
             except json.JSONDecodeError:
                 raise InputError(
-                    f"columns: {item.strip()!r}: a quoted column is one JSON string (\\\" for a quote inside it)"
+                    f'columns: {item.strip()!r}: a quoted column is one JSON string (\\" for a quote inside it)'
                 ) from None
         if not key or not value and key != TIME_COLUMN:  # time= (nothing): the time left unread, UNMAPPED
             raise InputError(f"columns: {item.strip()!r} is not CHANNEL=COLUMN (e.g. gyro_z=GyrZ)")
