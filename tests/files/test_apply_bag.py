@@ -5,17 +5,21 @@ command line too, the input never touched."""
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import warnings
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from gyrocomp import apply, fit_calibration, read
 from gyrocomp.errors import DataQualityWarning, InputError
 from gyrocomp.files.apply_bag import apply_bag
 from gyrocomp.io.rosbag import any_reader, message_arrays
+from gyrocomp.io.stamps import ticks_s
+from gyrocomp.io.tables import write_recording
 from gyrocomp.simulation import get_profile, simulate
 
 from ..conftest import run
@@ -451,3 +455,46 @@ def test_a_damaged_imu_record_the_reading_passed_over_is_refused_in_one_line(mod
     assert cli.returncode == 2 and "Traceback" not in cli.stderr, cli.stderr
     assert "bad.bag: damaged ROS bag: topic /imu/data" in cli.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.bag", "in.bag", "m.json"]
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_a_bag_with_epoch_stamps_is_compensated_as_the_table_of_its_samples(kind, consumer_model, tmp_path):
+    """Stamps at the Unix epoch (1.7e9 s, as every real bag has), spaced as a real clock's (not exactly evenly): apply
+    to the bag equals apply on a table of the same samples to 1e-12 deg/s, whether the table's time is in seconds
+    or in integer nanoseconds (a float64 keeps 256 ns of an integer nanosecond time at that epoch: read as ticks
+    1e-9, the steps and the sample rate taken from them differed from the bag's, and the thermal lag's filter with
+    them, by 1.3e-5 deg/s here)."""
+    options, name, out_name = KINDS[kind]
+    rec = simulate("consumer", profile="chamber", rate_hz=100, duration_s=120, seed=7, unit=3).recording
+    epoch_s = rec.time_s + 1_734_567_890.123456  # a logger's float stamps, at the nanosecond in the bag
+    whole = np.floor(epoch_s)
+    stamps_ns = whole.astype(np.int64) * 10**9 + np.round((epoch_s - whole) * 1e9).astype(np.int64)
+    rec = dataclasses.replace(rec, time_s=ticks_s(stamps_ns, 10**9))
+    source, output = tmp_path / name, tmp_path / out_name
+    folder = tmp_path / "written" if options.get("bare") else source
+    write_recording_bag(
+        folder, rec, ros2=options["ros2"], mcap=options.get("mcap", False), temperature_every=1, stamps_ns=stamps_ns
+    )
+    if options.get("bare"):
+        next(folder.glob("*.mcap")).rename(source)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        apply_bag(consumer_model, source, output)
+        compensated = read(output).gyro_dps
+        for unit in ("s", "ns"):
+            table = tmp_path / f"samples_{unit}.csv"
+            write_recording(rec, table)
+            if unit == "ns":  # the time column as the stamps' integer nanoseconds
+                frame = pd.read_csv(table)
+                frame["time"] = stamps_ns
+                frame.to_csv(table, index=False)
+            expected = apply(consumer_model, read(table, time_unit=unit)).gyro_dps
+            np.testing.assert_allclose(compensated, expected, rtol=0, atol=1e-12, err_msg=unit)
+
+
+def test_integer_stamps_become_the_seconds_a_bag_stamp_gives():
+    ticks = np.array([1_734_567_890_123_456_789, 1_734_567_890_133_456_790, -1, 0, 999_999_999], dtype=np.int64)
+    expected = [float(s) + float(n) * 1e-9 for s, n in (divmod(int(t), 10**9) for t in ticks)]
+    np.testing.assert_array_equal(ticks_s(ticks, 10**9), expected)
+    np.testing.assert_array_equal(ticks_s(ticks // 1000, 10**6), ticks_s(ticks // 1000 * 1000, 10**9))
+    assert ticks_s(ticks, 10**9)[1] - ticks_s(ticks, 10**9)[0] == pytest.approx(0.010000001, abs=3e-7)

@@ -181,10 +181,13 @@ def write_bag(
                 writer.write(thermo, int(t * 1e9), serialize(msg, Temperature.__msgtype__))
 
 
-def write_recording_bag(path, recording, ros2: bool, mcap: bool = False, temperature_every: int = 10):
+def write_recording_bag(
+    path, recording, ros2: bool, mcap: bool = False, temperature_every: int = 10, stamps_ns: np.ndarray | None = None
+):
     """A recording [s, deg/s, g, degC] as a bag (ROS 1 ``.bag``, or a ROS 2 folder in sqlite3 or MCAP storage),
     serialized by rosbags: ``/imu/data`` (rad/s, m/s^2) and every ``temperature_every``-th sample's temperature on
-    ``/imu/temperature``."""
+    ``/imu/temperature``; ``stamps_ns``: the messages' stamps as integer nanoseconds (default: the recording's time
+    rounded to them)."""
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
@@ -206,9 +209,11 @@ def write_recording_bag(path, recording, ros2: bool, mcap: bool = False, tempera
     with writer:
         imu = writer.add_connection("/imu/data", Imu.__msgtype__, typestore=store)
         thermo = writer.add_connection("/imu/temperature", Temperature.__msgtype__, typestore=store)
-        for i, t in enumerate(recording.time_s):
-            sec = int(t)
-            stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int(round((t - sec) * 1e9)))
+        if stamps_ns is None:
+            stamps_ns = [int(t) * 10**9 + int(round((t - int(t)) * 1e9)) for t in recording.time_s]
+        for i, ns in enumerate(stamps_ns):
+            sec, nanosec = divmod(int(ns), 10**9)
+            stamp = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
             header = (
                 types["std_msgs/msg/Header"](stamp=stamp, frame_id="imu_link")
                 if ros2
@@ -223,11 +228,11 @@ def write_recording_bag(path, recording, ros2: bool, mcap: bool = False, tempera
                 linear_acceleration=Vector3(*accel[i]),
                 linear_acceleration_covariance=cov,
             )
-            writer.write(imu, int(round(t * 1e9)), serialize(msg, Imu.__msgtype__))
+            writer.write(imu, int(ns), serialize(msg, Imu.__msgtype__))
             if i % temperature_every == 0:
                 writer.write(
                     thermo,
-                    int(round(t * 1e9)),
+                    int(ns),
                     serialize(
                         Temperature(header=header, temperature=float(recording.temperature_degc[i]), variance=0.0),
                         Temperature.__msgtype__,

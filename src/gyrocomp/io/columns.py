@@ -11,6 +11,7 @@ import pyarrow as pa
 
 from ..errors import InputError
 from ..units import unit_factor
+from .stamps import TICKS_PER_SECOND, ticks_s
 
 
 def arrow_floats(values: np.ndarray) -> pa.Array:
@@ -122,6 +123,9 @@ def time_column_s(
     array = table.column(column)
     clock = _clock_s(array, source, column, first_row, header_line, after_s)
     if clock is None:
+        per_second = next((n for u, n in TICKS_PER_SECOND.items() if _same_unit(time_unit, u)), None)
+        if per_second is not None and pa.types.is_integer(array.type) and not array.null_count:
+            return ticks_s(_integers(array), per_second)  # whole ticks since an epoch: exactly, as a bag's stamps
         return numeric_column(table, column, source, first_row, header_line, decimal) * unit_factor(
             "time", time_unit, "time_unit"
         )
@@ -131,6 +135,17 @@ def time_column_s(
             f"{time_unit!r} is for a column of numbers"
         )
     return clock
+
+
+def _same_unit(time_unit: str, unit: str) -> bool:
+    """Whether ``time_unit`` (as the options spell it) is ``unit`` exactly."""
+    return unit_factor("time", time_unit, "time_unit") == unit_factor("time", unit, "time_unit")
+
+
+def _integers(array: pa.ChunkedArray) -> np.ndarray:
+    """An integer column without nulls as int64, from its chunks' buffers."""
+    parts = [chunk.to_numpy(zero_copy_only=False).astype(np.int64, copy=False) for chunk in array.chunks]
+    return np.concatenate(parts) if parts else np.empty(0, dtype=np.int64)
 
 
 def holds_clock(array: pa.ChunkedArray | pa.Array) -> bool:
@@ -153,7 +168,7 @@ def _clock_s(
     :func:`_past_midnight`]; None for any other."""
     kind = array.type
     if pa.types.is_timestamp(kind):
-        return arrow_numbers(array.cast(pa.int64())) * _CLOCK_UNIT_S[kind.unit]
+        return ticks_s(_integers(array.cast(pa.int64())), TICKS_PER_SECOND[kind.unit])
     if pa.types.is_time(kind):
         whole = pa.int64() if kind.bit_width == 64 else pa.int32()
         return _past_midnight(arrow_numbers(array.cast(whole)) * _CLOCK_UNIT_S[kind.unit], after_s)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .byte_fields import Places
+from .stamps import stamp_s
 
 #: float64 values after the header: orientation (4), its covariance (9), angular velocity (3), its covariance (9),
 #: linear acceleration (3), its covariance (9)
@@ -57,7 +58,7 @@ class ImuBatch:
         follows the first four bytes in both layouts (ROS 1's ``seq``, ROS 2's encapsulation header)."""
         sec = np.ascontiguousarray(self.data[:, 4:8]).view("<i4" if cdr else "<u4")[:, 0]
         nsec = np.ascontiguousarray(self.data[:, 8:12]).view("<u4")[:, 0]
-        return sec.astype(float) + nsec.astype(float) * 1e-9
+        return stamp_s(sec, nsec)
 
     def with_values(self, start: int, rows: np.ndarray, values: np.ndarray) -> "ImuBatch":
         """A copy whose messages ``rows`` (indices) have their float64 values from index ``start`` (e.g.
@@ -114,7 +115,7 @@ def _stamps_s(places: Places, cdr: bool) -> np.ndarray:
     """The header stamps [s] of messages at ``places`` as :func:`gyrocomp.io.rosbag.header_stamp_s` computes them
     (sec + nanosec 1e-9); the stamp follows the first four bytes in both layouts."""
     sec = places.read(4, "<i4" if cdr else "<u4")
-    return sec.astype(float) + places.read(8, "<u4").astype(float) * 1e-9
+    return stamp_s(sec, places.read(8, "<u4"))
 
 
 def temperature_fields(raws: list, cdr: bool) -> tuple[np.ndarray, np.ndarray] | None:

@@ -41,6 +41,7 @@ from .common import (
 from .layout import TIME_COLUMN, TableLayout
 from .mcap_chunks import mcap_arrays
 from .readers import Reader, register_reader
+from .stamps import stamp_s
 from .ros_imu import ANGULAR_VELOCITY, LINEAR_ACCELERATION, ImuBatch, imu_batch, imu_fields, temperature_fields
 from .rosbag1_chunks import chunked_reader1
 from .stream import CHUNK_ROWS, NotStreamable
@@ -210,7 +211,7 @@ def _topic(path: Path, connections: list, msgtype: str, asked: str | None, optio
 def header_stamp_s(header) -> float:
     """A message header's stamp [s]: sec + nanosec 1e-9."""
     stamp = header.stamp
-    return stamp.sec + stamp.nanosec * 1e-9
+    return float(stamp_s(stamp.sec, stamp.nanosec))
 
 
 @contextlib.contextmanager
