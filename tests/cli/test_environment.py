@@ -163,6 +163,7 @@ def test_a_store_password_is_never_printed(tmp_path):
         result = run(*args)
         assert result.returncode == 2 and len(result.stderr.splitlines()) == 1, result.stderr
         assert "S3cretPw" not in result.stdout + result.stderr and "station:***@127.0.0.1" in result.stderr
+        assert "the database server cannot be reached" in result.stderr
     bad = "postgresql://station:S3cretPw@127.0.0.1:notaport/db"
     with pytest.raises(InputError, match=r"^postgresql://\*\*\*: not a database URL") as caught:
         CalibrationStore(bad)
@@ -171,18 +172,18 @@ def test_a_store_password_is_never_printed(tmp_path):
 
 def test_a_store_password_stays_out_of_the_fleet_report(postgres_server, unit, tmp_path):
     folder, runs = unit
-    url = postgres_server()
-    assert "@" in url
+    url = postgres_server().replace("postgresql://postgres@", "postgresql://postgres:S3cretPw@")  # trust: any
     fitted = run(
         "fleet", "fit", "--manifest", folder / "m.csv", "-o", tmp_path / "F", "--store", url, "--scheduler", "serial"
     )  # fmt: skip
     assert fitted.returncode == 0, fitted.stderr
+    assert "S3cretPw" not in fitted.stdout + fitted.stderr
     page = tmp_path / "r.html"
     assert run("fleet", "report", url, "-o", page).returncode == 0
-    password = url.split("://", 1)[1].split("@", 1)[0].partition(":")[2]
-    if password:
-        assert password not in page.read_text(encoding="utf-8")
-        assert password not in run("fleet", "status", "--store", url).stdout
+    text = page.read_text(encoding="utf-8")
+    assert "S3cretPw" not in text and "postgres:***@" in text
+    status = run("fleet", "status", "--store", url)
+    assert status.returncode == 0 and "S3cretPw" not in status.stdout and "postgres:***@" in status.stdout
 
 
 def test_a_database_holding_another_programs_calibrations_table_is_refused_untouched(tmp_path):
@@ -241,3 +242,39 @@ def test_a_pdf_printer_that_hangs_or_writes_garbage_is_one_line(tmp_path, monkey
     with pytest.raises(InputError, match=message) as caught:
         certificate.print_pdf(page, tmp_path / "c.pdf", timeout_s=1)
     assert len(str(caught.value)) < 600 and not (tmp_path / "c.pdf").exists()
+
+
+def test_a_locked_table_a_read_only_user_and_a_stopped_server_are_one_line_each(
+    postgres_server, unit, tmp_path, monkeypatch
+):
+    import psycopg
+
+    from gyrocomp.fleet import store as store_module
+    from gyrocomp.fleet.stations import station_status
+
+    folder, runs = unit
+    url = postgres_server()
+    fitted = run(
+        "fleet", "fit", "--manifest", folder / "m.csv", "-o", tmp_path / "F", "--store", url, "--scheduler", "serial"
+    )  # fmt: skip
+    assert fitted.returncode == 0, fitted.stderr
+    monkeypatch.setattr(store_module, "LOCK_TIMEOUT_S", 1.0)
+    with psycopg.connect(url) as other:  # another client holds the table locked in an open transaction
+        other.execute("LOCK TABLE calibrations IN ACCESS EXCLUSIVE MODE")
+        with pytest.raises(InputError, match=r": a table of the store is locked by another client for more than 1 s"):
+            with CalibrationStore(url) as db:
+                station_status(db)
+    with psycopg.connect(url, autocommit=True) as admin:
+        admin.execute("CREATE ROLE reader LOGIN")
+        admin.execute("GRANT SELECT ON ALL TABLES IN SCHEMA public TO reader")
+    reader = url.replace("postgresql://postgres@", "postgresql://reader@")
+    assert run("fleet", "status", "--store", reader).returncode == 0  # reading is allowed
+    (tmp_path / "other.csv").write_text(f"path,serial\n{runs[0]},SN2\n{runs[1]},SN2\n")
+    refused = run(
+        "fleet", "fit", "--manifest", tmp_path / "other.csv", "-o", tmp_path / "G", "--store", reader,
+        "--scheduler", "serial",
+    )  # fmt: skip
+    assert refused.returncode == 2 and len(refused.stderr.splitlines()) == 1, refused.stdout + refused.stderr
+    assert "the database user may not read or write the store's tables" in refused.stderr
+    with CalibrationStore(url) as db:  # as consistent as before: the one unit, no row of SN2
+        assert [r.serial for r in db.latest_rows()] == [HOSTILE]

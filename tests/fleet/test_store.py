@@ -134,6 +134,9 @@ def test_parse_time_reads_dates_times_and_zones():
     assert parse_time("2026-03-01T08:30:00Z") == dt.datetime(2026, 3, 1, 8, 30)
     with pytest.raises(InputError, match=r"at: 'March 1st' is not an ISO 8601 date"):
         parse_time("March 1st")
+    # instants beyond the years UTC holds are after (or before) every row, not an overflow
+    assert parse_time("9999-12-31T23:59:59-12:00") == dt.datetime.max
+    assert parse_time("0001-01-01T00:00:00+14:00") == dt.datetime.min
 
 
 def test_store_locations(tmp_path):

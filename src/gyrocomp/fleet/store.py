@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Literal
 
 from ..calibration import Calibration
-from ..errors import InputError, ModelError
+from ..errors import InputError, ModelError, foreign_message
 from ..io.atomic import refuse_link
 from ..io.common import require
 from ..jsontext import loads
@@ -151,7 +151,10 @@ def parse_time(text: str, name: str = "at") -> _dt.datetime:
     if len(text.strip()) <= 10:  # the end of that day (the last day there is: its last microsecond)
         value = _dt.datetime.combine(value.date(), _dt.time.max, value.tzinfo)
     if value.tzinfo is not None:
-        value = value.astimezone(_dt.timezone.utc).replace(tzinfo=None)
+        try:
+            value = value.astimezone(_dt.timezone.utc).replace(tzinfo=None)
+        except OverflowError:  # beyond the years UTC has (9999-12-31T23:59-12:00): before or after every row
+            value = _dt.datetime.min if value.utcoffset() > _dt.timedelta(0) else _dt.datetime.max
     return value
 
 
@@ -195,6 +198,56 @@ _RETRIED_SQLSTATES = ("40001", "40P01")
 _SCHEMA_LOCK_KEY = 0x6779726F636F6D70
 
 
+#: how long a statement waits for a lock another client of a server holds [s] (SQLite: SQLITE_BUSY_TIMEOUT_S)
+LOCK_TIMEOUT_S = 60.0
+
+
+def _connect_args(url: str, sqlite: bool) -> dict:
+    """The driver's connection options: SQLite's busy timeout; PostgreSQL's lock timeout (a table another client
+    holds locked is one line after LOCK_TIMEOUT_S, not a wait for ever)."""
+    if sqlite:
+        return {"timeout": SQLITE_BUSY_TIMEOUT_S}
+    if url.startswith("postgresql"):
+        return {"options": f"-c lock_timeout={int(LOCK_TIMEOUT_S * 1000)}"}
+    return {}
+
+
+#: PostgreSQL's error classes and codes, in words: what happened and what to do
+_TROUBLE = (
+    ("55P03", "a table of the store is locked by another client for more than {lock:g} s; run the command again "
+     "when that client is done"),
+    ("42501", "the database user may not read or write the store's tables (permission denied); give a user that "
+     "may, or grant this one SELECT, INSERT and UPDATE on them"),
+    ("57P", "the database server shut down while the command ran; the store is as it was before the statement "
+     "that failed: run the command again once the server is back"),
+    ("08", "the connection to the database server failed or dropped; the store is as it was before the statement "
+     "that failed: run the command again once the server can be reached"),
+)  # fmt: skip
+
+
+def database_trouble(exc) -> str:
+    """A database error (SQLAlchemy's, wrapping the driver's) in words: a lock held too long, a permission, a
+    server that stopped or cannot be reached (PostgreSQL's SQLSTATE classes), else the driver's own message cut to
+    one line (:func:`gyrocomp.errors.foreign_message`)."""
+    orig = getattr(exc, "orig", exc)
+    state = getattr(orig, "sqlstate", None) or ""
+    for prefix, words in _TROUBLE:
+        if state.startswith(prefix):
+            return words.format(lock=LOCK_TIMEOUT_S)
+    if "database is locked" in str(orig):
+        return (
+            f"the SQLite store is locked by another process for more than {SQLITE_BUSY_TIMEOUT_S:g} s; run the "
+            "command again when it is done"
+        )
+    text = str(orig).lower()
+    if not state and ("could not connect" in text or "connection" in text):
+        return (
+            "the database server cannot be reached (is it running, and is the URL's host and port right?): "
+            + foreign_message(orig)
+        )
+    return f"the database refused: {foreign_message(orig)}"
+
+
 class _Retry(Exception):
     """A write that conflicted with another writer's (a unique key taken, a serialization failure)."""
 
@@ -235,9 +288,7 @@ class CalibrationStore:
                     )
                 file.parent.mkdir(parents=True, exist_ok=True)
         try:
-            self.engine = sa.create_engine(
-                url, **({"connect_args": {"timeout": SQLITE_BUSY_TIMEOUT_S}} if self.file is not None else {})
-            )
+            self.engine = sa.create_engine(url, connect_args=_connect_args(url, self.file is not None))
         except (sa.exc.ArgumentError, sa.exc.NoSuchModuleError, ModuleNotFoundError, ValueError) as exc:
             # a URL's parse errors quote the URL, password and all: named by their kind alone
             why = exc if isinstance(exc, (sa.exc.NoSuchModuleError, ModuleNotFoundError)) else type(exc).__name__
@@ -251,6 +302,8 @@ class CalibrationStore:
             inspector = sa.inspect(self.engine)
             present = inspector.has_table(_ROWS.name)
         except sa.exc.DatabaseError as exc:
+            if isinstance(exc, sa.exc.OperationalError) and self.file is None:  # a server: down, refused, locked
+                raise InputError(f"{self.location}: {database_trouble(exc)}") from None
             raise InputError(f"{self.location}: not a database ({exc.orig})") from None
         if not present and not create:
             raise InputError(f"{self.location}: the database has no calibrations table; not a gyrocomp store")
@@ -303,8 +356,10 @@ class CalibrationStore:
     def __enter__(self) -> "CalibrationStore":
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, kind, exc, trace) -> None:
         self.close()
+        if isinstance(exc, sa.exc.DBAPIError):  # the database's own refusal, reaching the command: one line
+            raise InputError(f"{self.location}: {database_trouble(exc)}") from None
 
     # -- writing -------------------------------------------------------------------------------------------
     @contextlib.contextmanager
@@ -323,9 +378,16 @@ class CalibrationStore:
         except sa.exc.OperationalError as exc:
             if getattr(exc.orig, "sqlstate", None) in _RETRIED_SQLSTATES:
                 raise _Retry(str(exc.orig)) from None
+            if self.file is None or "locked" in str(exc.orig):  # a server, or a lock held too long: in words
+                trouble = database_trouble(exc)
+                raise InputError(f"{self.location}: cannot write to the calibration store: {trouble}") from None
             raise InputError(
                 f"{self.location}: cannot write to the calibration store ({exc.orig}); is the disk "
                 "full or the store read-only?"
+            ) from None
+        except sa.exc.ProgrammingError as exc:  # a user without the right to write the tables
+            raise InputError(
+                f"{self.location}: cannot write to the calibration store: {database_trouble(exc)}"
             ) from None
 
     @contextlib.contextmanager
