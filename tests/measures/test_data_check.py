@@ -280,7 +280,7 @@ def _counts(table):
     [
         (_dead, "gyro-constant", "refused", r"gyro_x \(0 deg/s\), gyro_y \(0 deg/s\), gyro_z \(0 deg/s\): every"),
         (_one_dead, "gyro-constant", "warning", r"gyro_y \(0 deg/s\): every sample the same value"),
-        (_same_column, "axes-identical", "refused", r"gyro_x and gyro_y hold the same samples"),
+        (_same_column, "axes-identical", "warning", r"gyro_x and gyro_y hold the same samples"),
         (_spikes, "temperature-spikes", "warning", r"temperature sample\(s\) jump 2 degC or more .*rows 1, 101, 201"),
         (_saturated, "rail", "warning", r"gyro_z sits at 250 deg/s"),
         (_counts, "counts", "warning", r"every gyro sample is a whole number"),

@@ -470,8 +470,8 @@ class Calibration:
         path : path or None
             The file (None: False).
         time_range_s : (float or None, float or None), optional
-            The window of the file judged, [A, B) in seconds from its first sample (None: an open end); default:
-            the whole file.
+            The window of the file judged, [A, B) [s from its first sample] (None: an open end); default: the
+            whole file.
         """
         return self.fitted_share(path, time_range_s) == "all"
 
@@ -488,7 +488,7 @@ class Calibration:
         path : path or None
             The file (None: ``"none"``).
         time_range_s : (float or None, float or None), optional
-            The window judged (None: the whole file).
+            The window judged, [A, B) [s from the file's first sample] (None: the whole file).
         """
         if path is None or not Path(path).is_file():
             return "none"

@@ -144,8 +144,12 @@ def _same_unit(time_unit: str, unit: str) -> bool:
 
 def _integers(array: pa.ChunkedArray) -> np.ndarray:
     """An integer column without nulls as int64, from its chunks' buffers."""
-    parts = [chunk.to_numpy(zero_copy_only=False).astype(np.int64, copy=False) for chunk in array.chunks]
-    return np.concatenate(parts) if parts else np.empty(0, dtype=np.int64)
+    parts = []
+    for chunk in array.chunks:  # the buffers themselves: pyarrow's to_numpy imports pandas
+        dtype = np.dtype(chunk.type.to_pandas_dtype())
+        data = chunk.buffers()[1]
+        parts.append(np.frombuffer(data, dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize))
+    return np.concatenate(parts).astype(np.int64, copy=False) if parts else np.empty(0, dtype=np.int64)
 
 
 def holds_clock(array: pa.ChunkedArray | pa.Array) -> bool:

@@ -295,8 +295,8 @@ def gap_findings(recording: Recording) -> list[Finding]:
 
 def gyro_findings(recording: Recording) -> list[Finding]:
     """A gyro that says nothing: an axis whose every sample is the same value (a dead or absent axis; every axis:
-    refused, one of several: a warning), and two axes that hold the same samples (one column mapped twice:
-    refused)."""
+    refused, one of several: a warning), and two axes that hold the same samples (one column mapped twice: a
+    warning)."""
     out = []
     x = recording.gyro_dps
     axes = recording.gyro_axes
@@ -319,9 +319,10 @@ def gyro_findings(recording: Recording) -> list[Finding]:
                 out.append(
                     Finding(
                         "axes-identical",
-                        "refuse",
+                        "warn",
                         f"{recording.source}: {axes[j]} and {axes[k]} hold the same samples in every row: one "
                         "column mapped to two axes? (map each axis to its own column)",
+                        "the two axes are fitted as one: if they are two sensors' axes, one of them is wrong",
                     )
                 )
     return out
