@@ -358,51 +358,6 @@ def static_recording(n=60_000, rate_hz=50.0, gap_after=None, seed=0) -> Recordin
     )
 
 
-def chamber_run(
-    legs_degc: list[float],
-    ramp_degc_per_min: float = 1.0,
-    hold_s: float = 600.0,
-    rate_hz: float = 10.0,
-    seed: int = 0,
-    start_s: float = 0.0,
-) -> Recording:
-    """A chamber run written from the physics alone, none of gyrocomp's model forms: the chamber steps through the
-    set points ``legs_degc`` [degC] at ``ramp_degc_per_min``, holding ``hold_s`` [s] at each (one set point: a
-    hold only); the die follows it through a first-order lag of 40 s, and each axis's bias is a saturating curve
-    of the die's temperature (a tanh), a term in its rate of change (a gradient across the package) and a power-on
-    constant, with white noise of 0.005 deg/s/sqrt(Hz); the temperature is reported in steps of 1/16 degC.
-    ``start_s``: the first time stamp [s] (an epoch, say)."""
-    rng = np.random.default_rng(seed)
-    knots_t, knots_v = [0.0], [legs_degc[0]]
-    for target in legs_degc[1:]:
-        knots_t.append(knots_t[-1] + hold_s)
-        knots_v.append(knots_v[-1])
-        knots_t.append(knots_t[-1] + abs(target - knots_v[-1]) / ramp_degc_per_min * 60.0)
-        knots_v.append(target)
-    knots_t.append(knots_t[-1] + hold_s)
-    knots_v.append(knots_v[-1])
-    t = np.arange(0.0, knots_t[-1], 1.0 / rate_hz)
-    chamber = np.interp(t, knots_t, knots_v)
-    alpha = 1.0 - math.exp(-1.0 / (rate_hz * 40.0))
-    die = np.empty_like(chamber)
-    die[0] = chamber[0]
-    for k in range(1, t.size):  # the die lags the chamber (first order, 40 s)
-        die[k] = die[k - 1] + alpha * (chamber[k] - die[k - 1])
-    rate_degc_per_s = np.gradient(die, t)
-    gains = np.array([[0.05, 0.4], [-0.03, 0.2], [0.08, -0.5]])  # [deg/s], [deg/s per degC/s] per axis
-    bias = np.column_stack(
-        [g * np.tanh((die - 25.0) / 20.0) + r * rate_degc_per_s + rng.normal(0, 0.01) for g, r in gains]
-    )
-    gyro = bias + rng.standard_normal(bias.shape) * 0.005 * math.sqrt(rate_hz)
-    return Recording(
-        time_s=t + start_s,
-        gyro_dps=gyro,
-        gyro_axes=GYRO_AXES,
-        temperature_degc=np.round(die * 16.0) / 16.0,
-        source=f"chamber_run_{seed}",
-    )
-
-
 def burst_stamped_recording(rate_hz: float, n: int, burst: int, arrival_step_s: float) -> Recording:
     """A sensor sampling evenly at ``rate_hz`` [Hz] whose samples reach the logger ``burst`` at a time (when the
     last of them is taken), stamped on arrival ``arrival_step_s`` [s] apart (a serial link's buffer)."""
@@ -425,6 +380,10 @@ def _tool(name: str):
 postgres_cluster = _tool("postgres_cluster")
 #: headless Chromium driven over its DevTools pipe (tools/browser.py): the browser tests
 browser = _tool("browser")
+#: every command on every shape of input (tools/shape_matrix.py): its runs written from the physics, none of
+#: gyrocomp's model forms (a tanh of a lagged die temperature, a rate-of-change term, a power-on constant)
+shape_matrix = _tool("shape_matrix")
+chamber_run = shape_matrix.chamber_run
 
 
 @pytest.fixture(scope="session")
