@@ -63,6 +63,19 @@ def _array(item: dict, n: int | None = None, lo: int = 0, hi: int | None = None)
     return out
 
 
+def _provenance() -> dict:
+    """What the model came from: its inputs (when given) a list of files, each named (``show`` and
+    :meth:`~gyrocomp.calibration.Calibration.fitted_share` read them)."""
+    return {
+        "type": "object",
+        "properties": {
+            "inputs": _array({"type": "object", "properties": {"file": {"type": "string"}}}),
+            "gyrocomp_version": {"type": "string"},
+            "created_utc": {"type": "string"},
+        },
+    }
+
+
 def _with_input_ranges(network: dict) -> dict:
     """An MLP curve's schema with its input ranges and reference one value per input (as many as ``inputs``, which
     defaults to the temperature alone): one ``if``/``then`` per count of inputs."""
@@ -284,16 +297,7 @@ def build_schema(version: int) -> dict:
             "gyro_triad": _nullable(_triad("_dps", "deg/s", rate)),
             "accel_triad": _nullable(_triad("_g", "g", accel)),
             "fit_report": {"type": "object"},
-            # what the model came from; its inputs (when given) a list of files, each named (show and fitted_share
-            # read them)
-            "provenance": {
-                "type": "object",
-                "properties": {
-                    "inputs": _array({"type": "object", "properties": {"file": {"type": "string"}}}),
-                    "gyrocomp_version": {"type": "string"},
-                    "created_utc": {"type": "string"},
-                },
-            },
+            "provenance": _provenance(),
         },
         "required": [
             "format",

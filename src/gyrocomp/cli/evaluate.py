@@ -108,7 +108,27 @@ def evaluate(
         return _installed(calibration, runs, opts, window_s, as_json, quiet)
     evaluation = _evaluate_runs(calibration, runs, opts, window_s, turn_on_window_s, rate_schedule)
     expected = calibration.report.expected_drift()
-    shares = {str(path): calibration.fitted_share(path, opts["time_range_s"]) for path in runs}
+    in_sample, partly = _in_sample(calibration, runs, opts["time_range_s"], quiet)
+    if as_json:
+        document = {**evaluation.to_dict(), "in_sample_files": in_sample, "partly_in_sample_files": partly}
+        document["expected_held_out_drift"] = [e.to_dict() for e in expected.values()]
+        echo(json.dumps(document, indent=2), lines=True)
+    elif not quiet:
+        print_evaluation(evaluation)
+        print_expected_drift(expected)
+        if turn_on_window_s is not None:
+            echo(
+                f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
+                "its first seconds; bias offset, bias instability and integration time do not depend on a "
+                "constant, so only the compensated output (gyrocomp apply) shows it",
+                err=True,
+            )
+
+
+def _in_sample(calibration, runs, time_range_s, quiet: bool) -> tuple[list[str], list[str]]:
+    """The runs whose judged rows the model was fitted on, all of them or part (:meth:`Calibration.fitted_share`),
+    each said in a note unless ``quiet``."""
+    shares = {str(path): calibration.fitted_share(path, time_range_s) for path in runs}
     in_sample = [path for path, share in shares.items() if share == "all"]
     partly = [path for path, share in shares.items() if share == "part"]
     for path in in_sample if not quiet else ():
@@ -124,20 +144,7 @@ def evaluate(
             "window alone for the drift to expect on new data",
             err=True,
         )
-    if as_json:
-        document = {**evaluation.to_dict(), "in_sample_files": in_sample, "partly_in_sample_files": partly}
-        document["expected_held_out_drift"] = [e.to_dict() for e in expected.values()]
-        echo(json.dumps(document, indent=2), lines=True)
-    elif not quiet:
-        print_evaluation(evaluation)
-        print_expected_drift(expected)
-        if turn_on_window_s is not None:
-            echo(
-                f"gyrocomp: note: --turn-on-window {turn_on_window_s:g}: each run's constant was taken from "
-                "its first seconds; bias offset, bias instability and integration time do not depend on a "
-                "constant, so only the compensated output (gyrocomp apply) shows it",
-                err=True,
-            )
+    return in_sample, partly
 
 
 def _installed(calibration: Calibration, runs, opts: dict, window_s, as_json: bool, quiet: bool) -> None:

@@ -89,6 +89,27 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
             rate_hz = parse_rate(click.prompt("no time column: the rows' sample rate [Hz]"))
         guess = guess_layout(log, parse_names(names), rate_hz, fmt)
     layout = guess.layout
+    write_text_atomic(output, _project_text(log, guess, fmt))
+    if not ctx.obj["quiet"]:
+        echo(f"wrote {output} from {log}:")
+        for reason in guess.reasons:
+            echo(f"  {reason}")
+        if guess.unused:
+            echo(f"  columns not used: {', '.join(n if n.strip() else repr(n) + ' (unnamed)' for n in guess.unused)}")
+        name = shlex.quote(Path(log).name)
+        if any(channel.startswith("temperature") for channel in layout.columns):
+            echo(f"check the units above; then e.g. gyrocomp fit {name} -o model.json")
+        else:  # a fit needs a temperature; a log without one still gives its noise
+            echo(
+                f"check the units above; the file has no temperature, so no temperature model can be fitted "
+                f"from it: its noise is measured by gyrocomp noise {name} (or gyrocomp allan {name})"
+            )
+
+
+def _project_text(log, guess, fmt: str | None) -> str:
+    """The project file's text for the layout ``guess`` made of ``log``: the reasons as comments (escaped), then
+    [read] (the units, the format, the delimiter, the names, the rate) and [read.columns]."""
+    layout = guess.layout
     lines = [
         f"# gyrocomp project file: written by `gyrocomp init {printable(Path(log).name)}` on "
         f"{_dt.date.today().isoformat()}; every gyrocomp command run in this folder reads it",
@@ -114,21 +135,7 @@ def init(ctx, log, output, force, names, rate_hz, fmt):
     # TOML: a table's keys come before its sub-tables, so the units go in a [read] written before [read.columns]
     head = lines.index("[read]")
     lines[head + 1 : head + 1] = [f"{k} = {_toml_text(v)}" for k, v in read.items()]
-    write_text_atomic(output, "\n".join(lines) + "\n")
-    if not ctx.obj["quiet"]:
-        echo(f"wrote {output} from {log}:")
-        for reason in guess.reasons:
-            echo(f"  {reason}")
-        if guess.unused:
-            echo(f"  columns not used: {', '.join(n if n.strip() else repr(n) + ' (unnamed)' for n in guess.unused)}")
-        name = shlex.quote(Path(log).name)
-        if any(channel.startswith("temperature") for channel in layout.columns):
-            echo(f"check the units above; then e.g. gyrocomp fit {name} -o model.json")
-        else:  # a fit needs a temperature; a log without one still gives its noise
-            echo(
-                f"check the units above; the file has no temperature, so no temperature model can be fitted "
-                f"from it: its noise is measured by gyrocomp noise {name} (or gyrocomp allan {name})"
-            )
+    return "\n".join(lines) + "\n"
 
 
 @click.group()
