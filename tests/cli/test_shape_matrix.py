@@ -11,8 +11,8 @@ import pytest
 from ..conftest import run, shape_matrix
 
 #: the sample the suite runs (the whole matrix takes half an hour): the certificate's unit of a cycle and one leg,
-#: epoch nanoseconds, a constant temperature (refusals)
-SAMPLE = ("cycle and a leg", "epoch ns", "constant temperature")
+#: a constant temperature (refusals); epoch clocks are the bag tests' (tests/files/test_apply_bag.py)
+SAMPLE = ("cycle and a leg", "constant temperature")
 
 
 @pytest.mark.parametrize(

@@ -27,12 +27,12 @@ from gyrocomp.io import (
     write_recording,
 )
 from gyrocomp.io.guess import guess_layout
-from gyrocomp.io.stream import TableStream
+from gyrocomp.io.stream import TableStream, TableWriter
 from gyrocomp.io.text_format import SpacedText, TextFormat, preamble_lines, spaced_as_fields, text_encoding, units_line
 from gyrocomp.simulation import GyroErrorModel, simulate
 from gyrocomp.units import unit_factor
 
-from ..conftest import run, shared_dataset
+from ..conftest import chamber_run, run, shared_dataset
 
 
 def write_csv(path, text):
@@ -870,3 +870,23 @@ def test_a_column_of_vectors_is_refused_saying_so_and_init_points_to_it(tmp_path
         match=r"its columns are time, gyro, temperature; column 'gyro' holds a list of 3 numbers in each row \(a vector\); gyrocomp reads one column per axis: split it into x, y and z first$",
     ):
         guess_layout(tmp_path / "list.parquet")
+
+
+@pytest.mark.parametrize(
+    "suffix, magic", [(".gz", b"\x1f\x8b"), (".bz2", b"BZh"), (".xz", b"\xfd7zXZ"), (".zst", b"\x28\xb5\x2f\xfd")]
+)
+def test_a_table_written_under_a_compressed_name_is_compressed_and_reads_back(tmp_path, suffix, magic):
+    """A name ending in .gz, .bz2, .xz or .zst is written compressed, whole and streamed (the matrix of shapes found
+    run.csv.gz written as plain text, which every reader then refused as a damaged gzip)."""
+    rec = chamber_run([20, 30, 20], ramp_degc_per_min=2, hold_s=60, seed=1)
+    whole = tmp_path / f"whole.csv{suffix}"
+    write_recording(rec, whole)
+    assert whole.read_bytes().startswith(magic)
+    back = read(whole)
+    np.testing.assert_array_equal(back.gyro_dps, rec.gyro_dps)
+    streamed = tmp_path / f"streamed.csv{suffix}"
+    with TableWriter(streamed) as writer:
+        for chunk in TableStream(whole, chunk_rows=1000).chunks():
+            writer.write(chunk.table)
+    assert streamed.read_bytes().startswith(magic)
+    np.testing.assert_array_equal(read(streamed).gyro_dps, rec.gyro_dps)

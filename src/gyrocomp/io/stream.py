@@ -47,6 +47,7 @@ from .text_format import (
     output_text_format,
     read_error,
     text_head,
+    text_sink,
     with_decimal,
 )
 
@@ -317,7 +318,7 @@ class TableWriter:
                 self._writer = pq.ParquetWriter(self._tmp, table.schema, use_dictionary=dictionary)
             else:
                 self._writer = pacsv.CSVWriter(
-                    self._tmp,
+                    text_sink(self._tmp, self.path, self._stack),
                     with_decimal(table, self.text_format).schema,
                     write_options=_csv_options(table.column_names, self.text_format),
                 )

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import os
 import warnings
 from dataclasses import dataclass
@@ -35,6 +37,7 @@ from .text_format import (
     output_text_format,
     read_error,
     spaced_as_fields,
+    text_sink,
     with_decimal,
 )
 
@@ -391,13 +394,21 @@ def _write_arrow(table: pa.Table, path: Path, fmt: str, text_format: TextFormat 
     with atomic_path(path) as tmp:
         if fmt == "parquet":
             pq.write_table(table, tmp)
-        else:
-            text_format = text_format or TextFormat()
-            decimal = with_decimal(table, text_format)
+            return
+        text_format = text_format or TextFormat()
+        decimal = with_decimal(table, text_format)
+        for quote_text in (False, True):  # a text value holding the separator: every text value quoted, as pyarrow does
             try:
-                pacsv.write_csv(decimal, tmp, _csv_options(table.column_names, text_format))
-            except pa.ArrowInvalid:  # a text value holds the separator: every text value quoted, as pyarrow does
-                pacsv.write_csv(decimal, tmp, _csv_options(table.column_names, text_format, quote_text=True))
+                with contextlib.ExitStack() as stack:
+                    pacsv.write_csv(
+                        decimal,
+                        text_sink(tmp, path, stack),
+                        _csv_options(table.column_names, text_format, quote_text=quote_text),
+                    )
+                return
+            except pa.ArrowInvalid:
+                if quote_text:
+                    raise
 
 
 def write_gyro_back(

@@ -403,6 +403,21 @@ TEXT_TABLE_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
 
 #: suffixes of compressed text tables after their own (``run.csv.gz``), read as they stream
 COMPRESSED_SUFFIXES = (".gz", ".bz2", ".xz", ".zst")
+#: pyarrow's codec of each compressed suffix it writes (xz through Python's lzma)
+_WRITTEN_CODECS = {".gz": "gzip", ".bz2": "bz2", ".zst": "zstd"}
+
+
+def text_sink(tmp: str | os.PathLike, name: str | os.PathLike, stack) -> object:
+    """Where a text table named ``name`` is written, at the temporary path ``tmp``: the file itself, or a stream
+    compressing into it when the name ends in ``.gz``, ``.bz2``, ``.zst`` or ``.xz`` (read back as such:
+    :func:`compression`); closed by ``stack`` (a :class:`contextlib.ExitStack`), so that the compressed file is
+    complete before it is renamed into place."""
+    suffix = Path(name).suffix.lower()
+    if suffix == ".xz":
+        return stack.enter_context(pa.PythonFile(stack.enter_context(lzma.open(tmp, "wb")), mode="w"))
+    if suffix in _WRITTEN_CODECS:
+        return stack.enter_context(pa.CompressedOutputStream(os.fspath(tmp), _WRITTEN_CODECS[suffix]))
+    return tmp
 
 
 def _csv_options(
@@ -438,6 +453,7 @@ def with_decimal(table: pa.Table, text_format: TextFormat) -> pa.Table:
 
 __all__ = [
     "COMPRESSED_SUFFIXES",
+    "text_sink",
     "CSV_BLOCK_BYTES",
     "DECOMPRESS_ERRORS",
     "DELIMITERS",
