@@ -52,7 +52,11 @@ def test_bad_splits_are_refused():
         split_runs(rec, "pose")
     with pytest.raises(InputError, match=r"min_gap_s: must be a positive number, got 0"):
         split_runs(rec, "power-on", min_gap_s=0.0)
-    with pytest.raises(InputError, match=r"by=still: no run of 10 samples or more found"):
+    # the poses were shorter than asked: said so, with the longest (it said "no run of 10 samples or more")
+    with pytest.raises(
+        InputError,
+        match=r"by=still: no still pose of min_still_s=1e\+06 s or more \(the longest lasts [\d.]+ s\); a shorter",
+    ):
         split_runs(rec, "still", min_still_s=1e6)
 
 

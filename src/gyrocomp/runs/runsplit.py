@@ -48,6 +48,11 @@ class RunPiece:
 
 def _poses(rec: Recording, min_still_s: float) -> list[tuple[int, int]]:
     """Still segments joined into poses (see the module), those lasting ``min_still_s`` or more."""
+    return [(a, b) for a, b, _ in _joined_poses(rec) if rec.time_s[b - 1] - rec.time_s[a] >= min_still_s]
+
+
+def _joined_poses(rec: Recording) -> list[list]:
+    """The still segments, neighbours whose gravity direction agrees joined: [start, stop, mean force [g]]."""
     segments = detect_still(rec).segments
     poses: list[list] = []
     cos_max = np.cos(np.radians(POSE_ANGLE_DEG))
@@ -58,7 +63,7 @@ def _poses(rec: Recording, min_still_s: float) -> list[tuple[int, int]]:
                 poses[-1][1] = seg.stop
                 continue
         poses.append([seg.start, seg.stop, seg.accel_mean_g])
-    return [(a, b) for a, b, _ in poses if rec.time_s[b - 1] - rec.time_s[a] >= min_still_s]
+    return poses
 
 
 def _bounds(rec: Recording, by: str, min_gap_s: float, min_still_s: float, min_leg_degc: float) -> list[tuple]:
@@ -123,6 +128,12 @@ def split_runs(
         if b - a >= min_samples
     ]
     if not pieces:
+        if by == "still":  # the poses found were all shorter than asked
+            longest = max((rec.time_s[b - 1] - rec.time_s[a] for a, b, _ in _joined_poses(rec)), default=0.0)
+            raise InputError(
+                f"{rec.source}: by=still: no still pose of min_still_s={min_still_s:g} s or more (the longest "
+                f"lasts {longest:.4g} s); a shorter min_still_s keeps shorter ones"
+            )
         raise InputError(f"{rec.source}: by={by}: no run of {min_samples} samples or more found")
     return pieces
 
