@@ -154,7 +154,7 @@ class LazyGroup(click.Group):
         project = ctx.meta[PROJECT_KEY]
         if project is not None:
             ctx.default_map = {**(ctx.default_map or {}), name: defaults_for(project, command, name)}
-            if set(project.defaults) - {o[2:] for p in _options(command) for o in p.opts}:  # another command's?
+            if unknown_defaults(project, [command]):  # another command's, or none's: every command asked
                 _refuse_unknown_defaults(project)
         return command
 

@@ -222,8 +222,11 @@ def _checked_runs(runs, read_opts: dict, rate_schedule, still_only, options: Fit
         moving = [r.recording.source for r in read if r.recording is not None]  # motion is not the question here
         checks = check_runs(read, ask_for(options), accept, still_only=moving)
         refuse(checks)
-        why = sorted((f for c in checks for f in c.findings if f.check in ("counts", "unit")), key=lambda f: f.check)
-        if why:  # raw counts before a unit: the first explains the second
+        reading = ("counts", "unit")  # raw counts first: they explain a unit out of range
+        why = sorted(
+            (f for c in checks for f in c.findings if f.check in reading), key=lambda f: reading.index(f.check)
+        )
+        if why:
             raise InputError(f"{exc}; it may be read wrongly: {why[0].message}") from None
         raise
     enforce(check_runs(read, ask_for(options), accept, still_only=[c.source for c in contributions if c.still_only]))

@@ -40,17 +40,22 @@ def _chunk_numbers(chunk: pa.Array) -> np.ndarray:
     kind = chunk.type
     if not (pa.types.is_integer(kind) or pa.types.is_float32(kind) or pa.types.is_float64(kind)):
         return chunk.to_numpy(zero_copy_only=False).astype(float, copy=False)
-    validity, data = chunk.buffers()[:2]
-    dtype = np.dtype(
-        np.float32 if pa.types.is_float32(kind) else np.float64 if pa.types.is_float64(kind) else kind.to_pandas_dtype()
-    )
-    values = np.frombuffer(data, dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize)
-    values = values.astype(float, copy=False)
+    validity = chunk.buffers()[0]
+    values = _chunk_values(chunk).astype(float, copy=False)
     if chunk.null_count:
         bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
         valid = bits[chunk.offset : chunk.offset + len(chunk)].astype(bool)
         values = np.where(valid, values, np.nan)
     return values
+
+
+def _chunk_values(chunk: pa.Array) -> np.ndarray:
+    """A numeric chunk's values in their own dtype, read from its data buffer (nulls not masked)."""
+    kind = chunk.type
+    dtype = np.dtype(
+        np.float32 if pa.types.is_float32(kind) else np.float64 if pa.types.is_float64(kind) else kind.to_pandas_dtype()
+    )
+    return np.frombuffer(chunk.buffers()[1], dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize)
 
 
 def numeric_column(
@@ -144,11 +149,7 @@ def _same_unit(time_unit: str, unit: str) -> bool:
 
 def _integers(array: pa.ChunkedArray) -> np.ndarray:
     """An integer column without nulls as int64, from its chunks' buffers."""
-    parts = []
-    for chunk in array.chunks:  # the buffers themselves: pyarrow's to_numpy imports pandas
-        dtype = np.dtype(chunk.type.to_pandas_dtype())
-        data = chunk.buffers()[1]
-        parts.append(np.frombuffer(data, dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize))
+    parts = [_chunk_values(chunk) for chunk in array.chunks]  # the buffers: pyarrow's to_numpy imports pandas
     return np.concatenate(parts).astype(np.int64, copy=False) if parts else np.empty(0, dtype=np.int64)
 
 

@@ -453,7 +453,6 @@ def with_decimal(table: pa.Table, text_format: TextFormat) -> pa.Table:
 
 __all__ = [
     "COMPRESSED_SUFFIXES",
-    "text_sink",
     "CSV_BLOCK_BYTES",
     "DECOMPRESS_ERRORS",
     "DELIMITERS",
@@ -474,6 +473,7 @@ __all__ = [
     "spaced_as_fields",
     "text_encoding",
     "text_head",
+    "text_sink",
     "units_line",
     "with_decimal",
 ]

@@ -397,9 +397,9 @@ def rail_findings(recording: Recording) -> list[Finding]:
                 continue
             centre, spread = median, sigma
             if x.size // 10 < at.size < x.size:  # plateaus hold much of the run: judged against the rest
-                rest = x[x != edge]
-                centre = float(np.median(rest))
-                spread = 1.4826 * float(np.median(np.abs(rest - centre))) or 1e-12
+                rest = [x[a:b][x[a:b] != edge] for a, b in parts(x.size)]
+                centre = streamed_median(rest)
+                spread = 1.4826 * streamed_median(np.abs(r - centre) for r in rest) or 1e-12
             if abs(edge - centre) < RAIL_SIGMAS * spread:
                 continue
             out.append(

@@ -288,14 +288,15 @@ def _evaluation(
         "<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
         "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>"
     )
-    shares = {
-        rec.source.rsplit("/", 1)[-1]: calibration.fitted_share(
-            rec.metadata.get("path"), rec.metadata.get(TIME_RANGE_KEY)
+    shares = [  # a list: two runs of one name in other folders are two runs
+        (
+            rec.source.rsplit("/", 1)[-1],
+            calibration.fitted_share(rec.metadata.get("path"), rec.metadata.get(TIME_RANGE_KEY)),
         )
         for rec in runs
-    }
-    fitted_on = [name for name, share in shares.items() if share == "all"]
-    partly = [name for name, share in shares.items() if share == "part"]
+    ]
+    fitted_on = [name for name, share in shares if share == "all"]
+    partly = [name for name, share in shares if share == "part"]
     if fitted_on:
         parts.append(
             f"<p class=note><b>In-sample</b>: the model was fitted on these rows of {escape_text(', '.join(fitted_on))}; "
