@@ -179,7 +179,7 @@ def test_a_parquet_file_replaced_while_it_is_read_is_said_to_have_changed_not_to
     changed, not that it is unreadable."""
     path = tmp_path / "run.parquet"
     pq.write_table(pa.table({"time": np.arange(100.0), "gyro_z": np.zeros(100)}), path)
-    read_arrow = tables_module._read_arrow
+    read_arrow = tables_module.read_arrow
 
     def replaced_part_way(*args):
         other = tmp_path / "other.parquet"
@@ -187,6 +187,6 @@ def test_a_parquet_file_replaced_while_it_is_read_is_said_to_have_changed_not_to
         os.replace(other, path)  # another program's atomic write lands while the file is read
         read_arrow(tmp_path / "missing.parquet", *args[1:])  # and the read fails part way
 
-    monkeypatch.setattr(tables_module, "_read_arrow", replaced_part_way)
+    monkeypatch.setattr(tables_module, "read_arrow", replaced_part_way)
     with pytest.raises(InputError, match=r"run.parquet: changed while it was read \(.*\); nothing written from it"):
         read_table(path)

@@ -28,8 +28,8 @@ from .estimators import (
     STOP_RATIO,
     AllanMinimum,
     AllanResult,
-    _normalize,
-    _variance_sums,
+    deviations_from_sums,
+    variance_sums,
     averaging_factors,
     phase_from_chunks,
     term_count,
@@ -166,7 +166,7 @@ def allan_deviation(
     forced = _noise_alpha(noise_alpha, len(ms))
     tau = ms / rate_hz
     counts = term_count(kind, phase.size, ms)
-    deviation = _normalize(kind, _variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
+    deviation = deviations_from_sums(kind, variance_sums(kind, phase, ms, counts), ms, tau, counts, scale)
     alphas, methods, edf = _noise_and_edf(kind, phase, ms, confidence, forced)
     return _result(kind, tau, deviation, counts, alphas, edf, methods, confidence)
 
@@ -252,12 +252,12 @@ def allan_deviation_segments(
     alphas = found.alpha if found is not None else np.full(len(ms), np.nan)
     for phase in phases:
         own = np.maximum(term_count(kind, phase.size, ms), 0)
-        sums += _variance_sums(kind, phase, ms, own)
+        sums += variance_sums(kind, phase, ms, own)
         counts += own
         if confidence is not None:
             own_edf = degrees_of_freedom(kind, alphas, ms, phase.size)
             edf += np.where((own > 0) & np.isfinite(own_edf), own_edf, 0.0)
     edf = np.where(np.isnan(alphas), np.nan, edf)
-    deviation = _normalize(kind, sums, ms, tau, counts, scale)
+    deviation = deviations_from_sums(kind, sums, ms, tau, counts, scale)
     methods = found.method if found is not None else ("",) * len(ms)
     return _result(kind, tau, deviation, counts, alphas, edf, methods, confidence)

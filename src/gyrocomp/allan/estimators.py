@@ -44,7 +44,8 @@ class _Estimator:
     modified: bool
 
 
-_ESTIMATORS = {
+#: the difference order and the averaging of each estimator, by its name
+ESTIMATORS = {
     "adev": _Estimator(2, False, False),
     "oadev": _Estimator(2, True, False),
     "mdev": _Estimator(2, True, True),
@@ -53,7 +54,8 @@ _ESTIMATORS = {
     "ohdev": _Estimator(3, True, False),
     "totdev": _Estimator(2, True, False),
 }
-_BLOCK = 1 << 16
+#: samples per block of the block-wise sums (bounds their temporary memory)
+BLOCK_SAMPLES = 1 << 16
 
 
 @dataclass(frozen=True)
@@ -112,7 +114,7 @@ class AllanResult:
         return AllanMinimum(tau_s=float(self.tau[i]), deviation=float(self.deviation[i]))
 
 
-def _blocks(count: int, block: int = _BLOCK):
+def _blocks(count: int, block: int = BLOCK_SAMPLES):
     for start in range(0, count, block):
         yield start, min(start + block, count)
 
@@ -213,7 +215,7 @@ def term_count(kind: str, n_phase: int, m):
 # --- sums of squared differences, in blocks -------------------------------------------------------------
 
 
-def _second_difference_sum(x, m: int, stride: int, count: int, buffer: np.ndarray) -> float:
+def second_difference_sum(x, m: int, stride: int, count: int, buffer: np.ndarray) -> float:
     """sum over i = 0, stride, ..., of (x[i+2m] - 2 x[i+m] + x[i])^2."""
     total = 0.0
     last = (count - 1) * stride + 1
@@ -362,7 +364,7 @@ def _octave_level_sums(x, top: int, block: int) -> np.ndarray:
 _LAGGED_MAX_SPANS = 128
 
 
-def _prefix_dots(x, cuts: dict[int, set[int]], block: int = _BLOCK) -> dict[int, dict[int, float]]:
+def _prefix_dots(x, cuts: dict[int, set[int]], block: int = BLOCK_SAMPLES) -> dict[int, dict[int, float]]:
     """P_k(c) = sum_{j<c} x[j] x[j+k] at each cut c (within 0..len(x)-k) of each lag k, in one pass over x in
     blocks: a block of x stays in cache while each lag's partner streams past it (measured at 1e7 points and 7
     lags: 0.022 s, against 0.031 s for one dot product per lag over the whole series)."""
@@ -495,7 +497,7 @@ class PhaseGrids:
         phase, mean = self.phase, self.mean
         blocks = len(phase) // g
         sums = np.empty(blocks)
-        step = max(g, (_BLOCK // g) * g)
+        step = max(g, (BLOCK_SAMPLES // g) * g)
         for start in range(0, blocks * g, step):
             stop = min(start + step, blocks * g)
             chunk = np.asarray(phase[start:stop], dtype=np.float64) - mean
@@ -545,9 +547,9 @@ class _LazyCumulated:
 
 
 def _one_sum(kind: str, phase, cumulated, m: int, count: int) -> float:
-    buffer, spare = np.empty(_BLOCK), np.empty(_BLOCK)
+    buffer, spare = np.empty(BLOCK_SAMPLES), np.empty(BLOCK_SAMPLES)
     if kind in ("oadev", "adev"):
-        return _second_difference_sum(phase, m, 1 if kind == "oadev" else m, count, buffer)
+        return second_difference_sum(phase, m, 1 if kind == "oadev" else m, count, buffer)
     if kind in ("hdev", "ohdev"):
         return _third_difference_sum(phase, m, 1 if kind == "ohdev" else m, count, buffer, spare)
     if kind == "totdev":
@@ -571,7 +573,7 @@ def _octave_chain(ms: np.ndarray, n_phase: int) -> int:
     return length
 
 
-def _variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.ndarray:
+def variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.ndarray:
     """The sum of squared differences behind each estimator, before its normalization.
 
     OADEV: octave factors 1, 2, 4, ... in one block-wise pass (_octave_oadev_sums), factors long against
@@ -594,7 +596,7 @@ def _variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.n
     return sums
 
 
-def _normalize(
+def deviations_from_sums(
     kind: str, sums: np.ndarray, ms: np.ndarray, tau: np.ndarray, counts: np.ndarray, phase_scale: float
 ) -> np.ndarray:
     """Deviations from the sums; ``phase_scale`` is what the phase was multiplied by (rate_hz for rate

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .estimators import _ESTIMATORS, ONE_SIGMA
+from .estimators import ESTIMATORS, ONE_SIGMA
 
 
 def _sw(t: np.ndarray, alpha: int) -> np.ndarray:
@@ -178,7 +178,7 @@ def _edf(kind: str, alpha: int, m: int, n_phase: int) -> float:
     """Equivalent degrees of freedom (cached: stretches of one length between gaps repeat the same terms)."""
     if kind == "totdev":
         return edf_totdev(alpha, m, n_phase)
-    spec = _ESTIMATORS[kind]
+    spec = ESTIMATORS[kind]
     return edf_greenhall(alpha, spec.difference_order, m, n_phase, overlapping=spec.overlapping, modified=spec.modified)
 
 

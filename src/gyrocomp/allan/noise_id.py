@@ -15,7 +15,7 @@ from typing import Literal
 
 import numpy as np
 
-from .estimators import _BLOCK, _ESTIMATORS, PhaseGrids, _second_difference_sum
+from .estimators import BLOCK_SAMPLES, ESTIMATORS, PhaseGrids, second_difference_sum
 
 #: fewest decimated points for which the lag-1 autocorrelation identifies a noise type (Riley 2004)
 NOISE_ID_MIN_POINTS = 30
@@ -229,7 +229,7 @@ def overlapping_allan_variance(phase, m: int) -> float:
     count = len(phase) - 2 * m
     if count < 1:
         return math.nan
-    return _second_difference_sum(phase, m, 1, count, np.empty(_BLOCK)) / (2.0 * float(m) ** 2 * count)
+    return second_difference_sum(phase, m, 1, count, np.empty(BLOCK_SAMPLES)) / (2.0 * float(m) ** 2 * count)
 
 
 def _rn_checked(
@@ -282,7 +282,7 @@ def noise_types(kind: str, phase, ms: np.ndarray) -> NoiseTypes:
     same evidence whatever the estimator: on 56 points the lag-1 statistic can call white FM white PM, whose
     interval would then be far too narrow.
     """
-    spec = _ESTIMATORS[kind]
+    spec = ESTIMATORS[kind]
     lowest = 2 - 2 * spec.difference_order
     alphas = np.full(len(ms), np.nan)
     methods = [""] * len(ms)

@@ -42,7 +42,7 @@ from ..fitting.online import (
     T_SCALE_DEGC,
     LearnerSettings,
 )
-from ..fitting.online.settings import _MAD_TO_SIGMA, _RIDGE
+from ..fitting.online.settings import MAD_TO_SIGMA, RIDGE
 from ..motion.stillness import MAX_ACCEL_NOISE_DENSITY, MAX_GYRO_NOISE_DENSITY, MIN_BLOCK_SAMPLES
 
 
@@ -92,10 +92,10 @@ def template_values(settings: LearnerSettings | None = None) -> dict[str, str]:
         "SAVE_CHANGE": c_number(s.save_change_dps),
         "GAP_PERIODS": c_number(GAP_PERIODS),
         "LEVEL_GROWTH": c_number(LEVEL_GROWTH),
-        "MAD": c_number(_MAD_TO_SIGMA),
+        "MAD": c_number(MAD_TO_SIGMA),
         "MIN_TILT": c_number(MIN_TILT_G),
         "PIECE_WEIGHT": c_number(PIECE_SPREAD_WEIGHT),
-        "RIDGE": c_number(_RIDGE),
+        "RIDGE": c_number(RIDGE),
         "T_REF": c_number(T_REF_DEGC),
         "T_SCALE": c_number(T_SCALE_DEGC),
         "CEILING": "{"

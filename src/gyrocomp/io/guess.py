@@ -32,7 +32,7 @@ from .readers import detect_format
 from .serial import MAX_LINE_BYTES, looks_headerless, read_headerless, split_fields
 from .columns import holds_clock, vector_column
 from .tables import TableLayout, check_parquet_footer, detect_table_format
-from .text_format import DECOMPRESS_ERRORS, DELIMITERS, TextFormat, _csv_bytes, read_error
+from .text_format import DECOMPRESS_ERRORS, DELIMITERS, TextFormat, csv_source, read_error
 
 #: rows read to guess from
 GUESS_ROWS = 20_000
@@ -153,7 +153,7 @@ def _sample(path: Path, fmt: str) -> tuple[pa.Table, str | None, list[str], tupl
         parquet = pq.ParquetFile(path)
         first = parquet.read_row_group(0) if parquet.num_row_groups else parquet.read()
         return first.slice(0, GUESS_ROWS), None, [], None
-    source, head = _csv_bytes(path)
+    source, head = csv_source(path)
     if not head.strip():
         raise InputError(f"{path}: the file is empty; nothing to guess from")
     headerless = _headerless_rows(head[:4096])

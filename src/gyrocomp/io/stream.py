@@ -29,9 +29,9 @@ from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (
     TableLayout,
-    _channel_selector,
-    _read_arrow,
-    _resolved_columns,
+    channel_selector,
+    read_arrow,
+    resolved_columns,
     check_parquet_footer,
     detect_table_format,
     rows_dropped,
@@ -41,7 +41,7 @@ from .text_format import (
     CSV_BLOCK_BYTES,
     DECOMPRESS_ERRORS,
     TextFormat,
-    _csv_options,
+    csv_write_options,
     csv_codec,
     open_csv_bytes,
     output_text_format,
@@ -110,10 +110,10 @@ class TableStream:
         self._opened = os.stat(self.path)  # the file as it was when the reading began
         self.schema = self._open_schema()
         if channels is None:
-            self.columns = _resolved_columns(self.schema.names, self.layout, self.path)
+            self.columns = resolved_columns(self.schema.names, self.layout, self.path)
         else:  # only these channels' columns (and time) are read, as read_table(channels=...)
             self.columns = {}
-            self._read = _channel_selector(tuple(channels), self.layout, self.path, self.columns)(self.schema.names)
+            self._read = channel_selector(tuple(channels), self.layout, self.path, self.columns)(self.schema.names)
         self.gyro_axes = tuple(a for a in GYRO_AXES if a in self.columns)
         self.accel_axes = tuple(a for a in ACCEL_AXES if a in self.columns)
         self.rows = 0
@@ -124,7 +124,7 @@ class TableStream:
     # ------------------------------------------------------------------ reading
     def _open_schema(self) -> pa.Schema:
         if self.layout.names is not None:
-            self._headerless, self.text_format = _read_arrow(self.path, self.fmt, self.layout)
+            self._headerless, self.text_format = read_arrow(self.path, self.fmt, self.layout)
             return self._headerless.schema
         if self.fmt == "parquet":
             check_parquet_footer(self.path)
@@ -320,7 +320,7 @@ class TableWriter:
                 self._writer = pacsv.CSVWriter(
                     text_sink(self._tmp, self.path, self._stack),
                     with_decimal(table, self.text_format).schema,
-                    write_options=_csv_options(table.column_names, self.text_format),
+                    write_options=csv_write_options(table.column_names, self.text_format),
                 )
         elif table.schema != self._schema:
             try:

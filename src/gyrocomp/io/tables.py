@@ -29,8 +29,8 @@ from .text_format import (
     DECOMPRESS_ERRORS,
     TEXT_TABLE_SUFFIXES,
     TextFormat,
-    _csv_bytes,
-    _csv_options,
+    csv_source,
+    csv_write_options,
     csv_codec,
     header_line,
     output_text_format,
@@ -81,7 +81,7 @@ def check_parquet_footer(path: Path) -> None:
         )
 
 
-def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple[pa.Table, TextFormat | None]:
+def read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple[pa.Table, TextFormat | None]:
     """The table, and a text table's format (None for Parquet); ``select`` (a function of the header's names
     giving the names to read, or None for all) reads only some columns. A table without a header line
     (``layout.names``) is read by :func:`gyrocomp.io.serial.read_headerless`."""
@@ -97,7 +97,7 @@ def _read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple
     if fmt == "csv":
         if address_space_left() is not None:  # under a limit only: the estimate opens the file once more
             require_memory(path, estimated_table_bytes(path, csv_codec(path) is not None))
-        source, head = _csv_bytes(path)
+        source, head = csv_source(path)
         if not head.strip():
             raise InputError(f"{path}: the file is empty; expected a header such as time,gyro_z,temperature")
         text = TextFormat.found(head[:4096], layout)
@@ -156,7 +156,7 @@ def detect_table_format(path: Path) -> str | None:
     return None
 
 
-def _resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dict[str, str]:
+def resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dict[str, str]:
     """Canonical name to column, refusing a repeated column name, a missing time column or no gyro column."""
     repeated = sorted({name for name in header if header.count(name) > 1})
     if repeated:
@@ -237,13 +237,13 @@ def _reference_rates(cols: dict[str, str], num, path: Path, factor: float) -> np
     return np.column_stack([num(a) for a in REFERENCE_RATE_AXES]) * factor
 
 
-def _channel_selector(channels: tuple[str, ...], layout: TableLayout, path: Path, chosen: dict):
+def channel_selector(channels: tuple[str, ...], layout: TableLayout, path: Path, chosen: dict):
     """The columns to read for ``channels`` (and time), resolved on the whole header (so a mapping may name any
     column), the channels found put in ``chosen``."""
     wanted = {TIME_COLUMN, *channels}
 
     def select(names: list[str]) -> list[str]:
-        found = _resolved_columns(names, layout, path)
+        found = resolved_columns(names, layout, path)
         chosen.update({channel: column for channel, column in found.items() if channel in wanted})
         if not any(a in chosen for a in GYRO_AXES):
             raise InputError(
@@ -285,10 +285,10 @@ def read_table(
     path = Path(path)
     fmt = fmt or detect_table_format(path) or "csv"
     chosen: dict[str, str] = {}
-    select = None if channels is None else _channel_selector(tuple(channels), layout, path, chosen)
+    select = None if channels is None else channel_selector(tuple(channels), layout, path, chosen)
     opened = os.stat(path) if path.is_file() else None
     try:
-        table, text_format = _read_arrow(path, fmt, layout, select)
+        table, text_format = read_arrow(path, fmt, layout, select)
     except InputError:
         if opened is not None:  # a file replaced while it was read (opened by path more than once): said so
             require_unchanged(path, opened)
@@ -297,7 +297,7 @@ def read_table(
         require_unchanged(path, opened)
     if table.num_rows == 0:
         raise InputError(f"{path}: a header but no data rows")
-    cols = chosen if channels is not None else _resolved_columns(table.column_names, layout, path)
+    cols = chosen if channels is not None else resolved_columns(table.column_names, layout, path)
     recording, kept = table_recording(
         table, cols, layout, path, fmt, drop_nonfinite=drop_nonfinite, text_format=text_format
     )
@@ -402,7 +402,7 @@ def _write_arrow(table: pa.Table, path: Path, fmt: str, text_format: TextFormat 
                     pacsv.write_csv(
                         decimal,
                         text_sink(tmp, path, stack),
-                        _csv_options(table.column_names, text_format, quote_text=quote_text),
+                        csv_write_options(table.column_names, text_format, quote_text=quote_text),
                     )
                 return
             except pa.ArrowInvalid:
@@ -521,4 +521,7 @@ __all__ = [
     "table_data",
     "file_sha256",
     "table_recording",
+    "read_arrow",
+    "resolved_columns",
+    "channel_selector",
 ]

@@ -275,7 +275,7 @@ def check_header(path: Path, head: bytes) -> None:
         )
 
 
-def _csv_bytes(path: Path) -> tuple[pa.NativeFile | str, bytes]:
+def csv_source(path: Path) -> tuple[pa.NativeFile | str, bytes]:
     """The CSV's source for pyarrow (gzip, bz2, zstd or xz decompressed as they are read, by their magic bytes)
     and its first bytes as :func:`text_head` gives them."""
     codec = csv_codec(path)
@@ -420,7 +420,7 @@ def text_sink(tmp: str | os.PathLike, name: str | os.PathLike, stack) -> object:
     return tmp
 
 
-def _csv_options(
+def csv_write_options(
     names: list[str], text_format: TextFormat | None = None, quote_text: bool = False
 ) -> pacsv.WriteOptions:
     """A header as other tools write and expect it: names unquoted unless one needs quotes; fields separated
@@ -476,4 +476,6 @@ __all__ = [
     "text_sink",
     "units_line",
     "with_decimal",
+    "csv_source",
+    "csv_write_options",
 ]

@@ -15,7 +15,7 @@ from ..runs.prepared import PreparedRun, prepare
 from ..threads import single_threaded_blas
 from .joint import checked_options, fit_joint
 from .options import FitOptions
-from .triads import _accel_triad, _spanning_poses
+from .triads import fit_accel_triad, spanning_poses
 
 
 def _accelerometer_pieces(recordings: list[PreparedRun], min_static_s: float) -> tuple[list[PreparedRun], tuple, bool]:
@@ -97,11 +97,11 @@ def fit_accel_channel(recordings: list[PreparedRun], options: FitOptions) -> Cal
         try:
             accel_cal = accelerometer_models(recordings, options)
         except InputError:
-            if _spanning_poses(recordings) is None:  # a multi-position session at one temperature: the triad alone
+            if spanning_poses(recordings) is None:  # a multi-position session at one temperature: the triad alone
                 raise
         if accel_cal is not None:
             recordings = [dataclasses.replace(rec, accel_g=apply(accel_cal, rec).accel_g) for rec in recordings]
-    poses = _spanning_poses(recordings)
+    poses = spanning_poses(recordings)
     if poses is None:
         if accel_cal is None:
             raise InputError(
@@ -109,7 +109,7 @@ def fit_accel_channel(recordings: list[PreparedRun], options: FitOptions) -> Cal
                 "every accelerometer axis up and down (for a multi-position calibration)"
             )
         return accel_cal
-    fit, accel_cal = _accel_triad(poses, accel_cal)
+    fit, accel_cal = fit_accel_triad(poses, accel_cal)
     report = {
         "accel_triad": {
             "method": fit.calibration.method,

@@ -23,7 +23,7 @@ from .accelerometer import fit_accel_channel
 from .joint import checked_options
 from .options import FitOptions
 from .pipelines import Pipeline, run_pipeline
-from .triads import ScaleFactor, _gyro_triad
+from .triads import ScaleFactor, fit_gyro_triad
 
 
 def check_channels(channels: tuple[Channel, ...]) -> tuple[Channel, ...]:
@@ -86,7 +86,7 @@ def fit(
     channels = check_channels(channels)
     options = checked_options(options)
     gyro_triad, recordings = (
-        _gyro_triad(recordings, scale_factor, options.temperature is not None)
+        fit_gyro_triad(recordings, scale_factor, options.temperature is not None)
         if "gyro" in channels
         else (None, recordings)
     )

@@ -34,7 +34,7 @@ from ..fitting.folds import FOLD_KINDS
 from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
 from ..fitting.selection import AxisSelection, prepare_axis
 from ..fitting.polynomial_model import PolynomialTemperatureModel
-from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, _accel_triad, _gyro_triad, _spanning_poses  # noqa: F401
+from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, fit_accel_triad, fit_gyro_triad, spanning_poses  # noqa: F401
 from .options import Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target, curve_candidates
 from ..fitting.thermal import (
     CANDIDATES,

@@ -16,7 +16,7 @@ from ..recording import Recording
 from ..fitting.acceleration import fit_acceleration_network
 from ..fitting.base import provenance
 from ..curves.network import NETWORK_INPUTS
-from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, _accel_triad, _gyro_triad, _spanning_poses  # noqa: F401
+from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, fit_accel_triad, fit_gyro_triad, spanning_poses  # noqa: F401
 from .joint import checked_options, fit_joint
 from .options import FitOptions, Network
 from ..threads import single_threaded_blas

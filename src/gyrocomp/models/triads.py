@@ -33,13 +33,13 @@ def _turning_sessions(recordings: list[Recording]) -> list[Recording]:
             and rec.gyro_axes == GYRO_AXES
             and rec.accel_g is not None
             and set(ACCEL_AXES) <= set(rec.accel_axes)
-            and _spanning_poses([rec]) is not None
+            and spanning_poses([rec]) is not None
         ):
             out.append(rec)
     return out
 
 
-def _gyro_triad(
+def fit_gyro_triad(
     recordings: list[Recording], scale_factor: str, wants_temperature: bool = True
 ) -> tuple[TriadCalibration | None, list[Recording]]:
     """The gyro's K(T) from the runs that carry reference rates (those runs then leave the bias model) or, without
@@ -103,7 +103,7 @@ def _still_stretches(rate_runs: list[Recording]) -> list[Recording]:
     return out
 
 
-def _spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
+def spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
     """The still poses of runs that turn the accelerometer's every axis up and down (a multi-position test), or
     None when they do not."""
     turned = [
@@ -124,7 +124,7 @@ def _reaches_both_ways(recording: Recording) -> bool:
     return bool(np.all(accel.max(axis=0)[order] > 0.4) and np.all(accel.min(axis=0)[order] < -0.4))
 
 
-def _accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[PoseFit, Calibration | None]:
+def fit_accel_triad(poses: list[Pose], accel_cal: Calibration | None) -> tuple[PoseFit, Calibration | None]:
     """The accelerometer triad from the (temperature-compensated) poses, and the temperature models it completes.
 
     Where the poses span temperatures (a six-face session through a temperature profile), the six-position fit

@@ -15,7 +15,7 @@ import pandas as pd
 from ..fleet import FIGURE_NAMES, Limits, fleet_yield
 from ..fleet.population import OUTLIER_THRESHOLD
 from . import figures
-from .html import Report, _img, _table, html_page
+from .html import Report, figure_html, table_html, html_page
 
 #: units listed in the worst-units table
 WORST_UNITS = 10
@@ -30,12 +30,12 @@ def build_fleet_report(table: pd.DataFrame, *, limits: Limits | None = None, tit
     if counts.fitted:
         sections["distributions"] = (
             "Distributions",
-            _img(figures.fleet_distributions(table, FIGURE_NAMES, axes, limits), "histograms of every figure"),
+            figure_html(figures.fleet_distributions(table, FIGURE_NAMES, axes, limits), "histograms of every figure"),
         )
     outliers = table[table["outlier"]].sort_values("outlier_score", ascending=False)
     sections["outliers"] = (
         "Outliers",
-        _table(
+        table_html(
             ["serial", "score", "figures", "verdict"],
             [
                 [s, float(z), f, v or "-"]
@@ -53,13 +53,15 @@ def build_fleet_report(table: pd.DataFrame, *, limits: Limits | None = None, tit
     if len(rejected):
         sections["rejected"] = (
             "Outside the limits",
-            _table(["serial", "failing figures"], [[s, f] for s, f in zip(rejected["serial"], rejected["failing"])]),
+            table_html(
+                ["serial", "failing figures"], [[s, f] for s, f in zip(rejected["serial"], rejected["failing"])]
+            ),
         )
     failed = table[table["status"] == "failed"]
     if len(failed):
         sections["failed"] = (
             "Failed fits",
-            _table(["serial", "error"], [[s, e] for s, e in zip(failed["serial"], failed["error"])]),
+            table_html(["serial", "error"], [[s, e] for s, e in zip(failed["serial"], failed["error"])]),
         )
     return Report(
         html_page(f"gyrocomp fleet report: {title}", f"gyrocomp fleet report: {title}", "", sections), tuple(sections)
@@ -76,9 +78,9 @@ def _summary(table: pd.DataFrame, counts, limits: Limits | None) -> str:
     if limits is not None or (table["verdict"] != "").any():
         rows.append(["pass", counts.passed])
         rows.append(["yield", f"{100 * counts.yield_fraction:.1f} %"])
-    text = _table(["", "count"], rows)
+    text = table_html(["", "count"], rows)
     if limits is not None:
-        text += _table(
+        text += table_html(
             ["figure", "axis", "min", "max", "abs_max"],
             [[lim.figure, lim.axis or "every", lim.min, lim.max, lim.abs_max] for lim in limits.limits],
             f"limits ({limits.source})",
@@ -99,7 +101,7 @@ def _worst(table: pd.DataFrame, axes: tuple[str, ...]) -> str:
             values = np.array([unit.get(f"{a}_{name}", np.nan) for a in axes], dtype=float)
             row.append(float(values[np.nanargmax(np.abs(values))]) if np.isfinite(values).any() else np.nan)
         rows.append(row)
-    return _table(["serial", "verdict", "score", *names], rows, "worst axis of each figure")
+    return table_html(["serial", "verdict", "score", *names], rows, "worst axis of each figure")
 
 
 __all__ = ["WORST_UNITS", "build_fleet_report"]

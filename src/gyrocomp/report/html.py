@@ -80,21 +80,13 @@ def _png(fig) -> str:
     return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
-def _img(fig, alt: str) -> str:
-    return f'<img src="{_png(fig)}" alt="{escape_text(alt)}">'
-
-
 def figure_html(fig, alt: str) -> str:
     """A matplotlib figure as an ``<img>`` with the PNG inside the page (``alt`` escaped)."""
-    return _img(fig, alt)
+    return f'<img src="{_png(fig)}" alt="{escape_text(alt)}">'
 
 
 def table_html(header: list[str], rows: list[list], caption: str | None = None) -> str:
     """A table as the report draws them (every text escaped; numbers right-aligned)."""
-    return _table(header, rows, caption)
-
-
-def _table(header: list[str], rows: list[list], caption: str | None = None) -> str:
     out = ["<table>"]
     if caption:
         out.append(f"<caption>{escape_text(caption)}</caption>")
@@ -152,7 +144,7 @@ def _summary(calibration: Calibration) -> str:
     if selection is not None:
         orders = selection.orders
         parts.append(
-            _table(
+            table_html(
                 ["axis"] + [f"order {p}" for p in orders],
                 [[a] + [s.get(p) for p in orders] for a, s in selection.scores.items()],
                 f"polynomial order by {selection.method} (lower is better)",
@@ -163,7 +155,7 @@ def _summary(calibration: Calibration) -> str:
     if scored:
         names = hyst.memories_scored
         parts.append(
-            _table(
+            table_html(
                 ["axis"] + list(names) + ["chosen"],
                 [[a] + [c.scores.get(m) for m in names] + [c.label] for a, c in scored.items()],
                 f"hysteresis / thermal lag candidates by {hyst.selection} (lower is better)",
@@ -195,7 +187,7 @@ def _axis_table(calibration: Calibration) -> str:
     header = ["axis", "model", "inputs", "valid range [degC]", "fit RMS", "run constants"]
     if all(row[4] == "-" for row in rows):  # no fit recorded one: no empty column
         header, rows = header[:4] + header[5:], [row[:4] + row[5:] for row in rows]
-    return _table(header, rows)
+    return table_html(header, rows)
 
 
 def _expected_drift(expected: dict) -> list[str]:
@@ -213,7 +205,7 @@ def _expected_drift(expected: dict) -> list[str]:
         for e in expected.values()
     ]
     parts = [
-        _table(
+        table_html(
             ["axis", "model", "expected held-out drift", "run constant alone"],
             rows,
             f"drift to expect on unseen data: mean +- standard error over {first.folds} held-out "
@@ -233,7 +225,7 @@ def _validation(result: ValidationResult) -> str:
     header, rows = result.table_rows()
     caption = f"{result.title}: each method fitted without the fold it is scored on"
     folds = f"<p class=note>folds: {escape_text(', '.join(result.folds))}</p>"
-    return _table(header, rows, caption) + folds
+    return table_html(header, rows, caption) + folds
 
 
 _STAGE_HEADERS = [
@@ -269,7 +261,7 @@ def _evaluation(
     staged = len(stage_calibrations(calibration)) > 1
     rows, accel_rows = [], []
     for rec, ev in zip(runs, evaluations):
-        name = rec.source.rsplit("/", 1)[-1]  # a table cell: escaped once, by _table
+        name = rec.source.rsplit("/", 1)[-1]  # a table cell: escaped once, by table_html
         if staged:
             rows += _stage_rows(calibration, rec, name, ev.window_s, turn_on_window_s)
         else:
@@ -279,11 +271,11 @@ def _evaluation(
             accel_rows.append([name, axis, m.bias_offset_raw_g, m.bias_offset_comp_g, improvement])
             accel_rows[-1] += [m.bias_instability_raw_ug, m.bias_instability_comp_ug]
     if staged:
-        parts = [_table(_STAGE_HEADERS, rows, "stages of the compensation (the thesis's Table 4.4)")]
+        parts = [table_html(_STAGE_HEADERS, rows, "stages of the compensation (the thesis's Table 4.4)")]
     else:
-        parts = [_table(_EVALUATION_HEADERS, rows)]
+        parts = [table_html(_EVALUATION_HEADERS, rows)]
     if accel_rows:
-        parts.append(_table(_ACCEL_HEADERS, accel_rows, "accelerometer"))
+        parts.append(table_html(_ACCEL_HEADERS, accel_rows, "accelerometer"))
     parts.append(
         "<p class=note>Bias offset: peak-to-peak of the moving average (window: tau at the raw Allan "
         "minimum, at least 1 s); bias instability: Allan minimum / 0.664 (IEEE Std 952).</p>"
@@ -405,12 +397,12 @@ def _triads(calibration: Calibration, runs: list[Recording], compensated: list[R
     temps = [rec.temperature_degc for rec in runs if rec.temperature_degc is not None]
     span = (float(min(np.min(t) for t in temps)), float(max(np.max(t) for t in temps))) if temps else None
     body = [
-        _table(
+        table_html(
             ["triad", "method", "K column x", "K column y", "K column z", "scale error [ppm]", "bias"],
             rows,
             "raw = K(T) v + bias, corrected v = K(T)^-1 (raw - bias); K at the reference temperature +- standard error",
         ),
-        _img(
+        figure_html(
             figures.triad_plot(triads, span, _pose_residuals(calibration, runs, compensated)),
             "scale-factor error against temperature, residual per pose",
         ),
@@ -430,11 +422,13 @@ def _axis_sections(
         body = []
         if runs[0].temperature_degc is not None:
             body.append(
-                _img(figures.temperature_plot(runs, compensated, axis, unit), f"{axis}: bias against temperature")
+                figure_html(
+                    figures.temperature_plot(runs, compensated, axis, unit), f"{axis}: bias against temperature"
+                )
             )
         for rec, comp, w in zip(runs, compensated, windows):
             body.append(
-                _img(
+                figure_html(
                     figures.timeseries_plot(rec, comp, axis, w, unit, title=f"{axis}: {rec.source.rsplit('/', 1)[-1]}"),
                     f"{axis}: raw and compensated output",
                 )
@@ -456,12 +450,12 @@ def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s
         g_matrix[axis] = (ax.g_sensitivity_dps_per_g, errors)
         rows.append([axis] + [with_error(g, e, sign=True) for g, e in zip(ax.g_sensitivity_dps_per_g, errors)])
     body = [
-        _table(
+        table_html(
             ["gyro axis", "accel_x", "accel_y", "accel_z"], rows, "g-sensitivity matrix G [deg/s/g] +- standard error"
         )
     ]
     if positions:
-        body.append(_img(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
+        body.append(figure_html(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
     else:
         body.append("<p class=note>These runs have no static positions to draw.</p>")
     return "\n".join(body)
@@ -575,7 +569,7 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
         for j, axis in enumerate(d.axes)
     ]
     parts = [
-        _table(
+        table_html(
             [
                 "firmware",
                 "axis",
@@ -595,7 +589,7 @@ def _firmware(calibration: Calibration, runs: list[Recording], evaluations: list
     run_rows = _firmware_run_rows(calibration, runs, evaluations, costs)
     if run_rows:
         parts.append(
-            _table(
+            table_html(
                 ["run", "axis", "raw", "model", "PX4 file (as run)", "ArduPilot file"],
                 run_rows,
                 "bias offset on each run [deg/s]: the model as gyrocomp applies it, and the exported "
@@ -643,7 +637,7 @@ def _allan(runs: list[Recording], noise: list[tuple], tick: Callable[[], None]) 
     for rec, (raw, compensated) in zip(runs, noise):
         analyses = {"raw": raw, "compensated": compensated}
         parts.append(
-            _img(
+            figure_html(
                 figures.allan_plot(analyses, title=f"Allan deviation: {rec.source.rsplit('/', 1)[-1]}"),
                 "Allan deviation, raw and compensated",
             )
@@ -672,7 +666,7 @@ def _noise_model_table(compensated) -> str:
         ]
         for name, a in model.axes.items()
     ]
-    return _table(
+    return table_html(
         ["axis", "IEEE 952 N", "IEEE 952 K", "bound N", "bound K", "bound / curve: median / largest"],
         rows,
         caption="noise model of the compensated gyro for an estimator (gyrocomp noise): N "
@@ -686,7 +680,9 @@ def _stillness(moving: list) -> str:
     listed (where, how long, temperature, mean rate = the bias there)."""
     parts = []
     for rec, found in moving:
-        parts.append(_img(figures.stillness_plot(rec, found), "rate and temperature with the still segments shaded"))
+        parts.append(
+            figure_html(figures.stillness_plot(rec, found), "rate and temperature with the still segments shaded")
+        )
         rows = [
             [
                 f"{s.start_s - rec.time_s[0]:.0f}",
@@ -698,7 +694,7 @@ def _stillness(moving: list) -> str:
         ]
         total = rec.duration_s
         parts.append(
-            _table(
+            table_html(
                 ["start [s]", "length [s]", "temperature [degC]", *(f"{a} mean [deg/s]" for a in rec.gyro_axes)],
                 rows,
                 f"{rec.source.rsplit('/', 1)[-1]}: {len(found.segments)} still segment(s), "

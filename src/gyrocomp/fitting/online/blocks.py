@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 
-def _quantile(values: np.ndarray, q: float) -> np.ndarray:
+def c_quantile(values: np.ndarray, q: float) -> np.ndarray:
     """Column quantiles by linear interpolation between order statistics (as the C code computes them)."""
     s = np.sort(values, axis=0)
     pos = q * (s.shape[0] - 1)
@@ -33,10 +33,10 @@ def block_statistics(blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mean, var
 
 
-def _fresh_dequantizer() -> dict:
+def fresh_dequantizer() -> dict:
     """The dequantizer's state: the last reading, the last crossing [degC], its time [s], the rate [degC/s] and
     half the step there [degC] (None/0: none yet)."""
     return {"previous": None, "crossing": None, "time": 0.0, "rate": 0.0, "half": 0.0}
 
 
-__all__ = ["block_statistics"]
+__all__ = ["block_statistics", "c_quantile", "fresh_dequantizer"]

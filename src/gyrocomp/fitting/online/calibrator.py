@@ -24,11 +24,11 @@ from .settings import (
     POOL_PIECES,
     T_REF_DEGC,
     T_SCALE_DEGC,
-    _MAD_TO_SIGMA,
+    MAD_TO_SIGMA,
     chi2_quantile,
 )
-from .refit import _curve, _design, _forward, _matrix, _tilted, _weighted_fit
-from .blocks import _fresh_dequantizer, _quantile, block_statistics
+from .refit import shape_curve, design_matrix, forward_substitute, xyz_rows, tilted_axes, weighted_fit
+from .blocks import fresh_dequantizer, c_quantile, block_statistics
 
 
 class OnlineCalibrator(LearnerFiles):
@@ -68,7 +68,7 @@ class OnlineCalibrator(LearnerFiles):
         self._buffer = np.zeros((self._w, 6 + self._lags))
         self._lag_state = np.zeros(self._lags)  # the lagged temperatures of the last good sample [degC]
         self._lag_t: float | None = None  # its time [s] (None: the filters start on the next sample)
-        self._dq = _fresh_dequantizer()
+        self._dq = fresh_dequantizer()
         self._fill = 0
         self._last_t: float | None = None
         self._t0 = 0.0
@@ -130,7 +130,7 @@ class OnlineCalibrator(LearnerFiles):
         self._accel = None
         self._last_t = None
         self._lag_t = None
-        self._dq = _fresh_dequantizer()
+        self._dq = fresh_dequantizer()
         self._base_clock = self._clock
         self._drop_old_sessions()
 
@@ -153,14 +153,14 @@ class OnlineCalibrator(LearnerFiles):
         m = t.size
         if temperature_degc is None:
             raise InputError("temperature_degc: the learner needs the temperature of every sample")
-        gyro = _matrix(gyro_dps, m, "gyro_dps")
+        gyro = xyz_rows(gyro_dps, m, "gyro_dps")
         temperature = np.asarray(temperature_degc, dtype=float).reshape(-1)
         if temperature.size != m:
             raise InputError(f"temperature_degc: {temperature.size} values for {m} times")
         has_accel = accel_g is not None
         if self._accel is not None and has_accel != self._accel:
             raise InputError("accel_g: given in some chunks of a session and not in others")
-        accel = _matrix(accel_g, m, "accel_g") if has_accel else np.zeros((m, 3))
+        accel = xyz_rows(accel_g, m, "accel_g") if has_accel else np.zeros((m, 3))
         if m == 0:
             return
         if not np.all(np.isfinite(t)):
@@ -354,7 +354,7 @@ class OnlineCalibrator(LearnerFiles):
                 continue
             scale = math.sqrt(2.0 * level / self._w)
             if self._step_count[c] >= MIN_STEPS:
-                robust = float(medians[c]) / _MAD_TO_SIGMA
+                robust = float(medians[c]) / MAD_TO_SIGMA
                 scale = max(scale, robust)
             if step[c] > self._z[f"step{channels}"] * scale:
                 agree = False
@@ -371,8 +371,8 @@ class OnlineCalibrator(LearnerFiles):
         channels when they hold as many values (the usual case), the same numbers as one channel at a time."""
         first = int(counts[0])
         if first and np.all(counts[:channels] == first):
-            return _quantile(ring[:first, :channels], q)
-        return np.array([_quantile(ring[: int(counts[c]), c], q) if counts[c] else np.nan for c in range(channels)])
+            return c_quantile(ring[:first, :channels], q)
+        return np.array([c_quantile(ring[: int(counts[c]), c], q) if counts[c] else np.nan for c in range(channels)])
 
     def _interior(self, block: dict, interior: bool, now: float) -> None:
         s = self.settings
@@ -535,7 +535,7 @@ class OnlineCalibrator(LearnerFiles):
         # the model's own uncertainty there: s^2 x' (X'WX)^-1 x, s^2 = rms^2 sum(w) / n
         u = (min(max(temperature, self._t_range[0]), self._t_range[1]) - T_REF_DEGC) / T_SCALE_DEGC
         x = np.concatenate([[u**k for k in range(1, self._degree + 1)], accel[self._tilted], sessions])
-        z = _forward(self._lower, x)
+        z = forward_substitute(self._lower, x)
         spread2 = spread2 + self._scale2 * float(z @ z)
         # past the temperatures the model has seen it cannot judge a piece closely: the bias may move by up to
         # max_tempco_dps_per_degc for every degree beyond them
@@ -581,13 +581,13 @@ class OnlineCalibrator(LearnerFiles):
         while degree > 0 and used.size < degree + sessions.size + 1:
             degree -= 1
         accel = self._pt_accel[used]
-        tilted = _tilted(accel, self._pt_session[used], sessions, used.size - degree - sessions.size - 1)
+        tilted = tilted_axes(accel, self._pt_session[used], sessions, used.size - degree - sessions.size - 1)
         weights = np.array([self._pt_s[i] * self._decay(now - self._pt_clock[i]) for i in used])
         while True:
             # every candidate lag, the one leaving the smallest weighted residual kept (the first of equals)
             solution, chosen = None, -1
             for k in range(self._lags):
-                fit = _weighted_fit(
+                fit = weighted_fit(
                     self._pt_t[used, k],
                     accel,
                     tilted,
@@ -621,7 +621,7 @@ class OnlineCalibrator(LearnerFiles):
         self._should_save = self._changed()
 
     def _shape(self, temperature) -> np.ndarray:
-        return _curve(self._coef, self._degree, self._t_range, temperature)
+        return shape_curve(self._coef, self._degree, self._t_range, temperature)
 
     def _changed(self) -> bool:
         if self._saved is None:
@@ -630,7 +630,7 @@ class OnlineCalibrator(LearnerFiles):
             return True
         temps = self._pt_t[self._pt_session > 0, self._lag_index]
         now = self._shape(temps) + self._constants.mean(axis=0)
-        before = _curve(self._saved["coef"], self._saved["degree"], self._t_range, temps) + self._saved["constant"]
+        before = shape_curve(self._saved["coef"], self._saved["degree"], self._t_range, temps) + self._saved["constant"]
         return bool(np.max(np.abs(now - before)) > self.settings.save_change_dps)
 
     def mark_saved(self) -> None:
@@ -703,7 +703,7 @@ class OnlineCalibrator(LearnerFiles):
         used = np.flatnonzero(self._pt_session > 0)
         if self._degree < 0:
             return (math.inf,) * 3
-        design = _design(
+        design = design_matrix(
             self._pt_t[used, self._lag_index],
             self._pt_accel[used],
             self._tilted,

@@ -18,7 +18,7 @@ from ...errors import InputError, NotFittedError
 from ...io.atomic import folder_lock, write_text_atomic
 from ..base import provenance
 from ...curves.polynomial import PolynomialCurve
-from .state import _record_to_dict, _restore, check_state_target
+from .state import record_to_dict, restore_learner, check_state_target
 from .settings import (
     GYRO_AXES,
     LEARNER_FORMAT,
@@ -158,7 +158,7 @@ class LearnerFiles:
                 f"{LEARNER_SCHEMA_VERSION}"
             )
         try:
-            return _restore(cls, d)
+            return restore_learner(cls, d)
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
         except (KeyError, TypeError, ValueError, IndexError) as exc:
@@ -217,7 +217,7 @@ class LearnerFiles:
             "lag_state_degc": self._lag_state.tolist(),
             "lag_t": self._lag_t,
             "dequantizer": dict(self._dq),
-            "recent": [_record_to_dict(r) for r in self._recent],
+            "recent": [record_to_dict(r) for r in self._recent],
         }
 
     def _model_state(self) -> dict[str, Any]:

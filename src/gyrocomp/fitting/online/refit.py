@@ -8,10 +8,11 @@ import math
 import numpy as np
 
 from ...errors import InputError
-from .settings import MIN_TILT_G, POINTS_PER_TILT, T_REF_DEGC, T_SCALE_DEGC, _RIDGE
+from .settings import MIN_TILT_G, POINTS_PER_TILT, T_REF_DEGC, T_SCALE_DEGC, RIDGE
 
 
-def _matrix(values, rows: int, name: str) -> np.ndarray:
+def xyz_rows(values, rows: int, name: str) -> np.ndarray:
+    """``values`` as a float array of shape (rows, 3) (x, y, z per time), or one line naming ``name``."""
     try:
         out = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
@@ -23,7 +24,7 @@ def _matrix(values, rows: int, name: str) -> np.ndarray:
     return out
 
 
-def _curve(coef: np.ndarray, degree: int, t_range: tuple[float, float], temperature) -> np.ndarray:
+def shape_curve(coef: np.ndarray, degree: int, t_range: tuple[float, float], temperature) -> np.ndarray:
     """The shape sum_k c_k u^k per axis [deg/s] (..., 3) at ``temperature`` [degC], continued along its tangent
     past ``t_range`` (as :class:`PolynomialCurve` with ``extrapolation="linear"``)."""
     t = np.asarray(temperature, dtype=float)
@@ -38,7 +39,7 @@ def _curve(coef: np.ndarray, degree: int, t_range: tuple[float, float], temperat
     return out + slope * beyond
 
 
-def _tilted(accel: np.ndarray, point_sessions: np.ndarray, sessions: np.ndarray, spare: int) -> np.ndarray:
+def tilted_axes(accel: np.ndarray, point_sessions: np.ndarray, sessions: np.ndarray, spare: int) -> np.ndarray:
     """Which accelerometer axes the points excite enough to fit their g-sensitivity: a range of MIN_TILT_G within
     one power-on (an attitude that changes only from one power-on to the next cannot be told from the power-ons'
     constants), POINTS_PER_TILT of the ``spare`` points (beyond the other unknowns) for each."""
@@ -51,7 +52,7 @@ def _tilted(accel: np.ndarray, point_sessions: np.ndarray, sessions: np.ndarray,
     return out
 
 
-def _design(
+def design_matrix(
     temps: np.ndarray,
     accel: np.ndarray,
     tilted: np.ndarray,
@@ -59,6 +60,8 @@ def _design(
     sessions: np.ndarray,
     degree: int,
 ) -> np.ndarray:
+    """The refit's columns per point: u^1..u^degree of the scaled temperature, the tilted accelerometer axes [g]
+    and one indicator per power-on (``sessions``)."""
     u = (temps - T_REF_DEGC) / T_SCALE_DEGC
     columns = [u**k for k in range(1, degree + 1)]
     columns += [accel[:, k] for k in range(3) if tilted[k]]
@@ -66,11 +69,11 @@ def _design(
     return np.column_stack(columns)
 
 
-def _weighted_fit(temps, accel, tilted, bin_sessions, sessions, bias, weights, degree):
+def weighted_fit(temps, accel, tilted, bin_sessions, sessions, bias, weights, degree):
     """Weighted least squares (see the module, step 7) by Cholesky on the normal equations, in the C code's order
     of operations: (coefficients (degree, 3), g-sensitivities (tilted axes, 3), constants (sessions, 3), residual
     RMS (3,)), or None when the system is not positive definite."""
-    x = _design(temps, accel, tilted, bin_sessions, sessions, degree)
+    x = design_matrix(temps, accel, tilted, bin_sessions, sessions, degree)
     n, p = x.shape
     # sums over the points in their order, each term w (x_r x_c): a reduction over the first axis of a contiguous
     # array adds the points one after the other, as the C code does
@@ -78,7 +81,7 @@ def _weighted_fit(temps, accel, tilted, bin_sessions, sessions, bias, weights, d
     a = np.ascontiguousarray(w * (x[:, :, None] * x[:, None, :])).sum(axis=0)
     b = np.ascontiguousarray(w * (x[:, :, None] * np.asarray(bias, dtype=float)[:, None, :])).sum(axis=0)
     for i in range(p):
-        a[i, i] *= 1.0 + _RIDGE
+        a[i, i] *= 1.0 + RIDGE
     lower = _cholesky(a)
     if lower is None:
         return None
@@ -111,7 +114,7 @@ def _cholesky(a: np.ndarray) -> np.ndarray | None:
     return lower
 
 
-def _forward(lower: np.ndarray, x: np.ndarray) -> np.ndarray:
+def forward_substitute(lower: np.ndarray, x: np.ndarray) -> np.ndarray:
     """L^-1 x by forward substitution."""
     p = lower.shape[0]
     y = np.zeros(p)
@@ -140,4 +143,4 @@ def _cholesky_solve(lower: np.ndarray, b: np.ndarray) -> np.ndarray:
     return x
 
 
-__all__ = []
+__all__ = ["xyz_rows", "shape_curve", "tilted_axes", "design_matrix", "weighted_fit", "forward_substitute"]

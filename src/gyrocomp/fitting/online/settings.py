@@ -23,7 +23,8 @@ LEVEL_GROWTH = 1.001
 MIN_STEPS = 10
 #: a step between samples beyond this many nominal periods breaks the stream
 GAP_PERIODS = 1.5
-_MAD_TO_SIGMA = 0.6745
+#: median absolute deviation of a unit normal (a MAD over this is a standard deviation)
+MAD_TO_SIGMA = 0.6745
 #: an accelerometer axis whose still means span this [g] has its g-sensitivity fitted
 MIN_TILT_G = 0.3
 #: spare points each fitted g-sensitivity column needs
@@ -37,7 +38,7 @@ PIECE_SPREAD_WEIGHT = 0.05
 #: the last rejected pieces of a session kept, to overrule its points when they agree and outweigh them
 POOL_PIECES = 4
 #: relative ridge on the normal equations' diagonal (guards a nearly singular system)
-_RIDGE = 1e-12
+RIDGE = 1e-12
 GYRO_AXES = ("gyro_x", "gyro_y", "gyro_z")
 
 
@@ -249,4 +250,6 @@ __all__ = [
     "T_REF_DEGC",
     "T_SCALE_DEGC",
     "chi2_quantile",
+    "MAD_TO_SIGMA",
+    "RIDGE",
 ]

@@ -41,7 +41,8 @@ def check_state_target(path: str | os.PathLike, lineage: tuple[str, ...]) -> Non
         )
 
 
-def _record_to_dict(record: dict) -> dict:
+def record_to_dict(record: dict) -> dict:
+    """A learner's per-block record as JSON values (flags as booleans, mean and temperature as lists)."""
     out = {k: bool(v) for k, v in record.items() if k not in ("mean", "temperature")}
     if "mean" in record:
         out["mean"] = [float(v) for v in record["mean"]]
@@ -87,7 +88,7 @@ def _scalar(value, name: str, bound: float = STATE_MAGNITUDE_MAX) -> float:
     return float(_finite_array(value, (), name, bound=bound))
 
 
-def _restore(cls, d: dict) -> Any:
+def restore_learner(cls, d: dict) -> Any:
     """A learner of class ``cls`` (an :class:`~gyrocomp.fitting.online.OnlineCalibrator`: not imported here, it
     imports this module) from a checked state dict, every field bounded."""
     self = cls(LearnerSettings(**d["settings"]))
@@ -237,4 +238,10 @@ def _restore_model(self, model: dict) -> None:
     )
 
 
-__all__ = ["STATE_MAGNITUDE_MAX", "STATE_TEMPERATURE_MAX_DEGC", "check_state_target"]
+__all__ = [
+    "STATE_MAGNITUDE_MAX",
+    "STATE_TEMPERATURE_MAX_DEGC",
+    "check_state_target",
+    "record_to_dict",
+    "restore_learner",
+]
