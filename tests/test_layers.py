@@ -210,3 +210,27 @@ def test_the_init_files_only_export():
                 continue
             code.append(f"{path.relative_to(SRC)}:{node.lineno}")
     assert code == []
+
+
+def _private_imports(text: str, module: str) -> list[str]:
+    """``module:line name`` for each ``_private`` name that ``text`` imports from a project module."""
+    out = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").split(".")[0] == "gyrocomp"):
+            out += [
+                f"{module}:{node.lineno} {a.name}"
+                for a in node.names
+                if a.name.startswith("_") and not a.name.startswith("__")
+            ]
+    return out
+
+
+def test_no_private_name_is_imported_from_another_module():
+    """A name another module needs is public in the module where it belongs (the seam is drawn there)."""
+    hits = [h for path in sorted(SRC.rglob("*.py")) for h in _private_imports(path.read_text(), _module_name(path))]
+    assert hits == []
+
+
+def test_the_private_import_check_sees_one():
+    text = "from .refit import _hidden, visible\nfrom gyrocomp.io import _also\nfrom numpy import _x\n"
+    assert _private_imports(text, "io.planted") == ["io.planted:1 _hidden", "io.planted:2 _also"]
