@@ -19,6 +19,7 @@ from ..errors import InputError
 from ..c_literals import c_array, c_number
 from ..recording import Recording
 from ..spilled_series import parts, streamed_median
+from .polynomial import power_columns
 from .protocol import MEMORY_CURVES, CCode, memory_curve_from_dict, register_memory_curve
 
 
@@ -164,6 +165,46 @@ class HysteresisCurve:
         )
 
 
+def turning_point_columns(
+    temperature_degc: np.ndarray,
+    turns,
+    order: int,
+    band_degc: tuple[float, float] | None = None,
+    scale_degc: float = 1.0,
+) -> np.ndarray:
+    """The fit columns of :class:`HysteresisCurve`: its offset is these columns times (descending, ascending).
+
+        x_j = (d / s)^j on cooling branches, then the same on heating branches,   d = |T - T_turn|,   j = 1..order
+
+    after the first confirmed reversal, inside ``band_degc`` if given, zero elsewhere.
+
+    Parameters
+    ----------
+    temperature_degc : array (n,)
+        Model temperature [degC].
+    turns : Turns
+        From :func:`gyrocomp.effects.find_turns` on the same series.
+    order : int
+        Terms per branch.
+    band_degc : (lo, hi), optional
+        Temperature band [degC] outside which the columns are zero.
+    scale_degc : float
+        Divisor s of the distance [degC] (conditions the normal equations; 1 gives the curve's own coefficients
+        [the axis's unit per degC^j]).
+
+    Returns
+    -------
+    array (n, 2 order)
+    """
+    t = np.asarray(temperature_degc, dtype=float)
+    active = ~np.isnan(turns.turn_degc)
+    if band_degc is not None:
+        active &= (t >= band_degc[0]) & (t <= band_degc[1])
+    d = np.where(active, np.abs(t - np.where(active, turns.turn_degc, 0.0)), 0.0) / scale_degc
+    powers = power_columns(d, 1, order)
+    return np.hstack([np.where((active & (turns.direction == sign))[:, None], powers, 0.0) for sign in (-1, 1)])
+
+
 @register_memory_curve
 @dataclass(frozen=True)
 class BranchCurve:
@@ -273,11 +314,54 @@ __all__ = [
     "BranchCurve",
     "HysteresisCurve",
     "MEMORY_CURVES",
+    "branch_columns",
     "heats_and_cools",
     "memory_curve_from_dict",
     "parting_band_degc",
     "turn_threshold_degc",
+    "turning_point_columns",
 ]
+
+
+def branch_columns(
+    temperature_degc: np.ndarray,
+    turns,
+    transition_degc: float,
+    order: int,
+    t_ref_degc: float,
+    t_scale_degc: float,
+    lo_degc: float | None = None,
+    hi_degc: float | None = None,
+) -> np.ndarray:
+    """The fit columns of :class:`BranchCurve`: its offset is these columns times its coefficients.
+
+        x_k = s(T) u^k,   u = (clip(T, lo, hi) - t_ref) / t_scale,   k = 0..order - 1
+
+    with s the branch position (:func:`gyrocomp.effects.branch_position`, crossover width ``transition_degc``).
+
+    Parameters
+    ----------
+    temperature_degc : array (n,)
+        Model temperature [degC].
+    turns : Turns
+        From :func:`gyrocomp.effects.find_turns` on the same series.
+    transition_degc : float
+        Crossover width w [degC].
+    order : int
+        Terms of the half difference between the branches.
+    t_ref_degc, t_scale_degc : float
+        Centre and half-span of u [degC].
+    lo_degc, hi_degc : float, optional
+        Range [degC] past which u is held (the curve's fitted range); not held when omitted.
+
+    Returns
+    -------
+    array (n, order)
+    """
+    t = np.asarray(temperature_degc, dtype=float)
+    held = t if lo_degc is None else np.clip(t, lo_degc, hi_degc)
+    position = branch_position(t, turns, transition_degc)
+    return position[:, None] * power_columns((held - t_ref_degc) / t_scale_degc, 0, order - 1)
 
 
 def _grow(core: np.ndarray, tail: np.ndarray, start: int, step: int) -> int:

@@ -44,24 +44,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
+from ..effects import find_turns, thermal_lag
 from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..measures.merit import moving_average
 from ..runs.prepared import PreparedRun, RunBlocks
 from ..spilled_series import parts, streamed_median
 from ..units import AxisUnit, in_unit, unit_suffix
 from .base import bin_width_for
+from .design import Terms, ThermalDesign
 from .folds import FoldKind, Folds, make_folds, window_for
 from .scores import CandidateScore, json_number
 from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
-from ..curves.polynomial import POLY_FAMILY, power_columns
-from ..curves.protocol import BASES
+from ..curves.polynomial import POLY_FAMILY
 from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, SCORE_WINDOW_S, lag_search_top_s
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
-#: crossover widths of the branch candidates [degC] (each fold takes the one of least training residual)
-BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
+#: crossover widths of the branch candidates in each fold [degC] (each fold takes the one of least training
+#: residual; each width is a block of columns at every lag of the grid, so the folds try three, and the final
+#: fit refines the width of the chosen model on the finer grid of gyrocomp.fitting.thermal.BRANCH_WIDTHS_DEGC)
+FOLD_BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
 #: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run; SelectionProblem.lag_grid_s)
 LAG_GRID_POINTS = 16
 #: polynomial order of the residual in which the band where the branches part is looked for (the field's cubic)
@@ -276,7 +278,7 @@ class SelectionProblem:
         Turning-point candidates only inside ``band_degc`` (none without a band): see :func:`prepare_axis`.
     branch_orders : tuple of int
         Terms of the heating-cooling difference of the branch candidates to try (empty: none); each fold's
-        crossover width is the one of :data:`BRANCH_WIDTHS_DEGC` that leaves the least training residual.
+        crossover width is the one of :data:`FOLD_BRANCH_WIDTHS_DEGC` that leaves the least training residual.
     """
 
     runs: list[RunBlocks]
@@ -321,43 +323,43 @@ class SelectionProblem:
             return thermal_lag(run.time_s, run.temperature_degc, tau_s, period_s=self.block_s)[0]
         return run.temperature_degc
 
+    @property
+    def thermal_design(self) -> ThermalDesign:
+        """The columns' builder (distances scaled by the half-span, for well-conditioned normal matrices)."""
+        return ThermalDesign(
+            self.t_ref_degc,
+            self.t_scale_degc,
+            self.threshold_degc,
+            self.accel_cols,
+            self.square_cols,
+            distance_scale_degc=self.t_scale_degc,
+        )
+
+    def terms(self, lagged: bool = False) -> Terms:
+        """Every block any candidate uses: u^1..u^max_order, the other families' blocks (none at a lag:
+        ``lagged``, see :meth:`other_blocks`), the hysteresis terms over the whole range and inside the band,
+        the branch terms at each crossover width, the accelerometer columns."""
+        shapes = ((POLY_FAMILY, self.max_order),) + tuple((name, size) for name, size, _ in self.other_blocks(lagged))
+        return Terms(
+            shapes=shapes,
+            turning_point_order=self.max_hysteresis,
+            bands_degc=(None,) if self.band_degc is None else (None, self.band_degc),
+            branch_order=self.max_branch,
+            branch_widths_degc=FOLD_BRANCH_WIDTHS_DEGC if self.branch_orders else (),
+        )
+
     def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
-        """Every column any candidate uses, at model temperature ``temp`` [degC]: u^1..u^max_order, the other
-        families' blocks (none at a lag: ``lagged``), the cooling then heating hysteresis terms (d / t_scale)^j,
-        the branch terms s_w u^j for each crossover width w, then the accelerometer columns, and last the value
+        """Every column any candidate uses (:meth:`terms`) at model temperature ``temp`` [degC], and last the value
         fitted (the run's block means [the axis's unit]: the normal matrices' last row, without a copy of the
         columns to join it). (A fold's training range is applied where its held-out blocks are scored,
         :meth:`_held_out`.)"""
-        u = (temp - self.t_ref_degc) / self.t_scale_degc
-        cols = [power_columns(u, 1, self.max_order)]
-        cols += [self.basis(name).columns(temp, size) for name, size, _ in self.other_blocks(lagged)]
-        h = self.max_hysteresis
-        turns = find_turns(temp, self.threshold_degc) if h or self.branch_orders else None
-        if h:
-            active = ~np.isnan(turns.turn_degc)
-            d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0) / self.t_scale_degc
-            powers = power_columns(d, 1, h)
-            for sign in (-1, 1):
-                cols.append(np.where((active & (turns.direction == sign))[:, None], powers, 0.0))
-            if self.band_degc is not None:  # the same terms, zero outside the band
-                inside = (temp >= self.band_degc[0]) & (temp <= self.band_degc[1])
-                for sign in (-1, 1):
-                    cols.append(np.where((active & inside & (turns.direction == sign))[:, None], powers, 0.0))
-        for width in BRANCH_WIDTHS_DEGC if self.branch_orders else ():
-            position = branch_position(temp, turns, width)
-            cols.append(position[:, None] * power_columns(u, 0, self.max_branch - 1))
-        cols += [self.accel_columns(k), self.runs[k].value[:, None]]
-        return np.hstack(cols)
+        run = self.runs[k]
+        return np.hstack([self.thermal_design.columns(temp, run.accel_g, self.terms(lagged)), run.value[:, None]])
 
     def accel_columns(self, k: int) -> np.ndarray:
         """The g and g x g sensitivity columns of run ``k`` (n, m), m = 0 without them."""
         run = self.runs[k]
-        cols = [np.zeros((run.value.size, 0))]
-        if self.accel_cols:
-            cols.append(run.accel_g[:, list(self.accel_cols)])
-        if self.square_cols:
-            cols.append(g_squared_products(run.accel_g)[:, list(self.square_cols)])
-        return np.hstack(cols)
+        return self.thermal_design.acceleration_columns(run.accel_g, run.value.size)
 
     @property
     def max_branch(self) -> int:
@@ -366,7 +368,7 @@ class SelectionProblem:
     def basis(self, name: str):
         """The curve family ``name`` over this axis's temperature range (polynomials continued along their
         tangent past a fold's training range, as the chosen curve is applied)."""
-        return BASES[name].over(self.t_ref_degc - self.t_scale_degc, self.t_ref_degc + self.t_scale_degc)
+        return self.thermal_design.basis(name)
 
     def other_blocks(self, lagged: bool = False) -> list[tuple[str, int, int]]:
         """(family, size, first column) of each block of columns of a family other than the polynomial: they
@@ -385,22 +387,20 @@ class SelectionProblem:
     def column_index(self, c: Candidate, width: int = 0) -> np.ndarray:
         """The columns of candidate ``c`` (its branch terms at crossover width number ``width``), among the columns
         at a lag when ``c`` has one (no block of another family there)."""
-        blocks = self.other_blocks(c.lag)
-        o = self.max_order + sum(size for _, size, _ in blocks)  # the shape columns, every family's
-        h = self.max_hysteresis
-        n_h = 2 * h * (2 if h and self.band_degc is not None else 1)
-        start = o + (2 * h if c.band else 0)
-        if c.curve == POLY_FAMILY:
-            idx = list(range(c.order))
-        else:
-            first = next(f for name, size, f in blocks if name == c.curve and size == c.order)
-            idx = list(range(first, first + c.order))
-        idx += [start + j for j in range(c.hysteresis_order)] + [start + h + j for j in range(c.hysteresis_order)]
-        b = self.max_branch
-        idx += [o + n_h + width * b + j for j in range(c.branch)]
-        n_b = b * len(BRANCH_WIDTHS_DEGC) if b else 0
-        n_accel = len(self.accel_cols) + len(self.square_cols)
-        idx += [o + n_h + n_b + j for j in range(n_accel)]
+        at = self.thermal_design.layout(self.terms(c.lag))
+        idx: list[int] = []
+        if c.order:
+            shape = at[
+                ("shape", POLY_FAMILY, self.max_order) if c.curve == POLY_FAMILY else ("shape", c.curve, c.order)
+            ]
+            idx += list(range(shape.start, shape.start + c.order))
+        if c.hysteresis_order:
+            first, h = at[("turning-point", self.band_degc if c.band else None)].start, self.max_hysteresis
+            idx += [first + j for j in range(c.hysteresis_order)] + [first + h + j for j in range(c.hysteresis_order)]
+        if c.branch:
+            first = at[("branch", FOLD_BRANCH_WIDTHS_DEGC[width])].start
+            idx += [first + j for j in range(c.branch)]
+        idx += list(range(at[("acceleration",)].start, at[("acceleration",)].stop))
         return np.asarray(idx, dtype=np.int64)
 
     def weights(self, k: int, weighting: Weighting) -> np.ndarray:
@@ -413,8 +413,9 @@ class SelectionProblem:
         """The polynomial's columns u^1..u^max_order at model temperature ``temp`` [degC], then the accelerometer
         columns: what a ``poly + lag`` candidate uses (:meth:`lag_rss`), without the hysteresis and branch terms
         that :meth:`columns` also makes; the value last, as there."""
-        u = (temp - self.t_ref_degc) / self.t_scale_degc
-        return np.hstack([power_columns(u, 1, self.max_order), self.accel_columns(k), self.runs[k].value[:, None]])
+        run = self.runs[k]
+        shape = Terms(shapes=((POLY_FAMILY, self.max_order),))
+        return np.hstack([self.thermal_design.columns(temp, run.accel_g, shape), run.value[:, None]])
 
     # -- normal equations, per fold --------------------------------------------------------------------
     def _model_temperatures(self, tau_s: float) -> list[np.ndarray]:
@@ -589,7 +590,7 @@ class SelectionProblem:
             # a fold whose training data holds one direction only cannot tell the branches apart: there the
             # candidate is its polynomial (its branch or turning-point terms would be confounded with the curve)
             fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False)
-            widths = range(len(BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
+            widths = range(len(FOLD_BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
             best = None
             for tau in taus if shared is None else shared[f : f + 1]:
                 matrices, lo, hi = self.training_matrices(float(tau), c.weighting)
@@ -765,7 +766,7 @@ def prepare_axis(
 
 __all__ = [
     "AxisSelection",
-    "BRANCH_WIDTHS_DEGC",
+    "FOLD_BRANCH_WIDTHS_DEGC",
     "Candidate",
     "SelectionProblem",
     "Weighting",

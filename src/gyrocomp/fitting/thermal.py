@@ -31,22 +31,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..curves.polynomial import POLY_FAMILY
-from ..effects import branch_position, find_turns, g_squared_products, thermal_lag
+from ..effects import find_turns, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError
 from ..calibration.fit_report import memory_name
 from ..recording import Recording
+from .design import Terms, ThermalDesign
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from ..runs.prepared import PreparedRun, RunBlocks, fit_axes
 from .base import LearnedAttributes, bin_width_for, one_temperature_column
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .polynomial_model import simplest_within
-from ..curves.protocol import BASES
 
 HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
 CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
 #: terms of the difference between the heating and the cooling curve (a constant, then a slope)
 MAX_BRANCH_ORDER = 2
-#: crossover widths tried for a branch model [degC] (refined: see _Problem.best_width)
+#: crossover widths the final fit tries for a branch model [degC] (refined: see _Problem.best_width); the
+#: model choice's folds try the coarser gyrocomp.fitting.selection.FOLD_BRANCH_WIDTHS_DEGC
 BRANCH_WIDTHS_DEGC = tuple(float(w) for w in np.geomspace(1.0, 40.0, 9))
 MAX_HYSTERESIS_ORDER = 3
 #: bounds of the thermal time constant search [s]
@@ -136,10 +137,6 @@ class _Problem:
     extended: bool = False
     _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
 
-    def basis(self, spec: _Spec):
-        """The curve family of ``spec`` over the data's temperature range."""
-        return BASES[spec.curve].over(self.t_ref - self.t_scale, self.t_ref + self.t_scale, self.extended)
-
     def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
         """The temperature the model reads [degC]: reported, or through the lag ``tau`` [s] (kept per run and tau:
         the searches over the lag, the band and the branch width ask for the same ones again)."""
@@ -150,29 +147,28 @@ class _Problem:
             self._lagged[key] = thermal_lag(run.time_s, run.temperature_degc, tau, period_s=self.block_s)[0]
         return self._lagged[key]
 
+    @property
+    def thermal_design(self) -> ThermalDesign:
+        """The columns' builder (the curves' own coefficients: distances in degC)."""
+        return ThermalDesign(
+            self.t_ref, self.t_scale, self.threshold, self.accel_cols, self.square_cols, extended=self.extended
+        )
+
+    def terms(self, spec: _Spec) -> Terms:
+        """The blocks of ``spec``: its shape, its hysteresis (inside the band, if any), its branch terms at its
+        crossover width, the g-sensitivity."""
+        return Terms(
+            shapes=((spec.curve, spec.order),),
+            turning_point_order=spec.hysteresis_order,
+            bands_degc=(self.band,),
+            branch_order=spec.branch,
+            branch_widths_degc=(spec.width_degc,),
+        )
+
     def features(self, run: RunBlocks, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
-        """Columns of the shape and the hysteresis at model temperature ``temp``, then of the g and g x g
-        sensitivity (the excited accelerometer axes only)."""
-        u = (np.clip(temp, t_lo, t_hi) - self.t_ref) / self.t_scale
-        cols = [self.basis(spec).columns(temp, spec.order, t_lo, t_hi)] if spec.order else []
-        if spec.hysteresis_order:
-            turns = find_turns(temp, self.threshold)
-            active = ~np.isnan(turns.turn_degc)
-            if self.band is not None:
-                active &= (temp >= self.band[0]) & (temp <= self.band[1])
-            d = np.where(active, np.abs(temp - np.where(active, turns.turn_degc, 0.0)), 0.0)
-            for sign in (-1, 1):
-                on = active & (turns.direction == sign)
-                cols += [np.where(on, d**j, 0.0) for j in range(1, spec.hysteresis_order + 1)]
-        if spec.branch:
-            position = branch_position(temp, find_turns(temp, self.threshold), spec.width_degc)
-            cols += [position * u**k for k in range(spec.branch)]
-        if self.accel_cols:
-            cols += [run.accel_g[:, j] for j in self.accel_cols]
-        if self.square_cols:
-            products = g_squared_products(run.accel_g)
-            cols += [products[:, m] for m in self.square_cols]
-        return np.column_stack(cols) if cols else np.zeros((temp.size, 0))
+        """Columns of the shape and the hysteresis at model temperature ``temp`` [degC] (the curves applied as fitted
+        on [t_lo, t_hi]), then of the g and g x g sensitivity (the excited accelerometer axes only)."""
+        return self.thermal_design.columns(temp, run.accel_g, self.terms(spec), t_lo, t_hi)
 
     def branch_reach(self, spec: _Spec, tau: float) -> tuple[float, float]:
         """The largest |T - T_turn| on the cooling and on the heating branches after a reversal (inside the
@@ -653,7 +649,7 @@ class ThermalHysteresisModel(LearnedAttributes):
                 problem.refine_band(spec, problem.fit(spec, list(range(n_runs)), tau_s)[0], step)
         tau, (coef, consts, rss, (t_lo, t_hi)), spec = problem.fit(spec, list(range(n_runs)), tau_s)
         self.lag_evidence_[axis] = problem.lag_evidence(spec, tau, rss) if tau > 0 else math.nan
-        self.curves_[axis] = problem.basis(spec).curve(coef[: spec.order], t_lo, t_hi)
+        self.curves_[axis] = problem.thermal_design.basis(spec.curve).curve(coef[: spec.order], t_lo, t_hi)
         self.lag_time_constants_s_[axis] = float(tau)
         p = spec.hysteresis_order
         self.hysteresis_[axis] = (
