@@ -24,6 +24,15 @@ axes and seeds of default/perfect and cubic/perfect, the count of axes the defau
 1 % above raw's drift), and how many of those perfect compensation leaves worse than raw too (the temperature
 effect on that leg happened to cancel part of the noise's drift: removing it, even exactly, leaves more).
 
+The shape zoo (``benchmarks/shape_zoo.py``, issue #70): seven thermal memories written from the physics, none of
+them one of gyrocomp's model forms (a play operator, a bank of plays of many widths, a bump after each turn of one
+shape after a maximum and another after a minimum, a thermal gradient behind a second node of 300 s, an offset that
+fades with the time since the turn, a slow second thermal path of 40 minutes, and the ADXRS450-like smooth bump in
+temperature after each maximum behind a 30 s lag), on one body (a tanh-shaped curve behind a 25 s lag, white noise
+and a slow random walk, a temperature register in 1/16 degC), at two noise levels, by two protocols: two heat-cool
+runs at 1 degC/min judged on a third at 3 degC/min (another ramp rate than the fit's: what a lag, a rate term and a
+memory of the turn must agree on), and the one-cycle protocol above. Three seeds each (``--zoo-seeds``).
+
 Also the thesis's ADXRS450 case (``adxrs450``: two heat-cool runs over -30..85 and -20..80 degC at 20 Hz, judged
 on a third over -25..85 degC), with its hysteresis as the preset has it, as a smooth bump that fades over 25 degC,
 and behind a 30 s lag instead of 60 s; and the real recordings (shared datasets, skipped when absent):
@@ -194,6 +203,46 @@ def adxrs450_case(hysteresis: Hysteresis | None, lag_s: float = 60.0):
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from tests.real import real_data  # noqa: E402  (the shared recordings, read as the tests read them)
+from benchmarks.shape_zoo import FORMS, zoo_run  # noqa: E402  (memories written from the physics)
+
+#: the zoo's two noise levels [deg/s/sqrt(Hz)] (white; a slow random walk 1/500 of it per sqrt(s) beside it)
+ZOO_NOISE_DPS_PER_SQRT_HZ = (0.005, 0.02)
+
+
+def zoo_two_cycles(form: str, seed: int, noise: float):
+    """Two heat-cool runs at 1 degC/min (-20..70 and -10..60 degC), judged on a third at 3 degC/min (-15..70)."""
+    fit = [
+        zoo_run(form, sp, 1.0, noise_dps_per_sqrt_hz=noise, seed=100 * seed + i).recording
+        for i, sp in enumerate([(-20.0, 70.0, -20.0), (-10.0, 60.0, -10.0)])
+    ]
+    held = zoo_run(form, (-15.0, 70.0, -15.0), 3.0, noise_dps_per_sqrt_hz=noise, seed=100 * seed + 99)
+    return judge(fit, held.recording, held.true_rate_dps, held.noise_dps, RATE_HZ)
+
+
+def zoo_one_cycle(form: str, seed: int, noise: float):
+    """One run 40 -> -20 -> 70 -> 30 degC at 2 degC/min, fitted up to its hottest point, judged on the cooling after."""
+    run = zoo_run(form, (40.0, -20.0, 70.0, 30.0), 2.0, hold_s=300.0, noise_dps_per_sqrt_hz=noise, seed=seed)
+    k = int(np.argmax(run.recording.temperature_degc))
+    rec = run.recording
+    return judge([rec.take(np.arange(k))], rec, run.true_rate_dps[k:], run.noise_dps[k:], RATE_HZ, start=k)
+
+
+def zoo_lines(seeds: int) -> list[str]:
+    """The shape zoo's table (Markdown lines): every form, noise level and protocol over ``seeds`` seeds."""
+    lines = [
+        "| shape zoo part | noise [deg/s/sqrt(Hz)] | protocol | default / perfect | plain cubic / perfect "
+        "| axes worse than raw | axes worse than the cubic |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for form in FORMS:
+        for noise in ZOO_NOISE_DPS_PER_SQRT_HZ:
+            for protocol, run in (("two cycles, third at 3 degC/min", zoo_two_cycles), ("one cycle", zoo_one_cycle)):
+                results = [run(form, s, noise) for s in range(seeds)]
+                d, c, worse, _, n = summarize(results)
+                beaten = int(sum(np.sum(np.array(r["default"]) > 1.01 * np.array(r["cubic"])) for r in results))
+                lines.append(f"| {form} | {noise:g} | {protocol} | {d:.2f} | {c:.2f} | {worse} of {n} | {beaten} |")
+                print(lines[-1], flush=True)
+    return lines
 
 
 def cats_case():
@@ -266,13 +315,17 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seeds", type=int, default=10)
     parser.add_argument("--markdown", type=Path, help="write the tables as Markdown to this file")
+    parser.add_argument("--zoo-seeds", type=int, default=3, help="seeds of each shape zoo case")
     parser.add_argument(
         "--only",
-        choices=("one cycle", "two cycles", "three runs"),
+        choices=("one cycle", "two cycles", "three runs", "zoo"),
         help="this protocol alone, no cases (a quick look; not for --markdown)",
     )
     args = parser.parse_args()
     start = time.perf_counter()
+    if args.only == "zoo":
+        zoo_lines(args.zoo_seeds)
+        return
     lines = [
         "| part | protocol | default / perfect | plain cubic / perfect | axes worse than raw | of them, perfect too |",
         "|---|---|---|---|---|---|",
@@ -302,7 +355,7 @@ def main() -> None:
         ratio, lag, model_name = adxrs450_case(hyst, lag_s)
         lines.append(f"| {label} | {ratio:.2f} | {lag:.1f} | {lag_s:g} | {model_name} |")
         print(lines[-1], flush=True)
-    for block in (real_one_cycle_lines(), real_still_lines()):
+    for block in (zoo_lines(args.zoo_seeds), real_one_cycle_lines(), real_still_lines()):
         lines += ["", *block]
         print("\n".join(block), flush=True)
     added, total = drifting_false_positives()
