@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import log_recording
+from .log_samples import log_recording
 from .readers import Reader, register_reader
 
 

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyrocomp.io import mcap_chunks, rosbag
-from gyrocomp.io.common import ReadOptions
+from gyrocomp.io.read_options import ReadOptions
 from gyrocomp.io.mcap_chunks import mcap_arrays
 from gyrocomp.io.rosbag2_storage import channel_ids
 

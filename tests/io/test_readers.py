@@ -12,7 +12,7 @@ import pytest
 
 from gyrocomp.errors import DataQualityWarning, InputError, MissingDependencyError
 from gyrocomp.io import READERS, TableLayout, detect_format, read, sniff_format
-from gyrocomp.io.common import match_by_time, order_by_time
+from gyrocomp.io.log_samples import match_by_time, order_by_time
 
 from ..conftest import run, shared_dataset
 from tests.io.log_writers import write_bag, write_dataflash, write_recording_bag, write_ulog

@@ -46,7 +46,7 @@ from ..calibration.compensate import accel_xyz, apply, compensator_for
 from ..errors import DataQualityWarning, InputError
 from ..io import ReadOptions
 from ..io.atomic import atomic_folder, refuse_link
-from ..io.common import require
+from ..io.foreign_libraries import require
 from ..io.mcap_chunks import mcap_arrays, mcap_storage
 from ..io.rosbag2_sqlite import sqlite_arrays, sqlite_storage
 from ..io.rosbag2_storage import topic_ids

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.byte_fields import Places
-from ..io.common import require
+from ..io.foreign_libraries import require
 from ..io.ros_imu import imu_fields
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InputError
 from ..io import ReadOptions, TableData, detect_format, read_input, table_formats
 from ..io.readers import reader_named
-from ..io.common import ProgressCallback
+from ..io.read_options import ProgressCallback
 from ..io.stream import CHUNK_ROWS, NotStreamable, TableStream
 from ..recording import GAP_FACTOR, Recording, nominal_rate_hz
 from ..spilled_series import DEFAULT_MEMORY_BYTES, SpillArray, block_median

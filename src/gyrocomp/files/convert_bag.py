@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError, printable
-from ..io.common import require
+from ..io.foreign_libraries import require
 from ..io.rosbag import KIND_WORDS, bag_kind, bag_path
 from .apply_bag import refuse_output, staged_bag
 

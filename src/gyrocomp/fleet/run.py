@@ -45,7 +45,7 @@ from ..files.check import ask_for, read_checked, refuse, rewarn, warn_findings
 from ..io import ReadOptions
 from ..measures.data_check import check_runs
 from ..io.atomic import atomic_path, folder_lock, write_text_atomic
-from ..io.common import require
+from ..io.foreign_libraries import require
 from ..models.fit import fit
 from ..models.pipelines import Pipeline
 from ..models.fit import check_channels

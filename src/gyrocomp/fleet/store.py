@@ -34,7 +34,7 @@ from typing import Literal
 from ..calibration import Calibration
 from ..errors import InputError, ModelError, foreign_message
 from ..io.atomic import refuse_link
-from ..io.common import require
+from ..io.foreign_libraries import require
 from ..jsontext import loads
 from .unit_figures import UnitFigures
 from .limits import Failure

@@ -23,7 +23,9 @@ import numpy as np
 from ..errors import DataQualityWarning, GyrocompError, InputError, LayoutError, printable
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
-from .common import ProgressCallback, ReadOptions, log_recording, require
+from .log_samples import log_recording
+from .foreign_libraries import require
+from .read_options import ProgressCallback, ReadOptions
 from .readers import Reader, check_magic, register_reader
 from .layout import TIME_COLUMN, UNMAPPED
 

@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, printable
-from .common import ProgressCallback, ReadOptions, require
+from .foreign_libraries import require
+from .read_options import ProgressCallback, ReadOptions
 from .hdf5 import ArrayStore, StoredArray, named_arrays_recording, opened_hdf5
 from .readers import Reader, register_reader
 from .serial import looks_headerless

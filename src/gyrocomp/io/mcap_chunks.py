@@ -37,7 +37,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from .byte_fields import Places, among
-from .common import require
+from .foreign_libraries import require
 from .read_ahead import ReadAhead
 from .rosbag1_chunks import SPARSE, ChunkArrays
 from .rosbag2_storage import channel_ids, one_storage

@@ -1,5 +1,5 @@
 """The project file's reading options (``gyrocomp.toml``'s ``[read]`` section, which ``gyrocomp init`` writes) for
-the library: :func:`project_read_options` gives the :class:`~gyrocomp.io.common.ReadOptions` and the format every
+the library: :func:`project_read_options` gives the :class:`~gyrocomp.io.read_options.ReadOptions` and the format every
 command reads the project's files with, so that ``gyrocomp.read(path, config="gyrocomp.toml")`` reads a file as
 ``gyrocomp fit`` run in that folder does.
 
@@ -18,7 +18,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..option_spelling import mapping_text, spelled_fields
-from .common import ReadOptions
+from .read_options import ReadOptions
 from .layout import TableLayout
 
 #: the key of the format in ``[read]`` (the reading functions' ``fmt``)

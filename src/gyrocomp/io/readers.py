@@ -20,7 +20,7 @@ from pathlib import Path
 
 from ..errors import InputError, UnusedOptionWarning
 from ..recording import Recording
-from .common import ProgressCallback, ReadOptions
+from .read_options import ProgressCallback, ReadOptions
 from .layout import TableLayout
 from .tables import TableData, table_data
 

@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..recording import Recording
 from ..option_spelling import Spelling
 from .atomic import atomic_path, refuse_to_overwrite_inputs, write_text_atomic
-from .common import ProgressCallback, ReadOptions
+from .read_options import ProgressCallback, ReadOptions
 from .project import project_read_options
 from . import read_formats  # noqa: F401  registers every reader
 from .readers import (

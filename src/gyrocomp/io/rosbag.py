@@ -26,18 +26,17 @@ import pyarrow as pa
 from ..errors import DataQualityWarning, InputError, TimeOrderWarning, foreign_message
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
-from .common import (
-    ProgressCallback,
-    ReadOptions,
+from .log_samples import (
     keep_matched,
     left_out,
     log_recording,
     match_by_time,
     none_matched,
     order_by_time,
-    require,
     time_order_warning,
 )
+from .foreign_libraries import require
+from .read_options import ProgressCallback, ReadOptions
 from .layout import TIME_COLUMN, TableLayout
 from .mcap_chunks import mcap_arrays
 from .readers import Reader, register_reader

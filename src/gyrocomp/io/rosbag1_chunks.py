@@ -33,7 +33,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from .byte_fields import Places, among
-from .common import require
+from .foreign_libraries import require
 from .read_ahead import ReadAhead
 
 

@@ -14,7 +14,7 @@ from itertools import islice
 
 import numpy as np
 
-from .common import require
+from .foreign_libraries import require
 from .rosbag1_chunks import ChunkArrays
 from .rosbag2_storage import channel_ids, one_storage
 

@@ -9,7 +9,7 @@ or, for a bare ``.mcap``, the MCAP reader itself.
 
 from __future__ import annotations
 
-from .common import require
+from .foreign_libraries import require
 
 
 def one_storage(reader):

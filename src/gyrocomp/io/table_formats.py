@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import ProgressCallback, ReadOptions
+from .read_options import ProgressCallback, ReadOptions
 from .readers import Reader, register_reader
 from .tables import PARQUET_MAGIC, PARQUET_SUFFIXES, TableData, read_table
 from .text_format import COMPRESSED_SUFFIXES, TEXT_TABLE_SUFFIXES

@@ -21,16 +21,9 @@ import numpy as np
 from ..errors import DataQualityWarning, InputError, foreign_message
 from ..recording import Recording
 from ..units import unit_factor
-from .common import (
-    ProgressCallback,
-    ReadOptions,
-    foreign_output,
-    keep_matched,
-    log_recording,
-    match_by_time,
-    order_by_time,
-    require,
-)
+from .log_samples import keep_matched, log_recording, match_by_time, order_by_time
+from .foreign_libraries import foreign_output, require
+from .read_options import ProgressCallback, ReadOptions
 from .readers import Reader, check_magic, register_reader
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"
