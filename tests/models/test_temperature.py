@@ -9,7 +9,7 @@ from gyrocomp import Curve, Network, Polynomial, apply, fit_calibration
 from gyrocomp.allan import allan_deviation
 from gyrocomp.errors import InputError, ModelError, NotFittedError, TemperatureRangeWarning
 from gyrocomp.measures.merit import default_window_s, smoothed_residual_rms
-from gyrocomp.fitting.base import bin_by_temperature
+from gyrocomp.fitting.temperature_bins import bin_by_temperature
 from gyrocomp.cli.common import parse_temperature_option
 from gyrocomp.fitting.polynomial_model import PolynomialTemperatureModel, simplest_within
 from gyrocomp.recording import Recording

@@ -19,7 +19,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..measures.merit import default_window_s, evaluate_run, moving_average
-from ..fitting.base import provenance
+from ..fitting.provenance import provenance
 from ..models.options import FitOptions, Network, Polynomial
 from ..models.pipelines import fit_pipeline
 from ..curves.polynomial import PolynomialCurve

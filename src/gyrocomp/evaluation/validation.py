@@ -29,7 +29,7 @@ from ..calibration import AxisCalibration, Calibration
 from ..calibration.compensate import apply
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, TemperatureRangeWarning
 from ..measures.merit import smoothed_residual_rms
-from ..fitting.base import provenance
+from ..fitting.provenance import provenance
 from ..curves.hysteresis import turn_threshold_degc
 from ..models.options import FitOptions, FoldChoice
 from ..fitting.folds import BLOCKS_PER_RUN, FOLD_KINDS, MIN_FOLDS, WINDOW_MIN_S, drift_window_s, leg_labels

@@ -20,7 +20,7 @@ from ..errors import InputError
 from ..calibration.fit_report import GSensitivityReport, GSensitivityRow
 from ..recording import Recording
 from ..runs.prepared import PreparedRun
-from .base import provenance
+from .provenance import provenance
 from .gsensitivity import ACCELERATION_CHOICES, EXCITATION_G, excited_columns, turned_between_positions
 from ..curves.network import ACCEL_INPUTS, DEFAULT_HIDDEN, NETWORK_BLOCK_S
 from .network_model import NetworkTemperatureModel

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, ModelError
-from .base import LearnedAttributes
+from .learned_attributes import LearnedAttributes
 from ..curves.network import DEFAULT_HIDDEN, NetworkCurve, forward, layer_shapes, n_parameters, unpack
 
 MAX_FAIL = 6

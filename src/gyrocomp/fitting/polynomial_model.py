@@ -14,7 +14,8 @@ import numpy as np
 from ..errors import InputError, ModelError
 from ..runs.prepared import fit_axes
 from ..recording import Recording
-from .base import LearnedAttributes, TemperatureBins, bin_by_temperature, bin_width_for
+from .temperature_bins import TemperatureBins, bin_by_temperature, bin_width_for
+from .learned_attributes import LearnedAttributes
 from ..curves.polynomial import MAX_ORDER, PolynomialCurve, power_columns
 
 #: with automatic order, the lowest order whose CV score is within this factor of the best wins

@@ -50,7 +50,7 @@ from ..measures.merit import moving_average
 from ..runs.prepared import PreparedRun, RunBlocks
 from ..spilled_series import parts, streamed_median
 from ..units import AxisUnit, in_unit, unit_suffix
-from .base import bin_width_for
+from .temperature_bins import bin_width_for
 from .design import Terms, ThermalDesign
 from .folds import FoldKind, Folds, make_folds, window_for
 from .scores import CandidateScore, json_number

@@ -38,7 +38,9 @@ from ..recording import Recording
 from .design import Terms, ThermalDesign
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from ..runs.prepared import PreparedRun, RunBlocks, fit_axes
-from .base import LearnedAttributes, bin_width_for, one_temperature_column
+from ..runs.prepared import one_temperature_column
+from .temperature_bins import bin_width_for
+from .learned_attributes import LearnedAttributes
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .polynomial_model import simplest_within
 

@@ -58,7 +58,7 @@ import numpy as np
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, thermal_lag
 from ..errors import DataQualityWarning, InputError
-from ..fitting.base import provenance
+from ..fitting.provenance import provenance
 from ..curves.polynomial import PolynomialCurve
 from ..recording import Recording
 from ..units import DEG_PER_S_TO_DEG_PER_H

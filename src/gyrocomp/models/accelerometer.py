@@ -8,7 +8,7 @@ import dataclasses
 from ..calibration import Calibration
 from ..calibration.compensate import apply
 from ..errors import InputError
-from ..fitting.base import provenance
+from ..fitting.provenance import provenance
 from ..motion.positions import orientations
 from ..recording import ACCEL_AXES, Recording
 from ..runs.prepared import PreparedRun, prepare

@@ -26,7 +26,9 @@ from ..measures.plausibility import calibration_concerns, temperature_span_conce
 from ..runs.prepared import PreparedRun, fit_axes, prepare
 from ..recording import Recording
 from ..fitting.acceleration import acceleration_report, excited_columns, fit_g_sensitivity, turned_between_positions
-from ..fitting.base import bin_width_for, one_temperature_column, provenance
+from ..runs.prepared import one_temperature_column
+from ..fitting.provenance import provenance
+from ..fitting.temperature_bins import bin_width_for
 from ..curves.hysteresis import heats_and_cools
 from ..curves.network import NETWORK_BLOCK_S
 from ..fitting.network_model import NetworkTemperatureModel

@@ -14,7 +14,7 @@ from ..errors import InputError, TemperatureRangeWarning
 from ..runs.prepared import PreparedRun, prepare
 from ..recording import Recording
 from ..fitting.acceleration import fit_acceleration_network
-from ..fitting.base import provenance
+from ..fitting.provenance import provenance
 from ..curves.network import NETWORK_INPUTS
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, fit_accel_triad, fit_gyro_triad, spanning_poses  # noqa: F401
 from .joint import checked_options, fit_joint

@@ -217,6 +217,15 @@ def fit_axes(recordings: Sequence[Recording]) -> tuple[str, ...]:
     return PreparedRun.of(recordings[0]).fit_axes
 
 
+def one_temperature_column(recordings: list[Recording]) -> bool:
+    """Whether every recording reads one temperature for all the axes a fit models (one sensor, so one die and one
+    lag): one column, or the accelerometer's axes (which all read the mean of the gyro's columns)."""
+    return all(
+        rec.temperature_degc is None or len({rec.temperature_column_for(a) for a in fit_axes([rec])}) == 1
+        for rec in recordings
+    )
+
+
 def prepare(recordings: Iterable[Recording]) -> list[PreparedRun]:
     """Each recording prepared once (:meth:`PreparedRun.of`): a fit's entry point calls this on its runs.
     Anything else in the list is refused, naming its place."""
@@ -230,4 +239,13 @@ def prepare(recordings: Iterable[Recording]) -> list[PreparedRun]:
     return out
 
 
-__all__ = ["CHANNELS", "Channel", "PreparedRun", "RunBlocks", "block_means", "fit_axes", "prepare"]
+__all__ = [
+    "CHANNELS",
+    "Channel",
+    "PreparedRun",
+    "RunBlocks",
+    "block_means",
+    "fit_axes",
+    "one_temperature_column",
+    "prepare",
+]

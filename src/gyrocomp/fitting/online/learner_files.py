@@ -16,7 +16,7 @@ from ...calibration import AxisCalibration, Calibration
 from ... import jsontext
 from ...errors import InputError, NotFittedError
 from ...io.atomic import folder_lock, write_text_atomic
-from ..base import provenance
+from ..provenance import provenance
 from ...curves.polynomial import PolynomialCurve
 from .state import record_to_dict, restore_learner, check_state_target
 from .settings import (
