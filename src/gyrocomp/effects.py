@@ -197,6 +197,47 @@ def _lag_stretches(
             i = stop + 1
 
 
+def temperature_rate(
+    time_s: np.ndarray,
+    temperature_degc: np.ndarray,
+    smoothing_s: float,
+    *,
+    period_s: float | None = None,
+    state: LagState | None = None,
+) -> tuple[np.ndarray, LagState]:
+    """Smoothed rate of change of a temperature [degC/s], causal, so a stream in chunks gives the batch result.
+
+        r = (T - T_f) / s,   dT_f/dt = (T - T_f) / s
+
+    T_f is T through a first-order lag of time constant s (:func:`thermal_lag`). On a steady ramp of rho
+    [degC/s], r settles to rho within a few s; at a hold it decays as exp(-t / s). (T - T_f) is also the gradient
+    between a surface at T and a core behind the lag s: a bias linear in r is the bias of a thermal gradient
+    across the part, which a lag of the bias's own temperature curve cannot follow where the curve is flat.
+
+    Parameters
+    ----------
+    time_s : array (n,)
+        Sample times [s], increasing.
+    temperature_degc : array (n,)
+        The temperature [degC] (the model's: reported, or through the thermal lag).
+    smoothing_s : float
+        Smoothing time constant s [s], positive.
+    period_s : float, optional
+        Nominal sample period [s] (see :func:`thermal_lag`).
+    state : LagState, optional
+        The smoothing filter's state where the previous chunk ended.
+
+    Returns
+    -------
+    rate_degc_per_s : array (n,)
+    state : LagState
+    """
+    if not smoothing_s > 0:
+        raise InputError(f"temperature-rate smoothing: must be positive [s], got {smoothing_s}")
+    smoothed, state = thermal_lag(time_s, temperature_degc, smoothing_s, period_s=period_s, state=state)
+    return (np.asarray(temperature_degc, dtype=float) - smoothed) / smoothing_s, state
+
+
 # -- turning points and hysteresis ------------------------------------------------------------------
 @dataclass(frozen=True)
 class TurnState:
@@ -557,5 +598,6 @@ __all__ = [
     "moving_average",
     "moving_average_range",
     "quantize",
+    "temperature_rate",
     "thermal_lag",
 ]

@@ -132,15 +132,16 @@ def test_schema_1_files_load_without_lag_or_hysteresis(calibration, tmp_path):
     d["schema_version"] = 1
     for ax in d["axes"].values():
         del ax["lag_time_constant_s"], ax["hysteresis"], ax["g_sensitivity_dps_per_g"], ax["g_squared_dps_per_g2"]
-        del ax["acceleration_network"]
+        del ax["acceleration_network"], ax["temperature_rate"]
     del d["accel_axes"], d["accel_reference_degc"], d["gyro_triad"], d["accel_triad"]
     path = tmp_path / "v1.json"
     path.write_text(json.dumps(d))
     loaded = Calibration.load(path)
-    assert loaded.schema_version == SCHEMA_VERSION == 6
+    assert loaded.schema_version == SCHEMA_VERSION == 7
     assert loaded.accel_axes == {} and loaded.accel_reference_degc is None
     assert loaded.gyro_triad is None and loaded.accel_triad is None
     assert all(ax.lag_time_constant_s == 0 and ax.hysteresis is None for ax in loaded.axes.values())
+    assert all(ax.rate_term is None for ax in loaded.axes.values())
     assert loaded.axes["gyro_z"].temperature == calibration.axes["gyro_z"].temperature
 
 

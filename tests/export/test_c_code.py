@@ -17,6 +17,7 @@ from gyrocomp.models.pipelines import fit_pipeline
 from gyrocomp.simulation import GyroErrorModel, Hysteresis, get_profile, simulate
 from gyrocomp.calibration.triad import TriadCalibration
 from gyrocomp.models.options import FitOptions
+from ..conftest import chamber_run
 
 DRIVER = r"""
 #include <stdio.h>
@@ -342,3 +343,12 @@ def test_lookup_table_with_lag_and_branches_past_its_grid(tmp_path):
         seed=9,
     ).recording
     _compare(cal, held, tmp_path)
+
+
+def test_a_temperature_rate_term_with_lag(tmp_path):
+    runs = [chamber_run([-10.0, 60.0, -10.0], 1.0, seed=s, rate_hz=1.0) for s in (1, 2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="rate+lag")
+    assert all(ax.rate_term is not None for ax in cal.axes.values())
+    _compare(cal, chamber_run([-5.0, 60.0, -5.0], 3.0, seed=3, rate_hz=1.0), tmp_path)

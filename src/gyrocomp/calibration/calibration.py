@@ -27,13 +27,14 @@ from ..curves.kinds import curve_from_dict
 from ..curves.protocol import TemperatureCurve
 from ..curves.network import NetworkCurve
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, memory_curve_from_dict
+from ..curves.rate import TemperatureRateTerm
 from ..recording import GYRO_AXES
 from .triad import TriadCalibration
 from .schema import UNITS, validate_model
 from ..units import AxisUnit, check_axis_unit, in_unit, require_unit
 
 FORMAT_NAME = "gyrocomp-calibration"
-SCHEMA_VERSION = 6
+SCHEMA_VERSION = 7
 
 
 def _refuse_later_fields(d: dict, version: int, top: tuple[str, ...] = (), per_axis: tuple[str, ...] = ()) -> None:
@@ -109,6 +110,19 @@ def _upgrade_5_to_6(d: dict) -> dict:
     return d
 
 
+def _upgrade_6_to_7(d: dict) -> dict:
+    """Schema 7 adds a temperature-rate term per axis (:mod:`gyrocomp.curves.rate`); older files have none."""
+    _refuse_later_fields(d, 6, (), ("temperature_rate",))
+    d = dict(d)
+    for key in ("axes", "accel_axes"):
+        if isinstance(d.get(key), dict):
+            d[key] = {
+                name: {**ax, "temperature_rate": None} if isinstance(ax, dict) else ax for name, ax in d[key].items()
+            }
+    d["schema_version"] = 7
+    return d
+
+
 #: upgrade functions from schema version v to v + 1, applied in turn by ``load``
 UPGRADES: dict[int, Callable[[dict], dict]] = {
     1: _upgrade_1_to_2,
@@ -116,6 +130,7 @@ UPGRADES: dict[int, Callable[[dict], dict]] = {
     3: _upgrade_3_to_4,
     4: _upgrade_4_to_5,
     5: _upgrade_5_to_6,
+    6: _upgrade_6_to_7,
 }
 
 
@@ -209,6 +224,8 @@ class AxisCalibration:
         A network of the three accelerations (the second stage of the ``mlp>mlp-accel`` pipeline).
     unit : {"deg/s", "g"}
         The unit of the axis's values.
+    rate_term : TemperatureRateTerm or None
+        A bias in the smoothed rate of change of the model temperature (:mod:`gyrocomp.curves.rate`).
     """
 
     temperature: TemperatureCurve | None
@@ -220,6 +237,7 @@ class AxisCalibration:
     g_squared_dps_per_g2: tuple[float, ...] | None = None
     acceleration_network: NetworkCurve | None = None
     unit: AxisUnit = "deg/s"
+    rate_term: TemperatureRateTerm | None = None
 
     def __post_init__(self) -> None:
         check_axis_unit(self.unit)
@@ -244,8 +262,9 @@ class AxisCalibration:
 
     @property
     def has_memory(self) -> bool:
-        """Whether the correction depends on the temperature history (lag or hysteresis), not only its value."""
-        return self.lag_time_constant_s > 0 or self.hysteresis is not None
+        """Whether the correction depends on the temperature history (lag, hysteresis or a rate term), not only its
+        value."""
+        return self.lag_time_constant_s > 0 or self.hysteresis is not None or self.rate_term is not None
 
     @property
     def mean_turn_on_bias(self) -> float:
@@ -274,6 +293,7 @@ class AxisCalibration:
             else list(self.g_sensitivity_dps_per_g),
             "g_squared_dps_per_g2": None if self.g_squared_dps_per_g2 is None else list(self.g_squared_dps_per_g2),
             "acceleration_network": None if self.acceleration_network is None else self.acceleration_network.to_dict(),
+            "temperature_rate": None if self.rate_term is None else self.rate_term.to_dict(),
         }
 
     @classmethod
@@ -290,6 +310,7 @@ class AxisCalibration:
             if d["acceleration_network"] is None
             else NetworkCurve.from_dict(d["acceleration_network"]),
             unit=unit,
+            rate_term=None if d["temperature_rate"] is None else TemperatureRateTerm.from_dict(d["temperature_rate"]),
         )
 
 
@@ -312,6 +333,8 @@ class AxisSummary:
         words = "constant" if curve is None else curve.describe()
         if ax.hysteresis is not None:
             words += f", {ax.hysteresis.describe()}"
+        if ax.rate_term is not None:
+            words += f", {ax.rate_term.describe(ax.unit)}"
         if ax.has_acceleration_stage:
             words += ", g-sensitivity"
         return cls(
@@ -395,16 +418,16 @@ class Calibration:
 
     def without(self, *parts: str) -> "Calibration":
         """The same calibration with parts switched off: ``"acceleration"`` (G and g x g), ``"hysteresis"``
-        (turning-point), ``"lag"``, ``"scale-factor"`` (the gyro triad's K(T)). What is left is applied as fitted
+        (turning-point), ``"lag"``, ``"rate"`` (the temperature-rate term), ``"scale-factor"`` (the gyro triad's K(T)). What is left is applied as fitted
         (the parts were fitted jointly), so this shows each part's contribution, as the stages of the thesis's
         Table 4.4.
 
         Parameters
         ----------
         *parts : str
-            Any of ``acceleration``, ``hysteresis``, ``lag``, ``scale-factor``.
+            Any of ``acceleration``, ``hysteresis``, ``lag``, ``rate``, ``scale-factor``.
         """
-        known = ("acceleration", "hysteresis", "lag", "scale-factor")
+        known = ("acceleration", "hysteresis", "lag", "rate", "scale-factor")
         for part in parts:
             if part not in known:
                 raise InputError(f"unknown part {part!r}; use any of {', '.join(known)}")
@@ -415,6 +438,8 @@ class Calibration:
             changes["hysteresis"] = None
         if "lag" in parts:
             changes["lag_time_constant_s"] = 0.0
+        if "rate" in parts:
+            changes["rate_term"] = None
         axes = {name: dataclasses.replace(ax, **changes) for name, ax in self.axes.items()}
         triad = None if "scale-factor" in parts else self.gyro_triad
         return dataclasses.replace(

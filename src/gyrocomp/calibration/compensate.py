@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 
 from .calibration import Calibration
-from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, thermal_lag
+from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, temperature_rate, thermal_lag
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
 from ..io.stream import CHUNK_ROWS
 from ..measures.plausibility import BlockMeans, ScaleAgreement, agreement_concern, recording_concerns, scale_agreement
@@ -80,8 +80,13 @@ class Compensator:
         every = [ax for _, ax in self._modelled] + [ax for _, _, ax, _ in self._accel_modelled]
         if rate_hz is None and any(ax.lag_time_constant_s > 0 for ax in every):
             raise InputError(f"{source}: the model has thermal lag; give the stream's sample rate (rate_hz)")
+        if rate_hz is None and any(ax.rate_term is not None for ax in every):
+            raise InputError(
+                f"{source}: the model has a temperature-rate term; give the stream's sample rate (rate_hz)"
+            )
         self.rate_hz = rate_hz
         self._lag_states: dict[str, object] = {}
+        self._rate_states: dict[str, object] = {}
         self._turn_states: dict[str, object] = {}
         self._accel_out: list[np.ndarray] = []
         self._warned = False
@@ -125,7 +130,7 @@ class Compensator:
     def _temperature_error(
         self, key: str, ax, time_s: np.ndarray, t: np.ndarray, accel_g: np.ndarray | None
     ) -> np.ndarray:
-        """The axis's temperature-driven error (shape and hysteresis) [deg/s, or g for an accelerometer]."""
+        """The axis's temperature-driven error (shape, hysteresis and rate term) [deg/s, or g for an accelerometer]."""
         t_model = self._model_temperature(key, ax, time_s, t)
         if not self._warned and ax.temperature.outside_range(t_model):
             lagged = f" (through its {ax.lag_time_constant_s:.3g} s thermal lag)" if ax.lag_time_constant_s else ""
@@ -142,6 +147,11 @@ class Compensator:
             turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states.get(key))
             self._turn_states[key] = turns.state
             error = error + ax.hysteresis.offset(t_model, turns)
+        if ax.rate_term is not None:
+            rate, self._rate_states[key] = temperature_rate(
+                time_s, t_model, ax.rate_term.smoothing_s, period_s=1.0 / self.rate_hz, state=self._rate_states.get(key)
+            )
+            error = error + ax.rate_term.offset(rate)
         return error
 
     def _compensate_accel(

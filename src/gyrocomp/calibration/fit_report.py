@@ -39,9 +39,11 @@ _TYPED = (
 )
 
 
-def memory_name(lag: bool, hysteresis_order: int, branch: int = 0) -> str:
+def memory_name(lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = False) -> str:
     """The thermal memory a model carries: ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``
-    (heating and cooling curves) or ``branch+lag``."""
+    (heating and cooling curves), ``branch+lag``, ``rate`` (a temperature-rate term) or ``rate+lag``."""
+    if rate:
+        return "rate+lag" if lag else "rate"
     if branch:
         return "branch+lag" if lag else "branch"
     if lag and hysteresis_order:
@@ -71,9 +73,10 @@ class Candidate:
     """One model of an axis's bias: the size of its temperature curve (``order``: a polynomial's order, a
     table's intervals), thermal lag, turning-point order, fit weighting, whether the turning-point terms act only
     in the band found in the data, the number of terms of the difference between a heating and a cooling curve
-    (``branch``; 0 for none), and the curve's family (``curve``, a name of
-    :data:`gyrocomp.curves.protocol.BASES`: ``poly``, ``table``). The model choice scores these
-    (:mod:`gyrocomp.fitting.selection`) and the report names them."""
+    (``branch``; 0 for none), the curve's family (``curve``, a name of
+    :data:`gyrocomp.curves.protocol.BASES`: ``poly``, ``table``), and a temperature-rate term (``rate``,
+    :mod:`gyrocomp.curves.rate`). The model choice scores these (:mod:`gyrocomp.fitting.selection`) and the report
+    names them."""
 
     order: int
     lag: bool = False
@@ -82,27 +85,30 @@ class Candidate:
     band: bool = False
     branch: int = 0
     curve: str = POLY_FAMILY
+    rate: bool = False
 
     @property
     def memory(self) -> str:
-        """``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch`` or ``branch+lag``."""
-        return memory_name(self.lag, self.hysteresis_order, self.branch)
+        """``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``, ``branch+lag``, ``rate`` or
+        ``rate+lag``."""
+        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate)
 
     @property
     def complexity(self) -> int:
         """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band, the
-        branch difference's terms and its crossover width."""
+        branch difference's terms and its crossover width, two for a rate term (its coefficient and smoothing)."""
         return (
             self.order
             + int(self.lag)
             + 2 * self.hysteresis_order
             + int(self.band)
             + (self.branch + 1 if self.branch else 0)
+            + 2 * int(self.rate)
         )
 
     @property
     def has_temperature_model(self) -> bool:
-        return self.order > 0 or self.lag or self.hysteresis_order > 0 or self.branch > 0
+        return self.order > 0 or self.lag or self.hysteresis_order > 0 or self.branch > 0 or self.rate
 
     @property
     def label(self) -> str:
@@ -115,6 +121,8 @@ class Candidate:
             parts.append(f"turning-point:{self.hysteresis_order}" + (" in band" if self.band else ""))
         if self.branch:
             parts.append(f"branch:{self.branch}")
+        if self.rate:
+            parts.append("rate")
         return " + ".join(parts) + f" ({self.weighting})"
 
     def to_dict(self) -> dict:
@@ -130,6 +138,8 @@ class Candidate:
             d["branch"] = self.branch
         if self.curve != POLY_FAMILY:
             d["curve"] = self.curve
+        if self.rate:  # written only when set
+            d["rate"] = True
         return d
 
     @classmethod
@@ -143,6 +153,7 @@ class Candidate:
             bool(d.get("band", False)),
             int(d.get("branch", 0)),
             str(d.get("curve", POLY_FAMILY)),
+            bool(d.get("rate", False)),
         )
 
 

@@ -227,6 +227,15 @@ def _axis(u: str, value: dict, per_g: bool) -> dict:
             "g_sensitivity_dps_per_g": _nullable(_array(sensitivity, 3)),
             "g_squared_dps_per_g2": _nullable(_array(sensitivity, 6)),
             "acceleration_network": _nullable({"$ref": f"#/$defs/curve{u}_mlp"}),
+            "temperature_rate": _nullable(
+                _object(
+                    {
+                        "type": {"const": "temperature-rate"},
+                        "coefficient_per_degc_per_s": _number(-1e6, 1e6),
+                        "smoothing_s": _number(0.0, LAG_S, exclusive_lo=True),
+                    }
+                )
+            ),
         },
         [
             "temperature",
@@ -236,6 +245,7 @@ def _axis(u: str, value: dict, per_g: bool) -> dict:
             "g_sensitivity_dps_per_g",
             "g_squared_dps_per_g2",
             "acceleration_network",
+            "temperature_rate",
         ],
     )
 

@@ -58,8 +58,9 @@ from .render import print_contributions, print_fit
     type=click.Choice(HYSTERESIS_CHOICES),
     default="auto",
     show_default=True,
-    help="Thermal lag and/or turning-point hysteresis; auto compares all by leave-one-run-out error "
-    "when the runs both heat and cool.",
+    help="The thermal memory: lag, turning-point hysteresis, heating/cooling branches or a temperature-rate term "
+    "(rate: a bias in the smoothed dT/dt, a thermal gradient); auto compares all but the rate term by held-out "
+    "drift when the runs both heat and cool.",
 )
 @click.option(
     "--hysteresis-order",

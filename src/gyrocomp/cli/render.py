@@ -137,12 +137,14 @@ def _print_triad(console, name: str, triad) -> None:
 
 
 def _describe_axis(ax) -> str:
-    """An axis's model in words: curve, lag, hysteresis."""
+    """An axis's model in words: curve, lag, hysteresis, rate term."""
     model = "constant" if ax.temperature is None else ax.temperature.describe()
     if ax.lag_time_constant_s > 0:
         model += f", lag {ax.lag_time_constant_s:.3g} s"
     if ax.hysteresis is not None:
         model += f", {ax.hysteresis.describe()}"
+    if ax.rate_term is not None:
+        model += f", {ax.rate_term.describe(ax.unit)}"
     return model
 
 

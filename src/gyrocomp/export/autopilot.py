@@ -90,6 +90,7 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
     if any(ax.lag_time_constant_s > 0 for ax in every):
         parts.append("thermal lag")
     parts += sorted({ax.hysteresis.title for ax in every if ax.hysteresis is not None})
+    parts += sorted({ax.rate_term.title for ax in every if ax.rate_term is not None})
     if any(ax.needs_accel for ax in calibration.axes.values()):
         parts.append("g-sensitivity")
     if calibration.gyro_triad is not None:

@@ -81,6 +81,7 @@ typedef struct gyrocomp_state {
     int started;
     double last_t;
     gyrocomp_lag lag[6];      /* gyro x, y, z, then accelerometer x, y, z */
+    gyrocomp_lag rate[6];     /* the temperature-rate terms' smoothing filters, in the same order */
     gyrocomp_turn turn[6];
     double accel_out[3];      /* accelerations of the last step, compensated as modelled [g] */
 } gyrocomp_state;
@@ -134,12 +135,14 @@ _HELPERS = [
 
 
 def _shape_code(k: int, ax: AxisCalibration) -> list[str]:
-    """C statements setting `shape` for state slot k: the (lagged) temperature, its curve and hysteresis."""
+    """C statements setting `shape` for state slot k: the (lagged) temperature, its curve, hysteresis and rate
+    term."""
     if ax.lag_time_constant_s > 0:
         lines = [f"    tm = lag_update(&s->lag[{k}], step, temperature, {c_number(ax.lag_time_constant_s)});"]
     else:
         lines = ["    tm = temperature;"]
-    return lines + _temperature_code(k, ax.temperature) + _hysteresis_code(k, ax)
+    rate = [] if ax.rate_term is None else ["    " + line for line in ax.rate_term.c_code(k)]
+    return lines + _temperature_code(k, ax.temperature) + _hysteresis_code(k, ax) + rate
 
 
 _SOLVE3 = [
@@ -183,6 +186,7 @@ def _init_code(codes: dict) -> list[str]:
         "    for (int j = 0; j < 3; ++j) s->accel_out[j] = 0.0;",
         "    for (int j = 0; j < 6; ++j) {",
         "        s->lag[j].started = 0; s->lag[j].last_input = 0.0; s->lag[j].last_output = 0.0;",
+        "        s->rate[j].started = 0; s->rate[j].last_input = 0.0; s->rate[j].last_output = 0.0;",
         "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
         "        s->turn[j].turn = 0.0; s->turn[j].low = INFINITY; s->turn[j].high = -INFINITY;",
         "    }",
@@ -253,8 +257,16 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
     if any(ax.temperature_column != "temperature" for ax in axes.values()):
         raise InputError("C export: the model reads one temperature per axis; the C interface takes one")
     every = list(axes.values()) + list(accel_axes.values())
-    if any(ax.lag_time_constant_s > 0 for ax in every) and not (rate_hz and rate_hz > 0):
-        raise InputError("C export: the model has thermal lag; give the data's sample rate with rate_hz=")
+    timed = [
+        what
+        for what, present in (
+            ("thermal lag", any(ax.lag_time_constant_s > 0 for ax in every)),
+            ("a temperature-rate term", any(ax.rate_term is not None for ax in every)),
+        )
+        if present
+    ]
+    if timed and not (rate_hz and rate_hz > 0):
+        raise InputError(f"C export: the model has {' and '.join(timed)}; give the data's sample rate with rate_hz=")
     period = 1.0 / rate_hz if rate_hz else 0.0
     body = (
         [

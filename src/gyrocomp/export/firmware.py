@@ -118,7 +118,9 @@ def firmware_difference(calibration: Calibration, params: dict, target: str, ins
 
     # static points of the curve (no history): the model without its memory there; the cycle with it
     static = (
-        calibration.without("hysteresis", "lag") if any(calibration.axes[a].has_memory for a in axes) else calibration
+        calibration.without("hysteresis", "lag", "rate")
+        if any(calibration.axes[a].has_memory for a in axes)
+        else calibration
     )
     diffs = [firmware(temps) - predict_error(static, _probe(temps, axes)) for temps in (inside, beyond)]
     diffs.append(firmware(ramp, time_s) - predict_error(calibration, _probe(ramp, axes, time_s)))

@@ -13,6 +13,8 @@ The blocks (:class:`Terms` names which a fit uses, in this order):
   (:func:`gyrocomp.curves.hysteresis.turning_point_columns`), one block per band (None: the whole range);
 - ``branch``: heating and cooling curves crossing over after each turn, s(T) u^k
   (:func:`gyrocomp.curves.hysteresis.branch_columns`), one block per crossover width;
+- ``rate``: the smoothed rate of the model temperature [degC/s] (:func:`gyrocomp.curves.rate.rate_columns`), one
+  column per smoothing time constant;
 - ``acceleration``: the g-sensitivity's accelerometer columns [g] and g x g products [g^2].
 
 Both the model choice (:class:`gyrocomp.fitting.selection.SelectionProblem`, which builds every candidate's
@@ -29,6 +31,7 @@ import numpy as np
 
 from ..curves.hysteresis import branch_columns, turning_point_columns
 from ..curves.protocol import BASES
+from ..curves.rate import rate_columns
 from ..effects import find_turns, g_squared_products
 
 
@@ -48,6 +51,8 @@ class Terms:
         Terms of each branch block (0: none).
     branch_widths_degc : tuple of float
         One branch block per crossover width [degC].
+    rate_smoothings_s : tuple of float
+        One temperature-rate column per smoothing time constant [s] (empty: none).
     acceleration : bool
         Whether the design ends with the g-sensitivity columns.
     """
@@ -57,6 +62,7 @@ class Terms:
     bands_degc: tuple[tuple[float, float] | None, ...] = (None,)
     branch_order: int = 0
     branch_widths_degc: tuple[float, ...] = ()
+    rate_smoothings_s: tuple[float, ...] = ()
     acceleration: bool = True
 
 
@@ -79,6 +85,8 @@ class ThermalDesign:
     distance_scale_degc : float
         Divisor of the turning-point distance [degC]: the half-span for normal equations, 1 for the curve's own
         coefficients.
+    period_s : float
+        Nominal period of the samples the columns are built on [s] (the rate's smoothing filter).
     """
 
     t_ref_degc: float
@@ -88,6 +96,7 @@ class ThermalDesign:
     square_cols: tuple[int, ...] = ()
     extended: bool = True
     distance_scale_degc: float = 1.0
+    period_s: float = 1.0
 
     def basis(self, family: str):
         """The curve family ``family`` over the calibration temperature range."""
@@ -114,12 +123,14 @@ class ThermalDesign:
         terms: Terms,
         lo_degc: float | None = None,
         hi_degc: float | None = None,
+        time_s: np.ndarray | None = None,
     ) -> np.ndarray:
         """The columns of ``terms`` (n, :meth:`width`) at model temperature ``temperature_degc`` [degC] and
         acceleration ``accel_g`` [g] (n, 3).
 
         ``lo_degc``, ``hi_degc``: the range [degC] the curves are applied as fitted on (held, or continued along
-        the tangent, past it); unlimited when omitted."""
+        the tangent, past it); unlimited when omitted. ``time_s`` [s]: the samples' times (the rate terms need
+        them)."""
         t = np.asarray(temperature_degc, dtype=float)
         cols = [self.basis(family).columns(t, size, lo_degc, hi_degc) for family, size in terms.shapes if size]
         if terms.turning_point_order or terms.branch_order:
@@ -136,13 +147,17 @@ class ThermalDesign:
                     )
                     for w in terms.branch_widths_degc
                 ]
+        if terms.rate_smoothings_s:
+            if time_s is None:
+                raise ValueError("ThermalDesign.columns: rate terms need the samples' times (time_s)")
+            cols.append(rate_columns(time_s, t, terms.rate_smoothings_s, self.period_s))
         if terms.acceleration:
             cols.append(self.acceleration_columns(accel_g, t.size))
         return np.hstack(cols) if cols else np.zeros((t.size, 0))
 
     def layout(self, terms: Terms) -> dict[tuple, slice]:
         """Where each block of :meth:`columns` lies: ``("shape", family, size)``, ``("turning-point", band)``,
-        ``("branch", width)`` and ``("acceleration",)`` to their columns."""
+        ``("branch", width)``, ``("rate", smoothing)`` and ``("acceleration",)`` to their columns."""
         out, start = {}, 0
 
         def take(key, size):
@@ -157,6 +172,8 @@ class ThermalDesign:
             take(("turning-point", band), 2 * terms.turning_point_order)
         for w in terms.branch_widths_degc if terms.branch_order else ():
             take(("branch", w), terms.branch_order)
+        for s in terms.rate_smoothings_s:
+            take(("rate", s), 1)
         if terms.acceleration:
             take(("acceleration",), self.acceleration_size())
         return out

@@ -64,6 +64,9 @@ WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 #: residual; each width is a block of columns at every lag of the grid, so the folds try three, and the final
 #: fit refines the width of the chosen model on the finer grid of gyrocomp.fitting.thermal.BRANCH_WIDTHS_DEGC)
 FOLD_BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
+#: smoothing time constants of the temperature-rate candidates in each fold [s] (each fold takes the one of least
+#: training residual; the final fit refines it on gyrocomp.fitting.thermal.RATE_SMOOTHINGS_S)
+FOLD_RATE_SMOOTHINGS_S = (60.0, 300.0, 1500.0)
 #: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run; SelectionProblem.lag_grid_s)
 LAG_GRID_POINTS = 16
 #: polynomial order of the residual in which the band where the branches part is looked for (the field's cubic)
@@ -301,6 +304,8 @@ class SelectionProblem:
     branch_orders: tuple[int, ...] = ()
     #: curves of families besides the polynomial: (name in :data:`gyrocomp.curves.protocol.BASES`, size) pairs
     other_curves: tuple[tuple[str, int], ...] = ()
+    #: smoothing time constants of the temperature-rate columns [s] (empty: no rate candidates)
+    rate_smoothings_s: tuple[float, ...] = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -333,6 +338,7 @@ class SelectionProblem:
             self.accel_cols,
             self.square_cols,
             distance_scale_degc=self.t_scale_degc,
+            period_s=self.block_s,
         )
 
     def terms(self, lagged: bool = False) -> Terms:
@@ -346,6 +352,7 @@ class SelectionProblem:
             bands_degc=(None,) if self.band_degc is None else (None, self.band_degc),
             branch_order=self.max_branch,
             branch_widths_degc=FOLD_BRANCH_WIDTHS_DEGC if self.branch_orders else (),
+            rate_smoothings_s=self.rate_smoothings_s,
         )
 
     def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
@@ -354,7 +361,8 @@ class SelectionProblem:
         columns to join it). (A fold's training range is applied where its held-out blocks are scored,
         :meth:`_held_out`.)"""
         run = self.runs[k]
-        return np.hstack([self.thermal_design.columns(temp, run.accel_g, self.terms(lagged)), run.value[:, None]])
+        columns = self.thermal_design.columns(temp, run.accel_g, self.terms(lagged), time_s=run.time_s)
+        return np.hstack([columns, run.value[:, None]])
 
     def accel_columns(self, k: int) -> np.ndarray:
         """The g and g x g sensitivity columns of run ``k`` (n, m), m = 0 without them."""
@@ -384,9 +392,10 @@ class SelectionProblem:
             start += size
         return out
 
-    def column_index(self, c: Candidate, width: int = 0) -> np.ndarray:
-        """The columns of candidate ``c`` (its branch terms at crossover width number ``width``), among the columns
-        at a lag when ``c`` has one (no block of another family there)."""
+    def column_index(self, c: Candidate, width: int = 0, smoothing: int = 0) -> np.ndarray:
+        """The columns of candidate ``c`` (its branch terms at crossover width number ``width``, its rate term at
+        smoothing number ``smoothing``), among the columns at a lag when ``c`` has one (no block of another family
+        there)."""
         at = self.thermal_design.layout(self.terms(c.lag))
         idx: list[int] = []
         if c.order:
@@ -400,6 +409,8 @@ class SelectionProblem:
         if c.branch:
             first = at[("branch", FOLD_BRANCH_WIDTHS_DEGC[width])].start
             idx += [first + j for j in range(c.branch)]
+        if c.rate:
+            idx.append(at[("rate", self.rate_smoothings_s[smoothing])].start)
         idx += list(range(at[("acceleration",)].start, at[("acceleration",)].stop))
         return np.asarray(idx, dtype=np.int64)
 
@@ -591,11 +602,12 @@ class SelectionProblem:
             # candidate is its polynomial (its branch or turning-point terms would be confounded with the curve)
             fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False)
             widths = range(len(FOLD_BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
+            smoothings = range(len(self.rate_smoothings_s)) if fc.rate else (0,)
             best = None
             for tau in taus if shared is None else shared[f : f + 1]:
                 matrices, lo, hi = self.training_matrices(float(tau), c.weighting)
-                for w in widths:
-                    idx = self.column_index(fc, w)
+                for w, s in ((w, s) for w in widths for s in smoothings):
+                    idx = self.column_index(fc, w, s)
                     coef, rss = self.solve(matrices[f], idx)
                     if best is None or rss < best[0]:
                         best = (rss, float(tau), coef, lo[f], hi[f], idx)
@@ -646,6 +658,11 @@ class SelectionProblem:
             for p in orders:
                 for mem in memories:
                     lag = "lag" in mem
+                    if "rate" in mem:
+                        c = Candidate(p, lag, 0, w, rate=True)
+                        if p > 0 and self.rate_smoothings_s and c not in out:
+                            out.append(c)
+                        continue
                     if "branch" in mem:
                         for b in self.branch_orders if p > 0 else ():
                             c = Candidate(p, lag, 0, w, False, b)
@@ -689,6 +706,7 @@ def prepare_axis(
     both_directions: bool = True,
     branch_orders: tuple[int, ...] = (),
     other_curves: tuple[tuple[str, int], ...] = (),
+    rate_smoothings_s: tuple[float, ...] = (),
 ) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
@@ -761,12 +779,14 @@ def prepare_axis(
         band_only=band_only,
         branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
         other_curves=tuple(other_curves),
+        rate_smoothings_s=tuple(rate_smoothings_s),
     )
 
 
 __all__ = [
     "AxisSelection",
     "FOLD_BRANCH_WIDTHS_DEGC",
+    "FOLD_RATE_SMOOTHINGS_S",
     "Candidate",
     "SelectionProblem",
     "Weighting",

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..curves.polynomial import POLY_FAMILY
+from ..curves.rate import TemperatureRateTerm
 from ..effects import find_turns, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError
 from ..calibration.fit_report import memory_name
@@ -44,8 +45,22 @@ from .learned_attributes import LearnedAttributes
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
 from .polynomial_model import simplest_within
 
-HYSTERESIS_CHOICES = ("auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+HYSTERESIS_CHOICES = (
+    "auto",
+    "none",
+    "turning-point",
+    "lag",
+    "turning-point+lag",
+    "branch",
+    "branch+lag",
+    "rate",
+    "rate+lag",
+)
+#: the memories the default compares (the temperature-rate term is fitted where asked for: ``rate``, ``rate+lag``)
 CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+#: smoothing time constants the final fit tries for a temperature-rate term [s] (the middle of those the data
+#: cannot tell from the best: _Problem.best_smoothing); the model choice's folds try FOLD_RATE_SMOOTHINGS_S
+RATE_SMOOTHINGS_S = tuple(float(s) for s in np.geomspace(30.0, 3000.0, 11))
 #: terms of the difference between the heating and the cooling curve (a constant, then a slope)
 MAX_BRANCH_ORDER = 2
 #: crossover widths the final fit tries for a branch model [degC] (refined: see _Problem.best_width); the
@@ -119,10 +134,13 @@ class _Spec:
     width_degc: float = 0.0
     #: the curve family of the shape (:data:`gyrocomp.curves.protocol.BASES`), ``order`` its size
     curve: str = POLY_FAMILY
+    #: a temperature-rate term, and its smoothing time constant [s] (0: to be found)
+    rate: bool = False
+    smoothing_s: float = 0.0
 
     @property
     def name(self) -> str:
-        return memory_name(self.lag, self.hysteresis_order, self.branch)
+        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate)
 
 
 @dataclass
@@ -153,7 +171,13 @@ class _Problem:
     def thermal_design(self) -> ThermalDesign:
         """The columns' builder (the curves' own coefficients: distances in degC)."""
         return ThermalDesign(
-            self.t_ref, self.t_scale, self.threshold, self.accel_cols, self.square_cols, extended=self.extended
+            self.t_ref,
+            self.t_scale,
+            self.threshold,
+            self.accel_cols,
+            self.square_cols,
+            extended=self.extended,
+            period_s=self.block_s,
         )
 
     def terms(self, spec: _Spec) -> Terms:
@@ -165,12 +189,13 @@ class _Problem:
             bands_degc=(self.band,),
             branch_order=spec.branch,
             branch_widths_degc=(spec.width_degc,),
+            rate_smoothings_s=(spec.smoothing_s,) if spec.rate else (),
         )
 
     def features(self, run: RunBlocks, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
         """Columns of the shape and the hysteresis at model temperature ``temp`` [degC] (the curves applied as fitted
         on [t_lo, t_hi]), then of the g and g x g sensitivity (the excited accelerometer axes only)."""
-        return self.thermal_design.columns(temp, run.accel_g, self.terms(spec), t_lo, t_hi)
+        return self.thermal_design.columns(temp, run.accel_g, self.terms(spec), t_lo, t_hi, time_s=run.time_s)
 
     def branch_reach(self, spec: _Spec, tau: float) -> tuple[float, float]:
         """The largest |T - T_turn| on the cooling and on the heating branches after a reversal (inside the
@@ -228,20 +253,37 @@ class _Problem:
         duration_s = sum(float(self.runs[r].time_s[-1] - self.runs[r].time_s[0]) for r in which)
         return specs[plausible_middle(rss, duration_s / SCORE_WINDOW_S)]
 
+    def best_smoothing(self, spec: _Spec, tau: float, which: list[int]) -> _Spec:
+        """``spec`` with the rate term's smoothing [s] of :data:`RATE_SMOOTHINGS_S` at lag ``tau`` [s] (``spec``
+        itself without a rate term or with its smoothing set): the middle of those the data cannot tell from the
+        best (:func:`plausible_middle`), as for the branch width; none longer than half the longest run."""
+        if not spec.rate or spec.smoothing_s > 0:
+            return spec
+        top = max(float(self.runs[r].time_s[-1] - self.runs[r].time_s[0]) for r in which) / 2.0
+        grid = [s for s in RATE_SMOOTHINGS_S if s <= max(top, RATE_SMOOTHINGS_S[0])]
+        specs = [dataclasses.replace(spec, smoothing_s=s) for s in grid]
+        rss = np.array([self.solve(s, tau, which)[2] for s in specs])
+        duration_s = sum(float(self.runs[r].time_s[-1] - self.runs[r].time_s[0]) for r in which)
+        return specs[plausible_middle(rss, duration_s / SCORE_WINDOW_S)]
+
+    def best_shape(self, spec: _Spec, tau: float, which: list[int]) -> _Spec:
+        """``spec`` with its branch crossover width and its rate term's smoothing found at lag ``tau`` [s]."""
+        return self.best_smoothing(self.best_width(spec, tau, which), tau, which)
+
     def fit(self, spec: _Spec, which: list[int], tau_s: float | None = None):
         """Best tau for the spec (0 without lag; ``tau_s`` when given) and the solution there; a branch model's
         crossover width is found at each tau tried. Returns (tau, solution, spec with its width)."""
         if not spec.lag:
-            spec = self.best_width(spec, 0.0, which)
+            spec = self.best_shape(spec, 0.0, which)
             return 0.0, self.solve(spec, 0.0, which), spec
         if tau_s is None:
             lo_s = LAG_MIN_BLOCKS * self.block_s
             tau_s = best_lag_s(
-                lambda tau: self.solve(self.best_width(spec, tau, which), tau, which)[2],
+                lambda tau: self.solve(self.best_shape(spec, tau, which), tau, which)[2],
                 lo_s,
                 lag_search_top_s(self.runs, lo_s),
             )
-        spec = self.best_width(spec, tau_s, which)
+        spec = self.best_shape(spec, tau_s, which)
         return tau_s, self.solve(spec, tau_s, which), spec
 
     def refine_band(self, spec: _Spec, tau_s: float, step_degc: float) -> None:
@@ -458,6 +500,8 @@ class ThermalHysteresisModel(LearnedAttributes):
         Fitted G row and its cluster-robust standard error [deg/s/g] (0 and NaN for axes not excited).
     g_squared_dps_per_g2_, g_squared_se_dps_per_g2_ : dict[str, np.ndarray (6,)]
         The g x g terms in the order of ``gyrocomp.effects.G_SQUARED_TERMS`` (``matrix2`` only).
+    rate_terms_ : dict[str, TemperatureRateTerm]
+        Per axis with a temperature-rate term (``rate``, ``rate+lag``), the term fitted.
     bands_ : dict[str, tuple or None]
         The hysteresis band used per axis [degC] (given, found in the data, or None).
     excited_axes_ : tuple of str
@@ -492,8 +536,10 @@ class ThermalHysteresisModel(LearnedAttributes):
         return list(CANDIDATES) if mode == "auto" else [mode]
 
     def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "") -> _Spec:
-        lag = name in ("lag", "turning-point+lag", "branch+lag")
+        lag = name in ("lag", "turning-point+lag", "branch+lag", "rate+lag")
         curve = self._of(self.curve, axis)
+        if "rate" in name:
+            return _Spec(order, lag, 0, curve=curve, rate=True)
         if "branch" in name:
             return _Spec(order, lag, 0, int(self._of(self.branch_order, axis)), curve=curve)
         if "turning-point" not in name:
@@ -510,6 +556,7 @@ class ThermalHysteresisModel(LearnedAttributes):
         self.turn_on_biases_, self.scores_, self.order_scores_ = {}, {}, {}
         self.memories_ = {}
         self.bands_ = {}
+        self.rate_terms_ = {}
         self.g_sensitivity_dps_per_g_, self.g_sensitivity_se_dps_per_g_ = {}, {}
         self.g_squared_dps_per_g2_, self.g_squared_se_dps_per_g2_ = {}, {}
         axes = fit_axes(recordings)
@@ -610,8 +657,11 @@ class ThermalHysteresisModel(LearnedAttributes):
         if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
             # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
             # which a higher order partly imitates; choose it again inside the winning candidate
-            tried = {o: score(_Spec(o, spec.lag, spec.hysteresis_order)) for o in range(1, self.max_order + 1)}
-            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order)
+            tried = {
+                o: score(_Spec(o, spec.lag, spec.hysteresis_order, rate=spec.rate))
+                for o in range(1, self.max_order + 1)
+            }
+            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order, rate=spec.rate)
             self.order_scores_[axis] = tried
         return _AxisChoice(problem, spec, chosen, scores)
 
@@ -676,6 +726,9 @@ class ThermalHysteresisModel(LearnedAttributes):
                 t_lo,
                 t_hi,
             )
+        if spec.rate:
+            rate = float(coef[spec.order + 2 * p + spec.branch])
+            self.rate_terms_[axis] = TemperatureRateTerm(rate, spec.smoothing_s)
         self.bands_[axis] = problem.band
         self.turn_on_biases_[axis] = consts
         self.memories_[axis] = (choice.name, spec.branch or p)

@@ -34,7 +34,7 @@ from ..curves.network import NETWORK_BLOCK_S
 from ..fitting.network_model import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
-from ..fitting.selection import AxisSelection, prepare_axis
+from ..fitting.selection import FOLD_RATE_SMOOTHINGS_S, AxisSelection, prepare_axis
 from ..fitting.polynomial_model import PolynomialTemperatureModel
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, fit_accel_triad, fit_gyro_triad, spanning_poses  # noqa: F401
 from .options import Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target, curve_candidates
@@ -157,7 +157,8 @@ def select_models(
     orders : tuple of int
         Polynomial orders to try (0: the run constant alone).
     memories : tuple of str
-        Among ``none``, ``lag``, ``turning-point``, ``turning-point+lag``.
+        Among ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``, ``branch+lag``, ``rate``,
+        ``rate+lag``.
     hysteresis_orders : tuple of int
         Turning-point orders to try.
     acceleration : {"none", "matrix", "matrix2"}
@@ -190,6 +191,7 @@ def select_models(
         both_directions="none" in memories,
         branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
         other_curves=other_curves,
+        rate_smoothings_s=FOLD_RATE_SMOOTHINGS_S if any("rate" in m for m in memories) else (),
     )
     one_die = shared_lag and one_temperature_column(recordings)
     if one_die and any("lag" in m for m in memories):
@@ -642,6 +644,7 @@ def _axis_calibration(
         g_row,
         g_sq,
         unit=recordings[0].unit_of(axis),
+        rate_term=thermal.rate_terms_.get(axis) if thermal is not None else None,
     )
     fit_rms = None
     if network is not None:

@@ -21,7 +21,9 @@ from ..curves.polynomial import POLY_FAMILY, MAX_ORDER
 from ..fitting.thermal import MAX_HYSTERESIS_ORDER
 
 #: the thermal memory on top of the temperature curve
-Memory = Literal["auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag"]
+Memory = Literal[
+    "auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag", "rate", "rate+lag"
+]
 #: what the model is fitted for: gyrocomp itself, or the best model a firmware carries (a cubic at most, clamped)
 Target = Literal["model", "px4", "ardupilot"]
 #: the highest polynomial order a firmware target carries
@@ -187,8 +189,9 @@ class FitOptions:
     bin_width_degc : float, optional
         Temperature bin width of the fit [degC].
     hysteresis : Memory
-        Thermal lag and/or turning-point hysteresis (``auto``: chosen by held-out drift when the runs heat and
-        cool).
+        Thermal lag and/or turning-point hysteresis, heating and cooling branches, or a temperature-rate term
+        (``rate``, ``rate+lag``: a bias in the smoothed dT/dt, :mod:`gyrocomp.curves.rate`, fitted where asked
+        for) (``auto``: chosen by held-out drift when the runs heat and cool).
     hysteresis_order : int or "auto"
         Order of the turning-point polynomial, 1..3.
     hysteresis_band_degc : (lo, hi), optional
@@ -240,6 +243,11 @@ class FitOptions:
             self._check_firmware_target()
         if isinstance(self.temperature, Curve) and self.temperature.family != POLY_FAMILY:
             self._check_other_family()
+        if isinstance(self.temperature, Network) and "rate" in self.hysteresis:
+            raise InputError(
+                "FitOptions.hysteresis: a network is trained without a temperature-rate term; use a polynomial "
+                "with hysteresis='rate' or 'rate+lag'"
+            )
         if self.bin_width_degc is not None and not (
             isinstance(self.bin_width_degc, (int, float)) and self.bin_width_degc > 0
         ):

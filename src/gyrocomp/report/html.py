@@ -118,6 +118,8 @@ def _describe(ax) -> str:
         text += f", thermal lag {ax.lag_time_constant_s:.3g} s"
     if ax.hysteresis is not None:
         text += f", {ax.hysteresis.describe()}"
+    if ax.rate_term is not None:
+        text += f", {ax.rate_term.describe(ax.unit)}"
     if ax.has_acceleration_stage:
         text += ", g-sensitivity"
     return text
