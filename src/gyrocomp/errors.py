@@ -6,7 +6,9 @@ and say what to do; only :mod:`gyrocomp.cli` turns them into one line on stderr 
 
 from __future__ import annotations
 
+import os
 import re
+import sys
 from typing import Literal, get_args
 
 
@@ -108,6 +110,19 @@ def install_hint(extra: str) -> str:
     """How to install an extra, from PyPI and from a clone of the repository (where ``pip install
     'gyrocomp[...]'`` would fetch the released package instead of the clone's)."""
     return f"pip install 'gyrocomp[{extra}]' (from a clone of the repository: pip install -e '.[{extra}]')"
+
+
+#: the package's folder: a warning is attributed to the first frame outside it (the user's line)
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def user_stacklevel() -> int:
+    """The ``stacklevel`` for :func:`warnings.warn`, called where the warning is raised, that attributes it to the
+    first caller outside gyrocomp (the user's line), however deep inside the package it is raised."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE_DIR):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 class ModelChoiceWarning(UserWarning):

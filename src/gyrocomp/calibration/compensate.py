@@ -9,7 +9,7 @@ import numpy as np
 
 from .calibration import Calibration
 from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, temperature_rate, thermal_lag
-from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning
+from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning, user_stacklevel
 from ..io.stream import CHUNK_ROWS
 from ..measures.plausibility import BlockMeans, ScaleAgreement, agreement_concern, recording_concerns, scale_agreement
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
@@ -139,7 +139,7 @@ class Compensator:
                 f"{ax.temperature.t_min_degc:.2f}..{ax.temperature.t_max_degc:.2f} degC; "
                 f"the model is {ax.temperature.beyond_range} there",
                 TemperatureRangeWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
             self._warned = True
         error = np.asarray(ax.temperature.shape(t_model, accel_g if ax.temperature.needs_accel else None), dtype=float)
@@ -375,7 +375,7 @@ class Compensator:
             f"{self.source}: the data lasts {held_s:.3g} s, shorter than the turn-on window of "
             f"{self.turn_on_window_s:g} s; the constant was estimated from all of it",
             UserWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
         return self._release()
 
@@ -452,7 +452,7 @@ def compensator_for(
     concerns warned about, the accelerometer's three axes required when the model compensates them."""
     calibration = _restricted(calibration, recording, axes)
     for concern in recording_concerns(recording):
-        warnings.warn(concern.warning(), stacklevel=3)
+        warnings.warn(concern.warning(), stacklevel=user_stacklevel())
     comp = Compensator(
         calibration,
         recording.gyro_axes,
@@ -468,13 +468,13 @@ def compensator_for(
     return comp
 
 
-def warn_disagreement(comp: Compensator, stacklevel: int = 3) -> None:
+def warn_disagreement(comp: Compensator) -> None:
     """Warn (:class:`~gyrocomp.errors.PlausibilityWarning`, check ``agreement``) about each axis whose output did
     not follow the model (:meth:`Compensator.agreement`): a unit or sign mistake, or a model of another part."""
     for axis, agreement in comp.agreement().items():
         concern = agreement_concern(comp.source, axis, agreement)
         if concern is not None:
-            warnings.warn(concern.warning(), stacklevel=stacklevel)
+            warnings.warn(concern.warning(), stacklevel=user_stacklevel())
 
 
 def accel_xyz(recording: Recording) -> np.ndarray | None:
@@ -519,7 +519,7 @@ def _restricted(calibration: Calibration, recording: Recording, axes: tuple[str,
         warnings.warn(
             f"{recording.source}: {', '.join(raw)} left raw (not among the axes to compensate)",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     return dataclasses.replace(calibration, axes={a: calibration.axes[a] for a in axes})
 

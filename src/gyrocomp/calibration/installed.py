@@ -31,7 +31,7 @@ from typing import Literal
 import numpy as np
 
 from .calibration import AxisCalibration, Calibration
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..curves.polynomial import PolynomialCurve
 
 DEG_TO_RAD = math.pi / 180.0
@@ -253,7 +253,9 @@ def installed_calibration(parameters: dict[str, float], autopilot: str, instance
         scales = [parameters.get(f"{p}SCL_{j}", 1.0) for j in range(3)]
         if any(abs(sc - 1.0) > 1e-6 for sc in scales):
             warnings.warn(
-                f"{p}SCL_*: scale factors {scales} are not modelled; the offsets are", DataQualityWarning, stacklevel=2
+                f"{p}SCL_*: scale factors {scales} are not modelled; the offsets are",
+                DataQualityWarning,
+                stacklevel=user_stacklevel(),
             )
     elif autopilot == "ardupilot":
         p = f"INS_TCAL{instance + 1}_"

@@ -38,7 +38,7 @@ from ..calibration.installed import (
     DEG_TO_RAD,
     installed_calibration,
 )
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment
 
@@ -108,7 +108,7 @@ def _warn_left_out(calibration: Calibration, target: str) -> None:
             "and the accelerometer's offsets and scales are written (compare the stages of the evaluation "
             "to see what that costs)",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -35,7 +35,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..measures.noise_model import NoiseModel, per_sample_covariance
 from ..units import STANDARD_GRAVITY_M_PER_S2
 from .encode import line_comment
@@ -293,7 +293,7 @@ def autopilot_noise_parameters(
                 f"export {target}: {name} would be {value:.6g}, outside the {low:g}..{high:g} the autopilot "
                 f"accepts; written as {clamped:g}",
                 DataQualityWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
             value = clamped
         out[name] = value

@@ -15,7 +15,7 @@ import math
 import warnings
 from dataclasses import dataclass
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..measures.noise import NoiseAnalysis
 from ..units import STANDARD_GRAVITY_M_PER_S2
 
@@ -43,7 +43,7 @@ def warn_zero_walks(source: str, gyro_walk: float | None, accel_walk: float | No
                 f"{source}: no {label} random walk is visible in this log (K = 0); {consumer} needs a "
                 "non-zero value: record a longer static log (hours)",
                 DataQualityWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
 
 
@@ -60,7 +60,7 @@ def kalibr_imu(analysis: NoiseAnalysis, rostopic: str = "/imu0") -> KalibrImu:
             f"{analysis.source}: no accelerometer axes, so imu.yaml has gyroscope values only; "
             "Kalibr needs both (name the accelerometer columns with columns=)",
             DataQualityWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     warn_zero_walks(analysis.source, gyro_walk, accel_walk)
     return KalibrImu(

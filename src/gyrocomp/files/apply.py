@@ -137,7 +137,7 @@ def _apply_stream(
                 accel_out = comp.take_accel()[:, accel_order]
             flush(gyro, accel_out)
         flush(comp.finish(), None)
-        warn_disagreement(comp, stacklevel=4)
+        warn_disagreement(comp)
     stream.warn_summary()
     return FileResult(written, compensated_axes(calibration, first, axes, comp.compensates_accel), True)
 

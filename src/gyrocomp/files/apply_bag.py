@@ -43,7 +43,7 @@ import numpy as np
 
 from ..calibration import Calibration
 from ..calibration.compensate import accel_xyz, apply, compensator_for
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..io import ReadOptions
 from ..io.atomic import atomic_folder, refuse_link
 from ..io.foreign_libraries import require
@@ -225,7 +225,7 @@ def _warn_unchanged(path: Path, counts: dict) -> None:
                 "reads as (outside the temperature topic's span, or not finite) and were copied "
                 "uncompensated",
                 DataQualityWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
 
 

@@ -7,7 +7,7 @@ import os
 import warnings
 from collections.abc import Iterable, Sequence
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..io import ReadOptions
 from ..io.tables import release_table_memory
 from .chunks import read_whole
@@ -94,7 +94,7 @@ def warn_findings(checks: Sequence[RunCheck]) -> None:
     for c in checks:
         for f in c.findings:
             if f.check not in SAID_ELSEWHERE:
-                warnings.warn(f"{f.text()} (data check '{f.check}')", DataQualityWarning, stacklevel=2)
+                warnings.warn(f"{f.text()} (data check '{f.check}')", DataQualityWarning, stacklevel=user_stacklevel())
 
 
 def read_noting(read, path: str | os.PathLike) -> CheckedRun:
@@ -109,7 +109,7 @@ def rewarn(runs: Iterable[CheckedRun]) -> None:
     """Say again what the reader said of each run (it was kept while the runs were checked)."""
     for run in runs:
         for note in run.notes:
-            warnings.warn(note, stacklevel=2)
+            warnings.warn(note, stacklevel=user_stacklevel())
 
 
 __all__ = [

@@ -10,6 +10,7 @@ from ..io.stream import TableStream, TableWriter
 from ..io.tables import recording_table
 from ..measures.plausibility import recording_concerns
 from .chunks import ChunkSettings, chunked_or_whole
+from ..errors import user_stacklevel
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,7 @@ def _warn_once(concerns) -> None:
     for concern in concerns:
         if concern.check not in said:
             said.add(concern.check)
-            warnings.warn(concern.warning(), stacklevel=4)
+            warnings.warn(concern.warning(), stacklevel=user_stacklevel())
 
 
 __all__ = ["ConvertResult", "convert_file"]

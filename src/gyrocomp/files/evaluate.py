@@ -103,7 +103,7 @@ def _evaluate_stream(calibration: Calibration, stream: TableStream, window_s, tu
         block = _compensated(comp, comp.finish(), accel_axes)
         _check_block(first, block, accel_axes, pending_rows[: len(block)])
         compensated.update(block)
-        warn_disagreement(comp, stacklevel=4)
+        warn_disagreement(comp)
         rate_hz = steps.rate_hz()
         stream.warn_summary()
         return evaluate_phases(

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..allan import AllanKind, TauGrid
 from ..allan.streaming import PhaseAccumulator
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..io import ReadOptions
 from ..io.stream import NotStreamable, TableStream
 from ..measures.noise import NoiseAnalysis, analyse_noise, analyse_noise_phases, axis_values, noise_axes, warn_if_moving
@@ -115,7 +115,7 @@ def _noise_stream(
                 phases.update(np.column_stack([axis_values(recording, name)[0] for name in names]))
                 if not said and recording.temperature_degc is not None:  # the first impossible sample, once
                     for concern in temperature_range_concerns(recording):
-                        warnings.warn(concern.warning(), stacklevel=3)
+                        warnings.warn(concern.warning(), stacklevel=user_stacklevel())
                         said = True
             rate_hz = steps.rate_hz()
             stream.warn_summary()
@@ -123,7 +123,7 @@ def _noise_stream(
                 warn_if_moving(str(stream.path), detection(still.blocks()))
             concern = time_unit_concern(str(stream.path), rate_hz, (steps.last or 0.0) - (first_s or 0.0))
             if concern is not None:  # the same words as a whole recording's check (allan on ns read as s)
-                warnings.warn(concern.warning(), stacklevel=3)
+                warnings.warn(concern.warning(), stacklevel=user_stacklevel())
             integrated = dict(zip(names, phases.finish(rate_hz)))
             return analyse_noise_phases(
                 integrated, rate_hz, source=str(stream.path), kind=kind, taus=taus, fit_taus_s=fit_taus_s

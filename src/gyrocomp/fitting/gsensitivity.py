@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 
 from ..effects import G_SQUARED_TERMS
-from ..errors import DataQualityWarning
+from ..errors import DataQualityWarning, user_stacklevel
 from ..recording import ACCEL_AXES, Recording
 from ..runs.prepared import PreparedRun
 
@@ -47,7 +47,7 @@ def excited_columns(
             "those columns of the g-sensitivity matrix are not fitted (reported as 0 with no standard error). "
             "Record positions that tilt every axis (a tumble: +1, 0 and -1 g on each)",
             DataQualityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
     chosen: tuple[int, ...] = ()
     if squares:

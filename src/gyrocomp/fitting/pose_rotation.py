@@ -27,7 +27,7 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..recording import Recording
 from ..calibration.triad import TriadCalibration
 from .triad_fit import MIN_TRIAD_SPAN_DEGC, ORDER_TOLERANCE, Pose, find_poses, fit_accel_multiposition, gyro_triad
@@ -349,7 +349,7 @@ def _session_accels(sessions: list[tuple[Recording, list[Pose]]]) -> list[TriadC
                     f"accelerometer not calibrated from the poses ({exc}); the gravity directions carry its "
                     "bias and scale errors, and so does the gyro's K",
                     DataQualityWarning,
-                    stacklevel=4,
+                    stacklevel=user_stacklevel(),
                 )
                 joint.append(None)
         out.append(joint[0])

@@ -33,7 +33,7 @@ import numpy as np
 from ..curves.polynomial import POLY_FAMILY
 from ..curves.rate import TemperatureRateTerm
 from ..effects import find_turns, thermal_lag
-from ..errors import DataQualityWarning, InputError, ModelError
+from ..errors import DataQualityWarning, InputError, ModelError, user_stacklevel
 from ..calibration.fit_report import memory_name
 from ..recording import Recording
 from .design import Terms, ThermalDesign
@@ -787,7 +787,9 @@ def static_pieces(
         segments.append(segs)
         if moves and not segs and warn:
             warnings.warn(
-                f"{rec.source}: no static segment found; fitting on every sample", DataQualityWarning, stacklevel=3
+                f"{rec.source}: no static segment found; fitting on every sample",
+                DataQualityWarning,
+                stacklevel=user_stacklevel(),
             )
         out.append([slice(g.start, g.stop) for g in segs] if segs else None)
     return segments, out

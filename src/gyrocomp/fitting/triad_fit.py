@@ -26,7 +26,7 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..recording import Recording
 from ..runs.prepared import PreparedRun
 from ..calibration.triad import TriadCalibration, rows_of
@@ -295,7 +295,7 @@ def _fixed_couplings(poses: list[Pose], units: np.ndarray) -> tuple[str, ...]:
             f"poses: no pose has gravity between the {pairs} axes; that misalignment is not determined and "
             "is taken as zero (add poses tilted between the axes to fit it)",
             DataQualityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
     return fixed
 

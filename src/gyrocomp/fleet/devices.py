@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..io.inputs import expand_inputs
 from ..io.tables import detect_table_format, file_sha256
 
@@ -77,7 +77,7 @@ def units_from_pattern(paths: Iterable[str | os.PathLike], pattern: str) -> list
         warnings.warn(
             f"unit_pattern: {len(unmatched)} file(s) do not match {pattern!r} and are left out (e.g. {unmatched[0]})",
             DataQualityWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     # a field that differs between the runs of any unit names runs (``{n}``); the others describe units
     per_run = {k for runs in groups.values() for k in runs[0][1] if len({f[k] for _, f in runs}) > 1}

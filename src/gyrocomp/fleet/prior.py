@@ -57,7 +57,7 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, thermal_lag
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..fitting.provenance import provenance
 from ..curves.polynomial import PolynomialCurve
 from ..recording import Recording
@@ -299,7 +299,7 @@ def fit_with_prior(
             "cannot be told from the temperature curve; a run that comes back (cold, hot, cold) tells "
             "them apart",
             DataQualityWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     axes, report = {}, {}
     for axis, p in prior.axes.items():

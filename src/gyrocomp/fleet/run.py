@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 from .._version import __version__
-from ..errors import DataQualityWarning, GyrocompError, InputError
+from ..errors import DataQualityWarning, GyrocompError, InputError, user_stacklevel
 from ..files.check import ask_for, read_checked, refuse, rewarn, warn_findings
 from ..io import ReadOptions
 from ..measures.data_check import check_runs
@@ -682,7 +682,7 @@ def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
                 f"{path}: differed from unit {serial!r}'s newest calibration in the store (row "
                 f"{ok[-1].id}); written again from the store",
                 DataQualityWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError, foreign_message
+from ..errors import DataQualityWarning, InputError, foreign_message, user_stacklevel
 from ..recording import Recording
 from ..units import unit_factor
 from .log_samples import keep_matched, log_recording, match_by_time, order_by_time
@@ -222,7 +222,7 @@ def _from_imu(log: _Log, instance: int, explicit: bool):
             f"{log.path}: {len(found)} IMU instances ({', '.join(map(str, found))}); read instance "
             f"{instance}, choose another with instance=",
             DataQualityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
     time_s = imu["TimeUS"].astype(float) * _US
     gyro = np.column_stack([imu[f"Gyr{a}"] for a in "XYZ"]).astype(float) * _RAD
@@ -271,14 +271,14 @@ def _warn_of_parameters(path: Path, params: dict, instance: int, corrected: bool
             f"{path}: AHRS_ORIENTATION = {orientation:g}: the logged IMU axes are the board's, rotated "
             "from the sensor's; INS_TCAL parameters apply in the sensor frame",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     if corrected:
         warnings.warn(
             f"{path}: INS_TCAL{instance + 1}_ENABLE = 1: the logged IMU data are already corrected by "
             "the onboard temperature calibration",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -312,7 +312,7 @@ def read_dataflash(path, options: ReadOptions | None = None, progress: ProgressC
                 f"{path}: the log ends mid-message ({log.cut_bytes} bytes after the last whole message, "
                 "a truncated download?); read up to there",
                 DataQualityWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
         instance = 0 if options.instance is None else options.instance
         if record == "TCLR":

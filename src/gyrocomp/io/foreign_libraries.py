@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from types import ModuleType
 
 
-from ..errors import DataQualityWarning, MissingDependencyError, install_hint, printable
+from ..errors import DataQualityWarning, MissingDependencyError, install_hint, printable, user_stacklevel
 
 
 def require(module: str, extra: str, what: str) -> ModuleType:
@@ -71,5 +71,5 @@ def foreign_output(source: str, library: str) -> Iterator[None]:
             f"{source}: {library} reported {len(lines)} line(s) while reading, the first: {first!r}; "
             "the log is probably damaged in places",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )

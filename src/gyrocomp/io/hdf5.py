@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, GyrocompError, InputError, LayoutError, printable
+from ..errors import DataQualityWarning, GyrocompError, InputError, LayoutError, printable, user_stacklevel
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .log_samples import log_recording
@@ -86,7 +86,7 @@ def _factor(kind: str, dataset, fallback: str, option: str, source: str) -> floa
                 f"{source}: dataset {dataset.name} has units {units!r}, which gyrocomp does not know; "
                 f"read as {fallback} (set {option}= if that is wrong)",
                 DataQualityWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
     return unit_factor(kind, fallback, option)
 

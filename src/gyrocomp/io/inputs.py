@@ -8,7 +8,7 @@ import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from .readers import folder_format, folder_markers, format_of_name, run_suffixes
 
 
@@ -36,7 +36,7 @@ def _each_once(paths: set[Path]) -> set[Path]:
             f"{dropped} name(s) matched are files already named by another path (through symbolic "
             "links, or a link loop); each file is read once",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     return set(by_file.values())
 

@@ -7,7 +7,7 @@ import json
 import warnings
 from dataclasses import dataclass
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN
 from ..option_spelling import Spelling, spelled
 from ..units import unit_factor
@@ -293,5 +293,5 @@ class TableLayout:
                 f"reads {canonical} from {self.columns[canonical]!r}; where the output keeps the table, "
                 f"{canonical!r} stays as it was",
                 DataQualityWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )

@@ -8,7 +8,7 @@ import warnings
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError, TimeOrderWarning
+from ..errors import DataQualityWarning, InputError, TimeOrderWarning, user_stacklevel
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .read_options import ReadOptions
 from .tables import keep_finite_rows
@@ -65,7 +65,7 @@ def order_by_time(source: str, time_s: np.ndarray, *arrays: np.ndarray | None) -
     dropped = int(sorted_t.size - index.size)
     if moved or dropped:
         back = float(np.max(np.maximum.accumulate(time_s)[:-1] - time_s[1:])) if time_s.size > 1 else 0.0
-        warnings.warn(time_order_warning(source, moved, dropped, back), stacklevel=3)
+        warnings.warn(time_order_warning(source, moved, dropped, back), stacklevel=user_stacklevel())
     return (time_s[index], *(None if a is None else np.asarray(a)[index] for a in arrays))
 
 
@@ -132,7 +132,11 @@ def keep_matched(source: str, what: str, ok: np.ndarray) -> np.ndarray:
     if not ok.any():
         raise none_matched(source, what)
     if not ok.all():
-        warnings.warn(left_out(source, what, int(np.count_nonzero(~ok)), ok.size), DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            left_out(source, what, int(np.count_nonzero(~ok)), ok.size),
+            DataQualityWarning,
+            stacklevel=user_stacklevel(),
+        )
     return np.flatnonzero(ok)
 
 

@@ -18,7 +18,7 @@ from typing import Any
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import InputError, UnusedOptionWarning
+from ..errors import InputError, UnusedOptionWarning, user_stacklevel
 from ..recording import Recording
 from .read_options import ProgressCallback, ReadOptions
 from .layout import TableLayout
@@ -97,7 +97,7 @@ class Reader:
                 f"{path}: {', '.join(f'{name}=' for name in given)} not used: they are for tables and files of "
                 f"named arrays, and a {self.name} file's fields, units and time stamps are its own",
                 UnusedOptionWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
 
     def read_table_data(self, path: Path, options: ReadOptions, progress: ProgressCallback | None) -> TableData:

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 import pyarrow as pa
 
-from ..errors import DataQualityWarning, InputError, TimeOrderWarning, foreign_message
+from ..errors import DataQualityWarning, InputError, TimeOrderWarning, foreign_message, user_stacklevel
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from ..units import unit_factor
 from .log_samples import (
@@ -233,7 +233,7 @@ def _read_all(path: Path, counted: int, read: int, topic: str) -> None:
             f"{path}: topic {topic}: the bag's index counts {counted} messages, {read} were read; the "
             "rest is damaged or missing",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -400,11 +400,11 @@ def _metadata(path: Path, imu: list, thermo: list) -> dict:
     }
 
 
-def _warn_no_temperature(path: Path, stacklevel: int) -> None:
+def _warn_no_temperature(path: Path) -> None:
     warnings.warn(
         f"{path}: no {TEMPERATURE_TYPE} topic; the recording has no temperature (only noise analysis works without it)",
         DataQualityWarning,
-        stacklevel=stacklevel + 1,
+        stacklevel=user_stacklevel(),
     )
 
 
@@ -437,7 +437,7 @@ def read_rosbag(path, options: ReadOptions | None = None, progress: ProgressCall
     finally:
         reader.close()
     if temperature is None:
-        _warn_no_temperature(path, stacklevel=2)
+        _warn_no_temperature(path)
     if progress:
         progress(1.0)
     return log_recording(path, options, time_s, gyro, accel, temperature, _metadata(path, imu, thermo))
@@ -539,7 +539,7 @@ class BagStream:
     def chunks(self):
         """The IMU topic as :class:`BagChunk` s."""
         if self._temperature is None:
-            _warn_no_temperature(self.path, stacklevel=2)
+            _warn_no_temperature(self.path)
         reader, self._reader = self._reader, None
         if reader is None:
             reader = _open(self.path)
@@ -620,7 +620,9 @@ class BagStream:
         temperature topic's span, rows dropped."""
         moved, dropped = self._order["moved"], self._order["dropped"]
         if moved or dropped:
-            warnings.warn(time_order_warning(str(self.path), moved, dropped, self._order["back"]), stacklevel=2)
+            warnings.warn(
+                time_order_warning(str(self.path), moved, dropped, self._order["back"]), stacklevel=user_stacklevel()
+            )
         if self._order["unmatched"]:
             warnings.warn(
                 left_out(
@@ -630,10 +632,12 @@ class BagStream:
                     self._order["samples"],
                 ),
                 DataQualityWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
         if self.rows_dropped:
-            warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
+            warnings.warn(
+                rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=user_stacklevel()
+            )
 
 
 class LoneSample(NamedTuple):

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 
-from ..errors import DataQualityWarning, InputError, printable
+from ..errors import DataQualityWarning, InputError, printable, user_stacklevel
 
 #: the longest line that can be a row [bytes]: 1 kB holds 40 numbers
 MAX_LINE_BYTES = 1024
@@ -158,7 +158,7 @@ def read_headerless(path, names: tuple[str, ...], rate_hz: float | None = None) 
             f"{path}: skipped {skipped} line(s) that are not {count} numbers (a banner, a header or "
             f"a garbled line), the first: line {line_number} {quoted}",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     values = np.asarray(rows, dtype=float)
     columns = {name: _floats(values[:, i]) for i, name in enumerate(names)}

@@ -24,7 +24,7 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..recording import ACCEL_AXES, GYRO_AXES, Recording
 from .atomic import arrow_source, atomic_path, require_unchanged
 from .tables import (
@@ -277,14 +277,16 @@ class TableStream:
     def warn_summary(self) -> None:
         """The warnings a whole-file read gives: rows dropped, time gaps (once each, for the whole file)."""
         if self.rows_dropped:
-            warnings.warn(rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=2)
+            warnings.warn(
+                rows_dropped(self.path, self.rows_dropped, self.rows), DataQualityWarning, stacklevel=user_stacklevel()
+            )
         if self.gaps:
             duration, row = self.longest_gap
             warnings.warn(
                 f"{self.path}: {self.gaps} time gap(s) longer than 2 sample periods (longest "
                 f"{duration:.6g} s after row {row}); kept as they are, nothing interpolated",
                 DataQualityWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
 
 

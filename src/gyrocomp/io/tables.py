@@ -14,7 +14,7 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from ..errors import DataQualityWarning, InputError, LayoutError, TimeOrderError
+from ..errors import DataQualityWarning, InputError, LayoutError, TimeOrderError, user_stacklevel
 from ..recording import ACCEL_AXES, GYRO_AXES, REFERENCE_RATE_AXES, TEMPERATURE_COLUMN, Recording
 from ..units import unit_factor
 from .digest import file_sha256
@@ -219,7 +219,7 @@ def keep_finite_rows(path: Path, time_s: np.ndarray, *channels: np.ndarray | Non
     if ok.all():
         return np.arange(n), [time_s, *channels]
     kept = np.flatnonzero(ok)
-    warnings.warn(rows_dropped(path, n - kept.size, n), DataQualityWarning, stacklevel=3)
+    warnings.warn(rows_dropped(path, n - kept.size, n), DataQualityWarning, stacklevel=user_stacklevel())
     return kept, [time_s[kept], *(None if v is None else v[kept] for v in channels)]
 
 
@@ -307,7 +307,7 @@ def read_table(
             f"{path}: {len(recording.gaps)} time gap(s) longer than 2 sample periods (longest {longest.duration_s:.6g} s "
             f"after row {longest.after_row}); kept as they are, nothing interpolated",
             DataQualityWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     return TableData(recording, table, layout, cols, kept, path, text_format)
 

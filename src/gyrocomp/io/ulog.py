@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataQualityWarning, InputError, foreign_message
+from ..errors import DataQualityWarning, InputError, foreign_message, user_stacklevel
 from ..recording import Recording
 from ..units import unit_factor
 from .log_samples import keep_matched, log_recording, match_by_time, order_by_time
@@ -89,7 +89,7 @@ def _check_framing(path: Path) -> None:
                 f"{path}: the flag bits say data were appended at byte {offset}, past the end of the file "
                 f"({size} bytes): none read",
                 DataQualityWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         elif offset not in starts:
             raise InputError(
@@ -101,7 +101,7 @@ def _check_framing(path: Path) -> None:
             f"{path}: the file ends {cut[1]} byte(s) short inside its last message (at byte {cut[0]}): "
             "a truncated or damaged log; read up to there",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -134,7 +134,7 @@ def _choose(path: Path, topic: str, datasets: list, options: ReadOptions, id_fie
             f"{path}: {len(found)} {topic} instances ({', '.join(map(str, sorted(found)))}); read instance 0, "
             "choose another with instance= or device_id=",
             DataQualityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
     return found[instance]
 
@@ -217,7 +217,7 @@ def _warn_if_corrected(path: Path, topic: str, parameters: dict, metadata: dict)
             "model fitted or applied on it would correct twice (log sensor_gyro, the raw topic, or "
             "disable TC_G_ENABLE)",
             DataQualityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -282,7 +282,7 @@ def read_ulog(path, options: ReadOptions | None = None, progress: ProgressCallba
             f"{path}: {metadata['topic']} carries no temperature; log sensor_gyro for temperature calibration "
             "(only noise analysis works without it)",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     if progress:
         progress(1.0)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..allan import BIAS_INSTABILITY_FACTOR, AllanResult, allan_deviation, allan_deviation_segments
 from ..effects import moving_average, moving_average_range
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from .plausibility import MAX_ACCEL_G, MAX_RATE_DPS
 from ..recording import Recording
 from ..units import AXIS_UNITS, DEG_PER_S_TO_DEG_PER_H, AxisUnit, check_axis_unit, in_unit
@@ -300,7 +300,7 @@ def _checked_stretches(raw: Recording, compensated: Recording, accel: bool) -> l
             f"{raw.source}: {len(raw.gaps)} time gap(s); the Allan deviation pools the {len(stretches)} stretches "
             "between them, the moving average runs across them",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     return stretches
 

@@ -24,7 +24,7 @@ from ..allan import (
     allan_deviation_segments,
     noise_terms,
 )
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from .plausibility import recording_concerns, time_bursts_concern
 from ..recording import Recording
 from ..motion.stillness import StillDetection, detect_still, moves_most_of_the_time
@@ -138,7 +138,7 @@ def warn_if_moving(source: str, found: StillDetection) -> None:
             "still): its Allan deviation and noise terms describe the motion, not the sensor's noise; "
             "analyse a still stretch (time_range_s=) or the still poses, split into runs of their own (split by still)",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -176,7 +176,9 @@ def analyse_noise(
     """
     names = noise_axes(axes, recording.gyro_axes, recording.accel_axes, with_accel)
     for concern in recording_concerns(recording) if plausibility_check else ():
-        warnings.warn(concern.warning(), stacklevel=2)  # a time column in ns read as s gives taus of 1e10 s
+        warnings.warn(
+            concern.warning(), stacklevel=user_stacklevel()
+        )  # a time column in ns read as s gives taus of 1e10 s
     if recording.gaps and not split_gaps:
         raise InputError(_describe_gap(recording))
     if motion_check:
@@ -268,7 +270,7 @@ def _axis_noise(
             "RMS; compare the read-offs, or restrict the fit to the taus where a term holds "
             "(fit_taus_s: (low, high) [s])",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     quoted = GyroNoise.from_terms(terms) if sensor == "gyro" else AccelNoise.from_terms(terms)
     return AxisNoise(name, sensor, unit, curve, allan, terms, quoted)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from ..errors import InputError, ModelChoiceWarning
+from ..errors import InputError, ModelChoiceWarning, user_stacklevel
 from ..calibration.fit_report import (
     THIN_FOLDS,
     AxisFit,
@@ -203,13 +203,13 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
     first = next(iter(selections.values()))
     across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[first.fold_kind]
     if first.fold_note:
-        warnings.warn(f"model choice: {first.fold_note}", ModelChoiceWarning, stacklevel=3)
+        warnings.warn(f"model choice: {first.fold_note}", ModelChoiceWarning, stacklevel=user_stacklevel())
     if first.validated and len(first.folds) < THIN_FOLDS:
         warnings.warn(
             f"model choice: only {len(first.folds)} {across} to hold out; the evidence for each axis's "
             f"choice is thin (more runs, or runs that heat and cool more than once, make it firmer)",
             ModelChoiceWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     for axis, sel in selections.items():
         unit = sel.unit
@@ -218,30 +218,32 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
                 f"{axis}: the held-out {across} cannot tell {sel.chosen.label} from the same without the lag "
                 "the other axes found; the die's lag is kept",
                 ModelChoiceWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         if sel.branch_test is not None:
-            warnings.warn(sel.branch_test.sentence(axis), ModelChoiceWarning, stacklevel=3)
+            warnings.warn(sel.branch_test.sentence(axis), ModelChoiceWarning, stacklevel=user_stacklevel())
         if not sel.validated:
             warnings.warn(
                 f"{axis}: too little data to hold out {across}; {sel.chosen.label} fitted without validation",
                 ModelChoiceWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         elif not sel.generalizes:
             warnings.warn(
                 f"{axis}: left with its constant only; {sel.decided_by or 'do no harm'} (best: {sel.best.label})",
                 ModelChoiceWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         elif len(sel.folds) == TWO_FOLDS:  # thin evidence: which rule chose, in one line
-            warnings.warn(f"{axis}: {sel.chosen.label}; {sel.decided_by}", ModelChoiceWarning, stacklevel=3)
+            warnings.warn(
+                f"{axis}: {sel.chosen.label}; {sel.decided_by}", ModelChoiceWarning, stacklevel=user_stacklevel()
+            )
         elif sel.chosen_drift > sel.raw_drift:
             warnings.warn(
                 f"{axis}: the chosen model ({sel.chosen.label}) leaves {sel.chosen_drift:.3g} {unit} of "
                 f"held-out drift, more than the raw output's {sel.raw_drift:.3g} {unit}",
                 ModelChoiceWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
 
 
@@ -502,7 +504,7 @@ def _check_fit_inputs(recordings: list[Recording], spec: Polynomial | Curve | Ne
     if isinstance(spec, (Network, Curve)) or (isinstance(spec, Polynomial) and spec.order not in ("auto", 0)):
         concerns.append(temperature_span_concern(recordings))  # a curve asked for
     for concern in filter(None, concerns):
-        warnings.warn(concern.warning(), stacklevel=4)
+        warnings.warn(concern.warning(), stacklevel=user_stacklevel())
     if spec is not None:
         for rec in recordings:
             if rec.temperature_degc is None:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..calibration import Calibration
 from ..calibration.triad import TriadCalibration
-from ..errors import DataQualityWarning, InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..fitting.pose_rotation import TooFewTurns, fit_gyro_between_poses
 from ..fitting.rate_table import MIN_REFERENCE_RATE_DPS, fit_gyro_rate_table
 from ..fitting.triad_fit import MIN_TRIAD_SPAN_DEGC, Pose, PoseFit, find_poses, fit_accel_multiposition, spans_axes
@@ -68,7 +68,9 @@ def fit_gyro_triad(
             if isinstance(exc, TooFewTurns):  # the turns were not recorded: nothing to say
                 return None, recordings
             warnings.warn(
-                f"scale factor not fitted from the multi-position runs: {exc}", DataQualityWarning, stacklevel=3
+                f"scale factor not fitted from the multi-position runs: {exc}",
+                DataQualityWarning,
+                stacklevel=user_stacklevel(),
             )
             return None, recordings
     rest = [r for r in recordings if r.reference_rate_dps is None]
@@ -87,7 +89,7 @@ def fit_gyro_triad(
                 "temperature, so their drift with temperature cannot be told from their turn-on biases (one "
                 "constant per run); fit no temperature model, or add runs at rest through a range",
                 DataQualityWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
     return triad, rest
 
