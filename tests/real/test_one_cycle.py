@@ -56,3 +56,22 @@ def test_no_memory_terms_on_real_still_noise_with_one_temperature_curve():
     # 1.5x the noise's in the mean (a cubic, the effect's own form: 1.15x)
     strong = [t for t in trials if t["amplitude_dps"] == 0.5]
     assert np.mean([t["default"] / t["perfect"] for t in strong]) <= 1.5
+
+
+def test_a_kept_model_whose_mean_drift_is_above_the_constants_says_which_rule_kept_it():
+    """Issue #72, item 3: fitted up to the hottest point, gyro_z's poly:2 + lag shows a mean held-out drift of
+    0.091 deg/s against the constant's 0.073 on the two legs; the fit says so, and which rule kept it."""
+    import warnings
+
+    from gyrocomp import fit
+    from gyrocomp.errors import ModelChoiceWarning
+
+    shared_dataset("tofupilot-imu-thermal")
+    run = tofupilot_run()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cal = fit([run.take(np.arange(int(np.argmax(run.temperature_degc)) + 1))])
+    sel = cal.report.selection["gyro_z"]
+    assert sel.chosen_drift > sel.raw_drift
+    said = [str(w.message) for w in caught if w.category is ModelChoiceWarning and "gyro_z: poly" in str(w.message)]
+    assert len(said) == 1 and "is above the constant's" in said[0] and "order test" in said[0], said

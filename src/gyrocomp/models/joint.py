@@ -235,8 +235,14 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
                 stacklevel=user_stacklevel(),
             )
         elif len(sel.folds) == TWO_FOLDS:  # thin evidence: which rule chose, in one line
+            above = (
+                f" (its mean held-out drift, {sel.chosen_drift:.3g} {unit}, is above the constant's "
+                f"{sel.raw_drift:.3g} {unit}, by less than the standard error of their difference over the two legs: the rule above kept it)"
+                if sel.chosen_drift > sel.raw_drift
+                else ""
+            )
             warnings.warn(
-                f"{axis}: {sel.chosen.label}; {sel.decided_by}", ModelChoiceWarning, stacklevel=user_stacklevel()
+                f"{axis}: {sel.chosen.label}; {sel.decided_by}{above}", ModelChoiceWarning, stacklevel=user_stacklevel()
             )
         elif sel.chosen_drift > sel.raw_drift:
             warnings.warn(
