@@ -647,3 +647,25 @@ def test_init_on_a_log_without_a_temperature_points_to_noise_not_fit(tmp_path):
     result = run("init", "still.csv", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert "gyrocomp fit" not in result.stdout and "gyrocomp noise still.csv" in result.stdout
+
+
+def test_init_states_the_units_an_arrays_units_attribute_gives(tmp_path):
+    """Issue #72, item 5: a NetCDF-like HDF5 file whose gyro array says ``mrad/s`` in its units attribute (as the
+    CATS recording's does): init says mrad/s, from the attribute, and writes it; it said rad/s (guessed from the
+    accelerometer's m/s2) while the reader used the attribute."""
+    n = 600
+    rng = np.random.default_rng(2)
+    with h5py.File(tmp_path / "tag.nc", "w") as f:
+        f["timestamp_utc"] = np.arange(n, dtype=float)
+        f["timestamp_utc"].attrs["units"] = np.bytes_(b"seconds since 2021-09-20 08:52:00")
+        f["angular_velocity"] = 3.0 + 0.1 * rng.standard_normal((n, 3))
+        f["angular_velocity"].attrs["units"] = np.bytes_(b"mrad/s")
+        f["acceleration"] = np.array([0.0, 0.0, 9.81]) + 0.01 * rng.standard_normal((n, 3))
+        f["acceleration"].attrs["units"] = np.bytes_(b"m/s2")
+        f["temperature"] = np.linspace(20.0, 30.0, n)
+        f["temperature"].attrs["units"] = np.bytes_(b"C")
+    done = run("init", "tag.nc", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "gyro in mrad/s: its array's units attribute says so" in done.stdout
+    assert "gyro in rad/s" not in done.stdout
+    assert 'gyro-unit = "mrad/s"' in (tmp_path / "gyrocomp.toml").read_text()

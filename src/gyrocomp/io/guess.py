@@ -653,7 +653,11 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     n = min(len(values) for _, values in flat.values())
     table = pa.table({column: np.asarray(values[:n], dtype=float) for column, values in flat.values()})
     named = {channel: column for channel, (column, _) in flat.items()}
-    time_unit, accel_unit, gyro_unit, why = _guessed_units(table, named, stated)
+    # an array's units attribute is what the reader applies: guessed from as a name that says its unit is
+    attributes = {name: str(array.attrs.get("units") or "").split(" since ")[0] for name, array in store.items()}
+    stated_units = tuple(attributes.get(column.split("[", 1)[0], "") for column in table.column_names)
+    time_unit, accel_unit, gyro_unit, why = _guessed_units(*_with_units(table, named, stated_units), stated)
+    why = tuple(w.replace("the column's name says so", "its array's units attribute says so") for w in why)
     units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
     if units:
         reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")
