@@ -669,3 +669,27 @@ def test_init_states_the_units_an_arrays_units_attribute_gives(tmp_path):
     assert "gyro in mrad/s: its array's units attribute says so" in done.stdout
     assert "gyro in rad/s" not in done.stdout
     assert 'gyro-unit = "mrad/s"' in (tmp_path / "gyrocomp.toml").read_text()
+
+
+def test_runs_over_less_than_a_degree_get_their_constants_and_the_fit_says_why(tmp_path):
+    """Issue #72, item 7: a hold whose temperature wanders 0.9 degC while the bias walks: the default fit said
+    nothing of the span and fitted poly + branch terms to the drift, while `check` promised that the automatic
+    choice fits a constant. Now both say the span, and the fit keeps the constants."""
+    rng = np.random.default_rng(0)
+    n = 18000
+    t = np.arange(n) / 10.0
+    walk = np.cumsum(rng.normal(0.0, 1.0, (n, 3)), axis=0) * 2e-4
+    gyro = 0.01 + walk + rng.normal(0.0, 0.005 * np.sqrt(10.0), (n, 3))
+    table = {"time": t, **{f"gyro_{a}": gyro[:, k] for k, a in enumerate("xyz")}}
+    pd.DataFrame({**table, "temperature": 25.0 + 0.46 * np.sin(t / 300.0)}).to_csv(tmp_path / "hold.csv", index=False)
+    checked = run("check", "hold.csv", cwd=tmp_path)
+    assert "span 0.92 degC, less than 1 degC" in checked.stdout + checked.stderr
+    assert "the automatic choice fits a constant bias" in checked.stdout + checked.stderr
+    done = run("fit", "hold.csv", "-o", "m.json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "the runs span 0.92 degC, less than 1 degC" in done.stderr
+    assert "fits each run's constant alone" in done.stderr
+    model = json.loads((tmp_path / "m.json").read_text())
+    assert all(ax["temperature"] is None and ax["hysteresis"] is None for ax in model["axes"].values())
+    asked = run("fit", "hold.csv", "--temperature", "poly:2", "-o", "asked.json", cwd=tmp_path)
+    assert asked.returncode == 2 and "accept" in asked.stderr and "temperature-span" in asked.stderr

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..effects import find_turns, g_sensitivity_offset, thermal_lag
-from ..errors import InputError, ModelChoiceWarning, user_stacklevel
+from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, user_stacklevel
 from ..calibration.fit_report import (
     THIN_FOLDS,
     AxisFit,
@@ -23,6 +23,7 @@ from ..calibration.fit_report import (
     NetworkReport,
 )
 from ..measures.plausibility import calibration_concerns, temperature_span_concern
+from ..measures.data_check import MIN_SPAN_DEGC
 from ..runs.prepared import PreparedRun, fit_axes, prepare
 from ..recording import Recording
 from ..fitting.acceleration import acceleration_report, excited_columns, fit_g_sensitivity, turned_between_positions
@@ -37,7 +38,18 @@ from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
 from ..fitting.selection import FOLD_RATE_SMOOTHINGS_S, AxisSelection, prepare_axis
 from ..fitting.polynomial_model import PolynomialTemperatureModel
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, fit_accel_triad, fit_gyro_triad, spanning_poses  # noqa: F401
-from .options import Acceleration, Curve, FitOptions, FoldChoice, Memory, Network, Polynomial, Target, curve_candidates
+from .options import (
+    Acceleration,
+    Curve,
+    CurveCandidates,
+    FitOptions,
+    FoldChoice,
+    Memory,
+    Network,
+    Polynomial,
+    Target,
+    curve_candidates,
+)
 from ..fitting.thermal import (
     CANDIDATES,
     LAG_EVIDENCE_CHI2,
@@ -296,6 +308,17 @@ def _fit_selected(recordings: list[Recording], options: FitOptions, accel_mode: 
     chosen model on all runs."""
     offered = curve_candidates(options.temperature, options.target)
     memories = tuple(CANDIDATES) if options.hysteresis == "auto" else (options.hysteresis,)
+    span = combined_span_degc(recordings)
+    if offered.do_no_harm and span is not None and span < MIN_SPAN_DEGC:
+        # over less than a degree a curve (and a memory of the temperature's path) follows the drift in time
+        warnings.warn(
+            f"{recordings[0].source}: the runs span {span:.3g} degC, less than {MIN_SPAN_DEGC:g} degC: a temperature "
+            "curve over so little follows the drift in time, not the temperature; the automatic choice fits each "
+            "run's constant alone (ask for a curve by name to fit one over this span anyway)",
+            DataQualityWarning,
+            stacklevel=user_stacklevel(),
+        )
+        offered, memories = CurveCandidates((0,), (), True), ("none",)
     h_orders = (
         tuple(range(1, MAX_HYSTERESIS_ORDER + 1))
         if options.hysteresis_order == "auto"
@@ -328,6 +351,17 @@ def _fit_selected(recordings: list[Recording], options: FitOptions, accel_mode: 
         thermal = _fit_chosen(recordings, selections, options, accel_mode)
     _warn_about_choice(selections)
     return selections, thermal
+
+
+def combined_span_degc(recordings: list[Recording]) -> float | None:
+    """The temperature range of all the runs together [degC] (highest minus lowest finite reading), None without a
+    temperature."""
+    temps = [np.asarray(r.temperature_degc, dtype=float).ravel() for r in recordings if r.temperature_degc is not None]
+    finite = [t[np.isfinite(t)] for t in temps]
+    finite = [t for t in finite if t.size]
+    if not finite:
+        return None
+    return float(max(t.max() for t in finite) - min(t.min() for t in finite))
 
 
 def _refuse_what_cannot_be_judged(recordings: list[Recording], selections: dict[str, AxisSelection]) -> None:
