@@ -249,7 +249,8 @@ def test_guessing_from_names_and_magnitudes(tmp_path):
         "accel_z": "AccZ",
         "temperature": "Temp",
     }
-    assert (layout.time_unit, layout.accel_unit, layout.gyro_unit, layout.delimiter) == ("ms", "g", "deg/s", ";")
+    # the separator (;) is told from the file by every reader too: the layout does not pin it
+    assert (layout.time_unit, layout.accel_unit, layout.gyro_unit, layout.delimiter) == ("ms", "g", "deg/s", None)
     assert any("50 Hz in ms" in r for r in guess.reasons)
     named = _log(
         tmp_path / "n.csv",
@@ -323,7 +324,7 @@ def test_an_xsens_export_with_its_comment_lines_and_sample_time_fine(tmp_path):
     (tmp_path / "MT_0001.txt").write_text(preamble + header + "\n".join(rows) + "\n")
     guess = guess_layout(tmp_path / "MT_0001.txt")
     assert guess.layout.columns["time"] == "SampleTimeFine" and guess.layout.time_unit == "100 us"
-    assert guess.layout.delimiter == "\t" and guess.unused == ("PacketCounter",)
+    assert guess.layout.delimiter is None and guess.unused == ("PacketCounter",)  # the tabs told by the reader
     as_written = np.round(gyro[:, 0], 6) * 180.0 / np.pi  # 6 decimals
     _init_then_allan_reads(tmp_path, "MT_0001.txt", "gyro_x", as_written, rate_hz)
     counted = "\n".join(r.split("\t", 2)[0] + "\t" + r.split("\t", 2)[2] for r in rows)
@@ -453,10 +454,11 @@ def test_a_spreadsheet_export_of_a_decimal_comma_locale_in_windows_1252_is_guess
     for folder in (tmp_path, tmp_path / "utf8"):
         applied = run("apply", tmp_path / "m.json", "cp1252.csv", "-o", "out.csv", cwd=folder)
         assert applied.returncode == 0, applied.stderr
-    out = (tmp_path / "out.csv").read_bytes()
+    out = (tmp_path / "out.csv").read_bytes()  # a .csv name: commas and decimal points (issue #72, item 8)
     assert (
-        out.decode("utf-8").startswith("time [s];gyro x [°/s]") and out == (tmp_path / "utf8" / "out.csv").read_bytes()
+        out.decode("utf-8").startswith("time [s],gyro x [°/s]") and out == (tmp_path / "utf8" / "out.csv").read_bytes()
     )
+    assert run("check", "out.csv", cwd=tmp_path).returncode == 0  # the project file reads its output back
 
 
 def test_a_log_timed_by_dates_and_times_is_guessed_in_seconds_and_compensated_by_its_project(tmp_path):
@@ -508,7 +510,7 @@ def test_init_reads_a_line_of_units_under_the_header_and_refuses_a_chosen_column
 
 def test_a_table_of_aligned_columns_goes_through_init_fit_and_apply(tmp_path):
     """A text table whose columns are aligned by runs of spaces (Fortran's, MATLAB's save -ascii with a header
-    line added, many instruments'): init writes its separator, the commands read it, `--delimiter space` names
+    line added, many instruments'): the commands tell its separator (init need not write it), `--delimiter space` names
     it, and apply writes the rows back separated by spaces, its values those of the same rows as a CSV."""
     rng = np.random.default_rng(12)
     n = 1500
@@ -524,7 +526,7 @@ def test_a_table_of_aligned_columns_goes_through_init_fit_and_apply(tmp_path):
         ",".join(names) + "\n" + "".join(",".join(map(repr, r)) + "\n" for r in rows)
     )
     assert run("init", "run.dat", cwd=tmp_path).returncode == 0
-    assert 'delimiter = " "' in (tmp_path / "gyrocomp.toml").read_text()
+    assert "delimiter" not in (tmp_path / "gyrocomp.toml").read_text()  # the reader tells the spaces itself
     fitted = run("fit", "run.dat", "-o", "m.json", "--temperature", "poly:1", cwd=tmp_path)
     assert fitted.returncode == 0, fitted.stderr
     applied = run("apply", "m.json", "run.dat", "-o", "out.dat", cwd=tmp_path)
@@ -693,3 +695,32 @@ def test_runs_over_less_than_a_degree_get_their_constants_and_the_fit_says_why(t
     assert all(ax["temperature"] is None and ax["hysteresis"] is None for ax in model["axes"].values())
     asked = run("fit", "hold.csv", "--temperature", "poly:2", "-o", "asked.json", cwd=tmp_path)
     assert asked.returncode == 2 and "accept" in asked.stderr and "temperature-span" in asked.stderr
+
+
+def test_apply_to_a_csv_name_writes_commas_after_init_on_a_tab_separated_log(tmp_path):
+    """Issue #72, item 8: init on a tab-separated .txt log pinned ``delimiter = "tab"`` in the project file, and
+    ``apply -o out.csv`` then wrote tabs into out.csv. The reader tells the tabs itself, so init writes no separator,
+    and a .csv output is written with commas (a separator given by hand still carries to the output)."""
+    n = 3000
+    t = np.arange(n) / 10.0
+    temperature = 20.0 + 30.0 * np.sin(t / 100.0)
+    rng = np.random.default_rng(3)
+    frame = pd.DataFrame(
+        {
+            "Time (s)": t,
+            **{f"Gyro {a.upper()} (dps)": 0.01 * temperature + 0.01 * rng.standard_normal(n) for a in "xyz"},
+            "Temp (C)": temperature,
+        }
+    )
+    frame.to_csv(tmp_path / "log.txt", sep="\t", index=False)
+    assert run("init", "log.txt", cwd=tmp_path).returncode == 0
+    assert "delimiter" not in (tmp_path / "gyrocomp.toml").read_text()
+    assert run("fit", "log.txt", "-o", "m.json", cwd=tmp_path).returncode == 0
+    done = run("apply", "m.json", "log.txt", "-o", "out.csv", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "out.csv").read_text().splitlines()[0].startswith("Time (s),Gyro X (dps),")
+    again = run("apply", "m.json", "out.csv", "-o", "twice.tsv", cwd=tmp_path)  # the project reads its own output
+    assert again.returncode == 0, again.stderr
+    given = run("apply", "m.json", "log.txt", "-o", "given.csv", "--delimiter", "tab", cwd=tmp_path)
+    assert given.returncode == 0, given.stderr
+    assert "\t" in (tmp_path / "given.csv").read_text().splitlines()[0]

@@ -483,7 +483,6 @@ def guess_layout(
         gyro_unit=gyro_unit,
         accel_unit=accel_unit,
         time_unit=time_unit,
-        delimiter=delimiter,
         names=check.names,
         rate_hz=check.rate_hz,
     )

@@ -29,14 +29,16 @@ class TextFormat:
     """How a text table separates its fields and writes its decimal point (``delimiter`` one of ``,``, ``;``, a
     tab, or :data:`SPACE` for runs of spaces and tabs; ``decimal`` ``.`` or ``,``), how many lines before its header are a preamble that is skipped
     (``preamble_lines``: a logger's metadata such as ``Fs,100``; :func:`preamble_lines`), its text's encoding
-    (:func:`text_encoding`), and the fields of a line of units under its header, skipped (``units``:
-    :func:`units_line`; None without one)."""
+    (:func:`text_encoding`), the fields of a line of units under its header, skipped (``units``:
+    :func:`units_line`; None without one), and whether the reading options named the separator or the decimal
+    point rather than the file's first bytes telling them (``given``)."""
 
     delimiter: str = ","
     decimal: str = "."
     preamble_lines: int = 0
     encoding: str = "utf-8"
     units: tuple[str, ...] | None = None
+    given: bool = False
 
     @classmethod
     def found(cls, head: bytes, layout: "TableLayout") -> "TextFormat":
@@ -49,7 +51,8 @@ class TextFormat:
         if skipped or units is not None:  # the decimal point told from the first row, not a preamble's or the units'
             lines = head.split(b"\n")
             decimal = sniff_csv(b"\n".join([lines[skipped], *lines[skipped + 1 + (units is not None) :]]))[1]
-        return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head), units)
+        given = bool(layout.delimiter or layout.decimal)
+        return cls(delimiter, layout.decimal or decimal, skipped, text_encoding(head), units, given)
 
     @property
     def spaced(self) -> bool:
@@ -165,10 +168,11 @@ def header_line(text_format: TextFormat | None) -> int:
 
 
 def output_text_format(path: str | os.PathLike, source: TextFormat | None = None) -> TextFormat:
-    """The format an output text table is written in: a ``.tsv`` name means tabs; otherwise the input's format
-    (``source``), so that the next command reading the output with the same project file reads it; a comma and a
-    decimal point where there is no input table. A decimal comma is kept only beside another separator. What gyrocomp
-    writes is UTF-8, whatever the input's encoding."""
+    """The format an output text table is written in: a ``.tsv`` name means tabs, a ``.csv`` name commas and a
+    decimal point, unless the reading options named the input's separator or decimal point (``source.given``: then
+    the input's format, so that the next command reading the output with the same options reads it); any other
+    name, the input's format (``source``); a comma and a decimal point where there is no input table. A decimal
+    comma is kept only beside another separator. What gyrocomp writes is UTF-8, whatever the input's encoding."""
     name = Path(path).name.lower()
     for compressed in COMPRESSED_SUFFIXES:
         name = name.removesuffix(compressed)
@@ -179,6 +183,8 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
     )
     if name.endswith(".tsv"):
         return TextFormat("\t", base.decimal)
+    if name.endswith(".csv") and not base.given:
+        return TextFormat()
     return base if base.delimiter != "," or base.decimal == "." else TextFormat()
 
 
