@@ -115,7 +115,12 @@ def test_model_file_keeps_g_and_old_files_upgrade(consumer, tmp_path):
     d = json.loads((tmp_path / "m.json").read_text())
     d["schema_version"] = 2  # what schema 3 and later added, taken out (a file of schema 2 holds none of it)
     for ax in d["axes"].values():
-        del ax["g_sensitivity_dps_per_g"], ax["g_squared_dps_per_g2"], ax["acceleration_network"]
+        del (
+            ax["g_sensitivity_dps_per_g"],
+            ax["g_squared_dps_per_g2"],
+            ax["acceleration_network"],
+            ax["temperature_rate"],
+        )
     for key in ("accel_axes", "accel_reference_degc", "gyro_triad", "accel_triad"):
         del d[key]
     (tmp_path / "v2.json").write_text(json.dumps(d))
