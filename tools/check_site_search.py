@@ -17,10 +17,12 @@ from browser import FLAGS, chromium as find_chromium  # tools/browser.py, beside
 
 #: words every build of the site must find (pages on the fit, the noise, the errors)
 WORDS = ("allan", "hysteresis", "symbolic")
+#: what a user types after a message, and the page that must come first for it
+FIRST = {"no such file": "errors.html"}
 
 
-def results(site: Path, word: str, chromium: str) -> int:
-    """How many documents Material's search says match ``word`` on the site opened from files."""
+def search_page(site: Path, word: str, chromium: str) -> str:
+    """The DOM of the site's index opened from files with Material's search for ``word``."""
     with tempfile.TemporaryDirectory() as profile:
         dom = subprocess.run(
             [
@@ -35,6 +37,18 @@ def results(site: Path, word: str, chromium: str) -> int:
             text=True,
             timeout=120,
         ).stdout
+    return dom
+
+
+def first_result(site: Path, words: str, chromium: str) -> str | None:
+    """The address of the first document Material's search lists for ``words`` (relative to the site), or None."""
+    found = re.search(r'<a href="([^"]*)" class="md-search-result__link"', search_page(site, words, chromium))
+    return None if found is None else found.group(1)
+
+
+def results(site: Path, word: str, chromium: str) -> int:
+    """How many documents Material's search says match ``word`` on the site opened from files."""
+    dom = search_page(site, word, chromium)
     found = re.search(r"md-search-result__meta\">\s*(\d+|One|No) matching document", dom)
     if not found:
         return 0
@@ -50,6 +64,11 @@ def main() -> int:
     failed = [w for w in WORDS if results(site, w, chromium) == 0]
     for word in WORDS:
         print(f"search from file:// for {word!r}: {'nothing found' if word in failed else 'found'}")
+    for words, page in FIRST.items():
+        first = first_result(site, words.replace(" ", "+"), chromium)
+        ok = first is not None and page in first
+        print(f"search from file:// for {words!r}: first {first!r} ({'as expected' if ok else f'expected {page}'})")
+        failed += [] if ok else [words]
     return 1 if failed else 0
 
 
