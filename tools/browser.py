@@ -42,6 +42,16 @@ _FIGURES_JS = """JSON.stringify(Array.from(document.querySelectorAll('img, svg, 
           width: r.width, height: r.height, complete: e.complete === undefined ? true : e.complete};
 }))"""
 
+#: the first screen a reader sees: a laptop's browser window [px]
+SCREEN_PX = (1280, 900)
+#: each section and table as laid out on that screen: its section's id, caption, top and bottom [px]
+_LAYOUT_JS = """JSON.stringify(Array.from(document.querySelectorAll('section, table')).map(e => {
+  const r = e.getBoundingClientRect(), s = e.closest('section');
+  const caption = e.tagName === 'TABLE' && e.caption ? e.caption.textContent : '';
+  return {tag: e.tagName, section: s ? s.id : '', caption: caption, top: r.top + window.scrollY,
+          bottom: r.bottom + window.scrollY, text: e.tagName === 'TABLE' ? e.innerText : ''};
+}))"""
+
 
 def chromium() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
@@ -57,6 +67,12 @@ class PageSeen:
     pdf: bytes
     pdf_pages: int
     height_px: float
+    #: each section and table laid out in a window of SCREEN_PX (section, caption, top, bottom [px], a table's text)
+    layout: tuple[dict, ...] = ()
+
+    def on_first_screen(self) -> tuple[dict, ...]:
+        """The sections and tables wholly inside the first screen (their bottom above SCREEN_PX's height)."""
+        return tuple(e for e in self.layout if e["bottom"] <= SCREEN_PX[1])
 
     def pages_expected(self) -> tuple[int, int]:
         """The fewest and most pages the page's printed height gives on Letter with Chromium's default margins
@@ -139,6 +155,13 @@ def open_page(path: str | os.PathLike, timeout_s: float = 60.0) -> PageSeen:
             pipe.wait_for("Page.loadEventFired", timeout_s)
             seen = pipe.send("Runtime.evaluate", {"expression": _FIGURES_JS, "returnByValue": True}, session=session)
             figures = tuple(json.loads(seen["result"]["value"]))
+            pipe.send(
+                "Emulation.setDeviceMetricsOverride",
+                {"width": SCREEN_PX[0], "height": SCREEN_PX[1], "deviceScaleFactor": 1, "mobile": False},
+                session=session,
+            )
+            laid = pipe.send("Runtime.evaluate", {"expression": _LAYOUT_JS, "returnByValue": True}, session=session)
+            layout = tuple(json.loads(laid["result"]["value"]))
             # the height as printed: print media at the printable width of a Letter page (0.4 in margins)
             pipe.send("Emulation.setEmulatedMedia", {"media": "print"}, session=session)
             pipe.send(
@@ -161,7 +184,7 @@ def open_page(path: str | os.PathLike, timeout_s: float = 60.0) -> PageSeen:
             process.wait()
             os.close(to_chrome_w)
             os.close(from_chrome_r)
-    return PageSeen(errors, figures, pdf, pdf_page_count(pdf), float(height))
+    return PageSeen(errors, figures, pdf, pdf_page_count(pdf), float(height), layout)
 
 
 def _errors(events: list[dict]) -> list[str]:

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from ..conftest import run
+from ..conftest import browser, run
 
 
 @pytest.mark.slow
@@ -71,12 +71,17 @@ def test_demo(tmp_path):
     report = (tmp_path / "demo" / "report.html").read_text()
     assert report.startswith("<!DOCTYPE html>") and "heldout_run.csv" in report and "data:image/png;base64," in report
     assert "report.html (open it in a browser)" in r.stdout
-    # the page opens with the case where compensation matters, its factor against PX4's cubic read from the page
-    # itself, every ratio written the same way round ("N x less drift than ...")
+    # the page opens with what this model bought on its own held-out run (raw, gyrocomp and the cubics), then the
+    # case where compensation matters, its factor against PX4's cubic read from the page itself, every ratio
+    # written the same way round ("N x less drift than ...")
     first = report[report.index("<section") :]
-    assert first.startswith('<section id="case"><h2>Where compensation matters</h2>')
-    opening = re.search(r"gyrocomp's default leaves <b>([0-9.]+)x less drift than PX4 cubic", first)
-    assert opening and float(opening.group(1)) >= 5.0, first[:400]  # measured 12.1x
+    assert first.startswith('<section id="this-model"><h2>This model on its held-out run</h2>')
+    case = report[report.index('<section id="case">') :]
+    assert case.startswith('<section id="case"><h2>Another part, where compensation matters: the consumer</h2>')
+    opening = re.search(r"gyrocomp's default leaves <b>([0-9.]+)x less drift than PX4 cubic", case)
+    assert opening and float(opening.group(1)) >= 5.0, case[:400]  # measured 12.1x
+    # the g-sensitivity of a held-out run at one attitude is not drawn as panels of one point each
+    assert "hold their static positions at one attitude" in report
     assert not re.search(r"\d\.\d+x (?!less drift than|more drift than)", report[: report.index('id="summary"')])
     # the case where gyrocomp's models matter, against the simulator's truth, and the one where they do not
     cases = json.loads((tmp_path / "demo" / "cases.json").read_text())
@@ -92,6 +97,14 @@ def test_demo(tmp_path):
         in r.stdout
     )
     assert "case_consumer.png" in names
+    if browser.chromium() is not None:  # the first screen, as a browser lays the page out
+        seen = browser.open_page(tmp_path / "demo" / "report.html")
+        shown = seen.on_first_screen()
+        tables = [e for e in shown if e["tag"] == "TABLE" and e["section"] == "this-model"]
+        assert tables, seen.layout[:4]
+        drift = tables[0]["text"]
+        assert all(name in drift for name in ("raw", "gyrocomp", "PX4 cubic", "ArduPilot cubic")), drift
+        assert not any(e["section"] == "case" and e["tag"] == "TABLE" for e in shown)
 
 
 def test_demo_without_matplotlib_says_why_there_is_no_report(tmp_path, monkeypatch):

@@ -40,6 +40,7 @@ from ..measures.noise import analyse_noise
 from ..measures.noise_model import noise_model
 from ..recording import ACCEL_AXES, Recording
 from ..rounding import with_error
+from ..fitting.gsensitivity import EXCITATION_G
 from ..motion.positions import static_segments
 from ..motion.stillness import detect_still
 from ..models.field import moves_most_of_the_time
@@ -456,8 +457,15 @@ def _g_sensitivity(calibration: Calibration, runs: list[Recording], min_static_s
             ["gyro axis", "accel_x", "accel_y", "accel_z"], rows, "g-sensitivity matrix G [deg/s/g] +- standard error"
         )
     ]
-    if positions:
+    spread = max((float(np.max(np.std(g, axis=0))) for g, _ in positions.values()), default=0.0)
+    if positions and spread > EXCITATION_G:
         body.append(figure_html(figures.g_sensitivity_plot(positions, g_matrix), "g-sensitivity"))
+    elif positions:
+        body.append(
+            f"<p class=note>The runs judged here hold their static positions at one attitude (gravity spread under "
+            f"{EXCITATION_G:g} g along every axis): no slope of the bias against gravity to draw. G was fitted on "
+            "the calibration runs' positions.</p>"
+        )
     else:
         body.append("<p class=note>These runs have no static positions to draw.</p>")
     return "\n".join(body)
