@@ -184,10 +184,8 @@ def test_the_project_file_is_switched_off_by_no_config_and_its_variable(tmp_path
         "time,gyro_z,temperature\n" + "".join(f"{k},{0.1 + 0.01 * (k % 5)},{25 + k / 20}\n" for k in range(200))
     )
     (tmp_path / "gyrocomp.toml").write_text("[read]\ncolumns = 'gyro_z=GyrZ'\n")  # wrong for run.csv
-    assert (
-        "no column 'GyrZ'"
-        in run("check", "run.csv", cwd=tmp_path).stderr + run("check", "run.csv", cwd=tmp_path).stdout
-    )
+    # a table in gyrocomp's own layout that the project file does not describe is read in that layout, said so
+    assert "run.csv: read in gyrocomp's own layout" in run("check", "run.csv", cwd=tmp_path).stderr
     for args, env in ((["--no-config"], {}), ([], {"GYROCOMP_NO_CONFIG": "1"})):
         result = subprocess.run(
             [str(SCRIPT), *args, "check", "run.csv"], capture_output=True, text=True, cwd=tmp_path,
@@ -454,9 +452,9 @@ def test_a_spreadsheet_export_of_a_decimal_comma_locale_in_windows_1252_is_guess
     for folder in (tmp_path, tmp_path / "utf8"):
         applied = run("apply", tmp_path / "m.json", "cp1252.csv", "-o", "out.csv", cwd=folder)
         assert applied.returncode == 0, applied.stderr
-    out = (tmp_path / "out.csv").read_bytes()  # a .csv name: commas and decimal points (issue #72, item 8)
+    out = (tmp_path / "out.csv").read_bytes()  # a .csv of semicolons stays one (the locale's convention)
     assert (
-        out.decode("utf-8").startswith("time [s],gyro x [°/s]") and out == (tmp_path / "utf8" / "out.csv").read_bytes()
+        out.decode("utf-8").startswith("time [s];gyro x [°/s]") and out == (tmp_path / "utf8" / "out.csv").read_bytes()
     )
     assert run("check", "out.csv", cwd=tmp_path).returncode == 0  # the project file reads its output back
 
@@ -724,3 +722,39 @@ def test_apply_to_a_csv_name_writes_commas_after_init_on_a_tab_separated_log(tmp
     given = run("apply", "m.json", "log.txt", "-o", "given.csv", "--delimiter", "tab", cwd=tmp_path)
     assert given.returncode == 0, given.stderr
     assert "\t" in (tmp_path / "given.csv").read_text().splitlines()[0]
+
+
+def test_split_then_fit_after_init_on_a_log_in_its_own_layout(tmp_path):
+    """Issue #72, item 4: after init on a NetCDF log (its arrays and units in gyrocomp.toml), split writes gyrocomp's
+    own tables, and fit on them failed on the project file's mapping ('accel=acceleration: a table has one column
+    per axis'). A table the project file does not describe but gyrocomp's names do is read in gyrocomp's layout,
+    said in a note; one of the project's columns is read with them; one that neither describes gets the error."""
+    n = 4000
+    rng = np.random.default_rng(5)
+    temperature = np.concatenate([np.linspace(10.0, 30.0, n // 2), np.linspace(30.0, 10.0, n - n // 2)])
+    with h5py.File(tmp_path / "tag.nc", "w") as f:
+        f["timestamp_utc"] = np.arange(n, dtype=float)
+        f["timestamp_utc"].attrs["units"] = np.bytes_(b"seconds since 2021-09-20 08:52:00")
+        gyro = 2.0 + 0.05 * (temperature - 20.0)[:, None] + 0.1 * rng.standard_normal((n, 3))
+        f["angular_velocity"] = gyro  # mrad/s
+        f["angular_velocity"].attrs["units"] = np.bytes_(b"mrad/s")
+        f["acceleration"] = np.array([0.0, 0.0, 9.81]) + 0.01 * rng.standard_normal((n, 3))
+        f["acceleration"].attrs["units"] = np.bytes_(b"m/s2")
+        f["temperature"] = temperature
+        f["temperature"].attrs["units"] = np.bytes_(b"C")
+    assert run("init", "tag.nc", cwd=tmp_path).returncode == 0
+    split = run("split", "tag.nc", "--by", "temperature-turn", "-o", "parts", cwd=tmp_path)
+    assert split.returncode == 0, split.stderr
+    parts = sorted(p.name for p in (tmp_path / "parts").iterdir())
+    done = run("fit", *[f"parts/{p}" for p in parts], "-o", "m.json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert f"parts/{parts[0]}: read in gyrocomp's own layout" in done.stderr
+    model = json.loads((tmp_path / "m.json").read_text())
+    assert model["units"]["gyro"] == "deg/s"
+    # the log itself is still read through the project file, without a note
+    again = run("check", "tag.nc", cwd=tmp_path)
+    assert again.returncode == 0 and "gyrocomp's own layout" not in again.stderr
+    # a table neither the project's mapping nor gyrocomp's names describe: the project's error stands
+    pd.DataFrame({"a": [1.0, 2.0], "b": [3.0, 4.0]}).to_csv(tmp_path / "other.csv", index=False)
+    refused = run("check", "other.csv", cwd=tmp_path)
+    assert refused.returncode == 1 and "refused" in refused.stdout and "own layout" not in refused.stderr

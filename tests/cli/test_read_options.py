@@ -41,11 +41,12 @@ def test_mapping_and_units_through_cli(workdir, tmp_path):
 
 def test_a_tab_separated_export_with_decimal_commas_reads_with_or_without_options(tmp_path):
     (tmp_path / "v.txt").write_text("Time\tGyro_Z\tTemperature\n0\t1,5\t20,5\n1\t2,5\t21\n2\t3\t22\n")
-    for extra in ([], ["--delimiter", "tab", "--decimal", ","]):
+    for extra, sep, decimal in (([], ",", "."), (["--delimiter", "tab", "--decimal", ","], "\t", ",")):
         r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", *extra)
         assert r.returncode == 0, r.stderr
-        # the canonical columns, in the input's separator and decimal point (the next command reads it as it read v.txt)
-        out = pd.read_csv(tmp_path / "o.csv", sep="\t", decimal=",")
+        # the canonical columns; a .csv name gets commas, unless the options named the input's format (then that,
+        # so that the next command given them reads it as it read v.txt)
+        out = pd.read_csv(tmp_path / "o.csv", sep=sep, decimal=decimal)
         assert list(out["gyro_z"]) == [1.5, 2.5, 3.0] and list(out["temperature"]) == [20.5, 21.0, 22.0]
     r = run("convert", tmp_path / "v.txt", tmp_path / "o.csv", "--decimal", ":")
     assert r.returncode == 2 and r.stderr.strip() == "gyrocomp: error: --decimal: ':'; use '.' or ','"

@@ -65,7 +65,7 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopi
         analysis = analyse_noise_file(
             input_path,
             named,
-            options=read_settings(opts),
+            options=read_settings(opts, path=input_path),
             fmt=opts["fmt"],
             with_accel=bool(kalibr),
             kind=kind,

@@ -91,7 +91,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **
             calibration,
             input_path,
             output,
-            options=read_settings(opts),
+            options=read_settings(opts, path=input_path),
             fmt=opts["fmt"],
             out_fmt=out_fmt,
             axes=named,

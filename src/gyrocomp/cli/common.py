@@ -16,6 +16,7 @@ from ..errors import InputError, printable
 from ..option_spelling import Spelling, from_values, spelled_fields
 from .projectfile import ReadingOption
 from ..io import ReadOptions, format_spelling, read_input
+from ..io.tables import layout_fits, table_header
 from ..io.atomic import check_output_file
 from ..files.chunks import read_whole
 from ..curves.network import DEFAULT_HIDDEN
@@ -175,26 +176,65 @@ def progress_bar(description: str, indeterminate: bool = False):
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
 
-def read_settings(opts: dict, channels: tuple[str, ...] | None = None) -> ReadOptions:
+def read_settings(opts: dict, channels: tuple[str, ...] | None = None, path=None) -> ReadOptions:
     """The :class:`ReadOptions` the common reading options (``pop_read_options``) give; ``channels``: a table's
-    channels to read (None: all)."""
+    channels to read (None: all). With ``path``, those for that file (:func:`settings_for`)."""
+    if path is not None:
+        return settings_for(path, opts, channels)
     return from_values(ReadOptions, {**opts, "channels": channels})
+
+
+#: the key of a command's reading options (``pop_read_options``) that names those its project file set
+FROM_PROJECT = "set by the project file"
+
+
+def settings_for(path, opts: dict, channels: tuple[str, ...] | None = None) -> ReadOptions:
+    """The reading options for the file ``path``: those of ``opts``; but a table that the project file's reading
+    options do not describe (none of the columns they map, or a mapping a table cannot take) while gyrocomp's own
+    names do (a table gyrocomp wrote: ``split``'s, ``convert``'s) is read without what the project file set, and a
+    note says so. A table that neither describes is read with ``opts``, whose error names what is missing."""
+    settings = read_settings(opts, channels)
+    set_there = opts.get(FROM_PROJECT, ())
+    header = table_header(path) if set_there else None
+    if header is None or layout_fits(header, settings.layout, path):
+        return settings
+    own = read_settings({**opts, **dict.fromkeys(set_there)}, channels)  # None: the field's default
+    if not layout_fits(header, own.layout, path):
+        return settings
+    ctx = click.get_current_context(silent=True)
+    if not (ctx and ctx.find_root().obj and ctx.find_root().obj.get("quiet")):
+        flags = ", ".join(f"--{k.replace('_', '-')}" for k in set_there)
+        echo(
+            f"gyrocomp: note: {path}: read in gyrocomp's own layout (time, gyro_x ... in s, deg/s): the project "
+            f"file's {flags} describe other files (this one has none of the columns they name)",
+            err=True,
+        )
+    return own
 
 
 def read_run(path, opts: dict, channels: tuple[str, ...] | None = None):
     with progress_bar(f"reading {Path(path).name}") as progress:
-        return read_input(path, read_settings(opts, channels), fmt=opts["fmt"], progress=progress)
+        return read_input(path, settings_for(path, opts, channels), fmt=opts["fmt"], progress=progress)
 
 
 def read_whole_run(path, opts: dict):
     """A run for a command that needs its whole recording (``.recording``; a fit): a large file gathered from its
     chunks into temporary files (:func:`gyrocomp.files.chunks.read_whole`), so its size is not the memory's."""
     with progress_bar(f"reading {Path(path).name}") as progress:
-        return read_whole(path, read_settings(opts), fmt=opts["fmt"], progress=progress)
+        return read_whole(path, settings_for(path, opts), fmt=opts["fmt"], progress=progress)
 
 
 def pop_read_options(kwargs: dict) -> dict:
-    return {k: kwargs.pop(k) for k in READ_OPTIONS}
+    """The reading options of a command's parameters, and (under :data:`FROM_PROJECT`) the names of those the
+    project file set."""
+    opts = {k: kwargs.pop(k) for k in READ_OPTIONS}
+    ctx = click.get_current_context(silent=True)
+    opts[FROM_PROJECT] = tuple(
+        k
+        for k in READ_OPTIONS
+        if ctx is not None and ctx.get_parameter_source(k) is click.core.ParameterSource.DEFAULT_MAP
+    )
+    return opts
 
 
 def parse_hidden(text: str) -> tuple[int, ...]:

@@ -38,7 +38,12 @@ def convert(ctx, input_path, output, **kwargs):
     out_fmt = output_format(output, option="OUT")
     with progress_bar(f"reading {Path(input_path).name}") as progress:
         result = convert_file(
-            input_path, output, options=read_settings(opts), fmt=opts["fmt"], out_fmt=out_fmt, progress=progress
+            input_path,
+            output,
+            options=read_settings(opts, path=input_path),
+            fmt=opts["fmt"],
+            out_fmt=out_fmt,
+            progress=progress,
         )
     rows, duration_s, rate_hz, gaps, channels = (
         result.rows,

@@ -196,7 +196,7 @@ def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, ra
                     evaluate_file(
                         calibration,
                         path,
-                        options=read_settings(opts),
+                        options=read_settings(opts, path=path),
                         fmt=opts["fmt"],
                         window_s=window_s,
                         turn_on_window_s=turn_on_window_s,

@@ -104,7 +104,7 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
                     analyse_noise_file(
                         path,
                         named,
-                        options=read_settings(opts),
+                        options=read_settings(opts, path=path),
                         fmt=opts["fmt"],
                         with_accel=named is None,
                         split_gaps=split_gaps,

@@ -65,8 +65,9 @@ from .common import FINITE, pop_read_options, read_options, read_run, echo
 @click.pass_context
 def split(ctx, log, folder, by, min_gap_s, min_still_s, min_leg_degc, suffix, **kwargs):
     """Cut LOG into runs, one file each, so that a recording of several power-ons, poses or temperature legs
-    becomes the runs a fit takes. A table's runs keep its columns, units, separator and decimal point (the
-    project file that reads the log reads them); any other log's are written in canonical columns."""
+    becomes the runs a fit takes. A table's runs keep its columns and units (the project file that reads the
+    log reads them), a text table's separator where the runs' names allow (a .csv run: commas or semicolons); any other log's
+    are written in canonical columns."""
     opts = pop_read_options(kwargs)
     data = read_run(log, opts)
     recording = data.recording

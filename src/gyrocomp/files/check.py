@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..io import ReadOptions
@@ -58,14 +58,14 @@ def _noted(read, path: str | os.PathLike) -> CheckedRun:
 
 def check_files(
     paths: Sequence[str | os.PathLike],
-    options: ReadOptions | None = None,
+    options: ReadOptions | Callable[[str | os.PathLike], ReadOptions] | None = None,
     fmt: str | None = None,
     ask: Ask | None = None,
     accept: Iterable[str] = (),
 ) -> tuple[list[CheckedRun], list[RunCheck]]:
     """Read and check ``paths`` as one set of runs (one unit's): the runs as read and their checks (``ask``:
-    default, ``gyrocomp fit``'s defaults)."""
-    runs = [read_checked(p, options, fmt) for p in paths]
+    default, ``gyrocomp fit``'s defaults). ``options``: the reading options, or a function giving each path's."""
+    runs = [read_checked(p, options(p) if callable(options) else options, fmt) for p in paths]
     return runs, check_runs(runs, ask or ask_for(), accept)
 
 

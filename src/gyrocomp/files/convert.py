@@ -36,8 +36,9 @@ def convert_file(
     progress=None,
 ) -> ConvertResult:
     """Any file gyrocomp reads written as the canonical table (time [s], gyro [deg/s], accel [g], temperature
-    [degC]) in CSV or Parquet (a text table with the input's separator and decimal point; a ``.tsv`` name means
-    tabs): the same bytes as reading it whole and writing the recording
+    [degC]) in CSV or Parquet (a text table by its name, :func:`gyrocomp.io.text_format.output_text_format`: ``.csv``
+    commas or the input's semicolons, ``.tsv`` tabs, another name the
+    input's): the same bytes as reading it whole and writing the recording
     (:func:`gyrocomp.io.write_recording`). A CSV or Parquet table is read and written chunk by chunk, in memory
     bounded by ``chunks.chunk_rows`` [rows]; any other file whole.
 

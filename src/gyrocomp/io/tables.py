@@ -156,6 +156,40 @@ def detect_table_format(path: Path) -> str | None:
     return None
 
 
+def table_header(path: str | os.PathLike) -> list[str] | None:
+    """The column names of a table file (CSV and its kin, or Parquet), read from its first bytes (a text table's
+    header after its preamble, as the reader finds it; a Parquet file's schema); None for a file of another kind or
+    one that does not open as a table (reading it says why)."""
+    path = Path(path)
+    fmt = detect_table_format(path)
+    try:
+        if fmt == "parquet":
+            return list(pq.read_schema(path).names)
+        if fmt != "csv":
+            return None
+        source, head = csv_source(path)
+        text = TextFormat.found(head[:4096], TableLayout())
+        reader = pacsv.open_csv(
+            text.source(path, source),
+            read_options=text.read_options(),
+            parse_options=text.parse_options(),
+            convert_options=pacsv.ConvertOptions(decimal_point=text.decimal),
+        )
+        return list(reader.schema.names)
+    except (InputError, OSError, pa.ArrowException, *DECOMPRESS_ERRORS):
+        return None
+
+
+def layout_fits(header: list[str], layout: TableLayout, path: str | os.PathLike) -> bool:
+    """Whether ``layout`` reads a table of the column names ``header``: its mapping resolves there, and it finds the
+    time (or a nominal rate) and a gyro axis (:func:`resolved_columns`)."""
+    try:
+        resolved_columns(header, layout, Path(path))
+    except InputError:
+        return False
+    return True
+
+
 def resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dict[str, str]:
     """Canonical name to column, refusing a repeated column name, a missing time column or no gyro column."""
     repeated = sorted({name for name in header if header.count(name) > 1})
@@ -422,8 +456,8 @@ def write_gyro_back(
     columns by ``accel_g`` [g], when given).
 
     Values are converted back to the file's units; every other column and the column order are unchanged, and a
-    text table is written with the input's separator and decimal point (:func:`~gyrocomp.io.text_format.output_text_format`: a ``.tsv``
-    name means tabs).
+    text table is written by its name (:func:`~gyrocomp.io.text_format.output_text_format`: ``.csv`` commas or the
+    input's semicolons, ``.tsv`` tabs, another name the input's).
     Rows dropped on reading (``drop_nonfinite``) are left out of the output as well, as ``convert`` does: a
     row that could not be compensated is not written with its valid values replaced. Written atomically.
     """
@@ -445,8 +479,8 @@ def write_gyro_back(
 
 def write_rows(data: TableData, samples: slice, path: str | os.PathLike, *, fmt: str | None = None) -> None:
     """Write the table as read, the rows of the recording's ``samples`` only (a slice of its sample indices), in
-    the input's columns, units, separator and decimal point (:func:`~gyrocomp.io.text_format.output_text_format`), atomically: a piece of a
-    log that reads as the log does."""
+    the input's columns and units, a text table by its name (:func:`~gyrocomp.io.text_format.output_text_format`),
+    atomically: a piece of a log that reads as the log does."""
     path = Path(path)
     rows = data.kept_rows[samples]
     _write_arrow(
@@ -498,8 +532,8 @@ def write_recording(
     text_format: TextFormat | None = None,
 ) -> None:
     """Write a recording in the default layout ([s], [deg/s], [g], [degC]), atomically; a text table with the
-    separator and decimal point of ``text_format`` (the input's, say), a ``.tsv`` name meaning tabs
-    (:func:`~gyrocomp.io.text_format.output_text_format`)."""
+    format :func:`~gyrocomp.io.text_format.output_text_format` gives for its name and ``text_format`` (the input's,
+    say)."""
     path = Path(path)
     _write_arrow(
         recording_table(recording, extra_columns),
@@ -510,6 +544,8 @@ def write_recording(
 
 
 __all__ = [
+    "layout_fits",
+    "table_header",
     "TableLayout",
     "TableData",
     "parse_column_mapping",

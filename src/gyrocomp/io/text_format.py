@@ -168,11 +168,12 @@ def header_line(text_format: TextFormat | None) -> int:
 
 
 def output_text_format(path: str | os.PathLike, source: TextFormat | None = None) -> TextFormat:
-    """The format an output text table is written in: a ``.tsv`` name means tabs, a ``.csv`` name commas and a
-    decimal point, unless the reading options named the input's separator or decimal point (``source.given``: then
-    the input's format, so that the next command reading the output with the same options reads it); any other
-    name, the input's format (``source``); a comma and a decimal point where there is no input table. A decimal
-    comma is kept only beside another separator. What gyrocomp writes is UTF-8, whatever the input's encoding."""
+    """The format an output text table is written in: a ``.tsv`` name means tabs; a ``.csv`` name the input's format
+    (``source``) where it separates by commas or semicolons (the two conventions of the name: a decimal-comma
+    locale's spreadsheet writes semicolons) or the reading options named it (``source.given``: the next command
+    reading the output with the same options then reads it), else (tabs, aligned spaces) commas and decimal points;
+    any other name, the input's format; a comma and a decimal point where there is no input table. A decimal comma
+    is kept only beside another separator. What gyrocomp writes is UTF-8, whatever the input's encoding."""
     name = Path(path).name.lower()
     for compressed in COMPRESSED_SUFFIXES:
         name = name.removesuffix(compressed)
@@ -183,7 +184,7 @@ def output_text_format(path: str | os.PathLike, source: TextFormat | None = None
     )
     if name.endswith(".tsv"):
         return TextFormat("\t", base.decimal)
-    if name.endswith(".csv") and not base.given:
+    if name.endswith(".csv") and not base.given and base.delimiter not in (",", ";"):
         return TextFormat()
     return base if base.delimiter != "," or base.decimal == "." else TextFormat()
 
