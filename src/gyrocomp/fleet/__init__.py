@@ -27,16 +27,8 @@ from .prior import (
     population_prior,
     prior_from_models,
 )
-from .run import (
-    FLEET_TABLE,
-    MODELS_FOLDER,
-    FleetSettings,
-    FleetSummary,
-    UnitOutcome,
-    fit_fleet,
-    fit_unit,
-    model_file_name,
-)
+from .model_files import FLEET_TABLE, MODELS_FOLDER, model_file_name
+from .run import FleetSettings, FleetSummary, UnitOutcome, fit_fleet, fit_unit
 from .store import CalibrationRecord, CalibrationStore, InputFile, parse_time, store_url, utc_now
 from .devices import UnitRuns, expand_inputs, input_hash, units_from_manifest, units_from_pattern
 

@@ -24,15 +24,7 @@ the baseline of ``benchmarks/bench_fleet.py``).
 
 from __future__ import annotations
 
-import contextlib
-import hashlib
-import logging
 import os
-import re
-import resource
-import signal
-import socket
-import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
@@ -40,11 +32,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 from .._version import __version__
-from ..errors import DataQualityWarning, GyrocompError, InputError, user_stacklevel
+from ..errors import GyrocompError, InputError
 from ..files.check import ask_for, read_checked, refuse, rewarn, warn_findings
 from ..io import ReadOptions
 from ..measures.data_check import check_runs
-from ..io.atomic import atomic_path, folder_lock, write_text_atomic
+from ..io.atomic import atomic_path, folder_lock
 from ..io.foreign_libraries import require
 from ..models.fit import fit
 from ..models.pipelines import Pipeline
@@ -58,12 +50,20 @@ from .prior import PopulationPrior, fit_with_prior
 from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
 from .stations import Station, claim, release, station as running_as
 from .devices import UnitRuns, content_hash, input_hash
+from .cluster import check_reachable, dask_client
+from .model_files import (
+    FLEET_TABLE,
+    MODELS_FOLDER,
+    model_file_name,
+    model_write_error,
+    repair_model,
+    serial_key,
+    write_fleet_table,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
 
-MODELS_FOLDER = "models"
-FLEET_TABLE = "fleet.parquet"
 #: most warnings kept per unit (a run can warn once per axis and check)
 _MAX_WARNINGS = 20
 
@@ -261,7 +261,7 @@ def _checked(units: Iterable[UnitRuns], output, scheduler: str) -> tuple[list[Un
     units = list(units)
     _check_units(units)
     if scheduler not in ("local", "serial"):
-        _check_reachable(scheduler)
+        check_reachable(scheduler)
     output = Path(output)
     if output.exists() and not output.is_dir():
         raise InputError(f"output: {output} is a file; a fleet is written into a folder")
@@ -318,7 +318,7 @@ def _keep(
         return
     if outcome.status == "unchanged":
         tally.unchanged.append(outcome.serial)
-        _repair_model(output, db, outcome.serial)
+        repair_model(output, db, outcome.serial)
         return
     record = _record(outcome, unit, limits, me.name)
     stored = (
@@ -353,7 +353,7 @@ def _store_with_model(db: CalibrationStore, record: CalibrationRecord, since, ou
     except _NotStored:
         return None
     except OSError as exc:
-        raise _model_write_error(path, record.serial, exc) from None
+        raise model_write_error(path, record.serial, exc) from None
     return row
 
 
@@ -420,7 +420,7 @@ def _outcomes(
             yield item.busy or fit_unit(item.unit, settings, item.known_hash)
         return
     distributed = require("dask.distributed", "fleet", "fitting a fleet on Dask (scheduler local or an address)")
-    with _client(distributed, scheduler, workers, memory_limit) as client:
+    with dask_client(distributed, scheduler, workers, memory_limit) as client:
         window = IN_FLIGHT_PER_THREAD * max(1, sum(client.nthreads().values()))
         futures: dict = {}
         running = distributed.as_completed()
@@ -440,7 +440,7 @@ def _outcomes(
                     settings,
                     item.known_hash,
                     pure=False,
-                    key=f"gyrocomp-fit-{_safe_name(item.unit.serial)}-{os.getpid()}-{id(item)}",
+                    key=f"gyrocomp-fit-{serial_key(item.unit.serial)}-{os.getpid()}-{id(item)}",
                 )
                 futures[future] = item.unit
                 running.add(future)
@@ -461,136 +461,6 @@ def _outcomes(
                 yield UnitOutcome(unit.serial, "failed", "", error=why + _error_text(exc))
             future.release()
             yield from top_up()
-
-
-#: the signals a terminal sends to every process of the command (Ctrl-C, a closed terminal): the local workers
-#: ignore them, and the command, which gets them too, stops them in order
-_TERMINAL_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGHUP") if hasattr(signal, name))
-
-
-@contextlib.contextmanager
-def _quiet_dask() -> Iterator[None]:
-    """Dask's own log lines (a worker killed on shutdown, a lost connection when the command is stopped) kept
-    from the user for the block: what matters reaches the command as an outcome or an exception."""
-    loggers = [logging.getLogger(name) for name in ("distributed", "asyncio", "tornado")]
-    levels = [logger.level for logger in loggers]
-    for logger in loggers:
-        logger.setLevel(logging.CRITICAL + 1)
-    try:
-        yield
-    finally:
-        for logger, level in zip(loggers, levels):
-            logger.setLevel(level)
-
-
-#: file descriptors a local Dask cluster takes: the scheduler's and the client's, and each worker's connections
-DESCRIPTORS_BASE = 128
-DESCRIPTORS_PER_WORKER = 32
-
-
-def _require_descriptors(workers: int) -> None:
-    """Refuse in one line, before Dask starts, a process that may not open enough files at once for a local
-    cluster of ``workers`` (Dask then fails in its event loop, each failure a log line, and the store cannot be
-    opened)."""
-    soft, _ = resource.getrlimit(resource.RLIMIT_NOFILE)
-    needed = DESCRIPTORS_BASE + DESCRIPTORS_PER_WORKER * workers
-    if soft != resource.RLIM_INFINITY and soft < needed:
-        raise InputError(
-            f"scheduler: local: this process may open {soft} files at once (ulimit -n), and a local "
-            f"Dask cluster of {workers} worker(s) needs about {needed}: raise the limit, use fewer "
-            "workers, or the serial scheduler, which fits without Dask"
-        )
-
-
-def _cluster_error(exc: BaseException) -> InputError:
-    """One line for a local Dask cluster that did not start, naming the machine's limit behind it where the
-    cause says (too many open files, no memory or threads)."""
-    causes, seen = [], exc
-    while seen is not None and len(causes) < 10:
-        causes.append(f"{type(seen).__name__}: {seen}")
-        seen = seen.__cause__ or seen.__context__
-    text = " / ".join(causes)
-    if re.search(r"too many open files|EMFILE", text, re.IGNORECASE):
-        why = "too many files open at once for this machine's limit (ulimit -n); raise it, or run with fewer workers"
-    elif re.search(r"memory|can't start new thread|resource temporarily unavailable", text, re.IGNORECASE):
-        why = "not enough memory or threads for the workers; run with fewer workers or a lower memory limit"
-    else:
-        why = f"{causes[0][:160]}"
-    return InputError(
-        f"scheduler: local: the Dask workers did not start ({why}); the serial scheduler fits without Dask"
-    )
-
-
-def _quiet_worker() -> None:
-    """Run in each local worker: Dask's log lines there kept from the user's terminal, as in the command."""
-    logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
-
-
-@contextlib.contextmanager
-def _workers_deaf_to_the_terminal() -> Iterator[None]:
-    """Start processes that ignore Ctrl-C and a closed terminal (an ignored signal stays ignored in a spawned
-    process): the command gets those signals and stops its workers in order, instead of each worker printing its
-    own traceback. While the workers start (a second or two), the command ignores them too: a Ctrl-C then is
-    lost, the next one stops it."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {sig: signal.signal(sig, signal.SIG_IGN) for sig in _TERMINAL_SIGNALS}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
-
-@contextlib.contextmanager
-def _client(distributed, scheduler: str, workers: int | None, memory_limit: str | int):
-    if scheduler == "local":
-        _require_descriptors(workers or os.cpu_count() or 1)
-        config = require("dask.config", "fleet", "fitting a fleet on Dask")
-        # Dask's statistical profiler samples every task's stack every 10 ms: 10 % of a fleet's time on 2 cores
-        with _quiet_dask():
-            with (
-                warnings.catch_warnings(),
-                config.set(
-                    {"distributed.worker.profile.enabled": False, "distributed.scheduler.worker-saturation": 1.0}
-                ),
-                _workers_deaf_to_the_terminal(),
-            ):
-                warnings.simplefilter("ignore")  # Dask's notes on ports and the dashboard are not the user's concern
-                try:
-                    cluster = distributed.LocalCluster(
-                        n_workers=workers or os.cpu_count() or 1,
-                        threads_per_worker=1,
-                        processes=True,
-                        memory_limit=memory_limit,
-                        dashboard_address=None,
-                    )
-                except Exception as exc:  # noqa: BLE001 - Dask wraps the cause (files, memory) in its own errors
-                    raise _cluster_error(exc) from None
-            with cluster, distributed.Client(cluster) as client:
-                client.run(_quiet_worker)  # and the workers' own log lines (tasks cancelled when the command stops)
-                yield client
-        return
-    try:
-        client = distributed.Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise InputError(f"scheduler: cannot reach a Dask scheduler at {scheduler!r} ({exc})") from None
-    with client:
-        yield client
-
-
-def _check_reachable(address: str) -> None:
-    """Refuse at once a TCP scheduler address nothing listens on (Dask would retry until its timeout)."""
-    m = re.fullmatch(r"(?:tcp://)?\[?([^\]\s]+?)\]?:(\d+)", address.strip())
-    if m is None:
-        if "://" not in address:
-            raise InputError(f"scheduler: {address!r}; use local, serial or a Dask scheduler address (tcp://host:8786)")
-        return  # another protocol (tls://, ucx://, inproc://): Dask connects and reports
-    try:
-        socket.create_connection((m.group(1), int(m.group(2))), timeout=10).close()
-    except OSError as exc:
-        raise InputError(f"scheduler: cannot reach a Dask scheduler at {address!r} ({exc.strerror or exc})") from None
 
 
 def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, station: str) -> CalibrationRecord:
@@ -615,91 +485,4 @@ def _record(outcome: UnitOutcome, unit: UnitRuns, limits: Limits | None, station
     )
 
 
-#: the longest serial kept whole in a model file's name [characters]
-MAX_NAME_CHARS = 80
-
-
-def model_file_name(serial: str) -> str:
-    """The model file of a unit, ``SERIAL.json``, one per serial: a serial of letters, digits, ``.``, ``-`` and
-    ``_`` (ASCII) up to :data:`MAX_NAME_CHARS` long is its own name; any other (``a/b``, a long or non-ASCII one)
-    becomes its safe characters, ``~`` and 16 hex digits of its SHA-256, so that two serials never share a file
-    (``a/b`` and ``a_b`` once did) and no name is too long for the file system."""
-    if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]*", serial) and len(serial) <= MAX_NAME_CHARS:
-        return serial + ".json"
-    safe = re.sub(r"[^A-Za-z0-9._-]", "_", serial)[:MAX_NAME_CHARS].lstrip(".")
-    return f"{safe}~{hashlib.sha256(serial.encode('utf-8', 'surrogatepass')).hexdigest()[:16]}.json"
-
-
-def _safe_name(serial: str) -> str:
-    """A Dask key part for a serial (file names: :func:`model_file_name`)."""
-    return model_file_name(serial)[: -len(".json")]
-
-
-def _write_model(output: Path, serial: str, model_json: str) -> None:
-    """Write the unit's model file atomically; a failed write (a full or read-only disk) is one line, and nothing
-    is stored for the unit, so the next run fits it again."""
-    folder = output / MODELS_FOLDER
-    try:
-        folder.mkdir(exist_ok=True)
-        write_text_atomic(folder / model_file_name(serial), model_json)
-    except OSError as exc:
-        raise _model_write_error(folder / model_file_name(serial), serial, exc) from None
-
-
-def _model_write_error(path: Path, serial: str, exc: OSError) -> InputError:
-    """The one line for a unit's model file that could not be written (nothing is stored for the unit)."""
-    return InputError(
-        f"{path}: cannot write unit {serial!r}'s model ({exc.strerror or exc}); nothing was stored "
-        "for it, the next run fits it again"
-    )
-
-
-def _repair_model(output: Path, db: CalibrationStore, serial: str) -> None:
-    """An unchanged unit's model file is checked against its newest successful row: a missing file (deleted, a
-    run stopped between the two writes) is put back; one that differs (another unit's copied over it, cut short,
-    edited) is written again from the row, and said."""
-    path = output / MODELS_FOLDER / model_file_name(serial)
-    ok = [r for r in db.history(serial) if r.status == "ok"]
-    if not ok:
-        return
-    try:
-        present = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        present = None
-    except (OSError, UnicodeDecodeError):
-        present = ""
-    if present != ok[-1].model_json:
-        try:  # a row another program damaged is no model to write back: said, the file left as it is
-            ok[-1].calibration()
-        except GyrocompError as exc:
-            raise InputError(
-                f"{db.location}: {exc}; {path} is left as it is (refit the unit into a new store, or "
-                "restore the store from a copy)"
-            ) from None
-        _write_model(output, serial, ok[-1].model_json)
-        if present is not None:
-            warnings.warn(
-                f"{path}: differed from unit {serial!r}'s newest calibration in the store (row "
-                f"{ok[-1].id}); written again from the store",
-                DataQualityWarning,
-                stacklevel=user_stacklevel(),
-            )
-
-
-def write_fleet_table(table: pd.DataFrame, path: Path) -> Path:
-    """Write the fleet table (one row per unit, its newest calibration; see :func:`fleet_table`) atomically."""
-    with atomic_path(path) as tmp:
-        table.to_parquet(tmp, index=False)
-    return path
-
-
-__all__ = [
-    "FLEET_TABLE",
-    "MODELS_FOLDER",
-    "FleetSettings",
-    "model_file_name",
-    "FleetSummary",
-    "UnitOutcome",
-    "fit_fleet",
-    "fit_unit",
-]
+__all__ = ["FleetSettings", "FleetSummary", "UnitOutcome", "fit_fleet", "fit_unit"]
