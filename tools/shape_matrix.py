@@ -238,6 +238,15 @@ def run_shape(name: str, shape: Shape, folder: Path, run) -> list[Call]:
     model = out / "m.json"
     fitted = classify("fit", run("fit", *runs, *unit, "-o", model))
     calls.append(fitted)
+    for family, args in (("rate+lag", ("--hysteresis", "rate+lag")), ("table", ("--temperature", "table"))):
+        calls.append(classify(f"fit {family}", run("fit", *runs, *unit, *args, "-o", out / f"m-{family}.json")))
+    state = out / "learner.json"
+    learned = classify("learn", run("learn", *runs, *unit, "-o", out / "learned.json", "--save-state", state))
+    calls.append(learned)
+    if learned.result == "ok":
+        calls.append(
+            classify("learn --resume", run("learn", runs[-1], *unit, "--resume", state, "-o", out / "again.json"))
+        )
     calls.append(classify("noise", run("noise", runs[0], *unit)))
     calls.append(classify("allan", run("allan", runs[0], *unit, "--json")))
     converted = out / "run.parquet"
@@ -281,12 +290,14 @@ def _fleet(runs: list[Path], unit: list[str], out: Path, run) -> list[Call]:
     )
     if fitted.result != "ok":
         return [fitted]
+    calls = [fitted, classify("fleet show", run("fleet", "show", "SN1", "--store", fleet))]
+    calls.append(classify("fleet report", run("fleet", "report", fleet, "-o", out / "fleet.html")))
     page = out / "cert.html"
     cert = classify("fleet certificate", run("fleet", "certificate", "SN1", "--store", fleet, *unit, "-o", page))
     if cert.result == "ok":
         text = page.read_text(encoding="utf-8")
         cert = _invariant(cert, "SN1" in text and "verdict" in text, "the certificate names no unit or verdict")
-    return [fitted, cert]
+    return [*calls, cert]
 
 
 def _same_as_library(model: Path, run_path: Path, table: Path, time_unit: str) -> tuple[bool, str]:

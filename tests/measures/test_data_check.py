@@ -172,6 +172,12 @@ def test_a_run_at_one_temperature_is_fine_beside_runs_that_span_enough(clean_col
     assert [c.verdict for c in check_runs([read_checked(still), read_checked(full)], asked)] == ["ok", "ok"]
     (alone,) = check_runs([read_checked(still)], asked)
     assert alone.verdict == "refused" and alone.reasons[0] == "temperature-constant"
+    # on the command line the message reads as written (its "one temperature:" once became "one --temperature:")
+    refused = run("fit", still, "--temperature", "poly:3", "-o", tmp_path / "m.json")
+    assert (
+        refused.returncode == 2 and "runs that all stay at one set point: refused by the data check" in refused.stderr
+    )
+    assert "--temperature:" not in refused.stderr
 
 
 def test_gaps_between_bursts_of_stamps_are_not_called_missing_samples():

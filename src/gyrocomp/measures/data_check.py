@@ -651,7 +651,7 @@ def set_findings(recordings: Sequence[Recording], ask: Ask) -> dict[int, list[Fi
                         _curve_severity(ask),
                         f"{recordings[i].source}: the temperature is "
                         f"constant ({t[0]:.4g} degC throughout), as in every run given: a stuck or absent sensor, or "
-                        "runs at one temperature",
+                        "runs that all stay at one set point",
                         _NO_CURVE if ask.temperature == "auto" else "",
                     )
                 )

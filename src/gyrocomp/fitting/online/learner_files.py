@@ -60,7 +60,8 @@ class LearnerFiles:
             low, high = float(self._pt_t[used, 0].min()), float(self._pt_t[used, 0].max())
             raise InputError(
                 f"the still data of {self._session} log(s) cover {low:.1f}..{high:.1f} degC; a "
-                f"temperature model needs at least {self.settings.min_span_degc:g} degC (min_span_degc)"
+                f"temperature model needs at least {self.settings.min_span_degc:g} degC of them (the learner's "
+                "min_span_degc): learn from logs whose still moments cover a wider temperature range"
             )
         out = {name: self._axis_calibration(j) for j, name in enumerate(GYRO_AXES) if name in axes}
         status = self.status
