@@ -1,6 +1,7 @@
 """Every command on a sample of the shapes of input (tools/shape_matrix.py: runs written from the physics, each
-unit's runs through check, fit, show, apply, evaluate, validate, report, export, split, noise, allan, convert,
-fleet fit and fleet certificate): each call succeeds with its invariant holding (apply equals the library's
+unit's runs through check, fit (the default, a rate term and a lookup table), learn and its resume, show, apply,
+evaluate, validate, report, export, split, noise, allan, convert, fleet fit, show, report and certificate): each
+call succeeds with its invariant holding (apply equals the library's
 apply; a certificate names its unit and verdict) or refuses in one line, never an internal error. The whole matrix
 runs as the script; its table is in docs/reliability.md."""
 
@@ -25,6 +26,7 @@ def test_every_command_on_a_shape_succeeds_or_refuses_in_one_line(name, tmp_path
     by = {c.command: c.result for c in calls}
     if name != "constant temperature":  # a temperature model needs a temperature that varies
         assert by["fit"] == by["apply"] == by["fleet certificate"] == "ok", calls
+        assert by["fit rate+lag"] == by["fit table"] == by["fleet show"] == by["fleet report"] == "ok", calls
 
 
 def test_the_matrix_covers_thirty_shapes_of_every_kind_the_issue_names():
