@@ -574,7 +574,11 @@ def _octave_chain(ms: np.ndarray, n_phase: int) -> int:
 
 
 def variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """The sum of squared differences behind each estimator, before its normalization.
+    """The sum of squared differences behind each estimator, before its normalization
+    (:func:`deviations_from_sums`).
+
+    ``kind`` names the estimator (a key of :data:`ESTIMATORS`); ``phase`` is the integrated series; ``ms`` the
+    averaging factors [samples] and ``counts`` the number of terms at each.
 
     OADEV: octave factors 1, 2, 4, ... in one block-wise pass (_octave_oadev_sums), factors long against
     the series from lag products (_lagged_oadev_sums); everything else term by term in blocks.
@@ -599,8 +603,24 @@ def variance_sums(kind: str, phase, ms: np.ndarray, counts: np.ndarray) -> np.nd
 def deviations_from_sums(
     kind: str, sums: np.ndarray, ms: np.ndarray, tau: np.ndarray, counts: np.ndarray, phase_scale: float
 ) -> np.ndarray:
-    """Deviations from the sums; ``phase_scale`` is what the phase was multiplied by (rate_hz for rate
-    data integrated in samples, see _as_phase)."""
+    """The deviations of estimator ``kind`` from its sums of squared differences (:func:`variance_sums`).
+
+    Parameters
+    ----------
+    kind : str
+        The estimator (a key of :data:`ESTIMATORS`).
+    sums, ms, counts : array (k,)
+        The sums, the averaging factors [samples] and the number of terms at each.
+    tau : array (k,)
+        The averaging times [s].
+    phase_scale : float
+        What the phase was multiplied by (the rate [Hz] for rate data integrated in samples).
+
+    Returns
+    -------
+    array (k,)
+        The deviation at each tau [the data's unit; TDEV in unit x s]; NaN where no term was summed.
+    """
     scaled_tau = tau * phase_scale
     with np.errstate(invalid="ignore", divide="ignore"):
         if kind in ("oadev", "adev", "totdev"):

@@ -82,9 +82,26 @@ def check_parquet_footer(path: Path) -> None:
 
 
 def read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple[pa.Table, TextFormat | None]:
-    """The table, and a text table's format (None for Parquet); ``select`` (a function of the header's names
-    giving the names to read, or None for all) reads only some columns. A table without a header line
-    (``layout.names``) is read by :func:`gyrocomp.io.serial.read_headerless`."""
+    """A table file as pyarrow reads it.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    fmt : {"csv", "parquet"}
+        Its format (a text table of any separator, compressed or not; or Parquet).
+    layout : TableLayout
+        How to read it (a table without a header line, ``layout.names``, is read by
+        :func:`gyrocomp.io.serial.read_headerless`).
+    select : callable, optional
+        A function of the header's names giving the names to read; None reads every column.
+
+    Returns
+    -------
+    table : pyarrow.Table
+    text_format : TextFormat or None
+        A text table's separator, decimal point, preamble and encoding; None for Parquet.
+    """
     if not path.exists():
         raise InputError(f"{path}: no such file")
     if path.is_dir():
@@ -191,7 +208,27 @@ def layout_fits(header: list[str], layout: TableLayout, path: str | os.PathLike)
 
 
 def resolved_columns(header: list[str], layout: TableLayout, path: Path) -> dict[str, str]:
-    """Canonical name to column, refusing a repeated column name, a missing time column or no gyro column."""
+    """The column that holds each channel, by the channel's canonical name.
+
+    Parameters
+    ----------
+    header : list of str
+        The table's column names.
+    layout : TableLayout
+        Its mapping and its nominal rate (a table without a time column).
+    path : Path
+        The file, for messages.
+
+    Returns
+    -------
+    dict
+        Canonical name (``time``, ``gyro_z``, ``temperature`` ...) to column.
+
+    Raises
+    ------
+    InputError
+        A column name repeated; LayoutError (an InputError) without a time column (or a rate) or a gyro column.
+    """
     repeated = sorted({name for name in header if header.count(name) > 1})
     if repeated:
         raise InputError(

@@ -42,8 +42,27 @@ def _turning_sessions(recordings: list[Recording]) -> list[Recording]:
 def fit_gyro_triad(
     recordings: list[Recording], scale_factor: str, wants_temperature: bool = True
 ) -> tuple[TriadCalibration | None, list[Recording]]:
-    """The gyro's K(T) from the runs that carry reference rates (those runs then leave the bias model) or, without
-    them, K from the turns between the still poses of multi-position sessions; and the runs for the bias model."""
+    """The gyro's scale factor and misalignment K(T), and the runs left for the bias model.
+
+    From the runs that carry reference rates (a rate table; those runs then leave the bias model), or, without
+    them, K from the turns between the still poses of multi-position sessions.
+
+    Parameters
+    ----------
+    recordings : list of Recording
+        The calibration runs [s, deg/s, g, degC].
+    scale_factor : {"auto", "none", "matrix", "matrix-temperature"}
+        What to fit (``auto``: K where the runs can tell it, ``matrix-temperature``: K and its temperature terms).
+    wants_temperature : bool
+        Whether K may carry temperature terms (the sessions span temperatures).
+
+    Returns
+    -------
+    triad : TriadCalibration or None
+        None where the runs cannot tell K (or ``scale_factor`` is ``none``).
+    runs : list of Recording
+        The runs for the bias model.
+    """
     if scale_factor not in SCALE_FACTOR_CHOICES:
         raise InputError(f"scale_factor: {scale_factor!r}; use one of {', '.join(SCALE_FACTOR_CHOICES)}")
     if scale_factor == "none":
@@ -106,8 +125,18 @@ def _still_stretches(rate_runs: list[Recording]) -> list[Recording]:
 
 
 def spanning_poses(recordings: list[Recording]) -> list[Pose] | None:
-    """The still poses of runs that turn the accelerometer's every axis up and down (a multi-position test), or
-    None when they do not."""
+    """The still poses of runs that turn the accelerometer's every axis up and down (a multi-position test).
+
+    Parameters
+    ----------
+    recordings : list of Recording
+        The calibration runs, with accelerometer columns [g].
+
+    Returns
+    -------
+    list of Pose or None
+        Every still pose of those runs, or None when the runs do not turn each axis both ways.
+    """
     turned = [
         rec
         for rec in recordings

@@ -70,9 +70,29 @@ def design_matrix(
 
 
 def weighted_fit(temps, accel, tilted, bin_sessions, sessions, bias, weights, degree):
-    """Weighted least squares (see the module, step 7) by Cholesky on the normal equations, in the C code's order
-    of operations: (coefficients (degree, 3), g-sensitivities (tilted axes, 3), constants (sessions, 3), residual
-    RMS (3,)), or None when the system is not positive definite."""
+    """The learner's weighted least squares (step 7 of :mod:`gyrocomp.fitting.online`), by Cholesky on the normal
+    equations in the C code's order of operations.
+
+    Parameters
+    ----------
+    temps : array (n,)
+        The points' temperatures [degC].
+    accel, tilted, bin_sessions, sessions
+        The points' specific force (n, 3) [g], the accelerometer axes fitted (:func:`tilted_axes`), each point's
+        power-on and the power-ons (:func:`design_matrix`).
+    bias : array (n, 3)
+        The points' mean rates [deg/s].
+    weights : array (n,)
+    degree : int
+        The temperature curve's degree.
+
+    Returns
+    -------
+    tuple or None
+        (coefficients (degree, 3), g-sensitivities (tilted axes, 3) [deg/s/g], constants (sessions, 3) [deg/s],
+        residual RMS (3,) [deg/s], the Cholesky factor, the residual scale, the weighted residual sum of squares);
+        None when the system is not positive definite.
+    """
     x = design_matrix(temps, accel, tilted, bin_sessions, sessions, degree)
     n, p = x.shape
     # sums over the points in their order, each term w (x_r x_c): a reduction over the first axis of a contiguous
