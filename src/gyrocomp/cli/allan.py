@@ -12,7 +12,7 @@ from ..files.noise_file import analyse_noise_file
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..export.kalibr import kalibr_imu, kalibr_imu_yaml
 from ..report.figures import allan_figure, check_figure_path
-from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, read_settings, echo
+from .common import OUTPUT_FILE, fit_taus_option, pop_read_options, progress_bar, read_options, echo, settings_for
 from .render import print_noise
 
 
@@ -65,7 +65,7 @@ def allan(ctx, input_path, axes, kind, taus, as_json, plot_path, kalibr, rostopi
         analysis = analyse_noise_file(
             input_path,
             named,
-            options=read_settings(opts, path=input_path),
+            options=settings_for(input_path, opts),
             fmt=opts["fmt"],
             with_accel=bool(kalibr),
             kind=kind,

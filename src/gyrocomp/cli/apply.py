@@ -11,6 +11,7 @@ from ..files.apply import apply_file
 from ..files.apply_bag import apply_bag, apply_bag_instances
 from ..io import detect_format, instances, output_format, refuse_to_overwrite_inputs
 from .common import (
+    settings_for,
     echo,
     FINITE,
     OUTPUT_FILE,
@@ -91,7 +92,7 @@ def apply(ctx, model, input_path, output, turn_on_window_s, axes, noise_path, **
             calibration,
             input_path,
             output,
-            options=read_settings(opts, path=input_path),
+            options=settings_for(input_path, opts),
             fmt=opts["fmt"],
             out_fmt=out_fmt,
             axes=named,

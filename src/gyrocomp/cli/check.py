@@ -12,12 +12,12 @@ from ..io.inputs import expand_runs
 from ..models.options import FitOptions
 from .entry_point import in_cli_words
 from .common import (
+    settings_for,
     echo,
     accept_option,
     parse_temperature_option,
     pop_read_options,
     read_options,
-    read_settings,
     temperature_help,
 )
 
@@ -49,7 +49,7 @@ def check(ctx, runs, temperature, hysteresis, accept, as_json, **kwargs):
     cost, or refused with the reason). Exit status 1 when a run is refused."""
     opts = pop_read_options(kwargs)
     ask = ask_for(FitOptions(temperature=parse_temperature_option(temperature), hysteresis=hysteresis))
-    _, checks = check_files(expand_runs(runs), lambda path: read_settings(opts, path=path), opts["fmt"], ask, accept)
+    _, checks = check_files(expand_runs(runs), lambda path: settings_for(path, opts), opts["fmt"], ask, accept)
     if as_json:
         echo(json.dumps([c.to_dict() for c in checks], indent=2), lines=True)
     elif not ctx.obj["quiet"]:

@@ -176,11 +176,9 @@ def progress_bar(description: str, indeterminate: bool = False):
         yield lambda fraction: bar.update(task, completed=min(max(fraction, 0.0), 1.0))
 
 
-def read_settings(opts: dict, channels: tuple[str, ...] | None = None, path=None) -> ReadOptions:
+def read_settings(opts: dict, channels: tuple[str, ...] | None = None) -> ReadOptions:
     """The :class:`ReadOptions` the common reading options (``pop_read_options``) give; ``channels``: a table's
-    channels to read (None: all). With ``path``, those for that file (:func:`settings_for`)."""
-    if path is not None:
-        return settings_for(path, opts, channels)
+    channels to read (None: all). For one file, :func:`settings_for`."""
     return from_values(ReadOptions, {**opts, "channels": channels})
 
 

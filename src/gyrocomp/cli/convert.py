@@ -10,7 +10,7 @@ from ..files.convert import convert_file
 from ..files.convert_bag import convert_bag
 from ..io import detect_format, output_format, refuse_to_overwrite_inputs
 from ..io.rosbag import KIND_WORDS
-from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, read_settings, echo
+from .common import OUTPUT_FILE, pop_read_options, progress_bar, read_options, echo, settings_for
 
 
 @click.command()
@@ -40,7 +40,7 @@ def convert(ctx, input_path, output, **kwargs):
         result = convert_file(
             input_path,
             output,
-            options=read_settings(opts, path=input_path),
+            options=settings_for(input_path, opts),
             fmt=opts["fmt"],
             out_fmt=out_fmt,
             progress=progress,

@@ -18,13 +18,13 @@ from ..evaluation.comparison import compare_methods
 from ..evaluation import evaluate as evaluate_calibration
 from ..evaluation import compare_installed, evaluate_stages
 from .common import (
+    settings_for,
     echo,
     hysteresis_band,
     pop_read_options,
     progress_bar,
     read_options,
     read_run,
-    read_settings,
     turn_on_window_option,
     window_option,
 )
@@ -196,7 +196,7 @@ def _evaluate_runs(calibration, runs, opts: dict, window_s, turn_on_window_s, ra
                     evaluate_file(
                         calibration,
                         path,
-                        options=read_settings(opts, path=path),
+                        options=settings_for(path, opts),
                         fmt=opts["fmt"],
                         window_s=window_s,
                         turn_on_window_s=turn_on_window_s,

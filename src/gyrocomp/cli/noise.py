@@ -13,13 +13,13 @@ from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..io.inputs import expand_runs
 from ..measures.noise_model import noise_model, noise_over_temperature
 from .common import (
+    settings_for,
     OUTPUT_FILE,
     fit_taus_option,
     pop_read_options,
     progress_bar,
     read_options,
     read_run,
-    read_settings,
     echo,
 )
 from .render import print_bias_process_noise, print_noise_model
@@ -104,7 +104,7 @@ def noise(ctx, logs, export_format, output, rostopic, axes, split_gaps, model_pa
                     analyse_noise_file(
                         path,
                         named,
-                        options=read_settings(opts, path=path),
+                        options=settings_for(path, opts),
                         fmt=opts["fmt"],
                         with_accel=named is None,
                         split_gaps=split_gaps,
