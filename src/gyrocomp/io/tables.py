@@ -36,6 +36,7 @@ from .text_format import (
     output_text_format,
     read_error,
     spaced_as_fields,
+    text_head,
     text_sink,
     with_decimal,
 )
@@ -123,14 +124,7 @@ def read_arrow(path: Path, fmt: str, layout: TableLayout, select=None) -> tuple[
         convert = pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=text.decimal)
         try:
             if select is not None:  # the header's names, from its line
-                names_line = head.split(b"\n")[text.preamble_lines]
-                names_line = spaced_as_fields(names_line) if text.spaced else names_line
-                header = pacsv.read_csv(
-                    pa.py_buffer(names_line + b"\n"),
-                    read_options=pacsv.ReadOptions(encoding=text.encoding),
-                    parse_options=parse,
-                )
-                convert.include_columns = select(header.column_names)
+                convert.include_columns = select(header_names(head, text))
             return pacsv.read_csv(
                 source, read_options=text.read_options(), parse_options=parse, convert_options=convert
             ), text
@@ -173,6 +167,18 @@ def detect_table_format(path: Path) -> str | None:
     return None
 
 
+def header_names(head: bytes, text: TextFormat) -> list[str]:
+    """The column names of a text table's header line, from its first bytes ``head`` (:func:`gyrocomp.io.text_format.text_head`) read in
+    the format ``text``."""
+    names_line = head.split(b"\n")[text.preamble_lines]
+    names_line = spaced_as_fields(names_line) if text.spaced else names_line
+    return pacsv.read_csv(
+        pa.py_buffer(names_line + b"\n"),
+        read_options=pacsv.ReadOptions(encoding=text.encoding),
+        parse_options=text.parse_options(),
+    ).column_names
+
+
 def table_header(path: str | os.PathLike) -> list[str] | None:
     """The column names of a table file (CSV and its kin, or Parquet), read from its first bytes (a text table's
     header after its preamble, as the reader finds it; a Parquet file's schema); None for a file of another kind or
@@ -184,16 +190,9 @@ def table_header(path: str | os.PathLike) -> list[str] | None:
             return list(pq.read_schema(path).names)
         if fmt != "csv":
             return None
-        source, head = csv_source(path)
-        text = TextFormat.found(head[:4096], TableLayout())
-        reader = pacsv.open_csv(
-            text.source(path, source),
-            read_options=text.read_options(),
-            parse_options=text.parse_options(),
-            convert_options=pacsv.ConvertOptions(decimal_point=text.decimal),
-        )
-        return list(reader.schema.names)
-    except (InputError, OSError, pa.ArrowException, *DECOMPRESS_ERRORS):
+        head = text_head(path, csv_codec(path))
+        return header_names(head, TextFormat.found(head[:4096], TableLayout())) if head.strip() else None
+    except (InputError, OSError, IndexError, pa.ArrowException, *DECOMPRESS_ERRORS):
         return None
 
 
@@ -581,6 +580,7 @@ def write_recording(
 
 
 __all__ = [
+    "header_names",
     "layout_fits",
     "table_header",
     "TableLayout",
