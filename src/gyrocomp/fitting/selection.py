@@ -396,7 +396,10 @@ class SelectionProblem:
         """The columns of candidate ``c`` (its branch terms at crossover width number ``width``, its rate term at
         smoothing number ``smoothing``), among the columns at a lag when ``c`` has one (no block of another family
         there)."""
-        at = self.thermal_design.layout(self.terms(c.lag))
+        key = ("layout", c.lag)  # asked for every candidate, fold, lag and width: built once per lagged or not
+        if key not in self._cache:
+            self._cache[key] = self.thermal_design.layout(self.terms(c.lag))
+        at = self._cache[key]
         idx: list[int] = []
         if c.order:
             shape = at[
