@@ -208,6 +208,11 @@ def _numbers(table: pa.Table, column: str) -> np.ndarray | None:
     return values[np.isfinite(values)]
 
 
+#: why a unit was taken from a column's name (for a file of arrays the name carries the array's units attribute,
+#: and the reason says that instead: _guess_arrays)
+_NAMED_SO = "the column's name says so"
+
+
 def _with_units(
     table: pa.Table, columns: dict[str, str], units: tuple[str, ...] | None
 ) -> tuple[pa.Table, dict[str, str]]:
@@ -248,7 +253,7 @@ def _time_unit(name: str, values: np.ndarray, stated: tuple[float, str] | None =
         )
     for word in _words(name):
         if word in _TIME_UNIT_WORDS:
-            return _TIME_UNIT_WORDS[word], f"time unit {_TIME_UNIT_WORDS[word]}: the column's name says so"
+            return _TIME_UNIT_WORDS[word], f"time unit {_TIME_UNIT_WORDS[word]}: " + _NAMED_SO
     period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else float("nan")
     for unit, factor in _TIME_FACTORS:
         if _PERIOD_RANGE_S[0] <= period * factor <= _PERIOD_RANGE_S[1]:
@@ -320,9 +325,9 @@ def _accel_unit(table: pa.Table, columns: dict[str, str]) -> tuple[str, str]:
     accel = [_numbers(table, columns[c]) for c in ("accel_x", "accel_y", "accel_z") if c in columns]
     hinted = {w for c in columns if c.startswith("accel") for w in _words(columns[c])}
     if hinted & {"mps2", "ms2", "m", "si"}:
-        return "m/s2", "accelerometer in m/s2: the column's name says so"
+        return "m/s2", "accelerometer in m/s2: " + _NAMED_SO
     if "mg" in hinted:
-        return "mg", "accelerometer in mg: the column's name says so"
+        return "mg", "accelerometer in mg: " + _NAMED_SO
     if not accel or not all(a is not None and a.size for a in accel):
         return "g", "accelerometer in g: the default"
     n = min(a.size for a in accel)
@@ -366,13 +371,13 @@ _MAX_REST_DPS = 50.0
 def _gyro_unit(table: pa.Table, columns: dict[str, str], accel_unit: str) -> tuple[str, str]:
     words = {w for c in columns if c.startswith("gyro") for w in _words(columns[c])}
     if words & {"rad", "rads", "radps"}:
-        return "rad/s", "gyro in rad/s: the column's name says so"
+        return "rad/s", "gyro in rad/s: " + _NAMED_SO
     if words & {"mrad", "mrads"}:
-        return "mrad/s", "gyro in mrad/s: the column's name says so"
+        return "mrad/s", "gyro in mrad/s: " + _NAMED_SO
     if "mdps" in words:
-        return "mdps", "gyro in mdps: the column's name says so"
+        return "mdps", "gyro in mdps: " + _NAMED_SO
     if words & {"dps", "deg", "degs"}:
-        return "deg/s", "gyro in deg/s: the column's name says so"
+        return "deg/s", "gyro in deg/s: " + _NAMED_SO
     if accel_unit == f"1/{_INVENSENSE_DEFAULT_PER_G} g":
         return f"1/{_INVENSENSE_DEFAULT_PER_DPS} deg/s", (
             f"gyro in raw counts, 1/{_INVENSENSE_DEFAULT_PER_DPS} deg/s: the accelerometer counts "
@@ -656,7 +661,7 @@ def _guess_arrays(path: Path, store: ArrayStore, rate_hz: float | None) -> Layou
     attributes = {name: str(array.attrs.get("units") or "").split(" since ")[0] for name, array in store.items()}
     stated_units = tuple(attributes.get(column.split("[", 1)[0], "") for column in table.column_names)
     time_unit, accel_unit, gyro_unit, why = _guessed_units(*_with_units(table, named, stated_units), stated)
-    why = tuple(w.replace("the column's name says so", "its array's units attribute says so") for w in why)
+    why = tuple(w.replace(_NAMED_SO, "its array's units attribute says so") for w in why)
     units = [name for name, array in store.items() if name in columns.values() and array.attrs.get("units")]
     if units:
         reasons.append(f"the units attributes of {', '.join(units)} are read from the file and win over these")
