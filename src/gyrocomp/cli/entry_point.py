@@ -103,6 +103,11 @@ COMMANDS = {
         "--validate-on, the held-out drift of each method on those calibration runs.",
     ),
     "plot": ("plot", "Single figures as PNG, SVG or PDF (from the suffix of -o)."),
+    "plan": (
+        "plan",
+        "How much chamber time is enough, and which run to record next: the drift MODEL should leave on a use "
+        "profile, and candidate runs scored per hour of chamber time.",
+    ),
     "fleet": (
         "fleet",
         "Production calibration of many units: fit them on Dask into a calibration store, judge them "

@@ -18,6 +18,7 @@ if TYPE_CHECKING:  # types only: `gyrocomp allan` need not import the fitting to
     from ..measures.noise import NoiseAnalysis
     from ..measures.noise_model import NoiseModel
     from ..evaluation.validation import ValidationResult
+    from ..evaluation.run_advice import CalibrationPlan
 
 
 def print_fit(calibration: Calibration, output) -> None:
@@ -407,6 +408,46 @@ def _metrics_table(title: str, evaluation: Evaluation, rows_of) -> Table | None:
             f"{m.residual_rms:.3g}",
         )
     return table
+
+
+def print_plan(result: CalibrationPlan, shown: int = 5) -> None:
+    """The drift to expect on the use profile, per axis, then the best ``shown`` candidate runs."""
+    console = make_console()
+    now = result.now
+    table = Table(title=f"drift to expect on {now.profile} ({now.window_s:g} s moving average, 95 % interval)")
+    for col in ("axis", "expected", "95 % interval", "coefficients", "own noise", "past the range", "lag"):
+        table.add_column(col, justify="left" if col == "axis" else "right")
+    for f in now.axes.values():
+        lag = "-" if f.lag_s is None else f"{f.lag_s:.3g} +- {f.lag_standard_error_s:.2g} s"
+        table.add_row(
+            f.axis,
+            f"{f.drift_dps:.3g} deg/s",
+            f"{f.low_dps:.3g}..{f.high_dps:.3g}",
+            f"{f.coefficients_dps:.2g}",
+            f"{f.noise_dps:.2g}",
+            f"{f.extrapolation_dps:.2g}"
+            + (f" ({f.outside_range_fraction:.0%} of the time)" if f.outside_range_fraction else ""),
+            lag,
+        )
+    console.print(table)
+    lo, hi = result.range_degc
+    runs = Table(
+        title=f"next run (calibrated {lo:.1f}..{hi:.1f} degC at {result.ramp_degc_per_min:.2g} degC/min; "
+        "best gain per hour of chamber time first)"
+    )
+    for col in ("run", "what", "hours", f"{now.worst.axis} after", "gain per hour", "what it resolves"):
+        runs.add_column(col, justify="right" if col in ("hours", "gain per hour") or col.endswith("after") else "left")
+    for a in result.advice[:shown]:
+        after = a.after.axes[now.worst.axis]
+        runs.add_row(
+            a.run.name,
+            a.run.description,
+            f"{a.run.hours:.1f}",
+            f"{after.drift_dps:.3g} ({after.low_dps:.2g}..{after.high_dps:.2g})",
+            f"{a.gain_dps_per_h:.2g} deg/s/h",
+            a.resolves,
+        )
+    console.print(runs)
 
 
 def print_expected_drift(expected: dict) -> None:
