@@ -13,6 +13,10 @@ from .common import FINITE, echo, pop_read_options, read_options, read_run
 from .render import print_plan
 
 
+#: the close candidates a note names (the nearest first), the rest counted
+SHOWN_CANDIDATES = 3
+
+
 def _use_range(text: str | None) -> tuple[float, float] | None:
     if text is None:
         return None
@@ -105,11 +109,17 @@ def plan(ctx, model, runs, use_log, use_range, use_ramp, window_s, as_json, **kw
                 err=True,
             )
         if forecast.close_candidates:
+            named = ", ".join(forecast.close_candidates[:SHOWN_CANDIDATES])
+            more = len(forecast.close_candidates) - SHOWN_CANDIDATES
             echo(
-                f"gyrocomp: note: {forecast.axis}: the model choice could not tell its curve from "
-                f"{', '.join(forecast.close_candidates)} (held-out drift within one standard error)",
+                f"gyrocomp: note: {forecast.axis}: the model choice could not tell its curve from {named}"
+                + (f" and {more} more" if more > 0 else "")
+                + " (held-out drift within one standard error); the forecast counts the chosen curve's uncertainty alone",
                 err=True,
             )
+    for axis in calibration.axes:
+        if axis not in result.now.axes:
+            echo(f"gyrocomp: note: {axis}: constants only (no temperature curve), not forecast", err=True)
     best = result.advice[0] if result.advice else None
     if result.enough or best is None:
         echo(

@@ -528,16 +528,17 @@ def axis_information(
 
 def close_candidates(calibration: Calibration, axis: str) -> tuple[str, ...]:
     """The model choice's candidates for ``axis`` whose held-out drift was within one standard error of the chosen
-    candidate's (none when the fit kept no choice)."""
+    candidate's, the nearest first (none when the fit kept no choice)."""
     report = calibration.report.selection.get(axis) if calibration.report is not None else None
     if report is None or report.chosen_drift is None:
         return ()
     limit = report.chosen_drift + (report.chosen_standard_error or 0.0)
-    return tuple(
-        c.candidate.label
+    close = sorted(
+        (c.mean_drift, c.candidate.label)
         for c in report.candidates
         if c.candidate != report.chosen and c.mean_drift is not None and c.mean_drift <= limit
     )
+    return tuple(label for _, label in close)
 
 
 def forecast_drift(
