@@ -182,3 +182,46 @@ def test_on_the_real_one_cycle_log_the_interval_holds_the_held_out_legs_drift():
     for axis, f in forecast.axes.items():
         actual = smoothed_residual_rms(left[:, log.gyro_axes.index(axis)], int(60 * log.rate_hz))
         assert f.low_dps <= actual <= f.high_dps, (axis, actual, f)
+
+
+def test_a_growing_log_is_looked_at_until_the_target_and_the_leg_under_way_pays_while_it_widens_the_range():
+    """A run under way, read at three moments (mid-way up the first heating leg, at the top, at the end): each look
+    fits what there is; the forecast on 20..50 degC falls as the log grows; mid-way up, one more hour of the leg
+    (which reaches the range still missing) pays more than one more hour of the final hold; the watch stops at the
+    look that reaches the target."""
+    from gyrocomp.evaluation.log_watch import look, watch_log
+
+    log = chamber_run([20, 50, 20], ramp_degc_per_min=1.0, hold_s=300, rate_hz=RATE_HZ, seed=4)
+    top = int(np.argmax(log.temperature_degc))
+    cuts = [int(0.6 * top), top, log.n_samples]
+    use = UseProfile.cycle(20, 50, 1.0)
+    looks = [look(log.take(np.arange(c)), use=use) for c in cuts]
+    assert [s.rows for s in looks] == cuts and all(s.worst is not None for s in looks), [s.waiting for s in looks]
+    assert looks[0].worst.drift_dps > looks[-1].worst.drift_dps
+    assert looks[0].worst.outside_range_fraction > 0.2
+    assert looks[0].leg_gain_dps_per_h > 2 * looks[-1].leg_gain_dps_per_h
+    pending = iter(cuts)
+    target = 1.01 * looks[1].worst.drift_dps
+    waits = []
+    seen = list(
+        watch_log(
+            lambda: log.take(np.arange(next(pending))), 30.0, use=use, target_drift_dps=target, sleep=waits.append
+        )
+    )
+    assert [s.rows for s in seen] == cuts[: len(seen)] and seen[-1].reached and len(seen) <= 2
+    assert waits == [30.0] * (len(seen) - 1)
+
+
+def test_plan_watch_on_the_command_line_prints_a_line_a_look_and_stops_at_its_target(files):
+    out = run("plan", "--watch", "run0.csv", "--every", "0", "--looks", "2", cwd=files)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert len(lines) == 2 and all(
+        line.startswith("run0.csv: ") and "one more hour of this leg" in line for line in lines
+    )
+    reached = run("plan", "--watch", "run0.csv", "--target-drift", "1", "--looks", "5", cwd=files)
+    assert reached.returncode == 0 and len(reached.stdout.splitlines()) == 1, reached.stderr
+    assert "100% of the way to 1 deg/s" in reached.stdout
+    assert "gyrocomp: target reached: " in reached.stderr
+    wrong = run("plan", "m.json", "run0.csv", "--target-drift", "0.01", cwd=files)
+    assert wrong.returncode == 2 and "--every, --target-drift and --looks go with --watch LOG" in wrong.stderr
