@@ -56,7 +56,13 @@ def _notes(result, calibration: Calibration) -> None:
             echo(
                 f"gyrocomp: note: {forecast.axis}: the model choice could not tell its curve from {named}"
                 + (f" and {more} more" if more > 0 else "")
-                + " (held-out drift within one standard error); the forecast counts the chosen curve's uncertainty alone",
+                + " (held-out drift within one standard error)"
+                + (
+                    f"; fitted, {' and '.join(forecast.alternatives)} part from it by {forecast.model_choice_dps:.2g} "
+                    "deg/s on this profile, added to the interval's upper end"
+                    if forecast.alternatives
+                    else "; the forecast counts the chosen curve's uncertainty alone"
+                ),
                 err=True,
             )
     for axis in calibration.axes:

@@ -47,6 +47,7 @@ from ..effects import moving_average, thermal_lag
 from ..errors import InputError
 from ..fitting.drift_gls import MAX_POINTS, DriftNoise, coarsen, covariance, fit_drift_noise
 from ..recording import Recording
+from .choice_alternatives import Alternative, choice_alternatives, predicted
 
 #: the moving-average window the accuracy page scores the held-out drift with [s]
 DEFAULT_WINDOW_S = 60.0
@@ -176,6 +177,11 @@ class AxisForecast:
         What the model applies whose uncertainty the forecast does not count.
     close_candidates : tuple of str
         Candidates of the model choice whose held-out drift was within one standard error of the chosen one's.
+    model_choice_dps : float
+        How far the fitted alternatives among them part from the chosen curve on the profile (the RMS about its
+        mean of the moving average of their difference, the largest) [deg/s]; added to the interval's upper end.
+    alternatives : tuple of str
+        The forms of those alternatives (:mod:`gyrocomp.evaluation.choice_alternatives`).
     """
 
     axis: str
@@ -190,6 +196,8 @@ class AxisForecast:
     lag_standard_error_s: float | None = None
     not_covered: tuple[str, ...] = ()
     close_candidates: tuple[str, ...] = ()
+    model_choice_dps: float = 0.0
+    alternatives: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -244,6 +252,7 @@ class _Run:
     """One run's series at full rate (model temperature) and as blocks, with its whitening factor."""
 
     time_s: np.ndarray
+    reported_degc: np.ndarray
     model_degc: np.ndarray
     factor: int
     extra: np.ndarray  # block means of the columns that do not depend on the range (lag, rate) (m, q)
@@ -260,10 +269,10 @@ class AxisInformation:
 
     Parameters
     ----------
+    calibration : Calibration
+        The fitted model.
     axis : str
         The gyro axis.
-    ax : AxisCalibration
-        Its fitted model.
     block_s : float
         The block length the series are averaged over [s].
     noise : DriftNoise
@@ -272,8 +281,9 @@ class AxisInformation:
         The runs the information comes from.
     """
 
-    def __init__(self, axis: str, ax: AxisCalibration, block_s: float, noise: DriftNoise, runs: list[_Run]):
-        self.axis, self.ax, self.block_s, self.noise, self.runs = axis, ax, block_s, noise, runs
+    def __init__(self, calibration: Calibration, axis: str, block_s: float, noise: DriftNoise, runs: list[_Run]):
+        self.calibration, self.axis, self.block_s, self.noise, self.runs = calibration, axis, block_s, noise, runs
+        ax = self.ax = calibration.axes[axis]
         self.family, self.size, self.extended = _surrogate(ax, axis)
         self.lo_degc = min(float(r.model_degc.min()) for r in runs)
         self.hi_degc = max(float(r.model_degc.max()) for r in runs)
@@ -304,7 +314,7 @@ class AxisInformation:
             residuals.append(run.blocks(out.gyro(axis) - out.gyro(axis).mean()))
             times.append(run.blocks(rec.time_s))
         noise = fit_drift_noise(residuals, times)
-        info = cls(axis, ax, block_s, noise, runs)
+        info = cls(calibration, axis, block_s, noise, runs)
         for run, t in zip(runs, times):
             run.chol = info.factor(t)
         return info
@@ -342,10 +352,15 @@ class AxisInformation:
         return run
 
     def forecast(
-        self, profile: UseProfile, window_s: float, extra_runs: Sequence[_Run] = (), close: tuple[str, ...] = ()
+        self,
+        profile: UseProfile,
+        window_s: float,
+        extra_runs: Sequence[_Run] = (),
+        close: tuple[str, ...] = (),
+        alternatives: Sequence[Alternative] = (),
     ) -> AxisForecast:
         """The predicted drift on ``profile`` at a moving-average window ``window_s`` [s], from these runs and
-        ``extra_runs``."""
+        ``extra_runs``; ``alternatives``: the fitted forms the choice could not tell from this one on this axis."""
         lo = min([self.lo_degc] + [float(r.model_degc.min()) for r in extra_runs])
         hi = max([self.hi_degc] + [float(r.model_degc.max()) for r in extra_runs])
         cov = _inverse(self.information(lo, hi, extra_runs))
@@ -356,6 +371,8 @@ class AxisInformation:
         held = _about_mean(use.blocks(_held_error(self.ax, use.model_degc, lo, hi, self.extended)), width)
         hold = float(np.sqrt(np.mean(held**2)))
         low, high = _percentiles(weights, white)
+        parting = [self.parting(use, width, alt) for alt in alternatives if self.axis in alt.axes]
+        choice = max(parting, default=0.0)
         coefficients = float(np.sum(weights[: x.shape[1]]))
         noise = float(np.sum(weights[x.shape[1] :])) + white
         lag = self.ax.lag_time_constant_s
@@ -363,7 +380,7 @@ class AxisInformation:
             self.axis,
             math.sqrt(coefficients + noise + hold**2),
             low,
-            high + hold,
+            high + hold + choice,
             math.sqrt(coefficients),
             math.sqrt(noise),
             hold,
@@ -372,7 +389,31 @@ class AxisInformation:
             math.sqrt(max(cov[self.size, self.size], 0.0)) if lag > 0 else None,
             ("memory of the turn",) if self.ax.hysteresis is not None else (),
             close,
+            choice,
+            tuple(alt.form for alt in alternatives if self.axis in alt.axes),
         )
+
+    def difference(self, run: _Run, alternative: Alternative) -> np.ndarray:
+        """The block means of the error the chosen model predicts on ``run`` less the alternative's [deg/s]."""
+        args = (self.axis, run.time_s, run.reported_degc)
+        return run.blocks(predicted(self.calibration, *args) - predicted(alternative.calibration, *args))
+
+    def parting(self, use: _Run, width: int, alternative: Alternative) -> float:
+        """How far ``alternative`` parts from the chosen model on a profile's series: the RMS about its mean of
+        the moving average of their difference [deg/s]."""
+        return float(np.sqrt(np.mean(_about_mean(self.difference(use, alternative), width) ** 2)))
+
+    def separation(self, run: _Run, alternative: Alternative) -> float:
+        """The chi-square (one degree of freedom) a run would give the difference between the chosen model and
+        ``alternative`` under the residual's drift model, its turn-on constant projected out: 9 or more, the run
+        tells them apart at three standard deviations."""
+        import scipy.linalg
+
+        d = self.difference(run, alternative)
+        dw = scipy.linalg.solve_triangular(run.chol, d, lower=True, check_finite=False)
+        one = scipy.linalg.solve_triangular(run.chol, np.ones(d.size), lower=True, check_finite=False)
+        dw = dw - one * (one @ dw) / float(one @ one)
+        return float(dw @ dw)
 
     def _profile(self, profile: UseProfile, window_s: float) -> tuple[_Run, int, np.ndarray]:
         """The profile's series, the moving average's width in its blocks and the drift's eigenvalues on it (kept:
@@ -421,7 +462,7 @@ def _series(ax: AxisCalibration, time_s: np.ndarray, temperature_degc: np.ndarra
     if ax.rate_term is not None:
         extra.append(rate_columns(time_s, model, (ax.rate_term.smoothing_s,), period)[:, 0])
     cols = np.column_stack(extra) if extra else np.zeros((time_s.size, 0))
-    return _Run(time_s, model, factor, coarsen(cols, factor), factor * period)
+    return _Run(time_s, temperature_degc, model, factor, coarsen(cols, factor), factor * period)
 
 
 def _about_mean(x: np.ndarray, width: int) -> np.ndarray:
@@ -542,7 +583,11 @@ def close_candidates(calibration: Calibration, axis: str) -> tuple[str, ...]:
 
 
 def forecast_drift(
-    calibration: Calibration, recordings: Sequence[Recording], profile: UseProfile, window_s: float = DEFAULT_WINDOW_S
+    calibration: Calibration,
+    recordings: Sequence[Recording],
+    profile: UseProfile,
+    window_s: float = DEFAULT_WINDOW_S,
+    model_choice: bool = True,
 ) -> DriftForecast:
     """The predicted held-out drift of ``calibration`` on ``profile``, from the static runs it was fitted on.
 
@@ -557,6 +602,9 @@ def forecast_drift(
         The temperatures the gyro will see.
     window_s : float
         Moving-average window of the drift [s] (the accuracy page's 60 s).
+    model_choice : bool
+        Fit the nearest forms the model choice could not tell apart (:func:`choice_alternatives`) and add how far
+        they part from the chosen curve to the interval (a fit of the runs each).
 
     Returns
     -------
@@ -564,10 +612,14 @@ def forecast_drift(
         Each compensated gyro axis's expected drift [deg/s] with its 95 % interval and its shares.
     """
     infos = axis_information(calibration, recordings, window_s)
+    alternatives = choice_alternatives(calibration, recordings) if model_choice else ()
     return DriftForecast(
         profile.name,
         window_s,
-        {a: i.forecast(profile, window_s, close=close_candidates(calibration, a)) for a, i in infos.items()},
+        {
+            a: i.forecast(profile, window_s, close=close_candidates(calibration, a), alternatives=alternatives)
+            for a, i in infos.items()
+        },
     )
 
 

@@ -20,9 +20,11 @@ import numpy as np
 
 from ..calibration.calibration import Calibration
 from ..recording import Recording
+from .choice_alternatives import choice_alternatives
 from .drift_forecast import (
     DEFAULT_WINDOW_S,
     AxisForecast,
+    AxisInformation,
     axis_information,
     DriftForecast,
     UseProfile,
@@ -35,6 +37,8 @@ HOLD_S = 600.0
 DWELL_S = 1800.0
 #: a candidate's gain below this share of the drift: more chamber time buys little
 WORTHWHILE_GAIN = 0.10
+#: the chi-square (one degree of freedom) at which a run tells an alternative from the chosen model: 3 sigma
+SEPARATION_CHI2 = 9.0
 #: a widened range goes at least this share of the calibrated span past the end it widens
 WIDEN_SHARE = 0.25
 
@@ -209,9 +213,26 @@ def candidate_runs(lo_degc: float, hi_degc: float, ramp: float, use: UseProfile)
     return [CandidateRun(name, text, set_point_profile(points, r, hold, name)) for name, text, points, r, hold in made]
 
 
-def _resolves(now: AxisForecast, after: AxisForecast) -> str:
+def _told_apart(info: AxisInformation, run, alternatives) -> dict:
+    """The alternatives on ``info``'s axis a run would tell from the chosen model, with their chi-square."""
+    found = {}
+    for alt in alternatives:
+        if info.axis in alt.axes:
+            statistic = info.separation(run, alt)
+            if statistic >= SEPARATION_CHI2:
+                found[alt] = statistic
+    return found
+
+
+def _resolves(now: AxisForecast, after: AxisForecast, told: dict) -> str:
     """What a run changes most on an axis, in words with its numbers."""
     changes = [
+        (
+            now.model_choice_dps - after.model_choice_dps,
+            "the model choice (it tells "
+            + ", ".join(f"{alt.form} apart at {math.sqrt(x):.1f} sigma" for alt, x in told.items())
+            + f"; their parting {now.model_choice_dps:.2g} -> {after.model_choice_dps:.2g} deg/s)",
+        ),
         (
             now.extrapolation_dps - after.extrapolation_dps,
             f"the range (extrapolation {now.extrapolation_dps:.2g} -> {after.extrapolation_dps:.2g} deg/s)",
@@ -229,7 +250,8 @@ def _resolves(now: AxisForecast, after: AxisForecast) -> str:
                 f"the lag ({now.lag_s:.0f} s +- {now.lag_standard_error_s:.2g} -> +- {after.lag_standard_error_s:.2g} s)",
             )
         )
-    return max(changes, key=lambda c: c[0])[1]
+    largest = max(change for change, _ in changes)
+    return " and ".join(text for change, text in sorted(changes, key=lambda c: -c[0]) if change >= 0.5 * largest)
 
 
 def plan_calibration(
@@ -237,6 +259,7 @@ def plan_calibration(
     recordings: Sequence[Recording],
     use: UseProfile | None = None,
     window_s: float = DEFAULT_WINDOW_S,
+    model_choice: bool = True,
 ) -> CalibrationPlan:
     """The drift ``calibration`` should leave on ``use``, and which run to record next.
 
@@ -251,6 +274,9 @@ def plan_calibration(
         ramp rate.
     window_s : float
         Moving-average window of the drift [s].
+    model_choice : bool
+        Fit the nearest forms the model choice could not tell apart, count how far they part on ``use``, and say
+        which candidate run tells them apart (a fit of the runs each).
 
     Returns
     -------
@@ -267,13 +293,22 @@ def plan_calibration(
             lo, hi, ramp, name=f"one cycle {lo:.0f}..{hi:.0f} degC at {ramp:.2g} degC/min (the calibration's)"
         )
     close = {a: close_candidates(calibration, a) for a in axes}
-    now = DriftForecast(use.name, window_s, {a: i.forecast(use, window_s, close=close[a]) for a, i in infos.items()})
+    alternatives = choice_alternatives(calibration, recordings) if model_choice else ()
+    now = DriftForecast(
+        use.name, window_s, {a: i.forecast(use, window_s, (), close[a], alternatives) for a, i in infos.items()}
+    )
     worst_now = now.worst.drift_dps
     advice = []
     for run in candidate_runs(lo, hi, ramp, use):
         extra = {a: i.with_run(run.profile.time_s, run.profile.temperature_degc, run.name) for a, i in infos.items()}
+        told = {a: _told_apart(i, extra[a], alternatives) for a, i in infos.items()}
         after = DriftForecast(
-            use.name, window_s, {a: i.forecast(use, window_s, [extra[a]], close[a]) for a, i in infos.items()}
+            use.name,
+            window_s,
+            {
+                a: i.forecast(use, window_s, [extra[a]], close[a], [alt for alt in alternatives if alt not in told[a]])
+                for a, i in infos.items()
+            },
         )
         worst = now.worst.axis
         advice.append(
@@ -281,7 +316,7 @@ def plan_calibration(
                 run,
                 after,
                 (worst_now - after.worst.drift_dps) / run.hours,
-                _resolves(now.axes[worst], after.axes[worst]),
+                _resolves(now.axes[worst], after.axes[worst], told[worst]),
             )
         )
     advice.sort(key=lambda a: -a.gain_dps_per_h)
