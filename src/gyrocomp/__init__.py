@@ -67,7 +67,7 @@ _EXPORTS = {
     "validate": ("evaluation.validation", "validate"),
     "UseProfile": ("evaluation.drift_forecast", "UseProfile"),
     "forecast_drift": ("evaluation.drift_forecast", "forecast_drift"),
-    "plan_calibration": ("evaluation.run_advice", "plan_calibration"),
+    "plan": ("evaluation.run_advice", "plan"),
     "detect_still": ("motion.stillness", "detect_still"),
     "StillnessState": ("motion.stillness", "StillnessState"),
     "field_recordings": ("models.field", "field_recordings"),

@@ -18,7 +18,7 @@ import gyrocomp
 from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError
 from gyrocomp.evaluation.drift_forecast import UseProfile, forecast_drift
-from gyrocomp.evaluation.run_advice import plan_calibration, ramp_rate_degc_per_min
+from gyrocomp.evaluation.run_advice import plan, ramp_rate_degc_per_min
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 
@@ -80,19 +80,21 @@ def test_a_use_profile_past_the_range_is_forecast_worse_and_the_run_it_recommend
     _, train, calibration = parts[0]
     use_run = chamber_run([10, 60, 10], ramp_degc_per_min=1.0, hold_s=300, rate_hz=RATE_HZ, seed=7)
     inside = forecast_drift(calibration, train, UseProfile.cycle(20, 50, 1.0))
-    plan = plan_calibration(calibration, train, UseProfile.of(use_run))
-    for axis, f in plan.now.axes.items():
+    advised = plan(calibration, train, UseProfile.of(use_run))
+    for axis, f in advised.now.axes.items():
         assert f.drift_dps > inside.axes[axis].drift_dps
         assert f.outside_range_fraction > 0.2 and inside.axes[axis].outside_range_fraction < 0.05
-    assert not plan.enough
-    assert [a.gain_dps_per_h for a in plan.advice] == sorted((a.gain_dps_per_h for a in plan.advice), reverse=True)
-    best = min(plan.advice, key=lambda a: a.after.worst.drift_dps)
+    assert not advised.enough
+    assert [a.gain_dps_per_h for a in advised.advice] == sorted(
+        (a.gain_dps_per_h for a in advised.advice), reverse=True
+    )
+    best = min(advised.advice, key=lambda a: a.after.worst.drift_dps)
     t = best.run.profile.temperature_degc
     assert t.min() <= 10.5 and t.max() >= 59.5, best.run.description
     assert "range" in best.resolves or "model choice" in best.resolves, best.resolves
     recorded = chamber_run(
         [float(t.min()), float(t.max()), float(t.min())],
-        ramp_degc_per_min=plan.ramp_degc_per_min,
+        ramp_degc_per_min=advised.ramp_degc_per_min,
         hold_s=600,
         rate_hz=RATE_HZ,
         seed=3,
@@ -100,8 +102,25 @@ def test_a_use_profile_past_the_range_is_forecast_worse_and_the_run_it_recommend
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         refit = gyrocomp.fit(train + [recorded])
-    worst = plan.now.worst.axis
+    worst = advised.now.worst.axis
     assert _drift(refit, use_run)[worst] < 0.7 * _drift(calibration, use_run)[worst]
+
+
+def test_within_a_budget_or_to_a_target_the_runs_are_chosen_in_turn(parts):
+    """A budget of 4 h: the runs in turn fit in it, each lowers the drift the one before left, the first is the
+    best gain per hour of the single runs; a target: the sequence stops at the first run that reaches it."""
+    _, train, calibration = parts[0]
+    use = UseProfile.cycle(10, 60, 1.0)
+    budget = plan(calibration, train, use, budget_h=4.0, model_choice=False)
+    assert budget.sequence and sum(a.run.hours for a in budget.sequence) <= 4.0
+    drifts = [budget.now.worst.drift_dps] + [a.after.worst.drift_dps for a in budget.sequence]
+    assert drifts == sorted(drifts, reverse=True) and drifts[-1] < drifts[0]
+    assert budget.sequence[0].run.name == budget.advice[0].run.name
+    target = 0.5 * (drifts[0] + drifts[1])
+    aimed = plan(calibration, train, use, target_drift_dps=target, model_choice=False)
+    assert aimed.reaches_target and len(aimed.sequence) == 1
+    far = plan(calibration, train, use, target_drift_dps=1e-9, budget_h=2.5, model_choice=False)
+    assert far.reaches_target is False and sum(a.run.hours for a in far.sequence) <= 2.5
 
 
 def test_the_calibration_runs_ramp_rate_is_read_from_their_temperatures():
@@ -135,26 +154,32 @@ def files(tmp_path_factory, parts):
 
 
 def test_plan_on_the_command_line_prints_the_forecast_and_the_next_run(files):
-    out = run("plan", "m.json", "run0.csv", "run1.csv", "--use", "use.csv", cwd=files)
+    out = run("plan", "m.json", "run0.csv", "run1.csv", "--use-profile", "use.csv", cwd=files)
     assert out.returncode == 0, out.stderr
     assert "drift to expect on use.csv (60 s moving average, 95 % interval)" in out.stdout
     next_line = [line for line in out.stderr.splitlines() if line.startswith("gyrocomp: next: record ")]
     assert len(next_line) == 1 and re.search("it resolves the (range|model choice)", next_line[0]), out.stderr
     document = json.loads(
-        run("plan", "m.json", "run0.csv", "run1.csv", "--use-range", "10:60", "--json", cwd=files).stdout
+        run("plan", "m.json", "run0.csv", "run1.csv", "--use-profile", "10:60", "--json", cwd=files).stdout
     )
     assert set(document["now"]["axes"]) == {"gyro_x", "gyro_y", "gyro_z"}
     assert document["now"]["profile"].startswith("10..60 degC at ")
     assert document["advice"][0]["gain_dps_per_h"] >= document["advice"][-1]["gain_dps_per_h"]
+    budget = run("plan", "m.json", "run0.csv", "run1.csv", "--use-profile", "10:60", "--budget-h", "4", cwd=files)
+    assert budget.returncode == 0 and "gyrocomp: next: within 4 h: record " in budget.stderr, budget.stderr
 
 
 @pytest.mark.parametrize(
     "extra, message",
     [
-        (("--use-range", "60:10"), "Invalid value for --use-range: '60:10': the lower end first"),
-        (("--use-range", "ten:60"), "'ten:60': give LO:HI in degC"),
-        (("--use-ramp", "2"), "--use-ramp goes with --use-range"),
-        (("--use", "use.csv", "--use-range", "10:60"), "give --use LOG or --use-range LO:HI, not both"),
+        (("--use-profile", "60:10"), "Invalid value for --use-profile: '60:10': the lower end first"),
+        (("--use-profile", "ten:60"), "'ten:60': no such file, and not a range LO:HI in degC"),
+        (("--use-profile", "nothere.csv"), "nothere.csv"),
+        (("--use-ramp", "2"), "--use-ramp goes with --use-profile LO:HI"),
+        (("--use-profile", "use.csv", "--use-ramp", "2"), "--use-ramp goes with --use-profile LO:HI"),
+        (("--looks", "2"), "--every and --looks go with --watch LOG"),
+        (("--budget-h", "0"), "Invalid value for --budget-h: must be positive"),
+        (("--target-drift", "-1"), "Invalid value for --target-drift: must be positive"),
         (("--window", "0"), "Invalid value for --window: must be positive"),
     ],
 )
@@ -224,5 +249,5 @@ def test_plan_watch_on_the_command_line_prints_a_line_a_look_and_stops_at_its_ta
     assert reached.returncode == 0 and len(reached.stdout.splitlines()) == 1, reached.stderr
     assert "100% of the way to 1 deg/s" in reached.stdout
     assert "gyrocomp: target reached: " in reached.stderr
-    wrong = run("plan", "m.json", "run0.csv", "--target-drift", "0.01", cwd=files)
-    assert wrong.returncode == 2 and "--every, --target-drift and --looks go with --watch LOG" in wrong.stderr
+    wrong = run("plan", "--watch", "run0.csv", "--budget-h", "3", cwd=files)
+    assert wrong.returncode == 2 and "--budget-h plans the runs to record next" in wrong.stderr

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
+from pathlib import Path
 
 import click
 
 from ..calibration import Calibration
 from ..evaluation.drift_forecast import DEFAULT_WINDOW_S, UseProfile
 from ..evaluation.log_watch import watch_log
-from ..evaluation.run_advice import WORTHWHILE_GAIN, plan_calibration, ramp_rate_degc_per_min
+from ..evaluation.run_advice import WORTHWHILE_GAIN, plan as plan_runs, ramp_rate_degc_per_min
 from .common import FINITE, echo, pop_read_options, read_options, read_run
 from .render import print_plan
 
@@ -19,22 +21,20 @@ from .render import print_plan
 SHOWN_CANDIDATES = 3
 
 
-def _check_options(
-    paths, watch, every_s, every_given, target_drift_dps, looks, use_log, use_range, use_ramp, window_s
-) -> None:
+def _check_options(paths, watch, every_given, looks, budget_h, use_ramp, use_profile, window_s, every_s) -> None:
     """Options that do not go together, or out of their range: a usage error naming them."""
     if not window_s > 0:
         raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
-    if use_log is not None and use_range is not None:
-        raise click.UsageError("give --use LOG or --use-range LO:HI, not both")
     if use_ramp is not None and not use_ramp > 0:
         raise click.BadParameter(f"must be positive, got {use_ramp:g}", param_hint="--use-ramp")
-    if use_ramp is not None and use_range is None:
-        raise click.UsageError("--use-ramp goes with --use-range (a log's own ramps are its own)")
-    if watch is None and (every_given or target_drift_dps is not None or looks is not None):
-        raise click.UsageError("--every, --target-drift and --looks go with --watch LOG")
-    if target_drift_dps is not None and not target_drift_dps > 0:
-        raise click.BadParameter(f"must be positive, got {target_drift_dps:g}", param_hint="--target-drift")
+    if use_ramp is not None and _range_text(use_profile) is None:
+        raise click.UsageError("--use-ramp goes with --use-profile LO:HI (a log's own ramps are its own)")
+    if watch is None and (every_given or looks is not None):
+        raise click.UsageError("--every and --looks go with --watch LOG")
+    if watch is not None and budget_h is not None:
+        raise click.UsageError("--budget-h plans the runs to record next; --watch follows the run under way")
+    if budget_h is not None and not budget_h > 0:
+        raise click.BadParameter(f"must be positive, got {budget_h:g}", param_hint="--budget-h")
     if not every_s >= 0:
         raise click.BadParameter(f"must be zero or more, got {every_s:g}", param_hint="--every")
     if watch is None and len(paths) < 2:
@@ -68,6 +68,9 @@ def _notes(result, calibration: Calibration) -> None:
     for axis in calibration.axes:
         if axis not in result.now.axes:
             echo(f"gyrocomp: note: {axis}: constants only (no temperature curve), not forecast", err=True)
+    if result.sequence or result.budget_h is not None or result.target_drift_dps is not None:
+        echo(_sequence_line(result), err=True)
+        return
     best = result.advice[0] if result.advice else None
     if result.enough or best is None:
         echo(
@@ -83,19 +86,53 @@ def _notes(result, calibration: Calibration) -> None:
         )
 
 
-def _use_profile(use_log, bounds, use_ramp, recordings, opts) -> UseProfile | None:
-    """The use profile the options describe (None: the calibration's own range)."""
-    if use_log is not None:
-        return UseProfile.of(read_run(use_log, opts).recording)
-    if bounds is not None:
-        return UseProfile.cycle(*bounds, use_ramp or ramp_rate_degc_per_min(recordings))
-    return None
+def _sequence_line(result) -> str:
+    """The runs to record in turn, within the budget or to the target, in one line."""
+    within = f"within {result.budget_h:g} h" if result.budget_h is not None else "to reach the target"
+    if not result.sequence:
+        return f"gyrocomp: next: {within}, no candidate run lowers the worst axis's expected drift"
+    runs = ", then ".join(f"{a.run.name} ({a.run.description}, {a.run.hours:.1f} h)" for a in result.sequence)
+    hours = sum(a.run.hours for a in result.sequence)
+    end = result.sequence[-1].after.worst.drift_dps
+    line = f"gyrocomp: next: {within}: record {runs}; {hours:.1f} h in all, the worst axis {result.now.worst.drift_dps:.2g} -> {end:.2g} deg/s"
+    if result.target_drift_dps is not None:
+        line += f"; {'reaches' if result.reaches_target else 'does not reach'} {result.target_drift_dps:g} deg/s"
+    return line
 
 
-def _watch(log, earlier_paths, opts, use_log, bounds, use_ramp, window_s, every_s, target, looks, as_json) -> None:
+#: a use profile given as a range: LO:HI in degC
+_RANGE = re.compile(r"^\s*([-+]?[0-9.]+(?:e[-+]?[0-9]+)?)\s*:\s*([-+]?[0-9.]+(?:e[-+]?[0-9]+)?)\s*$", re.I)
+
+
+def _range_text(text: str | None) -> re.Match | None:
+    """The range a --use-profile names (None: a file, or nothing given); a file of that name wins."""
+    if text is None or Path(text).exists():
+        return None
+    return _RANGE.match(text)
+
+
+def _use_profile(text, use_ramp, recordings, opts) -> UseProfile | None:
+    """The use profile --use-profile names: a log's temperatures, or one cycle over LO:HI degC (None: the
+    calibration's own range)."""
+    if text is None:
+        return None
+    found = _range_text(text)
+    if found is None:
+        if not Path(text).exists() and ":" in text:
+            raise click.BadParameter(
+                f"{text!r}: no such file, and not a range LO:HI in degC (e.g. -10:60)", param_hint="--use-profile"
+            )
+        return UseProfile.of(read_run(text, opts).recording)
+    lo, hi = float(found.group(1)), float(found.group(2))
+    if not lo < hi:
+        raise click.BadParameter(f"{text!r}: the lower end first", param_hint="--use-profile")
+    return UseProfile.cycle(lo, hi, use_ramp or ramp_rate_degc_per_min(recordings))
+
+
+def _watch(log, earlier_paths, opts, use_profile, use_ramp, window_s, every_s, target, looks, as_json) -> None:
     """Look at the growing ``log`` until the target is reached or the looks are done, a line (or a JSON line) each."""
     earlier = [read_run(path, opts).recording for path in earlier_paths]
-    use = _use_profile(use_log, bounds, use_ramp, earlier or [read_run(log, opts).recording], opts)
+    use = _use_profile(use_profile, use_ramp, earlier or [read_run(log, opts).recording], opts)
     first = None
     for seen in watch_log(lambda: read_run(log, opts).recording, every_s, earlier, use, window_s, target, looks):
         if as_json:
@@ -129,19 +166,6 @@ def _progress(first: float, now: float, target: float, width: int = 20) -> str:
     return f"[{'#' * filled}{'.' * (width - filled)}] {share:.0%} of the way to {target:g} deg/s"
 
 
-def _use_range(text: str | None) -> tuple[float, float] | None:
-    if text is None:
-        return None
-    parts = text.split(":")
-    try:
-        lo, hi = (float(p) for p in parts)
-    except ValueError:
-        raise click.BadParameter(f"{text!r}: give LO:HI in degC, e.g. -10:60", param_hint="--use-range") from None
-    if not lo < hi:
-        raise click.BadParameter(f"{text!r}: the lower end first", param_hint="--use-range")
-    return lo, hi
-
-
 @click.command()
 @click.argument("paths", nargs=-1, type=click.Path(), metavar="MODEL RUNS... | --watch LOG [RUNS...]")
 @click.option(
@@ -162,7 +186,17 @@ def _use_range(text: str | None) -> tuple[float, float] | None:
     type=FINITE,
     default=None,
     metavar="DEG_PER_S",
-    help="With --watch: stop (exit 0) once the worst axis's expected drift is at or under this [deg/s].",
+    help="The worst axis's expected drift to reach [deg/s]: the runs to record until it is reached; with --watch, "
+    "stop (exit 0) at the look that reaches it.",
+)
+@click.option(
+    "--budget-h",
+    "budget_h",
+    type=FINITE,
+    default=None,
+    metavar="HOURS",
+    help="Chamber time to spend [h]: the runs to record one after another within it, each the best gain per hour "
+    "after those before it.",
 )
 @click.option(
     "--looks",
@@ -171,19 +205,12 @@ def _use_range(text: str | None) -> tuple[float, float] | None:
     help="With --watch: stop after this many looks (default: until --target-drift is reached, or Ctrl-C).",
 )
 @click.option(
-    "--use",
-    "use_log",
-    type=click.Path(),
+    "--use-profile",
+    "use_profile",
     default=None,
-    metavar="LOG",
-    help="The temperatures the gyro will see: a log of the vehicle's own (its temperature column).",
-)
-@click.option(
-    "--use-range",
-    "use_range",
-    default=None,
-    metavar="LO:HI",
-    help="The temperatures the gyro will see, as one heat-cool cycle over LO..HI degC (default: the calibrated range).",
+    metavar="FILE|LO:HI",
+    help="The temperatures the gyro will see: a log of the vehicle's own (its temperature column), or one heat-cool "
+    "cycle over LO..HI degC (default: the calibrated range at the runs' ramp rate).",
 )
 @click.option(
     "--use-ramp",
@@ -191,7 +218,7 @@ def _use_range(text: str | None) -> tuple[float, float] | None:
     type=FINITE,
     default=None,
     metavar="DEGC_PER_MIN",
-    help="With --use-range: the cycle's ramp rate [degC/min] (default: the calibration runs').",
+    help="With --use-profile LO:HI: the cycle's ramp rate [degC/min] (default: the calibration runs').",
 )
 @click.option(
     "--window",
@@ -205,7 +232,7 @@ def _use_range(text: str | None) -> tuple[float, float] | None:
 @read_options
 @click.pass_context
 def plan(
-    ctx, paths, watch, every_s, target_drift_dps, looks, use_log, use_range, use_ramp, window_s, as_json, **kwargs
+    ctx, paths, watch, every_s, target_drift_dps, budget_h, looks, use_profile, use_ramp, window_s, as_json, **kwargs
 ):
     """How much chamber time is enough, and which run to record next: the drift MODEL should leave on a use
     profile, and candidate runs scored per hour of chamber time.
@@ -223,16 +250,15 @@ def plan(
     opts = pop_read_options(kwargs)
     # on the command line (a project file's [plan] every = ... is a default, for the watches that read it)
     every_given = ctx.get_parameter_source("every_s") is click.core.ParameterSource.COMMANDLINE
-    _check_options(paths, watch, every_s, every_given, target_drift_dps, looks, use_log, use_range, use_ramp, window_s)
-    bounds = _use_range(use_range)
+    _check_options(paths, watch, every_given, looks, budget_h, use_ramp, use_profile, window_s, every_s)
+    if target_drift_dps is not None and not target_drift_dps > 0:
+        raise click.BadParameter(f"must be positive, got {target_drift_dps:g}", param_hint="--target-drift")
     if watch is not None:
-        return _watch(
-            watch, paths, opts, use_log, bounds, use_ramp, window_s, every_s, target_drift_dps, looks, as_json
-        )
+        return _watch(watch, paths, opts, use_profile, use_ramp, window_s, every_s, target_drift_dps, looks, as_json)
     calibration = Calibration.load(paths[0])
     recordings = [read_run(path, opts).recording for path in paths[1:]]
-    use = _use_profile(use_log, bounds, use_ramp, recordings, opts)
-    result = plan_calibration(calibration, recordings, use, window_s)
+    use = _use_profile(use_profile, use_ramp, recordings, opts)
+    result = plan_runs(calibration, recordings, use, window_s, budget_h=budget_h, target_drift_dps=target_drift_dps)
     if as_json:
         echo(json.dumps(result.to_dict(), indent=2), lines=True)
         return

@@ -53,6 +53,9 @@ from .choice_alternatives import Alternative, choice_alternatives, predicted
 DEFAULT_WINDOW_S = 60.0
 #: blocks per window: the time resolution of the forecast's series (the longest runs coarser: :data:`MAX_POINTS`)
 BLOCKS_PER_WINDOW = 6
+#: the most blocks a run not yet recorded is averaged into (its information changes little coarser; its
+#: covariance is dense)
+CANDIDATE_BLOCKS = 400
 #: draws of the quadratic form for its percentiles, and its leading eigenvalues drawn (the rest by their mean)
 DRAWS = 4000
 LEADING = 60
@@ -319,11 +322,14 @@ class AxisInformation:
             run.chol = info.factor(t)
         return info
 
-    def factor(self, t_blocks: np.ndarray) -> np.ndarray:
-        """The Cholesky factor of a run's residual covariance at block times ``t_blocks`` [s]."""
+    def factor(self, t_blocks: np.ndarray, block_s: float | None = None) -> np.ndarray:
+        """The Cholesky factor of a run's residual covariance at block times ``t_blocks`` [s], of blocks
+        ``block_s`` [s] long (default the runs' own: the white part's variance per block scales with it)."""
         import scipy.linalg  # slow to import: only when a forecast is asked
 
-        return scipy.linalg.cholesky(covariance(t_blocks, self.noise), lower=True, check_finite=False)
+        white = self.noise.white_var * self.block_s / (block_s or self.block_s)
+        noise = DriftNoise(white, self.noise.walk_var_per_s, self.noise.exponent)
+        return scipy.linalg.cholesky(covariance(t_blocks, noise), lower=True, check_finite=False)
 
     def columns(self, run: _Run, lo_degc: float, hi_degc: float) -> np.ndarray:
         """The run's block columns (m, p): the curve family's over [lo, hi] degC, then the lag's and rate's."""
@@ -346,9 +352,10 @@ class AxisInformation:
 
     def with_run(self, time_s: np.ndarray, temperature_degc: np.ndarray, name: str) -> "_Run":
         """A run not yet recorded, at times ``time_s`` [s] and reported temperatures ``temperature_degc`` [degC],
-        as the forecast adds it (:meth:`forecast`'s ``extra_runs``)."""
-        run = _series(self.ax, time_s, temperature_degc, self.block_s, name)
-        run.chol = self.factor(run.blocks(time_s))
+        as the forecast adds it (:meth:`forecast`'s ``extra_runs``), in at most :data:`CANDIDATE_BLOCKS` blocks."""
+        duration_s = float(time_s[-1] - time_s[0]) if np.size(time_s) > 1 else 0.0
+        run = _series(self.ax, time_s, temperature_degc, max(self.block_s, duration_s / CANDIDATE_BLOCKS), name)
+        run.chol = self.factor(run.blocks(time_s), run.block_s)
         return run
 
     def forecast(
