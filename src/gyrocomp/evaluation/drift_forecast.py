@@ -53,6 +53,9 @@ from .choice_alternatives import Alternative, choice_alternatives, predicted
 DEFAULT_WINDOW_S = 60.0
 #: blocks per window: the time resolution of the forecast's series (the longest runs coarser: :data:`MAX_POINTS`)
 BLOCKS_PER_WINDOW = 6
+#: the residual's variogram is fitted up to 1/this of the run: the forecast needs the drift over a whole use
+#: profile, where a fit to the short lags alone extrapolates a smooth misfit's steep growth
+NOISE_REACH = 2
 #: the most blocks a run not yet recorded is averaged into (its information changes little coarser; its
 #: covariance is dense)
 CANDIDATE_BLOCKS = 400
@@ -316,7 +319,7 @@ class AxisInformation:
             runs.append(run)
             residuals.append(run.blocks(out.gyro(axis) - out.gyro(axis).mean()))
             times.append(run.blocks(rec.time_s))
-        noise = fit_drift_noise(residuals, times)
+        noise = fit_drift_noise(residuals, times, reach=NOISE_REACH)
         info = cls(calibration, axis, block_s, noise, runs)
         for run, t in zip(runs, times):
             run.chol = info.factor(t)

@@ -101,17 +101,20 @@ def _fit_at(dt: np.ndarray, v: np.ndarray, w: np.ndarray, exponent: float) -> tu
 
 
 def fit_drift_noise(
-    residuals: list[np.ndarray], times_s: list[np.ndarray], exponents: tuple[float, ...] = DRIFT_EXPONENTS
+    residuals: list[np.ndarray],
+    times_s: list[np.ndarray],
+    exponents: tuple[float, ...] = DRIFT_EXPONENTS,
+    reach: int = VARIOGRAM_REACH,
 ) -> DriftNoise:
     """The white variance ``a`` [unit^2], drift coefficient ``c`` [unit^2/s^alpha] and exponent ``alpha`` of
     residuals (one array per recording, at times ``times_s`` [s]), from a non-negative least-squares fit of
 
         V(L) = mean_i (r_{i+L} - r_i)^2 = 2 a + c dt(L)^alpha
 
-    over log-spaced lags L up to 1/:data:`VARIOGRAM_REACH` of the recording (:func:`empirical_variogram`), each
-    lag weighted by 1 / V(L)^2 (a relative fit), alpha the one of ``exponents`` of least misfit (``(1.0,)``: the
-    white plus random-walk model)."""
-    dt, v = empirical_variogram(residuals, times_s)
+    over log-spaced lags L up to 1/``reach`` of the recording (:func:`empirical_variogram`), each lag weighted by
+    1 / V(L)^2 (a relative fit), alpha the one of ``exponents`` of least misfit (``(1.0,)``: the white plus
+    random-walk model)."""
+    dt, v = empirical_variogram(residuals, times_s, reach=reach)
     if not dt.size:
         return DriftNoise(0.0, 0.0)
     w = 1.0 / np.maximum(v, 1e-300)
