@@ -17,7 +17,8 @@ import pytest
 import gyrocomp
 from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError
-from gyrocomp.evaluation.drift_forecast import UseProfile, forecast_drift
+from gyrocomp.evaluation.choice_alternatives import choice_alternatives
+from gyrocomp.evaluation.drift_forecast import DEFAULT_WINDOW_S, UseProfile, axis_information, forecast_drift
 from gyrocomp.evaluation.run_advice import plan, ramp_rate_degc_per_min
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
@@ -55,22 +56,31 @@ def parts():
     return out
 
 
-def test_the_interval_holds_the_drift_of_a_held_out_run_at_another_ramp_rate(parts):
-    """On a new power-on at 1.5 degC/min (the fit saw 1 degC/min), the drift the model leaves falls inside the
-    forecast's 95 % interval on nearly every axis of every part, and the forecast is the drift's size, not a
-    bound far off (the ratios' geometric mean within a factor 1.6)."""
+def test_the_interval_holds_the_drift_of_a_new_power_on_and_past_the_range(parts):
+    """On a new power-on of each part through the same cycle, the drift the model leaves falls inside the
+    forecast's 95 % interval on every axis and the forecast is its size (the ratios' geometric mean within a factor
+    1.3); on a run past both ends (10..60 degC, the fit saw 20..50), inside the interval on every axis, the
+    extrapolation measured by the fit made again without each end of its own range (measured: forecast/drift
+    0.84..1.17 on the cycle; 1.2..2.7 past the range on the zoo's parts, bench_plan)."""
     inside, ratios = [], []
     for seed, train, calibration in parts:
-        held_out = chamber_run([20, 50, 20], ramp_degc_per_min=1.5, hold_s=300, rate_hz=RATE_HZ, seed=10 * seed + 5)
-        forecast = forecast_drift(calibration, train, UseProfile.of(held_out))
-        actual = _drift(calibration, held_out)
-        for axis, f in forecast.axes.items():
-            assert f.low_dps <= f.drift_dps <= f.high_dps
-            assert f.drift_dps**2 == pytest.approx(f.coefficients_dps**2 + f.noise_dps**2 + f.extrapolation_dps**2)
-            inside.append(f.low_dps <= actual[axis] <= f.high_dps)
-            ratios.append(f.drift_dps / actual[axis])
-    assert sum(inside) >= len(inside) - 2, (inside, ratios)
-    assert 1 / 1.6 < math.exp(np.mean(np.log(ratios))) < 1.6, ratios
+        again = chamber_run([20, 50, 20], ramp_degc_per_min=1.0, hold_s=300, rate_hz=RATE_HZ, seed=10 * seed + 5)
+        wider = chamber_run([10, 60, 10], ramp_degc_per_min=1.0, hold_s=300, rate_hz=RATE_HZ, seed=10 * seed + 6)
+        # what forecast_drift does, its fits made once for both profiles
+        infos = axis_information(calibration, train, DEFAULT_WINDOW_S)
+        alternatives = choice_alternatives(calibration, train)
+        for held_out, scored in ((again, True), (wider, False)):
+            actual = _drift(calibration, held_out)
+            for axis, info in infos.items():
+                f = info.forecast(UseProfile.of(held_out), DEFAULT_WINDOW_S, alternatives=alternatives)
+                assert f.low_dps <= f.drift_dps <= f.high_dps
+                shares = f.coefficients_dps**2 + f.noise_dps**2 + f.extrapolation_dps**2
+                assert f.drift_dps**2 == pytest.approx(shares)
+                inside.append(f.low_dps <= actual[axis] <= f.high_dps)
+                if scored:
+                    ratios.append(f.drift_dps / actual[axis])
+    assert all(inside), (inside, ratios)
+    assert 1 / 1.3 < math.exp(np.mean(np.log(ratios))) < 1.3, ratios
 
 
 def test_a_use_profile_past_the_range_is_forecast_worse_and_the_run_it_recommends_helps(parts):
@@ -159,14 +169,16 @@ def test_plan_on_the_command_line_prints_the_forecast_and_the_next_run(files):
     assert "drift to expect on use.csv (60 s moving average, 95 % interval)" in out.stdout
     next_line = [line for line in out.stderr.splitlines() if line.startswith("gyrocomp: next: record ")]
     assert len(next_line) == 1 and re.search("it resolves the (range|model choice)", next_line[0]), out.stderr
-    document = json.loads(
-        run("plan", "m.json", "run0.csv", "run1.csv", "--use-profile", "10:60", "--json", cwd=files).stdout
+    budget = run(
+        "plan", "m.json", "run0.csv", "run1.csv", "--use-profile", "10:60", "--budget-h", "4", "--json", cwd=files
     )
+    document = json.loads(budget.stdout)
     assert set(document["now"]["axes"]) == {"gyro_x", "gyro_y", "gyro_z"}
     assert document["now"]["profile"].startswith("10..60 degC at ")
     assert document["advice"][0]["gain_dps_per_h"] >= document["advice"][-1]["gain_dps_per_h"]
-    budget = run("plan", "m.json", "run0.csv", "run1.csv", "--use-profile", "10:60", "--budget-h", "4", cwd=files)
-    assert budget.returncode == 0 and "gyrocomp: next: within 4 h: record " in budget.stderr, budget.stderr
+    assert document["budget_h"] == 4 and 0 < sum(a["hours"] for a in document["sequence"]) <= 4
+    first = document["sequence"][0]
+    assert first["run"] == document["advice"][0]["run"] and first["set_points_degc"] and first["ramp_degc_per_min"] > 0
 
 
 @pytest.mark.parametrize(

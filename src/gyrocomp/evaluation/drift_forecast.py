@@ -156,6 +156,38 @@ def set_point_profile(points_degc: Sequence[float], ramp_degc_per_min: float, ho
     return UseProfile(t, np.interp(t, knots_t, knots_v), name)
 
 
+#: the share of the calibrated span held out at each end to measure how fast the curve loses track past it
+HELD_SHARE = 0.2
+
+
+@dataclass(frozen=True)
+class EdgeRates:
+    """An axis's measured extrapolation rates past the low and the high end (None: not measured).
+
+    Attributes
+    ----------
+    low_dps, high_dps : float or None
+        ``k`` of ``e = k d^power`` past the low and the high end [deg/s per degC^power], d the distance [degC].
+    power : int
+        2 for a curve continued along its tangent, 1 for one held at its edge.
+    """
+
+    low_dps: float | None
+    high_dps: float | None
+    power: int
+
+    def error_dps(self, model_degc: np.ndarray, lo_degc: float, hi_degc: float) -> np.ndarray:
+        """The extrapolation error these rates give at ``model_degc`` past [lo, hi] degC [deg/s] (0 inside)."""
+        out = np.zeros(np.size(model_degc))
+        for rate, beyond, dist in (
+            (self.low_dps, model_degc < lo_degc, lo_degc - model_degc),
+            (self.high_dps, model_degc > hi_degc, model_degc - hi_degc),
+        ):
+            if rate is not None:
+                out[beyond] = rate * dist[beyond] ** self.power
+        return out
+
+
 @dataclass(frozen=True)
 class AxisForecast:
     """One axis's predicted held-out drift on a use profile [deg/s]: the RMS about its mean of the moving average.
@@ -264,6 +296,7 @@ class _Run:
     extra: np.ndarray  # block means of the columns that do not depend on the range (lag, rate) (m, q)
     block_s: float
     chol: np.ndarray | None = None
+    raw: np.ndarray | None = None  # block means of the gyro axis as recorded [deg/s] (calibration runs)
 
     def blocks(self, values: np.ndarray) -> np.ndarray:
         return coarsen(values, self.factor)
@@ -296,6 +329,7 @@ class AxisInformation:
         self.lo_degc = min(self.lo_degc, ax.temperature.t_min_degc)
         self.hi_degc = max(self.hi_degc, ax.temperature.t_max_degc)
         self._profiles: dict = {}  # a profile's series and its noise's eigenvalues, by profile and window
+        self.edge: EdgeRates | None = None  # the measured extrapolation rates (edge_holdout), when asked
 
     @classmethod
     def of(
@@ -316,6 +350,7 @@ class AxisInformation:
             if axis not in rec.gyro_axes:
                 raise InputError(f"{rec.source}: no {axis} column; give the runs the model was fitted on")
             run = _series(ax, rec.time_s, rec.temperature_for(axis), block_s, rec.source)
+            run.raw = run.blocks(rec.gyro(axis))
             runs.append(run)
             residuals.append(run.blocks(out.gyro(axis) - out.gyro(axis).mean()))
             times.append(run.blocks(rec.time_s))
@@ -378,7 +413,10 @@ class AxisInformation:
         x = _about_mean(self.columns(use, lo, hi), width)
         weights = np.concatenate([_form_weights(x, cov), noise_weights])
         white = self.noise.white_var * self.block_s / (width * use.block_s)
-        held = _about_mean(use.blocks(_held_error(self.ax, use.model_degc, lo, hi, self.extended)), width)
+        past = _held_error(self.ax, use.model_degc, lo, hi, self.extended)
+        if self.edge is not None:  # as fast as the same fit lost track past a cut in its own data, if faster
+            past = np.maximum(past, self.edge.error_dps(use.model_degc, lo, hi))
+        held = _about_mean(use.blocks(past), width)
         hold = float(np.sqrt(np.mean(held**2)))
         low, high = _percentiles(weights, white)
         parting = [self.parting(use, width, alt) for alt in alternatives if self.axis in alt.axes]
@@ -402,6 +440,46 @@ class AxisInformation:
             choice,
             tuple(alt.form for alt in alternatives if self.axis in alt.axes),
         )
+
+    def edge_rates(self) -> EdgeRates:
+        """How fast the axis's curve family, fitted to the runs without the top (or the bottom)
+        :data:`HELD_SHARE` of their model temperature and continued past the cut as the model is, parts from the
+        same family fitted on all of them, per degC^power past the cut (:class:`EdgeRates`)."""
+        held = HELD_SHARE * (self.hi_degc - self.lo_degc)
+        power = 2 if self.extended else 1
+        full = self._surrogate_fit(self.lo_degc, self.hi_degc, None)
+        rates = []
+        for cut, sign in ((self.lo_degc + held, -1.0), (self.hi_degc - held, 1.0)):
+            lo, hi = (cut, self.hi_degc) if sign < 0 else (self.lo_degc, cut)
+            part = self._surrogate_fit(lo, hi, (lo, hi))
+            num = den = 0.0
+            for run, x_cut, x_all in zip(self.runs, part, full):
+                temp = run.blocks(run.model_degc)
+                band = sign * (temp - cut) > 0
+                if not np.any(band) or np.all(band):
+                    continue
+                d = (x_cut - x_all) - (x_cut - x_all)[~band].mean()  # the constants put elsewhere: no extrapolation
+                num += float(np.sum(d[band] ** 2))
+                den += float(np.sum((sign * (temp[band] - cut)) ** (2 * power)))
+            rates.append(math.sqrt(num / den) if den > 0 else None)
+        return EdgeRates(rates[0], rates[1], power)
+
+    def _surrogate_fit(self, lo: float, hi: float, within: tuple[float, float] | None) -> list:
+        """Per run, the surrogate's fitted bias without its constant (blocks) [deg/s], its curve over [lo, hi] degC
+        (held or continued past it), fitted on the blocks within ``within`` (all: None) by least squares with a
+        constant per run."""
+        cols, ys, owners, keep = [], [], [], []
+        for k, run in enumerate(self.runs):
+            x = self.columns(run, lo, hi)
+            temp = run.blocks(run.model_degc)
+            cols.append(x)
+            ys.append(run.raw)
+            owners.append(np.full(x.shape[0], k))
+            keep.append(np.ones(x.shape[0], bool) if within is None else (temp >= within[0]) & (temp <= within[1]))
+        x, y, owner, keep = np.vstack(cols), np.concatenate(ys), np.concatenate(owners), np.concatenate(keep)
+        design = np.hstack([np.eye(len(self.runs))[owner], x])
+        coef = np.linalg.lstsq(design[keep], y[keep], rcond=None)[0]
+        return [c @ coef[len(self.runs) :] for c in cols]
 
     def difference(self, run: _Run, alternative: Alternative) -> np.ndarray:
         """The block means of the error the chosen model predicts on ``run`` less the alternative's [deg/s]."""
@@ -546,7 +624,7 @@ def _left(calibration: Calibration, recordings: Sequence[Recording]) -> list[Rec
 
 
 def axis_information(
-    calibration: Calibration, recordings: Sequence[Recording], window_s: float
+    calibration: Calibration, recordings: Sequence[Recording], window_s: float, extrapolation: bool = True
 ) -> dict[str, AxisInformation]:
     """:class:`AxisInformation` of every gyro axis with a temperature curve, the model applied to each run once.
 
@@ -558,6 +636,9 @@ def axis_information(
         The static runs it was fitted on.
     window_s : float
         Moving-average window of the drift [s].
+    extrapolation : bool
+        Measure how fast the axis's curve family fitted to these runs loses track past a cut in their own range
+        (:meth:`AxisInformation.edge_rates`), for the error past the calibrated range.
 
     Returns
     -------
@@ -574,7 +655,10 @@ def axis_information(
             "the model has no temperature curve on any axis (constants only); there is nothing to forecast"
         )
     left = _left(calibration, recordings)
-    return {a: AxisInformation.of(calibration, recordings, a, window_s, left) for a in axes}
+    infos = {a: AxisInformation.of(calibration, recordings, a, window_s, left) for a in axes}
+    for info in infos.values() if extrapolation else ():
+        info.edge = info.edge_rates()
+    return infos
 
 
 def close_candidates(calibration: Calibration, axis: str) -> tuple[str, ...]:

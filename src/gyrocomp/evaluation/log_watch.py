@@ -118,7 +118,7 @@ def look(
         with warnings.catch_warnings():  # a short log's warnings would repeat at every look
             warnings.simplefilter("ignore")
             calibration = fit(runs)
-        infos = axis_information(calibration, runs, window_s)
+        infos = axis_information(calibration, runs, window_s, extrapolation=use is not None)
     except InputError as exc:
         return LogLook(**base, worst=None, leg_gain_dps_per_h=None, reached=False, waiting=str(exc))
     if use is None:
