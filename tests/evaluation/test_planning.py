@@ -263,3 +263,26 @@ def test_plan_watch_on_the_command_line_prints_a_line_a_look_and_stops_at_its_ta
     assert "gyrocomp: target reached: " in reached.stderr
     wrong = run("plan", "--watch", "run0.csv", "--budget-h", "3", cwd=files)
     assert wrong.returncode == 2 and "--budget-h plans the runs to record next" in wrong.stderr
+
+
+def test_the_reports_planning_section_carries_the_numbers_of_the_json(parts):
+    """gyrocomp report --plan-on: its planning section's tables hold the plan's numbers, as --json gives them, to
+    the report's four significant figures; every text escaped."""
+    from gyrocomp.report.html import build_report
+
+    _, train, calibration = parts[0]
+    advised = plan(calibration, train, UseProfile.cycle(10, 60, 1.0), model_choice=False)
+    page = build_report(calibration, train[:1], plan=advised)
+    assert "planning" in page.sections
+    section = page.html.split('<section id="planning">', 1)[1].split("</section>", 1)[0]
+    cells = [re.findall(r"<td[^>]*>(.*?)</td>", row) for row in re.findall(r"<tr>(.*?)</tr>", section, re.S)]
+    cells = [c for c in cells if c]
+    document = advised.to_dict()
+    for row, (axis, f) in zip(cells, document["now"]["axes"].items()):
+        assert row[0] == axis
+        for text, key in zip(row[1:8], ("drift_dps", "low_dps", "high_dps", "coefficients_dps", "noise_dps")):
+            assert float(text) == pytest.approx(f[key], rel=5e-4), (axis, key)
+    runs = cells[len(document["now"]["axes"]) :]
+    assert [r[0] for r in runs] == [a["run"] for a in document["advice"]]
+    assert [float(r[4]) for r in runs] == pytest.approx([a["gain_dps_per_h"] for a in document["advice"]], rel=5e-4)
+    assert all("-&gt;" in r[1] for r in runs)  # the set points' arrows, escaped

@@ -8,6 +8,7 @@ from ..calibration import Calibration
 from ..io import refuse_to_overwrite_inputs, write_text_atomic
 from ..report.figures import require_matplotlib
 from ..report.html import build_report
+from ..evaluation.run_advice import plan as plan_runs
 from ..evaluation.validation import validate as validate_runs
 from .common import (
     echo,
@@ -43,15 +44,23 @@ from .common import (
     type=click.Path(),
     help="A calibration run to validate on (repeat it for each run): adds the table of gyrocomp validate.",
 )
+@click.option(
+    "--plan-on",
+    "plan_on",
+    multiple=True,
+    type=click.Path(),
+    help="A calibration run MODEL was fitted on (repeat it for each run): adds gyrocomp plan's section, the drift "
+    "to expect on the calibrated range and the next run to record.",
+)
 @read_options
 @click.pass_context
-def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_duration_s, validate_on, **kwargs):
+def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_duration_s, validate_on, plan_on, **kwargs):
     """One self-contained HTML report of MODEL judged on RUNS: the model, the figures of merit, bias against
     temperature, raw and compensated series, Allan deviations, g-sensitivity; with --validate-on, the held-out
     drift of each method on those calibration runs."""
 
     opts = pop_read_options(kwargs)
-    refuse_to_overwrite_inputs(output, [model, *runs, *validate_on])
+    refuse_to_overwrite_inputs(output, [model, *runs, *validate_on, *plan_on])
     if not str(output).lower().endswith((".html", ".htm")):
         raise click.BadParameter(f"{output}: name the report .html", param_hint="-o")
     if window_s is not None and not window_s > 0:
@@ -63,6 +72,10 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
     if validate_on:
         with progress_bar("validating", indeterminate=True):
             validation = validate_runs([read_run(path, opts).recording for path in validate_on])
+    planned = None
+    if plan_on:
+        with progress_bar("planning", indeterminate=True):
+            planned = plan_runs(calibration, [read_run(path, opts).recording for path in plan_on])
     with progress_bar("report") as progress:
         result = build_report(
             calibration,
@@ -72,6 +85,7 @@ def report(ctx, model, runs, output, window_s, turn_on_window_s, static_min_dura
             min_static_s=static_min_duration_s,
             progress=progress,
             validation=validation,
+            plan=planned,
         )
     write_text_atomic(output, result.html)
     if not ctx.obj["quiet"]:

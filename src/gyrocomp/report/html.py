@@ -2,7 +2,8 @@
 
 Images are PNGs embedded as data URIs and the style sheet is inline, so the file opens anywhere with
 no network access. Sections (each an ``<section id=...>``): ``summary`` (the model: type, order, inputs,
-valid ranges, validation scores, the candidates compared), ``validation`` when a
+valid ranges, validation scores, the candidates compared), ``planning`` when a plan is given (the drift to expect
+on a use profile and the next run, as ``gyrocomp plan`` gives them), ``validation`` when a
 :class:`~gyrocomp.evaluation.validation.ValidationResult` is given (held-out drift of raw, the autopilots' cubics, a
 plain cubic and gyrocomp's default, as ``gyrocomp validate`` prints it), ``evaluation`` (the thesis's figures of merit,
 by stage when the model has stages), one ``axis-<name>`` per axis (bias against temperature with the
@@ -44,6 +45,7 @@ from ..fitting.gsensitivity import EXCITATION_G
 from ..motion.positions import static_segments
 from ..motion.stillness import detect_still
 from ..models.field import moves_most_of_the_time
+from ..evaluation.run_advice import WORTHWHILE_GAIN, CalibrationPlan
 from ..evaluation.validation import ValidationResult
 from . import figures
 
@@ -221,6 +223,65 @@ def _expected_drift(expected: dict) -> list[str]:
             "cool more than once, make these figures firmer.</p>"
         )
     return parts
+
+
+def _planning(result: CalibrationPlan) -> str:
+    """The planning section: the drift to expect on the use profile per axis, then each candidate run (the
+    numbers of ``gyrocomp plan --json``, at four significant figures)."""
+    now = result.now
+    rows = [
+        [
+            f.axis,
+            f.drift_dps,
+            f.low_dps,
+            f.high_dps,
+            f.coefficients_dps,
+            f.noise_dps,
+            f.extrapolation_dps,
+            f.model_choice_dps,
+            f.lag_s,
+            f.lag_standard_error_s,
+        ]
+        for f in now.axes.values()
+    ]
+    header = [
+        "axis",
+        "expected [deg/s]",
+        "95 % low [deg/s]",
+        "95 % high [deg/s]",
+        "coefficients [deg/s]",
+        "own noise [deg/s]",
+        "past the range [deg/s]",
+        "model choice [deg/s]",
+        "lag [s]",
+        "lag s.e. [s]",
+    ]
+    caption = f"drift to expect on {now.profile} ({now.window_s:g} s moving average)"
+    worst = now.worst.axis
+    runs = [
+        [a.run.name, a.run.description, a.run.hours, a.after.axes[worst].drift_dps, a.gain_dps_per_h, a.resolves]
+        for a in result.advice
+    ]
+    runs_header = ["run", "what", "hours [h]", f"{worst} after [deg/s]", "gain per hour [deg/s/h]", "what it resolves"]
+    lo, hi = result.range_degc
+    body = [
+        table_html(header, rows, caption),
+        table_html(
+            runs_header,
+            runs,
+            f"the next run (calibrated {lo:.1f}..{hi:.1f} degC at {result.ramp_degc_per_min:.2g} degC/min), the best "
+            "gain per hour of chamber time first",
+        ),
+    ]
+    if result.sequence:
+        order = ", then ".join(f"{a.run.name} ({a.run.hours:.1f} h)" for a in result.sequence)
+        body.append(
+            f"<p>Runs to record in turn: {escape_text(order)}; the worst axis "
+            f"{_fmt(now.worst.drift_dps)} -> {_fmt(result.sequence[-1].after.worst.drift_dps)} deg/s.</p>"
+        )
+    elif result.enough:
+        body.append(f"<p>No candidate run lowers the worst axis's expected drift by {WORTHWHILE_GAIN:.0%} or more.</p>")
+    return "\n".join(body)
 
 
 def _validation(result: ValidationResult) -> str:
@@ -481,6 +542,7 @@ def build_report(
     progress: Callable[[float], None] | None = None,
     validation: ValidationResult | None = None,
     lead: dict[str, tuple[str, str]] | None = None,
+    plan: CalibrationPlan | None = None,
 ) -> Report:
     """The report of ``calibration`` judged on ``runs`` (see the module doc for what it holds).
 
@@ -496,6 +558,9 @@ def build_report(
     validation, lead : ValidationResult, dict, optional
         Held-out drift of the methods on the calibration runs (:func:`gyrocomp.evaluation.validation.validate`);
         sections to open the page with, id -> (title, HTML body) (the demo's case where compensation matters).
+    plan : CalibrationPlan, optional
+        The drift to expect and the next run (:func:`gyrocomp.evaluation.run_advice.plan`): a ``planning``
+        section.
     """
     figures._pyplot()  # fail early, in one line, without matplotlib
     steps = 3 + 2 * len(runs)
@@ -515,6 +580,8 @@ def build_report(
         sections["summary"] = ("Model", _summary(calibration))
         if validation is not None:
             sections["validation"] = ("Validation", _validation(validation))
+        if plan is not None:
+            sections["planning"] = ("How much chamber time", _planning(plan))
         # the Allan curves drawn below, raw and compensated: their minima are the bias instabilities (once)
         noise = [_noise(rec, comp) for rec, comp in zip(runs, compensated)]
         evaluations = _evaluations(calibration, runs, compensated, noise, window_s)
