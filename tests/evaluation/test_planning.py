@@ -6,8 +6,10 @@ leaves; the command line through its real entry point."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
+import subprocess
 import math
 import warnings
 
@@ -23,7 +25,7 @@ from gyrocomp.evaluation.run_advice import plan, ramp_rate_degc_per_min
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 
-from ..conftest import chamber_run, run, shared_dataset
+from ..conftest import SCRIPT, chamber_run, run, shared_dataset
 from ..real.real_data import tofupilot_run
 
 RATE_HZ = 2.0
@@ -286,3 +288,40 @@ def test_the_reports_planning_section_carries_the_numbers_of_the_json(parts):
     assert [r[0] for r in runs] == [a["run"] for a in document["advice"]]
     assert [float(r[4]) for r in runs] == pytest.approx([a["gain_dps_per_h"] for a in document["advice"]], rel=5e-4)
     assert all("-&gt;" in r[1] for r in runs)  # the set points' arrows, escaped
+
+
+def test_plan_watch_reads_a_log_appended_to_while_it_runs_and_refuses_one_that_shrinks_or_is_rewritten(tmp_path):
+    """A log that a writer appends to while the watch runs: a line per look, the second with more rows; a log that
+    is truncated or whose first rows are rewritten between looks: one line, exit 2."""
+    from gyrocomp.evaluation.log_watch import watch_log
+
+    log = chamber_run([20, 50, 20], ramp_degc_per_min=1.0, hold_s=300, rate_hz=RATE_HZ, seed=4)
+    write_recording(log, tmp_path / "whole.csv")
+    lines = (tmp_path / "whole.csv").read_text().splitlines(keepends=True)
+    first = int(0.6 * len(lines))
+    (tmp_path / "log.csv").write_text("".join(lines[:first]))
+
+    # the writer appends once the watch has printed its first look (it sleeps --every seconds before the next)
+    command = [str(SCRIPT), "plan", "--watch", "log.csv", "--every", "2", "--looks", "2"]
+    with subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as child:
+        printed = [child.stdout.readline()]
+        with open(tmp_path / "log.csv", "a") as out:
+            out.write("".join(lines[first:]))
+        rest, stderr = child.communicate(timeout=300)
+    assert child.returncode == 0, stderr
+    rows = [int(m) for m in re.findall(r"h, (\d+) rows", printed[0] + rest)]
+    assert rows == [first - 1, len(lines) - 1], printed[0] + rest
+
+    def reads(*cuts):
+        pending = iter(cuts)
+        return lambda: next(pending)
+
+    shrunk = watch_log(reads(log, log.take(np.arange(100, log.n_samples))), 0.0, sleep=lambda s: None)
+    next(shrunk)
+    with pytest.raises(InputError, match=r"chamber_run_4: 8900 rows, 9000 at the look before: the log was truncated"):
+        next(shrunk)
+    edited = dataclasses.replace(log, gyro_dps=log.gyro_dps + 0.001)
+    rewritten = watch_log(reads(log.take(np.arange(5000)), edited), 0.0, sleep=lambda s: None)
+    next(rewritten)
+    with pytest.raises(InputError, match="its first rows changed since the look before: the log was rewritten"):
+        next(rewritten)

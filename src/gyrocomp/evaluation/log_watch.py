@@ -167,15 +167,42 @@ def watch_log(
     """
     if not (math.isfinite(every_s) and every_s >= 0):
         raise InputError(f"every_s: {every_s!r}; give the seconds between looks")
-    count = 0
+    count, before = 0, None
     while looks is None or count < looks:
         if count:
             sleep(every_s)
-        seen = look(read(), earlier, use, window_s, target_drift_dps)
+        recording = read()
+        before = _still_growing(before, recording)
+        seen = look(recording, earlier, use, window_s, target_drift_dps)
         count += 1
         yield seen
         if seen.reached:
             return
+
+
+#: the rows whose values must not change from one look to the next
+FINGERPRINT_ROWS = 1000
+
+
+def _still_growing(before: tuple | None, recording: Recording) -> tuple:
+    """The log's rows and its first rows' times and rates, refusing a log that lost rows or whose first rows changed
+    since the look before (``before``): a run under way only grows."""
+    n = min(FINGERPRINT_ROWS, recording.n_samples)
+    now = (recording.n_samples, recording.time_s[:n].copy(), recording.gyro_dps[:n].copy())
+    if before is not None:
+        rows, times, rates = before
+        if recording.n_samples < rows:
+            raise InputError(
+                f"{recording.source}: {recording.n_samples} rows, {rows} at the look before: the log was truncated "
+                "or replaced; a run under way only grows (start the watch again on the new log)"
+            )
+        k = min(times.size, n)
+        if not (np.array_equal(times[:k], now[1][:k]) and np.array_equal(rates[:k], now[2][:k])):
+            raise InputError(
+                f"{recording.source}: its first rows changed since the look before: the log was rewritten; a run "
+                "under way only grows (start the watch again on the new log)"
+            )
+    return now
 
 
 __all__ = ["LogLook", "continued_leg", "look", "watch_log"]
