@@ -15,6 +15,10 @@ change). For each part and seed:
    programs it (set points, ramp, holds), the three runs fitted by default, and the drift that fit leaves on the
    held-out run, against the interval the plan predicted after that run.
 
+And the shared real recordings (skipped when absent): the CATS tag's three static periods (each predicted from the
+other two, at 60 s and at the dataset's 600 s window) and the real one-cycle chamber log (fitted up to its hottest
+point, the final cooling leg predicted), the forecast against the drift the default fit leaves.
+
 Per part and use case the table gives the share of axes inside the interval (now, after), the median ratio of the
 forecast to the drift (now, after) and the runs recommended. Usage:
 ``python benchmarks/bench_plan.py [--seeds 10] [--markdown FILE]``.
@@ -36,7 +40,7 @@ from benchmarks.shape_zoo import FORMS, zoo_run  # noqa: E402  (memories written
 from tools.shape_matrix import chamber_run  # noqa: E402  (the shape matrix's chamber part)
 
 from gyrocomp import __version__, apply, fit  # noqa: E402
-from gyrocomp.evaluation.drift_forecast import UseProfile  # noqa: E402
+from gyrocomp.evaluation.drift_forecast import UseProfile, forecast_drift  # noqa: E402
 from gyrocomp.evaluation.run_advice import plan  # noqa: E402
 from gyrocomp.measures.merit import smoothed_residual_rms  # noqa: E402
 
@@ -88,11 +92,56 @@ def one_case(part: str, case: str, seed: int) -> dict:
     return {"rows": rows, "run": best.run.name}
 
 
+def real_rows() -> list[str]:
+    """The forecast against the drift on the shared real recordings, one row per recording and window."""
+    from tests.real import real_data
+
+    rows = []
+    if real_data.CATS.exists():
+        runs = real_data.cats_runs()
+        for window in (60.0, float(real_data.CATS_WINDOW_S)):
+            inside, ratios = [], []
+            for held in range(len(runs)):
+                train = [r for k, r in enumerate(runs) if k != held]
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    model = fit(train)
+                    forecast = forecast_drift(model, train, UseProfile.of(runs[held]), window_s=window)
+                    out = apply(model, runs[held])
+                for axis, f in forecast.axes.items():
+                    actual = smoothed_residual_rms(out.gyro(axis), int(window * runs[held].rate_hz))
+                    inside.append(f.low_dps <= actual <= f.high_dps)
+                    ratios.append(f.drift_dps / actual)
+            rows.append(
+                f"| CATS, each static period from the other two | {window:g} s | {sum(inside)} of {len(inside)} | "
+                f"{np.median(ratios):.2f} |"
+            )
+    if real_data.TOFUPILOT.exists():
+        log = real_data.tofupilot_run()
+        hot = int(np.argmax(log.temperature_degc))
+        train, held = log.take(np.arange(hot + 1)), log.take(np.arange(hot + 1, log.n_samples))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = fit([train])
+            forecast = forecast_drift(model, [train], UseProfile.of(held))
+            left = apply(model, log).gyro_dps[hot + 1 :]
+        inside, ratios = [], []
+        for axis, f in forecast.axes.items():
+            actual = smoothed_residual_rms(left[:, log.gyro_axes.index(axis)], int(60 * log.rate_hz))
+            inside.append(f.low_dps <= actual <= f.high_dps)
+            ratios.append(f.drift_dps / actual)
+        rows.append(
+            f"| one-cycle log, the final cooling leg | 60 s | {sum(inside)} of {len(inside)} | {np.median(ratios):.2f} |"
+        )
+    return rows
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--parts", default="", help="comma-separated part names (default: all)")
     parser.add_argument("--markdown", type=Path, default=None)
+    parser.add_argument("--only", choices=("zoo", "real"), default=None, help="one section of the two")
     args = parser.parse_args(argv)
     parts = [p for p in (*FORMS, PHYSICS_CHAMBER) if not args.parts or p in args.parts.split(",")]
     lines = [
@@ -103,7 +152,7 @@ def main(argv=None) -> int:
     ]
     totals = {"now": [], "after": []}
     started = time.perf_counter()
-    for part in parts:
+    for part in parts if args.only != "real" else ():
         for case in USE_CASES:
             rows, runs = [], Counter()
             for seed in range(args.seeds):
@@ -118,12 +167,18 @@ def main(argv=None) -> int:
                 f"{np.median(after_ratio):.2f} | {', '.join(f'{k} {v}' for k, v in runs.most_common())} |"
             )
             print(lines[-1], flush=True)
-    lines += [
-        "",
-        f"All: inside now {np.mean(totals['now']):.0%} of {len(totals['now'])} axes, inside after "
-        f"{np.mean(totals['after']):.0%}; {time.perf_counter() - started:.0f} s",
-    ]
-    print(lines[-1])
+    if totals["now"]:
+        lines += [
+            "",
+            f"All: inside now {np.mean(totals['now']):.0%} of {len(totals['now'])} axes, inside after "
+            f"{np.mean(totals['after']):.0%}",
+        ]
+        print(lines[-1])
+    if args.only != "zoo":
+        lines += ["", "| real recording | window | inside | forecast/drift (median) |", "|---|---|---|---|"]
+        lines += real_rows()
+        print("\n".join(lines[-3:]))
+    lines.append(f"\n{time.perf_counter() - started:.0f} s")
     if args.markdown is not None:
         args.markdown.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return 0
