@@ -21,7 +21,8 @@ from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError
 from gyrocomp.evaluation.choice_alternatives import choice_alternatives
 from gyrocomp.evaluation.drift_forecast import DEFAULT_WINDOW_S, UseProfile, axis_information, forecast_drift
-from gyrocomp.evaluation.run_advice import plan, ramp_rate_degc_per_min
+from gyrocomp.evaluation.drift_forecast import ramp_rate_degc_per_min
+from gyrocomp.evaluation.run_advice import plan
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms
 
@@ -133,6 +134,21 @@ def test_within_a_budget_or_to_a_target_the_runs_are_chosen_in_turn(parts):
     assert aimed.reaches_target and len(aimed.sequence) == 1
     far = plan(calibration, train, use, target_drift_dps=1e-9, budget_h=2.5, model_choice=False)
     assert far.reaches_target is False and sum(a.run.hours for a in far.sequence) <= 2.5
+
+
+def test_a_use_profile_that_ramps_faster_than_the_calibration_is_warned_about(parts):
+    """Fitted at 1 degC/min, used at 2: the forecast says it cannot know what a faster ramp leaves (on the chamber
+    part, whose bias has a term in dT/dt, the drift at 1.5 degC/min was twice the forecast: bench_plan)."""
+    from gyrocomp.errors import DataQualityWarning
+
+    _, train, calibration = parts[0]
+    with pytest.warns(
+        DataQualityWarning, match=r"ramps at 2 degC/min, faster than the calibration runs' 1: the forecast"
+    ):
+        forecast_drift(calibration, train, UseProfile.cycle(20, 50, 2.0), model_choice=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        forecast_drift(calibration, train, UseProfile.cycle(20, 50, 1.1), model_choice=False)
 
 
 def test_the_calibration_runs_ramp_rate_is_read_from_their_temperatures():

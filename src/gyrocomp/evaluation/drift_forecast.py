@@ -44,7 +44,7 @@ from ..curves.polynomial import POLY_FAMILY, PolynomialCurve
 from ..curves.protocol import BASES, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION
 from ..curves.rate import rate_columns
 from ..effects import moving_average, thermal_lag
-from ..errors import InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..fitting.drift_gls import MAX_POINTS, DriftNoise, coarsen, covariance, fit_drift_noise
 from ..recording import Recording
 from .choice_alternatives import Alternative, choice_alternatives, predicted
@@ -261,6 +261,55 @@ class DriftForecast:
             "window_s": self.window_s,
             "axes": {k: v.to_dict() for k, v in self.axes.items()},
         }
+
+
+def _typical_ramp(series) -> float:
+    """The typical ramp rate [degC/min] of (time [s], temperature [degC]) pairs: the median rate of the minutes
+    whose temperature changes at more than a fifth of the fastest minutes' (the 95th percentile) rate."""
+    rates = []
+    for t, temps in series:
+        grid = np.arange(t[0], t[-1], 60.0)
+        if grid.size > 1:
+            rates.append(np.abs(np.diff(np.interp(grid, t, temps))))
+    rates = np.concatenate(rates) if rates else np.zeros(0)
+    top = float(np.percentile(rates, 95)) if rates.size else 0.0
+    moving = rates[rates > 0.2 * top] if top > 0 else rates
+    return float(np.median(moving)) if moving.size and np.median(moving) > 0 else 1.0
+
+
+def ramp_rate_degc_per_min(recordings: Sequence[Recording]) -> float:
+    """The runs' typical ramp rate [degC/min]: the median rate of the minutes whose temperature changes at more than
+    a fifth of the fastest minutes' (the 95th percentile) rate.
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The runs (those without a temperature are skipped).
+    """
+    return _typical_ramp(
+        (r.time_s, r.temperature_degc if r.temperature_degc.ndim == 1 else r.temperature_degc.mean(axis=1))
+        for r in recordings
+        if r.temperature_degc is not None
+    )
+
+
+#: a use profile ramping faster than this many times the calibration runs' is warned about
+FASTER_USE = 1.25
+
+
+def warn_faster_use(use: UseProfile, calibration_ramp_degc_per_min: float) -> None:
+    """Warn when ``use`` ramps faster than :data:`FASTER_USE` times the calibration runs' rate [degC/min]: what the
+    model leaves may grow with the ramp rate, which runs at one rate cannot show."""
+    ramp = _typical_ramp([(use.time_s, use.temperature_degc)])
+    if ramp > FASTER_USE * calibration_ramp_degc_per_min:
+        warnings.warn(
+            f"{use.name}: the use profile ramps at {ramp:.2g} degC/min, faster than the calibration runs' "
+            f"{calibration_ramp_degc_per_min:.2g}: the forecast takes what the model leaves to be the same at any "
+            "ramp rate, which runs at one rate cannot show (measured on parts with a term in dT/dt: half the drift "
+            "forecast); a run at the faster rate shows it",
+            DataQualityWarning,
+            stacklevel=user_stacklevel(),
+        )
 
 
 def _surrogate(ax: AxisCalibration, axis: str) -> tuple[str, int, bool]:
@@ -706,6 +755,7 @@ def forecast_drift(
         Each compensated gyro axis's expected drift [deg/s] with its 95 % interval and its shares.
     """
     infos = axis_information(calibration, recordings, window_s)
+    warn_faster_use(profile, ramp_rate_degc_per_min(recordings))
     alternatives = choice_alternatives(calibration, recordings) if model_choice else ()
     return DriftForecast(
         profile.name,
@@ -726,5 +776,7 @@ __all__ = [
     "axis_information",
     "close_candidates",
     "forecast_drift",
+    "ramp_rate_degc_per_min",
     "set_point_profile",
+    "warn_faster_use",
 ]

@@ -20,8 +20,14 @@ import numpy as np
 from ..errors import InputError
 from ..models.fit import fit
 from ..recording import Recording
-from .drift_forecast import DEFAULT_WINDOW_S, AxisForecast, UseProfile, axis_information, close_candidates
-from .run_advice import ramp_rate_degc_per_min
+from .drift_forecast import (
+    DEFAULT_WINDOW_S,
+    AxisForecast,
+    UseProfile,
+    axis_information,
+    close_candidates,
+    ramp_rate_degc_per_min,
+)
 
 #: the stretch of the log whose rate the leg under way is continued at [s], and for how long [s]
 TREND_S = 600.0

@@ -17,7 +17,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-import numpy as np
 
 from ..calibration.calibration import Calibration
 from ..errors import InputError
@@ -31,7 +30,9 @@ from .drift_forecast import (
     DriftForecast,
     UseProfile,
     close_candidates,
+    ramp_rate_degc_per_min,
     set_point_profile,
+    warn_faster_use,
 )
 
 #: the hold at each end of a candidate cycle, and a dwell's [s]
@@ -175,22 +176,6 @@ class CalibrationPlan:
             "reaches_target": self.reaches_target,
             "sequence": [advice(a) for a in self.sequence],
         }
-
-
-def ramp_rate_degc_per_min(recordings: Sequence[Recording]) -> float:
-    """The runs' typical ramp rate [degC/min]: the median rate of the minutes whose temperature changes at more than
-    a fifth of the fastest minutes' (the 95th percentile) rate."""
-    rates = []
-    for rec in recordings:
-        if rec.temperature_degc is None:
-            continue
-        temps = rec.temperature_degc if rec.temperature_degc.ndim == 1 else rec.temperature_degc.mean(axis=1)
-        grid = np.arange(rec.time_s[0], rec.time_s[-1], 60.0)
-        if grid.size > 1:
-            rates.append(np.abs(np.diff(np.interp(grid, rec.time_s, temps))))
-    rates = np.concatenate(rates) if rates else np.zeros(0)
-    moving = rates[rates > 0.2 * np.percentile(rates, 95)] if rates.size and np.percentile(rates, 95) > 0 else rates
-    return float(np.median(moving)) if moving.size and np.median(moving) > 0 else 1.0
 
 
 def candidate_runs(lo_degc: float, hi_degc: float, ramp: float, use: UseProfile) -> list[CandidateRun]:
@@ -370,6 +355,7 @@ def plan(
         use = UseProfile.cycle(
             lo, hi, ramp, name=f"one cycle {lo:.0f}..{hi:.0f} degC at {ramp:.2g} degC/min (the calibration's)"
         )
+    warn_faster_use(use, ramp)
     alternatives = choice_alternatives(calibration, recordings) if model_choice else ()
     planner = _Planner(infos, use, window_s, {a: close_candidates(calibration, a) for a in infos}, alternatives)
     now = planner.forecast({}, {})
@@ -383,4 +369,4 @@ def plan(
     return CalibrationPlan(now, tuple(advice), enough, ramp, (lo, hi), sequence, budget_h, target_drift_dps)
 
 
-__all__ = ["CalibrationPlan", "CandidateRun", "RunAdvice", "candidate_runs", "plan", "ramp_rate_degc_per_min"]
+__all__ = ["CalibrationPlan", "CandidateRun", "RunAdvice", "candidate_runs", "plan"]
