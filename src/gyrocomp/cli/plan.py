@@ -239,10 +239,11 @@ def plan(
     profile, and candidate runs scored per hour of chamber time.
 
     The drift MODEL should leave on the use profile (60 s moving average, as the accuracy page scores it), with a
-    95 % interval from its coefficients' uncertainty under the RUNS' own residual noise, the part's own drift and
-    the extrapolation past the calibrated range; then candidate runs (the cycle again, a wider range, a slower or
-    faster ramp, dwells, one leg) scored by the drift after each, per hour of chamber time. RUNS are the static
-    chamber runs MODEL was fitted on.
+    95 % interval from its coefficients' uncertainty under the RUNS' own residual noise, the part's own drift, the
+    extrapolation past the calibrated range and how far the forms the model choice could not tell apart part on
+    it; then candidate runs (the cycle again, a wider range, a slower or faster ramp, dwells, one leg) scored by
+    the drift after each, per hour of chamber time; with --budget-h or --target-drift, the runs to record in turn.
+    RUNS are the static chamber runs MODEL was fitted on.
 
     With --watch LOG, a run under way: LOG is read again every --every seconds and fitted (with RUNS recorded
     before it); each look prints a line with the worst axis's forecast so far and what one more hour of the leg

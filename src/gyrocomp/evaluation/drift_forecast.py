@@ -10,7 +10,9 @@ For one gyro axis, the error a model leaves on a new power-on is, to first order
 - ``n(t)`` the part's own residual, white plus power-law drift (:mod:`gyrocomp.fitting.drift_gls`), estimated from
   the variogram of what the model leaves on its calibration runs;
 - ``h(t)`` what holding the curve (or continuing it along its tangent) past the calibrated range leaves,
-  estimated from the curve's own slope (or curvature) at the edge.
+  estimated from the curve's own slope (or curvature) at the edge, or, when larger, from how fast the curve's
+  family fitted without the top (or bottom) fifth of the runs' range parts past that cut from the same family
+  fitted on all of them (:class:`EdgeRates`).
 
 Under the residual's drift model, generalized least squares on the calibration runs (each with its own turn-on
 constant, projected out) gives the covariance of ``delta``. The held-out drift the accuracy page scores, the RMS
@@ -21,7 +23,9 @@ predicts the drift after it: the basis of :mod:`gyrocomp.evaluation.run_advice`.
 
 The forecast takes the model's form as right: a memory of the turn (turning-point or branch hysteresis) is
 applied but its coefficients' uncertainty is not counted (:attr:`AxisForecast.not_covered` says so), and what
-the form cannot carry shows only as far as it is in the residual's drift.
+the form cannot carry shows only as far as it is in the residual's drift. The model choice's own uncertainty is
+added to the interval's upper end: how far the nearest forms it could not tell apart, fitted in their own right
+(:mod:`gyrocomp.evaluation.choice_alternatives`), part from the chosen curve on the profile.
 
 References: T. W. Anderson, *The Statistical Analysis of Time Series*, 1971 (GLS); A. M. Mathai, S. B. Provost,
 *Quadratic Forms in Random Variables*, 1992 (a quadratic form of Gaussians as a weighted sum of chi-squares).
@@ -378,7 +382,7 @@ class AxisInformation:
         self.lo_degc = min(self.lo_degc, ax.temperature.t_min_degc)
         self.hi_degc = max(self.hi_degc, ax.temperature.t_max_degc)
         self._profiles: dict = {}  # a profile's series and its noise's eigenvalues, by profile and window
-        self.edge: EdgeRates | None = None  # the measured extrapolation rates (edge_holdout), when asked
+        self.edge: EdgeRates | None = None  # the measured extrapolation rates (edge_rates), when asked
 
     @classmethod
     def of(
