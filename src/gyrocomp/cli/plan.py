@@ -22,7 +22,9 @@ from .render import print_plan
 SHOWN_CANDIDATES = 3
 
 
-def _check_options(paths, watch, every_given, looks, budget_h, use_ramp, use_profile, window_s, every_s) -> None:
+def _check_options(
+    paths, watch, every_given, looks, budget_h, target_drift_dps, use_ramp, use_profile, window_s, every_s
+) -> None:
     """Options that do not go together, or out of their range: a usage error naming them."""
     if not window_s > 0:
         raise click.BadParameter(f"must be positive, got {window_s:g}", param_hint="--window")
@@ -36,6 +38,8 @@ def _check_options(paths, watch, every_given, looks, budget_h, use_ramp, use_pro
         raise click.UsageError("--budget-h plans the runs to record next; --watch follows the run under way")
     if budget_h is not None and not budget_h > 0:
         raise click.BadParameter(f"must be positive, got {budget_h:g}", param_hint="--budget-h")
+    if target_drift_dps is not None and not target_drift_dps > 0:
+        raise click.BadParameter(f"must be positive, got {target_drift_dps:g}", param_hint="--target-drift")
     if not every_s >= 0:
         raise click.BadParameter(f"must be zero or more, got {every_s:g}", param_hint="--every")
     if watch is None and len(paths) < 2:
@@ -252,9 +256,9 @@ def plan(
     opts = pop_read_options(kwargs)
     # on the command line (a project file's [plan] every = ... is a default, for the watches that read it)
     every_given = ctx.get_parameter_source("every_s") is click.core.ParameterSource.COMMANDLINE
-    _check_options(paths, watch, every_given, looks, budget_h, use_ramp, use_profile, window_s, every_s)
-    if target_drift_dps is not None and not target_drift_dps > 0:
-        raise click.BadParameter(f"must be positive, got {target_drift_dps:g}", param_hint="--target-drift")
+    _check_options(
+        paths, watch, every_given, looks, budget_h, target_drift_dps, use_ramp, use_profile, window_s, every_s
+    )
     if watch is not None:
         return _watch(watch, paths, opts, use_profile, use_ramp, window_s, every_s, target_drift_dps, looks, as_json)
     calibration = Calibration.load(paths[0])

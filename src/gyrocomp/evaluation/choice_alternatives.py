@@ -54,6 +54,35 @@ def options_of(candidate: Candidate) -> FitOptions:
     return FitOptions(temperature=curve, hysteresis=candidate.memory, hysteresis_order=order)
 
 
+def within_one_standard_error(calibration: Calibration, axis: str) -> list[tuple[float, Candidate]]:
+    """(held-out drift, candidate) of the model choice's candidates for ``axis`` whose held-out drift was within
+    one standard error of the chosen candidate's, the chosen one left out, the nearest first (none when the fit
+    kept no choice)."""
+    sel = calibration.report.selection.get(axis) if calibration.report is not None else None
+    if sel is None or sel.chosen_drift is None:
+        return []
+    limit = sel.chosen_drift + (sel.chosen_standard_error or 0.0)
+    close = [
+        (c.mean_drift, c.candidate)
+        for c in sel.candidates
+        if c.candidate != sel.chosen and c.mean_drift is not None and c.mean_drift <= limit
+    ]
+    return sorted(close, key=lambda item: item[0])
+
+
+def close_candidates(calibration: Calibration, axis: str) -> tuple[str, ...]:
+    """The labels of :func:`within_one_standard_error`'s candidates, the nearest first.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The fitted model (its fit report holds the choice).
+    axis : str
+        The gyro axis.
+    """
+    return tuple(c.label for _, c in within_one_standard_error(calibration, axis))
+
+
 def choice_alternatives(
     calibration: Calibration, recordings: Sequence[Recording], most: int = MOST_ALTERNATIVES
 ) -> tuple[Alternative, ...]:
@@ -78,22 +107,15 @@ def choice_alternatives(
     report = calibration.report
     nearest: dict[str, tuple[float, Candidate, set]] = {}
     for axis, sel in (report.selection if report is not None else {}).items():
-        if sel.chosen_drift is None:
-            continue
-        limit = sel.chosen_drift + (sel.chosen_standard_error or 0.0)
         forms: dict[str, tuple[float, Candidate]] = {}
-        for c in sel.candidates:
-            form = form_of(c.candidate)
-            if c.mean_drift is None or c.mean_drift > limit or form == form_of(sel.chosen):
-                continue
-            if form not in forms or c.mean_drift < forms[form][0]:
-                forms[form] = (c.mean_drift, c.candidate)
-        for form, (drift, candidate) in sorted(forms.items(), key=lambda item: item[1][0])[:most]:
+        for drift, c in within_one_standard_error(calibration, axis):  # the nearest first: each form's nearest kept
+            if form_of(c) != form_of(sel.chosen):
+                forms.setdefault(form_of(c), (drift, c))
+        for form, (drift, candidate) in list(forms.items())[:most]:
             gap = drift - sel.chosen_drift
             if form in nearest:
-                nearest[form][2].add(axis)
-                gap = min(gap, nearest[form][0])
-            nearest[form] = (gap, candidate, nearest.get(form, (0, 0, {axis}))[2] | {axis})
+                gap, candidate = min(nearest[form][:2], (gap, candidate), key=lambda item: item[0])
+            nearest[form] = (gap, candidate, nearest.get(form, (0.0, candidate, set()))[2] | {axis})
     out = []
     for form, (_, candidate, axes) in sorted(nearest.items(), key=lambda item: item[1][0]):
         try:
@@ -124,4 +146,13 @@ def predicted(calibration: Calibration, axis: str, time_s: np.ndarray, temperatu
         return predict_error(calibration, rec)[:, axes.index(axis)]
 
 
-__all__ = ["Alternative", "MOST_ALTERNATIVES", "choice_alternatives", "form_of", "options_of", "predicted"]
+__all__ = [
+    "Alternative",
+    "MOST_ALTERNATIVES",
+    "choice_alternatives",
+    "close_candidates",
+    "form_of",
+    "options_of",
+    "predicted",
+    "within_one_standard_error",
+]

@@ -47,11 +47,13 @@ from ..curves.lookup import LookupTableCurve
 from ..curves.polynomial import POLY_FAMILY, PolynomialCurve
 from ..curves.protocol import BASES, RANGE_TOLERANCE_DEGC, RANGE_TOLERANCE_FRACTION
 from ..curves.rate import rate_columns
-from ..effects import moving_average, thermal_lag
+from ..effects import thermal_lag
 from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..fitting.drift_gls import MAX_POINTS, DriftNoise, coarsen, covariance, fit_drift_noise
+from ..measures.merit import smoothed_about_mean
 from ..recording import Recording
-from .choice_alternatives import Alternative, choice_alternatives, predicted
+from ..simulation.profiles import Profile
+from .choice_alternatives import Alternative, choice_alternatives, close_candidates, predicted
 
 #: the moving-average window the accuracy page scores the held-out drift with [s]
 DEFAULT_WINDOW_S = 60.0
@@ -147,17 +149,14 @@ class UseProfile:
 
 def set_point_profile(points_degc: Sequence[float], ramp_degc_per_min: float, hold_s: float, name: str) -> UseProfile:
     """A chamber's profile: hold ``hold_s`` [s] at each set point of ``points_degc`` [degC], ramping between them at
-    ``ramp_degc_per_min`` [degC/min], sampled at 1 Hz."""
-    knots_t, knots_v = [0.0], [float(points_degc[0])]
-    for target in points_degc[1:]:
-        knots_t += [knots_t[-1] + hold_s]
-        knots_v += [knots_v[-1]]
-        knots_t += [knots_t[-1] + abs(float(target) - knots_v[-1]) / ramp_degc_per_min * 60.0]
-        knots_v += [float(target)]
-    knots_t += [knots_t[-1] + hold_s]
-    knots_v += [knots_v[-1]]
-    t = np.arange(0.0, knots_t[-1] + 0.5, 1.0)
-    return UseProfile(t, np.interp(t, knots_t, knots_v), name)
+    ``ramp_degc_per_min`` [degC/min], sampled at 1 Hz (the simulator's ``chamber`` profile)."""
+    chamber = Profile(
+        "chamber",
+        set_points_degc=tuple(float(p) for p in points_degc),
+        ramp_rate_degc_per_min=ramp_degc_per_min,
+        dwell_s=hold_s,
+    ).trajectory(1.0)
+    return UseProfile(chamber.time_s, chamber.temperature_degc, name)
 
 
 #: the share of the calibrated span held out at each end to measure how fast the curve loses track past it
@@ -350,6 +349,8 @@ class _Run:
     block_s: float
     chol: np.ndarray | None = None
     raw: np.ndarray | None = None  # block means of the gyro axis as recorded [deg/s] (calibration runs)
+    chosen: np.ndarray | None = None  # the error the chosen model predicts on it [deg/s], once asked
+    partings: dict = dataclasses.field(default_factory=dict)  # (alternative, parting) by id of it and width
 
     def blocks(self, values: np.ndarray) -> np.ndarray:
         return coarsen(values, self.factor)
@@ -535,14 +536,23 @@ class AxisInformation:
         return [c @ coef[len(self.runs) :] for c in cols]
 
     def difference(self, run: _Run, alternative: Alternative) -> np.ndarray:
-        """The block means of the error the chosen model predicts on ``run`` less the alternative's [deg/s]."""
-        args = (self.axis, run.time_s, run.reported_degc)
-        return run.blocks(predicted(self.calibration, *args) - predicted(alternative.calibration, *args))
+        """The block means of the error the chosen model predicts on ``run`` less the alternative's [deg/s] (the
+        chosen model's prediction kept with the run: every alternative is set against it)."""
+        if run.chosen is None:
+            run.chosen = predicted(self.calibration, self.axis, run.time_s, run.reported_degc)
+        return run.blocks(run.chosen - predicted(alternative.calibration, self.axis, run.time_s, run.reported_degc))
 
     def parting(self, use: _Run, width: int, alternative: Alternative) -> float:
         """How far ``alternative`` parts from the chosen model on a profile's series: the RMS about its mean of
-        the moving average of their difference [deg/s]."""
-        return float(np.sqrt(np.mean(_about_mean(self.difference(use, alternative), width) ** 2)))
+        the moving average of their difference [deg/s] (kept with the series: each candidate run's forecast asks
+        for the same)."""
+        key = (id(alternative), width)
+        if key not in use.partings:
+            use.partings[key] = (
+                alternative,
+                float(np.sqrt(np.mean(_about_mean(self.difference(use, alternative), width) ** 2))),
+            )
+        return use.partings[key][1]
 
     def separation(self, run: _Run, alternative: Alternative) -> float:
         """The chi-square (one degree of freedom) a run would give the difference between the chosen model and
@@ -606,6 +616,32 @@ def _series(ax: AxisCalibration, time_s: np.ndarray, temperature_degc: np.ndarra
     return _Run(time_s, temperature_degc, model, factor, coarsen(cols, factor), factor * period)
 
 
+def calibrated_range(infos: dict[str, AxisInformation]) -> tuple[float, float]:
+    """The model temperature's range [degC] the axes were calibrated over, all of them together.
+
+    Parameters
+    ----------
+    infos : dict of str to AxisInformation
+        Each axis's information (:func:`axis_information`).
+    """
+    return min(i.lo_degc for i in infos.values()), max(i.hi_degc for i in infos.values())
+
+
+def calibration_cycle(infos: dict[str, AxisInformation], ramp_degc_per_min: float) -> UseProfile:
+    """One heat-cool cycle over the calibrated range (:func:`calibrated_range`): the use profile when none is given.
+
+    Parameters
+    ----------
+    infos : dict of str to AxisInformation
+        Each axis's information (:func:`axis_information`).
+    ramp_degc_per_min : float
+        The cycle's ramp rate [degC/min] (the calibration runs').
+    """
+    lo, hi = calibrated_range(infos)
+    name = f"one cycle {lo:.0f}..{hi:.0f} degC at {ramp_degc_per_min:.2g} degC/min (the calibration's)"
+    return UseProfile.cycle(lo, hi, ramp_degc_per_min, name=name)
+
+
 def _about_mean(x: np.ndarray, width: int) -> np.ndarray:
     """The moving average over ``width`` rows of each column of ``x``, about its mean."""
     x = np.asarray(x, dtype=float)
@@ -614,8 +650,7 @@ def _about_mean(x: np.ndarray, width: int) -> np.ndarray:
     if x.shape[1] == 0:
         return np.zeros((max(0, x.shape[0] - width + 1), 0))
     w = min(width, x.shape[0])
-    smooth = np.column_stack([moving_average(x[:, k], w) for k in range(x.shape[1])])
-    return smooth - smooth.mean(axis=0)
+    return np.column_stack([smoothed_about_mean(x[:, k], w) for k in range(x.shape[1])])
 
 
 def _inverse(information: np.ndarray) -> np.ndarray:
@@ -714,21 +749,6 @@ def axis_information(
     return infos
 
 
-def close_candidates(calibration: Calibration, axis: str) -> tuple[str, ...]:
-    """The model choice's candidates for ``axis`` whose held-out drift was within one standard error of the chosen
-    candidate's, the nearest first (none when the fit kept no choice)."""
-    report = calibration.report.selection.get(axis) if calibration.report is not None else None
-    if report is None or report.chosen_drift is None:
-        return ()
-    limit = report.chosen_drift + (report.chosen_standard_error or 0.0)
-    close = sorted(
-        (c.mean_drift, c.candidate.label)
-        for c in report.candidates
-        if c.candidate != report.chosen and c.mean_drift is not None and c.mean_drift <= limit
-    )
-    return tuple(label for _, label in close)
-
-
 def forecast_drift(
     calibration: Calibration,
     recordings: Sequence[Recording],
@@ -778,7 +798,8 @@ __all__ = [
     "DriftForecast",
     "UseProfile",
     "axis_information",
-    "close_candidates",
+    "calibrated_range",
+    "calibration_cycle",
     "forecast_drift",
     "ramp_rate_degc_per_min",
     "set_point_profile",

@@ -20,12 +20,13 @@ import numpy as np
 from ..errors import InputError
 from ..models.fit import fit
 from ..recording import Recording
+from .choice_alternatives import close_candidates
 from .drift_forecast import (
     DEFAULT_WINDOW_S,
     AxisForecast,
     UseProfile,
     axis_information,
-    close_candidates,
+    calibration_cycle,
     ramp_rate_degc_per_min,
 )
 
@@ -128,9 +129,7 @@ def look(
     except InputError as exc:
         return LogLook(**base, worst=None, leg_gain_dps_per_h=None, reached=False, waiting=str(exc))
     if use is None:
-        lo = min(i.lo_degc for i in infos.values())
-        hi = max(i.hi_degc for i in infos.values())
-        use = UseProfile.cycle(lo, hi, ramp_rate_degc_per_min(runs)) if hi > lo else UseProfile.cycle(lo, lo + 1, 1.0)
+        use = calibration_cycle(infos, ramp_rate_degc_per_min(runs))
     now = {a: i.forecast(use, window_s, close=close_candidates(calibration, a)) for a, i in infos.items()}
     worst = max(now.values(), key=lambda f: f.drift_dps)
     leg = continued_leg(recording)

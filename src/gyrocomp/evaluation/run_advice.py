@@ -21,15 +21,16 @@ from dataclasses import dataclass, field
 from ..calibration.calibration import Calibration
 from ..errors import InputError
 from ..recording import Recording
-from .choice_alternatives import choice_alternatives
+from .choice_alternatives import choice_alternatives, close_candidates
 from .drift_forecast import (
     DEFAULT_WINDOW_S,
     AxisForecast,
     AxisInformation,
     axis_information,
+    calibrated_range,
+    calibration_cycle,
     DriftForecast,
     UseProfile,
-    close_candidates,
     ramp_rate_degc_per_min,
     set_point_profile,
     warn_faster_use,
@@ -348,13 +349,9 @@ def plan(
     if target_drift_dps is not None and not (math.isfinite(target_drift_dps) and target_drift_dps > 0):
         raise InputError(f"target_drift_dps: {target_drift_dps!r}; give the drift to reach, a positive number of deg/s")
     infos = axis_information(calibration, recordings, window_s)
-    lo = min(i.lo_degc for i in infos.values())
-    hi = max(i.hi_degc for i in infos.values())
+    lo, hi = calibrated_range(infos)
     ramp = ramp_rate_degc_per_min(recordings)
-    if use is None:
-        use = UseProfile.cycle(
-            lo, hi, ramp, name=f"one cycle {lo:.0f}..{hi:.0f} degC at {ramp:.2g} degC/min (the calibration's)"
-        )
+    use = calibration_cycle(infos, ramp) if use is None else use
     warn_faster_use(use, ramp)
     alternatives = choice_alternatives(calibration, recordings) if model_choice else ()
     planner = _Planner(infos, use, window_s, {a: close_candidates(calibration, a) for a in infos}, alternatives)
