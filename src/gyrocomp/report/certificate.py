@@ -23,7 +23,7 @@ from ..fleet.limits import Limits
 from ..fleet.store import CalibrationRecord
 from ..io.atomic import atomic_path
 from . import figures
-from .html import Report, escape_text, figure_html, html_page, table_html
+from .page import Report, escape_text, figure_html, html_page, table_html
 
 SECTIONS = ("unit", "inputs", "model", "residual", "merit")
 #: printed: A4, small type, no navigation, the figure a third of a page: two pages for a three-axis unit

@@ -33,7 +33,8 @@ from ..io import read_table, write_gyro_back, write_recording, write_text_atomic
 from ..allan import allan_deviation_segments
 from ..measures.merit import Evaluation, evaluate_run, moving_average, smoothed_residual_rms, window_samples
 from ..models.joint import fit_calibration
-from .html import build_report, escape_text, figure_html, table_html
+from .html import build_report
+from .page import escape_text, figure_html, table_html
 from . import figures
 from ..simulation import get_preset, get_profile, simulate
 from ..units import DEG_PER_S_TO_DEG_PER_H

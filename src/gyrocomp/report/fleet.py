@@ -15,7 +15,7 @@ import pandas as pd
 from ..fleet import FIGURE_NAMES, Limits, fleet_yield
 from ..fleet.population import OUTLIER_THRESHOLD
 from . import figures
-from .html import Report, figure_html, table_html, html_page
+from .page import Report, figure_html, html_page, table_html
 
 #: units listed in the worst-units table
 WORST_UNITS = 10
