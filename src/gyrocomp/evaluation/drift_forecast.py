@@ -105,9 +105,11 @@ class UseProfile:
         """
         if recording.temperature_degc is None:
             raise InputError(f"{recording.source}: no temperature column; a use profile is its temperatures")
-        temps = recording.temperature_degc
-        mean = temps if temps.ndim == 1 else temps.mean(axis=1)
-        return cls(np.asarray(recording.time_s, dtype=float), np.asarray(mean, dtype=float), recording.source)
+        return cls(
+            np.asarray(recording.time_s, dtype=float),
+            np.asarray(recording.die_temperature_degc, dtype=float),
+            recording.source,
+        )
 
     @classmethod
     def cycle(
@@ -289,11 +291,7 @@ def ramp_rate_degc_per_min(recordings: Sequence[Recording]) -> float:
     recordings : sequence of Recording
         The runs (those without a temperature are skipped).
     """
-    return _typical_ramp(
-        (r.time_s, r.temperature_degc if r.temperature_degc.ndim == 1 else r.temperature_degc.mean(axis=1))
-        for r in recordings
-        if r.temperature_degc is not None
-    )
+    return _typical_ramp((r.time_s, r.die_temperature_degc) for r in recordings if r.temperature_degc is not None)
 
 
 #: a use profile ramping faster than this many times the calibration runs' is warned about

@@ -77,9 +77,7 @@ def continued_leg(recording: Recording) -> UseProfile:
     recording : Recording
         The log so far.
     """
-    temps = (
-        recording.temperature_degc if recording.temperature_degc.ndim == 1 else recording.temperature_degc.mean(axis=1)
-    )
+    temps = recording.die_temperature_degc
     t = recording.time_s
     recent = t >= t[-1] - TREND_S
     slope_per_s = float(np.polyfit(t[recent] - t[-1], temps[recent], 1)[0]) if np.count_nonzero(recent) > 2 else 0.0

@@ -367,6 +367,13 @@ class Recording:
         """The unit of an axis's values: ``deg/s`` for a gyro axis, ``g`` for an accelerometer axis."""
         return "g" if axis in self.accel_axes and axis not in self.gyro_axes else "deg/s"
 
+    @property
+    def die_temperature_degc(self) -> np.ndarray | None:
+        """The temperature of the die [degC]: the one column, or the mean of one per axis (None without a
+        temperature)."""
+        t = self.temperature_degc
+        return t if t is None or t.ndim == 1 else t.mean(axis=1)
+
     def temperature_for(self, axis: str) -> np.ndarray:
         """Temperature [degC] that goes with an axis: a gyro axis's own column when there is one per axis; for an
         accelerometer axis (one die, whatever the gyro's columns) their mean, as the compensation reads it."""
@@ -378,7 +385,7 @@ class Recording:
         if self.temperature_degc.ndim == 1:
             return self.temperature_degc
         if axis in self.accel_axes and axis not in self.gyro_axes:
-            return self.temperature_degc.mean(axis=1)
+            return self.die_temperature_degc
         return self.temperature_degc[:, self._axis_index(axis)]
 
     def _axis_index(self, axis: str) -> int:

@@ -367,7 +367,7 @@ def timeseries_plot(raw, compensated, axis: str, window_s: float, unit: str = "d
     top.grid(True, alpha=0.3)
     top.legend(fontsize="small", loc="best")
     if raw.temperature_degc is not None:
-        temp = raw.temperature_degc if raw.temperature_degc.ndim == 1 else raw.temperature_degc.mean(axis=1)
+        temp = raw.die_temperature_degc
         bottom.plot(*envelope(t, temp), "-", color="tab:red", lw=1.0)
     bottom.set_ylabel("temperature [degC]")
     bottom.set_xlabel(f"time [{t_unit}]")
