@@ -109,3 +109,29 @@ def test_a_flat_profile_takes_the_middle_and_a_sharp_one_its_least():
     assert plausible_middle(np.full(9, 10.0) + np.linspace(0, 1e-3, 9), independent=80) == 4
     sharp = 10.0 + (np.arange(9) - 2.0) ** 2
     assert plausible_middle(sharp, independent=80) == 2
+
+
+@pytest.mark.parametrize("jitter_s", [0.0, 0.4])
+def test_the_covariance_is_its_definition_on_even_and_uneven_times(jitter_s):
+    """Evenly spaced points take the Toeplitz path, jittered ones the general one: both equal the formula written
+    element by element."""
+    rng = np.random.default_rng(5)
+    t = 100.0 + np.arange(40) * DT_S + jitter_s * rng.uniform(-1, 1, 40)
+    noise = DriftNoise(1e-4, 3e-6, 1.4)
+    tau = t - t[0]
+    expected = np.array([[0.5 * 3e-6 * (a**1.4 + b**1.4 - abs(a - b) ** 1.4) for b in tau] for a in tau]) + np.eye(
+        t.size
+    ) * max(1e-4, 3e-6 * np.median(np.diff(t)) ** 1.4 / 3.0)
+    np.testing.assert_allclose(covariance(t, noise), expected, rtol=1e-12, atol=1e-18)
+
+
+def test_whitening_twice_at_the_same_times_gives_the_same_and_leaves_the_input():
+    rng = np.random.default_rng(6)
+    t = np.arange(200) * DT_S
+    x, y = rng.standard_normal((200, 3)), rng.standard_normal(200)
+    noise = DriftNoise(SIGMA**2, K**2)
+    first = whitened(x, y, t, noise)
+    chol = np.linalg.cholesky(covariance(t, noise))
+    np.testing.assert_allclose(first[0], np.linalg.solve(chol, x), rtol=1e-10, atol=1e-12)
+    again = whitened(2.0 * x, y, t.copy(), noise)  # the factor kept for these times, applied to other columns
+    np.testing.assert_allclose(again[0], 2.0 * first[0], rtol=1e-12, atol=1e-14)

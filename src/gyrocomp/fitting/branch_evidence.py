@@ -15,6 +15,7 @@ from ..effects import branch_position, find_turns, thermal_lag
 from ..calibration.fit_report import BranchTest
 from ..runs.prepared import RunBlocks
 from .drift_gls import chi2_threshold, fit_drift_noise, wald_statistic
+from .normal_equations import solve_normal
 from .order_evidence import CoarseRuns, run_constants
 from ..curves.hysteresis import parting_band_degc
 from ..curves.polynomial import power_columns
@@ -98,7 +99,7 @@ class _ProjectedFit:
         e = self._residual(extra * self.sw[:, None])
         gram = e.T @ e
         scale = np.sqrt(np.maximum(np.diag(gram), 1e-300))
-        coef, *_ = np.linalg.lstsq(gram / np.outer(scale, scale), (e.T @ self.y) / scale, rcond=1e-10)
+        coef = solve_normal(gram / np.outer(scale, scale), (e.T @ self.y) / scale)
         resid = self.y - e @ (coef / scale)
         return float(resid @ resid)
 

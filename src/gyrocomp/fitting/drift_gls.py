@@ -25,6 +25,7 @@ noises and applications", SIAM Review 10(4), 1968; T. W. Anderson, *The Statisti
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -132,19 +133,44 @@ def covariance(t_s: np.ndarray, noise: DriftNoise) -> np.ndarray:
     tau = t_s - t_s[0]
     e = noise.exponent
     powered = tau**e
-    cov = 0.5 * noise.walk_var_per_s * (powered[:, None] + powered[None, :] - np.abs(np.subtract.outer(tau, tau)) ** e)
+    cov = np.add.outer(powered, powered)
+    cov -= _lag_powers(tau, e)
+    cov *= 0.5 * noise.walk_var_per_s
     spacing = float(np.median(np.diff(t_s))) if t_s.size > 1 else 0.0
     floor = max(noise.walk_var_per_s * spacing**e / 3.0, 1e-12 * max(float(np.max(np.diag(cov))), 1e-300))
     cov[np.diag_indices_from(cov)] += max(noise.white_var, floor)
     return cov
 
 
+def _lag_powers(tau: np.ndarray, exponent: float) -> np.ndarray:
+    """``|tau_i - tau_j|^exponent`` (n, n) [s^exponent]; from the n lags alone when the points are evenly spaced
+    (the matrix is then Toeplitz)."""
+    import scipy.linalg  # slow to import (0.1 s with scipy's array API layer): not at every command's start
+
+    steps = np.diff(tau)
+    if steps.size and np.all(np.abs(steps - steps[0]) <= 1e-12 * abs(steps[0])):
+        return scipy.linalg.toeplitz(np.abs(tau - tau[0]) ** exponent)
+    return np.abs(np.subtract.outer(tau, tau)) ** exponent
+
+
+@functools.lru_cache(maxsize=4)
+def _lower_factor(t_bytes: bytes, noise: DriftNoise) -> np.ndarray:
+    """The lower Cholesky factor of :func:`covariance` at the times whose float64 bytes are ``t_bytes`` (kept:
+    the tests of one axis whiten several designs under one drift model at the same times)."""
+    import scipy.linalg  # slow to import: not at every command's start
+
+    t_s = np.frombuffer(t_bytes, dtype=float)
+    chol = scipy.linalg.cholesky(covariance(t_s, noise), lower=True, overwrite_a=True, check_finite=False)
+    chol.setflags(write=False)
+    return chol
+
+
 def whitened(x: np.ndarray, y: np.ndarray, t_s: np.ndarray, noise: DriftNoise) -> tuple[np.ndarray, np.ndarray]:
     """``x`` (n, p) and ``y`` (n,) of one recording multiplied by the inverse Cholesky factor of its
     :func:`covariance`: ordinary least squares on the result is GLS."""
-    import scipy.linalg  # slow to import (0.1 s with scipy's array API layer): not at every command's start
+    import scipy.linalg  # slow to import: not at every command's start
 
-    chol = scipy.linalg.cholesky(covariance(t_s, noise), lower=True, overwrite_a=True, check_finite=False)
+    chol = _lower_factor(np.ascontiguousarray(t_s, dtype=float).tobytes(), noise)
     from_left = scipy.linalg.solve_triangular(chol, np.column_stack([x, y]), lower=True, check_finite=False)
     return from_left[:, :-1], from_left[:, -1]
 

@@ -53,6 +53,7 @@ from ..units import AxisUnit, in_unit, unit_suffix
 from .temperature_bins import bin_width_for
 from .design import Terms, ThermalDesign
 from .folds import FoldKind, Folds, make_folds, window_for
+from .normal_equations import solve_normal
 from .scores import CandidateScore, json_number
 from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
@@ -502,11 +503,10 @@ class SelectionProblem:
         matrix (minimum-norm where columns are not identified, e.g. a branch absent from the training data)."""
         if idx.size == 0:
             return np.zeros(0), float(matrix[-1, -1])
-        a = matrix[np.ix_(idx, idx)]
+        a = matrix.take(idx, axis=0).take(idx, axis=1)
         b = matrix[idx, -1]
-        scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
-        coef, *_ = np.linalg.lstsq(a / np.outer(scale, scale), b / scale, rcond=1e-10)
-        coef = coef / scale
+        scale = np.sqrt(np.maximum(a.diagonal(), 1e-300))
+        coef = solve_normal(a / scale[:, None] / scale, b / scale) / scale
         return coef, float(matrix[-1, -1] - b @ coef)
 
     def _held_out(

@@ -156,6 +156,7 @@ class _Problem:
     #: a polynomial continues along its tangent past its range (as the model choice scored it), else is held
     extended: bool = False
     _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
+    _solved: dict = dataclasses.field(default_factory=dict, repr=False)
 
     def model_temperature(self, run: RunBlocks, spec: _Spec, tau: float) -> np.ndarray:
         """The temperature the model reads [degC]: reported, or through the lag ``tau`` [s] (kept per run and tau:
@@ -232,12 +233,17 @@ class _Problem:
         return x, y, w, (t_lo, t_hi)
 
     def solve(self, spec: _Spec, tau: float, which: list[int]):
-        """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range)."""
-        x, y, w, t_range = self.design(spec, tau, which)
-        sw = np.sqrt(w)
-        coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
-        rss = float(np.sum(w * (y - x @ coef) ** 2))
-        return coef[len(which) :], coef[: len(which)], rss, t_range
+        """Weighted least squares on the runs ``which``: (coefficients, run constants, weighted RSS, range); kept
+        per spec, lag, runs and band (the searches over the lag, the width and the band ask for the same again)."""
+        key = (spec, float(tau), tuple(which), self.band)
+        if key not in self._solved:
+            x, y, w, t_range = self.design(spec, tau, which)
+            sw = np.sqrt(w)
+            coef, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
+            coef.setflags(write=False)
+            rss = float(np.sum(w * (y - x @ coef) ** 2))
+            self._solved[key] = coef[len(which) :], coef[: len(which)], rss, t_range
+        return self._solved[key]
 
     def best_width(self, spec: _Spec, tau: float, which: list[int]) -> _Spec:
         """``spec`` with the branch crossover width [degC] of :data:`BRANCH_WIDTHS_DEGC` at lag ``tau`` [s]
