@@ -9,12 +9,14 @@ import shutil
 import sqlite3
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import pytest
 import sqlalchemy as sa
 
 from gyrocomp.calibration import Calibration
 from gyrocomp.fleet import CalibrationStore, model_file_name
+from gyrocomp.fleet.model_files import store_with_model
 from gyrocomp.io.tables import write_recording
 from gyrocomp.simulation import simulate
 
@@ -29,6 +31,47 @@ def test_model_file_names_are_one_per_serial_and_short():
     assert model_file_name("SN-1") == "SN-1.json"  # a plain serial keeps its name
     assert all(len(n) <= 120 and "/" not in n and not n.startswith(".") for n in names)
     assert model_file_name("a/b") == f"a_b~{hashlib.sha256(b'a/b').hexdigest()[:16]}.json"
+
+
+class _Store:
+    """A store whose insert sees what a reader of the folder would at the instant the row becomes visible, then
+    stores the row (its id), finds the unit already stored (None) or is interrupted."""
+
+    def __init__(self, model_file, outcome):
+        self.model_file, self.outcome, self.seen = model_file, outcome, None
+
+    def add_new(self, record, since, stamp):
+        self.seen = self.model_file.read_text() if self.model_file.exists() else None
+        if isinstance(self.outcome, BaseException):
+            raise self.outcome
+        return self.outcome
+
+
+@pytest.mark.parametrize("had_file", [False, True])
+@pytest.mark.parametrize("outcome", [7, None, KeyboardInterrupt()])
+def test_the_model_file_is_in_place_before_its_row_and_put_back_when_no_row_is_stored(tmp_path, had_file, outcome):
+    """A kill at any moment can leave a file newer than the rows, never a row without its file: the new model is
+    the file when the row is committed; a row not stored (another fit stored the unit, Ctrl-C) puts back what
+    was there."""
+    path = tmp_path / "models" / model_file_name("SN-1")
+    if had_file:
+        path.parent.mkdir()
+        path.write_text("the previous model")
+    db = _Store(path, outcome)
+    record = SimpleNamespace(serial="SN-1", model_json="the new model")
+    if isinstance(outcome, BaseException):
+        with pytest.raises(KeyboardInterrupt):
+            store_with_model(db, record, None, tmp_path)
+    else:
+        assert store_with_model(db, record, None, tmp_path) == outcome
+    assert db.seen == "the new model"
+    if outcome == 7:
+        assert path.read_text() == "the new model"
+    elif had_file:
+        assert path.read_text() == "the previous model"
+    else:
+        assert not path.exists()
+    assert sorted(p.name for p in path.parent.iterdir()) == ([path.name] if outcome == 7 or had_file else [])
 
 
 def _units(folder, serials):

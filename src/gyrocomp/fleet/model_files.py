@@ -1,5 +1,5 @@
-"""The fleet's output folder: each unit's model file under a name its serial gives, the fleet table, and a model
-file put back from the store."""
+"""The fleet's output folder: each unit's model file under a name its serial gives, stored with its row (the file
+in place before the row is visible), the fleet table, and a model file put back from the store."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import DataQualityWarning, GyrocompError, InputError, user_stacklevel
-from ..io.atomic import atomic_path, write_text_atomic
-from .store import CalibrationStore
+from ..io.atomic import atomic_path, folder_lock, write_text_atomic
+from .store import CalibrationRecord, CalibrationStore
 
 
 if TYPE_CHECKING:
@@ -52,6 +52,51 @@ def _write_model(output: Path, serial: str, model_json: str) -> None:
         write_text_atomic(folder / model_file_name(serial), model_json)
     except OSError as exc:
         raise model_write_error(folder / model_file_name(serial), serial, exc) from None
+
+
+def store_with_model(db: CalibrationStore, record: CalibrationRecord, since, output: Path) -> int | None:
+    """Store a successful ``record`` (:meth:`CalibrationStore.add_new` with ``since``, a time) and its unit's model
+    file in ``output``'s models folder, under the folder's lock (writers of one folder take turns).
+
+    The file is renamed into place before the row is committed, so that a row is never visible without its
+    model file, at any moment of a kill: a kill between the two leaves a file newer than the unit's newest row,
+    and the unit, its inputs not stored, is fitted again by the next run. When the row is not stored (another fit
+    stored the unit from the same inputs, or the store failed or the write was interrupted) the file the unit had
+    is put back. Returns the row's id, or None when another fit had stored the unit."""
+    folder = output / MODELS_FOLDER
+    path = folder / model_file_name(record.serial)
+    try:
+        folder.mkdir(exist_ok=True)
+        with folder_lock(path):
+            previous = _previous_model(path)
+            write_text_atomic(path, record.model_json)
+            try:
+                row = db.add_new(record, since=since, stamp=True)
+            except BaseException:
+                _put_back(path, previous)
+                raise
+            if row is None:
+                _put_back(path, previous)
+            return row
+    except OSError as exc:
+        raise model_write_error(path, record.serial, exc) from None
+
+
+def _previous_model(path: Path) -> bytes | None:
+    """The unit's model file as it is (None: none yet)."""
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        return None
+
+
+def _put_back(path: Path, previous: bytes | None) -> None:
+    """The unit's model file as it was before a row that was not stored (removed when there was none)."""
+    if previous is None:
+        path.unlink(missing_ok=True)
+    else:
+        with atomic_path(path) as tmp:
+            tmp.write_bytes(previous)
 
 
 def model_write_error(path: Path, serial: str, exc: OSError) -> InputError:
@@ -109,5 +154,6 @@ __all__ = [
     "model_write_error",
     "repair_model",
     "serial_key",
+    "store_with_model",
     "write_fleet_table",
 ]

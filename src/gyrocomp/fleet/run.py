@@ -36,7 +36,6 @@ from ..errors import GyrocompError, InputError
 from ..files.check import ask_for, read_checked, refuse, rewarn, warn_findings
 from ..io import ReadOptions
 from ..measures.data_check import check_runs
-from ..io.atomic import atomic_path, folder_lock
 from ..io.foreign_libraries import require
 from ..models.fit import fit
 from ..models.pipelines import Pipeline
@@ -51,15 +50,7 @@ from .store import CalibrationRecord, CalibrationStore, InputFile, utc_now
 from .stations import Station, claim, release, station as running_as
 from .devices import UnitRuns, content_hash, input_hash
 from .cluster import check_reachable, dask_client
-from .model_files import (
-    FLEET_TABLE,
-    MODELS_FOLDER,
-    model_file_name,
-    model_write_error,
-    repair_model,
-    serial_key,
-    write_fleet_table,
-)
+from .model_files import FLEET_TABLE, repair_model, serial_key, store_with_model, write_fleet_table
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -311,7 +302,7 @@ def _keep(
     tally: "_Tally",
     me: Station,
 ) -> None:
-    """Store one unit's outcome with its model file (:func:`_store_with_model`); a unit another fit stored from
+    """Store one unit's outcome with its model file (:func:`gyrocomp.fleet.model_files.store_with_model`); a unit another fit stored from
     the same inputs since ``started`` counts as unchanged; an unchanged unit's missing model file is put back."""
     if outcome.status == "busy":
         tally.busy[outcome.serial] = outcome.error or "busy"
@@ -322,7 +313,7 @@ def _keep(
         return
     record = _record(outcome, unit, limits, me.name)
     stored = (
-        _store_with_model(db, record, started, output)
+        store_with_model(db, record, started, output)
         if record.status == "ok"
         else db.add_new(record, since=started, stamp=True)
     )
@@ -330,31 +321,6 @@ def _keep(
         tally.unchanged.append(outcome.serial)
     else:
         tally.count(record)
-
-
-class _NotStored(Exception):
-    """Another fit stored the unit from the same inputs: the staged model file is dropped."""
-
-
-def _store_with_model(db: CalibrationStore, record: CalibrationRecord, since, output: Path) -> int | None:
-    """Store a successful ``record`` and its model file: the file staged (written to a temporary name) first, so
-    that a failed write stores nothing, then the row committed, then the file renamed into place, all under the
-    models folder's lock (writers of one folder take turns, and the file is always its unit's newest row's).
-    Returns the row's id, or None when another fit had stored the unit from the same inputs."""
-    folder = output / MODELS_FOLDER
-    path = folder / model_file_name(record.serial)
-    try:
-        folder.mkdir(exist_ok=True)
-        with folder_lock(path), atomic_path(path) as staged:
-            staged.write_text(record.model_json, encoding="utf-8")
-            row = db.add_new(record, since=since, stamp=True)
-            if row is None:
-                raise _NotStored
-    except _NotStored:
-        return None
-    except OSError as exc:
-        raise model_write_error(path, record.serial, exc) from None
-    return row
 
 
 @dataclass
