@@ -4,7 +4,9 @@ the same warnings once, names the file's own rows in its errors, and reads a fil
 
 from __future__ import annotations
 
+import dataclasses
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -251,3 +253,37 @@ def _run_bytes(*args) -> subprocess.CompletedProcess:
     """The command line with output kept as bytes (a file name that is not UTF-8 is printed as its bytes)."""
     cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "gyrocomp"]
     return subprocess.run([*cmd, *map(os.fspath, args)], capture_output=True, timeout=300)
+
+
+WHOLE = ReadOptions(time_range_s=(None, 1e6))
+
+
+def test_apply_names_a_dead_or_doubled_axis_and_temperature_spikes_streamed_or_whole(consumer_model, tmp_path):
+    """Issue #74, item 7: what the data check names in a run is named by apply too (the samples are checked as
+    they are compensated), the same whether the table is read in chunks or whole; a sound run is named by none."""
+    run = simulate("consumer", profile="chamber", rate_hz=2, duration_s=1800, seed=5, unit=3).recording
+    sound = tmp_path / "sound.csv"
+    write_recording(run, sound)
+    temperature = np.array(run.temperature_degc, dtype=float)
+    temperature[[100, 1500, 2900, 3300]] = -40.0  # read errors, one of them across a chunk boundary
+    gyro = run.gyro_dps.copy()
+    gyro[:, 1] = 0.0  # an axis that says nothing
+    gyro[:, 2] = gyro[:, 0]  # one column mapped twice
+    bad = tmp_path / "bad.csv"
+    write_recording(dataclasses.replace(run, gyro_dps=gyro, temperature_degc=temperature), bad)
+    said = {}
+    # in chunks of 1500 rows, or whole (a table whose rows are selected by time is read whole)
+    for name, how in (("streamed", {"chunks": ChunkSettings(chunk_rows=1500)}), ("whole", {"options": WHOLE})):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = apply_file(consumer_model, bad, tmp_path / f"{name}.csv", **how)
+            clean = apply_file(consumer_model, sound, tmp_path / f"clean-{name}.csv", **how)
+        assert result.streamed == clean.streamed == (name == "streamed")
+        said[name] = sorted(str(w.message) for w in caught if "(data check '" in str(w.message))
+    assert said["streamed"] == said["whole"]
+    text = "\n".join(said["whole"])
+    assert len(said["whole"]) == 3 and "sound.csv" not in text, said["whole"]
+    assert "gyro_y (0 deg/s): every sample the same value" in text
+    assert "gyro_x and gyro_z hold the same samples in every row" in text
+    assert re.search(r"bad\.csv: 4 temperature sample\(s\) jump 2 degC or more .*\(rows 101, 1501, 2901, \.\.\.;", text)
+    assert text.count("the output compensates those samples as they are") == 3

@@ -4,17 +4,21 @@ place ``gyrocomp apply`` and the library compensate files)."""
 from __future__ import annotations
 
 import dataclasses
+import os
+import warnings
 
 import numpy as np
 import pyarrow as pa
 
 from ..calibration import Calibration
 from ..calibration.compensate import accel_xyz, apply, compensated_axes, compensator_for, warn_disagreement
-from ..errors import InputError
+from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..io import ReadOptions
 from ..io.stream import NotStreamable, TableStream, TableWriter
 from ..io.columns import arrow_floats, arrow_indices
 from ..io.tables import write_gyro_back
+from ..measures.data_check import sample_findings
+from ..measures.sample_check import SampleCheck
 from ..recording import ACCEL_AXES
 from ..units import unit_factor
 from .chunks import ChunkSettings, chunked_or_whole
@@ -52,6 +56,9 @@ def apply_file(
     temporary file renamed over ``output_path`` at the end, so memory stays bounded by ``chunks.chunk_rows``
     [rows] whatever the file's length; a log, a table whose rows are selected by time, a table that cannot be
     read in chunks, or a model with accelerometer axes applied with ``turn_on_window_s``, is read whole instead.
+    The samples are checked as they are compensated (:class:`gyrocomp.measures.sample_check.SampleCheck`, the same
+    answer chunked or whole): a dead or doubled gyro axis, temperature spikes and raw counts are each a
+    :class:`~gyrocomp.errors.DataQualityWarning` naming the file and the axes or rows.
 
     Parameters
     ----------
@@ -76,8 +83,11 @@ def apply_file(
             f"got {type(calibration).__name__}"
         )
 
+    checks: list[SampleCheck] = []  # the samples as compensated (a stream that falls back to reading whole: anew)
+
     def whole(read) -> FileResult:
         data = read()
+        checks.append(SampleCheck().add(data.recording))
         compensated = apply(calibration, data.recording, turn_on_window_s=turn_on_window_s, axes=axes)
         accel = compensated.accel_g if calibration.accel_axes or calibration.accel_triad else None
         write_gyro_back(data, compensated.gyro_dps, output_path, fmt=out_fmt, accel_g=accel)
@@ -85,15 +95,29 @@ def apply_file(
         return FileResult(data.recording.n_samples, done, False)
 
     def chunked(stream) -> FileResult:
-        return _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s)
+        checks.append(SampleCheck())
+        return _apply_stream(calibration, stream, output_path, out_fmt, axes, turn_on_window_s, checks[-1])
 
-    return chunked_or_whole(
+    result = chunked_or_whole(
         input_path, options, fmt=fmt, chunks=chunks, progress=progress, whole=whole, chunked=chunked
     )
+    _warn_samples(checks[-1], os.fspath(input_path))
+    return result
+
+
+def _warn_samples(check: SampleCheck, source: str) -> None:
+    """Warn of what the sample checks found in the compensated samples (a dead or doubled axis, temperature
+    spikes, raw counts), as the data check names it."""
+    for f in sample_findings(check.facts(), source):
+        warnings.warn(
+            f"{f.message} (data check '{f.check}'; the output compensates those samples as they are)",
+            DataQualityWarning,
+            stacklevel=user_stacklevel(),
+        )
 
 
 def _apply_stream(
-    calibration: Calibration, stream: TableStream, output_path, out_fmt, axes, turn_on_window_s
+    calibration: Calibration, stream: TableStream, output_path, out_fmt, axes, turn_on_window_s, check: SampleCheck
 ) -> FileResult:
     gyro_factor = unit_factor("gyro", stream.layout.gyro_unit)
     accel_factor = unit_factor("accel", stream.layout.accel_unit)
@@ -120,6 +144,7 @@ def _apply_stream(
 
         for chunk in stream.chunks():
             rec = chunk.recording
+            check.add(rec)
             if comp is None:
                 first = rec
                 comp = compensator_for(calibration, rec, axes=axes, turn_on_window_s=turn_on_window_s)

@@ -28,13 +28,13 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
 from ..effects import moving_average
 from ..errors import TimeOrderWarning
 from ..recording import Recording
 from ..spilled_series import parts, streamed_median
 from .plausibility import time_bursts_concern, turned_between_poses
+from .sample_check import TEMPERATURE_SPIKE_DEGC, SampleCheck, SampleFacts
 
 Severity = Literal["refuse", "warn"]
 #: every check, in the order a verdict line lists them
@@ -61,9 +61,6 @@ DATA_CHECKS = (
 CONSTANT_SPAN_DEGC = 0.01
 #: a set of runs spanning less than this cannot identify a temperature curve [degC] (the plausibility check's)
 MIN_SPAN_DEGC = 1.0
-#: a temperature sample this far from the median of its TEMPERATURE_SPIKE_SAMPLES neighbours is a spike [degC]: a
-#: die changes temperature by well under a degree in a few samples, even on a 10 degC/min chamber ramp logged at 1 Hz
-TEMPERATURE_SPIKE_DEGC, TEMPERATURE_SPIKE_SAMPLES = 2.0, 9
 #: gyro samples that are whole numbers, on every axis, spread over at least this many of them: raw counts of the
 #: sensor's converter read as deg/s (a MEMS gyro's rate in deg/s is never whole in every sample)
 COUNTS_MIN_LEVELS = 8
@@ -293,88 +290,72 @@ def gap_findings(recording: Recording) -> list[Finding]:
     ]
 
 
-def gyro_findings(recording: Recording) -> list[Finding]:
+def sample_findings(facts: SampleFacts, source: str) -> list[Finding]:
+    """The findings of the sample checks (:class:`gyrocomp.measures.sample_check.SampleFacts` of the run
+    ``source``): a gyro that says nothing, temperature spikes and raw counts."""
+    return gyro_findings(facts, source) + temperature_spike_findings(facts, source) + counts_findings(facts, source)
+
+
+def gyro_findings(facts: SampleFacts, source: str) -> list[Finding]:
     """A gyro that says nothing: an axis whose every sample is the same value (a dead or absent axis; every axis:
     refused, one of several: a warning), and two axes that hold the same samples (one column mapped twice: a
     warning)."""
     out = []
-    x = recording.gyro_dps
-    axes = recording.gyro_axes
-    constant = [j for j in range(x.shape[1]) if x.shape[0] and np.all(x[:, j] == x[0, j])]
-    if constant:
-        every = len(constant) == x.shape[1]
-        named = ", ".join(f"{axes[j]} ({x[0, j]:.6g} deg/s)" for j in constant)
+    axes = facts.gyro_axes
+    if facts.constant_dps:
+        every = len(facts.constant_dps) == len(axes)
+        named = ", ".join(f"{axes[j]} ({v:.6g} deg/s)" for j, v in facts.constant_dps.items())
         out.append(
             Finding(
                 "gyro-constant",
                 "refuse" if every else "warn",
-                f"{recording.source}: {named}: every sample the same value: a dead, absent or unconnected "
+                f"{source}: {named}: every sample the same value: a dead, absent or unconnected "
                 + ("gyro, or the wrong columns mapped; nothing to calibrate" if every else "axis"),
                 "" if every else "that axis is fitted as the constant it holds",
             )
         )
-    for j in range(x.shape[1]):
-        for k in range(j + 1, x.shape[1]):
-            if j not in constant and np.array_equal(x[:, j], x[:, k]):
-                out.append(
-                    Finding(
-                        "axes-identical",
-                        "warn",
-                        f"{recording.source}: {axes[j]} and {axes[k]} hold the same samples in every row: one "
-                        "column mapped to two axes? (map each axis to its own column)",
-                        "the two axes are fitted as one: if they are two sensors' axes, one of them is wrong",
-                    )
-                )
+    for j, k in facts.identical:
+        out.append(
+            Finding(
+                "axes-identical",
+                "warn",
+                f"{source}: {axes[j]} and {axes[k]} hold the same samples in every row: one "
+                "column mapped to two axes? (map each axis to its own column)",
+                "the two axes are fitted as one: if they are two sensors' axes, one of them is wrong",
+            )
+        )
     return out
 
 
-def temperature_spike_findings(recording: Recording) -> list[Finding]:
+def temperature_spike_findings(facts: SampleFacts, source: str) -> list[Finding]:
     """Temperature spikes: samples TEMPERATURE_SPIKE_DEGC or more from the median of the TEMPERATURE_SPIKE_SAMPLES
     around them (a sensor's read errors, -40 degC or a bit flip), said with their count and first rows."""
-    t = _temperature(recording)
-    if t is None or t.size != recording.n_samples or t.size < TEMPERATURE_SPIKE_SAMPLES:
+    if not facts.spikes:
         return []
-    half = TEMPERATURE_SPIKE_SAMPLES // 2
-    rows = []
-    for start, stop in parts(t.size, overlap=2 * half):
-        piece = t[start:stop]
-        padded = np.pad(piece, half, mode="reflect")  # the median of the samples around each, the ends mirrored
-        local = np.median(sliding_window_view(padded, TEMPERATURE_SPIKE_SAMPLES), axis=1)
-        far = np.flatnonzero(np.abs(piece - local) >= TEMPERATURE_SPIKE_DEGC)
-        lo = 0 if start == 0 else half
-        rows.append(start + far[(far >= lo) & (far < piece.size - (half if stop < t.size else 0))])
-    spikes = np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=int)
-    if not spikes.size:
-        return []
-    first = ", ".join(str(int(recording.row_numbers[k])) for k in spikes[:3])
-    worst = float(np.max(np.abs(t[spikes] - np.median(t))))
+    first = ", ".join(str(r) for r in facts.spike_rows)
     return [
         Finding(
             "temperature-spikes",
             "warn",
-            f"{recording.source}: {spikes.size} temperature sample(s) jump {TEMPERATURE_SPIKE_DEGC:g} degC or more "
-            f"from their neighbours and back (rows {first}{', ...' if spikes.size > 3 else ''}; up to "
-            f"{worst:.3g} degC from the run's median): read errors of the sensor",
-            f"{100 * spikes.size / t.size:.2g} % of the samples fitted at temperatures the die never had: the "
-            "curve is bent toward them or left out; cut or mend those rows",
+            f"{source}: {facts.spikes} temperature sample(s) jump {TEMPERATURE_SPIKE_DEGC:g} degC or more "
+            f"from their neighbours and back (rows {first}{', ...' if facts.spikes > len(facts.spike_rows) else ''}; "
+            f"up to {facts.spike_worst_degc:.3g} degC from their neighbours' median): read errors of the sensor",
+            f"{100 * facts.spikes / facts.temperature_samples:.2g} % of the samples at temperatures the die never "
+            "had: a fit bends the curve toward them, a compensation applies the curve there; cut or mend those rows",
         )
     ]
 
 
-def counts_findings(recording: Recording) -> list[Finding]:
+def counts_findings(facts: SampleFacts, source: str) -> list[Finding]:
     """Raw counts: every gyro sample a whole number, on every axis, over COUNTS_MIN_LEVELS values or more (a
     converter's output read as deg/s)."""
-    x = recording.gyro_dps
-    if x.shape[0] < COUNTS_MIN_LEVELS or not all(np.all(x[a:b] == np.round(x[a:b])) for a, b in parts(x.shape[0])):
-        return []
-    spread = float(np.max(np.ptp(x, axis=0)))
-    if spread < COUNTS_MIN_LEVELS:
+    if facts.n_samples < COUNTS_MIN_LEVELS or not facts.whole_numbers or facts.spread_dps < COUNTS_MIN_LEVELS:
         return []
     return [
         Finding(
             "counts",
             "warn",
-            f"{recording.source}: every gyro sample is a whole number (spread over {spread:.0f} of them): raw "
+            f"{source}: every gyro sample is a whole number (spread over {facts.spread_dps:.0f} of them): raw "
             "counts of the sensor's converter read as deg/s? give their scale as the gyro's unit (gyro_unit="
             "'1/131 deg/s' for 131 counts per deg/s, as its data sheet states)",
             "a model in counts, wrong by the sensor's scale factor wherever deg/s are expected",
@@ -726,17 +707,18 @@ def check_runs(
             out.append(_split(unreadable(run.source, run.refusal or "unreadable").findings, run.source, accept))
             continue
         rec = run.recording
+        facts = SampleCheck().add(rec).facts()
         found = (
             time_findings(run.source, run.notes, rec.rate_hz)
             + temperature_findings(rec, ask)
             + together.get(position[i], [])
-            + gyro_findings(rec)
-            + temperature_spike_findings(rec)
+            + gyro_findings(facts, rec.source)
+            + temperature_spike_findings(facts, rec.source)
             + gap_findings(rec)
             + rail_findings(rec)
             + (motion_findings(rec) if rec.source not in still_only else [])
             + unit_findings(rec)
-            + counts_findings(rec)
+            + counts_findings(facts, rec.source)
         )
         out.append(_split(found, run.source, accept))
     return out
@@ -757,6 +739,7 @@ __all__ = [
     "RunCheck",
     "check_runs",
     "repeated_findings",
+    "sample_findings",
     "set_findings",
     "unreadable",
 ]
