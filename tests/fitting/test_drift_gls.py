@@ -111,12 +111,18 @@ def test_a_flat_profile_takes_the_middle_and_a_sharp_one_its_least():
     assert plausible_middle(sharp, independent=80) == 2
 
 
-@pytest.mark.parametrize("jitter_s", [0.0, 0.4])
-def test_the_covariance_is_its_definition_on_even_and_uneven_times(jitter_s):
-    """Evenly spaced points take the Toeplitz path, jittered ones the general one: both equal the formula written
-    element by element."""
+@pytest.mark.parametrize("shape", ["even", "a shorter last block", "even then a gap", "jittered"])
+def test_the_covariance_is_its_definition_on_even_and_uneven_times(shape):
+    """Evenly spaced points take the Toeplitz path, the others the general one, and a series even up to a point
+    both: each equals the formula written element by element."""
     rng = np.random.default_rng(5)
-    t = 100.0 + np.arange(40) * DT_S + jitter_s * rng.uniform(-1, 1, 40)
+    t = 100.0 + np.arange(40) * DT_S
+    if shape == "a shorter last block":
+        t[-1] -= 0.4 * DT_S
+    elif shape == "even then a gap":
+        t[25:] += 3.3
+    elif shape == "jittered":
+        t += 0.4 * rng.uniform(-1, 1, 40)
     noise = DriftNoise(1e-4, 3e-6, 1.4)
     tau = t - t[0]
     expected = np.array([[0.5 * 3e-6 * (a**1.4 + b**1.4 - abs(a - b) ** 1.4) for b in tau] for a in tau]) + np.eye(

@@ -143,14 +143,22 @@ def covariance(t_s: np.ndarray, noise: DriftNoise) -> np.ndarray:
 
 
 def _lag_powers(tau: np.ndarray, exponent: float) -> np.ndarray:
-    """``|tau_i - tau_j|^exponent`` (n, n) [s^exponent]; from the n lags alone when the points are evenly spaced
-    (the matrix is then Toeplitz)."""
+    """``|tau_i - tau_j|^exponent`` (n, n) [s^exponent]. Over the evenly spaced points that begin the series (all
+    but the last, shorter block of a coarsened run, often) the matrix is Toeplitz, built from their lags alone;
+    the rows and columns of the other points are computed in full."""
     import scipy.linalg  # slow to import (0.1 s with scipy's array API layer): not at every command's start
 
     steps = np.diff(tau)
-    if steps.size and np.all(np.abs(steps - steps[0]) <= 1e-12 * abs(steps[0])):
-        return scipy.linalg.toeplitz(np.abs(tau - tau[0]) ** exponent)
-    return np.abs(np.subtract.outer(tau, tau)) ** exponent
+    even = np.abs(steps - steps[0]) <= 1e-12 * abs(steps[0]) if steps.size else np.zeros(0, dtype=bool)
+    m = 1 + (int(np.argmin(even)) if not even.all() else even.size)  # the evenly spaced points that begin it
+    if m < 3:
+        return np.abs(np.subtract.outer(tau, tau)) ** exponent
+    out = np.empty((tau.size, tau.size))
+    out[:m, :m] = scipy.linalg.toeplitz(np.abs(tau[:m] - tau[0]) ** exponent)
+    rest = np.abs(np.subtract.outer(tau[m:], tau)) ** exponent
+    out[m:, :] = rest
+    out[:m, m:] = rest[:, :m].T
+    return out
 
 
 @functools.lru_cache(maxsize=4)
