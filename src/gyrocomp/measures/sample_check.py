@@ -97,8 +97,7 @@ class SampleCheck:
             self._whole = self._whole and bool(np.all(x == np.round(x)))
             self._lo, self._hi = np.minimum(self._lo, x.min(axis=0)), np.maximum(self._hi, x.max(axis=0))
         self._n += x.shape[0]
-        rows = np.arange(1, x.shape[0] + 1) if recording.row_numbers is None else recording.row_numbers
-        self._spikes.add(_temperature(recording, x.shape[0]), np.asarray(rows))
+        self._spikes.add(_temperature(recording, x.shape[0]), np.asarray(recording.row_numbers))
         return self
 
     def facts(self) -> SampleFacts:
@@ -144,8 +143,9 @@ class _Spikes:
 
     def add(self, t: np.ndarray | None, rows: np.ndarray) -> None:
         """Take a part's temperatures [degC] (None: the run is not checked) and file rows."""
-        if t is None or not self._valid:
-            self._valid = self._valid and (t is not None or rows.size == 0)
+        if t is None:
+            self._valid = False
+        if not self._valid:
             return
         self._t, self._rows = np.concatenate([self._t, t]), np.concatenate([self._rows, rows])
         self._checked += t.size
