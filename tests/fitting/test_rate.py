@@ -2,6 +2,7 @@
 equal to any chunking, its columns equal to its offset, fitted on runs written from the physics (a bias in the
 die's instantaneous rate of change, not our smoothed one) and recovered, carried by the model file."""
 
+import dataclasses
 import json
 import math
 import warnings
@@ -18,6 +19,7 @@ from gyrocomp.errors import InputError
 from gyrocomp.evaluation.validation import fit_plain_cubic
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.options import Network
+from gyrocomp.recording import ACCEL_AXES
 
 from ..conftest import assert_streaming_equals_batch, chamber_run, run
 
@@ -95,6 +97,35 @@ def test_the_rate_gain_is_recovered_and_holds_at_another_ramp_rate(rate_runs):
         assert smoothed_residual_rms(ours[:, j], window) < 0.25 * smoothed_residual_rms(cubic[:, j], window)
 
 
+#: a g-sensitivity matrix [deg/s per g] written into the runs below (rows: gyro axes; columns: specific force)
+G_SENSITIVITY = np.array([[0.05, -0.02, 0.01], [0.03, 0.06, -0.015], [-0.01, 0.02, 0.04]])
+
+
+def _turned(rec, seed):
+    """``rec`` turned through six orientations held in turn, its gyro biased by G_SENSITIVITY times the specific
+    force (the physics of a static multi-position run; the moves themselves are not modelled)."""
+    rng = np.random.default_rng(seed)
+    ups = np.array([(0, 0, 1), (0, 0, -1), (1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)], dtype=float)
+    pose = np.minimum((rec.time_s - rec.time_s[0]) // 400.0, 1e9).astype(int) % len(ups)
+    accel = ups[pose] + rng.standard_normal((rec.n_samples, 3)) * 1e-3
+    return dataclasses.replace(
+        rec, gyro_dps=rec.gyro_dps + accel @ G_SENSITIVITY.T, accel_g=accel, accel_axes=ACCEL_AXES
+    )
+
+
+def test_a_rate_term_beside_a_g_sensitivity_keeps_each_its_own_coefficients():
+    # the final fit once read the g-sensitivity one column early (the rate term's), so with both the model was wrong
+    runs = [_turned(chamber_run([-10.0, 60.0, -10.0], 1.0, seed=s, rate_hz=2.0), s) for s in (1, 2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit(runs, FitOptions(hysteresis="rate", acceleration="matrix"))
+    for j, (axis, gain) in enumerate(zip(("gyro_x", "gyro_y", "gyro_z"), TRUE_RATE_GAINS)):
+        ax = cal.axes[axis]
+        assert ax.rate_term.coefficient_per_degc_per_s == pytest.approx(gain, rel=0.15)
+        # each pose holds 400 s of white noise of 0.005 deg/s/sqrt(Hz): a sensitivity to 2e-3 deg/s per g and better
+        np.testing.assert_allclose(ax.g_sensitivity_dps_per_g, G_SENSITIVITY[j], rtol=0, atol=2e-3)
+
+
 def test_a_rate_model_streams_as_it_applies_and_round_trips(rate_runs, tmp_path):
     _, held, cal = rate_runs
     assert_streaming_equals_batch(cal, held, [1, 7, 300, 1999])
@@ -144,3 +175,4 @@ def test_the_command_line_fits_shows_and_exports_a_rate_term(rate_runs, tmp_path
     done = run("export", "m.json", "--format", "c", "--rate", "2", "-o", "c_out", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "s->rate[" in (tmp_path / "c_out" / "gyrocomp.c").read_text()
+

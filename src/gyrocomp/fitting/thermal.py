@@ -709,22 +709,21 @@ class ThermalHysteresisModel(LearnedAttributes):
         self.lag_evidence_[axis] = problem.lag_evidence(spec, tau, rss) if tau > 0 else math.nan
         self.curves_[axis] = problem.thermal_design.basis(spec.curve).curve(coef[: spec.order], t_lo, t_hi)
         self.lag_time_constants_s_[axis] = float(tau)
+        blocks = problem.thermal_design.layout(problem.terms(spec))  # where each term's coefficients lie
         p = spec.hysteresis_order
-        self.hysteresis_[axis] = (
-            None
-            if not p
-            else HysteresisCurve(
-                tuple(float(v) for v in coef[spec.order : spec.order + p]),
-                tuple(float(v) for v in coef[spec.order + p : spec.order + 2 * p]),
+        self.hysteresis_[axis] = None
+        if p:
+            turning = coef[blocks[("turning-point", problem.band)]]
+            self.hysteresis_[axis] = HysteresisCurve(
+                tuple(float(v) for v in turning[:p]),
+                tuple(float(v) for v in turning[p:]),
                 problem.threshold,
                 problem.band,
                 problem.branch_reach(spec, tau),
             )
-        )
         if spec.branch:
-            start = spec.order + 2 * p
             self.hysteresis_[axis] = BranchCurve(
-                tuple(float(v) for v in coef[start : start + spec.branch]),
+                tuple(float(v) for v in coef[blocks[("branch", spec.width_degc)]]),
                 problem.t_ref,
                 problem.t_scale,
                 spec.width_degc,
@@ -733,14 +732,14 @@ class ThermalHysteresisModel(LearnedAttributes):
                 t_hi,
             )
         if spec.rate:
-            rate = float(coef[spec.order + 2 * p + spec.branch])
-            self.rate_terms_[axis] = TemperatureRateTerm(rate, spec.smoothing_s)
+            (rate,) = coef[blocks[("rate", spec.smoothing_s)]]
+            self.rate_terms_[axis] = TemperatureRateTerm(float(rate), spec.smoothing_s)
         self.bands_[axis] = problem.band
         self.turn_on_biases_[axis] = consts
         self.memories_[axis] = (choice.name, spec.branch or p)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
-            self._store_acceleration(axis, problem, spec, tau, coef, n_runs)
+            self._store_acceleration(axis, problem, spec, tau, coef, blocks[("acceleration",)].start, n_runs)
 
     def _pieces(self, recordings: list[Recording]) -> list[list[slice] | None]:
         self.segments_, pieces = static_pieces(recordings, self.static_min_duration_s)
@@ -760,9 +759,9 @@ class ThermalHysteresisModel(LearnedAttributes):
         return excited, squares
 
     def _store_acceleration(
-        self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray, n_runs: int
+        self, axis: str, problem: _Problem, spec: _Spec, tau: float, coef: np.ndarray, start: int, n_runs: int
     ) -> None:
-        start = spec.order + 2 * spec.hysteresis_order + spec.branch
+        """Keep the g (and g x g) sensitivity of one axis, whose coefficients begin at ``coef[start]``."""
         full, cov = problem.covariance(spec, tau)
         se_all = np.sqrt(np.maximum(np.diag(cov), 0.0))[n_runs:]
         g, g_se = np.zeros(3), np.full(3, np.nan)
