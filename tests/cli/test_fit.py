@@ -72,8 +72,9 @@ def test_fit_compares_hysteresis_candidates_on_cycles(tmp_path):
     assert re.search(r"lag \d+(\.\d+)? s, turning-point hysteresis order 2 in 55..80 degC", r.stdout)
     model = json.loads((tmp_path / "m.json").read_text())
     scores = model["fit_report"]["hysteresis"]["axes"]["gyro_z"]["scores_dps"]
-    # every memory scored, the heating and cooling branches too (the runs heat and cool)
-    assert set(scores) == {"none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag"}
+    # every memory scored, the heating and cooling branches and the temperature-rate terms too (the runs heat and cool)
+    memories = {"none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag", "rate", "rate+lag"}
+    assert set(scores) == memories
     assert model["axes"]["gyro_z"]["hysteresis"]["band_degc"] == [55.0, 80.0]
 
 

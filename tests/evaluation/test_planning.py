@@ -21,7 +21,7 @@ from gyrocomp.calibration.compensate import apply
 from gyrocomp.errors import InputError
 from gyrocomp.evaluation.choice_alternatives import choice_alternatives
 from gyrocomp.evaluation.drift_forecast import DEFAULT_WINDOW_S, UseProfile, axis_information, forecast_drift
-from gyrocomp.evaluation.drift_forecast import ramp_rate_degc_per_min
+from gyrocomp.measures.ramp_rate import ramp_rate_degc_per_min
 from gyrocomp.evaluation.run_advice import plan
 from gyrocomp.io.tables import write_recording
 from gyrocomp.measures.merit import smoothed_residual_rms

@@ -20,6 +20,7 @@ from gyrocomp.evaluation.validation import fit_plain_cubic
 from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.models.options import Network
 from gyrocomp.recording import ACCEL_AXES
+from gyrocomp.report.html import build_report
 
 from ..conftest import assert_streaming_equals_batch, chamber_run, run
 
@@ -176,3 +177,36 @@ def test_the_command_line_fits_shows_and_exports_a_rate_term(rate_runs, tmp_path
     assert done.returncode == 0, done.stderr
     assert "s->rate[" in (tmp_path / "c_out" / "gyrocomp.c").read_text()
 
+
+@pytest.mark.parametrize("second_ramp", [1.0, 2.5])
+def test_the_default_finds_the_rate_term_and_says_whether_the_runs_ramp_rates_could_tell_it(second_ramp, tmp_path):
+    # the physics of chamber_run holds a term in the die's rate: the default offers a rate term and takes it, from
+    # runs at one ramp rate (saying that one rate cannot tell it from a lag or a memory of the turn, and which run
+    # would) or at two (no such warning)
+    runs = [chamber_run([-10.0, 60.0, -10.0], ramp, seed=s, rate_hz=2.0) for s, ramp in ((1, 1.0), (2, second_ramp))]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cal = fit(runs)
+    for axis, gain in zip(("gyro_x", "gyro_y", "gyro_z"), TRUE_RATE_GAINS):
+        assert cal.axes[axis].rate_term.coefficient_per_degc_per_s == pytest.approx(gain, rel=0.15)
+    one_rate = [str(w.message) for w in caught if "all ramp at about" in str(w.message)]
+    if second_ramp == 1.0:
+        (message,) = one_rate
+        assert "about 1 degC/min" in message and "a heat-cool run at 2 degC/min (or 0.5) tells them apart" in message
+        assert "gyro_x poly:" in message and "could not be checked at another rate" in message
+    else:
+        assert not one_rate
+    cal.save(tmp_path / "m.json")
+    selection = Calibration.load(tmp_path / "m.json").report.selection
+    for sel in selection.values():
+        assert sel.ramp_rates_degc_per_min == pytest.approx((1.0, second_ramp), rel=0.05)
+        assert sel.rates_separate == (second_ramp > 1.0)
+    shown = run("show", "m.json", cwd=tmp_path)
+    said = "all ramp at about 1 degC/min" if second_ramp == 1.0 else "far enough apart to tell a lag"
+    assert shown.returncode == 0 and said in " ".join(shown.stdout.split())  # the caption may wrap
+    page = build_report(cal, runs[:1]).html
+    assert (
+        "Ramp rates: "
+        + ("the runs all ramp at about 1 degC/min" if second_ramp == 1.0 else "the runs ramp at 1 to 2.5 degC/min")
+        in page
+    )

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from ..curves.polynomial import POLY_FAMILY
+from ..measures.ramp_rate import ramp_rates_separate, separation_sentence
 from ..units import AxisUnit, in_unit, unit_suffix
 
 #: the thermal memories a gyro axis's model may carry
@@ -283,7 +284,9 @@ class SelectionReport:
     ``lag_from_unit`` whether the lag was kept because the other axes of the die chose one (the folds unable to
     tell this axis's model with it from the one without; False in files written before it was stored);
     ``decided_by`` the rule that made the final choice, in one line ("" in files written before it was stored);
-    ``order_test`` what all the data said of the polynomial's order where two held-out legs were all there was.
+    ``order_test`` what all the data said of the polynomial's order where two held-out legs were all there was;
+    ``ramp_rates_degc_per_min`` each calibration recording's typical ramp rate [degC/min] (NaN: it did not ramp;
+    empty in files written before it was stored).
     """
 
     axis: str
@@ -306,6 +309,7 @@ class SelectionReport:
     lag_from_unit: bool = False
     decided_by: str = ""
     order_test: OrderTest | None = None
+    ramp_rates_degc_per_min: tuple[float, ...] = ()
 
     raw_drift_dps = in_unit("raw_drift", "deg/s", "raw_drift_dps")
     chosen_drift_dps = in_unit("chosen_drift", "deg/s", "chosen_drift_dps")
@@ -341,7 +345,20 @@ class SelectionReport:
             bool(d.get("lag_from_unit", False)),
             str(d.get("decided_by", "")),
             OrderTest.from_dict(d["order_test"]) if d.get("order_test") else None,
+            tuple(math.nan if r is None else float(r) for r in d.get("ramp_rates_degc_per_min", ())),
         )
+
+    @property
+    def ramp_note(self) -> str:
+        """What the runs' ramp rates could tell of the memory, in words (:func:`separation_sentence`; empty in
+        files written before the rates were stored)."""
+        return separation_sentence(self.ramp_rates_degc_per_min)
+
+    @property
+    def rates_separate(self) -> bool:
+        """Whether the runs' ramp rates could tell a lag or a rate term from a memory of the turn
+        (:func:`gyrocomp.measures.ramp_rate.ramp_rates_separate`)."""
+        return ramp_rates_separate(self.ramp_rates_degc_per_min)
 
 
 _CHOSEN = re.compile(r"^(?P<memory>[a-z+-]+)(?: \(order (?P<order>\d+)\))?$")
@@ -611,7 +628,9 @@ THIN_FOLDS = 4
 class ExpectedDrift:
     """The drift a model choice expects on data like a held-out fold (the next heating or cooling leg, or the next
     run): the chosen candidate's mean held-out drift and its standard error [``unit``], the moving-average window
-    the drift is taken over [s], and what was held out."""
+    the drift is taken over [s], what was held out, and what the runs' ramp rates could tell of the memory
+    (:func:`gyrocomp.measures.ramp_rate.separation_sentence`; empty in files written before the rates were stored).
+    """
 
     axis: str
     model: str
@@ -622,6 +641,7 @@ class ExpectedDrift:
     window_s: float
     fold_kind: str
     folds: int
+    ramp_note: str = ""
 
     @property
     def thin(self) -> bool:
@@ -640,6 +660,7 @@ class ExpectedDrift:
             "fold_kind": self.fold_kind,
             "folds": self.folds,
             "thin": self.thin,
+            "ramp_note": self.ramp_note,
         }
 
 
@@ -732,6 +753,7 @@ class FitReport:
                 sel.window_s,
                 sel.fold_kind,
                 len(sel.folds),
+                sel.ramp_note,
             )
         return out
 

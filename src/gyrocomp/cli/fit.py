@@ -59,8 +59,8 @@ from .render import print_contributions, print_fit
     default="auto",
     show_default=True,
     help="The thermal memory: lag, turning-point hysteresis, heating/cooling branches or a temperature-rate term "
-    "(rate: a bias in the smoothed dT/dt, a thermal gradient); auto compares all but the rate term by held-out "
-    "drift when the runs both heat and cool.",
+    "(rate: a bias in the smoothed dT/dt, a thermal gradient); auto compares them all by held-out drift when the "
+    "runs both heat and cool.",
 )
 @click.option(
     "--hysteresis-order",

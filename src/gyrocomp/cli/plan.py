@@ -10,7 +10,8 @@ from pathlib import Path
 import click
 
 from ..calibration import Calibration
-from ..evaluation.drift_forecast import DEFAULT_WINDOW_S, UseProfile, ramp_rate_degc_per_min
+from ..evaluation.drift_forecast import DEFAULT_WINDOW_S, UseProfile
+from ..measures.ramp_rate import ramp_rate_degc_per_min
 from ..evaluation.log_watch import watch_log
 from ..evaluation.run_advice import WORTHWHILE_GAIN, plan as plan_runs
 from .common import FINITE, echo, pop_read_options, read_options, read_run

@@ -234,7 +234,8 @@ def _print_selection(console, selection: dict[str, SelectionReport], unit: str) 
     first = next(iter(selection.values()))
     table = Table(
         title=f"model choice by held-out drift ({first.fold_kind}: {len(first.folds)} folds, "
-        f"{first.window_s:g} s moving average, simplest within one standard error) [{unit}]"
+        f"{first.window_s:g} s moving average, simplest within one standard error) [{unit}]",
+        caption=first.ramp_note or None,
     )
     decided = any(sel.decided_by for sel in selection.values())  # files written before it was stored have none
     columns = ("axis", "chosen", "held-out drift", "best", "best drift", "constant only") + (
@@ -457,7 +458,8 @@ def print_expected_drift(expected: dict) -> None:
     first = next(iter(expected.values()))
     table = Table(
         title=f"drift to expect on unseen data (the model file's {first.folds} held-out {first.fold_kind}, "
-        f"{first.window_s:g} s moving average" + ("; thin evidence" if first.thin else "") + ")"
+        f"{first.window_s:g} s moving average" + ("; thin evidence" if first.thin else "") + ")",
+        caption=first.ramp_note or None,
     )
     for col in ("axis", "model", "expected drift", "run constant alone"):
         table.add_column(col, justify="left" if col in ("axis", "model") else "right")

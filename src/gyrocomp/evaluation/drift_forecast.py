@@ -51,6 +51,7 @@ from ..effects import thermal_lag
 from ..errors import DataQualityWarning, InputError, user_stacklevel
 from ..fitting.drift_gls import MAX_POINTS, DriftNoise, coarsen, covariance, fit_drift_noise
 from ..measures.merit import smoothed_about_mean
+from ..measures.ramp_rate import ramp_rate_degc_per_min, typical_ramp_degc_per_min
 from ..recording import Recording
 from ..simulation.profiles import Profile
 from .choice_alternatives import Alternative, choice_alternatives, close_candidates, predicted
@@ -268,32 +269,6 @@ class DriftForecast:
         }
 
 
-def _typical_ramp(series) -> float:
-    """The typical ramp rate [degC/min] of (time [s], temperature [degC]) pairs: the median rate of the minutes
-    whose temperature changes at more than a fifth of the fastest minutes' (the 95th percentile) rate."""
-    rates = []
-    for t, temps in series:
-        grid = np.arange(t[0], t[-1], 60.0)
-        if grid.size > 1:
-            rates.append(np.abs(np.diff(np.interp(grid, t, temps))))
-    rates = np.concatenate(rates) if rates else np.zeros(0)
-    top = float(np.percentile(rates, 95)) if rates.size else 0.0
-    moving = rates[rates > 0.2 * top] if top > 0 else rates
-    return float(np.median(moving)) if moving.size and np.median(moving) > 0 else 1.0
-
-
-def ramp_rate_degc_per_min(recordings: Sequence[Recording]) -> float:
-    """The runs' typical ramp rate [degC/min]: the median rate of the minutes whose temperature changes at more than
-    a fifth of the fastest minutes' (the 95th percentile) rate.
-
-    Parameters
-    ----------
-    recordings : sequence of Recording
-        The runs (those without a temperature are skipped).
-    """
-    return _typical_ramp((r.time_s, r.die_temperature_degc) for r in recordings if r.temperature_degc is not None)
-
-
 #: a use profile ramping faster than this many times the calibration runs' is warned about
 FASTER_USE = 1.25
 
@@ -301,7 +276,7 @@ FASTER_USE = 1.25
 def warn_faster_use(use: UseProfile, calibration_ramp_degc_per_min: float) -> None:
     """Warn when ``use`` ramps faster than :data:`FASTER_USE` times the calibration runs' rate [degC/min]: what the
     model leaves may grow with the ramp rate, which runs at one rate cannot show."""
-    ramp = _typical_ramp([(use.time_s, use.temperature_degc)])
+    ramp = typical_ramp_degc_per_min([(use.time_s, use.temperature_degc)])
     if ramp > FASTER_USE * calibration_ramp_degc_per_min:
         warnings.warn(
             f"{use.name}: the use profile ramps at {ramp:.2g} degC/min, faster than the calibration runs' "
@@ -799,7 +774,6 @@ __all__ = [
     "calibrated_range",
     "calibration_cycle",
     "forecast_drift",
-    "ramp_rate_degc_per_min",
     "set_point_profile",
     "warn_faster_use",
 ]

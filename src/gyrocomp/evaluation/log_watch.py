@@ -19,16 +19,10 @@ import numpy as np
 
 from ..errors import InputError
 from ..models.fit import fit
+from ..measures.ramp_rate import ramp_rate_degc_per_min
 from ..recording import Recording
 from .choice_alternatives import close_candidates
-from .drift_forecast import (
-    DEFAULT_WINDOW_S,
-    AxisForecast,
-    UseProfile,
-    axis_information,
-    calibration_cycle,
-    ramp_rate_degc_per_min,
-)
+from .drift_forecast import DEFAULT_WINDOW_S, AxisForecast, UseProfile, axis_information, calibration_cycle
 
 #: the stretch of the log whose rate the leg under way is continued at [s], and for how long [s]
 TREND_S = 600.0

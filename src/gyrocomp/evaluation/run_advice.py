@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 from ..calibration.calibration import Calibration
 from ..errors import InputError
+from ..measures.ramp_rate import ramp_rate_degc_per_min
 from ..recording import Recording
 from .choice_alternatives import choice_alternatives, close_candidates
 from .drift_forecast import (
@@ -31,7 +32,6 @@ from .drift_forecast import (
     calibration_cycle,
     DriftForecast,
     UseProfile,
-    ramp_rate_degc_per_min,
     set_point_profile,
     warn_faster_use,
 )

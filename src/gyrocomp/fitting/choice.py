@@ -149,6 +149,7 @@ def choose_axis(
         lag_from_unit=unit_lag and chosen.lag,
         decided_by=decided_by,
         order_test=evidence,
+        ramp_rates_degc_per_min=problem.ramp_rates_degc_per_min,
     )
 
 

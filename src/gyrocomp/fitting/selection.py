@@ -47,6 +47,7 @@ import numpy as np
 from ..effects import find_turns, thermal_lag
 from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
 from ..measures.merit import moving_average
+from ..measures.ramp_rate import ramp_rates_separate, run_ramp_rates_degc_per_min
 from ..runs.prepared import PreparedRun, RunBlocks
 from ..spilled_series import parts, streamed_median
 from ..units import AxisUnit, in_unit, unit_suffix
@@ -68,6 +69,12 @@ FOLD_BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
 #: smoothing time constants of the temperature-rate candidates in each fold [s] (each fold takes the one of least
 #: training residual; the final fit refines it on gyrocomp.fitting.thermal.RATE_SMOOTHINGS_S)
 FOLD_RATE_SMOOTHINGS_S = (60.0, 300.0, 1500.0)
+#: what a rate term adds to its complexity where the runs ramp at one rate: there its heating-cooling difference
+#: is also a memory of the turn's (a branch), and the two part at another rate, in opposite directions; so a
+#: one-term branch scoring within one standard error of the best is taken before the rate term (measured on the
+#: shape zoo, fitted at 1 degC/min and judged at 3: without it the rate term replaced the branch of a play on 1
+#: axis in 9 and of a slow second thermal path on 4 in 9, leaving 1.4 to 3.8 times the branch's drift)
+ONE_RATE_RATE_TERM_COST = 1
 #: lag values tried per fold (log-spaced from two blocks to LAG_MAX_S or the longest run; SelectionProblem.lag_grid_s)
 LAG_GRID_POINTS = 16
 #: polynomial order of the residual in which the band where the branches part is looked for (the field's cubic)
@@ -107,6 +114,8 @@ class AxisSelection:
     lag_from_unit : bool
         Whether the chosen lag was taken because another axis of the same die chose one, the folds being unable
         to tell it from the same model without (:func:`gyrocomp.fitting.choice.choose_axis`).
+    ramp_rates_degc_per_min : tuple of float
+        Each calibration recording's typical ramp rate [degC/min] (NaN: it does not ramp); empty where not known.
     """
 
     axis: str
@@ -129,6 +138,13 @@ class AxisSelection:
     decided_by: str = ""
     #: where two held-out legs are all there is, what all the data say of the polynomial's order
     order_test: OrderTest | None = None
+    ramp_rates_degc_per_min: tuple[float, ...] = ()
+
+    @property
+    def rates_separate(self) -> bool:
+        """Whether the runs' ramp rates can tell a lag or a rate term from a memory of the turn
+        (:func:`gyrocomp.measures.ramp_rate.ramp_rates_separate`)."""
+        return ramp_rates_separate(self.ramp_rates_degc_per_min)
 
     def score_of(self, candidate: Candidate) -> CandidateScore:
         return next(s for s in self.scores if s.candidate == candidate)
@@ -184,6 +200,7 @@ class AxisSelection:
             "lag_from_unit": self.lag_from_unit,
             "decided_by": self.decided_by,
             "order_test": self.order_test.to_dict() if self.order_test is not None else None,
+            "ramp_rates_degc_per_min": [json_number(r) for r in self.ramp_rates_degc_per_min],
             "candidates": [s.to_dict(self.unit) for s in self.scores],
         }
 
@@ -307,6 +324,9 @@ class SelectionProblem:
     other_curves: tuple[tuple[str, int], ...] = ()
     #: smoothing time constants of the temperature-rate columns [s] (empty: no rate candidates)
     rate_smoothings_s: tuple[float, ...] = ()
+    #: each recording's typical ramp rate [degC/min] (NaN: it does not ramp;
+    #: :func:`gyrocomp.measures.ramp_rate.run_ramp_rates_degc_per_min`); empty: not known, taken as one rate
+    ramp_rates_degc_per_min: tuple[float, ...] = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -602,8 +622,9 @@ class SelectionProblem:
         both = self.fold_has_both_directions()
         for f in range(self.folds.count):
             # a fold whose training data holds one direction only cannot tell the branches apart: there the
-            # candidate is its polynomial (its branch or turning-point terms would be confounded with the curve)
-            fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False)
+            # candidate is its polynomial (its branch or turning-point terms would be confounded with the curve, and
+            # its rate term, of one sign but at the holds, with the run constant)
+            fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False, rate=False)
             widths = range(len(FOLD_BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
             smoothings = range(len(self.rate_smoothings_s)) if fc.rate else (0,)
             best = None
@@ -688,9 +709,18 @@ class SelectionProblem:
                                 out.append(c)
         return out
 
+    @property
+    def rates_separate(self) -> bool:
+        """Whether the runs' ramp rates can tell a memory that grows with the rate from one that does not
+        (:func:`gyrocomp.measures.ramp_rate.ramp_rates_separate`)."""
+        return ramp_rates_separate(self.ramp_rates_degc_per_min)
+
     def complexity(self, c: Candidate) -> int:
-        """Complexity for the rule: on a coarsely quantized register the lag is free (it de-quantizes)."""
-        return c.complexity - (1 if c.lag and self.temperature_step_degc > 0 else 0)
+        """Complexity for the rule: on a coarsely quantized register the lag is free (it de-quantizes); where the
+        runs ramp at one rate, a rate term counts one more (:data:`ONE_RATE_RATE_TERM_COST`)."""
+        lag_free = 1 if c.lag and self.temperature_step_degc > 0 else 0
+        one_rate = ONE_RATE_RATE_TERM_COST if c.rate and not self.rates_separate else 0
+        return c.complexity - lag_free + one_rate
 
 
 def prepare_axis(
@@ -783,6 +813,7 @@ def prepare_axis(
         branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
         other_curves=tuple(other_curves),
         rate_smoothings_s=tuple(rate_smoothings_s),
+        ramp_rates_degc_per_min=run_ramp_rates_degc_per_min(recordings),
     )
 
 
@@ -790,6 +821,7 @@ __all__ = [
     "AxisSelection",
     "FOLD_BRANCH_WIDTHS_DEGC",
     "FOLD_RATE_SMOOTHINGS_S",
+    "ONE_RATE_RATE_TERM_COST",
     "Candidate",
     "SelectionProblem",
     "Weighting",

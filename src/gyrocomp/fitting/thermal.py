@@ -56,8 +56,9 @@ HYSTERESIS_CHOICES = (
     "rate",
     "rate+lag",
 )
-#: the memories the default compares (the temperature-rate term is fitted where asked for: ``rate``, ``rate+lag``)
-CANDIDATES = ("none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag")
+#: the memories the default compares, simplest first (every memory there is; where the runs ramp at one rate a
+#: rate term counts as more complex in the model choice: gyrocomp.fitting.selection.ONE_RATE_RATE_TERM_COST)
+CANDIDATES = HYSTERESIS_CHOICES[1:]
 #: smoothing time constants the final fit tries for a temperature-rate term [s] (the middle of those the data
 #: cannot tell from the best: _Problem.best_smoothing); the model choice's folds try FOLD_RATE_SMOOTHINGS_S
 RATE_SMOOTHINGS_S = tuple(float(s) for s in np.geomspace(30.0, 3000.0, 11))

@@ -24,6 +24,7 @@ from ..calibration.fit_report import (
 )
 from ..measures.plausibility import calibration_concerns, temperature_span_concern
 from ..measures.data_check import MIN_SPAN_DEGC
+from ..measures.ramp_rate import separation_sentence
 from ..runs.prepared import PreparedRun, fit_axes, prepare
 from ..recording import Recording
 from ..fitting.acceleration import acceleration_report, excited_columns, fit_g_sensitivity, turned_between_positions
@@ -211,6 +212,25 @@ def select_models(
     return select_axes(problems, orders, memories, do_no_harm, one_die)
 
 
+def _rate_dependent(c) -> bool:
+    """Whether candidate ``c`` carries a memory whose size at another ramp rate runs at one rate cannot show."""
+    return bool(c.lag or c.rate or c.branch or c.hysteresis_order)
+
+
+def _warn_at_one_rate(selections: dict[str, AxisSelection]) -> None:
+    """Where the runs ramp at one rate and an axis's model carries a memory, say that one rate cannot check it."""
+    first = next(iter(selections.values()))
+    remembering = [f"{axis} {sel.chosen.label}" for axis, sel in selections.items() if _rate_dependent(sel.chosen)]
+    if remembering and first.ramp_rates_degc_per_min and not first.rates_separate:
+        warnings.warn(
+            f"model choice: {separation_sentence(first.ramp_rates_degc_per_min)}; the choice of "
+            + ", ".join(remembering)
+            + " could not be checked at another rate",
+            ModelChoiceWarning,
+            stacklevel=user_stacklevel(),
+        )
+
+
 def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
     first = next(iter(selections.values()))
     across = {"runs": "runs", "legs": "heating and cooling legs", "blocks": "time blocks"}[first.fold_kind]
@@ -223,6 +243,7 @@ def _warn_about_choice(selections: dict[str, AxisSelection]) -> None:
             ModelChoiceWarning,
             stacklevel=user_stacklevel(),
         )
+    _warn_at_one_rate(selections)
     for axis, sel in selections.items():
         unit = sel.unit
         if sel.lag_from_unit:

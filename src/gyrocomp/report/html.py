@@ -156,6 +156,8 @@ def _expected_drift(expected: dict) -> list[str]:
             f"<p class=note>Only {first.folds} folds: thin evidence; more runs, or runs that heat and "
             "cool more than once, make these figures firmer.</p>"
         )
+    if first.ramp_note:
+        parts.append(f"<p class=note>Ramp rates: {escape_text(first.ramp_note)}.</p>")
     return parts
 
 
