@@ -12,7 +12,7 @@ from gyrocomp.fitting.drift_gls import (
     wald_statistic,
     whitened,
 )
-from gyrocomp.fitting.thermal import plausible_middle
+from gyrocomp.fitting.grid_search import plausible_middle
 
 K = 2e-3  # random walk [unit/sqrt(s)]
 SIGMA = 0.01  # white noise per point [unit]

@@ -15,7 +15,7 @@ from gyrocomp.fitting.folds import leg_labels
 from gyrocomp.fitting.scores import CandidateScore
 from gyrocomp.fitting.choice import unidentified_lags
 from gyrocomp.fitting.selection import Candidate, prepare_axis, temperature_step_degc
-from gyrocomp.fitting.thermal import LAG_MAX_S, lag_search_top_s
+from gyrocomp.fitting.grid_search import LAG_MAX_S, lag_search_top_s
 from gyrocomp.models.options import curve_candidates
 from gyrocomp.curves.polynomial import PolynomialCurve
 from gyrocomp.recording import Recording

@@ -19,7 +19,8 @@ from .normal_equations import solve_normal
 from .order_evidence import CoarseRuns, run_constants
 from ..curves.hysteresis import parting_band_degc
 from ..curves.polynomial import power_columns
-from .thermal import BRANCH_WIDTHS_DEGC, LAG_MAX_S, MAX_BRANCH_ORDER, SCORE_WINDOW_S, plausible_middle
+from .grid_search import LAG_MAX_S, plausible_middle
+from .thermal import BRANCH_WIDTHS_DEGC, MAX_BRANCH_ORDER, SCORE_WINDOW_S
 
 
 def heats_and_cools_blocks(runs: list[RunBlocks], thresholds: list[float]) -> bool:
@@ -249,7 +250,7 @@ def branch_test(
     :func:`gyrocomp.fitting.drift_gls.chi2_threshold` (1 degree of freedom, :data:`BRANCH_TEST_SIGMAS`), and a
     slope too where that term alone does in the fit with both; both when only together they exceed the threshold
     of 2 degrees of freedom. The crossover width is the middle of those the data cannot tell apart
-    (:func:`gyrocomp.fitting.thermal.plausible_middle`).
+    (:func:`gyrocomp.fitting.grid_search.plausible_middle`).
 
     Parameters: ``runs`` the block means of each recording (one axis), ``groups`` the run of each (one constant
     each), ``threshold_degc`` the turning-point threshold [degC], ``t_ref_degc`` and ``t_scale_degc`` the centre
@@ -283,7 +284,7 @@ def branch_test(
 
 def _middle_width(runs: list[RunBlocks], designs: list, ys: np.ndarray) -> int:
     """The index of the crossover width (of ``BRANCH_WIDTHS_DEGC``) in the middle of those the fits of
-    ``designs`` cannot tell apart (:func:`gyrocomp.fitting.thermal.plausible_middle`)."""
+    ``designs`` cannot tell apart (:func:`gyrocomp.fitting.grid_search.plausible_middle`)."""
     fits = [_weighted_fit(np.vstack(x), ys, np.ones(ys.size)) for x in designs]  # (residual, rss) per width
     duration_s = sum(float(r.time_s[-1] - r.time_s[0]) for r in runs)
     return plausible_middle(np.array([rss for _, rss in fits]), duration_s / SCORE_WINDOW_S)

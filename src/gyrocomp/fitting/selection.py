@@ -59,7 +59,8 @@ from .scores import CandidateScore, json_number
 from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
 from ..curves.polynomial import POLY_FAMILY
-from .thermal import LAG_MAX_S, LAG_MIN_BLOCKS, SCORE_WINDOW_S, lag_search_top_s
+from .grid_search import LAG_MAX_S, LAG_MIN_BLOCKS, lag_search_top_s
+from .thermal import SCORE_WINDOW_S
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 #: crossover widths of the branch candidates in each fold [degC] (each fold takes the one of least training
@@ -335,8 +336,8 @@ class SelectionProblem:
 
     def lag_grid_s(self) -> np.ndarray:
         """The lags each fold's fit chooses from [s]: :data:`LAG_GRID_POINTS` log-spaced from two blocks to the
-        longest run (at most :data:`gyrocomp.fitting.thermal.LAG_MAX_S`), those up to
-        :func:`gyrocomp.fitting.thermal.lag_search_top_s` kept."""
+        longest run (at most :data:`gyrocomp.fitting.grid_search.LAG_MAX_S`), those up to
+        :func:`gyrocomp.fitting.grid_search.lag_search_top_s` kept."""
         lo = LAG_MIN_BLOCKS * self.block_s
         longest = max(float(r.time_s[-1] - r.time_s[0]) for r in self.runs)
         grid = np.geomspace(lo, max(2.0 * lo, min(LAG_MAX_S, longest)), LAG_GRID_POINTS)

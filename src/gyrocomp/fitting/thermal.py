@@ -15,9 +15,11 @@ Per gyro axis and run r, the bias is modelled as
 The fit works on block means of each run (``block_s`` seconds), in time order, weighted so that
 every temperature bin of every run counts equally (as the polynomial's binning does). For a fixed
 tau everything is linear; tau is found by a log-spaced search refined by a bounded scalar
-minimization (variable projection). The candidates none, turning-point, lag and turning-point+lag
-are compared by leave-one-run-out error (the held-out run's constant refitted), or by BIC with
-one run; the hysteresis order (1-3) is chosen the same way.
+minimization (variable projection, :mod:`gyrocomp.fitting.grid_search`). Where this model chooses the memory
+itself (a fixed order), the candidates of :data:`CANDIDATES` (none, lag, turning-point, branches, a
+temperature-rate term, each with and without the lag) are compared by leave-one-run-out error (the held-out
+run's constant refitted), or by BIC with one run; the hysteresis order (1-3) is chosen the same way. The
+default's choice is made on held-out folds (:mod:`gyrocomp.fitting.selection`) and fitted here.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from ..errors import DataQualityWarning, InputError, ModelError, user_stacklevel
 from ..calibration.fit_report import memory_name
 from ..recording import Recording
 from .design import Terms, ThermalDesign
+from .grid_search import LAG_MIN_BLOCKS, best_lag_s, lag_search_top_s, plausible_middle
 from .gsensitivity import ACCELERATION_CHOICES, excited_columns
 from ..runs.prepared import PreparedRun, RunBlocks, fit_axes
 from ..runs.prepared import one_temperature_column
@@ -68,12 +71,6 @@ MAX_BRANCH_ORDER = 2
 #: model choice's folds try the coarser gyrocomp.fitting.selection.FOLD_BRANCH_WIDTHS_DEGC
 BRANCH_WIDTHS_DEGC = tuple(float(w) for w in np.geomspace(1.0, 40.0, 9))
 MAX_HYSTERESIS_ORDER = 3
-#: bounds of the thermal time constant search [s]
-LAG_MIN_BLOCKS = 2.0
-LAG_MAX_S = 4 * 3600.0
-#: an axis whose fit at its lag the data cannot tell from the same at the bottom of the search (two blocks) by
-#: more than this chi-square (about two standard errors of one parameter, as in plausible_middle) does not see it
-LAG_EVIDENCE_CHI2 = 4.0
 DEFAULT_BLOCK_S = 2.0
 #: with this many runs or fewer, a band's edges and the lag are refined together (_Problem.refine_band_with_lag):
 #: the runs' few turns are all that tell the lag from the band's edge. With more, the lag is held by runs of other
@@ -83,44 +80,6 @@ JOINT_BAND_MAX_RUNS = 2
 #: held-out residuals are moving-averaged over this long before their RMS is taken [s], so that the
 #: score measures drift (what compensation is for) rather than white noise, which no model removes
 SCORE_WINDOW_S = 60.0
-
-
-def plausible_middle(rss: np.ndarray, independent: float, chi2: float = 4.0) -> int:
-    """The middle index of the grid points whose residual sum of squares ``rss`` the data cannot tell from the
-    least: within ``chi2`` (about two standard errors of one parameter) of it, on the scale of the least rss per
-    ``independent`` residual (the residual's independent stretches: its length over the drift window, as
-    block residuals are correlated over that long)::
-
-        plausible = {i : rss_i - min(rss) <= chi2 min(rss) / independent}
-
-    With a sharp minimum that is the least point itself; with a flat profile (the parameter not identified) the
-    middle of the grid rather than a point chance picked."""
-    least = float(np.min(rss))
-    plausible = np.flatnonzero(rss - least <= chi2 * max(least, 1e-300) / max(independent, 1.0))
-    return int(plausible[plausible.size // 2])
-
-
-def lag_search_top_s(runs, lo_s: float) -> float:
-    """The longest time constant [s] a lag search tries: half the longest of ``runs`` (anything with ``time_s``
-    [s]), at most :data:`LAG_MAX_S`, at least twice ``lo_s``. A die that takes longer to follow its sensor never
-    settles in any run, and its lagged temperature is a smooth trend over the run that fits a slow drift as well
-    as the temperature (measured: a simulated random walk unrelated to temperature, three runs of 3.1-3.75 h,
-    got lags of 4,600-7,900 s, and the fourth run drifted 2.1x raw)."""
-    longest = max(float(r.time_s[-1] - r.time_s[0]) for r in runs)
-    return max(2.0 * lo_s, min(LAG_MAX_S, longest / 2.0))
-
-
-def best_lag_s(rss: Callable[[float], float], lo_s: float, hi_s: float = LAG_MAX_S) -> float:
-    """The time constant [s] that minimizes ``rss(tau)``: a 12-point log-spaced search between ``lo_s`` and
-    ``hi_s`` [s], refined by a bounded scalar minimization in log(tau) around the best grid point."""
-    from scipy.optimize import minimize_scalar  # slow to import; only lag fits need it
-
-    grid = np.geomspace(lo_s, hi_s, 12)
-    values = [rss(float(tau)) for tau in grid]
-    best = int(np.argmin(values))
-    a, b = math.log(grid[max(best - 1, 0)]), math.log(grid[min(best + 1, grid.size - 1)])
-    res = minimize_scalar(lambda lt: rss(math.exp(lt)), bounds=(a, b), method="bounded", options={"xatol": 1e-2})
-    return math.exp(res.x) if res.fun <= values[best] else float(grid[best])
 
 
 @dataclass(frozen=True)
@@ -493,7 +452,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     lag_evidence_ : dict[str, float]
         Per axis with a lag, how far its all-run fit stands from the same at the bottom of the lag search (two
         blocks), as a chi-square of one parameter (:meth:`_Problem.lag_evidence`); at most
-        :data:`LAG_EVIDENCE_CHI2`, this axis's data do not see the lag. NaN without lag.
+        :data:`gyrocomp.fitting.grid_search.LAG_EVIDENCE_CHI2`, this axis's data do not see the lag. NaN without lag.
     hysteresis_ : dict[str, HysteresisCurve or None]
     turn_on_biases_ : dict[str, np.ndarray]
     memories_ : dict[str, (str, int)]

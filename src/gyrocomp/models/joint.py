@@ -51,14 +51,8 @@ from .options import (
     Target,
     curve_candidates,
 )
-from ..fitting.thermal import (
-    CANDIDATES,
-    LAG_EVIDENCE_CHI2,
-    MAX_BRANCH_ORDER,
-    MAX_HYSTERESIS_ORDER,
-    ThermalHysteresisModel,
-    static_pieces,
-)
+from ..fitting.grid_search import LAG_EVIDENCE_CHI2
+from ..fitting.thermal import CANDIDATES, MAX_BRANCH_ORDER, MAX_HYSTERESIS_ORDER, ThermalHysteresisModel, static_pieces
 from ..threads import single_threaded_blas
 
 #: the branch candidates' terms of the heating-cooling difference: a constant; a constant and a slope
