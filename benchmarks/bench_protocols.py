@@ -29,9 +29,10 @@ them one of gyrocomp's model forms (a play operator, a bank of plays of many wid
 shape after a maximum and another after a minimum, a thermal gradient behind a second node of 300 s, an offset that
 fades with the time since the turn, a slow second thermal path of 40 minutes, and the ADXRS450-like smooth bump in
 temperature after each maximum behind a 30 s lag), on one body (a tanh-shaped curve behind a 25 s lag, white noise
-and a slow random walk, a temperature register in 1/16 degC), at two noise levels, by two protocols: two heat-cool
+and a slow random walk, a temperature register in 1/16 degC), at two noise levels, by three protocols: two heat-cool
 runs at 1 degC/min judged on a third at 3 degC/min (another ramp rate than the fit's: what a lag, a rate term and a
-memory of the turn must agree on), and the one-cycle protocol above. Three seeds each (``--zoo-seeds``).
+memory of the turn must agree on), the same with the second run at 2 degC/min (the run the fit asks for when its
+runs ramp at one rate), and the one-cycle protocol above. Three seeds each (``--zoo-seeds``).
 
 Also the thesis's ADXRS450 case (``adxrs450``: two heat-cool runs over -30..85 and -20..80 degC at 20 Hz, judged
 on a third over -25..85 degC), with its hysteresis as the preset has it, as a smooth bump that fades over 25 degC,
@@ -57,7 +58,10 @@ Where the default loses on the shape zoo: everywhere a memory is large against t
 cycles judged at another ramp rate: the slow second thermal path (4.5x perfect at the lower noise), the ADXRS450-like
 bump (4.1x), a memory fading in time (3.1x), the bank of plays (3.0x), the bump after turns (2.4x); the thermal
 gradient, 32x and 8.1x before the default offered its temperature-rate term, is at 1.3x and 2.1x. Within 1.35x: the
-thermal gradient at the lower noise, and the play, the bank of plays and the bump after turns at the higher. One
+thermal gradient at the lower noise, and the play, the bank of plays and the bump after turns at the higher. With
+the second run at 2 degC/min, as the fit's warning asks, the slow second path goes from 4.5x to 1.8x (1.9x to 1.4x
+at the higher noise), the ADXRS450-like bump from 4.1x to 3.4x, the fading memory from 3.1x to 2.7x, the thermal
+gradient to 1.15x and 1.2x; the bump after turns at the lower noise goes from 2.4x to 2.7x. One
 cycle: the ADXRS450-like bump 21x, the bank of plays 17x, the thermal gradient 11x (a rate term is not judged on
 one cycle), and on several parts the default leaves more than a plain cubic on most axes (the last column). These
 are the targets of issue #70.
@@ -73,6 +77,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import sys
 import time
 import warnings
@@ -223,11 +228,12 @@ from benchmarks.shape_zoo import FORMS, zoo_run  # noqa: E402  (memories written
 ZOO_NOISE_DPS_PER_SQRT_HZ = (0.005, 0.02)
 
 
-def zoo_two_cycles(form: str, seed: int, noise: float):
-    """Two heat-cool runs at 1 degC/min (-20..70 and -10..60 degC), judged on a third at 3 degC/min (-15..70)."""
+def zoo_two_cycles(form: str, seed: int, noise: float, second_ramp_degc_per_min: float = 1.0):
+    """Two heat-cool runs at 1 degC/min (-20..70 and -10..60 degC; the second at ``second_ramp_degc_per_min``: 2 is
+    the run the fit asks for when its runs ramp at one rate), judged on a third at 3 degC/min (-15..70)."""
     fit = [
-        zoo_run(form, sp, 1.0, noise_dps_per_sqrt_hz=noise, seed=100 * seed + i).recording
-        for i, sp in enumerate([(-20.0, 70.0, -20.0), (-10.0, 60.0, -10.0)])
+        zoo_run(form, sp, ramp, noise_dps_per_sqrt_hz=noise, seed=100 * seed + i).recording
+        for i, (sp, ramp) in enumerate([((-20.0, 70.0, -20.0), 1.0), ((-10.0, 60.0, -10.0), second_ramp_degc_per_min)])
     ]
     held = zoo_run(form, (-15.0, 70.0, -15.0), 3.0, noise_dps_per_sqrt_hz=noise, seed=100 * seed + 99)
     return judge(fit, held.recording, held.true_rate_dps, held.noise_dps, RATE_HZ)
@@ -250,7 +256,14 @@ def zoo_lines(seeds: int) -> list[str]:
     ]
     for form in FORMS:
         for noise in ZOO_NOISE_DPS_PER_SQRT_HZ:
-            for protocol, run in (("two cycles, third at 3 degC/min", zoo_two_cycles), ("one cycle", zoo_one_cycle)):
+            for protocol, run in (
+                ("two cycles, third at 3 degC/min", zoo_two_cycles),
+                (
+                    "two cycles at 1 and 2 degC/min, third at 3",
+                    functools.partial(zoo_two_cycles, second_ramp_degc_per_min=2.0),
+                ),
+                ("one cycle", zoo_one_cycle),
+            ):
                 results = [run(form, s, noise) for s in range(seeds)]
                 d, c, worse, _, n = summarize(results)
                 beaten = int(sum(np.sum(np.array(r["default"]) > 1.01 * np.array(r["cubic"])) for r in results))
