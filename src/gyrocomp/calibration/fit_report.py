@@ -275,7 +275,7 @@ class OrderTest:
 
 @dataclass(frozen=True)
 class SelectionReport:
-    """The choice for one axis by held-out drift (:class:`gyrocomp.fitting.selection.AxisSelection` as stored):
+    """The choice for one axis by held-out drift (:class:`gyrocomp.fitting.axis_selection.AxisSelection` as stored):
     how the data was held out, the moving-average window of the score [s], every candidate's result, the best
     and the chosen one (the simplest within one standard error of the best); the drifts are in the axis's
     ``unit`` (deg/s, or g for an accelerometer axis). ``chosen_drift`` +- ``chosen_standard_error`` is the drift

@@ -24,7 +24,8 @@ from ..errors import InputError
 from .branch_evidence import branch_test
 from .order_evidence import order_test
 from .scores import CandidateScore, choose, harms, helps_on_every_fold, paired_difference
-from .selection import WEIGHTINGS, AxisSelection, SelectionProblem
+from .axis_selection import AxisSelection
+from .selection import WEIGHTINGS, SelectionProblem
 from .thermal import MAX_BRANCH_ORDER
 
 

@@ -36,7 +36,8 @@ from ..curves.network import NETWORK_BLOCK_S
 from ..fitting.network_model import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
-from ..fitting.selection import FOLD_RATE_SMOOTHINGS_S, AxisSelection, prepare_axis
+from ..fitting.axis_selection import AxisSelection
+from ..fitting.selection import FOLD_RATE_SMOOTHINGS_S, prepare_axis
 from ..fitting.polynomial_model import PolynomialTemperatureModel
 from .triads import SCALE_FACTOR_CHOICES, ScaleFactor, fit_accel_triad, fit_gyro_triad, spanning_poses  # noqa: F401
 from .options import (
@@ -206,15 +207,11 @@ def select_models(
     return select_axes(problems, orders, memories, do_no_harm, one_die)
 
 
-def _rate_dependent(c) -> bool:
-    """Whether candidate ``c`` carries a memory whose size at another ramp rate runs at one rate cannot show."""
-    return bool(c.lag or c.rate or c.branch or c.hysteresis_order)
-
-
 def _warn_at_one_rate(selections: dict[str, AxisSelection]) -> None:
     """Where the runs ramp at one rate and an axis's model carries a memory, say that one rate cannot check it."""
     first = next(iter(selections.values()))
-    remembering = [f"{axis} {sel.chosen.label}" for axis, sel in selections.items() if _rate_dependent(sel.chosen)]
+    # every memory (a lag, a rate term, a memory of the turn) differs at another ramp rate from what one rate shows
+    remembering = [f"{axis} {sel.chosen.label}" for axis, sel in selections.items() if sel.chosen.memory != "none"]
     if remembering and first.ramp_rates_degc_per_min and not first.rates_separate:
         warnings.warn(
             f"model choice: {separation_sentence(first.ramp_rates_degc_per_min)}; the choice of "
