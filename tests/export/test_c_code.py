@@ -352,3 +352,14 @@ def test_a_temperature_rate_term_with_lag(tmp_path):
         cal = fit_calibration(runs, hysteresis="rate+lag")
     assert all(ax.rate_term is not None for ax in cal.axes.values())
     _compare(cal, chamber_run([-5.0, 60.0, -5.0], 3.0, seed=3, rate_hz=1.0), tmp_path)
+
+
+def test_a_turning_point_table_with_lag_past_its_last_knot(tmp_path):
+    """A turning-point table fitted under the lag, then applied to a run that turns twice and goes farther from
+    its turns than the fit saw (the table held past its last knot): the C is apply's to 1e-9."""
+    runs = [chamber_run([-10.0, 60.0, -10.0], 1.0, seed=s, rate_hz=1.0) for s in (1, 2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit_calibration(runs, hysteresis="turning-table+lag")
+    assert all(type(ax.hysteresis).__name__ == "TurningTableCurve" for ax in cal.axes.values())
+    _compare(cal, chamber_run([-25.0, 75.0, -25.0, 40.0], 3.0, seed=3, rate_hz=1.0), tmp_path)

@@ -25,7 +25,18 @@ from ..measures.ramp_rate import ramp_rates_separate, separation_sentence
 from ..units import AxisUnit, in_unit, unit_suffix
 
 #: the thermal memories a gyro axis's model may carry
-MEMORIES = ("none", "lag", "turning-point", "turning-point+lag", "branch", "branch+lag")
+MEMORIES = (
+    "none",
+    "lag",
+    "turning-point",
+    "turning-point+lag",
+    "turning-table",
+    "turning-table+lag",
+    "branch",
+    "branch+lag",
+    "rate",
+    "rate+lag",
+)
 _TYPED = (
     "temperature",
     "axes",
@@ -40,9 +51,12 @@ _TYPED = (
 )
 
 
-def memory_name(lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = False) -> str:
-    """The thermal memory a model carries: ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``
+def memory_name(lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = False, table: int = 0) -> str:
+    """The thermal memory a model carries: ``none``, ``lag``, ``turning-point``, ``turning-point+lag``,
+    ``turning-table`` (a table in the distance from the turn: ``table`` knots), ``turning-table+lag``, ``branch``
     (heating and cooling curves), ``branch+lag``, ``rate`` (a temperature-rate term) or ``rate+lag``."""
+    if table:
+        return "turning-table+lag" if lag else "turning-table"
     if rate:
         return "rate+lag" if lag else "rate"
     if branch:
@@ -53,8 +67,13 @@ def memory_name(lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = 
 
 
 def memory_label(memory: str, hysteresis_order: int) -> str:
-    """A thermal memory in the words the model file stores: ``turning-point (order 2)``, ``lag``, ``none``."""
-    return memory + (f" (order {hysteresis_order})" if hysteresis_order else "")
+    """A thermal memory in the words the model file stores: ``turning-point (order 2)``, ``turning-table (8 knots)``,
+    ``lag``, ``none`` (``hysteresis_order``: a turning-point table's knots)."""
+    if not hysteresis_order:
+        return memory
+    return memory + (
+        f" ({hysteresis_order} knots)" if memory.startswith("turning-table") else f" (order {hysteresis_order})"
+    )
 
 
 def _number(value) -> float | None:
@@ -87,17 +106,19 @@ class Candidate:
     branch: int = 0
     curve: str = POLY_FAMILY
     rate: bool = False
+    turning_table: int = 0
 
     @property
     def memory(self) -> str:
-        """``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``, ``branch+lag``, ``rate`` or
-        ``rate+lag``."""
-        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate)
+        """``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``turning-table``, ``turning-table+lag``,
+        ``branch``, ``branch+lag``, ``rate`` or ``rate+lag``."""
+        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate, self.turning_table)
 
     @property
     def complexity(self) -> int:
         """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band, the
-        branch difference's terms and its crossover width, two for a rate term (its coefficient and smoothing)."""
+        branch difference's terms and its crossover width, two for a rate term (its coefficient and smoothing), two per
+        knot of a turning-point table."""
         return (
             self.order
             + int(self.lag)
@@ -105,11 +126,19 @@ class Candidate:
             + int(self.band)
             + (self.branch + 1 if self.branch else 0)
             + 2 * int(self.rate)
+            + 2 * self.turning_table
         )
 
     @property
     def has_temperature_model(self) -> bool:
-        return self.order > 0 or self.lag or self.hysteresis_order > 0 or self.branch > 0 or self.rate
+        return (
+            self.order > 0
+            or self.lag
+            or self.hysteresis_order > 0
+            or self.branch > 0
+            or self.rate
+            or self.turning_table > 0
+        )
 
     @property
     def label(self) -> str:
@@ -120,6 +149,8 @@ class Candidate:
             parts.append("lag")
         if self.hysteresis_order:
             parts.append(f"turning-point:{self.hysteresis_order}" + (" in band" if self.band else ""))
+        if self.turning_table:
+            parts.append(f"turning-table:{self.turning_table}")
         if self.branch:
             parts.append(f"branch:{self.branch}")
         if self.rate:
@@ -141,6 +172,8 @@ class Candidate:
             d["curve"] = self.curve
         if self.rate:  # written only when set
             d["rate"] = True
+        if self.turning_table:  # written only when set
+            d["turning_table"] = self.turning_table
         return d
 
     @classmethod
@@ -155,6 +188,7 @@ class Candidate:
             int(d.get("branch", 0)),
             str(d.get("curve", POLY_FAMILY)),
             bool(d.get("rate", False)),
+            int(d.get("turning_table", 0)),
         )
 
 

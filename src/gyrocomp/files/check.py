@@ -33,7 +33,7 @@ def ask_for(options: FitOptions | None = None) -> Ask:
     automatic = isinstance(spec, Polynomial) and spec.order == "auto"
     return Ask(
         temperature="auto" if automatic else "asked",
-        hysteresis=options.hysteresis.startswith("turning-point"),
+        hysteresis=options.hysteresis.startswith("turning-"),
         parameters=parameters,
     )
 

@@ -11,6 +11,8 @@ The blocks (:class:`Terms` names which a fit uses, in this order):
   u^1..u^p, a lookup table's hat functions), one block per (family, size);
 - ``turning-point``: the thesis's hysteresis (section 2.6), (d / s)^j on cooling then heating branches
   (:func:`gyrocomp.curves.hysteresis.turning_point_columns`), one block per band (None: the whole range);
+- ``turning-table``: a table in the distance from the last turn, hat functions of d on cooling then heating
+  branches (:func:`gyrocomp.curves.turning_table.turning_table_columns`), one block per set of knots;
 - ``branch``: heating and cooling curves crossing over after each turn, s(T) u^k
   (:func:`gyrocomp.curves.hysteresis.branch_columns`), one block per crossover width;
 - ``rate``: the smoothed rate of the model temperature [degC/s] (:func:`gyrocomp.curves.rate.rate_columns`), one
@@ -32,6 +34,7 @@ import numpy as np
 from ..curves.hysteresis import branch_columns, turning_point_columns
 from ..curves.protocol import BASES
 from ..curves.rate import rate_columns
+from ..curves.turning_table import turning_table_columns
 from ..effects import find_turns, g_squared_products
 
 
@@ -47,6 +50,8 @@ class Terms:
         Terms per branch of each turning-point block (0: none).
     bands_degc : tuple of (lo, hi) or None
         One turning-point block per entry: limited to that band [degC], or over the whole range (None).
+    turning_table_knots_degc : tuple of tuple of float
+        One turning-point table block per set of knots [degC] (empty: none).
     branch_order : int
         Terms of each branch block (0: none).
     branch_widths_degc : tuple of float
@@ -60,6 +65,7 @@ class Terms:
     shapes: tuple[tuple[str, int], ...] = ()
     turning_point_order: int = 0
     bands_degc: tuple[tuple[float, float] | None, ...] = (None,)
+    turning_table_knots_degc: tuple[tuple[float, ...], ...] = ()
     branch_order: int = 0
     branch_widths_degc: tuple[float, ...] = ()
     rate_smoothings_s: tuple[float, ...] = ()
@@ -133,13 +139,14 @@ class ThermalDesign:
         them)."""
         t = np.asarray(temperature_degc, dtype=float)
         cols = [self.basis(family).columns(t, size, lo_degc, hi_degc) for family, size in terms.shapes if size]
-        if terms.turning_point_order or terms.branch_order:
+        if terms.turning_point_order or terms.turning_table_knots_degc or terms.branch_order:
             turns = find_turns(t, self.threshold_degc)
             if terms.turning_point_order:
                 cols += [
                     turning_point_columns(t, turns, terms.turning_point_order, band, self.distance_scale_degc)
                     for band in terms.bands_degc
                 ]
+            cols += [turning_table_columns(t, turns, knots) for knots in terms.turning_table_knots_degc]
             if terms.branch_order:
                 cols += [
                     branch_columns(
@@ -157,7 +164,7 @@ class ThermalDesign:
 
     def layout(self, terms: Terms) -> dict[tuple, slice]:
         """Where each block of :meth:`columns` lies: ``("shape", family, size)``, ``("turning-point", band)``,
-        ``("branch", width)``, ``("rate", smoothing)`` and ``("acceleration",)`` to their columns."""
+        ``("turning-table", knots)``, ``("branch", width)``, ``("rate", smoothing)`` and ``("acceleration",)`` to their columns."""
         out, start = {}, 0
 
         def take(key, size):
@@ -170,6 +177,8 @@ class ThermalDesign:
                 take(("shape", family, size), size)
         for band in terms.bands_degc if terms.turning_point_order else ():
             take(("turning-point", band), 2 * terms.turning_point_order)
+        for knots in terms.turning_table_knots_degc:
+            take(("turning-table", knots), 2 * len(knots))
         for w in terms.branch_widths_degc if terms.branch_order else ():
             take(("branch", w), terms.branch_order)
         for s in terms.rate_smoothings_s:

@@ -59,6 +59,7 @@ from .scores import CandidateScore
 from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
 from ..curves.polynomial import POLY_FAMILY
+from ..curves.turning_table import largest_turn_distance_degc, turning_table_knots_degc
 from .grid_search import LAG_MAX_S, LAG_MIN_BLOCKS, lag_search_top_s
 from .thermal import SCORE_WINDOW_S
 
@@ -206,6 +207,10 @@ class SelectionProblem:
     #: each recording's typical ramp rate [degC/min] (NaN: it does not ramp;
     #: :func:`gyrocomp.measures.ramp_rate.run_ramp_rates_degc_per_min`); empty: not known, taken as one rate
     ramp_rates_degc_per_min: tuple[float, ...] = ()
+    #: knots per branch of the turning-point table candidates (empty: none), and the largest distance from a turn
+    #: the runs reach [degC] (the tables' last knot)
+    turning_table_sizes: tuple[int, ...] = ()
+    turn_reach_degc: float = 0.0
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -250,10 +255,15 @@ class SelectionProblem:
             shapes=shapes,
             turning_point_order=self.max_hysteresis,
             bands_degc=(None,) if self.band_degc is None else (None, self.band_degc),
+            turning_table_knots_degc=tuple(self.table_knots_degc(m) for m in self.turning_table_sizes),
             branch_order=self.max_branch,
             branch_widths_degc=FOLD_BRANCH_WIDTHS_DEGC if self.branch_orders else (),
             rate_smoothings_s=self.rate_smoothings_s,
         )
+
+    def table_knots_degc(self, size: int) -> tuple[float, ...]:
+        """The knots [degC] of a turning-point table of ``size`` knots per branch, to the runs' reach."""
+        return turning_table_knots_degc(self.turn_reach_degc, size)
 
     def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
         """Every column any candidate uses (:meth:`terms`) at model temperature ``temp`` [degC], and last the value
@@ -309,6 +319,9 @@ class SelectionProblem:
         if c.hysteresis_order:
             first, h = at[("turning-point", self.band_degc if c.band else None)].start, self.max_hysteresis
             idx += [first + j for j in range(c.hysteresis_order)] + [first + h + j for j in range(c.hysteresis_order)]
+        if c.turning_table:
+            table = at[("turning-table", self.table_knots_degc(c.turning_table))]
+            idx += list(range(table.start, table.stop))
         if c.branch:
             first = at[("branch", FOLD_BRANCH_WIDTHS_DEGC[width])].start
             idx += [first + j for j in range(c.branch)]
@@ -503,7 +516,11 @@ class SelectionProblem:
             # a fold whose training data holds one direction only cannot tell the branches apart: there the
             # candidate is its polynomial (its branch or turning-point terms would be confounded with the curve, and
             # its rate term, of one sign but at the holds, with the run constant)
-            fc = c if both[f] else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False, rate=False)
+            fc = (
+                c
+                if both[f]
+                else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False, rate=False, turning_table=0)
+            )
             widths = range(len(FOLD_BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
             smoothings = range(len(self.rate_smoothings_s)) if fc.rate else (0,)
             best = None
@@ -566,6 +583,12 @@ class SelectionProblem:
                         if p > 0 and self.rate_smoothings_s and c not in out:
                             out.append(c)
                         continue
+                    if "turning-table" in mem:
+                        for m in self.turning_table_sizes if p > 0 else ():
+                            c = Candidate(p, lag, 0, w, turning_table=m)
+                            if c not in out:
+                                out.append(c)
+                        continue
                     if "branch" in mem:
                         for b in self.branch_orders if p > 0 else ():
                             c = Candidate(p, lag, 0, w, False, b)
@@ -619,6 +642,7 @@ def prepare_axis(
     branch_orders: tuple[int, ...] = (),
     other_curves: tuple[tuple[str, int], ...] = (),
     rate_smoothings_s: tuple[float, ...] = (),
+    turning_table_sizes: tuple[int, ...] = (),
 ) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
@@ -650,6 +674,10 @@ def prepare_axis(
     other_curves : tuple of (str, int)
         The curves of other families than the polynomial offered, (name in
         :data:`gyrocomp.curves.protocol.BASES`, size) each (the polynomial's orders come from ``max_order``).
+    rate_smoothings_s : tuple of float
+        Smoothing time constants of the temperature-rate columns [s] (empty: no rate candidates).
+    turning_table_sizes : tuple of int
+        Knots per branch of the turning-point table candidates, offered where turning-point candidates are.
     """
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
@@ -693,6 +721,8 @@ def prepare_axis(
         other_curves=tuple(other_curves),
         rate_smoothings_s=tuple(rate_smoothings_s),
         ramp_rates_degc_per_min=run_ramp_rates_degc_per_min(recordings),
+        turning_table_sizes=tuple(turning_table_sizes) if reverses else (),
+        turn_reach_degc=largest_turn_distance_degc([r.temperature_degc for r in runs], max(thresholds)),
     )
 
 

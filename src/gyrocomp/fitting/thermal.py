@@ -46,6 +46,12 @@ from ..runs.prepared import one_temperature_column
 from .temperature_bins import bin_width_for
 from .learned_attributes import LearnedAttributes
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
+from ..curves.turning_table import (
+    TURNING_TABLE_SIZES,
+    TurningTableCurve,
+    largest_turn_distance_degc,
+    turning_table_knots_degc,
+)
 from .polynomial_model import simplest_within
 
 HYSTERESIS_CHOICES = (
@@ -54,14 +60,17 @@ HYSTERESIS_CHOICES = (
     "turning-point",
     "lag",
     "turning-point+lag",
+    "turning-table",
+    "turning-table+lag",
     "branch",
     "branch+lag",
     "rate",
     "rate+lag",
 )
-#: the memories the default compares, simplest first (every memory there is; where the runs ramp at one rate a
-#: rate term counts as more complex in the model choice: gyrocomp.fitting.selection.ONE_RATE_RATE_TERM_COST)
-CANDIDATES = HYSTERESIS_CHOICES[1:]
+#: the memories the default compares, simplest first: every memory but the turning-point table, which is fitted
+#: where asked for (docs/how-the-fit-works.md says why); where the runs ramp at one rate a rate term counts as
+#: more complex in the model choice (gyrocomp.fitting.selection.ONE_RATE_RATE_TERM_COST)
+CANDIDATES = tuple(c for c in HYSTERESIS_CHOICES[1:] if not c.startswith("turning-table"))
 #: smoothing time constants the final fit tries for a temperature-rate term [s] (the middle of those the data
 #: cannot tell from the best: _Problem.best_smoothing); the model choice's folds try FOLD_RATE_SMOOTHINGS_S
 RATE_SMOOTHINGS_S = tuple(float(s) for s in np.geomspace(30.0, 3000.0, 11))
@@ -97,10 +106,12 @@ class _Spec:
     #: a temperature-rate term, and its smoothing time constant [s] (0: to be found)
     rate: bool = False
     smoothing_s: float = 0.0
+    #: knots per branch of a turning-point table (0: none)
+    table: int = 0
 
     @property
     def name(self) -> str:
-        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate)
+        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate, self.table)
 
 
 @dataclass
@@ -115,6 +126,8 @@ class _Problem:
     square_cols: tuple[int, ...] = ()
     #: a polynomial continues along its tangent past its range (as the model choice scored it), else is held
     extended: bool = False
+    #: the largest distance from a turn the runs reach [degC] (a turning-point table's last knot)
+    turn_reach_degc: float = 0.0
     _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
     _solved: dict = dataclasses.field(default_factory=dict, repr=False)
 
@@ -148,6 +161,9 @@ class _Problem:
             shapes=((spec.curve, spec.order),),
             turning_point_order=spec.hysteresis_order,
             bands_degc=(self.band,),
+            turning_table_knots_degc=(turning_table_knots_degc(self.turn_reach_degc, spec.table),)
+            if spec.table
+            else (),
             branch_order=spec.branch,
             branch_widths_degc=(spec.width_degc,),
             rate_smoothings_s=(spec.smoothing_s,) if spec.rate else (),
@@ -433,6 +449,10 @@ class ThermalHysteresisModel(LearnedAttributes):
     branch_order : int or dict
         Terms of the difference between the heating and the cooling curve of a branch model (1: a constant,
         2: and a slope), or one per axis.
+    turning_table_size : int or "auto" or dict
+        Knots per branch of a turning-point table (``turning-table``, ``turning-table+lag``;
+        :class:`~gyrocomp.curves.turning_table.TurningTableCurve`), or chosen among
+        :data:`~gyrocomp.curves.turning_table.TURNING_TABLE_SIZES` by the same validation; or one per axis.
     curve : str or dict
         The family of the temperature shape, a name of :data:`gyrocomp.curves.protocol.BASES` (``poly``,
         ``table``), ``order`` its size; or one per axis.
@@ -453,7 +473,7 @@ class ThermalHysteresisModel(LearnedAttributes):
         Per axis with a lag, how far its all-run fit stands from the same at the bottom of the lag search (two
         blocks), as a chi-square of one parameter (:meth:`_Problem.lag_evidence`); at most
         :data:`gyrocomp.fitting.grid_search.LAG_EVIDENCE_CHI2`, this axis's data do not see the lag. NaN without lag.
-    hysteresis_ : dict[str, HysteresisCurve or None]
+    hysteresis_ : dict[str, HysteresisCurve, TurningTableCurve, BranchCurve or None]
     turn_on_biases_ : dict[str, np.ndarray]
     memories_ : dict[str, (str, int)]
         The candidate kept per axis: its memory (``none``, ``lag``, ``turning-point``, ``turning-point+lag``) and
@@ -492,6 +512,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     branch_order: int | dict[str, int] = MAX_BRANCH_ORDER
     curve: str | dict[str, str] = POLY_FAMILY
     extended: bool = False
+    turning_table_size: int | str | dict[str, int] = "auto"
 
     @staticmethod
     def _of(value, axis: str):
@@ -501,9 +522,12 @@ class ThermalHysteresisModel(LearnedAttributes):
         mode = self._of(self.hysteresis, axis)
         return list(CANDIDATES) if mode == "auto" else [mode]
 
-    def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "") -> _Spec:
-        lag = name in ("lag", "turning-point+lag", "branch+lag", "rate+lag")
+    def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "", table: int = 0) -> _Spec:
+        lag = name == "lag" or name.endswith("+lag")
         curve = self._of(self.curve, axis)
+        if "turning-table" in name:
+            fixed = self._of(self.turning_table_size, axis)
+            return _Spec(order, lag, 0, curve=curve, table=int(fixed) if fixed != "auto" else table or 8)
         if "rate" in name:
             return _Spec(order, lag, 0, curve=curve, rate=True)
         if "branch" in name:
@@ -582,6 +606,7 @@ class ThermalHysteresisModel(LearnedAttributes):
             accel_cols,
             square_cols,
             self.extended,
+            largest_turn_distance_degc([r.temperature_degc for r in runs], threshold),
         )
 
     def _choose(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _AxisChoice:
@@ -618,16 +643,21 @@ class ThermalHysteresisModel(LearnedAttributes):
             pick = _simplest(tried, n_runs)
             best_spec[chosen] = self._spec(chosen, order, pick, axis)
             scores[chosen] = tried[pick]
+        if "turning-table" in chosen and self.turning_table_size == "auto" and self.selection_ != "fixed":
+            tried = {m: score(self._spec(chosen, order, axis=axis, table=m)) for m in TURNING_TABLE_SIZES}
+            pick = _simplest(tried, n_runs)
+            best_spec[chosen] = self._spec(chosen, order, axis=axis, table=pick)
+            scores[chosen] = tried[pick]
         problem.band = bands.get(chosen, band)
         spec = best_spec[chosen]
         if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
             # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
             # which a higher order partly imitates; choose it again inside the winning candidate
             tried = {
-                o: score(_Spec(o, spec.lag, spec.hysteresis_order, rate=spec.rate))
+                o: score(_Spec(o, spec.lag, spec.hysteresis_order, rate=spec.rate, table=spec.table))
                 for o in range(1, self.max_order + 1)
             }
-            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order, rate=spec.rate)
+            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order, rate=spec.rate, table=spec.table)
             self.order_scores_[axis] = tried
         return _AxisChoice(problem, spec, chosen, scores)
 
@@ -681,6 +711,14 @@ class ThermalHysteresisModel(LearnedAttributes):
                 problem.band,
                 problem.branch_reach(spec, tau),
             )
+        if spec.table:
+            table = coef[blocks[("turning-table", problem.terms(spec).turning_table_knots_degc[0])]]
+            self.hysteresis_[axis] = TurningTableCurve(
+                problem.terms(spec).turning_table_knots_degc[0],
+                tuple(float(v) for v in table[: spec.table]),
+                tuple(float(v) for v in table[spec.table :]),
+                problem.threshold,
+            )
         if spec.branch:
             self.hysteresis_[axis] = BranchCurve(
                 tuple(float(v) for v in coef[blocks[("branch", spec.width_degc)]]),
@@ -696,7 +734,7 @@ class ThermalHysteresisModel(LearnedAttributes):
             self.rate_terms_[axis] = TemperatureRateTerm(float(rate), spec.smoothing_s)
         self.bands_[axis] = problem.band
         self.turn_on_biases_[axis] = consts
-        self.memories_[axis] = (choice.name, spec.branch or p)
+        self.memories_[axis] = (choice.name, spec.branch or p or spec.table)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
             self._store_acceleration(axis, problem, spec, tau, coef, blocks[("acceleration",)].start, n_runs)

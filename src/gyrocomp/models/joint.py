@@ -33,6 +33,7 @@ from ..fitting.provenance import provenance
 from ..fitting.temperature_bins import bin_width_for
 from ..curves.hysteresis import heats_and_cools
 from ..curves.network import NETWORK_BLOCK_S
+from ..curves.turning_table import TURNING_TABLE_SIZES
 from ..fitting.network_model import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
 from ..fitting.choice import TWO_FOLDS, select_axes, share_fold_lags
@@ -165,8 +166,8 @@ def select_models(
     orders : tuple of int
         Polynomial orders to try (0: the run constant alone).
     memories : tuple of str
-        Among ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``branch``, ``branch+lag``, ``rate``,
-        ``rate+lag``.
+        Among ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``turning-table``, ``turning-table+lag``,
+        ``branch``, ``branch+lag``, ``rate``, ``rate+lag``.
     hysteresis_orders : tuple of int
         Turning-point orders to try.
     acceleration : {"none", "matrix", "matrix2"}
@@ -200,6 +201,7 @@ def select_models(
         branch_orders=BRANCH_ORDERS if any("branch" in m for m in memories) else (),
         other_curves=other_curves,
         rate_smoothings_s=FOLD_RATE_SMOOTHINGS_S if any("rate" in m for m in memories) else (),
+        turning_table_sizes=TURNING_TABLE_SIZES if any("turning-table" in m for m in memories) else (),
     )
     one_die = shared_lag and one_temperature_column(recordings)
     if one_die and any("lag" in m for m in memories):
@@ -403,6 +405,7 @@ def _fit_chosen(
         weighting={a: c.weighting for a, c in chosen.items()},
         band_degc={a: selections[a].band_degc if c.band else None for a, c in chosen.items()},
         branch_order={a: c.branch for a, c in chosen.items()},
+        turning_table_size={a: c.turning_table for a, c in chosen.items()},
         curve={a: c.curve for a, c in chosen.items()},
         bin_width_degc=options.bin_width_degc,
         acceleration=accel_mode,

@@ -22,7 +22,17 @@ from ..fitting.thermal import MAX_HYSTERESIS_ORDER
 
 #: the thermal memory on top of the temperature curve
 Memory = Literal[
-    "auto", "none", "turning-point", "lag", "turning-point+lag", "branch", "branch+lag", "rate", "rate+lag"
+    "auto",
+    "none",
+    "turning-point",
+    "lag",
+    "turning-point+lag",
+    "turning-table",
+    "turning-table+lag",
+    "branch",
+    "branch+lag",
+    "rate",
+    "rate+lag",
 ]
 #: what the model is fitted for: gyrocomp itself, or the best model a firmware carries (a cubic at most, clamped)
 Target = Literal["model", "px4", "ardupilot"]
@@ -191,7 +201,9 @@ class FitOptions:
     hysteresis : Memory
         Thermal lag and/or turning-point hysteresis, heating and cooling branches, or a temperature-rate term
         (``rate``, ``rate+lag``: a bias in the smoothed dT/dt, :mod:`gyrocomp.curves.rate`, fitted where asked
-        for) (``auto``: chosen by held-out drift when the runs heat and cool).
+        for), or a table in the distance from the last turn (``turning-table``, ``turning-table+lag``: a memory of
+        any shape after a maximum and after a minimum, :mod:`gyrocomp.curves.turning_table`, fitted where asked for)
+        (``auto``: chosen by held-out drift when the runs heat and cool).
     hysteresis_order : int or "auto"
         Order of the turning-point polynomial, 1..3.
     hysteresis_band_degc : (lo, hi), optional
@@ -247,6 +259,11 @@ class FitOptions:
             raise InputError(
                 "FitOptions.hysteresis: a network is trained without a temperature-rate term; use a polynomial "
                 "with hysteresis='rate' or 'rate+lag'"
+            )
+        if isinstance(self.temperature, Network) and "turning-table" in self.hysteresis:
+            raise InputError(
+                "FitOptions.hysteresis: a network is trained without a turning-point table; use a polynomial "
+                "with hysteresis='turning-table' or 'turning-table+lag'"
             )
         if self.bin_width_degc is not None and not (
             isinstance(self.bin_width_degc, (int, float)) and self.bin_width_degc > 0

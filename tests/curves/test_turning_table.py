@@ -1,0 +1,172 @@
+"""The turning-point table (issue #70, item 2: a memory of the last turn of any shape): its offset against the
+table read by hand, its columns times its values, the model file, the streaming compensator; fitted on runs
+written from the physics (a smooth bump in the die temperature below each maximum, behind a lag: no table and no
+polynomial in the distance from the turn) and judged at another ramp rate, through the library and the command
+line."""
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from gyrocomp import Calibration, FitOptions, apply, fit
+from gyrocomp.curves.turning_table import (
+    TurningTableCurve,
+    largest_turn_distance_degc,
+    turning_table_columns,
+    turning_table_knots_degc,
+)
+from gyrocomp.effects import find_turns
+from gyrocomp.errors import InputError
+from gyrocomp.measures.merit import smoothed_residual_rms
+from gyrocomp.recording import GYRO_AXES, Recording
+
+from ..conftest import assert_streaming_equals_batch, run
+
+#: up 20 -> 80, down to 20, up to 50 degC in 0.1 degC steps
+PATH_DEGC = np.concatenate([np.linspace(20, 80, 601), np.linspace(79.9, 20, 600), np.linspace(20.1, 50, 300)])
+CURVE = TurningTableCurve((10.0, 20.0, 40.0), (0.01, 0.03, -0.02), (-0.005, 0.0, 0.004), threshold_degc=0.5)
+
+
+def test_the_offset_is_the_table_read_at_the_distance_from_the_last_turn():
+    offset = CURVE.offset(PATH_DEGC, find_turns(PATH_DEGC, CURVE.threshold_degc))
+    first, cooling, heating = offset[:601], offset[601:1201], offset[1201:]
+    assert np.all(first == 0.0)  # the first branch is the reference path
+    t_cool, t_heat = PATH_DEGC[601:1201], PATH_DEGC[1201:]
+    confirmed = t_cool < 80 - 0.5  # the reversal counts once T is the threshold past the extreme
+    # by hand: 0 at the turn, 0.01 at 10 degC, 0.03 at 20, -0.02 at 40, held past it
+    d = 80 - t_cool[confirmed]
+    by_hand = np.where(
+        d <= 10,
+        0.001 * d,
+        np.where(d <= 20, 0.01 + 0.002 * (d - 10), np.where(d <= 40, 0.03 - 0.0025 * (d - 20), -0.02)),
+    )
+    np.testing.assert_allclose(cooling[confirmed], by_hand, atol=1e-15)
+    d = t_heat[t_heat > 20 + 0.5] - 20
+    by_hand = np.where(d <= 10, -0.0005 * d, np.where(d <= 20, -0.005 + 0.0005 * (d - 10), 0.0002 * (d - 20)))
+    np.testing.assert_allclose(heating[t_heat > 20 + 0.5], by_hand, atol=1e-15)
+
+
+def test_the_curve_is_its_columns_times_its_values_and_its_knots_reach_the_farthest_distance():
+    turns = find_turns(PATH_DEGC, 0.5)
+    x = turning_table_columns(PATH_DEGC, turns, CURVE.knots_degc)
+    assert x.shape == (PATH_DEGC.size, 6)
+    np.testing.assert_allclose(x @ np.r_[CURVE.descending, CURVE.ascending], CURVE.offset(PATH_DEGC, turns), atol=0)
+    # every row of a branch is a partition of one between two neighbouring knots (or the last knot held)
+    on = ~np.isnan(turns.turn_degc)
+    assert np.allclose(x[on].sum(axis=1)[np.abs(PATH_DEGC[on] - turns.turn_degc[on]) >= 10.0], 1.0)
+    reach = largest_turn_distance_degc([PATH_DEGC], 0.5)
+    assert reach == pytest.approx(60.0)  # from the turn at 80 down to 20
+    assert turning_table_knots_degc(reach, 4) == pytest.approx((15.0, 30.0, 45.0, 60.0))
+    assert largest_turn_distance_degc([np.linspace(20, 80, 100)], 0.5) == 0.0
+
+
+def test_the_model_file_keeps_the_table_and_refuses_one_that_is_not():
+    assert TurningTableCurve.from_dict(json.loads(json.dumps(CURVE.to_dict()))) == CURVE
+    bad = CURVE.to_dict()
+    bad["knots_degc"] = [10.0, 5.0, 40.0]
+    with pytest.raises(InputError, match="knots_degc must be positive and increasing"):
+        TurningTableCurve.from_dict(bad)
+    bad = {**CURVE.to_dict(), "ascending_dps": [0.0]}
+    with pytest.raises(InputError, match="one descending and one ascending value per knot"):
+        TurningTableCurve.from_dict(bad)
+    with pytest.raises(InputError, match="needs knots_degc"):
+        TurningTableCurve.from_dict({"type": "turning-table"})
+
+
+def _die_with_a_bump(set_points_degc, ramp_degc_per_min: float, seed: int, rate_hz: float = 1.0):
+    """A chamber through ``set_points_degc`` at ``ramp_degc_per_min`` (15-minute holds), the die behind it by 30 s,
+    and on each gyro axis a smooth curve of the die's temperature plus, after the maximum the die passes, a
+    Gaussian bump 15 degC below it (6 degC wide), white noise 0.005 deg/s/sqrt(Hz); the temperature reported in
+    1/16 degC. Returns (recording, noise alone [deg/s])."""
+    rng = np.random.default_rng(seed)
+    knots_t, knots_v = [0.0], [float(set_points_degc[0])]
+    for target in set_points_degc[1:]:
+        knots_t += [knots_t[-1] + 900.0, knots_t[-1] + 900.0 + abs(target - knots_v[-1]) / ramp_degc_per_min * 60]
+        knots_v += [knots_v[-1], float(target)]
+    knots_t.append(knots_t[-1] + 900.0)
+    knots_v.append(knots_v[-1])
+    t = np.arange(0.0, knots_t[-1], 1.0 / rate_hz)
+    chamber = np.interp(t, knots_t, knots_v)
+    a = math.exp(-1.0 / (30.0 * rate_hz))
+    die = np.empty_like(chamber)
+    die[0] = chamber[0]
+    for k in range(1, t.size):
+        die[k] = a * die[k - 1] + (1 - a) * chamber[k]
+    # each run passes one maximum: after it, once the die is 1 degC below it, the bump belongs to the way down
+    peak = np.maximum.accumulate(die)
+    cooling = die < peak - 1.0
+    body = np.column_stack([g * np.tanh((die - 25.0) / 30.0) for g in (0.06, -0.04, 0.09)])
+    bump = np.where(cooling, np.exp(-0.5 * ((die - (peak - 15.0)) / 6.0) ** 2), 0.0)
+    noise = rng.standard_normal((t.size, 3)) * 0.005 * math.sqrt(rate_hz)
+    gyro = body + 0.05 * bump[:, None] * np.array([1.0, -0.6, 0.8]) + rng.normal(0.0, 0.02, 3) + noise
+    reported = np.round((die + rng.normal(0.0, 0.03, t.size)) * 16.0) / 16.0
+    return Recording(t, gyro, GYRO_AXES, reported, source=f"bump {seed}"), noise
+
+
+def _drift(series: np.ndarray) -> float:
+    return smoothed_residual_rms(series, 60)
+
+
+@pytest.fixture(scope="module")
+def bump_runs():
+    """Two heat-cool runs at 1 degC/min, and a third at 3 degC/min with its noise alone."""
+    fit_runs = [_die_with_a_bump(sp, 1.0, s)[0] for s, sp in ((0, (-20.0, 70.0, -20.0)), (1, (-10.0, 60.0, -10.0)))]
+    return fit_runs, _die_with_a_bump((-15.0, 70.0, -15.0), 3.0, 9)
+
+
+def test_a_bump_below_the_hottest_point_is_carried_to_another_ramp_rate(bump_runs):
+    """The turning-point table leaves the third run's drift within 1.35x of the noise's on every axis at 3
+    degC/min; the turning-point polynomial of order 1 to 3 leaves more than twice the noise's on some axis."""
+    fit_runs, (held, noise) = bump_runs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        table = fit(fit_runs, FitOptions(hysteresis="turning-table"))
+        poly = fit(fit_runs, FitOptions(hysteresis="turning-point"))
+    for name, cal in (("table", table), ("poly", poly)):
+        out = apply(cal, held).gyro_dps
+        ratio = [_drift(out[:, j]) / _drift(noise[:, j]) for j in range(3)]
+        if name == "table":
+            assert all(type(ax.hysteresis) is TurningTableCurve for ax in cal.axes.values())
+            assert max(ratio) < 1.35, ratio
+        else:
+            assert max(ratio) > 2.0, ratio
+
+
+def test_the_table_streams_as_it_applies_and_its_model_file_reads_back(bump_runs, tmp_path):
+    fit_runs, (held, _) = bump_runs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cal = fit(fit_runs, FitOptions(hysteresis="turning-table+lag"))
+    path = tmp_path / "m.json"
+    cal.save(path)
+    again = Calibration.load(path)
+    assert again.axes["gyro_z"].hysteresis == cal.axes["gyro_z"].hysteresis
+    assert again.fit_report["hysteresis"]["axes"]["gyro_z"]["memory"] == "turning-table+lag"
+    short = held.take(np.arange(4000))
+    assert_streaming_equals_batch(again, short, [1, 999, 37, 1500])
+    # a table without its ascending values is one line naming the field
+    d = json.loads(path.read_text())
+    d["axes"]["gyro_z"]["hysteresis"]["ascending_dps"] = d["axes"]["gyro_z"]["hysteresis"]["ascending_dps"][:1]
+    path.write_text(json.dumps(d))
+    with pytest.raises(InputError, match="one descending and one ascending value per knot"):
+        Calibration.load(path)
+
+
+def test_fit_and_show_on_the_command_line_name_the_table(bump_runs, tmp_path):
+    fit_runs, _ = bump_runs
+    paths = []
+    for k, rec in enumerate(fit_runs):
+        p = tmp_path / f"run_{k}.csv"
+        rec_table = np.column_stack([rec.time_s, rec.gyro_dps, rec.temperature_degc])
+        np.savetxt(p, rec_table, delimiter=",", header="time,gyro_x,gyro_y,gyro_z,temperature", comments="")
+        paths.append(p)
+    result = run("--no-config", "fit", *paths, "--hysteresis", "turning-table", "-o", tmp_path / "m.json")
+    assert result.returncode == 0, result.stderr
+    shown = run("--no-config", "show", tmp_path / "m.json")
+    assert shown.returncode == 0, shown.stderr
+    assert "turning-point table of" in shown.stdout and "knots" in shown.stdout
+    cal = Calibration.load(tmp_path / "m.json")
+    assert all(type(ax.hysteresis) is TurningTableCurve for ax in cal.axes.values())
