@@ -49,7 +49,8 @@ def default_model(runs):
 @pytest.fixture(scope="module")
 def models(runs, default_model):
     """A model of every kind the fitter writes: polynomial and lag, network, gyro and accelerometer, g x g terms,
-    an acceleration network, turning-point hysteresis, heating/cooling branches, a rate-table triad."""
+    an acceleration network, turning-point hysteresis and table, heating/cooling branches, a bank of plays, a
+    rate-table triad."""
     adx = [
         simulate("adxrs450", profile=get_profile("cycle", set_points_degc=sp, cycles=1), rate_hz=1.0, seed=s).recording
         for s, sp in ((0, (-30, 85)), (1, (-20, 80)))
@@ -65,6 +66,8 @@ def models(runs, default_model):
             "acceleration network": fit_pipeline(runs, "mlp>mlp-accel"),
             "turning-point": fit(adx),
             "branches": fit(adx, FitOptions(hysteresis="branch")),
+            "turning-point table": fit(adx, FitOptions(hysteresis="turning-table")),
+            "bank of plays": fit(adx, FitOptions(hysteresis="play-bank")),
             "triad": fit(table + runs[:1]),
         }
 
@@ -78,7 +81,7 @@ def test_the_shipped_schema_is_the_builders():
 @pytest.mark.slow
 def test_every_kind_of_model_gyrocomp_writes_validates(models, tmp_path):
     validator = jsonschema.Draft202012Validator(_published())
-    kinds = {"polynomial": 0, "mlp": 0, "turning-point": 0, "branch": 0}
+    kinds = {"polynomial": 0, "mlp": 0, "turning-point": 0, "turning-table": 0, "branch": 0, "play-bank": 0}
     for name, cal in models.items():
         cal.save(tmp_path / "m.json")
         document = json.loads((tmp_path / "m.json").read_text())

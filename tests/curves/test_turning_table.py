@@ -5,7 +5,6 @@ polynomial in the distance from the turn) and judged at another ramp rate, throu
 line."""
 
 import json
-import math
 import warnings
 
 import numpy as np
@@ -21,9 +20,9 @@ from gyrocomp.curves.turning_table import (
 from gyrocomp.effects import find_turns
 from gyrocomp.errors import InputError
 from gyrocomp.measures.merit import smoothed_residual_rms
-from gyrocomp.recording import GYRO_AXES, Recording
 
 from ..conftest import assert_streaming_equals_batch, run
+from .conftest import part_run
 
 #: up 20 -> 80, down to 20, up to 50 degC in 0.1 degC steps
 PATH_DEGC = np.concatenate([np.linspace(20, 80, 601), np.linspace(79.9, 20, 600), np.linspace(20.1, 50, 300)])
@@ -76,34 +75,16 @@ def test_the_model_file_keeps_the_table_and_refuses_one_that_is_not():
         TurningTableCurve.from_dict({"type": "turning-table"})
 
 
-def _die_with_a_bump(set_points_degc, ramp_degc_per_min: float, seed: int, rate_hz: float = 1.0):
-    """A chamber through ``set_points_degc`` at ``ramp_degc_per_min`` (15-minute holds), the die behind it by 30 s,
-    and on each gyro axis a smooth curve of the die's temperature plus, after the maximum the die passes, a
-    Gaussian bump 15 degC below it (6 degC wide), white noise 0.005 deg/s/sqrt(Hz); the temperature reported in
-    1/16 degC. Returns (recording, noise alone [deg/s])."""
-    rng = np.random.default_rng(seed)
-    knots_t, knots_v = [0.0], [float(set_points_degc[0])]
-    for target in set_points_degc[1:]:
-        knots_t += [knots_t[-1] + 900.0, knots_t[-1] + 900.0 + abs(target - knots_v[-1]) / ramp_degc_per_min * 60]
-        knots_v += [knots_v[-1], float(target)]
-    knots_t.append(knots_t[-1] + 900.0)
-    knots_v.append(knots_v[-1])
-    t = np.arange(0.0, knots_t[-1], 1.0 / rate_hz)
-    chamber = np.interp(t, knots_t, knots_v)
-    a = math.exp(-1.0 / (30.0 * rate_hz))
-    die = np.empty_like(chamber)
-    die[0] = chamber[0]
-    for k in range(1, t.size):
-        die[k] = a * die[k - 1] + (1 - a) * chamber[k]
-    # each run passes one maximum: after it, once the die is 1 degC below it, the bump belongs to the way down
+def _bump_below_the_peak(die: np.ndarray) -> np.ndarray:
+    """Once the die is 1 degC below the hottest point it has passed (each run passes one), a Gaussian bump 15 degC
+    below it, 6 degC wide, of 0.05 deg/s."""
     peak = np.maximum.accumulate(die)
-    cooling = die < peak - 1.0
-    body = np.column_stack([g * np.tanh((die - 25.0) / 30.0) for g in (0.06, -0.04, 0.09)])
-    bump = np.where(cooling, np.exp(-0.5 * ((die - (peak - 15.0)) / 6.0) ** 2), 0.0)
-    noise = rng.standard_normal((t.size, 3)) * 0.005 * math.sqrt(rate_hz)
-    gyro = body + 0.05 * bump[:, None] * np.array([1.0, -0.6, 0.8]) + rng.normal(0.0, 0.02, 3) + noise
-    reported = np.round((die + rng.normal(0.0, 0.03, t.size)) * 16.0) / 16.0
-    return Recording(t, gyro, GYRO_AXES, reported, source=f"bump {seed}"), noise
+    return np.where(die < peak - 1.0, 0.05 * np.exp(-0.5 * ((die - (peak - 15.0)) / 6.0) ** 2), 0.0)
+
+
+def _die_with_a_bump(set_points_degc, ramp_degc_per_min: float, seed: int):
+    """A part with the bump (:func:`tests.curves.conftest.part_run`): (recording, noise alone [deg/s])."""
+    return part_run(set_points_degc, ramp_degc_per_min, seed, _bump_below_the_peak)
 
 
 def _drift(series: np.ndarray) -> float:

@@ -6,6 +6,7 @@ import pytest
 
 from gyrocomp.curves.hysteresis import BranchCurve, HysteresisCurve, branch_columns, turning_point_columns
 from gyrocomp.curves.polynomial import POLY_FAMILY
+from gyrocomp.curves.play_bank import play_bank_columns
 from gyrocomp.curves.turning_table import turning_table_columns
 from gyrocomp.effects import find_turns
 from gyrocomp.fitting.design import Terms, ThermalDesign
@@ -53,10 +54,11 @@ def test_each_block_of_a_design_is_where_its_layout_says():
         turning_table_knots_degc=((20.0, 40.0, 60.0), (30.0, 60.0)),
         branch_order=2,
         branch_widths_degc=(2.0, 6.0),
+        play_half_widths_degc=((1.0, 4.0, 16.0),),
     )
     x = design.columns(t, accel, every)
     at = design.layout(every)
-    assert x.shape == (t.size, design.width(every)) == (t.size, 3 + 5 + 2 * 4 + 2 * 3 + 2 * 2 + 2 * 2 + 3)
+    assert x.shape == (t.size, design.width(every)) == (t.size, 3 + 5 + 2 * 4 + 2 * 3 + 2 * 2 + 2 * 2 + 3 + 3)
     turns = find_turns(t, 0.3)
     np.testing.assert_array_equal(x[:, at[("shape", "table", 5)]], design.basis("table").columns(t, 5))
     np.testing.assert_array_equal(
@@ -66,6 +68,7 @@ def test_each_block_of_a_design_is_where_its_layout_says():
         x[:, at[("turning-table", (30.0, 60.0))]], turning_table_columns(t, turns, (30.0, 60.0))
     )
     np.testing.assert_array_equal(x[:, at[("branch", 6.0)]], branch_columns(t, turns, 6.0, 2, 25.0, 45.0))
+    np.testing.assert_array_equal(x[:, at[("play-bank", (1.0, 4.0, 16.0))]], play_bank_columns(t, (1.0, 4.0, 16.0))[0])
     np.testing.assert_array_equal(
         x[:, at[("acceleration",)]], np.column_stack([accel[:, 0], accel[:, 2], accel[:, 1] ** 2])
     )

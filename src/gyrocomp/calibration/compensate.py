@@ -8,7 +8,8 @@ import warnings
 import numpy as np
 
 from .calibration import Calibration
-from ..effects import estimate_turn_on_bias, find_turns, g_sensitivity_offset, temperature_rate, thermal_lag
+from ..curves.protocol import memory_offset
+from ..effects import estimate_turn_on_bias, g_sensitivity_offset, temperature_rate, thermal_lag
 from ..errors import DataQualityWarning, InputError, TemperatureRangeWarning, user_stacklevel
 from ..io.stream import CHUNK_ROWS
 from ..measures.plausibility import BlockMeans, ScaleAgreement, agreement_concern, recording_concerns, scale_agreement
@@ -144,9 +145,8 @@ class Compensator:
             self._warned = True
         error = np.asarray(ax.temperature.shape(t_model, accel_g if ax.temperature.needs_accel else None), dtype=float)
         if ax.hysteresis is not None:
-            turns = find_turns(t_model, ax.hysteresis.threshold_degc, state=self._turn_states.get(key))
-            self._turn_states[key] = turns.state
-            error = error + ax.hysteresis.offset(t_model, turns)
+            offset, self._turn_states[key] = memory_offset(ax.hysteresis, t_model, self._turn_states.get(key))
+            error = error + offset
         if ax.rate_term is not None:
             rate, self._rate_states[key] = temperature_rate(
                 time_s, t_model, ax.rate_term.smoothing_s, period_s=1.0 / self.rate_hz, state=self._rate_states.get(key)

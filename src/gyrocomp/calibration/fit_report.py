@@ -34,6 +34,8 @@ MEMORIES = (
     "turning-table+lag",
     "branch",
     "branch+lag",
+    "play-bank",
+    "play-bank+lag",
     "rate",
     "rate+lag",
 )
@@ -51,10 +53,15 @@ _TYPED = (
 )
 
 
-def memory_name(lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = False, table: int = 0) -> str:
+def memory_name(
+    lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = False, table: int = 0, plays: int = 0
+) -> str:
     """The thermal memory a model carries: ``none``, ``lag``, ``turning-point``, ``turning-point+lag``,
     ``turning-table`` (a table in the distance from the turn: ``table`` knots), ``turning-table+lag``, ``branch``
-    (heating and cooling curves), ``branch+lag``, ``rate`` (a temperature-rate term) or ``rate+lag``."""
+    (heating and cooling curves), ``branch+lag``, ``play-bank`` (``plays`` play operators), ``play-bank+lag``,
+    ``rate`` (a temperature-rate term) or ``rate+lag``."""
+    if plays:
+        return "play-bank+lag" if lag else "play-bank"
     if table:
         return "turning-table+lag" if lag else "turning-table"
     if rate:
@@ -68,12 +75,15 @@ def memory_name(lag: bool, hysteresis_order: int, branch: int = 0, rate: bool = 
 
 def memory_label(memory: str, hysteresis_order: int) -> str:
     """A thermal memory in the words the model file stores: ``turning-point (order 2)``, ``turning-table (8 knots)``,
-    ``lag``, ``none`` (``hysteresis_order``: a turning-point table's knots)."""
+    ``play-bank (8 plays)``, ``lag``, ``none`` (``hysteresis_order``: a turning-point table's knots, a bank's
+    plays)."""
     if not hysteresis_order:
         return memory
-    return memory + (
-        f" ({hysteresis_order} knots)" if memory.startswith("turning-table") else f" (order {hysteresis_order})"
-    )
+    if memory.startswith("turning-table"):
+        return f"{memory} ({hysteresis_order} knots)"
+    if memory.startswith("play-bank"):
+        return f"{memory} ({hysteresis_order} plays)"
+    return f"{memory} (order {hysteresis_order})"
 
 
 def _number(value) -> float | None:
@@ -107,18 +117,19 @@ class Candidate:
     curve: str = POLY_FAMILY
     rate: bool = False
     turning_table: int = 0
+    plays: int = 0
 
     @property
     def memory(self) -> str:
         """``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``turning-table``, ``turning-table+lag``,
-        ``branch``, ``branch+lag``, ``rate`` or ``rate+lag``."""
-        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate, self.turning_table)
+        ``branch``, ``branch+lag``, ``play-bank``, ``play-bank+lag``, ``rate`` or ``rate+lag``."""
+        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate, self.turning_table, self.plays)
 
     @property
     def complexity(self) -> int:
         """Number of shape terms: the order, the lag's time constant, two per hysteresis order, one for a band, the
         branch difference's terms and its crossover width, two for a rate term (its coefficient and smoothing), two per
-        knot of a turning-point table."""
+        knot of a turning-point table, one per play of a bank."""
         return (
             self.order
             + int(self.lag)
@@ -127,6 +138,7 @@ class Candidate:
             + (self.branch + 1 if self.branch else 0)
             + 2 * int(self.rate)
             + 2 * self.turning_table
+            + self.plays
         )
 
     @property
@@ -138,6 +150,7 @@ class Candidate:
             or self.branch > 0
             or self.rate
             or self.turning_table > 0
+            or self.plays > 0
         )
 
     @property
@@ -153,6 +166,8 @@ class Candidate:
             parts.append(f"turning-table:{self.turning_table}")
         if self.branch:
             parts.append(f"branch:{self.branch}")
+        if self.plays:
+            parts.append(f"play-bank:{self.plays}")
         if self.rate:
             parts.append("rate")
         return " + ".join(parts) + f" ({self.weighting})"
@@ -174,6 +189,8 @@ class Candidate:
             d["rate"] = True
         if self.turning_table:  # written only when set
             d["turning_table"] = self.turning_table
+        if self.plays:  # written only when set
+            d["plays"] = self.plays
         return d
 
     @classmethod
@@ -189,6 +206,7 @@ class Candidate:
             str(d.get("curve", POLY_FAMILY)),
             bool(d.get("rate", False)),
             int(d.get("turning_table", 0)),
+            int(d.get("plays", 0)),
         )
 
 

@@ -10,7 +10,7 @@ schema version (older files are upgraded first, then validated):
 - ranges a sensor model can have: rates within +-1e4 deg/s, accelerations within +-100 g, temperatures within
   -100..200 degC, a temperature scale of at least 0.01 degC, a lag of at most 1e6 s, sensitivities within +-10;
 - the units block, where present, is exactly gyrocomp's (deg/s, degC, s, g): a model is never read in other units;
-- each curve by its ``type`` (polynomial, mlp, table; turning-point, turning-table, branch); a curve registered beyond these is
+- each curve by its ``type`` (polynomial, mlp, table; turning-point, turning-table, play-bank, branch); a curve registered beyond these is
   left to its own reader (``from_dict``), which refuses an unknown type.
 
 What a schema cannot say (a range whose minimum is above its maximum, a network's weights against its layers, a
@@ -30,6 +30,7 @@ import jsonschema
 from jsonschema.exceptions import best_match
 
 from ..curves.network import NETWORK_INPUTS
+from ..curves.play_bank import MAX_PLAYS
 from ..curves.polynomial import EXTRAPOLATIONS
 from ..errors import InputError
 from ..recording import ACCEL_AXES, GYRO_AXES, TEMPERATURE_COLUMN
@@ -192,6 +193,13 @@ def _memory(u: str, value: dict) -> dict:
                 f"descending{u}": _array(value, lo=1, hi=MAX_TABLE),
                 f"ascending{u}": _array(value, lo=1, hi=MAX_TABLE),
                 "threshold_degc": threshold,
+            }
+        ),
+        "play-bank": _object(
+            {
+                "type": {"const": "play-bank"},
+                "half_widths_degc": _array(_number(0.0, 300.0, exclusive_lo=True), lo=1, hi=MAX_PLAYS),
+                f"weights{u}": _array(value, lo=1, hi=MAX_PLAYS),
             }
         ),
         "branch": _object(

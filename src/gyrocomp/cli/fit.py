@@ -60,8 +60,9 @@ from .render import print_contributions, print_fit
     show_default=True,
     help="The thermal memory: lag, turning-point hysteresis, a turning-point table (turning-table: a memory of any "
     "shape in the distance from the last turn, one after a maximum and one after a minimum), heating/cooling "
-    "branches or a temperature-rate term (rate: a bias in the smoothed dT/dt, a thermal gradient); auto compares "
-    "them by held-out drift when the runs both heat and cool (all but the turning-point table).",
+    "branches, a bank of plays (play-bank: backlash operators of several widths, a loop of any shape) or a "
+    "temperature-rate term (rate: a bias in the smoothed dT/dt, a thermal gradient); auto compares them by "
+    "held-out drift when the runs both heat and cool (all but the turning-point table and the bank of plays).",
 )
 @click.option(
     "--hysteresis-order",

@@ -9,6 +9,7 @@ from . import network  # noqa: F401
 from . import lookup  # noqa: F401
 from . import hysteresis  # noqa: F401  (memory curves)
 from . import turning_table  # noqa: F401
+from . import play_bank  # noqa: F401
 from .protocol import BASES, CURVES, MEMORY_CURVES, curve_from_dict
 
 __all__ = ["BASES", "CURVES", "MEMORY_CURVES", "curve_from_dict"]

@@ -17,6 +17,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
+from ..effects import find_turns
 from ..errors import InputError
 
 #: how far outside its calibration range a temperature model is still used without a warning: the larger of
@@ -188,6 +189,18 @@ class MemoryCurve(Protocol):
         ``s->turn[slot]`` (updated by them)."""
 
 
+def memory_offset(curve, temperature_degc: np.ndarray, state=None):
+    """A memory curve's offset [the axis's unit] along ``temperature_degc`` [degC] from ``state`` (None: the
+    recording's start), and the state after the last sample: the curve's own ``streamed_offset`` where it keeps a
+    state of its own (a bank of plays), else its offset given the turns found from the turn state
+    (:func:`gyrocomp.effects.find_turns`)."""
+    own = getattr(curve, "streamed_offset", None)
+    if own is not None:
+        return own(temperature_degc, state)
+    turns = find_turns(temperature_degc, curve.threshold_degc, state=state)
+    return curve.offset(temperature_degc, turns), turns.state
+
+
 #: every memory curve a model file may hold, by its ``kind``
 MEMORY_CURVES: dict[str, type] = {}
 
@@ -218,6 +231,7 @@ __all__ = [
     "TemperatureCurve",
     "curve_from_dict",
     "memory_curve_from_dict",
+    "memory_offset",
     "register_basis",
     "register_curve",
     "register_memory_curve",

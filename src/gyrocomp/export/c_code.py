@@ -31,6 +31,7 @@ import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
 from ..c_literals import c_array, c_number
+from ..curves.play_bank import MAX_PLAYS
 from ..errors import InputError
 from ..io.atomic import write_texts_atomic
 from .encode import c_comment
@@ -83,6 +84,8 @@ typedef struct gyrocomp_state {
     gyrocomp_lag lag[6];      /* gyro x, y, z, then accelerometer x, y, z */
     gyrocomp_lag rate[6];     /* the temperature-rate terms' smoothing filters, in the same order */
     gyrocomp_turn turn[6];
+    int play_started[6];      /* the banks of plays start centred on the first sample */
+    double play[6][{max_plays}];    /* each play's last output [degC] */
     double accel_out[3];      /* accelerations of the last step, compensated as modelled [g] */
 } gyrocomp_state;
 
@@ -185,6 +188,7 @@ def _init_code(codes: dict) -> list[str]:
         "    s->last_t = 0.0;",
         "    for (int j = 0; j < 3; ++j) s->accel_out[j] = 0.0;",
         "    for (int j = 0; j < 6; ++j) {",
+        "        s->play_started[j] = 0;",
         "        s->lag[j].started = 0; s->lag[j].last_input = 0.0; s->lag[j].last_output = 0.0;",
         "        s->rate[j].started = 0; s->rate[j].last_input = 0.0; s->rate[j].last_output = 0.0;",
         "        s->turn[j].direction = 0; s->turn[j].has_turn = 0; s->turn[j].extreme = 0.0;",
@@ -306,7 +310,9 @@ def c_sources(calibration: Calibration, *, rate_hz: float | None = None) -> dict
     ]
     body += _accel_step_code(calibration, accel_axes) + _gyro_step_code(calibration, axes) + ["}", ""]
     return {
-        "gyrocomp.h": _HEADER.replace("{model}", f"'{c_comment(calibration.model)}'"),
+        "gyrocomp.h": _HEADER.replace("{model}", f"'{c_comment(calibration.model)}'").replace(
+            "{max_plays}", str(MAX_PLAYS)
+        ),
         "gyrocomp.c": "\n".join(body),
     }
 

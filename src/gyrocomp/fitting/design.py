@@ -13,6 +13,8 @@ The blocks (:class:`Terms` names which a fit uses, in this order):
   (:func:`gyrocomp.curves.hysteresis.turning_point_columns`), one block per band (None: the whole range);
 - ``turning-table``: a table in the distance from the last turn, hat functions of d on cooling then heating
   branches (:func:`gyrocomp.curves.turning_table.turning_table_columns`), one block per set of knots;
+- ``play-bank``: plays of several half-widths, play_r(T) - T (:func:`gyrocomp.curves.play_bank.play_bank_columns`),
+  one block per set of half-widths;
 - ``branch``: heating and cooling curves crossing over after each turn, s(T) u^k
   (:func:`gyrocomp.curves.hysteresis.branch_columns`), one block per crossover width;
 - ``rate``: the smoothed rate of the model temperature [degC/s] (:func:`gyrocomp.curves.rate.rate_columns`), one
@@ -33,6 +35,7 @@ import numpy as np
 
 from ..curves.hysteresis import branch_columns, turning_point_columns
 from ..curves.protocol import BASES
+from ..curves.play_bank import play_bank_columns
 from ..curves.rate import rate_columns
 from ..curves.turning_table import turning_table_columns
 from ..effects import find_turns, g_squared_products
@@ -52,6 +55,8 @@ class Terms:
         One turning-point block per entry: limited to that band [degC], or over the whole range (None).
     turning_table_knots_degc : tuple of tuple of float
         One turning-point table block per set of knots [degC] (empty: none).
+    play_half_widths_degc : tuple of tuple of float
+        One bank-of-plays block per set of half-widths [degC] (empty: none).
     branch_order : int
         Terms of each branch block (0: none).
     branch_widths_degc : tuple of float
@@ -66,6 +71,7 @@ class Terms:
     turning_point_order: int = 0
     bands_degc: tuple[tuple[float, float] | None, ...] = (None,)
     turning_table_knots_degc: tuple[tuple[float, ...], ...] = ()
+    play_half_widths_degc: tuple[tuple[float, ...], ...] = ()
     branch_order: int = 0
     branch_widths_degc: tuple[float, ...] = ()
     rate_smoothings_s: tuple[float, ...] = ()
@@ -154,6 +160,7 @@ class ThermalDesign:
                     )
                     for w in terms.branch_widths_degc
                 ]
+        cols += [play_bank_columns(t, widths)[0] for widths in terms.play_half_widths_degc]
         if terms.rate_smoothings_s:
             if time_s is None:
                 raise ValueError("ThermalDesign.columns: rate terms need the samples' times (time_s)")
@@ -181,6 +188,8 @@ class ThermalDesign:
             take(("turning-table", knots), 2 * len(knots))
         for w in terms.branch_widths_degc if terms.branch_order else ():
             take(("branch", w), terms.branch_order)
+        for widths in terms.play_half_widths_degc:
+            take(("play-bank", widths), len(widths))
         for s in terms.rate_smoothings_s:
             take(("rate", s), 1)
         if terms.acceleration:

@@ -59,6 +59,7 @@ from .scores import CandidateScore
 from .branch_evidence import band_offer, branches_identified, branches_present, heats_and_cools_blocks
 from ..curves.hysteresis import turn_threshold_degc
 from ..curves.polynomial import POLY_FAMILY
+from ..curves.play_bank import play_half_widths_degc
 from ..curves.turning_table import largest_turn_distance_degc, turning_table_knots_degc
 from .grid_search import LAG_MAX_S, LAG_MIN_BLOCKS, lag_search_top_s
 from .thermal import SCORE_WINDOW_S
@@ -211,6 +212,8 @@ class SelectionProblem:
     #: the runs reach [degC] (the tables' last knot)
     turning_table_sizes: tuple[int, ...] = ()
     turn_reach_degc: float = 0.0
+    #: plays per bank of the bank-of-plays candidates (empty: none)
+    play_bank_sizes: tuple[int, ...] = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     @property
@@ -256,6 +259,7 @@ class SelectionProblem:
             turning_point_order=self.max_hysteresis,
             bands_degc=(None,) if self.band_degc is None else (None, self.band_degc),
             turning_table_knots_degc=tuple(self.table_knots_degc(m) for m in self.turning_table_sizes),
+            play_half_widths_degc=tuple(self.play_widths_degc(m) for m in self.play_bank_sizes),
             branch_order=self.max_branch,
             branch_widths_degc=FOLD_BRANCH_WIDTHS_DEGC if self.branch_orders else (),
             rate_smoothings_s=self.rate_smoothings_s,
@@ -264,6 +268,10 @@ class SelectionProblem:
     def table_knots_degc(self, size: int) -> tuple[float, ...]:
         """The knots [degC] of a turning-point table of ``size`` knots per branch, to the runs' reach."""
         return turning_table_knots_degc(self.turn_reach_degc, size)
+
+    def play_widths_degc(self, size: int) -> tuple[float, ...]:
+        """The half-widths [degC] of a bank of ``size`` plays over this axis's temperature span."""
+        return play_half_widths_degc(2.0 * self.t_scale_degc, self.threshold_degc, size)
 
     def columns(self, k: int, temp: np.ndarray, lagged: bool = False) -> np.ndarray:
         """Every column any candidate uses (:meth:`terms`) at model temperature ``temp`` [degC], and last the value
@@ -322,6 +330,9 @@ class SelectionProblem:
         if c.turning_table:
             table = at[("turning-table", self.table_knots_degc(c.turning_table))]
             idx += list(range(table.start, table.stop))
+        if c.plays:
+            bank = at[("play-bank", self.play_widths_degc(c.plays))]
+            idx += list(range(bank.start, bank.stop))
         if c.branch:
             first = at[("branch", FOLD_BRANCH_WIDTHS_DEGC[width])].start
             idx += [first + j for j in range(c.branch)]
@@ -519,7 +530,9 @@ class SelectionProblem:
             fc = (
                 c
                 if both[f]
-                else dataclasses.replace(c, branch=0, hysteresis_order=0, band=False, rate=False, turning_table=0)
+                else dataclasses.replace(
+                    c, branch=0, hysteresis_order=0, band=False, rate=False, turning_table=0, plays=0
+                )
             )
             widths = range(len(FOLD_BRANCH_WIDTHS_DEGC)) if fc.branch else (0,)
             smoothings = range(len(self.rate_smoothings_s)) if fc.rate else (0,)
@@ -583,6 +596,12 @@ class SelectionProblem:
                         if p > 0 and self.rate_smoothings_s and c not in out:
                             out.append(c)
                         continue
+                    if "play-bank" in mem:
+                        for m in self.play_bank_sizes if p > 0 else ():
+                            c = Candidate(p, lag, 0, w, plays=m)
+                            if c not in out:
+                                out.append(c)
+                        continue
                     if "turning-table" in mem:
                         for m in self.turning_table_sizes if p > 0 else ():
                             c = Candidate(p, lag, 0, w, turning_table=m)
@@ -643,6 +662,7 @@ def prepare_axis(
     other_curves: tuple[tuple[str, int], ...] = (),
     rate_smoothings_s: tuple[float, ...] = (),
     turning_table_sizes: tuple[int, ...] = (),
+    play_bank_sizes: tuple[int, ...] = (),
 ) -> SelectionProblem:
     """Block means, folds and window of one axis: the :class:`SelectionProblem` every candidate is scored on.
 
@@ -678,6 +698,8 @@ def prepare_axis(
         Smoothing time constants of the temperature-rate columns [s] (empty: no rate candidates).
     turning_table_sizes : tuple of int
         Knots per branch of the turning-point table candidates, offered where turning-point candidates are.
+    play_bank_sizes : tuple of int
+        Plays of the bank-of-plays candidates, offered where the runs both heat and cool.
     """
     temps = [rec.temperature_for(axis) for rec in recordings]
     lo = min(float(t.min()) for t in temps)
@@ -723,6 +745,7 @@ def prepare_axis(
         ramp_rates_degc_per_min=run_ramp_rates_degc_per_min(recordings),
         turning_table_sizes=tuple(turning_table_sizes) if reverses else (),
         turn_reach_degc=largest_turn_distance_degc([r.temperature_degc for r in runs], max(thresholds)),
+        play_bank_sizes=tuple(play_bank_sizes) if heats_and_cools_blocks(runs, thresholds) else (),
     )
 
 

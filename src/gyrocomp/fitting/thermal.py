@@ -46,6 +46,7 @@ from ..runs.prepared import one_temperature_column
 from .temperature_bins import bin_width_for
 from .learned_attributes import LearnedAttributes
 from ..curves.hysteresis import BranchCurve, HysteresisCurve, parting_band_degc, turn_threshold_degc
+from ..curves.play_bank import PLAY_BANK_SIZES, PlayBankCurve, play_half_widths_degc
 from ..curves.turning_table import (
     TURNING_TABLE_SIZES,
     TurningTableCurve,
@@ -64,13 +65,15 @@ HYSTERESIS_CHOICES = (
     "turning-table+lag",
     "branch",
     "branch+lag",
+    "play-bank",
+    "play-bank+lag",
     "rate",
     "rate+lag",
 )
-#: the memories the default compares, simplest first: every memory but the turning-point table, which is fitted
-#: where asked for (docs/how-the-fit-works.md says why); where the runs ramp at one rate a rate term counts as
+#: the memories the default compares, simplest first: every memory but the turning-point table and the bank of
+#: plays, which are fitted where asked for (docs/how-the-fit-works.md says why); where the runs ramp at one rate a rate term counts as
 #: more complex in the model choice (gyrocomp.fitting.selection.ONE_RATE_RATE_TERM_COST)
-CANDIDATES = tuple(c for c in HYSTERESIS_CHOICES[1:] if not c.startswith("turning-table"))
+CANDIDATES = tuple(c for c in HYSTERESIS_CHOICES[1:] if not c.startswith(("turning-table", "play-bank")))
 #: smoothing time constants the final fit tries for a temperature-rate term [s] (the middle of those the data
 #: cannot tell from the best: _Problem.best_smoothing); the model choice's folds try FOLD_RATE_SMOOTHINGS_S
 RATE_SMOOTHINGS_S = tuple(float(s) for s in np.geomspace(30.0, 3000.0, 11))
@@ -108,10 +111,12 @@ class _Spec:
     smoothing_s: float = 0.0
     #: knots per branch of a turning-point table (0: none)
     table: int = 0
+    #: plays of a bank of plays (0: none)
+    plays: int = 0
 
     @property
     def name(self) -> str:
-        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate, self.table)
+        return memory_name(self.lag, self.hysteresis_order, self.branch, self.rate, self.table, self.plays)
 
 
 @dataclass
@@ -164,10 +169,15 @@ class _Problem:
             turning_table_knots_degc=(turning_table_knots_degc(self.turn_reach_degc, spec.table),)
             if spec.table
             else (),
+            play_half_widths_degc=(self.play_widths_degc(spec.plays),) if spec.plays else (),
             branch_order=spec.branch,
             branch_widths_degc=(spec.width_degc,),
             rate_smoothings_s=(spec.smoothing_s,) if spec.rate else (),
         )
+
+    def play_widths_degc(self, size: int) -> tuple[float, ...]:
+        """The half-widths [degC] of a bank of ``size`` plays over the calibration span."""
+        return play_half_widths_degc(2.0 * self.t_scale, self.threshold, size)
 
     def features(self, run: RunBlocks, temp: np.ndarray, spec: _Spec, t_lo: float, t_hi: float) -> np.ndarray:
         """Columns of the shape and the hysteresis at model temperature ``temp`` [degC] (the curves applied as fitted
@@ -453,6 +463,9 @@ class ThermalHysteresisModel(LearnedAttributes):
         Knots per branch of a turning-point table (``turning-table``, ``turning-table+lag``;
         :class:`~gyrocomp.curves.turning_table.TurningTableCurve`), or chosen among
         :data:`~gyrocomp.curves.turning_table.TURNING_TABLE_SIZES` by the same validation; or one per axis.
+    play_bank_size : int or "auto" or dict
+        Plays of a bank of plays (``play-bank``, ``play-bank+lag``; :class:`~gyrocomp.curves.play_bank.PlayBankCurve`),
+        or chosen among :data:`~gyrocomp.curves.play_bank.PLAY_BANK_SIZES`; or one per axis.
     curve : str or dict
         The family of the temperature shape, a name of :data:`gyrocomp.curves.protocol.BASES` (``poly``,
         ``table``), ``order`` its size; or one per axis.
@@ -513,6 +526,7 @@ class ThermalHysteresisModel(LearnedAttributes):
     curve: str | dict[str, str] = POLY_FAMILY
     extended: bool = False
     turning_table_size: int | str | dict[str, int] = "auto"
+    play_bank_size: int | str | dict[str, int] = "auto"
 
     @staticmethod
     def _of(value, axis: str):
@@ -522,12 +536,17 @@ class ThermalHysteresisModel(LearnedAttributes):
         mode = self._of(self.hysteresis, axis)
         return list(CANDIDATES) if mode == "auto" else [mode]
 
-    def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "", table: int = 0) -> _Spec:
+    def _spec(self, name: str, order: int, hysteresis_order: int = 2, axis: str = "", size: int = 0) -> _Spec:
+        """The candidate ``name`` at polynomial ``order`` (``hysteresis_order``: a turning-point polynomial's; ``size``:
+        a turning-point table's knots or a bank's plays, 0 for 8 where the size is chosen)."""
         lag = name == "lag" or name.endswith("+lag")
         curve = self._of(self.curve, axis)
         if "turning-table" in name:
             fixed = self._of(self.turning_table_size, axis)
-            return _Spec(order, lag, 0, curve=curve, table=int(fixed) if fixed != "auto" else table or 8)
+            return _Spec(order, lag, 0, curve=curve, table=int(fixed) if fixed != "auto" else size or 8)
+        if "play-bank" in name:
+            fixed = self._of(self.play_bank_size, axis)
+            return _Spec(order, lag, 0, curve=curve, plays=int(fixed) if fixed != "auto" else size or 8)
         if "rate" in name:
             return _Spec(order, lag, 0, curve=curve, rate=True)
         if "branch" in name:
@@ -635,31 +654,45 @@ class ThermalHysteresisModel(LearnedAttributes):
                 if with_band < scores[name]:
                     scores[name], bands[name] = with_band, found
         chosen = self._pick(axis, scores, n_runs)
-        if "turning-point" in chosen and self.hysteresis_order == "auto" and self.selection_ != "fixed":
-            tried = {
-                p: (scores[chosen] if p == 2 else score(self._spec(chosen, order, p, axis)))
-                for p in range(1, MAX_HYSTERESIS_ORDER + 1)
-            }
-            pick = _simplest(tried, n_runs)
-            best_spec[chosen] = self._spec(chosen, order, pick, axis)
-            scores[chosen] = tried[pick]
-        if "turning-table" in chosen and self.turning_table_size == "auto" and self.selection_ != "fixed":
-            tried = {m: score(self._spec(chosen, order, axis=axis, table=m)) for m in TURNING_TABLE_SIZES}
-            pick = _simplest(tried, n_runs)
-            best_spec[chosen] = self._spec(chosen, order, axis=axis, table=pick)
-            scores[chosen] = tried[pick]
+        sized = self._sized(chosen, order, axis, score, scores[chosen], n_runs)
+        if sized is not None:
+            best_spec[chosen], scores[chosen] = sized
         problem.band = bands.get(chosen, band)
         spec = best_spec[chosen]
         if self.reselect_order and self.selection_ != "fixed" and (chosen != "none" or self.acceleration != "none"):
             # the binned polynomial's order was chosen with lag, hysteresis and g-sensitivity unmodelled,
             # which a higher order partly imitates; choose it again inside the winning candidate
             tried = {
-                o: score(_Spec(o, spec.lag, spec.hysteresis_order, rate=spec.rate, table=spec.table))
+                o: score(dataclasses.replace(spec, order=o, branch=0, width_degc=0.0, smoothing_s=0.0))
                 for o in range(1, self.max_order + 1)
             }
-            spec = _Spec(_simplest(tried, n_runs), spec.lag, spec.hysteresis_order, rate=spec.rate, table=spec.table)
+            spec = dataclasses.replace(spec, order=_simplest(tried, n_runs), branch=0, width_degc=0.0, smoothing_s=0.0)
             self.order_scores_[axis] = tried
         return _AxisChoice(problem, spec, chosen, scores)
+
+    def _sized(self, chosen: str, order: int, axis: str, score, scored: float, n_runs: int):
+        """The memory ``chosen`` at the size its validation picks where the size is not given (the turning-point
+        polynomial's order, scored as ``scored`` at order 2; a turning-point table's knots; a bank's plays), with
+        its score: (spec, score), or None where there is no size to choose."""
+        if self.selection_ == "fixed":
+            return None
+        if "turning-point" in chosen and self.hysteresis_order == "auto":
+            tried = {
+                p: scored if p == 2 else score(self._spec(chosen, order, p, axis))
+                for p in range(1, MAX_HYSTERESIS_ORDER + 1)
+            }
+            pick = _simplest(tried, n_runs)
+            return self._spec(chosen, order, pick, axis), tried[pick]
+        sizes = {
+            "turning-table": (TURNING_TABLE_SIZES, self.turning_table_size),
+            "play-bank": (PLAY_BANK_SIZES, self.play_bank_size),
+        }
+        family = next((sizes[f] for f in sizes if f in chosen), None)
+        if family is None or family[1] != "auto":
+            return None
+        tried = {m: score(self._spec(chosen, order, axis=axis, size=m)) for m in family[0]}
+        pick = _simplest(tried, n_runs)
+        return self._spec(chosen, order, axis=axis, size=pick), tried[pick]
 
     def _pick(self, axis: str, scores: dict[str, float], n_runs: int) -> str:
         if len(scores) == 1:
@@ -719,6 +752,10 @@ class ThermalHysteresisModel(LearnedAttributes):
                 tuple(float(v) for v in table[spec.table :]),
                 problem.threshold,
             )
+        if spec.plays:
+            widths = problem.play_widths_degc(spec.plays)
+            bank = coef[blocks[("play-bank", widths)]]
+            self.hysteresis_[axis] = PlayBankCurve(widths, tuple(float(v) for v in bank))
         if spec.branch:
             self.hysteresis_[axis] = BranchCurve(
                 tuple(float(v) for v in coef[blocks[("branch", spec.width_degc)]]),
@@ -734,7 +771,7 @@ class ThermalHysteresisModel(LearnedAttributes):
             self.rate_terms_[axis] = TemperatureRateTerm(float(rate), spec.smoothing_s)
         self.bands_[axis] = problem.band
         self.turn_on_biases_[axis] = consts
-        self.memories_[axis] = (choice.name, spec.branch or p or spec.table)
+        self.memories_[axis] = (choice.name, spec.branch or p or spec.table or spec.plays)
         self.scores_[axis] = choice.scores
         if self.acceleration != "none":
             self._store_acceleration(axis, problem, spec, tau, coef, blocks[("acceleration",)].start, n_runs)

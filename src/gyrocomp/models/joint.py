@@ -12,7 +12,7 @@ from typing import Literal
 import numpy as np
 
 from ..calibration import AxisCalibration, Calibration
-from ..effects import find_turns, g_sensitivity_offset, thermal_lag
+from ..effects import g_sensitivity_offset, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelChoiceWarning, user_stacklevel
 from ..calibration.fit_report import (
     THIN_FOLDS,
@@ -33,6 +33,8 @@ from ..fitting.provenance import provenance
 from ..fitting.temperature_bins import bin_width_for
 from ..curves.hysteresis import heats_and_cools
 from ..curves.network import NETWORK_BLOCK_S
+from ..curves.play_bank import PLAY_BANK_SIZES
+from ..curves.protocol import memory_offset
 from ..curves.turning_table import TURNING_TABLE_SIZES
 from ..fitting.network_model import NetworkTemperatureModel
 from ..fitting.folds import FOLD_KINDS
@@ -92,7 +94,7 @@ def _fit_network(
             temp, _ = thermal_lag(blocks.time_s, temp, lag_s, period_s=block_s)
         value = blocks.value
         if hysteresis is not None:
-            value = value - hysteresis.offset(temp, find_turns(temp, hysteresis.threshold_degc))
+            value = value - memory_offset(hysteresis, temp)[0]
         if g_row is not None:
             q = None if g_squared is None else np.asarray(g_squared)[None, :]
             value = value - g_sensitivity_offset(blocks.accel_g, np.asarray(g_row)[None, :], q)[:, 0]
@@ -167,7 +169,7 @@ def select_models(
         Polynomial orders to try (0: the run constant alone).
     memories : tuple of str
         Among ``none``, ``lag``, ``turning-point``, ``turning-point+lag``, ``turning-table``, ``turning-table+lag``,
-        ``branch``, ``branch+lag``, ``rate``, ``rate+lag``.
+        ``branch``, ``branch+lag``, ``play-bank``, ``play-bank+lag``, ``rate``, ``rate+lag``.
     hysteresis_orders : tuple of int
         Turning-point orders to try.
     acceleration : {"none", "matrix", "matrix2"}
@@ -202,6 +204,7 @@ def select_models(
         other_curves=other_curves,
         rate_smoothings_s=FOLD_RATE_SMOOTHINGS_S if any("rate" in m for m in memories) else (),
         turning_table_sizes=TURNING_TABLE_SIZES if any("turning-table" in m for m in memories) else (),
+        play_bank_sizes=PLAY_BANK_SIZES if any("play-bank" in m for m in memories) else (),
     )
     one_die = shared_lag and one_temperature_column(recordings)
     if one_die and any("lag" in m for m in memories):
@@ -406,6 +409,7 @@ def _fit_chosen(
         band_degc={a: selections[a].band_degc if c.band else None for a, c in chosen.items()},
         branch_order={a: c.branch for a, c in chosen.items()},
         turning_table_size={a: c.turning_table for a, c in chosen.items()},
+        play_bank_size={a: c.plays for a, c in chosen.items()},
         curve={a: c.curve for a, c in chosen.items()},
         bin_width_degc=options.bin_width_degc,
         acceleration=accel_mode,

@@ -31,6 +31,8 @@ Memory = Literal[
     "turning-table+lag",
     "branch",
     "branch+lag",
+    "play-bank",
+    "play-bank+lag",
     "rate",
     "rate+lag",
 ]
@@ -202,7 +204,9 @@ class FitOptions:
         Thermal lag and/or turning-point hysteresis, heating and cooling branches, or a temperature-rate term
         (``rate``, ``rate+lag``: a bias in the smoothed dT/dt, :mod:`gyrocomp.curves.rate`, fitted where asked
         for), or a table in the distance from the last turn (``turning-table``, ``turning-table+lag``: a memory of
-        any shape after a maximum and after a minimum, :mod:`gyrocomp.curves.turning_table`, fitted where asked for)
+        any shape after a maximum and after a minimum, :mod:`gyrocomp.curves.turning_table`), or a bank of play
+        (backlash) operators (``play-bank``, ``play-bank+lag``: a loop of any shape whose width grows with the
+        excursion, :mod:`gyrocomp.curves.play_bank`), both fitted where asked for
         (``auto``: chosen by held-out drift when the runs heat and cool).
     hysteresis_order : int or "auto"
         Order of the turning-point polynomial, 1..3.
@@ -260,11 +264,12 @@ class FitOptions:
                 "FitOptions.hysteresis: a network is trained without a temperature-rate term; use a polynomial "
                 "with hysteresis='rate' or 'rate+lag'"
             )
-        if isinstance(self.temperature, Network) and "turning-table" in self.hysteresis:
-            raise InputError(
-                "FitOptions.hysteresis: a network is trained without a turning-point table; use a polynomial "
-                "with hysteresis='turning-table' or 'turning-table+lag'"
-            )
+        for memory, what in (("turning-table", "a turning-point table"), ("play-bank", "a bank of plays")):
+            if isinstance(self.temperature, Network) and memory in self.hysteresis:
+                raise InputError(
+                    f"FitOptions.hysteresis: a network is trained without {what}; use a polynomial with "
+                    f"hysteresis='{memory}' or '{memory}+lag'"
+                )
         if self.bin_width_degc is not None and not (
             isinstance(self.bin_width_degc, (int, float)) and self.bin_width_degc > 0
         ):
