@@ -1,8 +1,8 @@
 """The turning-point table (issue #70, item 2: a memory of the last turn of any shape): its offset against the
 table read by hand, its columns times its values, the model file, the streaming compensator; fitted on runs
-written from the physics (a smooth bump in the die temperature below each maximum, behind a lag: no table and no
-polynomial in the distance from the turn) and judged at another ramp rate, through the library and the command
-line."""
+written from the physics (a smooth bump in the die temperature below its hottest point, the die behind the
+chamber: no table and no polynomial in the distance from the turn) and judged at another ramp rate, through the
+library and the command line."""
 
 import json
 import warnings
