@@ -238,7 +238,12 @@ def run_shape(name: str, shape: Shape, folder: Path, run) -> list[Call]:
     model = out / "m.json"
     fitted = classify("fit", run("fit", *runs, *unit, "-o", model))
     calls.append(fitted)
-    for family, args in (("rate+lag", ("--hysteresis", "rate+lag")), ("table", ("--temperature", "table"))):
+    for family, args in (
+        ("rate+lag", ("--hysteresis", "rate+lag")),
+        ("turning-table", ("--hysteresis", "turning-table")),
+        ("play-bank", ("--hysteresis", "play-bank")),
+        ("table", ("--temperature", "table")),
+    ):
         calls.append(classify(f"fit {family}", run("fit", *runs, *unit, *args, "-o", out / f"m-{family}.json")))
     state = out / "learner.json"
     learned = classify("learn", run("learn", *runs, *unit, "-o", out / "learned.json", "--save-state", state))

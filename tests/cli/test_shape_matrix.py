@@ -1,5 +1,6 @@
 """Every command on a sample of the shapes of input (tools/shape_matrix.py: runs written from the physics, each
-unit's runs through check, fit (the default, a rate term and a lookup table), learn and its resume, show, apply,
+unit's runs through check, fit (the default, a rate term, a turning-point table, a bank of plays and a lookup
+table), learn and its resume, show, apply,
 evaluate, validate, report, export, split, noise, allan, convert, fleet fit, show, report and certificate): each
 call succeeds with its invariant holding (apply equals the library's
 apply; a certificate names its unit and verdict) or refuses in one line, never an internal error. The whole matrix
@@ -27,6 +28,7 @@ def test_every_command_on_a_shape_succeeds_or_refuses_in_one_line(name, tmp_path
     if name != "constant temperature":  # a temperature model needs a temperature that varies
         assert by["fit"] == by["apply"] == by["fleet certificate"] == "ok", calls
         assert by["fit rate+lag"] == by["fit table"] == by["fleet show"] == by["fleet report"] == "ok", calls
+        assert by["fit turning-table"] == by["fit play-bank"] == "ok", calls
 
 
 def test_the_matrix_covers_thirty_shapes_of_every_kind_the_issue_names():
