@@ -4,10 +4,13 @@ is given as a function of the die's temperature path (none of it one of gyrocomp
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 
 import numpy as np
 
+from gyrocomp import apply
+from gyrocomp.measures.merit import smoothed_residual_rms
 from gyrocomp.recording import GYRO_AXES, Recording
 
 #: each axis's share of the memory (other sizes and signs, so that no one term of the three axes stands in for it)
@@ -50,3 +53,18 @@ def part_run(
     gyro = body + memory(die)[:, None] * MEMORY_SHARE + rng.normal(0.0, 0.02, 3) + noise
     reported = np.round((die + rng.normal(0.0, 0.03, t.size)) * 16.0) / 16.0
     return Recording(t, gyro, GYRO_AXES, reported, source=f"part {seed}"), noise
+
+
+def runs_at_two_rates(memory: Callable[[np.ndarray], np.ndarray]):
+    """Two heat-cool runs at 1 degC/min (-20..70 and -10..60 degC) of a part with ``memory``, and a third at 3
+    degC/min (-15..70) with its noise alone: ``(fit runs, (held-out run, noise [deg/s]))``."""
+    fit_runs = [part_run(sp, 1.0, s, memory)[0] for s, sp in ((0, (-20.0, 70.0, -20.0)), (1, (-10.0, 60.0, -10.0)))]
+    return fit_runs, part_run((-15.0, 70.0, -15.0), 3.0, 9, memory)
+
+
+def drift_over_noise(calibration, held: Recording, noise_dps: np.ndarray) -> list[float]:
+    """Per axis, the 60 s drift the calibration leaves on ``held`` (still: the true rate 0) over the noise's own."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = apply(calibration, held).gyro_dps
+    return [smoothed_residual_rms(out[:, j], 60) / smoothed_residual_rms(noise_dps[:, j], 60) for j in range(3)]

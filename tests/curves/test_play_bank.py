@@ -12,13 +12,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gyrocomp import Calibration, FitOptions, apply, fit
+from gyrocomp import Calibration, FitOptions, fit
 from gyrocomp.curves.play_bank import PlayBankCurve, play_bank_columns, play_half_widths_degc, play_operator
 from gyrocomp.errors import InputError
-from gyrocomp.measures.merit import smoothed_residual_rms
 
 from ..conftest import assert_streaming_equals_batch, run
-from .conftest import part_run
+from .conftest import drift_over_noise, runs_at_two_rates
 
 
 def _play_by_steps(x: np.ndarray, r: float, start: float) -> np.ndarray:
@@ -87,9 +86,8 @@ def _backlash(die: np.ndarray) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def backlash_runs():
-    """Two heat-cool runs at 1 degC/min, and a third at 3 degC/min with its noise alone."""
-    fit_runs = [part_run(sp, 1.0, s, _backlash)[0] for s, sp in ((0, (-20.0, 70.0, -20.0)), (1, (-10.0, 60.0, -10.0)))]
-    return fit_runs, part_run((-15.0, 70.0, -15.0), 3.0, 9, _backlash)
+    """Two heat-cool runs at 1 degC/min of a part with the backlash, and a third at 3 degC/min with its noise."""
+    return runs_at_two_rates(_backlash)
 
 
 def test_a_backlash_is_carried_to_another_ramp_rate(backlash_runs):
@@ -100,14 +98,9 @@ def test_a_backlash_is_carried_to_another_ramp_rate(backlash_runs):
         warnings.simplefilter("ignore")
         bank = fit(fit_runs, FitOptions(hysteresis="play-bank"))
         poly = fit(fit_runs, FitOptions(hysteresis="turning-point"))
-    for name, cal in (("bank", bank), ("poly", poly)):
-        out = apply(cal, held).gyro_dps
-        ratio = [smoothed_residual_rms(out[:, j], 60) / smoothed_residual_rms(noise[:, j], 60) for j in range(3)]
-        if name == "bank":
-            assert all(type(ax.hysteresis) is PlayBankCurve for ax in cal.axes.values())
-            assert max(ratio) < 1.35, ratio
-        else:
-            assert max(ratio) > 2.0, ratio
+    assert all(type(ax.hysteresis) is PlayBankCurve for ax in bank.axes.values())
+    assert max(drift_over_noise(bank, held, noise)) < 1.35, drift_over_noise(bank, held, noise)
+    assert max(drift_over_noise(poly, held, noise)) > 2.0, drift_over_noise(poly, held, noise)
 
 
 def test_the_bank_streams_as_it_applies_reads_back_and_shows(backlash_runs, tmp_path):

@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gyrocomp import Calibration, FitOptions, apply, fit
+from gyrocomp import Calibration, FitOptions, fit
 from gyrocomp.curves.turning_table import (
     TurningTableCurve,
     largest_turn_distance_degc,
@@ -19,10 +19,9 @@ from gyrocomp.curves.turning_table import (
 )
 from gyrocomp.effects import find_turns
 from gyrocomp.errors import InputError
-from gyrocomp.measures.merit import smoothed_residual_rms
 
 from ..conftest import assert_streaming_equals_batch, run
-from .conftest import part_run
+from .conftest import drift_over_noise, runs_at_two_rates
 
 #: up 20 -> 80, down to 20, up to 50 degC in 0.1 degC steps
 PATH_DEGC = np.concatenate([np.linspace(20, 80, 601), np.linspace(79.9, 20, 600), np.linspace(20.1, 50, 300)])
@@ -82,20 +81,10 @@ def _bump_below_the_peak(die: np.ndarray) -> np.ndarray:
     return np.where(die < peak - 1.0, 0.05 * np.exp(-0.5 * ((die - (peak - 15.0)) / 6.0) ** 2), 0.0)
 
 
-def _die_with_a_bump(set_points_degc, ramp_degc_per_min: float, seed: int):
-    """A part with the bump (:func:`tests.curves.conftest.part_run`): (recording, noise alone [deg/s])."""
-    return part_run(set_points_degc, ramp_degc_per_min, seed, _bump_below_the_peak)
-
-
-def _drift(series: np.ndarray) -> float:
-    return smoothed_residual_rms(series, 60)
-
-
 @pytest.fixture(scope="module")
 def bump_runs():
-    """Two heat-cool runs at 1 degC/min, and a third at 3 degC/min with its noise alone."""
-    fit_runs = [_die_with_a_bump(sp, 1.0, s)[0] for s, sp in ((0, (-20.0, 70.0, -20.0)), (1, (-10.0, 60.0, -10.0)))]
-    return fit_runs, _die_with_a_bump((-15.0, 70.0, -15.0), 3.0, 9)
+    """Two heat-cool runs at 1 degC/min of a part with the bump, and a third at 3 degC/min with its noise alone."""
+    return runs_at_two_rates(_bump_below_the_peak)
 
 
 def test_a_bump_below_the_hottest_point_is_carried_to_another_ramp_rate(bump_runs):
@@ -106,14 +95,9 @@ def test_a_bump_below_the_hottest_point_is_carried_to_another_ramp_rate(bump_run
         warnings.simplefilter("ignore")
         table = fit(fit_runs, FitOptions(hysteresis="turning-table"))
         poly = fit(fit_runs, FitOptions(hysteresis="turning-point"))
-    for name, cal in (("table", table), ("poly", poly)):
-        out = apply(cal, held).gyro_dps
-        ratio = [_drift(out[:, j]) / _drift(noise[:, j]) for j in range(3)]
-        if name == "table":
-            assert all(type(ax.hysteresis) is TurningTableCurve for ax in cal.axes.values())
-            assert max(ratio) < 1.35, ratio
-        else:
-            assert max(ratio) > 2.0, ratio
+    assert all(type(ax.hysteresis) is TurningTableCurve for ax in table.axes.values())
+    assert max(drift_over_noise(table, held, noise)) < 1.35, drift_over_noise(table, held, noise)
+    assert max(drift_over_noise(poly, held, noise)) > 2.0, drift_over_noise(poly, held, noise)
 
 
 def test_the_table_streams_as_it_applies_and_its_model_file_reads_back(bump_runs, tmp_path):

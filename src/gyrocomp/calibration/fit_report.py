@@ -24,11 +24,12 @@ from ..curves.polynomial import POLY_FAMILY
 from ..measures.ramp_rate import ramp_rates_separate, separation_sentence
 from ..units import AxisUnit, in_unit, unit_suffix
 
-#: the thermal memories a gyro axis's model may carry
+#: the thermal memories a gyro axis's model may carry, simplest first (the order the model choice takes as
+#: simplest when two score alike: gyrocomp.fitting.thermal.CANDIDATES)
 MEMORIES = (
     "none",
-    "lag",
     "turning-point",
+    "lag",
     "turning-point+lag",
     "turning-table",
     "turning-table+lag",

@@ -165,6 +165,19 @@ class HysteresisCurve:
         )
 
 
+def distance_from_turn(
+    temperature_degc: np.ndarray, turns, band_degc: tuple[float, float] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where a memory of the last turn acts (after the first confirmed reversal, inside ``band_degc`` [degC] if
+    given) and the distance d = |T - T_turn| there [degC] (0 elsewhere), ``turns`` from
+    :func:`gyrocomp.effects.find_turns` on ``temperature_degc``."""
+    t = np.asarray(temperature_degc, dtype=float)
+    active = ~np.isnan(turns.turn_degc)
+    if band_degc is not None:
+        active &= (t >= band_degc[0]) & (t <= band_degc[1])
+    return active, np.where(active, np.abs(t - np.where(active, turns.turn_degc, 0.0)), 0.0)
+
+
 def turning_point_columns(
     temperature_degc: np.ndarray,
     turns,
@@ -196,12 +209,8 @@ def turning_point_columns(
     -------
     array (n, 2 order)
     """
-    t = np.asarray(temperature_degc, dtype=float)
-    active = ~np.isnan(turns.turn_degc)
-    if band_degc is not None:
-        active &= (t >= band_degc[0]) & (t <= band_degc[1])
-    d = np.where(active, np.abs(t - np.where(active, turns.turn_degc, 0.0)), 0.0) / scale_degc
-    powers = power_columns(d, 1, order)
+    active, d = distance_from_turn(temperature_degc, turns, band_degc)
+    powers = power_columns(d / scale_degc, 1, order)
     return np.hstack([np.where((active & (turns.direction == sign))[:, None], powers, 0.0) for sign in (-1, 1)])
 
 
@@ -315,6 +324,7 @@ __all__ = [
     "HysteresisCurve",
     "MEMORY_CURVES",
     "branch_columns",
+    "distance_from_turn",
     "heats_and_cools",
     "memory_curve_from_dict",
     "parting_band_degc",

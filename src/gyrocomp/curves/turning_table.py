@@ -24,6 +24,7 @@ import numpy as np
 from ..c_literals import c_array, c_number
 from ..effects import find_turns
 from ..errors import InputError
+from .hysteresis import distance_from_turn
 from .protocol import CCode, register_memory_curve
 
 #: knots per branch the default's model choice tries (each costs two values: one after a maximum, one after a
@@ -84,9 +85,7 @@ def turning_table_columns(temperature_degc: np.ndarray, turns, knots_degc: tuple
     -------
     array (n, 2 m)
     """
-    t = np.asarray(temperature_degc, dtype=float)
-    active = ~np.isnan(turns.turn_degc)
-    d = np.where(active, np.abs(t - np.where(active, turns.turn_degc, 0.0)), 0.0)
+    active, d = distance_from_turn(temperature_degc, turns)
     hats = _hats(d, knots_degc)
     return np.hstack([np.where((active & (turns.direction == sign))[:, None], hats, 0.0) for sign in (-1, 1)])
 

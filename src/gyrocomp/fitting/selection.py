@@ -596,21 +596,11 @@ class SelectionProblem:
                         if p > 0 and self.rate_smoothings_s and c not in out:
                             out.append(c)
                         continue
-                    if "play-bank" in mem:
-                        for m in self.play_bank_sizes if p > 0 else ():
-                            c = Candidate(p, lag, 0, w, plays=m)
-                            if c not in out:
-                                out.append(c)
-                        continue
-                    if "turning-table" in mem:
-                        for m in self.turning_table_sizes if p > 0 else ():
-                            c = Candidate(p, lag, 0, w, turning_table=m)
-                            if c not in out:
-                                out.append(c)
-                        continue
-                    if "branch" in mem:
-                        for b in self.branch_orders if p > 0 else ():
-                            c = Candidate(p, lag, 0, w, False, b)
+                    sized = next((k for k in self._sized_memories() if k in mem), None)
+                    if sized is not None:  # a memory of one size per candidate: the sizes offered, with a curve
+                        field_name, sizes = self._sized_memories()[sized]
+                        for m in sizes if p > 0 else ():
+                            c = Candidate(p, lag, 0, w, **{field_name: m})
                             if c not in out:
                                 out.append(c)
                         continue
@@ -629,6 +619,14 @@ class SelectionProblem:
                             if c not in out:
                                 out.append(c)
         return out
+
+    def _sized_memories(self) -> dict[str, tuple[str, tuple[int, ...]]]:
+        """The memories with a size of their own: name to (the candidate's field, the sizes offered)."""
+        return {
+            "play-bank": ("plays", self.play_bank_sizes),
+            "turning-table": ("turning_table", self.turning_table_sizes),
+            "branch": ("branch", self.branch_orders),
+        }
 
     @property
     def rates_separate(self) -> bool:

@@ -36,7 +36,7 @@ from ..curves.polynomial import POLY_FAMILY
 from ..curves.rate import TemperatureRateTerm
 from ..effects import find_turns, thermal_lag
 from ..errors import DataQualityWarning, InputError, ModelError, user_stacklevel
-from ..calibration.fit_report import memory_name
+from ..calibration.fit_report import MEMORIES, memory_name
 from ..recording import Recording
 from .design import Terms, ThermalDesign
 from .grid_search import LAG_MIN_BLOCKS, best_lag_s, lag_search_top_s, plausible_middle
@@ -55,21 +55,8 @@ from ..curves.turning_table import (
 )
 from .polynomial_model import simplest_within
 
-HYSTERESIS_CHOICES = (
-    "auto",
-    "none",
-    "turning-point",
-    "lag",
-    "turning-point+lag",
-    "turning-table",
-    "turning-table+lag",
-    "branch",
-    "branch+lag",
-    "play-bank",
-    "play-bank+lag",
-    "rate",
-    "rate+lag",
-)
+#: what ``hysteresis`` may ask for: a memory, or ``auto`` (the data's choice among CANDIDATES)
+HYSTERESIS_CHOICES = ("auto", *MEMORIES)
 #: the memories the default compares, simplest first: every memory but the turning-point table and the bank of
 #: plays, which are fitted where asked for (docs/how-the-fit-works.md says why); where the runs ramp at one rate a rate term counts as
 #: more complex in the model choice (gyrocomp.fitting.selection.ONE_RATE_RATE_TERM_COST)
