@@ -585,6 +585,7 @@ class SelectionProblem:
         self, orders: tuple[int, ...], memories: tuple[str, ...], weightings: tuple[Weighting, ...] = WEIGHTINGS
     ) -> list[Candidate]:
         out = []
+        sized_memories = self._sized_memories()
         for w in weightings:
             if "none" in memories:  # the other families: no lag, no hysteresis
                 out += [Candidate(size, False, 0, w, curve=name) for name, size in self.other_curves]
@@ -596,9 +597,9 @@ class SelectionProblem:
                         if p > 0 and self.rate_smoothings_s and c not in out:
                             out.append(c)
                         continue
-                    sized = next((k for k in self._sized_memories() if k in mem), None)
+                    sized = next((k for k in sized_memories if k in mem), None)
                     if sized is not None:  # a memory of one size per candidate: the sizes offered, with a curve
-                        field_name, sizes = self._sized_memories()[sized]
+                        field_name, sizes = sized_memories[sized]
                         for m in sizes if p > 0 else ():
                             c = Candidate(p, lag, 0, w, **{field_name: m})
                             if c not in out:
@@ -712,6 +713,8 @@ def prepare_axis(
     folds = make_folds(runs, groups, thresholds, fold_kind)
     step = max(p.of_temperature(axis, "step", temperature_step_degc) for p in prepared)
     reverses = branches_identified(runs, thresholds) if both_directions else branches_present(runs, thresholds)
+    heats_and_cools = heats_and_cools_blocks(runs, thresholds)
+    tables = tuple(turning_table_sizes) if reverses else ()
     t_ref, t_scale = (lo + hi) / 2, (hi - lo) / 2 if hi > lo else 1.0
     band, band_only = (
         band_offer(
@@ -737,13 +740,16 @@ def prepare_axis(
         band,
         unit=recordings[0].unit_of(axis),
         band_only=band_only,
-        branch_orders=branch_orders if heats_and_cools_blocks(runs, thresholds) else (),
+        branch_orders=branch_orders if heats_and_cools else (),
         other_curves=tuple(other_curves),
         rate_smoothings_s=tuple(rate_smoothings_s),
         ramp_rates_degc_per_min=run_ramp_rates_degc_per_min(recordings),
-        turning_table_sizes=tuple(turning_table_sizes) if reverses else (),
-        turn_reach_degc=largest_turn_distance_degc([r.temperature_degc for r in runs], max(thresholds)),
-        play_bank_sizes=tuple(play_bank_sizes) if heats_and_cools_blocks(runs, thresholds) else (),
+        turning_table_sizes=tables,
+        # the turns' reach only where a table is offered: every other fit goes without it
+        turn_reach_degc=largest_turn_distance_degc([r.temperature_degc for r in runs], max(thresholds))
+        if tables
+        else 0.0,
+        play_bank_sizes=tuple(play_bank_sizes) if heats_and_cools else (),
     )
 
 

@@ -25,6 +25,7 @@ default's choice is made on held-out folds (:mod:`gyrocomp.fitting.selection`) a
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import warnings
 from collections.abc import Callable
@@ -118,8 +119,6 @@ class _Problem:
     square_cols: tuple[int, ...] = ()
     #: a polynomial continues along its tangent past its range (as the model choice scored it), else is held
     extended: bool = False
-    #: the largest distance from a turn the runs reach [degC] (a turning-point table's last knot)
-    turn_reach_degc: float = 0.0
     _lagged: dict = dataclasses.field(default_factory=dict, repr=False)
     _solved: dict = dataclasses.field(default_factory=dict, repr=False)
 
@@ -153,14 +152,21 @@ class _Problem:
             shapes=((spec.curve, spec.order),),
             turning_point_order=spec.hysteresis_order,
             bands_degc=(self.band,),
-            turning_table_knots_degc=(turning_table_knots_degc(self.turn_reach_degc, spec.table),)
-            if spec.table
-            else (),
+            turning_table_knots_degc=(self.table_knots_degc(spec.table),) if spec.table else (),
             play_half_widths_degc=(self.play_widths_degc(spec.plays),) if spec.plays else (),
             branch_order=spec.branch,
             branch_widths_degc=(spec.width_degc,),
             rate_smoothings_s=(spec.smoothing_s,) if spec.rate else (),
         )
+
+    @functools.cached_property
+    def turn_reach_degc(self) -> float:
+        """The largest distance from a turn the runs reach [degC] (a turning-point table's last knot)."""
+        return largest_turn_distance_degc([r.temperature_degc for r in self.runs], self.threshold)
+
+    def table_knots_degc(self, size: int) -> tuple[float, ...]:
+        """The knots [degC] of a turning-point table of ``size`` knots per branch, to the runs' reach."""
+        return turning_table_knots_degc(self.turn_reach_degc, size)
 
     def play_widths_degc(self, size: int) -> tuple[float, ...]:
         """The half-widths [degC] of a bank of ``size`` plays over the calibration span."""
@@ -612,7 +618,6 @@ class ThermalHysteresisModel(LearnedAttributes):
             accel_cols,
             square_cols,
             self.extended,
-            largest_turn_distance_degc([r.temperature_degc for r in runs], threshold),
         )
 
     def _choose(self, axis: str, recordings: list[Recording], pieces, first: bool) -> _AxisChoice:
@@ -732,9 +737,10 @@ class ThermalHysteresisModel(LearnedAttributes):
                 problem.branch_reach(spec, tau),
             )
         if spec.table:
-            table = coef[blocks[("turning-table", problem.terms(spec).turning_table_knots_degc[0])]]
+            knots = problem.table_knots_degc(spec.table)
+            table = coef[blocks[("turning-table", knots)]]
             self.hysteresis_[axis] = TurningTableCurve(
-                problem.terms(spec).turning_table_knots_degc[0],
+                knots,
                 tuple(float(v) for v in table[: spec.table]),
                 tuple(float(v) for v in table[spec.table :]),
                 problem.threshold,
