@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from gyrocomp.calibration import Calibration
-from gyrocomp.calibration.fit_report import MEMORIES, AxisFit, FitReport, MemoryChoice
+from gyrocomp.calibration.candidate import MEMORIES
+from gyrocomp.calibration.fit_report import AxisFit, FitReport, MemoryChoice
 from gyrocomp.models.options import FitOptions, Network, Polynomial
 from gyrocomp.models.joint import fit_calibration
 from gyrocomp.models.pipelines import fit_pipeline

@@ -1,6 +1,6 @@
 """The rule that chooses among held-out scores (gyrocomp.fitting.scores): one standard error, do no harm."""
 
-from gyrocomp.calibration.fit_report import Candidate
+from gyrocomp.calibration.candidate import Candidate
 from gyrocomp.fitting.scores import CandidateScore, beats_constant, choose
 
 

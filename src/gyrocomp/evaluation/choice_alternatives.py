@@ -12,7 +12,7 @@ import numpy as np
 
 from ..calibration.calibration import Calibration
 from ..calibration.compensate import predict_error
-from ..calibration.fit_report import Candidate
+from ..calibration.candidate import Candidate
 from ..curves.polynomial import POLY_FAMILY
 from ..errors import GyrocompError
 from ..models.fit import fit

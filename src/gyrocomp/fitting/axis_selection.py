@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..calibration.fit_report import BranchTest, Candidate, OrderTest
+from ..calibration.candidate import Candidate
+from ..calibration.fit_report import BranchTest, OrderTest
 from ..measures.ramp_rate import ramp_rates_separate
 from ..units import AxisUnit, in_unit, unit_suffix
 from .folds import FoldKind

@@ -20,7 +20,8 @@ from .order_evidence import CoarseRuns, run_constants
 from ..curves.hysteresis import parting_band_degc
 from ..curves.polynomial import power_columns
 from .grid_search import LAG_MAX_S, plausible_middle
-from .thermal import BRANCH_WIDTHS_DEGC, MAX_BRANCH_ORDER, SCORE_WINDOW_S
+from .thermal import MAX_BRANCH_ORDER
+from .thermal_problem import BRANCH_WIDTHS_DEGC, SCORE_WINDOW_S
 
 
 def heats_and_cools_blocks(runs: list[RunBlocks], thresholds: list[float]) -> bool:

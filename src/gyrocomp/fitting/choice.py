@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..curves.polynomial import POLY_FAMILY
-from ..calibration.fit_report import BranchTest, Candidate, OrderTest, Weighting
+from ..calibration.candidate import Candidate, Weighting
+from ..calibration.fit_report import BranchTest, OrderTest
 from ..errors import InputError
 from .branch_evidence import branch_test
 from .order_evidence import order_test

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..curves.polynomial import POLY_FAMILY
-from ..calibration.fit_report import Candidate
+from ..calibration.candidate import Candidate
 from ..units import AxisUnit, unit_suffix
 
 

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..effects import find_turns, thermal_lag
-from ..calibration.fit_report import Candidate, Weighting
+from ..calibration.candidate import Candidate, Weighting
 from ..measures.merit import moving_average
 from ..measures.ramp_rate import ramp_rates_separate, run_ramp_rates_degc_per_min
 from ..runs.prepared import PreparedRun, RunBlocks
@@ -62,15 +62,15 @@ from ..curves.polynomial import POLY_FAMILY
 from ..curves.play_bank import play_half_widths_degc
 from ..curves.turning_table import largest_turn_distance_degc, turning_table_knots_degc
 from .grid_search import LAG_MAX_S, LAG_MIN_BLOCKS, lag_search_top_s
-from .thermal import SCORE_WINDOW_S
+from .thermal_problem import SCORE_WINDOW_S
 
 WEIGHTINGS: tuple[Weighting, ...] = ("time", "temperature-balanced")
 #: crossover widths of the branch candidates in each fold [degC] (each fold takes the one of least training
 #: residual; each width is a block of columns at every lag of the grid, so the folds try three, and the final
-#: fit refines the width of the chosen model on the finer grid of gyrocomp.fitting.thermal.BRANCH_WIDTHS_DEGC)
+#: fit refines the width of the chosen model on the finer grid of gyrocomp.fitting.thermal_problem.BRANCH_WIDTHS_DEGC)
 FOLD_BRANCH_WIDTHS_DEGC = (2.0, 6.0, 18.0)
 #: smoothing time constants of the temperature-rate candidates in each fold [s] (each fold takes the one of least
-#: training residual; the final fit refines it on gyrocomp.fitting.thermal.RATE_SMOOTHINGS_S)
+#: training residual; the final fit refines it on gyrocomp.fitting.thermal_problem.RATE_SMOOTHINGS_S)
 FOLD_RATE_SMOOTHINGS_S = (60.0, 300.0, 1500.0)
 #: what a rate term adds to its complexity where the runs ramp at one rate: there its heating-cooling difference
 #: is also a memory of the turn's (a branch), and the two part at another rate, in opposite directions; so a
@@ -512,7 +512,7 @@ class SelectionProblem:
 
     @property
     def short_window_s(self) -> float:
-        """The short window of the score [s]: :data:`gyrocomp.fitting.thermal.SCORE_WINDOW_S` (the timescale of the
+        """The short window of the score [s]: :data:`gyrocomp.fitting.thermal_problem.SCORE_WINDOW_S` (the timescale of the
         thesis's bias offset), at most the score's window and at least a block."""
         return max(self.block_s, min(SCORE_WINDOW_S, self.window_s))
 
