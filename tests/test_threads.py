@@ -93,3 +93,50 @@ def test_every_fit_entry_point_fits_with_blas_on_one_thread(monkeypatch, module,
     with threadpool_limits(2, user_api="blas"), pytest.raises(InputError, match="stopped here"):
         getattr(module, entry)([])
     assert seen and set(seen) == {1}
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="one core: BLAS runs one thread anyway")
+@pytest.mark.parametrize("setting, expected", [(None, 1), ("2", 2)])
+def test_a_command_runs_blas_on_one_thread_unless_the_environment_says_otherwise(setting, expected):
+    """The console script, in a new interpreter: what its command runs sees one BLAS thread (its many small
+    solves' threads would wait for each other on a shared machine), or the number the environment sets."""
+    code = """
+import sys
+import gyrocomp.cli.entry_point as entry
+from gyrocomp.cli import main
+
+def look(*args, **kwargs):
+    from gyrocomp.threads import blas_threads
+    print(blas_threads())
+    return 0
+
+entry.cli.main = look
+sys.argv = ["gyrocomp", "--help"]
+sys.exit(main())
+"""
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+    }
+    if setting is not None:
+        env["OPENBLAS_NUM_THREADS"] = setting
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
+    assert out.stdout.split() == [str(expected)], out
+
+
+@pytest.mark.parametrize("entry", ["plan", "forecast_drift"])
+def test_the_planning_entry_points_run_blas_on_one_thread(monkeypatch, entry):
+    """The forecast's many small decompositions (SVD, Cholesky) run on one BLAS thread whichever entry point."""
+    from gyrocomp.evaluation import drift_forecast, run_advice
+
+    seen = []
+
+    def information(calibration, recordings, window_s):  # the first step of both: note the setting, then stop
+        seen.append(blas_threads())
+        raise InputError("stopped here")
+
+    monkeypatch.setattr(run_advice, "axis_information", information)
+    monkeypatch.setattr(drift_forecast, "axis_information", information)
+    function = run_advice.plan if entry == "plan" else drift_forecast.forecast_drift
+    with threadpool_limits(2, user_api="blas"), pytest.raises(InputError, match="stopped here"):
+        function(None, [], drift_forecast.UseProfile.cycle(10, 60, 1.0))
+    assert seen == [1]

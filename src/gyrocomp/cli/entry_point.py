@@ -415,11 +415,23 @@ def _exit_on_termination() -> None:
 MIN_ADDRESS_SPACE_BYTES = 1 << 30
 
 
+#: the environment variables that size the numeric libraries' thread pools when they load
+THREAD_POOL_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def one_thread_per_pool() -> None:
+    """Keep the numeric libraries' thread pools to one thread each, before they load; settings already in the
+    environment are kept. A command's algebra is many small solves, whose BLAS threads (one per core) wait for
+    each other on a machine another job shares; under an address-space limit OpenBLAS reserves tens of MB per
+    thread, and a pool that cannot start its threads fails to load or waits for ever."""
+    for name in THREAD_POOL_VARIABLES:
+        os.environ.setdefault(name, "1")
+
+
 def _within_address_limit() -> None:
-    """Under an address-space limit (``ulimit -v``), the numeric libraries' thread pools are kept to one thread
-    each before they load: OpenBLAS reserves tens of MB per thread, and a pool that cannot start its threads
-    fails to load or waits for ever; pyarrow's allocator is the system's, whose failures it reports instead of
-    aborting. Settings already in the environment are kept."""
+    """Under an address-space limit (``ulimit -v``): refuse one too small to load the numeric libraries, and use
+    the system's allocator for pyarrow, whose failures it reports instead of aborting (settings already in the
+    environment kept)."""
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
         return
@@ -428,8 +440,6 @@ def _within_address_limit() -> None:
             f"this process may map {soft / 1e6:.0f} MB (ulimit -v); gyrocomp needs at least "
             f"{MIN_ADDRESS_SPACE_BYTES / 1e9:.0f} GB to load its numeric libraries: raise the limit"
         )
-    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(name, "1")
     os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
 
 
@@ -468,6 +478,7 @@ def main(argv: list[str] | None = None) -> int:
     warnings.showwarning = _show_warning
     try:
         if argv is None:
+            one_thread_per_pool()
             _within_address_limit()
         result = cli.main(args=args, prog_name="gyrocomp", standalone_mode=False)
         status = result if isinstance(result, int) else 0

@@ -54,6 +54,7 @@ from ..measures.merit import smoothed_about_mean
 from ..measures.ramp_rate import ramp_rate_degc_per_min, typical_ramp_degc_per_min
 from ..recording import Recording
 from ..simulation.profiles import Profile
+from ..threads import single_threaded_blas
 from .choice_alternatives import Alternative, choice_alternatives, close_candidates, predicted
 
 #: the moving-average window the accuracy page scores the held-out drift with [s]
@@ -722,6 +723,7 @@ def axis_information(
     return infos
 
 
+@single_threaded_blas
 def forecast_drift(
     calibration: Calibration,
     recordings: Sequence[Recording],

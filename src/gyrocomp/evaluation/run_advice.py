@@ -22,6 +22,7 @@ from ..calibration.calibration import Calibration
 from ..errors import InputError
 from ..measures.ramp_rate import ramp_rate_degc_per_min
 from ..recording import Recording
+from ..threads import single_threaded_blas
 from .choice_alternatives import choice_alternatives, close_candidates
 from .drift_forecast import (
     DEFAULT_WINDOW_S,
@@ -307,6 +308,7 @@ def _within(
     return tuple(chosen)
 
 
+@single_threaded_blas
 def plan(
     calibration: Calibration,
     recordings: Sequence[Recording],
