@@ -23,13 +23,24 @@ import weakref
 from html.parser import HTMLParser
 from pathlib import Path
 
-import numpy as np
-import pytest
+#: ``make test`` runs two processes on two cores: each holds the numeric libraries to one thread, as a command of
+#: gyrocomp does (``cli.entry_point.one_thread_per_pool``), and so do the commands and interpreters they start
+#: (two BLAS threads in each process, spinning while they waited for each other, made two processes' planning tests
+#: 3.6 times slower than one's); a setting already in the environment is kept
+for _pool in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_pool, "1")
 
-from gyrocomp import Compensator, apply
-from gyrocomp.models.fit import fit_channels
-from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording
-from gyrocomp.simulation import GyroErrorModel, simulate
+import numpy as np  # noqa: E402 - after the thread pools' setting, which numpy's BLAS reads when it loads
+import pytest  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+from gyrocomp import Compensator, apply  # noqa: E402
+from gyrocomp.models.fit import fit_channels  # noqa: E402
+from gyrocomp.recording import ACCEL_AXES, GYRO_AXES, Recording  # noqa: E402
+from gyrocomp.simulation import GyroErrorModel, simulate  # noqa: E402
+
+if os.environ["OPENBLAS_NUM_THREADS"] == "1":
+    threadpool_limits(1, user_api="blas")  # a BLAS a plugin loaded before the setting above
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"
